@@ -1,0 +1,62 @@
+//! The facade's error type.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in the facade: state files, and the lower crates' errors.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A file system operation failed.
+    #[error("{}: cannot {op}: {source}", path.display())]
+    Io {
+        /// The file or directory concerned.
+        path: PathBuf,
+        /// What was being done, e.g. "read state file".
+        op: &'static str,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// The file does not start with the state file's magic bytes.
+    #[error("{}: not a tandem state file (missing magic bytes \"TANDEMST\")", path.display())]
+    NotAStateFile {
+        /// The file concerned.
+        path: PathBuf,
+    },
+    /// The file was written by a build with another state format version.
+    #[error("{}: state format version {found}, this build reads version {expected}", path.display())]
+    UnsupportedVersion {
+        /// The file concerned.
+        path: PathBuf,
+        /// The version in the file.
+        found: u32,
+        /// The version this build reads ([`crate::state::FORMAT_VERSION`]).
+        expected: u32,
+    },
+    /// The file is shorter than its header announces.
+    #[error("{}: truncated state file: {found_bytes} bytes, expected {expected_bytes}", path.display())]
+    Truncated {
+        /// The file concerned.
+        path: PathBuf,
+        /// The length the header announces (bytes), or the header length if the header is cut.
+        expected_bytes: u64,
+        /// The actual length (bytes).
+        found_bytes: u64,
+    },
+    /// The file has the right length but its content is damaged.
+    #[error("{}: corrupt state file: {why}", path.display())]
+    Corrupt {
+        /// The file concerned.
+        path: PathBuf,
+        /// What is wrong (checksum, decoding, trailing bytes).
+        why: String,
+    },
+    /// The state could not be serialized.
+    #[error("cannot encode state: {source}")]
+    Encode {
+        /// The serializer's error.
+        source: postcard::Error,
+    },
+}
+
+/// Result alias of the facade.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
