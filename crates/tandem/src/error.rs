@@ -50,6 +50,14 @@ pub enum Error {
         /// What is wrong (checksum, decoding, trailing bytes).
         why: String,
     },
+    /// A parameter is out of its documented range.
+    #[error("parameter `{name}` {why}")]
+    BadParam {
+        /// The parameter's field name.
+        name: &'static str,
+        /// What its value must be.
+        why: &'static str,
+    },
     /// The state could not be serialized.
     #[error("cannot encode state: {source}")]
     Encode {

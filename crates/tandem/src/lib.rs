@@ -19,5 +19,6 @@
 
 pub mod error;
 pub mod state;
+pub mod study;
 
 pub use error::{Error, Result};

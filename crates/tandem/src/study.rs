@@ -1,0 +1,409 @@
+//! The simulated study of §III (Fig. 5): configuration, per-iteration records, summaries.
+//!
+//! A trial starts from the demonstrations, schedules, runs a pair of executions in the
+//! simulated workcell, records them (Eq. 21), re-schedules, and so on for
+//! `executions / 2` pairs. Iteration `k` is the schedule made after `k` recorded pairs
+//! (iteration 0: demonstrations only) together with the outcome of running the next pair
+//! under it (none for the last iteration).
+
+use std::fmt::Write as _;
+
+use serde::{Deserialize, Serialize};
+
+use crate::{Error, Result};
+
+/// Study configuration (`fixtures/study.toml`, §III).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StudyConfig {
+    /// Independent trials (paper: 5). Default: 5.
+    pub trials: usize,
+    /// Executions per trial, run in pairs, so must be even (paper: 300). Default: 300.
+    pub executions: usize,
+    /// Sampler iterations per re-schedule (paper: 5000). Default: 5000.
+    pub samples: usize,
+    /// Master seed; trial `k` is seeded from `(seed, k)` only. Default: 2023.
+    pub seed: u64,
+    /// Probability that the simulated operator misses a needed correction (§III: 1 %).
+    /// Default: 0.01.
+    pub miss_rate: f64,
+    /// Probability that the operator corrects a sample that needs none (§III: 1 %).
+    /// Default: 0.01.
+    pub false_correction_rate: f64,
+    /// Iterations whose schedules Fig. 5 draws as examples (trial 0). Default: 0, 25, 50, 100, 150.
+    pub example_iterations: Vec<usize>,
+}
+
+impl Default for StudyConfig {
+    fn default() -> Self {
+        Self {
+            trials: 5,
+            executions: 300,
+            samples: 5000,
+            seed: 2023,
+            miss_rate: 0.01,
+            false_correction_rate: 0.01,
+            example_iterations: vec![0, 25, 50, 100, 150],
+        }
+    }
+}
+
+impl StudyConfig {
+    /// Number of execution pairs per trial (`executions / 2`).
+    pub fn n_pairs(&self) -> usize {
+        self.executions / 2
+    }
+
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] naming the first invalid field.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name: &'static str, why: &'static str| Err(Error::BadParam { name, why });
+        if self.trials == 0 {
+            return bad("trials", "must be at least 1");
+        }
+        if self.executions == 0 || self.executions % 2 != 0 {
+            return bad(
+                "executions",
+                "must be a positive even number (executions run in pairs)",
+            );
+        }
+        if self.samples == 0 {
+            return bad("samples", "must be at least 1");
+        }
+        for (name, p) in [
+            ("miss_rate", self.miss_rate),
+            ("false_correction_rate", self.false_correction_rate),
+        ] {
+            if !(0.0..=1.0).contains(&p) {
+                return bad(name, "must be a probability in [0, 1]");
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What happened when a pair of executions ran under one schedule.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PairStats {
+    /// Control ticks in which both robots traversed a low-confidence sample (must be 0).
+    pub overlap_ticks: usize,
+    /// Share of the pair's duration (ticks) in which no robot was low-confidence, in [0, 1].
+    pub operator_idle_share: f64,
+    /// Actual duration of the pair (s, global time), from the start until both finished.
+    pub duration_s: f64,
+    /// Ticks in which a robot was low-confidence (supervised), both robots together.
+    pub supervised_ticks: usize,
+    /// Supervised ticks in which the operator corrected, both robots together.
+    pub corrected_ticks: usize,
+}
+
+/// One iteration of a trial: a schedule and what running it gave.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IterationRecord {
+    /// Pairs recorded before this schedule was made (0 = demonstrations only).
+    pub iteration: usize,
+    /// Planned `T_total` (Eq. 13, s).
+    pub t_total_s: f64,
+    /// Planned offset `τ` of robot 2 (s, global time).
+    pub offset_s: f64,
+    /// Share of reference samples that are high-confidence (Eq. 12), in percent.
+    pub high_conf_pct: f64,
+    /// Planned low-confidence intervals `[start_s, end_s)` of robot 1 and robot 2 (global time, s).
+    pub lc_intervals_s: [Vec<[f64; 2]>; 2],
+    /// The outcome of running the next pair under this schedule (`None` for the last one).
+    pub pair: Option<PairStats>,
+}
+
+/// One trial: its seed and every iteration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrialResult {
+    /// Trial index `k`.
+    pub trial: usize,
+    /// Seed of the trial, derived from `(seed, k)` by [`trial_seed`].
+    pub seed: u64,
+    /// Iterations `0..=n_pairs`.
+    pub iterations: Vec<IterationRecord>,
+}
+
+/// The whole study: everything the JSON output holds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StudyResult {
+    /// The configuration it ran with.
+    pub config: StudyConfig,
+    /// Reference samples of the task (`T_ref`).
+    pub n_ref: usize,
+    /// Reference sample period `Δt_s` (s).
+    pub dt_s: f64,
+    /// Ground truth (§III): percent of reference samples outside the sanding of passes 1–3.
+    pub ground_truth_pct: f64,
+    /// The trials, in trial order.
+    pub trials: Vec<TrialResult>,
+}
+
+/// Per-iteration statistics across trials.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IterationSummary {
+    /// Iteration index (pairs recorded).
+    pub iteration: usize,
+    /// Mean planned `T_total` across trials (s).
+    pub t_total_mean_s: f64,
+    /// Sample standard deviation of `T_total` across trials (s); 0 for a single trial.
+    pub t_total_std_s: f64,
+    /// Mean percent of high-confidence reference samples across trials.
+    pub high_conf_pct_mean: f64,
+    /// Overlap ticks summed across trials (must be 0).
+    pub overlap_ticks: usize,
+}
+
+/// Seed of trial `trial` from the master `seed`: SplitMix64 of both, so trials are
+/// independent of each other and of the order in which threads run them.
+pub fn trial_seed(seed: u64, trial: usize) -> u64 {
+    splitmix64(seed ^ splitmix64(trial as u64 + 1))
+}
+
+/// One SplitMix64 output for state `x` (Steele, Lea & Flood 2014).
+fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+impl StudyResult {
+    /// Mean and standard deviation of each iteration across trials (Fig. 5 top and bottom).
+    pub fn summary(&self) -> Vec<IterationSummary> {
+        let n_iter = self
+            .trials
+            .iter()
+            .map(|t| t.iterations.len())
+            .min()
+            .unwrap_or(0);
+        (0..n_iter)
+            .map(|k| {
+                let recs: Vec<&IterationRecord> =
+                    self.trials.iter().map(|t| &t.iterations[k]).collect();
+                let (mean, std) = mean_std(recs.iter().map(|r| r.t_total_s));
+                let (hc, _) = mean_std(recs.iter().map(|r| r.high_conf_pct));
+                IterationSummary {
+                    iteration: recs[0].iteration,
+                    t_total_mean_s: mean,
+                    t_total_std_s: std,
+                    high_conf_pct_mean: hc,
+                    overlap_ticks: recs
+                        .iter()
+                        .filter_map(|r| r.pair.as_ref())
+                        .map(|p| p.overlap_ticks)
+                        .sum(),
+                }
+            })
+            .collect()
+    }
+
+    /// Total overlap ticks over every pair of every trial (must be 0).
+    pub fn total_overlap_ticks(&self) -> usize {
+        self.trials
+            .iter()
+            .flat_map(|t| &t.iterations)
+            .filter_map(|r| r.pair.as_ref())
+            .map(|p| p.overlap_ticks)
+            .sum()
+    }
+
+    /// One CSV row per trial and iteration. Columns: `trial, iteration, t_total_s, offset_s,
+    /// high_conf_pct, overlap_ticks, operator_idle_share, duration_s, supervised_ticks,
+    /// corrected_ticks, lc_intervals_robot1_s, lc_intervals_robot2_s`; pair columns are
+    /// empty for the last iteration; intervals are `start-end` pairs (s) joined by `;`.
+    pub fn to_csv(&self) -> String {
+        let mut out = String::from(
+            "trial,iteration,t_total_s,offset_s,high_conf_pct,overlap_ticks,\
+             operator_idle_share,duration_s,supervised_ticks,corrected_ticks,\
+             lc_intervals_robot1_s,lc_intervals_robot2_s\n",
+        );
+        for t in &self.trials {
+            for r in &t.iterations {
+                let pair = match &r.pair {
+                    Some(p) => format!(
+                        "{},{},{},{},{}",
+                        p.overlap_ticks,
+                        p.operator_idle_share,
+                        p.duration_s,
+                        p.supervised_ticks,
+                        p.corrected_ticks
+                    ),
+                    None => ",,,,".to_string(),
+                };
+                let intervals = |v: &[[f64; 2]]| {
+                    v.iter()
+                        .map(|[a, b]| format!("{a:.3}-{b:.3}"))
+                        .collect::<Vec<_>>()
+                        .join(";")
+                };
+                // Writing to a String cannot fail.
+                let _ = writeln!(
+                    out,
+                    "{},{},{},{},{},{},{},{}",
+                    t.trial,
+                    r.iteration,
+                    r.t_total_s,
+                    r.offset_s,
+                    r.high_conf_pct,
+                    pair,
+                    intervals(&r.lc_intervals_s[0]),
+                    intervals(&r.lc_intervals_s[1]),
+                );
+            }
+        }
+        out
+    }
+}
+
+/// Mean and sample standard deviation (0 for fewer than two values).
+fn mean_std(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let v: Vec<f64> = values.collect();
+    if v.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    if v.len() < 2 {
+        return (mean, 0.0);
+    }
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, var.sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(iteration: usize, t_total_s: f64, pair: bool) -> IterationRecord {
+        IterationRecord {
+            iteration,
+            t_total_s,
+            offset_s: 1.0,
+            high_conf_pct: 10.0 * iteration as f64,
+            lc_intervals_s: [vec![[0.0, 1.5]], vec![[2.0, 2.25], [3.0, 4.0]]],
+            pair: pair.then_some(PairStats {
+                overlap_ticks: 0,
+                operator_idle_share: 0.5,
+                duration_s: t_total_s,
+                supervised_ticks: 10,
+                corrected_ticks: 4,
+            }),
+        }
+    }
+
+    fn result() -> StudyResult {
+        let trial = |k: usize, a: f64, b: f64| TrialResult {
+            trial: k,
+            seed: trial_seed(1, k),
+            iterations: vec![record(0, a, true), record(1, b, false)],
+        };
+        StudyResult {
+            config: StudyConfig::default(),
+            n_ref: 100,
+            dt_s: 0.01,
+            ground_truth_pct: 50.0,
+            trials: vec![trial(0, 10.0, 8.0), trial(1, 12.0, 8.0)],
+        }
+    }
+
+    #[test]
+    fn defaults_are_the_papers_study() {
+        let c = StudyConfig::default();
+        assert_eq!((c.trials, c.executions, c.samples), (5, 300, 5000));
+        assert_eq!(c.n_pairs(), 150);
+        assert_eq!((c.miss_rate, c.false_correction_rate), (0.01, 0.01));
+        c.validate().unwrap();
+    }
+
+    #[test]
+    fn bad_configs_name_the_field() {
+        let cases: [(StudyConfig, &str); 4] = [
+            (
+                StudyConfig {
+                    trials: 0,
+                    ..Default::default()
+                },
+                "trials",
+            ),
+            (
+                StudyConfig {
+                    executions: 7,
+                    ..Default::default()
+                },
+                "executions",
+            ),
+            (
+                StudyConfig {
+                    samples: 0,
+                    ..Default::default()
+                },
+                "samples",
+            ),
+            (
+                StudyConfig {
+                    miss_rate: f64::NAN,
+                    ..Default::default()
+                },
+                "miss_rate",
+            ),
+        ];
+        for (c, name) in cases {
+            let err = c.validate().unwrap_err();
+            assert!(
+                matches!(err, Error::BadParam { name: n, .. } if n == name),
+                "{err}"
+            );
+        }
+    }
+
+    #[test]
+    fn config_reads_from_toml_with_defaults_and_rejects_unknown_keys() {
+        let c: StudyConfig = toml::from_str("trials = 2\nseed = 7\n").unwrap();
+        assert_eq!((c.trials, c.seed, c.executions), (2, 7, 300));
+        assert!(toml::from_str::<StudyConfig>("trails = 2\n").is_err());
+    }
+
+    #[test]
+    fn trial_seeds_differ_and_are_stable() {
+        let seeds: Vec<u64> = (0..5).map(|k| trial_seed(2023, k)).collect();
+        for i in 0..5 {
+            for j in 0..i {
+                assert_ne!(seeds[i], seeds[j]);
+            }
+        }
+        assert_eq!(trial_seed(2023, 3), seeds[3]);
+        assert_ne!(trial_seed(2024, 0), seeds[0]);
+    }
+
+    #[test]
+    fn summary_is_mean_and_sample_std_across_trials() {
+        let s = result().summary();
+        assert_eq!(s.len(), 2);
+        // Trials give 10 and 12: mean 11, sample std sqrt(2).
+        assert_eq!(s[0].t_total_mean_s, 11.0);
+        assert!((s[0].t_total_std_s - 2f64.sqrt()).abs() < 1e-12);
+        assert_eq!((s[1].t_total_mean_s, s[1].t_total_std_s), (8.0, 0.0));
+        assert_eq!(s[1].high_conf_pct_mean, 10.0);
+    }
+
+    #[test]
+    fn csv_has_one_row_per_trial_and_iteration() {
+        let csv = result().to_csv();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 1 + 4);
+        let n_cols = lines[0].split(',').count();
+        assert_eq!(n_cols, 12);
+        for l in &lines[1..] {
+            assert_eq!(l.split(',').count(), n_cols, "{l}");
+        }
+        assert_eq!(
+            lines[1],
+            "0,0,10,1,0,0,0.5,10,10,4,0.000-1.500,2.000-2.250;3.000-4.000"
+        );
+        assert!(lines[2].starts_with("0,1,8,1,10,,,,,,"));
+    }
+}
