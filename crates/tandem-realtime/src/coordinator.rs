@@ -1,0 +1,241 @@
+//! Runtime coordinator: advances two robots one control tick at a time (§II-B5).
+
+use crate::error::{Error, Result};
+use crate::strategy::{high_conf_steps, response_step};
+use crate::timeline::{Timeline, clock_tolerance_s};
+
+/// What one [`Coordinator::tick`] did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tick {
+    /// Each robot's fractional reference time (reference samples, in `[0, T_ref]`) at the end of
+    /// the tick (Eq. 15 applied to its schedule clock).
+    pub ref_time: [f64; 2],
+    /// Whether each robot traversed ANY low-confidence reference sample during this tick
+    /// (see [`Coordinator`] for the exact, conservative definition).
+    pub low_conf: [bool; 2],
+    /// Whether each robot is running (started and not finished) during the tick: its schedule
+    /// clock moved inside `[τ_i, τ_i + |ψ_E|)`.
+    pub running: [bool; 2],
+}
+
+/// Per-robot monotone cursors into its timeline (all O(1) amortized).
+#[derive(Clone, Copy, Debug, Default)]
+struct Cursors {
+    /// Sample containing the schedule clock (mode and rates are read here).
+    at: usize,
+    /// Sample containing `clock − tol` (first sample a tick may traverse).
+    lo: usize,
+    /// Sample containing `clock + tol` (last sample a tick may traverse).
+    hi: usize,
+}
+
+/// Phase of one robot at the start of a tick.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Phase {
+    /// Schedule clock before `τ_i`: its start shifts with the other robot's steps.
+    Waiting,
+    /// Running; `low_conf` is the confidence of the sample it is in at the tick start.
+    Active { low_conf: bool },
+    /// Schedule clock at its end.
+    Finished,
+}
+
+/// Runtime coordinator (§II-B5): holds two timelines and advances both robots' schedule clocks
+/// one control period `tick_s` (real seconds) per [`tick`](Coordinator::tick).
+///
+/// Rules per tick (modes, rates and bounds are read at each robot's sample at the tick start):
+/// - a low-confidence robot steps at the operator's rate: operator gradient `g`, clamped to
+///   `[ψ̇min, ψ̇max]`, gives the schedule-clock step `(ψ̇_E/g)·tick_s ∈ [S·tick_s, F·tick_s]`;
+/// - the other robot, if running and high-confidence, responds with Eq. 18 to the lead measured
+///   after the low-confidence robot's step;
+/// - both high-confidence: `HIGH-CONF` (Alg. 1), the ahead robot (robot 0 when level) is `a`;
+/// - both low-confidence (a state `sufficient_margins` excludes): both follow the operator;
+/// - a robot running alone (the other finished, or not started) needs no adaptation: it runs on
+///   schedule (step `tick_s`) when high-confidence, at the operator's rate when low-confidence;
+/// - before the later robot starts, its schedule clock moves with the earlier robot's steps
+///   (its start shifts by the earlier robot's deviation), capped at its start `τ`, so it starts
+///   at a tick boundary at its first sample, at most one step behind the earlier robot;
+/// - once a robot has finished, the other needs no adaptation.
+///
+/// `low_conf[i]` is true when robot `i` moved during the tick and any low-confidence reference
+/// sample intersects its traversed schedule-clock interval `[s_start − tol, s_end + tol]` (clipped
+/// to `[τ_i, τ_i + |ψ_E|)`), `tol` = [`clock_tolerance_s`]: the tolerance only ever *adds*
+/// low-confidence reports.
+///
+/// [`tick`](Coordinator::tick) never allocates and is O(1) amortized: confidence is looked up
+/// through prefix counts and monotone cursors (schedule clocks never decrease).
+#[derive(Clone, Debug)]
+pub struct Coordinator {
+    robots: [Timeline; 2],
+    tick_s: f64,
+    tol_s: f64,
+    clock_s: [f64; 2],
+    cursors: [Cursors; 2],
+}
+
+impl Coordinator {
+    /// Builds a coordinator with both schedule clocks at the earlier start `min(τ_0, τ_1)`.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] if `tick_s` is not finite and > 0.
+    pub fn new(robots: [Timeline; 2], tick_s: f64) -> Result<Coordinator> {
+        if !(tick_s.is_finite() && tick_s > 0.0) {
+            return Err(Error::BadParam {
+                name: "tick_s",
+                why: "must be finite and > 0",
+            });
+        }
+        let tol_s = clock_tolerance_s(&robots, tick_s);
+        let t0 = robots[0].start_s().min(robots[1].start_s());
+        Ok(Coordinator {
+            robots,
+            tick_s,
+            tol_s,
+            clock_s: [t0, t0],
+            cursors: [Cursors::default(); 2],
+        })
+    }
+
+    /// The two timelines.
+    pub fn robots(&self) -> &[Timeline; 2] {
+        &self.robots
+    }
+
+    /// Control period (real seconds).
+    pub fn tick_s(&self) -> f64 {
+        self.tick_s
+    }
+
+    /// Each robot's schedule clock `s_i` (s, global/schedule-clock frame).
+    pub fn clock_s(&self) -> [f64; 2] {
+        self.clock_s
+    }
+
+    /// Whether both robots have finished.
+    pub fn is_finished(&self) -> bool {
+        (0..2).all(|i| self.clock_s[i] >= self.robots[i].end_s())
+    }
+
+    fn phase(&mut self, i: usize) -> Phase {
+        let r = &self.robots[i];
+        let s = self.clock_s[i];
+        if s >= r.end_s() {
+            Phase::Finished
+        } else if s < r.start_s() {
+            Phase::Waiting
+        } else {
+            let n = r.advance_cursor(&mut self.cursors[i].at, s);
+            Phase::Active {
+                low_conf: !r.conf()[n],
+            }
+        }
+    }
+
+    /// Schedule-clock step of robot `i` commanded by the operator's gradient `g`.
+    fn operator_step(&self, i: usize, g: f64) -> f64 {
+        let r = &self.robots[i];
+        let n = self.cursors[i].at;
+        let (lo, hi) = (r.grad_min()[n], r.grad_max()[n]);
+        let g = if g.is_nan() {
+            r.grad_exec()[n]
+        } else {
+            g.clamp(lo, hi)
+        };
+        r.grad_exec()[n] / g * self.tick_s
+    }
+
+    /// Step of a robot that runs without a partner to adapt to.
+    fn alone_step(&self, i: usize, low_conf: bool, g: f64) -> f64 {
+        if low_conf {
+            self.operator_step(i, g)
+        } else {
+            self.tick_s
+        }
+    }
+
+    /// Advances one control period. `operator_gradient` is the execution gradient the
+    /// operator's correction commands for the low-confidence robot (clamped to that robot's
+    /// `[ψ̇min, ψ̇max]` at its current sample; NaN means "no change", the scheduled `ψ̇_E`);
+    /// it is ignored when no robot is low-confidence.
+    pub fn tick(&mut self, operator_gradient: f64) -> Tick {
+        let g = operator_gradient;
+        let h = self.tick_s;
+        let phases = [self.phase(0), self.phase(1)];
+        let rates = |c: &Self, i: usize| c.robots[i].rates(c.cursors[i].at);
+        let mut step = [0.0_f64; 2];
+        match phases {
+            [Phase::Active { low_conf: l0 }, Phase::Active { low_conf: l1 }] => match (l0, l1) {
+                (false, false) => {
+                    let (a, b) = if self.clock_s[0] >= self.clock_s[1] {
+                        (0, 1)
+                    } else {
+                        (1, 0)
+                    };
+                    let lead = self.clock_s[a] - self.clock_s[b];
+                    let (da, db) = high_conf_steps(lead, rates(self, a), rates(self, b), h);
+                    step[a] = da;
+                    step[b] = db;
+                }
+                (true, true) => {
+                    step = [self.operator_step(0, g), self.operator_step(1, g)];
+                }
+                (l0, _) => {
+                    let (lc, resp) = if l0 { (0, 1) } else { (1, 0) };
+                    step[lc] = self.operator_step(lc, g);
+                    let lead = self.clock_s[resp] - (self.clock_s[lc] + step[lc]);
+                    step[resp] = response_step(lead, rates(self, resp), h);
+                }
+            },
+            [Phase::Active { low_conf }, other] | [other, Phase::Active { low_conf }] => {
+                let act = if matches!(phases[0], Phase::Active { .. }) {
+                    0
+                } else {
+                    1
+                };
+                step[act] = self.alone_step(act, low_conf, g);
+                if other == Phase::Waiting {
+                    step[1 - act] = step[act];
+                }
+            }
+            _ => {
+                // Nobody running: a waiting robot's clock runs on schedule.
+                for (i, p) in phases.iter().enumerate() {
+                    if *p == Phase::Waiting {
+                        step[i] = h;
+                    }
+                }
+            }
+        }
+        let mut out = Tick {
+            ref_time: [0.0; 2],
+            low_conf: [false; 2],
+            running: [false; 2],
+        };
+        for i in 0..2 {
+            let r = &self.robots[i];
+            let s_old = self.clock_s[i];
+            let cap = if phases[i] == Phase::Waiting {
+                r.start_s()
+            } else {
+                r.end_s()
+            };
+            let s_new = (s_old + step[i]).min(cap).max(s_old);
+            self.clock_s[i] = s_new;
+            let moved = s_new > s_old;
+            out.running[i] = moved && s_new > r.start_s() && s_old < r.end_s();
+            if moved
+                && s_new + self.tol_s >= r.start_s()
+                && phases[i] != Phase::Waiting
+                && s_old - self.tol_s < r.end_s()
+            {
+                let cur = &mut self.cursors[i];
+                let lo = r.advance_cursor(&mut cur.lo, s_old - self.tol_s);
+                let hi = r.advance_cursor(&mut cur.hi, s_new + self.tol_s);
+                out.low_conf[i] = r.any_low_conf(lo, hi);
+            }
+            let n = r.advance_cursor(&mut self.cursors[i].at, s_new);
+            out.ref_time[i] = r.ref_time_in(n, s_new);
+        }
+        out
+    }
+}

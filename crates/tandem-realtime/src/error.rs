@@ -1,0 +1,47 @@
+//! Error type of the crate.
+
+/// Everything that can go wrong when building timelines, checking margins or coordinating.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A timeline needs at least one reference sample.
+    #[error("timeline is empty: at least one reference sample is required")]
+    EmptyTimeline,
+    /// Two per-sample slices of one timeline have different lengths.
+    #[error("`{what}` has {found} samples, expected {expected} (length of `conf`)")]
+    LengthMismatch {
+        /// Name of the offending slice.
+        what: &'static str,
+        /// Expected length (T_ref, the length of `conf`).
+        expected: usize,
+        /// Length found.
+        found: usize,
+    },
+    /// A value is NaN or infinite.
+    #[error("`{what}` is not finite at reference sample {index}")]
+    NonFinite {
+        /// Name of the offending input.
+        what: &'static str,
+        /// Reference sample index (0 for scalars).
+        index: usize,
+    },
+    /// Gradients at one reference sample violate `0 < ψ̇min ≤ ψ̇_E ≤ ψ̇max`.
+    #[error("gradients at reference sample {index}: {why}")]
+    BadGradient {
+        /// Reference sample index.
+        index: usize,
+        /// What is wrong.
+        why: &'static str,
+    },
+    /// A scalar parameter is out of its valid range.
+    #[error("parameter `{name}` {why}")]
+    BadParam {
+        /// Parameter name.
+        name: &'static str,
+        /// What is wrong.
+        why: &'static str,
+    },
+}
+
+/// Result alias of the crate.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

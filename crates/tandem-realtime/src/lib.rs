@@ -1,0 +1,53 @@
+//! Real-time timing strategy, worst-case margins and runtime coordinator (paper §II-B5,
+//! Eq. 15–18, Alg. 1 and Alg. 2; DESIGN.md "tandem-realtime").
+//!
+//! Two robots do the same task in parallel under one operator. Each robot's plan is a
+//! [`Timeline`] in *schedule-clock* time (global seconds at which the schedule planned a
+//! reference position, Eq. 15–16). At run time the operator's corrections speed up or slow down
+//! the low-confidence robot; the [`Coordinator`] lets the other robot respond (Eq. 18, Alg. 1) so
+//! that the two schedule clocks stay close. [`sufficient_margins`] checks, before execution,
+//! that no admissible operator can make both robots low-confidence in the same control tick —
+//! a conservative, discretization-safe version of Alg. 2 (see [`margins`](crate::margins)).
+//!
+//! Time frames: reference sample index `n` (period `Δt_s`), schedule-clock/global time in
+//! seconds, control tick `tick_s` in real seconds.
+//!
+//! ```
+//! use tandem_realtime::{Coordinator, Timeline, sufficient_margins};
+//!
+//! // 6 reference samples of 0.1 s; samples 1 and 2 are low confidence (false).
+//! let conf = [true, false, false, true, true, true];
+//! let mean = [1.0; 6];
+//! let (lo, hi) = ([0.8; 6], [1.25; 6]);
+//! let dt_s = 0.1;
+//! // Robot 1 starts at 0; robot 2 starts τ = 0.45 s later on the same plan.
+//! let r1 = Timeline::new(&conf, &mean, &lo, &hi, 0.0, dt_s)?;
+//! let r2 = Timeline::new(&conf, &mean, &lo, &hi, 0.45, dt_s)?;
+//! assert_eq!(r1.end_s(), 0.6);
+//! let robots = [r1, r2];
+//! let tick_s = 0.05;
+//! assert!(sufficient_margins(&robots, tick_s)?);
+//! // Too small an offset is rejected.
+//! let r2_early = Timeline::new(&conf, &mean, &lo, &hi, 0.2, dt_s)?;
+//! assert!(!sufficient_margins(&[robots[0].clone(), r2_early], tick_s)?);
+//!
+//! // Run with an operator who slows the low-confidence robot down as much as allowed.
+//! let mut coord = Coordinator::new(robots, tick_s)?;
+//! while !coord.is_finished() {
+//!     let tick = coord.tick(f64::INFINITY);
+//!     assert!(!(tick.low_conf[0] && tick.low_conf[1]));
+//! }
+//! # Ok::<(), tandem_realtime::Error>(())
+//! ```
+
+mod coordinator;
+mod error;
+pub mod margins;
+mod strategy;
+mod timeline;
+
+pub use coordinator::{Coordinator, Tick};
+pub use error::{Error, Result};
+pub use margins::{sufficient_margins, sufficient_margins_per_pair, sufficient_margins_printed};
+pub use strategy::{high_conf_steps, response_step};
+pub use timeline::{Rates, Timeline, clock_tolerance_s};
