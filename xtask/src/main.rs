@@ -4,6 +4,8 @@
 //! dispatches, so that tasks added by different issues do not touch each other's code.
 #![allow(clippy::print_stdout, reason = "xtask reports to the terminal")]
 
+mod fig5;
+
 use clap::{Parser, Subcommand};
 
 /// Command line of `cargo xtask`.
@@ -16,9 +18,23 @@ struct Cli {
 
 /// The tasks.
 #[derive(Subcommand)]
-enum Cmd {}
+enum Cmd {
+    /// Render Fig. 5 from a synthetic, clearly labelled demo dataset (exercises the plot).
+    #[command(hide = true)]
+    Fig5Demo {
+        /// Output directory (created if missing) for fig5-demo.svg and fig5-demo.png.
+        #[arg(long)]
+        out: std::path::PathBuf,
+    },
+}
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    match cli.cmd {}
+    match cli.cmd {
+        Cmd::Fig5Demo { out } => {
+            let (svg, png) = fig5::run_demo(&out)?;
+            println!("wrote {} and {}", svg.display(), png.display());
+            Ok(())
+        }
+    }
 }
