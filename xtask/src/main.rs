@@ -5,6 +5,7 @@
 #![allow(clippy::print_stdout, reason = "xtask reports to the terminal")]
 
 mod fig5;
+mod fixtures;
 
 use clap::{Parser, Subcommand};
 
@@ -19,6 +20,12 @@ struct Cli {
 /// The tasks.
 #[derive(Subcommand)]
 enum Cmd {
+    /// Regenerate the sanding demonstrations in fixtures/sanding/ (see fixtures/README.md).
+    Fixtures {
+        /// Write nothing; fail, naming the files, if the committed fixtures differ.
+        #[arg(long)]
+        check: bool,
+    },
     /// Render Fig. 5 from a synthetic, clearly labelled demo dataset (exercises the plot).
     #[command(hide = true)]
     Fig5Demo {
@@ -31,6 +38,7 @@ enum Cmd {
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.cmd {
+        Cmd::Fixtures { check } => fixtures::run(check),
         Cmd::Fig5Demo { out } => {
             let (svg, png) = fig5::run_demo(&out)?;
             println!("wrote {} and {}", svg.display(), png.display());
