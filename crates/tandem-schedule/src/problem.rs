@@ -1,0 +1,331 @@
+//! The scheduling problem: confidence and warp-gradient bounds per reference sample (Eq. 12, 14).
+
+use serde::{Deserialize, Serialize};
+
+use crate::schedule::Schedule;
+use crate::{Error, Result};
+
+/// A maximal run of reference samples with the same confidence.
+///
+/// Reference time frame: samples `start..end` (end exclusive) of the reference demonstration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Run {
+    /// First reference sample of the run.
+    pub start: usize,
+    /// One past the last reference sample of the run.
+    pub end: usize,
+    /// `true` when every sample of the run is high-confidence (Eq. 12).
+    pub high_conf: bool,
+}
+
+/// The scheduling problem of Eq. 13–20 for two robots doing the same task.
+///
+/// Everything is indexed by reference sample `n ∈ 0..T_ref` (period `dt_s`). Gradients are
+/// warp gradients `ψ̇` in execution samples per reference sample (2.0 = half speed):
+/// `grad_mean` is the mean demonstration gradient `ψ̇̄_D` (followed on low-confidence samples,
+/// Eq. 20 constraint 4), `grad_min`/`grad_max` are `ψ̇min`/`ψ̇max` (Eq. 14). Build it with
+/// [`Problem::new`], which checks `0 < ψ̇min ≤ ψ̇̄ ≤ ψ̇max` everywhere.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "ProblemData", into = "ProblemData")]
+pub struct Problem {
+    conf: Vec<bool>,
+    grad_mean: Vec<f64>,
+    grad_min: Vec<f64>,
+    grad_max: Vec<f64>,
+    dt_s: f64,
+    runs: Vec<Run>,
+}
+
+/// Serialized form of [`Problem`]; deserialization goes through [`Problem::new`].
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ProblemData {
+    conf: Vec<bool>,
+    grad_mean: Vec<f64>,
+    grad_min: Vec<f64>,
+    grad_max: Vec<f64>,
+    dt_s: f64,
+}
+
+impl TryFrom<ProblemData> for Problem {
+    type Error = Error;
+    fn try_from(d: ProblemData) -> Result<Self> {
+        Problem::new(d.conf, d.grad_mean, d.grad_min, d.grad_max, d.dt_s)
+    }
+}
+
+impl From<Problem> for ProblemData {
+    fn from(p: Problem) -> Self {
+        ProblemData {
+            conf: p.conf,
+            grad_mean: p.grad_mean,
+            grad_min: p.grad_min,
+            grad_max: p.grad_max,
+            dt_s: p.dt_s,
+        }
+    }
+}
+
+impl Problem {
+    /// Checks and builds a problem.
+    ///
+    /// - `conf[n]`: `true` = high confidence at reference sample `n` (Eq. 12).
+    /// - `grad_mean[n]`, `grad_min[n]`, `grad_max[n]`: `ψ̇̄`, `ψ̇min`, `ψ̇max` (Eq. 14), execution
+    ///   samples per reference sample; must be finite with `0 < ψ̇min ≤ ψ̇̄ ≤ ψ̇max`.
+    /// - `dt_s`: reference sample period `Δt_s` (s), finite and > 0.
+    ///
+    /// All vectors must have the same length `T_ref ≥ 1`.
+    ///
+    /// # Errors
+    /// [`Error::Empty`], [`Error::LengthMismatch`], [`Error::NonFinite`], [`Error::BadBounds`]
+    /// (naming the first offending reference sample) or [`Error::BadParam`] for `dt_s`.
+    pub fn new(
+        conf: Vec<bool>,
+        grad_mean: Vec<f64>,
+        grad_min: Vec<f64>,
+        grad_max: Vec<f64>,
+        dt_s: f64,
+    ) -> Result<Self> {
+        if !(dt_s.is_finite() && dt_s > 0.0) {
+            return Err(Error::BadParam {
+                name: "dt_s",
+                why: "must be finite and > 0",
+            });
+        }
+        let n_ref = conf.len();
+        if n_ref == 0 {
+            return Err(Error::Empty);
+        }
+        for (name, v) in [
+            ("grad_mean", &grad_mean),
+            ("grad_min", &grad_min),
+            ("grad_max", &grad_max),
+        ] {
+            if v.len() != n_ref {
+                return Err(Error::LengthMismatch {
+                    name,
+                    len: v.len(),
+                    expected: n_ref,
+                });
+            }
+            if let Some(ref_idx) = v.iter().position(|x| !x.is_finite()) {
+                return Err(Error::NonFinite { name, ref_idx });
+            }
+        }
+        for ref_idx in 0..n_ref {
+            let (min, mean, max) = (grad_min[ref_idx], grad_mean[ref_idx], grad_max[ref_idx]);
+            if !(min > 0.0 && min <= mean && mean <= max) {
+                return Err(Error::BadBounds {
+                    ref_idx,
+                    min,
+                    mean,
+                    max,
+                });
+            }
+        }
+        let mut runs = Vec::new();
+        let mut start = 0;
+        for n in 1..=n_ref {
+            if n == n_ref || conf[n] != conf[start] {
+                runs.push(Run {
+                    start,
+                    end: n,
+                    high_conf: conf[start],
+                });
+                start = n;
+            }
+        }
+        Ok(Problem {
+            conf,
+            grad_mean,
+            grad_min,
+            grad_max,
+            dt_s,
+            runs,
+        })
+    }
+
+    /// Number of reference samples `T_ref` (≥ 1).
+    pub fn n_ref(&self) -> usize {
+        self.conf.len()
+    }
+
+    /// Confidence per reference sample: `true` = high (Eq. 12).
+    pub fn conf(&self) -> &[bool] {
+        &self.conf
+    }
+
+    /// Mean demonstration warp gradient `ψ̇̄` per reference sample.
+    pub fn grad_mean(&self) -> &[f64] {
+        &self.grad_mean
+    }
+
+    /// `ψ̇min` per reference sample (Eq. 14): the fastest permitted gradient.
+    pub fn grad_min(&self) -> &[f64] {
+        &self.grad_min
+    }
+
+    /// `ψ̇max` per reference sample (Eq. 14): the slowest permitted gradient.
+    pub fn grad_max(&self) -> &[f64] {
+        &self.grad_max
+    }
+
+    /// Reference sample period `Δt_s` (s).
+    pub fn dt_s(&self) -> f64 {
+        self.dt_s
+    }
+
+    /// Maximal runs of equal confidence, in reference order, covering `0..T_ref`.
+    pub fn runs(&self) -> &[Run] {
+        &self.runs
+    }
+
+    /// The fastest admissible execution warp: `ψ̇min` on high-confidence samples, `ψ̇̄` on
+    /// low-confidence ones (Eq. 20 constraints 1 and 4).
+    pub fn fastest_warp(&self) -> Vec<f64> {
+        (0..self.n_ref())
+            .map(|n| {
+                if self.conf[n] {
+                    self.grad_min[n]
+                } else {
+                    self.grad_mean[n]
+                }
+            })
+            .collect()
+    }
+
+    /// The fastest serial schedule (§II-C fallback): both robots on [`Problem::fastest_warp`],
+    /// robot 2 starting when robot 1 ends (`τ = |ψ_E1|`). Its `T_total` is twice the fastest
+    /// single execution. It satisfies every constraint of Eq. 20: no low-confidence overlap is
+    /// possible, since robot 2 starts only once robot 1 has finished.
+    pub fn serial_schedule(&self) -> Schedule {
+        let warp = self.fastest_warp();
+        // τ is robot 1's end exactly as the realtime timeline computes it (its own summation
+        // order), so that its margin check sees robot 2 start no earlier than robot 1 ends;
+        // the two sums differ by rounding only.
+        let sum_s = crate::schedule::execution_s(&warp, self.dt_s);
+        let offset_s = tandem_realtime::Timeline::new(
+            &self.conf,
+            &warp,
+            &self.grad_min,
+            &self.grad_max,
+            0.0,
+            self.dt_s,
+        )
+        .map_or(sum_s, |t| t.end_s().max(sum_s));
+        Schedule {
+            grad_exec: [warp.clone(), warp],
+            offset_s,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ok() -> Problem {
+        Problem::new(
+            vec![true, false, false, true],
+            vec![1.0; 4],
+            vec![0.5; 4],
+            vec![2.0; 4],
+            0.01,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn runs_cover_the_reference() {
+        let p = ok();
+        assert_eq!(
+            p.runs(),
+            &[
+                Run {
+                    start: 0,
+                    end: 1,
+                    high_conf: true
+                },
+                Run {
+                    start: 1,
+                    end: 3,
+                    high_conf: false
+                },
+                Run {
+                    start: 3,
+                    end: 4,
+                    high_conf: true
+                },
+            ]
+        );
+    }
+
+    #[test]
+    fn serial_schedule_by_hand() {
+        // HC at 0.5, LC at 1.0: |ψ_E| = (0.5 + 1 + 1 + 0.5)·0.01 = 0.03 s.
+        let s = ok().serial_schedule();
+        assert_eq!(s.grad_exec[0], vec![0.5, 1.0, 1.0, 0.5]);
+        assert!((s.offset_s - 0.03).abs() < 1e-12);
+        assert!((s.t_total_s(0.01) - 0.06).abs() < 1e-12);
+    }
+
+    #[test]
+    fn rejects_bad_input() {
+        let mk = |conf: Vec<bool>, mean: Vec<f64>, min: Vec<f64>, max: Vec<f64>, dt: f64| {
+            Problem::new(conf, mean, min, max, dt)
+        };
+        assert!(matches!(
+            mk(vec![], vec![], vec![], vec![], 0.01),
+            Err(Error::Empty)
+        ));
+        assert!(matches!(
+            mk(vec![true], vec![1.0], vec![1.0], vec![1.0], 0.0),
+            Err(Error::BadParam { name: "dt_s", .. })
+        ));
+        assert!(matches!(
+            mk(vec![true], vec![1.0, 1.0], vec![1.0], vec![1.0], 0.01),
+            Err(Error::LengthMismatch {
+                name: "grad_mean",
+                len: 2,
+                expected: 1
+            })
+        ));
+        assert!(matches!(
+            mk(
+                vec![true; 2],
+                vec![1.0; 2],
+                vec![1.0, f64::NAN],
+                vec![1.0; 2],
+                0.01
+            ),
+            Err(Error::NonFinite {
+                name: "grad_min",
+                ref_idx: 1
+            })
+        ));
+        assert!(matches!(
+            mk(
+                vec![true; 2],
+                vec![1.0, 0.4],
+                vec![0.5; 2],
+                vec![2.0; 2],
+                0.01
+            ),
+            Err(Error::BadBounds { ref_idx: 1, .. })
+        ));
+        assert!(matches!(
+            mk(vec![true], vec![1.0], vec![0.0], vec![2.0], 0.01),
+            Err(Error::BadBounds { ref_idx: 0, .. })
+        ));
+    }
+
+    #[test]
+    fn serde_goes_through_the_checks() {
+        let p = ok();
+        let json = serde_json::to_string(&p).unwrap();
+        let back: Problem = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, p);
+        let bad = json.replace("\"dt_s\":0.01", "\"dt_s\":-1.0");
+        assert!(serde_json::from_str::<Problem>(&bad).is_err());
+    }
+}

@@ -1,0 +1,164 @@
+//! The safety invariant end to end: schedules FOUND BY THE SAMPLER, run through
+//! `tandem_realtime::Coordinator` under random and extreme operator gradient sequences, never
+//! have both robots low-confidence in the same control tick.
+
+use proptest::prelude::*;
+use proptest::strategy::ValueTree;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use tandem_realtime::{Coordinator, Timeline};
+use tandem_schedule::{Problem, SamplerParams, Schedule, Source, sample_schedule};
+
+/// Operator gradient sequences (the coordinator clamps to the LC robot's `[ψ̇min, ψ̇max]`).
+#[derive(Clone, Copy, Debug)]
+enum Operator {
+    /// Always ψ̇min (fastest).
+    Fastest,
+    /// Always ψ̇max (slowest).
+    Slowest,
+    /// Alternate fastest/slowest every tick.
+    Switching,
+    /// Hold an extreme for a random number of ticks (1–20), then switch.
+    RandomSwitching,
+    /// A fresh random gradient in a range covering all bounds every tick.
+    Random,
+}
+
+const FAST: f64 = 0.0;
+const SLOW: f64 = 1e9;
+
+fn timelines(p: &Problem, s: &Schedule) -> [Timeline; 2] {
+    [0, 1].map(|i| {
+        Timeline::new(
+            p.conf(),
+            &s.grad_exec[i],
+            p.grad_min(),
+            p.grad_max(),
+            s.starts_s()[i],
+            p.dt_s(),
+        )
+        .expect("a validated schedule makes valid timelines")
+    })
+}
+
+/// Runs one execution; returns the first tick index with both robots low-confidence.
+fn run(p: &Problem, s: &Schedule, tick_s: f64, op: Operator, seed: u64) -> Option<usize> {
+    let mut c = Coordinator::new(timelines(p, s), tick_s).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    // Generous cap: every robot at its slowest, run serially, plus slack.
+    let slowest_s: f64 = p.grad_max().iter().sum::<f64>() * p.dt_s() * 4.0;
+    let max_ticks = (slowest_s / tick_s) as usize + 100;
+    let (mut hold, mut current) = (0usize, FAST);
+    for n in 0..max_ticks {
+        if c.is_finished() {
+            return None;
+        }
+        let g = match op {
+            Operator::Fastest => FAST,
+            Operator::Slowest => SLOW,
+            Operator::Switching => {
+                if n % 2 == 0 {
+                    FAST
+                } else {
+                    SLOW
+                }
+            }
+            Operator::RandomSwitching => {
+                if hold == 0 {
+                    current = if current == FAST { SLOW } else { FAST };
+                    hold = rng.random_range(1..=20);
+                }
+                hold -= 1;
+                current
+            }
+            Operator::Random => rng.random_range(0.1..3.0),
+        };
+        let t = c.tick(g);
+        if t.low_conf[0] && t.low_conf[1] {
+            return Some(n);
+        }
+    }
+    panic!("execution did not finish within {max_ticks} ticks");
+}
+
+/// Random small problems: confidence in runs (1–12 samples, HC runs twice as likely), random
+/// means and bounds per sample.
+fn random_problem() -> impl Strategy<Value = Problem> {
+    proptest::collection::vec((1usize..12, prop::bool::weighted(0.65)), 1..8)
+        .prop_flat_map(|blocks| {
+            let conf: Vec<bool> = blocks
+                .iter()
+                .flat_map(|&(len, hc)| std::iter::repeat_n(hc, len))
+                .collect();
+            let n = conf.len();
+            (
+                Just(conf),
+                proptest::collection::vec((0.5f64..2.0, 0.3f64..1.0, 1.0f64..2.5), n),
+            )
+        })
+        .prop_map(|(conf, g)| {
+            Problem::new(
+                conf,
+                g.iter().map(|x| x.0).collect(),
+                g.iter().map(|x| x.0 * x.1).collect(),
+                g.iter().map(|x| x.0 * x.2).collect(),
+                0.01,
+            )
+            .unwrap()
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(500))]
+
+    #[test]
+    fn sampled_schedules_never_overlap_at_runtime(
+        p in random_problem(),
+        seed in any::<u64>(),
+        tick_frac in 0.25f64..=1.0,
+        samples in 20usize..150,
+    ) {
+        let tick_s = tick_frac * p.dt_s();
+        let params = SamplerParams { samples, seed, tick_s: Some(tick_s), ..SamplerParams::default() };
+        let out = sample_schedule(&p, &params, None).unwrap();
+        for op in [
+            Operator::Fastest,
+            Operator::Slowest,
+            Operator::Switching,
+            Operator::RandomSwitching,
+            Operator::Random,
+        ] {
+            for rep in 0..2u64 {
+                let hit = run(&p, &out.schedule, tick_s, op, seed ^ rep);
+                prop_assert!(
+                    hit.is_none(),
+                    "both LC at tick {:?} with {:?} (source {:?})", hit, op, out.source
+                );
+            }
+        }
+    }
+}
+
+/// The proptest above must exercise sampled (overlapping) schedules, not only serial ones.
+#[test]
+fn most_random_problems_get_sampled_schedules() {
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    let strategy = random_problem();
+    let mut sampled = 0;
+    for seed in 0..40 {
+        let p = strategy.new_tree(&mut runner).unwrap().current();
+        let params = SamplerParams {
+            samples: 100,
+            seed,
+            ..SamplerParams::default()
+        };
+        let out = sample_schedule(&p, &params, None).unwrap();
+        if matches!(out.source, Source::Sampled { .. }) {
+            sampled += 1;
+            for op in [Operator::Fastest, Operator::Slowest, Operator::Switching] {
+                assert_eq!(run(&p, &out.schedule, p.dt_s(), op, seed), None);
+            }
+        }
+    }
+    assert!(sampled >= 20, "only {sampled} of 40 sampled");
+}

@@ -1,0 +1,215 @@
+//! The anytime sampler (§II-C) through the public API.
+
+use proptest::prelude::*;
+use tandem_schedule::{
+    MarginCheck, Problem, SamplerParams, Schedule, Source, sample_schedule, validate,
+    validate_with_tick,
+};
+
+/// `n` samples, low confidence on `lc`, bounds `[lo, hi]`×mean around a wobbling mean.
+fn problem(n: usize, lc: &[std::ops::Range<usize>], lo: f64, hi: f64) -> Problem {
+    let mean: Vec<f64> = (0..n).map(|i| 1.0 + 0.2 * (i as f64 / 7.0).sin()).collect();
+    let conf = (0..n).map(|i| !lc.iter().any(|r| r.contains(&i))).collect();
+    Problem::new(
+        conf,
+        mean.clone(),
+        mean.iter().map(|m| lo * m).collect(),
+        mean.iter().map(|m| hi * m).collect(),
+        0.01,
+    )
+    .unwrap()
+}
+
+fn params(samples: usize, seed: u64) -> SamplerParams {
+    SamplerParams {
+        samples,
+        seed,
+        ..SamplerParams::default()
+    }
+}
+
+fn random_problem() -> impl Strategy<Value = Problem> {
+    (3usize..60).prop_flat_map(|n| {
+        (
+            proptest::collection::vec(prop::bool::weighted(0.7), n),
+            proptest::collection::vec((0.5f64..2.0, 0.3f64..1.0, 1.0f64..2.5), n),
+        )
+            .prop_map(|(conf, g)| {
+                Problem::new(
+                    conf,
+                    g.iter().map(|x| x.0).collect(),
+                    g.iter().map(|x| x.0 * x.1).collect(),
+                    g.iter().map(|x| x.0 * x.2).collect(),
+                    0.01,
+                )
+                .unwrap()
+            })
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(128))]
+
+    /// Every returned schedule passes `validate`, and it is never slower than the serial one.
+    #[test]
+    fn returned_schedules_are_valid_and_no_slower_than_serial(
+        p in random_problem(), seed in any::<u64>(), tick_frac in 0.3f64..=1.0
+    ) {
+        let tick_s = tick_frac * p.dt_s();
+        let params = SamplerParams { samples: 200, seed, tick_s: Some(tick_s), ..SamplerParams::default() };
+        let out = sample_schedule(&p, &params, None).unwrap();
+        prop_assert_eq!(validate_with_tick(&p, &out.schedule, tick_s), Ok(()));
+        let serial = p.serial_schedule().t_total_s(p.dt_s());
+        prop_assert!(out.t_total_s <= serial);
+        prop_assert!((out.t_total_s - out.schedule.t_total_s(p.dt_s())).abs() < 1e-12);
+        if out.source == Source::Serial {
+            prop_assert_eq!(&out.schedule, &p.serial_schedule());
+        }
+    }
+}
+
+#[test]
+fn sampler_beats_serial_on_a_schedulable_problem() {
+    let p = problem(120, &[10..30, 70..90], 0.5, 2.0);
+    let out = sample_schedule(&p, &params(2000, 3), None).unwrap();
+    assert!(matches!(out.source, Source::Sampled { .. }));
+    assert_eq!(validate(&p, &out.schedule), Ok(()));
+    assert!(out.t_total_s < 0.9 * p.serial_schedule().t_total_s(0.01));
+}
+
+#[test]
+fn all_low_confidence_gives_the_serial_schedule() {
+    let all = std::slice::from_ref(&(0..50));
+    let p = problem(50, all, 0.5, 2.0);
+    let out = sample_schedule(&p, &params(1000, 1), None).unwrap();
+    assert_eq!(out.source, Source::Serial);
+    assert_eq!(out.schedule, p.serial_schedule());
+    // Serial at the mean gradient: T_total = 2·Σ mean·dt.
+    let single: f64 = p.grad_mean().iter().sum::<f64>() * 0.01;
+    assert!((out.t_total_s - 2.0 * single).abs() < 1e-9);
+}
+
+#[test]
+fn all_high_confidence_overlaps_fully() {
+    let p = problem(80, &[], 0.5, 2.0);
+    let out = sample_schedule(&p, &params(5000, 2), None).unwrap();
+    let fastest: f64 = p.grad_min().iter().sum::<f64>() * 0.01;
+    // Nearly both robots at ψ̇min, started nearly together: T_total ≈ fastest single run.
+    assert!(
+        out.t_total_s <= 1.02 * fastest,
+        "{} vs {fastest}",
+        out.t_total_s
+    );
+    assert!(out.schedule.offset_s <= 0.02 * fastest);
+}
+
+#[test]
+fn same_seed_same_schedule_with_1_and_2_threads() {
+    let p = problem(300, &[20..60, 120..160, 220..250], 0.6, 1.8);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| sample_schedule(&p, &params(3000, 42), None).unwrap())
+    };
+    let one = run(1);
+    let two = run(2);
+    assert_eq!(one, two);
+    assert!(matches!(one.source, Source::Sampled { .. }));
+    // And another seed gives another schedule.
+    let other = sample_schedule(&p, &params(3000, 43), None).unwrap();
+    assert_ne!(other.schedule, one.schedule);
+}
+
+#[test]
+fn lazy_and_exhaustive_margins_agree_with_both_checks() {
+    let p = problem(200, &[20..50, 100..130], 0.7, 1.5);
+    let base = params(1500, 9);
+    let lazy = sample_schedule(&p, &base, None).unwrap();
+    for (check, exhaustive) in [
+        (MarginCheck::SinglePass, true),
+        (MarginCheck::PerPair, false),
+        (MarginCheck::PerPair, true),
+    ] {
+        let q = SamplerParams {
+            margin_check: check,
+            exhaustive_margins: exhaustive,
+            ..base.clone()
+        };
+        let out = sample_schedule(&p, &q, None).unwrap();
+        assert_eq!(out.schedule, lazy.schedule);
+        assert_eq!(out.source, lazy.source);
+    }
+}
+
+#[test]
+fn previous_schedule_is_kept_when_nothing_better_is_found() {
+    let p = problem(120, &[10..30, 70..90], 0.5, 2.0);
+    let first = sample_schedule(&p, &params(2000, 5), None).unwrap();
+    // The same candidates again: the best ties with the previous one, which is kept.
+    let again = sample_schedule(&p, &params(2000, 5), Some(&first.schedule)).unwrap();
+    assert_eq!(again.source, Source::Previous);
+    assert_eq!(again.schedule, first.schedule);
+    // A single fresh candidate cannot beat 2000.
+    let one = sample_schedule(&p, &params(1, 6), Some(&first.schedule)).unwrap();
+    assert_eq!(one.source, Source::Previous);
+    assert_eq!(one.schedule, first.schedule);
+}
+
+#[test]
+fn previous_schedule_is_repaired_after_the_model_moves() {
+    let p = problem(120, &[10..30, 70..90], 0.5, 2.0);
+    let first = sample_schedule(&p, &params(2000, 5), None).unwrap();
+    // New model: mean 2 % slower everywhere (bounds scale with it), same confidence.
+    let q = Problem::new(
+        p.conf().to_vec(),
+        p.grad_mean().iter().map(|m| 1.02 * m).collect(),
+        p.grad_min().iter().map(|m| 1.02 * m).collect(),
+        p.grad_max().iter().map(|m| 1.02 * m).collect(),
+        0.01,
+    )
+    .unwrap();
+    assert!(validate(&q, &first.schedule).is_err());
+    let out = sample_schedule(&q, &params(1, 6), Some(&first.schedule)).unwrap();
+    assert_eq!(validate(&q, &out.schedule), Ok(()));
+    assert!(matches!(
+        out.source,
+        Source::RepairedPrevious | Source::Sampled { .. } | Source::Serial
+    ));
+    // A previous schedule of the wrong shape is ignored.
+    let junk = Schedule {
+        grad_exec: [vec![1.0; 3], vec![1.0; 3]],
+        offset_s: 0.0,
+    };
+    let out = sample_schedule(&q, &params(10, 6), Some(&junk)).unwrap();
+    assert_eq!(validate(&q, &out.schedule), Ok(()));
+}
+
+#[test]
+fn bad_params_are_rejected() {
+    let p = problem(10, &[], 0.5, 2.0);
+    for bad in [
+        SamplerParams {
+            samples: 0,
+            ..SamplerParams::default()
+        },
+        SamplerParams {
+            tick_s: Some(f64::NAN),
+            ..SamplerParams::default()
+        },
+        SamplerParams {
+            p_fastest: 1.5,
+            ..SamplerParams::default()
+        },
+        SamplerParams {
+            distribution: tandem_schedule::Distribution::PerRun { pieces: 0 },
+            ..SamplerParams::default()
+        },
+    ] {
+        assert!(matches!(
+            sample_schedule(&p, &bad, None),
+            Err(tandem_schedule::Error::BadParam { .. })
+        ));
+    }
+}
