@@ -164,7 +164,10 @@ impl Coordinator {
         let rates = |c: &Self, i: usize| c.robots[i].rates(c.cursors[i].at);
         let mut step = [0.0_f64; 2];
         match phases {
-            [Phase::Active { low_conf: l0 }, Phase::Active { low_conf: l1 }] => match (l0, l1) {
+            [
+                Phase::Active { low_conf: l0 },
+                Phase::Active { low_conf: l1 },
+            ] => match (l0, l1) {
                 (false, false) => {
                     let (a, b) = if self.clock_s[0] >= self.clock_s[1] {
                         (0, 1)
@@ -237,5 +240,129 @@ impl Coordinator {
             out.ref_time[i] = r.ref_time_in(n, s_new);
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [HC, LC, HC], gradients 1, bounds [½, 2], Δt_s = 1 (DESIGN.md's 3-sample case).
+    fn three_sample(tau: f64) -> [Timeline; 2] {
+        let conf = [true, false, true];
+        let (g, lo, hi) = ([1.0; 3], [0.5; 3], [2.0; 3]);
+        [
+            Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap(),
+            Timeline::new(&conf, &g, &lo, &hi, tau, 1.0).unwrap(),
+        ]
+    }
+
+    #[test]
+    fn three_sample_case_drag_then_rush_overlaps() {
+        let mut c = Coordinator::new(three_sample(1.5), 1.0).unwrap();
+        // Tick 0: robot 0 alone and HC runs on schedule (step 1); robot 1 waits, its clock
+        // follows. Robot 0 ends exactly where its LC sample starts: the tolerance reports it LC.
+        let t = c.tick(0.0);
+        assert_eq!(c.clock_s(), [1.0, 1.0]);
+        assert_eq!(t.ref_time, [1.0, 0.0]);
+        assert_eq!(t.running, [true, false]);
+        assert_eq!(t.low_conf, [true, false]);
+        // Tick 1: robot 0 LC, operator drags (g → ψ̇max = 2, step ½); robot 1's clock reaches
+        // its start 1.5 (capped) and starts at the next tick boundary.
+        let t = c.tick(f64::INFINITY);
+        assert_eq!(c.clock_s(), [1.5, 1.5]);
+        assert_eq!(t.ref_time, [1.5, 0.0]);
+        assert_eq!(t.low_conf, [true, false]);
+        assert_eq!(t.running, [true, false]);
+        // Tick 2: operator rushes robot 0 (g → ψ̇min = ½, step 2); robot 1 (HC) matches the
+        // step (Eq. 18) and enters its LC sample (clock 2.5) while robot 0 is still in its own.
+        let t = c.tick(0.0);
+        assert_eq!(c.clock_s(), [3.0, 3.5]);
+        assert_eq!(t.ref_time, [3.0, 2.0]);
+        assert_eq!(t.low_conf, [true, true]);
+        assert!(c.robots()[0].end_s() <= c.clock_s()[0]);
+    }
+
+    #[test]
+    fn start_shift_follows_the_first_robot() {
+        // Robot 0: [LC, HC, HC, HC]; robot 1 scheduled to start at τ = 2; tick ½.
+        let conf = [false, true, true, true];
+        let (g, lo, hi) = ([1.0; 4], [0.5; 4], [2.0; 4]);
+        let first_running_tick = |operator: f64| {
+            let r0 = Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap();
+            let r1 = Timeline::new(&conf, &g, &lo, &hi, 2.0, 1.0).unwrap();
+            let mut c = Coordinator::new([r0, r1], 0.5).unwrap();
+            (0..100).find(|_| {
+                let t = c.tick(operator);
+                // Until it starts, robot 1's clock equals robot 0's (capped at τ).
+                assert!(t.running[1] || c.clock_s()[1] == c.clock_s()[0].min(2.0));
+                t.running[1]
+            })
+        };
+        // On schedule: LC sample in 2 ticks of ½, HC samples run on schedule → starts after 4.
+        assert_eq!(first_running_tick(f64::NAN), Some(4));
+        // Dragged (step S·tick = ¼): the LC sample takes 4 ticks, robot 1 starts 1 s later.
+        assert_eq!(first_running_tick(f64::INFINITY), Some(6));
+        // Rushed (step F·tick = 1): one tick on the LC sample, robot 1 starts ½ s earlier.
+        assert_eq!(first_running_tick(0.0), Some(3));
+    }
+
+    #[test]
+    fn both_high_confidence_follow_alg1() {
+        // Robot 0: F = 2; robot 1: F = 1.5 (ψ̇min = 2/3); both HC, level → both step 1.5·tick.
+        let conf = [true; 4];
+        let g = [1.0; 4];
+        let r0 = Timeline::new(&conf, &g, &[0.5; 4], &[2.0; 4], 0.0, 1.0).unwrap();
+        let r1 = Timeline::new(&conf, &g, &[2.0 / 3.0; 4], &[2.0; 4], 0.0, 1.0).unwrap();
+        let mut c = Coordinator::new([r0, r1], 1.0).unwrap();
+        let t = c.tick(0.0);
+        assert_eq!(c.clock_s(), [1.5, 1.5]);
+        assert_eq!(t.ref_time, [1.5, 1.5]);
+        assert_eq!(t.low_conf, [false, false]);
+    }
+
+    #[test]
+    fn responder_matches_low_confidence_robot_and_stops_adapting_after_finish() {
+        // Robot 0 is LC on sample 0 only and one sample long; robot 1 HC, both start at 0.
+        let r0 = Timeline::new(&[false], &[1.0], &[0.5], &[2.0], 0.0, 1.0).unwrap();
+        let r1 = Timeline::new(&[true; 4], &[1.0; 4], &[0.8; 4], &[1.25; 4], 0.0, 1.0).unwrap();
+        let mut c = Coordinator::new([r0, r1], 0.25).unwrap();
+        // Operator gradient 0.8 (inside [½, 2]) → robot 0 steps (1/0.8)·¼ = 0.3125; robot 1
+        // (F = 1.25) matches it exactly.
+        let t = c.tick(0.8);
+        assert_eq!(c.clock_s(), [0.3125, 0.3125]);
+        assert_eq!(t.low_conf, [true, false]);
+        // Operator fastest: robot 0 steps 2·¼ = ½; robot 1 can only do 1.25·¼.
+        c.tick(0.0);
+        assert_eq!(c.clock_s(), [0.8125, 0.625]);
+        // Robot 0 finishes (clock capped at its end, 1.0); robot 1 then runs on schedule.
+        c.tick(0.0);
+        assert_eq!(c.clock_s()[0], 1.0);
+        let before = c.clock_s()[1];
+        let t = c.tick(0.0);
+        assert_eq!(c.clock_s()[1], before + 0.25);
+        assert_eq!(t.running, [false, true]);
+        assert_eq!(t.low_conf, [false, false]);
+        while !c.is_finished() {
+            c.tick(0.0);
+        }
+        let t = c.tick(0.0);
+        assert_eq!(t.ref_time, [1.0, 4.0]);
+        assert_eq!(t.running, [false, false]);
+    }
+
+    #[test]
+    fn bad_tick_and_nan_operator() {
+        let r = three_sample(1.5);
+        assert!(matches!(
+            Coordinator::new(r.clone(), 0.0),
+            Err(Error::BadParam { name: "tick_s", .. })
+        ));
+        assert!(Coordinator::new(r.clone(), f64::NAN).is_err());
+        let mut c = Coordinator::new(r, 1.0).unwrap();
+        c.tick(f64::NAN);
+        // NaN operator = scheduled gradient: robot 0 in its LC sample steps exactly one tick.
+        c.tick(f64::NAN);
+        assert_eq!(c.clock_s(), [2.0, 1.5]);
     }
 }

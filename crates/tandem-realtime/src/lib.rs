@@ -7,7 +7,7 @@
 //! the low-confidence robot; the [`Coordinator`] lets the other robot respond (Eq. 18, Alg. 1) so
 //! that the two schedule clocks stay close. [`sufficient_margins`] checks, before execution,
 //! that no admissible operator can make both robots low-confidence in the same control tick —
-//! a conservative, discretization-safe version of Alg. 2 (see [`margins`](crate::margins)).
+//! a conservative, discretization-safe version of Alg. 2 (see [`margins`]).
 //!
 //! Time frames: reference sample index `n` (period `Δt_s`), schedule-clock/global time in
 //! seconds, control tick `tick_s` in real seconds.

@@ -47,7 +47,7 @@
 //!    rejects such pairs). Conversely the earlier robot may be up to one step ahead when the
 //!    later one starts, so when `c` is the earlier robot its simulated clock starts at `τ + M`.
 //!
-//! A pair whose regions already overlap on schedule (`T_c < T_p + ε`) is rejected outright.
+//! Any other pair whose regions already overlap on schedule (`T_c < T_p + ε`) is rejected outright.
 //!
 //! In continuous time the extreme policy bounds every admissible operator; the fixes above only
 //! widen the discrete check by at most one maximal step in clock, rate and mode. This is a
@@ -138,18 +138,18 @@ impl Setup {
         })
     }
 
-    /// Fixes 1 and 4 and the on-schedule overlap test for pairs that need no simulation:
-    /// `Some(decision)` or `None` (simulate).
+    /// Fix 4, then the on-schedule overlap test, for pairs that need no simulation:
+    /// `Some(decision)` or `None` (simulate). Fix 4 comes first: in the serial schedule the
+    /// previous robot may end in an LC sample exactly where the later robot starts in one.
     fn prefilter(&self, robots: &[Timeline; 2], p: usize, pair: Pair) -> Option<bool> {
-        if pair.t_c_start < pair.t_p_end + self.eps {
-            return Some(false);
-        }
         let end_p = robots[p].end_s();
         if p == self.first
-            && (pair.t_p_end + self.eps <= self.tau
-                || (pair.t_p_end >= end_p && end_p <= self.tau))
+            && (pair.t_p_end + self.eps <= self.tau || (pair.t_p_end >= end_p && end_p <= self.tau))
         {
             return Some(true);
+        }
+        if pair.t_c_start < pair.t_p_end + self.eps {
+            return Some(false);
         }
         None
     }
@@ -283,13 +283,19 @@ impl<'a> RoleSim<'a> {
     /// `c` rushes (`F`), `p` responds with Eq. 18: new `(t_p, t_c)`.
     fn c_rushing(&self, rp: Rates, rc: Rates) -> (f64, f64) {
         let t_c = self.t_c + rc.fast * self.tick_s;
-        (self.t_p + response_step(self.t_p - t_c, rp, self.tick_s), t_c)
+        (
+            self.t_p + response_step(self.t_p - t_c, rp, self.tick_s),
+            t_c,
+        )
     }
 
     /// `p` drags (`S`), `c` responds with Eq. 18: new `(t_p, t_c)`.
     fn p_dragging(&self, rp: Rates, rc: Rates) -> (f64, f64) {
         let t_p = self.t_p + rp.slow * self.tick_s;
-        (t_p, self.t_c + response_step(self.t_c - t_p, rc, self.tick_s))
+        (
+            t_p,
+            self.t_c + response_step(self.t_c - t_p, rc, self.tick_s),
+        )
     }
 
     fn step(&mut self) {

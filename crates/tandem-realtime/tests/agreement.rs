@@ -1,0 +1,53 @@
+//! The single-pass conservative check decides exactly like the per-pair re-simulation.
+
+mod common;
+
+use std::cell::Cell;
+
+use common::{Problem, rng};
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+use rand::Rng;
+use tandem_realtime::{sufficient_margins, sufficient_margins_per_pair};
+
+#[test]
+fn single_pass_equals_per_pair_on_random_schedules() {
+    let config = Config {
+        cases: 1000,
+        failure_persistence: None,
+        ..Config::default()
+    };
+    let mut runner =
+        TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+    let counts = Cell::new([0u32; 2]);
+    let result = runner.run(&(any::<u64>(), 0.0..=1.0f64), |(seed, frac)| {
+        let mut r = rng(seed);
+        let problem = Problem::random(&mut r);
+        let tick_s = problem.dt_s * r.random_range(0.25..=1.5);
+        // Offsets from simultaneous starts to fully serial, biased to the interesting upper half.
+        let tau = problem.duration0() * frac.sqrt();
+        let robots = problem.robots(tau);
+        let single = sufficient_margins(&robots, tick_s).unwrap();
+        let per_pair = sufficient_margins_per_pair(&robots, tick_s).unwrap();
+        prop_assert_eq!(
+            single,
+            per_pair,
+            "seed {} tau {} tick {}",
+            seed,
+            tau,
+            tick_s
+        );
+        let mut c = counts.get();
+        c[usize::from(single)] += 1;
+        counts.set(c);
+        Ok(())
+    });
+    if let Err(e) = result {
+        panic!("{e}");
+    }
+    let [rejected, accepted] = counts.get();
+    assert!(
+        rejected >= 100 && accepted >= 100,
+        "both decisions must be exercised: {accepted} accepted, {rejected} rejected"
+    );
+}
