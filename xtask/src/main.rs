@@ -6,6 +6,7 @@
 
 mod fig5;
 mod fixtures;
+mod stress;
 
 use clap::{Parser, Subcommand};
 
@@ -33,12 +34,23 @@ enum Cmd {
         #[arg(long)]
         out: std::path::PathBuf,
     },
+    /// Run N Coordinator executions of sampled schedules under adversarial operators and
+    /// count ticks with both robots low-confidence (expected 0).
+    Stress {
+        /// Total number of executions.
+        #[arg(long, default_value_t = 1_000_000)]
+        executions: u64,
+        /// Seed of the random problems, the sampler and the operators.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
 }
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.cmd {
         Cmd::Fixtures { check } => fixtures::run(check),
+        Cmd::Stress { executions, seed } => stress::run(executions, seed),
         Cmd::Fig5Demo { out } => {
             let (svg, png) = fig5::run_demo(&out)?;
             println!("wrote {} and {}", svg.display(), png.display());
