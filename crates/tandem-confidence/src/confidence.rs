@@ -1,0 +1,379 @@
+//! The latched high-confidence state per reference sample (Eq. 12 + latch).
+
+use std::ops::Range;
+
+use serde::{Deserialize, Serialize};
+
+use crate::beta::{check_len, check_variance, decide, prior_ab};
+use crate::boundary::Boundary;
+use crate::{ConfidenceParams, Error, Observations, Result};
+
+/// `conf(t)` per reference sample, latched: once a sample is high-confidence it stays so.
+///
+/// [`update`](Confidence::update) recomputes Eq. 12 from the current demonstration
+/// variance (prior, Eq. 10–11) and observations (posterior, Eq. 9) for every sample that
+/// is still low-confidence, and latches those that pass. A latched sample is never
+/// re-evaluated, so a later variance increase (which moves its prior towards
+/// `Beta(2, 2)`) or a later correction cannot turn it back to low confidence. The paper's
+/// claim that "the previous scheduling solution will always remain valid" rests on this:
+/// a schedule that was feasible for one confidence map is feasible for any map with
+/// more high-confidence samples.
+///
+/// ```
+/// use tandem_confidence::{Confidence, ConfidenceParams, Observations};
+/// let sigma2_d = [0.0, 10.0, 10.0, 0.0];
+/// let mut conf = Confidence::from_prior(&sigma2_d, ConfidenceParams::default())?;
+/// assert_eq!(conf.conf(), &[true, false, false, true]);
+/// assert_eq!(conf.low_regions(), vec![1..3]);
+/// assert_eq!(conf.high_share(), 0.5);
+/// // 90 executions supervise samples 1 and 2 and only ever correct sample 2.
+/// let mut obs = Observations::new(4)?;
+/// for _ in 0..90 {
+///     obs.record(&[1.0, 2.0], &[false, true])?;
+/// }
+/// assert_eq!(conf.update(&sigma2_d, &obs)?, 1); // one sample newly latched
+/// assert_eq!(conf.conf(), &[true, true, false, true]);
+/// # Ok::<(), tandem_confidence::Error>(())
+/// ```
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(try_from = "ConfidenceData")]
+pub struct Confidence {
+    params: ConfidenceParams,
+    high: Vec<bool>,
+    /// Cache of certified points of the Eq. 12 boundary (speed only; see `boundary.rs`).
+    #[serde(skip)]
+    boundary: Boundary,
+}
+
+/// Equality of the model state (parameters and latched `conf`); the evaluation cache is
+/// ignored.
+impl PartialEq for Confidence {
+    fn eq(&self, other: &Self) -> bool {
+        self.params == other.params && self.high == other.high
+    }
+}
+
+/// Unchecked serde form of [`Confidence`].
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConfidenceData {
+    params: ConfidenceParams,
+    high: Vec<bool>,
+}
+
+impl TryFrom<ConfidenceData> for Confidence {
+    type Error = Error;
+    fn try_from(d: ConfidenceData) -> Result<Self> {
+        Self::from_parts(d.params, d.high)
+    }
+}
+
+impl Confidence {
+    /// All `n_ref` samples low-confidence (nothing latched yet). Call
+    /// [`update`](Self::update) to evaluate the prior, or use
+    /// [`from_prior`](Self::from_prior).
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for invalid `params`; [`Error::EmptyReference`] if `n_ref == 0`.
+    pub fn new(n_ref: usize, params: ConfidenceParams) -> Result<Self> {
+        Self::from_parts(params, vec![false; n_ref])
+    }
+
+    /// State after evaluating the prior alone (no executions yet): high confidence where
+    /// the demonstrations barely vary.
+    ///
+    /// # Errors
+    /// As [`new`](Self::new) and [`update`](Self::update).
+    pub fn from_prior(sigma2_d: &[f64], params: ConfidenceParams) -> Result<Self> {
+        let mut conf = Self::new(sigma2_d.len(), params)?;
+        conf.latch(sigma2_d, |_| (0.0, 0.0))?;
+        Ok(conf)
+    }
+
+    /// Restores a saved state: `high[n]` is the latched `conf` of reference sample `n`.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for invalid `params`; [`Error::EmptyReference`] if `high` is
+    /// empty.
+    pub fn from_parts(params: ConfidenceParams, high: Vec<bool>) -> Result<Self> {
+        params.validate()?;
+        if high.is_empty() {
+            return Err(Error::EmptyReference);
+        }
+        Ok(Self {
+            params,
+            high,
+            boundary: Boundary::default(),
+        })
+    }
+
+    /// Re-evaluates Eq. 12 for every sample that is not yet latched, from the current
+    /// demonstration variance `sigma2_d` (Eq. 6, dimensionless, one per reference sample)
+    /// and all observations so far, and latches the samples that pass.
+    /// Returns how many samples became high-confidence in this call.
+    ///
+    /// Every input is checked before the state changes: on error nothing is latched.
+    ///
+    /// Cost: latched samples are skipped; for the others the incomplete beta function is
+    /// evaluated only when neither a Cantelli bound on the Beta CDF nor a cached, certified
+    /// bracket of the Eq. 12 boundary (monotonicity of `I_{μ_c}(α, β)` in `α` and `β`)
+    /// settles the comparison with `γ_c`. The decision is identical to evaluating statrs
+    /// everywhere; the cache fills on first use (a few ms once) and is not serialized.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] if `sigma2_d` or `obs` do not have
+    /// [`n_ref`](Self::n_ref) samples; [`Error::BadVariance`] naming the first bad `σ²_D`;
+    /// [`Error::DegeneratePrior`] if a prior is not representable.
+    pub fn update(&mut self, sigma2_d: &[f64], obs: &Observations) -> Result<usize> {
+        check_len(
+            "observations",
+            obs.n_ref(),
+            "the confidence state",
+            self.n_ref(),
+        )?;
+        let (c, s) = (obs.corrections(), obs.supervised());
+        self.latch(sigma2_d, |n| (c[n], s[n]))
+    }
+
+    /// Shared body of [`update`](Self::update) and [`from_prior`](Self::from_prior):
+    /// `counts(n)` gives `(corrections[n], supervised[n])`, with `0 ≤ c ≤ s` finite.
+    fn latch(&mut self, sigma2_d: &[f64], counts: impl Fn(usize) -> (f64, f64)) -> Result<usize> {
+        self.params.validate()?;
+        check_len(
+            "sigma2_d",
+            sigma2_d.len(),
+            "the confidence state",
+            self.n_ref(),
+        )?;
+        for (ref_idx, &v) in sigma2_d.iter().enumerate() {
+            check_variance(ref_idx, v)?;
+        }
+        let Self {
+            params: p,
+            high: latched,
+            boundary,
+        } = self;
+        let mut newly = Vec::new();
+        for (ref_idx, (&high, &s2)) in latched.iter().zip(sigma2_d).enumerate() {
+            if high {
+                continue;
+            }
+            let (alpha0, beta0) = prior_ab(s2, p);
+            if !(alpha0 > 0.0 && beta0 > 0.0 && alpha0.is_finite() && beta0.is_finite()) {
+                return Err(Error::DegeneratePrior {
+                    ref_idx,
+                    alpha: alpha0,
+                    beta: beta0,
+                });
+            }
+            let (c, s) = counts(ref_idx);
+            let (alpha, beta) = (alpha0 + c, beta0 + (s - c));
+            if !(alpha.is_finite() && beta.is_finite()) {
+                return Err(Error::DegeneratePrior {
+                    ref_idx,
+                    alpha,
+                    beta,
+                });
+            }
+            if boundary.decide(alpha, beta, p.mu_c, p.gamma_c) {
+                newly.push(ref_idx);
+            }
+        }
+        for &ref_idx in &newly {
+            self.high[ref_idx] = true;
+        }
+        Ok(newly.len())
+    }
+
+    /// The parameters this state was built with.
+    #[must_use]
+    pub fn params(&self) -> &ConfidenceParams {
+        &self.params
+    }
+
+    /// Number of reference samples `T_ref`.
+    #[must_use]
+    pub fn n_ref(&self) -> usize {
+        self.high.len()
+    }
+
+    /// `conf` per reference sample: `true` = high confidence (may run unsupervised).
+    #[must_use]
+    pub fn conf(&self) -> &[bool] {
+        &self.high
+    }
+
+    /// Number of high-confidence reference samples.
+    #[must_use]
+    pub fn n_high(&self) -> usize {
+        self.high.iter().filter(|&&h| h).count()
+    }
+
+    /// Share of high-confidence reference samples, in `[0, 1]` (Fig. 5, bottom).
+    #[must_use]
+    pub fn high_share(&self) -> f64 {
+        // Lossless for any reference shorter than 2^53 samples.
+        self.n_high() as f64 / self.n_ref() as f64
+    }
+
+    /// Maximal runs of low-confidence reference samples, in increasing order.
+    #[must_use]
+    pub fn low_regions(&self) -> Vec<Range<usize>> {
+        low_regions(&self.high)
+    }
+}
+
+/// Eq. 12 per reference sample without any latch: `I_{μ_c}(α, β) > γ_c` for the
+/// posterior of [`posterior`](crate::posterior). The decision is exactly statrs'
+/// (a Cantelli bound only skips evaluations it provably cannot change).
+///
+/// # Errors
+/// As [`posterior`](crate::posterior).
+pub fn evaluate(
+    sigma2_d: &[f64],
+    obs: &Observations,
+    params: &ConfidenceParams,
+) -> Result<Vec<bool>> {
+    Ok(crate::posterior(sigma2_d, obs, params)?
+        .iter()
+        .map(|b| decide(b.alpha(), b.beta(), params.mu_c, params.gamma_c))
+        .collect())
+}
+
+/// Maximal runs of `false` (low confidence) in `conf`, as half-open reference-sample
+/// ranges in increasing order.
+///
+/// ```
+/// let conf = [false, true, true, false, false, true, false];
+/// assert_eq!(tandem_confidence::low_regions(&conf), vec![0..1, 3..5, 6..7]);
+/// ```
+#[must_use]
+pub fn low_regions(conf: &[bool]) -> Vec<Range<usize>> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (n, &high) in conf.iter().enumerate() {
+        match (high, start) {
+            (false, None) => start = Some(n),
+            (true, Some(s)) => {
+                out.push(s..n);
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some(s) = start {
+        out.push(s..conf.len());
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn latch_holds_when_variance_increases() {
+        let p = ConfidenceParams::default();
+        // Near-zero variance: high from the prior alone.
+        let mut conf = Confidence::from_prior(&[0.0, 0.0], p.clone()).unwrap();
+        assert_eq!(conf.conf(), &[true, true]);
+        // Variance jumps: the fresh prior Beta(2, 2) would be low-confidence...
+        let obs = Observations::new(2).unwrap();
+        assert_eq!(
+            evaluate(&[10.0, 10.0], &obs, &p).unwrap(),
+            vec![false, false]
+        );
+        // ...but the latched state keeps both samples high.
+        assert_eq!(conf.update(&[10.0, 10.0], &obs).unwrap(), 0);
+        assert_eq!(conf.conf(), &[true, true]);
+        // Corrections after latching do not unlatch either.
+        let mut obs = Observations::new(2).unwrap();
+        obs.record(&[0.0; 50], &[true; 50]).unwrap();
+        conf.update(&[10.0, 10.0], &obs).unwrap();
+        assert_eq!(conf.conf(), &[true, true]);
+    }
+
+    #[test]
+    fn errors_leave_state_unchanged_and_name_lengths() {
+        let p = ConfidenceParams::default();
+        let mut conf = Confidence::new(3, p).unwrap();
+        let obs = Observations::new(3).unwrap();
+        let err = conf.update(&[0.0, 0.0], &obs).unwrap_err();
+        assert_eq!(
+            err,
+            Error::LengthMismatch {
+                left_name: "sigma2_d",
+                left: 2,
+                right_name: "the confidence state",
+                right: 3
+            }
+        );
+        assert!(
+            err.to_string().contains("2") && err.to_string().contains("3"),
+            "{err}"
+        );
+        let err = conf
+            .update(&[0.0, 0.0, 0.0], &Observations::new(4).unwrap())
+            .unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::LengthMismatch {
+                    left: 4,
+                    right: 3,
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        // Sample 0 would latch, but sample 2 is bad: nothing may change.
+        let err = conf.update(&[0.0, 0.0, f64::NAN], &obs).unwrap_err();
+        assert!(
+            matches!(err, Error::BadVariance { ref_idx: 2, .. }),
+            "{err:?}"
+        );
+        assert_eq!(conf.conf(), &[false, false, false]);
+        assert_eq!(
+            Confidence::new(0, ConfidenceParams::default()),
+            Err(Error::EmptyReference)
+        );
+        let bad = ConfidenceParams {
+            gamma_c: 1.0,
+            ..Default::default()
+        };
+        assert!(matches!(
+            Confidence::new(3, bad),
+            Err(Error::BadParam {
+                name: "gamma_c",
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn summaries() {
+        let p = ConfidenceParams::default();
+        let conf = Confidence::from_parts(p, vec![true, false, false, true, false]).unwrap();
+        assert_eq!(conf.n_high(), 2);
+        assert_eq!(conf.high_share(), 0.4);
+        assert_eq!(conf.low_regions(), vec![1..3, 4..5]);
+        assert_eq!(low_regions(&[true, true]), Vec::<Range<usize>>::new());
+        assert_eq!(low_regions(&[false, false]), vec![0..2]);
+        assert_eq!(low_regions(&[]), Vec::<Range<usize>>::new());
+    }
+
+    #[test]
+    fn serde_round_trip() {
+        let mut conf = Confidence::from_prior(&[0.0, 1.0, 0.001], Default::default()).unwrap();
+        let mut obs = Observations::new(3).unwrap();
+        obs.record(&[1.0, 1.5], &[false, true]).unwrap();
+        conf.update(&[0.0, 1.0, 0.001], &obs).unwrap();
+        let json = serde_json::to_string(&conf).unwrap();
+        let back: Confidence = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, conf);
+        let bad = r#"{"params":{"mu_c":2.0},"high":[true]}"#;
+        let err = serde_json::from_str::<Confidence>(bad).unwrap_err();
+        assert!(err.to_string().contains("mu_c"), "{err}");
+        assert!(serde_json::from_str::<Confidence>(r#"{"params":{},"high":[]}"#).is_err());
+    }
+}

@@ -1,0 +1,293 @@
+//! Empirical correction data per reference sample (the `z_t` of Eq. 8–9).
+
+use serde::{Deserialize, Serialize};
+
+use crate::beta::check_len;
+use crate::{Error, Result};
+
+/// Accumulated observations per reference sample: how much supervised execution time fell
+/// on it and how much of that was corrected.
+///
+/// Both counts are real numbers because an execution visits fractional reference times:
+/// an observation at reference time `t` is split linearly between samples `⌊t⌋` and
+/// `⌊t⌋ + 1` (weights `1 − frac(t)` and `frac(t)`), so every observation adds exactly one
+/// unit of mass in total. Only *supervised* (low-confidence) samples are observed; an
+/// unsupervised execution sample says nothing about whether the operator would have
+/// corrected it.
+///
+/// Invariant (checked on construction and deserialization): equal lengths `T_ref ≥ 1`,
+/// and `0 ≤ corrections[n] ≤ supervised[n]`, all finite.
+///
+/// ```
+/// use tandem_confidence::Observations;
+/// let mut obs = Observations::new(4)?;
+/// // One execution supervised reference times 0.5 (corrected) and 2.0 (not corrected).
+/// obs.record(&[0.5, 2.0], &[true, false])?;
+/// assert_eq!(obs.supervised(), &[0.5, 0.5, 1.0, 0.0]);
+/// assert_eq!(obs.corrections(), &[0.5, 0.5, 0.0, 0.0]);
+/// # Ok::<(), tandem_confidence::Error>(())
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "ObservationsData")]
+pub struct Observations {
+    corrections: Vec<f64>,
+    supervised: Vec<f64>,
+}
+
+/// Unchecked serde form of [`Observations`].
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObservationsData {
+    corrections: Vec<f64>,
+    supervised: Vec<f64>,
+}
+
+impl TryFrom<ObservationsData> for Observations {
+    type Error = Error;
+    fn try_from(d: ObservationsData) -> Result<Self> {
+        Self::from_counts(d.corrections, d.supervised)
+    }
+}
+
+impl Observations {
+    /// No observations yet for a reference of `n_ref` samples.
+    ///
+    /// # Errors
+    /// [`Error::EmptyReference`] if `n_ref == 0`.
+    pub fn new(n_ref: usize) -> Result<Self> {
+        if n_ref == 0 {
+            return Err(Error::EmptyReference);
+        }
+        Ok(Self {
+            corrections: vec![0.0; n_ref],
+            supervised: vec![0.0; n_ref],
+        })
+    }
+
+    /// Observations from stored per-sample counts (e.g. a saved state).
+    ///
+    /// # Errors
+    /// [`Error::EmptyReference`], [`Error::LengthMismatch`], or [`Error::BadCounts`]
+    /// naming the first sample where `0 ≤ corrections ≤ supervised` (finite) fails.
+    pub fn from_counts(corrections: Vec<f64>, supervised: Vec<f64>) -> Result<Self> {
+        check_len(
+            "corrections",
+            corrections.len(),
+            "supervised",
+            supervised.len(),
+        )?;
+        if corrections.is_empty() {
+            return Err(Error::EmptyReference);
+        }
+        for (ref_idx, (&c, &s)) in corrections.iter().zip(&supervised).enumerate() {
+            if !(c.is_finite() && s.is_finite() && c >= 0.0 && c <= s) {
+                return Err(Error::BadCounts {
+                    ref_idx,
+                    corrections: c,
+                    supervised: s,
+                });
+            }
+        }
+        Ok(Self {
+            corrections,
+            supervised,
+        })
+    }
+
+    /// Number of reference samples `T_ref`.
+    #[must_use]
+    pub fn n_ref(&self) -> usize {
+        self.supervised.len()
+    }
+
+    /// Correction mass per reference sample (`Σ z_t` of Eq. 9, fractional).
+    #[must_use]
+    pub fn corrections(&self) -> &[f64] {
+        &self.corrections
+    }
+
+    /// Supervised mass per reference sample (replaces `n_e` in Eq. 9, fractional).
+    #[must_use]
+    pub fn supervised(&self) -> &[f64] {
+        &self.supervised
+    }
+
+    /// Total correction mass over all samples (= number of corrected observations
+    /// recorded, up to rounding).
+    #[must_use]
+    pub fn total_corrections(&self) -> f64 {
+        self.corrections.iter().sum()
+    }
+
+    /// Total supervised mass over all samples (= number of observations recorded, up to
+    /// rounding).
+    #[must_use]
+    pub fn total_supervised(&self) -> f64 {
+        self.supervised.iter().sum()
+    }
+
+    /// Records one execution.
+    ///
+    /// `supervised_ref_times[k]` is the reference time (in reference samples, fractional,
+    /// in `[0, T_ref − 1]`) of the execution's `k`-th *supervised* control sample, and
+    /// `corrected[k]` says whether the operator gave a correction there. Each observation
+    /// is split linearly between the two neighbouring reference samples. Samples the robot
+    /// ran unsupervised (high confidence) must not be passed: they carry no information.
+    ///
+    /// All inputs are checked before anything is added, so an error leaves `self`
+    /// unchanged.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] if the slices differ in length;
+    /// [`Error::RefTimeOutOfRange`] naming the first non-finite or out-of-range time.
+    pub fn record(&mut self, supervised_ref_times: &[f64], corrected: &[bool]) -> Result<()> {
+        check_len(
+            "supervised_ref_times",
+            supervised_ref_times.len(),
+            "corrected",
+            corrected.len(),
+        )?;
+        let n_ref = self.n_ref();
+        // Lossless for any reference shorter than 2^53 samples.
+        let t_max = (n_ref - 1) as f64;
+        for (obs_idx, &ref_time) in supervised_ref_times.iter().enumerate() {
+            if !(ref_time >= 0.0 && ref_time <= t_max) {
+                return Err(Error::RefTimeOutOfRange {
+                    obs_idx,
+                    ref_time,
+                    n_ref,
+                });
+            }
+        }
+        for (&t, &c) in supervised_ref_times.iter().zip(corrected) {
+            let (lo, w) = split(t, n_ref);
+            let w_lo = 1.0 - w;
+            self.supervised[lo] += w_lo;
+            if c {
+                self.corrections[lo] += w_lo;
+            }
+            if w > 0.0 {
+                self.supervised[lo + 1] += w;
+                if c {
+                    self.corrections[lo + 1] += w;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `(⌊t⌋, t − ⌊t⌋)` for a checked `t ∈ [0, n_ref − 1]`; the weight is 0 at `t = n_ref − 1`
+/// so `⌊t⌋ + 1` is only touched when it exists.
+#[inline]
+fn split(t: f64, n_ref: usize) -> (usize, f64) {
+    let lo = (t.floor() as usize).min(n_ref - 1);
+    (lo, t - lo as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn splits_linearly_between_neighbours() {
+        let mut obs = Observations::new(5).unwrap();
+        obs.record(&[1.25, 3.0, 4.0, 0.0], &[true, false, true, false])
+            .unwrap();
+        assert_eq!(obs.supervised(), &[1.0, 0.75, 0.25, 1.0, 1.0]);
+        assert_eq!(obs.corrections(), &[0.0, 0.75, 0.25, 0.0, 1.0]);
+        assert_eq!(obs.total_supervised(), 4.0);
+        assert_eq!(obs.total_corrections(), 2.0);
+    }
+
+    #[test]
+    fn bad_times_are_rejected_by_index_and_leave_state_unchanged() {
+        let mut obs = Observations::new(3).unwrap();
+        obs.record(&[0.5], &[true]).unwrap();
+        let before = obs.clone();
+        for bad in [-1e-9, 2.000_001, f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let err = obs
+                .record(&[1.0, 0.2, bad], &[false, true, true])
+                .unwrap_err();
+            assert!(
+                matches!(
+                    err,
+                    Error::RefTimeOutOfRange {
+                        obs_idx: 2,
+                        n_ref: 3,
+                        ..
+                    }
+                ),
+                "{err:?}"
+            );
+            assert!(err.to_string().contains("supervised sample 2"), "{err}");
+            assert_eq!(obs, before);
+        }
+        let err = obs.record(&[1.0, 0.2], &[false]).unwrap_err();
+        assert_eq!(
+            err,
+            Error::LengthMismatch {
+                left_name: "supervised_ref_times",
+                left: 2,
+                right_name: "corrected",
+                right: 1
+            }
+        );
+        assert_eq!(obs, before);
+    }
+
+    #[test]
+    fn single_sample_reference() {
+        let mut obs = Observations::new(1).unwrap();
+        obs.record(&[0.0, 0.0], &[true, false]).unwrap();
+        assert_eq!(
+            (obs.supervised(), obs.corrections()),
+            (&[2.0][..], &[1.0][..])
+        );
+        assert!(obs.record(&[0.1], &[false]).is_err());
+        assert_eq!(Observations::new(0).unwrap_err(), Error::EmptyReference);
+    }
+
+    #[test]
+    fn from_counts_checks_invariant() {
+        assert!(Observations::from_counts(vec![0.0, 1.0], vec![1.0, 1.0]).is_ok());
+        assert!(matches!(
+            Observations::from_counts(vec![0.0, 1.5], vec![1.0, 1.0]),
+            Err(Error::BadCounts { ref_idx: 1, .. })
+        ));
+        assert!(matches!(
+            Observations::from_counts(vec![-0.1], vec![1.0]),
+            Err(Error::BadCounts { ref_idx: 0, .. })
+        ));
+        assert!(matches!(
+            Observations::from_counts(vec![0.0], vec![f64::NAN]),
+            Err(Error::BadCounts { ref_idx: 0, .. })
+        ));
+        assert!(matches!(
+            Observations::from_counts(vec![0.0], vec![1.0, 2.0]),
+            Err(Error::LengthMismatch {
+                left: 1,
+                right: 2,
+                ..
+            })
+        ));
+        assert_eq!(
+            Observations::from_counts(vec![], vec![]),
+            Err(Error::EmptyReference)
+        );
+    }
+
+    #[test]
+    fn serde_round_trip_and_validation() {
+        let mut obs = Observations::new(3).unwrap();
+        obs.record(&[0.3, 1.9], &[true, false]).unwrap();
+        let json = serde_json::to_string(&obs).unwrap();
+        let back: Observations = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, obs);
+        let bad = r#"{"corrections":[2.0],"supervised":[1.0]}"#;
+        let err = serde_json::from_str::<Observations>(bad).unwrap_err();
+        assert!(err.to_string().contains("reference sample 0"), "{err}");
+        let unknown = r#"{"corrections":[0.0],"supervised":[1.0],"x":1}"#;
+        assert!(serde_json::from_str::<Observations>(unknown).is_err());
+    }
+}
