@@ -1,23 +1,39 @@
 //! Criterion bench: record two executions and recompute `conf` for 6000 reference samples
 //! in a mid-study state (about half the samples still low-confidence, each execution
-//! supervising ~3000 samples). Target: ≤ 1 ms. `warm` = the evaluation cache as left by
-//! earlier iterations; `cold_cache` = the same state just restored from a file.
+//! supervising ~3000 samples). Target: ≤ 1 ms. The state is produced by replaying 40
+//! study iterations; `warm` keeps the evaluation cache those iterations filled,
+//! `cold_cache` is the same state as just restored from a file.
 
 use criterion::{BatchSize, BenchmarkId, Criterion};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tandem_confidence::{Confidence, ConfidenceParams, Observations};
 
-/// Kind of reference sample in the synthetic mid-study state.
+/// Kind of reference sample in the synthetic sanding-like task.
 #[derive(Clone, Copy, PartialEq)]
 enum Kind {
-    /// Already latched high-confidence.
-    Latched,
-    /// Sanding over paint about half the time: frequent corrections, never latches.
-    Painted,
-    /// Variable demonstrations but never corrected (1 % false corrections): slowly
-    /// accumulating evidence, near the threshold.
+    /// Demonstrations agree (σ²_D ≤ 0.001): high confidence from the prior.
+    Steady,
+    /// Moderate variance (σ²_D in 0.01–0.05): latches after 25–67 clean executions.
+    Moderate,
+    /// Large variance, corrected only by mistake (1 %): latches after ≥ 90 executions.
     Quiet,
+    /// Painted about half the time: corrected in half the executions, never latches.
+    Painted,
+}
+
+impl Kind {
+    fn sigma2_d(self, rng: &mut ChaCha8Rng) -> f64 {
+        match self {
+            Kind::Steady => rng.random_range(0.0..0.001),
+            Kind::Moderate => rng.random_range(0.01..0.05),
+            Kind::Quiet => rng.random_range(0.2..2.0),
+            Kind::Painted => rng.random_range(0.3..1.0),
+        }
+    }
+    fn p_correction(self) -> f64 {
+        if self == Kind::Painted { 0.5 } else { 0.01 }
+    }
 }
 
 /// One study iteration's inputs, built outside the timed closure.
@@ -29,17 +45,37 @@ struct Setup {
     executions: Vec<(Vec<f64>, Vec<bool>)>,
 }
 
+/// One execution: every low-confidence sample is supervised, visited at fractional
+/// reference times (local speed 0.8–1.25 reference samples per control tick).
+fn execution(rng: &mut ChaCha8Rng, conf: &Confidence, kind: &[Kind]) -> (Vec<f64>, Vec<bool>) {
+    let mut times = Vec::new();
+    let mut corrected = Vec::new();
+    for region in conf.low_regions() {
+        let mut t = region.start as f64 + rng.random_range(0.0..0.5);
+        while t <= (region.end - 1) as f64 {
+            times.push(t);
+            corrected.push(rng.random_bool(kind[t as usize].p_correction()));
+            t += rng.random_range(0.8..1.25);
+        }
+    }
+    (times, corrected)
+}
+
 fn setup(n_ref: usize, seed: u64, warm: bool) -> Setup {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    // Regions of 100–400 samples cycling latched, painted, latched, quiet, latched,
-    // painted: ~1/2 latched, ~1/3 painted, ~1/6 quiet.
+    // Regions of 100–400 samples cycling through the kinds: ~30 % steady, ~20 % moderate,
+    // ~20 % quiet, ~30 % painted.
     let cycle = [
-        Kind::Latched,
+        Kind::Steady,
         Kind::Painted,
-        Kind::Latched,
+        Kind::Moderate,
         Kind::Quiet,
-        Kind::Latched,
+        Kind::Steady,
         Kind::Painted,
+        Kind::Moderate,
+        Kind::Painted,
+        Kind::Quiet,
+        Kind::Steady,
     ];
     let mut kind = Vec::with_capacity(n_ref);
     for &k in cycle.iter().cycle() {
@@ -49,73 +85,33 @@ fn setup(n_ref: usize, seed: u64, warm: bool) -> Setup {
         let len = rng.random_range(100..400).min(n_ref - kind.len());
         kind.extend(std::iter::repeat_n(k, len));
     }
-    let sigma2_d: Vec<f64> = kind
-        .iter()
-        .map(|k| match k {
-            Kind::Latched => rng.random_range(0.0..0.2),
-            Kind::Painted => rng.random_range(0.3..1.0),
-            Kind::Quiet => rng.random_range(0.05..0.5),
-        })
-        .collect();
-    // ~60 executions so far; supervised mass and corrections per kind.
-    let mut corrections = vec![0.0; n_ref];
-    let mut supervised = vec![0.0; n_ref];
-    for n in 0..n_ref {
-        let (s, rate) = match kind[n] {
-            Kind::Latched => (rng.random_range(0.0..40.0), 0.01),
-            Kind::Painted => (rng.random_range(50.0..70.0), 0.5),
-            Kind::Quiet => (rng.random_range(0.0..70.0), 0.01),
-        };
-        supervised[n] = s;
-        corrections[n] = s * rate * rng.random_range(0.5..1.5);
-    }
-    let obs = Observations::from_counts(corrections, supervised).expect("valid by construction");
+    let base: Vec<f64> = kind.iter().map(|k| k.sigma2_d(&mut rng)).collect();
+    // Each iteration's executions enter Eq. 6, so the variance moves a little.
+    let jitter = |rng: &mut ChaCha8Rng| -> Vec<f64> {
+        base.iter()
+            .map(|s| s * rng.random_range(0.95..1.05))
+            .collect()
+    };
     let params = ConfidenceParams::default();
-    let mut conf =
-        Confidence::from_parts(params, kind.iter().map(|&k| k == Kind::Latched).collect())
-            .expect("valid by construction");
-    // Earlier iterations saw slightly different variances (each pair of executions enters
-    // Eq. 6): replaying 20 of them latches what the history supports and, as in a running
-    // study, fills the boundary cache around the current priors.
-    for _ in 0..20 {
-        let jittered: Vec<f64> = sigma2_d
-            .iter()
-            .map(|s| s * rng.random_range(0.9..1.1))
-            .collect();
-        conf.update(&jittered, &obs).expect("valid by construction");
+    let mut conf = Confidence::from_prior(&jitter(&mut rng), params).expect("valid");
+    let mut obs = Observations::new(n_ref).expect("n_ref > 0");
+    // Replay 40 iterations of the study loop (two executions each).
+    for _ in 0..40 {
+        for _ in 0..2 {
+            let (times, corrected) = execution(&mut rng, &conf, &kind);
+            obs.record(&times, &corrected).expect("valid times");
+        }
+        conf.update(&jitter(&mut rng), &obs).expect("valid inputs");
     }
     if !warm {
-        // Same latched state, empty cache (e.g. just loaded from a state file).
         let params = conf.params().clone();
         conf = Confidence::from_parts(params, conf.conf().to_vec()).expect("valid state");
     }
-    // Two executions: each supervises every low-confidence sample, visiting it at a
-    // fractional reference time (local speed 0.8–1.25 reference samples per tick).
-    let executions = (0..2)
-        .map(|_| {
-            let mut times = Vec::new();
-            let mut corrected = Vec::new();
-            for region in conf.low_regions() {
-                let mut t = region.start as f64 + rng.random_range(0.0..0.5);
-                while t <= (region.end - 1) as f64 {
-                    let k = kind[t as usize];
-                    times.push(t);
-                    corrected.push(rng.random_bool(if k == Kind::Painted { 0.5 } else { 0.01 }));
-                    t += rng.random_range(0.8..1.25);
-                }
-            }
-            (times, corrected)
-        })
-        .collect();
-    // The variance also moves a little between iterations (new executions enter Eq. 6).
-    let sigma2_d = sigma2_d
-        .iter()
-        .map(|s| s * rng.random_range(0.95..1.05))
-        .collect();
+    let executions = (0..2).map(|_| execution(&mut rng, &conf, &kind)).collect();
     Setup {
+        sigma2_d: jitter(&mut rng),
         conf,
         obs,
-        sigma2_d,
         executions,
     }
 }

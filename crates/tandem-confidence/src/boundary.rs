@@ -4,7 +4,7 @@
 //! For fixed `x = μ_c`, `I_x(α, β)` is strictly decreasing in `α` and strictly increasing
 //! in `β`. So the set `{I_x(α, β) > γ_c}` lies above a curve `β = B*(α)` that increases
 //! with `α`. At grid nodes `α_k = k·H` this module brackets `B*(α_k)` by two values that
-//! statrs has classified with a margin: `β_lo` with `I(α_k, β_lo) ≤ γ_c − M` and `β_hi` with
+//! statrs has classified with a margin `M = 1e-6`: `β_lo` with `I(α_k, β_lo) ≤ γ_c − M` and `β_hi` with
 //! `I(α_k, β_hi) ≥ γ_c + M`. For a sample with `α_k ≤ α < α_{k+1}`:
 //!
 //! - `β ≤ β_lo(α_k)` ⇒ `I(α, β) ≤ I(α_k, β) ≤ I(α_k, β_lo) ≤ γ_c − M`: low confidence;
