@@ -416,8 +416,8 @@ fn overlaps(lc: &[Vec<(f64, f64)>; 2], offset_s: f64) -> bool {
     false
 }
 
-/// The point at fraction `v ∈ [0, 1)` of the measure of the admissible offsets: `[0, L1]`
-/// without every open interval `(a_i − d_j, b_i − c_j)` that would make robot 1's interval
+/// The point at fraction `v ∈ [0, 1)` of the measure of the admissible offsets:
+/// `[0, max_s = |ψ_E1|]` without every open interval `(a_i − d_j, b_i − c_j)` that would make robot 1's interval
 /// `[a_i, b_i)` and robot 2's `[c_j, d_j)` overlap. `None` if that set has measure zero.
 fn feasible_offset(scratch: &mut Scratch, max_s: f64, v: f64) -> Option<f64> {
     let forbidden = &mut scratch.forbidden;
@@ -612,4 +612,61 @@ pub fn sample_schedule(
         source: chosen.2,
         stats,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(lc0: &[(f64, f64)], lc1: &[(f64, f64)]) -> Scratch {
+        Scratch {
+            lc: [lc0.to_vec(), lc1.to_vec()],
+            ..Scratch::default()
+        }
+    }
+
+    #[test]
+    fn feasible_offset_by_hand() {
+        // Robot 1 LC [1, 2), robot 2 LC [0, 1) after its start: τ ∈ (0, 2) overlaps, so the
+        // admissible offsets in [0, 3] are {0} ∪ [2, 3], of measure 1.
+        let mut s = scratch(&[(1.0, 2.0)], &[(0.0, 1.0)]);
+        assert_eq!(feasible_offset(&mut s, 3.0, 0.0), Some(2.0));
+        assert_eq!(feasible_offset(&mut s, 3.0, 0.5), Some(2.5));
+        // Two forbidden stretches: robot 2 LC [0, 1) and [2, 3) against robot 1 LC [4, 5):
+        // τ ∈ (3, 5) and (1, 3) → free [0, 1] ∪ [5, 6] within [0, 6].
+        let mut s = scratch(&[(4.0, 5.0)], &[(0.0, 1.0), (2.0, 3.0)]);
+        assert_eq!(feasible_offset(&mut s, 6.0, 0.25), Some(0.5));
+        assert_eq!(feasible_offset(&mut s, 6.0, 0.75), Some(5.5));
+        // Everything forbidden: one LC run covering each whole execution.
+        let mut s = scratch(&[(0.0, 3.0)], &[(0.0, 3.0)]);
+        assert_eq!(feasible_offset(&mut s, 3.0, 0.5), None);
+    }
+
+    #[test]
+    fn overlap_test_by_hand() {
+        let lc = [vec![(1.0, 2.0)], vec![(0.0, 1.0)]];
+        assert!(overlaps(&lc, 0.5));
+        assert!(!overlaps(&lc, 2.0)); // touching
+        assert!(!overlaps(&lc, 0.0)); // touching
+    }
+
+    #[test]
+    fn pieces_split_runs_evenly() {
+        let p = Problem::new(
+            vec![true; 5].into_iter().chain([false; 2]).collect(),
+            vec![1.0; 7],
+            vec![0.5; 7],
+            vec![2.0; 7],
+            0.1,
+        )
+        .unwrap();
+        let ps = pieces(&p, Distribution::PerRun { pieces: 2 });
+        let spans: Vec<(usize, usize, bool)> =
+            ps.iter().map(|q| (q.start, q.end, q.high_conf)).collect();
+        assert_eq!(spans, vec![(0, 2, true), (2, 5, true), (5, 7, false)]);
+        // Durations: HC piece of 2 samples = 2·0.5·0.1 s at u = 0, + 2·1.5·0.1 s at u = 1.
+        assert!((ps[0].min_s - 0.1).abs() < 1e-12 && (ps[0].span_s - 0.3).abs() < 1e-12);
+        assert!((ps[2].min_s - 0.2).abs() < 1e-12 && ps[2].span_s == 0.0);
+        assert_eq!(pieces(&p, Distribution::PerSample).len(), 6);
+    }
 }

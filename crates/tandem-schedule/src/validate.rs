@@ -53,7 +53,8 @@ pub enum Violation {
     },
     /// Constraint 3: both robots are scheduled low-confidence at once (global time).
     #[error(
-        "both robots low-confidence from global time {start_s} s to {end_s} s (robot 1 reference samples {ref_ranges:?}[0], robot 2 {ref_ranges:?}[1]) (Eq. 20, constraint 3)"
+        "both robots low-confidence from global time {start_s} s to {end_s} s (reference samples {:?} of robot 1, {:?} of robot 2) (Eq. 20, constraint 3)",
+        .ref_ranges[0], .ref_ranges[1]
     )]
     BothLowConfidence {
         /// Global time (s) at which the overlap starts.
@@ -317,14 +318,16 @@ mod tests {
         // τ = 0: both robots reach the LC run at 0.25 s.
         let mut s = ok_schedule();
         s.offset_s = 0.0;
+        let v = validate(&p, &s).unwrap_err();
         assert_eq!(
-            validate(&p, &s),
-            Err(Violation::BothLowConfidence {
+            v,
+            Violation::BothLowConfidence {
                 start_s: 0.25,
                 end_s: 1.25,
                 ref_ranges: [(1, 3), (1, 3)]
-            })
+            }
         );
+        assert!(v.to_string().contains("(1, 3) of robot 1"), "{v}");
 
         let mut s = ok_schedule();
         s.grad_exec[0][2] = 1.5;

@@ -162,3 +162,16 @@ fn most_random_problems_get_sampled_schedules() {
     }
     assert!(sampled >= 20, "only {sampled} of 40 sampled");
 }
+
+/// Non-vacuity: the runtime check does see overlaps when a schedule breaks constraint 3.
+#[test]
+fn an_overlapping_schedule_is_caught_at_runtime() {
+    let conf: Vec<bool> = (0..30).map(|n| !(10..20).contains(&n)).collect();
+    let p = Problem::new(conf, vec![1.0; 30], vec![0.5; 30], vec![2.0; 30], 0.01).unwrap();
+    let mut s = p.serial_schedule();
+    s.offset_s = 0.0;
+    assert!(tandem_schedule::validate(&p, &s).is_err());
+    for op in [Operator::Fastest, Operator::Slowest, Operator::Switching] {
+        assert!(run(&p, &s, p.dt_s(), op, 0).is_some(), "{op:?}");
+    }
+}

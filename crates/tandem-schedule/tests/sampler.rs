@@ -2,8 +2,8 @@
 
 use proptest::prelude::*;
 use tandem_schedule::{
-    MarginCheck, Problem, SamplerParams, Schedule, Source, sample_schedule, validate,
-    validate_with_tick,
+    Distribution, MarginCheck, OffsetSampling, Problem, SamplerParams, Schedule, Source,
+    sample_schedule, validate, validate_with_tick,
 };
 
 /// `n` samples, low confidence on `lc`, bounds `[lo, hi]`×mean around a wobbling mean.
@@ -53,10 +53,27 @@ proptest! {
     /// Every returned schedule passes `validate`, and it is never slower than the serial one.
     #[test]
     fn returned_schedules_are_valid_and_no_slower_than_serial(
-        p in random_problem(), seed in any::<u64>(), tick_frac in 0.3f64..=1.0
+        p in random_problem(),
+        seed in any::<u64>(),
+        tick_frac in 0.3f64..=1.0,
+        pieces in 0usize..4,
+        uniform_offset in any::<bool>(),
+        p_fastest in 0.0f64..=1.0,
     ) {
         let tick_s = tick_frac * p.dt_s();
-        let params = SamplerParams { samples: 200, seed, tick_s: Some(tick_s), ..SamplerParams::default() };
+        let params = SamplerParams {
+            samples: 200,
+            seed,
+            tick_s: Some(tick_s),
+            distribution: if pieces == 0 {
+                Distribution::PerSample
+            } else {
+                Distribution::PerRun { pieces }
+            },
+            offset: if uniform_offset { OffsetSampling::Uniform } else { OffsetSampling::UniformFeasible },
+            p_fastest,
+            ..SamplerParams::default()
+        };
         let out = sample_schedule(&p, &params, None).unwrap();
         prop_assert_eq!(validate_with_tick(&p, &out.schedule, tick_s), Ok(()));
         let serial = p.serial_schedule().t_total_s(p.dt_s());
@@ -203,7 +220,7 @@ fn bad_params_are_rejected() {
             ..SamplerParams::default()
         },
         SamplerParams {
-            distribution: tandem_schedule::Distribution::PerRun { pieces: 0 },
+            distribution: Distribution::PerRun { pieces: 0 },
             ..SamplerParams::default()
         },
     ] {
