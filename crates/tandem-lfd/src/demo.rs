@@ -1,0 +1,664 @@
+//! Demonstrations (paper Eq. 1): channel names, sample-major data, sample period; CSV and
+//! JSON readers with located errors; the channel-kind schema.
+
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::{Error, Result};
+
+/// Sample period used when a file carries neither a `t` column nor a `dt_s` field and the
+/// caller gives none: 0.01 s (100 Hz, the fixtures' rate).
+pub const DEFAULT_DT_S: f64 = 0.01;
+
+/// Relative tolerance on sample periods (even spacing of a `t` column; equal periods
+/// across demonstrations): 1 %.
+pub const DT_TOLERANCE: f64 = 0.01;
+
+/// One demonstration `X_i ∈ R^{m × T_i}` (Eq. 1) in its own demo time.
+///
+/// Samples are stored sample-major: sample `t` (demo samples), channel `j` at
+/// `samples()[t * n_channels() + j]`, so a `tandem_warp::SignalRef` can borrow them.
+/// Every value is finite and there are at least 2 samples.
+///
+/// Serde form: the JSON document of [`Demonstration::from_json_str`]
+/// (`{"channels", "dt_s", "samples"}`); deserializing validates like
+/// [`Demonstration::new`] (the source label is not persisted).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "DemoJson", into = "DemoJson")]
+pub struct Demonstration {
+    source: String,
+    channel_names: Vec<String>,
+    samples: Vec<f64>,
+    dt_s: f64,
+}
+
+impl Demonstration {
+    /// Builds a demonstration from channel names, sample-major samples and the sample
+    /// period `dt_s` (seconds). The source label (used in error messages) is `<memory>`.
+    ///
+    /// Errors: no channels, empty or duplicated names, `samples.len()` not a multiple of
+    /// the channel count, fewer than 2 samples, a non-finite value, `dt_s` not finite > 0.
+    pub fn new(channel_names: Vec<String>, samples: Vec<f64>, dt_s: f64) -> Result<Self> {
+        let demo = Self {
+            source: "<memory>".to_owned(),
+            channel_names,
+            samples,
+            dt_s,
+        };
+        demo.check()?;
+        Ok(demo)
+    }
+
+    /// Replaces the source label that error messages use to name this demonstration.
+    #[must_use]
+    pub fn with_source(mut self, source: impl Into<String>) -> Self {
+        self.source = source.into();
+        self
+    }
+
+    fn check(&self) -> Result<()> {
+        let bad = |why: String| Error::BadData {
+            what: self.source.clone(),
+            why,
+        };
+        if self.channel_names.is_empty() {
+            return Err(bad("no channels".into()));
+        }
+        let mut seen = BTreeMap::new();
+        for (j, name) in self.channel_names.iter().enumerate() {
+            if name.is_empty() {
+                return Err(bad(format!("channel {j} has an empty name")));
+            }
+            if let Some(k) = seen.insert(name.as_str(), j) {
+                return Err(bad(format!("channel `{name}` appears twice ({k} and {j})")));
+            }
+        }
+        let m = self.channel_names.len();
+        if self.samples.len() % m != 0 {
+            return Err(bad(format!(
+                "{} values are not a whole number of {m}-channel samples",
+                self.samples.len()
+            )));
+        }
+        if self.samples.len() / m < 2 {
+            return Err(Error::TooFewSamples {
+                file: self.source.clone(),
+                found: self.samples.len() / m,
+            });
+        }
+        if let Some(k) = self.samples.iter().position(|v| !v.is_finite()) {
+            return Err(bad(format!(
+                "sample {}, channel `{}`: non-finite value {}",
+                k / m,
+                self.channel_names[k % m],
+                self.samples[k]
+            )));
+        }
+        if !(self.dt_s.is_finite() && self.dt_s > 0.0) {
+            return Err(bad(format!(
+                "sample period {} s is not finite > 0",
+                self.dt_s
+            )));
+        }
+        Ok(())
+    }
+
+    /// The source label (file path, or `<memory>`).
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// Channel names, in column order.
+    pub fn channel_names(&self) -> &[String] {
+        &self.channel_names
+    }
+
+    /// Number of channels `m`.
+    pub fn n_channels(&self) -> usize {
+        self.channel_names.len()
+    }
+
+    /// Number of samples `T_i` (demo samples).
+    pub fn n_samples(&self) -> usize {
+        self.samples.len() / self.channel_names.len()
+    }
+
+    /// Sample period `Δt_s`, seconds.
+    pub fn dt_s(&self) -> f64 {
+        self.dt_s
+    }
+
+    /// All samples, sample-major (`T_i × m`).
+    pub fn samples(&self) -> &[f64] {
+        &self.samples
+    }
+
+    /// Sample `t` (demo time, samples) as `m` values. Panics if `t ≥ n_samples()`.
+    pub fn sample(&self, t: usize) -> &[f64] {
+        let m = self.n_channels();
+        &self.samples[t * m..(t + 1) * m]
+    }
+
+    /// Index of channel `name`, if present.
+    pub fn channel_index(&self, name: &str) -> Option<usize> {
+        self.channel_names.iter().position(|c| c == name)
+    }
+
+    /// This demonstration with its channels in the order of `names`.
+    ///
+    /// Errors with [`Error::ChannelMismatch`] when the channel sets differ.
+    pub fn conform_to(&self, names: &[String]) -> Result<Cow<'_, Self>> {
+        if self.channel_names == names {
+            return Ok(Cow::Borrowed(self));
+        }
+        let mismatch = || Error::ChannelMismatch {
+            file: self.source.clone(),
+            expected: names.to_vec(),
+            found: self.channel_names.clone(),
+        };
+        if names.len() != self.channel_names.len() {
+            return Err(mismatch());
+        }
+        let map = names
+            .iter()
+            .map(|n| self.channel_index(n).ok_or_else(mismatch))
+            .collect::<Result<Vec<_>>>()?;
+        let m = names.len();
+        let mut samples = Vec::with_capacity(self.samples.len());
+        for row in self.samples.chunks_exact(m) {
+            samples.extend(map.iter().map(|&j| row[j]));
+        }
+        Ok(Cow::Owned(Self {
+            source: self.source.clone(),
+            channel_names: names.to_vec(),
+            samples,
+            dt_s: self.dt_s,
+        }))
+    }
+
+    /// Reads a CSV file: see [`Demonstration::from_csv_str`].
+    pub fn from_csv_path(path: impl AsRef<Path>, dt_s: Option<f64>) -> Result<Self> {
+        let path = path.as_ref();
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            file: file.clone(),
+            source,
+        })?;
+        Self::from_csv_str(&text, &file, dt_s)
+    }
+
+    /// Parses CSV text: a header row of channel names, then one row of numbers per sample.
+    ///
+    /// A column named `t` (seconds) is optional; when present it is removed from the
+    /// channels, must be strictly increasing and evenly spaced within 1 %, and sets `Δt_s`
+    /// to its mean spacing. Otherwise `Δt_s` is `dt_s`, or [`DEFAULT_DT_S`] when `None`.
+    /// Blank lines are skipped; header names may be double-quoted.
+    /// `file` names the input in errors, which carry the 1-based line and field number.
+    pub fn from_csv_str(text: &str, file: &str, dt_s: Option<f64>) -> Result<Self> {
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .map(|(k, l)| (k + 1, l))
+            .filter(|(_, l)| !l.trim().is_empty());
+        let Some((header_line, header)) = lines.next() else {
+            return Err(Error::EmptyFile { file: file.into() });
+        };
+        let names: Vec<String> = header
+            .split(',')
+            .map(|f| f.trim().trim_matches('"').to_owned())
+            .collect();
+        let bad_header = |column: usize, why: String| Error::BadHeader {
+            file: file.into(),
+            line: header_line,
+            column,
+            why,
+        };
+        for (j, name) in names.iter().enumerate() {
+            if name.is_empty() {
+                return Err(bad_header(j + 1, "empty channel name".into()));
+            }
+            if let Some(k) = names[..j].iter().position(|n| n == name) {
+                return Err(bad_header(
+                    j + 1,
+                    format!("channel `{name}` repeats column {}", k + 1),
+                ));
+            }
+        }
+        let t_col = names.iter().position(|n| n == "t");
+        if names.len() == usize::from(t_col.is_some()) {
+            return Err(bad_header(1, "no data channels".into()));
+        }
+        let width = names.len();
+        let mut samples = Vec::new();
+        let mut times: Vec<(usize, f64)> = Vec::new();
+        for (line, row) in lines {
+            let fields: Vec<&str> = row.split(',').collect();
+            if fields.len() != width {
+                return Err(Error::RaggedRow {
+                    file: file.into(),
+                    line,
+                    column: fields.len().min(width) + 1,
+                    expected: width,
+                    found: fields.len(),
+                });
+            }
+            for (j, field) in fields.iter().enumerate() {
+                let text = field.trim();
+                let value: f64 = text.parse().map_err(|_| Error::NotNumeric {
+                    file: file.into(),
+                    line,
+                    column: j + 1,
+                    channel: names[j].clone(),
+                    text: text.into(),
+                })?;
+                if !value.is_finite() {
+                    return Err(Error::NonFinite {
+                        file: file.into(),
+                        line,
+                        column: j + 1,
+                        channel: names[j].clone(),
+                        text: text.into(),
+                    });
+                }
+                if Some(j) == t_col {
+                    times.push((line, value));
+                } else {
+                    samples.push(value);
+                }
+            }
+        }
+        let n = samples.len() / (width - usize::from(t_col.is_some()));
+        if n < 2 {
+            return Err(Error::TooFewSamples {
+                file: file.into(),
+                found: n,
+            });
+        }
+        let dt_s = match t_col {
+            Some(col) => time_column_period(&times, file, col + 1)?,
+            None => dt_s.unwrap_or(DEFAULT_DT_S),
+        };
+        let channel_names = names
+            .into_iter()
+            .enumerate()
+            .filter(|(j, _)| Some(*j) != t_col)
+            .map(|(_, n)| n)
+            .collect();
+        Ok(Self::new(channel_names, samples, dt_s)?.with_source(file))
+    }
+
+    /// Reads a JSON file: see [`Demonstration::from_json_str`].
+    pub fn from_json_path(path: impl AsRef<Path>, dt_s: Option<f64>) -> Result<Self> {
+        let path = path.as_ref();
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            file: file.clone(),
+            source,
+        })?;
+        Self::from_json_str(&text, &file, dt_s)
+    }
+
+    /// Parses a JSON document `{"channels": [names], "dt_s": seconds, "samples": [[row], …]}`
+    /// (one row of `m` numbers per sample; `dt_s` optional, defaulting to `dt_s` then
+    /// [`DEFAULT_DT_S`]; no other keys). Errors carry the 1-based line and character column.
+    pub fn from_json_str(text: &str, file: &str, dt_s: Option<f64>) -> Result<Self> {
+        if text.trim().is_empty() {
+            return Err(Error::EmptyFile { file: file.into() });
+        }
+        let doc: DemoJson = serde_json::from_str(text).map_err(|e| Error::Json {
+            file: file.into(),
+            line: e.line(),
+            column: e.column(),
+            why: e.to_string(),
+        })?;
+        let m = doc.channels.len();
+        let json_err = |row: Option<usize>, why: String| {
+            let (line, column) = row
+                .and_then(|r| json_row_position(text, r))
+                .unwrap_or((1, 1));
+            Error::Json {
+                file: file.into(),
+                line,
+                column,
+                why,
+            }
+        };
+        if m == 0 {
+            return Err(json_err(None, "`channels` is empty".into()));
+        }
+        for (r, row) in doc.samples.iter().enumerate() {
+            if row.len() != m {
+                return Err(json_err(
+                    Some(r),
+                    format!(
+                        "ragged row: sample {r} has {} values, expected {m}",
+                        row.len()
+                    ),
+                ));
+            }
+        }
+        if doc.samples.len() < 2 {
+            return Err(Error::TooFewSamples {
+                file: file.into(),
+                found: doc.samples.len(),
+            });
+        }
+        let period = doc.dt_s.or(dt_s).unwrap_or(DEFAULT_DT_S);
+        if !(period.is_finite() && period > 0.0) {
+            return Err(json_err(
+                None,
+                format!("`dt_s` = {period} is not finite > 0"),
+            ));
+        }
+        let samples = doc.samples.into_iter().flatten().collect();
+        Demonstration::new(doc.channels, samples, period)
+            .map(|d| d.with_source(file))
+            .map_err(|e| match e {
+                Error::BadData { why, .. } => json_err(None, why),
+                other => other,
+            })
+    }
+
+    /// Serializes to the JSON document [`Demonstration::from_json_str`] reads.
+    pub fn to_json_string(&self) -> String {
+        let doc = DemoJsonRef {
+            channels: &self.channel_names,
+            dt_s: self.dt_s,
+            samples: self.samples.chunks_exact(self.n_channels()).collect(),
+        };
+        serde_json::to_string(&doc).expect("serializing numbers and strings cannot fail")
+    }
+}
+
+/// Checks a `t` column and returns its mean spacing (seconds).
+fn time_column_period(times: &[(usize, f64)], file: &str, column: usize) -> Result<f64> {
+    let bad = |line: usize, why: String| Error::BadTime {
+        file: file.into(),
+        line,
+        column,
+        why,
+    };
+    for w in times.windows(2) {
+        if w[1].1 <= w[0].1 {
+            return Err(bad(
+                w[1].0,
+                format!("{} does not increase after {}", w[1].1, w[0].1),
+            ));
+        }
+    }
+    let n = times.len();
+    let mean = (times[n - 1].1 - times[0].1) / (n - 1) as f64;
+    for w in times.windows(2) {
+        let step = w[1].1 - w[0].1;
+        if (step - mean).abs() > DT_TOLERANCE * mean {
+            return Err(bad(
+                w[1].0,
+                format!("step {step} s differs from the mean step {mean} s by more than 1 %"),
+            ));
+        }
+    }
+    Ok(mean)
+}
+
+/// 1-based (line, column) of the start of row `row` of the top-level `samples` array.
+fn json_row_position(text: &str, row: usize) -> Option<(usize, usize)> {
+    let (mut depth, mut in_string, mut escape) = (0usize, false, false);
+    let mut string_start = 0;
+    let mut last_key: Option<&str> = None;
+    let mut in_samples = false;
+    let mut count = 0;
+    for (pos, ch) in text.char_indices() {
+        if in_string {
+            if escape {
+                escape = false;
+            } else if ch == '\\' {
+                escape = true;
+            } else if ch == '"' {
+                in_string = false;
+                if depth == 1 {
+                    last_key = Some(&text[string_start..pos]);
+                }
+            }
+            continue;
+        }
+        match ch {
+            '"' => {
+                in_string = true;
+                string_start = pos + 1;
+            }
+            '[' | '{' => {
+                if in_samples && depth == 2 && ch == '[' {
+                    if count == row {
+                        let before = &text[..pos];
+                        let line = before.matches('\n').count() + 1;
+                        let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+                        return Some((line, col));
+                    }
+                    count += 1;
+                }
+                if depth == 1 && ch == '[' && last_key == Some("samples") {
+                    in_samples = true;
+                }
+                depth += 1;
+            }
+            ']' | '}' => {
+                depth = depth.saturating_sub(1);
+                if depth == 1 {
+                    in_samples = false;
+                }
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DemoJson {
+    channels: Vec<String>,
+    #[serde(default)]
+    dt_s: Option<f64>,
+    samples: Vec<Vec<f64>>,
+}
+
+impl TryFrom<DemoJson> for Demonstration {
+    type Error = Error;
+    fn try_from(doc: DemoJson) -> Result<Self> {
+        let m = doc.channels.len();
+        if let Some(r) = doc.samples.iter().position(|row| row.len() != m) {
+            return Err(Error::BadData {
+                what: "demonstration".into(),
+                why: format!("ragged row: sample {r} does not have {m} values"),
+            });
+        }
+        let samples = doc.samples.into_iter().flatten().collect();
+        Self::new(doc.channels, samples, doc.dt_s.unwrap_or(DEFAULT_DT_S))
+    }
+}
+
+impl From<Demonstration> for DemoJson {
+    fn from(d: Demonstration) -> Self {
+        let m = d.n_channels();
+        Self {
+            samples: d.samples.chunks_exact(m).map(<[f64]>::to_vec).collect(),
+            channels: d.channel_names,
+            dt_s: Some(d.dt_s),
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct DemoJsonRef<'a> {
+    channels: &'a [String],
+    dt_s: f64,
+    samples: Vec<&'a [f64]>,
+}
+
+/// What a scalar channel measures. Only quaternion blocks change the statistics
+/// (they are handled on the rotation manifold); the other kinds are documentation for
+/// users of the model and are all averaged as numbers (binary channels may be fractional
+/// in the mean, DESIGN.md).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ChannelKind {
+    /// A Cartesian position coordinate (fixtures: metres).
+    Position,
+    /// A force (fixtures: newtons).
+    Force,
+    /// An on/off signal stored as 0/1.
+    Binary,
+    /// A rate or speed recorded as a channel.
+    Rate,
+    /// Anything else, averaged as a number.
+    Scalar,
+}
+
+/// Four channels that together hold one unit quaternion, named in `[x, y, z, w]` order.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuaternionBlock {
+    /// Block name, used for its rotation-vector coordinates (`<name>.rx`, `.ry`, `.rz`).
+    pub name: String,
+    /// The channel names of the `x, y, z, w` components.
+    pub channels: [String; 4],
+}
+
+/// Channel kinds by name: which channels are quaternion blocks and what the scalars are.
+///
+/// Default: `x, y, z` position; block `q` = `qx, qy, qz, qw`; `force` force; `tool`
+/// binary; `rate` rate; any other channel [`ChannelKind::Scalar`].
+/// A quaternion block applies only when all four of its channels are present; a block with
+/// some but not all channels present is an error at fit time.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ChannelSchema {
+    /// Scalar channel kinds by channel name.
+    pub kinds: BTreeMap<String, ChannelKind>,
+    /// Quaternion blocks.
+    pub quaternions: Vec<QuaternionBlock>,
+}
+
+impl Default for ChannelSchema {
+    fn default() -> Self {
+        let kinds = [
+            ("x", ChannelKind::Position),
+            ("y", ChannelKind::Position),
+            ("z", ChannelKind::Position),
+            ("force", ChannelKind::Force),
+            ("tool", ChannelKind::Binary),
+            ("rate", ChannelKind::Rate),
+        ]
+        .into_iter()
+        .map(|(n, k)| (n.to_owned(), k))
+        .collect();
+        Self {
+            kinds,
+            quaternions: vec![QuaternionBlock {
+                name: "q".into(),
+                channels: ["qx", "qy", "qz", "qw"].map(String::from),
+            }],
+        }
+    }
+}
+
+impl ChannelSchema {
+    /// Kind of scalar channel `name` ([`ChannelKind::Scalar`] when not listed).
+    pub fn kind(&self, name: &str) -> ChannelKind {
+        self.kinds.get(name).copied().unwrap_or(ChannelKind::Scalar)
+    }
+
+    /// Checks that no channel belongs to two quaternion blocks and block names are unique.
+    pub fn validate(&self) -> Result<()> {
+        let mut seen = BTreeMap::new();
+        for (b, block) in self.quaternions.iter().enumerate() {
+            if block.name.is_empty() {
+                return Err(Error::BadParam {
+                    name: "schema.quaternions",
+                    why: format!("block {b} has an empty name"),
+                });
+            }
+            for c in &block.channels {
+                if seen.insert(c.as_str(), b).is_some() {
+                    return Err(Error::BadParam {
+                        name: "schema.quaternions",
+                        why: format!("channel `{c}` appears in more than one block slot"),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_with_time_column_sets_dt() {
+        let d = Demonstration::from_csv_str("t,a,b\n0.0,1,2\n0.02,3,4\n0.04,5,6\n", "f.csv", None)
+            .unwrap();
+        assert_eq!(d.channel_names(), ["a", "b"]);
+        assert_eq!(d.samples(), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert!((d.dt_s() - 0.02).abs() < 1e-15);
+        assert_eq!(d.source(), "f.csv");
+    }
+
+    #[test]
+    fn csv_without_time_uses_given_or_default_dt() {
+        let d = Demonstration::from_csv_str("a\n1\n2\n", "f", Some(0.5)).unwrap();
+        assert_eq!(d.dt_s(), 0.5);
+        let d = Demonstration::from_csv_str("a\r\n1\r\n2\r\n\r\n", "f", None).unwrap();
+        assert_eq!(d.dt_s(), DEFAULT_DT_S);
+        assert_eq!(d.n_samples(), 2);
+    }
+
+    #[test]
+    fn json_row_positions() {
+        let text = "{\"channels\": [\"a\"],\n \"samples\": [[1],\n   [2, 3]]}";
+        assert_eq!(json_row_position(text, 0), Some((2, 14)));
+        assert_eq!(json_row_position(text, 1), Some((3, 4)));
+        assert_eq!(json_row_position(text, 2), None);
+    }
+
+    #[test]
+    fn json_round_trip() {
+        let d = Demonstration::new(vec!["a".into(), "b".into()], vec![1.0, 2.0, 3.5, -4.0], 0.1)
+            .unwrap();
+        let back = Demonstration::from_json_str(&d.to_json_string(), "<memory>", None).unwrap();
+        assert_eq!(back, d);
+    }
+
+    #[test]
+    fn conform_reorders_and_rejects_other_sets() {
+        let d = Demonstration::new(vec!["b".into(), "a".into()], vec![1.0, 2.0, 3.0, 4.0], 0.1)
+            .unwrap();
+        let names = vec!["a".to_owned(), "b".to_owned()];
+        assert_eq!(
+            d.conform_to(&names).unwrap().samples(),
+            [2.0, 1.0, 4.0, 3.0]
+        );
+        let other = vec!["a".to_owned(), "c".to_owned()];
+        assert!(matches!(
+            d.conform_to(&other),
+            Err(Error::ChannelMismatch { .. })
+        ));
+    }
+
+    #[test]
+    fn new_rejects_bad_shapes() {
+        let names = || vec!["a".to_owned(), "b".to_owned()];
+        assert!(Demonstration::new(names(), vec![1.0, 2.0, 3.0], 0.1).is_err());
+        assert!(matches!(
+            Demonstration::new(names(), vec![1.0, 2.0], 0.1),
+            Err(Error::TooFewSamples { found: 1, .. })
+        ));
+        assert!(Demonstration::new(names(), vec![1.0, f64::NAN, 3.0, 4.0], 0.1).is_err());
+        assert!(Demonstration::new(names(), vec![1.0, 2.0, 3.0, 4.0], 0.0).is_err());
+        assert!(Demonstration::new(vec!["a".into(), "a".into()], vec![0.0; 4], 0.1).is_err());
+    }
+}

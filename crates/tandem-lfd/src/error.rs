@@ -1,0 +1,178 @@
+//! The crate's error type.
+
+/// Everything that can go wrong in `tandem-lfd`.
+///
+/// Input errors name the file (or the in-memory source label of a [`crate::Demonstration`]),
+/// the 1-based line and the 1-based column where the problem is.
+/// For CSV files the column is the 1-based field number; for JSON files it is the
+/// 1-based character column reported by the parser.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// Reading a file failed at the operating-system level.
+    #[error("{file}: cannot read: {source}")]
+    Io {
+        /// The file.
+        file: String,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The file holds no header (CSV) or no document (JSON).
+    #[error("{file}:1:1: empty file")]
+    EmptyFile {
+        /// The file.
+        file: String,
+    },
+    /// The header is malformed (empty or duplicated channel name).
+    #[error("{file}:{line}:{column}: bad header: {why}")]
+    BadHeader {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column (field number).
+        column: usize,
+        /// What is wrong.
+        why: String,
+    },
+    /// A row has a different number of fields than the header.
+    #[error("{file}:{line}:{column}: ragged row: expected {expected} fields, found {found}")]
+    RaggedRow {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column of the first missing or surplus field.
+        column: usize,
+        /// Number of fields in the header.
+        expected: usize,
+        /// Number of fields in this row.
+        found: usize,
+    },
+    /// A field is not a number.
+    #[error("{file}:{line}:{column}: channel `{channel}`: not a number: `{text}`")]
+    NotNumeric {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// Channel name of the column.
+        channel: String,
+        /// The offending text.
+        text: String,
+    },
+    /// A field is NaN or infinite.
+    #[error("{file}:{line}:{column}: channel `{channel}`: non-finite value `{text}`")]
+    NonFinite {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// Channel name of the column.
+        channel: String,
+        /// The offending text.
+        text: String,
+    },
+    /// The time column is not strictly increasing or not evenly spaced within 1 %.
+    #[error("{file}:{line}:{column}: time column `t`: {why}")]
+    BadTime {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What is wrong.
+        why: String,
+    },
+    /// A JSON document could not be parsed or has the wrong shape.
+    #[error("{file}:{line}:{column}: {why}")]
+    Json {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What is wrong.
+        why: String,
+    },
+    /// A demonstration has fewer than 2 samples.
+    #[error("{file}: {found} sample(s); at least 2 are required")]
+    TooFewSamples {
+        /// The file or source label.
+        file: String,
+        /// Number of samples found.
+        found: usize,
+    },
+    /// Fewer than 2 demonstrations where a variance (Eq. 6) is asked for.
+    #[error("{found} demonstration(s); at least 2 are required for a variance")]
+    TooFewDemonstrations {
+        /// Number of demonstrations given.
+        found: usize,
+    },
+    /// A demonstration's channel set differs from the reference demonstration's.
+    #[error("{file}: channels {found:?} differ from the reference channels {expected:?}")]
+    ChannelMismatch {
+        /// The file or source label of the offending demonstration.
+        file: String,
+        /// The reference channel names.
+        expected: Vec<String>,
+        /// This demonstration's channel names.
+        found: Vec<String>,
+    },
+    /// Sample periods differ by more than 1 %.
+    #[error(
+        "{file}: sample period {found_s} s differs from the reference {expected_s} s by more than 1 %"
+    )]
+    SamplePeriodMismatch {
+        /// The file or source label.
+        file: String,
+        /// The reference period Δt_s, seconds.
+        expected_s: f64,
+        /// This demonstration's period, seconds.
+        found_s: f64,
+    },
+    /// In-memory data has an inconsistent shape or a bad value.
+    #[error("{what}: {why}")]
+    BadData {
+        /// Which input.
+        what: String,
+        /// What is wrong.
+        why: String,
+    },
+    /// A parameter is out of its valid range.
+    #[error("parameter `{name}` {why}")]
+    BadParam {
+        /// Parameter name.
+        name: &'static str,
+        /// Why it is rejected.
+        why: String,
+    },
+    /// A warp given to [`crate::TaskModel::fit_aligned`] is malformed.
+    #[error("warp of demonstration {demo_idx}: {why}")]
+    BadWarp {
+        /// Index of the demonstration.
+        demo_idx: usize,
+        /// What is wrong.
+        why: String,
+    },
+    /// An execution's reference-time log is malformed.
+    #[error("execution `{file}`: reference-time log: {why}")]
+    BadLog {
+        /// Source label of the execution.
+        file: String,
+        /// What is wrong.
+        why: String,
+    },
+    /// The time-warping crate failed.
+    #[error("alignment failed: {0}")]
+    Warp(#[from] tandem_warp::Error),
+}
+
+/// `Result` with this crate's [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,42 @@
+//! Learning from demonstration for tandem (paper §II-B1/B2).
+//!
+//! - [`Demonstration`]: one demonstration `X_i ∈ R^{m × T_i}` (Eq. 1), read from CSV or
+//!   JSON with errors naming file, line and column.
+//! - [`TaskModel`]: every demonstration aligned to demo 0 (GDTW, `tandem-warp`), then per
+//!   reference sample the mean behaviour `μ̂`, the augmented mean `μ̂⁺` (Eq. 4–5), the
+//!   weighted variance `σ²_D` (Eq. 6), the warp-gradient bounds `ψ̇min/ψ̇max` (Eq. 14), and
+//!   the admissible corrections: principal components of the weighted augmented residuals,
+//!   scaled so the commanded rate stays inside the bounds; the command
+//!   `x_f⁺ = μ̂⁺ + δx⁺` (Eq. 7).
+//! - [`TaskModel::update`]: adds an execution with its known reference-time log (Eq. 21)
+//!   through per-sample sufficient statistics, without re-alignment.
+//!
+//! Time frames: all per-time arrays are indexed by *reference sample* `n ∈ 0..n_ref()`
+//! (demo 0's samples, period `dt_s()`); warps map reference samples to demo samples.
+//!
+//! ```
+//! use tandem_lfd::{Demonstration, FitParams, TaskModel};
+//! let names = vec!["force".to_string()];
+//! let a = Demonstration::new(names.clone(), vec![1.0, 2.0, 3.0], 0.01)?;
+//! let b = Demonstration::new(names, vec![3.0, 4.0, 5.0], 0.01)?;
+//! let identity = vec![0.0, 1.0, 2.0];
+//! let model = TaskModel::fit_aligned(&[a, b], &[identity.clone(), identity], &FitParams::default())?;
+//! assert_eq!(model.mean(), [2.0, 3.0, 4.0]);
+//! // Residuals ±1 N over a 4 N range: σ²_D = 2·(1/4)² / (2 − 1) = 0.125.
+//! assert!((model.sigma2_d()[1] - 0.125).abs() < 1e-12);
+//! // One correction component: ±3σ along force (σ = 1 N), rate unchanged.
+//! let cmd = model.command(&[1.0], 1.0)?;
+//! assert!((cmd[0] - 6.0).abs() < 1e-12 && (cmd[1] - 1.0).abs() < 1e-12);
+//! # Ok::<(), tandem_lfd::Error>(())
+//! ```
+
+mod demo;
+mod error;
+mod model;
+mod quat;
+
+pub use demo::{
+    ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, QuaternionBlock,
+};
+pub use error::{Error, Result};
+pub use model::{Corrections, Execution, FitParams, TaskModel};

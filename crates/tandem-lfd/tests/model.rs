@@ -1,0 +1,226 @@
+//! Task-model invariants through the public API: gradient bounds, admissible commands,
+//! incremental updates equal to a refit, alignment with `tandem-warp`.
+
+use proptest::prelude::*;
+use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
+
+const NAMES: [&str; 7] = ["x", "qx", "qy", "qz", "qw", "force", "tool"];
+
+/// A smooth synthetic demonstration of `t_len` samples: `shape` shifts the force and the
+/// tilt so demonstrations differ; the quaternion sign flips every 7 samples (q ≡ −q).
+fn synthetic(t_len: usize, shape: f64) -> Demonstration {
+    let mut s = Vec::with_capacity(t_len * NAMES.len());
+    for t in 0..t_len {
+        let p = t as f64 / (t_len - 1) as f64;
+        let angle = 0.1 * shape * (3.0 * p).sin() + 0.05 * p;
+        let (sin, cos) = (0.5 * angle).sin_cos();
+        let sign = if (t / 7) % 2 == 0 { 1.0 } else { -1.0 };
+        s.extend([
+            0.6 * p,
+            sign * sin * 0.6,
+            sign * sin * 0.8,
+            0.0,
+            sign * cos,
+            10.0 + 5.0 * shape * (6.0 * p).cos(),
+            if p > 0.2 + 0.1 * shape { 1.0 } else { 0.0 },
+        ]);
+    }
+    let names = NAMES.iter().map(|n| n.to_string()).collect();
+    Demonstration::new(names, s, 0.01).unwrap()
+}
+
+/// A monotone warp from reference samples `0..n_ref` onto `0..t_len` with a bump of size
+/// `bend ∈ (−1, 1)` (0 = linear).
+fn warp(n_ref: usize, t_len: usize, bend: f64) -> Vec<f64> {
+    (0..n_ref)
+        .map(|n| {
+            let p = n as f64 / (n_ref - 1) as f64;
+            let q = p + bend * p * (1.0 - p) * 0.9;
+            q * (t_len - 1) as f64
+        })
+        .collect()
+}
+
+fn data(shapes: &[f64], lens: &[usize], bends: &[f64]) -> (Vec<Demonstration>, Vec<Vec<f64>>) {
+    let n_ref = lens[0];
+    let demos = shapes
+        .iter()
+        .zip(lens)
+        .map(|(&s, &l)| synthetic(l, s))
+        .collect();
+    let warps = lens
+        .iter()
+        .zip(bends)
+        .map(|(&l, &b)| warp(n_ref, l, b))
+        .collect();
+    (demos, warps)
+}
+
+fn interp(v: &[f64], t: f64) -> f64 {
+    let lo = (t.floor() as usize).min(v.len() - 1);
+    let hi = (lo + 1).min(v.len() - 1);
+    v[lo] + (t - lo as f64) * (v[hi] - v[lo])
+}
+
+#[test]
+fn bounds_contain_every_demonstration_gradient() {
+    let (demos, warps) = data(&[0.0, 1.0, -0.5], &[40, 55, 31], &[0.0, 0.6, -0.4]);
+    let m = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+    for w in &warps {
+        for n in 0..m.n_ref() {
+            let g = if n + 1 < w.len() {
+                w[n + 1] - w[n]
+            } else {
+                w[n] - w[n - 1]
+            };
+            assert!(m.grad_min()[n] <= g && g <= m.grad_max()[n], "n = {n}: {g}");
+        }
+    }
+    assert_eq!(m.n_components(), 2);
+    assert_eq!(m.channel_names(), NAMES);
+    assert_eq!(m.mean().len(), 40 * NAMES.len());
+}
+
+fn assert_same_statistics(a: &TaskModel, b: &TaskModel) {
+    assert_eq!(a.count(), b.count());
+    assert_eq!(a.n_components(), b.n_components());
+    let near = |x: f64, y: f64| (x - y).abs() <= 1e-9 * (1.0 + y.abs());
+    for n in 0..a.n_ref() {
+        assert!(near(a.sigma2_d()[n], b.sigma2_d()[n]), "sigma2 at {n}");
+        assert!(near(a.grad_mean()[n], b.grad_mean()[n]));
+        assert_eq!(a.grad_min()[n], b.grad_min()[n]);
+        assert_eq!(a.grad_max()[n], b.grad_max()[n]);
+        for (x, y) in a.tangent_mean(n).iter().zip(b.tangent_mean(n)) {
+            assert!(near(*x, *y), "mean at {n}");
+        }
+        for (x, y) in a.covariance(n).iter().zip(&b.covariance(n)) {
+            assert!(near(*x, *y), "covariance at {n}");
+        }
+    }
+    for (x, y) in a.mean().iter().zip(b.mean()) {
+        assert!(near(*x, *y));
+    }
+}
+
+/// An execution made from a demonstration and its known warp: each sample's reference
+/// time is the inverse warp at that sample.
+fn execution_from(demo: &Demonstration, warp: &[f64]) -> Execution {
+    let log = (0..demo.n_samples())
+        .map(|q| {
+            let q = q as f64;
+            let k = warp.partition_point(|&v| v < q);
+            if k == 0 {
+                0.0
+            } else if k >= warp.len() {
+                (warp.len() - 1) as f64
+            } else {
+                (k - 1) as f64 + (q - warp[k - 1]) / (warp[k] - warp[k - 1])
+            }
+        })
+        .collect();
+    Execution {
+        demonstration: demo.clone(),
+        ref_time_log: log,
+    }
+}
+
+#[test]
+fn update_equals_refit() {
+    let (demos, warps) = data(&[0.0, 1.0, -0.5], &[40, 55, 31], &[0.0, 0.6, -0.4]);
+    let mut model = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+    let params = FitParams {
+        ranges: Some(model.ranges().to_vec()),
+        ..FitParams::default()
+    };
+    let mut all_demos = demos.clone();
+    let mut all_warps = warps.clone();
+    for (shape, len, bend) in [(0.7, 47, 0.3), (-1.2, 36, -0.7)] {
+        let exec = execution_from(&synthetic(len, shape), &warp(40, len, bend));
+        let values = model.execution_warp(&exec).unwrap();
+        // The execution's warp recovered from its log is the warp it was made from, up to
+        // the log's piecewise-linear sampling.
+        for (v, w) in values.iter().zip(warp(40, len, bend)) {
+            assert!((v - w).abs() < 0.05, "{v} vs {w}");
+        }
+        model.prepare_corrections();
+        model.update(&exec).unwrap();
+        all_demos.push(exec.demonstration.clone());
+        all_warps.push(values);
+        let refit = TaskModel::fit_aligned(&all_demos, &all_warps, &params).unwrap();
+        assert_same_statistics(&model, &refit);
+        assert_eq!(
+            model.command(&[0.3, -0.2, 0.9], 17.5).unwrap().len(),
+            NAMES.len() + 1
+        );
+        let c = model.corrections_at(17.5).unwrap();
+        let r = refit.corrections_at(17.5).unwrap();
+        assert!((c.scale - r.scale).abs() < 1e-9);
+    }
+    assert_eq!(model.count(), 5);
+}
+
+#[test]
+fn fit_with_alignment_recovers_known_timing() {
+    // Demo 1 is demo 0 played 1.5× slower (same shape over 90 instead of 60 samples):
+    // its warp gradient is 89/59 ≈ 1.51 everywhere.
+    let d0 = synthetic(60, 1.0);
+    let d1 = synthetic(90, 1.0);
+    let m = TaskModel::fit(&[d0.clone(), d1, d0], &FitParams::default()).unwrap();
+    let mid: Vec<f64> = m.grad_max()[5..55].to_vec();
+    let avg = mid.iter().sum::<f64>() / mid.len() as f64;
+    assert!((avg - 89.0 / 59.0).abs() < 0.1, "mean max gradient {avg}");
+    assert!(m.grad_min()[5..55].iter().all(|&g| (g - 1.0).abs() < 0.05));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn commanded_rate_stays_inside_the_bounds(
+        shapes in prop::collection::vec(-1.5f64..1.5, 2..5),
+        bends in prop::collection::vec(-0.9f64..0.9, 4),
+        lens in prop::collection::vec(12usize..40, 4),
+        u in prop::collection::vec(-1.0f64..=1.0, 3),
+        t_frac in 0.0f64..=1.0,
+        k_max in 1usize..4,
+    ) {
+        let n_d = shapes.len();
+        let (demos, warps) = data(&shapes, &lens[..n_d], &bends[..n_d]);
+        let params = FitParams { k_max, ..FitParams::default() };
+        let m = TaskModel::fit_aligned(&demos, &warps, &params).unwrap();
+        let k = m.n_components();
+        prop_assert_eq!(k, k_max.min(n_d - 1));
+        let t = t_frac * (m.n_ref() - 1) as f64;
+        let cmd = m.command(&u[..k], t).unwrap();
+        let rate = cmd[NAMES.len()];
+        let (lo, hi) = (interp(m.grad_min(), t), interp(m.grad_max(), t));
+        prop_assert!(lo - 1e-12 <= rate && rate <= hi + 1e-12, "{} not in [{}, {}]", rate, lo, hi);
+        // The admissible scale alone (no clamping needed) keeps the rate inside.
+        let c = m.corrections_at(t).unwrap();
+        let reach: f64 = c.components.iter().map(|v| v[v.len() - 1].abs()).sum::<f64>() * c.scale;
+        let g = interp(m.grad_mean(), t);
+        prop_assert!(g + reach <= hi + 1e-9 && g - reach >= lo - 1e-9);
+        let q = &cmd[1..5];
+        prop_assert!((q.iter().map(|v| v * v).sum::<f64>().sqrt() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn update_equals_refit_for_any_execution(
+        shape in -1.5f64..1.5,
+        len in 10usize..60,
+        bend in -0.9f64..0.9,
+    ) {
+        let (demos, warps) = data(&[0.0, 1.0], &[30, 44], &[0.0, 0.5]);
+        let mut model = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+        let exec = execution_from(&synthetic(len, shape), &warp(30, len, bend));
+        let values = model.execution_warp(&exec).unwrap();
+        model.update(&exec).unwrap();
+        let params = FitParams { ranges: Some(model.ranges().to_vec()), ..FitParams::default() };
+        let refit = TaskModel::fit_aligned(
+            &[demos[0].clone(), demos[1].clone(), exec.demonstration.clone()],
+            &[warps[0].clone(), warps[1].clone(), values],
+            &params,
+        ).unwrap();
+        assert_same_statistics(&model, &refit);
+    }
+}

@@ -1,0 +1,220 @@
+//! CSV and JSON readers: every malformed case is an error naming file, line and column.
+
+use tandem_lfd::{Demonstration, Error, FitParams, TaskModel};
+
+fn csv_err(text: &str) -> String {
+    let e = Demonstration::from_csv_str(text, "demo.csv", None).unwrap_err();
+    e.to_string()
+}
+
+fn json_err(text: &str) -> String {
+    Demonstration::from_json_str(text, "demo.json", None)
+        .unwrap_err()
+        .to_string()
+}
+
+#[test]
+fn csv_empty_file() {
+    assert_eq!(csv_err(""), "demo.csv:1:1: empty file");
+    assert_eq!(csv_err("\n  \n"), "demo.csv:1:1: empty file");
+}
+
+#[test]
+fn csv_ragged_rows() {
+    let short = "t,a,b\n0,1,2\n0.01,3\n";
+    assert_eq!(
+        csv_err(short),
+        "demo.csv:3:3: ragged row: expected 3 fields, found 2"
+    );
+    let long = "a,b\n1,2\n3,4,5\n";
+    assert_eq!(
+        csv_err(long),
+        "demo.csv:3:3: ragged row: expected 2 fields, found 3"
+    );
+}
+
+#[test]
+fn csv_non_numeric_and_non_finite() {
+    let text = "a,b\n1,2\n3,x4\n";
+    assert_eq!(
+        csv_err(text),
+        "demo.csv:3:2: channel `b`: not a number: `x4`"
+    );
+    let text = "a,b\n1,2\nNaN,4\n";
+    assert_eq!(
+        csv_err(text),
+        "demo.csv:3:1: channel `a`: non-finite value `NaN`"
+    );
+    let text = "a,b\n1,inf\n3,4\n";
+    assert_eq!(
+        csv_err(text),
+        "demo.csv:2:2: channel `b`: non-finite value `inf`"
+    );
+    let text = "a,b\n1,2\n3,\n";
+    assert_eq!(csv_err(text), "demo.csv:3:2: channel `b`: not a number: ``");
+}
+
+#[test]
+fn csv_too_few_samples() {
+    assert_eq!(
+        csv_err("a,b\n1,2\n"),
+        "demo.csv: 1 sample(s); at least 2 are required"
+    );
+    assert_eq!(
+        csv_err("a,b\n"),
+        "demo.csv: 0 sample(s); at least 2 are required"
+    );
+}
+
+#[test]
+fn csv_bad_header() {
+    assert_eq!(
+        csv_err("a,,b\n1,2,3\n"),
+        "demo.csv:1:2: bad header: empty channel name"
+    );
+    assert_eq!(
+        csv_err("a,b,a\n1,2,3\n"),
+        "demo.csv:1:3: bad header: channel `a` repeats column 1"
+    );
+    assert_eq!(
+        csv_err("t\n0\n1\n"),
+        "demo.csv:1:1: bad header: no data channels"
+    );
+}
+
+#[test]
+fn csv_bad_time_column() {
+    let text = "a,t\n1,0.00\n2,0.01\n3,0.01\n";
+    assert_eq!(
+        csv_err(text),
+        "demo.csv:4:2: time column `t`: 0.01 does not increase after 0.01"
+    );
+    let text = "t,a\n0.00,1\n0.01,2\n0.025,3\n0.03,4\n";
+    assert!(
+        csv_err(text).starts_with("demo.csv:4:1: time column `t`: step "),
+        "{}",
+        csv_err(text)
+    );
+    // Within 1 %: accepted, Δt_s = mean step.
+    let d = Demonstration::from_csv_str("t,a\n0,1\n0.01,2\n0.02005,3\n", "f", None).unwrap();
+    assert!((d.dt_s() - 0.010025).abs() < 1e-12);
+}
+
+#[test]
+fn json_malformed_cases() {
+    assert_eq!(json_err(""), "demo.json:1:1: empty file");
+    let ragged = "{\"channels\": [\"a\", \"b\"],\n \"samples\": [[1, 2],\n   [3]]}";
+    assert_eq!(
+        json_err(ragged),
+        "demo.json:3:4: ragged row: sample 1 has 1 values, expected 2"
+    );
+    let text = "{\"channels\": [\"a\"],\n \"samples\": [[1], [\"x\"]]}";
+    assert!(
+        json_err(text).starts_with("demo.json:2:"),
+        "{}",
+        json_err(text)
+    );
+    assert!(
+        json_err(text).contains("invalid type: string"),
+        "{}",
+        json_err(text)
+    );
+    let text = "{\"channels\": [\"a\"],\n \"samples\": [[1],\n [NaN]]}";
+    assert!(
+        json_err(text).starts_with("demo.json:3:3:"),
+        "{}",
+        json_err(text)
+    );
+    let text = "{\"channels\": [\"a\"], \"samples\": [[1], [1e999]]}";
+    assert!(
+        json_err(text).starts_with("demo.json:1:"),
+        "{}",
+        json_err(text)
+    );
+    let text = "{\"channels\": [\"a\"], \"samples\": [[1]]}";
+    assert_eq!(
+        json_err(text),
+        "demo.json: 1 sample(s); at least 2 are required"
+    );
+    let text = "{\"channels\": [\"a\"], \"samples\": [[1], [2]], \"extra\": 1}";
+    assert!(
+        json_err(text).contains("unknown field `extra`"),
+        "{}",
+        json_err(text)
+    );
+    let text = "{\"channels\": [\"a\", \"a\"], \"samples\": [[1, 2], [2, 3]]}";
+    assert!(
+        json_err(text).contains("appears twice"),
+        "{}",
+        json_err(text)
+    );
+}
+
+#[test]
+fn json_reads_dt_and_round_trips() {
+    let text = "{\"channels\": [\"a\", \"b\"], \"dt_s\": 0.02, \"samples\": [[1, 2], [3, 4]]}";
+    let d = Demonstration::from_json_str(text, "d.json", None).unwrap();
+    assert_eq!(d.dt_s(), 0.02);
+    assert_eq!(d.samples(), [1.0, 2.0, 3.0, 4.0]);
+    let via_serde: Demonstration = serde_json::from_str(&d.to_json_string()).unwrap();
+    assert_eq!(via_serde.samples(), d.samples());
+    let without_dt = "{\"channels\": [\"a\"], \"samples\": [[1], [2]]}";
+    assert_eq!(
+        Demonstration::from_json_str(without_dt, "d", Some(0.5))
+            .unwrap()
+            .dt_s(),
+        0.5
+    );
+}
+
+#[test]
+fn missing_file_names_the_path() {
+    let e = Demonstration::from_csv_path("/nonexistent/demo_9.csv", None).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("/nonexistent/demo_9.csv: cannot read"),
+        "{e}"
+    );
+}
+
+#[test]
+fn demonstration_sets_are_checked() {
+    let a = Demonstration::from_csv_str("a,b\n1,2\n3,4\n", "a.csv", None).unwrap();
+    let b = Demonstration::from_csv_str("a,c\n1,2\n3,4\n", "b.csv", None).unwrap();
+    let id = vec![0.0, 1.0];
+    let e = TaskModel::fit_aligned(
+        &[a.clone(), b],
+        &[id.clone(), id.clone()],
+        &FitParams::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(e, Error::ChannelMismatch { .. }));
+    assert!(
+        e.to_string()
+            .starts_with("b.csv: channels [\"a\", \"c\"] differ"),
+        "{e}"
+    );
+    let e = TaskModel::fit_aligned(
+        std::slice::from_ref(&a),
+        std::slice::from_ref(&id),
+        &FitParams::default(),
+    )
+    .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "1 demonstration(s); at least 2 are required for a variance"
+    );
+    // Same set in another order is reordered, not rejected.
+    let c = Demonstration::from_csv_str("b,a\n2,1\n4,3\n", "c.csv", None).unwrap();
+    let m = TaskModel::fit_aligned(&[a, c], &[id.clone(), id], &FitParams::default()).unwrap();
+    assert!(m.sigma2_d().iter().all(|&s| s == 0.0));
+    let slow = Demonstration::from_csv_str("t,a,b\n0,1,2\n0.1,3,4\n", "slow.csv", None).unwrap();
+    let fast = Demonstration::from_csv_str("a,b\n1,2\n3,4\n", "fast.csv", None).unwrap();
+    let e = TaskModel::fit_aligned(
+        &[fast, slow],
+        &[vec![0.0, 1.0], vec![0.0, 1.0]],
+        &FitParams::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(e, Error::SamplePeriodMismatch { .. }), "{e}");
+}
