@@ -1,0 +1,338 @@
+//! Parameters of the GDTW optimization.
+
+use serde::{Deserialize, Serialize};
+
+use crate::{Error, Result};
+
+/// Default spacing of time nodes, in reference samples, when [`WarpParams::n_nodes`] is `None`.
+pub const DEFAULT_NODE_SPACING: usize = 4;
+
+/// GDTW parameters (Deriso & Boyd; paper §II-B1, Eq. 3).
+///
+/// Time is normalized on both sides: reference time `t ∈ [0, 1]` (reference sample `n` is at
+/// `t = n / (T_ref − 1)`), query time `φ(t) ∈ [0, 1]` (query sample `q` is at `q / (T_query − 1)`).
+/// The warp `φ` is piecewise linear between time nodes placed on reference samples; the
+/// optimizer minimizes
+///
+/// `∫₀¹ (x₂(φ(t)) − x₁(t))ᵀ W (x₂(φ(t)) − x₁(t)) dt + λ_inst ∫₀¹ (φ'(t) − 1)² dt + λ_cum ∫₀¹ (φ(t) − t)² dt`
+///
+/// subject to `φ(0) = 0`, `φ(1) = 1` and `slope_min ≤ φ' ≤ slope_max`, where `x₁` is the
+/// reference, `x₂` the query (linearly interpolated at fractional times) and `W = diag(weights)`.
+/// See [`crate::objective_of`] for the exact discretization.
+///
+/// Solver: a first dynamic-programming pass over the whole feasible band with
+/// [`coarse_nodes`](Self::coarse_nodes) nodes and [`coarse_candidates`](Self::coarse_candidates)
+/// candidates each, then [`refinements`](Self::refinements) passes on all
+/// [`n_nodes`](Self::n_nodes) nodes, each on a finer candidate grid centred on the previous
+/// solution (see [`refine_radius`](Self::refine_radius)).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct WarpParams {
+    /// Number `N` of time nodes of the final passes, placed on reference samples as evenly as
+    /// possible (the first and last reference samples are always nodes). The loss is integrated
+    /// over every reference sample between nodes, so `N` sets only the warp's flexibility.
+    /// `None` (default) = one node every [`DEFAULT_NODE_SPACING`] reference samples.
+    /// Must be ≥ 2; values above `T_ref` are clamped to `T_ref` (one node per reference sample).
+    pub n_nodes: Option<usize>,
+    /// Number `M` of candidate values of `φ` per node in the refinement passes.
+    /// Must be in `3..=65535`. Default: 15.
+    pub n_candidates: usize,
+    /// `λ_inst`, weight of `∫ (φ'(t) − 1)² dt` (normalized time). Must be finite and ≥ 0.
+    /// Default: 0.1.
+    pub lambda_inst: f64,
+    /// `λ_cum`, weight of `∫ (φ(t) − t)² dt` (normalized time). Must be finite and ≥ 0.
+    /// Default: 0.1.
+    pub lambda_cum: f64,
+    /// `s_min`, lower bound on `φ'` in normalized time. Must be in `(0, 1]`. Default: 0.25.
+    pub slope_min: f64,
+    /// `s_max`, upper bound on `φ'` in normalized time. Must be finite and ≥ 1. Default: 4.
+    pub slope_max: f64,
+    /// Number of grid-refinement passes after the first pass. Pass `k < refinements` uses
+    /// `min(N, coarse_nodes · 2^k)` nodes (and the coarse loss quadrature while below `N`); the
+    /// last pass uses all `N` nodes. Must be ≤ 64. Default: 4.
+    pub refinements: usize,
+    /// Half-width of a refinement pass's candidate range at a node, in candidate spacings of the
+    /// previous pass there. The range is centred on the previous solution and truncated to the
+    /// feasible band; its `n_candidates` values are equally spaced, so each pass shrinks the
+    /// spacing by `2 · refine_radius / (n_candidates − 1)`. Must be finite and ≥ 0.5.
+    /// Default: 2.5.
+    pub refine_radius: f64,
+    /// In refinement passes, a transition from candidate `j` to candidate `k` of the next node
+    /// is searched only if `|k − j| ≤ max_jump` (both grids are centred on the previous
+    /// solution, so this bounds how fast the solution may depart from it); slope bounds are
+    /// always enforced. `None` = search every feasible transition. Default: `Some(3)`.
+    pub max_jump: Option<usize>,
+    /// Number of nodes of the first pass, which searches the whole feasible band; clamped to
+    /// `N`. When it is below `N`, the first pass evaluates the loss at
+    /// [`COARSE_POINTS_PER_SEGMENT`](crate::COARSE_POINTS_PER_SEGMENT) reference samples per
+    /// segment instead of all of them. Must be ≥ 2. Default: 48.
+    pub coarse_nodes: usize,
+    /// Number of candidates per node in the first pass, spread evenly over the feasible band
+    /// `[max(s_min t, 1 − s_max (1 − t)), min(s_max t, 1 − s_min (1 − t))]`.
+    /// Must be in `3..=65535`. Default: 97.
+    pub coarse_candidates: usize,
+    /// Diagonal of `W`: one weight ≥ 0 (finite) per channel. `None` (default) = all 1.
+    pub weights: Option<Vec<f64>>,
+}
+
+impl Default for WarpParams {
+    fn default() -> Self {
+        Self {
+            n_nodes: None,
+            n_candidates: 15,
+            lambda_inst: 0.1,
+            lambda_cum: 0.1,
+            slope_min: 0.25,
+            slope_max: 4.0,
+            refinements: 4,
+            refine_radius: 2.5,
+            max_jump: Some(3),
+            coarse_nodes: 48,
+            coarse_candidates: 97,
+            weights: None,
+        }
+    }
+}
+
+fn bad(name: &'static str, why: impl Into<String>) -> Error {
+    Error::BadParam {
+        name,
+        why: why.into(),
+    }
+}
+
+impl WarpParams {
+    /// Checks every field against its documented range (channel count is checked by
+    /// [`crate::align`], which knows the signals).
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] naming the field, or [`Error::InfeasibleSlopes`] if
+    /// `slope_min > 1` or `slope_max < 1` (no monotone warp joins `(0, 0)` and `(1, 1)`).
+    pub fn validate(&self) -> Result<()> {
+        if let Some(n) = self.n_nodes {
+            if n < 2 {
+                return Err(bad("n_nodes", format!("must be >= 2 (got {n})")));
+            }
+        }
+        if !(3..=65535).contains(&self.n_candidates) {
+            return Err(bad(
+                "n_candidates",
+                format!("must be in 3..=65535 (got {})", self.n_candidates),
+            ));
+        }
+        for (name, v) in [
+            ("lambda_inst", self.lambda_inst),
+            ("lambda_cum", self.lambda_cum),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(bad(name, format!("must be finite and >= 0 (got {v})")));
+            }
+        }
+        if !(self.slope_min.is_finite() && self.slope_min > 0.0) {
+            return Err(bad(
+                "slope_min",
+                format!("must be finite and > 0 (got {})", self.slope_min),
+            ));
+        }
+        if !self.slope_max.is_finite() {
+            return Err(bad(
+                "slope_max",
+                format!("must be finite (got {})", self.slope_max),
+            ));
+        }
+        if self.slope_min > 1.0 || self.slope_max < 1.0 {
+            return Err(Error::InfeasibleSlopes {
+                slope_min: self.slope_min,
+                slope_max: self.slope_max,
+            });
+        }
+        if self.refinements > 64 {
+            return Err(bad(
+                "refinements",
+                format!("must be <= 64 (got {})", self.refinements),
+            ));
+        }
+        if !(self.refine_radius.is_finite() && self.refine_radius >= 0.5) {
+            return Err(bad(
+                "refine_radius",
+                format!("must be finite and >= 0.5 (got {})", self.refine_radius),
+            ));
+        }
+        if !(3..=65535).contains(&self.coarse_candidates) {
+            return Err(bad(
+                "coarse_candidates",
+                format!("must be in 3..=65535 (got {})", self.coarse_candidates),
+            ));
+        }
+        if self.coarse_nodes < 2 {
+            return Err(bad(
+                "coarse_nodes",
+                format!("must be >= 2 (got {})", self.coarse_nodes),
+            ));
+        }
+        if let Some(w) = &self.weights {
+            if let Some((i, v)) = w
+                .iter()
+                .enumerate()
+                .find(|(_, v)| !(v.is_finite() && **v >= 0.0))
+            {
+                return Err(bad(
+                    "weights",
+                    format!("weight {i} must be finite and >= 0 (got {v})"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Validates and also checks `weights` against a channel count.
+    pub(crate) fn validate_for(&self, n_channels: usize) -> Result<()> {
+        self.validate()?;
+        if let Some(w) = &self.weights {
+            if w.len() != n_channels {
+                return Err(bad(
+                    "weights",
+                    format!(
+                        "has {} entries but the signals have {n_channels} channels",
+                        w.len()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The diagonal of `W` for `n_channels` channels (all ones when `weights` is `None`).
+    pub(crate) fn weight_vec(&self, n_channels: usize) -> Vec<f64> {
+        self.weights
+            .clone()
+            .unwrap_or_else(|| vec![1.0; n_channels])
+    }
+
+    /// Number of nodes `N` actually used for a reference of `n_ref` samples.
+    #[must_use]
+    pub fn nodes_for(&self, n_ref: usize) -> usize {
+        let n = self
+            .n_nodes
+            .unwrap_or_else(|| (n_ref - 1).div_ceil(DEFAULT_NODE_SPACING) + 1);
+        n.clamp(2, n_ref.max(2))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_documented() {
+        let p = WarpParams::default();
+        p.validate().unwrap();
+        assert_eq!(p.n_candidates, 15);
+        assert_eq!(p.nodes_for(9), 3);
+        assert_eq!(p.nodes_for(10), 4);
+        assert_eq!(p.nodes_for(2), 2);
+    }
+
+    #[test]
+    fn rejects_bad_values() {
+        let cases: Vec<(WarpParams, &str)> = vec![
+            (
+                WarpParams {
+                    n_nodes: Some(1),
+                    ..Default::default()
+                },
+                "n_nodes",
+            ),
+            (
+                WarpParams {
+                    n_candidates: 2,
+                    ..Default::default()
+                },
+                "n_candidates",
+            ),
+            (
+                WarpParams {
+                    lambda_inst: -1.0,
+                    ..Default::default()
+                },
+                "lambda_inst",
+            ),
+            (
+                WarpParams {
+                    lambda_cum: f64::NAN,
+                    ..Default::default()
+                },
+                "lambda_cum",
+            ),
+            (
+                WarpParams {
+                    slope_min: 0.0,
+                    ..Default::default()
+                },
+                "slope_min",
+            ),
+            (
+                WarpParams {
+                    slope_max: f64::INFINITY,
+                    ..Default::default()
+                },
+                "slope_max",
+            ),
+            (
+                WarpParams {
+                    refine_radius: 0.1,
+                    ..Default::default()
+                },
+                "refine_radius",
+            ),
+            (
+                WarpParams {
+                    coarse_candidates: 1,
+                    ..Default::default()
+                },
+                "coarse_candidates",
+            ),
+            (
+                WarpParams {
+                    coarse_nodes: 1,
+                    ..Default::default()
+                },
+                "coarse_nodes",
+            ),
+            (
+                WarpParams {
+                    weights: Some(vec![1.0, -0.5]),
+                    ..Default::default()
+                },
+                "weights",
+            ),
+        ];
+        for (p, field) in cases {
+            match p.validate() {
+                Err(Error::BadParam { name, .. }) => assert_eq!(name, field),
+                other => panic!("{field}: expected BadParam, got {other:?}"),
+            }
+        }
+        for (lo, hi) in [(1.5, 3.0), (0.2, 0.9)] {
+            let p = WarpParams {
+                slope_min: lo,
+                slope_max: hi,
+                ..Default::default()
+            };
+            assert!(matches!(p.validate(), Err(Error::InfeasibleSlopes { .. })));
+        }
+    }
+
+    #[test]
+    fn serde_uses_defaults_and_rejects_unknown() {
+        let p: WarpParams = serde_json::from_str(r#"{"lambda_inst": 0.5}"#).unwrap();
+        assert_eq!(
+            p,
+            WarpParams {
+                lambda_inst: 0.5,
+                ..Default::default()
+            }
+        );
+        assert!(serde_json::from_str::<WarpParams>(r#"{"lambda": 0.5}"#).is_err());
+    }
+}

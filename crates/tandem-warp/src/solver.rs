@@ -1,0 +1,622 @@
+//! Dynamic programming over the node × candidate grid (Deriso & Boyd's GDTW solver).
+
+use rayon::prelude::*;
+
+use crate::Result;
+use crate::objective::Prepared;
+use crate::params::WarpParams;
+use crate::signal::SignalRef;
+use crate::warp::Warp;
+
+/// Reference samples at which the first (coarse) pass evaluates the loss inside each segment
+/// between two nodes, when it uses fewer nodes than the final passes. The final passes always
+/// integrate over every reference sample.
+pub const COARSE_POINTS_PER_SEGMENT: usize = 4;
+
+/// Candidate grid of one pass: node `i` sits at reference sample `nodes[i]` and has candidates
+/// `lo[i] + j * step[i]` (query samples), `j < count[i]`; `center[i]` is the candidate equal to
+/// the previous pass's solution (0 in the first pass).
+struct Grid {
+    nodes: Vec<usize>,
+    lo: Vec<f64>,
+    step: Vec<f64>,
+    count: Vec<usize>,
+    center: Vec<usize>,
+}
+
+impl Grid {
+    #[inline]
+    fn cand(&self, i: usize, j: usize) -> f64 {
+        #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
+        let jf = j as f64;
+        self.lo[i] + jf * self.step[i]
+    }
+    fn hi(&self, i: usize) -> f64 {
+        self.cand(i, self.count[i] - 1)
+    }
+}
+
+/// `N` node positions spread evenly over `0..n_ref` (first and last sample included).
+fn spread_nodes(n_ref: usize, n_nodes: usize) -> Vec<usize> {
+    let n_nodes = n_nodes.clamp(2, n_ref);
+    (0..n_nodes)
+        .map(|i| (i * (n_ref - 1) + (n_nodes - 1) / 2) / (n_nodes - 1))
+        .collect()
+}
+
+/// Feasible band `[l, u]` of `ψ` (query samples) at reference sample `n`: the values reachable
+/// from `(0, 0)` and able to reach `(1, 1)` with slopes in `[s_min, s_max]`.
+fn band(prep: &Prepared<'_>, s_min: f64, s_max: f64, n: usize) -> (f64, f64) {
+    if n == 0 {
+        return (0.0, 0.0);
+    }
+    if n == prep.nr - 1 {
+        return (prep.qscale, prep.qscale);
+    }
+    #[expect(
+        clippy::cast_precision_loss,
+        reason = "sample counts are far below 2^52"
+    )]
+    let t = n as f64 * prep.h;
+    let l = (s_min * t).max(1.0 - s_max * (1.0 - t)).clamp(0.0, 1.0);
+    let u = (s_max * t).min(1.0 - s_min * (1.0 - t)).clamp(0.0, 1.0);
+    (l * prep.qscale, u.max(l) * prep.qscale)
+}
+
+/// First pass: about `m` equally spaced candidates covering the whole feasible band at every
+/// node, anchored so that the identity warp `φ(t) = t` is one of them (candidate `center[i]`).
+fn first_grid(prep: &Prepared<'_>, nodes: Vec<usize>, m: usize, s: (f64, f64)) -> Grid {
+    let n = nodes.len();
+    let mut g = Grid {
+        lo: vec![0.0; n],
+        step: vec![0.0; n],
+        count: vec![1; n],
+        center: vec![0; n],
+        nodes,
+    };
+    for i in 0..n {
+        let (l, u) = band(prep, s.0, s.1, g.nodes[i]);
+        #[expect(
+            clippy::cast_precision_loss,
+            reason = "sample counts are far below 2^52"
+        )]
+        let c = (g.nodes[i] as f64 * prep.h * prep.qscale).clamp(l, u);
+        g.lo[i] = c;
+        if u - l > 1e-9 {
+            #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
+            let step = (u - l) / (m - 1) as f64;
+            #[expect(
+                clippy::cast_possible_truncation,
+                clippy::cast_sign_loss,
+                reason = "non-negative step counts bounded by m"
+            )]
+            let steps = |room: f64| (room / step + 1e-9).floor().max(0.0) as usize;
+            let (down, up) = (steps(c - l), steps(u - c));
+            #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
+            let lo = c - down as f64 * step;
+            g.lo[i] = lo;
+            g.step[i] = step;
+            g.count[i] = down + up + 1;
+            g.center[i] = down;
+        }
+    }
+    g
+}
+
+/// Refinement pass: `m` candidates centred on `centers[i]`, spacing `2 radius prev_step[i] / (m − 1)`,
+/// truncated (not compressed) to the feasible band so the centre stays a candidate.
+fn refine_grid(
+    prep: &Prepared<'_>,
+    nodes: Vec<usize>,
+    centers: &[f64],
+    prev_step: &[f64],
+    m: usize,
+    radius: f64,
+    s: (f64, f64),
+) -> Grid {
+    let n = nodes.len();
+    let mut g = Grid {
+        lo: centers.to_vec(),
+        step: vec![0.0; n],
+        count: vec![1; n],
+        center: vec![0; n],
+        nodes,
+    };
+    let half = (m - 1) / 2;
+    for i in 0..n {
+        let (l, u) = band(prep, s.0, s.1, g.nodes[i]);
+        #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
+        let step = 2.0 * radius * prev_step[i] / (m - 1) as f64;
+        if u - l <= 1e-9 || step <= 1e-12 {
+            continue;
+        }
+        let c = centers[i];
+        #[expect(
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss,
+            reason = "non-negative step counts bounded by m"
+        )]
+        let steps = |room: f64| (room / step + 1e-9).floor().max(0.0) as usize;
+        let down = steps(c - l).min(half);
+        let up = steps(u - c).min(m - 1 - half);
+        #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
+        let lo = c - down as f64 * step;
+        g.lo[i] = lo;
+        g.step[i] = step;
+        g.count[i] = down + up + 1;
+        g.center[i] = down;
+    }
+    g
+}
+
+/// Scratch for the per-segment cost table: `ℓ(n, s)` for interior reference samples `n` and
+/// integer query samples `s` in a window.
+struct Table {
+    e: Vec<f64>,
+    s0: usize,
+    width: usize,
+}
+
+/// One DP pass. Returns the optimal value at every node and the DP objective, or `None` if no
+/// feasible path exists in the grid.
+#[expect(
+    clippy::too_many_lines,
+    reason = "the hot loop is kept in one place on purpose"
+)]
+fn solve_pass(
+    prep: &Prepared<'_>,
+    grid: &Grid,
+    s: (f64, f64),
+    max_jump: Option<usize>,
+    points: Option<usize>,
+) -> Option<(Vec<f64>, f64)> {
+    let n_nodes = grid.nodes.len();
+    let mut off = Vec::with_capacity(n_nodes + 1);
+    off.push(0usize);
+    for &c in &grid.count {
+        off.push(off[off.len() - 1] + c);
+    }
+    let mut back = vec![0u16; off[n_nodes]];
+    let mut f_prev: Vec<f64> = (0..grid.count[0])
+        .map(|j| prep.trap_weight(grid.nodes[0]) * prep.loss(grid.nodes[0], grid.cand(0, j)))
+        .collect();
+    let mut f_next: Vec<f64> = Vec::new();
+    let mut rows: Vec<(usize, f64)> = Vec::new();
+    let mut cum_b: Vec<f64> = Vec::new();
+    let mut table = Table {
+        e: Vec::new(),
+        s0: 0,
+        width: 0,
+    };
+    let g = prep.qscale * prep.h; // query samples per reference sample at slope 1
+    let nq = prep.nq;
+
+    for i in 0..n_nodes - 1 {
+        let (a, b) = (grid.nodes[i], grid.nodes[i + 1]);
+        let dr = b - a;
+        #[expect(
+            clippy::cast_precision_loss,
+            reason = "sample counts are far below 2^52"
+        )]
+        let drf = dr as f64;
+        let (dmin, dmax, tol) = (s.0 * drf * g, s.1 * drf * g, 1e-9 * drf * g);
+
+        // interior reference samples of this segment and their weight
+        rows.clear();
+        let n_int = dr - 1;
+        let take = points.map_or(n_int, |p| p.min(n_int));
+        for r in 0..take {
+            let n = if take == n_int {
+                a + 1 + r
+            } else {
+                a + 1 + (2 * r + 1) * n_int / (2 * take)
+            };
+            #[expect(
+                clippy::cast_precision_loss,
+                reason = "sample counts are far below 2^52"
+            )]
+            let alpha = (n - a) as f64 / drf;
+            rows.push((n, alpha));
+        }
+        #[expect(
+            clippy::cast_precision_loss,
+            reason = "sample counts are far below 2^52"
+        )]
+        let w_int = if take > 0 {
+            prep.h * n_int as f64 / take as f64
+        } else {
+            0.0
+        };
+
+        let (ca, cb) = (grid.count[i], grid.count[i + 1]);
+        let jump_w = max_jump.map_or(cb, |k| (2 * k + 1).min(cb));
+        let est_edges = ca * jump_w;
+        let tmin = grid.lo[i].min(grid.lo[i + 1]).max(0.0);
+        let tmax = grid.hi(i).max(grid.hi(i + 1)).min(prep.qscale);
+        #[expect(
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss,
+            reason = "clamped non-negative query times"
+        )]
+        let (s0, s1) = (
+            (tmin as usize).min(nq - 2),
+            ((tmax as usize) + 1).min(nq - 1),
+        );
+        let width = s1 - s0 + 1;
+        // Loss evaluation strategy for the interior samples of this segment:
+        // - exact table (stride 1): ℓ at every integer query sample of the window, then
+        //   ℓ(n, s + f) = (1 − f) ℓ(n, s) + f ℓ(n, s + 1) − f (1 − f) ‖x₂(s+1) − x₂(s)‖²_W exactly;
+        // - strided table (approximate passes only): ℓ every `stride` query samples, linearly
+        //   interpolated;
+        // - direct evaluation otherwise.
+        let stride = if rows.is_empty() {
+            0
+        } else if width + 1 < est_edges {
+            1
+        } else if points.is_some() {
+            (4 * width).div_ceil(est_edges.max(1)).max(2)
+        } else {
+            0
+        };
+        if stride > 0 {
+            let cols = (s1 - s0).div_ceil(stride) + 1;
+            table.s0 = s0;
+            table.width = cols;
+            table.e.clear();
+            for &(n, _) in &rows {
+                for c in 0..cols {
+                    table
+                        .e
+                        .push(prep.loss_int(n, (s0 + c * stride).min(nq - 1)));
+                }
+            }
+        }
+        #[expect(clippy::cast_precision_loss, reason = "small")]
+        let inv_stride = if stride > 0 { 1.0 / stride as f64 } else { 0.0 };
+
+        // regularizer constants of this segment (see Prepared::reg_cost)
+        #[expect(
+            clippy::cast_precision_loss,
+            reason = "sample counts are far below 2^52"
+        )]
+        let (ta, tb) = (a as f64 * prep.h, b as f64 * prep.h);
+        let dt = tb - ta;
+        let kappa = 1.0 / (prep.qscale * dt);
+        let (inst_c, cum_c) = (prep.lambda_inst * dt, prep.lambda_cum * dt / 3.0);
+        cum_b.clear();
+        cum_b.extend((0..cb).map(|k| grid.cand(i + 1, k) / prep.qscale - tb));
+        f_next.clear();
+        f_next.resize(cb, f64::INFINITY);
+        let back_b = &mut back[off[i + 1]..off[i + 2]];
+        let (lo_b, step_b) = (grid.lo[i + 1], grid.step[i + 1]);
+        for (j, &fj) in f_prev.iter().enumerate() {
+            if !fj.is_finite() {
+                continue;
+            }
+            let p = grid.cand(i, j);
+            let da = p / prep.qscale - ta;
+            // candidates k of node i+1 satisfying the slope bounds
+            let (mut k_lo, mut k_hi) = if cb == 1 || step_b <= 0.0 {
+                (0usize, 0usize)
+            } else {
+                let lo = ((p + dmin - tol - lo_b) / step_b).ceil();
+                let hi = ((p + dmax + tol - lo_b) / step_b).floor();
+                if hi < 0.0 || lo > (cb - 1) as f64 {
+                    continue;
+                }
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    clippy::cast_sign_loss,
+                    reason = "clamped to 0..cb"
+                )]
+                let r = (lo.max(0.0) as usize, (hi as usize).min(cb - 1));
+                r
+            };
+            if let Some(kj) = max_jump {
+                // relative offsets from the previous solution: (k − center_b) vs (j − center_a)
+                let rel = j as isize - grid.center[i] as isize + grid.center[i + 1] as isize;
+                let lo = (rel - kj as isize).max(0) as usize;
+                let hi = rel + kj as isize;
+                if hi < 0 {
+                    continue;
+                }
+                k_lo = k_lo.max(lo);
+                k_hi = k_hi.min(hi as usize);
+            }
+            for k in k_lo..=k_hi.min(cb - 1) {
+                let qv = grid.cand(i + 1, k);
+                let d = qv - p;
+                if d < dmin - tol || d > dmax + tol {
+                    continue;
+                }
+                let slope_m1 = d * kappa - 1.0;
+                let db = cum_b[k];
+                let mut cost =
+                    fj + inst_c * slope_m1 * slope_m1 + cum_c * (da * da + da * db + db * db);
+                if !rows.is_empty() {
+                    let mut acc = 0.0;
+                    if stride == 1 {
+                        let e = &table.e;
+                        for (r, &(_, alpha)) in rows.iter().enumerate() {
+                            let tau = p + d * alpha;
+                            #[expect(
+                                clippy::cast_possible_truncation,
+                                clippy::cast_sign_loss,
+                                reason = "tau within the window"
+                            )]
+                            let sq = (tau.max(0.0) as usize).clamp(s0, s1 - 1);
+                            #[expect(clippy::cast_precision_loss, reason = "small")]
+                            let f = tau - sq as f64;
+                            let base = r * width + (sq - s0);
+                            let (e0, e1) = (e[base], e[base + 1]);
+                            acc += e0 + f * (e1 - e0) - f * (1.0 - f) * prep.d2[sq];
+                        }
+                    } else if stride > 1 {
+                        let (e, cols) = (&table.e, table.width);
+                        #[expect(clippy::cast_precision_loss, reason = "small")]
+                        let s0f = s0 as f64;
+                        for (r, &(_, alpha)) in rows.iter().enumerate() {
+                            let u = ((p + d * alpha - s0f) * inv_stride).max(0.0);
+                            #[expect(
+                                clippy::cast_possible_truncation,
+                                clippy::cast_sign_loss,
+                                reason = "u >= 0"
+                            )]
+                            let c = (u as usize).min(cols - 2);
+                            #[expect(clippy::cast_precision_loss, reason = "small")]
+                            let f = u - c as f64;
+                            let base = r * cols + c;
+                            acc += e[base] + f * (e[base + 1] - e[base]);
+                        }
+                    } else {
+                        for &(n, alpha) in &rows {
+                            acc += prep.loss(n, p + d * alpha);
+                        }
+                    }
+                    cost += w_int * acc;
+                }
+                if cost < f_next[k] {
+                    f_next[k] = cost;
+                    #[expect(clippy::cast_possible_truncation, reason = "counts are <= 65535")]
+                    let jj = j as u16;
+                    back_b[k] = jj;
+                }
+            }
+        }
+        let wb = prep.trap_weight(b);
+        for (k, fk) in f_next.iter_mut().enumerate() {
+            if fk.is_finite() {
+                *fk += wb * prep.loss(b, grid.cand(i + 1, k));
+            }
+        }
+        std::mem::swap(&mut f_prev, &mut f_next);
+    }
+
+    let last = n_nodes - 1;
+    let total = f_prev[0];
+    if !total.is_finite() {
+        return None;
+    }
+    let mut vals = vec![0.0; n_nodes];
+    let mut j = 0usize;
+    for i in (0..=last).rev() {
+        vals[i] = grid.cand(i, j);
+        if i > 0 {
+            j = usize::from(back[off[i] + j]);
+        }
+    }
+    vals[0] = 0.0;
+    vals[last] = prep.qscale;
+    Some((vals, total))
+}
+
+/// Linear interpolation of `vals` given at sorted reference samples `xs`, at sample `n`.
+fn interp_at(xs: &[usize], vals: &[f64], n: usize) -> f64 {
+    let i = xs.partition_point(|&x| x <= n).clamp(1, xs.len() - 1);
+    let (a, b) = (xs[i - 1], xs[i]);
+    #[expect(
+        clippy::cast_precision_loss,
+        reason = "sample counts are far below 2^52"
+    )]
+    let alpha = (n.clamp(a, b) - a) as f64 / (b - a) as f64;
+    vals[i - 1] + alpha * (vals[i] - vals[i - 1])
+}
+
+/// Per-reference-sample warp from node values (linear between nodes).
+fn expand(nodes: &[usize], vals: &[f64], n_ref: usize) -> Vec<f64> {
+    let mut out = vec![0.0; n_ref];
+    for (seg, w) in nodes.windows(2).enumerate() {
+        let (a, b) = (w[0], w[1]);
+        let (p, q) = (vals[seg], vals[seg + 1]);
+        #[expect(
+            clippy::cast_precision_loss,
+            reason = "sample counts are far below 2^52"
+        )]
+        let dr = (b - a) as f64;
+        for (n, o) in out.iter_mut().enumerate().take(b + 1).skip(a) {
+            #[expect(
+                clippy::cast_precision_loss,
+                reason = "sample counts are far below 2^52"
+            )]
+            let alpha = (n - a) as f64 / dr;
+            *o = p + (q - p) * alpha;
+        }
+    }
+    out[n_ref - 1] = vals[vals.len() - 1];
+    // rounding can never make a valid warp decrease, but guard the invariant anyway
+    for n in 1..n_ref {
+        if out[n] < out[n - 1] {
+            out[n] = out[n - 1];
+        }
+    }
+    out
+}
+
+fn align_prepared(prep: &Prepared<'_>, params: &WarpParams) -> Warp {
+    let s = (params.slope_min, params.slope_max);
+    let n_final = params.nodes_for(prep.nr);
+    let nodes = spread_nodes(prep.nr, n_final);
+    let n0 = params.coarse_nodes.min(n_final);
+    let nodes0 = spread_nodes(prep.nr, n0);
+    let points0 = if n0 == n_final {
+        None
+    } else {
+        Some(COARSE_POINTS_PER_SEGMENT)
+    };
+    let grid0 = first_grid(prep, nodes0, params.coarse_candidates, s);
+    let (vals0, _) = solve_pass(prep, &grid0, s, None, points0)
+        .expect("the identity warp is a feasible path of the first grid");
+    let mut best = expand(&grid0.nodes, &vals0, prep.nr);
+    let mut best_obj = prep.objective(&best);
+    let mut prev = grid0;
+    let mut current = best.clone();
+    for pass in 1..=params.refinements {
+        // node count doubles every pass from the coarse count; the last pass uses all N nodes
+        let n_pass = if pass == params.refinements {
+            n_final
+        } else {
+            n0.saturating_mul(1usize << pass.min(40)).min(n_final)
+        };
+        let nodes = if n_pass == n_final {
+            nodes.clone()
+        } else {
+            spread_nodes(prep.nr, n_pass)
+        };
+        let points = if n_pass == n_final {
+            None
+        } else {
+            Some(COARSE_POINTS_PER_SEGMENT)
+        };
+        let prev_step: Vec<f64> = if prev.nodes == nodes {
+            prev.step.clone()
+        } else {
+            nodes
+                .iter()
+                .map(|&n| interp_at(&prev.nodes, &prev.step, n))
+                .collect()
+        };
+        let centers: Vec<f64> = nodes.iter().map(|&n| current[n]).collect();
+        let grid = refine_grid(
+            prep,
+            nodes,
+            &centers,
+            &prev_step,
+            params.n_candidates,
+            params.refine_radius,
+            s,
+        );
+        let Some((vals, _)) = solve_pass(prep, &grid, s, params.max_jump, points) else {
+            break;
+        };
+        current = expand(&grid.nodes, &vals, prep.nr);
+        let obj = prep.objective(&current);
+        if obj < best_obj {
+            best_obj = obj;
+            best.clone_from(&current);
+        }
+        prev = grid;
+    }
+    Warp::from_parts(best, best_obj)
+}
+
+/// Aligns `query` to `reference` with GDTW (paper §II-B1, Eq. 2–3): finds the warp
+/// `ψ: reference samples → query samples` minimizing [`crate::objective_of`] under the
+/// slope bounds of `params`. Single-threaded and deterministic (ties go to the lowest index).
+///
+/// # Errors
+/// [`crate::Error::ChannelMismatch`], [`crate::Error::NonFinite`], [`crate::Error::BadParam`],
+/// [`crate::Error::InfeasibleSlopes`].
+pub fn align(reference: SignalRef<'_>, query: SignalRef<'_>, params: &WarpParams) -> Result<Warp> {
+    let prep = Prepared::new(reference, query, params, "query")?;
+    Ok(align_prepared(&prep, params))
+}
+
+/// Aligns every query to the one reference, in parallel with rayon (one alignment per task).
+/// Output order = input order; each result is identical to [`align`] on that query, whatever the
+/// thread count. On failure the error of the lowest-index failing query is returned.
+///
+/// # Errors
+/// As [`align`]; non-finite values name the query as `"query #i"`.
+pub fn align_many(
+    reference: SignalRef<'_>,
+    queries: &[SignalRef<'_>],
+    params: &WarpParams,
+) -> Result<Vec<Warp>> {
+    params.validate()?;
+    let results: Vec<Result<Warp>> = queries
+        .par_iter()
+        .enumerate()
+        .map(|(i, &q)| {
+            let prep = Prepared::new(reference, q, params, &format!("query #{i}"))?;
+            Ok(align_prepared(&prep, params))
+        })
+        .collect();
+    results.into_iter().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nodes_are_spread_and_pinned() {
+        assert_eq!(spread_nodes(10, 4), vec![0, 3, 6, 9]);
+        assert_eq!(spread_nodes(5, 5), vec![0, 1, 2, 3, 4]);
+        assert_eq!(spread_nodes(5, 9), vec![0, 1, 2, 3, 4]);
+        let n = spread_nodes(1001, 37);
+        assert_eq!((n[0], n[36]), (0, 1000));
+        assert!(n.windows(2).all(|w| w[1] > w[0]));
+    }
+
+    fn ramp(n: usize, f: impl Fn(f64) -> f64) -> Vec<f64> {
+        (0..n).map(|i| f(i as f64 / (n - 1) as f64)).collect()
+    }
+
+    #[test]
+    fn dp_cost_equals_objective_of_the_returned_warp() {
+        // With every reference sample integrated (points = None), the DP's own total must be
+        // exactly the discretized objective of the expanded warp, with and without the table.
+        let r = ramp(200, |t| (6.0 * t).sin() + 0.3 * t);
+        let q = ramp(260, |t| (6.0 * t.powf(1.3)).sin() + 0.3 * t);
+        let (rs, qs) = (
+            SignalRef::new(&r, 1).unwrap(),
+            SignalRef::new(&q, 1).unwrap(),
+        );
+        let params = WarpParams {
+            n_nodes: Some(23),
+            ..Default::default()
+        };
+        let prep = Prepared::new(rs, qs, &params, "query").unwrap();
+        let s = (params.slope_min, params.slope_max);
+        let nodes = spread_nodes(200, 23);
+        for m in [5, 41] {
+            let grid = first_grid(&prep, nodes.clone(), m, s);
+            let (vals, dp) = solve_pass(&prep, &grid, s, None, None).unwrap();
+            let obj = prep.objective(&expand(&nodes, &vals, 200));
+            assert!(
+                (dp - obj).abs() <= 1e-9 * obj.abs().max(1e-12),
+                "m={m}: {dp} vs {obj}"
+            );
+        }
+    }
+
+    #[test]
+    fn refinement_never_worsens_the_objective() {
+        let r = ramp(300, |t| (9.0 * t).sin());
+        let q = ramp(300, |t| (9.0 * t * t).sin());
+        let (rs, qs) = (
+            SignalRef::new(&r, 1).unwrap(),
+            SignalRef::new(&q, 1).unwrap(),
+        );
+        let mut last = f64::INFINITY;
+        for refinements in 0..4 {
+            let params = WarpParams {
+                refinements,
+                ..Default::default()
+            };
+            let obj = align(rs, qs, &params).unwrap().objective();
+            assert!(obj <= last + 1e-12, "{refinements}: {obj} > {last}");
+            last = obj;
+        }
+    }
+}
