@@ -229,7 +229,19 @@ fn solve_pass(
         };
 
         let (ca, cb) = (grid.count[i], grid.count[i + 1]);
-        let jump_w = max_jump.map_or(cb, |k| (2 * k + 1).min(cb));
+        // transitions searched per candidate j: limited by the slope band and by max_jump
+        let slope_w = if grid.step[i + 1] > 0.0 {
+            #[expect(
+                clippy::cast_possible_truncation,
+                clippy::cast_sign_loss,
+                reason = "non-negative, capped at cb below"
+            )]
+            let w = ((dmax - dmin) / grid.step[i + 1]) as usize + 1;
+            w.min(cb)
+        } else {
+            1
+        };
+        let jump_w = max_jump.map_or(slope_w, |k| (2 * k + 1).min(slope_w));
         let est_edges = ca * jump_w;
         let tmin = grid.lo[i].min(grid.lo[i + 1]).max(0.0);
         let tmax = grid.hi(i).max(grid.hi(i + 1)).min(prep.qscale);
@@ -254,7 +266,15 @@ fn solve_pass(
         } else if width + 1 < est_edges {
             1
         } else if points.is_some() {
-            (4 * width).div_ceil(est_edges.max(1)).max(2)
+            // resolve a quarter of the candidate spacing; use it only if cheaper than direct
+            let min_step = grid.step[i].min(grid.step[i + 1]);
+            #[expect(
+                clippy::cast_possible_truncation,
+                clippy::cast_sign_loss,
+                reason = "non-negative spacing"
+            )]
+            let stride = ((min_step / 4.0) as usize).max(2);
+            if (s1 - s0) / stride + 2 < est_edges { stride } else { 0 }
         } else {
             0
         };
