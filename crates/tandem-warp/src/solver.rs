@@ -8,9 +8,11 @@ use crate::params::WarpParams;
 use crate::signal::SignalRef;
 use crate::warp::Warp;
 
-/// Reference samples at which the first (coarse) pass evaluates the loss inside each segment
-/// between two nodes, when it uses fewer nodes than the final passes. The final passes always
-/// integrate over every reference sample.
+/// Reference samples at which a coarse pass (one with fewer nodes than the final `N`: the first
+/// pass and the early refinement passes) evaluates the loss inside each segment between two nodes;
+/// such a pass may also interpolate the loss linearly between query samples a quarter candidate
+/// spacing apart. Coarse passes only steer the search; the last pass integrates the exact loss
+/// over every reference sample, and [`crate::Warp::objective`] is always exact.
 pub const COARSE_POINTS_PER_SEGMENT: usize = 4;
 
 /// Candidate grid of one pass: node `i` sits at reference sample `nodes[i]` and has candidates
@@ -274,7 +276,11 @@ fn solve_pass(
                 reason = "non-negative spacing"
             )]
             let stride = ((min_step / 4.0) as usize).max(2);
-            if (s1 - s0) / stride + 2 < est_edges { stride } else { 0 }
+            if (s1 - s0) / stride + 2 < est_edges {
+                stride
+            } else {
+                0
+            }
         } else {
             0
         };
