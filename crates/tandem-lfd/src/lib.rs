@@ -14,6 +14,30 @@
 //! Time frames: all per-time arrays are indexed by *reference sample* `n ∈ 0..n_ref()`
 //! (demo 0's samples, period `dt_s()`); warps map reference samples to demo samples.
 //!
+//! # Decisions
+//!
+//! - **Weights.** `W⁺ = diag(1/r_j²)` with `r_j` a per-coordinate range (default: the
+//!   channel's range over all demonstrations; for the rate, the range of all warp
+//!   gradients; ranges below `min_range` become 1), so `σ²_D` is dimensionless. The same
+//!   ranges weight the alignment (`1/r_j²`, and `4/r_q²` on each quaternion component since
+//!   a small rotation `δr` moves a unit quaternion by `|δr|/2`). Ranges are fixed at fit
+//!   time; updates keep them so `σ²_D` stays comparable across iterations.
+//! - **Quaternions.** Statistics use rotation vectors `log(q_a⁻¹ ⊗ q)` relative to a fixed
+//!   per-sample anchor `q_a` (demo 0's orientation there); the mean is `q_a ⊗ exp(r̄)`. This
+//!   is sign-proof (`q ≡ −q`) and makes [`TaskModel::update`] equal a refit exactly. For
+//!   alignment only, quaternion signs are made continuous and put in demo 0's hemisphere.
+//! - **Corrections.** Per reference sample, the eigen-decomposition of the range-scaled
+//!   scatter matrix (equivalent to the SVD of the scaled residuals); `K = min(n − 1, k_max, d)`
+//!   components, each stored as a ±3σ displacement `c_k = 3·s_k/√n · v_k ⊙ r`, signs kept
+//!   continuous in time. The scale `a(t) ∈ [0, 1]` is uniform over the input box: the largest
+//!   factor keeping `ψ̄̇ + a·Σ_k u_k c_k,rate` inside `[ψ̇min, ψ̇max]` for *every*
+//!   `u ∈ [−1, 1]^K`, so the operator's input maps linearly to the correction. Where the
+//!   demonstrated rate range is zero the components' rate entries are zero. The table is
+//!   computed lazily on first use after a fit, load or update (an update alone stays cheap).
+//! - **Executions.** An execution's warp is the inverse of its reference-time log
+//!   ([`TaskModel::execution_warp`]); no re-alignment. All demonstrations and executions must
+//!   share `Δt_s` within 1 %.
+//!
 //! ```
 //! use tandem_lfd::{Demonstration, FitParams, TaskModel};
 //! let names = vec!["force".to_string()];

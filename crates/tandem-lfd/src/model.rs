@@ -260,11 +260,24 @@ impl TryFrom<ModelData> for TaskModel {
             && data.scatter.len() == n * packed_len(d)
             && data.grad_min.len() == n
             && data.grad_max.len() == n
-            && data.layout.names.len() == d;
+            && data.layout.names.len() == d
+            && data.layout.items.iter().all(|it| match it {
+                Item::Scalar(j) => *j < data.channel_names.len(),
+                Item::Quat(cols, b) => {
+                    cols.iter().all(|c| *c < data.channel_names.len()) && *b < data.layout.n_quat
+                }
+            })
+            && data.ranges.iter().all(|r| r.is_finite() && *r > 0.0)
+            && data
+                .stat_mean
+                .iter()
+                .chain(&data.scatter)
+                .all(|v| v.is_finite())
+            && data.anchors.iter().flatten().all(|v| v.is_finite());
         if !ok {
             return Err(Error::BadData {
                 what: "task model".into(),
-                why: "inconsistent array lengths in persisted model".into(),
+                why: "inconsistent shapes or non-finite values in persisted model".into(),
             });
         }
         Ok(Self::from_data(data))
@@ -361,34 +374,54 @@ fn bracket(t: f64, n: usize) -> (usize, usize, f64) {
     (lo, hi, t - lo as f64)
 }
 
-/// Forward-difference gradient, last entry repeating the previous one.
-fn gradient(values: &[f64]) -> Vec<f64> {
-    let n = values.len();
-    let mut g: Vec<f64> = values.windows(2).map(|w| w[1] - w[0]).collect();
-    g.push(g[n - 2]);
-    g
-}
+/// Reference samples per parallel work item in per-sample loops (results do not depend
+/// on the split).
+const PAR_MIN_LEN: usize = 512;
 
-/// Tangent-layout observations `x_i⁺(ψ_i(n))` of one aligned demonstration, `n_ref × d`.
-fn observe(layout: &Layout, anchors: &[Quat], demo: &Demonstration, warp: &[f64]) -> Vec<f64> {
-    let d = layout.dim();
+/// Tangent-layout observation `x_i⁺(ψ_i(n))` of an aligned demonstration at reference
+/// sample `n` into `out` (`d` values; rate = forward-difference warp gradient, the last
+/// entry repeating the previous one).
+fn observe_at(
+    layout: &Layout,
+    anchors: &[Quat],
+    demo: &Demonstration,
+    warp: &[f64],
+    n: usize,
+    out: &mut [f64],
+) {
     let nq = layout.n_quat;
-    let grad = gradient(warp);
-    let mut out = Vec::with_capacity(warp.len() * d);
-    for (n, &q_t) in warp.iter().enumerate() {
-        let (lo, hi, alpha) = bracket(q_t, demo.n_samples());
-        let (a, b) = (demo.sample(lo), demo.sample(hi));
-        for item in &layout.items {
-            match item {
-                Item::Scalar(j) => out.push(a[*j] + alpha * (b[*j] - a[*j])),
-                Item::Quat(cols, blk) => {
-                    let q = quat_at(demo, cols, q_t);
-                    out.extend(quat::log_relative(&anchors[n * nq + blk], &q));
-                }
+    let q_t = warp[n];
+    let (lo, hi, alpha) = bracket(q_t, demo.n_samples());
+    let (a, b) = (demo.sample(lo), demo.sample(hi));
+    let mut k = 0;
+    for item in &layout.items {
+        match item {
+            Item::Scalar(j) => {
+                out[k] = a[*j] + alpha * (b[*j] - a[*j]);
+                k += 1;
+            }
+            Item::Quat(cols, blk) => {
+                let q = quat_at(demo, cols, q_t);
+                out[k..k + 3].copy_from_slice(&quat::log_relative(&anchors[n * nq + blk], &q));
+                k += 3;
             }
         }
-        out.push(grad[n]);
     }
+    out[k] = if n + 1 < warp.len() {
+        warp[n + 1] - warp[n]
+    } else {
+        warp[n] - warp[n - 1]
+    };
+}
+
+/// Tangent-layout observations of one aligned demonstration, `n_ref × d`.
+fn observe(layout: &Layout, anchors: &[Quat], demo: &Demonstration, warp: &[f64]) -> Vec<f64> {
+    let d = layout.dim();
+    let mut out = vec![0.0; warp.len() * d];
+    out.par_chunks_mut(d)
+        .enumerate()
+        .with_min_len(PAR_MIN_LEN)
+        .for_each(|(n, x)| observe_at(layout, anchors, demo, warp, n, x));
     out
 }
 
@@ -692,33 +725,36 @@ impl TaskModel {
         sigma2.resize(n_ref, 0.0);
         let inv_w: Vec<f64> = data.ranges.iter().map(|r| 1.0 / (r * r)).collect();
         let denom = (data.count - 1) as f64;
-        for n in 0..n_ref {
-            let mu = &data.stat_mean[n * d..(n + 1) * d];
-            let out = &mut mean[n * m..(n + 1) * m];
-            let mut k = 0;
-            for item in &data.layout.items {
-                match item {
-                    Item::Scalar(j) => {
-                        out[*j] = mu[k];
-                        k += 1;
-                    }
-                    Item::Quat(cols, blk) => {
-                        let r = [mu[k], mu[k + 1], mu[k + 2]];
-                        let q = quat::exp_relative(&data.anchors[n * nq + blk], &r);
-                        for (c, v) in cols.iter().zip(q) {
-                            out[*c] = v;
+        mean.par_chunks_mut(m)
+            .zip(grad_mean.par_iter_mut().zip(sigma2.par_iter_mut()))
+            .enumerate()
+            .with_min_len(PAR_MIN_LEN)
+            .for_each(|(n, (out, (g, s2)))| {
+                let mu = &data.stat_mean[n * d..(n + 1) * d];
+                let mut k = 0;
+                for item in &data.layout.items {
+                    match item {
+                        Item::Scalar(j) => {
+                            out[*j] = mu[k];
+                            k += 1;
                         }
-                        k += 3;
+                        Item::Quat(cols, blk) => {
+                            let r = [mu[k], mu[k + 1], mu[k + 2]];
+                            let q = quat::exp_relative(&data.anchors[n * nq + blk], &r);
+                            for (c, v) in cols.iter().zip(q) {
+                                out[*c] = v;
+                            }
+                            k += 3;
+                        }
                     }
                 }
-            }
-            grad_mean[n] = mu[d - 1];
-            let sc = &data.scatter[n * pl..(n + 1) * pl];
-            sigma2[n] = (0..d)
-                .map(|i| sc[packed_idx(d, i, i)] * inv_w[i])
-                .sum::<f64>()
-                / denom;
-        }
+                *g = mu[d - 1];
+                let sc = &data.scatter[n * pl..(n + 1) * pl];
+                *s2 = (0..d)
+                    .map(|i| sc[packed_idx(d, i, i)] * inv_w[i])
+                    .sum::<f64>()
+                    / denom;
+            });
         self.mean = mean;
         self.grad_mean = grad_mean;
         self.sigma2_d = sigma2;
@@ -739,30 +775,40 @@ impl TaskModel {
             .conform_to(&self.data.channel_names)?;
         let d = self.data.layout.dim();
         let pl = packed_len(d);
-        let obs = observe(&self.data.layout, &self.data.anchors, &demo, &values);
         let data = &mut self.data;
+        let (layout, anchors) = (&data.layout, &data.anchors);
         let count = data.count as f64 + 1.0;
-        let factor = data.count as f64 / count;
-        let mut delta = vec![0.0; d];
-        for n in 0..data.n_ref {
-            let x = &obs[n * d..(n + 1) * d];
-            let mu = &mut data.stat_mean[n * d..(n + 1) * d];
-            for k in 0..d {
-                delta[k] = x[k] - mu[k];
-                mu[k] += delta[k] / count;
-            }
-            let sc = &mut data.scatter[n * pl..(n + 1) * pl];
-            let mut p = 0;
-            for (i, &di) in delta.iter().enumerate() {
-                let di = di * factor;
-                for dj in &delta[i..] {
-                    sc[p] += di * dj;
-                    p += 1;
-                }
-            }
-            data.grad_min[n] = data.grad_min[n].min(x[d - 1]);
-            data.grad_max[n] = data.grad_max[n].max(x[d - 1]);
-        }
+        let (inv_count, factor) = (1.0 / count, data.count as f64 / count);
+        data.stat_mean
+            .par_chunks_mut(d)
+            .zip(data.scatter.par_chunks_mut(pl))
+            .zip(
+                data.grad_min
+                    .par_iter_mut()
+                    .zip(data.grad_max.par_iter_mut()),
+            )
+            .enumerate()
+            .with_min_len(PAR_MIN_LEN)
+            .for_each_init(
+                || (vec![0.0; d], vec![0.0; d]),
+                |(x, delta), (n, ((mu, sc), (gmin, gmax)))| {
+                    observe_at(layout, anchors, &demo, &values, n, x);
+                    for k in 0..d {
+                        delta[k] = x[k] - mu[k];
+                        mu[k] += delta[k] * inv_count;
+                    }
+                    let mut p = 0;
+                    for (i, &di) in delta.iter().enumerate() {
+                        let di = di * factor;
+                        for dj in &delta[i..] {
+                            sc[p] += di * dj;
+                            p += 1;
+                        }
+                    }
+                    *gmin = gmin.min(x[d - 1]);
+                    *gmax = gmax.max(x[d - 1]);
+                },
+            );
         data.count += 1;
         self.corrections = OnceLock::new();
         self.refresh_derived();

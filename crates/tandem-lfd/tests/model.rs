@@ -224,3 +224,26 @@ proptest! {
         assert_same_statistics(&model, &refit);
     }
 }
+
+#[test]
+fn correction_components_are_sign_continuous() {
+    let (demos, warps) = data(
+        &[0.0, 1.0, -0.5, 0.8],
+        &[50, 61, 44, 57],
+        &[0.0, 0.6, -0.4, 0.2],
+    );
+    let m = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+    assert_eq!(m.n_components(), 3);
+    let r = m.ranges().to_vec();
+    let scaled = |t: usize, k: usize| -> Vec<f64> {
+        let c = m.corrections_at(t as f64).unwrap();
+        c.components[k].iter().zip(&r).map(|(c, r)| c / r).collect()
+    };
+    for n in 1..m.n_ref() {
+        for k in 0..3 {
+            let (a, b) = (scaled(n - 1, k), scaled(n, k));
+            let dot: f64 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
+            assert!(dot >= 0.0, "component {k} flips between {} and {n}", n - 1);
+        }
+    }
+}
