@@ -1,0 +1,68 @@
+//! Benchmarks of the margin checks (single pass, per pair, printed) and of the coordinator.
+
+use criterion::{BenchmarkId, Criterion, black_box, criterion_main};
+use tandem_realtime::{
+    Coordinator, Timeline, sufficient_margins, sufficient_margins_per_pair,
+    sufficient_margins_printed,
+};
+
+/// A deterministic problem of `n_ref` samples with 16 evenly spaced LC regions (a sixth of each
+/// period), both robots on the mean gradient; robot 2 starts half a period after robot 1, so
+/// the executions overlap throughout and every pair of both roles is simulated.
+fn robots(n_ref: usize) -> [Timeline; 2] {
+    let period = n_ref / 16;
+    let conf: Vec<bool> = (0..n_ref).map(|n| n % period >= period / 6).collect();
+    let mean: Vec<f64> = (0..n_ref)
+        .map(|n| 1.0 + 0.3 * ((n as f64) * 0.05).sin())
+        .collect();
+    let lo: Vec<f64> = mean.iter().map(|m| 0.6 * m).collect();
+    let hi: Vec<f64> = mean.iter().map(|m| 1.8 * m).collect();
+    let dt_s = 0.01;
+    let r0 = Timeline::new(&conf, &mean, &lo, &hi, 0.0, dt_s).expect("valid");
+    let tau = r0.sample_clock_s()[period / 2];
+    let r1 = Timeline::new(&conf, &mean, &lo, &hi, tau, dt_s).expect("valid");
+    [r0, r1]
+}
+
+fn bench(c: &mut Criterion) {
+    let tick_s = 0.01;
+    let mut g = c.benchmark_group("margins");
+    for n_ref in [1000usize, 6000] {
+        let r = robots(n_ref);
+        assert!(sufficient_margins(&r, tick_s).expect("valid tick"));
+        g.bench_with_input(BenchmarkId::new("single_pass", n_ref), &r, |b, r| {
+            b.iter(|| sufficient_margins(black_box(r), tick_s))
+        });
+        g.bench_with_input(BenchmarkId::new("per_pair", n_ref), &r, |b, r| {
+            b.iter(|| sufficient_margins_per_pair(black_box(r), tick_s))
+        });
+        // The printed check rejects this schedule at its first pair (robot 2 starts in an LC
+        // sample after robot 1's first region ended: the printed loop steps before testing).
+        assert!(!sufficient_margins_printed(&r, tick_s).expect("valid tick"));
+        g.bench_with_input(BenchmarkId::new("printed", n_ref), &r, |b, r| {
+            b.iter(|| sufficient_margins_printed(black_box(r), tick_s))
+        });
+    }
+    g.finish();
+    let r = robots(6000);
+    c.bench_function("coordinator_run/6000", |b| {
+        b.iter(|| {
+            let mut co = Coordinator::new(r.clone(), tick_s).expect("valid tick");
+            let mut k = 0u32;
+            while !co.is_finished() {
+                let g = if k % 7 < 3 { 0.0 } else { f64::INFINITY };
+                black_box(co.tick(g));
+                k += 1;
+            }
+            k
+        })
+    });
+}
+
+/// Runs every benchmark of this file (configured from the command line).
+pub fn benches() {
+    let mut c = Criterion::default().configure_from_args();
+    bench(&mut c);
+}
+
+criterion_main!(benches);
