@@ -51,3 +51,28 @@ fn single_pass_equals_per_pair_on_random_schedules() {
         "both decisions must be exercised: {accepted} accepted, {rejected} rejected"
     );
 }
+
+/// The fastest serial schedule (`τ = |ψ_E1|`, robot 2 starting at `robots[0].end_s()`) is always
+/// accepted: the scheduler's fallback of last resort (DESIGN.md, tandem-schedule).
+#[test]
+fn serial_schedule_is_always_accepted() {
+    let config = Config {
+        cases: 500,
+        failure_persistence: None,
+        ..Config::default()
+    };
+    let mut runner =
+        TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+    let result = runner.run(&(any::<u64>(), 0.25..=1.5f64), |(seed, tick_frac)| {
+        let mut r = rng(seed);
+        let problem = Problem::random(&mut r);
+        let tick_s = problem.dt_s * tick_frac;
+        let robots = problem.robots(problem.duration0());
+        prop_assert!(sufficient_margins(&robots, tick_s).unwrap());
+        prop_assert!(sufficient_margins_per_pair(&robots, tick_s).unwrap());
+        Ok(())
+    });
+    if let Err(e) = result {
+        panic!("{e}");
+    }
+}
