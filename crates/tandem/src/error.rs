@@ -58,6 +58,48 @@ pub enum Error {
         /// What its value must be.
         why: &'static str,
     },
+    /// An execution record is malformed.
+    #[error("bad execution record: `{what}`: {why}")]
+    BadExecution {
+        /// Which part.
+        what: &'static str,
+        /// What is wrong.
+        why: String,
+    },
+    /// An input file or data set is unusable.
+    #[error("{}: {why}", path.display())]
+    BadInput {
+        /// The file or folder concerned.
+        path: PathBuf,
+        /// What is wrong.
+        why: String,
+    },
+    /// Parts of a loaded state do not fit together.
+    #[error("inconsistent state: `{what}`: {why}")]
+    Inconsistent {
+        /// Which part.
+        what: &'static str,
+        /// What is wrong.
+        why: String,
+    },
+    /// Time warping failed (§II-B1).
+    #[error(transparent)]
+    Warp(#[from] tandem_warp::Error),
+    /// Demonstrations, executions or the task model (§II-B1/2).
+    #[error(transparent)]
+    Lfd(#[from] tandem_lfd::Error),
+    /// Confidence (§II-B3).
+    #[error(transparent)]
+    Confidence(#[from] tandem_confidence::Error),
+    /// Real-time coordination (§II-B5).
+    #[error(transparent)]
+    Realtime(#[from] tandem_realtime::Error),
+    /// Scheduling (§II-B4/6).
+    #[error(transparent)]
+    Schedule(#[from] tandem_schedule::Error),
+    /// Simulation (§III).
+    #[error(transparent)]
+    Sim(#[from] tandem_sim::Error),
     /// The state could not be serialized.
     #[error("cannot encode state: {source}")]
     Encode {

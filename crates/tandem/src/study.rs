@@ -7,10 +7,13 @@
 //! under it (none for the last iteration).
 
 use std::fmt::Write as _;
+use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::{Error, Result};
+use crate::lfd::Demonstration;
+use crate::sim::task::{self, Label, TaskParams};
+use crate::{Error, PlannerParams, Result};
 
 /// Study configuration (`fixtures/study.toml`, §III).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -32,6 +35,12 @@ pub struct StudyConfig {
     pub false_correction_rate: f64,
     /// Iterations whose schedules Fig. 5 draws as examples (trial 0). Default: 0, 25, 50, 100, 150.
     pub example_iterations: Vec<usize>,
+    /// Model, confidence and sampler parameters. The sampler's `samples` and `seed` are
+    /// replaced by [`StudyConfig::samples`] and the trial's seed. Default: `PlannerParams::default()`.
+    pub planner: PlannerParams,
+    /// Task parameters for drawing each execution's workpiece (only `n_sections` matters);
+    /// must match the demonstrations'. Default: `TaskParams::default()` (the fixtures').
+    pub task: TaskParams,
 }
 
 impl Default for StudyConfig {
@@ -44,6 +53,8 @@ impl Default for StudyConfig {
             miss_rate: 0.01,
             false_correction_rate: 0.01,
             example_iterations: vec![0, 25, 50, 100, 150],
+            planner: PlannerParams::default(),
+            task: TaskParams::default(),
         }
     }
 }
@@ -80,6 +91,8 @@ impl StudyConfig {
                 return bad(name, "must be a probability in [0, 1]");
             }
         }
+        self.planner.validate()?;
+        self.task.validate()?;
         Ok(())
     }
 }
@@ -110,6 +123,9 @@ pub struct IterationRecord {
     pub offset_s: f64,
     /// Share of reference samples that are high-confidence (Eq. 12), in percent.
     pub high_conf_pct: f64,
+    /// Where the schedule came from: `sampled`, `previous`, `repaired` (the previous
+    /// schedule re-projected onto the new problem) or `serial`.
+    pub source: String,
     /// Planned low-confidence intervals `[start_s, end_s)` of robot 1 and robot 2 (global time, s).
     pub lc_intervals_s: [Vec<[f64; 2]>; 2],
     /// The outcome of running the next pair under this schedule (`None` for the last one).
@@ -153,22 +169,16 @@ pub struct IterationSummary {
     pub t_total_std_s: f64,
     /// Mean percent of high-confidence reference samples across trials.
     pub high_conf_pct_mean: f64,
+    /// Sample standard deviation of that percent across trials (percentage points).
+    pub high_conf_pct_std: f64,
     /// Overlap ticks summed across trials (must be 0).
     pub overlap_ticks: usize,
 }
 
-/// Seed of trial `trial` from the master `seed`: SplitMix64 of both, so trials are
+/// Seed of trial `trial` from the master `seed` ([`crate::derive_seed`]), so trials are
 /// independent of each other and of the order in which threads run them.
 pub fn trial_seed(seed: u64, trial: usize) -> u64 {
-    splitmix64(seed ^ splitmix64(trial as u64 + 1))
-}
-
-/// One SplitMix64 output for state `x` (Steele, Lea & Flood 2014).
-fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+    crate::derive_seed(seed, trial as u64)
 }
 
 impl StudyResult {
@@ -185,12 +195,13 @@ impl StudyResult {
                 let recs: Vec<&IterationRecord> =
                     self.trials.iter().map(|t| &t.iterations[k]).collect();
                 let (mean, std) = mean_std(recs.iter().map(|r| r.t_total_s));
-                let (hc, _) = mean_std(recs.iter().map(|r| r.high_conf_pct));
+                let (hc, hc_std) = mean_std(recs.iter().map(|r| r.high_conf_pct));
                 IterationSummary {
                     iteration: recs[0].iteration,
                     t_total_mean_s: mean,
                     t_total_std_s: std,
                     high_conf_pct_mean: hc,
+                    high_conf_pct_std: hc_std,
                     overlap_ticks: recs
                         .iter()
                         .filter_map(|r| r.pair.as_ref())
@@ -212,12 +223,12 @@ impl StudyResult {
     }
 
     /// One CSV row per trial and iteration. Columns: `trial, iteration, t_total_s, offset_s,
-    /// high_conf_pct, overlap_ticks, operator_idle_share, duration_s, supervised_ticks,
+    /// high_conf_pct, source, overlap_ticks, operator_idle_share, duration_s, supervised_ticks,
     /// corrected_ticks, lc_intervals_robot1_s, lc_intervals_robot2_s`; pair columns are
     /// empty for the last iteration; intervals are `start-end` pairs (s) joined by `;`.
     pub fn to_csv(&self) -> String {
         let mut out = String::from(
-            "trial,iteration,t_total_s,offset_s,high_conf_pct,overlap_ticks,\
+            "trial,iteration,t_total_s,offset_s,high_conf_pct,source,overlap_ticks,\
              operator_idle_share,duration_s,supervised_ticks,corrected_ticks,\
              lc_intervals_robot1_s,lc_intervals_robot2_s\n",
         );
@@ -243,12 +254,13 @@ impl StudyResult {
                 // Writing to a String cannot fail.
                 let _ = writeln!(
                     out,
-                    "{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{}",
                     t.trial,
                     r.iteration,
                     r.t_total_s,
                     r.offset_s,
                     r.high_conf_pct,
+                    r.source,
                     pair,
                     intervals(&r.lc_intervals_s[0]),
                     intervals(&r.lc_intervals_s[1]),
@@ -256,6 +268,105 @@ impl StudyResult {
             }
         }
         out
+    }
+}
+
+/// What a study learns from: demonstrations (demo 0 is the reference) and the ground-truth
+/// labels of the reference demonstration, one per sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StudyInputs {
+    /// The demonstrations, demo 0 first.
+    pub demos: Vec<Demonstration>,
+    /// Labels of demo 0's samples (pass, section, painted, phase).
+    pub reference_labels: Vec<Label>,
+}
+
+impl StudyInputs {
+    /// Reads `demo_0.csv`, `demo_1.csv`, … (until the first missing index) and
+    /// `demo_0.labels.csv` from `dir` (the layout of `fixtures/sanding/`).
+    ///
+    /// # Errors
+    /// [`Error::BadInput`] naming the file for a missing or unreadable labels file, fewer
+    /// than two demonstrations, or labels that do not match demo 0's samples; the model
+    /// crate's error (naming file and line) for a bad demonstration.
+    pub fn from_dir(dir: &Path) -> Result<Self> {
+        let mut demos = Vec::new();
+        loop {
+            let path = dir.join(format!("demo_{}.csv", demos.len()));
+            if !path.exists() {
+                break;
+            }
+            demos.push(Demonstration::from_csv_path(&path, None)?);
+        }
+        if demos.len() < 2 {
+            return Err(Error::BadInput {
+                path: dir.to_path_buf(),
+                why: format!(
+                    "found {} demonstrations demo_0.csv, demo_1.csv, …; need at least 2",
+                    demos.len()
+                ),
+            });
+        }
+        let path = dir.join("demo_0.labels.csv");
+        let bad = |why: String| Error::BadInput {
+            path: path.clone(),
+            why,
+        };
+        let mut reader = csv::Reader::from_path(&path).map_err(|e| bad(e.to_string()))?;
+        let reference_labels = reader
+            .deserialize::<Label>()
+            .enumerate()
+            .map(|(k, r)| r.map_err(|e| bad(format!("row {}: {e}", k + 1))))
+            .collect::<Result<Vec<_>>>()?;
+        let inputs = Self {
+            demos,
+            reference_labels,
+        };
+        inputs.check().map_err(bad)?;
+        Ok(inputs)
+    }
+
+    /// From demonstrations made by the task generator (`tandem_sim::task`), demo 0 the
+    /// reference: channels [`task::CHANNELS`], each demo's own `Δt_s`.
+    ///
+    /// # Errors
+    /// The model crate's error if a demonstration is invalid, [`Error::BadInput`] for
+    /// fewer than two.
+    pub fn from_task_demos(demos: &[task::TaskDemo]) -> Result<Self> {
+        let names: Vec<String> = task::CHANNELS.iter().map(|c| (*c).to_string()).collect();
+        let converted = demos
+            .iter()
+            .map(|d| {
+                let flat: Vec<f64> = d.samples.iter().flatten().copied().collect();
+                Demonstration::new(names.clone(), flat, d.dt_s)
+            })
+            .collect::<std::result::Result<Vec<_>, _>>()?;
+        let inputs = Self {
+            demos: converted,
+            reference_labels: demos.first().map(|d| d.labels.clone()).unwrap_or_default(),
+        };
+        inputs.check().map_err(|why| Error::BadInput {
+            path: "<generated demonstrations>".into(),
+            why,
+        })?;
+        Ok(inputs)
+    }
+
+    fn check(&self) -> std::result::Result<(), String> {
+        if self.demos.len() < 2 {
+            return Err(format!(
+                "{} demonstrations, need at least 2",
+                self.demos.len()
+            ));
+        }
+        let n = self.demos[0].n_samples();
+        if self.reference_labels.len() != n {
+            return Err(format!(
+                "{} labels for the {n} samples of the reference demonstration",
+                self.reference_labels.len()
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -284,6 +395,7 @@ mod tests {
             t_total_s,
             offset_s: 1.0,
             high_conf_pct: 10.0 * iteration as f64,
+            source: "sampled".into(),
             lc_intervals_s: [vec![[0.0, 1.5]], vec![[2.0, 2.25], [3.0, 4.0]]],
             pair: pair.then_some(PairStats {
                 overlap_ticks: 0,
@@ -396,14 +508,14 @@ mod tests {
         let lines: Vec<&str> = csv.lines().collect();
         assert_eq!(lines.len(), 1 + 4);
         let n_cols = lines[0].split(',').count();
-        assert_eq!(n_cols, 12);
+        assert_eq!(n_cols, 13);
         for l in &lines[1..] {
             assert_eq!(l.split(',').count(), n_cols, "{l}");
         }
         assert_eq!(
             lines[1],
-            "0,0,10,1,0,0,0.5,10,10,4,0.000-1.500,2.000-2.250;3.000-4.000"
+            "0,0,10,1,0,sampled,0,0.5,10,10,4,0.000-1.500,2.000-2.250;3.000-4.000"
         );
-        assert!(lines[2].starts_with("0,1,8,1,10,,,,,,"));
+        assert!(lines[2].starts_with("0,1,8,1,10,sampled,,,,,,"));
     }
 }
