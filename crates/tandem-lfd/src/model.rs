@@ -414,6 +414,43 @@ fn observe_at(
     };
 }
 
+/// Derived values at one reference sample from its statistics: the physical mean into
+/// `out` (`m` values, quaternions `anchor ⊗ exp(r̄)`), and returns (mean rate, `σ²_D`) with
+/// `σ²_D = Σ_j scatter_jj / r_j² / denom` (Eq. 6, `denom = n − 1`).
+fn derive_at(
+    layout: &Layout,
+    anchors: &[Quat],
+    inv_w: &[f64],
+    denom: f64,
+    mu: &[f64],
+    sc: &[f64],
+    out: &mut [f64],
+) -> (f64, f64) {
+    let d = mu.len();
+    let mut k = 0;
+    for item in &layout.items {
+        match item {
+            Item::Scalar(j) => {
+                out[*j] = mu[k];
+                k += 1;
+            }
+            Item::Quat(cols, blk) => {
+                let r = [mu[k], mu[k + 1], mu[k + 2]];
+                let q = quat::exp_relative(&anchors[*blk], &r);
+                for (c, v) in cols.iter().zip(q) {
+                    out[*c] = v;
+                }
+                k += 3;
+            }
+        }
+    }
+    let s2 = (0..d)
+        .map(|i| sc[packed_idx(d, i, i)] * inv_w[i])
+        .sum::<f64>()
+        / denom;
+    (mu[d - 1], s2)
+}
+
 /// Tangent-layout observations of one aligned demonstration, `n_ref × d`.
 fn observe(layout: &Layout, anchors: &[Quat], demo: &Demonstration, warp: &[f64]) -> Vec<f64> {
     let d = layout.dim();
@@ -731,29 +768,9 @@ impl TaskModel {
             .with_min_len(PAR_MIN_LEN)
             .for_each(|(n, (out, (g, s2)))| {
                 let mu = &data.stat_mean[n * d..(n + 1) * d];
-                let mut k = 0;
-                for item in &data.layout.items {
-                    match item {
-                        Item::Scalar(j) => {
-                            out[*j] = mu[k];
-                            k += 1;
-                        }
-                        Item::Quat(cols, blk) => {
-                            let r = [mu[k], mu[k + 1], mu[k + 2]];
-                            let q = quat::exp_relative(&data.anchors[n * nq + blk], &r);
-                            for (c, v) in cols.iter().zip(q) {
-                                out[*c] = v;
-                            }
-                            k += 3;
-                        }
-                    }
-                }
-                *g = mu[d - 1];
                 let sc = &data.scatter[n * pl..(n + 1) * pl];
-                *s2 = (0..d)
-                    .map(|i| sc[packed_idx(d, i, i)] * inv_w[i])
-                    .sum::<f64>()
-                    / denom;
+                let anchors = &data.anchors[n * nq..(n + 1) * nq];
+                (*g, *s2) = derive_at(&data.layout, anchors, &inv_w, denom, mu, sc, out);
             });
         self.mean = mean;
         self.grad_mean = grad_mean;
@@ -779,6 +796,9 @@ impl TaskModel {
         let (layout, anchors) = (&data.layout, &data.anchors);
         let count = data.count as f64 + 1.0;
         let (inv_count, factor) = (1.0 / count, data.count as f64 / count);
+        let (m, nq) = (data.channel_names.len(), layout.n_quat);
+        let inv_w: Vec<f64> = data.ranges.iter().map(|r| 1.0 / (r * r)).collect();
+        let denom = data.count as f64; // (count + 1) − 1
         data.stat_mean
             .par_chunks_mut(d)
             .zip(data.scatter.par_chunks_mut(pl))
@@ -787,11 +807,18 @@ impl TaskModel {
                     .par_iter_mut()
                     .zip(data.grad_max.par_iter_mut()),
             )
+            .zip(
+                self.mean.par_chunks_mut(m).zip(
+                    self.grad_mean
+                        .par_iter_mut()
+                        .zip(self.sigma2_d.par_iter_mut()),
+                ),
+            )
             .enumerate()
             .with_min_len(PAR_MIN_LEN)
             .for_each_init(
                 || (vec![0.0; d], vec![0.0; d]),
-                |(x, delta), (n, ((mu, sc), (gmin, gmax)))| {
+                |(x, delta), (n, (((mu, sc), (gmin, gmax)), (out, (g, s2))))| {
                     observe_at(layout, anchors, &demo, &values, n, x);
                     for k in 0..d {
                         delta[k] = x[k] - mu[k];
@@ -807,11 +834,12 @@ impl TaskModel {
                     }
                     *gmin = gmin.min(x[d - 1]);
                     *gmax = gmax.max(x[d - 1]);
+                    let anchors = &anchors[n * nq..(n + 1) * nq];
+                    (*g, *s2) = derive_at(layout, anchors, &inv_w, denom, mu, sc, out);
                 },
             );
         data.count += 1;
         self.corrections = OnceLock::new();
-        self.refresh_derived();
         Ok(())
     }
 
