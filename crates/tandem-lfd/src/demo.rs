@@ -85,7 +85,7 @@ impl Demonstration {
         }
         if self.samples.len() / m < 2 {
             return Err(Error::TooFewSamples {
-                file: self.source.clone(),
+                at: self.source.clone(),
                 found: self.samples.len() / m,
             });
         }
@@ -234,7 +234,9 @@ impl Demonstration {
         let width = names.len();
         let mut samples = Vec::new();
         let mut times: Vec<(usize, f64)> = Vec::new();
+        let mut last_line = header_line;
         for (line, row) in lines {
+            last_line = line;
             let fields: Vec<&str> = row.split(',').collect();
             if fields.len() != width {
                 return Err(Error::RaggedRow {
@@ -273,7 +275,7 @@ impl Demonstration {
         let n = samples.len() / (width - usize::from(t_col.is_some()));
         if n < 2 {
             return Err(Error::TooFewSamples {
-                file: file.into(),
+                at: format!("{file}:{}:1", last_line + 1),
                 found: n,
             });
         }
@@ -317,7 +319,7 @@ impl Demonstration {
         let m = doc.channels.len();
         let json_err = |row: Option<usize>, why: String| {
             let (line, column) = row
-                .and_then(|r| json_row_position(text, r))
+                .and_then(|r| json_row_position(text, Some(r)))
                 .unwrap_or((1, 1));
             Error::Json {
                 file: file.into(),
@@ -341,8 +343,9 @@ impl Demonstration {
             }
         }
         if doc.samples.len() < 2 {
+            let (line, column) = json_row_position(text, None).unwrap_or((1, 1));
             return Err(Error::TooFewSamples {
-                file: file.into(),
+                at: format!("{file}:{line}:{column}"),
                 found: doc.samples.len(),
             });
         }
@@ -403,8 +406,15 @@ fn time_column_period(times: &[(usize, f64)], file: &str, column: usize) -> Resu
     Ok(mean)
 }
 
-/// 1-based (line, column) of the start of row `row` of the top-level `samples` array.
-fn json_row_position(text: &str, row: usize) -> Option<(usize, usize)> {
+/// 1-based (line, column) of the start of row `row` of the top-level `samples` array, or
+/// of the array itself when `row` is `None`.
+fn json_row_position(text: &str, row: Option<usize>) -> Option<(usize, usize)> {
+    let position = |pos: usize| {
+        let before = &text[..pos];
+        let line = before.matches('\n').count() + 1;
+        let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        (line, col)
+    };
     let (mut depth, mut in_string, mut escape) = (0usize, false, false);
     let mut string_start = 0;
     let mut last_key: Option<&str> = None;
@@ -431,15 +441,15 @@ fn json_row_position(text: &str, row: usize) -> Option<(usize, usize)> {
             }
             '[' | '{' => {
                 if in_samples && depth == 2 && ch == '[' {
-                    if count == row {
-                        let before = &text[..pos];
-                        let line = before.matches('\n').count() + 1;
-                        let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-                        return Some((line, col));
+                    if Some(count) == row {
+                        return Some(position(pos));
                     }
                     count += 1;
                 }
                 if depth == 1 && ch == '[' && last_key == Some("samples") {
+                    if row.is_none() {
+                        return Some(position(pos));
+                    }
                     in_samples = true;
                 }
                 depth += 1;
@@ -620,9 +630,10 @@ mod tests {
     #[test]
     fn json_row_positions() {
         let text = "{\"channels\": [\"a\"],\n \"samples\": [[1],\n   [2, 3]]}";
-        assert_eq!(json_row_position(text, 0), Some((2, 14)));
-        assert_eq!(json_row_position(text, 1), Some((3, 4)));
-        assert_eq!(json_row_position(text, 2), None);
+        assert_eq!(json_row_position(text, None), Some((2, 13)));
+        assert_eq!(json_row_position(text, Some(0)), Some((2, 14)));
+        assert_eq!(json_row_position(text, Some(1)), Some((3, 4)));
+        assert_eq!(json_row_position(text, Some(2)), None);
     }
 
     #[test]

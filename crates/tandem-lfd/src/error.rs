@@ -102,10 +102,11 @@ pub enum Error {
         why: String,
     },
     /// A demonstration has fewer than 2 samples.
-    #[error("{file}: {found} sample(s); at least 2 are required")]
+    #[error("{at}: {found} sample(s); at least 2 are required")]
     TooFewSamples {
-        /// The file or source label.
-        file: String,
+        /// Where: `file:line:column` of the end of the CSV data or of the JSON `samples`
+        /// array, or the source label of an in-memory demonstration.
+        at: String,
         /// Number of samples found.
         found: usize,
     },

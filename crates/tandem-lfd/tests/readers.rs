@@ -58,11 +58,11 @@ fn csv_non_numeric_and_non_finite() {
 fn csv_too_few_samples() {
     assert_eq!(
         csv_err("a,b\n1,2\n"),
-        "demo.csv: 1 sample(s); at least 2 are required"
+        "demo.csv:3:1: 1 sample(s); at least 2 are required"
     );
     assert_eq!(
         csv_err("a,b\n"),
-        "demo.csv: 0 sample(s); at least 2 are required"
+        "demo.csv:2:1: 0 sample(s); at least 2 are required"
     );
 }
 
@@ -134,7 +134,7 @@ fn json_malformed_cases() {
     let text = "{\"channels\": [\"a\"], \"samples\": [[1]]}";
     assert_eq!(
         json_err(text),
-        "demo.json: 1 sample(s); at least 2 are required"
+        "demo.json:1:32: 1 sample(s); at least 2 are required"
     );
     let text = "{\"channels\": [\"a\"], \"samples\": [[1], [2]], \"extra\": 1}";
     assert!(
