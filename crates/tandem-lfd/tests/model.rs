@@ -247,3 +247,23 @@ fn correction_components_are_sign_continuous() {
         }
     }
 }
+
+#[test]
+fn results_do_not_depend_on_thread_count() {
+    let (demos, _) = data(&[0.0, 1.0, -0.5], &[40, 55, 31], &[0.0, 0.6, -0.4]);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let m = TaskModel::fit(&demos, &FitParams::default()).unwrap();
+            let c = m.corrections_at(12.25).unwrap();
+            (serde_json::to_string(&m).unwrap(), c)
+        })
+    };
+    let (a, ca) = run(1);
+    let (b, cb) = run(2);
+    assert_eq!(a, b);
+    assert_eq!(ca, cb);
+}
