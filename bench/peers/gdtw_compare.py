@@ -113,6 +113,8 @@ def main():
     ap.add_argument("--max-jump", type=int, default=16,
                     help="tandem-warp max_jump in the refinement passes")
     ap.add_argument("--refinements", type=int, default=6)
+    ap.add_argument("--refine-radius", type=float, default=22.5,
+                    help="tandem-warp refine_radius (22.5 = gdtw's eta 0.15 at M = 301)")
     ap.add_argument("--no-build", action="store_true", help="use an already built example")
     args = ap.parse_args()
     exe = os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target")),
@@ -141,6 +143,7 @@ def main():
             "n_nodes": len(x_ref), "n_candidates": M, "lambda_inst": LAMBDA_INST,
             "lambda_cum": LAMBDA_CUM, "slope_min": S_MIN, "slope_max": S_MAX,
             "refinements": args.refinements, "max_jump": args.max_jump,
+            "refine_radius": args.refine_radius,
         }
         psi_t, wall_t, obj_rust = run_tandem(x_ref, x_q, names, exe, tp)
         # the crate's fast defaults on the same data and lambdas / slope bounds

@@ -238,7 +238,8 @@ fn solve_pass(
                 clippy::cast_sign_loss,
                 reason = "non-negative, capped at cb below"
             )]
-            let w = ((dmax - dmin) / grid.step[i + 1]) as usize + 1;
+            #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
+            let w = ((dmax - dmin) / grid.step[i + 1]).min(cb as f64) as usize + 1;
             w.min(cb)
         } else {
             1

@@ -160,6 +160,7 @@ fn defaults_are_as_accurate_as_the_same_problem_setting() {
         n_nodes: Some(600),
         n_candidates: 301,
         refinements: 6,
+        refine_radius: 22.5,
         max_jump: Some(16),
         ..base.clone()
     };
@@ -327,6 +328,28 @@ fn bad_inputs_are_errors() {
     )
     .unwrap_err();
     assert!(matches!(e, Error::NonFinite { ref signal, .. } if signal == "query #1"));
+}
+
+#[test]
+fn extreme_slope_bounds_are_handled() {
+    // gdtw's defaults: practically unconstrained slopes
+    let (r, q, truth) = warped_pair(300, 360, 0.02, 7);
+    let p = WarpParams {
+        slope_min: 1e-8,
+        slope_max: 1e8,
+        lambda_inst: 0.01,
+        lambda_cum: 0.01,
+        ..Default::default()
+    };
+    let w = align(
+        SignalRef::new(&r, 3).unwrap(),
+        SignalRef::new(&q, 3).unwrap(),
+        &p,
+    )
+    .unwrap();
+    assert!(w.values().windows(2).all(|x| x[1] >= x[0]));
+    assert_eq!(w.values()[299], 359.0);
+    assert!(mae(&w, &truth) <= 3.6, "MAE {}", mae(&w, &truth));
 }
 
 #[test]
