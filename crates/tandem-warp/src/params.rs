@@ -25,8 +25,8 @@ pub const DEFAULT_NODE_SPACING: usize = 4;
 /// candidates each, then [`refinements`](Self::refinements) passes on all
 /// [`n_nodes`](Self::n_nodes) nodes, each on a finer candidate grid centred on the previous
 /// solution (see [`refine_radius`](Self::refine_radius)).
-/// The defaults align two 7000-sample, 9-channel fixture demonstrations in about 10 ms on one
-/// core (bench `align_fixture`). To solve "the same problem" as the authors' `gdtw` package, use
+/// The defaults align two ~7000-sample, 9-channel fixture demonstrations in under 20 ms on one
+/// core (bench `align_fixture`; 16.7 ms measured on a busy shared 2-core machine). To solve "the same problem" as the authors' `gdtw` package, use
 /// `n_nodes = Some(T_ref)` (one node per reference sample) and `n_candidates = 301`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]

@@ -125,6 +125,7 @@ fn recovers_a_known_smooth_warp_from_noisy_signals() {
         )
         .unwrap();
         let err = mae(&w, &truth);
+        eprintln!("known warp {n_ref} -> {n_query}: MAE {err:.3} query samples");
         assert!(
             err <= 0.01 * n_query as f64,
             "MAE {err} samples > 1% of {n_query}"
@@ -166,6 +167,7 @@ fn defaults_are_as_accurate_as_the_same_problem_setting() {
     };
     let e_default = mae(&align(rs, qs, &base).unwrap(), &truth);
     let e_same = mae(&align(rs, qs, &same).unwrap(), &truth);
+    eprintln!("known warp: MAE default {e_default:.3}, same-problem {e_same:.3} query samples");
     assert!(
         e_default <= 1.1 * e_same + 0.1,
         "default MAE {e_default} vs same-problem {e_same}"
