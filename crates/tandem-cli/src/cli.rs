@@ -1,0 +1,242 @@
+//! Command-line arguments (clap derive).
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand};
+
+/// Coordinated two-robot shared autonomy from your own demonstrations (Hagenow et al., RA-L 2023).
+///
+/// Typical session:
+///
+///   tandem fit demo_*.csv -o cell.tandem        # learn the task and a first schedule
+///   tandem schedule cell.tandem                 # show it (text Gantt; --json for robots)
+///   tandem simulate cell.tandem --need need.csv --pairs 5    # what-if, nothing saved
+///   tandem record cell.tandem --execution a.csv --log a.reflog.csv --corrections a.corr.csv \
+///                             --execution b.csv --log b.reflog.csv --corrections b.corr.csv
+///   tandem inspect cell.tandem                  # model and confidence summary
+///   tandem plot cell.tandem -o plots/           # SVG and PNG figures
+///
+/// Every user error prints `error: ...` naming the file and the problem and exits with
+/// code 2; a failing command writes nothing and leaves the state file as it was.
+/// File formats: docs/formats.md; walk-through: docs/guide.md.
+#[derive(Debug, Parser)]
+#[command(name = "tandem", version, verbatim_doc_comment)]
+pub(crate) struct Cli {
+    /// The command.
+    #[command(subcommand)]
+    pub(crate) command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub(crate) enum Command {
+    /// Learn the task model and the first schedule from demonstrations; write a state file.
+    ///
+    /// Aligns every demonstration to the first one (the reference, GDTW), computes the mean
+    /// behaviour, its variability σ²_D(t), the demonstrated speed bounds and the admissible
+    /// corrections, sets the confidence from the demonstrations alone (the prior) and
+    /// samples a first schedule. The first file is the reference: the model's time axis is
+    /// its sample index.
+    ///
+    /// Demonstrations are CSV (header of channel names, optional time column `t` in seconds)
+    /// or JSON ({"channels", "dt_s", "samples"}), chosen by the extension `.json`.
+    ///
+    /// Example:
+    ///
+    ///   tandem fit fixtures/sanding/demo_*.csv -o cell.tandem
+    ///   tandem fit a.csv b.csv c.csv --ranges force=20,x=0.5 --params params.toml --samples 2000 -o cell.tandem
+    #[command(verbatim_doc_comment)]
+    Fit(FitArgs),
+    /// Re-optimize the schedule of a state file and show it (text Gantt, or JSON).
+    ///
+    /// Runs the anytime sampler warm-started with the saved schedule, so the result is never
+    /// longer than the saved one. The state file is changed only with --save (atomically).
+    /// The JSON (--json) has the offset τ, per-robot execution gradients, every
+    /// low-confidence interval in global time and T_total: give it to the robots.
+    ///
+    /// Example:
+    ///
+    ///   tandem schedule cell.tandem
+    ///   tandem schedule cell.tandem --samples 20000 --seed 3 --save
+    ///   tandem schedule cell.tandem --json > schedule.json
+    #[command(verbatim_doc_comment)]
+    Schedule(ScheduleArgs),
+    /// Add an executed pair of executions (Eq. 21), update the confidence, re-schedule, save.
+    ///
+    /// Give exactly two executions (robot 1 first), each with its execution CSV, its
+    /// reference-time log and its correction flags. Everything is checked before the state
+    /// file is replaced (atomically); on any error it is left byte for byte as it was.
+    ///
+    /// Example:
+    ///
+    ///   tandem record cell.tandem \
+    ///     --execution run1_robot1.csv --log run1_robot1.reflog.csv --corrections run1_robot1.corr.csv \
+    ///     --execution run1_robot2.csv --log run1_robot2.reflog.csv --corrections run1_robot2.corr.csv
+    #[command(verbatim_doc_comment)]
+    Record(RecordArgs),
+    /// Summarize the model, the confidence and the schedule of a state file.
+    ///
+    /// Example:
+    ///
+    ///   tandem inspect cell.tandem
+    ///   tandem inspect cell.tandem --json
+    #[command(verbatim_doc_comment)]
+    Inspect(InspectArgs),
+    /// Draw the model, the confidence and the schedule as SVG and PNG files.
+    ///
+    /// Writes model.{svg,png} (mean ± one standard deviation per channel and the speed
+    /// bounds over reference time), confidence.{svg,png} (σ²_D(t), the high-confidence
+    /// map and the correction observations) and schedule.{svg,png} (both robots in global
+    /// time; blue = robot 1 low-confidence, red = robot 2 low-confidence). The folder is
+    /// created if missing; existing files of these names are replaced.
+    ///
+    /// Example:
+    ///
+    ///   tandem plot cell.tandem -o plots/
+    #[command(verbatim_doc_comment)]
+    Plot(PlotArgs),
+    /// What-if: run pairs with a simulated operator on your model; nothing is saved.
+    ///
+    /// NEED.csv gives, per reference sample, the probability that a correction is needed
+    /// (column `need`, optional integer column `region`: samples of one region share one
+    /// draw per workpiece; without it, every run of consecutive equal non-zero values is a
+    /// region). For each pair, each robot's workpiece draws its needed regions, the two
+    /// robots run the current schedule through the real-time coordinator, the operator
+    /// corrects the supervised (low-confidence) robot where needed (missing 1 %, and
+    /// correcting 1 % of unneeded samples by default), and the pair is recorded in memory
+    /// exactly as `tandem record` would. Prints T_total and the share of high-confidence
+    /// samples per pair. With --write DIR, each execution is written in the formats
+    /// `tandem record` reads (pair_K_robot_I.csv, .reflog.csv, .corr.csv).
+    ///
+    /// Example:
+    ///
+    ///   tandem simulate cell.tandem --need need.csv --pairs 10
+    ///   tandem simulate cell.tandem --need need.csv --pairs 2 --write sim/ --seed 7
+    #[command(verbatim_doc_comment)]
+    Simulate(SimulateArgs),
+    /// Print the default parameter file (TOML) for `tandem fit --params`.
+    ///
+    /// Example:
+    ///
+    ///   tandem params > params.toml
+    #[command(verbatim_doc_comment)]
+    Params,
+}
+
+/// Overrides of the anytime sampler's settings.
+#[derive(Debug, Args)]
+pub(crate) struct SamplerArgs {
+    /// Number of sampled candidate schedules (the paper uses 5000). Default: from the
+    /// parameters (5000).
+    #[arg(long, value_name = "N")]
+    pub(crate) samples: Option<usize>,
+    /// Master seed of the sampler. Default: from the parameters (0).
+    #[arg(long, value_name = "S")]
+    pub(crate) seed: Option<u64>,
+}
+
+/// `tandem fit`.
+#[derive(Debug, Args)]
+pub(crate) struct FitArgs {
+    /// Demonstration files (CSV or .json); the first is the reference. At least two.
+    #[arg(required = true, value_name = "DEMO")]
+    pub(crate) demos: Vec<PathBuf>,
+    /// Per-coordinate ranges r_j of the weights W = diag(1/r_j²), as NAME=VALUE pairs
+    /// (channel names, `<block>.rx|ry|rz` for quaternions, `rate` for the speed). Unnamed
+    /// coordinates keep their automatic range (spread over all demonstrations).
+    #[arg(long, value_name = "NAME=VALUE,…", value_delimiter = ',')]
+    pub(crate) ranges: Vec<String>,
+    /// Parameter file (TOML, sections [fit], [confidence], [sampler]; `tandem params`
+    /// prints the defaults).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) params: Option<PathBuf>,
+    /// Sample period (s) of demonstrations without a time column `t`. Default: 0.01.
+    #[arg(long, value_name = "SECONDS")]
+    pub(crate) dt: Option<f64>,
+    /// Sampler overrides.
+    #[command(flatten)]
+    pub(crate) sampler: SamplerArgs,
+    /// The state file to write (replaced atomically if it exists).
+    #[arg(short, long, value_name = "STATE")]
+    pub(crate) output: PathBuf,
+}
+
+/// `tandem schedule`.
+#[derive(Debug, Args)]
+pub(crate) struct ScheduleArgs {
+    /// The state file.
+    pub(crate) state: PathBuf,
+    /// Sampler overrides.
+    #[command(flatten)]
+    pub(crate) sampler: SamplerArgs,
+    /// Print JSON instead of the text Gantt.
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Save the re-optimized schedule into the state file (atomically).
+    #[arg(long)]
+    pub(crate) save: bool,
+}
+
+/// `tandem record`.
+#[derive(Debug, Args)]
+pub(crate) struct RecordArgs {
+    /// The state file (updated atomically).
+    pub(crate) state: PathBuf,
+    /// Execution CSV of robot 1, then of robot 2 (channel columns, optional `t`).
+    #[arg(long, value_name = "CSV", num_args = 1, required = true)]
+    pub(crate) execution: Vec<PathBuf>,
+    /// Reference-time log of each execution (column `ref_sample`), same order.
+    #[arg(long, value_name = "CSV", num_args = 1, required = true)]
+    pub(crate) log: Vec<PathBuf>,
+    /// Correction flags of each execution (columns `supervised,corrected`), same order.
+    #[arg(long, value_name = "CSV", num_args = 1, required = true)]
+    pub(crate) corrections: Vec<PathBuf>,
+}
+
+/// `tandem inspect`.
+#[derive(Debug, Args)]
+pub(crate) struct InspectArgs {
+    /// The state file.
+    pub(crate) state: PathBuf,
+    /// Print JSON.
+    #[arg(long)]
+    pub(crate) json: bool,
+}
+
+/// `tandem plot`.
+#[derive(Debug, Args)]
+pub(crate) struct PlotArgs {
+    /// The state file.
+    pub(crate) state: PathBuf,
+    /// Output folder.
+    #[arg(short, long, value_name = "DIR")]
+    pub(crate) output: PathBuf,
+}
+
+/// `tandem simulate`.
+#[derive(Debug, Args)]
+pub(crate) struct SimulateArgs {
+    /// The state file (read only).
+    pub(crate) state: PathBuf,
+    /// Probability of a needed correction per reference sample (CSV, see docs/formats.md).
+    #[arg(long, value_name = "CSV")]
+    pub(crate) need: PathBuf,
+    /// Number of pairs to run.
+    #[arg(long, value_name = "N")]
+    pub(crate) pairs: usize,
+    /// Write every execution into this folder in `tandem record`'s formats.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) write: Option<PathBuf>,
+    /// Seed of the simulated workpieces and operator.
+    #[arg(long, value_name = "S", default_value_t = 0)]
+    pub(crate) seed: u64,
+    /// Probability that the operator misses a needed correction, in [0, 1].
+    #[arg(long, value_name = "P", default_value_t = 0.01)]
+    pub(crate) miss_rate: f64,
+    /// Probability that the operator corrects a sample that needs none, in [0, 1].
+    #[arg(long, value_name = "P", default_value_t = 0.01)]
+    pub(crate) false_rate: f64,
+    /// Channel whose increase a correction aims at.
+    #[arg(long, value_name = "NAME", default_value = "force")]
+    pub(crate) channel: String,
+}

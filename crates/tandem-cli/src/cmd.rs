@@ -1,0 +1,415 @@
+//! The subcommands.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use serde_json::json;
+use tandem::lfd::{Demonstration, Execution, TaskModel};
+use tandem::schedule::{SamplerParams, sample_schedule};
+use tandem::{ExecutionRecord, Planner, PlannerParams, derive_seed};
+
+use crate::cli::{
+    Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
+};
+use crate::gantt::{gantt_text, schedule_json, serial_t_total_s, source_name};
+use crate::{input, plot, sim, state_io};
+
+/// Runs one command.
+pub(crate) fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Fit(a) => fit(&a),
+        Command::Schedule(a) => schedule(&a),
+        Command::Record(a) => record(&a),
+        Command::Inspect(a) => inspect(&a),
+        Command::Plot(a) => plot_cmd(&a),
+        Command::Simulate(a) => sim::simulate(&a),
+        Command::Params => params(),
+    }
+}
+
+/// Prints a line to stdout (the CLI's output channel). A closed pipe (`tandem … | head`)
+/// ends the process quietly instead of panicking.
+pub(crate) fn out(text: &str) {
+    use std::io::Write as _;
+    let mut stdout = std::io::stdout().lock();
+    if writeln!(stdout, "{text}").is_err() {
+        std::process::exit(0);
+    }
+}
+
+/// A period or time in seconds without floating-point noise (`0.01`, not `0.009999…`).
+pub(crate) fn secs(v: f64) -> f64 {
+    (v * 1e9).round() / 1e9
+}
+
+/// Applies `--samples`/`--seed` to sampler parameters and checks them.
+fn apply_sampler(mut p: SamplerParams, a: &SamplerArgs) -> Result<SamplerParams> {
+    if let Some(n) = a.samples {
+        p.samples = n;
+    }
+    if let Some(s) = a.seed {
+        p.seed = s;
+    }
+    p.validate().context("--samples/--seed")?;
+    Ok(p)
+}
+
+fn fit(a: &FitArgs) -> Result<()> {
+    let mut params = match &a.params {
+        Some(p) => input::read_params(p)?,
+        None => PlannerParams::default(),
+    };
+    params.sampler = apply_sampler(params.sampler, &a.sampler)?;
+    if let Some(dt) = a.dt
+        && !(dt.is_finite() && dt > 0.0)
+    {
+        bail!("--dt {dt}: the sample period must be finite and > 0 seconds");
+    }
+    state_io::check_file_target(&a.output)?;
+    let demos = a
+        .demos
+        .iter()
+        .map(|p| input::read_demo(p, a.dt))
+        .collect::<Result<Vec<Demonstration>>>()?;
+    if demos.len() < 2 {
+        bail!(
+            "{}: only one demonstration; the variability of the task needs at least 2 \
+             (give every demonstration file)",
+            a.demos[0].display()
+        );
+    }
+    if !a.ranges.is_empty() {
+        let names = input::tangent_names(demos[0].channel_names(), &params.fit.schema);
+        let given = input::parse_ranges(&a.ranges, &names)?;
+        let mut ranges = if given.len() == names.len() {
+            vec![0.0; names.len()]
+        } else {
+            // The automatic ranges of the coordinates not given (quaternion and rate ranges
+            // need the alignment): one fit with the defaults.
+            let model = TaskModel::fit(&demos, &params.fit).context("cannot fit the task model")?;
+            model.ranges().to_vec()
+        };
+        for (j, v) in given {
+            ranges[j] = v;
+        }
+        params.fit.ranges = Some(ranges);
+    }
+    let planner = Planner::new(&demos, params).context("cannot fit the task model")?;
+    planner.save(&a.output)?;
+    let model = planner.model();
+    let files: Vec<String> = a.demos.iter().map(|p| p.display().to_string()).collect();
+    out(&format!(
+        "fitted {} demonstrations (reference: {})",
+        demos.len(),
+        files[0]
+    ));
+    out(&format!(
+        "reference: {} samples × {} s = {:.2} s; channels: {}",
+        model.n_ref(),
+        secs(model.dt_s()),
+        model.n_ref() as f64 * model.dt_s(),
+        model.channel_names().join(", ")
+    ));
+    summary_lines(&planner);
+    out(&format!("saved {}", a.output.display()));
+    Ok(())
+}
+
+/// Confidence and schedule lines shared by `fit`, `record` and `inspect`.
+fn summary_lines(planner: &Planner) {
+    let conf = planner.confidence();
+    out(&format!(
+        "high confidence: {:.1} % of reference samples ({} of {}), {} low-confidence regions",
+        100.0 * conf.high_share(),
+        conf.n_high(),
+        conf.n_ref(),
+        conf.low_regions().len()
+    ));
+    let serial = serial_t_total_s(planner.problem());
+    let t = planner.outcome().t_total_s;
+    out(&format!(
+        "schedule: T_total {t:.2} s vs fastest serial {serial:.2} s ({:.1} %); τ = {:.2} s; {}",
+        100.0 * t / serial,
+        planner.schedule().offset_s,
+        source_name(&planner.outcome().source)
+    ));
+}
+
+fn schedule(a: &ScheduleArgs) -> Result<()> {
+    let planner = state_io::load(&a.state)?;
+    let mut sp = planner.params().sampler.clone();
+    if a.sampler.seed.is_none() {
+        sp.seed = derive_seed(sp.seed, planner.pairs_recorded() as u64);
+    }
+    let sp = apply_sampler(sp, &a.sampler)?;
+    let outcome = sample_schedule(planner.problem(), &sp, Some(planner.schedule()))
+        .context("cannot schedule")?;
+    if a.save {
+        state_io::save_outcome(&a.state, &outcome)?;
+    }
+    if a.json {
+        let mut doc = schedule_json(planner.problem(), &outcome)?;
+        doc["saved"] = json!(a.save);
+        doc["previous_t_total_s"] = json!(planner.outcome().t_total_s);
+        out(&serde_json::to_string_pretty(&doc)?);
+    } else {
+        out(&gantt_text(planner.problem(), &outcome)?);
+        out(&format!(
+            "saved schedule: T_total {:.2} s; {}",
+            planner.outcome().t_total_s,
+            if a.save {
+                format!("replaced by this one in {}", a.state.display())
+            } else {
+                "unchanged (use --save to keep this one)".into()
+            }
+        ));
+    }
+    Ok(())
+}
+
+/// One robot's three files, read and checked against the model.
+fn read_execution(
+    model: &TaskModel,
+    robot: usize,
+    exec: &Path,
+    log: &Path,
+    corr: &Path,
+) -> Result<ExecutionRecord> {
+    let demonstration = input::read_demo(exec, Some(model.dt_s()))?;
+    let ref_time_log = input::read_log(log)?;
+    let (supervised, corrected) = input::read_corrections(corr)?;
+    let n = demonstration.n_samples();
+    if ref_time_log.len() != n {
+        bail!(
+            "{}: {} rows, but execution {} has {n} samples (one log row per sample)",
+            log.display(),
+            ref_time_log.len(),
+            exec.display()
+        );
+    }
+    if supervised.len() != n {
+        bail!(
+            "{}: {} rows, but execution {} has {n} samples (one row per sample)",
+            corr.display(),
+            supervised.len(),
+            exec.display()
+        );
+    }
+    let execution = Execution {
+        demonstration,
+        ref_time_log,
+    };
+    model.execution_warp(&execution).with_context(|| {
+        format!(
+            "robot {robot}: execution {} with log {} does not fit the model",
+            exec.display(),
+            log.display()
+        )
+    })?;
+    Ok(ExecutionRecord {
+        execution,
+        supervised,
+        corrected,
+    })
+}
+
+fn record(a: &RecordArgs) -> Result<()> {
+    for (flag, v) in [
+        ("--execution", &a.execution),
+        ("--log", &a.log),
+        ("--corrections", &a.corrections),
+    ] {
+        if v.len() != 2 {
+            bail!(
+                "{flag} given {} time(s); a pair needs exactly 2 (robot 1, then robot 2)",
+                v.len()
+            );
+        }
+    }
+    let mut planner = state_io::load(&a.state)?;
+    let before_t = planner.outcome().t_total_s;
+    let before_high = planner.confidence().high_share();
+    let r = |i: usize| {
+        read_execution(
+            planner.model(),
+            i + 1,
+            &a.execution[i],
+            &a.log[i],
+            &a.corrections[i],
+        )
+    };
+    let pair = [r(0)?, r(1)?];
+    let report = planner
+        .record_pair(&pair)
+        .context("cannot record the pair")?;
+    planner.save(&a.state)?;
+    out(&format!(
+        "recorded pair {} into {}",
+        planner.pairs_recorded(),
+        a.state.display()
+    ));
+    out(&format!(
+        "confidence: {} reference samples became high-confidence; {:.1} % → {:.1} %",
+        report.newly_high,
+        100.0 * before_high,
+        100.0 * planner.confidence().high_share()
+    ));
+    out(&format!(
+        "T_total: {before_t:.2} s → {:.2} s",
+        report.t_total_s
+    ));
+    summary_lines(&planner);
+    Ok(())
+}
+
+fn inspect(a: &InspectArgs) -> Result<()> {
+    let planner = state_io::load(&a.state)?;
+    let model = planner.model();
+    let conf = planner.confidence();
+    let obs = planner.observations();
+    let s2 = model.sigma2_d();
+    let mut sorted = s2.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let q = |p: f64| sorted[((sorted.len() - 1) as f64 * p).round() as usize];
+    let dt = model.dt_s();
+    let regions: Vec<_> = conf
+        .low_regions()
+        .iter()
+        .map(|r| {
+            json!({"ref_start": r.start, "ref_end": r.end,
+                        "start_s": r.start as f64 * dt, "end_s": r.end as f64 * dt})
+        })
+        .collect();
+    let ranges: serde_json::Map<_, _> = model
+        .tangent_names()
+        .iter()
+        .zip(model.ranges())
+        .map(|(n, r)| (n.clone(), json!(r)))
+        .collect();
+    let doc = json!({
+        "state": a.state.display().to_string(),
+        "pairs_recorded": planner.pairs_recorded(),
+        "model": {
+            "channels": model.channel_names(),
+            "n_ref": model.n_ref(),
+            "dt_s": dt,
+            "reference_duration_s": model.n_ref() as f64 * dt,
+            "count": model.count(),
+            "correction_components": model.n_components(),
+            "ranges": ranges,
+            "sigma2_d": {"min": q(0.0), "median": q(0.5), "p90": q(0.9), "max": q(1.0)},
+            "mean_duration_s": model.grad_mean().iter().sum::<f64>() * dt,
+            "fastest_duration_s": model.grad_min().iter().sum::<f64>() * dt,
+            "slowest_duration_s": model.grad_max().iter().sum::<f64>() * dt,
+        },
+        "confidence": {
+            "params": serde_json::to_value(conf.params())?,
+            "high_share": conf.high_share(),
+            "n_high": conf.n_high(),
+            "low_regions": regions,
+            "total_supervised": obs.total_supervised(),
+            "total_corrections": obs.total_corrections(),
+        },
+        "schedule": schedule_json(planner.problem(), planner.outcome())?,
+    });
+    if a.json {
+        out(&serde_json::to_string_pretty(&doc)?);
+        return Ok(());
+    }
+    out(&format!("state file {}", a.state.display()));
+    out(&format!(
+        "model: {} demonstrations and executions, {} pairs recorded",
+        model.count(),
+        planner.pairs_recorded()
+    ));
+    out(&format!(
+        "  reference: {} samples × {} s = {:.2} s; channels: {}",
+        model.n_ref(),
+        secs(dt),
+        model.n_ref() as f64 * dt,
+        model.channel_names().join(", ")
+    ));
+    out(&format!(
+        "  execution length: mean {:.2} s, fastest {:.2} s, slowest {:.2} s (demonstrated speed bounds)",
+        doc["model"]["mean_duration_s"].as_f64().unwrap_or(f64::NAN),
+        doc["model"]["fastest_duration_s"]
+            .as_f64()
+            .unwrap_or(f64::NAN),
+        doc["model"]["slowest_duration_s"]
+            .as_f64()
+            .unwrap_or(f64::NAN),
+    ));
+    let ranges_txt: Vec<String> = model
+        .tangent_names()
+        .iter()
+        .zip(model.ranges())
+        .map(|(n, r)| format!("{n}={r:.4}"))
+        .collect();
+    out(&format!(
+        "  ranges (W = diag(1/r²)): {}",
+        ranges_txt.join(", ")
+    ));
+    out(&format!(
+        "  σ²_D (dimensionless): min {:.2e}, median {:.2e}, 90 % {:.2e}, max {:.2e}",
+        q(0.0),
+        q(0.5),
+        q(0.9),
+        q(1.0)
+    ));
+    out(&format!(
+        "  correction directions per sample: {}",
+        model.n_components()
+    ));
+    let p = conf.params();
+    out(&format!(
+        "confidence: γ_p {}, σ²_MAX {}, ε {}, μ_c {}, γ_c {}",
+        p.gamma_p, p.sigma2_max, p.epsilon, p.mu_c, p.gamma_c
+    ));
+    out(&format!(
+        "  observations: {:.0} supervised samples, {:.0} corrected",
+        obs.total_supervised(),
+        obs.total_corrections()
+    ));
+    summary_lines(&planner);
+    let lows = conf.low_regions();
+    const SHOWN: usize = 20;
+    out(&format!(
+        "low-confidence regions (reference time): {}",
+        lows.len()
+    ));
+    for r in lows.iter().take(SHOWN) {
+        out(&format!(
+            "  {:>9.2} – {:>9.2} s   samples {:>6} – {:>6}",
+            r.start as f64 * dt,
+            r.end as f64 * dt,
+            r.start,
+            r.end
+        ));
+    }
+    if lows.len() > SHOWN {
+        out(&format!(
+            "  … {} more (tandem inspect --json lists all)",
+            lows.len() - SHOWN
+        ));
+    }
+    Ok(())
+}
+
+fn plot_cmd(a: &PlotArgs) -> Result<()> {
+    let planner = state_io::load(&a.state)?;
+    state_io::prepare_dir(&a.output)?;
+    let written: Vec<PathBuf> = plot::plot_all(&planner, &a.output)?;
+    for p in written {
+        out(&format!("wrote {}", p.display()));
+    }
+    Ok(())
+}
+
+fn params() -> Result<()> {
+    let text = toml::to_string_pretty(&PlannerParams::default())
+        .context("cannot print the default parameters")?;
+    out("# tandem parameters (defaults). Use with: tandem fit --params FILE …");
+    out("# Sections: [fit] alignment and model, [confidence] Eq. 10–12, [sampler] §II-C.");
+    out(&text);
+    Ok(())
+}

@@ -1,0 +1,150 @@
+//! The schedule as the user sees it: a text Gantt chart and a JSON document.
+
+use std::fmt::Write as _;
+
+use anyhow::Result;
+use serde_json::{Value, json};
+use tandem::schedule::{GlobalTimeline, Outcome, Problem, Source};
+
+/// Columns of the text Gantt's bars.
+const GANTT_COLUMNS: usize = 72;
+
+/// Human-readable name of where a schedule came from.
+pub(crate) fn source_name(source: &Source) -> String {
+    match source {
+        Source::Sampled { candidate } => format!("sampled (candidate {candidate})"),
+        Source::Previous => "previous schedule (still valid, nothing better found)".into(),
+        Source::RepairedPrevious => "previous schedule, repaired for the new model".into(),
+        Source::Serial => "fastest serial schedule (fallback)".into(),
+    }
+}
+
+/// `T_total` (s) of the fastest serial schedule of `problem` (robot 2 starts when robot 1 ends).
+pub(crate) fn serial_t_total_s(problem: &Problem) -> f64 {
+    problem.serial_schedule().t_total_s(problem.dt_s())
+}
+
+/// The schedule as JSON: offset, per-robot gradients, low-confidence intervals in global
+/// time, `T_total` (all times in seconds of global time; gradients in execution samples per
+/// reference sample). `schedule` is exactly `tandem::schedule::Schedule`'s serde form.
+pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Value> {
+    let tl = GlobalTimeline::new(problem, &outcome.schedule)?;
+    let dt = problem.dt_s();
+    let mut intervals: Vec<_> = tl.lc_intervals().iter().flatten().copied().collect();
+    intervals.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
+    let intervals: Vec<Value> = intervals
+        .iter()
+        .map(|iv| {
+            json!({
+                "robot": iv.robot + 1,
+                "ref_start": iv.ref_start,
+                "ref_end": iv.ref_end,
+                "start_s": iv.start_s,
+                "end_s": iv.end_s,
+            })
+        })
+        .collect();
+    let s = &outcome.schedule;
+    Ok(json!({
+        "t_total_s": outcome.t_total_s,
+        "serial_t_total_s": serial_t_total_s(problem),
+        "offset_s": s.offset_s,
+        "durations_s": s.durations_s(dt),
+        "dt_s": dt,
+        "n_ref": problem.n_ref(),
+        "source": source_name(&outcome.source),
+        "lc_intervals": intervals,
+        "schedule": serde_json::to_value(s)?,
+    }))
+}
+
+/// The text Gantt chart: one bar per robot over `[0, T_total]` (`=` running high-confidence,
+/// `#` running low-confidence, blank not running) and the operator's row (`1`/`2`: which
+/// robot is supervised, `.` idle), followed by the low-confidence intervals.
+pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String> {
+    let tl = GlobalTimeline::new(problem, &outcome.schedule)?;
+    let t_total = tl.t_total_s();
+    let spans = tl.spans_s();
+    let mut rows = [String::new(), String::new(), String::new()];
+    for c in 0..GANTT_COLUMNS {
+        let t = (c as f64 + 0.5) / GANTT_COLUMNS as f64 * t_total;
+        let conf = tl.conf_at(t);
+        let mut supervised = Vec::new();
+        for i in 0..2 {
+            let running = t >= spans[i].0 && t < spans[i].1;
+            rows[i].push(match (running, conf[i]) {
+                (false, _) => ' ',
+                (true, true) => '=',
+                (true, false) => {
+                    supervised.push(i);
+                    '#'
+                }
+            });
+        }
+        rows[2].push(match supervised.as_slice() {
+            [] => '.',
+            [0] => '1',
+            [1] => '2',
+            _ => '!',
+        });
+    }
+    let mut out = String::new();
+    let dt = problem.dt_s();
+    let [d0, d1] = outcome.schedule.durations_s(dt);
+    let serial = serial_t_total_s(problem);
+    writeln!(
+        out,
+        "T_total {:.2} s (fastest serial {:.2} s, {:.1} % of it); robot 2 starts at τ = {:.2} s",
+        outcome.t_total_s,
+        serial,
+        100.0 * outcome.t_total_s / serial,
+        outcome.schedule.offset_s
+    )?;
+    writeln!(
+        out,
+        "robot 1 runs {d0:.2} s, robot 2 runs {d1:.2} s; schedule: {}",
+        source_name(&outcome.source)
+    )?;
+    writeln!(out)?;
+    writeln!(
+        out,
+        "          0 s{:>w$}",
+        format!("{t_total:.1} s"),
+        w = GANTT_COLUMNS - 3
+    )?;
+    writeln!(out, "robot 1  |{}|", rows[0])?;
+    writeln!(out, "robot 2  |{}|", rows[1])?;
+    writeln!(out, "operator |{}|", rows[2])?;
+    writeln!(
+        out,
+        "          = high confidence (unsupervised)   # low confidence (operator supervises)"
+    )?;
+    let mut intervals: Vec<_> = tl.lc_intervals().iter().flatten().copied().collect();
+    intervals.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
+    writeln!(out)?;
+    writeln!(
+        out,
+        "{} low-confidence intervals (global time; reference samples):",
+        intervals.len()
+    )?;
+    const SHOWN: usize = 40;
+    for iv in intervals.iter().take(SHOWN) {
+        writeln!(
+            out,
+            "  robot {}  {:>9.2} – {:>9.2} s   ref {:>6} – {:>6}",
+            iv.robot + 1,
+            iv.start_s,
+            iv.end_s,
+            iv.ref_start,
+            iv.ref_end
+        )?;
+    }
+    if intervals.len() > SHOWN {
+        writeln!(
+            out,
+            "  … {} more (tandem schedule --json lists all)",
+            intervals.len() - SHOWN
+        )?;
+    }
+    Ok(out)
+}

@@ -1,0 +1,362 @@
+//! Readers for the user's files: demonstrations, executions, reference-time logs,
+//! correction flags, need probabilities, parameter files and `--ranges`.
+//!
+//! Every error names the file and, where there is one, the 1-based line and column.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::{Context, Result, anyhow, bail};
+use tandem::PlannerParams;
+use tandem::lfd::{ChannelSchema, Demonstration};
+
+/// Reads a demonstration or execution: JSON when the extension is `.json`, CSV otherwise.
+/// `dt_s` is the sample period for files without a time column (CSV) or `dt_s` key (JSON).
+pub(crate) fn read_demo(path: &Path, dt_s: Option<f64>) -> Result<Demonstration> {
+    let is_json = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let demo = if is_json {
+        Demonstration::from_json_path(path, dt_s)?
+    } else {
+        Demonstration::from_csv_path(path, dt_s)?
+    };
+    Ok(demo)
+}
+
+/// A small CSV table: header names and rows of trimmed fields with their 1-based line.
+struct Table {
+    file: String,
+    names: Vec<String>,
+    rows: Vec<(usize, Vec<String>)>,
+}
+
+impl Table {
+    /// Reads `path`; blank lines are skipped; every row must have the header's width.
+    fn read(path: &Path) -> Result<Self> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).with_context(|| format!("{file}: cannot read"))?;
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .map(|(k, l)| (k + 1, l))
+            .filter(|(_, l)| !l.trim().is_empty());
+        let Some((_, header)) = lines.next() else {
+            bail!("{file}:1:1: empty file (expected a header row)");
+        };
+        let names: Vec<String> = header
+            .split(',')
+            .map(|f| f.trim().trim_matches('"').to_owned())
+            .collect();
+        let mut rows = Vec::new();
+        for (line, row) in lines {
+            let fields: Vec<String> = row.split(',').map(|f| f.trim().to_owned()).collect();
+            if fields.len() != names.len() {
+                bail!(
+                    "{file}:{line}:{}: ragged row: expected {} fields, found {}",
+                    fields.len().min(names.len()) + 1,
+                    names.len(),
+                    fields.len()
+                );
+            }
+            rows.push((line, fields));
+        }
+        if rows.is_empty() {
+            bail!("{file}: header only, no data rows");
+        }
+        Ok(Self { file, names, rows })
+    }
+
+    /// Column index of `name`, or an error listing the header.
+    fn column(&self, name: &str) -> Result<usize> {
+        self.names.iter().position(|n| n == name).ok_or_else(|| {
+            anyhow!(
+                "{}:1: no column `{name}` in the header {:?}",
+                self.file,
+                self.names
+            )
+        })
+    }
+
+    /// Rejects header names other than `allowed`.
+    fn only(&self, allowed: &[&str]) -> Result<()> {
+        for (j, n) in self.names.iter().enumerate() {
+            if !allowed.contains(&n.as_str()) {
+                bail!(
+                    "{}:1:{}: unexpected column `{n}` (allowed: {})",
+                    self.file,
+                    j + 1,
+                    allowed.join(", ")
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// The finite numbers of column `j`.
+    fn numbers(&self, j: usize) -> Result<Vec<f64>> {
+        self.rows
+            .iter()
+            .map(|(line, f)| {
+                let text = &f[j];
+                let v: f64 = text.parse().map_err(|_| {
+                    anyhow!(
+                        "{}:{line}:{}: column `{}`: not a number: `{text}`",
+                        self.file,
+                        j + 1,
+                        self.names[j]
+                    )
+                })?;
+                if !v.is_finite() {
+                    bail!(
+                        "{}:{line}:{}: column `{}`: non-finite value `{text}`",
+                        self.file,
+                        j + 1,
+                        self.names[j]
+                    );
+                }
+                Ok(v)
+            })
+            .collect()
+    }
+
+    /// The 0/1 flags of column `j` (`true`/`false` accepted too).
+    fn flags(&self, j: usize) -> Result<Vec<bool>> {
+        self.rows
+            .iter()
+            .map(|(line, f)| match f[j].as_str() {
+                "0" | "false" => Ok(false),
+                "1" | "true" => Ok(true),
+                other => bail!(
+                    "{}:{line}:{}: column `{}`: expected 0 or 1, found `{other}`",
+                    self.file,
+                    j + 1,
+                    self.names[j]
+                ),
+            })
+            .collect()
+    }
+}
+
+/// Reads a reference-time log: one column `ref_sample`, one row per execution sample, the
+/// fractional reference sample the execution was at (monotone non-decreasing, in
+/// `[0, T_ref − 1]`; the model checks the range).
+pub(crate) fn read_log(path: &Path) -> Result<Vec<f64>> {
+    let t = Table::read(path)?;
+    t.only(&["ref_sample"])?;
+    let j = t.column("ref_sample")?;
+    let v = t.numbers(j)?;
+    for k in 1..v.len() {
+        if v[k] < v[k - 1] {
+            bail!(
+                "{}:{}:1: `ref_sample` decreases from {} to {} (the log must be monotone)",
+                t.file,
+                t.rows[k].0,
+                v[k - 1],
+                v[k]
+            );
+        }
+    }
+    Ok(v)
+}
+
+/// Reads correction flags: columns `supervised,corrected` (0/1), one row per execution
+/// sample. `corrected` may be 1 only where `supervised` is 1.
+pub(crate) fn read_corrections(path: &Path) -> Result<(Vec<bool>, Vec<bool>)> {
+    let t = Table::read(path)?;
+    t.only(&["supervised", "corrected"])?;
+    let supervised = t.flags(t.column("supervised")?)?;
+    let corrected = t.flags(t.column("corrected")?)?;
+    if let Some(k) = (0..supervised.len()).find(|&k| corrected[k] && !supervised[k]) {
+        bail!(
+            "{}:{}: `corrected` is 1 but `supervised` is 0 (only a supervised, low-confidence \
+             sample can be corrected)",
+            t.file,
+            t.rows[k].0
+        );
+    }
+    Ok((supervised, corrected))
+}
+
+/// Need probabilities per reference sample and the region of each sample.
+pub(crate) struct Need {
+    /// Probability in `[0, 1]` that reference sample `n` needs a correction on a workpiece.
+    pub(crate) p: Vec<f64>,
+    /// Region id of each sample: samples of one region share one draw per workpiece.
+    pub(crate) region: Vec<usize>,
+}
+
+/// Reads a need file: column `need` in `[0, 1]` per reference sample (`n_ref` rows),
+/// optional integer column `region` (≥ 0) grouping samples into one draw; without it every
+/// maximal run of consecutive equal values is a region. All samples of a region must have
+/// the same probability.
+pub(crate) fn read_need(path: &Path, n_ref: usize) -> Result<Need> {
+    let t = Table::read(path)?;
+    t.only(&["need", "region"])?;
+    let p = t.numbers(t.column("need")?)?;
+    if p.len() != n_ref {
+        bail!(
+            "{}: {} rows, the model has {n_ref} reference samples (one row per reference sample)",
+            t.file,
+            p.len()
+        );
+    }
+    if let Some(k) = p.iter().position(|v| !(0.0..=1.0).contains(v)) {
+        bail!(
+            "{}:{}:{}: `need` = {} is not a probability in [0, 1]",
+            t.file,
+            t.rows[k].0,
+            t.column("need")? + 1,
+            p[k]
+        );
+    }
+    let region = match t.names.iter().position(|n| n == "region") {
+        Some(j) => {
+            let ids = t.numbers(j)?;
+            let mut out = Vec::with_capacity(ids.len());
+            let mut first_p: BTreeMap<usize, (usize, f64)> = BTreeMap::new();
+            for (k, &v) in ids.iter().enumerate() {
+                if !(v >= 0.0 && v.fract() == 0.0 && v < 1e9) {
+                    bail!(
+                        "{}:{}:{}: `region` = {v} is not a whole number ≥ 0",
+                        t.file,
+                        t.rows[k].0,
+                        j + 1
+                    );
+                }
+                let id = v as usize;
+                let (line0, p0) = *first_p.entry(id).or_insert((t.rows[k].0, p[k]));
+                if p0 != p[k] {
+                    bail!(
+                        "{}:{}: region {id} has need {} here but {p0} on line {line0} (one \
+                         probability per region)",
+                        t.file,
+                        t.rows[k].0,
+                        p[k]
+                    );
+                }
+                out.push(id);
+            }
+            out
+        }
+        None => {
+            let mut out = Vec::with_capacity(p.len());
+            let mut id = 0;
+            for k in 0..p.len() {
+                if k > 0 && p[k] != p[k - 1] {
+                    id += 1;
+                }
+                out.push(id);
+            }
+            out
+        }
+    };
+    Ok(Need { p, region })
+}
+
+/// Reads a parameter file (TOML with sections `[fit]`, `[confidence]`, `[sampler]`) and
+/// validates it.
+pub(crate) fn read_params(path: &Path) -> Result<PlannerParams> {
+    let file = path.display();
+    let text = std::fs::read_to_string(path).with_context(|| format!("{file}: cannot read"))?;
+    let params: PlannerParams = toml::from_str(&text).map_err(|e| {
+        let at = e
+            .span()
+            .map(|s| {
+                let line = text[..s.start].matches('\n').count() + 1;
+                format!(":{line}")
+            })
+            .unwrap_or_default();
+        anyhow!("{file}{at}: {}", e.message())
+    })?;
+    params
+        .validate()
+        .with_context(|| format!("{file}: invalid parameter"))?;
+    Ok(params)
+}
+
+/// The tangent coordinate names the model will have for `channels` (see
+/// `TaskModel::tangent_names`): scalar channels by name, each complete quaternion block of
+/// `schema` as `<block>.rx/.ry/.rz` at its first channel's position, then `rate`.
+pub(crate) fn tangent_names(channels: &[String], schema: &ChannelSchema) -> Vec<String> {
+    let mut block_of: BTreeMap<&str, usize> = BTreeMap::new();
+    for (b, block) in schema.quaternions.iter().enumerate() {
+        if block.channels.iter().all(|c| channels.contains(c)) {
+            for c in &block.channels {
+                block_of.insert(c.as_str(), b);
+            }
+        }
+    }
+    let mut names = Vec::new();
+    let mut emitted = vec![false; schema.quaternions.len()];
+    for c in channels {
+        match block_of.get(c.as_str()) {
+            None => names.push(c.clone()),
+            Some(&b) if !emitted[b] => {
+                emitted[b] = true;
+                for axis in ["rx", "ry", "rz"] {
+                    names.push(format!("{}.{axis}", schema.quaternions[b].name));
+                }
+            }
+            Some(_) => {}
+        }
+    }
+    names.push("rate".into());
+    names
+}
+
+/// Parses `--ranges NAME=VALUE` items against the tangent names; each value finite > 0.
+pub(crate) fn parse_ranges(items: &[String], names: &[String]) -> Result<BTreeMap<usize, f64>> {
+    let mut out = BTreeMap::new();
+    for item in items {
+        let (name, value) = item.split_once('=').ok_or_else(|| {
+            anyhow!("--ranges: `{item}` is not NAME=VALUE (e.g. --ranges force=20,x=0.5)")
+        })?;
+        let (name, value) = (name.trim(), value.trim());
+        let j = names.iter().position(|n| n == name).ok_or_else(|| {
+            anyhow!(
+                "--ranges: `{name}` is not a coordinate of these demonstrations (known: {})",
+                names.join(", ")
+            )
+        })?;
+        let v: f64 = value
+            .parse()
+            .map_err(|_| anyhow!("--ranges: `{name}`: not a number: `{value}`"))?;
+        if !(v.is_finite() && v > 0.0) {
+            bail!("--ranges: `{name}` = {value}: a range must be finite and > 0");
+        }
+        if out.insert(j, v).is_some() {
+            bail!("--ranges: `{name}` is given twice");
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(v: &[&str]) -> Vec<String> {
+        v.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn tangent_names_replace_a_complete_quaternion_block_at_its_first_channel() {
+        let ch = names(&["t0", "qx", "qy", "qz", "qw", "force"]);
+        let got = tangent_names(&ch, &ChannelSchema::default());
+        assert_eq!(got, names(&["t0", "q.rx", "q.ry", "q.rz", "force", "rate"]));
+        let got = tangent_names(&names(&["a", "qx"]), &ChannelSchema::default());
+        assert_eq!(got, names(&["a", "qx", "rate"]));
+    }
+
+    #[test]
+    fn ranges_are_parsed_by_name_and_checked() {
+        let n = names(&["x", "force", "rate"]);
+        let r = parse_ranges(&["force=20".into(), " x = 0.5".into()], &n).unwrap();
+        assert_eq!(r.into_iter().collect::<Vec<_>>(), vec![(0, 0.5), (1, 20.0)]);
+        for bad in ["force", "torque=1", "force=abc", "force=-1", "force=inf"] {
+            assert!(parse_ranges(&[bad.into()], &n).is_err(), "{bad}");
+        }
+        assert!(parse_ranges(&["x=1".into(), "x=2".into()], &n).is_err());
+    }
+}

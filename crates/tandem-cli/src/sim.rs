@@ -1,0 +1,334 @@
+//! `tandem simulate`: a what-if run of pairs with a simulated operator on the user's model.
+//!
+//! Per pair `k` (seed `derive_seed(seed, k)`):
+//!
+//! 1. Each robot's workpiece draws, per need region `r`, whether the region needs the
+//!    operator (probability `need[r]`, one draw per region and workpiece).
+//! 2. Both robots run the state's current schedule through the real-time coordinator
+//!    (`tandem::realtime::Coordinator`, Eq. 17–18, Alg. 1), one control tick per reference
+//!    sample period, exactly as on the robots.
+//! 3. The robot on a low-confidence sample is *supervised*. The operator corrects it where
+//!    its workpiece needs it (missing a needed correction with `--miss-rate`) and, where it
+//!    does not, with `--false-rate`. A correction is the joystick input `u_k = ±gain` along
+//!    the model's correction components with the sign that raises `--channel` (components
+//!    that would speed the robot up are dropped when the combined input would), `gain = 1/3`
+//!    (about one standard deviation). The command `x_f⁺ = μ̂⁺ + δx⁺(u)` (Eq. 7) is logged and
+//!    its rate (clamped to the demonstrated bounds) is the operator's gradient for the tick.
+//! 4. Every running robot logs its command, its reference time (Eq. 21) and its
+//!    supervised/corrected flags; the pair is then recorded in memory with
+//!    `Planner::record_pair`, exactly as `tandem record` does with the written files.
+//!
+//! The state file is never modified.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use tandem::lfd::{Demonstration, Execution, TaskModel};
+use tandem::realtime::{Coordinator, Timeline};
+use tandem::schedule::{Problem, Schedule};
+use tandem::{ExecutionRecord, derive_seed};
+
+use crate::cli::SimulateArgs;
+use crate::cmd::out;
+use crate::{input, state_io};
+
+/// Joystick deflection of a correction (`|u_k|`): the components span ±3σ at 1, so 1/3 moves
+/// the command about one standard deviation towards what the demonstrations did.
+const GAIN: f64 = 1.0 / 3.0;
+
+/// The simulated operator.
+struct Operator {
+    miss_rate: f64,
+    false_rate: f64,
+    /// Tangent index of the channel a correction raises.
+    target: usize,
+}
+
+/// One robot's run as the system records it.
+#[derive(Default)]
+struct RobotLog {
+    samples: Vec<f64>,
+    ref_time_log: Vec<f64>,
+    supervised: Vec<bool>,
+    corrected: Vec<bool>,
+}
+
+/// A simulated pair.
+struct PairLog {
+    robots: [RobotLog; 2],
+    ticks: usize,
+    overlap_ticks: usize,
+}
+
+/// The input `u` of a correction that raises coordinate `target` and does not speed the
+/// robot up; `false` when no component moves the target.
+fn correction_input(
+    model: &TaskModel,
+    target: usize,
+    ref_time: f64,
+    u: &mut [f64],
+) -> Result<bool> {
+    let corr = model.corrections_at(ref_time)?;
+    let rate = model.tangent_names().len() - 1;
+    let mut rate_change = 0.0;
+    for (k, c) in corr.components.iter().enumerate() {
+        u[k] = GAIN * c[target].signum() * f64::from(u8::from(c[target] != 0.0));
+        rate_change += u[k] * c[rate];
+    }
+    if rate_change < 0.0 {
+        for (k, c) in corr.components.iter().enumerate() {
+            if u[k] * c[rate] < 0.0 {
+                u[k] = 0.0;
+            }
+        }
+    }
+    Ok(u.iter().any(|&x| x != 0.0))
+}
+
+/// Runs one pair (see the module docs). `needed[i][n]`: robot `i`'s workpiece needs the
+/// operator at reference sample `n`.
+fn run_pair(
+    model: &TaskModel,
+    problem: &Problem,
+    schedule: &Schedule,
+    needed: &[Vec<bool>; 2],
+    op: &Operator,
+    rng: &mut impl Rng,
+) -> Result<PairLog> {
+    let dt = problem.dt_s();
+    let n_ref = problem.n_ref();
+    let starts = schedule.starts_s();
+    let timeline = |i: usize| {
+        Timeline::new(
+            problem.conf(),
+            &schedule.grad_exec[i],
+            problem.grad_min(),
+            problem.grad_max(),
+            starts[i],
+            dt,
+        )
+    };
+    let mut coord = Coordinator::new([timeline(0)?, timeline(1)?], dt)?;
+    let m = model.channel_names().len();
+    let k = model.n_components();
+    let (u_zero, mut u) = (vec![0.0; k], vec![0.0; k]);
+    let mut cmd = vec![0.0; m + 1];
+    let mut robots = [RobotLog::default(), RobotLog::default()];
+    let (mut ticks, mut overlap_ticks) = (0, 0);
+    // The slowest admissible run takes ψ̇max/ψ̇min times the scheduled one; anything beyond
+    // twice that is a bug, not a user error.
+    let ratio = problem
+        .grad_max()
+        .iter()
+        .zip(problem.grad_min())
+        .map(|(hi, lo)| hi / lo)
+        .fold(1.0, f64::max);
+    let end = coord
+        .robots()
+        .iter()
+        .map(Timeline::end_s)
+        .fold(0.0, f64::max);
+    let budget = (end / dt * ratio * 2.0) as usize + 1000;
+    let last_ref = (n_ref - 1) as f64;
+    while !coord.is_finished() {
+        if ticks >= budget {
+            bail!("the simulated pair did not finish within {budget} control ticks");
+        }
+        let clocks = coord.clock_s();
+        let mut operator_gradient = f64::NAN;
+        for (i, log) in robots.iter_mut().enumerate() {
+            let tl = &coord.robots()[i];
+            if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() {
+                continue;
+            }
+            let n = tl.sample_at(clocks[i]);
+            let ref_time = tl.ref_time_at(clocks[i]).min(last_ref);
+            let supervised = !problem.conf()[n];
+            let corrected = supervised && {
+                let draw: f64 = rng.random();
+                if needed[i][(ref_time.round() as usize).min(n_ref - 1)] {
+                    draw >= op.miss_rate
+                } else {
+                    draw < op.false_rate
+                }
+            };
+            let input = if corrected && correction_input(model, op.target, ref_time, &mut u)? {
+                &u
+            } else {
+                &u_zero
+            };
+            model.command_into(input, ref_time, &mut cmd)?;
+            if corrected {
+                operator_gradient = cmd[m].clamp(problem.grad_min()[n], problem.grad_max()[n]);
+            }
+            log.samples.extend_from_slice(&cmd[..m]);
+            log.ref_time_log.push(ref_time);
+            log.supervised.push(supervised);
+            log.corrected.push(corrected);
+        }
+        let tick = coord.tick(operator_gradient);
+        ticks += 1;
+        overlap_ticks += usize::from(tick.low_conf == [true, true]);
+    }
+    Ok(PairLog {
+        robots,
+        ticks,
+        overlap_ticks,
+    })
+}
+
+/// The three files of one execution, as `tandem record` reads them (numbers printed in
+/// shortest round-trip form, so reading them back gives the same bits).
+fn execution_files(log: &RobotLog, channels: &[String]) -> [String; 3] {
+    let m = channels.len();
+    let mut exec = channels.join(",");
+    exec.push('\n');
+    for row in log.samples.chunks_exact(m) {
+        let fields: Vec<String> = row.iter().map(|v| format!("{v}")).collect();
+        exec.push_str(&fields.join(","));
+        exec.push('\n');
+    }
+    let mut reflog = String::from("ref_sample\n");
+    for v in &log.ref_time_log {
+        let _ = writeln!(reflog, "{v}");
+    }
+    let mut corr = String::from("supervised,corrected\n");
+    for (s, c) in log.supervised.iter().zip(&log.corrected) {
+        let _ = writeln!(corr, "{},{}", u8::from(*s), u8::from(*c));
+    }
+    [exec, reflog, corr]
+}
+
+/// `tandem simulate`.
+pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
+    if a.pairs == 0 {
+        bail!("--pairs 0: simulate at least one pair");
+    }
+    for (flag, p) in [("--miss-rate", a.miss_rate), ("--false-rate", a.false_rate)] {
+        if !(0.0..=1.0).contains(&p) {
+            bail!("{flag} {p}: must be a probability in [0, 1]");
+        }
+    }
+    let mut planner = state_io::load(&a.state)?;
+    let need = input::read_need(&a.need, planner.model().n_ref())?;
+    let target = planner
+        .model()
+        .tangent_names()
+        .iter()
+        .position(|n| *n == a.channel)
+        .with_context(|| {
+            format!(
+                "--channel {}: the model has no such channel (channels: {})",
+                a.channel,
+                planner.model().channel_names().join(", ")
+            )
+        })?;
+    if let Some(dir) = &a.write {
+        state_io::prepare_dir(dir)?;
+    }
+    let op = Operator {
+        miss_rate: a.miss_rate,
+        false_rate: a.false_rate,
+        target,
+    };
+    let n_regions = need.region.iter().copied().max().unwrap_or(0) + 1;
+    let mut region_p = vec![0.0; n_regions];
+    for (&r, &p) in need.region.iter().zip(&need.p) {
+        region_p[r] = p;
+    }
+    let mut files: Vec<(PathBuf, String)> = Vec::new();
+    out(
+        "pair  T_total ran (s)  actual (s)  supervised  corrected  overlap  → high-conf %  next T_total (s)",
+    );
+    for k in 0..a.pairs {
+        let mut rng = ChaCha8Rng::seed_from_u64(derive_seed(a.seed, k as u64));
+        let needed: [Vec<bool>; 2] = std::array::from_fn(|_| {
+            let hit: Vec<bool> = region_p.iter().map(|&p| rng.random::<f64>() < p).collect();
+            need.region.iter().map(|&r| hit[r]).collect()
+        });
+        let t_ran = planner.outcome().t_total_s;
+        let pair = run_pair(
+            planner.model(),
+            planner.problem(),
+            planner.schedule(),
+            &needed,
+            &op,
+            &mut rng,
+        )
+        .with_context(|| format!("simulating pair {}", k + 1))?;
+        let channels = planner.model().channel_names().to_vec();
+        let dt = planner.model().dt_s();
+        let mut records = Vec::with_capacity(2);
+        for (i, log) in pair.robots.iter().enumerate() {
+            let stem = format!("pair_{}_robot_{}", k + 1, i + 1);
+            let demonstration = Demonstration::new(channels.clone(), log.samples.clone(), dt)?
+                .with_source(format!("{stem}.csv"));
+            records.push(ExecutionRecord {
+                execution: Execution {
+                    demonstration,
+                    ref_time_log: log.ref_time_log.clone(),
+                },
+                supervised: log.supervised.clone(),
+                corrected: log.corrected.clone(),
+            });
+            if let Some(dir) = &a.write {
+                let [e, l, c] = execution_files(log, &channels);
+                files.push((dir.join(format!("{stem}.csv")), e));
+                files.push((dir.join(format!("{stem}.reflog.csv")), l));
+                files.push((dir.join(format!("{stem}.corr.csv")), c));
+            }
+        }
+        let supervised: usize = pair
+            .robots
+            .iter()
+            .map(|r| r.supervised.iter().filter(|s| **s).count())
+            .sum();
+        let corrected: usize = pair
+            .robots
+            .iter()
+            .map(|r| r.corrected.iter().filter(|s| **s).count())
+            .sum();
+        let records: [ExecutionRecord; 2] = records
+            .try_into()
+            .map_err(|_| anyhow::anyhow!("internal: a pair has two robots"))?;
+        let report = planner
+            .record_pair(&records)
+            .with_context(|| format!("recording simulated pair {}", k + 1))?;
+        out(&format!(
+            "{:>4}  {:>15.2}  {:>10.2}  {:>10}  {:>9}  {:>7}  {:>14.1}  {:>16.2}",
+            k + 1,
+            t_ran,
+            pair.ticks as f64 * dt,
+            supervised,
+            corrected,
+            pair.overlap_ticks,
+            100.0 * planner.confidence().high_share(),
+            report.t_total_s
+        ));
+    }
+    if let Some(dir) = &a.write {
+        write_all(&files)?;
+        out(&format!(
+            "wrote {} files into {} (tandem record reads them; pair_K_robot_1 first)",
+            files.len(),
+            dir.display()
+        ));
+    }
+    out(&format!("what-if only: {} is unchanged", a.state.display()));
+    Ok(())
+}
+
+/// Writes every file (after the whole simulation succeeded).
+fn write_all(files: &[(PathBuf, String)]) -> Result<()> {
+    for (p, text) in files {
+        write_file(p, text)?;
+    }
+    Ok(())
+}
+
+fn write_file(p: &Path, text: &str) -> Result<()> {
+    std::fs::write(p, text).with_context(|| format!("{}: cannot write", p.display()))
+}

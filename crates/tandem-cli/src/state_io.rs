@@ -1,0 +1,111 @@
+//! Loading and saving state files, and checking output locations before any work is done.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use serde::{Deserialize, Serialize};
+use tandem::confidence::{Confidence, Observations};
+use tandem::lfd::TaskModel;
+use tandem::schedule::Outcome;
+use tandem::{Planner, PlannerParams};
+
+/// Loads a planner, naming the file in every error.
+pub(crate) fn load(path: &Path) -> Result<Planner> {
+    if path.is_dir() {
+        bail!("{}: is a folder, not a state file", path.display());
+    }
+    Planner::load(path).context("cannot load the state")
+}
+
+/// Checks that a file can be created at `path` (its folder exists and accepts a new file,
+/// and `path` is not a folder), without touching `path` itself.
+pub(crate) fn check_file_target(path: &Path) -> Result<()> {
+    let shown = path.display();
+    if path.is_dir() {
+        bail!("{shown}: is a folder; give a file name for the output");
+    }
+    let Some(name) = path.file_name() else {
+        bail!("{shown}: has no file name");
+    };
+    let dir = parent_dir(path);
+    if !dir.is_dir() {
+        bail!(
+            "{shown}: cannot write: folder {} does not exist or is not a folder",
+            dir.display()
+        );
+    }
+    let mut probe_name = std::ffi::OsString::from(".");
+    probe_name.push(name);
+    probe_name.push(format!(".probe{}", std::process::id()));
+    let probe = dir.join(probe_name);
+    File::create(&probe)
+        .with_context(|| format!("{shown}: cannot write into folder {}", dir.display()))?;
+    std::fs::remove_file(&probe)
+        .with_context(|| format!("cannot remove probe file {}", probe.display()))?;
+    Ok(())
+}
+
+/// Creates `dir` if needed and checks that files can be created in it.
+pub(crate) fn prepare_dir(dir: &Path) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("{}: exists and is not a folder", dir.display());
+    }
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create output folder", dir.display()))?;
+    let probe = dir.join(format!(".tandem-probe{}", std::process::id()));
+    File::create(&probe)
+        .with_context(|| format!("{}: cannot write into output folder", dir.display()))?;
+    std::fs::remove_file(&probe)
+        .with_context(|| format!("cannot remove probe file {}", probe.display()))?;
+    Ok(())
+}
+
+/// The folder of `path` (`.` for a bare file name).
+pub(crate) fn parent_dir(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Field-for-field copy of the facade's private `PlannerState` (planner.rs): the facade has
+/// no method to replace a planner's schedule, so `tandem schedule --save` decodes the state
+/// file into this, swaps the outcome and encodes it again. The copy is verified by loading
+/// the result with `Planner::load` before it replaces the state file.
+#[derive(Serialize, Deserialize)]
+struct PlannerStateCopy {
+    params: PlannerParams,
+    model: TaskModel,
+    observations: Observations,
+    confidence: Confidence,
+    outcome: Outcome,
+    pairs_recorded: usize,
+}
+
+/// Replaces the schedule saved in `path` by `outcome`, atomically: the new file is written
+/// next to it, loaded back and checked, then renamed over `path`.
+pub(crate) fn save_outcome(path: &Path, outcome: &Outcome) -> Result<()> {
+    let shown = path.display();
+    let mut st: PlannerStateCopy =
+        tandem::state::load(path).with_context(|| format!("cannot load state file {shown}"))?;
+    st.outcome = outcome.clone();
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(path.file_name().unwrap_or_default());
+    tmp_name.push(".schedule.tmp");
+    let tmp = parent_dir(path).join(tmp_name);
+    let result = (|| -> Result<()> {
+        tandem::state::save(&tmp, &st)?;
+        let back = Planner::load(&tmp)?;
+        if back.schedule() != &outcome.schedule || back.pairs_recorded() != st.pairs_recorded {
+            bail!("the re-encoded state does not read back the same (state layout changed?)");
+        }
+        std::fs::rename(&tmp, path)?;
+        File::open(parent_dir(path))?.sync_all()?;
+        Ok(())
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.with_context(|| format!("cannot save the schedule into {shown}"))
+}

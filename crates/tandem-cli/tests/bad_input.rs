@@ -1,0 +1,462 @@
+//! The bad-input catalogue: every malformed input ends with exit code 2, a message on stderr
+//! that names the file (or flag) and what is wrong, no panic, and an unchanged state file.
+
+mod common;
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+
+use common::*;
+
+/// Runs `args`, expects a user error whose message contains every item of `needles`, and
+/// checks that the state file (if any) is byte-identical afterwards.
+fn expect_user_error<S: Into<OsString> + Clone>(
+    args: &[S],
+    needles: &[&str],
+    state: Option<&Path>,
+) {
+    let before = state.map(|p| std::fs::read(p).expect("state file exists"));
+    let args: Vec<OsString> = args.iter().cloned().map(Into::into).collect();
+    let out = tandem(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "args {args:?}: expected exit code 2\nstderr:\n{stderr}"
+    );
+    assert!(
+        stderr.starts_with("error: "),
+        "args {args:?}: stderr should start with `error: `:\n{stderr}"
+    );
+    for n in needles {
+        assert!(
+            stderr.contains(n),
+            "args {args:?}: stderr should mention `{n}`:\n{stderr}"
+        );
+    }
+    for bad in ["panicked", "RUST_BACKTRACE", "stack backtrace"] {
+        assert!(
+            !stderr.contains(bad),
+            "args {args:?}: panic text:\n{stderr}"
+        );
+    }
+    if let (Some(p), Some(before)) = (state, before) {
+        assert_eq!(
+            std::fs::read(p).expect("state file still exists"),
+            before,
+            "args {args:?}: the state file changed"
+        );
+    }
+}
+
+fn s(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// `fit` with demos 1 and 2 of the small task plus `bad` as the reference or the last demo.
+fn fit_with(dir: &Path, bad: &Path, first: bool) -> Vec<String> {
+    let demos = small_demos(dir);
+    let mut v = vec!["fit".to_string()];
+    if first {
+        v.push(s(bad));
+        v.extend(demos[1..].iter().map(|p| s(p)));
+    } else {
+        v.extend(demos.iter().map(|p| s(p)));
+        v.push(s(bad));
+    }
+    v.extend(["--samples", "50", "-o"].map(String::from));
+    v.push(s(&dir.join("out.tandem")));
+    v
+}
+
+#[test]
+fn malformed_demonstrations() {
+    let dir = scratch("bad-demos");
+    let cases: Vec<(&str, String, Vec<&str>)> = vec![
+        ("empty.csv", String::new(), vec!["empty file"]),
+        ("header_only.csv", "t,x,force\n".into(), vec!["0 sample(s)"]),
+        (
+            "ragged.csv",
+            "t,x,force\n0.00,0,5\n0.01,0.5\n0.02,1,5\n".into(),
+            vec![":3:", "ragged row"],
+        ),
+        (
+            "text.csv",
+            "t,x,force\n0.00,0,5\n0.01,0.5,five\n0.02,1,5\n".into(),
+            vec![":3:3", "not a number", "five"],
+        ),
+        (
+            "nan.csv",
+            "t,x,force\n0.00,0,5\n0.01,NaN,5\n0.02,1,5\n".into(),
+            vec![":3:2", "non-finite"],
+        ),
+        (
+            "inf.csv",
+            "t,x,force\n0.00,0,5\n0.01,0.5,inf\n0.02,1,5\n".into(),
+            vec![":3:3", "non-finite"],
+        ),
+        (
+            "time_back.csv",
+            "t,x,force\n0.00,0,5\n0.02,0.5,5\n0.01,1,5\n".into(),
+            vec!["time column"],
+        ),
+        (
+            "other_channels.csv",
+            small_demo(50, 1.0).replace("t,x,force", "t,x,torque"),
+            vec!["torque", "differ from the reference channels"],
+        ),
+        (
+            "dup_header.csv",
+            "t,x,x\n0.00,0,5\n0.01,0.5,5\n".into(),
+            vec!["bad header", "repeats"],
+        ),
+        (
+            "bad.json",
+            "{\"channels\": [\"x\", \"force\"], \"samples\": [[0, 1], [2]]}".into(),
+            vec!["ragged row"],
+        ),
+    ];
+    for (name, text, needles) in &cases {
+        let bad = write(&dir, name, text);
+        let mut needles = needles.clone();
+        let shown = s(&bad);
+        needles.push(&shown);
+        expect_user_error(&fit_with(&dir, &bad, false), &needles, None);
+        assert!(
+            !dir.join("out.tandem").exists(),
+            "{name}: no output on error"
+        );
+    }
+    // A missing file.
+    let missing = dir.join("missing.csv");
+    expect_user_error(
+        &fit_with(&dir, &missing, true),
+        &[&s(&missing), "cannot read"],
+        None,
+    );
+    // A single demonstration.
+    let one = small_demos(&dir).remove(0);
+    let out = dir.join("out.tandem");
+    expect_user_error(
+        &["fit".into(), s(&one), "-o".into(), s(&out)],
+        &[&s(&one), "only one demonstration"],
+        None,
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn bad_parameters_and_outputs() {
+    let dir = scratch("bad-params");
+    let demos: Vec<String> = small_demos(&dir).iter().map(|p| s(p)).collect();
+    let out = s(&dir.join("out.tandem"));
+    let fit = |extra: &[&str]| {
+        let mut v = vec!["fit".to_string()];
+        v.extend(demos.iter().cloned());
+        v.extend(extra.iter().map(|x| x.to_string()));
+        v
+    };
+    let params = |name: &str, text: &str| s(&write(&dir, name, text));
+    let dir_s = s(&dir);
+    let p_range = params("range.toml", "[confidence]\nsigma2_max = 0.3\n");
+    let p_unknown = params("unknown.toml", "[confidence]\ngamma_q = 1.0\n");
+    let p_syntax = params("syntax.toml", "[sampler\nsamples = 10\n");
+    let p_type = params("type.toml", "[sampler]\nsamples = \"many\"\n");
+    let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
+        (
+            fit(&["--params", &p_range, "-o", &out]),
+            vec![&p_range, "sigma2_max"],
+        ),
+        (
+            fit(&["--params", &p_unknown, "-o", &out]),
+            vec![&p_unknown, "gamma_q"],
+        ),
+        (fit(&["--params", &p_syntax, "-o", &out]), vec![&p_syntax]),
+        (fit(&["--params", &p_type, "-o", &out]), vec![&p_type, ":2"]),
+        (fit(&["--samples", "0", "-o", &out]), vec!["samples"]),
+        (fit(&["--dt=-1", "-o", &out]), vec!["--dt"]),
+        (
+            fit(&["--ranges", "torque=3", "-o", &out]),
+            vec!["--ranges", "torque", "known: x, force, rate"],
+        ),
+        (
+            fit(&["--ranges", "force=-3", "-o", &out]),
+            vec!["--ranges", "force", "> 0"],
+        ),
+        (
+            fit(&["-o", &s(&dir.join("no/such/folder/cell.tandem"))]),
+            vec!["no/such/folder", "does not exist"],
+        ),
+        (
+            fit(&["-o", &format!("{}/cell.tandem", demos[0])]),
+            vec![&demos[0], "not a folder"],
+        ),
+        (fit(&["-o", &dir_s]), vec![&dir_s, "is a folder"]),
+    ];
+    for (args, needles) in &cases {
+        expect_user_error(args, needles, None);
+        assert!(
+            !dir.join("out.tandem").exists(),
+            "{args:?}: no output on error"
+        );
+    }
+}
+
+/// Damaged state files: every command that reads one reports the file and the damage.
+#[test]
+fn damaged_state_files() {
+    let dir = scratch("bad-state");
+    let state = small_state(&dir);
+    let good = std::fs::read(&state).expect("read state");
+    let variants: Vec<(&str, Vec<u8>, &str)> = vec![
+        (
+            "truncated.tandem",
+            good[..good.len() / 2].to_vec(),
+            "truncated",
+        ),
+        ("short_header.tandem", good[..12].to_vec(), "truncated"),
+        (
+            "corrupt.tandem",
+            {
+                let mut b = good.clone();
+                let k = b.len() - 10;
+                b[k] ^= 0xff;
+                b
+            },
+            "checksum",
+        ),
+        (
+            "version.tandem",
+            {
+                let mut b = good.clone();
+                b[8..12].copy_from_slice(&99u32.to_le_bytes());
+                b
+            },
+            "version 99",
+        ),
+        (
+            "trailing.tandem",
+            {
+                let mut b = good.clone();
+                b.extend_from_slice(b"junk");
+                b
+            },
+            "corrupt",
+        ),
+        (
+            "text.tandem",
+            b"t,x,force\n1,2,3\n".to_vec(),
+            "not a tandem state file",
+        ),
+        ("empty.tandem", Vec::new(), "not a tandem state file"),
+    ];
+    let [ea, la, ca] = small_execution(&dir, "a");
+    let [eb, lb, cb] = small_execution(&dir, "b");
+    for (name, bytes, what) in &variants {
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).expect("write damaged state");
+        let sp = s(&p);
+        for args in [
+            vec!["schedule".to_string(), sp.clone()],
+            vec!["inspect".into(), sp.clone(), "--json".into()],
+            vec![
+                "plot".into(),
+                sp.clone(),
+                "-o".into(),
+                s(&dir.join("plots")),
+            ],
+        ] {
+            expect_user_error(&args, &[&sp, what], Some(&p));
+        }
+        let rec = record_args(
+            &p,
+            &[ea.clone(), la.clone(), ca.clone()],
+            &[eb.clone(), lb.clone(), cb.clone()],
+        );
+        expect_user_error(&rec, &[&sp, what], Some(&p));
+    }
+    let missing = dir.join("missing.tandem");
+    expect_user_error(
+        &["inspect".to_string(), s(&missing)],
+        &[&s(&missing), "No such file"],
+        None,
+    );
+    expect_user_error(
+        &["schedule".to_string(), s(&dir)],
+        &[&s(&dir), "is a folder"],
+        None,
+    );
+    // Plot into a path that is a file.
+    expect_user_error(
+        &["plot".to_string(), s(&state), "-o".into(), s(&ea)],
+        &[&s(&ea), "not a folder"],
+        Some(&state),
+    );
+    expect_user_error(
+        &[
+            "schedule".to_string(),
+            s(&state),
+            "--samples".into(),
+            "0".into(),
+        ],
+        &["samples"],
+        Some(&state),
+    );
+}
+
+/// Malformed executions, logs and correction files: `record` refuses and the state stays.
+#[test]
+fn malformed_executions() {
+    let dir = scratch("bad-exec");
+    let state = small_state(&dir);
+    let good_a = small_execution(&dir, "a");
+    let good_b = small_execution(&dir, "b");
+    let n = SMALL_N_REF;
+    let lines = |f: &dyn Fn(usize) -> String| -> String { (0..n).map(f).collect() };
+    // (name of the replaced file, which of the three, content, needles)
+    let cases: Vec<(&str, usize, String, Vec<&str>)> = vec![
+        (
+            "short.corr.csv",
+            2,
+            format!("supervised,corrected\n{}", "1,0\n".repeat(n - 5)),
+            vec!["55 rows", "60 samples"],
+        ),
+        (
+            "outside.reflog.csv",
+            1,
+            format!("ref_sample\n{}", lines(&|k| format!("{}\n", k * 2))),
+            vec!["outside"],
+        ),
+        (
+            "decreasing.reflog.csv",
+            1,
+            format!(
+                "ref_sample\n{}",
+                lines(&|k| format!("{}\n", if k == 30 { 3 } else { k }))
+            ),
+            vec![":32:", "decreases"],
+        ),
+        (
+            "wrong_col.reflog.csv",
+            1,
+            format!("time\n{}", lines(&|k| format!("{k}\n"))),
+            vec!["unexpected column `time`"],
+        ),
+        (
+            "nan.reflog.csv",
+            1,
+            format!(
+                "ref_sample\n{}",
+                lines(&|k| if k == 7 {
+                    "nan\n".into()
+                } else {
+                    format!("{k}\n")
+                })
+            ),
+            vec![":9:1", "non-finite"],
+        ),
+        (
+            "two.corr.csv",
+            2,
+            format!("supervised,corrected\n1,2\n{}", "1,0\n".repeat(n - 1)),
+            vec![":2:2", "expected 0 or 1"],
+        ),
+        (
+            "unsupervised.corr.csv",
+            2,
+            format!("supervised,corrected\n0,1\n{}", "1,0\n".repeat(n - 1)),
+            vec![":2", "supervised"],
+        ),
+        (
+            "ragged.corr.csv",
+            2,
+            format!("supervised,corrected\n1\n{}", "1,0\n".repeat(n - 1)),
+            vec![":2:2", "ragged row"],
+        ),
+        ("empty.corr.csv", 2, String::new(), vec!["empty file"]),
+        (
+            "header_only.reflog.csv",
+            1,
+            "ref_sample\n".into(),
+            vec!["header only"],
+        ),
+        (
+            "channels.csv",
+            0,
+            small_demo(n, 0.0).replace("t,x,force", "t,x,torque"),
+            vec!["torque", "differ from the reference channels"],
+        ),
+        (
+            "text.csv",
+            0,
+            small_demo(n, 0.0).replacen("5.0000", "high", 1),
+            vec![":2:3", "not a number"],
+        ),
+    ];
+    for (name, which, text, needles) in &cases {
+        let bad = write(&dir, name, text);
+        let mut a = good_a.clone();
+        a[*which] = bad.clone();
+        let shown = s(&bad);
+        let mut needles = needles.clone();
+        needles.push(&shown);
+        // As robot 1 and as robot 2.
+        expect_user_error(&record_args(&state, &a, &good_b), &needles, Some(&state));
+        expect_user_error(&record_args(&state, &good_b, &a), &needles, Some(&state));
+    }
+    // Only one execution.
+    let mut one: Vec<PathBuf> = record_args(&state, &good_a, &good_b);
+    one.truncate(8);
+    expect_user_error(&one, &["--execution", "exactly 2"], Some(&state));
+    // The good files are accepted: each failure above was the one bad file.
+    let ok_out = tandem(record_args(&state, &good_a, &good_b));
+    ok(&ok_out);
+}
+
+/// Need files for `simulate`.
+#[test]
+fn malformed_need_files() {
+    let dir = scratch("bad-need");
+    let state = small_state(&dir);
+    let n = SMALL_N_REF;
+    let cases: Vec<(&str, String, Vec<&str>)> = vec![
+        (
+            "short.csv",
+            format!("need\n{}", "0.5\n".repeat(n - 1)),
+            vec!["59 rows", "60 reference samples"],
+        ),
+        (
+            "prob.csv",
+            format!("need\n1.5\n{}", "0.5\n".repeat(n - 1)),
+            vec![":2:1", "not a probability"],
+        ),
+        (
+            "region.csv",
+            format!("need,region\n0.5,1\n0.2,1\n{}", "0.5,2\n".repeat(n - 2)),
+            vec![":3", "region 1"],
+        ),
+        (
+            "nocol.csv",
+            format!("p\n{}", "0.5\n".repeat(n)),
+            vec!["unexpected column `p`"],
+        ),
+    ];
+    for (name, text, needles) in &cases {
+        let bad = write(&dir, name, text);
+        let shown = s(&bad);
+        let mut needles = needles.clone();
+        needles.push(&shown);
+        expect_user_error(
+            &[
+                "simulate".to_string(),
+                s(&state),
+                "--need".into(),
+                shown.clone(),
+                "--pairs".into(),
+                "1".into(),
+            ],
+            &needles,
+            Some(&state),
+        );
+    }
+}
