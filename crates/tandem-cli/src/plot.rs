@@ -12,6 +12,7 @@ use anyhow::{Result, anyhow, bail};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::register_font;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use tandem::Planner;
 use tandem::schedule::GlobalTimeline;
 
@@ -431,23 +432,14 @@ impl Figure for ScheduleFigure {
             .caption(&self.title, (FONT, 18))
             .margin(10)
             .x_label_area_size(40)
-            .y_label_area_size(80)
+            .y_label_area_size(10)
             .build_cartesian_2d(0.0..self.t_total_s.max(1e-9), 0.0..2.0)
             .map_err(de)?;
         chart
             .configure_mesh()
             .disable_y_mesh()
             .light_line_style(WHITE)
-            .y_labels(3)
-            .y_label_formatter(&|y: &f64| {
-                if (*y - 1.5).abs() < 0.26 {
-                    "robot 1".into()
-                } else if (*y - 0.5).abs() < 0.26 {
-                    "robot 2".into()
-                } else {
-                    String::new()
-                }
-            })
+            .y_labels(0)
             .x_desc("global time (s); blue = robot 1 low-confidence, red = robot 2 low-confidence, gray = high-confidence")
             .label_style((FONT, 12))
             .draw()
@@ -459,6 +451,22 @@ impl Figure for ScheduleFigure {
                 .draw_series(std::iter::once(Rectangle::new(
                     [(a, y - 0.3), (b, y + 0.3)],
                     HIGH.filled(),
+                )))
+                .map_err(de)?;
+            let label = format!(
+                "robot {}: {:.2} – {:.2} s",
+                i + 1,
+                self.spans[i].0,
+                self.spans[i].1
+            );
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    label,
+                    (a, y + 0.33),
+                    (FONT, 13)
+                        .into_font()
+                        .color(&BLACK)
+                        .pos(Pos::new(HPos::Left, VPos::Bottom)),
                 )))
                 .map_err(de)?;
             let colour = if i == 0 { ROBOT1 } else { ROBOT2 };

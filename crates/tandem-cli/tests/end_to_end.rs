@@ -1,0 +1,310 @@
+//! End to end through the binary: fit on the six sanding fixtures, simulate two pairs and
+//! write them, record them with `tandem record`, re-schedule; plus the documented examples
+//! under `fixtures/examples/`, `--help`, `params` and `plot`.
+
+mod common;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use common::*;
+use tandem::Planner;
+use tandem::schedule::{Schedule, validate};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn s(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// A need file for the fixtures' reference demonstration: sanding in passes 1–3 needs the
+/// operator on half the workpieces, one region per (pass, section); nothing else does
+/// (the study of §III).
+fn sanding_need(dir: &Path) -> PathBuf {
+    let labels = std::fs::read_to_string(repo().join("fixtures/sanding/demo_0.labels.csv"))
+        .expect("read labels");
+    let mut need = String::from("need,region\n");
+    for row in labels.lines().skip(1) {
+        let f: Vec<&str> = row.split(',').collect();
+        let (pass, section) = (f[0].parse::<u32>().unwrap(), f[1].parse::<u32>().unwrap());
+        if f[3] == "sanding" && pass < 4 {
+            writeln!(need, "0.5,{}", pass * 100 + section + 1).unwrap();
+        } else {
+            need.push_str("0,0\n");
+        }
+    }
+    write(dir, "need.csv", &need)
+}
+
+/// The pair-`k` files `tandem simulate --write` produced, as `record` arguments.
+fn pair_files(dir: &Path, k: usize) -> [[PathBuf; 3]; 2] {
+    std::array::from_fn(|i| {
+        let stem = format!("pair_{k}_robot_{}", i + 1);
+        [
+            dir.join(format!("{stem}.csv")),
+            dir.join(format!("{stem}.reflog.csv")),
+            dir.join(format!("{stem}.corr.csv")),
+        ]
+    })
+}
+
+/// The last column (next T_total, s) of each pair row of `simulate`'s table.
+fn simulated_t_totals(stdout: &str) -> Vec<f64> {
+    stdout
+        .lines()
+        .filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit()))
+        .map(|l| l.split_whitespace().last().unwrap().parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn fixtures_fit_simulate_record_schedule() {
+    let dir = scratch("e2e");
+    let state = dir.join("cell.tandem");
+    let mut fit = vec!["fit".to_string()];
+    fit.extend((0..6).map(|i| s(&repo().join(format!("fixtures/sanding/demo_{i}.csv")))));
+    fit.extend(["--samples", "200", "-o"].map(String::from));
+    fit.push(s(&state));
+    let stdout = ok(&tandem(&fit));
+    assert!(stdout.contains("fitted 6 demonstrations"), "{stdout}");
+    let fitted = Planner::load(&state).unwrap();
+    assert_eq!(fitted.params().sampler.samples, 200);
+    let n_ref = fitted.model().n_ref();
+    assert_eq!(n_ref, 6936, "demo_0.csv has 6936 samples");
+
+    // Simulate two pairs: a what-if that leaves the state alone.
+    let need = sanding_need(&dir);
+    let before = std::fs::read(&state).unwrap();
+    let sim_dir = dir.join("sim");
+    let stdout = ok(&tandem([
+        "simulate",
+        &s(&state),
+        "--need",
+        &s(&need),
+        "--pairs",
+        "2",
+        "--seed",
+        "7",
+        "--write",
+        &s(&sim_dir),
+    ]));
+    assert_eq!(
+        std::fs::read(&state).unwrap(),
+        before,
+        "simulate is read-only"
+    );
+    let predicted = simulated_t_totals(&stdout);
+    assert_eq!(predicted.len(), 2, "{stdout}");
+    // Each pair row reports 0 ticks with both robots low-confidence.
+    for line in stdout
+        .lines()
+        .filter(|l| l.trim_start().starts_with(['1', '2']))
+    {
+        let cols: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(cols[5], "0", "overlap ticks: {line}");
+    }
+
+    // Record both pairs from the written files.
+    for k in 1..=2 {
+        let [a, b] = pair_files(&sim_dir, k);
+        let stdout = ok(&tandem(record_args(&state, &a, &b)));
+        assert!(stdout.contains(&format!("recorded pair {k}")), "{stdout}");
+    }
+    let recorded = Planner::load(&state).unwrap();
+    assert_eq!(recorded.pairs_recorded(), 2);
+    assert_eq!(recorded.model().count(), 6 + 4);
+    assert!(recorded.observations().total_supervised() > 0.0);
+    // The files round-trip exactly: `record` reproduces the simulation's own updates.
+    assert!(
+        (recorded.outcome().t_total_s - predicted[1]).abs() < 0.006,
+        "recorded T_total {} vs simulated {}",
+        recorded.outcome().t_total_s,
+        predicted[1]
+    );
+
+    // Re-schedule: valid for the state's problem and never longer than the saved schedule.
+    let out = tandem([
+        "schedule",
+        &s(&state),
+        "--json",
+        "--samples",
+        "300",
+        "--seed",
+        "5",
+    ]);
+    let doc: serde_json::Value = serde_json::from_str(&ok(&out)).unwrap();
+    let schedule: Schedule = serde_json::from_value(doc["schedule"].clone()).unwrap();
+    validate(recorded.problem(), &schedule).expect("the JSON schedule satisfies Eq. 20");
+    let t_total = doc["t_total_s"].as_f64().unwrap();
+    assert!((t_total - schedule.t_total_s(recorded.model().dt_s())).abs() < 1e-9);
+    assert!(t_total <= recorded.outcome().t_total_s + 1e-9);
+    assert!(t_total <= doc["serial_t_total_s"].as_f64().unwrap() + 1e-9);
+    assert_eq!(doc["offset_s"].as_f64().unwrap(), schedule.offset_s);
+    // Low-confidence intervals of the two robots never overlap in global time.
+    let iv = doc["lc_intervals"].as_array().unwrap();
+    for a in iv.iter().filter(|x| x["robot"] == 1) {
+        for b in iv.iter().filter(|x| x["robot"] == 2) {
+            let (a0, a1) = (a["start_s"].as_f64().unwrap(), a["end_s"].as_f64().unwrap());
+            let (b0, b1) = (b["start_s"].as_f64().unwrap(), b["end_s"].as_f64().unwrap());
+            assert!(a1 <= b0 + 1e-9 || b1 <= a0 + 1e-9, "{a} overlaps {b}");
+        }
+    }
+    assert_eq!(doc["saved"], false);
+
+    // --save keeps exactly that schedule, and the state still loads.
+    let before = std::fs::read(&state).unwrap();
+    ok(&tandem([
+        "schedule",
+        &s(&state),
+        "--samples",
+        "300",
+        "--seed",
+        "5",
+        "--save",
+    ]));
+    assert_ne!(std::fs::read(&state).unwrap(), before);
+    let saved = Planner::load(&state).unwrap();
+    // serde_json reads floats to within an ulp, not bit for bit.
+    assert!((saved.schedule().offset_s - schedule.offset_s).abs() < 1e-12);
+    for (a, b) in saved.schedule().grad_exec.iter().zip(&schedule.grad_exec) {
+        assert_eq!(a.len(), b.len());
+        let worst = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            worst < 1e-12,
+            "saved schedule differs from the JSON by {worst}"
+        );
+    }
+    assert_eq!(saved.pairs_recorded(), 2);
+    assert_eq!(saved.model().count(), recorded.model().count());
+
+    // Plot the recorded state: SVG and PNG of each figure.
+    let plots = dir.join("plots");
+    ok(&tandem(["plot", &s(&state), "-o", &s(&plots)]));
+    for name in ["model", "confidence", "schedule"] {
+        let svg = std::fs::read_to_string(plots.join(format!("{name}.svg"))).unwrap();
+        assert!(svg.contains("<svg"), "{name}.svg");
+        let png = std::fs::read(plots.join(format!("{name}.png"))).unwrap();
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{name}.png");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The tiny files of `fixtures/examples/` (docs/formats.md) work as documented.
+#[test]
+fn documented_examples_work() {
+    let dir = scratch("examples");
+    let ex = repo().join("fixtures/examples");
+    let state = dir.join("ex.tandem");
+    let demos: Vec<String> = (0..3)
+        .map(|i| s(&ex.join(format!("demo_{i}.csv"))))
+        .collect();
+    let mut fit = vec!["fit".to_string()];
+    fit.extend(demos);
+    fit.extend([
+        "--params".into(),
+        s(&ex.join("params.toml")),
+        "-o".into(),
+        s(&state),
+    ]);
+    let stdout = ok(&tandem(&fit));
+    // demo_0.csv: 40 samples at 10 ms.
+    assert!(stdout.contains("40 samples × 0.01 s = 0.40 s"), "{stdout}");
+    let p = Planner::load(&state).unwrap();
+    assert_eq!(p.params().sampler.samples, 2000, "params.toml sets 2000");
+    assert_eq!(p.params().fit.k_max, 2);
+    let [a, b] = pair_files(&ex, 1);
+    ok(&tandem(record_args(&state, &a, &b)));
+    let p = Planner::load(&state).unwrap();
+    assert_eq!(p.pairs_recorded(), 1);
+    // 42 samples per execution, all supervised before the first update.
+    assert_eq!(p.observations().total_supervised(), 84.0);
+    ok(&tandem([
+        "simulate",
+        &s(&state),
+        "--need",
+        &s(&ex.join("need.csv")),
+        "--pairs",
+        "1",
+    ]));
+    let inspect: serde_json::Value =
+        serde_json::from_str(&ok(&tandem(["inspect", &s(&state), "--json"]))).unwrap();
+    assert_eq!(inspect["pairs_recorded"], 1);
+    assert_eq!(inspect["model"]["count"], 5);
+    assert_eq!(inspect["model"]["n_ref"], 40);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn every_subcommand_has_help_with_an_example() {
+    for sub in [
+        "fit", "schedule", "record", "inspect", "plot", "simulate", "params",
+    ] {
+        let stdout = ok(&tandem([sub, "--help"]));
+        assert!(stdout.contains("Example"), "{sub} --help:\n{stdout}");
+        assert!(
+            stdout.contains(&format!("tandem {sub}")),
+            "{sub} --help:\n{stdout}"
+        );
+    }
+    let top = ok(&tandem(["--help"]));
+    for sub in ["fit", "schedule", "record", "inspect", "plot", "simulate"] {
+        assert!(top.contains(sub), "{top}");
+    }
+    // A usage error is a user error too: exit code 2.
+    assert_eq!(tandem(["fit"]).status.code(), Some(2));
+    assert_eq!(tandem(["frobnicate"]).status.code(), Some(2));
+}
+
+/// `tandem params` prints a parameter file that `fit --params` reads back as the defaults.
+#[test]
+fn printed_default_parameters_read_back() {
+    let dir = scratch("params");
+    let text = ok(&tandem(["params"]));
+    let p = write(&dir, "params.toml", &text);
+    let state = small_state_with(&dir, &["--params", &s(&p)]);
+    let loaded = Planner::load(&state).unwrap();
+    assert_eq!(loaded.params(), &tandem::PlannerParams::default());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Fits the small task with extra `fit` arguments.
+fn small_state_with(dir: &Path, extra: &[&str]) -> PathBuf {
+    let demos = small_demos(dir);
+    let state = dir.join("cell.tandem");
+    let mut args: Vec<String> = vec!["fit".into()];
+    args.extend(demos.iter().map(|p| s(p)));
+    args.extend(extra.iter().map(|x| x.to_string()));
+    args.extend(["-o".into(), s(&state)]);
+    ok(&tandem(&args));
+    state
+}
+
+/// `--ranges` sets the named ranges and keeps the automatic ones for the rest.
+#[test]
+fn ranges_override_only_the_named_coordinates() {
+    let dir = scratch("ranges");
+    let auto = Planner::load(small_state_with(&dir, &["--samples", "50"])).unwrap();
+    let names = auto.model().tangent_names().to_vec();
+    assert_eq!(names, ["x", "force", "rate"]);
+    // Force spans 5..17 N over the demonstrations, x spans 0..1.
+    assert!((auto.model().ranges()[1] - 12.0).abs() < 1e-9);
+    assert!((auto.model().ranges()[0] - 1.0).abs() < 1e-9);
+    let set = Planner::load(small_state_with(
+        &dir,
+        &["--samples", "50", "--ranges", "force=24"],
+    ))
+    .unwrap();
+    assert_eq!(set.model().ranges()[1], 24.0);
+    assert_eq!(set.model().ranges()[0], auto.model().ranges()[0]);
+    assert_eq!(set.model().ranges()[2], auto.model().ranges()[2]);
+    // Doubling the force range quarters its weight: σ²_D falls where only force varies.
+    let mid = SMALL_N_REF / 2;
+    assert!(set.model().sigma2_d()[mid] < auto.model().sigma2_d()[mid]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
