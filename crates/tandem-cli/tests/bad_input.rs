@@ -459,4 +459,28 @@ fn malformed_need_files() {
             Some(&state),
         );
     }
+    let good = write(&dir, "good.csv", &format!("need\n{}", "0.5\n".repeat(n)));
+    let sim = |extra: &[&str]| {
+        let mut v = vec!["simulate".to_string(), s(&state), "--need".into(), s(&good)];
+        v.extend(extra.iter().map(|x| x.to_string()));
+        v
+    };
+    let out_file = s(&good);
+    for (args, needles) in [
+        (sim(&["--pairs", "0"]), vec!["--pairs"]),
+        (
+            sim(&["--pairs", "1", "--miss-rate", "2"]),
+            vec!["--miss-rate"],
+        ),
+        (
+            sim(&["--pairs", "1", "--channel", "torque"]),
+            vec!["--channel", "torque"],
+        ),
+        (
+            sim(&["--pairs", "1", "--write", &out_file]),
+            vec![out_file.as_str(), "not a folder"],
+        ),
+    ] {
+        expect_user_error(&args, &needles, Some(&state));
+    }
 }
