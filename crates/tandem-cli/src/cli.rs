@@ -43,7 +43,7 @@ pub(crate) enum Command {
     ///
     /// Example:
     ///
-    ///   tandem fit fixtures/sanding/demo_*.csv -o cell.tandem
+    ///   tandem fit fixtures/sanding/demo_?.csv -o cell.tandem
     ///   tandem fit a.csv b.csv c.csv --ranges force=20,x=0.5 --params params.toml --samples 2000 -o cell.tandem
     #[command(verbatim_doc_comment)]
     Fit(FitArgs),
