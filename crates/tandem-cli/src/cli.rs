@@ -146,7 +146,7 @@ pub(crate) struct FitArgs {
     /// coordinates keep their automatic range (spread over all demonstrations).
     #[arg(long, value_name = "NAME=VALUE,…", value_delimiter = ',')]
     pub(crate) ranges: Vec<String>,
-    /// Parameter file (TOML, sections [fit], [confidence], [sampler]; `tandem params`
+    /// Parameter file (TOML, sections `[fit]`, `[confidence]`, `[sampler]`; `tandem params`
     /// prints the defaults).
     #[arg(long, value_name = "FILE")]
     pub(crate) params: Option<PathBuf>,
