@@ -182,7 +182,8 @@ pub(crate) fn read_corrections(path: &Path) -> Result<(Vec<bool>, Vec<bool>)> {
 pub(crate) struct Need {
     /// Probability in `[0, 1]` that reference sample `n` needs a correction on a workpiece.
     pub(crate) p: Vec<f64>,
-    /// Region id of each sample: samples of one region share one draw per workpiece.
+    /// Region of each sample, numbered densely from 0: samples of one region share one
+    /// draw per workpiece.
     pub(crate) region: Vec<usize>,
 }
 
@@ -214,9 +215,10 @@ pub(crate) fn read_need(path: &Path, n_ref: usize) -> Result<Need> {
         Some(j) => {
             let ids = t.numbers(j)?;
             let mut out = Vec::with_capacity(ids.len());
-            let mut first_p: BTreeMap<usize, (usize, f64)> = BTreeMap::new();
+            // User id → (dense index, first line, probability).
+            let mut seen: BTreeMap<u64, (usize, usize, f64)> = BTreeMap::new();
             for (k, &v) in ids.iter().enumerate() {
-                if !(v >= 0.0 && v.fract() == 0.0 && v < 1e9) {
+                if !(v >= 0.0 && v.fract() == 0.0 && v < 1e15) {
                     bail!(
                         "{}:{}:{}: `region` = {v} is not a whole number ≥ 0",
                         t.file,
@@ -224,8 +226,9 @@ pub(crate) fn read_need(path: &Path, n_ref: usize) -> Result<Need> {
                         j + 1
                     );
                 }
-                let id = v as usize;
-                let (line0, p0) = *first_p.entry(id).or_insert((t.rows[k].0, p[k]));
+                let id = v as u64;
+                let next = seen.len();
+                let (dense, line0, p0) = *seen.entry(id).or_insert((next, t.rows[k].0, p[k]));
                 if p0 != p[k] {
                     bail!(
                         "{}:{}: region {id} has need {} here but {p0} on line {line0} (one \
@@ -235,7 +238,7 @@ pub(crate) fn read_need(path: &Path, n_ref: usize) -> Result<Need> {
                         p[k]
                     );
                 }
-                out.push(id);
+                out.push(dense);
             }
             out
         }
@@ -347,6 +350,51 @@ mod tests {
         assert_eq!(got, names(&["t0", "q.rx", "q.ry", "q.rz", "force", "rate"]));
         let got = tangent_names(&names(&["a", "qx"]), &ChannelSchema::default());
         assert_eq!(got, names(&["a", "qx", "rate"]));
+    }
+
+    /// The names computed before fitting are the ones the fitted model reports.
+    #[test]
+    fn tangent_names_match_the_fitted_model() {
+        use tandem::lfd::{FitParams, TaskModel};
+        let ch = names(&["a", "qx", "qy", "qz", "qw", "force"]);
+        let row = [1.0, 0.0, 0.0, 0.0, 1.0, 5.0];
+        let demo = |bump: f64| {
+            let mut v = Vec::new();
+            for k in 0..4 {
+                let mut r = row;
+                r[5] += bump * k as f64;
+                v.extend_from_slice(&r);
+            }
+            Demonstration::new(ch.clone(), v, 0.01).unwrap()
+        };
+        let id = vec![0.0, 1.0, 2.0, 3.0];
+        let model = TaskModel::fit_aligned(
+            &[demo(0.0), demo(1.0)],
+            &[id.clone(), id],
+            &FitParams::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            tangent_names(&ch, &ChannelSchema::default()),
+            model.tangent_names()
+        );
+    }
+
+    #[test]
+    fn need_regions_are_dense_whatever_the_ids() {
+        let dir = std::env::temp_dir().join(format!("tandem-cli-need-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("need.csv");
+        std::fs::write(
+            &path,
+            "need,region\n0.5,900000000000\n0,3\n0.5,900000000000\n",
+        )
+        .unwrap();
+        let need = read_need(&path, 3).unwrap();
+        assert_eq!(need.region, [0, 1, 0]);
+        std::fs::write(&path, "need\n0\n0.5\n0.5\n0\n").unwrap();
+        assert_eq!(read_need(&path, 4).unwrap().region, [0, 1, 1, 2]);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
