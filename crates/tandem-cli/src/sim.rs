@@ -332,3 +332,96 @@ fn write_all(files: &[(PathBuf, String)]) -> Result<()> {
 fn write_file(p: &Path, text: &str) -> Result<()> {
     std::fs::write(p, text).with_context(|| format!("{}: cannot write", p.display()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tandem::lfd::FitParams;
+    use tandem::schedule::SamplerParams;
+    use tandem::{Planner, PlannerParams};
+
+    /// Three one-channel demonstrations aligned by known warps: demos 0 and 2 press 1 N
+    /// everywhere; demo 1 presses 9 N over reference samples 10..20 and takes two samples per
+    /// reference sample there (the expert slows down where pressing hard).
+    fn model() -> TaskModel {
+        let names = vec!["force".to_string()];
+        let light = Demonstration::new(names.clone(), vec![1.0; 40], 0.01).unwrap();
+        let hard: Vec<f64> = (0..50)
+            .map(|q| if (10..30).contains(&q) { 9.0 } else { 1.0 })
+            .collect();
+        let hard = Demonstration::new(names, hard, 0.01).unwrap();
+        let id: Vec<f64> = (0..40).map(f64::from).collect();
+        let slow: Vec<f64> = (0..40)
+            .map(|n| match n {
+                0..10 => f64::from(n),
+                10..20 => 10.0 + 2.0 * f64::from(n - 10),
+                _ => 30.0 + f64::from(n - 20),
+            })
+            .collect();
+        TaskModel::fit_aligned(
+            &[light.clone(), hard, light],
+            &[id.clone(), slow, id],
+            &FitParams::default(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn a_correction_presses_harder_and_does_not_speed_up() {
+        let model = model();
+        let mut u = vec![0.0; model.n_components()];
+        assert!(correction_input(&model, 0, 15.0, &mut u).unwrap());
+        let cmd = model.command(&u, 15.0).unwrap();
+        let mean = model.command(&vec![0.0; u.len()], 15.0).unwrap();
+        assert!(cmd[0] > mean[0], "force {} vs mean {}", cmd[0], mean[0]);
+        assert!(cmd[1] >= mean[1], "rate {} vs mean {}", cmd[1], mean[1]);
+        // Where the demonstrations agree there is nothing to correct along.
+        assert!(!correction_input(&model, 0, 30.0, &mut u).unwrap());
+    }
+
+    #[test]
+    fn a_perfect_operator_corrects_exactly_the_supervised_needed_samples() {
+        let params = PlannerParams {
+            sampler: SamplerParams {
+                samples: 50,
+                ..SamplerParams::default()
+            },
+            ..PlannerParams::default()
+        };
+        let planner = Planner::from_model(model(), params).unwrap();
+        let op = Operator {
+            miss_rate: 0.0,
+            false_rate: 0.0,
+            target: 0,
+        };
+        let needed = [vec![true; 40], vec![false; 40]];
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let pair = run_pair(
+            planner.model(),
+            planner.problem(),
+            planner.schedule(),
+            &needed,
+            &op,
+            &mut rng,
+        )
+        .unwrap();
+        assert_eq!(pair.overlap_ticks, 0);
+        let [r1, r2] = &pair.robots;
+        assert!(
+            r1.supervised.iter().any(|s| *s),
+            "robot 1 is supervised somewhere"
+        );
+        assert_eq!(
+            r1.corrected, r1.supervised,
+            "robot 1 needs every supervised sample"
+        );
+        assert!(r2.corrected.iter().all(|c| !c), "robot 2 needs none");
+        for r in [r1, r2] {
+            assert_eq!(r.samples.len(), r.ref_time_log.len());
+            assert!(r.ref_time_log.windows(2).all(|w| w[0] <= w[1]));
+            assert!(r.ref_time_log.iter().all(|t| (0.0..=39.0).contains(t)));
+        }
+        // Corrections slow robot 1 down: it runs longer than robot 2.
+        assert!(r1.samples.len() > r2.samples.len());
+    }
+}
