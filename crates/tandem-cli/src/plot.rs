@@ -203,7 +203,7 @@ impl ModelFigure {
             }
         }
         panels.push(Panel {
-            title: "speed: warp gradient ψ̇ (mean; band = demonstrated min..max)".into(),
+            title: "speed: warp gradient dψ/dn (mean; band = demonstrated min..max)".into(),
             unit: "samples/ref. sample".into(),
             line: model.grad_mean().to_vec(),
             lo: model.grad_min().to_vec(),
