@@ -21,8 +21,24 @@ pub(crate) fn read_demo(path: &Path, dt_s: Option<f64>) -> Result<Demonstration>
     } else {
         Demonstration::from_csv_path(path, dt_s)?
     };
+    let m = demo.n_channels();
+    if let Some(k) = demo.samples().iter().position(|v| v.abs() > MAX_ABS_VALUE) {
+        bail!(
+            "{}: data row {}, channel `{}`: value {:e} is beyond ±{MAX_ABS_VALUE:e} (squared \
+             differences would overflow; check the units)",
+            path.display(),
+            k / m + 1,
+            demo.channel_names()[k % m],
+            demo.samples()[k]
+        );
+    }
     Ok(demo)
 }
+
+/// Largest magnitude accepted in a demonstration or execution: alignment and statistics
+/// square differences of values, which overflow `f64` near 1e154; physical task data never
+/// comes near this.
+const MAX_ABS_VALUE: f64 = 1e100;
 
 /// A small CSV table: header names and rows of trimmed fields with their 1-based line.
 struct Table {

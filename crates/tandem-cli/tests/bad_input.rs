@@ -96,6 +96,11 @@ fn malformed_demonstrations() {
             vec![":3:3", "non-finite"],
         ),
         (
+            "huge.csv",
+            "t,x,force\n0.00,0,5\n0.01,1e308,5\n0.02,1,5\n".into(),
+            vec!["data row 2", "`x`", "beyond"],
+        ),
+        (
             "time_back.csv",
             "t,x,force\n0.00,0,5\n0.02,0.5,5\n0.01,1,5\n".into(),
             vec!["time column"],
