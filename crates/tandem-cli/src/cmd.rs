@@ -195,6 +195,25 @@ fn read_execution(
             exec.display()
         );
     }
+    // Reference samples before the first or after the last logged one would get a zero
+    // execution gradient: the execution must cover the whole task.
+    let last_ref = model.n_ref() as f64 - 1.0;
+    let (first, last) = (ref_time_log[0], ref_time_log[n - 1]);
+    if first >= 1.0 && first <= last_ref {
+        bail!(
+            "{}: the log starts at reference sample {first}; an execution must start at the \
+             beginning of the task (first `ref_sample` < 1)",
+            log.display()
+        );
+    }
+    if last < last_ref - 1.0 && last >= 0.0 {
+        bail!(
+            "{}: the log ends at reference sample {last}; an execution must run to the end of \
+             the task (last `ref_sample` ≥ {})",
+            log.display(),
+            last_ref - 1.0
+        );
+    }
     let execution = Execution {
         demonstration,
         ref_time_log,

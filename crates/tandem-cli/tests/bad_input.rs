@@ -342,6 +342,21 @@ fn malformed_executions() {
             vec![":32:", "decreases"],
         ),
         (
+            "stuck.reflog.csv",
+            1,
+            format!("ref_sample\n{}", "0\n".repeat(n)),
+            vec!["ends at reference sample 0", "end of"],
+        ),
+        (
+            "late.reflog.csv",
+            1,
+            format!(
+                "ref_sample\n{}",
+                lines(&|k| format!("{}\n", (k + 5).min(59)))
+            ),
+            vec!["starts at reference sample 5"],
+        ),
+        (
             "wrong_col.reflog.csv",
             1,
             format!("time\n{}", lines(&|k| format!("{k}\n"))),
