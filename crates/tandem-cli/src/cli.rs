@@ -50,7 +50,9 @@ pub(crate) enum Command {
     /// Re-optimize the schedule of a state file and show it (text Gantt, or JSON).
     ///
     /// Runs the anytime sampler warm-started with the saved schedule, so the result is never
-    /// longer than the saved one. The state file is changed only with --save (atomically).
+    /// longer than the saved one. Without --seed it draws candidates from a seed stream that
+    /// fit/record did not use (deterministic: the same state gives the same result). The
+    /// state file is changed only with --save (atomically).
     /// The JSON (--json) has the offset τ, per-robot execution gradients, every
     /// low-confidence interval in global time and T_total: give it to the robots.
     ///

@@ -135,11 +135,17 @@ fn summary_lines(planner: &Planner) {
     ));
 }
 
+/// Offset of the seed streams `tandem schedule` uses by default (see [`schedule`]).
+const SCHEDULE_STREAM: u64 = 1 << 32;
+
 fn schedule(a: &ScheduleArgs) -> Result<()> {
     let planner = state_io::load(&a.state)?;
     let mut sp = planner.params().sampler.clone();
     if a.sampler.seed.is_none() {
-        sp.seed = derive_seed(sp.seed, planner.pairs_recorded() as u64);
+        // `fit` and `record` used stream `pairs_recorded` of the master seed for the saved
+        // schedule; a plain re-run draws a different, still deterministic, stream so that it
+        // tries new candidates instead of repeating those.
+        sp.seed = derive_seed(sp.seed, SCHEDULE_STREAM + planner.pairs_recorded() as u64);
     }
     let sp = apply_sampler(sp, &a.sampler)?;
     let outcome = sample_schedule(planner.problem(), &sp, Some(planner.schedule()))
