@@ -94,7 +94,13 @@ fn fit(a: &FitArgs) -> Result<()> {
         }
         params.fit.ranges = Some(ranges);
     }
-    let planner = Planner::new(&demos, params).context("cannot fit the task model")?;
+    let planner = Planner::new(&demos, params).with_context(|| match &a.params {
+        Some(p) => format!(
+            "cannot fit the task model (parameters from {})",
+            p.display()
+        ),
+        None => "cannot fit the task model".into(),
+    })?;
     planner.save(&a.output)?;
     let model = planner.model();
     let files: Vec<String> = a.demos.iter().map(|p| p.display().to_string()).collect();

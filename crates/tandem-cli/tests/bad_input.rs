@@ -167,6 +167,7 @@ fn bad_parameters_and_outputs() {
     let p_unknown = params("unknown.toml", "[confidence]\ngamma_q = 1.0\n");
     let p_syntax = params("syntax.toml", "[sampler\nsamples = 10\n");
     let p_type = params("type.toml", "[sampler]\nsamples = \"many\"\n");
+    let p_len = params("len.toml", "[fit]\nranges = [1.0, 2.0]\n");
     let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
         (
             fit(&["--params", &p_range, "-o", &out]),
@@ -178,6 +179,10 @@ fn bad_parameters_and_outputs() {
         ),
         (fit(&["--params", &p_syntax, "-o", &out]), vec![&p_syntax]),
         (fit(&["--params", &p_type, "-o", &out]), vec![&p_type, ":2"]),
+        (
+            fit(&["--params", &p_len, "-o", &out]),
+            vec![&p_len, "ranges", "has 2 entries"],
+        ),
         (fit(&["--samples", "0", "-o", &out]), vec!["samples"]),
         (fit(&["--dt=-1", "-o", &out]), vec!["--dt"]),
         (
