@@ -35,5 +35,6 @@
 
 mod error;
 pub mod task;
+pub mod workcell;
 
 pub use error::{Error, Result};

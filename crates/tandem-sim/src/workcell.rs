@@ -1,0 +1,630 @@
+//! The simulated workcell of the study (§III): two robots run one schedule through the
+//! real-time coordinator while a simulated operator supervises the low-confidence robot.
+//!
+//! # One control tick
+//!
+//! The control period is the reference sample period `Δt_s`, so every tick gives each
+//! running robot one execution sample, as in the demonstrations.
+//!
+//! 1. Each running robot's position is read from the coordinator: its schedule clock
+//!    `s_i` gives its reference sample `n_i` and fractional reference time `t_i` (Eq. 15).
+//!    A robot whose sample `n_i` is low-confidence is *supervised* this tick; that is the
+//!    robot the coordinator will move at the operator's rate.
+//! 2. The operator decides for the supervised robot whether to correct: the sample *needs*
+//!    a correction when, on that robot's own workpiece, the reference demonstration's label
+//!    at `round(t_i)` is sanding in pass 1–3 over a painted section. A needed correction is
+//!    given with probability `1 − miss_rate`, an unneeded one with `false_correction_rate`
+//!    (§III: 1 % each).
+//! 3. A correction is a joystick input `u` along the model's correction components
+//!    (`TaskModel::corrections_at`), `u_k = ±gain` with the sign that raises the force; a
+//!    component whose rate part would speed the robot up is left out when the combined
+//!    input would otherwise speed it up, so a correction presses harder *and* slows the
+//!    robot, as the expert did over paint. The command `x_f⁺ = μ̂⁺ + δx⁺(u)` (Eq. 7) comes
+//!    from `TaskModel::command`; its last component, the warp gradient, is clamped to
+//!    `[ψ̇min, ψ̇max]` at `n_i` and passed to `Coordinator::tick` as the operator's gradient.
+//!    That is what perturbs the timing. Without a correction the operator passes NaN (the
+//!    robot keeps its scheduled gradient, the mean on low-confidence samples).
+//! 4. Every running robot logs the command at `t_i` (`u = 0` unless corrected) as its
+//!    execution sample, `t_i` in its reference-time log (Eq. 21), and its supervised and
+//!    corrected flags.
+//! 5. After the tick, `Tick::low_conf` says which robots traversed any low-confidence sample:
+//!    both at once is an *overlap* (a valid schedule never has one), neither is operator
+//!    idle time.
+
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+use tandem_lfd::{Demonstration, Execution, TaskModel};
+use tandem_realtime::{Coordinator, Timeline};
+use tandem_schedule::{Problem, Schedule};
+
+use crate::task::{Label, N_PASSES, Phase, Workpiece};
+
+/// Errors of the workcell simulation.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum WorkcellError {
+    /// A parameter is out of its documented range.
+    #[error("parameter `{name}` {why}")]
+    BadParam {
+        /// Field name.
+        name: &'static str,
+        /// What it must be.
+        why: &'static str,
+    },
+    /// Two inputs that must agree in size do not.
+    #[error("{what}: expected {expected}, found {found}")]
+    Mismatch {
+        /// What was compared.
+        what: &'static str,
+        /// The size required.
+        expected: usize,
+        /// The size given.
+        found: usize,
+    },
+    /// The model has no channel of the name the operator corrects.
+    #[error("the task model has no channel `{0}` for the operator to correct")]
+    NoForceChannel(String),
+    /// The robots did not finish within the tick budget (a bug or a degenerate schedule).
+    #[error("the pair did not finish within {ticks} control ticks")]
+    DidNotFinish {
+        /// The tick budget.
+        ticks: usize,
+    },
+    /// The sanding task (workpieces).
+    #[error(transparent)]
+    Task(#[from] crate::Error),
+    /// The task model (commands, corrections, executions).
+    #[error(transparent)]
+    Lfd(#[from] tandem_lfd::Error),
+    /// Timelines or the coordinator.
+    #[error(transparent)]
+    Realtime(#[from] tandem_realtime::Error),
+}
+
+/// Result alias of the workcell.
+pub type Result<T, E = WorkcellError> = std::result::Result<T, E>;
+
+/// The simulated operator (§III).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OperatorParams {
+    /// Probability of missing a needed correction, in `[0, 1]`. Default: 0.01 (§III).
+    pub miss_rate: f64,
+    /// Probability of correcting a sample that needs none, in `[0, 1]`. Default: 0.01 (§III).
+    pub false_correction_rate: f64,
+    /// Channel whose increase a correction aims at. Default: `"force"` (the sanding
+    /// task's normal force, N).
+    pub force_channel: String,
+    /// Joystick deflection `|u_k|` of a correction, in `(0, 1]`. The model's components
+    /// span ±3σ at `|u_k| = 1`, so the default 1/3 moves the command about one standard
+    /// deviation along each component: from the mean towards how the experts sanded over
+    /// paint, not to the edge of what they ever did. Default: 1/3.
+    pub gain: f64,
+}
+
+impl Default for OperatorParams {
+    fn default() -> Self {
+        Self {
+            miss_rate: 0.01,
+            false_correction_rate: 0.01,
+            force_channel: "force".into(),
+            gain: 1.0 / 3.0,
+        }
+    }
+}
+
+impl OperatorParams {
+    /// Checks the rates.
+    ///
+    /// # Errors
+    /// [`WorkcellError::BadParam`] naming the field.
+    pub fn validate(&self) -> Result<()> {
+        for (name, p) in [
+            ("miss_rate", self.miss_rate),
+            ("false_correction_rate", self.false_correction_rate),
+        ] {
+            if !(0.0..=1.0).contains(&p) {
+                return Err(WorkcellError::BadParam {
+                    name,
+                    why: "must be a probability in [0, 1]",
+                });
+            }
+        }
+        if !(self.gain > 0.0 && self.gain <= 1.0) {
+            return Err(WorkcellError::BadParam {
+                name: "gain",
+                why: "must be in (0, 1]",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Whether a reference sample with this label needs a correction on `workpiece`: sanding
+/// in passes 1–3 over a painted section (pass 4 is always painted and never needs one).
+#[must_use]
+pub fn needs_correction(label: &Label, workpiece: &Workpiece) -> bool {
+    label.phase == Phase::Sanding
+        && (1..N_PASSES).contains(&usize::from(label.pass))
+        && workpiece.painted_at(label)
+}
+
+/// One robot's execution as the system records it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RobotRun {
+    /// Commanded samples, sample-major (`m` channels in the model's channel order), one per
+    /// control tick in which the robot ran.
+    pub samples: Vec<f64>,
+    /// Reference time (reference samples, fractional, in `[0, T_ref − 1]`) of each sample.
+    pub ref_time_log: Vec<f64>,
+    /// Whether the robot was low-confidence (supervised) at each sample.
+    pub supervised: Vec<bool>,
+    /// Whether the operator corrected each sample (only ever true where supervised).
+    pub corrected: Vec<bool>,
+    /// Supervised samples that needed a correction.
+    pub needed: usize,
+    /// Needed corrections the operator missed.
+    pub missed: usize,
+    /// Corrections given where none was needed.
+    pub false_corrections: usize,
+}
+
+impl RobotRun {
+    /// The execution for the model update (Eq. 21): samples with `channel_names` and
+    /// period `dt_s`, plus the reference-time log.
+    ///
+    /// # Errors
+    /// The model crate's error if the samples do not form a valid demonstration.
+    pub fn execution(&self, channel_names: &[String], dt_s: f64) -> Result<Execution> {
+        let demonstration = Demonstration::new(channel_names.to_vec(), self.samples.clone(), dt_s)?;
+        Ok(Execution {
+            demonstration,
+            ref_time_log: self.ref_time_log.clone(),
+        })
+    }
+}
+
+/// A pair of executions run under one schedule.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PairRun {
+    /// Robot 1 and robot 2.
+    pub robots: [RobotRun; 2],
+    /// Control ticks until both robots finished.
+    pub ticks: usize,
+    /// Control period (s).
+    pub tick_s: f64,
+    /// Ticks in which both robots traversed a low-confidence sample (must be 0).
+    pub overlap_ticks: usize,
+    /// Ticks in which neither robot traversed a low-confidence sample.
+    pub idle_ticks: usize,
+}
+
+impl PairRun {
+    /// Whether both robots were ever low-confidence in the same tick.
+    #[must_use]
+    pub fn overlapped(&self) -> bool {
+        self.overlap_ticks > 0
+    }
+
+    /// Operator idle time as a share of the pair's duration (ticks), in `[0, 1]`.
+    #[must_use]
+    pub fn operator_idle_share(&self) -> f64 {
+        if self.ticks == 0 {
+            return 1.0;
+        }
+        self.idle_ticks as f64 / self.ticks as f64
+    }
+
+    /// Actual duration of the pair (s): ticks times the control period.
+    #[must_use]
+    pub fn duration_s(&self) -> f64 {
+        self.ticks as f64 * self.tick_s
+    }
+}
+
+/// The joystick input for a force-raising, slowing correction at `ref_time` (see the module
+/// docs), or `None` when no component moves the force.
+fn correction_input(
+    model: &TaskModel,
+    force_idx: usize,
+    gain: f64,
+    ref_time: f64,
+    u: &mut [f64],
+) -> Result<bool> {
+    let corr = model.corrections_at(ref_time)?;
+    let rate_idx = model.tangent_names().len() - 1;
+    let mut rate_change = 0.0;
+    let mut any = false;
+    for (k, c) in corr.components.iter().enumerate() {
+        u[k] = if c[force_idx] > 0.0 {
+            gain
+        } else if c[force_idx] < 0.0 {
+            -gain
+        } else {
+            0.0
+        };
+        any |= u[k] != 0.0;
+        rate_change += u[k] * c[rate_idx];
+    }
+    if rate_change < 0.0 {
+        // Keep only the components that slow the robot down (or leave its rate alone).
+        for (k, c) in corr.components.iter().enumerate() {
+            if u[k] * c[rate_idx] < 0.0 {
+                u[k] = 0.0;
+            }
+        }
+        any = u.iter().any(|&x| x != 0.0);
+    }
+    Ok(any)
+}
+
+/// Runs both robots of `schedule` to the end with a simulated operator (see the module
+/// docs). `problem` must be the one `schedule` was made for, from `model`'s gradients;
+/// `labels` are the reference demonstration's labels (one per reference sample);
+/// `workpieces[i]` is robot `i`'s workpiece. Deterministic for the state of `rng`.
+///
+/// # Errors
+/// Invalid parameters, mismatched sizes, a model without the force channel, or the lower
+/// crates' errors for an invalid schedule.
+pub fn run_pair(
+    model: &TaskModel,
+    problem: &Problem,
+    schedule: &Schedule,
+    labels: &[Label],
+    workpieces: &[Workpiece; 2],
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<PairRun> {
+    params.validate()?;
+    let n_ref = problem.n_ref();
+    for (what, found) in [
+        ("model reference samples", model.n_ref()),
+        ("reference labels", labels.len()),
+        ("robot 1 gradients", schedule.grad_exec[0].len()),
+        ("robot 2 gradients", schedule.grad_exec[1].len()),
+    ] {
+        if found != n_ref {
+            return Err(WorkcellError::Mismatch {
+                what,
+                expected: n_ref,
+                found,
+            });
+        }
+    }
+    let force_idx = model
+        .tangent_names()
+        .iter()
+        .position(|n| *n == params.force_channel)
+        .ok_or_else(|| WorkcellError::NoForceChannel(params.force_channel.clone()))?;
+    let dt_s = problem.dt_s();
+    let tick_s = dt_s;
+    let starts = schedule.starts_s();
+    let timeline = |i: usize| {
+        Timeline::new(
+            problem.conf(),
+            &schedule.grad_exec[i],
+            problem.grad_min(),
+            problem.grad_max(),
+            starts[i],
+            dt_s,
+        )
+    };
+    let mut coord = Coordinator::new([timeline(0)?, timeline(1)?], tick_s)?;
+
+    let m = model.channel_names().len();
+    let k = model.n_components();
+    let u_zero = vec![0.0; k];
+    let mut u_corr = vec![0.0; k];
+    let mut cmd = vec![0.0; m + 1];
+    let empty = || RobotRun {
+        samples: Vec::with_capacity(n_ref * m * 2),
+        ref_time_log: Vec::with_capacity(n_ref * 2),
+        supervised: Vec::with_capacity(n_ref * 2),
+        corrected: Vec::with_capacity(n_ref * 2),
+        needed: 0,
+        missed: 0,
+        false_corrections: 0,
+    };
+    let mut runs = [empty(), empty()];
+    let (mut ticks, mut overlap_ticks, mut idle_ticks) = (0, 0, 0);
+    let max_end_s = coord
+        .robots()
+        .iter()
+        .map(Timeline::end_s)
+        .fold(0.0, f64::max);
+    // The slowest admissible execution is bounded by ψ̇max/ψ̇min per sample; a generous cap
+    // on top of that only guards against a bug looping forever.
+    let max_ratio = problem
+        .grad_max()
+        .iter()
+        .zip(problem.grad_min())
+        .map(|(hi, lo)| hi / lo)
+        .fold(1.0, f64::max);
+    let budget = ((max_end_s / tick_s) * max_ratio * 2.0) as usize + 1000;
+    let last_ref = (n_ref - 1) as f64;
+
+    while !coord.is_finished() {
+        if ticks >= budget {
+            return Err(WorkcellError::DidNotFinish { ticks: budget });
+        }
+        let clocks = coord.clock_s();
+        let mut operator_gradient = f64::NAN;
+        for i in 0..2 {
+            let tl = &coord.robots()[i];
+            if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() {
+                continue;
+            }
+            let n = tl.sample_at(clocks[i]);
+            let ref_time = tl.ref_time_at(clocks[i]).min(last_ref);
+            let supervised = !problem.conf()[n];
+            let mut corrected = false;
+            if supervised {
+                let label_idx = (ref_time.round() as usize).min(n_ref - 1);
+                let needed = needs_correction(&labels[label_idx], &workpieces[i]);
+                let draw: f64 = rng.random();
+                let run = &mut runs[i];
+                if needed {
+                    run.needed += 1;
+                    corrected = draw >= params.miss_rate;
+                    run.missed += usize::from(!corrected);
+                } else {
+                    corrected = draw < params.false_correction_rate;
+                    run.false_corrections += usize::from(corrected);
+                }
+            }
+            let u = if corrected
+                && correction_input(model, force_idx, params.gain, ref_time, &mut u_corr)?
+            {
+                &u_corr
+            } else {
+                &u_zero
+            };
+            model.command_into(u, ref_time, &mut cmd)?;
+            if supervised && corrected {
+                operator_gradient = cmd[m].clamp(problem.grad_min()[n], problem.grad_max()[n]);
+            }
+            let run = &mut runs[i];
+            run.samples.extend_from_slice(&cmd[..m]);
+            run.ref_time_log.push(ref_time);
+            run.supervised.push(supervised);
+            run.corrected.push(corrected);
+        }
+        let tick = coord.tick(operator_gradient);
+        ticks += 1;
+        match tick.low_conf {
+            [true, true] => overlap_ticks += 1,
+            [false, false] => idle_ticks += 1,
+            _ => {}
+        }
+    }
+    Ok(PairRun {
+        robots: runs,
+        ticks,
+        tick_s,
+        overlap_ticks,
+        idle_ticks,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    use tandem_lfd::FitParams;
+
+    const N_REF: usize = 60;
+
+    /// Three demonstrations of a one-channel "force" task aligned by known warps: demo 0
+    /// (the reference) and demo 2 press lightly (1 N) everywhere; demo 1 presses hard (9 N)
+    /// over reference samples 10..20 and takes two samples per reference sample there.
+    /// So samples 10..20 vary (low confidence), force rising with the warp gradient.
+    fn model() -> TaskModel {
+        let names = vec!["force".to_string()];
+        let light = Demonstration::new(names.clone(), vec![1.0; N_REF], 0.01).unwrap();
+        let mut hard = Vec::new();
+        let mut warp1 = Vec::new();
+        for n in 0..N_REF {
+            warp1.push(hard.len() as f64);
+            let reps = if (10..20).contains(&n) { 2 } else { 1 };
+            for _ in 0..reps {
+                hard.push(if (10..20).contains(&n) { 9.0 } else { 1.0 });
+            }
+        }
+        let hard = Demonstration::new(names, hard, 0.01).unwrap();
+        let identity: Vec<f64> = (0..N_REF).map(|n| n as f64).collect();
+        TaskModel::fit_aligned(
+            &[light.clone(), hard, light],
+            &[identity.clone(), warp1, identity],
+            &FitParams::default(),
+        )
+        .unwrap()
+    }
+
+    fn problem(model: &TaskModel) -> Problem {
+        let conf = (0..N_REF).map(|n| !(10..20).contains(&n)).collect();
+        let (gmin, gmax) = (model.grad_min().to_vec(), model.grad_max().to_vec());
+        let gmean = model
+            .grad_mean()
+            .iter()
+            .zip(gmin.iter().zip(&gmax))
+            .map(|(g, (lo, hi))| g.clamp(*lo, *hi))
+            .collect();
+        Problem::new(conf, gmean, gmin, gmax, model.dt_s()).unwrap()
+    }
+
+    fn painted_labels() -> Vec<Label> {
+        vec![
+            Label {
+                pass: 1,
+                section: 0,
+                painted: true,
+                phase: Phase::Sanding,
+            };
+            N_REF
+        ]
+    }
+
+    fn all_painted() -> Workpiece {
+        Workpiece {
+            painted: vec![vec![true; 8]; N_PASSES],
+        }
+    }
+
+    fn run(params: &OperatorParams, seed: u64) -> (PairRun, f64) {
+        let model = model();
+        let problem = problem(&model);
+        let schedule = problem.serial_schedule();
+        let planned_s = schedule.t_total_s(problem.dt_s());
+        let wp = [all_painted(), all_painted()];
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let run = run_pair(
+            &model,
+            &problem,
+            &schedule,
+            &painted_labels(),
+            &wp,
+            params,
+            &mut rng,
+        )
+        .unwrap();
+        (run, planned_s)
+    }
+
+    #[test]
+    fn only_painted_sanding_of_passes_one_to_three_needs_a_correction() {
+        let mut wp = all_painted();
+        wp.painted[1][3] = false;
+        let label = |pass, section, phase| Label {
+            pass,
+            section,
+            painted: true,
+            phase,
+        };
+        assert!(needs_correction(&label(1, 0, Phase::Sanding), &wp));
+        assert!(needs_correction(&label(3, 7, Phase::Sanding), &wp));
+        assert!(
+            !needs_correction(&label(2, 3, Phase::Sanding), &wp),
+            "unpainted"
+        );
+        assert!(
+            !needs_correction(&label(4, 0, Phase::Sanding), &wp),
+            "pass 4"
+        );
+        assert!(!needs_correction(&label(1, 0, Phase::Transition), &wp));
+    }
+
+    #[test]
+    fn bad_rates_are_rejected() {
+        let p = OperatorParams {
+            miss_rate: 1.5,
+            ..OperatorParams::default()
+        };
+        assert!(matches!(
+            p.validate(),
+            Err(WorkcellError::BadParam {
+                name: "miss_rate",
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn a_perfect_operator_corrects_every_needed_sample_and_slows_the_robots() {
+        let perfect = OperatorParams {
+            miss_rate: 0.0,
+            false_correction_rate: 0.0,
+            ..OperatorParams::default()
+        };
+        let (run, planned_s) = run(&perfect, 1);
+        assert_eq!(run.overlap_ticks, 0);
+        let model = model();
+        for r in &run.robots {
+            let n = r.ref_time_log.len();
+            assert_eq!(r.samples.len(), n);
+            assert!(r.ref_time_log.windows(2).all(|w| w[0] <= w[1]));
+            assert!(
+                r.ref_time_log
+                    .iter()
+                    .all(|t| (0.0..=(N_REF - 1) as f64).contains(t))
+            );
+            assert_eq!(r.missed + r.false_corrections, 0);
+            for k in 0..n {
+                let t = r.ref_time_log[k];
+                assert_eq!(r.supervised[k], (10..20).contains(&(t as usize)), "t = {t}");
+                assert_eq!(r.corrected[k], r.supervised[k]);
+                // A correction presses harder than the mean. By hand, inside 10..19: one
+                // component c = 2·(8, 1)/√2 (±3σ of the normalised residuals, ranges 8 N
+                // and 1), admissible scale (4/3 − 1)/√2, u = 1/3: δforce = 8/9 N.
+                let mean = model.command(&[0.0, 0.0], t).unwrap()[0];
+                if r.corrected[k] {
+                    if (10.0..=19.0).contains(&t) {
+                        assert!((r.samples[k] - mean - 8.0 / 9.0).abs() < 1e-9, "t = {t}");
+                    }
+                    assert!(r.samples[k] > mean + 0.1, "{} vs {mean}", r.samples[k]);
+                } else {
+                    assert!((r.samples[k] - mean).abs() < 1e-9);
+                }
+            }
+            assert_eq!(r.needed, r.supervised.iter().filter(|s| **s).count());
+        }
+        // Slower than planned: the corrected gradient is 4/3 + 1/9 instead of 4/3 on the 10
+        // low-confidence samples, 10/9 samples (11 ms) more per robot, 22 ms in series.
+        assert!(
+            run.duration_s() > planned_s + 0.01,
+            "{} vs {planned_s}",
+            run.duration_s()
+        );
+        // The operator is idle while both robots are high-confidence.
+        assert!(run.idle_ticks > 0 && run.operator_idle_share() < 1.0);
+    }
+
+    #[test]
+    fn without_corrections_the_pair_runs_on_schedule() {
+        let never = OperatorParams {
+            miss_rate: 1.0,
+            false_correction_rate: 0.0,
+            ..OperatorParams::default()
+        };
+        let (run, planned_s) = run(&never, 2);
+        assert_eq!(run.overlap_ticks, 0);
+        assert!(run.robots.iter().all(|r| r.corrected.iter().all(|c| !c)));
+        assert!(
+            run.robots
+                .iter()
+                .all(|r| r.missed == r.needed && r.needed > 0)
+        );
+        assert!(
+            (run.duration_s() - planned_s).abs() <= 2.0 * run.tick_s,
+            "{} vs {planned_s}",
+            run.duration_s()
+        );
+    }
+
+    #[test]
+    fn same_seed_same_run_and_mismatches_are_errors() {
+        let p = OperatorParams::default();
+        assert_eq!(run(&p, 7).0, run(&p, 7).0);
+        let model = model();
+        let problem = problem(&model);
+        let schedule = problem.serial_schedule();
+        let mut rng = ChaCha8Rng::seed_from_u64(0);
+        let err = run_pair(
+            &model,
+            &problem,
+            &schedule,
+            &painted_labels()[..5],
+            &[all_painted(), all_painted()],
+            &p,
+            &mut rng,
+        )
+        .unwrap_err();
+        assert!(matches!(
+            err,
+            WorkcellError::Mismatch {
+                what: "reference labels",
+                ..
+            }
+        ));
+    }
+}
