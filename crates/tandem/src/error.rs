@@ -100,6 +100,9 @@ pub enum Error {
     /// Simulation (§III).
     #[error(transparent)]
     Sim(#[from] tandem_sim::Error),
+    /// The simulated workcell (§III).
+    #[error(transparent)]
+    Workcell(#[from] tandem_sim::workcell::WorkcellError),
     /// The state could not be serialized.
     #[error("cannot encode state: {source}")]
     Encode {

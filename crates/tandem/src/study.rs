@@ -8,12 +8,18 @@
 
 use std::fmt::Write as _;
 use std::path::Path;
+use std::time::{Duration, Instant};
 
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::lfd::Demonstration;
-use crate::sim::task::{self, Label, TaskParams};
-use crate::{Error, PlannerParams, Result};
+use crate::lfd::{Demonstration, TaskModel};
+use crate::schedule::{GlobalTimeline, Source};
+use crate::sim::task::{self, Label, TaskParams, Workpiece};
+use crate::sim::workcell::{self, OperatorParams};
+use crate::{Error, ExecutionRecord, Planner, PlannerParams, Result};
 
 /// Study configuration (`fixtures/study.toml`, §III).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -94,6 +100,15 @@ impl StudyConfig {
         self.planner.validate()?;
         self.task.validate()?;
         Ok(())
+    }
+
+    /// The operator of the workcell.
+    pub fn operator(&self) -> OperatorParams {
+        OperatorParams {
+            miss_rate: self.miss_rate,
+            false_correction_rate: self.false_correction_rate,
+            ..OperatorParams::default()
+        }
     }
 }
 
@@ -271,6 +286,41 @@ impl StudyResult {
     }
 }
 
+/// Wall time spent in each phase of a study, summed over trials (trials run in parallel,
+/// so the sum can exceed the elapsed time).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhaseTimes {
+    /// Aligning the demonstrations and fitting the model (once per study, §II-B1).
+    pub alignment: Duration,
+    /// Adding executions to the model (Eq. 21).
+    pub model_update: Duration,
+    /// Recording observations and updating the confidence (Eq. 9–12).
+    pub confidence: Duration,
+    /// Sampling schedules (§II-C), the first one included.
+    pub scheduling: Duration,
+    /// Running the workcell (coordinator, operator, commands).
+    pub simulation: Duration,
+}
+
+impl PhaseTimes {
+    fn add(&mut self, other: &PhaseTimes) {
+        self.alignment += other.alignment;
+        self.model_update += other.model_update;
+        self.confidence += other.confidence;
+        self.scheduling += other.scheduling;
+        self.simulation += other.simulation;
+    }
+}
+
+/// Progress of a running study, reported after every recorded pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// Trial index.
+    pub trial: usize,
+    /// Pairs of this trial recorded so far.
+    pub pairs_done: usize,
+}
+
 /// What a study learns from: demonstrations (demo 0 is the reference) and the ground-truth
 /// labels of the reference demonstration, one per sample.
 #[derive(Clone, Debug, PartialEq)]
@@ -368,6 +418,196 @@ impl StudyInputs {
         }
         Ok(())
     }
+}
+
+/// Short name of a schedule's source for the records.
+fn source_name(source: Source) -> String {
+    match source {
+        Source::Sampled { .. } => "sampled",
+        Source::Previous => "previous",
+        Source::RepairedPrevious => "repaired",
+        Source::Serial => "serial",
+    }
+    .to_string()
+}
+
+/// The record of the planner's current schedule (no pair run yet).
+fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
+    let schedule = planner.schedule();
+    let timeline = GlobalTimeline::new(planner.problem(), schedule)?;
+    let lc_intervals_s = timeline
+        .lc_intervals()
+        .each_ref()
+        .map(|v| v.iter().map(|i| [i.start_s, i.end_s]).collect());
+    Ok(IterationRecord {
+        iteration: planner.pairs_recorded(),
+        t_total_s: planner.outcome().t_total_s,
+        offset_s: schedule.offset_s,
+        high_conf_pct: 100.0 * planner.confidence().high_share(),
+        source: source_name(planner.outcome().source),
+        lc_intervals_s,
+        pair: None,
+    })
+}
+
+/// Runs trial `trial` of a study from a fitted model (see the module docs). Its seed is
+/// [`trial_seed`]`(config.seed, trial)`: schedules use `derive_seed(trial seed, k)`,
+/// workpieces and the operator a ChaCha8 stream of the trial seed.
+///
+/// # Errors
+/// Invalid configuration, or any stage's error.
+pub fn run_trial(
+    config: &StudyConfig,
+    model: &TaskModel,
+    reference_labels: &[Label],
+    trial: usize,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<(TrialResult, PhaseTimes)> {
+    config.validate()?;
+    let seed = trial_seed(config.seed, trial);
+    let mut params = config.planner.clone();
+    params.sampler.samples = config.samples;
+    params.sampler.seed = seed;
+    let mut times = PhaseTimes::default();
+    let t = Instant::now();
+    let mut planner = Planner::from_model(model.clone(), params)?;
+    times.scheduling += t.elapsed();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(1);
+    let operator = config.operator();
+    let n_pairs = config.n_pairs();
+    let mut iterations = Vec::with_capacity(n_pairs + 1);
+    for pair in 0..n_pairs {
+        let mut record = iteration_record(&planner)?;
+        let workpieces = [
+            Workpiece::random(&config.task, &mut rng)?,
+            Workpiece::random(&config.task, &mut rng)?,
+        ];
+        let t = Instant::now();
+        let run = workcell::run_pair(
+            planner.model(),
+            planner.problem(),
+            planner.schedule(),
+            reference_labels,
+            &workpieces,
+            &operator,
+            &mut rng,
+        )?;
+        let (names, dt_s) = (planner.model().channel_names(), planner.model().dt_s());
+        let mut records = Vec::with_capacity(2);
+        for robot in &run.robots {
+            records.push(ExecutionRecord {
+                execution: robot.execution(names, dt_s)?,
+                supervised: robot.supervised.clone(),
+                corrected: robot.corrected.clone(),
+            });
+        }
+        let records: [ExecutionRecord; 2] = records
+            .try_into()
+            .expect("one execution record per robot of the pair");
+        times.simulation += t.elapsed();
+        let count = |f: fn(&bool) -> bool, pick: fn(&workcell::RobotRun) -> &Vec<bool>| {
+            run.robots
+                .iter()
+                .map(|r| pick(r).iter().filter(|b| f(b)).count())
+                .sum()
+        };
+        record.pair = Some(PairStats {
+            overlap_ticks: run.overlap_ticks,
+            operator_idle_share: run.operator_idle_share(),
+            duration_s: run.duration_s(),
+            supervised_ticks: count(|b| *b, |r| &r.supervised),
+            corrected_ticks: count(|b| *b, |r| &r.corrected),
+        });
+        iterations.push(record);
+        let report = planner.record_pair(&records)?;
+        times.model_update += report.model_update;
+        times.confidence += report.confidence;
+        times.scheduling += report.scheduling;
+        progress(Progress {
+            trial,
+            pairs_done: pair + 1,
+        });
+    }
+    iterations.push(iteration_record(&planner)?);
+    Ok((
+        TrialResult {
+            trial,
+            seed,
+            iterations,
+        },
+        times,
+    ))
+}
+
+/// Runs the study (§III): fits the model once, then runs the trials ([`run_trials`]).
+///
+/// # Errors
+/// Invalid configuration or inputs, or any stage's error (the first trial's in order).
+pub fn run_study(
+    config: &StudyConfig,
+    inputs: &StudyInputs,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<(StudyResult, PhaseTimes)> {
+    config.validate()?;
+    inputs.check().map_err(|why| Error::BadInput {
+        path: "<study inputs>".into(),
+        why,
+    })?;
+    let t = Instant::now();
+    let model = TaskModel::fit(&inputs.demos, &config.planner.fit)?;
+    model.prepare_corrections();
+    let alignment = t.elapsed();
+    let (result, mut times) = run_trials(config, &model, &inputs.reference_labels, progress)?;
+    times.alignment = alignment;
+    Ok((result, times))
+}
+
+/// Runs every trial of a study from a fitted model, in parallel (rayon). Each trial
+/// depends only on `(config.seed, trial)`, so the result is the same for any number of
+/// threads. `progress` is called after every recorded pair, from worker threads.
+///
+/// # Errors
+/// Invalid configuration, labels that do not match the model's reference, or any stage's
+/// error (the first trial's in trial order).
+pub fn run_trials(
+    config: &StudyConfig,
+    model: &TaskModel,
+    reference_labels: &[Label],
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<(StudyResult, PhaseTimes)> {
+    config.validate()?;
+    if reference_labels.len() != model.n_ref() {
+        return Err(Error::BadInput {
+            path: "<reference labels>".into(),
+            why: format!(
+                "{} labels for {} reference samples",
+                reference_labels.len(),
+                model.n_ref()
+            ),
+        });
+    }
+    let outcomes: Vec<Result<(TrialResult, PhaseTimes)>> = (0..config.trials)
+        .into_par_iter()
+        .map(|k| run_trial(config, model, reference_labels, k, progress))
+        .collect();
+    let mut times = PhaseTimes::default();
+    let mut trials = Vec::with_capacity(config.trials);
+    for outcome in outcomes {
+        let (trial, t) = outcome?;
+        times.add(&t);
+        trials.push(trial);
+    }
+    Ok((
+        StudyResult {
+            config: config.clone(),
+            n_ref: model.n_ref(),
+            dt_s: model.dt_s(),
+            ground_truth_pct: 100.0 * task::ground_truth_share(reference_labels),
+            trials,
+        },
+        times,
+    ))
 }
 
 /// Mean and sample standard deviation (0 for fewer than two values).
@@ -477,6 +717,21 @@ mod tests {
         let c: StudyConfig = toml::from_str("trials = 2\nseed = 7\n").unwrap();
         assert_eq!((c.trials, c.seed, c.executions), (2, 7, 300));
         assert!(toml::from_str::<StudyConfig>("trails = 2\n").is_err());
+        let nested: StudyConfig = toml::from_str(
+            "[planner.sampler]\np_fastest = 0.5\n[planner.confidence]\ngamma_c = 0.9\n",
+        )
+        .unwrap();
+        assert_eq!(nested.planner.sampler.p_fastest, 0.5);
+        assert_eq!(nested.planner.confidence.gamma_c, 0.9);
+        assert!(toml::from_str::<StudyConfig>("[planner.sampler]\nbogus = 1\n").is_err());
+        // The committed configuration is the paper's study.
+        let committed = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/study.toml"
+        ))
+        .unwrap();
+        let c: StudyConfig = toml::from_str(&committed).unwrap();
+        assert_eq!(c, StudyConfig::default());
     }
 
     #[test]
