@@ -33,6 +33,20 @@ pub enum Error {
         /// Channel index.
         channel: usize,
     },
+    /// A sample value is finite but larger in magnitude than [`crate::MAX_ABS_VALUE`].
+    #[error(
+        "{signal} signal: value {value:e} at sample {sample}, channel {channel} is too large (|value| must be <= 1e100)"
+    )]
+    TooLarge {
+        /// Which signal (`"reference"` or `"query"`, or `"query #i"` in `align_many`).
+        signal: String,
+        /// Sample index (in that signal's own samples).
+        sample: usize,
+        /// Channel index.
+        channel: usize,
+        /// The offending value.
+        value: f64,
+    },
     /// Reference and query have different channel counts.
     #[error("channel count mismatch: reference has {reference}, query has {query}")]
     ChannelMismatch {

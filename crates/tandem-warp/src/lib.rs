@@ -39,6 +39,6 @@ mod warp;
 pub use error::{Error, Result};
 pub use objective::objective_of;
 pub use params::{DEFAULT_NODE_SPACING, WarpParams};
-pub use signal::SignalRef;
+pub use signal::{MAX_ABS_VALUE, SignalRef};
 pub use solver::{COARSE_POINTS_PER_SEGMENT, align, align_many};
 pub use warp::Warp;

@@ -49,19 +49,24 @@ impl<'a> Prepared<'a> {
         }
         let nc = reference.n_channels();
         params.validate_for(nc)?;
-        if let Some((sample, channel)) = reference.first_non_finite() {
-            return Err(Error::NonFinite {
-                signal: "reference".into(),
-                sample,
-                channel,
-            });
-        }
-        if let Some((sample, channel)) = query.first_non_finite() {
-            return Err(Error::NonFinite {
-                signal: query_name.into(),
-                sample,
-                channel,
-            });
+        for (signal, name) in [(reference, "reference"), (query, query_name)] {
+            if let Some((sample, channel, value)) = signal.first_unusable() {
+                let signal = name.into();
+                return Err(if value.is_finite() {
+                    Error::TooLarge {
+                        signal,
+                        sample,
+                        channel,
+                        value,
+                    }
+                } else {
+                    Error::NonFinite {
+                        signal,
+                        sample,
+                        channel,
+                    }
+                });
+            }
         }
         let w = params.weight_vec(nc);
         let (r, q) = (reference.data(), query.data());

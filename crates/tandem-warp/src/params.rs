@@ -177,11 +177,11 @@ impl WarpParams {
             if let Some((i, v)) = w
                 .iter()
                 .enumerate()
-                .find(|(_, v)| !(v.is_finite() && **v >= 0.0))
+                .find(|(_, v)| !(v.is_finite() && **v >= 0.0 && **v <= crate::MAX_ABS_VALUE))
             {
                 return Err(bad(
                     "weights",
-                    format!("weight {i} must be finite and >= 0 (got {v})"),
+                    format!("weight {i} must be in [0, 1e100] (got {v})"),
                 ));
             }
         }

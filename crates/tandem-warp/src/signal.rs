@@ -59,14 +59,20 @@ impl<'a> SignalRef<'a> {
         &self.data[t * self.n_channels..(t + 1) * self.n_channels]
     }
 
-    /// First non-finite value as `(sample, channel)`, if any.
-    pub(crate) fn first_non_finite(&self) -> Option<(usize, usize)> {
+    /// First value the loss cannot use, as `(sample, channel, value)`: non-finite, or larger in
+    /// magnitude than [`MAX_ABS_VALUE`] (its squared differences would overflow to infinity).
+    pub(crate) fn first_unusable(&self) -> Option<(usize, usize, f64)> {
         self.data
             .iter()
-            .position(|v| !v.is_finite())
-            .map(|i| (i / self.n_channels, i % self.n_channels))
+            .position(|v| !(v.is_finite() && v.abs() <= MAX_ABS_VALUE))
+            .map(|i| (i / self.n_channels, i % self.n_channels, self.data[i]))
     }
 }
+
+/// Largest sample magnitude the alignment accepts. Weighted squared differences of values up
+/// to this size (and weights up to [`MAX_ABS_VALUE`]) stay finite in `f64`; anything larger is
+/// rejected with [`Error::TooLarge`](crate::Error::TooLarge) instead of overflowing the loss.
+pub const MAX_ABS_VALUE: f64 = 1e100;
 
 #[cfg(test)]
 mod tests {
@@ -102,7 +108,10 @@ mod tests {
     fn finds_non_finite() {
         let d = [0.0, 1.0, 2.0, f64::NAN];
         assert_eq!(
-            SignalRef::new(&d, 2).unwrap().first_non_finite(),
+            SignalRef::new(&d, 2)
+                .unwrap()
+                .first_unusable()
+                .map(|(t, j, _)| (t, j)),
             Some((1, 1))
         );
     }

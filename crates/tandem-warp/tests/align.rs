@@ -262,6 +262,25 @@ fn bad_inputs_are_errors() {
     let mut inf = good.clone();
     inf[0] = f64::INFINITY;
     assert!(align(g2, SignalRef::new(&inf, 2).unwrap(), &p).is_err());
+    // finite but so large that squared differences would overflow: an error, not a panic
+    let mut huge = good.clone();
+    huge[5] = 1e200;
+    let e = align(g2, SignalRef::new(&huge, 2).unwrap(), &p).unwrap_err();
+    assert_eq!(
+        e,
+        Error::TooLarge {
+            signal: "query".into(),
+            sample: 2,
+            channel: 1,
+            value: 1e200
+        }
+    );
+    let mut heavy = p.clone();
+    heavy.weights = Some(vec![1.0, 1e200]);
+    assert!(matches!(
+        align(g2, g2, &heavy).unwrap_err(),
+        Error::BadParam { .. }
+    ));
     // channel mismatch
     let e = align(g2, SignalRef::new(&good, 1).unwrap(), &p).unwrap_err();
     assert_eq!(
