@@ -257,13 +257,6 @@ fn ensure_font() -> anyhow::Result<()> {
 ///
 /// # Errors
 /// Invalid data (see [`Fig5Data::validate`]), or a failure to render or write a file.
-#[cfg_attr(
-    not(test),
-    expect(
-        dead_code,
-        reason = "called by the study command (issue 6); tests exercise it now"
-    )
-)]
 pub(crate) fn draw_fig5(data: &Fig5Data, svg: &Path, png: &Path) -> anyhow::Result<()> {
     draw_fig5_annotated(data, svg, png, None)
 }

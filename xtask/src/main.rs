@@ -7,6 +7,7 @@
 mod fig5;
 mod fixtures;
 mod stress;
+mod study;
 
 use clap::{Parser, Subcommand};
 
@@ -21,6 +22,8 @@ struct Cli {
 /// The tasks.
 #[derive(Subcommand)]
 enum Cmd {
+    /// Run the simulated study of §III and draw Fig. 5 (defaults: fixtures/study.toml).
+    Study(study::StudyArgs),
     /// Regenerate the sanding demonstrations in fixtures/sanding/ (see fixtures/README.md).
     Fixtures {
         /// Write nothing; fail, naming the files, if the committed fixtures differ.
@@ -50,6 +53,7 @@ fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.cmd {
         Cmd::Fixtures { check } => fixtures::run(check),
+        Cmd::Study(args) => study::run(&args),
         Cmd::Stress { executions, seed } => stress::run(executions, seed),
         Cmd::Fig5Demo { out } => {
             let (svg, png) = fig5::run_demo(&out)?;

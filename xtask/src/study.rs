@@ -1,0 +1,245 @@
+//! `cargo xtask study`: the simulated study of §III (Fig. 5).
+//!
+//! Reads the configuration (`fixtures/study.toml`, overridable by flags), runs the study
+//! loop of `tandem::study` on the fixture demonstrations with a progress bar on stderr,
+//! and writes under the output folder (default `results/`):
+//! `study.json` (compact; git revision, configuration, every trial and iteration, the
+//! per-iteration summary), `study.csv` (one row per trial and iteration), `fig5.svg` and `fig5.png`.
+//! Finally it prints the time spent in each phase.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+use tandem::study::{IterationSummary, PhaseTimes, StudyConfig, StudyInputs, StudyResult};
+
+use crate::fig5::{ExampleSchedule, Fig5Data, draw_fig5};
+
+/// Flags of `cargo xtask study`; unset flags take the configuration file's values.
+#[derive(clap::Args, Debug)]
+pub(crate) struct StudyArgs {
+    /// Study configuration (TOML with the fields of `tandem::study::StudyConfig`).
+    /// Default: fixtures/study.toml in the workspace.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Number of trials.
+    #[arg(long)]
+    trials: Option<usize>,
+    /// Executions per trial (even: they run in pairs).
+    #[arg(long)]
+    executions: Option<usize>,
+    /// Sampler iterations per re-schedule.
+    #[arg(long)]
+    samples: Option<usize>,
+    /// Master seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Output folder (created if missing). Default: results/ in the workspace.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Folder with demo_{i}.csv and demo_0.labels.csv. Default: fixtures/sanding/.
+    #[arg(long)]
+    fixtures: Option<PathBuf>,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+/// What `study.json` holds.
+#[derive(Serialize)]
+struct StudyFile<'a> {
+    /// `git describe --always --dirty` of the workspace, or "unknown".
+    git_revision: String,
+    /// Mean and standard deviation per iteration across trials (Fig. 5).
+    summary: Vec<IterationSummary>,
+    /// Everything else: configuration, trials, iterations.
+    result: &'a StudyResult,
+}
+
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives one folder below the workspace root")
+        .to_path_buf()
+}
+
+fn git_revision(root: &Path) -> String {
+    std::process::Command::new("git")
+        .args(["describe", "--always", "--dirty"])
+        .current_dir(root)
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .and_then(|o| String::from_utf8(o.stdout).ok())
+        .map(|s| s.trim().to_string())
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// The configuration file with the flags applied.
+fn config(args: &StudyArgs, root: &Path) -> anyhow::Result<StudyConfig> {
+    let path = args
+        .config
+        .clone()
+        .unwrap_or_else(|| root.join("fixtures/study.toml"));
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("reading study configuration {}", path.display()))?;
+    let mut config: StudyConfig =
+        toml::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+    if let Some(v) = args.trials {
+        config.trials = v;
+    }
+    if let Some(v) = args.executions {
+        config.executions = v;
+    }
+    if let Some(v) = args.samples {
+        config.samples = v;
+    }
+    if let Some(v) = args.seed {
+        config.seed = v;
+    }
+    config
+        .validate()
+        .with_context(|| format!("study configuration {} with flags", path.display()))?;
+    Ok(config)
+}
+
+/// Fig. 5 from the study: the summary, example schedules of trial 0, the ground truth.
+fn fig5_data(result: &StudyResult, summary: &[IterationSummary]) -> Fig5Data {
+    let trial0 = &result.trials[0];
+    let examples = result
+        .config
+        .example_iterations
+        .iter()
+        .filter_map(|&k| trial0.iterations.iter().find(|r| r.iteration == k))
+        .map(|r| {
+            let pairs = |v: &[[f64; 2]]| v.iter().map(|[a, b]| (*a, b.min(r.t_total_s))).collect();
+            ExampleSchedule {
+                iteration: r.iteration,
+                t_total_s: r.t_total_s,
+                lc_robot1: pairs(&r.lc_intervals_s[0]),
+                lc_robot2: pairs(&r.lc_intervals_s[1]),
+            }
+        })
+        .collect();
+    Fig5Data {
+        iterations: summary.iter().map(|s| s.iteration).collect(),
+        t_total_mean_s: summary.iter().map(|s| s.t_total_mean_s).collect(),
+        t_total_std_s: summary.iter().map(|s| s.t_total_std_s).collect(),
+        high_conf_pct_mean: summary.iter().map(|s| s.high_conf_pct_mean).collect(),
+        high_conf_pct_std: summary.iter().map(|s| s.high_conf_pct_std).collect(),
+        ground_truth_pct: result.ground_truth_pct,
+        examples,
+    }
+}
+
+fn print_times(times: &PhaseTimes, wall: std::time::Duration) {
+    println!("phase times (summed over trials; trials run in parallel):");
+    for (name, d) in [
+        ("alignment (fit, once)", times.alignment),
+        ("model update (Eq. 21)", times.model_update),
+        ("confidence (Eq. 9-12)", times.confidence),
+        ("scheduling (sampler)", times.scheduling),
+        ("simulation (workcell)", times.simulation),
+    ] {
+        println!("  {name:<24} {:>9.2} s", d.as_secs_f64());
+    }
+    println!("  {:<24} {:>9.2} s", "wall time", wall.as_secs_f64());
+}
+
+/// Runs `cargo xtask study`.
+pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
+    let wall = Instant::now();
+    let root = workspace_root();
+    let config = config(args, &root)?;
+    if let Some(n) = args.threads {
+        if n == 0 {
+            bail!("--threads must be at least 1");
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("setting up the worker threads")?;
+    }
+    let fixtures = args
+        .fixtures
+        .clone()
+        .unwrap_or_else(|| root.join("fixtures/sanding"));
+    let inputs = StudyInputs::from_dir(&fixtures)
+        .with_context(|| format!("reading demonstrations from {}", fixtures.display()))?;
+    let out = args.out.clone().unwrap_or_else(|| root.join("results"));
+
+    let n_pairs = config.n_pairs();
+    let bar = ProgressBar::new((config.trials * n_pairs) as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {pos}/{len} pairs, {msg} (eta {eta})",
+        )
+        .context("progress bar template")?
+        .progress_chars("=> "),
+    );
+    let trials_done = AtomicUsize::new(0);
+    bar.set_message(format!("0/{} trials done", config.trials));
+    let (result, times) = tandem::study::run_study(&config, &inputs, &|p| {
+        bar.inc(1);
+        if p.pairs_done == n_pairs {
+            let done = trials_done.fetch_add(1, Ordering::Relaxed) + 1;
+            bar.set_message(format!("{done}/{} trials done", config.trials));
+        }
+    })?;
+    bar.finish();
+
+    let summary = result.summary();
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let file = StudyFile {
+        git_revision: git_revision(&root),
+        summary: summary.clone(),
+        result: &result,
+    };
+    let json = serde_json::to_string(&file)? + "\n";
+    let write = |name: &str, bytes: &[u8]| -> anyhow::Result<PathBuf> {
+        let path = out.join(name);
+        std::fs::write(&path, bytes).with_context(|| format!("writing {}", path.display()))?;
+        Ok(path)
+    };
+    write("study.json", json.as_bytes())?;
+    write("study.csv", result.to_csv().as_bytes())?;
+    draw_fig5(
+        &fig5_data(&result, &summary),
+        &out.join("fig5.svg"),
+        &out.join("fig5.png"),
+    )?;
+
+    let (first, last) = (&summary[0], &summary[summary.len() - 1]);
+    println!(
+        "{} trials × {} executions, {} samples per schedule, seed {}",
+        config.trials, config.executions, config.samples, config.seed
+    );
+    println!(
+        "T_total: {:.2} ± {:.2} s at iteration 0 → {:.2} ± {:.2} s at iteration {}",
+        first.t_total_mean_s,
+        first.t_total_std_s,
+        last.t_total_mean_s,
+        last.t_total_std_s,
+        last.iteration
+    );
+    println!(
+        "high confidence: {:.1} % → {:.1} % (ground truth {:.1} %)",
+        first.high_conf_pct_mean, last.high_conf_pct_mean, result.ground_truth_pct
+    );
+    println!(
+        "overlapping low-confidence ticks: {}",
+        result.total_overlap_ticks()
+    );
+    println!(
+        "wrote study.json, study.csv, fig5.svg, fig5.png in {}",
+        out.display()
+    );
+    print_times(&times, wall.elapsed());
+    if result.total_overlap_ticks() > 0 {
+        bail!("both robots were low-confidence in the same tick: the schedule is unsafe");
+    }
+    Ok(())
+}
