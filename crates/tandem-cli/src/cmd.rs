@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use serde_json::json;
 use tandem::lfd::{Demonstration, Execution, TaskModel};
-use tandem::schedule::{SamplerParams, sample_schedule};
+use tandem::schedule::SamplerParams;
 use tandem::{ExecutionRecord, Planner, PlannerParams, derive_seed};
 
 use crate::cli::{
@@ -145,7 +145,7 @@ fn summary_lines(planner: &Planner) {
 const SCHEDULE_STREAM: u64 = 1 << 32;
 
 fn schedule(a: &ScheduleArgs) -> Result<()> {
-    let planner = state_io::load(&a.state)?;
+    let mut planner = state_io::load(&a.state)?;
     let mut sp = planner.params().sampler.clone();
     if a.sampler.seed.is_none() {
         // `fit` and `record` used stream `pairs_recorded` of the master seed for the saved
@@ -154,21 +154,24 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
         sp.seed = derive_seed(sp.seed, SCHEDULE_STREAM + planner.pairs_recorded() as u64);
     }
     let sp = apply_sampler(sp, &a.sampler)?;
-    let outcome = sample_schedule(planner.problem(), &sp, Some(planner.schedule()))
-        .context("cannot schedule")?;
+    let previous_t_total_s = planner.outcome().t_total_s;
+    planner.reschedule(&sp).context("cannot schedule")?;
     if a.save {
-        state_io::save_outcome(&a.state, &outcome)?;
+        // Atomic: on error the previous state file is intact.
+        planner
+            .save(&a.state)
+            .with_context(|| format!("cannot save the schedule into {}", a.state.display()))?;
     }
     if a.json {
-        let mut doc = schedule_json(planner.problem(), &outcome)?;
+        let mut doc = schedule_json(planner.problem(), planner.outcome())?;
         doc["saved"] = json!(a.save);
-        doc["previous_t_total_s"] = json!(planner.outcome().t_total_s);
+        doc["previous_t_total_s"] = json!(previous_t_total_s);
         out(&serde_json::to_string_pretty(&doc)?);
     } else {
-        out(&gantt_text(planner.problem(), &outcome)?);
+        out(&gantt_text(planner.problem(), planner.outcome())?);
         out(&format!(
             "saved schedule: T_total {:.2} s; {}",
-            planner.outcome().t_total_s,
+            previous_t_total_s,
             if a.save {
                 format!("replaced by this one in {}", a.state.display())
             } else {

@@ -4,11 +4,7 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use serde::{Deserialize, Serialize};
-use tandem::confidence::{Confidence, Observations};
-use tandem::lfd::TaskModel;
-use tandem::schedule::Outcome;
-use tandem::{Planner, PlannerParams};
+use tandem::Planner;
 
 /// Loads a planner, naming the file in every error.
 pub(crate) fn load(path: &Path) -> Result<Planner> {
@@ -67,45 +63,4 @@ pub(crate) fn parent_dir(path: &Path) -> PathBuf {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     }
-}
-
-/// Field-for-field copy of the facade's private `PlannerState` (planner.rs): the facade has
-/// no method to replace a planner's schedule, so `tandem schedule --save` decodes the state
-/// file into this, swaps the outcome and encodes it again. The copy is verified by loading
-/// the result with `Planner::load` before it replaces the state file.
-#[derive(Serialize, Deserialize)]
-struct PlannerStateCopy {
-    params: PlannerParams,
-    model: TaskModel,
-    observations: Observations,
-    confidence: Confidence,
-    outcome: Outcome,
-    pairs_recorded: usize,
-}
-
-/// Replaces the schedule saved in `path` by `outcome`, atomically: the new file is written
-/// next to it, loaded back and checked, then renamed over `path`.
-pub(crate) fn save_outcome(path: &Path, outcome: &Outcome) -> Result<()> {
-    let shown = path.display();
-    let mut st: PlannerStateCopy =
-        tandem::state::load(path).with_context(|| format!("cannot load state file {shown}"))?;
-    st.outcome = outcome.clone();
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(path.file_name().unwrap_or_default());
-    tmp_name.push(".schedule.tmp");
-    let tmp = parent_dir(path).join(tmp_name);
-    let result = (|| -> Result<()> {
-        tandem::state::save(&tmp, &st)?;
-        let back = Planner::load(&tmp)?;
-        if back.schedule() != &outcome.schedule || back.pairs_recorded() != st.pairs_recorded {
-            bail!("the re-encoded state does not read back the same (state layout changed?)");
-        }
-        std::fs::rename(&tmp, path)?;
-        File::open(parent_dir(path))?.sync_all()?;
-        Ok(())
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.with_context(|| format!("cannot save the schedule into {shown}"))
 }

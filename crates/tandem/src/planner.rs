@@ -252,6 +252,27 @@ impl Planner {
         Ok(report)
     }
 
+    /// Re-runs the anytime sampler (§II-C) on the current problem with `sampler`, warm-started
+    /// by the current schedule, and replaces the stored outcome by the result. Model,
+    /// observations, confidence, parameters and [`Planner::pairs_recorded`] are unchanged
+    /// (`sampler` is used for this call only and not stored in [`Planner::params`]).
+    ///
+    /// The current schedule is the sampler's incumbent, so `T_total` (Eq. 13, s) never
+    /// increases as long as the current schedule is valid at `sampler.tick_s`: always so
+    /// when `tick_s` is the one the current schedule was made with. Otherwise the sampler
+    /// repairs it or falls back to the fastest serial schedule, as in
+    /// [`Planner::record_pair`].
+    ///
+    /// On error the planner is as before.
+    ///
+    /// # Errors
+    /// The schedule crate's error for invalid `sampler` parameters or an infeasible problem.
+    pub fn reschedule(&mut self, sampler: &SamplerParams) -> Result<&Outcome> {
+        let outcome = sample_schedule(&self.problem, sampler, Some(&self.outcome.schedule))?;
+        self.outcome = outcome;
+        Ok(&self.outcome)
+    }
+
     /// The current schedule.
     pub fn schedule(&self) -> &Schedule {
         &self.outcome.schedule
@@ -436,6 +457,36 @@ mod tests {
             ),
             "{err}"
         );
+    }
+
+    #[test]
+    fn reschedule_never_increases_t_total_and_stays_valid() {
+        let mut p = small_planner(3);
+        let (conf, pairs) = (p.confidence().conf().to_vec(), p.pairs_recorded());
+        let mut t_prev = p.outcome().t_total_s;
+        for seed in 10..14 {
+            let sp = SamplerParams {
+                samples: 20,
+                seed,
+                ..p.params().sampler.clone()
+            };
+            let t = p.reschedule(&sp).unwrap().t_total_s;
+            assert!(t <= t_prev, "seed {seed}: {t} > {t_prev}");
+            assert_eq!(t, p.schedule().t_total_s(p.problem().dt_s()));
+            crate::schedule::validate(p.problem(), p.schedule()).unwrap();
+            t_prev = t;
+        }
+        // Only the outcome changes.
+        assert_eq!(p.confidence().conf(), &conf[..]);
+        assert_eq!(p.pairs_recorded(), pairs);
+        // Bad sampler parameters leave the planner as it was.
+        let before = p.outcome().clone();
+        let bad = SamplerParams {
+            samples: 0,
+            ..SamplerParams::default()
+        };
+        assert!(p.reschedule(&bad).is_err());
+        assert_eq!(p.outcome(), &before);
     }
 
     #[test]
