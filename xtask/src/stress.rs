@@ -2,7 +2,7 @@
 //!
 //! Samples random problems of a few hundred reference samples, schedules each with the anytime
 //! sampler of `tandem-schedule`, then runs `N` executions in all through
-//! `tandem_realtime::Coordinator` under adversarial operator gradient sequences (always
+//! `tandem::realtime::Coordinator` under adversarial operator gradient sequences (always
 //! fastest, always slowest, switching every tick, switching at random times, random every
 //! tick, random values held for random times), in parallel, and counts ticks in which both
 //! robots were low-confidence (expected: 0). Every number depends only on `N` and the seed.
@@ -14,8 +14,8 @@ use anyhow::{Context, bail};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use tandem_realtime::{Coordinator, Timeline};
-use tandem_schedule::{Problem, SamplerParams, Schedule, Source, sample_schedule};
+use tandem::realtime::{Coordinator, Timeline};
+use tandem::schedule::{Problem, SamplerParams, Schedule, Source, sample_schedule};
 
 /// Executions per scheduled problem (the number of problems is `N / this`, at least 1 and at
 /// most [`MAX_PROBLEMS`]).
