@@ -4,9 +4,10 @@
 //!
 //! 1. Each robot's workpiece draws, per need region `r`, whether the region needs the
 //!    operator (probability `need[r]`, one draw per region and workpiece).
-//! 2. Both robots run the state's current schedule through the real-time coordinator
-//!    (`tandem::realtime::Coordinator`, Eq. 17–18, Alg. 1), one control tick per reference
-//!    sample period, exactly as on the robots.
+//! 2. Both robots run the state's current schedule with the study's simulated operator,
+//!    `tandem::sim::workcell::run_pair_with` (the real-time coordinator, Eq. 17–18, Alg. 1,
+//!    one control tick per reference sample period, exactly as on the robots), told by
+//!    step 1 which reference samples of which robot need the operator.
 //! 3. The robot on a low-confidence sample is *supervised*. The operator corrects it where
 //!    its workpiece needs it (missing a needed correction with `--miss-rate`) and, where it
 //!    does not, with `--false-rate`. A correction is the joystick input `u_k = ±gain` along
@@ -26,10 +27,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tandem::lfd::{Demonstration, Execution, TaskModel};
-use tandem::realtime::{Coordinator, Timeline};
-use tandem::schedule::{Problem, Schedule};
-use tandem::{ExecutionRecord, derive_seed};
+use tandem::lfd::{Demonstration, Execution};
+use tandem::sim::workcell::{OperatorParams, PairRun, RobotRun, run_pair_with};
+use tandem::{ExecutionRecord, Planner, derive_seed};
 
 use crate::cli::SimulateArgs;
 use crate::cmd::out;
@@ -39,150 +39,27 @@ use crate::{input, state_io};
 /// the command about one standard deviation towards what the demonstrations did.
 const GAIN: f64 = 1.0 / 3.0;
 
-/// The simulated operator.
-struct Operator {
-    miss_rate: f64,
-    false_rate: f64,
-    /// Tangent index of the channel a correction raises.
-    target: usize,
-}
-
-/// One robot's run as the system records it.
-#[derive(Default)]
-struct RobotLog {
-    samples: Vec<f64>,
-    ref_time_log: Vec<f64>,
-    supervised: Vec<bool>,
-    corrected: Vec<bool>,
-}
-
-/// A simulated pair.
-struct PairLog {
-    robots: [RobotLog; 2],
-    ticks: usize,
-    overlap_ticks: usize,
-}
-
-/// The input `u` of a correction that raises coordinate `target` and does not speed the
-/// robot up; `false` when no component moves the target.
-fn correction_input(
-    model: &TaskModel,
-    target: usize,
-    ref_time: f64,
-    u: &mut [f64],
-) -> Result<bool> {
-    let corr = model.corrections_at(ref_time)?;
-    let rate = model.tangent_names().len() - 1;
-    let mut rate_change = 0.0;
-    for (k, c) in corr.components.iter().enumerate() {
-        u[k] = GAIN * c[target].signum() * f64::from(u8::from(c[target] != 0.0));
-        rate_change += u[k] * c[rate];
-    }
-    if rate_change < 0.0 {
-        for (k, c) in corr.components.iter().enumerate() {
-            if u[k] * c[rate] < 0.0 {
-                u[k] = 0.0;
-            }
-        }
-    }
-    Ok(u.iter().any(|&x| x != 0.0))
-}
-
 /// Runs one pair (see the module docs). `needed[i][n]`: robot `i`'s workpiece needs the
 /// operator at reference sample `n`.
 fn run_pair(
-    model: &TaskModel,
-    problem: &Problem,
-    schedule: &Schedule,
+    planner: &Planner,
     needed: &[Vec<bool>; 2],
-    op: &Operator,
+    op: &OperatorParams,
     rng: &mut impl Rng,
-) -> Result<PairLog> {
-    let dt = problem.dt_s();
-    let n_ref = problem.n_ref();
-    let starts = schedule.starts_s();
-    let timeline = |i: usize| {
-        Timeline::new(
-            problem.conf(),
-            &schedule.grad_exec[i],
-            problem.grad_min(),
-            problem.grad_max(),
-            starts[i],
-            dt,
-        )
-    };
-    let mut coord = Coordinator::new([timeline(0)?, timeline(1)?], dt)?;
-    let m = model.channel_names().len();
-    let k = model.n_components();
-    let (u_zero, mut u) = (vec![0.0; k], vec![0.0; k]);
-    let mut cmd = vec![0.0; m + 1];
-    let mut robots = [RobotLog::default(), RobotLog::default()];
-    let (mut ticks, mut overlap_ticks) = (0, 0);
-    // The slowest admissible run takes ψ̇max/ψ̇min times the scheduled one; anything beyond
-    // twice that is a bug, not a user error.
-    let ratio = problem
-        .grad_max()
-        .iter()
-        .zip(problem.grad_min())
-        .map(|(hi, lo)| hi / lo)
-        .fold(1.0, f64::max);
-    let end = coord
-        .robots()
-        .iter()
-        .map(Timeline::end_s)
-        .fold(0.0, f64::max);
-    let budget = (end / dt * ratio * 2.0) as usize + 1000;
-    let last_ref = (n_ref - 1) as f64;
-    while !coord.is_finished() {
-        if ticks >= budget {
-            bail!("the simulated pair did not finish within {budget} control ticks");
-        }
-        let clocks = coord.clock_s();
-        let mut operator_gradient = f64::NAN;
-        for (i, log) in robots.iter_mut().enumerate() {
-            let tl = &coord.robots()[i];
-            if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() {
-                continue;
-            }
-            let n = tl.sample_at(clocks[i]);
-            let ref_time = tl.ref_time_at(clocks[i]).min(last_ref);
-            let supervised = !problem.conf()[n];
-            let corrected = supervised && {
-                let draw: f64 = rng.random();
-                if needed[i][(ref_time.round() as usize).min(n_ref - 1)] {
-                    draw >= op.miss_rate
-                } else {
-                    draw < op.false_rate
-                }
-            };
-            let input = if corrected && correction_input(model, op.target, ref_time, &mut u)? {
-                &u
-            } else {
-                &u_zero
-            };
-            model.command_into(input, ref_time, &mut cmd)?;
-            if corrected {
-                operator_gradient = cmd[m].clamp(problem.grad_min()[n], problem.grad_max()[n]);
-            }
-            log.samples.extend_from_slice(&cmd[..m]);
-            log.ref_time_log.push(ref_time);
-            log.supervised.push(supervised);
-            log.corrected.push(corrected);
-        }
-        let tick = coord.tick(operator_gradient);
-        ticks += 1;
-        overlap_ticks += usize::from(tick.low_conf == [true, true]);
-    }
-    Ok(PairLog {
-        robots,
-        ticks,
-        overlap_ticks,
-    })
+) -> Result<PairRun> {
+    Ok(run_pair_with(
+        planner.model(),
+        planner.problem(),
+        planner.schedule(),
+        |robot, n| needed[robot][n],
+        op,
+        rng,
+    )?)
 }
 
 /// The three files of one execution, as `tandem record` reads them (numbers printed in
 /// shortest round-trip form, so reading them back gives the same bits).
-fn execution_files(log: &RobotLog, channels: &[String]) -> [String; 3] {
+fn execution_files(log: &RobotRun, channels: &[String]) -> [String; 3] {
     let m = channels.len();
     let mut exec = channels.join(",");
     exec.push('\n');
@@ -214,25 +91,21 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
     }
     let mut planner = state_io::load(&a.state)?;
     let need = input::read_need(&a.need, planner.model().n_ref())?;
-    let target = planner
-        .model()
-        .tangent_names()
-        .iter()
-        .position(|n| *n == a.channel)
-        .with_context(|| {
-            format!(
-                "--channel {}: the model has no such channel (channels: {})",
-                a.channel,
-                planner.model().channel_names().join(", ")
-            )
-        })?;
+    if !planner.model().tangent_names().contains(&a.channel) {
+        bail!(
+            "--channel {}: the model has no such channel (channels: {})",
+            a.channel,
+            planner.model().channel_names().join(", ")
+        );
+    }
     if let Some(dir) = &a.write {
         state_io::prepare_dir(dir)?;
     }
-    let op = Operator {
+    let op = OperatorParams {
         miss_rate: a.miss_rate,
-        false_rate: a.false_rate,
-        target,
+        false_correction_rate: a.false_rate,
+        force_channel: a.channel.clone(),
+        gain: GAIN,
     };
     let n_regions = need.region.iter().copied().max().unwrap_or(0) + 1;
     let mut region_p = vec![0.0; n_regions];
@@ -250,15 +123,8 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
             need.region.iter().map(|&r| hit[r]).collect()
         });
         let t_ran = planner.outcome().t_total_s;
-        let pair = run_pair(
-            planner.model(),
-            planner.problem(),
-            planner.schedule(),
-            &needed,
-            &op,
-            &mut rng,
-        )
-        .with_context(|| format!("simulating pair {}", k + 1))?;
+        let pair = run_pair(&planner, &needed, &op, &mut rng)
+            .with_context(|| format!("simulating pair {}", k + 1))?;
         let channels = planner.model().channel_names().to_vec();
         let dt = planner.model().dt_s();
         let mut records = Vec::with_capacity(2);
@@ -336,9 +202,9 @@ fn write_file(p: &Path, text: &str) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tandem::lfd::FitParams;
+    use tandem::PlannerParams;
+    use tandem::lfd::{FitParams, TaskModel};
     use tandem::schedule::SamplerParams;
-    use tandem::{Planner, PlannerParams};
 
     /// Three one-channel demonstrations aligned by known warps: demos 0 and 2 press 1 N
     /// everywhere; demo 1 presses 9 N over reference samples 10..20 and takes two samples per
@@ -367,19 +233,6 @@ mod tests {
     }
 
     #[test]
-    fn a_correction_presses_harder_and_does_not_speed_up() {
-        let model = model();
-        let mut u = vec![0.0; model.n_components()];
-        assert!(correction_input(&model, 0, 15.0, &mut u).unwrap());
-        let cmd = model.command(&u, 15.0).unwrap();
-        let mean = model.command(&vec![0.0; u.len()], 15.0).unwrap();
-        assert!(cmd[0] > mean[0], "force {} vs mean {}", cmd[0], mean[0]);
-        assert!(cmd[1] >= mean[1], "rate {} vs mean {}", cmd[1], mean[1]);
-        // Where the demonstrations agree there is nothing to correct along.
-        assert!(!correction_input(&model, 0, 30.0, &mut u).unwrap());
-    }
-
-    #[test]
     fn a_perfect_operator_corrects_exactly_the_supervised_needed_samples() {
         let params = PlannerParams {
             sampler: SamplerParams {
@@ -389,22 +242,15 @@ mod tests {
             ..PlannerParams::default()
         };
         let planner = Planner::from_model(model(), params).unwrap();
-        let op = Operator {
+        let op = OperatorParams {
             miss_rate: 0.0,
-            false_rate: 0.0,
-            target: 0,
+            false_correction_rate: 0.0,
+            force_channel: "force".into(),
+            gain: GAIN,
         };
         let needed = [vec![true; 40], vec![false; 40]];
         let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let pair = run_pair(
-            planner.model(),
-            planner.problem(),
-            planner.schedule(),
-            &needed,
-            &op,
-            &mut rng,
-        )
-        .unwrap();
+        let pair = run_pair(&planner, &needed, &op, &mut rng).unwrap();
         assert_eq!(pair.overlap_ticks, 0);
         let [r1, r2] = &pair.robots;
         assert!(

@@ -10,9 +10,11 @@
 //!    `s_i` gives its reference sample `n_i` and fractional reference time `t_i` (Eq. 15).
 //!    A robot whose sample `n_i` is low-confidence is *supervised* this tick; that is the
 //!    robot the coordinator will move at the operator's rate.
-//! 2. The operator decides for the supervised robot whether to correct: the sample *needs*
-//!    a correction when, on that robot's own workpiece, the reference demonstration's label
-//!    at `round(t_i)` is sanding in pass 1–3 over a painted section. A needed correction is
+//! 2. The operator decides for the supervised robot whether to correct. Whether the sample
+//!    *needs* a correction is the caller's `needs(i, round(t_i))` in [`run_pair_with`]; on
+//!    the sanding task ([`run_pair`]) it does when, on that robot's own workpiece, the
+//!    reference demonstration's label at `round(t_i)` is sanding in pass 1–3 over a painted
+//!    section. A needed correction is
 //!    given with probability `1 − miss_rate`, an unneeded one with `false_correction_rate`
 //!    (§III: 1 % each).
 //! 3. A correction is a joystick input `u` along the model's correction components
@@ -258,8 +260,10 @@ fn correction_input(
     Ok(any)
 }
 
-/// Runs both robots of `schedule` to the end with a simulated operator (see the module
-/// docs). `problem` must be the one `schedule` was made for, from `model`'s gradients;
+/// Runs both robots of `schedule` to the end with a simulated operator on the sanding task
+/// (see the module docs): [`run_pair_with`] where a sample needs a correction when
+/// [`needs_correction`] says so for the reference label at the sample and the robot's own
+/// workpiece. `problem` must be the one `schedule` was made for, from `model`'s gradients;
 /// `labels` are the reference demonstration's labels (one per reference sample);
 /// `workpieces[i]` is robot `i`'s workpiece. Deterministic for the state of `rng`.
 ///
@@ -276,14 +280,36 @@ pub fn run_pair(
     rng: &mut impl Rng,
 ) -> Result<PairRun> {
     params.validate()?;
+    check_sizes(model, problem, schedule, Some(labels.len()))?;
+    run_pair_with(
+        model,
+        problem,
+        schedule,
+        |robot, ref_idx| needs_correction(&labels[ref_idx], &workpieces[robot]),
+        params,
+        rng,
+    )
+}
+
+/// Checks that the model, the labels (if any) and both robots' gradients have one entry per
+/// reference sample of `problem`, in that order.
+fn check_sizes(
+    model: &TaskModel,
+    problem: &Problem,
+    schedule: &Schedule,
+    labels: Option<usize>,
+) -> Result<()> {
     let n_ref = problem.n_ref();
-    for (what, found) in [
-        ("model reference samples", model.n_ref()),
-        ("reference labels", labels.len()),
-        ("robot 1 gradients", schedule.grad_exec[0].len()),
-        ("robot 2 gradients", schedule.grad_exec[1].len()),
-    ] {
-        if found != n_ref {
+    let sizes = [
+        ("model reference samples", Some(model.n_ref())),
+        ("reference labels", labels),
+        ("robot 1 gradients", Some(schedule.grad_exec[0].len())),
+        ("robot 2 gradients", Some(schedule.grad_exec[1].len())),
+    ];
+    for (what, found) in sizes {
+        if let Some(found) = found
+            && found != n_ref
+        {
             return Err(WorkcellError::Mismatch {
                 what,
                 expected: n_ref,
@@ -291,6 +317,31 @@ pub fn run_pair(
             });
         }
     }
+    Ok(())
+}
+
+/// Runs both robots of `schedule` to the end with a simulated operator (see the module
+/// docs), the caller deciding which samples need a correction: `needs(robot, ref_idx)`
+/// says whether robot `robot` (0 or 1) needs the operator at reference sample `ref_idx`
+/// (`round(t_i)`, in `0..n_ref`). It is asked once per supervised sample, just before the
+/// operator's draw from `rng`; samples of high confidence are never asked about.
+/// `problem` must be the one `schedule` was made for, from `model`'s gradients.
+/// Deterministic for the state of `rng` (and a deterministic `needs`).
+///
+/// # Errors
+/// Invalid parameters, mismatched sizes, a model without the force channel, or the lower
+/// crates' errors for an invalid schedule.
+pub fn run_pair_with(
+    model: &TaskModel,
+    problem: &Problem,
+    schedule: &Schedule,
+    mut needs: impl FnMut(usize, usize) -> bool,
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<PairRun> {
+    params.validate()?;
+    check_sizes(model, problem, schedule, None)?;
+    let n_ref = problem.n_ref();
     let force_idx = model
         .tangent_names()
         .iter()
@@ -360,7 +411,7 @@ pub fn run_pair(
             let mut corrected = false;
             if supervised {
                 let label_idx = (ref_time.round() as usize).min(n_ref - 1);
-                let needed = needs_correction(&labels[label_idx], &workpieces[i]);
+                let needed = needs(i, label_idx);
                 let draw: f64 = rng.random();
                 let run = &mut runs[i];
                 if needed {
@@ -598,6 +649,64 @@ mod tests {
             (run.duration_s() - planned_s).abs() <= 2.0 * run.tick_s,
             "{} vs {planned_s}",
             run.duration_s()
+        );
+    }
+
+    #[test]
+    fn run_pair_with_asks_the_caller_only_about_supervised_samples() {
+        let model = model();
+        let problem = problem(&model);
+        let schedule = problem.serial_schedule();
+        let p = OperatorParams::default();
+        // The labels' closure gives exactly run_pair's run.
+        let (labels, wp) = (painted_labels(), [all_painted(), all_painted()]);
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let same = run_pair_with(
+            &model,
+            &problem,
+            &schedule,
+            |i, n| needs_correction(&labels[n], &wp[i]),
+            &p,
+            &mut rng,
+        )
+        .unwrap();
+        assert_eq!(same, run(&p, 7).0);
+        // Only robot 1 needs the operator; a perfect operator corrects exactly its
+        // supervised samples, and is asked about nothing but low-confidence samples.
+        let perfect = OperatorParams {
+            miss_rate: 0.0,
+            false_correction_rate: 0.0,
+            ..OperatorParams::default()
+        };
+        let mut asked = Vec::new();
+        let run = run_pair_with(
+            &model,
+            &problem,
+            &schedule,
+            |i, n| {
+                asked.push((i, n));
+                i == 0
+            },
+            &perfect,
+            &mut rng,
+        )
+        .unwrap();
+        let [r1, r2] = &run.robots;
+        assert!(r1.supervised.iter().any(|s| *s));
+        assert_eq!(r1.corrected, r1.supervised);
+        assert!(r2.supervised.iter().any(|s| *s));
+        assert!(r2.corrected.iter().all(|c| !c));
+        assert_eq!(r1.needed, r1.supervised.iter().filter(|s| **s).count());
+        assert_eq!(r2.needed, 0);
+        let supervised: usize = run
+            .robots
+            .iter()
+            .map(|r| r.supervised.iter().filter(|s| **s).count())
+            .sum();
+        assert_eq!(asked.len(), supervised);
+        assert!(
+            asked.iter().all(|&(_, n)| (10..=20).contains(&n)),
+            "{asked:?}"
         );
     }
 
