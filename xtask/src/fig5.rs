@@ -488,22 +488,12 @@ fn draw_task_length_panel<DB: DrawingBackend>(
         .map_err(draw_err("top panel mesh"))?;
 
     let xs: Vec<f64> = data.iterations.iter().map(|&i| i as f64).collect();
-    let band_hi = data
-        .t_total_mean_s
-        .iter()
-        .zip(&data.t_total_std_s)
-        .map(|(m, s)| m + s);
-    let band_lo = data
-        .t_total_mean_s
-        .iter()
-        .zip(&data.t_total_std_s)
-        .map(|(m, s)| (m - s).max(0.0));
-    let band: Vec<(f64, f64)> = xs
-        .iter()
-        .copied()
-        .zip(band_hi)
-        .chain(xs.iter().copied().zip(band_lo).rev())
-        .collect();
+    let band = std_band(
+        &xs,
+        &data.t_total_mean_s,
+        &data.t_total_std_s,
+        f64::INFINITY,
+    );
     chart
         .draw_series(std::iter::once(Polygon::new(
             band,
@@ -620,22 +610,12 @@ fn draw_high_conf_panel<DB: DrawingBackend>(
 
     let xs: Vec<f64> = data.iterations.iter().map(|&i| i as f64).collect();
     if data.high_conf_pct_std.iter().any(|&s| s > 0.0) {
-        let hi = data
-            .high_conf_pct_mean
-            .iter()
-            .zip(&data.high_conf_pct_std)
-            .map(|(m, s)| (m + s).min(100.0));
-        let lo = data
-            .high_conf_pct_mean
-            .iter()
-            .zip(&data.high_conf_pct_std)
-            .map(|(m, s)| (m - s).max(0.0));
-        let band: Vec<(f64, f64)> = xs
-            .iter()
-            .copied()
-            .zip(hi)
-            .chain(xs.iter().copied().zip(lo).rev())
-            .collect();
+        let band = std_band(
+            &xs,
+            &data.high_conf_pct_mean,
+            &data.high_conf_pct_std,
+            100.0,
+        );
         chart
             .draw_series(std::iter::once(Polygon::new(
                 band,
@@ -765,15 +745,16 @@ fn demo_high_conf_pct(lc: &[(f64, f64)]) -> f64 {
     100.0 * (1.0 - lc_s / DEMO_EXEC_S)
 }
 
-/// Sample mean and sample standard deviation (n − 1 denominator) of `v` (non-empty).
-fn mean_std(v: &[f64]) -> (f64, f64) {
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    if v.len() < 2 {
-        return (mean, 0.0);
-    }
-    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, var.sqrt())
+/// The closed polygon of a ±1 std band: `mean + std` (capped at `cap`) along `xs`, then
+/// `mean − std` (floored at 0) back.
+fn std_band(xs: &[f64], mean: &[f64], std: &[f64], cap: f64) -> Vec<(f64, f64)> {
+    let hi = mean.iter().zip(std).map(|(m, s)| (m + s).min(cap));
+    let lo = mean.iter().zip(std).map(|(m, s)| (m - s).max(0.0));
+    xs.iter()
+        .copied()
+        .zip(hi)
+        .chain(xs.iter().copied().zip(lo).rev())
+        .collect()
 }
 
 /// A synthetic, deterministic dataset shaped like the paper's study (two robots, one
@@ -799,8 +780,8 @@ pub(crate) fn demo_data() -> Fig5Data {
                 (DEMO_EXEC_S + demo_offset_s(&lc), demo_high_conf_pct(&lc))
             })
             .unzip();
-        let (t_mean, t_std) = mean_std(&t_totals);
-        let (p_mean, p_std) = mean_std(&pcts);
+        let (t_mean, t_std) = tandem::study::mean_std(t_totals.iter().copied());
+        let (p_mean, p_std) = tandem::study::mean_std(pcts.iter().copied());
         fig.t_total_mean_s.push(t_mean);
         fig.t_total_std_s.push(t_std);
         fig.high_conf_pct_mean.push(p_mean);

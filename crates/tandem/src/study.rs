@@ -610,8 +610,8 @@ pub fn run_trials(
     ))
 }
 
-/// Mean and sample standard deviation (0 for fewer than two values).
-fn mean_std(values: impl Iterator<Item = f64>) -> (f64, f64) {
+/// Mean and sample standard deviation (n − 1 denominator; 0 for one value, NaN for none).
+pub fn mean_std(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let v: Vec<f64> = values.collect();
     if v.is_empty() {
         return (f64::NAN, f64::NAN);
