@@ -35,6 +35,15 @@ pub struct Demonstration {
     dt_s: f64,
 }
 
+/// The text of `path` and the name errors use for it.
+fn read_text(path: &Path) -> Result<(String, String)> {
+    let file = path.display().to_string();
+    match std::fs::read_to_string(path) {
+        Ok(text) => Ok((text, file)),
+        Err(source) => Err(Error::Io { file, source }),
+    }
+}
+
 impl Demonstration {
     /// Builds a demonstration from channel names, sample-major samples and the sample
     /// period `dt_s` (seconds). The source label (used in error messages) is `<memory>`.
@@ -181,12 +190,7 @@ impl Demonstration {
 
     /// Reads a CSV file: see [`Demonstration::from_csv_str`].
     pub fn from_csv_path(path: impl AsRef<Path>, dt_s: Option<f64>) -> Result<Self> {
-        let path = path.as_ref();
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            file: file.clone(),
-            source,
-        })?;
+        let (text, file) = read_text(path.as_ref())?;
         Self::from_csv_str(&text, &file, dt_s)
     }
 
@@ -294,12 +298,7 @@ impl Demonstration {
 
     /// Reads a JSON file: see [`Demonstration::from_json_str`].
     pub fn from_json_path(path: impl AsRef<Path>, dt_s: Option<f64>) -> Result<Self> {
-        let path = path.as_ref();
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            file: file.clone(),
-            source,
-        })?;
+        let (text, file) = read_text(path.as_ref())?;
         Self::from_json_str(&text, &file, dt_s)
     }
 
