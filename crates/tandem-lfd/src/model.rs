@@ -374,6 +374,14 @@ fn bracket(t: f64, n: usize) -> (usize, usize, f64) {
     (lo, hi, t - lo as f64)
 }
 
+/// Execution samples per reference sample over the first step `[a, b]` of `steps` (pairs
+/// of consecutive reference-time log entries) that moves; 1 if none does.
+fn pace<'a>(mut steps: impl Iterator<Item = &'a [f64]>) -> f64 {
+    steps
+        .find(|w| w[1] > w[0])
+        .map_or(1.0, |w| 1.0 / (w[1] - w[0]))
+}
+
 /// Reference samples per parallel work item in per-sample loops (results do not depend
 /// on the split).
 const PAR_MIN_LEN: usize = 512;
@@ -845,8 +853,13 @@ impl TaskModel {
 
     /// The warp (reference → execution samples) of an execution: the inverse of its
     /// reference-time log, `ψ_E(n) = min{q : log(q) ≥ n}` with linear interpolation of the
-    /// log between samples; reference samples before the log's first entry map to 0 and
-    /// after its last entry to `T_E − 1`. Validates the execution.
+    /// log between samples. Reference samples before the log's first entry or after its
+    /// last are extrapolated at the execution's first or last pace (execution samples per
+    /// reference sample, from the nearest pair of distinct log entries; 1 if there is
+    /// none), so the warp gradient stays that of the execution at both ends — an execution
+    /// ends once its last step passes `T_ref − 1`, so its log may stop a step short of it.
+    /// The warp may thus leave `[0, T_E − 1]` by less than a step at either end.
+    /// Validates the execution.
     pub fn execution_warp(&self, execution: &Execution) -> Result<Vec<f64>> {
         let demo = &execution.demonstration;
         let log = &execution.ref_time_log;
@@ -877,14 +890,17 @@ impl TaskModel {
             }
         }
         let t_e = log.len();
+        // Execution samples per reference sample over the first and last distinct steps.
+        let first_pace = pace(log.windows(2));
+        let last_pace = pace(log.windows(2).rev());
         let mut values = Vec::with_capacity(self.data.n_ref);
         let mut k = 0;
         for n in 0..self.data.n_ref {
             let nf = n as f64;
             let q = if nf <= log[0] {
-                0.0
+                -(log[0] - nf) * first_pace
             } else if nf > log[t_e - 1] {
-                (t_e - 1) as f64
+                (t_e - 1) as f64 + (nf - log[t_e - 1]) * last_pace
             } else {
                 while log[k + 1] < nf {
                     k += 1;
@@ -1398,12 +1414,21 @@ mod tests {
             ref_time_log: vec![0.0, 0.5, 1.0, 1.5, 2.0],
         };
         assert_eq!(m.execution_warp(&exec).unwrap(), [0.0, 2.0, 4.0]);
-        // A pause (flat log) maps to its first sample; a late start maps to 0.
+        // A pause (flat log) maps to its first sample; a late start is extrapolated at the
+        // first pace (2 samples per reference sample): 0.5 reference samples early → −1.
         let exec = Execution {
             demonstration: demo(&["force"], vec![0.0; 5]),
             ref_time_log: vec![0.5, 1.0, 1.0, 1.0, 2.0],
         };
-        assert_eq!(m.execution_warp(&exec).unwrap(), [0.0, 1.0, 4.0]);
+        assert_eq!(m.execution_warp(&exec).unwrap(), [-1.0, 1.0, 4.0]);
+        // A log that stops short of the last reference sample (its last step went past it)
+        // is extrapolated from its last sample (4) at the last moving pace (2 samples per
+        // reference sample): 4 + 0.5·2 = 5, so the gradient there is 3, not 0.
+        let exec = Execution {
+            demonstration: demo(&["force"], vec![0.0; 5]),
+            ref_time_log: vec![0.0, 0.5, 1.0, 1.5, 1.5],
+        };
+        assert_eq!(m.execution_warp(&exec).unwrap(), [0.0, 2.0, 5.0]);
     }
 
     #[test]
