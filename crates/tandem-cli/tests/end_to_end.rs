@@ -72,7 +72,7 @@ fn fixtures_fit_simulate_record_schedule() {
     let fitted = Planner::load(&state).unwrap();
     assert_eq!(fitted.params().sampler.samples, 200);
     let n_ref = fitted.model().n_ref();
-    assert_eq!(n_ref, 6936, "demo_0.csv has 6936 samples");
+    assert_eq!(n_ref, 9873, "demo_0.csv has 9873 samples");
 
     // Simulate two pairs: a what-if that leaves the state alone.
     let need = sanding_need(&dir);
