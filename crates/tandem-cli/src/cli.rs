@@ -235,9 +235,14 @@ pub(crate) struct SimulateArgs {
     /// Probability that the operator misses a needed correction, in [0, 1].
     #[arg(long, value_name = "P", default_value_t = 0.01)]
     pub(crate) miss_rate: f64,
-    /// Probability that the operator corrects a sample that needs none, in [0, 1].
+    /// Share of the supervised samples needing no correction that the operator corrects
+    /// anyway, in [0, 1).
     #[arg(long, value_name = "P", default_value_t = 0.01)]
     pub(crate) false_rate: f64,
+    /// Mean duration (s) of one unneeded correction episode (0: every control tick drawn
+    /// on its own).
+    #[arg(long, value_name = "S", default_value_t = 0.5)]
+    pub(crate) false_episode: f64,
     /// Channel whose increase a correction aims at.
     #[arg(long, value_name = "NAME", default_value = "force")]
     pub(crate) channel: String,

@@ -104,6 +104,7 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
     let op = OperatorParams {
         miss_rate: a.miss_rate,
         false_correction_rate: a.false_rate,
+        false_correction_s: a.false_episode,
         force_channel: a.channel.clone(),
         gain: GAIN,
     };
@@ -245,6 +246,7 @@ mod tests {
         let op = OperatorParams {
             miss_rate: 0.0,
             false_correction_rate: 0.0,
+            false_correction_s: 0.0,
             force_channel: "force".into(),
             gain: GAIN,
         };

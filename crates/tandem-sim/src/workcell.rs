@@ -15,8 +15,19 @@
 //!    the sanding task ([`run_pair`]) it does when, on that robot's own workpiece, the
 //!    reference demonstration's label at `round(t_i)` is sanding in pass 1–3 over a painted
 //!    section. A needed correction is
-//!    given with probability `1 − miss_rate`, an unneeded one with `false_correction_rate`
-//!    (§III: 1 % each).
+//!    given with probability `1 − miss_rate` (§III: 1 % misses). Unneeded corrections
+//!    cover `false_correction_rate` of the supervised time that needs none (§III: "1 % of
+//!    the time") in episodes of mean length `false_correction_s` (default 0.5 s): a person
+//!    who corrects by mistake holds the joystick for a moment, not for one 10 ms tick.
+//!    Why it matters for the study: drawn per tick, the 1 % leaves hundreds of isolated
+//!    one-sample low-confidence "islands" after 150 pairs (samples whose few observations
+//!    happened to include several false corrections); every island of one robot forbids
+//!    the other robot's low-confidence pass at that moment, so the schedule stays nearly
+//!    serial. Measured on the default study (5 × 300 executions): per-tick draws leave
+//!    81–102 low-confidence runs per schedule after 150 pairs and end at `T_total`
+//!    148.3 ± 0.7 s; 0.5 s episodes leave 3–6 runs and end at 114.8 ± 16.0 s (serial:
+//!    191.8 s). Episodes give each sample about the same 1 % chance per execution but make
+//!    the islands contiguous and far fewer (see docs/study.md).
 //! 3. A correction is a joystick input `u` along the model's correction components
 //!    (`TaskModel::corrections_at`), `u_k = ±gain` with the sign that raises the force; a
 //!    component whose rate part would speed the robot up is left out when the combined
@@ -92,8 +103,15 @@ pub type Result<T, E = WorkcellError> = std::result::Result<T, E>;
 pub struct OperatorParams {
     /// Probability of missing a needed correction, in `[0, 1]`. Default: 0.01 (§III).
     pub miss_rate: f64,
-    /// Probability of correcting a sample that needs none, in `[0, 1]`. Default: 0.01 (§III).
+    /// Share of the supervised samples that need no correction on which the operator
+    /// corrects anyway, in `[0, 1)`. Default: 0.01 (§III: "1 % of the time").
     pub false_correction_rate: f64,
+    /// Mean duration (s) of one unneeded correction: a person who corrects by mistake
+    /// holds the joystick for a while, so unneeded corrections come as episodes of
+    /// geometric length with this mean, started at the rate that makes them cover
+    /// `false_correction_rate` of the time. `0` (or anything up to one control tick) draws
+    /// every tick independently. Finite and `≥ 0`. Default: 0.5 s.
+    pub false_correction_s: f64,
     /// Channel whose increase a correction aims at. Default: `"force"` (the sanding
     /// task's normal force, N).
     pub force_channel: String,
@@ -109,6 +127,7 @@ impl Default for OperatorParams {
         Self {
             miss_rate: 0.01,
             false_correction_rate: 0.01,
+            false_correction_s: 0.5,
             force_channel: "force".into(),
             gain: 1.0 / 3.0,
         }
@@ -131,6 +150,18 @@ impl OperatorParams {
                     why: "must be a probability in [0, 1]",
                 });
             }
+        }
+        if !(0.0..1.0).contains(&self.false_correction_rate) {
+            return Err(WorkcellError::BadParam {
+                name: "false_correction_rate",
+                why: "must be in [0, 1)",
+            });
+        }
+        if !(self.false_correction_s.is_finite() && self.false_correction_s >= 0.0) {
+            return Err(WorkcellError::BadParam {
+                name: "false_correction_s",
+                why: "must be finite and ≥ 0",
+            });
         }
         if !(self.gain > 0.0 && self.gain <= 1.0) {
             return Err(WorkcellError::BadParam {
@@ -221,6 +252,40 @@ impl PairRun {
     #[must_use]
     pub fn duration_s(&self) -> f64 {
         self.ticks as f64 * self.tick_s
+    }
+}
+
+/// Unneeded corrections as episodes of geometric length with mean `l ≥ 1` ticks: outside
+/// one, a tick starts one with probability `p_start`; each tick of an episode is followed
+/// by another with probability `1 − 1/l`. Off runs last `(1 − p_start)/p_start` ticks on
+/// average, so episodes cover `l·p_start / (l·p_start + 1 − p_start)` of the time, which
+/// `p_start = rate / (l·(1 − rate) + rate)` makes equal to `rate`.
+#[derive(Clone, Copy, Debug)]
+struct Episodes {
+    p_start: f64,
+    p_end: f64,
+    /// `l > 1`: episodes last more than one tick (else every tick is drawn alone).
+    lasting: bool,
+}
+
+impl Episodes {
+    /// `rate` in `[0, 1)`, mean length `ticks` (values below 1 mean 1).
+    fn new(rate: f64, ticks: f64) -> Self {
+        let l = ticks.max(1.0);
+        Episodes {
+            p_start: rate / (l * (1.0 - rate) + rate),
+            p_end: 1.0 / l,
+            lasting: l > 1.0,
+        }
+    }
+
+    /// One supervised tick that needs no correction: `(corrected, in an episode after it)`
+    /// from the state before it, the tick's draw `draw ∈ [0, 1)` and, for the length of an
+    /// episode, one more draw from `rng`.
+    fn tick(&self, in_episode: bool, draw: f64, rng: &mut impl Rng) -> (bool, bool) {
+        let corrected = in_episode || draw < self.p_start;
+        let goes_on = corrected && self.lasting && rng.random::<f64>() >= self.p_end;
+        (corrected, goes_on)
     }
 }
 
@@ -393,6 +458,14 @@ pub fn run_pair_with(
         .fold(1.0, f64::max);
     let budget = ((max_end_s / tick_s) * max_ratio * 2.0) as usize + 1000;
     let last_ref = (n_ref - 1) as f64;
+    // Unneeded corrections as episodes of mean length `l` ticks: each tick of an episode
+    // ends it with probability 1/l; outside one, a new one starts with the probability that
+    // makes episodes cover `false_correction_rate` of the time (per tick when l = 1).
+    let episodes = Episodes::new(
+        params.false_correction_rate,
+        params.false_correction_s / tick_s,
+    );
+    let mut in_episode = [false; 2];
 
     while !coord.is_finished() {
         if ticks >= budget {
@@ -415,13 +488,16 @@ pub fn run_pair_with(
                 let draw: f64 = rng.random();
                 let run = &mut runs[i];
                 if needed {
+                    in_episode[i] = false;
                     run.needed += 1;
                     corrected = draw >= params.miss_rate;
                     run.missed += usize::from(!corrected);
                 } else {
-                    corrected = draw < params.false_correction_rate;
+                    (corrected, in_episode[i]) = episodes.tick(in_episode[i], draw, rng);
                     run.false_corrections += usize::from(corrected);
                 }
+            } else {
+                in_episode[i] = false;
             }
             let u = if corrected
                 && correction_input(model, force_idx, params.gain, ref_time, &mut u_corr)?
@@ -460,6 +536,34 @@ pub fn run_pair_with(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unneeded_corrections_cover_the_rate_in_episodes_of_the_mean_length() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for (rate, ticks) in [(0.01, 50.0), (0.01, 1.0), (0.2, 10.0)] {
+            let e = Episodes::new(rate, ticks);
+            let (mut state, mut on, mut starts) = (false, 0usize, 0usize);
+            let n = 2_000_000;
+            for _ in 0..n {
+                let before = state;
+                let draw: f64 = rng.random();
+                let (corrected, next) = e.tick(state, draw, &mut rng);
+                on += usize::from(corrected);
+                starts += usize::from(corrected && !before);
+                state = next;
+            }
+            let share = on as f64 / n as f64;
+            let mean_len = on as f64 / starts as f64;
+            assert!(
+                (share - rate).abs() < 0.1 * rate,
+                "{rate} {ticks}: share {share}"
+            );
+            assert!(
+                (mean_len - ticks).abs() < 0.1 * ticks,
+                "{rate} {ticks}: {mean_len}"
+            );
+        }
+    }
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
     use tandem_lfd::FitParams;

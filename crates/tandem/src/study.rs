@@ -39,6 +39,9 @@ pub struct StudyConfig {
     /// Probability that the operator corrects a sample that needs none (§III: 1 %).
     /// Default: 0.01.
     pub false_correction_rate: f64,
+    /// Mean duration (s) of one unneeded correction episode (see
+    /// `tandem_sim::workcell::OperatorParams::false_correction_s`). Default: 0.5 s.
+    pub false_correction_s: f64,
     /// Iterations whose schedules Fig. 5 draws as examples (trial 0). Default: 0, 25, 50, 100, 150.
     pub example_iterations: Vec<usize>,
     /// Model, confidence and sampler parameters. The sampler's `samples` and `seed` are
@@ -58,6 +61,7 @@ impl Default for StudyConfig {
             seed: 2023,
             miss_rate: 0.01,
             false_correction_rate: 0.01,
+            false_correction_s: 0.5,
             example_iterations: vec![0, 25, 50, 100, 150],
             planner: PlannerParams::default(),
             task: TaskParams::default(),
@@ -97,6 +101,12 @@ impl StudyConfig {
                 return bad(name, "must be a probability in [0, 1]");
             }
         }
+        if self.false_correction_rate >= 1.0 {
+            return bad("false_correction_rate", "must be below 1");
+        }
+        if !(self.false_correction_s.is_finite() && self.false_correction_s >= 0.0) {
+            return bad("false_correction_s", "must be finite and ≥ 0");
+        }
         self.planner.validate()?;
         self.task.validate()?;
         Ok(())
@@ -107,6 +117,7 @@ impl StudyConfig {
         OperatorParams {
             miss_rate: self.miss_rate,
             false_correction_rate: self.false_correction_rate,
+            false_correction_s: self.false_correction_s,
             ..OperatorParams::default()
         }
     }
