@@ -18,7 +18,7 @@ fn main() -> Result<(), tandem_schedule::Error> {
         "{label}: T_ref = {}, serial T_total = {serial:.2} s",
         problem.n_ref()
     );
-    use OffsetSampling::{Uniform, UniformFeasible};
+    use OffsetSampling::{Fitted, Uniform, UniformFeasible};
     let options = [
         (
             "per sample, τ uniform",
@@ -74,6 +74,24 @@ fn main() -> Result<(), tandem_schedule::Error> {
             0.25,
             UniformFeasible,
         ),
+        (
+            "per run, p0 .5, robot 2 fitted, w 0",
+            Distribution::PerRun { pieces: 1 },
+            0.5,
+            Fitted { widen_max: 0.0 },
+        ),
+        (
+            "per run, p0 .5, robot 2 fitted, w .1",
+            Distribution::PerRun { pieces: 1 },
+            0.5,
+            Fitted { widen_max: 0.1 },
+        ),
+        (
+            "per run, p0 .5, robot 2 fitted, w .3",
+            Distribution::PerRun { pieces: 1 },
+            0.5,
+            Fitted { widen_max: 0.3 },
+        ),
     ];
     let samples = 5000;
     println!(
@@ -109,7 +127,7 @@ fn main() -> Result<(), tandem_schedule::Error> {
             (lo.min(b), hi.max(b))
         });
         println!(
-            "{name:<30} {mean:6.2} ± {std:5.2} [{lo:6.2}, {hi:6.2}]  {:6.1}  {:7.2} µs",
+            "{name:<38} {mean:6.2} ± {std:5.2} [{lo:6.2}, {hi:6.2}]  {:6.1}  {:7.2} µs",
             feasible as f64 / n,
             total_time / (n * samples as f64) * 1e6
         );

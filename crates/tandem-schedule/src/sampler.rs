@@ -4,13 +4,18 @@
 //! # Sampling distribution
 //!
 //! Candidate `k` draws, from its own ChaCha8 stream `(seed, k)`:
-//! 1. for each robot, one *speed factor* `u ∈ [0, 1]` per piece of every maximal
-//!    high-confidence run (see [`Distribution`]); the piece's gradients are
-//!    `ψ̇_E[n] = ψ̇min[n] + u·(ψ̇max[n] − ψ̇min[n])`, and `u = 0` (fastest) with probability
-//!    [`SamplerParams::p_fastest`], else `u` is uniform;
-//! 2. `v` uniform in `[0, 1)`, giving `τ` at fraction `v` of the offsets in `[0, |ψ_E1|]`
-//!    (Eq. 20 constraint 2) that keep the two robots' low-confidence intervals apart
-//!    ([`OffsetSampling::UniformFeasible`]; or of all of them, [`OffsetSampling::Uniform`]).
+//! 1. for robot 1 (and, unless robot 2 is fitted, robot 2), one *speed factor* `u ∈ [0, 1]`
+//!    per piece of every maximal high-confidence run (see [`Distribution`]); the piece's
+//!    gradients are `ψ̇_E[n] = ψ̇min[n] + u·(ψ̇max[n] − ψ̇min[n])`, and `u = 0` (fastest) with
+//!    probability [`SamplerParams::p_fastest`], else `u` is uniform;
+//! 2. the offset `τ` as [`SamplerParams::offset`] says. The default,
+//!    [`OffsetSampling::Fitted`], draws only a widening `w` and *fits* `τ` and robot 2's
+//!    factors to robot 1's warp: an exact sweep over robot 2's pieces (see
+//!    `Sampler::fit_second`) finds the earliest finish of robot 2 whose low-confidence
+//!    intervals keep `w·length + 2 ticks` clear of robot 1's. The alternatives draw `v`
+//!    uniform in `[0, 1)` and put `τ` at fraction `v` of the offsets in `[0, |ψ_E1|]` (Eq. 20
+//!    constraint 2) that keep the two robots' low-confidence intervals apart
+//!    ([`OffsetSampling::UniformFeasible`]) or of all of them ([`OffsetSampling::Uniform`]).
 //!
 //! Low-confidence samples follow the mean gradient (constraint 4).
 //!
@@ -21,27 +26,49 @@
 //! — which decides overlap and `T_total` — depends only on the run durations. One factor per
 //! piece spreads each run's duration evenly over its whole admissible range, and lets a
 //! candidate's low-confidence intervals and `T_total` be computed in `O(#pieces)` from
-//! per-piece sums of `ψ̇min`, `ψ̇max` and `ψ̇̄`, without building the warp. The numbers that
-//! decided it (`cargo run --release -p tandem-schedule --example sampling_distributions`,
-//! synthetic fixture-like problem of 5700 samples, serial `T_total` 93.47 s, 5000 samples,
-//! best `T_total` as mean ± std over 20 seeds (4 for per-sample), 2 cores):
+//! per-piece sums of `ψ̇min`, `ψ̇max` and `ψ̇̄`, without building the warp.
 //!
-//! | distribution                              | best `T_total` (s) | time per sample |
-//! |-------------------------------------------|--------------------|-----------------|
-//! | per sample, `τ` uniform                   | 93.47 (= serial)   | 191 µs          |
-//! | per sample, `τ` uniform-feasible          | 93.47 (= serial)   | 232 µs          |
-//! | per run, `τ` uniform                      | 79.35 ± 3.40       | 1.1 µs          |
-//! | per run, `p_fastest` 0.25, `τ` uniform    | 78.71 ± 2.78       | 1.0 µs          |
-//! | per run, `τ` uniform-feasible             | 77.19 ± 2.67       | 2.3 µs          |
-//! | per run, `p_fastest` 0.25, feasible `τ`   | 76.92 ± 2.44       | 1.6 µs          |
-//! | **per run, `p_fastest` 0.5, feasible `τ`**| **76.93 ± 2.07**   | **1.0 µs**      |
-//! | 2 pieces per run, 0.25, feasible `τ`      | 78.37 ± 4.68       | 1.9 µs          |
-//! | 4 pieces per run, 0.25, feasible `τ`      | 76.82 ± 3.93       | 2.8 µs          |
+//! Why fit robot 2: for two robots to alternate, each of robot 2's low-confidence passes
+//! must land in a gap of robot 1's, which takes every one of robot 2's run durations and
+//! `τ` to be right at once; independent draws almost never are. Given robot 1, the sweep
+//! finds the best robot 2 exactly (up to the widening), so each candidate is a good one.
+//! The widening `w` (uniform in `[0, widen_max]`) trades `T_total` for room that the
+//! worst-case margin check (Alg. 2) needs; the candidates are checked in `T_total` order,
+//! so the least widening that passes wins.
 //!
-//! Per-sample candidates never beat the serial schedule (their hundreds of cheap-feasible
-//! candidates all fail the margin check) and cost ~200× more; more pieces per run did not
-//! help on average and widened the spread. The default is one factor per run, exact zero
-//! (fastest) with probability 0.5, and `τ` uniform over the non-overlapping offsets.
+//! The numbers that decided it (`cargo run --release -p tandem-schedule --example
+//! sampling_distributions`: `fixtures/sanding/problem.csv` with passes 1–3 sanding low
+//! confidence, `T_ref` 9873, serial `T_total` 145.75 s, 5000 samples, best `T_total` as
+//! mean ± std over 20 seeds (4 for per sample), default margin budget, 2 cores):
+//!
+//! | distribution                               | best `T_total` (s) | time per sample |
+//! |--------------------------------------------|--------------------|-----------------|
+//! | per sample, `τ` uniform                    | 145.75 (= serial)  | 123 µs          |
+//! | per sample, `τ` uniform-feasible           | 145.75 (= serial)  | 124 µs          |
+//! | per run, `τ` uniform                       | 116.71 ± 8.20      | 6.7 µs          |
+//! | per run, `p_fastest` 0.25, `τ` uniform     | 114.72 ± 4.44      | 3.8 µs          |
+//! | per run, `τ` uniform-feasible              | 108.82 ± 6.67      | 6.2 µs          |
+//! | per run, `p_fastest` 0.25, feasible `τ`    | 109.76 ± 7.55      | 5.0 µs          |
+//! | per run, `p_fastest` 0.5, feasible `τ`     | 111.96 ± 4.16      | 3.6 µs          |
+//! | 2 pieces per run, 0.25, feasible `τ`       | 105.88 ± 5.99      | 6.4 µs          |
+//! | 4 pieces per run, 0.25, feasible `τ`       | 109.96 ± 10.51     | 10.0 µs         |
+//! | per run, 0.5, robot 2 fitted, `w` = 0      | 124.21 ± 0.00      | 23.7 µs         |
+//! | **per run, 0.5, robot 2 fitted, `w` ≤ 0.1**| **94.38 ± 1.22**   | **4.8 µs**      |
+//! | per run, 0.5, robot 2 fitted, `w` ≤ 0.3    | 95.73 ± 4.59       | 4.3 µs          |
+//!
+//! Per-sample candidates never beat the serial schedule. Fitting robot 2 with no widening
+//! packs the regions so tightly that almost every candidate fails the margin check; a
+//! little widening (the default `widen_max` 0.1) gives the best and steadiest result, 16 %
+//! below the best sampled-offset setting. The default is one factor per run, exact zero
+//! (fastest) with probability 0.5, robot 2 fitted with `w ≤ 0.1`.
+//!
+//! # Warm start
+//!
+//! With [`OffsetSampling::Fitted`] and a previous schedule, 8 more candidates
+//! (`k = samples..samples + 8`) keep robot 1's warp of the (repaired) previous schedule and
+//! fit robot 2 with widenings `w ∈ widen_max·{0, ¼, ½, ¾, 1, 1½, 2, 3}`: after a model
+//! update moves the mean gradients, the previous schedule itself may no longer pass, but
+//! its robot 1 usually still admits a good robot 2.
 //!
 //! # Evaluation order
 //!
@@ -53,7 +80,11 @@
 //! 3. The survivors sorted by `(T_total, k)`; the full constraints (the margin check of
 //!    Alg. 2 last) run in that order, a few candidates at a time in parallel, until the first
 //!    passes. The winner is therefore the least `(T_total, k)` among the fully feasible
-//!    candidates, whatever the number of threads.
+//!    candidates checked, whatever the number of threads. At most
+//!    [`SamplerParams::max_margin_checks`] are checked (default 64: the best 32, then 32
+//!    ranks spread geometrically down to the last): in the study, once the confidence is
+//!    fragmented, thousands of candidates can beat the incumbent on paper and fail the
+//!    margin check, at ~0.4 ms each.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -87,7 +118,7 @@ impl Default for Distribution {
 }
 
 /// How a candidate's offset `τ` is drawn, given its two warps.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum OffsetSampling {
     /// Uniform in `[0, |ψ_E1|]`; candidates whose low-confidence intervals overlap are
     /// rejected (the literal reading of §II-C).
@@ -96,8 +127,23 @@ pub enum OffsetSampling {
     /// intervals do not overlap (computed exactly from the intervals). This is the
     /// distribution of `Uniform` conditioned on passing constraint 3 — the same proposals,
     /// without the rejected ones.
-    #[default]
     UniformFeasible,
+    /// `τ` and robot 2's high-confidence speed factors are not sampled but *fitted* to robot
+    /// 1's sampled warp: an exact sweep over robot 2's pieces finds the earliest finish of
+    /// robot 2 whose low-confidence intervals keep clear of robot 1's, each of robot 1's
+    /// intervals `[a, b)` widened to `[a − δ, b + δ)` with `δ = w·(b − a) + 2·tick_s` and `w`
+    /// drawn uniformly in `[0, widen_max]` per candidate (room for the operator's drag and
+    /// rush, which the margin check then verifies). See the module docs.
+    Fitted {
+        /// Largest relative widening `w` of robot 1's low-confidence intervals, `≥ 0`.
+        widen_max: f64,
+    },
+}
+
+impl Default for OffsetSampling {
+    fn default() -> Self {
+        OffsetSampling::Fitted { widen_max: 0.1 }
+    }
 }
 
 /// Parameters of [`sample_schedule`].
@@ -125,6 +171,14 @@ pub struct SamplerParams {
     /// passes. `true`: check every cheap-feasible candidate (the straightforward baseline; the
     /// same result, slower).
     pub exhaustive_margins: bool,
+    /// At most this many cheap-feasible candidates go through the full constraints: the
+    /// best half of them in `(T_total, k)` order, the rest at geometrically spaced ranks
+    /// down to the last; the first to pass wins, and if none does the incumbent stays. `None` = no
+    /// limit. Once the confidence is fragmented into many short low-confidence runs, most
+    /// candidates that beat a good incumbent fail the margin check, and checking them all
+    /// costs up to ~0.5 s per re-schedule for nothing (see the module docs). ≥ 1.
+    /// Default: `Some(64)`.
+    pub max_margin_checks: Option<usize>,
 }
 
 impl Default for SamplerParams {
@@ -135,9 +189,10 @@ impl Default for SamplerParams {
             tick_s: None,
             distribution: Distribution::default(),
             p_fastest: 0.5,
-            offset: OffsetSampling::UniformFeasible,
+            offset: OffsetSampling::default(),
             margin_check: MarginCheck::SinglePass,
             exhaustive_margins: false,
+            max_margin_checks: Some(64),
         }
     }
 }
@@ -166,6 +221,20 @@ impl SamplerParams {
             return Err(Error::BadParam {
                 name: "distribution.pieces",
                 why: "must be ≥ 1",
+            });
+        }
+        if self.max_margin_checks == Some(0) {
+            return Err(Error::BadParam {
+                name: "max_margin_checks",
+                why: "must be ≥ 1 (or none for no limit)",
+            });
+        }
+        if let OffsetSampling::Fitted { widen_max } = self.offset
+            && !(widen_max.is_finite() && widen_max >= 0.0)
+        {
+            return Err(Error::BadParam {
+                name: "offset.widen_max",
+                why: "must be finite and ≥ 0",
             });
         }
         if !(0.0..=1.0).contains(&self.p_fastest) {
@@ -276,7 +345,39 @@ struct Sampler<'a> {
     problem: &'a Problem,
     params: &'a SamplerParams,
     pieces: Vec<Piece>,
+    /// `suffix_min_s[p]`: shortest duration (s) of pieces `p..` (`0` past the last).
+    suffix_min_s: Vec<f64>,
     tick_s: f64,
+    /// Warm start ([`OffsetSampling::Fitted`] only): robot 1's warp of the (repaired)
+    /// previous schedule, with its low-confidence intervals and duration (s). Candidates
+    /// `k ≥ samples` keep it and fit robot 2 with the widening `WARM_WIDEN[k − samples]`.
+    warm: Option<Warm>,
+}
+
+/// Robot 1 of the warm start: warp (gradients per reference sample), low-confidence
+/// intervals relative to its start (s), duration (s).
+struct Warm {
+    warp: Vec<f64>,
+    lc: Vec<(f64, f64)>,
+    dur_s: f64,
+}
+
+/// Relative widenings `w / widen_max` of the warm-start candidates.
+const WARM_WIDEN: [f64; 8] = [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0];
+
+/// Low-confidence intervals (relative to the start) and duration (s) of one robot's warp.
+fn lc_of_warp(problem: &Problem, warp: &[f64]) -> (Vec<(f64, f64)>, f64) {
+    let dt = problem.dt_s();
+    let mut lc = Vec::new();
+    let mut t = 0.0;
+    for run in problem.runs() {
+        let d = warp[run.start..run.end].iter().sum::<f64>() * dt;
+        if !run.high_conf {
+            lc.push((t, t + d));
+        }
+        t += d;
+    }
+    (lc, t)
 }
 
 /// Per-worker scratch: factors and low-confidence intervals relative to each robot's start.
@@ -285,6 +386,9 @@ struct Scratch {
     factors: [Vec<f64>; 2],
     lc: [Vec<(f64, f64)>; 2],
     forbidden: Vec<(f64, f64)>,
+    /// Fitted robot 2: feasible start sets of all pieces, flattened, and where each begins.
+    sets: Vec<(f64, f64)>,
+    set_starts: Vec<usize>,
 }
 
 /// A candidate's draws, with its factors left in the scratch.
@@ -293,6 +397,42 @@ struct Draw {
     dur: [f64; 2],
     /// `τ` (s); `None` when no admissible offset avoids a low-confidence overlap.
     offset_s: Option<f64>,
+}
+
+impl<'a> Sampler<'a> {
+    /// The pieces, their suffix sums and, for [`OffsetSampling::Fitted`] with a previous
+    /// schedule, the warm start (robot 1 of its repair).
+    fn new(
+        problem: &'a Problem,
+        params: &'a SamplerParams,
+        tick_s: f64,
+        previous: Option<&Schedule>,
+    ) -> Self {
+        let pieces = pieces(problem, params.distribution);
+        let mut suffix_min_s = vec![0.0; pieces.len() + 1];
+        for (p, piece) in pieces.iter().enumerate().rev() {
+            suffix_min_s[p] = suffix_min_s[p + 1] + piece.min_s;
+        }
+        let warm = match (
+            params.offset,
+            previous.and_then(|prev| repair(problem, prev)),
+        ) {
+            (OffsetSampling::Fitted { .. }, Some(fixed)) => {
+                let [warp, _] = fixed.grad_exec;
+                let (lc, dur_s) = lc_of_warp(problem, &warp);
+                Some(Warm { warp, lc, dur_s })
+            }
+            _ => None,
+        };
+        Sampler {
+            problem,
+            params,
+            pieces,
+            suffix_min_s,
+            tick_s,
+            warm,
+        }
+    }
 }
 
 impl Sampler<'_> {
@@ -310,9 +450,60 @@ impl Sampler<'_> {
         }
     }
 
-    /// Draws candidate `k`: factors (into `scratch.factors`), durations and offset.
-    fn draw(&self, scratch: &mut Scratch, k: u64) -> Draw {
+    /// Draws robot 1's factors into `factors` and its low-confidence intervals (relative to
+    /// its start) into `lc`; returns its duration `|ψ_E1|` (s).
+    fn draw_robot(
+        &self,
+        rng: &mut ChaCha8Rng,
+        factors: &mut Vec<f64>,
+        lc: &mut Vec<(f64, f64)>,
+    ) -> f64 {
+        factors.clear();
+        lc.clear();
+        let mut t = 0.0;
+        for p in &self.pieces {
+            if p.high_conf {
+                let u = self.factor(rng);
+                factors.push(u);
+                t += p.min_s + u * p.span_s;
+            } else {
+                lc.push((t, t + p.min_s));
+                t += p.min_s;
+            }
+        }
+        t
+    }
+
+    /// Draws candidate `k`: factors (into `scratch.factors`), durations and offset. With
+    /// [`OffsetSampling::Fitted`], candidates whose robot 2 cannot finish before `bound_s`
+    /// get no offset (the same draws otherwise, whatever `bound_s`).
+    fn draw(&self, scratch: &mut Scratch, k: u64, bound_s: f64) -> Draw {
         let mut rng = self.rng(k);
+        if let OffsetSampling::Fitted { widen_max } = self.params.offset {
+            let (dur0, w) = match (&self.warm, k.checked_sub(self.params.samples as u64)) {
+                (Some(warm), Some(j)) => {
+                    scratch.factors[0].clear();
+                    scratch.lc[0].clear();
+                    scratch.lc[0].extend_from_slice(&warm.lc);
+                    (warm.dur_s, widen_max * WARM_WIDEN[j as usize])
+                }
+                _ => {
+                    let dur0 =
+                        self.draw_robot(&mut rng, &mut scratch.factors[0], &mut scratch.lc[0]);
+                    (dur0, rng.random::<f64>() * widen_max)
+                }
+            };
+            return match self.fit_second(scratch, dur0, w, bound_s) {
+                Some((offset_s, dur1)) => Draw {
+                    dur: [dur0, dur1],
+                    offset_s: Some(offset_s),
+                },
+                None => Draw {
+                    dur: [dur0, f64::INFINITY],
+                    offset_s: None,
+                },
+            };
+        }
         let mut dur = [0.0; 2];
         for ((factors, lc), dur) in scratch
             .factors
@@ -342,14 +533,164 @@ impl Sampler<'_> {
                 (!overlaps(&scratch.lc, offset_s)).then_some(offset_s)
             }
             OffsetSampling::UniformFeasible => feasible_offset(scratch, dur[0], v),
+            OffsetSampling::Fitted { .. } => unreachable!("fitted candidates returned above"),
         };
         Draw { dur, offset_s }
+    }
+
+    /// [`OffsetSampling::Fitted`]: robot 2's earliest finish given robot 1's low-confidence
+    /// intervals in `scratch.lc[0]` (global time: robot 1 starts at 0) widened by
+    /// `δ = w·length + 2·tick_s`, over `τ ∈ [0, dur0]` and robot 2's per-piece durations.
+    /// Writes robot 2's factors into `scratch.factors[1]`; returns `(τ, |ψ_E2|)`, or `None`
+    /// when robot 2 cannot finish before `bound_s` clear of robot 1.
+    ///
+    /// The sweep keeps, for each piece, the set of its feasible start times as sorted
+    /// disjoint intervals: a high-confidence piece of durations `[d_min, d_max]` maps `[x, y]`
+    /// to `[x + d_min, y + d_max]`; a low-confidence piece of duration `L` keeps the starts
+    /// `s` with `[s, s + L]` inside a gap between forbidden intervals, shifted by `L`. Starts
+    /// from which even the fastest rest of robot 2 would end at or after `bound_s` are cut.
+    /// The earliest end is then traced back, each high-confidence piece taking its shortest
+    /// duration that still meets the start set before it (the fastest speeds: the most room
+    /// for the coordinator to slow that robot down while the other is dragged).
+    fn fit_second(
+        &self,
+        scratch: &mut Scratch,
+        dur0: f64,
+        w: f64,
+        bound_s: f64,
+    ) -> Option<(f64, f64)> {
+        let margin = 2.0 * self.tick_s;
+        let forbidden = &mut scratch.forbidden;
+        forbidden.clear();
+        forbidden.extend(scratch.lc[0].iter().map(|&(a, b)| {
+            let d = w * (b - a) + margin;
+            (a - d, b + d)
+        }));
+        forbidden.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+        let mut merged = 0;
+        for i in 0..forbidden.len() {
+            let cur = forbidden[i];
+            if merged > 0 && cur.0 <= forbidden[merged - 1].1 {
+                forbidden[merged - 1].1 = forbidden[merged - 1].1.max(cur.1);
+            } else {
+                forbidden[merged] = cur;
+                merged += 1;
+            }
+        }
+        forbidden.truncate(merged);
+        let forbidden = &scratch.forbidden;
+        // Gap g lies between forbidden[g − 1] and forbidden[g] (unbounded at both ends).
+        // Starts of a piece of length `len` inside gap g, `w·len` clear of both ends.
+        let gap = |g: usize, len: f64| -> (f64, f64) {
+            let pad = w * len;
+            let lo = if g == 0 {
+                f64::NEG_INFINITY
+            } else {
+                forbidden[g - 1].1 + pad
+            };
+            let hi = forbidden.get(g).map_or(f64::INFINITY, |f| f.0 - len - pad);
+            (lo, hi)
+        };
+
+        let sets = &mut scratch.sets;
+        let starts = &mut scratch.set_starts;
+        sets.clear();
+        starts.clear();
+        let n_pieces = self.pieces.len();
+        let hi0 = dur0.min(bound_s - self.suffix_min_s[0]);
+        if hi0 < 0.0 {
+            return None;
+        }
+        starts.push(0);
+        sets.push((0.0, hi0));
+        for (p, piece) in self.pieces.iter().enumerate() {
+            let (from, to) = (starts[p], sets.len());
+            let cap = bound_s - self.suffix_min_s[p + 1];
+            starts.push(to);
+            let push = |sets: &mut Vec<(f64, f64)>, lo: f64, hi: f64| {
+                let hi = hi.min(cap);
+                if lo > hi {
+                    return;
+                }
+                let fresh = sets.len() == to;
+                match sets.last_mut() {
+                    Some(last) if !fresh && lo <= last.1 => last.1 = last.1.max(hi),
+                    _ => sets.push((lo, hi)),
+                }
+            };
+            if piece.high_conf {
+                let (d_min, d_max) = (piece.min_s, piece.min_s + piece.span_s);
+                for i in from..to {
+                    let (x, y) = sets[i];
+                    push(sets, x + d_min, y + d_max);
+                }
+            } else {
+                let len = piece.min_s;
+                let x_min = sets[from].0;
+                let mut g = forbidden.partition_point(|f| f.0 - len - w * len < x_min);
+                let mut i = from;
+                while i < to && g <= forbidden.len() {
+                    let (x, y) = sets[i];
+                    let (glo, ghi) = gap(g, len);
+                    let (lo, hi) = (x.max(glo), y.min(ghi));
+                    if lo <= hi {
+                        push(sets, lo + len, hi + len);
+                    }
+                    if y < ghi {
+                        i += 1;
+                    } else {
+                        g += 1;
+                    }
+                }
+            }
+            if sets.len() == starts[p + 1] {
+                return None;
+            }
+        }
+
+        // Trace the earliest end back.
+        let factors = &mut scratch.factors[1];
+        factors.clear();
+        let mut e = sets[starts[n_pieces]].0;
+        if e >= bound_s {
+            return None;
+        }
+        for (p, piece) in self.pieces.iter().enumerate().rev() {
+            if !piece.high_conf {
+                e -= piece.min_s;
+                continue;
+            }
+            let set = &sets[starts[p]..starts[p + 1]];
+            let (d_min, d_max) = (piece.min_s, piece.min_s + piece.span_s);
+            let latest = e - d_min;
+            let idx = set.partition_point(|iv| iv.0 <= latest).max(1) - 1;
+            let s = set[idx].1.min(latest).max(e - d_max);
+            let u = if piece.span_s > 0.0 {
+                ((e - s - d_min) / piece.span_s).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            factors.push(u);
+            e = s;
+        }
+        factors.reverse();
+        let tau = e.clamp(0.0, dur0);
+        let mut dur1 = 0.0;
+        let mut f = factors.iter();
+        for p in &self.pieces {
+            dur1 += if p.high_conf {
+                p.min_s + f.next().copied().unwrap_or(0.0) * p.span_s
+            } else {
+                p.min_s
+            };
+        }
+        Some((tau, dur1))
     }
 
     /// Cheap evaluation of candidate `k`: `Some(T_total)` if it beats `bound_s` and has no
     /// low-confidence overlap.
     fn cheap(&self, scratch: &mut Scratch, k: u64, bound_s: f64) -> Option<f64> {
-        let d = self.draw(scratch, k);
+        let d = self.draw(scratch, k, bound_s);
         let t_total = d.dur[0].max(d.offset_s? + d.dur[1]);
         (t_total < bound_s).then_some(t_total)
     }
@@ -357,7 +698,7 @@ impl Sampler<'_> {
     /// The full schedule of candidate `k` (same draws as [`Sampler::cheap`]).
     fn materialize(&self, k: u64) -> Option<Schedule> {
         let mut scratch = Scratch::default();
-        let d = self.draw(&mut scratch, k);
+        let d = self.draw(&mut scratch, k, f64::INFINITY);
         let (gmin, gmax, gmean) = (
             self.problem.grad_min(),
             self.problem.grad_max(),
@@ -365,7 +706,14 @@ impl Sampler<'_> {
         );
         let n_ref = self.problem.n_ref();
         let mut warps = [Vec::with_capacity(n_ref), Vec::with_capacity(n_ref)];
-        for (warp, factors) in warps.iter_mut().zip(&scratch.factors) {
+        for (robot, (warp, factors)) in warps.iter_mut().zip(&scratch.factors).enumerate() {
+            if robot == 0
+                && k >= self.params.samples as u64
+                && let Some(warm) = &self.warm
+            {
+                warp.extend_from_slice(&warm.warp);
+                continue;
+            }
             let mut factors = factors.iter();
             for p in &self.pieces {
                 if p.high_conf {
@@ -461,6 +809,29 @@ fn feasible_offset(scratch: &mut Scratch, max_s: f64, v: f64) -> Option<f64> {
     Some((lo + target).min(max_s))
 }
 
+/// Which ranks (in `(T_total, k)` order) of `len` cheap-feasible candidates get the full
+/// check when at most `cap` may: all if `len ≤ cap`; else the best `cap / 2`, then
+/// `cap − cap / 2` ranks spread geometrically over the rest up to the last, so a run of
+/// failing aggressive candidates at the top cannot hide the good, more cautious ones
+/// further down. Ascending, distinct.
+fn margin_ranks(len: usize, cap: usize) -> Vec<usize> {
+    if len <= cap {
+        return (0..len).collect();
+    }
+    let head = cap / 2;
+    let tail = cap - head;
+    let mut ranks: Vec<usize> = (0..head).collect();
+    let span = (len - head) as f64;
+    for j in 1..=tail {
+        let r = head - 1 + span.powf(j as f64 / tail as f64).round() as usize;
+        let r = r.min(len - 1);
+        if ranks.last().is_none_or(|&last| r > last) {
+            ranks.push(r);
+        }
+    }
+    ranks
+}
+
 fn repair(problem: &Problem, previous: &Schedule) -> Option<Schedule> {
     let n_ref = problem.n_ref();
     if previous.grad_exec.iter().any(|g| g.len() != n_ref) {
@@ -543,14 +914,13 @@ pub fn sample_schedule(
     let bound_s = incumbent.as_ref().map_or(f64::INFINITY, |inc| inc.1);
 
     // 2. Cheap checks, in parallel; collect keeps candidate order.
-    let pieces = pieces(problem, params.distribution);
-    let sampler = Sampler {
-        problem,
-        params,
-        pieces,
-        tick_s,
+    let sampler = Sampler::new(problem, params, tick_s, previous);
+    let n_warm = if sampler.warm.is_some() {
+        WARM_WIDEN.len()
+    } else {
+        0
     };
-    let n = params.samples as u64;
+    let n = (params.samples + n_warm) as u64;
     let mut feasible: Vec<(f64, u64)> = (0..n)
         .into_par_iter()
         .map_init(Scratch::default, |scratch, k| {
@@ -560,8 +930,13 @@ pub fn sample_schedule(
         .collect();
     feasible.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let cheap_feasible = feasible.len();
-
     // 3. Full constraints in (T_total, k) order.
+    if let Some(max) = params.max_margin_checks {
+        feasible = margin_ranks(feasible.len(), max)
+            .into_iter()
+            .map(|r| feasible[r])
+            .collect();
+    }
     let mut winner: Option<(Schedule, f64, u64)> = None;
     let mut margin_checks = 0;
     if params.exhaustive_margins {
@@ -640,6 +1015,55 @@ mod tests {
         // Everything forbidden: one LC run covering each whole execution.
         let mut s = scratch(&[(0.0, 3.0)], &[(0.0, 3.0)]);
         assert_eq!(feasible_offset(&mut s, 3.0, 0.5), None);
+    }
+
+    /// [LC ×10, HC ×20, LC ×10] at 0.1 s per sample, gradients 1 in [0.5, 2]: pieces LC
+    /// 1 s, HC 1–4 s, LC 1 s.
+    fn three_runs() -> Problem {
+        let conf: Vec<bool> = (0..40).map(|n| (10..30).contains(&n)).collect();
+        Problem::new(conf, vec![1.0; 40], vec![0.5; 40], vec![2.0; 40], 0.1).unwrap()
+    }
+
+    #[test]
+    fn fitted_robot_2_by_hand() {
+        let p = three_runs();
+        let params = SamplerParams::default();
+        let sampler = Sampler::new(&p, &params, 0.1, None);
+        // Robot 1 runs its HC piece at the slowest (4 s): LC [0, 1) and [5, 6), 6 s long.
+        let mut s = scratch(&[(0.0, 1.0), (5.0, 6.0)], &[]);
+        // w = 0: forbidden [−0.2, 1.2] and [4.8, 6.2] (two ticks of 0.1 s). Robot 2's first
+        // LC starts in [1.2, 3.8] and ends in [2.2, 4.8]; its HC piece (1–4 s) reaches
+        // [3.2, 8.8]; its last LC must start in [3.2, 3.8] or from 6.2: earliest end 4.2,
+        // traced back with the HC piece at its shortest (u = 0) and τ = 1.2.
+        let (tau, dur) = sampler.fit_second(&mut s, 6.0, 0.0, f64::INFINITY).unwrap();
+        assert!(
+            (tau - 1.2).abs() < 1e-9 && (dur - 3.0).abs() < 1e-9,
+            "{tau} {dur}"
+        );
+        assert_eq!(s.factors[1], [0.0]);
+        // w = 0.1: robot 1's regions grow by 0.1·1 + 0.2 s and robot 2's LC keeps 0.1 s
+        // clear: starts [1.4, 3.6] → earliest end 4.4 with τ = 1.4.
+        let (tau, dur) = sampler.fit_second(&mut s, 6.0, 0.1, f64::INFINITY).unwrap();
+        assert!(
+            (tau - 1.4).abs() < 1e-9 && (dur - 3.0).abs() < 1e-9,
+            "{tau} {dur}"
+        );
+        // An incumbent of 4 s cuts every start: robot 2 needs 3 s and cannot start before 1.2.
+        assert_eq!(sampler.fit_second(&mut s, 6.0, 0.0, 4.0), None);
+        // Robot 1 at its fastest (LC [0, 1) and [2, 3)): no gap holds a 1 s region before
+        // τ's upper end |ψ_E1| = 3 s, so robot 2 cannot be fitted.
+        let mut s = scratch(&[(0.0, 1.0), (2.0, 3.0)], &[]);
+        assert_eq!(sampler.fit_second(&mut s, 3.0, 0.0, f64::INFINITY), None);
+    }
+
+    #[test]
+    fn margin_ranks_keep_the_best_then_spread_geometrically() {
+        assert_eq!(margin_ranks(10, 64), (0..10).collect::<Vec<_>>());
+        // Head 0..4, then 3 + 996^(j/4) rounded: 9, 35, 180, 999.
+        assert_eq!(margin_ranks(1000, 8), [0, 1, 2, 3, 9, 35, 180, 999]);
+        let r = margin_ranks(5000, 64);
+        assert!(r.len() <= 64 && r.windows(2).all(|w| w[0] < w[1]));
+        assert_eq!((r[31], r[32], *r.last().unwrap()), (31, 32, 4999));
     }
 
     #[test]

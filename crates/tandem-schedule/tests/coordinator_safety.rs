@@ -7,7 +7,7 @@ use proptest::strategy::ValueTree;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tandem_realtime::{Coordinator, Timeline};
-use tandem_schedule::{Problem, SamplerParams, Schedule, Source, sample_schedule};
+use tandem_schedule::{OffsetSampling, Problem, SamplerParams, Schedule, Source, sample_schedule};
 
 /// Operator gradient sequences (the coordinator clamps to the LC robot's `[ψ̇min, ψ̇max]`).
 #[derive(Clone, Copy, Debug)]
@@ -83,6 +83,15 @@ fn run(p: &Problem, s: &Schedule, tick_s: f64, op: Operator, seed: u64) -> Optio
 
 /// Random small problems: confidence in runs (1–12 samples, HC runs twice as likely), random
 /// means and bounds per sample.
+/// The sampler's default (robot 2 fitted) or the uniform-feasible offsets.
+fn offset_mode(fitted: bool) -> OffsetSampling {
+    if fitted {
+        OffsetSampling::default()
+    } else {
+        OffsetSampling::UniformFeasible
+    }
+}
+
 fn random_problem() -> impl Strategy<Value = Problem> {
     proptest::collection::vec((1usize..12, prop::bool::weighted(0.65)), 1..8)
         .prop_flat_map(|blocks| {
@@ -117,9 +126,16 @@ proptest! {
         seed in any::<u64>(),
         tick_frac in 0.25f64..=1.0,
         samples in 20usize..150,
+        fitted in any::<bool>(),
     ) {
         let tick_s = tick_frac * p.dt_s();
-        let params = SamplerParams { samples, seed, tick_s: Some(tick_s), ..SamplerParams::default() };
+        let params = SamplerParams {
+            samples,
+            seed,
+            tick_s: Some(tick_s),
+            offset: offset_mode(fitted),
+            ..SamplerParams::default()
+        };
         let out = sample_schedule(&p, &params, None).unwrap();
         for op in [
             Operator::Fastest,
@@ -142,25 +158,35 @@ proptest! {
 /// The proptest above must exercise sampled (overlapping) schedules, not only serial ones.
 #[test]
 fn most_random_problems_get_sampled_schedules() {
-    let mut runner = proptest::test_runner::TestRunner::deterministic();
-    let strategy = random_problem();
-    let mut sampled = 0;
-    for seed in 0..40 {
-        let p = strategy.new_tree(&mut runner).unwrap().current();
-        let params = SamplerParams {
-            samples: 100,
-            seed,
-            ..SamplerParams::default()
-        };
-        let out = sample_schedule(&p, &params, None).unwrap();
-        if matches!(out.source, Source::Sampled { .. }) {
-            sampled += 1;
-            for op in [Operator::Fastest, Operator::Slowest, Operator::Switching] {
-                assert_eq!(run(&p, &out.schedule, p.dt_s(), op, seed), None);
+    for fitted in [false, true] {
+        let mut runner = proptest::test_runner::TestRunner::deterministic();
+        let strategy = random_problem();
+        let mut sampled = 0;
+        for seed in 0..40 {
+            let p = strategy.new_tree(&mut runner).unwrap().current();
+            let params = SamplerParams {
+                samples: 100,
+                seed,
+                offset: offset_mode(fitted),
+                ..SamplerParams::default()
+            };
+            let out = sample_schedule(&p, &params, None).unwrap();
+            if matches!(out.source, Source::Sampled { .. }) {
+                sampled += 1;
+                for op in [Operator::Fastest, Operator::Slowest, Operator::Switching] {
+                    assert_eq!(run(&p, &out.schedule, p.dt_s(), op, seed), None);
+                }
             }
         }
+        eprintln!("fitted {fitted}: {sampled} of 40 sampled");
+        // Fitted robot 2 keeps 2 ticks + 10 % clear around each region, a lot on these
+        // problems of a few dozen 10 ms samples, so fewer beat the serial schedule there.
+        let need = if fitted { 12 } else { 20 };
+        assert!(
+            sampled >= need,
+            "fitted {fitted}: only {sampled} of 40 sampled"
+        );
     }
-    assert!(sampled >= 20, "only {sampled} of 40 sampled");
 }
 
 /// Non-vacuity: the runtime check does see overlaps when a schedule breaks constraint 3.
