@@ -1,9 +1,11 @@
 //! Benchmark: re-scheduling with 5000 samples on the fixture task model with the mid-study
 //! confidence pattern (passes 1–3 sanding low-confidence, the rest high-confidence): the
 //! sampler with the single-pass margin check run lazily in `(T_total, k)` order, against the
-//! baseline that runs the per-pair margin check on every cheap-feasible candidate (same
-//! result, asserted below and in `tests/sampler.rs`). `single_pass_exhaustive` separates the
-//! two gains.
+//! baseline that runs the per-pair margin check on every cheap-feasible candidate within the
+//! margin budget (`SamplerParams::max_margin_checks`, 64 by default; same result, asserted
+//! below and in `tests/sampler.rs`). `single_pass_exhaustive` separates the two gains.
+//! Measured (2 cores): 5.0 ms lazy, 35 ms single-pass exhaustive, 43.5 ms per-pair
+//! exhaustive; best `T_total` 93.66 s against 145.75 s serial.
 #![allow(clippy::print_stdout, reason = "a bench reports which problem it used")]
 #![allow(
     missing_docs,
