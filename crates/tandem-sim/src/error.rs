@@ -1,7 +1,8 @@
 //! The crate's error type.
 
-/// Everything that can go wrong in `tandem-sim`.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+/// Everything that can go wrong in `tandem-sim`: the task generator ([`crate::task`]) and
+/// the simulated workcell ([`crate::workcell`]).
+#[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
     /// A parameter is out of its documented range.
@@ -30,6 +31,32 @@ pub enum Error {
         /// The limit that was hit, in samples.
         limit: usize,
     },
+    /// Workcell: two inputs that must agree in size do not.
+    #[error("{what}: expected {expected}, found {found}")]
+    Mismatch {
+        /// What was compared.
+        what: &'static str,
+        /// The size required.
+        expected: usize,
+        /// The size given.
+        found: usize,
+    },
+    /// Workcell: the model has no channel of the name the operator corrects.
+    #[error("the task model has no channel `{0}` for the operator to correct")]
+    NoForceChannel(String),
+    /// Workcell: the robots did not finish within the tick budget (a bug or a degenerate
+    /// schedule).
+    #[error("the pair did not finish within {ticks} control ticks")]
+    DidNotFinish {
+        /// The tick budget.
+        ticks: usize,
+    },
+    /// Workcell: the task model (commands, corrections, executions).
+    #[error(transparent)]
+    Lfd(#[from] tandem_lfd::Error),
+    /// Workcell: timelines or the coordinator.
+    #[error(transparent)]
+    Realtime(#[from] tandem_realtime::Error),
 }
 
 /// `Result` with this crate's [`Error`].

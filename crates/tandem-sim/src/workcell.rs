@@ -51,51 +51,7 @@ use tandem_realtime::{Coordinator, Timeline};
 use tandem_schedule::{Problem, Schedule};
 
 use crate::task::{Label, N_PASSES, Phase, Workpiece};
-
-/// Errors of the workcell simulation.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum WorkcellError {
-    /// A parameter is out of its documented range.
-    #[error("parameter `{name}` {why}")]
-    BadParam {
-        /// Field name.
-        name: &'static str,
-        /// What it must be.
-        why: &'static str,
-    },
-    /// Two inputs that must agree in size do not.
-    #[error("{what}: expected {expected}, found {found}")]
-    Mismatch {
-        /// What was compared.
-        what: &'static str,
-        /// The size required.
-        expected: usize,
-        /// The size given.
-        found: usize,
-    },
-    /// The model has no channel of the name the operator corrects.
-    #[error("the task model has no channel `{0}` for the operator to correct")]
-    NoForceChannel(String),
-    /// The robots did not finish within the tick budget (a bug or a degenerate schedule).
-    #[error("the pair did not finish within {ticks} control ticks")]
-    DidNotFinish {
-        /// The tick budget.
-        ticks: usize,
-    },
-    /// The sanding task (workpieces).
-    #[error(transparent)]
-    Task(#[from] crate::Error),
-    /// The task model (commands, corrections, executions).
-    #[error(transparent)]
-    Lfd(#[from] tandem_lfd::Error),
-    /// Timelines or the coordinator.
-    #[error(transparent)]
-    Realtime(#[from] tandem_realtime::Error),
-}
-
-/// Result alias of the workcell.
-pub type Result<T, E = WorkcellError> = std::result::Result<T, E>;
+use crate::{Error, Result};
 
 /// The simulated operator (§III).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -138,33 +94,33 @@ impl OperatorParams {
     /// Checks the rates.
     ///
     /// # Errors
-    /// [`WorkcellError::BadParam`] naming the field.
+    /// [`Error::BadParam`] naming the field.
     pub fn validate(&self) -> Result<()> {
         for (name, p) in [
             ("miss_rate", self.miss_rate),
             ("false_correction_rate", self.false_correction_rate),
         ] {
             if !(0.0..=1.0).contains(&p) {
-                return Err(WorkcellError::BadParam {
+                return Err(Error::BadParam {
                     name,
                     why: "must be a probability in [0, 1]",
                 });
             }
         }
         if !(0.0..1.0).contains(&self.false_correction_rate) {
-            return Err(WorkcellError::BadParam {
+            return Err(Error::BadParam {
                 name: "false_correction_rate",
                 why: "must be in [0, 1)",
             });
         }
         if !(self.false_correction_s.is_finite() && self.false_correction_s >= 0.0) {
-            return Err(WorkcellError::BadParam {
+            return Err(Error::BadParam {
                 name: "false_correction_s",
                 why: "must be finite and ≥ 0",
             });
         }
         if !(self.gain > 0.0 && self.gain <= 1.0) {
-            return Err(WorkcellError::BadParam {
+            return Err(Error::BadParam {
                 name: "gain",
                 why: "must be in (0, 1]",
             });
@@ -375,7 +331,7 @@ fn check_sizes(
         if let Some(found) = found
             && found != n_ref
         {
-            return Err(WorkcellError::Mismatch {
+            return Err(Error::Mismatch {
                 what,
                 expected: n_ref,
                 found,
@@ -411,7 +367,7 @@ pub fn run_pair_with(
         .tangent_names()
         .iter()
         .position(|n| *n == params.force_channel)
-        .ok_or_else(|| WorkcellError::NoForceChannel(params.force_channel.clone()))?;
+        .ok_or_else(|| Error::NoForceChannel(params.force_channel.clone()))?;
     let dt_s = problem.dt_s();
     let tick_s = dt_s;
     let starts = schedule.starts_s();
@@ -469,7 +425,7 @@ pub fn run_pair_with(
 
     while !coord.is_finished() {
         if ticks >= budget {
-            return Err(WorkcellError::DidNotFinish { ticks: budget });
+            return Err(Error::DidNotFinish { ticks: budget });
         }
         let clocks = coord.clock_s();
         let mut operator_gradient = f64::NAN;
@@ -677,7 +633,7 @@ mod tests {
         };
         assert!(matches!(
             p.validate(),
-            Err(WorkcellError::BadParam {
+            Err(Error::BadParam {
                 name: "miss_rate",
                 ..
             })
@@ -834,7 +790,7 @@ mod tests {
         .unwrap_err();
         assert!(matches!(
             err,
-            WorkcellError::Mismatch {
+            Error::Mismatch {
                 what: "reference labels",
                 ..
             }

@@ -97,12 +97,9 @@ pub enum Error {
     /// Scheduling (§II-B4/6).
     #[error(transparent)]
     Schedule(#[from] tandem_schedule::Error),
-    /// Simulation (§III).
+    /// Simulation (§III): the task generator and the simulated workcell.
     #[error(transparent)]
     Sim(#[from] tandem_sim::Error),
-    /// The simulated workcell (§III).
-    #[error(transparent)]
-    Workcell(#[from] tandem_sim::workcell::WorkcellError),
     /// The state could not be serialized.
     #[error("cannot encode state: {source}")]
     Encode {
