@@ -566,18 +566,7 @@ impl Sampler<'_> {
             let d = w * (b - a) + margin;
             (a - d, b + d)
         }));
-        forbidden.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-        let mut merged = 0;
-        for i in 0..forbidden.len() {
-            let cur = forbidden[i];
-            if merged > 0 && cur.0 <= forbidden[merged - 1].1 {
-                forbidden[merged - 1].1 = forbidden[merged - 1].1.max(cur.1);
-            } else {
-                forbidden[merged] = cur;
-                merged += 1;
-            }
-        }
-        forbidden.truncate(merged);
+        sort_and_merge(forbidden);
         let forbidden = &scratch.forbidden;
         // Gap g lies between forbidden[g − 1] and forbidden[g] (unbounded at both ends).
         // Starts of a piece of length `len` inside gap g, `w·len` clear of both ends.
@@ -764,6 +753,22 @@ fn overlaps(lc: &[Vec<(f64, f64)>; 2], offset_s: f64) -> bool {
     false
 }
 
+/// Sorts intervals `(lo, hi)` by start and merges, in place, those that overlap or touch.
+fn sort_and_merge(intervals: &mut Vec<(f64, f64)>) {
+    intervals.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    let mut merged = 0;
+    for i in 0..intervals.len() {
+        let cur = intervals[i];
+        if merged > 0 && cur.0 <= intervals[merged - 1].1 {
+            intervals[merged - 1].1 = intervals[merged - 1].1.max(cur.1);
+        } else {
+            intervals[merged] = cur;
+            merged += 1;
+        }
+    }
+    intervals.truncate(merged);
+}
+
 /// The point at fraction `v ∈ [0, 1)` of the measure of the admissible offsets:
 /// `[0, max_s = |ψ_E1|]` without every open interval `(a_i − d_j, b_i − c_j)` that would make robot 1's interval
 /// `[a_i, b_i)` and robot 2's `[c_j, d_j)` overlap. `None` if that set has measure zero.
@@ -778,19 +783,8 @@ fn feasible_offset(scratch: &mut Scratch, max_s: f64, v: f64) -> Option<f64> {
             }
         }
     }
-    forbidden.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-    // Merge in place, then walk the gaps.
-    let mut merged = 0;
-    for i in 0..forbidden.len() {
-        let cur = forbidden[i];
-        if merged > 0 && cur.0 <= forbidden[merged - 1].1 {
-            forbidden[merged - 1].1 = forbidden[merged - 1].1.max(cur.1);
-        } else {
-            forbidden[merged] = cur;
-            merged += 1;
-        }
-    }
-    forbidden.truncate(merged);
+    // Merge, then walk the gaps.
+    sort_and_merge(forbidden);
     let blocked: f64 = forbidden.iter().map(|(lo, hi)| hi - lo).sum();
     let free = max_s - blocked;
     if free <= 1e-12 * max_s.max(1.0) {
