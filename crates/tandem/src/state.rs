@@ -37,7 +37,10 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 
 /// The state format version this build writes and reads.
 /// Bump it whenever the serialized payload changes shape.
-pub const FORMAT_VERSION: u32 = 1;
+///
+/// - 1: first format.
+/// - 2: the sampler parameters gained `OffsetSampling::Fitted` and `max_margin_checks`.
+pub const FORMAT_VERSION: u32 = 2;
 
 /// Header length in bytes: magic (8) + version (4) + payload length (8) + CRC-32 (4).
 pub const HEADER_LEN: usize = 24;
@@ -263,7 +266,7 @@ mod tests {
     fn header_layout_is_as_documented() {
         let bytes = encode(&payload(4)).unwrap();
         assert_eq!(&bytes[..8], b"TANDEMST");
-        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 1);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 2);
         let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
         assert_eq!(len as usize, bytes.len() - HEADER_LEN);
         let crc = u32::from_le_bytes(bytes[20..24].try_into().unwrap());
@@ -353,7 +356,7 @@ mod tests {
             }
         ));
         let msg = err.to_string();
-        assert!(msg.contains("v.tandem") && msg.contains('7') && msg.contains('1'));
+        assert!(msg.contains("v.tandem") && msg.contains('7') && msg.contains('2'));
     }
 
     #[test]
