@@ -14,6 +14,7 @@ use anyhow::{Context, bail};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use tandem::realtime::adversary::{Adversary, AdversaryRun, run_adversary};
 use tandem::realtime::{Coordinator, Timeline};
 use tandem::schedule::{Problem, SamplerParams, Schedule, Source, sample_schedule};
 
@@ -39,30 +40,26 @@ struct Case {
     sampled: bool,
 }
 
-/// Adversarial operator gradient sequences (the coordinator clamps to the LC robot's bounds).
-#[derive(Clone, Copy, Debug)]
-enum Operator {
-    Fastest,
-    Slowest,
-    Switching,
-    RandomSwitching,
-    Random,
-    RandomHeld,
+/// Number of adversarial operator policies.
+const N_ADVERSARIES: usize = 6;
+
+/// The adversaries, each with holds of up to 50 ticks and random gradients over the
+/// problem's whole `[min ψ̇min, max ψ̇max]`.
+fn adversaries(case: &Case) -> [Adversary; N_ADVERSARIES] {
+    let (lo, hi) = (case.grad_lo, case.grad_hi);
+    [
+        Adversary::Fastest,
+        Adversary::Slowest,
+        Adversary::Switching,
+        Adversary::RandomSwitching { max_hold: 50 },
+        Adversary::Random { lo, hi },
+        Adversary::RandomHeld {
+            lo,
+            hi,
+            max_hold: 50,
+        },
+    ]
 }
-
-const OPERATORS: [Operator; 6] = [
-    Operator::Fastest,
-    Operator::Slowest,
-    Operator::Switching,
-    Operator::RandomSwitching,
-    Operator::Random,
-    Operator::RandomHeld,
-];
-
-/// Gradient far below every `ψ̇min`: clamps to the fastest admissible.
-const FAST: f64 = 0.0;
-/// Gradient far above every `ψ̇max`: clamps to the slowest admissible.
-const SLOW: f64 = 1e9;
 
 /// A random problem: 200–400 samples, confidence in runs (LC runs 5–60 samples, HC runs 5–80),
 /// a smooth random mean gradient and random per-run bound factors.
@@ -131,59 +128,11 @@ fn make_case(seed: u64, index: u64) -> anyhow::Result<Case> {
 }
 
 /// Result of one execution.
-#[derive(Clone, Copy, Default)]
-struct Run {
-    ticks: u64,
-    overlap_ticks: u64,
-    unfinished: bool,
-}
-
-fn execute(case: &Case, op: Operator, seed: u64, exec: u64) -> anyhow::Result<Run> {
+fn execute(case: &Case, op: Adversary, seed: u64, exec: u64) -> anyhow::Result<AdversaryRun> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
     rng.set_stream(exec);
-    let mut c = Coordinator::new(case.timelines.clone(), case.tick_s)?;
-    let mut run = Run::default();
-    let (mut hold, mut current) = (0u32, FAST);
-    while !c.is_finished() {
-        if run.ticks >= case.max_ticks {
-            run.unfinished = true;
-            break;
-        }
-        let g = match op {
-            Operator::Fastest => FAST,
-            Operator::Slowest => SLOW,
-            Operator::Switching => {
-                if run.ticks % 2 == 0 {
-                    FAST
-                } else {
-                    SLOW
-                }
-            }
-            Operator::RandomSwitching => {
-                if hold == 0 {
-                    current = if current == FAST { SLOW } else { FAST };
-                    hold = rng.random_range(1..=50);
-                }
-                hold -= 1;
-                current
-            }
-            Operator::Random => rng.random_range(case.grad_lo..=case.grad_hi),
-            Operator::RandomHeld => {
-                if hold == 0 {
-                    current = rng.random_range(case.grad_lo..=case.grad_hi);
-                    hold = rng.random_range(1..=50);
-                }
-                hold -= 1;
-                current
-            }
-        };
-        let t = c.tick(g);
-        run.ticks += 1;
-        if t.low_conf[0] && t.low_conf[1] {
-            run.overlap_ticks += 1;
-        }
-    }
-    Ok(run)
+    let c = Coordinator::new(case.timelines.clone(), case.tick_s)?;
+    Ok(run_adversary(c, op, &mut rng, case.max_ticks))
 }
 
 /// Runs the stress test; fails if any tick had both robots low-confidence.
@@ -218,14 +167,15 @@ pub(crate) fn run(executions: u64, seed: u64) -> anyhow::Result<()> {
         let end = (done + BATCH).min(executions);
         (done..end).into_par_iter().try_for_each(|e| {
             let case = &cases[(e % n_problems) as usize];
-            let op = OPERATORS[((e / n_problems) % OPERATORS.len() as u64) as usize];
+            let ops = adversaries(case);
+            let op = ops[((e / n_problems) % ops.len() as u64) as usize];
             let r = execute(case, op, seed, e)?;
             ticks.fetch_add(r.ticks, Ordering::Relaxed);
             if r.overlap_ticks > 0 {
                 overlap_ticks.fetch_add(r.overlap_ticks, Ordering::Relaxed);
                 overlap_runs.fetch_add(1, Ordering::Relaxed);
             }
-            if r.unfinished {
+            if !r.finished {
                 unfinished.fetch_add(1, Ordering::Relaxed);
             }
             anyhow::Ok(())
@@ -252,7 +202,7 @@ pub(crate) fn run(executions: u64, seed: u64) -> anyhow::Result<()> {
          {threads} threads: {overlap_ticks} ticks with both robots low-confidence (expected 0) \
          in {overlap_runs} executions; {unfinished} unfinished; {secs:.1} s, {:.0} executions/s, \
          {:.1} M ticks/s",
-        OPERATORS.len(),
+        N_ADVERSARIES,
         executions as f64 / secs,
         ticks as f64 / secs / 1e6,
         threads = rayon::current_num_threads(),

@@ -40,6 +40,7 @@
 //! # Ok::<(), tandem_realtime::Error>(())
 //! ```
 
+pub mod adversary;
 mod coordinator;
 mod error;
 pub mod margins;

@@ -4,28 +4,19 @@
 
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use tandem_realtime::adversary::{Adversary, run_adversary};
 use tandem_realtime::{Coordinator, Timeline};
 use tandem_schedule::{OffsetSampling, Problem, SamplerParams, Schedule, Source, sample_schedule};
 
-/// Operator gradient sequences (the coordinator clamps to the LC robot's `[ψ̇min, ψ̇max]`).
-#[derive(Clone, Copy, Debug)]
-enum Operator {
-    /// Always ψ̇min (fastest).
-    Fastest,
-    /// Always ψ̇max (slowest).
-    Slowest,
-    /// Alternate fastest/slowest every tick.
-    Switching,
-    /// Hold an extreme for a random number of ticks (1–20), then switch.
-    RandomSwitching,
-    /// A fresh random gradient in a range covering all bounds every tick.
-    Random,
-}
-
-const FAST: f64 = 0.0;
-const SLOW: f64 = 1e9;
+/// The adversaries of these tests: the extremes, switching every tick or after 1–20 ticks,
+/// and a fresh random gradient in a range covering all bounds every tick.
+const FASTEST: Adversary = Adversary::Fastest;
+const SLOWEST: Adversary = Adversary::Slowest;
+const SWITCHING: Adversary = Adversary::Switching;
+const RANDOM_SWITCHING: Adversary = Adversary::RandomSwitching { max_hold: 20 };
+const RANDOM: Adversary = Adversary::Random { lo: 0.1, hi: 3.0 };
 
 fn timelines(p: &Problem, s: &Schedule) -> [Timeline; 2] {
     [0, 1].map(|i| {
@@ -42,43 +33,18 @@ fn timelines(p: &Problem, s: &Schedule) -> [Timeline; 2] {
 }
 
 /// Runs one execution; returns the first tick index with both robots low-confidence.
-fn run(p: &Problem, s: &Schedule, tick_s: f64, op: Operator, seed: u64) -> Option<usize> {
-    let mut c = Coordinator::new(timelines(p, s), tick_s).unwrap();
+fn run(p: &Problem, s: &Schedule, tick_s: f64, op: Adversary, seed: u64) -> Option<u64> {
+    let c = Coordinator::new(timelines(p, s), tick_s).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     // Generous cap: every robot at its slowest, run serially, plus slack.
     let slowest_s: f64 = p.grad_max().iter().sum::<f64>() * p.dt_s() * 4.0;
-    let max_ticks = (slowest_s / tick_s) as usize + 100;
-    let (mut hold, mut current) = (0usize, FAST);
-    for n in 0..max_ticks {
-        if c.is_finished() {
-            return None;
-        }
-        let g = match op {
-            Operator::Fastest => FAST,
-            Operator::Slowest => SLOW,
-            Operator::Switching => {
-                if n % 2 == 0 {
-                    FAST
-                } else {
-                    SLOW
-                }
-            }
-            Operator::RandomSwitching => {
-                if hold == 0 {
-                    current = if current == FAST { SLOW } else { FAST };
-                    hold = rng.random_range(1..=20);
-                }
-                hold -= 1;
-                current
-            }
-            Operator::Random => rng.random_range(0.1..3.0),
-        };
-        let t = c.tick(g);
-        if t.low_conf[0] && t.low_conf[1] {
-            return Some(n);
-        }
-    }
-    panic!("execution did not finish within {max_ticks} ticks");
+    let max_ticks = (slowest_s / tick_s) as u64 + 100;
+    let r = run_adversary(c, op, &mut rng, max_ticks);
+    assert!(
+        r.finished,
+        "execution did not finish within {max_ticks} ticks"
+    );
+    r.first_overlap
 }
 
 /// Random small problems: confidence in runs (1–12 samples, HC runs twice as likely), random
@@ -138,11 +104,11 @@ proptest! {
         };
         let out = sample_schedule(&p, &params, None).unwrap();
         for op in [
-            Operator::Fastest,
-            Operator::Slowest,
-            Operator::Switching,
-            Operator::RandomSwitching,
-            Operator::Random,
+            FASTEST,
+            SLOWEST,
+            SWITCHING,
+            RANDOM_SWITCHING,
+            RANDOM,
         ] {
             for rep in 0..2u64 {
                 let hit = run(&p, &out.schedule, tick_s, op, seed ^ rep);
@@ -173,7 +139,7 @@ fn most_random_problems_get_sampled_schedules() {
             let out = sample_schedule(&p, &params, None).unwrap();
             if matches!(out.source, Source::Sampled { .. }) {
                 sampled += 1;
-                for op in [Operator::Fastest, Operator::Slowest, Operator::Switching] {
+                for op in [FASTEST, SLOWEST, SWITCHING] {
                     assert_eq!(run(&p, &out.schedule, p.dt_s(), op, seed), None);
                 }
             }
@@ -197,7 +163,7 @@ fn an_overlapping_schedule_is_caught_at_runtime() {
     let mut s = p.serial_schedule();
     s.offset_s = 0.0;
     assert!(tandem_schedule::validate(&p, &s).is_err());
-    for op in [Operator::Fastest, Operator::Slowest, Operator::Switching] {
+    for op in [FASTEST, SLOWEST, SWITCHING] {
         assert!(run(&p, &s, p.dt_s(), op, 0).is_some(), "{op:?}");
     }
 }
