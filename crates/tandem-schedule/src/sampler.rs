@@ -163,7 +163,8 @@ pub struct SamplerParams {
     /// Probability that a factor is exactly 0 (the run at `ψ̇min`, fastest), in `[0, 1]`.
     /// Default: 0.5.
     pub p_fastest: f64,
-    /// How `τ` is drawn. Default: [`OffsetSampling::UniformFeasible`].
+    /// How `τ` (and, with [`OffsetSampling::Fitted`], robot 2's speeds) are chosen. Default:
+    /// `OffsetSampling::Fitted { widen_max: 0.1 }`.
     pub offset: OffsetSampling,
     /// Margin-check implementation. Default: [`MarginCheck::SinglePass`].
     pub margin_check: MarginCheck,
@@ -860,8 +861,9 @@ fn repair(problem: &Problem, previous: &Schedule) -> Option<Schedule> {
 }
 
 /// The anytime sampler of §II-C (see the module docs for the distribution and the order of
-/// evaluation): the least-`T_total` schedule among `params.samples` sampled candidates, the
-/// previous schedule (kept on ties) and the fastest serial schedule that satisfies every
+/// evaluation): the least-`T_total` schedule among the previous schedule (kept on ties), the
+/// fastest serial schedule and the `params.samples` sampled candidates (plus the warm-start
+/// ones) whose full check ran (at most `params.max_margin_checks`), that satisfies every
 /// constraint of Eq. 20 at the control tick `params.tick_s`.
 ///
 /// Runs on the current rayon thread pool; the result for a seed is the same whatever the
