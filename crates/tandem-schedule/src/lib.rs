@@ -6,8 +6,9 @@
 //! sample) and robot 2 a start offset `τ`. [`GlobalTimeline`] lays a schedule out in global
 //! time (Eq. 15, 16, 19), [`Schedule::t_total_s`] is Eq. 13, [`validate`] checks every
 //! constraint of Eq. 20 (the margin check of Alg. 2 through `tandem_realtime`), and
-//! [`sample_schedule`] is the paper's anytime sampler: parallel, and deterministic for a seed
-//! whatever the thread count.
+//! [`sample_schedule`] is the paper's anytime sampler — by default robot 1's speeds are sampled
+//! and `τ` and robot 2's speeds fitted to them exactly ([`OffsetSampling::Fitted`]) —
+//! parallel, and deterministic for a seed whatever the thread count.
 //!
 //! ```
 //! use tandem_schedule::{Problem, SamplerParams, Source, sample_schedule, validate};
