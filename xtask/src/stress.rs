@@ -16,7 +16,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use tandem::realtime::adversary::{Adversary, AdversaryRun, run_adversary};
 use tandem::realtime::{Coordinator, Timeline};
-use tandem::schedule::{Problem, SamplerParams, Schedule, Source, sample_schedule};
+use tandem::schedule::{Problem, SamplerParams, Source, sample_schedule};
 
 /// Executions per scheduled problem (the number of problems is `N / this`, at least 1 and at
 /// most [`MAX_PROBLEMS`]).
@@ -88,20 +88,6 @@ fn random_problem(rng: &mut ChaCha8Rng) -> anyhow::Result<Problem> {
     Ok(Problem::new(conf, mean, min, max, DT_S)?)
 }
 
-fn timelines(p: &Problem, s: &Schedule) -> anyhow::Result<[Timeline; 2]> {
-    let make = |i: usize| {
-        Timeline::new(
-            p.conf(),
-            &s.grad_exec[i],
-            p.grad_min(),
-            p.grad_max(),
-            s.starts_s()[i],
-            p.dt_s(),
-        )
-    };
-    Ok([make(0)?, make(1)?])
-}
-
 fn make_case(seed: u64, index: u64) -> anyhow::Result<Case> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(index);
@@ -118,7 +104,7 @@ fn make_case(seed: u64, index: u64) -> anyhow::Result<Case> {
     let slowest_s = problem.grad_max().iter().sum::<f64>() * DT_S * 2.0;
     let fold = |f: fn(f64, f64) -> f64, init: f64, v: &[f64]| v.iter().copied().fold(init, f);
     Ok(Case {
-        timelines: timelines(&problem, &out.schedule)?,
+        timelines: out.schedule.timelines(&problem)?,
         tick_s,
         max_ticks: (2.0 * slowest_s / tick_s) as u64 + 100,
         grad_lo: fold(f64::min, f64::INFINITY, problem.grad_min()),

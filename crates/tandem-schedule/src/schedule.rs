@@ -1,6 +1,7 @@
 //! Schedules, `T_total` (Eq. 13) and the global timeline (Eq. 15, 16, 19).
 
 use serde::{Deserialize, Serialize};
+use tandem_realtime::{Error as RtError, Timeline};
 
 use crate::problem::Problem;
 use crate::{Error, Result};
@@ -25,6 +26,38 @@ pub struct Schedule {
 }
 
 impl Schedule {
+    /// Each robot's [`Timeline`] (schedule-clock plan for the real-time coordinator and the
+    /// margin check, Eq. 15–16) on `problem`. Gradients are clamped into `[ψ̇min, ψ̇max]`
+    /// first: [`crate::validate`] lets values through within a relative `1e-9` of the bounds,
+    /// and the realtime crate checks them exactly.
+    ///
+    /// # Errors
+    /// The realtime crate's error for a warp whose length is not `T_ref`, or non-finite values.
+    pub fn timelines(&self, problem: &Problem) -> std::result::Result<[Timeline; 2], RtError> {
+        let (gmin, gmax) = (problem.grad_min(), problem.grad_max());
+        let build = |robot: usize| {
+            let raw = &self.grad_exec[robot];
+            // Clamp only a warp of the right length; the realtime crate names the mismatch.
+            let grad: Vec<f64> = if raw.len() == gmin.len() {
+                raw.iter()
+                    .zip(gmin.iter().zip(gmax))
+                    .map(|(g, (lo, hi))| g.clamp(*lo, *hi))
+                    .collect()
+            } else {
+                raw.clone()
+            };
+            Timeline::new(
+                problem.conf(),
+                &grad,
+                gmin,
+                gmax,
+                self.starts_s()[robot],
+                problem.dt_s(),
+            )
+        };
+        Ok([build(0)?, build(1)?])
+    }
+
     /// Start time of each robot in global time (s): `[0, τ]`.
     pub fn starts_s(&self) -> [f64; 2] {
         [0.0, self.offset_s]
@@ -254,6 +287,22 @@ mod tests {
             grad_exec: [vec![2.0, 1.0, 1.0, 0.5], vec![0.5, 1.0, 1.0, 2.0]],
             offset_s,
         }
+    }
+
+    #[test]
+    fn timelines_clamp_into_the_bounds_and_name_a_wrong_length() {
+        // 2.0 + 1e-12 is just above ψ̇max = 2: clamped, so the realtime crate accepts it.
+        let mut s = schedule(1.0);
+        s.grad_exec[0][0] = 2.0 + 1e-12;
+        let [r1, r2] = s.timelines(&problem()).unwrap();
+        assert_eq!((r1.start_s(), r2.start_s()), (0.0, 1.0));
+        assert_eq!(r1.end_s(), 2.25);
+        // A warp one sample short is an error, not a panic.
+        s.grad_exec[1].pop();
+        assert!(matches!(
+            s.timelines(&problem()),
+            Err(tandem_realtime::Error::LengthMismatch { .. })
+        ));
     }
 
     #[test]

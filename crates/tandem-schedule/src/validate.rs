@@ -1,7 +1,5 @@
 //! The constraints of Eq. 20, checked in the paper's order.
 
-use tandem_realtime::Timeline;
-
 use crate::problem::Problem;
 use crate::schedule::{GlobalTimeline, Schedule};
 
@@ -200,33 +198,6 @@ pub(crate) fn validate_cheap(problem: &Problem, schedule: &Schedule) -> Result<(
     Ok(())
 }
 
-/// Builds the realtime timelines of a schedule that passed [`validate_cheap`].
-///
-/// Gradients are clamped into `[ψ̇min, ψ̇max]` first: `validate_cheap` lets values through
-/// within a relative `1e-9` of the bounds, and the realtime crate checks them exactly.
-pub(crate) fn timelines(
-    problem: &Problem,
-    schedule: &Schedule,
-) -> Result<[Timeline; 2], tandem_realtime::Error> {
-    let (gmin, gmax) = (problem.grad_min(), problem.grad_max());
-    let build = |robot: usize| {
-        let grad: Vec<f64> = schedule.grad_exec[robot]
-            .iter()
-            .enumerate()
-            .map(|(n, g)| g.clamp(gmin[n], gmax[n]))
-            .collect();
-        Timeline::new(
-            problem.conf(),
-            &grad,
-            gmin,
-            gmax,
-            schedule.starts_s()[robot],
-            problem.dt_s(),
-        )
-    };
-    Ok([build(0)?, build(1)?])
-}
-
 /// Constraint 5 for a schedule that passed [`validate_cheap`].
 pub(crate) fn margins_ok(
     problem: &Problem,
@@ -237,7 +208,7 @@ pub(crate) fn margins_ok(
     // A rejection by the realtime crate of a schedule that passed constraints 1–4 can only
     // concern the tick (validated by the callers) or a degenerate timeline: count it as
     // insufficient margins rather than accept a schedule the margin check did not pass.
-    let Ok(robots) = timelines(problem, schedule) else {
+    let Ok(robots) = schedule.timelines(problem) else {
         return Ok(false);
     };
     let decided = match check {

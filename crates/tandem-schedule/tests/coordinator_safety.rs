@@ -6,8 +6,8 @@ use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use tandem_realtime::Coordinator;
 use tandem_realtime::adversary::{Adversary, run_adversary};
-use tandem_realtime::{Coordinator, Timeline};
 use tandem_schedule::{OffsetSampling, Problem, SamplerParams, Schedule, Source, sample_schedule};
 
 /// The adversaries of these tests: the extremes, switching every tick or after 1–20 ticks,
@@ -18,23 +18,9 @@ const SWITCHING: Adversary = Adversary::Switching;
 const RANDOM_SWITCHING: Adversary = Adversary::RandomSwitching { max_hold: 20 };
 const RANDOM: Adversary = Adversary::Random { lo: 0.1, hi: 3.0 };
 
-fn timelines(p: &Problem, s: &Schedule) -> [Timeline; 2] {
-    [0, 1].map(|i| {
-        Timeline::new(
-            p.conf(),
-            &s.grad_exec[i],
-            p.grad_min(),
-            p.grad_max(),
-            s.starts_s()[i],
-            p.dt_s(),
-        )
-        .expect("a validated schedule makes valid timelines")
-    })
-}
-
 /// Runs one execution; returns the first tick index with both robots low-confidence.
 fn run(p: &Problem, s: &Schedule, tick_s: f64, op: Adversary, seed: u64) -> Option<u64> {
-    let c = Coordinator::new(timelines(p, s), tick_s).unwrap();
+    let c = Coordinator::new(s.timelines(p).unwrap(), tick_s).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     // Generous cap: every robot at its slowest, run serially, plus slack.
     let slowest_s: f64 = p.grad_max().iter().sum::<f64>() * p.dt_s() * 4.0;

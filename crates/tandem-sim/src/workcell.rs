@@ -370,18 +370,7 @@ pub fn run_pair_with(
         .ok_or_else(|| Error::NoForceChannel(params.force_channel.clone()))?;
     let dt_s = problem.dt_s();
     let tick_s = dt_s;
-    let starts = schedule.starts_s();
-    let timeline = |i: usize| {
-        Timeline::new(
-            problem.conf(),
-            &schedule.grad_exec[i],
-            problem.grad_min(),
-            problem.grad_max(),
-            starts[i],
-            dt_s,
-        )
-    };
-    let mut coord = Coordinator::new([timeline(0)?, timeline(1)?], tick_s)?;
+    let mut coord = Coordinator::new(schedule.timelines(problem)?, tick_s)?;
 
     let m = model.channel_names().len();
     let k = model.n_components();
