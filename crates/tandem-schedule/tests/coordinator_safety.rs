@@ -2,6 +2,8 @@
 //! `tandem_realtime::Coordinator` under random and extreme operator gradient sequences, never
 //! have both robots low-confidence in the same control tick.
 
+mod common;
+
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use rand::SeedableRng;
@@ -52,21 +54,9 @@ fn random_problem() -> impl Strategy<Value = Problem> {
                 .flat_map(|&(len, hc)| std::iter::repeat_n(hc, len))
                 .collect();
             let n = conf.len();
-            (
-                Just(conf),
-                proptest::collection::vec((0.5f64..2.0, 0.3f64..1.0, 1.0f64..2.5), n),
-            )
+            (Just(conf), common::gradients(n))
         })
-        .prop_map(|(conf, g)| {
-            Problem::new(
-                conf,
-                g.iter().map(|x| x.0).collect(),
-                g.iter().map(|x| x.0 * x.1).collect(),
-                g.iter().map(|x| x.0 * x.2).collect(),
-                0.01,
-            )
-            .unwrap()
-        })
+        .prop_map(|(conf, g)| common::problem(conf, &g))
 }
 
 proptest! {

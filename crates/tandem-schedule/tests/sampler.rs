@@ -1,5 +1,7 @@
 //! The anytime sampler (§II-C) through the public API.
 
+mod common;
+
 use proptest::prelude::*;
 use tandem_schedule::{
     Distribution, MarginCheck, OffsetSampling, Problem, SamplerParams, Schedule, Source,
@@ -32,18 +34,9 @@ fn random_problem() -> impl Strategy<Value = Problem> {
     (3usize..60).prop_flat_map(|n| {
         (
             proptest::collection::vec(prop::bool::weighted(0.7), n),
-            proptest::collection::vec((0.5f64..2.0, 0.3f64..1.0, 1.0f64..2.5), n),
+            common::gradients(n),
         )
-            .prop_map(|(conf, g)| {
-                Problem::new(
-                    conf,
-                    g.iter().map(|x| x.0).collect(),
-                    g.iter().map(|x| x.0 * x.1).collect(),
-                    g.iter().map(|x| x.0 * x.2).collect(),
-                    0.01,
-                )
-                .unwrap()
-            })
+            .prop_map(|(conf, g)| common::problem(conf, &g))
     })
 }
 
