@@ -1,26 +1,17 @@
 //! The Fig. 2 loop through the public API: recording pairs, saving and loading state.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use tandem::lfd::{FitParams, TaskModel};
 use tandem::schedule::{SamplerParams, validate};
 use tandem::sim::task::{TaskParams, Workpiece};
 use tandem::sim::workcell::{OperatorParams, run_pair};
-use tandem::study::StudyInputs;
 use tandem::{Error, ExecutionRecord, Planner, PlannerParams};
 
-fn fixtures() -> &'static (StudyInputs, TaskModel) {
-    static CELL: OnceLock<(StudyInputs, TaskModel)> = OnceLock::new();
-    CELL.get_or_init(|| {
-        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/sanding");
-        let inputs = StudyInputs::from_dir(&dir).expect("the committed fixtures load");
-        let model = TaskModel::fit(&inputs.demos, &FitParams::default()).expect("fit");
-        (inputs, model)
-    })
-}
+use common::fixtures;
 
 fn params() -> PlannerParams {
     PlannerParams {

@@ -1,23 +1,11 @@
 //! End-to-end: the study loop of §III on the committed sanding fixtures.
 
-use std::path::PathBuf;
-use std::sync::OnceLock;
+mod common;
 
-use tandem::lfd::{FitParams, TaskModel};
-use tandem::study::{StudyConfig, StudyInputs, StudyResult, run_trials};
-
-fn inputs() -> &'static (StudyInputs, TaskModel) {
-    static CELL: OnceLock<(StudyInputs, TaskModel)> = OnceLock::new();
-    CELL.get_or_init(|| {
-        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/sanding");
-        let inputs = StudyInputs::from_dir(&dir).expect("the committed fixtures load");
-        let model = TaskModel::fit(&inputs.demos, &FitParams::default()).expect("fit");
-        (inputs, model)
-    })
-}
+use tandem::study::{StudyConfig, StudyResult, run_trials};
 
 fn run(config: &StudyConfig) -> StudyResult {
-    let (inputs, model) = inputs();
+    let (inputs, model) = common::fixtures();
     run_trials(config, model, &inputs.reference_labels, &|_| {})
         .expect("the study runs")
         .0

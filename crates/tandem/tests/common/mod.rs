@@ -1,0 +1,18 @@
+//! The committed sanding fixtures, loaded and fitted once per test binary.
+
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+use tandem::lfd::{FitParams, TaskModel};
+use tandem::study::StudyInputs;
+
+/// `fixtures/sanding/` as study inputs, and the task model fitted on them with the defaults.
+pub(crate) fn fixtures() -> &'static (StudyInputs, TaskModel) {
+    static CELL: OnceLock<(StudyInputs, TaskModel)> = OnceLock::new();
+    CELL.get_or_init(|| {
+        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/sanding");
+        let inputs = StudyInputs::from_dir(&dir).expect("the committed fixtures load");
+        let model = TaskModel::fit(&inputs.demos, &FitParams::default()).expect("fit");
+        (inputs, model)
+    })
+}
