@@ -220,19 +220,26 @@ impl Problem {
     }
 }
 
+/// Unit-test problem shared by this crate's modules: `[HC, LC, LC, HC]`, gradients 1 within
+/// `[0.5, 2]`, reference period `dt_s`.
+#[cfg(test)]
+pub(crate) fn hllh(dt_s: f64) -> Problem {
+    Problem::new(
+        vec![true, false, false, true],
+        vec![1.0; 4],
+        vec![0.5; 4],
+        vec![2.0; 4],
+        dt_s,
+    )
+    .expect("valid by construction")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn ok() -> Problem {
-        Problem::new(
-            vec![true, false, false, true],
-            vec![1.0; 4],
-            vec![0.5; 4],
-            vec![2.0; 4],
-            0.01,
-        )
-        .unwrap()
+        hllh(0.01)
     }
 
     #[test]

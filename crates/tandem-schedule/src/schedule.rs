@@ -270,16 +270,9 @@ impl GlobalTimeline {
 mod tests {
     use super::*;
 
+    /// [HC, LC, LC, HC], gradients 1 in [0.5, 2], dt = 0.5 s.
     fn problem() -> Problem {
-        // [HC, LC, LC, HC], dt = 0.5 s.
-        Problem::new(
-            vec![true, false, false, true],
-            vec![1.0; 4],
-            vec![0.5; 4],
-            vec![2.0; 4],
-            0.5,
-        )
-        .unwrap()
+        crate::problem::hllh(0.5)
     }
 
     fn schedule(offset_s: f64) -> Schedule {
