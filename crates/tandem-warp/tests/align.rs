@@ -109,6 +109,16 @@ fn direct_objective(r: &[f64], q: &[f64], nc: usize, psi: &[f64], p: &WarpParams
     total
 }
 
+/// Aligns two 3-channel signals of [`warped_pair`] (which are valid by construction).
+fn align3(r: &[f64], q: &[f64], params: &WarpParams) -> Warp {
+    align(
+        SignalRef::new(r, 3).unwrap(),
+        SignalRef::new(q, 3).unwrap(),
+        params,
+    )
+    .unwrap()
+}
+
 #[test]
 fn recovers_a_known_smooth_warp_from_noisy_signals() {
     for (n_ref, n_query, seed) in [(800, 1000, 1), (900, 700, 2)] {
@@ -118,12 +128,7 @@ fn recovers_a_known_smooth_warp_from_noisy_signals() {
             lambda_cum: 0.01,
             ..Default::default()
         };
-        let w = align(
-            SignalRef::new(&r, 3).unwrap(),
-            SignalRef::new(&q, 3).unwrap(),
-            &params,
-        )
-        .unwrap();
+        let w = align3(&r, &q, &params);
         let err = mae(&w, &truth);
         eprintln!("known warp {n_ref} -> {n_query}: MAE {err:.3} query samples");
         assert!(
@@ -362,12 +367,7 @@ fn extreme_slope_bounds_are_handled() {
         lambda_cum: 0.01,
         ..Default::default()
     };
-    let w = align(
-        SignalRef::new(&r, 3).unwrap(),
-        SignalRef::new(&q, 3).unwrap(),
-        &p,
-    )
-    .unwrap();
+    let w = align3(&r, &q, &p);
     assert!(w.values().windows(2).all(|x| x[1] >= x[0]));
     assert_eq!(w.values()[299], 359.0);
     assert!(mae(&w, &truth) <= 3.6, "MAE {}", mae(&w, &truth));
@@ -381,12 +381,7 @@ fn tight_but_feasible_slopes_force_the_identity() {
         slope_max: 1.0,
         ..Default::default()
     };
-    let w = align(
-        SignalRef::new(&r, 3).unwrap(),
-        SignalRef::new(&q, 3).unwrap(),
-        &p,
-    )
-    .unwrap();
+    let w = align3(&r, &q, &p);
     for (n, v) in w.values().iter().enumerate() {
         assert!((v - n as f64 * 149.0 / 119.0).abs() < 1e-6);
     }
