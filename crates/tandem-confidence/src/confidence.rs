@@ -219,7 +219,7 @@ impl Confidence {
     /// Maximal runs of low-confidence reference samples, in increasing order.
     #[must_use]
     pub fn low_regions(&self) -> Vec<Range<usize>> {
-        low_regions(&self.high)
+        crate::low_regions(&self.high)
     }
 }
 
@@ -238,33 +238,6 @@ pub fn evaluate(
         .iter()
         .map(|b| decide(b.alpha(), b.beta(), params.mu_c, params.gamma_c))
         .collect())
-}
-
-/// Maximal runs of `false` (low confidence) in `conf`, as half-open reference-sample
-/// ranges in increasing order.
-///
-/// ```
-/// let conf = [false, true, true, false, false, true, false];
-/// assert_eq!(tandem_confidence::low_regions(&conf), vec![0..1, 3..5, 6..7]);
-/// ```
-#[must_use]
-pub fn low_regions(conf: &[bool]) -> Vec<Range<usize>> {
-    let mut out = Vec::new();
-    let mut start = None;
-    for (n, &high) in conf.iter().enumerate() {
-        match (high, start) {
-            (false, None) => start = Some(n),
-            (true, Some(s)) => {
-                out.push(s..n);
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    if let Some(s) = start {
-        out.push(s..conf.len());
-    }
-    out
 }
 
 #[cfg(test)]
@@ -357,9 +330,8 @@ mod tests {
         assert_eq!(conf.n_high(), 2);
         assert_eq!(conf.high_share(), 0.4);
         assert_eq!(conf.low_regions(), vec![1..3, 4..5]);
-        assert_eq!(low_regions(&[true, true]), Vec::<Range<usize>>::new());
-        assert_eq!(low_regions(&[false, false]), vec![0..2]);
-        assert_eq!(low_regions(&[]), Vec::<Range<usize>>::new());
+        assert_eq!(crate::low_regions(&[false, false]), vec![0..2]);
+        assert!(crate::low_regions(&[]).is_empty());
     }
 
     #[test]

@@ -87,9 +87,11 @@ mod confidence;
 mod error;
 mod observations;
 mod params;
+mod runs;
 
 pub use beta::{BetaParams, posterior, prior};
-pub use confidence::{Confidence, evaluate, low_regions};
+pub use confidence::{Confidence, evaluate};
 pub use error::{Error, Result};
 pub use observations::Observations;
 pub use params::ConfidenceParams;
+pub use runs::{Run, low_regions, runs};
