@@ -1,11 +1,13 @@
 //! `cargo xtask stress --executions N [--seed S]`: the safety invariant under load.
 //!
 //! Samples random problems of a few hundred reference samples, schedules each with the anytime
-//! sampler of `tandem-schedule`, then runs `N` executions in all through
-//! `tandem::realtime::Coordinator` under adversarial operator gradient sequences (always
-//! fastest, always slowest, switching every tick, switching at random times, random every
-//! tick, random values held for random times), in parallel, and counts ticks in which both
-//! robots were low-confidence (expected: 0). Every number depends only on `N` and the seed.
+//! sampler of `tandem-schedule` at a random control tick, then runs `N` executions in all
+//! through each schedule's own `Coordinator` (at the tick it was checked with) under the full
+//! adversary set of `tandem::realtime::adversary` (no correction, always fastest, always
+//! slowest, Alg. 2's worst case for each role, switching every tick, periodic, one switch,
+//! random switching, random extremes per tick and per robot, random gradients per tick and
+//! held), in parallel, and counts ticks in which both robots were low-confidence (expected:
+//! 0). Every number depends only on `N` and the seed.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -14,8 +16,10 @@ use anyhow::{Context, bail};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use tandem::realtime::adversary::{Adversary, AdversaryRun, run_adversary};
-use tandem::realtime::{Coordinator, Timeline};
+use tandem::realtime::Coordinator;
+use tandem::realtime::adversary::{
+    Adversary, AdversaryRun, SET_SIZE, adversary_set, run_adversary,
+};
 use tandem::schedule::{Problem, SamplerParams, Source, sample_schedule};
 
 /// Executions per scheduled problem (the number of problems is `N / this`, at least 1 and at
@@ -32,33 +36,14 @@ const DT_S: f64 = 0.01;
 
 /// One scheduled random problem, ready to run.
 struct Case {
-    timelines: [Timeline; 2],
-    tick_s: f64,
+    /// The schedule's coordinator, at the tick the schedule was checked with (cloned per
+    /// execution).
+    coordinator: Coordinator,
     max_ticks: u64,
-    grad_lo: f64,
-    grad_hi: f64,
+    /// The full adversary set for this case (random gradients over the problem's whole
+    /// `[min ψ̇min, max ψ̇max]`).
+    adversaries: [Adversary; SET_SIZE],
     sampled: bool,
-}
-
-/// Number of adversarial operator policies.
-const N_ADVERSARIES: usize = 6;
-
-/// The adversaries, each with holds of up to 50 ticks and random gradients over the
-/// problem's whole `[min ψ̇min, max ψ̇max]`.
-fn adversaries(case: &Case) -> [Adversary; N_ADVERSARIES] {
-    let (lo, hi) = (case.grad_lo, case.grad_hi);
-    [
-        Adversary::Fastest,
-        Adversary::Slowest,
-        Adversary::Switching,
-        Adversary::RandomSwitching { max_hold: 50 },
-        Adversary::Random { lo, hi },
-        Adversary::RandomHeld {
-            lo,
-            hi,
-            max_hold: 50,
-        },
-    ]
 }
 
 /// A random problem: 200–400 samples, confidence in runs (LC runs 5–60 samples, HC runs 5–80),
@@ -103,12 +88,15 @@ fn make_case(seed: u64, index: u64) -> anyhow::Result<Case> {
     // Every robot at its slowest, one after the other, plus slack.
     let slowest_s = problem.grad_max().iter().sum::<f64>() * DT_S * 2.0;
     let fold = |f: fn(f64, f64) -> f64, init: f64, v: &[f64]| v.iter().copied().fold(init, f);
+    let grad_range = [
+        fold(f64::min, f64::INFINITY, problem.grad_min()),
+        fold(f64::max, 0.0, problem.grad_max()),
+    ];
+    let ticks = (out.t_total_s / tick_s) as u64;
     Ok(Case {
-        timelines: out.schedule.timelines(&problem)?,
-        tick_s,
+        coordinator: out.schedule.coordinator(&problem)?,
         max_ticks: (2.0 * slowest_s / tick_s) as u64 + 100,
-        grad_lo: fold(f64::min, f64::INFINITY, problem.grad_min()),
-        grad_hi: fold(f64::max, 0.0, problem.grad_max()),
+        adversaries: adversary_set(grad_range, ticks, &mut rng),
         sampled: matches!(out.source, Source::Sampled { .. }),
     })
 }
@@ -117,8 +105,12 @@ fn make_case(seed: u64, index: u64) -> anyhow::Result<Case> {
 fn execute(case: &Case, op: Adversary, seed: u64, exec: u64) -> anyhow::Result<AdversaryRun> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
     rng.set_stream(exec);
-    let c = Coordinator::new(case.timelines.clone(), case.tick_s)?;
-    Ok(run_adversary(c, op, &mut rng, case.max_ticks))
+    Ok(run_adversary(
+        case.coordinator.clone(),
+        op,
+        &mut rng,
+        case.max_ticks,
+    )?)
 }
 
 /// Runs the stress test; fails if any tick had both robots low-confidence.
@@ -153,8 +145,7 @@ pub(crate) fn run(executions: u64, seed: u64) -> anyhow::Result<()> {
         let end = (done + BATCH).min(executions);
         (done..end).into_par_iter().try_for_each(|e| {
             let case = &cases[(e % n_problems) as usize];
-            let ops = adversaries(case);
-            let op = ops[((e / n_problems) % ops.len() as u64) as usize];
+            let op = case.adversaries[((e / n_problems) % SET_SIZE as u64) as usize];
             let r = execute(case, op, seed, e)?;
             ticks.fetch_add(r.ticks, Ordering::Relaxed);
             if r.overlap_ticks > 0 {
@@ -188,7 +179,7 @@ pub(crate) fn run(executions: u64, seed: u64) -> anyhow::Result<()> {
          {threads} threads: {overlap_ticks} ticks with both robots low-confidence (expected 0) \
          in {overlap_runs} executions; {unfinished} unfinished; {secs:.1} s, {:.0} executions/s, \
          {:.1} M ticks/s",
-        N_ADVERSARIES,
+        SET_SIZE,
         executions as f64 / secs,
         ticks as f64 / secs / 1e6,
         threads = rayon::current_num_threads(),

@@ -116,13 +116,13 @@ fn fit(a: &FitArgs) -> Result<()> {
         model.n_ref() as f64 * model.dt_s(),
         model.channel_names().join(", ")
     ));
-    summary_lines(&planner);
+    summary_lines(&planner)?;
     out(&format!("saved {}", a.output.display()));
     Ok(())
 }
 
 /// Confidence and schedule lines shared by `fit`, `record` and `inspect`.
-fn summary_lines(planner: &Planner) {
+fn summary_lines(planner: &Planner) -> Result<()> {
     let conf = planner.confidence();
     out(&format!(
         "high confidence: {:.1} % of reference samples ({} of {}), {} low-confidence regions",
@@ -131,7 +131,7 @@ fn summary_lines(planner: &Planner) {
         conf.n_ref(),
         conf.low_regions().len()
     ));
-    let serial = serial_t_total_s(planner.problem());
+    let serial = serial_t_total_s(planner.problem(), planner.schedule().tick_s)?;
     let t = planner.outcome().t_total_s;
     out(&format!(
         "schedule: T_total {t:.2} s vs fastest serial {serial:.2} s ({:.1} %); τ = {:.2} s; {}",
@@ -139,6 +139,7 @@ fn summary_lines(planner: &Planner) {
         planner.schedule().offset_s,
         source_name(&planner.outcome().source)
     ));
+    Ok(())
 }
 
 /// Offset of the seed streams `tandem schedule` uses by default (see [`schedule`]).
@@ -292,7 +293,7 @@ fn record(a: &RecordArgs) -> Result<()> {
         "T_total: {before_t:.2} s → {:.2} s",
         report.t_total_s
     ));
-    summary_lines(&planner);
+    summary_lines(&planner)?;
     Ok(())
 }
 
@@ -404,7 +405,7 @@ fn inspect(a: &InspectArgs) -> Result<()> {
         obs.total_supervised(),
         obs.total_corrections()
     ));
-    summary_lines(&planner);
+    summary_lines(&planner)?;
     let lows = conf.low_regions();
     const SHOWN: usize = 20;
     out(&format!(

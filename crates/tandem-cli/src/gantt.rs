@@ -4,7 +4,7 @@ use std::fmt::Write as _;
 
 use anyhow::Result;
 use serde_json::{Value, json};
-use tandem::schedule::{GlobalTimeline, Outcome, Problem, Source};
+use tandem::schedule::{GlobalTimeline, LcInterval, Outcome, Problem, Source};
 
 /// Columns of the text Gantt's bars.
 const GANTT_COLUMNS: usize = 72;
@@ -19,9 +19,23 @@ pub(crate) fn source_name(source: &Source) -> String {
     }
 }
 
-/// `T_total` (s) of the fastest serial schedule of `problem` (robot 2 starts when robot 1 ends).
-pub(crate) fn serial_t_total_s(problem: &Problem) -> f64 {
-    problem.serial_schedule().t_total_s(problem.dt_s())
+/// `T_total` (s) of the fastest serial schedule of `problem` (robot 2 starts when robot 1 ends)
+/// at control tick `tick_s` (s; `T_total` does not depend on it, the schedule does).
+pub(crate) fn serial_t_total_s(problem: &Problem, tick_s: f64) -> Result<f64> {
+    Ok(problem.serial_schedule(tick_s)?.t_total_s(problem.dt_s()))
+}
+
+/// Both robots' low-confidence intervals with their robot index (0 or 1), sorted by start
+/// (robot 1 first on a tie).
+fn sorted_intervals(tl: &GlobalTimeline) -> Vec<(usize, LcInterval)> {
+    let mut out: Vec<(usize, LcInterval)> = tl
+        .lc_intervals()
+        .iter()
+        .enumerate()
+        .flat_map(|(robot, ivs)| ivs.iter().map(move |iv| (robot, *iv)))
+        .collect();
+    out.sort_by(|a, b| a.1.start_s.total_cmp(&b.1.start_s));
+    out
 }
 
 /// The schedule as JSON: offset, per-robot gradients, low-confidence intervals in global
@@ -30,13 +44,11 @@ pub(crate) fn serial_t_total_s(problem: &Problem) -> f64 {
 pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Value> {
     let tl = GlobalTimeline::new(problem, &outcome.schedule)?;
     let dt = problem.dt_s();
-    let mut intervals: Vec<_> = tl.lc_intervals().iter().flatten().copied().collect();
-    intervals.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
-    let intervals: Vec<Value> = intervals
+    let intervals: Vec<Value> = sorted_intervals(&tl)
         .iter()
-        .map(|iv| {
+        .map(|(robot, iv)| {
             json!({
-                "robot": iv.robot + 1,
+                "robot": robot + 1,
                 "ref_start": iv.ref_start,
                 "ref_end": iv.ref_end,
                 "start_s": iv.start_s,
@@ -47,10 +59,11 @@ pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Valu
     let s = &outcome.schedule;
     Ok(json!({
         "t_total_s": outcome.t_total_s,
-        "serial_t_total_s": serial_t_total_s(problem),
+        "serial_t_total_s": serial_t_total_s(problem, s.tick_s)?,
         "offset_s": s.offset_s,
         "durations_s": s.durations_s(dt),
         "dt_s": dt,
+        "tick_s": s.tick_s,
         "n_ref": problem.n_ref(),
         "source": source_name(&outcome.source),
         "lc_intervals": intervals,
@@ -91,7 +104,7 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
     let mut out = String::new();
     let dt = problem.dt_s();
     let [d0, d1] = outcome.schedule.durations_s(dt);
-    let serial = serial_t_total_s(problem);
+    let serial = serial_t_total_s(problem, outcome.schedule.tick_s)?;
     writeln!(
         out,
         "T_total {:.2} s (fastest serial {:.2} s, {:.1} % of it); robot 2 starts at τ = {:.2} s",
@@ -119,8 +132,7 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
         out,
         "          = high confidence (unsupervised)   # low confidence (operator supervises)"
     )?;
-    let mut intervals: Vec<_> = tl.lc_intervals().iter().flatten().copied().collect();
-    intervals.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
+    let intervals = sorted_intervals(&tl);
     writeln!(out)?;
     writeln!(
         out,
@@ -128,11 +140,11 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
         intervals.len()
     )?;
     const SHOWN: usize = 40;
-    for iv in intervals.iter().take(SHOWN) {
+    for (robot, iv) in intervals.iter().take(SHOWN) {
         writeln!(
             out,
             "  robot {}  {:>9.2} – {:>9.2} s   ref {:>6} – {:>6}",
-            iv.robot + 1,
+            robot + 1,
             iv.start_s,
             iv.end_s,
             iv.ref_start,

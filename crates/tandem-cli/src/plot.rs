@@ -402,9 +402,8 @@ impl ScheduleFigure {
         let tl = GlobalTimeline::new(planner.problem(), planner.schedule())?;
         let lc = tl
             .lc_intervals()
-            .clone()
             .map(|v| v.iter().map(|iv| (iv.start_s, iv.end_s)).collect());
-        let serial = crate::gantt::serial_t_total_s(planner.problem());
+        let serial = crate::gantt::serial_t_total_s(planner.problem(), planner.schedule().tick_s)?;
         Ok(Self {
             t_total_s: tl.t_total_s(),
             spans: tl.spans_s(),

@@ -509,3 +509,48 @@ fn malformed_need_files() {
         expect_user_error(&args, &needles, Some(&state));
     }
 }
+
+/// A schedule made for another control tick (`[sampler] tick_s`) is refused by `simulate`,
+/// whose workcell runs one tick per reference sample period: its margin check never saw that
+/// period.
+#[test]
+fn simulate_refuses_a_schedule_checked_at_another_tick() {
+    let dir = scratch("bad-tick");
+    let demos = small_demos(&dir);
+    let params = write(
+        &dir,
+        "half_tick.toml",
+        "[sampler]\nsamples = 200\ntick_s = 0.005\n",
+    );
+    let state = dir.join("cell.tandem");
+    let mut fit = vec!["fit".to_string()];
+    fit.extend(demos.iter().map(|p| s(p)));
+    fit.extend(["--params".into(), s(&params), "-o".into(), s(&state)]);
+    ok(&tandem(&fit));
+    // The exported schedule says which tick it was checked with.
+    let json = ok(&tandem([
+        "schedule".to_string(),
+        s(&state),
+        "--json".into(),
+    ]));
+    let doc: serde_json::Value = serde_json::from_str(&json).expect("JSON document");
+    assert_eq!(doc["tick_s"], 0.005);
+    assert_eq!(doc["schedule"]["tick_s"], 0.005);
+    let need = write(
+        &dir,
+        "need.csv",
+        &format!("need\n{}", "0.5\n".repeat(SMALL_N_REF)),
+    );
+    expect_user_error(
+        &[
+            "simulate".to_string(),
+            s(&state),
+            "--need".into(),
+            s(&need),
+            "--pairs".into(),
+            "1".into(),
+        ],
+        &["0.005 s", "re-schedule"],
+        Some(&state),
+    );
+}

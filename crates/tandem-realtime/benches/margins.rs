@@ -2,7 +2,7 @@
 
 use criterion::{BenchmarkId, Criterion, black_box, criterion_main};
 use tandem_realtime::{
-    Coordinator, Timeline, sufficient_margins, sufficient_margins_per_pair,
+    Coordinator, Operator, Timeline, sufficient_margins, sufficient_margins_per_pair,
     sufficient_margins_printed,
 };
 
@@ -50,8 +50,12 @@ fn bench(c: &mut Criterion) {
             let mut co = Coordinator::new(r.clone(), tick_s).expect("valid tick");
             let mut k = 0u32;
             while !co.is_finished() {
-                let g = if k % 7 < 3 { 0.0 } else { f64::INFINITY };
-                black_box(co.tick(g));
+                let g = if k % 7 < 3 {
+                    Operator::Fastest
+                } else {
+                    Operator::Slowest
+                };
+                black_box(co.tick(g).expect("admissible operator"));
                 k += 1;
             }
             k

@@ -1,16 +1,20 @@
-//! Adversarial operators for testing schedules against the safety invariant (DESIGN.md: for
-//! every accepted schedule and every admissible operator rate sequence, the robots are never
-//! both low-confidence in one tick).
+//! Adversarial operators: the one set of operator policies that the safety checks draw from
+//! (`cargo xtask stress`, the schedule crate's `coordinator_safety` test and this crate's
+//! property test `tests/safety.rs`).
 //!
-//! An [`Adversary`] is the gradient the operator commands each control tick; the
-//! [`Coordinator`] clamps it to the low-confidence robot's `[ψ̇min, ψ̇max]` at that sample, so
-//! [`FASTEST`] and [`SLOWEST`] stand for "as fast / as slow as admissible" everywhere.
-//! [`run_adversary`] runs one execution under one adversary and counts the ticks with both
-//! robots low-confidence.
+//! The invariant they test: for every schedule [`sufficient_margins`](crate::sufficient_margins)
+//! accepts and every admissible operator, the robots are never both low-confidence in one
+//! tick. An [`Adversary`] picks the [`Operator`] input of each control tick, possibly from
+//! the coordinator's state (which robot is low-confidence now); the set contains the extremes,
+//! random and switching sequences, and — as [`Adversary::RushRobot`] — exactly Alg. 2's worst
+//! case for each role (rush the current robot while it is low-confidence, drag the previous
+//! one while it is). [`adversary_set`] returns the full set for one case, [`run_adversary`]
+//! runs one execution under one adversary and counts the ticks with both robots
+//! low-confidence.
 //!
 //! ```
 //! use rand::SeedableRng;
-//! use tandem_realtime::adversary::{Adversary, run_adversary};
+//! use tandem_realtime::adversary::{adversary_set, run_adversary};
 //! use tandem_realtime::{Coordinator, Timeline};
 //!
 //! let conf = [true, false, false, true, true, true];
@@ -20,53 +24,125 @@
 //!     Timeline::new(&conf, &mean, &lo, &hi, 0.45, 0.1)?,
 //! ];
 //! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
-//! let adversary = Adversary::RandomSwitching { max_hold: 5 };
-//! let run = run_adversary(Coordinator::new(robots, 0.05)?, adversary, &mut rng, 1000);
-//! assert!(run.finished && run.overlap_ticks == 0 && run.first_overlap.is_none());
+//! for adversary in adversary_set([0.8, 1.25], 20, &mut rng) {
+//!     let coordinator = Coordinator::new(robots.clone(), 0.05)?;
+//!     let run = run_adversary(coordinator, adversary, &mut rng, 1000)?;
+//!     assert!(run.finished && run.overlap_ticks == 0 && run.first_overlap.is_none());
+//! }
 //! # Ok::<(), tandem_realtime::Error>(())
 //! ```
 
 use rand::Rng;
 
-use crate::Coordinator;
+use crate::{Coordinator, Operator, Result};
 
-/// A gradient far below every `ψ̇min`: the coordinator clamps it to the fastest admissible.
-pub const FASTEST: f64 = 0.0;
-/// A gradient far above every `ψ̇max`: the coordinator clamps it to the slowest admissible.
-pub const SLOWEST: f64 = 1e9;
-
-/// An operator policy: which gradient (execution samples per reference sample) the operator
-/// commands at each control tick.
+/// An operator policy: which [`Operator`] input the operator gives at each control tick.
+/// Extremes are clamped by the coordinator to the low-confidence robot's `[ψ̇min, ψ̇max]` at
+/// its sample, so [`Operator::Fastest`] / [`Operator::Slowest`] mean "as fast / as slowly as
+/// admissible" everywhere.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Adversary {
-    /// Always [`FASTEST`] (rushing).
+    /// Never corrects ([`Operator::Scheduled`]).
+    Nominal,
+    /// Always [`Operator::Fastest`] (rushing).
     Fastest,
-    /// Always [`SLOWEST`] (dragging).
+    /// Always [`Operator::Slowest`] (dragging).
     Slowest,
-    /// [`FASTEST`] on even ticks, [`SLOWEST`] on odd ones.
-    Switching,
-    /// Holds one extreme for a uniform `1..=max_hold` ticks, then switches to the other
-    /// (starting with [`SLOWEST`]). `max_hold ≥ 1`.
+    /// Fastest for `period` ticks, then slowest for `period` ticks, and so on, shifted by
+    /// `phase` ticks; `period: 1, phase: 0` switches every tick (fastest on even ticks).
+    Periodic {
+        /// Ticks per half period (≥ 1).
+        period: u32,
+        /// Ticks by which the pattern is shifted.
+        phase: u32,
+    },
+    /// Fastest until tick `at`, slowest from then on (`rev`: slowest first).
+    SwitchOnce {
+        /// Index of the first tick of the second half.
+        at: u64,
+        /// Slowest first, fastest after.
+        rev: bool,
+    },
+    /// Holds one extreme for a uniform `1..=max_hold` ticks, then the other (starting with
+    /// slowest).
     RandomSwitching {
-        /// Longest hold, ticks.
+        /// Longest hold, ticks (≥ 1).
         max_hold: u32,
     },
-    /// A fresh gradient uniform in `[lo, hi]` every tick (choose a range covering the bounds).
+    /// Fastest or slowest, drawn afresh every tick.
+    RandomExtreme,
+    /// A fresh gradient uniform in `[lo, hi]` every tick (choose a range covering the bounds;
+    /// `lo > 0`).
     Random {
-        /// Lowest gradient.
+        /// Lowest gradient (execution samples per reference sample).
         lo: f64,
         /// Highest gradient.
         hi: f64,
     },
     /// A gradient uniform in `[lo, hi]` held for a uniform `1..=max_hold` ticks.
     RandomHeld {
-        /// Lowest gradient.
+        /// Lowest gradient (> 0).
         lo: f64,
         /// Highest gradient.
         hi: f64,
         /// Longest hold, ticks (≥ 1).
         max_hold: u32,
     },
+    /// Alg. 2's worst case for the role whose current robot is `rush`: rush robot `rush`
+    /// whenever it is the low-confidence one, drag the other whenever it is.
+    RushRobot {
+        /// Robot (0 or 1) to rush.
+        rush: usize,
+    },
+    /// Each time the low-confidence robot changes, an extreme drawn at random for it, held
+    /// while it stays low-confidence.
+    RandomPerRobot,
+}
+
+/// Number of adversaries in [`adversary_set`].
+pub const SET_SIZE: usize = 13;
+
+/// The full set of adversaries for one case: the extremes, no correction, Alg. 2's worst case
+/// for both roles, switching every tick, periodic with a random period (1–8 ticks) and phase,
+/// one switch at a random tick below `ticks` (about one execution's length, in ticks), random
+/// switching (holds up to 50 ticks), random extremes per tick and per robot, and random
+/// gradients over `grad_range = [lo, hi]` (the problem's `[min ψ̇min, max ψ̇max]`, execution
+/// samples per reference sample) per tick and held up to 50 ticks. The random parameters are
+/// drawn from `rng`.
+pub fn adversary_set(
+    grad_range: [f64; 2],
+    ticks: u64,
+    rng: &mut impl Rng,
+) -> [Adversary; SET_SIZE] {
+    let [lo, hi] = grad_range;
+    [
+        Adversary::Nominal,
+        Adversary::Fastest,
+        Adversary::Slowest,
+        Adversary::RushRobot { rush: 0 },
+        Adversary::RushRobot { rush: 1 },
+        Adversary::Periodic {
+            period: 1,
+            phase: 0,
+        },
+        Adversary::Periodic {
+            period: rng.random_range(1..=8),
+            phase: rng.random_range(0..16),
+        },
+        Adversary::SwitchOnce {
+            at: rng.random_range(0..ticks.max(1)),
+            rev: rng.random_bool(0.5),
+        },
+        Adversary::RandomSwitching { max_hold: 50 },
+        Adversary::RandomExtreme,
+        Adversary::RandomPerRobot,
+        Adversary::Random { lo, hi },
+        Adversary::RandomHeld {
+            lo,
+            hi,
+            max_hold: 50,
+        },
+    ]
 }
 
 /// What one execution under an [`Adversary`] did.
@@ -91,49 +167,118 @@ fn uniform(rng: &mut impl Rng, lo: f64, hi: f64) -> f64 {
     }
 }
 
-/// Runs `coordinator` to the end (or for at most `max_ticks` ticks) with the operator
-/// gradients of `adversary`, drawing from `rng` (deterministic for its state).
+/// The extreme drawn at random.
+fn random_extreme(rng: &mut impl Rng) -> Operator {
+    if rng.random_bool(0.5) {
+        Operator::Fastest
+    } else {
+        Operator::Slowest
+    }
+}
+
+/// An adversary's memory between ticks (holds, per-robot choices).
+struct PolicyState {
+    /// Ticks left in the current hold.
+    hold: u32,
+    /// The input being held.
+    current: Operator,
+    /// [`Adversary::RandomPerRobot`]: each robot's extreme.
+    per_robot: [Operator; 2],
+    /// The low-confidence robot at the previous tick.
+    last_lc: Option<usize>,
+}
+
+impl PolicyState {
+    fn new() -> Self {
+        PolicyState {
+            hold: 0,
+            current: Operator::Fastest,
+            per_robot: [Operator::Fastest, Operator::Slowest],
+            last_lc: None,
+        }
+    }
+
+    /// The input of tick `k` given the low-confidence robot at its start, `lc`.
+    fn next(
+        &mut self,
+        adversary: Adversary,
+        k: u64,
+        lc: Option<usize>,
+        rng: &mut impl Rng,
+    ) -> Operator {
+        let extreme = |fast: bool| {
+            if fast {
+                Operator::Fastest
+            } else {
+                Operator::Slowest
+            }
+        };
+        let op = match adversary {
+            Adversary::Nominal => Operator::Scheduled,
+            Adversary::Fastest => Operator::Fastest,
+            Adversary::Slowest => Operator::Slowest,
+            Adversary::Periodic { period, phase } => {
+                extreme(((k + u64::from(phase)) / u64::from(period.max(1))) % 2 == 0)
+            }
+            Adversary::SwitchOnce { at, rev } => extreme((k < at) != rev),
+            Adversary::RandomSwitching { max_hold } => {
+                if self.hold == 0 {
+                    self.current = if self.current == Operator::Fastest {
+                        Operator::Slowest
+                    } else {
+                        Operator::Fastest
+                    };
+                    self.hold = rng.random_range(1..=max_hold.max(1));
+                }
+                self.hold -= 1;
+                self.current
+            }
+            Adversary::RandomExtreme => random_extreme(rng),
+            Adversary::Random { lo, hi } => Operator::Gradient(uniform(rng, lo, hi)),
+            Adversary::RandomHeld { lo, hi, max_hold } => {
+                if self.hold == 0 {
+                    self.current = Operator::Gradient(uniform(rng, lo, hi));
+                    self.hold = rng.random_range(1..=max_hold.max(1));
+                }
+                self.hold -= 1;
+                self.current
+            }
+            Adversary::RushRobot { rush } => extreme(lc == Some(rush)),
+            Adversary::RandomPerRobot => {
+                if lc != self.last_lc
+                    && let Some(i) = lc
+                {
+                    self.per_robot[i] = random_extreme(rng);
+                }
+                lc.map_or(Operator::Scheduled, |i| self.per_robot[i])
+            }
+        };
+        self.last_lc = lc;
+        op
+    }
+}
+
+/// Runs `coordinator` to the end (or for at most `max_ticks` ticks) with the operator inputs
+/// of `adversary`, drawing from `rng` (deterministic for its state).
+///
+/// # Errors
+/// [`crate::Error::BadOperator`] when the adversary produces an inadmissible gradient (a
+/// [`Adversary::Random`] range reaching 0 or beyond).
 pub fn run_adversary(
     mut coordinator: Coordinator,
     adversary: Adversary,
     rng: &mut impl Rng,
     max_ticks: u64,
-) -> AdversaryRun {
+) -> Result<AdversaryRun> {
     let mut run = AdversaryRun::default();
-    let (mut hold, mut current) = (0u32, FASTEST);
+    let mut state = PolicyState::new();
     while !coordinator.is_finished() {
         if run.ticks >= max_ticks {
-            return run;
+            return Ok(run);
         }
-        let g = match adversary {
-            Adversary::Fastest => FASTEST,
-            Adversary::Slowest => SLOWEST,
-            Adversary::Switching => {
-                if run.ticks % 2 == 0 {
-                    FASTEST
-                } else {
-                    SLOWEST
-                }
-            }
-            Adversary::RandomSwitching { max_hold } => {
-                if hold == 0 {
-                    current = if current == FASTEST { SLOWEST } else { FASTEST };
-                    hold = rng.random_range(1..=max_hold.max(1));
-                }
-                hold -= 1;
-                current
-            }
-            Adversary::Random { lo, hi } => uniform(rng, lo, hi),
-            Adversary::RandomHeld { lo, hi, max_hold } => {
-                if hold == 0 {
-                    current = uniform(rng, lo, hi);
-                    hold = rng.random_range(1..=max_hold.max(1));
-                }
-                hold -= 1;
-                current
-            }
-        };
-        let tick = coordinator.tick(g);
+        let lc = coordinator.low_conf_now().iter().position(|&l| l);
+        let op = state.next(adversary, run.ticks, lc, rng);
+        let tick = coordinator.tick(op)?;
         if tick.low_conf[0] && tick.low_conf[1] {
             run.first_overlap.get_or_insert(run.ticks);
             run.overlap_ticks += 1;
@@ -141,5 +286,77 @@ pub fn run_adversary(
         run.ticks += 1;
     }
     run.finished = true;
-    run
+    Ok(run)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Timeline;
+    use rand::SeedableRng;
+
+    /// [LC, HC, HC] for both robots, Δt_s = 1, started together: an unsafe schedule.
+    fn robots() -> [Timeline; 2] {
+        let (g, lo, hi) = ([1.0; 3], [0.5; 3], [2.0; 3]);
+        let conf = [false, true, true];
+        [
+            Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap(),
+            Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap(),
+        ]
+    }
+
+    #[test]
+    fn policies_by_hand() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
+        let mut st = PolicyState::new();
+        let seq = |st: &mut PolicyState, a, rng: &mut rand_chacha::ChaCha8Rng| {
+            (0..6).map(|k| st.next(a, k, None, rng)).collect::<Vec<_>>()
+        };
+        use Operator::{Fastest as F, Slowest as S};
+        let periodic = Adversary::Periodic {
+            period: 2,
+            phase: 1,
+        };
+        assert_eq!(seq(&mut st, periodic, &mut rng), [F, S, S, F, F, S]);
+        let once = Adversary::SwitchOnce { at: 2, rev: true };
+        assert_eq!(seq(&mut st, once, &mut rng), [S, S, F, F, F, F]);
+        // Rushing robot 1 when it is LC, dragging robot 0 when it is.
+        let rush = Adversary::RushRobot { rush: 1 };
+        assert_eq!(st.next(rush, 0, Some(1), &mut rng), F);
+        assert_eq!(st.next(rush, 1, Some(0), &mut rng), S);
+        // Per robot: the extreme is drawn when the LC robot changes and held while it stays.
+        let mut st = PolicyState::new();
+        let a = st.next(Adversary::RandomPerRobot, 0, Some(0), &mut rng);
+        assert!((1..20).all(|k| st.next(Adversary::RandomPerRobot, k, Some(0), &mut rng) == a));
+        assert_eq!(
+            st.next(Adversary::RandomPerRobot, 20, None, &mut rng),
+            Operator::Scheduled
+        );
+    }
+
+    #[test]
+    fn a_bad_random_range_is_an_error_and_the_set_is_complete() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        let c = Coordinator::new(robots(), 1.0).unwrap();
+        let bad = Adversary::Random { lo: -1.0, hi: -0.5 };
+        assert!(matches!(
+            run_adversary(c, bad, &mut rng, 100),
+            Err(crate::Error::BadOperator { .. })
+        ));
+        let set = adversary_set([0.5, 2.0], 10, &mut rng);
+        for want in [
+            Adversary::Nominal,
+            Adversary::RushRobot { rush: 0 },
+            Adversary::RushRobot { rush: 1 },
+            Adversary::RandomPerRobot,
+        ] {
+            assert!(set.contains(&want), "{want:?}");
+        }
+        // Both robots are LC together from the start: every policy sees the overlap.
+        for a in set {
+            let c = Coordinator::new(robots(), 1.0).unwrap();
+            let run = run_adversary(c, a, &mut rng, 100).unwrap();
+            assert!(run.finished && run.first_overlap.is_some(), "{a:?}");
+        }
+    }
 }

@@ -2,7 +2,42 @@
 
 use crate::error::{Error, Result};
 use crate::strategy::{high_conf_steps, response_step};
-use crate::timeline::{Timeline, clock_tolerance_s};
+use crate::timeline::Timeline;
+use crate::tol::clock_tolerance_s;
+
+/// The operator's input to one control tick (§II-B5): how the correction given to the
+/// low-confidence robot sets its timing. Ignored when no robot is low-confidence.
+///
+/// The three conventions that used to encode this in one `f64` (0 for fastest, a huge value
+/// or infinity for slowest, NaN for "no correction") are gone: a NaN from a degenerate
+/// command is now an error ([`Error::BadOperator`]), not a silent "no correction".
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Operator {
+    /// No correction: the low-confidence robot keeps its scheduled gradient `ψ̇_E`.
+    Scheduled,
+    /// The correction commands execution gradient `g` (execution samples per reference
+    /// sample; finite and > 0), clamped to `[ψ̇min, ψ̇max]` at the robot's current sample.
+    Gradient(f64),
+    /// As fast as the demonstrations allow: the gradient `ψ̇min` (the operator rushes).
+    Fastest,
+    /// As slowly as the demonstrations allow: the gradient `ψ̇max` (the operator drags).
+    Slowest,
+}
+
+impl Operator {
+    /// Checks a [`Operator::Gradient`]: finite and > 0.
+    ///
+    /// # Errors
+    /// [`Error::BadOperator`] with the gradient.
+    pub fn validate(self) -> Result<Self> {
+        match self {
+            Operator::Gradient(g) if !(g.is_finite() && g > 0.0) => {
+                Err(Error::BadOperator { gradient: g })
+            }
+            op => Ok(op),
+        }
+    }
+}
 
 /// What one [`Coordinator::tick`] did.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,8 +79,9 @@ enum Phase {
 /// one control period `tick_s` (real seconds) per [`tick`](Coordinator::tick).
 ///
 /// Rules per tick (modes, rates and bounds are read at each robot's sample at the tick start):
-/// - a low-confidence robot steps at the operator's rate: operator gradient `g`, clamped to
-///   `[ψ̇min, ψ̇max]`, gives the schedule-clock step `(ψ̇_E/g)·tick_s ∈ [S·tick_s, F·tick_s]`;
+/// - a low-confidence robot steps at the operator's rate: the [`Operator`]'s gradient `g`
+///   (`ψ̇_E` when there is no correction), clamped to `[ψ̇min, ψ̇max]`, gives the
+///   schedule-clock step `(ψ̇_E/g)·tick_s ∈ [S·tick_s, F·tick_s]`;
 /// - the other robot, if running and high-confidence, responds with Eq. 18 to the lead measured
 ///   after the low-confidence robot's step;
 /// - both high-confidence: `HIGH-CONF` (Alg. 1), the ahead robot (robot 0 when level) is `a`;
@@ -116,6 +152,25 @@ impl Coordinator {
         (0..2).all(|i| self.clock_s[i] >= self.robots[i].end_s())
     }
 
+    /// Puts both schedule clocks back at the earlier start, as [`Coordinator::new`] left them
+    /// (no allocation: to run the same plan again).
+    pub fn reset(&mut self) {
+        let t0 = self.robots[0].start_s().min(self.robots[1].start_s());
+        self.clock_s = [t0, t0];
+        self.cursors = [Cursors::default(); 2];
+    }
+
+    /// Whether each robot is running and low-confidence at its current schedule clock (Eq. 16
+    /// at the tick start): the robot the next [`tick`](Coordinator::tick) moves at the
+    /// operator's rate. O(1), no allocation.
+    pub fn low_conf_now(&self) -> [bool; 2] {
+        [0, 1].map(|i| {
+            let r = &self.robots[i];
+            let s = self.clock_s[i];
+            s >= r.start_s() && s < r.end_s() && !r.conf()[self.cursors[i].at]
+        })
+    }
+
     fn phase(&mut self, i: usize) -> Phase {
         let r = &self.robots[i];
         let s = self.clock_s[i];
@@ -131,34 +186,37 @@ impl Coordinator {
         }
     }
 
-    /// Schedule-clock step of robot `i` commanded by the operator's gradient `g`.
-    fn operator_step(&self, i: usize, g: f64) -> f64 {
+    /// Schedule-clock step of robot `i` commanded by the operator.
+    fn operator_step(&self, i: usize, op: Operator) -> f64 {
         let r = &self.robots[i];
         let n = self.cursors[i].at;
         let (lo, hi) = (r.grad_min()[n], r.grad_max()[n]);
-        let g = if g.is_nan() {
-            r.grad_exec()[n]
-        } else {
-            g.clamp(lo, hi)
+        let g = match op {
+            Operator::Scheduled => r.grad_exec()[n],
+            Operator::Gradient(g) => g.clamp(lo, hi),
+            Operator::Fastest => lo,
+            Operator::Slowest => hi,
         };
         r.grad_exec()[n] / g * self.tick_s
     }
 
     /// Step of a robot that runs without a partner to adapt to.
-    fn alone_step(&self, i: usize, low_conf: bool, g: f64) -> f64 {
+    fn alone_step(&self, i: usize, low_conf: bool, op: Operator) -> f64 {
         if low_conf {
-            self.operator_step(i, g)
+            self.operator_step(i, op)
         } else {
             self.tick_s
         }
     }
 
-    /// Advances one control period. `operator_gradient` is the execution gradient the
-    /// operator's correction commands for the low-confidence robot (clamped to that robot's
-    /// `[ψ̇min, ψ̇max]` at its current sample; NaN means "no change", the scheduled `ψ̇_E`);
-    /// it is ignored when no robot is low-confidence.
-    pub fn tick(&mut self, operator_gradient: f64) -> Tick {
-        let g = operator_gradient;
+    /// Advances one control period with the operator's input `operator` for the
+    /// low-confidence robot (ignored when no robot is low-confidence). Never allocates.
+    ///
+    /// # Errors
+    /// [`Error::BadOperator`] for an [`Operator::Gradient`] that is NaN, infinite or ≤ 0;
+    /// the coordinator is then unchanged.
+    pub fn tick(&mut self, operator: Operator) -> Result<Tick> {
+        let g = operator.validate()?;
         let h = self.tick_s;
         let phases = [self.phase(0), self.phase(1)];
         let rates = |c: &Self, i: usize| c.robots[i].rates(c.cursors[i].at);
@@ -239,7 +297,7 @@ impl Coordinator {
             let n = r.advance_cursor(&mut self.cursors[i].at, s_new);
             out.ref_time[i] = r.ref_time_in(n, s_new);
         }
-        out
+        Ok(out)
     }
 }
 
@@ -262,21 +320,21 @@ mod tests {
         let mut c = Coordinator::new(three_sample(1.5), 1.0).unwrap();
         // Tick 0: robot 0 alone and HC runs on schedule (step 1); robot 1 waits, its clock
         // follows. Robot 0 ends exactly where its LC sample starts: the tolerance reports it LC.
-        let t = c.tick(0.0);
+        let t = c.tick(Operator::Fastest).unwrap();
         assert_eq!(c.clock_s(), [1.0, 1.0]);
         assert_eq!(t.ref_time, [1.0, 0.0]);
         assert_eq!(t.running, [true, false]);
         assert_eq!(t.low_conf, [true, false]);
         // Tick 1: robot 0 LC, operator drags (g → ψ̇max = 2, step ½); robot 1's clock reaches
         // its start 1.5 (capped) and starts at the next tick boundary.
-        let t = c.tick(f64::INFINITY);
+        let t = c.tick(Operator::Slowest).unwrap();
         assert_eq!(c.clock_s(), [1.5, 1.5]);
         assert_eq!(t.ref_time, [1.5, 0.0]);
         assert_eq!(t.low_conf, [true, false]);
         assert_eq!(t.running, [true, false]);
         // Tick 2: operator rushes robot 0 (g → ψ̇min = ½, step 2); robot 1 (HC) matches the
         // step (Eq. 18) and enters its LC sample (clock 2.5) while robot 0 is still in its own.
-        let t = c.tick(0.0);
+        let t = c.tick(Operator::Fastest).unwrap();
         assert_eq!(c.clock_s(), [3.0, 3.5]);
         assert_eq!(t.ref_time, [3.0, 2.0]);
         assert_eq!(t.low_conf, [true, true]);
@@ -288,23 +346,23 @@ mod tests {
         // Robot 0: [LC, HC, HC, HC]; robot 1 scheduled to start at τ = 2; tick ½.
         let conf = [false, true, true, true];
         let (g, lo, hi) = ([1.0; 4], [0.5; 4], [2.0; 4]);
-        let first_running_tick = |operator: f64| {
+        let first_running_tick = |operator: Operator| {
             let r0 = Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap();
             let r1 = Timeline::new(&conf, &g, &lo, &hi, 2.0, 1.0).unwrap();
             let mut c = Coordinator::new([r0, r1], 0.5).unwrap();
             (0..100).find(|_| {
-                let t = c.tick(operator);
+                let t = c.tick(operator).unwrap();
                 // Until it starts, robot 1's clock equals robot 0's (capped at τ).
                 assert!(t.running[1] || c.clock_s()[1] == c.clock_s()[0].min(2.0));
                 t.running[1]
             })
         };
         // On schedule: LC sample in 2 ticks of ½, HC samples run on schedule → starts after 4.
-        assert_eq!(first_running_tick(f64::NAN), Some(4));
+        assert_eq!(first_running_tick(Operator::Scheduled), Some(4));
         // Dragged (step S·tick = ¼): the LC sample takes 4 ticks, robot 1 starts 1 s later.
-        assert_eq!(first_running_tick(f64::INFINITY), Some(6));
+        assert_eq!(first_running_tick(Operator::Slowest), Some(6));
         // Rushed (step F·tick = 1): one tick on the LC sample, robot 1 starts ½ s earlier.
-        assert_eq!(first_running_tick(0.0), Some(3));
+        assert_eq!(first_running_tick(Operator::Fastest), Some(3));
     }
 
     #[test]
@@ -315,7 +373,7 @@ mod tests {
         let r0 = Timeline::new(&conf, &g, &[0.5; 4], &[2.0; 4], 0.0, 1.0).unwrap();
         let r1 = Timeline::new(&conf, &g, &[2.0 / 3.0; 4], &[2.0; 4], 0.0, 1.0).unwrap();
         let mut c = Coordinator::new([r0, r1], 1.0).unwrap();
-        let t = c.tick(0.0);
+        let t = c.tick(Operator::Fastest).unwrap();
         assert_eq!(c.clock_s(), [1.5, 1.5]);
         assert_eq!(t.ref_time, [1.5, 1.5]);
         assert_eq!(t.low_conf, [false, false]);
@@ -329,30 +387,30 @@ mod tests {
         let mut c = Coordinator::new([r0, r1], 0.25).unwrap();
         // Operator gradient 0.8 (inside [½, 2]) → robot 0 steps (1/0.8)·¼ = 0.3125; robot 1
         // (F = 1.25) matches it exactly.
-        let t = c.tick(0.8);
+        let t = c.tick(Operator::Gradient(0.8)).unwrap();
         assert_eq!(c.clock_s(), [0.3125, 0.3125]);
         assert_eq!(t.low_conf, [true, false]);
         // Operator fastest: robot 0 steps 2·¼ = ½; robot 1 can only do 1.25·¼.
-        c.tick(0.0);
+        c.tick(Operator::Fastest).unwrap();
         assert_eq!(c.clock_s(), [0.8125, 0.625]);
         // Robot 0 finishes (clock capped at its end, 1.0); robot 1 then runs on schedule.
-        c.tick(0.0);
+        c.tick(Operator::Fastest).unwrap();
         assert_eq!(c.clock_s()[0], 1.0);
         let before = c.clock_s()[1];
-        let t = c.tick(0.0);
+        let t = c.tick(Operator::Fastest).unwrap();
         assert_eq!(c.clock_s()[1], before + 0.25);
         assert_eq!(t.running, [false, true]);
         assert_eq!(t.low_conf, [false, false]);
         while !c.is_finished() {
-            c.tick(0.0);
+            c.tick(Operator::Fastest).unwrap();
         }
-        let t = c.tick(0.0);
+        let t = c.tick(Operator::Fastest).unwrap();
         assert_eq!(t.ref_time, [1.0, 4.0]);
         assert_eq!(t.running, [false, false]);
     }
 
     #[test]
-    fn bad_tick_and_nan_operator() {
+    fn bad_tick_and_bad_operator_are_errors() {
         let r = three_sample(1.5);
         assert!(matches!(
             Coordinator::new(r.clone(), 0.0),
@@ -360,9 +418,53 @@ mod tests {
         ));
         assert!(Coordinator::new(r.clone(), f64::NAN).is_err());
         let mut c = Coordinator::new(r, 1.0).unwrap();
-        c.tick(f64::NAN);
-        // NaN operator = scheduled gradient: robot 0 in its LC sample steps exactly one tick.
-        c.tick(f64::NAN);
+        c.tick(Operator::Scheduled).unwrap();
+        // Robot 0 is now in its LC sample. A degenerate gradient is an error that leaves the
+        // coordinator as it was, not "no correction".
+        for g in [f64::NAN, f64::INFINITY, 0.0, -1.0] {
+            let err = c.tick(Operator::Gradient(g)).unwrap_err();
+            assert!(
+                matches!(err, Error::BadOperator { gradient } if gradient.total_cmp(&g).is_eq()),
+                "{err}"
+            );
+            assert_eq!(c.clock_s(), [1.0, 1.0]);
+        }
+        // No correction = the scheduled gradient: robot 0 steps exactly one tick.
+        assert_eq!(c.low_conf_now(), [true, false]);
+        c.tick(Operator::Scheduled).unwrap();
         assert_eq!(c.clock_s(), [2.0, 1.5]);
+        // A gradient far outside the bounds is clamped: 1e9 drags like Slowest.
+        let mut drag = Coordinator::new(three_sample(1.5), 1.0).unwrap();
+        let mut slow = drag.clone();
+        drag.tick(Operator::Scheduled).unwrap();
+        slow.tick(Operator::Scheduled).unwrap();
+        drag.tick(Operator::Gradient(1e9)).unwrap();
+        slow.tick(Operator::Slowest).unwrap();
+        assert_eq!(drag.clock_s(), slow.clock_s());
+    }
+
+    #[test]
+    fn reset_runs_the_same_plan_again() {
+        let mut c = Coordinator::new(three_sample(1.5), 0.5).unwrap();
+        let ops = [
+            Operator::Fastest,
+            Operator::Slowest,
+            Operator::Gradient(0.7),
+        ];
+        let run = |c: &mut Coordinator| {
+            let mut ticks = Vec::new();
+            let mut k = 0;
+            while !c.is_finished() {
+                ticks.push(c.tick(ops[k % 3]).unwrap());
+                k += 1;
+            }
+            ticks
+        };
+        let first = run(&mut c);
+        assert!(c.is_finished());
+        c.reset();
+        assert_eq!(c.clock_s(), [0.0, 0.0]);
+        assert_eq!(c.low_conf_now(), [false, false]);
+        assert_eq!(run(&mut c), first);
     }
 }

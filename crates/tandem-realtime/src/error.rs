@@ -33,6 +33,15 @@ pub enum Error {
         /// What is wrong.
         why: &'static str,
     },
+    /// The operator's gradient for a control tick is NaN, infinite or not positive (e.g. from
+    /// a degenerate command); "no correction" is `Operator::Scheduled`.
+    #[error(
+        "operator gradient {gradient} must be finite and > 0 (no correction is `Operator::Scheduled`)"
+    )]
+    BadOperator {
+        /// The gradient given (execution samples per reference sample).
+        gradient: f64,
+    },
     /// A scalar parameter is out of its valid range.
     #[error("parameter `{name}` {why}")]
     BadParam {

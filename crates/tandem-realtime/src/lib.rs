@@ -13,7 +13,7 @@
 //! seconds, control tick `tick_s` in real seconds.
 //!
 //! ```
-//! use tandem_realtime::{Coordinator, Timeline, sufficient_margins};
+//! use tandem_realtime::{Coordinator, Operator, Timeline, sufficient_margins};
 //!
 //! // 6 reference samples of 0.1 s; samples 1 and 2 are low confidence (false).
 //! let conf = [true, false, false, true, true, true];
@@ -34,7 +34,7 @@
 //! // Run with an operator who slows the low-confidence robot down as much as allowed.
 //! let mut coord = Coordinator::new(robots, tick_s)?;
 //! while !coord.is_finished() {
-//!     let tick = coord.tick(f64::INFINITY);
+//!     let tick = coord.tick(Operator::Slowest)?;
 //!     assert!(!(tick.low_conf[0] && tick.low_conf[1]));
 //! }
 //! # Ok::<(), tandem_realtime::Error>(())
@@ -46,9 +46,10 @@ mod error;
 pub mod margins;
 mod strategy;
 mod timeline;
+pub mod tol;
 
-pub use coordinator::{Coordinator, Tick};
+pub use coordinator::{Coordinator, Operator, Tick};
 pub use error::{Error, Result};
 pub use margins::{sufficient_margins, sufficient_margins_per_pair, sufficient_margins_printed};
 pub use strategy::{high_conf_steps, response_step};
-pub use timeline::{Rates, Timeline, clock_tolerance_s};
+pub use timeline::{LcInterval, Rates, Timeline, clock_end_s, clock_s};

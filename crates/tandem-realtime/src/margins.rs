@@ -2,7 +2,7 @@
 //!
 //! # Pairs and roles
 //! The low-confidence (LC) regions of both robots are taken as exact schedule-clock intervals
-//! `[c_{n0}, c_{n1+1})` (see [`Timeline::low_conf_regions`]) and merged by start time. Every two
+//! `[c_{n0}, c_{n1+1})` (see [`Timeline::lc_intervals`]) and merged by start time. Every two
 //! consecutive regions of *different* robots form a pair: the earlier region's robot is the
 //! previous robot `p`, whose region ends at `T_p`; the later one is the current robot `c`, whose
 //! region starts at `T_c`. The pair is safe when `c` can never enter its region before `p` has
@@ -68,17 +68,31 @@ use std::collections::VecDeque;
 
 use crate::error::{Error, Result};
 use crate::strategy::{high_conf_steps, response_step};
-use crate::timeline::{Rates, Timeline, clock_tolerance_s};
+use crate::timeline::{LcInterval, Rates, Timeline};
+use crate::tol::clock_tolerance_s;
 
 /// Upper bound on simulated ticks per role; a `tick_s` needing more is rejected as invalid.
 const MAX_SIM_TICKS: f64 = 1e8;
 
-/// A pair of consecutive LC regions of different robots: previous region ends at `t_p_end`,
-/// current region starts at `t_c_start` (schedule clock, s).
+/// A pair of consecutive LC regions of different robots: the previous robot's region `prev`
+/// (it leaves it at `T_p = prev.end_s`) and the current robot's `cur` (it enters it at
+/// `T_c = cur.start_s`), schedule clock.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Pair {
-    t_p_end: f64,
-    t_c_start: f64,
+    prev: LcInterval,
+    cur: LcInterval,
+}
+
+impl Pair {
+    /// `T_p` (s): where the previous robot leaves its region.
+    fn t_p_end(&self) -> f64 {
+        self.prev.end_s
+    }
+
+    /// `T_c` (s): where the current robot enters its region.
+    fn t_c_start(&self) -> f64 {
+        self.cur.start_s
+    }
 }
 
 /// Shared set-up of the three checks.
@@ -114,19 +128,16 @@ impl Setup {
                 why: "too small: the margin simulation would need more than 1e8 ticks",
             });
         }
-        let mut regions: Vec<(f64, f64, usize)> = Vec::new();
+        let mut regions: Vec<(LcInterval, usize)> = Vec::new();
         for (i, r) in robots.iter().enumerate() {
-            regions.extend(r.low_conf_regions().into_iter().map(|(a, b)| (a, b, i)));
+            regions.extend(r.lc_intervals().iter().map(|&iv| (iv, i)));
         }
-        regions.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
+        regions.sort_by(|x, y| x.0.start_s.total_cmp(&y.0.start_s).then(x.1.cmp(&y.1)));
         let mut pairs: [Vec<Pair>; 2] = [Vec::new(), Vec::new()];
         for w in regions.windows(2) {
-            let (prev, cur) = (w[0], w[1]);
-            if prev.2 != cur.2 {
-                pairs[prev.2].push(Pair {
-                    t_p_end: prev.1,
-                    t_c_start: cur.0,
-                });
+            let ((prev, p), (cur, c)) = (w[0], w[1]);
+            if p != c {
+                pairs[p].push(Pair { prev, cur });
             }
         }
         Ok(Setup {
@@ -144,11 +155,12 @@ impl Setup {
     fn prefilter(&self, robots: &[Timeline; 2], p: usize, pair: Pair) -> Option<bool> {
         let end_p = robots[p].end_s();
         if p == self.first
-            && (pair.t_p_end + self.eps <= self.tau || (pair.t_p_end >= end_p && end_p <= self.tau))
+            && (pair.t_p_end() + self.eps <= self.tau
+                || (pair.t_p_end() >= end_p && end_p <= self.tau))
         {
             return Some(true);
         }
-        if pair.t_c_start < pair.t_p_end + self.eps {
+        if pair.t_c_start() < pair.t_p_end() + self.eps {
             return Some(false);
         }
         None
@@ -338,18 +350,18 @@ impl<'a> RoleSim<'a> {
     fn test(&self, pair: Pair, setup: &Setup) -> Option<bool> {
         match self.variant {
             Variant::Printed => {
-                if self.t_c >= pair.t_c_start {
+                if self.t_c >= pair.t_c_start() {
                     Some(false)
-                } else if self.t_p >= pair.t_p_end {
+                } else if self.t_p >= pair.t_p_end() {
                     Some(true)
                 } else {
                     None
                 }
             }
             Variant::Conservative => {
-                if self.t_c + setup.max_step >= pair.t_c_start - setup.eps {
+                if self.t_c + setup.max_step >= pair.t_c_start() - setup.eps {
                     Some(false)
-                } else if self.t_p >= pair.t_p_end + setup.eps {
+                } else if self.t_p >= pair.t_p_end() + setup.eps {
                     Some(true)
                 } else {
                     None
@@ -492,12 +504,22 @@ mod tests {
         assert_eq!(s.tau, 1.5);
         assert_eq!(s.first, 0);
         assert_eq!(s.max_step, 2.0);
+        let iv = |start_s, end_s| LcInterval {
+            ref_start: 1,
+            ref_end: 2,
+            start_s,
+            end_s,
+        };
         assert_eq!(
             s.pairs[0],
             vec![Pair {
-                t_p_end: 2.0,
-                t_c_start: 2.5
+                prev: iv(1.0, 2.0),
+                cur: iv(2.5, 3.5)
             }]
+        );
+        assert_eq!(
+            (s.pairs[0][0].t_p_end(), s.pairs[0][0].t_c_start()),
+            (2.0, 2.5)
         );
         assert!(s.pairs[1].is_empty());
     }

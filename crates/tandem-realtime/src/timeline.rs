@@ -1,16 +1,76 @@
 //! One robot's plan in schedule-clock time (Eq. 15–16) and its rates (Eq. 17).
+//!
+//! [`clock_s`] is the one computation of the Eq. 15 clock: a [`Timeline`] stores its
+//! breakpoints, and every duration, end and `T_total` of a schedule is read from it.
 
 use crate::error::{Error, Result};
+use crate::tol;
 
-/// Relative tolerance accepted when checking `ψ̇min ≤ ψ̇_E ≤ ψ̇max`.
+/// The Eq. 15 clock of one robot: the schedule-clock breakpoints `c_0, …, c_{T_ref}` (s,
+/// global/schedule-clock frame) of execution gradients `grad_exec` (`ψ̇_E[n]`, execution
+/// samples per reference sample) started at `start_s` (`τ_i`, s) with reference period
+/// `dt_s` (`Δt_s`, s): `c_0 = τ_i`, `c_{n+1} = c_n + ψ̇_E[n]·Δt_s`, summed in this order.
 ///
-/// A mean gradient computed in floating point can exceed the maximum of identical
-/// demonstrations by an ulp; such schedules are accepted instead of rejected.
-const GRADIENT_REL_TOL: f64 = 1e-9;
+/// This is the only place schedule-clock time is summed: [`Timeline`], the coordinator, the
+/// margin check and the schedule's durations and `T_total` all read it, so they agree to
+/// the last bit. `|ψ_E| = Σ_n ψ̇_E[n]·Δt_s` is the last breakpoint of the clock started at 0.
+///
+/// ```
+/// let c: Vec<f64> = tandem_realtime::clock_s(&[1.0, 2.0, 0.5], 10.0, 0.5).collect();
+/// assert_eq!(c, [10.0, 10.5, 11.5, 11.75]);
+/// ```
+pub fn clock_s(grad_exec: &[f64], start_s: f64, dt_s: f64) -> impl Iterator<Item = f64> + '_ {
+    std::iter::once(start_s).chain(grad_exec.iter().scan(start_s, move |c, &e| {
+        *c += e * dt_s;
+        Some(*c)
+    }))
+}
 
-/// Relative tolerance of every schedule-clock comparison that decides low-confidence
-/// membership or the outcome of a margin check (see [`clock_tolerance_s`]).
-pub(crate) const CLOCK_REL_TOL: f64 = 1e-9;
+/// The last breakpoint of [`clock_s`]: the schedule-clock time (s) at which a robot started
+/// at `start_s` ends on schedule, `τ_i + |ψ_E|`. With `start_s = 0` it is the execution's
+/// duration `|ψ_E|` (s).
+#[must_use]
+pub fn clock_end_s(grad_exec: &[f64], start_s: f64, dt_s: f64) -> f64 {
+    clock_s(grad_exec, start_s, dt_s)
+        .last()
+        .expect("the clock yields at least its start")
+}
+
+/// A scheduled low-confidence interval of one robot (Eq. 19): the maximal low-confidence run
+/// of reference samples `ref_start..ref_end` occupies schedule-clock (global) time
+/// `[start_s, end_s)`, in seconds.
+///
+/// Which robot it belongs to is where it is stored (robot 0 first, robot 1 second).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LcInterval {
+    /// First reference sample of the low-confidence run.
+    pub ref_start: usize,
+    /// One past the last reference sample of the run.
+    pub ref_end: usize,
+    /// Schedule-clock time (s) at which the robot enters the run.
+    pub start_s: f64,
+    /// Schedule-clock time (s) at which the robot leaves the run (end exclusive).
+    pub end_s: f64,
+}
+
+impl LcInterval {
+    /// Length of the intersection with `other` (s); zero or negative when they do not
+    /// overlap (touching half-open intervals give 0).
+    #[must_use]
+    pub fn overlap_s(&self, other: &LcInterval) -> f64 {
+        self.end_s.min(other.end_s) - self.start_s.max(other.start_s)
+    }
+
+    /// The same interval `by_s` seconds later.
+    #[must_use]
+    pub fn shifted(self, by_s: f64) -> LcInterval {
+        LcInterval {
+            start_s: self.start_s + by_s,
+            end_s: self.end_s + by_s,
+            ..self
+        }
+    }
+}
 
 /// One robot's plan in schedule-clock time (Eq. 15–16), built from its execution warp
 /// (one gradient `ψ̇_E[n]` per reference sample) and its start offset `τ_i`.
@@ -19,8 +79,9 @@ pub(crate) const CLOCK_REL_TOL: f64 = 1e-9;
 /// global/schedule-clock frame) with `c_0 = τ_i` and `c_{n+1} = c_n + ψ̇_E[n]·Δt_s`, so the
 /// robot ends at `τ_i + |ψ_E|` with `|ψ_E| = Σ_n ψ̇_E[n]·Δt_s`. Between breakpoints the
 /// reference time (in reference samples) is linear in the schedule clock: this is the inverse
-/// warp of Eq. 15. Prefix sums of the breakpoints and of the low-confidence samples are
-/// computed once here, so lookups by the coordinator are O(1) amortized.
+/// warp of Eq. 15. The breakpoints ([`clock_s`]), the low-confidence intervals and prefix
+/// counts of the low-confidence samples are computed once here, so lookups by the
+/// coordinator are O(1) amortized.
 #[derive(Clone, Debug)]
 pub struct Timeline {
     /// Eq. 12 per reference sample: `true` = high confidence.
@@ -35,6 +96,8 @@ pub struct Timeline {
     clock_s: Vec<f64>,
     /// `lc_prefix[n]` = number of low-confidence samples among `0..n`.
     lc_prefix: Vec<usize>,
+    /// Maximal low-confidence runs in schedule-clock time, in order.
+    lc_intervals: Vec<LcInterval>,
     /// Reference sample period Δt_s (s).
     dt_s: f64,
 }
@@ -46,7 +109,7 @@ impl Timeline {
     /// - `grad_exec[n]`: scheduled execution gradient `ψ̇_E[n]` (execution samples per reference
     ///   sample, > 0).
     /// - `grad_min`, `grad_max`: `ψ̇min`, `ψ̇max` (Eq. 14) with `0 < ψ̇min ≤ ψ̇_E ≤ ψ̇max`
-    ///   (up to a relative tolerance of 1e-9 for floating-point means).
+    ///   (up to [`tol::GRADIENT_REL`] of the bounds, for floating-point means).
     /// - `start_s`: `τ_i`, global time (s) at which the robot starts.
     /// - `dt_s`: reference sample period `Δt_s` (s), > 0.
     ///
@@ -109,27 +172,20 @@ impl Timeline {
                     why: "grad_min exceeds grad_max",
                 });
             }
-            if e < lo * (1.0 - GRADIENT_REL_TOL) {
+            if !tol::within_bounds(e, lo, hi) {
                 return Err(Error::BadGradient {
                     index: n,
-                    why: "grad_exec below grad_min",
-                });
-            }
-            if e > hi * (1.0 + GRADIENT_REL_TOL) {
-                return Err(Error::BadGradient {
-                    index: n,
-                    why: "grad_exec above grad_max",
+                    why: if e < lo {
+                        "grad_exec below grad_min"
+                    } else {
+                        "grad_exec above grad_max"
+                    },
                 });
             }
         }
-        let mut clock_s = Vec::with_capacity(n_ref + 1);
-        let mut c = start_s;
-        clock_s.push(c);
-        for &e in grad_exec {
-            c += e * dt_s;
-            clock_s.push(c);
-        }
-        if !c.is_finite() {
+        let mut clock = Vec::with_capacity(n_ref + 1);
+        clock.extend(clock_s(grad_exec, start_s, dt_s));
+        if !clock[n_ref].is_finite() {
             return Err(Error::NonFinite {
                 what: "end_s",
                 index: n_ref,
@@ -142,13 +198,24 @@ impl Timeline {
             count += usize::from(!hc);
             lc_prefix.push(count);
         }
+        let lc_intervals = tandem_confidence::runs(conf)
+            .into_iter()
+            .filter(|r| !r.high_conf)
+            .map(|r| LcInterval {
+                ref_start: r.start,
+                ref_end: r.end,
+                start_s: clock[r.start],
+                end_s: clock[r.end],
+            })
+            .collect();
         Ok(Timeline {
             conf: conf.to_vec(),
             grad_exec: grad_exec.to_vec(),
             grad_min: grad_min.to_vec(),
             grad_max: grad_max.to_vec(),
-            clock_s,
+            clock_s: clock,
             lc_prefix,
+            lc_intervals,
             dt_s,
         })
     }
@@ -253,24 +320,10 @@ impl Timeline {
         self.conf[self.sample_at(t_s)]
     }
 
-    /// Low-confidence regions as schedule-clock intervals `[start_s, end_s)` (s): maximal runs of
-    /// low-confidence reference samples `n0..=n1`, mapped to `[c_{n0}, c_{n1+1})`.
-    pub fn low_conf_regions(&self) -> Vec<(f64, f64)> {
-        let mut out = Vec::new();
-        let mut n = 0;
-        let n_ref = self.n_ref();
-        while n < n_ref {
-            if self.conf[n] {
-                n += 1;
-                continue;
-            }
-            let n0 = n;
-            while n < n_ref && !self.conf[n] {
-                n += 1;
-            }
-            out.push((self.clock_s[n0], self.clock_s[n]));
-        }
-        out
+    /// Low-confidence intervals (Eq. 19): each maximal run of low-confidence reference samples
+    /// `n0..n1` as the schedule-clock interval `[c_{n0}, c_{n1})` (s), in time order.
+    pub fn lc_intervals(&self) -> &[LcInterval] {
+        &self.lc_intervals
     }
 
     /// Whether any reference sample in `lo..=hi` is low confidence (O(1), prefix counts).
@@ -327,21 +380,6 @@ pub struct Rates {
     pub slow: f64,
 }
 
-/// Absolute tolerance (schedule-clock s) used where floating-point comparisons decide
-/// low-confidence membership: `1e-9 × max(|τ_i|, |end_i|, tick_s)` over both robots.
-///
-/// It always errs on the safe side: the [`Coordinator`](crate::Coordinator) widens every
-/// traversed interval by it (reporting *more* low-confidence ticks), and the margin checks
-/// widen by four times it (rejecting *more* schedules), so rounding in either never turns an
-/// overlap into a pass.
-pub fn clock_tolerance_s(robots: &[Timeline; 2], tick_s: f64) -> f64 {
-    let scale = robots
-        .iter()
-        .flat_map(|r| [r.start_s().abs(), r.end_s().abs()])
-        .fold(tick_s.abs(), f64::max);
-    CLOCK_REL_TOL * scale
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -386,7 +424,17 @@ mod tests {
         assert_eq!(t.ref_time_at(11.625), 2.5);
         assert_eq!(t.ref_time_at(12.0), 3.0);
         assert!(t.conf_at(9.0) && !t.conf_at(11.0) && t.conf_at(11.6) && t.conf_at(11.75));
-        assert_eq!(t.low_conf_regions(), vec![(10.5, 11.5)]);
+        assert_eq!(
+            t.lc_intervals(),
+            [LcInterval {
+                ref_start: 1,
+                ref_end: 2,
+                start_s: 10.5,
+                end_s: 11.5
+            }]
+        );
+        assert_eq!(clock_end_s(&[1.0, 2.0, 0.5], 10.0, 0.5), t.end_s());
+        assert_eq!(clock_end_s(&[1.0, 2.0, 0.5], 0.0, 0.5), 1.75);
         assert!(t.any_low_conf(0, 1) && !t.any_low_conf(2, 2));
         let mut cur = 0;
         assert_eq!(t.advance_cursor(&mut cur, 11.5), 2);

@@ -3,8 +3,9 @@
 
 mod common;
 
-use common::{FAST, Problem, SLOW, find_overlap, policies, rng};
+use common::{Problem, adversaries, find_overlap, rng};
 use rand::Rng;
+use tandem_realtime::Operator::{Fastest as FAST, Slowest as SLOW};
 use tandem_realtime::{
     Coordinator, Timeline, sufficient_margins, sufficient_margins_per_pair,
     sufficient_margins_printed,
@@ -30,7 +31,10 @@ fn three_sample_case_printed_accepts_overlaps_conservative_rejects() {
     // The operator drags the previous robot for one tick (setting the tick phase), then rushes
     // it: the responder matches the rushed step and enters its LC sample in the same tick.
     let mut c = Coordinator::new(robots, 1.0).unwrap();
-    let ticks: Vec<_> = [FAST, SLOW, FAST].iter().map(|&g| c.tick(g)).collect();
+    let ticks: Vec<_> = [FAST, SLOW, FAST]
+        .iter()
+        .map(|&g| c.tick(g).unwrap())
+        .collect();
     assert_eq!(ticks[2].low_conf, [true, true]);
     assert!(ticks[..2].iter().all(|t| !(t.low_conf[0] && t.low_conf[1])));
     // Moving robot 2 later by two maximal steps is accepted, and the same operator is harmless.
@@ -41,7 +45,7 @@ fn three_sample_case_printed_accepts_overlaps_conservative_rejects() {
     assert!(sufficient_margins(&later, 1.0).unwrap());
     let mut c = Coordinator::new(later, 1.0).unwrap();
     for g in [FAST, SLOW, FAST, FAST, SLOW, FAST, FAST, FAST] {
-        let t = c.tick(g);
+        let t = c.tick(g).unwrap();
         assert!(!(t.low_conf[0] && t.low_conf[1]));
     }
 }
@@ -76,7 +80,8 @@ fn printed_check_accepts_schedules_that_overlap() {
             continue;
         }
         cases += 1;
-        if find_overlap(&robots, tick_s, &policies(&mut r), &mut r).is_some() {
+        let set = adversaries(&problem, &robots, tick_s, &mut r);
+        if find_overlap(&robots, tick_s, &set, &mut r).is_some() {
             overlaps += 1;
         }
     }

@@ -1,12 +1,13 @@
-//! The safety invariant (DESIGN.md): for every schedule `sufficient_margins` accepts and every
-//! admissible operator rate sequence, the coordinator never has both robots traverse a
-//! low-confidence reference sample in the same tick.
+//! The safety invariant: for every schedule `sufficient_margins` accepts and every admissible
+//! operator rate sequence, the coordinator never has both robots traverse a low-confidence
+//! reference sample in the same tick. The operators are the full set of
+//! `tandem_realtime::adversary`, Alg. 2's worst case per role included.
 
 mod common;
 
 use std::cell::Cell;
 
-use common::{Problem, find_overlap, policies, rng};
+use common::{Problem, adversaries, find_overlap, rng};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use rand::Rng;
@@ -56,8 +57,8 @@ fn accepted_schedules_never_overlap_under_any_operator() {
         if tau < e1 {
             accepted.set(accepted.get() + 1);
         }
-        let pol = policies(&mut r);
-        let hit = find_overlap(&robots, tick_s, &pol, &mut r);
+        let set = adversaries(&problem, &robots, tick_s, &mut r);
+        let hit = find_overlap(&robots, tick_s, &set, &mut r);
         prop_assert!(
             hit.is_none(),
             "overlap {hit:?} for seed {seed}, tau {tau}, tick {tick_s}"

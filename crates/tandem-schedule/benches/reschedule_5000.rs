@@ -16,7 +16,9 @@
 mod fixture;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use tandem_schedule::{MarginCheck, SamplerParams, sample_schedule};
+use tandem_schedule::{
+    MarginCheck, SamplerBaselines, SamplerParams, sample_schedule, sample_schedule_with_baselines,
+};
 
 fn bench(c: &mut Criterion) {
     let (problem, label) = fixture::mid_study_problem();
@@ -25,17 +27,18 @@ fn bench(c: &mut Criterion) {
         seed: 1,
         ..SamplerParams::default()
     };
-    let baseline = SamplerParams {
+    let baseline = SamplerBaselines {
         margin_check: MarginCheck::PerPair,
         exhaustive_margins: true,
-        ..fast.clone()
+        ..SamplerBaselines::default()
     };
-    let single_exhaustive = SamplerParams {
+    let single_exhaustive = SamplerBaselines {
         exhaustive_margins: true,
-        ..fast.clone()
+        ..SamplerBaselines::default()
     };
     let a = sample_schedule(&problem, &fast, None).expect("the fixture problem is valid");
-    let b = sample_schedule(&problem, &baseline, None).expect("the fixture problem is valid");
+    let b = sample_schedule_with_baselines(&problem, &fast, &baseline, None)
+        .expect("the fixture problem is valid");
     assert!(
         a.schedule == b.schedule && a.source == b.source,
         "both strategies must pick the same schedule"
@@ -45,7 +48,10 @@ fn bench(c: &mut Criterion) {
          best T_total = {:.2} s ({:?}); cheap-feasible {}, margin checks lazy {} / exhaustive {}",
         problem.n_ref(),
         rayon::current_num_threads(),
-        problem.serial_schedule().t_total_s(problem.dt_s()),
+        problem
+            .serial_schedule(problem.dt_s())
+            .expect("Δt_s is a valid tick")
+            .t_total_s(problem.dt_s()),
         a.t_total_s,
         a.source,
         a.stats.cheap_feasible,
@@ -58,10 +64,10 @@ fn bench(c: &mut Criterion) {
         bch.iter(|| sample_schedule(&problem, &fast, None))
     });
     group.bench_function("single_pass_exhaustive", |bch| {
-        bch.iter(|| sample_schedule(&problem, &single_exhaustive, None))
+        bch.iter(|| sample_schedule_with_baselines(&problem, &fast, &single_exhaustive, None))
     });
     group.bench_function("per_pair_exhaustive_baseline", |bch| {
-        bch.iter(|| sample_schedule(&problem, &baseline, None))
+        bch.iter(|| sample_schedule_with_baselines(&problem, &fast, &baseline, None))
     });
     group.finish();
 }

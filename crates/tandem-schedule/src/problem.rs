@@ -1,22 +1,10 @@
 //! The scheduling problem: confidence and warp-gradient bounds per reference sample (Eq. 12, 14).
 
 use serde::{Deserialize, Serialize};
+use tandem_confidence::Run;
 
 use crate::schedule::Schedule;
 use crate::{Error, Result};
-
-/// A maximal run of reference samples with the same confidence.
-///
-/// Reference time frame: samples `start..end` (end exclusive) of the reference demonstration.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Run {
-    /// First reference sample of the run.
-    pub start: usize,
-    /// One past the last reference sample of the run.
-    pub end: usize,
-    /// `true` when every sample of the run is high-confidence (Eq. 12).
-    pub high_conf: bool,
-}
 
 /// The scheduling problem of Eq. 13–20 for two robots doing the same task.
 ///
@@ -123,18 +111,7 @@ impl Problem {
                 });
             }
         }
-        let mut runs = Vec::new();
-        let mut start = 0;
-        for n in 1..=n_ref {
-            if n == n_ref || conf[n] != conf[start] {
-                runs.push(Run {
-                    start,
-                    end: n,
-                    high_conf: conf[start],
-                });
-                start = n;
-            }
-        }
+        let runs = tandem_confidence::runs(&conf);
         Ok(Problem {
             conf,
             grad_mean,
@@ -175,7 +152,8 @@ impl Problem {
         self.dt_s
     }
 
-    /// Maximal runs of equal confidence, in reference order, covering `0..T_ref`.
+    /// Maximal runs of equal confidence ([`tandem_confidence::runs`]), in reference order,
+    /// covering `0..T_ref`.
     pub fn runs(&self) -> &[Run] {
         &self.runs
     }
@@ -194,29 +172,36 @@ impl Problem {
             .collect()
     }
 
-    /// The fastest serial schedule (§II-C fallback): both robots on [`Problem::fastest_warp`],
-    /// robot 2 starting when robot 1 ends (`τ = |ψ_E1|`). Its `T_total` is twice the fastest
-    /// single execution. It satisfies every constraint of Eq. 20: no low-confidence overlap is
-    /// possible, since robot 2 starts only once robot 1 has finished.
-    pub fn serial_schedule(&self) -> Schedule {
+    /// The fastest serial schedule (§II-C fallback) for control tick `tick_s` (real s): both
+    /// robots on [`Problem::fastest_warp`], robot 2 starting when robot 1 ends
+    /// (`τ = |ψ_E1|`). Its `T_total` is twice the fastest single execution. It satisfies every
+    /// constraint of Eq. 20 at any tick: no low-confidence overlap is possible, since robot 2
+    /// starts only once robot 1 has finished.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for a `tick_s` that is not finite and > 0.
+    pub fn serial_schedule(&self, tick_s: f64) -> Result<Schedule> {
+        if !(tick_s.is_finite() && tick_s > 0.0) {
+            return Err(Error::BadParam {
+                name: "tick_s",
+                why: "must be finite and > 0",
+            });
+        }
         let warp = self.fastest_warp();
-        // τ is robot 1's end exactly as the realtime timeline computes it (its own summation
-        // order), so that its margin check sees robot 2 start no earlier than robot 1 ends;
-        // the two sums differ by rounding only.
-        let sum_s = crate::schedule::execution_s(&warp, self.dt_s);
-        let offset_s = tandem_realtime::Timeline::new(
-            &self.conf,
-            &warp,
-            &self.grad_min,
-            &self.grad_max,
-            0.0,
-            self.dt_s,
-        )
-        .map_or(sum_s, |t| t.end_s().max(sum_s));
-        Schedule {
+        // τ must not precede robot 1's end on the clock the coordinator and the margin check
+        // run (`clock_end_s`, summed sample by sample). It is the later of that end and the
+        // closed form `Σ ψ̇·Δt` of Eq. 13, which differ by rounding only: robot 2 starts at
+        // robot 1's end or a few ulps after it, never before. (Taking the clock end alone
+        // moves robot 2's first tick in some serial schedules and with it every later pair
+        // of the study; this keeps the study's executions bit-identical to the closed form
+        // used before the clock had one owner.)
+        let offset_s = tandem_realtime::clock_end_s(&warp, 0.0, self.dt_s)
+            .max(warp.iter().sum::<f64>() * self.dt_s);
+        Ok(Schedule {
             grad_exec: [warp.clone(), warp],
             offset_s,
-        }
+            tick_s,
+        })
     }
 }
 
@@ -270,10 +255,20 @@ mod tests {
     #[test]
     fn serial_schedule_by_hand() {
         // HC at 0.5, LC at 1.0: |ψ_E| = (0.5 + 1 + 1 + 0.5)·0.01 = 0.03 s.
-        let s = ok().serial_schedule();
+        let s = ok().serial_schedule(0.005).unwrap();
         assert_eq!(s.grad_exec[0], vec![0.5, 1.0, 1.0, 0.5]);
+        assert_eq!(s.tick_s, 0.005);
         assert!((s.offset_s - 0.03).abs() < 1e-12);
+        // Robot 2 starts where robot 1's clock ends (or an ulp later).
+        assert!(s.offset_s >= s.ends_s(0.01)[0] && s.offset_s - s.ends_s(0.01)[0] < 1e-15);
+        assert_eq!(s.t_total_s(0.01), s.ends_s(0.01)[1]);
         assert!((s.t_total_s(0.01) - 0.06).abs() < 1e-12);
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(matches!(
+                ok().serial_schedule(bad),
+                Err(Error::BadParam { name: "tick_s", .. })
+            ));
+        }
     }
 
     #[test]

@@ -5,17 +5,23 @@
 //!
 //! Candidate `k` draws, from its own ChaCha8 stream `(seed, k)`:
 //! 1. for robot 1 (and, unless robot 2 is fitted, robot 2), one *speed factor* `u ∈ [0, 1]`
-//!    per piece of every maximal high-confidence run (see [`Distribution`]); the piece's
+//!    per piece of every maximal high-confidence run ([`SamplerParams::pieces`] per run;
+//!    the baseline [`SamplerBaselines::per_sample`]: one per sample); the piece's
 //!    gradients are `ψ̇_E[n] = ψ̇min[n] + u·(ψ̇max[n] − ψ̇min[n])`, and `u = 0` (fastest) with
 //!    probability [`SamplerParams::p_fastest`], else `u` is uniform;
-//! 2. the offset `τ` as [`SamplerParams::offset`] says. The default,
-//!    [`OffsetSampling::Fitted`], draws only a widening `w` and *fits* `τ` and robot 2's
-//!    factors to robot 1's warp: an exact sweep over robot 2's pieces (see
-//!    `Sampler::fit_second`) finds the earliest finish of robot 2 whose low-confidence
-//!    intervals keep `w·length + 2 ticks` clear of robot 1's. The alternatives draw `v`
-//!    uniform in `[0, 1)` and put `τ` at fraction `v` of the offsets in `[0, |ψ_E1|]` (Eq. 20
-//!    constraint 2) that keep the two robots' low-confidence intervals apart
-//!    ([`OffsetSampling::UniformFeasible`]) or of all of them ([`OffsetSampling::Uniform`]).
+//! 2. the offset `τ`: by default only a widening `w ≤` [`SamplerParams::widen_max`] is
+//!    drawn, and `τ` and robot 2's factors are *fitted* to robot 1's warp: an exact sweep
+//!    over robot 2's pieces (see `Sampler::fit_second`) finds the earliest finish of robot 2
+//!    whose low-confidence intervals keep `w·length + 2 ticks` clear of robot 1's. The
+//!    baselines ([`SamplerBaselines::drawn_offset`]) draw `v` uniform in `[0, 1)` and put `τ`
+//!    at fraction `v` of the offsets in `[0, |ψ_E1|]` (Eq. 20 constraint 2) that keep the two
+//!    robots' low-confidence intervals apart ([`DrawnOffset::UniformFeasible`]) or of all of
+//!    them ([`DrawnOffset::Uniform`]).
+//!
+//! The piece sums (and the per-run sums of the warm start) are the search's heuristic: they
+//! order the candidates and cut those that cannot beat the incumbent. Every `T_total` the
+//! sampler returns or compares for its final choice is read from the one clock
+//! ([`Schedule::t_total_s`], `tandem_realtime::clock_s`) of the materialized schedule.
 //!
 //! Low-confidence samples follow the mean gradient (constraint 4).
 //!
@@ -64,7 +70,7 @@
 //!
 //! # Warm start
 //!
-//! With [`OffsetSampling::Fitted`] and a previous schedule, 8 more candidates
+//! With robot 2 fitted (the default) and a previous schedule, 8 more candidates
 //! (`k = samples..samples + 8`) keep robot 1's warp of the (repaired) previous schedule and
 //! fit robot 2 with widenings `w ∈ widen_max·{0, ¼, ½, ¾, 1, 1½, 2, 3}`: after a model
 //! update moves the mean gradients, the previous schedule itself may no longer pass, but
@@ -92,61 +98,15 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::problem::Problem;
-use crate::schedule::{Schedule, execution_s};
-use crate::validate::{MarginCheck, margins_ok, validate_cheap, validate_with_tick};
+use tandem_realtime::{LcInterval, clock_end_s, tol};
+
+use crate::schedule::Schedule;
+use crate::validate::{MarginCheck, validate, validate_full};
 use crate::{Error, Result};
 
-/// How a candidate's high-confidence gradients are sampled (see the module docs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub enum Distribution {
-    /// One independent factor per high-confidence reference sample (the literal reading of
-    /// §II-C). Kept as a measured baseline.
-    PerSample,
-    /// Each maximal high-confidence run is cut into `pieces` pieces of (nearly) equal sample
-    /// count, with one speed factor per piece. `pieces ≥ 1`.
-    PerRun {
-        /// Pieces per high-confidence run.
-        pieces: usize,
-    },
-}
-
-impl Default for Distribution {
-    fn default() -> Self {
-        Distribution::PerRun { pieces: 1 }
-    }
-}
-
-/// How a candidate's offset `τ` is drawn, given its two warps.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub enum OffsetSampling {
-    /// Uniform in `[0, |ψ_E1|]`; candidates whose low-confidence intervals overlap are
-    /// rejected (the literal reading of §II-C).
-    Uniform,
-    /// Uniform over the offsets in `[0, |ψ_E1|]` at which the two robots' low-confidence
-    /// intervals do not overlap (computed exactly from the intervals). This is the
-    /// distribution of `Uniform` conditioned on passing constraint 3 — the same proposals,
-    /// without the rejected ones.
-    UniformFeasible,
-    /// `τ` and robot 2's high-confidence speed factors are not sampled but *fitted* to robot
-    /// 1's sampled warp: an exact sweep over robot 2's pieces finds the earliest finish of
-    /// robot 2 whose low-confidence intervals keep clear of robot 1's, each of robot 1's
-    /// intervals `[a, b)` widened to `[a − δ, b + δ)` with `δ = w·(b − a) + 2·tick_s` and `w`
-    /// drawn uniformly in `[0, widen_max]` per candidate (room for the operator's drag and
-    /// rush, which the margin check then verifies). See the module docs.
-    Fitted {
-        /// Largest relative widening `w` of robot 1's low-confidence intervals, `≥ 0`.
-        widen_max: f64,
-    },
-}
-
-impl Default for OffsetSampling {
-    fn default() -> Self {
-        OffsetSampling::Fitted { widen_max: 0.1 }
-    }
-}
-
-/// Parameters of [`sample_schedule`].
+/// Parameters of [`sample_schedule`]: what a user tunes. They are stored in the planner's
+/// state file and printed by `tandem params`; the benchmark-only alternatives measured in the
+/// module docs are [`SamplerBaselines`], which are never stored.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SamplerParams {
@@ -154,24 +114,23 @@ pub struct SamplerParams {
     pub samples: usize,
     /// Seed; candidate `k` uses ChaCha8 stream `k` of this seed. Default: 0.
     pub seed: u64,
-    /// Control tick (s) of the margin check (Alg. 2). `None` = the reference period `Δt_s`.
-    /// Must be finite and > 0. Default: `None`.
+    /// Control tick (real s) of the margin check (Alg. 2), stored in the returned schedule
+    /// ([`Schedule::tick_s`]) as the only period the coordinator may run it at. `None` = the
+    /// reference period `Δt_s`. Must be finite and > 0. Default: `None`.
     pub tick_s: Option<f64>,
-    /// Sampling distribution of the high-confidence gradients. Default: one factor per
-    /// high-confidence run (`PerRun { pieces: 1 }`).
-    pub distribution: Distribution,
+    /// Pieces per maximal high-confidence run, each with one speed factor (the run is cut
+    /// into `pieces` stretches of nearly equal sample count; see the module docs). ≥ 1.
+    /// Default: 1.
+    pub pieces: usize,
     /// Probability that a factor is exactly 0 (the run at `ψ̇min`, fastest), in `[0, 1]`.
     /// Default: 0.5.
     pub p_fastest: f64,
-    /// How `τ` (and, with [`OffsetSampling::Fitted`], robot 2's speeds) are chosen. Default:
-    /// `OffsetSampling::Fitted { widen_max: 0.1 }`.
-    pub offset: OffsetSampling,
-    /// Margin-check implementation. Default: [`MarginCheck::SinglePass`].
-    pub margin_check: MarginCheck,
-    /// `false` (default): margins only in `(T_total, k)` order until the first candidate
-    /// passes. `true`: check every cheap-feasible candidate (the straightforward baseline; the
-    /// same result, slower).
-    pub exhaustive_margins: bool,
+    /// Largest relative widening `w` of robot 1's low-confidence intervals when robot 2 is
+    /// fitted to robot 1: each interval `[a, b)` is widened to `[a − δ, b + δ)` with
+    /// `δ = w·(b − a) + 2·tick_s`, `w` drawn uniformly in `[0, widen_max]` per candidate
+    /// (room for the operator's drag and rush, which the margin check then verifies). Finite
+    /// and ≥ 0. Default: 0.1.
+    pub widen_max: f64,
     /// At most this many cheap-feasible candidates go through the full constraints: the
     /// best half of them in `(T_total, k)` order, the rest at geometrically spaced ranks
     /// down to the last; the first to pass wins, and if none does the incumbent stays. `None` = no
@@ -188,11 +147,9 @@ impl Default for SamplerParams {
             samples: 5000,
             seed: 0,
             tick_s: None,
-            distribution: Distribution::default(),
+            pieces: 1,
             p_fastest: 0.5,
-            offset: OffsetSampling::default(),
-            margin_check: MarginCheck::SinglePass,
-            exhaustive_margins: false,
+            widen_max: 0.1,
             max_margin_checks: Some(64),
         }
     }
@@ -218,9 +175,9 @@ impl SamplerParams {
                 why: "must be finite and > 0",
             });
         }
-        if let Distribution::PerRun { pieces: 0 } = self.distribution {
+        if self.pieces == 0 {
             return Err(Error::BadParam {
-                name: "distribution.pieces",
+                name: "pieces",
                 why: "must be ≥ 1",
             });
         }
@@ -230,11 +187,9 @@ impl SamplerParams {
                 why: "must be ≥ 1 (or none for no limit)",
             });
         }
-        if let OffsetSampling::Fitted { widen_max } = self.offset
-            && !(widen_max.is_finite() && widen_max >= 0.0)
-        {
+        if !(self.widen_max.is_finite() && self.widen_max >= 0.0) {
             return Err(Error::BadParam {
-                name: "offset.widen_max",
+                name: "widen_max",
                 why: "must be finite and ≥ 0",
             });
         }
@@ -248,6 +203,59 @@ impl SamplerParams {
     }
 }
 
+/// Benchmark-only alternatives to the sampler's design, measured in the module docs' table
+/// (`sampling_distributions` example) and in the `reschedule_5000` bench.
+///
+/// They are not part of [`SamplerParams`] and have no serde form: an experiment never
+/// changes the user's state file or what `tandem params` prints. The default is the
+/// sampler's own design (what [`sample_schedule`] runs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SamplerBaselines {
+    /// One independent factor per high-confidence reference sample instead of per piece of
+    /// a run (the literal reading of §II-C; [`SamplerParams::pieces`] is then ignored).
+    pub per_sample: bool,
+    /// Draw `τ` (and sample robot 2's factors like robot 1's) instead of fitting robot 2 to
+    /// robot 1 (`None`, the default; [`SamplerParams::widen_max`] is then ignored).
+    pub drawn_offset: Option<DrawnOffset>,
+    /// Margin-check implementation. Default: [`MarginCheck::SinglePass`].
+    pub margin_check: MarginCheck,
+    /// `false` (default): margins only in `(T_total, k)` order until the first candidate
+    /// passes. `true`: check every cheap-feasible candidate within the margin budget (the
+    /// straightforward baseline; the same result, slower).
+    pub exhaustive_margins: bool,
+}
+
+/// How a [`SamplerBaselines::drawn_offset`] candidate draws its offset `τ` from `v` uniform in
+/// `[0, 1)`, given its two warps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DrawnOffset {
+    /// Uniform in `[0, |ψ_E1|]`; candidates whose low-confidence intervals overlap are
+    /// rejected (the literal reading of §II-C).
+    Uniform,
+    /// Uniform over the offsets in `[0, |ψ_E1|]` at which the two robots' low-confidence
+    /// intervals do not overlap (computed exactly from the intervals): the distribution of
+    /// `Uniform` conditioned on passing constraint 3.
+    UniformFeasible,
+}
+
+/// How a candidate's high-confidence gradients are drawn (from params and baselines).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Distribution {
+    /// One factor per high-confidence reference sample.
+    PerSample,
+    /// `pieces` factors per maximal high-confidence run.
+    PerRun { pieces: usize },
+}
+
+/// How a candidate's offset (and robot 2) is chosen (from params and baselines).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum OffsetSampling {
+    /// A drawn offset (a baseline).
+    Drawn(DrawnOffset),
+    /// Robot 2 fitted to robot 1 with widenings up to `widen_max`.
+    Fitted { widen_max: f64 },
+}
+
 /// Where the returned schedule came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Source {
@@ -256,7 +264,8 @@ pub enum Source {
         /// Candidate index `k`.
         candidate: u64,
     },
-    /// The previous schedule, unchanged (still valid, nothing better found).
+    /// The previous schedule's warps and offset, unchanged (still valid at the sampler's
+    /// tick, nothing better found).
     Previous,
     /// The previous schedule repaired for the new problem (gradients clamped into the new
     /// bounds, new mean on low-confidence samples, `τ` clamped to `[0, |ψ_E1|]`).
@@ -280,7 +289,8 @@ pub struct SamplerStats {
 /// The sampler's result.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Outcome {
-    /// The schedule; it passes [`crate::validate_with_tick`] at the sampler's tick.
+    /// The schedule; its [`Schedule::tick_s`] is the sampler's tick, at which it passes
+    /// [`crate::validate`].
     pub schedule: Schedule,
     /// Its `T_total` (Eq. 13), s.
     pub t_total_s: f64,
@@ -345,11 +355,15 @@ fn pieces(problem: &Problem, distribution: Distribution) -> Vec<Piece> {
 struct Sampler<'a> {
     problem: &'a Problem,
     params: &'a SamplerParams,
+    /// How `τ` and robot 2 are chosen.
+    offset: OffsetSampling,
+    /// Margin-check implementation.
+    margin_check: MarginCheck,
     pieces: Vec<Piece>,
     /// `suffix_min_s[p]`: shortest duration (s) of pieces `p..` (`0` past the last).
     suffix_min_s: Vec<f64>,
     tick_s: f64,
-    /// Warm start ([`OffsetSampling::Fitted`] only): robot 1's warp of the (repaired)
+    /// Warm start (fitted robot 2 only): robot 1's warp of the (repaired)
     /// previous schedule, with its low-confidence intervals and duration (s). Candidates
     /// `k ≥ samples` keep it and fit robot 2 with the widening `WARM_WIDEN[k − samples]`.
     warm: Option<Warm>,
@@ -359,22 +373,29 @@ struct Sampler<'a> {
 /// intervals relative to its start (s), duration (s).
 struct Warm {
     warp: Vec<f64>,
-    lc: Vec<(f64, f64)>,
+    lc: Vec<LcInterval>,
     dur_s: f64,
 }
 
 /// Relative widenings `w / widen_max` of the warm-start candidates.
 const WARM_WIDEN: [f64; 8] = [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0];
 
-/// Low-confidence intervals (relative to the start) and duration (s) of one robot's warp.
-fn lc_of_warp(problem: &Problem, warp: &[f64]) -> (Vec<(f64, f64)>, f64) {
+/// Low-confidence intervals (relative to the start) and duration (s) of one robot's warp, from
+/// per-run sums: the sampler's search heuristic, like the piece sums (the schedule it returns
+/// is timed by the one clock, `tandem_realtime::clock_s`).
+fn lc_of_warp(problem: &Problem, warp: &[f64]) -> (Vec<LcInterval>, f64) {
     let dt = problem.dt_s();
     let mut lc = Vec::new();
     let mut t = 0.0;
     for run in problem.runs() {
         let d = warp[run.start..run.end].iter().sum::<f64>() * dt;
         if !run.high_conf {
-            lc.push((t, t + d));
+            lc.push(LcInterval {
+                ref_start: run.start,
+                ref_end: run.end,
+                start_s: t,
+                end_s: t + d,
+            });
         }
         t += d;
     }
@@ -385,7 +406,7 @@ fn lc_of_warp(problem: &Problem, warp: &[f64]) -> (Vec<(f64, f64)>, f64) {
 #[derive(Default)]
 struct Scratch {
     factors: [Vec<f64>; 2],
-    lc: [Vec<(f64, f64)>; 2],
+    lc: [Vec<LcInterval>; 2],
     forbidden: Vec<(f64, f64)>,
     /// Fitted robot 2: feasible start sets of all pieces, flattened, and where each begins.
     sets: Vec<(f64, f64)>,
@@ -401,22 +422,36 @@ struct Draw {
 }
 
 impl<'a> Sampler<'a> {
-    /// The pieces, their suffix sums and, for [`OffsetSampling::Fitted`] with a previous
+    /// The pieces, their suffix sums and, for fitted robot 2 with a previous
     /// schedule, the warm start (robot 1 of its repair).
     fn new(
         problem: &'a Problem,
         params: &'a SamplerParams,
+        baselines: &SamplerBaselines,
         tick_s: f64,
         previous: Option<&Schedule>,
     ) -> Self {
-        let pieces = pieces(problem, params.distribution);
+        let distribution = if baselines.per_sample {
+            Distribution::PerSample
+        } else {
+            Distribution::PerRun {
+                pieces: params.pieces,
+            }
+        };
+        let offset = match baselines.drawn_offset {
+            Some(drawn) => OffsetSampling::Drawn(drawn),
+            None => OffsetSampling::Fitted {
+                widen_max: params.widen_max,
+            },
+        };
+        let pieces = pieces(problem, distribution);
         let mut suffix_min_s = vec![0.0; pieces.len() + 1];
         for (p, piece) in pieces.iter().enumerate().rev() {
             suffix_min_s[p] = suffix_min_s[p + 1] + piece.min_s;
         }
         let warm = match (
-            params.offset,
-            previous.and_then(|prev| repair(problem, prev)),
+            offset,
+            previous.and_then(|prev| repair(problem, prev, tick_s)),
         ) {
             (OffsetSampling::Fitted { .. }, Some(fixed)) => {
                 let [warp, _] = fixed.grad_exec;
@@ -428,6 +463,8 @@ impl<'a> Sampler<'a> {
         Sampler {
             problem,
             params,
+            offset,
+            margin_check: baselines.margin_check,
             pieces,
             suffix_min_s,
             tick_s,
@@ -451,13 +488,13 @@ impl Sampler<'_> {
         }
     }
 
-    /// Draws robot 1's factors into `factors` and its low-confidence intervals (relative to
-    /// its start) into `lc`; returns its duration `|ψ_E1|` (s).
+    /// Draws one robot's factors into `factors` and its low-confidence intervals (relative to
+    /// its start, from the piece sums) into `lc`; returns its duration `|ψ_E|` (s).
     fn draw_robot(
         &self,
         rng: &mut ChaCha8Rng,
         factors: &mut Vec<f64>,
-        lc: &mut Vec<(f64, f64)>,
+        lc: &mut Vec<LcInterval>,
     ) -> f64 {
         factors.clear();
         lc.clear();
@@ -468,7 +505,12 @@ impl Sampler<'_> {
                 factors.push(u);
                 t += p.min_s + u * p.span_s;
             } else {
-                lc.push((t, t + p.min_s));
+                lc.push(LcInterval {
+                    ref_start: p.start,
+                    ref_end: p.end,
+                    start_s: t,
+                    end_s: t + p.min_s,
+                });
                 t += p.min_s;
             }
         }
@@ -476,11 +518,11 @@ impl Sampler<'_> {
     }
 
     /// Draws candidate `k`: factors (into `scratch.factors`), durations and offset. With
-    /// [`OffsetSampling::Fitted`], candidates whose robot 2 cannot finish before `bound_s`
+    /// fitted robot 2, candidates whose robot 2 cannot finish before `bound_s`
     /// get no offset (the same draws otherwise, whatever `bound_s`).
     fn draw(&self, scratch: &mut Scratch, k: u64, bound_s: f64) -> Draw {
         let mut rng = self.rng(k);
-        if let OffsetSampling::Fitted { widen_max } = self.params.offset {
+        if let OffsetSampling::Fitted { widen_max } = self.offset {
             let (dur0, w) = match (&self.warm, k.checked_sub(self.params.samples as u64)) {
                 (Some(warm), Some(j)) => {
                     scratch.factors[0].clear();
@@ -505,41 +547,27 @@ impl Sampler<'_> {
                 },
             };
         }
-        let mut dur = [0.0; 2];
-        for ((factors, lc), dur) in scratch
-            .factors
-            .iter_mut()
-            .zip(scratch.lc.iter_mut())
-            .zip(dur.iter_mut())
-        {
-            factors.clear();
-            lc.clear();
-            let mut t = 0.0;
-            for p in &self.pieces {
-                if p.high_conf {
-                    let u = self.factor(&mut rng);
-                    factors.push(u);
-                    t += p.min_s + u * p.span_s;
-                } else {
-                    lc.push((t, t + p.min_s));
-                    t += p.min_s;
-                }
-            }
-            *dur = t;
-        }
+        let [f0, f1] = &mut scratch.factors;
+        let [lc0, lc1] = &mut scratch.lc;
+        let dur = [
+            self.draw_robot(&mut rng, f0, lc0),
+            self.draw_robot(&mut rng, f1, lc1),
+        ];
         let v = rng.random::<f64>();
-        let offset_s = match self.params.offset {
-            OffsetSampling::Uniform => {
+        let offset_s = match self.offset {
+            OffsetSampling::Drawn(DrawnOffset::Uniform) => {
                 let offset_s = v * dur[0];
                 (!overlaps(&scratch.lc, offset_s)).then_some(offset_s)
             }
-            OffsetSampling::UniformFeasible => feasible_offset(scratch, dur[0], v),
+            OffsetSampling::Drawn(DrawnOffset::UniformFeasible) => {
+                feasible_offset(scratch, dur[0], v)
+            }
             OffsetSampling::Fitted { .. } => unreachable!("fitted candidates returned above"),
         };
         Draw { dur, offset_s }
     }
 
-    /// [`OffsetSampling::Fitted`]: robot 2's earliest finish given robot 1's low-confidence
+    /// fitted robot 2: robot 2's earliest finish given robot 1's low-confidence
     /// intervals in `scratch.lc[0]` (global time: robot 1 starts at 0) widened by
     /// `δ = w·length + 2·tick_s`, over `τ ∈ [0, dur0]` and robot 2's per-piece durations.
     /// Writes robot 2's factors into `scratch.factors[1]`; returns `(τ, |ψ_E2|)`, or `None`
@@ -563,9 +591,9 @@ impl Sampler<'_> {
         let margin = 2.0 * self.tick_s;
         let forbidden = &mut scratch.forbidden;
         forbidden.clear();
-        forbidden.extend(scratch.lc[0].iter().map(|&(a, b)| {
-            let d = w * (b - a) + margin;
-            (a - d, b + d)
+        forbidden.extend(scratch.lc[0].iter().map(|iv| {
+            let d = w * (iv.end_s - iv.start_s) + margin;
+            (iv.start_s - d, iv.end_s + d)
         }));
         sort_and_merge(forbidden);
         let forbidden = &scratch.forbidden;
@@ -708,7 +736,11 @@ impl Sampler<'_> {
             for p in &self.pieces {
                 if p.high_conf {
                     let u = *factors.next().expect("one factor was drawn per HC piece");
-                    warp.extend((p.start..p.end).map(|n| gmin[n] + u * (gmax[n] - gmin[n])));
+                    // `ψ̇min + u·(ψ̇max − ψ̇min)` can round one ulp above `ψ̇max` at `u = 1`:
+                    // capped, so every stored gradient meets constraint 1 exactly.
+                    warp.extend(
+                        (p.start..p.end).map(|n| (gmin[n] + u * (gmax[n] - gmin[n])).min(gmax[n])),
+                    );
                 } else {
                     warp.extend_from_slice(&gmean[p.start..p.end]);
                 }
@@ -717,17 +749,14 @@ impl Sampler<'_> {
         Some(Schedule {
             grad_exec: warps,
             offset_s: d.offset_s?,
+            tick_s: self.tick_s,
         })
     }
 
     /// Full constraints of candidate `k`: the schedule and its `T_total` if feasible.
     fn full(&self, k: u64) -> Option<(Schedule, f64)> {
         let s = self.materialize(k)?;
-        let ok = validate_cheap(self.problem, &s).is_ok()
-            && matches!(
-                margins_ok(self.problem, &s, self.tick_s, self.params.margin_check),
-                Ok(true)
-            );
+        let ok = validate_full(self.problem, &s, self.margin_check).is_ok();
         ok.then(|| {
             let t = s.t_total_s(self.problem.dt_s());
             (s, t)
@@ -737,15 +766,15 @@ impl Sampler<'_> {
 
 /// Whether robot 2's low-confidence intervals shifted by `offset_s` overlap robot 1's
 /// (positive-length intersection; both lists in time order).
-fn overlaps(lc: &[Vec<(f64, f64)>; 2], offset_s: f64) -> bool {
+fn overlaps(lc: &[Vec<LcInterval>; 2], offset_s: f64) -> bool {
     let (a, b) = (&lc[0], &lc[1]);
     let (mut i, mut j) = (0, 0);
     while i < a.len() && j < b.len() {
-        let (b0, b1) = (b[j].0 + offset_s, b[j].1 + offset_s);
-        if a[i].0.max(b0) < a[i].1.min(b1) {
+        let bj = b[j].shifted(offset_s);
+        if a[i].overlap_s(&bj) > 0.0 {
             return true;
         }
-        if a[i].1 <= b1 {
+        if a[i].end_s <= bj.end_s {
             i += 1;
         } else {
             j += 1;
@@ -776,8 +805,18 @@ fn sort_and_merge(intervals: &mut Vec<(f64, f64)>) {
 fn feasible_offset(scratch: &mut Scratch, max_s: f64, v: f64) -> Option<f64> {
     let forbidden = &mut scratch.forbidden;
     forbidden.clear();
-    for &(a, b) in &scratch.lc[0] {
-        for &(c, d) in &scratch.lc[1] {
+    for &LcInterval {
+        start_s: a,
+        end_s: b,
+        ..
+    } in &scratch.lc[0]
+    {
+        for &LcInterval {
+            start_s: c,
+            end_s: d,
+            ..
+        } in &scratch.lc[1]
+        {
             let (lo, hi) = ((a - d).max(0.0), (b - c).min(max_s));
             if lo < hi {
                 forbidden.push((lo, hi));
@@ -788,7 +827,7 @@ fn feasible_offset(scratch: &mut Scratch, max_s: f64, v: f64) -> Option<f64> {
     sort_and_merge(forbidden);
     let blocked: f64 = forbidden.iter().map(|(lo, hi)| hi - lo).sum();
     let free = max_s - blocked;
-    if free <= 1e-12 * max_s.max(1.0) {
+    if free <= tol::MEASURE_ZERO_REL * max_s.max(1.0) {
         return None;
     }
     let mut target = v * free;
@@ -827,7 +866,10 @@ fn margin_ranks(len: usize, cap: usize) -> Vec<usize> {
     ranks
 }
 
-fn repair(problem: &Problem, previous: &Schedule) -> Option<Schedule> {
+/// The previous schedule re-projected onto `problem` at control tick `tick_s` (s): gradients
+/// clamped into the new bounds, the new mean on low-confidence samples, `τ` clamped into
+/// `[0, |ψ_E1|]`. `None` for warps of the wrong length.
+fn repair(problem: &Problem, previous: &Schedule, tick_s: f64) -> Option<Schedule> {
     let n_ref = problem.n_ref();
     if previous.grad_exec.iter().any(|g| g.len() != n_ref) {
         return None;
@@ -848,7 +890,7 @@ fn repair(problem: &Problem, previous: &Schedule) -> Option<Schedule> {
             })
             .collect::<Vec<f64>>()
     });
-    let max_s = execution_s(&warps[0], problem.dt_s());
+    let max_s = clock_end_s(&warps[0], 0.0, problem.dt_s());
     let offset_s = if previous.offset_s.is_finite() {
         previous.offset_s.clamp(0.0, max_s)
     } else {
@@ -857,6 +899,7 @@ fn repair(problem: &Problem, previous: &Schedule) -> Option<Schedule> {
     Some(Schedule {
         grad_exec: warps,
         offset_s,
+        tick_s,
     })
 }
 
@@ -878,6 +921,20 @@ pub fn sample_schedule(
     params: &SamplerParams,
     previous: Option<&Schedule>,
 ) -> Result<Outcome> {
+    sample_schedule_with_baselines(problem, params, &SamplerBaselines::default(), previous)
+}
+
+/// [`sample_schedule`] with benchmark-only alternatives to its design (see
+/// [`SamplerBaselines`]); `SamplerBaselines::default()` is [`sample_schedule`] itself.
+///
+/// # Errors
+/// As [`sample_schedule`].
+pub fn sample_schedule_with_baselines(
+    problem: &Problem,
+    params: &SamplerParams,
+    baselines: &SamplerBaselines,
+    previous: Option<&Schedule>,
+) -> Result<Outcome> {
     params.validate()?;
     let tick_s = params.tick_s.unwrap_or(problem.dt_s());
     let dt_s = problem.dt_s();
@@ -885,19 +942,25 @@ pub fn sample_schedule(
     // 1. Incumbent.
     let mut incumbent: Option<(Schedule, f64, Source)> = None;
     if let Some(prev) = previous {
-        if validate_with_tick(problem, prev, tick_s).is_ok() {
-            incumbent = Some((prev.clone(), prev.t_total_s(dt_s), Source::Previous));
-        } else if let Some(fixed) = repair(problem, prev)
-            && validate_with_tick(problem, &fixed, tick_s).is_ok()
+        // The previous schedule is valid at its own tick; re-check it at this one.
+        let prev = Schedule {
+            tick_s,
+            ..prev.clone()
+        };
+        if validate(problem, &prev).is_ok() {
+            let t = prev.t_total_s(dt_s);
+            incumbent = Some((prev, t, Source::Previous));
+        } else if let Some(fixed) = repair(problem, &prev, tick_s)
+            && validate(problem, &fixed).is_ok()
         {
             let t = fixed.t_total_s(dt_s);
             incumbent = Some((fixed, t, Source::RepairedPrevious));
         }
     }
-    let serial = problem.serial_schedule();
+    let serial = problem.serial_schedule(tick_s)?;
     let serial_t = serial.t_total_s(dt_s);
     let serial_violation = if incumbent.as_ref().is_none_or(|inc| serial_t < inc.1) {
-        match validate_with_tick(problem, &serial, tick_s) {
+        match validate(problem, &serial) {
             Ok(()) => {
                 incumbent = Some((serial, serial_t, Source::Serial));
                 None
@@ -910,7 +973,7 @@ pub fn sample_schedule(
     let bound_s = incumbent.as_ref().map_or(f64::INFINITY, |inc| inc.1);
 
     // 2. Cheap checks, in parallel; collect keeps candidate order.
-    let sampler = Sampler::new(problem, params, tick_s, previous);
+    let sampler = Sampler::new(problem, params, baselines, tick_s, previous);
     let n_warm = if sampler.warm.is_some() {
         WARM_WIDEN.len()
     } else {
@@ -935,7 +998,7 @@ pub fn sample_schedule(
     }
     let mut winner: Option<(Schedule, f64, u64)> = None;
     let mut margin_checks = 0;
-    if params.exhaustive_margins {
+    if baselines.exhaustive_margins {
         let results: Vec<Option<(Schedule, f64)>> =
             feasible.par_iter().map(|&(_, k)| sampler.full(k)).collect();
         margin_checks = results.len();
@@ -989,9 +1052,21 @@ pub fn sample_schedule(
 mod tests {
     use super::*;
 
+    /// Intervals `[a, b)` (s) as low-confidence intervals (their reference samples unused).
+    fn ivs(v: &[(f64, f64)]) -> Vec<LcInterval> {
+        v.iter()
+            .map(|&(start_s, end_s)| LcInterval {
+                ref_start: 0,
+                ref_end: 1,
+                start_s,
+                end_s,
+            })
+            .collect()
+    }
+
     fn scratch(lc0: &[(f64, f64)], lc1: &[(f64, f64)]) -> Scratch {
         Scratch {
-            lc: [lc0.to_vec(), lc1.to_vec()],
+            lc: [ivs(lc0), ivs(lc1)],
             ..Scratch::default()
         }
     }
@@ -1024,7 +1099,7 @@ mod tests {
     fn fitted_robot_2_by_hand() {
         let p = three_runs();
         let params = SamplerParams::default();
-        let sampler = Sampler::new(&p, &params, 0.1, None);
+        let sampler = Sampler::new(&p, &params, &SamplerBaselines::default(), 0.1, None);
         // Robot 1 runs its HC piece at the slowest (4 s): LC [0, 1) and [5, 6), 6 s long.
         let mut s = scratch(&[(0.0, 1.0), (5.0, 6.0)], &[]);
         // w = 0: forbidden [−0.2, 1.2] and [4.8, 6.2] (two ticks of 0.1 s). Robot 2's first
@@ -1064,7 +1139,7 @@ mod tests {
 
     #[test]
     fn overlap_test_by_hand() {
-        let lc = [vec![(1.0, 2.0)], vec![(0.0, 1.0)]];
+        let lc = [ivs(&[(1.0, 2.0)]), ivs(&[(0.0, 1.0)])];
         assert!(overlaps(&lc, 0.5));
         assert!(!overlaps(&lc, 2.0)); // touching
         assert!(!overlaps(&lc, 0.0)); // touching

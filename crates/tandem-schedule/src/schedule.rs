@@ -1,20 +1,21 @@
 //! Schedules, `T_total` (Eq. 13) and the global timeline (Eq. 15, 16, 19).
+//!
+//! Every time here is read from the one Eq. 15 clock of `tandem_realtime` ([`clock_end_s`],
+//! the breakpoints of a [`Timeline`]): durations, ends, `T_total` and the low-confidence
+//! intervals agree to the last bit with what the margin check and the coordinator use.
 
 use serde::{Deserialize, Serialize};
-use tandem_realtime::{Error as RtError, Timeline};
+use tandem_realtime::{Coordinator, LcInterval, Timeline, clock_end_s, tol};
 
 use crate::problem::Problem;
 use crate::{Error, Result};
 
-/// `|ψ_E| = Σ_n ψ̇_E[n]·Δt_s` (s): the duration of an execution warp given by its gradients.
-pub(crate) fn execution_s(grad_exec: &[f64], dt_s: f64) -> f64 {
-    grad_exec.iter().sum::<f64>() * dt_s
-}
-
-/// A two-robot schedule: one execution warp per robot and the offset of robot 2 (§II-B4).
+/// A two-robot schedule: one execution warp per robot, the offset of robot 2 (§II-B4) and
+/// the control tick it was checked with.
 ///
 /// Robot index 0 is the first robot (`τ_1 = 0`), index 1 the second (`τ_2 = offset_s`).
-/// Check a schedule against a [`Problem`] with [`crate::validate`].
+/// Check a schedule against a [`Problem`] with [`crate::validate`] (at its own tick), run
+/// it with [`Schedule::coordinator`] (at its own tick).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Schedule {
@@ -23,39 +24,55 @@ pub struct Schedule {
     pub grad_exec: [Vec<f64>; 2],
     /// Offset `τ` (s, global time) at which robot 2 starts; `0 ≤ τ ≤ |ψ_E1|` (Eq. 20).
     pub offset_s: f64,
+    /// Control tick (real s, finite and > 0) of the margin check (Alg. 2, Eq. 20 constraint
+    /// 5) that accepted the schedule, and so the only period at which the [`Coordinator`] may
+    /// run it: the check's guarantee (never both robots low-confidence in one tick) holds for
+    /// this tick, not for another.
+    pub tick_s: f64,
 }
 
 impl Schedule {
     /// Each robot's [`Timeline`] (schedule-clock plan for the real-time coordinator and the
-    /// margin check, Eq. 15–16) on `problem`. Gradients are clamped into `[ψ̇min, ψ̇max]`
-    /// first: [`crate::validate`] lets values through within a relative `1e-9` of the bounds,
-    /// and the realtime crate checks them exactly.
+    /// margin check, Eq. 15–16) on `problem`, built from the schedule's own gradients: the
+    /// realtime crate accepts gradients within [`tol::GRADIENT_REL`] of the bounds, as
+    /// [`crate::validate`] does.
     ///
     /// # Errors
-    /// The realtime crate's error for a warp whose length is not `T_ref`, or non-finite values.
-    pub fn timelines(&self, problem: &Problem) -> std::result::Result<[Timeline; 2], RtError> {
-        let (gmin, gmax) = (problem.grad_min(), problem.grad_max());
+    /// [`Error::Timeline`] naming the robot, for a warp whose length is not `T_ref`, a
+    /// non-finite value or a gradient outside its bounds.
+    pub fn timelines(&self, problem: &Problem) -> Result<[Timeline; 2]> {
+        self.timelines_of(problem)
+            .map_err(|(robot, source)| Error::Timeline { robot, source })
+    }
+
+    /// [`Schedule::timelines`] with the failing robot's index beside the realtime error.
+    pub(crate) fn timelines_of(
+        &self,
+        problem: &Problem,
+    ) -> std::result::Result<[Timeline; 2], (usize, tandem_realtime::Error)> {
         let build = |robot: usize| {
-            let raw = &self.grad_exec[robot];
-            // Clamp only a warp of the right length; the realtime crate names the mismatch.
-            let grad: Vec<f64> = if raw.len() == gmin.len() {
-                raw.iter()
-                    .zip(gmin.iter().zip(gmax))
-                    .map(|(g, (lo, hi))| g.clamp(*lo, *hi))
-                    .collect()
-            } else {
-                raw.clone()
-            };
             Timeline::new(
                 problem.conf(),
-                &grad,
-                gmin,
-                gmax,
+                &self.grad_exec[robot],
+                problem.grad_min(),
+                problem.grad_max(),
                 self.starts_s()[robot],
                 problem.dt_s(),
             )
+            .map_err(|e| (robot, e))
         };
         Ok([build(0)?, build(1)?])
+    }
+
+    /// The runtime coordinator of this schedule on `problem` (§II-B5): both robots'
+    /// [`Timeline`]s, advanced one control tick of [`Schedule::tick_s`] real seconds per
+    /// [`Coordinator::tick`].
+    ///
+    /// # Errors
+    /// [`Error::Timeline`] as [`Schedule::timelines`]; [`Error::Realtime`] for a tick that is
+    /// not finite and > 0.
+    pub fn coordinator(&self, problem: &Problem) -> Result<Coordinator> {
+        Ok(Coordinator::new(self.timelines(problem)?, self.tick_s)?)
     }
 
     /// Start time of each robot in global time (s): `[0, τ]`.
@@ -63,197 +80,106 @@ impl Schedule {
         [0.0, self.offset_s]
     }
 
-    /// Execution durations `[|ψ_E1|, |ψ_E2|]` (s) for reference sample period `dt_s` (s).
+    /// Execution durations `[|ψ_E1|, |ψ_E2|]` (s) for reference sample period `dt_s` (s): the
+    /// end of each warp's clock started at 0 ([`clock_end_s`]).
     pub fn durations_s(&self, dt_s: f64) -> [f64; 2] {
         [
-            execution_s(&self.grad_exec[0], dt_s),
-            execution_s(&self.grad_exec[1], dt_s),
+            clock_end_s(&self.grad_exec[0], 0.0, dt_s),
+            clock_end_s(&self.grad_exec[1], 0.0, dt_s),
         ]
     }
 
-    /// `T_total = max(|ψ_E1|, τ + |ψ_E2|)` (Eq. 13), global time (s), for sample period `dt_s`.
+    /// Global time (s) at which each robot ends on schedule, `[|ψ_E1|, τ + |ψ_E2|]`, for
+    /// sample period `dt_s` (s): the end of its clock started at its start ([`clock_end_s`]),
+    /// exactly [`Timeline::end_s`] of [`Schedule::timelines`].
+    pub fn ends_s(&self, dt_s: f64) -> [f64; 2] {
+        let starts = self.starts_s();
+        [0, 1].map(|i| clock_end_s(&self.grad_exec[i], starts[i], dt_s))
+    }
+
+    /// `T_total = max(|ψ_E1|, τ + |ψ_E2|)` (Eq. 13), global time (s), for sample period `dt_s`:
+    /// the later of [`Schedule::ends_s`].
     pub fn t_total_s(&self, dt_s: f64) -> f64 {
-        let [d0, d1] = self.durations_s(dt_s);
-        d0.max(self.offset_s + d1)
+        let [e0, e1] = self.ends_s(dt_s);
+        e0.max(e1)
     }
 }
 
-/// A maximal low-confidence stretch of one robot, in both time frames.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LcInterval {
-    /// Robot index (0 = first robot, 1 = second).
-    pub robot: usize,
-    /// Reference samples `ref_start..ref_end` (end exclusive) of the low-confidence run.
-    pub ref_start: usize,
-    /// One past the last reference sample of the run.
-    pub ref_end: usize,
-    /// Global time (s) at which the robot enters the run (scheduled, Eq. 15).
-    pub start_s: f64,
-    /// Global time (s) at which the robot leaves the run (scheduled); the interval is
-    /// `[start_s, end_s)`.
-    pub end_s: f64,
-}
-
-/// One robot's schedule in global time: start and cumulative execution times.
-#[derive(Clone, Debug)]
-struct RobotLine {
-    start_s: f64,
-    /// `cum_s[n]`: execution time (s) from the robot's start to entering reference sample `n`;
-    /// length `T_ref + 1`.
-    cum_s: Vec<f64>,
-}
-
-/// The global timeline of a schedule (Eq. 15–16, 19): where each robot is in the reference at
+/// The global timeline of a schedule (Eq. 15–16, 19): a view of both robots' [`Timeline`]s
+/// (built once by [`Schedule::timelines`]) that says where each robot is in the reference at
 /// any global time, its confidence then, and every low-confidence interval in global time.
 ///
-/// Reference sample `n` of robot `i` occupies global time
-/// `[τ_i + Σ_{m<n} ψ̇_Ei[m]·Δt_s, τ_i + Σ_{m≤n} ψ̇_Ei[m]·Δt_s)`.
+/// Reference sample `n` of robot `i` occupies global time `[c_n, c_{n+1})` of its clock
+/// ([`tandem_realtime::clock_s`], started at `τ_i`).
 #[derive(Clone, Debug)]
 pub struct GlobalTimeline {
-    conf: Vec<bool>,
-    robots: [RobotLine; 2],
-    intervals: [Vec<LcInterval>; 2],
+    robots: [Timeline; 2],
+}
+
+impl From<[Timeline; 2]> for GlobalTimeline {
+    fn from(robots: [Timeline; 2]) -> Self {
+        GlobalTimeline { robots }
+    }
 }
 
 impl GlobalTimeline {
-    /// Lays `schedule` out in global time for `problem`.
-    ///
-    /// Only shapes and finiteness are checked here (bounds and the other constraints are
-    /// [`crate::validate`]'s job).
+    /// Lays `schedule` out in global time for `problem` ([`Schedule::timelines`]).
     ///
     /// # Errors
-    /// [`Error::LengthMismatch`] when a warp does not have `T_ref` gradients,
-    /// [`Error::NonFinite`] for a non-finite or non-positive gradient or offset.
+    /// [`Error::Timeline`] naming the robot whose warp has the wrong length, a non-finite
+    /// value, or a gradient outside its bounds.
     pub fn new(problem: &Problem, schedule: &Schedule) -> Result<Self> {
-        let n_ref = problem.n_ref();
-        let dt_s = problem.dt_s();
-        if !schedule.offset_s.is_finite() {
-            return Err(Error::NonFinite {
-                name: "offset_s",
-                ref_idx: 0,
-            });
-        }
-        let mut lines = Vec::with_capacity(2);
-        for (robot, grad) in schedule.grad_exec.iter().enumerate() {
-            let name = if robot == 0 {
-                "grad_exec[0]"
-            } else {
-                "grad_exec[1]"
-            };
-            if grad.len() != n_ref {
-                return Err(Error::LengthMismatch {
-                    name,
-                    len: grad.len(),
-                    expected: n_ref,
-                });
-            }
-            if let Some(ref_idx) = grad.iter().position(|g| !(g.is_finite() && *g > 0.0)) {
-                return Err(Error::NonFinite { name, ref_idx });
-            }
-            let mut cum_s = Vec::with_capacity(n_ref + 1);
-            let mut acc = 0.0;
-            cum_s.push(0.0);
-            for g in grad {
-                acc += g;
-                cum_s.push(acc * dt_s);
-            }
-            lines.push(RobotLine {
-                start_s: schedule.starts_s()[robot],
-                cum_s,
-            });
-        }
-        let robots: [RobotLine; 2] = [lines.remove(0), lines.remove(0)];
-        let intervals = [0, 1].map(|robot| {
-            let line = &robots[robot];
-            problem
-                .runs()
-                .iter()
-                .filter(|r| !r.high_conf)
-                .map(|r| LcInterval {
-                    robot,
-                    ref_start: r.start,
-                    ref_end: r.end,
-                    start_s: line.start_s + line.cum_s[r.start],
-                    end_s: line.start_s + line.cum_s[r.end],
-                })
-                .collect()
-        });
-        Ok(GlobalTimeline {
-            conf: problem.conf().to_vec(),
-            robots,
-            intervals,
-        })
+        Ok(schedule.timelines(problem)?.into())
+    }
+
+    /// Both robots' timelines (robot 1, robot 2).
+    pub fn timelines(&self) -> &[Timeline; 2] {
+        &self.robots
     }
 
     /// Each robot's `[start, end]` in global time (s).
     pub fn spans_s(&self) -> [(f64, f64); 2] {
-        self.robots
-            .each_ref()
-            .map(|r| (r.start_s, r.start_s + r.cum_s[r.cum_s.len() - 1]))
+        self.robots.each_ref().map(|r| (r.start_s(), r.end_s()))
     }
 
-    /// `T_total` (Eq. 13), global time (s).
+    /// `T_total` (Eq. 13), global time (s): the later end.
     pub fn t_total_s(&self) -> f64 {
-        let [a, b] = self.spans_s();
-        a.1.max(b.1)
+        self.robots[0].end_s().max(self.robots[1].end_s())
     }
 
     /// Eq. 15: robot `robot`'s fractional reference time (reference samples, in `[0, T_ref]`)
     /// at global time `t_global_s`: 0 before its start, `T_ref` after its end, linear within
     /// each reference sample in between. `robot` > 1 is treated as robot 1.
     pub fn ref_time(&self, robot: usize, t_global_s: f64) -> f64 {
-        let line = &self.robots[robot.min(1)];
-        let n_ref = line.cum_s.len() - 1;
-        let t = t_global_s - line.start_s;
-        if t.is_nan() || t <= 0.0 {
-            return 0.0;
-        }
-        if t >= line.cum_s[n_ref] {
-            return n_ref as f64;
-        }
-        // Last n with cum_s[n] <= t.
-        let n = line.cum_s.partition_point(|&c| c <= t) - 1;
-        let width = line.cum_s[n + 1] - line.cum_s[n];
-        n as f64 + ((t - line.cum_s[n]) / width).clamp(0.0, 1.0)
+        self.robots[robot.min(1)].ref_time_at(t_global_s)
     }
 
     /// Eq. 16: `[conf_1(t), conf_2(t)]` at global time `t_global_s` (`true` = high confidence;
     /// a robot that is not running, `t < τ_i` or `t ≥ τ_i + |ψ_Ei|`, counts as high).
     pub fn conf_at(&self, t_global_s: f64) -> [bool; 2] {
-        [0, 1].map(|robot| {
-            let line = &self.robots[robot];
-            let t = t_global_s - line.start_s;
-            let n_ref = line.cum_s.len() - 1;
-            if t.is_nan() || t < 0.0 || t >= line.cum_s[n_ref] {
-                return true;
-            }
-            let n = line.cum_s.partition_point(|&c| c <= t) - 1;
-            self.conf[n.min(n_ref - 1)]
-        })
+        self.robots.each_ref().map(|r| r.conf_at(t_global_s))
     }
 
     /// Each robot's low-confidence intervals in global time, in time order (Eq. 19: their
     /// union is `T_lc`).
-    pub fn lc_intervals(&self) -> &[Vec<LcInterval>; 2] {
-        &self.intervals
+    pub fn lc_intervals(&self) -> [&[LcInterval]; 2] {
+        self.robots.each_ref().map(Timeline::lc_intervals)
     }
 
     /// The first stretch of global time in which both robots are scheduled low-confidence
     /// (Eq. 20 constraint 3), as `(robot 1's interval, robot 2's interval)`, or `None`.
     ///
     /// Intervals are half-open, so one robot may enter a low-confidence run exactly when the
-    /// other leaves one. An overlap shorter than `1e-9·max(1, T_total)` s is treated as
-    /// rounding and ignored.
+    /// other leaves one. An overlap shorter than [`tol::overlap_tolerance_s`]`(T_total)` is
+    /// treated as rounding and ignored.
     pub fn first_lc_overlap(&self) -> Option<(LcInterval, LcInterval)> {
-        let eps = 1e-9 * self.t_total_s().max(1.0);
-        let (a, b) = (&self.intervals[0], &self.intervals[1]);
+        let eps = tol::overlap_tolerance_s(self.t_total_s());
+        let [a, b] = self.lc_intervals();
         let (mut i, mut j) = (0, 0);
         // Two-pointer merge: each robot's intervals are disjoint and in time order, so the
         // intersections come out in time order and the first one found is the earliest.
         while i < a.len() && j < b.len() {
-            let lo = a[i].start_s.max(b[j].start_s);
-            let hi = a[i].end_s.min(b[j].end_s);
-            if hi - lo > eps {
+            if a[i].overlap_s(&b[j]) > eps {
                 return Some((a[i], b[j]));
             }
             if a[i].end_s <= b[j].end_s {
@@ -279,23 +205,33 @@ mod tests {
         Schedule {
             grad_exec: [vec![2.0, 1.0, 1.0, 0.5], vec![0.5, 1.0, 1.0, 2.0]],
             offset_s,
+            tick_s: 0.5,
         }
     }
 
     #[test]
-    fn timelines_clamp_into_the_bounds_and_name_a_wrong_length() {
-        // 2.0 + 1e-12 is just above ψ̇max = 2: clamped, so the realtime crate accepts it.
+    fn timelines_accept_rounding_and_name_the_robot_of_a_wrong_length() {
+        // 2.0 + 1e-12 is just above ψ̇max = 2: within the gradient tolerance, kept as it is.
         let mut s = schedule(1.0);
         s.grad_exec[0][0] = 2.0 + 1e-12;
         let [r1, r2] = s.timelines(&problem()).unwrap();
         assert_eq!((r1.start_s(), r2.start_s()), (0.0, 1.0));
-        assert_eq!(r1.end_s(), 2.25);
-        // A warp one sample short is an error, not a panic.
+        assert_eq!(r1.grad_exec()[0], 2.0 + 1e-12);
+        assert_eq!(r1.end_s(), s.ends_s(0.5)[0]);
+        // A warp one sample short is an error naming robot 2, not a panic.
         s.grad_exec[1].pop();
-        assert!(matches!(
-            s.timelines(&problem()),
-            Err(tandem_realtime::Error::LengthMismatch { .. })
-        ));
+        let err = s.timelines(&problem()).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::Timeline {
+                    robot: 1,
+                    source: tandem_realtime::Error::LengthMismatch { .. }
+                }
+            ),
+            "{err}"
+        );
+        assert!(err.to_string().starts_with("robot 2: "), "{err}");
     }
 
     #[test]
@@ -303,6 +239,7 @@ mod tests {
         // |ψ_E1| = 4.5·0.5 = 2.25 s, |ψ_E2| = 2.25 s.
         let s = schedule(1.0);
         assert_eq!(s.durations_s(0.5), [2.25, 2.25]);
+        assert_eq!(s.ends_s(0.5), [2.25, 3.25]);
         assert_eq!(s.t_total_s(0.5), 3.25);
         assert_eq!(schedule(0.0).t_total_s(0.5), 2.25);
     }
@@ -315,9 +252,8 @@ mod tests {
         let [a, b] = g.lc_intervals();
         assert_eq!((a[0].start_s, a[0].end_s), (1.0, 2.0));
         assert_eq!((b[0].start_s, b[0].end_s), (1.5, 2.5));
-        assert_eq!((b[0].ref_start, b[0].ref_end, b[0].robot), (1, 3, 1));
-        let (x, y) = g.first_lc_overlap().unwrap();
-        assert_eq!((x.robot, y.robot), (0, 1));
+        assert_eq!((b[0].ref_start, b[0].ref_end), (1, 3));
+        assert_eq!(g.first_lc_overlap(), Some((a[0], b[0])));
         // Touching is not overlapping: τ = 1.75 puts robot 2's LC at [2, 3).
         let g = GlobalTimeline::new(&problem(), &schedule(1.75)).unwrap();
         assert_eq!(g.lc_intervals()[1][0].start_s, 2.0);
@@ -350,27 +286,52 @@ mod tests {
         s.grad_exec[1].pop();
         assert!(matches!(
             GlobalTimeline::new(&problem(), &s),
-            Err(Error::LengthMismatch {
-                name: "grad_exec[1]",
-                len: 3,
-                expected: 4
+            Err(Error::Timeline {
+                robot: 1,
+                source: tandem_realtime::Error::LengthMismatch {
+                    what: "grad_exec",
+                    expected: 4,
+                    found: 3
+                }
             })
         ));
         let mut s = schedule(0.0);
         s.grad_exec[0][2] = f64::NAN;
         assert!(matches!(
             GlobalTimeline::new(&problem(), &s),
-            Err(Error::NonFinite {
-                name: "grad_exec[0]",
-                ref_idx: 2
+            Err(Error::Timeline {
+                robot: 0,
+                source: tandem_realtime::Error::NonFinite {
+                    what: "grad_exec",
+                    index: 2
+                }
             })
         ));
     }
 
     #[test]
-    fn schedule_serde_round_trip() {
+    fn schedule_serde_round_trip_keeps_the_tick() {
         let s = schedule(0.125);
-        let back: Schedule = serde_json::from_str(&serde_json::to_string(&s).unwrap()).unwrap();
+        let json = serde_json::to_string(&s).unwrap();
+        assert!(json.contains("\"tick_s\":0.5"), "{json}");
+        let back: Schedule = serde_json::from_str(&json).unwrap();
         assert_eq!(back, s);
+    }
+
+    #[test]
+    fn the_coordinator_runs_at_the_schedule_tick() {
+        let mut s = schedule(1.25);
+        s.tick_s = 0.125;
+        let c = s.coordinator(&problem()).unwrap();
+        assert_eq!(c.tick_s(), 0.125);
+        assert_eq!(c.robots()[1].start_s(), 1.25);
+        s.tick_s = f64::NAN;
+        assert!(matches!(
+            s.coordinator(&problem()),
+            Err(Error::Realtime(tandem_realtime::Error::BadParam {
+                name: "tick_s",
+                ..
+            }))
+        ));
     }
 }

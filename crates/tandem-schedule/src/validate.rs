@@ -1,11 +1,9 @@
 //! The constraints of Eq. 20, checked in the paper's order.
 
+use tandem_realtime::tol;
+
 use crate::problem::Problem;
 use crate::schedule::{GlobalTimeline, Schedule};
-
-/// Relative tolerance for the equality and bound tests on gradients and the offset: values
-/// that went through a text round trip or a different summation order still pass.
-const REL_TOL: f64 = 1e-9;
 
 /// The first constraint of Eq. 20 that a schedule breaks.
 ///
@@ -86,52 +84,81 @@ pub enum Violation {
         /// Control tick (s) the check ran with.
         tick_s: f64,
     },
-    /// The control tick given to [`validate_with_tick`] is not finite and > 0 (not a fault of
-    /// the schedule).
+    /// The schedule's control tick ([`Schedule::tick_s`]) is not finite and > 0.
     #[error("control tick {tick_s} s must be finite and > 0")]
     InvalidTick {
         /// The tick (s).
         tick_s: f64,
     },
+    /// A robot's plan cannot be laid out in schedule-clock time (e.g. its end overflows), so
+    /// neither constraint 3 nor the margin check can be evaluated.
+    #[error("robot {}: cannot lay out the schedule: {source}", .robot + 1)]
+    Timeline {
+        /// Robot index (0 = first robot, 1 = second).
+        robot: usize,
+        /// What the realtime crate rejected.
+        source: tandem_realtime::Error,
+    },
+    /// Constraint 5 could not be evaluated: the margin check rejected its input (e.g. a tick
+    /// so small that its simulation would need more than 1e8 ticks).
+    #[error(
+        "the margin check at control tick {tick_s} s cannot run: {source} (Eq. 20, constraint 5)"
+    )]
+    MarginCheck {
+        /// Control tick (s) the check was asked to run with.
+        tick_s: f64,
+        /// What the realtime crate rejected.
+        source: tandem_realtime::Error,
+    },
 }
 
-/// Checks every constraint of Eq. 20 with the control tick equal to the reference sample
-/// period `Δt_s`; see [`validate_with_tick`].
+/// Checks every constraint of Eq. 20 at the schedule's own control tick
+/// ([`Schedule::tick_s`]) and names the first one broken, in this order: the tick (finite,
+/// positive), warp lengths, (1) gradient bounds (robot 1 then robot 2, in reference order),
+/// (2) offset `0 ≤ τ ≤ |ψ_E1|`, the layout of both robots in schedule-clock time, (3) no
+/// global time with both robots low-confidence, (4) mean gradient on low-confidence samples,
+/// (5) `tandem_realtime::sufficient_margins` at the schedule's tick.
+///
+/// To re-check a schedule at another tick, set its `tick_s` first (the sampler does so for a
+/// previous schedule handed to it at a new tick): a schedule is valid *at its tick*.
+///
+/// Gradient bounds, the mean and the offset bound are tested up to [`tol::GRADIENT_REL`];
+/// overlaps shorter than [`tol::overlap_tolerance_s`]`(T_total)` are ignored (see
+/// `tandem_realtime::tol` for the policy).
 ///
 /// # Errors
-/// The first [`Violation`], in the order of [`validate_with_tick`].
+/// The first [`Violation`] found: a broken constraint, or [`Violation::Timeline`] /
+/// [`Violation::MarginCheck`] with the realtime crate's error when a check cannot run.
 pub fn validate(problem: &Problem, schedule: &Schedule) -> Result<(), Violation> {
-    validate_with_tick(problem, schedule, problem.dt_s())
+    validate_full(problem, schedule, MarginCheck::SinglePass)
 }
 
-/// Checks every constraint of Eq. 20 and names the first one broken, in this order:
-/// warp lengths, (1) gradient bounds (robot 1 then robot 2, in reference order), (2) offset
-/// `0 ≤ τ ≤ |ψ_E1|`, (3) no global time with both robots low-confidence, (4) mean gradient on
-/// low-confidence samples, (5) `tandem_realtime::sufficient_margins` at control tick `tick_s`
-/// (s).
-///
-/// Gradient bounds, the mean and the offset bound are tested with a relative tolerance of
-/// `1e-9`; overlaps shorter than `1e-9·max(1, T_total)` s are ignored.
-///
-/// # Errors
-/// The first [`Violation`] found.
-pub fn validate_with_tick(
+/// Every constraint of Eq. 20 (see [`validate`]) with margin-check implementation `check`.
+pub(crate) fn validate_full(
     problem: &Problem,
     schedule: &Schedule,
-    tick_s: f64,
+    check: MarginCheck,
 ) -> Result<(), Violation> {
+    let tick_s = schedule.tick_s;
     if !(tick_s.is_finite() && tick_s > 0.0) {
         return Err(Violation::InvalidTick { tick_s });
     }
-    validate_cheap(problem, schedule)?;
-    if !margins_ok(problem, schedule, tick_s, MarginCheck::SinglePass)? {
-        return Err(Violation::InsufficientMargins { tick_s });
+    let timeline = validate_cheap(problem, schedule)?;
+    let robots = timeline.timelines();
+    let decided = match check {
+        MarginCheck::SinglePass => tandem_realtime::sufficient_margins(robots, tick_s),
+        MarginCheck::PerPair => tandem_realtime::sufficient_margins_per_pair(robots, tick_s),
+    };
+    match decided {
+        Ok(true) => Ok(()),
+        Ok(false) => Err(Violation::InsufficientMargins { tick_s }),
+        Err(source) => Err(Violation::MarginCheck { tick_s, source }),
     }
-    Ok(())
 }
 
-/// Which implementation of `SUFFICIENT_MARGINS` (Alg. 2) to run; both decide identically.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// Which implementation of `SUFFICIENT_MARGINS` (Alg. 2) to run; both decide identically
+/// (a benchmark-only choice, see `SamplerBaselines`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum MarginCheck {
     /// `tandem_realtime::sufficient_margins`: two worst-case simulations decide every pair.
     #[default]
@@ -141,8 +168,12 @@ pub enum MarginCheck {
     PerPair,
 }
 
-/// Constraints 1–4 (everything but the margins).
-pub(crate) fn validate_cheap(problem: &Problem, schedule: &Schedule) -> Result<(), Violation> {
+/// Constraints 1–4 (everything but the margins); on success, the schedule's global timeline
+/// (built once, for the margin check to reuse).
+pub(crate) fn validate_cheap(
+    problem: &Problem,
+    schedule: &Schedule,
+) -> Result<GlobalTimeline, Violation> {
     let n_ref = problem.n_ref();
     for (robot, grad) in schedule.grad_exec.iter().enumerate() {
         if grad.len() != n_ref {
@@ -157,7 +188,7 @@ pub(crate) fn validate_cheap(problem: &Problem, schedule: &Schedule) -> Result<(
     for (robot, grad) in schedule.grad_exec.iter().enumerate() {
         for (ref_idx, &value) in grad.iter().enumerate() {
             let (min, max) = (gmin[ref_idx], gmax[ref_idx]);
-            if !(value >= min * (1.0 - REL_TOL) && value <= max * (1.0 + REL_TOL)) {
+            if !tol::within_bounds(value, min, max) {
                 return Err(Violation::GradientOutOfBounds {
                     robot,
                     ref_idx,
@@ -168,13 +199,15 @@ pub(crate) fn validate_cheap(problem: &Problem, schedule: &Schedule) -> Result<(
             }
         }
     }
-    let max_s = crate::schedule::execution_s(&schedule.grad_exec[0], problem.dt_s());
+    let max_s = schedule.durations_s(problem.dt_s())[0];
     let offset_s = schedule.offset_s;
-    if !(offset_s >= 0.0 && offset_s <= max_s * (1.0 + REL_TOL)) {
+    if !tol::within_bounds(offset_s, 0.0, max_s) {
         return Err(Violation::Offset { offset_s, max_s });
     }
-    let timeline = GlobalTimeline::new(problem, schedule)
-        .expect("lengths, bounds (> 0, finite) and offset were checked just above");
+    let timeline: GlobalTimeline = schedule
+        .timelines_of(problem)
+        .map_err(|(robot, source)| Violation::Timeline { robot, source })?
+        .into();
     if let Some((a, b)) = timeline.first_lc_overlap() {
         return Err(Violation::BothLowConfidence {
             start_s: a.start_s.max(b.start_s),
@@ -185,7 +218,7 @@ pub(crate) fn validate_cheap(problem: &Problem, schedule: &Schedule) -> Result<(
     for (robot, grad) in schedule.grad_exec.iter().enumerate() {
         for (ref_idx, &value) in grad.iter().enumerate() {
             let mean = gmean[ref_idx];
-            if !problem.conf()[ref_idx] && (value - mean).abs() > REL_TOL * mean {
+            if !problem.conf()[ref_idx] && !tol::close_to(value, mean) {
                 return Err(Violation::NotMeanGradient {
                     robot,
                     ref_idx,
@@ -195,27 +228,7 @@ pub(crate) fn validate_cheap(problem: &Problem, schedule: &Schedule) -> Result<(
             }
         }
     }
-    Ok(())
-}
-
-/// Constraint 5 for a schedule that passed [`validate_cheap`].
-pub(crate) fn margins_ok(
-    problem: &Problem,
-    schedule: &Schedule,
-    tick_s: f64,
-    check: MarginCheck,
-) -> Result<bool, Violation> {
-    // A rejection by the realtime crate of a schedule that passed constraints 1–4 can only
-    // concern the tick (validated by the callers) or a degenerate timeline: count it as
-    // insufficient margins rather than accept a schedule the margin check did not pass.
-    let Ok(robots) = schedule.timelines(problem) else {
-        return Ok(false);
-    };
-    let decided = match check {
-        MarginCheck::SinglePass => tandem_realtime::sufficient_margins(&robots, tick_s),
-        MarginCheck::PerPair => tandem_realtime::sufficient_margins_per_pair(&robots, tick_s),
-    };
-    decided.map_err(|_| Violation::InvalidTick { tick_s })
+    Ok(timeline)
 }
 
 #[cfg(test)]
@@ -228,7 +241,7 @@ mod tests {
     }
 
     fn ok_schedule() -> Schedule {
-        problem().serial_schedule()
+        problem().serial_schedule(0.5).unwrap()
     }
 
     #[test]
@@ -304,8 +317,10 @@ mod tests {
                 mean: 1.0
             })
         );
+        let mut s = ok_schedule();
+        s.tick_s = 0.0;
         assert_eq!(
-            validate_with_tick(&p, &ok_schedule(), 0.0),
+            validate(&p, &s),
             Err(Violation::InvalidTick { tick_s: 0.0 })
         );
     }
@@ -316,7 +331,7 @@ mod tests {
         let mut s = ok_schedule();
         s.grad_exec[0][0] = 0.5 * (1.0 - 1e-12);
         s.offset_s *= 1.0 + 1e-12;
-        assert_eq!(validate_cheap(&p, &s), Ok(()));
+        assert!(validate_cheap(&p, &s).is_ok());
         s.grad_exec[0][0] = 0.5 * (1.0 - 1e-6);
         assert!(validate_cheap(&p, &s).is_err());
     }

@@ -1,6 +1,7 @@
 //! The safety invariant end to end: schedules FOUND BY THE SAMPLER, run through
-//! `tandem_realtime::Coordinator` under random and extreme operator gradient sequences, never
-//! have both robots low-confidence in the same control tick.
+//! `tandem_realtime::Coordinator` at their own tick under the full adversary set of
+//! `tandem_realtime::adversary` (extremes, switching, random, and Alg. 2's worst case per
+//! role), never have both robots low-confidence in the same control tick.
 
 mod common;
 
@@ -8,26 +9,34 @@ use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use tandem_realtime::Coordinator;
-use tandem_realtime::adversary::{Adversary, run_adversary};
-use tandem_schedule::{OffsetSampling, Problem, SamplerParams, Schedule, Source, sample_schedule};
+use tandem_realtime::adversary::{Adversary, adversary_set, run_adversary};
+use tandem_schedule::{
+    DrawnOffset, Problem, SamplerBaselines, SamplerParams, Schedule, Source,
+    sample_schedule_with_baselines,
+};
 
-/// The adversaries of these tests: the extremes, switching every tick or after 1–20 ticks,
-/// and a fresh random gradient in a range covering all bounds every tick.
-const FASTEST: Adversary = Adversary::Fastest;
-const SLOWEST: Adversary = Adversary::Slowest;
-const SWITCHING: Adversary = Adversary::Switching;
-const RANDOM_SWITCHING: Adversary = Adversary::RandomSwitching { max_hold: 20 };
-const RANDOM: Adversary = Adversary::Random { lo: 0.1, hi: 3.0 };
-
-/// Runs one execution; returns the first tick index with both robots low-confidence.
-fn run(p: &Problem, s: &Schedule, tick_s: f64, op: Adversary, seed: u64) -> Option<u64> {
-    let c = Coordinator::new(s.timelines(p).unwrap(), tick_s).unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    // Generous cap: every robot at its slowest, run serially, plus slack.
+/// Tick budget of one execution: every robot at its slowest, run serially, plus slack.
+fn max_ticks(p: &Problem, s: &Schedule) -> u64 {
     let slowest_s: f64 = p.grad_max().iter().sum::<f64>() * p.dt_s() * 4.0;
-    let max_ticks = (slowest_s / tick_s) as u64 + 100;
-    let r = run_adversary(c, op, &mut rng, max_ticks);
+    (slowest_s / s.tick_s) as u64 + 100
+}
+
+/// The full adversary set for `s` on `p`, its random parameters from `seed`.
+fn adversaries(p: &Problem, s: &Schedule, seed: u64) -> Vec<Adversary> {
+    let lo = p.grad_min().iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = p.grad_max().iter().copied().fold(0.0, f64::max);
+    let ticks = (s.t_total_s(p.dt_s()) / s.tick_s) as u64;
+    adversary_set([lo, hi], ticks, &mut ChaCha8Rng::seed_from_u64(seed)).to_vec()
+}
+
+/// Runs one execution at the schedule's tick; returns the first tick index with both robots
+/// low-confidence.
+fn run(p: &Problem, s: &Schedule, op: Adversary, seed: u64) -> Option<u64> {
+    let c = s.coordinator(p).unwrap();
+    assert_eq!(c.tick_s(), s.tick_s);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let max_ticks = max_ticks(p, s);
+    let r = run_adversary(c, op, &mut rng, max_ticks).unwrap();
     assert!(
         r.finished,
         "execution did not finish within {max_ticks} ticks"
@@ -35,17 +44,16 @@ fn run(p: &Problem, s: &Schedule, tick_s: f64, op: Adversary, seed: u64) -> Opti
     r.first_overlap
 }
 
-/// Random small problems: confidence in runs (1–12 samples, HC runs twice as likely), random
-/// means and bounds per sample.
-/// The sampler's default (robot 2 fitted) or the uniform-feasible offsets.
-fn offset_mode(fitted: bool) -> OffsetSampling {
-    if fitted {
-        OffsetSampling::default()
-    } else {
-        OffsetSampling::UniformFeasible
+/// The sampler's default (robot 2 fitted) or the uniform-feasible offsets baseline.
+fn baselines(fitted: bool) -> SamplerBaselines {
+    SamplerBaselines {
+        drawn_offset: (!fitted).then_some(DrawnOffset::UniformFeasible),
+        ..SamplerBaselines::default()
     }
 }
 
+/// Random small problems: confidence in runs (1–12 samples, HC runs twice as likely), random
+/// means and bounds per sample.
 fn random_problem() -> impl Strategy<Value = Problem> {
     proptest::collection::vec((1usize..12, prop::bool::weighted(0.65)), 1..8)
         .prop_flat_map(|blocks| {
@@ -60,7 +68,7 @@ fn random_problem() -> impl Strategy<Value = Problem> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(500))]
+    #![proptest_config(ProptestConfig::with_cases(400))]
 
     #[test]
     fn sampled_schedules_never_overlap_at_runtime(
@@ -75,24 +83,16 @@ proptest! {
             samples,
             seed,
             tick_s: Some(tick_s),
-            offset: offset_mode(fitted),
             ..SamplerParams::default()
         };
-        let out = sample_schedule(&p, &params, None).unwrap();
-        for op in [
-            FASTEST,
-            SLOWEST,
-            SWITCHING,
-            RANDOM_SWITCHING,
-            RANDOM,
-        ] {
-            for rep in 0..2u64 {
-                let hit = run(&p, &out.schedule, tick_s, op, seed ^ rep);
-                prop_assert!(
-                    hit.is_none(),
-                    "both LC at tick {:?} with {:?} (source {:?})", hit, op, out.source
-                );
-            }
+        let out = sample_schedule_with_baselines(&p, &params, &baselines(fitted), None).unwrap();
+        prop_assert_eq!(out.schedule.tick_s, tick_s);
+        for op in adversaries(&p, &out.schedule, seed) {
+            let hit = run(&p, &out.schedule, op, seed);
+            prop_assert!(
+                hit.is_none(),
+                "both LC at tick {:?} with {:?} (source {:?})", hit, op, out.source
+            );
         }
     }
 }
@@ -109,14 +109,14 @@ fn most_random_problems_get_sampled_schedules() {
             let params = SamplerParams {
                 samples: 100,
                 seed,
-                offset: offset_mode(fitted),
                 ..SamplerParams::default()
             };
-            let out = sample_schedule(&p, &params, None).unwrap();
+            let out =
+                sample_schedule_with_baselines(&p, &params, &baselines(fitted), None).unwrap();
             if matches!(out.source, Source::Sampled { .. }) {
                 sampled += 1;
-                for op in [FASTEST, SLOWEST, SWITCHING] {
-                    assert_eq!(run(&p, &out.schedule, p.dt_s(), op, seed), None);
+                for op in adversaries(&p, &out.schedule, seed) {
+                    assert_eq!(run(&p, &out.schedule, op, seed), None, "{op:?}");
                 }
             }
         }
@@ -136,10 +136,10 @@ fn most_random_problems_get_sampled_schedules() {
 fn an_overlapping_schedule_is_caught_at_runtime() {
     let conf: Vec<bool> = (0..30).map(|n| !(10..20).contains(&n)).collect();
     let p = Problem::new(conf, vec![1.0; 30], vec![0.5; 30], vec![2.0; 30], 0.01).unwrap();
-    let mut s = p.serial_schedule();
+    let mut s = p.serial_schedule(p.dt_s()).unwrap();
     s.offset_s = 0.0;
     assert!(tandem_schedule::validate(&p, &s).is_err());
-    for op in [FASTEST, SLOWEST, SWITCHING] {
-        assert!(run(&p, &s, p.dt_s(), op, 0).is_some(), "{op:?}");
+    for op in adversaries(&p, &s, 0) {
+        assert!(run(&p, &s, op, 0).is_some(), "{op:?}");
     }
 }

@@ -4,8 +4,8 @@ mod common;
 
 use proptest::prelude::*;
 use tandem_schedule::{
-    Distribution, MarginCheck, OffsetSampling, Problem, SamplerParams, Schedule, Source,
-    sample_schedule, validate, validate_with_tick,
+    DrawnOffset, MarginCheck, Problem, SamplerBaselines, SamplerParams, Schedule, Source,
+    sample_schedule, sample_schedule_with_baselines, validate,
 };
 
 /// `n` samples, low confidence on `lc`, bounds `[lo, hi]`×mean around a wobbling mean.
@@ -58,22 +58,29 @@ proptest! {
             samples: 200,
             seed,
             tick_s: Some(tick_s),
-            distribution: if pieces == 0 {
-                Distribution::PerSample
-            } else {
-                Distribution::PerRun { pieces }
-            },
-            offset: if uniform_offset { OffsetSampling::Uniform } else { OffsetSampling::UniformFeasible },
+            pieces: pieces.max(1),
             p_fastest,
             ..SamplerParams::default()
         };
-        let out = sample_schedule(&p, &params, None).unwrap();
-        prop_assert_eq!(validate_with_tick(&p, &out.schedule, tick_s), Ok(()));
-        let serial = p.serial_schedule().t_total_s(p.dt_s());
-        prop_assert!(out.t_total_s <= serial);
-        prop_assert!((out.t_total_s - out.schedule.t_total_s(p.dt_s())).abs() < 1e-12);
+        let baselines = SamplerBaselines {
+            per_sample: pieces == 0,
+            drawn_offset: Some(if uniform_offset {
+                DrawnOffset::Uniform
+            } else {
+                DrawnOffset::UniformFeasible
+            }),
+            ..SamplerBaselines::default()
+        };
+        let out = sample_schedule_with_baselines(&p, &params, &baselines, None).unwrap();
+        // The schedule carries the sampler's tick and is valid at it.
+        prop_assert_eq!(out.schedule.tick_s, tick_s);
+        prop_assert_eq!(validate(&p, &out.schedule), Ok(()));
+        let serial = p.serial_schedule(tick_s).unwrap();
+        prop_assert!(out.t_total_s <= serial.t_total_s(p.dt_s()));
+        // The returned T_total is the schedule's own, read from the one clock.
+        prop_assert_eq!(out.t_total_s, out.schedule.t_total_s(p.dt_s()));
         if out.source == Source::Serial {
-            prop_assert_eq!(&out.schedule, &p.serial_schedule());
+            prop_assert_eq!(&out.schedule, &serial);
         }
     }
 }
@@ -84,7 +91,8 @@ fn sampler_beats_serial_on_a_schedulable_problem() {
     let out = sample_schedule(&p, &params(2000, 3), None).unwrap();
     assert!(matches!(out.source, Source::Sampled { .. }));
     assert_eq!(validate(&p, &out.schedule), Ok(()));
-    assert!(out.t_total_s < 0.9 * p.serial_schedule().t_total_s(0.01));
+    let serial = p.serial_schedule(0.01).unwrap();
+    assert!(out.t_total_s < 0.9 * serial.t_total_s(0.01));
 }
 
 #[test]
@@ -93,7 +101,7 @@ fn all_low_confidence_gives_the_serial_schedule() {
     let p = problem(50, all, 0.5, 2.0);
     let out = sample_schedule(&p, &params(1000, 1), None).unwrap();
     assert_eq!(out.source, Source::Serial);
-    assert_eq!(out.schedule, p.serial_schedule());
+    assert_eq!(out.schedule, p.serial_schedule(p.dt_s()).unwrap());
     // Serial at the mean gradient: T_total = 2·Σ mean·dt.
     let single: f64 = p.grad_mean().iter().sum::<f64>() * 0.01;
     assert!((out.t_total_s - 2.0 * single).abs() < 1e-9);
@@ -137,17 +145,17 @@ fn lazy_and_exhaustive_margins_agree_with_both_checks() {
     let p = problem(200, &[20..50, 100..130], 0.7, 1.5);
     let base = params(1500, 9);
     let lazy = sample_schedule(&p, &base, None).unwrap();
-    for (check, exhaustive) in [
+    for (margin_check, exhaustive_margins) in [
         (MarginCheck::SinglePass, true),
         (MarginCheck::PerPair, false),
         (MarginCheck::PerPair, true),
     ] {
-        let q = SamplerParams {
-            margin_check: check,
-            exhaustive_margins: exhaustive,
-            ..base.clone()
+        let baselines = SamplerBaselines {
+            margin_check,
+            exhaustive_margins,
+            ..SamplerBaselines::default()
         };
-        let out = sample_schedule(&p, &q, None).unwrap();
+        let out = sample_schedule_with_baselines(&p, &base, &baselines, None).unwrap();
         assert_eq!(out.schedule, lazy.schedule);
         assert_eq!(out.source, lazy.source);
     }
@@ -165,6 +173,42 @@ fn previous_schedule_is_kept_when_nothing_better_is_found() {
     let one = sample_schedule(&p, &params(1, 6), Some(&first.schedule)).unwrap();
     assert_eq!(one.source, Source::Previous);
     assert_eq!(one.schedule, first.schedule);
+}
+
+/// A previous schedule handed to the sampler at another tick is re-checked at the new tick
+/// and comes back carrying it; the returned schedule never keeps a tick it was not checked at.
+#[test]
+fn a_previous_schedule_at_another_tick_is_rechecked_at_the_new_one() {
+    let p = problem(120, &[10..30, 70..90], 0.5, 2.0);
+    let first = sample_schedule(&p, &params(2000, 5), None).unwrap();
+    assert_eq!(first.schedule.tick_s, p.dt_s());
+    let half = SamplerParams {
+        tick_s: Some(0.005),
+        ..params(1, 6)
+    };
+    let out = sample_schedule(&p, &half, Some(&first.schedule)).unwrap();
+    assert_eq!(out.schedule.tick_s, 0.005);
+    assert_eq!(validate(&p, &out.schedule), Ok(()));
+    if out.source == Source::Previous {
+        assert_eq!(out.schedule.grad_exec, first.schedule.grad_exec);
+        assert_eq!(out.schedule.offset_s, first.schedule.offset_s);
+    }
+    // A coarser tick (4 samples): the margin check needs more room than the previous
+    // schedule left, so it is not kept as it is.
+    let coarse = SamplerParams {
+        tick_s: Some(0.04),
+        ..params(1, 6)
+    };
+    let mut at_coarse = first.schedule.clone();
+    at_coarse.tick_s = 0.04;
+    let out = sample_schedule(&p, &coarse, Some(&first.schedule)).unwrap();
+    assert_eq!(out.schedule.tick_s, 0.04);
+    assert_eq!(validate(&p, &out.schedule), Ok(()));
+    assert!(matches!(
+        validate(&p, &at_coarse),
+        Err(tandem_schedule::Violation::InsufficientMargins { tick_s: 0.04 })
+    ));
+    assert_ne!(out.source, Source::Previous);
 }
 
 #[test]
@@ -191,6 +235,7 @@ fn previous_schedule_is_repaired_after_the_model_moves() {
     let junk = Schedule {
         grad_exec: [vec![1.0; 3], vec![1.0; 3]],
         offset_s: 0.0,
+        tick_s: 0.01,
     };
     let out = sample_schedule(&q, &params(10, 6), Some(&junk)).unwrap();
     assert_eq!(validate(&q, &out.schedule), Ok(()));
@@ -213,7 +258,11 @@ fn bad_params_are_rejected() {
             ..SamplerParams::default()
         },
         SamplerParams {
-            distribution: Distribution::PerRun { pieces: 0 },
+            pieces: 0,
+            ..SamplerParams::default()
+        },
+        SamplerParams {
+            widen_max: f64::NAN,
             ..SamplerParams::default()
         },
     ] {

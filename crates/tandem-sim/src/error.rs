@@ -51,12 +51,27 @@ pub enum Error {
         /// The tick budget.
         ticks: usize,
     },
+    /// Workcell: the schedule was checked at a control tick other than the workcell's period
+    /// (one tick per reference sample period `Δt_s`); running it would void its margin check.
+    #[error(
+        "the schedule was checked at a control tick of {schedule_tick_s} s but the workcell \
+         runs one tick per reference sample period, {workcell_tick_s} s: re-schedule at that tick"
+    )]
+    TickMismatch {
+        /// The schedule's tick (`Schedule::tick_s`, real s).
+        schedule_tick_s: f64,
+        /// The workcell's control period (`Δt_s`, real s).
+        workcell_tick_s: f64,
+    },
     /// Workcell: the task model (commands, corrections, executions).
     #[error(transparent)]
     Lfd(#[from] tandem_lfd::Error),
     /// Workcell: timelines or the coordinator.
     #[error(transparent)]
     Realtime(#[from] tandem_realtime::Error),
+    /// Workcell: the schedule cannot be laid out on the problem (a robot's timeline).
+    #[error(transparent)]
+    Schedule(#[from] tandem_schedule::Error),
 }
 
 /// `Result` with this crate's [`Error`].

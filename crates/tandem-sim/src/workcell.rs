@@ -4,7 +4,10 @@
 //! # One control tick
 //!
 //! The control period is the reference sample period `Δt_s`, so every tick gives each
-//! running robot one execution sample, as in the demonstrations.
+//! running robot one execution sample, as in the demonstrations. The schedule must have been
+//! checked at that tick ([`Schedule::tick_s`], the tick of its margin check): a schedule made
+//! for another tick is rejected with [`Error::TickMismatch`] rather than run at a period its
+//! safety check never saw.
 //!
 //! 1. Each running robot's position is read from the coordinator: its schedule clock
 //!    `s_i` gives its reference sample `n_i` and fractional reference time `t_i` (Eq. 15).
@@ -34,9 +37,11 @@
 //!    input would otherwise speed it up, so a correction presses harder *and* slows the
 //!    robot, as the expert did over paint. The command `x_f⁺ = μ̂⁺ + δx⁺(u)` (Eq. 7) comes
 //!    from `TaskModel::command`; its last component, the warp gradient, is clamped to
-//!    `[ψ̇min, ψ̇max]` at `n_i` and passed to `Coordinator::tick` as the operator's gradient.
-//!    That is what perturbs the timing. Without a correction the operator passes NaN (the
-//!    robot keeps its scheduled gradient, the mean on low-confidence samples).
+//!    `[ψ̇min, ψ̇max]` at `n_i` and passed to `Coordinator::tick` as `Operator::Gradient`.
+//!    That is what perturbs the timing. Without a correction the operator's input is
+//!    `Operator::Scheduled` (the robot keeps its scheduled gradient, the mean on
+//!    low-confidence samples); a degenerate command (NaN rate) is an error, not "no
+//!    correction".
 //! 4. Every running robot logs the command at `t_i` (`u = 0` unless corrected) as its
 //!    execution sample, `t_i` in its reference-time log (Eq. 21), and its supervised and
 //!    corrected flags.
@@ -47,7 +52,7 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 use tandem_lfd::{Demonstration, Execution, TaskModel};
-use tandem_realtime::{Coordinator, Timeline};
+use tandem_realtime::{Operator, Timeline, tol};
 use tandem_schedule::{Problem, Schedule};
 
 use crate::task::{Label, N_PASSES, Phase, Workpiece};
@@ -369,8 +374,14 @@ pub fn run_pair_with(
         .position(|n| *n == params.force_channel)
         .ok_or_else(|| Error::NoForceChannel(params.force_channel.clone()))?;
     let dt_s = problem.dt_s();
-    let tick_s = dt_s;
-    let mut coord = Coordinator::new(schedule.timelines(problem)?, tick_s)?;
+    if !tol::same_tick(schedule.tick_s, dt_s) {
+        return Err(Error::TickMismatch {
+            schedule_tick_s: schedule.tick_s,
+            workcell_tick_s: dt_s,
+        });
+    }
+    let mut coord = schedule.coordinator(problem)?;
+    let tick_s = coord.tick_s();
 
     let m = model.channel_names().len();
     let k = model.n_components();
@@ -417,7 +428,7 @@ pub fn run_pair_with(
             return Err(Error::DidNotFinish { ticks: budget });
         }
         let clocks = coord.clock_s();
-        let mut operator_gradient = f64::NAN;
+        let mut operator = Operator::Scheduled;
         for i in 0..2 {
             let tl = &coord.robots()[i];
             if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() {
@@ -453,7 +464,8 @@ pub fn run_pair_with(
             };
             model.command_into(u, ref_time, &mut cmd)?;
             if supervised && corrected {
-                operator_gradient = cmd[m].clamp(problem.grad_min()[n], problem.grad_max()[n]);
+                operator =
+                    Operator::Gradient(cmd[m].clamp(problem.grad_min()[n], problem.grad_max()[n]));
             }
             let run = &mut runs[i];
             run.samples.extend_from_slice(&cmd[..m]);
@@ -461,7 +473,7 @@ pub fn run_pair_with(
             run.supervised.push(supervised);
             run.corrected.push(corrected);
         }
-        let tick = coord.tick(operator_gradient);
+        let tick = coord.tick(operator)?;
         ticks += 1;
         match tick.low_conf {
             [true, true] => overlap_ticks += 1,
@@ -574,7 +586,7 @@ mod tests {
     fn run(params: &OperatorParams, seed: u64) -> (PairRun, f64) {
         let model = model();
         let problem = problem(&model);
-        let schedule = problem.serial_schedule();
+        let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
         let planned_s = schedule.t_total_s(problem.dt_s());
         let wp = [all_painted(), all_painted()];
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -705,7 +717,7 @@ mod tests {
     fn run_pair_with_asks_the_caller_only_about_supervised_samples() {
         let model = model();
         let problem = problem(&model);
-        let schedule = problem.serial_schedule();
+        let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
         let p = OperatorParams::default();
         // The labels' closure gives exactly run_pair's run.
         let (labels, wp) = (painted_labels(), [all_painted(), all_painted()]);
@@ -760,12 +772,51 @@ mod tests {
     }
 
     #[test]
+    fn a_schedule_checked_at_another_tick_is_rejected() {
+        let model = model();
+        let problem = problem(&model);
+        let dt_s = problem.dt_s();
+        // Checked at half the workcell's period: its margins say nothing about 10 ms ticks.
+        let schedule = problem.serial_schedule(dt_s / 2.0).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(0);
+        let p = OperatorParams::default();
+        let wp = [all_painted(), all_painted()];
+        let err = run_pair(
+            &model,
+            &problem,
+            &schedule,
+            &painted_labels(),
+            &wp,
+            &p,
+            &mut rng,
+        )
+        .unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::TickMismatch {
+                    schedule_tick_s,
+                    workcell_tick_s,
+                } if schedule_tick_s == dt_s / 2.0 && workcell_tick_s == dt_s
+            ),
+            "{err}"
+        );
+        let msg = err.to_string();
+        assert!(msg.contains("0.005 s") && msg.contains("0.01 s"), "{msg}");
+        let err = run_pair_with(&model, &problem, &schedule, |_, _| true, &p, &mut rng);
+        assert!(matches!(err, Err(Error::TickMismatch { .. })));
+        // At the workcell's own tick (the sampler's default) it runs.
+        let ok = problem.serial_schedule(dt_s).unwrap();
+        assert!(run_pair_with(&model, &problem, &ok, |_, _| true, &p, &mut rng).is_ok());
+    }
+
+    #[test]
     fn same_seed_same_run_and_mismatches_are_errors() {
         let p = OperatorParams::default();
         assert_eq!(run(&p, 7).0, run(&p, 7).0);
         let model = model();
         let problem = problem(&model);
-        let schedule = problem.serial_schedule();
+        let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(0);
         let err = run_pair(
             &model,

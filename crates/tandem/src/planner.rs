@@ -257,11 +257,12 @@ impl Planner {
     /// observations, confidence, parameters and [`Planner::pairs_recorded`] are unchanged
     /// (`sampler` is used for this call only and not stored in [`Planner::params`]).
     ///
-    /// The current schedule is the sampler's incumbent, so `T_total` (Eq. 13, s) never
-    /// increases as long as the current schedule is valid at `sampler.tick_s`: always so
-    /// when `tick_s` is the one the current schedule was made with. Otherwise the sampler
-    /// repairs it or falls back to the fastest serial schedule, as in
-    /// [`Planner::record_pair`].
+    /// The current schedule is the sampler's incumbent, re-checked at `sampler.tick_s`, so
+    /// `T_total` (Eq. 13, s) never increases as long as the current schedule is valid at
+    /// that tick: always so when it is the tick the current schedule was made with
+    /// ([`Schedule::tick_s`]). Otherwise the sampler repairs it or falls back to the fastest
+    /// serial schedule, as in [`Planner::record_pair`]. The new schedule carries
+    /// `sampler.tick_s`: run it at that tick.
     ///
     /// On error the planner is as before.
     ///

@@ -1,4 +1,5 @@
-//! Shared generators and operator policies for the integration tests.
+//! Shared generators for the integration tests; the operator policies are
+//! `tandem_realtime::adversary`'s.
 #![allow(
     dead_code,
     unreachable_pub,
@@ -7,7 +8,8 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tandem_realtime::{Coordinator, Tick, Timeline};
+use tandem_realtime::adversary::{Adversary, SET_SIZE, adversary_set, run_adversary};
+use tandem_realtime::{Coordinator, Timeline};
 
 /// A random two-robot problem: shared confidence and bounds, one execution warp per robot.
 #[derive(Clone, Debug)]
@@ -100,144 +102,46 @@ pub fn rng(seed: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed)
 }
 
-/// An operator policy: picks the operator gradient for the next tick from the coordinator's
-/// state (which robot is low-confidence at its current sample).
-#[derive(Clone, Copy, Debug)]
-pub enum Policy {
-    /// Always the fastest gradient (clamped to ψ̇min).
-    Fastest,
-    /// Always the slowest gradient (clamped to ψ̇max).
-    Slowest,
-    /// Always the scheduled gradient.
-    Nominal,
-    /// Uniform random gradient in [0.1, 6] per tick (clamped).
-    Uniform,
-    /// Fastest or slowest, chosen at random per tick.
-    RandomExtreme,
-    /// Fastest for `period` ticks, then slowest for `period` ticks, from phase `phase`.
-    Periodic { period: u32, phase: u32 },
-    /// Fastest until tick `at`, slowest after (or the reverse if `rev`).
-    SwitchOnce { at: u32, rev: bool },
-    /// Rush whichever robot is LC if it is `rush`, drag the other (the worst case of one role).
-    RushRobot { rush: usize },
-    /// Per-robot extreme chosen at random per LC region entry.
-    RandomPerRobot,
-}
-
-pub const FAST: f64 = 0.0;
-pub const SLOW: f64 = f64::INFINITY;
-
-/// Index of the robot that is low-confidence at its current sample, if any.
-pub fn lc_robot(c: &Coordinator) -> Option<usize> {
-    let clocks = c.clock_s();
-    (0..2).find(|&i| !c.robots()[i].conf_at(clocks[i]))
-}
-
-/// Runs the coordinator to completion under `policy`; calls `on_tick` for each tick.
-/// Returns the number of ticks. Panics if it does not finish within a generous budget.
-pub fn run(
-    robots: [Timeline; 2],
-    tick_s: f64,
-    policy: Policy,
-    rng: &mut ChaCha8Rng,
-    mut on_tick: impl FnMut(u32, &Tick),
-) -> u32 {
-    let total =
-        robots[0].end_s().max(robots[1].end_s()) - robots[0].start_s().min(robots[1].start_s());
-    // Slowest rate is ≥ 1/12 here (ψ̇_E ≥ ψ̇max/12 for the generated bounds) — be generous.
-    let budget = (total / tick_s * 40.0).ceil() as u32 + 100;
-    let mut c = Coordinator::new(robots, tick_s).expect("valid tick");
-    let mut k = 0u32;
-    let mut per_robot = [FAST, SLOW];
-    let mut last_lc = None;
-    while !c.is_finished() {
-        assert!(k < budget, "coordinator did not finish");
-        let lc = lc_robot(&c);
-        let g = match policy {
-            Policy::Fastest => FAST,
-            Policy::Slowest => SLOW,
-            Policy::Nominal => f64::NAN,
-            Policy::Uniform => rng.random_range(0.1..6.0),
-            Policy::RandomExtreme => {
-                if rng.random_bool(0.5) {
-                    FAST
-                } else {
-                    SLOW
-                }
-            }
-            Policy::Periodic { period, phase } => {
-                if ((k + phase) / period) % 2 == 0 {
-                    FAST
-                } else {
-                    SLOW
-                }
-            }
-            Policy::SwitchOnce { at, rev } => {
-                if (k < at) != rev {
-                    FAST
-                } else {
-                    SLOW
-                }
-            }
-            Policy::RushRobot { rush } => match lc {
-                Some(i) if i == rush => FAST,
-                _ => SLOW,
-            },
-            Policy::RandomPerRobot => {
-                if lc != last_lc {
-                    if let Some(i) = lc {
-                        per_robot[i] = if rng.random_bool(0.5) { FAST } else { SLOW };
-                    }
-                }
-                lc.map_or(f64::NAN, |i| per_robot[i])
-            }
-        };
-        last_lc = lc;
-        let t = c.tick(g);
-        on_tick(k, &t);
-        k += 1;
+impl Problem {
+    /// `[min ψ̇min, max ψ̇max]` over the reference: the range random adversaries draw from.
+    pub fn grad_range(&self) -> [f64; 2] {
+        [
+            self.lo.iter().copied().fold(f64::INFINITY, f64::min),
+            self.hi.iter().copied().fold(0.0, f64::max),
+        ]
     }
-    k
 }
 
-/// A varied set of policies for one case (extremes, role-worst-cases and random ones).
-pub fn policies(rng: &mut ChaCha8Rng) -> Vec<Policy> {
-    vec![
-        Policy::Fastest,
-        Policy::Slowest,
-        Policy::Nominal,
-        Policy::RushRobot { rush: 0 },
-        Policy::RushRobot { rush: 1 },
-        Policy::Uniform,
-        Policy::RandomExtreme,
-        Policy::RandomPerRobot,
-        Policy::Periodic {
-            period: rng.random_range(1..=8),
-            phase: rng.random_range(0..16),
-        },
-        Policy::SwitchOnce {
-            at: rng.random_range(0..400),
-            rev: rng.random_bool(0.5),
-        },
-    ]
+/// The full adversary set of `tandem_realtime::adversary` for this problem at tick `tick_s`
+/// (random parameters from `rng`).
+pub fn adversaries(
+    problem: &Problem,
+    robots: &[Timeline; 2],
+    tick_s: f64,
+    rng: &mut ChaCha8Rng,
+) -> [Adversary; SET_SIZE] {
+    let ticks = (robots[1].end_s().max(robots[0].end_s()) / tick_s).ceil() as u64;
+    adversary_set(problem.grad_range(), ticks, rng)
 }
 
-/// Runs every policy; returns the first (policy, tick) at which both robots were LC.
+/// Runs every adversary to the end; returns the first (adversary, tick) at which both robots
+/// were low-confidence. Panics if an execution does not finish within a generous budget.
 pub fn find_overlap(
     robots: &[Timeline; 2],
     tick_s: f64,
-    policies: &[Policy],
+    adversaries: &[Adversary],
     rng: &mut ChaCha8Rng,
-) -> Option<(Policy, u32)> {
-    for &p in policies {
-        let mut hit = None;
-        run(robots.clone(), tick_s, p, rng, |k, t| {
-            if hit.is_none() && t.low_conf[0] && t.low_conf[1] {
-                hit = Some(k);
-            }
-        });
-        if let Some(k) = hit {
-            return Some((p, k));
+) -> Option<(Adversary, u64)> {
+    let total =
+        robots[0].end_s().max(robots[1].end_s()) - robots[0].start_s().min(robots[1].start_s());
+    // Slowest rate is ≥ 1/12 here (ψ̇_E ≥ ψ̇max/12 for the generated bounds) — be generous.
+    let budget = (total / tick_s * 40.0).ceil() as u64 + 100;
+    for &a in adversaries {
+        let c = Coordinator::new(robots.clone(), tick_s).expect("valid tick");
+        let run = run_adversary(c, a, rng, budget).expect("admissible adversaries");
+        assert!(run.finished, "coordinator did not finish under {a:?}");
+        if let Some(k) = run.first_overlap {
+            return Some((a, k));
         }
     }
     None

@@ -1,0 +1,73 @@
+//! The crate's error type.
+
+use crate::validate::Violation;
+
+/// Everything that can go wrong when building a problem, laying out a schedule or sampling.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The problem has no reference sample.
+    #[error("the problem has no reference sample")]
+    Empty,
+    /// A per-sample vector does not have `T_ref` entries.
+    #[error("`{name}` has {len} entries, expected {expected} (one per reference sample)")]
+    LengthMismatch {
+        /// Which vector.
+        name: &'static str,
+        /// Its length.
+        len: usize,
+        /// `T_ref`.
+        expected: usize,
+    },
+    /// A value is not finite (or a gradient not > 0).
+    #[error("`{name}` is not finite (and > 0 for gradients) at reference sample {ref_idx}")]
+    NonFinite {
+        /// Which vector or value.
+        name: &'static str,
+        /// First offending reference sample (0 for scalars).
+        ref_idx: usize,
+    },
+    /// The gradient bounds are not `0 < ψ̇min ≤ ψ̇̄ ≤ ψ̇max` at a reference sample.
+    #[error(
+        "reference sample {ref_idx}: need 0 < min ≤ mean ≤ max, got min {min}, mean {mean}, max {max}"
+    )]
+    BadBounds {
+        /// Reference sample.
+        ref_idx: usize,
+        /// `ψ̇min`.
+        min: f64,
+        /// `ψ̇̄`.
+        mean: f64,
+        /// `ψ̇max`.
+        max: f64,
+    },
+    /// A parameter is out of range.
+    #[error("parameter `{name}` {why}")]
+    BadParam {
+        /// Field name.
+        name: &'static str,
+        /// What is required.
+        why: &'static str,
+    },
+    /// No schedule satisfies Eq. 20, not even the serial one.
+    #[error("no feasible schedule: even the serial schedule fails: {serial}")]
+    NoFeasibleSchedule {
+        /// Why the serial schedule failed.
+        serial: Violation,
+    },
+    /// One robot's plan cannot be laid out in schedule-clock time (Eq. 15–16): a warp of the
+    /// wrong length, a non-finite value or a gradient outside its bounds.
+    #[error("robot {}: {source}", .robot + 1)]
+    Timeline {
+        /// Robot index (0 = first robot, 1 = second).
+        robot: usize,
+        /// What the realtime crate rejected.
+        source: tandem_realtime::Error,
+    },
+    /// The realtime crate (coordinator, margin check) rejected its input.
+    #[error(transparent)]
+    Realtime(#[from] tandem_realtime::Error),
+}
+
+/// Result alias of this crate.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
