@@ -1,4 +1,6 @@
-//! Benchmarks of the margin checks (single pass, per pair, printed) and of the coordinator.
+//! Benchmarks of the margin checks (single pass, per pair, printed) and of the coordinator:
+//! a whole run, and one `Coordinator::tick` (run with
+//! `cargo bench -p tandem-realtime --bench margins -- coordinator_tick`).
 
 use criterion::{BenchmarkId, Criterion, black_box, criterion_main};
 use tandem_realtime::{
@@ -59,6 +61,26 @@ fn bench(c: &mut Criterion) {
                 k += 1;
             }
             k
+        })
+    });
+    // One tick: the same run, one tick per iteration (rewound with `reset` at the end, which
+    // allocates nothing), operator inputs cycling through rush, drag and a gradient.
+    let mut co = Coordinator::new(r, tick_s).expect("valid tick");
+    let ops = [
+        Operator::Fastest,
+        Operator::Fastest,
+        Operator::Slowest,
+        Operator::Gradient(1.1),
+        Operator::Scheduled,
+    ];
+    let mut k = 0usize;
+    c.bench_function("coordinator_tick/6000", |b| {
+        b.iter(|| {
+            if co.is_finished() {
+                co.reset();
+            }
+            k = k.wrapping_add(1);
+            black_box(co.tick(black_box(ops[k % ops.len()])))
         })
     });
 }
