@@ -12,6 +12,12 @@
 //! Time frames: reference sample index `n` (period `Δt_s`), schedule-clock/global time in
 //! seconds, control tick `tick_s` in real seconds.
 //!
+//! One owner per concept: [`clock_s`] is the only summation of the schedule clock (every
+//! timeline, duration and `T_total` reads it); [`LcInterval`] is the one low-confidence
+//! interval type; [`tol`] holds every tolerance and says which way each errs; the operator's
+//! input to a tick is an explicit [`Operator`]; [`adversary`] is the one set of operator
+//! policies the safety checks run.
+//!
 //! ```
 //! use tandem_realtime::{Coordinator, Operator, Timeline, sufficient_margins};
 //!

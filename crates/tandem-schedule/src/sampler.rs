@@ -292,7 +292,8 @@ pub struct Outcome {
     /// The schedule; its [`Schedule::tick_s`] is the sampler's tick, at which it passes
     /// [`crate::validate`].
     pub schedule: Schedule,
-    /// Its `T_total` (Eq. 13), s.
+    /// Its `T_total` (Eq. 13), s: exactly `schedule.t_total_s(Δt_s)`, read from the one
+    /// clock.
     pub t_total_s: f64,
     /// Where it came from.
     pub source: Source,
