@@ -1,0 +1,262 @@
+//! Fitting: checks of the demonstration set, alignment to the reference (GDTW), and the
+//! batch statistics from the warps.
+
+use std::borrow::Cow;
+
+use rayon::prelude::*;
+
+use super::layout::{Item, Layout, quat_at};
+use super::stats::{batch_statistics, observe};
+use super::{FitParams, ModelData, TaskModel, check_dt};
+use crate::demo::Demonstration;
+use crate::{Error, Result};
+
+/// Checks the demonstration set; returns it with every channel order equal to demo 0's
+/// (borrowed when it already is).
+fn check_demos(demos: &[Demonstration]) -> Result<Cow<'_, [Demonstration]>> {
+    if demos.len() < 2 {
+        return Err(Error::TooFewDemonstrations { found: demos.len() });
+    }
+    let names = demos[0].channel_names();
+    let dt = demos[0].dt_s();
+    let mut reordered = false;
+    for demo in demos {
+        check_dt(demo, dt)?;
+        reordered |= matches!(demo.conform_to(names)?, Cow::Owned(_));
+    }
+    if !reordered {
+        return Ok(Cow::Borrowed(demos));
+    }
+    demos
+        .iter()
+        .map(|demo| Ok(demo.conform_to(names)?.into_owned()))
+        .collect::<Result<Vec<_>>>()
+        .map(Cow::Owned)
+}
+
+/// Checks warp `demo_idx` (`n_ref` values, monotone, inside `[0, T_i − 1]`).
+fn check_warp(demo_idx: usize, warp: &[f64], n_ref: usize, t_i: usize) -> Result<()> {
+    let bad = |why: String| Error::BadWarp { demo_idx, why };
+    if warp.len() != n_ref {
+        return Err(bad(format!(
+            "{} values for {n_ref} reference samples",
+            warp.len()
+        )));
+    }
+    let last = (t_i - 1) as f64;
+    let tol = 1e-9 * last.max(1.0);
+    for (n, &v) in warp.iter().enumerate() {
+        if !v.is_finite() || v < -tol || v > last + tol {
+            return Err(bad(format!(
+                "value {v} at reference sample {n} is outside [0, {last}]"
+            )));
+        }
+        if n > 0 && v < warp[n - 1] {
+            return Err(bad(format!("decreases at reference sample {n}")));
+        }
+    }
+    Ok(())
+}
+
+impl TaskModel {
+    /// Fits the model: aligns every demonstration to demo 0 with GDTW
+    /// (`tandem_warp::align_many`, in parallel), then computes the statistics as
+    /// [`TaskModel::fit_aligned`] does. Demo 0 is the reference: `n_ref() = T_0`.
+    ///
+    /// # Errors
+    /// Fewer than 2 demonstrations, different channel sets or sample periods, a partial
+    /// or zero quaternion, bad parameters, alignment failure.
+    pub fn fit(demos: &[Demonstration], params: &FitParams) -> Result<Self> {
+        params.validate()?;
+        let demos = check_demos(demos)?;
+        let layout = Layout::new(demos[0].channel_names(), &params.schema)?;
+        for demo in demos.iter() {
+            layout.check_quaternion_norms(demo)?;
+        }
+        let d = layout.dim();
+        params.check_ranges_len(d)?;
+        let non_rate_ranges = match &params.ranges {
+            Some(r) => r[..d - 1].to_vec(),
+            None => layout.channel_ranges(&demos, params.min_range),
+        };
+        let m = demos[0].n_channels();
+        let mut warp_params = params.warp.clone();
+        if warp_params.weights.is_none() {
+            warp_params.weights = Some(layout.warp_weights(&non_rate_ranges, m));
+        }
+        let reference_orientations = layout.first_orientations(&demos[0]);
+        let signals: Vec<Vec<f64>> = demos
+            .par_iter()
+            .map(|demo| layout.sign_aligned(demo, &reference_orientations))
+            .collect();
+        let refs = signals
+            .iter()
+            .map(|s| tandem_warp::SignalRef::new(s, m))
+            .collect::<std::result::Result<Vec<_>, _>>()?;
+        let aligned = tandem_warp::align_many(refs[0], &refs[1..], &warp_params)?;
+        let mut warps: Vec<Vec<f64>> = Vec::with_capacity(demos.len());
+        warps.push((0..demos[0].n_samples()).map(|n| n as f64).collect());
+        warps.extend(aligned.iter().map(|w| w.values().to_vec()));
+        Self::fit_from_warps(&demos, &warps, params, layout, Some(non_rate_ranges))
+    }
+
+    /// Fits the model from known warps: `warps[i][n]` is demo `i`'s time (demo samples,
+    /// fractional) at reference sample `n` (demo 0 is the reference, so `warps[0]` is
+    /// normally the identity `0, 1, …, T_0 − 1`).
+    ///
+    /// Per reference sample it computes the mean `μ̂(n)`, the mean warp gradient and the
+    /// augmented mean `μ̂⁺` (Eq. 5), the weighted variance `σ²_D(n)` (Eq. 6) and the gradient
+    /// bounds (Eq. 14); the correction directions are computed on first use.
+    ///
+    /// # Errors
+    /// As [`TaskModel::fit`], plus a warp of the wrong length, non-finite, decreasing, or
+    /// outside `[0, T_i − 1]`.
+    pub fn fit_aligned(
+        demos: &[Demonstration],
+        warps: &[Vec<f64>],
+        params: &FitParams,
+    ) -> Result<Self> {
+        params.validate()?;
+        let demos = check_demos(demos)?;
+        let layout = Layout::new(demos[0].channel_names(), &params.schema)?;
+        for demo in demos.iter() {
+            layout.check_quaternion_norms(demo)?;
+        }
+        Self::fit_from_warps(&demos, warps, params, layout, None)
+    }
+
+    /// The statistics of checked demonstrations from their warps. `non_rate_ranges`: the
+    /// default ranges of the non-rate coordinates when the caller already computed them.
+    fn fit_from_warps(
+        demos: &[Demonstration],
+        warps: &[Vec<f64>],
+        params: &FitParams,
+        layout: Layout,
+        non_rate_ranges: Option<Vec<f64>>,
+    ) -> Result<Self> {
+        let n_ref = demos[0].n_samples();
+        if warps.len() != demos.len() {
+            return Err(Error::BadData {
+                what: "warps".into(),
+                why: format!("{} warps for {} demonstrations", warps.len(), demos.len()),
+            });
+        }
+        for (demo_idx, (warp, demo)) in warps.iter().zip(demos).enumerate() {
+            check_warp(demo_idx, warp, n_ref, demo.n_samples())?;
+        }
+        let d = layout.dim();
+        // Anchors: demo 0's orientation at its aligned time, `n_ref × n_quat`.
+        let mut anchors = Vec::with_capacity(n_ref * layout.n_quat);
+        for &demo_t in &warps[0] {
+            for item in &layout.items {
+                if let Item::Quat(cols, _) = item {
+                    anchors.push(quat_at(&demos[0], cols, demo_t));
+                }
+            }
+        }
+        let obs: Vec<Vec<f64>> = demos
+            .par_iter()
+            .zip(warps.par_iter())
+            .map(|(demo, warp)| observe(&layout, &anchors, demo, warp))
+            .collect();
+        params.check_ranges_len(d)?;
+        let ranges = match &params.ranges {
+            Some(r) => r.clone(),
+            None => {
+                let mut r = non_rate_ranges
+                    .unwrap_or_else(|| layout.channel_ranges(demos, params.min_range));
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                for o in &obs {
+                    for g in o.iter().skip(d - 1).step_by(d) {
+                        lo = lo.min(*g);
+                        hi = hi.max(*g);
+                    }
+                }
+                let rate_range = hi - lo;
+                r.push(if rate_range < params.min_range {
+                    1.0
+                } else {
+                    rate_range
+                });
+                r
+            }
+        };
+        let stats = batch_statistics(&obs, n_ref, d);
+        let data = ModelData {
+            channel_names: demos[0].channel_names().to_vec(),
+            layout,
+            dt_s: demos[0].dt_s(),
+            n_ref,
+            k_max: params.k_max,
+            ranges,
+            anchors,
+            count: obs.len(),
+            tangent_mean: stats.tangent_mean,
+            scatter: stats.scatter,
+            grad_min: stats.grad_min,
+            grad_max: stats.grad_max,
+        };
+        Ok(Self::from_data(data))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{close, demo, three_demos};
+    use super::*;
+
+    #[test]
+    fn hand_derived_statistics() {
+        let (demos, warps) = three_demos();
+        let model = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+        assert_eq!(model.n_ref(), 3);
+        assert_eq!(model.tangent_names(), ["force", "rate"]);
+        // Force range 20 N; gradients {1, 1.5, 2.5} → rate range 1.5.
+        assert_eq!(model.ranges(), [20.0, 1.5]);
+        // n = 1: forces 10, 7.5, 10 (demo 1 at its time 1.5); gradients 1, 2.5, 1.
+        assert!(close(model.mean()[1], 55.0 / 6.0));
+        assert!(close(model.grad_mean()[1], 1.5));
+        assert_eq!((model.grad_min()[1], model.grad_max()[1]), (1.0, 2.5));
+        // σ²_D = [ (25+100+25)/36 / 20² + 1.5 / 1.5² ] / 2 = (1/96 + 2/3) / 2 = 65/192.
+        assert!(close(model.sigma2_d()[1], 65.0 / 192.0));
+        // n = 0: forces all 0, gradients 1, 1.5, 1 → rate residuals −1/6, 1/3, −1/6.
+        assert!(close(model.grad_mean()[0], 7.0 / 6.0));
+        assert!(close(model.sigma2_d()[0], (1.0 / 6.0) / 2.25 / 2.0));
+        // n = 2: last gradient repeats the previous: 1, 2.5, 1.
+        assert_eq!(model.grad_max()[2], 2.5);
+        assert_eq!(model.n_components(), 2);
+    }
+
+    #[test]
+    fn bad_fits_are_errors() {
+        let (demos, warps) = three_demos();
+        let p = FitParams::default();
+        assert!(matches!(
+            TaskModel::fit_aligned(&demos[..1], &warps[..1], &p),
+            Err(Error::TooFewDemonstrations { found: 1 })
+        ));
+        let mut w = warps.clone();
+        w[1] = vec![0.0, 3.0, 2.0];
+        assert!(matches!(
+            TaskModel::fit_aligned(&demos, &w, &p),
+            Err(Error::BadWarp { demo_idx: 1, .. })
+        ));
+        w[1] = vec![0.0, 1.0, 4.5];
+        assert!(matches!(
+            TaskModel::fit_aligned(&demos, &w, &p),
+            Err(Error::BadWarp { demo_idx: 1, .. })
+        ));
+        let bad = FitParams {
+            k_max: 0,
+            ..FitParams::default()
+        };
+        assert!(matches!(
+            TaskModel::fit_aligned(&demos, &warps, &bad),
+            Err(Error::BadParam { name: "k_max", .. })
+        ));
+        // A partial quaternion block is rejected.
+        let q = demo(&["qx", "qy", "qz"], vec![0.0; 6]);
+        let id = vec![0.0, 1.0];
+        assert!(TaskModel::fit_aligned(&[q.clone(), q], &[id.clone(), id], &p).is_err());
+    }
+}
