@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
+use tandem::sim::workcell::OperatorParams;
 
 /// Coordinated two-robot shared autonomy from your own demonstrations (Hagenow et al., RA-L 2023).
 ///
@@ -215,7 +216,8 @@ pub(crate) struct PlotArgs {
     pub(crate) output: PathBuf,
 }
 
-/// `tandem simulate`.
+/// `tandem simulate`. The operator's defaults are the study's
+/// (`tandem::sim::workcell::OperatorParams::default()`).
 #[derive(Debug, Args)]
 pub(crate) struct SimulateArgs {
     /// The state file (read only).
@@ -233,17 +235,17 @@ pub(crate) struct SimulateArgs {
     #[arg(long, value_name = "S", default_value_t = 0)]
     pub(crate) seed: u64,
     /// Probability that the operator misses a needed correction, in [0, 1].
-    #[arg(long, value_name = "P", default_value_t = 0.01)]
+    #[arg(long, value_name = "P", default_value_t = OperatorParams::default().miss_rate)]
     pub(crate) miss_rate: f64,
     /// Share of the supervised samples needing no correction that the operator corrects
     /// anyway, in [0, 1).
-    #[arg(long, value_name = "P", default_value_t = 0.01)]
+    #[arg(long, value_name = "P", default_value_t = OperatorParams::default().false_correction_rate)]
     pub(crate) false_rate: f64,
     /// Mean duration (s) of one unneeded correction episode (0: every control tick drawn
     /// on its own).
-    #[arg(long, value_name = "S", default_value_t = 0.5)]
+    #[arg(long, value_name = "S", default_value_t = OperatorParams::default().false_correction_s)]
     pub(crate) false_episode: f64,
     /// Channel whose increase a correction aims at.
-    #[arg(long, value_name = "NAME", default_value = "force")]
+    #[arg(long, value_name = "NAME", default_value_t = OperatorParams::default().force_channel)]
     pub(crate) channel: String,
 }
