@@ -79,7 +79,7 @@ fn fit(a: &FitArgs) -> Result<()> {
         );
     }
     if !a.ranges.is_empty() {
-        let names = input::tangent_names(demos[0].channel_names(), &params.fit.schema);
+        let names = demos[0].tangent_names(&params.fit.schema)?;
         let given = input::parse_ranges(&a.ranges, &names)?;
         let mut ranges = if given.len() == names.len() {
             vec![0.0; names.len()]

@@ -1,7 +1,12 @@
 //! Learning from demonstration for tandem (paper §II-B1/B2).
 //!
 //! - [`Demonstration`]: one demonstration `X_i ∈ R^{m × T_i}` (Eq. 1), read from CSV or
-//!   JSON with errors naming file, line and column.
+//!   JSON with errors naming file, line and column; every value finite and within
+//!   `±`[`MAX_ABS_VALUE`], whoever builds it. [`CsvTable`] is the one CSV tokenizer (the
+//!   command line reads its other CSV files with it too).
+//! - [`Demonstration::tangent_names`]: the coordinates a model fitted on the demonstrations
+//!   will have; an incomplete quaternion block or a channel named like a derived
+//!   coordinate (`rate`, `<block>.rx|ry|rz`) is a located error here and in the fit.
 //! - [`TaskModel`]: every demonstration aligned to demo 0 (GDTW, `tandem-warp`), then per
 //!   reference sample the mean behaviour `μ̂`, the augmented mean `μ̂⁺` (Eq. 4–5), the
 //!   weighted variance `σ²_D` (Eq. 6), the warp-gradient bounds `ψ̇min/ψ̇max` (Eq. 14), and
@@ -54,13 +59,16 @@
 //! # Ok::<(), tandem_lfd::Error>(())
 //! ```
 
+mod csv;
 mod demo;
 mod error;
 mod model;
 mod quat;
 
+pub use csv::{CsvRow, CsvTable};
 pub use demo::{
-    ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, QuaternionBlock,
+    ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, MAX_ABS_VALUE,
+    QuaternionBlock,
 };
 pub use error::{Error, Result};
 pub use model::{Corrections, Execution, FitParams, TaskModel};

@@ -69,7 +69,7 @@ impl TaskModel {
     pub fn fit(demos: &[Demonstration], params: &FitParams) -> Result<Self> {
         params.validate()?;
         let demos = check_demos(demos)?;
-        let layout = Layout::new(demos[0].channel_names(), &params.schema)?;
+        let layout = Layout::new(&demos[0], &params.schema)?;
         for demo in demos.iter() {
             layout.check_quaternion_norms(demo)?;
         }
@@ -118,7 +118,7 @@ impl TaskModel {
     ) -> Result<Self> {
         params.validate()?;
         let demos = check_demos(demos)?;
-        let layout = Layout::new(demos[0].channel_names(), &params.schema)?;
+        let layout = Layout::new(&demos[0], &params.schema)?;
         for demo in demos.iter() {
             layout.check_quaternion_norms(demo)?;
         }

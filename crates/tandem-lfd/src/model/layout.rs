@@ -27,31 +27,62 @@ pub(super) struct Layout {
     pub(super) n_quat: usize,
 }
 
+/// Name of the derived rate coordinate (the warp gradient `ψ̇`), last in every layout.
+const RATE: &str = "rate";
+
 impl Layout {
-    pub(super) fn new(channels: &[String], schema: &ChannelSchema) -> Result<Self> {
-        let find = |n: &str| channels.iter().position(|c| c == n);
+    /// The layout of `demo`'s channels under `schema`: scalars in column order, each
+    /// complete quaternion block at the position of its first channel, the rate last.
+    ///
+    /// Errors name `demo`'s source: a block with some but not all of its channels, or a
+    /// channel named like a derived coordinate.
+    pub(super) fn new(demo: &Demonstration, schema: &ChannelSchema) -> Result<Self> {
+        let channels = demo.channel_names();
         let mut in_block = vec![None; channels.len()];
         let mut blocks = Vec::new();
         for block in &schema.quaternions {
-            let cols: Vec<Option<usize>> = block.channels.iter().map(|c| find(c)).collect();
-            let present = cols.iter().filter(|c| c.is_some()).count();
-            if present == 0 {
+            let cols = block.channels.clone().map(|c| demo.channel_index(&c));
+            let (present, missing): (Vec<_>, Vec<_>) =
+                (0..4).partition(|&axis| cols[axis].is_some());
+            if present.is_empty() {
                 continue;
             }
-            if present < 4 {
-                return Err(Error::BadData {
-                    what: format!("quaternion block `{}`", block.name),
-                    why: format!(
-                        "only {present} of its channels {:?} are present",
-                        block.channels
-                    ),
+            if !missing.is_empty() {
+                let names =
+                    |axes: Vec<usize>| axes.iter().map(|&a| block.channels[a].clone()).collect();
+                return Err(Error::PartialQuaternionBlock {
+                    file: demo.source().into(),
+                    block: block.name.clone(),
+                    present: names(present),
+                    missing: names(missing),
                 });
             }
-            let cols = [0, 1, 2, 3].map(|k| cols[k].expect("all four present"));
+            let cols = cols.map(|c| c.expect("every channel of the block is present"));
             for &c in &cols {
                 in_block[c] = Some(blocks.len());
             }
             blocks.push((block.name.clone(), cols));
+        }
+        let derived = |name: &str| -> Option<String> {
+            if name == RATE {
+                return Some("the warp gradient (speed)".into());
+            }
+            blocks.iter().find_map(|(block, _)| {
+                let axis = name.strip_prefix(block.as_str())?.strip_prefix('.')?;
+                ["rx", "ry", "rz"]
+                    .contains(&axis)
+                    .then(|| format!("a rotation-vector coordinate of quaternion block `{block}`"))
+            })
+        };
+        if let Some((channel, why)) = channels
+            .iter()
+            .find_map(|name| derived(name).map(|why| (name, why)))
+        {
+            return Err(Error::ReservedChannelName {
+                file: demo.source().into(),
+                channel: channel.clone(),
+                derived: why,
+            });
         }
         let mut items = Vec::new();
         let mut names = Vec::new();
@@ -72,7 +103,7 @@ impl Layout {
                 Some(_) => {}
             }
         }
-        names.push("rate".into());
+        names.push(RATE.into());
         Ok(Self {
             items,
             names,
@@ -220,6 +251,23 @@ impl Layout {
             }
         }
         data
+    }
+}
+
+impl Demonstration {
+    /// Names of the `d` tangent coordinates of a model fitted on demonstrations with this
+    /// one first (the model's channel order is the first demonstration's), under `schema`:
+    /// scalar channels by name in column order, each quaternion block as
+    /// `<block>.rx/.ry/.rz` at the position of its first channel, then `rate` (the warp
+    /// gradient). [`crate::TaskModel::tangent_names`] of the fitted model returns the same
+    /// list; [`crate::FitParams::ranges`] is indexed by it.
+    ///
+    /// # Errors
+    /// [`Error::PartialQuaternionBlock`] for a block of `schema` with some but not all of
+    /// its four channels; [`Error::ReservedChannelName`] for a channel named `rate`, or
+    /// `<block>.rx|ry|rz` of a block that is present. Both name this demonstration's source.
+    pub fn tangent_names(&self, schema: &ChannelSchema) -> Result<Vec<String>> {
+        Ok(Layout::new(self, schema)?.names)
     }
 }
 
