@@ -59,7 +59,8 @@ struct StudyFile<'a> {
     result: &'a StudyResult,
 }
 
-fn workspace_root() -> PathBuf {
+/// The workspace root (the folder above `xtask/`).
+pub(crate) fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .expect("xtask lives one folder below the workspace root")

@@ -40,7 +40,8 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 ///
 /// - 1: first format.
 /// - 2: the sampler parameters gained `OffsetSampling::Fitted` and `max_margin_checks`.
-pub const FORMAT_VERSION: u32 = 2;
+/// - 3: the fit parameters gained `reference` and the model `reference_idx`.
+pub const FORMAT_VERSION: u32 = 3;
 
 /// Header length in bytes: magic (8) + version (4) + payload length (8) + CRC-32 (4).
 pub const HEADER_LEN: usize = 24;
@@ -266,7 +267,7 @@ mod tests {
     fn header_layout_is_as_documented() {
         let bytes = encode(&payload(4)).unwrap();
         assert_eq!(&bytes[..8], b"TANDEMST");
-        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 2);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 3);
         let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
         assert_eq!(len as usize, bytes.len() - HEADER_LEN);
         let crc = u32::from_le_bytes(bytes[20..24].try_into().unwrap());
@@ -356,7 +357,7 @@ mod tests {
             }
         ));
         let msg = err.to_string();
-        assert!(msg.contains("v.tandem") && msg.contains('7') && msg.contains('2'));
+        assert!(msg.contains("v.tandem") && msg.contains('7') && msg.contains('3'));
     }
 
     #[test]

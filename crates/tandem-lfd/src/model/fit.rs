@@ -1,13 +1,14 @@
-//! Fitting: checks of the demonstration set, alignment to the reference (GDTW), and the
-//! batch statistics from the warps.
+//! Fitting: checks of the demonstration set, the choice of the reference and the alignment
+//! to it (GDTW), and the batch statistics from the warps.
 
 use std::borrow::Cow;
+use std::cmp::Ordering;
 
 use rayon::prelude::*;
 
 use super::layout::{Item, Layout, quat_at};
 use super::stats::{batch_statistics, observe};
-use super::{FitParams, ModelData, TaskModel, check_dt};
+use super::{FitParams, ModelData, Reference, TaskModel, check_dt};
 use crate::demo::Demonstration;
 use crate::{Error, Result};
 
@@ -58,14 +59,118 @@ fn check_warp(demo_idx: usize, warp: &[f64], n_ref: usize, t_i: usize) -> Result
     Ok(())
 }
 
+/// Every demonstration aligned to one reference (the alignment stage of a fit).
+struct Alignment {
+    /// Demonstration indices (into the caller's list) in model order, the reference first.
+    order: Vec<usize>,
+    /// The ranges of the non-rate coordinates the weights came from.
+    non_rate_ranges: Vec<f64>,
+    /// One warp per demonstration in model order (the reference's is the identity).
+    warps: Vec<Vec<f64>>,
+    /// Total GDTW objective of the non-reference alignments (Eq. 3), summed in ascending
+    /// order so that it does not depend on the order of the others.
+    cost: f64,
+}
+
+/// Aligns every demonstration of `demos` to `demos[order[0]]` with the weights the fit
+/// would derive with that reference; `order` lists the others in the order they enter the
+/// statistics.
+fn align_to(
+    demos: &[Demonstration],
+    order: Vec<usize>,
+    layout: &Layout,
+    params: &FitParams,
+) -> Result<Alignment> {
+    let reference = &demos[order[0]];
+    let d = layout.dim();
+    let non_rate_ranges = match &params.ranges {
+        Some(r) => r[..d - 1].to_vec(),
+        None => layout.channel_ranges(reference, demos, params.min_range),
+    };
+    let m = reference.n_channels();
+    let mut warp_params = params.warp.clone();
+    if warp_params.weights.is_none() {
+        warp_params.weights = Some(layout.warp_weights(&non_rate_ranges, m));
+    }
+    let reference_orientations = layout.first_orientations(reference);
+    let signals: Vec<Vec<f64>> = order
+        .par_iter()
+        .map(|&i| layout.sign_aligned(&demos[i], &reference_orientations))
+        .collect();
+    let refs = signals
+        .iter()
+        .map(|s| tandem_warp::SignalRef::new(s, m))
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let aligned = tandem_warp::align_many(refs[0], &refs[1..], &warp_params)?;
+    let mut objectives: Vec<f64> = aligned.iter().map(tandem_warp::Warp::objective).collect();
+    objectives.sort_by(f64::total_cmp);
+    let mut warps: Vec<Vec<f64>> = Vec::with_capacity(order.len());
+    warps.push((0..reference.n_samples()).map(|n| n as f64).collect());
+    warps.extend(aligned.iter().map(|w| w.values().to_vec()));
+    Ok(Alignment {
+        order,
+        non_rate_ranges,
+        warps,
+        cost: objectives.iter().sum(),
+    })
+}
+
+/// A fixed order of demonstrations by content (length, then samples, then period), for
+/// statistics that must not depend on the order the caller gave them in.
+fn content_order(a: &Demonstration, b: &Demonstration) -> Ordering {
+    a.n_samples()
+        .cmp(&b.n_samples())
+        .then_with(|| {
+            a.samples()
+                .iter()
+                .zip(b.samples())
+                .map(|(x, y)| x.total_cmp(y))
+                .find(|o| o.is_ne())
+                .unwrap_or(Ordering::Equal)
+        })
+        .then_with(|| a.dt_s().total_cmp(&b.dt_s()))
+}
+
+/// The alignment the fit uses: to demo 0 ([`Reference::First`]), or to each demonstration
+/// in turn keeping the cheapest ([`Reference::Medoid`]).
+fn choose_alignment(
+    demos: &[Demonstration],
+    layout: &Layout,
+    params: &FitParams,
+) -> Result<Alignment> {
+    match params.reference {
+        Reference::First => align_to(demos, (0..demos.len()).collect(), layout, params),
+        Reference::Medoid => {
+            let candidates = (0..demos.len())
+                .into_par_iter()
+                .map(|r| {
+                    let mut others: Vec<usize> = (0..demos.len()).filter(|&i| i != r).collect();
+                    others.sort_by(|&a, &b| content_order(&demos[a], &demos[b]));
+                    let order = std::iter::once(r).chain(others).collect();
+                    align_to(demos, order, layout, params)
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let best = candidates
+                .into_iter()
+                .reduce(|best, c| if c.cost < best.cost { c } else { best })
+                .expect("at least two demonstrations");
+            Ok(best)
+        }
+    }
+}
+
 impl TaskModel {
-    /// Fits the model: aligns every demonstration to demo 0 with GDTW
+    /// Fits the model: chooses the reference ([`FitParams::reference`]: demo 0 by default,
+    /// or the medoid), aligns every demonstration to it with GDTW
     /// (`tandem_warp::align_many`, in parallel), then computes the statistics as
-    /// [`TaskModel::fit_aligned`] does. Demo 0 is the reference: `n_ref() = T_0`.
+    /// [`TaskModel::fit_aligned`] does. `n_ref() = T_ref`, the reference's sample count;
+    /// [`TaskModel::reference_idx`] says which demonstration it was. The model's channel
+    /// order is demo 0's.
     ///
     /// # Errors
     /// Fewer than 2 demonstrations, different channel sets or sample periods, a partial
-    /// or zero quaternion, bad parameters, alignment failure.
+    /// quaternion block, a channel named like a derived coordinate, a zero quaternion, bad
+    /// parameters, alignment failure.
     pub fn fit(demos: &[Demonstration], params: &FitParams) -> Result<Self> {
         params.validate()?;
         let demos = check_demos(demos)?;
@@ -73,36 +178,24 @@ impl TaskModel {
         for demo in demos.iter() {
             layout.check_quaternion_norms(demo)?;
         }
-        let d = layout.dim();
-        params.check_ranges_len(d)?;
-        let non_rate_ranges = match &params.ranges {
-            Some(r) => r[..d - 1].to_vec(),
-            None => layout.channel_ranges(&demos, params.min_range),
-        };
-        let m = demos[0].n_channels();
-        let mut warp_params = params.warp.clone();
-        if warp_params.weights.is_none() {
-            warp_params.weights = Some(layout.warp_weights(&non_rate_ranges, m));
-        }
-        let reference_orientations = layout.first_orientations(&demos[0]);
-        let signals: Vec<Vec<f64>> = demos
-            .par_iter()
-            .map(|demo| layout.sign_aligned(demo, &reference_orientations))
-            .collect();
-        let refs = signals
-            .iter()
-            .map(|s| tandem_warp::SignalRef::new(s, m))
-            .collect::<std::result::Result<Vec<_>, _>>()?;
-        let aligned = tandem_warp::align_many(refs[0], &refs[1..], &warp_params)?;
-        let mut warps: Vec<Vec<f64>> = Vec::with_capacity(demos.len());
-        warps.push((0..demos[0].n_samples()).map(|n| n as f64).collect());
-        warps.extend(aligned.iter().map(|w| w.values().to_vec()));
-        Self::fit_from_warps(&demos, &warps, params, layout, Some(non_rate_ranges))
+        params.check_ranges_len(layout.dim())?;
+        let alignment = choose_alignment(&demos, &layout, params)?;
+        let ordered: Vec<&Demonstration> = alignment.order.iter().map(|&i| &demos[i]).collect();
+        let mut model = Self::fit_from_warps(
+            &ordered,
+            &alignment.warps,
+            params,
+            layout,
+            alignment.non_rate_ranges,
+        )?;
+        model.data.reference_idx = alignment.order[0];
+        Ok(model)
     }
 
     /// Fits the model from known warps: `warps[i][n]` is demo `i`'s time (demo samples,
-    /// fractional) at reference sample `n` (demo 0 is the reference, so `warps[0]` is
-    /// normally the identity `0, 1, …, T_0 − 1`).
+    /// fractional) at reference sample `n`. Demo 0 is the reference (`warps[0]` is normally
+    /// the identity `0, 1, …, T_0 − 1`), so [`FitParams::reference`] must be
+    /// [`Reference::First`].
     ///
     /// Per reference sample it computes the mean `μ̂(n)`, the mean warp gradient and the
     /// augmented mean `μ̂⁺` (Eq. 5), the weighted variance `σ²_D(n)` (Eq. 6) and the gradient
@@ -110,29 +203,44 @@ impl TaskModel {
     ///
     /// # Errors
     /// As [`TaskModel::fit`], plus a warp of the wrong length, non-finite, decreasing, or
-    /// outside `[0, T_i − 1]`.
+    /// outside `[0, T_i − 1]`, and [`Error::BadParam`] for another reference choice.
     pub fn fit_aligned(
         demos: &[Demonstration],
         warps: &[Vec<f64>],
         params: &FitParams,
     ) -> Result<Self> {
         params.validate()?;
+        if params.reference != Reference::First {
+            return Err(Error::BadParam {
+                name: "reference",
+                why: format!(
+                    "is `{}`, but fit_aligned takes warps onto demo 0 (use `first`)",
+                    params.reference
+                ),
+            });
+        }
         let demos = check_demos(demos)?;
         let layout = Layout::new(&demos[0], &params.schema)?;
         for demo in demos.iter() {
             layout.check_quaternion_norms(demo)?;
         }
-        Self::fit_from_warps(&demos, warps, params, layout, None)
+        params.check_ranges_len(layout.dim())?;
+        let non_rate_ranges = match &params.ranges {
+            Some(r) => r[..r.len() - 1].to_vec(),
+            None => layout.channel_ranges(&demos[0], &demos, params.min_range),
+        };
+        let ordered: Vec<&Demonstration> = demos.iter().collect();
+        Self::fit_from_warps(&ordered, warps, params, layout, non_rate_ranges)
     }
 
-    /// The statistics of checked demonstrations from their warps. `non_rate_ranges`: the
-    /// default ranges of the non-rate coordinates when the caller already computed them.
+    /// The statistics of checked demonstrations, reference first, from their warps.
+    /// `non_rate_ranges`: the ranges of the non-rate coordinates (explicit or default).
     fn fit_from_warps(
-        demos: &[Demonstration],
+        demos: &[&Demonstration],
         warps: &[Vec<f64>],
         params: &FitParams,
         layout: Layout,
-        non_rate_ranges: Option<Vec<f64>>,
+        non_rate_ranges: Vec<f64>,
     ) -> Result<Self> {
         let n_ref = demos[0].n_samples();
         if warps.len() != demos.len() {
@@ -145,12 +253,12 @@ impl TaskModel {
             check_warp(demo_idx, warp, n_ref, demo.n_samples())?;
         }
         let d = layout.dim();
-        // Anchors: demo 0's orientation at its aligned time, `n_ref × n_quat`.
+        // Anchors: the reference's orientation at its aligned time, `n_ref × n_quat`.
         let mut anchors = Vec::with_capacity(n_ref * layout.n_quat);
         for &demo_t in &warps[0] {
             for item in &layout.items {
                 if let Item::Quat(cols, _) = item {
-                    anchors.push(quat_at(&demos[0], cols, demo_t));
+                    anchors.push(quat_at(demos[0], cols, demo_t));
                 }
             }
         }
@@ -159,12 +267,10 @@ impl TaskModel {
             .zip(warps.par_iter())
             .map(|(demo, warp)| observe(&layout, &anchors, demo, warp))
             .collect();
-        params.check_ranges_len(d)?;
         let ranges = match &params.ranges {
             Some(r) => r.clone(),
             None => {
-                let mut r = non_rate_ranges
-                    .unwrap_or_else(|| layout.channel_ranges(demos, params.min_range));
+                let mut r = non_rate_ranges;
                 let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
                 for o in &obs {
                     for g in o.iter().skip(d - 1).step_by(d) {
@@ -187,6 +293,7 @@ impl TaskModel {
             layout,
             dt_s: demos[0].dt_s(),
             n_ref,
+            reference_idx: 0,
             k_max: params.k_max,
             ranges,
             anchors,

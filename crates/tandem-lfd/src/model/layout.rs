@@ -159,9 +159,15 @@ impl Layout {
     }
 
     /// Default ranges of the non-rate tangent coordinates (`d − 1` values, see
-    /// [`FitParams::ranges`](super::FitParams::ranges)); demo 0's first orientation is the
-    /// origin of the quaternion blocks' rotation vectors.
-    pub(super) fn channel_ranges(&self, demos: &[Demonstration], min_range: f64) -> Vec<f64> {
+    /// [`FitParams::ranges`](super::FitParams::ranges)) over every sample of `demos`; the
+    /// first orientation of `reference` is the origin of the quaternion blocks' rotation
+    /// vectors. The result does not depend on the order of `demos`.
+    pub(super) fn channel_ranges(
+        &self,
+        reference: &Demonstration,
+        demos: &[Demonstration],
+        min_range: f64,
+    ) -> Vec<f64> {
         let mut ranges = Vec::with_capacity(self.dim());
         let guard = |r: f64| {
             if r < min_range || !r.is_finite() {
@@ -184,7 +190,7 @@ impl Layout {
                     ranges.push(guard(hi - lo));
                 }
                 Item::Quat(cols, _) => {
-                    let origin = quat::normalize(&cols.map(|c| demos[0].sample(0)[c]));
+                    let origin = quat::normalize(&cols.map(|c| reference.sample(0)[c]));
                     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
                     for demo in demos {
                         for t in 0..demo.n_samples() {
@@ -227,8 +233,8 @@ impl Layout {
     }
 
     /// A copy of the samples with every quaternion block sign-continuous in time and in the
-    /// hemisphere of `reference_orientations` (demo 0's first orientation per block), for
-    /// alignment.
+    /// hemisphere of `reference_orientations` (the reference's first orientation per block),
+    /// for alignment.
     pub(super) fn sign_aligned(
         &self,
         demo: &Demonstration,

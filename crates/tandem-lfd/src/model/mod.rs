@@ -12,8 +12,8 @@
 //!
 //! # Quaternion statistics
 //!
-//! The anchor `q_a(n)` at reference sample `n` is the reference demonstration's (demo 0's)
-//! orientation at its aligned time `ψ_0(n)`, fixed at fit time.
+//! The anchor `q_a(n)` at reference sample `n` is the reference demonstration's orientation
+//! at its aligned time `ψ_0(n)`, fixed at fit time.
 //! Each orientation `q` enters the statistics as `r = log(q_a⁻¹ ⊗ q)` (the shortest rotation
 //! vector, so `q` and `−q` give the same `r`). The mean orientation is `q_a ⊗ exp(r̄)`, with
 //! `r̄` the mean rotation vector; residuals are `r − r̄`. Because the anchor never changes,
@@ -55,7 +55,7 @@ mod stats;
 
 pub use corrections::Corrections;
 pub use execution::Execution;
-pub use params::FitParams;
+pub use params::{FitParams, Reference};
 
 use corrections::CorrectionTable;
 use layout::Layout;
@@ -84,6 +84,8 @@ struct ModelData {
     layout: Layout,
     dt_s: f64,
     n_ref: usize,
+    /// Index of the reference among the demonstrations given to the fit.
+    reference_idx: usize,
     k_max: usize,
     ranges: Vec<f64>,
     /// `n_ref × n_quat` anchor quaternions `[x, y, z, w]`.
@@ -177,6 +179,13 @@ impl TaskModel {
     /// Number of reference samples `T_ref` (the length of every per-time array).
     pub fn n_ref(&self) -> usize {
         self.data.n_ref
+    }
+
+    /// Index of the reference demonstration (whose samples are the time axis) among the
+    /// demonstrations given to [`TaskModel::fit`] (see [`FitParams::reference`]); 0 after
+    /// [`TaskModel::fit_aligned`].
+    pub fn reference_idx(&self) -> usize {
+        self.data.reference_idx
     }
 
     /// Reference sample period `Δt_s`, seconds.
