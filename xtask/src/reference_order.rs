@@ -12,8 +12,9 @@
 //! the model with the ground-truth labels of whichever demonstration is the reference,
 //! and the final share of high-confidence samples and `T_total` are reported.
 //! Per choice the spread (largest minus smallest over the rotations) says how much the
-//! order matters. Prints a Markdown table and writes `reference_order.json` into the
-//! output folder.
+//! order matters. Prints the medoid's criterion per demonstration
+//! (`TaskModel::reference_costs`), a Markdown table, and writes `reference_order.json` into
+//! the output folder.
 
 use std::path::PathBuf;
 
@@ -185,6 +186,16 @@ pub(crate) fn run(args: &ReferenceOrderArgs) -> anyhow::Result<()> {
         .collect::<Result<Vec<_>, _>>()?;
     let labels_path = |i: usize| fixtures.join(format!("demo_{i}.labels.csv"));
 
+    let costs = TaskModel::reference_costs(&demos, &config.planner.fit)?;
+    let costs: Vec<String> = costs
+        .iter()
+        .enumerate()
+        .map(|(i, c)| format!("demo {i} {c:.4}"))
+        .collect();
+    println!(
+        "medoid criterion (total alignment objective with each demo as the reference): {}",
+        costs.join(", ")
+    );
     println!(
         "reduced study: {} trials × {} executions, {} samples per schedule, seed {}",
         config.trials, config.executions, config.samples, config.seed

@@ -330,6 +330,14 @@ fn medoid_is_the_demonstration_with_the_least_total_alignment_cost() {
         .min_by(|&a, &b| costs[a].total_cmp(&costs[b]))
         .unwrap();
     assert_eq!(model.reference_idx(), argmin, "costs {costs:?}");
+    // The library reports the same costs (summed in another order).
+    let reported = TaskModel::reference_costs(&demos, &params).unwrap();
+    for (a, b) in reported.iter().zip(&costs) {
+        assert!(
+            (a - b).abs() <= 1e-12 * b.abs(),
+            "{reported:?} vs {costs:?}"
+        );
+    }
     // A middle plateau is closest to all others; the extremes are not.
     assert!(argmin == 1 || argmin == 2, "costs {costs:?}");
     assert_eq!(model.n_ref(), demos[argmin].n_samples());

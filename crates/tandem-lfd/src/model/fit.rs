@@ -131,8 +131,25 @@ fn content_order(a: &Demonstration, b: &Demonstration) -> Ordering {
         .then_with(|| a.dt_s().total_cmp(&b.dt_s()))
 }
 
+/// Every demonstration tried as the reference, in input order (the medoid's candidates).
+fn all_candidates(
+    demos: &[Demonstration],
+    layout: &Layout,
+    params: &FitParams,
+) -> Result<Vec<Alignment>> {
+    (0..demos.len())
+        .into_par_iter()
+        .map(|r| {
+            let mut others: Vec<usize> = (0..demos.len()).filter(|&i| i != r).collect();
+            others.sort_by(|&a, &b| content_order(&demos[a], &demos[b]));
+            let order = std::iter::once(r).chain(others).collect();
+            align_to(demos, order, layout, params)
+        })
+        .collect()
+}
+
 /// The alignment the fit uses: to demo 0 ([`Reference::First`]), or to each demonstration
-/// in turn keeping the cheapest ([`Reference::Medoid`]).
+/// in turn keeping the cheapest ([`Reference::Medoid`]; ties go to the earlier one).
 fn choose_alignment(
     demos: &[Demonstration],
     layout: &Layout,
@@ -140,23 +157,27 @@ fn choose_alignment(
 ) -> Result<Alignment> {
     match params.reference {
         Reference::First => align_to(demos, (0..demos.len()).collect(), layout, params),
-        Reference::Medoid => {
-            let candidates = (0..demos.len())
-                .into_par_iter()
-                .map(|r| {
-                    let mut others: Vec<usize> = (0..demos.len()).filter(|&i| i != r).collect();
-                    others.sort_by(|&a, &b| content_order(&demos[a], &demos[b]));
-                    let order = std::iter::once(r).chain(others).collect();
-                    align_to(demos, order, layout, params)
-                })
-                .collect::<Result<Vec<_>>>()?;
-            let best = candidates
-                .into_iter()
-                .reduce(|best, c| if c.cost < best.cost { c } else { best })
-                .expect("at least two demonstrations");
-            Ok(best)
-        }
+        Reference::Medoid => Ok(all_candidates(demos, layout, params)?
+            .into_iter()
+            .reduce(|best, c| if c.cost < best.cost { c } else { best })
+            .expect("at least two demonstrations")),
     }
+}
+
+/// The checks every fit starts with: parameters, the demonstration set (returned with
+/// demo 0's channel order), its tangent layout, quaternion norms, explicit ranges' length.
+fn checked<'a>(
+    demos: &'a [Demonstration],
+    params: &FitParams,
+) -> Result<(Cow<'a, [Demonstration]>, Layout)> {
+    params.validate()?;
+    let demos = check_demos(demos)?;
+    let layout = Layout::new(&demos[0], &params.schema)?;
+    for demo in demos.iter() {
+        layout.check_quaternion_norms(demo)?;
+    }
+    params.check_ranges_len(layout.dim())?;
+    Ok((demos, layout))
 }
 
 impl TaskModel {
@@ -172,13 +193,7 @@ impl TaskModel {
     /// quaternion block, a channel named like a derived coordinate, a zero quaternion, bad
     /// parameters, alignment failure.
     pub fn fit(demos: &[Demonstration], params: &FitParams) -> Result<Self> {
-        params.validate()?;
-        let demos = check_demos(demos)?;
-        let layout = Layout::new(&demos[0], &params.schema)?;
-        for demo in demos.iter() {
-            layout.check_quaternion_norms(demo)?;
-        }
-        params.check_ranges_len(layout.dim())?;
+        let (demos, layout) = checked(demos, params)?;
         let alignment = choose_alignment(&demos, &layout, params)?;
         let ordered: Vec<&Demonstration> = alignment.order.iter().map(|&i| &demos[i]).collect();
         let mut model = Self::fit_from_warps(
@@ -209,7 +224,6 @@ impl TaskModel {
         warps: &[Vec<f64>],
         params: &FitParams,
     ) -> Result<Self> {
-        params.validate()?;
         if params.reference != Reference::First {
             return Err(Error::BadParam {
                 name: "reference",
@@ -219,18 +233,29 @@ impl TaskModel {
                 ),
             });
         }
-        let demos = check_demos(demos)?;
-        let layout = Layout::new(&demos[0], &params.schema)?;
-        for demo in demos.iter() {
-            layout.check_quaternion_norms(demo)?;
-        }
-        params.check_ranges_len(layout.dim())?;
+        let (demos, layout) = checked(demos, params)?;
         let non_rate_ranges = match &params.ranges {
             Some(r) => r[..r.len() - 1].to_vec(),
             None => layout.channel_ranges(&demos[0], &demos, params.min_range),
         };
         let ordered: Vec<&Demonstration> = demos.iter().collect();
         Self::fit_from_warps(&ordered, warps, params, layout, non_rate_ranges)
+    }
+
+    /// The medoid's criterion for every demonstration, in input order: the total GDTW
+    /// objective (Eq. 3, on normalized time) of aligning all the others to it, with the
+    /// weights it would have as the reference. [`Reference::Medoid`] picks the smallest;
+    /// how far apart the costs are says how clear that choice is. Ignores
+    /// [`FitParams::reference`].
+    ///
+    /// # Errors
+    /// As [`TaskModel::fit`].
+    pub fn reference_costs(demos: &[Demonstration], params: &FitParams) -> Result<Vec<f64>> {
+        let (demos, layout) = checked(demos, params)?;
+        Ok(all_candidates(&demos, &layout, params)?
+            .iter()
+            .map(|c| c.cost)
+            .collect())
     }
 
     /// The statistics of checked demonstrations, reference first, from their warps.
