@@ -23,7 +23,7 @@ use serde::Serialize;
 use tandem::lfd::{Demonstration, Reference, TaskModel};
 use tandem::study::{StudyConfig, read_labels, run_trials};
 
-use crate::study::workspace_root;
+use crate::study::{read_config, workspace_root};
 
 /// Flags of `cargo xtask reference-order`.
 #[derive(clap::Args, Debug)]
@@ -162,14 +162,7 @@ fn run_one(
 /// Runs `cargo xtask reference-order`.
 pub(crate) fn run(args: &ReferenceOrderArgs) -> anyhow::Result<()> {
     let root = workspace_root();
-    let path = args
-        .config
-        .clone()
-        .unwrap_or_else(|| root.join("fixtures/study.toml"));
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("reading study configuration {}", path.display()))?;
-    let mut config: StudyConfig =
-        toml::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+    let (mut config, path) = read_config(args.config.as_deref())?;
     config.trials = args.trials;
     config.executions = args.executions;
     config.samples = args.samples;

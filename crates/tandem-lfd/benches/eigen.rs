@@ -2,14 +2,17 @@
 //! §II-B2): the scaled scatter matrices `D·S·D` of every reference sample of the committed
 //! sanding fixtures (9 × 9, 9873 of them), one sweep over all of them per iteration, single
 //! thread. `tests/eigen_faer.rs` checks that both give the same results to 1e-12.
-//! Decision and numbers: docs/decisions.md ("faer or nalgebra").
+//! Decision and numbers: docs/decisions.md ("nalgebra, not faer, for the per-sample
+//! eigendecompositions").
 #![expect(
     missing_docs,
     reason = "criterion_group! generates an undocumented pub fn"
 )]
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use std::hint::black_box;
-use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use faer::diag::Diag;
@@ -17,36 +20,11 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::evd::{self, ComputeEigenvectors};
 use faer::{Mat, Par, Side};
 use nalgebra::{DMatrix, SymmetricEigen};
-use tandem_lfd::{Demonstration, FitParams, TaskModel};
 
-/// The scaled scatter of every reference sample of the fixture model, row-major `d × d`.
-fn fixture_matrices() -> (usize, Vec<Vec<f64>>) {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/sanding");
-    let demos: Vec<Demonstration> = (0..6)
-        .map(|i| {
-            Demonstration::from_csv_path(dir.join(format!("demo_{i}.csv")), None)
-                .expect("committed fixture parses")
-        })
-        .collect();
-    let model = TaskModel::fit(&demos, &FitParams::default()).expect("fixtures fit");
-    let (d, r, dof) = (
-        model.ranges().len(),
-        model.ranges(),
-        (model.count() - 1) as f64,
-    );
-    let matrices = (0..model.n_ref())
-        .map(|n| {
-            let cov = model.covariance(n);
-            (0..d * d)
-                .map(|ij| cov[ij] * dof / (r[ij / d] * r[ij % d]))
-                .collect()
-        })
-        .collect();
-    (d, matrices)
-}
+use common::fixture_matrices;
 
 fn benches(c: &mut Criterion) {
-    let (d, matrices) = fixture_matrices();
+    let (d, _, matrices) = fixture_matrices();
     let mut group = c.benchmark_group("eigen_fixtures");
     group.sample_size(20);
     let id = |lib: &str| format!("{lib}/{}x{d}x{d}", matrices.len());

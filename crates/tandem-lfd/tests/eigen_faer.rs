@@ -1,37 +1,14 @@
 //! faer and nalgebra give the same per-sample eigendecompositions on the committed sanding
 //! fixtures (the input of the correction directions, paper §II-B2): every eigenvalue to
 //! 1e-12 of the matrix's largest, and the eigenvectors that the corrections use to 1e-12 up
-//! to sign wherever they are determined (see docs/decisions.md, "faer or nalgebra").
+//! to sign wherever they are determined (docs/decisions.md, "nalgebra, not faer, for the per-sample eigendecompositions").
 
-use std::path::PathBuf;
+mod common;
 
 use faer::{Mat, Side};
 use nalgebra::{DMatrix, SymmetricEigen};
-use tandem_lfd::{Demonstration, FitParams, TaskModel};
 
-/// The scaled scatter `D·S·D`, `D = diag(1/r)`, of every reference sample of the fixture
-/// model, row-major `d × d` (what `TaskModel`'s corrections decompose).
-fn fixture_matrices() -> (usize, usize, Vec<Vec<f64>>) {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/sanding");
-    let demos: Vec<Demonstration> = (0..6)
-        .map(|i| Demonstration::from_csv_path(dir.join(format!("demo_{i}.csv")), None).unwrap())
-        .collect();
-    let model = TaskModel::fit(&demos, &FitParams::default()).unwrap();
-    let (d, r, dof) = (
-        model.ranges().len(),
-        model.ranges(),
-        (model.count() - 1) as f64,
-    );
-    let matrices = (0..model.n_ref())
-        .map(|n| {
-            let cov = model.covariance(n);
-            (0..d * d)
-                .map(|ij| cov[ij] * dof / (r[ij / d] * r[ij % d]))
-                .collect()
-        })
-        .collect();
-    (d, model.n_components(), matrices)
-}
+use common::fixture_matrices;
 
 /// Eigenvalues (descending) and eigenvectors (columns in the same order) of a symmetric
 /// row-major matrix, with nalgebra.

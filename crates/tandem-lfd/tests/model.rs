@@ -290,6 +290,16 @@ fn plateau(len: usize, start: f64) -> Demonstration {
     Demonstration::new(vec!["force".into()], s, 0.01).unwrap()
 }
 
+/// Four plateau demonstrations of different lengths and timings.
+fn plateaus() -> Vec<Demonstration> {
+    vec![
+        plateau(60, 0.10),
+        plateau(70, 0.45),
+        plateau(64, 0.30),
+        plateau(58, 0.60),
+    ]
+}
+
 fn medoid_params() -> FitParams {
     FitParams {
         reference: Reference::Medoid,
@@ -304,12 +314,7 @@ fn medoid_params() -> FitParams {
 
 #[test]
 fn medoid_is_the_demonstration_with_the_least_total_alignment_cost() {
-    let demos = vec![
-        plateau(60, 0.10),
-        plateau(70, 0.45),
-        plateau(64, 0.30),
-        plateau(58, 0.60),
-    ];
+    let demos = plateaus();
     let params = medoid_params();
     let model = TaskModel::fit(&demos, &params).unwrap();
     fn signal(d: &Demonstration) -> tandem_warp::SignalRef<'_> {
@@ -351,12 +356,7 @@ fn medoid_is_the_demonstration_with_the_least_total_alignment_cost() {
 
 #[test]
 fn medoid_model_does_not_depend_on_the_order_of_the_demonstrations() {
-    let demos = vec![
-        plateau(60, 0.10),
-        plateau(70, 0.45),
-        plateau(64, 0.30),
-        plateau(58, 0.60),
-    ];
+    let demos = plateaus();
     let params = medoid_params();
     let model = TaskModel::fit(&demos, &params).unwrap();
     let json = serde_json::to_string(&model).unwrap();

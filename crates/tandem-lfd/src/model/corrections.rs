@@ -272,7 +272,7 @@ impl TaskModel {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{close, demo};
+    use super::super::tests::{close, demo, three_demo_model};
     use super::*;
     use crate::FitParams;
 
@@ -322,8 +322,7 @@ mod tests {
 
     #[test]
     fn bad_commands_are_errors() {
-        let (demos, warps) = super::super::tests::three_demos();
-        let model = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+        let model = three_demo_model();
         assert!(model.command(&[2.0, 0.0], 1.0).is_err());
         assert!(model.command(&[0.0], 1.0).is_err());
         assert!(model.command(&[0.0, 0.0], 2.5).is_err());

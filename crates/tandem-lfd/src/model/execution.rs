@@ -152,14 +152,12 @@ impl TaskModel {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{demo, three_demos};
+    use super::super::tests::{demo, three_demo_model};
     use super::*;
-    use crate::FitParams;
 
     #[test]
     fn execution_warp_inverts_the_log() {
-        let (demos, warps) = three_demos();
-        let model = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+        let model = three_demo_model();
         // 5 samples at half speed: ref times 0, 0.5, …, 2 → warp 0, 2, 4.
         let exec = Execution {
             demonstration: demo(&["force"], vec![0.0, 5.0, 10.0, 15.0, 20.0]),
@@ -185,8 +183,7 @@ mod tests {
 
     #[test]
     fn bad_executions_are_errors_and_leave_the_model() {
-        let (demos, warps) = three_demos();
-        let mut model = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+        let mut model = three_demo_model();
         let exec = Execution {
             demonstration: demo(&["force"], vec![0.0; 3]),
             ref_time_log: vec![0.0, 2.0, 1.0],

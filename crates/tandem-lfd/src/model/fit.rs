@@ -334,13 +334,12 @@ impl TaskModel {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{close, demo, three_demos};
+    use super::super::tests::{close, demo, three_demo_model, three_demos};
     use super::*;
 
     #[test]
     fn hand_derived_statistics() {
-        let (demos, warps) = three_demos();
-        let model = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+        let model = three_demo_model();
         assert_eq!(model.n_ref(), 3);
         assert_eq!(model.tangent_names(), ["force", "rate"]);
         // Force range 20 N; gradients {1, 1.5, 2.5} → rate range 1.5.

@@ -268,24 +268,29 @@ mod tests {
         )
     }
 
-    fn quat_demo(qs: &[[f64; 4]]) -> Demonstration {
-        demo(
-            &["qx", "qy", "qz", "qw"],
-            qs.iter().flatten().copied().collect(),
+    /// The model of [`three_demos`] with the default parameters.
+    pub(super) fn three_demo_model() -> TaskModel {
+        let (demos, warps) = three_demos();
+        TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap()
+    }
+
+    /// The model of two 2-sample demonstrations holding the constant orientations `a` and
+    /// `b` (channels `qx, qy, qz, qw`), identity warps.
+    fn constant_orientations_model(a: quat::Quat, b: quat::Quat) -> TaskModel {
+        let quat_demo = |q: quat::Quat| demo(&["qx", "qy", "qz", "qw"], [q, q].concat());
+        let id = vec![0.0, 1.0];
+        TaskModel::fit_aligned(
+            &[quat_demo(a), quat_demo(b)],
+            &[id.clone(), id],
+            &FitParams::default(),
         )
+        .unwrap()
     }
 
     #[test]
     fn quaternion_mean_of_q_and_minus_q_is_q() {
         let q = quat::exp(&[0.1, -0.2, 0.3]);
-        let mq = q.map(|v| -v);
-        let id = vec![0.0, 1.0];
-        let model = TaskModel::fit_aligned(
-            &[quat_demo(&[q, q]), quat_demo(&[mq, mq])],
-            &[id.clone(), id],
-            &FitParams::default(),
-        )
-        .unwrap();
+        let model = constant_orientations_model(q, q.map(|v| -v));
         assert_eq!(model.tangent_names(), ["q.rx", "q.ry", "q.rz", "rate"]);
         for n in 0..2 {
             let got = &model.mean()[n * 4..(n + 1) * 4];
@@ -301,13 +306,7 @@ mod tests {
         // ±0.2 rad about z: the mean is the identity; residuals ±0.2 rad about z.
         let a = quat::exp(&[0.0, 0.0, 0.2]);
         let b = quat::exp(&[0.0, 0.0, -0.2]);
-        let id = vec![0.0, 1.0];
-        let model = TaskModel::fit_aligned(
-            &[quat_demo(&[a, a]), quat_demo(&[b, b])],
-            &[id.clone(), id],
-            &FitParams::default(),
-        )
-        .unwrap();
+        let model = constant_orientations_model(a, b);
         let mean = &model.mean()[0..4];
         assert!(
             mean.iter()
@@ -326,8 +325,7 @@ mod tests {
 
     #[test]
     fn serde_round_trip_keeps_statistics() {
-        let (demos, warps) = three_demos();
-        let model = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+        let model = three_demo_model();
         let json = serde_json::to_string(&model).unwrap();
         let back: TaskModel = serde_json::from_str(&json).unwrap();
         assert_eq!(back.sigma2_d(), model.sigma2_d());
