@@ -6,6 +6,7 @@
 
 mod fig5;
 mod fixtures;
+mod reference_order;
 mod stress;
 mod study;
 
@@ -30,6 +31,10 @@ enum Cmd {
         #[arg(long)]
         check: bool,
     },
+    /// Fit the fixtures in each of their six rotations with each reference choice (first,
+    /// medoid) and run a reduced study on each: how much the order of the demonstrations
+    /// changes σ²_D, the speed bounds and the confidence (docs/decisions.md).
+    ReferenceOrder(reference_order::ReferenceOrderArgs),
     /// Render Fig. 5 from a synthetic, clearly labelled demo dataset (exercises the plot).
     #[command(hide = true)]
     Fig5Demo {
@@ -55,6 +60,7 @@ fn main() -> anyhow::Result<()> {
         Cmd::Fixtures { check } => fixtures::run(check),
         Cmd::Study(args) => study::run(&args),
         Cmd::Stress { executions, seed } => stress::run(executions, seed),
+        Cmd::ReferenceOrder(args) => reference_order::run(&args),
         Cmd::Fig5Demo { out } => {
             let (svg, png) = fig5::run_demo(&out)?;
             println!("wrote {} and {}", svg.display(), png.display());

@@ -59,7 +59,8 @@ struct StudyFile<'a> {
     result: &'a StudyResult,
 }
 
-fn workspace_root() -> PathBuf {
+/// The workspace root (the folder above `xtask/`).
+pub(crate) fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .expect("xtask lives one folder below the workspace root")
@@ -78,16 +79,22 @@ fn git_revision(root: &Path) -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
-/// The configuration file with the flags applied.
-fn config(args: &StudyArgs, root: &Path) -> anyhow::Result<StudyConfig> {
-    let path = args
-        .config
-        .clone()
-        .unwrap_or_else(|| root.join("fixtures/study.toml"));
+/// The study configuration at `path`, or `fixtures/study.toml` of the workspace; returns it
+/// with the path read (for messages).
+pub(crate) fn read_config(path: Option<&Path>) -> anyhow::Result<(StudyConfig, PathBuf)> {
+    let path = path.map_or_else(
+        || workspace_root().join("fixtures/study.toml"),
+        Path::to_path_buf,
+    );
     let text = std::fs::read_to_string(&path)
         .with_context(|| format!("reading study configuration {}", path.display()))?;
-    let mut config: StudyConfig =
-        toml::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+    let config = toml::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+    Ok((config, path))
+}
+
+/// The configuration file with the flags applied.
+fn config(args: &StudyArgs) -> anyhow::Result<StudyConfig> {
+    let (mut config, path) = read_config(args.config.as_deref())?;
     if let Some(v) = args.trials {
         config.trials = v;
     }
@@ -153,7 +160,7 @@ fn print_times(times: &PhaseTimes, wall: std::time::Duration) {
 pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
     let wall = Instant::now();
     let root = workspace_root();
-    let config = config(args, &root)?;
+    let config = config(args)?;
     if let Some(n) = args.threads {
         if n == 0 {
             bail!("--threads must be at least 1");

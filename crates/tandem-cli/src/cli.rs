@@ -2,7 +2,9 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use tandem::lfd::Reference;
+use tandem::sim::workcell::OperatorParams;
 
 /// Coordinated two-robot shared autonomy from your own demonstrations (Hagenow et al., RA-L 2023).
 ///
@@ -32,11 +34,12 @@ pub(crate) struct Cli {
 pub(crate) enum Command {
     /// Learn the task model and the first schedule from demonstrations; write a state file.
     ///
-    /// Aligns every demonstration to the first one (the reference, GDTW), computes the mean
-    /// behaviour, its variability σ²_D(t), the demonstrated speed bounds and the admissible
-    /// corrections, sets the confidence from the demonstrations alone (the prior) and
-    /// samples a first schedule. The first file is the reference: the model's time axis is
-    /// its sample index.
+    /// Aligns every demonstration to the reference (GDTW), computes the mean behaviour, its
+    /// variability σ²_D(t), the demonstrated speed bounds and the admissible corrections,
+    /// sets the confidence from the demonstrations alone (the prior) and samples a first
+    /// schedule. The model's time axis is the reference's sample index. The reference is
+    /// the first file, or with --reference medoid the demonstration closest to all the
+    /// others (then the model does not depend on the order of the files).
     ///
     /// Demonstrations are CSV (header of channel names, optional time column `t` in seconds)
     /// or JSON ({"channels", "dt_s", "samples"}), chosen by the extension `.json`.
@@ -45,6 +48,7 @@ pub(crate) enum Command {
     ///
     ///   tandem fit fixtures/sanding/demo_?.csv -o cell.tandem
     ///   tandem fit a.csv b.csv c.csv --ranges force=20,x=0.5 --params params.toml --samples 2000 -o cell.tandem
+    ///   tandem fit fixtures/sanding/demo_?.csv --reference medoid -o cell.tandem
     #[command(verbatim_doc_comment)]
     Fit(FitArgs),
     /// Re-optimize the schedule of a state file and show it (text Gantt, or JSON).
@@ -140,9 +144,15 @@ pub(crate) struct SamplerArgs {
 /// `tandem fit`.
 #[derive(Debug, Args)]
 pub(crate) struct FitArgs {
-    /// Demonstration files (CSV or .json); the first is the reference. At least two.
+    /// Demonstration files (CSV or .json). At least two.
     #[arg(required = true, value_name = "DEMO")]
     pub(crate) demos: Vec<PathBuf>,
+    /// Which demonstration is the reference, whose samples are the model's time axis:
+    /// `first` (the first file) or `medoid` (the one whose alignments to all the others cost
+    /// least; n alignment passes instead of one). Default: from the parameters (`[fit]
+    /// reference`, `first`).
+    #[arg(long, value_name = "CHOICE", value_enum)]
+    pub(crate) reference: Option<ReferenceArg>,
     /// Per-coordinate ranges r_j of the weights W = diag(1/r_j²), as NAME=VALUE pairs
     /// (channel names, `<block>.rx|ry|rz` for quaternions, `rate` for the speed). Unnamed
     /// coordinates keep their automatic range (spread over all demonstrations).
@@ -161,6 +171,24 @@ pub(crate) struct FitArgs {
     /// The state file to write (replaced atomically if it exists).
     #[arg(short, long, value_name = "STATE")]
     pub(crate) output: PathBuf,
+}
+
+/// `tandem fit --reference`: `tandem::lfd::Reference` by its parameter-file names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum ReferenceArg {
+    /// The first demonstration file.
+    First,
+    /// The demonstration with the least total alignment cost to the others.
+    Medoid,
+}
+
+impl From<ReferenceArg> for Reference {
+    fn from(r: ReferenceArg) -> Self {
+        match r {
+            ReferenceArg::First => Reference::First,
+            ReferenceArg::Medoid => Reference::Medoid,
+        }
+    }
 }
 
 /// `tandem schedule`.
@@ -215,7 +243,8 @@ pub(crate) struct PlotArgs {
     pub(crate) output: PathBuf,
 }
 
-/// `tandem simulate`.
+/// `tandem simulate`. The operator's defaults are the study's
+/// (`tandem::sim::workcell::OperatorParams::default()`).
 #[derive(Debug, Args)]
 pub(crate) struct SimulateArgs {
     /// The state file (read only).
@@ -233,17 +262,17 @@ pub(crate) struct SimulateArgs {
     #[arg(long, value_name = "S", default_value_t = 0)]
     pub(crate) seed: u64,
     /// Probability that the operator misses a needed correction, in [0, 1].
-    #[arg(long, value_name = "P", default_value_t = 0.01)]
+    #[arg(long, value_name = "P", default_value_t = OperatorParams::default().miss_rate)]
     pub(crate) miss_rate: f64,
     /// Share of the supervised samples needing no correction that the operator corrects
     /// anyway, in [0, 1).
-    #[arg(long, value_name = "P", default_value_t = 0.01)]
+    #[arg(long, value_name = "P", default_value_t = OperatorParams::default().false_correction_rate)]
     pub(crate) false_rate: f64,
     /// Mean duration (s) of one unneeded correction episode (0: every control tick drawn
     /// on its own).
-    #[arg(long, value_name = "S", default_value_t = 0.5)]
+    #[arg(long, value_name = "S", default_value_t = OperatorParams::default().false_correction_s)]
     pub(crate) false_episode: f64,
     /// Channel whose increase a correction aims at.
-    #[arg(long, value_name = "NAME", default_value = "force")]
+    #[arg(long, value_name = "NAME", default_value_t = OperatorParams::default().force_channel)]
     pub(crate) channel: String,
 }

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use serde_json::json;
-use tandem::lfd::{Demonstration, Execution, TaskModel};
+use tandem::lfd::{Demonstration, Execution, Reference, TaskModel};
 use tandem::schedule::SamplerParams;
 use tandem::{ExecutionRecord, Planner, PlannerParams, derive_seed};
 
@@ -60,6 +60,9 @@ fn fit(a: &FitArgs) -> Result<()> {
         None => PlannerParams::default(),
     };
     params.sampler = apply_sampler(params.sampler, &a.sampler)?;
+    if let Some(reference) = a.reference {
+        params.fit.reference = reference.into();
+    }
     if let Some(dt) = a.dt
         && !(dt.is_finite() && dt > 0.0)
     {
@@ -79,7 +82,7 @@ fn fit(a: &FitArgs) -> Result<()> {
         );
     }
     if !a.ranges.is_empty() {
-        let names = input::tangent_names(demos[0].channel_names(), &params.fit.schema);
+        let names = demos[0].tangent_names(&params.fit.schema)?;
         let given = input::parse_ranges(&a.ranges, &names)?;
         let mut ranges = if given.len() == names.len() {
             vec![0.0; names.len()]
@@ -105,9 +108,13 @@ fn fit(a: &FitArgs) -> Result<()> {
     let model = planner.model();
     let files: Vec<String> = a.demos.iter().map(|p| p.display().to_string()).collect();
     out(&format!(
-        "fitted {} demonstrations (reference: {})",
+        "fitted {} demonstrations (reference: {}, {})",
         demos.len(),
-        files[0]
+        files[model.reference_idx()],
+        match planner.params().fit.reference {
+            Reference::First => "the first file",
+            Reference::Medoid => "the medoid",
+        }
     ));
     out(&format!(
         "reference: {} samples × {} s = {:.2} s; channels: {}",
@@ -326,6 +333,10 @@ fn inspect(a: &InspectArgs) -> Result<()> {
         "pairs_recorded": planner.pairs_recorded(),
         "model": {
             "channels": model.channel_names(),
+            "reference": {
+                "choice": planner.params().fit.reference.to_string(),
+                "demo_idx": model.reference_idx(),
+            },
             "n_ref": model.n_ref(),
             "dt_s": dt,
             "reference_duration_s": model.n_ref() as f64 * dt,
@@ -358,7 +369,9 @@ fn inspect(a: &InspectArgs) -> Result<()> {
         planner.pairs_recorded()
     ));
     out(&format!(
-        "  reference: {} samples × {} s = {:.2} s; channels: {}",
+        "  reference: demonstration {} of the fit ({}), {} samples × {} s = {:.2} s; channels: {}",
+        model.reference_idx() + 1,
+        planner.params().fit.reference,
         model.n_ref(),
         secs(dt),
         model.n_ref() as f64 * dt,

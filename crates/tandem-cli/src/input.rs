@@ -8,99 +8,75 @@ use std::path::Path;
 
 use anyhow::{Context, Result, anyhow, bail};
 use tandem::PlannerParams;
-use tandem::lfd::{ChannelSchema, Demonstration};
+use tandem::lfd::{CsvTable, Demonstration};
 
 /// Reads a demonstration or execution: JSON when the extension is `.json`, CSV otherwise.
 /// `dt_s` is the sample period for files without a time column (CSV) or `dt_s` key (JSON).
+/// The model crate checks every value (finite, within its magnitude limit) and names the
+/// file, line and column of a bad one.
 pub(crate) fn read_demo(path: &Path, dt_s: Option<f64>) -> Result<Demonstration> {
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    let demo = if is_json {
+    Ok(if is_json {
         Demonstration::from_json_path(path, dt_s)?
     } else {
         Demonstration::from_csv_path(path, dt_s)?
-    };
-    let m = demo.n_channels();
-    if let Some(k) = demo.samples().iter().position(|v| v.abs() > MAX_ABS_VALUE) {
-        bail!(
-            "{}: data row {}, channel `{}`: value {:e} is beyond ±{MAX_ABS_VALUE:e} (squared \
-             differences would overflow; check the units)",
-            path.display(),
-            k / m + 1,
-            demo.channel_names()[k % m],
-            demo.samples()[k]
-        );
-    }
-    Ok(demo)
+    })
 }
 
-/// Largest magnitude accepted in a demonstration or execution: alignment and statistics
-/// square differences of values, which overflow `f64` near 1e154; physical task data never
-/// comes near this.
-const MAX_ABS_VALUE: f64 = 1e100;
-
-/// A small CSV table: header names and rows of trimmed fields with their 1-based line.
-struct Table {
-    file: String,
-    names: Vec<String>,
-    rows: Vec<(usize, Vec<String>)>,
+/// The text of `path` and the name errors use for it.
+fn read_text(path: &Path) -> Result<(String, String)> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).with_context(|| format!("{file}: cannot read"))?;
+    Ok((text, file))
 }
 
-impl Table {
-    /// Reads `path`; blank lines are skipped; every row must have the header's width.
-    fn read(path: &Path) -> Result<Self> {
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).with_context(|| format!("{file}: cannot read"))?;
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .map(|(k, l)| (k + 1, l))
-            .filter(|(_, l)| !l.trim().is_empty());
-        let Some((_, header)) = lines.next() else {
-            bail!("{file}:1:1: empty file (expected a header row)");
-        };
-        let names: Vec<String> = header
-            .split(',')
-            .map(|f| f.trim().trim_matches('"').to_owned())
-            .collect();
-        let mut rows = Vec::new();
-        for (line, row) in lines {
-            let fields: Vec<String> = row.split(',').map(|f| f.trim().to_owned()).collect();
-            if fields.len() != names.len() {
-                bail!(
-                    "{file}:{line}:{}: ragged row: expected {} fields, found {}",
-                    fields.len().min(names.len()) + 1,
-                    names.len(),
-                    fields.len()
-                );
-            }
-            rows.push((line, fields));
-        }
-        if rows.is_empty() {
+/// A small CSV table, split by the model crate's tokenizer ([`CsvTable`]: header, rows of
+/// trimmed fields with their 1-based line, ragged rows rejected), with at least one row.
+struct Table<'a> {
+    csv: CsvTable<'a>,
+}
+
+impl<'a> Table<'a> {
+    /// Splits `text` (of `file`); a header without rows is an error.
+    fn new(text: &'a str, file: &str) -> Result<Self> {
+        let csv = CsvTable::parse(text, file)?;
+        if csv.rows().is_empty() {
             bail!("{file}: header only, no data rows");
         }
-        Ok(Self { file, names, rows })
+        Ok(Self { csv })
+    }
+
+    fn file(&self) -> &str {
+        self.csv.file()
+    }
+
+    /// 1-based line of row `k`.
+    fn line(&self, k: usize) -> usize {
+        self.csv.rows()[k].line
     }
 
     /// Column index of `name`, or an error listing the header.
     fn column(&self, name: &str) -> Result<usize> {
-        self.names.iter().position(|n| n == name).ok_or_else(|| {
+        self.csv.column(name).ok_or_else(|| {
             anyhow!(
-                "{}:1: no column `{name}` in the header {:?}",
-                self.file,
-                self.names
+                "{}:{}: no column `{name}` in the header {:?}",
+                self.file(),
+                self.csv.header_line(),
+                self.csv.names()
             )
         })
     }
 
     /// Rejects header names other than `allowed`.
     fn only(&self, allowed: &[&str]) -> Result<()> {
-        for (j, n) in self.names.iter().enumerate() {
+        for (j, n) in self.csv.names().iter().enumerate() {
             if !allowed.contains(&n.as_str()) {
                 bail!(
-                    "{}:1:{}: unexpected column `{n}` (allowed: {})",
-                    self.file,
+                    "{}:{}:{}: unexpected column `{n}` (allowed: {})",
+                    self.file(),
+                    self.csv.header_line(),
                     j + 1,
                     allowed.join(", ")
                 );
@@ -111,43 +87,25 @@ impl Table {
 
     /// The finite numbers of column `j`.
     fn numbers(&self, j: usize) -> Result<Vec<f64>> {
-        self.rows
-            .iter()
-            .map(|(line, f)| {
-                let text = &f[j];
-                let v: f64 = text.parse().map_err(|_| {
-                    anyhow!(
-                        "{}:{line}:{}: column `{}`: not a number: `{text}`",
-                        self.file,
-                        j + 1,
-                        self.names[j]
-                    )
-                })?;
-                if !v.is_finite() {
-                    bail!(
-                        "{}:{line}:{}: column `{}`: non-finite value `{text}`",
-                        self.file,
-                        j + 1,
-                        self.names[j]
-                    );
-                }
-                Ok(v)
-            })
+        (0..self.csv.rows().len())
+            .map(|r| Ok(self.csv.number(r, j)?))
             .collect()
     }
 
     /// The 0/1 flags of column `j` (`true`/`false` accepted too).
     fn flags(&self, j: usize) -> Result<Vec<bool>> {
-        self.rows
+        self.csv
+            .rows()
             .iter()
-            .map(|(line, f)| match f[j].as_str() {
+            .map(|row| match row.fields[j] {
                 "0" | "false" => Ok(false),
                 "1" | "true" => Ok(true),
                 other => bail!(
-                    "{}:{line}:{}: column `{}`: expected 0 or 1, found `{other}`",
-                    self.file,
+                    "{}:{}:{}: column `{}`: expected 0 or 1, found `{other}`",
+                    self.file(),
+                    row.line,
                     j + 1,
-                    self.names[j]
+                    self.csv.names()[j]
                 ),
             })
             .collect()
@@ -158,7 +116,8 @@ impl Table {
 /// fractional reference sample the execution was at (monotone non-decreasing, in
 /// `[0, T_ref − 1]`; the model checks the range).
 pub(crate) fn read_log(path: &Path) -> Result<Vec<f64>> {
-    let t = Table::read(path)?;
+    let (text, file) = read_text(path)?;
+    let t = Table::new(&text, &file)?;
     t.only(&["ref_sample"])?;
     let j = t.column("ref_sample")?;
     let v = t.numbers(j)?;
@@ -166,8 +125,8 @@ pub(crate) fn read_log(path: &Path) -> Result<Vec<f64>> {
         if v[k] < v[k - 1] {
             bail!(
                 "{}:{}:1: `ref_sample` decreases from {} to {} (the log must be monotone)",
-                t.file,
-                t.rows[k].0,
+                t.file(),
+                t.line(k),
                 v[k - 1],
                 v[k]
             );
@@ -179,7 +138,8 @@ pub(crate) fn read_log(path: &Path) -> Result<Vec<f64>> {
 /// Reads correction flags: columns `supervised,corrected` (0/1), one row per execution
 /// sample. `corrected` may be 1 only where `supervised` is 1.
 pub(crate) fn read_corrections(path: &Path) -> Result<(Vec<bool>, Vec<bool>)> {
-    let t = Table::read(path)?;
+    let (text, file) = read_text(path)?;
+    let t = Table::new(&text, &file)?;
     t.only(&["supervised", "corrected"])?;
     let supervised = t.flags(t.column("supervised")?)?;
     let corrected = t.flags(t.column("corrected")?)?;
@@ -187,8 +147,8 @@ pub(crate) fn read_corrections(path: &Path) -> Result<(Vec<bool>, Vec<bool>)> {
         bail!(
             "{}:{}: `corrected` is 1 but `supervised` is 0 (only a supervised, low-confidence \
              sample can be corrected)",
-            t.file,
-            t.rows[k].0
+            t.file(),
+            t.line(k)
         );
     }
     Ok((supervised, corrected))
@@ -208,26 +168,27 @@ pub(crate) struct Need {
 /// maximal run of consecutive equal values is a region. All samples of a region must have
 /// the same probability.
 pub(crate) fn read_need(path: &Path, n_ref: usize) -> Result<Need> {
-    let t = Table::read(path)?;
+    let (text, file) = read_text(path)?;
+    let t = Table::new(&text, &file)?;
     t.only(&["need", "region"])?;
     let p = t.numbers(t.column("need")?)?;
     if p.len() != n_ref {
         bail!(
             "{}: {} rows, the model has {n_ref} reference samples (one row per reference sample)",
-            t.file,
+            t.file(),
             p.len()
         );
     }
     if let Some(k) = p.iter().position(|v| !(0.0..=1.0).contains(v)) {
         bail!(
             "{}:{}:{}: `need` = {} is not a probability in [0, 1]",
-            t.file,
-            t.rows[k].0,
+            t.file(),
+            t.line(k),
             t.column("need")? + 1,
             p[k]
         );
     }
-    let region = match t.names.iter().position(|n| n == "region") {
+    let region = match t.csv.column("region") {
         Some(j) => {
             let ids = t.numbers(j)?;
             let mut out = Vec::with_capacity(ids.len());
@@ -237,20 +198,20 @@ pub(crate) fn read_need(path: &Path, n_ref: usize) -> Result<Need> {
                 if !(v >= 0.0 && v.fract() == 0.0 && v < 1e15) {
                     bail!(
                         "{}:{}:{}: `region` = {v} is not a whole number ≥ 0",
-                        t.file,
-                        t.rows[k].0,
+                        t.file(),
+                        t.line(k),
                         j + 1
                     );
                 }
                 let id = v as u64;
                 let next = seen.len();
-                let (dense, line0, p0) = *seen.entry(id).or_insert((next, t.rows[k].0, p[k]));
+                let (dense, line0, p0) = *seen.entry(id).or_insert((next, t.line(k), p[k]));
                 if p0 != p[k] {
                     bail!(
                         "{}:{}: region {id} has need {} here but {p0} on line {line0} (one \
                          probability per region)",
-                        t.file,
-                        t.rows[k].0,
+                        t.file(),
+                        t.line(k),
                         p[k]
                     );
                 }
@@ -294,36 +255,6 @@ pub(crate) fn read_params(path: &Path) -> Result<PlannerParams> {
     Ok(params)
 }
 
-/// The tangent coordinate names the model will have for `channels` (see
-/// `TaskModel::tangent_names`): scalar channels by name, each complete quaternion block of
-/// `schema` as `<block>.rx/.ry/.rz` at its first channel's position, then `rate`.
-pub(crate) fn tangent_names(channels: &[String], schema: &ChannelSchema) -> Vec<String> {
-    let mut block_of: BTreeMap<&str, usize> = BTreeMap::new();
-    for (b, block) in schema.quaternions.iter().enumerate() {
-        if block.channels.iter().all(|c| channels.contains(c)) {
-            for c in &block.channels {
-                block_of.insert(c.as_str(), b);
-            }
-        }
-    }
-    let mut names = Vec::new();
-    let mut emitted = vec![false; schema.quaternions.len()];
-    for c in channels {
-        match block_of.get(c.as_str()) {
-            None => names.push(c.clone()),
-            Some(&b) if !emitted[b] => {
-                emitted[b] = true;
-                for axis in ["rx", "ry", "rz"] {
-                    names.push(format!("{}.{axis}", schema.quaternions[b].name));
-                }
-            }
-            Some(_) => {}
-        }
-    }
-    names.push("rate".into());
-    names
-}
-
 /// Parses `--ranges NAME=VALUE` items against the tangent names; each value finite > 0.
 pub(crate) fn parse_ranges(items: &[String], names: &[String]) -> Result<BTreeMap<usize, f64>> {
     let mut out = BTreeMap::new();
@@ -357,43 +288,6 @@ mod tests {
 
     fn names(v: &[&str]) -> Vec<String> {
         v.iter().map(|s| s.to_string()).collect()
-    }
-
-    #[test]
-    fn tangent_names_replace_a_complete_quaternion_block_at_its_first_channel() {
-        let ch = names(&["t0", "qx", "qy", "qz", "qw", "force"]);
-        let got = tangent_names(&ch, &ChannelSchema::default());
-        assert_eq!(got, names(&["t0", "q.rx", "q.ry", "q.rz", "force", "rate"]));
-        let got = tangent_names(&names(&["a", "qx"]), &ChannelSchema::default());
-        assert_eq!(got, names(&["a", "qx", "rate"]));
-    }
-
-    /// The names computed before fitting are the ones the fitted model reports.
-    #[test]
-    fn tangent_names_match_the_fitted_model() {
-        use tandem::lfd::{FitParams, TaskModel};
-        let ch = names(&["a", "qx", "qy", "qz", "qw", "force"]);
-        let row = [1.0, 0.0, 0.0, 0.0, 1.0, 5.0];
-        let demo = |bump: f64| {
-            let mut v = Vec::new();
-            for k in 0..4 {
-                let mut r = row;
-                r[5] += bump * k as f64;
-                v.extend_from_slice(&r);
-            }
-            Demonstration::new(ch.clone(), v, 0.01).unwrap()
-        };
-        let id = vec![0.0, 1.0, 2.0, 3.0];
-        let model = TaskModel::fit_aligned(
-            &[demo(0.0), demo(1.0)],
-            &[id.clone(), id],
-            &FitParams::default(),
-        )
-        .unwrap();
-        assert_eq!(
-            tangent_names(&ch, &ChannelSchema::default()),
-            model.tangent_names()
-        );
     }
 
     #[test]

@@ -12,9 +12,11 @@
 //!    its workpiece needs it (missing a needed correction with `--miss-rate`) and, where it
 //!    does not, with `--false-rate`. A correction is the joystick input `u_k = ±gain` along
 //!    the model's correction components with the sign that raises `--channel` (components
-//!    that would speed the robot up are dropped when the combined input would), `gain = 1/3`
-//!    (about one standard deviation). The command `x_f⁺ = μ̂⁺ + δx⁺(u)` (Eq. 7) is logged and
-//!    its rate (clamped to the demonstrated bounds) is the operator's gradient for the tick.
+//!    that would speed the robot up are dropped when the combined input would), with the
+//!    study's `gain` (`OperatorParams::default()`: 1/3, about one standard deviation). The
+//!    command `x_f⁺ = μ̂⁺ + δx⁺(u)` (Eq. 7) is logged and its rate (clamped to the
+//!    demonstrated bounds) is the operator's gradient for the tick. Every flag's default is
+//!    the study's (`OperatorParams::default()`).
 //! 4. Every running robot logs its command, its reference time (Eq. 21) and its
 //!    supervised/corrected flags; the pair is then recorded in memory with
 //!    `Planner::record_pair`, exactly as `tandem record` does with the written files.
@@ -34,10 +36,6 @@ use tandem::{ExecutionRecord, Planner, derive_seed};
 use crate::cli::SimulateArgs;
 use crate::cmd::out;
 use crate::{input, state_io};
-
-/// Joystick deflection of a correction (`|u_k|`): the components span ±3σ at 1, so 1/3 moves
-/// the command about one standard deviation towards what the demonstrations did.
-const GAIN: f64 = 1.0 / 3.0;
 
 /// Runs one pair (see the module docs). `needed[i][n]`: robot `i`'s workpiece needs the
 /// operator at reference sample `n`.
@@ -84,10 +82,30 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
     if a.pairs == 0 {
         bail!("--pairs 0: simulate at least one pair");
     }
-    for (flag, p) in [("--miss-rate", a.miss_rate), ("--false-rate", a.false_rate)] {
-        if !(0.0..=1.0).contains(&p) {
-            bail!("{flag} {p}: must be a probability in [0, 1]");
-        }
+    // The study's operator with the flags' values; its own checks name the flag.
+    let op = OperatorParams {
+        miss_rate: a.miss_rate,
+        false_correction_rate: a.false_rate,
+        false_correction_s: a.false_episode,
+        force_channel: a.channel.clone(),
+        ..OperatorParams::default()
+    };
+    if let Err(e) = op.validate() {
+        let flag = match e {
+            tandem::sim::Error::BadParam {
+                name: "miss_rate", ..
+            } => "--miss-rate",
+            tandem::sim::Error::BadParam {
+                name: "false_correction_rate",
+                ..
+            } => "--false-rate",
+            tandem::sim::Error::BadParam {
+                name: "false_correction_s",
+                ..
+            } => "--false-episode",
+            _ => "simulate",
+        };
+        bail!("{flag}: {e}");
     }
     let mut planner = state_io::load(&a.state)?;
     let need = input::read_need(&a.need, planner.model().n_ref())?;
@@ -101,13 +119,6 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
     if let Some(dir) = &a.write {
         state_io::prepare_dir(dir)?;
     }
-    let op = OperatorParams {
-        miss_rate: a.miss_rate,
-        false_correction_rate: a.false_rate,
-        false_correction_s: a.false_episode,
-        force_channel: a.channel.clone(),
-        gain: GAIN,
-    };
     let n_regions = need.region.iter().copied().max().unwrap_or(0) + 1;
     let mut region_p = vec![0.0; n_regions];
     for (&r, &p) in need.region.iter().zip(&need.p) {
@@ -247,8 +258,7 @@ mod tests {
             miss_rate: 0.0,
             false_correction_rate: 0.0,
             false_correction_s: 0.0,
-            force_channel: "force".into(),
-            gain: GAIN,
+            ..OperatorParams::default()
         };
         let needed = [vec![true; 40], vec![false; 40]];
         let mut rng = ChaCha8Rng::seed_from_u64(1);

@@ -98,7 +98,7 @@ fn malformed_demonstrations() {
         (
             "huge.csv",
             "t,x,force\n0.00,0,5\n0.01,1e308,5\n0.02,1,5\n".into(),
-            vec!["data row 2", "`x`", "beyond"],
+            vec![":3:2", "`x`", "beyond"],
         ),
         (
             "time_back.csv",
@@ -148,6 +148,49 @@ fn malformed_demonstrations() {
         None,
     );
     assert!(!out.exists());
+}
+
+/// Channel sets the model cannot take: a channel named like a coordinate the model derives,
+/// and an incomplete quaternion block. The model crate finds both; the message names the
+/// reference file, with and without `--ranges` (which needs the coordinate names first).
+#[test]
+fn channel_sets_the_model_rejects() {
+    let dir = scratch("bad-channels");
+    // (header, extra values per row, needles)
+    let cases: [(&str, &str, &[&str]); 2] = [
+        ("t,x,rate", "", &["channel `rate`", "derives", "rename"]),
+        (
+            "t,x,qx,qy,qz",
+            ",0,0",
+            &["quaternion block `q` is incomplete", "qw"],
+        ),
+    ];
+    for (k, (header, pad, needles)) in cases.iter().enumerate() {
+        let demos: Vec<String> = (0..2)
+            .map(|i| {
+                let text: String = small_demo(50 + 5 * i, 2.0 * i as f64)
+                    .lines()
+                    .enumerate()
+                    .map(|(l, row)| match l {
+                        0 => format!("{header}\n"),
+                        _ => format!("{row}{pad}\n"),
+                    })
+                    .collect();
+                s(&write(&dir, &format!("case{k}_demo_{i}.csv"), &text))
+            })
+            .collect();
+        let out = s(&dir.join("out.tandem"));
+        for extra in [&[][..], &["--ranges", "x=2"][..]] {
+            let mut args = vec!["fit".to_string()];
+            args.extend(demos.iter().cloned());
+            args.extend(extra.iter().map(|x| x.to_string()));
+            args.extend(["-o".to_string(), out.clone()]);
+            let mut needles = needles.to_vec();
+            needles.push(&demos[0]);
+            expect_user_error(&args, &needles, None);
+            assert!(!dir.join("out.tandem").exists());
+        }
+    }
 }
 
 #[test]

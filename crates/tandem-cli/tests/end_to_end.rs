@@ -308,3 +308,47 @@ fn ranges_override_only_the_named_coordinates() {
     assert!(set.model().sigma2_d()[mid] < auto.model().sigma2_d()[mid]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--reference medoid` makes the model independent of the order of the files: the same
+/// reference file, the same statistics and the same first schedule; `first` follows the
+/// order. The parameter file's `[fit] reference` does the same as the flag.
+#[test]
+fn medoid_reference_does_not_depend_on_the_order_of_the_files() {
+    let dir = scratch("reference");
+    let demos: Vec<String> = small_demos(&dir).iter().map(|p| s(p)).collect();
+    let fit = |order: &[usize], extra: &[&str], name: &str| -> (String, Planner) {
+        let state = dir.join(name);
+        let mut args: Vec<String> = vec!["fit".into()];
+        args.extend(order.iter().map(|&i| demos[i].clone()));
+        args.extend(["--samples", "50"].map(String::from));
+        args.extend(extra.iter().map(|x| x.to_string()));
+        args.extend(["-o".into(), s(&state)]);
+        let stdout = ok(&tandem(&args));
+        (stdout, Planner::load(&state).unwrap())
+    };
+    let (out_a, a) = fit(&[0, 1, 2], &["--reference", "medoid"], "a.tandem");
+    let (out_b, b) = fit(&[2, 0, 1], &["--reference", "medoid"], "b.tandem");
+    let medoid = &demos[a.model().reference_idx()];
+    assert_eq!(
+        &[2, 0, 1].map(|i| &demos[i])[b.model().reference_idx()],
+        &medoid
+    );
+    for out in [&out_a, &out_b] {
+        assert!(
+            out.contains(&format!("reference: {medoid}, the medoid")),
+            "{out}"
+        );
+    }
+    assert_eq!(a.model().sigma2_d(), b.model().sigma2_d());
+    assert_eq!(a.model().grad_min(), b.model().grad_min());
+    assert_eq!(a.schedule(), b.schedule());
+    // The same choice from the parameter file.
+    let p = write(&dir, "medoid.toml", "[fit]\nreference = \"medoid\"\n");
+    let (_, c) = fit(&[1, 2, 0], &["--params", &s(&p)], "c.tandem");
+    assert_eq!(c.model().sigma2_d(), a.model().sigma2_d());
+    // `first` (the default) takes the first file.
+    let (out_d, d) = fit(&[1, 2, 0], &[], "d.tandem");
+    assert_eq!(d.model().reference_idx(), 0);
+    assert!(out_d.contains(&format!("reference: {}, the first file", demos[1])));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,5 +1,6 @@
 //! Criterion benches of the task model on the six sanding fixtures: full fit (alignment
-//! included), statistics from known warps, correction directions, and one incremental update.
+//! included) with the first and the medoid reference, statistics from known warps,
+//! correction directions, and one incremental update.
 #![expect(
     missing_docs,
     reason = "criterion_group! generates an undocumented pub fn"
@@ -9,7 +10,7 @@ use std::hint::black_box;
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
+use tandem_lfd::{Demonstration, Execution, FitParams, Reference, TaskModel};
 
 fn fixtures() -> Vec<Demonstration> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/sanding");
@@ -43,6 +44,14 @@ fn benches(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function(format!("fit/6x{n_ref}"), |b| {
         b.iter(|| TaskModel::fit(black_box(&demos), &params).expect("fixtures fit"))
+    });
+    // The medoid reference: every demonstration tried as the reference (6 alignment passes).
+    let medoid = FitParams {
+        reference: Reference::Medoid,
+        ..params.clone()
+    };
+    group.bench_function(format!("fit_medoid/6x{n_ref}"), |b| {
+        b.iter(|| TaskModel::fit(black_box(&demos), &medoid).expect("fixtures fit"))
     });
     // Statistics only, from warps computed once (the split: alignment = fit − this).
     let m = demos[0].n_channels();

@@ -7,11 +7,17 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use crate::csv::CsvTable;
 use crate::{Error, Result};
 
 /// Sample period used when a file carries neither a `t` column nor a `dt_s` field and the
 /// caller gives none: 0.01 s (100 Hz, the fixtures' rate).
 pub const DEFAULT_DT_S: f64 = 0.01;
+
+/// Largest magnitude of a demonstration value, `1e100` (the alignment's
+/// `tandem_warp::MAX_ABS_VALUE`): alignment and statistics square differences of values,
+/// which overflow `f64` near `1e154`; physical task data never comes near this.
+pub const MAX_ABS_VALUE: f64 = tandem_warp::MAX_ABS_VALUE;
 
 /// Relative tolerance on sample periods (even spacing of a `t` column; equal periods
 /// across demonstrations): 1 %.
@@ -49,7 +55,8 @@ impl Demonstration {
     /// period `dt_s` (seconds). The source label (used in error messages) is `<memory>`.
     ///
     /// Errors: no channels, empty or duplicated names, `samples.len()` not a multiple of
-    /// the channel count, fewer than 2 samples, a non-finite value, `dt_s` not finite > 0.
+    /// the channel count, fewer than 2 samples, a non-finite value or one beyond
+    /// `±`[`MAX_ABS_VALUE`], `dt_s` not finite > 0.
     pub fn new(channel_names: Vec<String>, samples: Vec<f64>, dt_s: f64) -> Result<Self> {
         let demo = Self {
             source: "<memory>".to_owned(),
@@ -104,6 +111,14 @@ impl Demonstration {
                 k / m,
                 self.channel_names[k % m],
                 self.samples[k]
+            )));
+        }
+        if let Some(k) = first_too_large(&self.samples) {
+            return Err(bad(format!(
+                "sample {}, channel `{}`: {}",
+                k / m,
+                self.channel_names[k % m],
+                too_large_why(self.samples[k])
             )));
         }
         if !(self.dt_s.is_finite() && self.dt_s > 0.0) {
@@ -199,87 +214,46 @@ impl Demonstration {
     /// A column named `t` (seconds) is optional; when present it is removed from the
     /// channels, must be strictly increasing and evenly spaced within 1 %, and sets `Δt_s`
     /// to its mean spacing. Otherwise `Δt_s` is `dt_s`, or [`DEFAULT_DT_S`] when `None`.
-    /// Blank lines are skipped; header names may be double-quoted.
+    /// The text is split by [`CsvTable`] (blank lines skipped, header names may be
+    /// double-quoted); a value beyond `±`[`MAX_ABS_VALUE`] is rejected.
     /// `file` names the input in errors, which carry the 1-based line and field number.
     pub fn from_csv_str(text: &str, file: &str, dt_s: Option<f64>) -> Result<Self> {
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .map(|(k, l)| (k + 1, l))
-            .filter(|(_, l)| !l.trim().is_empty());
-        let Some((header_line, header)) = lines.next() else {
-            return Err(Error::EmptyFile { file: file.into() });
-        };
-        let names: Vec<String> = header
-            .split(',')
-            .map(|f| f.trim().trim_matches('"').to_owned())
-            .collect();
-        let bad_header = |column: usize, why: String| Error::BadHeader {
-            file: file.into(),
-            line: header_line,
-            column,
-            why,
-        };
-        for (j, name) in names.iter().enumerate() {
-            if name.is_empty() {
-                return Err(bad_header(j + 1, "empty channel name".into()));
-            }
-            if let Some(k) = names[..j].iter().position(|n| n == name) {
-                return Err(bad_header(
-                    j + 1,
-                    format!("channel `{name}` repeats column {}", k + 1),
-                ));
-            }
-        }
-        let t_col = names.iter().position(|n| n == "t");
+        let table = CsvTable::parse(text, file)?;
+        let names = table.names();
+        let t_col = table.column("t");
         if names.len() == usize::from(t_col.is_some()) {
-            return Err(bad_header(1, "no data channels".into()));
+            return Err(Error::BadHeader {
+                file: file.into(),
+                line: table.header_line(),
+                column: 1,
+                why: "no data channels".into(),
+            });
         }
-        let width = names.len();
-        let mut samples = Vec::new();
+        let mut samples = Vec::with_capacity(table.rows().len() * names.len());
         let mut times: Vec<(usize, f64)> = Vec::new();
-        let mut last_line = header_line;
-        for (line, row) in lines {
-            last_line = line;
-            let fields: Vec<&str> = row.split(',').collect();
-            if fields.len() != width {
-                return Err(Error::RaggedRow {
-                    file: file.into(),
-                    line,
-                    column: fields.len().min(width) + 1,
-                    expected: width,
-                    found: fields.len(),
-                });
-            }
-            for (j, field) in fields.iter().enumerate() {
-                let text = field.trim();
-                let value: f64 = text.parse().map_err(|_| Error::NotNumeric {
-                    file: file.into(),
-                    line,
-                    column: j + 1,
-                    channel: names[j].clone(),
-                    text: text.into(),
-                })?;
-                if !value.is_finite() {
-                    return Err(Error::NonFinite {
+        for (r, row) in table.rows().iter().enumerate() {
+            for (j, (name, text)) in names.iter().zip(&row.fields).enumerate() {
+                let value = table.number(r, j)?;
+                if Some(j) == t_col {
+                    times.push((row.line, value));
+                    continue;
+                }
+                if value.abs() > MAX_ABS_VALUE {
+                    return Err(Error::TooLarge {
                         file: file.into(),
-                        line,
+                        line: row.line,
                         column: j + 1,
-                        channel: names[j].clone(),
-                        text: text.into(),
+                        channel: name.clone(),
+                        text: (*text).into(),
                     });
                 }
-                if Some(j) == t_col {
-                    times.push((line, value));
-                } else {
-                    samples.push(value);
-                }
+                samples.push(value);
             }
         }
-        let n = samples.len() / (width - usize::from(t_col.is_some()));
+        let n = table.rows().len();
         if n < 2 {
             return Err(Error::TooFewSamples {
-                at: format!("{file}:{}:1", last_line + 1),
+                at: format!("{file}:{}:1", table.end_line()),
                 found: n,
             });
         }
@@ -288,10 +262,10 @@ impl Demonstration {
             None => dt_s.unwrap_or(DEFAULT_DT_S),
         };
         let channel_names = names
-            .into_iter()
+            .iter()
             .enumerate()
             .filter(|(j, _)| Some(*j) != t_col)
-            .map(|(_, n)| n)
+            .map(|(_, n)| n.clone())
             .collect();
         Ok(Self::new(channel_names, samples, dt_s)?.with_source(file))
     }
@@ -341,6 +315,19 @@ impl Demonstration {
                 ));
             }
         }
+        if let Some((r, j)) = doc.samples.iter().enumerate().find_map(|(r, row)| {
+            let j = first_too_large(row)?;
+            Some((r, j))
+        }) {
+            return Err(json_err(
+                Some(r),
+                format!(
+                    "sample {r}, channel `{}`: {}",
+                    doc.channels[j],
+                    too_large_why(doc.samples[r][j])
+                ),
+            ));
+        }
         if doc.samples.len() < 2 {
             let (line, column) = json_row_position(text, None).unwrap_or((1, 1));
             return Err(Error::TooFewSamples {
@@ -373,6 +360,19 @@ impl Demonstration {
         };
         serde_json::to_string(&doc).expect("serializing numbers and strings cannot fail")
     }
+}
+
+/// Index of the first value beyond `±`[`MAX_ABS_VALUE`].
+fn first_too_large(values: &[f64]) -> Option<usize> {
+    values.iter().position(|v| v.abs() > MAX_ABS_VALUE)
+}
+
+/// Why a value beyond `±`[`MAX_ABS_VALUE`] is rejected.
+fn too_large_why(value: f64) -> String {
+    format!(
+        "value {value:e} is beyond ±{MAX_ABS_VALUE:e} (squared differences would overflow; \
+         check the units)"
+    )
 }
 
 /// Checks a `t` column and returns its mean spacing (seconds).
@@ -520,7 +520,8 @@ pub enum ChannelKind {
     Force,
     /// An on/off signal stored as 0/1.
     Binary,
-    /// A rate or speed recorded as a channel.
+    /// A rate or speed recorded as a channel (under any name but `rate`, which is the
+    /// model's derived warp gradient).
     Rate,
     /// Anything else, averaged as a number.
     Scalar,
@@ -539,9 +540,12 @@ pub struct QuaternionBlock {
 /// Channel kinds by name: which channels are quaternion blocks and what the scalars are.
 ///
 /// Default: `x, y, z` position; block `q` = `qx, qy, qz, qw`; `force` force; `tool`
-/// binary; `rate` rate; any other channel [`ChannelKind::Scalar`].
+/// binary; any other channel [`ChannelKind::Scalar`].
 /// A quaternion block applies only when all four of its channels are present; a block with
-/// some but not all channels present is an error at fit time.
+/// some but not all channels present is an error at fit time
+/// ([`Error::PartialQuaternionBlock`], see [`Demonstration::tangent_names`]). No channel may
+/// be named like a coordinate the model derives: `rate`, or `<block>.rx|ry|rz` of a block
+/// that is present ([`Error::ReservedChannelName`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ChannelSchema {
@@ -559,7 +563,6 @@ impl Default for ChannelSchema {
             ("z", ChannelKind::Position),
             ("force", ChannelKind::Force),
             ("tool", ChannelKind::Binary),
-            ("rate", ChannelKind::Rate),
         ]
         .into_iter()
         .map(|(n, k)| (n.to_owned(), k))

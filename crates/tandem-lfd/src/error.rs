@@ -23,7 +23,7 @@ pub enum Error {
         /// The file.
         file: String,
     },
-    /// The header is malformed (empty or duplicated channel name).
+    /// The header is malformed (empty or repeated column name, no data channel).
     #[error("{file}:{line}:{column}: bad header: {why}")]
     BadHeader {
         /// The file.
@@ -49,8 +49,8 @@ pub enum Error {
         /// Number of fields in this row.
         found: usize,
     },
-    /// A field is not a number.
-    #[error("{file}:{line}:{column}: channel `{channel}`: not a number: `{text}`")]
+    /// A CSV field is not a number.
+    #[error("{file}:{line}:{column}: column `{name}`: not a number: `{text}`")]
     NotNumeric {
         /// The file.
         file: String,
@@ -58,14 +58,32 @@ pub enum Error {
         line: usize,
         /// 1-based column.
         column: usize,
-        /// Channel name of the column.
-        channel: String,
+        /// Name of the column (the channel, in a demonstration).
+        name: String,
         /// The offending text.
         text: String,
     },
-    /// A field is NaN or infinite.
-    #[error("{file}:{line}:{column}: channel `{channel}`: non-finite value `{text}`")]
+    /// A CSV field is NaN or infinite.
+    #[error("{file}:{line}:{column}: column `{name}`: non-finite value `{text}`")]
     NonFinite {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// Name of the column (the channel, in a demonstration).
+        name: String,
+        /// The offending text.
+        text: String,
+    },
+    /// A CSV value of a demonstration is beyond `±`[`crate::MAX_ABS_VALUE`].
+    #[error(
+        "{file}:{line}:{column}: channel `{channel}`: value `{text}` is beyond ±{max:e} \
+         (squared differences would overflow; check the units)",
+        max = crate::MAX_ABS_VALUE
+    )]
+    TooLarge {
         /// The file.
         file: String,
         /// 1-based line.
@@ -125,6 +143,35 @@ pub enum Error {
         expected: Vec<String>,
         /// This demonstration's channel names.
         found: Vec<String>,
+    },
+    /// A quaternion block of the schema has some but not all of its four channels.
+    #[error(
+        "{file}: quaternion block `{block}` is incomplete: {missing:?} missing, {present:?} \
+         present (give all four channels, or none, or change `schema.quaternions`)"
+    )]
+    PartialQuaternionBlock {
+        /// The file or source label of the demonstration whose channels are checked.
+        file: String,
+        /// Name of the block.
+        block: String,
+        /// Its channels that are present.
+        present: Vec<String>,
+        /// Its channels that are missing.
+        missing: Vec<String>,
+    },
+    /// A channel has the name of a coordinate the model derives (`rate`, or
+    /// `<block>.rx|ry|rz` of a quaternion block).
+    #[error(
+        "{file}: channel `{channel}` has the name of a coordinate the model derives: \
+         {derived}; rename the channel"
+    )]
+    ReservedChannelName {
+        /// The file or source label of the demonstration whose channels are checked.
+        file: String,
+        /// The channel name.
+        channel: String,
+        /// What the model derives under that name.
+        derived: String,
     },
     /// Sample periods differ by more than 1 %.
     #[error(

@@ -1,8 +1,14 @@
 //! Learning from demonstration for tandem (paper §II-B1/B2).
 //!
 //! - [`Demonstration`]: one demonstration `X_i ∈ R^{m × T_i}` (Eq. 1), read from CSV or
-//!   JSON with errors naming file, line and column.
-//! - [`TaskModel`]: every demonstration aligned to demo 0 (GDTW, `tandem-warp`), then per
+//!   JSON with errors naming file, line and column; every value finite and within
+//!   `±`[`MAX_ABS_VALUE`], whoever builds it. [`CsvTable`] is the one CSV tokenizer (the
+//!   command line reads its other CSV files with it too).
+//! - [`Demonstration::tangent_names`]: the coordinates a model fitted on the demonstrations
+//!   will have; an incomplete quaternion block or a channel named like a derived
+//!   coordinate (`rate`, `<block>.rx|ry|rz`) is a located error here and in the fit.
+//! - [`TaskModel`]: every demonstration aligned to the reference (GDTW, `tandem-warp`):
+//!   demo 0, or the medoid ([`FitParams::reference`], [`Reference`]); then per
 //!   reference sample the mean behaviour `μ̂`, the augmented mean `μ̂⁺` (Eq. 4–5), the
 //!   weighted variance `σ²_D` (Eq. 6), the warp-gradient bounds `ψ̇min/ψ̇max` (Eq. 14), and
 //!   the admissible corrections: principal components of the weighted augmented residuals,
@@ -12,7 +18,7 @@
 //!   through per-sample sufficient statistics, without re-alignment.
 //!
 //! Time frames: all per-time arrays are indexed by *reference sample* `n ∈ 0..n_ref()`
-//! (demo 0's samples, period `dt_s()`); warps map reference samples to demo samples.
+//! (the reference's samples, period `dt_s()`); warps map reference samples to demo samples.
 //!
 //! # Decisions
 //!
@@ -23,9 +29,10 @@
 //!   a small rotation `δr` moves a unit quaternion by `|δr|/2`). Ranges are fixed at fit
 //!   time; updates keep them so `σ²_D` stays comparable across iterations.
 //! - **Quaternions.** Statistics use rotation vectors `log(q_a⁻¹ ⊗ q)` relative to a fixed
-//!   per-sample anchor `q_a` (demo 0's orientation there); the mean is `q_a ⊗ exp(r̄)`. This
+//!   per-sample anchor `q_a` (the reference's orientation there); the mean is `q_a ⊗ exp(r̄)`. This
 //!   is sign-proof (`q ≡ −q`) and makes [`TaskModel::update`] equal a refit exactly. For
-//!   alignment only, quaternion signs are made continuous and put in demo 0's hemisphere.
+//!   alignment only, quaternion signs are made continuous and put in the reference's
+//!   hemisphere.
 //! - **Corrections.** Per reference sample, the eigen-decomposition of the range-scaled
 //!   scatter matrix (equivalent to the SVD of the scaled residuals); `K = min(n − 1, k_max, d)`
 //!   components, each stored as a ±3σ displacement `c_k = 3·s_k/√n · v_k ⊙ r`, signs kept
@@ -37,6 +44,14 @@
 //! - **Executions.** An execution's warp is the inverse of its reference-time log
 //!   ([`TaskModel::execution_warp`]); no re-alignment. All demonstrations and executions must
 //!   share `Δt_s` within 1 %.
+//! - **Reference.** [`Reference::First`] (default) keeps the user's choice; with
+//!   [`Reference::Medoid`] every demonstration is tried as the reference and the one with
+//!   the least total alignment objective wins, and the model no longer depends on the order
+//!   of the demonstrations (measured with `cargo xtask reference-order`, see
+//!   docs/decisions.md).
+//! - **Eigendecompositions.** nalgebra's `SymmetricEigen`; faer gives the same results to
+//!   1e-12 on the fixtures but was slower on these 9 × 9 matrices (`benches/eigen.rs`,
+//!   docs/decisions.md).
 //!
 //! ```
 //! use tandem_lfd::{Demonstration, FitParams, TaskModel};
@@ -54,13 +69,16 @@
 //! # Ok::<(), tandem_lfd::Error>(())
 //! ```
 
+mod csv;
 mod demo;
 mod error;
 mod model;
 mod quat;
 
+pub use csv::{CsvRow, CsvTable};
 pub use demo::{
-    ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, QuaternionBlock,
+    ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, MAX_ABS_VALUE,
+    QuaternionBlock,
 };
 pub use error::{Error, Result};
-pub use model::{Corrections, Execution, FitParams, TaskModel};
+pub use model::{Corrections, Execution, FitParams, Reference, TaskModel};

@@ -2,7 +2,7 @@
 //! incremental updates equal to a refit, alignment with `tandem-warp`.
 
 use proptest::prelude::*;
-use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
+use tandem_lfd::{Demonstration, Execution, FitParams, Reference, TaskModel};
 
 const NAMES: [&str; 7] = ["x", "qx", "qy", "qz", "qw", "force", "tool"];
 
@@ -251,19 +251,148 @@ fn correction_components_are_sign_continuous() {
 #[test]
 fn results_do_not_depend_on_thread_count() {
     let (demos, _) = data(&[0.0, 1.0, -0.5], &[40, 55, 31], &[0.0, 0.6, -0.4]);
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let m = TaskModel::fit(&demos, &FitParams::default()).unwrap();
-            let c = m.corrections_at(12.25).unwrap();
-            (serde_json::to_string(&m).unwrap(), c)
+    for reference in [Reference::First, Reference::Medoid] {
+        let params = FitParams {
+            reference,
+            ..FitParams::default()
+        };
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let m = TaskModel::fit(&demos, &params).unwrap();
+                let c = m.corrections_at(12.25).unwrap();
+                (serde_json::to_string(&m).unwrap(), c)
+            })
+        };
+        let (a, ca) = run(1);
+        let (b, cb) = run(3);
+        assert_eq!(a, b, "{reference}");
+        assert_eq!(ca, cb, "{reference}");
+    }
+}
+
+/// One force channel: a plateau of height 10 N starting at `start` (fraction of the length)
+/// and lasting a quarter of it, on `len` samples.
+fn plateau(len: usize, start: f64) -> Demonstration {
+    let s: Vec<f64> = (0..len)
+        .map(|t| {
+            let p = t as f64 / (len - 1) as f64;
+            if (start..start + 0.25).contains(&p) {
+                10.0
+            } else {
+                0.0
+            }
         })
+        .collect();
+    Demonstration::new(vec!["force".into()], s, 0.01).unwrap()
+}
+
+/// Four plateau demonstrations of different lengths and timings.
+fn plateaus() -> Vec<Demonstration> {
+    vec![
+        plateau(60, 0.10),
+        plateau(70, 0.45),
+        plateau(64, 0.30),
+        plateau(58, 0.60),
+    ]
+}
+
+fn medoid_params() -> FitParams {
+    FitParams {
+        reference: Reference::Medoid,
+        // Explicit weights, so the test can recompute every candidate's cost with tandem-warp.
+        warp: tandem_warp::WarpParams {
+            weights: Some(vec![1.0]),
+            ..tandem_warp::WarpParams::default()
+        },
+        ..FitParams::default()
+    }
+}
+
+#[test]
+fn medoid_is_the_demonstration_with_the_least_total_alignment_cost() {
+    let demos = plateaus();
+    let params = medoid_params();
+    let model = TaskModel::fit(&demos, &params).unwrap();
+    fn signal(d: &Demonstration) -> tandem_warp::SignalRef<'_> {
+        tandem_warp::SignalRef::new(d.samples(), 1).unwrap()
+    }
+    let cost = |r: usize| -> f64 {
+        (0..demos.len())
+            .filter(|&j| j != r)
+            .map(|j| {
+                tandem_warp::align(signal(&demos[r]), signal(&demos[j]), &params.warp)
+                    .unwrap()
+                    .objective()
+            })
+            .sum()
     };
-    let (a, ca) = run(1);
-    let (b, cb) = run(2);
-    assert_eq!(a, b);
-    assert_eq!(ca, cb);
+    let costs: Vec<f64> = (0..demos.len()).map(cost).collect();
+    let argmin = (0..demos.len())
+        .min_by(|&a, &b| costs[a].total_cmp(&costs[b]))
+        .unwrap();
+    assert_eq!(model.reference_idx(), argmin, "costs {costs:?}");
+    // The library reports the same costs (summed in another order).
+    let reported = TaskModel::reference_costs(&demos, &params).unwrap();
+    for (a, b) in reported.iter().zip(&costs) {
+        assert!(
+            (a - b).abs() <= 1e-12 * b.abs(),
+            "{reported:?} vs {costs:?}"
+        );
+    }
+    // A middle plateau is closest to all others; the extremes are not.
+    assert!(argmin == 1 || argmin == 2, "costs {costs:?}");
+    assert_eq!(model.n_ref(), demos[argmin].n_samples());
+    // First: demo 0, whatever the costs.
+    let first = FitParams {
+        reference: Reference::First,
+        ..params.clone()
+    };
+    assert_eq!(TaskModel::fit(&demos, &first).unwrap().reference_idx(), 0);
+}
+
+#[test]
+fn medoid_model_does_not_depend_on_the_order_of_the_demonstrations() {
+    let demos = plateaus();
+    let params = medoid_params();
+    let model = TaskModel::fit(&demos, &params).unwrap();
+    let json = serde_json::to_string(&model).unwrap();
+    let reference = &demos[model.reference_idx()];
+    for order in [[3, 2, 1, 0], [2, 0, 3, 1], [1, 3, 0, 2]] {
+        let shuffled: Vec<Demonstration> = order.iter().map(|&i| demos[i].clone()).collect();
+        let other = TaskModel::fit(&shuffled, &params).unwrap();
+        assert_eq!(&shuffled[other.reference_idx()], reference);
+        // Bit-identical statistics (the reference index itself is where it was given).
+        let same = serde_json::to_string(&other).unwrap().replace(
+            &format!("\"reference_idx\":{}", other.reference_idx()),
+            &format!("\"reference_idx\":{}", model.reference_idx()),
+        );
+        assert_eq!(same, json, "order {order:?}");
+    }
+    // First depends on the order: another first demonstration, another time axis.
+    let first = FitParams {
+        reference: Reference::First,
+        ..params
+    };
+    let a = TaskModel::fit(&demos, &first).unwrap();
+    let b = TaskModel::fit(&[demos[3].clone(), demos[0].clone()], &first).unwrap();
+    assert_ne!(a.n_ref(), b.n_ref());
+}
+
+#[test]
+fn fit_aligned_takes_only_the_first_reference() {
+    let (demos, warps) = data(&[0.0, 1.0], &[30, 44], &[0.0, 0.5]);
+    let e = TaskModel::fit_aligned(&demos, &warps, &medoid_params()).unwrap_err();
+    assert!(matches!(
+        e,
+        tandem_lfd::Error::BadParam {
+            name: "reference",
+            ..
+        }
+    ));
+    let m = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+    assert_eq!(m.reference_idx(), 0);
 }

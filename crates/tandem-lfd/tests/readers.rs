@@ -1,6 +1,6 @@
 //! CSV and JSON readers: every malformed case is an error naming file, line and column.
 
-use tandem_lfd::{Demonstration, Error, FitParams, TaskModel};
+use tandem_lfd::{ChannelSchema, Demonstration, Error, FitParams, TaskModel};
 
 fn csv_err(text: &str) -> String {
     let e = Demonstration::from_csv_str(text, "demo.csv", None).unwrap_err();
@@ -38,20 +38,111 @@ fn csv_non_numeric_and_non_finite() {
     let text = "a,b\n1,2\n3,x4\n";
     assert_eq!(
         csv_err(text),
-        "demo.csv:3:2: channel `b`: not a number: `x4`"
+        "demo.csv:3:2: column `b`: not a number: `x4`"
     );
     let text = "a,b\n1,2\nNaN,4\n";
     assert_eq!(
         csv_err(text),
-        "demo.csv:3:1: channel `a`: non-finite value `NaN`"
+        "demo.csv:3:1: column `a`: non-finite value `NaN`"
     );
     let text = "a,b\n1,inf\n3,4\n";
     assert_eq!(
         csv_err(text),
-        "demo.csv:2:2: channel `b`: non-finite value `inf`"
+        "demo.csv:2:2: column `b`: non-finite value `inf`"
     );
     let text = "a,b\n1,2\n3,\n";
-    assert_eq!(csv_err(text), "demo.csv:3:2: channel `b`: not a number: ``");
+    assert_eq!(csv_err(text), "demo.csv:3:2: column `b`: not a number: ``");
+}
+
+#[test]
+fn values_beyond_the_magnitude_limit_are_rejected_where_they_are() {
+    // CSV: line, column and channel; the `t` column is not a channel but counts as a column.
+    assert_eq!(
+        csv_err("t,a,b\n0,1,2\n0.01,3,-1e101\n"),
+        "demo.csv:3:3: channel `b`: value `-1e101` is beyond ±1e100 (squared differences \
+         would overflow; check the units)"
+    );
+    // 1e100 itself is accepted.
+    assert!(Demonstration::from_csv_str("a\n1e100\n2\n", "f", None).is_ok());
+    // JSON: the row of the value.
+    let text = "{\"channels\": [\"a\"],\n \"samples\": [[1],\n [2e150]]}";
+    let e = json_err(text);
+    assert!(
+        e.starts_with("demo.json:3:2: sample 1, channel `a`: value 2e150 is beyond"),
+        "{e}"
+    );
+    // In memory (a library caller of `Demonstration::new`, e.g. before `fit_aligned`).
+    let e = Demonstration::new(vec!["a".into()], vec![0.0, 1e300], 0.01).unwrap_err();
+    assert!(matches!(e, Error::BadData { .. }));
+    assert_eq!(
+        e.to_string(),
+        "<memory>: sample 1, channel `a`: value 1e300 is beyond ±1e100 (squared differences \
+         would overflow; check the units)"
+    );
+}
+
+#[test]
+fn tangent_names_follow_the_channels_and_the_schema() {
+    let schema = ChannelSchema::default();
+    let d = Demonstration::from_csv_str(
+        "t0,qx,qy,qz,qw,force\n0,0,0,0,1,1\n1,0,0,0,1,2\n",
+        "d.csv",
+        None,
+    )
+    .unwrap();
+    assert_eq!(
+        d.tangent_names(&schema).unwrap(),
+        ["t0", "q.rx", "q.ry", "q.rz", "force", "rate"]
+    );
+    // The fitted model reports the same names.
+    let id = vec![0.0, 1.0];
+    let model = TaskModel::fit_aligned(
+        &[d.clone(), d.clone()],
+        &[id.clone(), id],
+        &FitParams::default(),
+    )
+    .unwrap();
+    assert_eq!(model.tangent_names(), d.tangent_names(&schema).unwrap());
+}
+
+#[test]
+fn a_partial_quaternion_block_is_an_error_naming_the_file() {
+    let d = Demonstration::from_csv_str("a,qx,qz\n0,0,0\n1,0,0\n", "part.csv", None).unwrap();
+    let e = d.tangent_names(&ChannelSchema::default()).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "part.csv: quaternion block `q` is incomplete: [\"qy\", \"qw\"] missing, [\"qx\", \
+         \"qz\"] present (give all four channels, or none, or change `schema.quaternions`)"
+    );
+    // The fit reports the same error.
+    let id = vec![0.0, 1.0];
+    let fit = TaskModel::fit_aligned(&[d.clone(), d], &[id.clone(), id], &FitParams::default());
+    assert!(matches!(fit, Err(Error::PartialQuaternionBlock { .. })));
+}
+
+#[test]
+fn channels_named_like_derived_coordinates_are_rejected() {
+    let schema = ChannelSchema::default();
+    let rate = Demonstration::from_csv_str("t,x,rate\n0,0,1\n0.01,1,1\n", "r.csv", None).unwrap();
+    assert_eq!(
+        rate.tangent_names(&schema).unwrap_err().to_string(),
+        "r.csv: channel `rate` has the name of a coordinate the model derives: the warp \
+         gradient (speed); rename the channel"
+    );
+    let id = vec![0.0, 1.0];
+    let fit = TaskModel::fit_aligned(
+        &[rate.clone(), rate],
+        &[id.clone(), id.clone()],
+        &FitParams::default(),
+    );
+    assert!(matches!(fit, Err(Error::ReservedChannelName { .. })));
+    // `q.rx` collides only when block `q` is present.
+    let text = "qx,qy,qz,qw,q.rx\n0,0,0,1,5\n0,0,0,1,6\n";
+    let clash = Demonstration::from_csv_str(text, "c.csv", None).unwrap();
+    let e = clash.tangent_names(&schema).unwrap_err().to_string();
+    assert!(e.contains("`q.rx`") && e.contains("block `q`"), "{e}");
+    let alone = Demonstration::from_csv_str("x,q.rx\n0,5\n1,6\n", "a.csv", None).unwrap();
+    assert_eq!(alone.tangent_names(&schema).unwrap(), ["x", "q.rx", "rate"]);
 }
 
 #[test]
@@ -70,11 +161,11 @@ fn csv_too_few_samples() {
 fn csv_bad_header() {
     assert_eq!(
         csv_err("a,,b\n1,2,3\n"),
-        "demo.csv:1:2: bad header: empty channel name"
+        "demo.csv:1:2: bad header: empty column name"
     );
     assert_eq!(
         csv_err("a,b,a\n1,2,3\n"),
-        "demo.csv:1:3: bad header: channel `a` repeats column 1"
+        "demo.csv:1:3: bad header: column `a` repeats column 1"
     );
     assert_eq!(
         csv_err("t\n0\n1\n"),

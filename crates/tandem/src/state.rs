@@ -43,7 +43,8 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 /// - 3: the schedule stores the control tick it was checked with (`Schedule::tick_s`), and
 ///   the sampler parameters keep only what a user tunes (`pieces` and `widen_max` replace
 ///   `distribution` and `offset`; the benchmark-only `margin_check` and
-///   `exhaustive_margins` moved to `SamplerBaselines`, which is never stored).
+///   `exhaustive_margins` moved to `SamplerBaselines`, which is never stored); the fit
+///   parameters gained `reference` and the model `reference_idx`.
 pub const FORMAT_VERSION: u32 = 3;
 
 /// Header length in bytes: magic (8) + version (4) + payload length (8) + CRC-32 (4).

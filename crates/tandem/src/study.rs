@@ -369,21 +369,13 @@ impl StudyInputs {
             });
         }
         let path = dir.join("demo_0.labels.csv");
-        let bad = |why: String| Error::BadInput {
-            path: path.clone(),
-            why,
-        };
-        let mut reader = csv::Reader::from_path(&path).map_err(|e| bad(e.to_string()))?;
-        let reference_labels = reader
-            .deserialize::<Label>()
-            .enumerate()
-            .map(|(k, r)| r.map_err(|e| bad(format!("row {}: {e}", k + 1))))
-            .collect::<Result<Vec<_>>>()?;
         let inputs = Self {
             demos,
-            reference_labels,
+            reference_labels: read_labels(&path)?,
         };
-        inputs.check().map_err(bad)?;
+        inputs
+            .check()
+            .map_err(|why| Error::BadInput { path, why })?;
         Ok(inputs)
     }
 
@@ -429,6 +421,24 @@ impl StudyInputs {
         }
         Ok(())
     }
+}
+
+/// Reads a labels file of the fixtures (`demo_<i>.labels.csv`: columns `pass, section,
+/// painted, phase`, one row per sample of demo `i`).
+///
+/// # Errors
+/// [`Error::BadInput`] naming the file (and the row) when it cannot be read or parsed.
+pub fn read_labels(path: &Path) -> Result<Vec<Label>> {
+    let bad = |why: String| Error::BadInput {
+        path: path.to_path_buf(),
+        why,
+    };
+    let mut reader = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
+    reader
+        .deserialize::<Label>()
+        .enumerate()
+        .map(|(k, r)| r.map_err(|e| bad(format!("row {}: {e}", k + 1))))
+        .collect()
 }
 
 /// Short name of a schedule's source for the records.
@@ -554,7 +564,9 @@ pub fn run_trial(
 /// Runs the study (§III): fits the model once, then runs the trials ([`run_trials`]).
 ///
 /// # Errors
-/// Invalid configuration or inputs, or any stage's error (the first trial's in order).
+/// Invalid configuration or inputs, a fit whose reference is not demo 0 (the labels are
+/// demo 0's; call [`run_trials`] with the reference's labels), or any stage's error (the
+/// first trial's in order).
 pub fn run_study(
     config: &StudyConfig,
     inputs: &StudyInputs,
@@ -567,6 +579,18 @@ pub fn run_study(
     })?;
     let t = Instant::now();
     let model = TaskModel::fit(&inputs.demos, &config.planner.fit)?;
+    if model.reference_idx() != 0 {
+        // The labels are demo 0's; another reference needs its own labels (`run_trials`).
+        return Err(Error::BadInput {
+            path: "<study inputs>".into(),
+            why: format!(
+                "the fit chose demo {} as the reference (fit.reference = {}), but the \
+                 ground-truth labels are demo 0's",
+                model.reference_idx(),
+                config.planner.fit.reference
+            ),
+        });
+    }
     model.prepare_corrections();
     let alignment = t.elapsed();
     let (result, mut times) = run_trials(config, &model, &inputs.reference_labels, progress)?;

@@ -96,3 +96,29 @@ fn same_seed_same_bytes_on_one_and_two_threads() {
     });
     assert_ne!(serde_json::to_string(&other).unwrap(), one);
 }
+
+/// `run_study` reads the ground truth of demo 0: a fit that chose another reference (the
+/// medoid of the fixtures is demo 2) is refused instead of pairing the model with the wrong
+/// labels; `run_trials` with the reference's own labels runs.
+#[test]
+fn a_study_needs_the_labels_of_its_reference() {
+    let (inputs, _) = common::fixtures();
+    let mut config = StudyConfig {
+        trials: 1,
+        executions: 2,
+        samples: 20,
+        ..StudyConfig::default()
+    };
+    config.planner.fit.reference = tandem::lfd::Reference::Medoid;
+    let e = tandem::study::run_study(&config, inputs, &|_| {}).unwrap_err();
+    assert!(
+        e.to_string().contains("chose demo 2 as the reference"),
+        "{e}"
+    );
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/sanding");
+    let labels = tandem::study::read_labels(&dir.join("demo_2.labels.csv")).unwrap();
+    let model = tandem::lfd::TaskModel::fit(&inputs.demos, &config.planner.fit).unwrap();
+    assert_eq!(model.n_ref(), labels.len());
+    let (result, _) = run_trials(&config, &model, &labels, &|_| {}).unwrap();
+    assert_eq!(result.n_ref, labels.len());
+}

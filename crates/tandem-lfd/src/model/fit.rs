@@ -1,0 +1,393 @@
+//! Fitting: checks of the demonstration set, the choice of the reference and the alignment
+//! to it (GDTW), and the batch statistics from the warps.
+
+use std::borrow::Cow;
+use std::cmp::Ordering;
+
+use rayon::prelude::*;
+
+use super::layout::{Item, Layout, quat_at};
+use super::stats::{batch_statistics, observe};
+use super::{FitParams, ModelData, Reference, TaskModel, check_dt};
+use crate::demo::Demonstration;
+use crate::{Error, Result};
+
+/// Checks the demonstration set; returns it with every channel order equal to demo 0's
+/// (borrowed when it already is).
+fn check_demos(demos: &[Demonstration]) -> Result<Cow<'_, [Demonstration]>> {
+    if demos.len() < 2 {
+        return Err(Error::TooFewDemonstrations { found: demos.len() });
+    }
+    let names = demos[0].channel_names();
+    let dt = demos[0].dt_s();
+    let mut reordered = false;
+    for demo in demos {
+        check_dt(demo, dt)?;
+        reordered |= matches!(demo.conform_to(names)?, Cow::Owned(_));
+    }
+    if !reordered {
+        return Ok(Cow::Borrowed(demos));
+    }
+    demos
+        .iter()
+        .map(|demo| Ok(demo.conform_to(names)?.into_owned()))
+        .collect::<Result<Vec<_>>>()
+        .map(Cow::Owned)
+}
+
+/// Checks warp `demo_idx` (`n_ref` values, monotone, inside `[0, T_i − 1]`).
+fn check_warp(demo_idx: usize, warp: &[f64], n_ref: usize, t_i: usize) -> Result<()> {
+    let bad = |why: String| Error::BadWarp { demo_idx, why };
+    if warp.len() != n_ref {
+        return Err(bad(format!(
+            "{} values for {n_ref} reference samples",
+            warp.len()
+        )));
+    }
+    let last = (t_i - 1) as f64;
+    let tol = 1e-9 * last.max(1.0);
+    for (n, &v) in warp.iter().enumerate() {
+        if !v.is_finite() || v < -tol || v > last + tol {
+            return Err(bad(format!(
+                "value {v} at reference sample {n} is outside [0, {last}]"
+            )));
+        }
+        if n > 0 && v < warp[n - 1] {
+            return Err(bad(format!("decreases at reference sample {n}")));
+        }
+    }
+    Ok(())
+}
+
+/// Every demonstration aligned to one reference (the alignment stage of a fit).
+struct Alignment {
+    /// Demonstration indices (into the caller's list) in model order, the reference first.
+    order: Vec<usize>,
+    /// The ranges of the non-rate coordinates the weights came from.
+    non_rate_ranges: Vec<f64>,
+    /// One warp per demonstration in model order (the reference's is the identity).
+    warps: Vec<Vec<f64>>,
+    /// Total GDTW objective of the non-reference alignments (Eq. 3), summed in ascending
+    /// order so that it does not depend on the order of the others.
+    cost: f64,
+}
+
+/// Aligns every demonstration of `demos` to `demos[order[0]]` with the weights the fit
+/// would derive with that reference; `order` lists the others in the order they enter the
+/// statistics.
+fn align_to(
+    demos: &[Demonstration],
+    order: Vec<usize>,
+    layout: &Layout,
+    params: &FitParams,
+) -> Result<Alignment> {
+    let reference = &demos[order[0]];
+    let d = layout.dim();
+    let non_rate_ranges = match &params.ranges {
+        Some(r) => r[..d - 1].to_vec(),
+        None => layout.channel_ranges(reference, demos, params.min_range),
+    };
+    let m = reference.n_channels();
+    let mut warp_params = params.warp.clone();
+    if warp_params.weights.is_none() {
+        warp_params.weights = Some(layout.warp_weights(&non_rate_ranges, m));
+    }
+    let reference_orientations = layout.first_orientations(reference);
+    let signals: Vec<Vec<f64>> = order
+        .par_iter()
+        .map(|&i| layout.sign_aligned(&demos[i], &reference_orientations))
+        .collect();
+    let refs = signals
+        .iter()
+        .map(|s| tandem_warp::SignalRef::new(s, m))
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let aligned = tandem_warp::align_many(refs[0], &refs[1..], &warp_params)?;
+    let mut objectives: Vec<f64> = aligned.iter().map(tandem_warp::Warp::objective).collect();
+    objectives.sort_by(f64::total_cmp);
+    let mut warps: Vec<Vec<f64>> = Vec::with_capacity(order.len());
+    warps.push((0..reference.n_samples()).map(|n| n as f64).collect());
+    warps.extend(aligned.iter().map(|w| w.values().to_vec()));
+    Ok(Alignment {
+        order,
+        non_rate_ranges,
+        warps,
+        cost: objectives.iter().sum(),
+    })
+}
+
+/// A fixed order of demonstrations by content (length, then samples, then period), for
+/// statistics that must not depend on the order the caller gave them in.
+fn content_order(a: &Demonstration, b: &Demonstration) -> Ordering {
+    a.n_samples()
+        .cmp(&b.n_samples())
+        .then_with(|| {
+            a.samples()
+                .iter()
+                .zip(b.samples())
+                .map(|(x, y)| x.total_cmp(y))
+                .find(|o| o.is_ne())
+                .unwrap_or(Ordering::Equal)
+        })
+        .then_with(|| a.dt_s().total_cmp(&b.dt_s()))
+}
+
+/// Every demonstration tried as the reference, in input order (the medoid's candidates).
+fn all_candidates(
+    demos: &[Demonstration],
+    layout: &Layout,
+    params: &FitParams,
+) -> Result<Vec<Alignment>> {
+    (0..demos.len())
+        .into_par_iter()
+        .map(|r| {
+            let mut others: Vec<usize> = (0..demos.len()).filter(|&i| i != r).collect();
+            others.sort_by(|&a, &b| content_order(&demos[a], &demos[b]));
+            let order = std::iter::once(r).chain(others).collect();
+            align_to(demos, order, layout, params)
+        })
+        .collect()
+}
+
+/// The alignment the fit uses: to demo 0 ([`Reference::First`]), or to each demonstration
+/// in turn keeping the cheapest ([`Reference::Medoid`]; ties go to the earlier one).
+fn choose_alignment(
+    demos: &[Demonstration],
+    layout: &Layout,
+    params: &FitParams,
+) -> Result<Alignment> {
+    match params.reference {
+        Reference::First => align_to(demos, (0..demos.len()).collect(), layout, params),
+        Reference::Medoid => Ok(all_candidates(demos, layout, params)?
+            .into_iter()
+            .reduce(|best, c| if c.cost < best.cost { c } else { best })
+            .expect("at least two demonstrations")),
+    }
+}
+
+/// The checks every fit starts with: parameters, the demonstration set (returned with
+/// demo 0's channel order), its tangent layout, quaternion norms, explicit ranges' length.
+fn checked<'a>(
+    demos: &'a [Demonstration],
+    params: &FitParams,
+) -> Result<(Cow<'a, [Demonstration]>, Layout)> {
+    params.validate()?;
+    let demos = check_demos(demos)?;
+    let layout = Layout::new(&demos[0], &params.schema)?;
+    for demo in demos.iter() {
+        layout.check_quaternion_norms(demo)?;
+    }
+    params.check_ranges_len(layout.dim())?;
+    Ok((demos, layout))
+}
+
+impl TaskModel {
+    /// Fits the model: chooses the reference ([`FitParams::reference`]: demo 0 by default,
+    /// or the medoid), aligns every demonstration to it with GDTW
+    /// (`tandem_warp::align_many`, in parallel), then computes the statistics as
+    /// [`TaskModel::fit_aligned`] does. `n_ref() = T_ref`, the reference's sample count;
+    /// [`TaskModel::reference_idx`] says which demonstration it was. The model's channel
+    /// order is demo 0's.
+    ///
+    /// # Errors
+    /// Fewer than 2 demonstrations, different channel sets or sample periods, a partial
+    /// quaternion block, a channel named like a derived coordinate, a zero quaternion, bad
+    /// parameters, alignment failure.
+    pub fn fit(demos: &[Demonstration], params: &FitParams) -> Result<Self> {
+        let (demos, layout) = checked(demos, params)?;
+        let alignment = choose_alignment(&demos, &layout, params)?;
+        let ordered: Vec<&Demonstration> = alignment.order.iter().map(|&i| &demos[i]).collect();
+        let mut model = Self::fit_from_warps(
+            &ordered,
+            &alignment.warps,
+            params,
+            layout,
+            alignment.non_rate_ranges,
+        )?;
+        model.data.reference_idx = alignment.order[0];
+        Ok(model)
+    }
+
+    /// Fits the model from known warps: `warps[i][n]` is demo `i`'s time (demo samples,
+    /// fractional) at reference sample `n`. Demo 0 is the reference (`warps[0]` is normally
+    /// the identity `0, 1, …, T_0 − 1`), so [`FitParams::reference`] must be
+    /// [`Reference::First`].
+    ///
+    /// Per reference sample it computes the mean `μ̂(n)`, the mean warp gradient and the
+    /// augmented mean `μ̂⁺` (Eq. 5), the weighted variance `σ²_D(n)` (Eq. 6) and the gradient
+    /// bounds (Eq. 14); the correction directions are computed on first use.
+    ///
+    /// # Errors
+    /// As [`TaskModel::fit`], plus a warp of the wrong length, non-finite, decreasing, or
+    /// outside `[0, T_i − 1]`, and [`Error::BadParam`] for another reference choice.
+    pub fn fit_aligned(
+        demos: &[Demonstration],
+        warps: &[Vec<f64>],
+        params: &FitParams,
+    ) -> Result<Self> {
+        if params.reference != Reference::First {
+            return Err(Error::BadParam {
+                name: "reference",
+                why: format!(
+                    "is `{}`, but fit_aligned takes warps onto demo 0 (use `first`)",
+                    params.reference
+                ),
+            });
+        }
+        let (demos, layout) = checked(demos, params)?;
+        let non_rate_ranges = match &params.ranges {
+            Some(r) => r[..r.len() - 1].to_vec(),
+            None => layout.channel_ranges(&demos[0], &demos, params.min_range),
+        };
+        let ordered: Vec<&Demonstration> = demos.iter().collect();
+        Self::fit_from_warps(&ordered, warps, params, layout, non_rate_ranges)
+    }
+
+    /// The medoid's criterion for every demonstration, in input order: the total GDTW
+    /// objective (Eq. 3, on normalized time) of aligning all the others to it, with the
+    /// weights it would have as the reference. [`Reference::Medoid`] picks the smallest;
+    /// how far apart the costs are says how clear that choice is. Ignores
+    /// [`FitParams::reference`].
+    ///
+    /// # Errors
+    /// As [`TaskModel::fit`].
+    pub fn reference_costs(demos: &[Demonstration], params: &FitParams) -> Result<Vec<f64>> {
+        let (demos, layout) = checked(demos, params)?;
+        Ok(all_candidates(&demos, &layout, params)?
+            .iter()
+            .map(|c| c.cost)
+            .collect())
+    }
+
+    /// The statistics of checked demonstrations, reference first, from their warps.
+    /// `non_rate_ranges`: the ranges of the non-rate coordinates (explicit or default).
+    fn fit_from_warps(
+        demos: &[&Demonstration],
+        warps: &[Vec<f64>],
+        params: &FitParams,
+        layout: Layout,
+        non_rate_ranges: Vec<f64>,
+    ) -> Result<Self> {
+        let n_ref = demos[0].n_samples();
+        if warps.len() != demos.len() {
+            return Err(Error::BadData {
+                what: "warps".into(),
+                why: format!("{} warps for {} demonstrations", warps.len(), demos.len()),
+            });
+        }
+        for (demo_idx, (warp, demo)) in warps.iter().zip(demos).enumerate() {
+            check_warp(demo_idx, warp, n_ref, demo.n_samples())?;
+        }
+        let d = layout.dim();
+        // Anchors: the reference's orientation at its aligned time, `n_ref × n_quat`.
+        let mut anchors = Vec::with_capacity(n_ref * layout.n_quat);
+        for &demo_t in &warps[0] {
+            for item in &layout.items {
+                if let Item::Quat(cols, _) = item {
+                    anchors.push(quat_at(demos[0], cols, demo_t));
+                }
+            }
+        }
+        let obs: Vec<Vec<f64>> = demos
+            .par_iter()
+            .zip(warps.par_iter())
+            .map(|(demo, warp)| observe(&layout, &anchors, demo, warp))
+            .collect();
+        let ranges = match &params.ranges {
+            Some(r) => r.clone(),
+            None => {
+                let mut r = non_rate_ranges;
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                for o in &obs {
+                    for g in o.iter().skip(d - 1).step_by(d) {
+                        lo = lo.min(*g);
+                        hi = hi.max(*g);
+                    }
+                }
+                let rate_range = hi - lo;
+                r.push(if rate_range < params.min_range {
+                    1.0
+                } else {
+                    rate_range
+                });
+                r
+            }
+        };
+        let stats = batch_statistics(&obs, n_ref, d);
+        let data = ModelData {
+            channel_names: demos[0].channel_names().to_vec(),
+            layout,
+            dt_s: demos[0].dt_s(),
+            n_ref,
+            reference_idx: 0,
+            k_max: params.k_max,
+            ranges,
+            anchors,
+            count: obs.len(),
+            tangent_mean: stats.tangent_mean,
+            scatter: stats.scatter,
+            grad_min: stats.grad_min,
+            grad_max: stats.grad_max,
+        };
+        Ok(Self::from_data(data))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{close, demo, three_demo_model, three_demos};
+    use super::*;
+
+    #[test]
+    fn hand_derived_statistics() {
+        let model = three_demo_model();
+        assert_eq!(model.n_ref(), 3);
+        assert_eq!(model.tangent_names(), ["force", "rate"]);
+        // Force range 20 N; gradients {1, 1.5, 2.5} → rate range 1.5.
+        assert_eq!(model.ranges(), [20.0, 1.5]);
+        // n = 1: forces 10, 7.5, 10 (demo 1 at its time 1.5); gradients 1, 2.5, 1.
+        assert!(close(model.mean()[1], 55.0 / 6.0));
+        assert!(close(model.grad_mean()[1], 1.5));
+        assert_eq!((model.grad_min()[1], model.grad_max()[1]), (1.0, 2.5));
+        // σ²_D = [ (25+100+25)/36 / 20² + 1.5 / 1.5² ] / 2 = (1/96 + 2/3) / 2 = 65/192.
+        assert!(close(model.sigma2_d()[1], 65.0 / 192.0));
+        // n = 0: forces all 0, gradients 1, 1.5, 1 → rate residuals −1/6, 1/3, −1/6.
+        assert!(close(model.grad_mean()[0], 7.0 / 6.0));
+        assert!(close(model.sigma2_d()[0], (1.0 / 6.0) / 2.25 / 2.0));
+        // n = 2: last gradient repeats the previous: 1, 2.5, 1.
+        assert_eq!(model.grad_max()[2], 2.5);
+        assert_eq!(model.n_components(), 2);
+    }
+
+    #[test]
+    fn bad_fits_are_errors() {
+        let (demos, warps) = three_demos();
+        let p = FitParams::default();
+        assert!(matches!(
+            TaskModel::fit_aligned(&demos[..1], &warps[..1], &p),
+            Err(Error::TooFewDemonstrations { found: 1 })
+        ));
+        let mut w = warps.clone();
+        w[1] = vec![0.0, 3.0, 2.0];
+        assert!(matches!(
+            TaskModel::fit_aligned(&demos, &w, &p),
+            Err(Error::BadWarp { demo_idx: 1, .. })
+        ));
+        w[1] = vec![0.0, 1.0, 4.5];
+        assert!(matches!(
+            TaskModel::fit_aligned(&demos, &w, &p),
+            Err(Error::BadWarp { demo_idx: 1, .. })
+        ));
+        let bad = FitParams {
+            k_max: 0,
+            ..FitParams::default()
+        };
+        assert!(matches!(
+            TaskModel::fit_aligned(&demos, &warps, &bad),
+            Err(Error::BadParam { name: "k_max", .. })
+        ));
+        // A partial quaternion block is rejected.
+        let q = demo(&["qx", "qy", "qz"], vec![0.0; 6]);
+        let id = vec![0.0, 1.0];
+        assert!(TaskModel::fit_aligned(&[q.clone(), q], &[id.clone(), id], &p).is_err());
+    }
+}

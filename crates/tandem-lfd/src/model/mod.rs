@@ -1,0 +1,340 @@
+//! The aligned task model (paper §II-B1/B2): mean behaviour, augmented mean (Eq. 5),
+//! variance (Eq. 6), gradient bounds (Eq. 14), admissible corrections and commands (Eq. 7),
+//! incremental updates with executions (Eq. 21).
+//!
+//! # Coordinates
+//!
+//! Statistics live in the *tangent layout* of dimension `d = m − 3·(quaternion blocks) + 1`:
+//! the channels in column order, where each quaternion block is replaced (at the position
+//! of its first channel) by the 3 components of its rotation vector relative to a per
+//! reference-sample anchor orientation, followed by the warp gradient `ψ̇` ("rate", demo
+//! samples per reference sample). See [`TaskModel::tangent_names`].
+//!
+//! # Quaternion statistics
+//!
+//! The anchor `q_a(n)` at reference sample `n` is the reference demonstration's orientation
+//! at its aligned time `ψ_0(n)`, fixed at fit time.
+//! Each orientation `q` enters the statistics as `r = log(q_a⁻¹ ⊗ q)` (the shortest rotation
+//! vector, so `q` and `−q` give the same `r`). The mean orientation is `q_a ⊗ exp(r̄)`, with
+//! `r̄` the mean rotation vector; residuals are `r − r̄`. Because the anchor never changes,
+//! these are ordinary vector statistics: an [`TaskModel::update`] equals a refit on the same
+//! aligned data exactly (up to rounding). For the small orientation spreads of one task
+//! instant, `q_a ⊗ exp(r̄)` agrees with the Karcher mean to second order in the spread.
+//!
+//! # Files
+//!
+//! `params.rs`: [`FitParams`]. `layout.rs`: the tangent layout and what reads a
+//! demonstration through it. `fit.rs`: checks, alignment, statistics from warps.
+//! `stats.rs`: per sample sufficient statistics and derived arrays. `execution.rs`:
+//! [`Execution`] and the update (Eq. 21). `corrections.rs`: [`Corrections`] and the
+//! command (Eq. 7).
+//!
+//! # Names
+//!
+//! A per reference-sample array keeps its plain name for the whole array (`anchors`,
+//! `tangent_mean`, `scatter`: `n_ref` rows); the slice of it at one reference sample `n`
+//! carries the suffix `_n` (`anchors_n`, `mean_n`, `scatter_n`); a value interpolated at a
+//! fractional reference time carries `_t` (`comps_t`). A warp (`warp`, `warps[i]`) is the
+//! demo time (demo samples, fractional) at every reference sample. `d` is the tangent
+//! dimension, `m` the channel count, `coord` an index into the tangent layout.
+
+use std::sync::OnceLock;
+
+use serde::{Deserialize, Serialize};
+
+use crate::demo::{DT_TOLERANCE, Demonstration};
+use crate::quat::Quat;
+use crate::{Error, Result};
+
+mod corrections;
+mod execution;
+mod fit;
+mod layout;
+mod params;
+mod stats;
+
+pub use corrections::Corrections;
+pub use execution::Execution;
+pub use params::{FitParams, Reference};
+
+use corrections::CorrectionTable;
+use layout::Layout;
+use stats::packed_len;
+
+/// Sufficient statistics and derived arrays of the aligned task model.
+///
+/// All per-time arrays are indexed by reference sample `n ∈ 0..n_ref()` (period
+/// [`TaskModel::dt_s`]). Serialized form: the sufficient statistics only; derived arrays are
+/// recomputed on load and the corrections lazily on first use.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(try_from = "ModelData", into = "ModelData")]
+pub struct TaskModel {
+    data: ModelData,
+    mean: Vec<f64>,
+    grad_mean: Vec<f64>,
+    sigma2_d: Vec<f64>,
+    corrections: OnceLock<CorrectionTable>,
+}
+
+/// The persisted part of a [`TaskModel`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModelData {
+    channel_names: Vec<String>,
+    layout: Layout,
+    dt_s: f64,
+    n_ref: usize,
+    /// Index of the reference among the demonstrations given to the fit.
+    reference_idx: usize,
+    k_max: usize,
+    ranges: Vec<f64>,
+    /// `n_ref × n_quat` anchor quaternions `[x, y, z, w]`.
+    anchors: Vec<Quat>,
+    count: usize,
+    /// `n_ref × d` means in the tangent layout.
+    tangent_mean: Vec<f64>,
+    /// `n_ref × d(d+1)/2` packed upper-triangular scatter matrices `Σ_i e_i e_iᵀ`.
+    scatter: Vec<f64>,
+    grad_min: Vec<f64>,
+    grad_max: Vec<f64>,
+}
+
+impl TryFrom<ModelData> for TaskModel {
+    type Error = Error;
+    fn try_from(data: ModelData) -> Result<Self> {
+        let d = data.layout.dim();
+        let n = data.n_ref;
+        let ok = n >= 2
+            && data.count >= 2
+            && data.k_max >= 1
+            && data.dt_s.is_finite()
+            && data.dt_s > 0.0
+            && data.ranges.len() == d
+            && data.anchors.len() == n * data.layout.n_quat
+            && data.tangent_mean.len() == n * d
+            && data.scatter.len() == n * packed_len(d)
+            && data.grad_min.len() == n
+            && data.grad_max.len() == n
+            && data.layout.fits(data.channel_names.len())
+            && data.ranges.iter().all(|r| r.is_finite() && *r > 0.0)
+            && data
+                .tangent_mean
+                .iter()
+                .chain(&data.scatter)
+                .all(|v| v.is_finite())
+            && data.anchors.iter().flatten().all(|v| v.is_finite());
+        if !ok {
+            return Err(Error::BadData {
+                what: "task model".into(),
+                why: "inconsistent shapes or non-finite values in persisted model".into(),
+            });
+        }
+        Ok(Self::from_data(data))
+    }
+}
+
+impl From<TaskModel> for ModelData {
+    fn from(model: TaskModel) -> Self {
+        model.data
+    }
+}
+
+/// `(lo, hi, alpha)` with `t = lo + alpha`, clamped to `[0, n − 1]`.
+fn bracket(t: f64, n: usize) -> (usize, usize, f64) {
+    let t = t.clamp(0.0, (n - 1) as f64);
+    let lo = (t.floor() as usize).min(n - 1);
+    let hi = (lo + 1).min(n - 1);
+    (lo, hi, t - lo as f64)
+}
+
+/// Reference samples per parallel work item in per-sample loops (results do not depend
+/// on the split).
+const PAR_MIN_LEN: usize = 512;
+
+/// Rejects a demonstration whose sample period differs from `dt_ref` by more than 1 %.
+fn check_dt(demo: &Demonstration, dt_ref: f64) -> Result<()> {
+    if (demo.dt_s() - dt_ref).abs() > DT_TOLERANCE * dt_ref {
+        return Err(Error::SamplePeriodMismatch {
+            file: demo.source().into(),
+            expected_s: dt_ref,
+            found_s: demo.dt_s(),
+        });
+    }
+    Ok(())
+}
+
+impl TaskModel {
+    fn from_data(data: ModelData) -> Self {
+        let mut model = Self {
+            data,
+            mean: Vec::new(),
+            grad_mean: Vec::new(),
+            sigma2_d: Vec::new(),
+            corrections: OnceLock::new(),
+        };
+        model.refresh_derived();
+        model
+    }
+
+    /// Number of reference samples `T_ref` (the length of every per-time array).
+    pub fn n_ref(&self) -> usize {
+        self.data.n_ref
+    }
+
+    /// Index of the reference demonstration (whose samples are the time axis) among the
+    /// demonstrations given to [`TaskModel::fit`] (see [`FitParams::reference`]); 0 after
+    /// [`TaskModel::fit_aligned`].
+    pub fn reference_idx(&self) -> usize {
+        self.data.reference_idx
+    }
+
+    /// Reference sample period `Δt_s`, seconds.
+    pub fn dt_s(&self) -> f64 {
+        self.data.dt_s
+    }
+
+    /// Channel names `m`, in the order of [`TaskModel::mean`]'s rows.
+    pub fn channel_names(&self) -> &[String] {
+        &self.data.channel_names
+    }
+
+    /// Names of the `d` tangent coordinates (statistics, ranges, corrections): scalar
+    /// channels by name, quaternion blocks as `<block>.rx/.ry/.rz`, then `rate`.
+    pub fn tangent_names(&self) -> &[String] {
+        &self.data.layout.names
+    }
+
+    /// Number of demonstrations and executions in the statistics `n`.
+    pub fn count(&self) -> usize {
+        self.data.count
+    }
+
+    /// Mean behaviour `μ̂(n)`, sample-major `n_ref × m` in channel units (reference time);
+    /// quaternions unit-norm.
+    pub fn mean(&self) -> &[f64] {
+        &self.mean
+    }
+
+    /// Weighted demonstration variance `σ²_D(n)` (Eq. 6), dimensionless, per reference sample.
+    pub fn sigma2_d(&self) -> &[f64] {
+        &self.sigma2_d
+    }
+
+    /// Mean warp gradient `ψ̄̇_D(n)` (Eq. 5), demo samples per reference sample.
+    pub fn grad_mean(&self) -> &[f64] {
+        &self.grad_mean
+    }
+
+    /// Minimum warp gradient `ψ̇min(n)` (Eq. 14), demo samples per reference sample.
+    pub fn grad_min(&self) -> &[f64] {
+        &self.data.grad_min
+    }
+
+    /// Maximum warp gradient `ψ̇max(n)` (Eq. 14), demo samples per reference sample.
+    pub fn grad_max(&self) -> &[f64] {
+        &self.data.grad_max
+    }
+
+    /// Ranges `r_j` of the tangent coordinates; `W⁺ = diag(1/r_j²)`.
+    pub fn ranges(&self) -> &[f64] {
+        &self.data.ranges
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quat;
+
+    pub(super) fn demo(names: &[&str], samples: Vec<f64>) -> Demonstration {
+        Demonstration::new(names.iter().map(|s| s.to_string()).collect(), samples, 0.01).unwrap()
+    }
+
+    pub(super) fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-12 * (1.0 + b.abs())
+    }
+
+    /// Demo 1 is demo 0 played at varying speed; warp values given.
+    pub(super) fn three_demos() -> (Vec<Demonstration>, Vec<Vec<f64>>) {
+        let d0 = demo(&["force"], vec![0.0, 10.0, 20.0]);
+        let d1 = demo(&["force"], vec![0.0, 5.0, 10.0, 15.0, 20.0]);
+        (
+            vec![d0.clone(), d1, d0],
+            vec![
+                vec![0.0, 1.0, 2.0],
+                vec![0.0, 1.5, 4.0],
+                vec![0.0, 1.0, 2.0],
+            ],
+        )
+    }
+
+    /// The model of [`three_demos`] with the default parameters.
+    pub(super) fn three_demo_model() -> TaskModel {
+        let (demos, warps) = three_demos();
+        TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap()
+    }
+
+    /// The model of two 2-sample demonstrations holding the constant orientations `a` and
+    /// `b` (channels `qx, qy, qz, qw`), identity warps.
+    fn constant_orientations_model(a: quat::Quat, b: quat::Quat) -> TaskModel {
+        let quat_demo = |q: quat::Quat| demo(&["qx", "qy", "qz", "qw"], [q, q].concat());
+        let id = vec![0.0, 1.0];
+        TaskModel::fit_aligned(
+            &[quat_demo(a), quat_demo(b)],
+            &[id.clone(), id],
+            &FitParams::default(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn quaternion_mean_of_q_and_minus_q_is_q() {
+        let q = quat::exp(&[0.1, -0.2, 0.3]);
+        let model = constant_orientations_model(q, q.map(|v| -v));
+        assert_eq!(model.tangent_names(), ["q.rx", "q.ry", "q.rz", "rate"]);
+        for n in 0..2 {
+            let got = &model.mean()[n * 4..(n + 1) * 4];
+            for k in 0..4 {
+                assert!((got[k] - q[k]).abs() < 1e-12, "{got:?} vs {q:?}");
+            }
+            assert!(model.sigma2_d()[n].abs() < 1e-20);
+        }
+    }
+
+    #[test]
+    fn quaternion_mean_of_opposite_turns_is_between() {
+        // ±0.2 rad about z: the mean is the identity; residuals ±0.2 rad about z.
+        let a = quat::exp(&[0.0, 0.0, 0.2]);
+        let b = quat::exp(&[0.0, 0.0, -0.2]);
+        let model = constant_orientations_model(a, b);
+        let mean = &model.mean()[0..4];
+        assert!(
+            mean.iter()
+                .zip(quat::IDENTITY)
+                .all(|(x, y)| (x - y).abs() < 1e-12)
+        );
+        // Range: rotation vectors relative to demo 0's first orientation span 0.4 rad.
+        assert!(close(model.ranges()[2], 0.4));
+        // σ²_D = 2·0.2² / 0.4² / 1 = 0.5.
+        assert!(close(model.sigma2_d()[0], 0.5));
+        // The command at u = 1 turns the mean by +3σ = 3·0.2 rad about ±z.
+        let cmd = model.command(&[1.0], 0.0).unwrap();
+        let r = quat::log(&[cmd[0], cmd[1], cmd[2], cmd[3]]);
+        assert!(close(r[2].abs(), 0.6) && r[0].abs() < 1e-12);
+    }
+
+    #[test]
+    fn serde_round_trip_keeps_statistics() {
+        let model = three_demo_model();
+        let json = serde_json::to_string(&model).unwrap();
+        let back: TaskModel = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.sigma2_d(), model.sigma2_d());
+        assert_eq!(back.mean(), model.mean());
+        assert_eq!(
+            back.command(&[0.5, -0.5], 1.3).unwrap(),
+            model.command(&[0.5, -0.5], 1.3).unwrap()
+        );
+        let broken = json.replace("\"n_ref\":3", "\"n_ref\":4");
+        assert!(serde_json::from_str::<TaskModel>(&broken).is_err());
+    }
+}
