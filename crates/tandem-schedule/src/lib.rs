@@ -26,11 +26,16 @@
 //! # Ok::<(), tandem_schedule::Error>(())
 //! ```
 
+mod exact;
 mod problem;
 mod sampler;
 mod schedule;
 mod validate;
 
+pub use exact::{
+    Certificate, CertifiedSource, ExactParams, MarginFree, SearchStats, certify, earliest_schedule,
+    solve_exact,
+};
 pub use problem::{Problem, Run};
 pub use sampler::{
     Distribution, OffsetSampling, Outcome, SamplerParams, SamplerStats, Source, sample_schedule,
