@@ -19,7 +19,7 @@ const FIRST_CLEARANCE_M: f64 = 2.0;
 /// Bisection steps on the uniform clearance once a passing one is known.
 const UNIFORM_STEPS: usize = 3;
 /// Bisection rounds of the per-pair clearances.
-const PAIR_ROUNDS: usize = 5;
+const PAIR_ROUNDS: usize = 4;
 
 /// A schedule the margin check accepted, with its `T_total` (s).
 #[derive(Clone, Debug)]
@@ -102,6 +102,19 @@ impl<'a> Completion<'a> {
         order: Option<&[Robot]>,
         cap_s: f64,
     ) -> Option<Candidate> {
+        self.candidate_upto(clear, order, cap_s, None)
+    }
+
+    /// [`Completion::candidate`]; with `keep = Some(((r, k), base))`, only the HC runs entered
+    /// before robot `r`'s LC run `k` starts (plus the shaping window) are shaped, the later ones
+    /// keep `base`'s gradients (enough for the margin check of the LC runs up to that one).
+    fn candidate_upto(
+        &self,
+        clear: Clearance,
+        order: Option<&[Robot]>,
+        cap_s: f64,
+        keep: Option<((usize, usize), &Schedule)>,
+    ) -> Option<Candidate> {
         let order = match order {
             Some(o) => o.to_vec(),
             None => match search::search(self.chain, &clear, cap_s, self.max_pieces).0 {
@@ -110,7 +123,8 @@ impl<'a> Completion<'a> {
             },
         };
         let times = stn::earliest(self.chain, &order, &clear)?;
-        let schedule = shaped_schedule(self.problem, self.chain, &times, &self.knobs);
+        let keep = keep.map(|((r, k), base)| (times.lc_start_s[r][k] + self.knobs.window_s, base));
+        let schedule = shaped_schedule(self.problem, self.chain, &times, &self.knobs, keep);
         Some(Candidate {
             clear,
             order,
@@ -176,7 +190,7 @@ impl<'a> Completion<'a> {
                 .par_iter()
                 .map(|&d| {
                     let c = self.candidate(self.uniform(d), None, cap_s)?;
-                    let ok = self.valid(&c);
+                    let ok = self.margins_pass(&c, None);
                     Some((c, ok))
                 })
                 .collect();
@@ -205,7 +219,7 @@ impl<'a> Completion<'a> {
                 match self.candidate(self.uniform(mid), None, cap_s) {
                     Some(c) => {
                         self.checks += 1;
-                        if self.valid(&c) {
+                        if self.margins_pass(&c, None) {
                             pass = Some((mid, c));
                             break;
                         }
@@ -227,7 +241,7 @@ impl<'a> Completion<'a> {
             let mid = 0.5 * (fail + pass_delta);
             self.checks += 1;
             match self.candidate(self.uniform(mid), None, cap_s) {
-                Some(c) if self.valid(&c) => {
+                Some(c) if self.margins_pass(&c, None) => {
                     pass_delta = mid;
                     best = c;
                 }
@@ -238,6 +252,11 @@ impl<'a> Completion<'a> {
         // (each on the margin check of the LC runs up to its own), while the budget lasts.
         if refine && let Some(better) = self.refine(&best, &pairs, m_step, budget) {
             best = better;
+        }
+        // Constraints 1–4 hold by construction (earliest times, gradients in bounds, the mean
+        // on LC samples); the full check confirms it, and the margins.
+        if !self.valid(&best) {
+            return None;
         }
         let t = best.schedule.t_total_s(dt);
         (t < cap_s).then_some(Completed {
@@ -302,8 +321,10 @@ impl<'a> Completion<'a> {
                 .map(|i| {
                     let mut vals = hi.clone();
                     vals[i] = 0.5 * (lo[i] + hi[i]);
-                    self.candidate(with(&vals), Some(&best.order), f64::INFINITY)
-                        .is_some_and(|c| self.margins_pass(&c, Some(pairs[i].0)))
+                    let (q, r, k) = pairs[i];
+                    let keep = Some(((r, k), &best.schedule));
+                    self.candidate_upto(with(&vals), Some(&best.order), f64::INFINITY, keep)
+                        .is_some_and(|c| self.margins_pass(&c, Some(q)))
                 })
                 .collect();
             self.checks += pairs.len();

@@ -56,11 +56,15 @@ fn other_stretches(times: &Times, chain: &Chain, other: usize, k: &Shaping) -> V
 }
 
 /// The schedule with event times `times` and shaped HC speeds (LC samples at the mean).
+///
+/// With `keep = Some((t_s, base))`, HC runs entered at or after global time `t_s` keep
+/// `base`'s gradients instead (for a margin check that only looks at what comes before).
 pub(crate) fn shaped_schedule(
     problem: &Problem,
     chain: &Chain,
     times: &Times,
     knobs: &Shaping,
+    keep: Option<(f64, &Schedule)>,
 ) -> Schedule {
     let warps = [0, 1].map(|r| {
         let stretches = other_stretches(times, chain, 1 - r, knobs);
@@ -75,6 +79,12 @@ pub(crate) fn shaped_schedule(
             } else {
                 times.lc_start_s[r][g - 1] + chain.lc_s[g - 1]
             };
+            if let Some((t_keep, base)) = keep
+                && t0 >= t_keep
+            {
+                warp[a..b].copy_from_slice(&base.grad_exec[r][a..b]);
+                continue;
+            }
             let post_slow = (g > 0).then(|| problem.grad_mean()[a - 1] / problem.grad_max()[a - 1]);
             let run = Run {
                 problem,
