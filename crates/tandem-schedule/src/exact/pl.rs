@@ -125,6 +125,46 @@ fn push(out: &mut Vec<Piece>, p: Piece) {
     out.push(p);
 }
 
+/// The sorted, distinct end points of the pieces of `f` and `g`: each function's end points
+/// come sorted (pieces sorted by `lo` with disjoint interiors) except for isolated points
+/// inside another piece, so two sorted runs are merged and only those stragglers sorted in.
+fn breakpoints(f: &[Piece], g: &[Piece]) -> Vec<f64> {
+    let ends = |h: &[Piece]| -> (Vec<f64>, bool) {
+        let mut v = Vec::with_capacity(2 * h.len());
+        let mut sorted = true;
+        for p in h {
+            if v.last().is_some_and(|&x| p.lo < x) {
+                sorted = false;
+            }
+            v.push(p.lo);
+            v.push(p.hi);
+        }
+        (v, sorted)
+    };
+    let ((mut a, sa), (mut b, sb)) = (ends(f), ends(g));
+    if !sa {
+        a.sort_unstable_by(f64::total_cmp);
+    }
+    if !sb {
+        b.sort_unstable_by(f64::total_cmp);
+    }
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() || j < b.len() {
+        let x = if j >= b.len() || (i < a.len() && a[i] <= b[j]) {
+            i += 1;
+            a[i - 1]
+        } else {
+            j += 1;
+            b[j - 1]
+        };
+        if out.last() != Some(&x) {
+            out.push(x);
+        }
+    }
+    out
+}
+
 /// Pointwise minimum of two functions (ties go to `f`).
 pub(crate) fn min_of(f: &[Piece], g: &[Piece]) -> Vec<Piece> {
     if f.is_empty() {
@@ -133,9 +173,7 @@ pub(crate) fn min_of(f: &[Piece], g: &[Piece]) -> Vec<Piece> {
     if g.is_empty() {
         return f.to_vec();
     }
-    let mut xs: Vec<f64> = f.iter().chain(g).flat_map(|p| [p.lo, p.hi]).collect();
-    xs.sort_unstable_by(f64::total_cmp);
-    xs.dedup();
+    let xs = breakpoints(f, g);
     let mut out: Vec<Piece> = Vec::with_capacity(f.len() + g.len());
     let (mut i, mut j) = (0, 0);
     for w in xs.windows(2) {
@@ -281,6 +319,30 @@ pub(crate) fn restrict(f: &[Piece], lo: f64, hi: f64, cap: f64) -> Vec<Piece> {
             continue;
         }
         if a > b || (p.slope != 0.0 && p.sub(a, b).min_value() > cap) {
+            continue;
+        }
+        out.push(p.sub(a, b));
+    }
+    out
+}
+
+/// `f` restricted to where `f(x) − x ≤ cap` (the search's bound on the other robot's free
+/// time `value − lead`).
+pub(crate) fn restrict_lagging(f: &[Piece], cap: f64) -> Vec<Piece> {
+    let mut out = Vec::with_capacity(f.len());
+    for p in f {
+        // f(x) − x has slope `slope − 1` on the piece.
+        let s = p.slope - 1.0;
+        let g0 = p.at_lo - p.lo;
+        let (mut a, mut b) = (p.lo, p.hi);
+        if s > 0.0 {
+            b = b.min(p.lo + (cap - g0) / s);
+        } else if s < 0.0 {
+            a = a.max(p.lo + (cap - g0) / s);
+        } else if g0 > cap {
+            continue;
+        }
+        if a > b {
             continue;
         }
         out.push(p.sub(a, b));

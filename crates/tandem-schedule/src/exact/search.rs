@@ -91,10 +91,13 @@ pub(crate) fn search(
     let tol = 1e-9 * (1.0 + slowest);
     let cap = cap + tol;
     // Largest value a state may keep: T ≥ value + rest, rest from the machine and the robot.
-    let value_cap = |i: usize, j: usize, last: usize| {
+    // Largest value (free time of the last robot) and largest free time of the other robot
+    // (value − d) a state may keep: T ≥ value + rest of the operator's LC time and tail,
+    // T ≥ value + the last robot's fastest rest, T ≥ (value − d) + the other's fastest rest.
+    let caps = |i: usize, j: usize, last: usize| {
         let (mine, other) = if last == 0 { (i, j) } else { (j, i) };
         let machine = rest_lc[mine] + rest_lc[other] + tail_a;
-        cap - machine.max(rest_robot[mine])
+        (cap - machine.max(rest_robot[mine]), cap - rest_robot[other])
     };
 
     let n_states = (m + 1) * (m + 1) * 2;
@@ -112,6 +115,21 @@ pub(crate) fn search(
                     continue;
                 }
                 let k = mine - 1;
+                // Predecessors: (same robot before, other robot before); skip unreachable states.
+                let pred = if last == 0 { (i - 1, j) } else { (i, j - 1) };
+                let same_n = if mine >= 2 {
+                    span[sidx(m, pred.0, pred.1, last)].1
+                } else {
+                    0
+                };
+                let cross_n = if other >= 1 {
+                    span[sidx(m, pred.0, pred.1, 1 - last)].1
+                } else {
+                    0
+                };
+                if same_n == 0 && cross_n == 0 && !(mine == 1 && other == 0) {
+                    continue;
+                }
                 let (a, b) = gap[k];
                 let (lo_a, lo_b) = (a + l[k], b + l[k]);
                 let delta = clear.before[last][k];
@@ -163,7 +181,9 @@ pub(crate) fn search(
                 } else {
                     f64::INFINITY
                 };
-                let f = pl::restrict(&f, f64::NEG_INFINITY, hi, value_cap(i, j, last));
+                let (value_cap, other_cap) = caps(i, j, last);
+                let f = pl::restrict(&f, f64::NEG_INFINITY, hi, value_cap);
+                let f = pl::restrict_lagging(&f, other_cap);
                 counts.states += usize::from(!f.is_empty());
                 counts.pieces += f.len();
                 if counts.pieces > budget {
