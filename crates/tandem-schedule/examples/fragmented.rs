@@ -5,7 +5,8 @@
 //! cargo run --release -p tandem-schedule --example fragmented [-- --write DIR]
 //! ```
 //!
-//! The gradients are those of `fixtures/sanding/problem.csv`; the confidence mimics a study
+//! The gradients are those of `fixtures/sanding/problem.csv`; `fixture` is that problem itself
+//! (all sanding of passes 1–3 low-confidence). The other confidences mimic a study
 //! half-way through (docs/study.md: 15–257 LC runs per robot between iterations 10 and 75):
 //! the painted sections of passes 1–3 (labels of the reference demonstration,
 //! `fixtures/sanding/demo_0.labels.csv`) stay low-confidence, and each other sample of passes
@@ -31,7 +32,8 @@ use tandem_schedule::{ExactParams, Problem, SamplerParams, certify, sample_sched
 const DT_S: f64 = 0.01;
 
 /// The problems: name, `p_sanding`, `p_transition`, seed.
-const CASES: [(&str, f64, f64, u64); 8] = [
+const CASES: [(&str, f64, f64, u64); 9] = [
+    ("fixture", 1.0, 0.0, 0),
     ("painted", 0.0, 0.0, 1),
     ("islands_1pct", 0.01, 0.0, 2),
     ("islands_3pct", 0.03, 0.002, 3),
@@ -150,7 +152,7 @@ fn main() -> Result<(), String> {
             sample_schedule(&p, &SamplerParams::default(), None).map_err(|e| e.to_string())?;
         let sampler_ms = t.elapsed().as_secs_f64() * 1e3;
         println!(
-            "| {name} | {} | {:.3} | {} | {} | {search_ms:.1} | {:.3} | {:.2} % | {certify_ms:.1} | {:.3} | {sampler_ms:.1} |",
+            "| {name} | {} | {:.6} | {} | {} | {search_ms:.1} | {:.3} | {:.2} % | {certify_ms:.1} | {:.3} | {sampler_ms:.1} |",
             free.stats.lc_runs,
             free.lower_bound_s,
             if free.proven_optimal { "yes" } else { "no" },
