@@ -125,28 +125,23 @@ def solve_highs(lc, gaps, time_limit, threads):
         val = [v for _, v in coefs]
         h.addRow(lo, hi, len(idx), idx, val)
 
+    def after(prev, prev_len, g):
+        """A new time at a lag in gap g's range after prev (robot 1's start 0 when None)."""
+        x = var(0.0, inf)
+        lo, hi = prev_len + gaps[g][0], prev_len + gaps[g][1]
+        row(lo, hi, [(x, 1.0)] + ([] if prev is None else [(prev, -1.0)]))
+        return x
+
     tau = var(0.0, inf)
     starts, ends = [], []
     for r in range(2):
         prev, prev_len = (None, 0.0) if r == 0 else (tau, 0.0)
         st = []
         for k in range(m):
-            s = var(0.0, inf)
-            lo, hi = prev_len + gaps[k][0], prev_len + gaps[k][1]
-            if prev is None:
-                row(lo, hi, [(s, 1.0)])
-            else:
-                row(lo, hi, [(s, 1.0), (prev, -1.0)])
-            st.append(s)
-            prev, prev_len = s, lc[k]
-        e = var(0.0, inf)
-        lo, hi = prev_len + gaps[m][0], prev_len + gaps[m][1]
-        if prev is None:
-            row(lo, hi, [(e, 1.0)])
-        else:
-            row(lo, hi, [(e, 1.0), (prev, -1.0)])
+            st.append(after(prev, prev_len, k))
+            prev, prev_len = st[-1], lc[k]
         starts.append(st)
-        ends.append(e)
+        ends.append(after(prev, prev_len, m))
     row(-inf, 0.0, [(tau, 1.0), (ends[0], -1.0)])
     t = var(0.0, inf)
     for e in ends:

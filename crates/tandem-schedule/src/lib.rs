@@ -26,7 +26,7 @@
 //! # Ok::<(), tandem_schedule::Error>(())
 //! ```
 
-mod exact;
+pub mod exact;
 mod problem;
 mod sampler;
 mod schedule;

@@ -55,6 +55,10 @@ pub(crate) struct Completion<'a> {
 }
 
 impl<'a> Completion<'a> {
+    /// The completion of `problem` (whose chain is `chain`) for the margin check at `tick_s`
+    /// (s). `M = tick_s·F*` with `F*` the largest `F = ψ̇̄/ψ̇min` of an LC sample, which the
+    /// shaping keeps as the largest `F` of any sample unless a run's duration needs more; the
+    /// shaping's knobs are multiples of `M` (tuned on the fixture problem, docs/decisions.md).
     pub(crate) fn new(
         problem: &'a Problem,
         chain: &'a Chain,
