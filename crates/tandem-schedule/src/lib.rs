@@ -32,12 +32,17 @@
 //! ```
 
 mod error;
+pub mod exact;
 mod problem;
 mod sampler;
 mod schedule;
 mod validate;
 
 pub use error::{Error, Result};
+pub use exact::{
+    Certificate, CertifiedSource, ExactParams, MarginFree, SearchStats, certify, earliest_schedule,
+    solve_exact,
+};
 pub use problem::Problem;
 pub use sampler::{
     DrawnOffset, Outcome, SamplerBaselines, SamplerParams, SamplerStats, Source, sample_schedule,
