@@ -29,7 +29,6 @@ struct Grid {
 impl Grid {
     #[inline]
     fn cand(&self, i: usize, j: usize) -> f64 {
-        #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
         let jf = j as f64;
         self.lo[i] + jf * self.step[i]
     }
@@ -55,10 +54,6 @@ fn band(prep: &Prepared<'_>, s_min: f64, s_max: f64, n: usize) -> (f64, f64) {
     if n == prep.nr - 1 {
         return (prep.qscale, prep.qscale);
     }
-    #[expect(
-        clippy::cast_precision_loss,
-        reason = "sample counts are far below 2^52"
-    )]
     let t = n as f64 * prep.h;
     let l = (s_min * t).max(1.0 - s_max * (1.0 - t)).clamp(0.0, 1.0);
     let u = (s_max * t).min(1.0 - s_min * (1.0 - t)).clamp(0.0, 1.0);
@@ -78,23 +73,12 @@ fn first_grid(prep: &Prepared<'_>, nodes: Vec<usize>, m: usize, s: (f64, f64)) -
     };
     for i in 0..n {
         let (l, u) = band(prep, s.0, s.1, g.nodes[i]);
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let c = (g.nodes[i] as f64 * prep.h * prep.qscale).clamp(l, u);
         g.lo[i] = c;
         if u - l > 1e-9 {
-            #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
             let step = (u - l) / (m - 1) as f64;
-            #[expect(
-                clippy::cast_possible_truncation,
-                clippy::cast_sign_loss,
-                reason = "non-negative step counts bounded by m"
-            )]
             let steps = |room: f64| (room / step + 1e-9).floor().max(0.0) as usize;
             let (down, up) = (steps(c - l), steps(u - c));
-            #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
             let lo = c - down as f64 * step;
             g.lo[i] = lo;
             g.step[i] = step;
@@ -127,21 +111,14 @@ fn refine_grid(
     let half = (m - 1) / 2;
     for i in 0..n {
         let (l, u) = band(prep, s.0, s.1, g.nodes[i]);
-        #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
         let step = 2.0 * radius * prev_step[i] / (m - 1) as f64;
         if u - l <= 1e-9 || step <= 1e-12 {
             continue;
         }
         let c = centers[i];
-        #[expect(
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss,
-            reason = "non-negative step counts bounded by m"
-        )]
         let steps = |room: f64| (room / step + 1e-9).floor().max(0.0) as usize;
         let down = steps(c - l).min(half);
         let up = steps(u - c).min(m - 1 - half);
-        #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
         let lo = c - down as f64 * step;
         g.lo[i] = lo;
         g.step[i] = step;
@@ -196,10 +173,6 @@ fn solve_pass(
     for i in 0..n_nodes - 1 {
         let (a, b) = (grid.nodes[i], grid.nodes[i + 1]);
         let dr = b - a;
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let drf = dr as f64;
         let (dmin, dmax, tol) = (s.0 * drf * g, s.1 * drf * g, 1e-9 * drf * g);
 
@@ -213,17 +186,9 @@ fn solve_pass(
             } else {
                 a + 1 + (2 * r + 1) * n_int / (2 * take)
             };
-            #[expect(
-                clippy::cast_precision_loss,
-                reason = "sample counts are far below 2^52"
-            )]
             let alpha = (n - a) as f64 / drf;
             rows.push((n, alpha));
         }
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let w_int = if take > 0 {
             prep.h * n_int as f64 / take as f64
         } else {
@@ -233,12 +198,6 @@ fn solve_pass(
         let (ca, cb) = (grid.count[i], grid.count[i + 1]);
         // transitions searched per candidate j: limited by the slope band and by max_jump
         let slope_w = if grid.step[i + 1] > 0.0 {
-            #[expect(
-                clippy::cast_possible_truncation,
-                clippy::cast_sign_loss,
-                reason = "non-negative, capped at cb below"
-            )]
-            #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
             let w = ((dmax - dmin) / grid.step[i + 1]).min(cb as f64) as usize + 1;
             w.min(cb)
         } else {
@@ -248,11 +207,6 @@ fn solve_pass(
         let est_edges = ca * jump_w;
         let tmin = grid.lo[i].min(grid.lo[i + 1]).max(0.0);
         let tmax = grid.hi(i).max(grid.hi(i + 1)).min(prep.qscale);
-        #[expect(
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss,
-            reason = "clamped non-negative query times"
-        )]
         let (s0, s1) = (
             (tmin as usize).min(nq - 2),
             ((tmax as usize) + 1).min(nq - 1),
@@ -271,11 +225,6 @@ fn solve_pass(
         } else if points.is_some() {
             // resolve a quarter of the candidate spacing; use it only if cheaper than direct
             let min_step = grid.step[i].min(grid.step[i + 1]);
-            #[expect(
-                clippy::cast_possible_truncation,
-                clippy::cast_sign_loss,
-                reason = "non-negative spacing"
-            )]
             let stride = ((min_step / 4.0) as usize).max(2);
             if (s1 - s0) / stride + 2 < est_edges {
                 stride
@@ -298,14 +247,9 @@ fn solve_pass(
                 }
             }
         }
-        #[expect(clippy::cast_precision_loss, reason = "small")]
         let inv_stride = if stride > 0 { 1.0 / stride as f64 } else { 0.0 };
 
         // regularizer constants of this segment (see Prepared::reg_cost)
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let (ta, tb) = (a as f64 * prep.h, b as f64 * prep.h);
         let dt = tb - ta;
         let kappa = 1.0 / (prep.qscale * dt);
@@ -331,13 +275,7 @@ fn solve_pass(
                 if hi < 0.0 || lo > (cb - 1) as f64 {
                     continue;
                 }
-                #[expect(
-                    clippy::cast_possible_truncation,
-                    clippy::cast_sign_loss,
-                    reason = "clamped to 0..cb"
-                )]
-                let r = (lo.max(0.0) as usize, (hi as usize).min(cb - 1));
-                r
+                (lo.max(0.0) as usize, (hi as usize).min(cb - 1))
             };
             if let Some(kj) = max_jump {
                 // relative offsets from the previous solution: (k − center_b) vs (j − center_a)
@@ -366,13 +304,7 @@ fn solve_pass(
                         let e = &table.e;
                         for (r, &(_, alpha)) in rows.iter().enumerate() {
                             let tau = p + d * alpha;
-                            #[expect(
-                                clippy::cast_possible_truncation,
-                                clippy::cast_sign_loss,
-                                reason = "tau within the window"
-                            )]
                             let sq = (tau.max(0.0) as usize).clamp(s0, s1 - 1);
-                            #[expect(clippy::cast_precision_loss, reason = "small")]
                             let f = tau - sq as f64;
                             let base = r * width + (sq - s0);
                             let (e0, e1) = (e[base], e[base + 1]);
@@ -380,17 +312,10 @@ fn solve_pass(
                         }
                     } else if stride > 1 {
                         let (e, cols) = (&table.e, table.width);
-                        #[expect(clippy::cast_precision_loss, reason = "small")]
                         let s0f = s0 as f64;
                         for (r, &(_, alpha)) in rows.iter().enumerate() {
                             let u = ((p + d * alpha - s0f) * inv_stride).max(0.0);
-                            #[expect(
-                                clippy::cast_possible_truncation,
-                                clippy::cast_sign_loss,
-                                reason = "u >= 0"
-                            )]
                             let c = (u as usize).min(cols - 2);
-                            #[expect(clippy::cast_precision_loss, reason = "small")]
                             let f = u - c as f64;
                             let base = r * cols + c;
                             acc += e[base] + f * (e[base + 1] - e[base]);
@@ -404,7 +329,6 @@ fn solve_pass(
                 }
                 if cost < f_next[k] {
                     f_next[k] = cost;
-                    #[expect(clippy::cast_possible_truncation, reason = "counts are <= 65535")]
                     let jj = j as u16;
                     back_b[k] = jj;
                 }
@@ -441,10 +365,6 @@ fn solve_pass(
 fn interp_at(xs: &[usize], vals: &[f64], n: usize) -> f64 {
     let i = xs.partition_point(|&x| x <= n).clamp(1, xs.len() - 1);
     let (a, b) = (xs[i - 1], xs[i]);
-    #[expect(
-        clippy::cast_precision_loss,
-        reason = "sample counts are far below 2^52"
-    )]
     let alpha = (n.clamp(a, b) - a) as f64 / (b - a) as f64;
     vals[i - 1] + alpha * (vals[i] - vals[i - 1])
 }
@@ -455,16 +375,8 @@ fn expand(nodes: &[usize], vals: &[f64], n_ref: usize) -> Vec<f64> {
     for (seg, w) in nodes.windows(2).enumerate() {
         let (a, b) = (w[0], w[1]);
         let (p, q) = (vals[seg], vals[seg + 1]);
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let dr = (b - a) as f64;
         for (n, o) in out.iter_mut().enumerate().take(b + 1).skip(a) {
-            #[expect(
-                clippy::cast_precision_loss,
-                reason = "sample counts are far below 2^52"
-            )]
             let alpha = (n - a) as f64 / dr;
             *o = p + (q - p) * alpha;
         }
