@@ -20,7 +20,7 @@ then multiplied by sqrt(weight) for gdtw (its L2 loss then equals tandem's W-wei
 own per-signal re-scaling is switched off for that, through its `Signal(scale_signals=False)`).
 
 Run from the repository root (see README.md):
-    python3 bench/peers/warp_truth.py --seeds 0-11 --gdtw default
+    python3 bench/peers/warp_truth.py --seeds 0-23 --gdtw default --gdtw lambda0.01 --gdtw best
 """
 import argparse
 import json
@@ -44,6 +44,8 @@ S_MIN, S_MAX = 0.25, 4.0
 GDTW_SETTINGS = {
     # gdtw's own defaults: lambda_inst = 0.1, lambda_cum = 1, unbounded slopes, stops early
     "default": {},
+    # the issue's setting: weaker regularization, gdtw's own stopping rule
+    "lambda0.01": {"lambda_inst": 0.01, "lambda_cum": 0.01},
     # its most accurate setting here: weaker regularization, all max_iters = 10 refinements
     "best": {"lambda_inst": 0.01, "lambda_cum": 0.01, "epsilon_abs": 0.0, "epsilon_rel": 0.0},
     # the slope bounds tandem-warp uses: its first grid cannot follow moderate slopes at N = T_ref
