@@ -35,8 +35,10 @@ pub const DEFAULT_NODE_SPACING: usize = 4;
 /// **Defaults** were chosen on the ground-truth benchmark `bench/peers/warp_truth.py`
 /// (synthetic demonstrations with known warps; docs/decisions.md, "tandem-warp defaults"):
 /// `λ_inst = 0.01`, `λ_cum = 0.001` lower the mean error against the true warp from 3.55 to
-/// 2.72 query samples (outside dwells 2.85 → 1.71) against the former `0.1, 0.1`. The defaults align two ~10 000-sample, 9-channel fixture demonstrations in under
-/// 20 ms on one core (bench `align_fixture`). To solve "the same problem" as the authors'
+/// 2.72 query samples (outside dwells 2.85 → 1.71) against the former `0.1, 0.1`.
+/// The defaults align two ~10 000-sample, 9-channel fixture demonstrations in under 20 ms on one
+/// core (bench `align_fixture`: 13.4–14.4 ms on the quiet 2-core build machine, against 11.3 ms
+/// for the former solver in the same session). To solve "the same problem" as the authors'
 /// `gdtw` package, use `n_nodes = Some(T_ref)` (one node per reference sample) and
 /// `n_candidates = 301`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
