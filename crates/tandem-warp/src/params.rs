@@ -34,8 +34,8 @@ pub const DEFAULT_NODE_SPACING: usize = 4;
 ///
 /// **Defaults** were chosen on the ground-truth benchmark `bench/peers/warp_truth.py`
 /// (synthetic demonstrations with known warps; docs/decisions.md, "tandem-warp defaults"):
-/// `λ_inst = 0.01`, `λ_cum = 0.001` lower the mean error against the true warp from 3.55 to
-/// 2.72 query samples (outside dwells 2.85 → 1.71) against the former `0.1, 0.1`.
+/// `λ_inst = 0.02`, `λ_cum = 0.001` lower the mean error against the true warp from 3.55 to
+/// 2.77 query samples (outside dwells 2.85 → 1.89) against the former `0.1, 0.1`.
 /// The defaults align two ~10 000-sample, 9-channel fixture demonstrations in under 20 ms on one
 /// core (bench `align_fixture`: 13.4–14.4 ms on the quiet 2-core build machine, against 11.3 ms
 /// for the former solver in the same session). To solve "the same problem" as the authors'
@@ -55,15 +55,16 @@ pub struct WarpParams {
     /// [`refine_radius`](Self::refine_radius)). Must be in `3..=65535`. Default: 15.
     pub n_candidates: usize,
     /// `λ_inst`, weight of `∫ (φ'(t) − 1)² dt` (normalized time). Must be finite and ≥ 0.
-    /// Default: 0.01, the lowest mean error on the ground-truth benchmark (mean error in query
-    /// samples over all samples / outside dwells: 0.1 → 3.55 / 2.85, 0.02 → 2.77 / 1.89,
-    /// 0.01 → 2.72 / 1.71, 0.007 → 2.74 / 1.67; docs/decisions.md). Its effect depends on the
-    /// loss scale: the benchmark's channels span `[−1, 1]`.
+    /// Default: 0.02, chosen on the ground-truth benchmark (docs/decisions.md): mean error in
+    /// query samples of the warp / of its gradient (samples per sample): 0.1 → 3.55 / 0.083,
+    /// 0.05 → 3.06 / 0.086, 0.02 → 2.77 / 0.098, 0.01 → 2.72 / 0.119, 0.005 → 2.79 / 0.154.
+    /// Below 0.02 the values barely improve while the gradients (which give `σ²_D`'s rate
+    /// channel and the speed bounds) get noisier. Its effect depends on the loss scale: the
+    /// benchmark's channels span `[−1, 1]`.
     pub lambda_inst: f64,
     /// `λ_cum`, weight of `∫ (φ(t) − t)² dt` (normalized time). Must be finite and ≥ 0.
     /// Default: 0.001, a tie-breaker only (ground-truth benchmark: pulling the warp towards the
-    /// identity never helped; at `λ_inst = 0.01`, `λ_cum = 0.1` raised the mean error from 2.72
-    /// to 2.78 query samples).
+    /// identity never helped; `λ_cum = 0.1` gave 2.78 query samples against 2.77).
     pub lambda_cum: f64,
     /// `s_min`, lower bound on `φ'` in normalized time. Must be in `(0, 1]`. Default: 0.25.
     pub slope_min: f64,
@@ -112,7 +113,7 @@ impl Default for WarpParams {
         Self {
             n_nodes: None,
             n_candidates: 15,
-            lambda_inst: 0.01,
+            lambda_inst: 0.02,
             lambda_cum: 0.001,
             slope_min: 0.25,
             slope_max: 4.0,
