@@ -14,7 +14,7 @@
 //! the more expensive search to re-run the cheaper one. The optima it ends in differ mostly by
 //! sub-sample choices of where to interpolate the noise (linear interpolation halves the noise's
 //! variance half-way between two query samples), worth a fraction of the loss the noise itself
-//! contributes ([`NOISE_LOSS`]). Over 8 000 random cases the largest rises seen were about one
+//! contributes ([`NOISE_LOSS`]). Over 11 000 random cases the largest rises seen were about one
 //! `NOISE_LOSS` and 1.3 query samples; the former solver fails this test within 500 cases
 //! (docs/decisions.md, "tandem-warp: effort never hurts").
 
