@@ -107,6 +107,16 @@ def run_tandem(x_ref, x_query, names, exe, tandem_params):
     return psi, float(rep["wall_s"]), float(rep["objective"])
 
 
+def build_tandem(build=True):
+    """Path of the `align` example under $CARGO_TARGET_DIR (built first unless `build` is False)."""
+    exe = os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target")),
+                       "release", "examples", "align")
+    if build:
+        subprocess.run(["cargo", "build", "--release", "-q", "-p", "tandem-warp", "--example", "align"],
+                       cwd=ROOT, check=True)
+    return exe
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--demos", default="1,2,3,4,5")
@@ -117,11 +127,7 @@ def main():
                     help="tandem-warp refine_radius (22.5 = gdtw's eta 0.15 at M = 301)")
     ap.add_argument("--no-build", action="store_true", help="use an already built example")
     args = ap.parse_args()
-    exe = os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target")),
-                       "release", "examples", "align")
-    if not args.no_build:
-        subprocess.run(["cargo", "build", "--release", "-q", "-p", "tandem-warp", "--example", "align"],
-                       cwd=ROOT, check=True)
+    exe = build_tandem(not args.no_build)
     demos = [int(d) for d in args.demos.split(",")]
     raw = {i: load(i) for i in [0] + demos}
     names = raw[0][0]

@@ -159,7 +159,6 @@ fn run() -> Result<String, String> {
     for _ in 1..repeat {
         warp = align(rs, qs, &params).map_err(|e| e.to_string())?;
     }
-    #[expect(clippy::cast_precision_loss, reason = "small repeat counts")]
     let wall_s = start.elapsed().as_secs_f64() / repeat as f64;
     if report {
         eprintln!("objective={:.12e} wall_s={wall_s:.6}", warp.objective());

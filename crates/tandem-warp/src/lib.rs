@@ -40,5 +40,8 @@ pub use error::{Error, Result};
 pub use objective::objective_of;
 pub use params::{DEFAULT_NODE_SPACING, WarpParams};
 pub use signal::{MAX_ABS_VALUE, SignalRef};
-pub use solver::{COARSE_POINTS_PER_SEGMENT, align, align_many};
+pub use solver::{
+    COARSE_POINTS_PER_SEGMENT, COARSE_SLOPE_STEP, POLISH_RADIUS, POLISH_STEPS,
+    REFINE_SPACING_RATIO, align, align_many,
+};
 pub use warp::Warp;

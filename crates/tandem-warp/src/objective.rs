@@ -76,10 +76,6 @@ impl<'a> Prepared<'a> {
             .chunks_exact(nc)
             .map(|d| d.iter().zip(&w).map(|(d, w)| w * d * d).sum())
             .collect();
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let (h, qscale) = (1.0 / (nr - 1) as f64, (nq - 1) as f64);
         Ok(Self {
             r,
@@ -102,16 +98,7 @@ impl<'a> Prepared<'a> {
     #[inline]
     pub(crate) fn loss(&self, n: usize, tau: f64) -> f64 {
         let nc = self.nc;
-        #[expect(
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss,
-            reason = "tau is a clamped query time >= 0"
-        )]
         let s = (tau.max(0.0) as usize).min(self.nq - 2);
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let f = tau - s as f64;
         let qs = &self.q[s * nc..(s + 1) * nc];
         let ds = &self.dq[s * nc..(s + 1) * nc];
@@ -152,10 +139,6 @@ impl<'a> Prepared<'a> {
     /// query samples): `λ_inst Δt (s − 1)² + λ_cum Δt (d_a² + d_a d_b + d_b²) / 3`.
     #[inline]
     pub(crate) fn reg_cost(&self, ra: usize, p: f64, rb: usize, qv: f64) -> f64 {
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let (ta, tb) = (ra as f64 * self.h, rb as f64 * self.h);
         let dt = tb - ta;
         let (pa, pb) = (p / self.qscale, qv / self.qscale);

@@ -21,13 +21,26 @@ pub const DEFAULT_NODE_SPACING: usize = 4;
 /// See [`crate::objective_of`] for the exact discretization.
 ///
 /// Solver: a first dynamic-programming pass over the whole feasible band with
-/// [`coarse_nodes`](Self::coarse_nodes) nodes and [`coarse_candidates`](Self::coarse_candidates)
-/// candidates each, then [`refinements`](Self::refinements) passes on all
+/// [`coarse_nodes`](Self::coarse_nodes) nodes and at least
+/// [`coarse_candidates`](Self::coarse_candidates) candidates each, then
+/// [`refinements`](Self::refinements) passes that double the node count up to all
 /// [`n_nodes`](Self::n_nodes) nodes, each on a finer candidate grid centred on the previous
-/// solution (see [`refine_radius`](Self::refine_radius)).
-/// The defaults align two ~7000-sample, 9-channel fixture demonstrations in under 20 ms on one
-/// core (bench `align_fixture`; 16.7 ms measured on a busy shared 2-core machine). To solve "the same problem" as the authors' `gdtw` package, use
-/// `n_nodes = Some(T_ref)` (one node per reference sample) and `n_candidates = 301`.
+/// solution (see [`refine_radius`](Self::refine_radius)), then two polish passes on all `N`
+/// nodes ([`POLISH_STEPS`](crate::POLISH_STEPS)). Every pass keeps the best warp so far (by the
+/// exact objective). Candidate spacings are tied to the node spacing
+/// ([`COARSE_SLOPE_STEP`](crate::COARSE_SLOPE_STEP),
+/// [`REFINE_SPACING_RATIO`](crate::REFINE_SPACING_RATIO)), so more nodes, more candidates, more
+/// refinements or a larger radius widen or refine the search and never coarsen it.
+///
+/// **Defaults** were chosen on the ground-truth benchmark `bench/peers/warp_truth.py`
+/// (synthetic demonstrations with known warps; docs/decisions.md, "tandem-warp defaults"):
+/// `λ_inst = 0.02`, `λ_cum = 0.001` lower the mean error against the true warp from 3.55 to
+/// 2.77 query samples (outside dwells 2.85 → 1.89) against the former `0.1, 0.1`.
+/// The defaults align two ~10 000-sample, 9-channel fixture demonstrations in under 20 ms on one
+/// core (bench `align_fixture`: 13.4–14.4 ms on the quiet 2-core build machine, against 11.3 ms
+/// for the former solver in the same session). To solve "the same problem" as the authors'
+/// `gdtw` package, use `n_nodes = Some(T_ref)` (one node per reference sample) and
+/// `n_candidates = 301`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct WarpParams {
@@ -37,14 +50,21 @@ pub struct WarpParams {
     /// `None` (default) = one node every [`DEFAULT_NODE_SPACING`] reference samples.
     /// Must be ≥ 2; values above `T_ref` are clamped to `T_ref` (one node per reference sample).
     pub n_nodes: Option<usize>,
-    /// Number `M` of candidate values of `φ` per node in the refinement passes.
-    /// Must be in `3..=65535`. Default: 15.
+    /// Least number `M` of candidate values of `φ` per node in the refinement passes; more
+    /// candidates widen the searched range at the same spacing (see
+    /// [`refine_radius`](Self::refine_radius)). Must be in `3..=65535`. Default: 15.
     pub n_candidates: usize,
     /// `λ_inst`, weight of `∫ (φ'(t) − 1)² dt` (normalized time). Must be finite and ≥ 0.
-    /// Default: 0.1.
+    /// Default: 0.02, chosen on the ground-truth benchmark (docs/decisions.md): mean error in
+    /// query samples of the warp / of its gradient (samples per sample): 0.1 → 3.55 / 0.083,
+    /// 0.05 → 3.06 / 0.086, 0.02 → 2.77 / 0.098, 0.01 → 2.72 / 0.119, 0.005 → 2.79 / 0.154.
+    /// Below 0.02 the values barely improve while the gradients (which give `σ²_D`'s rate
+    /// channel and the speed bounds) get noisier. Its effect depends on the loss scale: the
+    /// benchmark's channels span `[−1, 1]`.
     pub lambda_inst: f64,
     /// `λ_cum`, weight of `∫ (φ(t) − t)² dt` (normalized time). Must be finite and ≥ 0.
-    /// Default: 0.1.
+    /// Default: 0.001, a tie-breaker only (ground-truth benchmark: pulling the warp towards the
+    /// identity never helped; `λ_cum = 0.1` gave 2.78 query samples against 2.77).
     pub lambda_cum: f64,
     /// `s_min`, lower bound on `φ'` in normalized time. Must be in `(0, 1]`. Default: 0.25.
     pub slope_min: f64,
@@ -52,27 +72,37 @@ pub struct WarpParams {
     pub slope_max: f64,
     /// Number of grid-refinement passes after the first pass. Pass `k < refinements` uses
     /// `min(N, coarse_nodes · 2^k)` nodes (and the coarse loss quadrature while below `N`); the
-    /// last pass uses all `N` nodes. Must be ≤ 64. Default: 4.
+    /// last pass uses all `N` nodes. The polish passes follow in any case. Must be ≤ 64.
+    /// Default: 4.
     pub refinements: usize,
-    /// Half-width of a refinement pass's candidate range at a node, in candidate spacings of the
-    /// previous pass there. The range is centred on the previous solution and truncated to the
-    /// feasible band; its `n_candidates` values are equally spaced, so each pass shrinks the
-    /// spacing by `2 · refine_radius / (n_candidates − 1)`. Must be finite and ≥ 0.5.
-    /// Default: 2.5.
+    /// Least half-width of a refinement pass's candidate range at a node, in units of the
+    /// previous pass's resolution there: its candidate spacing, but at least the query span of a
+    /// slope change of [`COARSE_SLOPE_STEP`](crate::COARSE_SLOPE_STEP) over its node spacing
+    /// (what its nodes and quadrature cannot resolve). The candidates are
+    /// [`REFINE_SPACING_RATIO`](crate::REFINE_SPACING_RATIO) resolutions apart, centred on the
+    /// previous solution and truncated to the feasible band; there are
+    /// `max(n_candidates, 2 ⌈refine_radius / REFINE_SPACING_RATIO⌉ + 1)` of them, so a larger
+    /// radius or more candidates widen the range and never coarsen it. Must be finite and
+    /// ≥ 0.5. Default: 2.5 (with 15 candidates: the former grid, ±7 spacings of 5/14).
     pub refine_radius: f64,
     /// In refinement passes, a transition from candidate `j` to candidate `k` of the next node
     /// is searched only if `|k − j| ≤ max_jump` (both grids are centred on the previous
-    /// solution, so this bounds how fast the solution may depart from it); slope bounds are
-    /// always enforced. `None` = search every feasible transition. Default: `Some(3)`.
+    /// solution and have the fixed relative spacing
+    /// [`REFINE_SPACING_RATIO`](crate::REFINE_SPACING_RATIO), so this bounds how fast the
+    /// solution may depart from it whatever the candidate count); slope bounds are always
+    /// enforced. The polish passes search every feasible transition. `None` = search every
+    /// feasible transition. Default: `Some(3)`.
     pub max_jump: Option<usize>,
     /// Number of nodes of the first pass, which searches the whole feasible band; clamped to
     /// `N`. While a pass has fewer than `N` nodes it evaluates the loss at
     /// [`COARSE_POINTS_PER_SEGMENT`](crate::COARSE_POINTS_PER_SEGMENT) reference samples per
     /// segment instead of all of them. Must be ≥ 2. Default: 48.
     pub coarse_nodes: usize,
-    /// Number of candidates per node in the first pass, spread evenly over the feasible band
-    /// `[max(s_min t, 1 − s_max (1 − t)), min(s_max t, 1 − s_min (1 − t))]`.
-    /// Must be in `3..=65535`. Default: 97.
+    /// Least number of candidates per node in the first pass, spread evenly over the feasible
+    /// band `[max(s_min t, 1 − s_max (1 − t)), min(s_max t, 1 − s_min (1 − t))]`. More are used
+    /// where needed to keep neighbouring candidates within a slope change of
+    /// [`COARSE_SLOPE_STEP`](crate::COARSE_SLOPE_STEP) over the first pass's node spacing (at most
+    /// 65535). Must be in `3..=65535`. Default: 97.
     pub coarse_candidates: usize,
     /// Diagonal of `W`: one weight ≥ 0 (finite) per channel. `None` (default) = all 1.
     pub weights: Option<Vec<f64>>,
@@ -83,8 +113,8 @@ impl Default for WarpParams {
         Self {
             n_nodes: None,
             n_candidates: 15,
-            lambda_inst: 0.1,
-            lambda_cum: 0.1,
+            lambda_inst: 0.02,
+            lambda_cum: 0.001,
             slope_min: 0.25,
             slope_max: 4.0,
             refinements: 4,
@@ -117,7 +147,7 @@ impl WarpParams {
                 return Err(bad("n_nodes", format!("must be >= 2 (got {n})")));
             }
         }
-        if !(3..=65535).contains(&self.n_candidates) {
+        if !(3..=crate::solver::MAX_CANDIDATES).contains(&self.n_candidates) {
             return Err(bad(
                 "n_candidates",
                 format!("must be in 3..=65535 (got {})", self.n_candidates),
@@ -161,7 +191,7 @@ impl WarpParams {
                 format!("must be finite and >= 0.5 (got {})", self.refine_radius),
             ));
         }
-        if !(3..=65535).contains(&self.coarse_candidates) {
+        if !(3..=crate::solver::MAX_CANDIDATES).contains(&self.coarse_candidates) {
             return Err(bad(
                 "coarse_candidates",
                 format!("must be in 3..=65535 (got {})", self.coarse_candidates),

@@ -15,6 +15,32 @@ use crate::warp::Warp;
 /// over every reference sample, and [`crate::Warp::objective`] is always exact.
 pub const COARSE_POINTS_PER_SEGMENT: usize = 4;
 
+/// Largest difference of slope `φ'` (normalized time) between two neighbouring candidate paths
+/// of the first pass: its candidate spacing at a node is at most this times the node spacing
+/// (in query samples at slope 1). More first-pass nodes therefore bring more candidates, so a
+/// finer time grid never makes the first pass unable to follow a slope that a coarser one could.
+pub const COARSE_SLOPE_STEP: f64 = 0.5;
+
+/// Ratio of a refinement pass's candidate spacing to the previous pass's resolution. It is fixed,
+/// so more refinement candidates or a larger [`refine_radius`](crate::WarpParams::refine_radius)
+/// widen the searched range and never coarsen it. `5/14` is the ratio of the former defaults
+/// (15 candidates over ±2.5 previous spacings).
+pub const REFINE_SPACING_RATIO: f64 = 5.0 / 14.0;
+
+/// Candidate spacings, in query samples, of the two polish passes that end every alignment.
+/// After the refinements, the best warp so far is moved by at most [`POLISH_RADIUS`] such
+/// spacings at every one of the `N` nodes (dynamic programming over the exact objective), first
+/// by whole query samples, then by half samples. A pass keeps the warp unless it lowers the
+/// objective. These passes make the result depend less on where the refinements ended, and so
+/// on the search effort.
+pub const POLISH_STEPS: [f64; 2] = [1.0, 0.5];
+
+/// Spacings searched either side of the current warp at every node in a polish pass.
+pub const POLISH_RADIUS: usize = 1;
+
+/// Largest candidate count of one node (back pointers are `u16`).
+pub(crate) const MAX_CANDIDATES: usize = 65535;
+
 /// Candidate grid of one pass: node `i` sits at reference sample `nodes[i]` and has candidates
 /// `lo[i] + j * step[i]` (query samples), `j < count[i]`; `center[i]` is the candidate equal to
 /// the previous pass's solution (0 in the first pass).
@@ -29,7 +55,6 @@ struct Grid {
 impl Grid {
     #[inline]
     fn cand(&self, i: usize, j: usize) -> f64 {
-        #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
         let jf = j as f64;
         self.lo[i] + jf * self.step[i]
     }
@@ -55,19 +80,22 @@ fn band(prep: &Prepared<'_>, s_min: f64, s_max: f64, n: usize) -> (f64, f64) {
     if n == prep.nr - 1 {
         return (prep.qscale, prep.qscale);
     }
-    #[expect(
-        clippy::cast_precision_loss,
-        reason = "sample counts are far below 2^52"
-    )]
     let t = n as f64 * prep.h;
     let l = (s_min * t).max(1.0 - s_max * (1.0 - t)).clamp(0.0, 1.0);
     let u = (s_max * t).min(1.0 - s_min * (1.0 - t)).clamp(0.0, 1.0);
     (l * prep.qscale, u.max(l) * prep.qscale)
 }
 
-/// First pass: about `m` equally spaced candidates covering the whole feasible band at every
-/// node, anchored so that the identity warp `φ(t) = t` is one of them (candidate `center[i]`).
-fn first_grid(prep: &Prepared<'_>, nodes: Vec<usize>, m: usize, s: (f64, f64)) -> Grid {
+/// First pass: equally spaced candidates covering the whole feasible band at every node, at least
+/// `m` of them and at most `max_step` query samples apart, anchored so that the identity warp
+/// `φ(t) = t` is one of them (candidate `center[i]`).
+fn first_grid(
+    prep: &Prepared<'_>,
+    nodes: Vec<usize>,
+    m: usize,
+    max_step: f64,
+    s: (f64, f64),
+) -> Grid {
     let n = nodes.len();
     let mut g = Grid {
         lo: vec![0.0; n],
@@ -78,23 +106,15 @@ fn first_grid(prep: &Prepared<'_>, nodes: Vec<usize>, m: usize, s: (f64, f64)) -
     };
     for i in 0..n {
         let (l, u) = band(prep, s.0, s.1, g.nodes[i]);
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let c = (g.nodes[i] as f64 * prep.h * prep.qscale).clamp(l, u);
         g.lo[i] = c;
         if u - l > 1e-9 {
-            #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
-            let step = (u - l) / (m - 1) as f64;
-            #[expect(
-                clippy::cast_possible_truncation,
-                clippy::cast_sign_loss,
-                reason = "non-negative step counts bounded by m"
-            )]
+            // at most MAX_CANDIDATES candidates: back pointers are u16
+            let step = ((u - l) / (m - 1) as f64)
+                .min(max_step)
+                .max((u - l) / (MAX_CANDIDATES - 1) as f64);
             let steps = |room: f64| (room / step + 1e-9).floor().max(0.0) as usize;
             let (down, up) = (steps(c - l), steps(u - c));
-            #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
             let lo = c - down as f64 * step;
             g.lo[i] = lo;
             g.step[i] = step;
@@ -105,15 +125,39 @@ fn first_grid(prep: &Prepared<'_>, nodes: Vec<usize>, m: usize, s: (f64, f64)) -
     g
 }
 
-/// Refinement pass: `m` candidates centred on `centers[i]`, spacing `2 radius prev_step[i] / (m − 1)`,
-/// truncated (not compressed) to the feasible band so the centre stays a candidate.
+/// Refinement pass: [`refine_count`] candidates centred on `centers[i]`, spacing
+/// `REFINE_SPACING_RATIO · prev_res[i]`, truncated (not compressed) to the feasible band so the
+/// centre stays a candidate.
 fn refine_grid(
     prep: &Prepared<'_>,
     nodes: Vec<usize>,
     centers: &[f64],
-    prev_step: &[f64],
+    prev_res: &[f64],
     m: usize,
     radius: f64,
+    s: (f64, f64),
+) -> Grid {
+    let m = refine_count(m, radius);
+    let step: Vec<f64> = prev_res.iter().map(|r| REFINE_SPACING_RATIO * r).collect();
+    tube_grid(prep, nodes, centers, &step, (m - 1) / 2, m / 2, s)
+}
+
+/// Candidate count of a refinement pass: at least `m`, and enough to reach `±radius` previous
+/// resolutions at the spacing `REFINE_SPACING_RATIO` of one.
+fn refine_count(m: usize, radius: f64) -> usize {
+    let half = (radius / REFINE_SPACING_RATIO - 1e-9).ceil() as usize;
+    m.max(2 * half + 1).min(MAX_CANDIDATES)
+}
+
+/// Candidates `centers[i] + j · step[i]` for `j` in `−down..=up`, truncated (not compressed) to
+/// the feasible band so the centre stays a candidate (`center[i]`).
+fn tube_grid(
+    prep: &Prepared<'_>,
+    nodes: Vec<usize>,
+    centers: &[f64],
+    step: &[f64],
+    down: usize,
+    up: usize,
     s: (f64, f64),
 ) -> Grid {
     let n = nodes.len();
@@ -124,29 +168,19 @@ fn refine_grid(
         center: vec![0; n],
         nodes,
     };
-    let half = (m - 1) / 2;
     for i in 0..n {
         let (l, u) = band(prep, s.0, s.1, g.nodes[i]);
-        #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
-        let step = 2.0 * radius * prev_step[i] / (m - 1) as f64;
-        if u - l <= 1e-9 || step <= 1e-12 {
+        let st = step[i];
+        if u - l <= 1e-9 || st <= 1e-12 {
             continue;
         }
         let c = centers[i];
-        #[expect(
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss,
-            reason = "non-negative step counts bounded by m"
-        )]
-        let steps = |room: f64| (room / step + 1e-9).floor().max(0.0) as usize;
-        let down = steps(c - l).min(half);
-        let up = steps(u - c).min(m - 1 - half);
-        #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
-        let lo = c - down as f64 * step;
-        g.lo[i] = lo;
-        g.step[i] = step;
-        g.count[i] = down + up + 1;
-        g.center[i] = down;
+        let steps = |room: f64| (room / st + 1e-9).floor().max(0.0) as usize;
+        let d = steps(c - l).min(down);
+        g.lo[i] = c - d as f64 * st;
+        g.step[i] = st;
+        g.count[i] = d + steps(u - c).min(up) + 1;
+        g.center[i] = d;
     }
     g
 }
@@ -196,10 +230,6 @@ fn solve_pass(
     for i in 0..n_nodes - 1 {
         let (a, b) = (grid.nodes[i], grid.nodes[i + 1]);
         let dr = b - a;
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let drf = dr as f64;
         let (dmin, dmax, tol) = (s.0 * drf * g, s.1 * drf * g, 1e-9 * drf * g);
 
@@ -213,17 +243,9 @@ fn solve_pass(
             } else {
                 a + 1 + (2 * r + 1) * n_int / (2 * take)
             };
-            #[expect(
-                clippy::cast_precision_loss,
-                reason = "sample counts are far below 2^52"
-            )]
             let alpha = (n - a) as f64 / drf;
             rows.push((n, alpha));
         }
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let w_int = if take > 0 {
             prep.h * n_int as f64 / take as f64
         } else {
@@ -233,12 +255,6 @@ fn solve_pass(
         let (ca, cb) = (grid.count[i], grid.count[i + 1]);
         // transitions searched per candidate j: limited by the slope band and by max_jump
         let slope_w = if grid.step[i + 1] > 0.0 {
-            #[expect(
-                clippy::cast_possible_truncation,
-                clippy::cast_sign_loss,
-                reason = "non-negative, capped at cb below"
-            )]
-            #[expect(clippy::cast_precision_loss, reason = "candidate counts are <= 65535")]
             let w = ((dmax - dmin) / grid.step[i + 1]).min(cb as f64) as usize + 1;
             w.min(cb)
         } else {
@@ -248,11 +264,6 @@ fn solve_pass(
         let est_edges = ca * jump_w;
         let tmin = grid.lo[i].min(grid.lo[i + 1]).max(0.0);
         let tmax = grid.hi(i).max(grid.hi(i + 1)).min(prep.qscale);
-        #[expect(
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss,
-            reason = "clamped non-negative query times"
-        )]
         let (s0, s1) = (
             (tmin as usize).min(nq - 2),
             ((tmax as usize) + 1).min(nq - 1),
@@ -271,11 +282,6 @@ fn solve_pass(
         } else if points.is_some() {
             // resolve a quarter of the candidate spacing; use it only if cheaper than direct
             let min_step = grid.step[i].min(grid.step[i + 1]);
-            #[expect(
-                clippy::cast_possible_truncation,
-                clippy::cast_sign_loss,
-                reason = "non-negative spacing"
-            )]
             let stride = ((min_step / 4.0) as usize).max(2);
             if (s1 - s0) / stride + 2 < est_edges {
                 stride
@@ -298,14 +304,9 @@ fn solve_pass(
                 }
             }
         }
-        #[expect(clippy::cast_precision_loss, reason = "small")]
         let inv_stride = if stride > 0 { 1.0 / stride as f64 } else { 0.0 };
 
         // regularizer constants of this segment (see Prepared::reg_cost)
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let (ta, tb) = (a as f64 * prep.h, b as f64 * prep.h);
         let dt = tb - ta;
         let kappa = 1.0 / (prep.qscale * dt);
@@ -331,13 +332,7 @@ fn solve_pass(
                 if hi < 0.0 || lo > (cb - 1) as f64 {
                     continue;
                 }
-                #[expect(
-                    clippy::cast_possible_truncation,
-                    clippy::cast_sign_loss,
-                    reason = "clamped to 0..cb"
-                )]
-                let r = (lo.max(0.0) as usize, (hi as usize).min(cb - 1));
-                r
+                (lo.max(0.0) as usize, (hi as usize).min(cb - 1))
             };
             if let Some(kj) = max_jump {
                 // relative offsets from the previous solution: (k − center_b) vs (j − center_a)
@@ -366,13 +361,7 @@ fn solve_pass(
                         let e = &table.e;
                         for (r, &(_, alpha)) in rows.iter().enumerate() {
                             let tau = p + d * alpha;
-                            #[expect(
-                                clippy::cast_possible_truncation,
-                                clippy::cast_sign_loss,
-                                reason = "tau within the window"
-                            )]
                             let sq = (tau.max(0.0) as usize).clamp(s0, s1 - 1);
-                            #[expect(clippy::cast_precision_loss, reason = "small")]
                             let f = tau - sq as f64;
                             let base = r * width + (sq - s0);
                             let (e0, e1) = (e[base], e[base + 1]);
@@ -380,17 +369,10 @@ fn solve_pass(
                         }
                     } else if stride > 1 {
                         let (e, cols) = (&table.e, table.width);
-                        #[expect(clippy::cast_precision_loss, reason = "small")]
                         let s0f = s0 as f64;
                         for (r, &(_, alpha)) in rows.iter().enumerate() {
                             let u = ((p + d * alpha - s0f) * inv_stride).max(0.0);
-                            #[expect(
-                                clippy::cast_possible_truncation,
-                                clippy::cast_sign_loss,
-                                reason = "u >= 0"
-                            )]
                             let c = (u as usize).min(cols - 2);
-                            #[expect(clippy::cast_precision_loss, reason = "small")]
                             let f = u - c as f64;
                             let base = r * cols + c;
                             acc += e[base] + f * (e[base + 1] - e[base]);
@@ -404,7 +386,6 @@ fn solve_pass(
                 }
                 if cost < f_next[k] {
                     f_next[k] = cost;
-                    #[expect(clippy::cast_possible_truncation, reason = "counts are <= 65535")]
                     let jj = j as u16;
                     back_b[k] = jj;
                 }
@@ -441,10 +422,6 @@ fn solve_pass(
 fn interp_at(xs: &[usize], vals: &[f64], n: usize) -> f64 {
     let i = xs.partition_point(|&x| x <= n).clamp(1, xs.len() - 1);
     let (a, b) = (xs[i - 1], xs[i]);
-    #[expect(
-        clippy::cast_precision_loss,
-        reason = "sample counts are far below 2^52"
-    )]
     let alpha = (n.clamp(a, b) - a) as f64 / (b - a) as f64;
     vals[i - 1] + alpha * (vals[i] - vals[i - 1])
 }
@@ -455,16 +432,8 @@ fn expand(nodes: &[usize], vals: &[f64], n_ref: usize) -> Vec<f64> {
     for (seg, w) in nodes.windows(2).enumerate() {
         let (a, b) = (w[0], w[1]);
         let (p, q) = (vals[seg], vals[seg + 1]);
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let dr = (b - a) as f64;
         for (n, o) in out.iter_mut().enumerate().take(b + 1).skip(a) {
-            #[expect(
-                clippy::cast_precision_loss,
-                reason = "sample counts are far below 2^52"
-            )]
             let alpha = (n - a) as f64 / dr;
             *o = p + (q - p) * alpha;
         }
@@ -479,24 +448,48 @@ fn expand(nodes: &[usize], vals: &[f64], n_ref: usize) -> Vec<f64> {
     out
 }
 
+/// Query samples spanned by a slope change of [`COARSE_SLOPE_STEP`] over `seg` reference samples.
+fn slope_step_span(prep: &Prepared<'_>, seg: f64) -> f64 {
+    COARSE_SLOPE_STEP * seg * prep.qscale * prep.h
+}
+
+/// The best warp found so far (values at every reference sample) and its exact objective.
+struct Best {
+    values: Vec<f64>,
+    objective: f64,
+}
+
+impl Best {
+    /// Keeps `values` if its exact objective is lower.
+    fn offer(&mut self, prep: &Prepared<'_>, values: &[f64]) {
+        let objective = prep.objective(values);
+        if objective < self.objective {
+            self.objective = objective;
+            self.values.clear();
+            self.values.extend_from_slice(values);
+        }
+    }
+}
+
 fn align_prepared(prep: &Prepared<'_>, params: &WarpParams) -> Warp {
     let s = (params.slope_min, params.slope_max);
     let n_final = params.nodes_for(prep.nr);
     let nodes = spread_nodes(prep.nr, n_final);
     let n0 = params.coarse_nodes.min(n_final);
+    let points_for = |n_pass: usize| (n_pass < n_final).then_some(COARSE_POINTS_PER_SEGMENT);
+    // first pass: the whole band, candidates at most COARSE_SLOPE_STEP of slope apart
     let nodes0 = spread_nodes(prep.nr, n0);
-    let points0 = if n0 == n_final {
-        None
-    } else {
-        Some(COARSE_POINTS_PER_SEGMENT)
-    };
-    let grid0 = first_grid(prep, nodes0, params.coarse_candidates, s);
-    let (vals0, _) = solve_pass(prep, &grid0, s, None, points0)
+    let min_seg = nodes0.windows(2).map(|w| w[1] - w[0]).min().unwrap_or(1);
+    let max_step = slope_step_span(prep, min_seg as f64);
+    let grid0 = first_grid(prep, nodes0, params.coarse_candidates, max_step, s);
+    let (vals0, _) = solve_pass(prep, &grid0, s, None, points_for(n0))
         .expect("the identity warp is a feasible path of the first grid");
-    let mut best = expand(&grid0.nodes, &vals0, prep.nr);
-    let mut best_obj = prep.objective(&best);
+    let mut current = expand(&grid0.nodes, &vals0, prep.nr);
+    let mut best = Best {
+        objective: prep.objective(&current),
+        values: current.clone(),
+    };
     let mut prev = grid0;
-    let mut current = best.clone();
     for pass in 1..=params.refinements {
         // node count doubles every pass from the coarse count; the last pass uses all N nodes
         let n_pass = if pass == params.refinements {
@@ -504,46 +497,56 @@ fn align_prepared(prep: &Prepared<'_>, params: &WarpParams) -> Warp {
         } else {
             n0.saturating_mul(1usize << pass.min(40)).min(n_final)
         };
-        let nodes = if n_pass == n_final {
+        let pass_nodes = if n_pass == n_final {
             nodes.clone()
         } else {
             spread_nodes(prep.nr, n_pass)
         };
-        let points = if n_pass == n_final {
-            None
-        } else {
-            Some(COARSE_POINTS_PER_SEGMENT)
-        };
-        let prev_step: Vec<f64> = if prev.nodes == nodes {
-            prev.step.clone()
-        } else {
-            nodes
-                .iter()
-                .map(|&n| interp_at(&prev.nodes, &prev.step, n))
-                .collect()
-        };
-        let centers: Vec<f64> = nodes.iter().map(|&n| current[n]).collect();
+        // resolution of the previous pass at each new node: its candidate spacing, but at least
+        // the span of COARSE_SLOPE_STEP of slope over its node spacing (what its nodes and
+        // quadrature could not resolve, whatever its candidate count)
+        let prev_seg = (prep.nr - 1) as f64 / (prev.nodes.len() - 1) as f64;
+        let seg_res = slope_step_span(prep, prev_seg);
+        let prev_res: Vec<f64> = pass_nodes
+            .iter()
+            .map(|&n| interp_at(&prev.nodes, &prev.step, n).max(seg_res))
+            .collect();
+        let centers: Vec<f64> = pass_nodes.iter().map(|&n| current[n]).collect();
         let grid = refine_grid(
             prep,
-            nodes,
+            pass_nodes,
             &centers,
-            &prev_step,
+            &prev_res,
             params.n_candidates,
             params.refine_radius,
             s,
         );
-        let Some((vals, _)) = solve_pass(prep, &grid, s, params.max_jump, points) else {
+        let Some((vals, _)) = solve_pass(prep, &grid, s, params.max_jump, points_for(n_pass))
+        else {
             break;
         };
         current = expand(&grid.nodes, &vals, prep.nr);
-        let obj = prep.objective(&current);
-        if obj < best_obj {
-            best_obj = obj;
-            best.clone_from(&current);
-        }
+        best.offer(prep, &current);
         prev = grid;
     }
-    Warp::from_parts(best, best_obj)
+    // polish the best warp at fixed spacings on all N nodes (see POLISH_STEPS)
+    for step in POLISH_STEPS {
+        let centers: Vec<f64> = nodes.iter().map(|&n| best.values[n]).collect();
+        let steps = vec![step; nodes.len()];
+        let grid = tube_grid(
+            prep,
+            nodes.clone(),
+            &centers,
+            &steps,
+            POLISH_RADIUS,
+            POLISH_RADIUS,
+            s,
+        );
+        if let Some((vals, _)) = solve_pass(prep, &grid, s, None, None) {
+            best.offer(prep, &expand(&grid.nodes, &vals, prep.nr));
+        }
+    }
+    Warp::from_parts(best.values, best.objective)
 }
 
 /// Aligns `query` to `reference` with GDTW (paper §II-B1, Eq. 2–3): finds the warp
@@ -617,7 +620,7 @@ mod tests {
         let s = (params.slope_min, params.slope_max);
         let nodes = spread_nodes(200, 23);
         for m in [5, 41] {
-            let grid = first_grid(&prep, nodes.clone(), m, s);
+            let grid = first_grid(&prep, nodes.clone(), m, f64::INFINITY, s);
             let (vals, dp) = solve_pass(&prep, &grid, s, None, None).unwrap();
             let obj = prep.objective(&expand(&nodes, &vals, 200));
             assert!(
@@ -628,22 +631,64 @@ mod tests {
     }
 
     #[test]
-    fn refinement_never_worsens_the_objective() {
+    fn the_final_warp_is_never_worse_than_the_first_pass() {
         let r = ramp(300, |t| (9.0 * t).sin());
         let q = ramp(300, |t| (9.0 * t * t).sin());
         let (rs, qs) = (
             SignalRef::new(&r, 1).unwrap(),
             SignalRef::new(&q, 1).unwrap(),
         );
-        let mut last = f64::INFINITY;
-        for refinements in 0..4 {
-            let params = WarpParams {
-                refinements,
-                ..Default::default()
-            };
-            let obj = align(rs, qs, &params).unwrap().objective();
-            assert!(obj <= last + 1e-12, "{refinements}: {obj} > {last}");
-            last = obj;
+        let params = WarpParams::default();
+        let prep = Prepared::new(rs, qs, &params, "query").unwrap();
+        let s = (params.slope_min, params.slope_max);
+        let nodes = spread_nodes(300, params.nodes_for(300));
+        let grid = first_grid(
+            &prep,
+            nodes.clone(),
+            params.coarse_candidates,
+            f64::INFINITY,
+            s,
+        );
+        let (vals, _) = solve_pass(&prep, &grid, s, None, None).unwrap();
+        let first = prep.objective(&expand(&nodes, &vals, 300));
+        let warp = align(rs, qs, &params).unwrap();
+        assert!(warp.objective() <= first, "{} > {first}", warp.objective());
+    }
+
+    #[test]
+    fn more_effort_widens_a_refinement_grid() {
+        // the former defaults keep their grid: 15 candidates over ±2.5 previous spacings
+        assert_eq!(refine_count(15, 2.5), 15);
+        for m in [3, 4, 5, 15, 31] {
+            for radius in [0.5, 1.0, 2.5, 4.0] {
+                let count = refine_count(m, radius);
+                // the range reaches ±radius previous resolutions
+                let half = ((count - 1) / 2) as f64 * REFINE_SPACING_RATIO;
+                assert!(half >= radius - 1e-9 && count >= m, "{m} {radius}: {count}");
+                assert!(refine_count(m + 4, radius) >= count);
+                assert!(refine_count(m, radius + 0.5) >= count);
+            }
+        }
+    }
+
+    #[test]
+    fn more_coarse_nodes_bring_more_first_pass_candidates() {
+        // the first pass keeps neighbouring candidates within COARSE_SLOPE_STEP of slope
+        let r = ramp(600, |t| t);
+        let rs = SignalRef::new(&r, 1).unwrap();
+        let params = WarpParams::default();
+        let prep = Prepared::new(rs, rs, &params, "query").unwrap();
+        let s = (params.slope_min, params.slope_max);
+        let mut last = 0;
+        for n0 in [12, 48, 100, 200] {
+            let nodes = spread_nodes(600, n0);
+            let seg = nodes.windows(2).map(|w| w[1] - w[0]).min().unwrap() as f64;
+            let max_step = slope_step_span(&prep, seg);
+            let grid = first_grid(&prep, nodes, params.coarse_candidates, max_step, s);
+            assert!(grid.step.iter().all(|&st| st <= max_step + 1e-9));
+            let most = *grid.count.iter().max().unwrap();
+            assert!(most >= last, "{n0} nodes: {most} < {last} candidates");
+            last = most;
         }
     }
 }

@@ -65,10 +65,6 @@ pub(crate) fn check_values(values: &[f64], n_query: Option<usize>) -> Result<()>
     }
     if let Some(nq) = n_query {
         let last = values[values.len() - 1];
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let end = (nq - 1) as f64;
         if last != end {
             return bad(format!(
@@ -125,10 +121,6 @@ impl Warp {
             return 0.0;
         }
         let (a, b) = (v[idx - 1], v[idx]);
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "sample counts are far below 2^52"
-        )]
         let base = (idx - 1) as f64;
         base + (q - a) / (b - a)
     }
@@ -152,22 +144,9 @@ pub(crate) fn interp(v: &[f64], x: f64) -> f64 {
     if x.is_nan() {
         return f64::NAN;
     }
-    #[expect(
-        clippy::cast_precision_loss,
-        reason = "sample counts are far below 2^52"
-    )]
     let last = (v.len() - 1) as f64;
     let x = x.clamp(0.0, last);
-    #[expect(
-        clippy::cast_possible_truncation,
-        clippy::cast_sign_loss,
-        reason = "x is clamped to [0, len - 1]"
-    )]
     let i = (x.floor() as usize).min(v.len() - 2);
-    #[expect(
-        clippy::cast_precision_loss,
-        reason = "sample counts are far below 2^52"
-    )]
     let f = x - i as f64;
     v[i] + f * (v[i + 1] - v[i])
 }
