@@ -780,8 +780,8 @@ pub(crate) fn demo_data() -> Fig5Data {
                 (DEMO_EXEC_S + demo_offset_s(&lc), demo_high_conf_pct(&lc))
             })
             .unzip();
-        let (t_mean, t_std) = tandem::study::mean_std(t_totals.iter().copied());
-        let (p_mean, p_std) = tandem::study::mean_std(pcts.iter().copied());
+        let (t_mean, t_std) = tandem::sim::study::mean_std(t_totals.iter().copied());
+        let (p_mean, p_std) = tandem::sim::study::mean_std(pcts.iter().copied());
         fig.t_total_mean_s.push(t_mean);
         fig.t_total_std_s.push(t_std);
         fig.high_conf_pct_mean.push(p_mean);

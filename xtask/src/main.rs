@@ -10,7 +10,18 @@ mod reference_order;
 mod stress;
 mod study;
 
+use std::path::{Path, PathBuf};
+
 use clap::{Parser, Subcommand};
+
+/// The workspace root (the folder above `xtask/`): every path an xtask reads or writes by
+/// default is relative to it.
+pub(crate) fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives one folder below the workspace root")
+        .to_path_buf()
+}
 
 /// Command line of `cargo xtask`.
 #[derive(Parser)]

@@ -21,9 +21,10 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use serde::Serialize;
 use tandem::lfd::{Demonstration, Reference, TaskModel};
-use tandem::study::{StudyConfig, read_labels, run_trials};
+use tandem::sim::study::{StudyConfig, read_labels, run_trials};
 
-use crate::study::{read_config, workspace_root};
+use crate::study::read_config;
+use crate::workspace_root;
 
 /// Flags of `cargo xtask reference-order`.
 #[derive(clap::Args, Debug)]

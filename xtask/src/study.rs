@@ -1,7 +1,7 @@
 //! `cargo xtask study`: the simulated study of §III (Fig. 5).
 //!
 //! Reads the configuration (`fixtures/study.toml`, overridable by flags), runs the study
-//! loop of `tandem::study` on the fixture demonstrations with a progress bar on stderr,
+//! loop of `tandem::sim::study` on the fixture demonstrations with a progress bar on stderr,
 //! and writes under the output folder (default `results/`):
 //! `study.json` (compact; git revision, configuration, every trial and iteration, the
 //! per-iteration summary), `study.csv` (one row per trial and iteration), `fig5.svg` and `fig5.png`.
@@ -14,14 +14,15 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
-use tandem::study::{IterationSummary, PhaseTimes, StudyConfig, StudyInputs, StudyResult};
+use tandem::sim::study::{IterationSummary, PhaseTimes, StudyConfig, StudyInputs, StudyResult};
 
 use crate::fig5::{ExampleSchedule, Fig5Data, draw_fig5};
+use crate::workspace_root;
 
 /// Flags of `cargo xtask study`; unset flags take the configuration file's values.
 #[derive(clap::Args, Debug)]
 pub(crate) struct StudyArgs {
-    /// Study configuration (TOML with the fields of `tandem::study::StudyConfig`).
+    /// Study configuration (TOML with the fields of `tandem::sim::study::StudyConfig`).
     /// Default: fixtures/study.toml in the workspace.
     #[arg(long)]
     config: Option<PathBuf>,
@@ -57,14 +58,6 @@ struct StudyFile<'a> {
     summary: Vec<IterationSummary>,
     /// Everything else: configuration, trials, iterations.
     result: &'a StudyResult,
-}
-
-/// The workspace root (the folder above `xtask/`).
-pub(crate) fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("xtask lives one folder below the workspace root")
-        .to_path_buf()
 }
 
 fn git_revision(root: &Path) -> String {
@@ -189,7 +182,7 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
     );
     let trials_done = AtomicUsize::new(0);
     bar.set_message(format!("0/{} trials done", config.trials));
-    let (result, times) = tandem::study::run_study(&config, &inputs, &|p| {
+    let (result, times) = tandem::sim::study::run_study(&config, &inputs, &|p| {
         bar.inc(1);
         if p.pairs_done == n_pairs {
             let done = trials_done.fetch_add(1, Ordering::Relaxed) + 1;

@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tandem::lfd::{Demonstration, Execution};
+use tandem::lfd::Execution;
 use tandem::sim::workcell::{OperatorParams, PairRun, RobotRun, run_pair_with};
 use tandem::{ExecutionRecord, Planner, derive_seed};
 
@@ -46,13 +46,32 @@ fn run_pair(
     rng: &mut impl Rng,
 ) -> Result<PairRun> {
     Ok(run_pair_with(
-        planner.model(),
-        planner.problem(),
-        planner.schedule(),
+        planner,
         |robot, n| needed[robot][n],
         op,
         rng,
     )?)
+}
+
+/// File stem of robot `robot`'s execution in pair `pair` (both 1-based).
+fn stem(pair: usize, robot: usize) -> String {
+    format!("pair_{pair}_robot_{robot}")
+}
+
+/// `record` with its demonstration named like the file `--write` gives it, so that an error
+/// names the execution.
+fn named(record: ExecutionRecord, pair: usize, robot: usize) -> ExecutionRecord {
+    let demonstration = record
+        .execution
+        .demonstration
+        .with_source(format!("{}.csv", stem(pair, robot)));
+    ExecutionRecord {
+        execution: Execution {
+            demonstration,
+            ..record.execution
+        },
+        ..record
+    }
 }
 
 /// The three files of one execution, as `tandem record` reads them (numbers printed in
@@ -139,26 +158,17 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
             .with_context(|| format!("simulating pair {}", k + 1))?;
         let channels = planner.model().channel_names().to_vec();
         let dt = planner.model().dt_s();
-        let mut records = Vec::with_capacity(2);
-        for (i, log) in pair.robots.iter().enumerate() {
-            let stem = format!("pair_{}_robot_{}", k + 1, i + 1);
-            let demonstration = Demonstration::new(channels.clone(), log.samples.clone(), dt)?
-                .with_source(format!("{stem}.csv"));
-            records.push(ExecutionRecord {
-                execution: Execution {
-                    demonstration,
-                    ref_time_log: log.ref_time_log.clone(),
-                },
-                supervised: log.supervised.clone(),
-                corrected: log.corrected.clone(),
-            });
-            if let Some(dir) = &a.write {
+        if let Some(dir) = &a.write {
+            for (i, log) in pair.robots.iter().enumerate() {
+                let stem = stem(k + 1, i + 1);
                 let [e, l, c] = execution_files(log, &channels);
                 files.push((dir.join(format!("{stem}.csv")), e));
                 files.push((dir.join(format!("{stem}.reflog.csv")), l));
                 files.push((dir.join(format!("{stem}.corr.csv")), c));
             }
         }
+        let [r1, r2] = pair.records(planner.model())?;
+        let records = [named(r1, k + 1, 1), named(r2, k + 1, 2)];
         let supervised: usize = pair
             .robots
             .iter()
@@ -169,9 +179,6 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
             .iter()
             .map(|r| r.corrected.iter().filter(|s| **s).count())
             .sum();
-        let records: [ExecutionRecord; 2] = records
-            .try_into()
-            .map_err(|_| anyhow::anyhow!("internal: a pair has two robots"))?;
         let report = planner
             .record_pair(&records)
             .with_context(|| format!("recording simulated pair {}", k + 1))?;
@@ -215,7 +222,7 @@ fn write_file(p: &Path, text: &str) -> Result<()> {
 mod tests {
     use super::*;
     use tandem::PlannerParams;
-    use tandem::lfd::{FitParams, TaskModel};
+    use tandem::lfd::{Demonstration, FitParams, TaskModel};
     use tandem::schedule::SamplerParams;
 
     /// Three one-channel demonstrations aligned by known warps: demos 0 and 2 press 1 N

@@ -1,7 +1,7 @@
 //! The crate's error type.
 
-/// Everything that can go wrong in `tandem-sim`: the task generator ([`crate::task`]) and
-/// the simulated workcell ([`crate::workcell`]).
+/// Everything that can go wrong in `tandem-sim`: the task generator ([`crate::task`]), the
+/// simulated workcell ([`crate::workcell`]) and the study ([`crate::study`]).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
@@ -63,9 +63,20 @@ pub enum Error {
         /// The workcell's control period (`Δt_s`, real s).
         workcell_tick_s: f64,
     },
-    /// Workcell: the task model (commands, corrections, executions).
+    /// Study: an input file or data set is unusable.
+    #[error("{}: {why}", path.display())]
+    BadInput {
+        /// The file or folder concerned (or a description such as `<study inputs>`).
+        path: std::path::PathBuf,
+        /// What is wrong.
+        why: String,
+    },
+    /// Workcell and study: the task model (commands, corrections, executions, the fit).
     #[error(transparent)]
     Lfd(#[from] tandem_lfd::Error),
+    /// Study: the planner (model update, confidence, re-scheduling; Fig. 2).
+    #[error(transparent)]
+    Planner(#[from] tandem_planner::Error),
     /// Workcell: timelines or the coordinator.
     #[error(transparent)]
     Realtime(#[from] tandem_realtime::Error),

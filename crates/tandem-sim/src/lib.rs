@@ -8,6 +8,15 @@
 //! Every demonstration comes with per-sample ground-truth labels (pass, section, painted, phase)
 //! that the simulated study uses to decide whether a sample needs the operator's correction.
 //!
+//! The [`workcell`] runs a planner's schedule on two robots through the real-time coordinator
+//! while a simulated operator supervises the low-confidence robot
+//! ([`workcell::run_pair`]`(&planner, …)` reads model, problem, schedule and control tick from
+//! the one `tandem_planner::Planner`), and turns the pair into the planner's execution records
+//! ([`workcell::PairRun::records`]).
+//! The [`study`] is the paper's §III loop (Fig. 5): per trial, schedule, run a pair, record
+//! it, re-schedule, 150 times; trials in parallel, the same bytes for a seed on any number of
+//! threads.
+//!
 //! All samples are 9-dimensional (see [`task::CHANNELS`]): tool position in metres and
 //! orientation quaternion in the plate frame, normal force in newtons and tool on/off, sampled
 //! every `Δt_s` seconds of *demo time* (default 0.01 s, i.e. 100 Hz).
@@ -34,6 +43,7 @@
 //! ```
 
 mod error;
+pub mod study;
 pub mod task;
 pub mod workcell;
 

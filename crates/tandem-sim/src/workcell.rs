@@ -52,6 +52,7 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 use tandem_lfd::{Demonstration, Execution, TaskModel};
+use tandem_planner::{ExecutionRecord, Planner};
 use tandem_realtime::{Operator, Timeline, tol};
 use tandem_schedule::{Problem, Schedule};
 
@@ -164,16 +165,25 @@ pub struct RobotRun {
 }
 
 impl RobotRun {
-    /// The execution for the model update (Eq. 21): samples with `channel_names` and
-    /// period `dt_s`, plus the reference-time log.
+    /// The execution record for [`Planner::record_pair`] (Eq. 21): the samples as a
+    /// demonstration with `model`'s channel names and sample period, the reference-time log,
+    /// and the supervised and corrected flags.
     ///
     /// # Errors
     /// The model crate's error if the samples do not form a valid demonstration.
-    pub fn execution(&self, channel_names: &[String], dt_s: f64) -> Result<Execution> {
-        let demonstration = Demonstration::new(channel_names.to_vec(), self.samples.clone(), dt_s)?;
-        Ok(Execution {
-            demonstration,
-            ref_time_log: self.ref_time_log.clone(),
+    pub fn record(&self, model: &TaskModel) -> Result<ExecutionRecord> {
+        let demonstration = Demonstration::new(
+            model.channel_names().to_vec(),
+            self.samples.clone(),
+            model.dt_s(),
+        )?;
+        Ok(ExecutionRecord {
+            execution: Execution {
+                demonstration,
+                ref_time_log: self.ref_time_log.clone(),
+            },
+            supervised: self.supervised.clone(),
+            corrected: self.corrected.clone(),
         })
     }
 }
@@ -194,6 +204,16 @@ pub struct PairRun {
 }
 
 impl PairRun {
+    /// Both robots' execution records, robot 1 first, for [`Planner::record_pair`] (see
+    /// [`RobotRun::record`]); `model` is the planner's model the pair ran with.
+    ///
+    /// # Errors
+    /// The model crate's error if a robot's samples do not form a valid demonstration.
+    pub fn records(&self, model: &TaskModel) -> Result<[ExecutionRecord; 2]> {
+        let [a, b] = &self.robots;
+        Ok([a.record(model)?, b.record(model)?])
+    }
+
     /// Whether both robots were ever low-confidence in the same tick.
     #[must_use]
     pub fn overlapped(&self) -> bool {
@@ -286,56 +306,78 @@ fn correction_input(
     Ok(any)
 }
 
-/// Runs both robots of `schedule` to the end with a simulated operator on the sanding task
-/// (see the module docs): [`run_pair_with`] where a sample needs a correction when
-/// [`needs_correction`] says so for the reference label at the sample and the robot's own
-/// workpiece. `problem` must be the one `schedule` was made for, from `model`'s gradients;
-/// `labels` are the reference demonstration's labels (one per reference sample);
-/// `workpieces[i]` is robot `i`'s workpiece. Deterministic for the state of `rng`.
+/// Runs both robots of the planner's current schedule to the end with a simulated operator
+/// on the sanding task (see the module docs): [`run_pair_with`] where a sample needs a
+/// correction when [`needs_correction`] says so for the reference label at the sample and the
+/// robot's own workpiece. `labels` are the reference demonstration's labels (one per
+/// reference sample); `workpieces[i]` is robot `i`'s workpiece. Deterministic for the state
+/// of `rng`.
 ///
 /// # Errors
-/// Invalid parameters, mismatched sizes, a model without the force channel, or the lower
-/// crates' errors for an invalid schedule.
+/// As [`run_pair_with`], and [`Error::Mismatch`] for labels that are not one per reference
+/// sample.
 pub fn run_pair(
-    model: &TaskModel,
-    problem: &Problem,
-    schedule: &Schedule,
+    planner: &Planner,
     labels: &[Label],
     workpieces: &[Workpiece; 2],
     params: &OperatorParams,
     rng: &mut impl Rng,
 ) -> Result<PairRun> {
-    params.validate()?;
-    check_sizes(model, problem, schedule, Some(labels.len()))?;
+    let n_ref = planner.model().n_ref();
+    if labels.len() != n_ref {
+        return Err(Error::Mismatch {
+            what: "reference labels",
+            expected: n_ref,
+            found: labels.len(),
+        });
+    }
     run_pair_with(
-        model,
-        problem,
-        schedule,
+        planner,
         |robot, ref_idx| needs_correction(&labels[ref_idx], &workpieces[robot]),
         params,
         rng,
     )
 }
 
-/// Checks that the model, the labels (if any) and both robots' gradients have one entry per
-/// reference sample of `problem`, in that order.
-fn check_sizes(
-    model: &TaskModel,
-    problem: &Problem,
-    schedule: &Schedule,
-    labels: Option<usize>,
-) -> Result<()> {
+/// Runs both robots of the planner's current schedule to the end with a simulated operator
+/// (see the module docs), the caller deciding which samples need a correction:
+/// `needs(robot, ref_idx)` says whether robot `robot` (0 or 1) needs the operator at
+/// reference sample `ref_idx` (`round(t_i)`, in `0..n_ref`). It is asked once per supervised
+/// sample, just before the operator's draw from `rng`; samples of high confidence are never
+/// asked about. Model, problem, schedule and control tick are the planner's, so they agree
+/// by construction. Deterministic for the state of `rng` (and a deterministic `needs`).
+///
+/// # Errors
+/// Invalid parameters, a model without the force channel, a schedule checked at a tick other
+/// than the workcell's ([`Error::TickMismatch`]), a degenerate command, or a pair that does
+/// not finish ([`Error::DidNotFinish`]).
+pub fn run_pair_with(
+    planner: &Planner,
+    needs: impl FnMut(usize, usize) -> bool,
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<PairRun> {
+    run_schedule(
+        planner.model(),
+        planner.problem(),
+        planner.schedule(),
+        needs,
+        params,
+        rng,
+    )
+}
+
+/// Checks that the model and both robots' gradients have one entry per reference sample of
+/// `problem`, in that order.
+fn check_sizes(model: &TaskModel, problem: &Problem, schedule: &Schedule) -> Result<()> {
     let n_ref = problem.n_ref();
     let sizes = [
-        ("model reference samples", Some(model.n_ref())),
-        ("reference labels", labels),
-        ("robot 1 gradients", Some(schedule.grad_exec[0].len())),
-        ("robot 2 gradients", Some(schedule.grad_exec[1].len())),
+        ("model reference samples", model.n_ref()),
+        ("robot 1 gradients", schedule.grad_exec[0].len()),
+        ("robot 2 gradients", schedule.grad_exec[1].len()),
     ];
     for (what, found) in sizes {
-        if let Some(found) = found
-            && found != n_ref
-        {
+        if found != n_ref {
             return Err(Error::Mismatch {
                 what,
                 expected: n_ref,
@@ -346,18 +388,9 @@ fn check_sizes(
     Ok(())
 }
 
-/// Runs both robots of `schedule` to the end with a simulated operator (see the module
-/// docs), the caller deciding which samples need a correction: `needs(robot, ref_idx)`
-/// says whether robot `robot` (0 or 1) needs the operator at reference sample `ref_idx`
-/// (`round(t_i)`, in `0..n_ref`). It is asked once per supervised sample, just before the
-/// operator's draw from `rng`; samples of high confidence are never asked about.
-/// `problem` must be the one `schedule` was made for, from `model`'s gradients.
-/// Deterministic for the state of `rng` (and a deterministic `needs`).
-///
-/// # Errors
-/// Invalid parameters, mismatched sizes, a model without the force channel, or the lower
-/// crates' errors for an invalid schedule.
-pub fn run_pair_with(
+/// [`run_pair_with`] on the parts of a planner: `problem` must be the one `schedule` was
+/// made for, from `model`'s gradients (the unit tests build them by hand).
+fn run_schedule(
     model: &TaskModel,
     problem: &Problem,
     schedule: &Schedule,
@@ -366,7 +399,7 @@ pub fn run_pair_with(
     rng: &mut impl Rng,
 ) -> Result<PairRun> {
     params.validate()?;
-    check_sizes(model, problem, schedule, None)?;
+    check_sizes(model, problem, schedule)?;
     let n_ref = problem.n_ref();
     let force_idx = model
         .tangent_names()
@@ -583,24 +616,40 @@ mod tests {
         }
     }
 
+    /// Whether robot `robot` needs the operator at reference sample `ref_idx` on the
+    /// painted labels and workpieces ([`run_pair`]'s rule).
+    fn painted_needs(robot: usize, ref_idx: usize) -> bool {
+        needs_correction(
+            &painted_labels()[ref_idx],
+            &[all_painted(), all_painted()][robot],
+        )
+    }
+
+    /// The serial schedule of the hand-made problem, run with `params`: the pair and its
+    /// planned `T_total` (s).
     fn run(params: &OperatorParams, seed: u64) -> (PairRun, f64) {
         let model = model();
         let problem = problem(&model);
         let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
         let planned_s = schedule.t_total_s(problem.dt_s());
-        let wp = [all_painted(), all_painted()];
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let run = run_pair(
-            &model,
-            &problem,
-            &schedule,
-            &painted_labels(),
-            &wp,
-            params,
-            &mut rng,
-        )
-        .unwrap();
+        let run =
+            run_schedule(&model, &problem, &schedule, painted_needs, params, &mut rng).unwrap();
         (run, planned_s)
+    }
+
+    /// A planner on the hand-made model: low confidence exactly where the demonstrations
+    /// differ (samples 10..20), a sampled schedule at the workcell's tick.
+    fn planner() -> Planner {
+        let params = tandem_planner::PlannerParams {
+            sampler: tandem_schedule::SamplerParams {
+                samples: 50,
+                seed: 3,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        Planner::from_model(model(), params).unwrap()
     }
 
     #[test]
@@ -714,24 +763,53 @@ mod tests {
     }
 
     #[test]
-    fn run_pair_with_asks_the_caller_only_about_supervised_samples() {
-        let model = model();
-        let problem = problem(&model);
-        let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
+    fn run_pair_reads_everything_from_the_planner() {
+        let planner = planner();
+        let conf = planner.confidence().conf();
+        assert!(
+            (0..N_REF).all(|n| conf[n] != (10..20).contains(&n)),
+            "{conf:?}"
+        );
         let p = OperatorParams::default();
-        // The labels' closure gives exactly run_pair's run.
         let (labels, wp) = (painted_labels(), [all_painted(), all_painted()]);
         let mut rng = ChaCha8Rng::seed_from_u64(7);
-        let same = run_pair_with(
-            &model,
-            &problem,
-            &schedule,
-            |i, n| needs_correction(&labels[n], &wp[i]),
+        let by_labels = run_pair(&planner, &labels, &wp, &p, &mut rng).unwrap();
+        assert_eq!(by_labels.overlap_ticks, 0);
+        assert_eq!(by_labels.tick_s, planner.schedule().tick_s);
+        // The same as the caller's rule, and as the planner's parts run by hand.
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let by_rule = run_pair_with(&planner, painted_needs, &p, &mut rng).unwrap();
+        assert_eq!(by_rule, by_labels);
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let by_parts = run_schedule(
+            planner.model(),
+            planner.problem(),
+            planner.schedule(),
+            painted_needs,
             &p,
             &mut rng,
         )
         .unwrap();
-        assert_eq!(same, run(&p, 7).0);
+        assert_eq!(by_parts, by_labels);
+        // Its records are what the planner takes (Eq. 21): one per robot, flags per sample.
+        let records = by_labels.records(planner.model()).unwrap();
+        for (record, robot) in records.iter().zip(&by_labels.robots) {
+            assert_eq!(record.execution.ref_time_log, robot.ref_time_log);
+            assert_eq!(record.execution.demonstration.samples(), &robot.samples[..]);
+            assert_eq!(record.supervised, robot.supervised);
+            assert_eq!(record.corrected, robot.corrected);
+        }
+        let mut next = planner.clone();
+        next.record_pair(&records).unwrap();
+        assert_eq!(next.model().count(), planner.model().count() + 2);
+    }
+
+    #[test]
+    fn run_pair_with_asks_the_caller_only_about_supervised_samples() {
+        let model = model();
+        let problem = problem(&model);
+        let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
         // Only robot 1 needs the operator; a perfect operator corrects exactly its
         // supervised samples, and is asked about nothing but low-confidence samples.
         let perfect = OperatorParams {
@@ -740,7 +818,7 @@ mod tests {
             ..OperatorParams::default()
         };
         let mut asked = Vec::new();
-        let run = run_pair_with(
+        let run = run_schedule(
             &model,
             &problem,
             &schedule,
@@ -773,24 +851,19 @@ mod tests {
 
     #[test]
     fn a_schedule_checked_at_another_tick_is_rejected() {
-        let model = model();
-        let problem = problem(&model);
-        let dt_s = problem.dt_s();
-        // Checked at half the workcell's period: its margins say nothing about 10 ms ticks.
-        let schedule = problem.serial_schedule(dt_s / 2.0).unwrap();
+        let mut planner = planner();
+        let dt_s = planner.problem().dt_s();
+        // Re-scheduled at half the workcell's period: its margins say nothing about 10 ms ticks.
+        let half = tandem_schedule::SamplerParams {
+            tick_s: Some(dt_s / 2.0),
+            ..planner.params().sampler.clone()
+        };
+        planner.reschedule(&half).unwrap();
+        assert_eq!(planner.schedule().tick_s, dt_s / 2.0);
         let mut rng = ChaCha8Rng::seed_from_u64(0);
         let p = OperatorParams::default();
         let wp = [all_painted(), all_painted()];
-        let err = run_pair(
-            &model,
-            &problem,
-            &schedule,
-            &painted_labels(),
-            &wp,
-            &p,
-            &mut rng,
-        )
-        .unwrap_err();
+        let err = run_pair(&planner, &painted_labels(), &wp, &p, &mut rng).unwrap_err();
         assert!(
             matches!(
                 err,
@@ -803,25 +876,24 @@ mod tests {
         );
         let msg = err.to_string();
         assert!(msg.contains("0.005 s") && msg.contains("0.01 s"), "{msg}");
-        let err = run_pair_with(&model, &problem, &schedule, |_, _| true, &p, &mut rng);
+        let err = run_pair_with(&planner, |_, _| true, &p, &mut rng);
         assert!(matches!(err, Err(Error::TickMismatch { .. })));
-        // At the workcell's own tick (the sampler's default) it runs.
-        let ok = problem.serial_schedule(dt_s).unwrap();
-        assert!(run_pair_with(&model, &problem, &ok, |_, _| true, &p, &mut rng).is_ok());
+        // Re-scheduled at the workcell's own tick (the sampler's default) it runs.
+        let own = tandem_schedule::SamplerParams {
+            tick_s: None,
+            ..half
+        };
+        planner.reschedule(&own).unwrap();
+        assert!(run_pair_with(&planner, |_, _| true, &p, &mut rng).is_ok());
     }
 
     #[test]
     fn same_seed_same_run_and_mismatches_are_errors() {
         let p = OperatorParams::default();
         assert_eq!(run(&p, 7).0, run(&p, 7).0);
-        let model = model();
-        let problem = problem(&model);
-        let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(0);
         let err = run_pair(
-            &model,
-            &problem,
-            &schedule,
+            &planner(),
             &painted_labels()[..5],
             &[all_painted(), all_painted()],
             &p,
@@ -832,7 +904,8 @@ mod tests {
             err,
             Error::Mismatch {
                 what: "reference labels",
-                ..
+                expected: N_REF,
+                found: 5,
             }
         ));
     }

@@ -15,11 +15,13 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::lfd::{Demonstration, TaskModel};
-use crate::schedule::{GlobalTimeline, Source};
-use crate::sim::task::{self, Label, TaskParams, Workpiece};
-use crate::sim::workcell::{self, OperatorParams};
-use crate::{Error, ExecutionRecord, Planner, PlannerParams, Result};
+use tandem_lfd::{Demonstration, TaskModel};
+use tandem_planner::{Planner, PlannerParams, derive_seed};
+use tandem_schedule::{GlobalTimeline, Source};
+
+use crate::task::{self, Label, TaskParams, Workpiece};
+use crate::workcell::{self, OperatorParams};
+use crate::{Error, Result};
 
 /// Study configuration (`fixtures/study.toml`, §III).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -40,7 +42,7 @@ pub struct StudyConfig {
     /// Default: 0.01.
     pub false_correction_rate: f64,
     /// Mean duration (s) of one unneeded correction episode (see
-    /// `tandem_sim::workcell::OperatorParams::false_correction_s`). Default: 0.5 s.
+    /// [`OperatorParams::false_correction_s`]). Default: 0.5 s.
     pub false_correction_s: f64,
     /// Iterations whose schedules Fig. 5 draws as examples (trial 0). Default: 0, 25, 50, 100, 150.
     pub example_iterations: Vec<usize>,
@@ -149,13 +151,57 @@ pub struct IterationRecord {
     pub offset_s: f64,
     /// Share of reference samples that are high-confidence (Eq. 12), in percent.
     pub high_conf_pct: f64,
-    /// Where the schedule came from: `sampled`, `previous`, `repaired` (the previous
-    /// schedule re-projected onto the new problem) or `serial`.
-    pub source: String,
+    /// Where the schedule came from.
+    pub source: ScheduleSource,
     /// Planned low-confidence intervals `[start_s, end_s)` of robot 1 and robot 2 (global time, s).
     pub lc_intervals_s: [Vec<[f64; 2]>; 2],
     /// The outcome of running the next pair under this schedule (`None` for the last one).
     pub pair: Option<PairStats>,
+}
+
+/// Where a study iteration's schedule came from: the kind of [`tandem_schedule::Source`]
+/// without the candidate index, under the name the study's JSON and CSV give it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ScheduleSource {
+    /// A candidate of the anytime sampler (`Source::Sampled`): `sampled`.
+    Sampled,
+    /// The previous schedule, unchanged (`Source::Previous`): `previous`.
+    Previous,
+    /// The previous schedule re-projected onto the new problem (`Source::RepairedPrevious`):
+    /// `repaired`.
+    Repaired,
+    /// The fastest serial schedule (`Source::Serial`): `serial`.
+    Serial,
+}
+
+impl ScheduleSource {
+    /// The name in the study's JSON and CSV.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Sampled => "sampled",
+            Self::Previous => "previous",
+            Self::Repaired => "repaired",
+            Self::Serial => "serial",
+        }
+    }
+}
+
+impl From<Source> for ScheduleSource {
+    fn from(source: Source) -> Self {
+        match source {
+            Source::Sampled { .. } => Self::Sampled,
+            Source::Previous => Self::Previous,
+            Source::RepairedPrevious => Self::Repaired,
+            Source::Serial => Self::Serial,
+        }
+    }
+}
+
+impl std::fmt::Display for ScheduleSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// One trial: its seed and every iteration.
@@ -201,10 +247,10 @@ pub struct IterationSummary {
     pub overlap_ticks: usize,
 }
 
-/// Seed of trial `trial` from the master `seed` ([`crate::derive_seed`]), so trials are
+/// Seed of trial `trial` from the master `seed` ([`derive_seed`]), so trials are
 /// independent of each other and of the order in which threads run them.
 pub fn trial_seed(seed: u64, trial: usize) -> u64 {
-    crate::derive_seed(seed, trial as u64)
+    derive_seed(seed, trial as u64)
 }
 
 impl StudyResult {
@@ -379,7 +425,7 @@ impl StudyInputs {
         Ok(inputs)
     }
 
-    /// From demonstrations made by the task generator (`tandem_sim::task`), demo 0 the
+    /// From demonstrations made by the task generator ([`crate::task`]), demo 0 the
     /// reference: channels [`task::CHANNELS`], each demo's own `Δt_s`.
     ///
     /// # Errors
@@ -441,17 +487,6 @@ pub fn read_labels(path: &Path) -> Result<Vec<Label>> {
         .collect()
 }
 
-/// Short name of a schedule's source for the records.
-fn source_name(source: Source) -> String {
-    match source {
-        Source::Sampled { .. } => "sampled",
-        Source::Previous => "previous",
-        Source::RepairedPrevious => "repaired",
-        Source::Serial => "serial",
-    }
-    .to_string()
-}
-
 /// The record of the planner's current schedule (no pair run yet).
 fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
     let schedule = planner.schedule();
@@ -465,7 +500,7 @@ fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
         t_total_s: planner.outcome().t_total_s,
         offset_s: schedule.offset_s,
         high_conf_pct: 100.0 * planner.confidence().high_share(),
-        source: source_name(planner.outcome().source),
+        source: planner.outcome().source.into(),
         lc_intervals_s,
         pair: None,
     })
@@ -505,27 +540,8 @@ pub fn run_trial(
             Workpiece::random(&config.task, &mut rng)?,
         ];
         let t = Instant::now();
-        let run = workcell::run_pair(
-            planner.model(),
-            planner.problem(),
-            planner.schedule(),
-            reference_labels,
-            &workpieces,
-            &operator,
-            &mut rng,
-        )?;
-        let (names, dt_s) = (planner.model().channel_names(), planner.model().dt_s());
-        let mut records = Vec::with_capacity(2);
-        for robot in &run.robots {
-            records.push(ExecutionRecord {
-                execution: robot.execution(names, dt_s)?,
-                supervised: robot.supervised.clone(),
-                corrected: robot.corrected.clone(),
-            });
-        }
-        let records: [ExecutionRecord; 2] = records
-            .try_into()
-            .expect("one execution record per robot of the pair");
+        let run = workcell::run_pair(&planner, reference_labels, &workpieces, &operator, &mut rng)?;
+        let records = run.records(planner.model())?;
         times.simulation += t.elapsed();
         let count = |f: fn(&bool) -> bool, pick: fn(&workcell::RobotRun) -> &Vec<bool>| {
             run.robots
@@ -670,7 +686,7 @@ mod tests {
             t_total_s,
             offset_s: 1.0,
             high_conf_pct: 10.0 * iteration as f64,
-            source: "sampled".into(),
+            source: ScheduleSource::Sampled,
             lc_intervals_s: [vec![[0.0, 1.5]], vec![[2.0, 2.25], [3.0, 4.0]]],
             pair: pair.then_some(PairStats {
                 overlap_ticks: 0,
@@ -767,6 +783,31 @@ mod tests {
         .unwrap();
         let c: StudyConfig = toml::from_str(&committed).unwrap();
         assert_eq!(c, StudyConfig::default());
+    }
+
+    #[test]
+    fn schedule_sources_keep_their_names_in_json_csv_and_display() {
+        let cases = [
+            (
+                Source::Sampled { candidate: 41 },
+                ScheduleSource::Sampled,
+                "sampled",
+            ),
+            (Source::Previous, ScheduleSource::Previous, "previous"),
+            (
+                Source::RepairedPrevious,
+                ScheduleSource::Repaired,
+                "repaired",
+            ),
+            (Source::Serial, ScheduleSource::Serial, "serial"),
+        ];
+        for (source, kind, name) in cases {
+            assert_eq!(ScheduleSource::from(source), kind);
+            assert_eq!(kind.to_string(), name);
+            let json = serde_json::to_string(&kind).unwrap();
+            assert_eq!(json, format!("\"{name}\""));
+            assert_eq!(serde_json::from_str::<ScheduleSource>(&json).unwrap(), kind);
+        }
     }
 
     #[test]

@@ -1,8 +1,9 @@
-//! The facade's error type.
+//! The crate's error type.
 
 use std::path::PathBuf;
 
-/// Everything that can go wrong in the facade: state files, and the lower crates' errors.
+/// Everything that can go wrong in `tandem-planner`: state files, execution records, and the
+/// lower crates' errors.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
@@ -23,7 +24,11 @@ pub enum Error {
         path: PathBuf,
     },
     /// The file was written by a build with another state format version.
-    #[error("{}: state format version {found}, this build reads version {expected}", path.display())]
+    #[error(
+        "{}: state format version {found}, this build reads version {expected} only ({})",
+        path.display(),
+        version_advice(*found, *expected)
+    )]
     UnsupportedVersion {
         /// The file concerned.
         path: PathBuf,
@@ -50,27 +55,11 @@ pub enum Error {
         /// What is wrong (checksum, decoding, trailing bytes).
         why: String,
     },
-    /// A parameter is out of its documented range.
-    #[error("parameter `{name}` {why}")]
-    BadParam {
-        /// The parameter's field name.
-        name: &'static str,
-        /// What its value must be.
-        why: &'static str,
-    },
     /// An execution record is malformed.
     #[error("bad execution record: `{what}`: {why}")]
     BadExecution {
         /// Which part.
         what: &'static str,
-        /// What is wrong.
-        why: String,
-    },
-    /// An input file or data set is unusable.
-    #[error("{}: {why}", path.display())]
-    BadInput {
-        /// The file or folder concerned.
-        path: PathBuf,
         /// What is wrong.
         why: String,
     },
@@ -82,24 +71,18 @@ pub enum Error {
         /// What is wrong.
         why: String,
     },
-    /// Time warping failed (§II-B1).
-    #[error(transparent)]
-    Warp(#[from] tandem_warp::Error),
-    /// Demonstrations, executions or the task model (§II-B1/2).
+    /// Demonstrations, executions or the task model (§II-B1/2), alignment included.
     #[error(transparent)]
     Lfd(#[from] tandem_lfd::Error),
     /// Confidence (§II-B3).
     #[error(transparent)]
     Confidence(#[from] tandem_confidence::Error),
-    /// Real-time coordination (§II-B5).
+    /// Real-time coordination (§II-B5): the coordinator of the current schedule.
     #[error(transparent)]
     Realtime(#[from] tandem_realtime::Error),
     /// Scheduling (§II-B4/6).
     #[error(transparent)]
     Schedule(#[from] tandem_schedule::Error),
-    /// Simulation (§III): the task generator and the simulated workcell.
-    #[error(transparent)]
-    Sim(#[from] tandem_sim::Error),
     /// The state could not be serialized.
     #[error("cannot encode state: {source}")]
     Encode {
@@ -108,5 +91,14 @@ pub enum Error {
     },
 }
 
-/// Result alias of the facade.
+/// What to do about a state file of format `found` in a build that reads `expected`.
+fn version_advice(found: u32, expected: u32) -> &'static str {
+    if found < expected {
+        "written by an older build: fit again with this build, or keep using the build that wrote it"
+    } else {
+        "written by a newer build: use that build"
+    }
+}
+
+/// `Result` with this crate's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -6,10 +6,12 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use crate::lfd::{Demonstration, Execution, FitParams, TaskModel};
-use crate::schedule::{Outcome, Problem, SamplerParams, Schedule, Source, sample_schedule};
-use crate::{Error, Result, confidence, derive_seed, state};
-use confidence::{Confidence, ConfidenceParams, Observations};
+use tandem_confidence::{Confidence, ConfidenceParams, Observations};
+use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
+use tandem_realtime::Coordinator;
+use tandem_schedule::{Outcome, Problem, SamplerParams, Schedule, Source, sample_schedule};
+
+use crate::{Error, Result, derive_seed, state};
 
 /// Parameters of a [`Planner`]: one block per stage of Fig. 2.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -164,9 +166,10 @@ fn problem_for(model: &TaskModel, confidence: &Confidence) -> Result<Problem> {
 }
 
 impl Planner {
-    /// Learns the task from demonstrations (demo 0 is the reference) and makes the first
-    /// schedule: aligns and fits the model (§II-B1/2), sets the confidence from the prior
-    /// alone (Eq. 10–12) and samples a schedule (§II-C) with seed `derive_seed(seed, 0)`.
+    /// Learns the task from demonstrations (the reference is the one `params.fit.reference`
+    /// chooses) and makes the first schedule: aligns and fits the model (§II-B1/2), sets the
+    /// confidence from the prior alone (Eq. 10–12) and samples a schedule (§II-C) with seed
+    /// `derive_seed(seed, 0)`.
     ///
     /// # Errors
     /// Invalid parameters, or the lower crates' errors for the demonstrations.
@@ -277,6 +280,17 @@ impl Planner {
     /// The current schedule.
     pub fn schedule(&self) -> &Schedule {
         &self.outcome.schedule
+    }
+
+    /// The real-time coordinator (Eq. 17–18, Alg. 1) of the current schedule on the current
+    /// problem, at the control tick the schedule was checked with ([`Schedule::tick_s`]): what
+    /// runs the two robots until the next [`Planner::record_pair`].
+    ///
+    /// # Errors
+    /// The schedule crate's error if the schedule does not lay out on the problem (not for a
+    /// planner made by [`Planner::new`], [`Planner::from_model`] or [`Planner::load`]).
+    pub fn coordinator(&self) -> Result<Coordinator> {
+        Ok(self.schedule().coordinator(&self.problem)?)
     }
 
     /// The sampler's result for the current schedule (`T_total`, source, counts).
@@ -474,7 +488,7 @@ mod tests {
             let t = p.reschedule(&sp).unwrap().t_total_s;
             assert!(t <= t_prev, "seed {seed}: {t} > {t_prev}");
             assert_eq!(t, p.schedule().t_total_s(p.problem().dt_s()));
-            crate::schedule::validate(p.problem(), p.schedule()).unwrap();
+            tandem_schedule::validate(p.problem(), p.schedule()).unwrap();
             t_prev = t;
         }
         // Only the outcome changes.

@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
-use tandem::lfd::{FitParams, TaskModel};
-use tandem::study::StudyInputs;
+use tandem_lfd::{FitParams, TaskModel};
+use tandem_sim::study::StudyInputs;
 
 /// `fixtures/sanding/` as study inputs, and the task model fitted on them with the defaults.
 pub(crate) fn fixtures() -> &'static (StudyInputs, TaskModel) {

@@ -2,7 +2,7 @@
 
 mod common;
 
-use tandem::study::{StudyConfig, StudyResult, run_trials};
+use tandem_sim::study::{ScheduleSource, StudyConfig, StudyResult, run_trials};
 
 fn run(config: &StudyConfig) -> StudyResult {
     let (inputs, model) = common::fixtures();
@@ -49,7 +49,7 @@ fn reduced_study_never_overlaps_and_learns() {
     // the first sampled schedules come after 22-24 pairs, once the transitions are
     // mostly high-confidence).
     assert!(
-        its.iter().any(|r| r.source == "sampled"),
+        its.iter().any(|r| r.source == ScheduleSource::Sampled),
         "{:?}",
         its.iter().map(|r| &r.source).collect::<Vec<_>>()
     );
@@ -109,15 +109,15 @@ fn a_study_needs_the_labels_of_its_reference() {
         samples: 20,
         ..StudyConfig::default()
     };
-    config.planner.fit.reference = tandem::lfd::Reference::Medoid;
-    let e = tandem::study::run_study(&config, inputs, &|_| {}).unwrap_err();
+    config.planner.fit.reference = tandem_lfd::Reference::Medoid;
+    let e = tandem_sim::study::run_study(&config, inputs, &|_| {}).unwrap_err();
     assert!(
         e.to_string().contains("chose demo 2 as the reference"),
         "{e}"
     );
     let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/sanding");
-    let labels = tandem::study::read_labels(&dir.join("demo_2.labels.csv")).unwrap();
-    let model = tandem::lfd::TaskModel::fit(&inputs.demos, &config.planner.fit).unwrap();
+    let labels = tandem_sim::study::read_labels(&dir.join("demo_2.labels.csv")).unwrap();
+    let model = tandem_lfd::TaskModel::fit(&inputs.demos, &config.planner.fit).unwrap();
     assert_eq!(model.n_ref(), labels.len());
     let (result, _) = run_trials(&config, &model, &labels, &|_| {}).unwrap();
     assert_eq!(result.n_ref, labels.len());

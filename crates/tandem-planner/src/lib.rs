@@ -1,0 +1,73 @@
+//! The iterative loop of the paper's Fig. 2 (§II-C, Eq. 21).
+//!
+//! A [`Planner`] holds what the system has learned so far: the task model fitted on the
+//! expert demonstrations (`tandem_lfd`, §II-B1/2), the operator's correction observations
+//! and the latched confidence (`tandem_confidence`, Eq. 8–12), the scheduling problem and the
+//! current schedule (`tandem_schedule`, §II-B4/6, §II-C). After every pair of executions,
+//! [`Planner::record_pair`] adds both executions to the model with their known
+//! reference-time logs (Eq. 21), adds their supervised samples to the observations, updates
+//! the confidence and re-schedules, warm-started by the previous schedule. The robots run the
+//! schedule through [`Planner::coordinator`] (`tandem_realtime`, Eq. 17–18, Alg. 1/2), at the
+//! control tick the schedule was checked with.
+//!
+//! The planner is saved as a versioned, checksummed, atomically written file ([`state`]):
+//! a crash while saving never loses the recorded executions.
+//!
+//! ```
+//! use tandem_lfd::{Demonstration, Execution};
+//! use tandem_planner::{ExecutionRecord, Planner, PlannerParams};
+//! use tandem_schedule::SamplerParams;
+//!
+//! // Three demonstrations of a one-channel task (force, N) at 10 ms: the experts agree
+//! // except over samples 10..20, where they press 2, 5 or 8 N.
+//! let demo = |press: f64| {
+//!     let force = (0..40).map(|n| if (10..20).contains(&n) { press } else { 1.0 }).collect();
+//!     Demonstration::new(vec!["force".into()], force, 0.01)
+//! };
+//! let demos = [demo(2.0)?, demo(5.0)?, demo(8.0)?];
+//! let sampler = SamplerParams { samples: 200, seed: 7, ..SamplerParams::default() };
+//! let mut planner = Planner::new(&demos, PlannerParams { sampler, ..PlannerParams::default() })?;
+//! // Where the experts disagree the robots may need help: low confidence there (Eq. 10–12).
+//! let low = planner.confidence().conf().iter().filter(|c| !**c).count();
+//! assert!(low >= 10);
+//!
+//! // A pair of executions that replay the reference demonstration, supervised on the
+//! // low-confidence samples, never corrected: the operator was not needed there.
+//! let record = ExecutionRecord {
+//!     execution: Execution {
+//!         demonstration: demos[0].clone(),
+//!         ref_time_log: (0..40).map(f64::from).collect(),
+//!     },
+//!     supervised: planner.confidence().conf().iter().map(|c| !c).collect(),
+//!     corrected: vec![false; 40],
+//! };
+//! let report = planner.record_pair(&[record.clone(), record])?;
+//! assert_eq!(planner.pairs_recorded(), 1);
+//! assert_eq!(planner.model().count(), 5, "three demonstrations and two executions (Eq. 21)");
+//! assert_eq!(report.t_total_s, planner.outcome().t_total_s);
+//! // The new schedule runs at the tick it was checked with.
+//! assert_eq!(planner.coordinator()?.tick_s(), planner.schedule().tick_s);
+//! # Ok::<(), tandem_planner::Error>(())
+//! ```
+
+mod error;
+mod planner;
+pub mod state;
+
+pub use error::{Error, Result};
+pub use planner::{ExecutionRecord, Planner, PlannerParams, RecordReport};
+
+/// A seed for item `index` of a seeded family (trial `k` of a study, the schedule after
+/// `k` recorded pairs): SplitMix64 of both, so items are independent of each other and of
+/// the order in which threads process them.
+pub fn derive_seed(seed: u64, index: u64) -> u64 {
+    splitmix64(seed ^ splitmix64(index.wrapping_add(1)))
+}
+
+/// One SplitMix64 output for state `x` (Steele, Lea & Flood 2014).
+fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
