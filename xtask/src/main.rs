@@ -36,7 +36,8 @@ struct Cli {
 enum Cmd {
     /// Run the simulated study of §III and draw Fig. 5 (defaults: fixtures/study.toml).
     Study(study::StudyArgs),
-    /// Regenerate the sanding demonstrations in fixtures/sanding/ (see fixtures/README.md).
+    /// Regenerate the generated fixtures: the sanding demonstrations in fixtures/sanding/
+    /// and the golden state file in fixtures/state/ (see fixtures/README.md).
     Fixtures {
         /// Write nothing; fail, naming the files, if the committed fixtures differ.
         #[arg(long)]

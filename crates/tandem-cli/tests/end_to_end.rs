@@ -220,6 +220,12 @@ fn documented_examples_work() {
     assert_eq!(p.params().fit.k_max, 2);
     let [a, b] = pair_files(&ex, 1);
     ok(&tandem(record_args(&state, &a, &b)));
+    // The walk-through writes exactly the committed golden state file (`cargo xtask fixtures`).
+    assert!(
+        std::fs::read(&state).unwrap()
+            == std::fs::read(repo().join("fixtures/state/example.tandem")).unwrap(),
+        "tandem fit + record on fixtures/examples/ differ from fixtures/state/example.tandem"
+    );
     let p = Planner::load(&state).unwrap();
     assert_eq!(p.pairs_recorded(), 1);
     // 42 samples per execution, all supervised before the first update.

@@ -15,6 +15,20 @@
 //! exactly the announced length (shorter = truncated, longer = trailing garbage), the
 //! checksum matches, and `postcard` decodes the payload using every byte.
 //! Each failure is its own [`Error`] variant naming the file.
+//! A file of another version is refused ([`Error::UnsupportedVersion`] says whether it is
+//! older or newer than the build); there is no migration.
+//!
+//! # The golden file
+//!
+//! `fixtures/state/example.tandem` is a committed file of the current version: the planner of
+//! the guide's walk-through on `fixtures/examples/` (fit on `demo_{0,1,2}.csv` with
+//! `params.toml`, then the pair `pair_1_robot_{1,2}` recorded). `tests/state_file.rs` loads it
+//! and checks its values against those inputs, so a change of the payload's shape, or a new
+//! [`FORMAT_VERSION`] without a new file, fails the tests. The file is written only by
+//! `cargo xtask fixtures`; CI runs `cargo xtask fixtures --check`, which fails on any byte
+//! that differs, so every change of the format or of a number in the file is a reviewed diff.
+//! The command line writes the same bytes for the same inputs (`tandem fit` + `tandem
+//! record`, checked by `tandem-cli`'s end-to-end test).
 //!
 //! # Atomic write
 //!
@@ -36,7 +50,8 @@ use crate::{Error, Result};
 pub const MAGIC: [u8; 8] = *b"TANDEMST";
 
 /// The state format version this build writes and reads.
-/// Bump it whenever the serialized payload changes shape.
+/// Bump it whenever the serialized payload changes shape, and regenerate the golden file
+/// (`cargo xtask fixtures`, see the module docs).
 ///
 /// - 1: first format.
 /// - 2: the sampler parameters gained `OffsetSampling::Fitted` and `max_margin_checks`.

@@ -1,0 +1,205 @@
+//! The state file through the public API: the committed golden file of the current format
+//! (`fixtures/state/example.tandem`, regenerated only by `cargo xtask fixtures`) loads with
+//! the values its inputs give, and damaged or other-version files give clear errors.
+
+use std::path::{Path, PathBuf};
+
+use tandem_confidence::Confidence;
+use tandem_lfd::{Demonstration, TaskModel};
+use tandem_planner::state::FORMAT_VERSION;
+use tandem_planner::{Error, Planner, PlannerParams};
+use tandem_schedule::validate;
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The golden state file: `tandem fit --params params.toml demo_0.csv demo_1.csv demo_2.csv`
+/// then `tandem record` of `pair_1_robot_{1,2}`, all from `fixtures/examples/`.
+fn golden_path() -> PathBuf {
+    repo().join("fixtures/state/example.tandem")
+}
+
+fn examples(name: &str) -> PathBuf {
+    repo().join("fixtures/examples").join(name)
+}
+
+/// Rows of a correction-flag file (`supervised,corrected`) whose line starts with `prefix`.
+fn flag_rows(file: &str, prefix: &str) -> usize {
+    let text = std::fs::read_to_string(examples(file)).unwrap();
+    text.lines()
+        .skip(1)
+        .filter(|l| l.starts_with(prefix))
+        .count()
+}
+
+fn tmp_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tandem-state-file-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn the_golden_state_file_loads_with_the_values_of_its_inputs() {
+    let bytes = std::fs::read(golden_path()).unwrap();
+    assert_eq!(
+        u32::from_le_bytes(bytes[8..12].try_into().unwrap()),
+        FORMAT_VERSION,
+        "fixtures/state/example.tandem is not of the current format: run `cargo xtask fixtures` \
+         and review the diff"
+    );
+    let p = Planner::load(golden_path()).unwrap();
+
+    // The parameters are fixtures/examples/params.toml's.
+    let text = std::fs::read_to_string(examples("params.toml")).unwrap();
+    let params: PlannerParams = toml::from_str(&text).unwrap();
+    assert_eq!(p.params(), &params);
+    assert_eq!(
+        (p.params().fit.k_max, p.params().sampler.samples),
+        (2, 2000)
+    );
+    assert_eq!(p.params().sampler.seed, 1);
+
+    // The model: demo_0.csv's 40 samples at 10 ms are the reference; three demonstrations
+    // and the pair's two executions (Eq. 21).
+    let model = p.model();
+    assert_eq!(model.n_ref(), 40);
+    assert!((model.dt_s() - 0.01).abs() < 1e-12, "{}", model.dt_s());
+    assert_eq!(model.channel_names(), ["x", "force"]);
+    assert_eq!(model.count(), 5);
+    assert_eq!(p.pairs_recorded(), 1);
+    // Every demonstration and execution starts at x = 0 m with 5 N and ends at x = 1 m with
+    // 5 N; warps and reference-time logs are pinned at both ends, so the mean is exactly that.
+    assert_eq!(&model.mean()[..2], &[0.0, 5.0]);
+    assert_eq!(&model.mean()[2 * 39..], &[1.0, 5.0]);
+
+    // The observations: every supervised row of the two correction files is one unit of
+    // supervised mass (Eq. 9, split between neighbouring reference samples), every corrected
+    // row one unit of corrections.
+    let supervised =
+        flag_rows("pair_1_robot_1.corr.csv", "1,") + flag_rows("pair_1_robot_2.corr.csv", "1,");
+    let corrected =
+        flag_rows("pair_1_robot_1.corr.csv", "1,1") + flag_rows("pair_1_robot_2.corr.csv", "1,1");
+    assert_eq!((supervised, corrected), (84, 33));
+    let obs = p.observations();
+    assert!((obs.total_supervised() - supervised as f64).abs() < 1e-9);
+    assert!((obs.total_corrections() - corrected as f64).abs() < 1e-9);
+
+    // The confidence is the prior of the three demonstrations, updated once with the new
+    // model's variance and the observations (Eq. 9–12, latched).
+    let demos: Vec<Demonstration> = (0..3)
+        .map(|i| Demonstration::from_csv_path(examples(&format!("demo_{i}.csv")), None).unwrap())
+        .collect();
+    let fitted = TaskModel::fit(&demos, &params.fit).unwrap();
+    let mut conf = Confidence::from_prior(fitted.sigma2_d(), params.confidence.clone()).unwrap();
+    conf.update(model.sigma2_d(), obs).unwrap();
+    assert_eq!(p.confidence(), &conf);
+    assert!(
+        p.confidence().n_high() < 40,
+        "the corrected stretch stays low-confidence"
+    );
+
+    // The schedule: checked at the default tick Δt_s, valid for the loaded problem, its
+    // T_total the clock's, and never slower than the serial schedule.
+    let s = p.schedule();
+    assert_eq!(s.tick_s, model.dt_s());
+    assert_eq!([s.grad_exec[0].len(), s.grad_exec[1].len()], [40, 40]);
+    validate(p.problem(), s).unwrap();
+    assert_eq!(p.outcome().t_total_s, s.t_total_s(model.dt_s()));
+    let serial = p.problem().serial_schedule(s.tick_s).unwrap();
+    assert!(p.outcome().t_total_s <= serial.t_total_s(model.dt_s()));
+    assert_eq!(p.coordinator().unwrap().tick_s(), s.tick_s);
+
+    // Saving what was loaded gives the same bytes.
+    let dir = tmp_dir("golden");
+    let again = dir.join("again.tandem");
+    p.save(&again).unwrap();
+    assert!(
+        std::fs::read(&again).unwrap() == bytes,
+        "load + save changed the bytes"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn older_and_newer_files_say_which_version_they_are() {
+    let dir = tmp_dir("version");
+    let golden = std::fs::read(golden_path()).unwrap();
+    for (found, age) in [
+        (FORMAT_VERSION - 1, "an older"),
+        (FORMAT_VERSION + 1, "a newer"),
+    ] {
+        let path = dir.join(format!("v{found}.tandem"));
+        let mut bytes = golden.clone();
+        bytes[8..12].copy_from_slice(&found.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let err = Planner::load(&path).unwrap_err();
+        assert!(
+            matches!(err, Error::UnsupportedVersion { found: f, expected: FORMAT_VERSION, .. } if f == found),
+            "{err}"
+        );
+        let msg = err.to_string();
+        for part in [
+            path.display().to_string(),
+            format!("state format version {found}"),
+            format!("reads version {FORMAT_VERSION} only"),
+            format!("written by {age} build"),
+        ] {
+            assert!(msg.contains(&part), "`{part}` missing in: {msg}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn assert_names(err: &Error, path: &Path) {
+    assert!(
+        err.to_string().contains(&path.display().to_string()),
+        "error does not name the file: {err}"
+    );
+}
+
+#[test]
+fn damaged_state_files_give_clear_errors() {
+    let dir = tmp_dir("damaged");
+    let bytes = std::fs::read(golden_path()).unwrap();
+
+    let truncated = dir.join("truncated.tandem");
+    std::fs::write(&truncated, &bytes[..bytes.len() - 17]).unwrap();
+    let err = Planner::load(&truncated).unwrap_err();
+    assert!(matches!(err, Error::Truncated { .. }), "{err}");
+    assert_names(&err, &truncated);
+
+    let noise = dir.join("noise.tandem");
+    let mut x = 0x2545_F491_4F6C_DD1D_u64;
+    let junk: Vec<u8> = (0..4096)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x as u8
+        })
+        .collect();
+    std::fs::write(&noise, &junk).unwrap();
+    let err = Planner::load(&noise).unwrap_err();
+    assert!(matches!(err, Error::NotAStateFile { .. }), "{err}");
+    assert_names(&err, &noise);
+
+    let flipped = dir.join("flipped.tandem");
+    let mut bad = bytes.clone();
+    let mid = bad.len() / 2;
+    bad[mid] ^= 0x01;
+    std::fs::write(&flipped, &bad).unwrap();
+    let err = Planner::load(&flipped).unwrap_err();
+    assert!(matches!(err, Error::Corrupt { .. }), "{err}");
+    assert_names(&err, &flipped);
+
+    let missing = dir.join("missing.tandem");
+    let err = Planner::load(&missing).unwrap_err();
+    assert!(matches!(err, Error::Io { .. }), "{err}");
+    assert_names(&err, &missing);
+
+    // None of this touched the committed file.
+    assert!(std::fs::read(golden_path()).unwrap() == bytes);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
