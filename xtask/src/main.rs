@@ -47,13 +47,6 @@ enum Cmd {
     /// medoid) and run a reduced study on each: how much the order of the demonstrations
     /// changes σ²_D, the speed bounds and the confidence (docs/decisions.md).
     ReferenceOrder(reference_order::ReferenceOrderArgs),
-    /// Render Fig. 5 from a synthetic, clearly labelled demo dataset (exercises the plot).
-    #[command(hide = true)]
-    Fig5Demo {
-        /// Output directory (created if missing) for fig5-demo.svg and fig5-demo.png.
-        #[arg(long)]
-        out: std::path::PathBuf,
-    },
     /// Run N Coordinator executions of sampled schedules under adversarial operators and
     /// count ticks with both robots low-confidence (expected 0).
     Stress {
@@ -73,10 +66,5 @@ fn main() -> anyhow::Result<()> {
         Cmd::Study(args) => study::run(&args),
         Cmd::Stress { executions, seed } => stress::run(executions, seed),
         Cmd::ReferenceOrder(args) => reference_order::run(&args),
-        Cmd::Fig5Demo { out } => {
-            let (svg, png) = fig5::run_demo(&out)?;
-            println!("wrote {} and {}", svg.display(), png.display());
-            Ok(())
-        }
     }
 }

@@ -1,48 +1,24 @@
 //! `tandem plot`: the model, the confidence and the schedule as SVG and PNG.
 //!
-//! Pure Rust (plotters' SVG and bitmap backends, text through `ab_glyph` with the bundled
-//! DejaVu Sans), so plotting needs nothing but a Rust toolchain. Every file is rendered to a
+//! Pure Rust (plotters' SVG and bitmap backends, text through `ab_glyph` with the font and
+//! colours of `tandem_plot`, shared with `cargo xtask study`'s Fig. 5), so plotting needs
+//! nothing but a Rust toolchain. Every file is rendered to a
 //! temporary name in the output folder first and renamed only when all of them succeeded,
 //! so a failure leaves no partial figure set.
 
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use plotters::style::register_font;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use tandem::Planner;
 use tandem::schedule::GlobalTimeline;
-
-/// DejaVu Sans 2.37, see `assets/README.md`.
-static FONT_TTF: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-/// Family the bundled font is registered under.
-const FONT: &str = "sans-serif";
+use tandem_plot::{FONT_FAMILY, HIGH_CONFIDENCE, MEAN, NEITHER_LC, ROBOT_LC};
 /// Figure width (px, SVG user units).
 const WIDTH: u32 = 1200;
 /// Height of one panel (px).
 const PANEL_H: u32 = 170;
-
-/// Mean line colour.
-const MEAN: RGBColor = RGBColor(16, 42, 120);
-/// Robot 1 low-confidence (blue, as in the paper's Fig. 5).
-const ROBOT1: RGBColor = RGBColor(66, 133, 244);
-/// Robot 2 low-confidence (red).
-const ROBOT2: RGBColor = RGBColor(214, 39, 40);
-/// Running high-confidence (gray).
-const HIGH: RGBColor = RGBColor(185, 185, 185);
-/// High-confidence map and corrections.
-const GREEN: RGBColor = RGBColor(44, 160, 44);
-
-fn ensure_font() -> Result<()> {
-    static OK: OnceLock<bool> = OnceLock::new();
-    if !*OK.get_or_init(|| register_font(FONT, FontStyle::Normal, FONT_TTF).is_ok()) {
-        bail!("the bundled font assets/DejaVuSans.ttf could not be parsed");
-    }
-    Ok(())
-}
 
 /// Turns a plotters error into an `anyhow` error.
 fn de<E: std::fmt::Debug>(e: E) -> anyhow::Error {
@@ -85,7 +61,7 @@ fn render<F: Figure>(fig: &F, dir: &Path) -> Result<Vec<(PathBuf, PathBuf)>> {
 
 /// Draws the three figures into `dir` (which must exist); returns the files written.
 pub(crate) fn plot_all(planner: &Planner, dir: &Path) -> Result<Vec<PathBuf>> {
-    ensure_font()?;
+    tandem_plot::register_font()?;
     let mut pending = Vec::new();
     let result = (|| -> Result<()> {
         pending.extend(render(&ModelFigure::new(planner), dir)?);
@@ -228,7 +204,7 @@ impl Figure for ModelFigure {
         let (top, body) = root.split_vertically(40);
         top.titled(
             "task model: mean ± 1 standard deviation over reference time",
-            (FONT, 20),
+            (FONT_FAMILY, 20),
         )
         .map_err(de)?;
         let areas = body.split_evenly((self.panels.len(), 1));
@@ -238,7 +214,7 @@ impl Figure for ModelFigure {
             let hi = p.hi.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             let (y0, y1) = padded(lo, hi);
             let mut chart = ChartBuilder::on(area)
-                .caption(&p.title, (FONT, 14))
+                .caption(&p.title, (FONT_FAMILY, 14))
                 .margin(5)
                 .x_label_area_size(22)
                 .y_label_area_size(70)
@@ -249,7 +225,7 @@ impl Figure for ModelFigure {
                 .light_line_style(WHITE)
                 .x_desc("reference time (s)")
                 .y_desc(p.unit.as_str())
-                .label_style((FONT, 11))
+                .label_style((FONT_FAMILY, 11))
                 .draw()
                 .map_err(de)?;
             let step = stride(p.line.len());
@@ -306,7 +282,7 @@ impl Figure for ConfidenceFigure<'_> {
                 100.0 * conf.high_share(),
                 self.planner.pairs_recorded()
             ),
-            (FONT, 20),
+            (FONT_FAMILY, 20),
         )
         .map_err(de)?;
         let areas = body.split_evenly((2, 1));
@@ -318,7 +294,7 @@ impl Figure for ConfidenceFigure<'_> {
         let mut chart = ChartBuilder::on(&areas[0])
             .caption(
                 "demonstration variance σ²_D(t) (Eq. 6, dimensionless)",
-                (FONT, 14),
+                (FONT_FAMILY, 14),
             )
             .margin(5)
             .x_label_area_size(30)
@@ -330,7 +306,7 @@ impl Figure for ConfidenceFigure<'_> {
             .light_line_style(WHITE)
             .x_desc("reference time (s)")
             .y_desc("σ²_D")
-            .label_style((FONT, 11))
+            .label_style((FONT_FAMILY, 11))
             .draw()
             .map_err(de)?;
         chart
@@ -345,7 +321,7 @@ impl Figure for ConfidenceFigure<'_> {
         let mut chart = ChartBuilder::on(&areas[1])
             .caption(
                 "high confidence (green area, Eq. 12, latched); dots: corrections / supervised executions",
-                (FONT, 14),
+                (FONT_FAMILY, 14),
             )
             .margin(5)
             .x_label_area_size(30)
@@ -357,7 +333,7 @@ impl Figure for ConfidenceFigure<'_> {
             .light_line_style(WHITE)
             .x_desc("reference time (s)")
             .y_desc("share")
-            .label_style((FONT, 11))
+            .label_style((FONT_FAMILY, 11))
             .draw()
             .map_err(de)?;
         let c = conf.conf();
@@ -371,7 +347,7 @@ impl Figure for ConfidenceFigure<'_> {
                 chart
                     .draw_series(std::iter::once(Rectangle::new(
                         [(start as f64 * dt, 0.0), (n as f64 * dt, 1.0)],
-                        GREEN.mix(0.3).filled(),
+                        HIGH_CONFIDENCE.mix(0.3).filled(),
                     )))
                     .map_err(de)?;
             }
@@ -428,7 +404,7 @@ impl Figure for ScheduleFigure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
         root.fill(&WHITE).map_err(de)?;
         let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, (FONT, 18))
+            .caption(&self.title, (FONT_FAMILY, 18))
             .margin(10)
             .x_label_area_size(40)
             .y_label_area_size(10)
@@ -440,16 +416,16 @@ impl Figure for ScheduleFigure {
             .light_line_style(WHITE)
             .y_labels(0)
             .x_desc("global time (s); blue = robot 1 low-confidence, red = robot 2 low-confidence, gray = high-confidence")
-            .label_style((FONT, 12))
+            .label_style((FONT_FAMILY, 12))
             .draw()
             .map_err(de)?;
-        for i in 0..2 {
+        for (i, colour) in ROBOT_LC.iter().enumerate() {
             let y = if i == 0 { 1.5 } else { 0.5 };
             let (a, b) = self.spans[i];
             chart
                 .draw_series(std::iter::once(Rectangle::new(
                     [(a, y - 0.3), (b, y + 0.3)],
-                    HIGH.filled(),
+                    NEITHER_LC.filled(),
                 )))
                 .map_err(de)?;
             let label = format!(
@@ -462,13 +438,12 @@ impl Figure for ScheduleFigure {
                 .draw_series(std::iter::once(Text::new(
                     label,
                     (a, y + 0.33),
-                    (FONT, 13)
+                    (FONT_FAMILY, 13)
                         .into_font()
                         .color(&BLACK)
                         .pos(Pos::new(HPos::Left, VPos::Bottom)),
                 )))
                 .map_err(de)?;
-            let colour = if i == 0 { ROBOT1 } else { ROBOT2 };
             chart
                 .draw_series(
                     self.lc[i].iter().map(|&(s, e)| {

@@ -7,42 +7,26 @@
 //! Bottom panel: the percentage of high-confidence reference samples (mean line and band)
 //! and the ground-truth percentage as a gray dotted line, on the same iteration axis.
 //!
-//! The figure is written as SVG and PNG. Text uses the bundled DejaVu Sans
-//! (`xtask/assets/`, Bitstream Vera licence) through plotters' pure-Rust `ab_glyph` text
-//! renderer, so rendering needs no system font, fontconfig or freetype.
+//! The figure is written as SVG and PNG. Text uses the bundled DejaVu Sans and the colours
+//! are the palette of `tandem_plot` (shared with `tandem plot`), through plotters' pure-Rust
+//! `ab_glyph` text renderer, so rendering needs no system font, fontconfig or freetype.
+//! The figure's tests draw a synthetic dataset ([`demo`], test-only).
+
+#[cfg(test)]
+mod demo;
 
 use std::path::Path;
-use std::sync::OnceLock;
 
 use anyhow::{Context, anyhow, bail, ensure};
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
-use plotters::style::register_font;
+use tandem_plot::{BOTH_LC, FONT_FAMILY, GROUND_TRUTH, MEAN, NEITHER_LC, ROBOT_LC};
 
 /// Width of both output images, in pixels (SVG user units for the SVG).
 pub(crate) const WIDTH_PX: u32 = 1200;
 /// Height of both output images, in pixels (SVG user units for the SVG).
 pub(crate) const HEIGHT_PX: u32 = 900;
-
-/// DejaVu Sans 2.37 (Debian `fonts-dejavu-core`), see `xtask/assets/README.md`.
-static FONT_TTF: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-/// Family name the bundled font is registered under; the SVG names the same generic
-/// family, so viewers use their own sans-serif face.
-const FONT_FAMILY: &str = "sans-serif";
-
-/// Dark blue of the mean lines and their bands (the paper's "dark blue line").
-const MEAN_COLOUR: RGBColor = RGBColor(16, 42, 120);
-/// Robot 1 low-confidence (blue in the paper's example schedules).
-const ROBOT1_COLOUR: RGBColor = RGBColor(66, 133, 244);
-/// Robot 2 low-confidence (red in the paper's example schedules).
-const ROBOT2_COLOUR: RGBColor = RGBColor(214, 39, 40);
-/// Neither robot low-confidence (gray in the paper's example schedules).
-const NEITHER_COLOUR: RGBColor = RGBColor(185, 185, 185);
-/// Both robots low-confidence at once: a valid schedule never has this (it is the
-/// constraint the scheduler enforces), so it gets a loud colour of its own.
-const BOTH_COLOUR: RGBColor = RGBColor(148, 0, 211);
-/// Ground-truth line (the paper's "gray dotted line").
-const GROUND_TRUTH_COLOUR: RGBColor = RGBColor(110, 110, 110);
 
 /// Everything Fig. 5 shows, as plain numbers (global schedule time in seconds).
 #[derive(Clone, Debug, PartialEq)]
@@ -98,10 +82,10 @@ enum Occupancy {
 impl Occupancy {
     fn colour(self) -> RGBColor {
         match self {
-            Self::Neither => NEITHER_COLOUR,
-            Self::Robot1 => ROBOT1_COLOUR,
-            Self::Robot2 => ROBOT2_COLOUR,
-            Self::Both => BOTH_COLOUR,
+            Self::Neither => NEITHER_LC,
+            Self::Robot1 => ROBOT_LC[0],
+            Self::Robot2 => ROBOT_LC[1],
+            Self::Both => BOTH_LC,
         }
     }
 }
@@ -239,18 +223,6 @@ fn occupancy_segments(ex: &ExampleSchedule) -> Vec<(f64, f64, Occupancy)> {
     segments
 }
 
-/// Registers the bundled font with plotters once per process.
-fn ensure_font() -> anyhow::Result<()> {
-    static REGISTERED: OnceLock<bool> = OnceLock::new();
-    let ok =
-        *REGISTERED.get_or_init(|| register_font(FONT_FAMILY, FontStyle::Normal, FONT_TTF).is_ok());
-    ensure!(
-        ok,
-        "the bundled font xtask/assets/DejaVuSans.ttf could not be parsed"
-    );
-    Ok(())
-}
-
 /// Draws Fig. 5 from `data` and writes it to `svg` and `png` ([`WIDTH_PX`] × [`HEIGHT_PX`]).
 ///
 /// The data is validated before anything is written; the parent directories must exist.
@@ -258,33 +230,19 @@ fn ensure_font() -> anyhow::Result<()> {
 /// # Errors
 /// Invalid data (see [`Fig5Data::validate`]), or a failure to render or write a file.
 pub(crate) fn draw_fig5(data: &Fig5Data, svg: &Path, png: &Path) -> anyhow::Result<()> {
-    draw_fig5_annotated(data, svg, png, None)
-}
-
-/// [`draw_fig5`] with an optional note in a strip above the panels (used to label the
-/// synthetic demo figure so it cannot be mistaken for study results).
-///
-/// # Errors
-/// As [`draw_fig5`].
-pub(crate) fn draw_fig5_annotated(
-    data: &Fig5Data,
-    svg: &Path,
-    png: &Path,
-    note: Option<&str>,
-) -> anyhow::Result<()> {
     data.validate()?;
-    ensure_font()?;
+    tandem_plot::register_font()?;
     let mut svg_text = String::new();
     {
         let root =
             SVGBackend::with_string(&mut svg_text, (WIDTH_PX, HEIGHT_PX)).into_drawing_area();
-        draw_on(&root, data, note)?;
+        draw_on(&root, data)?;
         root.present()
             .map_err(|e| anyhow!("finishing the SVG of Fig. 5: {e}"))?;
     }
     {
         let root = BitMapBackend::new(png, (WIDTH_PX, HEIGHT_PX)).into_drawing_area();
-        draw_on(&root, data, note)?;
+        draw_on(&root, data)?;
         root.present()
             .map_err(|e| anyhow!("writing the PNG of Fig. 5 to {}: {e}", png.display()))?;
     }
@@ -436,28 +394,56 @@ const Y_LABEL_AREA_PX: u32 = 95;
 fn draw_on<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     data: &Fig5Data,
-    note: Option<&str>,
 ) -> anyhow::Result<()> {
     root.fill(&WHITE).map_err(draw_err("background"))?;
-    let body = match note {
-        Some(text) => {
-            let (strip, body) = root.split_vertically(44);
-            strip
-                .draw(&Text::new(
-                    text.to_owned(),
-                    (Y_LABEL_AREA_PX as i32, 12),
-                    (FONT_FAMILY, AXIS_FONT).into_font().color(&BOTH_COLOUR),
-                ))
-                .map_err(draw_err("note"))?;
-            body
-        }
-        None => root.clone(),
-    };
-    let top_height = body.dim_in_pixel().1 * 62 / 100;
-    let (top, bottom) = body.split_vertically(top_height);
+    let top_height = root.dim_in_pixel().1 * 62 / 100;
+    let (top, bottom) = root.split_vertically(top_height);
     let layout = Layout::new(data);
     draw_task_length_panel(&top, data, &layout)?;
     draw_high_conf_panel(&bottom, data, &layout)?;
+    Ok(())
+}
+
+/// A panel's chart: iterations on x, seconds or percent on y.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// Draws the closed polygon `band` (a ±1 std band, [`std_band`]) with its legend entry;
+/// `what` names it in errors.
+fn draw_band<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    band: Vec<(f64, f64)>,
+    what: &str,
+) -> anyhow::Result<()> {
+    chart
+        .draw_series(std::iter::once(Polygon::new(band, MEAN.mix(0.22).filled())))
+        .map_err(draw_err(what))?
+        .label("±1 std over trials")
+        .legend(|(x, y)| Rectangle::new([(x, y - 7), (x + 24, y + 7)], MEAN.mix(0.22).filled()));
+    Ok(())
+}
+
+/// Draws the mean line through `(xs, mean)` with legend entry `label` (a single iteration
+/// is no line: it gets a dot); `what` names it in errors.
+fn draw_mean<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    xs: &[f64],
+    mean: &[f64],
+    label: &str,
+    what: &str,
+) -> anyhow::Result<()> {
+    chart
+        .draw_series(LineSeries::new(
+            xs.iter().copied().zip(mean.iter().copied()),
+            MEAN.stroke_width(3),
+        ))
+        .map_err(draw_err(what))?
+        .label(label)
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], MEAN.stroke_width(3)));
+    if let ([x], [m]) = (xs, mean) {
+        chart
+            .draw_series(std::iter::once(Circle::new((*x, *m), 5, MEAN.filled())))
+            .map_err(draw_err(what))?;
+    }
     Ok(())
 }
 
@@ -494,19 +480,7 @@ fn draw_task_length_panel<DB: DrawingBackend>(
         &data.t_total_std_s,
         f64::INFINITY,
     );
-    chart
-        .draw_series(std::iter::once(Polygon::new(
-            band,
-            MEAN_COLOUR.mix(0.22).filled(),
-        )))
-        .map_err(draw_err("task length band"))?
-        .label("±1 std over trials")
-        .legend(|(x, y)| {
-            Rectangle::new(
-                [(x, y - 7), (x + 24, y + 7)],
-                MEAN_COLOUR.mix(0.22).filled(),
-            )
-        });
+    draw_band(&mut chart, band, "task length band")?;
 
     let half = 0.5 * layout.bar_width;
     let mut bars: Vec<Rectangle<(f64, f64)>> = Vec::new();
@@ -548,24 +522,13 @@ fn draw_task_length_panel<DB: DrawingBackend>(
         }
     }
 
-    chart
-        .draw_series(LineSeries::new(
-            xs.iter().copied().zip(data.t_total_mean_s.iter().copied()),
-            MEAN_COLOUR.stroke_width(3),
-        ))
-        .map_err(draw_err("task length mean"))?
-        .label("mean task length")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], MEAN_COLOUR.stroke_width(3)));
-    if let ([x], [t]) = (xs.as_slice(), data.t_total_mean_s.as_slice()) {
-        // A single iteration is no line: mark it.
-        chart
-            .draw_series(std::iter::once(Circle::new(
-                (*x, *t),
-                5,
-                MEAN_COLOUR.filled(),
-            )))
-            .map_err(draw_err("task length mean"))?;
-    }
+    draw_mean(
+        &mut chart,
+        &xs,
+        &data.t_total_mean_s,
+        "mean task length",
+        "task length mean",
+    )?;
 
     chart
         .configure_series_labels()
@@ -616,54 +579,30 @@ fn draw_high_conf_panel<DB: DrawingBackend>(
             &data.high_conf_pct_std,
             100.0,
         );
-        chart
-            .draw_series(std::iter::once(Polygon::new(
-                band,
-                MEAN_COLOUR.mix(0.22).filled(),
-            )))
-            .map_err(draw_err("high-confidence band"))?
-            .label("±1 std over trials")
-            .legend(|(x, y)| {
-                Rectangle::new(
-                    [(x, y - 7), (x + 24, y + 7)],
-                    MEAN_COLOUR.mix(0.22).filled(),
-                )
-            });
+        draw_band(&mut chart, band, "high-confidence band")?;
     }
-    chart
-        .draw_series(LineSeries::new(
-            xs.iter()
-                .copied()
-                .zip(data.high_conf_pct_mean.iter().copied()),
-            MEAN_COLOUR.stroke_width(3),
-        ))
-        .map_err(draw_err("high-confidence mean"))?
-        .label("mean high-confidence share")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], MEAN_COLOUR.stroke_width(3)));
-    if let ([x], [p]) = (xs.as_slice(), data.high_conf_pct_mean.as_slice()) {
-        chart
-            .draw_series(std::iter::once(Circle::new(
-                (*x, *p),
-                5,
-                MEAN_COLOUR.filled(),
-            )))
-            .map_err(draw_err("high-confidence mean"))?;
-    }
+    draw_mean(
+        &mut chart,
+        &xs,
+        &data.high_conf_pct_mean,
+        "mean high-confidence share",
+        "high-confidence mean",
+    )?;
     let gt = data.ground_truth_pct;
     chart
         .draw_series(DashedLineSeries::new(
             [(layout.x_min, gt), (layout.x_max, gt)],
             3,
             5,
-            GROUND_TRUTH_COLOUR.stroke_width(3),
+            GROUND_TRUTH.stroke_width(3),
         ))
         .map_err(draw_err("ground truth"))?
         .label("ground truth")
         .legend(|(x, y)| {
             EmptyElement::at((x, y))
-                + PathElement::new(vec![(0, 0), (4, 0)], GROUND_TRUTH_COLOUR.stroke_width(3))
-                + PathElement::new(vec![(10, 0), (14, 0)], GROUND_TRUTH_COLOUR.stroke_width(3))
-                + PathElement::new(vec![(20, 0), (24, 0)], GROUND_TRUTH_COLOUR.stroke_width(3))
+                + PathElement::new(vec![(0, 0), (4, 0)], GROUND_TRUTH.stroke_width(3))
+                + PathElement::new(vec![(10, 0), (14, 0)], GROUND_TRUTH.stroke_width(3))
+                + PathElement::new(vec![(20, 0), (24, 0)], GROUND_TRUTH.stroke_width(3))
         });
 
     chart
@@ -679,72 +618,6 @@ fn draw_high_conf_panel<DB: DrawingBackend>(
     Ok(())
 }
 
-// ----------------------------------------------------------------------------------------
-// Synthetic demo data (`cargo xtask fig5-demo`): NOT study results.
-
-/// Duration of one robot's execution in the demo model, in seconds of its own time.
-const DEMO_EXEC_S: f64 = 84.0;
-/// Sanding passes of the demo model, `(start_s, end_s)` in execution time: 10 s of
-/// sanding, then 12 s of slow transit to the next pass (as in the paper's demonstrations,
-/// slow enough for the other robot to sand a pass meanwhile).
-const DEMO_PASSES: [(f64, f64); 4] = [(4.0, 14.0), (26.0, 36.0), (48.0, 58.0), (70.0, 80.0)];
-/// Decay constants (in iterations) of the five synthetic "trials".
-const DEMO_TAUS: [f64; 5] = [20.0, 22.5, 25.0, 27.5, 30.0];
-/// Number of executed pairs in the demo (the paper's 300 executions).
-const DEMO_PAIRS: usize = 150;
-/// Step of the demo's offset search, in seconds.
-const DEMO_OFFSET_STEP_S: f64 = 0.5;
-
-/// Low-confidence intervals of one execution (execution time, sorted, disjoint) after
-/// `k` pairs in a synthetic trial with decay constant `tau`: everything before the first
-/// pair; then passes 1–3 widened by a margin that shrinks as `10 s · exp(-k/tau)`, and
-/// pass 4 (never corrected) fading out faster.
-fn demo_lc_intervals(k: usize, tau: f64) -> Vec<(f64, f64)> {
-    if k == 0 {
-        return vec![(0.0, DEMO_EXEC_S)];
-    }
-    let kf = k as f64;
-    let margin = 10.0 * (-kf / tau).exp();
-    let mut raw: Vec<(f64, f64)> = DEMO_PASSES[..3]
-        .iter()
-        .map(|&(s, e)| ((s - margin).max(0.0), (e + margin).min(DEMO_EXEC_S)))
-        .collect();
-    let (s4, e4) = DEMO_PASSES[3];
-    let half4 = (0.5 * (e4 - s4) + margin) * (-kf / (0.4 * tau)).exp();
-    if half4 >= 0.5 {
-        let mid = 0.5 * (s4 + e4);
-        raw.push(((mid - half4).max(0.0), (mid + half4).min(DEMO_EXEC_S)));
-    }
-    let mut merged: Vec<(f64, f64)> = Vec::new();
-    for (s, e) in raw {
-        match merged.last_mut() {
-            Some(last) if s <= last.1 => last.1 = last.1.max(e),
-            _ => merged.push((s, e)),
-        }
-    }
-    merged
-}
-
-/// Smallest offset (multiple of [`DEMO_OFFSET_STEP_S`]) of robot 2's start such that the
-/// two robots' low-confidence intervals never overlap (touching is allowed).
-fn demo_offset_s(lc: &[(f64, f64)]) -> f64 {
-    let overlaps = |o: f64| {
-        lc.iter()
-            .any(|&(s1, e1)| lc.iter().any(|&(s2, e2)| s1 < e2 + o && s2 + o < e1))
-    };
-    let steps = (DEMO_EXEC_S / DEMO_OFFSET_STEP_S).ceil() as usize;
-    (0..=steps)
-        .map(|i| i as f64 * DEMO_OFFSET_STEP_S)
-        .find(|&o| !overlaps(o))
-        .unwrap_or(DEMO_EXEC_S)
-}
-
-/// Share (0–100) of the execution that is high-confidence.
-fn demo_high_conf_pct(lc: &[(f64, f64)]) -> f64 {
-    let lc_s: f64 = lc.iter().map(|(s, e)| e - s).sum();
-    100.0 * (1.0 - lc_s / DEMO_EXEC_S)
-}
-
 /// The closed polygon of a ±1 std band: `mean + std` (capped at `cap`) along `xs`, then
 /// `mean − std` (floored at 0) back.
 fn std_band(xs: &[f64], mean: &[f64], std: &[f64], cap: f64) -> Vec<(f64, f64)> {
@@ -757,70 +630,6 @@ fn std_band(xs: &[f64], mean: &[f64], std: &[f64], cap: f64) -> Vec<(f64, f64)> 
         .collect()
 }
 
-/// A synthetic, deterministic dataset shaped like the paper's study (two robots, one
-/// 84 s sanding execution each, 150 pairs, five "trials" that differ only in how fast
-/// their low-confidence margins shrink). It exercises the figure end to end; it is a
-/// closed-form toy, not output of the tandem pipeline.
-pub(crate) fn demo_data() -> Fig5Data {
-    let iterations: Vec<usize> = (0..=DEMO_PAIRS).collect();
-    let mut fig = Fig5Data {
-        iterations: iterations.clone(),
-        t_total_mean_s: Vec::with_capacity(iterations.len()),
-        t_total_std_s: Vec::with_capacity(iterations.len()),
-        high_conf_pct_mean: Vec::with_capacity(iterations.len()),
-        high_conf_pct_std: Vec::with_capacity(iterations.len()),
-        ground_truth_pct: 100.0 * (1.0 - 30.0 / DEMO_EXEC_S),
-        examples: Vec::new(),
-    };
-    for &k in &iterations {
-        let (t_totals, pcts): (Vec<f64>, Vec<f64>) = DEMO_TAUS
-            .iter()
-            .map(|&tau| {
-                let lc = demo_lc_intervals(k, tau);
-                (DEMO_EXEC_S + demo_offset_s(&lc), demo_high_conf_pct(&lc))
-            })
-            .unzip();
-        let (t_mean, t_std) = tandem::sim::study::mean_std(t_totals.iter().copied());
-        let (p_mean, p_std) = tandem::sim::study::mean_std(pcts.iter().copied());
-        fig.t_total_mean_s.push(t_mean);
-        fig.t_total_std_s.push(t_std);
-        fig.high_conf_pct_mean.push(p_mean);
-        fig.high_conf_pct_std.push(p_std);
-    }
-    let tau = DEMO_TAUS[2];
-    fig.examples = (0..=DEMO_PAIRS)
-        .step_by(25)
-        .map(|k| {
-            let lc = demo_lc_intervals(k, tau);
-            let offset = demo_offset_s(&lc);
-            ExampleSchedule {
-                iteration: k,
-                t_total_s: DEMO_EXEC_S + offset,
-                lc_robot1: lc.clone(),
-                lc_robot2: lc.iter().map(|&(s, e)| (s + offset, e + offset)).collect(),
-            }
-        })
-        .collect();
-    fig
-}
-
-/// Note printed above the demo figure.
-pub(crate) const DEMO_NOTE: &str = "SYNTHETIC DEMO DATA (cargo xtask fig5-demo): not study results";
-
-/// `cargo xtask fig5-demo --out DIR`: renders [`demo_data`] to `DIR/fig5-demo.svg` and
-/// `DIR/fig5-demo.png` (creating `DIR`), and returns the two paths.
-///
-/// # Errors
-/// If `DIR` cannot be created or a file cannot be written.
-pub(crate) fn run_demo(out: &Path) -> anyhow::Result<(std::path::PathBuf, std::path::PathBuf)> {
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("creating output directory {}", out.display()))?;
-    let svg = out.join("fig5-demo.svg");
-    let png = out.join("fig5-demo.png");
-    draw_fig5_annotated(&demo_data(), &svg, &png, Some(DEMO_NOTE))?;
-    Ok((svg, png))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -830,7 +639,7 @@ mod tests {
     type Corruption = fn(&mut Fig5Data);
 
     /// A fresh, empty per-test directory under the system temp dir.
-    fn scratch_dir(name: &str) -> PathBuf {
+    pub(super) fn scratch_dir(name: &str) -> PathBuf {
         let dir =
             std::env::temp_dir().join(format!("tandem-xtask-fig5-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
@@ -864,7 +673,7 @@ mod tests {
     }
 
     /// Width and height from a PNG's IHDR chunk, after checking the signature.
-    fn png_size(bytes: &[u8]) -> (u32, u32) {
+    pub(super) fn png_size(bytes: &[u8]) -> (u32, u32) {
         assert!(bytes.len() > 24, "PNG too short: {} bytes", bytes.len());
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
         assert_eq!(&bytes[12..16], b"IHDR", "first chunk is IHDR");
@@ -1069,50 +878,5 @@ mod tests {
         assert_eq!(nice_ceiling(0.7), 0.8);
         assert_eq!(nice_ceiling(40.0), 40.0);
         assert_eq!(nice_ceiling(0.031), 0.04);
-    }
-
-    #[test]
-    fn demo_data_is_valid_and_has_the_papers_shape() {
-        let d = demo_data();
-        d.validate().unwrap();
-        let last = d.iterations.len() - 1;
-        // Before any pair everything is low-confidence: the robots run one after the other
-        // (T_total = 2 · 84 s) with no high-confidence samples, identically in every trial.
-        assert_eq!((d.t_total_mean_s[0], d.t_total_std_s[0]), (168.0, 0.0));
-        assert_eq!(
-            (d.high_conf_pct_mean[0], d.high_conf_pct_std[0]),
-            (0.0, 0.0)
-        );
-        // At the end only the 10 s sanding of passes 1–3 plus margins m <= 10 s · exp(-150/30)
-        // = 0.067 s per side is low-confidence. Any offset in [10 + 2m, 12 - 2m] s lets robot 2
-        // sand each pass while robot 1 is in transit; the first 0.5 s step in it is 10.5 s, so
-        // T_total = 84 + 10.5 s in every trial, and the high-confidence share is below the
-        // ground truth by at most 6 · 0.067 s / 84 s = 0.48 percentage points.
-        assert_eq!((d.t_total_mean_s[last], d.t_total_std_s[last]), (94.5, 0.0));
-        let gap = d.ground_truth_pct - d.high_conf_pct_mean[last];
-        assert!(0.0 < gap && gap < 0.48, "gap {gap}");
-        assert!((d.ground_truth_pct - 100.0 * 54.0 / 84.0).abs() < 1e-12);
-        for ex in &d.examples {
-            assert!(
-                occupancy_segments(ex)
-                    .iter()
-                    .all(|s| s.2 != Occupancy::Both),
-                "demo schedule at iteration {} overlaps",
-                ex.iteration
-            );
-        }
-    }
-
-    #[test]
-    fn run_demo_writes_both_files() {
-        let dir = scratch_dir("demo");
-        let (svg, png) = run_demo(&dir.join("out")).unwrap();
-        let svg_text = std::fs::read_to_string(svg).unwrap();
-        assert!(svg_text.contains("SYNTHETIC DEMO DATA"));
-        assert_eq!(
-            png_size(&std::fs::read(png).unwrap()),
-            (WIDTH_PX, HEIGHT_PX)
-        );
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
