@@ -7,8 +7,9 @@ use crate::{Error, Result};
 /// Parameters of the confidence model (paper §II-B3).
 ///
 /// All quantities are dimensionless: `σ²_D` is the weighted demonstration variance of
-/// Eq. 6 with `W` normalizing each channel by its variance over all demonstrations
-/// (DESIGN.md), and `p_{c|t}` is a probability.
+/// Eq. 6 with `W = diag(1/r_j²)` normalizing each coordinate by its range over all
+/// demonstrations (`tandem_lfd::FitParams::ranges`; docs/decisions.md, "Channel weights and
+/// kinds"), and `p_{c|t}` is a probability. Why the defaults: docs/decisions.md, "Defaults".
 ///
 /// # Why `σ²_MAX < 1/4`
 ///

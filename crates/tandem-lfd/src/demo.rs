@@ -510,7 +510,7 @@ struct DemoJsonRef<'a> {
 /// What a scalar channel measures. Only quaternion blocks change the statistics
 /// (they are handled on the rotation manifold); the other kinds are documentation for
 /// users of the model and are all averaged as numbers (binary channels may be fractional
-/// in the mean, DESIGN.md).
+/// in the mean: docs/decisions.md, "Channel weights and kinds").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ChannelKind {

@@ -1,4 +1,5 @@
-//! The versioned binary state file and its atomic write (DESIGN.md, "Data the user sees").
+//! The versioned binary state file and its atomic write (why postcard: docs/decisions.md,
+//! "postcard, not bincode, for the state file").
 //!
 //! # Format (version [`FORMAT_VERSION`])
 //!

@@ -305,7 +305,8 @@ impl Coordinator {
 mod tests {
     use super::*;
 
-    /// [HC, LC, HC], gradients 1, bounds [½, 2], Δt_s = 1 (DESIGN.md's 3-sample case).
+    /// [HC, LC, HC], gradients 1, bounds [½, 2], Δt_s = 1 (the 3-sample case of
+    /// docs/decisions.md, "Alg. 2 as printed is not sound on a tick grid").
     fn three_sample(tau: f64) -> [Timeline; 2] {
         let conf = [true, false, true];
         let (g, lo, hi) = ([1.0; 3], [0.5; 3], [2.0; 3]);

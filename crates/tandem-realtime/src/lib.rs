@@ -1,5 +1,7 @@
 //! Real-time timing strategy, worst-case margins and runtime coordinator (paper §II-B5,
-//! Eq. 15–18, Alg. 1 and Alg. 2; DESIGN.md "tandem-realtime").
+//! Eq. 15–18, Alg. 1 and Alg. 2; the readings and fixes of the paper behind it are in
+//! docs/decisions.md: "Typos of Eq. 17 and Alg. 1", "Alg. 2 as printed is not sound on a tick
+//! grid", "Time frames").
 //!
 //! Two robots do the same task in parallel under one operator. Each robot's plan is a
 //! [`Timeline`] in *schedule-clock* time (global seconds at which the schedule planned a

@@ -9,22 +9,24 @@
 //! left its own. (Non-consecutive regions are implied: robot clocks only move forward.)
 //!
 //! # The printed check
-//! [`sufficient_margins_printed`] is Alg. 2 as printed (typos fixed as in DESIGN.md: the rates
-//! of Eq. 17 are `F = ψ̇_E/ψ̇min`, `S = ψ̇_E/ψ̇max`, and Alg. 1 line 9 uses the behind robot's own
-//! `F`): for each pair, both schedule clocks start at `τ` (the later start); each step, if `c` is
+//! [`sufficient_margins_printed`] is Alg. 2 as printed (typos fixed as in docs/decisions.md,
+//! "Typos of Eq. 17 and Alg. 1": the rates of Eq. 17 are `F = ψ̇_E/ψ̇min`, `S = ψ̇_E/ψ̇max`, and
+//! Alg. 1 line 9 uses the behind robot's own `F`): for each pair, both schedule clocks start at `τ` (the later start); each step, if `c` is
 //! LC it rushes (`F`) and `p` responds (Eq. 18), else if `p` is LC it drags (`S`) and `c`
 //! responds, else `HIGH-CONF`; after the step, reject if `t_c ≥ T_c`, accept if `t_p ≥ T_p`.
-//! **It is not sound on a tick grid** (DESIGN.md; the 3-sample case [HC, LC, HC] with gradients 1,
-//! bounds `[½, 2]`, one sample per tick and `τ = 3/2` is accepted yet overlaps when the operator
-//! rushes the previous robot). It is kept only as a named, documented-unsafe baseline.
+//! **It is not sound on a tick grid** (docs/decisions.md, "Alg. 2 as printed is not sound on a
+//! tick grid"; the 3-sample case [HC, LC, HC] with gradients 1, bounds `[½, 2]`, one sample per
+//! tick and `τ = 3/2` is accepted yet overlaps when the operator rushes the previous robot). It
+//! is kept only as a named, documented-unsafe baseline.
 //!
 //! # The conservative check
 //! [`sufficient_margins`] keeps the paper's worst case (current robot rushing while LC,
 //! previous robot dragging while LC, the strategy everywhere else) and makes the discrete
-//! simulation conservative against the three ways a tick grid breaks it (DESIGN.md): the exit
-//! tick, rate aliasing and mode aliasing. With `M = tick_s · max(1, max F)` the largest step any
-//! robot can take in one tick (maximum over *both* robots and *all* samples, a superset of
-//! DESIGN.md's local maxima) and `ε` four times [`clock_tolerance_s`]:
+//! simulation conservative against the three ways a tick grid breaks it (docs/decisions.md):
+//! the exit tick, rate aliasing and mode aliasing. With `M = tick_s · max(1, max F)` the
+//! largest step any robot can take in one tick (maximum over *both* robots and *all* samples,
+//! a superset of the local maxima the design-time fix used) and `ε` four times
+//! [`clock_tolerance_s`]:
 //!
 //! 1. **Stop test, `c` first.** After each step, reject if `t_c + M ≥ T_c − ε`, else accept the
 //!    pair if `t_p ≥ T_p + ε`. The real robots' tick phase is set by the operator, not by the
@@ -412,8 +414,9 @@ fn run_role(
     false
 }
 
-/// The conservative, discretization-safe worst-case margin check (Alg. 2 with DESIGN.md's
-/// fixes 1–4, single pass): `true` when no admissible operator can make both robots
+/// The conservative, discretization-safe worst-case margin check (Alg. 2 with the fixes 1–4
+/// of the module docs and docs/decisions.md, single pass): `true` when no admissible operator
+/// can make both robots
 /// low-confidence in the same control tick of `tick_s` real seconds.
 ///
 /// Two simulations (one per role `(p, c)`), each deciding all pairs of its role with a pointer;
@@ -462,7 +465,8 @@ pub fn sufficient_margins_per_pair(robots: &[Timeline; 2], tick_s: f64) -> Resul
     Ok(true)
 }
 
-/// Alg. 2 exactly as printed (with DESIGN.md's typo fixes), one simulation per pair from `τ`.
+/// Alg. 2 exactly as printed (with the typo fixes of docs/decisions.md, "Typos of Eq. 17 and
+/// Alg. 1"), one simulation per pair from `τ`.
 ///
 /// **UNSAFE on a tick grid**: it can accept schedules on which an admissible operator makes both
 /// robots low-confidence in the same tick (see the [module docs](self)). Use only as a baseline.
@@ -485,7 +489,8 @@ pub fn sufficient_margins_printed(robots: &[Timeline; 2], tick_s: f64) -> Result
 mod tests {
     use super::*;
 
-    /// DESIGN.md's 3-sample case: [HC, LC, HC], gradients 1, bounds [½, 2], Δt_s = 1.
+    /// The 3-sample case of docs/decisions.md: [HC, LC, HC], gradients 1, bounds [½, 2],
+    /// Δt_s = 1.
     fn three_sample(tau: f64) -> [Timeline; 2] {
         let conf = [true, false, true];
         let g = [1.0; 3];

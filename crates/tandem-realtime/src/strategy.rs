@@ -30,8 +30,8 @@ pub fn response_step(lead_s: f64, rates: Rates, tick_s: f64) -> f64 {
 ///
 /// If the behind robot can reach the ahead robot's fastest step (`F_b·tick ≥ F_a·tick + ΔT`),
 /// `a` goes fastest and `b` lands level with it. Otherwise `b` goes at its *own* fastest rate
-/// (line 9 prints `ψ̇^F_{i_a}(t_b)`; DESIGN.md fixes it to `b`'s own `F`) and `a` responds with
-/// Eq. 18 to the lead left after `b`'s step.
+/// (line 9 prints `ψ̇^F_{i_a}(t_b)`, read as `b`'s own `F`: docs/decisions.md, "Typos of
+/// Eq. 17 and Alg. 1") and `a` responds with Eq. 18 to the lead left after `b`'s step.
 pub fn high_conf_steps(lead_s: f64, rates_a: Rates, rates_b: Rates, tick_s: f64) -> (f64, f64) {
     let fast_a = rates_a.fast * tick_s;
     let fast_b = rates_b.fast * tick_s;

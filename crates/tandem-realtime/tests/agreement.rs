@@ -53,7 +53,8 @@ fn single_pass_equals_per_pair_on_random_schedules() {
 }
 
 /// The fastest serial schedule (`τ = |ψ_E1|`, robot 2 starting at `robots[0].end_s()`) is always
-/// accepted: the scheduler's fallback of last resort (DESIGN.md, tandem-schedule).
+/// accepted: the scheduler's fallback of last resort (`tandem_schedule::Problem::serial_schedule`,
+/// fix 4 of docs/decisions.md, "Alg. 2 as printed is not sound on a tick grid").
 #[test]
 fn serial_schedule_is_always_accepted() {
     let config = Config {

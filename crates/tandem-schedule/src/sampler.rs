@@ -45,7 +45,10 @@
 //! The numbers that decided it (`cargo run --release -p tandem-schedule --example
 //! sampling_distributions`: `fixtures/sanding/problem.csv` with passes 1–3 sanding low
 //! confidence, `T_ref` 9873, serial `T_total` 145.75 s, 5000 samples, best `T_total` as
-//! mean ± std over 20 seeds (4 for per sample), default margin budget, 2 cores):
+//! mean ± std over 20 seeds (4 for per sample), default margin budget, 2 cores; measured at
+//! commit `6b0ffb6`, before the fixtures' warp defaults changed — the same command on the
+//! current fixtures, with the same ranking, is in docs/decisions.md, "The sampler's
+//! distributions"):
 //!
 //! | distribution                               | best `T_total` (s) | time per sample |
 //! |--------------------------------------------|--------------------|-----------------|
@@ -90,7 +93,7 @@
 //!    [`SamplerParams::max_margin_checks`] are checked (default 64: the best 32, then 32
 //!    ranks spread geometrically down to the last): in the study, once the confidence is
 //!    fragmented, thousands of candidates can beat the incumbent on paper and fail the
-//!    margin check, at ~0.4 ms each.
+//!    margin check, at ~0.4 ms each (measured at commit `6b0ffb6`).
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

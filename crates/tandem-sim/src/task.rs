@@ -1,4 +1,5 @@
-//! Sanding task generator (paper §III, DESIGN.md "tandem-sim and the study").
+//! Sanding task generator (paper §III; why its transitions last 16 s ± 45 %:
+//! docs/decisions.md, "The fixtures' transitions: 16 s ± 45 %").
 //!
 //! # The task
 //!
@@ -128,7 +129,8 @@ pub struct TaskParams {
     /// sanding pass (11–12 s at the mean pace) plus the worst-case margins of Alg. 2: with
     /// 7 s ± 20 % transitions (at most ~10 s even at the slowest demonstrated pace) no
     /// schedule could put one robot's pass inside the other's transition, and the best
-    /// schedule of the mid-study problem overlapped the robots only from pass 4 on.
+    /// schedule of the mid-study problem overlapped the robots only from pass 4 on
+    /// (measured at commit `0c9ae47`; docs/decisions.md).
     pub transition_duration_s: f64,
     /// Variability of the transition duration, fraction: uniform in
     /// `transition_duration_s·(1 ± transition_duration_var)`. Must be in `[0, 1)`.
@@ -137,7 +139,8 @@ pub struct TaskParams {
     /// The spread across demonstrations sets `[ψ̇min, ψ̇max]` over the transitions, i.e.
     /// how much the coordinator may speed up or slow down the robot in transition while
     /// the operator rushes or drags the other one's pass; Alg. 2's worst-case check needs
-    /// that room (with ± 20 % no alternating schedule of the mid-study problem passed it).
+    /// that room (with ± 20 % no alternating schedule of the mid-study problem passed it;
+    /// measured at commit `0c9ae47`).
     pub transition_duration_var: f64,
     /// Lowest apex height of the lift-off arc above the plate. Must be ≥ 0. Default: 0.04 m.
     pub lift_height_min_m: f64,

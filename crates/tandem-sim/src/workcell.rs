@@ -26,11 +26,13 @@
 //!    one-sample low-confidence "islands" after 150 pairs (samples whose few observations
 //!    happened to include several false corrections); every island of one robot forbids
 //!    the other robot's low-confidence pass at that moment, so the schedule stays nearly
-//!    serial. Measured on the default study (5 × 300 executions): per-tick draws leave
-//!    81–102 low-confidence runs per schedule after 150 pairs and end at `T_total`
-//!    148.3 ± 0.7 s; 0.5 s episodes leave 3–6 runs and end at 114.8 ± 16.0 s (serial:
-//!    191.8 s). Episodes give each sample about the same 1 % chance per execution but make
-//!    the islands contiguous and far fewer (see docs/study.md).
+//!    serial. Measured on the default study (5 × 300 executions, seed 2023; `cargo xtask
+//!    study`, and with `false_correction_s = 0` in its configuration for per-tick draws):
+//!    per-tick draws leave 92–116 low-confidence runs per robot and schedule after 150
+//!    pairs and end at `T_total` 136.63 ± 1.08 s; 0.5 s episodes leave 3–6 runs and end at
+//!    106.22 ± 11.04 s (serial: 191.81 s). Episodes give each sample about the same 1 %
+//!    chance per execution but make the islands contiguous and far fewer (docs/decisions.md,
+//!    "Unneeded corrections come in 0.5 s episodes", with the figures of earlier commits).
 //! 3. A correction is a joystick input `u` along the model's correction components
 //!    (`TaskModel::corrections_at`), `u_k = ±gain` with the sign that raises the force; a
 //!    component whose rate part would speed the robot up is left out when the combined
