@@ -10,7 +10,7 @@
 //! The figure is written as SVG and PNG. Text uses the bundled DejaVu Sans and the colours
 //! are the palette of `tandem_plot` (shared with `tandem plot`), through plotters' pure-Rust
 //! `ab_glyph` text renderer, so rendering needs no system font, fontconfig or freetype.
-//! The figure's tests draw a synthetic dataset ([`demo`], test-only).
+//! The figure's tests draw a synthetic dataset (module `demo`, compiled for tests only).
 
 #[cfg(test)]
 mod demo;
