@@ -170,16 +170,9 @@ fn damaged_state_files_give_clear_errors() {
     assert!(matches!(err, Error::Truncated { .. }), "{err}");
     assert_names(&err, &truncated);
 
+    // Not a state file: the golden file's bytes in reverse order.
     let noise = dir.join("noise.tandem");
-    let mut x = 0x2545_F491_4F6C_DD1D_u64;
-    let junk: Vec<u8> = (0..4096)
-        .map(|_| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x as u8
-        })
-        .collect();
+    let junk: Vec<u8> = bytes.iter().rev().copied().collect();
     std::fs::write(&noise, &junk).unwrap();
     let err = Planner::load(&noise).unwrap_err();
     assert!(matches!(err, Error::NotAStateFile { .. }), "{err}");

@@ -447,6 +447,25 @@ fn draw_mean<DB: DrawingBackend>(
     Ok(())
 }
 
+/// Draws the legend of the series labelled so far at `position`; `what` names it in errors.
+fn draw_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    position: SeriesLabelPosition,
+    what: &str,
+) -> anyhow::Result<()> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .margin(12)
+        .legend_area_size(30)
+        .label_font((FONT_FAMILY, LEGEND_FONT))
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK.mix(0.5))
+        .draw()
+        .map_err(draw_err(what))?;
+    Ok(())
+}
+
 /// Top panel: mean ± std `T_total` and the example schedule bars.
 fn draw_task_length_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
@@ -530,17 +549,11 @@ fn draw_task_length_panel<DB: DrawingBackend>(
         "task length mean",
     )?;
 
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .margin(12)
-        .legend_area_size(30)
-        .label_font((FONT_FAMILY, LEGEND_FONT))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK.mix(0.5))
-        .draw()
-        .map_err(draw_err("top panel legend"))?;
-    Ok(())
+    draw_legend(
+        &mut chart,
+        SeriesLabelPosition::UpperRight,
+        "top panel legend",
+    )
 }
 
 /// Bottom panel: % high-confidence samples and the ground-truth line.
@@ -605,17 +618,7 @@ fn draw_high_conf_panel<DB: DrawingBackend>(
                 + PathElement::new(vec![(20, 0), (24, 0)], GROUND_TRUTH.stroke_width(3))
         });
 
-    chart
-        .configure_series_labels()
-        .position(layout.pct_legend.clone())
-        .margin(12)
-        .legend_area_size(30)
-        .label_font((FONT_FAMILY, LEGEND_FONT))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK.mix(0.5))
-        .draw()
-        .map_err(draw_err("bottom panel legend"))?;
-    Ok(())
+    draw_legend(&mut chart, layout.pct_legend.clone(), "bottom panel legend")
 }
 
 /// The closed polygon of a ±1 std band: `mean + std` (capped at `cap`) along `xs`, then
