@@ -9,6 +9,7 @@ mod fixtures;
 mod reference_order;
 mod stress;
 mod study;
+mod test;
 
 use clap::{Parser, Subcommand};
 
@@ -42,6 +43,10 @@ enum Cmd {
         #[arg(long)]
         out: std::path::PathBuf,
     },
+    /// Run every test: `cargo test --workspace`, then build the Python wheel (maturin) into a
+    /// virtual environment under target/ with the pinned packages of
+    /// python/requirements-dev.txt and run pytest on python/tests (the README's test command).
+    Test(test::TestArgs),
     /// Run N Coordinator executions of sampled schedules under adversarial operators and
     /// count ticks with both robots low-confidence (expected 0).
     Stress {
@@ -61,6 +66,7 @@ fn main() -> anyhow::Result<()> {
         Cmd::Study(args) => study::run(&args),
         Cmd::Stress { executions, seed } => stress::run(executions, seed),
         Cmd::ReferenceOrder(args) => reference_order::run(&args),
+        Cmd::Test(args) => test::run_all(&args),
         Cmd::Fig5Demo { out } => {
             let (svg, png) = fig5::run_demo(&out)?;
             println!("wrote {} and {}", svg.display(), png.display());
