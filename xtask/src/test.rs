@@ -53,6 +53,19 @@ fn venv_python(venv: &Path) -> PathBuf {
     venv.join("bin").join("python")
 }
 
+/// `pip install` (quiet) of the environment `venv`, to be given what to install.
+fn pip_install(venv: &Path) -> Command {
+    let mut cmd = Command::new(venv_python(venv));
+    cmd.args([
+        "-m",
+        "pip",
+        "install",
+        "--disable-pip-version-check",
+        "--quiet",
+    ]);
+    cmd
+}
+
 /// Creates the virtual environment if needed and installs the pinned requirements when they
 /// changed since the last install.
 fn prepare_venv(root: &Path, venv: &Path) -> anyhow::Result<()> {
@@ -75,16 +88,7 @@ fn prepare_venv(root: &Path, venv: &Path) -> anyhow::Result<()> {
         return Ok(());
     }
     run(
-        Command::new(venv_python(venv))
-            .args([
-                "-m",
-                "pip",
-                "install",
-                "--disable-pip-version-check",
-                "--quiet",
-                "-r",
-            ])
-            .arg(&requirements),
+        pip_install(venv).arg("-r").arg(&requirements),
         "install the pinned Python packages (python/requirements-dev.txt)",
     )?;
     std::fs::write(&stamp, wanted).with_context(|| format!("writing {}", stamp.display()))?;
@@ -113,16 +117,8 @@ fn install_wheel(root: &Path, venv: &Path, target: &Path) -> anyhow::Result<()> 
         .find(|p| p.extension().is_some_and(|e| e == "whl"))
         .with_context(|| format!("maturin wrote no wheel into {}", wheels.display()))?;
     run(
-        Command::new(venv_python(venv))
-            .args([
-                "-m",
-                "pip",
-                "install",
-                "--disable-pip-version-check",
-                "--quiet",
-                "--force-reinstall",
-                "--no-deps",
-            ])
+        pip_install(venv)
+            .args(["--force-reinstall", "--no-deps"])
             .arg(&wheel),
         &format!("install {}", wheel.display()),
     )

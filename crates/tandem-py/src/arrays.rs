@@ -60,15 +60,14 @@ fn shape_text(shape: &[usize]) -> String {
     }
 }
 
-/// `x` as a float64 array with `ndim` dimensions: integers and other floats converted, any
-/// other dtype or number of dimensions an error naming `what` and `expected` (the meaning
-/// of the axes, for the message).
-fn real_array<'py>(
+/// `x` as a NumPy array with `ndim` dimensions, or an [`Error::Input`] naming `what`, the
+/// shape found and `expected` (the meaning of the axes).
+fn with_ndim<'py>(
     x: &Bound<'py, PyAny>,
     what: &str,
     ndim: usize,
     expected: &str,
-) -> Result<Bound<'py, PyArrayDyn<f64>>> {
+) -> Result<Bound<'py, PyUntypedArray>> {
     let a = as_ndarray(x, what)?;
     if a.ndim() != ndim {
         return Err(Error::input(
@@ -80,6 +79,19 @@ fn real_array<'py>(
             ),
         ));
     }
+    Ok(a)
+}
+
+/// `x` as a float64 array with `ndim` dimensions: integers and other floats converted, any
+/// other dtype or number of dimensions an error naming `what` and `expected` (the meaning
+/// of the axes, for the message).
+fn real_array<'py>(
+    x: &Bound<'py, PyAny>,
+    what: &str,
+    ndim: usize,
+    expected: &str,
+) -> Result<Bound<'py, PyArrayDyn<f64>>> {
+    let a = with_ndim(x, what, ndim, expected)?;
     let dtype = a.dtype();
     let kind = dtype.kind();
     if let Ok(f) = a.cast::<PyArrayDyn<f64>>() {
@@ -141,17 +153,7 @@ pub(crate) fn vector(x: &Bound<'_, PyAny>, what: &str, axis: &str) -> Result<Vec
 
 /// A 1-D array of flags: dtype bool, or integers that are all 0 or 1.
 pub(crate) fn flags(x: &Bound<'_, PyAny>, what: &str, axis: &str) -> Result<Vec<bool>> {
-    let a = as_ndarray(x, what)?;
-    if a.ndim() != 1 {
-        return Err(Error::input(
-            what,
-            format!(
-                "{}-D array of shape {}, expected a 1-D array ({axis})",
-                a.ndim(),
-                shape_text(a.shape())
-            ),
-        ));
-    }
+    let a = with_ndim(x, what, 1, axis)?;
     let dtype = a.dtype();
     if let Ok(b) = a.cast::<PyArray1<bool>>() {
         return Ok(b.readonly().as_array().iter().copied().collect());

@@ -666,6 +666,17 @@ impl PyConfidence {
             })
         })??)
     }
+
+    /// One parameter of [`PyConfidence::betas`] per reference sample, as an array.
+    fn beta_column<'py>(
+        &self,
+        py: Python<'py>,
+        posterior_too: bool,
+        pick: fn(&BetaParams) -> f64,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let betas = self.betas(py, posterior_too)?;
+        Ok(out_vector(py, betas.iter().map(pick).collect()))
+    }
 }
 
 #[pymethods]
@@ -717,36 +728,26 @@ impl PyConfidence {
     /// Prior ``α₀`` per reference sample (Eq. 10–11 from the current ``σ²_D``), ``(T_ref,)``.
     #[getter]
     fn prior_alpha<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let betas = self.betas(py, false)?;
-        Ok(out_vector(
-            py,
-            betas.iter().map(BetaParams::alpha).collect(),
-        ))
+        self.beta_column(py, false, BetaParams::alpha)
     }
 
     /// Prior ``β₀`` per reference sample (Eq. 10–11), ``(T_ref,)``.
     #[getter]
     fn prior_beta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let betas = self.betas(py, false)?;
-        Ok(out_vector(py, betas.iter().map(BetaParams::beta).collect()))
+        self.beta_column(py, false, BetaParams::beta)
     }
 
     /// Posterior ``α = α₀ + corrections`` per reference sample (Eq. 9), ``(T_ref,)``.
     #[getter]
     fn posterior_alpha<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let betas = self.betas(py, true)?;
-        Ok(out_vector(
-            py,
-            betas.iter().map(BetaParams::alpha).collect(),
-        ))
+        self.beta_column(py, true, BetaParams::alpha)
     }
 
     /// Posterior ``β = β₀ + supervised − corrections`` per reference sample (Eq. 9),
     /// ``(T_ref,)``.
     #[getter]
     fn posterior_beta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let betas = self.betas(py, true)?;
-        Ok(out_vector(py, betas.iter().map(BetaParams::beta).collect()))
+        self.beta_column(py, true, BetaParams::beta)
     }
 
     /// ``P(p_c|t < μ_c | z_t) = I_μc(α, β)`` per reference sample, the left side of Eq. 12
