@@ -3,26 +3,27 @@
 //!
 //! What Python gets, NumPy arrays in and out, with shapes and units in every docstring:
 //!
-//! - [`planner`]: `tandem.fit` (demonstrations as arrays or the command line's CSV/JSON
+//! - `planner`: `tandem.fit` (demonstrations as arrays or the command line's CSV/JSON
 //!   files → the Fig. 2 loop), `tandem.Planner` (`record_pair`, `reschedule`, `save`/`load`
 //!   with the command line's state file, `command` of Eq. 7) and the per-sample arrays of
 //!   the model (`tandem.Model`: `μ̂`, `σ²_D`, `ψ̇min/ψ̇max`) and of the confidence
 //!   (`tandem.Confidence`: latched `conf`, Beta posterior, observations).
-//! - [`schedule`]: `tandem.Problem` and `tandem.Schedule` (offsets, gradients,
+//! - `schedule`: `tandem.Problem` and `tandem.Schedule` (offsets, gradients,
 //!   low-confidence intervals, `T_total`, tick; `validate` against Eq. 20).
-//! - [`coordinator`]: `tandem.Coordinator`, the Rust real-time coordinator itself (not a
+//! - `coordinator`: `tandem.Coordinator`, the Rust real-time coordinator itself (not a
 //!   re-implementation), one control tick per `tick(operator)`.
-//! - [`study`] and [`sim`]: the simulated study of §III and its workcell.
-//! - [`warp`]: `tandem.align`, GDTW (Eq. 2–3).
+//! - `study` and `sim`: the simulated study of §III and its workcell.
+//! - `warp`: `tandem.align`, GDTW (Eq. 2–3).
 //!
-//! Errors become subclasses of `tandem.TandemError` ([`errors`]); a panic is caught at the
+//! Errors become subclasses of `tandem.TandemError` (`errors`); a panic is caught at the
 //! boundary and raised as `tandem.InternalError`. The GIL is released around every long call
 //! (fit, record, reschedule, study, align, load, save). The per-robot arrays are shaped for
 //! `N` robots (`(N,)`, `(N, T_ref)`, `N − 1` offsets); this build coordinates two.
 //!
-//! Every path into the `tandem` facade is in [`facade`], so moving the planner into its own
-//! crate changes one file here. The crate has no Rust test harness: it is tested from
-//! Python (`python/tests/`, run by `cargo xtask test`).
+//! Every path into the `tandem` facade is in `facade`, so moving the planner into its own
+//! crate changes one file here. The crate has no Rust test harness and no doctest (either
+//! would need libpython at link time): it is tested from Python (`python/tests/`, run by
+//! `cargo xtask test`), and its examples are `examples/python/`.
 
 mod arrays;
 mod coordinator;
