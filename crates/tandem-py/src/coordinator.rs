@@ -177,7 +177,7 @@ impl PyCoordinator {
         )
     }
 
-    /// Each robot's reference sample now (the sample its clock is in), ``(N,)`` int.
+    /// Each robot's reference sample now (the sample its clock is in), a list of ``N`` ints.
     #[getter]
     fn sample_now(&self) -> Vec<usize> {
         let clock = self.inner.clock_s();
