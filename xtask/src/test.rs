@@ -1,7 +1,8 @@
 //! `cargo xtask test`: every test of the project, Rust and Python, in one command (the
 //! README's test command, which `.ci/run` calls).
 //!
-//! 1. `cargo test --workspace`.
+//! 1. `cargo test --workspace --no-fail-fast`; the steps below run even if it fails, and the
+//!    command fails at the end if any step did.
 //! 2. `cargo build -p tandem-cli`: the Python tests compare the bindings with the command line
 //!    (`TANDEM_CLI` points them at this binary).
 //! 3. A virtual environment under the target folder (`<target>/py-venv`, never committed),
@@ -131,14 +132,18 @@ pub(crate) fn run_all(args: &TestArgs) -> anyhow::Result<()> {
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| root.join("target"));
-    if !args.python_only {
+    // Every test binary runs even if one fails, and the Python tests run after failing Rust
+    // tests too: one run reports every failure; the command fails if any did.
+    let rust = if args.python_only {
+        Ok(())
+    } else {
         run(
             Command::new(&cargo)
                 .current_dir(&root)
-                .args(["test", "--workspace"]),
-            "cargo test --workspace",
-        )?;
-    }
+                .args(["test", "--workspace", "--no-fail-fast"]),
+            "cargo test --workspace --no-fail-fast",
+        )
+    };
     run(
         Command::new(&cargo)
             .current_dir(&root)
@@ -156,9 +161,15 @@ pub(crate) fn run_all(args: &TestArgs) -> anyhow::Result<()> {
         .args(&args.pytest_args)
         .status()
         .context("cannot start pytest")?;
-    match status.code() {
+    let python = match status.code() {
         Some(0) => Ok(()),
-        Some(5) => bail!("pytest collected no tests in python/tests (exit code 5)"),
-        _ => bail!("pytest failed ({status})"),
+        Some(5) => Err(anyhow::anyhow!(
+            "pytest collected no tests in python/tests (exit code 5)"
+        )),
+        _ => Err(anyhow::anyhow!("pytest failed ({status})")),
+    };
+    match (rust, python) {
+        (Err(r), Err(p)) => bail!("{r:#}; {p:#}"),
+        (r, p) => r.and(p),
     }
 }
