@@ -91,7 +91,7 @@ def run_gdtw(x_ref, x_query):
     return psi, wall, float(f_tau)
 
 
-def run_tandem(x_ref, x_query, names, exe, tandem_params):
+def run_tandem(x_ref, x_query, names, exe, tandem_params, repeat=1):
     with tempfile.TemporaryDirectory() as tmp:
         paths = []
         for tag, x in (("ref", x_ref), ("query", x_query)):
@@ -99,7 +99,8 @@ def run_tandem(x_ref, x_query, names, exe, tandem_params):
             np.savetxt(p, x, delimiter=",", header=",".join(names), comments="", fmt="%.17g")
             paths.append(p)
         out = subprocess.run(
-            [exe, paths[0], paths[1], "--params", json.dumps(tandem_params), "--report"],
+            [exe, paths[0], paths[1], "--params", json.dumps(tandem_params), "--report",
+             "--repeat", str(repeat)],
             capture_output=True, text=True, check=True,
         )
     psi = np.loadtxt(out.stdout.splitlines()[1:], delimiter=",")[:, 1]
@@ -107,14 +108,16 @@ def run_tandem(x_ref, x_query, names, exe, tandem_params):
     return psi, float(rep["wall_s"]), float(rep["objective"])
 
 
-def run_tandem_python(x_ref, x_query, tandem_params):
+def run_tandem_python(x_ref, x_query, tandem_params, repeat=1):
     """The same alignment through the Python API (`tandem.align`, built from crates/tandem-py),
-    timed around the call: array conversion, GIL release and the result's copy included."""
+    timed around the call (array conversion, GIL release and the result's copy included); the
+    mean over `repeat` calls, like the example's `--repeat`."""
     import tandem
 
     start = time.perf_counter()
-    warp = tandem.align(x_ref, x_query, params=tandem_params)
-    wall = time.perf_counter() - start
+    for _ in range(repeat):
+        warp = tandem.align(x_ref, x_query, params=tandem_params)
+    wall = (time.perf_counter() - start) / repeat
     return warp.values, wall, warp.objective
 
 
@@ -140,6 +143,9 @@ def main():
     ap.add_argument("--python", action="store_true",
                     help="also align through the Python API (tandem.align; the tandem package "
                          "installed, see docs/python.md) and report its wall time and speed-up")
+    ap.add_argument("--tandem-repeat", type=int, default=1,
+                    help="time tandem's same-problem alignment as the mean of this many runs "
+                         "(both through the example and through Python); gdtw runs once")
     args = ap.parse_args()
     exe = build_tandem(not args.no_build)
     demos = [int(d) for d in args.demos.split(",")]
@@ -166,7 +172,7 @@ def main():
             "refinements": args.refinements, "max_jump": args.max_jump,
             "refine_radius": args.refine_radius,
         }
-        psi_t, wall_t, obj_rust = run_tandem(x_ref, x_q, names, exe, tp)
+        psi_t, wall_t, obj_rust = run_tandem(x_ref, x_q, names, exe, tp, args.tandem_repeat)
         # the crate's fast defaults on the same data and lambdas / slope bounds
         dp = {k: tp[k] for k in ("lambda_inst", "lambda_cum", "slope_min", "slope_max")}
         psi_d, wall_d, _ = run_tandem(x_ref, x_q, names, exe, dp)
@@ -177,7 +183,7 @@ def main():
         assert abs(j_t - obj_rust) <= 1e-6 * max(1.0, abs(j_t)), (j_t, obj_rust)
         py_cols = ""
         if args.python:
-            psi_p, wall_p, _ = run_tandem_python(x_ref, x_q, tp)
+            psi_p, wall_p, _ = run_tandem_python(x_ref, x_q, tp, args.tandem_repeat)
             # Same data, same parameters, same solver: the same warp to the last bit.
             assert np.array_equal(psi_p, psi_t), "tandem.align differs from the align example"
             py_cols = f" | {wall_p:.3f} | {wall_g / wall_p:.1f}x"
