@@ -7,7 +7,7 @@ use pyo3::types::PyString;
 
 use crate::arrays::{PyBool, out_flags, out_vector, repr_list};
 use crate::errors::{Error, Result, guard};
-use crate::facade::{Coordinator, Operator, Tick};
+use crate::facade::{Coordinator, Operator, Tick, Timeline};
 use crate::planner::N_ROBOTS;
 use crate::schedule::PySchedule;
 
@@ -55,6 +55,19 @@ fn operator(x: Option<&Bound<'_, PyAny>>) -> Result<Operator> {
 #[pyclass(module = "tandem", name = "Coordinator")]
 pub(crate) struct PyCoordinator {
     inner: Coordinator,
+}
+
+impl PyCoordinator {
+    /// `f(timeline, schedule clock)` for every robot.
+    fn per_robot<T>(&self, f: impl Fn(&Timeline, f64) -> T) -> Vec<T> {
+        let clock = self.inner.clock_s();
+        self.inner
+            .robots()
+            .iter()
+            .zip(clock)
+            .map(|(r, s)| f(r, s))
+            .collect()
+    }
 }
 
 #[pymethods]
@@ -126,32 +139,20 @@ impl PyCoordinator {
     /// Scheduled start of every robot, ``(N,)``, s of global time.
     #[getter]
     fn starts_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        out_vector(
-            py,
-            self.inner.robots().iter().map(|r| r.start_s()).collect(),
-        )
+        out_vector(py, self.per_robot(|r, _| r.start_s()))
     }
 
     /// Scheduled end of every robot, ``(N,)``, s of global time.
     #[getter]
     fn ends_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        out_vector(py, self.inner.robots().iter().map(|r| r.end_s()).collect())
+        out_vector(py, self.per_robot(|r, _| r.end_s()))
     }
 
     /// Whether each robot is running now (its clock in ``[start, end)``), ``(N,)`` bool:
     /// the robots that execute a sample in the next tick.
     #[getter]
     fn running_now<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        let clock = self.inner.clock_s();
-        out_flags(
-            py,
-            self.inner
-                .robots()
-                .iter()
-                .zip(clock)
-                .map(|(r, s)| s >= r.start_s() && s < r.end_s())
-                .collect(),
-        )
+        out_flags(py, self.per_robot(|r, s| s >= r.start_s() && s < r.end_s()))
     }
 
     /// Whether each robot is running and low-confidence now (Eq. 16 at the tick start),
@@ -165,28 +166,13 @@ impl PyCoordinator {
     /// reference samples in ``[0, T_ref]``: where to read its command (:meth:`Planner.command`).
     #[getter]
     fn ref_time_now<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let clock = self.inner.clock_s();
-        out_vector(
-            py,
-            self.inner
-                .robots()
-                .iter()
-                .zip(clock)
-                .map(|(r, s)| r.ref_time_at(s))
-                .collect(),
-        )
+        out_vector(py, self.per_robot(Timeline::ref_time_at))
     }
 
     /// Each robot's reference sample now (the sample its clock is in), a list of ``N`` ints.
     #[getter]
     fn sample_now(&self) -> Vec<usize> {
-        let clock = self.inner.clock_s();
-        self.inner
-            .robots()
-            .iter()
-            .zip(clock)
-            .map(|(r, s)| r.sample_at(s))
-            .collect()
+        self.per_robot(Timeline::sample_at)
     }
 
     fn __repr__(&self) -> String {

@@ -7,7 +7,7 @@
 
 pub(crate) use tandem::confidence::{BetaParams, Observations, posterior, prior};
 pub(crate) use tandem::lfd::{DEFAULT_DT_S, Demonstration, Execution, TaskModel};
-pub(crate) use tandem::realtime::{Coordinator, Operator, Tick};
+pub(crate) use tandem::realtime::{Coordinator, Operator, Tick, Timeline};
 pub(crate) use tandem::schedule::{
     GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, Violation, sample_schedule,
     validate,
