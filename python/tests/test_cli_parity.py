@@ -116,3 +116,22 @@ def test_memory_layout_of_arrays_does_not_matter() -> None:
         other = tandem.fit_model(variant, channels=channels)
         np.testing.assert_array_equal(other.mean, reference.mean)
         np.testing.assert_array_equal(other.sigma2_d, reference.sigma2_d)
+
+
+def test_record_pair_takes_execution_files_with_columns_in_any_order(tmp_path: Path) -> None:
+    from_arrays = tandem.fit(DEMOS, params=PARAMS)
+    from_files = tandem.fit(DEMOS, params=PARAMS)
+    run = tandem.sim.run_pair(from_arrays, tandem.sim.sanding_needs(LABELS, seed=2), seed=2)
+    channels = from_arrays.model.channels
+    files = []
+    for i, r in enumerate(run.robots):
+        path = tmp_path / f"exec{i}.csv"
+        np.savetxt(path, r.samples[:, ::-1], delimiter=",", header=",".join(channels[::-1]),
+                   comments="", fmt="%.17g")
+        files.append(path)
+    args = run.record_args()
+    from_arrays.record_pair(**args)
+    from_files.record_pair(**{**args, "executions": files})
+    from_arrays.save(tmp_path / "a.state")
+    from_files.save(tmp_path / "f.state")
+    assert (tmp_path / "a.state").read_bytes() == (tmp_path / "f.state").read_bytes()

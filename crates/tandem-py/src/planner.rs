@@ -40,13 +40,22 @@ fn relabel(e: errors::Lfd, label: &str) -> errors::Lfd {
     }
 }
 
+/// The channel names that go with a demonstration argument.
+#[derive(Clone, Copy)]
+struct Channels<'a> {
+    /// The names of an array's columns (required for arrays).
+    array: Option<&'a [String]>,
+    /// Names a file's header must have, in order, if any.
+    file: Option<&'a [String]>,
+}
+
 /// One demonstration or execution from a Python value: a CSV or JSON path (the command
-/// line's formats; JSON by extension) or a `(T, C)` array with `channels` naming its columns
-/// and sample period `dt_s` (s). `label` names it in errors (`demos[2]`).
+/// line's formats; JSON by extension) or a `(T, C)` array with `channels.array` naming its
+/// columns, sample period `dt_s` (s). `label` names it in errors (`demos[2]`).
 fn demonstration(
     x: &Bound<'_, PyAny>,
     label: &str,
-    channels: Option<&[String]>,
+    channels: Channels<'_>,
     dt_s: Option<f64>,
 ) -> Result<Demonstration> {
     if x.is_instance_of::<PyString>() || x.hasattr("__fspath__").unwrap_or(false) {
@@ -61,7 +70,7 @@ fn demonstration(
         } else {
             Demonstration::from_csv_path(&path, dt_s)?
         };
-        if let Some(names) = channels
+        if let Some(names) = channels.file
             && names != demo.channel_names()
         {
             return Err(Error::Input {
@@ -78,7 +87,7 @@ fn demonstration(
         return Ok(demo);
     }
     let (values, cols) = matrix(x, label, "samples × channels")?;
-    let names = channels.ok_or_else(|| {
+    let names = channels.array.ok_or_else(|| {
         Error::input(
             "channels",
             format!("{label} is an array: give channels=[...], one name per column"),
@@ -136,7 +145,13 @@ fn demonstrations(
     }
     list.iter()
         .enumerate()
-        .map(|(k, d)| demonstration(d, &format!("demos[{k}]"), channels, dt_s))
+        .map(|(k, d)| {
+            let both = Channels {
+                array: channels,
+                file: channels,
+            };
+            demonstration(d, &format!("demos[{k}]"), both, dt_s)
+        })
         .collect()
 }
 
@@ -305,7 +320,12 @@ impl PyPlanner {
         channels: Option<Vec<String>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let model = self.inner.model();
-        let names = channels.unwrap_or_else(|| model.channel_names().to_vec());
+        // Arrays default to the model's channel order; a file's header may list the
+        // channels in any order (the model matches them by name, as `tandem record` does).
+        let names = Channels {
+            array: Some(channels.as_deref().unwrap_or(model.channel_names())),
+            file: channels.as_deref(),
+        };
         let (execs, logs, sups, cors) = (
             per_robot(executions, "executions")?,
             per_robot(ref_time_logs, "ref_time_logs")?,
@@ -317,7 +337,7 @@ impl PyPlanner {
             let demonstration = demonstration(
                 &execs[i],
                 &format!("executions[{i}]"),
-                Some(&names),
+                names,
                 Some(model.dt_s()),
             )?;
             let ref_time_log = vector(
