@@ -18,7 +18,7 @@ Fairness notes (see README.md):
   (phi' - 1)^2 (the objectives differ by the constant lambda_inst).  We score with (phi' - 1)^2.
 * gdtw's default epsilon_abs = 0.1 stops refinement after ~2 passes; we set both tolerances to 0
   so it runs all max_iters = 10 passes.
-Run from the repository root:  python3 bench/peers/gdtw_compare.py [--demos 1,2,3,4,5]
+Run from the repository root:  python3 bench/peers/gdtw_compare.py [--demos 1,2,3,4,5] [--python]
 """
 import argparse
 import json
@@ -91,7 +91,7 @@ def run_gdtw(x_ref, x_query):
     return psi, wall, float(f_tau)
 
 
-def run_tandem(x_ref, x_query, names, exe, tandem_params):
+def run_tandem(x_ref, x_query, names, exe, tandem_params, repeat=1):
     with tempfile.TemporaryDirectory() as tmp:
         paths = []
         for tag, x in (("ref", x_ref), ("query", x_query)):
@@ -99,12 +99,26 @@ def run_tandem(x_ref, x_query, names, exe, tandem_params):
             np.savetxt(p, x, delimiter=",", header=",".join(names), comments="", fmt="%.17g")
             paths.append(p)
         out = subprocess.run(
-            [exe, paths[0], paths[1], "--params", json.dumps(tandem_params), "--report"],
+            [exe, paths[0], paths[1], "--params", json.dumps(tandem_params), "--report",
+             "--repeat", str(repeat)],
             capture_output=True, text=True, check=True,
         )
     psi = np.loadtxt(out.stdout.splitlines()[1:], delimiter=",")[:, 1]
     rep = dict(kv.split("=") for kv in out.stderr.split())
     return psi, float(rep["wall_s"]), float(rep["objective"])
+
+
+def run_tandem_python(x_ref, x_query, tandem_params, repeat=1):
+    """The same alignment through the Python API (`tandem.align`, built from crates/tandem-py),
+    timed around the call (array conversion, GIL release and the result's copy included); the
+    mean over `repeat` calls, like the example's `--repeat`."""
+    import tandem
+
+    start = time.perf_counter()
+    for _ in range(repeat):
+        warp = tandem.align(x_ref, x_query, params=tandem_params)
+    wall = (time.perf_counter() - start) / repeat
+    return warp.values, wall, warp.objective
 
 
 def build_tandem(build=True):
@@ -126,6 +140,12 @@ def main():
     ap.add_argument("--refine-radius", type=float, default=22.5,
                     help="tandem-warp refine_radius (22.5 = gdtw's eta 0.15 at M = 301)")
     ap.add_argument("--no-build", action="store_true", help="use an already built example")
+    ap.add_argument("--python", action="store_true",
+                    help="also align through the Python API (tandem.align; the tandem package "
+                         "installed, see docs/python.md) and report its wall time and speed-up")
+    ap.add_argument("--tandem-repeat", type=int, default=1,
+                    help="time tandem's same-problem alignment as the mean of this many runs "
+                         "(both through the example and through Python); gdtw runs once")
     args = ap.parse_args()
     exe = build_tandem(not args.no_build)
     demos = [int(d) for d in args.demos.split(",")]
@@ -140,9 +160,10 @@ def main():
     w = np.ones(len(keep))
     print(f"# N = T_ref = {len(x_ref)}, M = {M}, lambda_inst = {LAMBDA_INST}, "
           f"lambda_cum = {LAMBDA_CUM}, s in [{S_MIN}, {S_MAX}], W = I, channels = {names}")
+    py_head = " | tandem.align wall s | speed-up via Python" if args.python else ""
     print("demo | T_query | gdtw wall s | tandem wall s | speed-up | gdtw J | tandem J | "
-          "J ratio (tandem/gdtw) | gdtw own f | tandem defaults: wall s, J")
-    print("---|---|---|---|---|---|---|---|---|---")
+          "J ratio (tandem/gdtw) | gdtw own f | tandem defaults: wall s, J" + py_head)
+    print("---|---|---|---|---|---|---|---|---|---" + ("|---|---" if args.python else ""))
     for i in demos:
         x_q = minmax(raw[i][1][:, keep])
         tp = {
@@ -151,7 +172,7 @@ def main():
             "refinements": args.refinements, "max_jump": args.max_jump,
             "refine_radius": args.refine_radius,
         }
-        psi_t, wall_t, obj_rust = run_tandem(x_ref, x_q, names, exe, tp)
+        psi_t, wall_t, obj_rust = run_tandem(x_ref, x_q, names, exe, tp, args.tandem_repeat)
         # the crate's fast defaults on the same data and lambdas / slope bounds
         dp = {k: tp[k] for k in ("lambda_inst", "lambda_cum", "slope_min", "slope_max")}
         psi_d, wall_d, _ = run_tandem(x_ref, x_q, names, exe, dp)
@@ -160,9 +181,15 @@ def main():
         j_t = objective(x_ref, x_q, psi_t, w, LAMBDA_INST, LAMBDA_CUM)
         j_d = objective(x_ref, x_q, psi_d, w, LAMBDA_INST, LAMBDA_CUM)
         assert abs(j_t - obj_rust) <= 1e-6 * max(1.0, abs(j_t)), (j_t, obj_rust)
+        py_cols = ""
+        if args.python:
+            psi_p, wall_p, _ = run_tandem_python(x_ref, x_q, tp, args.tandem_repeat)
+            # Same data, same parameters, same solver: the same warp to the last bit.
+            assert np.array_equal(psi_p, psi_t), "tandem.align differs from the align example"
+            py_cols = f" | {wall_p:.3f} | {wall_g / wall_p:.1f}x"
         print(f"{i} | {len(x_q)} | {wall_g:.2f} | {wall_t:.3f} | {wall_g / wall_t:.1f}x | "
-              f"{j_g:.6f} | {j_t:.6f} | {j_t / j_g:.4f} | {f_g:.6f} | {wall_d:.4f}, {j_d:.6f}",
-              flush=True)
+              f"{j_g:.6f} | {j_t:.6f} | {j_t / j_g:.4f} | {f_g:.6f} | {wall_d:.4f}, {j_d:.6f}"
+              + py_cols, flush=True)
 
 
 if __name__ == "__main__":

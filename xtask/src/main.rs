@@ -9,6 +9,7 @@ mod fixtures;
 mod reference_order;
 mod stress;
 mod study;
+mod test;
 
 use std::path::{Path, PathBuf};
 
@@ -47,6 +48,10 @@ enum Cmd {
     /// medoid) and run a reduced study on each: how much the order of the demonstrations
     /// changes σ²_D, the speed bounds and the confidence (docs/decisions.md).
     ReferenceOrder(reference_order::ReferenceOrderArgs),
+    /// Run every test: `cargo test --workspace`, then build the Python wheel (maturin) into a
+    /// virtual environment under target/ with the pinned packages of
+    /// python/requirements-dev.txt and run pytest on python/tests (the README's test command).
+    Test(test::TestArgs),
     /// Run N Coordinator executions of sampled schedules under adversarial operators and
     /// count ticks with both robots low-confidence (expected 0).
     Stress {
@@ -66,5 +71,6 @@ fn main() -> anyhow::Result<()> {
         Cmd::Study(args) => study::run(&args),
         Cmd::Stress { executions, seed } => stress::run(executions, seed),
         Cmd::ReferenceOrder(args) => reference_order::run(&args),
+        Cmd::Test(args) => test::run_all(&args),
     }
 }

@@ -272,9 +272,16 @@ impl Episodes {
     }
 }
 
-/// The joystick input for a force-raising, slowing correction at `ref_time` (see the module
-/// docs), or `None` when no component moves the force.
-fn correction_input(
+/// The simulated operator's joystick input for a force-raising, slowing correction at
+/// fractional reference time `ref_time` (see the module docs, step 3): fills `u` (one entry
+/// per correction component, [`TaskModel::n_components`]) with `±gain` or 0 and returns
+/// whether any entry is non-zero. `force_idx` is the force channel's index in
+/// [`TaskModel::tangent_names`]. The workcell passes `u` to [`TaskModel::command_into`]
+/// (Eq. 7); it is public so that a replay of a run can recompute the operator's input.
+///
+/// # Errors
+/// The model crate's error for `ref_time` outside `[0, T_ref − 1]`.
+pub fn correction_input(
     model: &TaskModel,
     force_idx: usize,
     gain: f64,

@@ -1,0 +1,231 @@
+//! `tandem.Coordinator` and `tandem.Tick`: the Rust runtime coordinator (§II-B5, Eq. 15–18,
+//! Alg. 1), the same object the safety property tests run, one control tick per call.
+
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyString;
+
+use crate::arrays::{PyBool, out_flags, out_vector, repr_list};
+use crate::errors::{Error, Result, guard};
+use crate::facade::{Coordinator, Operator, Tick, Timeline};
+use crate::planner::N_ROBOTS;
+use crate::schedule::PySchedule;
+
+/// The operator's input from Python: `None`/`"scheduled"`, a gradient, `"fastest"` or
+/// `"slowest"`.
+fn operator(x: Option<&Bound<'_, PyAny>>) -> Result<Operator> {
+    let Some(x) = x.filter(|x| !x.is_none()) else {
+        return Ok(Operator::Scheduled);
+    };
+    if let Ok(s) = x.cast::<PyString>() {
+        return match s.to_cow().unwrap_or_default().as_ref() {
+            "scheduled" => Ok(Operator::Scheduled),
+            "fastest" => Ok(Operator::Fastest),
+            "slowest" => Ok(Operator::Slowest),
+            other => Err(Error::input(
+                "operator",
+                format!(
+                    "'{other}': expected None, a gradient, 'fastest', 'slowest' or 'scheduled'"
+                ),
+            )),
+        };
+    }
+    let g: f64 = x.extract().map_err(|_| {
+        Error::input(
+            "operator",
+            "expected None, a gradient (float), 'fastest', 'slowest' or 'scheduled'",
+        )
+    })?;
+    Operator::Gradient(g).validate().map_err(|_| {
+        Error::input(
+            "operator",
+            format!("gradient {g} must be finite and > 0 (None means no correction)"),
+        )
+    })
+}
+
+/// The runtime coordinator of a schedule (§II-B5): advances every robot's schedule clock by
+/// one control tick of ``schedule.tick_s`` real seconds per :meth:`tick`, the
+/// low-confidence robot at the operator's rate, the others responding (Eq. 18, Alg. 1) so
+/// that no two robots are ever low-confidence in the same tick — the guarantee of the
+/// margin check that accepted the schedule, at that tick.
+///
+/// It wraps the Rust ``tandem_realtime::Coordinator`` (no re-implementation): a tick is
+/// O(1) and allocates nothing on the Rust side.
+#[pyclass(module = "tandem", name = "Coordinator")]
+pub(crate) struct PyCoordinator {
+    inner: Coordinator,
+}
+
+impl PyCoordinator {
+    /// `f(timeline, schedule clock)` for every robot.
+    fn per_robot<T>(&self, f: impl Fn(&Timeline, f64) -> T) -> Vec<T> {
+        let clock = self.inner.clock_s();
+        self.inner
+            .robots()
+            .iter()
+            .zip(clock)
+            .map(|(r, s)| f(r, s))
+            .collect()
+    }
+}
+
+#[pymethods]
+impl PyCoordinator {
+    /// The coordinator of ``schedule`` on its problem, at its tick, both clocks at the
+    /// earliest start.
+    ///
+    /// Raises:
+    ///     ScheduleError: a schedule whose warps do not fit its problem.
+    #[new]
+    fn py_new(schedule: PyRef<'_, PySchedule>) -> PyResult<Self> {
+        let inner = guard(|| Ok(schedule.schedule.coordinator(&schedule.problem)?))?;
+        Ok(Self { inner })
+    }
+
+    /// Advances one control tick.
+    ///
+    /// Args:
+    ///     operator: the operator's input for the low-confidence robot (ignored when no
+    ///         robot is low-confidence): ``None`` (no correction: its scheduled gradient),
+    ///         a gradient ``g > 0`` (execution samples per reference sample, e.g. the rate
+    ///         component of :meth:`Planner.command`; clamped to ``[ψ̇min, ψ̇max]``),
+    ///         ``"fastest"`` (``ψ̇min``) or ``"slowest"`` (``ψ̇max``).
+    ///
+    /// Returns:
+    ///     Tick: each robot's reference time at the end of the tick, who was
+    ///     low-confidence during it, who was running.
+    ///
+    /// Raises:
+    ///     InputError: a gradient that is NaN, infinite or ≤ 0 (the coordinator is then
+    ///         unchanged), or another kind of input.
+    #[pyo3(signature = (operator=None))]
+    fn tick(&mut self, operator: Option<&Bound<'_, PyAny>>) -> PyResult<PyTick> {
+        let op = self::operator(operator)?;
+        let inner = &mut self.inner;
+        let tick = guard(|| Ok(inner.tick(op)?))?;
+        Ok(PyTick { inner: tick })
+    }
+
+    /// Puts every clock back at the earliest start (to run the same plan again).
+    fn reset(&mut self) {
+        self.inner.reset();
+    }
+
+    /// Whether every robot has finished.
+    #[getter]
+    fn is_finished(&self) -> bool {
+        self.inner.is_finished()
+    }
+
+    /// Number of robots ``N``.
+    #[getter]
+    fn n_robots(&self) -> usize {
+        N_ROBOTS
+    }
+
+    /// Control tick (real s) per :meth:`tick`.
+    #[getter]
+    fn tick_s(&self) -> f64 {
+        self.inner.tick_s()
+    }
+
+    /// Each robot's schedule clock ``s_i``, ``(N,)``, s of global time.
+    #[getter]
+    fn clock_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        out_vector(py, self.inner.clock_s().to_vec())
+    }
+
+    /// Scheduled start of every robot, ``(N,)``, s of global time.
+    #[getter]
+    fn starts_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        out_vector(py, self.per_robot(|r, _| r.start_s()))
+    }
+
+    /// Scheduled end of every robot, ``(N,)``, s of global time.
+    #[getter]
+    fn ends_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        out_vector(py, self.per_robot(|r, _| r.end_s()))
+    }
+
+    /// Whether each robot is running now (its clock in ``[start, end)``), ``(N,)`` bool:
+    /// the robots that execute a sample in the next tick.
+    #[getter]
+    fn running_now<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        out_flags(py, self.per_robot(|r, s| s >= r.start_s() && s < r.end_s()))
+    }
+
+    /// Whether each robot is running and low-confidence now (Eq. 16 at the tick start),
+    /// ``(N,)`` bool: the robot the next tick moves at the operator's rate.
+    #[getter]
+    fn low_conf_now<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        out_flags(py, self.inner.low_conf_now().to_vec())
+    }
+
+    /// Each robot's fractional reference time now (Eq. 15 at its clock), ``(N,)``,
+    /// reference samples in ``[0, T_ref]``: where to read its command (:meth:`Planner.command`).
+    #[getter]
+    fn ref_time_now<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        out_vector(py, self.per_robot(Timeline::ref_time_at))
+    }
+
+    /// Each robot's reference sample now (the sample its clock is in), a list of ``N`` ints.
+    #[getter]
+    fn sample_now(&self) -> Vec<usize> {
+        self.per_robot(Timeline::sample_at)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Coordinator(n_robots={N_ROBOTS}, tick_s={}, clock_s={}, is_finished={})",
+            self.inner.tick_s(),
+            repr_list(&self.inner.clock_s()),
+            PyBool(self.inner.is_finished())
+        )
+    }
+}
+
+/// What one :meth:`Coordinator.tick` did, per robot.
+#[pyclass(module = "tandem", name = "Tick", frozen)]
+pub(crate) struct PyTick {
+    inner: Tick,
+}
+
+#[pymethods]
+impl PyTick {
+    /// Each robot's fractional reference time at the end of the tick, ``(N,)``, reference
+    /// samples in ``[0, T_ref]`` (Eq. 15 at its schedule clock).
+    #[getter]
+    fn ref_time<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        out_vector(py, self.inner.ref_time.to_vec())
+    }
+
+    /// Whether each robot traversed any low-confidence reference sample during the tick,
+    /// ``(N,)`` bool (conservative: a tolerance only adds reports).
+    #[getter]
+    fn low_conf<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        out_flags(py, self.inner.low_conf.to_vec())
+    }
+
+    /// Whether each robot ran during the tick, ``(N,)`` bool.
+    #[getter]
+    fn running<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        out_flags(py, self.inner.running.to_vec())
+    }
+
+    /// Whether more than one robot was low-confidence in this tick (never, for a schedule
+    /// that passed the margin check).
+    #[getter]
+    fn overlap(&self) -> bool {
+        self.inner.low_conf.iter().filter(|l| **l).count() > 1
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Tick(ref_time={}, low_conf={}, running={})",
+            repr_list(&self.inner.ref_time),
+            repr_list(&self.inner.low_conf),
+            repr_list(&self.inner.running)
+        )
+    }
+}

@@ -1,0 +1,852 @@
+//! `tandem.fit`, `tandem.Planner` (the Fig. 2 loop and its state file), `tandem.Model`,
+//! `tandem.Confidence` and `tandem.Observations`.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+
+use crate::arrays::{flags, matrix, out_flags, out_matrix, out_vector, repr_list, vector};
+use crate::errors::{Error, Result, guard};
+use crate::facade::{
+    BetaParams, DEFAULT_DT_S, Demonstration, Execution, ExecutionRecord, Observations, Planner,
+    PlannerParams, RecordReport, TaskModel, derive_seed, errors, posterior, prior,
+};
+use crate::params::{from_py, serialize_to_py};
+use crate::schedule::PyProblem;
+use crate::schedule::PySchedule;
+
+/// Robots this build coordinates (the Python API takes per-robot sequences of this length).
+pub(crate) const N_ROBOTS: usize = 2;
+
+/// Offset of the seed streams `Planner.reschedule` uses without a seed: the streams of
+/// `tandem schedule` without `--seed`, so both draw the same candidates for the same state.
+const SCHEDULE_STREAM: u64 = 1 << 32;
+
+/// `e` with the in-memory source label replaced by `label` (the Python argument).
+fn relabel(e: errors::Lfd, label: &str) -> errors::Lfd {
+    match e {
+        errors::Lfd::BadData { why, .. } => errors::Lfd::BadData {
+            what: label.to_owned(),
+            why,
+        },
+        errors::Lfd::TooFewSamples { found, .. } => errors::Lfd::TooFewSamples {
+            at: label.to_owned(),
+            found,
+        },
+        other => other,
+    }
+}
+
+/// The channel names that go with a demonstration argument.
+#[derive(Clone, Copy)]
+struct Channels<'a> {
+    /// The names of an array's columns (required for arrays).
+    array: Option<&'a [String]>,
+    /// Names a file's header must have, in order, if any.
+    file: Option<&'a [String]>,
+}
+
+/// One demonstration or execution from a Python value: a CSV or JSON path (the command
+/// line's formats; JSON by extension) or a `(T, C)` array with `channels.array` naming its
+/// columns, sample period `dt_s` (s). `label` names it in errors (`demos[2]`).
+fn demonstration(
+    x: &Bound<'_, PyAny>,
+    label: &str,
+    channels: Channels<'_>,
+    dt_s: Option<f64>,
+) -> Result<Demonstration> {
+    if x.is_instance_of::<PyString>() || x.hasattr("__fspath__").unwrap_or(false) {
+        let path: PathBuf = x
+            .extract()
+            .map_err(|e| Error::input(label, format!("not a path: {e}")))?;
+        let is_json = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+        let demo = if is_json {
+            Demonstration::from_json_path(&path, dt_s)?
+        } else {
+            Demonstration::from_csv_path(&path, dt_s)?
+        };
+        if let Some(names) = channels.file
+            && names != demo.channel_names()
+        {
+            return Err(Error::Input {
+                what: label.to_owned(),
+                why: format!(
+                    "{}: columns {} differ from channels={}",
+                    path.display(),
+                    repr_list(demo.channel_names()),
+                    repr_list(names)
+                ),
+                file: Some(path.display().to_string()),
+            });
+        }
+        return Ok(demo);
+    }
+    let (values, cols) = matrix(x, label, "samples × channels")?;
+    let names = channels.array.ok_or_else(|| {
+        Error::input(
+            "channels",
+            format!("{label} is an array: give channels=[...], one name per column"),
+        )
+    })?;
+    if names.len() != cols {
+        return Err(Error::input(
+            label,
+            format!(
+                "{cols} columns, but channels names {}: {}",
+                names.len(),
+                repr_list(names)
+            ),
+        ));
+    }
+    let demo = Demonstration::new(names.to_vec(), values, dt_s.unwrap_or(DEFAULT_DT_S))
+        .map_err(|e| relabel(e, label))?;
+    Ok(demo.with_source(label))
+}
+
+/// The items of a Python sequence argument (not a string or a single array).
+fn items<'py>(x: &Bound<'py, PyAny>, what: &str) -> Result<Vec<Bound<'py, PyAny>>> {
+    let single = x.is_instance_of::<PyString>()
+        || x.hasattr("__fspath__").unwrap_or(false)
+        || x.hasattr("__array_interface__").unwrap_or(false)
+        || x.is_instance_of::<PyDict>();
+    if single {
+        return Err(Error::input(
+            what,
+            "expected a list (one entry per demonstration or robot), got a single value",
+        ));
+    }
+    let iter = x
+        .try_iter()
+        .map_err(|_| Error::input(what, "expected a list"))?;
+    iter.map(|item| item.map_err(|e| Error::input(what, e.to_string())))
+        .collect()
+}
+
+/// Demonstrations from `demos` (paths or arrays, see [`demonstration`]).
+fn demonstrations(
+    demos: &Bound<'_, PyAny>,
+    channels: Option<&[String]>,
+    dt_s: Option<f64>,
+) -> Result<Vec<Demonstration>> {
+    let list = items(demos, "demos")?;
+    if list.len() < 2 {
+        return Err(Error::input(
+            "demos",
+            format!(
+                "{} demonstration(s); the variability of the task needs at least 2",
+                list.len()
+            ),
+        ));
+    }
+    list.iter()
+        .enumerate()
+        .map(|(k, d)| {
+            let both = Channels {
+                array: channels,
+                file: channels,
+            };
+            demonstration(d, &format!("demos[{k}]"), both, dt_s)
+        })
+        .collect()
+}
+
+/// Planner parameters from `params` (None, a dict or a TOML path), checked.
+fn planner_params(params: Option<&Bound<'_, PyAny>>) -> Result<PlannerParams> {
+    let p: PlannerParams = from_py(params, "params")?;
+    p.validate()?;
+    Ok(p)
+}
+
+/// Learns the task from demonstrations and makes the first schedule (paper Fig. 2).
+///
+/// Aligns every demonstration to the reference (GDTW, Eq. 2–3; demo 0, or the medoid with
+/// ``params["fit"]["reference"] = "medoid"``), fits the model (mean ``μ̂``, ``σ²_D`` of
+/// Eq. 6, gradient bounds of Eq. 14, correction directions), sets the confidence from the
+/// prior (Eq. 10–12) and samples a schedule (§II-C). Exactly what ``tandem fit`` does: the
+/// same inputs and parameters give the same state file.
+///
+/// Args:
+///     demos: at least two demonstrations, each a path to a CSV or JSON file (the command
+///         line's formats, a ``t`` column sets the period) or a float array of shape
+///         ``(T_i, C)`` (samples × channels, channel units).
+///     channels: the ``C`` channel names of array demonstrations (required for arrays;
+///         checked against a file's header if given).
+///     params: ``None`` (defaults), a nested dict ``{"fit": …, "confidence": …,
+///         "sampler": …}`` or the path of a TOML file (``tandem params`` prints the
+///         defaults).
+///     dt_s: sample period (s) of arrays and of files without a ``t`` column (default 0.01).
+///
+/// Raises:
+///     InputError: a bad demonstration (with ``file``/``line`` for files).
+///     ParamError: a bad parameter.
+#[pyfunction]
+#[pyo3(signature = (demos, channels=None, params=None, dt_s=None))]
+pub(crate) fn fit(
+    py: Python<'_>,
+    demos: &Bound<'_, PyAny>,
+    channels: Option<Vec<String>>,
+    params: Option<&Bound<'_, PyAny>>,
+    dt_s: Option<f64>,
+) -> PyResult<PyPlanner> {
+    let demos = demonstrations(demos, channels.as_deref(), dt_s)?;
+    let params = planner_params(params)?;
+    let planner = py.detach(|| guard(|| Ok(Planner::new(&demos, params)?)))?;
+    Ok(PyPlanner { inner: planner })
+}
+
+/// The task model alone (alignment and statistics, §II-B1/2), without confidence or
+/// schedule: as :func:`fit` but returns a :class:`Model`. ``params`` takes the same form as
+/// :func:`fit`'s; only its ``"fit"`` block is used.
+#[pyfunction]
+#[pyo3(signature = (demos, channels=None, params=None, dt_s=None))]
+pub(crate) fn fit_model(
+    py: Python<'_>,
+    demos: &Bound<'_, PyAny>,
+    channels: Option<Vec<String>>,
+    params: Option<&Bound<'_, PyAny>>,
+    dt_s: Option<f64>,
+) -> PyResult<PyModel> {
+    let demos = demonstrations(demos, channels.as_deref(), dt_s)?;
+    let params = planner_params(params)?;
+    let model = py.detach(|| guard(|| Ok(TaskModel::fit(&demos, &params.fit)?)))?;
+    Ok(PyModel {
+        source: ModelSource::Owned(Arc::new(model)),
+    })
+}
+
+/// The default parameters as a nested dict (``{"fit": …, "confidence": …, "sampler": …}``,
+/// the command line's ``tandem params``).
+#[pyfunction]
+pub(crate) fn default_params(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    serialize_to_py(py, &PlannerParams::default())
+}
+
+/// The loop of the paper's Fig. 2: the task model, the correction observations, the
+/// latched confidence and the current schedule, updated after every pair of executions.
+///
+/// Make one with :func:`fit` or :meth:`Planner.load`. The state file is the command line's:
+/// a file saved here opens with ``tandem inspect``/``record``/``schedule`` and vice versa.
+#[pyclass(module = "tandem", name = "Planner")]
+pub(crate) struct PyPlanner {
+    pub(crate) inner: Planner,
+}
+
+/// Per-robot arguments of `record_pair`, checked to have one entry per robot.
+fn per_robot<'py>(x: &Bound<'py, PyAny>, what: &str) -> Result<Vec<Bound<'py, PyAny>>> {
+    let v = items(x, what)?;
+    if v.len() != N_ROBOTS {
+        return Err(Error::input(
+            what,
+            format!(
+                "{} entries; give one per robot ({N_ROBOTS} robots: robot 1, then robot 2)",
+                v.len()
+            ),
+        ));
+    }
+    Ok(v)
+}
+
+/// The report of a recorded pair as a dict.
+fn report_dict<'py>(py: Python<'py>, r: &RecordReport) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("newly_high", r.newly_high)?;
+    d.set_item("source", crate::schedule::source_name(r.source))?;
+    d.set_item("t_total_s", r.t_total_s)?;
+    d.set_item("model_update_s", r.model_update.as_secs_f64())?;
+    d.set_item("confidence_s", r.confidence.as_secs_f64())?;
+    d.set_item("scheduling_s", r.scheduling.as_secs_f64())?;
+    Ok(d)
+}
+
+#[pymethods]
+impl PyPlanner {
+    /// Loads a planner from a state file written by :meth:`save` or by the command line.
+    ///
+    /// Raises:
+    ///     StateFileError: the file is missing, not a state file, of another format version,
+    ///         truncated or corrupt (``path`` names it).
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyPlanner> {
+        let inner = py.detach(|| guard(|| Ok(Planner::load(&path)?)))?;
+        Ok(PyPlanner { inner })
+    }
+
+    /// Saves the planner to ``path`` atomically (temporary file, fsync, rename): on error or
+    /// a crash the previous file at ``path`` is intact.
+    ///
+    /// Raises:
+    ///     StateFileError: the file cannot be written (``path`` names it).
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let inner = &self.inner;
+        py.detach(|| guard(|| Ok(inner.save(&path)?)))?;
+        Ok(())
+    }
+
+    /// Records a pair of executions and re-schedules (Eq. 21, Eq. 9–12, §II-C).
+    ///
+    /// Adds both executions to the model with their reference-time logs (no re-alignment),
+    /// their supervised samples to the observations, updates the latched confidence and
+    /// samples a new schedule warm-started by the current one. Everything is checked first:
+    /// on error the planner is as before.
+    ///
+    /// Args:
+    ///     executions: per robot, the executed samples: a ``(T_k, C)`` float array in the
+    ///         model's channels (or ``channels``) or a CSV/JSON path.
+    ///     ref_time_logs: per robot, a ``(T_k,)`` float array: the fractional reference
+    ///         sample of each executed sample (monotone, in ``[0, T_ref − 1]``).
+    ///     supervised: per robot, a ``(T_k,)`` bool array: the sample ran low-confidence,
+    ///         with the operator watching.
+    ///     corrected: per robot, a ``(T_k,)`` bool array: the operator corrected the sample
+    ///         (only read where supervised).
+    ///     channels: column names of the arrays (default: the model's channels).
+    ///
+    /// Returns:
+    ///     dict: ``newly_high`` (samples latched high-confidence), ``source`` of the new
+    ///     schedule, its ``t_total_s`` (Eq. 13, s), and wall times ``model_update_s``,
+    ///     ``confidence_s``, ``scheduling_s``.
+    #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None))]
+    fn record_pair<'py>(
+        &mut self,
+        py: Python<'py>,
+        executions: &Bound<'py, PyAny>,
+        ref_time_logs: &Bound<'py, PyAny>,
+        supervised: &Bound<'py, PyAny>,
+        corrected: &Bound<'py, PyAny>,
+        channels: Option<Vec<String>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let model = self.inner.model();
+        // Arrays default to the model's channel order; a file's header may list the
+        // channels in any order (the model matches them by name, as `tandem record` does).
+        let names = Channels {
+            array: Some(channels.as_deref().unwrap_or(model.channel_names())),
+            file: channels.as_deref(),
+        };
+        let (execs, logs, sups, cors) = (
+            per_robot(executions, "executions")?,
+            per_robot(ref_time_logs, "ref_time_logs")?,
+            per_robot(supervised, "supervised")?,
+            per_robot(corrected, "corrected")?,
+        );
+        let mut records = Vec::with_capacity(N_ROBOTS);
+        for i in 0..N_ROBOTS {
+            let demonstration = demonstration(
+                &execs[i],
+                &format!("executions[{i}]"),
+                names,
+                Some(model.dt_s()),
+            )?;
+            let ref_time_log = vector(
+                &logs[i],
+                &format!("ref_time_logs[{i}]"),
+                "one reference time per executed sample",
+            )?;
+            records.push(ExecutionRecord {
+                execution: Execution {
+                    demonstration,
+                    ref_time_log,
+                },
+                supervised: flags(
+                    &sups[i],
+                    &format!("supervised[{i}]"),
+                    "one flag per executed sample",
+                )?,
+                corrected: flags(
+                    &cors[i],
+                    &format!("corrected[{i}]"),
+                    "one flag per executed sample",
+                )?,
+            });
+        }
+        let pair: [ExecutionRecord; N_ROBOTS] = records
+            .try_into()
+            .map_err(|_| Error::Panic("one record per robot".into()))?;
+        let inner = &mut self.inner;
+        let report = py.detach(|| guard(|| Ok(inner.record_pair(&pair)?)))?;
+        report_dict(py, &report)
+    }
+
+    /// Re-runs the anytime sampler (§II-C) on the current problem, warm-started by the
+    /// current schedule, and keeps the result (``T_total`` never increases at the same
+    /// tick). Model, observations, confidence and parameters are unchanged.
+    ///
+    /// Args:
+    ///     samples: candidates to sample (default: the parameters').
+    ///     seed: the sampler's seed (default: the stream ``tandem schedule`` uses without
+    ///         ``--seed``, so both give the same schedule for the same state).
+    ///     tick_s: control tick (real s) the margins are checked at and the schedule runs at
+    ///         (default: the parameters', else the reference period ``Δt_s``).
+    ///
+    /// Returns:
+    ///     Schedule: the new current schedule.
+    #[pyo3(signature = (samples=None, seed=None, tick_s=None))]
+    fn reschedule(
+        &mut self,
+        py: Python<'_>,
+        samples: Option<usize>,
+        seed: Option<u64>,
+        tick_s: Option<f64>,
+    ) -> PyResult<PySchedule> {
+        let mut sp = self.inner.params().sampler.clone();
+        sp.seed = match seed {
+            Some(s) => s,
+            None => derive_seed(
+                sp.seed,
+                SCHEDULE_STREAM + self.inner.pairs_recorded() as u64,
+            ),
+        };
+        if let Some(n) = samples {
+            sp.samples = n;
+        }
+        if tick_s.is_some() {
+            sp.tick_s = tick_s;
+        }
+        let inner = &mut self.inner;
+        py.detach(|| guard(|| Ok(inner.reschedule(&sp).map(|_| ())?)))?;
+        Ok(self.current_schedule())
+    }
+
+    /// The current schedule (a snapshot: it does not change when the planner does).
+    #[getter]
+    fn schedule(&self) -> PySchedule {
+        self.current_schedule()
+    }
+
+    /// The current scheduling problem (confidence and gradient bounds per reference sample).
+    #[getter]
+    fn problem(&self) -> PyProblem {
+        PyProblem::new(Arc::new(self.inner.problem().clone()))
+    }
+
+    /// The task model (a live view: it follows the planner).
+    #[getter]
+    fn model(slf: Py<Self>) -> PyModel {
+        PyModel {
+            source: ModelSource::Planner(slf),
+        }
+    }
+
+    /// The latched confidence and the observations (a live view).
+    #[getter]
+    fn confidence(slf: Py<Self>) -> PyConfidence {
+        PyConfidence { planner: slf }
+    }
+
+    /// The parameters as a nested dict.
+    #[getter]
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        serialize_to_py(py, self.inner.params())
+    }
+
+    /// Pairs of executions recorded so far.
+    #[getter]
+    fn pairs_recorded(&self) -> usize {
+        self.inner.pairs_recorded()
+    }
+
+    /// Number of robots the planner schedules.
+    #[getter]
+    fn n_robots(&self) -> usize {
+        N_ROBOTS
+    }
+
+    /// The command ``x_f⁺(u, t) = μ̂⁺(t) + δx⁺(u, t)`` (Eq. 7) at fractional reference time
+    /// ``ref_time`` (reference samples) for joystick input ``u`` in ``[−1, 1]^K``
+    /// (``None``: no correction). Returns a ``(C + 1,)`` array: the ``C`` channel values
+    /// (channel units) then the rate, the warp gradient in ``[ψ̇min, ψ̇max]`` (demo samples
+    /// per reference sample) that the coordinator takes as the operator's gradient.
+    #[pyo3(signature = (ref_time, u=None))]
+    fn command<'py>(
+        &self,
+        py: Python<'py>,
+        ref_time: f64,
+        u: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        command(py, self.inner.model(), ref_time, u)
+    }
+
+    fn __repr__(&self) -> String {
+        let m = self.inner.model();
+        format!(
+            "Planner(n_ref={}, channels={}, pairs_recorded={}, high_share={:.3}, t_total_s={:.3})",
+            m.n_ref(),
+            repr_list(m.channel_names()),
+            self.inner.pairs_recorded(),
+            self.inner.confidence().high_share(),
+            self.inner.outcome().t_total_s
+        )
+    }
+}
+
+impl PyPlanner {
+    fn current_schedule(&self) -> PySchedule {
+        PySchedule::from_outcome(Arc::new(self.inner.problem().clone()), self.inner.outcome())
+    }
+}
+
+/// Eq. 7 on `model`; `u = None` is no correction.
+fn command<'py>(
+    py: Python<'py>,
+    model: &TaskModel,
+    ref_time: f64,
+    u: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let u = match u.filter(|u| !u.is_none()) {
+        Some(u) => vector(u, "u", "one input per correction component")?,
+        None => vec![0.0; model.n_components()],
+    };
+    let cmd = guard(|| Ok(model.command(&u, ref_time)?))?;
+    Ok(out_vector(py, cmd))
+}
+
+/// Where a [`PyModel`] reads its model.
+enum ModelSource {
+    /// The planner's current model.
+    Planner(Py<PyPlanner>),
+    /// A model of its own (from `fit_model`).
+    Owned(Arc<TaskModel>),
+}
+
+/// The task model (§II-B1/2): per reference sample ``n`` (period ``dt_s``) the mean
+/// behaviour, the demonstration variance, the warp-gradient bounds and the correction
+/// directions.
+#[pyclass(module = "tandem", name = "Model", frozen)]
+pub(crate) struct PyModel {
+    source: ModelSource,
+}
+
+impl PyModel {
+    fn with<R>(&self, py: Python<'_>, f: impl FnOnce(&TaskModel) -> R) -> PyResult<R> {
+        match &self.source {
+            ModelSource::Planner(p) => Ok(f(p.bind(py).try_borrow()?.inner.model())),
+            ModelSource::Owned(m) => Ok(f(m)),
+        }
+    }
+}
+
+#[pymethods]
+impl PyModel {
+    /// Channel names ``C``, in column order.
+    #[getter]
+    fn channels(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        self.with(py, |m| m.channel_names().to_vec())
+    }
+
+    /// Names of the ``d`` tangent coordinates (scalar channels, ``<block>.rx/ry/rz`` per
+    /// quaternion block, then ``rate``): the columns of :meth:`corrections_at`.
+    #[getter]
+    fn tangent_names(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        self.with(py, |m| m.tangent_names().to_vec())
+    }
+
+    /// ``T_ref``: reference samples (the length of every per-sample array).
+    #[getter]
+    fn n_ref(&self, py: Python<'_>) -> PyResult<usize> {
+        self.with(py, TaskModel::n_ref)
+    }
+
+    /// Reference sample period ``Δt_s`` (s).
+    #[getter]
+    fn dt_s(&self, py: Python<'_>) -> PyResult<f64> {
+        self.with(py, TaskModel::dt_s)
+    }
+
+    /// Index of the reference demonstration among those given to the fit.
+    #[getter]
+    fn reference_idx(&self, py: Python<'_>) -> PyResult<usize> {
+        self.with(py, TaskModel::reference_idx)
+    }
+
+    /// Demonstrations and executions in the statistics.
+    #[getter]
+    fn count(&self, py: Python<'_>) -> PyResult<usize> {
+        self.with(py, TaskModel::count)
+    }
+
+    /// Correction components ``K = min(n − 1, k_max, d)``: the length of ``u``.
+    #[getter]
+    fn n_components(&self, py: Python<'_>) -> PyResult<usize> {
+        self.with(py, TaskModel::n_components)
+    }
+
+    /// Mean behaviour ``μ̂(n)``, shape ``(T_ref, C)``, channel units (quaternions unit-norm).
+    #[getter]
+    fn mean<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (v, c) = self.with(py, |m| (m.mean().to_vec(), m.channel_names().len()))?;
+        Ok(out_matrix(py, v, c)?)
+    }
+
+    /// Demonstration variance ``σ²_D(n)`` (Eq. 6), shape ``(T_ref,)``, dimensionless
+    /// (weighted by ``W⁺ = diag(1/r²)``).
+    #[getter]
+    fn sigma2_d<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(out_vector(py, self.with(py, |m| m.sigma2_d().to_vec())?))
+    }
+
+    /// Mean warp gradient ``ψ̄̇_D(n)`` (Eq. 5), shape ``(T_ref,)``, demo samples per
+    /// reference sample.
+    #[getter]
+    fn grad_mean<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(out_vector(py, self.with(py, |m| m.grad_mean().to_vec())?))
+    }
+
+    /// Minimum warp gradient ``ψ̇min(n)`` (Eq. 14, the fastest), shape ``(T_ref,)``.
+    #[getter]
+    fn grad_min<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(out_vector(py, self.with(py, |m| m.grad_min().to_vec())?))
+    }
+
+    /// Maximum warp gradient ``ψ̇max(n)`` (Eq. 14, the slowest), shape ``(T_ref,)``.
+    #[getter]
+    fn grad_max<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(out_vector(py, self.with(py, |m| m.grad_max().to_vec())?))
+    }
+
+    /// Ranges ``r_j`` of the tangent coordinates, shape ``(d,)``; ``W⁺ = diag(1/r²)``.
+    #[getter]
+    fn ranges<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(out_vector(py, self.with(py, |m| m.ranges().to_vec())?))
+    }
+
+    /// The admissible corrections at fractional reference time ``ref_time``: ``(scale,
+    /// components)`` with ``components`` of shape ``(K, d)`` (±3σ displacements in the
+    /// tangent coordinates) and ``scale`` in ``[0, 1]`` keeping the rate within bounds for
+    /// every ``u`` in ``[−1, 1]^K`` (§II-B2).
+    fn corrections_at<'py>(
+        &self,
+        py: Python<'py>,
+        ref_time: f64,
+    ) -> PyResult<(f64, Bound<'py, PyArray2<f64>>)> {
+        let (c, d) = self.with(py, |m| {
+            (
+                guard(|| Ok(m.corrections_at(ref_time)?)),
+                m.tangent_names().len(),
+            )
+        })?;
+        let c = c?;
+        let flat: Vec<f64> = c.components.concat();
+        Ok((c.scale, out_matrix(py, flat, d)?))
+    }
+
+    /// The command of Eq. 7 (see :meth:`Planner.command`).
+    #[pyo3(signature = (ref_time, u=None))]
+    fn command<'py>(
+        &self,
+        py: Python<'py>,
+        ref_time: f64,
+        u: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        match &self.source {
+            ModelSource::Planner(p) => {
+                command(py, p.bind(py).try_borrow()?.inner.model(), ref_time, u)
+            }
+            ModelSource::Owned(m) => command(py, m, ref_time, u),
+        }
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        self.with(py, |m| {
+            format!(
+                "Model(n_ref={}, dt_s={}, channels={}, count={})",
+                m.n_ref(),
+                m.dt_s(),
+                repr_list(m.channel_names()),
+                m.count()
+            )
+        })
+    }
+}
+
+/// The latched confidence (Eq. 9–12) of a planner and its observations, per reference
+/// sample (a live view of the planner).
+#[pyclass(module = "tandem", name = "Confidence", frozen)]
+pub(crate) struct PyConfidence {
+    planner: Py<PyPlanner>,
+}
+
+impl PyConfidence {
+    fn with<R>(&self, py: Python<'_>, f: impl FnOnce(&Planner) -> R) -> PyResult<R> {
+        Ok(f(&self.planner.bind(py).try_borrow()?.inner))
+    }
+
+    /// Prior (Eq. 10–11) or posterior (Eq. 9) Beta parameters per reference sample.
+    fn betas(&self, py: Python<'_>, posterior_too: bool) -> PyResult<Vec<BetaParams>> {
+        Ok(self.with(py, |p| {
+            let (s2, params) = (p.model().sigma2_d(), p.confidence().params());
+            guard(|| {
+                Ok(if posterior_too {
+                    posterior(s2, p.observations(), params)?
+                } else {
+                    prior(s2, params)?
+                })
+            })
+        })??)
+    }
+
+    /// One parameter of [`PyConfidence::betas`] per reference sample, as an array.
+    fn beta_column<'py>(
+        &self,
+        py: Python<'py>,
+        posterior_too: bool,
+        pick: fn(&BetaParams) -> f64,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let betas = self.betas(py, posterior_too)?;
+        Ok(out_vector(py, betas.iter().map(pick).collect()))
+    }
+}
+
+#[pymethods]
+impl PyConfidence {
+    /// ``conf(n)`` (Eq. 12, latched), shape ``(T_ref,)`` bool: ``True`` = high confidence
+    /// (no supervision needed). A sample that became high-confidence stays so.
+    #[getter]
+    fn high<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<bool>>> {
+        Ok(out_flags(
+            py,
+            self.with(py, |p| p.confidence().conf().to_vec())?,
+        ))
+    }
+
+    /// High-confidence reference samples.
+    #[getter]
+    fn n_high(&self, py: Python<'_>) -> PyResult<usize> {
+        self.with(py, |p| p.confidence().n_high())
+    }
+
+    /// Share of high-confidence reference samples, in ``[0, 1]``.
+    #[getter]
+    fn high_share(&self, py: Python<'_>) -> PyResult<f64> {
+        self.with(py, |p| p.confidence().high_share())
+    }
+
+    /// Maximal low-confidence runs of reference samples, shape ``(k, 2)`` int64,
+    /// ``[start, end)``.
+    #[getter]
+    fn low_regions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let flat: Vec<i64> = self.with(py, |p| {
+            p.confidence()
+                .low_regions()
+                .iter()
+                .flat_map(|r| [r.start as i64, r.end as i64])
+                .collect()
+        })?;
+        Ok(out_matrix(py, flat, 2)?)
+    }
+
+    /// The confidence parameters (``gamma_p``, ``sigma2_max``, ``epsilon``, ``mu_c``,
+    /// ``gamma_c``) as a dict.
+    #[getter]
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let params = self.with(py, |p| p.confidence().params().clone())?;
+        serialize_to_py(py, &params)
+    }
+
+    /// Prior ``α₀`` per reference sample (Eq. 10–11 from the current ``σ²_D``), ``(T_ref,)``.
+    #[getter]
+    fn prior_alpha<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.beta_column(py, false, BetaParams::alpha)
+    }
+
+    /// Prior ``β₀`` per reference sample (Eq. 10–11), ``(T_ref,)``.
+    #[getter]
+    fn prior_beta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.beta_column(py, false, BetaParams::beta)
+    }
+
+    /// Posterior ``α = α₀ + corrections`` per reference sample (Eq. 9), ``(T_ref,)``.
+    #[getter]
+    fn posterior_alpha<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.beta_column(py, true, BetaParams::alpha)
+    }
+
+    /// Posterior ``β = β₀ + supervised − corrections`` per reference sample (Eq. 9),
+    /// ``(T_ref,)``.
+    #[getter]
+    fn posterior_beta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.beta_column(py, true, BetaParams::beta)
+    }
+
+    /// ``P(p_c|t < μ_c | z_t) = I_μc(α, β)`` per reference sample, the left side of Eq. 12
+    /// for the posterior, ``(T_ref,)``. A sample is newly high-confidence when it exceeds
+    /// ``γ_c``; latched samples stay high whatever it says now.
+    #[getter]
+    fn p_below_mu_c<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let betas = self.betas(py, true)?;
+        let mu_c = self.with(py, |p| p.confidence().params().mu_c)?;
+        let cdf = guard(|| {
+            betas
+                .iter()
+                .map(|b| Ok(b.cdf(mu_c)?))
+                .collect::<Result<Vec<f64>>>()
+        })?;
+        Ok(out_vector(py, cdf))
+    }
+
+    /// The correction observations (Eq. 9's counts per reference sample).
+    #[getter]
+    fn observations(&self, py: Python<'_>) -> PyResult<PyObservations> {
+        Ok(PyObservations {
+            inner: self.with(py, |p| p.observations().clone())?,
+        })
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        self.with(py, |p| {
+            let c = p.confidence();
+            format!(
+                "Confidence(n_ref={}, n_high={}, high_share={:.3})",
+                c.n_ref(),
+                c.n_high(),
+                c.high_share()
+            )
+        })
+    }
+}
+
+/// Correction observations per reference sample (Eq. 9): fractional counts, each
+/// supervised execution sample split linearly between its two neighbouring reference
+/// samples. A snapshot.
+#[pyclass(module = "tandem", name = "Observations", frozen)]
+pub(crate) struct PyObservations {
+    inner: Observations,
+}
+
+#[pymethods]
+impl PyObservations {
+    /// Supervised (low-confidence) observations per reference sample, ``(T_ref,)``.
+    #[getter]
+    fn supervised<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        out_vector(py, self.inner.supervised().to_vec())
+    }
+
+    /// Corrected observations per reference sample, ``(T_ref,)``, ``≤ supervised``.
+    #[getter]
+    fn corrections<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        out_vector(py, self.inner.corrections().to_vec())
+    }
+
+    /// Sum of :attr:`supervised`.
+    #[getter]
+    fn total_supervised(&self) -> f64 {
+        self.inner.total_supervised()
+    }
+
+    /// Sum of :attr:`corrections`.
+    #[getter]
+    fn total_corrections(&self) -> f64 {
+        self.inner.total_corrections()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Observations(n_ref={}, total_supervised={}, total_corrections={})",
+            self.inner.n_ref(),
+            self.inner.total_supervised(),
+            self.inner.total_corrections()
+        )
+    }
+}

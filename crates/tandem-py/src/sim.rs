@@ -1,0 +1,156 @@
+//! The simulated workcell of §III for `tandem.sim`: a pair of executions run through the
+//! schedule's coordinator with a simulated operator (`tandem_sim::workcell`).
+
+use std::path::PathBuf;
+
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+use crate::arrays::{flag_matrix, out_flags, out_matrix, out_vector};
+use crate::errors::{Error, Result, guard};
+use crate::facade::{
+    OperatorParams, PairRun, TaskParams, Workpiece, correction_input, needs_correction,
+    read_labels, run_pair_with,
+};
+use crate::params::from_py;
+use crate::planner::{N_ROBOTS, PyPlanner};
+
+/// The run of a pair as a dict of arrays (see `sim_run_pair`).
+fn run_dict<'py>(py: Python<'py>, run: PairRun, channels: usize) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("ticks", run.ticks)?;
+    d.set_item("tick_s", run.tick_s)?;
+    d.set_item("overlap_ticks", run.overlap_ticks)?;
+    d.set_item("idle_ticks", run.idle_ticks)?;
+    d.set_item("duration_s", run.duration_s())?;
+    d.set_item("operator_idle_share", run.operator_idle_share())?;
+    let robots = PyList::empty(py);
+    for r in run.robots {
+        let rd = PyDict::new(py);
+        rd.set_item("samples", out_matrix(py, r.samples, channels)?)?;
+        rd.set_item("ref_time_log", out_vector(py, r.ref_time_log))?;
+        rd.set_item("supervised", out_flags(py, r.supervised))?;
+        rd.set_item("corrected", out_flags(py, r.corrected))?;
+        rd.set_item("needed", r.needed)?;
+        rd.set_item("missed", r.missed)?;
+        rd.set_item("false_corrections", r.false_corrections)?;
+        robots.append(rd)?;
+    }
+    d.set_item("robots", robots)?;
+    Ok(d)
+}
+
+/// Runs the planner's current schedule once in the simulated workcell (§III): every robot
+/// through the Rust coordinator at the schedule's tick, a simulated operator supervising the
+/// low-confidence robot. `needs[i, n]`: robot `i` needs a correction at reference sample `n`
+/// (shape `(N, T_ref)`); `operator` the operator's parameters (dict). Deterministic for
+/// `seed` (a ChaCha8 stream).
+#[pyfunction]
+#[pyo3(signature = (planner, needs, seed, operator=None))]
+pub(crate) fn sim_run_pair<'py>(
+    py: Python<'py>,
+    planner: PyRef<'py, PyPlanner>,
+    needs: &Bound<'py, PyAny>,
+    seed: u64,
+    operator: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let p = &planner.inner;
+    let n_ref = p.model().n_ref();
+    let (needs, cols) = flag_matrix(needs, "needs", "robots × reference samples")?;
+    if cols != n_ref || needs.len() != N_ROBOTS * n_ref {
+        return Err(Error::input(
+            "needs",
+            format!(
+                "shape ({}, {cols}), expected ({N_ROBOTS}, {n_ref}) (robots × reference samples)",
+                needs.len().checked_div(cols).unwrap_or(0)
+            ),
+        )
+        .into());
+    }
+    let params: OperatorParams = from_py(operator, "operator")?;
+    let run = py.detach(|| {
+        guard(|| {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            Ok(run_pair_with(
+                p,
+                |robot, ref_idx| needs[robot * n_ref + ref_idx],
+                &params,
+                &mut rng,
+            )?)
+        })
+    })?;
+    run_dict(py, run, p.model().channel_names().len())
+}
+
+/// Which reference samples need a correction on each of `N` random sanding workpieces
+/// (§III: sanding in passes 1–3 over a painted section), from the reference
+/// demonstration's labels file (`demo_0.labels.csv` of the fixtures' layout): a `(N, T_ref)`
+/// bool array. `task` holds the task parameters (dict; only `n_sections` matters).
+/// Deterministic for `seed`.
+#[pyfunction]
+#[pyo3(signature = (labels, seed, task=None))]
+pub(crate) fn sim_sanding_needs<'py>(
+    py: Python<'py>,
+    labels: PathBuf,
+    seed: u64,
+    task: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyArray2<bool>>> {
+    let params: TaskParams = from_py(task, "task")?;
+    let flat = guard(|| {
+        params.validate()?;
+        let labels = read_labels(&labels)?;
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut out = Vec::with_capacity(N_ROBOTS * labels.len());
+        for _ in 0..N_ROBOTS {
+            let wp = Workpiece::random(&params, &mut rng)?;
+            out.extend(labels.iter().map(|l| needs_correction(l, &wp)));
+        }
+        Ok((out, labels.len()))
+    })?;
+    Ok(out_matrix(py, flat.0, flat.1)?)
+}
+
+/// The simulated operator's joystick input `u` (shape `(K,)`) for a correction at
+/// fractional reference time `ref_time`: `±gain` along each correction component, the sign
+/// that raises `force_channel`, leaving out components that would speed the robot up
+/// (`tandem_sim::workcell::correction_input`). `None` when no component moves the force (the
+/// workcell then commands `u = 0`).
+#[pyfunction]
+#[pyo3(signature = (planner, ref_time, force_channel="force", gain=1.0 / 3.0))]
+pub(crate) fn sim_correction_input<'py>(
+    py: Python<'py>,
+    planner: PyRef<'py, PyPlanner>,
+    ref_time: f64,
+    force_channel: &str,
+    gain: f64,
+) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
+    let model = planner.inner.model();
+    let params = OperatorParams {
+        force_channel: force_channel.to_owned(),
+        gain,
+        ..OperatorParams::default()
+    };
+    let u = guard(|| -> Result<Option<Vec<f64>>> {
+        params.validate()?;
+        let force_idx = model
+            .tangent_names()
+            .iter()
+            .position(|n| *n == params.force_channel)
+            .ok_or_else(|| {
+                Error::input(
+                    "force_channel",
+                    format!(
+                        "'{force_channel}' is not a coordinate of the model ({})",
+                        crate::arrays::repr_list(model.tangent_names())
+                    ),
+                )
+            })?;
+        let mut u = vec![0.0; model.n_components()];
+        let any = correction_input(model, force_idx, params.gain, ref_time, &mut u)?;
+        Ok(any.then_some(u))
+    })?;
+    Ok(u.map(|u| out_vector(py, u)))
+}

@@ -1,0 +1,71 @@
+"""tandem: coordinated multi-robot shared autonomy (Hagenow et al., RA-L 2023).
+
+One operator, several robots doing the same task in parallel. tandem learns the task from
+expert demonstrations, learns from the operator's past corrections *when* each robot may need
+help, and schedules the robots so that at most one is ever low-confidence, robust to the
+timing changes the operator's corrections cause. This package is the Rust implementation with
+NumPy arrays in and out (docs/python.md):
+
+- :func:`fit` → :class:`Planner` (the paper's Fig. 2 loop): :attr:`Planner.model`,
+  :attr:`Planner.confidence`, :attr:`Planner.schedule`, :meth:`Planner.record_pair`,
+  :meth:`Planner.reschedule`, :meth:`Planner.save` / :meth:`Planner.load` (the command
+  line's state file), :meth:`Planner.command` (Eq. 7).
+- :class:`Coordinator`: the real-time coordinator of a schedule (§II-B5), one control tick
+  per :meth:`Coordinator.tick`.
+- :mod:`tandem.study`: the simulated study of §III; :mod:`tandem.sim`: its workcell.
+- :func:`align`: GDTW time warping (Eq. 2–3).
+
+Every error is a :class:`TandemError`: :class:`InputError`, :class:`ParamError`,
+:class:`StateFileError`, :class:`ScheduleError`, :class:`InternalError`.
+"""
+
+from ._tandem import (
+    N_ROBOTS,
+    Confidence,
+    Coordinator,
+    InputError,
+    InternalError,
+    Model,
+    Observations,
+    ParamError,
+    Planner,
+    Problem,
+    Schedule,
+    ScheduleError,
+    StateFileError,
+    TandemError,
+    Tick,
+    Warp,
+    __version__,
+    align,
+    default_params,
+    fit,
+    fit_model,
+)
+from . import sim, study
+
+__all__ = [
+    "N_ROBOTS",
+    "Confidence",
+    "Coordinator",
+    "InputError",
+    "InternalError",
+    "Model",
+    "Observations",
+    "ParamError",
+    "Planner",
+    "Problem",
+    "Schedule",
+    "ScheduleError",
+    "StateFileError",
+    "TandemError",
+    "Tick",
+    "Warp",
+    "__version__",
+    "align",
+    "default_params",
+    "fit",
+    "fit_model",
+    "sim",
+    "study",
+]

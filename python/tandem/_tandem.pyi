@@ -1,0 +1,370 @@
+"""Type stubs of the Rust extension module ``tandem._tandem`` (crates/tandem-py).
+
+Shapes: ``T_ref`` reference samples, ``C`` channels, ``d`` tangent coordinates (``C`` with
+quaternion blocks as rotation vectors, plus the rate), ``K`` correction components, ``N``
+robots (2 in this build). Times in seconds unless named in samples.
+"""
+
+from os import PathLike
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+F64 = npt.NDArray[np.float64]
+Bool = npt.NDArray[np.bool_]
+I64 = npt.NDArray[np.int64]
+ArrayLike = npt.ArrayLike
+Path = Union[str, PathLike]
+Params = Union[None, Mapping[str, Any], str, PathLike]
+Demo = Union[Path, ArrayLike]
+
+N_ROBOTS: int
+__version__: str
+
+class TandemError(Exception):
+    """Base class of every error tandem raises (never a panic or an abort)."""
+
+class InputError(TandemError):
+    """Bad input data; ``file`` (or the argument, e.g. ``demos[2]``), ``line``, ``column``."""
+
+    file: Optional[str]
+    line: Optional[int]
+    column: Optional[int]
+
+class ParamError(TandemError):
+    """A parameter out of range, or an unknown or ill-typed key; ``name``."""
+
+    name: Optional[str]
+
+class StateFileError(TandemError):
+    """A state file that cannot be read or written; ``path``. The file is left as it was."""
+
+    path: Optional[str]
+
+class ScheduleError(TandemError):
+    """An infeasible problem, a schedule that violates Eq. 20, or one run at another tick."""
+
+    violation: Optional[str]
+
+class InternalError(TandemError):
+    """A bug in tandem (a Rust panic caught at the Python boundary)."""
+
+def fit(
+    demos: Sequence[Demo],
+    channels: Optional[Sequence[str]] = None,
+    params: Params = None,
+    dt_s: Optional[float] = None,
+) -> Planner:
+    """Learns the task from demonstrations (paths or ``(T_i, C)`` arrays) and makes the first
+    schedule (Fig. 2); the same inputs and parameters as ``tandem fit`` give the same state."""
+
+def fit_model(
+    demos: Sequence[Demo],
+    channels: Optional[Sequence[str]] = None,
+    params: Params = None,
+    dt_s: Optional[float] = None,
+) -> Model:
+    """The task model alone (alignment and statistics, §II-B1/2)."""
+
+def default_params() -> Dict[str, Any]:
+    """The default parameters ``{"fit": …, "confidence": …, "sampler": …}``."""
+
+def align(reference: ArrayLike, query: ArrayLike, params: Params = None) -> Warp:
+    """GDTW (Eq. 2–3): the warp from reference samples to query samples."""
+
+class Planner:
+    """The loop of Fig. 2: model, observations, latched confidence and schedule."""
+
+    @staticmethod
+    def load(path: Path) -> Planner:
+        """Loads a state file (written here or by the command line)."""
+    def save(self, path: Path) -> None:
+        """Saves the state file atomically (the previous file survives any error)."""
+    def record_pair(
+        self,
+        executions: Sequence[Demo],
+        ref_time_logs: Sequence[ArrayLike],
+        supervised: Sequence[ArrayLike],
+        corrected: Sequence[ArrayLike],
+        channels: Optional[Sequence[str]] = None,
+    ) -> Dict[str, Any]:
+        """Records one execution per robot (Eq. 21, 9–12) and re-schedules (§II-C)."""
+    def reschedule(
+        self,
+        samples: Optional[int] = None,
+        seed: Optional[int] = None,
+        tick_s: Optional[float] = None,
+    ) -> Schedule:
+        """Re-runs the sampler warm-started by the current schedule and keeps the result."""
+    @property
+    def schedule(self) -> Schedule:
+        """The current schedule (a snapshot)."""
+    @property
+    def problem(self) -> Problem:
+        """The current scheduling problem."""
+    @property
+    def model(self) -> Model:
+        """The task model (a live view)."""
+    @property
+    def confidence(self) -> Confidence:
+        """The latched confidence and the observations (a live view)."""
+    @property
+    def params(self) -> Dict[str, Any]:
+        """The parameters as a nested dict."""
+    @property
+    def pairs_recorded(self) -> int:
+        """Pairs of executions recorded so far."""
+    @property
+    def n_robots(self) -> int:
+        """Robots scheduled (``N``)."""
+    def command(self, ref_time: float, u: Optional[ArrayLike] = None) -> F64:
+        """Eq. 7: ``(C + 1,)``, the channel values then the rate (warp gradient)."""
+
+class Model:
+    """The task model: per reference sample mean, variance, gradient bounds, corrections."""
+
+    @property
+    def channels(self) -> List[str]: ...
+    @property
+    def tangent_names(self) -> List[str]: ...
+    @property
+    def n_ref(self) -> int: ...
+    @property
+    def dt_s(self) -> float: ...
+    @property
+    def reference_idx(self) -> int: ...
+    @property
+    def count(self) -> int: ...
+    @property
+    def n_components(self) -> int: ...
+    @property
+    def mean(self) -> F64:
+        """``μ̂``, ``(T_ref, C)``."""
+    @property
+    def sigma2_d(self) -> F64:
+        """``σ²_D`` (Eq. 6), ``(T_ref,)``, dimensionless."""
+    @property
+    def grad_mean(self) -> F64:
+        """``ψ̄̇_D`` (Eq. 5), ``(T_ref,)``."""
+    @property
+    def grad_min(self) -> F64:
+        """``ψ̇min`` (Eq. 14), ``(T_ref,)``."""
+    @property
+    def grad_max(self) -> F64:
+        """``ψ̇max`` (Eq. 14), ``(T_ref,)``."""
+    @property
+    def ranges(self) -> F64:
+        """``r_j``, ``(d,)``; ``W⁺ = diag(1/r²)``."""
+    def corrections_at(self, ref_time: float) -> Tuple[float, F64]:
+        """``(scale, components (K, d))`` at a fractional reference time."""
+    def command(self, ref_time: float, u: Optional[ArrayLike] = None) -> F64:
+        """Eq. 7, ``(C + 1,)``."""
+
+class Confidence:
+    """Latched confidence (Eq. 9–12) per reference sample, and the observations."""
+
+    @property
+    def high(self) -> Bool:
+        """``conf(n)``, ``(T_ref,)``: ``True`` = high confidence (latched)."""
+    @property
+    def n_high(self) -> int: ...
+    @property
+    def high_share(self) -> float: ...
+    @property
+    def low_regions(self) -> I64:
+        """``(k, 2)`` ``[start, end)`` reference samples."""
+    @property
+    def params(self) -> Dict[str, Any]: ...
+    @property
+    def prior_alpha(self) -> F64: ...
+    @property
+    def prior_beta(self) -> F64: ...
+    @property
+    def posterior_alpha(self) -> F64: ...
+    @property
+    def posterior_beta(self) -> F64: ...
+    @property
+    def p_below_mu_c(self) -> F64:
+        """``I_μc(α, β)``, the left side of Eq. 12, ``(T_ref,)``."""
+    @property
+    def observations(self) -> Observations: ...
+
+class Observations:
+    """Correction observations per reference sample (Eq. 9), fractional counts."""
+
+    @property
+    def supervised(self) -> F64: ...
+    @property
+    def corrections(self) -> F64: ...
+    @property
+    def total_supervised(self) -> float: ...
+    @property
+    def total_corrections(self) -> float: ...
+
+class Problem:
+    """The scheduling problem: confidence and gradient bounds per reference sample."""
+
+    def __init__(
+        self,
+        conf: ArrayLike,
+        grad_mean: ArrayLike,
+        grad_min: ArrayLike,
+        grad_max: ArrayLike,
+        dt_s: float,
+    ) -> None: ...
+    @property
+    def n_ref(self) -> int: ...
+    @property
+    def dt_s(self) -> float: ...
+    @property
+    def conf(self) -> Bool: ...
+    @property
+    def grad_mean(self) -> F64: ...
+    @property
+    def grad_min(self) -> F64: ...
+    @property
+    def grad_max(self) -> F64: ...
+    def serial_schedule(self, tick_s: Optional[float] = None) -> Schedule: ...
+    def sample_schedule(
+        self,
+        samples: int = 5000,
+        seed: int = 0,
+        tick_s: Optional[float] = None,
+        previous: Optional[Schedule] = None,
+    ) -> Schedule: ...
+
+class Schedule:
+    """Execution warps ``(N, T_ref)``, ``N − 1`` start offsets and the control tick."""
+
+    def __init__(
+        self, problem: Problem, gradients: ArrayLike, offsets: ArrayLike, tick_s: float
+    ) -> None: ...
+    @property
+    def n_robots(self) -> int: ...
+    @property
+    def offsets(self) -> F64:
+        """``(N − 1,)`` s: ``τ`` of robots 2…N."""
+    @property
+    def starts_s(self) -> F64: ...
+    @property
+    def gradients(self) -> F64:
+        """``ψ̇_Ei(n)``, ``(N, T_ref)``."""
+    @property
+    def tick_s(self) -> float: ...
+    @property
+    def dt_s(self) -> float: ...
+    @property
+    def t_total_s(self) -> float:
+        """Eq. 13, s."""
+    @property
+    def durations_s(self) -> F64: ...
+    @property
+    def ends_s(self) -> F64: ...
+    @property
+    def lc_intervals(self) -> List[F64]:
+        """Per robot ``(k_i, 2)`` ``[start_s, end_s)`` global time (Eq. 19)."""
+    @property
+    def lc_ref_intervals(self) -> List[I64]: ...
+    @property
+    def source(self) -> str: ...
+    @property
+    def stats(self) -> Optional[Dict[str, int]]: ...
+    @property
+    def lower_bound_s(self) -> Optional[float]: ...
+    @property
+    def gap(self) -> Optional[float]: ...
+    @property
+    def problem(self) -> Problem: ...
+    def validate(self) -> None:
+        """Raises ScheduleError for the first broken constraint of Eq. 20."""
+    def ref_time(self, t_global_s: float) -> F64:
+        """Eq. 15, ``(N,)``."""
+    def conf_at(self, t_global_s: float) -> Bool:
+        """Eq. 16, ``(N,)``."""
+    def to_json(self) -> str: ...
+    @staticmethod
+    def from_json(problem: Problem, text: str) -> Schedule: ...
+
+class Coordinator:
+    """The Rust real-time coordinator of a schedule (§II-B5), one control tick per call."""
+
+    def __init__(self, schedule: Schedule) -> None: ...
+    def tick(self, operator: Union[None, float, str] = None) -> Tick:
+        """One tick; ``operator``: None, a gradient, ``"fastest"``, ``"slowest"``."""
+    def reset(self) -> None: ...
+    @property
+    def is_finished(self) -> bool: ...
+    @property
+    def n_robots(self) -> int: ...
+    @property
+    def tick_s(self) -> float: ...
+    @property
+    def clock_s(self) -> F64: ...
+    @property
+    def starts_s(self) -> F64: ...
+    @property
+    def ends_s(self) -> F64: ...
+    @property
+    def running_now(self) -> Bool: ...
+    @property
+    def low_conf_now(self) -> Bool: ...
+    @property
+    def ref_time_now(self) -> F64: ...
+    @property
+    def sample_now(self) -> List[int]: ...
+
+class Tick:
+    """What one tick did, per robot."""
+
+    @property
+    def ref_time(self) -> F64: ...
+    @property
+    def low_conf(self) -> Bool: ...
+    @property
+    def running(self) -> Bool: ...
+    @property
+    def overlap(self) -> bool: ...
+
+class Warp:
+    """A time warp from reference samples to query samples."""
+
+    @property
+    def values(self) -> F64: ...
+    @property
+    def gradient(self) -> F64: ...
+    @property
+    def objective(self) -> float: ...
+    @property
+    def n_ref(self) -> int: ...
+    def eval(self, ref_time: float) -> float: ...
+    def inverse(self, query_time: float) -> float: ...
+
+class StudyTask:
+    """The fitted task of a study (model and reference labels)."""
+
+    @property
+    def n_ref(self) -> int: ...
+    @property
+    def alignment_s(self) -> float: ...
+
+def study_config(config: Params = None) -> Dict[str, Any]: ...
+def study_prepare(config: Params = None, demos_dir: Optional[Path] = None) -> StudyTask: ...
+def study_run(
+    task: StudyTask, config: Params = None, threads: Optional[int] = None
+) -> Tuple[Dict[str, Any], List[Dict[str, Any]], Dict[str, float]]: ...
+def study_run_trial(
+    task: StudyTask, config: Params, trial: int
+) -> Tuple[Dict[str, Any], Dict[str, float]]: ...
+def sim_run_pair(
+    planner: Planner,
+    needs: ArrayLike,
+    seed: int,
+    operator: Optional[Mapping[str, Any]] = None,
+) -> Dict[str, Any]: ...
+def sim_sanding_needs(
+    labels: Path, seed: int, task: Optional[Mapping[str, Any]] = None
+) -> Bool: ...
+def sim_correction_input(
+    planner: Planner, ref_time: float, force_channel: str = "force", gain: float = ...
+) -> Optional[F64]: ...

@@ -1,0 +1,144 @@
+"""The simulated workcell of the paper's §III: run a schedule once with a simulated operator.
+
+:func:`run_pair` runs the planner's current schedule through the Rust real-time coordinator at
+the schedule's tick, one control tick per reference sample period, while a simulated operator
+supervises the low-confidence robot: it corrects the samples that need it (missing 1 %), and
+corrects unneeded ones 1 % of the time in short episodes (``tandem_sim::workcell``). Each
+correction is a joystick input along the model's correction directions that raises the force
+and slows the robot (:func:`correction_input`); the rate of the resulting command (Eq. 7)
+is the operator's gradient for the coordinator. The result feeds :meth:`tandem.Planner.record_pair`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from os import PathLike
+from typing import Any, Mapping, Optional, Union
+
+import numpy as np
+
+from ._tandem import Planner, sim_correction_input, sim_run_pair, sim_sanding_needs
+
+__all__ = ["PairRun", "RobotRun", "correction_input", "run_pair", "sanding_needs"]
+
+
+@dataclass(frozen=True)
+class RobotRun:
+    """One robot's execution as the system records it (Eq. 21).
+
+    Attributes:
+        samples: ``(T, C)`` commanded samples, one per control tick the robot ran, in the
+            model's channels (channel units).
+        ref_time_log: ``(T,)`` fractional reference time of each sample (reference samples).
+        supervised: ``(T,)`` bool: the robot was low-confidence (the operator watched).
+        corrected: ``(T,)`` bool: the operator corrected (only where supervised).
+        needed: supervised samples that needed a correction.
+        missed: needed corrections the operator missed.
+        false_corrections: corrections given where none was needed.
+    """
+
+    samples: np.ndarray
+    ref_time_log: np.ndarray
+    supervised: np.ndarray
+    corrected: np.ndarray
+    needed: int
+    missed: int
+    false_corrections: int
+
+
+@dataclass(frozen=True)
+class PairRun:
+    """A pair of executions run under one schedule.
+
+    Attributes:
+        robots: one :class:`RobotRun` per robot.
+        ticks: control ticks until every robot finished.
+        tick_s: the control tick (s).
+        overlap_ticks: ticks in which two robots traversed low-confidence samples (0 for a
+            schedule that passed the margin check).
+        idle_ticks: ticks in which no robot was low-confidence (the operator was free).
+        duration_s: ``ticks · tick_s`` (s).
+        operator_idle_share: ``idle_ticks / ticks``.
+    """
+
+    robots: list
+    ticks: int
+    tick_s: float
+    overlap_ticks: int
+    idle_ticks: int
+    duration_s: float
+    operator_idle_share: float
+
+    def record_args(self) -> dict:
+        """The keyword arguments of :meth:`tandem.Planner.record_pair` for this run."""
+        return {
+            "executions": [r.samples for r in self.robots],
+            "ref_time_logs": [r.ref_time_log for r in self.robots],
+            "supervised": [r.supervised for r in self.robots],
+            "corrected": [r.corrected for r in self.robots],
+        }
+
+
+def run_pair(
+    planner: Planner,
+    needs: Any,
+    seed: int,
+    operator: Optional[Mapping[str, Any]] = None,
+) -> PairRun:
+    """Runs the planner's current schedule once in the simulated workcell (§III).
+
+    Args:
+        planner: the planner whose model, problem and schedule to run.
+        needs: ``(N, T_ref)`` bool array: robot ``i`` needs a correction at reference sample
+            ``n`` (e.g. :func:`sanding_needs`).
+        seed: seed of the operator's draws (ChaCha8); the same seed gives the same run.
+        operator: the simulated operator's parameters (``miss_rate`` 0.01,
+            ``false_correction_rate`` 0.01, ``false_correction_s`` 0.5 s, ``force_channel``
+            ``"force"``, ``gain`` 1/3).
+
+    Raises:
+        InputError: ``needs`` of the wrong shape or dtype.
+        ScheduleError: a schedule made for another tick than the reference period.
+    """
+    raw = sim_run_pair(planner, needs, seed, operator)
+    robots = [RobotRun(**r) for r in raw.pop("robots")]
+    return PairRun(robots=robots, **raw)
+
+
+def sanding_needs(
+    labels: Union[str, PathLike],
+    seed: int,
+    task: Optional[Mapping[str, Any]] = None,
+) -> np.ndarray:
+    """Which reference samples need a correction on ``N`` random sanding workpieces (§III).
+
+    A sample needs one when it is sanding in passes 1–3 over a painted section of the robot's
+    own workpiece (half the sections of passes 1–3 are painted at random).
+
+    Args:
+        labels: the reference demonstration's labels file (``demo_0.labels.csv`` of the
+            fixtures' layout: ``pass,section,painted,phase``).
+        seed: seed of the workpieces' draw.
+        task: task parameters (dict; only ``n_sections`` matters).
+
+    Returns:
+        ``(N, T_ref)`` bool array.
+    """
+    return sim_sanding_needs(labels, seed, task)
+
+
+def correction_input(
+    planner: Planner,
+    ref_time: float,
+    force_channel: str = "force",
+    gain: float = 1.0 / 3.0,
+) -> Optional[np.ndarray]:
+    """The simulated operator's joystick input ``u`` (``(K,)``) for a correction at fractional
+    reference time ``ref_time``: ``±gain`` along each correction component, the sign that
+    raises ``force_channel``, without the components that would speed the robot up. ``None``
+    when no component moves the force (the workcell then commands ``u = 0``).
+
+    ``planner.command(ref_time, u)[-1]``, clamped to ``[ψ̇min, ψ̇max]`` at the robot's sample,
+    is the gradient the workcell gives :meth:`tandem.Coordinator.tick`.
+    """
+    return sim_correction_input(planner, ref_time, force_channel, gain)

@@ -1,0 +1,54 @@
+"""``tandem.align``: GDTW from Python (Eq. 2–3)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tandem
+from conftest import DEMOS, load_arrays
+
+
+def test_a_warp_of_a_known_time_change_is_recovered() -> None:
+    t = np.linspace(0.0, 1.0, 400)
+    reference = np.column_stack([np.sin(6 * t), np.cos(4 * t)])
+    # The query runs the same signal with the time map q(t) = t² + … (monotone).
+    true_map = 0.6 * t**2 + 0.4 * t
+    query_t = np.linspace(0.0, 1.0, 500)
+    query = np.column_stack(
+        [np.interp(query_t, true_map, reference[:, 0]), np.interp(query_t, true_map, reference[:, 1])]
+    )
+    w = tandem.align(reference, query)
+    assert w.values.shape == (400,) and w.n_ref == 400
+    assert w.values[0] == 0.0 and w.values[-1] == 499.0
+    assert (np.diff(w.values) >= 0).all()
+    expected = true_map * 499.0
+    assert np.abs(w.values - expected).mean() < 3.0
+    assert w.objective >= 0.0
+    assert w.eval(399.0) == 499.0
+    assert abs(w.inverse(w.eval(123.4)) - 123.4) < 1e-9
+
+
+def test_one_channel_signals_and_identical_signals() -> None:
+    x = np.sin(np.linspace(0, 7, 300))
+    w = tandem.align(x, x)
+    np.testing.assert_allclose(w.values, np.arange(300.0), atol=1e-9)
+    np.testing.assert_allclose(w.gradient, 1.0, atol=1e-9)
+
+
+def test_params_and_errors() -> None:
+    _, ref = load_arrays(DEMOS[0])
+    _, query = load_arrays(DEMOS[1])
+    a = tandem.align(ref, query, params={"lambda_inst": 0.1, "lambda_cum": 1.0})
+    assert a.n_ref == len(ref) and a.values[-1] == len(query) - 1
+    with pytest.raises(tandem.ParamError) as e:
+        tandem.align(ref, query, params={"slope_min": 2.0})
+    assert e.value.name == "slope_min"
+    with pytest.raises(tandem.ParamError, match="unknown field"):
+        tandem.align(ref, query, params={"lambda": 1.0})
+    bad = query.copy()
+    bad[10, 0] = np.inf
+    with pytest.raises(tandem.InputError):
+        tandem.align(ref, bad)
+    with pytest.raises(tandem.InputError):
+        tandem.align(ref, query[:, :3])
