@@ -18,6 +18,8 @@ use std::process::Command;
 
 use anyhow::{Context, bail};
 
+use crate::workspace_root;
+
 /// Options of `cargo xtask test`.
 #[derive(clap::Args)]
 pub(crate) struct TestArgs {
@@ -27,14 +29,6 @@ pub(crate) struct TestArgs {
     /// Extra arguments for pytest (after `--`), e.g. `-- -k coordinator -x`.
     #[arg(last = true)]
     pytest_args: Vec<String>,
-}
-
-/// The workspace root (the parent of this crate's directory).
-fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("xtask lives one level below the workspace root")
-        .to_path_buf()
 }
 
 /// Runs `cmd`, failing with `what` when it cannot start or exits non-zero.

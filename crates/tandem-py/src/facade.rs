@@ -2,10 +2,16 @@
 
 pub(crate) use tandem::confidence::{BetaParams, Observations, posterior, prior};
 pub(crate) use tandem::lfd::{DEFAULT_DT_S, Demonstration, Execution, TaskModel};
+pub(crate) use tandem::planner::{
+    Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, derive_seed,
+};
 pub(crate) use tandem::realtime::{Coordinator, Operator, Tick, Timeline};
 pub(crate) use tandem::schedule::{
     GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, Violation, sample_schedule,
     validate,
+};
+pub(crate) use tandem::sim::study::{
+    PhaseTimes, StudyConfig, StudyInputs, read_labels, run_trial, run_trials,
 };
 pub(crate) use tandem::sim::task::{
     FIXTURE_SEED, Label, N_FIXTURE_DEMOS, TaskDemo, TaskParams, Workpiece, demonstrations,
@@ -13,13 +19,7 @@ pub(crate) use tandem::sim::task::{
 pub(crate) use tandem::sim::workcell::{
     OperatorParams, PairRun, correction_input, needs_correction, run_pair_with,
 };
-pub(crate) use tandem::sim::study::{
-    PhaseTimes, StudyConfig, StudyInputs, read_labels, run_trial, run_trials,
-};
 pub(crate) use tandem::warp::{SignalRef, Warp, WarpParams, align};
-pub(crate) use tandem::planner::{
-    Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, derive_seed,
-};
 
 /// The crates' own error types, for classifying them into Python exceptions.
 pub(crate) mod errors {
