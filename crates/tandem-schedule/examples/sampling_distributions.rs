@@ -107,6 +107,8 @@ fn main() -> Result<(), tandem_schedule::Error> {
         let baselines = SamplerBaselines {
             per_sample: setting.per_sample,
             drawn_offset: setting.drawn_offset,
+            // The sampler's own distribution, without the completion beside it.
+            sampler_only: true,
             ..SamplerBaselines::default()
         };
         let (mut best, mut feasible, mut total_time) = (Vec::new(), 0, 0.0);

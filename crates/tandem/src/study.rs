@@ -445,6 +445,7 @@ pub fn read_labels(path: &Path) -> Result<Vec<Label>> {
 fn source_name(source: Source) -> String {
     match source {
         Source::Sampled { .. } => "sampled",
+        Source::Completed => "completed",
         Source::Previous => "previous",
         Source::RepairedPrevious => "repaired",
         Source::Serial => "serial",
