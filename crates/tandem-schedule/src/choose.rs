@@ -13,11 +13,11 @@
 //!    passes the margin check;
 //!    The completion starts both cold and warm from the incumbent (when that is not the
 //!    serial schedule, which keeps no pair of LC runs);
-//! 3. with a quarter of the completion's budget, the completion warm-started from the
+//! 3. with a quarter of the completion's budget on top, the completion warm-started from the
 //!    sampler's winner, if that beats the incumbent: it tightens the winner's clearances;
 //! 4. **the choice**: the least `T_total` of the three, ties going to the incumbent, then to
-//!    the sampler's winner. The sampler runs exactly as it would alone (same seed, same
-//!    incumbent), so the result is never worse than the sampler's.
+//!    the sampler's winner. The sampler and the completion run exactly as they would alone
+//!    (same seed, same incumbent, same budget), so the result is never worse than either's.
 //!
 //! Every candidate is checked with [`crate::validate`] at the tick before it can win. The
 //! [`Outcome`] carries the schedule, its `T_total`, where it came from, and its certificate:
@@ -167,7 +167,8 @@ fn incumbent(
 /// `params.tick_s`, certified against the margin-free lower bound `T*₀`.
 ///
 /// Runs on the current rayon thread pool; the result for a seed is the same whatever the
-/// number of threads. Never worse than the sampler alone with the same seed.
+/// number of threads. Never worse than the sampler alone with the same seed, nor than the
+/// completion alone ([`SamplerBaselines::sampler_only`], [`SamplerBaselines::completion_only`]).
 ///
 /// # Errors
 /// [`Error::BadParam`] for invalid parameters; [`Error::NoFeasibleSchedule`] if not even the
@@ -204,8 +205,8 @@ pub fn sample_schedule_with_baselines(
     } else {
         params.exact.max_margin_checks
     };
-    // A quarter of the completion's budget is kept to refine the sampler's winner (when
-    // there is a sampler).
+    // Refining the sampler's winner gets a quarter of the completion's budget on top, so the
+    // completion itself runs exactly as it would alone.
     let refine_budget = if baselines.completion_only {
         0
     } else {
@@ -226,15 +227,7 @@ pub fn sample_schedule_with_baselines(
         || {
             let bound = exact::bound(problem, &params.exact);
             let done = if bound.lower_bound_s < cap_s {
-                exact::completion(
-                    problem,
-                    &params.exact,
-                    tick_s,
-                    cap_s,
-                    budget - refine_budget,
-                    true,
-                    &warm,
-                )
+                exact::completion(problem, &params.exact, tick_s, cap_s, budget, true, &warm)
             } else {
                 (None, 0)
             };

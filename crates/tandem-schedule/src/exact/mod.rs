@@ -150,8 +150,8 @@ pub struct ExactParams {
     /// Default: 4,000,000.
     pub max_pieces: usize,
     /// Largest number of margin checks (Alg. 2, ~1 ms each on the 9873-sample fixture
-    /// problem) the completion may run per re-schedule, a quarter of them kept to refine the
-    /// sampler's winner; 0 switches the completion off (the bound is still computed).
+    /// problem) the completion may run per re-schedule (plus a quarter of it to refine the
+    /// sampler's winner); 0 switches the completion off (the bound is still computed).
     /// Default: 24 (docs/decisions.md: the fixture and fragmented problems' gaps against the
     /// budget).
     pub max_margin_checks: usize,
