@@ -28,14 +28,8 @@ fn bench(c: &mut Criterion) {
         seed: 1,
         ..SamplerParams::default()
     };
-    let completion_only = SamplerBaselines {
-        completion_only: true,
-        ..SamplerBaselines::default()
-    };
-    let sampler_only = SamplerBaselines {
-        sampler_only: true,
-        ..SamplerBaselines::default()
-    };
+    let completion_only = SamplerBaselines::COMPLETION_ONLY;
+    let sampler_only = SamplerBaselines::SAMPLER_ONLY;
     let free = solve_exact(&problem, &exact).expect("the fixture problem is valid");
     let done = sample_schedule_with_baselines(&problem, &scheduler, &completion_only, None)
         .expect("the fixture problem is valid");

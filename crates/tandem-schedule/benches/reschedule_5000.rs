@@ -29,10 +29,7 @@ fn bench(c: &mut Criterion) {
         seed: 1,
         ..SamplerParams::default()
     };
-    let lazy = SamplerBaselines {
-        sampler_only: true,
-        ..SamplerBaselines::default()
-    };
+    let lazy = SamplerBaselines::SAMPLER_ONLY;
     let baseline = SamplerBaselines {
         margin_check: MarginCheck::PerPair,
         exhaustive_margins: true,

@@ -98,14 +98,10 @@ struct Row {
 
 /// Runs the search, the completion alone and the sampler alone on `p` and prints the row.
 fn row(name: &str, p: &Problem) -> Result<Row, String> {
-    let completion_only = SamplerBaselines {
-        completion_only: true,
-        ..SamplerBaselines::default()
-    };
-    let sampler_only = SamplerBaselines {
-        sampler_only: true,
-        ..SamplerBaselines::default()
-    };
+    let (completion_only, sampler_only) = (
+        SamplerBaselines::COMPLETION_ONLY,
+        SamplerBaselines::SAMPLER_ONLY,
+    );
     let t = Instant::now();
     let free = solve_exact(p, &ExactParams::default()).map_err(|e| e.to_string())?;
     let search_ms = t.elapsed().as_secs_f64() * 1e3;

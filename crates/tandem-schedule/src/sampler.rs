@@ -244,6 +244,25 @@ pub struct SamplerBaselines {
     pub exhaustive_margins: bool,
 }
 
+impl SamplerBaselines {
+    /// The sampler alone, as designed ([`SamplerBaselines::sampler_only`]).
+    pub const SAMPLER_ONLY: SamplerBaselines = SamplerBaselines {
+        sampler_only: true,
+        completion_only: false,
+        per_sample: false,
+        drawn_offset: None,
+        margin_check: MarginCheck::SinglePass,
+        exhaustive_margins: false,
+    };
+
+    /// The margin-aware completion alone ([`SamplerBaselines::completion_only`]).
+    pub const COMPLETION_ONLY: SamplerBaselines = SamplerBaselines {
+        sampler_only: false,
+        completion_only: true,
+        ..SamplerBaselines::SAMPLER_ONLY
+    };
+}
+
 /// How a [`SamplerBaselines::drawn_offset`] candidate draws its offset `τ` from `v` uniform in
 /// `[0, 1)`, given its two warps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -21,11 +21,7 @@ fn complete(p: &Problem, exact: ExactParams) -> Outcome {
         exact,
         ..SamplerParams::default()
     };
-    let alone = SamplerBaselines {
-        completion_only: true,
-        ..SamplerBaselines::default()
-    };
-    sample_schedule_with_baselines(p, &params, &alone, None).unwrap()
+    sample_schedule_with_baselines(p, &params, &SamplerBaselines::COMPLETION_ONLY, None).unwrap()
 }
 
 /// The certificate's fields agree with the schedule and the bound.
@@ -154,8 +150,7 @@ proptest! {
     #[test]
     fn scheduled_schedules_pass_validate_and_beat_the_sampler(p in small_problem(), seed in 0u64..4) {
         let params = SamplerParams { samples: 200, seed, ..SamplerParams::default() };
-        let sampler_only = SamplerBaselines { sampler_only: true, ..SamplerBaselines::default() };
-        let alone = sample_schedule_with_baselines(&p, &params, &sampler_only, None).unwrap();
+        let alone = sample_schedule_with_baselines(&p, &params, &SamplerBaselines::SAMPLER_ONLY, None).unwrap();
         let both = sample_schedule(&p, &params, None).unwrap();
         let done = complete(&p, ExactParams::default());
         for out in [&alone, &both, &done] {

@@ -34,10 +34,7 @@ fn sample_schedule(
 }
 
 fn sampler_only() -> SamplerBaselines {
-    SamplerBaselines {
-        sampler_only: true,
-        ..SamplerBaselines::default()
-    }
+    SamplerBaselines::SAMPLER_ONLY
 }
 
 fn params(samples: usize, seed: u64) -> SamplerParams {

@@ -117,7 +117,7 @@
 //! assert!((free.lower_bound_s - 0.4).abs() < 1e-9);
 //! assert_eq!(free.order, vec![0, 1, 0, 1]);
 //! // The completion alone (no sampled candidates): certified against the same bound.
-//! let alone = SamplerBaselines { completion_only: true, ..SamplerBaselines::default() };
+//! let alone = SamplerBaselines::COMPLETION_ONLY;
 //! let out = sample_schedule_with_baselines(&p, &SamplerParams::default(), &alone, None)?;
 //! assert!(validate(&p, &out.schedule).is_ok());
 //! assert!(out.bound_is_optimum && (out.lower_bound_s - 0.4).abs() < 1e-9);
