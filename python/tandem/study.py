@@ -78,7 +78,7 @@ class TrialResult:
         t_total_s: ``(n_pairs + 1,)`` planned ``T_total`` (Eq. 13, s).
         offset_s: ``(n_pairs + 1,)`` planned offset ``τ`` of robot 2 (s).
         high_conf_pct: ``(n_pairs + 1,)`` percent of high-confidence reference samples.
-        source: where each schedule came from (``sampled``, ``previous``, ``repaired``,
+        source: where each schedule came from (``sampled``, ``completed``, ``previous``, ``repaired``,
             ``serial``).
         lc_intervals_s: per iteration, a list of one ``(k_i, 2)`` array per robot: planned
             low-confidence intervals ``[start, end)`` in s of global time.

@@ -27,8 +27,10 @@ def test_planner_schedule_passes_validate_and_has_n_robot_shapes(
     assert s.ends_s.tolist() == ends
     assert s.durations_s.tolist() == [clock_end(0.0, g) for g in s.gradients]
     assert s.t_total_s == max(ends)
-    assert s.lower_bound_s is None and s.gap is None
-    assert s.source in ("sampled", "previous", "repaired", "serial")
+    # The certificate: a lower bound no schedule can beat, and the relative gap to it.
+    assert s.lower_bound_s is not None and 0.0 < s.lower_bound_s <= s.t_total_s
+    assert s.gap == pytest.approx((s.t_total_s - s.lower_bound_s) / s.lower_bound_s, rel=1e-12)
+    assert s.source in ("sampled", "completed", "previous", "repaired", "serial")
     assert set(s.stats) == {"candidates", "cheap_feasible", "margin_checks"}
 
 

@@ -1,7 +1,8 @@
 //! `cargo xtask stress --executions N [--seed S]`: the safety invariant under load.
 //!
-//! Samples random problems of a few hundred reference samples, schedules each with the anytime
-//! sampler of `tandem-schedule` at a random control tick, then runs `N` executions in all
+//! Samples random problems of a few hundred reference samples, schedules each with the
+//! scheduler of `tandem-schedule` (the anytime sampler and the margin-aware completion beside
+//! it) at a random control tick, then runs `N` executions in all
 //! through each schedule's own `Coordinator` (at the tick it was checked with) under the full
 //! adversary set of `tandem::realtime::adversary` (no correction, always fastest, always
 //! slowest, Alg. 2's worst case for each role, switching every tick, periodic, one switch,
@@ -43,6 +44,7 @@ struct Case {
     /// The full adversary set for this case (random gradients over the problem's whole
     /// `[min ψ̇min, max ψ̇max]`).
     adversaries: [Adversary; SET_SIZE],
+    /// The schedule overlaps the robots: sampled or completed, not a serial fallback.
     sampled: bool,
 }
 
@@ -97,7 +99,7 @@ fn make_case(seed: u64, index: u64) -> anyhow::Result<Case> {
         coordinator: out.schedule.coordinator(&problem)?,
         max_ticks: (2.0 * slowest_s / tick_s) as u64 + 100,
         adversaries: adversary_set(grad_range, ticks, &mut rng),
-        sampled: matches!(out.source, Source::Sampled { .. }),
+        sampled: matches!(out.source, Source::Sampled { .. } | Source::Completed),
     })
 }
 
@@ -127,7 +129,7 @@ pub(crate) fn run(executions: u64, seed: u64) -> anyhow::Result<()> {
     let n_sampled = cases.iter().filter(|c| c.sampled).count();
     println!(
         "stress: {n_problems} random problems (200–400 samples, tick 0.25–1 sample), \
-         {SAMPLES} sampler candidates each: {n_sampled} overlapping sampled schedules, {} serial \
+         {SAMPLES} sampler candidates each: {n_sampled} overlapping sampled or completed schedules, {} serial \
          fallbacks; scheduling took {:.1} s",
         n_problems as usize - n_sampled,
         start.elapsed().as_secs_f64()

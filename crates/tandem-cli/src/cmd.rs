@@ -11,7 +11,7 @@ use tandem::{ExecutionRecord, Planner, PlannerParams, derive_seed};
 use crate::cli::{
     Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
 };
-use crate::gantt::{gantt_text, schedule_json, serial_t_total_s, source_name};
+use crate::gantt::{certificate_line, gantt_text, schedule_json, source_name};
 use crate::{input, plot, sim, state_io};
 
 /// Runs one command.
@@ -138,11 +138,12 @@ fn summary_lines(planner: &Planner) -> Result<()> {
         conf.n_ref(),
         conf.low_regions().len()
     ));
-    let serial = serial_t_total_s(planner.problem(), planner.schedule().tick_s)?;
-    let t = planner.outcome().t_total_s;
     out(&format!(
-        "schedule: T_total {t:.2} s vs fastest serial {serial:.2} s ({:.1} %); τ = {:.2} s; {}",
-        100.0 * t / serial,
+        "schedule: {}",
+        certificate_line(planner.problem(), planner.outcome())?
+    ));
+    out(&format!(
+        "schedule: τ = {:.2} s; {}",
         planner.schedule().offset_s,
         source_name(&planner.outcome().source)
     ));

@@ -13,6 +13,7 @@ const GANTT_COLUMNS: usize = 72;
 pub(crate) fn source_name(source: &Source) -> String {
     match source {
         Source::Sampled { candidate } => format!("sampled (candidate {candidate})"),
+        Source::Completed => "margin-aware completion of the exact optimum".into(),
         Source::Previous => "previous schedule (still valid, nothing better found)".into(),
         Source::RepairedPrevious => "previous schedule, repaired for the new model".into(),
         Source::Serial => "fastest serial schedule (fallback)".into(),
@@ -23,6 +24,24 @@ pub(crate) fn source_name(source: &Source) -> String {
 /// at control tick `tick_s` (s; `T_total` does not depend on it, the schedule does).
 pub(crate) fn serial_t_total_s(problem: &Problem, tick_s: f64) -> Result<f64> {
     Ok(problem.serial_schedule(tick_s)?.t_total_s(problem.dt_s()))
+}
+
+/// The certificate of a schedule in one line: its `T_total`, the margin-free lower bound
+/// `T*₀` with the gap to it, and the fastest serial schedule's `T_total` (all s), e.g.
+/// `T_total 90.34 s — lower bound 89.91 s without margins (+0.49 %), fastest serial 145.75 s`.
+pub(crate) fn certificate_line(problem: &Problem, outcome: &Outcome) -> Result<String> {
+    let serial = serial_t_total_s(problem, outcome.schedule.tick_s)?;
+    let bound = if outcome.bound_is_optimum {
+        "lower bound"
+    } else {
+        "lower bound (search budget spent: not the optimum)"
+    };
+    Ok(format!(
+        "T_total {:.2} s — {bound} {:.2} s without margins (+{:.2} %), fastest serial {serial:.2} s",
+        outcome.t_total_s,
+        outcome.lower_bound_s,
+        100.0 * outcome.gap,
+    ))
 }
 
 /// Both robots' low-confidence intervals with their robot index (0 or 1), sorted by start
@@ -39,7 +58,8 @@ fn sorted_intervals(tl: &GlobalTimeline) -> Vec<(usize, LcInterval)> {
 }
 
 /// The schedule as JSON: offset, per-robot gradients, low-confidence intervals in global
-/// time, `T_total` (all times in seconds of global time; gradients in execution samples per
+/// time, `T_total` and its certificate (the margin-free lower bound, whether it is the proven
+/// optimum, the gap) (all times in seconds of global time; gradients in execution samples per
 /// reference sample). `schedule` is exactly `tandem::schedule::Schedule`'s serde form.
 pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Value> {
     let tl = GlobalTimeline::new(problem, &outcome.schedule)?;
@@ -59,6 +79,9 @@ pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Valu
     let s = &outcome.schedule;
     Ok(json!({
         "t_total_s": outcome.t_total_s,
+        "lower_bound_s": outcome.lower_bound_s,
+        "bound_is_optimum": outcome.bound_is_optimum,
+        "gap": outcome.gap,
         "serial_t_total_s": serial_t_total_s(problem, s.tick_s)?,
         "offset_s": s.offset_s,
         "durations_s": s.durations_s(dt),
@@ -104,18 +127,11 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
     let mut out = String::new();
     let dt = problem.dt_s();
     let [d0, d1] = outcome.schedule.durations_s(dt);
-    let serial = serial_t_total_s(problem, outcome.schedule.tick_s)?;
+    writeln!(out, "{}", certificate_line(problem, outcome)?)?;
     writeln!(
         out,
-        "T_total {:.2} s (fastest serial {:.2} s, {:.1} % of it); robot 2 starts at τ = {:.2} s",
-        outcome.t_total_s,
-        serial,
-        100.0 * outcome.t_total_s / serial,
-        outcome.schedule.offset_s
-    )?;
-    writeln!(
-        out,
-        "robot 1 runs {d0:.2} s, robot 2 runs {d1:.2} s; schedule: {}",
+        "robot 2 starts at τ = {:.2} s; robot 1 runs {d0:.2} s, robot 2 runs {d1:.2} s; schedule: {}",
+        outcome.schedule.offset_s,
         source_name(&outcome.source)
     )?;
     writeln!(out)?;

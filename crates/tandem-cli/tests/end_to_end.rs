@@ -141,6 +141,11 @@ fn fixtures_fit_simulate_record_schedule() {
     assert!((t_total - schedule.t_total_s(recorded.model().dt_s())).abs() < 1e-9);
     assert!(t_total <= recorded.outcome().t_total_s + 1e-9);
     assert!(t_total <= doc["serial_t_total_s"].as_f64().unwrap() + 1e-9);
+    // The certificate: the proven margin-free lower bound and the gap to it.
+    let bound = doc["lower_bound_s"].as_f64().unwrap();
+    assert!(bound > 0.0 && bound <= t_total, "{bound} vs {t_total}");
+    assert_eq!(doc["bound_is_optimum"], true);
+    assert!((doc["gap"].as_f64().unwrap() - (t_total - bound) / bound).abs() < 1e-9);
     assert_eq!(doc["offset_s"].as_f64().unwrap(), schedule.offset_s);
     // Low-confidence intervals of the two robots never overlap in global time.
     let iv = doc["lc_intervals"].as_array().unwrap();
@@ -238,8 +243,19 @@ fn documented_examples_work() {
         "--pairs",
         "1",
     ]));
+    // The text views print the certificate.
+    let text = ok(&tandem(["inspect", &s(&state)]));
+    assert!(
+        text.contains("lower bound") && text.contains("without margins"),
+        "{text}"
+    );
+    let text = ok(&tandem(["schedule", &s(&state), "--samples", "50"]));
+    assert!(text.starts_with("T_total "), "{text}");
+    assert!(text.contains("without margins") && text.contains("fastest serial"));
     let inspect: serde_json::Value =
         serde_json::from_str(&ok(&tandem(["inspect", &s(&state), "--json"]))).unwrap();
+    let bound = inspect["schedule"]["lower_bound_s"].as_f64().unwrap();
+    assert!(bound <= inspect["schedule"]["t_total_s"].as_f64().unwrap());
     assert_eq!(inspect["pairs_recorded"], 1);
     assert_eq!(inspect["model"]["count"], 5);
     assert_eq!(inspect["model"]["n_ref"], 40);

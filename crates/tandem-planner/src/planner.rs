@@ -497,7 +497,7 @@ mod tests {
         // Bad sampler parameters leave the planner as it was.
         let before = p.outcome().clone();
         let bad = SamplerParams {
-            samples: 0,
+            p_fastest: 1.5,
             ..SamplerParams::default()
         };
         assert!(p.reschedule(&bad).is_err());

@@ -61,7 +61,10 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 ///   `distribution` and `offset`; the benchmark-only `margin_check` and
 ///   `exhaustive_margins` moved to `SamplerBaselines`, which is never stored); the fit
 ///   parameters gained `reference` and the model `reference_idx`.
-pub const FORMAT_VERSION: u32 = 3;
+/// - 4: the outcome carries its certificate (`lower_bound_s`, `bound_is_optimum`, `gap`), its
+///   counts the completion's and the search's, `Source` gained `Completed`, and the sampler
+///   parameters the exact search's and completion's (`exact`).
+pub const FORMAT_VERSION: u32 = 4;
 
 /// Header length in bytes: magic (8) + version (4) + payload length (8) + CRC-32 (4).
 pub const HEADER_LEN: usize = 24;
@@ -287,7 +290,7 @@ mod tests {
     fn header_layout_is_as_documented() {
         let bytes = encode(&payload(4)).unwrap();
         assert_eq!(&bytes[..8], b"TANDEMST");
-        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 3);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 4);
         let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
         assert_eq!(len as usize, bytes.len() - HEADER_LEN);
         let crc = u32::from_le_bytes(bytes[20..24].try_into().unwrap());
@@ -377,7 +380,7 @@ mod tests {
             }
         ));
         let msg = err.to_string();
-        assert!(msg.contains("v.tandem") && msg.contains('7') && msg.contains('3'));
+        assert!(msg.contains("v.tandem") && msg.contains('7') && msg.contains('4'));
     }
 
     #[test]

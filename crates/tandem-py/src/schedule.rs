@@ -13,15 +13,10 @@ use crate::facade::{
 };
 use crate::planner::N_ROBOTS;
 
-/// The name of a schedule's source in records: `sampled`, `previous`, `repaired` (the
-/// previous schedule re-projected onto a new problem) or `serial`.
+/// The name of a schedule's source in records ([`Source::name`]): `sampled`, `completed`,
+/// `previous`, `repaired` (the previous schedule re-projected onto a new problem) or `serial`.
 pub(crate) fn source_name(source: Source) -> &'static str {
-    match source {
-        Source::Sampled { .. } => "sampled",
-        Source::Previous => "previous",
-        Source::RepairedPrevious => "repaired",
-        Source::Serial => "serial",
-    }
+    source.name()
 }
 
 /// The scheduling problem of Eq. 13–20: per reference sample ``n`` (period ``dt_s``) the
@@ -162,6 +157,8 @@ pub(crate) struct PySchedule {
     pub(crate) problem: Arc<Problem>,
     source: String,
     stats: Option<[usize; 3]>,
+    /// `(lower bound T*₀ or the simple bound (s), relative gap)` of a scheduler's outcome.
+    certificate: Option<(f64, f64)>,
 }
 
 impl PySchedule {
@@ -176,17 +173,21 @@ impl PySchedule {
             problem,
             source,
             stats,
+            certificate: None,
         }
     }
 
     pub(crate) fn from_outcome(problem: Arc<Problem>, outcome: &Outcome) -> Self {
         let s = &outcome.stats;
-        Self::new(
-            problem,
-            outcome.schedule.clone(),
-            source_name(outcome.source).into(),
-            Some([s.candidates, s.cheap_feasible, s.margin_checks]),
-        )
+        Self {
+            certificate: Some((outcome.lower_bound_s, outcome.gap)),
+            ..Self::new(
+                problem,
+                outcome.schedule.clone(),
+                source_name(outcome.source).into(),
+                Some([s.candidates, s.cheap_feasible, s.margin_checks]),
+            )
+        }
     }
 
     fn timeline(&self) -> Result<GlobalTimeline> {
@@ -352,18 +353,19 @@ impl PySchedule {
         Ok(Some(d))
     }
 
-    /// A lower bound on ``T_total`` (s) over all schedules of the problem, or ``None``: the
-    /// sampler of this build does not certify its schedules.
+    /// A lower bound on ``T_total`` (s) over all schedules of the problem (the margin-free
+    /// optimum ``T*₀`` of Eq. 20 constraints 1–4 when proven), for a schedule made by the
+    /// scheduler (``Planner.schedule``, ``reschedule``); ``None`` for a schedule built by hand.
     #[getter]
     fn lower_bound_s(&self) -> Option<f64> {
-        None
+        self.certificate.map(|c| c.0)
     }
 
-    /// Relative gap ``(T_total − lower_bound_s) / lower_bound_s``, or ``None`` without a
+    /// Relative gap ``(T_total − lower_bound_s) / lower_bound_s`` (≥ 0), or ``None`` without a
     /// lower bound.
     #[getter]
     fn gap(&self) -> Option<f64> {
-        None
+        self.certificate.map(|c| c.1)
     }
 
     /// The problem the schedule was made for.

@@ -58,6 +58,9 @@ pub mod tol;
 
 pub use coordinator::{Coordinator, Operator, Tick};
 pub use error::{Error, Result};
-pub use margins::{sufficient_margins, sufficient_margins_per_pair, sufficient_margins_printed};
+pub use margins::{
+    PairSlack, pair_slacks, sufficient_margins, sufficient_margins_per_pair,
+    sufficient_margins_printed,
+};
 pub use strategy::{high_conf_steps, response_step};
 pub use timeline::{LcInterval, Rates, Timeline, clock_end_s, clock_s};

@@ -65,6 +65,14 @@
 //! simulation per pair would: at every earlier state the earlier pair was undecided, so
 //! `t_c + M < T_c ≤ T_c'` and `t_p < T_p ≤ T_p'`, and the later pair was undecided too.
 //! [`sufficient_margins_per_pair`] is that per-pair loop (a benchmark baseline).
+//!
+//! # Slacks
+//! [`pair_slacks`] runs the same two simulations to the end of each role instead of stopping at
+//! the first rejection and reports, per pair, rule 1's room left when `p` is out:
+//! `(T_c − ε) − (t_c + M)` at the deciding step (`t_c` only grows, so that is the smallest room
+//! of the pair's whole stretch). The check accepts exactly when every slack is positive; a
+//! scheduler reads from the slacks how much clearance each pair lacks or has to spare, with
+//! the check itself as the only owner of the worst case.
 
 use std::collections::VecDeque;
 
@@ -361,15 +369,26 @@ impl<'a> RoleSim<'a> {
                 }
             }
             Variant::Conservative => {
-                if self.t_c + setup.max_step >= pair.t_c_start() - setup.eps {
+                if self.slack(pair, setup) <= 0.0 {
                     Some(false)
-                } else if self.t_p >= pair.t_p_end() + setup.eps {
+                } else if self.p_is_out(pair, setup) {
                     Some(true)
                 } else {
                     None
                 }
             }
         }
+    }
+
+    /// Rule 1's room left for `c` (conservative check): `(T_c − ε) − (t_c + M)`, schedule-clock
+    /// s; `c` is a full step short of its region while this is > 0.
+    fn slack(&self, pair: Pair, setup: &Setup) -> f64 {
+        (pair.t_c_start() - setup.eps) - (self.t_c + setup.max_step)
+    }
+
+    /// Rule 1's acceptance (conservative check): `p` has left its region, `t_p ≥ T_p + ε`.
+    fn p_is_out(&self, pair: Pair, setup: &Setup) -> bool {
+        self.t_p >= pair.t_p_end() + setup.eps
     }
 }
 
@@ -441,6 +460,71 @@ pub fn sufficient_margins(robots: &[Timeline; 2], tick_s: f64) -> Result<bool> {
         }
     }
     Ok(true)
+}
+
+/// One pair of consecutive LC regions of different robots with its worst-case room, from the
+/// simulation of [`sufficient_margins`] (see [`pair_slacks`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairSlack {
+    /// The previous robot `p` (0 = the first robot, 1 = the second); the current robot `c` is
+    /// the other one.
+    pub prev_robot: usize,
+    /// `p`'s region (schedule clock); `p` leaves it at `T_p = prev.end_s`.
+    pub prev: LcInterval,
+    /// `c`'s region (schedule clock); `c` enters it at `T_c = cur.start_s`.
+    pub cur: LcInterval,
+    /// Schedule-clock s, `> 0` exactly when [`sufficient_margins`] accepts the pair: how much
+    /// earlier `c`'s region could start before rule 1 rejects it on the same worst-case
+    /// trajectory, `(T_c − ε) − (t_c + M)` at the first simulated step with `t_p ≥ T_p + ε`
+    /// (`t_c` is then the furthest the worst case has pushed `c`); its negative is the clearance
+    /// missing. `+∞` for a pair accepted without simulation (rule 4); for a pair whose regions
+    /// already overlap on schedule, the smaller of that and `T_c − (T_p + ε) < 0`; `−∞` if the
+    /// simulation budget ran out first.
+    pub slack_s: f64,
+}
+
+/// Every pair's worst-case slack ([`PairSlack`]), in the order of the current regions' starts,
+/// from the same two simulations as [`sufficient_margins`] (one per role, run until every pair
+/// of the role is decided): `sufficient_margins(robots, tick_s)` is `true` exactly when every
+/// `slack_s > 0`. A scheduler uses it to see how much clearance each pair lacks or has to spare.
+///
+/// # Errors
+/// As [`sufficient_margins`].
+pub fn pair_slacks(robots: &[Timeline; 2], tick_s: f64) -> Result<Vec<PairSlack>> {
+    let setup = Setup::new(robots, tick_s)?;
+    let mut out = Vec::with_capacity(setup.pairs[0].len() + setup.pairs[1].len());
+    for (p, pairs) in setup.pairs.iter().enumerate() {
+        let mut slack = vec![f64::NEG_INFINITY; pairs.len()];
+        if !pairs.is_empty() {
+            let mut sim = RoleSim::new(Variant::Conservative, robots, &setup, p, tick_s);
+            let mut k = 0;
+            for _ in 0..step_budget(robots, &setup, tick_s) {
+                sim.step();
+                while k < pairs.len() && sim.p_is_out(pairs[k], &setup) {
+                    slack[k] = sim.slack(pairs[k], &setup);
+                    k += 1;
+                }
+                if k == pairs.len() {
+                    break;
+                }
+            }
+        }
+        for (&pair, s) in pairs.iter().zip(slack) {
+            let slack_s = match setup.prefilter(robots, p, pair) {
+                Some(true) => f64::INFINITY,
+                Some(false) => s.min(pair.t_c_start() - (pair.t_p_end() + setup.eps)),
+                None => s,
+            };
+            out.push(PairSlack {
+                prev_robot: p,
+                prev: pair.prev,
+                cur: pair.cur,
+                slack_s,
+            });
+        }
+    }
+    out.sort_by(|x, y| x.cur.start_s.total_cmp(&y.cur.start_s));
+    Ok(out)
 }
 
 /// The same conservative check as [`sufficient_margins`], written as the straightforward loop:
@@ -538,6 +622,29 @@ mod tests {
         // Conservative: after the first step t_c ≥ 1.5 + 0.5 and 2.0 + M(2) ≥ 2.5 → rejected.
         assert!(!sufficient_margins(&r, 1.0).unwrap());
         assert!(!sufficient_margins_per_pair(&r, 1.0).unwrap());
+    }
+
+    #[test]
+    fn slack_of_three_sample_case_by_hand() {
+        // τ = 1.5, tick 1, M = 2: at the first step both robots count as LC (widened windows);
+        // c rushing (t_c = 3.5, p follows to 3.5) and p dragging (both to 2.0) leave c level,
+        // so the tie keeps the rush. p is then out (3.5 ≥ T_p = 2): slack = 2.5 − (3.5 + 2) = −3
+        // (less ε).
+        let s = pair_slacks(&three_sample(1.5), 1.0).unwrap();
+        assert_eq!(s.len(), 1);
+        assert_eq!(
+            (s[0].prev_robot, s[0].prev.end_s, s[0].cur.start_s),
+            (0, 2.0, 2.5)
+        );
+        assert!(
+            s[0].slack_s < -3.0 && s[0].slack_s > -3.0 - 1e-6,
+            "{}",
+            s[0].slack_s
+        );
+        // Serial: rule 4 accepts the pair without simulating it.
+        let s = pair_slacks(&three_sample(3.0), 1.0).unwrap();
+        assert_eq!(s[0].slack_s, f64::INFINITY);
+        assert!(pair_slacks(&three_sample(1.5), 0.0).is_err());
     }
 
     #[test]

@@ -8,7 +8,7 @@ use common::{Problem, rng};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use rand::Rng;
-use tandem_realtime::{sufficient_margins, sufficient_margins_per_pair};
+use tandem_realtime::{pair_slacks, sufficient_margins, sufficient_margins_per_pair};
 
 #[test]
 fn single_pass_equals_per_pair_on_random_schedules() {
@@ -36,6 +36,14 @@ fn single_pass_equals_per_pair_on_random_schedules() {
             seed,
             tau,
             tick_s
+        );
+        // The slacks come from the same simulation: all positive exactly when accepted.
+        let slacks = pair_slacks(&robots, tick_s).unwrap();
+        prop_assert_eq!(
+            slacks.iter().all(|s| s.slack_s > 0.0),
+            single,
+            "slacks {:?}",
+            slacks
         );
         let mut c = counts.get();
         c[usize::from(single)] += 1;

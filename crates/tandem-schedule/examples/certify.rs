@@ -1,5 +1,6 @@
 //! A certified schedule for a problem file: the margin-free lower bound `T*₀` (exact search),
-//! the margin-aware completion and, with `--seed`, the sampler's schedule as a second opinion.
+//! the margin-aware completion and, with `--seed`, the sampler beside it (the scheduler the
+//! planner runs, `sample_schedule`).
 //!
 //! ```text
 //! cargo run --release -p tandem-schedule --example certify -- PROBLEM.csv [--dt 0.01] [--seed S]
@@ -11,18 +12,21 @@
 //! `fixtures/sanding/problem.csv` are read instead (low confidence = sanding in passes 1–3).
 //! `--dt`: the reference sample period `Δt_s` (s), default 0.01; the margin check runs at a
 //! control tick of `Δt_s`. `--seed S`: also run the sampler (5000 samples, seed `S`) and keep
-//! its schedule if it is better.
+//! its schedule if it is better; without it, no candidate is sampled
+//! (`SamplerBaselines::completion_only`).
 //!
 //! Prints one JSON object `{"t_total_s", "lower_bound_s", "gap", "wall_ms", "accepted"}` for the
 //! schedule it returns (`accepted`: it passes `validate` at tick `Δt_s`; `wall_ms`: the time of
-//! the search, the completion and the sampler). Bad input: a message naming the file and the
+//! the whole re-schedule: search, completion and sampler). Bad input: a message naming the file and the
 //! line on stderr, exit code 2.
 #![allow(clippy::print_stdout, reason = "an example reports to the terminal")]
 
 use std::process::ExitCode;
 use std::time::Instant;
 
-use tandem_schedule::{ExactParams, Problem, SamplerParams, certify, sample_schedule, validate};
+use tandem_schedule::{
+    Problem, SamplerBaselines, SamplerParams, sample_schedule_with_baselines, validate,
+};
 
 /// Command-line arguments.
 struct Args {
@@ -162,27 +166,23 @@ enum ConfColumn {
 fn run() -> Result<String, String> {
     let args = parse_args()?;
     let problem = read_problem(&args.path, args.dt_s)?;
-    let start = Instant::now();
-    let incumbent = match args.seed {
-        Some(seed) => {
-            let params = SamplerParams {
-                seed,
-                ..SamplerParams::default()
-            };
-            let out = sample_schedule(&problem, &params, None)
-                .map_err(|e| format!("{}: sampler: {e}", args.path))?;
-            Some(out.schedule)
-        }
-        None => None,
+    let params = SamplerParams {
+        seed: args.seed.unwrap_or(0),
+        ..SamplerParams::default()
     };
-    let cert = certify(&problem, &ExactParams::default(), incumbent.as_ref())
+    let baselines = SamplerBaselines {
+        completion_only: args.seed.is_none(),
+        ..SamplerBaselines::default()
+    };
+    let start = Instant::now();
+    let out = sample_schedule_with_baselines(&problem, &params, &baselines, None)
         .map_err(|e| format!("{}: {e}", args.path))?;
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-    let accepted = validate(&problem, &cert.schedule).is_ok();
+    let accepted = validate(&problem, &out.schedule).is_ok();
     let report = Report {
-        t_total_s: cert.t_total_s,
-        lower_bound_s: cert.lower_bound_s,
-        gap: cert.gap,
+        t_total_s: out.t_total_s,
+        lower_bound_s: out.lower_bound_s,
+        gap: out.gap,
         wall_ms,
         accepted,
     };

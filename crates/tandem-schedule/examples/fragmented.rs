@@ -1,5 +1,7 @@
 //! Mid-study-like problems with fragmented confidence, built from the fixture problem: the
-//! exact search (`solve_exact`), the certified completion (`certify`) and the sampler on each.
+//! exact search (`solve_exact`), the margin-aware completion alone
+//! (`SamplerBaselines::completion_only`) and the sampler alone
+//! (`SamplerBaselines::sampler_only`) on each.
 //!
 //! ```text
 //! cargo run --release -p tandem-schedule --example fragmented [-- --write DIR]
@@ -16,8 +18,15 @@
 //! example and of `bench/peers/exact_compare.py`).
 //!
 //! Prints one row per problem: LC runs per robot, `T*₀` and whether it is proven, the search's
-//! pieces and wall time, the certified `T_total`, its gap and wall time, and the sampler's
-//! `T_total` and wall time (5000 samples, seed 0).
+//! pieces and wall time; the completion's `T_total` (with where it came from: `completed`, or
+//! `serial` when the completion found nothing shorter), its gap to `T*₀`, margin checks and
+//! wall time; the sampler's `T_total`, gap and wall time (5000 samples, seed 0); and the
+//! scheduler's (`sample_schedule`: both, the completion also refining the sampler's winner).
+//!
+//! Then the same for `RANDOM` random problems (`random_<k>`, ChaCha8 seed `k`): 2000–4000
+//! samples at 10 ms in alternating runs (LC runs of 20–400 samples, HC runs of 50–800), a
+//! smooth random mean gradient and per-run bound factors `ψ̇min/ψ̇̄ ∈ [0.3, 0.9]`,
+//! `ψ̇max/ψ̇̄ ∈ [1.1, 2.5]`; and a last row with the means over them.
 #![allow(clippy::print_stdout, reason = "an example reports to the terminal")]
 
 use std::fmt::Write as _;
@@ -26,7 +35,10 @@ use std::time::Instant;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tandem_schedule::{ExactParams, Problem, SamplerParams, certify, sample_schedule, solve_exact};
+use tandem_schedule::{
+    ExactParams, Problem, SamplerBaselines, SamplerParams, Source, sample_schedule,
+    sample_schedule_with_baselines, solve_exact,
+};
 
 /// Reference sample period of the fixtures (s).
 const DT_S: f64 = 0.01;
@@ -43,6 +55,100 @@ const CASES: [(&str, f64, f64, u64); 9] = [
     ("islands_40pct", 0.4, 0.0, 7),
     ("transition_islands", 0.0, 0.01, 8),
 ];
+
+/// Number of random problems.
+const RANDOM: u64 = 12;
+
+/// Random problem `k` (see the module docs).
+fn random_problem(k: u64) -> Problem {
+    let mut rng = ChaCha8Rng::seed_from_u64(k);
+    let n_ref = rng.random_range(2000..=4000);
+    let (mut conf, mut mean, mut min, mut max) = (vec![], vec![], vec![], vec![]);
+    let mut hc = rng.random_bool(0.5);
+    let (freq, phase) = (rng.random_range(0.001..0.02), rng.random_range(0.0..6.3));
+    while conf.len() < n_ref {
+        let len = if hc {
+            rng.random_range(50..=800)
+        } else {
+            rng.random_range(20..=400)
+        };
+        let (lo, hi) = (rng.random_range(0.3..0.9), rng.random_range(1.1..2.5));
+        for _ in 0..len.min(n_ref - conf.len()) {
+            let m = 1.0 + 0.5 * (freq * conf.len() as f64 + phase).sin();
+            conf.push(hc);
+            mean.push(m);
+            min.push(lo * m);
+            max.push(hi * m);
+        }
+        hc = !hc;
+    }
+    Problem::new(conf, mean, min, max, DT_S).expect("bounds around a positive mean")
+}
+
+/// One row's numbers: `T*₀`, completion `T_total` and gap and wall time, sampler `T_total` and
+/// gap and wall time.
+struct Row {
+    completion_gap: f64,
+    completion_ms: f64,
+    sampler_gap: f64,
+    sampler_ms: f64,
+    scheduler_gap: f64,
+    scheduler_ms: f64,
+}
+
+/// Runs the search, the completion alone and the sampler alone on `p` and prints the row.
+fn row(name: &str, p: &Problem) -> Result<Row, String> {
+    let (completion_only, sampler_only) = (
+        SamplerBaselines::COMPLETION_ONLY,
+        SamplerBaselines::SAMPLER_ONLY,
+    );
+    let t = Instant::now();
+    let free = solve_exact(p, &ExactParams::default()).map_err(|e| e.to_string())?;
+    let search_ms = t.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    let done = sample_schedule_with_baselines(p, &SamplerParams::default(), &completion_only, None)
+        .map_err(|e| e.to_string())?;
+    let completion_ms = t.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    let sampled = sample_schedule_with_baselines(p, &SamplerParams::default(), &sampler_only, None)
+        .map_err(|e| e.to_string())?;
+    let sampler_ms = t.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    let both = sample_schedule(p, &SamplerParams::default(), None).map_err(|e| e.to_string())?;
+    let scheduler_ms = t.elapsed().as_secs_f64() * 1e3;
+    let from = if done.source == Source::Completed {
+        "completed"
+    } else {
+        "serial"
+    };
+    let chosen = match both.source {
+        Source::Completed => "completed",
+        Source::Sampled { .. } => "sampled",
+        _ => "serial",
+    };
+    println!(
+        "| {name} | {} | {:.6} | {} | {} | {search_ms:.1} | {:.3} | {from} | {:.2} % | {} | {completion_ms:.1} | {:.3} | {:.2} % | {sampler_ms:.1} | {:.3} | {chosen} | {:.2} % | {scheduler_ms:.1} |",
+        free.stats.lc_runs,
+        free.lower_bound_s,
+        if free.proven_optimal { "yes" } else { "no" },
+        free.stats.pieces,
+        done.t_total_s,
+        100.0 * done.gap,
+        done.stats.completion_margin_checks,
+        sampled.t_total_s,
+        100.0 * sampled.gap,
+        both.t_total_s,
+        100.0 * both.gap,
+    );
+    Ok(Row {
+        completion_gap: done.gap,
+        completion_ms,
+        sampler_gap: sampled.gap,
+        sampler_ms,
+        scheduler_gap: both.gap,
+        scheduler_ms,
+    })
+}
 
 /// Per reference sample: mean, min, max gradient, pass, phase is sanding, painted.
 struct Fixture {
@@ -131,36 +237,32 @@ fn main() -> Result<(), String> {
     if let Some(d) = &write_dir {
         std::fs::create_dir_all(d).map_err(|e| format!("{}: {e}", d.display()))?;
     }
-    println!(
-        "| problem | LC runs | T*0 (s) | proven | pieces | search (ms) | certified (s) | gap | certify (ms) | sampler (s) | sampler (ms) |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
-    let exact = ExactParams::default();
+    let header = "| problem | LC runs | T*0 (s) | proven | pieces | search (ms) | completion (s) | from | gap | checks | completion (ms) | sampler (s) | gap | sampler (ms) | scheduler (s) | from | gap | scheduler (ms) |";
+    let rule = "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+    println!("{header}");
+    println!("{rule}");
     for (name, p_sanding, p_transition, seed) in CASES {
         let p = build(&fx, p_sanding, p_transition, seed);
         if let Some(d) = &write_dir {
             write_csv(&d.join(format!("{name}.csv")), &p)?;
         }
-        let t = Instant::now();
-        let free = solve_exact(&p, &exact).map_err(|e| e.to_string())?;
-        let search_ms = t.elapsed().as_secs_f64() * 1e3;
-        let t = Instant::now();
-        let cert = certify(&p, &exact, None).map_err(|e| e.to_string())?;
-        let certify_ms = t.elapsed().as_secs_f64() * 1e3;
-        let t = Instant::now();
-        let sampled =
-            sample_schedule(&p, &SamplerParams::default(), None).map_err(|e| e.to_string())?;
-        let sampler_ms = t.elapsed().as_secs_f64() * 1e3;
-        println!(
-            "| {name} | {} | {:.6} | {} | {} | {search_ms:.1} | {:.3} | {:.2} % | {certify_ms:.1} | {:.3} | {sampler_ms:.1} |",
-            free.stats.lc_runs,
-            free.lower_bound_s,
-            if free.proven_optimal { "yes" } else { "no" },
-            free.stats.pieces,
-            cert.t_total_s,
-            100.0 * cert.gap,
-            sampled.t_total_s,
-        );
+        row(name, &p)?;
     }
+    println!();
+    println!("{header}");
+    println!("{rule}");
+    let rows: Vec<Row> = (0..RANDOM)
+        .map(|k| row(&format!("random_{k}"), &random_problem(k)))
+        .collect::<Result<_, _>>()?;
+    let mean = |f: fn(&Row) -> f64| rows.iter().map(f).sum::<f64>() / rows.len() as f64;
+    println!(
+        "| mean of {RANDOM} | | | | | | | | {:.2} % | | {:.1} | | {:.2} % | {:.1} | | | {:.2} % | {:.1} |",
+        100.0 * mean(|r| r.completion_gap),
+        mean(|r| r.completion_ms),
+        100.0 * mean(|r| r.sampler_gap),
+        mean(|r| r.sampler_ms),
+        100.0 * mean(|r| r.scheduler_gap),
+        mean(|r| r.scheduler_ms),
+    );
     Ok(())
 }

@@ -6,11 +6,14 @@
 //! sample) and robot 2 a start offset `τ`. [`GlobalTimeline`] lays a schedule out in global
 //! time (Eq. 15, 16, 19), [`Schedule::t_total_s`] is Eq. 13, [`validate`] checks every
 //! constraint of Eq. 20 (the margin check of Alg. 2 through `tandem_realtime`), and
-//! [`sample_schedule`] is the paper's anytime sampler — robot 1's speeds are sampled and `τ`
-//! and robot 2's speeds fitted to them exactly (the measured alternatives are
-//! [`SamplerBaselines`]) — parallel, and deterministic for a seed whatever the thread count.
-//! A schedule carries the control tick it was checked at ([`Schedule::tick_s`]); the
-//! runtime [`Schedule::coordinator`] runs at that tick.
+//! [`sample_schedule`] is the scheduler: the paper's anytime sampler — robot 1's speeds are
+//! sampled and `τ` and robot 2's speeds fitted to them exactly (the measured alternatives are
+//! [`SamplerBaselines`]) — and, beside it, the margin-aware completion of the exact
+//! margin-free optimum ([`exact`]), the shorter of the two (or of the previous or serial
+//! schedule) winning; parallel, and deterministic for a seed whatever the thread count. Every
+//! [`Outcome`] is certified: it carries the margin-free lower bound `T*₀` ([`solve_exact`])
+//! and the gap to it. A schedule carries the control tick it was checked at
+//! ([`Schedule::tick_s`]); the runtime [`Schedule::coordinator`] runs at that tick.
 //!
 //! ```
 //! use tandem_schedule::{Problem, SamplerParams, Source, sample_schedule, validate};
@@ -27,10 +30,14 @@
 //! // The schedule was checked at the default control tick, Δt_s, and runs at it.
 //! assert_eq!(out.schedule.tick_s, 0.01);
 //! assert_eq!(out.schedule.coordinator(&problem)?.tick_s(), 0.01);
-//! assert!(matches!(out.source, Source::Sampled { .. }));
+//! assert!(matches!(out.source, Source::Sampled { .. } | Source::Completed));
+//! // The certificate: no schedule of Eq. 20 is shorter than the margin-free optimum T*₀.
+//! assert!(out.bound_is_optimum && out.lower_bound_s <= out.t_total_s);
+//! assert_eq!(out.gap, (out.t_total_s - out.lower_bound_s) / out.lower_bound_s);
 //! # Ok::<(), tandem_schedule::Error>(())
 //! ```
 
+mod choose;
 mod error;
 pub mod exact;
 mod problem;
@@ -38,16 +45,11 @@ mod sampler;
 mod schedule;
 mod validate;
 
+pub use choose::{Outcome, Source, sample_schedule, sample_schedule_with_baselines};
 pub use error::{Error, Result};
-pub use exact::{
-    Certificate, CertifiedSource, ExactParams, MarginFree, SearchStats, certify, earliest_schedule,
-    solve_exact,
-};
+pub use exact::{ExactParams, MarginFree, SearchStats, earliest_schedule, solve_exact};
 pub use problem::Problem;
-pub use sampler::{
-    DrawnOffset, Outcome, SamplerBaselines, SamplerParams, SamplerStats, Source, sample_schedule,
-    sample_schedule_with_baselines,
-};
+pub use sampler::{DrawnOffset, SamplerBaselines, SamplerParams, SamplerStats};
 pub use schedule::{GlobalTimeline, Schedule};
 pub use tandem_confidence::Run;
 pub use tandem_realtime::LcInterval;

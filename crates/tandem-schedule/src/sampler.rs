@@ -81,9 +81,13 @@
 //!
 //! # Evaluation order
 //!
-//! 1. The incumbent: the previous schedule if it is still valid (else its repair: gradients
+//! 1. The incumbent, chosen by the scheduler ([`crate::sample_schedule`], which owns the
+//!    choice): the previous schedule if it is still valid (else its repair: gradients
 //!    clamped into the new bounds, the new mean on low-confidence samples, `τ` clamped), or
-//!    the fastest serial schedule if that is faster or there is no valid previous one.
+//!    the fastest serial schedule if that is faster or there is no valid previous one. The
+//!    sampler only sees its `T_total`, the bound its candidates must beat; the scheduler
+//!    keeps the incumbent unless the sampler's winner or the margin-aware completion beside
+//!    it is shorter.
 //! 2. Cheap checks on all candidates in parallel: `T_total` below the incumbent's and no
 //!    overlap of the two robots' low-confidence intervals (constraint 3).
 //! 3. The survivors sorted by `(T_total, k)`; the full constraints (the margin check of
@@ -100,16 +104,19 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::choose::repair;
+use crate::exact::SearchStats;
 use crate::problem::Problem;
-use tandem_realtime::{LcInterval, clock_end_s, tol};
+use tandem_realtime::{LcInterval, tol};
 
 use crate::schedule::Schedule;
-use crate::validate::{MarginCheck, validate, validate_full};
-use crate::{Error, Result};
+use crate::validate::{MarginCheck, validate_full};
+use crate::{Error, ExactParams, Result};
 
-/// Parameters of [`sample_schedule`]: what a user tunes. They are stored in the planner's
-/// state file and printed by `tandem params`; the benchmark-only alternatives measured in the
-/// module docs are [`SamplerBaselines`], which are never stored.
+/// Parameters of [`crate::sample_schedule`] (the sampler and, in [`SamplerParams::exact`], the
+/// exact search and completion it runs beside): what a user tunes. They are stored in the
+/// planner's state file and printed by `tandem params`; the benchmark-only alternatives
+/// measured in the module docs are [`SamplerBaselines`], which are never stored.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SamplerParams {
@@ -142,6 +149,10 @@ pub struct SamplerParams {
     /// costs up to ~0.5 s per re-schedule for nothing (see the module docs). ≥ 1.
     /// Default: `Some(64)`.
     pub max_margin_checks: Option<usize>,
+    /// The exact margin-free search (the lower bound `T*₀` every returned schedule is
+    /// certified against) and the margin-aware completion run beside the sampler as its
+    /// second opinion. Default: `ExactParams::default()`.
+    pub exact: ExactParams,
 }
 
 impl Default for SamplerParams {
@@ -154,6 +165,7 @@ impl Default for SamplerParams {
             p_fastest: 0.5,
             widen_max: 0.1,
             max_margin_checks: Some(64),
+            exact: ExactParams::default(),
         }
     }
 }
@@ -164,6 +176,7 @@ impl SamplerParams {
     /// # Errors
     /// [`Error::BadParam`] naming the field.
     pub fn validate(&self) -> Result<()> {
+        self.exact.validate()?;
         if self.samples == 0 {
             return Err(Error::BadParam {
                 name: "samples",
@@ -211,9 +224,15 @@ impl SamplerParams {
 ///
 /// They are not part of [`SamplerParams`] and have no serde form: an experiment never
 /// changes the user's state file or what `tandem params` prints. The default is the
-/// sampler's own design (what [`sample_schedule`] runs).
+/// sampler's own design with its second opinion (what [`crate::sample_schedule`] runs).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SamplerBaselines {
+    /// The sampler alone: no margin-aware completion beside it (the bound `T*₀` is still
+    /// computed for the certificate). For measuring the sampler itself.
+    pub sampler_only: bool,
+    /// The margin-aware completion alone: no candidate is sampled (the fallbacks stay). For
+    /// measuring the completion itself (the `certify` bench and example).
+    pub completion_only: bool,
     /// One independent factor per high-confidence reference sample instead of per piece of
     /// a run (the literal reading of §II-C; [`SamplerParams::pieces`] is then ignored).
     pub per_sample: bool,
@@ -226,6 +245,25 @@ pub struct SamplerBaselines {
     /// passes. `true`: check every cheap-feasible candidate within the margin budget (the
     /// straightforward baseline; the same result, slower).
     pub exhaustive_margins: bool,
+}
+
+impl SamplerBaselines {
+    /// The sampler alone, as designed ([`SamplerBaselines::sampler_only`]).
+    pub const SAMPLER_ONLY: SamplerBaselines = SamplerBaselines {
+        sampler_only: true,
+        completion_only: false,
+        per_sample: false,
+        drawn_offset: None,
+        margin_check: MarginCheck::SinglePass,
+        exhaustive_margins: false,
+    };
+
+    /// The margin-aware completion alone ([`SamplerBaselines::completion_only`]).
+    pub const COMPLETION_ONLY: SamplerBaselines = SamplerBaselines {
+        sampler_only: false,
+        completion_only: true,
+        ..SamplerBaselines::SAMPLER_ONLY
+    };
 }
 
 /// How a [`SamplerBaselines::drawn_offset`] candidate draws its offset `τ` from `v` uniform in
@@ -259,26 +297,8 @@ enum OffsetSampling {
     Fitted { widen_max: f64 },
 }
 
-/// Where the returned schedule came from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Source {
-    /// Sampled candidate number `candidate` (ChaCha8 stream of the seed).
-    Sampled {
-        /// Candidate index `k`.
-        candidate: u64,
-    },
-    /// The previous schedule's warps and offset, unchanged (still valid at the sampler's
-    /// tick, nothing better found).
-    Previous,
-    /// The previous schedule repaired for the new problem (gradients clamped into the new
-    /// bounds, new mean on low-confidence samples, `τ` clamped to `[0, |ψ_E1|]`).
-    RepairedPrevious,
-    /// The fastest serial schedule ([`Problem::serial_schedule`]).
-    Serial,
-}
-
-/// Counts of one sampler run (identical for a seed whatever the thread count).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+/// Counts of one scheduler run (identical for a seed whatever the thread count).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct SamplerStats {
     /// Candidates sampled.
     pub candidates: usize,
@@ -287,21 +307,10 @@ pub struct SamplerStats {
     /// Candidates whose full constraints (incl. margins) were decided in `(T_total, k)` order
     /// (the parallel loop may check up to a few more, whose results are discarded).
     pub margin_checks: usize,
-}
-
-/// The sampler's result.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Outcome {
-    /// The schedule; its [`Schedule::tick_s`] is the sampler's tick, at which it passes
-    /// [`crate::validate`].
-    pub schedule: Schedule,
-    /// Its `T_total` (Eq. 13), s: exactly `schedule.t_total_s(Δt_s)`, read from the one
-    /// clock.
-    pub t_total_s: f64,
-    /// Where it came from.
-    pub source: Source,
-    /// Counts.
-    pub stats: SamplerStats,
+    /// Margin checks (Alg. 2) the margin-aware completion ran ([`crate::ExactParams`]).
+    pub completion_margin_checks: usize,
+    /// Work counts of the exact search behind the bound.
+    pub search: SearchStats,
 }
 
 /// One piece of the reference with a fixed duration (low confidence) or a speed factor.
@@ -870,113 +879,21 @@ fn margin_ranks(len: usize, cap: usize) -> Vec<usize> {
     ranks
 }
 
-/// The previous schedule re-projected onto `problem` at control tick `tick_s` (s): gradients
-/// clamped into the new bounds, the new mean on low-confidence samples, `τ` clamped into
-/// `[0, |ψ_E1|]`. `None` for warps of the wrong length.
-fn repair(problem: &Problem, previous: &Schedule, tick_s: f64) -> Option<Schedule> {
-    let n_ref = problem.n_ref();
-    if previous.grad_exec.iter().any(|g| g.len() != n_ref) {
-        return None;
-    }
-    let warps = previous.grad_exec.each_ref().map(|g| {
-        (0..n_ref)
-            .map(|n| {
-                if problem.conf()[n] {
-                    let x = if g[n].is_finite() {
-                        g[n]
-                    } else {
-                        problem.grad_mean()[n]
-                    };
-                    x.clamp(problem.grad_min()[n], problem.grad_max()[n])
-                } else {
-                    problem.grad_mean()[n]
-                }
-            })
-            .collect::<Vec<f64>>()
-    });
-    let max_s = clock_end_s(&warps[0], 0.0, problem.dt_s());
-    let offset_s = if previous.offset_s.is_finite() {
-        previous.offset_s.clamp(0.0, max_s)
-    } else {
-        max_s
-    };
-    Some(Schedule {
-        grad_exec: warps,
-        offset_s,
-        tick_s,
-    })
-}
-
-/// The anytime sampler of §II-C (see the module docs for the distribution and the order of
-/// evaluation): the least-`T_total` schedule among the previous schedule (kept on ties), the
-/// fastest serial schedule and the `params.samples` sampled candidates (plus the warm-start
-/// ones) whose full check ran (at most `params.max_margin_checks`), that satisfies every
-/// constraint of Eq. 20 at the control tick `params.tick_s`.
+/// The sampler's winner (§II-C): the least `(T_total, k)` among the `params.samples` sampled
+/// candidates (plus the warm-start ones, robot 1 of `previous` repaired) that beat `bound_s`
+/// (s, the incumbent's `T_total`) and pass every constraint of Eq. 20 at `tick_s`, with at
+/// most `params.max_margin_checks` full checks (see the module docs); and its counts.
 ///
 /// Runs on the current rayon thread pool; the result for a seed is the same whatever the
 /// number of threads.
-///
-/// # Errors
-/// [`Error::BadParam`] for invalid parameters; [`Error::NoFeasibleSchedule`] if not even the
-/// serial schedule passes (which would mean the margin check rejects a schedule with no
-/// concurrent execution at all).
-pub fn sample_schedule(
-    problem: &Problem,
-    params: &SamplerParams,
-    previous: Option<&Schedule>,
-) -> Result<Outcome> {
-    sample_schedule_with_baselines(problem, params, &SamplerBaselines::default(), previous)
-}
-
-/// [`sample_schedule`] with benchmark-only alternatives to its design (see
-/// [`SamplerBaselines`]); `SamplerBaselines::default()` is [`sample_schedule`] itself.
-///
-/// # Errors
-/// As [`sample_schedule`].
-pub fn sample_schedule_with_baselines(
+pub(crate) fn run(
     problem: &Problem,
     params: &SamplerParams,
     baselines: &SamplerBaselines,
+    tick_s: f64,
     previous: Option<&Schedule>,
-) -> Result<Outcome> {
-    params.validate()?;
-    let tick_s = params.tick_s.unwrap_or(problem.dt_s());
-    let dt_s = problem.dt_s();
-
-    // 1. Incumbent.
-    let mut incumbent: Option<(Schedule, f64, Source)> = None;
-    if let Some(prev) = previous {
-        // The previous schedule is valid at its own tick; re-check it at this one.
-        let prev = Schedule {
-            tick_s,
-            ..prev.clone()
-        };
-        if validate(problem, &prev).is_ok() {
-            let t = prev.t_total_s(dt_s);
-            incumbent = Some((prev, t, Source::Previous));
-        } else if let Some(fixed) = repair(problem, &prev, tick_s)
-            && validate(problem, &fixed).is_ok()
-        {
-            let t = fixed.t_total_s(dt_s);
-            incumbent = Some((fixed, t, Source::RepairedPrevious));
-        }
-    }
-    let serial = problem.serial_schedule(tick_s)?;
-    let serial_t = serial.t_total_s(dt_s);
-    let serial_violation = if incumbent.as_ref().is_none_or(|inc| serial_t < inc.1) {
-        match validate(problem, &serial) {
-            Ok(()) => {
-                incumbent = Some((serial, serial_t, Source::Serial));
-                None
-            }
-            Err(v) => Some(v),
-        }
-    } else {
-        None
-    };
-    let bound_s = incumbent.as_ref().map_or(f64::INFINITY, |inc| inc.1);
-
-    // 2. Cheap checks, in parallel; collect keeps candidate order.
+    bound_s: f64,
+) -> (Option<Winner>, SamplerStats) {
     let sampler = Sampler::new(problem, params, baselines, tick_s, previous);
     let n_warm = if sampler.warm.is_some() {
         WARM_WIDEN.len()
@@ -993,14 +910,14 @@ pub fn sample_schedule_with_baselines(
         .collect();
     feasible.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let cheap_feasible = feasible.len();
-    // 3. Full constraints in (T_total, k) order.
+    // Full constraints in (T_total, k) order.
     if let Some(max) = params.max_margin_checks {
         feasible = margin_ranks(feasible.len(), max)
             .into_iter()
             .map(|r| feasible[r])
             .collect();
     }
-    let mut winner: Option<(Schedule, f64, u64)> = None;
+    let mut winner: Option<Winner> = None;
     let mut margin_checks = 0;
     if baselines.exhaustive_margins {
         let results: Vec<Option<(Schedule, f64)>> =
@@ -1028,29 +945,17 @@ pub fn sample_schedule_with_baselines(
             margin_checks += group.len();
         }
     }
-
     let stats = SamplerStats {
         candidates: params.samples,
         cheap_feasible,
         margin_checks,
+        ..SamplerStats::default()
     };
-    let chosen = match (winner, incumbent) {
-        (Some((_, t, _)), Some(inc)) if t >= inc.1 => inc,
-        (Some((s, t, k)), _) => (s, t, Source::Sampled { candidate: k }),
-        (None, Some(inc)) => inc,
-        (None, None) => {
-            return Err(Error::NoFeasibleSchedule {
-                serial: serial_violation.expect("the serial schedule was checked: no incumbent"),
-            });
-        }
-    };
-    Ok(Outcome {
-        schedule: chosen.0,
-        t_total_s: chosen.1,
-        source: chosen.2,
-        stats,
-    })
+    (winner, stats)
 }
+
+/// A sampled schedule that passed every constraint: schedule, `T_total` (s), candidate `k`.
+pub(crate) type Winner = (Schedule, f64, u64);
 
 #[cfg(test)]
 mod tests {

@@ -1,7 +1,8 @@
-//! The safety invariant end to end: schedules FOUND BY THE SAMPLER, run through
-//! `tandem_realtime::Coordinator` at their own tick under the full adversary set of
-//! `tandem_realtime::adversary` (extremes, switching, random, and Alg. 2's worst case per
-//! role), never have both robots low-confidence in the same control tick.
+//! The safety invariant end to end: schedules FOUND BY THE SCHEDULER (the sampler's winners
+//! and the margin-aware completions), run through `tandem_realtime::Coordinator` at their own
+//! tick under the full adversary set of `tandem_realtime::adversary` (extremes, switching,
+//! random, and Alg. 2's worst case per role), never have both robots low-confidence in the
+//! same control tick.
 
 mod common;
 
@@ -87,23 +88,34 @@ proptest! {
         };
         let out = sample_schedule_with_baselines(&p, &params, &baselines(fitted), None).unwrap();
         prop_assert_eq!(out.schedule.tick_s, tick_s);
-        for op in adversaries(&p, &out.schedule, seed) {
-            let hit = run(&p, &out.schedule, op, seed);
-            prop_assert!(
-                hit.is_none(),
-                "both LC at tick {:?} with {:?} (source {:?})", hit, op, out.source
-            );
+        // The completion's own schedule too, even where the sampler's wins.
+        let completion = SamplerBaselines { completion_only: true, ..baselines(fitted) };
+        let done = sample_schedule_with_baselines(&p, &params, &completion, None).unwrap();
+        prop_assert_eq!(done.schedule.tick_s, tick_s);
+        for out in [&out, &done] {
+            for op in adversaries(&p, &out.schedule, seed) {
+                let hit = run(&p, &out.schedule, op, seed);
+                prop_assert!(
+                    hit.is_none(),
+                    "both LC at tick {:?} with {:?} (source {:?})", hit, op, out.source
+                );
+            }
         }
     }
 }
 
-/// The proptest above must exercise sampled (overlapping) schedules, not only serial ones.
+/// The proptest above must exercise sampled and completed (overlapping) schedules, not only
+/// serial ones.
 #[test]
 fn most_random_problems_get_sampled_schedules() {
     for fitted in [false, true] {
         let mut runner = proptest::test_runner::TestRunner::deterministic();
         let strategy = random_problem();
-        let mut sampled = 0;
+        let sampler_only = SamplerBaselines {
+            sampler_only: true,
+            ..baselines(fitted)
+        };
+        let (mut sampled, mut completed) = (0, 0);
         for seed in 0..40 {
             let p = strategy.new_tree(&mut runner).unwrap().current();
             let params = SamplerParams {
@@ -111,15 +123,26 @@ fn most_random_problems_get_sampled_schedules() {
                 seed,
                 ..SamplerParams::default()
             };
-            let out =
-                sample_schedule_with_baselines(&p, &params, &baselines(fitted), None).unwrap();
-            if matches!(out.source, Source::Sampled { .. }) {
-                sampled += 1;
-                for op in adversaries(&p, &out.schedule, seed) {
-                    assert_eq!(run(&p, &out.schedule, op, seed), None, "{op:?}");
+            let out = sample_schedule_with_baselines(&p, &params, &sampler_only, None).unwrap();
+            let completion = SamplerBaselines {
+                completion_only: true,
+                ..baselines(fitted)
+            };
+            let done = sample_schedule_with_baselines(&p, &params, &completion, None).unwrap();
+            for (out, source) in [(&out, &mut sampled), (&done, &mut completed)] {
+                if matches!(out.source, Source::Sampled { .. } | Source::Completed) {
+                    *source += 1;
+                    for op in adversaries(&p, &out.schedule, seed) {
+                        assert_eq!(run(&p, &out.schedule, op, seed), None, "{op:?}");
+                    }
                 }
             }
         }
+        eprintln!("fitted {fitted}: {completed} of 40 completed");
+        assert!(
+            completed >= 12,
+            "fitted {fitted}: only {completed} of 40 completed"
+        );
         eprintln!("fitted {fitted}: {sampled} of 40 sampled");
         // Fitted robot 2 keeps 2 ticks + 10 % clear around each region, a lot on these
         // problems of a few dozen 10 ms samples, so fewer beat the serial schedule there.

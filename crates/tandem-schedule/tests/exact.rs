@@ -1,4 +1,5 @@
-//! The exact margin-free search and the certified completion through the public API.
+//! The exact margin-free search, the margin-aware completion and the scheduler that chooses
+//! between it, the sampler and the fallbacks, through the public API.
 
 mod common;
 #[path = "../benches/support/fixture.rs"]
@@ -10,9 +11,27 @@ mod fixture;
 
 use proptest::prelude::*;
 use tandem_schedule::{
-    CertifiedSource, ExactParams, Problem, SamplerParams, Violation, certify, earliest_schedule,
-    sample_schedule, solve_exact, validate,
+    ExactParams, Outcome, Problem, SamplerBaselines, SamplerParams, Source, Violation,
+    earliest_schedule, sample_schedule, sample_schedule_with_baselines, solve_exact, validate,
 };
+
+/// The completion alone (no sampled candidate), with `exact`.
+fn complete(p: &Problem, exact: ExactParams) -> Outcome {
+    let params = SamplerParams {
+        exact,
+        ..SamplerParams::default()
+    };
+    sample_schedule_with_baselines(p, &params, &SamplerBaselines::COMPLETION_ONLY, None).unwrap()
+}
+
+/// The certificate's fields agree with the schedule and the bound.
+fn check_certificate(p: &Problem, out: &Outcome) {
+    assert_eq!(validate(p, &out.schedule), Ok(()));
+    assert_eq!(out.t_total_s, out.schedule.t_total_s(p.dt_s()));
+    assert!(out.lower_bound_s <= out.t_total_s);
+    assert!(out.gap >= 0.0);
+    assert!((out.gap - (out.t_total_s - out.lower_bound_s) / out.lower_bound_s).abs() <= 1e-12);
+}
 
 /// Every machine order with `m` runs per robot (robot of each LC run in time order).
 fn all_orders(m: usize) -> Vec<Vec<usize>> {
@@ -125,20 +144,24 @@ proptest! {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
 
-    /// Every certified schedule passes `validate` (margins included), lies above the bound,
-    /// and is never worse than the incumbent it was given.
+    /// Every schedule the scheduler returns passes `validate` (margins included), lies above
+    /// the proven bound, is never worse than the sampler alone with the same seed nor than the
+    /// completion alone, and says where it came from.
     #[test]
-    fn certified_schedules_pass_validate_and_beat_the_incumbent(p in small_problem(), seed in 0u64..4) {
-        let sampled = sample_schedule(&p, &SamplerParams { samples: 200, seed, ..SamplerParams::default() }, None).unwrap();
-        let cert = certify(&p, &ExactParams::default(), Some(&sampled.schedule)).unwrap();
-        prop_assert_eq!(validate(&p, &cert.schedule), Ok(()));
-        prop_assert!((cert.schedule.t_total_s(p.dt_s()) - cert.t_total_s).abs() <= 1e-12);
-        prop_assert!(cert.t_total_s <= sampled.t_total_s);
-        prop_assert!(cert.t_total_s >= cert.lower_bound_s);
-        prop_assert!(cert.bound_is_optimum);
-        prop_assert!(cert.gap >= 0.0);
+    fn scheduled_schedules_pass_validate_and_beat_the_sampler(p in small_problem(), seed in 0u64..4) {
+        let params = SamplerParams { samples: 200, seed, ..SamplerParams::default() };
+        let alone = sample_schedule_with_baselines(&p, &params, &SamplerBaselines::SAMPLER_ONLY, None).unwrap();
+        let both = sample_schedule(&p, &params, None).unwrap();
+        let done = complete(&p, ExactParams::default());
+        for out in [&alone, &both, &done] {
+            check_certificate(&p, out);
+            prop_assert!(out.bound_is_optimum);
+        }
+        prop_assert!(both.t_total_s <= alone.t_total_s);
+        prop_assert!(both.t_total_s <= done.t_total_s);
+        prop_assert!(both.source == alone.source || both.source == Source::Completed);
         let free = solve_exact(&p, &ExactParams::default()).unwrap();
-        prop_assert!((cert.lower_bound_s - free.lower_bound_s).abs() <= 1e-9 * free.lower_bound_s.max(1.0));
+        prop_assert!((both.lower_bound_s - free.lower_bound_s).abs() <= 1e-9 * free.lower_bound_s.max(1.0));
     }
 }
 
@@ -171,22 +194,22 @@ fn alternation_by_hand() {
 #[test]
 fn certificate_by_hand() {
     let p = lhl();
-    let cert = certify(&p, &ExactParams::default(), None).unwrap();
-    assert_eq!(validate(&p, &cert.schedule), Ok(()));
-    assert!(cert.bound_is_optimum);
-    assert!((cert.lower_bound_s - 0.4).abs() < 1e-12);
+    let out = complete(&p, ExactParams::default());
+    check_certificate(&p, &out);
+    assert!(out.bound_is_optimum);
+    assert!((out.lower_bound_s - 0.4).abs() < 1e-12);
     // Never worse than serial (here the margins leave no room to overlap the robots).
-    assert!(cert.t_total_s <= 0.5 + 1e-12);
-    assert!((cert.gap - (cert.t_total_s - 0.4) / 0.4).abs() < 1e-12);
+    assert!(out.t_total_s <= 0.5 + 1e-12);
     // No completion allowed: the serial schedule, with the same bound.
     let none = ExactParams {
         max_margin_checks: 0,
         ..ExactParams::default()
     };
-    let cert = certify(&p, &none, None).unwrap();
-    assert_eq!(cert.source, CertifiedSource::Serial);
-    assert!((cert.t_total_s - 0.5).abs() < 1e-12);
-    assert!((cert.gap - 0.25).abs() < 1e-12);
+    let out = complete(&p, none);
+    assert_eq!(out.source, Source::Serial);
+    assert!((out.t_total_s - 0.5).abs() < 1e-12);
+    assert!((out.gap - 0.25).abs() < 1e-12);
+    assert_eq!(out.stats.completion_margin_checks, 0);
 }
 
 #[test]
@@ -202,9 +225,9 @@ fn out_of_budget_gives_the_simple_bound() {
     assert!(!free.proven_optimal);
     assert!(free.schedule.is_none());
     assert!((free.lower_bound_s - 0.4).abs() < 1e-12);
-    let cert = certify(&p, &tiny, None).unwrap();
-    assert!(!cert.bound_is_optimum);
-    assert_eq!(validate(&p, &cert.schedule), Ok(()));
+    let out = complete(&p, tiny);
+    assert!(!out.bound_is_optimum);
+    check_certificate(&p, &out);
 }
 
 #[test]
@@ -213,35 +236,38 @@ fn no_low_confidence_means_both_fastest_at_once() {
     let free = solve_exact(&p, &ExactParams::default()).unwrap();
     assert!((free.lower_bound_s - 0.25).abs() < 1e-12);
     assert!(free.order.is_empty());
-    let cert = certify(&p, &ExactParams::default(), None).unwrap();
-    assert_eq!(validate(&p, &cert.schedule), Ok(()));
-    assert!((cert.t_total_s - 0.25).abs() < 1e-12);
-    assert_eq!(cert.gap, 0.0);
+    let out = complete(&p, ExactParams::default());
+    check_certificate(&p, &out);
+    assert_eq!(out.source, Source::Completed);
+    assert!((out.t_total_s - 0.25).abs() < 1e-12);
+    assert_eq!(out.gap, 0.0);
 }
 
 #[test]
 fn bad_parameters_are_errors() {
     let p = lhl();
-    for bad in [
-        ExactParams {
-            tick_s: Some(0.0),
-            ..ExactParams::default()
-        },
-        ExactParams {
-            tick_s: Some(f64::NAN),
-            ..ExactParams::default()
-        },
-        ExactParams {
-            max_pieces: 0,
-            ..ExactParams::default()
-        },
-    ] {
-        assert!(matches!(
-            solve_exact(&p, &bad),
-            Err(tandem_schedule::Error::BadParam { .. })
-        ));
-        assert!(certify(&p, &bad, None).is_err());
-    }
+    let bad = ExactParams {
+        max_pieces: 0,
+        ..ExactParams::default()
+    };
+    assert!(matches!(
+        solve_exact(&p, &bad),
+        Err(tandem_schedule::Error::BadParam {
+            name: "max_pieces",
+            ..
+        })
+    ));
+    let params = SamplerParams {
+        exact: bad,
+        ..SamplerParams::default()
+    };
+    assert!(matches!(
+        sample_schedule(&p, &params, None),
+        Err(tandem_schedule::Error::BadParam {
+            name: "max_pieces",
+            ..
+        })
+    ));
 }
 
 /// Fragmented confidence like mid-study: `islands` one-sample LC islands spread over three
@@ -283,10 +309,10 @@ fn fragmented_problems_are_solved_exactly_and_certified() {
         let s = free.schedule.as_ref().unwrap();
         assert!(margin_free_valid(&p, s).is_ok());
         assert!((s.t_total_s(0.01) - free.lower_bound_s).abs() < 1e-6);
-        let cert = certify(&p, &ExactParams::default(), None).unwrap();
-        assert_eq!(validate(&p, &cert.schedule), Ok(()));
-        assert!(cert.t_total_s >= free.lower_bound_s - 1e-9);
-        assert!(cert.t_total_s <= p.serial_schedule(0.01).unwrap().t_total_s(0.01));
+        let out = complete(&p, ExactParams::default());
+        check_certificate(&p, &out);
+        assert!(out.t_total_s >= free.lower_bound_s - 1e-9);
+        assert!(out.t_total_s <= p.serial_schedule(0.01).unwrap().t_total_s(0.01));
     }
 }
 
@@ -298,11 +324,32 @@ fn fixture_problem_bound_matches_all_orders_and_the_certificate_passes() {
     let free = solve_exact(&p, &ExactParams::default()).unwrap();
     let brute = brute_force(&p, m).unwrap();
     assert!((free.lower_bound_s - brute).abs() < 1e-9 * brute, "{label}");
-    let cert = certify(&p, &ExactParams::default(), None).unwrap();
-    assert_eq!(validate(&p, &cert.schedule), Ok(()));
-    assert!(cert.bound_is_optimum);
-    assert_eq!(cert.source, CertifiedSource::Completed);
-    // Issue #15 asks for 0.6 % on this problem (measured: 0.49 %, docs/decisions.md); 1 % leaves
-    // room for a regenerated fixture while still catching a completion that falls apart.
-    assert!(cert.gap < 0.01, "{label}: gap {}", cert.gap);
+    let out = complete(&p, ExactParams::default());
+    check_certificate(&p, &out);
+    assert!(out.bound_is_optimum);
+    assert_eq!(out.source, Source::Completed);
+    // Issue #15 asks for 0.6 % on the problem it measured (the fixture before its
+    // regeneration: 0.45 % now); on the regenerated fixture, with wider gradient bounds, the
+    // margins cost more (0.72 %, docs/decisions.md). 1 % catches a completion that falls apart.
+    assert!(out.gap < 0.01, "{label}: gap {}", out.gap);
+}
+
+#[test]
+fn same_seed_same_outcome_with_1_and_2_threads() {
+    let (p, _) = fixture::mid_study_problem();
+    let params = SamplerParams {
+        samples: 500,
+        seed: 3,
+        ..SamplerParams::default()
+    };
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| sample_schedule(&p, &params, None).unwrap())
+    };
+    let one = run(1);
+    assert_eq!(one, run(2));
+    check_certificate(&p, &one);
 }

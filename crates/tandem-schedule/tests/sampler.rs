@@ -1,11 +1,13 @@
-//! The anytime sampler (§II-C) through the public API.
+//! The anytime sampler (§II-C) through the public API: the sampler alone
+//! (`SamplerBaselines::sampler_only`), as the benchmarks measure it; the scheduler with the
+//! completion beside it is tested in `tests/exact.rs`.
 
 mod common;
 
 use proptest::prelude::*;
 use tandem_schedule::{
-    DrawnOffset, MarginCheck, Problem, SamplerBaselines, SamplerParams, Schedule, Source,
-    sample_schedule, sample_schedule_with_baselines, validate,
+    DrawnOffset, ExactParams, MarginCheck, Problem, SamplerBaselines, SamplerParams, Schedule,
+    Source, sample_schedule_with_baselines, validate,
 };
 
 /// `n` samples, low confidence on `lc`, bounds `[lo, hi]`×mean around a wobbling mean.
@@ -20,6 +22,19 @@ fn problem(n: usize, lc: &[std::ops::Range<usize>], lo: f64, hi: f64) -> Problem
         0.01,
     )
     .unwrap()
+}
+
+/// The sampler alone (no completion beside it).
+fn sample_schedule(
+    p: &Problem,
+    params: &SamplerParams,
+    previous: Option<&Schedule>,
+) -> tandem_schedule::Result<tandem_schedule::Outcome> {
+    sample_schedule_with_baselines(p, params, &sampler_only(), previous)
+}
+
+fn sampler_only() -> SamplerBaselines {
+    SamplerBaselines::SAMPLER_ONLY
 }
 
 fn params(samples: usize, seed: u64) -> SamplerParams {
@@ -69,7 +84,7 @@ proptest! {
             } else {
                 DrawnOffset::UniformFeasible
             }),
-            ..SamplerBaselines::default()
+            ..sampler_only()
         };
         let out = sample_schedule_with_baselines(&p, &params, &baselines, None).unwrap();
         // The schedule carries the sampler's tick and is valid at it.
@@ -153,7 +168,7 @@ fn lazy_and_exhaustive_margins_agree_with_both_checks() {
         let baselines = SamplerBaselines {
             margin_check,
             exhaustive_margins,
-            ..SamplerBaselines::default()
+            ..sampler_only()
         };
         let out = sample_schedule_with_baselines(&p, &base, &baselines, None).unwrap();
         assert_eq!(out.schedule, lazy.schedule);
@@ -247,6 +262,17 @@ fn bad_params_are_rejected() {
     for bad in [
         SamplerParams {
             samples: 0,
+            ..SamplerParams::default()
+        },
+        SamplerParams {
+            samples: 0,
+            ..SamplerParams::default()
+        },
+        SamplerParams {
+            exact: ExactParams {
+                max_pieces: 0,
+                ..ExactParams::default()
+            },
             ..SamplerParams::default()
         },
         SamplerParams {

@@ -166,6 +166,9 @@ pub struct IterationRecord {
 pub enum ScheduleSource {
     /// A candidate of the anytime sampler (`Source::Sampled`): `sampled`.
     Sampled,
+    /// The margin-aware completion of the exact margin-free optimum (`Source::Completed`):
+    /// `completed`.
+    Completed,
     /// The previous schedule, unchanged (`Source::Previous`): `previous`.
     Previous,
     /// The previous schedule re-projected onto the new problem (`Source::RepairedPrevious`):
@@ -180,6 +183,7 @@ impl ScheduleSource {
     pub fn name(self) -> &'static str {
         match self {
             Self::Sampled => "sampled",
+            Self::Completed => "completed",
             Self::Previous => "previous",
             Self::Repaired => "repaired",
             Self::Serial => "serial",
@@ -191,6 +195,7 @@ impl From<Source> for ScheduleSource {
     fn from(source: Source) -> Self {
         match source {
             Source::Sampled { .. } => Self::Sampled,
+            Source::Completed => Self::Completed,
             Source::Previous => Self::Previous,
             Source::RepairedPrevious => Self::Repaired,
             Source::Serial => Self::Serial,

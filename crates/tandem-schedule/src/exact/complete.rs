@@ -1,64 +1,85 @@
-//! Margin-aware completion: clearances between the robots' LC runs found with the margin check
-//! as the oracle (see "Margin-aware completion" in the module docs of [`super`]).
+//! Margin-aware completion: clearances between the robots' LC runs derived from the margin
+//! check's own worst-case slacks (`tandem_realtime::pair_slacks`), placed by the exact search,
+//! iterated (see "Margin-aware completion" in the module docs of [`super`]).
+
+use std::collections::BTreeMap;
 
 use rayon::prelude::*;
-use tandem_realtime::{Timeline, sufficient_margins};
+use tandem_realtime::pair_slacks;
 
 use super::chain::Chain;
 use super::search::{self, Clearance, Robot};
 use super::shape::{Shaping, shaped_schedule};
-use super::stn::{self, Times};
+use super::stn;
 use crate::problem::Problem;
 use crate::schedule::Schedule;
-use crate::validate::validate;
 
-/// Growth factor of the uniform clearance between tries, in units of the maximal step `M`.
-const GROWTH: f64 = 1.5;
-/// First uniform clearance tried, in units of `M`.
-const FIRST_CLEARANCE_M: f64 = 2.0;
-/// Bisection steps on the uniform clearance once a passing one is known.
-const UNIFORM_STEPS: usize = 3;
-/// Bisection rounds of the per-pair clearances.
-const PAIR_ROUNDS: usize = 4;
-
-/// A schedule the margin check accepted, with its `T_total` (s).
+/// A schedule whose margins the check accepted, with its `T_total` (s).
 #[derive(Clone, Debug)]
 pub(crate) struct Completed {
     pub(crate) schedule: Schedule,
     pub(crate) t_total_s: f64,
 }
 
-/// One candidate: clearances, machine order, times and shaped schedule.
-#[derive(Clone, Debug)]
-struct Candidate {
-    clear: Clearance,
-    order: Vec<Robot>,
-    times: Times,
-    schedule: Schedule,
-}
+/// Tilts of the HC body shaping tried from a cold start ([`Shaping::tilt`]): one factor per
+/// run, and two steps towards "slow first, fast last".
+const FIRST_TILTS: [f64; 3] = [0.0, 0.25, 0.5];
 
-/// The completion's context.
+/// Margin checks every start gets before the two most promising continue: enough for most
+/// iterations to reach a first passing schedule (docs/decisions.md).
+const FIRST_ROUND: usize = 4;
+
+/// The completion's context: the problem, its chain and the margin check's scale.
 pub(crate) struct Completion<'a> {
     problem: &'a Problem,
     chain: &'a Chain,
     tick_s: f64,
-    /// `M`: the largest step (schedule-clock s) of any robot in one tick, with HC samples kept
-    /// at `F ≤ f_cap`.
+    /// `M` (schedule-clock s): `tick_s · max(1, largest F = ψ̇̄/ψ̇min of an LC sample)`, the
+    /// least maximal step in one tick of any schedule (LC samples run at the mean); the check
+    /// needs `c` at least that far short of its LC run when `p` leaves its own.
     max_step_s: f64,
-    knobs: Shaping,
     /// `ε` of the "robot 2 starts after robot 1's run ended" exception (s).
     after_start_s: f64,
     /// Piece budget of each search.
     max_pieces: usize,
-    /// Margin checks spent.
-    pub(crate) checks: usize,
+}
+
+/// One clearance iteration (at one tilt, from one start), resumable: its clearances, every
+/// pair's search state, the last order, the best schedule found and the checks spent.
+#[derive(Clone, Debug)]
+struct Trial {
+    tilt: f64,
+    clear: Clearance,
+    pairs: BTreeMap<(usize, usize), PairState>,
+    order: Option<Vec<Robot>>,
+    best: Option<Completed>,
+    checks: usize,
+    /// Whether the iteration stopped by itself (no clearance moves, or no order left).
+    done: bool,
+}
+
+impl Trial {
+    fn new(tilt: f64, clear: Clearance) -> Trial {
+        Trial {
+            tilt,
+            clear,
+            pairs: BTreeMap::new(),
+            order: None,
+            best: None,
+            checks: 0,
+            done: false,
+        }
+    }
+
+    /// `T_total` (s) of the best schedule found, `+∞` if none.
+    fn t_total_s(&self) -> f64 {
+        self.best.as_ref().map_or(f64::INFINITY, |b| b.t_total_s)
+    }
 }
 
 impl<'a> Completion<'a> {
     /// The completion of `problem` (whose chain is `chain`) for the margin check at `tick_s`
-    /// (s). `M = tick_s·F*` with `F*` the largest `F = ψ̇̄/ψ̇min` of an LC sample, which the
-    /// shaping keeps as the largest `F` of any sample unless a run's duration needs more; the
-    /// shaping's knobs are multiples of `M` (tuned on the fixture problem, docs/decisions.md).
+    /// (s), each search holding at most `max_pieces` pieces.
     pub(crate) fn new(
         problem: &'a Problem,
         chain: &'a Chain,
@@ -66,304 +87,330 @@ impl<'a> Completion<'a> {
         max_pieces: usize,
     ) -> Self {
         let (gmean, gmin) = (problem.grad_mean(), problem.grad_min());
-        let f_cap = (0..problem.n_ref())
+        let f_lc = (0..problem.n_ref())
             .filter(|&n| !problem.conf()[n])
             .map(|n| gmean[n] / gmin[n])
             .fold(1.0, f64::max);
-        let max_step_s = tick_s * f_cap;
         let scale = 2.0 * chain.slowest_s().max(1.0);
         Completion {
             problem,
             chain,
             tick_s,
-            max_step_s,
-            knobs: Shaping {
-                window_s: 2.0 * max_step_s,
-                zone_s: 20.0 * max_step_s,
-                edge_s: 2.0 * max_step_s,
-                f_cap,
-            },
+            max_step_s: tick_s * f_lc,
             after_start_s: 1e-6 * scale,
             max_pieces,
-            checks: 0,
         }
     }
 
-    /// Uniform clearance `delta_s` before every LC run that follows the other robot's.
-    fn uniform(&self, delta_s: f64) -> Clearance {
-        let m = self.chain.n_lc();
-        Clearance {
-            before: [vec![delta_s; m], vec![delta_s; m]],
-            after_start: Some(self.after_start_s),
-        }
-    }
-
-    /// The candidate for clearances `clear`: the best order found by the search (below
-    /// `cap_s`) when `order` is `None`, its earliest times and shaped speeds.
-    fn candidate(
+    /// The least-`T_total` schedule this completion finds that the margin check accepts and
+    /// that beats `cap_s`, spending at most `budget` margin checks; with the number spent.
+    ///
+    /// Clearance iterations from several starts: with `cold`, one per tilt of [`FIRST_TILTS`]
+    /// from every clearance at `M`; and one per schedule of `warm` (schedules that pass the
+    /// check, e.g. the previous one or the sampler's), at tilt 0, from the clearances that
+    /// schedule keeps between its pairs and no other pair allowed (so the search starts from
+    /// that schedule's order). All run [`FIRST_ROUND`] checks in parallel; then the two best
+    /// (least `T_total`, unfinished first) continue in parallel with the rest of the budget.
+    pub(crate) fn run(
         &self,
-        clear: Clearance,
-        order: Option<&[Robot]>,
         cap_s: f64,
-    ) -> Option<Candidate> {
-        self.candidate_upto(clear, order, cap_s, None)
-    }
-
-    /// [`Completion::candidate`]; with `keep = Some(((r, k), base))`, only the HC runs entered
-    /// before robot `r`'s LC run `k` starts (plus the shaping window) are shaped, the later ones
-    /// keep `base`'s gradients (enough for the margin check of the LC runs up to that one).
-    fn candidate_upto(
-        &self,
-        clear: Clearance,
-        order: Option<&[Robot]>,
-        cap_s: f64,
-        keep: Option<((usize, usize), &Schedule)>,
-    ) -> Option<Candidate> {
-        let order = match order {
-            Some(o) => o.to_vec(),
-            None => match search::search(self.chain, &clear, cap_s, self.max_pieces).0 {
-                search::Outcome::Done(Some(found)) => found.order,
-                _ => return None,
-            },
-        };
-        let times = stn::earliest(self.chain, &order, &clear)?;
-        let keep = keep.map(|((r, k), base)| (times.lc_start_s[r][k] + self.knobs.window_s, base));
-        let schedule = shaped_schedule(
-            self.problem,
-            self.chain,
-            &times,
-            &self.knobs,
-            keep,
-            self.tick_s,
-        );
-        Some(Candidate {
-            clear,
-            order,
-            times,
-            schedule,
-        })
-    }
-
-    /// The margin check on the candidate's LC runs up to machine position `upto` (later LC
-    /// runs count as HC; all of them when `None`).
-    fn margins_pass(&self, c: &Candidate, upto: Option<usize>) -> bool {
-        let p = self.problem;
-        let mut conf = [p.conf().to_vec(), p.conf().to_vec()];
-        if let Some(q) = upto {
-            let mut seen = [0usize; 2];
-            for (pos, &r) in c.order.iter().enumerate() {
-                let r = usize::from(r);
-                let k = seen[r];
-                seen[r] += 1;
-                if pos > q {
-                    let (a, b) = self.chain.lc_ref[k];
-                    conf[r][a..b].fill(true);
-                }
-            }
-        }
-        let starts = c.schedule.starts_s();
-        let build = |r: usize| {
-            Timeline::new(
-                &conf[r],
-                &c.schedule.grad_exec[r],
-                p.grad_min(),
-                p.grad_max(),
-                starts[r],
-                p.dt_s(),
-            )
-        };
-        match (build(0), build(1)) {
-            (Ok(a), Ok(b)) => sufficient_margins(&[a, b], self.tick_s).unwrap_or(false),
-            _ => false,
-        }
-    }
-
-    /// The full constraints of Eq. 20 at the completion's tick.
-    fn valid(&self, c: &Candidate) -> bool {
-        validate(self.problem, &c.schedule).is_ok()
-    }
-
-    /// The least-`T_total` schedule this completion finds that passes every constraint of
-    /// Eq. 20 and beats `cap_s`, spending at most `budget` margin checks.
-    pub(crate) fn run(&mut self, cap_s: f64, budget: usize) -> Option<Completed> {
-        let dt = self.problem.dt_s();
-        let m_step = self.max_step_s;
-        // Phase 1: a uniform clearance, grown geometrically (two tries at a time) until one
-        // passes; if the clearances grow too large for any order to beat the cap first, the
-        // stretch between the last failure and that size is bisected instead.
-        let mut fail = 0.0;
-        let mut pass: Option<(f64, Candidate)> = None;
-        let mut too_big: Option<f64> = None;
-        let mut delta = FIRST_CLEARANCE_M * m_step;
-        while pass.is_none() && too_big.is_none() && self.checks + 2 <= budget {
-            let deltas = [delta, delta * GROWTH];
-            let tried: Vec<Option<(Candidate, bool)>> = deltas
-                .par_iter()
-                .map(|&d| {
-                    let c = self.candidate(self.uniform(d), None, cap_s)?;
-                    let ok = self.margins_pass(&c, None);
-                    Some((c, ok))
-                })
-                .collect();
-            self.checks += tried.iter().filter(|t| t.is_some()).count();
-            for (d, t) in deltas.iter().zip(tried) {
-                match t {
-                    Some((c, true)) => {
-                        pass = Some((*d, c));
-                        break;
-                    }
-                    Some((_, false)) => fail = *d,
-                    None => {
-                        too_big = Some(*d);
-                        break;
-                    }
-                }
-            }
-            delta *= GROWTH * GROWTH;
-        }
-        if let (None, Some(mut hi)) = (&pass, too_big) {
-            for _ in 0..UNIFORM_STEPS {
-                if self.checks >= budget {
-                    break;
-                }
-                let mid = 0.5 * (fail + hi);
-                match self.candidate(self.uniform(mid), None, cap_s) {
-                    Some(c) => {
-                        self.checks += 1;
-                        if self.margins_pass(&c, None) {
-                            pass = Some((mid, c));
-                            break;
-                        }
-                        fail = mid;
-                    }
-                    None => hi = mid,
-                }
-            }
-        }
-        let (mut pass_delta, mut best) = pass?;
-        // Per-pair refinement follows when the budget allows it: it starts from the passing
-        // uniform clearance, so the uniform bisection is skipped then.
-        let pairs = self.cross_pairs(&best);
-        let refine = !pairs.is_empty() && self.checks + PAIR_ROUNDS * pairs.len() < budget;
-        for _ in 0..if refine { 0 } else { UNIFORM_STEPS } {
-            if self.checks >= budget {
-                break;
-            }
-            let mid = 0.5 * (fail + pass_delta);
-            self.checks += 1;
-            match self.candidate(self.uniform(mid), None, cap_s) {
-                Some(c) if self.margins_pass(&c, None) => {
-                    pass_delta = mid;
-                    best = c;
-                }
-                _ => fail = mid,
-            }
-        }
-        // Phase 2: per-pair clearances on the winner's order, every pair bisected at once
-        // (each on the margin check of the LC runs up to its own), while the budget lasts.
-        if refine && let Some(better) = self.refine(&best, &pairs, m_step, budget) {
-            best = better;
-        }
-        // Constraints 1–4 hold by construction (earliest times, gradients in bounds, the mean
-        // on LC samples); the full check confirms it, and the margins.
-        if !self.valid(&best) {
-            return None;
-        }
-        let t = best.schedule.t_total_s(dt);
-        (t < cap_s).then_some(Completed {
-            schedule: best.schedule,
-            t_total_s: t,
-        })
-    }
-
-    /// Machine positions `q` whose LC run follows the other robot's and needs a clearance:
-    /// `(q, robot, run index)`. Robot 2's first run is left out when robot 2 starts after the
-    /// previous run ended (the margin check accepts such pairs without simulating them).
-    fn cross_pairs(&self, c: &Candidate) -> Vec<(usize, usize, usize)> {
-        let mut out = Vec::new();
-        let mut seen = [0usize; 2];
-        let mut prev: Option<(usize, usize)> = None;
-        for (q, &r) in c.order.iter().enumerate() {
-            let r = usize::from(r);
-            let k = seen[r];
-            seen[r] += 1;
-            if let Some((pr, pk)) = prev
-                && pr != r
-            {
-                let prev_end = c.times.lc_start_s[pr][pk] + self.chain.lc_s[pk];
-                let exempt = r == 1 && k == 0 && c.times.tau_s >= prev_end + self.after_start_s;
-                if !exempt {
-                    out.push((q, r, k));
-                }
-            }
-            prev = Some((r, k));
-        }
-        out
-    }
-
-    /// Bisects every pair's clearance between `M` (the margin check's own step: never enough)
-    /// and its current value, all pairs at once per round; keeps the result if the full check
-    /// accepts it (after one widening by the last bisection step if needed).
-    fn refine(
-        &mut self,
-        best: &Candidate,
-        pairs: &[(usize, usize, usize)],
-        m_step: f64,
         budget: usize,
-    ) -> Option<Candidate> {
-        let mut hi: Vec<f64> = pairs
+        cold: bool,
+        warm: &[&Schedule],
+    ) -> (Option<Completed>, usize) {
+        let mut trials: Vec<Trial> = Vec::new();
+        if cold {
+            let all = Clearance::uniform(self.max_step_s, Some(self.after_start_s));
+            trials.extend(FIRST_TILTS.iter().map(|&t| Trial::new(t, all.clone())));
+        }
+        trials.extend(
+            warm.iter()
+                .filter_map(|s| Some(Trial::new(0.0, self.clearances_of(s)?))),
+        );
+        if budget == 0 || trials.is_empty() {
+            return (None, 0);
+        }
+        let first = FIRST_ROUND.min(budget / trials.len()).max(1);
+        trials
+            .par_iter_mut()
+            .for_each(|t| self.iterate(t, cap_s, first));
+        let mut spent: usize = trials.iter().map(|t| t.checks).sum();
+        // The two most promising continue: unfinished before finished, then by T_total (the
+        // start order on ties).
+        let mut rank: Vec<usize> = (0..trials.len()).collect();
+        rank.sort_by(|&a, &b| {
+            let (ta, tb) = (&trials[a], &trials[b]);
+            ta.done
+                .cmp(&tb.done)
+                .then(ta.t_total_s().total_cmp(&tb.t_total_s()))
+        });
+        rank.truncate(2);
+        rank.retain(|&i| !trials[i].done);
+        if spent < budget && !rank.is_empty() {
+            let share = (budget - spent) / rank.len();
+            let mut go: Vec<Trial> = rank.iter().map(|&i| trials[i].clone()).collect();
+            go.par_iter_mut()
+                .for_each(|t| self.iterate(t, cap_s, t.checks + share));
+            for (&i, t) in rank.iter().zip(go) {
+                spent += t.checks - trials[i].checks;
+                trials[i] = t;
+            }
+        }
+        let best = trials
             .iter()
-            .map(|&(_, r, k)| best.clear.before[r][k])
-            .collect();
-        let mut lo: Vec<f64> = hi.iter().map(|&h| m_step.min(h)).collect();
-        let with = |vals: &[f64]| {
-            let mut clear = best.clear.clone();
-            for (&(_, r, k), &v) in pairs.iter().zip(vals) {
-                clear.before[r][k] = v;
+            .filter(|t| t.best.is_some())
+            .min_by(|a, b| a.t_total_s().total_cmp(&b.t_total_s()));
+        (best.and_then(|t| t.best.clone()), spent)
+    }
+
+    /// The clearances `schedule` keeps: for every two consecutive LC regions of different
+    /// robots, the time from the end of the earlier to the start of the later (s), by the
+    /// pair `(j, k)` of their runs (the larger if the pair comes twice); every other pair
+    /// forbidden (infinite clearance). `None` if the schedule cannot be laid out, has no such
+    /// pair, or overlaps.
+    fn clearances_of(&self, schedule: &Schedule) -> Option<Clearance> {
+        let tl = schedule.timelines(self.problem).ok()?;
+        let mut regions: Vec<(f64, f64, usize, usize)> = Vec::new();
+        for (r, t) in tl.iter().enumerate() {
+            for iv in t.lc_intervals() {
+                regions.push((iv.start_s, iv.end_s, r, self.lc_index(iv.ref_start)?));
             }
-            clear
+        }
+        regions.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+        let mut clear = Clearance::uniform(f64::INFINITY, Some(self.after_start_s));
+        for w in regions.windows(2) {
+            let ((_, end, pr, j), (start, _, r, k)) = (w[0], w[1]);
+            if pr != r {
+                let gap = start - end;
+                if gap.is_nan() || gap < 0.0 {
+                    return None;
+                }
+                let entry = clear.pairs.entry((j, k)).or_insert(gap);
+                *entry = entry.max(gap).max(self.max_step_s);
+            }
+        }
+        (!clear.pairs.is_empty()).then_some(clear)
+    }
+
+    /// Runs the clearance iteration `trial` until it has spent `until` margin checks or stops:
+    /// solve the search with the clearances (its best order below `cap_s`), time the order,
+    /// shape it at the trial's tilt, read every pair's worst-case slack from the check, and
+    /// move each pair's clearance towards a slack of a tenth of `M` ([`PairState::update`]);
+    /// keep the best schedule whose pairs all pass. Stops when no clearance moves.
+    fn iterate(&self, trial: &mut Trial, cap_s: f64, until: usize) {
+        let shaping = Shaping {
+            edge_s: 2.0 * self.max_step_s,
+            tilt: trial.tilt,
         };
-        for _ in 0..PAIR_ROUNDS {
-            if self.checks + pairs.len() > budget {
-                break;
+        let target = 0.1 * self.max_step_s;
+        let Trial {
+            clear,
+            pairs,
+            order,
+            best,
+            checks,
+            done,
+            ..
+        } = trial;
+        while *checks < until && !*done {
+            *done = true;
+            match search::search(self.chain, clear, cap_s, self.max_pieces).0 {
+                search::Outcome::Done(Some(found)) => {
+                    *order = Some(found.order);
+                }
+                // Nothing beats the cap with these clearances (or the budget ran out): keep
+                // timing the last order, whose clearances may still come down.
+                _ if order.is_some() => {}
+                _ => break,
             }
-            let results: Vec<bool> = (0..pairs.len())
-                .into_par_iter()
-                .map(|i| {
-                    let mut vals = hi.clone();
-                    vals[i] = 0.5 * (lo[i] + hi[i]);
-                    let (q, r, k) = pairs[i];
-                    let keep = Some(((r, k), &best.schedule));
-                    self.candidate_upto(with(&vals), Some(&best.order), f64::INFINITY, keep)
-                        .is_some_and(|c| self.margins_pass(&c, Some(q)))
-                })
-                .collect();
-            self.checks += pairs.len();
-            for (i, ok) in results.into_iter().enumerate() {
-                let mid = 0.5 * (lo[i] + hi[i]);
-                if ok {
-                    hi[i] = mid;
+            let Some(times) = order
+                .as_deref()
+                .and_then(|o| stn::earliest(self.chain, o, clear))
+            else {
+                break;
+            };
+            let schedule = shaped_schedule(self.problem, self.chain, &times, &shaping, self.tick_s);
+            *checks += 1;
+            let Some(slacks) = schedule
+                .timelines(self.problem)
+                .ok()
+                .and_then(|tl| pair_slacks(&tl, self.tick_s).ok())
+            else {
+                break;
+            };
+            let t = schedule.t_total_s(self.problem.dt_s());
+            let passes = slacks.iter().all(|s| s.slack_s > 0.0);
+            if passes && t < cap_s && best.as_ref().is_none_or(|b| t < b.t_total_s) {
+                *best = Some(Completed {
+                    schedule,
+                    t_total_s: t,
+                });
+            }
+            // Per role (the previous robot), whether a failing pair came already: a later
+            // pair's deficit includes the lead carried over from the earlier one, so only the
+            // first failing pair of each role moves by its whole deficit, the others at most
+            // double their clearance per round.
+            let mut failed = [false; 2];
+            let mut raised: Vec<f64> = Vec::new();
+            for s in slacks.iter().filter(|s| s.slack_s < f64::INFINITY) {
+                let (Some(j), Some(k)) = (
+                    self.lc_index(s.prev.ref_start),
+                    self.lc_index(s.cur.ref_start),
+                ) else {
+                    continue;
+                };
+                let slack = s.slack_s.max(-self.chain.slowest_s());
+                // Raise failing pairs; once all pass, lower those with room to spare.
+                let aim = slack <= 0.0 || (passes && slack > 2.0 * target);
+                let delta = clear.between(j, k);
+                let max_growth = if failed[s.prev_robot] {
+                    2.0
                 } else {
-                    lo[i] = mid;
+                    f64::INFINITY
+                };
+                failed[s.prev_robot] |= slack <= 0.0;
+                let next = pairs.entry((j, k)).or_insert(PairState::NEW).update(
+                    delta,
+                    slack,
+                    aim.then_some(target),
+                    target,
+                    max_growth,
+                );
+                let next = next.max(self.max_step_s);
+                if next > delta {
+                    raised.push(next);
+                }
+                if next != delta {
+                    clear.pairs.insert((j, k), next);
+                    *done = false;
                 }
             }
-        }
-        for widen in [0.0, 1.0] {
-            if self.checks >= budget {
-                break;
-            }
-            let vals: Vec<f64> = hi
-                .iter()
-                .zip(&lo)
-                .map(|(&h, &l)| h + widen * (h - l))
-                .collect();
-            self.checks += 1;
-            if let Some(c) = self.candidate(with(&vals), Some(&best.order), f64::INFINITY)
-                && self.valid(&c)
-            {
-                return Some(c);
+            // Pairs the search has not tried yet start from what a switch of robots has
+            // typically needed so far (the median of this round's raised clearances): with
+            // hundreds of LC islands, learning every pair from `M` would let the search run
+            // from one untried switch to the next.
+            if !raised.is_empty() {
+                raised.sort_by(f64::total_cmp);
+                clear.base = clear.base.max(raised[raised.len() / 2]);
             }
         }
-        None
+    }
+
+    /// Index `k` of the LC run starting at reference sample `ref_start`.
+    fn lc_index(&self, ref_start: usize) -> Option<usize> {
+        self.chain
+            .lc_ref
+            .binary_search_by_key(&ref_start, |r| r.0)
+            .ok()
+    }
+}
+
+/// One pair's clearance search (s): the largest clearance seen failing, the smallest seen
+/// passing, and the last measurement `(clearance, slack)`.
+#[derive(Clone, Copy, Debug)]
+struct PairState {
+    fail: f64,
+    pass: f64,
+    last: Option<(f64, f64)>,
+}
+
+impl PairState {
+    const NEW: PairState = PairState {
+        fail: f64::NEG_INFINITY,
+        pass: f64::INFINITY,
+        last: None,
+    };
+
+    /// Records that clearance `delta` gave `slack` and returns the next clearance (s): `delta`
+    /// without a `goal`; else a secant step towards slack `goal` (the first one assuming the
+    /// slack moves one for one with the clearance), at most halving the clearance and at most
+    /// multiplying it by `max_growth`, kept strictly inside the bracket of failing and passing
+    /// clearances (bisecting it when the step leaves it). A bracket narrower than
+    /// `resolution` settles on its passing end; an end the new measurement contradicts (the
+    /// other pairs' clearances move too) is dropped.
+    fn update(
+        &mut self,
+        delta: f64,
+        slack: f64,
+        goal: Option<f64>,
+        resolution: f64,
+        max_growth: f64,
+    ) -> f64 {
+        // The other pairs move too, so an old end of the bracket the new measurement
+        // contradicts is dropped.
+        if slack > 0.0 {
+            self.pass = self.pass.min(delta);
+            if self.fail >= delta {
+                self.fail = f64::NEG_INFINITY;
+            }
+        } else {
+            self.fail = self.fail.max(delta);
+            if self.pass <= delta {
+                self.pass = f64::INFINITY;
+            }
+        }
+        let last = self.last.replace((delta, slack));
+        let Some(goal) = goal else {
+            return delta;
+        };
+        if self.pass - self.fail <= resolution {
+            return self.pass;
+        }
+        // Below this measured sensitivity, a clearance is raised by at most 10× its deficit.
+        const MIN_SENSITIVITY: f64 = 0.1;
+        let sens = match last {
+            Some((d0, s0)) if d0 != delta && (slack - s0) / (delta - d0) > 0.0 => {
+                ((slack - s0) / (delta - d0)).max(MIN_SENSITIVITY)
+            }
+            _ => 1.0,
+        };
+        let step = (delta + (goal - slack) / sens).clamp(0.5 * delta, max_growth * delta);
+        if step > self.fail && step < self.pass {
+            step
+        } else if self.fail.is_finite() && self.pass.is_finite() {
+            0.5 * (self.fail + self.pass)
+        } else {
+            step
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pair_state_brackets_and_settles() {
+        let mut s = PairState::NEW;
+        // Fails at 1 by 0.5: first step assumes one for one, 1 + 0.6 = 1.6.
+        assert_eq!(s.update(1.0, -0.5, Some(0.1), 0.01, 2.0), 1.6);
+        // Passes at 1.6 with 0.7 to spare: measured sensitivity (0.7 + 0.5)/0.6 = 2, so
+        // lowering to 1.6 − 0.6/2 = 1.3, inside the bracket (1, 1.6).
+        let next = s.update(1.6, 0.7, Some(0.1), 0.01, 2.0);
+        assert!((next - 1.3).abs() < 1e-12, "{next}");
+        // A step leaving the bracket bisects it: passing at 2 (nothing asked), then failing at
+        // 1 by 1: the secant (sensitivity 1.05/1) says 2.05, capped at double, 2, which is the
+        // passing end: the midpoint 1.5.
+        let mut s = PairState::NEW;
+        assert_eq!(s.update(2.0, 0.05, None, 0.01, 2.0), 2.0);
+        assert_eq!(s.update(1.0, -1.0, Some(0.1), 0.01, 2.0), 1.5);
+        // Growth is capped: failing at 0.1 by 1 would step to 1.2, at most doubling: 0.2;
+        // uncapped, 1.2.
+        let mut s = PairState::NEW;
+        assert_eq!(s.update(0.1, -1.0, Some(0.1), 0.01, 2.0), 0.2);
+        let mut s = PairState::NEW;
+        assert!((s.update(0.1, -1.0, Some(0.1), 0.01, f64::INFINITY) - 1.2).abs() < 1e-12);
+        // A bracket narrower than the resolution settles on its passing end.
+        let mut s = PairState::NEW;
+        s.update(1.0, -0.1, Some(0.1), 0.5, 2.0);
+        assert_eq!(s.update(1.2, 0.05, Some(0.1), 0.5, 2.0), 1.2);
+        // A measurement contradicting the bracket drops the stale end: passing at 1, then
+        // failing at 1 (other pairs moved): no passing end left, a plain secant step up.
+        let mut s = PairState::NEW;
+        s.update(1.0, 0.5, None, 0.01, 2.0);
+        assert_eq!(s.update(1.0, -0.1, Some(0.1), 0.01, 2.0), 1.2);
+        // Without a goal the clearance stays.
+        let mut s = PairState::NEW;
+        assert_eq!(s.update(0.7, 0.3, None, 0.01, 2.0), 0.7);
     }
 }

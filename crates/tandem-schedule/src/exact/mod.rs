@@ -59,30 +59,53 @@
 //! (`tandem_realtime::sufficient_margins`, Alg. 2) rejects: it simulates, from `τ`, the current
 //! robot `c` rushing while LC and the previous robot `p` dragging while LC, and needs `c` to stay
 //! one maximal step `M` (the largest step of any robot in one tick) short of its LC run until
-//! `p` has left its own. [`certify`] therefore (`complete.rs`)
-//! 1. re-solves the program with a clearance `δ` before every LC run that follows the other
-//!    robot's (robot 2's first run needs none if robot 2 starts after robot 1's run ended, as
-//!    the check accepts such pairs outright), shapes the HC speeds (below) and runs the check,
-//!    growing `δ` geometrically from `2M` until it passes;
-//! 2. then, on that order, bisects every pair's clearance at once between `M` and its current
-//!    value, each pair judged by the check on the LC runs up to its own (later ones counted as
-//!    HC), and keeps the result if the full check accepts it.
+//! `p` has left its own. The completion (`complete.rs`) keeps that check as its only oracle:
+//! `tandem_realtime::pair_slacks` runs the same simulation and reports, for every pair, how much
+//! room `c` has left when `p` leaves (negative: the clearance missing). From there:
+//! 1. **Clearances from the check.** An LC run `k` placed right after the other robot's run
+//!    `j` gets a clearance `δ(j, k)` (the search's difference constraint "starts `δ` after the
+//!    other's run ends"; one table for both robots, since both traverse the same chain and a
+//!    pair and its mirror image need the same room; robot 2's first run needs none if robot 2
+//!    starts after robot 1's run ended, as the check accepts such pairs outright). The search
+//!    places the runs with these clearances (switching robots costs a clearance, so the order
+//!    may change), the order's earliest times are shaped into speeds (below), the check reads
+//!    every pair's slack, and each pair's clearance moves towards a slack of `M/10`: a secant
+//!    step inside the bracket of the clearances seen failing and passing, raising failing
+//!    pairs and, once all pass, lowering those with room to spare. The deficit of a later
+//!    pair of the same role includes the lead carried over from an earlier failing one, so
+//!    only the first failing pair of each role moves by its whole deficit per round, the
+//!    others at most double. Pairs never tried start from the median clearance raised so far
+//!    (the typical cost of a switch), so that with hundreds of LC islands the search does not
+//!    run from one untried switch to the next. The best schedule whose pairs all pass is kept.
+//! 2. **Speed shaping within HC runs** (`shape.rs`). A run's duration is fixed by the times;
+//!    how it is spread over the run's samples decides how much lead the worst case builds.
+//!    Next to the robot's own LC runs the check's windows decide: over the last `2M` of clock
+//!    before its LC run the robot runs at `ψ̇min` (`F = 1`: as `c` it has no rush room beyond its
+//!    LC run's own), over the first `2M` after one it runs no faster than the run left it (as
+//!    `p` it drags at the smallest `S` in its window, which stays the LC run's). In between,
+//!    one speed factor per sample `u_i = u₀ + θ·(1 − 2i/(N − 1))` (clamped to `[0, 1]`, between
+//!    `ψ̇min` and `ψ̇max`) with `u₀` set by the duration: at tilt `θ = 0` one factor for the
+//!    whole run; at `θ > 0` slow first, fast last — slow early helps the robot, as `p`, follow
+//!    the other robot rushing through the LC run this HC run spans, fast late gives it, as `c`,
+//!    room to slow down while the other drags out of it. The tilt trades the two roles'
+//!    leads and the best one is problem-dependent.
+//! 3. **Starts.** Iterations start cold (every clearance at `M`) at the tilts `θ ∈ {0, ¼, ½}`,
+//!    and warm from a schedule that already passes — the previous schedule, and the sampler's
+//!    winner once it is known — at its own clearances, no other pair allowed, so the search
+//!    begins from that schedule's order and tightens it. Every start gets a few checks in
+//!    parallel; the two most promising continue with the rest of the budget
+//!    ([`ExactParams::max_margin_checks`]).
 //!
-//! Speed shaping within HC runs (`shape.rs`), by the global time at which a sample is entered:
-//! right after the robot's own LC run it keeps that run's slow rate (it is the dragging robot
-//! `p` there, and a robot scheduled fast right after its LC run drags even slower in the
-//! check's rate window); in the last `20·M` before the other robot leaves an LC stretch it runs
-//! at `ψ̇min`, so that as the responding robot `c` it can slow down as much as possible while
-//! the pair is decided; elsewhere one speed level makes the run last as the times say, HC
-//! samples kept at `F = ψ̇_E/ψ̇min` no larger than the largest `F` of an LC sample (so `M` does
-//! not grow) unless the duration needs it.
-//!
-//! Every schedule returned passes [`crate::validate`] at its own tick (`Schedule::tick_s`);
-//! when the completion finds nothing better, the caller's incumbent or the fastest serial
-//! schedule is returned, with the same certificate.
+//! Every schedule the scheduler returns passes [`crate::validate`] at its own tick
+//! (`Schedule::tick_s`); the completion is one of its candidates ([`crate::sample_schedule`]),
+//! beside the sampler and the previous or serial schedule, and the returned
+//! [`crate::Outcome`] carries the bound and the gap.
 //!
 //! ```
-//! use tandem_schedule::{ExactParams, Problem, certify, solve_exact, validate};
+//! use tandem_schedule::{
+//!     ExactParams, Problem, SamplerBaselines, SamplerParams, Source, sample_schedule_with_baselines,
+//!     solve_exact, validate,
+//! };
 //!
 //! // [LC, HC, LC] with gradients 1 in [0.5, 2], 10 samples each at 10 ms: LC runs of 0.1 s, an
 //! // HC gap of [0.05, 0.2] s. Best: robot 1 LC, robot 2 LC, robot 1 LC, robot 2 LC, back to
@@ -93,9 +116,13 @@
 //! assert!(free.proven_optimal);
 //! assert!((free.lower_bound_s - 0.4).abs() < 1e-9);
 //! assert_eq!(free.order, vec![0, 1, 0, 1]);
-//! let cert = certify(&p, &ExactParams::default(), None)?;
-//! assert!(validate(&p, &cert.schedule).is_ok());
-//! assert!(cert.t_total_s >= cert.lower_bound_s);
+//! // The completion alone (no sampled candidates): certified against the same bound.
+//! let alone = SamplerBaselines::COMPLETION_ONLY;
+//! let out = sample_schedule_with_baselines(&p, &SamplerParams::default(), &alone, None)?;
+//! assert!(validate(&p, &out.schedule).is_ok());
+//! assert!(out.bound_is_optimum && (out.lower_bound_s - 0.4).abs() < 1e-9);
+//! assert!(out.t_total_s >= out.lower_bound_s);
+//! assert!(matches!(out.source, Source::Completed | Source::Serial));
 //! # Ok::<(), tandem_schedule::Error>(())
 //! ```
 
@@ -111,32 +138,30 @@ use serde::{Deserialize, Serialize};
 
 use crate::problem::Problem;
 use crate::schedule::Schedule;
-use crate::validate::validate;
 use crate::{Error, Result};
 
-/// Parameters of [`solve_exact`] and [`certify`].
+/// Parameters of the exact search ([`solve_exact`]) and of the margin-aware completion that
+/// [`crate::sample_schedule`] runs beside the sampler (see the [module docs](self)).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ExactParams {
-    /// Control tick (s) of the margin check (Alg. 2). `None` = the reference period `Δt_s`.
-    /// Must be finite and > 0. Default: `None`.
-    pub tick_s: Option<f64>,
     /// Largest number of value-function pieces the exact search may hold (memory ~48 bytes
-    /// each); past it [`solve_exact`] returns the simple lower bound, not proven optimal. ≥ 1.
+    /// each); past it the search returns the simple lower bound, not proven optimal. ≥ 1.
     /// Default: 4,000,000.
     pub max_pieces: usize,
-    /// Largest number of margin checks (Alg. 2) the completion of [`certify`] may run. The
-    /// fixture problem needs about 24 for per-pair clearances; 0 skips the completion. Default:
-    /// 32.
+    /// Largest number of margin checks (Alg. 2, ~1 ms each on the 9873-sample fixture
+    /// problem) the completion may run per re-schedule (plus a quarter of it to refine the
+    /// sampler's winner); 0 switches the completion off (the bound is still computed).
+    /// Default: 24 (docs/decisions.md: the fixture and fragmented problems' gaps against the
+    /// budget).
     pub max_margin_checks: usize,
 }
 
 impl Default for ExactParams {
     fn default() -> Self {
         ExactParams {
-            tick_s: None,
             max_pieces: 4_000_000,
-            max_margin_checks: 32,
+            max_margin_checks: 24,
         }
     }
 }
@@ -147,14 +172,6 @@ impl ExactParams {
     /// # Errors
     /// [`Error::BadParam`] naming the field.
     pub fn validate(&self) -> Result<()> {
-        if let Some(t) = self.tick_s
-            && !(t.is_finite() && t > 0.0)
-        {
-            return Err(Error::BadParam {
-                name: "tick_s",
-                why: "must be finite and > 0",
-            });
-        }
         if self.max_pieces == 0 {
             return Err(Error::BadParam {
                 name: "max_pieces",
@@ -193,56 +210,24 @@ pub struct MarginFree {
     pub stats: SearchStats,
 }
 
-/// Where a [`Certificate`]'s schedule comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum CertifiedSource {
-    /// The margin-aware completion of the exact search.
-    Completed,
-    /// The incumbent passed to [`certify`] (e.g. the sampler's schedule).
-    Incumbent,
-    /// The fastest serial schedule ([`Problem::serial_schedule`]).
-    Serial,
-}
-
-/// A schedule that satisfies every constraint of Eq. 20, with how far it can be from optimal.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Certificate {
-    /// The schedule; it passes [`crate::validate`] at its own tick (`Schedule::tick_s`).
-    pub schedule: Schedule,
-    /// Its `T_total` (Eq. 13), s.
-    pub t_total_s: f64,
-    /// A lower bound (s) on the `T_total` of every schedule satisfying Eq. 20: the margin-free
-    /// optimum `T*₀` when [`Certificate::bound_is_optimum`].
-    pub lower_bound_s: f64,
-    /// Whether the bound is the proven margin-free optimum `T*₀`.
-    pub bound_is_optimum: bool,
-    /// `(T_total − bound)/bound`: the schedule is at most this much (relative) above optimal.
-    pub gap: f64,
-    /// Where the schedule comes from.
-    pub source: CertifiedSource,
-    /// Margin checks (Alg. 2) the completion ran.
-    pub margin_checks: usize,
-    /// Work counts of the exact search.
-    pub stats: SearchStats,
-}
-
-/// Solves the margin-free problem exactly (see the [module docs](self)).
+/// Solves the margin-free problem exactly (see the [module docs](self)); the optimal schedule
+/// carries the control tick `Δt_s`.
 ///
 /// # Errors
 /// [`Error::BadParam`] for invalid parameters.
 pub fn solve_exact(problem: &Problem, params: &ExactParams) -> Result<MarginFree> {
     params.validate()?;
     let chain = chain::Chain::new(problem);
-    Ok(margin_free(problem, &chain, params))
+    Ok(margin_free(problem, &chain, params.max_pieces))
 }
 
-fn margin_free(problem: &Problem, chain: &chain::Chain, params: &ExactParams) -> MarginFree {
+fn margin_free(problem: &Problem, chain: &chain::Chain, max_pieces: usize) -> MarginFree {
     let m = chain.n_lc();
-    let zero = search::Clearance::zero(m);
+    let zero = search::Clearance::zero();
     // The incumbent: the fastest serial schedule, 2 × the fastest execution (feasible for the
     // margin-free problem, so the optimum is never above it).
     let serial_s = 2.0 * chain.fastest_s();
-    let (outcome, counts) = search::search(chain, &zero, serial_s, params.max_pieces);
+    let (outcome, counts) = search::search(chain, &zero, serial_s, max_pieces);
     let stats = SearchStats {
         lc_runs: m,
         states: counts.states,
@@ -264,7 +249,7 @@ fn margin_free(problem: &Problem, chain: &chain::Chain, params: &ExactParams) ->
                 problem,
                 chain,
                 &times,
-                params.tick_s.unwrap_or(problem.dt_s()),
+                problem.dt_s(),
             )),
             order: f.order.iter().map(|&r| usize::from(r)).collect(),
             stats,
@@ -312,75 +297,29 @@ pub fn earliest_schedule(problem: &Problem, order: &[usize]) -> Result<Option<Sc
         });
     }
     let order: Vec<search::Robot> = order.iter().map(|&r| u8::from(r == 1)).collect();
-    Ok(stn::earliest(&chain, &order, &search::Clearance::zero(m))
+    Ok(stn::earliest(&chain, &order, &search::Clearance::zero())
         .map(|t| build::uniform_schedule(problem, &chain, &t, problem.dt_s())))
 }
 
-/// A schedule satisfying every constraint of Eq. 20 with its certificate: the margin-free
-/// lower bound `T*₀` ([`solve_exact`]) and the gap to it. The schedule is the best of the
-/// margin-aware completion (see the [module docs](self)), `incumbent` (if it passes
-/// [`crate::validate`] at the certificate's tick) and the fastest serial schedule; so it is never worse than
-/// the incumbent.
-///
-/// Deterministic: the same problem and parameters give the same certificate whatever the
-/// number of threads.
-///
-/// # Errors
-/// [`Error::BadParam`] for invalid parameters; [`Error::NoFeasibleSchedule`] if nothing passes,
-/// not even the serial schedule.
-pub fn certify(
+/// The margin-free bound of `problem` (see [`solve_exact`]).
+pub(crate) fn bound(problem: &Problem, params: &ExactParams) -> MarginFree {
+    margin_free(problem, &chain::Chain::new(problem), params.max_pieces)
+}
+
+/// The margin-aware completion (see the [module docs](self)) at control tick `tick_s` (s):
+/// the best schedule it finds that passes the margin check and beats `cap_s` (s), with at
+/// most `budget` margin checks, from every clearance at `M` when `cold` and from the
+/// clearances of each schedule of `warm`; with the number of checks spent.
+pub(crate) fn completion(
     problem: &Problem,
     params: &ExactParams,
-    incumbent: Option<&Schedule>,
-) -> Result<Certificate> {
-    params.validate()?;
-    let tick_s = params.tick_s.unwrap_or(problem.dt_s());
-    let dt = problem.dt_s();
+    tick_s: f64,
+    cap_s: f64,
+    budget: usize,
+    cold: bool,
+    warm: &[&Schedule],
+) -> (Option<complete::Completed>, usize) {
     let chain = chain::Chain::new(problem);
-    let free = margin_free(problem, &chain, params);
-
-    let serial = problem.serial_schedule(tick_s)?;
-    let serial_violation = validate(problem, &serial).err();
-    let mut best: Option<(Schedule, f64, CertifiedSource)> =
-        serial_violation.is_none().then(|| {
-            let t = serial.t_total_s(dt);
-            (serial, t, CertifiedSource::Serial)
-        });
-    // The incumbent is re-checked at this certificate's tick (it may have been made for another).
-    if let Some(inc) = incumbent {
-        let inc = Schedule {
-            tick_s,
-            ..inc.clone()
-        };
-        if validate(problem, &inc).is_ok() {
-            let t = inc.t_total_s(dt);
-            if best.as_ref().is_none_or(|b| t <= b.1) {
-                best = Some((inc, t, CertifiedSource::Incumbent));
-            }
-        }
-    }
-    let cap_s = best.as_ref().map_or(f64::INFINITY, |b| b.1);
-    let mut completion = complete::Completion::new(problem, &chain, tick_s, params.max_pieces);
-    if params.max_margin_checks > 0
-        && let Some(done) = completion.run(cap_s, params.max_margin_checks)
-        && best.as_ref().is_none_or(|b| done.t_total_s < b.1)
-    {
-        best = Some((done.schedule, done.t_total_s, CertifiedSource::Completed));
-    }
-    let Some((schedule, t_total_s, source)) = best else {
-        return Err(Error::NoFeasibleSchedule {
-            serial: serial_violation.expect("no incumbent means the serial schedule failed"),
-        });
-    };
-    let lower_bound_s = free.lower_bound_s.min(t_total_s);
-    Ok(Certificate {
-        schedule,
-        t_total_s,
-        lower_bound_s,
-        bound_is_optimum: free.proven_optimal,
-        gap: (t_total_s - lower_bound_s) / lower_bound_s,
-        source,
-        margin_checks: completion.checks,
-        stats: free.stats,
-    })
+    complete::Completion::new(problem, &chain, tick_s, params.max_pieces)
+        .run(cap_s, budget, cold, warm)
 }

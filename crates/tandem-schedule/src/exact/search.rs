@@ -1,30 +1,59 @@
 //! The exact search over interleavings: a dynamic program over `(i, j, last)` whose value
 //! functions are piecewise linear in the lead `d` (see the module docs of [`super`]).
 
+use std::collections::BTreeMap;
+
 use super::chain::Chain;
 use super::pl::{self, Origin, Piece, Step};
 
 /// Robot index in a machine order (0 = robot 1, 1 = robot 2).
 pub(crate) type Robot = u8;
 
-/// Clearances of the search (s): `before[r][k]` must separate robot `r`'s LC run `k` from the
-/// other robot's LC run just before it on the operator (0 for the margin-free problem).
+/// Clearances of the search (s): an LC run `k` placed right after the other robot's LC run `j`
+/// on the operator must start [`Clearance::between`]`(j, k)` after that run ends (0 for the
+/// margin-free problem). The table is the same for both robots: the two robots traverse the
+/// same chain, and a pair and its mirror image (robots swapped) need the same room.
 /// `after_start`: robot 2's first LC run needs no clearance from a robot-1 run that ended at
 /// least this long before robot 2 started (`Some(ε)`), mirroring the margin check's rule that
 /// such pairs cannot overlap; `None`: no such exception.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Clearance {
-    pub(crate) before: [Vec<f64>; 2],
+    /// Clearance (s) of the pairs `(j, k)` listed; [`Clearance::base`] for the others.
+    pub(crate) pairs: BTreeMap<(usize, usize), f64>,
+    /// Clearance (s) of every pair not in [`Clearance::pairs`].
+    pub(crate) base: f64,
     pub(crate) after_start: Option<f64>,
 }
 
 impl Clearance {
     /// No clearance at all: the margin-free problem.
-    pub(crate) fn zero(m: usize) -> Clearance {
+    pub(crate) fn zero() -> Clearance {
+        Clearance::uniform(0.0, None)
+    }
+
+    /// Clearance `base_s` (s) between every two runs, with the exception `after_start`.
+    pub(crate) fn uniform(base_s: f64, after_start: Option<f64>) -> Clearance {
         Clearance {
-            before: [vec![0.0; m], vec![0.0; m]],
-            after_start: None,
+            pairs: BTreeMap::new(),
+            base: base_s,
+            after_start,
         }
+    }
+
+    /// Clearance (s) before LC run `k` placed right after the other robot's LC run `j`.
+    pub(crate) fn between(&self, j: usize, k: usize) -> f64 {
+        self.pairs.get(&(j, k)).copied().unwrap_or(self.base)
+    }
+
+    /// Per LC run `k ∈ 0..m`, the least clearance it can need after any run of the other robot.
+    fn least_before(&self, m: usize) -> Vec<f64> {
+        let mut least = vec![self.base; m];
+        for (&(_, k), &v) in &self.pairs {
+            if k < m {
+                least[k] = least[k].min(v);
+            }
+        }
+        least
     }
 }
 
@@ -100,6 +129,7 @@ pub(crate) fn search(
         (cap - machine.max(rest_robot[mine]), cap - rest_robot[other])
     };
 
+    let least_before = clear.least_before(m);
     let n_states = (m + 1) * (m + 1) * 2;
     let mut span: Vec<(usize, usize)> = vec![(0, 0); n_states];
     let mut arena: Vec<Piece> = Vec::new();
@@ -132,7 +162,12 @@ pub(crate) fn search(
                 }
                 let (a, b) = gap[k];
                 let (lo_a, lo_b) = (a + l[k], b + l[k]);
-                let delta = clear.before[last][k];
+                // The clearance after the other robot's last run (when it placed one).
+                let delta = if other >= 1 {
+                    clear.between(other - 1, k)
+                } else {
+                    0.0
+                };
                 let mut f: Vec<Piece> = Vec::new();
                 if mine == 1 && other == 0 {
                     f = initial(last, a, b, l[k], tau_max);
@@ -176,7 +211,7 @@ pub(crate) fn search(
                     if other == 0 {
                         wait_b
                     } else {
-                        wait_b - clear.before[1 - last][other]
+                        wait_b - least_before[other]
                     }
                 } else {
                     f64::INFINITY

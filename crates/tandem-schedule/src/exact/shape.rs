@@ -1,5 +1,6 @@
-//! Speed shaping inside HC runs, so that the worst-case margin check (Alg. 2) finds little lead
-//! to absorb (see "Margin-aware completion" in the module docs of [`super`]).
+//! Speed shaping inside HC runs: how a run's duration (fixed by the event times) is spread over
+//! its samples so that the worst-case margin check (Alg. 2) finds little lead to absorb (see
+//! "Margin-aware completion" in the module docs of [`super`]).
 
 use super::build::fill_uniform;
 use super::chain::Chain;
@@ -7,96 +8,57 @@ use super::stn::Times;
 use crate::problem::Problem;
 use crate::schedule::Schedule;
 
-/// Knobs of the shaping; times in s of global (schedule-clock) time.
+/// How the HC runs are shaped; times in s of schedule clock.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Shaping {
-    /// How far around the other robot's LC stretches it counts as LC (the margin check widens
-    /// LC regions by one maximal step `M`).
-    pub(crate) window_s: f64,
-    /// Length of the stretch before the end of the other robot's LC stretch in which this robot
-    /// runs at `ψ̇min` (where the margin check decides the pair).
-    pub(crate) zone_s: f64,
-    /// Length of the stretch after the robot's own LC run in which it keeps the slow rate of its
-    /// last LC sample (it is the dragging robot there).
+    /// Length of the edges next to the robot's own LC runs: the margin check reads a robot's
+    /// mode and rates over a window of one maximal step `M` around its clock and its clock can
+    /// overshoot by one more step, so `2·M` (plus the check's tolerance).
     pub(crate) edge_s: f64,
-    /// Largest fast rate `F = ψ̇_E/ψ̇min` a sample may get unless the run's duration needs more
-    /// (the margin check's maximal step grows with the largest `F` of any sample).
-    pub(crate) f_cap: f64,
+    /// Tilt `θ` of the body's speed factor, in `[0, 1]`: sample `i` of `N` gets
+    /// `u_i = u₀ + θ·(1 − 2i/(N − 1))` clamped into `[0, 1]` (slow first, fast last for `θ > 0`;
+    /// one factor for the whole body at `θ = 0`), with `u₀` set by the run's duration.
+    pub(crate) tilt: f64,
 }
 
-/// Time class of an HC sample, by the global time at which the robot enters it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Class {
-    /// Right after the robot's own LC run: it is the dragging robot there.
-    Post,
-    /// The other robot is LC nearby and its LC stretch ends soon: the pair is decided there.
-    Zone,
-    /// The other robot is LC nearby.
-    Band,
-    /// The other robot is HC.
-    Free,
-}
-
-/// Where the other robot is LC, as time intervals (s) of global time: `(band_from, zone_from,
-/// end, band_to)` per LC stretch (band `[start − w, end + w]`, zone `[end − zone, end]`).
-fn other_stretches(times: &Times, chain: &Chain, other: usize, k: &Shaping) -> Vec<[f64; 4]> {
-    times.lc_start_s[other]
-        .iter()
-        .zip(&chain.lc_s)
-        .map(|(&s, &l)| {
-            let e = s + l;
-            [
-                s - k.window_s,
-                (e - k.zone_s).max(s - k.window_s),
-                e,
-                e + k.window_s,
-            ]
-        })
-        .collect()
-}
-
-/// The schedule with event times `times` and shaped HC speeds (LC samples at the mean).
+/// The schedule with event times `times` and shaped HC speeds (LC samples at the mean, Eq. 20
+/// constraint 4), at control tick `tick_s` (s).
 ///
-/// With `keep = Some((t_s, base))`, HC runs entered at or after global time `t_s` keep
-/// `base`'s gradients instead (for a margin check that only looks at what comes before).
+/// Each HC run (gap `g` of robot `r`) lasts exactly as `times` say, up to rounding:
+/// - its last samples, over `edge_s` of clock before the robot's own next LC run, run at
+///   `ψ̇min` (`F = 1`): the check counts the robot as LC up to a step before its run and lets it
+///   rush at its largest `F` in the window, which is then no more than the LC run's own;
+/// - its first samples, over `edge_s` after the robot's own LC run, run no faster than that run
+///   left it (`S = ψ̇_E/ψ̇max` at least the smallest `S` of the run's last `edge_s`): the check
+///   lets the leaving robot drag at the smallest `S` in its window, which then stays the LC
+///   run's own;
+/// - the body in between gets the tilted speed factor of [`Shaping::tilt`] between `ψ̇min` and
+///   `ψ̇max`.
+///
+/// If the edges leave no way to reach the duration, the run gets one speed factor for all its
+/// samples (`fill_uniform`).
 pub(crate) fn shaped_schedule(
     problem: &Problem,
     chain: &Chain,
     times: &Times,
-    knobs: &Shaping,
-    keep: Option<(f64, &Schedule)>,
+    shaping: &Shaping,
     tick_s: f64,
 ) -> Schedule {
     let warps = [0, 1].map(|r| {
-        let stretches = other_stretches(times, chain, 1 - r, knobs);
         let gaps = times.gaps_s(chain, r);
         let mut warp = problem.grad_mean().to_vec();
         for (g, &(a, b)) in chain.gap_ref.iter().enumerate() {
-            if b == a {
-                continue;
+            if b > a {
+                let run = Run {
+                    problem,
+                    chain,
+                    gap: g,
+                    start: a,
+                    end: b,
+                    shaping,
+                };
+                run.fill(&mut warp[a..b], gaps[g]);
             }
-            let t0 = if g == 0 {
-                if r == 0 { 0.0 } else { times.tau_s }
-            } else {
-                times.lc_start_s[r][g - 1] + chain.lc_s[g - 1]
-            };
-            if let Some((t_keep, base)) = keep
-                && t0 >= t_keep
-            {
-                warp[a..b].copy_from_slice(&base.grad_exec[r][a..b]);
-                continue;
-            }
-            let post_slow = (g > 0).then(|| problem.grad_mean()[a - 1] / problem.grad_max()[a - 1]);
-            let run = Run {
-                problem,
-                stretches: &stretches,
-                start: a,
-                t0,
-                post_slow,
-                knobs,
-            };
-            fill_uniform(problem, &mut warp[a..b], a, gaps[g]);
-            run.fill(&mut warp[a..b], gaps[g]);
         }
         warp
     });
@@ -107,147 +69,137 @@ pub(crate) fn shaped_schedule(
     }
 }
 
-/// One HC run of one robot to be shaped.
+/// One HC run (gap `gap` of the chain, reference samples `start..end`).
 struct Run<'a> {
     problem: &'a Problem,
-    stretches: &'a [[f64; 4]],
-    /// First reference sample.
+    chain: &'a Chain,
+    gap: usize,
     start: usize,
-    /// Global time (s) at which the robot enters the run.
-    t0: f64,
-    /// `S = ψ̇̄/ψ̇max` of the robot's last LC sample when the run follows one of its LC runs.
-    post_slow: Option<f64>,
-    knobs: &'a Shaping,
+    end: usize,
+    shaping: &'a Shaping,
 }
 
 impl Run<'_> {
-    /// Walks the run at speed level `lam` (see [`level`]), writing the gradients into `out`;
-    /// returns the run's duration (s). Each sample's class follows the walk's own times.
-    fn walk(&self, lam: f64, out: &mut [f64]) -> f64 {
-        self.walk_with(out, |_, lo, hi, class| {
-            level(
-                lam,
-                lo,
-                hi,
-                class,
-                self.post_slow.unwrap_or(1.0),
-                self.knobs.f_cap,
-            )
-        })
-    }
-
-    /// Walks the run with gradient `gradient(i, lo, hi, class)` per sample, writing the
-    /// gradients into `out`; returns the run's duration (s).
-    fn walk_with(
-        &self,
-        out: &mut [f64],
-        mut gradient: impl FnMut(usize, f64, f64, Class) -> f64,
-    ) -> f64 {
-        let p = self.problem;
-        let (gmin, gmax) = (p.grad_min(), p.grad_max());
-        let dt = p.dt_s();
-        let k = self.knobs;
-        let st = self.stretches;
-        let mut j = st.partition_point(|s| s[3] < self.t0);
-        let mut t = self.t0;
-        for (i, g) in out.iter_mut().enumerate() {
-            while j < st.len() && st[j][3] < t {
-                j += 1;
-            }
-            let class = match self.post_slow {
-                Some(_) if t - self.t0 < k.edge_s => Class::Post,
-                _ => match st.get(j) {
-                    Some(s) if t >= s[1] && t <= s[2] => Class::Zone,
-                    Some(s) if t >= s[0] => Class::Band,
-                    _ => Class::Free,
-                },
-            };
-            let n = self.start + i;
-            *g = gradient(i, gmin[n], gmax[n], class);
-            t += *g * dt;
-        }
-        t - self.t0
-    }
-
-    /// The speed level that gives `dur_s` (s) with every sample kept in the class it has at the
-    /// times of the gradients in `g` (the duration is then piecewise linear in the level).
-    fn guess(&self, g: &[f64], dur_s: f64) -> f64 {
-        let dt = self.problem.dt_s();
-        let mut at = g.to_vec();
-        let mut class = Vec::with_capacity(g.len());
-        self.walk_with(&mut at, |i, lo, hi, c| {
-            class.push((lo, hi, c));
-            g[i]
-        });
-        let (post, cap) = (self.post_slow.unwrap_or(1.0), self.knobs.f_cap);
-        let total = |lam: f64| {
-            class
-                .iter()
-                .map(|&(lo, hi, c)| level(lam, lo, hi, c, post, cap))
-                .sum::<f64>()
-                * dt
-        };
-        let knots = [-1.0, 0.0, 1.0, 2.0];
-        let totals = knots.map(total);
-        if dur_s <= totals[0] {
-            return -1.0;
-        }
-        for s in 0..3 {
-            if dur_s <= totals[s + 1] {
-                let (t0, t1) = (totals[s], totals[s + 1]);
-                return knots[s]
-                    + if t1 > t0 {
-                        (dur_s - t0) / (t1 - t0)
-                    } else {
-                        0.0
-                    };
-            }
-        }
-        2.0
-    }
-
-    /// Writes the shaped gradients lasting `dur_s` (s) into `out` (which holds the uniform
-    /// speeds of that duration): the speed level is found by a safeguarded regula falsi on the
-    /// walk's duration (monotone in the level, but it may jump by up to a sample where a sample
-    /// changes class), and the two bracketing walks are blended sample by sample to the exact
-    /// duration. If no level reaches it (only rounding: the times respect every run's range),
-    /// the uniform speeds stay.
+    /// Writes into `out` gradients lasting `dur_s` (s); see [`shaped_schedule`].
     fn fill(&self, out: &mut [f64], dur_s: f64) {
-        let dt = self.problem.dt_s();
-        let guess = self.guess(out, dur_s);
-        let mut lower = out.to_vec();
-        let mut upper = out.to_vec();
-        let mut scratch = out.to_vec();
-        // Bracket outward from the guess.
-        let (mut a, mut b) = (
-            (guess - GUESS_STEP).max(-1.0),
-            (guess + GUESS_STEP).min(2.0),
-        );
-        let mut fa = self.walk(a, &mut lower) - dur_s;
-        while fa > 0.0 && a > -1.0 {
-            a = (a - 4.0 * (b - a)).max(-1.0);
-            fa = self.walk(a, &mut lower) - dur_s;
+        let p = self.problem;
+        let dt = p.dt_s();
+        let (gmin, gmax) = (p.grad_min(), p.grad_max());
+        let (a, b) = (self.start, self.end);
+        let edge = self.shaping.edge_s;
+        // Trailing edge at ψ̇min before the robot's own next LC run.
+        let mut pre = b;
+        if self.gap < self.chain.n_lc() {
+            let mut clock = 0.0;
+            while pre > a && clock < edge {
+                pre -= 1;
+                clock += gmin[pre] * dt;
+            }
         }
-        let mut fb = self.walk(b, &mut upper) - dur_s;
-        while fb < 0.0 && b < 2.0 {
-            b = (b + 4.0 * (b - a)).min(2.0);
-            fb = self.walk(b, &mut upper) - dur_s;
+        // Leading edge no faster than the robot's own LC run left it.
+        let mut post = a;
+        if self.gap > 0 {
+            let slow = self.exit_slow_rate();
+            let mut clock = 0.0;
+            while post < pre && clock < edge {
+                let g = (slow * gmax[post]).clamp(gmin[post], gmax[post]);
+                out[post - a] = g;
+                clock += g * dt;
+                post += 1;
+            }
         }
-        if !(fa <= 0.0 && fb >= 0.0) {
-            return;
+        out[pre - a..].copy_from_slice(&gmin[pre..b]);
+        let fixed_s: f64 = out[..post - a].iter().chain(&out[pre - a..]).sum::<f64>() * dt;
+        let body = Body {
+            problem: p,
+            start: post,
+            end: pre,
+            tilt: self.shaping.tilt,
+        };
+        if !body.fill(&mut out[post - a..pre - a], dur_s - fixed_s) {
+            fill_uniform(p, out, a, dur_s);
         }
-        let mut side = 0;
-        for iter in 0..60 {
-            if fa == 0.0 || fb == 0.0 || b - a < 1e-12 {
+        // Rounding goes to the last samples, within their bounds.
+        let mut rest = (dur_s - out.iter().sum::<f64>() * dt) / dt;
+        for (i, g) in out.iter_mut().enumerate().rev() {
+            if rest == 0.0 {
                 break;
             }
-            let secant = (a * fb - b * fa) / (fb - fa);
-            let c = if iter % 3 != 2 && secant > a && secant < b {
-                secant
-            } else {
-                0.5 * (a + b)
-            };
-            let fc = self.walk(c, &mut scratch) - dur_s;
+            let n = a + i;
+            let new = (*g + rest).clamp(gmin[n], gmax[n]);
+            rest -= new - *g;
+            *g = new;
+        }
+    }
+
+    /// The smallest `S = ψ̇̄/ψ̇max` over the last `edge_s` of clock of the LC run before this gap.
+    fn exit_slow_rate(&self) -> f64 {
+        let p = self.problem;
+        let (lc_a, lc_b) = self.chain.lc_ref[self.gap - 1];
+        let (gmean, gmax) = (p.grad_mean(), p.grad_max());
+        let mut clock = 0.0;
+        let mut slow = f64::INFINITY;
+        let mut n = lc_b;
+        while n > lc_a && clock < self.shaping.edge_s {
+            n -= 1;
+            clock += gmean[n] * p.dt_s();
+            slow = slow.min(gmean[n] / gmax[n]);
+        }
+        slow
+    }
+}
+
+/// The body of an HC run: reference samples `start..end` with a tilted speed factor.
+struct Body<'a> {
+    problem: &'a Problem,
+    start: usize,
+    end: usize,
+    tilt: f64,
+}
+
+impl Body<'_> {
+    /// Writes the gradients at level `u0` into `out`; returns their duration (s),
+    /// non-decreasing in `u0`.
+    fn walk(&self, u0: f64, out: &mut [f64]) -> f64 {
+        let p = self.problem;
+        let (gmin, gmax) = (p.grad_min(), p.grad_max());
+        let last = (self.end - self.start).saturating_sub(1).max(1) as f64;
+        let mut sum = 0.0;
+        for (i, g) in out.iter_mut().enumerate() {
+            let n = self.start + i;
+            let u = (u0 + self.tilt * (1.0 - 2.0 * i as f64 / last)).clamp(0.0, 1.0);
+            *g = gmin[n] + u * (gmax[n] - gmin[n]);
+            sum += *g;
+        }
+        sum * p.dt_s()
+    }
+
+    /// Fills `out` with the level whose duration is `need_s` (s), blending the two bracketing
+    /// walks sample by sample to the exact duration; `false` (and `out` undefined) if no level
+    /// reaches it.
+    fn fill(&self, out: &mut [f64], need_s: f64) -> bool {
+        if out.is_empty() {
+            return need_s.abs() <= 1e-12;
+        }
+        let (mut a, mut b) = (-1.0 - self.tilt, 2.0 + self.tilt);
+        let mut lower = out.to_vec();
+        let mut upper = out.to_vec();
+        let fa = self.walk(a, &mut lower);
+        let fb = self.walk(b, &mut upper);
+        if !(fa <= need_s && need_s <= fb) {
+            return false;
+        }
+        let (mut fa, mut fb) = (fa - need_s, fb - need_s);
+        let mut scratch = out.to_vec();
+        let mut side = 0;
+        // Illinois regula falsi on the (piecewise linear, non-decreasing) duration.
+        for _ in 0..48 {
+            if fa == 0.0 || fb == 0.0 || b - a < 1e-9 {
+                break;
+            }
+            let c = (a * fb - b * fa) / (fb - fa);
+            let c = if c > a && c < b { c } else { 0.5 * (a + b) };
+            let fc = self.walk(c, &mut scratch) - need_s;
             if fc < 0.0 {
                 (a, fa) = (c, fc);
                 std::mem::swap(&mut lower, &mut scratch);
@@ -263,60 +215,79 @@ impl Run<'_> {
                 }
                 side = 1;
             }
-            if fc.abs() < 1e-7 || b - a < 1e-3 {
+            if fc.abs() < 1e-9 {
                 break;
             }
         }
+        let dt = self.problem.dt_s();
         let total = |g: &[f64]| g.iter().sum::<f64>() * dt;
         let (ta, tb) = (total(&lower), total(&upper));
         let mu = if tb > ta {
-            ((dur_s - ta) / (tb - ta)).clamp(0.0, 1.0)
+            ((need_s - ta) / (tb - ta)).clamp(0.0, 1.0)
         } else {
             0.0
         };
         for ((g, lo), up) in out.iter_mut().zip(&lower).zip(&upper) {
             *g = lo + mu * (up - lo);
         }
-        // Rounding goes to the last samples, within their bounds.
-        let (gmin, gmax) = (self.problem.grad_min(), self.problem.grad_max());
-        let mut rest = (dur_s - total(out)) / dt;
-        for (i, g) in out.iter_mut().enumerate().rev() {
-            if rest == 0.0 {
-                break;
-            }
-            let n = self.start + i;
-            let new = (*g + rest).clamp(gmin[n], gmax[n]);
-            rest -= new - *g;
-            *g = new;
-        }
+        true
     }
 }
 
-/// Half-width of the first bracket around the guessed speed level.
-const GUESS_STEP: f64 = 0.01;
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exact::search::Clearance;
+    use crate::exact::stn;
 
-/// The gradient of a sample with bounds `[lo, hi]` in class `class` at speed level
-/// `lam ∈ [−1, 2]` (larger is slower). Presets: `Post` at `hi·post_slow` (the robot's last LC
-/// sample's slow rate), `Zone` at `lo`, `Free` at `lo`, `Band` free to move: on `[−1, 0]` the
-/// presets go from `lo` to their value (`Band` stays at `lo`); on `[0, 1]` `Band` goes from `lo`
-/// to `min(hi, f_cap·lo)`; on `[1, 2]` everyone goes to `hi`.
-fn level(lam: f64, lo: f64, hi: f64, class: Class, post_slow: f64, f_cap: f64) -> f64 {
-    let cap = hi.min(lo * f_cap).max(lo);
-    let preset = match class {
-        Class::Post => (hi * post_slow).clamp(lo, cap),
-        Class::Zone | Class::Free | Class::Band => lo,
-    };
-    let lam = lam.clamp(-1.0, 2.0);
-    if lam < 0.0 {
-        lo + (lam + 1.0) * (preset - lo)
-    } else if lam < 1.0 {
-        if class == Class::Band {
-            lo + lam * (cap - lo)
-        } else {
-            preset
+    /// [LC ×10, HC ×40, LC ×10], mean 1 in [0.5, 2] with a wobble in the HC bounds, 10 ms.
+    fn lhl() -> Problem {
+        let n = 60;
+        let conf: Vec<bool> = (0..n).map(|i| (10..50).contains(&i)).collect();
+        let hi: Vec<f64> = (0..n).map(|i| 2.0 + 0.5 * ((i % 7) as f64 / 7.0)).collect();
+        Problem::new(conf, vec![1.0; n], vec![0.5; n], hi, 0.01).unwrap()
+    }
+
+    #[test]
+    fn shaped_runs_last_as_the_times_say_within_bounds() {
+        let p = lhl();
+        let chain = Chain::new(&p);
+        // 1 2 1 2 with 0.1 s between the robots: each HC run lasts 0.3 s (of [0.2, ~0.9] s),
+        // waiting for the other robot's LC run and the clearances.
+        let times = stn::earliest(&chain, &[0, 1, 0, 1], &Clearance::uniform(0.1, None)).unwrap();
+        for tilt in [0.0, 0.5, 1.0] {
+            let shaping = Shaping { edge_s: 0.02, tilt };
+            let s = shaped_schedule(&p, &chain, &times, &shaping, 0.01);
+            for r in 0..2 {
+                let g = &s.grad_exec[r];
+                // LC samples at the mean (Eq. 20 constraint 4), HC within the bounds.
+                assert!(g[..10].iter().chain(&g[50..]).all(|&x| x == 1.0));
+                let bounds = p.grad_min().iter().zip(p.grad_max());
+                for (n, (&x, (&lo, &hi))) in g.iter().zip(bounds).enumerate().take(50).skip(10) {
+                    assert!(x >= lo && x <= hi, "{tilt} {r} {n}");
+                }
+                let dur: f64 = g[10..50].iter().sum::<f64>() * 0.01;
+                let want = times.gaps_s(&chain, r)[1];
+                assert!(
+                    (dur - want).abs() < 1e-12,
+                    "tilt {tilt}, robot {r}: {dur} vs {want}"
+                );
+                assert!((times.gaps_s(&chain, r)[1] - 0.3).abs() < 1e-12);
+                // The edge before the robot's own next LC run is at ψ̇min (0.02 s = 4 samples);
+                // rounding goes to the last sample.
+                assert!(g[46..49].iter().all(|&x| x == 0.5), "{:?}", &g[40..50]);
+                // The first 0.02 s after its LC run are no faster than the run left it: the
+                // smallest S = ψ̇̄/ψ̇max over the run's last 0.02 s (samples 8 and 9), so
+                // ψ̇_E ≥ S·ψ̇max.
+                let (gmax, gmean) = (p.grad_max(), p.grad_mean());
+                let exit = (gmean[8] / gmax[8]).min(gmean[9] / gmax[9]);
+                assert!(g[10] >= exit * gmax[10] - 1e-12 && g[11] >= exit * gmax[11] - 1e-12);
+                // With a tilt the body runs slow first, fast last.
+                if tilt > 0.0 {
+                    let u = |n: usize| (g[n] - 0.5) / (p.grad_max()[n] - 0.5);
+                    assert!(u(16) > u(44), "tilt {tilt}: {} ≤ {}", u(16), u(44));
+                }
+            }
         }
-    } else {
-        let base = if class == Class::Band { cap } else { preset };
-        base + (lam - 1.0) * (hi - base)
     }
 }

@@ -127,7 +127,7 @@ fn solve(chain: &Chain, order: &[Robot], clear: &Clearance, after_start: bool) -
                 });
                 end_prev
             } else {
-                end_prev + clear.before[r][k]
+                end_prev + clear.between(pk, k)
             };
             edges.push(Edge {
                 from: lc(pr, pk),
@@ -190,17 +190,14 @@ mod tests {
         // 1 2 1 2: robot 1 LC [0, 1), robot 2 LC [1, 2) (τ = 1), robot 1's gap 1 s → LC
         // [2, 3), robot 2's gap 1 s → LC [3, 4): T_total 4.
         let c = lhl();
-        let t = earliest(&c, &[0, 1, 0, 1], &Clearance::zero(2)).unwrap();
+        let t = earliest(&c, &[0, 1, 0, 1], &Clearance::zero()).unwrap();
         assert_eq!(t.tau_s, 1.0);
         assert_eq!(t.lc_start_s, [vec![0.0, 2.0], vec![1.0, 3.0]]);
         assert_eq!(t.t_total_s(), 4.0);
         assert_eq!(t.gaps_s(&c, 1), vec![0.0, 1.0, 0.0]);
         // Clearance 0.25 before every run: robot 2 at 1.25, robot 1's second run at 2.5,
         // robot 2's at 3.75: 4.75.
-        let clear = Clearance {
-            before: [vec![0.25; 2], vec![0.25; 2]],
-            after_start: None,
-        };
+        let clear = Clearance::uniform(0.25, None);
         let t = earliest(&c, &[0, 1, 0, 1], &clear).unwrap();
         assert_eq!(t.t_total_s(), 4.75);
     }
@@ -210,11 +207,11 @@ mod tests {
         // 1 1 2 2: robot 1's runs at 0 and 1.5, robot 2 starts when robot 1 ends (τ = 2.5 =
         // |ψ_E1|), its second run at 4: T_total 5.
         let c = lhl();
-        let t = earliest(&c, &[0, 0, 1, 1], &Clearance::zero(2)).unwrap();
+        let t = earliest(&c, &[0, 0, 1, 1], &Clearance::zero()).unwrap();
         assert_eq!((t.tau_s, t.end_s), (2.5, [2.5, 5.0]));
         // Robot 2's gap cannot hold both of robot 1's runs (1 + 0.5 + 1 > 2): 2 1 1 2 fails.
-        assert!(earliest(&c, &[1, 0, 0, 1], &Clearance::zero(2)).is_none());
+        assert!(earliest(&c, &[1, 0, 0, 1], &Clearance::zero()).is_none());
         // Wrong counts.
-        assert!(earliest(&c, &[0, 0, 0, 1], &Clearance::zero(2)).is_none());
+        assert!(earliest(&c, &[0, 0, 0, 1], &Clearance::zero()).is_none());
     }
 }

@@ -1,0 +1,292 @@
+//! Choosing the schedule: the one place that decides which schedule a re-schedule returns, and
+//! the certificate that comes with it.
+//!
+//! [`sample_schedule`] runs, for one problem and control tick:
+//! 1. **the incumbent**: the previous schedule if it is still valid at the tick, else its
+//!    repair (gradients clamped into the new bounds, the new mean on low-confidence samples,
+//!    `τ` clamped into `[0, |ψ_E1|]`) if that is valid, else nothing; the fastest serial
+//!    schedule ([`Problem::serial_schedule`]) replaces it if it is faster or there is none;
+//! 2. in parallel (rayon, deterministic whatever the thread count), **the sampler** of §II-C
+//!    (`crate::sampler`, its candidates cut at the incumbent's `T_total`) and **the exact
+//!    search with the margin-aware completion** (`crate::exact`): the margin-free optimum
+//!    `T*₀` (a lower bound on every schedule of Eq. 20) and a schedule built from it that
+//!    passes the margin check;
+//!    The completion starts both cold and warm from the incumbent (when that is not the
+//!    serial schedule, which keeps no pair of LC runs);
+//! 3. with a quarter of the completion's budget on top, the completion warm-started from the
+//!    sampler's winner, if that beats the incumbent: it tightens the winner's clearances;
+//! 4. **the choice**: the least `T_total` of the three, ties going to the incumbent, then to
+//!    the sampler's winner. The sampler and the completion run exactly as they would alone
+//!    (same seed, same incumbent, same budget), so the result is never worse than either's.
+//!
+//! Every candidate is checked with [`crate::validate`] at the tick before it can win. The
+//! [`Outcome`] carries the schedule, its `T_total`, where it came from, and its certificate:
+//! the bound and the gap `(T_total − bound)/bound`.
+
+use serde::{Deserialize, Serialize};
+use tandem_realtime::clock_end_s;
+
+use crate::exact;
+use crate::problem::Problem;
+use crate::sampler::{self, SamplerBaselines, SamplerParams, SamplerStats};
+use crate::schedule::Schedule;
+use crate::validate::{Violation, validate};
+use crate::{Error, Result};
+
+/// Where the returned schedule came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Source {
+    /// Sampled candidate number `candidate` (ChaCha8 stream of the seed).
+    Sampled {
+        /// Candidate index `k`.
+        candidate: u64,
+    },
+    /// The margin-aware completion of the exact margin-free optimum
+    /// ([`crate::exact`], "Margin-aware completion").
+    Completed,
+    /// The previous schedule's warps and offset, unchanged (still valid at the scheduler's
+    /// tick, nothing better found).
+    Previous,
+    /// The previous schedule repaired for the new problem (gradients clamped into the new
+    /// bounds, new mean on low-confidence samples, `τ` clamped to `[0, |ψ_E1|]`).
+    RepairedPrevious,
+    /// The fastest serial schedule ([`Problem::serial_schedule`]).
+    Serial,
+}
+
+impl Source {
+    /// The short name of the source in records (the study's JSON and CSV, the Python
+    /// package): `sampled`, `completed`, `previous`, `repaired` or `serial`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Source::Sampled { .. } => "sampled",
+            Source::Completed => "completed",
+            Source::Previous => "previous",
+            Source::RepairedPrevious => "repaired",
+            Source::Serial => "serial",
+        }
+    }
+}
+
+/// A re-schedule's result: the schedule and its certificate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Outcome {
+    /// The schedule; its [`Schedule::tick_s`] is the scheduler's tick, at which it passes
+    /// [`crate::validate`].
+    pub schedule: Schedule,
+    /// Its `T_total` (Eq. 13), s: exactly `schedule.t_total_s(Δt_s)`, read from the one
+    /// clock.
+    pub t_total_s: f64,
+    /// Where it came from.
+    pub source: Source,
+    /// Counts.
+    pub stats: SamplerStats,
+    /// A lower bound (s) on the `T_total` of every schedule satisfying Eq. 20: the margin-free
+    /// optimum `T*₀` (constraints 1–4, [`crate::solve_exact`]) when
+    /// [`Outcome::bound_is_optimum`], else the simple bound of an unfinished search. Never
+    /// above [`Outcome::t_total_s`].
+    pub lower_bound_s: f64,
+    /// Whether [`Outcome::lower_bound_s`] is the proven margin-free optimum `T*₀`.
+    pub bound_is_optimum: bool,
+    /// `(T_total − lower_bound_s)/lower_bound_s` (dimensionless, ≥ 0): the schedule is at most
+    /// this much (relative) above the optimum of Eq. 20; what it is above `T*₀` is what the
+    /// margins (constraint 5) cost, plus whatever the search left.
+    pub gap: f64,
+}
+
+/// A schedule that passed every constraint of Eq. 20 at the scheduler's tick, with its
+/// `T_total` (s) and where it came from.
+type Candidate = (Schedule, f64, Source);
+
+/// The previous schedule re-projected onto `problem` at control tick `tick_s` (s): gradients
+/// clamped into the new bounds, the new mean on low-confidence samples, `τ` clamped into
+/// `[0, |ψ_E1|]`. `None` for warps of the wrong length.
+pub(crate) fn repair(problem: &Problem, previous: &Schedule, tick_s: f64) -> Option<Schedule> {
+    let n_ref = problem.n_ref();
+    if previous.grad_exec.iter().any(|g| g.len() != n_ref) {
+        return None;
+    }
+    let warps = previous.grad_exec.each_ref().map(|g| {
+        (0..n_ref)
+            .map(|n| {
+                if problem.conf()[n] {
+                    let x = if g[n].is_finite() {
+                        g[n]
+                    } else {
+                        problem.grad_mean()[n]
+                    };
+                    x.clamp(problem.grad_min()[n], problem.grad_max()[n])
+                } else {
+                    problem.grad_mean()[n]
+                }
+            })
+            .collect::<Vec<f64>>()
+    });
+    let max_s = clock_end_s(&warps[0], 0.0, problem.dt_s());
+    let offset_s = if previous.offset_s.is_finite() {
+        previous.offset_s.clamp(0.0, max_s)
+    } else {
+        max_s
+    };
+    Some(Schedule {
+        grad_exec: warps,
+        offset_s,
+        tick_s,
+    })
+}
+
+/// The incumbent at control tick `tick_s` (see the module docs, step 1), or, if there is none,
+/// why the serial schedule failed.
+fn incumbent(
+    problem: &Problem,
+    previous: Option<&Schedule>,
+    tick_s: f64,
+) -> Result<std::result::Result<Candidate, Violation>> {
+    let dt_s = problem.dt_s();
+    let mut found: Option<Candidate> = None;
+    if let Some(prev) = previous {
+        // The previous schedule is valid at its own tick; re-check it at this one.
+        let prev = Schedule {
+            tick_s,
+            ..prev.clone()
+        };
+        if validate(problem, &prev).is_ok() {
+            let t = prev.t_total_s(dt_s);
+            found = Some((prev, t, Source::Previous));
+        } else if let Some(fixed) = repair(problem, &prev, tick_s)
+            && validate(problem, &fixed).is_ok()
+        {
+            let t = fixed.t_total_s(dt_s);
+            found = Some((fixed, t, Source::RepairedPrevious));
+        }
+    }
+    let serial = problem.serial_schedule(tick_s)?;
+    let serial_t = serial.t_total_s(dt_s);
+    if found.as_ref().is_none_or(|inc| serial_t < inc.1) {
+        match validate(problem, &serial) {
+            Ok(()) => found = Some((serial, serial_t, Source::Serial)),
+            Err(v) if found.is_none() => return Ok(Err(v)),
+            Err(_) => {}
+        }
+    }
+    Ok(Ok(found.expect(
+        "the serial schedule or an earlier incumbent was kept",
+    )))
+}
+
+/// The scheduler (see the module docs): the least-`T_total` schedule among the incumbent
+/// (previous schedule, its repair, the fastest serial schedule), the anytime sampler's winner
+/// (§II-C, `params.samples` candidates) and the margin-aware completion of the exact
+/// margin-free optimum, that satisfies every constraint of Eq. 20 at the control tick
+/// `params.tick_s`, certified against the margin-free lower bound `T*₀`.
+///
+/// Runs on the current rayon thread pool; the result for a seed is the same whatever the
+/// number of threads. Never worse than the sampler alone with the same seed, nor than the
+/// completion alone ([`SamplerBaselines::sampler_only`], [`SamplerBaselines::completion_only`]).
+///
+/// # Errors
+/// [`Error::BadParam`] for invalid parameters; [`Error::NoFeasibleSchedule`] if not even the
+/// serial schedule passes (which would mean the margin check rejects a schedule with no
+/// concurrent execution at all).
+pub fn sample_schedule(
+    problem: &Problem,
+    params: &SamplerParams,
+    previous: Option<&Schedule>,
+) -> Result<Outcome> {
+    sample_schedule_with_baselines(problem, params, &SamplerBaselines::default(), previous)
+}
+
+/// [`sample_schedule`] with benchmark-only alternatives to its design (see
+/// [`SamplerBaselines`]); `SamplerBaselines::default()` is [`sample_schedule`] itself.
+///
+/// # Errors
+/// As [`sample_schedule`].
+pub fn sample_schedule_with_baselines(
+    problem: &Problem,
+    params: &SamplerParams,
+    baselines: &SamplerBaselines,
+    previous: Option<&Schedule>,
+) -> Result<Outcome> {
+    params.validate()?;
+    let tick_s = params.tick_s.unwrap_or(problem.dt_s());
+    let incumbent = match incumbent(problem, previous, tick_s)? {
+        Ok(inc) => inc,
+        Err(serial) => return Err(Error::NoFeasibleSchedule { serial }),
+    };
+    let cap_s = incumbent.1;
+    let budget = if baselines.sampler_only {
+        0
+    } else {
+        params.exact.max_margin_checks
+    };
+    // Refining the sampler's winner gets a quarter of the completion's budget on top, so the
+    // completion itself runs exactly as it would alone.
+    let refine_budget = if baselines.completion_only {
+        0
+    } else {
+        budget / 4
+    };
+    let warm: Vec<&Schedule> = (incumbent.2 != Source::Serial)
+        .then_some(&incumbent.0)
+        .into_iter()
+        .collect();
+    let ((winner, mut stats), (bound, (done, mut checks))) = rayon::join(
+        || {
+            if baselines.completion_only {
+                (None, SamplerStats::default())
+            } else {
+                sampler::run(problem, params, baselines, tick_s, previous, cap_s)
+            }
+        },
+        || {
+            let bound = exact::bound(problem, &params.exact);
+            let done = if bound.lower_bound_s < cap_s {
+                exact::completion(problem, &params.exact, tick_s, cap_s, budget, true, &warm)
+            } else {
+                (None, 0)
+            };
+            (bound, done)
+        },
+    );
+    let mut best = incumbent;
+    let mut completed = done.map(|d| (d.schedule, d.t_total_s));
+    if let Some((s, t, k)) = winner {
+        if t < best.1 {
+            // The sampler's winner as a warm start: the completion tightens its clearances.
+            let cap = completed.as_ref().map_or(t, |c| c.1.min(t));
+            let (better, more) = exact::completion(
+                problem,
+                &params.exact,
+                tick_s,
+                cap,
+                refine_budget,
+                false,
+                &[&s],
+            );
+            checks += more;
+            if let Some(b) = better {
+                completed = Some((b.schedule, b.t_total_s));
+            }
+            best = (s, t, Source::Sampled { candidate: k });
+        }
+    }
+    stats.completion_margin_checks = checks;
+    stats.search = bound.stats;
+    if let Some((schedule, t)) = completed
+        && t < best.1
+        && validate(problem, &schedule).is_ok()
+    {
+        best = (schedule, t, Source::Completed);
+    }
+    let (schedule, t_total_s, source) = best;
+    let lower_bound_s = bound.lower_bound_s.min(t_total_s);
+    Ok(Outcome {
+        schedule,
+        t_total_s,
+        source,
+        stats,
+        lower_bound_s,
+        bound_is_optimum: bound.proven_optimal,
+        gap: (t_total_s - lower_bound_s) / lower_bound_s,
+    })
+}
