@@ -42,12 +42,15 @@ enum Cmd {
         #[arg(long)]
         out: std::path::PathBuf,
     },
-    /// Run N Coordinator executions of sampled schedules under adversarial operators and
-    /// count ticks with both robots low-confidence (expected 0).
+    /// Run E Coordinator executions of random schedules of N robots under adversarial operators
+    /// and count ticks with two or more robots low-confidence (expected 0).
     Stress {
         /// Total number of executions.
         #[arg(long, default_value_t = 1_000_000)]
         executions: u64,
+        /// Number of robots N (1 to 8); 2 schedules with the sampler, others draw schedules.
+        #[arg(long, default_value_t = 2)]
+        robots: usize,
         /// Seed of the random problems, the sampler and the operators.
         #[arg(long, default_value_t = 1)]
         seed: u64,
@@ -59,7 +62,11 @@ fn main() -> anyhow::Result<()> {
     match cli.cmd {
         Cmd::Fixtures { check } => fixtures::run(check),
         Cmd::Study(args) => study::run(&args),
-        Cmd::Stress { executions, seed } => stress::run(executions, seed),
+        Cmd::Stress {
+            executions,
+            robots,
+            seed,
+        } => stress::run(executions, seed, robots),
         Cmd::ReferenceOrder(args) => reference_order::run(&args),
         Cmd::Fig5Demo { out } => {
             let (svg, png) = fig5::run_demo(&out)?;

@@ -475,7 +475,7 @@ pub fn run_pair_with(
         }
         let tick = coord.tick(operator)?;
         ticks += 1;
-        match tick.low_conf {
+        match *tick.low_conf {
             [true, true] => overlap_ticks += 1,
             [false, false] => idle_ticks += 1,
             _ => {}
