@@ -311,7 +311,7 @@ pub fn run_adversary(
         if run.ticks >= max_ticks {
             return Ok(run);
         }
-        let lc = coordinator.low_conf_now().iter().position(|&l| l);
+        let lc = coordinator.low_conf_now().first();
         let op = state.next(adversary, run.ticks, lc, rng);
         let tick = coordinator.tick(op)?;
         if tick.overlap() {

@@ -1,7 +1,7 @@
 //! Runtime coordinator: advances N robots one control tick at a time (§II-B5).
 
 use crate::error::{Error, Result};
-use crate::robots::{MAX_ROBOTS, PerRobot, check_count};
+use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
 use crate::strategy::{Member, Mode, advance};
 use crate::timeline::Timeline;
 use crate::tol::clock_tolerance_s;
@@ -48,10 +48,10 @@ pub struct Tick {
     pub ref_time: PerRobot<f64>,
     /// Whether each robot traversed ANY low-confidence reference sample during this tick
     /// (see [`Coordinator`] for the exact, conservative definition).
-    pub low_conf: PerRobot<bool>,
+    pub low_conf: RobotFlags,
     /// Whether each robot is running (started and not finished) during the tick: its schedule
     /// clock moved inside `[τ_i, τ_i + |ψ_E|)`.
-    pub running: PerRobot<bool>,
+    pub running: RobotFlags,
 }
 
 impl Tick {
@@ -60,7 +60,7 @@ impl Tick {
     /// [`sufficient_margins`](crate::sufficient_margins) accepts never has such a tick).
     #[must_use]
     pub fn overlap(&self) -> bool {
-        self.low_conf.iter().filter(|&&lc| lc).count() >= 2
+        self.low_conf.count() >= 2
     }
 }
 
@@ -200,15 +200,15 @@ impl Coordinator {
     /// Whether each robot is running and low-confidence at its current schedule clock (Eq. 16
     /// at the tick start): the robot the next [`tick`](Coordinator::tick) moves at the
     /// operator's rate. O(N), no allocation.
-    pub fn low_conf_now(&self) -> PerRobot<bool> {
-        let mut out = PerRobot::new(self.robots.len());
-        for ((lc, r), (&s, cur)) in out
-            .as_mut_slice()
-            .iter_mut()
-            .zip(&self.robots)
+    pub fn low_conf_now(&self) -> RobotFlags {
+        let mut out = RobotFlags::new(self.robots.len());
+        for (i, (r, (&s, cur))) in self
+            .robots
+            .iter()
             .zip(self.clock_s.iter().zip(&self.cursors))
+            .enumerate()
         {
-            *lc = s >= r.start_s() && s < r.end_s() && !r.conf()[cur.at];
+            out.set(i, s >= r.start_s() && s < r.end_s() && !r.conf()[cur.at]);
         }
         out
     }
@@ -251,56 +251,51 @@ impl Coordinator {
     pub fn tick(&mut self, operator: Operator) -> Result<Tick> {
         let g = operator.validate()?;
         let n = self.robots.len();
-        let mut phases = [Phase::Finished; MAX_ROBOTS];
         let mut members = [Member::idle(0.0, Mode::Finished); MAX_ROBOTS];
         let mut next_s = [0.0_f64; MAX_ROBOTS];
         let mut pace_robot = None;
         for i in 0..n {
-            phases[i] = self.phase(i);
             let s = self.clock_s[i];
-            members[i] = match phases[i] {
+            members[i] = match self.phase(i) {
                 Phase::Waiting => Member::idle(s, Mode::Waiting),
                 Phase::Finished => Member::idle(s, Mode::Finished),
-                Phase::Active { low_conf } => {
-                    if low_conf {
-                        next_s[i] = s + self.operator_step(i, g);
-                        pace_robot.get_or_insert(i);
-                    }
-                    Member {
-                        clock_s: s,
-                        mode: if low_conf { Mode::Low } else { Mode::High },
-                        rates: self.robots[i].rates(self.cursors[i].at),
-                    }
+                Phase::Active { low_conf: true } => {
+                    next_s[i] = s + self.operator_step(i, g);
+                    pace_robot.get_or_insert(i);
+                    Member::idle(s, Mode::Low)
                 }
+                Phase::Active { low_conf: false } => Member {
+                    clock_s: s,
+                    mode: Mode::High,
+                    rates: self.robots[i].rates(self.cursors[i].at),
+                },
             };
         }
         advance(&members[..n], pace_robot, self.tick_s, &mut next_s[..n]);
         let mut out = Tick {
             ref_time: PerRobot::new(n),
-            low_conf: PerRobot::new(n),
-            running: PerRobot::new(n),
+            low_conf: RobotFlags::new(n),
+            running: RobotFlags::new(n),
         };
-        for i in 0..n {
+        for (i, m) in members[..n].iter().enumerate() {
             let r = &self.robots[i];
             let s_old = self.clock_s[i];
-            let cap = if phases[i] == Phase::Waiting {
-                r.start_s()
-            } else {
-                r.end_s()
-            };
+            let waiting = m.mode == Mode::Waiting;
+            let cap = if waiting { r.start_s() } else { r.end_s() };
             let s_new = next_s[i].min(cap).max(s_old);
             self.clock_s[i] = s_new;
             let moved = s_new > s_old;
-            out.running.as_mut_slice()[i] = moved && s_new > r.start_s() && s_old < r.end_s();
+            out.running
+                .set(i, moved && s_new > r.start_s() && s_old < r.end_s());
             if moved
                 && s_new + self.tol_s >= r.start_s()
-                && phases[i] != Phase::Waiting
+                && !waiting
                 && s_old - self.tol_s < r.end_s()
             {
                 let cur = &mut self.cursors[i];
                 let lo = r.advance_cursor(&mut cur.lo, s_old - self.tol_s);
                 let hi = r.advance_cursor(&mut cur.hi, s_new + self.tol_s);
-                out.low_conf.as_mut_slice()[i] = r.any_low_conf(lo, hi);
+                out.low_conf.set(i, r.any_low_conf(lo, hi));
             }
             let at = r.advance_cursor(&mut self.cursors[i].at, s_new);
             out.ref_time.as_mut_slice()[i] = r.ref_time_in(at, s_new);
@@ -555,7 +550,7 @@ mod tests {
         let t = c.tick(Operator::Slowest).unwrap();
         assert_eq!(
             (c.clock_s(), t.low_conf),
-            ([1.0].as_slice(), PerRobot::from_slice(&[true]))
+            ([1.0].as_slice(), RobotFlags::from_slice(&[true]))
         );
         c.tick(Operator::Slowest).unwrap();
         assert_eq!(c.clock_s(), [1.5]);

@@ -68,6 +68,6 @@ pub use margins::{
     sufficient_margins, sufficient_margins_pairwise, sufficient_margins_per_pair,
     sufficient_margins_printed,
 };
-pub use robots::{MAX_ROBOTS, PerRobot};
+pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};
 pub use strategy::{high_conf_steps, response_step};
 pub use timeline::{LcInterval, Rates, Timeline, clock_end_s, clock_s};

@@ -107,7 +107,8 @@ impl Member {
 
 /// One tick of the N-robot strategy (the [module docs](self)): writes each robot's new,
 /// uncapped schedule clock into `next_s` and returns the clock that robots not yet started
-/// follow — the smallest new clock of a running robot (s) — or `None` when no robot runs.
+/// follow — the smallest new clock of a running robot (s) — or `None` when no robot waits or
+/// none runs.
 ///
 /// `next_s[i]` must already hold the operator-set new clock of every [`Mode::Low`] robot;
 /// `pace_robot` is the LC robot that sets the pace (`None` when none is LC). O(N), no
@@ -170,7 +171,8 @@ pub(crate) fn advance(
             }
         }
     };
-    let follow = pace.map(|_| {
+    let waiting = members.iter().any(|m| m.mode == Mode::Waiting);
+    let follow = pace.filter(|_| waiting).map(|_| {
         next_s
             .iter()
             .zip(members)
@@ -262,13 +264,14 @@ mod tests {
         // Both HC: exactly `high_conf_steps`, robot 0 the leader on a tie.
         let m = [hc(0.0, 4.0, 0.25), hc(0.0, 1.5, 0.5)];
         let mut next = [0.0; 2];
-        assert_eq!(advance(&m, None, 1.0, &mut next), Some(1.5));
+        // No robot waits: nothing to follow.
+        assert_eq!(advance(&m, None, 1.0, &mut next), None);
         assert_eq!(next, [1.5, 1.5]);
-        // Robot 1 LC at the operator's step 2: robot 0 (ahead by 1) responds to the lead
-        // 0 + ... after the step: lead 3 − 2 = 1 ≥ 0 → slowest.
+        // Robot 1 LC, the operator steps it to 2: robot 0, at 3, leads by 3 − 2 = 1 after that
+        // step → slowest.
         let m = [hc(3.0, 2.0, 0.5), Member::idle(0.0, Mode::Low)];
         let mut next = [0.0, 2.0];
-        assert_eq!(advance(&m, Some(1), 1.0, &mut next), Some(2.0));
+        assert_eq!(advance(&m, Some(1), 1.0, &mut next), None);
         assert_eq!(next, [3.5, 2.0]);
     }
 
@@ -280,7 +283,7 @@ mod tests {
         // robot 2 (at 1) matches it.
         let m = [hc(2.0, 2.0, 0.5), hc(0.0, 1.5, 0.5), hc(1.0, 3.0, 0.5)];
         let mut next = [0.0; 3];
-        assert_eq!(advance(&m, None, 1.0, &mut next), Some(1.5));
+        assert_eq!(advance(&m, None, 1.0, &mut next), None);
         assert_eq!(next, [2.5, 1.5, 1.5]);
         // A waiting robot follows the running robot furthest behind, a finished one stays.
         let m = [
@@ -320,9 +323,10 @@ mod tests {
             hc(0.0, 3.0, 0.5),
             hc(3.0, 2.0, 0.25),
         ];
-        let mut next = [0.0, 2.0, 0.0, 0.0];
-        // The returned clock, the one robots not yet started follow, is the smallest: 1.5.
+        let mut next = [0.0, 2.0, 0.0, 0.0, 0.0];
+        let m = [m[0], m[1], m[2], m[3], Member::idle(0.0, Mode::Waiting)];
+        // The returned clock, the one a robot not yet started follows, is the smallest: 1.5.
         assert_eq!(advance(&m, Some(1), 1.0, &mut next), Some(1.5));
-        assert_eq!(next, [1.5, 2.0, 2.0, 3.25]);
+        assert_eq!(next, [1.5, 2.0, 2.0, 3.25, 1.5]);
     }
 }
