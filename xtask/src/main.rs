@@ -52,12 +52,15 @@ enum Cmd {
     /// virtual environment under target/ with the pinned packages of
     /// python/requirements-dev.txt and run pytest on python/tests (the README's test command).
     Test(test::TestArgs),
-    /// Run N Coordinator executions of sampled schedules under adversarial operators and
-    /// count ticks with both robots low-confidence (expected 0).
+    /// Run E Coordinator executions of random schedules of N robots under adversarial operators
+    /// and count ticks with two or more robots low-confidence (expected 0).
     Stress {
         /// Total number of executions.
         #[arg(long, default_value_t = 1_000_000)]
         executions: u64,
+        /// Number of robots N (1 to 8); 2 schedules with the sampler, others draw schedules.
+        #[arg(long, default_value_t = 2)]
+        robots: usize,
         /// Seed of the random problems, the sampler and the operators.
         #[arg(long, default_value_t = 1)]
         seed: u64,
@@ -69,7 +72,11 @@ fn main() -> anyhow::Result<()> {
     match cli.cmd {
         Cmd::Fixtures { check } => fixtures::run(check),
         Cmd::Study(args) => study::run(&args),
-        Cmd::Stress { executions, seed } => stress::run(executions, seed),
+        Cmd::Stress {
+            executions,
+            robots,
+            seed,
+        } => stress::run(executions, seed, robots),
         Cmd::ReferenceOrder(args) => reference_order::run(&args),
         Cmd::Test(args) => test::run_all(&args),
     }

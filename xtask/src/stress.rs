@@ -1,14 +1,22 @@
-//! `cargo xtask stress --executions N [--seed S]`: the safety invariant under load.
+//! `cargo xtask stress --executions E [--robots N] [--seed S]`: the safety invariant under load.
 //!
-//! Samples random problems of a few hundred reference samples, schedules each with the
-//! scheduler of `tandem-schedule` (the anytime sampler and the margin-aware completion beside
-//! it) at a random control tick, then runs `N` executions in all
-//! through each schedule's own `Coordinator` (at the tick it was checked with) under the full
-//! adversary set of `tandem::realtime::adversary` (no correction, always fastest, always
-//! slowest, Alg. 2's worst case for each role, switching every tick, periodic, one switch,
-//! random switching, random extremes per tick and per robot, random gradients per tick and
-//! held), in parallel, and counts ticks in which both robots were low-confidence (expected:
-//! 0). Every number depends only on `N` and the seed.
+//! Samples random problems of a few hundred reference samples and schedules each at a random
+//! control tick, then runs `E` executions in all through each schedule's own `Coordinator` (at
+//! the tick it was checked with) under the full adversary set of
+//! `tandem::realtime::adversary` (no correction, always fastest, always slowest, Alg. 2's
+//! worst case with each robot as the current one, the favoured robot switching at random
+//! times, switching every tick, periodic, one switch, random switching, random extremes per
+//! tick and per robot, random gradients per tick and held), in parallel, and counts ticks in
+//! which two or more robots were low-confidence (expected: 0). Every number depends only on
+//! `E`, `N` and the seed.
+//!
+//! Two robots (the default) are scheduled by the scheduler of `tandem-schedule` (the anytime
+//! sampler and the margin-aware completion beside it). For
+//! other robot counts the schedules are drawn here, because the N-robot sampler is a later
+//! step: random warps (per robot and high-confidence run a fraction of the gradient bounds,
+//! fastest with probability ½), robot 1 at 0 and each further robot at the earliest of a few
+//! random offsets that `sufficient_margins` accepts with the robots before it, bisected towards
+//! the last rejected one (so most schedules sit at the acceptance boundary).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -17,10 +25,8 @@ use anyhow::{Context, bail};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use tandem::realtime::Coordinator;
-use tandem::realtime::adversary::{
-    Adversary, AdversaryRun, SET_SIZE, adversary_set, run_adversary,
-};
+use tandem::realtime::adversary::{Adversary, AdversaryRun, adversary_set, run_adversary};
+use tandem::realtime::{Coordinator, Timeline, sufficient_margins};
 use tandem::schedule::{Problem, SamplerParams, Source, sample_schedule};
 
 /// Executions per scheduled problem (the number of problems is `N / this`, at least 1 and at
@@ -34,6 +40,10 @@ const SAMPLES: usize = 500;
 const BATCH: u64 = 50_000;
 /// Reference sample period of the random problems (s).
 const DT_S: f64 = 0.01;
+/// Random candidate offsets per drawn robot (besides the serial start).
+const OFFSET_CANDIDATES: usize = 6;
+/// Bisection steps towards the acceptance boundary per drawn robot.
+const OFFSET_BISECTIONS: usize = 8;
 
 /// One scheduled random problem, ready to run.
 struct Case {
@@ -43,9 +53,10 @@ struct Case {
     max_ticks: u64,
     /// The full adversary set for this case (random gradients over the problem's whole
     /// `[min ψ̇min, max ψ̇max]`).
-    adversaries: [Adversary; SET_SIZE],
-    /// The schedule overlaps the robots: sampled or completed, not a serial fallback.
-    sampled: bool,
+    adversaries: Vec<Adversary>,
+    /// Whether the executions overlap (a sampled or completed two-robot schedule, or a drawn schedule in
+    /// which some robot starts before the robots placed before it have ended).
+    overlapping: bool,
 }
 
 /// A random problem: 200–400 samples, confidence in runs (LC runs 5–60 samples, HC runs 5–80),
@@ -75,31 +86,136 @@ fn random_problem(rng: &mut ChaCha8Rng) -> anyhow::Result<Problem> {
     Ok(Problem::new(conf, mean, min, max, DT_S)?)
 }
 
-fn make_case(seed: u64, index: u64) -> anyhow::Result<Case> {
+/// One robot's timeline on `problem`: its warp `grad_exec`, started at `start_s`.
+fn timeline(problem: &Problem, grad_exec: &[f64], start_s: f64) -> anyhow::Result<Timeline> {
+    Ok(Timeline::new(
+        problem.conf(),
+        grad_exec,
+        problem.grad_min(),
+        problem.grad_max(),
+        start_s,
+        problem.dt_s(),
+    )?)
+}
+
+/// Latest end (s) of `robots`.
+fn last_end_s(robots: &[Timeline]) -> f64 {
+    robots.iter().map(Timeline::end_s).fold(0.0, f64::max)
+}
+
+/// A drawn schedule of `n_robots` robots (see the module docs) as their timelines, and whether
+/// the executions overlap. A robot for which no offset is accepted (a decision of the earlier
+/// robots at the edge of the tolerance) makes the whole schedule serial, which is always
+/// accepted.
+fn draw_schedule(
+    problem: &Problem,
+    n_robots: usize,
+    tick_s: f64,
+    rng: &mut ChaCha8Rng,
+) -> anyhow::Result<(Vec<Timeline>, bool)> {
+    let warps: Vec<Vec<f64>> = (0..n_robots)
+        .map(|_| {
+            let mut warp = problem.grad_mean().to_vec();
+            for run in problem.runs().iter().filter(|r| r.high_conf) {
+                let frac = if rng.random_bool(0.5) {
+                    0.0
+                } else {
+                    rng.random::<f64>()
+                };
+                let bounds = problem.grad_min()[run.start..run.end]
+                    .iter()
+                    .zip(&problem.grad_max()[run.start..run.end]);
+                for (w, (lo, hi)) in warp[run.start..run.end].iter_mut().zip(bounds) {
+                    *w = lo + frac * (hi - lo);
+                }
+            }
+            warp
+        })
+        .collect();
+    let mut robots = vec![timeline(problem, &warps[0], 0.0)?];
+    let mut overlapping = false;
+    for warp in &warps[1..] {
+        let latest_end = last_end_s(&robots);
+        let mut offsets: Vec<f64> = (0..OFFSET_CANDIDATES)
+            .map(|_| latest_end * rng.random::<f64>().sqrt())
+            .collect();
+        offsets.push(latest_end);
+        offsets.sort_by(f64::total_cmp);
+        let mut accepts = |t: f64| -> anyhow::Result<bool> {
+            robots.push(timeline(problem, warp, t)?);
+            let ok = sufficient_margins(&robots, tick_s)?;
+            robots.pop();
+            Ok(ok)
+        };
+        let mut first = None;
+        for (k, &t) in offsets.iter().enumerate() {
+            if accepts(t)? {
+                first = Some(k);
+                break;
+            }
+        }
+        let Some(k) = first else {
+            let mut start_s = 0.0;
+            let serial = warps
+                .iter()
+                .map(|w| {
+                    let tl = timeline(problem, w, start_s)?;
+                    start_s = tl.end_s();
+                    Ok(tl)
+                })
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            return Ok((serial, false));
+        };
+        let mut tau = offsets[k];
+        if k > 0 {
+            let mut lo = offsets[k - 1];
+            for _ in 0..OFFSET_BISECTIONS {
+                let m = 0.5 * (lo + tau);
+                if accepts(m)? {
+                    tau = m;
+                } else {
+                    lo = m;
+                }
+            }
+        }
+        overlapping |= tau < latest_end;
+        robots.push(timeline(problem, warp, tau)?);
+    }
+    Ok((robots, overlapping))
+}
+
+fn make_case(seed: u64, index: u64, n_robots: usize) -> anyhow::Result<Case> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(index);
     let problem = random_problem(&mut rng)?;
     let tick_s = DT_S * rng.random_range(0.25..=1.0);
-    let params = SamplerParams {
-        samples: SAMPLES,
-        seed: rng.random(),
-        tick_s: Some(tick_s),
-        ..SamplerParams::default()
+    let (coordinator, overlapping) = if n_robots == 2 {
+        let params = SamplerParams {
+            samples: SAMPLES,
+            seed: rng.random(),
+            tick_s: Some(tick_s),
+            ..SamplerParams::default()
+        };
+        let out = sample_schedule(&problem, &params, None)?;
+        let sampled = matches!(out.source, Source::Sampled { .. } | Source::Completed);
+        (out.schedule.coordinator(&problem)?, sampled)
+    } else {
+        let (robots, overlapping) = draw_schedule(&problem, n_robots, tick_s, &mut rng)?;
+        (Coordinator::new(robots, tick_s)?, overlapping)
     };
-    let out = sample_schedule(&problem, &params, None)?;
     // Every robot at its slowest, one after the other, plus slack.
-    let slowest_s = problem.grad_max().iter().sum::<f64>() * DT_S * 2.0;
+    let slowest_s = problem.grad_max().iter().sum::<f64>() * DT_S * n_robots as f64;
     let fold = |f: fn(f64, f64) -> f64, init: f64, v: &[f64]| v.iter().copied().fold(init, f);
     let grad_range = [
         fold(f64::min, f64::INFINITY, problem.grad_min()),
         fold(f64::max, 0.0, problem.grad_max()),
     ];
-    let ticks = (out.t_total_s / tick_s) as u64;
+    let ticks = (last_end_s(coordinator.robots()) / tick_s) as u64;
     Ok(Case {
-        coordinator: out.schedule.coordinator(&problem)?,
         max_ticks: (2.0 * slowest_s / tick_s) as u64 + 100,
-        adversaries: adversary_set(grad_range, ticks, &mut rng),
-        sampled: matches!(out.source, Source::Sampled { .. } | Source::Completed),
+        adversaries: adversary_set(n_robots, grad_range, ticks, &mut rng),
+        coordinator,
+        overlapping,
     })
 }
 
@@ -115,25 +231,36 @@ fn execute(case: &Case, op: Adversary, seed: u64, exec: u64) -> anyhow::Result<A
     )?)
 }
 
-/// Runs the stress test; fails if any tick had both robots low-confidence.
-pub(crate) fn run(executions: u64, seed: u64) -> anyhow::Result<()> {
+/// Runs the stress test with `n_robots` robots; fails if any tick had two or more robots
+/// low-confidence.
+pub(crate) fn run(executions: u64, seed: u64, n_robots: usize) -> anyhow::Result<()> {
     if executions == 0 {
         bail!("--executions must be ≥ 1");
+    }
+    if !(1..=tandem::realtime::MAX_ROBOTS).contains(&n_robots) {
+        bail!("--robots must be in 1..={}", tandem::realtime::MAX_ROBOTS);
     }
     let start = Instant::now();
     let n_problems = (executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS);
     let cases: Vec<Case> = (0..n_problems)
         .into_par_iter()
-        .map(|i| make_case(seed, i).with_context(|| format!("scheduling problem {i}")))
+        .map(|i| make_case(seed, i, n_robots).with_context(|| format!("scheduling problem {i}")))
         .collect::<anyhow::Result<_>>()?;
-    let n_sampled = cases.iter().filter(|c| c.sampled).count();
+    let n_overlapping = cases.iter().filter(|c| c.overlapping).count();
+    let how = if n_robots == 2 {
+        format!(
+            "{SAMPLES} sampler candidates each: {n_overlapping} overlapping sampled or completed schedules"
+        )
+    } else {
+        format!("drawn schedules: {n_overlapping} with overlapping executions")
+    };
     println!(
-        "stress: {n_problems} random problems (200–400 samples, tick 0.25–1 sample), \
-         {SAMPLES} sampler candidates each: {n_sampled} overlapping sampled or completed schedules, {} serial \
-         fallbacks; scheduling took {:.1} s",
-        n_problems as usize - n_sampled,
+        "stress: {n_robots} robots, {n_problems} random problems (200–400 samples, tick 0.25–1 \
+         sample), {how}, {} serial; scheduling took {:.1} s",
+        n_problems as usize - n_overlapping,
         start.elapsed().as_secs_f64()
     );
+    let set_size = cases[0].adversaries.len() as u64;
     let run_start = Instant::now();
     let (ticks, overlap_ticks, overlap_runs, unfinished) = (
         AtomicU64::new(0),
@@ -147,7 +274,7 @@ pub(crate) fn run(executions: u64, seed: u64) -> anyhow::Result<()> {
         let end = (done + BATCH).min(executions);
         (done..end).into_par_iter().try_for_each(|e| {
             let case = &cases[(e % n_problems) as usize];
-            let op = case.adversaries[((e / n_problems) % SET_SIZE as u64) as usize];
+            let op = case.adversaries[((e / n_problems) % set_size) as usize];
             let r = execute(case, op, seed, e)?;
             ticks.fetch_add(r.ticks, Ordering::Relaxed);
             if r.overlap_ticks > 0 {
@@ -177,11 +304,10 @@ pub(crate) fn run(executions: u64, seed: u64) -> anyhow::Result<()> {
         unfinished.into_inner(),
     );
     println!(
-        "stress: {executions} executions ({} operator policies, seed {seed}), {ticks} ticks, \
-         {threads} threads: {overlap_ticks} ticks with both robots low-confidence (expected 0) \
-         in {overlap_runs} executions; {unfinished} unfinished; {secs:.1} s, {:.0} executions/s, \
-         {:.1} M ticks/s",
-        SET_SIZE,
+        "stress: {executions} executions of {n_robots} robots ({set_size} operator policies, \
+         seed {seed}), {ticks} ticks, {threads} threads: {overlap_ticks} ticks with two or more \
+         robots low-confidence (expected 0) in {overlap_runs} executions; {unfinished} \
+         unfinished; {secs:.1} s, {:.0} executions/s, {:.1} M ticks/s",
         executions as f64 / secs,
         ticks as f64 / secs / 1e6,
         threads = rayon::current_num_threads(),

@@ -65,7 +65,7 @@ impl PyCoordinator {
             .robots()
             .iter()
             .zip(clock)
-            .map(|(r, s)| f(r, s))
+            .map(|(r, &s)| f(r, s))
             .collect()
     }
 }
@@ -159,7 +159,7 @@ impl PyCoordinator {
     /// ``(N,)`` bool: the robot the next tick moves at the operator's rate.
     #[getter]
     fn low_conf_now<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        out_flags(py, self.inner.low_conf_now().to_vec())
+        out_flags(py, self.inner.low_conf_now().iter().collect())
     }
 
     /// Each robot's fractional reference time now (Eq. 15 at its clock), ``(N,)``,
@@ -179,7 +179,7 @@ impl PyCoordinator {
         format!(
             "Coordinator(n_robots={N_ROBOTS}, tick_s={}, clock_s={}, is_finished={})",
             self.inner.tick_s(),
-            repr_list(&self.inner.clock_s()),
+            repr_list(self.inner.clock_s()),
             PyBool(self.inner.is_finished())
         )
     }
@@ -204,28 +204,28 @@ impl PyTick {
     /// ``(N,)`` bool (conservative: a tolerance only adds reports).
     #[getter]
     fn low_conf<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        out_flags(py, self.inner.low_conf.to_vec())
+        out_flags(py, self.inner.low_conf.iter().collect())
     }
 
     /// Whether each robot ran during the tick, ``(N,)`` bool.
     #[getter]
     fn running<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        out_flags(py, self.inner.running.to_vec())
+        out_flags(py, self.inner.running.iter().collect())
     }
 
     /// Whether more than one robot was low-confidence in this tick (never, for a schedule
     /// that passed the margin check).
     #[getter]
     fn overlap(&self) -> bool {
-        self.inner.low_conf.iter().filter(|l| **l).count() > 1
+        self.inner.overlap()
     }
 
     fn __repr__(&self) -> String {
         format!(
             "Tick(ref_time={}, low_conf={}, running={})",
             repr_list(&self.inner.ref_time),
-            repr_list(&self.inner.low_conf),
-            repr_list(&self.inner.running)
+            repr_list(&self.inner.low_conf.iter().collect::<Vec<_>>()),
+            repr_list(&self.inner.running.iter().collect::<Vec<_>>())
         )
     }
 }

@@ -1,5 +1,5 @@
-//! Benchmarks of the margin checks (single pass, per pair, printed) and of the coordinator:
-//! a whole run, and one `Coordinator::tick` (run with
+//! Benchmarks of the margin checks (single pass, per pair, printed; two robots and N) and of the
+//! coordinator: a whole run, and one `Coordinator::tick` for 2, 4 and 8 robots (run with
 //! `cargo bench -p tandem-realtime --bench margins -- coordinator_tick`).
 
 use criterion::{BenchmarkId, Criterion, black_box, criterion_main};
@@ -26,6 +26,51 @@ fn robots(n_ref: usize) -> [Timeline; 2] {
     [r0, r1]
 }
 
+/// `n_robots` robots on the plan of [`robots`]: robot `i` starts `i` periods / `n_robots` after
+/// robot 0 (wrapping), so the robots' regions interleave.
+fn robots_n(n_ref: usize, n_robots: usize) -> Vec<Timeline> {
+    let [r0, _] = robots(n_ref);
+    let period = n_ref / 16;
+    (0..n_robots)
+        .map(|i| {
+            let start = r0.sample_clock_s()[(i * period / n_robots) % n_ref];
+            Timeline::new(
+                r0.conf(),
+                r0.grad_exec(),
+                r0.grad_min(),
+                r0.grad_max(),
+                start,
+                0.01,
+            )
+            .expect("valid")
+        })
+        .collect()
+}
+
+/// One `Coordinator::tick` per iteration of a run of `robots` (rewound with `reset` at the end,
+/// which allocates nothing), operator inputs cycling through rush, drag, a gradient and no
+/// correction.
+fn bench_tick(c: &mut Criterion, id: &str, robots: Vec<Timeline>, tick_s: f64) {
+    let mut co = Coordinator::new(robots, tick_s).expect("valid tick");
+    let ops = [
+        Operator::Fastest,
+        Operator::Fastest,
+        Operator::Slowest,
+        Operator::Gradient(1.1),
+        Operator::Scheduled,
+    ];
+    let mut k = 0usize;
+    c.bench_function(id, |b| {
+        b.iter(|| {
+            if co.is_finished() {
+                co.reset();
+            }
+            k = k.wrapping_add(1);
+            black_box(co.tick(black_box(ops[k % ops.len()])))
+        })
+    });
+}
+
 fn bench(c: &mut Criterion) {
     let tick_s = 0.01;
     let mut g = c.benchmark_group("margins");
@@ -45,6 +90,12 @@ fn bench(c: &mut Criterion) {
             b.iter(|| sufficient_margins_printed(black_box(r), tick_s))
         });
     }
+    let r4 = robots_n(1000, 4);
+    g.bench_with_input(
+        BenchmarkId::new("single_pass_4robots", 1000),
+        &r4,
+        |b, r| b.iter(|| sufficient_margins(black_box(r), tick_s)),
+    );
     g.finish();
     let r = robots(6000);
     c.bench_function("coordinator_run/6000", |b| {
@@ -63,26 +114,12 @@ fn bench(c: &mut Criterion) {
             k
         })
     });
-    // One tick: the same run, one tick per iteration (rewound with `reset` at the end, which
-    // allocates nothing), operator inputs cycling through rush, drag and a gradient.
-    let mut co = Coordinator::new(r, tick_s).expect("valid tick");
-    let ops = [
-        Operator::Fastest,
-        Operator::Fastest,
-        Operator::Slowest,
-        Operator::Gradient(1.1),
-        Operator::Scheduled,
-    ];
-    let mut k = 0usize;
-    c.bench_function("coordinator_tick/6000", |b| {
-        b.iter(|| {
-            if co.is_finished() {
-                co.reset();
-            }
-            k = k.wrapping_add(1);
-            black_box(co.tick(black_box(ops[k % ops.len()])))
-        })
-    });
+    // One tick: the same run, one tick per iteration (the two-robot figure of issue #11).
+    bench_tick(c, "coordinator_tick/6000", r.to_vec(), tick_s);
+    for n_robots in [2, 4, 8] {
+        let id = format!("coordinator_tick_robots/{n_robots}");
+        bench_tick(c, &id, robots_n(6000, n_robots), tick_s);
+    }
 }
 
 /// Runs every benchmark of this file (configured from the command line).

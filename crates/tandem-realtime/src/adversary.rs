@@ -3,14 +3,15 @@
 //! property test `tests/safety.rs`).
 //!
 //! The invariant they test: for every schedule [`sufficient_margins`](crate::sufficient_margins)
-//! accepts and every admissible operator, the robots are never both low-confidence in one
-//! tick. An [`Adversary`] picks the [`Operator`] input of each control tick, possibly from
-//! the coordinator's state (which robot is low-confidence now); the set contains the extremes,
-//! random and switching sequences, and — as [`Adversary::RushRobot`] — exactly Alg. 2's worst
-//! case for each role (rush the current robot while it is low-confidence, drag the previous
-//! one while it is). [`adversary_set`] returns the full set for one case, [`run_adversary`]
-//! runs one execution under one adversary and counts the ticks with both robots
-//! low-confidence.
+//! accepts and every admissible operator, no two robots are low-confidence in one tick. An
+//! [`Adversary`] picks the [`Operator`] input of each control tick, possibly from the
+//! coordinator's state (which robot is low-confidence now); the set contains the extremes,
+//! random and switching sequences, and — as [`Adversary::RushRobot`], one per robot — exactly
+//! Alg. 2's worst case for every role whose current robot is that robot (rush it while it is
+//! low-confidence, drag every other robot while it is), and, as
+//! [`Adversary::SwitchFavourite`], the same with the favoured robot changing at random times.
+//! [`adversary_set`] returns the full set for one case of `N` robots, [`run_adversary`] runs one
+//! execution under one adversary and counts the ticks with two or more robots low-confidence.
 //!
 //! ```
 //! use rand::SeedableRng;
@@ -24,7 +25,7 @@
 //!     Timeline::new(&conf, &mean, &lo, &hi, 0.45, 0.1)?,
 //! ];
 //! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
-//! for adversary in adversary_set([0.8, 1.25], 20, &mut rng) {
+//! for adversary in adversary_set(2, [0.8, 1.25], 20, &mut rng) {
 //!     let coordinator = Coordinator::new(robots.clone(), 0.05)?;
 //!     let run = run_adversary(coordinator, adversary, &mut rng, 1000)?;
 //!     assert!(run.finished && run.overlap_ticks == 0 && run.first_overlap.is_none());
@@ -34,7 +35,7 @@
 
 use rand::Rng;
 
-use crate::{Coordinator, Operator, Result};
+use crate::{Coordinator, MAX_ROBOTS, Operator, Result};
 
 /// An operator policy: which [`Operator`] input the operator gives at each control tick.
 /// Extremes are clamped by the coordinator to the low-confidence robot's `[ψ̇min, ψ̇max]` at
@@ -88,39 +89,55 @@ pub enum Adversary {
         /// Longest hold, ticks (≥ 1).
         max_hold: u32,
     },
-    /// Alg. 2's worst case for the role whose current robot is `rush`: rush robot `rush`
-    /// whenever it is the low-confidence one, drag the other whenever it is.
+    /// Alg. 2's worst case for every role whose current robot is `rush`: rush robot `rush`
+    /// whenever it is the low-confidence one, drag any other robot whenever it is.
     RushRobot {
-        /// Robot (0 or 1) to rush.
+        /// Robot (index `0..N`) to rush.
         rush: usize,
     },
     /// Each time the low-confidence robot changes, an extreme drawn at random for it, held
     /// while it stays low-confidence.
     RandomPerRobot,
+    /// [`Adversary::RushRobot`] with the favoured robot changing at random times: a robot drawn
+    /// uniformly from the `N` robots is favoured (rushed while it is low-confidence, every other
+    /// dragged) for a uniform `1..=max_hold` ticks, then another draw, and so on.
+    SwitchFavourite {
+        /// Longest hold, ticks (≥ 1).
+        max_hold: u32,
+    },
 }
 
-/// Number of adversaries in [`adversary_set`].
-pub const SET_SIZE: usize = 13;
+/// Number of adversaries [`adversary_set`] returns for `n_robots` robots: 13 families plus one
+/// [`Adversary::RushRobot`] per robot.
+#[must_use]
+pub fn set_size(n_robots: usize) -> usize {
+    13 + n_robots
+}
 
-/// The full set of adversaries for one case: the extremes, no correction, Alg. 2's worst case
-/// for both roles, switching every tick, periodic with a random period (1–8 ticks) and phase,
-/// one switch at a random tick below `ticks` (about one execution's length, in ticks), random
+/// The full set of adversaries for one case of `n_robots` robots: the extremes, no correction,
+/// Alg. 2's worst case with each robot as the current one ([`Adversary::RushRobot`]), the
+/// favoured robot switching at random times (holds up to 50 ticks, and up to a quarter of
+/// `ticks`), switching every tick, periodic with a random period (1–8 ticks) and phase, one
+/// switch at a random tick below `ticks` (about one execution's length, in ticks), random
 /// switching (holds up to 50 ticks), random extremes per tick and per robot, and random
 /// gradients over `grad_range = [lo, hi]` (the problem's `[min ψ̇min, max ψ̇max]`, execution
 /// samples per reference sample) per tick and held up to 50 ticks. The random parameters are
-/// drawn from `rng`.
+/// drawn from `rng`; [`set_size`] gives the length.
 pub fn adversary_set(
+    n_robots: usize,
     grad_range: [f64; 2],
     ticks: u64,
     rng: &mut impl Rng,
-) -> [Adversary; SET_SIZE] {
+) -> Vec<Adversary> {
     let [lo, hi] = grad_range;
-    [
-        Adversary::Nominal,
-        Adversary::Fastest,
-        Adversary::Slowest,
-        Adversary::RushRobot { rush: 0 },
-        Adversary::RushRobot { rush: 1 },
+    let mut set = vec![Adversary::Nominal, Adversary::Fastest, Adversary::Slowest];
+    set.extend((0..n_robots).map(|rush| Adversary::RushRobot { rush }));
+    let slow_switch = u32::try_from(ticks / 4).unwrap_or(u32::MAX).max(1);
+    set.extend([
+        Adversary::SwitchFavourite { max_hold: 50 },
+        Adversary::SwitchFavourite {
+            max_hold: slow_switch,
+        },
         Adversary::Periodic {
             period: 1,
             phase: 0,
@@ -142,7 +159,8 @@ pub fn adversary_set(
             hi,
             max_hold: 50,
         },
-    ]
+    ]);
+    set
 }
 
 /// What one execution under an [`Adversary`] did.
@@ -150,11 +168,12 @@ pub fn adversary_set(
 pub struct AdversaryRun {
     /// Control ticks run.
     pub ticks: u64,
-    /// Ticks in which both robots traversed a low-confidence sample (0 for a safe schedule).
+    /// Ticks in which two or more robots traversed a low-confidence sample (0 for a safe
+    /// schedule).
     pub overlap_ticks: u64,
     /// Index of the first such tick.
     pub first_overlap: Option<u64>,
-    /// Whether both robots finished within the tick budget.
+    /// Whether every robot finished within the tick budget.
     pub finished: bool,
 }
 
@@ -183,18 +202,26 @@ struct PolicyState {
     /// The input being held.
     current: Operator,
     /// [`Adversary::RandomPerRobot`]: each robot's extreme.
-    per_robot: [Operator; 2],
+    per_robot: [Operator; MAX_ROBOTS],
     /// The low-confidence robot at the previous tick.
     last_lc: Option<usize>,
+    /// Number of robots.
+    n_robots: usize,
+    /// [`Adversary::SwitchFavourite`]: the favoured robot.
+    favourite: usize,
 }
 
 impl PolicyState {
-    fn new() -> Self {
+    fn new(n_robots: usize) -> Self {
+        let mut per_robot = [Operator::Slowest; MAX_ROBOTS];
+        per_robot[0] = Operator::Fastest;
         PolicyState {
             hold: 0,
             current: Operator::Fastest,
-            per_robot: [Operator::Fastest, Operator::Slowest],
+            per_robot,
             last_lc: None,
+            n_robots,
+            favourite: 0,
         }
     }
 
@@ -244,6 +271,14 @@ impl PolicyState {
                 self.current
             }
             Adversary::RushRobot { rush } => extreme(lc == Some(rush)),
+            Adversary::SwitchFavourite { max_hold } => {
+                if self.hold == 0 {
+                    self.favourite = rng.random_range(0..self.n_robots.max(1));
+                    self.hold = rng.random_range(1..=max_hold.max(1));
+                }
+                self.hold -= 1;
+                extreme(lc == Some(self.favourite))
+            }
             Adversary::RandomPerRobot => {
                 if lc != self.last_lc
                     && let Some(i) = lc
@@ -271,15 +306,15 @@ pub fn run_adversary(
     max_ticks: u64,
 ) -> Result<AdversaryRun> {
     let mut run = AdversaryRun::default();
-    let mut state = PolicyState::new();
+    let mut state = PolicyState::new(coordinator.n_robots());
     while !coordinator.is_finished() {
         if run.ticks >= max_ticks {
             return Ok(run);
         }
-        let lc = coordinator.low_conf_now().iter().position(|&l| l);
+        let lc = coordinator.low_conf_now().first();
         let op = state.next(adversary, run.ticks, lc, rng);
         let tick = coordinator.tick(op)?;
-        if tick.low_conf[0] && tick.low_conf[1] {
+        if tick.overlap() {
             run.first_overlap.get_or_insert(run.ticks);
             run.overlap_ticks += 1;
         }
@@ -308,7 +343,7 @@ mod tests {
     #[test]
     fn policies_by_hand() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
-        let mut st = PolicyState::new();
+        let mut st = PolicyState::new(2);
         let seq = |st: &mut PolicyState, a, rng: &mut rand_chacha::ChaCha8Rng| {
             (0..6).map(|k| st.next(a, k, None, rng)).collect::<Vec<_>>()
         };
@@ -325,7 +360,7 @@ mod tests {
         assert_eq!(st.next(rush, 0, Some(1), &mut rng), F);
         assert_eq!(st.next(rush, 1, Some(0), &mut rng), S);
         // Per robot: the extreme is drawn when the LC robot changes and held while it stays.
-        let mut st = PolicyState::new();
+        let mut st = PolicyState::new(2);
         let a = st.next(Adversary::RandomPerRobot, 0, Some(0), &mut rng);
         assert!((1..20).all(|k| st.next(Adversary::RandomPerRobot, k, Some(0), &mut rng) == a));
         assert_eq!(
@@ -343,12 +378,14 @@ mod tests {
             run_adversary(c, bad, &mut rng, 100),
             Err(crate::Error::BadOperator { .. })
         ));
-        let set = adversary_set([0.5, 2.0], 10, &mut rng);
+        let set = adversary_set(2, [0.5, 2.0], 10, &mut rng);
+        assert_eq!(set.len(), set_size(2));
         for want in [
             Adversary::Nominal,
             Adversary::RushRobot { rush: 0 },
             Adversary::RushRobot { rush: 1 },
             Adversary::RandomPerRobot,
+            Adversary::SwitchFavourite { max_hold: 50 },
         ] {
             assert!(set.contains(&want), "{want:?}");
         }
@@ -358,5 +395,25 @@ mod tests {
             let run = run_adversary(c, a, &mut rng, 100).unwrap();
             assert!(run.finished && run.first_overlap.is_some(), "{a:?}");
         }
+    }
+
+    #[test]
+    fn the_favoured_robot_switches_and_is_the_one_rushed() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut st = PolicyState::new(4);
+        let a = Adversary::SwitchFavourite { max_hold: 5 };
+        let mut favourites = Vec::new();
+        for k in 0..400 {
+            let lc = Some((k % 4) as usize);
+            let op = st.next(a, k, lc, &mut rng);
+            // Rushed exactly when the low-confidence robot is the favoured one.
+            assert_eq!(op == Operator::Fastest, lc == Some(st.favourite));
+            favourites.push(st.favourite);
+        }
+        // Every robot is favoured at some time, and the favourite changes often.
+        assert!((0..4).all(|i| favourites.contains(&i)));
+        let changes = favourites.windows(2).filter(|w| w[0] != w[1]).count();
+        assert!(changes > 50, "{changes}");
+        assert_eq!(st.next(a, 400, None, &mut rng), Operator::Slowest);
     }
 }

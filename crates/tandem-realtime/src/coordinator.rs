@@ -1,7 +1,8 @@
-//! Runtime coordinator: advances two robots one control tick at a time (§II-B5).
+//! Runtime coordinator: advances N robots one control tick at a time (§II-B5).
 
 use crate::error::{Error, Result};
-use crate::strategy::{high_conf_steps, response_step};
+use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
+use crate::strategy::{Member, Mode, advance};
 use crate::timeline::Timeline;
 use crate::tol::clock_tolerance_s;
 
@@ -39,18 +40,28 @@ impl Operator {
     }
 }
 
-/// What one [`Coordinator::tick`] did.
+/// What one [`Coordinator::tick`] did, one value per robot (robot `i` at index `i`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tick {
     /// Each robot's fractional reference time (reference samples, in `[0, T_ref]`) at the end of
     /// the tick (Eq. 15 applied to its schedule clock).
-    pub ref_time: [f64; 2],
+    pub ref_time: PerRobot<f64>,
     /// Whether each robot traversed ANY low-confidence reference sample during this tick
     /// (see [`Coordinator`] for the exact, conservative definition).
-    pub low_conf: [bool; 2],
+    pub low_conf: RobotFlags,
     /// Whether each robot is running (started and not finished) during the tick: its schedule
     /// clock moved inside `[τ_i, τ_i + |ψ_E|)`.
-    pub running: [bool; 2],
+    pub running: RobotFlags,
+}
+
+impl Tick {
+    /// Whether two or more robots traversed a low-confidence sample in this tick: the operator
+    /// was needed by two robots at once (a schedule that
+    /// [`sufficient_margins`](crate::sufficient_margins) accepts never has such a tick).
+    #[must_use]
+    pub fn overlap(&self) -> bool {
+        self.low_conf.count() >= 2
+    }
 }
 
 /// Per-robot monotone cursors into its timeline (all O(1) amortized).
@@ -67,7 +78,7 @@ struct Cursors {
 /// Phase of one robot at the start of a tick.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Phase {
-    /// Schedule clock before `τ_i`: its start shifts with the other robot's steps.
+    /// Schedule clock before `τ_i`: its start shifts with the running robots.
     Waiting,
     /// Running; `low_conf` is the confidence of the sample it is in at the tick start.
     Active { low_conf: bool },
@@ -75,46 +86,59 @@ enum Phase {
     Finished,
 }
 
-/// Runtime coordinator (§II-B5): holds two timelines and advances both robots' schedule clocks
-/// one control period `tick_s` (real seconds) per [`tick`](Coordinator::tick).
+/// Runtime coordinator (§II-B5): holds the timelines of `1 ≤ N ≤ MAX_ROBOTS` robots and
+/// advances every robot's schedule clock one control period `tick_s` (real seconds) per
+/// [`tick`](Coordinator::tick).
 ///
-/// Rules per tick (modes, rates and bounds are read at each robot's sample at the tick start):
+/// Rules per tick (modes, rates and bounds are read at each robot's sample at the tick start;
+/// the rules are [`strategy`](crate::strategy)'s, argued in docs/decisions.md):
 /// - a low-confidence robot steps at the operator's rate: the [`Operator`]'s gradient `g`
 ///   (`ψ̇_E` when there is no correction), clamped to `[ψ̇min, ψ̇max]`, gives the
-///   schedule-clock step `(ψ̇_E/g)·tick_s ∈ [S·tick_s, F·tick_s]`;
-/// - the other robot, if running and high-confidence, responds with Eq. 18 to the lead measured
-///   after the low-confidence robot's step;
-/// - both high-confidence: `HIGH-CONF` (Alg. 1), the ahead robot (robot 0 when level) is `a`;
-/// - both low-confidence (a state `sufficient_margins` excludes): both follow the operator;
-/// - a robot running alone (the other finished, or not started) needs no adaptation: it runs on
-///   schedule (step `tick_s`) when high-confidence, at the operator's rate when low-confidence;
-/// - before the later robot starts, its schedule clock moves with the earlier robot's steps
-///   (its start shifts by the earlier robot's deviation), capped at its start `τ`, so it starts
-///   at a tick boundary at its first sample, at most one step behind the earlier robot;
-/// - once a robot has finished, the other needs no adaptation.
+///   schedule-clock step `(ψ̇_E/g)·tick_s ∈ [S·tick_s, F·tick_s]`; it sets the pace;
+/// - every other running high-confidence robot responds to it with Eq. 18 (its lead measured
+///   after the low-confidence robot's step);
+/// - no robot low-confidence: `HIGH-CONF` for N robots — the robot furthest ahead leads (robot
+///   with the lowest index on a tie), Alg. 1 is run between it and the robot that can reach
+///   least far this tick, and every other robot responds to the resulting pace, the furthest
+///   clock all of them can reach (for two robots this is Alg. 1 exactly);
+/// - two or more robots low-confidence (a state `sufficient_margins` excludes): every one of
+///   them follows the operator, the one with the lowest index sets the pace;
+/// - a robot running alone needs no adaptation: it runs on schedule (step `tick_s`) when
+///   high-confidence, at the operator's rate when low-confidence;
+/// - before a robot starts, its schedule clock moves to the new clock of the running robot
+///   furthest behind, capped at its start `τ_i`: it starts at a tick boundary at its first
+///   sample once every running robot has reached `τ_i` (its start shifts by the deviation of
+///   the slowest running robot); with no robot running it runs on schedule;
+/// - a finished robot drops out.
 ///
 /// `low_conf[i]` is true when robot `i` moved during the tick and any low-confidence reference
 /// sample intersects its traversed schedule-clock interval `[s_start − tol, s_end + tol]` (clipped
 /// to `[τ_i, τ_i + |ψ_E|)`), `tol` = [`clock_tolerance_s`]: the tolerance only ever *adds*
 /// low-confidence reports.
 ///
-/// [`tick`](Coordinator::tick) never allocates and is O(1) amortized: confidence is looked up
-/// through prefix counts and monotone cursors (schedule clocks never decrease).
+/// With one robot the coordinator just runs it (on schedule, or at the operator's rate while
+/// low-confidence). [`tick`](Coordinator::tick) never allocates and is O(N) amortized: state is
+/// kept in arrays of [`MAX_ROBOTS`], confidence is looked up through prefix counts and monotone
+/// cursors (schedule clocks never decrease).
 #[derive(Clone, Debug)]
 pub struct Coordinator {
-    robots: [Timeline; 2],
+    robots: Vec<Timeline>,
     tick_s: f64,
     tol_s: f64,
-    clock_s: [f64; 2],
-    cursors: [Cursors; 2],
+    clock_s: [f64; MAX_ROBOTS],
+    cursors: [Cursors; MAX_ROBOTS],
 }
 
 impl Coordinator {
-    /// Builds a coordinator with both schedule clocks at the earlier start `min(τ_0, τ_1)`.
+    /// Builds a coordinator of `robots` (robot `i` at index `i`, e.g. an array of
+    /// [`Timeline`]s) with every schedule clock at the earliest start `min_i τ_i`.
     ///
     /// # Errors
-    /// [`Error::BadParam`] if `tick_s` is not finite and > 0.
-    pub fn new(robots: [Timeline; 2], tick_s: f64) -> Result<Coordinator> {
+    /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] if `tick_s` is
+    /// not finite and > 0.
+    pub fn new(robots: impl Into<Vec<Timeline>>, tick_s: f64) -> Result<Coordinator> {
+        let robots = robots.into();
+        check_count(robots.len())?;
         if !(tick_s.is_finite() && tick_s > 0.0) {
             return Err(Error::BadParam {
                 name: "tick_s",
@@ -122,19 +146,25 @@ impl Coordinator {
             });
         }
         let tol_s = clock_tolerance_s(&robots, tick_s);
-        let t0 = robots[0].start_s().min(robots[1].start_s());
-        Ok(Coordinator {
+        let mut c = Coordinator {
             robots,
             tick_s,
             tol_s,
-            clock_s: [t0, t0],
-            cursors: [Cursors::default(); 2],
-        })
+            clock_s: [0.0; MAX_ROBOTS],
+            cursors: [Cursors::default(); MAX_ROBOTS],
+        };
+        c.reset();
+        Ok(c)
     }
 
-    /// The two timelines.
-    pub fn robots(&self) -> &[Timeline; 2] {
+    /// The timelines, robot `i` at index `i`.
+    pub fn robots(&self) -> &[Timeline] {
         &self.robots
+    }
+
+    /// Number of robots `N`.
+    pub fn n_robots(&self) -> usize {
+        self.robots.len()
     }
 
     /// Control period (real seconds).
@@ -143,32 +173,44 @@ impl Coordinator {
     }
 
     /// Each robot's schedule clock `s_i` (s, global/schedule-clock frame).
-    pub fn clock_s(&self) -> [f64; 2] {
-        self.clock_s
+    pub fn clock_s(&self) -> &[f64] {
+        &self.clock_s[..self.robots.len()]
     }
 
-    /// Whether both robots have finished.
+    /// Whether every robot has finished.
     pub fn is_finished(&self) -> bool {
-        (0..2).all(|i| self.clock_s[i] >= self.robots[i].end_s())
+        self.robots
+            .iter()
+            .zip(&self.clock_s)
+            .all(|(r, &s)| s >= r.end_s())
     }
 
-    /// Puts both schedule clocks back at the earlier start, as [`Coordinator::new`] left them
+    /// Puts every schedule clock back at the earliest start, as [`Coordinator::new`] left them
     /// (no allocation: to run the same plan again).
     pub fn reset(&mut self) {
-        let t0 = self.robots[0].start_s().min(self.robots[1].start_s());
-        self.clock_s = [t0, t0];
-        self.cursors = [Cursors::default(); 2];
+        let t0 = self
+            .robots
+            .iter()
+            .map(Timeline::start_s)
+            .fold(f64::INFINITY, f64::min);
+        self.clock_s = [t0; MAX_ROBOTS];
+        self.cursors = [Cursors::default(); MAX_ROBOTS];
     }
 
     /// Whether each robot is running and low-confidence at its current schedule clock (Eq. 16
     /// at the tick start): the robot the next [`tick`](Coordinator::tick) moves at the
-    /// operator's rate. O(1), no allocation.
-    pub fn low_conf_now(&self) -> [bool; 2] {
-        [0, 1].map(|i| {
-            let r = &self.robots[i];
-            let s = self.clock_s[i];
-            s >= r.start_s() && s < r.end_s() && !r.conf()[self.cursors[i].at]
-        })
+    /// operator's rate. O(N), no allocation.
+    pub fn low_conf_now(&self) -> RobotFlags {
+        let mut out = RobotFlags::new(self.robots.len());
+        for (i, (r, (&s, cur))) in self
+            .robots
+            .iter()
+            .zip(self.clock_s.iter().zip(&self.cursors))
+            .enumerate()
+        {
+            out.set(i, s >= r.start_s() && s < r.end_s() && !r.conf()[cur.at]);
+        }
+        out
     }
 
     fn phase(&mut self, i: usize) -> Phase {
@@ -200,102 +242,63 @@ impl Coordinator {
         r.grad_exec()[n] / g * self.tick_s
     }
 
-    /// Step of a robot that runs without a partner to adapt to.
-    fn alone_step(&self, i: usize, low_conf: bool, op: Operator) -> f64 {
-        if low_conf {
-            self.operator_step(i, op)
-        } else {
-            self.tick_s
-        }
-    }
-
     /// Advances one control period with the operator's input `operator` for the
-    /// low-confidence robot (ignored when no robot is low-confidence). Never allocates.
+    /// low-confidence robot (ignored when no robot is low-confidence). Never allocates; O(N).
     ///
     /// # Errors
     /// [`Error::BadOperator`] for an [`Operator::Gradient`] that is NaN, infinite or ≤ 0;
     /// the coordinator is then unchanged.
     pub fn tick(&mut self, operator: Operator) -> Result<Tick> {
         let g = operator.validate()?;
-        let h = self.tick_s;
-        let phases = [self.phase(0), self.phase(1)];
-        let rates = |c: &Self, i: usize| c.robots[i].rates(c.cursors[i].at);
-        let mut step = [0.0_f64; 2];
-        match phases {
-            [
-                Phase::Active { low_conf: l0 },
-                Phase::Active { low_conf: l1 },
-            ] => match (l0, l1) {
-                (false, false) => {
-                    let (a, b) = if self.clock_s[0] >= self.clock_s[1] {
-                        (0, 1)
-                    } else {
-                        (1, 0)
-                    };
-                    let lead = self.clock_s[a] - self.clock_s[b];
-                    let (da, db) = high_conf_steps(lead, rates(self, a), rates(self, b), h);
-                    step[a] = da;
-                    step[b] = db;
+        let n = self.robots.len();
+        let mut members = [Member::idle(0.0, Mode::Finished); MAX_ROBOTS];
+        let mut next_s = [0.0_f64; MAX_ROBOTS];
+        let mut pace_robot = None;
+        for i in 0..n {
+            let s = self.clock_s[i];
+            members[i] = match self.phase(i) {
+                Phase::Waiting => Member::idle(s, Mode::Waiting),
+                Phase::Finished => Member::idle(s, Mode::Finished),
+                Phase::Active { low_conf: true } => {
+                    next_s[i] = s + self.operator_step(i, g);
+                    pace_robot.get_or_insert(i);
+                    Member::idle(s, Mode::Low)
                 }
-                (true, true) => {
-                    step = [self.operator_step(0, g), self.operator_step(1, g)];
-                }
-                (l0, _) => {
-                    let (lc, resp) = if l0 { (0, 1) } else { (1, 0) };
-                    step[lc] = self.operator_step(lc, g);
-                    let lead = self.clock_s[resp] - (self.clock_s[lc] + step[lc]);
-                    step[resp] = response_step(lead, rates(self, resp), h);
-                }
-            },
-            [Phase::Active { low_conf }, other] | [other, Phase::Active { low_conf }] => {
-                let act = if matches!(phases[0], Phase::Active { .. }) {
-                    0
-                } else {
-                    1
-                };
-                step[act] = self.alone_step(act, low_conf, g);
-                if other == Phase::Waiting {
-                    step[1 - act] = step[act];
-                }
-            }
-            _ => {
-                // Nobody running: a waiting robot's clock runs on schedule.
-                for (i, p) in phases.iter().enumerate() {
-                    if *p == Phase::Waiting {
-                        step[i] = h;
-                    }
-                }
-            }
+                Phase::Active { low_conf: false } => Member {
+                    clock_s: s,
+                    mode: Mode::High,
+                    rates: self.robots[i].rates(self.cursors[i].at),
+                },
+            };
         }
+        advance(&members[..n], pace_robot, self.tick_s, &mut next_s[..n]);
         let mut out = Tick {
-            ref_time: [0.0; 2],
-            low_conf: [false; 2],
-            running: [false; 2],
+            ref_time: PerRobot::new(n),
+            low_conf: RobotFlags::new(n),
+            running: RobotFlags::new(n),
         };
-        for i in 0..2 {
+        for (i, m) in members[..n].iter().enumerate() {
             let r = &self.robots[i];
             let s_old = self.clock_s[i];
-            let cap = if phases[i] == Phase::Waiting {
-                r.start_s()
-            } else {
-                r.end_s()
-            };
-            let s_new = (s_old + step[i]).min(cap).max(s_old);
+            let waiting = m.mode == Mode::Waiting;
+            let cap = if waiting { r.start_s() } else { r.end_s() };
+            let s_new = next_s[i].min(cap).max(s_old);
             self.clock_s[i] = s_new;
             let moved = s_new > s_old;
-            out.running[i] = moved && s_new > r.start_s() && s_old < r.end_s();
+            out.running
+                .set(i, moved && s_new > r.start_s() && s_old < r.end_s());
             if moved
                 && s_new + self.tol_s >= r.start_s()
-                && phases[i] != Phase::Waiting
+                && !waiting
                 && s_old - self.tol_s < r.end_s()
             {
                 let cur = &mut self.cursors[i];
                 let lo = r.advance_cursor(&mut cur.lo, s_old - self.tol_s);
                 let hi = r.advance_cursor(&mut cur.hi, s_new + self.tol_s);
-                out.low_conf[i] = r.any_low_conf(lo, hi);
+                out.low_conf.set(i, r.any_low_conf(lo, hi));
             }
-            let n = r.advance_cursor(&mut self.cursors[i].at, s_new);
-            out.ref_time[i] = r.ref_time_in(n, s_new);
+            let at = r.advance_cursor(&mut self.cursors[i].at, s_new);
+            out.ref_time.as_mut_slice()[i] = r.ref_time_in(at, s_new);
         }
         Ok(out)
     }
@@ -467,5 +470,98 @@ mod tests {
         assert_eq!(c.clock_s(), [0.0, 0.0]);
         assert_eq!(c.low_conf_now(), [false, false]);
         assert_eq!(run(&mut c), first);
+    }
+
+    /// Robot 0: [LC, HC, HC, HC], F = 2, S = ½; robot 1: all HC with bounds [0.8, 1.25]
+    /// (F = 1.25, S = 0.8); robot 2: all HC, F = 2, S = ½; robot 3 like robot 2 but starting at
+    /// 3. Δt_s = 1, tick 1 s.
+    fn four_robots() -> Vec<Timeline> {
+        let (g, lo, hi) = ([1.0; 4], [0.5; 4], [2.0; 4]);
+        vec![
+            Timeline::new(&[false, true, true, true], &g, &lo, &hi, 0.0, 1.0).unwrap(),
+            Timeline::new(&[true; 4], &g, &[0.8; 4], &[1.25; 4], 0.0, 1.0).unwrap(),
+            Timeline::new(&[true; 4], &g, &lo, &hi, 0.0, 1.0).unwrap(),
+            Timeline::new(&[true; 4], &g, &lo, &hi, 3.0, 1.0).unwrap(),
+        ]
+    }
+
+    #[test]
+    fn n_robots_respond_to_the_low_confidence_one_then_run_high_conf_together() {
+        let mut c = Coordinator::new(four_robots(), 1.0).unwrap();
+        assert_eq!(c.n_robots(), 4);
+        assert_eq!(c.low_conf_now(), [true, false, false, false]);
+        // Tick 0: robot 0 LC, rushed (step F·tick = 2). Robot 1 cannot keep up (fastest
+        // 1.25), robot 2 matches; robot 3 waits and follows the running robot furthest
+        // behind (robot 1, at 1.25).
+        let t = c.tick(Operator::Fastest).unwrap();
+        assert_eq!(c.clock_s(), [2.0, 1.25, 2.0, 1.25]);
+        assert_eq!(t.low_conf, [true, false, false, false]);
+        assert_eq!(t.running, [true, true, true, false]);
+        assert!(!t.overlap());
+        // Tick 1: nobody LC. Leader robot 0 (tie with robot 2, lowest index); robot 1 reaches
+        // least far (2.5): Alg. 1 for (0, 1) lands both on 2.5, robot 2 responds to that pace
+        // (step ½ = its slowest) — all level again; robot 3 follows to 2.5.
+        c.tick(Operator::Fastest).unwrap();
+        assert_eq!(c.clock_s(), [2.5, 2.5, 2.5, 2.5]);
+        // Tick 2: level, the pace is robot 1's fastest (3.75); robot 3 reaches its start 3.
+        let t = c.tick(Operator::Fastest).unwrap();
+        assert_eq!(c.clock_s(), [3.75, 3.75, 3.75, 3.0]);
+        assert_eq!(t.running, [true, true, true, false]);
+        // Tick 3: robot 3 runs; robots 0 and 2 finish at 4 (capped), robot 1 too.
+        let t = c.tick(Operator::Fastest).unwrap();
+        assert_eq!(c.clock_s()[..3], [4.0, 4.0, 4.0]);
+        assert_eq!(t.running, [true, true, true, true]);
+        // Then robot 3 runs alone, on schedule.
+        let before = c.clock_s()[3];
+        let t = c.tick(Operator::Fastest).unwrap();
+        assert_eq!(c.clock_s()[3], before + 1.0);
+        assert_eq!(t.running, [false, false, false, true]);
+        while !c.is_finished() {
+            c.tick(Operator::Scheduled).unwrap();
+        }
+        assert_eq!(c.clock_s(), [4.0, 4.0, 4.0, 7.0]);
+    }
+
+    #[test]
+    fn two_low_confidence_robots_both_follow_the_operator() {
+        // Robots 0 and 1 LC at sample 0 (a state a valid schedule excludes), robot 2 HC.
+        let (g, lo, hi) = ([1.0; 2], [0.5; 2], [2.0; 2]);
+        let lc = [false, true];
+        let robots = vec![
+            Timeline::new(&lc, &g, &lo, &hi, 0.0, 1.0).unwrap(),
+            Timeline::new(&lc, &g, &[0.8; 2], &[1.25; 2], 0.0, 1.0).unwrap(),
+            Timeline::new(&[true; 2], &g, &lo, &hi, 0.5, 1.0).unwrap(),
+        ];
+        let mut c = Coordinator::new(robots, 1.0).unwrap();
+        // Dragged: robot 0 steps ½, robot 1 steps 0.8; robot 2 waits for the robot furthest
+        // behind (robot 0, at ½ = its start).
+        let t = c.tick(Operator::Slowest).unwrap();
+        assert_eq!(c.clock_s(), [0.5, 0.8, 0.5]);
+        assert!(t.overlap());
+        // Still both LC; robot 2 (HC, at ½) responds to robot 0, the lowest-index LC robot,
+        // which steps ½ to 1: robot 2 matches.
+        c.tick(Operator::Slowest).unwrap();
+        assert_eq!(c.clock_s(), [1.0, 1.6, 1.0]);
+    }
+
+    #[test]
+    fn one_robot_runs_alone_and_the_count_is_checked() {
+        let r = three_sample(0.0);
+        let mut c = Coordinator::new(vec![r[0].clone()], 1.0).unwrap();
+        let t = c.tick(Operator::Slowest).unwrap();
+        assert_eq!(
+            (c.clock_s(), t.low_conf),
+            ([1.0].as_slice(), RobotFlags::from_slice(&[true]))
+        );
+        c.tick(Operator::Slowest).unwrap();
+        assert_eq!(c.clock_s(), [1.5]);
+        assert!(matches!(
+            Coordinator::new(Vec::new(), 1.0),
+            Err(Error::RobotCount { n: 0, .. })
+        ));
+        assert!(matches!(
+            Coordinator::new(vec![r[0].clone(); MAX_ROBOTS + 1], 1.0),
+            Err(Error::RobotCount { n: 9, max: 8 })
+        ));
     }
 }

@@ -42,6 +42,14 @@ pub enum Error {
         /// The gradient given (execution samples per reference sample).
         gradient: f64,
     },
+    /// The number of robots is not in `1..=MAX_ROBOTS`.
+    #[error("{n} robots: a coordinator and the margin check take 1 to {max} robots")]
+    RobotCount {
+        /// Number of timelines given.
+        n: usize,
+        /// The largest count, [`MAX_ROBOTS`](crate::MAX_ROBOTS).
+        max: usize,
+    },
     /// A scalar parameter is out of its valid range.
     #[error("parameter `{name}` {why}")]
     BadParam {

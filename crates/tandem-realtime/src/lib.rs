@@ -1,15 +1,17 @@
 //! Real-time timing strategy, worst-case margins and runtime coordinator (paper §II-B5,
-//! Eq. 15–18, Alg. 1 and Alg. 2; the readings and fixes of the paper behind it are in
-//! docs/decisions.md: "Typos of Eq. 17 and Alg. 1", "Alg. 2 as printed is not sound on a tick
-//! grid", "Time frames").
+//! Eq. 15–18, Alg. 1 and Alg. 2), for one operator and `1 ≤ N ≤` [`MAX_ROBOTS`] robots; the
+//! readings and fixes of the paper behind it are in docs/decisions.md: "Typos of Eq. 17 and
+//! Alg. 1", "Alg. 2 as printed is not sound on a tick grid", "Time frames").
 //!
-//! Two robots do the same task in parallel under one operator. Each robot's plan is a
+//! The robots do the same task in parallel under one operator. Each robot's plan is a
 //! [`Timeline`] in *schedule-clock* time (global seconds at which the schedule planned a
 //! reference position, Eq. 15–16). At run time the operator's corrections speed up or slow down
-//! the low-confidence robot; the [`Coordinator`] lets the other robot respond (Eq. 18, Alg. 1) so
-//! that the two schedule clocks stay close. [`sufficient_margins`] checks, before execution,
-//! that no admissible operator can make both robots low-confidence in the same control tick —
-//! a conservative, discretization-safe version of Alg. 2 (see [`margins`]).
+//! the low-confidence robot; the [`Coordinator`] lets every other robot respond (Eq. 18, and
+//! Alg. 1 when none is low-confidence) so that the schedule clocks stay close; for two robots
+//! these are the paper's rules exactly (docs/decisions.md, "N robots at run time").
+//! [`sufficient_margins`] checks, before execution, that no admissible operator can make two
+//! robots low-confidence in the same control tick — a conservative, discretization-safe
+//! version of Alg. 2 extended to N robots (see [`margins`]).
 //!
 //! Time frames: reference sample index `n` (period `Δt_s`), schedule-clock/global time in
 //! seconds, control tick `tick_s` in real seconds.
@@ -39,11 +41,16 @@
 //! let r2_early = Timeline::new(&conf, &mean, &lo, &hi, 0.2, dt_s)?;
 //! assert!(!sufficient_margins(&[robots[0].clone(), r2_early], tick_s)?);
 //!
+//! // A third robot 0.45 s after the second: three robots, one operator.
+//! let r3 = Timeline::new(&conf, &mean, &lo, &hi, 0.9, dt_s)?;
+//! let robots = [robots[0].clone(), robots[1].clone(), r3];
+//! assert!(sufficient_margins(&robots, tick_s)?);
+//!
 //! // Run with an operator who slows the low-confidence robot down as much as allowed.
 //! let mut coord = Coordinator::new(robots, tick_s)?;
 //! while !coord.is_finished() {
 //!     let tick = coord.tick(Operator::Slowest)?;
-//!     assert!(!(tick.low_conf[0] && tick.low_conf[1]));
+//!     assert!(!tick.overlap()); // never two robots low-confidence in one tick
 //! }
 //! # Ok::<(), tandem_realtime::Error>(())
 //! ```
@@ -52,6 +59,7 @@ pub mod adversary;
 mod coordinator;
 mod error;
 pub mod margins;
+mod robots;
 mod strategy;
 mod timeline;
 pub mod tol;
@@ -59,8 +67,9 @@ pub mod tol;
 pub use coordinator::{Coordinator, Operator, Tick};
 pub use error::{Error, Result};
 pub use margins::{
-    PairSlack, pair_slacks, sufficient_margins, sufficient_margins_per_pair,
-    sufficient_margins_printed,
+    PairSlack, pair_slacks, sufficient_margins, sufficient_margins_pairwise,
+    sufficient_margins_per_pair, sufficient_margins_printed,
 };
+pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};
 pub use strategy::{high_conf_steps, response_step};
 pub use timeline::{LcInterval, Rates, Timeline, clock_end_s, clock_s};

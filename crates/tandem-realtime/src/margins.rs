@@ -1,32 +1,42 @@
-//! Worst-case margins between low-confidence regions (Alg. 2, §II-B5).
+//! Worst-case margins between low-confidence regions (Alg. 2, §II-B5), for `1 ≤ N ≤ MAX_ROBOTS`
+//! robots.
 //!
 //! # Pairs and roles
-//! The low-confidence (LC) regions of both robots are taken as exact schedule-clock intervals
+//! The low-confidence (LC) regions of all robots are taken as exact schedule-clock intervals
 //! `[c_{n0}, c_{n1+1})` (see [`Timeline::lc_intervals`]) and merged by start time. Every two
 //! consecutive regions of *different* robots form a pair: the earlier region's robot is the
 //! previous robot `p`, whose region ends at `T_p`; the later one is the current robot `c`, whose
 //! region starts at `T_c`. The pair is safe when `c` can never enter its region before `p` has
-//! left its own. (Non-consecutive regions are implied: robot clocks only move forward.)
+//! left its own; `(p, c)` is the pair's *role* (an ordered pair of robots).
+//!
+//! **Non-consecutive pairs are implied.** Suppose every consecutive pair is safe and consider
+//! the first tick in which two robots are LC, in regions `A` before `B` in merged order. Before
+//! that tick at most one robot was LC, which is all the pairs' simulations below assume about
+//! the past. If `A` and `B` are not consecutive, let `X` be the region right after `A`: `X`
+//! cannot start before `A` ends (pair `(A, X)`, or the same robot's regions in order), so it
+//! starts after `A`'s robot has left `A`; by induction along the merged order the same holds up
+//! to `B`, which therefore starts after `A` ended — no overlap. Only consecutive pairs need a
+//! check.
 //!
 //! # The printed check
-//! [`sufficient_margins_printed`] is Alg. 2 as printed (typos fixed as in docs/decisions.md,
-//! "Typos of Eq. 17 and Alg. 1": the rates of Eq. 17 are `F = ψ̇_E/ψ̇min`, `S = ψ̇_E/ψ̇max`, and
-//! Alg. 1 line 9 uses the behind robot's own `F`): for each pair, both schedule clocks start at `τ` (the later start); each step, if `c` is
-//! LC it rushes (`F`) and `p` responds (Eq. 18), else if `p` is LC it drags (`S`) and `c`
-//! responds, else `HIGH-CONF`; after the step, reject if `t_c ≥ T_c`, accept if `t_p ≥ T_p`.
-//! **It is not sound on a tick grid** (docs/decisions.md, "Alg. 2 as printed is not sound on a
-//! tick grid"; the 3-sample case [HC, LC, HC] with gradients 1, bounds `[½, 2]`, one sample per
-//! tick and `τ = 3/2` is accepted yet overlaps when the operator rushes the previous robot). It
-//! is kept only as a named, documented-unsafe baseline.
+//! [`sufficient_margins_printed`] is Alg. 2 as printed (typos fixed as in docs/decisions.md: the
+//! rates of Eq. 17 are `F = ψ̇_E/ψ̇min`, `S = ψ̇_E/ψ̇max`, and Alg. 1 line 9 uses the behind
+//! robot's own `F`), each pair on its own: both schedule clocks start at `τ` (the later start of
+//! the two); each step, if `c` is LC it rushes (`F`) and `p` responds (Eq. 18), else if `p` is
+//! LC it drags (`S`) and `c` responds, else `HIGH-CONF`; after the step, reject if `t_c ≥ T_c`,
+//! accept if `t_p ≥ T_p`. **It is not sound on a tick grid** (the 3-sample case [HC, LC, HC] with
+//! gradients 1, bounds `[½, 2]`, one sample per tick and `τ = 3/2` is accepted yet overlaps when
+//! the operator rushes the previous robot; tests/regression.rs). It is kept only as a named,
+//! documented-unsafe baseline.
 //!
 //! # The conservative check
 //! [`sufficient_margins`] keeps the paper's worst case (current robot rushing while LC,
 //! previous robot dragging while LC, the strategy everywhere else) and makes the discrete
-//! simulation conservative against the three ways a tick grid breaks it (docs/decisions.md):
-//! the exit tick, rate aliasing and mode aliasing. With `M = tick_s · max(1, max F)` the
-//! largest step any robot can take in one tick (maximum over *both* robots and *all* samples,
-//! a superset of the local maxima the design-time fix used) and `ε` four times
-//! [`clock_tolerance_s`]:
+//! simulation conservative against the three ways a tick grid breaks it: the exit tick, rate
+//! aliasing and mode aliasing (fixes 1–4); for three or more robots it adds the robots that are
+//! neither `p` nor `c` (fixes 5–6). `M_i = tick_s · max(1, max_n F_i)` is the largest step robot
+//! `i` can take in one tick (over *all* its samples), `M = max(M_p, M_c)` that of the pair (for
+//! two robots: of both robots, as before), and `ε` four times [`clock_tolerance_s`]:
 //!
 //! 1. **Stop test, `c` first.** After each step, reject if `t_c + M ≥ T_c − ε`, else accept the
 //!    pair if `t_p ≥ T_p + ε`. The real robots' tick phase is set by the operator, not by the
@@ -39,36 +49,78 @@
 //!    for `c` and smaller for `p` only move the simulated `c` further ahead.
 //! 3. **Widened LC regions.** A robot counts as LC in the simulation when any LC sample meets
 //!    the same window (mode aliasing: the real coordinator reads modes at the tick start, up to
-//!    a step away). Where both robots then count as LC, both branches (`c` rushing with `p`
-//!    responding, `p` dragging with `c` responding) are simulated and the one leaving `c`
-//!    further ahead (larger `t_c − t_p`) is kept.
-//! 4. **Pairs decided before the later robot starts.** The coordinator starts the later robot at
-//!    a tick boundary once the earlier robot's clock reaches `τ`, so a pair whose previous region
-//!    ends at `T_p ≤ τ − ε` (or at the previous robot's end, `≤ τ`) can never overlap and is
-//!    accepted without simulation (the printed loop steps once before testing and needlessly
-//!    rejects such pairs). Conversely the earlier robot may be up to one step ahead when the
-//!    later one starts, so when `c` is the earlier robot its simulated clock starts at `τ + M`.
+//!    a step away). Where several robots then count as LC, each is simulated as the one setting
+//!    the pace (`c` rushing, `p` dragging, any other robot rushing and dragging, the rest
+//!    responding) and the branch leaving `c` furthest ahead (larger `t_c − t_p`, the first on a
+//!    tie) is kept.
+//! 4. **Pairs decided before the later robot starts.** A robot starts at a tick boundary once
+//!    the running robot furthest behind has reached its start `τ`, so when the later of `p` and
+//!    `c` starts, `p` has reached `τ`: a pair whose previous region ends at `T_p ≤ t_p − ε` (or
+//!    at `p`'s end, `≤ t_p`) can never overlap and is accepted without simulation (the printed
+//!    loop steps once before testing and needlessly rejects such pairs). Conversely the earlier
+//!    robot may be up to one step ahead when the later one starts, so when `c` is the earlier
+//!    robot its clock starts a full step `M` ahead (`τ + M` when only `p` and `c` run before).
+//!    Any other pair whose regions already overlap on schedule (`T_c < T_p + ε`) is rejected
+//!    outright.
+//! 5. **A common pace set by the other robots (N ≥ 3).** When `p` or `c` is LC, the other
+//!    responds to it with Eq. 18 whatever the other robots do (every high-confidence robot
+//!    responds only to the LC robot, see the strategy in docs/decisions.md): the two-robot
+//!    worst case holds in those steps. But while neither is LC, both respond to one pace set by
+//!    the others — a third robot at the operator's rate, or `HIGH-CONF`'s target, which a robot
+//!    far behind holds back — and robots that track one pace within *different* bounds drift
+//!    apart. A dragged third robot that `p` can follow and `c` cannot (its `S` is larger) lets
+//!    `c` gain on `p` for the whole third region: in tests/regression.rs each pair of three
+//!    robots is safe on its own, yet `c` gains 8 s and overlaps; the per-pair check
+//!    [`sufficient_margins_pairwise`] accepts that schedule. So in every step where neither `p`
+//!    nor `c` counts as LC and another robot may already run (its start `≤ t_c`), `p`'s and
+//!    `c`'s steps are replaced by those of the common pace `x ∈ ℝ` that leaves `c` furthest
+//!    ahead (on a tie the simulated step is kept). `t_c − t_p` after the step is piecewise
+//!    linear in `x` with breakpoints at `p`'s and `c`'s slowest and fastest clocks, so the
+//!    maximum is at one of those or at `x = ±∞`. This bounds every pace the other robots can
+//!    set, whatever their timing, which the simulation of fix 6 cannot be trusted to find.
+//! 6. **Starts while other robots run (N ≥ 3).** If another robot starts before the later of
+//!    `p` and `c`, the simulation starts at the earliest start and runs every robot by the
+//!    coordinator's rules (`p` with its smallest rates, `c` its largest, the others the widest
+//!    range; an LC other robot is a branch of fix 3 both rushing and dragging), so that the
+//!    deviations at which the later of `p` and `c` starts are simulated. When `c` starts, `p`
+//!    is put at `τ_c` (every running robot is then at or past `τ_c`: an exact bound); when `p`
+//!    starts, `c` keeps its simulated lead over the running robot furthest behind, plus a full
+//!    step of any robot running before (where that robot crossed `τ_p` within its last step),
+//!    or the simulated overshoot if that is larger (a robot finishing makes the furthest-behind
+//!    clock jump).
 //!
-//! Any other pair whose regions already overlap on schedule (`T_c < T_p + ε`) is rejected outright.
+//! In continuous time the extreme policy bounds every admissible operator; fixes 1–4 only
+//! widen the discrete check by at most one maximal step in clock, rate and mode, and fix 5
+//! replaces the other robots by the worst pace they could set. This is a conservative
+//! construction validated by search, not a machine-checked proof: the property tests
+//! `tests/safety.rs` (two robots) and `tests/safety_n.rs` (N = 2 … 6, two problem families,
+//! schedules bisected to the acceptance boundary, the full adversary set: Alg. 2's worst case
+//! with each robot as `c`, the favoured robot switching, extremes, random and switching
+//! sequences), and `cargo xtask stress --robots N`. Without fix 5 (fix 6's simulated branches
+//! only), the search found accepted schedules that overlap in 0.6–2 % of the long-region
+//! problems; fix 5 costs 2–3 % of `T_total` on random problems and nothing measurable on the
+//! fixture problem (docs/decisions.md, "N robots at run time").
 //!
-//! In continuous time the extreme policy bounds every admissible operator; the fixes above only
-//! widen the discrete check by at most one maximal step in clock, rate and mode. This is a
-//! conservative construction validated by search (the property test `tests/safety.rs`: random
-//! problems, schedules, tick lengths and random/extreme/switching operators, no accepted schedule
-//! ever has both robots LC in one tick), not a machine-checked proof.
+//! # Two robots
+//! With `N = 2` there are no other robots: fixes 5 and 6 never apply, every simulation starts
+//! at `τ` with `p` at `τ` and `c` at `τ` (or `τ + M` when `c` starts first), `M` is the largest
+//! step of both robots, and the decisions are those of the two-robot check to the bit (the
+//! rules of fix 3 for two robots are the two branches `c` rushing and `p` dragging).
 //!
 //! # Single pass
-//! The simulated dynamics do not depend on `T_p` or `T_c` (only the stop test does), and the
-//! pairs of one role `(p, c)` are ordered in both `T_p` and `T_c`. So one simulation per role,
-//! with a pointer over that role's pairs (test the current pair after each step; when it is
-//! accepted, test the next one at the same state), decides every pair exactly as a fresh
-//! simulation per pair would: at every earlier state the earlier pair was undecided, so
-//! `t_c + M < T_c ≤ T_c'` and `t_p < T_p ≤ T_p'`, and the later pair was undecided too.
-//! [`sufficient_margins_per_pair`] is that per-pair loop (a benchmark baseline).
+//! The simulated dynamics do not depend on `T_p` or `T_c` (only the stop test does; the branch
+//! choices compare `t_c − t_p` only), and the pairs of one role `(p, c)` are ordered in both
+//! `T_p` and `T_c`. So one simulation per ordered role, with a pointer over that role's pairs
+//! (test the current pair after each step; when it is accepted, test the next one at the same
+//! state), decides every pair exactly as a fresh simulation per pair would: at every earlier
+//! state the earlier pair was undecided, so `t_c + M < T_c ≤ T_c'` and `t_p < T_p ≤ T_p'`, and
+//! the later pair was undecided too. Fix 4's filter at the later robot's start keeps the order.
+//! [`sufficient_margins_per_pair`] is that per-pair loop (a benchmark baseline and the oracle of
+//! `tests/agreement.rs`). Cost: one simulation per ordered role with pairs, `N` robots per step.
 //!
 //! # Slacks
-//! [`pair_slacks`] runs the same two simulations to the end of each role instead of stopping at
-//! the first rejection and reports, per pair, rule 1's room left when `p` is out:
+//! [`pair_slacks`] runs the same simulations to the end of each role instead of stopping at the
+//! first rejection and reports, per pair, rule 1's room left when `p` is out:
 //! `(T_c − ε) − (t_c + M)` at the deciding step (`t_c` only grows, so that is the smallest room
 //! of the pair's whole stretch). The check accepts exactly when every slack is positive; a
 //! scheduler reads from the slacks how much clearance each pair lacks or has to spare, with
@@ -77,7 +129,8 @@
 use std::collections::VecDeque;
 
 use crate::error::{Error, Result};
-use crate::strategy::{high_conf_steps, response_step};
+use crate::robots::{MAX_ROBOTS, check_count};
+use crate::strategy::{Member, Mode, advance, response_step};
 use crate::timeline::{LcInterval, Rates, Timeline};
 use crate::tol::clock_tolerance_s;
 
@@ -105,34 +158,94 @@ impl Pair {
     }
 }
 
-/// Shared set-up of the three checks.
+/// Which variant of Alg. 2 a simulation runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Variant {
+    /// Alg. 2 as printed, per pair of robots, the other robots ignored.
+    Printed,
+    /// The conservative two-robot check (fixes 1–4), per pair of robots, the other robots
+    /// ignored: [`sufficient_margins`] for two robots, an unsafe baseline for more.
+    Pairwise,
+    /// The conservative check with every robot simulated (fixes 1–6).
+    Conservative,
+}
+
+impl Variant {
+    /// Whether the robots other than `p` and `c` take part in a role's simulation.
+    fn with_thirds(self) -> bool {
+        self == Variant::Conservative
+    }
+}
+
+/// Shared set-up of the checks.
 struct Setup {
-    /// `τ`: the later start (s).
-    tau: f64,
-    /// Index of the robot that starts first (robot 0 on a tie).
-    first: usize,
+    /// Number of robots `N`.
+    n: usize,
     /// `M`: largest step of any robot in one tick (schedule-clock s).
     max_step: f64,
+    /// `M_i = tick_s·max(1, max_n F_i)`: largest step of robot `i` in one tick (schedule-clock
+    /// s).
+    max_step_of: Vec<f64>,
     /// Comparison tolerance of the checks (schedule-clock s).
     eps: f64,
-    /// Pairs per role, indexed by the previous robot `p` (so `c = 1 − p`).
-    pairs: [Vec<Pair>; 2],
+    /// Pairs per ordered role `(p, c)`, at index `p·N + c`.
+    pairs: Vec<Vec<Pair>>,
+}
+
+/// Schedule-clock time (s) at which the simulation of role `(p, c)` starts: the later start `τ`
+/// of `p` and `c` (fix 4), or — when other robots are simulated and one of them starts before
+/// `τ` — the earliest start of all (fix 6).
+fn role_start(robots: &[Timeline], p: usize, c: usize, thirds: bool) -> f64 {
+    let tau = robots[p].start_s().max(robots[c].start_s());
+    let early_third = robots
+        .iter()
+        .enumerate()
+        .any(|(r, tl)| r != p && r != c && tl.start_s() < tau);
+    if thirds && early_third {
+        robots
+            .iter()
+            .map(Timeline::start_s)
+            .fold(f64::INFINITY, f64::min)
+    } else {
+        tau
+    }
+}
+
+/// Smallest slow rate `S` of any robot at any sample (≤ 1).
+fn min_rate_slow(robots: &[Timeline]) -> f64 {
+    robots
+        .iter()
+        .map(Timeline::min_rate_slow)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Latest scheduled end of any robot (s).
+fn max_end_s(robots: &[Timeline]) -> f64 {
+    robots
+        .iter()
+        .map(Timeline::end_s)
+        .fold(f64::NEG_INFINITY, f64::max)
 }
 
 impl Setup {
-    fn new(robots: &[Timeline; 2], tick_s: f64) -> Result<Setup> {
+    fn new(robots: &[Timeline], tick_s: f64) -> Result<Setup> {
+        check_count(robots.len())?;
         if !(tick_s.is_finite() && tick_s > 0.0) {
             return Err(Error::BadParam {
                 name: "tick_s",
                 why: "must be finite and > 0",
             });
         }
-        let first = usize::from(robots[1].start_s() < robots[0].start_s());
-        let tau = robots[1 - first].start_s();
-        let max_rate = robots[0].max_rate_fast().max(robots[1].max_rate_fast());
-        let min_slow = robots[0].min_rate_slow().min(robots[1].min_rate_slow());
-        let horizon = robots[0].end_s().max(robots[1].end_s()) - tau;
-        if horizon / (min_slow * tick_s) > MAX_SIM_TICKS {
+        let n = robots.len();
+        let max_step_of: Vec<f64> = robots.iter().map(|r| tick_s * r.max_rate_fast()).collect();
+        let mut sim_from = f64::INFINITY;
+        for p in 0..n {
+            for c in (0..n).filter(|&c| c != p) {
+                sim_from = sim_from.min(role_start(robots, p, c, true));
+            }
+        }
+        let horizon = max_end_s(robots) - sim_from;
+        if horizon / (min_rate_slow(robots) * tick_s) > MAX_SIM_TICKS {
             return Err(Error::BadParam {
                 name: "tick_s",
                 why: "too small: the margin simulation would need more than 1e8 ticks",
@@ -143,47 +256,34 @@ impl Setup {
             regions.extend(r.lc_intervals().iter().map(|&iv| (iv, i)));
         }
         regions.sort_by(|x, y| x.0.start_s.total_cmp(&y.0.start_s).then(x.1.cmp(&y.1)));
-        let mut pairs: [Vec<Pair>; 2] = [Vec::new(), Vec::new()];
+        let mut pairs = vec![Vec::new(); n * n];
         for w in regions.windows(2) {
             let ((prev, p), (cur, c)) = (w[0], w[1]);
             if p != c {
-                pairs[p].push(Pair { prev, cur });
+                pairs[p * n + c].push(Pair { prev, cur });
             }
         }
         Ok(Setup {
-            tau,
-            first,
-            max_step: tick_s * max_rate,
+            n,
+            max_step: max_step_of
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max),
+            max_step_of,
             eps: 4.0 * clock_tolerance_s(robots, tick_s),
             pairs,
         })
     }
 
-    /// Fix 4, then the on-schedule overlap test, for pairs that need no simulation:
-    /// `Some(decision)` or `None` (simulate). Fix 4 comes first: in the serial schedule the
-    /// previous robot may end in an LC sample exactly where the later robot starts in one.
-    fn prefilter(&self, robots: &[Timeline; 2], p: usize, pair: Pair) -> Option<bool> {
-        let end_p = robots[p].end_s();
-        if p == self.first
-            && (pair.t_p_end() + self.eps <= self.tau
-                || (pair.t_p_end() >= end_p && end_p <= self.tau))
-        {
-            return Some(true);
-        }
-        if pair.t_c_start() < pair.t_p_end() + self.eps {
-            return Some(false);
-        }
-        None
+    /// `M_pc = max(M_p, M_c)`: the largest step of `p` or `c` in one tick (schedule-clock s).
+    /// For two robots it is `M`.
+    fn max_step_pc(&self, p: usize, c: usize) -> f64 {
+        self.max_step_of[p].max(self.max_step_of[c])
     }
 
-    /// Initial simulated clocks `(t_p, t_c)` of role `(p, c)`.
-    fn initial(&self, robots: &[Timeline; 2], c: usize) -> (f64, f64) {
-        let lead = if c == self.first && robots[c].start_s() < self.tau {
-            self.max_step
-        } else {
-            0.0
-        };
-        (self.tau, self.tau + lead)
+    /// The pairs of role `(p, c)`, ordered in both `T_p` and `T_c`.
+    fn role_pairs(&self, p: usize, c: usize) -> &[Pair] {
+        &self.pairs[p * self.n + c]
     }
 }
 
@@ -216,12 +316,24 @@ impl Sliding {
     }
 }
 
+/// Which extreme of the rates over its window a simulated robot uses (fix 2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Extreme {
+    /// The current robot `c`: the largest `F` and `S` (it moves as far ahead as it can).
+    Largest,
+    /// The previous robot `p`: the smallest `F` and `S`.
+    Smallest,
+    /// Any other robot: the largest `F` and the smallest `S` (the widest range of paces).
+    Widest,
+}
+
 /// One robot's view in a simulation: either the exact point look-up of the printed check or
 /// the conservative window look-up (fixes 2 and 3).
 struct Side<'a> {
     tl: &'a Timeline,
-    /// `true` for `c` (largest rates), `false` for `p` (smallest rates).
-    maximize: bool,
+    extreme: Extreme,
+    /// Half-width of the window (schedule-clock s): one step of the robot plus `ε`.
+    window_s: f64,
     lo: usize,
     hi: usize,
     fast: Sliding,
@@ -229,10 +341,11 @@ struct Side<'a> {
 }
 
 impl<'a> Side<'a> {
-    fn new(tl: &'a Timeline, maximize: bool) -> Self {
+    fn new(tl: &'a Timeline, extreme: Extreme, window_s: f64) -> Self {
         Side {
             tl,
-            maximize,
+            extreme,
+            window_s,
             lo: 0,
             hi: 0,
             fast: Sliding::default(),
@@ -241,13 +354,15 @@ impl<'a> Side<'a> {
     }
 
     /// Conservative mode and rates over the window `[t − w, t + w]` (`t` never decreases).
-    fn window(&mut self, t: f64, w: f64) -> (bool, Rates) {
-        let tl = self.tl;
+    fn window(&mut self, t: f64) -> (bool, Rates) {
+        let (tl, w) = (self.tl, self.window_s);
         let lo = tl.advance_cursor(&mut self.lo, t - w);
         let hi = tl.advance_cursor(&mut self.hi, t + w);
         let lc = tl.any_low_conf(lo, hi);
-        let fast = self.fast.query(lo, hi, |n| tl.rate_fast(n), self.maximize);
-        let slow = self.slow.query(lo, hi, |n| tl.rate_slow(n), self.maximize);
+        let fast_max = self.extreme != Extreme::Smallest;
+        let slow_max = self.extreme == Extreme::Largest;
+        let fast = self.fast.query(lo, hi, |n| tl.rate_fast(n), fast_max);
+        let slow = self.slow.query(lo, hi, |n| tl.rate_slow(n), slow_max);
         (lc, Rates { fast, slow })
     }
 
@@ -260,172 +375,372 @@ impl<'a> Side<'a> {
     }
 }
 
-/// Which variant of Alg. 2 a simulation runs.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Variant {
-    Printed,
-    Conservative,
+/// Fix 4's verdict on a pair when the later of its two robots starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Admission {
+    /// `p` had already left its region: accepted without simulation.
+    Left,
+    /// The regions overlap on schedule (`T_c < T_p + ε`): rejected outright.
+    Overlapping,
+    /// Decided by the simulation.
+    Live,
 }
 
-/// The worst-case simulation of one role `(p, c)`.
+/// The worst-case simulation of one role `(p, c)`. Simulated robot 0 is `p`, 1 is `c`, then
+/// (conservative variant only) every other robot in index order.
 struct RoleSim<'a> {
     variant: Variant,
-    p: Side<'a>,
-    c: Side<'a>,
-    t_p: f64,
-    t_c: f64,
+    sides: Vec<Side<'a>>,
+    /// Schedule clocks (s).
+    clock_s: [f64; MAX_ROBOTS],
+    /// Whether each simulated robot has reached its start.
+    started: [bool; MAX_ROBOTS],
     tick_s: f64,
-    window_s: f64,
+    /// `M_pc`: the largest step of `p` or `c` (schedule-clock s).
+    step_pc: f64,
+    /// The largest step of a robot running before the later of `p` and `c` starts
+    /// (schedule-clock s): `M_pc` if only `p` and `c` run before it.
+    step_before: f64,
 }
 
 impl<'a> RoleSim<'a> {
     fn new(
         variant: Variant,
-        robots: &'a [Timeline; 2],
+        robots: &'a [Timeline],
         setup: &Setup,
         p: usize,
+        c: usize,
         tick_s: f64,
     ) -> Self {
-        let c = 1 - p;
-        let (t_p, t_c) = match variant {
-            Variant::Printed => (setup.tau, setup.tau),
-            Variant::Conservative => setup.initial(robots, c),
-        };
-        RoleSim {
+        let step_pc = setup.max_step_pc(p, c);
+        let w_pc = step_pc + setup.eps;
+        let mut sides = vec![
+            Side::new(&robots[p], Extreme::Smallest, w_pc),
+            Side::new(&robots[c], Extreme::Largest, w_pc),
+        ];
+        let thirds = (0..robots.len()).filter(|&r| r != p && r != c);
+        if variant.with_thirds() {
+            sides.extend(thirds.clone().map(|r| {
+                Side::new(
+                    &robots[r],
+                    Extreme::Widest,
+                    setup.max_step_of[r] + setup.eps,
+                )
+            }));
+        }
+        let t0 = role_start(robots, p, c, variant.with_thirds());
+        let tau = robots[p].start_s().max(robots[c].start_s());
+        let step_before = thirds
+            .filter(|&r| variant.with_thirds() && robots[r].start_s() < tau)
+            .map(|r| setup.max_step_of[r])
+            .fold(step_pc, f64::max);
+        let mut started = [false; MAX_ROBOTS];
+        for (s, side) in started.iter_mut().zip(&sides) {
+            *s = side.tl.start_s() <= t0;
+        }
+        let mut sim = RoleSim {
             variant,
-            p: Side::new(&robots[p], false),
-            c: Side::new(&robots[c], true),
-            t_p,
-            t_c,
+            sides,
+            clock_s: [t0; MAX_ROBOTS],
+            started,
             tick_s,
-            window_s: setup.max_step + setup.eps,
+            step_pc,
+            step_before,
+        };
+        if variant != Variant::Printed && sim.both_started() {
+            let (start_p, start_c) = (robots[p].start_s(), robots[c].start_s());
+            if start_p < start_c {
+                sim.on_start(1, t0);
+            } else if start_c < start_p {
+                sim.on_start(0, t0);
+            }
+        }
+        sim
+    }
+
+    fn both_started(&self) -> bool {
+        self.started[0] && self.started[1]
+    }
+
+    /// Fixes 4 and 6, the later robot's start: robot `w` (0 = `p`, 1 = `c`) has just started,
+    /// in the simulated tick in which the running robot furthest behind reached `follow_s`,
+    /// while the other was running. A real robot starts at a tick boundary once the running
+    /// robot furthest behind has reached its start, i.e. with that robot anywhere in
+    /// `[τ_w, τ_w + M)`, so the other robot (which keeps its deviation from it) is moved to its
+    /// least favourable place: `p` as if `τ_w` had been reached exactly, `c` as if overshot by
+    /// a full step.
+    fn on_start(&mut self, w: usize, follow_s: f64) {
+        let tau_w = self.sides[w].tl.start_s();
+        if w == 1 {
+            self.clock_s[0] = tau_w;
+        } else {
+            let t_c = self.clock_s[1];
+            self.clock_s[1] = ((tau_w + self.step_before) + (t_c - follow_s)).max(t_c);
         }
     }
 
-    /// `c` rushes (`F`), `p` responds with Eq. 18: new `(t_p, t_c)`.
-    fn c_rushing(&self, rp: Rates, rc: Rates) -> (f64, f64) {
-        let t_c = self.t_c + rc.fast * self.tick_s;
-        (
-            self.t_p + response_step(self.t_p - t_c, rp, self.tick_s),
-            t_c,
-        )
-    }
-
-    /// `p` drags (`S`), `c` responds with Eq. 18: new `(t_p, t_c)`.
-    fn p_dragging(&self, rp: Rates, rc: Rates) -> (f64, f64) {
-        let t_p = self.t_p + rp.slow * self.tick_s;
-        (
-            t_p,
-            self.t_c + response_step(self.t_c - t_p, rc, self.tick_s),
-        )
-    }
-
-    fn step(&mut self) {
-        let ((lc_p, rp), (lc_c, rc)) = match self.variant {
-            Variant::Printed => (self.p.point(self.t_p), self.c.point(self.t_c)),
-            Variant::Conservative => (
-                self.p.window(self.t_p, self.window_s),
-                self.c.window(self.t_c, self.window_s),
-            ),
+    /// One simulated tick; `true` when `p` and `c` are both started after it and were not
+    /// before.
+    fn step(&mut self) -> bool {
+        let k = self.sides.len();
+        let mut members = [Member::idle(0.0, Mode::Finished); MAX_ROBOTS];
+        let mut lc = [false; MAX_ROBOTS];
+        for i in 0..k {
+            let t = self.clock_s[i];
+            let tl = self.sides[i].tl;
+            members[i] = if !self.started[i] {
+                Member::idle(t, Mode::Waiting)
+            } else if i >= 2 && t >= tl.end_s() {
+                Member::idle(t, Mode::Finished)
+            } else {
+                let (low, rates) = match self.variant {
+                    Variant::Printed => self.sides[i].point(t),
+                    Variant::Pairwise | Variant::Conservative => self.sides[i].window(t),
+                };
+                lc[i] = low;
+                Member {
+                    clock_s: t,
+                    mode: Mode::High,
+                    rates,
+                }
+            };
+        }
+        // Who may set the pace and how (fixes 3 and 5): `c` rushing, `p` dragging, any other
+        // robot rushing or dragging; the branch leaving `c` furthest ahead of `p` is kept (the
+        // first on a tie). The printed check takes the first only.
+        let mut branches = [(0_usize, false); 2 * MAX_ROBOTS];
+        let mut n_branches = 0;
+        let mut push = |robot: usize, rush: bool| {
+            branches[n_branches] = (robot, rush);
+            n_branches += 1;
         };
-        let (t_p, t_c) = match (lc_p, lc_c) {
-            (true, true) if self.variant == Variant::Conservative => {
-                let rush = self.c_rushing(rp, rc);
-                let drag = self.p_dragging(rp, rc);
-                if drag.1 - drag.0 > rush.1 - rush.0 {
-                    drag
-                } else {
-                    rush
-                }
-            }
-            (_, true) => self.c_rushing(rp, rc),
-            (true, false) => self.p_dragging(rp, rc),
-            (false, false) => {
-                let h = self.tick_s;
-                if self.t_c - self.t_p > 0.0 {
-                    let (dc, dp) = high_conf_steps(self.t_c - self.t_p, rc, rp, h);
-                    (self.t_p + dp, self.t_c + dc)
-                } else {
-                    let (dp, dc) = high_conf_steps(self.t_p - self.t_c, rp, rc, h);
-                    (self.t_p + dp, self.t_c + dc)
-                }
-            }
-        };
-        self.t_p = t_p;
-        self.t_c = t_c;
-    }
-
-    /// Stop test of one pair after a step: `Some(false)` reject, `Some(true)` accept, `None`
-    /// undecided.
-    fn test(&self, pair: Pair, setup: &Setup) -> Option<bool> {
-        match self.variant {
-            Variant::Printed => {
-                if self.t_c >= pair.t_c_start() {
-                    Some(false)
-                } else if self.t_p >= pair.t_p_end() {
-                    Some(true)
-                } else {
-                    None
-                }
-            }
-            Variant::Conservative => {
-                if self.slack(pair, setup) <= 0.0 {
-                    Some(false)
-                } else if self.p_is_out(pair, setup) {
-                    Some(true)
-                } else {
-                    None
-                }
+        if lc[1] {
+            push(1, true);
+        }
+        if lc[0] {
+            push(0, false);
+        }
+        for (i, &low) in lc.iter().enumerate().take(k).skip(2) {
+            if low {
+                push(i, true);
+                push(i, false);
             }
         }
+        if self.variant == Variant::Printed {
+            n_branches = n_branches.min(1);
+        }
+        let mut best: Option<(f64, [f64; MAX_ROBOTS], Option<f64>)> = None;
+        for &(l, rush) in &branches[..n_branches] {
+            let mut m = members;
+            m[l].mode = Mode::Low;
+            let mut next = [0.0_f64; MAX_ROBOTS];
+            let rate = if rush {
+                m[l].rates.fast
+            } else {
+                m[l].rates.slow
+            };
+            next[l] = m[l].clock_s + rate * self.tick_s;
+            let follow = advance(&m[..k], Some(l), self.tick_s, &mut next[..k]);
+            let lead = next[1] - next[0];
+            if best.is_none_or(|(b, _, _)| lead > b) {
+                best = Some((lead, next, follow));
+            }
+        }
+        let (mut next, follow) = match best {
+            Some((_, next, follow)) => (next, follow),
+            None => {
+                let mut next = [0.0_f64; MAX_ROBOTS];
+                let follow = advance(&members[..k], None, self.tick_s, &mut next[..k]);
+                (next, follow)
+            }
+        };
+        if self.variant.with_thirds() && !lc[0] && !lc[1] && self.both_started() {
+            let t_c = self.clock_s[1];
+            if self.sides[2..k].iter().any(|side| side.tl.start_s() <= t_c) {
+                self.worst_common_pace(&members, &mut next);
+            }
+        }
+        let before = [self.started[0], self.started[1]];
+        for (((clock, started), side), &next) in self
+            .clock_s
+            .iter_mut()
+            .zip(self.started.iter_mut())
+            .zip(&self.sides)
+            .zip(&next)
+        {
+            if *started {
+                *clock = next;
+            } else {
+                let start = side.tl.start_s();
+                *clock = next.min(start).max(*clock);
+                *started = *clock >= start;
+            }
+        }
+        for w in 0..2 {
+            if !before[w] && self.started[w] && before[1 - w] {
+                self.on_start(w, follow.unwrap_or(next[w]));
+            }
+        }
+        !(before[0] && before[1]) && self.both_started()
+    }
+
+    /// Fix 5, robots other than `p` and `c`: while neither `p` nor `c` is low-confidence and
+    /// another robot may run, both respond to one common pace `x` set by the others (a
+    /// low-confidence robot at the operator's rate, or `HIGH-CONF`'s target, which a robot
+    /// far behind holds back). Replaces `p`'s and `c`'s new clocks in `next` by those of the
+    /// `x ∈ ℝ` that leaves `c` furthest ahead: `t_c − t_p` after the step is piecewise linear in
+    /// `x` with breakpoints at their slowest and fastest clocks, so the maximum is at one of those
+    /// or at `x = ±∞`. The simulated step is kept on a tie.
+    fn worst_common_pace(&self, members: &[Member], next: &mut [f64]) {
+        let (mp, mc) = (members[0], members[1]);
+        let h = self.tick_s;
+        let reach = |m: Member| m.clock_s + m.rates.fast * h;
+        let least = |m: Member| m.clock_s + m.rates.slow * h;
+        let mut best = (next[1] - next[0], next[0], next[1]);
+        for x in [
+            f64::NEG_INFINITY,
+            least(mp),
+            least(mc),
+            reach(mp),
+            reach(mc),
+            f64::INFINITY,
+        ] {
+            let t_p = mp.clock_s + response_step(mp.clock_s - x, mp.rates, h);
+            let t_c = mc.clock_s + response_step(mc.clock_s - x, mc.rates, h);
+            if t_c - t_p > best.0 {
+                best = (t_c - t_p, t_p, t_c);
+            }
+        }
+        (next[0], next[1]) = (best.1, best.2);
+    }
+
+    /// Fix 4: once both `p` and `c` run, the pairs that need no simulation. `None` if one is
+    /// rejected (its regions already overlap on schedule), else the pairs left to simulate.
+    /// Fix 4 for one pair, read when the later of `p` and `c` has started.
+    fn admission(&self, pair: Pair, setup: &Setup) -> Admission {
+        let t_p = self.clock_s[0];
+        let end_p = self.sides[0].tl.end_s();
+        if pair.t_p_end() + setup.eps <= t_p || (pair.t_p_end() >= end_p && end_p <= t_p) {
+            Admission::Left
+        } else if pair.t_c_start() < pair.t_p_end() + setup.eps {
+            Admission::Overlapping
+        } else {
+            Admission::Live
+        }
+    }
+
+    /// The pairs still to be decided by simulation once the later robot has started, or `None`
+    /// if one of them overlaps on schedule. A pair whose previous region `p` had left
+    /// ([`Admission::Left`]) is accepted: the printed loop steps once before testing and
+    /// needlessly rejects such pairs. This comes before the overlap test: in the serial
+    /// schedule `p` may end in an LC sample exactly where the later robot starts in one.
+    fn admit(&self, pairs: &[Pair], setup: &Setup) -> Option<Vec<Pair>> {
+        if self.variant == Variant::Printed {
+            return Some(pairs.to_vec());
+        }
+        let mut live = Vec::with_capacity(pairs.len());
+        for &pair in pairs {
+            match self.admission(pair, setup) {
+                Admission::Left => {}
+                Admission::Overlapping => return None,
+                Admission::Live => live.push(pair),
+            }
+        }
+        Some(live)
     }
 
     /// Rule 1's room left for `c` (conservative check): `(T_c − ε) − (t_c + M)`, schedule-clock
     /// s; `c` is a full step short of its region while this is > 0.
-    fn slack(&self, pair: Pair, setup: &Setup) -> f64 {
-        (pair.t_c_start() - setup.eps) - (self.t_c + setup.max_step)
+    fn slack(&self, pair: Pair, eps: f64) -> f64 {
+        (pair.t_c_start() - eps) - (self.clock_s[1] + self.step_pc)
     }
 
     /// Rule 1's acceptance (conservative check): `p` has left its region, `t_p ≥ T_p + ε`.
-    fn p_is_out(&self, pair: Pair, setup: &Setup) -> bool {
-        self.t_p >= pair.t_p_end() + setup.eps
+    fn p_is_out(&self, pair: Pair, eps: f64) -> bool {
+        self.clock_s[0] >= pair.t_p_end() + eps
+    }
+
+    /// Stop test of one pair after a step: `Some(false)` reject, `Some(true)` accept, `None`
+    /// undecided.
+    fn test(&self, pair: Pair, eps: f64) -> Option<bool> {
+        let (t_p, t_c) = (self.clock_s[0], self.clock_s[1]);
+        match self.variant {
+            Variant::Printed => {
+                if t_c >= pair.t_c_start() {
+                    Some(false)
+                } else if t_p >= pair.t_p_end() {
+                    Some(true)
+                } else {
+                    None
+                }
+            }
+            Variant::Pairwise | Variant::Conservative => {
+                if self.slack(pair, eps) <= 0.0 {
+                    Some(false)
+                } else if self.p_is_out(pair, eps) {
+                    Some(true)
+                } else {
+                    None
+                }
+            }
+        }
     }
 }
 
-/// Simulation budget: every step moves `t_p` by at least `S_min·tick_s > 0`.
-fn step_budget(robots: &[Timeline; 2], setup: &Setup, tick_s: f64) -> u64 {
-    let min_slow = robots[0].min_rate_slow().min(robots[1].min_rate_slow());
-    let horizon = robots[0].end_s().max(robots[1].end_s()) + setup.max_step - setup.tau;
+/// Simulation budget of a role started at `t_start_s`: every step moves every running robot by
+/// at least `S_min·tick_s > 0`.
+fn step_budget(robots: &[Timeline], setup: &Setup, t_start_s: f64, tick_s: f64) -> u64 {
+    let horizon = max_end_s(robots) + setup.max_step - t_start_s;
     // Bounded by MAX_SIM_TICKS (checked in Setup::new), so the cast cannot overflow.
-    (horizon / (min_slow * tick_s)).ceil().max(0.0) as u64 + 4
+    (horizon / (min_rate_slow(robots) * tick_s)).ceil().max(0.0) as u64 + 4
 }
 
 /// Runs one role's simulation over `pairs` (already ordered) with a pointer; `false` as soon as
 /// one pair is rejected.
 fn run_role(
     variant: Variant,
-    robots: &[Timeline; 2],
+    robots: &[Timeline],
     setup: &Setup,
-    p: usize,
+    (p, c): (usize, usize),
     pairs: &[Pair],
     tick_s: f64,
 ) -> bool {
     if pairs.is_empty() {
         return true;
     }
-    let budget = step_budget(robots, setup, tick_s);
-    let mut sim = RoleSim::new(variant, robots, setup, p, tick_s);
+    let mut sim = RoleSim::new(variant, robots, setup, p, c, tick_s);
+    let mut live = Vec::new();
+    let mut ready = false;
+    if sim.both_started() {
+        match sim.admit(pairs, setup) {
+            None => return false,
+            Some(l) if l.is_empty() => return true,
+            Some(l) => (live, ready) = (l, true),
+        }
+    }
+    let t_start = role_start(robots, p, c, variant.with_thirds());
+    let budget = step_budget(robots, setup, t_start, tick_s);
     let mut k = 0;
     for _ in 0..budget {
-        sim.step();
-        while k < pairs.len() {
-            match sim.test(pairs[k], setup) {
+        if sim.step() {
+            match sim.admit(pairs, setup) {
+                None => return false,
+                Some(l) if l.is_empty() => return true,
+                Some(l) => (live, ready) = (l, true),
+            }
+            continue;
+        }
+        if !ready {
+            continue;
+        }
+        while k < live.len() {
+            match sim.test(live[k], setup.eps) {
                 Some(false) => return false,
                 Some(true) => k += 1,
                 None => break,
             }
         }
-        if k == pairs.len() {
+        if k == live.len() {
             return true;
         }
     }
@@ -433,98 +748,50 @@ fn run_role(
     false
 }
 
-/// The conservative, discretization-safe worst-case margin check (Alg. 2 with the fixes 1–4
-/// of the module docs and docs/decisions.md, single pass): `true` when no admissible operator
-/// can make both robots
-/// low-confidence in the same control tick of `tick_s` real seconds.
-///
-/// Two simulations (one per role `(p, c)`), each deciding all pairs of its role with a pointer;
-/// see the [module docs](self) for the argument. Cost O(T_ref · steps per sample).
-///
-/// # Errors
-/// [`Error::BadParam`] for `tick_s` not finite and > 0, or so small that a simulation would need
-/// more than 1e8 ticks.
-pub fn sufficient_margins(robots: &[Timeline; 2], tick_s: f64) -> Result<bool> {
+/// Every ordered role `(p, c)` of `setup`, in the order the checks decide them.
+fn roles(n: usize) -> impl Iterator<Item = (usize, usize)> {
+    (0..n).flat_map(move |p| (0..n).filter(move |&c| c != p).map(move |c| (p, c)))
+}
+
+/// Runs `variant` with one single-pass simulation per ordered role.
+fn check_single_pass(robots: &[Timeline], tick_s: f64, variant: Variant) -> Result<bool> {
     let setup = Setup::new(robots, tick_s)?;
-    for p in 0..2 {
-        let mut sim_pairs = Vec::with_capacity(setup.pairs[p].len());
-        for &pair in &setup.pairs[p] {
-            match setup.prefilter(robots, p, pair) {
-                Some(false) => return Ok(false),
-                Some(true) => {}
-                None => sim_pairs.push(pair),
-            }
-        }
-        if !run_role(Variant::Conservative, robots, &setup, p, &sim_pairs, tick_s) {
+    for role in roles(setup.n) {
+        let pairs = setup.role_pairs(role.0, role.1);
+        if !run_role(variant, robots, &setup, role, pairs, tick_s) {
             return Ok(false);
         }
     }
     Ok(true)
 }
 
-/// One pair of consecutive LC regions of different robots with its worst-case room, from the
-/// simulation of [`sufficient_margins`] (see [`pair_slacks`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PairSlack {
-    /// The previous robot `p` (0 = the first robot, 1 = the second); the current robot `c` is
-    /// the other one.
-    pub prev_robot: usize,
-    /// `p`'s region (schedule clock); `p` leaves it at `T_p = prev.end_s`.
-    pub prev: LcInterval,
-    /// `c`'s region (schedule clock); `c` enters it at `T_c = cur.start_s`.
-    pub cur: LcInterval,
-    /// Schedule-clock s, `> 0` exactly when [`sufficient_margins`] accepts the pair: how much
-    /// earlier `c`'s region could start before rule 1 rejects it on the same worst-case
-    /// trajectory, `(T_c − ε) − (t_c + M)` at the first simulated step with `t_p ≥ T_p + ε`
-    /// (`t_c` is then the furthest the worst case has pushed `c`); its negative is the clearance
-    /// missing. `+∞` for a pair accepted without simulation (rule 4); for a pair whose regions
-    /// already overlap on schedule, the smaller of that and `T_c − (T_p + ε) < 0`; `−∞` if the
-    /// simulation budget ran out first.
-    pub slack_s: f64,
-}
-
-/// Every pair's worst-case slack ([`PairSlack`]), in the order of the current regions' starts,
-/// from the same two simulations as [`sufficient_margins`] (one per role, run until every pair
-/// of the role is decided): `sufficient_margins(robots, tick_s)` is `true` exactly when every
-/// `slack_s > 0`. A scheduler uses it to see how much clearance each pair lacks or has to spare.
-///
-/// # Errors
-/// As [`sufficient_margins`].
-pub fn pair_slacks(robots: &[Timeline; 2], tick_s: f64) -> Result<Vec<PairSlack>> {
+/// Runs `variant` with one fresh simulation per pair.
+fn check_per_pair(robots: &[Timeline], tick_s: f64, variant: Variant) -> Result<bool> {
     let setup = Setup::new(robots, tick_s)?;
-    let mut out = Vec::with_capacity(setup.pairs[0].len() + setup.pairs[1].len());
-    for (p, pairs) in setup.pairs.iter().enumerate() {
-        let mut slack = vec![f64::NEG_INFINITY; pairs.len()];
-        if !pairs.is_empty() {
-            let mut sim = RoleSim::new(Variant::Conservative, robots, &setup, p, tick_s);
-            let mut k = 0;
-            for _ in 0..step_budget(robots, &setup, tick_s) {
-                sim.step();
-                while k < pairs.len() && sim.p_is_out(pairs[k], &setup) {
-                    slack[k] = sim.slack(pairs[k], &setup);
-                    k += 1;
-                }
-                if k == pairs.len() {
-                    break;
-                }
+    for role in roles(setup.n) {
+        for pair in setup.role_pairs(role.0, role.1) {
+            if !run_role(variant, robots, &setup, role, &[*pair], tick_s) {
+                return Ok(false);
             }
         }
-        for (&pair, s) in pairs.iter().zip(slack) {
-            let slack_s = match setup.prefilter(robots, p, pair) {
-                Some(true) => f64::INFINITY,
-                Some(false) => s.min(pair.t_c_start() - (pair.t_p_end() + setup.eps)),
-                None => s,
-            };
-            out.push(PairSlack {
-                prev_robot: p,
-                prev: pair.prev,
-                cur: pair.cur,
-                slack_s,
-            });
-        }
     }
-    out.sort_by(|x, y| x.cur.start_s.total_cmp(&y.cur.start_s));
-    Ok(out)
+    Ok(true)
+}
+
+/// The conservative, discretization-safe worst-case margin check for `1 ≤ N ≤ MAX_ROBOTS`
+/// robots (Alg. 2 with fixes 1–6, single pass): `true` when no admissible operator can make two
+/// robots low-confidence in the same control tick of `tick_s` real seconds. Robot `i` is
+/// `robots[i]`; one robot is always accepted.
+///
+/// One simulation per ordered role `(p, c)`, each deciding all pairs of its role with a pointer;
+/// see the [module docs](self) for the argument. Cost O(N³ · T_ref · steps per sample) at worst
+/// (O(T_ref · steps per sample) for two robots).
+///
+/// # Errors
+/// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] for `tick_s` not
+/// finite and > 0, or so small that a simulation would need more than 1e8 ticks.
+pub fn sufficient_margins(robots: &[Timeline], tick_s: f64) -> Result<bool> {
+    check_single_pass(robots, tick_s, Variant::Conservative)
 }
 
 /// The same conservative check as [`sufficient_margins`], written as the straightforward loop:
@@ -533,40 +800,138 @@ pub fn pair_slacks(robots: &[Timeline; 2], tick_s: f64) -> Result<Vec<PairSlack>
 ///
 /// # Errors
 /// As [`sufficient_margins`].
-pub fn sufficient_margins_per_pair(robots: &[Timeline; 2], tick_s: f64) -> Result<bool> {
-    let setup = Setup::new(robots, tick_s)?;
-    for p in 0..2 {
-        for &pair in &setup.pairs[p] {
-            let ok = match setup.prefilter(robots, p, pair) {
-                Some(d) => d,
-                None => run_role(Variant::Conservative, robots, &setup, p, &[pair], tick_s),
-            };
-            if !ok {
-                return Ok(false);
-            }
-        }
-    }
-    Ok(true)
+pub fn sufficient_margins_per_pair(robots: &[Timeline], tick_s: f64) -> Result<bool> {
+    check_per_pair(robots, tick_s, Variant::Conservative)
 }
 
-/// Alg. 2 exactly as printed (with the typo fixes of docs/decisions.md, "Typos of Eq. 17 and
-/// Alg. 1"), one simulation per pair from `τ`.
+/// The two-robot conservative check (fixes 1–4) applied to every pair of robots as if the other
+/// robots were absent. For two robots it is [`sufficient_margins`].
 ///
-/// **UNSAFE on a tick grid**: it can accept schedules on which an admissible operator makes both
+/// **UNSAFE for three or more robots**: a third robot that sets the pace can move `p` and `c`
+/// apart (see the [module docs](self)), and this check does not see it. Use only as a
+/// baseline.
+///
+/// # Errors
+/// As [`sufficient_margins`].
+pub fn sufficient_margins_pairwise(robots: &[Timeline], tick_s: f64) -> Result<bool> {
+    check_single_pass(robots, tick_s, Variant::Pairwise)
+}
+
+/// Alg. 2 exactly as printed (with the typo fixes of docs/decisions.md), one simulation per pair
+/// from the later start of its two robots, the other robots ignored.
+///
+/// **UNSAFE on a tick grid**: it can accept schedules on which an admissible operator makes two
 /// robots low-confidence in the same tick (see the [module docs](self)). Use only as a baseline.
 ///
 /// # Errors
 /// As [`sufficient_margins`].
-pub fn sufficient_margins_printed(robots: &[Timeline; 2], tick_s: f64) -> Result<bool> {
+pub fn sufficient_margins_printed(robots: &[Timeline], tick_s: f64) -> Result<bool> {
+    check_per_pair(robots, tick_s, Variant::Printed)
+}
+
+/// One pair of consecutive LC regions of different robots with its worst-case room, from the
+/// simulation of [`sufficient_margins`] (see [`pair_slacks`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairSlack {
+    /// The previous robot `p` (index into the robots given, 0 = the first robot).
+    pub prev_robot: usize,
+    /// The current robot `c` (index into the robots given); for two robots `1 − prev_robot`.
+    pub cur_robot: usize,
+    /// `p`'s region (schedule clock); `p` leaves it at `T_p = prev.end_s`.
+    pub prev: LcInterval,
+    /// `c`'s region (schedule clock); `c` enters it at `T_c = cur.start_s`.
+    pub cur: LcInterval,
+    /// Schedule-clock s, `> 0` exactly when [`sufficient_margins`] accepts the pair: how much
+    /// earlier `c`'s region could start before rule 1 rejects it on the same worst-case
+    /// trajectory, `(T_c − ε) − (t_c + M)` at the first simulated step with `t_p ≥ T_p + ε`
+    /// (`t_c` is then the furthest the worst case has pushed `c`); its negative is the clearance
+    /// missing. `+∞` for a pair accepted without simulation (fix 4); for a pair whose regions
+    /// already overlap on schedule, the smaller of that and `T_c − (T_p + ε) < 0`; `−∞` if the
+    /// simulation budget ran out first.
+    pub slack_s: f64,
+}
+
+/// Every pair's worst-case slack ([`PairSlack`]), in the order of the current regions' starts,
+/// from the same simulations as [`sufficient_margins`] (one per ordered role, run until every
+/// pair of the role is decided): `sufficient_margins(robots, tick_s)` is `true` exactly when
+/// every `slack_s > 0`. A scheduler uses it to see how much clearance each pair lacks or has
+/// to spare.
+///
+/// # Errors
+/// As [`sufficient_margins`].
+pub fn pair_slacks(robots: &[Timeline], tick_s: f64) -> Result<Vec<PairSlack>> {
     let setup = Setup::new(robots, tick_s)?;
-    for p in 0..2 {
-        for &pair in &setup.pairs[p] {
-            if !run_role(Variant::Printed, robots, &setup, p, &[pair], tick_s) {
-                return Ok(false);
+    let mut out = Vec::new();
+    for (p, c) in roles(setup.n) {
+        let pairs = setup.role_pairs(p, c);
+        if pairs.is_empty() {
+            continue;
+        }
+        let slacks = role_slacks(robots, &setup, (p, c), pairs, tick_s);
+        out.extend(pairs.iter().zip(slacks).map(|(pair, slack_s)| PairSlack {
+            prev_robot: p,
+            cur_robot: c,
+            prev: pair.prev,
+            cur: pair.cur,
+            slack_s,
+        }));
+    }
+    out.sort_by(|x, y| x.cur.start_s.total_cmp(&y.cur.start_s));
+    Ok(out)
+}
+
+/// The slack of each of one role's `pairs` (see [`PairSlack::slack_s`]): the role's
+/// conservative simulation run until `p` has left every region.
+fn role_slacks(
+    robots: &[Timeline],
+    setup: &Setup,
+    (p, c): (usize, usize),
+    pairs: &[Pair],
+    tick_s: f64,
+) -> Vec<f64> {
+    let mut slack = vec![f64::NEG_INFINITY; pairs.len()];
+    let mut sim = RoleSim::new(Variant::Conservative, robots, setup, p, c, tick_s);
+    let classify = |sim: &RoleSim| -> Vec<Admission> {
+        pairs
+            .iter()
+            .map(|&pair| sim.admission(pair, setup))
+            .collect()
+    };
+    let mut admission = sim.both_started().then(|| classify(&sim));
+    let t_start = role_start(robots, p, c, true);
+    let mut k = 0;
+    for _ in 0..step_budget(robots, setup, t_start, tick_s) {
+        if sim.step() {
+            admission = Some(classify(&sim));
+            continue;
+        }
+        let Some(adm) = &admission else { continue };
+        while k < pairs.len() {
+            if adm[k] == Admission::Left {
+                slack[k] = f64::INFINITY;
+            } else if sim.p_is_out(pairs[k], setup.eps) {
+                slack[k] = sim.slack(pairs[k], setup.eps);
+            } else {
+                break;
+            }
+            k += 1;
+        }
+        if k == pairs.len() {
+            break;
+        }
+    }
+    if let Some(adm) = &admission {
+        for ((s, a), pair) in slack.iter_mut().zip(adm).zip(pairs) {
+            match a {
+                Admission::Left => *s = f64::INFINITY,
+                Admission::Overlapping => {
+                    *s = s.min(pair.t_c_start() - (pair.t_p_end() + setup.eps));
+                }
+                Admission::Live => {}
             }
         }
     }
-    Ok(true)
+    slack
 }
 
 #[cfg(test)]
@@ -590,8 +955,7 @@ mod tests {
     fn pairs_of_three_sample_case() {
         let r = three_sample(1.5);
         let s = Setup::new(&r, 1.0).unwrap();
-        assert_eq!(s.tau, 1.5);
-        assert_eq!(s.first, 0);
+        assert_eq!(role_start(&r, 0, 1, true), 1.5);
         assert_eq!(s.max_step, 2.0);
         let iv = |start_s, end_s| LcInterval {
             ref_start: 1,
@@ -600,17 +964,20 @@ mod tests {
             end_s,
         };
         assert_eq!(
-            s.pairs[0],
-            vec![Pair {
+            s.role_pairs(0, 1),
+            [Pair {
                 prev: iv(1.0, 2.0),
                 cur: iv(2.5, 3.5)
             }]
         );
         assert_eq!(
-            (s.pairs[0][0].t_p_end(), s.pairs[0][0].t_c_start()),
+            (
+                s.role_pairs(0, 1)[0].t_p_end(),
+                s.role_pairs(0, 1)[0].t_c_start()
+            ),
             (2.0, 2.5)
         );
-        assert!(s.pairs[1].is_empty());
+        assert!(s.role_pairs(1, 0).is_empty());
     }
 
     #[test]
@@ -633,15 +1000,20 @@ mod tests {
         let s = pair_slacks(&three_sample(1.5), 1.0).unwrap();
         assert_eq!(s.len(), 1);
         assert_eq!(
-            (s[0].prev_robot, s[0].prev.end_s, s[0].cur.start_s),
-            (0, 2.0, 2.5)
+            (
+                s[0].prev_robot,
+                s[0].cur_robot,
+                s[0].prev.end_s,
+                s[0].cur.start_s
+            ),
+            (0, 1, 2.0, 2.5)
         );
         assert!(
             s[0].slack_s < -3.0 && s[0].slack_s > -3.0 - 1e-6,
             "{}",
             s[0].slack_s
         );
-        // Serial: rule 4 accepts the pair without simulating it.
+        // Serial: fix 4 accepts the pair without simulating it.
         let s = pair_slacks(&three_sample(3.0), 1.0).unwrap();
         assert_eq!(s[0].slack_s, f64::INFINITY);
         assert!(pair_slacks(&three_sample(1.5), 0.0).is_err());

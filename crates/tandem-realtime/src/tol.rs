@@ -10,7 +10,7 @@
 //!   these tests but on the margin check, which runs on the same numbers the coordinator runs.
 //! - **Schedule clock** ([`clock_tolerance_s`]): where a comparison of schedule-clock times
 //!   decides low-confidence membership, the tolerance is `CLOCK_REL = 1e-9` times the largest
-//!   time involved (both robots' starts and ends, and the tick). It errs on the safe side: the
+//!   time involved (every robot's start and end, and the tick). It errs on the safe side: the
 //!   [`Coordinator`](crate::Coordinator) widens every traversed interval by it (reporting
 //!   *more* low-confidence ticks) and the margin check widens by four times it (rejecting
 //!   *more* schedules).
@@ -56,10 +56,10 @@ pub fn close_to(value: f64, target: f64) -> bool {
 }
 
 /// Absolute tolerance (schedule-clock s) used where floating-point comparisons decide
-/// low-confidence membership: `CLOCK_REL × max(|τ_i|, |end_i|, tick_s)` over both robots
+/// low-confidence membership: `CLOCK_REL × max(|τ_i|, |end_i|, tick_s)` over all robots
 /// (`tick_s` in real seconds). Errs on the safe side (see the [module docs](self)).
 #[must_use]
-pub fn clock_tolerance_s(robots: &[Timeline; 2], tick_s: f64) -> f64 {
+pub fn clock_tolerance_s(robots: &[Timeline], tick_s: f64) -> f64 {
     let scale = robots
         .iter()
         .flat_map(|r| [r.start_s().abs(), r.end_s().abs()])

@@ -1,4 +1,5 @@
-//! The single-pass conservative check decides exactly like the per-pair re-simulation.
+//! The single-pass conservative check decides exactly like the per-pair re-simulation, for two
+//! robots and for N; serial schedules are always accepted.
 
 mod common;
 
@@ -8,7 +9,7 @@ use common::{Problem, rng};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use rand::Rng;
-use tandem_realtime::{pair_slacks, sufficient_margins, sufficient_margins_per_pair};
+use tandem_realtime::{Timeline, pair_slacks, sufficient_margins, sufficient_margins_per_pair};
 
 #[test]
 fn single_pass_equals_per_pair_on_random_schedules() {
@@ -83,5 +84,77 @@ fn serial_schedule_is_always_accepted() {
     });
     if let Err(e) = result {
         panic!("{e}");
+    }
+}
+
+#[test]
+fn single_pass_equals_per_pair_for_n_robots() {
+    for n in 3..=5usize {
+        let mut counts = [0u32; 2];
+        for seed in 0..200u64 {
+            let mut r = rng(0xA6 + seed);
+            let problem = if seed % 2 == 0 {
+                Problem::random_styled(&mut r, n)
+            } else {
+                Problem::random_structured(&mut r, n)
+            };
+            let tick_s = problem.dt_s * r.random_range(0.25..=1.5);
+            // Each robot from simultaneous with the first to after the latest end so far.
+            let mut starts = vec![0.0];
+            for _ in 1..n {
+                let end = problem
+                    .robots_at(&starts)
+                    .iter()
+                    .map(Timeline::end_s)
+                    .fold(0.0, f64::max);
+                starts.push(end * r.random::<f64>().powf(0.25) * 1.05);
+            }
+            let robots = problem.robots_at(&starts);
+            let single = sufficient_margins(&robots, tick_s).unwrap();
+            let per_pair = sufficient_margins_per_pair(&robots, tick_s).unwrap();
+            assert_eq!(single, per_pair, "N = {n}, seed {seed}, starts {starts:?}");
+            // The slacks come from the same simulations: all positive exactly when accepted.
+            let slacks = pair_slacks(&robots, tick_s).unwrap();
+            assert_eq!(
+                slacks.iter().all(|s| s.slack_s > 0.0),
+                single,
+                "N = {n}, seed {seed}, slacks {slacks:?}"
+            );
+            assert!(slacks.iter().all(|s| s.prev_robot != s.cur_robot));
+            counts[usize::from(single)] += 1;
+        }
+        let [rejected, accepted] = counts;
+        assert!(
+            rejected >= 20 && accepted >= 20,
+            "N = {n}: {accepted} accepted, {rejected} rejected"
+        );
+    }
+}
+
+/// The serial schedule of N robots (each starting when the one before it ends) is always
+/// accepted: robots not yet started follow the running robot furthest behind, so each starts
+/// only once the others have finished.
+#[test]
+fn serial_schedules_of_n_robots_are_always_accepted() {
+    for n in 1..=6usize {
+        for seed in 0..60u64 {
+            let mut r = rng(0x5E + seed);
+            let problem = if seed % 2 == 0 {
+                Problem::random_styled(&mut r, n)
+            } else {
+                Problem::random_structured(&mut r, n)
+            };
+            let tick_s = problem.dt_s * r.random_range(0.25..=1.5);
+            let mut starts = vec![0.0];
+            for i in 1..n {
+                starts.push(problem.timeline(i - 1, starts[i - 1]).end_s());
+            }
+            let robots = problem.robots_at(&starts);
+            assert!(
+                sufficient_margins(&robots, tick_s).unwrap(),
+                "N = {n}, seed {seed}"
+            );
+            assert!(sufficient_margins_per_pair(&robots, tick_s).unwrap());
+        }
     }
 }

@@ -1,14 +1,16 @@
-//! The margin check is not vacuous: schedules it rejects (and the printed Alg. 2 accepts) really
-//! do overlap under some admissible operator.
+//! The margin check is not vacuous: schedules it rejects (and the printed Alg. 2, or for three
+//! robots the two-robot check applied per pair, accepts) really do overlap under some admissible
+//! operator.
 
 mod common;
 
 use common::{Problem, adversaries, find_overlap, rng};
-use rand::Rng;
+use rand::{Rng, SeedableRng};
 use tandem_realtime::Operator::{Fastest as FAST, Slowest as SLOW};
+use tandem_realtime::adversary::{adversary_set, run_adversary};
 use tandem_realtime::{
-    Coordinator, Timeline, sufficient_margins, sufficient_margins_per_pair,
-    sufficient_margins_printed,
+    Coordinator, Timeline, sufficient_margins, sufficient_margins_pairwise,
+    sufficient_margins_per_pair, sufficient_margins_printed,
 };
 
 /// The smallest case of docs/decisions.md, "Alg. 2 as printed is not sound on a tick grid":
@@ -94,4 +96,57 @@ fn printed_check_accepts_schedules_that_overlap() {
         overlaps >= 40,
         "only {overlaps} of {cases} printed-only cases overlapped"
     );
+}
+
+/// The smallest three-robot case found where a robot that is neither `p` nor `c` breaks the
+/// pair's two-robot worst case: 32 reference samples [HC×16, LC×8, HC×8], Δt_s = 1, bounds
+/// `[½, 2]`, tick ¼ s. Robot 0 (gradients 1) starts at 0, robot 1 (gradients 1) at 12, robot 2
+/// at `tau_c` with gradient 2 on its HC samples, i.e. at `ψ̇max`: `S = 1`, it cannot slow down.
+/// Regions: robot 0 `[16, 24)`, robot 1 `[28, 36)`, robot 2 `[tau_c + 32, tau_c + 40)`.
+fn third_robot_case(tau_c: f64) -> Vec<Timeline> {
+    let conf: Vec<bool> = (0..32).map(|k| !(16..24).contains(&k)).collect();
+    let (lo, hi, ones) = ([0.5; 32], [2.0; 32], [1.0; 32]);
+    let slow_hc: Vec<f64> = conf.iter().map(|&hc| if hc { 2.0 } else { 1.0 }).collect();
+    vec![
+        Timeline::new(&conf, &ones, &lo, &hi, 0.0, 1.0).unwrap(),
+        Timeline::new(&conf, &ones, &lo, &hi, 12.0, 1.0).unwrap(),
+        Timeline::new(&conf, &slow_hc, &lo, &hi, tau_c, 1.0).unwrap(),
+    ]
+}
+
+#[test]
+fn a_dragged_third_robot_breaks_the_two_robot_worst_case() {
+    let tick_s = 0.25;
+    // τ_c = 16: robot 2's region starts 12 s after robot 1's ends. Each pair on its own is
+    // safe, so the per-pair check accepts; the N-robot check rejects.
+    let robots = third_robot_case(16.0);
+    assert!(sufficient_margins_pairwise(&robots, tick_s).unwrap());
+    assert!(!sufficient_margins(&robots, tick_s).unwrap());
+    assert!(!sufficient_margins_per_pair(&robots, tick_s).unwrap());
+    // The operator drags every low-confidence robot. While robot 0 is dragged (step ⅛ s),
+    // robot 1 follows it but robot 2 cannot go below ¼ s per tick and gains 8 s; robot 1's own
+    // dragged region adds 8 s more, and robot 2 enters its region while robot 1 is in its own.
+    let mut c = Coordinator::new(robots, tick_s).unwrap();
+    let mut first = None;
+    for k in 0.. {
+        if c.is_finished() {
+            break;
+        }
+        let t = c.tick(SLOW).unwrap();
+        if t.overlap() && first.is_none() {
+            first = Some((k, t.low_conf));
+        }
+    }
+    let (k, low_conf) = first.expect("the dragged third robot makes robots 1 and 2 overlap");
+    assert_eq!(low_conf, [false, true, true], "tick {k}");
+    // Six seconds later the N-robot check accepts (from 21 s on, on a 1 s grid), and the full
+    // adversary set finds nothing.
+    let later = third_robot_case(22.0);
+    assert!(sufficient_margins(&later, tick_s).unwrap());
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    for a in adversary_set(3, [0.5, 2.0], 400, &mut rng) {
+        let c = Coordinator::new(later.clone(), tick_s).unwrap();
+        let run = run_adversary(c, a, &mut rng, 100_000).unwrap();
+        assert!(run.finished && run.first_overlap.is_none(), "{a:?}");
+    }
 }

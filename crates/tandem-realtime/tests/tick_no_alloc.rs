@@ -1,6 +1,6 @@
 //! `Coordinator::tick` never allocates (docs/ARCHITECTURE.md): a whole run of ticks, under every
-//! kind of operator input and through the adversary loop, is measured with a counting global
-//! allocator.
+//! kind of operator input and through the adversary loop, for 2, 4 and `MAX_ROBOTS` robots, is
+//! measured with a counting global allocator.
 //!
 //! The allocator is the `allocation-counter` crate's: linking it installs a
 //! `#[global_allocator]` that counts per thread, so this file needs no `unsafe` of its own
@@ -12,11 +12,13 @@ use std::hint::black_box;
 use allocation_counter::measure;
 use rand::SeedableRng;
 use tandem_realtime::adversary::{adversary_set, run_adversary};
-use tandem_realtime::{Coordinator, Operator, Timeline};
+use tandem_realtime::{Coordinator, MAX_ROBOTS, Operator, Timeline};
 
-/// 3000 reference samples at 10 ms with 12 low-confidence runs; robot 2 starts a quarter of
-/// the way through robot 1, so both run together, one low-confidence while the other is not.
-fn robots() -> [Timeline; 2] {
+/// `n_robots` robots on 3000 reference samples at 10 ms with 12 low-confidence runs; robot `i`
+/// starts `i` quarter-periods plus half a run after robot 0, so they run together, one
+/// low-confidence while the others are not (for two robots: robot 2 a quarter of the way
+/// through robot 1).
+fn robots(n_robots: usize) -> Vec<Timeline> {
     let n = 3000;
     let conf: Vec<bool> = (0..n).map(|k| k % 250 >= 40).collect();
     let mean: Vec<f64> = (0..n)
@@ -25,9 +27,19 @@ fn robots() -> [Timeline; 2] {
     let lo: Vec<f64> = mean.iter().map(|m| 0.6 * m).collect();
     let hi: Vec<f64> = mean.iter().map(|m| 1.7 * m).collect();
     let r0 = Timeline::new(&conf, &mean, &lo, &hi, 0.0, 0.01).expect("valid timeline");
-    let tau = r0.sample_clock_s()[n / 4 + 125];
-    let r1 = Timeline::new(&conf, &mean, &lo, &hi, tau, 0.01).expect("valid timeline");
-    [r0, r1]
+    let starts: Vec<f64> = (0..n_robots)
+        .map(|i| {
+            if i == 0 {
+                0.0
+            } else {
+                r0.sample_clock_s()[(i * (n / 4 + 125)) % n]
+            }
+        })
+        .collect();
+    starts
+        .iter()
+        .map(|&s| Timeline::new(&conf, &mean, &lo, &hi, s, 0.01).expect("valid timeline"))
+        .collect()
 }
 
 #[test]
@@ -38,7 +50,13 @@ fn a_whole_run_of_ticks_allocates_nothing() {
     });
     assert_eq!(boxed.count_total, 1, "the counting allocator is not active");
 
-    let mut c = Coordinator::new(robots(), 0.01).expect("valid tick");
+    for n_robots in [2, 4, MAX_ROBOTS] {
+        whole_run_allocates_nothing(n_robots);
+    }
+}
+
+fn whole_run_allocates_nothing(n_robots: usize) {
+    let mut c = Coordinator::new(robots(n_robots), 0.01).expect("valid tick");
     let ops = [
         Operator::Fastest,
         Operator::Slowest,
@@ -55,7 +73,7 @@ fn a_whole_run_of_ticks_allocates_nothing() {
                 match c.tick(ops[k % ops.len()]) {
                     Ok(t) => {
                         ticks += 1;
-                        low_conf_ticks += u64::from(t.low_conf[0] || t.low_conf[1]);
+                        low_conf_ticks += u64::from(t.low_conf.count() > 0);
                     }
                     Err(e) => {
                         black_box(&e);
@@ -67,20 +85,26 @@ fn a_whole_run_of_ticks_allocates_nothing() {
             c.reset();
         }
     });
-    assert_eq!(info.count_total, 0, "{info:?}");
+    assert_eq!(info.count_total, 0, "{n_robots} robots: {info:?}");
     // The run was real: thousands of ticks, many low-confidence, every NaN rejected.
     assert!(
         ticks > 5000 && low_conf_ticks > 1000,
-        "{ticks} {low_conf_ticks}"
+        "{n_robots} robots: {ticks} {low_conf_ticks}"
     );
-    assert!(errors > 1000, "{errors}");
+    assert!(errors > 1000, "{n_robots} robots: {errors}");
 }
 
 #[test]
 fn the_adversary_loop_allocates_nothing() {
-    let robots = robots();
+    for n_robots in [2, 4] {
+        adversary_loop_allocates_nothing(n_robots);
+    }
+}
+
+fn adversary_loop_allocates_nothing(n_robots: usize) {
+    let robots = robots(n_robots);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
-    let set = adversary_set([0.5, 2.0], 4000, &mut rng);
+    let set = adversary_set(n_robots, [0.5, 2.0], 4000, &mut rng);
     // Coordinators are cloned (allocated) outside the measurement.
     let coordinators: Vec<Coordinator> = set
         .iter()
@@ -96,6 +120,6 @@ fn the_adversary_loop_allocates_nothing() {
             total_ticks += run.ticks;
         }
     });
-    assert_eq!(info.count_total, 0, "{info:?}");
-    assert!(total_ticks > 13 * 3000, "{total_ticks}");
+    assert_eq!(info.count_total, 0, "{n_robots} robots: {info:?}");
+    assert!(total_ticks > set.len() as u64 * 3000, "{total_ticks}");
 }

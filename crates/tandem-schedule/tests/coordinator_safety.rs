@@ -27,7 +27,7 @@ fn adversaries(p: &Problem, s: &Schedule, seed: u64) -> Vec<Adversary> {
     let lo = p.grad_min().iter().copied().fold(f64::INFINITY, f64::min);
     let hi = p.grad_max().iter().copied().fold(0.0, f64::max);
     let ticks = (s.t_total_s(p.dt_s()) / s.tick_s) as u64;
-    adversary_set([lo, hi], ticks, &mut ChaCha8Rng::seed_from_u64(seed)).to_vec()
+    adversary_set(2, [lo, hi], ticks, &mut ChaCha8Rng::seed_from_u64(seed))
 }
 
 /// Runs one execution at the schedule's tick; returns the first tick index with both robots

@@ -517,9 +517,9 @@ fn run_schedule(
         }
         let tick = coord.tick(operator)?;
         ticks += 1;
-        match tick.low_conf {
-            [true, true] => overlap_ticks += 1,
-            [false, false] => idle_ticks += 1,
+        match (tick.low_conf[0], tick.low_conf[1]) {
+            (true, true) => overlap_ticks += 1,
+            (false, false) => idle_ticks += 1,
             _ => {}
         }
     }

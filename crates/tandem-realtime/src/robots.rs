@@ -1,0 +1,232 @@
+//! The robot count: at most [`MAX_ROBOTS`] robots share one operator, and per-robot values of
+//! one tick live in a fixed-capacity [`PerRobot`] or, for flags, a [`RobotFlags`] bit set (no
+//! allocation in the control loop).
+
+use std::fmt;
+use std::ops::{Deref, Index};
+
+use crate::error::{Error, Result};
+
+/// Largest number of robots one [`Coordinator`](crate::Coordinator) or one
+/// [`sufficient_margins`](crate::sufficient_margins) call takes (the per-tick state lives in
+/// arrays of this size).
+pub const MAX_ROBOTS: usize = 8;
+
+/// Checks a robot count: `1 ≤ n ≤ MAX_ROBOTS`.
+///
+/// # Errors
+/// [`Error::RobotCount`] with the count.
+pub(crate) fn check_count(n: usize) -> Result<()> {
+    if (1..=MAX_ROBOTS).contains(&n) {
+        Ok(())
+    } else {
+        Err(Error::RobotCount { n, max: MAX_ROBOTS })
+    }
+}
+
+/// One value per robot (robot `i` at index `i`), for the `n ≤ MAX_ROBOTS` robots of one
+/// coordinator: a fixed-capacity array that reads as the slice `[T]` of length `n`, so it is
+/// returned by value from [`Coordinator::tick`](crate::Coordinator::tick) without allocating.
+///
+/// ```
+/// use tandem_realtime::PerRobot;
+/// let flags = PerRobot::from_slice(&[true, false, false]);
+/// assert_eq!(flags.len(), 3);
+/// assert_eq!(flags, [true, false, false]);
+/// assert_eq!(flags.iter().filter(|&&f| f).count(), 1);
+/// ```
+#[derive(Clone, Copy)]
+pub struct PerRobot<T> {
+    len: u8,
+    items: [T; MAX_ROBOTS],
+}
+
+impl<T: Copy + Default> PerRobot<T> {
+    /// `n` default values (`n ≤ MAX_ROBOTS`, larger counts are cut to `MAX_ROBOTS`).
+    #[must_use]
+    pub fn new(n: usize) -> Self {
+        PerRobot {
+            len: n.min(MAX_ROBOTS) as u8,
+            items: [T::default(); MAX_ROBOTS],
+        }
+    }
+
+    /// The first `MAX_ROBOTS` values of `values`.
+    #[must_use]
+    pub fn from_slice(values: &[T]) -> Self {
+        let mut out = Self::new(values.len());
+        let n = usize::from(out.len);
+        out.items[..n].copy_from_slice(&values[..n]);
+        out
+    }
+
+    /// Mutable view of the `n` values.
+    pub fn as_mut_slice(&mut self) -> &mut [T] {
+        &mut self.items[..usize::from(self.len)]
+    }
+}
+
+impl<T> Deref for PerRobot<T> {
+    type Target = [T];
+
+    fn deref(&self) -> &[T] {
+        &self.items[..usize::from(self.len)]
+    }
+}
+
+impl<T: PartialEq> PartialEq for PerRobot<T> {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
+    }
+}
+
+impl<T: PartialEq, const K: usize> PartialEq<[T; K]> for PerRobot<T> {
+    fn eq(&self, other: &[T; K]) -> bool {
+        **self == other[..]
+    }
+}
+
+impl<T: fmt::Debug> fmt::Debug for PerRobot<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(&**self, f)
+    }
+}
+
+/// One flag per robot (robot `i` at index `i`) for the `n ≤ MAX_ROBOTS` robots of one
+/// coordinator, as a bit set: two bytes, copied for free with every
+/// [`Tick`](crate::Tick). Reads like a `[bool]` of length `n`: `flags[i]`, `iter`, comparison
+/// with a `[bool; n]`.
+///
+/// ```
+/// use tandem_realtime::RobotFlags;
+/// let flags = RobotFlags::from_slice(&[true, false, true]);
+/// assert!(flags[0] && !flags[1]);
+/// assert_eq!(flags, [true, false, true]);
+/// assert_eq!((flags.len(), flags.count()), (3, 2));
+/// assert_eq!(flags.first(), Some(0));
+/// ```
+#[derive(Clone, Copy, Default, PartialEq, Eq)]
+pub struct RobotFlags {
+    len: u8,
+    bits: u8,
+}
+
+impl RobotFlags {
+    /// `n` flags, all `false` (`n ≤ MAX_ROBOTS`, larger counts are cut to `MAX_ROBOTS`).
+    #[must_use]
+    pub fn new(n: usize) -> Self {
+        RobotFlags {
+            len: n.min(MAX_ROBOTS) as u8,
+            bits: 0,
+        }
+    }
+
+    /// The first `MAX_ROBOTS` values of `values`.
+    #[must_use]
+    pub fn from_slice(values: &[bool]) -> Self {
+        let mut out = Self::new(values.len());
+        for (i, &v) in values.iter().take(MAX_ROBOTS).enumerate() {
+            out.set(i, v);
+        }
+        out
+    }
+
+    /// Number of robots `n`.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        usize::from(self.len)
+    }
+
+    /// Whether there are no robots.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Flag of robot `i` (`false` for `i ≥ n`).
+    #[must_use]
+    pub fn get(&self, i: usize) -> bool {
+        i < self.len() && self.bits & (1 << i) != 0
+    }
+
+    /// Sets the flag of robot `i < n` (ignored for `i ≥ n`).
+    pub fn set(&mut self, i: usize, value: bool) {
+        if i < self.len() {
+            if value {
+                self.bits |= 1 << i;
+            } else {
+                self.bits &= !(1 << i);
+            }
+        }
+    }
+
+    /// Number of robots whose flag is set.
+    #[must_use]
+    pub fn count(&self) -> usize {
+        self.bits.count_ones() as usize
+    }
+
+    /// The lowest-index robot whose flag is set.
+    #[must_use]
+    pub fn first(&self) -> Option<usize> {
+        (self.bits != 0).then(|| self.bits.trailing_zeros() as usize)
+    }
+
+    /// The flags in robot order.
+    pub fn iter(&self) -> impl Iterator<Item = bool> + '_ {
+        (0..self.len()).map(|i| self.get(i))
+    }
+}
+
+impl Index<usize> for RobotFlags {
+    type Output = bool;
+
+    /// Flag of robot `i`.
+    ///
+    /// # Panics
+    /// If `i ≥ n`.
+    fn index(&self, i: usize) -> &bool {
+        assert!(i < self.len(), "robot {i} of {}", self.len());
+        if self.get(i) { &true } else { &false }
+    }
+}
+
+impl<const K: usize> PartialEq<[bool; K]> for RobotFlags {
+    fn eq(&self, other: &[bool; K]) -> bool {
+        K == self.len() && other.iter().enumerate().all(|(i, &v)| self.get(i) == v)
+    }
+}
+
+impl fmt::Debug for RobotFlags {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_as_a_slice_of_its_length() {
+        let mut v = PerRobot::<f64>::new(3);
+        v.as_mut_slice()[2] = 1.5;
+        assert_eq!(v, [0.0, 0.0, 1.5]);
+        assert_eq!(format!("{v:?}"), "[0.0, 0.0, 1.5]");
+        assert_ne!(v, PerRobot::from_slice(&[0.0, 0.0]));
+        assert_eq!(PerRobot::<bool>::new(20).len(), MAX_ROBOTS);
+        assert!(check_count(0).is_err() && check_count(9).is_err());
+        let mut f = RobotFlags::new(3);
+        f.set(2, true);
+        f.set(5, true);
+        assert_eq!(f, [false, false, true]);
+        assert_eq!(
+            (f.count(), f.first(), f[2], f.get(5)),
+            (1, Some(2), true, false)
+        );
+        assert_eq!(format!("{f:?}"), "[false, false, true]");
+        assert_ne!(f, [false, false, true, false]);
+        assert_eq!(RobotFlags::new(2).first(), None);
+        assert!(check_count(1).is_ok() && check_count(MAX_ROBOTS).is_ok());
+    }
+}
