@@ -60,7 +60,7 @@ mod coordinator;
 mod error;
 pub mod margins;
 mod robots;
-mod strategy;
+pub mod strategy;
 mod timeline;
 pub mod tol;
 

@@ -1,5 +1,5 @@
 //! The real-time timing strategy of §II-B5: the response of Eq. 18, `HIGH-CONF` (Alg. 1), and
-//! their N-robot form [`advance`], which the [`Coordinator`](crate::Coordinator) runs and the
+//! their N-robot form `advance`, which the [`Coordinator`](crate::Coordinator) runs and the
 //! margin check simulates (one owner of the rules).
 //!
 //! All quantities are schedule-clock seconds (the global time at which the schedule planned a
@@ -7,7 +7,7 @@
 //! advances during one control tick of `tick_s` real seconds; a rate `r` gives `δt = r·tick_s`.
 //!
 //! # N robots
-//! [`advance`] moves every robot's schedule clock by one tick (the argument that these rules
+//! `advance` moves every robot's schedule clock by one tick (the argument that these rules
 //! are Eq. 17–18 and Alg. 1 when `N = 2` is in docs/decisions.md, "N robots at run time"):
 //!
 //! 1. **The pace.** If a robot is low-confidence (LC) its new clock is set by the operator (the
