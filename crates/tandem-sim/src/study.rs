@@ -496,14 +496,16 @@ pub fn read_labels(path: &Path) -> Result<Vec<Label>> {
 fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
     let schedule = planner.schedule();
     let timeline = GlobalTimeline::new(planner.problem(), schedule)?;
-    let lc_intervals_s = timeline
-        .lc_intervals()
-        .each_ref()
-        .map(|v| v.iter().map(|i| [i.start_s, i.end_s]).collect());
+    let lc = timeline.lc_intervals();
+    let lc_intervals_s = [0, 1].map(|r| {
+        lc.get(r).map_or_else(Vec::new, |v| {
+            v.iter().map(|i| [i.start_s, i.end_s]).collect()
+        })
+    });
     Ok(IterationRecord {
         iteration: planner.pairs_recorded(),
         t_total_s: planner.outcome().t_total_s,
-        offset_s: schedule.offset_s,
+        offset_s: schedule.start_s(1),
         high_conf_pct: 100.0 * planner.confidence().high_share(),
         source: planner.outcome().source.into(),
         lc_intervals_s,

@@ -382,8 +382,14 @@ fn check_sizes(model: &TaskModel, problem: &Problem, schedule: &Schedule) -> Res
     let n_ref = problem.n_ref();
     let sizes = [
         ("model reference samples", model.n_ref()),
-        ("robot 1 gradients", schedule.grad_exec[0].len()),
-        ("robot 2 gradients", schedule.grad_exec[1].len()),
+        (
+            "robot 1 gradients",
+            schedule.grad_exec.first().map_or(0, Vec::len),
+        ),
+        (
+            "robot 2 gradients",
+            schedule.grad_exec.get(1).map_or(0, Vec::len),
+        ),
     ];
     for (what, found) in sizes {
         if found != n_ref {
