@@ -2,7 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
-use crate::strategy::{Member, Mode, advance};
+use crate::strategy::{Member, Mode, advance, first_waiting_start};
 use crate::timeline::Timeline;
 use crate::tol::clock_tolerance_s;
 
@@ -277,11 +277,16 @@ impl Coordinator {
             low_conf: RobotFlags::new(n),
             running: RobotFlags::new(n),
         };
+        let first_waiting_start = first_waiting_start(&members[..n], |i| self.robots[i].start_s());
         for (i, m) in members[..n].iter().enumerate() {
             let r = &self.robots[i];
             let s_old = self.clock_s[i];
             let waiting = m.mode == Mode::Waiting;
-            let cap = if waiting { r.start_s() } else { r.end_s() };
+            let cap = if waiting {
+                r.start_s().min(first_waiting_start)
+            } else {
+                r.end_s()
+            };
             let s_new = next_s[i].min(cap).max(s_old);
             self.clock_s[i] = s_new;
             let moved = s_new > s_old;

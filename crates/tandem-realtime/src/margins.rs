@@ -130,7 +130,7 @@ use std::collections::VecDeque;
 
 use crate::error::{Error, Result};
 use crate::robots::{MAX_ROBOTS, check_count};
-use crate::strategy::{Member, Mode, advance, response_step};
+use crate::strategy::{Member, Mode, advance, first_waiting_start, response_step};
 use crate::timeline::{LcInterval, Rates, Timeline};
 use crate::tol::clock_tolerance_s;
 
@@ -560,6 +560,7 @@ impl<'a> RoleSim<'a> {
                 self.worst_common_pace(&members, &mut next);
             }
         }
+        let first_waiting = first_waiting_start(&members[..k], |i| self.sides[i].tl.start_s());
         let before = [self.started[0], self.started[1]];
         for (((clock, started), side), &next) in self
             .clock_s
@@ -572,7 +573,7 @@ impl<'a> RoleSim<'a> {
                 *clock = next;
             } else {
                 let start = side.tl.start_s();
-                *clock = next.min(start).max(*clock);
+                *clock = next.min(start).min(first_waiting).max(*clock);
                 *started = *clock >= start;
             }
         }

@@ -21,9 +21,10 @@
 //!    `s_i − x` measured after the pace's step): it lands on `x` when it can, else goes as
 //!    slowly or as fast as it can towards it.
 //! 3. **Start shift.** A robot not yet started has its clock moved to the new clock of the
-//!    running robot furthest behind (the caller caps it at its start `τ_i`): it starts once
-//!    every running robot has reached its start, so its start shifts by the deviation of the
-//!    slowest one; with nobody running its clock runs on schedule.
+//!    running robot furthest behind (the caller caps it at its start `τ_i` and at the earliest
+//!    start of the robots waiting, `first_waiting_start`): it starts once every running robot
+//!    has reached its start and every robot due before it has started, so its start shifts by
+//!    the deviation of the slowest one; with nobody running its clock runs on schedule.
 //! 4. **Finished** robots do not move and set nothing.
 
 use crate::timeline::Rates;
@@ -188,6 +189,22 @@ pub(crate) fn advance(
         }
     }
     follow
+}
+
+/// The earliest start `τ_i` (schedule clock, s) of the robots waiting at the start of the tick
+/// (`+∞` if none waits), `start_s(i)` giving robot `i`'s start. The caller caps every waiting
+/// robot's new clock at it as well as at its own start (rule 3): robots start one start time at
+/// a time, a robot only once every robot due to start before it runs and has reached its start.
+/// Otherwise a robot finishing within a tick could carry two waiting robots past their starts
+/// in the same tick, and executions shorter than a tick would start, and be low-confidence,
+/// together. With two robots at most one waits and this is its own start.
+pub(crate) fn first_waiting_start(members: &[Member], start_s: impl Fn(usize) -> f64) -> f64 {
+    members
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| m.mode == Mode::Waiting)
+        .map(|(i, _)| start_s(i))
+        .fold(f64::INFINITY, f64::min)
 }
 
 #[cfg(test)]

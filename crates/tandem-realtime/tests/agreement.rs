@@ -158,3 +158,30 @@ fn serial_schedules_of_n_robots_are_always_accepted() {
         }
     }
 }
+
+/// Serial schedules of executions of one to three samples, at ticks of ¼ to 2 samples (so an
+/// execution may be shorter than a tick), are accepted for 2 to 5 robots: robots start one
+/// start time at a time (strategy rule 3), so the check never sees two waiting robots start
+/// together. (Before that rule, 921 of these 20,000 schedules were rejected.)
+#[test]
+fn serial_schedules_of_executions_shorter_than_a_tick_are_accepted() {
+    let mut r = rng(0x5407);
+    for case in 0..20_000 {
+        let len = r.random_range(1..=3usize);
+        let conf: Vec<bool> = (0..len).map(|_| r.random_bool(0.5)).collect();
+        let g: Vec<f64> = (0..len).map(|_| r.random_range(0.5..1.5)).collect();
+        let lo: Vec<f64> = g.iter().map(|x| x * r.random_range(0.5..1.0)).collect();
+        let hi: Vec<f64> = g.iter().map(|x| x * r.random_range(1.0..2.0)).collect();
+        let tick_s = 0.01 * r.random_range(0.25..=2.0);
+        let n = r.random_range(2..=5usize);
+        let mut robots: Vec<Timeline> = Vec::new();
+        for _ in 0..n {
+            let start = robots.last().map_or(0.0, Timeline::end_s);
+            robots.push(Timeline::new(&conf, &g, &lo, &hi, start, 0.01).unwrap());
+        }
+        assert!(
+            sufficient_margins(&robots, tick_s).unwrap(),
+            "case {case}: N = {n}, conf {conf:?}, ψ̇_E {g:?}, bounds {lo:?} {hi:?}, tick {tick_s}"
+        );
+    }
+}

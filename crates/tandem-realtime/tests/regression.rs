@@ -150,3 +150,43 @@ fn a_dragged_third_robot_breaks_the_two_robot_worst_case() {
         assert!(run.finished && run.first_overlap.is_none(), "{a:?}");
     }
 }
+
+/// Executions shorter than one tick (found by the N-robot schedule property test): one
+/// low-confidence sample, ψ̇_E = 0.801 (8.0 ms per execution), a 9.36 ms tick, three robots
+/// serial (each starting where the one before it ends). Robot 1 finishing within a tick once
+/// carried both waiting robots past their starts in the same tick, and they were low-confidence
+/// together under `Periodic { period: 1, phase: 7 }`, although the check accepts the schedule.
+/// Robots now start one start time at a time (strategy rule 3), as the check assumes.
+#[test]
+fn executions_shorter_than_a_tick_start_one_at_a_time() {
+    let conf = [false];
+    let (g, lo, hi) = (
+        [0.801_036_476_389_653_6],
+        [0.617_476_277_615_212_2],
+        [1.078_909_833_189_365],
+    );
+    let tick_s = 0.009_360_638_873_002_192;
+    let mut robots: Vec<Timeline> = Vec::new();
+    for _ in 0..3 {
+        let start = robots.last().map_or(0.0, Timeline::end_s);
+        robots.push(Timeline::new(&conf, &g, &lo, &hi, start, 0.01).unwrap());
+    }
+    assert!(sufficient_margins(&robots, tick_s).unwrap());
+    let periodic = tandem_realtime::adversary::Adversary::Periodic {
+        period: 1,
+        phase: 7,
+    };
+    let mut r = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    let mut set = adversary_set(3, [lo[0], hi[0]], 4, &mut r);
+    set.push(periodic);
+    for a in set {
+        let c = Coordinator::new(robots.clone(), tick_s).unwrap();
+        let run = run_adversary(c, a, &mut r, 1000).unwrap();
+        assert!(run.finished, "{a:?}");
+        assert_eq!(
+            run.overlap_ticks, 0,
+            "{a:?}: first at {:?}",
+            run.first_overlap
+        );
+    }
+}

@@ -20,9 +20,6 @@ fn random_problem() -> impl Strategy<Value = Problem> {
     runtime::random_problem(10, 7)
 }
 
-/// Shortest single execution, in control ticks, of the problems the N-robot properties cover.
-const MIN_TICKS: f64 = 4.0;
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(2000))]
 
@@ -35,11 +32,6 @@ proptest! {
         samples in 20usize..120,
     ) {
         let tick_s = tick_frac * p.dt_s();
-        // Executions of a few ticks at most are outside the N-robot margin check's domain
-        // (docs/decisions.md, "N robots in the schedule": a 3-robot serial schedule of one
-        // 8 ms sample at a 9.4 ms tick is accepted and overlaps).
-        let fastest_s = p.serial_schedule_n(1, tick_s).unwrap().t_total_s(p.dt_s());
-        prop_assume!(fastest_s >= MIN_TICKS * tick_s);
         let params = SamplerParams {
             samples,
             seed,
