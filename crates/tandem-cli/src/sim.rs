@@ -167,8 +167,12 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
                 files.push((dir.join(format!("{stem}.corr.csv")), c));
             }
         }
-        let [r1, r2] = pair.records(planner.model())?;
-        let records = [named(r1, k + 1, 1), named(r2, k + 1, 2)];
+        let records: Vec<ExecutionRecord> = pair
+            .records(planner.model())?
+            .into_iter()
+            .enumerate()
+            .map(|(i, r)| named(r, k + 1, i + 1))
+            .collect();
         let supervised: usize = pair
             .robots
             .iter()
@@ -180,7 +184,7 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
             .map(|r| r.corrected.iter().filter(|s| **s).count())
             .sum();
         let report = planner
-            .record_pair(&records)
+            .record_round(&records)
             .with_context(|| format!("recording simulated pair {}", k + 1))?;
         out(&format!(
             "{:>4}  {:>15.2}  {:>10.2}  {:>10}  {:>9}  {:>7}  {:>14.1}  {:>16.2}",
@@ -271,7 +275,9 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let pair = run_pair(&planner, &needed, &op, &mut rng).unwrap();
         assert_eq!(pair.overlap_ticks, 0);
-        let [r1, r2] = &pair.robots;
+        let [r1, r2] = &pair.robots[..] else {
+            panic!("{} robots", pair.robots.len())
+        };
         assert!(
             r1.supervised.iter().any(|s| *s),
             "robot 1 is supervised somewhere"

@@ -208,14 +208,26 @@ impl Planner {
         }
     }
 
-    /// Records a pair of executions and re-schedules (see the type docs).
+    /// Records a round of executions, one per robot of the schedule (robot 1 first), and
+    /// re-schedules (see the type docs).
     ///
     /// Everything is checked before the planner changes: on error it is as before.
     ///
     /// # Errors
-    /// [`Error::BadExecution`] for flag vectors of the wrong length; the lower crates'
-    /// errors for a bad execution (channels, period, log) or observation.
-    pub fn record_pair(&mut self, executions: &[ExecutionRecord; 2]) -> Result<RecordReport> {
+    /// [`Error::BadExecution`] for a number of records other than the schedule's robot count
+    /// or flag vectors of the wrong length; the lower crates' errors for a bad execution
+    /// (channels, period, log) or observation.
+    pub fn record_round(&mut self, executions: &[ExecutionRecord]) -> Result<RecordReport> {
+        let n_robots = self.schedule().grad_exec.len();
+        if executions.len() != n_robots {
+            return Err(Error::BadExecution {
+                what: "executions",
+                why: format!(
+                    "{} execution records for a round of {n_robots} robots (one per robot)",
+                    executions.len()
+                ),
+            });
+        }
         let t0 = Instant::now();
         let mut model = self.model.clone();
         for e in executions {
@@ -253,6 +265,14 @@ impl Planner {
         self.outcome = outcome;
         self.pairs_recorded = pairs_recorded;
         Ok(report)
+    }
+
+    /// [`Planner::record_round`] for the paper's two robots.
+    ///
+    /// # Errors
+    /// As [`Planner::record_round`].
+    pub fn record_pair(&mut self, executions: &[ExecutionRecord; 2]) -> Result<RecordReport> {
+        self.record_round(executions)
     }
 
     /// Re-runs the anytime sampler (§II-C) on the current problem with `sampler`, warm-started

@@ -81,6 +81,8 @@ fn demo_data() -> Fig5Data {
         iterations: iterations.clone(),
         t_total_mean_s: Vec::with_capacity(iterations.len()),
         t_total_std_s: Vec::with_capacity(iterations.len()),
+        // Robot 2 cannot sand its first pass (10 s) before robot 1's ends: T ≥ 84 + 10 s.
+        lower_bound_mean_s: vec![DEMO_EXEC_S + 10.0; iterations.len()],
         high_conf_pct_mean: Vec::with_capacity(iterations.len()),
         high_conf_pct_std: Vec::with_capacity(iterations.len()),
         ground_truth_pct: 100.0 * (1.0 - 30.0 / DEMO_EXEC_S),

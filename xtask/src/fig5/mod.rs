@@ -2,7 +2,9 @@
 //!
 //! Top panel: the mean task length `T_total` (Eq. 13) per study iteration as a dark blue
 //! line with a shaded ±1 standard deviation band over trials, and at a few iterations an
-//! example schedule as a vertical bar from 0 to its `T_total`, coloured along global time:
+//! example schedule as a vertical bar from 0 to its `T_total`, and the mean certificate lower
+//! bound `T*₀` (the margin-free optimum, a bound on every admissible schedule) as a dashed
+//! line under the `T_total` curve; each bar is coloured along global time:
 //! blue where robot 1 is low-confidence, red where robot 2 is, gray where neither is.
 //! Bottom panel: the percentage of high-confidence reference samples (mean line and band)
 //! and the ground-truth percentage as a gray dotted line, on the same iteration axis.
@@ -39,6 +41,9 @@ pub(crate) struct Fig5Data {
     pub t_total_mean_s: Vec<f64>,
     /// Standard deviation over trials of `T_total` per iteration, in seconds (≥ 0).
     pub t_total_std_s: Vec<f64>,
+    /// Mean over trials of the schedule's certificate lower bound (`T*₀` where proven), in
+    /// seconds of global schedule time (≥ 0; drawn dashed under the `T_total` curve).
+    pub lower_bound_mean_s: Vec<f64>,
     /// Mean over trials of the percentage (0–100) of reference samples that are
     /// high-confidence (Eq. 12) per iteration.
     pub high_conf_pct_mean: Vec<f64>,
@@ -106,6 +111,7 @@ impl Fig5Data {
         for (name, len) in [
             ("t_total_mean_s", self.t_total_mean_s.len()),
             ("t_total_std_s", self.t_total_std_s.len()),
+            ("lower_bound_mean_s", self.lower_bound_mean_s.len()),
             ("high_conf_pct_mean", self.high_conf_pct_mean.len()),
             ("high_conf_pct_std", self.high_conf_pct_std.len()),
         ] {
@@ -126,6 +132,12 @@ impl Fig5Data {
         }
         check_values("t_total_mean_s", &self.t_total_mean_s, 0.0, f64::INFINITY)?;
         check_values("t_total_std_s", &self.t_total_std_s, 0.0, f64::INFINITY)?;
+        check_values(
+            "lower_bound_mean_s",
+            &self.lower_bound_mean_s,
+            0.0,
+            f64::INFINITY,
+        )?;
         check_values("high_conf_pct_mean", &self.high_conf_pct_mean, 0.0, 100.0)?;
         check_values(
             "high_conf_pct_std",
@@ -254,7 +266,7 @@ pub(crate) fn draw_fig5(data: &Fig5Data, svg: &Path, png: &Path) -> anyhow::Resu
 /// Share of the x axis, from the right, that the legends cover.
 const LEGEND_X_SHARE: f64 = 0.3;
 /// Share of the top panel's y axis, from the top, that its legend covers.
-const TOP_LEGEND_Y_SHARE: f64 = 0.36;
+const TOP_LEGEND_Y_SHARE: f64 = 0.43;
 /// Share of the bottom panel's y axis, from the top or bottom, that its legend covers.
 const BOTTOM_LEGEND_Y_SHARE: f64 = 0.5;
 
@@ -360,7 +372,7 @@ impl Layout {
 
 /// Rounds `v > 0` up to a round number: 1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6 or 8 times a power
 /// of ten.
-fn nice_ceiling(v: f64) -> f64 {
+pub(crate) fn nice_ceiling(v: f64) -> f64 {
     let magnitude = 10f64.powf(v.log10().floor());
     let step = [1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0]
         .into_iter()
@@ -548,6 +560,23 @@ fn draw_task_length_panel<DB: DrawingBackend>(
         "mean task length",
         "task length mean",
     )?;
+    chart
+        .draw_series(DashedLineSeries::new(
+            xs.iter()
+                .copied()
+                .zip(data.lower_bound_mean_s.iter().copied()),
+            6,
+            5,
+            MEAN.stroke_width(2),
+        ))
+        .map_err(draw_err("lower bound"))?
+        .label("mean lower bound T*₀ (no margins)")
+        .legend(|(x, y)| {
+            EmptyElement::at((x, y))
+                + PathElement::new(vec![(0, 0), (6, 0)], MEAN.stroke_width(2))
+                + PathElement::new(vec![(11, 0), (17, 0)], MEAN.stroke_width(2))
+                + PathElement::new(vec![(22, 0), (24, 0)], MEAN.stroke_width(2))
+        });
 
     draw_legend(
         &mut chart,
@@ -634,7 +663,7 @@ fn std_band(xs: &[f64], mean: &[f64], std: &[f64], cap: f64) -> Vec<(f64, f64)> 
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use std::path::PathBuf;
 
@@ -642,7 +671,7 @@ mod tests {
     type Corruption = fn(&mut Fig5Data);
 
     /// A fresh, empty per-test directory under the system temp dir.
-    pub(super) fn scratch_dir(name: &str) -> PathBuf {
+    pub(crate) fn scratch_dir(name: &str) -> PathBuf {
         let dir =
             std::env::temp_dir().join(format!("tandem-xtask-fig5-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
@@ -655,6 +684,7 @@ mod tests {
             iterations: vec![0, 1, 2, 3, 4],
             t_total_mean_s: vec![100.0, 90.0, 80.0, 70.0, 65.0],
             t_total_std_s: vec![0.0, 5.0, 4.0, 3.0, 2.0],
+            lower_bound_mean_s: vec![100.0, 80.0, 70.0, 60.0, 60.0],
             high_conf_pct_mean: vec![0.0, 20.0, 35.0, 45.0, 50.0],
             high_conf_pct_std: vec![0.0, 3.0, 2.0, 1.0, 1.0],
             ground_truth_pct: 55.0,
@@ -676,7 +706,7 @@ mod tests {
     }
 
     /// Width and height from a PNG's IHDR chunk, after checking the signature.
-    pub(super) fn png_size(bytes: &[u8]) -> (u32, u32) {
+    pub(crate) fn png_size(bytes: &[u8]) -> (u32, u32) {
         assert!(bytes.len() > 24, "PNG too short: {} bytes", bytes.len());
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
         assert_eq!(&bytes[12..16], b"IHDR", "first chunk is IHDR");
@@ -700,6 +730,7 @@ mod tests {
             "robot 2 low-confidence",
             "neither low-confidence",
             "mean task length",
+            "mean lower bound T*₀ (no margins)",
             "ground truth",
         ] {
             assert!(svg_text.contains(label), "SVG lacks the label {label:?}");
@@ -757,6 +788,7 @@ mod tests {
                 d.iterations.clear();
                 d.t_total_mean_s.clear();
                 d.t_total_std_s.clear();
+                d.lower_bound_mean_s.clear();
                 d.high_conf_pct_mean.clear();
                 d.high_conf_pct_std.clear();
             }),
@@ -764,6 +796,9 @@ mod tests {
                 d.t_total_mean_s[2] = f64::NAN
             }),
             ("t_total_std_s`[1] = -1", |d| d.t_total_std_s[1] = -1.0),
+            ("lower_bound_mean_s`[0] = NaN", |d| {
+                d.lower_bound_mean_s[0] = f64::NAN
+            }),
             ("high_conf_pct_mean`[3] = 101", |d| {
                 d.high_conf_pct_mean[3] = 101.0
             }),
@@ -849,7 +884,7 @@ mod tests {
         // cover the right 30 %, x >= 4.58 - 0.3 · 5.16 = 3.032, i.e. iteration 4, where
         // T_total + std = 67 s (bar 65 s) and the high-confidence band is [49, 51] %.
         assert!((layout.x_min + 0.58).abs() < 1e-12 && (layout.x_max - 4.58).abs() < 1e-12);
-        // 100 s overall needs 106 s -> 120 s; 67 s under the legend needs 67 / 0.64 = 105 s.
+        // 100 s overall needs 106 s -> 120 s; 67 s under the legend needs 67 / 0.57 = 118 s.
         assert_eq!(layout.t_max_s, 120.0);
         // 55 % · 1.12 -> 70 %; the band under the legend starts at 49 % >= 0.5 · 70 %.
         assert_eq!(layout.pct_max, 70.0);
@@ -867,8 +902,9 @@ mod tests {
         let mut flat = small_data();
         flat.t_total_mean_s = vec![100.0; 5];
         flat.t_total_std_s = vec![0.0; 5];
+        flat.lower_bound_mean_s = vec![90.0; 5];
         flat.examples.clear();
-        // 100 / 0.64 = 156.25 -> 200.
+        // 100 / 0.57 = 175.4 -> 200.
         assert_eq!(Layout::new(&flat).t_max_s, 200.0);
     }
 
