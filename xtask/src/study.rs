@@ -141,8 +141,7 @@ fn fig5_data(result: &StudyResult, summary: &[IterationSummary]) -> Fig5Data {
             ExampleSchedule {
                 iteration: r.iteration,
                 t_total_s: r.t_total_s,
-                lc_robot1: pairs(&r.lc_intervals_s[0]),
-                lc_robot2: pairs(&r.lc_intervals_s[1]),
+                lc: r.lc_intervals_s.iter().map(|v| pairs(v)).collect(),
             }
         })
         .collect();

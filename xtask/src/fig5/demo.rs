@@ -112,8 +112,10 @@ fn demo_data() -> Fig5Data {
             ExampleSchedule {
                 iteration: k,
                 t_total_s: DEMO_EXEC_S + offset,
-                lc_robot1: lc.clone(),
-                lc_robot2: lc.iter().map(|&(s, e)| (s + offset, e + offset)).collect(),
+                lc: vec![
+                    lc.clone(),
+                    lc.iter().map(|&(s, e)| (s + offset, e + offset)).collect(),
+                ],
             }
         })
         .collect();

@@ -23,7 +23,7 @@ use anyhow::{Context, anyhow, bail, ensure};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
-use tandem_plot::{BOTH_LC, FONT_FAMILY, GROUND_TRUTH, MEAN, NEITHER_LC, ROBOT_LC};
+use tandem_plot::{BOTH_LC, FONT_FAMILY, GROUND_TRUTH, MEAN, NEITHER_LC, ROBOT_LC_N};
 
 /// Width of both output images, in pixels (SVG user units for the SVG).
 pub(crate) const WIDTH_PX: u32 = 1200;
@@ -63,24 +63,21 @@ pub(crate) struct ExampleSchedule {
     pub iteration: usize,
     /// The schedule's task length `T_total` (Eq. 13), in seconds of global time.
     pub t_total_s: f64,
-    /// Global-time intervals `(start_s, end_s)` in which robot 1 is low-confidence;
-    /// each within `[0, t_total_s]`.
-    pub lc_robot1: Vec<(f64, f64)>,
-    /// Global-time intervals `(start_s, end_s)` in which robot 2 is low-confidence;
-    /// each within `[0, t_total_s]`.
-    pub lc_robot2: Vec<(f64, f64)>,
+    /// Per robot (robot 1 first; 1 to 8 robots), the global-time intervals
+    /// `(start_s, end_s)` in which it is low-confidence; each within `[0, t_total_s]`.
+    pub lc: Vec<Vec<(f64, f64)>>,
 }
 
 /// Who is low-confidence during a stretch of an example schedule's global time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Occupancy {
-    /// Neither robot (gray).
+    /// No robot (gray).
     Neither,
-    /// Robot 1 only (blue).
-    Robot1,
-    /// Robot 2 only (red).
-    Robot2,
-    /// Both robots: a schedule violating the one-low-confidence-robot constraint (purple).
+    /// Robot `i` (0-based) only: blue for robot 1, red for robot 2, then
+    /// [`ROBOT_LC_N`]'s colours.
+    Robot(usize),
+    /// Two or more robots: a schedule violating the one-low-confidence-robot constraint
+    /// (purple).
     Both,
 }
 
@@ -88,8 +85,7 @@ impl Occupancy {
     fn colour(self) -> RGBColor {
         match self {
             Self::Neither => NEITHER_LC,
-            Self::Robot1 => ROBOT_LC[0],
-            Self::Robot2 => ROBOT_LC[1],
+            Self::Robot(i) => ROBOT_LC_N[i % ROBOT_LC_N.len()],
             Self::Both => BOTH_LC,
         }
     }
@@ -161,7 +157,14 @@ impl Fig5Data {
                 ex.t_total_s
             );
             let limit = ex.t_total_s * (1.0 + INTERVAL_SLACK) + INTERVAL_SLACK;
-            for (robot, intervals) in [("lc_robot1", &ex.lc_robot1), ("lc_robot2", &ex.lc_robot2)] {
+            ensure!(
+                (1..=ROBOT_LC_N.len()).contains(&ex.lc.len()),
+                "Fig. 5 data: examples[{k}] has {} robots, must have 1 to {}",
+                ex.lc.len(),
+                ROBOT_LC_N.len()
+            );
+            for (robot, intervals) in ex.lc.iter().enumerate() {
+                let robot = format!("robot {}", robot + 1);
                 for (j, &(start, end)) in intervals.iter().enumerate() {
                     ensure!(
                         start.is_finite()
@@ -169,7 +172,7 @@ impl Fig5Data {
                             && 0.0 <= start
                             && start <= end
                             && end <= limit,
-                        "Fig. 5 data: examples[{k}].{robot}[{j}] = ({start}, {end}) s must satisfy \
+                        "Fig. 5 data: examples[{k}], {robot}, interval {j} = ({start}, {end}) s must satisfy \
                          0 <= start <= end <= t_total_s = {}",
                         ex.t_total_s
                     );
@@ -207,7 +210,7 @@ fn occupancy_segments(ex: &ExampleSchedule) -> Vec<(f64, f64, Occupancy)> {
     let t_end = ex.t_total_s;
     let clip = |t: f64| t.clamp(0.0, t_end);
     let mut cuts: Vec<f64> = vec![0.0, t_end];
-    for &(s, e) in ex.lc_robot1.iter().chain(&ex.lc_robot2) {
+    for &(s, e) in ex.lc.iter().flatten() {
         cuts.push(clip(s));
         cuts.push(clip(e));
     }
@@ -221,11 +224,11 @@ fn occupancy_segments(ex: &ExampleSchedule) -> Vec<(f64, f64, Occupancy)> {
             continue;
         }
         let mid = 0.5 * (a + b);
-        let occupancy = match (covers(&ex.lc_robot1, mid), covers(&ex.lc_robot2, mid)) {
-            (false, false) => Occupancy::Neither,
-            (true, false) => Occupancy::Robot1,
-            (false, true) => Occupancy::Robot2,
-            (true, true) => Occupancy::Both,
+        let mut covering = ex.lc.iter().enumerate().filter(|(_, v)| covers(v, mid));
+        let occupancy = match (covering.next(), covering.next()) {
+            (None, _) => Occupancy::Neither,
+            (Some((i, _)), None) => Occupancy::Robot(i),
+            (Some(_), Some(_)) => Occupancy::Both,
         };
         match segments.last_mut() {
             Some(last) if last.2 == occupancy => last.1 = b,
@@ -533,22 +536,55 @@ fn draw_task_length_panel<DB: DrawingBackend>(
     chart
         .draw_series(bars)
         .map_err(draw_err("example schedules"))?;
-    let mut swatches = vec![
-        ("robot 1 low-confidence", Occupancy::Robot1),
-        ("robot 2 low-confidence", Occupancy::Robot2),
-        ("neither low-confidence", Occupancy::Neither),
-    ];
+    let n_robots = data.examples.iter().map(|e| e.lc.len()).max().unwrap_or(0);
+    // Two robots: one swatch each, as in the paper; more: one swatch striped in the robots'
+    // colours, so the legend keeps its size.
+    let mut swatches: Vec<(String, Vec<Occupancy>)> = if n_robots <= 2 {
+        (0..n_robots)
+            .map(|i| {
+                (
+                    format!("robot {} low-confidence", i + 1),
+                    vec![Occupancy::Robot(i)],
+                )
+            })
+            .collect()
+    } else {
+        vec![(
+            format!("robot 1, 2, …, {n_robots} low-confidence"),
+            (0..n_robots).map(Occupancy::Robot).collect(),
+        )]
+    };
+    let none = if n_robots <= 2 { "neither" } else { "none" };
+    swatches.push((format!("{none} low-confidence"), vec![Occupancy::Neither]));
     if any_both {
-        swatches.push(("both low-confidence (invalid)", Occupancy::Both));
+        let two = if n_robots <= 2 { "both" } else { "two or more" };
+        swatches.push((
+            format!("{two} low-confidence (invalid)"),
+            vec![Occupancy::Both],
+        ));
     }
     if !data.examples.is_empty() {
-        for (label, occupancy) in swatches {
+        for (label, colours) in swatches {
             chart
                 .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
                 .map_err(draw_err("legend"))?
                 .label(label)
                 .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 7), (x + 24, y + 7)], occupancy.colour().filled())
+                    // Eight 3 px stripes, robot colours in turn (one colour: a plain swatch).
+                    let stripe = |j: usize| {
+                        let x0 = 3 * j as i32;
+                        let colour = colours[j * colours.len() / 8].colour();
+                        Rectangle::new([(x0, -7), (x0 + 3, 7)], colour.filled())
+                    };
+                    EmptyElement::at((x, y))
+                        + stripe(0)
+                        + stripe(1)
+                        + stripe(2)
+                        + stripe(3)
+                        + stripe(4)
+                        + stripe(5)
+                        + stripe(6)
+                        + stripe(7)
                 });
         }
     }
@@ -692,14 +728,15 @@ pub(crate) mod tests {
                 ExampleSchedule {
                     iteration: 0,
                     t_total_s: 100.0,
-                    lc_robot1: vec![(0.0, 50.0)],
-                    lc_robot2: vec![(50.0, 100.0)],
+                    lc: vec![vec![(0.0, 50.0)], vec![(50.0, 100.0)]],
                 },
                 ExampleSchedule {
                     iteration: 4,
                     t_total_s: 65.0,
-                    lc_robot1: vec![(5.0, 15.0), (25.0, 35.0)],
-                    lc_robot2: vec![(15.0, 25.0), (35.0, 45.0)],
+                    lc: vec![
+                        vec![(5.0, 15.0), (25.0, 35.0)],
+                        vec![(15.0, 25.0), (35.0, 45.0)],
+                    ],
                 },
             ],
         }
@@ -753,10 +790,30 @@ pub(crate) mod tests {
     fn overlapping_low_confidence_gets_the_violation_swatch() {
         let dir = scratch_dir("overlap");
         let mut data = small_data();
-        data.examples[0].lc_robot2 = vec![(40.0, 100.0)];
+        data.examples[0].lc[1] = vec![(40.0, 100.0)];
         draw_fig5(&data, &dir.join("a.svg"), &dir.join("a.png")).unwrap();
         let svg_text = std::fs::read_to_string(dir.join("a.svg")).unwrap();
         assert!(svg_text.contains("both low-confidence (invalid)"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn three_robots_get_their_own_colours_and_one_striped_swatch() {
+        let dir = scratch_dir("three");
+        let mut data = small_data();
+        data.examples[1].lc.push(vec![(50.0, 60.0)]);
+        assert_eq!(
+            occupancy_segments(&data.examples[1]).last(),
+            Some(&(60.0, 65.0, Occupancy::Neither))
+        );
+        assert!(
+            occupancy_segments(&data.examples[1]).contains(&(50.0, 60.0, Occupancy::Robot(2)))
+        );
+        draw_fig5(&data, &dir.join("a.svg"), &dir.join("a.png")).unwrap();
+        let svg_text = std::fs::read_to_string(dir.join("a.svg")).unwrap();
+        assert!(svg_text.contains("robot 1, 2, …, 3 low-confidence"));
+        assert!(svg_text.contains("none low-confidence"));
+        assert!(svg_text.contains("#FF7F0E"), "robot 3 orange bar segment");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -808,11 +865,11 @@ pub(crate) mod tests {
             ("examples[1].t_total_s", |d| {
                 d.examples[1].t_total_s = f64::NAN
             }),
-            ("examples[1].lc_robot2[1]", |d| {
-                d.examples[1].lc_robot2[1] = (35.0, 66.0)
+            ("examples[1], robot 2, interval 1", |d| {
+                d.examples[1].lc[1][1] = (35.0, 66.0)
             }),
-            ("examples[0].lc_robot1[0]", |d| {
-                d.examples[0].lc_robot1[0] = (20.0, 10.0)
+            ("examples[0], robot 1, interval 0", |d| {
+                d.examples[0].lc[0][0] = (20.0, 10.0)
             }),
             ("both at iteration 0", |d| d.examples[1].iteration = 0),
         ];
@@ -831,7 +888,7 @@ pub(crate) mod tests {
     #[test]
     fn interval_ending_at_t_total_within_rounding_is_accepted() {
         let mut data = small_data();
-        data.examples[1].lc_robot2[1] = (35.0, 65.0 + 1e-12);
+        data.examples[1].lc[1][1] = (35.0, 65.0 + 1e-12);
         data.validate().unwrap();
     }
 
@@ -840,38 +897,35 @@ pub(crate) mod tests {
         let ex = ExampleSchedule {
             iteration: 0,
             t_total_s: 10.0,
-            lc_robot1: vec![(0.0, 3.0), (3.0, 4.0)],
-            lc_robot2: vec![(5.0, 7.0)],
+            lc: vec![vec![(0.0, 3.0), (3.0, 4.0)], vec![(5.0, 7.0)]],
         };
         assert_eq!(
             occupancy_segments(&ex),
             vec![
-                (0.0, 4.0, Occupancy::Robot1),
+                (0.0, 4.0, Occupancy::Robot(0)),
                 (4.0, 5.0, Occupancy::Neither),
-                (5.0, 7.0, Occupancy::Robot2),
+                (5.0, 7.0, Occupancy::Robot(1)),
                 (7.0, 10.0, Occupancy::Neither),
             ]
         );
         let clash = ExampleSchedule {
             iteration: 0,
             t_total_s: 6.0,
-            lc_robot1: vec![(1.0, 4.0)],
-            lc_robot2: vec![(3.0, 6.0)],
+            lc: vec![vec![(1.0, 4.0)], vec![(3.0, 6.0)]],
         };
         assert_eq!(
             occupancy_segments(&clash),
             vec![
                 (0.0, 1.0, Occupancy::Neither),
-                (1.0, 3.0, Occupancy::Robot1),
+                (1.0, 3.0, Occupancy::Robot(0)),
                 (3.0, 4.0, Occupancy::Both),
-                (4.0, 6.0, Occupancy::Robot2),
+                (4.0, 6.0, Occupancy::Robot(1)),
             ]
         );
         let empty = ExampleSchedule {
             iteration: 0,
             t_total_s: 0.0,
-            lc_robot1: vec![],
-            lc_robot2: vec![],
+            lc: vec![vec![], vec![]],
         };
         assert!(occupancy_segments(&empty).is_empty());
     }
