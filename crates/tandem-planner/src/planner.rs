@@ -165,6 +165,29 @@ fn problem_for(model: &TaskModel, confidence: &Confidence) -> Result<Problem> {
     )?)
 }
 
+/// [`Error::RobotCount`] unless `1 ≤ n_robots ≤ MAX_ROBOTS`.
+fn check_robot_count(n_robots: usize) -> Result<()> {
+    let max = tandem_realtime::MAX_ROBOTS;
+    if (1..=max).contains(&n_robots) {
+        Ok(())
+    } else {
+        Err(Error::RobotCount { n_robots, max })
+    }
+}
+
+/// The scheduler (§II-C) for `n_robots` robots on `problem`, warm-started by `previous`.
+fn schedule_robots(
+    problem: &Problem,
+    n_robots: usize,
+    params: &SamplerParams,
+    previous: Option<&Schedule>,
+) -> Result<Outcome> {
+    if n_robots != 2 {
+        return Err(Error::RobotCount { n_robots, max: 2 });
+    }
+    Ok(sample_schedule(problem, params, previous)?)
+}
+
 impl Planner {
     /// Learns the task from demonstrations (the reference is the one `params.fit.reference`
     /// chooses) and makes the first schedule: aligns and fits the model (§II-B1/2), sets the
@@ -174,9 +197,25 @@ impl Planner {
     /// # Errors
     /// Invalid parameters, or the lower crates' errors for the demonstrations.
     pub fn new(demos: &[Demonstration], params: PlannerParams) -> Result<Self> {
+        Self::with_robots(demos, params, 2)
+    }
+
+    /// As [`Planner::new`] for `n_robots` robots (`1 ≤ N ≤` [`tandem_realtime::MAX_ROBOTS`])
+    /// doing the same task under one operator: every schedule has `N` warps and `N − 1`
+    /// offsets, and [`Planner::record_round`] takes `N` executions. [`Planner::new`] is the
+    /// paper's `N = 2`. The state file stores `N` (as the schedule's robot count).
+    ///
+    /// # Errors
+    /// [`Error::RobotCount`] for `n_robots` outside `1..=MAX_ROBOTS`, and as [`Planner::new`].
+    pub fn with_robots(
+        demos: &[Demonstration],
+        params: PlannerParams,
+        n_robots: usize,
+    ) -> Result<Self> {
+        check_robot_count(n_robots)?;
         params.validate()?;
         let model = TaskModel::fit(demos, &params.fit)?;
-        Self::from_model(model, params)
+        Self::from_model_with_robots(model, params, n_robots)
     }
 
     /// As [`Planner::new`] from an already fitted model (e.g. to run several trials from
@@ -185,11 +224,24 @@ impl Planner {
     /// # Errors
     /// Invalid parameters, a degenerate prior or an infeasible problem.
     pub fn from_model(model: TaskModel, params: PlannerParams) -> Result<Self> {
+        Self::from_model_with_robots(model, params, 2)
+    }
+
+    /// As [`Planner::from_model`] for `n_robots` robots (see [`Planner::with_robots`]).
+    ///
+    /// # Errors
+    /// [`Error::RobotCount`], and as [`Planner::from_model`].
+    pub fn from_model_with_robots(
+        model: TaskModel,
+        params: PlannerParams,
+        n_robots: usize,
+    ) -> Result<Self> {
+        check_robot_count(n_robots)?;
         params.validate()?;
         let confidence = Confidence::from_prior(model.sigma2_d(), params.confidence.clone())?;
         let observations = Observations::new(model.n_ref())?;
         let problem = problem_for(&model, &confidence)?;
-        let outcome = sample_schedule(&problem, &Self::sampler_params(&params, 0), None)?;
+        let outcome = schedule_robots(&problem, n_robots, &Self::sampler_params(&params, 0), None)?;
         Ok(Self {
             params,
             model,
@@ -218,7 +270,7 @@ impl Planner {
     /// or flag vectors of the wrong length; the lower crates' errors for a bad execution
     /// (channels, period, log) or observation.
     pub fn record_round(&mut self, executions: &[ExecutionRecord]) -> Result<RecordReport> {
-        let n_robots = self.schedule().grad_exec.len();
+        let n_robots = self.n_robots();
         if executions.len() != n_robots {
             return Err(Error::BadExecution {
                 what: "executions",
@@ -244,8 +296,9 @@ impl Planner {
         let problem = problem_for(&model, &confidence)?;
         let t2 = Instant::now();
         let pairs_recorded = self.pairs_recorded + 1;
-        let outcome = sample_schedule(
+        let outcome = schedule_robots(
             &problem,
+            n_robots,
             &Self::sampler_params(&self.params, pairs_recorded),
             Some(&self.outcome.schedule),
         )?;
@@ -292,9 +345,20 @@ impl Planner {
     /// # Errors
     /// The schedule crate's error for invalid `sampler` parameters or an infeasible problem.
     pub fn reschedule(&mut self, sampler: &SamplerParams) -> Result<&Outcome> {
-        let outcome = sample_schedule(&self.problem, sampler, Some(&self.outcome.schedule))?;
+        let outcome = schedule_robots(
+            &self.problem,
+            self.n_robots(),
+            sampler,
+            Some(&self.outcome.schedule),
+        )?;
         self.outcome = outcome;
         Ok(&self.outcome)
+    }
+
+    /// Robots `N` the planner schedules (the current schedule's robot count; 2 unless made by
+    /// [`Planner::with_robots`]).
+    pub fn n_robots(&self) -> usize {
+        self.outcome.schedule.grad_exec.len()
     }
 
     /// The current schedule.
@@ -452,6 +516,38 @@ mod tests {
         let conf = p.confidence().conf();
         assert!(conf[..10].iter().all(|c| *c) && conf[20..].iter().all(|c| *c));
         assert!(conf[10..20].iter().all(|c| !*c));
+    }
+
+    #[test]
+    fn robot_counts_outside_one_to_max_and_rounds_of_another_size_are_refused() {
+        let p = small_planner(1);
+        assert_eq!(p.n_robots(), 2);
+        for n in [0, tandem_realtime::MAX_ROBOTS + 1] {
+            let err = Planner::from_model_with_robots(p.model().clone(), p.params().clone(), n)
+                .unwrap_err();
+            assert!(
+                matches!(err, Error::RobotCount { n_robots, max: 8 } if n_robots == n),
+                "{err}"
+            );
+            assert!(err.to_string().contains("1 to 8 robots"), "{err}");
+        }
+        let mut q = p.clone();
+        let err = q.record_round(&[]).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::BadExecution {
+                    what: "executions",
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert!(
+            err.to_string()
+                .contains("0 execution records for a round of 2 robots")
+        );
+        assert_eq!(q.pairs_recorded(), 0);
     }
 
     #[test]

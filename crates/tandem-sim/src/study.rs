@@ -582,7 +582,7 @@ fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
         .map(|v| v.iter().map(|i| [i.start_s, i.end_s]).collect())
         .collect();
     let outcome = planner.outcome();
-    let n_robots = schedule.grad_exec.len();
+    let n_robots = planner.n_robots();
     Ok(IterationRecord {
         iteration: planner.pairs_recorded(),
         t_total_s: outcome.t_total_s,
@@ -618,13 +618,13 @@ pub fn run_trial(
     params.sampler.seed = seed;
     let mut times = PhaseTimes::default();
     let t = Instant::now();
-    let mut planner = Planner::from_model(model.clone(), params)?;
+    let mut planner = Planner::from_model_with_robots(model.clone(), params, config.robots)?;
     times.scheduling += t.elapsed();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(1);
     let operator = config.operator();
     let n_pairs = config.n_rounds();
-    let n_robots = planner.schedule().grad_exec.len();
+    let n_robots = planner.n_robots();
     let mut iterations = Vec::with_capacity(n_pairs + 1);
     for pair in 0..n_pairs {
         let mut record = iteration_record(&planner)?;

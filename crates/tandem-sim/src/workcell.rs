@@ -353,7 +353,7 @@ pub fn run_round(
             found: labels.len(),
         });
     }
-    let n_robots = planner.schedule().grad_exec.len();
+    let n_robots = planner.n_robots();
     if workpieces.len() != n_robots {
         return Err(Error::Mismatch {
             what: "workpieces (one per robot)",

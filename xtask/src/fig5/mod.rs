@@ -806,9 +806,7 @@ pub(crate) mod tests {
             occupancy_segments(&data.examples[1]).last(),
             Some(&(60.0, 65.0, Occupancy::Neither))
         );
-        assert!(
-            occupancy_segments(&data.examples[1]).contains(&(50.0, 60.0, Occupancy::Robot(2)))
-        );
+        assert!(occupancy_segments(&data.examples[1]).contains(&(50.0, 60.0, Occupancy::Robot(2))));
         draw_fig5(&data, &dir.join("a.svg"), &dir.join("a.png")).unwrap();
         let svg_text = std::fs::read_to_string(dir.join("a.svg")).unwrap();
         assert!(svg_text.contains("robot 1, 2, …, 3 low-confidence"));
