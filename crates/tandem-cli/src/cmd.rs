@@ -149,7 +149,7 @@ fn summary_lines(planner: &Planner) -> Result<()> {
     ));
     out(&format!(
         "schedule: τ = {:.2} s; {}",
-        planner.schedule().offset_s,
+        planner.schedule().start_s(1),
         source_name(&planner.outcome().source)
     ));
     Ok(())

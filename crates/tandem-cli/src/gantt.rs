@@ -83,7 +83,7 @@ pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Valu
         "bound_is_optimum": outcome.bound_is_optimum,
         "gap": outcome.gap,
         "serial_t_total_s": serial_t_total_s(problem, s.tick_s)?,
-        "offset_s": s.offset_s,
+        "offset_s": s.start_s(1),
         "durations_s": s.durations_s(dt),
         "dt_s": dt,
         "tick_s": s.tick_s,
@@ -126,12 +126,13 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
     }
     let mut out = String::new();
     let dt = problem.dt_s();
-    let [d0, d1] = outcome.schedule.durations_s(dt);
+    let d = outcome.schedule.durations_s(dt);
+    let (d0, d1) = (d[0], d.get(1).copied().unwrap_or(f64::NAN));
     writeln!(out, "{}", certificate_line(problem, outcome)?)?;
     writeln!(
         out,
         "robot 2 starts at τ = {:.2} s; robot 1 runs {d0:.2} s, robot 2 runs {d1:.2} s; schedule: {}",
-        outcome.schedule.offset_s,
+        outcome.schedule.start_s(1),
         source_name(&outcome.source)
     )?;
     writeln!(out)?;

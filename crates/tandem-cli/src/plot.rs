@@ -376,19 +376,22 @@ struct ScheduleFigure {
 impl ScheduleFigure {
     fn new(planner: &Planner) -> Result<Self> {
         let tl = GlobalTimeline::new(planner.problem(), planner.schedule())?;
-        let lc = tl
-            .lc_intervals()
-            .map(|v| v.iter().map(|iv| (iv.start_s, iv.end_s)).collect());
+        let all = tl.lc_intervals();
+        let lc = [0, 1].map(|r| {
+            all.get(r).map_or_else(Vec::new, |v| {
+                v.iter().map(|iv| (iv.start_s, iv.end_s)).collect()
+            })
+        });
         let serial = crate::gantt::serial_t_total_s(planner.problem(), planner.schedule().tick_s)?;
         Ok(Self {
             t_total_s: tl.t_total_s(),
-            spans: tl.spans_s(),
+            spans: [0, 1].map(|r| tl.spans_s().get(r).copied().unwrap_or((0.0, 0.0))),
             lc,
             title: format!(
                 "schedule: T_total {:.2} s (fastest serial {:.2} s), robot 2 starts at τ = {:.2} s",
                 tl.t_total_s(),
                 serial,
-                planner.schedule().offset_s
+                planner.schedule().start_s(1)
             ),
         })
     }

@@ -146,7 +146,7 @@ fn fixtures_fit_simulate_record_schedule() {
     assert!(bound > 0.0 && bound <= t_total, "{bound} vs {t_total}");
     assert_eq!(doc["bound_is_optimum"], true);
     assert!((doc["gap"].as_f64().unwrap() - (t_total - bound) / bound).abs() < 1e-9);
-    assert_eq!(doc["offset_s"].as_f64().unwrap(), schedule.offset_s);
+    assert_eq!(doc["offset_s"].as_f64().unwrap(), schedule.offsets_s[0]);
     // Low-confidence intervals of the two robots never overlap in global time.
     let iv = doc["lc_intervals"].as_array().unwrap();
     for a in iv.iter().filter(|x| x["robot"] == 1) {
@@ -172,7 +172,7 @@ fn fixtures_fit_simulate_record_schedule() {
     assert_ne!(std::fs::read(&state).unwrap(), before);
     let saved = Planner::load(&state).unwrap();
     // serde_json reads floats to within an ulp, not bit for bit.
-    assert!((saved.schedule().offset_s - schedule.offset_s).abs() < 1e-12);
+    assert!((saved.schedule().offsets_s[0] - schedule.offsets_s[0]).abs() < 1e-12);
     for (a, b) in saved.schedule().grad_exec.iter().zip(&schedule.grad_exec) {
         assert_eq!(a.len(), b.len());
         let worst = a

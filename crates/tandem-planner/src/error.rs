@@ -25,8 +25,9 @@ pub enum Error {
     },
     /// The file was written by a build with another state format version.
     #[error(
-        "{}: state format version {found}, this build reads version {expected} only ({})",
+        "{}: state format version {found}, this build reads versions {} to {expected} only ({})",
         path.display(),
+        crate::state::OLDEST_READABLE_VERSION,
         version_advice(*found, *expected)
     )]
     UnsupportedVersion {

@@ -9,7 +9,9 @@ use serde::{Deserialize, Serialize};
 use tandem_confidence::{Confidence, ConfidenceParams, Observations};
 use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
 use tandem_realtime::Coordinator;
-use tandem_schedule::{Outcome, Problem, SamplerParams, Schedule, Source, sample_schedule};
+use tandem_schedule::{
+    Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source, sample_schedule,
+};
 
 use crate::{Error, Result, derive_seed, state};
 
@@ -141,6 +143,73 @@ struct PlannerState {
     confidence: Confidence,
     outcome: Outcome,
     pairs_recorded: usize,
+}
+
+/// [`PlannerState`] as state format version 4 wrote it: the same but for the two-robot
+/// schedule ([`ScheduleV4`]).
+#[derive(Deserialize)]
+struct PlannerStateV4 {
+    params: PlannerParams,
+    model: TaskModel,
+    observations: Observations,
+    confidence: Confidence,
+    outcome: OutcomeV4,
+    pairs_recorded: usize,
+}
+
+/// [`Outcome`] as state format version 4 wrote it (field for field, the schedule
+/// [`ScheduleV4`]).
+#[derive(Deserialize)]
+struct OutcomeV4 {
+    schedule: ScheduleV4,
+    t_total_s: f64,
+    source: Source,
+    stats: SamplerStats,
+    lower_bound_s: f64,
+    bound_is_optimum: bool,
+    gap: f64,
+}
+
+/// The two-robot [`Schedule`] of state format version 4: two warps and robot 2's offset.
+#[derive(Deserialize)]
+struct ScheduleV4 {
+    grad_exec: [Vec<f64>; 2],
+    offset_s: f64,
+    tick_s: f64,
+}
+
+impl From<PlannerStateV4> for PlannerState {
+    fn from(v4: PlannerStateV4) -> Self {
+        let OutcomeV4 {
+            schedule,
+            t_total_s,
+            source,
+            stats,
+            lower_bound_s,
+            bound_is_optimum,
+            gap,
+        } = v4.outcome;
+        PlannerState {
+            params: v4.params,
+            model: v4.model,
+            observations: v4.observations,
+            confidence: v4.confidence,
+            outcome: Outcome {
+                schedule: Schedule {
+                    grad_exec: Vec::from(schedule.grad_exec),
+                    offsets_s: vec![schedule.offset_s],
+                    tick_s: schedule.tick_s,
+                },
+                t_total_s,
+                source,
+                stats,
+                lower_bound_s,
+                bound_is_optimum,
+                gap,
+            },
+            pairs_recorded: v4.pairs_recorded,
+        }
+    }
 }
 
 /// The scheduling problem for the current model and confidence (Eq. 12, 14).
@@ -358,7 +427,7 @@ impl Planner {
     /// Robots `N` the planner schedules (the current schedule's robot count; 2 unless made by
     /// [`Planner::with_robots`]).
     pub fn n_robots(&self) -> usize {
-        self.outcome.schedule.grad_exec.len()
+        self.outcome.schedule.n_robots()
     }
 
     /// The current schedule.
@@ -421,14 +490,22 @@ impl Planner {
         state::save(path.as_ref(), &self.to_state())
     }
 
-    /// Loads a planner saved by [`Planner::save`].
+    /// Loads a planner saved by [`Planner::save`], of the current state format or an older one
+    /// this build still reads (version 4: a two-robot schedule with one offset, converted to
+    /// `offsets_s = [offset_s]`; saving writes the current version).
     ///
     /// # Errors
     /// As [`crate::state::load`] (missing, foreign, truncated, corrupt or other-version
     /// file, each naming `path`), or [`Error::Corrupt`] when the parts do not fit together.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let st: PlannerState = state::load(path)?;
+        let bytes = state::read(path)?;
+        let (version, payload) = state::checked_payload(&bytes, path)?;
+        let st: PlannerState = if version == 4 {
+            state::decode_payload::<PlannerStateV4>(payload, path)?.into()
+        } else {
+            state::decode_payload(payload, path)?
+        };
         Self::from_state(st).map_err(|e| Error::Corrupt {
             path: path.to_path_buf(),
             why: e.to_string(),
@@ -449,12 +526,33 @@ impl Planner {
     fn from_state(st: PlannerState) -> Result<Self> {
         st.params.validate()?;
         let n_ref = st.model.n_ref();
+        let schedule = &st.outcome.schedule;
+        schedule.check_shape().map_err(|v| Error::Inconsistent {
+            what: "schedule",
+            why: v.to_string(),
+        })?;
+        // `check_shape` bounds the robot count by MAX_ROBOTS, the names' count.
+        const WARPS: [&str; tandem_realtime::MAX_ROBOTS] = [
+            "schedule robot 1",
+            "schedule robot 2",
+            "schedule robot 3",
+            "schedule robot 4",
+            "schedule robot 5",
+            "schedule robot 6",
+            "schedule robot 7",
+            "schedule robot 8",
+        ];
+        let warps = WARPS
+            .iter()
+            .zip(&schedule.grad_exec)
+            .map(|(&w, g)| (w, g.len()));
         for (what, n) in [
             ("observations", st.observations.n_ref()),
             ("confidence", st.confidence.n_ref()),
-            ("schedule robot 1", st.outcome.schedule.grad_exec[0].len()),
-            ("schedule robot 2", st.outcome.schedule.grad_exec[1].len()),
-        ] {
+        ]
+        .into_iter()
+        .chain(warps)
+        {
             if n != n_ref {
                 return Err(Error::Inconsistent {
                     what,

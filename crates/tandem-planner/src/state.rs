@@ -12,12 +12,15 @@
 //! | 24.. | payload: the state encoded with `postcard` |
 //!
 //! Reading checks, in this order: the file can be read, it is at least a header long and
-//! starts with the magic bytes, the version is the one this build reads, the payload has
+//! starts with the magic bytes, the version is one this build reads
+//! ([`OLDEST_READABLE_VERSION`]`..=`[`FORMAT_VERSION`]), the payload has
 //! exactly the announced length (shorter = truncated, longer = trailing garbage), the
 //! checksum matches, and `postcard` decodes the payload using every byte.
 //! Each failure is its own [`Error`] variant naming the file.
 //! A file of another version is refused ([`Error::UnsupportedVersion`] says whether it is
-//! older or newer than the build); there is no migration.
+//! older or newer than the build). A file of an older readable version is decoded with that
+//! version's payload shape and converted (`Planner::load`); saving it again writes the
+//! current version.
 //!
 //! # The golden file
 //!
@@ -64,7 +67,13 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 /// - 4: the outcome carries its certificate (`lower_bound_s`, `bound_is_optimum`, `gap`), its
 ///   counts the completion's and the search's, `Source` gained `Completed`, and the sampler
 ///   parameters the exact search's and completion's (`exact`).
-pub const FORMAT_VERSION: u32 = 4;
+/// - 5: the schedule holds `N` robots (`Schedule::grad_exec` a list of warps, `offsets_s` the
+///   `N − 1` start offsets instead of the one `offset_s`). Version 4 files still load, as
+///   two-robot schedules with `offsets_s = [offset_s]`.
+pub const FORMAT_VERSION: u32 = 5;
+
+/// The oldest state format version this build reads (converting it on load).
+pub const OLDEST_READABLE_VERSION: u32 = 4;
 
 /// Header length in bytes: magic (8) + version (4) + payload length (8) + CRC-32 (4).
 pub const HEADER_LEN: usize = 24;
@@ -81,8 +90,29 @@ pub(crate) fn encode<T: Serialize>(value: &T) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// Decode a state file image read from `path` (used only in error messages).
+/// Decode a state file image of the current version read from `path` (used only in error
+/// messages).
 pub(crate) fn decode<T: DeserializeOwned>(bytes: &[u8], path: &Path) -> Result<T> {
+    let (version, payload) = checked_payload(bytes, path)?;
+    if version != FORMAT_VERSION {
+        return Err(unsupported(path, version));
+    }
+    decode_payload(payload, path)
+}
+
+/// The [`Error::UnsupportedVersion`] of a file of version `found` at `path`.
+fn unsupported(path: &Path, found: u32) -> Error {
+    Error::UnsupportedVersion {
+        path: path.to_path_buf(),
+        found,
+        expected: FORMAT_VERSION,
+    }
+}
+
+/// The version and the payload of a state file image read from `path`, after every check of
+/// the module docs but the decoding: magic, a readable version
+/// ([`OLDEST_READABLE_VERSION`]`..=`[`FORMAT_VERSION`]), length and checksum.
+pub(crate) fn checked_payload<'a>(bytes: &'a [u8], path: &Path) -> Result<(u32, &'a [u8])> {
     let path_buf = || path.to_path_buf();
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
         return Err(Error::NotAStateFile { path: path_buf() });
@@ -96,12 +126,8 @@ pub(crate) fn decode<T: DeserializeOwned>(bytes: &[u8], path: &Path) -> Result<T
     }
     let word = |range: std::ops::Range<usize>| -> &[u8] { &bytes[range] };
     let version = u32::from_le_bytes(word(8..12).try_into().expect("4-byte slice"));
-    if version != FORMAT_VERSION {
-        return Err(Error::UnsupportedVersion {
-            path: path_buf(),
-            found: version,
-            expected: FORMAT_VERSION,
-        });
+    if !(OLDEST_READABLE_VERSION..=FORMAT_VERSION).contains(&version) {
+        return Err(unsupported(path, version));
     }
     let payload_len = u64::from_le_bytes(word(12..20).try_into().expect("8-byte slice"));
     let crc = u32::from_le_bytes(word(20..24).try_into().expect("4-byte slice"));
@@ -130,6 +156,13 @@ pub(crate) fn decode<T: DeserializeOwned>(bytes: &[u8], path: &Path) -> Result<T
             why: format!("payload checksum {actual_crc:#010x} differs from header {crc:#010x}"),
         });
     }
+    Ok((version, payload))
+}
+
+/// Decodes a checked payload ([`checked_payload`]) of a file read from `path` as `T`, using
+/// every byte.
+pub(crate) fn decode_payload<T: DeserializeOwned>(payload: &[u8], path: &Path) -> Result<T> {
+    let path_buf = || path.to_path_buf();
     let (value, rest) = postcard::take_from_bytes::<T>(payload).map_err(|e| Error::Corrupt {
         path: path_buf(),
         why: format!("payload does not decode: {e}"),
@@ -290,7 +323,7 @@ mod tests {
     fn header_layout_is_as_documented() {
         let bytes = encode(&payload(4)).unwrap();
         assert_eq!(&bytes[..8], b"TANDEMST");
-        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 4);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 5);
         let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
         assert_eq!(len as usize, bytes.len() - HEADER_LEN);
         let crc = u32::from_le_bytes(bytes[20..24].try_into().unwrap());
@@ -380,7 +413,7 @@ mod tests {
             }
         ));
         let msg = err.to_string();
-        assert!(msg.contains("v.tandem") && msg.contains('7') && msg.contains('4'));
+        assert!(msg.contains("v.tandem") && msg.contains('7') && msg.contains('5'));
     }
 
     #[test]

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use tandem_confidence::Confidence;
 use tandem_lfd::{Demonstration, TaskModel};
-use tandem_planner::state::FORMAT_VERSION;
+use tandem_planner::state::{FORMAT_VERSION, OLDEST_READABLE_VERSION};
 use tandem_planner::{Error, Planner, PlannerParams};
 use tandem_schedule::validate;
 
@@ -104,6 +104,7 @@ fn the_golden_state_file_loads_with_the_values_of_its_inputs() {
     // T_total the clock's, and never slower than the serial schedule.
     let s = p.schedule();
     assert_eq!(s.tick_s, model.dt_s());
+    assert_eq!((s.n_robots(), s.offsets_s.len()), (2, 1));
     assert_eq!([s.grad_exec[0].len(), s.grad_exec[1].len()], [40, 40]);
     validate(p.problem(), s).unwrap();
     assert_eq!(p.outcome().t_total_s, s.t_total_s(model.dt_s()));
@@ -122,12 +123,53 @@ fn the_golden_state_file_loads_with_the_values_of_its_inputs() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `tests/fixtures/example_v4.tandem`: the golden state file as format version 4 wrote it
+/// (two warps and one offset `offset_s`), copied before the format became version 5.
+fn v4_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/example_v4.tandem")
+}
+
+#[test]
+fn a_version_4_file_loads_as_the_same_two_robot_schedule() {
+    let bytes = std::fs::read(v4_path()).unwrap();
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 4);
+    let old = Planner::load(v4_path()).unwrap();
+    let new = Planner::load(golden_path()).unwrap();
+    // The same planner: the current golden file is the same inputs written as version 5.
+    assert_eq!(old.params(), new.params());
+    assert_eq!(old.model().mean(), new.model().mean());
+    assert_eq!(old.model().count(), new.model().count());
+    assert_eq!(old.confidence(), new.confidence());
+    assert_eq!(old.pairs_recorded(), new.pairs_recorded());
+    // The schedule: offset_s became offsets_s = [offset_s], the rest field for field.
+    assert_eq!(old.schedule().offsets_s.len(), 1);
+    assert_eq!(old.outcome(), new.outcome());
+    validate(old.problem(), old.schedule()).unwrap();
+    // Saving it writes the current version, byte for byte the golden file.
+    let dir = tmp_dir("v4");
+    let again = dir.join("again.tandem");
+    old.save(&again).unwrap();
+    assert!(
+        std::fs::read(&again).unwrap() == std::fs::read(golden_path()).unwrap(),
+        "a version 4 file saved again is not the version 5 golden file"
+    );
+    // A version 4 header on a version 5 payload does not decode: a clear error, no panic.
+    let mut wrong = std::fs::read(golden_path()).unwrap();
+    wrong[8..12].copy_from_slice(&4u32.to_le_bytes());
+    let path = dir.join("wrong.tandem");
+    std::fs::write(&path, &wrong).unwrap();
+    let err = Planner::load(&path).unwrap_err();
+    assert!(matches!(err, Error::Corrupt { .. }), "{err}");
+    assert_names(&err, &path);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn older_and_newer_files_say_which_version_they_are() {
     let dir = tmp_dir("version");
     let golden = std::fs::read(golden_path()).unwrap();
     for (found, age) in [
-        (FORMAT_VERSION - 1, "an older"),
+        (OLDEST_READABLE_VERSION - 1, "an older"),
         (FORMAT_VERSION + 1, "a newer"),
     ] {
         let path = dir.join(format!("v{found}.tandem"));
@@ -143,7 +185,7 @@ fn older_and_newer_files_say_which_version_they_are() {
         for part in [
             path.display().to_string(),
             format!("state format version {found}"),
-            format!("reads version {FORMAT_VERSION} only"),
+            format!("reads versions {OLDEST_READABLE_VERSION} to {FORMAT_VERSION} only"),
             format!("written by {age} build"),
         ] {
             assert!(msg.contains(&part), "`{part}` missing in: {msg}");

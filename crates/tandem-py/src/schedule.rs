@@ -234,8 +234,8 @@ impl PySchedule {
             .into());
         }
         let schedule = Schedule {
-            grad_exec: [g[..n_ref].to_vec(), g[n_ref..].to_vec()],
-            offset_s: offsets[0],
+            grad_exec: vec![g[..n_ref].to_vec(), g[n_ref..].to_vec()],
+            offsets_s: offsets.to_vec(),
             tick_s,
         };
         Ok(Self::new(
@@ -255,7 +255,7 @@ impl PySchedule {
     /// Start offsets of robots 2…N, ``(N − 1,)``, s of global time (``τ``, §II-B4).
     #[getter]
     fn offsets<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        out_vector(py, vec![self.schedule.offset_s])
+        out_vector(py, self.schedule.offsets_s.clone())
     }
 
     /// Start time of every robot, ``(N,)``, s of global time: ``[0, τ]``.
@@ -411,7 +411,7 @@ impl PySchedule {
         Ok(out_flags(py, tl.conf_at(t_global_s).to_vec()))
     }
 
-    /// The schedule as JSON (``grad_exec``, ``offset_s``, ``tick_s``), the form of the
+    /// The schedule as JSON (``grad_exec``, ``offsets_s``, ``tick_s``), the form of the
     /// command line's ``tandem schedule --json`` schedule.
     fn to_json(&self) -> PyResult<String> {
         serde_json::to_string(&self.schedule)
@@ -423,6 +423,18 @@ impl PySchedule {
     fn from_json(problem: PyRef<'_, PyProblem>, text: &str) -> PyResult<Self> {
         let schedule: Schedule =
             serde_json::from_str(text).map_err(|e| Error::input("schedule JSON", e.to_string()))?;
+        if schedule.n_robots() != N_ROBOTS || schedule.offsets_s.len() != N_ROBOTS - 1 {
+            return Err(Error::input(
+                "schedule JSON",
+                format!(
+                    "{} warps and {} offsets, expected {N_ROBOTS} and {}",
+                    schedule.n_robots(),
+                    schedule.offsets_s.len(),
+                    N_ROBOTS - 1
+                ),
+            )
+            .into());
+        }
         if schedule
             .grad_exec
             .iter()
@@ -449,7 +461,7 @@ impl PySchedule {
     fn __repr__(&self) -> String {
         format!(
             "Schedule(n_robots={N_ROBOTS}, offsets=[{:.3}], t_total_s={:.3}, tick_s={}, source='{}')",
-            self.schedule.offset_s,
+            self.schedule.start_s(1),
             self.t_total_s(),
             self.schedule.tick_s,
             self.source

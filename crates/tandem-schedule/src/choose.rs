@@ -99,38 +99,49 @@ pub struct Outcome {
 type Candidate = (Schedule, f64, Source);
 
 /// The previous schedule re-projected onto `problem` at control tick `tick_s` (s): gradients
-/// clamped into the new bounds, the new mean on low-confidence samples, `τ` clamped into
-/// `[0, |ψ_E1|]`. `None` for warps of the wrong length.
+/// clamped into the new bounds, the new mean on low-confidence samples, each `τ_i` clamped into
+/// `[0, max_{j<i}(τ_j + |ψ_Ej|)]` (for two robots `[0, |ψ_E1|]`). `None` for a schedule of
+/// the wrong shape or warps of the wrong length.
 pub(crate) fn repair(problem: &Problem, previous: &Schedule, tick_s: f64) -> Option<Schedule> {
     let n_ref = problem.n_ref();
-    if previous.grad_exec.iter().any(|g| g.len() != n_ref) {
+    if previous.check_shape().is_err() || previous.grad_exec.iter().any(|g| g.len() != n_ref) {
         return None;
     }
-    let warps = previous.grad_exec.each_ref().map(|g| {
-        (0..n_ref)
-            .map(|n| {
-                if problem.conf()[n] {
-                    let x = if g[n].is_finite() {
-                        g[n]
+    let warps: Vec<Vec<f64>> = previous
+        .grad_exec
+        .iter()
+        .map(|g| {
+            (0..n_ref)
+                .map(|n| {
+                    if problem.conf()[n] {
+                        let x = if g[n].is_finite() {
+                            g[n]
+                        } else {
+                            problem.grad_mean()[n]
+                        };
+                        x.clamp(problem.grad_min()[n], problem.grad_max()[n])
                     } else {
                         problem.grad_mean()[n]
-                    };
-                    x.clamp(problem.grad_min()[n], problem.grad_max()[n])
-                } else {
-                    problem.grad_mean()[n]
-                }
-            })
-            .collect::<Vec<f64>>()
-    });
-    let max_s = clock_end_s(&warps[0], 0.0, problem.dt_s());
-    let offset_s = if previous.offset_s.is_finite() {
-        previous.offset_s.clamp(0.0, max_s)
-    } else {
-        max_s
-    };
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let dt_s = problem.dt_s();
+    let mut latest_end_s = clock_end_s(&warps[0], 0.0, dt_s);
+    let mut offsets_s = Vec::with_capacity(previous.offsets_s.len());
+    for (warp, &offset_s) in warps[1..].iter().zip(&previous.offsets_s) {
+        let offset_s = if offset_s.is_finite() {
+            offset_s.clamp(0.0, latest_end_s)
+        } else {
+            latest_end_s
+        };
+        offsets_s.push(offset_s);
+        latest_end_s = latest_end_s.max(clock_end_s(warp, offset_s, dt_s));
+    }
     Some(Schedule {
         grad_exec: warps,
-        offset_s,
+        offsets_s,
         tick_s,
     })
 }

@@ -55,11 +55,15 @@ pub enum Error {
         /// Why the serial schedule failed.
         serial: Violation,
     },
+    /// The schedule does not have `1 ≤ N ≤ MAX_ROBOTS` warps and `N − 1` start offsets
+    /// ([`crate::Schedule::check_shape`]).
+    #[error("schedule of the wrong shape: {0}")]
+    Shape(Violation),
     /// One robot's plan cannot be laid out in schedule-clock time (Eq. 15–16): a warp of the
     /// wrong length, a non-finite value or a gradient outside its bounds.
     #[error("robot {}: {source}", .robot + 1)]
     Timeline {
-        /// Robot index (0 = first robot, 1 = second).
+        /// Robot index (0 = first robot).
         robot: usize,
         /// What the realtime crate rejected.
         source: tandem_realtime::Error,

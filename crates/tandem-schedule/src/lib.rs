@@ -3,7 +3,7 @@
 //! A [`Problem`] holds, per reference sample `n` (period `Δt_s`), whether the learned model is
 //! high-confidence (Eq. 12) and the mean, minimum and maximum demonstration warp gradients
 //! (Eq. 14). A [`Schedule`] gives each robot an execution warp (one gradient per reference
-//! sample) and robot 2 a start offset `τ`. [`GlobalTimeline`] lays a schedule out in global
+//! sample) and robots 2..N start offsets `τ_i`. [`GlobalTimeline`] lays a schedule out in global
 //! time (Eq. 15, 16, 19), [`Schedule::t_total_s`] is Eq. 13, [`validate`] checks every
 //! constraint of Eq. 20 (the margin check of Alg. 2 through `tandem_realtime`), and
 //! [`sample_schedule`] is the scheduler: the paper's anytime sampler — robot 1's speeds are
@@ -50,7 +50,7 @@ pub use error::{Error, Result};
 pub use exact::{ExactParams, MarginFree, SearchStats, earliest_schedule, solve_exact};
 pub use problem::Problem;
 pub use sampler::{DrawnOffset, SamplerBaselines, SamplerParams, SamplerStats};
-pub use schedule::{GlobalTimeline, Schedule};
+pub use schedule::{GlobalTimeline, LcOverlap, Schedule};
 pub use tandem_confidence::Run;
 pub use tandem_realtime::LcInterval;
 pub use validate::{MarginCheck, Violation, validate};

@@ -172,35 +172,68 @@ impl Problem {
             .collect()
     }
 
-    /// The fastest serial schedule (§II-C fallback) for control tick `tick_s` (real s): both
-    /// robots on [`Problem::fastest_warp`], robot 2 starting when robot 1 ends
-    /// (`τ = |ψ_E1|`). Its `T_total` is twice the fastest single execution. It satisfies every
-    /// constraint of Eq. 20 at any tick: no low-confidence overlap is possible, since robot 2
-    /// starts only once robot 1 has finished.
+    /// The fastest serial schedule of two robots (§II-C fallback) for control tick `tick_s`
+    /// (real s): [`Problem::serial_schedule_n`] with `N = 2`. Its `T_total` is twice the
+    /// fastest single execution.
     ///
     /// # Errors
     /// [`Error::BadParam`] for a `tick_s` that is not finite and > 0.
     pub fn serial_schedule(&self, tick_s: f64) -> Result<Schedule> {
+        self.serial_schedule_n(2, tick_s)
+    }
+
+    /// The fastest serial schedule of `n_robots` robots for control tick `tick_s` (real s):
+    /// every robot on [`Problem::fastest_warp`], robot `i + 1` starting when robot `i` ends
+    /// (`τ_{i+1} = τ_i + |ψ_E|`). Its `T_total` is `N` times the fastest single execution. It
+    /// satisfies every constraint of Eq. 20 at any tick: no low-confidence overlap is
+    /// possible, since each robot starts only once the one before it has finished.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for a `tick_s` that is not finite and > 0, or `n_robots` not in
+    /// `1..=MAX_ROBOTS`.
+    pub fn serial_schedule_n(&self, n_robots: usize, tick_s: f64) -> Result<Schedule> {
         if !(tick_s.is_finite() && tick_s > 0.0) {
             return Err(Error::BadParam {
                 name: "tick_s",
                 why: "must be finite and > 0",
             });
         }
+        check_robot_count(n_robots)?;
         let warp = self.fastest_warp();
-        // τ must not precede robot 1's end on the clock the coordinator and the margin check
-        // run (`clock_end_s`, summed sample by sample). It is the later of that end and the
-        // closed form `Σ ψ̇·Δt` of Eq. 13, which differ by rounding only: robot 2 starts at
-        // robot 1's end or a few ulps after it, never before. (Taking the clock end alone
-        // moves robot 2's first tick in some serial schedules and with it every later pair
-        // of the study; this keeps the study's executions bit-identical to the closed form
-        // used before the clock had one owner.)
-        let offset_s = tandem_realtime::clock_end_s(&warp, 0.0, self.dt_s)
-            .max(warp.iter().sum::<f64>() * self.dt_s);
+        // Each start must not precede the previous robot's end on the clock the coordinator
+        // and the margin check run (`clock_end_s`, summed sample by sample). It is the later
+        // of that end and the closed form `τ + Σ ψ̇·Δt` of Eq. 13, which differ by rounding
+        // only: a robot starts at the previous robot's end or a few ulps after it, never
+        // before. (Taking the clock end alone moves robot 2's first tick in some serial
+        // schedules and with it every later pair of the study; this keeps the study's
+        // executions bit-identical to the closed form used before the clock had one owner.)
+        let duration_s = warp.iter().sum::<f64>() * self.dt_s;
+        let mut offsets_s = Vec::with_capacity(n_robots - 1);
+        let mut start_s = 0.0;
+        for _ in 1..n_robots {
+            start_s =
+                tandem_realtime::clock_end_s(&warp, start_s, self.dt_s).max(start_s + duration_s);
+            offsets_s.push(start_s);
+        }
         Ok(Schedule {
-            grad_exec: [warp.clone(), warp],
-            offset_s,
+            grad_exec: vec![warp; n_robots],
+            offsets_s,
             tick_s,
+        })
+    }
+}
+
+/// Checks a robot count `N`: `1 ≤ N ≤ MAX_ROBOTS` (`tandem_realtime::MAX_ROBOTS`).
+///
+/// # Errors
+/// [`Error::BadParam`] naming `n_robots`.
+pub(crate) fn check_robot_count(n_robots: usize) -> Result<()> {
+    if (1..=tandem_realtime::MAX_ROBOTS).contains(&n_robots) {
+        Ok(())
+    } else {
+        Err(Error::BadParam {
+            name: "n_robots",
+            why: "must be in 1..=8 (tandem_realtime::MAX_ROBOTS)",
         })
     }
 }
@@ -258,15 +291,42 @@ mod tests {
         let s = ok().serial_schedule(0.005).unwrap();
         assert_eq!(s.grad_exec[0], vec![0.5, 1.0, 1.0, 0.5]);
         assert_eq!(s.tick_s, 0.005);
-        assert!((s.offset_s - 0.03).abs() < 1e-12);
+        assert!((s.offsets_s[0] - 0.03).abs() < 1e-12);
         // Robot 2 starts where robot 1's clock ends (or an ulp later).
-        assert!(s.offset_s >= s.ends_s(0.01)[0] && s.offset_s - s.ends_s(0.01)[0] < 1e-15);
+        assert!(s.offsets_s[0] >= s.ends_s(0.01)[0] && s.offsets_s[0] - s.ends_s(0.01)[0] < 1e-15);
         assert_eq!(s.t_total_s(0.01), s.ends_s(0.01)[1]);
         assert!((s.t_total_s(0.01) - 0.06).abs() < 1e-12);
         for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
             assert!(matches!(
                 ok().serial_schedule(bad),
                 Err(Error::BadParam { name: "tick_s", .. })
+            ));
+        }
+    }
+
+    #[test]
+    fn serial_schedule_of_n_robots_by_hand() {
+        // Each robot takes 0.03 s and starts when the one before ends: T_total = N·0.03 s.
+        for n in 1..=tandem_realtime::MAX_ROBOTS {
+            let s = ok().serial_schedule_n(n, 0.01).unwrap();
+            assert_eq!((s.n_robots(), s.offsets_s.len()), (n, n - 1));
+            let ends = s.ends_s(0.01);
+            for i in 1..n {
+                assert!(s.start_s(i) >= ends[i - 1] && s.start_s(i) - ends[i - 1] < 1e-15);
+            }
+            assert!((s.t_total_s(0.01) - 0.03 * n as f64).abs() < 1e-12);
+        }
+        assert_eq!(
+            ok().serial_schedule_n(2, 0.01).unwrap(),
+            ok().serial_schedule(0.01).unwrap()
+        );
+        for bad in [0, tandem_realtime::MAX_ROBOTS + 1] {
+            assert!(matches!(
+                ok().serial_schedule_n(bad, 0.01),
+                Err(Error::BadParam {
+                    name: "n_robots",
+                    ..
+                })
             ));
         }
     }

@@ -464,10 +464,11 @@ impl<'a> Sampler<'a> {
         }
         let warm = match (
             offset,
-            previous.and_then(|prev| repair(problem, prev, tick_s)),
+            previous
+                .and_then(|prev| repair(problem, prev, tick_s))
+                .and_then(|fixed| fixed.grad_exec.into_iter().next()),
         ) {
-            (OffsetSampling::Fitted { .. }, Some(fixed)) => {
-                let [warp, _] = fixed.grad_exec;
+            (OffsetSampling::Fitted { .. }, Some(warp)) => {
                 let (lc, dur_s) = lc_of_warp(problem, &warp);
                 Some(Warm { warp, lc, dur_s })
             }
@@ -736,7 +737,7 @@ impl Sampler<'_> {
             self.problem.grad_mean(),
         );
         let n_ref = self.problem.n_ref();
-        let mut warps = [Vec::with_capacity(n_ref), Vec::with_capacity(n_ref)];
+        let mut warps = vec![Vec::with_capacity(n_ref), Vec::with_capacity(n_ref)];
         for (robot, (warp, factors)) in warps.iter_mut().zip(&scratch.factors).enumerate() {
             if robot == 0
                 && k >= self.params.samples as u64
@@ -761,7 +762,7 @@ impl Sampler<'_> {
         }
         Some(Schedule {
             grad_exec: warps,
-            offset_s: d.offset_s?,
+            offsets_s: vec![d.offset_s?],
             tick_s: self.tick_s,
         })
     }

@@ -5,107 +5,160 @@
 //! intervals agree to the last bit with what the margin check and the coordinator use.
 
 use serde::{Deserialize, Serialize};
-use tandem_realtime::{Coordinator, LcInterval, Timeline, clock_end_s, tol};
+use tandem_realtime::{Coordinator, LcInterval, MAX_ROBOTS, Timeline, clock_end_s, tol};
 
 use crate::problem::Problem;
+use crate::validate::Violation;
 use crate::{Error, Result};
 
-/// A two-robot schedule: one execution warp per robot, the offset of robot 2 (§II-B4) and
-/// the control tick it was checked with.
+/// A schedule of `N` robots (`1 ≤ N ≤` [`MAX_ROBOTS`]) doing the same task under one
+/// operator: one execution warp per robot, the start offsets of robots 2..N (§II-B4; robot 1
+/// starts at 0) and the control tick it was checked with.
 ///
-/// Robot index 0 is the first robot (`τ_1 = 0`), index 1 the second (`τ_2 = offset_s`).
-/// Check a schedule against a [`Problem`] with [`crate::validate`] (at its own tick), run
-/// it with [`Schedule::coordinator`] (at its own tick).
+/// Robot index 0 is the first robot (`τ_1 = 0`), index `i ≥ 1` starts at
+/// `τ_{i+1} = offsets_s[i − 1]`; for two robots `offsets_s = [τ]`. Check a schedule against a
+/// [`Problem`] with [`crate::validate`] (at its own tick), run it with
+/// [`Schedule::coordinator`] (at its own tick).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Schedule {
-    /// Execution warp gradients `ψ̇_Ei[n]` per robot and reference sample `n` (execution samples
-    /// per reference sample; robot `i` spends `ψ̇_Ei[n]·Δt_s` seconds on reference sample `n`).
-    pub grad_exec: [Vec<f64>; 2],
-    /// Offset `τ` (s, global time) at which robot 2 starts; `0 ≤ τ ≤ |ψ_E1|` (Eq. 20).
-    pub offset_s: f64,
+    /// Execution warp gradients `ψ̇_Ei[n]` per robot `i` (`N ≥ 1` warps, each of length `T_ref`)
+    /// and reference sample `n` (execution samples per reference sample; robot `i` spends
+    /// `ψ̇_Ei[n]·Δt_s` seconds on reference sample `n`).
+    pub grad_exec: Vec<Vec<f64>>,
+    /// Start offsets `τ_i` (s, global time) of robots 2..N (length `N − 1`; robot 1 starts at
+    /// 0), each finite with `0 ≤ τ_i ≤ max_{j<i}(τ_j + |ψ_Ej|)` (Eq. 20 constraint 2: for two
+    /// robots `0 ≤ τ ≤ |ψ_E1|`).
+    pub offsets_s: Vec<f64>,
     /// Control tick (real s, finite and > 0) of the margin check (Alg. 2, Eq. 20 constraint
     /// 5) that accepted the schedule, and so the only period at which the [`Coordinator`] may
-    /// run it: the check's guarantee (never both robots low-confidence in one tick) holds for
+    /// run it: the check's guarantee (never two robots low-confidence in one tick) holds for
     /// this tick, not for another.
     pub tick_s: f64,
 }
 
 impl Schedule {
+    /// Number of robots `N` (the number of warps).
+    pub fn n_robots(&self) -> usize {
+        self.grad_exec.len()
+    }
+
+    /// Start time `τ_i` (s, global time) of robot `robot` (0-based): 0 for robot 0,
+    /// `offsets_s[robot − 1]` otherwise; NaN for a robot without an offset (which
+    /// [`Schedule::check_shape`] rejects).
+    pub fn start_s(&self, robot: usize) -> f64 {
+        match robot {
+            0 => 0.0,
+            i => self.offsets_s.get(i - 1).copied().unwrap_or(f64::NAN),
+        }
+    }
+
+    /// Checks the schedule's shape: `1 ≤ N ≤` [`MAX_ROBOTS`] warps and `N − 1` offsets (the
+    /// offsets' range, Eq. 20 constraint 2, and the warps' lengths are [`crate::validate`]'s).
+    ///
+    /// # Errors
+    /// [`Violation::RobotCount`] or [`Violation::OffsetCount`].
+    pub fn check_shape(&self) -> std::result::Result<(), Violation> {
+        let n = self.n_robots();
+        if !(1..=MAX_ROBOTS).contains(&n) {
+            return Err(Violation::RobotCount {
+                n_robots: n,
+                max: MAX_ROBOTS,
+            });
+        }
+        if self.offsets_s.len() + 1 != n {
+            return Err(Violation::OffsetCount {
+                found: self.offsets_s.len(),
+                expected: n - 1,
+            });
+        }
+        Ok(())
+    }
+
     /// Each robot's [`Timeline`] (schedule-clock plan for the real-time coordinator and the
     /// margin check, Eq. 15–16) on `problem`, built from the schedule's own gradients: the
     /// realtime crate accepts gradients within [`tol::GRADIENT_REL`] of the bounds, as
     /// [`crate::validate`] does.
     ///
     /// # Errors
+    /// [`Error::Shape`] for a schedule that fails [`Schedule::check_shape`];
     /// [`Error::Timeline`] naming the robot, for a warp whose length is not `T_ref`, a
     /// non-finite value or a gradient outside its bounds.
-    pub fn timelines(&self, problem: &Problem) -> Result<[Timeline; 2]> {
+    pub fn timelines(&self, problem: &Problem) -> Result<Vec<Timeline>> {
+        self.check_shape().map_err(Error::Shape)?;
         self.timelines_of(problem)
             .map_err(|(robot, source)| Error::Timeline { robot, source })
     }
 
-    /// [`Schedule::timelines`] with the failing robot's index beside the realtime error.
+    /// [`Schedule::timelines`] of a schedule of valid shape, with the failing robot's index
+    /// beside the realtime error.
     pub(crate) fn timelines_of(
         &self,
         problem: &Problem,
-    ) -> std::result::Result<[Timeline; 2], (usize, tandem_realtime::Error)> {
-        let build = |robot: usize| {
-            Timeline::new(
-                problem.conf(),
-                &self.grad_exec[robot],
-                problem.grad_min(),
-                problem.grad_max(),
-                self.starts_s()[robot],
-                problem.dt_s(),
-            )
-            .map_err(|e| (robot, e))
-        };
-        Ok([build(0)?, build(1)?])
+    ) -> std::result::Result<Vec<Timeline>, (usize, tandem_realtime::Error)> {
+        (0..self.n_robots())
+            .map(|robot| {
+                Timeline::new(
+                    problem.conf(),
+                    &self.grad_exec[robot],
+                    problem.grad_min(),
+                    problem.grad_max(),
+                    self.start_s(robot),
+                    problem.dt_s(),
+                )
+                .map_err(|e| (robot, e))
+            })
+            .collect()
     }
 
-    /// The runtime coordinator of this schedule on `problem` (§II-B5): both robots'
-    /// [`Timeline`]s, advanced one control tick of [`Schedule::tick_s`] real seconds per
+    /// The runtime coordinator of this schedule on `problem` (§II-B5): every robot's
+    /// [`Timeline`], advanced one control tick of [`Schedule::tick_s`] real seconds per
     /// [`Coordinator::tick`].
     ///
     /// # Errors
-    /// [`Error::Timeline`] as [`Schedule::timelines`]; [`Error::Realtime`] for a tick that is
-    /// not finite and > 0.
+    /// [`Error::Shape`] and [`Error::Timeline`] as [`Schedule::timelines`];
+    /// [`Error::Realtime`] for a tick that is not finite and > 0.
     pub fn coordinator(&self, problem: &Problem) -> Result<Coordinator> {
         Ok(Coordinator::new(self.timelines(problem)?, self.tick_s)?)
     }
 
-    /// Start time of each robot in global time (s): `[0, τ]`.
-    pub fn starts_s(&self) -> [f64; 2] {
-        [0.0, self.offset_s]
+    /// Start time of each robot in global time (s): `[0, τ_2, …, τ_N]`.
+    pub fn starts_s(&self) -> Vec<f64> {
+        (0..self.n_robots()).map(|i| self.start_s(i)).collect()
     }
 
-    /// Execution durations `[|ψ_E1|, |ψ_E2|]` (s) for reference sample period `dt_s` (s): the
+    /// Execution durations `|ψ_Ei|` (s) per robot for reference sample period `dt_s` (s): the
     /// end of each warp's clock started at 0 ([`clock_end_s`]).
-    pub fn durations_s(&self, dt_s: f64) -> [f64; 2] {
-        [
-            clock_end_s(&self.grad_exec[0], 0.0, dt_s),
-            clock_end_s(&self.grad_exec[1], 0.0, dt_s),
-        ]
+    pub fn durations_s(&self, dt_s: f64) -> Vec<f64> {
+        self.grad_exec
+            .iter()
+            .map(|g| clock_end_s(g, 0.0, dt_s))
+            .collect()
     }
 
-    /// Global time (s) at which each robot ends on schedule, `[|ψ_E1|, τ + |ψ_E2|]`, for
-    /// sample period `dt_s` (s): the end of its clock started at its start ([`clock_end_s`]),
-    /// exactly [`Timeline::end_s`] of [`Schedule::timelines`].
-    pub fn ends_s(&self, dt_s: f64) -> [f64; 2] {
-        let starts = self.starts_s();
-        [0, 1].map(|i| clock_end_s(&self.grad_exec[i], starts[i], dt_s))
+    /// Global time (s) at which each robot ends on schedule, `τ_i + |ψ_Ei|`, for sample period
+    /// `dt_s` (s): the end of its clock started at its start ([`clock_end_s`]), exactly
+    /// [`Timeline::end_s`] of [`Schedule::timelines`].
+    pub fn ends_s(&self, dt_s: f64) -> Vec<f64> {
+        (0..self.n_robots()).map(|i| self.end_s(i, dt_s)).collect()
     }
 
-    /// `T_total = max(|ψ_E1|, τ + |ψ_E2|)` (Eq. 13), global time (s), for sample period `dt_s`:
-    /// the later of [`Schedule::ends_s`].
+    /// Global time (s) at which robot `robot` ends on schedule, `τ_i + |ψ_Ei|`, for sample
+    /// period `dt_s` (s) (one entry of [`Schedule::ends_s`]).
+    pub fn end_s(&self, robot: usize, dt_s: f64) -> f64 {
+        clock_end_s(&self.grad_exec[robot], self.start_s(robot), dt_s)
+    }
+
+    /// `T_total = max_i(τ_i + |ψ_Ei|)` (Eq. 13), global time (s), for sample period `dt_s`:
+    /// the latest of [`Schedule::ends_s`].
     pub fn t_total_s(&self, dt_s: f64) -> f64 {
-        let [e0, e1] = self.ends_s(dt_s);
-        e0.max(e1)
+        (0..self.n_robots())
+            .map(|i| self.end_s(i, dt_s))
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 }
 
-/// The global timeline of a schedule (Eq. 15–16, 19): a view of both robots' [`Timeline`]s
+/// The global timeline of a schedule (Eq. 15–16, 19): a view of every robot's [`Timeline`]
 /// (built once by [`Schedule::timelines`]) that says where each robot is in the reference at
 /// any global time, its confidence then, and every low-confidence interval in global time.
 ///
@@ -113,12 +166,35 @@ impl Schedule {
 /// ([`tandem_realtime::clock_s`], started at `τ_i`).
 #[derive(Clone, Debug)]
 pub struct GlobalTimeline {
-    robots: [Timeline; 2],
+    robots: Vec<Timeline>,
 }
 
-impl From<[Timeline; 2]> for GlobalTimeline {
-    fn from(robots: [Timeline; 2]) -> Self {
+impl From<Vec<Timeline>> for GlobalTimeline {
+    fn from(robots: Vec<Timeline>) -> Self {
         GlobalTimeline { robots }
+    }
+}
+
+/// Two robots scheduled low-confidence at once (Eq. 20 constraint 3): robot `robots[0]` in
+/// `intervals[0]` and robot `robots[1]` in `intervals[1]` (global time), `robots[0] <
+/// robots[1]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LcOverlap {
+    /// The two robots (0-based, ascending).
+    pub robots: [usize; 2],
+    /// Their overlapping low-confidence intervals (global time, s), in the order of `robots`.
+    pub intervals: [LcInterval; 2],
+}
+
+impl LcOverlap {
+    /// Global time (s) at which the overlap starts.
+    pub fn start_s(&self) -> f64 {
+        self.intervals[0].start_s.max(self.intervals[1].start_s)
+    }
+
+    /// Global time (s) at which the overlap ends.
+    pub fn end_s(&self) -> f64 {
+        self.intervals[0].end_s.min(self.intervals[1].end_s)
     }
 }
 
@@ -126,70 +202,112 @@ impl GlobalTimeline {
     /// Lays `schedule` out in global time for `problem` ([`Schedule::timelines`]).
     ///
     /// # Errors
-    /// [`Error::Timeline`] naming the robot whose warp has the wrong length, a non-finite
-    /// value, or a gradient outside its bounds.
+    /// As [`Schedule::timelines`]: a schedule of the wrong shape, or [`Error::Timeline`]
+    /// naming the robot whose warp has the wrong length, a non-finite value, or a gradient
+    /// outside its bounds.
     pub fn new(problem: &Problem, schedule: &Schedule) -> Result<Self> {
         Ok(schedule.timelines(problem)?.into())
     }
 
-    /// Both robots' timelines (robot 1, robot 2).
-    pub fn timelines(&self) -> &[Timeline; 2] {
+    /// Number of robots `N`.
+    pub fn n_robots(&self) -> usize {
+        self.robots.len()
+    }
+
+    /// Every robot's timeline (robot 1 first).
+    pub fn timelines(&self) -> &[Timeline] {
         &self.robots
     }
 
     /// Each robot's `[start, end]` in global time (s).
-    pub fn spans_s(&self) -> [(f64, f64); 2] {
-        self.robots.each_ref().map(|r| (r.start_s(), r.end_s()))
+    pub fn spans_s(&self) -> Vec<(f64, f64)> {
+        self.robots
+            .iter()
+            .map(|r| (r.start_s(), r.end_s()))
+            .collect()
     }
 
-    /// `T_total` (Eq. 13), global time (s): the later end.
+    /// `T_total` (Eq. 13), global time (s): the latest end.
     pub fn t_total_s(&self) -> f64 {
-        self.robots[0].end_s().max(self.robots[1].end_s())
+        self.robots
+            .iter()
+            .map(Timeline::end_s)
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// Eq. 15: robot `robot`'s fractional reference time (reference samples, in `[0, T_ref]`)
     /// at global time `t_global_s`: 0 before its start, `T_ref` after its end, linear within
-    /// each reference sample in between. `robot` > 1 is treated as robot 1.
+    /// each reference sample in between. `robot ≥ N` is treated as the last robot.
     pub fn ref_time(&self, robot: usize, t_global_s: f64) -> f64 {
-        self.robots[robot.min(1)].ref_time_at(t_global_s)
+        self.robots[robot.min(self.robots.len() - 1)].ref_time_at(t_global_s)
     }
 
-    /// Eq. 16: `[conf_1(t), conf_2(t)]` at global time `t_global_s` (`true` = high confidence;
-    /// a robot that is not running, `t < τ_i` or `t ≥ τ_i + |ψ_Ei|`, counts as high).
-    pub fn conf_at(&self, t_global_s: f64) -> [bool; 2] {
-        self.robots.each_ref().map(|r| r.conf_at(t_global_s))
+    /// Eq. 16: `conf_i(t)` of every robot at global time `t_global_s` (`true` = high
+    /// confidence; a robot that is not running, `t < τ_i` or `t ≥ τ_i + |ψ_Ei|`, counts as
+    /// high).
+    pub fn conf_at(&self, t_global_s: f64) -> Vec<bool> {
+        self.robots.iter().map(|r| r.conf_at(t_global_s)).collect()
     }
 
     /// Each robot's low-confidence intervals in global time, in time order (Eq. 19: their
     /// union is `T_lc`).
-    pub fn lc_intervals(&self) -> [&[LcInterval]; 2] {
-        self.robots.each_ref().map(Timeline::lc_intervals)
+    pub fn lc_intervals(&self) -> Vec<&[LcInterval]> {
+        self.robots.iter().map(Timeline::lc_intervals).collect()
     }
 
-    /// The first stretch of global time in which both robots are scheduled low-confidence
-    /// (Eq. 20 constraint 3), as `(robot 1's interval, robot 2's interval)`, or `None`.
+    /// The first stretch of global time in which two robots are scheduled low-confidence
+    /// (Eq. 20 constraint 3), or `None`: of every pair of robots the first overlap in time,
+    /// and of those the one starting earliest (the lower pair of robots on a tie).
     ///
-    /// Intervals are half-open, so one robot may enter a low-confidence run exactly when the
-    /// other leaves one. An overlap shorter than [`tol::overlap_tolerance_s`]`(T_total)` is
+    /// Intervals are half-open, so one robot may enter a low-confidence run exactly when
+    /// another leaves one. An overlap shorter than [`tol::overlap_tolerance_s`]`(T_total)` is
     /// treated as rounding and ignored.
-    pub fn first_lc_overlap(&self) -> Option<(LcInterval, LcInterval)> {
+    pub fn first_lc_overlap(&self) -> Option<LcOverlap> {
         let eps = tol::overlap_tolerance_s(self.t_total_s());
-        let [a, b] = self.lc_intervals();
-        let (mut i, mut j) = (0, 0);
-        // Two-pointer merge: each robot's intervals are disjoint and in time order, so the
-        // intersections come out in time order and the first one found is the earliest.
-        while i < a.len() && j < b.len() {
-            if a[i].overlap_s(&b[j]) > eps {
-                return Some((a[i], b[j]));
-            }
-            if a[i].end_s <= b[j].end_s {
-                i += 1;
-            } else {
-                j += 1;
+        let mut first: Option<LcOverlap> = None;
+        for i in 0..self.robots.len() {
+            for j in i + 1..self.robots.len() {
+                let found = first_overlap_of(
+                    self.robots[i].lc_intervals(),
+                    self.robots[j].lc_intervals(),
+                    eps,
+                );
+                if let Some((a, b)) = found {
+                    let o = LcOverlap {
+                        robots: [i, j],
+                        intervals: [a, b],
+                    };
+                    if first.is_none_or(|f| o.start_s() < f.start_s()) {
+                        first = Some(o);
+                    }
+                }
             }
         }
-        None
+        first
     }
+}
+
+/// The first pair of intervals of `a` and `b` (each disjoint and in time order) that overlap
+/// by more than `eps` (s).
+fn first_overlap_of(
+    a: &[LcInterval],
+    b: &[LcInterval],
+    eps: f64,
+) -> Option<(LcInterval, LcInterval)> {
+    let (mut i, mut j) = (0, 0);
+    // Two-pointer merge: each robot's intervals are disjoint and in time order, so the
+    // intersections come out in time order and the first one found is the earliest.
+    while i < a.len() && j < b.len() {
+        if a[i].overlap_s(&b[j]) > eps {
+            return Some((a[i], b[j]));
+        }
+        if a[i].end_s <= b[j].end_s {
+            i += 1;
+        } else {
+            j += 1;
+        }
+    }
+    None
 }
 
 #[cfg(test)]
@@ -203,8 +321,8 @@ mod tests {
 
     fn schedule(offset_s: f64) -> Schedule {
         Schedule {
-            grad_exec: [vec![2.0, 1.0, 1.0, 0.5], vec![0.5, 1.0, 1.0, 2.0]],
-            offset_s,
+            grad_exec: vec![vec![2.0, 1.0, 1.0, 0.5], vec![0.5, 1.0, 1.0, 2.0]],
+            offsets_s: vec![offset_s],
             tick_s: 0.5,
         }
     }
@@ -214,7 +332,7 @@ mod tests {
         // 2.0 + 1e-12 is just above ψ̇max = 2: within the gradient tolerance, kept as it is.
         let mut s = schedule(1.0);
         s.grad_exec[0][0] = 2.0 + 1e-12;
-        let [r1, r2] = s.timelines(&problem()).unwrap();
+        let [r1, r2]: [Timeline; 2] = s.timelines(&problem()).unwrap().try_into().unwrap();
         assert_eq!((r1.start_s(), r2.start_s()), (0.0, 1.0));
         assert_eq!(r1.grad_exec()[0], 2.0 + 1e-12);
         assert_eq!(r1.end_s(), s.ends_s(0.5)[0]);
@@ -239,6 +357,7 @@ mod tests {
         // |ψ_E1| = 4.5·0.5 = 2.25 s, |ψ_E2| = 2.25 s.
         let s = schedule(1.0);
         assert_eq!(s.durations_s(0.5), [2.25, 2.25]);
+        assert_eq!((s.n_robots(), s.start_s(0), s.start_s(1)), (2, 0.0, 1.0));
         assert_eq!(s.ends_s(0.5), [2.25, 3.25]);
         assert_eq!(s.t_total_s(0.5), 3.25);
         assert_eq!(schedule(0.0).t_total_s(0.5), 2.25);
@@ -249,11 +368,19 @@ mod tests {
         // Robot 1: sample 0 takes 1 s, LC samples 1..3 take 0.5 s each → [1, 2).
         // Robot 2 (τ = 1.25): sample 0 takes 0.25 s → LC [1.5, 2.5).
         let g = GlobalTimeline::new(&problem(), &schedule(1.25)).unwrap();
-        let [a, b] = g.lc_intervals();
+        let [a, b] = g.lc_intervals()[..] else {
+            panic!("two robots")
+        };
         assert_eq!((a[0].start_s, a[0].end_s), (1.0, 2.0));
         assert_eq!((b[0].start_s, b[0].end_s), (1.5, 2.5));
         assert_eq!((b[0].ref_start, b[0].ref_end), (1, 3));
-        assert_eq!(g.first_lc_overlap(), Some((a[0], b[0])));
+        assert_eq!(
+            g.first_lc_overlap(),
+            Some(LcOverlap {
+                robots: [0, 1],
+                intervals: [a[0], b[0]]
+            })
+        );
         // Touching is not overlapping: τ = 1.75 puts robot 2's LC at [2, 3).
         let g = GlobalTimeline::new(&problem(), &schedule(1.75)).unwrap();
         assert_eq!(g.lc_intervals()[1][0].start_s, 2.0);

@@ -7,10 +7,29 @@ use crate::schedule::{GlobalTimeline, Schedule};
 
 /// The first constraint of Eq. 20 that a schedule breaks.
 ///
-/// Robot indices: 0 = first robot (starts at 0), 1 = second robot (starts at `τ`).
+/// Robot indices: 0 = first robot (starts at 0), `i ≥ 1` starts at `τ_{i+1}` (for two robots
+/// 1 = the second robot, starting at `τ`).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum Violation {
+    /// The schedule has no robot or more than `MAX_ROBOTS` (`tandem_realtime::MAX_ROBOTS`).
+    #[error("the schedule has {n_robots} robots; 1 to {max} are supported")]
+    RobotCount {
+        /// Number of warps in the schedule.
+        n_robots: usize,
+        /// The largest supported count.
+        max: usize,
+    },
+    /// The schedule does not have one start offset per robot after the first.
+    #[error(
+        "the schedule has {found} start offsets, expected {expected} (one per robot after the first)"
+    )]
+    OffsetCount {
+        /// Number of offsets in the schedule.
+        found: usize,
+        /// `N − 1`.
+        expected: usize,
+    },
     /// A warp does not have one gradient per reference sample.
     #[error(
         "robot {robot}: execution warp has {len} gradients, the problem has {expected} reference samples"
@@ -39,26 +58,34 @@ pub enum Violation {
         /// `ψ̇max[n]`.
         max: f64,
     },
-    /// Constraint 2: `0 ≤ τ ≤ |ψ_E1|` (also raised for a non-finite offset).
-    #[error("offset τ = {offset_s} s outside [0, |ψ_E1| = {max_s} s] (Eq. 20, constraint 2)")]
+    /// Constraint 2: `0 ≤ τ_i ≤ max_{j<i}(τ_j + |ψ_Ej|)` — for two robots `0 ≤ τ ≤ |ψ_E1|`
+    /// (also raised for a non-finite offset).
+    #[error(
+        "robot {}: offset τ = {offset_s} s outside [0, {max_s} s] (the latest end of the robots before it; for two robots |ψ_E1|) (Eq. 20, constraint 2)",
+        .robot + 1
+    )]
     Offset {
-        /// The schedule's `τ` (s).
+        /// Robot index (≥ 1).
+        robot: usize,
+        /// The robot's offset `τ_i` (s).
         offset_s: f64,
-        /// `|ψ_E1|` (s).
+        /// `max_{j<i}(τ_j + |ψ_Ej|)` (s; `|ψ_E1|` for two robots).
         max_s: f64,
     },
-    /// Constraint 3: both robots are scheduled low-confidence at once (global time).
+    /// Constraint 3: two robots are scheduled low-confidence at once (global time).
     #[error(
-        "both robots low-confidence from global time {start_s} s to {end_s} s (reference samples {:?} of robot 1, {:?} of robot 2) (Eq. 20, constraint 3)",
-        .ref_ranges[0], .ref_ranges[1]
+        "robots {} and {} both low-confidence from global time {start_s} s to {end_s} s (reference samples {:?} of robot {}, {:?} of robot {}) (Eq. 20, constraint 3)",
+        .robots[0] + 1, .robots[1] + 1, .ref_ranges[0], .robots[0] + 1, .ref_ranges[1], .robots[1] + 1
     )]
     BothLowConfidence {
+        /// The two robots (0-based, ascending).
+        robots: [usize; 2],
         /// Global time (s) at which the overlap starts.
         start_s: f64,
         /// Global time (s) at which the overlap ends.
         end_s: f64,
         /// The overlapping low-confidence runs, as reference sample ranges `(start, end)` of
-        /// robot 1 and robot 2.
+        /// the two robots, in the order of `robots`.
         ref_ranges: [(usize, usize); 2],
     },
     /// Constraint 4: a low-confidence sample does not follow the mean gradient.
@@ -94,7 +121,7 @@ pub enum Violation {
     /// neither constraint 3 nor the margin check can be evaluated.
     #[error("robot {}: cannot lay out the schedule: {source}", .robot + 1)]
     Timeline {
-        /// Robot index (0 = first robot, 1 = second).
+        /// Robot index (0 = first robot).
         robot: usize,
         /// What the realtime crate rejected.
         source: tandem_realtime::Error,
@@ -114,10 +141,12 @@ pub enum Violation {
 
 /// Checks every constraint of Eq. 20 at the schedule's own control tick
 /// ([`Schedule::tick_s`]) and names the first one broken, in this order: the tick (finite,
-/// positive), warp lengths, (1) gradient bounds (robot 1 then robot 2, in reference order),
-/// (2) offset `0 ≤ τ ≤ |ψ_E1|`, the layout of both robots in schedule-clock time, (3) no
-/// global time with both robots low-confidence, (4) mean gradient on low-confidence samples,
-/// (5) `tandem_realtime::sufficient_margins` at the schedule's tick.
+/// positive), the shape ([`Schedule::check_shape`]: `1 ≤ N ≤ MAX_ROBOTS` warps, `N − 1`
+/// offsets), warp lengths, (1) gradient bounds (robot by robot, in reference order),
+/// (2) offsets `0 ≤ τ_i ≤ max_{j<i}(τ_j + |ψ_Ej|)` (for two robots `0 ≤ τ ≤ |ψ_E1|`), the
+/// layout of every robot in schedule-clock time, (3) no global time with two robots
+/// low-confidence, (4) mean gradient on low-confidence samples, (5)
+/// `tandem_realtime::sufficient_margins` for all `N` robots at the schedule's tick.
 ///
 /// To re-check a schedule at another tick, set its `tick_s` first (the sampler does so for a
 /// previous schedule handed to it at a new tick): a schedule is valid *at its tick*.
@@ -174,6 +203,7 @@ pub(crate) fn validate_cheap(
     problem: &Problem,
     schedule: &Schedule,
 ) -> Result<GlobalTimeline, Violation> {
+    schedule.check_shape()?;
     let n_ref = problem.n_ref();
     for (robot, grad) in schedule.grad_exec.iter().enumerate() {
         if grad.len() != n_ref {
@@ -199,19 +229,29 @@ pub(crate) fn validate_cheap(
             }
         }
     }
-    let max_s = schedule.durations_s(problem.dt_s())[0];
-    let offset_s = schedule.offset_s;
-    if !tol::within_bounds(offset_s, 0.0, max_s) {
-        return Err(Violation::Offset { offset_s, max_s });
+    let dt_s = problem.dt_s();
+    let mut latest_end_s = schedule.end_s(0, dt_s);
+    for (i, &offset_s) in schedule.offsets_s.iter().enumerate() {
+        let robot = i + 1;
+        if !tol::within_bounds(offset_s, 0.0, latest_end_s) {
+            return Err(Violation::Offset {
+                robot,
+                offset_s,
+                max_s: latest_end_s,
+            });
+        }
+        latest_end_s = latest_end_s.max(schedule.end_s(robot, dt_s));
     }
     let timeline: GlobalTimeline = schedule
         .timelines_of(problem)
         .map_err(|(robot, source)| Violation::Timeline { robot, source })?
         .into();
-    if let Some((a, b)) = timeline.first_lc_overlap() {
+    if let Some(o) = timeline.first_lc_overlap() {
+        let [a, b] = o.intervals;
         return Err(Violation::BothLowConfidence {
-            start_s: a.start_s.max(b.start_s),
-            end_s: a.end_s.min(b.end_s),
+            robots: o.robots,
+            start_s: o.start_s(),
+            end_s: o.end_s(),
             ref_ranges: [(a.ref_start, a.ref_end), (b.ref_start, b.ref_end)],
         });
     }
@@ -280,13 +320,14 @@ mod tests {
         ));
 
         let mut s = ok_schedule();
-        s.offset_s = -0.1;
+        s.offsets_s[0] = -0.1;
         assert!(matches!(validate(&p, &s), Err(Violation::Offset { .. })));
         // |ψ_E1| = (0.5 + 1 + 1 + 0.5)·0.5 = 1.5 s.
-        s.offset_s = 1.6;
+        s.offsets_s[0] = 1.6;
         assert_eq!(
             validate(&p, &s),
             Err(Violation::Offset {
+                robot: 1,
                 offset_s: 1.6,
                 max_s: 1.5
             })
@@ -294,11 +335,12 @@ mod tests {
 
         // τ = 0: both robots reach the LC run at 0.25 s.
         let mut s = ok_schedule();
-        s.offset_s = 0.0;
+        s.offsets_s[0] = 0.0;
         let v = validate(&p, &s).unwrap_err();
         assert_eq!(
             v,
             Violation::BothLowConfidence {
+                robots: [0, 1],
                 start_s: 0.25,
                 end_s: 1.25,
                 ref_ranges: [(1, 3), (1, 3)]
@@ -326,11 +368,73 @@ mod tests {
     }
 
     #[test]
+    fn names_the_shape_and_the_robot_of_n_robot_schedules() {
+        let p = problem();
+        // Serial, three robots: each starts when the one before ends (1.5 s each).
+        let s = p.serial_schedule_n(3, 0.5).unwrap();
+        assert_eq!(validate(&p, &s), Ok(()));
+        let mut bad = s.clone();
+        bad.offsets_s.pop();
+        assert_eq!(
+            validate(&p, &bad),
+            Err(Violation::OffsetCount {
+                found: 1,
+                expected: 2
+            })
+        );
+        let mut bad = s.clone();
+        bad.grad_exec.clear();
+        bad.offsets_s.clear();
+        assert!(matches!(
+            validate(&p, &bad),
+            Err(Violation::RobotCount { n_robots: 0, .. })
+        ));
+        let mut bad = s.clone();
+        bad.grad_exec = vec![bad.grad_exec[0].clone(); 9];
+        bad.offsets_s = vec![0.0; 8];
+        assert!(matches!(
+            validate(&p, &bad),
+            Err(Violation::RobotCount { n_robots: 9, .. })
+        ));
+        // Robot 3 may start no later than the latest end before it, 3 s (robot 2's end).
+        let mut bad = s.clone();
+        bad.offsets_s[1] = 3.25;
+        assert_eq!(
+            validate(&p, &bad),
+            Err(Violation::Offset {
+                robot: 2,
+                offset_s: 3.25,
+                max_s: 3.0
+            })
+        );
+        bad.offsets_s[1] = f64::NAN;
+        assert!(matches!(
+            validate(&p, &bad),
+            Err(Violation::Offset { robot: 2, .. })
+        ));
+        // Robot 3 at 1.5 s runs its LC stretch together with robot 2's: named by both robots.
+        let mut bad = s.clone();
+        bad.offsets_s[1] = 1.5;
+        let v = validate(&p, &bad).unwrap_err();
+        assert!(
+            matches!(v, Violation::BothLowConfidence { robots: [1, 2], .. }),
+            "{v}"
+        );
+        assert!(v.to_string().starts_with("robots 2 and 3 "), "{v}");
+        // The layout errors of a wrong shape, from `timelines`, name it too.
+        bad.offsets_s.pop();
+        assert!(matches!(
+            bad.timelines(&p),
+            Err(crate::Error::Shape(Violation::OffsetCount { .. }))
+        ));
+    }
+
+    #[test]
     fn tolerates_rounding_only() {
         let p = problem();
         let mut s = ok_schedule();
         s.grad_exec[0][0] = 0.5 * (1.0 - 1e-12);
-        s.offset_s *= 1.0 + 1e-12;
+        s.offsets_s[0] *= 1.0 + 1e-12;
         assert!(validate_cheap(&p, &s).is_ok());
         s.grad_exec[0][0] = 0.5 * (1.0 - 1e-6);
         assert!(validate_cheap(&p, &s).is_err());

@@ -160,7 +160,7 @@ fn an_overlapping_schedule_is_caught_at_runtime() {
     let conf: Vec<bool> = (0..30).map(|n| !(10..20).contains(&n)).collect();
     let p = Problem::new(conf, vec![1.0; 30], vec![0.5; 30], vec![2.0; 30], 0.01).unwrap();
     let mut s = p.serial_schedule(p.dt_s()).unwrap();
-    s.offset_s = 0.0;
+    s.offsets_s[0] = 0.0;
     assert!(tandem_schedule::validate(&p, &s).is_err());
     for op in adversaries(&p, &s, 0) {
         assert!(run(&p, &s, op, 0).is_some(), "{op:?}");

@@ -181,7 +181,7 @@ fn alternation_by_hand() {
     assert_eq!(free.order, vec![0, 1, 0, 1]);
     assert_eq!(free.stats.lc_runs, 2);
     let s = free.schedule.unwrap();
-    assert!((s.offset_s - 0.1).abs() < 1e-12);
+    assert!((s.offsets_s[0] - 0.1).abs() < 1e-12);
     // 1 1 2 2: robot 1's gap at its fastest (0.05 s), robot 2 starts at 0.25 s: 0.5 s.
     let serial_like = earliest_schedule(&p, &[0, 0, 1, 1]).unwrap().unwrap();
     assert!((serial_like.t_total_s(0.01) - 0.5).abs() < 1e-12);

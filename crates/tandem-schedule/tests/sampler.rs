@@ -133,7 +133,7 @@ fn all_high_confidence_overlaps_fully() {
         "{} vs {fastest}",
         out.t_total_s
     );
-    assert!(out.schedule.offset_s <= 0.02 * fastest);
+    assert!(out.schedule.offsets_s[0] <= 0.02 * fastest);
 }
 
 #[test]
@@ -206,7 +206,7 @@ fn a_previous_schedule_at_another_tick_is_rechecked_at_the_new_one() {
     assert_eq!(validate(&p, &out.schedule), Ok(()));
     if out.source == Source::Previous {
         assert_eq!(out.schedule.grad_exec, first.schedule.grad_exec);
-        assert_eq!(out.schedule.offset_s, first.schedule.offset_s);
+        assert_eq!(out.schedule.offsets_s, first.schedule.offsets_s);
     }
     // A coarser tick (4 samples): the margin check needs more room than the previous
     // schedule left, so it is not kept as it is.
@@ -248,8 +248,8 @@ fn previous_schedule_is_repaired_after_the_model_moves() {
     ));
     // A previous schedule of the wrong shape is ignored.
     let junk = Schedule {
-        grad_exec: [vec![1.0; 3], vec![1.0; 3]],
-        offset_s: 0.0,
+        grad_exec: vec![vec![1.0; 3], vec![1.0; 3]],
+        offsets_s: vec![0.0],
         tick_s: 0.01,
     };
     let out = sample_schedule(&q, &params(10, 6), Some(&junk)).unwrap();

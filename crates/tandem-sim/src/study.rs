@@ -168,7 +168,7 @@ pub struct IterationRecord {
     pub iteration: usize,
     /// Planned `T_total` (Eq. 13, s).
     pub t_total_s: f64,
-    /// Planned offset `τ` of robot 2 (s, global time).
+    /// Planned offset `τ` of robot 2 (s, global time; 0 for a single robot).
     pub offset_s: f64,
     /// Share of reference samples that are high-confidence (Eq. 12), in percent.
     pub high_conf_pct: f64,
@@ -191,6 +191,9 @@ pub struct IterationRecord {
     /// Planned throughput: tasks per hour per operator, `N·3600 / T_total` (`N` robots each
     /// finish one task per `T_total` seconds of the schedule).
     pub throughput_per_h: f64,
+    /// Planned start offsets `τ_2, …, τ_N` of robots 2..N (s, global time; `N − 1` values,
+    /// `[offset_s]` for two robots).
+    pub offsets_s: Vec<f64>,
 }
 
 /// Where a study iteration's schedule came from: the kind of [`tandem_schedule::Source`]
@@ -586,7 +589,7 @@ fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
     Ok(IterationRecord {
         iteration: planner.pairs_recorded(),
         t_total_s: outcome.t_total_s,
-        offset_s: schedule.offset_s,
+        offset_s: schedule.offsets_s.first().copied().unwrap_or(0.0),
         high_conf_pct: 100.0 * planner.confidence().high_share(),
         source: outcome.source.into(),
         lc_intervals_s,
@@ -595,6 +598,7 @@ fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
         bound_is_optimum: outcome.bound_is_optimum,
         gap: outcome.gap,
         throughput_per_h: throughput_per_h(n_robots, outcome.t_total_s),
+        offsets_s: schedule.offsets_s.clone(),
     })
 }
 
@@ -801,6 +805,7 @@ mod tests {
             bound_is_optimum: iteration == 0,
             gap: 1.0 / (t_total_s - 1.0),
             throughput_per_h: throughput_per_h(2, t_total_s),
+            offsets_s: vec![1.0],
         }
     }
 

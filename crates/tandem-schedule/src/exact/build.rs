@@ -25,8 +25,8 @@ pub(crate) fn uniform_schedule(
         warp
     });
     Schedule {
-        grad_exec: warps,
-        offset_s: times.tau_s,
+        grad_exec: Vec::from(warps),
+        offsets_s: vec![times.tau_s],
         tick_s,
     }
 }

@@ -63,8 +63,8 @@ pub(crate) fn shaped_schedule(
         warp
     });
     Schedule {
-        grad_exec: warps,
-        offset_s: times.tau_s,
+        grad_exec: Vec::from(warps),
+        offsets_s: vec![times.tau_s],
         tick_s,
     }
 }
