@@ -9,9 +9,9 @@ use pyo3::types::{PyDict, PyList};
 use crate::arrays::{flags, matrix, out_flags, out_matrix, out_vector, vector};
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
-    GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, sample_schedule, validate,
+    GlobalTimeline, MAX_ROBOTS, Outcome, Problem, SamplerParams, Schedule, Source, sample_schedule,
+    validate,
 };
-use crate::planner::N_ROBOTS;
 
 /// The name of a schedule's source in records ([`Source::name`]): `sampled`, `completed`,
 /// `previous`, `repaired` (the previous schedule re-projected onto a new problem) or `serial`.
@@ -150,7 +150,7 @@ impl PyProblem {
 /// was made for.
 ///
 /// Shaped for ``N`` robots: ``gradients`` is ``(N, T_ref)``, ``offsets`` holds the ``N − 1``
-/// start offsets of robots 2…N (this build schedules ``N = 2``).
+/// start offsets of robots 2…N (``1 ≤ N ≤ MAX_ROBOTS``).
 #[pyclass(module = "tandem", name = "Schedule", frozen)]
 pub(crate) struct PySchedule {
     pub(crate) schedule: Schedule,
@@ -211,30 +211,30 @@ impl PySchedule {
         let n_ref = problem.inner.n_ref();
         let (g, cols) = matrix(gradients, "gradients", "robots × reference samples")?;
         let rows = g.len().checked_div(cols).unwrap_or(0);
-        if rows != N_ROBOTS || cols != n_ref {
+        if !(1..=MAX_ROBOTS).contains(&rows) || cols != n_ref {
             return Err(Error::input(
                 "gradients",
                 format!(
-                    "shape ({rows}, {cols}), expected ({N_ROBOTS}, {n_ref}) (robots × reference \
-                     samples; this build schedules {N_ROBOTS} robots)"
+                    "shape ({rows}, {cols}), expected (N, {n_ref}) with 1 ≤ N ≤ {MAX_ROBOTS} \
+                     (robots × reference samples)"
                 ),
             )
             .into());
         }
         let offsets = vector(offsets, "offsets", "robots 2…N")?;
-        if offsets.len() != N_ROBOTS - 1 {
+        if offsets.len() != rows - 1 {
             return Err(Error::input(
                 "offsets",
                 format!(
                     "{} offsets, expected {} (one per robot after the first)",
                     offsets.len(),
-                    N_ROBOTS - 1
+                    rows - 1
                 ),
             )
             .into());
         }
         let schedule = Schedule {
-            grad_exec: vec![g[..n_ref].to_vec(), g[n_ref..].to_vec()],
+            grad_exec: g.chunks_exact(n_ref).map(<[f64]>::to_vec).collect(),
             offsets_s: offsets.to_vec(),
             tick_s,
         };
@@ -249,7 +249,7 @@ impl PySchedule {
     /// Number of robots ``N``.
     #[getter]
     fn n_robots(&self) -> usize {
-        N_ROBOTS
+        self.schedule.n_robots()
     }
 
     /// Start offsets of robots 2…N, ``(N − 1,)``, s of global time (``τ``, §II-B4).
@@ -258,7 +258,7 @@ impl PySchedule {
         out_vector(py, self.schedule.offsets_s.clone())
     }
 
-    /// Start time of every robot, ``(N,)``, s of global time: ``[0, τ]``.
+    /// Start time of every robot, ``(N,)``, s of global time: ``[0, τ_2, …, τ_N]``.
     #[getter]
     fn starts_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         out_vector(py, self.schedule.starts_s().to_vec())
@@ -396,7 +396,9 @@ impl PySchedule {
         let tl = self.timeline()?;
         Ok(out_vector(
             py,
-            (0..N_ROBOTS).map(|i| tl.ref_time(i, t_global_s)).collect(),
+            (0..self.schedule.n_robots())
+                .map(|i| tl.ref_time(i, t_global_s))
+                .collect(),
         ))
     }
 
@@ -423,17 +425,8 @@ impl PySchedule {
     fn from_json(problem: PyRef<'_, PyProblem>, text: &str) -> PyResult<Self> {
         let schedule: Schedule =
             serde_json::from_str(text).map_err(|e| Error::input("schedule JSON", e.to_string()))?;
-        if schedule.n_robots() != N_ROBOTS || schedule.offsets_s.len() != N_ROBOTS - 1 {
-            return Err(Error::input(
-                "schedule JSON",
-                format!(
-                    "{} warps and {} offsets, expected {N_ROBOTS} and {}",
-                    schedule.n_robots(),
-                    schedule.offsets_s.len(),
-                    N_ROBOTS - 1
-                ),
-            )
-            .into());
+        if let Err(v) = schedule.check_shape() {
+            return Err(Error::input("schedule JSON", v.to_string()).into());
         }
         if schedule
             .grad_exec
@@ -460,8 +453,14 @@ impl PySchedule {
 
     fn __repr__(&self) -> String {
         format!(
-            "Schedule(n_robots={N_ROBOTS}, offsets=[{:.3}], t_total_s={:.3}, tick_s={}, source='{}')",
-            self.schedule.start_s(1),
+            "Schedule(n_robots={}, offsets=[{}], t_total_s={:.3}, tick_s={}, source='{}')",
+            self.schedule.n_robots(),
+            self.schedule
+                .offsets_s
+                .iter()
+                .map(|t| format!("{t:.3}"))
+                .collect::<Vec<_>>()
+                .join(", "),
             self.t_total_s(),
             self.schedule.tick_s,
             self.source
