@@ -823,6 +823,53 @@ mod tests {
     }
 
     #[test]
+    fn a_round_of_three_robots_runs_each_once_and_busies_the_operator_for_each() {
+        let model = model();
+        let problem = problem(&model);
+        let schedule = problem.serial_schedule_n(3, problem.dt_s()).unwrap();
+        let perfect = OperatorParams {
+            miss_rate: 0.0,
+            false_correction_rate: 0.0,
+            ..OperatorParams::default()
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let run = run_schedule(
+            &model,
+            &problem,
+            &schedule,
+            painted_needs_n,
+            &perfect,
+            &mut rng,
+        )
+        .unwrap();
+        assert_eq!(run.robots.len(), 3);
+        assert_eq!(run.overlap_ticks, 0);
+        for r in &run.robots {
+            assert!(r.needed > 0 && r.corrected == r.supervised);
+        }
+        // Serial: the operator is busy exactly while one robot is supervised, so the busy
+        // ticks are the three robots' supervised ticks, up to one tick at each end of each
+        // robot's one low-confidence stretch (a tick that enters or leaves it is busy).
+        let supervised: usize = run
+            .robots
+            .iter()
+            .map(|r| r.supervised.iter().filter(|s| **s).count())
+            .sum();
+        let busy = run.ticks - run.idle_ticks;
+        assert!(busy.abs_diff(supervised) <= 6, "{busy} vs {supervised}");
+        assert!(
+            (run.operator_busy_share() - busy as f64 / run.ticks as f64).abs() < 1e-15
+                && (run.operator_busy_share() + run.operator_idle_share() - 1.0).abs() < 1e-15
+        );
+        assert_eq!(run.records(&model).unwrap().len(), 3);
+    }
+
+    /// [`painted_needs`] for any robot index (every workpiece painted).
+    fn painted_needs_n(_robot: usize, ref_idx: usize) -> bool {
+        needs_correction(&painted_labels()[ref_idx], &all_painted())
+    }
+
+    #[test]
     fn run_pair_reads_everything_from_the_planner() {
         let planner = planner();
         let conf = planner.confidence().conf();
