@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 use tandem_realtime::clock_end_s;
 
 use crate::exact;
-use crate::problem::Problem;
+use crate::problem::{Problem, check_robot_count};
 use crate::sampler::{self, SamplerBaselines, SamplerParams, SamplerStats};
 use crate::schedule::Schedule;
 use crate::validate::{Violation, validate};
@@ -150,12 +150,15 @@ pub(crate) fn repair(problem: &Problem, previous: &Schedule, tick_s: f64) -> Opt
 /// why the serial schedule failed.
 fn incumbent(
     problem: &Problem,
+    n_robots: usize,
     previous: Option<&Schedule>,
     tick_s: f64,
 ) -> Result<std::result::Result<Candidate, Violation>> {
     let dt_s = problem.dt_s();
     let mut found: Option<Candidate> = None;
-    if let Some(prev) = previous {
+    // A previous schedule of another robot count is no incumbent (the sampler still starts
+    // from its robot 1).
+    if let Some(prev) = previous.filter(|p| p.n_robots() == n_robots) {
         // The previous schedule is valid at its own tick; re-check it at this one.
         let prev = Schedule {
             tick_s,
@@ -171,7 +174,7 @@ fn incumbent(
             found = Some((fixed, t, Source::RepairedPrevious));
         }
     }
-    let serial = problem.serial_schedule(tick_s)?;
+    let serial = problem.serial_schedule_n(n_robots, tick_s)?;
     let serial_t = serial.t_total_s(dt_s);
     if found.as_ref().is_none_or(|inc| serial_t < inc.1) {
         match validate(problem, &serial) {
@@ -207,6 +210,39 @@ pub fn sample_schedule(
     sample_schedule_with_baselines(problem, params, &SamplerBaselines::default(), previous)
 }
 
+/// The scheduler for `n_robots` robots (`1 ≤ N ≤ MAX_ROBOTS`; [`sample_schedule`] is its
+/// `N = 2` case, to the bit): the least-`T_total` schedule among the incumbent (the previous
+/// schedule if it has `N` robots, its repair, the fastest serial schedule of `N` robots,
+/// [`Problem::serial_schedule_n`]) and the sampler's winner, valid at `params.tick_s`
+/// (every constraint of Eq. 20 for all `N` robots, the margins by
+/// `tandem_realtime::sufficient_margins`), certified against a lower bound.
+///
+/// The sampler draws robot 1 as for two robots and places robots 2..N in turn, each by the
+/// exact interval sweep against the union of the earlier robots' widened low-confidence
+/// intervals (one widening `w` per candidate), its offset at most the latest end before it;
+/// candidates are checked in `(T_total, k)` order as for two robots. The warm start keeps
+/// robot 1 of the previous schedule (whatever its robot count). For `N = 2` the margin-aware
+/// completion runs beside the sampler and the bound is the exact margin-free optimum `T*₀`;
+/// for `N ≠ 2` there is no completion and the bound is [`crate::operator_bound_s`] (the
+/// optimum itself for `N = 1`). Deterministic for a seed whatever the thread count.
+///
+/// # Errors
+/// As [`sample_schedule`]; [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS`.
+pub fn sample_schedule_n(
+    problem: &Problem,
+    n_robots: usize,
+    params: &SamplerParams,
+    previous: Option<&Schedule>,
+) -> Result<Outcome> {
+    schedule_n(
+        problem,
+        n_robots,
+        params,
+        &SamplerBaselines::default(),
+        previous,
+    )
+}
+
 /// [`sample_schedule`] with benchmark-only alternatives to its design (see
 /// [`SamplerBaselines`]); `SamplerBaselines::default()` is [`sample_schedule`] itself.
 ///
@@ -218,14 +254,35 @@ pub fn sample_schedule_with_baselines(
     baselines: &SamplerBaselines,
     previous: Option<&Schedule>,
 ) -> Result<Outcome> {
+    schedule_n(problem, 2, params, baselines, previous)
+}
+
+/// [`sample_schedule_n`] with benchmark-only baselines (for two robots only, the default
+/// otherwise).
+fn schedule_n(
+    problem: &Problem,
+    n_robots: usize,
+    params: &SamplerParams,
+    baselines: &SamplerBaselines,
+    previous: Option<&Schedule>,
+) -> Result<Outcome> {
     params.validate()?;
+    check_robot_count(n_robots)?;
+    let two = n_robots == 2;
+    if !two && *baselines != SamplerBaselines::default() {
+        return Err(Error::BadParam {
+            name: "baselines",
+            why: "the benchmark baselines are for two robots only",
+        });
+    }
     let tick_s = params.tick_s.unwrap_or(problem.dt_s());
-    let incumbent = match incumbent(problem, previous, tick_s)? {
+    let incumbent = match incumbent(problem, n_robots, previous, tick_s)? {
         Ok(inc) => inc,
         Err(serial) => return Err(Error::NoFeasibleSchedule { serial }),
     };
     let cap_s = incumbent.1;
-    let budget = if baselines.sampler_only {
+    // The margin-aware completion is for two robots only.
+    let budget = if baselines.sampler_only || !two {
         0
     } else {
         params.exact.max_margin_checks
@@ -246,10 +303,15 @@ pub fn sample_schedule_with_baselines(
             if baselines.completion_only {
                 (None, SamplerStats::default())
             } else {
-                sampler::run(problem, params, baselines, tick_s, previous, cap_s)
+                sampler::run(
+                    problem, n_robots, params, baselines, tick_s, previous, cap_s,
+                )
             }
         },
         || {
+            if !two {
+                return (exact::operator_bound(problem, n_robots), (None, 0));
+            }
             let bound = exact::bound(problem, &params.exact);
             let done = if bound.lower_bound_s < cap_s {
                 exact::completion(problem, &params.exact, tick_s, cap_s, budget, true, &warm)
@@ -262,7 +324,7 @@ pub fn sample_schedule_with_baselines(
     let mut best = incumbent;
     let mut completed = done.map(|d| (d.schedule, d.t_total_s));
     if let Some((s, t, k)) = winner {
-        if t < best.1 {
+        if t < best.1 && two {
             // The sampler's winner as a warm start: the completion tightens its clearances.
             let cap = completed.as_ref().map_or(t, |c| c.1.min(t));
             let (better, more) = exact::completion(
@@ -278,6 +340,8 @@ pub fn sample_schedule_with_baselines(
             if let Some(b) = better {
                 completed = Some((b.schedule, b.t_total_s));
             }
+            best = (s, t, Source::Sampled { candidate: k });
+        } else if t < best.1 {
             best = (s, t, Source::Sampled { candidate: k });
         }
     }

@@ -45,9 +45,13 @@ mod sampler;
 mod schedule;
 mod validate;
 
-pub use choose::{Outcome, Source, sample_schedule, sample_schedule_with_baselines};
+pub use choose::{
+    Outcome, Source, sample_schedule, sample_schedule_n, sample_schedule_with_baselines,
+};
 pub use error::{Error, Result};
-pub use exact::{ExactParams, MarginFree, SearchStats, earliest_schedule, solve_exact};
+pub use exact::{
+    ExactParams, MarginFree, SearchStats, earliest_schedule, operator_bound_s, solve_exact,
+};
 pub use problem::Problem;
 pub use sampler::{DrawnOffset, SamplerBaselines, SamplerParams, SamplerStats};
 pub use schedule::{GlobalTimeline, LcOverlap, Schedule};

@@ -368,6 +368,9 @@ fn pieces(problem: &Problem, distribution: Distribution) -> Vec<Piece> {
 struct Sampler<'a> {
     problem: &'a Problem,
     params: &'a SamplerParams,
+    /// Number of robots `N` (2 unless the caller says otherwise; the drawn-offset baselines
+    /// are for two robots only).
+    n_robots: usize,
     /// How `τ` and robot 2 are chosen.
     offset: OffsetSampling,
     /// Margin-check implementation.
@@ -415,23 +418,30 @@ fn lc_of_warp(problem: &Problem, warp: &[f64]) -> (Vec<LcInterval>, f64) {
     (lc, t)
 }
 
-/// Per-worker scratch: factors and low-confidence intervals relative to each robot's start.
+/// Per-worker scratch: per robot its factors and low-confidence intervals (robot 1 from its
+/// start at 0; fitted robots in global time; a drawn-offset baseline's robot 2 relative to its
+/// start), the fitted robots' offsets `τ_i` and every robot's duration (s).
 #[derive(Default)]
 struct Scratch {
-    factors: [Vec<f64>; 2],
-    lc: [Vec<LcInterval>; 2],
+    factors: Vec<Vec<f64>>,
+    lc: Vec<Vec<LcInterval>>,
+    offsets_s: Vec<f64>,
+    durs_s: Vec<f64>,
     forbidden: Vec<(f64, f64)>,
     /// Fitted robot 2: feasible start sets of all pieces, flattened, and where each begins.
     sets: Vec<(f64, f64)>,
     set_starts: Vec<usize>,
 }
 
-/// A candidate's draws, with its factors left in the scratch.
-struct Draw {
-    /// `[|ψ_E1|, |ψ_E2|]` from the piece sums (s).
-    dur: [f64; 2],
-    /// `τ` (s); `None` when no admissible offset avoids a low-confidence overlap.
-    offset_s: Option<f64>,
+impl Scratch {
+    /// Room for `n_robots` robots' factors and intervals.
+    fn for_robots(n_robots: usize) -> Scratch {
+        Scratch {
+            factors: vec![Vec::new(); n_robots],
+            lc: vec![Vec::new(); n_robots],
+            ..Scratch::default()
+        }
+    }
 }
 
 impl<'a> Sampler<'a> {
@@ -439,6 +449,7 @@ impl<'a> Sampler<'a> {
     /// schedule, the warm start (robot 1 of its repair).
     fn new(
         problem: &'a Problem,
+        n_robots: usize,
         params: &'a SamplerParams,
         baselines: &SamplerBaselines,
         tick_s: f64,
@@ -477,6 +488,7 @@ impl<'a> Sampler<'a> {
         Sampler {
             problem,
             params,
+            n_robots,
             offset,
             margin_check: baselines.margin_check,
             pieces,
@@ -531,11 +543,15 @@ impl Sampler<'_> {
         t
     }
 
-    /// Draws candidate `k`: factors (into `scratch.factors`), durations and offset. With
-    /// fitted robot 2, candidates whose robot 2 cannot finish before `bound_s`
-    /// get no offset (the same draws otherwise, whatever `bound_s`).
-    fn draw(&self, scratch: &mut Scratch, k: u64, bound_s: f64) -> Draw {
+    /// Draws candidate `k`: factors (into `scratch.factors`), durations (into
+    /// `scratch.durs_s`) and offsets (into `scratch.offsets_s`); returns its `T_total` (s,
+    /// from the piece sums), or `None` when no admissible offset avoids a low-confidence
+    /// overlap. With fitted robots, candidates whose robots cannot all finish before
+    /// `bound_s` get `None` (the same draws otherwise, whatever `bound_s`).
+    fn draw(&self, scratch: &mut Scratch, k: u64, bound_s: f64) -> Option<f64> {
         let mut rng = self.rng(k);
+        scratch.offsets_s.clear();
+        scratch.durs_s.clear();
         if let OffsetSampling::Fitted { widen_max } = self.offset {
             let (dur0, w) = match (&self.warm, k.checked_sub(self.params.samples as u64)) {
                 (Some(warm), Some(j)) => {
@@ -545,47 +561,77 @@ impl Sampler<'_> {
                     (warm.dur_s, widen_max * WARM_WIDEN[j as usize])
                 }
                 _ => {
-                    let dur0 =
-                        self.draw_robot(&mut rng, &mut scratch.factors[0], &mut scratch.lc[0]);
+                    let (f0, lc0) = (&mut scratch.factors[0], &mut scratch.lc[0]);
+                    let dur0 = self.draw_robot(&mut rng, f0, lc0);
                     (dur0, rng.random::<f64>() * widen_max)
                 }
             };
-            return match self.fit_second(scratch, dur0, w, bound_s) {
-                Some((offset_s, dur1)) => Draw {
-                    dur: [dur0, dur1],
-                    offset_s: Some(offset_s),
-                },
-                None => Draw {
-                    dur: [dur0, f64::INFINITY],
-                    offset_s: None,
-                },
-            };
+            // Robots 2..N in turn, each fitted against every earlier robot (the latest end
+            // so far bounds its offset, Eq. 20 constraint 2); `T_total` is the latest end.
+            scratch.durs_s.push(dur0);
+            let mut t_total = dur0;
+            for robot in 1..self.n_robots {
+                let (offset_s, dur) = self.fit_next(scratch, robot, t_total, w, bound_s)?;
+                scratch.offsets_s.push(offset_s);
+                scratch.durs_s.push(dur);
+                t_total = t_total.max(offset_s + dur);
+                if robot + 1 < self.n_robots {
+                    self.lc_of_factors(scratch, robot, offset_s);
+                }
+            }
+            return Some(t_total);
         }
-        let [f0, f1] = &mut scratch.factors;
-        let [lc0, lc1] = &mut scratch.lc;
+        let (f0, f1) = scratch.factors.split_at_mut(1);
+        let (lc0, lc1) = scratch.lc.split_at_mut(1);
         let dur = [
-            self.draw_robot(&mut rng, f0, lc0),
-            self.draw_robot(&mut rng, f1, lc1),
+            self.draw_robot(&mut rng, &mut f0[0], &mut lc0[0]),
+            self.draw_robot(&mut rng, &mut f1[0], &mut lc1[0]),
         ];
         let v = rng.random::<f64>();
         let offset_s = match self.offset {
             OffsetSampling::Drawn(DrawnOffset::Uniform) => {
                 let offset_s = v * dur[0];
-                (!overlaps(&scratch.lc, offset_s)).then_some(offset_s)
+                (!overlaps(&scratch.lc[0], &scratch.lc[1], offset_s)).then_some(offset_s)
             }
             OffsetSampling::Drawn(DrawnOffset::UniformFeasible) => {
                 feasible_offset(scratch, dur[0], v)
             }
             OffsetSampling::Fitted { .. } => unreachable!("fitted candidates returned above"),
-        };
-        Draw { dur, offset_s }
+        }?;
+        scratch.durs_s.extend(dur);
+        scratch.offsets_s.push(offset_s);
+        Some(dur[0].max(offset_s + dur[1]))
     }
 
-    /// fitted robot 2: robot 2's earliest finish given robot 1's low-confidence
-    /// intervals in `scratch.lc[0]` (global time: robot 1 starts at 0) widened by
-    /// `δ = w·length + 2·tick_s`, over `τ ∈ [0, dur0]` and robot 2's per-piece durations.
-    /// Writes robot 2's factors into `scratch.factors[1]`; returns `(τ, |ψ_E2|)`, or `None`
-    /// when robot 2 cannot finish before `bound_s` clear of robot 1.
+    /// Writes robot `robot`'s low-confidence intervals in global time (it starts at
+    /// `offset_s`) into `scratch.lc[robot]`, from its factors and the piece sums.
+    fn lc_of_factors(&self, scratch: &mut Scratch, robot: usize, offset_s: f64) {
+        let lc = &mut scratch.lc[robot];
+        lc.clear();
+        let mut factors = scratch.factors[robot].iter();
+        let mut t = offset_s;
+        for p in &self.pieces {
+            if p.high_conf {
+                t += p.min_s + factors.next().copied().unwrap_or(0.0) * p.span_s;
+            } else {
+                lc.push(LcInterval {
+                    ref_start: p.start,
+                    ref_end: p.end,
+                    start_s: t,
+                    end_s: t + p.min_s,
+                });
+                t += p.min_s;
+            }
+        }
+    }
+
+    /// Fitted robot `robot` (≥ 1; robot 2 for two robots): its earliest finish given the
+    /// low-confidence intervals of robots `0..robot` in `scratch.lc` (global time; robot 1
+    /// starts at 0), each widened by `δ = w·length + 2·tick_s`, over `τ ∈ [0, latest_end_s]`
+    /// (the latest end of the earlier robots, s; `|ψ_E1|` for robot 2) and the robot's
+    /// per-piece durations. Writes its factors into `scratch.factors[robot]`; returns
+    /// `(τ, |ψ_E|)`, or `None` when it cannot finish before `bound_s` clear of the earlier
+    /// robots.
     ///
     /// The sweep keeps, for each piece, the set of its feasible start times as sorted
     /// disjoint intervals: a high-confidence piece of durations `[d_min, d_max]` maps `[x, y]`
@@ -595,17 +641,19 @@ impl Sampler<'_> {
     /// The earliest end is then traced back, each high-confidence piece taking its shortest
     /// duration that still meets the start set before it (the fastest speeds: the most room
     /// for the coordinator to slow that robot down while the other is dragged).
-    fn fit_second(
+    fn fit_next(
         &self,
         scratch: &mut Scratch,
-        dur0: f64,
+        robot: usize,
+        latest_end_s: f64,
         w: f64,
         bound_s: f64,
     ) -> Option<(f64, f64)> {
+        let dur0 = latest_end_s;
         let margin = 2.0 * self.tick_s;
         let forbidden = &mut scratch.forbidden;
         forbidden.clear();
-        forbidden.extend(scratch.lc[0].iter().map(|iv| {
+        forbidden.extend(scratch.lc[..robot].iter().flatten().map(|iv| {
             let d = w * (iv.end_s - iv.start_s) + margin;
             (iv.start_s - d, iv.end_s + d)
         }));
@@ -681,7 +729,7 @@ impl Sampler<'_> {
         }
 
         // Trace the earliest end back.
-        let factors = &mut scratch.factors[1];
+        let factors = &mut scratch.factors[robot];
         factors.clear();
         let mut e = sets[starts[n_pieces]].0;
         if e >= bound_s {
@@ -722,22 +770,21 @@ impl Sampler<'_> {
     /// Cheap evaluation of candidate `k`: `Some(T_total)` if it beats `bound_s` and has no
     /// low-confidence overlap.
     fn cheap(&self, scratch: &mut Scratch, k: u64, bound_s: f64) -> Option<f64> {
-        let d = self.draw(scratch, k, bound_s);
-        let t_total = d.dur[0].max(d.offset_s? + d.dur[1]);
+        let t_total = self.draw(scratch, k, bound_s)?;
         (t_total < bound_s).then_some(t_total)
     }
 
     /// The full schedule of candidate `k` (same draws as [`Sampler::cheap`]).
     fn materialize(&self, k: u64) -> Option<Schedule> {
-        let mut scratch = Scratch::default();
-        let d = self.draw(&mut scratch, k, f64::INFINITY);
+        let mut scratch = Scratch::for_robots(self.n_robots);
+        self.draw(&mut scratch, k, f64::INFINITY)?;
         let (gmin, gmax, gmean) = (
             self.problem.grad_min(),
             self.problem.grad_max(),
             self.problem.grad_mean(),
         );
         let n_ref = self.problem.n_ref();
-        let mut warps = vec![Vec::with_capacity(n_ref), Vec::with_capacity(n_ref)];
+        let mut warps = vec![Vec::with_capacity(n_ref); self.n_robots];
         for (robot, (warp, factors)) in warps.iter_mut().zip(&scratch.factors).enumerate() {
             if robot == 0
                 && k >= self.params.samples as u64
@@ -762,7 +809,7 @@ impl Sampler<'_> {
         }
         Some(Schedule {
             grad_exec: warps,
-            offsets_s: vec![d.offset_s?],
+            offsets_s: scratch.offsets_s,
             tick_s: self.tick_s,
         })
     }
@@ -778,10 +825,9 @@ impl Sampler<'_> {
     }
 }
 
-/// Whether robot 2's low-confidence intervals shifted by `offset_s` overlap robot 1's
+/// Whether robot 2's low-confidence intervals `b` shifted by `offset_s` overlap robot 1's `a`
 /// (positive-length intersection; both lists in time order).
-fn overlaps(lc: &[Vec<LcInterval>; 2], offset_s: f64) -> bool {
-    let (a, b) = (&lc[0], &lc[1]);
+fn overlaps(a: &[LcInterval], b: &[LcInterval], offset_s: f64) -> bool {
     let (mut i, mut j) = (0, 0);
     while i < a.len() && j < b.len() {
         let bj = b[j].shifted(offset_s);
@@ -889,13 +935,14 @@ fn margin_ranks(len: usize, cap: usize) -> Vec<usize> {
 /// number of threads.
 pub(crate) fn run(
     problem: &Problem,
+    n_robots: usize,
     params: &SamplerParams,
     baselines: &SamplerBaselines,
     tick_s: f64,
     previous: Option<&Schedule>,
     bound_s: f64,
 ) -> (Option<Winner>, SamplerStats) {
-    let sampler = Sampler::new(problem, params, baselines, tick_s, previous);
+    let sampler = Sampler::new(problem, n_robots, params, baselines, tick_s, previous);
     let n_warm = if sampler.warm.is_some() {
         WARM_WIDEN.len()
     } else {
@@ -904,9 +951,10 @@ pub(crate) fn run(
     let n = (params.samples + n_warm) as u64;
     let mut feasible: Vec<(f64, u64)> = (0..n)
         .into_par_iter()
-        .map_init(Scratch::default, |scratch, k| {
-            sampler.cheap(scratch, k, bound_s).map(|t| (t, k))
-        })
+        .map_init(
+            || Scratch::for_robots(n_robots),
+            |scratch, k| sampler.cheap(scratch, k, bound_s).map(|t| (t, k)),
+        )
         .flatten_iter()
         .collect();
     feasible.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
@@ -976,7 +1024,8 @@ mod tests {
 
     fn scratch(lc0: &[(f64, f64)], lc1: &[(f64, f64)]) -> Scratch {
         Scratch {
-            lc: [ivs(lc0), ivs(lc1)],
+            factors: vec![Vec::new(); 2],
+            lc: vec![ivs(lc0), ivs(lc1)],
             ..Scratch::default()
         }
     }
@@ -1009,14 +1058,16 @@ mod tests {
     fn fitted_robot_2_by_hand() {
         let p = three_runs();
         let params = SamplerParams::default();
-        let sampler = Sampler::new(&p, &params, &SamplerBaselines::default(), 0.1, None);
+        let sampler = Sampler::new(&p, 2, &params, &SamplerBaselines::default(), 0.1, None);
         // Robot 1 runs its HC piece at the slowest (4 s): LC [0, 1) and [5, 6), 6 s long.
         let mut s = scratch(&[(0.0, 1.0), (5.0, 6.0)], &[]);
         // w = 0: forbidden [−0.2, 1.2] and [4.8, 6.2] (two ticks of 0.1 s). Robot 2's first
         // LC starts in [1.2, 3.8] and ends in [2.2, 4.8]; its HC piece (1–4 s) reaches
         // [3.2, 8.8]; its last LC must start in [3.2, 3.8] or from 6.2: earliest end 4.2,
         // traced back with the HC piece at its shortest (u = 0) and τ = 1.2.
-        let (tau, dur) = sampler.fit_second(&mut s, 6.0, 0.0, f64::INFINITY).unwrap();
+        let (tau, dur) = sampler
+            .fit_next(&mut s, 1, 6.0, 0.0, f64::INFINITY)
+            .unwrap();
         assert!(
             (tau - 1.2).abs() < 1e-9 && (dur - 3.0).abs() < 1e-9,
             "{tau} {dur}"
@@ -1024,17 +1075,19 @@ mod tests {
         assert_eq!(s.factors[1], [0.0]);
         // w = 0.1: robot 1's regions grow by 0.1·1 + 0.2 s and robot 2's LC keeps 0.1 s
         // clear: starts [1.4, 3.6] → earliest end 4.4 with τ = 1.4.
-        let (tau, dur) = sampler.fit_second(&mut s, 6.0, 0.1, f64::INFINITY).unwrap();
+        let (tau, dur) = sampler
+            .fit_next(&mut s, 1, 6.0, 0.1, f64::INFINITY)
+            .unwrap();
         assert!(
             (tau - 1.4).abs() < 1e-9 && (dur - 3.0).abs() < 1e-9,
             "{tau} {dur}"
         );
         // An incumbent of 4 s cuts every start: robot 2 needs 3 s and cannot start before 1.2.
-        assert_eq!(sampler.fit_second(&mut s, 6.0, 0.0, 4.0), None);
+        assert_eq!(sampler.fit_next(&mut s, 1, 6.0, 0.0, 4.0), None);
         // Robot 1 at its fastest (LC [0, 1) and [2, 3)): no gap holds a 1 s region before
         // τ's upper end |ψ_E1| = 3 s, so robot 2 cannot be fitted.
         let mut s = scratch(&[(0.0, 1.0), (2.0, 3.0)], &[]);
-        assert_eq!(sampler.fit_second(&mut s, 3.0, 0.0, f64::INFINITY), None);
+        assert_eq!(sampler.fit_next(&mut s, 1, 3.0, 0.0, f64::INFINITY), None);
     }
 
     #[test]
@@ -1049,10 +1102,10 @@ mod tests {
 
     #[test]
     fn overlap_test_by_hand() {
-        let lc = [ivs(&[(1.0, 2.0)]), ivs(&[(0.0, 1.0)])];
-        assert!(overlaps(&lc, 0.5));
-        assert!(!overlaps(&lc, 2.0)); // touching
-        assert!(!overlaps(&lc, 0.0)); // touching
+        let (a, b) = (ivs(&[(1.0, 2.0)]), ivs(&[(0.0, 1.0)]));
+        assert!(overlaps(&a, &b, 0.5));
+        assert!(!overlaps(&a, &b, 2.0)); // touching
+        assert!(!overlaps(&a, &b, 0.0)); // touching
     }
 
     #[test]

@@ -266,15 +266,61 @@ fn margin_free(problem: &Problem, chain: &chain::Chain, max_pieces: usize) -> Ma
 
 /// `max(a_0 + 2·Σ L_k + a_m, fastest execution)` (s): the operator serves `2·Σ L_k` of LC time,
 /// not before the fastest head and followed by at least the fastest tail; and each robot needs
-/// its fastest execution.
+/// its fastest execution ([`operator_bound_of`] for two robots).
 fn simple_bound(chain: &chain::Chain) -> f64 {
+    operator_bound_of(chain, 2)
+}
+
+/// [`operator_bound_s`] of the chain of runs.
+fn operator_bound_of(chain: &chain::Chain, n_robots: usize) -> f64 {
     let m = chain.n_lc();
     let operator = if m == 0 {
         0.0
     } else {
-        chain.gap_s[0].0 + 2.0 * chain.lc_s.iter().sum::<f64>() + chain.gap_s[m].0
+        chain.gap_s[0].0 + n_robots as f64 * chain.lc_s.iter().sum::<f64>() + chain.gap_s[m].0
     };
     operator.max(chain.fastest_s())
+}
+
+/// The operator-limited lower bound (s, global time) on the `T_total` of every schedule of
+/// `n_robots` robots that satisfies Eq. 20 constraints 1–4 on `problem` (so also of every
+/// valid schedule): `max(a_0 + N·Σ_k L_k + a_m, fastest execution)`, where `L_k = Σ ψ̇̄·Δt_s`
+/// is the duration of LC run `k` (constraint 4 fixes it), `a_0` the fastest head (the HC
+/// samples before the first LC sample at `ψ̇min`, constraint 1) and `a_m` the fastest tail.
+///
+/// **Why it is a lower bound.** With `m ≥ 1` LC runs, each of the `N` robots traverses
+/// every LC run once, so the schedule has `N·m` LC intervals of total length `N·Σ L_k`.
+/// Constraint 3 makes them pairwise disjoint, so they cover `N·Σ L_k` seconds of global time.
+/// None starts before `a_0`: every robot starts at `τ_i ≥ 0` (constraint 2) and spends at
+/// least `a_0` on its head. So the interval that ends last ends at `T_end ≥ a_0 + N·Σ L_k`,
+/// and its robot then still has to traverse at least the tail after the last LC run,
+/// `≥ a_m` (what follows any LC run contains the tail), before it ends, which is `≤ T_total`
+/// (Eq. 13). And robot 1 starts at 0 and needs its fastest execution. For `N = 1` the
+/// bound is the optimum (the fastest execution); for `N = 2` it is the simple bound of
+/// [`solve_exact`], never above `T*₀`. (Durations are the clock's sums; constraint 4 holds
+/// up to `tol::GRADIENT_REL`, so a valid schedule can be shorter by that relative rounding.)
+///
+/// # Errors
+/// [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS`.
+pub fn operator_bound_s(problem: &Problem, n_robots: usize) -> Result<f64> {
+    crate::problem::check_robot_count(n_robots)?;
+    Ok(operator_bound_of(&chain::Chain::new(problem), n_robots))
+}
+
+/// The certificate of the scheduler for `n_robots ≠ 2` robots: [`operator_bound_s`], marked
+/// as the optimum for one robot (the fastest execution is then both bound and schedule).
+pub(crate) fn operator_bound(problem: &Problem, n_robots: usize) -> MarginFree {
+    let chain = chain::Chain::new(problem);
+    MarginFree {
+        lower_bound_s: operator_bound_of(&chain, n_robots),
+        proven_optimal: n_robots == 1,
+        schedule: None,
+        order: Vec::new(),
+        stats: SearchStats {
+            lc_runs: chain.n_lc(),
+            ..SearchStats::default()
+        },
+    }
 }
 
 /// The margin-free schedule of one machine order: `order[q]` is the robot (0 or 1) whose LC

@@ -1,0 +1,294 @@
+//! N robots in the schedule: schedules from the N-robot scheduler (`sample_schedule_n`) pass
+//! `validate` and, run through `tandem_realtime::Coordinator` at their own tick under the full
+//! adversary set for N robots, never have two robots low-confidence in one control tick; the
+//! N = 2 case is `sample_schedule` itself; the operator-limited lower bound
+//! (`operator_bound_s`) is never above a schedule that satisfies Eq. 20 constraints 1–4.
+
+mod common;
+
+use proptest::prelude::*;
+use proptest::strategy::ValueTree;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use tandem_realtime::adversary::{Adversary, adversary_set, run_adversary};
+use tandem_schedule::{
+    ExactParams, Problem, SamplerParams, Schedule, Source, Violation, operator_bound_s,
+    sample_schedule, sample_schedule_n, solve_exact, validate,
+};
+
+/// Tick budget of one execution: every robot at its slowest, run serially, plus slack.
+fn max_ticks(p: &Problem, s: &Schedule) -> u64 {
+    let slowest_s: f64 = p.grad_max().iter().sum::<f64>() * p.dt_s() * 2.0 * s.n_robots() as f64;
+    (slowest_s / s.tick_s) as u64 + 100
+}
+
+/// The full adversary set for `s` (N robots) on `p`, its random parameters from `seed`.
+fn adversaries(p: &Problem, s: &Schedule, seed: u64) -> Vec<Adversary> {
+    let lo = p.grad_min().iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = p.grad_max().iter().copied().fold(0.0, f64::max);
+    let ticks = (s.t_total_s(p.dt_s()) / s.tick_s) as u64;
+    adversary_set(
+        s.n_robots(),
+        [lo, hi],
+        ticks,
+        &mut ChaCha8Rng::seed_from_u64(seed),
+    )
+}
+
+/// Runs one execution at the schedule's tick; returns the first tick with two robots
+/// low-confidence (a robot counts as low-confidence in a tick when any reference sample it
+/// traverses in it is, `Tick::low_conf`).
+fn run(p: &Problem, s: &Schedule, op: Adversary, seed: u64) -> Option<u64> {
+    let c = s.coordinator(p).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let max_ticks = max_ticks(p, s);
+    let r = run_adversary(c, op, &mut rng, max_ticks).unwrap();
+    assert!(
+        r.finished,
+        "execution did not finish within {max_ticks} ticks"
+    );
+    r.first_overlap
+}
+
+/// Random small problems: confidence in runs (1–10 samples, HC runs twice as likely), random
+/// means and bounds per sample.
+fn random_problem() -> impl Strategy<Value = Problem> {
+    proptest::collection::vec((1usize..10, prop::bool::weighted(0.65)), 1..7)
+        .prop_flat_map(|blocks| {
+            let conf: Vec<bool> = blocks
+                .iter()
+                .flat_map(|&(len, hc)| std::iter::repeat_n(hc, len))
+                .collect();
+            let n = conf.len();
+            (Just(conf), common::gradients(n))
+        })
+        .prop_map(|(conf, g)| common::problem(conf, &g))
+}
+
+/// Shortest single execution, in control ticks, of the problems the N-robot properties cover.
+const MIN_TICKS: f64 = 4.0;
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    #[test]
+    fn n_robot_schedules_are_valid_and_never_overlap_at_runtime(
+        p in random_problem(),
+        n in 3usize..=5,
+        seed in any::<u64>(),
+        tick_frac in 0.25f64..=1.0,
+        samples in 20usize..120,
+    ) {
+        let tick_s = tick_frac * p.dt_s();
+        // Executions of a few ticks at most are outside the N-robot margin check's domain
+        // (docs/decisions.md, "N robots in the schedule": a 3-robot serial schedule of one
+        // 8 ms sample at a 9.4 ms tick is accepted and overlaps).
+        let fastest_s = p.serial_schedule_n(1, tick_s).unwrap().t_total_s(p.dt_s());
+        prop_assume!(fastest_s >= MIN_TICKS * tick_s);
+        let params = SamplerParams {
+            samples,
+            seed,
+            tick_s: Some(tick_s),
+            ..SamplerParams::default()
+        };
+        let out = sample_schedule_n(&p, n, &params, None).unwrap();
+        let s = &out.schedule;
+        prop_assert_eq!((s.n_robots(), s.offsets_s.len(), s.tick_s), (n, n - 1, tick_s));
+        prop_assert_eq!(validate(&p, s), Ok(()));
+        prop_assert_eq!(out.t_total_s, s.t_total_s(p.dt_s()));
+        // Never slower than serial, never below the bound.
+        let serial = p.serial_schedule_n(n, tick_s).unwrap().t_total_s(p.dt_s());
+        prop_assert!(out.t_total_s <= serial);
+        // The bound and the clock sum the same durations in other orders: equal up to rounding.
+        prop_assert!(operator_bound_s(&p, n).unwrap() <= out.t_total_s * (1.0 + 1e-9));
+        prop_assert!(out.lower_bound_s <= out.t_total_s && out.gap >= 0.0);
+        for op in adversaries(&p, s, seed) {
+            let hit = run(&p, s, op, seed);
+            prop_assert!(
+                hit.is_none(),
+                "two robots LC at tick {:?} with {:?} (source {:?})", hit, op, out.source
+            );
+        }
+    }
+}
+
+/// Non-vacuity: the proptest above must see overlapping (sampled) schedules of N robots, not
+/// only serial ones, and the runtime check must see the overlap of a schedule that breaks
+/// constraint 3.
+#[test]
+fn most_random_problems_get_sampled_n_robot_schedules() {
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    let strategy = random_problem();
+    let mut sampled = 0;
+    for seed in 0..30 {
+        let p = strategy.new_tree(&mut runner).unwrap().current();
+        let n = 3 + (seed as usize % 3);
+        let params = SamplerParams {
+            samples: 100,
+            seed,
+            ..SamplerParams::default()
+        };
+        let out = sample_schedule_n(&p, n, &params, None).unwrap();
+        if matches!(out.source, Source::Sampled { .. }) {
+            sampled += 1;
+            let serial = p.serial_schedule_n(n, p.dt_s()).unwrap();
+            assert!(out.t_total_s < serial.t_total_s(p.dt_s()));
+        }
+    }
+    eprintln!("{sampled} of 30 sampled");
+    assert!(sampled >= 15, "only {sampled} of 30 sampled");
+
+    // Three robots at once in one LC stretch: validate names it, the coordinator sees it.
+    let conf: Vec<bool> = (0..30).map(|n| !(10..20).contains(&n)).collect();
+    let p = Problem::new(conf, vec![1.0; 30], vec![0.5; 30], vec![2.0; 30], 0.01).unwrap();
+    let mut s = p.serial_schedule_n(3, p.dt_s()).unwrap();
+    s.offsets_s = vec![0.0, 0.05];
+    assert!(matches!(
+        validate(&p, &s),
+        Err(Violation::BothLowConfidence { .. })
+    ));
+    for op in adversaries(&p, &s, 0) {
+        assert!(run(&p, &s, op, 0).is_some(), "{op:?}");
+    }
+}
+
+/// The two-robot scheduler is the N = 2 case of the N-robot one, to the bit.
+#[test]
+fn two_robots_are_the_n_robot_scheduler_with_n_2() {
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    let strategy = random_problem();
+    for seed in 0..12 {
+        let p = strategy.new_tree(&mut runner).unwrap().current();
+        let params = SamplerParams {
+            samples: 200,
+            seed,
+            ..SamplerParams::default()
+        };
+        let two = sample_schedule(&p, &params, None).unwrap();
+        assert_eq!(sample_schedule_n(&p, 2, &params, None).unwrap(), two);
+        // Warm-started from it, too.
+        let again = sample_schedule(&p, &params, Some(&two.schedule)).unwrap();
+        assert_eq!(
+            sample_schedule_n(&p, 2, &params, Some(&two.schedule)).unwrap(),
+            again
+        );
+    }
+}
+
+/// One robot: the fastest execution is both the schedule and the bound.
+#[test]
+fn one_robot_runs_its_fastest_execution() {
+    let conf: Vec<bool> = (0..30).map(|n| !(10..20).contains(&n)).collect();
+    let p = Problem::new(conf, vec![1.0; 30], vec![0.5; 30], vec![2.0; 30], 0.01).unwrap();
+    let out = sample_schedule_n(&p, 1, &SamplerParams::default(), None).unwrap();
+    // 20 HC samples at 0.5 and 10 LC at 1: 0.2 s.
+    assert!((out.t_total_s - 0.2).abs() < 1e-12, "{}", out.t_total_s);
+    assert!(out.schedule.offsets_s.is_empty());
+    assert!(out.bound_is_optimum && out.gap < 1e-12, "{}", out.gap);
+    for bad in [0, tandem_realtime::MAX_ROBOTS + 1] {
+        assert!(sample_schedule_n(&p, bad, &SamplerParams::default(), None).is_err());
+        assert!(operator_bound_s(&p, bad).is_err());
+    }
+}
+
+/// The bound by hand, and where it is tight: with one LC run the robots can pass it back to
+/// back, each at its fastest around it, and that schedule (constraints 1–4) has `T_total`
+/// equal to the bound.
+#[test]
+fn the_operator_bound_by_hand_and_tight_for_one_lc_run() {
+    // [HC ×10, LC ×10, HC ×10] at 10 ms, gradients 1 in [0.5, 2]: a_0 = a_m = 0.05 s, L = 0.1 s.
+    let conf: Vec<bool> = (0..30).map(|n| !(10..20).contains(&n)).collect();
+    let p = Problem::new(conf, vec![1.0; 30], vec![0.5; 30], vec![2.0; 30], 0.01).unwrap();
+    for n in 1..=tandem_realtime::MAX_ROBOTS {
+        let bound = operator_bound_s(&p, n).unwrap();
+        // max(0.05 + N·0.1 + 0.05, fastest execution 0.2).
+        let want = (0.1 + 0.1 * n as f64).max(0.2);
+        assert!((bound - want).abs() < 1e-12, "N = {n}: {bound} vs {want}");
+        // Robot i starts at i·L: its LC run follows robot i − 1's back to back.
+        let s = Schedule {
+            grad_exec: vec![p.fastest_warp(); n],
+            offsets_s: (1..n).map(|i| 0.1 * i as f64).collect(),
+            tick_s: p.dt_s(),
+        };
+        let free = validate(&p, &s);
+        assert!(
+            matches!(free, Ok(()) | Err(Violation::InsufficientMargins { .. })),
+            "N = {n}: {free:?}"
+        );
+        assert!((s.t_total_s(p.dt_s()) - bound).abs() < 1e-9, "N = {n}");
+    }
+}
+
+/// Whether `s` satisfies Eq. 20 constraints 1–4 (everything `validate` checks before the
+/// margins).
+fn margin_free_feasible(p: &Problem, s: &Schedule) -> bool {
+    matches!(
+        validate(p, s),
+        Ok(()) | Err(Violation::InsufficientMargins { .. })
+    )
+}
+
+/// Brute force on small random problems: the bound is never above any schedule of
+/// constraints 1–4 found on a grid (every robot's HC runs at one of three speed factors,
+/// offsets on a grid over their admissible range), and for two robots never above the exact
+/// margin-free optimum `T*₀`.
+#[test]
+fn the_operator_bound_is_below_every_margin_free_schedule() {
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    let strategy = random_problem();
+    let mut feasible_seen = 0;
+    for case in 0..16 {
+        let p = strategy.new_tree(&mut runner).unwrap().current();
+        let exact = solve_exact(&p, &ExactParams::default()).unwrap();
+        assert!(operator_bound_s(&p, 2).unwrap() <= exact.lower_bound_s * (1.0 + 1e-9));
+        let n = 3;
+        let bound = operator_bound_s(&p, n).unwrap();
+        let warp = |u: f64| -> Vec<f64> {
+            (0..p.n_ref())
+                .map(|k| {
+                    if p.conf()[k] {
+                        p.grad_min()[k] + u * (p.grad_max()[k] - p.grad_min()[k])
+                    } else {
+                        p.grad_mean()[k]
+                    }
+                })
+                .collect()
+        };
+        let speeds = [0.0, 0.5, 1.0];
+        let grid = 10;
+        let mut best = f64::INFINITY;
+        for &u0 in &speeds {
+            for &u1 in &speeds {
+                for &u2 in &speeds {
+                    let grad_exec = vec![warp(u0), warp(u1), warp(u2)];
+                    let mut s = Schedule {
+                        grad_exec,
+                        offsets_s: vec![0.0, 0.0],
+                        tick_s: p.dt_s(),
+                    };
+                    let end0 = s.end_s(0, p.dt_s());
+                    for a in 0..=grid {
+                        s.offsets_s[0] = end0 * a as f64 / grid as f64;
+                        let end1 = end0.max(s.end_s(1, p.dt_s()));
+                        for b in 0..=grid {
+                            s.offsets_s[1] = end1 * b as f64 / grid as f64;
+                            if margin_free_feasible(&p, &s) {
+                                feasible_seen += 1;
+                                best = best.min(s.t_total_s(p.dt_s()));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            best.is_finite(),
+            "case {case}: the grid holds the serial schedule"
+        );
+        assert!(
+            bound <= best * (1.0 + 1e-9),
+            "case {case}: bound {bound} above a feasible {best}"
+        );
+    }
+    assert!(feasible_seen > 1000, "{feasible_seen}");
+}
