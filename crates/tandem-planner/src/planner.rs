@@ -10,7 +10,7 @@ use tandem_confidence::{Confidence, ConfidenceParams, Observations};
 use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
-    Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source, sample_schedule,
+    Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source, sample_schedule_n,
 };
 
 use crate::{Error, Result, derive_seed, state};
@@ -244,19 +244,6 @@ fn check_robot_count(n_robots: usize) -> Result<()> {
     }
 }
 
-/// The scheduler (§II-C) for `n_robots` robots on `problem`, warm-started by `previous`.
-fn schedule_robots(
-    problem: &Problem,
-    n_robots: usize,
-    params: &SamplerParams,
-    previous: Option<&Schedule>,
-) -> Result<Outcome> {
-    if n_robots != 2 {
-        return Err(Error::RobotCount { n_robots, max: 2 });
-    }
-    Ok(sample_schedule(problem, params, previous)?)
-}
-
 impl Planner {
     /// Learns the task from demonstrations (the reference is the one `params.fit.reference`
     /// chooses) and makes the first schedule: aligns and fits the model (§II-B1/2), sets the
@@ -310,7 +297,8 @@ impl Planner {
         let confidence = Confidence::from_prior(model.sigma2_d(), params.confidence.clone())?;
         let observations = Observations::new(model.n_ref())?;
         let problem = problem_for(&model, &confidence)?;
-        let outcome = schedule_robots(&problem, n_robots, &Self::sampler_params(&params, 0), None)?;
+        let outcome =
+            sample_schedule_n(&problem, n_robots, &Self::sampler_params(&params, 0), None)?;
         Ok(Self {
             params,
             model,
@@ -365,7 +353,7 @@ impl Planner {
         let problem = problem_for(&model, &confidence)?;
         let t2 = Instant::now();
         let pairs_recorded = self.pairs_recorded + 1;
-        let outcome = schedule_robots(
+        let outcome = sample_schedule_n(
             &problem,
             n_robots,
             &Self::sampler_params(&self.params, pairs_recorded),
@@ -414,7 +402,7 @@ impl Planner {
     /// # Errors
     /// The schedule crate's error for invalid `sampler` parameters or an infeasible problem.
     pub fn reschedule(&mut self, sampler: &SamplerParams) -> Result<&Outcome> {
-        let outcome = schedule_robots(
+        let outcome = sample_schedule_n(
             &self.problem,
             self.n_robots(),
             sampler,
