@@ -345,6 +345,7 @@ fn draw_on<DB: DrawingBackend>(
         .map_err(err("mesh"))?;
     chart
         .configure_secondary_axes()
+        .y_label_formatter(&|v| format!("{v:.0}"))
         .y_desc("operator busy share (%)")
         .label_style((FONT_FAMILY, 18))
         .axis_desc_style((FONT_FAMILY, 20))

@@ -147,9 +147,20 @@ fn summary_lines(planner: &Planner) -> Result<()> {
         "schedule: {}",
         certificate_line(planner.problem(), planner.outcome())?
     ));
+    let offsets: Vec<String> = planner
+        .schedule()
+        .offsets_s
+        .iter()
+        .map(|t| format!("{t:.2}"))
+        .collect();
+    // Two robots: `τ = 12.65 s`; N robots: `τ = 0.29, 0.58 s` (robots 2..N); one: no offset.
     out(&format!(
-        "schedule: τ = {:.2} s; {}",
-        planner.schedule().start_s(1),
+        "schedule: {}; {}",
+        if offsets.is_empty() {
+            "one robot".to_string()
+        } else {
+            format!("τ = {} s", offsets.join(", "))
+        },
         source_name(&planner.outcome().source)
     ));
     Ok(())

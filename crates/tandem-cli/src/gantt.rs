@@ -37,8 +37,10 @@ pub(crate) fn certificate_line(problem: &Problem, outcome: &Outcome) -> Result<S
     let serial = serial_t_total_s(problem, s.n_robots(), s.tick_s)?;
     let bound = if outcome.bound_is_optimum {
         "lower bound"
-    } else {
+    } else if s.n_robots() == 2 {
         "lower bound (search budget spent: not the optimum)"
+    } else {
+        "operator-limited lower bound (every robot's low-confidence time in turn)"
     };
     Ok(format!(
         "T_total {:.2} s — {bound} {:.2} s without margins (+{:.2} %), fastest serial {serial:.2} s",
