@@ -7,8 +7,8 @@ pub(crate) use tandem::planner::{
 };
 pub(crate) use tandem::realtime::{Coordinator, MAX_ROBOTS, Operator, Tick, Timeline};
 pub(crate) use tandem::schedule::{
-    GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, Violation, sample_schedule,
-    validate,
+    GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, Violation,
+    sample_schedule_n, validate,
 };
 pub(crate) use tandem::sim::study::{
     PhaseTimes, StudyConfig, StudyInputs, read_labels, run_trial, run_trials,

@@ -9,9 +9,10 @@ use pyo3::types::{PyDict, PyList};
 use crate::arrays::{flags, matrix, out_flags, out_matrix, out_vector, vector};
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
-    GlobalTimeline, MAX_ROBOTS, Outcome, Problem, SamplerParams, Schedule, Source, sample_schedule,
-    validate,
+    GlobalTimeline, MAX_ROBOTS, Outcome, Problem, SamplerParams, Schedule, Source,
+    sample_schedule_n, validate,
 };
+use crate::planner::N_ROBOTS;
 
 /// The name of a schedule's source in records ([`Source::name`]): `sampled`, `completed`,
 /// `previous`, `repaired` (the previous schedule re-projected onto a new problem) or `serial`.
@@ -94,13 +95,16 @@ impl PyProblem {
         out_vector(py, self.inner.grad_max().to_vec())
     }
 
-    /// The fastest serial schedule (§II-C fallback): both robots as fast as allowed, robot
-    /// 2 starting when robot 1 ends; valid at any tick. ``tick_s`` (real s) defaults to
-    /// ``dt_s``.
-    #[pyo3(signature = (tick_s=None))]
-    fn serial_schedule(&self, tick_s: Option<f64>) -> PyResult<PySchedule> {
+    /// The fastest serial schedule (§II-C fallback): every robot as fast as allowed, each
+    /// starting when the one before it ends; valid at any tick. ``tick_s`` (real s) defaults
+    /// to ``dt_s``; ``robots`` is ``N`` (1 to 8, default 2).
+    #[pyo3(signature = (tick_s=None, robots=N_ROBOTS))]
+    fn serial_schedule(&self, tick_s: Option<f64>, robots: usize) -> PyResult<PySchedule> {
         let tick_s = tick_s.unwrap_or(self.inner.dt_s());
-        let s = self.inner.serial_schedule(tick_s).map_err(Error::from)?;
+        let s = self
+            .inner
+            .serial_schedule_n(robots, tick_s)
+            .map_err(Error::from)?;
         Ok(PySchedule::new(
             self.inner.clone(),
             s,
@@ -109,10 +113,11 @@ impl PyProblem {
         ))
     }
 
-    /// The paper's anytime sampler (§II-C) on this problem: ``samples`` candidates from
-    /// ``seed`` (deterministic for a seed whatever the thread count), margins checked at
-    /// control tick ``tick_s`` (real s, default ``dt_s``), warm-started by ``previous``.
-    #[pyo3(signature = (samples=5000, seed=0, tick_s=None, previous=None))]
+    /// The scheduler (§II-C) on this problem for ``robots`` robots (1 to 8, default 2):
+    /// ``samples`` candidates from ``seed`` (deterministic for a seed whatever the thread
+    /// count), margins checked at control tick ``tick_s`` (real s, default ``dt_s``),
+    /// warm-started by ``previous``.
+    #[pyo3(signature = (samples=5000, seed=0, tick_s=None, previous=None, robots=N_ROBOTS))]
     fn sample_schedule(
         &self,
         py: Python<'_>,
@@ -120,6 +125,7 @@ impl PyProblem {
         seed: u64,
         tick_s: Option<f64>,
         previous: Option<PyRef<'_, PySchedule>>,
+        robots: usize,
     ) -> PyResult<PySchedule> {
         let params = SamplerParams {
             samples,
@@ -129,8 +135,16 @@ impl PyProblem {
         };
         let previous = previous.map(|p| p.schedule.clone());
         let problem = &*self.inner;
-        let outcome =
-            py.detach(|| guard(|| Ok(sample_schedule(problem, &params, previous.as_ref())?)))?;
+        let outcome = py.detach(|| {
+            guard(|| {
+                Ok(sample_schedule_n(
+                    problem,
+                    robots,
+                    &params,
+                    previous.as_ref(),
+                )?)
+            })
+        })?;
         Ok(PySchedule::from_outcome(self.inner.clone(), &outcome))
     }
 
@@ -212,12 +226,14 @@ impl PySchedule {
         let (g, cols) = matrix(gradients, "gradients", "robots × reference samples")?;
         let rows = g.len().checked_div(cols).unwrap_or(0);
         if !(1..=MAX_ROBOTS).contains(&rows) || cols != n_ref {
+            let expected = if (1..=MAX_ROBOTS).contains(&rows) {
+                format!("({rows}, {n_ref})")
+            } else {
+                format!("(N, {n_ref}) with 1 ≤ N ≤ {MAX_ROBOTS}")
+            };
             return Err(Error::input(
                 "gradients",
-                format!(
-                    "shape ({rows}, {cols}), expected (N, {n_ref}) with 1 ≤ N ≤ {MAX_ROBOTS} \
-                     (robots × reference samples)"
-                ),
+                format!("shape ({rows}, {cols}), expected {expected} (robots × reference samples)"),
             )
             .into());
         }
