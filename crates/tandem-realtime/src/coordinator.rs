@@ -91,7 +91,7 @@ enum Phase {
 /// [`tick`](Coordinator::tick).
 ///
 /// Rules per tick (modes, rates and bounds are read at each robot's sample at the tick start;
-/// the rules are [`strategy`](crate::strategy)'s, argued in docs/decisions.md):
+/// the rules are those of the `strategy` module, argued in docs/decisions.md):
 /// - a low-confidence robot steps at the operator's rate: the [`Operator`]'s gradient `g`
 ///   (`ψ̇_E` when there is no correction), clamped to `[ψ̇min, ψ̇max]`, gives the
 ///   schedule-clock step `(ψ̇_E/g)·tick_s ∈ [S·tick_s, F·tick_s]`; it sets the pace;

@@ -9,6 +9,13 @@
 //! Measured (2 cores, at commit `2ff2944`, on that commit's fixtures): 5.0 ms lazy, 35 ms
 //! single-pass exhaustive, 43.5 ms per-pair exhaustive; best `T_total` 93.66 s against
 //! 145.75 s serial. `cargo bench -p tandem-schedule --bench reschedule_5000` re-measures.
+//!
+//! The group `reschedule_5000_robots` times the whole scheduler for `N` robots
+//! (`sample_schedule_n`, default parameters, 5000 samples, seed 1) on the same problem for
+//! N = 2, 4, 8 in one run (N = 2: sampler and margin-aware completion; N ≠ 2: the sampler
+//! with robots 2..N placed in turn); the figures and their ratio to N = 2 are in
+//! docs/decisions.md, "N robots in the schedule"
+//! (`cargo bench -p tandem-schedule --bench reschedule_5000 -- robots`).
 #![allow(clippy::print_stdout, reason = "a bench reports which problem it used")]
 #![allow(
     missing_docs,
@@ -18,9 +25,9 @@
 #[path = "support/fixture.rs"]
 mod fixture;
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use tandem_schedule::{
-    MarginCheck, SamplerBaselines, SamplerParams, sample_schedule_with_baselines,
+    MarginCheck, SamplerBaselines, SamplerParams, sample_schedule_n, sample_schedule_with_baselines,
 };
 
 fn bench(c: &mut Criterion) {
@@ -77,5 +84,35 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+fn bench_robots(c: &mut Criterion) {
+    let (problem, label) = fixture::mid_study_problem();
+    let params = SamplerParams {
+        samples: 5000,
+        seed: 1,
+        ..SamplerParams::default()
+    };
+    let mut group = c.benchmark_group("reschedule_5000_robots");
+    group.sample_size(10);
+    for n in [2, 4, 8] {
+        let out = sample_schedule_n(&problem, n, &params, None).expect("the fixture is valid");
+        println!(
+            "reschedule_5000_robots on {label}: N = {n}, T_total = {:.2} s, lower bound {:.2} s \
+             (gap {:.1} %), serial {:.2} s, source {}",
+            out.t_total_s,
+            out.lower_bound_s,
+            100.0 * out.gap,
+            problem
+                .serial_schedule_n(n, problem.dt_s())
+                .expect("Δt_s is a valid tick")
+                .t_total_s(problem.dt_s()),
+            out.source.name(),
+        );
+        group.bench_with_input(BenchmarkId::from_parameter(n), &n, |bch, &n| {
+            bch.iter(|| sample_schedule_n(&problem, n, &params, None))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_robots);
 criterion_main!(benches);

@@ -1,4 +1,4 @@
-//! Scheduling two robots around low confidence (paper §II-B4, §II-B6, §II-C).
+//! Scheduling `N` robots (two in the paper) around low confidence (paper §II-B4, §II-B6, §II-C).
 //!
 //! A [`Problem`] holds, per reference sample `n` (period `Δt_s`), whether the learned model is
 //! high-confidence (Eq. 12) and the mean, minimum and maximum demonstration warp gradients
@@ -6,7 +6,7 @@
 //! sample) and robots 2..N start offsets `τ_i`. [`GlobalTimeline`] lays a schedule out in global
 //! time (Eq. 15, 16, 19), [`Schedule::t_total_s`] is Eq. 13, [`validate`] checks every
 //! constraint of Eq. 20 (the margin check of Alg. 2 through `tandem_realtime`), and
-//! [`sample_schedule`] is the scheduler: the paper's anytime sampler — robot 1's speeds are
+//! [`sample_schedule`] is the scheduler (for two robots; [`sample_schedule_n`] for `N`): the paper's anytime sampler — robot 1's speeds are
 //! sampled and `τ` and robot 2's speeds fitted to them exactly (the measured alternatives are
 //! [`SamplerBaselines`]) — and, beside it, the margin-aware completion of the exact
 //! margin-free optimum ([`exact`]), the shorter of the two (or of the previous or serial
@@ -16,7 +16,9 @@
 //! ([`Schedule::tick_s`]); the runtime [`Schedule::coordinator`] runs at that tick.
 //!
 //! ```
-//! use tandem_schedule::{Problem, SamplerParams, Source, sample_schedule, validate};
+//! use tandem_schedule::{
+//!     Problem, SamplerParams, Source, operator_bound_s, sample_schedule, sample_schedule_n, validate,
+//! };
 //!
 //! // 30 reference samples at 10 ms: low confidence on samples 10..15, loose bounds elsewhere.
 //! let conf: Vec<bool> = (0..30).map(|n| !(10..15).contains(&n)).collect();
@@ -34,6 +36,16 @@
 //! // The certificate: no schedule of Eq. 20 is shorter than the margin-free optimum T*₀.
 //! assert!(out.bound_is_optimum && out.lower_bound_s <= out.t_total_s);
 //! assert_eq!(out.gap, (out.t_total_s - out.lower_bound_s) / out.lower_bound_s);
+//!
+//! // Three robots, one operator: robot 1 sampled, robots 2 and 3 placed in turn, certified
+//! // against the operator-limited bound: 3 × 0.05 s of low confidence after the fastest
+//! // head (10 samples at 0.5: 0.05 s) and before the fastest tail (15 samples: 0.075 s).
+//! let three = sample_schedule_n(&problem, 3, &params, None)?;
+//! assert_eq!((three.schedule.n_robots(), three.schedule.offsets_s.len()), (3, 2));
+//! assert!(validate(&problem, &three.schedule).is_ok());
+//! assert!((operator_bound_s(&problem, 3)? - 0.275).abs() < 1e-12);
+//! assert!(three.lower_bound_s <= three.t_total_s);
+//! assert!(three.t_total_s <= problem.serial_schedule_n(3, 0.01)?.t_total_s(0.01));
 //! # Ok::<(), tandem_schedule::Error>(())
 //! ```
 

@@ -523,13 +523,28 @@ impl Sampler<'_> {
         lc: &mut Vec<LcInterval>,
     ) -> f64 {
         factors.clear();
+        self.walk(0.0, lc, || {
+            let u = self.factor(rng);
+            factors.push(u);
+            u
+        })
+    }
+
+    /// One robot's pass over the pieces from `start_s` (s): each high-confidence piece takes
+    /// the factor `next_factor()` (its duration `min_s + u·span_s`), each low-confidence piece
+    /// its mean duration, pushed into `lc` (cleared first) as an interval; returns the end
+    /// (s), from the piece sums.
+    fn walk(
+        &self,
+        start_s: f64,
+        lc: &mut Vec<LcInterval>,
+        mut next_factor: impl FnMut() -> f64,
+    ) -> f64 {
         lc.clear();
-        let mut t = 0.0;
+        let mut t = start_s;
         for p in &self.pieces {
             if p.high_conf {
-                let u = self.factor(rng);
-                factors.push(u);
-                t += p.min_s + u * p.span_s;
+                t += p.min_s + next_factor() * p.span_s;
             } else {
                 lc.push(LcInterval {
                     ref_start: p.start,
@@ -606,23 +621,10 @@ impl Sampler<'_> {
     /// Writes robot `robot`'s low-confidence intervals in global time (it starts at
     /// `offset_s`) into `scratch.lc[robot]`, from its factors and the piece sums.
     fn lc_of_factors(&self, scratch: &mut Scratch, robot: usize, offset_s: f64) {
-        let lc = &mut scratch.lc[robot];
-        lc.clear();
         let mut factors = scratch.factors[robot].iter();
-        let mut t = offset_s;
-        for p in &self.pieces {
-            if p.high_conf {
-                t += p.min_s + factors.next().copied().unwrap_or(0.0) * p.span_s;
-            } else {
-                lc.push(LcInterval {
-                    ref_start: p.start,
-                    ref_end: p.end,
-                    start_s: t,
-                    end_s: t + p.min_s,
-                });
-                t += p.min_s;
-            }
-        }
+        self.walk(offset_s, &mut scratch.lc[robot], || {
+            factors.next().copied().unwrap_or(0.0)
+        });
     }
 
     /// Fitted robot `robot` (≥ 1; robot 2 for two robots): its earliest finish given the

@@ -5,45 +5,14 @@
 //! same control tick.
 
 mod common;
+mod runtime;
 
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use tandem_realtime::adversary::{Adversary, adversary_set, run_adversary};
+use runtime::{adversaries, run};
 use tandem_schedule::{
-    DrawnOffset, Problem, SamplerBaselines, SamplerParams, Schedule, Source,
-    sample_schedule_with_baselines,
+    DrawnOffset, Problem, SamplerBaselines, SamplerParams, Source, sample_schedule_with_baselines,
 };
-
-/// Tick budget of one execution: every robot at its slowest, run serially, plus slack.
-fn max_ticks(p: &Problem, s: &Schedule) -> u64 {
-    let slowest_s: f64 = p.grad_max().iter().sum::<f64>() * p.dt_s() * 4.0;
-    (slowest_s / s.tick_s) as u64 + 100
-}
-
-/// The full adversary set for `s` on `p`, its random parameters from `seed`.
-fn adversaries(p: &Problem, s: &Schedule, seed: u64) -> Vec<Adversary> {
-    let lo = p.grad_min().iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = p.grad_max().iter().copied().fold(0.0, f64::max);
-    let ticks = (s.t_total_s(p.dt_s()) / s.tick_s) as u64;
-    adversary_set(2, [lo, hi], ticks, &mut ChaCha8Rng::seed_from_u64(seed))
-}
-
-/// Runs one execution at the schedule's tick; returns the first tick index with both robots
-/// low-confidence.
-fn run(p: &Problem, s: &Schedule, op: Adversary, seed: u64) -> Option<u64> {
-    let c = s.coordinator(p).unwrap();
-    assert_eq!(c.tick_s(), s.tick_s);
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let max_ticks = max_ticks(p, s);
-    let r = run_adversary(c, op, &mut rng, max_ticks).unwrap();
-    assert!(
-        r.finished,
-        "execution did not finish within {max_ticks} ticks"
-    );
-    r.first_overlap
-}
 
 /// The sampler's default (robot 2 fitted) or the uniform-feasible offsets baseline.
 fn baselines(fitted: bool) -> SamplerBaselines {
@@ -53,19 +22,9 @@ fn baselines(fitted: bool) -> SamplerBaselines {
     }
 }
 
-/// Random small problems: confidence in runs (1–12 samples, HC runs twice as likely), random
-/// means and bounds per sample.
+/// Random small problems: 1–7 runs of 1–11 samples.
 fn random_problem() -> impl Strategy<Value = Problem> {
-    proptest::collection::vec((1usize..12, prop::bool::weighted(0.65)), 1..8)
-        .prop_flat_map(|blocks| {
-            let conf: Vec<bool> = blocks
-                .iter()
-                .flat_map(|&(len, hc)| std::iter::repeat_n(hc, len))
-                .collect();
-            let n = conf.len();
-            (Just(conf), common::gradients(n))
-        })
-        .prop_map(|(conf, g)| common::problem(conf, &g))
+    runtime::random_problem(12, 8)
 }
 
 proptest! {

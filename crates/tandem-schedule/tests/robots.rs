@@ -5,64 +5,19 @@
 //! (`operator_bound_s`) is never above a schedule that satisfies Eq. 20 constraints 1–4.
 
 mod common;
+mod runtime;
 
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use tandem_realtime::adversary::{Adversary, adversary_set, run_adversary};
+use runtime::{adversaries, run};
 use tandem_schedule::{
     ExactParams, Problem, SamplerParams, Schedule, Source, Violation, operator_bound_s,
     sample_schedule, sample_schedule_n, solve_exact, validate,
 };
 
-/// Tick budget of one execution: every robot at its slowest, run serially, plus slack.
-fn max_ticks(p: &Problem, s: &Schedule) -> u64 {
-    let slowest_s: f64 = p.grad_max().iter().sum::<f64>() * p.dt_s() * 2.0 * s.n_robots() as f64;
-    (slowest_s / s.tick_s) as u64 + 100
-}
-
-/// The full adversary set for `s` (N robots) on `p`, its random parameters from `seed`.
-fn adversaries(p: &Problem, s: &Schedule, seed: u64) -> Vec<Adversary> {
-    let lo = p.grad_min().iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = p.grad_max().iter().copied().fold(0.0, f64::max);
-    let ticks = (s.t_total_s(p.dt_s()) / s.tick_s) as u64;
-    adversary_set(
-        s.n_robots(),
-        [lo, hi],
-        ticks,
-        &mut ChaCha8Rng::seed_from_u64(seed),
-    )
-}
-
-/// Runs one execution at the schedule's tick; returns the first tick with two robots
-/// low-confidence (a robot counts as low-confidence in a tick when any reference sample it
-/// traverses in it is, `Tick::low_conf`).
-fn run(p: &Problem, s: &Schedule, op: Adversary, seed: u64) -> Option<u64> {
-    let c = s.coordinator(p).unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let max_ticks = max_ticks(p, s);
-    let r = run_adversary(c, op, &mut rng, max_ticks).unwrap();
-    assert!(
-        r.finished,
-        "execution did not finish within {max_ticks} ticks"
-    );
-    r.first_overlap
-}
-
-/// Random small problems: confidence in runs (1–10 samples, HC runs twice as likely), random
-/// means and bounds per sample.
+/// Random small problems for N robots: 1–6 runs of 1–9 samples.
 fn random_problem() -> impl Strategy<Value = Problem> {
-    proptest::collection::vec((1usize..10, prop::bool::weighted(0.65)), 1..7)
-        .prop_flat_map(|blocks| {
-            let conf: Vec<bool> = blocks
-                .iter()
-                .flat_map(|&(len, hc)| std::iter::repeat_n(hc, len))
-                .collect();
-            let n = conf.len();
-            (Just(conf), common::gradients(n))
-        })
-        .prop_map(|(conf, g)| common::problem(conf, &g))
+    runtime::random_problem(10, 7)
 }
 
 /// Shortest single execution, in control ticks, of the problems the N-robot properties cover.
