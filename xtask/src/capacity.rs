@@ -446,6 +446,64 @@ mod tests {
     }
 
     #[test]
+    fn the_row_takes_the_final_schedule_and_the_last_tenth_of_the_rounds() {
+        use tandem::sim::study::{
+            IterationRecord, PairStats, ScheduleSource, StudyConfig, StudyResult, TrialResult,
+        };
+        // Three robots, 30 executions: 10 rounds, the last 10 % is round 9 alone. Round k
+        // keeps the operator busy k/10 of the time and supervises 300·k ticks (10 ms) over the
+        // three robots: k s per task.
+        let record = |k: usize, t_total_s: f64| IterationRecord {
+            iteration: k,
+            t_total_s,
+            offset_s: 1.0,
+            high_conf_pct: 60.0,
+            source: ScheduleSource::Sampled,
+            lc_intervals_s: vec![vec![]; 3],
+            pair: (k < 10).then(|| PairStats {
+                overlap_ticks: 0,
+                operator_idle_share: 1.0 - k as f64 / 10.0,
+                duration_s: t_total_s,
+                supervised_ticks: 300 * k,
+                corrected_ticks: 0,
+                operator_busy_share: k as f64 / 10.0,
+            }),
+            lower_bound_s: t_total_s,
+            bound_is_optimum: false,
+            gap: 0.0,
+            throughput_per_h: 3.0 * 3600.0 / t_total_s,
+            offsets_s: vec![1.0, 2.0],
+        };
+        let trial = |k: usize, last_s: f64| TrialResult {
+            trial: k,
+            seed: k as u64,
+            iterations: (0..=10)
+                .map(|i| record(i, if i == 10 { last_s } else { 500.0 }))
+                .collect(),
+        };
+        let result = StudyResult {
+            config: StudyConfig {
+                executions: 30,
+                robots: 3,
+                ..StudyConfig::default()
+            },
+            n_ref: 100,
+            dt_s: 0.01,
+            ground_truth_pct: 66.0,
+            trials: vec![trial(0, 100.0), trial(1, 200.0)],
+        };
+        let row = row(&result, 1.0).unwrap();
+        assert_eq!((row.robots, row.executions, row.rounds), (3, 30, 10));
+        assert_eq!(row.t_total_mean_s, 150.0);
+        assert!((row.t_total_std_s - 50.0 * 2f64.sqrt()).abs() < 1e-12);
+        // 3·3600/100 = 108 and 3·3600/200 = 54 tasks per hour: mean 81.
+        assert_eq!(row.throughput_per_h, 81.0);
+        assert!((row.operator_busy_share - 0.9).abs() < 1e-15);
+        assert!((row.lc_s_per_task - 9.0).abs() < 1e-12);
+        assert_eq!(row.overlap_ticks, 0);
+    }
+
+    #[test]
     fn the_figure_renders_with_its_labels() {
         let dir = crate::fig5::tests::scratch_dir("capacity");
         let rows: Vec<CapacityRow> = (1..=4)
