@@ -11,7 +11,7 @@ use tandem::{ExecutionRecord, Planner, PlannerParams, derive_seed};
 use crate::cli::{
     Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
 };
-use crate::gantt::{certificate_line, gantt_text, schedule_json, source_name};
+use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_json, source_name};
 use crate::{input, plot, sim, state_io};
 
 /// Runs one command.
@@ -147,20 +147,11 @@ fn summary_lines(planner: &Planner) -> Result<()> {
         "schedule: {}",
         certificate_line(planner.problem(), planner.outcome())?
     ));
-    let offsets: Vec<String> = planner
-        .schedule()
-        .offsets_s
-        .iter()
-        .map(|t| format!("{t:.2}"))
-        .collect();
     // Two robots: `τ = 12.65 s`; N robots: `τ = 0.29, 0.58 s` (robots 2..N); one: no offset.
+    let offsets =
+        offsets_text(planner.schedule()).map_or("one robot".into(), |t| format!("τ = {t} s"));
     out(&format!(
-        "schedule: {}; {}",
-        if offsets.is_empty() {
-            "one robot".to_string()
-        } else {
-            format!("τ = {} s", offsets.join(", "))
-        },
+        "schedule: {offsets}; {}",
         source_name(&planner.outcome().source)
     ));
     Ok(())

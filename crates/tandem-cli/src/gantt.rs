@@ -4,7 +4,7 @@ use std::fmt::Write as _;
 
 use anyhow::Result;
 use serde_json::{Value, json};
-use tandem::schedule::{GlobalTimeline, LcInterval, Outcome, Problem, Source};
+use tandem::schedule::{GlobalTimeline, LcInterval, Outcome, Problem, Schedule, Source};
 
 /// Columns of the text Gantt's bars.
 const GANTT_COLUMNS: usize = 72;
@@ -27,6 +27,19 @@ pub(crate) fn serial_t_total_s(problem: &Problem, n_robots: usize, tick_s: f64) 
     Ok(problem
         .serial_schedule_n(n_robots, tick_s)?
         .t_total_s(problem.dt_s()))
+}
+
+/// The start offsets `τ_2, …, τ_N` of a schedule as text, `"12.65"` for two robots,
+/// `"0.29, 0.58"` for three (s, two decimals); `None` for a single robot.
+pub(crate) fn offsets_text(schedule: &Schedule) -> Option<String> {
+    (!schedule.offsets_s.is_empty()).then(|| {
+        schedule
+            .offsets_s
+            .iter()
+            .map(|t| format!("{t:.2}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    })
 }
 
 /// The certificate of a schedule in one line: its `T_total`, the margin-free lower bound

@@ -388,19 +388,11 @@ impl ScheduleFigure {
             schedule.n_robots(),
             schedule.tick_s,
         )?;
-        let offsets: Vec<String> = schedule
-            .offsets_s
-            .iter()
-            .map(|t| format!("{t:.2}"))
-            .collect();
-        let starts = match schedule.n_robots() {
-            1 => String::new(),
-            2 => format!(", robot 2 starts at τ = {} s", offsets[0]),
-            _ => format!(
-                ", robots 2–{} start at τ = {} s",
-                offsets.len() + 1,
-                offsets.join(", ")
-            ),
+        let n = schedule.n_robots();
+        let starts = match crate::gantt::offsets_text(schedule) {
+            None => String::new(),
+            Some(t) if n == 2 => format!(", robot 2 starts at τ = {t} s"),
+            Some(t) => format!(", robots 2–{n} start at τ = {t} s"),
         };
         Ok(Self {
             t_total_s: tl.t_total_s(),
