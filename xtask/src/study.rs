@@ -153,6 +153,7 @@ fn fig5_data(result: &StudyResult, summary: &[IterationSummary]) -> Fig5Data {
         high_conf_pct_mean: summary.iter().map(|s| s.high_conf_pct_mean).collect(),
         high_conf_pct_std: summary.iter().map(|s| s.high_conf_pct_std).collect(),
         ground_truth_pct: result.ground_truth_pct,
+        n_robots: result.config.robots,
         examples,
     }
 }

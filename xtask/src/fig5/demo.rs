@@ -86,6 +86,7 @@ fn demo_data() -> Fig5Data {
         high_conf_pct_mean: Vec::with_capacity(iterations.len()),
         high_conf_pct_std: Vec::with_capacity(iterations.len()),
         ground_truth_pct: 100.0 * (1.0 - 30.0 / DEMO_EXEC_S),
+        n_robots: 2,
         examples: Vec::new(),
     };
     for &k in &iterations {

@@ -52,6 +52,9 @@ pub(crate) struct Fig5Data {
     /// Ground-truth percentage (0–100) of reference samples that never need a correction
     /// (the paper's gray dotted line).
     pub ground_truth_pct: f64,
+    /// Robots per round (`N ≥ 1`; the paper's 2): names the iterations (pairs or rounds of
+    /// `N`) and the bound (`T*₀` for two robots, the operator-limited bound otherwise).
+    pub n_robots: usize,
     /// Example schedules drawn as coloured bars at a few iterations (may be empty).
     pub examples: Vec<ExampleSchedule>,
 }
@@ -550,7 +553,7 @@ fn draw_task_length_panel<DB: DrawingBackend>(
             .collect()
     } else {
         vec![(
-            format!("robot 1, 2, …, {n_robots} low-confidence"),
+            format!("robots 1–{n_robots} low-confidence"),
             (0..n_robots).map(Occupancy::Robot).collect(),
         )]
     };
@@ -606,7 +609,11 @@ fn draw_task_length_panel<DB: DrawingBackend>(
             MEAN.stroke_width(2),
         ))
         .map_err(draw_err("lower bound"))?
-        .label("mean lower bound T*₀ (no margins)")
+        .label(if data.n_robots == 2 {
+            "mean lower bound T*₀ (no margins)".to_string()
+        } else {
+            "mean lower bound (operator-limited)".to_string()
+        })
         .legend(|(x, y)| {
             EmptyElement::at((x, y))
                 + PathElement::new(vec![(0, 0), (6, 0)], MEAN.stroke_width(2))
@@ -640,7 +647,11 @@ fn draw_high_conf_panel<DB: DrawingBackend>(
         .configure_mesh()
         .x_label_formatter(&iteration_label)
         .y_label_formatter(&|v| format!("{v:.0}"))
-        .x_desc("iteration (pairs of executions)")
+        .x_desc(if data.n_robots == 2 {
+            "iteration (pairs of executions)".to_string()
+        } else {
+            format!("iteration (rounds of {} executions)", data.n_robots)
+        })
         .y_desc("high-confidence samples (%)")
         .label_style((FONT_FAMILY, TICK_FONT))
         .axis_desc_style((FONT_FAMILY, AXIS_FONT))
@@ -724,6 +735,7 @@ pub(crate) mod tests {
             high_conf_pct_mean: vec![0.0, 20.0, 35.0, 45.0, 50.0],
             high_conf_pct_std: vec![0.0, 3.0, 2.0, 1.0, 1.0],
             ground_truth_pct: 55.0,
+            n_robots: 2,
             examples: vec![
                 ExampleSchedule {
                     iteration: 0,
@@ -807,9 +819,12 @@ pub(crate) mod tests {
             Some(&(60.0, 65.0, Occupancy::Neither))
         );
         assert!(occupancy_segments(&data.examples[1]).contains(&(50.0, 60.0, Occupancy::Robot(2))));
+        data.n_robots = 3;
         draw_fig5(&data, &dir.join("a.svg"), &dir.join("a.png")).unwrap();
         let svg_text = std::fs::read_to_string(dir.join("a.svg")).unwrap();
-        assert!(svg_text.contains("robot 1, 2, …, 3 low-confidence"));
+        assert!(svg_text.contains("robots 1–3 low-confidence"));
+        assert!(svg_text.contains("iteration (rounds of 3 executions)"));
+        assert!(svg_text.contains("mean lower bound (operator-limited)"));
         assert!(svg_text.contains("none low-confidence"));
         assert!(svg_text.contains("#FF7F0E"), "robot 3 orange bar segment");
         std::fs::remove_dir_all(&dir).unwrap();
