@@ -20,6 +20,7 @@ Every error is a :class:`TandemError`: :class:`InputError`, :class:`ParamError`,
 """
 
 from ._tandem import (
+    MAX_ROBOTS,
     N_ROBOTS,
     Confidence,
     Coordinator,
@@ -45,6 +46,7 @@ from ._tandem import (
 from . import sim, study
 
 __all__ = [
+    "MAX_ROBOTS",
     "N_ROBOTS",
     "Confidence",
     "Coordinator",

@@ -2,7 +2,7 @@
 
 Shapes: ``T_ref`` reference samples, ``C`` channels, ``d`` tangent coordinates (``C`` with
 quaternion blocks as rotation vectors, plus the rate), ``K`` correction components, ``N``
-robots (2 in this build). Times in seconds unless named in samples.
+robots (1 to ``MAX_ROBOTS`` = 8; ``fit(robots=...)``, default ``N_ROBOTS`` = 2). Times in seconds unless named in samples.
 """
 
 from os import PathLike
@@ -20,6 +20,7 @@ Params = Union[None, Mapping[str, Any], str, PathLike]
 Demo = Union[Path, ArrayLike]
 
 N_ROBOTS: int
+MAX_ROBOTS: int
 __version__: str
 
 class TandemError(Exception):
@@ -55,6 +56,7 @@ def fit(
     channels: Optional[Sequence[str]] = None,
     params: Params = None,
     dt_s: Optional[float] = None,
+    robots: int = 2,
 ) -> Planner:
     """Learns the task from demonstrations (paths or ``(T_i, C)`` arrays) and makes the first
     schedule (Fig. 2); the same inputs and parameters as ``tandem fit`` give the same state."""
@@ -81,6 +83,16 @@ class Planner:
         """Loads a state file (written here or by the command line)."""
     def save(self, path: Path) -> None:
         """Saves the state file atomically (the previous file survives any error)."""
+    def record_round(
+        self,
+        executions: Sequence[Demo],
+        ref_time_logs: Sequence[ArrayLike],
+        supervised: Sequence[ArrayLike],
+        corrected: Sequence[ArrayLike],
+        channels: Optional[Sequence[str]] = None,
+    ) -> Dict[str, Any]:
+        """Records one execution per robot (``N`` of each argument; Eq. 21, 9–12) and
+        re-schedules (§II-C)."""
     def record_pair(
         self,
         executions: Sequence[Demo],
@@ -89,7 +101,7 @@ class Planner:
         corrected: Sequence[ArrayLike],
         channels: Optional[Sequence[str]] = None,
     ) -> Dict[str, Any]:
-        """Records one execution per robot (Eq. 21, 9–12) and re-schedules (§II-C)."""
+        """:meth:`record_round` under the paper's name (two robots)."""
     def reschedule(
         self,
         samples: Optional[int] = None,
@@ -114,7 +126,7 @@ class Planner:
         """The parameters as a nested dict."""
     @property
     def pairs_recorded(self) -> int:
-        """Pairs of executions recorded so far."""
+        """Rounds of executions (pairs for two robots) recorded so far."""
     @property
     def n_robots(self) -> int:
         """Robots scheduled (``N``)."""
@@ -225,13 +237,14 @@ class Problem:
     def grad_min(self) -> F64: ...
     @property
     def grad_max(self) -> F64: ...
-    def serial_schedule(self, tick_s: Optional[float] = None) -> Schedule: ...
+    def serial_schedule(self, tick_s: Optional[float] = None, robots: int = 2) -> Schedule: ...
     def sample_schedule(
         self,
         samples: int = 5000,
         seed: int = 0,
         tick_s: Optional[float] = None,
         previous: Optional[Schedule] = None,
+        robots: int = 2,
     ) -> Schedule: ...
 
 class Schedule:
@@ -356,14 +369,14 @@ def study_run(
 def study_run_trial(
     task: StudyTask, config: Params, trial: int
 ) -> Tuple[Dict[str, Any], Dict[str, float]]: ...
-def sim_run_pair(
+def sim_run_round(
     planner: Planner,
     needs: ArrayLike,
     seed: int,
     operator: Optional[Mapping[str, Any]] = None,
 ) -> Dict[str, Any]: ...
 def sim_sanding_needs(
-    labels: Path, seed: int, task: Optional[Mapping[str, Any]] = None
+    labels: Path, seed: int, task: Optional[Mapping[str, Any]] = None, robots: int = 2
 ) -> Bool: ...
 def sim_correction_input(
     planner: Planner, ref_time: float, force_channel: str = "force", gain: float = ...

@@ -1,12 +1,13 @@
 """The simulated workcell of the paper's §III: run a schedule once with a simulated operator.
 
-:func:`run_pair` runs the planner's current schedule through the Rust real-time coordinator at
+:func:`run_round` (:func:`run_pair` for two robots) runs the planner's current schedule through the Rust real-time coordinator at
 the schedule's tick, one control tick per reference sample period, while a simulated operator
 supervises the low-confidence robot: it corrects the samples that need it (missing 1 %), and
 corrects unneeded ones 1 % of the time in short episodes (``tandem_sim::workcell``). Each
 correction is a joystick input along the model's correction directions that raises the force
 and slows the robot (:func:`correction_input`); the rate of the resulting command (Eq. 7)
-is the operator's gradient for the coordinator. The result feeds :meth:`tandem.Planner.record_pair`.
+is the operator's gradient for the coordinator. The result feeds
+:meth:`tandem.Planner.record_round`.
 """
 
 from __future__ import annotations
@@ -17,9 +18,17 @@ from typing import Any, Mapping, Optional, Union
 
 import numpy as np
 
-from ._tandem import Planner, sim_correction_input, sim_run_pair, sim_sanding_needs
+from ._tandem import Planner, sim_correction_input, sim_run_round, sim_sanding_needs
 
-__all__ = ["PairRun", "RobotRun", "correction_input", "run_pair", "sanding_needs"]
+__all__ = [
+    "PairRun",
+    "RobotRun",
+    "RoundRun",
+    "correction_input",
+    "run_pair",
+    "run_round",
+    "sanding_needs",
+]
 
 
 @dataclass(frozen=True)
@@ -47,8 +56,8 @@ class RobotRun:
 
 
 @dataclass(frozen=True)
-class PairRun:
-    """A pair of executions run under one schedule.
+class RoundRun:
+    """A round of executions, one per robot, run under one schedule.
 
     Attributes:
         robots: one :class:`RobotRun` per robot.
@@ -59,6 +68,8 @@ class PairRun:
         idle_ticks: ticks in which no robot was low-confidence (the operator was free).
         duration_s: ``ticks · tick_s`` (s).
         operator_idle_share: ``idle_ticks / ticks``.
+        operator_busy_share: ``1 − idle_ticks / ticks``: the share of the round's ticks in
+            which some robot was low-confidence (the operator was needed).
     """
 
     robots: list
@@ -68,9 +79,11 @@ class PairRun:
     idle_ticks: int
     duration_s: float
     operator_idle_share: float
+    operator_busy_share: float
 
     def record_args(self) -> dict:
-        """The keyword arguments of :meth:`tandem.Planner.record_pair` for this run."""
+        """The keyword arguments of :meth:`tandem.Planner.record_round` (and
+        :meth:`tandem.Planner.record_pair`) for this run."""
         return {
             "executions": [r.samples for r in self.robots],
             "ref_time_logs": [r.ref_time_log for r in self.robots],
@@ -79,13 +92,18 @@ class PairRun:
         }
 
 
-def run_pair(
+#: The paper's two-robot round.
+PairRun = RoundRun
+
+
+def run_round(
     planner: Planner,
     needs: Any,
     seed: int,
     operator: Optional[Mapping[str, Any]] = None,
-) -> PairRun:
-    """Runs the planner's current schedule once in the simulated workcell (§III).
+) -> RoundRun:
+    """Runs the planner's current schedule once in the simulated workcell (§III): one
+    execution per robot (``planner.n_robots``).
 
     Args:
         planner: the planner whose model, problem and schedule to run.
@@ -100,15 +118,26 @@ def run_pair(
         InputError: ``needs`` of the wrong shape or dtype.
         ScheduleError: a schedule made for another tick than the reference period.
     """
-    raw = sim_run_pair(planner, needs, seed, operator)
+    raw = sim_run_round(planner, needs, seed, operator)
     robots = [RobotRun(**r) for r in raw.pop("robots")]
-    return PairRun(robots=robots, **raw)
+    return RoundRun(robots=robots, **raw)
+
+
+def run_pair(
+    planner: Planner,
+    needs: Any,
+    seed: int,
+    operator: Optional[Mapping[str, Any]] = None,
+) -> RoundRun:
+    """:func:`run_round` under the paper's name (a two-robot planner runs a pair)."""
+    return run_round(planner, needs, seed, operator)
 
 
 def sanding_needs(
     labels: Union[str, PathLike],
     seed: int,
     task: Optional[Mapping[str, Any]] = None,
+    robots: int = 2,
 ) -> np.ndarray:
     """Which reference samples need a correction on ``N`` random sanding workpieces (§III).
 
@@ -120,11 +149,12 @@ def sanding_needs(
             fixtures' layout: ``pass,section,painted,phase``).
         seed: seed of the workpieces' draw.
         task: task parameters (dict; only ``n_sections`` matters).
+        robots: ``N``, one workpiece per robot (1 to 8; default 2).
 
     Returns:
         ``(N, T_ref)`` bool array.
     """
-    return sim_sanding_needs(labels, seed, task)
+    return sim_sanding_needs(labels, seed, task, robots)
 
 
 def correction_input(

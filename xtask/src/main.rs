@@ -4,6 +4,7 @@
 //! dispatches, so that tasks added by different issues do not touch each other's code.
 #![allow(clippy::print_stdout, reason = "xtask reports to the terminal")]
 
+mod capacity;
 mod fig5;
 mod fixtures;
 mod reference_order;
@@ -37,6 +38,9 @@ struct Cli {
 enum Cmd {
     /// Run the simulated study of §III and draw Fig. 5 (defaults: fixtures/study.toml).
     Study(study::StudyArgs),
+    /// Run the study for N = 1..8 robots with reduced sizes and draw throughput and operator
+    /// busy share against N (results/capacity/capacity.svg and .png; docs/study.md).
+    Capacity(capacity::CapacityArgs),
     /// Regenerate the generated fixtures: the sanding demonstrations in fixtures/sanding/
     /// and the golden state file in fixtures/state/ (see fixtures/README.md).
     Fixtures {
@@ -72,6 +76,7 @@ fn main() -> anyhow::Result<()> {
     match cli.cmd {
         Cmd::Fixtures { check } => fixtures::run(check),
         Cmd::Study(args) => study::run(&args),
+        Cmd::Capacity(args) => capacity::run(&args),
         Cmd::Stress {
             executions,
             robots,

@@ -29,9 +29,14 @@ pub(crate) struct StudyArgs {
     /// Number of trials.
     #[arg(long)]
     trials: Option<usize>,
-    /// Executions per trial (even: they run in pairs).
+    /// Executions per trial (a multiple of the robot count: they run in rounds of one
+    /// execution per robot).
     #[arg(long)]
     executions: Option<usize>,
+    /// Robots N run by the one operator (1 to 8; default: the configuration's, 2). The
+    /// configured executions are rounded down to a multiple of N unless --executions is given.
+    #[arg(long)]
+    robots: Option<usize>,
     /// Sampler iterations per re-schedule.
     #[arg(long)]
     samples: Option<usize>,
@@ -85,14 +90,31 @@ pub(crate) fn read_config(path: Option<&Path>) -> anyhow::Result<(StudyConfig, P
     Ok((config, path))
 }
 
-/// The configuration file with the flags applied.
+/// The configuration file with the flags applied. With `--robots N` and no `--executions`,
+/// the configured executions are rounded down to a multiple of `N` (a remainder cannot form
+/// a round), and a note says so.
 fn config(args: &StudyArgs) -> anyhow::Result<StudyConfig> {
     let (mut config, path) = read_config(args.config.as_deref())?;
     if let Some(v) = args.trials {
         config.trials = v;
     }
+    if let Some(v) = args.robots {
+        config.robots = v;
+    }
     if let Some(v) = args.executions {
         config.executions = v;
+    } else if let Some(n) = args.robots.filter(|&n| n > 0) {
+        let whole = config.executions / n * n;
+        if whole != config.executions && whole > 0 {
+            println!(
+                "note: {} executions do not fill rounds of {n} robots; running {whole} \
+                 ({} rounds), the remainder of {} is dropped",
+                config.executions,
+                whole / n,
+                config.executions - whole
+            );
+            config.executions = whole;
+        }
     }
     if let Some(v) = args.samples {
         config.samples = v;
@@ -119,8 +141,7 @@ fn fig5_data(result: &StudyResult, summary: &[IterationSummary]) -> Fig5Data {
             ExampleSchedule {
                 iteration: r.iteration,
                 t_total_s: r.t_total_s,
-                lc_robot1: pairs(&r.lc_intervals_s[0]),
-                lc_robot2: pairs(&r.lc_intervals_s[1]),
+                lc: r.lc_intervals_s.iter().map(|v| pairs(v)).collect(),
             }
         })
         .collect();
@@ -128,9 +149,11 @@ fn fig5_data(result: &StudyResult, summary: &[IterationSummary]) -> Fig5Data {
         iterations: summary.iter().map(|s| s.iteration).collect(),
         t_total_mean_s: summary.iter().map(|s| s.t_total_mean_s).collect(),
         t_total_std_s: summary.iter().map(|s| s.t_total_std_s).collect(),
+        lower_bound_mean_s: summary.iter().map(|s| s.lower_bound_mean_s).collect(),
         high_conf_pct_mean: summary.iter().map(|s| s.high_conf_pct_mean).collect(),
         high_conf_pct_std: summary.iter().map(|s| s.high_conf_pct_std).collect(),
         ground_truth_pct: result.ground_truth_pct,
+        n_robots: result.config.robots,
         examples,
     }
 }
@@ -171,11 +194,11 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
         .with_context(|| format!("reading demonstrations from {}", fixtures.display()))?;
     let out = args.out.clone().unwrap_or_else(|| root.join("results"));
 
-    let n_pairs = config.n_pairs();
-    let bar = ProgressBar::new((config.trials * n_pairs) as u64);
+    let n_rounds = config.n_rounds();
+    let bar = ProgressBar::new((config.trials * n_rounds) as u64);
     bar.set_style(
         ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {pos}/{len} pairs, {msg} (eta {eta})",
+            "{elapsed_precise} [{bar:40}] {pos}/{len} rounds, {msg} (eta {eta})",
         )
         .context("progress bar template")?
         .progress_chars("=> "),
@@ -184,7 +207,7 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
     bar.set_message(format!("0/{} trials done", config.trials));
     let (result, times) = tandem::sim::study::run_study(&config, &inputs, &|p| {
         bar.inc(1);
-        if p.pairs_done == n_pairs {
+        if p.pairs_done == n_rounds {
             let done = trials_done.fetch_add(1, Ordering::Relaxed) + 1;
             bar.set_message(format!("{done}/{} trials done", config.trials));
         }
@@ -214,8 +237,13 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
 
     let (first, last) = (&summary[0], &summary[summary.len() - 1]);
     println!(
-        "{} trials × {} executions, {} samples per schedule, seed {}",
-        config.trials, config.executions, config.samples, config.seed
+        "{} trials × {} executions ({} rounds of {} robots), {} samples per schedule, seed {}",
+        config.trials,
+        config.executions,
+        config.n_rounds(),
+        config.robots,
+        config.samples,
+        config.seed
     );
     println!(
         "T_total: {:.2} ± {:.2} s at iteration 0 → {:.2} ± {:.2} s at iteration {}",
@@ -229,6 +257,25 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
         "high confidence: {:.1} % → {:.1} % (ground truth {:.1} %)",
         first.high_conf_pct_mean, last.high_conf_pct_mean, result.ground_truth_pct
     );
+    println!(
+        "certificate at iteration {}: lower bound {:.2} s (the proven margin-free optimum in {:.0} % of trials), \
+         mean gap {:.1} %",
+        last.iteration,
+        last.lower_bound_mean_s,
+        100.0 * last.bound_proven_share,
+        100.0 * last.gap_mean
+    );
+    let last_round = summary.iter().rev().find_map(|s| {
+        s.operator_busy_share_mean
+            .map(|b| (s.iteration, s.throughput_mean_per_h, b))
+    });
+    if let Some((k, throughput, busy)) = last_round {
+        println!(
+            "round at iteration {k}: {throughput:.1} tasks per hour per operator (planned), \
+             operator busy {:.1} % of the round",
+            100.0 * busy
+        );
+    }
     println!(
         "overlapping low-confidence ticks: {}",
         result.total_overlap_ticks()

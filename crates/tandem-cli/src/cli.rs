@@ -49,6 +49,7 @@ pub(crate) enum Command {
     ///   tandem fit fixtures/sanding/demo_?.csv -o cell.tandem
     ///   tandem fit a.csv b.csv c.csv --ranges force=20,x=0.5 --params params.toml --samples 2000 -o cell.tandem
     ///   tandem fit fixtures/sanding/demo_?.csv --reference medoid -o cell.tandem
+    ///   tandem fit fixtures/sanding/demo_?.csv --robots 3 -o cell3.tandem
     #[command(verbatim_doc_comment)]
     Fit(FitArgs),
     /// Re-optimize the schedule of a state file and show it (text Gantt, or JSON).
@@ -67,10 +68,12 @@ pub(crate) enum Command {
     ///   tandem schedule cell.tandem --json > schedule.json
     #[command(verbatim_doc_comment)]
     Schedule(ScheduleArgs),
-    /// Add an executed pair of executions (Eq. 21), update the confidence, re-schedule, save.
+    /// Add an executed round (one execution per robot; a pair for two robots) (Eq. 21),
+    /// update the confidence, re-schedule, save.
     ///
-    /// Give exactly two executions (robot 1 first), each with its execution CSV, its
-    /// reference-time log and its correction flags. Everything is checked before the state
+    /// Give exactly one execution per robot of the state file (robot 1 first; two unless
+    /// fitted with --robots), each with its execution CSV, its reference-time log and its
+    /// correction flags. Everything is checked before the state
     /// file is replaced (atomically); on any error it is left byte for byte as it was.
     ///
     /// Example:
@@ -101,7 +104,8 @@ pub(crate) enum Command {
     ///   tandem plot cell.tandem -o plots/
     #[command(verbatim_doc_comment)]
     Plot(PlotArgs),
-    /// What-if: run pairs with a simulated operator on your model; nothing is saved.
+    /// What-if: run pairs (rounds of N robots) with a simulated operator on your model;
+    /// nothing is saved.
     ///
     /// NEED.csv gives, per reference sample, the probability that a correction is needed
     /// (column `need`, optional integer column `region`: samples of one region share one
@@ -165,6 +169,10 @@ pub(crate) struct FitArgs {
     /// Sample period (s) of demonstrations without a time column `t`. Default: 0.01.
     #[arg(long, value_name = "SECONDS")]
     pub(crate) dt: Option<f64>,
+    /// Robots run by the one operator, 1 to 8 (the paper: 2): every schedule has N warps and
+    /// `tandem record` takes N executions per round. Stored in the state file.
+    #[arg(long, value_name = "N", default_value_t = 2)]
+    pub(crate) robots: usize,
     /// Sampler overrides.
     #[command(flatten)]
     pub(crate) sampler: SamplerArgs,
@@ -212,7 +220,7 @@ pub(crate) struct ScheduleArgs {
 pub(crate) struct RecordArgs {
     /// The state file (updated atomically).
     pub(crate) state: PathBuf,
-    /// Execution CSV of robot 1, then of robot 2 (channel columns, optional `t`).
+    /// Execution CSV of robot 1, then robot 2, … (channel columns, optional `t`).
     #[arg(long, value_name = "CSV", num_args = 1, required = true)]
     pub(crate) execution: Vec<PathBuf>,
     /// Reference-time log of each execution (column `ref_sample`), same order.
@@ -252,8 +260,9 @@ pub(crate) struct SimulateArgs {
     /// Probability of a needed correction per reference sample (CSV, see docs/formats.md).
     #[arg(long, value_name = "CSV")]
     pub(crate) need: PathBuf,
-    /// Number of pairs to run.
-    #[arg(long, value_name = "N")]
+    /// Number of rounds to run (one execution per robot of the state file; pairs for two
+    /// robots).
+    #[arg(long, value_name = "N", alias = "rounds")]
     pub(crate) pairs: usize,
     /// Write every execution into this folder in `tandem record`'s formats.
     #[arg(long, value_name = "DIR")]

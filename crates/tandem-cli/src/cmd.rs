@@ -11,7 +11,7 @@ use tandem::{ExecutionRecord, Planner, PlannerParams, derive_seed};
 use crate::cli::{
     Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
 };
-use crate::gantt::{certificate_line, gantt_text, schedule_json, source_name};
+use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_json, source_name};
 use crate::{input, plot, sim, state_io};
 
 /// Runs one command.
@@ -68,6 +68,10 @@ fn fit(a: &FitArgs) -> Result<()> {
     {
         bail!("--dt {dt}: the sample period must be finite and > 0 seconds");
     }
+    let max = tandem::realtime::MAX_ROBOTS;
+    if !(1..=max).contains(&a.robots) {
+        bail!("--robots {}: one operator runs 1 to {max} robots", a.robots);
+    }
     state_io::check_file_target(&a.output)?;
     let demos = a
         .demos
@@ -97,13 +101,14 @@ fn fit(a: &FitArgs) -> Result<()> {
         }
         params.fit.ranges = Some(ranges);
     }
-    let planner = Planner::new(&demos, params).with_context(|| match &a.params {
-        Some(p) => format!(
-            "cannot fit the task model (parameters from {})",
-            p.display()
-        ),
-        None => "cannot fit the task model".into(),
-    })?;
+    let planner =
+        Planner::with_robots(&demos, params, a.robots).with_context(|| match &a.params {
+            Some(p) => format!(
+                "cannot fit the task model (parameters from {})",
+                p.display()
+            ),
+            None => "cannot fit the task model".into(),
+        })?;
     planner.save(&a.output)?;
     let model = planner.model();
     let files: Vec<String> = a.demos.iter().map(|p| p.display().to_string()).collect();
@@ -142,9 +147,11 @@ fn summary_lines(planner: &Planner) -> Result<()> {
         "schedule: {}",
         certificate_line(planner.problem(), planner.outcome())?
     ));
+    // Two robots: `τ = 12.65 s`; N robots: `τ = 0.29, 0.58 s` (robots 2..N); one: no offset.
+    let offsets =
+        offsets_text(planner.schedule()).map_or("one robot".into(), |t| format!("τ = {t} s"));
     out(&format!(
-        "schedule: τ = {:.2} s; {}",
-        planner.schedule().start_s(1),
+        "schedule: {offsets}; {}",
         source_name(&planner.outcome().source)
     ));
     Ok(())
@@ -257,19 +264,22 @@ fn read_execution(
 }
 
 fn record(a: &RecordArgs) -> Result<()> {
+    let mut planner = state_io::load(&a.state)?;
+    let n = planner.n_robots();
     for (flag, v) in [
         ("--execution", &a.execution),
         ("--log", &a.log),
         ("--corrections", &a.corrections),
     ] {
-        if v.len() != 2 {
+        if v.len() != n {
             bail!(
-                "{flag} given {} time(s); a pair needs exactly 2 (robot 1, then robot 2)",
-                v.len()
+                "{flag} given {} time(s); {} has {n} robots, so a round needs exactly {n} \
+                 (robot 1 first)",
+                v.len(),
+                a.state.display()
             );
         }
     }
-    let mut planner = state_io::load(&a.state)?;
     let before_t = planner.outcome().t_total_s;
     let before_high = planner.confidence().high_share();
     let r = |i: usize| {
@@ -281,13 +291,16 @@ fn record(a: &RecordArgs) -> Result<()> {
             &a.corrections[i],
         )
     };
-    let pair = [r(0)?, r(1)?];
-    let report = planner
-        .record_pair(&pair)
-        .context("cannot record the pair")?;
+    let round = (0..n).map(r).collect::<Result<Vec<_>>>()?;
+    let report = planner.record_round(&round).context(if n == 2 {
+        "cannot record the pair"
+    } else {
+        "cannot record the round"
+    })?;
     planner.save(&a.state)?;
     out(&format!(
-        "recorded pair {} into {}",
+        "recorded {} {} into {}",
+        if n == 2 { "pair" } else { "round" },
         planner.pairs_recorded(),
         a.state.display()
     ));

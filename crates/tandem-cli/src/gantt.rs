@@ -4,7 +4,7 @@ use std::fmt::Write as _;
 
 use anyhow::Result;
 use serde_json::{Value, json};
-use tandem::schedule::{GlobalTimeline, LcInterval, Outcome, Problem, Source};
+use tandem::schedule::{GlobalTimeline, LcInterval, Outcome, Problem, Schedule, Source};
 
 /// Columns of the text Gantt's bars.
 const GANTT_COLUMNS: usize = 72;
@@ -20,21 +20,40 @@ pub(crate) fn source_name(source: &Source) -> String {
     }
 }
 
-/// `T_total` (s) of the fastest serial schedule of `problem` (robot 2 starts when robot 1 ends)
-/// at control tick `tick_s` (s; `T_total` does not depend on it, the schedule does).
-pub(crate) fn serial_t_total_s(problem: &Problem, tick_s: f64) -> Result<f64> {
-    Ok(problem.serial_schedule(tick_s)?.t_total_s(problem.dt_s()))
+/// `T_total` (s) of the fastest serial schedule of `n_robots` robots on `problem` (each robot
+/// starts when the one before it ends) at control tick `tick_s` (s; `T_total` does not depend
+/// on it, the schedule does).
+pub(crate) fn serial_t_total_s(problem: &Problem, n_robots: usize, tick_s: f64) -> Result<f64> {
+    Ok(problem
+        .serial_schedule_n(n_robots, tick_s)?
+        .t_total_s(problem.dt_s()))
+}
+
+/// The start offsets `τ_2, …, τ_N` of a schedule as text, `"12.65"` for two robots,
+/// `"0.29, 0.58"` for three (s, two decimals); `None` for a single robot.
+pub(crate) fn offsets_text(schedule: &Schedule) -> Option<String> {
+    (!schedule.offsets_s.is_empty()).then(|| {
+        schedule
+            .offsets_s
+            .iter()
+            .map(|t| format!("{t:.2}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    })
 }
 
 /// The certificate of a schedule in one line: its `T_total`, the margin-free lower bound
 /// `T*₀` with the gap to it, and the fastest serial schedule's `T_total` (all s), e.g.
 /// `T_total 90.34 s — lower bound 89.91 s without margins (+0.49 %), fastest serial 145.75 s`.
 pub(crate) fn certificate_line(problem: &Problem, outcome: &Outcome) -> Result<String> {
-    let serial = serial_t_total_s(problem, outcome.schedule.tick_s)?;
+    let s = &outcome.schedule;
+    let serial = serial_t_total_s(problem, s.n_robots(), s.tick_s)?;
     let bound = if outcome.bound_is_optimum {
         "lower bound"
-    } else {
+    } else if s.n_robots() == 2 {
         "lower bound (search budget spent: not the optimum)"
+    } else {
+        "operator-limited lower bound (every robot's low-confidence time in turn)"
     };
     Ok(format!(
         "T_total {:.2} s — {bound} {:.2} s without margins (+{:.2} %), fastest serial {serial:.2} s",
@@ -44,8 +63,8 @@ pub(crate) fn certificate_line(problem: &Problem, outcome: &Outcome) -> Result<S
     ))
 }
 
-/// Both robots' low-confidence intervals with their robot index (0 or 1), sorted by start
-/// (robot 1 first on a tie).
+/// Every robot's low-confidence intervals with their robot index (0-based), sorted by start
+/// (the lower robot first on a tie).
 fn sorted_intervals(tl: &GlobalTimeline) -> Vec<(usize, LcInterval)> {
     let mut out: Vec<(usize, LcInterval)> = tl
         .lc_intervals()
@@ -57,8 +76,8 @@ fn sorted_intervals(tl: &GlobalTimeline) -> Vec<(usize, LcInterval)> {
     out
 }
 
-/// The schedule as JSON: offset, per-robot gradients, low-confidence intervals in global
-/// time, `T_total` and its certificate (the margin-free lower bound, whether it is the proven
+/// The schedule as JSON: robot count, offsets, per-robot gradients and durations,
+/// low-confidence intervals in global time, `T_total` and its certificate (the margin-free lower bound, whether it is the proven
 /// optimum, the gap) (all times in seconds of global time; gradients in execution samples per
 /// reference sample). `schedule` is exactly `tandem::schedule::Schedule`'s serde form.
 pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Value> {
@@ -82,8 +101,10 @@ pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Valu
         "lower_bound_s": outcome.lower_bound_s,
         "bound_is_optimum": outcome.bound_is_optimum,
         "gap": outcome.gap,
-        "serial_t_total_s": serial_t_total_s(problem, s.tick_s)?,
-        "offset_s": s.start_s(1),
+        "serial_t_total_s": serial_t_total_s(problem, s.n_robots(), s.tick_s)?,
+        "n_robots": s.n_robots(),
+        "offset_s": s.offsets_s.first(),
+        "offsets_s": s.offsets_s,
         "durations_s": s.durations_s(dt),
         "dt_s": dt,
         "tick_s": s.tick_s,
@@ -95,18 +116,19 @@ pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Valu
 }
 
 /// The text Gantt chart: one bar per robot over `[0, T_total]` (`=` running high-confidence,
-/// `#` running low-confidence, blank not running) and the operator's row (`1`/`2`: which
-/// robot is supervised, `.` idle), followed by the low-confidence intervals.
+/// `#` running low-confidence, blank not running) and the operator's row (`1`…`8`: which
+/// robot is supervised, `.` idle, `!` two or more), followed by the low-confidence intervals.
 pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String> {
     let tl = GlobalTimeline::new(problem, &outcome.schedule)?;
     let t_total = tl.t_total_s();
     let spans = tl.spans_s();
-    let mut rows = [String::new(), String::new(), String::new()];
+    let n = outcome.schedule.n_robots();
+    let mut rows = vec![String::new(); n + 1];
     for c in 0..GANTT_COLUMNS {
         let t = (c as f64 + 0.5) / GANTT_COLUMNS as f64 * t_total;
         let conf = tl.conf_at(t);
         let mut supervised = Vec::new();
-        for i in 0..2 {
+        for i in 0..n {
             let running = t >= spans[i].0 && t < spans[i].1;
             rows[i].push(match (running, conf[i]) {
                 (false, _) => ' ',
@@ -117,22 +139,39 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
                 }
             });
         }
-        rows[2].push(match supervised.as_slice() {
+        rows[n].push(match supervised.as_slice() {
             [] => '.',
-            [0] => '1',
-            [1] => '2',
+            [i] => char::from_digit(*i as u32 + 1, 10).unwrap_or('?'),
             _ => '!',
         });
     }
     let mut out = String::new();
     let dt = problem.dt_s();
     let d = outcome.schedule.durations_s(dt);
-    let (d0, d1) = (d[0], d.get(1).copied().unwrap_or(f64::NAN));
     writeln!(out, "{}", certificate_line(problem, outcome)?)?;
+    let starts: Vec<String> = (1..n)
+        .map(|i| {
+            format!(
+                "robot {} starts at τ = {:.2} s",
+                i + 1,
+                outcome.schedule.start_s(i)
+            )
+        })
+        .collect();
+    let runs: Vec<String> = d
+        .iter()
+        .enumerate()
+        .map(|(i, d)| format!("robot {} runs {d:.2} s", i + 1))
+        .collect();
+    let starts = if starts.is_empty() {
+        String::new()
+    } else {
+        starts.join(", ") + "; "
+    };
     writeln!(
         out,
-        "robot 2 starts at τ = {:.2} s; robot 1 runs {d0:.2} s, robot 2 runs {d1:.2} s; schedule: {}",
-        outcome.schedule.start_s(1),
+        "{starts}{}; schedule: {}",
+        runs.join(", "),
         source_name(&outcome.source)
     )?;
     writeln!(out)?;
@@ -142,9 +181,10 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
         format!("{t_total:.1} s"),
         w = GANTT_COLUMNS - 3
     )?;
-    writeln!(out, "robot 1  |{}|", rows[0])?;
-    writeln!(out, "robot 2  |{}|", rows[1])?;
-    writeln!(out, "operator |{}|", rows[2])?;
+    for (i, row) in rows[..n].iter().enumerate() {
+        writeln!(out, "robot {}  |{row}|", i + 1)?;
+    }
+    writeln!(out, "operator |{}|", rows[n])?;
     writeln!(
         out,
         "          = high confidence (unsupervised)   # low confidence (operator supervises)"

@@ -14,7 +14,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use tandem::Planner;
 use tandem::schedule::GlobalTimeline;
-use tandem_plot::{FONT_FAMILY, HIGH_CONFIDENCE, MEAN, NEITHER_LC, ROBOT_LC};
+use tandem_plot::{FONT_FAMILY, HIGH_CONFIDENCE, MEAN, NEITHER_LC, ROBOT_LC_N};
 /// Figure width (px, SVG user units).
 const WIDTH: u32 = 1200;
 /// Height of one panel (px).
@@ -365,33 +365,43 @@ impl Figure for ConfidenceFigure<'_> {
     }
 }
 
-/// Both robots in global time: gray running high-confidence, blue/red low-confidence.
+/// Every robot in global time: gray running high-confidence, each robot's colour
+/// (`ROBOT_LC_N`: robot 1 blue, robot 2 red, …) low-confidence.
 struct ScheduleFigure {
     t_total_s: f64,
-    spans: [(f64, f64); 2],
-    lc: [Vec<(f64, f64)>; 2],
+    spans: Vec<(f64, f64)>,
+    lc: Vec<Vec<(f64, f64)>>,
     title: String,
 }
 
 impl ScheduleFigure {
     fn new(planner: &Planner) -> Result<Self> {
         let tl = GlobalTimeline::new(planner.problem(), planner.schedule())?;
-        let all = tl.lc_intervals();
-        let lc = [0, 1].map(|r| {
-            all.get(r).map_or_else(Vec::new, |v| {
-                v.iter().map(|iv| (iv.start_s, iv.end_s)).collect()
-            })
-        });
-        let serial = crate::gantt::serial_t_total_s(planner.problem(), planner.schedule().tick_s)?;
+        let lc = tl
+            .lc_intervals()
+            .iter()
+            .map(|v| v.iter().map(|iv| (iv.start_s, iv.end_s)).collect())
+            .collect();
+        let schedule = planner.schedule();
+        let serial = crate::gantt::serial_t_total_s(
+            planner.problem(),
+            schedule.n_robots(),
+            schedule.tick_s,
+        )?;
+        let n = schedule.n_robots();
+        let starts = match crate::gantt::offsets_text(schedule) {
+            None => String::new(),
+            Some(t) if n == 2 => format!(", robot 2 starts at τ = {t} s"),
+            Some(t) => format!(", robots 2–{n} start at τ = {t} s"),
+        };
         Ok(Self {
             t_total_s: tl.t_total_s(),
-            spans: [0, 1].map(|r| tl.spans_s().get(r).copied().unwrap_or((0.0, 0.0))),
+            spans: tl.spans_s(),
             lc,
             title: format!(
-                "schedule: T_total {:.2} s (fastest serial {:.2} s), robot 2 starts at τ = {:.2} s",
+                "schedule: T_total {:.2} s (fastest serial {:.2} s){starts}",
                 tl.t_total_s(),
                 serial,
-                planner.schedule().start_s(1)
             ),
         })
     }
@@ -402,7 +412,7 @@ impl Figure for ScheduleFigure {
         "schedule"
     }
     fn height(&self) -> u32 {
-        260
+        60 + 100 * self.spans.len() as u32
     }
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
         root.fill(&WHITE).map_err(de)?;
@@ -411,19 +421,24 @@ impl Figure for ScheduleFigure {
             .margin(10)
             .x_label_area_size(40)
             .y_label_area_size(10)
-            .build_cartesian_2d(0.0..self.t_total_s.max(1e-9), 0.0..2.0)
+            .build_cartesian_2d(0.0..self.t_total_s.max(1e-9), 0.0..self.spans.len() as f64)
             .map_err(de)?;
         chart
             .configure_mesh()
             .disable_y_mesh()
             .light_line_style(WHITE)
             .y_labels(0)
-            .x_desc("global time (s); blue = robot 1 low-confidence, red = robot 2 low-confidence, gray = high-confidence")
+            .x_desc(if self.spans.len() <= 2 {
+                "global time (s); blue = robot 1 low-confidence, red = robot 2 low-confidence, gray = high-confidence"
+            } else {
+                "global time (s); coloured = low-confidence (robot 1 blue, robot 2 red, 3 orange, …), gray = high-confidence"
+            })
             .label_style((FONT_FAMILY, 12))
             .draw()
             .map_err(de)?;
-        for (i, colour) in ROBOT_LC.iter().enumerate() {
-            let y = if i == 0 { 1.5 } else { 0.5 };
+        let n = self.spans.len();
+        for (i, colour) in ROBOT_LC_N.iter().take(n).enumerate() {
+            let y = (n - i) as f64 - 0.5;
             let (a, b) = self.spans[i];
             chart
                 .draw_series(std::iter::once(Rectangle::new(

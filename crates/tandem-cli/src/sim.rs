@@ -1,11 +1,12 @@
-//! `tandem simulate`: a what-if run of pairs with a simulated operator on the user's model.
+//! `tandem simulate`: a what-if run of rounds (one execution per robot of the state's
+//! schedule; pairs for two robots) with a simulated operator on the user's model.
 //!
-//! Per pair `k` (seed `derive_seed(seed, k)`):
+//! Per round `k` (seed `derive_seed(seed, k)`):
 //!
 //! 1. Each robot's workpiece draws, per need region `r`, whether the region needs the
 //!    operator (probability `need[r]`, one draw per region and workpiece).
-//! 2. Both robots run the state's current schedule with the study's simulated operator,
-//!    `tandem::sim::workcell::run_pair_with` (the real-time coordinator, Eq. 17–18, Alg. 1,
+//! 2. Every robot runs the state's current schedule with the study's simulated operator,
+//!    `tandem::sim::workcell::run_round_with` (the real-time coordinator, Eq. 17–18, Alg. 1,
 //!    one control tick per reference sample period, exactly as on the robots), told by
 //!    step 1 which reference samples of which robot need the operator.
 //! 3. The robot on a low-confidence sample is *supervised*. The operator corrects it where
@@ -18,8 +19,8 @@
 //!    demonstrated bounds) is the operator's gradient for the tick. Every flag's default is
 //!    the study's (`OperatorParams::default()`).
 //! 4. Every running robot logs its command, its reference time (Eq. 21) and its
-//!    supervised/corrected flags; the pair is then recorded in memory with
-//!    `Planner::record_pair`, exactly as `tandem record` does with the written files.
+//!    supervised/corrected flags; the round is then recorded in memory with
+//!    `Planner::record_round`, exactly as `tandem record` does with the written files.
 //!
 //! The state file is never modified.
 
@@ -30,22 +31,22 @@ use anyhow::{Context, Result, bail};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tandem::lfd::Execution;
-use tandem::sim::workcell::{OperatorParams, PairRun, RobotRun, run_pair_with};
+use tandem::sim::workcell::{OperatorParams, RobotRun, RoundRun, run_round_with};
 use tandem::{ExecutionRecord, Planner, derive_seed};
 
 use crate::cli::SimulateArgs;
 use crate::cmd::out;
 use crate::{input, state_io};
 
-/// Runs one pair (see the module docs). `needed[i][n]`: robot `i`'s workpiece needs the
-/// operator at reference sample `n`.
-fn run_pair(
+/// Runs one round (see the module docs). `needed[i][n]`: robot `i`'s workpiece needs the
+/// operator at reference sample `n`; one entry per robot.
+fn run_round(
     planner: &Planner,
-    needed: &[Vec<bool>; 2],
+    needed: &[Vec<bool>],
     op: &OperatorParams,
     rng: &mut impl Rng,
-) -> Result<PairRun> {
-    Ok(run_pair_with(
+) -> Result<RoundRun> {
+    Ok(run_round_with(
         planner,
         |robot, n| needed[robot][n],
         op,
@@ -149,12 +150,14 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
     );
     for k in 0..a.pairs {
         let mut rng = ChaCha8Rng::seed_from_u64(derive_seed(a.seed, k as u64));
-        let needed: [Vec<bool>; 2] = std::array::from_fn(|_| {
-            let hit: Vec<bool> = region_p.iter().map(|&p| rng.random::<f64>() < p).collect();
-            need.region.iter().map(|&r| hit[r]).collect()
-        });
+        let needed: Vec<Vec<bool>> = (0..planner.n_robots())
+            .map(|_| {
+                let hit: Vec<bool> = region_p.iter().map(|&p| rng.random::<f64>() < p).collect();
+                need.region.iter().map(|&r| hit[r]).collect()
+            })
+            .collect();
         let t_ran = planner.outcome().t_total_s;
-        let pair = run_pair(&planner, &needed, &op, &mut rng)
+        let pair = run_round(&planner, &needed, &op, &mut rng)
             .with_context(|| format!("simulating pair {}", k + 1))?;
         let channels = planner.model().channel_names().to_vec();
         let dt = planner.model().dt_s();
@@ -167,8 +170,12 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
                 files.push((dir.join(format!("{stem}.corr.csv")), c));
             }
         }
-        let [r1, r2] = pair.records(planner.model())?;
-        let records = [named(r1, k + 1, 1), named(r2, k + 1, 2)];
+        let records: Vec<ExecutionRecord> = pair
+            .records(planner.model())?
+            .into_iter()
+            .enumerate()
+            .map(|(i, r)| named(r, k + 1, i + 1))
+            .collect();
         let supervised: usize = pair
             .robots
             .iter()
@@ -180,7 +187,7 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
             .map(|r| r.corrected.iter().filter(|s| **s).count())
             .sum();
         let report = planner
-            .record_pair(&records)
+            .record_round(&records)
             .with_context(|| format!("recording simulated pair {}", k + 1))?;
         out(&format!(
             "{:>4}  {:>15.2}  {:>10.2}  {:>10}  {:>9}  {:>7}  {:>14.1}  {:>16.2}",
@@ -269,9 +276,11 @@ mod tests {
         };
         let needed = [vec![true; 40], vec![false; 40]];
         let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let pair = run_pair(&planner, &needed, &op, &mut rng).unwrap();
+        let pair = run_round(&planner, &needed, &op, &mut rng).unwrap();
         assert_eq!(pair.overlap_ticks, 0);
-        let [r1, r2] = &pair.robots;
+        let [r1, r2] = &pair.robots[..] else {
+            panic!("{} robots", pair.robots.len())
+        };
         assert!(
             r1.supervised.iter().any(|s| *s),
             "robot 1 is supervised somewhere"

@@ -374,3 +374,110 @@ fn medoid_reference_does_not_depend_on_the_order_of_the_files() {
     assert!(out_d.contains(&format!("reference: {}, the first file", demos[1])));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Three robots through the binary: `fit --robots 3` on the documented example, the schedule
+/// JSON of docs/formats.md (three warps, two offsets, no two robots low-confidence at once),
+/// `simulate --write` writes three executions per round, `record` takes exactly three and
+/// refuses two, and `--robots 9` is a user error.
+#[test]
+fn three_robots_fit_schedule_simulate_record() {
+    let dir = scratch("three");
+    let ex = repo().join("fixtures/examples");
+    let state = dir.join("cell3.tandem");
+    let mut fit = vec!["fit".to_string()];
+    fit.extend((0..3).map(|i| s(&ex.join(format!("demo_{i}.csv")))));
+    fit.extend(["--params".into(), s(&ex.join("params.toml"))]);
+    fit.extend(["--robots", "3", "-o"].map(String::from));
+    fit.push(s(&state));
+    let stdout = ok(&tandem(&fit));
+    assert!(stdout.contains("schedule: τ = "), "{stdout}");
+    assert_eq!(Planner::load(&state).unwrap().n_robots(), 3);
+
+    let doc: serde_json::Value =
+        serde_json::from_str(&ok(&tandem(["schedule", &s(&state), "--json"]))).unwrap();
+    assert_eq!(doc["n_robots"], 3);
+    let offsets = doc["offsets_s"].as_array().unwrap();
+    assert_eq!(offsets.len(), 2);
+    assert_eq!(doc["offset_s"], offsets[0]);
+    assert_eq!(doc["durations_s"].as_array().unwrap().len(), 3);
+    let schedule: Schedule = serde_json::from_value(doc["schedule"].clone()).unwrap();
+    assert_eq!(schedule.n_robots(), 3);
+    let p = Planner::load(&state).unwrap();
+    validate(p.problem(), &schedule).unwrap();
+    // The robots overlap (faster than serial), yet their low-confidence intervals never do.
+    let t_total = doc["t_total_s"].as_f64().unwrap();
+    assert!(t_total < doc["serial_t_total_s"].as_f64().unwrap());
+    let mut lc: Vec<(f64, f64)> = doc["lc_intervals"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|iv| {
+            (
+                iv["start_s"].as_f64().unwrap(),
+                iv["end_s"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    lc.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert!(lc.windows(2).all(|w| w[0].1 <= w[1].0), "{lc:?}");
+    let text = ok(&tandem(["schedule", &s(&state)]));
+    assert!(
+        text.contains("robot 3  |") && text.contains("operator-limited lower bound"),
+        "{text}"
+    );
+
+    let sim = dir.join("sim");
+    let stdout = ok(&tandem([
+        "simulate",
+        &s(&state),
+        "--need",
+        &s(&ex.join("need.csv")),
+        "--rounds",
+        "1",
+        "--write",
+        &s(&sim),
+    ]));
+    assert!(stdout.contains("wrote 9 files"), "{stdout}");
+    let files = |robot: usize| {
+        let stem = format!("pair_1_robot_{robot}");
+        [
+            sim.join(format!("{stem}.csv")),
+            sim.join(format!("{stem}.reflog.csv")),
+            sim.join(format!("{stem}.corr.csv")),
+        ]
+    };
+    // Two executions for a three-robot state: refused, the state unchanged.
+    let before = std::fs::read(&state).unwrap();
+    let out = tandem(record_args(&state, &files(1), &files(2)));
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("3 robots") && err.contains("exactly 3"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(&state).unwrap(), before);
+    let mut args = vec![PathBuf::from("record"), state.clone()];
+    for robot in 1..=3 {
+        let [e, l, c] = files(robot);
+        args.extend([
+            "--execution".into(),
+            e,
+            "--log".into(),
+            l,
+            "--corrections".into(),
+            c,
+        ]);
+    }
+    let stdout = ok(&tandem(args));
+    assert!(stdout.contains("recorded round 1"), "{stdout}");
+    let p = Planner::load(&state).unwrap();
+    assert_eq!((p.n_robots(), p.pairs_recorded()), (3, 1));
+
+    let mut bad = fit.clone();
+    let k = bad.iter().position(|a| a == "3").unwrap();
+    bad[k] = "9".into();
+    let out = tandem(&bad);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--robots 9"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -64,6 +64,15 @@ pub enum Error {
         /// What is wrong.
         why: String,
     },
+    /// A robot count outside `1..=MAX_ROBOTS` (one operator supervises at most
+    /// [`tandem_realtime::MAX_ROBOTS`] robots).
+    #[error("{n_robots} robots: a planner schedules 1 to {max} robots for its one operator")]
+    RobotCount {
+        /// The robot count asked for.
+        n_robots: usize,
+        /// [`tandem_realtime::MAX_ROBOTS`].
+        max: usize,
+    },
     /// Parts of a loaded state do not fit together.
     #[error("inconsistent state: `{what}`: {why}")]
     Inconsistent {

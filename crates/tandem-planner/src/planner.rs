@@ -10,7 +10,7 @@ use tandem_confidence::{Confidence, ConfidenceParams, Observations};
 use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
-    Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source, sample_schedule,
+    Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source, sample_schedule_n,
 };
 
 use crate::{Error, Result, derive_seed, state};
@@ -234,6 +234,16 @@ fn problem_for(model: &TaskModel, confidence: &Confidence) -> Result<Problem> {
     )?)
 }
 
+/// [`Error::RobotCount`] unless `1 ≤ n_robots ≤ MAX_ROBOTS`.
+fn check_robot_count(n_robots: usize) -> Result<()> {
+    let max = tandem_realtime::MAX_ROBOTS;
+    if (1..=max).contains(&n_robots) {
+        Ok(())
+    } else {
+        Err(Error::RobotCount { n_robots, max })
+    }
+}
+
 impl Planner {
     /// Learns the task from demonstrations (the reference is the one `params.fit.reference`
     /// chooses) and makes the first schedule: aligns and fits the model (§II-B1/2), sets the
@@ -243,9 +253,25 @@ impl Planner {
     /// # Errors
     /// Invalid parameters, or the lower crates' errors for the demonstrations.
     pub fn new(demos: &[Demonstration], params: PlannerParams) -> Result<Self> {
+        Self::with_robots(demos, params, 2)
+    }
+
+    /// As [`Planner::new`] for `n_robots` robots (`1 ≤ N ≤` [`tandem_realtime::MAX_ROBOTS`])
+    /// doing the same task under one operator: every schedule has `N` warps and `N − 1`
+    /// offsets, and [`Planner::record_round`] takes `N` executions. [`Planner::new`] is the
+    /// paper's `N = 2`. The state file stores `N` (as the schedule's robot count).
+    ///
+    /// # Errors
+    /// [`Error::RobotCount`] for `n_robots` outside `1..=MAX_ROBOTS`, and as [`Planner::new`].
+    pub fn with_robots(
+        demos: &[Demonstration],
+        params: PlannerParams,
+        n_robots: usize,
+    ) -> Result<Self> {
+        check_robot_count(n_robots)?;
         params.validate()?;
         let model = TaskModel::fit(demos, &params.fit)?;
-        Self::from_model(model, params)
+        Self::from_model_with_robots(model, params, n_robots)
     }
 
     /// As [`Planner::new`] from an already fitted model (e.g. to run several trials from
@@ -254,11 +280,25 @@ impl Planner {
     /// # Errors
     /// Invalid parameters, a degenerate prior or an infeasible problem.
     pub fn from_model(model: TaskModel, params: PlannerParams) -> Result<Self> {
+        Self::from_model_with_robots(model, params, 2)
+    }
+
+    /// As [`Planner::from_model`] for `n_robots` robots (see [`Planner::with_robots`]).
+    ///
+    /// # Errors
+    /// [`Error::RobotCount`], and as [`Planner::from_model`].
+    pub fn from_model_with_robots(
+        model: TaskModel,
+        params: PlannerParams,
+        n_robots: usize,
+    ) -> Result<Self> {
+        check_robot_count(n_robots)?;
         params.validate()?;
         let confidence = Confidence::from_prior(model.sigma2_d(), params.confidence.clone())?;
         let observations = Observations::new(model.n_ref())?;
         let problem = problem_for(&model, &confidence)?;
-        let outcome = sample_schedule(&problem, &Self::sampler_params(&params, 0), None)?;
+        let outcome =
+            sample_schedule_n(&problem, n_robots, &Self::sampler_params(&params, 0), None)?;
         Ok(Self {
             params,
             model,
@@ -277,14 +317,26 @@ impl Planner {
         }
     }
 
-    /// Records a pair of executions and re-schedules (see the type docs).
+    /// Records a round of executions, one per robot of the schedule (robot 1 first), and
+    /// re-schedules (see the type docs).
     ///
     /// Everything is checked before the planner changes: on error it is as before.
     ///
     /// # Errors
-    /// [`Error::BadExecution`] for flag vectors of the wrong length; the lower crates'
-    /// errors for a bad execution (channels, period, log) or observation.
-    pub fn record_pair(&mut self, executions: &[ExecutionRecord; 2]) -> Result<RecordReport> {
+    /// [`Error::BadExecution`] for a number of records other than the schedule's robot count
+    /// or flag vectors of the wrong length; the lower crates' errors for a bad execution
+    /// (channels, period, log) or observation.
+    pub fn record_round(&mut self, executions: &[ExecutionRecord]) -> Result<RecordReport> {
+        let n_robots = self.n_robots();
+        if executions.len() != n_robots {
+            return Err(Error::BadExecution {
+                what: "executions",
+                why: format!(
+                    "{} execution records for a round of {n_robots} robots (one per robot)",
+                    executions.len()
+                ),
+            });
+        }
         let t0 = Instant::now();
         let mut model = self.model.clone();
         for e in executions {
@@ -301,8 +353,9 @@ impl Planner {
         let problem = problem_for(&model, &confidence)?;
         let t2 = Instant::now();
         let pairs_recorded = self.pairs_recorded + 1;
-        let outcome = sample_schedule(
+        let outcome = sample_schedule_n(
             &problem,
+            n_robots,
             &Self::sampler_params(&self.params, pairs_recorded),
             Some(&self.outcome.schedule),
         )?;
@@ -324,6 +377,14 @@ impl Planner {
         Ok(report)
     }
 
+    /// [`Planner::record_round`] for the paper's two robots.
+    ///
+    /// # Errors
+    /// As [`Planner::record_round`].
+    pub fn record_pair(&mut self, executions: &[ExecutionRecord; 2]) -> Result<RecordReport> {
+        self.record_round(executions)
+    }
+
     /// Re-runs the anytime sampler (§II-C) on the current problem with `sampler`, warm-started
     /// by the current schedule, and replaces the stored outcome by the result. Model,
     /// observations, confidence, parameters and [`Planner::pairs_recorded`] are unchanged
@@ -341,9 +402,20 @@ impl Planner {
     /// # Errors
     /// The schedule crate's error for invalid `sampler` parameters or an infeasible problem.
     pub fn reschedule(&mut self, sampler: &SamplerParams) -> Result<&Outcome> {
-        let outcome = sample_schedule(&self.problem, sampler, Some(&self.outcome.schedule))?;
+        let outcome = sample_schedule_n(
+            &self.problem,
+            self.n_robots(),
+            sampler,
+            Some(&self.outcome.schedule),
+        )?;
         self.outcome = outcome;
         Ok(&self.outcome)
+    }
+
+    /// Robots `N` the planner schedules (the current schedule's robot count; 2 unless made by
+    /// [`Planner::with_robots`]).
+    pub fn n_robots(&self) -> usize {
+        self.outcome.schedule.n_robots()
     }
 
     /// The current schedule.
@@ -530,6 +602,38 @@ mod tests {
         let conf = p.confidence().conf();
         assert!(conf[..10].iter().all(|c| *c) && conf[20..].iter().all(|c| *c));
         assert!(conf[10..20].iter().all(|c| !*c));
+    }
+
+    #[test]
+    fn robot_counts_outside_one_to_max_and_rounds_of_another_size_are_refused() {
+        let p = small_planner(1);
+        assert_eq!(p.n_robots(), 2);
+        for n in [0, tandem_realtime::MAX_ROBOTS + 1] {
+            let err = Planner::from_model_with_robots(p.model().clone(), p.params().clone(), n)
+                .unwrap_err();
+            assert!(
+                matches!(err, Error::RobotCount { n_robots, max: 8 } if n_robots == n),
+                "{err}"
+            );
+            assert!(err.to_string().contains("1 to 8 robots"), "{err}");
+        }
+        let mut q = p.clone();
+        let err = q.record_round(&[]).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::BadExecution {
+                    what: "executions",
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert!(
+            err.to_string()
+                .contains("0 execution records for a round of 2 robots")
+        );
+        assert_eq!(q.pairs_recorded(), 0);
     }
 
     #[test]

@@ -39,8 +39,22 @@ pub const FONT_FAMILY: &str = "sans-serif";
 pub const MEAN: RGBColor = RGBColor(16, 42, 120);
 
 /// Low-confidence stretches of robot 1 (blue) and robot 2 (red), as in the paper's example
-/// schedules (Fig. 5); index by robot (0 or 1).
-pub const ROBOT_LC: [RGBColor; 2] = [RGBColor(66, 133, 244), RGBColor(214, 39, 40)];
+/// schedules (Fig. 5); index by robot (0 or 1). The first two of [`ROBOT_LC_N`].
+pub const ROBOT_LC: [RGBColor; 2] = [ROBOT_LC_N[0], ROBOT_LC_N[1]];
+
+/// Low-confidence stretches of robots 1 to 8 (the most `tandem_realtime` runs): robot 1 blue
+/// and robot 2 red as in [`ROBOT_LC`], then orange, brown, pink, olive, cyan and gold; index
+/// by robot (0-based).
+pub const ROBOT_LC_N: [RGBColor; 8] = [
+    RGBColor(66, 133, 244),
+    RGBColor(214, 39, 40),
+    RGBColor(255, 127, 14),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+    RGBColor(230, 171, 2),
+];
 
 /// Neither robot low-confidence, or a robot running high-confidence (gray in Fig. 5).
 pub const NEITHER_LC: RGBColor = RGBColor(185, 185, 185);
@@ -94,15 +108,9 @@ mod tests {
 
     #[test]
     fn the_palette_tells_the_robots_and_the_violation_apart() {
-        let all = [
-            MEAN,
-            ROBOT_LC[0],
-            ROBOT_LC[1],
-            NEITHER_LC,
-            BOTH_LC,
-            GROUND_TRUTH,
-            HIGH_CONFIDENCE,
-        ];
+        assert_eq!(ROBOT_LC, [ROBOT_LC_N[0], ROBOT_LC_N[1]]);
+        let mut all = vec![MEAN, NEITHER_LC, BOTH_LC, GROUND_TRUTH, HIGH_CONFIDENCE];
+        all.extend(ROBOT_LC_N);
         for (i, a) in all.iter().enumerate() {
             for b in &all[..i] {
                 assert_ne!((a.0, a.1, a.2), (b.0, b.1, b.2));

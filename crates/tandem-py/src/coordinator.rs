@@ -8,7 +8,6 @@ use pyo3::types::PyString;
 use crate::arrays::{PyBool, out_flags, out_vector, repr_list};
 use crate::errors::{Error, Result, guard};
 use crate::facade::{Coordinator, Operator, Tick, Timeline};
-use crate::planner::N_ROBOTS;
 use crate::schedule::PySchedule;
 
 /// The operator's input from Python: `None`/`"scheduled"`, a gradient, `"fastest"` or
@@ -121,7 +120,7 @@ impl PyCoordinator {
     /// Number of robots ``N``.
     #[getter]
     fn n_robots(&self) -> usize {
-        N_ROBOTS
+        self.inner.n_robots()
     }
 
     /// Control tick (real s) per :meth:`tick`.
@@ -177,7 +176,8 @@ impl PyCoordinator {
 
     fn __repr__(&self) -> String {
         format!(
-            "Coordinator(n_robots={N_ROBOTS}, tick_s={}, clock_s={}, is_finished={})",
+            "Coordinator(n_robots={}, tick_s={}, clock_s={}, is_finished={})",
+            self.inner.n_robots(),
             self.inner.tick_s(),
             repr_list(self.inner.clock_s()),
             PyBool(self.inner.is_finished())

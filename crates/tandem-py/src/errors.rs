@@ -281,6 +281,7 @@ fn classify_facade(e: &Facade) -> Kind {
             path: PathBuf::new(),
         },
         Facade::BadExecution { .. } => input_at(None),
+        Facade::RobotCount { .. } => param("robots"),
         Facade::Lfd(l) => classify_lfd(l),
         Facade::Confidence(c) => classify_confidence(c),
         Facade::Realtime(r) => classify_realtime(r),

@@ -5,10 +5,10 @@ pub(crate) use tandem::lfd::{DEFAULT_DT_S, Demonstration, Execution, TaskModel};
 pub(crate) use tandem::planner::{
     Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, derive_seed,
 };
-pub(crate) use tandem::realtime::{Coordinator, Operator, Tick, Timeline};
+pub(crate) use tandem::realtime::{Coordinator, MAX_ROBOTS, Operator, Tick, Timeline};
 pub(crate) use tandem::schedule::{
-    GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, Violation, sample_schedule,
-    validate,
+    GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, Violation,
+    sample_schedule_n, validate,
 };
 pub(crate) use tandem::sim::study::{
     PhaseTimes, StudyConfig, StudyInputs, read_labels, run_trial, run_trials,
@@ -17,7 +17,7 @@ pub(crate) use tandem::sim::task::{
     FIXTURE_SEED, Label, N_FIXTURE_DEMOS, TaskDemo, TaskParams, Workpiece, demonstrations,
 };
 pub(crate) use tandem::sim::workcell::{
-    OperatorParams, PairRun, correction_input, needs_correction, run_pair_with,
+    OperatorParams, RoundRun, correction_input, needs_correction, run_round_with,
 };
 pub(crate) use tandem::warp::{SignalRef, Warp, WarpParams, align};
 

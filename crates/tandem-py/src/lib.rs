@@ -55,7 +55,7 @@ mod _tandem {
     #[pymodule_export]
     use crate::schedule::{PyProblem, PySchedule};
     #[pymodule_export]
-    use crate::sim::{sim_correction_input, sim_run_pair, sim_sanding_needs};
+    use crate::sim::{sim_correction_input, sim_run_round, sim_sanding_needs};
     #[pymodule_export]
     use crate::study::{PyStudyTask, study_config, study_prepare, study_run, study_run_trial};
     #[pymodule_export]
@@ -67,6 +67,7 @@ mod _tandem {
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.add("N_ROBOTS", crate::planner::N_ROBOTS)?;
+        m.add("MAX_ROBOTS", crate::facade::MAX_ROBOTS)?;
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         Ok(())
     }

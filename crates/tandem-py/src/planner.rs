@@ -18,7 +18,7 @@ use crate::params::{from_py, serialize_to_py};
 use crate::schedule::PyProblem;
 use crate::schedule::PySchedule;
 
-/// Robots this build coordinates (the Python API takes per-robot sequences of this length).
+/// The default robot count (the paper's two robots): `tandem.fit(robots=...)`'s default.
 pub(crate) const N_ROBOTS: usize = 2;
 
 /// Offset of the seed streams `Planner.reschedule` uses without a seed: the streams of
@@ -180,22 +180,25 @@ fn planner_params(params: Option<&Bound<'_, PyAny>>) -> Result<PlannerParams> {
 ///         "sampler": …}`` or the path of a TOML file (``tandem params`` prints the
 ///         defaults).
 ///     dt_s: sample period (s) of arrays and of files without a ``t`` column (default 0.01).
+///     robots: robots ``N`` run by the one operator, 1 to 8 (default 2, the paper's): every
+///         schedule has ``N`` warps and :meth:`Planner.record_round` takes ``N`` executions.
 ///
 /// Raises:
 ///     InputError: a bad demonstration (with ``file``/``line`` for files).
-///     ParamError: a bad parameter.
+///     ParamError: a bad parameter or robot count.
 #[pyfunction]
-#[pyo3(signature = (demos, channels=None, params=None, dt_s=None))]
+#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, robots=N_ROBOTS))]
 pub(crate) fn fit(
     py: Python<'_>,
     demos: &Bound<'_, PyAny>,
     channels: Option<Vec<String>>,
     params: Option<&Bound<'_, PyAny>>,
     dt_s: Option<f64>,
+    robots: usize,
 ) -> PyResult<PyPlanner> {
     let demos = demonstrations(demos, channels.as_deref(), dt_s)?;
     let params = planner_params(params)?;
-    let planner = py.detach(|| guard(|| Ok(Planner::new(&demos, params)?)))?;
+    let planner = py.detach(|| guard(|| Ok(Planner::with_robots(&demos, params, robots)?)))?;
     Ok(PyPlanner { inner: planner })
 }
 
@@ -236,14 +239,14 @@ pub(crate) struct PyPlanner {
     pub(crate) inner: Planner,
 }
 
-/// Per-robot arguments of `record_pair`, checked to have one entry per robot.
-fn per_robot<'py>(x: &Bound<'py, PyAny>, what: &str) -> Result<Vec<Bound<'py, PyAny>>> {
+/// Per-robot arguments of `record_round`, checked to have one entry per robot (`n`).
+fn per_robot<'py>(x: &Bound<'py, PyAny>, what: &str, n: usize) -> Result<Vec<Bound<'py, PyAny>>> {
     let v = items(x, what)?;
-    if v.len() != N_ROBOTS {
+    if v.len() != n {
         return Err(Error::input(
             what,
             format!(
-                "{} entries; give one per robot ({N_ROBOTS} robots: robot 1, then robot 2)",
+                "{} entries; give one per robot ({n} robots: robot 1 first)",
                 v.len()
             ),
         ));
@@ -287,9 +290,10 @@ impl PyPlanner {
         Ok(())
     }
 
-    /// Records a pair of executions and re-schedules (Eq. 21, Eq. 9–12, §II-C).
+    /// Records a round of executions, one per robot (robot 1 first), and re-schedules (Eq. 21,
+    /// Eq. 9–12, §II-C).
     ///
-    /// Adds both executions to the model with their reference-time logs (no re-alignment),
+    /// Adds every execution to the model with their reference-time logs (no re-alignment),
     /// their supervised samples to the observations, updates the latched confidence and
     /// samples a new schedule warm-started by the current one. Everything is checked first:
     /// on error the planner is as before.
@@ -310,7 +314,7 @@ impl PyPlanner {
     ///     schedule, its ``t_total_s`` (Eq. 13, s), and wall times ``model_update_s``,
     ///     ``confidence_s``, ``scheduling_s``.
     #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None))]
-    fn record_pair<'py>(
+    fn record_round<'py>(
         &mut self,
         py: Python<'py>,
         executions: &Bound<'py, PyAny>,
@@ -320,6 +324,7 @@ impl PyPlanner {
         channels: Option<Vec<String>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let model = self.inner.model();
+        let n = self.inner.n_robots();
         // Arrays default to the model's channel order; a file's header may list the
         // channels in any order (the model matches them by name, as `tandem record` does).
         let names = Channels {
@@ -327,13 +332,13 @@ impl PyPlanner {
             file: channels.as_deref(),
         };
         let (execs, logs, sups, cors) = (
-            per_robot(executions, "executions")?,
-            per_robot(ref_time_logs, "ref_time_logs")?,
-            per_robot(supervised, "supervised")?,
-            per_robot(corrected, "corrected")?,
+            per_robot(executions, "executions", n)?,
+            per_robot(ref_time_logs, "ref_time_logs", n)?,
+            per_robot(supervised, "supervised", n)?,
+            per_robot(corrected, "corrected", n)?,
         );
-        let mut records = Vec::with_capacity(N_ROBOTS);
-        for i in 0..N_ROBOTS {
+        let mut records = Vec::with_capacity(n);
+        for i in 0..n {
             let demonstration = demonstration(
                 &execs[i],
                 &format!("executions[{i}]"),
@@ -362,12 +367,31 @@ impl PyPlanner {
                 )?,
             });
         }
-        let pair: [ExecutionRecord; N_ROBOTS] = records
-            .try_into()
-            .map_err(|_| Error::Panic("one record per robot".into()))?;
         let inner = &mut self.inner;
-        let report = py.detach(|| guard(|| Ok(inner.record_pair(&pair)?)))?;
+        let report = py.detach(|| guard(|| Ok(inner.record_round(&records)?)))?;
         report_dict(py, &report)
+    }
+
+    /// :meth:`record_round` under the paper's name, for a two-robot planner (the same
+    /// arguments, one entry per robot).
+    #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None))]
+    fn record_pair<'py>(
+        &mut self,
+        py: Python<'py>,
+        executions: &Bound<'py, PyAny>,
+        ref_time_logs: &Bound<'py, PyAny>,
+        supervised: &Bound<'py, PyAny>,
+        corrected: &Bound<'py, PyAny>,
+        channels: Option<Vec<String>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        self.record_round(
+            py,
+            executions,
+            ref_time_logs,
+            supervised,
+            corrected,
+            channels,
+        )
     }
 
     /// Re-runs the anytime sampler (§II-C) on the current problem, warm-started by the
@@ -442,7 +466,7 @@ impl PyPlanner {
         serialize_to_py(py, self.inner.params())
     }
 
-    /// Pairs of executions recorded so far.
+    /// Rounds of executions (pairs for two robots) recorded so far.
     #[getter]
     fn pairs_recorded(&self) -> usize {
         self.inner.pairs_recorded()
@@ -451,7 +475,7 @@ impl PyPlanner {
     /// Number of robots the planner schedules.
     #[getter]
     fn n_robots(&self) -> usize {
-        N_ROBOTS
+        self.inner.n_robots()
     }
 
     /// The command ``x_f⁺(u, t) = μ̂⁺(t) + δx⁺(u, t)`` (Eq. 7) at fractional reference time

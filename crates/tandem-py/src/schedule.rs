@@ -9,7 +9,8 @@ use pyo3::types::{PyDict, PyList};
 use crate::arrays::{flags, matrix, out_flags, out_matrix, out_vector, vector};
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
-    GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, sample_schedule, validate,
+    GlobalTimeline, MAX_ROBOTS, Outcome, Problem, SamplerParams, Schedule, Source,
+    sample_schedule_n, validate,
 };
 use crate::planner::N_ROBOTS;
 
@@ -94,13 +95,16 @@ impl PyProblem {
         out_vector(py, self.inner.grad_max().to_vec())
     }
 
-    /// The fastest serial schedule (§II-C fallback): both robots as fast as allowed, robot
-    /// 2 starting when robot 1 ends; valid at any tick. ``tick_s`` (real s) defaults to
-    /// ``dt_s``.
-    #[pyo3(signature = (tick_s=None))]
-    fn serial_schedule(&self, tick_s: Option<f64>) -> PyResult<PySchedule> {
+    /// The fastest serial schedule (§II-C fallback): every robot as fast as allowed, each
+    /// starting when the one before it ends; valid at any tick. ``tick_s`` (real s) defaults
+    /// to ``dt_s``; ``robots`` is ``N`` (1 to 8, default 2).
+    #[pyo3(signature = (tick_s=None, robots=N_ROBOTS))]
+    fn serial_schedule(&self, tick_s: Option<f64>, robots: usize) -> PyResult<PySchedule> {
         let tick_s = tick_s.unwrap_or(self.inner.dt_s());
-        let s = self.inner.serial_schedule(tick_s).map_err(Error::from)?;
+        let s = self
+            .inner
+            .serial_schedule_n(robots, tick_s)
+            .map_err(Error::from)?;
         Ok(PySchedule::new(
             self.inner.clone(),
             s,
@@ -109,10 +113,11 @@ impl PyProblem {
         ))
     }
 
-    /// The paper's anytime sampler (§II-C) on this problem: ``samples`` candidates from
-    /// ``seed`` (deterministic for a seed whatever the thread count), margins checked at
-    /// control tick ``tick_s`` (real s, default ``dt_s``), warm-started by ``previous``.
-    #[pyo3(signature = (samples=5000, seed=0, tick_s=None, previous=None))]
+    /// The scheduler (§II-C) on this problem for ``robots`` robots (1 to 8, default 2):
+    /// ``samples`` candidates from ``seed`` (deterministic for a seed whatever the thread
+    /// count), margins checked at control tick ``tick_s`` (real s, default ``dt_s``),
+    /// warm-started by ``previous``.
+    #[pyo3(signature = (samples=5000, seed=0, tick_s=None, previous=None, robots=N_ROBOTS))]
     fn sample_schedule(
         &self,
         py: Python<'_>,
@@ -120,6 +125,7 @@ impl PyProblem {
         seed: u64,
         tick_s: Option<f64>,
         previous: Option<PyRef<'_, PySchedule>>,
+        robots: usize,
     ) -> PyResult<PySchedule> {
         let params = SamplerParams {
             samples,
@@ -129,8 +135,16 @@ impl PyProblem {
         };
         let previous = previous.map(|p| p.schedule.clone());
         let problem = &*self.inner;
-        let outcome =
-            py.detach(|| guard(|| Ok(sample_schedule(problem, &params, previous.as_ref())?)))?;
+        let outcome = py.detach(|| {
+            guard(|| {
+                Ok(sample_schedule_n(
+                    problem,
+                    robots,
+                    &params,
+                    previous.as_ref(),
+                )?)
+            })
+        })?;
         Ok(PySchedule::from_outcome(self.inner.clone(), &outcome))
     }
 
@@ -150,7 +164,7 @@ impl PyProblem {
 /// was made for.
 ///
 /// Shaped for ``N`` robots: ``gradients`` is ``(N, T_ref)``, ``offsets`` holds the ``N − 1``
-/// start offsets of robots 2…N (this build schedules ``N = 2``).
+/// start offsets of robots 2…N (``1 ≤ N ≤ MAX_ROBOTS``).
 #[pyclass(module = "tandem", name = "Schedule", frozen)]
 pub(crate) struct PySchedule {
     pub(crate) schedule: Schedule,
@@ -211,30 +225,32 @@ impl PySchedule {
         let n_ref = problem.inner.n_ref();
         let (g, cols) = matrix(gradients, "gradients", "robots × reference samples")?;
         let rows = g.len().checked_div(cols).unwrap_or(0);
-        if rows != N_ROBOTS || cols != n_ref {
+        if !(1..=MAX_ROBOTS).contains(&rows) || cols != n_ref {
+            let expected = if (1..=MAX_ROBOTS).contains(&rows) {
+                format!("({rows}, {n_ref})")
+            } else {
+                format!("(N, {n_ref}) with 1 ≤ N ≤ {MAX_ROBOTS}")
+            };
             return Err(Error::input(
                 "gradients",
-                format!(
-                    "shape ({rows}, {cols}), expected ({N_ROBOTS}, {n_ref}) (robots × reference \
-                     samples; this build schedules {N_ROBOTS} robots)"
-                ),
+                format!("shape ({rows}, {cols}), expected {expected} (robots × reference samples)"),
             )
             .into());
         }
         let offsets = vector(offsets, "offsets", "robots 2…N")?;
-        if offsets.len() != N_ROBOTS - 1 {
+        if offsets.len() != rows - 1 {
             return Err(Error::input(
                 "offsets",
                 format!(
                     "{} offsets, expected {} (one per robot after the first)",
                     offsets.len(),
-                    N_ROBOTS - 1
+                    rows - 1
                 ),
             )
             .into());
         }
         let schedule = Schedule {
-            grad_exec: vec![g[..n_ref].to_vec(), g[n_ref..].to_vec()],
+            grad_exec: g.chunks_exact(n_ref).map(<[f64]>::to_vec).collect(),
             offsets_s: offsets.to_vec(),
             tick_s,
         };
@@ -249,7 +265,7 @@ impl PySchedule {
     /// Number of robots ``N``.
     #[getter]
     fn n_robots(&self) -> usize {
-        N_ROBOTS
+        self.schedule.n_robots()
     }
 
     /// Start offsets of robots 2…N, ``(N − 1,)``, s of global time (``τ``, §II-B4).
@@ -258,7 +274,7 @@ impl PySchedule {
         out_vector(py, self.schedule.offsets_s.clone())
     }
 
-    /// Start time of every robot, ``(N,)``, s of global time: ``[0, τ]``.
+    /// Start time of every robot, ``(N,)``, s of global time: ``[0, τ_2, …, τ_N]``.
     #[getter]
     fn starts_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         out_vector(py, self.schedule.starts_s().to_vec())
@@ -396,7 +412,9 @@ impl PySchedule {
         let tl = self.timeline()?;
         Ok(out_vector(
             py,
-            (0..N_ROBOTS).map(|i| tl.ref_time(i, t_global_s)).collect(),
+            (0..self.schedule.n_robots())
+                .map(|i| tl.ref_time(i, t_global_s))
+                .collect(),
         ))
     }
 
@@ -423,17 +441,8 @@ impl PySchedule {
     fn from_json(problem: PyRef<'_, PyProblem>, text: &str) -> PyResult<Self> {
         let schedule: Schedule =
             serde_json::from_str(text).map_err(|e| Error::input("schedule JSON", e.to_string()))?;
-        if schedule.n_robots() != N_ROBOTS || schedule.offsets_s.len() != N_ROBOTS - 1 {
-            return Err(Error::input(
-                "schedule JSON",
-                format!(
-                    "{} warps and {} offsets, expected {N_ROBOTS} and {}",
-                    schedule.n_robots(),
-                    schedule.offsets_s.len(),
-                    N_ROBOTS - 1
-                ),
-            )
-            .into());
+        if let Err(v) = schedule.check_shape() {
+            return Err(Error::input("schedule JSON", v.to_string()).into());
         }
         if schedule
             .grad_exec
@@ -460,8 +469,14 @@ impl PySchedule {
 
     fn __repr__(&self) -> String {
         format!(
-            "Schedule(n_robots={N_ROBOTS}, offsets=[{:.3}], t_total_s={:.3}, tick_s={}, source='{}')",
-            self.schedule.start_s(1),
+            "Schedule(n_robots={}, offsets=[{}], t_total_s={:.3}, tick_s={}, source='{}')",
+            self.schedule.n_robots(),
+            self.schedule
+                .offsets_s
+                .iter()
+                .map(|t| format!("{t:.3}"))
+                .collect::<Vec<_>>()
+                .join(", "),
             self.t_total_s(),
             self.schedule.tick_s,
             self.source

@@ -1,5 +1,5 @@
-//! The simulated workcell of §III for `tandem.sim`: a pair of executions run through the
-//! schedule's coordinator with a simulated operator (`tandem_sim::workcell`).
+//! The simulated workcell of §III for `tandem.sim`: a round of executions, one per robot, run
+//! through the schedule's coordinator with a simulated operator (`tandem_sim::workcell`).
 
 use std::path::PathBuf;
 
@@ -12,14 +12,14 @@ use rand_chacha::ChaCha8Rng;
 use crate::arrays::{flag_matrix, out_flags, out_matrix, out_vector};
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
-    OperatorParams, PairRun, TaskParams, Workpiece, correction_input, needs_correction,
-    read_labels, run_pair_with,
+    MAX_ROBOTS, OperatorParams, RoundRun, TaskParams, Workpiece, correction_input,
+    needs_correction, read_labels, run_round_with,
 };
 use crate::params::from_py;
 use crate::planner::{N_ROBOTS, PyPlanner};
 
-/// The run of a pair as a dict of arrays (see `sim_run_pair`).
-fn run_dict<'py>(py: Python<'py>, run: PairRun, channels: usize) -> PyResult<Bound<'py, PyDict>> {
+/// The run of a round as a dict of arrays (see `sim_run_round`).
+fn run_dict<'py>(py: Python<'py>, run: RoundRun, channels: usize) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("ticks", run.ticks)?;
     d.set_item("tick_s", run.tick_s)?;
@@ -27,6 +27,7 @@ fn run_dict<'py>(py: Python<'py>, run: PairRun, channels: usize) -> PyResult<Bou
     d.set_item("idle_ticks", run.idle_ticks)?;
     d.set_item("duration_s", run.duration_s())?;
     d.set_item("operator_idle_share", run.operator_idle_share())?;
+    d.set_item("operator_busy_share", run.operator_busy_share())?;
     let robots = PyList::empty(py);
     for r in run.robots {
         let rd = PyDict::new(py);
@@ -50,7 +51,7 @@ fn run_dict<'py>(py: Python<'py>, run: PairRun, channels: usize) -> PyResult<Bou
 /// `seed` (a ChaCha8 stream).
 #[pyfunction]
 #[pyo3(signature = (planner, needs, seed, operator=None))]
-pub(crate) fn sim_run_pair<'py>(
+pub(crate) fn sim_run_round<'py>(
     py: Python<'py>,
     planner: PyRef<'py, PyPlanner>,
     needs: &Bound<'py, PyAny>,
@@ -58,13 +59,13 @@ pub(crate) fn sim_run_pair<'py>(
     operator: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = &planner.inner;
-    let n_ref = p.model().n_ref();
+    let (n_ref, n_robots) = (p.model().n_ref(), p.n_robots());
     let (needs, cols) = flag_matrix(needs, "needs", "robots × reference samples")?;
-    if cols != n_ref || needs.len() != N_ROBOTS * n_ref {
+    if cols != n_ref || needs.len() != n_robots * n_ref {
         return Err(Error::input(
             "needs",
             format!(
-                "shape ({}, {cols}), expected ({N_ROBOTS}, {n_ref}) (robots × reference samples)",
+                "shape ({}, {cols}), expected ({n_robots}, {n_ref}) (robots × reference samples)",
                 needs.len().checked_div(cols).unwrap_or(0)
             ),
         )
@@ -74,7 +75,7 @@ pub(crate) fn sim_run_pair<'py>(
     let run = py.detach(|| {
         guard(|| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            Ok(run_pair_with(
+            Ok(run_round_with(
                 p,
                 |robot, ref_idx| needs[robot * n_ref + ref_idx],
                 &params,
@@ -88,23 +89,27 @@ pub(crate) fn sim_run_pair<'py>(
 /// Which reference samples need a correction on each of `N` random sanding workpieces
 /// (§III: sanding in passes 1–3 over a painted section), from the reference
 /// demonstration's labels file (`demo_0.labels.csv` of the fixtures' layout): a `(N, T_ref)`
-/// bool array. `task` holds the task parameters (dict; only `n_sections` matters).
-/// Deterministic for `seed`.
+/// bool array. `task` holds the task parameters (dict; only `n_sections` matters); `robots`
+/// is `N` (1 to 8, default 2). Deterministic for `seed`.
 #[pyfunction]
-#[pyo3(signature = (labels, seed, task=None))]
+#[pyo3(signature = (labels, seed, task=None, robots=N_ROBOTS))]
 pub(crate) fn sim_sanding_needs<'py>(
     py: Python<'py>,
     labels: PathBuf,
     seed: u64,
     task: Option<&Bound<'py, PyAny>>,
+    robots: usize,
 ) -> PyResult<Bound<'py, PyArray2<bool>>> {
     let params: TaskParams = from_py(task, "task")?;
+    if !(1..=MAX_ROBOTS).contains(&robots) {
+        return Err(Error::param("robots", format!("{robots}: must be 1 to {MAX_ROBOTS}")).into());
+    }
     let flat = guard(|| {
         params.validate()?;
         let labels = read_labels(&labels)?;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let mut out = Vec::with_capacity(N_ROBOTS * labels.len());
-        for _ in 0..N_ROBOTS {
+        let mut out = Vec::with_capacity(robots * labels.len());
+        for _ in 0..robots {
             let wp = Workpiece::random(&params, &mut rng)?;
             out.extend(labels.iter().map(|l| needs_correction(l, &wp)));
         }

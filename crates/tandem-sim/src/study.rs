@@ -29,8 +29,12 @@ use crate::{Error, Result};
 pub struct StudyConfig {
     /// Independent trials (paper: 5). Default: 5.
     pub trials: usize,
-    /// Executions per trial, run in pairs, so must be even (paper: 300). Default: 300.
+    /// Executions per trial, run in rounds of [`StudyConfig::robots`] (one execution per
+    /// robot), so a positive multiple of `robots` (paper: 300, in pairs). Default: 300.
     pub executions: usize,
+    /// Robots `N` run by the one operator, `1 ≤ N ≤` [`tandem_realtime::MAX_ROBOTS`]
+    /// (paper: 2). Default: 2.
+    pub robots: usize,
     /// Sampler iterations per re-schedule (paper: 5000). Default: 5000.
     pub samples: usize,
     /// Master seed; trial `k` is seeded from `(seed, k)` only. Default: 2023.
@@ -59,6 +63,7 @@ impl Default for StudyConfig {
         Self {
             trials: 5,
             executions: 300,
+            robots: 2,
             samples: 5000,
             seed: 2023,
             miss_rate: 0.01,
@@ -72,9 +77,9 @@ impl Default for StudyConfig {
 }
 
 impl StudyConfig {
-    /// Number of execution pairs per trial (`executions / 2`).
-    pub fn n_pairs(&self) -> usize {
-        self.executions / 2
+    /// Number of rounds per trial (`executions / robots`; pairs for two robots).
+    pub fn n_rounds(&self) -> usize {
+        self.executions / self.robots.max(1)
     }
 
     /// Checks every field.
@@ -86,10 +91,21 @@ impl StudyConfig {
         if self.trials == 0 {
             return bad("trials", "must be at least 1");
         }
-        if self.executions == 0 || self.executions % 2 != 0 {
+        if !(1..=tandem_realtime::MAX_ROBOTS).contains(&self.robots) {
+            return bad(
+                "robots",
+                "must be between 1 and 8 (tandem_realtime::MAX_ROBOTS)",
+            );
+        }
+        if self.executions == 0 || self.executions % self.robots != 0 {
             return bad(
                 "executions",
-                "must be a positive even number (executions run in pairs)",
+                if self.robots == 2 {
+                    "must be a positive even number (executions run in pairs)"
+                } else {
+                    "must be a positive multiple of `robots` (executions run in rounds of one \
+                     execution per robot)"
+                },
             );
         }
         if self.samples == 0 {
@@ -138,6 +154,11 @@ pub struct PairStats {
     pub supervised_ticks: usize,
     /// Supervised ticks in which the operator corrected, both robots together.
     pub corrected_ticks: usize,
+    /// Operator busy share, in [0, 1]: the share of the round's control ticks (from the
+    /// first robot's start until the last robot finished) in which at least one robot
+    /// traversed a low-confidence sample, so that the operator was needed
+    /// (`1 − operator_idle_share`; docs/study.md).
+    pub operator_busy_share: f64,
 }
 
 /// One iteration of a trial: a schedule and what running it gave.
@@ -147,16 +168,32 @@ pub struct IterationRecord {
     pub iteration: usize,
     /// Planned `T_total` (Eq. 13, s).
     pub t_total_s: f64,
-    /// Planned offset `τ` of robot 2 (s, global time).
+    /// Planned offset `τ` of robot 2 (s, global time; 0 for a single robot).
     pub offset_s: f64,
     /// Share of reference samples that are high-confidence (Eq. 12), in percent.
     pub high_conf_pct: f64,
     /// Where the schedule came from.
     pub source: ScheduleSource,
-    /// Planned low-confidence intervals `[start_s, end_s)` of robot 1 and robot 2 (global time, s).
-    pub lc_intervals_s: [Vec<[f64; 2]>; 2],
+    /// Planned low-confidence intervals `[start_s, end_s)` of each robot, robot 1 first
+    /// (global time, s).
+    pub lc_intervals_s: Vec<Vec<[f64; 2]>>,
     /// The outcome of running the next pair under this schedule (`None` for the last one).
     pub pair: Option<PairStats>,
+    /// The schedule's certificate ([`tandem_schedule::Outcome::lower_bound_s`]): a lower
+    /// bound (s, global time) on the `T_total` of every schedule of Eq. 20 for this
+    /// iteration's problem, the margin-free optimum `T*₀` when
+    /// [`IterationRecord::bound_is_optimum`].
+    pub lower_bound_s: f64,
+    /// Whether [`IterationRecord::lower_bound_s`] is the proven margin-free optimum `T*₀`.
+    pub bound_is_optimum: bool,
+    /// `(T_total − lower_bound_s) / lower_bound_s` (dimensionless, ≥ 0).
+    pub gap: f64,
+    /// Planned throughput: tasks per hour per operator, `N·3600 / T_total` (`N` robots each
+    /// finish one task per `T_total` seconds of the schedule).
+    pub throughput_per_h: f64,
+    /// Planned start offsets `τ_2, …, τ_N` of robots 2..N (s, global time; `N − 1` values,
+    /// `[offset_s]` for two robots).
+    pub offsets_s: Vec<f64>,
 }
 
 /// Where a study iteration's schedule came from: the kind of [`tandem_schedule::Source`]
@@ -250,6 +287,19 @@ pub struct IterationSummary {
     pub high_conf_pct_std: f64,
     /// Overlap ticks summed across trials (must be 0).
     pub overlap_ticks: usize,
+    /// Mean certificate lower bound `T*₀` across trials (s; [`IterationRecord::lower_bound_s`]).
+    pub lower_bound_mean_s: f64,
+    /// Share of trials, in [0, 1], whose lower bound is the proven margin-free optimum.
+    pub bound_proven_share: f64,
+    /// Mean relative gap of `T_total` to the lower bound across trials (dimensionless).
+    pub gap_mean: f64,
+    /// Mean planned throughput across trials (tasks per hour per operator,
+    /// [`IterationRecord::throughput_per_h`]).
+    pub throughput_mean_per_h: f64,
+    /// Mean operator busy share across trials of the round run under this iteration's
+    /// schedule ([`PairStats::operator_busy_share`], in [0, 1]); `None` for the last
+    /// iteration, after which no round runs.
+    pub operator_busy_share_mean: Option<f64>,
 }
 
 /// Seed of trial `trial` from the master `seed` ([`derive_seed`]), so trials are
@@ -284,6 +334,19 @@ impl StudyResult {
                         .filter_map(|r| r.pair.as_ref())
                         .map(|p| p.overlap_ticks)
                         .sum(),
+                    lower_bound_mean_s: mean_std(recs.iter().map(|r| r.lower_bound_s)).0,
+                    bound_proven_share: recs.iter().filter(|r| r.bound_is_optimum).count() as f64
+                        / recs.len() as f64,
+                    gap_mean: mean_std(recs.iter().map(|r| r.gap)).0,
+                    throughput_mean_per_h: mean_std(recs.iter().map(|r| r.throughput_per_h)).0,
+                    operator_busy_share_mean: {
+                        let busy: Vec<f64> = recs
+                            .iter()
+                            .filter_map(|r| r.pair.as_ref())
+                            .map(|p| p.operator_busy_share)
+                            .collect();
+                        (!busy.is_empty()).then(|| mean_std(busy.into_iter()).0)
+                    },
                 }
             })
             .collect()
@@ -301,37 +364,45 @@ impl StudyResult {
 
     /// One CSV row per trial and iteration. Columns: `trial, iteration, t_total_s, offset_s,
     /// high_conf_pct, source, overlap_ticks, operator_idle_share, duration_s, supervised_ticks,
-    /// corrected_ticks, lc_intervals_robot1_s, lc_intervals_robot2_s`; pair columns are
-    /// empty for the last iteration; intervals are `start-end` pairs (s) joined by `;`.
+    /// corrected_ticks, operator_busy_share, lower_bound_s, bound_is_optimum, gap,
+    /// throughput_per_h`, then one `lc_intervals_robot<i>_s` column per robot; round columns
+    /// (`overlap_ticks` to `operator_busy_share`) are empty for the last iteration;
+    /// intervals are `start-end` pairs (s) joined by `;`.
     pub fn to_csv(&self) -> String {
+        let n_robots = self
+            .trials
+            .iter()
+            .flat_map(|t| &t.iterations)
+            .map(|r| r.lc_intervals_s.len())
+            .max()
+            .unwrap_or(0);
         let mut out = String::from(
             "trial,iteration,t_total_s,offset_s,high_conf_pct,source,overlap_ticks,\
              operator_idle_share,duration_s,supervised_ticks,corrected_ticks,\
-             lc_intervals_robot1_s,lc_intervals_robot2_s\n",
+             operator_busy_share,lower_bound_s,bound_is_optimum,gap,throughput_per_h",
         );
+        for i in 1..=n_robots {
+            let _ = write!(out, ",lc_intervals_robot{i}_s");
+        }
+        out.push('\n');
         for t in &self.trials {
             for r in &t.iterations {
                 let pair = match &r.pair {
                     Some(p) => format!(
-                        "{},{},{},{},{}",
+                        "{},{},{},{},{},{}",
                         p.overlap_ticks,
                         p.operator_idle_share,
                         p.duration_s,
                         p.supervised_ticks,
-                        p.corrected_ticks
+                        p.corrected_ticks,
+                        p.operator_busy_share,
                     ),
-                    None => ",,,,".to_string(),
-                };
-                let intervals = |v: &[[f64; 2]]| {
-                    v.iter()
-                        .map(|[a, b]| format!("{a:.3}-{b:.3}"))
-                        .collect::<Vec<_>>()
-                        .join(";")
+                    None => ",,,,,".to_string(),
                 };
                 // Writing to a String cannot fail.
-                let _ = writeln!(
+                let _ = write!(
                     out,
-                    "{},{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{},{},{}",
                     t.trial,
                     r.iteration,
                     r.t_total_s,
@@ -339,9 +410,21 @@ impl StudyResult {
                     r.high_conf_pct,
                     r.source,
                     pair,
-                    intervals(&r.lc_intervals_s[0]),
-                    intervals(&r.lc_intervals_s[1]),
+                    r.lower_bound_s,
+                    r.bound_is_optimum,
+                    r.gap,
+                    r.throughput_per_h,
                 );
+                for i in 0..n_robots {
+                    let intervals = r.lc_intervals_s.get(i).map_or_else(String::new, |v| {
+                        v.iter()
+                            .map(|[a, b]| format!("{a:.3}-{b:.3}"))
+                            .collect::<Vec<_>>()
+                            .join(";")
+                    });
+                    let _ = write!(out, ",{intervals}");
+                }
+                out.push('\n');
             }
         }
         out
@@ -496,20 +579,26 @@ pub fn read_labels(path: &Path) -> Result<Vec<Label>> {
 fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
     let schedule = planner.schedule();
     let timeline = GlobalTimeline::new(planner.problem(), schedule)?;
-    let lc = timeline.lc_intervals();
-    let lc_intervals_s = [0, 1].map(|r| {
-        lc.get(r).map_or_else(Vec::new, |v| {
-            v.iter().map(|i| [i.start_s, i.end_s]).collect()
-        })
-    });
+    let lc_intervals_s = timeline
+        .lc_intervals()
+        .iter()
+        .map(|v| v.iter().map(|i| [i.start_s, i.end_s]).collect())
+        .collect();
+    let outcome = planner.outcome();
+    let n_robots = planner.n_robots();
     Ok(IterationRecord {
         iteration: planner.pairs_recorded(),
-        t_total_s: planner.outcome().t_total_s,
-        offset_s: schedule.start_s(1),
+        t_total_s: outcome.t_total_s,
+        offset_s: schedule.offsets_s.first().copied().unwrap_or(0.0),
         high_conf_pct: 100.0 * planner.confidence().high_share(),
-        source: planner.outcome().source.into(),
+        source: outcome.source.into(),
         lc_intervals_s,
         pair: None,
+        lower_bound_s: outcome.lower_bound_s,
+        bound_is_optimum: outcome.bound_is_optimum,
+        gap: outcome.gap,
+        throughput_per_h: throughput_per_h(n_robots, outcome.t_total_s),
+        offsets_s: schedule.offsets_s.clone(),
     })
 }
 
@@ -533,21 +622,22 @@ pub fn run_trial(
     params.sampler.seed = seed;
     let mut times = PhaseTimes::default();
     let t = Instant::now();
-    let mut planner = Planner::from_model(model.clone(), params)?;
+    let mut planner = Planner::from_model_with_robots(model.clone(), params, config.robots)?;
     times.scheduling += t.elapsed();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(1);
     let operator = config.operator();
-    let n_pairs = config.n_pairs();
+    let n_pairs = config.n_rounds();
+    let n_robots = planner.n_robots();
     let mut iterations = Vec::with_capacity(n_pairs + 1);
     for pair in 0..n_pairs {
         let mut record = iteration_record(&planner)?;
-        let workpieces = [
-            Workpiece::random(&config.task, &mut rng)?,
-            Workpiece::random(&config.task, &mut rng)?,
-        ];
+        let workpieces = (0..n_robots)
+            .map(|_| Workpiece::random(&config.task, &mut rng))
+            .collect::<Result<Vec<_>>>()?;
         let t = Instant::now();
-        let run = workcell::run_pair(&planner, reference_labels, &workpieces, &operator, &mut rng)?;
+        let run =
+            workcell::run_round(&planner, reference_labels, &workpieces, &operator, &mut rng)?;
         let records = run.records(planner.model())?;
         times.simulation += t.elapsed();
         let count = |f: fn(&bool) -> bool, pick: fn(&workcell::RobotRun) -> &Vec<bool>| {
@@ -562,9 +652,10 @@ pub fn run_trial(
             duration_s: run.duration_s(),
             supervised_ticks: count(|b| *b, |r| &r.supervised),
             corrected_ticks: count(|b| *b, |r| &r.corrected),
+            operator_busy_share: run.operator_busy_share(),
         });
         iterations.push(record);
-        let report = planner.record_pair(&records)?;
+        let report = planner.record_round(&records)?;
         times.model_update += report.model_update;
         times.confidence += report.confidence;
         times.scheduling += report.scheduling;
@@ -668,6 +759,13 @@ pub fn run_trials(
     ))
 }
 
+/// Tasks per hour per operator when `n_robots` robots each finish one task every
+/// `t_total_s` seconds: `N·3600 / T_total`.
+#[must_use]
+pub fn throughput_per_h(n_robots: usize, t_total_s: f64) -> f64 {
+    n_robots as f64 * 3600.0 / t_total_s
+}
+
 /// Mean and sample standard deviation (n − 1 denominator; 0 for one value, NaN for none).
 pub fn mean_std(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let v: Vec<f64> = values.collect();
@@ -694,14 +792,20 @@ mod tests {
             offset_s: 1.0,
             high_conf_pct: 10.0 * iteration as f64,
             source: ScheduleSource::Sampled,
-            lc_intervals_s: [vec![[0.0, 1.5]], vec![[2.0, 2.25], [3.0, 4.0]]],
+            lc_intervals_s: vec![vec![[0.0, 1.5]], vec![[2.0, 2.25], [3.0, 4.0]]],
             pair: pair.then_some(PairStats {
                 overlap_ticks: 0,
                 operator_idle_share: 0.5,
                 duration_s: t_total_s,
                 supervised_ticks: 10,
                 corrected_ticks: 4,
+                operator_busy_share: 0.5,
             }),
+            lower_bound_s: t_total_s - 1.0,
+            bound_is_optimum: iteration == 0,
+            gap: 1.0 / (t_total_s - 1.0),
+            throughput_per_h: throughput_per_h(2, t_total_s),
+            offsets_s: vec![1.0],
         }
     }
 
@@ -724,14 +828,35 @@ mod tests {
     fn defaults_are_the_papers_study() {
         let c = StudyConfig::default();
         assert_eq!((c.trials, c.executions, c.samples), (5, 300, 5000));
-        assert_eq!(c.n_pairs(), 150);
+        assert_eq!((c.robots, c.n_rounds()), (2, 150));
         assert_eq!((c.miss_rate, c.false_correction_rate), (0.01, 0.01));
         c.validate().unwrap();
     }
 
     #[test]
     fn bad_configs_name_the_field() {
-        let cases: [(StudyConfig, &str); 4] = [
+        let cases: [(StudyConfig, &str); 7] = [
+            (
+                StudyConfig {
+                    robots: 0,
+                    ..Default::default()
+                },
+                "robots",
+            ),
+            (
+                StudyConfig {
+                    robots: 9,
+                    ..Default::default()
+                },
+                "robots",
+            ),
+            (
+                StudyConfig {
+                    robots: 7,
+                    ..Default::default()
+                },
+                "executions",
+            ),
             (
                 StudyConfig {
                     trials: 0,
@@ -761,6 +886,13 @@ mod tests {
                 "miss_rate",
             ),
         ];
+        // Rounds of N robots: 300 executions are 100 rounds of 3.
+        let three = StudyConfig {
+            robots: 3,
+            ..Default::default()
+        };
+        three.validate().unwrap();
+        assert_eq!(three.n_rounds(), 100);
         for (c, name) in cases {
             let err = c.validate().unwrap_err();
             assert!(
@@ -838,6 +970,27 @@ mod tests {
         assert!((s[0].t_total_std_s - 2f64.sqrt()).abs() < 1e-12);
         assert_eq!((s[1].t_total_mean_s, s[1].t_total_std_s), (8.0, 0.0));
         assert_eq!(s[1].high_conf_pct_mean, 10.0);
+        // The certificate: bounds 9 and 11 (mean 10), both proven at iteration 0, neither
+        // at 1; gaps 1/9 and 1/11.
+        assert_eq!(s[0].lower_bound_mean_s, 10.0);
+        assert_eq!(
+            (s[0].bound_proven_share, s[1].bound_proven_share),
+            (1.0, 0.0)
+        );
+        assert!((s[0].gap_mean - (1.0 / 9.0 + 1.0 / 11.0) / 2.0).abs() < 1e-15);
+        // Two robots at 8 s: 900 tasks per hour; 10 s and 12 s: (720 + 600) / 2.
+        assert_eq!(s[1].throughput_mean_per_h, 900.0);
+        assert_eq!(s[0].throughput_mean_per_h, 660.0);
+        // A round ran at iteration 0 only.
+        assert_eq!(s[0].operator_busy_share_mean, Some(0.5));
+        assert_eq!(s[1].operator_busy_share_mean, None);
+    }
+
+    #[test]
+    fn throughput_is_tasks_per_hour_per_operator() {
+        assert_eq!(throughput_per_h(2, 120.0), 60.0);
+        assert_eq!(throughput_per_h(1, 3600.0), 1.0);
+        assert_eq!(throughput_per_h(8, 90.0), 320.0);
     }
 
     #[test]
@@ -846,14 +999,16 @@ mod tests {
         let lines: Vec<&str> = csv.lines().collect();
         assert_eq!(lines.len(), 1 + 4);
         let n_cols = lines[0].split(',').count();
-        assert_eq!(n_cols, 13);
+        assert_eq!(n_cols, 18);
+        assert!(lines[0].ends_with(",lc_intervals_robot1_s,lc_intervals_robot2_s"));
         for l in &lines[1..] {
             assert_eq!(l.split(',').count(), n_cols, "{l}");
         }
         assert_eq!(
             lines[1],
-            "0,0,10,1,0,sampled,0,0.5,10,10,4,0.000-1.500,2.000-2.250;3.000-4.000"
+            "0,0,10,1,0,sampled,0,0.5,10,10,4,0.5,9,true,0.1111111111111111,720,\
+             0.000-1.500,2.000-2.250;3.000-4.000"
         );
-        assert!(lines[2].starts_with("0,1,8,1,10,sampled,,,,,,"));
+        assert!(lines[2].starts_with("0,1,8,1,10,sampled,,,,,,,7,false,"));
     }
 }

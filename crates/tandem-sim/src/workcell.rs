@@ -1,5 +1,6 @@
-//! The simulated workcell of the study (§III): two robots run one schedule through the
-//! real-time coordinator while a simulated operator supervises the low-confidence robot.
+//! The simulated workcell of the study (§III): the `N` robots of the planner's schedule
+//! (two in the paper) run one round, one execution each, through the real-time
+//! coordinator while a simulated operator supervises the low-confidence robot.
 //!
 //! # One control tick
 //!
@@ -14,8 +15,8 @@
 //!    A robot whose sample `n_i` is low-confidence is *supervised* this tick; that is the
 //!    robot the coordinator will move at the operator's rate.
 //! 2. The operator decides for the supervised robot whether to correct. Whether the sample
-//!    *needs* a correction is the caller's `needs(i, round(t_i))` in [`run_pair_with`]; on
-//!    the sanding task ([`run_pair`]) it does when, on that robot's own workpiece, the
+//!    *needs* a correction is the caller's `needs(i, round(t_i))` in [`run_round_with`]; on
+//!    the sanding task ([`run_round`]) it does when, on that robot's own workpiece, the
 //!    reference demonstration's label at `round(t_i)` is sanding in pass 1–3 over a painted
 //!    section. A needed correction is
 //!    given with probability `1 − miss_rate` (§III: 1 % misses). Unneeded corrections
@@ -48,8 +49,8 @@
 //!    execution sample, `t_i` in its reference-time log (Eq. 21), and its supervised and
 //!    corrected flags.
 //! 5. After the tick, `Tick::low_conf` says which robots traversed any low-confidence sample:
-//!    both at once is an *overlap* (a valid schedule never has one), neither is operator
-//!    idle time.
+//!    two or more at once is an *overlap* (a valid schedule never has one), none is operator
+//!    idle time, and any is operator busy time.
 
 use rand::Rng;
 use serde::{Deserialize, Serialize};
@@ -167,7 +168,7 @@ pub struct RobotRun {
 }
 
 impl RobotRun {
-    /// The execution record for [`Planner::record_pair`] (Eq. 21): the samples as a
+    /// The execution record for [`Planner::record_round`] (Eq. 21): the samples as a
     /// demonstration with `model`'s channel names and sample period, the reference-time log,
     /// and the supervised and corrected flags.
     ///
@@ -190,39 +191,41 @@ impl RobotRun {
     }
 }
 
-/// A pair of executions run under one schedule.
+/// A round of executions, one per robot, run under one schedule.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PairRun {
-    /// Robot 1 and robot 2.
-    pub robots: [RobotRun; 2],
-    /// Control ticks until both robots finished.
+pub struct RoundRun {
+    /// Robot 1, robot 2, …: one run per robot of the schedule.
+    pub robots: Vec<RobotRun>,
+    /// Control ticks until every robot finished.
     pub ticks: usize,
     /// Control period (s).
     pub tick_s: f64,
-    /// Ticks in which both robots traversed a low-confidence sample (must be 0).
+    /// Ticks in which two or more robots traversed a low-confidence sample (must be 0).
     pub overlap_ticks: usize,
-    /// Ticks in which neither robot traversed a low-confidence sample.
+    /// Ticks in which no robot traversed a low-confidence sample.
     pub idle_ticks: usize,
 }
 
-impl PairRun {
-    /// Both robots' execution records, robot 1 first, for [`Planner::record_pair`] (see
-    /// [`RobotRun::record`]); `model` is the planner's model the pair ran with.
+/// The two-robot round of the paper: a [`RoundRun`] with two robots ([`run_pair`]).
+pub type PairRun = RoundRun;
+
+impl RoundRun {
+    /// Every robot's execution record, robot 1 first, for [`Planner::record_round`] (see
+    /// [`RobotRun::record`]); `model` is the planner's model the round ran with.
     ///
     /// # Errors
     /// The model crate's error if a robot's samples do not form a valid demonstration.
-    pub fn records(&self, model: &TaskModel) -> Result<[ExecutionRecord; 2]> {
-        let [a, b] = &self.robots;
-        Ok([a.record(model)?, b.record(model)?])
+    pub fn records(&self, model: &TaskModel) -> Result<Vec<ExecutionRecord>> {
+        self.robots.iter().map(|r| r.record(model)).collect()
     }
 
-    /// Whether both robots were ever low-confidence in the same tick.
+    /// Whether two or more robots were ever low-confidence in the same tick.
     #[must_use]
     pub fn overlapped(&self) -> bool {
         self.overlap_ticks > 0
     }
 
-    /// Operator idle time as a share of the pair's duration (ticks), in `[0, 1]`.
+    /// Operator idle time as a share of the round's duration (ticks), in `[0, 1]`.
     #[must_use]
     pub fn operator_idle_share(&self) -> f64 {
         if self.ticks == 0 {
@@ -231,7 +234,17 @@ impl PairRun {
         self.idle_ticks as f64 / self.ticks as f64
     }
 
-    /// Actual duration of the pair (s): ticks times the control period.
+    /// Operator busy share, in `[0, 1]`: the share of the round's ticks in which at least
+    /// one robot traversed a low-confidence sample (`1 − idle share`, counted in ticks).
+    #[must_use]
+    pub fn operator_busy_share(&self) -> f64 {
+        if self.ticks == 0 {
+            return 0.0;
+        }
+        (self.ticks - self.idle_ticks) as f64 / self.ticks as f64
+    }
+
+    /// Actual duration of the round (s): ticks times the control period.
     #[must_use]
     pub fn duration_s(&self) -> f64 {
         self.ticks as f64 * self.tick_s
@@ -315,23 +328,23 @@ pub fn correction_input(
     Ok(any)
 }
 
-/// Runs both robots of the planner's current schedule to the end with a simulated operator
-/// on the sanding task (see the module docs): [`run_pair_with`] where a sample needs a
+/// Runs every robot of the planner's current schedule to the end with a simulated operator
+/// on the sanding task (see the module docs): [`run_round_with`] where a sample needs a
 /// correction when [`needs_correction`] says so for the reference label at the sample and the
 /// robot's own workpiece. `labels` are the reference demonstration's labels (one per
-/// reference sample); `workpieces[i]` is robot `i`'s workpiece. Deterministic for the state
-/// of `rng`.
+/// reference sample); `workpieces[i]` is robot `i`'s workpiece, one per robot of the
+/// schedule. Deterministic for the state of `rng`.
 ///
 /// # Errors
-/// As [`run_pair_with`], and [`Error::Mismatch`] for labels that are not one per reference
-/// sample.
-pub fn run_pair(
+/// As [`run_round_with`], and [`Error::Mismatch`] for labels that are not one per reference
+/// sample or workpieces that are not one per robot.
+pub fn run_round(
     planner: &Planner,
     labels: &[Label],
-    workpieces: &[Workpiece; 2],
+    workpieces: &[Workpiece],
     params: &OperatorParams,
     rng: &mut impl Rng,
-) -> Result<PairRun> {
+) -> Result<RoundRun> {
     let n_ref = planner.model().n_ref();
     if labels.len() != n_ref {
         return Err(Error::Mismatch {
@@ -340,7 +353,15 @@ pub fn run_pair(
             found: labels.len(),
         });
     }
-    run_pair_with(
+    let n_robots = planner.n_robots();
+    if workpieces.len() != n_robots {
+        return Err(Error::Mismatch {
+            what: "workpieces (one per robot)",
+            expected: n_robots,
+            found: workpieces.len(),
+        });
+    }
+    run_round_with(
         planner,
         |robot, ref_idx| needs_correction(&labels[ref_idx], &workpieces[robot]),
         params,
@@ -348,9 +369,24 @@ pub fn run_pair(
     )
 }
 
-/// Runs both robots of the planner's current schedule to the end with a simulated operator
+/// [`run_round`] for the paper's two robots: one workpiece per robot of a two-robot
+/// schedule.
+///
+/// # Errors
+/// As [`run_round`] ([`Error::Mismatch`] for a planner with another robot count).
+pub fn run_pair(
+    planner: &Planner,
+    labels: &[Label],
+    workpieces: &[Workpiece; 2],
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<PairRun> {
+    run_round(planner, labels, workpieces, params, rng)
+}
+
+/// Runs every robot of the planner's current schedule to the end with a simulated operator
 /// (see the module docs), the caller deciding which samples need a correction:
-/// `needs(robot, ref_idx)` says whether robot `robot` (0 or 1) needs the operator at
+/// `needs(robot, ref_idx)` says whether robot `robot` (`0..N`) needs the operator at
 /// reference sample `ref_idx` (`round(t_i)`, in `0..n_ref`). It is asked once per supervised
 /// sample, just before the operator's draw from `rng`; samples of high confidence are never
 /// asked about. Model, problem, schedule and control tick are the planner's, so they agree
@@ -358,14 +394,14 @@ pub fn run_pair(
 ///
 /// # Errors
 /// Invalid parameters, a model without the force channel, a schedule checked at a tick other
-/// than the workcell's ([`Error::TickMismatch`]), a degenerate command, or a pair that does
+/// than the workcell's ([`Error::TickMismatch`]), a degenerate command, or a round that does
 /// not finish ([`Error::DidNotFinish`]).
-pub fn run_pair_with(
+pub fn run_round_with(
     planner: &Planner,
     needs: impl FnMut(usize, usize) -> bool,
     params: &OperatorParams,
     rng: &mut impl Rng,
-) -> Result<PairRun> {
+) -> Result<RoundRun> {
     run_schedule(
         planner.model(),
         planner.problem(),
@@ -376,21 +412,29 @@ pub fn run_pair_with(
     )
 }
 
-/// Checks that the model and both robots' gradients have one entry per reference sample of
+/// [`run_round_with`] under its two-robot name.
+///
+/// # Errors
+/// As [`run_round_with`].
+pub fn run_pair_with(
+    planner: &Planner,
+    needs: impl FnMut(usize, usize) -> bool,
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<PairRun> {
+    run_round_with(planner, needs, params, rng)
+}
+
+/// Checks that the model and every robot's gradients have one entry per reference sample of
 /// `problem`, in that order.
 fn check_sizes(model: &TaskModel, problem: &Problem, schedule: &Schedule) -> Result<()> {
     let n_ref = problem.n_ref();
-    let sizes = [
-        ("model reference samples", model.n_ref()),
-        (
-            "robot 1 gradients",
-            schedule.grad_exec.first().map_or(0, Vec::len),
-        ),
-        (
-            "robot 2 gradients",
-            schedule.grad_exec.get(1).map_or(0, Vec::len),
-        ),
-    ];
+    let sizes = std::iter::once(("model reference samples", model.n_ref())).chain(
+        schedule
+            .grad_exec
+            .iter()
+            .map(|g| ("a robot's gradients", g.len())),
+    );
     for (what, found) in sizes {
         if found != n_ref {
             return Err(Error::Mismatch {
@@ -403,7 +447,7 @@ fn check_sizes(model: &TaskModel, problem: &Problem, schedule: &Schedule) -> Res
     Ok(())
 }
 
-/// [`run_pair_with`] on the parts of a planner: `problem` must be the one `schedule` was
+/// [`run_round_with`] on the parts of a planner: `problem` must be the one `schedule` was
 /// made for, from `model`'s gradients (the unit tests build them by hand).
 fn run_schedule(
     model: &TaskModel,
@@ -412,7 +456,7 @@ fn run_schedule(
     mut needs: impl FnMut(usize, usize) -> bool,
     params: &OperatorParams,
     rng: &mut impl Rng,
-) -> Result<PairRun> {
+) -> Result<RoundRun> {
     params.validate()?;
     check_sizes(model, problem, schedule)?;
     let n_ref = problem.n_ref();
@@ -445,7 +489,8 @@ fn run_schedule(
         missed: 0,
         false_corrections: 0,
     };
-    let mut runs = [empty(), empty()];
+    let n_robots = coord.n_robots();
+    let mut runs: Vec<RobotRun> = (0..n_robots).map(|_| empty()).collect();
     let (mut ticks, mut overlap_ticks, mut idle_ticks) = (0, 0, 0);
     let max_end_s = coord
         .robots()
@@ -469,7 +514,7 @@ fn run_schedule(
         params.false_correction_rate,
         params.false_correction_s / tick_s,
     );
-    let mut in_episode = [false; 2];
+    let mut in_episode = vec![false; n_robots];
 
     while !coord.is_finished() {
         if ticks >= budget {
@@ -477,7 +522,7 @@ fn run_schedule(
         }
         let clocks = coord.clock_s();
         let mut operator = Operator::Scheduled;
-        for i in 0..2 {
+        for i in 0..n_robots {
             let tl = &coord.robots()[i];
             if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() {
                 continue;
@@ -523,13 +568,13 @@ fn run_schedule(
         }
         let tick = coord.tick(operator)?;
         ticks += 1;
-        match (tick.low_conf[0], tick.low_conf[1]) {
-            (true, true) => overlap_ticks += 1,
-            (false, false) => idle_ticks += 1,
-            _ => {}
+        match tick.low_conf.count() {
+            0 => idle_ticks += 1,
+            1 => {}
+            _ => overlap_ticks += 1,
         }
     }
-    Ok(PairRun {
+    Ok(RoundRun {
         robots: runs,
         ticks,
         tick_s,
@@ -778,6 +823,53 @@ mod tests {
     }
 
     #[test]
+    fn a_round_of_three_robots_runs_each_once_and_busies_the_operator_for_each() {
+        let model = model();
+        let problem = problem(&model);
+        let schedule = problem.serial_schedule_n(3, problem.dt_s()).unwrap();
+        let perfect = OperatorParams {
+            miss_rate: 0.0,
+            false_correction_rate: 0.0,
+            ..OperatorParams::default()
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let run = run_schedule(
+            &model,
+            &problem,
+            &schedule,
+            painted_needs_n,
+            &perfect,
+            &mut rng,
+        )
+        .unwrap();
+        assert_eq!(run.robots.len(), 3);
+        assert_eq!(run.overlap_ticks, 0);
+        for r in &run.robots {
+            assert!(r.needed > 0 && r.corrected == r.supervised);
+        }
+        // Serial: the operator is busy exactly while one robot is supervised, so the busy
+        // ticks are the three robots' supervised ticks, up to one tick at each end of each
+        // robot's one low-confidence stretch (a tick that enters or leaves it is busy).
+        let supervised: usize = run
+            .robots
+            .iter()
+            .map(|r| r.supervised.iter().filter(|s| **s).count())
+            .sum();
+        let busy = run.ticks - run.idle_ticks;
+        assert!(busy.abs_diff(supervised) <= 6, "{busy} vs {supervised}");
+        assert!(
+            (run.operator_busy_share() - busy as f64 / run.ticks as f64).abs() < 1e-15
+                && (run.operator_busy_share() + run.operator_idle_share() - 1.0).abs() < 1e-15
+        );
+        assert_eq!(run.records(&model).unwrap().len(), 3);
+    }
+
+    /// [`painted_needs`] for any robot index (every workpiece painted).
+    fn painted_needs_n(_robot: usize, ref_idx: usize) -> bool {
+        needs_correction(&painted_labels()[ref_idx], &all_painted())
+    }
+
+    #[test]
     fn run_pair_reads_everything_from_the_planner() {
         let planner = planner();
         let conf = planner.confidence().conf();
@@ -815,7 +907,7 @@ mod tests {
             assert_eq!(record.corrected, robot.corrected);
         }
         let mut next = planner.clone();
-        next.record_pair(&records).unwrap();
+        next.record_round(&records).unwrap();
         assert_eq!(next.model().count(), planner.model().count() + 2);
     }
 
@@ -845,7 +937,9 @@ mod tests {
             &mut rng,
         )
         .unwrap();
-        let [r1, r2] = &run.robots;
+        let [r1, r2] = &run.robots[..] else {
+            panic!("{} robots", run.robots.len())
+        };
         assert!(r1.supervised.iter().any(|s| *s));
         assert_eq!(r1.corrected, r1.supervised);
         assert!(r2.supervised.iter().any(|s| *s));

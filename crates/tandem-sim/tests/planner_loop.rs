@@ -46,7 +46,7 @@ fn pair(planner: &Planner, seed: u64) -> [ExecutionRecord; 2] {
     )
     .unwrap();
     assert!(!run.overlapped());
-    run.records(planner.model()).unwrap()
+    run.records(planner.model()).unwrap().try_into().unwrap()
 }
 
 fn tmp_dir(tag: &str) -> PathBuf {

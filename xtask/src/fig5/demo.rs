@@ -81,9 +81,12 @@ fn demo_data() -> Fig5Data {
         iterations: iterations.clone(),
         t_total_mean_s: Vec::with_capacity(iterations.len()),
         t_total_std_s: Vec::with_capacity(iterations.len()),
+        // Robot 2 cannot sand its first pass (10 s) before robot 1's ends: T ≥ 84 + 10 s.
+        lower_bound_mean_s: vec![DEMO_EXEC_S + 10.0; iterations.len()],
         high_conf_pct_mean: Vec::with_capacity(iterations.len()),
         high_conf_pct_std: Vec::with_capacity(iterations.len()),
         ground_truth_pct: 100.0 * (1.0 - 30.0 / DEMO_EXEC_S),
+        n_robots: 2,
         examples: Vec::new(),
     };
     for &k in &iterations {
@@ -110,8 +113,10 @@ fn demo_data() -> Fig5Data {
             ExampleSchedule {
                 iteration: k,
                 t_total_s: DEMO_EXEC_S + offset,
-                lc_robot1: lc.clone(),
-                lc_robot2: lc.iter().map(|&(s, e)| (s + offset, e + offset)).collect(),
+                lc: vec![
+                    lc.clone(),
+                    lc.iter().map(|&(s, e)| (s + offset, e + offset)).collect(),
+                ],
             }
         })
         .collect();

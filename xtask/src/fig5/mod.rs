@@ -2,7 +2,9 @@
 //!
 //! Top panel: the mean task length `T_total` (Eq. 13) per study iteration as a dark blue
 //! line with a shaded ±1 standard deviation band over trials, and at a few iterations an
-//! example schedule as a vertical bar from 0 to its `T_total`, coloured along global time:
+//! example schedule as a vertical bar from 0 to its `T_total`, and the mean certificate lower
+//! bound `T*₀` (the margin-free optimum, a bound on every admissible schedule) as a dashed
+//! line under the `T_total` curve; each bar is coloured along global time:
 //! blue where robot 1 is low-confidence, red where robot 2 is, gray where neither is.
 //! Bottom panel: the percentage of high-confidence reference samples (mean line and band)
 //! and the ground-truth percentage as a gray dotted line, on the same iteration axis.
@@ -21,7 +23,7 @@ use anyhow::{Context, anyhow, bail, ensure};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
-use tandem_plot::{BOTH_LC, FONT_FAMILY, GROUND_TRUTH, MEAN, NEITHER_LC, ROBOT_LC};
+use tandem_plot::{BOTH_LC, FONT_FAMILY, GROUND_TRUTH, MEAN, NEITHER_LC, ROBOT_LC_N};
 
 /// Width of both output images, in pixels (SVG user units for the SVG).
 pub(crate) const WIDTH_PX: u32 = 1200;
@@ -39,6 +41,9 @@ pub(crate) struct Fig5Data {
     pub t_total_mean_s: Vec<f64>,
     /// Standard deviation over trials of `T_total` per iteration, in seconds (≥ 0).
     pub t_total_std_s: Vec<f64>,
+    /// Mean over trials of the schedule's certificate lower bound (`T*₀` where proven), in
+    /// seconds of global schedule time (≥ 0; drawn dashed under the `T_total` curve).
+    pub lower_bound_mean_s: Vec<f64>,
     /// Mean over trials of the percentage (0–100) of reference samples that are
     /// high-confidence (Eq. 12) per iteration.
     pub high_conf_pct_mean: Vec<f64>,
@@ -47,6 +52,9 @@ pub(crate) struct Fig5Data {
     /// Ground-truth percentage (0–100) of reference samples that never need a correction
     /// (the paper's gray dotted line).
     pub ground_truth_pct: f64,
+    /// Robots per round (`N ≥ 1`; the paper's 2): names the iterations (pairs or rounds of
+    /// `N`) and the bound (`T*₀` for two robots, the operator-limited bound otherwise).
+    pub n_robots: usize,
     /// Example schedules drawn as coloured bars at a few iterations (may be empty).
     pub examples: Vec<ExampleSchedule>,
 }
@@ -58,24 +66,21 @@ pub(crate) struct ExampleSchedule {
     pub iteration: usize,
     /// The schedule's task length `T_total` (Eq. 13), in seconds of global time.
     pub t_total_s: f64,
-    /// Global-time intervals `(start_s, end_s)` in which robot 1 is low-confidence;
-    /// each within `[0, t_total_s]`.
-    pub lc_robot1: Vec<(f64, f64)>,
-    /// Global-time intervals `(start_s, end_s)` in which robot 2 is low-confidence;
-    /// each within `[0, t_total_s]`.
-    pub lc_robot2: Vec<(f64, f64)>,
+    /// Per robot (robot 1 first; 1 to 8 robots), the global-time intervals
+    /// `(start_s, end_s)` in which it is low-confidence; each within `[0, t_total_s]`.
+    pub lc: Vec<Vec<(f64, f64)>>,
 }
 
 /// Who is low-confidence during a stretch of an example schedule's global time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Occupancy {
-    /// Neither robot (gray).
+    /// No robot (gray).
     Neither,
-    /// Robot 1 only (blue).
-    Robot1,
-    /// Robot 2 only (red).
-    Robot2,
-    /// Both robots: a schedule violating the one-low-confidence-robot constraint (purple).
+    /// Robot `i` (0-based) only: blue for robot 1, red for robot 2, then
+    /// [`ROBOT_LC_N`]'s colours.
+    Robot(usize),
+    /// Two or more robots: a schedule violating the one-low-confidence-robot constraint
+    /// (purple).
     Both,
 }
 
@@ -83,8 +88,7 @@ impl Occupancy {
     fn colour(self) -> RGBColor {
         match self {
             Self::Neither => NEITHER_LC,
-            Self::Robot1 => ROBOT_LC[0],
-            Self::Robot2 => ROBOT_LC[1],
+            Self::Robot(i) => ROBOT_LC_N[i % ROBOT_LC_N.len()],
             Self::Both => BOTH_LC,
         }
     }
@@ -106,6 +110,7 @@ impl Fig5Data {
         for (name, len) in [
             ("t_total_mean_s", self.t_total_mean_s.len()),
             ("t_total_std_s", self.t_total_std_s.len()),
+            ("lower_bound_mean_s", self.lower_bound_mean_s.len()),
             ("high_conf_pct_mean", self.high_conf_pct_mean.len()),
             ("high_conf_pct_std", self.high_conf_pct_std.len()),
         ] {
@@ -126,6 +131,12 @@ impl Fig5Data {
         }
         check_values("t_total_mean_s", &self.t_total_mean_s, 0.0, f64::INFINITY)?;
         check_values("t_total_std_s", &self.t_total_std_s, 0.0, f64::INFINITY)?;
+        check_values(
+            "lower_bound_mean_s",
+            &self.lower_bound_mean_s,
+            0.0,
+            f64::INFINITY,
+        )?;
         check_values("high_conf_pct_mean", &self.high_conf_pct_mean, 0.0, 100.0)?;
         check_values(
             "high_conf_pct_std",
@@ -149,7 +160,14 @@ impl Fig5Data {
                 ex.t_total_s
             );
             let limit = ex.t_total_s * (1.0 + INTERVAL_SLACK) + INTERVAL_SLACK;
-            for (robot, intervals) in [("lc_robot1", &ex.lc_robot1), ("lc_robot2", &ex.lc_robot2)] {
+            ensure!(
+                (1..=ROBOT_LC_N.len()).contains(&ex.lc.len()),
+                "Fig. 5 data: examples[{k}] has {} robots, must have 1 to {}",
+                ex.lc.len(),
+                ROBOT_LC_N.len()
+            );
+            for (robot, intervals) in ex.lc.iter().enumerate() {
+                let robot = format!("robot {}", robot + 1);
                 for (j, &(start, end)) in intervals.iter().enumerate() {
                     ensure!(
                         start.is_finite()
@@ -157,7 +175,7 @@ impl Fig5Data {
                             && 0.0 <= start
                             && start <= end
                             && end <= limit,
-                        "Fig. 5 data: examples[{k}].{robot}[{j}] = ({start}, {end}) s must satisfy \
+                        "Fig. 5 data: examples[{k}], {robot}, interval {j} = ({start}, {end}) s must satisfy \
                          0 <= start <= end <= t_total_s = {}",
                         ex.t_total_s
                     );
@@ -195,7 +213,7 @@ fn occupancy_segments(ex: &ExampleSchedule) -> Vec<(f64, f64, Occupancy)> {
     let t_end = ex.t_total_s;
     let clip = |t: f64| t.clamp(0.0, t_end);
     let mut cuts: Vec<f64> = vec![0.0, t_end];
-    for &(s, e) in ex.lc_robot1.iter().chain(&ex.lc_robot2) {
+    for &(s, e) in ex.lc.iter().flatten() {
         cuts.push(clip(s));
         cuts.push(clip(e));
     }
@@ -209,11 +227,11 @@ fn occupancy_segments(ex: &ExampleSchedule) -> Vec<(f64, f64, Occupancy)> {
             continue;
         }
         let mid = 0.5 * (a + b);
-        let occupancy = match (covers(&ex.lc_robot1, mid), covers(&ex.lc_robot2, mid)) {
-            (false, false) => Occupancy::Neither,
-            (true, false) => Occupancy::Robot1,
-            (false, true) => Occupancy::Robot2,
-            (true, true) => Occupancy::Both,
+        let mut covering = ex.lc.iter().enumerate().filter(|(_, v)| covers(v, mid));
+        let occupancy = match (covering.next(), covering.next()) {
+            (None, _) => Occupancy::Neither,
+            (Some((i, _)), None) => Occupancy::Robot(i),
+            (Some(_), Some(_)) => Occupancy::Both,
         };
         match segments.last_mut() {
             Some(last) if last.2 == occupancy => last.1 = b,
@@ -254,7 +272,7 @@ pub(crate) fn draw_fig5(data: &Fig5Data, svg: &Path, png: &Path) -> anyhow::Resu
 /// Share of the x axis, from the right, that the legends cover.
 const LEGEND_X_SHARE: f64 = 0.3;
 /// Share of the top panel's y axis, from the top, that its legend covers.
-const TOP_LEGEND_Y_SHARE: f64 = 0.36;
+const TOP_LEGEND_Y_SHARE: f64 = 0.43;
 /// Share of the bottom panel's y axis, from the top or bottom, that its legend covers.
 const BOTTOM_LEGEND_Y_SHARE: f64 = 0.5;
 
@@ -360,7 +378,7 @@ impl Layout {
 
 /// Rounds `v > 0` up to a round number: 1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6 or 8 times a power
 /// of ten.
-fn nice_ceiling(v: f64) -> f64 {
+pub(crate) fn nice_ceiling(v: f64) -> f64 {
     let magnitude = 10f64.powf(v.log10().floor());
     let step = [1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0]
         .into_iter()
@@ -521,22 +539,55 @@ fn draw_task_length_panel<DB: DrawingBackend>(
     chart
         .draw_series(bars)
         .map_err(draw_err("example schedules"))?;
-    let mut swatches = vec![
-        ("robot 1 low-confidence", Occupancy::Robot1),
-        ("robot 2 low-confidence", Occupancy::Robot2),
-        ("neither low-confidence", Occupancy::Neither),
-    ];
+    let n_robots = data.examples.iter().map(|e| e.lc.len()).max().unwrap_or(0);
+    // Two robots: one swatch each, as in the paper; more: one swatch striped in the robots'
+    // colours, so the legend keeps its size.
+    let mut swatches: Vec<(String, Vec<Occupancy>)> = if n_robots <= 2 {
+        (0..n_robots)
+            .map(|i| {
+                (
+                    format!("robot {} low-confidence", i + 1),
+                    vec![Occupancy::Robot(i)],
+                )
+            })
+            .collect()
+    } else {
+        vec![(
+            format!("robots 1–{n_robots} low-confidence"),
+            (0..n_robots).map(Occupancy::Robot).collect(),
+        )]
+    };
+    let none = if n_robots <= 2 { "neither" } else { "none" };
+    swatches.push((format!("{none} low-confidence"), vec![Occupancy::Neither]));
     if any_both {
-        swatches.push(("both low-confidence (invalid)", Occupancy::Both));
+        let two = if n_robots <= 2 { "both" } else { "two or more" };
+        swatches.push((
+            format!("{two} low-confidence (invalid)"),
+            vec![Occupancy::Both],
+        ));
     }
     if !data.examples.is_empty() {
-        for (label, occupancy) in swatches {
+        for (label, colours) in swatches {
             chart
                 .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
                 .map_err(draw_err("legend"))?
                 .label(label)
                 .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 7), (x + 24, y + 7)], occupancy.colour().filled())
+                    // Eight 3 px stripes, robot colours in turn (one colour: a plain swatch).
+                    let stripe = |j: usize| {
+                        let x0 = 3 * j as i32;
+                        let colour = colours[j * colours.len() / 8].colour();
+                        Rectangle::new([(x0, -7), (x0 + 3, 7)], colour.filled())
+                    };
+                    EmptyElement::at((x, y))
+                        + stripe(0)
+                        + stripe(1)
+                        + stripe(2)
+                        + stripe(3)
+                        + stripe(4)
+                        + stripe(5)
+                        + stripe(6)
+                        + stripe(7)
                 });
         }
     }
@@ -548,6 +599,27 @@ fn draw_task_length_panel<DB: DrawingBackend>(
         "mean task length",
         "task length mean",
     )?;
+    chart
+        .draw_series(DashedLineSeries::new(
+            xs.iter()
+                .copied()
+                .zip(data.lower_bound_mean_s.iter().copied()),
+            6,
+            5,
+            MEAN.stroke_width(2),
+        ))
+        .map_err(draw_err("lower bound"))?
+        .label(if data.n_robots == 2 {
+            "mean lower bound T*₀ (no margins)".to_string()
+        } else {
+            "mean lower bound (operator-limited)".to_string()
+        })
+        .legend(|(x, y)| {
+            EmptyElement::at((x, y))
+                + PathElement::new(vec![(0, 0), (6, 0)], MEAN.stroke_width(2))
+                + PathElement::new(vec![(11, 0), (17, 0)], MEAN.stroke_width(2))
+                + PathElement::new(vec![(22, 0), (24, 0)], MEAN.stroke_width(2))
+        });
 
     draw_legend(
         &mut chart,
@@ -575,7 +647,11 @@ fn draw_high_conf_panel<DB: DrawingBackend>(
         .configure_mesh()
         .x_label_formatter(&iteration_label)
         .y_label_formatter(&|v| format!("{v:.0}"))
-        .x_desc("iteration (pairs of executions)")
+        .x_desc(if data.n_robots == 2 {
+            "iteration (pairs of executions)".to_string()
+        } else {
+            format!("iteration (rounds of {} executions)", data.n_robots)
+        })
         .y_desc("high-confidence samples (%)")
         .label_style((FONT_FAMILY, TICK_FONT))
         .axis_desc_style((FONT_FAMILY, AXIS_FONT))
@@ -634,7 +710,7 @@ fn std_band(xs: &[f64], mean: &[f64], std: &[f64], cap: f64) -> Vec<(f64, f64)> 
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use std::path::PathBuf;
 
@@ -642,7 +718,7 @@ mod tests {
     type Corruption = fn(&mut Fig5Data);
 
     /// A fresh, empty per-test directory under the system temp dir.
-    pub(super) fn scratch_dir(name: &str) -> PathBuf {
+    pub(crate) fn scratch_dir(name: &str) -> PathBuf {
         let dir =
             std::env::temp_dir().join(format!("tandem-xtask-fig5-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
@@ -655,28 +731,31 @@ mod tests {
             iterations: vec![0, 1, 2, 3, 4],
             t_total_mean_s: vec![100.0, 90.0, 80.0, 70.0, 65.0],
             t_total_std_s: vec![0.0, 5.0, 4.0, 3.0, 2.0],
+            lower_bound_mean_s: vec![100.0, 80.0, 70.0, 60.0, 60.0],
             high_conf_pct_mean: vec![0.0, 20.0, 35.0, 45.0, 50.0],
             high_conf_pct_std: vec![0.0, 3.0, 2.0, 1.0, 1.0],
             ground_truth_pct: 55.0,
+            n_robots: 2,
             examples: vec![
                 ExampleSchedule {
                     iteration: 0,
                     t_total_s: 100.0,
-                    lc_robot1: vec![(0.0, 50.0)],
-                    lc_robot2: vec![(50.0, 100.0)],
+                    lc: vec![vec![(0.0, 50.0)], vec![(50.0, 100.0)]],
                 },
                 ExampleSchedule {
                     iteration: 4,
                     t_total_s: 65.0,
-                    lc_robot1: vec![(5.0, 15.0), (25.0, 35.0)],
-                    lc_robot2: vec![(15.0, 25.0), (35.0, 45.0)],
+                    lc: vec![
+                        vec![(5.0, 15.0), (25.0, 35.0)],
+                        vec![(15.0, 25.0), (35.0, 45.0)],
+                    ],
                 },
             ],
         }
     }
 
     /// Width and height from a PNG's IHDR chunk, after checking the signature.
-    pub(super) fn png_size(bytes: &[u8]) -> (u32, u32) {
+    pub(crate) fn png_size(bytes: &[u8]) -> (u32, u32) {
         assert!(bytes.len() > 24, "PNG too short: {} bytes", bytes.len());
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
         assert_eq!(&bytes[12..16], b"IHDR", "first chunk is IHDR");
@@ -700,6 +779,7 @@ mod tests {
             "robot 2 low-confidence",
             "neither low-confidence",
             "mean task length",
+            "mean lower bound T*₀ (no margins)",
             "ground truth",
         ] {
             assert!(svg_text.contains(label), "SVG lacks the label {label:?}");
@@ -722,10 +802,31 @@ mod tests {
     fn overlapping_low_confidence_gets_the_violation_swatch() {
         let dir = scratch_dir("overlap");
         let mut data = small_data();
-        data.examples[0].lc_robot2 = vec![(40.0, 100.0)];
+        data.examples[0].lc[1] = vec![(40.0, 100.0)];
         draw_fig5(&data, &dir.join("a.svg"), &dir.join("a.png")).unwrap();
         let svg_text = std::fs::read_to_string(dir.join("a.svg")).unwrap();
         assert!(svg_text.contains("both low-confidence (invalid)"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn three_robots_get_their_own_colours_and_one_striped_swatch() {
+        let dir = scratch_dir("three");
+        let mut data = small_data();
+        data.examples[1].lc.push(vec![(50.0, 60.0)]);
+        assert_eq!(
+            occupancy_segments(&data.examples[1]).last(),
+            Some(&(60.0, 65.0, Occupancy::Neither))
+        );
+        assert!(occupancy_segments(&data.examples[1]).contains(&(50.0, 60.0, Occupancy::Robot(2))));
+        data.n_robots = 3;
+        draw_fig5(&data, &dir.join("a.svg"), &dir.join("a.png")).unwrap();
+        let svg_text = std::fs::read_to_string(dir.join("a.svg")).unwrap();
+        assert!(svg_text.contains("robots 1–3 low-confidence"));
+        assert!(svg_text.contains("iteration (rounds of 3 executions)"));
+        assert!(svg_text.contains("mean lower bound (operator-limited)"));
+        assert!(svg_text.contains("none low-confidence"));
+        assert!(svg_text.contains("#FF7F0E"), "robot 3 orange bar segment");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -757,6 +858,7 @@ mod tests {
                 d.iterations.clear();
                 d.t_total_mean_s.clear();
                 d.t_total_std_s.clear();
+                d.lower_bound_mean_s.clear();
                 d.high_conf_pct_mean.clear();
                 d.high_conf_pct_std.clear();
             }),
@@ -764,6 +866,9 @@ mod tests {
                 d.t_total_mean_s[2] = f64::NAN
             }),
             ("t_total_std_s`[1] = -1", |d| d.t_total_std_s[1] = -1.0),
+            ("lower_bound_mean_s`[0] = NaN", |d| {
+                d.lower_bound_mean_s[0] = f64::NAN
+            }),
             ("high_conf_pct_mean`[3] = 101", |d| {
                 d.high_conf_pct_mean[3] = 101.0
             }),
@@ -773,11 +878,11 @@ mod tests {
             ("examples[1].t_total_s", |d| {
                 d.examples[1].t_total_s = f64::NAN
             }),
-            ("examples[1].lc_robot2[1]", |d| {
-                d.examples[1].lc_robot2[1] = (35.0, 66.0)
+            ("examples[1], robot 2, interval 1", |d| {
+                d.examples[1].lc[1][1] = (35.0, 66.0)
             }),
-            ("examples[0].lc_robot1[0]", |d| {
-                d.examples[0].lc_robot1[0] = (20.0, 10.0)
+            ("examples[0], robot 1, interval 0", |d| {
+                d.examples[0].lc[0][0] = (20.0, 10.0)
             }),
             ("both at iteration 0", |d| d.examples[1].iteration = 0),
         ];
@@ -796,7 +901,7 @@ mod tests {
     #[test]
     fn interval_ending_at_t_total_within_rounding_is_accepted() {
         let mut data = small_data();
-        data.examples[1].lc_robot2[1] = (35.0, 65.0 + 1e-12);
+        data.examples[1].lc[1][1] = (35.0, 65.0 + 1e-12);
         data.validate().unwrap();
     }
 
@@ -805,38 +910,35 @@ mod tests {
         let ex = ExampleSchedule {
             iteration: 0,
             t_total_s: 10.0,
-            lc_robot1: vec![(0.0, 3.0), (3.0, 4.0)],
-            lc_robot2: vec![(5.0, 7.0)],
+            lc: vec![vec![(0.0, 3.0), (3.0, 4.0)], vec![(5.0, 7.0)]],
         };
         assert_eq!(
             occupancy_segments(&ex),
             vec![
-                (0.0, 4.0, Occupancy::Robot1),
+                (0.0, 4.0, Occupancy::Robot(0)),
                 (4.0, 5.0, Occupancy::Neither),
-                (5.0, 7.0, Occupancy::Robot2),
+                (5.0, 7.0, Occupancy::Robot(1)),
                 (7.0, 10.0, Occupancy::Neither),
             ]
         );
         let clash = ExampleSchedule {
             iteration: 0,
             t_total_s: 6.0,
-            lc_robot1: vec![(1.0, 4.0)],
-            lc_robot2: vec![(3.0, 6.0)],
+            lc: vec![vec![(1.0, 4.0)], vec![(3.0, 6.0)]],
         };
         assert_eq!(
             occupancy_segments(&clash),
             vec![
                 (0.0, 1.0, Occupancy::Neither),
-                (1.0, 3.0, Occupancy::Robot1),
+                (1.0, 3.0, Occupancy::Robot(0)),
                 (3.0, 4.0, Occupancy::Both),
-                (4.0, 6.0, Occupancy::Robot2),
+                (4.0, 6.0, Occupancy::Robot(1)),
             ]
         );
         let empty = ExampleSchedule {
             iteration: 0,
             t_total_s: 0.0,
-            lc_robot1: vec![],
-            lc_robot2: vec![],
+            lc: vec![vec![], vec![]],
         };
         assert!(occupancy_segments(&empty).is_empty());
     }
@@ -849,7 +951,7 @@ mod tests {
         // cover the right 30 %, x >= 4.58 - 0.3 · 5.16 = 3.032, i.e. iteration 4, where
         // T_total + std = 67 s (bar 65 s) and the high-confidence band is [49, 51] %.
         assert!((layout.x_min + 0.58).abs() < 1e-12 && (layout.x_max - 4.58).abs() < 1e-12);
-        // 100 s overall needs 106 s -> 120 s; 67 s under the legend needs 67 / 0.64 = 105 s.
+        // 100 s overall needs 106 s -> 120 s; 67 s under the legend needs 67 / 0.57 = 118 s.
         assert_eq!(layout.t_max_s, 120.0);
         // 55 % · 1.12 -> 70 %; the band under the legend starts at 49 % >= 0.5 · 70 %.
         assert_eq!(layout.pct_max, 70.0);
@@ -867,8 +969,9 @@ mod tests {
         let mut flat = small_data();
         flat.t_total_mean_s = vec![100.0; 5];
         flat.t_total_std_s = vec![0.0; 5];
+        flat.lower_bound_mean_s = vec![90.0; 5];
         flat.examples.clear();
-        // 100 / 0.64 = 156.25 -> 200.
+        // 100 / 0.57 = 175.4 -> 200.
         assert_eq!(Layout::new(&flat).t_max_s, 200.0);
     }
 
