@@ -93,12 +93,7 @@ fn single_pass_equals_per_pair_for_n_robots() {
         let mut counts = [0u32; 2];
         for seed in 0..200u64 {
             let mut r = rng(0xA6 + seed);
-            let problem = if seed % 2 == 0 {
-                Problem::random_styled(&mut r, n)
-            } else {
-                Problem::random_structured(&mut r, n)
-            };
-            let tick_s = problem.dt_s * r.random_range(0.25..=1.5);
+            let (problem, tick_s) = Problem::random_alternating(&mut r, n, seed);
             // Each robot from simultaneous with the first to after the latest end so far.
             let mut starts = vec![0.0];
             for _ in 1..n {
@@ -139,12 +134,7 @@ fn serial_schedules_of_n_robots_are_always_accepted() {
     for n in 1..=6usize {
         for seed in 0..60u64 {
             let mut r = rng(0x5E + seed);
-            let problem = if seed % 2 == 0 {
-                Problem::random_styled(&mut r, n)
-            } else {
-                Problem::random_structured(&mut r, n)
-            };
-            let tick_s = problem.dt_s * r.random_range(0.25..=1.5);
+            let (problem, tick_s) = Problem::random_alternating(&mut r, n, seed);
             let mut starts = vec![0.0];
             for i in 1..n {
                 starts.push(problem.timeline(i - 1, starts[i - 1]).end_s());

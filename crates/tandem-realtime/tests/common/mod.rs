@@ -184,6 +184,19 @@ impl Problem {
     pub fn duration0(&self) -> f64 {
         self.timeline(0, 0.0).end_s()
     }
+
+    /// A problem of `n_robots` from the two families in turn ([`Problem::random_styled`] for
+    /// an even `seed`, [`Problem::random_structured`] for an odd one) and a control tick of
+    /// ¼ to 1½ reference samples (s), drawn from `rng` in that order.
+    pub fn random_alternating(rng: &mut ChaCha8Rng, n_robots: usize, seed: u64) -> (Problem, f64) {
+        let problem = if seed % 2 == 0 {
+            Problem::random_styled(rng, n_robots)
+        } else {
+            Problem::random_structured(rng, n_robots)
+        };
+        let tick_s = problem.dt_s * rng.random_range(0.25..=1.5);
+        (problem, tick_s)
+    }
 }
 
 pub fn rng(seed: u64) -> ChaCha8Rng {
