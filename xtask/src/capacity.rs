@@ -26,7 +26,9 @@ use anyhow::{Context, anyhow, bail};
 use plotters::prelude::*;
 use serde::Serialize;
 use tandem::realtime::MAX_ROBOTS;
-use tandem::sim::study::{StudyConfig, StudyInputs, StudyResult, mean_std, run_study};
+use tandem::sim::study::{
+    StudyConfig, StudyInputs, StudyResult, mean_std, run_study, throughput_per_h,
+};
 use tandem_plot::{FONT_FAMILY, GROUND_TRUTH, MEAN, ROBOT_LC};
 
 use crate::study::read_config;
@@ -149,9 +151,10 @@ pub(crate) fn row(result: &StudyResult, wall_s: f64) -> anyhow::Result<CapacityR
     })
 }
 
-/// `3600 / E[low-confidence seconds per task]` pooled over the rows (tasks per hour).
+/// `3600 / E[low-confidence seconds per task]` pooled over the rows (tasks per hour): the
+/// throughput of one operator busy all the time, each task taking its low-confidence seconds.
 pub(crate) fn operator_limited_per_h(rows: &[CapacityRow]) -> f64 {
-    3600.0 / mean_std(rows.iter().map(|r| r.lc_s_per_task)).0
+    throughput_per_h(1, mean_std(rows.iter().map(|r| r.lc_s_per_task)).0)
 }
 
 /// The table as Markdown (docs/study.md).
