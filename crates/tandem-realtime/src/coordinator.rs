@@ -1,5 +1,7 @@
 //! Runtime coordinator: advances N robots one control tick at a time (§II-B5).
 
+use std::sync::Arc;
+
 use crate::error::{Error, Result};
 use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
 use crate::strategy::{Member, Mode, advance, first_waiting_start};
@@ -122,7 +124,9 @@ enum Phase {
 /// cursors (schedule clocks never decrease).
 #[derive(Clone, Debug)]
 pub struct Coordinator {
-    robots: Vec<Timeline>,
+    /// The plans, shared: cloning a coordinator (to run the same schedule again, or to search
+    /// over operator sequences) copies only its clocks.
+    robots: Arc<[Timeline]>,
     tick_s: f64,
     tol_s: f64,
     clock_s: [f64; MAX_ROBOTS],
@@ -137,7 +141,7 @@ impl Coordinator {
     /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] if `tick_s` is
     /// not finite and > 0.
     pub fn new(robots: impl Into<Vec<Timeline>>, tick_s: f64) -> Result<Coordinator> {
-        let robots = robots.into();
+        let robots: Arc<[Timeline]> = robots.into().into();
         check_count(robots.len())?;
         if !(tick_s.is_finite() && tick_s > 0.0) {
             return Err(Error::BadParam {
