@@ -10,6 +10,9 @@
 //! Alg. 2's worst case for every role whose current robot is that robot (rush it while it is
 //! low-confidence, drag every other robot while it is), and, as
 //! [`Adversary::SwitchFavourite`], the same with the favoured robot changing at random times.
+//! [`Adversary::Beam`] is not a policy but a search: a beam search over the per-tick choices
+//! that compares operator sequences at equal progress and keeps those with the smallest
+//! clearance between regions ([`search`]).
 //! [`adversary_set`] returns the full set for one case of `N` robots, [`run_adversary`] runs one
 //! execution under one adversary and counts the ticks with two or more robots low-confidence.
 //!
@@ -32,6 +35,8 @@
 //! }
 //! # Ok::<(), tandem_realtime::Error>(())
 //! ```
+
+pub mod search;
 
 use rand::Rng;
 
@@ -105,19 +110,30 @@ pub enum Adversary {
         /// Longest hold, ticks (≥ 1).
         max_hold: u32,
     },
+    /// Not a fixed policy: the beam search of [`search::beam_search`] over fastest, slowest and
+    /// no correction at every tick, keeping `width` sequences per progress cell, those with the
+    /// smallest clearance between low-confidence regions; it reports the first sequence found
+    /// that overlaps.
+    Beam {
+        /// Sequences kept per progress cell (≥ 1).
+        width: u32,
+    },
 }
 
-/// Number of adversaries [`adversary_set`] returns for `n_robots` robots: 13 families plus one
-/// [`Adversary::RushRobot`] per robot.
+/// Number of adversaries [`adversary_set`] returns for `n_robots` robots: 14 families (the beam
+/// search included) plus one [`Adversary::RushRobot`] per robot.
 #[must_use]
 pub fn set_size(n_robots: usize) -> usize {
-    13 + n_robots
+    14 + n_robots
 }
+
+/// Sequences per progress cell of the [`Adversary::Beam`] in [`adversary_set`].
+pub const BEAM_WIDTH: u32 = 8;
 
 /// The full set of adversaries for one case of `n_robots` robots: the extremes, no correction,
 /// Alg. 2's worst case with each robot as the current one ([`Adversary::RushRobot`]), the
 /// favoured robot switching at random times (holds up to 50 ticks, and up to a quarter of
-/// `ticks`), switching every tick, periodic with a random period (1–8 ticks) and phase, one
+/// `ticks`), the beam search ([`BEAM_WIDTH`] sequences per progress cell), switching every tick, periodic with a random period (1–8 ticks) and phase, one
 /// switch at a random tick below `ticks` (about one execution's length, in ticks), random
 /// switching (holds up to 50 ticks), random extremes per tick and per robot, and random
 /// gradients over `grad_range = [lo, hi]` (the problem's `[min ψ̇min, max ψ̇max]`, execution
@@ -138,6 +154,7 @@ pub fn adversary_set(
         Adversary::SwitchFavourite {
             max_hold: slow_switch,
         },
+        Adversary::Beam { width: BEAM_WIDTH },
         Adversary::Periodic {
             period: 1,
             phase: 0,
@@ -279,6 +296,8 @@ impl PolicyState {
                 self.hold -= 1;
                 extreme(lc == Some(self.favourite))
             }
+            // The search does not run through a policy (see `run_adversary`).
+            Adversary::Beam { .. } => Operator::Scheduled,
             Adversary::RandomPerRobot => {
                 if lc != self.last_lc
                     && let Some(i) = lc
@@ -294,7 +313,8 @@ impl PolicyState {
 }
 
 /// Runs `coordinator` to the end (or for at most `max_ticks` ticks) with the operator inputs
-/// of `adversary`, drawing from `rng` (deterministic for its state).
+/// of `adversary`, drawing from `rng` (deterministic for its state). [`Adversary::Beam`] runs
+/// the search instead and reports its worst sequence.
 ///
 /// # Errors
 /// [`crate::Error::BadOperator`] when the adversary produces an inadmissible gradient (a
@@ -305,6 +325,9 @@ pub fn run_adversary(
     rng: &mut impl Rng,
     max_ticks: u64,
 ) -> Result<AdversaryRun> {
+    if let Adversary::Beam { width } = adversary {
+        return search::beam_search(coordinator, width as usize, max_ticks);
+    }
     let mut run = AdversaryRun::default();
     let mut state = PolicyState::new(coordinator.n_robots());
     while !coordinator.is_finished() {
