@@ -1,11 +1,12 @@
-//! Benchmarks of the margin checks (single pass, per pair, printed; two robots and N) and of the
+//! Benchmarks of the margin checks (two robots: single pass, per pair, printed; N robots: the
+//! lead bound against the per-tick worst-pace simulation it replaced) and of the
 //! coordinator: a whole run, and one `Coordinator::tick` for 2, 4 and 8 robots (run with
 //! `cargo bench -p tandem-realtime --bench margins -- coordinator_tick`).
 
 use criterion::{BenchmarkId, Criterion, black_box, criterion_main};
+use tandem_realtime::margins::baseline;
 use tandem_realtime::{
     Coordinator, Operator, Timeline, sufficient_margins, sufficient_margins_per_pair,
-    sufficient_margins_printed,
 };
 
 /// A deterministic problem of `n_ref` samples with 16 evenly spaced LC regions (a sixth of each
@@ -40,6 +41,28 @@ fn robots_n(n_ref: usize, n_robots: usize) -> Vec<Timeline> {
                 r0.grad_min(),
                 r0.grad_max(),
                 start,
+                0.01,
+            )
+            .expect("valid")
+        })
+        .collect()
+}
+
+/// `n_robots` robots on the plan of [`robots`], robot `i` starting half an execution after robot
+/// `i − 1`, every other one half a period later: two executions overlap at any time, their
+/// low-confidence regions alternate.
+fn robots_staggered(n_ref: usize, n_robots: usize) -> Vec<Timeline> {
+    let [r0, _] = robots(n_ref);
+    let period_s = r0.sample_clock_s()[n_ref / 16];
+    let half = 0.5 * r0.end_s() + 0.5 * period_s;
+    (0..n_robots)
+        .map(|i| {
+            Timeline::new(
+                r0.conf(),
+                r0.grad_exec(),
+                r0.grad_min(),
+                r0.grad_max(),
+                half * i as f64,
                 0.01,
             )
             .expect("valid")
@@ -85,17 +108,43 @@ fn bench(c: &mut Criterion) {
         });
         // The printed check rejects this schedule at its first pair (robot 2 starts in an LC
         // sample after robot 1's first region ended: the printed loop steps before testing).
-        assert!(!sufficient_margins_printed(&r, tick_s).expect("valid tick"));
+        assert!(!baseline::printed(&r, tick_s).expect("valid tick"));
         g.bench_with_input(BenchmarkId::new("printed", n_ref), &r, |b, r| {
-            b.iter(|| sufficient_margins_printed(black_box(r), tick_s))
+            b.iter(|| baseline::printed(black_box(r), tick_s))
         });
     }
-    let r4 = robots_n(1000, 4);
-    g.bench_with_input(
-        BenchmarkId::new("single_pass_4robots", 1000),
-        &r4,
-        |b, r| b.iter(|| sufficient_margins(black_box(r), tick_s)),
-    );
+    g.finish();
+    // N robots: the lead bound (`sufficient_margins` for N ≥ 3) against the per-tick worst-pace
+    // simulation it replaced (`baseline::greedy_pace`, the N-robot check before), on schedules
+    // both accept (each robot half an execution after the one before: every pair is decided
+    // by integrating or simulating to its end) and on the interleaved ones of `robots_n`.
+    let mut g = c.benchmark_group("margins_n");
+    for n_robots in [3usize, 4, 8] {
+        let staggered = robots_staggered(6000, n_robots);
+        assert!(sufficient_margins(&staggered, tick_s).expect("valid tick"));
+        assert!(baseline::greedy_pace(&staggered, tick_s).expect("valid tick"));
+        g.bench_with_input(
+            BenchmarkId::new("lead_bound_staggered", n_robots),
+            &staggered,
+            |b, r| b.iter(|| sufficient_margins(black_box(r), tick_s)),
+        );
+        g.bench_with_input(
+            BenchmarkId::new("greedy_pace_staggered", n_robots),
+            &staggered,
+            |b, r| b.iter(|| baseline::greedy_pace(black_box(r), tick_s)),
+        );
+        let interleaved = robots_n(6000, n_robots);
+        g.bench_with_input(
+            BenchmarkId::new("lead_bound_interleaved", n_robots),
+            &interleaved,
+            |b, r| b.iter(|| sufficient_margins(black_box(r), tick_s)),
+        );
+        g.bench_with_input(
+            BenchmarkId::new("greedy_pace_interleaved", n_robots),
+            &interleaved,
+            |b, r| b.iter(|| baseline::greedy_pace(black_box(r), tick_s)),
+        );
+    }
     g.finish();
     let r = robots(6000);
     c.bench_function("coordinator_run/6000", |b| {

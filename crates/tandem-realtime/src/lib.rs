@@ -61,15 +61,14 @@ mod error;
 pub mod margins;
 mod robots;
 pub mod strategy;
+#[cfg(feature = "testkit")]
+pub mod testkit;
 mod timeline;
 pub mod tol;
 
 pub use coordinator::{Coordinator, Operator, Tick};
 pub use error::{Error, Result};
-pub use margins::{
-    PairSlack, pair_slacks, sufficient_margins, sufficient_margins_pairwise,
-    sufficient_margins_per_pair, sufficient_margins_printed,
-};
+pub use margins::{PairSlack, pair_slacks, sufficient_margins, sufficient_margins_per_pair};
 pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};
 pub use strategy::{high_conf_steps, response_step};
 pub use timeline::{LcInterval, Rates, Timeline, clock_end_s, clock_s};

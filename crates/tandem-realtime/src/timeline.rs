@@ -331,6 +331,11 @@ impl Timeline {
         self.lc_prefix[hi + 1] > self.lc_prefix[lo]
     }
 
+    /// Whether any reference sample in `lo..=hi` is high confidence (O(1), prefix counts).
+    pub(crate) fn any_high_conf(&self, lo: usize, hi: usize) -> bool {
+        self.lc_prefix[hi + 1] - self.lc_prefix[lo] < hi + 1 - lo
+    }
+
     /// Advances a monotone cursor to `sample_at(clock_s)`; amortized O(1) when `clock_s` never
     /// decreases between calls with the same cursor.
     pub(crate) fn advance_cursor(&self, cursor: &mut usize, clock_s: f64) -> usize {
@@ -359,6 +364,20 @@ impl Timeline {
         (0..self.n_ref())
             .map(|n| self.rate_fast(n))
             .fold(1.0, f64::max)
+    }
+
+    /// Largest slow rate `S` over all samples.
+    pub(crate) fn max_rate_slow(&self) -> f64 {
+        (0..self.n_ref())
+            .map(|n| self.rate_slow(n))
+            .fold(0.0, f64::max)
+    }
+
+    /// Smallest fast rate `F` over all samples.
+    pub(crate) fn min_rate_fast(&self) -> f64 {
+        (0..self.n_ref())
+            .map(|n| self.rate_fast(n))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Smallest slow rate over all samples (at most 1).

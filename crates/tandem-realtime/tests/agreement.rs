@@ -1,14 +1,14 @@
-//! The single-pass conservative check decides exactly like the per-pair re-simulation, for two
-//! robots and for N; serial schedules are always accepted.
-
-mod common;
+//! The fast and the straightforward forms of the margin check decide alike — for two robots the
+//! single-pass simulation and one simulation per pair, for three or more the lead bound with
+//! sliding extremes and with every window scanned — and `pair_slacks` agrees with both; serial
+//! schedules are always accepted.
 
 use std::cell::Cell;
 
-use common::{Problem, rng};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use rand::Rng;
+use tandem_realtime::testkit::{Case, Family, rng};
 use tandem_realtime::{Timeline, pair_slacks, sufficient_margins, sufficient_margins_per_pair};
 
 #[test]
@@ -23,11 +23,11 @@ fn single_pass_equals_per_pair_on_random_schedules() {
     let counts = Cell::new([0u32; 2]);
     let result = runner.run(&(any::<u64>(), 0.0..=1.0f64), |(seed, frac)| {
         let mut r = rng(seed);
-        let problem = Problem::random(&mut r);
-        let tick_s = problem.dt_s * r.random_range(0.25..=1.5);
+        let case = Case::random(Family::of_seed(seed), 2, &mut r);
+        let tick_s = case.tick_s;
         // Offsets from simultaneous starts to fully serial, biased to the interesting upper half.
-        let tau = problem.duration0() * frac.sqrt();
-        let robots = problem.robots(tau);
+        let tau = case.plans[0].timeline(0.0).end_s() * frac.sqrt();
+        let robots = case.robots_at(&[0.0, tau]);
         let single = sufficient_margins(&robots, tick_s).unwrap();
         let per_pair = sufficient_margins_per_pair(&robots, tick_s).unwrap();
         prop_assert_eq!(
@@ -75,9 +75,9 @@ fn serial_schedule_is_always_accepted() {
         TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
     let result = runner.run(&(any::<u64>(), 0.25..=1.5f64), |(seed, tick_frac)| {
         let mut r = rng(seed);
-        let problem = Problem::random(&mut r);
-        let tick_s = problem.dt_s * tick_frac;
-        let robots = problem.robots(problem.duration0());
+        let case = Case::random(Family::of_seed(seed), 2, &mut r);
+        let tick_s = case.plans[0].dt_s * tick_frac;
+        let robots = case.robots_at(&[0.0, case.plans[0].timeline(0.0).end_s()]);
         prop_assert!(sufficient_margins(&robots, tick_s).unwrap());
         prop_assert!(sufficient_margins_per_pair(&robots, tick_s).unwrap());
         Ok(())
@@ -93,18 +93,19 @@ fn single_pass_equals_per_pair_for_n_robots() {
         let mut counts = [0u32; 2];
         for seed in 0..200u64 {
             let mut r = rng(0xA6 + seed);
-            let (problem, tick_s) = Problem::random_alternating(&mut r, n, seed);
+            let case = Case::random(Family::of_seed(seed), n, &mut r);
+            let tick_s = case.tick_s;
             // Each robot from simultaneous with the first to after the latest end so far.
             let mut starts = vec![0.0];
             for _ in 1..n {
-                let end = problem
+                let end = case
                     .robots_at(&starts)
                     .iter()
                     .map(Timeline::end_s)
                     .fold(0.0, f64::max);
                 starts.push(end * r.random::<f64>().powf(0.25) * 1.05);
             }
-            let robots = problem.robots_at(&starts);
+            let robots = case.robots_at(&starts);
             let single = sufficient_margins(&robots, tick_s).unwrap();
             let per_pair = sufficient_margins_per_pair(&robots, tick_s).unwrap();
             assert_eq!(single, per_pair, "N = {n}, seed {seed}, starts {starts:?}");
@@ -134,12 +135,18 @@ fn serial_schedules_of_n_robots_are_always_accepted() {
     for n in 1..=6usize {
         for seed in 0..60u64 {
             let mut r = rng(0x5E + seed);
-            let (problem, tick_s) = Problem::random_alternating(&mut r, n, seed);
-            let mut starts = vec![0.0];
-            for i in 1..n {
-                starts.push(problem.timeline(i - 1, starts[i - 1]).end_s());
+            let case = Case::random(Family::of_seed(seed), n, &mut r);
+            let tick_s = case.tick_s;
+            let mut starts: Vec<f64> = vec![0.0];
+            for _ in 1..n {
+                let latest_end = case
+                    .robots_at(&starts)
+                    .iter()
+                    .map(Timeline::end_s)
+                    .fold(0.0, f64::max);
+                starts.push(latest_end);
             }
-            let robots = problem.robots_at(&starts);
+            let robots = case.robots_at(&starts);
             assert!(
                 sufficient_margins(&robots, tick_s).unwrap(),
                 "N = {n}, seed {seed}"

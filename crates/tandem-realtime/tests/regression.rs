@@ -2,16 +2,12 @@
 //! robots the two-robot check applied per pair, accepts) really do overlap under some admissible
 //! operator.
 
-mod common;
-
-use common::{Problem, adversaries, find_overlap, rng};
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use tandem_realtime::Operator::{Fastest as FAST, Slowest as SLOW};
 use tandem_realtime::adversary::{adversary_set, run_adversary};
-use tandem_realtime::{
-    Coordinator, Timeline, sufficient_margins, sufficient_margins_pairwise,
-    sufficient_margins_per_pair, sufficient_margins_printed,
-};
+use tandem_realtime::margins::baseline;
+use tandem_realtime::testkit::{Case, Family, find_overlap, rng};
+use tandem_realtime::{Coordinator, Timeline, sufficient_margins, sufficient_margins_per_pair};
 
 /// The smallest case of docs/decisions.md, "Alg. 2 as printed is not sound on a tick grid":
 /// [HC, LC, HC], gradients 1, bounds [½, 2] (F = 2, S = ½),
@@ -28,7 +24,7 @@ fn three_sample() -> [Timeline; 2] {
 #[test]
 fn three_sample_case_printed_accepts_overlaps_conservative_rejects() {
     let robots = three_sample();
-    assert!(sufficient_margins_printed(&robots, 1.0).unwrap());
+    assert!(baseline::printed(&robots, 1.0).unwrap());
     assert!(!sufficient_margins(&robots, 1.0).unwrap());
     assert!(!sufficient_margins_per_pair(&robots, 1.0).unwrap());
     // The operator drags the previous robot for one tick (setting the tick phase), then rushes
@@ -60,30 +56,31 @@ fn printed_check_accepts_schedules_that_overlap() {
     let (mut cases, mut overlaps) = (0, 0);
     for seed in 0..150u64 {
         let mut r = rng(0xA11CE + seed);
-        let problem = Problem::random(&mut r);
-        let e1 = problem.duration0();
-        let tick_s = problem.dt_s * r.random_range(0.25..=1.5);
+        let case = Case::random(Family::Uniform, 2, &mut r);
+        let e1 = case.plans[0].timeline(0.0).end_s();
+        let tick_s = case.tick_s;
+        let robots_at = |tau: f64| case.robots_at(&[0.0, tau]);
         // Tightest offset the printed check accepts (bisection, accepted end kept).
         let (mut lo, mut hi) = (0.0, e1);
-        if sufficient_margins_printed(&problem.robots(0.0), tick_s).unwrap() {
+        if baseline::printed(&robots_at(0.0), tick_s).unwrap() {
             hi = 0.0;
         }
         for _ in 0..30 {
             let m = 0.5 * (lo + hi);
-            if sufficient_margins_printed(&problem.robots(m), tick_s).unwrap() {
+            if baseline::printed(&robots_at(m), tick_s).unwrap() {
                 hi = m;
             } else {
                 lo = m;
             }
         }
-        let robots = problem.robots(hi);
-        if !sufficient_margins_printed(&robots, tick_s).unwrap()
+        let robots = robots_at(hi);
+        if !baseline::printed(&robots, tick_s).unwrap()
             || sufficient_margins(&robots, tick_s).unwrap()
         {
             continue;
         }
         cases += 1;
-        let set = adversaries(&problem, &robots, tick_s, &mut r);
+        let set = case.adversaries(&robots, &mut r);
         if find_overlap(&robots, tick_s, &set, &mut r).is_some() {
             overlaps += 1;
         }
@@ -120,7 +117,7 @@ fn a_dragged_third_robot_breaks_the_two_robot_worst_case() {
     // τ_c = 16: robot 2's region starts 12 s after robot 1's ends. Each pair on its own is
     // safe, so the per-pair check accepts; the N-robot check rejects.
     let robots = third_robot_case(16.0);
-    assert!(sufficient_margins_pairwise(&robots, tick_s).unwrap());
+    assert!(baseline::pairwise(&robots, tick_s).unwrap());
     assert!(!sufficient_margins(&robots, tick_s).unwrap());
     assert!(!sufficient_margins_per_pair(&robots, tick_s).unwrap());
     // The operator drags every low-confidence robot. While robot 0 is dragged (step ⅛ s),

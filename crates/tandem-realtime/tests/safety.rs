@@ -1,16 +1,15 @@
-//! The safety invariant: for every schedule `sufficient_margins` accepts and every admissible
-//! operator rate sequence, the coordinator never has both robots traverse a low-confidence
-//! reference sample in the same tick. The operators are the full set of
-//! `tandem_realtime::adversary`, Alg. 2's worst case per role included.
-
-mod common;
+//! The safety invariant for two robots: for every schedule `sufficient_margins` accepts and
+//! every admissible operator rate sequence, the coordinator never has both robots traverse a
+//! low-confidence reference sample in the same tick. The operators are the full set of
+//! `tandem_realtime::adversary`, Alg. 2's worst case per role and the beam search included; the
+//! problems cycle through the test kit's families (`tandem_realtime::testkit::Family`).
 
 use std::cell::Cell;
 
-use common::{Problem, adversaries, find_overlap, rng};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use rand::Rng;
+use tandem_realtime::testkit::{Case, Family, find_overlap, rng};
 use tandem_realtime::{sufficient_margins, sufficient_margins_per_pair};
 
 const CASES: u32 = 2000;
@@ -27,14 +26,14 @@ fn accepted_schedules_never_overlap_under_any_operator() {
     let accepted = Cell::new(0u32); // accepted with τ < |ψ_E1|
     let result = runner.run(&any::<u64>(), |seed| {
         let mut r = rng(seed);
-        let problem = Problem::random(&mut r);
-        let e1 = problem.duration0();
-        let tick_s = problem.dt_s * r.random_range(0.25..=1.5);
+        let case = Case::random(Family::of_seed(seed), 2, &mut r);
+        let e1 = case.plans[0].timeline(0.0).end_s();
+        let tick_s = case.tick_s;
         // Tight cases: try offsets from small to large, keep the first one accepted.
         let mut taus: Vec<f64> = (0..8).map(|_| e1 * r.random::<f64>().sqrt()).collect();
         taus.push(e1);
         taus.sort_by(f64::total_cmp);
-        let accepts = |t: f64| sufficient_margins(&problem.robots(t), tick_s).unwrap();
+        let accepts = |t: f64| sufficient_margins(&case.robots_at(&[0.0, t]), tick_s).unwrap();
         let Some(i) = taus.iter().position(|&t| accepts(t)) else {
             return Ok(());
         };
@@ -52,12 +51,12 @@ fn accepted_schedules_never_overlap_under_any_operator() {
                 }
             }
         }
-        let robots = problem.robots(tau);
+        let robots = case.robots_at(&[0.0, tau]);
         prop_assert!(sufficient_margins_per_pair(&robots, tick_s).unwrap());
         if tau < e1 {
             accepted.set(accepted.get() + 1);
         }
-        let set = adversaries(&problem, &robots, tick_s, &mut r);
+        let set = case.adversaries(&robots, &mut r);
         let hit = find_overlap(&robots, tick_s, &set, &mut r);
         prop_assert!(
             hit.is_none(),

@@ -1,0 +1,392 @@
+//! The lead bound for `N ≥ 3` robots: upper bounds on how far robot `c`'s schedule clock can be
+//! ahead of robot `p`'s when `p`'s clock is at `u`, over every operator strategy, integrated
+//! along `p`'s progress (the argument is in the [module docs](super), "Three or more robots: the
+//! lead bound").
+
+use super::window::Sliding;
+use super::{PairSlack, Windows};
+use crate::timeline::Timeline;
+
+/// The bound of one ordered pair `(p, c)` on `p`'s sample grid: for every tick start at which
+/// `p` and `c` both run, no two robots have been low-confidence in one tick, and `p`'s clock
+/// lies in the cell `(u_s[k − 1], u_s[k]]` (the first cell includes its left end), `c`'s clock
+/// is at most `reach_s[k]` (schedule-clock s). `reach_s` is non-decreasing: the largest
+/// `u + Λ_pc(u)` over the cells up to `k`.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Lead {
+    /// Cell ends (p's schedule clock, s), increasing; `u_s[0]` is where the analysis starts.
+    u_s: Vec<f64>,
+    /// The largest `c`-clock (s) at a tick start with `p` in any cell up to this one.
+    reach_s: Vec<f64>,
+}
+
+impl Lead {
+    /// Where the analysis starts: the later start of `p` and `c` (s).
+    pub(super) fn start_s(&self) -> f64 {
+        self.u_s[0]
+    }
+
+    /// The largest `c`-clock (s) at any tick start with `p`'s clock below `u` (or at the start
+    /// of the analysis).
+    pub(super) fn reach_below(&self, u: f64) -> f64 {
+        // The cell containing u, or the last one.
+        let k = self.u_s.partition_point(|&x| x < u).min(self.u_s.len() - 1);
+        self.reach_s[k]
+    }
+}
+
+/// What one pair's analysis needs besides the two timelines.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PairInputs {
+    /// `M_p`: the largest step of `p` in one tick (schedule-clock s).
+    pub(super) max_step_p: f64,
+    /// Earliest start `τ_r` of a robot other than `p` and `c` (s; `+∞` if there is none): from
+    /// `u = τ_r` on another robot may set the pace.
+    pub(super) third_start_s: f64,
+    /// Where the analysis starts (s): `max(τ_p, τ_c)`.
+    pub(super) u0_s: f64,
+    /// The lead of `c` over `p` there (s).
+    pub(super) lead0_s: f64,
+}
+
+/// One robot's Eq. 17 rates per reference sample, computed once per check: `S` and `F`, and
+/// the same restricted to the high- or low-confidence samples (`−∞` elsewhere).
+pub(super) struct RateTable {
+    slow: Vec<f64>,
+    fast: Vec<f64>,
+    slow_hc: Vec<f64>,
+    fast_hc: Vec<f64>,
+    fast_lc: Vec<f64>,
+}
+
+impl RateTable {
+    pub(super) fn new(tl: &Timeline) -> Self {
+        let n = tl.n_ref();
+        let (slow, fast): (Vec<f64>, Vec<f64>) =
+            (0..n).map(|i| (tl.rate_slow(i), tl.rate_fast(i))).unzip();
+        let only = |v: &[f64], hc: bool| -> Vec<f64> {
+            v.iter()
+                .zip(tl.conf())
+                .map(|(&x, &c)| if c == hc { x } else { f64::NEG_INFINITY })
+                .collect()
+        };
+        RateTable {
+            slow_hc: only(&slow, true),
+            fast_hc: only(&fast, true),
+            fast_lc: only(&fast, false),
+            slow,
+            fast,
+        }
+    }
+}
+
+/// One robot's rate window of the lead bound: the samples meeting a schedule-clock interval whose
+/// ends never decrease, and extreme rates over them, overall or over the samples of one
+/// confidence.
+struct RateWindow<'a> {
+    windows: Windows,
+    table: &'a RateTable,
+    /// Largest rates (`c`) or smallest (`p`).
+    largest: bool,
+    lo: usize,
+    hi: usize,
+    slow: Sliding,
+    fast: Sliding,
+    /// `c` only: over its high-confidence samples (`−∞` where there is none).
+    slow_hc: Sliding,
+    fast_hc: Sliding,
+    /// `c` only: over its low-confidence samples.
+    fast_lc: Sliding,
+}
+
+/// What a [`RateWindow`] read: the samples `lo..=hi` and extreme rates over them.
+struct Read {
+    lo: usize,
+    hi: usize,
+    /// Extreme `S` and `F` over all the samples.
+    slow: f64,
+    fast: f64,
+    /// Largest `S` and `F` over the high-confidence samples, largest `F` over the
+    /// low-confidence ones (`−∞` where there is none; `c`'s window only).
+    slow_hc: f64,
+    fast_hc: f64,
+    fast_lc: f64,
+}
+
+impl<'a> RateWindow<'a> {
+    fn new(windows: Windows, table: &'a RateTable, largest: bool) -> Self {
+        RateWindow {
+            windows,
+            table,
+            largest,
+            lo: 0,
+            hi: 0,
+            slow: Sliding::default(),
+            fast: Sliding::default(),
+            slow_hc: Sliding::default(),
+            fast_hc: Sliding::default(),
+            fast_lc: Sliding::default(),
+        }
+    }
+
+    /// The samples of `tl` meeting `[a_s, b_s]` and their extreme rates.
+    fn read(&mut self, tl: &Timeline, a_s: f64, b_s: f64) -> Read {
+        let max = self.largest;
+        let t = self.table;
+        match self.windows {
+            Windows::Sliding => {
+                let lo = tl.advance_cursor(&mut self.lo, a_s);
+                let hi = tl.advance_cursor(&mut self.hi, b_s);
+                let (mut slow_hc, mut fast_hc, mut fast_lc) = (0.0, 0.0, 0.0);
+                if max {
+                    slow_hc = self.slow_hc.query(lo, hi, |n| t.slow_hc[n], true);
+                    fast_hc = self.fast_hc.query(lo, hi, |n| t.fast_hc[n], true);
+                    fast_lc = self.fast_lc.query(lo, hi, |n| t.fast_lc[n], true);
+                }
+                Read {
+                    lo,
+                    hi,
+                    slow: self.slow.query(lo, hi, |n| t.slow[n], max),
+                    fast: self.fast.query(lo, hi, |n| t.fast[n], max),
+                    slow_hc,
+                    fast_hc,
+                    fast_lc,
+                }
+            }
+            Windows::Scanned => {
+                // The oracle reads the timeline itself, not the table.
+                let (lo, hi) = (tl.sample_at(a_s), tl.sample_at(b_s));
+                let pick = |a: f64, b: f64| if max { a.max(b) } else { a.min(b) };
+                let first = tl.rates(lo);
+                let (mut slow, mut fast) = (first.slow, first.fast);
+                let (mut slow_hc, mut fast_hc, mut fast_lc) =
+                    (f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+                for n in lo..=hi {
+                    let r = tl.rates(n);
+                    (slow, fast) = (pick(slow, r.slow), pick(fast, r.fast));
+                    if tl.conf()[n] {
+                        slow_hc = slow_hc.max(r.slow);
+                        fast_hc = fast_hc.max(r.fast);
+                    } else {
+                        fast_lc = fast_lc.max(r.fast);
+                    }
+                }
+                Read {
+                    lo,
+                    hi,
+                    slow,
+                    fast,
+                    slow_hc,
+                    fast_hc,
+                    fast_lc,
+                }
+            }
+        }
+    }
+}
+
+/// Integrates the bound `Λ_pc` of `(p, c)` over `p`'s samples from `inputs.u0_s` to `p`'s end,
+/// as a piecewise-linear function of `p`'s clock `u`.
+///
+/// `Λ` grows along the *frontier*: on each cell `[u_a, u_b]` (between two of `p`'s breakpoints)
+/// its slope `ρ̄` is the largest gain per unit of `p`'s progress of every tick that can start
+/// with `p` at `u ∈ [u_a − M_p, u_b]` (a tick moves `p` by at most `M_p`) and `c` within `δ` of
+/// the frontier, `c ∈ [u + Λ(u) − δ, u + Λ(u)]`: `p`'s mode and smallest rates over the samples
+/// meeting `[u_a − M_p, u_b]`, `c`'s mode and largest rates over the samples meeting
+/// `[u_a − M_p + Λ(u_a − M_p) − δ, u_b + Λ(u_b)]`, and whether another robot may already run
+/// (`τ_r ≤ u_b`). Per unit of `p`'s progress (module docs, (b)):
+///
+/// - `c` low-confidence (it sets the pace): `F_c/F_p − 1`;
+/// - `c` high-confidence and `p` low-confidence: `S_c/S_p − 1`;
+/// - both high-confidence, another robot may set the pace: `max(S_c/S_p, F_c/F_p) − 1`; only
+///   `p` and `c` run: `S_c/F_p − 1` (Alg. 1 pulls a robot ahead back).
+///
+/// A state further than `δ` below the frontier cannot overtake it in one tick when
+/// `δ ≥ (ρ_max + 1)·M_p`, with `ρ_max` the largest gain of any state (`≥ −1` everywhere): so
+/// `δ = (ρ_max + 1)·M_p` over the two robots' extreme rates. `Λ` is floored at 0 (a robot
+/// behind does not matter) and `u + Λ(u)` is non-decreasing (`ρ̄ ≥ −1`). Cost O(T_ref).
+pub(super) fn integrate(
+    (tp, rates_p): (&Timeline, &RateTable),
+    (tc, rates_c): (&Timeline, &RateTable),
+    inputs: PairInputs,
+    windows: Windows,
+) -> Lead {
+    let PairInputs {
+        max_step_p: mp,
+        third_start_s,
+        u0_s,
+        lead0_s,
+    } = inputs;
+    let end = tp.end_s();
+    let mut lead = Lead {
+        u_s: vec![u0_s],
+        reach_s: vec![u0_s + lead0_s],
+    };
+    if u0_s >= end {
+        return lead;
+    }
+    // The largest gain of any state, from the two robots' extreme rates.
+    let rho_max = (tc.max_rate_slow() / tp.min_rate_slow())
+        .max(tc.max_rate_fast() / tp.min_rate_fast())
+        - 1.0;
+    let delta = (rho_max.max(-1.0) + 1.0) * mp;
+    let bp = tp.sample_clock_s();
+    let mut k = bp.partition_point(|&b| b <= u0_s);
+    let mut p_win = RateWindow::new(windows, rates_p, false);
+    let mut c_win = RateWindow::new(windows, rates_c, true);
+    let mut c_top_s = f64::NEG_INFINITY;
+    // (u, u + Λ(u)) at the grid points of the last M_p, for the near window's lower end.
+    let mut history: std::collections::VecDeque<(f64, f64)> = [(u0_s, u0_s + lead0_s)].into();
+    let mut lam = lead0_s;
+    let mut reach = u0_s + lead0_s;
+    let mut u_a = u0_s;
+    loop {
+        let u_b = if k < bp.len() { bp[k].min(end) } else { end };
+        let du = u_b - u_a;
+        let left = u_a - mp;
+        let p_read = p_win.read(tp, left, u_b);
+        let p_lc = tp.any_low_conf(p_read.lo, p_read.hi);
+        let p_hc = tp.any_high_conf(p_read.lo, p_read.hi);
+        let (s_p, f_p) = (p_read.slow, p_read.fast);
+        // The frontier's c-clock at the last grid point at or before `left` bounds it from
+        // below there (u + Λ(u) is non-decreasing).
+        while history.len() >= 2 && history[1].0 <= left {
+            history.pop_front();
+        }
+        let near_lo = history[0].1 - delta;
+        c_top_s = c_top_s.max(u_b + lam + rho_max.max(0.0) * du);
+        let c_read = c_win.read(tc, near_lo, c_top_s);
+        let c_lc = tc.any_low_conf(c_read.lo, c_read.hi);
+        let c_hc = tc.any_high_conf(c_read.lo, c_read.hi);
+        let mut rho = f64::NEG_INFINITY;
+        if c_lc {
+            rho = rho.max(c_read.fast_lc / f_p - 1.0);
+        }
+        if c_hc {
+            let drag = c_read.slow_hc / s_p - 1.0;
+            if p_lc {
+                rho = rho.max(drag);
+            }
+            if p_hc {
+                if third_start_s <= u_b {
+                    rho = rho.max(drag).max(c_read.fast_hc / f_p - 1.0);
+                } else {
+                    rho = rho.max(c_read.slow_hc / f_p - 1.0);
+                }
+            }
+        }
+        lam = (lam + rho * du).max(0.0);
+        reach = reach.max(u_b + lam);
+        history.push_back((u_b, u_b + lam));
+        lead.u_s.push(u_b);
+        lead.reach_s.push(reach);
+        if u_b >= end {
+            return lead;
+        }
+        u_a = u_b;
+        k += 1;
+    }
+}
+
+/// The slacks of every pair of regions of `robots` (`N ≥ 2`) under the lead bound.
+///
+/// The ordered pairs `(p, c)` are integrated in the order of their later start `max(τ_p, τ_c)`,
+/// so that the lead with which `c` can be ahead when a later `p` starts is read from pairs
+/// already done; each pair's regions are tested as soon as its bound is known (and with
+/// `stop_at_first` the check stops at the first slack `≤ 0`). `max_step_of[i]` is `M_i`, `eps`
+/// the comparison tolerance `ε` (schedule-clock s).
+///
+/// For every region `P` of `p` and the first region `C` of `c` starting at or after `P` starts
+/// (later regions of `c` are implied): `slack = (T_c − ε) − (reach + M_c)` with `T_c` where `c`
+/// enters `C` and `reach` the largest `c`-clock at a tick start with `p` below
+/// `u_max = min(T_p + ε, end_p)` (the largest `p`-clock at a tick start from which `p` can still
+/// traverse `P`); `+∞` when `u_max` is at or before the later start of `p` and `c` (`p` has left
+/// `P` before both run). The result is sorted by `C`'s start, then `P`'s.
+pub(super) fn slacks(
+    robots: &[Timeline],
+    max_step_of: &[f64],
+    eps: f64,
+    windows: Windows,
+    stop_at_first: bool,
+) -> Vec<PairSlack> {
+    let n = robots.len();
+    let start = |i: usize| robots[i].start_s();
+    let mut order: Vec<(usize, usize)> = (0..n)
+        .flat_map(|p| (0..n).filter(move |&c| c != p).map(move |c| (p, c)))
+        .collect();
+    order.sort_by(|&(p, c), &(q, d)| {
+        start(p)
+            .max(start(c))
+            .total_cmp(&start(q).max(start(d)))
+            .then((p, c).cmp(&(q, d)))
+    });
+    let tables: Vec<RateTable> = robots.iter().map(RateTable::new).collect();
+    let mut leads = vec![Lead::default(); n * n];
+    let mut out = Vec::new();
+    for (p, c) in order {
+        let (tau_p, tau_c) = (start(p), start(c));
+        let lead0_s = if tau_c >= tau_p {
+            // c starts at τ_c once every running robot, p included, has reached τ_c.
+            0.0
+        } else {
+            // p starts at τ_p in the tick in which the running robot furthest behind, m, passes
+            // τ_p: at that tick's start s_m < τ_p and c is at most at reach_mc below τ_p (or
+            // m = c, below τ_p), and c then moves at most M_c.
+            let behind = (0..n)
+                .filter(|&m| m != p && m != c && start(m) < tau_p)
+                .filter(|&m| robots[m].end_s() > start(m).max(tau_c))
+                .map(|m| leads[m * n + c].reach_below(tau_p.min(robots[m].end_s())) - tau_p)
+                .fold(0.0, f64::max);
+            max_step_of[c] + behind
+        };
+        let third_start_s = (0..n)
+            .filter(|&r| r != p && r != c)
+            .map(start)
+            .fold(f64::INFINITY, f64::min);
+        let inputs = PairInputs {
+            max_step_p: max_step_of[p],
+            third_start_s,
+            u0_s: tau_p.max(tau_c),
+            lead0_s,
+        };
+        let lead = integrate(
+            (&robots[p], &tables[p]),
+            (&robots[c], &tables[c]),
+            inputs,
+            windows,
+        );
+        let end_p = robots[p].end_s();
+        let cur = robots[c].lc_intervals();
+        let mut j = 0;
+        for &prev in robots[p].lc_intervals() {
+            while j < cur.len() && cur[j].start_s < prev.start_s {
+                j += 1;
+            }
+            let Some(&c_iv) = cur.get(j) else { break };
+            let u_max = (prev.end_s + eps).min(end_p);
+            let slack_s = if u_max <= lead.start_s() {
+                f64::INFINITY
+            } else {
+                (c_iv.start_s - eps) - (lead.reach_below(u_max) + max_step_of[c])
+            };
+            out.push(PairSlack {
+                prev_robot: p,
+                cur_robot: c,
+                prev,
+                cur: c_iv,
+                slack_s,
+            });
+            if stop_at_first && slack_s <= 0.0 {
+                return out;
+            }
+        }
+        leads[p * n + c] = lead;
+    }
+    out.sort_by(|x, y| {
+        x.cur
+            .start_s
+            .total_cmp(&y.cur.start_s)
+            .then(x.prev.start_s.total_cmp(&y.prev.start_s))
+    });
+    out
+}

@@ -1,0 +1,347 @@
+//! Worst-case margins between low-confidence regions (Alg. 2, §II-B5), for `1 ≤ N ≤ MAX_ROBOTS`
+//! robots: [`sufficient_margins`] is `true` only when no admissible operator can make two robots
+//! low-confidence (LC) in the same control tick.
+//!
+//! Two robots are checked by a worst-case *simulation* (Alg. 2 with fixes 1–4, below); three or
+//! more by a *lead bound* integrated along each robot's progress (section "Three or more robots:
+//! the lead bound"). The simulation's extension to `N ≥ 3` robots (fixes 5–6) was found to accept
+//! schedules that overlap and is kept only as the named baseline [`baseline::greedy_pace`].
+//!
+//! Notation: `h` = `tick_s`; robot `i`'s schedule clock `s_i` (s); at its current sample the
+//! Eq. 17 rates `S_i = ψ̇_E/ψ̇max ≤ 1 ≤ F_i = ψ̇_E/ψ̇min`; `M_i = h · max(1, max_n F_i)` the
+//! largest step robot `i` can take in one tick (over *all* its samples); `ε` four times
+//! [`clock_tolerance_s`](crate::tol::clock_tolerance_s). An LC region of robot `i` is the exact
+//! schedule-clock interval of a maximal LC run, `[c_{n0}, c_{n1+1})` (see
+//! [`Timeline::lc_intervals`]); `p` leaves its region `P` at `T_p`, `c` enters its region `C` at
+//! `T_c`.
+//!
+//! # The first overlap
+//! Everything below looks at the *first* tick in which two robots are LC. Before it, at most one
+//! robot is LC at every tick start: a running robot moves every tick (at least `S·h > 0`), so a
+//! robot whose clock is in an LC sample at a tick start traverses that sample and is LC in that
+//! tick. So every tick before the first overlap follows the coordinator's single-pace rules
+//! (`strategy`, rules 1–4), and it suffices to show that no tick start reachable under those
+//! rules lets two robots traverse LC samples in the next tick.
+//!
+//! # Two robots: the worst-case simulation (fixes 1–4)
+//! The regions of both robots are merged by start time; every two consecutive regions of
+//! different robots form a pair `(p, c)`, safe when `c` can never enter its region before `p`
+//! has left its own. Non-consecutive pairs are implied: if every consecutive pair is safe and `A`
+//! before `B` overlap first, the region `X` right after `A` cannot start before `A` ends (its
+//! pair, or the same robot's order), and by induction along the merged order neither can `B`.
+//!
+//! Alg. 2 as printed ([`baseline::printed`]) simulates from the later start `τ`, each step: if
+//! `c` is LC it rushes (`F`) and `p` responds (Eq. 18), else if `p` is LC it drags (`S`) and `c`
+//! responds, else `HIGH-CONF`; after the step it rejects if `t_c ≥ T_c` and accepts if
+//! `t_p ≥ T_p`. **It is not sound on a tick grid** (the 3-sample case [HC, LC, HC] with gradients
+//! 1, bounds `[½, 2]`, one sample per tick and `τ = 3/2` is accepted yet overlaps when the
+//! operator rushes the previous robot; tests/regression.rs). The conservative check keeps the
+//! paper's worst case and widens the discrete simulation against the three ways a tick grid
+//! breaks it — the exit tick, rate aliasing and mode aliasing (`M` = the larger step of the two
+//! robots):
+//!
+//! 1. **Stop test, `c` first.** After each step, reject if `t_c + M ≥ T_c − ε`, else accept the
+//!    pair if `t_p ≥ T_p + ε`. The real robots' tick phase is set by the operator, not by the
+//!    check, and `p` is LC for the *whole* tick in which it leaves its region while `c` may move
+//!    a full step in that tick: requiring `c` to be a full step short of `T_c` at the first
+//!    simulated clock where `p` is out covers the exit tick whatever its phase.
+//! 2. **Conservative rates.** At each clock, `c` uses the largest `F` and `S`, and `p` the
+//!    smallest, over all samples whose interval meets `[t − M − ε, t + M + ε]`: a real tick may
+//!    read its rates up to one step away from the simulated clock (rate aliasing); larger rates
+//!    for `c` and smaller for `p` only move the simulated `c` further ahead.
+//! 3. **Widened LC regions.** A robot counts as LC in the simulation when any LC sample meets
+//!    the same window (mode aliasing: the real coordinator reads modes at the tick start, up to
+//!    a step away). Where both robots then count as LC, both branches (`c` rushing, `p`
+//!    dragging) are simulated and the one leaving `c` furthest ahead (larger `t_c − t_p`, the
+//!    first on a tie) is kept.
+//! 4. **Pairs decided before the later robot starts.** A robot starts at a tick boundary once
+//!    the running robot has reached its start `τ`, so when the later of `p` and `c` starts, `p`
+//!    has reached `τ`: a pair whose previous region ends at `T_p ≤ t_p − ε` (or at `p`'s end,
+//!    `≤ t_p`) can never overlap and is accepted without simulation (the printed loop steps once
+//!    before testing and needlessly rejects such pairs). Conversely the earlier robot may be up
+//!    to one step ahead when the later one starts, so when `c` is the earlier robot its clock
+//!    starts a full step `M` ahead. Any other pair whose regions already overlap on schedule
+//!    (`T_c < T_p + ε`) is rejected outright.
+//!
+//! In continuous time the extreme policy bounds every admissible operator; fixes 1–4 only widen
+//! the discrete check by at most one maximal step in clock, rate and mode. Branches of fix 3 are
+//! chosen per tick, but they exist only where both robots are within one maximal step of LC
+//! samples, and there the stop test already demands a full step of room; the search adversary
+//! ([`adversary::Adversary::Beam`](crate::adversary::Adversary::Beam)), the property tests
+//! `tests/safety.rs` and `tests/safety_n.rs` and `cargo xtask stress` find no overlap
+//! (docs/decisions.md, "The N-robot margin check: a lead bound per unit of progress").
+//!
+//! **Single pass.** The simulated dynamics do not depend on `T_p` or `T_c` (only the stop test
+//! does), and the pairs of one role `(p, c)` are ordered in both `T_p` and `T_c`. So one
+//! simulation per ordered role, with a pointer over that role's pairs, decides every pair
+//! exactly as a fresh simulation per pair would ([`sufficient_margins_per_pair`], the oracle of
+//! `tests/agreement.rs`).
+//!
+//! # Three or more robots: the lead bound
+//! With a third robot the pace of `p` and `c` is no longer theirs: while neither is LC both
+//! respond to a pace set by another robot (the operator's rate for a third LC robot, or
+//! `HIGH-CONF`'s target, which a robot far behind holds back), and two robots that track one
+//! pace within different bounds drift apart. The lead `L = s_c − s_p` that `c` gains is bounded
+//! here per unit of `p`'s progress, which holds over any operator strategy however many ticks it
+//! takes.
+//!
+//! **(a) One common pace.** In a tick with at most one LC robot, every running HC robot `i` ends
+//! at `clamp(x, s_i + S_i·h, s_i + F_i·h)` for one common `x`, and an LC robot at `x` itself with
+//! `x` in its own range: with an LC robot `x` is its new clock and every other robot responds
+//! with Eq. 18, which is that clamp; with none, Alg. 1 between the leader `a` and the robot `b`
+//! that can reach least far either moves `a` fastest and lands `b` on it, or moves `b` fastest and
+//! lands `a` on `b` or as slowly as it can (then above `b`), so both are the clamp of
+//! `x = min(s_a', s_b')`, to which every other robot responds.
+//!
+//! **(b) The gain of one tick.** For an ordered pair `(p, c)` with `Δp = s_p' − s_p` and rates
+//! read at the tick start, `max(0, L') ≤ max(0, L + ρ·Δp)`, where `ρ` depends on the modes:
+//!
+//! - `c` LC: `c` sets the pace (`x = s_c'`), `p` (HC, by the first overlap) responds. `p` lands
+//!   on `x` (`L' = 0`), cannot go slowly enough (`L' < 0`), or cannot go fast enough:
+//!   `L' = L + Δc − F_p·h ≤ L + (F_c − F_p)·h = L + (F_c/F_p − 1)·Δp`. So `ρ = F_c/F_p − 1`.
+//! - `c` HC, `p` LC: `p` sets the pace, `c` responds. `c` lands on `x`, cannot go fast enough
+//!   (`L' < 0`), or cannot go slowly enough: `L' = L + S_c·h − Δp ≤ L + (S_c/S_p − 1)·Δp` since
+//!   `Δp ≥ S_p·h`. So `ρ = S_c/S_p − 1`: the paper's drag.
+//! - both HC and another robot may set the pace (a robot that runs started when every running
+//!   robot had reached its start, so this needs `τ_r ≤ s_p`): of `p` and `c` at most one is
+//!   clamped away from `x` in the direction that makes `L` grow; `c` held at its slowest gives
+//!   the drag term, `p` held at its fastest `L + (F_c − F_p)·h`; so
+//!   `ρ = max(S_c/S_p, F_c/F_p) − 1`.
+//! - both HC and only `p` and `c` run: Alg. 1 between the two. With `c` ahead, `p` goes fastest
+//!   and `c` lands on it or goes as slowly as it can: `L' ≤ max(0, L + (S_c − F_p)·h)`, so
+//!   `ρ = S_c/F_p − 1 < 0` — the pull that brings a robot ahead back; with `c` behind, `L' ≤ 0`.
+//!
+//! The lead can only become positive from `c`-positions with `s_c > s_p − M_c`, and `ρ ≥ −1`
+//! always. None of these bounds depends on how many ticks a stretch takes: they are per unit of
+//! `p`'s progress, which is what the simulation of fixes 5–6 got wrong. It picked, per tick,
+//! the pace leaving `c` furthest ahead *after that tick*; the operator picks the pace that
+//! leaves `c` furthest ahead when `p` leaves its region, and dragging a third robot, which gains
+//! less lead per tick than rushing it, can gain more per unit of `p`'s progress (four times
+//! more in the reproducers of `tests/reproducers.rs`).
+//!
+//! **(c) The frontier.** `Λ_pc(u)` bounds `L` at every tick start with `p` at `u`; it is
+//! integrated along `p`'s clock, `Λ' = ρ̄` (floored at 0), where `ρ̄(u)` is the largest `ρ` over
+//! the ticks that can cover `u` — starting with `p` in `[u − M_p, u]`, `p`'s mode and smallest
+//! rates over those samples, whether a robot other than `p` and `c` may run — and with `c`
+//! within `δ` of the frontier, `c ∈ [s_p + Λ(s_p) − δ, s_p + Λ(s_p)]`, `c`'s mode and largest
+//! rates over those samples. A state on the frontier gains at most `ρ̄·Δp`; a state further than
+//! `δ` below it gains at most `ρ_max·Δp` (`ρ_max`: the largest `ρ` over the two robots' extreme
+//! rates) and so stays below when `δ = (ρ_max + 1)·M_p`. Taking `c`'s rates only near the
+//! frontier, not over every position `c` could be in, keeps the bound from feeding on its own
+//! width; it is the envelope of every trajectory, and the simulated worst case of two robots
+//! is one of them. `u + Λ(u)` is non-decreasing (`ρ̄ ≥ −1`).
+//!
+//! **(d) Starts.** When `c` starts after `p`, it starts at `τ_c` once every running robot has
+//! reached `τ_c`, so `L ≤ 0` there and `Λ_pc` starts at 0. When `p` starts after `c`, it starts
+//! at `τ_p` in the tick in which the running robot furthest behind, `m`, passes `τ_p`: at that
+//! tick's start `s_m < τ_p` and `s_c ≤ s_m + Λ_mc(s_m)` (or `m = c`), and `c` moves at most
+//! `M_c`, so `L ≤ M_c + max(0, max_m (s + Λ_mc(s)) − τ_p)` over `s < τ_p`. The ordered pairs
+//! are integrated in the order of their later start, so every `Λ_mc` needed is known.
+//!
+//! **(e) The test.** `p` can traverse its region `P` in a tick that starts at `s_p` only if
+//! `s_p < u_max = min(T_p + ε, end_p)`, and `c` can traverse `C` only if `s_c + M_c ≥ T_c − ε`.
+//! So the pair is safe when the largest `u + Λ_pc(u)` over `u < u_max`, plus `M_c`, is below
+//! `T_c − ε`, or when `u_max` is at or before the later start (then `p` has left `P` before both
+//! run). This excludes `c` being in `C` — entering, inside, or already past it — while `p` has
+//! not left `P`, so for each `P` only the first region of `c` starting at or after `P` needs the
+//! test; a region of `c` starting before `P` is the pair `(c, p)`. Cost: `O(N² · T_ref)` with
+//! sliding extremes, independent of the tick.
+//!
+//! This is a proof on paper, checked by search (the property tests `tests/safety_n.rs` over the
+//! test kit's problem families, the search adversary, `cargo xtask stress`), not a
+//! machine-checked one. For two robots [`lead_bound`] is sound too, but neither it nor the
+//! simulation is uniformly tighter (docs/decisions.md, "The N-robot margin check: a lead bound
+//! per unit of progress"), so two robots keep the simulation, bit for bit.
+//!
+//! # Slacks
+//! [`pair_slacks`] reports, per pair, the room rule 1 (two robots) or the test (d) (three or
+//! more) leaves: `> 0` exactly when the pair is accepted, its negative the clearance missing. A
+//! scheduler reads from the slacks how much clearance each pair lacks or has to spare, with the
+//! check itself as the only owner of the worst case.
+
+mod lead;
+mod sim;
+mod window;
+
+use crate::error::{Error, Result};
+use crate::robots::check_count;
+use crate::timeline::{LcInterval, Timeline};
+use crate::tol::clock_tolerance_s;
+use sim::Variant;
+
+/// The conservative, discretization-safe worst-case margin check for `1 ≤ N ≤ MAX_ROBOTS`
+/// robots: `true` when no admissible operator can make two robots low-confidence in the same
+/// control tick of `tick_s` real seconds. Robot `i` is `robots[i]`; one robot is always
+/// accepted.
+///
+/// Two robots: the single-pass worst-case simulation (Alg. 2 with fixes 1–4), O(T_ref · steps
+/// per sample). Three or more: the lead bound, O(N² · T_ref). See the [module docs](self) for the
+/// arguments.
+///
+/// # Errors
+/// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] for `tick_s` not
+/// finite and > 0, or (two robots) so small that the simulation would need more than 1e8 ticks.
+pub fn sufficient_margins(robots: &[Timeline], tick_s: f64) -> Result<bool> {
+    match robots.len() {
+        0..=2 => sim::check_single_pass(robots, tick_s, Variant::Conservative),
+        _ => lead_bound(robots, tick_s),
+    }
+}
+
+/// The same decisions as [`sufficient_margins`], computed the straightforward way: for two
+/// robots one fresh worst-case simulation per pair; for three or more the lead bound with every
+/// window scanned sample by sample instead of by sliding extremes. O(pairs) or O(window) times
+/// the cost; a benchmark baseline and the oracle of `tests/agreement.rs`.
+///
+/// # Errors
+/// As [`sufficient_margins`].
+pub fn sufficient_margins_per_pair(robots: &[Timeline], tick_s: f64) -> Result<bool> {
+    match robots.len() {
+        0..=2 => sim::check_per_pair(robots, tick_s, Variant::Conservative),
+        _ => Ok(lead_slacks(robots, tick_s, false, Windows::Scanned)?
+            .iter()
+            .all(|s| s.slack_s > 0.0)),
+    }
+}
+
+/// The lead bound alone (section "Three or more robots: the lead bound" of the
+/// [module docs](self)) for any `1 ≤ N ≤ MAX_ROBOTS`: `true` when it shows that no admissible
+/// operator can make two robots low-confidence in one tick. Sound for every `N`;
+/// [`sufficient_margins`] uses it for `N ≥ 3`. For two robots it is more conservative than the
+/// simulation, which sees how `HIGH-CONF` pulls the robots together between regions.
+///
+/// # Errors
+/// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] for `tick_s` not
+/// finite and > 0.
+pub fn lead_bound(robots: &[Timeline], tick_s: f64) -> Result<bool> {
+    Ok(lead_slacks(robots, tick_s, true, Windows::Sliding)?
+        .iter()
+        .all(|s| s.slack_s > 0.0))
+}
+
+/// One pair of LC regions of different robots with its worst-case room (see [`pair_slacks`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairSlack {
+    /// The previous robot `p` (index into the robots given, 0 = the first robot).
+    pub prev_robot: usize,
+    /// The current robot `c` (index into the robots given); for two robots `1 − prev_robot`.
+    pub cur_robot: usize,
+    /// `p`'s region (schedule clock); `p` leaves it at `T_p = prev.end_s`.
+    pub prev: LcInterval,
+    /// `c`'s region (schedule clock); `c` enters it at `T_c = cur.start_s`.
+    pub cur: LcInterval,
+    /// Schedule-clock s, `> 0` exactly when [`sufficient_margins`] accepts the pair; its
+    /// negative is the clearance missing.
+    ///
+    /// Two robots: how much earlier `c`'s region could start before rule 1 rejects it on the
+    /// same worst-case trajectory, `(T_c − ε) − (t_c + M)` at the first simulated step with
+    /// `t_p ≥ T_p + ε`; `+∞` for a pair accepted without simulation (fix 4); for a pair whose
+    /// regions already overlap on schedule, the smaller of that and `T_c − (T_p + ε) < 0`; `−∞`
+    /// if the simulation budget ran out first. Three or more robots: the room of test (d),
+    /// `(T_c − ε) − (u_max + Λ_pc(u_max) + M_c)`, `+∞` when `p` has left `P` before both run.
+    pub slack_s: f64,
+}
+
+/// Every pair's worst-case slack ([`PairSlack`]), in the order of the current regions' starts,
+/// from the same computation as [`sufficient_margins`] (run to the end instead of stopping at
+/// the first rejection): `sufficient_margins(robots, tick_s)` is `true` exactly when every
+/// `slack_s > 0`. Two robots: every pair of consecutive regions; three or more: for every region
+/// `P` of every robot `p` and every other robot `c`, the first region of `c` starting at or after
+/// `P`.
+///
+/// # Errors
+/// As [`sufficient_margins`].
+pub fn pair_slacks(robots: &[Timeline], tick_s: f64) -> Result<Vec<PairSlack>> {
+    match robots.len() {
+        0..=2 => sim::pair_slacks(robots, tick_s),
+        _ => lead_slacks(robots, tick_s, false, Windows::Sliding),
+    }
+}
+
+/// How the lead bound reads its rate windows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Windows {
+    /// Sliding extremes over monotone cursors (amortized O(1) per cell).
+    Sliding,
+    /// Every window scanned sample by sample (the oracle).
+    Scanned,
+}
+
+/// Count, tick and steps shared by the checks: `M_i` per robot and `ε` (schedule-clock s).
+fn steps_and_eps(robots: &[Timeline], tick_s: f64) -> Result<(Vec<f64>, f64)> {
+    check_count(robots.len())?;
+    if !(tick_s.is_finite() && tick_s > 0.0) {
+        return Err(Error::BadParam {
+            name: "tick_s",
+            why: "must be finite and > 0",
+        });
+    }
+    let max_step_of = robots.iter().map(|r| tick_s * r.max_rate_fast()).collect();
+    Ok((max_step_of, 4.0 * clock_tolerance_s(robots, tick_s)))
+}
+
+/// The slacks of the lead bound (three or more robots).
+fn lead_slacks(
+    robots: &[Timeline],
+    tick_s: f64,
+    stop_at_first: bool,
+    windows: Windows,
+) -> Result<Vec<PairSlack>> {
+    let (max_step_of, eps) = steps_and_eps(robots, tick_s)?;
+    Ok(lead::slacks(
+        robots,
+        &max_step_of,
+        eps,
+        windows,
+        stop_at_first,
+    ))
+}
+
+/// Margin checks that are **not safe**, kept by name so that tests can show what they miss and
+/// benchmarks can compare against them. Never use them to accept a schedule.
+pub mod baseline {
+    use super::sim::{self, Variant};
+    use crate::error::Result;
+    use crate::timeline::Timeline;
+
+    /// Alg. 2 exactly as printed (with the typo fixes of docs/decisions.md), one simulation per
+    /// pair from the later start of its two robots, the other robots ignored.
+    ///
+    /// **UNSAFE on a tick grid**: it can accept schedules on which an admissible operator makes
+    /// two robots low-confidence in the same tick (see the [module docs](super)).
+    ///
+    /// # Errors
+    /// As [`sufficient_margins`](super::sufficient_margins).
+    pub fn printed(robots: &[Timeline], tick_s: f64) -> Result<bool> {
+        sim::check_per_pair(robots, tick_s, Variant::Printed)
+    }
+
+    /// The two-robot conservative check (fixes 1–4) applied to every pair of robots as if the
+    /// other robots were absent. For two robots it is
+    /// [`sufficient_margins`](super::sufficient_margins).
+    ///
+    /// **UNSAFE for three or more robots**: a third robot that sets the pace can move `p` and
+    /// `c` apart, and this check does not see it (tests/regression.rs).
+    ///
+    /// # Errors
+    /// As [`sufficient_margins`](super::sufficient_margins).
+    pub fn pairwise(robots: &[Timeline], tick_s: f64) -> Result<bool> {
+        sim::check_single_pass(robots, tick_s, Variant::Pairwise)
+    }
+
+    /// The worst-case simulation extended to N robots by choosing, at every simulated tick in
+    /// which neither `p` nor `c` is LC and a third robot may run, the common pace that leaves
+    /// `c` furthest ahead after that tick (fix 5), and by simulating the other robots' starts
+    /// (fix 6). For two robots it is [`sufficient_margins`](super::sufficient_margins).
+    ///
+    /// **UNSAFE for three or more robots**: a per-tick maximum along one trajectory is not a
+    /// bound over multi-tick strategies (the operator can drag a third robot, which gains less
+    /// lead per tick but more per unit of `p`'s progress); the two reproducers in
+    /// tests/regression.rs overlap under a constant slowest operator.
+    ///
+    /// # Errors
+    /// As [`sufficient_margins`](super::sufficient_margins).
+    pub fn greedy_pace(robots: &[Timeline], tick_s: f64) -> Result<bool> {
+        sim::check_single_pass(robots, tick_s, Variant::Conservative)
+    }
+}
