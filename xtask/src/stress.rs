@@ -1,22 +1,23 @@
 //! `cargo xtask stress --executions E [--robots N] [--seed S]`: the safety invariant under load.
 //!
-//! Samples random problems of a few hundred reference samples and schedules each at a random
-//! control tick, then runs `E` executions in all through each schedule's own `Coordinator` (at
-//! the tick it was checked with) under the full adversary set of
-//! `tandem::realtime::adversary` (no correction, always fastest, always slowest, Alg. 2's
-//! worst case with each robot as the current one, the favoured robot switching at random
-//! times, switching every tick, periodic, one switch, random switching, random extremes per
-//! tick and per robot, random gradients per tick and held), in parallel, and counts ticks in
-//! which two or more robots were low-confidence (expected: 0). Every number depends only on
-//! `E`, `N` and the seed.
+//! Draws random problems and schedules each at a random control tick, then runs `E` executions
+//! in all through each schedule's own `Coordinator` (at the tick it was checked with) under the
+//! full adversary set of `tandem::realtime::adversary` (no correction, always fastest, always
+//! slowest, Alg. 2's worst case with each robot as the current one, the favoured robot switching
+//! at random times, switching every tick, periodic, one switch, random switching, random
+//! extremes per tick and per robot, random gradients per tick and held, and the beam search over
+//! per-tick choices), in parallel, and counts ticks in which two or more robots were
+//! low-confidence (expected: 0). Every number depends only on `E`, `N` and the seed.
 //!
-//! Two robots (the default) are scheduled by the scheduler of `tandem-schedule` (the anytime
-//! sampler and the margin-aware completion beside it). For
-//! other robot counts the schedules are drawn here, because the N-robot sampler is a later
-//! step: random warps (per robot and high-confidence run a fraction of the gradient bounds,
-//! fastest with probability ½), robot 1 at 0 and each further robot at the earliest of a few
-//! random offsets that `sufficient_margins` accepts with the robots before it, bisected towards
-//! the last rejected one (so most schedules sit at the acceptance boundary).
+//! Half the problems are this task's own (200–400 samples in runs, a smooth mean, per-run bound
+//! factors); the other half cycle through the test kit's eight families
+//! (`tandem::realtime::testkit::Family`: one mask with uniform or styled gradients, a few long
+//! regions, per-run bound ratios, per-robot plans of different lengths and bounds, one robot's
+//! long low-confidence stretch, and the two families built like the reproducers of a dragged
+//! third robot). Every shared-mask problem is scheduled by the production scheduler
+//! (`tandem::schedule::sample_schedule_n`, for any `N`); per-robot plans, which no
+//! `tandem-schedule` problem describes, get a tight schedule at an edge of
+//! `sufficient_margins`' acceptance (`testkit::tight_starts`).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -26,8 +27,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use tandem::realtime::adversary::{Adversary, AdversaryRun, adversary_set, run_adversary};
+use tandem::realtime::testkit::{self, Family};
 use tandem::realtime::{Coordinator, Timeline, sufficient_margins};
-use tandem::schedule::{Problem, SamplerParams, Source, sample_schedule};
+use tandem::schedule::{Problem, SamplerParams, Source, sample_schedule_n};
 
 /// Executions per scheduled problem (the number of problems is `N / this`, at least 1 and at
 /// most [`MAX_PROBLEMS`]).
@@ -38,12 +40,8 @@ const MAX_PROBLEMS: u64 = 200;
 const SAMPLES: usize = 500;
 /// Executions per parallel batch (a progress line may follow each batch).
 const BATCH: u64 = 50_000;
-/// Reference sample period of the random problems (s).
+/// Reference sample period of this task's random problems (s).
 const DT_S: f64 = 0.01;
-/// Random candidate offsets per drawn robot (besides the serial start).
-const OFFSET_CANDIDATES: usize = 6;
-/// Bisection steps towards the acceptance boundary per drawn robot.
-const OFFSET_BISECTIONS: usize = 8;
 
 /// One scheduled random problem, ready to run.
 struct Case {
@@ -54,9 +52,13 @@ struct Case {
     /// The full adversary set for this case (random gradients over the problem's whole
     /// `[min ψ̇min, max ψ̇max]`).
     adversaries: Vec<Adversary>,
-    /// Whether the executions overlap (a sampled or completed two-robot schedule, or a drawn schedule in
-    /// which some robot starts before the robots placed before it have ended).
+    /// Whether the executions overlap (a sampled or completed schedule, or a tight one in which
+    /// some robot starts before the robots placed before it have ended).
     overlapping: bool,
+    /// The problem's family (`stress` for this task's own).
+    family: &'static str,
+    /// How the schedule was made.
+    made: Made,
 }
 
 /// A random problem: 200–400 samples, confidence in runs (LC runs 5–60 samples, HC runs 5–80),
@@ -86,137 +88,87 @@ fn random_problem(rng: &mut ChaCha8Rng) -> anyhow::Result<Problem> {
     Ok(Problem::new(conf, mean, min, max, DT_S)?)
 }
 
-/// One robot's timeline on `problem`: its warp `grad_exec`, started at `start_s`.
-fn timeline(problem: &Problem, grad_exec: &[f64], start_s: f64) -> anyhow::Result<Timeline> {
-    Ok(Timeline::new(
-        problem.conf(),
-        grad_exec,
-        problem.grad_min(),
-        problem.grad_max(),
-        start_s,
-        problem.dt_s(),
-    )?)
+/// How the schedule of a case was made.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Made {
+    /// By the production scheduler (`sample_schedule_n`) on a shared-mask problem.
+    Scheduled,
+    /// Bisected to an acceptance edge of `sufficient_margins` (`testkit::tight_starts`).
+    Tight,
 }
 
-/// Latest end (s) of `robots`.
-fn last_end_s(robots: &[Timeline]) -> f64 {
-    robots.iter().map(Timeline::end_s).fold(0.0, f64::max)
-}
-
-/// A drawn schedule of `n_robots` robots (see the module docs) as their timelines, and whether
-/// the executions overlap. A robot for which no offset is accepted (a decision of the earlier
-/// robots at the edge of the tolerance) makes the whole schedule serial, which is always
-/// accepted.
-fn draw_schedule(
+/// Schedules `problem` for `n_robots` with the production scheduler at `tick_s`: its
+/// coordinator and whether the executions overlap (a sampled or completed schedule).
+fn scheduled(
     problem: &Problem,
     n_robots: usize,
     tick_s: f64,
     rng: &mut ChaCha8Rng,
-) -> anyhow::Result<(Vec<Timeline>, bool)> {
-    let warps: Vec<Vec<f64>> = (0..n_robots)
-        .map(|_| {
-            let mut warp = problem.grad_mean().to_vec();
-            for run in problem.runs().iter().filter(|r| r.high_conf) {
-                let frac = if rng.random_bool(0.5) {
-                    0.0
-                } else {
-                    rng.random::<f64>()
-                };
-                let bounds = problem.grad_min()[run.start..run.end]
-                    .iter()
-                    .zip(&problem.grad_max()[run.start..run.end]);
-                for (w, (lo, hi)) in warp[run.start..run.end].iter_mut().zip(bounds) {
-                    *w = lo + frac * (hi - lo);
-                }
-            }
-            warp
-        })
-        .collect();
-    let mut robots = vec![timeline(problem, &warps[0], 0.0)?];
-    let mut overlapping = false;
-    for warp in &warps[1..] {
-        let latest_end = last_end_s(&robots);
-        let mut offsets: Vec<f64> = (0..OFFSET_CANDIDATES)
-            .map(|_| latest_end * rng.random::<f64>().sqrt())
-            .collect();
-        offsets.push(latest_end);
-        offsets.sort_by(f64::total_cmp);
-        let mut accepts = |t: f64| -> anyhow::Result<bool> {
-            robots.push(timeline(problem, warp, t)?);
-            let ok = sufficient_margins(&robots, tick_s)?;
-            robots.pop();
-            Ok(ok)
-        };
-        let mut first = None;
-        for (k, &t) in offsets.iter().enumerate() {
-            if accepts(t)? {
-                first = Some(k);
-                break;
-            }
-        }
-        let Some(k) = first else {
-            let mut start_s = 0.0;
-            let serial = warps
-                .iter()
-                .map(|w| {
-                    let tl = timeline(problem, w, start_s)?;
-                    start_s = tl.end_s();
-                    Ok(tl)
-                })
-                .collect::<anyhow::Result<Vec<_>>>()?;
-            return Ok((serial, false));
-        };
-        let mut tau = offsets[k];
-        if k > 0 {
-            let mut lo = offsets[k - 1];
-            for _ in 0..OFFSET_BISECTIONS {
-                let m = 0.5 * (lo + tau);
-                if accepts(m)? {
-                    tau = m;
-                } else {
-                    lo = m;
-                }
-            }
-        }
-        overlapping |= tau < latest_end;
-        robots.push(timeline(problem, warp, tau)?);
-    }
-    Ok((robots, overlapping))
+) -> anyhow::Result<(Coordinator, bool)> {
+    let params = SamplerParams {
+        samples: SAMPLES,
+        seed: rng.random(),
+        tick_s: Some(tick_s),
+        ..SamplerParams::default()
+    };
+    let out = sample_schedule_n(problem, n_robots, &params, None)?;
+    let sampled = matches!(out.source, Source::Sampled { .. } | Source::Completed);
+    Ok((out.schedule.coordinator(problem)?, sampled))
 }
 
+/// Problem `index` of the run: even indices are this task's random problems, odd ones cycle
+/// through the test kit's families (`tandem::realtime::testkit::Family`). Shared-mask problems
+/// are scheduled by the production scheduler; per-robot plans (which no `tandem-schedule`
+/// problem describes) get a tight schedule at an acceptance edge of `sufficient_margins`.
 fn make_case(seed: u64, index: u64, n_robots: usize) -> anyhow::Result<Case> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(index);
-    let problem = random_problem(&mut rng)?;
-    let tick_s = DT_S * rng.random_range(0.25..=1.0);
-    let (coordinator, overlapping) = if n_robots == 2 {
-        let params = SamplerParams {
-            samples: SAMPLES,
-            seed: rng.random(),
-            tick_s: Some(tick_s),
-            ..SamplerParams::default()
-        };
-        let out = sample_schedule(&problem, &params, None)?;
-        let sampled = matches!(out.source, Source::Sampled { .. } | Source::Completed);
-        (out.schedule.coordinator(&problem)?, sampled)
+    let (coordinator, overlapping, family, made) = if index % 2 == 0 {
+        let problem = random_problem(&mut rng)?;
+        let tick_s = DT_S * rng.random_range(0.25..=1.0);
+        let (c, o) = scheduled(&problem, n_robots, tick_s, &mut rng)?;
+        (c, o, "stress", Made::Scheduled)
     } else {
-        let (robots, overlapping) = draw_schedule(&problem, n_robots, tick_s, &mut rng)?;
-        (Coordinator::new(robots, tick_s)?, overlapping)
+        let family = Family::ALL[((index / 2) % Family::ALL.len() as u64) as usize];
+        let case = testkit::Case::random(family, n_robots, &mut rng);
+        if let Some(m) = case.shared_mask() {
+            let problem = Problem::new(m.conf, m.mean, m.lo, m.hi, m.dt_s)?;
+            let (c, o) = scheduled(&problem, n_robots, case.tick_s, &mut rng)?;
+            (c, o, family.name(), Made::Scheduled)
+        } else {
+            let check: testkit::Check = sufficient_margins;
+            let (starts, o) = testkit::tight_starts(&case, check, &mut rng)
+                .context("no start accepted, not even the serial one")?;
+            let c = Coordinator::new(case.robots_at(&starts), case.tick_s)?;
+            (c, o, family.name(), Made::Tight)
+        }
     };
+    let robots = coordinator.robots();
+    let tick_s = coordinator.tick_s();
     // Every robot at its slowest, one after the other, plus slack.
-    let slowest_s = problem.grad_max().iter().sum::<f64>() * DT_S * n_robots as f64;
-    let fold = |f: fn(f64, f64) -> f64, init: f64, v: &[f64]| v.iter().copied().fold(init, f);
+    let slowest_s: f64 = robots
+        .iter()
+        .map(|r| r.grad_max().iter().sum::<f64>() * r.dt_s())
+        .sum();
+    let all = |f: fn(&Timeline) -> &[f64]| robots.iter().flat_map(move |r| f(r).iter().copied());
     let grad_range = [
-        fold(f64::min, f64::INFINITY, problem.grad_min()),
-        fold(f64::max, 0.0, problem.grad_max()),
+        all(Timeline::grad_min).fold(f64::INFINITY, f64::min),
+        all(Timeline::grad_max).fold(0.0, f64::max),
     ];
-    let ticks = (last_end_s(coordinator.robots()) / tick_s) as u64;
+    let ticks = (last_end_s(robots) / tick_s) as u64;
     Ok(Case {
         max_ticks: (2.0 * slowest_s / tick_s) as u64 + 100,
         adversaries: adversary_set(n_robots, grad_range, ticks, &mut rng),
         coordinator,
         overlapping,
+        family,
+        made,
     })
+}
+
+/// Latest end (s) of `robots`.
+fn last_end_s(robots: &[Timeline]) -> f64 {
+    robots.iter().map(Timeline::end_s).fold(0.0, f64::max)
 }
 
 /// Result of one execution.
@@ -246,20 +198,28 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize) -> anyhow::Result
         .into_par_iter()
         .map(|i| make_case(seed, i, n_robots).with_context(|| format!("scheduling problem {i}")))
         .collect::<anyhow::Result<_>>()?;
-    let n_overlapping = cases.iter().filter(|c| c.overlapping).count();
-    let how = if n_robots == 2 {
-        format!(
-            "{SAMPLES} sampler candidates each: {n_overlapping} overlapping sampled or completed schedules"
-        )
-    } else {
-        format!("drawn schedules: {n_overlapping} with overlapping executions")
-    };
+    let count = |f: &dyn Fn(&Case) -> bool| cases.iter().filter(|c| f(c)).count();
+    let n_overlapping = count(&|c| c.overlapping);
     println!(
-        "stress: {n_robots} robots, {n_problems} random problems (200–400 samples, tick 0.25–1 \
-         sample), {how}, {} serial; scheduling took {:.1} s",
+        "stress: {n_robots} robots, {n_problems} random problems: {} scheduled by the production \
+         scheduler ({SAMPLES} candidates), {} tight at an acceptance edge (per-robot plans); \
+         {n_overlapping} with overlapping executions, {} serial; scheduling took {:.1} s",
+        count(&|c| c.made == Made::Scheduled),
+        count(&|c| c.made == Made::Tight),
         n_problems as usize - n_overlapping,
         start.elapsed().as_secs_f64()
     );
+    let mut families: Vec<&str> = cases.iter().map(|c| c.family).collect();
+    families.sort_unstable();
+    families.dedup();
+    let per_family: Vec<String> = families
+        .iter()
+        .map(|&f| {
+            let of = |c: &Case| c.family == f;
+            format!("{f} {}/{}", count(&|c| of(c) && c.overlapping), count(&of))
+        })
+        .collect();
+    println!("  overlapping/all per family: {}", per_family.join(", "));
     let set_size = cases[0].adversaries.len() as u64;
     let run_start = Instant::now();
     let (ticks, overlap_ticks, overlap_runs, unfinished) = (
