@@ -24,12 +24,20 @@ fn complete(p: &Problem, exact: ExactParams) -> Outcome {
     sample_schedule_with_baselines(p, &params, &SamplerBaselines::COMPLETION_ONLY, None).unwrap()
 }
 
-/// The certificate's fields agree with the schedule and the bound.
+/// The certificate's fields agree with the schedule and the bound, and the bound (reported as
+/// computed, never clamped) is not above the schedule: the scheduler's schedules have their
+/// gradients inside the bounds, so only summation order separates the two (far below
+/// 1e-12 relative).
 fn check_certificate(p: &Problem, out: &Outcome) {
     assert_eq!(validate(p, &out.schedule), Ok(()));
     assert_eq!(out.t_total_s, out.schedule.t_total_s(p.dt_s()));
-    assert!(out.lower_bound_s <= out.t_total_s);
-    assert!(out.gap >= 0.0);
+    assert!(
+        out.lower_bound_s <= out.t_total_s * (1.0 + 1e-12),
+        "bound {} above T_total {}",
+        out.lower_bound_s,
+        out.t_total_s
+    );
+    assert!(out.gap >= -1e-12, "gap {:e}", out.gap);
     assert!((out.gap - (out.t_total_s - out.lower_bound_s) / out.lower_bound_s).abs() <= 1e-12);
 }
 
