@@ -54,7 +54,9 @@ struct Edge {
 /// clearance when the robots differ; with `clear.after_start = Some(ε)`, robot 2's first run
 /// may instead have `τ ≥ end + ε`, and the better of the two is kept). The earliest solution
 /// (longest paths from the origin; a positive cycle means infeasible) is the least solution in
-/// every variable at once, so it also minimizes `T_total`.
+/// every variable at once, so it also minimizes `T_total`. A positive cycle found with exact
+/// comparisons is re-checked ignoring gains within rounding (`relax_tolerance`), so a cycle
+/// of weight 0 (a rigid HC run) never reads as positive.
 pub(crate) fn earliest(chain: &Chain, order: &[Robot], clear: &Clearance) -> Option<Times> {
     let m = chain.n_lc();
     if order.len() != 2 * m || order.iter().filter(|&&r| r == 0).count() != m {
@@ -137,27 +139,12 @@ fn solve(chain: &Chain, order: &[Robot], clear: &Clearance, after_start: bool) -
         }
         prev = Some((r, k));
     }
-    let mut x = vec![f64::NEG_INFINITY; n];
-    x[ORIGIN] = 0.0;
-    let mut changed = true;
-    let mut rounds = 0;
-    while changed {
-        changed = false;
-        rounds += 1;
-        if rounds > n + 1 {
-            return None;
-        }
-        for e in &edges {
-            let cand = x[e.from] + e.w;
-            if cand > x[e.to] {
-                if e.to == ORIGIN {
-                    return None;
-                }
-                x[e.to] = cand;
-                changed = true;
-            }
-        }
-    }
+    // Exact comparisons first: when they converge, the earliest solution to the last bit.
+    // Their verdict "positive cycle" is re-checked with gains within rounding ignored.
+    let x = match longest_paths(&edges, n, 0.0) {
+        Some(x) => x,
+        None => longest_paths(&edges, n, relax_tolerance(&edges, n))?,
+    };
     if x.iter().any(|v| !v.is_finite()) {
         return None;
     }
@@ -169,6 +156,70 @@ fn solve(chain: &Chain, order: &[Robot], clear: &Clearance, after_start: bool) -
         ],
         end_s: [x[end(0)], x[end(1)]],
     })
+}
+
+/// Longest paths from the origin (variable 0, pinned at 0) over the `n` variables by
+/// Bellman–Ford, relaxing an edge only for a gain above `eps` (s); `None` on a positive cycle
+/// (a relaxation still happening in round `n + 1`, or one that would move the origin).
+fn longest_paths(edges: &[Edge], n: usize, eps: f64) -> Option<Vec<f64>> {
+    const ORIGIN: usize = 0;
+    let mut x = vec![f64::NEG_INFINITY; n];
+    x[ORIGIN] = 0.0;
+    let mut changed = true;
+    let mut rounds = 0;
+    while changed {
+        changed = false;
+        rounds += 1;
+        if rounds > n + 1 {
+            return None;
+        }
+        for e in edges {
+            let cand = x[e.from] + e.w;
+            if cand > x[e.to] + eps {
+                if e.to == ORIGIN {
+                    return None;
+                }
+                x[e.to] = cand;
+                changed = true;
+            }
+        }
+    }
+    Some(x)
+}
+
+/// The gain (s) below which the re-check of a "positive cycle" verdict ignores a relaxation:
+/// `4·n·ε_f64·Σ|w|` for `n` variables and edge weights `w`.
+///
+/// **Why.** A cycle of weight 0 in exact arithmetic can have a positive weight of a few
+/// rounding errors in floating point. A rigid HC run (`a_g = b_g`, one sample with
+/// `ψ̇min = ψ̇max`) gives the pair `x_k ≥ x_j + w`, `x_j ≥ x_k − w`, and `(x + w) − w` can
+/// exceed `x` by an ulp; exact comparisons then relax around the cycle round after round
+/// and report a feasible order as infeasible. Proptest found such problems (about one in
+/// 2,400 of `tests/exact.rs`'s generator): every order, the optimal one included, read as
+/// infeasible, so the search's optimum was not proven.
+///
+/// **Bound.** Suppose some value is still raised by more than `eps` in round `n + 1`. Follow
+/// each relaxation back to the one that set the value it used (that value changed after the
+/// edge was last examined, so at most one round earlier): a chain of at least `n` edges, so a
+/// variable repeats, and the cycle between its two visits raised it by more than `eps`: its
+/// floating-point weight exceeds `eps`. A simple cycle has at most `n` edges; each sum along
+/// it is rounded by at most `ε_f64/2` of the largest value, at most `Σ|w|` (a value is a sum
+/// of weights along a path), so its floating-point weight exceeds its exact weight by at most
+/// `n·ε_f64·Σ|w| < eps`. So a network without a positive cycle in exact arithmetic converges
+/// within `n` rounds, while a cycle of exact weight above `2·eps` is still caught. At
+/// convergence every constraint holds up to `eps` (1.1e-10 to 1.6e-10 s on the study's
+/// networks of 120 to 180 LC runs per robot, ≈ 1e-12 of their `T_total`), far inside the
+/// schedule tolerances (`tol::GRADIENT_REL`, `tol::CLOCK_REL`: 1e-9), and the schedule is
+/// built with its gradients clamped into their bounds.
+///
+/// The exact comparisons run first because their solution, when they converge, is exact to
+/// the last bit: always relaxing with `eps` moved 10 of the study's network solutions by at
+/// most 4e-13 s, and that, through the margin check and the supervised samples, changed
+/// one trial's outcome (docs/decisions.md, "Certified schedules", "Rounding in the
+/// earliest-times network").
+fn relax_tolerance(edges: &[Edge], n: usize) -> f64 {
+    let scale: f64 = edges.iter().map(|e| e.w.abs()).sum();
+    4.0 * n as f64 * f64::EPSILON * scale
 }
 
 #[cfg(test)]
@@ -200,6 +251,55 @@ mod tests {
         let clear = Clearance::uniform(0.25, None);
         let t = earliest(&c, &[0, 1, 0, 1], &clear).unwrap();
         assert_eq!(t.t_total_s(), 4.75);
+    }
+
+    #[test]
+    fn rigid_runs_do_not_read_as_a_positive_cycle() {
+        // The chain of a problem proptest found: a rigid head (`a_0 = b_0`) and a rigid gap
+        // between LC runs 0 and 1. Robot 1's first LC start is pinned by `x ≥ 0 + a_0` and
+        // `0 ≥ x − a_0`, and by the rigid lag to its second run; in floating point
+        // `(x + w) − w` exceeded `x` by one ulp, and the exact comparison declared every order
+        // infeasible. Serial order by hand: robot 1's last LC run ends at
+        // `a_0 + 0.015 + 0.005 + 0.03 + 0.003 + 0.015 = a_0 + 0.068`, robot 2 starts `a_0`
+        // before that (τ = 0.068) and runs its fastest, `a_0 + 0.0755`.
+        let a0 = 0.006749386554742199;
+        let c = Chain {
+            lc_s: vec![0.015, 0.03, 0.015],
+            gap_s: vec![(a0, a0), (0.005, 0.005), (0.003, 0.01), (0.0075, 0.025)],
+            lc_ref: vec![(1, 4), (5, 11), (13, 16)],
+            gap_ref: vec![(0, 1), (4, 5), (11, 13), (16, 21)],
+        };
+        let t = earliest(&c, &[0, 0, 0, 1, 1, 1], &Clearance::zero()).unwrap();
+        assert!((t.tau_s - 0.068).abs() < 1e-15, "{}", t.tau_s);
+        assert!((t.t_total_s() - (0.068 + a0 + 0.0755)).abs() < 1e-15);
+        // The rigid gaps keep their length up to the tolerance.
+        for r in 0..2 {
+            let g = t.gaps_s(&c, r);
+            assert!(
+                (g[0] - a0).abs() < 1e-15 && (g[1] - 0.005).abs() < 1e-15,
+                "{g:?}"
+            );
+        }
+        // Robot 2 inside robot 1's rigid stretch is still infeasible: 1 2 1 ... needs robot
+        // 2's 0.015 s run in robot 1's 0.005 s gap.
+        assert!(earliest(&c, &[0, 1, 0, 0, 1, 1], &Clearance::zero()).is_none());
+    }
+
+    #[test]
+    fn a_small_positive_cycle_is_still_a_positive_cycle() {
+        // x1 ≥ x0 + 1 and x0 ≥ x1 − (1 − 1e-9): a cycle of weight 1e-9 s, far above the
+        // tolerance (4·2·ε_f64·2 ≈ 3.6e-15 s), is infeasible with and without it; with
+        // weight 0 (the pair of a rigid lag) it is solved, x1 = 1.
+        let edge = |from, to, w| Edge { from, to, w };
+        let pos = [edge(0, 1, 1.0), edge(1, 0, -(1.0 - 1e-9))];
+        assert!(relax_tolerance(&pos, 2) < 1e-14);
+        assert_eq!(longest_paths(&pos, 2, 0.0), None);
+        assert_eq!(longest_paths(&pos, 2, relax_tolerance(&pos, 2)), None);
+        let zero = [edge(0, 1, 1.0), edge(1, 0, -1.0)];
+        assert_eq!(
+            longest_paths(&zero, 2, relax_tolerance(&zero, 2)),
+            Some(vec![0.0, 1.0])
+        );
     }
 
     #[test]
