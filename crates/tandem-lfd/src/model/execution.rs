@@ -45,8 +45,11 @@ pub struct Resampled {
     /// The execution, its samples `Δt_s` (the model's period) apart.
     pub execution: Execution,
     /// For every sample `k` of the original execution, the sample of `execution` whose
-    /// period it falls in (`round(k·Δt_E/Δt_s)`): per-sample flags are merged through it.
+    /// period it falls in (`round(k·Δt_E/Δt_s)`): per-sample events are merged through it.
     pub bin_of: Vec<usize>,
+    /// For every sample `j` of `execution`, the original sample nearest to it in time:
+    /// per-sample states are read through it.
+    pub nearest: Vec<usize>,
 }
 
 impl TaskModel {
@@ -248,6 +251,7 @@ impl TaskModel {
                     ref_time_log: execution.ref_time_log.clone(),
                 },
                 bin_of: (0..t_e).collect(),
+                nearest: (0..t_e).collect(),
             });
         }
         if dt_e > dt_m {
@@ -292,6 +296,9 @@ impl TaskModel {
         let bin_of = (0..t_e)
             .map(|k| ((k as f64 / ratio).round() as usize).min(n_new - 1))
             .collect();
+        let nearest = (0..n_new)
+            .map(|j| ((j as f64 * ratio).round() as usize).min(t_e - 1))
+            .collect();
         let demonstration = Demonstration::new(self.data.channel_names.clone(), samples, dt_m)?
             .with_source(demo.source());
         Ok(Resampled {
@@ -300,6 +307,7 @@ impl TaskModel {
                 ref_time_log: new_log,
             },
             bin_of,
+            nearest,
         })
     }
 }
@@ -426,6 +434,7 @@ mod tests {
         assert_eq!(r.bin_of[14], 1);
         assert_eq!(r.bin_of[15], 2);
         assert_eq!(r.bin_of[200], 20);
+        assert_eq!(r.nearest, (0..21).map(|j| 10 * j).collect::<Vec<_>>());
         let mut m = model.clone();
         m.update(&r.execution).unwrap();
         assert_eq!(m.count(), 3);
