@@ -274,7 +274,9 @@ impl Demonstration {
         let t_col = table.column("t");
         if let Some(j) = names.iter().position(|n| crate::checks::time_like(n)) {
             return Err(Error::TimeLikeChannel {
-                at: format!("{file}:{}:{}", table.header_line(), j + 1),
+                file: file.into(),
+                line: Some(table.header_line()),
+                column: Some(j + 1),
                 channel: names[j].clone(),
             });
         }

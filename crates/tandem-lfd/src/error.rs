@@ -175,13 +175,18 @@ pub enum Error {
     },
     /// A channel is named like a time column other than `t` (see [`crate::time_like`]).
     #[error(
-        "{at}: column `{channel}` looks like a time column, but tandem reads time only from a \
+        "{}: column `{channel}` looks like a time column, but tandem reads time only from a \
          column named `t` (seconds): rename it to `t` (converted to seconds) or remove it; \
-         as a channel it would be aligned and averaged like a measurement"
+         as a channel it would be aligned and averaged like a measurement",
+        located(file, *line, *column)
     )]
     TimeLikeChannel {
-        /// Where: `file:line:column` of the header field, or the source label.
-        at: String,
+        /// The file or source label.
+        file: String,
+        /// 1-based line of the header, where known (CSV).
+        line: Option<usize>,
+        /// 1-based column (field number), where known (CSV).
+        column: Option<usize>,
         /// The column's name.
         channel: String,
     },
@@ -298,6 +303,14 @@ pub enum Error {
     /// The time-warping crate failed.
     #[error("alignment failed: {0}")]
     Warp(#[from] tandem_warp::Error),
+}
+
+/// `file:line:column`, or `file` alone where the position is unknown.
+fn located(file: &str, line: Option<usize>, column: Option<usize>) -> String {
+    match (line, column) {
+        (Some(l), Some(c)) => format!("{file}:{l}:{c}"),
+        _ => file.to_owned(),
+    }
 }
 
 /// `Result` with this crate's [`Error`].

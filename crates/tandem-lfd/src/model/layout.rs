@@ -76,7 +76,9 @@ impl Layout {
         };
         if let Some(channel) = channels.iter().find(|n| crate::checks::time_like(n)) {
             return Err(Error::TimeLikeChannel {
-                at: demo.source().into(),
+                file: demo.source().into(),
+                line: None,
+                column: None,
                 channel: channel.clone(),
             });
         }
