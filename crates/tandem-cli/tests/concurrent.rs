@@ -7,8 +7,14 @@ use std::path::{Path, PathBuf};
 
 use common::*;
 
-/// Rounds each of the two writers records.
-const ROUNDS: usize = 50;
+/// Rounds each of the two writers records: 50, or more with `TANDEM_CONCURRENT_ROUNDS`
+/// (docs/decisions.md, "State files are locked…", runs it by hand with 200).
+fn rounds_per_writer() -> usize {
+    std::env::var("TANDEM_CONCURRENT_ROUNDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map_or(50, |n: usize| n.max(50))
+}
 
 /// Round `i`'s two executions of the small task (as `small_execution`, every sample
 /// supervised), each with a force of its own so that no two rounds are the same.
@@ -24,11 +30,17 @@ fn distinct_round(dir: &Path, i: usize) -> [[PathBuf; 3]; 2] {
 
 #[test]
 fn two_concurrent_writers_lose_no_round() {
+    let rounds_each = rounds_per_writer();
     let dir = scratch("two-writers");
     let state = small_state(&dir);
-    let rounds: Vec<[[PathBuf; 3]; 2]> = (0..2 * ROUNDS).map(|i| distinct_round(&dir, i)).collect();
+    let rounds: Vec<[[PathBuf; 3]; 2]> = (0..2 * rounds_each)
+        .map(|i| distinct_round(&dir, i))
+        .collect();
     let writer = |w: usize| {
-        let (state, mine) = (state.clone(), rounds[w * ROUNDS..(w + 1) * ROUNDS].to_vec());
+        let (state, mine) = (
+            state.clone(),
+            rounds[w * rounds_each..(w + 1) * rounds_each].to_vec(),
+        );
         std::thread::spawn(move || {
             mine.iter()
                 .map(|[a, b]| tandem(record_args(&state, a, b)))
@@ -51,7 +63,7 @@ fn two_concurrent_writers_lose_no_round() {
         })
         .collect();
     numbers.sort_unstable();
-    assert_eq!(numbers, (1..=2 * ROUNDS).collect::<Vec<_>>());
+    assert_eq!(numbers, (1..=2 * rounds_each).collect::<Vec<_>>());
     // Every round is in the file: 100 rounds, the 3 demonstrations and 200 executions in the
     // model, and all 200 × 60 supervised samples in the observations.
     let doc: serde_json::Value = serde_json::from_str(&ok(&tandem([
@@ -60,13 +72,13 @@ fn two_concurrent_writers_lose_no_round() {
         "--json".into(),
     ])))
     .expect("JSON document");
-    assert_eq!(doc["pairs_recorded"], 2 * ROUNDS);
-    assert_eq!(doc["model"]["count"], 3 + 4 * ROUNDS);
+    assert_eq!(doc["pairs_recorded"], 2 * rounds_each);
+    assert_eq!(doc["model"]["count"], 3 + 4 * rounds_each);
     let supervised = doc["confidence"]["total_supervised"]
         .as_f64()
         .expect("a number");
     assert!(
-        (supervised - (4 * ROUNDS * SMALL_N_REF) as f64).abs() < 1e-6,
+        (supervised - (4 * rounds_each * SMALL_N_REF) as f64).abs() < 1e-6,
         "{supervised}"
     );
     // No temporary file is left; the lock file stays beside the state file.

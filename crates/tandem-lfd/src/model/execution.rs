@@ -60,9 +60,11 @@ impl TaskModel {
     /// correction directions are recomputed on next use.
     ///
     /// # Errors
-    /// The model is unchanged on error: different channel set or sample period, log length
-    /// ≠ sample count, non-finite, decreasing or outside `[0, n_ref − 1]` log, zero
-    /// quaternion.
+    /// The model is unchanged on error: different channel set or sample period (resample it
+    /// first: [`TaskModel::resample_execution`]), log length ≠ sample count, non-finite,
+    /// decreasing or outside `[0, n_ref − 1]` log, a log that does not cover the whole task
+    /// ([`Error::TruncatedExecution`]), a duration outside half the fastest to twice the
+    /// slowest admissible execution ([`Error::ExecutionDuration`]), zero quaternion.
     pub fn update(&mut self, execution: &Execution) -> Result<()> {
         let warp = self.execution_warp(execution)?;
         let demo = execution
