@@ -16,7 +16,9 @@ NumPy arrays in and out (docs/python.md):
 - :func:`align`: GDTW time warping (Eq. 2–3).
 
 Every error is a :class:`TandemError`: :class:`InputError`, :class:`ParamError`,
-:class:`StateFileError`, :class:`ScheduleError`, :class:`InternalError`.
+:class:`StateFileError`, :class:`ScheduleError`, :class:`InternalError`. Data taken in but
+not as given (a period assumed for a file without time column, a resampled execution, a
+demonstration of unusual length) raises a :class:`DataWarning`.
 """
 
 from ._tandem import (
@@ -24,6 +26,7 @@ from ._tandem import (
     N_ROBOTS,
     Confidence,
     Coordinator,
+    DataWarning,
     InputError,
     InternalError,
     Model,
@@ -33,6 +36,7 @@ from ._tandem import (
     Problem,
     Schedule,
     ScheduleError,
+    StateEdit,
     StateFileError,
     TandemError,
     Tick,
@@ -50,6 +54,7 @@ __all__ = [
     "N_ROBOTS",
     "Confidence",
     "Coordinator",
+    "DataWarning",
     "InputError",
     "InternalError",
     "Model",
@@ -59,6 +64,7 @@ __all__ = [
     "Problem",
     "Schedule",
     "ScheduleError",
+    "StateEdit",
     "StateFileError",
     "TandemError",
     "Tick",

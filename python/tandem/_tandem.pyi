@@ -51,6 +51,10 @@ class ScheduleError(TandemError):
 class InternalError(TandemError):
     """A bug in tandem (a Rust panic caught at the Python boundary)."""
 
+class DataWarning(UserWarning):
+    """Data taken in, but not as given: an assumed period, a resampled execution, an unusual
+    demonstration length. The message names the file and the fix."""
+
 def fit(
     demos: Sequence[Demo],
     channels: Optional[Sequence[str]] = None,
@@ -81,8 +85,13 @@ class Planner:
     @staticmethod
     def load(path: Path) -> Planner:
         """Loads a state file (written here or by the command line)."""
-    def save(self, path: Path) -> None:
-        """Saves the state file atomically (the previous file survives any error)."""
+    @staticmethod
+    def locked(path: Path, timeout_s: Optional[float] = None) -> StateEdit:
+        """``with Planner.locked(path) as planner:`` loads, and saves at the end, under the
+        state file's lock (waiting up to ``timeout_s``, default 60 s, for another writer)."""
+    def save(self, path: Path, timeout_s: Optional[float] = None) -> None:
+        """Saves the state file atomically under its lock (the previous file survives any
+        error); never replaces a non-state file or what another process saved since the load."""
     def record_round(
         self,
         executions: Sequence[Demo],
@@ -90,9 +99,11 @@ class Planner:
         supervised: Sequence[ArrayLike],
         corrected: Sequence[ArrayLike],
         channels: Optional[Sequence[str]] = None,
+        dt_s: Optional[float] = None,
     ) -> Dict[str, Any]:
         """Records one execution per robot (``N`` of each argument; Eq. 21, 9–12) and
-        re-schedules (§II-C)."""
+        re-schedules (§II-C). ``dt_s``: the logs' sample period (default: the schedule's
+        tick); a finer log is resampled to the model's period."""
     def record_pair(
         self,
         executions: Sequence[Demo],
@@ -100,6 +111,7 @@ class Planner:
         supervised: Sequence[ArrayLike],
         corrected: Sequence[ArrayLike],
         channels: Optional[Sequence[str]] = None,
+        dt_s: Optional[float] = None,
     ) -> Dict[str, Any]:
         """:meth:`record_round` under the paper's name (two robots)."""
     def reschedule(
@@ -132,6 +144,13 @@ class Planner:
         """Robots scheduled (``N``)."""
     def command(self, ref_time: float, u: Optional[ArrayLike] = None) -> F64:
         """Eq. 7: ``(C + 1,)``, the channel values then the rate (warp gradient)."""
+
+class StateEdit:
+    """The context manager of :meth:`Planner.locked`: the lock is held from ``__enter__``
+    (which returns the loaded planner) to ``__exit__`` (which saves it if no exception)."""
+
+    def __enter__(self) -> Planner: ...
+    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> bool: ...
 
 class Model:
     """The task model: per reference sample mean, variance, gradient bounds, corrections."""

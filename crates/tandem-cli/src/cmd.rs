@@ -37,6 +37,12 @@ pub(crate) fn out(text: &str) {
     }
 }
 
+/// Prints a note about the user's data on stderr (the output channel stays clean for
+/// `--json`): how a file was read, or something that looks wrong but is not refused.
+pub(crate) fn note(text: &str) {
+    eprintln!("note: {text}");
+}
+
 /// A period or time in seconds without floating-point noise (`0.01`, not `0.009999…`).
 pub(crate) fn secs(v: f64) -> f64 {
     (v * 1e9).round() / 1e9
@@ -78,6 +84,14 @@ fn fit(a: &FitArgs) -> Result<()> {
         .iter()
         .map(|p| input::read_demo(p, a.dt))
         .collect::<Result<Vec<Demonstration>>>()?;
+    for d in &demos {
+        if let Some(n) = d.period_note() {
+            note(&n);
+        }
+    }
+    for w in tandem::lfd::length_warnings(&demos) {
+        note(&w);
+    }
     if demos.len() < 2 {
         bail!(
             "{}: only one demonstration; the variability of the task needs at least 2 \
@@ -161,8 +175,12 @@ fn summary_lines(planner: &Planner) -> Result<()> {
 const SCHEDULE_STREAM: u64 = 1 << 32;
 
 fn schedule(a: &ScheduleArgs) -> Result<()> {
+    // With --save this is a read–modify–write: hold the state file's lock throughout.
+    let lock = a.save.then(|| state_io::lock(&a.state)).transpose()?;
     let mut planner = state_io::load(&a.state)?;
     let mut sp = planner.params().sampler.clone();
+    // The schedule's own control tick is kept (the planner's rule for `tick_s = None`).
+    sp.tick_s = None;
     if a.sampler.seed.is_none() {
         // `fit` and `record` used stream `pairs_recorded` of the master seed for the saved
         // schedule; a plain re-run draws a different, still deterministic, stream so that it
@@ -172,10 +190,10 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
     let sp = apply_sampler(sp, &a.sampler)?;
     let previous_t_total_s = planner.outcome().t_total_s;
     planner.reschedule(&sp).context("cannot schedule")?;
-    if a.save {
+    if let Some(lock) = &lock {
         // Atomic: on error the previous state file is intact.
         planner
-            .save(&a.state)
+            .save_locked(lock)
             .with_context(|| format!("cannot save the schedule into {}", a.state.display()))?;
     }
     if a.json {
@@ -198,15 +216,23 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
     Ok(())
 }
 
-/// One robot's three files, read and checked against the model.
+/// One robot's three files, read and checked as the planner takes them in
+/// ([`Planner::check_execution`]: resampled to the model's period if logged finer, the whole
+/// task covered, a plausible duration). An execution without a `t` column is taken to be
+/// logged once per control tick of the schedule it ran (stated on stderr).
 fn read_execution(
-    model: &TaskModel,
+    planner: &Planner,
     robot: usize,
     exec: &Path,
     log: &Path,
     corr: &Path,
 ) -> Result<ExecutionRecord> {
-    let demonstration = input::read_demo(exec, Some(model.dt_s()))?;
+    let demonstration = input::read_demo(exec, Some(planner.schedule().tick_s))?;
+    if let Some(n) = demonstration.period_note() {
+        note(&format!(
+            "{n} (the assumed period is the control tick of the schedule it ran)"
+        ));
+    }
     let ref_time_log = input::read_log(log)?;
     let (supervised, corrected) = input::read_corrections(corr)?;
     let n = demonstration.n_samples();
@@ -226,44 +252,28 @@ fn read_execution(
             exec.display()
         );
     }
-    // Reference samples before the first or after the last logged one would get a zero
-    // execution gradient: the execution must cover the whole task.
-    let last_ref = model.n_ref() as f64 - 1.0;
-    let (first, last) = (ref_time_log[0], ref_time_log[n - 1]);
-    if first >= 1.0 && first <= last_ref {
-        bail!(
-            "{}: the log starts at reference sample {first}; an execution must start at the \
-             beginning of the task (first `ref_sample` < 1)",
-            log.display()
-        );
-    }
-    if last < last_ref - 1.0 && last >= 0.0 {
-        bail!(
-            "{}: the log ends at reference sample {last}; an execution must run to the end of \
-             the task (last `ref_sample` ≥ {})",
-            log.display(),
-            last_ref - 1.0
-        );
-    }
-    let execution = Execution {
-        demonstration,
-        ref_time_log,
+    let record = ExecutionRecord {
+        execution: Execution {
+            demonstration,
+            ref_time_log,
+        },
+        supervised,
+        corrected,
     };
-    model.execution_warp(&execution).with_context(|| {
+    planner.check_execution(&record).with_context(|| {
         format!(
             "robot {robot}: execution {} with log {} does not fit the model",
             exec.display(),
             log.display()
         )
     })?;
-    Ok(ExecutionRecord {
-        execution,
-        supervised,
-        corrected,
-    })
+    Ok(record)
 }
 
 fn record(a: &RecordArgs) -> Result<()> {
+    // A read–modify–write: hold the state file's lock from the load to the save, so that a
+    // concurrent `record` waits for this one instead of overwriting its round.
+    let lock = state_io::lock(&a.state)?;
     let mut planner = state_io::load(&a.state)?;
     let n = planner.n_robots();
     for (flag, v) in [
@@ -284,7 +294,7 @@ fn record(a: &RecordArgs) -> Result<()> {
     let before_high = planner.confidence().high_share();
     let r = |i: usize| {
         read_execution(
-            planner.model(),
+            &planner,
             i + 1,
             &a.execution[i],
             &a.log[i],
@@ -297,7 +307,11 @@ fn record(a: &RecordArgs) -> Result<()> {
     } else {
         "cannot record the round"
     })?;
-    planner.save(&a.state)?;
+    planner.save_locked(&lock)?;
+    drop(lock);
+    for n in &report.notices {
+        note(n);
+    }
     out(&format!(
         "recorded {} {} into {}",
         if n == 2 { "pair" } else { "round" },

@@ -5,6 +5,17 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use tandem::Planner;
+use tandem::planner::state::{self, DEFAULT_LOCK_TIMEOUT, StateLock};
+
+/// Locks the state file `path` for a read–modify–write, waiting up to
+/// [`DEFAULT_LOCK_TIMEOUT`] for another `tandem` command that holds it.
+pub(crate) fn lock(path: &Path) -> Result<StateLock> {
+    if !path.is_file() {
+        // A missing file or a folder: the error load gives, and no lock file beside it.
+        load(path)?;
+    }
+    Ok(StateLock::acquire(path, DEFAULT_LOCK_TIMEOUT)?)
+}
 
 /// Loads a planner, naming the file in every error.
 pub(crate) fn load(path: &Path) -> Result<Planner> {
@@ -14,8 +25,9 @@ pub(crate) fn load(path: &Path) -> Result<Planner> {
     Planner::load(path).context("cannot load the state")
 }
 
-/// Checks that a file can be created at `path` (its folder exists and accepts a new file,
-/// and `path` is not a folder), without touching `path` itself.
+/// Checks that a state file can be written at `path` (its folder exists and accepts a new
+/// file, `path` is not a folder, and an existing file there is a state file:
+/// [`state::check_target`]), without touching `path` itself.
 pub(crate) fn check_file_target(path: &Path) -> Result<()> {
     let shown = path.display();
     if path.is_dir() {
@@ -31,6 +43,7 @@ pub(crate) fn check_file_target(path: &Path) -> Result<()> {
             dir.display()
         );
     }
+    state::check_target(path)?;
     let mut probe_name = std::ffi::OsString::from(".");
     probe_name.push(name);
     probe_name.push(format!(".probe{}", std::process::id()));

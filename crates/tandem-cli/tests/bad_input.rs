@@ -4,6 +4,7 @@
 mod common;
 
 use std::ffi::OsString;
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use common::*;
@@ -24,9 +25,13 @@ fn expect_user_error<S: Into<OsString> + Clone>(
         Some(2),
         "args {args:?}: expected exit code 2\nstderr:\n{stderr}"
     );
+    // Notes on the data read so far may come first, then the error.
     assert!(
-        stderr.starts_with("error: "),
-        "args {args:?}: stderr should start with `error: `:\n{stderr}"
+        stderr
+            .lines()
+            .find(|l| !l.starts_with("note: "))
+            .is_some_and(|l| l.starts_with("error: ")),
+        "args {args:?}: stderr should be notes, then `error: `:\n{stderr}"
     );
     for n in needles {
         assert!(
@@ -120,6 +125,36 @@ fn malformed_demonstrations() {
             "{\"channels\": [\"x\", \"force\"], \"samples\": [[0, 1], [2]]}".into(),
             vec!["ragged row"],
         ),
+        // A time column under another name than `t` would be a channel that only grows.
+        (
+            "time_col.csv",
+            small_demo(60, 1.0).replace("t,x,force", "time,x,force"),
+            vec![
+                ":1:1",
+                "column `time` looks like a time column",
+                "rename it to `t`",
+            ],
+        ),
+        (
+            "stamp_col.csv",
+            small_demo(60, 1.0).replace("t,x,force", "x,force,t_ms"),
+            vec![":1:3", "`t_ms`", "rename it to `t`"],
+        ),
+        // 0.19 s against a median of 0.57 s: not the same task (or a recording cut short).
+        (
+            "short.csv",
+            small_demo(20, 1.0),
+            vec![
+                "0.19 s long",
+                "0.33× the median demonstration (0.57 s)",
+                "leave it out",
+            ],
+        ),
+        (
+            "long.csv",
+            small_demo(130, 1.0),
+            vec!["1.29 s long", "× the median demonstration", "trim it"],
+        ),
     ];
     for (name, text, needles) in &cases {
         let bad = write(&dir, name, text);
@@ -132,6 +167,27 @@ fn malformed_demonstrations() {
             "{name}: no output on error"
         );
     }
+    // Half the task (30 of 60 samples: 0.51× the median) is not refused, but said, with the
+    // fix; the fit goes through.
+    let half: String = small_demo(60, 1.0)
+        .lines()
+        .take(31)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let half = write(&dir, "half.csv", &half);
+    let out = tandem(fit_with(&dir, &half, false));
+    ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    for part in [
+        &format!(
+            "note: {}: 0.29 s long, 0.51× the median demonstration",
+            s(&half)
+        ),
+        "trim it or leave it out",
+    ] {
+        assert!(stderr.contains(part), "`{part}` missing in:\n{stderr}");
+    }
+    std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
     // A missing file.
     let missing = dir.join("missing.csv");
     expect_user_error(
@@ -253,6 +309,16 @@ fn bad_parameters_and_outputs() {
             "{args:?}: no output on error"
         );
     }
+    // `-o` never replaces a file that is not a state file: here an input demonstration.
+    expect_user_error(
+        &fit(&["-o", &demos[2]]),
+        &[
+            &demos[2],
+            "refusing to overwrite",
+            "not a tandem state file",
+        ],
+        Some(Path::new(&demos[2])),
+    );
 }
 
 /// Damaged state files: every command that reads one reports the file and the damage.
@@ -472,6 +538,68 @@ fn malformed_executions() {
         expect_user_error(&record_args(&state, &a, &good_b), &needles, Some(&state));
         expect_user_error(&record_args(&state, &good_b, &a), &needles, Some(&state));
     }
+    // Executions logged at 1 kHz (ten samples per reference sample of the 10 ms model),
+    // taken for one sample per 10 ms tick: ten times too long, refused naming the fix.
+    let fast_rows = 10 * (n - 1) + 1;
+    // `small_demo`'s rows at 1 kHz, with the time column `t` replaced by `time(k)` (or
+    // dropped).
+    let at_1khz = |time: &dyn Fn(usize) -> Option<String>| -> String {
+        let text = small_demo(fast_rows, 0.0);
+        let mut lines = text.lines();
+        let header = lines.next().expect("header").split_once(',').expect("t").1;
+        let mut out = match time(0) {
+            Some(_) => format!("t,{header}\n"),
+            None => format!("{header}\n"),
+        };
+        for (k, row) in lines.enumerate() {
+            let rest = row.split_once(',').expect("t field").1;
+            match time(k) {
+                Some(t) => writeln!(out, "{t},{rest}").expect("write to string"),
+                None => writeln!(out, "{rest}").expect("write to string"),
+            }
+        }
+        out
+    };
+    let fast_exec = write(&dir, "fast.csv", &at_1khz(&|_| None));
+    let fast_log = write(
+        &dir,
+        "fast.reflog.csv",
+        &format!(
+            "ref_sample\n{}",
+            (0..fast_rows)
+                .map(|k| format!("{}\n", k as f64 / 10.0))
+                .collect::<String>()
+        ),
+    );
+    let fast_corr = write(
+        &dir,
+        "fast.corr.csv",
+        &format!("supervised,corrected\n{}", "1,0\n".repeat(fast_rows)),
+    );
+    let fast = [fast_exec.clone(), fast_log.clone(), fast_corr.clone()];
+    expect_user_error(
+        &record_args(&state, &fast, &good_b),
+        &[
+            &s(&fast_exec),
+            "5.91 s long",
+            "give its sample period",
+            "column `t`",
+        ],
+        Some(&state),
+    );
+    // A time column named otherwise in an execution.
+    let stamped = write(
+        &dir,
+        "stamped.csv",
+        &small_demo(n, 0.0).replace("t,x,force", "stamp,x,force"),
+    );
+    let mut with_stamp = good_a.clone();
+    with_stamp[0] = stamped.clone();
+    expect_user_error(
+        &record_args(&state, &with_stamp, &good_b),
+        &[&s(&stamped), "`stamp` looks like a time column"],
+        Some(&state),
+    );
     // Only one execution.
     let mut one: Vec<PathBuf> = record_args(&state, &good_a, &good_b);
     one.truncate(8);
@@ -479,6 +607,32 @@ fn malformed_executions() {
     // The good files are accepted: each failure above was the one bad file.
     let ok_out = tandem(record_args(&state, &good_a, &good_b));
     ok(&ok_out);
+    // The same round again (robots in either order) is refused; the state keeps one round.
+    for (a, b) in [(&good_a, &good_b), (&good_b, &good_a)] {
+        expect_user_error(
+            &record_args(&state, a, b),
+            &["already recorded as round 1", "record each round once"],
+            Some(&state),
+        );
+    }
+    // With its `t` column the 1 kHz execution is resampled to the model's 10 ms, and said.
+    let timed = write(
+        &dir,
+        "fast_t.csv",
+        &at_1khz(&|k| Some(format!("{:.3}", k as f64 * 0.001))),
+    );
+    let timed_round = [timed.clone(), fast_log, fast_corr];
+    // (Resampled, it is exactly `good_a`: recorded with `good_b` it would repeat round 1.)
+    let other = write(&dir, "other.csv", &small_demo(n, 0.5));
+    let other_b = [other, good_b[1].clone(), good_b[2].clone()];
+    let out = tandem(record_args(&state, &timed_round, &other_b));
+    ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let want = format!(
+        "note: {}: logged 0.001 s apart, resampled to the model's 0.01 s ({fast_rows} → {n} samples)",
+        s(&timed)
+    );
+    assert!(stderr.contains(&want), "`{want}` missing in:\n{stderr}");
 }
 
 /// Need files for `simulate`.

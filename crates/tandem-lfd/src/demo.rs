@@ -32,13 +32,37 @@ pub const DT_TOLERANCE: f64 = 0.01;
 /// Serde form: the JSON document of [`Demonstration::from_json_str`]
 /// (`{"channels", "dt_s", "samples"}`); deserializing validates like
 /// [`Demonstration::new`] (the source label is not persisted).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(try_from = "DemoJson", into = "DemoJson")]
 pub struct Demonstration {
     source: String,
     channel_names: Vec<String>,
     samples: Vec<f64>,
     dt_s: f64,
+    period: PeriodSource,
+}
+
+/// Equal channels, samples, period and source label; where the period came from
+/// ([`Demonstration::period_source`]) is not compared.
+impl PartialEq for Demonstration {
+    fn eq(&self, other: &Self) -> bool {
+        self.source == other.source
+            && self.channel_names == other.channel_names
+            && self.samples == other.samples
+            && self.dt_s == other.dt_s
+    }
+}
+
+/// Where a demonstration's sample period `Δt_s` came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PeriodSource {
+    /// The file's own time: a CSV `t` column or a JSON `dt_s` key.
+    File,
+    /// The caller gave it ([`Demonstration::new`], or deserialized from a document with `dt_s`).
+    Given,
+    /// The file has no time of its own: the reader's `dt_s` argument, or [`DEFAULT_DT_S`]
+    /// without one, was assumed. [`Demonstration::period_note`] says so in words.
+    Assumed,
 }
 
 /// The text of `path` and the name errors use for it.
@@ -63,9 +87,35 @@ impl Demonstration {
             channel_names,
             samples,
             dt_s,
+            period: PeriodSource::Given,
         };
         demo.check()?;
         Ok(demo)
+    }
+
+    /// Where [`Demonstration::dt_s`] came from (the file, the caller, or an assumption).
+    pub fn period_source(&self) -> PeriodSource {
+        self.period
+    }
+
+    /// A sentence saying which sample period was assumed for a file without a time of its
+    /// own ([`PeriodSource::Assumed`]), and how to state the real one; `None` otherwise.
+    /// The command line prints it, the Python package raises it as a warning.
+    pub fn period_note(&self) -> Option<String> {
+        (self.period == PeriodSource::Assumed).then(|| {
+            format!(
+                "{}: no time column `t`: its samples are taken to be {} s apart ({} Hz); \
+                 if it was logged at another rate, add a column `t` (seconds)",
+                self.source,
+                round_s(self.dt_s),
+                round_s(1.0 / self.dt_s)
+            )
+        })
+    }
+
+    fn with_period_source(mut self, period: PeriodSource) -> Self {
+        self.period = period;
+        self
     }
 
     /// Replaces the source label that error messages use to name this demonstration.
@@ -200,6 +250,7 @@ impl Demonstration {
             channel_names: names.to_vec(),
             samples,
             dt_s: self.dt_s,
+            period: self.period,
         }))
     }
 
@@ -221,6 +272,14 @@ impl Demonstration {
         let table = CsvTable::parse(text, file)?;
         let names = table.names();
         let t_col = table.column("t");
+        if let Some(j) = names.iter().position(|n| crate::checks::time_like(n)) {
+            return Err(Error::TimeLikeChannel {
+                file: file.into(),
+                line: Some(table.header_line()),
+                column: Some(j + 1),
+                channel: names[j].clone(),
+            });
+        }
         if names.len() == usize::from(t_col.is_some()) {
             return Err(Error::BadHeader {
                 file: file.into(),
@@ -257,9 +316,12 @@ impl Demonstration {
                 found: n,
             });
         }
-        let dt_s = match t_col {
-            Some(col) => time_column_period(&times, file, col + 1)?,
-            None => dt_s.unwrap_or(DEFAULT_DT_S),
+        let (dt_s, period) = match t_col {
+            Some(col) => (
+                time_column_period(&times, file, col + 1)?,
+                PeriodSource::File,
+            ),
+            None => (dt_s.unwrap_or(DEFAULT_DT_S), PeriodSource::Assumed),
         };
         let channel_names = names
             .iter()
@@ -267,7 +329,9 @@ impl Demonstration {
             .filter(|(j, _)| Some(*j) != t_col)
             .map(|(_, n)| n.clone())
             .collect();
-        Ok(Self::new(channel_names, samples, dt_s)?.with_source(file))
+        Ok(Self::new(channel_names, samples, dt_s)?
+            .with_source(file)
+            .with_period_source(period))
     }
 
     /// Reads a JSON file: see [`Demonstration::from_json_str`].
@@ -335,6 +399,11 @@ impl Demonstration {
                 found: doc.samples.len(),
             });
         }
+        let source = if doc.dt_s.is_some() {
+            PeriodSource::File
+        } else {
+            PeriodSource::Assumed
+        };
         let period = doc.dt_s.or(dt_s).unwrap_or(DEFAULT_DT_S);
         if !(period.is_finite() && period > 0.0) {
             return Err(json_err(
@@ -344,7 +413,7 @@ impl Demonstration {
         }
         let samples = doc.samples.into_iter().flatten().collect();
         Demonstration::new(doc.channels, samples, period)
-            .map(|d| d.with_source(file))
+            .map(|d| d.with_source(file).with_period_source(source))
             .map_err(|e| match e {
                 Error::BadData { why, .. } => json_err(None, why),
                 other => other,
@@ -360,6 +429,11 @@ impl Demonstration {
         };
         serde_json::to_string(&doc).expect("serializing numbers and strings cannot fail")
     }
+}
+
+/// A period or rate without floating-point noise (`0.01`, not `0.009999…`).
+pub(crate) fn round_s(v: f64) -> f64 {
+    (v * 1e9).round() / 1e9
 }
 
 /// Index of the first value beyond `±`[`MAX_ABS_VALUE`].
@@ -485,7 +559,14 @@ impl TryFrom<DemoJson> for Demonstration {
             });
         }
         let samples = doc.samples.into_iter().flatten().collect();
-        Self::new(doc.channels, samples, doc.dt_s.unwrap_or(DEFAULT_DT_S))
+        let period = match doc.dt_s {
+            Some(_) => PeriodSource::Given,
+            None => PeriodSource::Assumed,
+        };
+        Ok(
+            Self::new(doc.channels, samples, doc.dt_s.unwrap_or(DEFAULT_DT_S))?
+                .with_period_source(period),
+        )
     }
 }
 
@@ -627,6 +708,66 @@ mod tests {
         let d = Demonstration::from_csv_str("a\r\n1\r\n2\r\n\r\n", "f", None).unwrap();
         assert_eq!(d.dt_s(), DEFAULT_DT_S);
         assert_eq!(d.n_samples(), 2);
+    }
+
+    #[test]
+    fn a_time_like_column_is_refused_where_it_stands() {
+        for (header, at) in [
+            ("x,time,force", "f.csv:2:2"),
+            ("t_ms,x", "f.csv:2:1"),
+            ("x,header.stamp", "f.csv:2:2"),
+        ] {
+            let width = header.split(',').count();
+            let row = vec!["1"; width].join(",");
+            let text = format!("\n{header}\n{row}\n{row}\n");
+            let err = Demonstration::from_csv_str(&text, "f.csv", None).unwrap_err();
+            assert!(matches!(err, Error::TimeLikeChannel { .. }), "{err}");
+            let msg = err.to_string();
+            assert!(msg.starts_with(at), "{msg}");
+            assert!(msg.contains("rename it to `t`"), "{msg}");
+        }
+        // In memory the fit refuses it (naming the source).
+        let d = Demonstration::new(vec!["x".into(), "Time".into()], vec![0.0; 4], 0.01)
+            .unwrap()
+            .with_source("demos[1]");
+        let err = d.tangent_names(&ChannelSchema::default()).unwrap_err();
+        assert!(
+            err.to_string().starts_with("demos[1]: column `Time`"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn the_assumed_period_is_said() {
+        let with_t = Demonstration::from_csv_str("t,a\n0,1\n0.01,2\n", "a.csv", None).unwrap();
+        assert_eq!(with_t.period_source(), PeriodSource::File);
+        assert_eq!(with_t.period_note(), None);
+        let without = Demonstration::from_csv_str("a\n1\n2\n", "b.csv", Some(0.001)).unwrap();
+        assert_eq!(without.period_source(), PeriodSource::Assumed);
+        assert_eq!(
+            without.period_note().unwrap(),
+            "b.csv: no time column `t`: its samples are taken to be 0.001 s apart (1000 Hz); \
+             if it was logged at another rate, add a column `t` (seconds)"
+        );
+        let json = Demonstration::from_json_str(
+            r#"{"channels":["a"],"samples":[[1],[2]]}"#,
+            "c.json",
+            None,
+        )
+        .unwrap();
+        assert_eq!(json.period_source(), PeriodSource::Assumed);
+        assert!(
+            json.period_note()
+                .unwrap()
+                .contains("0.01 s apart (100 Hz)")
+        );
+        let given = Demonstration::new(vec!["a".into()], vec![1.0, 2.0], 0.01).unwrap();
+        assert_eq!(given.period_source(), PeriodSource::Given);
+        // Where the period came from does not make two demonstrations different.
+        assert_eq!(
+            Demonstration::from_csv_str("a\n1\n2\n", "<memory>", None).unwrap(),
+            given
+        );
     }
 
     #[test]

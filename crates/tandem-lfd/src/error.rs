@@ -173,6 +173,40 @@ pub enum Error {
         /// What the model derives under that name.
         derived: String,
     },
+    /// A channel is named like a time column other than `t` (see [`crate::time_like`]).
+    #[error(
+        "{}: column `{channel}` looks like a time column, but tandem reads time only from a \
+         column named `t` (seconds): rename it to `t` (converted to seconds) or remove it; \
+         as a channel it would be aligned and averaged like a measurement",
+        located(file, *line, *column)
+    )]
+    TimeLikeChannel {
+        /// The file or source label.
+        file: String,
+        /// 1-based line of the header, where known (CSV).
+        line: Option<usize>,
+        /// 1-based column (field number), where known (CSV).
+        column: Option<usize>,
+        /// The column's name.
+        channel: String,
+    },
+    /// A demonstration's length is an outlier of the set ([`crate::check_lengths`]).
+    #[error(
+        "{file}: {duration_s:.2} s long, {ratio:.2}× the median demonstration \
+         ({median_s:.2} s); a demonstration outside 0.5–2× the median is a partial task, a \
+         recording left running or a long pause, and would widen the speed bounds and the \
+         variance of the whole model: leave it out, trim it, or demonstrate the whole task again"
+    )]
+    DemonstrationLength {
+        /// The file or source label.
+        file: String,
+        /// Its duration `(T_i − 1)·Δt_s`, seconds.
+        duration_s: f64,
+        /// The median duration of the demonstrations, seconds.
+        median_s: f64,
+        /// `duration_s / median_s`.
+        ratio: f64,
+    },
     /// Sample periods differ by more than 1 %.
     #[error(
         "{file}: sample period {found_s} s differs from the reference {expected_s} s by more than 1 %"
@@ -217,9 +251,66 @@ pub enum Error {
         /// What is wrong.
         why: String,
     },
+    /// An execution does not cover the whole task: its reference-time log starts after the
+    /// first reference sample or ends before the last (by more than one step of its pace).
+    #[error(
+        "execution `{file}`: the reference-time log {why}; an execution must cover the whole \
+         task (record complete executions only: the model would extrapolate the missing part)"
+    )]
+    TruncatedExecution {
+        /// Source label of the execution.
+        file: String,
+        /// Where the log starts or ends and what was expected.
+        why: String,
+    },
+    /// An execution lasts far longer or shorter than any admissible speed allows: most likely
+    /// it was logged at another rate than the one assumed for it.
+    #[error(
+        "execution `{file}`: {duration_s:.2} s long ({n_samples} samples {dt_s} s apart), but \
+         the demonstrated speeds take {fastest_s:.2} to {slowest_s:.2} s and an execution \
+         outside half the fastest to twice the slowest is refused: if it was logged at another \
+         rate, give its sample period (a column `t` in seconds; `dt_s=` in Python) and it is \
+         resampled to the model's"
+    )]
+    ExecutionDuration {
+        /// Source label of the execution.
+        file: String,
+        /// `T_E·Δt_E`, seconds (the convention of `Σ_n ψ̇(n)·Δt_s`).
+        duration_s: f64,
+        /// Samples `T_E`.
+        n_samples: usize,
+        /// The execution's sample period `Δt_E`, seconds.
+        dt_s: f64,
+        /// `Σ_n ψ̇min(n)·Δt_s`: the fastest admissible execution, seconds.
+        fastest_s: f64,
+        /// `Σ_n ψ̇max(n)·Δt_s`: the slowest admissible execution, seconds.
+        slowest_s: f64,
+    },
+    /// An execution was logged at a coarser period than the model's: resampling it would
+    /// invent samples (and observations) between the logged ones.
+    #[error(
+        "execution `{file}`: sample period {found_s} s is coarser than the model's {model_s} s: \
+         log executions at the model's period or finer (a finer log is resampled to it)"
+    )]
+    CoarseExecution {
+        /// Source label of the execution.
+        file: String,
+        /// The execution's period, seconds.
+        found_s: f64,
+        /// The model's period `Δt_s`, seconds.
+        model_s: f64,
+    },
     /// The time-warping crate failed.
     #[error("alignment failed: {0}")]
     Warp(#[from] tandem_warp::Error),
+}
+
+/// `file:line:column`, or `file` alone where the position is unknown.
+fn located(file: &str, line: Option<usize>, column: Option<usize>) -> String {
+    match (line, column) {
+        (Some(l), Some(c)) => format!("{file}:{l}:{c}"),
+        _ => file.to_owned(),
+    }
 }
 
 /// `Result` with this crate's [`Error`].

@@ -69,16 +69,22 @@
 //! # Ok::<(), tandem_lfd::Error>(())
 //! ```
 
+mod checks;
 mod csv;
 mod demo;
 mod error;
 mod model;
 mod quat;
 
+pub use checks::{
+    LENGTH_REFUSE_RATIO, LENGTH_WARN_RATIO, check_lengths, length_warnings, time_like,
+};
 pub use csv::{CsvRow, CsvTable};
 pub use demo::{
     ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, MAX_ABS_VALUE,
-    QuaternionBlock,
+    PeriodSource, QuaternionBlock,
 };
 pub use error::{Error, Result};
-pub use model::{Corrections, Execution, FitParams, Reference, TaskModel};
+pub use model::{
+    Corrections, EXECUTION_DURATION_RATIO, Execution, FitParams, Reference, Resampled, TaskModel,
+};

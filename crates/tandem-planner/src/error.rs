@@ -56,6 +56,50 @@ pub enum Error {
         /// What is wrong (checksum, decoding, trailing bytes).
         why: String,
     },
+    /// Another writer has held the state file's lock for longer than the caller waits.
+    #[error(
+        "{}: another process has been writing this state file for {waited_s:.0} s (lock file \
+         {}): let it finish and try again; nothing was written",
+        path.display(),
+        lock_path.display()
+    )]
+    Locked {
+        /// The state file.
+        path: PathBuf,
+        /// Its lock file.
+        lock_path: PathBuf,
+        /// How long this process waited, seconds.
+        waited_s: f64,
+    },
+    /// A save would replace a file that is not a state file.
+    #[error("{}: refusing to overwrite: {why}; give another file name", path.display())]
+    WouldOverwrite {
+        /// The file that would have been replaced.
+        path: PathBuf,
+        /// What it is.
+        why: String,
+    },
+    /// The state file changed on disk since this planner was loaded from it (another process
+    /// saved into it): saving would lose what that process recorded.
+    #[error(
+        "{}: the state file changed since this planner was loaded from it (another process \
+         saved into it); nothing was written: load it again and repeat the change, or save \
+         this planner under another name",
+        path.display()
+    )]
+    Changed {
+        /// The state file.
+        path: PathBuf,
+    },
+    /// The round was recorded before (the same executions, logs and flags).
+    #[error(
+        "this round was already recorded as round {round} (the same executions, logs and \
+         flags): nothing was recorded; record each round once"
+    )]
+    DuplicateRound {
+        /// The earlier round (1-based).
+        round: usize,
+    },
     /// An execution record is malformed.
     #[error("bad execution record: `{what}`: {why}")]
     BadExecution {

@@ -11,7 +11,11 @@
 //! control tick the schedule was checked with.
 //!
 //! The planner is saved as a versioned, checksummed, atomically written file ([`state`]):
-//! a crash while saving never loses the recorded executions.
+//! a crash while saving never loses the recorded executions, and every writer holds the
+//! file's advisory lock ([`state::StateLock`]) for its whole read–modify–write, so two
+//! writers never lose each other's rounds. Executions are checked where they enter
+//! ([`Planner::check_execution`]): resampled to the model's period, complete, of a plausible
+//! duration; a round recorded twice is refused.
 //!
 //! ```
 //! use tandem_lfd::{Demonstration, Execution};

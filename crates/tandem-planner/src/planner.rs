@@ -1,7 +1,8 @@
 //! The iterative loop of the paper's Fig. 2 (§II-C, Eq. 21): model, observations,
 //! confidence and schedule, updated after every pair of executions.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
@@ -13,6 +14,7 @@ use tandem_schedule::{
     Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source, sample_schedule_n,
 };
 
+use crate::state::{Stamp, StateLock};
 use crate::{Error, Result, derive_seed, state};
 
 /// Parameters of a [`Planner`]: one block per stage of Fig. 2.
@@ -83,6 +85,80 @@ impl ExecutionRecord {
         }
         Ok((times, corrected))
     }
+
+    /// FNV-1a (64 bit) of the samples (in their channel order), the log and the flags: what
+    /// makes two records the same execution. Stable across builds and platforms.
+    fn fingerprint(&self) -> u64 {
+        let mut h = Fnv::new();
+        let demo = &self.execution.demonstration;
+        h.word(demo.n_samples() as u64);
+        h.word(demo.n_channels() as u64);
+        for v in demo.samples().iter().chain(&self.execution.ref_time_log) {
+            h.word(v.to_bits());
+        }
+        for flags in [&self.supervised, &self.corrected] {
+            h.word(flags.len() as u64);
+            for &f in flags {
+                h.byte(u8::from(f));
+            }
+        }
+        h.finish()
+    }
+}
+
+/// The 64-bit FNV-1a hash (Fowler, Noll, Vo): small, stable, enough to tell accidental
+/// repeats of a round from new rounds.
+struct Fnv(u64);
+
+impl Fnv {
+    fn new() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+    fn byte(&mut self, b: u8) {
+        self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    fn word(&mut self, w: u64) {
+        for b in w.to_le_bytes() {
+            self.byte(b);
+        }
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// The fingerprint of a round: of its executions' fingerprints in sorted order, so that the
+/// same executions given in another robot order are the same round.
+fn round_fingerprint(records: &[ExecutionRecord]) -> u64 {
+    let mut each: Vec<u64> = records.iter().map(ExecutionRecord::fingerprint).collect();
+    each.sort_unstable();
+    let mut h = Fnv::new();
+    for f in each {
+        h.word(f);
+    }
+    h.finish()
+}
+
+/// Where a planner was loaded from (or last saved to), and that file's content then: a save
+/// into the same file refuses to overwrite content some other process wrote since.
+#[derive(Debug, Default)]
+struct Origin(Mutex<Option<(PathBuf, Stamp)>>);
+
+impl Origin {
+    fn get(&self) -> Option<(PathBuf, Stamp)> {
+        self.0.lock().map_or(None, |o| o.clone())
+    }
+    fn set(&self, path: PathBuf, stamp: Stamp) {
+        if let Ok(mut o) = self.0.lock() {
+            *o = Some((path, stamp));
+        }
+    }
+}
+
+impl Clone for Origin {
+    fn clone(&self) -> Self {
+        Self(Mutex::new(self.get()))
+    }
 }
 
 /// What [`Planner::record_pair`] did.
@@ -100,6 +176,9 @@ pub struct RecordReport {
     pub confidence: Duration,
     /// Wall time of re-scheduling (§II-C).
     pub scheduling: Duration,
+    /// One sentence per execution that was not taken in as given: resampled from its own
+    /// sample period to the model's ([`Planner::check_execution`]). Front ends show them.
+    pub notices: Vec<String>,
 }
 
 /// The loop of Fig. 2: the task model learned from demonstrations and executions, the
@@ -132,6 +211,9 @@ pub struct Planner {
     problem: Problem,
     outcome: Outcome,
     pairs_recorded: usize,
+    /// Fingerprints of the rounds recorded since the state format had them (version 6).
+    rounds: Vec<u64>,
+    origin: Origin,
 }
 
 /// The serialized part of a [`Planner`] (the problem is rebuilt on load).
@@ -143,6 +225,33 @@ struct PlannerState {
     confidence: Confidence,
     outcome: Outcome,
     pairs_recorded: usize,
+    rounds: Vec<u64>,
+}
+
+/// [`PlannerState`] as state format version 5 wrote it: the same without the round
+/// fingerprints.
+#[derive(Deserialize)]
+struct PlannerStateV5 {
+    params: PlannerParams,
+    model: TaskModel,
+    observations: Observations,
+    confidence: Confidence,
+    outcome: Outcome,
+    pairs_recorded: usize,
+}
+
+impl From<PlannerStateV5> for PlannerState {
+    fn from(v5: PlannerStateV5) -> Self {
+        PlannerState {
+            params: v5.params,
+            model: v5.model,
+            observations: v5.observations,
+            confidence: v5.confidence,
+            outcome: v5.outcome,
+            pairs_recorded: v5.pairs_recorded,
+            rounds: Vec::new(),
+        }
+    }
 }
 
 /// [`PlannerState`] as state format version 4 wrote it: the same but for the two-robot
@@ -208,6 +317,7 @@ impl From<PlannerStateV4> for PlannerState {
                 gap,
             },
             pairs_recorded: v4.pairs_recorded,
+            rounds: Vec::new(),
         }
     }
 }
@@ -307,6 +417,8 @@ impl Planner {
             problem,
             outcome,
             pairs_recorded: 0,
+            rounds: Vec::new(),
+            origin: Origin::default(),
         })
     }
 
@@ -317,15 +429,90 @@ impl Planner {
         }
     }
 
-    /// Records a round of executions, one per robot of the schedule (robot 1 first), and
-    /// re-schedules (see the type docs).
+    /// One execution as [`Planner::record_round`] takes it in, checked: its flags have one
+    /// entry per sample; an execution logged at a finer period than the model's (a control
+    /// loop faster than the demonstrations) is resampled to the model's period
+    /// ([`TaskModel::resample_execution`]: samples and log interpolated; a sample is supervised
+    /// if the original sample nearest to it in time was, and corrected (and supervised) if any
+    /// original sample of its period was corrected, so no correction is lost); then the
+    /// model's checks of an execution (channels,
+    /// log, coverage of the whole task, a duration the demonstrated speeds allow). Returns the
+    /// record at the model's period and, when it was resampled, a sentence saying so.
     ///
+    /// # Errors
+    /// [`Error::BadExecution`] for flag vectors of the wrong length; the model crate's errors
+    /// (`CoarseExecution`, `TruncatedExecution`, `ExecutionDuration`, channels, log).
+    pub fn check_execution(
+        &self,
+        record: &ExecutionRecord,
+    ) -> Result<(ExecutionRecord, Option<String>)> {
+        let demo = &record.execution.demonstration;
+        let n = demo.n_samples();
+        for (what, len) in [
+            ("supervised", record.supervised.len()),
+            ("corrected", record.corrected.len()),
+        ] {
+            if len != n {
+                return Err(Error::BadExecution {
+                    what,
+                    why: format!("{len} flags for the {n} samples of {}", demo.source()),
+                });
+            }
+        }
+        let resampled = self.model.resample_execution(&record.execution)?;
+        let n_new = resampled.execution.demonstration.n_samples();
+        let (supervised, corrected, note) = if resampled.bin_of.len() == n_new {
+            (record.supervised.clone(), record.corrected.clone(), None)
+        } else {
+            // Supervision is a state: read at the nearest original sample, as a logger at
+            // the model's period would have. A correction is an event: kept if any original
+            // sample of the period had one (and then the sample counts as supervised).
+            let mut sup: Vec<bool> = resampled
+                .nearest
+                .iter()
+                .map(|&k| record.supervised[k])
+                .collect();
+            let mut cor = vec![false; n_new];
+            for (k, &j) in resampled.bin_of.iter().enumerate() {
+                cor[j] |= record.corrected[k];
+            }
+            for (s, c) in sup.iter_mut().zip(&cor) {
+                *s |= *c;
+            }
+            let note = format!(
+                "{}: logged {} s apart, resampled to the model's {} s ({n} → {n_new} samples)",
+                demo.source(),
+                (demo.dt_s() * 1e9).round() / 1e9,
+                (self.model.dt_s() * 1e9).round() / 1e9
+            );
+            (sup, cor, Some(note))
+        };
+        self.model.execution_warp(&resampled.execution)?;
+        Ok((
+            ExecutionRecord {
+                execution: resampled.execution,
+                supervised,
+                corrected,
+            },
+            note,
+        ))
+    }
+
+    /// Records a round of executions, one per robot of the schedule (robot 1 first), and
+    /// re-schedules (see the type docs) at the control tick of the current schedule (the one
+    /// the round ran at, [`Schedule::tick_s`]), with seed `derive_seed(seed, k)` after `k`
+    /// recorded rounds.
+    ///
+    /// Each execution is taken in through [`Planner::check_execution`] (resampled to the
+    /// model's period if it was logged finer; refused if it does not cover the task or lasts
+    /// longer or shorter than any admissible speed allows). A round with the same executions,
+    /// logs and flags as one recorded before (in any robot order) is refused.
     /// Everything is checked before the planner changes: on error it is as before.
     ///
     /// # Errors
     /// [`Error::BadExecution`] for a number of records other than the schedule's robot count
-    /// or flag vectors of the wrong length; the lower crates' errors for a bad execution
-    /// (channels, period, log) or observation.
+    /// or flag vectors of the wrong length; [`Error::DuplicateRound`]; the lower crates'
+    /// errors for a bad execution (channels, period, log, coverage, duration) or observation.
     pub fn record_round(&mut self, executions: &[ExecutionRecord]) -> Result<RecordReport> {
         let n_robots = self.n_robots();
         if executions.len() != n_robots {
@@ -337,14 +524,27 @@ impl Planner {
                 ),
             });
         }
+        let mut records = Vec::with_capacity(n_robots);
+        let mut notices = Vec::new();
+        for e in executions {
+            let (record, note) = self.check_execution(e)?;
+            records.push(record);
+            notices.extend(note);
+        }
+        let fingerprint = round_fingerprint(&records);
+        if let Some(k) = self.rounds.iter().position(|&f| f == fingerprint) {
+            return Err(Error::DuplicateRound {
+                round: self.pairs_recorded - self.rounds.len() + k + 1,
+            });
+        }
         let t0 = Instant::now();
         let mut model = self.model.clone();
-        for e in executions {
+        for e in &records {
             model.update(&e.execution)?;
         }
         let t1 = Instant::now();
         let mut observations = self.observations.clone();
-        for e in executions {
+        for e in &records {
             let (times, corrected) = e.observations()?;
             observations.record(&times, &corrected)?;
         }
@@ -353,12 +553,12 @@ impl Planner {
         let problem = problem_for(&model, &confidence)?;
         let t2 = Instant::now();
         let pairs_recorded = self.pairs_recorded + 1;
-        let outcome = sample_schedule_n(
-            &problem,
-            n_robots,
-            &Self::sampler_params(&self.params, pairs_recorded),
-            Some(&self.outcome.schedule),
-        )?;
+        let sampler = SamplerParams {
+            tick_s: Some(self.schedule().tick_s),
+            ..Self::sampler_params(&self.params, pairs_recorded)
+        };
+        let outcome =
+            sample_schedule_n(&problem, n_robots, &sampler, Some(&self.outcome.schedule))?;
         let t3 = Instant::now();
         let report = RecordReport {
             newly_high,
@@ -367,6 +567,7 @@ impl Planner {
             model_update: t1 - t0,
             confidence: t2 - t1,
             scheduling: t3 - t2,
+            notices,
         };
         self.model = model;
         self.observations = observations;
@@ -374,6 +575,7 @@ impl Planner {
         self.problem = problem;
         self.outcome = outcome;
         self.pairs_recorded = pairs_recorded;
+        self.rounds.push(fingerprint);
         Ok(report)
     }
 
@@ -390,22 +592,27 @@ impl Planner {
     /// observations, confidence, parameters and [`Planner::pairs_recorded`] are unchanged
     /// (`sampler` is used for this call only and not stored in [`Planner::params`]).
     ///
-    /// The current schedule is the sampler's incumbent, re-checked at `sampler.tick_s`, so
-    /// `T_total` (Eq. 13, s) never increases as long as the current schedule is valid at
-    /// that tick: always so when it is the tick the current schedule was made with
-    /// ([`Schedule::tick_s`]). Otherwise the sampler repairs it or falls back to the fastest
-    /// serial schedule, as in [`Planner::record_pair`]. The new schedule carries
-    /// `sampler.tick_s`: run it at that tick.
+    /// `sampler.tick_s = None` keeps the current schedule's control tick
+    /// ([`Schedule::tick_s`]); `Some(t)` re-schedules for tick `t`, which later
+    /// [`Planner::record_round`]s keep. The current schedule is the sampler's incumbent,
+    /// re-checked at that tick, so `T_total` (Eq. 13, s) never increases as long as the
+    /// current schedule is valid at it: always so at the current schedule's own tick.
+    /// Otherwise the sampler repairs it or falls back to the fastest serial schedule, as in
+    /// [`Planner::record_pair`]. The new schedule carries the tick: run it at that tick.
     ///
     /// On error the planner is as before.
     ///
     /// # Errors
     /// The schedule crate's error for invalid `sampler` parameters or an infeasible problem.
     pub fn reschedule(&mut self, sampler: &SamplerParams) -> Result<&Outcome> {
+        let sampler = SamplerParams {
+            tick_s: sampler.tick_s.or(Some(self.schedule().tick_s)),
+            ..sampler.clone()
+        };
         let outcome = sample_schedule_n(
             &self.problem,
             self.n_robots(),
-            sampler,
+            &sampler,
             Some(&self.outcome.schedule),
         )?;
         self.outcome = outcome;
@@ -469,18 +676,56 @@ impl Planner {
         self.pairs_recorded
     }
 
-    /// Saves the planner to `path` as a versioned state file, atomically: on error or a
-    /// crash the previous file at `path` is intact (see [`crate::state`]).
+    /// Saves the planner to `path` as a versioned state file, atomically and under the
+    /// file's lock ([`StateLock`], waiting up to [`state::DEFAULT_LOCK_TIMEOUT`]): on error or
+    /// a crash the previous file at `path` is intact (see [`crate::state`]). For a whole
+    /// read–modify–write (load, record, save) hold the lock throughout and use
+    /// [`Planner::save_locked`].
     ///
     /// # Errors
-    /// [`Error::Io`] naming the file or directory, [`Error::Encode`].
+    /// As [`Planner::save_locked`], and [`Error::Locked`] when another writer holds the lock
+    /// for longer than the timeout.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
-        state::save(path.as_ref(), &self.to_state())
+        let lock = StateLock::acquire(path.as_ref(), state::DEFAULT_LOCK_TIMEOUT)?;
+        self.save_locked(&lock)
+    }
+
+    /// Saves the planner to the state file `lock` protects ([`StateLock::state_path`]),
+    /// atomically. Refuses to replace a file that is not a state file
+    /// ([`state::check_target`]), and, when this planner was loaded from (or last saved to)
+    /// that file, a file whose content changed since (another process saved into it: saving
+    /// would lose its round).
+    ///
+    /// # Errors
+    /// [`Error::WouldOverwrite`], [`Error::Changed`], [`Error::Io`] naming the file or
+    /// directory, [`Error::Encode`].
+    pub fn save_locked(&self, lock: &StateLock) -> Result<()> {
+        let path = lock.state_path();
+        state::check_target(path)?;
+        let here = state::resolved(path);
+        if let Some((from, stamp)) = self.origin.get()
+            && from == here
+            && let Some(now) = state::stamp_at(path)?
+            && now != stamp
+        {
+            return Err(Error::Changed {
+                path: path.to_path_buf(),
+            });
+        }
+        let bytes = state::encode(&self.to_state())?;
+        state::write_atomic(path, &bytes)?;
+        if let Some(stamp) = state::stamp_of(&bytes) {
+            self.origin.set(here, stamp);
+        }
+        Ok(())
     }
 
     /// Loads a planner saved by [`Planner::save`], of the current state format or an older one
     /// this build still reads (version 4: a two-robot schedule with one offset, converted to
-    /// `offsets_s = [offset_s]`; saving writes the current version).
+    /// `offsets_s = [offset_s]`; versions 4 and 5 have no round fingerprints, so the rounds
+    /// they hold are not checked for repeats; saving writes the current version). Reading
+    /// takes no lock (saves are atomic renames); the planner remembers the file's content, so
+    /// that saving into it again refuses to overwrite what another process saved meanwhile.
     ///
     /// # Errors
     /// As [`crate::state::load`] (missing, foreign, truncated, corrupt or other-version
@@ -489,15 +734,19 @@ impl Planner {
         let path = path.as_ref();
         let bytes = state::read(path)?;
         let (version, payload) = state::checked_payload(&bytes, path)?;
-        let st: PlannerState = if version == 4 {
-            state::decode_payload::<PlannerStateV4>(payload, path)?.into()
-        } else {
-            state::decode_payload(payload, path)?
+        let st: PlannerState = match version {
+            4 => state::decode_payload::<PlannerStateV4>(payload, path)?.into(),
+            5 => state::decode_payload::<PlannerStateV5>(payload, path)?.into(),
+            _ => state::decode_payload(payload, path)?,
         };
-        Self::from_state(st).map_err(|e| Error::Corrupt {
+        let planner = Self::from_state(st).map_err(|e| Error::Corrupt {
             path: path.to_path_buf(),
             why: e.to_string(),
-        })
+        })?;
+        if let Some(stamp) = state::stamp_of(&bytes) {
+            planner.origin.set(state::resolved(path), stamp);
+        }
+        Ok(planner)
     }
 
     fn to_state(&self) -> PlannerState {
@@ -508,6 +757,7 @@ impl Planner {
             confidence: self.confidence.clone(),
             outcome: self.outcome.clone(),
             pairs_recorded: self.pairs_recorded,
+            rounds: self.rounds.clone(),
         }
     }
 
@@ -548,6 +798,16 @@ impl Planner {
                 });
             }
         }
+        if st.rounds.len() > st.pairs_recorded {
+            return Err(Error::Inconsistent {
+                what: "rounds",
+                why: format!(
+                    "{} round fingerprints for {} recorded rounds",
+                    st.rounds.len(),
+                    st.pairs_recorded
+                ),
+            });
+        }
         let problem = problem_for(&st.model, &st.confidence)?;
         Ok(Self {
             params: st.params,
@@ -557,6 +817,8 @@ impl Planner {
             problem,
             outcome: st.outcome,
             pairs_recorded: st.pairs_recorded,
+            rounds: st.rounds,
+            origin: Origin::default(),
         })
     }
 }
@@ -564,7 +826,7 @@ impl Planner {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::{CrashPoint, encode, temp_path, write_atomic_with};
+    use crate::state::{CrashPoint, encode, write_atomic_with};
 
     /// A small planner: three 1-channel demonstrations, aligned by the identity warp, whose
     /// force differs only on reference samples 10..20 (low confidence there).
@@ -647,8 +909,8 @@ mod tests {
         let newer = small_planner(2);
         let bytes = encode(&newer.to_state()).unwrap();
         for crash in [CrashPoint::MidWrite, CrashPoint::BeforeRename] {
-            write_atomic_with(&path, &bytes, crash).unwrap();
-            assert!(temp_path(&path).unwrap().exists());
+            let tmp = write_atomic_with(&path, &bytes, crash).unwrap();
+            assert!(tmp.exists());
             let loaded = Planner::load(&path).unwrap();
             assert_eq!(loaded.schedule(), old.schedule(), "{crash:?}");
             assert_eq!(loaded.params(), old.params(), "{crash:?}");
@@ -704,6 +966,215 @@ mod tests {
         };
         assert!(p.reschedule(&bad).is_err());
         assert_eq!(p.outcome(), &before);
+    }
+
+    /// A round of two replays of the small planner's first demonstration (identity log,
+    /// supervised on its low-confidence stretch 10..20, never corrected) whose force is offset by `a` and `b`,
+    /// logged `per_sample` times per reference sample at `dt_s`.
+    fn round(p: &Planner, a: f64, b: f64, per_sample: usize, dt_s: f64) -> [ExecutionRecord; 2] {
+        let n_ref = p.model().n_ref();
+        let n = (n_ref - 1) * per_sample + 1;
+        let record = |offset: f64| {
+            let log: Vec<f64> = (0..n).map(|k| k as f64 / per_sample as f64).collect();
+            let force = log
+                .iter()
+                .map(|&r| {
+                    let bump = if (10.0..20.0).contains(&r) { 5.0 } else { 1.0 };
+                    bump + offset
+                })
+                .collect();
+            let supervised: Vec<bool> = log.iter().map(|r| (10.0..20.0).contains(r)).collect();
+            ExecutionRecord {
+                execution: Execution {
+                    demonstration: Demonstration::new(vec!["force".into()], force, dt_s).unwrap(),
+                    ref_time_log: log,
+                },
+                corrected: vec![false; n],
+                supervised,
+            }
+        };
+        [record(a), record(b)]
+    }
+
+    #[test]
+    fn the_tick_a_user_chose_survives_record_round() {
+        let mut p = small_planner(4);
+        assert_eq!(p.schedule().tick_s, 0.01);
+        let sp = SamplerParams {
+            tick_s: Some(0.005),
+            ..p.params().sampler.clone()
+        };
+        p.reschedule(&sp).unwrap();
+        assert_eq!(p.schedule().tick_s, 0.005);
+        p.record_pair(&round(&p, 0.0, 0.1, 1, 0.01)).unwrap();
+        assert_eq!(
+            p.schedule().tick_s,
+            0.005,
+            "record_round kept the chosen tick"
+        );
+        // Without a tick of its own, a re-schedule keeps the current one as well.
+        let plain = SamplerParams {
+            tick_s: None,
+            ..p.params().sampler.clone()
+        };
+        p.reschedule(&plain).unwrap();
+        assert_eq!(p.schedule().tick_s, 0.005);
+        assert_eq!(p.coordinator().unwrap().tick_s(), 0.005);
+    }
+
+    #[test]
+    fn the_same_round_recorded_twice_is_refused() {
+        let mut p = small_planner(5);
+        let first = round(&p, 0.0, 0.1, 1, 0.01);
+        p.record_pair(&first).unwrap();
+        let before = (p.pairs_recorded(), p.model().count(), p.outcome().clone());
+        let swapped = [first[1].clone(), first[0].clone()];
+        for again in [first.clone(), swapped] {
+            let err = p.record_pair(&again).unwrap_err();
+            assert!(matches!(err, Error::DuplicateRound { round: 1 }), "{err}");
+            assert!(
+                err.to_string().contains("already recorded as round 1"),
+                "{err}"
+            );
+            assert_eq!(
+                (p.pairs_recorded(), p.model().count(), p.outcome().clone()),
+                before
+            );
+        }
+        // Another round records; the fingerprints survive a save and a load.
+        p.record_pair(&round(&p, 0.2, 0.3, 1, 0.01)).unwrap();
+        let dir = std::env::temp_dir().join(format!("tandem-planner-dup-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("cell.tandem");
+        p.save(&path).unwrap();
+        let mut q = Planner::load(&path).unwrap();
+        assert!(matches!(
+            q.record_pair(&first),
+            Err(Error::DuplicateRound { round: 1 })
+        ));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn an_execution_logged_at_1_khz_is_resampled_to_the_model_period() {
+        let base = small_planner(6);
+        let mut at_100hz = base.clone();
+        let mut at_1khz = base.clone();
+        let r100 = at_100hz
+            .record_pair(&round(&base, 0.0, 0.5, 1, 0.01))
+            .unwrap();
+        assert!(r100.notices.is_empty());
+        let r1k = at_1khz
+            .record_pair(&round(&base, 0.0, 0.5, 10, 0.001))
+            .unwrap();
+        assert_eq!(r1k.notices.len(), 2);
+        assert!(
+            r1k.notices[0].contains(
+                "logged 0.001 s apart, resampled to the model's 0.01 s (391 → 40 samples)"
+            ),
+            "{}",
+            r1k.notices[0]
+        );
+        // The same model and observations as the same executions logged at 100 Hz: the mean
+        // execution does not grow tenfold.
+        let (a, b) = (at_100hz.model(), at_1khz.model());
+        for (x, y) in a.grad_mean().iter().zip(b.grad_mean()) {
+            assert!((x - y).abs() < 1e-9, "{x} vs {y}");
+        }
+        for (x, y) in a.mean().iter().zip(b.mean()) {
+            assert!((x - y).abs() < 1e-9, "{x} vs {y}");
+        }
+        let (oa, ob) = (at_100hz.observations(), at_1khz.observations());
+        assert!((oa.total_supervised() - ob.total_supervised()).abs() < 1e-9);
+        // Given as 10 ms samples, the 1 kHz log lasts ten times too long: refused, naming
+        // the fix, and the planner is unchanged.
+        let mut wrong = base.clone();
+        let err = wrong
+            .record_pair(&round(&base, 0.0, 0.5, 10, 0.01))
+            .unwrap_err();
+        assert!(err.to_string().contains("give its sample period"), "{err}");
+        assert_eq!(wrong.pairs_recorded(), 0);
+    }
+
+    #[test]
+    fn a_save_refuses_to_overwrite_what_another_process_saved_since_the_load() {
+        let dir = std::env::temp_dir().join(format!("tandem-planner-cas-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("cell.tandem");
+        small_planner(7).save(&path).unwrap();
+        let mut mine = Planner::load(&path).unwrap();
+        let mut theirs = Planner::load(&path).unwrap();
+        theirs
+            .record_pair(&round(&theirs, 0.0, 0.1, 1, 0.01))
+            .unwrap();
+        theirs.save(&path).unwrap();
+        let after_theirs = std::fs::read(&path).unwrap();
+        mine.record_pair(&round(&mine, 0.4, 0.5, 1, 0.01)).unwrap();
+        let err = mine.save(&path).unwrap_err();
+        assert!(matches!(err, Error::Changed { .. }), "{err}");
+        assert!(err.to_string().contains("load it again"), "{err}");
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            after_theirs,
+            "their round is kept"
+        );
+        // Saved elsewhere it goes through; a planner that saved keeps saving into its file.
+        mine.save(dir.join("mine.tandem")).unwrap();
+        theirs
+            .record_pair(&round(&theirs, 0.6, 0.7, 1, 0.01))
+            .unwrap();
+        theirs.save(&path).unwrap();
+        assert_eq!(Planner::load(&path).unwrap().pairs_recorded(), 2);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn two_concurrent_writers_lose_no_round() {
+        let dir = std::env::temp_dir().join(format!("tandem-planner-two-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("cell.tandem");
+        let start = small_planner(8);
+        start.save(&path).unwrap();
+        const ROUNDS: usize = 50;
+        let writer = |w: usize| {
+            let path = path.clone();
+            std::thread::spawn(move || {
+                for k in 0..ROUNDS {
+                    let lock = StateLock::acquire(&path, state::DEFAULT_LOCK_TIMEOUT).unwrap();
+                    let mut p = Planner::load(&path).unwrap();
+                    let offset = (w * ROUNDS + k) as f64 * 1e-3;
+                    p.record_pair(&round(&p, offset, offset + 0.5, 1, 0.01))
+                        .unwrap();
+                    p.save_locked(&lock).unwrap();
+                }
+            })
+        };
+        let (a, b) = (writer(0), writer(1));
+        a.join().unwrap();
+        b.join().unwrap();
+        let p = Planner::load(&path).unwrap();
+        assert_eq!(p.pairs_recorded(), 2 * ROUNDS);
+        assert_eq!(p.model().count(), 3 + 4 * ROUNDS);
+        // Every round is in the file: its fingerprint, computed from the same inputs.
+        let mut want: Vec<u64> = (0..2 * ROUNDS)
+            .map(|i| {
+                let offset = i as f64 * 1e-3;
+                let r = round(&start, offset, offset + 0.5, 1, 0.01);
+                let checked: Vec<ExecutionRecord> = r
+                    .iter()
+                    .map(|e| start.check_execution(e).unwrap().0)
+                    .collect();
+                round_fingerprint(&checked)
+            })
+            .collect();
+        let mut got = p.rounds.clone();
+        want.sort_unstable();
+        got.sort_unstable();
+        assert_eq!(got, want);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

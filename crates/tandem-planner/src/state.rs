@@ -36,14 +36,29 @@
 //!
 //! # Atomic write
 //!
-//! The bytes go to a temporary file in the same directory (`.<name>.tmp`), which is
-//! flushed to disk (`fsync`), then renamed over the target, then the directory itself is
-//! flushed so the rename survives a power cut. A crash at any point leaves either the old
-//! file or the new one, never a mix: the previous state is never lost.
+//! The bytes go to a temporary file in the same directory with a name no other writer uses
+//! (`.<name>.<process id>-<counter>.tmp`), which is flushed to disk (`fsync`), then renamed
+//! over the target, then the directory itself is flushed so the rename survives a power cut.
+//! A crash at any point leaves either the old file or the new one, never a mix: the previous
+//! state is never lost. Temporary files a crashed writer left are removed by the next save.
+//! An existing file that is not a state file is never replaced ([`check_target`]).
+//!
+//! # Locking
+//!
+//! Every writer holds a [`StateLock`] for its whole read–modify–write: an advisory exclusive
+//! lock (`flock` on Unix, through the `fs4` crate) on the lock file `.<name>.lock` beside the
+//! state file, which is never renamed or removed (locking the state file itself would lock
+//! the inode that the rename replaces). A second writer waits for the first, at most
+//! [`DEFAULT_LOCK_TIMEOUT`] unless told otherwise, then fails with [`Error::Locked`]; it never
+//! overwrites the first one's round. Readers need no lock: the rename is atomic. The lock is
+//! released when the [`StateLock`] is dropped, and by the operating system when its process
+//! dies, so a crashed writer never leaves a stale lock.
 
 use std::fs::{self, File, OpenOptions};
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
@@ -70,7 +85,10 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 /// - 5: the schedule holds `N` robots (`Schedule::grad_exec` a list of warps, `offsets_s` the
 ///   `N − 1` start offsets instead of the one `offset_s`). Version 4 files still load, as
 ///   two-robot schedules with `offsets_s = [offset_s]`.
-pub const FORMAT_VERSION: u32 = 5;
+/// - 6: the planner keeps a fingerprint of every round it recorded, so that the same round
+///   recorded twice is refused. Version 4 and 5 files still load, with no fingerprints for
+///   the rounds they hold.
+pub const FORMAT_VERSION: u32 = 6;
 
 /// The oldest state format version this build reads (converting it on load).
 pub const OLDEST_READABLE_VERSION: u32 = 4;
@@ -187,26 +205,269 @@ pub(crate) enum CrashPoint {
     MidWrite,
 }
 
-/// The temporary file used while saving `path`: `.<name>.tmp` in the same directory.
-pub(crate) fn temp_path(path: &Path) -> Result<PathBuf> {
+/// How long a writer waits for another one's lock by default: 60 s, far above one `record`
+/// on the sanding fixtures (docs/decisions.md, "State files are locked").
+pub const DEFAULT_LOCK_TIMEOUT: Duration = Duration::from_secs(60);
+
+/// How often a waiting writer tries the lock again: 10 ms.
+const LOCK_POLL: Duration = Duration::from_millis(10);
+
+/// `.<name><suffix>` beside `path`.
+fn sibling(path: &Path, suffix: &str) -> Result<PathBuf> {
     let name = path.file_name().ok_or_else(|| Error::Io {
         path: path.to_path_buf(),
-        op: "save state to (the path has no file name)",
+        op: "use as a state file (the path has no file name)",
         source: std::io::Error::from(std::io::ErrorKind::InvalidInput),
     })?;
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(name);
-    tmp_name.push(".tmp");
-    Ok(path.with_file_name(tmp_name))
+    let mut sibling_name = std::ffi::OsString::from(".");
+    sibling_name.push(name);
+    sibling_name.push(suffix);
+    Ok(path.with_file_name(sibling_name))
 }
 
-/// Write `bytes` to `path` atomically (see the module docs).
+/// The lock file of the state file `path`: `.<name>.lock` in the same directory.
+pub fn lock_path(path: &Path) -> Result<PathBuf> {
+    sibling(path, ".lock")
+}
+
+/// Saves made by this process so far: the counter of the unique temporary names.
+static SAVES: AtomicU64 = AtomicU64::new(0);
+
+/// A temporary file for saving `path` that no other save uses:
+/// `.<name>.<process id>-<counter>.tmp` in the same directory.
+pub(crate) fn temp_path(path: &Path) -> Result<PathBuf> {
+    let k = SAVES.fetch_add(1, Ordering::Relaxed);
+    sibling(path, &format!(".{}-{k}.tmp", std::process::id()))
+}
+
+/// Whether `name` is a temporary file of [`temp_path`] for the state file named `state_name`.
+fn is_temp_of(name: &str, state_name: &str) -> bool {
+    name.strip_prefix('.')
+        .and_then(|n| n.strip_prefix(state_name))
+        .and_then(|n| n.strip_prefix('.'))
+        .and_then(|n| n.strip_suffix(".tmp"))
+        .and_then(|n| n.split_once('-'))
+        .is_some_and(|(pid, k)| {
+            !pid.is_empty()
+                && !k.is_empty()
+                && pid.bytes().all(|b| b.is_ascii_digit())
+                && k.bytes().all(|b| b.is_ascii_digit())
+        })
+}
+
+/// Removes the temporary files of `path` that crashed writers left (best effort: a file that
+/// cannot be listed or removed stays). Call it only while holding the lock of `path`.
+fn remove_stale_temps(path: &Path) {
+    let (Some(dir), Some(name)) = (parent_dir(path), path.file_name().and_then(|n| n.to_str()))
+    else {
+        return;
+    };
+    let Ok(entries) = fs::read_dir(&dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        if entry
+            .file_name()
+            .to_str()
+            .is_some_and(|n| is_temp_of(n, name))
+        {
+            let _ = fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// The directory holding `path` (`.` for a bare file name).
+fn parent_dir(path: &Path) -> Option<PathBuf> {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => Some(d.to_path_buf()),
+        _ => Some(PathBuf::from(".")),
+    }
+}
+
+/// An advisory exclusive lock on a state file, held for a whole read–modify–write (see the
+/// module docs): at most one `StateLock` of a path exists at a time, across processes and
+/// threads. Dropping it releases the lock.
+#[derive(Debug)]
+pub struct StateLock {
+    file: File,
+    state_path: PathBuf,
+    lock_path: PathBuf,
+}
+
+impl StateLock {
+    /// Locks the state file `path` (which need not exist yet), waiting up to `timeout` for a
+    /// writer that holds it (polling every 10 ms).
+    ///
+    /// # Errors
+    /// [`Error::Locked`] when the lock is still held after `timeout`; [`Error::Io`] when the
+    /// lock file cannot be created or locked (e.g. the folder does not exist).
+    pub fn acquire(path: &Path, timeout: Duration) -> Result<Self> {
+        let lock_path = lock_path(path)?;
+        let file = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&lock_path)
+            .map_err(|source| Error::Io {
+                path: lock_path.clone(),
+                op: "create the lock file of the state file",
+                source,
+            })?;
+        let start = Instant::now();
+        loop {
+            match fs4::FileExt::try_lock(&file) {
+                Ok(()) => {
+                    return Ok(Self {
+                        file,
+                        state_path: path.to_path_buf(),
+                        lock_path,
+                    });
+                }
+                Err(fs4::TryLockError::WouldBlock) => {}
+                Err(fs4::TryLockError::Error(source)) => {
+                    return Err(Error::Io {
+                        path: lock_path,
+                        op: "lock",
+                        source,
+                    });
+                }
+            }
+            let waited = start.elapsed();
+            if waited >= timeout {
+                return Err(Error::Locked {
+                    path: path.to_path_buf(),
+                    lock_path,
+                    waited_s: waited.as_secs_f64(),
+                });
+            }
+            std::thread::sleep(LOCK_POLL.min(timeout - waited));
+        }
+    }
+
+    /// The state file this lock protects.
+    pub fn state_path(&self) -> &Path {
+        &self.state_path
+    }
+
+    /// The lock file (`.<name>.lock` beside the state file).
+    pub fn lock_path(&self) -> &Path {
+        &self.lock_path
+    }
+}
+
+impl Drop for StateLock {
+    fn drop(&mut self) {
+        // Closing the file releases the lock too; unlocking first says so explicitly.
+        let _ = fs4::FileExt::unlock(&self.file);
+    }
+}
+
+/// Refuses to replace `path` unless it is missing, empty or a tandem state file (it starts
+/// with [`MAGIC`]): a save never overwrites a demonstration, a log or any other file by
+/// accident.
+///
+/// # Errors
+/// [`Error::WouldOverwrite`] for a folder or a file of other content; [`Error::Io`] when an
+/// existing file cannot be read.
+pub fn check_target(path: &Path) -> Result<()> {
+    let meta = match fs::metadata(path) {
+        Ok(m) => m,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(source) => {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                op: "inspect the file to be replaced",
+                source,
+            });
+        }
+    };
+    if meta.is_dir() {
+        return Err(Error::WouldOverwrite {
+            path: path.to_path_buf(),
+            why: "it is a folder".into(),
+        });
+    }
+    let mut head = Vec::with_capacity(MAGIC.len());
+    File::open(path)
+        .and_then(|f| f.take(MAGIC.len() as u64).read_to_end(&mut head))
+        .map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            op: "read the file to be replaced",
+            source,
+        })?;
+    if !head.is_empty() && head != MAGIC {
+        return Err(Error::WouldOverwrite {
+            path: path.to_path_buf(),
+            why: "it is not a tandem state file (it does not start with \"TANDEMST\")".into(),
+        });
+    }
+    Ok(())
+}
+
+/// What identifies the content of a state file: its payload length and checksum (header
+/// bytes 12..24).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Stamp {
+    payload_len: u64,
+    crc: u32,
+}
+
+/// The [`Stamp`] of a state file image, if it has a whole header.
+pub(crate) fn stamp_of(bytes: &[u8]) -> Option<Stamp> {
+    let header = bytes.get(..HEADER_LEN)?;
+    Some(Stamp {
+        payload_len: u64::from_le_bytes(header[12..20].try_into().expect("8-byte slice")),
+        crc: u32::from_le_bytes(header[20..24].try_into().expect("4-byte slice")),
+    })
+}
+
+/// The [`Stamp`] of the file at `path` (`None` when it is missing or shorter than a header).
+pub(crate) fn stamp_at(path: &Path) -> Result<Option<Stamp>> {
+    let mut header = Vec::with_capacity(HEADER_LEN);
+    match File::open(path) {
+        Ok(f) => f
+            .take(HEADER_LEN as u64)
+            .read_to_end(&mut header)
+            .map_err(|source| Error::Io {
+                path: path.to_path_buf(),
+                op: "read the header of state file",
+                source,
+            })?,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(source) => {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                op: "read the header of state file",
+                source,
+            });
+        }
+    };
+    Ok(stamp_of(&header))
+}
+
+/// `path` with its folder resolved (symbolic links, `.`/`..`), whether or not the file
+/// exists: what decides that two paths name the same state file.
+pub(crate) fn resolved(path: &Path) -> PathBuf {
+    if let Ok(p) = fs::canonicalize(path) {
+        return p;
+    }
+    match (parent_dir(path), path.file_name()) {
+        (Some(dir), Some(name)) => fs::canonicalize(&dir)
+            .map(|d| d.join(name))
+            .unwrap_or_else(|_| path.to_path_buf()),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// Write `bytes` to `path` atomically (see the module docs). The caller holds the lock.
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    write_atomic_with(path, bytes, CrashPoint::None)
+    remove_stale_temps(path);
+    write_atomic_with(path, bytes, CrashPoint::None).map(|_| ())
 }
 
-/// [`write_atomic`] with a simulated crash point for tests.
-pub(crate) fn write_atomic_with(path: &Path, bytes: &[u8], crash: CrashPoint) -> Result<()> {
+/// [`write_atomic`] with a simulated crash point for tests; returns the temporary file used.
+pub(crate) fn write_atomic_with(path: &Path, bytes: &[u8], crash: CrashPoint) -> Result<PathBuf> {
     let tmp = temp_path(path)?;
     let io = |p: &Path, op: &'static str| {
         let p = p.to_path_buf();
@@ -225,19 +486,29 @@ pub(crate) fn write_atomic_with(path: &Path, bytes: &[u8], crash: CrashPoint) ->
     if crash == CrashPoint::MidWrite {
         file.write_all(&bytes[..bytes.len() / 2])
             .map_err(io(&tmp, "write temporary state file"))?;
-        return Ok(());
+        return Ok(tmp);
     }
-    file.write_all(bytes)
-        .map_err(io(&tmp, "write temporary state file"))?;
-    file.sync_all()
-        .map_err(io(&tmp, "flush temporary state file to disk"))?;
+    let written = file
+        .write_all(bytes)
+        .map_err(io(&tmp, "write temporary state file"))
+        .and_then(|()| {
+            file.sync_all()
+                .map_err(io(&tmp, "flush temporary state file to disk"))
+        });
     drop(file);
-    if crash == CrashPoint::BeforeRename {
-        return Ok(());
+    if let Err(e) = written {
+        let _ = fs::remove_file(&tmp);
+        return Err(e);
     }
-    fs::rename(&tmp, path).map_err(io(path, "rename the temporary state file onto"))?;
+    if crash == CrashPoint::BeforeRename {
+        return Ok(tmp);
+    }
+    if let Err(e) = fs::rename(&tmp, path) {
+        let _ = fs::remove_file(&tmp);
+        return Err(io(path, "rename the temporary state file onto")(e));
+    }
     sync_parent_dir(path)?;
-    Ok(())
+    Ok(tmp)
 }
 
 /// Flush the directory holding `path`, so that a rename in it is durable.
@@ -271,14 +542,19 @@ pub(crate) fn read(path: &Path) -> Result<Vec<u8>> {
     })
 }
 
-/// Save `value` to `path` as a versioned state file (see the module docs), atomically:
-/// on any error, or a crash, the file previously at `path` is untouched.
+/// Save `value` to `path` as a versioned state file (see the module docs), atomically and
+/// under the file's lock (waiting up to [`DEFAULT_LOCK_TIMEOUT`]): on any error, or a crash,
+/// the file previously at `path` is untouched.
 ///
 /// # Errors
-/// [`Error::Encode`] if `value` cannot be serialized, [`Error::Io`] naming the file or
+/// [`Error::Locked`], [`Error::WouldOverwrite`] for an existing file that is not a state
+/// file, [`Error::Encode`] if `value` cannot be serialized, [`Error::Io`] naming the file or
 /// directory whose creation, write, flush or rename failed.
 pub fn save<T: Serialize>(path: &Path, value: &T) -> Result<()> {
-    write_atomic(path, &encode(value)?)
+    let bytes = encode(value)?;
+    let _lock = StateLock::acquire(path, DEFAULT_LOCK_TIMEOUT)?;
+    check_target(path)?;
+    write_atomic(path, &bytes)
 }
 
 /// Load a versioned state file from `path`.
@@ -323,7 +599,7 @@ mod tests {
     fn header_layout_is_as_documented() {
         let bytes = encode(&payload(4)).unwrap();
         assert_eq!(&bytes[..8], b"TANDEMST");
-        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 5);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 6);
         let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
         assert_eq!(len as usize, bytes.len() - HEADER_LEN);
         let crc = u32::from_le_bytes(bytes[20..24].try_into().unwrap());
@@ -337,10 +613,16 @@ mod tests {
         let value = payload(50);
         save(&path, &value).unwrap();
         assert_eq!(load::<Payload>(&path).unwrap(), value);
-        // Overwriting replaces the content and leaves no temporary file behind.
+        // Overwriting replaces the content and leaves no temporary file behind: only the
+        // state file and its lock file.
         save(&path, &payload(7)).unwrap();
         assert_eq!(load::<Payload>(&path).unwrap(), payload(7));
-        assert!(!temp_path(&path).unwrap().exists());
+        let mut names: Vec<String> = fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        assert_eq!(names, [".state.tandem.lock", "state.tandem"]);
         fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -413,7 +695,7 @@ mod tests {
             }
         ));
         let msg = err.to_string();
-        assert!(msg.contains("v.tandem") && msg.contains('7') && msg.contains('5'));
+        assert!(msg.contains("v.tandem") && msg.contains('7') && msg.contains("4 to 6"));
     }
 
     #[test]
@@ -423,14 +705,83 @@ mod tests {
         let old = payload(30);
         save(&path, &old).unwrap();
         let new_bytes = encode(&payload(40)).unwrap();
+        let mut stale = Vec::new();
         for crash in [CrashPoint::MidWrite, CrashPoint::BeforeRename] {
-            write_atomic_with(&path, &new_bytes, crash).unwrap();
-            assert!(temp_path(&path).unwrap().exists());
+            let tmp = write_atomic_with(&path, &new_bytes, crash).unwrap();
+            assert!(tmp.exists());
             assert_eq!(load::<Payload>(&path).unwrap(), old, "{crash:?}");
+            stale.push(tmp);
         }
-        // The next save overwrites the stale temporary file and succeeds.
+        assert_ne!(
+            stale[0], stale[1],
+            "every save has a temporary file of its own"
+        );
+        // The next save succeeds and removes the crashed writers' temporary files.
         save(&path, &payload(40)).unwrap();
         assert_eq!(load::<Payload>(&path).unwrap(), payload(40));
+        assert!(stale.iter().all(|t| !t.exists()));
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn temporary_names_are_recognised_exactly() {
+        assert!(is_temp_of(".cell.tandem.123-0.tmp", "cell.tandem"));
+        for other in [
+            ".cell.tandem.tmp",
+            ".cell.tandem.lock",
+            ".cell.tandem.x-1.tmp",
+            ".cell.tandem.1-.tmp",
+            ".other.tandem.1-2.tmp",
+            "cell.tandem.1-2.tmp",
+        ] {
+            assert!(!is_temp_of(other, "cell.tandem"), "{other}");
+        }
+    }
+
+    #[test]
+    fn a_save_never_replaces_a_file_of_other_content() {
+        let dir = tmp_dir("target");
+        let csv = dir.join("demo_3.csv");
+        fs::write(&csv, "t,x\n0,1\n").unwrap();
+        let err = save(&csv, &payload(3)).unwrap_err();
+        assert!(matches!(err, Error::WouldOverwrite { .. }), "{err}");
+        let msg = err.to_string();
+        assert!(
+            msg.contains("demo_3.csv") && msg.contains("not a tandem state file"),
+            "{msg}"
+        );
+        assert_eq!(fs::read_to_string(&csv).unwrap(), "t,x\n0,1\n");
+        let err = save(&dir, &payload(3)).unwrap_err();
+        assert!(err.to_string().contains("is a folder"), "{err}");
+        // Missing, empty and state files may be replaced.
+        let empty = dir.join("empty.tandem");
+        fs::write(&empty, b"").unwrap();
+        save(&empty, &payload(3)).unwrap();
+        save(&empty, &payload(4)).unwrap();
+        assert_eq!(load::<Payload>(&empty).unwrap(), payload(4));
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_second_writer_waits_for_the_lock_then_gives_up_with_a_clear_error() {
+        let dir = tmp_dir("lock");
+        let path = dir.join("cell.tandem");
+        let held = StateLock::acquire(&path, Duration::ZERO).unwrap();
+        assert_eq!(held.lock_path(), dir.join(".cell.tandem.lock"));
+        let start = Instant::now();
+        let err = StateLock::acquire(&path, Duration::from_millis(50)).unwrap_err();
+        assert!(start.elapsed() >= Duration::from_millis(50));
+        assert!(matches!(err, Error::Locked { .. }), "{err}");
+        assert!(err.to_string().contains("another process"), "{err}");
+        // Another thread's save waits while the lock is held and goes through once it is
+        // released.
+        let p2 = path.clone();
+        let writer = std::thread::spawn(move || save(&p2, &payload(5)));
+        std::thread::sleep(Duration::from_millis(100));
+        assert!(!path.exists(), "the save waited for the lock");
+        drop(held);
+        writer.join().unwrap().unwrap();
+        assert_eq!(load::<Payload>(&path).unwrap(), payload(5));
         fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -135,7 +135,7 @@ fn a_version_4_file_loads_as_the_same_two_robot_schedule() {
     assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 4);
     let old = Planner::load(v4_path()).unwrap();
     let new = Planner::load(golden_path()).unwrap();
-    // The same planner: the current golden file is the same inputs written as version 5.
+    // The same planner: the current golden file is the same inputs written as version 6.
     assert_eq!(old.params(), new.params());
     assert_eq!(old.model().mean(), new.model().mean());
     assert_eq!(old.model().count(), new.model().count());
@@ -145,13 +145,16 @@ fn a_version_4_file_loads_as_the_same_two_robot_schedule() {
     assert_eq!(old.schedule().offsets_s.len(), 1);
     assert_eq!(old.outcome(), new.outcome());
     validate(old.problem(), old.schedule()).unwrap();
-    // Saving it writes the current version, byte for byte the golden file.
+    // Saving it writes the current version: byte for byte the version 5 file saved again
+    // (neither knows the fingerprint of the round it holds).
     let dir = tmp_dir("v4");
     let again = dir.join("again.tandem");
     old.save(&again).unwrap();
+    let v5_again = dir.join("v5_again.tandem");
+    Planner::load(v5_path()).unwrap().save(&v5_again).unwrap();
     assert!(
-        std::fs::read(&again).unwrap() == std::fs::read(golden_path()).unwrap(),
-        "a version 4 file saved again is not the version 5 golden file"
+        std::fs::read(&again).unwrap() == std::fs::read(&v5_again).unwrap(),
+        "a version 4 file saved again is not the version 5 file saved again"
     );
     // A version 4 header on a version 5 payload does not decode: a clear error, no panic.
     let mut wrong = std::fs::read(golden_path()).unwrap();
@@ -161,6 +164,42 @@ fn a_version_4_file_loads_as_the_same_two_robot_schedule() {
     let err = Planner::load(&path).unwrap_err();
     assert!(matches!(err, Error::Corrupt { .. }), "{err}");
     assert_names(&err, &path);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `tests/fixtures/example_v5.tandem`: the golden state file as format version 5 wrote it
+/// (no round fingerprints), copied before the format became version 6.
+fn v5_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/example_v5.tandem")
+}
+
+#[test]
+fn a_version_5_file_loads_as_the_same_planner_without_round_fingerprints() {
+    let v5 = std::fs::read(v5_path()).unwrap();
+    assert_eq!(u32::from_le_bytes(v5[8..12].try_into().unwrap()), 5);
+    let old = Planner::load(v5_path()).unwrap();
+    let new = Planner::load(golden_path()).unwrap();
+    assert_eq!(old.params(), new.params());
+    assert_eq!(old.model().mean(), new.model().mean());
+    assert_eq!(old.confidence(), new.confidence());
+    assert_eq!(old.outcome(), new.outcome());
+    assert_eq!(old.pairs_recorded(), new.pairs_recorded());
+    // Version 6 only appends the fingerprints to version 5's payload: the golden payload
+    // starts with the version 5 payload, then the list of one round fingerprint.
+    let golden = std::fs::read(golden_path()).unwrap();
+    let (v5_payload, v6_payload) = (&v5[24..], &golden[24..]);
+    assert!(v6_payload.starts_with(v5_payload));
+    assert_eq!(v6_payload[v5_payload.len()], 1, "one round fingerprint");
+    // Saved again, it is version 6 with no fingerprint (an empty list).
+    let dir = tmp_dir("v5");
+    let again = dir.join("again.tandem");
+    old.save(&again).unwrap();
+    let bytes = std::fs::read(&again).unwrap();
+    assert_eq!(
+        u32::from_le_bytes(bytes[8..12].try_into().unwrap()),
+        FORMAT_VERSION
+    );
+    assert_eq!(&bytes[24..], [v5_payload, &[0]].concat().as_slice());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

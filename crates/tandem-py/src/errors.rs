@@ -15,7 +15,7 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 
-use pyo3::exceptions::PyException;
+use pyo3::exceptions::{PyException, PyUserWarning};
 use pyo3::prelude::*;
 
 use crate::facade::{TandemError as Facade, Violation, errors};
@@ -56,6 +56,14 @@ pyo3::create_exception!(
     "An infeasible scheduling problem, a schedule that violates Eq. 20, or a schedule run\n\
      at another control tick than the one its margins were checked at.\n\n\
      Attribute: ``violation`` (name of the broken rule, e.g. ``GradientOutOfBounds``, or ``None``)."
+);
+pyo3::create_exception!(
+    tandem,
+    DataWarning,
+    PyUserWarning,
+    "Data that was taken in, but not as given or not without doubt: a file without a time\n\
+     column (the sample period it was assumed to have), an execution resampled to the model's\n\
+     period, a demonstration of unusual length. The message names the file and the fix."
 );
 pyo3::create_exception!(
     tandem,
@@ -216,7 +224,18 @@ fn classify_lfd(e: &errors::Lfd) -> Kind {
             file, line, column, ..
         } => located(file, *line, *column),
         E::EmptyFile { file } => located(file, 1, 1),
+        E::TimeLikeChannel {
+            file,
+            line: Some(line),
+            column: Some(column),
+            ..
+        } => located(file, *line, *column),
+        E::TimeLikeChannel { file, .. } => input_at(Some(file)),
         E::Io { file, .. }
+        | E::DemonstrationLength { file, .. }
+        | E::TruncatedExecution { file, .. }
+        | E::ExecutionDuration { file, .. }
+        | E::CoarseExecution { file, .. }
         | E::ChannelMismatch { file, .. }
         | E::PartialQuaternionBlock { file, .. }
         | E::ReservedChannelName { file, .. }
@@ -276,11 +295,14 @@ fn classify_facade(e: &Facade) -> Kind {
         | Facade::NotAStateFile { path }
         | Facade::UnsupportedVersion { path, .. }
         | Facade::Truncated { path, .. }
-        | Facade::Corrupt { path, .. } => Kind::StateFile { path: path.clone() },
+        | Facade::Corrupt { path, .. }
+        | Facade::Locked { path, .. }
+        | Facade::WouldOverwrite { path, .. }
+        | Facade::Changed { path } => Kind::StateFile { path: path.clone() },
         Facade::Inconsistent { .. } | Facade::Encode { .. } => Kind::StateFile {
             path: PathBuf::new(),
         },
-        Facade::BadExecution { .. } => input_at(None),
+        Facade::BadExecution { .. } | Facade::DuplicateRound { .. } => input_at(None),
         Facade::RobotCount { .. } => param("robots"),
         Facade::Lfd(l) => classify_lfd(l),
         Facade::Confidence(c) => classify_confidence(c),
@@ -355,6 +377,13 @@ impl From<Error> for PyErr {
             raise(py, message, kind).unwrap_or_else(|setattr_failed| setattr_failed)
         })
     }
+}
+
+/// Raises `message` as a `tandem.DataWarning` (Python's warning filters decide whether it is
+/// shown, ignored or turned into an error).
+pub(crate) fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
+    let text = std::ffi::CString::new(message.replace('\0', " ")).expect("no NUL left");
+    PyErr::warn(py, &py.get_type::<DataWarning>(), &text, 1)
 }
 
 /// Runs `f`, turning a panic into [`Error::Panic`] so that it reaches Python as

@@ -1,7 +1,8 @@
 //! Every item this crate uses from the `tandem` facade, in one place.
 
 pub(crate) use tandem::confidence::{BetaParams, Observations, posterior, prior};
-pub(crate) use tandem::lfd::{DEFAULT_DT_S, Demonstration, Execution, TaskModel};
+pub(crate) use tandem::lfd::{DEFAULT_DT_S, Demonstration, Execution, TaskModel, length_warnings};
+pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{
     Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, derive_seed,
 };

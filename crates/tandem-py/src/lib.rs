@@ -46,11 +46,13 @@ mod _tandem {
     use crate::coordinator::{PyCoordinator, PyTick};
     #[pymodule_export]
     use crate::errors::{
-        InputError, InternalError, ParamError, ScheduleError, StateFileError, TandemError,
+        DataWarning, InputError, InternalError, ParamError, ScheduleError, StateFileError,
+        TandemError,
     };
     #[pymodule_export]
     use crate::planner::{
-        PyConfidence, PyModel, PyObservations, PyPlanner, default_params, fit, fit_model,
+        PyConfidence, PyModel, PyObservations, PyPlanner, PyStateEdit, default_params, fit,
+        fit_model,
     };
     #[pymodule_export]
     use crate::schedule::{PyProblem, PySchedule};

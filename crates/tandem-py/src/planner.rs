@@ -3,16 +3,18 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
+use std::time::Duration;
 
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
 use crate::arrays::{flags, matrix, out_flags, out_matrix, out_vector, repr_list, vector};
-use crate::errors::{Error, Result, guard};
+use crate::errors::{Error, Result, guard, warn};
 use crate::facade::{
-    BetaParams, DEFAULT_DT_S, Demonstration, Execution, ExecutionRecord, Observations, Planner,
-    PlannerParams, RecordReport, TaskModel, derive_seed, errors, posterior, prior,
+    BetaParams, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, Demonstration, Execution, ExecutionRecord,
+    Observations, Planner, PlannerParams, RecordReport, StateLock, TaskModel, derive_seed, errors,
+    length_warnings, posterior, prior,
 };
 use crate::params::{from_py, serialize_to_py};
 use crate::schedule::PyProblem;
@@ -155,6 +157,32 @@ fn demonstrations(
         .collect()
 }
 
+/// Raises the `DataWarning`s of a set of demonstrations: the period assumed for a file
+/// without a time column, and lengths far from the median (`tandem_lfd::length_warnings`).
+fn warn_demonstrations(py: Python<'_>, demos: &[Demonstration]) -> PyResult<()> {
+    for d in demos {
+        if let Some(note) = d.period_note() {
+            warn(py, &note)?;
+        }
+    }
+    for w in length_warnings(demos) {
+        warn(py, &w)?;
+    }
+    Ok(())
+}
+
+/// The timeout of a lock wait given in seconds from Python (`None`: the default, 60 s).
+fn lock_timeout(timeout_s: Option<f64>) -> Result<Duration> {
+    match timeout_s {
+        None => Ok(DEFAULT_LOCK_TIMEOUT),
+        Some(t) if t.is_finite() && t >= 0.0 => Ok(Duration::from_secs_f64(t)),
+        Some(t) => Err(Error::param(
+            "timeout_s",
+            format!("{t} is not a finite number ≥ 0"),
+        )),
+    }
+}
+
 /// Planner parameters from `params` (None, a dict or a TOML path), checked.
 fn planner_params(params: Option<&Bound<'_, PyAny>>) -> Result<PlannerParams> {
     let p: PlannerParams = from_py(params, "params")?;
@@ -198,6 +226,7 @@ pub(crate) fn fit(
 ) -> PyResult<PyPlanner> {
     let demos = demonstrations(demos, channels.as_deref(), dt_s)?;
     let params = planner_params(params)?;
+    warn_demonstrations(py, &demos)?;
     let planner = py.detach(|| guard(|| Ok(Planner::with_robots(&demos, params, robots)?)))?;
     Ok(PyPlanner { inner: planner })
 }
@@ -216,6 +245,7 @@ pub(crate) fn fit_model(
 ) -> PyResult<PyModel> {
     let demos = demonstrations(demos, channels.as_deref(), dt_s)?;
     let params = planner_params(params)?;
+    warn_demonstrations(py, &demos)?;
     let model = py.detach(|| guard(|| Ok(TaskModel::fit(&demos, &params.fit)?)))?;
     Ok(PyModel {
         source: ModelSource::Owned(Arc::new(model)),
@@ -263,12 +293,16 @@ fn report_dict<'py>(py: Python<'py>, r: &RecordReport) -> PyResult<Bound<'py, Py
     d.set_item("model_update_s", r.model_update.as_secs_f64())?;
     d.set_item("confidence_s", r.confidence.as_secs_f64())?;
     d.set_item("scheduling_s", r.scheduling.as_secs_f64())?;
+    d.set_item("notices", r.notices.clone())?;
     Ok(d)
 }
 
 #[pymethods]
 impl PyPlanner {
     /// Loads a planner from a state file written by :meth:`save` or by the command line.
+    /// Reading takes no lock (saves are atomic); the planner remembers the file's content,
+    /// so :meth:`save` into the same file refuses to overwrite what another process saved
+    /// into it meanwhile.
     ///
     /// Raises:
     ///     StateFileError: the file is missing, not a state file, of another format version,
@@ -279,14 +313,45 @@ impl PyPlanner {
         Ok(PyPlanner { inner })
     }
 
-    /// Saves the planner to ``path`` atomically (temporary file, fsync, rename): on error or
-    /// a crash the previous file at ``path`` is intact.
+    /// A read–modify–write of the state file ``path`` under its lock (the lock
+    /// ``tandem record`` takes): ``with tandem.Planner.locked(path) as planner: ...`` waits
+    /// up to ``timeout_s`` seconds (default 60) for another writer, loads the planner, and
+    /// saves it when the block ends without an exception (nothing is saved otherwise); the
+    /// lock is held throughout, so no other writer can record in between.
     ///
     /// Raises:
-    ///     StateFileError: the file cannot be written (``path`` names it).
-    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+    ///     StateFileError: the lock is still held by another writer after ``timeout_s``, or
+    ///         the file cannot be loaded or saved (``path`` names it).
+    #[staticmethod]
+    #[pyo3(signature = (path, timeout_s=None))]
+    fn locked(path: PathBuf, timeout_s: Option<f64>) -> PyResult<PyStateEdit> {
+        Ok(PyStateEdit {
+            path,
+            timeout: lock_timeout(timeout_s)?,
+            lock: None,
+            planner: None,
+        })
+    }
+
+    /// Saves the planner to ``path`` atomically (temporary file with a name of its own,
+    /// fsync, rename) under the file's lock, waiting up to ``timeout_s`` seconds (default
+    /// 60) for another writer: on error or a crash the previous file at ``path`` is intact.
+    /// Refuses to replace a file that is not a state file, and, when this planner was loaded
+    /// from (or saved to) ``path``, a file another process saved into since.
+    ///
+    /// Raises:
+    ///     StateFileError: the file cannot be written, is not a state file, changed since the
+    ///         load, or stays locked (``path`` names it).
+    #[pyo3(signature = (path, timeout_s=None))]
+    fn save(&self, py: Python<'_>, path: PathBuf, timeout_s: Option<f64>) -> PyResult<()> {
+        let timeout = lock_timeout(timeout_s)?;
         let inner = &self.inner;
-        py.detach(|| guard(|| Ok(inner.save(&path)?)))?;
+        py.detach(|| {
+            guard(|| {
+                let lock = StateLock::acquire(&path, timeout)?;
+                Ok(inner.save_locked(&lock)?)
+            })
+        })?;
         Ok(())
     }
 
@@ -308,12 +373,25 @@ impl PyPlanner {
     ///     corrected: per robot, a ``(T_k,)`` bool array: the operator corrected the sample
     ///         (only read where supervised).
     ///     channels: column names of the arrays (default: the model's channels).
+    ///     dt_s: sample period (s) of the arrays and of files without a ``t`` column
+    ///         (default: the control tick of the current schedule, ``schedule.tick_s``: one
+    ///         sample per tick of the schedule the round ran). A log finer than the model's
+    ///         ``Δt_s`` is resampled to it (a ``DataWarning`` says so); a coarser one is
+    ///         refused.
+    ///
+    /// Every execution must cover the whole task and last no less than half the fastest and
+    /// no more than twice the slowest demonstrated execution (a log taken at another rate
+    /// than ``dt_s`` says fails this); the same round recorded twice is refused.
     ///
     /// Returns:
     ///     dict: ``newly_high`` (samples latched high-confidence), ``source`` of the new
-    ///     schedule, its ``t_total_s`` (Eq. 13, s), and wall times ``model_update_s``,
-    ///     ``confidence_s``, ``scheduling_s``.
-    #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None))]
+    ///     schedule, its ``t_total_s`` (Eq. 13, s), wall times ``model_update_s``,
+    ///     ``confidence_s``, ``scheduling_s``, and ``notices`` (what was resampled).
+    #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None, dt_s=None))]
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "the Python signature: one list per robot and two keywords"
+    )]
     fn record_round<'py>(
         &mut self,
         py: Python<'py>,
@@ -322,7 +400,14 @@ impl PyPlanner {
         supervised: &Bound<'py, PyAny>,
         corrected: &Bound<'py, PyAny>,
         channels: Option<Vec<String>>,
+        dt_s: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        if let Some(dt) = dt_s
+            && !(dt.is_finite() && dt > 0.0)
+        {
+            return Err(Error::param("dt_s", format!("{dt} s is not a finite period > 0")).into());
+        }
+        let dt_s = dt_s.unwrap_or(self.inner.schedule().tick_s);
         let model = self.inner.model();
         let n = self.inner.n_robots();
         // Arrays default to the model's channel order; a file's header may list the
@@ -339,12 +424,11 @@ impl PyPlanner {
         );
         let mut records = Vec::with_capacity(n);
         for i in 0..n {
-            let demonstration = demonstration(
-                &execs[i],
-                &format!("executions[{i}]"),
-                names,
-                Some(model.dt_s()),
-            )?;
+            let demonstration =
+                demonstration(&execs[i], &format!("executions[{i}]"), names, Some(dt_s))?;
+            if let Some(note) = demonstration.period_note() {
+                warn(py, &note)?;
+            }
             let ref_time_log = vector(
                 &logs[i],
                 &format!("ref_time_logs[{i}]"),
@@ -369,12 +453,19 @@ impl PyPlanner {
         }
         let inner = &mut self.inner;
         let report = py.detach(|| guard(|| Ok(inner.record_round(&records)?)))?;
+        for note in &report.notices {
+            warn(py, note)?;
+        }
         report_dict(py, &report)
     }
 
     /// :meth:`record_round` under the paper's name, for a two-robot planner (the same
     /// arguments, one entry per robot).
-    #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None))]
+    #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None, dt_s=None))]
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "the Python signature: one list per robot and two keywords"
+    )]
     fn record_pair<'py>(
         &mut self,
         py: Python<'py>,
@@ -383,6 +474,7 @@ impl PyPlanner {
         supervised: &Bound<'py, PyAny>,
         corrected: &Bound<'py, PyAny>,
         channels: Option<Vec<String>>,
+        dt_s: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         self.record_round(
             py,
@@ -391,6 +483,7 @@ impl PyPlanner {
             supervised,
             corrected,
             channels,
+            dt_s,
         )
     }
 
@@ -403,7 +496,8 @@ impl PyPlanner {
     ///     seed: the sampler's seed (default: the stream ``tandem schedule`` uses without
     ///         ``--seed``, so both give the same schedule for the same state).
     ///     tick_s: control tick (real s) the margins are checked at and the schedule runs at
-    ///         (default: the parameters', else the reference period ``Δt_s``).
+    ///         (default: the current schedule's tick). Later :meth:`record_round` calls keep
+    ///         the tick chosen here.
     ///
     /// Returns:
     ///     Schedule: the new current schedule.
@@ -426,9 +520,8 @@ impl PyPlanner {
         if let Some(n) = samples {
             sp.samples = n;
         }
-        if tick_s.is_some() {
-            sp.tick_s = tick_s;
-        }
+        // `None` keeps the current schedule's tick (the planner's rule).
+        sp.tick_s = tick_s;
         let inner = &mut self.inner;
         py.detach(|| guard(|| Ok(inner.reschedule(&sp).map(|_| ())?)))?;
         Ok(self.current_schedule())
@@ -502,6 +595,65 @@ impl PyPlanner {
             self.inner.pairs_recorded(),
             self.inner.confidence().high_share(),
             self.inner.outcome().t_total_s
+        )
+    }
+}
+
+/// A read–modify–write of a state file under its lock: what :meth:`Planner.locked`
+/// returns, a context manager (``with ... as planner:``).
+#[pyclass(module = "tandem", name = "StateEdit")]
+pub(crate) struct PyStateEdit {
+    path: PathBuf,
+    timeout: Duration,
+    lock: Option<StateLock>,
+    planner: Option<Py<PyPlanner>>,
+}
+
+#[pymethods]
+impl PyStateEdit {
+    /// Takes the lock (waiting up to the timeout) and loads the planner.
+    fn __enter__(&mut self, py: Python<'_>) -> PyResult<Py<PyPlanner>> {
+        if self.lock.is_some() {
+            return Err(Error::input("locked", "this block is already open").into());
+        }
+        let (path, timeout) = (self.path.clone(), self.timeout);
+        let (lock, inner) = py.detach(|| {
+            guard(|| {
+                let lock = StateLock::acquire(&path, timeout)?;
+                let inner = Planner::load(&path)?;
+                Ok((lock, inner))
+            })
+        })?;
+        let planner = Py::new(py, PyPlanner { inner })?;
+        self.lock = Some(lock);
+        self.planner = Some(planner.clone_ref(py));
+        Ok(planner)
+    }
+
+    /// Saves the planner if the block raised nothing, then releases the lock. Never
+    /// swallows the block's exception.
+    fn __exit__(
+        &mut self,
+        py: Python<'_>,
+        exc_type: Option<&Bound<'_, PyAny>>,
+        _exc: Option<&Bound<'_, PyAny>>,
+        _tb: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<bool> {
+        let (lock, planner) = (self.lock.take(), self.planner.take());
+        if let (Some(lock), Some(planner), None) = (&lock, &planner, exc_type) {
+            let p = planner.bind(py).try_borrow()?;
+            let inner = &p.inner;
+            py.detach(|| guard(|| Ok(inner.save_locked(lock)?)))?;
+        }
+        drop(lock);
+        Ok(false)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "StateEdit(path={:?}, locked={})",
+            self.path.display().to_string(),
+            self.lock.is_some()
         )
     }
 }

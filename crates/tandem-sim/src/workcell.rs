@@ -987,9 +987,10 @@ mod tests {
         assert!(msg.contains("0.005 s") && msg.contains("0.01 s"), "{msg}");
         let err = run_pair_with(&planner, |_, _| true, &p, &mut rng);
         assert!(matches!(err, Err(Error::TickMismatch { .. })));
-        // Re-scheduled at the workcell's own tick (the sampler's default) it runs.
+        // Re-scheduled at the workcell's own tick it runs (`tick_s: None` would keep the
+        // schedule's half tick: a re-schedule keeps the tick a user chose).
         let own = tandem_schedule::SamplerParams {
-            tick_s: None,
+            tick_s: Some(dt_s),
             ..half
         };
         planner.reschedule(&own).unwrap();

@@ -194,6 +194,7 @@ impl TaskModel {
     /// parameters, alignment failure.
     pub fn fit(demos: &[Demonstration], params: &FitParams) -> Result<Self> {
         let (demos, layout) = checked(demos, params)?;
+        crate::checks::check_lengths(&demos)?;
         let alignment = choose_alignment(&demos, &layout, params)?;
         let ordered: Vec<&Demonstration> = alignment.order.iter().map(|&i| &demos[i]).collect();
         let mut model = Self::fit_from_warps(

@@ -74,6 +74,14 @@ impl Layout {
                     .then(|| format!("a rotation-vector coordinate of quaternion block `{block}`"))
             })
         };
+        if let Some(channel) = channels.iter().find(|n| crate::checks::time_like(n)) {
+            return Err(Error::TimeLikeChannel {
+                file: demo.source().into(),
+                line: None,
+                column: None,
+                channel: channel.clone(),
+            });
+        }
         if let Some((channel, why)) = channels
             .iter()
             .find_map(|name| derived(name).map(|why| (name, why)))

@@ -54,7 +54,7 @@ mod params;
 mod stats;
 
 pub use corrections::Corrections;
-pub use execution::Execution;
+pub use execution::{EXECUTION_DURATION_RATIO, Execution, Resampled};
 pub use params::{FitParams, Reference};
 
 use corrections::CorrectionTable;
