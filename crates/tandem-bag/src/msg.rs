@@ -85,7 +85,8 @@ impl MsgType {
     /// `mcap-ros2-support` parse).
     #[must_use]
     pub fn schema_text(self) -> String {
-        const HEADER: &str = "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n";
+        const HEADER: &str =
+            "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n";
         const TIME: &str = "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n";
         const VECTOR3: &str = "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z\n";
         let parts: Vec<&str> = match self {
@@ -248,7 +249,8 @@ pub(crate) fn decode(t: MsgType, payload: &[u8], values: &mut Vec<f64>) -> Resul
             } else {
                 from_bytes::<$ty, byteorder::BigEndian>(body)
             };
-            r.map_err(|e| format!("not a valid {} (CDR): {e}", t.ros_name()))?.0
+            r.map_err(|e| format!("not a valid {} (CDR): {e}", t.ros_name()))?
+                .0
         }};
     }
     let plain = |stamp: Option<i64>| Decoded {
@@ -357,8 +359,17 @@ mod tests {
                 stamp: Time { sec: 3, nanosec: 7 },
                 frame_id: "ab".into(),
             },
-            position: Vector3 { x: 1.0, y: 2.0, z: 3.0 },
-            orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 },
+            position: Vector3 {
+                x: 1.0,
+                y: 2.0,
+                z: 3.0,
+            },
+            orientation: Quaternion {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+                w: 1.0,
+            },
         };
         let bytes = encode(&m);
         // sec(4) nanosec(4) len(4) "ab\0"(3) pad(1): the doubles start at body offset 16,
@@ -374,10 +385,8 @@ mod tests {
 
     #[test]
     fn big_endian_and_bad_headers() {
-        let body = cdr_encoding::to_vec::<Float64, byteorder::BigEndian>(&Float64 {
-            data: -2.0,
-        })
-        .unwrap();
+        let body =
+            cdr_encoding::to_vec::<Float64, byteorder::BigEndian>(&Float64 { data: -2.0 }).unwrap();
         let mut be = vec![0, 0, 0, 0];
         be.extend(body);
         let mut v = Vec::new();

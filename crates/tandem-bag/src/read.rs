@@ -445,7 +445,10 @@ fn check_selection(topics: &[RawTopic], file: &str, sel: &Selection<'_>) -> Resu
             }
         }
     }
-    for t in topics.iter().filter(|t| t.selected && t.topic != SCHEDULE_TOPIC) {
+    for t in topics
+        .iter()
+        .filter(|t| t.selected && t.topic != SCHEDULE_TOPIC)
+    {
         let Some(schema) = &t.schema else {
             return Err(Error::MissingSchema {
                 file: file.into(),
@@ -462,10 +465,7 @@ fn check_selection(topics: &[RawTopic], file: &str, sel: &Selection<'_>) -> Resu
             });
         }
     }
-    if !topics
-        .iter()
-        .any(|t| t.selected && t.msg_type.is_some())
-    {
+    if !topics.iter().any(|t| t.selected && t.msg_type.is_some()) {
         return Err(Error::NoSupportedTopics {
             file: file.into(),
             found: if topics.is_empty() {
@@ -495,11 +495,13 @@ pub(crate) struct Series {
 
 /// The messages of topic `t` with log time in `window` (`[start, end)`
 /// ns; all when `None`), with times checked: at least 2 messages, strictly increasing, no
-/// gap over [`GAP_FACTOR`] × the median period.
+/// gap over [`GAP_FACTOR`] × the median period (unless `gaps_allowed`: the whole of a run of
+/// several rounds, between which a robot is idle).
 pub(crate) fn series(
     t: &RawTopic,
     file: &str,
     window: Option<(i64, i64)>,
+    gaps_allowed: bool,
 ) -> Result<Series> {
     let use_log = t.stamp_ns.len() != t.log_ns.len() || t.stamp_ns.iter().all(|&s| s == 0);
     let keep: Vec<usize> = (0..t.log_ns.len())
@@ -539,7 +541,7 @@ pub(crate) fn series(
     let mut periods: Vec<i64> = times_ns.windows(2).map(|p| p[1] - p[0]).collect();
     periods.sort_unstable();
     let median_ns = periods[(periods.len() - 1) / 2];
-    for k in 1..times_ns.len() {
+    for k in (1..times_ns.len()).filter(|_| !gaps_allowed) {
         let gap = times_ns[k] - times_ns[k - 1];
         if gap as f64 > GAP_FACTOR * median_ns as f64 {
             return Err(Error::Gap {

@@ -8,9 +8,7 @@ use tandem_lfd::{ChannelKind, ChannelSchema, Demonstration, Execution, Quaternio
 use tandem_planner::ExecutionRecord;
 
 use crate::msg::MsgType;
-use crate::read::{
-    RawTopic, Role, SCHEDULE_TOPIC, Selection, Series, read_topics, series, under,
-};
+use crate::read::{RawTopic, Role, SCHEDULE_TOPIC, Selection, Series, read_topics, series, under};
 use crate::resample::{Grid, Interp, grid, resample_into};
 use crate::{Error, Result};
 
@@ -117,12 +115,10 @@ impl Recording {
     /// # Errors
     /// The model crate's checks ([`Demonstration::new`]).
     pub fn demonstration(&self) -> Result<Demonstration> {
-        Ok(Demonstration::new(
-            self.channel_names.clone(),
-            self.samples.clone(),
-            self.dt_s,
-        )?
-        .with_source(self.source.clone()))
+        Ok(
+            Demonstration::new(self.channel_names.clone(), self.samples.clone(), self.dt_s)?
+                .with_source(self.source.clone()),
+        )
     }
 }
 
@@ -161,7 +157,12 @@ pub fn extend_schema(schema: &mut ChannelSchema, recordings: &[Recording]) {
 /// The resampling plan of a topic's columns.
 fn plan(t: &RawTopic) -> Vec<Interp> {
     match t.msg_type {
-        Some(MsgType::PoseStamped) => vec![Interp::Linear, Interp::Linear, Interp::Linear, Interp::Slerp],
+        Some(MsgType::PoseStamped) => vec![
+            Interp::Linear,
+            Interp::Linear,
+            Interp::Linear,
+            Interp::Slerp,
+        ],
         Some(MsgType::Bool) => vec![Interp::Hold],
         _ => vec![Interp::Linear; t.width()],
     }
@@ -212,11 +213,10 @@ fn grid_topics(
 ) -> Result<(Gridded, Vec<Series>)> {
     let series: Vec<Series> = chosen
         .iter()
-        .map(|&k| series(&topics[k], file, window))
+        .map(|&k| series(&topics[k], file, window, false))
         .collect::<Result<_>>()?;
-    let period_ns = period_ns.unwrap_or_else(|| {
-        series.iter().map(|s| s.median_ns).max().expect("non-empty") as f64
-    });
+    let period_ns = period_ns
+        .unwrap_or_else(|| series.iter().map(|s| s.median_ns).max().expect("non-empty") as f64);
     let refs: Vec<&Series> = series.iter().collect();
     let names: Vec<&str> = chosen.iter().map(|&k| topics[k].topic.as_str()).collect();
     let g = grid(&refs, &names, file, period_ns)?;
@@ -290,7 +290,11 @@ fn channels(
 
 /// The quaternion blocks of the chosen `PoseStamped` topics whose four orientation columns
 /// are kept and named `<stem>qx … <stem>qw`.
-fn quaternion_blocks(topics: &[RawTopic], chosen: &[usize], namespace: Option<&str>) -> Vec<QuaternionBlock> {
+fn quaternion_blocks(
+    topics: &[RawTopic],
+    chosen: &[usize],
+    namespace: Option<&str>,
+) -> Vec<QuaternionBlock> {
     chosen
         .iter()
         .filter(|&&k| topics[k].msg_type == Some(MsgType::PoseStamped))
@@ -375,7 +379,8 @@ fn chosen_topics(
 
 /// Every topic of a bag: type, message count, the channels it gives, its rate and span (for
 /// `tandem inspect`). Topics of a supported type are decoded and checked as [`read_bag`]
-/// would; the error of a damaged one is the result.
+/// would (in a run of several rounds, without the gap check: a robot idles between rounds);
+/// the error of a damaged one is the result.
 ///
 /// # Errors
 /// As [`read_bag`] (for every topic of a supported type).
@@ -388,11 +393,13 @@ pub fn inspect(path: impl AsRef<Path>) -> Result<Vec<TopicInfo>> {
         views: true,
     };
     let topics = read_topics(path, &sel)?;
+    // A run of several rounds: robots idle between rounds, so gaps are expected there.
+    let rounds = round_starts(&topics).len() > 1;
     topics
         .iter()
         .map(|t| {
             if t.selected && t.msg_type.is_some() {
-                let s = series(t, &file, None)?;
+                let s = series(t, &file, None, rounds)?;
                 Ok(info(t, Some(&s), None))
             } else {
                 Ok(info(t, None, None))
@@ -573,8 +580,16 @@ fn read_robot(
     let (g, _) = grid_topics(topics, &chosen, file, window, Some(options.dt_s * 1e9))?;
     let block = |k: usize| chosen.iter().position(|&c| c == k).expect("chosen");
     let ref_time_log = g.column(block(log_k), 0);
-    let supervised: Vec<bool> = g.column(block(sup_k), 0).iter().map(|&v| v != 0.0).collect();
-    let corrected: Vec<bool> = g.column(block(cor_k), 0).iter().map(|&v| v != 0.0).collect();
+    let supervised: Vec<bool> = g
+        .column(block(sup_k), 0)
+        .iter()
+        .map(|&v| v != 0.0)
+        .collect();
+    let corrected: Vec<bool> = g
+        .column(block(cor_k), 0)
+        .iter()
+        .map(|&v| v != 0.0)
+        .collect();
     if let Some(j) = (0..supervised.len()).find(|&j| corrected[j] && !supervised[j]) {
         return Err(layout(format!(
             "robot {robot}: sample {j} (bag time {:.6} s): `corrected` is true but `supervised` \

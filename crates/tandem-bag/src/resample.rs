@@ -47,12 +47,7 @@ impl Grid {
 /// [`Error::Coverage`] when a topic starts later or ends earlier than the first-starting or
 /// last-ending topic by more than [`GAP_FACTOR`] × its own median period;
 /// [`Error::Layout`] when the span holds fewer than 2 grid times.
-pub(crate) fn grid(
-    series: &[&Series],
-    names: &[&str],
-    file: &str,
-    period_ns: f64,
-) -> Result<Grid> {
+pub(crate) fn grid(series: &[&Series], names: &[&str], file: &str, period_ns: f64) -> Result<Grid> {
     let first = |s: &Series| s.times_ns[0];
     let last = |s: &Series| s.times_ns[s.times_ns.len() - 1];
     let (k_first, _) = series
@@ -211,7 +206,10 @@ mod tests {
     #[test]
     fn linear_hold_and_snap() {
         // Messages at 0, 10, 20 ms; grid every 5 ms.
-        let s = series(&[0, 10_000_000, 20_000_000], &[0.0, 1.0, 10.0, 20.0, 4.0, 0.0]);
+        let s = series(
+            &[0, 10_000_000, 20_000_000],
+            &[0.0, 1.0, 10.0, 20.0, 4.0, 0.0],
+        );
         let g = grid(&[&s], &["a"], "f", 5e6).unwrap();
         assert_eq!(g.n, 5);
         let mut out = vec![0.0; 10];
@@ -233,11 +231,20 @@ mod tests {
         let h = std::f64::consts::FRAC_1_SQRT_2;
         // Identity to 90° about z: halfway is 45° about z.
         let q = slerp(&[0.0, 0.0, 0.0, 1.0], &[0.0, 0.0, h, h], 0.5);
-        let (s, c) = (std::f64::consts::FRAC_PI_8.sin(), std::f64::consts::FRAC_PI_8.cos());
-        assert!((q[2] - s).abs() < 1e-12 && (q[3] - c).abs() < 1e-12, "{q:?}");
+        let (s, c) = (
+            std::f64::consts::FRAC_PI_8.sin(),
+            std::f64::consts::FRAC_PI_8.cos(),
+        );
+        assert!(
+            (q[2] - s).abs() < 1e-12 && (q[3] - c).abs() < 1e-12,
+            "{q:?}"
+        );
         // The same rotation given as −q: still the short way, in a's hemisphere.
         let q2 = slerp(&[0.0, 0.0, 0.0, 1.0], &[0.0, 0.0, -h, -h], 0.5);
-        assert!((q2[2] - s).abs() < 1e-12 && (q2[3] - c).abs() < 1e-12, "{q2:?}");
+        assert!(
+            (q2[2] - s).abs() < 1e-12 && (q2[3] - c).abs() < 1e-12,
+            "{q2:?}"
+        );
     }
 
     #[test]

@@ -202,7 +202,8 @@ impl RunWriter {
         }
         let mut meta = BTreeMap::new();
         meta.insert(crate::ROLE_KEY.to_owned(), Role::View.name().to_owned());
-        let schedule = bag.add_json_topic(SCHEDULE_TOPIC, "tandem.Schedule", SCHEDULE_SCHEMA, &meta)?;
+        let schedule =
+            bag.add_json_topic(SCHEDULE_TOPIC, "tandem.Schedule", SCHEDULE_SCHEMA, &meta)?;
         Ok(Self {
             bag,
             robots,
@@ -276,8 +277,11 @@ impl RunWriter {
                         }
                     }
                 }
-                self.bag
-                    .write(topics.ref_sample, t, &Message::Float64(robot.ref_time_log[k]))?;
+                self.bag.write(
+                    topics.ref_sample,
+                    t,
+                    &Message::Float64(robot.ref_time_log[k]),
+                )?;
                 self.bag
                     .write(topics.supervised, t, &Message::Bool(robot.supervised[k]))?;
                 self.bag

@@ -187,10 +187,9 @@ impl BagWriter {
                     .into(),
             });
         }
-        let name = path.file_name().map_or_else(
-            || "bag.mcap".into(),
-            |n| n.to_string_lossy().into_owned(),
-        );
+        let name = path
+            .file_name()
+            .map_or_else(|| "bag.mcap".into(), |n| n.to_string_lossy().into_owned());
         let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
         let out = File::create(&tmp).map_err(|source| Error::Io {
             file: tmp.display().to_string(),
@@ -410,7 +409,8 @@ pub struct TopicSpec {
     pub start_ns: i64,
 }
 
-/// Writes `demo` as a bag of topics at their own rates: each topic's messages on its own
+/// Writes `demo` as a ROS 2 recording would hold it (no tandem metadata, so the reader names
+/// the channels from the topics): each topic's messages on its own
 /// period from its start, its values resampled from the demonstration (sample `t` at
 /// `t·Δt_s` from the demonstration's start at bag time 0) by the reader's interpolation
 /// (linear, slerp for a pose's orientation, held for a `Bool`), over the demonstration's
@@ -442,7 +442,10 @@ pub fn write_demonstration(
         if !(spec.rate_hz.is_finite() && spec.rate_hz > 0.0) || spec.start_ns < 0 {
             return Err(Error::BadParam {
                 name: "topics",
-                why: format!("{}: rate {} Hz, start {} ns", spec.topic, spec.rate_hz, spec.start_ns),
+                why: format!(
+                    "{}: rate {} Hz, start {} ns",
+                    spec.topic, spec.rate_hz, spec.start_ns
+                ),
             });
         }
         let width = match spec.msg_type {
@@ -464,12 +467,13 @@ pub fn write_demonstration(
             .iter()
             .map(|c| match c {
                 None => Ok(None),
-                Some(name) => demo.channel_index(name).map(Some).ok_or_else(|| {
-                    Error::BadParam {
+                Some(name) => demo
+                    .channel_index(name)
+                    .map(Some)
+                    .ok_or_else(|| Error::BadParam {
                         name: "topics",
                         why: format!("{}: the demonstration has no channel `{name}`", spec.topic),
-                    }
-                }),
+                    }),
             })
             .collect::<Result<_>>()?;
         let period_ns = 1e9 / spec.rate_hz;
@@ -487,10 +491,9 @@ pub fn write_demonstration(
         // the demonstration; otherwise linearly and renormalized below.
         let plan = slerp_plan(vec![Interp::Linear; m], spec, &cols);
         resample_into(&demo_series, m, &plan, &grid, &mut all, m, 0);
-        let mut metadata = BTreeMap::new();
-        let fields: Vec<String> = spec.channels.iter().map(|c| c.clone().unwrap_or_default()).collect();
-        metadata.insert(FIELDS_KEY.to_owned(), fields.join(","));
-        let id = bag.add_topic(&spec.topic, spec.msg_type, &metadata)?;
+        // No tandem metadata: the bag looks like any rosbag2 recording, and its channels are
+        // named from the topics.
+        let id = bag.add_topic(&spec.topic, spec.msg_type, &BTreeMap::new())?;
         let zeros = vec![0.0; spec.joints.len()];
         for j in 0..grid.n {
             let row = &all[j * m..(j + 1) * m];

@@ -12,7 +12,7 @@ use crate::cli::{
     Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
 };
 use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_json, source_name};
-use crate::{input, plot, sim, state_io};
+use crate::{bag, input, plot, sim, state_io};
 
 /// Runs one command.
 pub(crate) fn run(cli: Cli) -> Result<()> {
@@ -73,11 +73,8 @@ fn fit(a: &FitArgs) -> Result<()> {
         bail!("--robots {}: one operator runs 1 to {max} robots", a.robots);
     }
     state_io::check_file_target(&a.output)?;
-    let demos = a
-        .demos
-        .iter()
-        .map(|p| input::read_demo(p, a.dt))
-        .collect::<Result<Vec<Demonstration>>>()?;
+    let demos: Vec<Demonstration> =
+        bag::read_demos(&a.demos, a.dt, a.rate, &a.topics, &mut params.fit.schema)?;
     if demos.len() < 2 {
         bail!(
             "{}: only one demonstration; the variability of the task needs at least 2 \
@@ -271,7 +268,7 @@ fn record(a: &RecordArgs) -> Result<()> {
         ("--log", &a.log),
         ("--corrections", &a.corrections),
     ] {
-        if v.len() != n {
+        if v.len() != n && a.bags.is_empty() {
             bail!(
                 "{flag} given {} time(s); {} has {n} robots, so a round needs exactly {n} \
                  (robot 1 first)",
@@ -291,7 +288,11 @@ fn record(a: &RecordArgs) -> Result<()> {
             &a.corrections[i],
         )
     };
-    let round = (0..n).map(r).collect::<Result<Vec<_>>>()?;
+    let round = if a.bags.is_empty() {
+        (0..n).map(r).collect::<Result<Vec<_>>>()?
+    } else {
+        bag::read_round(&planner, &a.bags, a.round, &a.topics)?
+    };
     let report = planner.record_round(&round).context(if n == 2 {
         "cannot record the pair"
     } else {
@@ -319,6 +320,9 @@ fn record(a: &RecordArgs) -> Result<()> {
 }
 
 fn inspect(a: &InspectArgs) -> Result<()> {
+    if tandem::bag::is_bag(&a.state) {
+        return bag::inspect_bag(&a.state, a.json);
+    }
     let planner = state_io::load(&a.state)?;
     let model = planner.model();
     let conf = planner.confidence();
