@@ -533,8 +533,8 @@ pub(crate) fn series(
                 topic: t.topic.clone(),
                 index: first_index + k,
                 clock,
-                this_s: times_ns[k] as f64 * 1e-9,
-                previous_s: times_ns[k - 1] as f64 * 1e-9,
+                this_s: times_ns[k] as f64 / 1e9,
+                previous_s: times_ns[k - 1] as f64 / 1e9,
             });
         }
     }
@@ -548,8 +548,8 @@ pub(crate) fn series(
                 file: file.into(),
                 topic: t.topic.clone(),
                 index: first_index + k,
-                gap_s: gap as f64 * 1e-9,
-                median_s: median_ns as f64 * 1e-9,
+                gap_s: gap as f64 / 1e9,
+                median_s: median_ns as f64 / 1e9,
             });
         }
     }

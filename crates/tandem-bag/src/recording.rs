@@ -180,11 +180,11 @@ fn info(t: &RawTopic, s: Option<&Series>, namespace: Option<&str>) -> TopicInfo 
         } else {
             Vec::new()
         },
-        median_period_s: s.map(|s| s.median_ns as f64 * 1e-9),
+        median_period_s: s.map(|s| s.median_ns as f64 / 1e9),
         span_s: s.map(|s| {
             (
-                s.times_ns[0] as f64 * 1e-9,
-                s.times_ns[s.times_ns.len() - 1] as f64 * 1e-9,
+                s.times_ns[0] as f64 / 1e9,
+                s.times_ns[s.times_ns.len() - 1] as f64 / 1e9,
             )
         }),
         log_time: s.is_some_and(|s| s.log_time),
@@ -354,8 +354,8 @@ pub fn read_bag(path: impl AsRef<Path>, options: &BagOptions) -> Result<Recordin
         source: file,
         channel_names,
         samples,
-        dt_s: g.grid.period_ns * 1e-9,
-        start_s: g.grid.t0_ns as f64 * 1e-9,
+        dt_s: g.grid.period_ns / 1e9,
+        start_s: g.grid.t0_ns as f64 / 1e9,
         topics: topics_info,
         quaternions: quaternion_blocks(&topics, &chosen, namespace),
     })
@@ -594,7 +594,7 @@ fn read_robot(
         return Err(layout(format!(
             "robot {robot}: sample {j} (bag time {:.6} s): `corrected` is true but `supervised` \
              is false (only a supervised, low-confidence sample can be corrected)",
-            g.grid.time(j) as f64 * 1e-9
+            g.grid.time(j) as f64 / 1e9
         )));
     }
     let data: Vec<usize> = chosen

@@ -75,9 +75,9 @@ pub(crate) fn grid(series: &[&Series], names: &[&str], file: &str, period_ns: f6
                     topic: names[k].into(),
                     what,
                     when,
-                    by_s: by as f64 * 1e-9,
+                    by_s: by as f64 / 1e9,
                     other: names[other].into(),
-                    median_s: s.median_ns as f64 * 1e-9,
+                    median_s: s.median_ns as f64 / 1e9,
                 });
             }
         }
@@ -105,8 +105,8 @@ pub(crate) fn grid(series: &[&Series], names: &[&str], file: &str, period_ns: f6
             why: format!(
                 "the selected topics overlap for {:.6} s only: fewer than 2 samples at a period \
                  of {} s",
-                span.max(0.0) * 1e-9,
-                period_ns * 1e-9
+                span.max(0.0) / 1e9,
+                period_ns / 1e9
             ),
         });
     }

@@ -328,7 +328,7 @@ fn schedule_doc(planner: &Planner, round: usize, start_ns: i64, ticks: usize) ->
     let dt = problem.dt_s();
     let doc = json!({
         "round": round,
-        "start_time_s": start_ns as f64 * 1e-9,
+        "start_time_s": start_ns as f64 / 1e9,
         "n_robots": s.n_robots(),
         "t_total_s": outcome.t_total_s,
         "lower_bound_s": outcome.lower_bound_s,
