@@ -236,5 +236,32 @@ pub enum Error {
     Schedule(#[from] tandem_schedule::Error),
 }
 
+impl Error {
+    /// The file the error is about, if any (every input error names one).
+    #[must_use]
+    pub fn file(&self) -> Option<&str> {
+        match self {
+            Error::Io { file, .. }
+            | Error::NotMcap { file }
+            | Error::Truncated { file, .. }
+            | Error::Corrupt { file, .. }
+            | Error::MissingSchema { file, .. }
+            | Error::UnknownSchema { file, .. }
+            | Error::NoSupportedTopics { file, .. }
+            | Error::TopicNotFound { file, .. }
+            | Error::TooFewMessages { file, .. }
+            | Error::BadMessage { file, .. }
+            | Error::BadValue { file, .. }
+            | Error::TimeNotIncreasing { file, .. }
+            | Error::Gap { file, .. }
+            | Error::Coverage { file, .. }
+            | Error::ChannelClash { file, .. }
+            | Error::Layout { file, .. }
+            | Error::Write { file, .. } => Some(file),
+            Error::BadParam { .. } | Error::Lfd(_) | Error::Schedule(_) => None,
+        }
+    }
+}
+
 /// `Result` with this crate's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
