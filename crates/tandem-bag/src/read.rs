@@ -4,8 +4,9 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use mcap::read::{ChunkFlattener, Options};
-use mcap::records::Record;
+use mcap::read::parse_record;
+use mcap::records::{Record, op};
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 use crate::msg::{self, ALL_TYPES, MsgType, joint_columns};
 use crate::{Error, GAP_FACTOR, Result};
@@ -118,6 +119,9 @@ pub(crate) struct RawTopic {
     pub(crate) columns: Vec<String>,
     /// JSON payloads (the schedule topic).
     pub(crate) json: Vec<Vec<u8>>,
+    /// A `JointState`'s joint names and whether it has velocities and efforts (from its first
+    /// message; every message must have the same).
+    pub(crate) joints: (Vec<String>, (bool, bool)),
 }
 
 impl RawTopic {
@@ -227,15 +231,62 @@ pub(crate) fn read_topics(path: &Path, sel: &Selection<'_>) -> Result<Vec<RawTop
     read_bytes(&bytes, &file, sel)
 }
 
+/// Largest record the reader accepts beyond the file's own length: 256 MiB (a decompressed
+/// chunk's record may exceed the compressed file; a corrupt length must not make the reader
+/// allocate without bound).
+const RECORD_LIMIT: usize = 256 << 20;
+
 fn read_bytes(bytes: &[u8], file: &str, sel: &Selection<'_>) -> Result<Vec<RawTopic>> {
-    let reader = ChunkFlattener::new_with_options(bytes, Options::ValidateChunkCrcs.into())
-        .map_err(|e| mcap_error(file, e))?;
+    // The sans-io reader yields every record borrowed from its buffer (chunks decompressed
+    // and their CRCs checked), so a message's payload is decoded where it lies, not copied.
+    let options = LinearReaderOptions::default()
+        .with_validate_chunk_crcs(true)
+        .with_record_length_limit(bytes.len() + RECORD_LIMIT);
+    let mut reader = LinearReader::new_with_options(options);
+    let mut rest = bytes;
     let mut schemas: BTreeMap<u16, (String, String)> = BTreeMap::new();
     let mut channels: BTreeMap<u16, usize> = BTreeMap::new();
     let mut topics: Vec<RawTopic> = Vec::new();
     let mut by_name: BTreeMap<String, usize> = BTreeMap::new();
-    for record in reader {
-        match record.map_err(|e| mcap_error(file, e))? {
+    while let Some(event) = reader.next_event() {
+        let (opcode, data) = match event.map_err(|e| mcap_error(file, e))? {
+            LinearReadEvent::ReadRequest(need) => {
+                let len = need.min(rest.len());
+                reader.insert(len).copy_from_slice(&rest[..len]);
+                reader.notify_read(len);
+                rest = &rest[len..];
+                continue;
+            }
+            LinearReadEvent::Record { opcode, data } => (opcode, data),
+        };
+        if opcode == op::MESSAGE {
+            let (channel_id, log_time, payload) =
+                message_parts(data).ok_or_else(|| Error::Corrupt {
+                    file: file.into(),
+                    why: format!(
+                        "a message record of {} bytes is shorter than its header",
+                        data.len()
+                    ),
+                })?;
+            let Some(&idx) = channels.get(&channel_id) else {
+                return Err(Error::Corrupt {
+                    file: file.into(),
+                    why: format!(
+                        "a message refers to channel {channel_id}, which has no channel record"
+                    ),
+                });
+            };
+            let t = &mut topics[idx];
+            t.count += 1;
+            if t.selected {
+                add_message(t, file, log_time, payload)?;
+            }
+            continue;
+        }
+        if opcode != op::SCHEMA && opcode != op::CHANNEL {
+            continue;
+        }
+        match parse_record(opcode, data).map_err(|e| mcap_error(file, e))? {
             Record::Schema { header, .. } => {
                 schemas
                     .entry(header.id)
@@ -262,27 +313,19 @@ fn read_bytes(bytes: &[u8], file: &str, sel: &Selection<'_>) -> Result<Vec<RawTo
                 };
                 channels.insert(c.id, idx);
             }
-            Record::Message { header, data } => {
-                let Some(&idx) = channels.get(&header.channel_id) else {
-                    return Err(Error::Corrupt {
-                        file: file.into(),
-                        why: format!(
-                            "a message refers to channel {}, which has no channel record",
-                            header.channel_id
-                        ),
-                    });
-                };
-                let t = &mut topics[idx];
-                t.count += 1;
-                if t.selected {
-                    add_message(t, file, header.log_time, &data)?;
-                }
-            }
             _ => {}
         }
     }
     check_selection(&topics, file, sel)?;
     Ok(topics)
+}
+
+/// A message record's channel ID, log time and payload (its header is channel ID `u16`,
+/// sequence `u32`, log and publish time `u64`, little-endian).
+fn message_parts(data: &[u8]) -> Option<(u16, u64, &[u8])> {
+    let channel = u16::from_le_bytes(data.get(0..2)?.try_into().ok()?);
+    let log_time = u64::from_le_bytes(data.get(6..14)?.try_into().ok()?);
+    Some((channel, log_time, data.get(22..)?))
 }
 
 /// A topic for a new channel record: its type, whether it is selected.
@@ -314,6 +357,7 @@ fn new_topic(
             .map(|m| m.fixed_columns().iter().map(|c| (*c).to_owned()).collect())
             .unwrap_or_default(),
         json: Vec::new(),
+        joints: (Vec::new(), (false, false)),
     };
     let explicit = sel.topics.is_some_and(|l| l.contains(&t.topic));
     let is_view = t.role(sel.namespace) == Role::View;
@@ -348,11 +392,12 @@ fn add_message(t: &mut RawTopic, file: &str, log_time: u64, data: &[u8]) -> Resu
     let start = t.values.len();
     let d = msg::decode(msg_type, data, &mut t.values).map_err(bad)?;
     if msg_type == MsgType::JointState {
-        let cols = joint_columns(&d.joint_names, d.joint_arrays.0, d.joint_arrays.1);
         if t.log_ns.is_empty() {
-            t.columns = cols;
-        } else if cols != t.columns {
+            t.columns = joint_columns(&d.joint_names, d.joint_arrays.0, d.joint_arrays.1);
+            t.joints = (d.joint_names, d.joint_arrays);
+        } else if (&d.joint_names, d.joint_arrays) != (&t.joints.0, t.joints.1) {
             t.values.truncate(start);
+            let cols = joint_columns(&d.joint_names, d.joint_arrays.0, d.joint_arrays.1);
             return Err(Error::BadMessage {
                 file: file.into(),
                 topic: t.topic.clone(),

@@ -157,6 +157,29 @@ pub(crate) fn catalogue(dir: &Path) -> Vec<BadBag> {
     let p = case("no messages", None, vec!["topic `/force`", "0 message(s)"]);
     write_good(&p, |_| None);
 
+    let p = case("one message", None, vec!["topic `/force`", "1 message(s)"]);
+    write_good(&p, |k| if k == 0 { normal(k) } else { None });
+
+    let p = case(
+        "two topics give one channel",
+        None,
+        vec!["channel `pose.x` comes from both `/pose` and `/pose.x`"],
+    );
+    {
+        let mut bag = BagWriter::create(&p, false, Existing::Replace).unwrap();
+        let a = bag
+            .add_topic("/pose", MsgType::PoseStamped, &BTreeMap::new())
+            .unwrap();
+        let b = bag
+            .add_topic("/pose.x", MsgType::Float64, &BTreeMap::new())
+            .unwrap();
+        for k in 0..10 {
+            bag.write(a, k * 10 * MS, &pose(0.0)).unwrap();
+            bag.write(b, k * 10 * MS, &Message::Float64(0.0)).unwrap();
+        }
+        bag.finish().unwrap();
+    }
+
     let p = case(
         "non-finite value",
         None,
