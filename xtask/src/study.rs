@@ -5,7 +5,9 @@
 //! and writes under the output folder (default `results/`):
 //! `study.json` (compact; git revision, configuration, every trial and iteration, the
 //! per-iteration summary), `study.csv` (one row per trial and iteration), `fig5.svg` and `fig5.png`.
-//! Finally it prints the time spent in each phase.
+//! Finally it prints the time spent in each phase. With `--bag DIR` it writes the chosen rounds
+//! (`--bag-trials`, `--bag-rounds`; default the first and the last round of trial 0) as ROS 2
+//! bags, `DIR/trial_<T>_round_<K>.mcap` (`tandem::bag::RunWriter`), as they run.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
