@@ -36,10 +36,17 @@ fn refused(args: &[OsString], needles: &[&str], state: &Path) {
     assert_eq!(out.status.code(), Some(2), "{args:?}\n{stderr}");
     assert!(stderr.starts_with("error: "), "{args:?}\n{stderr}");
     for n in needles {
-        assert!(stderr.contains(n), "{args:?}: stderr lacks `{n}`:\n{stderr}");
+        assert!(
+            stderr.contains(n),
+            "{args:?}: stderr lacks `{n}`:\n{stderr}"
+        );
     }
     assert!(!stderr.contains("panicked"), "{stderr}");
-    assert_eq!(std::fs::read(state).unwrap(), before, "{args:?}: the state changed");
+    assert_eq!(
+        std::fs::read(state).unwrap(),
+        before,
+        "{args:?}: the state changed"
+    );
 }
 
 fn os(v: &[&dyn AsRef<std::ffi::OsStr>]) -> Vec<OsString> {
@@ -68,6 +75,7 @@ fn every_bad_bag_is_refused_by_fit_and_record_and_leaves_the_state() {
     let dir = scratch("bad-bags");
     let state = bag_state(&dir);
     for case in bad::catalogue(&dir.join("bags")) {
+        eprintln!("bad bag: {}", case.name);
         let file = case.path.display().to_string();
         let mut needles = vec![file.as_str()];
         needles.extend(case.needles.iter().copied());
@@ -111,13 +119,26 @@ fn a_simulated_run_bag_records_like_its_csv_files_and_is_never_overwritten() {
         tandem(&args)
     };
     let text = ok(&sim(&[&"--bag", &run, &"--write", &dir.join("csv")]));
-    assert!(text.contains("wrote") && text.contains("3 round(s)"), "{text}");
+    assert!(
+        text.contains("wrote") && text.contains("3 round(s)"),
+        "{text}"
+    );
     assert_eq!(bag::count_rounds(&run).unwrap(), 3);
     // The same run again onto the same file: refused, the file kept.
     let before = std::fs::read(&run).unwrap();
     refused(
-        &os(&[&"simulate", &state, &"--need", &examples().join("need.csv"), &"--pairs", &"1",
-              &"--channel", &"wrench.fz", &"--bag", &run]),
+        &os(&[
+            &"simulate",
+            &state,
+            &"--need",
+            &examples().join("need.csv"),
+            &"--pairs",
+            &"1",
+            &"--channel",
+            &"wrench.fz",
+            &"--bag",
+            &run,
+        ]),
         &["the file exists", "does not overwrite"],
         &state,
     );
@@ -130,7 +151,13 @@ fn a_simulated_run_bag_records_like_its_csv_files_and_is_never_overwritten() {
                 std::fs::copy(&state, p).unwrap();
             }
         }
-        ok(&tandem(os(&[&"record", &a, &run, &"--round", &round.to_string()])));
+        ok(&tandem(os(&[
+            &"record",
+            &a,
+            &run,
+            &"--round",
+            &round.to_string(),
+        ])));
         let mut args = os(&[&"record", &b]);
         for r in 1..=2 {
             let stem = dir.join("csv").join(format!("pair_{round}_robot_{r}"));
@@ -145,12 +172,23 @@ fn a_simulated_run_bag_records_like_its_csv_files_and_is_never_overwritten() {
             ]));
         }
         ok(&tandem(&args));
-        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "round {round}");
+        assert_eq!(
+            std::fs::read(&a).unwrap(),
+            std::fs::read(&b).unwrap(),
+            "round {round}"
+        );
     }
     // Without --round the run is refused; inspect lists its topics and rounds.
-    refused(&os(&[&"record", &a, &run]), &["holds 3 rounds", "--round"], &a);
+    refused(
+        &os(&[&"record", &a, &run]),
+        &["holds 3 rounds", "--round"],
+        &a,
+    );
     let text = ok(&tandem(os(&[&"inspect", &run])));
-    assert!(text.contains("3 round(s)") && text.contains("/robot_2/supervised"), "{text}");
+    assert!(
+        text.contains("3 round(s)") && text.contains("/robot_2/supervised"),
+        "{text}"
+    );
     let json = ok(&tandem(os(&[&"inspect", &run, &"--json"])));
     let doc: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(doc["rounds"], 3);
@@ -169,13 +207,16 @@ fn bag_flags_are_checked() {
     );
     let b = example_bags();
     refused(
-        &os(&[&"fit", &b[0], &b[1], &"--rate", &"-5", &"-o", &state]),
-        &["--rate -5"],
+        &os(&[&"fit", &b[0], &b[1], &"--rate", &"0", &"-o", &state]),
+        &["--rate 0: the grid rate must be finite and > 0"],
         &state,
     );
     refused(
         &os(&[&"fit", &b[0], &b[1], &"--topics", &"/nope", &"-o", &state]),
-        &["no topic `/nope`", "/tool_pose (geometry_msgs/msg/PoseStamped)"],
+        &[
+            "no topic `/nope`",
+            "/tool_pose (geometry_msgs/msg/PoseStamped)",
+        ],
         &state,
     );
     // A bag and CSV files: the channel names differ, and the error says so.
