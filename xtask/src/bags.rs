@@ -233,8 +233,8 @@ fn synthetic(rng: &mut ChaCha8Rng) -> anyhow::Result<Demonstration> {
             sn,
             cs,
         ]);
-        for c in 7..names.len() - 1 {
-            v.push((c as f64 * 0.1) * ((c as f64 * 0.37 + 1.0) * s + phase[c]).sin());
+        for (c, p) in phase.iter().enumerate().take(names.len() - 1).skip(7) {
+            v.push((c as f64 * 0.1) * ((c as f64 * 0.37 + 1.0) * s + p).sin());
         }
         v.push(f64::from(u8::from(s.sin() > 0.0)));
     }

@@ -56,7 +56,8 @@ pub enum Error {
     /// A selected topic has a message type tandem does not read.
     #[error(
         "{file}: topic `{topic}`: unknown schema `{schema}` (encoding `{encoding}`); tandem reads \
-         {supported}"
+         {supported}",
+        supported = crate::read::supported_list()
     )]
     UnknownSchema {
         /// The file.
@@ -67,18 +68,17 @@ pub enum Error {
         schema: String,
         /// The schema (or message) encoding.
         encoding: String,
-        /// The supported types.
-        supported: String,
     },
     /// No topic of the file has a supported type (nothing to read).
-    #[error("{file}: no topic of a supported type (found: {found}); tandem reads {supported}")]
+    #[error(
+        "{file}: no topic of a supported type (found: {found}); tandem reads {supported}",
+        supported = crate::read::supported_list()
+    )]
     NoSupportedTopics {
         /// The file.
         file: String,
         /// The topics found, with their types.
         found: String,
-        /// The supported types.
-        supported: String,
     },
     /// A topic named in the selection is not in the file.
     #[error("{file}: no topic `{topic}` (topics: {available})")]
@@ -171,9 +171,11 @@ pub enum Error {
     },
     /// A topic starts later (or ends earlier) than the others by more than the gap limit.
     #[error(
-        "{file}: topic `{topic}` {what} {by_s} s {when} topic `{other}` (more than {factor}× its \
+        "{file}: topic `{topic}` {} {by_s} s {} topic `{other}` (more than {factor}× its \
          median period of {median_s} s): the topics do not cover the same recording; trim the \
          bag or leave the topic out with --topics",
+        if *starts_late { "starts" } else { "ends" },
+        if *starts_late { "after" } else { "before" },
         factor = crate::GAP_FACTOR
     )]
     Coverage {
@@ -181,10 +183,8 @@ pub enum Error {
         file: String,
         /// The late-starting or early-ending topic.
         topic: String,
-        /// `starts` or `ends`.
-        what: &'static str,
-        /// `after` or `before`.
-        when: &'static str,
+        /// Whether it starts late (else it ends early).
+        starts_late: bool,
         /// By how much (s).
         by_s: f64,
         /// The topic that starts first or ends last.

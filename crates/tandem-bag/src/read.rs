@@ -506,7 +506,6 @@ fn check_selection(topics: &[RawTopic], file: &str, sel: &Selection<'_>) -> Resu
                 topic: t.topic.clone(),
                 schema: schema.clone(),
                 encoding: format!("{}/{}", t.schema_encoding, t.message_encoding),
-                supported: supported_list(),
             });
         }
     }
@@ -518,7 +517,6 @@ fn check_selection(topics: &[RawTopic], file: &str, sel: &Selection<'_>) -> Resu
             } else {
                 list()
             },
-            supported: supported_list(),
         });
     }
     Ok(())

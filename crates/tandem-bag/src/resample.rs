@@ -65,16 +65,12 @@ pub(crate) fn grid(series: &[&Series], names: &[&str], file: &str, period_ns: f6
         let limit = GAP_FACTOR * s.median_ns as f64;
         let late = first(s) - earliest;
         let early = latest_end - last(s);
-        for (by, what, when, other) in [
-            (late, "starts", "after", k_first),
-            (early, "ends", "before", k_last),
-        ] {
+        for (by, starts_late, other) in [(late, true, k_first), (early, false, k_last)] {
             if by as f64 > limit {
                 return Err(Error::Coverage {
                     file: file.into(),
                     topic: names[k].into(),
-                    what,
-                    when,
+                    starts_late,
                     by_s: by as f64 / 1e9,
                     other: names[other].into(),
                     median_s: s.median_ns as f64 / 1e9,
