@@ -157,7 +157,7 @@ fn an_observed_study_is_the_same_study_and_shows_every_round() {
         serde_json::to_string(&plain).unwrap()
     );
     let mut seen = seen.into_inner().unwrap();
-    seen.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+    seen.sort_by_key(|s| (s.0, s.1));
     let keys: Vec<(usize, usize)> = seen.iter().map(|s| (s.0, s.1)).collect();
     assert_eq!(keys, [(0, 1), (0, 2), (0, 3), (1, 1), (1, 2), (1, 3)]);
     for (trial, round, t_total_s, robots) in seen {
