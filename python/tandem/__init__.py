@@ -14,6 +14,7 @@ NumPy arrays in and out (docs/python.md):
   per :meth:`Coordinator.tick`.
 - :mod:`tandem.study`: the simulated study of §III; :mod:`tandem.sim`: its workcell.
 - :func:`align`: GDTW time warping (Eq. 2–3).
+- :func:`read_bag`: a ROS 2 bag (rosbag2 MCAP) on one grid; :func:`fit` takes ``.mcap`` paths.
 
 Every error is a :class:`TandemError`: :class:`InputError`, :class:`ParamError`,
 :class:`StateFileError`, :class:`ScheduleError`, :class:`InternalError`. Data taken in but
@@ -46,6 +47,7 @@ from ._tandem import (
     default_params,
     fit,
     fit_model,
+    read_bag,
 )
 from . import sim, study
 
@@ -74,6 +76,7 @@ __all__ = [
     "default_params",
     "fit",
     "fit_model",
+    "read_bag",
     "sim",
     "study",
 ]

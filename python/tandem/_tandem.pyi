@@ -65,6 +65,15 @@ def fit(
     """Learns the task from demonstrations (paths or ``(T_i, C)`` arrays) and makes the first
     schedule (Fig. 2); the same inputs and parameters as ``tandem fit`` give the same state."""
 
+def read_bag(
+    path: Path,
+    topics: Optional[Sequence[str]] = None,
+    rate: Optional[float] = None,
+    namespace: Optional[str] = None,
+) -> Dict[str, Any]:
+    """A ROS 2 bag (rosbag2 MCAP) on one grid, as ``tandem fit`` reads it: ``samples``
+    ``(T, C)``, ``channels``, ``t`` ``(T,)`` bag times (s), ``dt_s``, ``topics``, ``quaternions``."""
+
 def fit_model(
     demos: Sequence[Demo],
     channels: Optional[Sequence[str]] = None,

@@ -4,6 +4,7 @@
 //! dispatches, so that tasks added by different issues do not touch each other's code.
 #![allow(clippy::print_stdout, reason = "xtask reports to the terminal")]
 
+mod bags;
 mod capacity;
 mod fig5;
 mod fixtures;
@@ -38,6 +39,9 @@ struct Cli {
 enum Cmd {
     /// Run the simulated study of §III and draw Fig. 5 (defaults: fixtures/study.toml).
     Study(study::StudyArgs),
+    /// Measure ROS 2 bag support: the sanding fixtures as bags fitted against the CSV fit, and
+    /// the time to read and fit bags against the same data as CSV (docs/decisions.md).
+    Bags(bags::BagsArgs),
     /// Run the study for N = 1..8 robots with reduced sizes and draw throughput and operator
     /// busy share against N (results/capacity/capacity.svg and .png; docs/study.md).
     Capacity(capacity::CapacityArgs),
@@ -77,6 +81,7 @@ fn main() -> anyhow::Result<()> {
         Cmd::Fixtures { check } => fixtures::run(check),
         Cmd::Study(args) => study::run(&args),
         Cmd::Capacity(args) => capacity::run(&args),
+        Cmd::Bags(args) => bags::run(&args),
         Cmd::Stress {
             executions,
             robots,

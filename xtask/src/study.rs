@@ -5,7 +5,9 @@
 //! and writes under the output folder (default `results/`):
 //! `study.json` (compact; git revision, configuration, every trial and iteration, the
 //! per-iteration summary), `study.csv` (one row per trial and iteration), `fig5.svg` and `fig5.png`.
-//! Finally it prints the time spent in each phase.
+//! Finally it prints the time spent in each phase. With `--bag DIR` it writes the chosen rounds
+//! (`--bag-trials`, `--bag-rounds`; default the first and the last round of trial 0) as ROS 2
+//! bags, `DIR/trial_<T>_round_<K>.mcap` (`tandem::bag::RunWriter`), as they run.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -52,6 +54,88 @@ pub(crate) struct StudyArgs {
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
+    /// Write chosen rounds as ROS 2 bags (MCAP, for Foxglove) into this folder, one file per
+    /// round: `trial_<T>_round_<K>.mcap` (replaced if present).
+    #[arg(long, value_name = "DIR")]
+    bag: Option<PathBuf>,
+    /// With --bag: the trials to write (0-based). Default: 0.
+    #[arg(long, value_name = "T,…", value_delimiter = ',', requires = "bag")]
+    bag_trials: Vec<usize>,
+    /// With --bag: the rounds to write (1-based). Default: the first and the last.
+    #[arg(long, value_name = "K,…", value_delimiter = ',', requires = "bag")]
+    bag_rounds: Vec<usize>,
+}
+
+/// Writes the rounds `--bag` chose as they run (from worker threads); remembers the files
+/// written and the first error.
+struct BagSink {
+    dir: PathBuf,
+    trials: Vec<usize>,
+    rounds: Vec<usize>,
+    written: std::sync::Mutex<Vec<PathBuf>>,
+    error: std::sync::Mutex<Option<String>>,
+}
+
+impl BagSink {
+    fn new(args: &StudyArgs, config: &StudyConfig) -> anyhow::Result<Option<Self>> {
+        let Some(dir) = &args.bag else {
+            return Ok(None);
+        };
+        let n = config.n_rounds();
+        let trials = if args.bag_trials.is_empty() {
+            vec![0]
+        } else {
+            args.bag_trials.clone()
+        };
+        let rounds = if args.bag_rounds.is_empty() {
+            vec![1, n]
+        } else {
+            args.bag_rounds.clone()
+        };
+        if let Some(t) = trials.iter().find(|&&t| t >= config.trials) {
+            bail!(
+                "--bag-trials {t}: the study runs trials 0 to {}",
+                config.trials - 1
+            );
+        }
+        if let Some(k) = rounds.iter().find(|&&k| k == 0 || k > n) {
+            bail!("--bag-rounds {k}: a trial runs rounds 1 to {n}");
+        }
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        Ok(Some(Self {
+            dir: dir.clone(),
+            trials,
+            rounds,
+            written: std::sync::Mutex::new(Vec::new()),
+            error: std::sync::Mutex::new(None),
+        }))
+    }
+
+    fn observe(&self, view: tandem::sim::study::RoundView<'_>) {
+        if !(self.trials.contains(&view.trial) && self.rounds.contains(&view.round)) {
+            return;
+        }
+        let path = self
+            .dir
+            .join(format!("trial_{}_round_{}.mcap", view.trial, view.round));
+        let result = (|| -> anyhow::Result<()> {
+            let mut w = tandem::bag::RunWriter::create(
+                &path,
+                view.planner,
+                tandem::bag::Existing::Replace,
+            )?;
+            w.write_round(view.planner, view.run)?;
+            w.finish()?;
+            Ok(())
+        })();
+        match result {
+            Ok(()) => self.written.lock().expect("no panic holds it").push(path),
+            Err(e) => {
+                let mut first = self.error.lock().expect("no panic holds it");
+                first.get_or_insert(format!("{}: {e:#}", path.display()));
+            }
+        }
+    }
 }
 
 /// What `study.json` holds.
@@ -205,14 +289,32 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
     );
     let trials_done = AtomicUsize::new(0);
     bar.set_message(format!("0/{} trials done", config.trials));
-    let (result, times) = tandem::sim::study::run_study(&config, &inputs, &|p| {
+    let sink = BagSink::new(args, &config)?;
+    let observe = |view: tandem::sim::study::RoundView<'_>| {
+        if let Some(s) = &sink {
+            s.observe(view);
+        }
+    };
+    let progress = |p: tandem::sim::study::Progress| {
         bar.inc(1);
         if p.pairs_done == n_rounds {
             let done = trials_done.fetch_add(1, Ordering::Relaxed) + 1;
             bar.set_message(format!("{done}/{} trials done", config.trials));
         }
-    })?;
+    };
+    let (result, times) =
+        tandem::sim::study::run_study_observed(&config, &inputs, &progress, &observe)?;
     bar.finish();
+    if let Some(s) = sink {
+        if let Some(e) = s.error.into_inner().expect("no panic holds it") {
+            bail!("writing a bag: {e}");
+        }
+        let mut written = s.written.into_inner().expect("no panic holds it");
+        written.sort();
+        for p in written {
+            println!("wrote {}", p.display());
+        }
+    }
 
     let summary = result.summary();
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;

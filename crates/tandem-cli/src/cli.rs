@@ -41,8 +41,11 @@ pub(crate) enum Command {
     /// the first file, or with --reference medoid the demonstration closest to all the
     /// others (then the model does not depend on the order of the files).
     ///
-    /// Demonstrations are CSV (header of channel names, optional time column `t` in seconds)
-    /// or JSON ({"channels", "dt_s", "samples"}), chosen by the extension `.json`.
+    /// Demonstrations are CSV (header of channel names, optional time column `t` in seconds),
+    /// JSON ({"channels", "dt_s", "samples"}, extension `.json`), or ROS 2 bags (rosbag2
+    /// MCAP, extension `.mcap`: every topic of a supported type resampled onto one grid,
+    /// --rate, --topics; `tandem inspect BAG` lists the channels). They may be mixed if the
+    /// channel names agree.
     ///
     /// Example:
     ///
@@ -50,6 +53,7 @@ pub(crate) enum Command {
     ///   tandem fit a.csv b.csv c.csv --ranges force=20,x=0.5 --params params.toml --samples 2000 -o cell.tandem
     ///   tandem fit fixtures/sanding/demo_?.csv --reference medoid -o cell.tandem
     ///   tandem fit fixtures/sanding/demo_?.csv --robots 3 -o cell3.tandem
+    ///   tandem fit fixtures/examples/ros2/demo_?.mcap -o cell.tandem
     #[command(verbatim_doc_comment)]
     Fit(FitArgs),
     /// Re-optimize the schedule of a state file and show it (text Gantt, or JSON).
@@ -81,6 +85,8 @@ pub(crate) enum Command {
     ///   tandem record cell.tandem \
     ///     --execution run1_robot1.csv --log run1_robot1.reflog.csv --corrections run1_robot1.corr.csv \
     ///     --execution run1_robot2.csv --log run1_robot2.reflog.csv --corrections run1_robot2.corr.csv
+    ///   tandem record cell.tandem round1.mcap                 # a ROS 2 bag of the round
+    ///   tandem record cell.tandem run.mcap --round 3          # round 3 of simulate --bag
     #[command(verbatim_doc_comment)]
     Record(RecordArgs),
     /// Summarize the model, the confidence and the schedule of a state file.
@@ -89,6 +95,7 @@ pub(crate) enum Command {
     ///
     ///   tandem inspect cell.tandem
     ///   tandem inspect cell.tandem --json
+    ///   tandem inspect demo.mcap                # a bag's topics and channel names
     #[command(verbatim_doc_comment)]
     Inspect(InspectArgs),
     /// Draw the model, the confidence and the schedule as SVG and PNG files.
@@ -122,6 +129,7 @@ pub(crate) enum Command {
     ///
     ///   tandem simulate cell.tandem --need need.csv --pairs 10
     ///   tandem simulate cell.tandem --need need.csv --pairs 2 --write sim/ --seed 7
+    ///   tandem simulate cell.tandem --need need.csv --pairs 20 --bag run.mcap
     #[command(verbatim_doc_comment)]
     Simulate(SimulateArgs),
     /// Print the default parameter file (TOML) for `tandem fit --params`.
@@ -148,7 +156,7 @@ pub(crate) struct SamplerArgs {
 /// `tandem fit`.
 #[derive(Debug, Args)]
 pub(crate) struct FitArgs {
-    /// Demonstration files (CSV or .json). At least two.
+    /// Demonstration files (CSV, .json, or ROS 2 bags .mcap). At least two.
     #[arg(required = true, value_name = "DEMO")]
     pub(crate) demos: Vec<PathBuf>,
     /// Which demonstration is the reference, whose samples are the model's time axis:
@@ -169,6 +177,14 @@ pub(crate) struct FitArgs {
     /// Sample period (s) of demonstrations without a time column `t`. Default: 0.01.
     #[arg(long, value_name = "SECONDS")]
     pub(crate) dt: Option<f64>,
+    /// ROS 2 bags: rate (Hz) of the grid every topic is resampled onto. Default: each bag's
+    /// slowest selected topic's median message rate.
+    #[arg(long, value_name = "HZ")]
+    pub(crate) rate: Option<f64>,
+    /// ROS 2 bags: the topics to read (full names). Default: every topic of a supported type
+    /// (PoseStamped, WrenchStamped, TwistStamped, JointState, Float64, Bool).
+    #[arg(long, value_name = "/A,/B", value_delimiter = ',')]
+    pub(crate) topics: Vec<String>,
     /// Robots run by the one operator, 1 to 8 (the paper: 2): every schedule has N warps and
     /// `tandem record` takes N executions per round. Stored in the state file.
     #[arg(long, value_name = "N", default_value_t = 2)]
@@ -220,21 +236,47 @@ pub(crate) struct ScheduleArgs {
 pub(crate) struct RecordArgs {
     /// The state file (updated atomically).
     pub(crate) state: PathBuf,
+    /// ROS 2 bags (.mcap) of the round instead of CSV files: one bag holding every robot
+    /// (topics under /robot_1 … /robot_N), or one bag per robot, robot 1 first; each robot's
+    /// channel topics, a Float64 topic `ref_sample` and Bool topics `supervised`, `corrected`.
+    #[arg(value_name = "BAG", conflicts_with_all = ["execution", "log", "corrections"])]
+    pub(crate) bags: Vec<PathBuf>,
+    /// With bags: the round to read from a bag of several (a run of `tandem simulate --bag`).
+    #[arg(long, value_name = "K", requires = "bags")]
+    pub(crate) round: Option<usize>,
+    /// With bags: the topics to read (full names). Default: every topic of a supported type.
+    #[arg(long, value_name = "/A,/B", value_delimiter = ',', requires = "bags")]
+    pub(crate) topics: Vec<String>,
     /// Execution CSV of robot 1, then robot 2, … (channel columns, optional `t`).
-    #[arg(long, value_name = "CSV", num_args = 1, required = true)]
+    #[arg(
+        long,
+        value_name = "CSV",
+        num_args = 1,
+        required_unless_present = "bags"
+    )]
     pub(crate) execution: Vec<PathBuf>,
     /// Reference-time log of each execution (column `ref_sample`), same order.
-    #[arg(long, value_name = "CSV", num_args = 1, required = true)]
+    #[arg(
+        long,
+        value_name = "CSV",
+        num_args = 1,
+        required_unless_present = "bags"
+    )]
     pub(crate) log: Vec<PathBuf>,
     /// Correction flags of each execution (columns `supervised,corrected`), same order.
-    #[arg(long, value_name = "CSV", num_args = 1, required = true)]
+    #[arg(
+        long,
+        value_name = "CSV",
+        num_args = 1,
+        required_unless_present = "bags"
+    )]
     pub(crate) corrections: Vec<PathBuf>,
 }
 
 /// `tandem inspect`.
 #[derive(Debug, Args)]
 pub(crate) struct InspectArgs {
-    /// The state file.
+    /// The state file, or a ROS 2 bag (.mcap): its topics, types, rates and channel names.
     pub(crate) state: PathBuf,
     /// Print JSON.
     #[arg(long)]
@@ -267,6 +309,11 @@ pub(crate) struct SimulateArgs {
     /// Write every execution into this folder in `tandem record`'s formats.
     #[arg(long, value_name = "DIR")]
     pub(crate) write: Option<PathBuf>,
+    /// Write the run as one ROS 2 bag (MCAP, a new file) for Foxglove: per robot the commanded
+    /// pose and channels, low-confidence and corrected flags, reference time, schedule clock
+    /// and waits; the schedule of every round.
+    #[arg(long, value_name = "FILE.mcap")]
+    pub(crate) bag: Option<PathBuf>,
     /// Seed of the simulated workpieces and operator.
     #[arg(long, value_name = "S", default_value_t = 0)]
     pub(crate) seed: u64,

@@ -12,7 +12,7 @@ use crate::cli::{
     Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
 };
 use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_json, source_name};
-use crate::{input, plot, sim, state_io};
+use crate::{bag, input, plot, sim, state_io};
 
 /// Runs one command.
 pub(crate) fn run(cli: Cli) -> Result<()> {
@@ -79,11 +79,8 @@ fn fit(a: &FitArgs) -> Result<()> {
         bail!("--robots {}: one operator runs 1 to {max} robots", a.robots);
     }
     state_io::check_file_target(&a.output)?;
-    let demos = a
-        .demos
-        .iter()
-        .map(|p| input::read_demo(p, a.dt))
-        .collect::<Result<Vec<Demonstration>>>()?;
+    let demos: Vec<Demonstration> =
+        bag::read_demos(&a.demos, a.dt, a.rate, &a.topics, &mut params.fit.schema)?;
     for d in &demos {
         if let Some(n) = d.period_note() {
             note(&n);
@@ -281,7 +278,7 @@ fn record(a: &RecordArgs) -> Result<()> {
         ("--log", &a.log),
         ("--corrections", &a.corrections),
     ] {
-        if v.len() != n {
+        if v.len() != n && a.bags.is_empty() {
             bail!(
                 "{flag} given {} time(s); {} has {n} robots, so a round needs exactly {n} \
                  (robot 1 first)",
@@ -301,7 +298,11 @@ fn record(a: &RecordArgs) -> Result<()> {
             &a.corrections[i],
         )
     };
-    let round = (0..n).map(r).collect::<Result<Vec<_>>>()?;
+    let round = if a.bags.is_empty() {
+        (0..n).map(r).collect::<Result<Vec<_>>>()?
+    } else {
+        bag::read_round(&planner, &a.bags, a.round, &a.topics)?
+    };
     let report = planner.record_round(&round).context(if n == 2 {
         "cannot record the pair"
     } else {
@@ -333,6 +334,9 @@ fn record(a: &RecordArgs) -> Result<()> {
 }
 
 fn inspect(a: &InspectArgs) -> Result<()> {
+    if tandem::bag::is_bag(&a.state) {
+        return bag::inspect_bag(&a.state, a.json);
+    }
     let planner = state_io::load(&a.state)?;
     let model = planner.model();
     let conf = planner.confidence();

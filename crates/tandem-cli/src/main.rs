@@ -16,6 +16,7 @@
 //! Every user error prints `error: …` naming the file and the problem, and exits with code 2;
 //! nothing is written when a command fails.
 
+mod bag;
 mod cli;
 mod cmd;
 mod gantt;

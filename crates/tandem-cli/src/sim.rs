@@ -36,7 +36,7 @@ use tandem::{ExecutionRecord, Planner, derive_seed};
 
 use crate::cli::SimulateArgs;
 use crate::cmd::out;
-use crate::{input, state_io};
+use crate::{bag, input, state_io};
 
 /// Runs one round (see the module docs). `needed[i][n]`: robot `i`'s workpiece needs the
 /// operator at reference sample `n`; one entry per robot.
@@ -139,6 +139,10 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
     if let Some(dir) = &a.write {
         state_io::prepare_dir(dir)?;
     }
+    let mut run_bag = match &a.bag {
+        Some(path) => Some(bag::RunBag::create(path, &planner)?),
+        None => None,
+    };
     let n_regions = need.region.iter().copied().max().unwrap_or(0) + 1;
     let mut region_p = vec![0.0; n_regions];
     for (&r, &p) in need.region.iter().zip(&need.p) {
@@ -169,6 +173,9 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
                 files.push((dir.join(format!("{stem}.reflog.csv")), l));
                 files.push((dir.join(format!("{stem}.corr.csv")), c));
             }
+        }
+        if let Some(b) = &mut run_bag {
+            b.write_round(&planner, &pair)?;
         }
         let records: Vec<ExecutionRecord> = pair
             .records(planner.model())?
@@ -208,6 +215,9 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
             files.len(),
             dir.display()
         ));
+    }
+    if let Some(b) = run_bag {
+        b.finish()?;
     }
     out(&format!("what-if only: {} is unchanged", a.state.display()));
     Ok(())

@@ -25,10 +25,18 @@ pub(crate) fn load(path: &Path) -> Result<Planner> {
     Planner::load(path).context("cannot load the state")
 }
 
-/// Checks that a state file can be written at `path` (its folder exists and accepts a new
-/// file, `path` is not a folder, and an existing file there is a state file:
-/// [`state::check_target`]), without touching `path` itself.
+/// Checks that a state file can be written at `path` (as [`check_writable`], and an existing
+/// file there is a state file: [`state::check_target`]), without touching `path` itself.
 pub(crate) fn check_file_target(path: &Path) -> Result<()> {
+    check_writable(path)?;
+    state::check_target(path)?;
+    Ok(())
+}
+
+/// Checks that a file can be created at `path`: its folder exists and accepts a new file, and
+/// `path` is not a folder. Touches nothing at `path` itself; whether an existing file may be
+/// replaced is the caller's rule.
+pub(crate) fn check_writable(path: &Path) -> Result<()> {
     let shown = path.display();
     if path.is_dir() {
         bail!("{shown}: is a folder; give a file name for the output");
@@ -43,7 +51,6 @@ pub(crate) fn check_file_target(path: &Path) -> Result<()> {
             dir.display()
         );
     }
-    state::check_target(path)?;
     let mut probe_name = std::ffi::OsString::from(".");
     probe_name.push(name);
     probe_name.push(format!(".probe{}", std::process::id()));

@@ -4,7 +4,7 @@
 //!
 //! | exception | raised for | attributes |
 //! |---|---|---|
-//! | `InputError` | demonstrations, executions, arrays, CSV/JSON files, labels, operator input | `file`, `line`, `column` (`None` where unknown; `file` is the argument, e.g. `demos[2]`, for an array) |
+//! | `InputError` | demonstrations, executions, arrays, CSV/JSON files, ROS 2 bags, labels, operator input | `file`, `line`, `column` (`None` where unknown; `file` is the argument, e.g. `demos[2]`, for an array) |
 //! | `ParamError` | a parameter out of range, an unknown or ill-typed key | `name` |
 //! | `StateFileError` | a state file that is missing, foreign, truncated, corrupt, of another version, inconsistent, or cannot be written | `path` |
 //! | `ScheduleError` | an infeasible problem, a schedule that violates Eq. 20, a schedule run at another tick | `violation` (the broken rule's name, or `None`) |
@@ -97,6 +97,9 @@ pub(crate) enum Error {
     /// The simulated workcell, called directly.
     #[error(transparent)]
     Sim(#[from] errors::Sim),
+    /// ROS 2 bags.
+    #[error(transparent)]
+    Bag(#[from] errors::Bag),
     /// A schedule breaks a constraint of Eq. 20.
     #[error("the schedule violates Eq. 20: {0}")]
     Violation(Violation),
@@ -289,6 +292,15 @@ fn classify_sim(e: &errors::Sim) -> Kind {
     }
 }
 
+fn classify_bag(e: &errors::Bag) -> Kind {
+    match e {
+        errors::Bag::BadParam { name, .. } => param(name),
+        errors::Bag::Lfd(l) => classify_lfd(l),
+        errors::Bag::Schedule(s) => classify_schedule(s),
+        other => input_at(other.file()),
+    }
+}
+
 fn classify_facade(e: &Facade) -> Kind {
     match e {
         Facade::Io { path, .. }
@@ -332,6 +344,7 @@ impl Error {
             Error::Realtime(e) => classify_realtime(e),
             Error::Schedule(e) => classify_schedule(e),
             Error::Sim(e) => classify_sim(e),
+            Error::Bag(e) => classify_bag(e),
             Error::Violation(v) => Kind::Schedule {
                 violation: Some(violation_name(v)),
             },

@@ -22,8 +22,13 @@ pub(crate) use tandem::sim::workcell::{
 };
 pub(crate) use tandem::warp::{SignalRef, Warp, WarpParams, align};
 
+pub(crate) use tandem::bag::{
+    BagOptions, Recording, extend_schema as extend_bag_schema, is_bag, read_bag,
+};
+
 /// The crates' own error types, for classifying them into Python exceptions.
 pub(crate) mod errors {
+    pub(crate) use tandem::bag::Error as Bag;
     pub(crate) use tandem::confidence::Error as Confidence;
     pub(crate) use tandem::lfd::Error as Lfd;
     pub(crate) use tandem::realtime::Error as Realtime;

@@ -14,6 +14,8 @@
 //!   re-implementation), one control tick per `tick(operator)`.
 //! - `study` and `sim`: the simulated study of §III and its workcell.
 //! - `warp`: `tandem.align`, GDTW (Eq. 2–3).
+//! - `bag`: `tandem.read_bag`, a ROS 2 bag (rosbag2 MCAP) on one grid; `tandem.fit` takes
+//!   `.mcap` paths too.
 //!
 //! Errors become subclasses of `tandem.TandemError` (`errors`); a panic is caught at the
 //! boundary and raised as `tandem.InternalError`. The GIL is released around every long call
@@ -26,6 +28,7 @@
 //! `cargo xtask test`), and its examples are `examples/python/`.
 
 mod arrays;
+mod bag;
 mod coordinator;
 mod errors;
 mod facade;
@@ -42,6 +45,8 @@ use pyo3::prelude::*;
 /// extension module. Import ``tandem``, not this module.
 #[pymodule]
 mod _tandem {
+    #[pymodule_export]
+    use crate::bag::read_bag;
     #[pymodule_export]
     use crate::coordinator::{PyCoordinator, PyTick};
     #[pymodule_export]

@@ -11,6 +11,7 @@ use pyo3::types::{PyDict, PyString};
 
 use crate::arrays::{flags, matrix, out_flags, out_matrix, out_vector, repr_list, vector};
 use crate::errors::{Error, Result, guard, warn};
+use crate::facade::{BagOptions, Recording, extend_bag_schema, is_bag, read_bag};
 use crate::facade::{
     BetaParams, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, Demonstration, Execution, ExecutionRecord,
     Observations, Planner, PlannerParams, RecordReport, StateLock, TaskModel, derive_seed, errors,
@@ -52,13 +53,16 @@ struct Channels<'a> {
 }
 
 /// One demonstration or execution from a Python value: a CSV or JSON path (the command
-/// line's formats; JSON by extension) or a `(T, C)` array with `channels.array` naming its
-/// columns, sample period `dt_s` (s). `label` names it in errors (`demos[2]`).
+/// line's formats; JSON by extension), a ROS 2 bag (`.mcap`, read like `tandem fit` reads it,
+/// its recording pushed to `recordings` when given), or a `(T, C)` array with
+/// `channels.array` naming its columns, sample period `dt_s` (s). `label` names it in errors
+/// (`demos[2]`).
 fn demonstration(
     x: &Bound<'_, PyAny>,
     label: &str,
     channels: Channels<'_>,
     dt_s: Option<f64>,
+    recordings: Option<&mut Vec<Recording>>,
 ) -> Result<Demonstration> {
     if x.is_instance_of::<PyString>() || x.hasattr("__fspath__").unwrap_or(false) {
         let path: PathBuf = x
@@ -67,7 +71,14 @@ fn demonstration(
         let is_json = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-        let demo = if is_json {
+        let demo = if is_bag(&path) {
+            let rec = read_bag(&path, &BagOptions::default())?;
+            let demo = rec.demonstration()?;
+            if let Some(r) = recordings {
+                r.push(rec);
+            }
+            demo
+        } else if is_json {
             Demonstration::from_json_path(&path, dt_s)?
         } else {
             Demonstration::from_csv_path(&path, dt_s)?
@@ -129,11 +140,13 @@ fn items<'py>(x: &Bound<'py, PyAny>, what: &str) -> Result<Vec<Bound<'py, PyAny>
         .collect()
 }
 
-/// Demonstrations from `demos` (paths or arrays, see [`demonstration`]).
+/// Demonstrations from `demos` (paths or arrays, see [`demonstration`]), with the bags'
+/// orientations added to `params`' channel schema as quaternion blocks.
 fn demonstrations(
     demos: &Bound<'_, PyAny>,
     channels: Option<&[String]>,
     dt_s: Option<f64>,
+    params: &mut PlannerParams,
 ) -> Result<Vec<Demonstration>> {
     let list = items(demos, "demos")?;
     if list.len() < 2 {
@@ -145,16 +158,21 @@ fn demonstrations(
             ),
         ));
     }
-    list.iter()
+    let mut recordings = Vec::new();
+    let out = list
+        .iter()
         .enumerate()
         .map(|(k, d)| {
             let both = Channels {
                 array: channels,
                 file: channels,
             };
-            demonstration(d, &format!("demos[{k}]"), both, dt_s)
+            demonstration(d, &format!("demos[{k}]"), both, dt_s, Some(&mut recordings))
         })
-        .collect()
+        .collect::<Result<Vec<_>>>()?;
+    extend_bag_schema(&mut params.fit.schema, &recordings);
+    params.validate()?;
+    Ok(out)
 }
 
 /// Raises the `DataWarning`s of a set of demonstrations: the period assumed for a file
@@ -200,8 +218,10 @@ fn planner_params(params: Option<&Bound<'_, PyAny>>) -> Result<PlannerParams> {
 ///
 /// Args:
 ///     demos: at least two demonstrations, each a path to a CSV or JSON file (the command
-///         line's formats, a ``t`` column sets the period) or a float array of shape
-///         ``(T_i, C)`` (samples × channels, channel units).
+///         line's formats, a ``t`` column sets the period), a ROS 2 bag (``.mcap``: every
+///         topic of a supported type on one grid at the slowest topic's rate, as
+///         ``tandem fit`` reads it; :func:`read_bag` shows what it reads) or a float array of
+///         shape ``(T_i, C)`` (samples × channels, channel units).
 ///     channels: the ``C`` channel names of array demonstrations (required for arrays;
 ///         checked against a file's header if given).
 ///     params: ``None`` (defaults), a nested dict ``{"fit": …, "confidence": …,
@@ -224,8 +244,8 @@ pub(crate) fn fit(
     dt_s: Option<f64>,
     robots: usize,
 ) -> PyResult<PyPlanner> {
-    let demos = demonstrations(demos, channels.as_deref(), dt_s)?;
-    let params = planner_params(params)?;
+    let mut params = planner_params(params)?;
+    let demos = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
     warn_demonstrations(py, &demos)?;
     let planner = py.detach(|| guard(|| Ok(Planner::with_robots(&demos, params, robots)?)))?;
     Ok(PyPlanner { inner: planner })
@@ -243,8 +263,8 @@ pub(crate) fn fit_model(
     params: Option<&Bound<'_, PyAny>>,
     dt_s: Option<f64>,
 ) -> PyResult<PyModel> {
-    let demos = demonstrations(demos, channels.as_deref(), dt_s)?;
-    let params = planner_params(params)?;
+    let mut params = planner_params(params)?;
+    let demos = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
     warn_demonstrations(py, &demos)?;
     let model = py.detach(|| guard(|| Ok(TaskModel::fit(&demos, &params.fit)?)))?;
     Ok(PyModel {
@@ -424,8 +444,13 @@ impl PyPlanner {
         );
         let mut records = Vec::with_capacity(n);
         for i in 0..n {
-            let demonstration =
-                demonstration(&execs[i], &format!("executions[{i}]"), names, Some(dt_s))?;
+            let demonstration = demonstration(
+                &execs[i],
+                &format!("executions[{i}]"),
+                names,
+                Some(dt_s),
+                None,
+            )?;
             if let Some(note) = demonstration.period_note() {
                 warn(py, &note)?;
             }

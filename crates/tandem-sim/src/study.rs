@@ -615,6 +615,35 @@ pub fn run_trial(
     trial: usize,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<(TrialResult, PhaseTimes)> {
+    run_trial_observed(config, model, reference_labels, trial, progress, &|_| {})
+}
+
+/// One simulated round of a study as it ran: what [`run_study_observed`]'s observer sees.
+#[derive(Clone, Copy, Debug)]
+pub struct RoundView<'a> {
+    /// The trial (0-based).
+    pub trial: usize,
+    /// The round within the trial (1-based; round `k` ran the schedule of iteration `k − 1`).
+    pub round: usize,
+    /// The planner the round ran under (its schedule), before the round is recorded.
+    pub planner: &'a Planner,
+    /// The round.
+    pub run: &'a workcell::RoundRun,
+}
+
+/// [`run_trial`] calling `observe` with every round after it ran and before it is recorded
+/// (to write chosen rounds out, e.g. as bags); the result is the same as without.
+///
+/// # Errors
+/// As [`run_trial`].
+pub fn run_trial_observed(
+    config: &StudyConfig,
+    model: &TaskModel,
+    reference_labels: &[Label],
+    trial: usize,
+    progress: &(dyn Fn(Progress) + Sync),
+    observe: &(dyn Fn(RoundView<'_>) + Sync),
+) -> Result<(TrialResult, PhaseTimes)> {
     config.validate()?;
     let seed = trial_seed(config.seed, trial);
     let mut params = config.planner.clone();
@@ -646,6 +675,12 @@ pub fn run_trial(
                 .map(|r| pick(r).iter().filter(|b| f(b)).count())
                 .sum()
         };
+        observe(RoundView {
+            trial,
+            round: pair + 1,
+            planner: &planner,
+            run: &run,
+        });
         record.pair = Some(PairStats {
             overlap_ticks: run.overlap_ticks,
             operator_idle_share: run.operator_idle_share(),
@@ -686,6 +721,21 @@ pub fn run_study(
     inputs: &StudyInputs,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<(StudyResult, PhaseTimes)> {
+    run_study_observed(config, inputs, progress, &|_| {})
+}
+
+/// [`run_study`] calling `observe` with every round of every trial after it ran and before it
+/// is recorded ([`RoundView`]; from worker threads, in no particular order across trials);
+/// the result is the same as without.
+///
+/// # Errors
+/// As [`run_study`].
+pub fn run_study_observed(
+    config: &StudyConfig,
+    inputs: &StudyInputs,
+    progress: &(dyn Fn(Progress) + Sync),
+    observe: &(dyn Fn(RoundView<'_>) + Sync),
+) -> Result<(StudyResult, PhaseTimes)> {
     config.validate()?;
     inputs.check().map_err(|why| Error::BadInput {
         path: "<study inputs>".into(),
@@ -707,7 +757,8 @@ pub fn run_study(
     }
     model.prepare_corrections();
     let alignment = t.elapsed();
-    let (result, mut times) = run_trials(config, &model, &inputs.reference_labels, progress)?;
+    let (result, mut times) =
+        run_trials_observed(config, &model, &inputs.reference_labels, progress, observe)?;
     times.alignment = alignment;
     Ok((result, times))
 }
@@ -725,6 +776,20 @@ pub fn run_trials(
     reference_labels: &[Label],
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<(StudyResult, PhaseTimes)> {
+    run_trials_observed(config, model, reference_labels, progress, &|_| {})
+}
+
+/// [`run_trials`] with an observer of every round ([`run_trial_observed`]).
+///
+/// # Errors
+/// As [`run_trials`].
+pub fn run_trials_observed(
+    config: &StudyConfig,
+    model: &TaskModel,
+    reference_labels: &[Label],
+    progress: &(dyn Fn(Progress) + Sync),
+    observe: &(dyn Fn(RoundView<'_>) + Sync),
+) -> Result<(StudyResult, PhaseTimes)> {
     config.validate()?;
     if reference_labels.len() != model.n_ref() {
         return Err(Error::BadInput {
@@ -738,7 +803,7 @@ pub fn run_trials(
     }
     let outcomes: Vec<Result<(TrialResult, PhaseTimes)>> = (0..config.trials)
         .into_par_iter()
-        .map(|k| run_trial(config, model, reference_labels, k, progress))
+        .map(|k| run_trial_observed(config, model, reference_labels, k, progress, observe))
         .collect();
     let mut times = PhaseTimes::default();
     let mut trials = Vec::with_capacity(config.trials);

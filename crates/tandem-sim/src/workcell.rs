@@ -165,6 +165,15 @@ pub struct RobotRun {
     pub missed: usize,
     /// Corrections given where none was needed.
     pub false_corrections: usize,
+    /// The robot's schedule clock `s_i` (global schedule time, s) at the start of every
+    /// control tick of the round, running or not (`RoundRun::ticks` entries): before the robot
+    /// starts it follows the pace of the running robots (its start shifts), after it finishes
+    /// it stays at its end.
+    pub clock_s: Vec<f64>,
+    /// The round's control tick (0-based) of the robot's first sample: ticks
+    /// `0..start_tick` it waited for its start, ticks `start_tick..start_tick + n` it ran
+    /// (`n` samples), later ticks it had finished. `RoundRun::ticks` when it never ran.
+    pub start_tick: usize,
 }
 
 impl RobotRun {
@@ -488,6 +497,8 @@ fn run_schedule(
         needed: 0,
         missed: 0,
         false_corrections: 0,
+        clock_s: Vec::with_capacity(n_ref * 2),
+        start_tick: usize::MAX,
     };
     let n_robots = coord.n_robots();
     let mut runs: Vec<RobotRun> = (0..n_robots).map(|_| empty()).collect();
@@ -524,8 +535,12 @@ fn run_schedule(
         let mut operator = Operator::Scheduled;
         for i in 0..n_robots {
             let tl = &coord.robots()[i];
+            runs[i].clock_s.push(clocks[i]);
             if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() {
                 continue;
+            }
+            if runs[i].start_tick == usize::MAX {
+                runs[i].start_tick = ticks;
             }
             let n = tl.sample_at(clocks[i]);
             let ref_time = tl.ref_time_at(clocks[i]).min(last_ref);
@@ -573,6 +588,9 @@ fn run_schedule(
             1 => {}
             _ => overlap_ticks += 1,
         }
+    }
+    for run in &mut runs {
+        run.start_tick = run.start_tick.min(ticks);
     }
     Ok(RoundRun {
         robots: runs,
@@ -862,6 +880,45 @@ mod tests {
                 && (run.operator_busy_share() + run.operator_idle_share() - 1.0).abs() < 1e-15
         );
         assert_eq!(run.records(&model).unwrap().len(), 3);
+    }
+
+    #[test]
+    fn every_robot_logs_its_clock_every_tick_and_runs_from_its_start_tick() {
+        let model = model();
+        let problem = problem(&model);
+        let schedule = problem.serial_schedule_n(3, problem.dt_s()).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let params = OperatorParams::default();
+        let run = run_schedule(
+            &model,
+            &problem,
+            &schedule,
+            painted_needs_n,
+            &params,
+            &mut rng,
+        )
+        .unwrap();
+        let starts: Vec<f64> = std::iter::once(0.0)
+            .chain(schedule.offsets_s.iter().copied())
+            .collect();
+        for (i, r) in run.robots.iter().enumerate() {
+            assert_eq!(r.clock_s.len(), run.ticks, "robot {i}: one clock per tick");
+            assert!(r.clock_s.windows(2).all(|w| w[0] <= w[1]), "robot {i}");
+            let n = r.ref_time_log.len();
+            assert!(n > 0 && r.start_tick + n <= run.ticks, "robot {i}");
+            // Waiting before its start tick (clock short of its start τ_i), running from it.
+            let tau = starts[i];
+            assert!(
+                r.clock_s[..r.start_tick].iter().all(|&c| c < tau),
+                "robot {i}"
+            );
+            assert!(r.clock_s[r.start_tick] >= tau, "robot {i}");
+        }
+        assert_eq!(run.robots[0].start_tick, 0);
+        // Serial: each robot starts once the one before it has finished.
+        for w in run.robots.windows(2) {
+            assert!(w[1].start_tick >= w[0].start_tick + w[0].ref_time_log.len());
+        }
     }
 
     /// [`painted_needs`] for any robot index (every workpiece painted).

@@ -124,3 +124,45 @@ fn a_study_needs_the_labels_of_its_reference() {
     let (result, _) = run_trials(&config, &model, &labels, &|_| {}).unwrap();
     assert_eq!(result.n_ref, labels.len());
 }
+
+/// The observer sees every round of every trial once, with the planner whose schedule the round
+/// ran, and does not change the study.
+#[test]
+fn an_observed_study_is_the_same_study_and_shows_every_round() {
+    use std::sync::Mutex;
+    use tandem_sim::study::run_trials_observed;
+    let config = StudyConfig {
+        trials: 2,
+        executions: 6,
+        samples: 100,
+        seed: 13,
+        ..StudyConfig::default()
+    };
+    let (inputs, model) = common::fixtures();
+    let seen = Mutex::new(Vec::new());
+    let (observed, _) =
+        run_trials_observed(&config, model, &inputs.reference_labels, &|_| {}, &|v| {
+            // The round ran the planner's current schedule: its T_total is the iteration's.
+            seen.lock().unwrap().push((
+                v.trial,
+                v.round,
+                v.planner.outcome().t_total_s,
+                v.run.robots.len(),
+            ));
+        })
+        .unwrap();
+    let plain = run(&config);
+    assert_eq!(
+        serde_json::to_string(&observed).unwrap(),
+        serde_json::to_string(&plain).unwrap()
+    );
+    let mut seen = seen.into_inner().unwrap();
+    seen.sort_by_key(|s| (s.0, s.1));
+    let keys: Vec<(usize, usize)> = seen.iter().map(|s| (s.0, s.1)).collect();
+    assert_eq!(keys, [(0, 1), (0, 2), (0, 3), (1, 1), (1, 2), (1, 3)]);
+    for (trial, round, t_total_s, robots) in seen {
+        assert_eq!(robots, 2);
+        let it = &plain.trials[trial].iterations[round - 1];
+        assert_eq!(it.t_total_s, t_total_s, "trial {trial} round {round}");
+    }
+}

@@ -12,6 +12,7 @@
 //! | [`schedule`] | `tandem-schedule` | §II-B4/6, §II-C, execution warps, offset, anytime sampler (Eq. 13, 19–20) |
 //! | [`planner`] | `tandem-planner` | Fig. 2, the loop and its state file |
 //! | [`sim`] | `tandem-sim` | §III, sanding task, simulated workcell and operator, the study |
+//! | [`bag`] | `tandem-bag` | ROS 2 bags: MCAP recordings as demonstrations and executions, runs as MCAP |
 //!
 //! The loop of Fig. 2: learn from demonstrations, run a pair of executions under the
 //! schedule, record it, get the next schedule.
@@ -90,6 +91,12 @@ pub mod planner {
 /// (Fig. 5): the crate `tandem-sim`.
 pub mod sim {
     pub use tandem_sim::*;
+}
+
+/// ROS 2 bags: rosbag2 MCAP recordings read as demonstrations and executions, simulated runs
+/// written as MCAP for Foxglove: the crate `tandem-bag`.
+pub mod bag {
+    pub use tandem_bag::*;
 }
 
 pub use tandem_planner::{ExecutionRecord, Planner, PlannerParams, RecordReport, derive_seed};
