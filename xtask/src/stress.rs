@@ -33,7 +33,7 @@ use tandem::schedule::{Problem, SamplerParams, Source, sample_schedule_n};
 
 /// Executions per scheduled problem (the number of problems is `N / this`, at least 1 and at
 /// most [`MAX_PROBLEMS`]).
-const EXECUTIONS_PER_PROBLEM: u64 = 10_000;
+const EXECUTIONS_PER_PROBLEM: u64 = 1_000;
 /// Upper bound on the number of sampled problems.
 const MAX_PROBLEMS: u64 = 200;
 /// Sampler candidates per problem.
