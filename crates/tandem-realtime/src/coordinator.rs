@@ -54,6 +54,26 @@ pub struct Tick {
     /// Whether each robot is running (started and not finished) during the tick: its schedule
     /// clock moved inside `[τ_i, τ_i + |ψ_E|)`.
     pub running: RobotFlags,
+    /// The latched fault, if any (this tick's or an earlier one's, until
+    /// [`Coordinator::clear_fault`]): see [`Fault`].
+    pub fault: Option<Fault>,
+}
+
+/// A latched fault of the run-time monitor: in tick `tick` two or more robots traversed a
+/// low-confidence sample (`low_conf`), a state [`sufficient_margins`](crate::sufficient_margins)
+/// excludes. The coordinator fails safe instead of carrying on: it holds `stopped`, the robot
+/// whose low-confidence stretch began last (the highest index on a tie), where it is — its
+/// schedule clock no longer advances — until the caller clears the fault, so that the operator
+/// has one robot to help. The fault is reported in every later [`Tick`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fault {
+    /// Index of the tick (counted from the coordinator's start or last reset) in which it
+    /// happened.
+    pub tick: u64,
+    /// The robots low-confidence in that tick.
+    pub low_conf: RobotFlags,
+    /// The robot held (index `0..N`).
+    pub stopped: usize,
 }
 
 impl Tick {
@@ -131,16 +151,43 @@ pub struct Coordinator {
     tol_s: f64,
     clock_s: [f64; MAX_ROBOTS],
     cursors: [Cursors; MAX_ROBOTS],
+    /// Ticks run since the start or the last reset.
+    ticks: u64,
+    /// Per robot, the tick at which its current run of low-confidence ticks began.
+    lc_since: [u64; MAX_ROBOTS],
+    /// Whether each robot was low-confidence in the previous tick.
+    lc_last: RobotFlags,
+    /// The latched fault.
+    fault: Option<Fault>,
 }
 
 impl Coordinator {
     /// Builds a coordinator of `robots` (robot `i` at index `i`, e.g. an array of
-    /// [`Timeline`]s) with every schedule clock at the earliest start `min_i τ_i`.
+    /// [`Timeline`]s) with every schedule clock at the earliest start `min_i τ_i`, after
+    /// checking with [`sufficient_margins`](crate::sufficient_margins) at `tick_s` that no
+    /// admissible operator can make two robots low-confidence in one tick.
+    ///
+    /// # Errors
+    /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] if `tick_s` is
+    /// not finite and > 0; [`Error::Unsafe`] if the margin check rejects the robots' plans at
+    /// that tick.
+    pub fn new(robots: impl Into<Vec<Timeline>>, tick_s: f64) -> Result<Coordinator> {
+        let c = Coordinator::new_unchecked(robots, tick_s)?;
+        if !crate::sufficient_margins(&c.robots, tick_s)? {
+            return Err(Error::Unsafe { tick_s });
+        }
+        Ok(c)
+    }
+
+    /// [`Coordinator::new`] without the margin check: for tests and studies of what a schedule
+    /// the check rejects does at run time, and for callers that have just run the check on the
+    /// same plans and tick (`tandem_schedule::CheckedSchedule`). The run-time monitor still
+    /// latches a [`Fault`] and holds a robot if two are ever low-confidence together.
     ///
     /// # Errors
     /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] if `tick_s` is
     /// not finite and > 0.
-    pub fn new(robots: impl Into<Vec<Timeline>>, tick_s: f64) -> Result<Coordinator> {
+    pub fn new_unchecked(robots: impl Into<Vec<Timeline>>, tick_s: f64) -> Result<Coordinator> {
         let robots: Arc<[Timeline]> = robots.into().into();
         check_count(robots.len())?;
         if !(tick_s.is_finite() && tick_s > 0.0) {
@@ -150,15 +197,32 @@ impl Coordinator {
             });
         }
         let tol_s = clock_tolerance_s(&robots, tick_s);
+        let n = robots.len();
         let mut c = Coordinator {
             robots,
             tick_s,
             tol_s,
             clock_s: [0.0; MAX_ROBOTS],
             cursors: [Cursors::default(); MAX_ROBOTS],
+            ticks: 0,
+            lc_since: [0; MAX_ROBOTS],
+            lc_last: RobotFlags::new(n),
+            fault: None,
         };
         c.reset();
         Ok(c)
+    }
+
+    /// The latched fault, if two robots have been low-confidence in one tick since the start,
+    /// the last reset or the last [`Coordinator::clear_fault`].
+    pub fn fault(&self) -> Option<Fault> {
+        self.fault
+    }
+
+    /// Clears the latched fault: the held robot moves again from the next tick on (once the
+    /// operator has dealt with the robot that kept running).
+    pub fn clear_fault(&mut self) {
+        self.fault = None;
     }
 
     /// The timelines, robot `i` at index `i`.
@@ -199,6 +263,10 @@ impl Coordinator {
             .fold(f64::INFINITY, f64::min);
         self.clock_s = [t0; MAX_ROBOTS];
         self.cursors = [Cursors::default(); MAX_ROBOTS];
+        self.ticks = 0;
+        self.lc_since = [0; MAX_ROBOTS];
+        self.lc_last = RobotFlags::new(self.robots.len());
+        self.fault = None;
     }
 
     /// Whether each robot is running and low-confidence at its current schedule clock (Eq. 16
@@ -258,8 +326,14 @@ impl Coordinator {
         let mut members = [Member::idle(0.0, Mode::Finished); MAX_ROBOTS];
         let mut next_s = [0.0_f64; MAX_ROBOTS];
         let mut pace_robot = None;
+        let held = self.fault.map(|f| f.stopped);
         for i in 0..n {
             let s = self.clock_s[i];
+            if held == Some(i) {
+                // Held by the fault monitor: it does not move and sets nothing.
+                members[i] = Member::idle(s, Mode::Finished);
+                continue;
+            }
             members[i] = match self.phase(i) {
                 Phase::Waiting => Member::idle(s, Mode::Waiting),
                 Phase::Finished => Member::idle(s, Mode::Finished),
@@ -280,6 +354,7 @@ impl Coordinator {
             ref_time: PerRobot::new(n),
             low_conf: RobotFlags::new(n),
             running: RobotFlags::new(n),
+            fault: None,
         };
         let first_waiting_start = first_waiting_start(&members[..n], |i| self.robots[i].start_s());
         for (i, m) in members[..n].iter().enumerate() {
@@ -309,7 +384,35 @@ impl Coordinator {
             let at = r.advance_cursor(&mut self.cursors[i].at, s_new);
             out.ref_time.as_mut_slice()[i] = r.ref_time_in(at, s_new);
         }
+        self.monitor(&out);
+        out.fault = self.fault;
+        self.ticks += 1;
         Ok(out)
+    }
+
+    /// The run-time monitor, after each tick: keeps when each robot's run of low-confidence
+    /// ticks began and latches a [`Fault`] (holding the robot whose run began last) in a tick
+    /// with two or more robots low-confidence, unless a fault is already latched. O(N).
+    fn monitor(&mut self, tick: &Tick) {
+        let n = self.robots.len();
+        for i in 0..n {
+            if tick.low_conf[i] && !self.lc_last[i] {
+                self.lc_since[i] = self.ticks;
+            }
+        }
+        self.lc_last = tick.low_conf;
+        if self.fault.is_some() || !tick.overlap() {
+            return;
+        }
+        let stopped = (0..n)
+            .filter(|&i| tick.low_conf[i])
+            .max_by_key(|&i| (self.lc_since[i], i))
+            .expect("an overlap has low-confidence robots");
+        self.fault = Some(Fault {
+            tick: self.ticks,
+            low_conf: tick.low_conf,
+            stopped,
+        });
     }
 }
 
@@ -330,7 +433,7 @@ mod tests {
 
     #[test]
     fn three_sample_case_drag_then_rush_overlaps() {
-        let mut c = Coordinator::new(three_sample(1.5), 1.0).unwrap();
+        let mut c = Coordinator::new_unchecked(three_sample(1.5), 1.0).unwrap();
         // Tick 0: robot 0 alone and HC runs on schedule (step 1); robot 1 waits, its clock
         // follows. Robot 0 ends exactly where its LC sample starts: the tolerance reports it LC.
         let t = c.tick(Operator::Fastest).unwrap();
@@ -352,6 +455,46 @@ mod tests {
         assert_eq!(t.ref_time, [3.0, 2.0]);
         assert_eq!(t.low_conf, [true, true]);
         assert!(c.robots()[0].end_s() <= c.clock_s()[0]);
+        // The monitor latches the fault and holds robot 1, whose run of LC ticks began last
+        // (in this tick; robot 0's in tick 0).
+        let fault = Fault {
+            tick: 2,
+            low_conf: RobotFlags::from_slice(&[true, true]),
+            stopped: 1,
+        };
+        assert_eq!(t.fault, Some(fault));
+        assert_eq!(c.fault(), Some(fault));
+        // Held: robot 1 does not move while the fault stands, and every tick reports it.
+        let held_at = c.clock_s()[1];
+        for _ in 0..3 {
+            let t = c.tick(Operator::Slowest).unwrap();
+            assert_eq!(t.fault, Some(fault));
+            assert!(!t.running[1] && !t.low_conf[1]);
+            assert_eq!(c.clock_s()[1], held_at);
+        }
+        assert!(!c.is_finished());
+        // Cleared: robot 1 moves again and finishes; no new fault (robot 0 has finished).
+        c.clear_fault();
+        while !c.is_finished() {
+            let t = c.tick(Operator::Slowest).unwrap();
+            assert_eq!(t.fault, None);
+        }
+        // A reset clears everything.
+        c.reset();
+        assert_eq!(c.fault(), None);
+    }
+
+    #[test]
+    fn new_checks_the_margins_and_new_unchecked_does_not() {
+        // τ = 3/2 is the unsafe three-sample case; τ = 3 (serial) is safe.
+        assert!(matches!(
+            Coordinator::new(three_sample(1.5), 1.0),
+            Err(Error::Unsafe { tick_s }) if tick_s == 1.0
+        ));
+        assert!(Coordinator::new_unchecked(three_sample(1.5), 1.0).is_ok());
+        let c = Coordinator::new(three_sample(3.0), 1.0).unwrap();
+        assert_eq!(c.fault(), None);
+        assert!(Coordinator::new(three_sample(3.0), 0.0).is_err());
     }
 
     #[test]
@@ -362,7 +505,7 @@ mod tests {
         let first_running_tick = |operator: Operator| {
             let r0 = Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap();
             let r1 = Timeline::new(&conf, &g, &lo, &hi, 2.0, 1.0).unwrap();
-            let mut c = Coordinator::new([r0, r1], 0.5).unwrap();
+            let mut c = Coordinator::new_unchecked([r0, r1], 0.5).unwrap();
             (0..100).find(|_| {
                 let t = c.tick(operator).unwrap();
                 // Until it starts, robot 1's clock equals robot 0's (capped at τ).
@@ -385,7 +528,7 @@ mod tests {
         let g = [1.0; 4];
         let r0 = Timeline::new(&conf, &g, &[0.5; 4], &[2.0; 4], 0.0, 1.0).unwrap();
         let r1 = Timeline::new(&conf, &g, &[2.0 / 3.0; 4], &[2.0; 4], 0.0, 1.0).unwrap();
-        let mut c = Coordinator::new([r0, r1], 1.0).unwrap();
+        let mut c = Coordinator::new_unchecked([r0, r1], 1.0).unwrap();
         let t = c.tick(Operator::Fastest).unwrap();
         assert_eq!(c.clock_s(), [1.5, 1.5]);
         assert_eq!(t.ref_time, [1.5, 1.5]);
@@ -397,7 +540,7 @@ mod tests {
         // Robot 0 is LC on sample 0 only and one sample long; robot 1 HC, both start at 0.
         let r0 = Timeline::new(&[false], &[1.0], &[0.5], &[2.0], 0.0, 1.0).unwrap();
         let r1 = Timeline::new(&[true; 4], &[1.0; 4], &[0.8; 4], &[1.25; 4], 0.0, 1.0).unwrap();
-        let mut c = Coordinator::new([r0, r1], 0.25).unwrap();
+        let mut c = Coordinator::new_unchecked([r0, r1], 0.25).unwrap();
         // Operator gradient 0.8 (inside [½, 2]) → robot 0 steps (1/0.8)·¼ = 0.3125; robot 1
         // (F = 1.25) matches it exactly.
         let t = c.tick(Operator::Gradient(0.8)).unwrap();
@@ -430,7 +573,7 @@ mod tests {
             Err(Error::BadParam { name: "tick_s", .. })
         ));
         assert!(Coordinator::new(r.clone(), f64::NAN).is_err());
-        let mut c = Coordinator::new(r, 1.0).unwrap();
+        let mut c = Coordinator::new_unchecked(r, 1.0).unwrap();
         c.tick(Operator::Scheduled).unwrap();
         // Robot 0 is now in its LC sample. A degenerate gradient is an error that leaves the
         // coordinator as it was, not "no correction".
@@ -447,7 +590,7 @@ mod tests {
         c.tick(Operator::Scheduled).unwrap();
         assert_eq!(c.clock_s(), [2.0, 1.5]);
         // A gradient far outside the bounds is clamped: 1e9 drags like Slowest.
-        let mut drag = Coordinator::new(three_sample(1.5), 1.0).unwrap();
+        let mut drag = Coordinator::new_unchecked(three_sample(1.5), 1.0).unwrap();
         let mut slow = drag.clone();
         drag.tick(Operator::Scheduled).unwrap();
         slow.tick(Operator::Scheduled).unwrap();
@@ -458,7 +601,7 @@ mod tests {
 
     #[test]
     fn reset_runs_the_same_plan_again() {
-        let mut c = Coordinator::new(three_sample(1.5), 0.5).unwrap();
+        let mut c = Coordinator::new_unchecked(three_sample(1.5), 0.5).unwrap();
         let ops = [
             Operator::Fastest,
             Operator::Slowest,
@@ -468,7 +611,12 @@ mod tests {
             let mut ticks = Vec::new();
             let mut k = 0;
             while !c.is_finished() {
-                ticks.push(c.tick(ops[k % 3]).unwrap());
+                let t = c.tick(ops[k % 3]).unwrap();
+                // The plan is unsafe: release a held robot, as an operator would.
+                if t.fault.is_some() {
+                    c.clear_fault();
+                }
+                ticks.push(t);
                 k += 1;
             }
             ticks
@@ -496,7 +644,7 @@ mod tests {
 
     #[test]
     fn n_robots_respond_to_the_low_confidence_one_then_run_high_conf_together() {
-        let mut c = Coordinator::new(four_robots(), 1.0).unwrap();
+        let mut c = Coordinator::new_unchecked(four_robots(), 1.0).unwrap();
         assert_eq!(c.n_robots(), 4);
         assert_eq!(c.low_conf_now(), [true, false, false, false]);
         // Tick 0: robot 0 LC, rushed (step F·tick = 2). Robot 1 cannot keep up (fastest
@@ -541,22 +689,27 @@ mod tests {
             Timeline::new(&lc, &g, &[0.8; 2], &[1.25; 2], 0.0, 1.0).unwrap(),
             Timeline::new(&[true; 2], &g, &lo, &hi, 0.5, 1.0).unwrap(),
         ];
-        let mut c = Coordinator::new(robots, 1.0).unwrap();
+        let mut c = Coordinator::new_unchecked(robots, 1.0).unwrap();
         // Dragged: robot 0 steps ½, robot 1 steps 0.8; robot 2 waits for the robot furthest
         // behind (robot 0, at ½ = its start).
         let t = c.tick(Operator::Slowest).unwrap();
         assert_eq!(c.clock_s(), [0.5, 0.8, 0.5]);
         assert!(t.overlap());
-        // Still both LC; robot 2 (HC, at ½) responds to robot 0, the lowest-index LC robot,
-        // which steps ½ to 1: robot 2 matches.
+        // The monitor holds robot 1 (both runs began in this tick: the higher index): robot 0
+        // steps ½ to 1 and robot 2 (HC, at ½) responds to it and matches.
+        assert_eq!(t.fault.map(|f| f.stopped), Some(1));
         c.tick(Operator::Slowest).unwrap();
-        assert_eq!(c.clock_s(), [1.0, 1.6, 1.0]);
+        assert_eq!(c.clock_s(), [1.0, 0.8, 1.0]);
+        // Released, robot 1 follows the operator again.
+        c.clear_fault();
+        c.tick(Operator::Slowest).unwrap();
+        assert_eq!(c.clock_s()[1], 1.6);
     }
 
     #[test]
     fn one_robot_runs_alone_and_the_count_is_checked() {
         let r = three_sample(0.0);
-        let mut c = Coordinator::new(vec![r[0].clone()], 1.0).unwrap();
+        let mut c = Coordinator::new_unchecked(vec![r[0].clone()], 1.0).unwrap();
         let t = c.tick(Operator::Slowest).unwrap();
         assert_eq!(
             (c.clock_s(), t.low_conf),

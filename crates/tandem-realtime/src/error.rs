@@ -50,6 +50,16 @@ pub enum Error {
         /// The largest count, [`MAX_ROBOTS`](crate::MAX_ROBOTS).
         max: usize,
     },
+    /// The margin check rejects the robots' plans at this control tick: some admissible operator
+    /// could make two robots low-confidence in one tick (build the coordinator from a schedule
+    /// that passes the check, or with `Coordinator::new_unchecked` to study what it does).
+    #[error(
+        "the margin check rejects these plans at a tick of {tick_s} s: two robots could be low-confidence in one tick"
+    )]
+    Unsafe {
+        /// The control tick checked (real s).
+        tick_s: f64,
+    },
     /// A scalar parameter is out of its valid range.
     #[error("parameter `{name}` {why}")]
     BadParam {

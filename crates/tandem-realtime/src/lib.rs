@@ -66,7 +66,7 @@ pub mod testkit;
 mod timeline;
 pub mod tol;
 
-pub use coordinator::{Coordinator, Operator, Tick};
+pub use coordinator::{Coordinator, Fault, Operator, Tick};
 pub use error::{Error, Result};
 pub use margins::{PairSlack, pair_slacks, sufficient_margins, sufficient_margins_per_pair};
 pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};

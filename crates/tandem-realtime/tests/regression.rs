@@ -29,7 +29,7 @@ fn three_sample_case_printed_accepts_overlaps_conservative_rejects() {
     assert!(!sufficient_margins_per_pair(&robots, 1.0).unwrap());
     // The operator drags the previous robot for one tick (setting the tick phase), then rushes
     // it: the responder matches the rushed step and enters its LC sample in the same tick.
-    let mut c = Coordinator::new(robots, 1.0).unwrap();
+    let mut c = Coordinator::new_unchecked(robots, 1.0).unwrap();
     let ticks: Vec<_> = [FAST, SLOW, FAST]
         .iter()
         .map(|&g| c.tick(g).unwrap())
@@ -123,15 +123,16 @@ fn a_dragged_third_robot_breaks_the_two_robot_worst_case() {
     // The operator drags every low-confidence robot. While robot 0 is dragged (step ⅛ s),
     // robot 1 follows it but robot 2 cannot go below ¼ s per tick and gains 8 s; robot 1's own
     // dragged region adds 8 s more, and robot 2 enters its region while robot 1 is in its own.
-    let mut c = Coordinator::new(robots, tick_s).unwrap();
+    let mut c = Coordinator::new_unchecked(robots, tick_s).unwrap();
     let mut first = None;
     for k in 0.. {
         if c.is_finished() {
             break;
         }
         let t = c.tick(SLOW).unwrap();
-        if t.overlap() && first.is_none() {
+        if t.overlap() {
             first = Some((k, t.low_conf));
+            break;
         }
     }
     let (k, low_conf) = first.expect("the dragged third robot makes robots 1 and 2 overlap");

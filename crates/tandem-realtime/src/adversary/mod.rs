@@ -314,7 +314,8 @@ impl PolicyState {
 
 /// Runs `coordinator` to the end (or for at most `max_ticks` ticks) with the operator inputs
 /// of `adversary`, drawing from `rng` (deterministic for its state). [`Adversary::Beam`] runs
-/// the search instead and reports its worst sequence.
+/// the search instead and reports its worst sequence. A [`Fault`](crate::Fault) the
+/// coordinator latches is counted and cleared at once, so that the run goes on to the end.
 ///
 /// # Errors
 /// [`crate::Error::BadOperator`] when the adversary produces an inadmissible gradient (a
@@ -340,6 +341,11 @@ pub fn run_adversary(
         if tick.overlap() {
             run.first_overlap.get_or_insert(run.ticks);
             run.overlap_ticks += 1;
+        }
+        // A measurement runs to the end: the fault a run-time monitor latches (and the robot it
+        // holds) is recorded above and released.
+        if tick.fault.is_some() {
+            coordinator.clear_fault();
         }
         run.ticks += 1;
     }
@@ -395,7 +401,7 @@ mod tests {
     #[test]
     fn a_bad_random_range_is_an_error_and_the_set_is_complete() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
-        let c = Coordinator::new(robots(), 1.0).unwrap();
+        let c = Coordinator::new_unchecked(robots(), 1.0).unwrap();
         let bad = Adversary::Random { lo: -1.0, hi: -0.5 };
         assert!(matches!(
             run_adversary(c, bad, &mut rng, 100),
@@ -414,7 +420,7 @@ mod tests {
         }
         // Both robots are LC together from the start: every policy sees the overlap.
         for a in set {
-            let c = Coordinator::new(robots(), 1.0).unwrap();
+            let c = Coordinator::new_unchecked(robots(), 1.0).unwrap();
             let run = run_adversary(c, a, &mut rng, 100).unwrap();
             assert!(run.finished && run.first_overlap.is_some(), "{a:?}");
         }

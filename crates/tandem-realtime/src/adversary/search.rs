@@ -73,6 +73,7 @@ fn finish(
 ) -> Result<AdversaryRun> {
     let mut overlap_ticks = 1;
     while !coordinator.is_finished() && ticks < max_ticks {
+        coordinator.clear_fault();
         overlap_ticks += u64::from(coordinator.tick(Operator::Scheduled)?.overlap());
         ticks += 1;
     }

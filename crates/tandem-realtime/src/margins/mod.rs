@@ -10,7 +10,7 @@
 //! Notation: `h` = `tick_s`; robot `i`'s schedule clock `s_i` (s); at its current sample the
 //! Eq. 17 rates `S_i = ψ̇_E/ψ̇max ≤ 1 ≤ F_i = ψ̇_E/ψ̇min`; `M_i = h · max(1, max_n F_i)` the
 //! largest step robot `i` can take in one tick (over *all* its samples); `ε` four times
-//! [`clock_tolerance_s`](crate::tol::clock_tolerance_s). An LC region of robot `i` is the exact
+//! [`clock_tolerance_s`]. An LC region of robot `i` is the exact
 //! schedule-clock interval of a maximal LC run, `[c_{n0}, c_{n1+1})` (see
 //! [`Timeline::lc_intervals`]); `p` leaves its region `P` at `T_p`, `c` enters its region `C` at
 //! `T_c`.
