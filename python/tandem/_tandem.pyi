@@ -330,10 +330,15 @@ class Schedule:
 class Coordinator:
     """The Rust real-time coordinator of a schedule (§II-B5), one control tick per call."""
 
-    def __init__(self, schedule: Schedule) -> None: ...
+    def __init__(self, schedule: Schedule) -> None:
+        """Raises ``ScheduleError`` for a schedule of your own not yet ``validate()``d."""
     def tick(self, operator: Union[None, float, str] = None) -> Tick:
         """One tick; ``operator``: None, a gradient, ``"fastest"``, ``"slowest"``."""
     def reset(self) -> None: ...
+    @property
+    def fault(self) -> Optional[Dict[str, Any]]:
+        """``{"tick", "low_conf", "stopped"}`` once two robots were low-confidence in a tick."""
+    def clear_fault(self) -> None: ...
     @property
     def is_finished(self) -> bool: ...
     @property
@@ -366,6 +371,8 @@ class Tick:
     def running(self) -> Bool: ...
     @property
     def overlap(self) -> bool: ...
+    @property
+    def fault(self) -> Optional[Dict[str, Any]]: ...
 
 class Warp:
     """A time warp from reference samples to query samples."""

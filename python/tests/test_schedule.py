@@ -111,3 +111,34 @@ def test_problem_from_arrays_schedules_like_the_planner(overlapping_planner: tan
     np.testing.assert_array_equal(twice.gradients, sampled.gradients)
     with pytest.raises(tandem.InputError):
         tandem.Problem(p.conf, p.grad_mean, p.grad_max, p.grad_min, p.dt_s)
+
+
+def test_a_coordinator_runs_only_a_checked_schedule(overlapping_planner: tandem.Planner) -> None:
+    s = overlapping_planner.schedule
+    problem, g = s.problem, s.gradients
+    # A schedule of your own, even a valid one, is refused until validate() passed on it.
+    mine = tandem.Schedule(problem, g, s.offsets, s.tick_s)
+    with pytest.raises(tandem.ScheduleError, match=r"validate\(\)") as e:
+        tandem.Coordinator(mine)
+    assert isinstance(e.value, tandem.TandemError) and e.value.violation == "Unchecked"
+    mine.validate()
+    coord = tandem.Coordinator(mine)
+    assert coord.tick_s == s.tick_s and coord.fault is None
+    # One that fails the check can never be run: validate() raises, and so does the
+    # coordinator, naming the rule.
+    together = tandem.Schedule(problem, g, [0.0], s.tick_s)
+    with pytest.raises(tandem.ScheduleError):
+        together.validate()
+    with pytest.raises(tandem.ScheduleError) as e:
+        tandem.Coordinator(together)
+    assert e.value.violation == "Unchecked"
+    # From JSON: unchecked again, however it was made.
+    back = tandem.Schedule.from_json(problem, s.to_json())
+    with pytest.raises(tandem.ScheduleError):
+        tandem.Coordinator(back)
+    # The scheduler's and the planner's schedules run as they are.
+    tandem.Coordinator(s)
+    tandem.Coordinator(problem.sample_schedule(samples=50, seed=1))
+    # So does tandem's serial schedule (checked by the coordinator itself).
+    tick = tandem.Coordinator(problem.serial_schedule()).tick()
+    assert tick.fault is None

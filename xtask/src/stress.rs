@@ -113,7 +113,7 @@ fn scheduled(
     };
     let out = sample_schedule_n(problem, n_robots, &params, None)?;
     let sampled = matches!(out.source, Source::Sampled { .. } | Source::Completed);
-    Ok((out.schedule.coordinator(problem)?, sampled))
+    Ok((out.schedule.check(problem)?.coordinator()?, sampled))
 }
 
 /// Problem `index` of the run: even indices are this task's random problems, odd ones cycle

@@ -22,7 +22,11 @@ pub(crate) fn load(path: &Path) -> Result<Planner> {
     if path.is_dir() {
         bail!("{}: is a folder, not a state file", path.display());
     }
-    Planner::load(path).context("cannot load the state")
+    let planner = Planner::load(path).context("cannot load the state")?;
+    if let Some(notice) = planner.load_notice() {
+        eprintln!("notice: {}: {notice}", path.display());
+    }
+    Ok(planner)
 }
 
 /// Checks that a state file can be written at `path` (as [`check_writable`], and an existing

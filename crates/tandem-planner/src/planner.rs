@@ -11,7 +11,8 @@ use tandem_confidence::{Confidence, ConfidenceParams, Observations};
 use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
-    Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source, sample_schedule_n,
+    CheckedSchedule, Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source,
+    sample_schedule_n, validate,
 };
 
 use crate::state::{Stamp, StateLock};
@@ -214,6 +215,8 @@ pub struct Planner {
     /// Fingerprints of the rounds recorded since the state format had them (version 6).
     rounds: Vec<u64>,
     origin: Origin,
+    /// Set by [`Planner::load`] when it replaced a stored schedule that failed the check.
+    load_notice: Option<String>,
 }
 
 /// The serialized part of a [`Planner`] (the problem is rebuilt on load).
@@ -419,6 +422,7 @@ impl Planner {
             pairs_recorded: 0,
             rounds: Vec::new(),
             origin: Origin::default(),
+            load_notice: None,
         })
     }
 
@@ -634,11 +638,33 @@ impl Planner {
     /// problem, at the control tick the schedule was checked with ([`Schedule::tick_s`]): what
     /// runs the two robots until the next [`Planner::record_pair`].
     ///
+    /// The schedule is checked on the problem first ([`Schedule::check`]: every constraint of
+    /// Eq. 20 with this build's margin check), so that a coordinator never runs a schedule
+    /// this build has not accepted.
+    ///
     /// # Errors
-    /// The schedule crate's error if the schedule does not lay out on the problem (not for a
-    /// planner made by [`Planner::new`], [`Planner::from_model`] or [`Planner::load`]).
+    /// The schedule crate's [`tandem_schedule::Error::Invalid`] if the schedule fails the
+    /// check (never for a planner made by [`Planner::new`], [`Planner::from_model`] or
+    /// [`Planner::load`], which re-schedules a stored schedule that fails it).
     pub fn coordinator(&self) -> Result<Coordinator> {
-        Ok(self.schedule().coordinator(&self.problem)?)
+        Ok(self.checked_schedule()?.coordinator()?)
+    }
+
+    /// The current schedule checked on the current problem ([`Schedule::check`]): what
+    /// [`Planner::coordinator`] runs.
+    ///
+    /// # Errors
+    /// As [`Planner::coordinator`].
+    pub fn checked_schedule(&self) -> Result<CheckedSchedule> {
+        Ok(self.schedule().check(&self.problem)?)
+    }
+
+    /// Why [`Planner::load`] replaced the stored schedule, if it did: the stored one failed
+    /// this build's check on the stored problem (e.g. a file written by a build whose margin
+    /// check accepted more, or edited by hand), and a fresh one was made. The replacement is
+    /// in memory until the planner is saved.
+    pub fn load_notice(&self) -> Option<&str> {
+        self.load_notice.as_deref()
     }
 
     /// The sampler's result for the current schedule (`T_total`, source, counts).
@@ -739,14 +765,39 @@ impl Planner {
             5 => state::decode_payload::<PlannerStateV5>(payload, path)?.into(),
             _ => state::decode_payload(payload, path)?,
         };
-        let planner = Self::from_state(st).map_err(|e| Error::Corrupt {
+        let mut planner = Self::from_state(st).map_err(|e| Error::Corrupt {
             path: path.to_path_buf(),
             why: e.to_string(),
         })?;
+        planner.recheck_schedule()?;
         if let Some(stamp) = state::stamp_of(&bytes) {
             planner.origin.set(state::resolved(path), stamp);
         }
         Ok(planner)
+    }
+
+    /// Re-checks the stored schedule on the stored problem with this build's check
+    /// ([`validate`]); one that fails is never run: it is replaced by a fresh schedule (the
+    /// sampler from scratch, at the stored tick when that is a valid tick, with the seed the
+    /// next schedule would have had) and [`Planner::load_notice`] says why.
+    fn recheck_schedule(&mut self) -> Result<()> {
+        let Err(violation) = validate(&self.problem, self.schedule()) else {
+            return Ok(());
+        };
+        let tick_s = self.schedule().tick_s;
+        let sampler = SamplerParams {
+            tick_s: (tick_s.is_finite() && tick_s > 0.0).then_some(tick_s),
+            ..Self::sampler_params(&self.params, self.pairs_recorded)
+        };
+        let outcome = sample_schedule_n(&self.problem, self.n_robots(), &sampler, None)?;
+        self.load_notice = Some(format!(
+            "the stored schedule fails this build's check ({violation}); it was replaced by a \
+             new schedule of {:.2} s (T_total), saved with the next command that writes the \
+             state",
+            outcome.t_total_s
+        ));
+        self.outcome = outcome;
+        Ok(())
     }
 
     fn to_state(&self) -> PlannerState {
@@ -819,6 +870,7 @@ impl Planner {
             pairs_recorded: st.pairs_recorded,
             rounds: st.rounds,
             origin: Origin::default(),
+            load_notice: None,
         })
     }
 }
@@ -917,6 +969,62 @@ mod tests {
         }
         newer.save(&path).unwrap();
         assert_eq!(Planner::load(&path).unwrap().params(), newer.params());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_stored_schedule_that_fails_the_check_is_replaced_on_load_never_run() {
+        let dir =
+            std::env::temp_dir().join(format!("tandem-planner-recheck-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("cell.tandem");
+        let p = small_planner(1);
+        p.save(&path).unwrap();
+        let fresh = Planner::load(&path).unwrap();
+        assert_eq!(fresh.load_notice(), None);
+        assert_eq!(fresh.schedule(), p.schedule());
+        // Edit the stored schedule: robot 2 starts so that its low-confidence stretch begins
+        // 1 ms after robot 1's ends on schedule. Constraints 1–4 hold; the margin check
+        // rejects it (robot 1 may be dragged into robot 2's stretch).
+        let mut st = p.to_state();
+        let s = &mut st.outcome.schedule;
+        let clock = |g: &[f64], n: usize| g[..n].iter().sum::<f64>() * 0.01;
+        let lc_end_1 = clock(&s.grad_exec[0], 20);
+        let lc_start_2 = clock(&s.grad_exec[1], 10);
+        s.offsets_s[0] = lc_end_1 - lc_start_2 + 1e-3;
+        let edited = s.clone();
+        assert!(matches!(
+            validate(p.problem(), &edited),
+            Err(tandem_schedule::Violation::InsufficientMargins { .. })
+        ));
+        crate::state::write_atomic(&path, &encode(&st).unwrap()).unwrap();
+        let loaded = Planner::load(&path).unwrap();
+        let notice = loaded.load_notice().expect("a notice");
+        assert!(
+            notice.contains("fails this build's check") && notice.contains("margin"),
+            "{notice}"
+        );
+        // Replaced, valid, at the stored tick; the coordinator runs the new one.
+        assert_ne!(loaded.schedule(), &edited);
+        assert!(validate(loaded.problem(), loaded.schedule()).is_ok());
+        assert_eq!(loaded.schedule().tick_s, edited.tick_s);
+        let c = loaded.coordinator().unwrap();
+        assert_eq!(c.robots()[1].start_s(), loaded.schedule().offsets_s[0]);
+        // The file is untouched until a command saves.
+        assert_eq!(
+            Planner::from_state(crate::state::load(&path).unwrap())
+                .unwrap()
+                .schedule(),
+            &edited
+        );
+        // And a planner holding a failing schedule (built in memory) gives no coordinator.
+        let mut bad = p.clone();
+        bad.outcome.schedule = edited;
+        assert!(matches!(
+            bad.coordinator(),
+            Err(Error::Schedule(tandem_schedule::Error::Invalid(_)))
+        ));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

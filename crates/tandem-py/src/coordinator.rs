@@ -3,11 +3,11 @@
 
 use numpy::PyArray1;
 use pyo3::prelude::*;
-use pyo3::types::PyString;
+use pyo3::types::{PyDict, PyString};
 
 use crate::arrays::{PyBool, out_flags, out_vector, repr_list};
 use crate::errors::{Error, Result, guard};
-use crate::facade::{Coordinator, Operator, Tick, Timeline};
+use crate::facade::{Coordinator, Fault, Operator, Tick, Timeline};
 use crate::schedule::PySchedule;
 
 /// The operator's input from Python: `None`/`"scheduled"`, a gradient, `"fastest"` or
@@ -75,10 +75,16 @@ impl PyCoordinator {
     /// earliest start.
     ///
     /// Raises:
-    ///     ScheduleError: a schedule whose warps do not fit its problem.
+    /// ``schedule`` must be checked by this build: one the scheduler or a planner made, or
+    /// one of your own that passed :meth:`Schedule.validate` (the margin check of Alg. 2 at
+    /// its tick is what makes a run safe).
+    ///
+    /// Raises:
+    ///     ScheduleError: a schedule of your own not yet validated (``violation`` is
+    ///         ``"Unchecked"``), or one that fails the check (``violation`` names the rule).
     #[new]
     fn py_new(schedule: PyRef<'_, PySchedule>) -> PyResult<Self> {
-        let inner = guard(|| Ok(schedule.schedule.coordinator(&schedule.problem)?))?;
+        let inner = guard(|| schedule.checked()?.coordinator().map_err(Error::from))?;
         Ok(Self { inner })
     }
 
@@ -106,9 +112,27 @@ impl PyCoordinator {
         Ok(PyTick { inner: tick })
     }
 
-    /// Puts every clock back at the earliest start (to run the same plan again).
+    /// Puts every clock back at the earliest start (to run the same plan again); clears a
+    /// latched fault.
     fn reset(&mut self) {
         self.inner.reset();
+    }
+
+    /// The latched fault of the run-time monitor, or ``None``: a dict ``{"tick": int,
+    /// "low_conf": (N,) bool, "stopped": int}`` if a tick ever had two robots
+    /// low-confidence (a state the margin check excludes, so a bug, never expected). The
+    /// coordinator then fails safe: robot ``stopped`` (the one whose low-confidence stretch
+    /// began last) is held where it is until :meth:`clear_fault`, and
+    /// :attr:`is_finished` stays false while it is held.
+    #[getter]
+    fn fault<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.inner.fault().map(|f| fault_dict(py, &f)).transpose()
+    }
+
+    /// Releases the robot the fault monitor holds (once the operator has dealt with the
+    /// other one); the fault is no longer reported.
+    fn clear_fault(&mut self) {
+        self.inner.clear_fault();
     }
 
     /// Whether every robot has finished.
@@ -185,6 +209,15 @@ impl PyCoordinator {
     }
 }
 
+/// A fault as the dict :attr:`Coordinator.fault` returns.
+fn fault_dict<'py>(py: Python<'py>, f: &Fault) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("tick", f.tick)?;
+    d.set_item("low_conf", out_flags(py, f.low_conf.iter().collect()))?;
+    d.set_item("stopped", f.stopped)?;
+    Ok(d)
+}
+
 /// What one :meth:`Coordinator.tick` did, per robot.
 #[pyclass(module = "tandem", name = "Tick", frozen)]
 pub(crate) struct PyTick {
@@ -218,6 +251,13 @@ impl PyTick {
     #[getter]
     fn overlap(&self) -> bool {
         self.inner.overlap()
+    }
+
+    /// The coordinator's latched fault after this tick (see :attr:`Coordinator.fault`), or
+    /// ``None``.
+    #[getter]
+    fn fault<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.inner.fault.map(|f| fault_dict(py, &f)).transpose()
     }
 
     fn __repr__(&self) -> String {

@@ -63,7 +63,8 @@ pyo3::create_exception!(
     PyUserWarning,
     "Data that was taken in, but not as given or not without doubt: a file without a time\n\
      column (the sample period it was assumed to have), an execution resampled to the model's\n\
-     period, a demonstration of unusual length. The message names the file and the fix."
+     period, a demonstration of unusual length, a stored schedule that failed this build's\n\
+     check and was replaced on load. The message names the file and the fix."
 );
 pyo3::create_exception!(
     tandem,
@@ -103,6 +104,13 @@ pub(crate) enum Error {
     /// A schedule breaks a constraint of Eq. 20.
     #[error("the schedule violates Eq. 20: {0}")]
     Violation(Violation),
+    /// A schedule of the user's own was given to a coordinator before it was checked.
+    #[error(
+        "this schedule has not been checked: call schedule.validate() first (it checks every \
+         constraint of Eq. 20, the margin check included); a coordinator runs only a schedule \
+         this build has checked"
+    )]
+    Unchecked,
     /// A Python argument has the wrong type, shape, dtype or value.
     #[error("{what}: {why}")]
     Input {
@@ -275,6 +283,9 @@ fn classify_schedule(e: &errors::Schedule) -> Kind {
         | errors::Schedule::NonFinite { .. }
         | errors::Schedule::BadBounds { .. } => input_at(None),
         errors::Schedule::Realtime(r) => classify_realtime(r),
+        errors::Schedule::Invalid(v) => Kind::Schedule {
+            violation: Some(violation_name(v)),
+        },
         _ => SCHEDULE,
     }
 }
@@ -347,6 +358,9 @@ impl Error {
             Error::Bag(e) => classify_bag(e),
             Error::Violation(v) => Kind::Schedule {
                 violation: Some(violation_name(v)),
+            },
+            Error::Unchecked => Kind::Schedule {
+                violation: Some("Unchecked".to_owned()),
             },
             Error::Input { file, what, .. } => input_at(Some(file.as_deref().unwrap_or(what))),
             Error::Param { what, .. } => param(what),

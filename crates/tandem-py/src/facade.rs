@@ -6,10 +6,10 @@ pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{
     Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, derive_seed,
 };
-pub(crate) use tandem::realtime::{Coordinator, MAX_ROBOTS, Operator, Tick, Timeline};
+pub(crate) use tandem::realtime::{Coordinator, Fault, MAX_ROBOTS, Operator, Tick, Timeline};
 pub(crate) use tandem::schedule::{
-    GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, Violation,
-    sample_schedule_n, validate,
+    CheckedSchedule, GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, Violation,
+    sample_schedule_n,
 };
 pub(crate) use tandem::sim::study::{
     PhaseTimes, StudyConfig, StudyInputs, read_labels, run_trial, run_trials,

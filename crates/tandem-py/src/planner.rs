@@ -324,12 +324,17 @@ impl PyPlanner {
     /// so :meth:`save` into the same file refuses to overwrite what another process saved
     /// into it meanwhile.
     ///
+    /// A stored schedule that fails this build's check (every constraint of Eq. 20 with the
+    /// margin check) is never run: it is replaced by a fresh schedule, with a ``DataWarning``
+    /// that says why (the file changes only when the planner is saved).
+    ///
     /// Raises:
     ///     StateFileError: the file is missing, not a state file, of another format version,
     ///         truncated or corrupt (``path`` names it).
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyPlanner> {
         let inner = py.detach(|| guard(|| Ok(Planner::load(&path)?)))?;
+        warn_load_notice(py, &path, &inner)?;
         Ok(PyPlanner { inner })
     }
 
@@ -624,6 +629,15 @@ impl PyPlanner {
     }
 }
 
+/// Warns (``DataWarning``) when loading replaced the stored schedule because it failed this
+/// build's check (see `Planner::load_notice`).
+fn warn_load_notice(py: Python<'_>, path: &std::path::Path, planner: &Planner) -> PyResult<()> {
+    match planner.load_notice() {
+        Some(notice) => crate::errors::warn(py, &format!("{}: {notice}", path.display())),
+        None => Ok(()),
+    }
+}
+
 /// A read–modify–write of a state file under its lock: what :meth:`Planner.locked`
 /// returns, a context manager (``with ... as planner:``).
 #[pyclass(module = "tandem", name = "StateEdit")]
@@ -649,6 +663,7 @@ impl PyStateEdit {
                 Ok((lock, inner))
             })
         })?;
+        warn_load_notice(py, &path, &inner)?;
         let planner = Py::new(py, PyPlanner { inner })?;
         self.lock = Some(lock);
         self.planner = Some(planner.clone_ref(py));

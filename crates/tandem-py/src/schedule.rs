@@ -1,6 +1,6 @@
 //! `tandem.Problem` and `tandem.Schedule` (§II-B4/6, Eq. 13, 15–16, 19–20).
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -9,8 +9,8 @@ use pyo3::types::{PyDict, PyList};
 use crate::arrays::{flags, matrix, out_flags, out_matrix, out_vector, vector};
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
-    GlobalTimeline, MAX_ROBOTS, Outcome, Problem, SamplerParams, Schedule, Source,
-    sample_schedule_n, validate,
+    CheckedSchedule, GlobalTimeline, MAX_ROBOTS, Outcome, Problem, SamplerParams, Schedule, Source,
+    sample_schedule_n,
 };
 use crate::planner::N_ROBOTS;
 
@@ -105,12 +105,10 @@ impl PyProblem {
             .inner
             .serial_schedule_n(robots, tick_s)
             .map_err(Error::from)?;
-        Ok(PySchedule::new(
-            self.inner.clone(),
-            s,
-            "serial".into(),
-            None,
-        ))
+        Ok(PySchedule {
+            from_scheduler: true,
+            ..PySchedule::new(self.inner.clone(), s, "serial".into(), None)
+        })
     }
 
     /// The scheduler (§II-C) on this problem for ``robots`` robots (1 to 8, default 2):
@@ -173,6 +171,14 @@ pub(crate) struct PySchedule {
     stats: Option<[usize; 3]>,
     /// `(lower bound T*₀ or the simple bound (s), relative gap)` of a scheduler's outcome.
     certificate: Option<(f64, f64)>,
+    /// The schedule as this build checked it on `problem`: set by [`PySchedule::checked`]
+    /// (the first time a coordinator is built from a scheduler's schedule) or by a
+    /// successful `validate()`; a user's schedule has none until then.
+    checked: OnceLock<CheckedSchedule>,
+    /// Whether the schedule came from this build's scheduler, planner or serial construction
+    /// (valid when made), so that a coordinator checks it itself instead of asking for
+    /// `validate()`.
+    from_scheduler: bool,
 }
 
 impl PySchedule {
@@ -188,13 +194,34 @@ impl PySchedule {
             source,
             stats,
             certificate: None,
+            checked: OnceLock::new(),
+            from_scheduler: false,
         }
+    }
+
+    /// The schedule as checked on its problem ([`Schedule::check`]), for the coordinator: a
+    /// user's schedule must have passed `validate()` first; a scheduler's is checked here
+    /// once (the check is this build's; a schedule the scheduler made passes it).
+    ///
+    /// # Errors
+    /// [`Error::Unchecked`] for a user's schedule that was not validated; the check's
+    /// violation otherwise.
+    pub(crate) fn checked(&self) -> Result<&CheckedSchedule> {
+        if let Some(c) = self.checked.get() {
+            return Ok(c);
+        }
+        if !self.from_scheduler {
+            return Err(Error::Unchecked);
+        }
+        let c = checked_or_violation(&self.problem, &self.schedule)?;
+        Ok(self.checked.get_or_init(|| c))
     }
 
     pub(crate) fn from_outcome(problem: Arc<Problem>, outcome: &Outcome) -> Self {
         let s = &outcome.stats;
         Self {
             certificate: Some((outcome.lower_bound_s, outcome.gap)),
+            from_scheduler: true,
             ..Self::new(
                 problem,
                 outcome.schedule.clone(),
@@ -207,6 +234,15 @@ impl PySchedule {
     fn timeline(&self) -> Result<GlobalTimeline> {
         Ok(GlobalTimeline::new(&self.problem, &self.schedule)?)
     }
+}
+
+/// [`Schedule::check`], a broken constraint as [`Error::Violation`] (``ScheduleError`` with
+/// the rule's name).
+fn checked_or_violation(problem: &Problem, schedule: &Schedule) -> Result<CheckedSchedule> {
+    schedule.check(problem).map_err(|e| match e {
+        crate::facade::errors::Schedule::Invalid(v) => Error::Violation(v),
+        other => other.into(),
+    })
 }
 
 #[pymethods]
@@ -396,9 +432,16 @@ impl PySchedule {
     ///
     /// Raises:
     ///     ScheduleError: the first broken constraint; ``violation`` names it.
+    ///
+    /// A schedule that passes may then run in a :class:`Coordinator` (a schedule of your own
+    /// must pass this first; the scheduler's and the planner's were checked when made).
     fn validate(&self, py: Python<'_>) -> PyResult<()> {
+        if self.checked.get().is_some() {
+            return Ok(());
+        }
         let (problem, schedule) = (&*self.problem, &self.schedule);
-        py.detach(|| guard(|| validate(problem, schedule).map_err(Error::Violation)))?;
+        let checked = py.detach(|| guard(|| checked_or_violation(problem, schedule)))?;
+        let _ = self.checked.set(checked);
         Ok(())
     }
 

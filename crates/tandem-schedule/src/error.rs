@@ -68,6 +68,10 @@ pub enum Error {
         /// What the realtime crate rejected.
         source: tandem_realtime::Error,
     },
+    /// The schedule breaks a constraint of Eq. 20 on its problem (the margin check of Alg. 2
+    /// included), so it is not run ([`crate::Schedule::check`]).
+    #[error("the schedule is not valid on its problem: {0}")]
+    Invalid(Violation),
     /// The realtime crate (coordinator, margin check) rejected its input.
     #[error(transparent)]
     Realtime(#[from] tandem_realtime::Error),

@@ -13,7 +13,9 @@
 //! schedule) winning; parallel, and deterministic for a seed whatever the thread count. Every
 //! [`Outcome`] is certified: it carries the margin-free lower bound `T*₀` ([`solve_exact`])
 //! and the gap to it. A schedule carries the control tick it was checked at
-//! ([`Schedule::tick_s`]); the runtime [`Schedule::coordinator`] runs at that tick.
+//! ([`Schedule::tick_s`]); [`Schedule::check`] re-checks it on its problem and the
+//! [`CheckedSchedule`] it returns is the only form the runtime coordinator is built from, at
+//! that tick.
 //!
 //! ```
 //! use tandem_schedule::{
@@ -31,7 +33,7 @@
 //! assert!(out.t_total_s < problem.serial_schedule(0.01)?.t_total_s(0.01));
 //! // The schedule was checked at the default control tick, Δt_s, and runs at it.
 //! assert_eq!(out.schedule.tick_s, 0.01);
-//! assert_eq!(out.schedule.coordinator(&problem)?.tick_s(), 0.01);
+//! assert_eq!(out.schedule.check(&problem)?.coordinator()?.tick_s(), 0.01);
 //! assert!(matches!(out.source, Source::Sampled { .. } | Source::Completed));
 //! // The certificate: no schedule of Eq. 20 is shorter than the margin-free optimum T*₀.
 //! assert!(out.bound_is_optimum && out.lower_bound_s <= out.t_total_s);
@@ -49,6 +51,7 @@
 //! # Ok::<(), tandem_schedule::Error>(())
 //! ```
 
+mod checked;
 mod choose;
 mod error;
 pub mod exact;
@@ -57,6 +60,7 @@ mod sampler;
 mod schedule;
 mod validate;
 
+pub use checked::CheckedSchedule;
 pub use choose::{
     Outcome, Source, sample_schedule, sample_schedule_n, sample_schedule_with_baselines,
 };

@@ -5,7 +5,7 @@
 //! intervals agree to the last bit with what the margin check and the coordinator use.
 
 use serde::{Deserialize, Serialize};
-use tandem_realtime::{Coordinator, LcInterval, MAX_ROBOTS, Timeline, clock_end_s, tol};
+use tandem_realtime::{LcInterval, MAX_ROBOTS, Timeline, clock_end_s, tol};
 
 use crate::problem::Problem;
 use crate::validate::Violation;
@@ -17,8 +17,8 @@ use crate::{Error, Result};
 ///
 /// Robot index 0 is the first robot (`τ_1 = 0`), index `i ≥ 1` starts at
 /// `τ_{i+1} = offsets_s[i − 1]`; for two robots `offsets_s = [τ]`. Check a schedule against a
-/// [`Problem`] with [`crate::validate`] (at its own tick), run it with
-/// [`Schedule::coordinator`] (at its own tick).
+/// [`Problem`] with [`crate::validate`] (at its own tick); [`Schedule::check`] does the same
+/// and returns the [`crate::CheckedSchedule`] whose coordinator runs it (at its own tick).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Schedule {
@@ -31,7 +31,7 @@ pub struct Schedule {
     /// robots `0 ≤ τ ≤ |ψ_E1|`).
     pub offsets_s: Vec<f64>,
     /// Control tick (real s, finite and > 0) of the margin check (Alg. 2, Eq. 20 constraint
-    /// 5) that accepted the schedule, and so the only period at which the [`Coordinator`] may
+    /// 5) that accepted the schedule, and so the only period at which the `tandem_realtime::Coordinator` may
     /// run it: the check's guarantee (never two robots low-confidence in one tick) holds for
     /// this tick, not for another.
     pub tick_s: f64,
@@ -111,15 +111,15 @@ impl Schedule {
             .collect()
     }
 
-    /// The runtime coordinator of this schedule on `problem` (§II-B5): every robot's
-    /// [`Timeline`], advanced one control tick of [`Schedule::tick_s`] real seconds per
-    /// [`Coordinator::tick`].
+    /// Checks this schedule on `problem` ([`validate`](crate::validate): every constraint of
+    /// Eq. 20, with this build's margin check of Alg. 2 at [`Schedule::tick_s`]) and, if it
+    /// passes, returns it as a [`CheckedSchedule`](crate::CheckedSchedule), the only form
+    /// the runtime coordinator is built from.
     ///
     /// # Errors
-    /// [`Error::Shape`] and [`Error::Timeline`] as [`Schedule::timelines`];
-    /// [`Error::Realtime`] for a tick that is not finite and > 0.
-    pub fn coordinator(&self, problem: &Problem) -> Result<Coordinator> {
-        Ok(Coordinator::new(self.timelines(problem)?, self.tick_s)?)
+    /// [`Error::Invalid`] with the first broken constraint.
+    pub fn check(&self, problem: &Problem) -> Result<crate::CheckedSchedule> {
+        crate::CheckedSchedule::new(problem, self.clone())
     }
 
     /// Start time of each robot in global time (s): `[0, τ_2, …, τ_N]`.
@@ -217,6 +217,11 @@ impl GlobalTimeline {
     /// Every robot's timeline (robot 1 first).
     pub fn timelines(&self) -> &[Timeline] {
         &self.robots
+    }
+
+    /// The timelines, by value.
+    pub(crate) fn into_timelines(self) -> Vec<Timeline> {
+        self.robots
     }
 
     /// Each robot's `[start, end]` in global time (s).
@@ -446,19 +451,26 @@ mod tests {
     }
 
     #[test]
-    fn the_coordinator_runs_at_the_schedule_tick() {
+    fn only_a_checked_schedule_gets_a_coordinator_at_its_tick() {
+        // τ = 1.25: robot 2's low-confidence samples (clock 1.5–2.5) meet robot 1's (1–2).
         let mut s = schedule(1.25);
         s.tick_s = 0.125;
-        let c = s.coordinator(&problem()).unwrap();
+        assert!(matches!(
+            s.check(&problem()),
+            Err(Error::Invalid(Violation::BothLowConfidence { .. }))
+        ));
+        // Serial (τ = |ψ_E1| = 2.25 s) passes; the coordinator runs the checked plans at the
+        // schedule's tick.
+        s.offsets_s = vec![2.25];
+        let checked = s.check(&problem()).unwrap();
+        let c = checked.coordinator().unwrap();
         assert_eq!(c.tick_s(), 0.125);
-        assert_eq!(c.robots()[1].start_s(), 1.25);
+        assert_eq!(c.robots()[1].start_s(), 2.25);
+        assert_eq!(checked.schedule(), &s);
         s.tick_s = f64::NAN;
         assert!(matches!(
-            s.coordinator(&problem()),
-            Err(Error::Realtime(tandem_realtime::Error::BadParam {
-                name: "tick_s",
-                ..
-            }))
+            s.check(&problem()),
+            Err(Error::Invalid(Violation::InvalidTick { .. }))
         ));
     }
 }

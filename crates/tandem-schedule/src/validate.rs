@@ -168,6 +168,16 @@ pub(crate) fn validate_full(
     schedule: &Schedule,
     check: MarginCheck,
 ) -> Result<(), Violation> {
+    validated_timeline(problem, schedule, check).map(drop)
+}
+
+/// Every constraint of Eq. 20 (see [`validate`]) with margin-check implementation `check`;
+/// on success, the schedule's global timeline (what [`crate::CheckedSchedule`] keeps).
+pub(crate) fn validated_timeline(
+    problem: &Problem,
+    schedule: &Schedule,
+    check: MarginCheck,
+) -> Result<GlobalTimeline, Violation> {
     let tick_s = schedule.tick_s;
     if !(tick_s.is_finite() && tick_s > 0.0) {
         return Err(Violation::InvalidTick { tick_s });
@@ -179,7 +189,7 @@ pub(crate) fn validate_full(
         MarginCheck::PerPair => tandem_realtime::sufficient_margins_per_pair(robots, tick_s),
     };
     match decided {
-        Ok(true) => Ok(()),
+        Ok(true) => Ok(timeline),
         Ok(false) => Err(Violation::InsufficientMargins { tick_s }),
         Err(source) => Err(Violation::MarginCheck { tick_s, source }),
     }

@@ -481,7 +481,7 @@ fn run_schedule(
             workcell_tick_s: dt_s,
         });
     }
-    let mut coord = schedule.coordinator(problem)?;
+    let mut coord = schedule.check(problem)?.coordinator()?;
     let tick_s = coord.tick_s();
 
     let m = model.channel_names().len();
