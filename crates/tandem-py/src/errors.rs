@@ -275,6 +275,8 @@ fn classify_schedule(e: &errors::Schedule) -> Kind {
         | errors::Schedule::NonFinite { .. }
         | errors::Schedule::BadBounds { .. } => input_at(None),
         errors::Schedule::Realtime(r) => classify_realtime(r),
+        // A wrong certificate bound is a bug in tandem, not in the caller's data.
+        errors::Schedule::BoundAboveSchedule { .. } => Kind::Internal,
         _ => SCHEDULE,
     }
 }
@@ -397,6 +399,18 @@ impl From<Error> for PyErr {
 pub(crate) fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
     let text = std::ffi::CString::new(message.replace('\0', " ")).expect("no NUL left");
     PyErr::warn(py, &py.get_type::<DataWarning>(), &text, 1)
+}
+
+/// Emits a Python `DeprecationWarning` with `message` (an old name kept one release; the
+/// message names its replacement).
+pub(crate) fn deprecated(py: Python<'_>, message: &str) -> PyResult<()> {
+    let text = std::ffi::CString::new(message.replace('\0', " ")).expect("no NUL left");
+    PyErr::warn(
+        py,
+        &py.get_type::<pyo3::exceptions::PyDeprecationWarning>(),
+        &text,
+        1,
+    )
 }
 
 /// Runs `f`, turning a panic into [`Error::Panic`] so that it reaches Python as
