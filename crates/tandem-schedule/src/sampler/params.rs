@@ -10,7 +10,7 @@ use crate::{Error, ExactParams, Result};
 /// Parameters of [`crate::sample_schedule`] (the sampler and, in [`SamplerParams::exact`], the
 /// exact search and completion it runs beside): what a user tunes. They are stored in the
 /// planner's state file and printed by `tandem params`; the benchmark-only alternatives
-/// measured in the module docs are [`SamplerBaselines`], which are never stored.
+/// measured in the sampler's module docs are [`SamplerBaselines`], which are never stored.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SamplerParams {
@@ -19,7 +19,7 @@ pub struct SamplerParams {
     /// Seed; candidate `k` uses ChaCha8 stream `k` of this seed. Default: 0.
     pub seed: u64,
     /// Control tick (real s) of the margin check (Alg. 2), stored in the returned schedule
-    /// ([`Schedule::tick_s`]) as the only period the coordinator may run it at. `None` = the
+    /// ([`Schedule::tick_s`](crate::Schedule::tick_s)) as the only period the coordinator may run it at. `None` = the
     /// reference period `Δt_s`. Must be finite and > 0. Default: `None`.
     pub tick_s: Option<f64>,
     /// Pieces per maximal high-confidence run, each with one speed factor (the run is cut
