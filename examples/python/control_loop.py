@@ -21,12 +21,12 @@ It prints the latency of ``Coordinator.tick`` alone and of a whole iteration (p5
 By default it runs as fast as it can (what the latency figures need); ``--realtime`` sleeps to
 hold the 1 kHz period and counts missed deadlines.
 
-    python examples/python/control_loop.py                      # one pair of executions
+    python examples/python/control_loop.py                      # one round of executions
     python examples/python/control_loop.py --calls 1000000      # the latency benchmark
     python examples/python/control_loop.py --state cell.tandem --realtime
 
 Without ``--state`` it fits the repository's sanding fixtures with a quick-learning confidence
-(``μ_c`` 0.3, ``γ_c`` 0.5) and records two simulated pairs, so that the schedule overlaps the
+(``μ_c`` 0.3, ``γ_c`` 0.5) and records two simulated rounds, so that the schedule overlaps the
 robots and both move in most ticks.
 """
 
@@ -73,8 +73,8 @@ def planner_for(args: argparse.Namespace) -> tandem.Planner:
         params={"sampler": {"samples": args.samples}, "confidence": {"mu_c": 0.3, "gamma_c": 0.5}},
     )
     for k in range(2):
-        run = tandem.sim.run_pair(planner, tandem.sim.sanding_needs(SANDING / "demo_0.labels.csv", k), k)
-        planner.record_pair(**run.record_args())
+        run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(SANDING / "demo_0.labels.csv", k), k)
+        planner.record_round(**run.record_args())
     return planner
 
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """A parameter sweep of the paper's study on dask.distributed: μ_c × operator error rate × seed.
 
-Each point of the grid is one trial of the study (§III: demonstrations, then pairs of
-executions in the simulated workcell, re-scheduling after every pair) with the confidence
+Each point of the grid is one trial of the study (§III: demonstrations, then rounds of
+executions in the simulated workcell, re-scheduling after every round) with the confidence
 threshold ``μ_c`` (Eq. 12) and an operator who misses needed corrections and gives unneeded
 ones at the same ``error_rate``. Replicate ``r`` is trial ``r`` of that configuration, seeded by
 ``(seed, r)`` only: every point is independent of where and in which order it runs, so the

@@ -7,7 +7,7 @@ timing changes the operator's corrections cause. This package is the Rust implem
 NumPy arrays in and out (docs/python.md):
 
 - :func:`fit` → :class:`Planner` (the paper's Fig. 2 loop): :attr:`Planner.model`,
-  :attr:`Planner.confidence`, :attr:`Planner.schedule`, :meth:`Planner.record_pair`,
+  :attr:`Planner.confidence`, :attr:`Planner.schedule`, :meth:`Planner.record_round`,
   :meth:`Planner.reschedule`, :meth:`Planner.save` / :meth:`Planner.load` (the command
   line's state file), :meth:`Planner.command` (Eq. 7).
 - :class:`Coordinator`: the real-time coordinator of a schedule (§II-B5), one control tick

@@ -122,7 +122,8 @@ class Planner:
         channels: Optional[Sequence[str]] = None,
         dt_s: Optional[float] = None,
     ) -> Dict[str, Any]:
-        """:meth:`record_round` under the paper's name (two robots)."""
+        """Deprecated (kept one release): :meth:`record_round` under its two-robot name;
+        emits a ``DeprecationWarning``."""
     def reschedule(
         self,
         samples: Optional[int] = None,
@@ -146,8 +147,12 @@ class Planner:
     def params(self) -> Dict[str, Any]:
         """The parameters as a nested dict."""
     @property
+    def rounds_recorded(self) -> int:
+        """Rounds recorded so far (a round is one execution of each robot)."""
+    @property
     def pairs_recorded(self) -> int:
-        """Rounds of executions (pairs for two robots) recorded so far."""
+        """Deprecated (kept one release): :attr:`rounds_recorded`; emits a
+        ``DeprecationWarning``."""
     @property
     def n_robots(self) -> int:
         """Robots scheduled (``N``)."""

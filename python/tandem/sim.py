@@ -1,6 +1,6 @@
 """The simulated workcell of the paper's §III: run a schedule once with a simulated operator.
 
-:func:`run_round` (:func:`run_pair` for two robots) runs the planner's current schedule through the Rust real-time coordinator at
+:func:`run_round` runs the planner's current schedule through the Rust real-time coordinator at
 the schedule's tick, one control tick per reference sample period, while a simulated operator
 supervises the low-confidence robot: it corrects the samples that need it (missing 1 %), and
 corrects unneeded ones 1 % of the time in short episodes (``tandem_sim::workcell``). Each
@@ -12,6 +12,7 @@ is the operator's gradient for the coordinator. The result feeds
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from os import PathLike
 from typing import Any, Mapping, Optional, Union
@@ -83,7 +84,7 @@ class RoundRun:
 
     def record_args(self) -> dict:
         """The keyword arguments of :meth:`tandem.Planner.record_round` (and
-        :meth:`tandem.Planner.record_pair`) for this run."""
+        :meth:`tandem.Planner.record_round`) for this run."""
         return {
             "executions": [r.samples for r in self.robots],
             "ref_time_logs": [r.ref_time_log for r in self.robots],
@@ -92,7 +93,7 @@ class RoundRun:
         }
 
 
-#: The paper's two-robot round.
+#: Deprecated (kept one release): :class:`RoundRun` under its two-robot name.
 PairRun = RoundRun
 
 
@@ -129,7 +130,14 @@ def run_pair(
     seed: int,
     operator: Optional[Mapping[str, Any]] = None,
 ) -> RoundRun:
-    """:func:`run_round` under the paper's name (a two-robot planner runs a pair)."""
+    """Deprecated (kept one release): :func:`run_round` under its two-robot name; emits a
+    ``DeprecationWarning``."""
+    warnings.warn(
+        "tandem.sim.run_pair is deprecated: use tandem.sim.run_round (a round is one "
+        "execution of each robot)",
+        DeprecationWarning,
+        stacklevel=2,
+    )
     return run_round(planner, needs, seed, operator)
 
 

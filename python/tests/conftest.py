@@ -39,12 +39,12 @@ def load_arrays(path: Path):
     return [header[k] for k in keep], data[:, keep]
 
 
-def record_pairs(planner: tandem.Planner, pairs: int, seed0: int = 0) -> None:
-    """Runs and records ``pairs`` pairs in the simulated workcell."""
-    for k in range(seed0, seed0 + pairs):
+def record_rounds(planner: tandem.Planner, rounds: int, seed0: int = 0) -> None:
+    """Runs and records ``rounds`` rounds in the simulated workcell."""
+    for k in range(seed0, seed0 + rounds):
         needs = tandem.sim.sanding_needs(LABELS, seed=k)
-        run = tandem.sim.run_pair(planner, needs, seed=k)
-        planner.record_pair(**run.record_args())
+        run = tandem.sim.run_round(planner, needs, seed=k)
+        planner.record_round(**run.record_args())
 
 
 @pytest.fixture(scope="session")
@@ -55,11 +55,11 @@ def planner() -> tandem.Planner:
 
 @pytest.fixture(scope="session")
 def overlapping_planner() -> tandem.Planner:
-    """A planner whose schedule overlaps the robots (quick confidence, two pairs recorded)."""
+    """A planner whose schedule overlaps the robots (quick confidence, two rounds recorded)."""
     p = tandem.fit(
         DEMOS,
         params={"sampler": {"samples": SAMPLES, "seed": 3}, "confidence": QUICK_CONFIDENCE},
     )
-    record_pairs(p, 2)
+    record_rounds(p, 2)
     assert p.schedule.offsets[0] < p.schedule.durations_s[0] / 2, "the robots overlap"
     return p

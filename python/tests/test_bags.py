@@ -90,7 +90,7 @@ def run_20(tmp_path_factory) -> dict:
     run_cli("fit", *BAGS, "--params", EXAMPLES / "params.toml", "-o", state)
     bag = tmp / "run.mcap"
     run_cli(
-        "simulate", state, "--need", EXAMPLES / "need.csv", "--pairs", 20,
+        "simulate", state, "--need", EXAMPLES / "need.csv", "--rounds", 20,
         "--channel", "wrench.fz", "--bag", bag, "--write", tmp / "csv", "--seed", 3,
     )
     return {"bag": bag, "csv": tmp / "csv", "state": state}
@@ -109,7 +109,7 @@ def test_a_20_round_run_opens_in_the_python_reader_with_every_topic_and_count(ru
     for robot in (1, 2):
         # Samples per round from the run's own CSV files: one message per sample and topic.
         samples = sum(
-            len((run_20["csv"] / f"pair_{k}_robot_{robot}.reflog.csv").read_text().split()) - 1
+            len((run_20["csv"] / f"round_{k}_robot_{robot}.reflog.csv").read_text().split()) - 1
             for k in range(1, 21)
         )
         ns = f"/robot_{robot}"
@@ -134,10 +134,10 @@ def test_the_decoded_run_is_the_runs_csv_files(run_20) -> None:
     )
     pick = lambda topic: [m[3] for m in first if m[0] == topic and m[2] < end]  # noqa: E731
     csv = run_20["csv"]
-    exe = np.loadtxt(csv / "pair_1_robot_1.csv", delimiter=",", skiprows=1)
-    header = (csv / "pair_1_robot_1.csv").read_text().split("\n", 1)[0].split(",")
-    log = np.loadtxt(csv / "pair_1_robot_1.reflog.csv", skiprows=1)
-    flags = np.loadtxt(csv / "pair_1_robot_1.corr.csv", delimiter=",", skiprows=1)
+    exe = np.loadtxt(csv / "round_1_robot_1.csv", delimiter=",", skiprows=1)
+    header = (csv / "round_1_robot_1.csv").read_text().split("\n", 1)[0].split(",")
+    log = np.loadtxt(csv / "round_1_robot_1.reflog.csv", skiprows=1)
+    flags = np.loadtxt(csv / "round_1_robot_1.corr.csv", delimiter=",", skiprows=1)
     poses = pick("/robot_1/tool_pose")
     assert [p.pose.position.x for p in poses] == list(exe[:, header.index("tool_pose.x")])
     assert [p.pose.orientation.w for p in poses] == list(exe[:, header.index("tool_pose.qw")])
@@ -157,7 +157,7 @@ def test_record_from_the_bag_equals_record_from_the_csv_files(run_20, tmp_path: 
     csv = run_20["csv"]
     args = []
     for r in (1, 2):
-        stem = csv / f"pair_1_robot_{r}"
+        stem = csv / f"round_1_robot_{r}"
         args += ["--execution", f"{stem}.csv", "--log", f"{stem}.reflog.csv",
                  "--corrections", f"{stem}.corr.csv"]
     run_cli("record", b, *args)

@@ -58,7 +58,8 @@ def test_each_side_opens_the_others_state(planner: tandem.Planner, tmp_path: Pat
     planner.save(tmp_path / "py.state")
     doc = json.loads(run_cli("inspect", tmp_path / "py.state", "--json"))
     assert doc["model"]["n_ref"] == planner.model.n_ref
-    assert doc["pairs_recorded"] == 0
+    # `rounds_recorded`, and its deprecated duplicate `pairs_recorded` (kept one release).
+    assert doc["rounds_recorded"] == doc["pairs_recorded"] == 0
     assert doc["schedule"]["t_total_s"] == planner.schedule.t_total_s
 
 
@@ -73,10 +74,10 @@ def write_execution(folder: Path, robot: int, run, channels) -> list:
     return [exe, log, corr]
 
 
-def test_record_pair_equals_tandem_record(tmp_path: Path) -> None:
+def test_record_round_equals_tandem_record(tmp_path: Path) -> None:
     cli_fit(tmp_path / "cli.state")
     py = tandem.fit(DEMOS, params=PARAMS)
-    run = tandem.sim.run_pair(py, tandem.sim.sanding_needs(LABELS, seed=1), seed=1)
+    run = tandem.sim.run_round(py, tandem.sim.sanding_needs(LABELS, seed=1), seed=1)
     files = [write_execution(tmp_path, i, run, py.model.channels) for i in range(2)]
     run_cli(
         "record", tmp_path / "cli.state",
@@ -84,11 +85,11 @@ def test_record_pair_equals_tandem_record(tmp_path: Path) -> None:
         "--log", files[0][1], "--log", files[1][1],
         "--corrections", files[0][2], "--corrections", files[1][2],
     )
-    report = py.record_pair(**run.record_args())
+    report = py.record_round(**run.record_args())
     py.save(tmp_path / "py.state")
     assert (tmp_path / "py.state").read_bytes() == (tmp_path / "cli.state").read_bytes()
     assert report["t_total_s"] == py.schedule.t_total_s
-    assert py.pairs_recorded == 1 and py.model.count == 8
+    assert py.rounds_recorded == 1 and py.model.count == 8
 
 
 def test_reschedule_equals_tandem_schedule(
@@ -118,10 +119,10 @@ def test_memory_layout_of_arrays_does_not_matter() -> None:
         np.testing.assert_array_equal(other.sigma2_d, reference.sigma2_d)
 
 
-def test_record_pair_takes_execution_files_with_columns_in_any_order(tmp_path: Path) -> None:
+def test_record_round_takes_execution_files_with_columns_in_any_order(tmp_path: Path) -> None:
     from_arrays = tandem.fit(DEMOS, params=PARAMS)
     from_files = tandem.fit(DEMOS, params=PARAMS)
-    run = tandem.sim.run_pair(from_arrays, tandem.sim.sanding_needs(LABELS, seed=2), seed=2)
+    run = tandem.sim.run_round(from_arrays, tandem.sim.sanding_needs(LABELS, seed=2), seed=2)
     channels = from_arrays.model.channels
     files = []
     for i, r in enumerate(run.robots):
@@ -130,8 +131,8 @@ def test_record_pair_takes_execution_files_with_columns_in_any_order(tmp_path: P
                    comments="", fmt="%.17g")
         files.append(path)
     args = run.record_args()
-    from_arrays.record_pair(**args)
-    from_files.record_pair(**{**args, "executions": files})
+    from_arrays.record_round(**args)
+    from_files.record_round(**{**args, "executions": files})
     from_arrays.save(tmp_path / "a.state")
     from_files.save(tmp_path / "f.state")
     assert (tmp_path / "a.state").read_bytes() == (tmp_path / "f.state").read_bytes()

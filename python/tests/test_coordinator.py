@@ -10,7 +10,7 @@ import tandem
 from conftest import LABELS
 
 
-def replay(planner: tandem.Planner, run: tandem.sim.PairRun) -> dict:
+def replay(planner: tandem.Planner, run: tandem.sim.RoundRun) -> dict:
     """Drives a Python ``Coordinator`` through the workcell's protocol (tandem_sim::workcell,
     steps 1-5): each running robot reads its reference time, a supervised and corrected robot
     gets the rate of its command (Eq. 7) as the operator's gradient. Asserts at every tick that
@@ -50,7 +50,7 @@ def replay(planner: tandem.Planner, run: tandem.sim.PairRun) -> dict:
 def test_python_coordinator_reproduces_a_rust_workcell_run(
     overlapping_planner: tandem.Planner, seed: int
 ) -> None:
-    run = tandem.sim.run_pair(
+    run = tandem.sim.run_round(
         overlapping_planner, tandem.sim.sanding_needs(LABELS, seed=seed), seed=seed
     )
     corrected = sum(int(r.corrected.sum()) for r in run.robots)

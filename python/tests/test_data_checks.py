@@ -45,7 +45,7 @@ def at_1khz(args: dict) -> dict:
 def test_a_1_khz_log_is_resampled_never_a_model_whose_mean_execution_triples() -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
     before = mean_execution_s(planner)
-    run = tandem.sim.run_pair(planner, tandem.sim.sanding_needs(LABELS, seed=4), seed=4)
+    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=4), seed=4)
     args = run.record_args()
     fast = at_1khz(args)
     # The same round at 100 Hz, for comparison.
@@ -55,7 +55,7 @@ def test_a_1_khz_log_is_resampled_never_a_model_whose_mean_execution_triples() -
     # refused, with the fix, and nothing recorded.
     with pytest.raises(tandem.InputError, match="give its sample period"):
         planner.record_round(**fast)
-    assert planner.pairs_recorded == 0
+    assert planner.rounds_recorded == 0
     # With its period it is resampled to the model's 10 ms, and said.
     with pytest.warns(tandem.DataWarning, match=r"logged 0\.001 s apart, resampled to the model's 0\.01 s"):
         report = planner.record_round(**fast, dt_s=0.001)
@@ -72,7 +72,7 @@ def test_a_1_khz_log_is_resampled_never_a_model_whose_mean_execution_triples() -
 
 def test_a_coarser_log_is_refused() -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
-    args = tandem.sim.run_pair(planner, tandem.sim.sanding_needs(LABELS, seed=1), seed=1).record_args()
+    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=1), seed=1).record_args()
     with pytest.raises(tandem.InputError, match="coarser than the model's 0.01 s") as e:
         planner.record_round(**{**args, "dt_s": 0.02})
     assert e.value.file == "executions[0]"
@@ -82,18 +82,18 @@ def test_a_coarser_log_is_refused() -> None:
 
 def test_a_truncated_execution_is_refused() -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
-    args = tandem.sim.run_pair(planner, tandem.sim.sanding_needs(LABELS, seed=2), seed=2).record_args()
+    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=2), seed=2).record_args()
     half = len(args["ref_time_logs"][1]) // 2
     cut = {k: [v[0], v[1][:half]] for k, v in args.items()}
     with pytest.raises(tandem.InputError, match=r"ends at reference sample .*whole task") as e:
         planner.record_round(**cut)
     assert e.value.file == "executions[1]"
-    assert planner.pairs_recorded == 0
+    assert planner.rounds_recorded == 0
 
 
 def test_the_same_round_twice_is_refused() -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
-    args = tandem.sim.run_pair(planner, tandem.sim.sanding_needs(LABELS, seed=3), seed=3).record_args()
+    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=3), seed=3).record_args()
     planner.record_round(**args)
     before = planner.schedule.t_total_s
     with pytest.raises(tandem.InputError, match="already recorded as round 1"):
@@ -101,7 +101,7 @@ def test_the_same_round_twice_is_refused() -> None:
     swapped = {k: v[::-1] for k, v in args.items()}
     with pytest.raises(tandem.InputError, match="record each round once"):
         planner.record_round(**swapped)
-    assert planner.pairs_recorded == 1 and planner.schedule.t_total_s == before
+    assert planner.rounds_recorded == 1 and planner.schedule.t_total_s == before
 
 
 def test_outlier_demonstrations_are_refused_or_warned_with_the_fix() -> None:
@@ -136,7 +136,7 @@ def test_a_time_column_under_another_name_is_refused(tmp_path: Path) -> None:
 
 def test_a_file_without_t_states_its_assumed_period(tmp_path: Path) -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
-    run = tandem.sim.run_pair(planner, tandem.sim.sanding_needs(LABELS, seed=5), seed=5)
+    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=5), seed=5)
     args = run.record_args()
     files = []
     for i, x in enumerate(args["executions"]):
@@ -149,7 +149,7 @@ def test_a_file_without_t_states_its_assumed_period(tmp_path: Path) -> None:
 
 def test_the_tick_a_user_chose_survives_record_round() -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
-    args = tandem.sim.run_pair(planner, tandem.sim.sanding_needs(LABELS, seed=6), seed=6).record_args()
+    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=6), seed=6).record_args()
     planner.reschedule(tick_s=0.005)
     assert planner.schedule.tick_s == 0.005
     planner.record_round(**args, dt_s=0.01)  # logged at the 10 ms tick it ran at
@@ -161,7 +161,7 @@ def test_the_tick_a_user_chose_survives_record_round() -> None:
 def test_the_state_file_is_locked_and_never_overwritten_by_accident(tmp_path: Path) -> None:
     path = tmp_path / "cell.tandem"
     tandem.fit(DEMOS, params=PARAMS).save(path)
-    args = tandem.sim.run_pair(tandem.Planner.load(path), tandem.sim.sanding_needs(LABELS, seed=7), seed=7).record_args()
+    args = tandem.sim.run_round(tandem.Planner.load(path), tandem.sim.sanding_needs(LABELS, seed=7), seed=7).record_args()
     with tandem.Planner.locked(path) as planner:
         planner.record_round(**args)
         # Another writer waits for the lock, then gives up with a clear error.
@@ -169,17 +169,17 @@ def test_the_state_file_is_locked_and_never_overwritten_by_accident(tmp_path: Pa
         with pytest.raises(tandem.StateFileError, match="another process has been writing") as e:
             other.save(path, timeout_s=0.05)
         assert e.value.path == str(path)
-    assert tandem.Planner.load(path).pairs_recorded == 1
+    assert tandem.Planner.load(path).rounds_recorded == 1
     # A planner loaded before that save does not overwrite the recorded round.
     with pytest.raises(tandem.StateFileError, match="changed since this planner was loaded"):
         other.save(path)
-    assert tandem.Planner.load(path).pairs_recorded == 1
+    assert tandem.Planner.load(path).rounds_recorded == 1
     # An exception inside the block saves nothing.
     with pytest.raises(RuntimeError):
         with tandem.Planner.locked(path) as planner:
             planner.reschedule(samples=50)
             raise RuntimeError("abandon")
-    assert tandem.Planner.load(path).pairs_recorded == 1
+    assert tandem.Planner.load(path).rounds_recorded == 1
     # Saving over a file that is not a state file is refused.
     csv = tmp_path / "demo_3.csv"
     csv.write_text(DEMOS[3].read_text())

@@ -120,12 +120,12 @@ def test_missing_and_unwritable_state_files(planner: tandem.Planner, tmp_path: P
     assert path.read_bytes() == before
 
 
-def test_a_failed_record_pair_leaves_planner_and_file_intact(tmp_path: Path) -> None:
+def test_a_failed_record_round_leaves_planner_and_file_intact(tmp_path: Path) -> None:
     path = tmp_path / "cell.tandem"
     tandem.fit(DEMOS, params={"sampler": {"samples": SAMPLES}}).save(path)
     before = path.read_bytes()
     planner = tandem.Planner.load(path)
-    run = tandem.sim.run_pair(planner, tandem.sim.sanding_needs(LABELS, seed=3), seed=3)
+    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=3), seed=3)
     args = run.record_args()
     n = len(args["ref_time_logs"][1])
     bad_cases = [
@@ -138,11 +138,29 @@ def test_a_failed_record_pair_leaves_planner_and_file_intact(tmp_path: Path) -> 
     ]
     for change, error in bad_cases:
         with pytest.raises(error):
-            planner.record_pair(**{**args, **change})
-        assert planner.pairs_recorded == 0
+            planner.record_round(**{**args, **change})
+        assert planner.rounds_recorded == 0
     planner.save(tmp_path / "after.tandem")
     assert (tmp_path / "after.tandem").read_bytes() == before
     assert path.read_bytes() == before
-    # The good pair still records.
-    planner.record_pair(**args)
-    assert planner.pairs_recorded == 1
+    # The good round still records.
+    planner.record_round(**args)
+    assert planner.rounds_recorded == 1
+
+
+def test_the_two_robot_names_are_deprecated_aliases(tmp_path: Path) -> None:
+    """``record_pair`` and ``pairs_recorded`` (kept one release) warn and do what
+    ``record_round`` and ``rounds_recorded`` do: the same state file, byte for byte."""
+    fitted = tandem.fit(DEMOS, params={"sampler": {"samples": SAMPLES}})
+    fitted.save(tmp_path / "base.tandem")
+    new, old = (tandem.Planner.load(tmp_path / "base.tandem") for _ in range(2))
+    run = tandem.sim.run_round(new, tandem.sim.sanding_needs(LABELS, seed=4), seed=4)
+    new.record_round(**run.record_args())
+    with pytest.warns(DeprecationWarning, match="use Planner.record_round"):
+        old.record_pair(**run.record_args())
+    with pytest.warns(DeprecationWarning, match="use Planner.rounds_recorded"):
+        assert old.pairs_recorded == 1
+    assert new.rounds_recorded == old.rounds_recorded == 1
+    new.save(tmp_path / "new.tandem")
+    old.save(tmp_path / "old.tandem")
+    assert (tmp_path / "new.tandem").read_bytes() == (tmp_path / "old.tandem").read_bytes()

@@ -26,8 +26,8 @@ def run(script: str, *args: str) -> str:
 
 def test_quickstart(tmp_path: Path) -> None:
     state = tmp_path / "cell.tandem"
-    out = run("quickstart.py", "--pairs", "2", "--samples", "100", "--save", str(state))
-    assert re.search(r"pair  2: T_total +\d+\.\d+ s", out), out
+    out = run("quickstart.py", "--rounds", "2", "--samples", "100", "--save", str(state))
+    assert re.search(r"round  2: T_total +\d+\.\d+ s", out), out
     assert "overlap ticks 0" in out
     assert state.exists()
 

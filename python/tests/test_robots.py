@@ -34,7 +34,7 @@ def test_a_three_robot_planner_has_three_warps_and_two_offsets(three: tandem.Pla
     assert s.gradients.shape == (3, three.model.n_ref)
     assert s.offsets.shape == (2,)
     assert len(s.lc_intervals) == 3
-    assert three.pairs_recorded == 2
+    assert three.rounds_recorded == 2
     s.validate()
 
 
@@ -92,10 +92,10 @@ def test_rounds_take_one_execution_per_robot(three: tandem.Planner) -> None:
     run = tandem.sim.run_round(three, needs, seed=9)
     args = run.record_args()
     short = {k: v[:2] for k, v in args.items()}
-    before = three.pairs_recorded
+    before = three.rounds_recorded
     with pytest.raises(tandem.InputError, match="3 robots"):
         three.record_round(**short)
-    assert three.pairs_recorded == before
+    assert three.rounds_recorded == before
     with pytest.raises(tandem.InputError):
         tandem.sim.run_round(three, tandem.sim.sanding_needs(LABELS, seed=9), seed=9)
     with pytest.raises(tandem.ParamError):

@@ -106,7 +106,7 @@ fn generate_state(examples: &Path) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
         example_record(examples, 2, dt_s)?,
     ];
     planner
-        .record_pair(&pair)
+        .record_round(&pair)
         .context("recording the example pair")?;
     // The bytes `Planner::save` writes, through a scratch file.
     let scratch = std::env::temp_dir().join(format!("tandem-xtask-state-{}", std::process::id()));

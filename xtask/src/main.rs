@@ -1,7 +1,7 @@
 //! `cargo xtask <cmd>`: repeatable project tasks (see README.md and docs/ARCHITECTURE.md).
 //!
 //! Each subcommand lives in its own module; this file only parses the command line and
-//! dispatches, so that tasks added by different issues do not touch each other's code.
+//! dispatches, so that tasks added by different changes do not touch each other's code.
 #![allow(clippy::print_stdout, reason = "xtask reports to the terminal")]
 
 mod bags;

@@ -1,6 +1,6 @@
 //! `cargo xtask reference-order`: how much the fitted model, and the confidence after a
 //! reduced study, change when the same demonstrations are given in another order, with
-//! each reference choice (`tandem::lfd::Reference`, issue #14 item 4).
+//! each reference choice (`tandem::lfd::Reference`).
 //!
 //! The six sanding fixtures are given in their six rotations (`0 1 2 3 4 5`,
 //! `1 2 3 4 5 0`, …: each demonstration first once). For each rotation and each choice

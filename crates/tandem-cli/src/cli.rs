@@ -12,7 +12,7 @@ use tandem::sim::workcell::OperatorParams;
 ///
 ///   tandem fit demo_*.csv -o cell.tandem        # learn the task and a first schedule
 ///   tandem schedule cell.tandem                 # show it (text Gantt; --json for robots)
-///   tandem simulate cell.tandem --need need.csv --pairs 5    # what-if, nothing saved
+///   tandem simulate cell.tandem --need need.csv --rounds 5   # what-if, nothing saved
 ///   tandem record cell.tandem --execution a.csv --log a.reflog.csv --corrections a.corr.csv \
 ///                             --execution b.csv --log b.reflog.csv --corrections b.corr.csv
 ///   tandem inspect cell.tandem                  # model and confidence summary
@@ -72,7 +72,7 @@ pub(crate) enum Command {
     ///   tandem schedule cell.tandem --json > schedule.json
     #[command(verbatim_doc_comment)]
     Schedule(ScheduleArgs),
-    /// Add an executed round (one execution per robot; a pair for two robots) (Eq. 21),
+    /// Add an executed round (one execution of each robot) (Eq. 21),
     /// update the confidence, re-schedule, save.
     ///
     /// Give exactly one execution per robot of the state file (robot 1 first; two unless
@@ -111,25 +111,25 @@ pub(crate) enum Command {
     ///   tandem plot cell.tandem -o plots/
     #[command(verbatim_doc_comment)]
     Plot(PlotArgs),
-    /// What-if: run pairs (rounds of N robots) with a simulated operator on your model;
-    /// nothing is saved.
+    /// What-if: run rounds (one execution of each robot) with a simulated operator on your
+    /// model; nothing is saved.
     ///
     /// NEED.csv gives, per reference sample, the probability that a correction is needed
     /// (column `need`, optional integer column `region`: samples of one region share one
     /// draw per workpiece; without it, every run of consecutive equal non-zero values is a
-    /// region). For each pair, each robot's workpiece draws its needed regions, the two
+    /// region). For each round, each robot's workpiece draws its needed regions, the
     /// robots run the current schedule through the real-time coordinator, the operator
     /// corrects the supervised (low-confidence) robot where needed (missing 1 %, and
-    /// correcting 1 % of unneeded samples by default), and the pair is recorded in memory
+    /// correcting 1 % of unneeded samples by default), and the round is recorded in memory
     /// exactly as `tandem record` would. Prints T_total and the share of high-confidence
-    /// samples per pair. With --write DIR, each execution is written in the formats
-    /// `tandem record` reads (pair_K_robot_I.csv, .reflog.csv, .corr.csv).
+    /// samples per round. With --write DIR, each execution is written in the formats
+    /// `tandem record` reads (round_K_robot_I.csv, .reflog.csv, .corr.csv).
     ///
     /// Example:
     ///
-    ///   tandem simulate cell.tandem --need need.csv --pairs 10
-    ///   tandem simulate cell.tandem --need need.csv --pairs 2 --write sim/ --seed 7
-    ///   tandem simulate cell.tandem --need need.csv --pairs 20 --bag run.mcap
+    ///   tandem simulate cell.tandem --need need.csv --rounds 10
+    ///   tandem simulate cell.tandem --need need.csv --rounds 2 --write sim/ --seed 7
+    ///   tandem simulate cell.tandem --need need.csv --rounds 20 --bag run.mcap
     #[command(verbatim_doc_comment)]
     Simulate(SimulateArgs),
     /// Print the default parameter file (TOML) for `tandem fit --params`.
@@ -302,10 +302,12 @@ pub(crate) struct SimulateArgs {
     /// Probability of a needed correction per reference sample (CSV, see docs/formats.md).
     #[arg(long, value_name = "CSV")]
     pub(crate) need: PathBuf,
-    /// Number of rounds to run (one execution per robot of the state file; pairs for two
-    /// robots).
-    #[arg(long, value_name = "N", alias = "rounds")]
-    pub(crate) pairs: usize,
+    /// Number of rounds to run (a round is one execution of each robot of the state file).
+    #[arg(long, value_name = "N", required_unless_present = "pairs")]
+    pub(crate) rounds: Option<usize>,
+    /// Deprecated alias of `--rounds` (kept one release; prints a deprecation line on stderr).
+    #[arg(long, value_name = "N", hide = true, conflicts_with = "rounds")]
+    pub(crate) pairs: Option<usize>,
     /// Write every execution into this folder in `tandem record`'s formats.
     #[arg(long, value_name = "DIR")]
     pub(crate) write: Option<PathBuf>,

@@ -5,8 +5,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use serde_json::json;
 use tandem::lfd::{Demonstration, Execution, Reference, TaskModel};
+use tandem::planner::reschedule_seed;
 use tandem::schedule::SamplerParams;
-use tandem::{ExecutionRecord, Planner, PlannerParams, derive_seed};
+use tandem::{ExecutionRecord, Planner, PlannerParams};
 
 use crate::cli::{
     Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
@@ -41,6 +42,12 @@ pub(crate) fn out(text: &str) {
 /// `--json`): how a file was read, or something that looks wrong but is not refused.
 pub(crate) fn note(text: &str) {
     eprintln!("note: {text}");
+}
+
+/// Prints a deprecation line on stderr: an old flag or name, kept one release, and what
+/// replaces it.
+pub(crate) fn deprecated(text: &str) {
+    eprintln!("warning: deprecated: {text}");
 }
 
 /// A period or time in seconds without floating-point noise (`0.01`, not `0.009999…`).
@@ -168,9 +175,6 @@ fn summary_lines(planner: &Planner) -> Result<()> {
     Ok(())
 }
 
-/// Offset of the seed streams `tandem schedule` uses by default (see [`schedule`]).
-const SCHEDULE_STREAM: u64 = 1 << 32;
-
 fn schedule(a: &ScheduleArgs) -> Result<()> {
     // With --save this is a read–modify–write: hold the state file's lock throughout.
     let lock = a.save.then(|| state_io::lock(&a.state)).transpose()?;
@@ -179,10 +183,9 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
     // The schedule's own control tick is kept (the planner's rule for `tick_s = None`).
     sp.tick_s = None;
     if a.sampler.seed.is_none() {
-        // `fit` and `record` used stream `pairs_recorded` of the master seed for the saved
-        // schedule; a plain re-run draws a different, still deterministic, stream so that it
-        // tries new candidates instead of repeating those.
-        sp.seed = derive_seed(sp.seed, SCHEDULE_STREAM + planner.pairs_recorded() as u64);
+        // A plain re-run draws new, still deterministic, candidates (the planner's rule,
+        // shared with Python's `Planner.reschedule`).
+        sp.seed = reschedule_seed(sp.seed, planner.rounds_recorded());
     }
     let sp = apply_sampler(sp, &a.sampler)?;
     let previous_t_total_s = planner.outcome().t_total_s;
@@ -303,20 +306,17 @@ fn record(a: &RecordArgs) -> Result<()> {
     } else {
         bag::read_round(&planner, &a.bags, a.round, &a.topics)?
     };
-    let report = planner.record_round(&round).context(if n == 2 {
-        "cannot record the pair"
-    } else {
-        "cannot record the round"
-    })?;
+    let report = planner
+        .record_round(&round)
+        .context("cannot record the round")?;
     planner.save_locked(&lock)?;
     drop(lock);
     for n in &report.notices {
         note(n);
     }
     out(&format!(
-        "recorded {} {} into {}",
-        if n == 2 { "pair" } else { "round" },
-        planner.pairs_recorded(),
+        "recorded round {} into {}",
+        planner.rounds_recorded(),
         a.state.display()
     ));
     out(&format!(
@@ -362,7 +362,9 @@ fn inspect(a: &InspectArgs) -> Result<()> {
         .collect();
     let doc = json!({
         "state": a.state.display().to_string(),
-        "pairs_recorded": planner.pairs_recorded(),
+        "rounds_recorded": planner.rounds_recorded(),
+        // Deprecated duplicate of `rounds_recorded` (the two-robot name), kept one release.
+        "pairs_recorded": planner.rounds_recorded(),
         "model": {
             "channels": model.channel_names(),
             "reference": {
@@ -396,9 +398,9 @@ fn inspect(a: &InspectArgs) -> Result<()> {
     }
     out(&format!("state file {}", a.state.display()));
     out(&format!(
-        "model: {} demonstrations and executions, {} pairs recorded",
+        "model: {} demonstrations and executions, {} rounds recorded",
         model.count(),
-        planner.pairs_recorded()
+        planner.rounds_recorded()
     ));
     out(&format!(
         "  reference: demonstration {} of the fit ({}), {} samples × {} s = {:.2} s; channels: {}",

@@ -4,6 +4,7 @@ use std::fmt::Write as _;
 
 use anyhow::Result;
 use serde_json::{Value, json};
+use tandem::realtime::tol;
 use tandem::schedule::{GlobalTimeline, LcInterval, Outcome, Problem, Schedule, Source};
 
 /// Columns of the text Gantt's bars.
@@ -56,11 +57,25 @@ pub(crate) fn certificate_line(problem: &Problem, outcome: &Outcome) -> Result<S
         "operator-limited lower bound (every robot's low-confidence time in turn)"
     };
     Ok(format!(
-        "T_total {:.2} s — {bound} {:.2} s without margins (+{:.2} %), fastest serial {serial:.2} s",
+        "T_total {:.2} s — {bound} {:.2} s without margins ({}), fastest serial {serial:.2} s",
         outcome.t_total_s,
         outcome.lower_bound_s,
-        100.0 * outcome.gap,
+        gap_text(outcome.gap),
     ))
+}
+
+/// A certificate's relative gap as a signed percentage with two decimals, `"+0.49 %"`.
+/// A gap of magnitude at most `tol::BOUND_REL` is the bound equal to `T_total` up to the
+/// rounding a valid schedule is allowed (the bound is reported unclamped, so such a gap may
+/// be `−5.7e-15`): it prints `"+0.00 %"`. A gap below `−tol::BOUND_REL` is a wrong bound and
+/// prints with its minus sign, never hidden.
+pub(crate) fn gap_text(gap: f64) -> String {
+    let pct = if gap.abs() <= tol::BOUND_REL {
+        0.0
+    } else {
+        100.0 * gap
+    };
+    format!("{pct:+.2} %")
 }
 
 /// Every robot's low-confidence intervals with their robot index (0-based), sorted by start
@@ -216,4 +231,22 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
         )?;
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_gap_prints_signed_and_rounding_prints_as_zero() {
+        assert_eq!(gap_text(0.0049), "+0.49 %");
+        assert_eq!(gap_text(0.25), "+25.00 %");
+        // The bound as computed can sit a rounding above T_total: zero, not "+-0.00 %".
+        assert_eq!(gap_text(-5.7e-15), "+0.00 %");
+        assert_eq!(gap_text(-tol::BOUND_REL), "+0.00 %");
+        assert_eq!(gap_text(1e-12), "+0.00 %");
+        // Beyond the rounding allowance a negative gap (a wrong bound) keeps its sign.
+        assert_eq!(gap_text(-1e-3), "-0.10 %");
+        assert_eq!(gap_text(-3.0 * tol::BOUND_REL), "-0.00 %");
+    }
 }

@@ -278,9 +278,9 @@ impl Figure for ConfidenceFigure<'_> {
         let (top, body) = root.split_vertically(40);
         top.titled(
             &format!(
-                "confidence: {:.1} % of reference samples high-confidence after {} recorded pairs",
+                "confidence: {:.1} % of reference samples high-confidence after {} recorded rounds",
                 100.0 * conf.high_share(),
-                self.planner.pairs_recorded()
+                self.planner.rounds_recorded()
             ),
             (FONT_FAMILY, 20),
         )

@@ -1,5 +1,5 @@
 //! `tandem simulate`: a what-if run of rounds (one execution per robot of the state's
-//! schedule; pairs for two robots) with a simulated operator on the user's model.
+//! schedule) with a simulated operator on the user's model.
 //!
 //! Per round `k` (seed `derive_seed(seed, k)`):
 //!
@@ -35,7 +35,7 @@ use tandem::sim::workcell::{OperatorParams, RobotRun, RoundRun, run_round_with};
 use tandem::{ExecutionRecord, Planner, derive_seed};
 
 use crate::cli::SimulateArgs;
-use crate::cmd::out;
+use crate::cmd::{deprecated, out};
 use crate::{bag, input, state_io};
 
 /// Runs one round (see the module docs). `needed[i][n]`: robot `i`'s workpiece needs the
@@ -54,18 +54,18 @@ fn run_round(
     )?)
 }
 
-/// File stem of robot `robot`'s execution in pair `pair` (both 1-based).
-fn stem(pair: usize, robot: usize) -> String {
-    format!("pair_{pair}_robot_{robot}")
+/// File stem of robot `robot`'s execution in round `round` (both 1-based).
+fn stem(round: usize, robot: usize) -> String {
+    format!("round_{round}_robot_{robot}")
 }
 
 /// `record` with its demonstration named like the file `--write` gives it, so that an error
 /// names the execution.
-fn named(record: ExecutionRecord, pair: usize, robot: usize) -> ExecutionRecord {
+fn named(record: ExecutionRecord, round: usize, robot: usize) -> ExecutionRecord {
     let demonstration = record
         .execution
         .demonstration
-        .with_source(format!("{}.csv", stem(pair, robot)));
+        .with_source(format!("{}.csv", stem(round, robot)));
     ExecutionRecord {
         execution: Execution {
             demonstration,
@@ -99,8 +99,16 @@ fn execution_files(log: &RobotRun, channels: &[String]) -> [String; 3] {
 
 /// `tandem simulate`.
 pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
-    if a.pairs == 0 {
-        bail!("--pairs 0: simulate at least one pair");
+    let rounds = match (a.rounds, a.pairs) {
+        (Some(n), _) => n,
+        (None, Some(n)) => {
+            deprecated("--pairs is --rounds (a round is one execution of each robot)");
+            n
+        }
+        (None, None) => bail!("--rounds N is required"),
+    };
+    if rounds == 0 {
+        bail!("--rounds 0: simulate at least one round");
     }
     // The study's operator with the flags' values; its own checks name the flag.
     let op = OperatorParams {
@@ -150,9 +158,9 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
     }
     let mut files: Vec<(PathBuf, String)> = Vec::new();
     out(
-        "pair  T_total ran (s)  actual (s)  supervised  corrected  overlap  → high-conf %  next T_total (s)",
+        "round  T_total ran (s)  actual (s)  supervised  corrected  overlap  → high-conf %  next T_total (s)",
     );
-    for k in 0..a.pairs {
+    for k in 0..rounds {
         let mut rng = ChaCha8Rng::seed_from_u64(derive_seed(a.seed, k as u64));
         let needed: Vec<Vec<bool>> = (0..planner.n_robots())
             .map(|_| {
@@ -161,12 +169,12 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
             })
             .collect();
         let t_ran = planner.outcome().t_total_s;
-        let pair = run_round(&planner, &needed, &op, &mut rng)
-            .with_context(|| format!("simulating pair {}", k + 1))?;
+        let round = run_round(&planner, &needed, &op, &mut rng)
+            .with_context(|| format!("simulating round {}", k + 1))?;
         let channels = planner.model().channel_names().to_vec();
         let dt = planner.model().dt_s();
         if let Some(dir) = &a.write {
-            for (i, log) in pair.robots.iter().enumerate() {
+            for (i, log) in round.robots.iter().enumerate() {
                 let stem = stem(k + 1, i + 1);
                 let [e, l, c] = execution_files(log, &channels);
                 files.push((dir.join(format!("{stem}.csv")), e));
@@ -175,35 +183,35 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
             }
         }
         if let Some(b) = &mut run_bag {
-            b.write_round(&planner, &pair)?;
+            b.write_round(&planner, &round)?;
         }
-        let records: Vec<ExecutionRecord> = pair
+        let records: Vec<ExecutionRecord> = round
             .records(planner.model())?
             .into_iter()
             .enumerate()
             .map(|(i, r)| named(r, k + 1, i + 1))
             .collect();
-        let supervised: usize = pair
+        let supervised: usize = round
             .robots
             .iter()
             .map(|r| r.supervised.iter().filter(|s| **s).count())
             .sum();
-        let corrected: usize = pair
+        let corrected: usize = round
             .robots
             .iter()
             .map(|r| r.corrected.iter().filter(|s| **s).count())
             .sum();
         let report = planner
             .record_round(&records)
-            .with_context(|| format!("recording simulated pair {}", k + 1))?;
+            .with_context(|| format!("recording simulated round {}", k + 1))?;
         out(&format!(
-            "{:>4}  {:>15.2}  {:>10.2}  {:>10}  {:>9}  {:>7}  {:>14.1}  {:>16.2}",
+            "{:>5}  {:>15.2}  {:>10.2}  {:>10}  {:>9}  {:>7}  {:>14.1}  {:>16.2}",
             k + 1,
             t_ran,
-            pair.ticks as f64 * dt,
+            round.ticks as f64 * dt,
             supervised,
             corrected,
-            pair.overlap_ticks,
+            round.overlap_ticks,
             100.0 * planner.confidence().high_share(),
             report.t_total_s
         ));
@@ -211,7 +219,7 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
     if let Some(dir) = &a.write {
         write_all(&files)?;
         out(&format!(
-            "wrote {} files into {} (tandem record reads them; pair_K_robot_1 first)",
+            "wrote {} files into {} (tandem record reads them; round_K_robot_1 first)",
             files.len(),
             dir.display()
         ));
@@ -286,10 +294,10 @@ mod tests {
         };
         let needed = [vec![true; 40], vec![false; 40]];
         let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let pair = run_round(&planner, &needed, &op, &mut rng).unwrap();
-        assert_eq!(pair.overlap_ticks, 0);
-        let [r1, r2] = &pair.robots[..] else {
-            panic!("{} robots", pair.robots.len())
+        let round = run_round(&planner, &needed, &op, &mut rng).unwrap();
+        assert_eq!(round.overlap_ticks, 0);
+        let [r1, r2] = &round.robots[..] else {
+            panic!("{} robots", round.robots.len())
         };
         assert!(
             r1.supervised.iter().any(|s| *s),

@@ -674,7 +674,7 @@ fn malformed_need_files() {
                 s(&state),
                 "--need".into(),
                 shown.clone(),
-                "--pairs".into(),
+                "--rounds".into(),
                 "1".into(),
             ],
             &needles,
@@ -689,17 +689,17 @@ fn malformed_need_files() {
     };
     let out_file = s(&good);
     for (args, needles) in [
-        (sim(&["--pairs", "0"]), vec!["--pairs"]),
+        (sim(&["--rounds", "0"]), vec!["--rounds"]),
         (
-            sim(&["--pairs", "1", "--miss-rate", "2"]),
+            sim(&["--rounds", "1", "--miss-rate", "2"]),
             vec!["--miss-rate"],
         ),
         (
-            sim(&["--pairs", "1", "--channel", "torque"]),
+            sim(&["--rounds", "1", "--channel", "torque"]),
             vec!["--channel", "torque"],
         ),
         (
-            sim(&["--pairs", "1", "--write", &out_file]),
+            sim(&["--rounds", "1", "--write", &out_file]),
             vec![out_file.as_str(), "not a folder"],
         ),
     ] {
@@ -744,7 +744,7 @@ fn simulate_refuses_a_schedule_checked_at_another_tick() {
             s(&state),
             "--need".into(),
             s(&need),
-            "--pairs".into(),
+            "--rounds".into(),
             "1".into(),
         ],
         &["0.005 s", "re-schedule"],

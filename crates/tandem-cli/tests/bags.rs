@@ -111,7 +111,7 @@ fn a_simulated_run_bag_records_like_its_csv_files_and_is_never_overwritten() {
             &state,
             &"--need",
             &examples().join("need.csv"),
-            &"--pairs",
+            &"--rounds",
             &"3",
             &"--channel",
             &"wrench.fz",
@@ -135,7 +135,7 @@ fn a_simulated_run_bag_records_like_its_csv_files_and_is_never_overwritten() {
             &state,
             &"--need",
             &examples().join("need.csv"),
-            &"--pairs",
+            &"--rounds",
             &"1",
             &"--channel",
             &"wrench.fz",
@@ -163,7 +163,7 @@ fn a_simulated_run_bag_records_like_its_csv_files_and_is_never_overwritten() {
         ])));
         let mut args = os(&[&"record", &b]);
         for r in 1..=2 {
-            let stem = dir.join("csv").join(format!("pair_{round}_robot_{r}"));
+            let stem = dir.join("csv").join(format!("round_{round}_robot_{r}"));
             let with = |ext: &str| PathBuf::from(format!("{}{ext}", stem.display()));
             args.extend(os(&[
                 &"--execution",

@@ -56,7 +56,7 @@ fn two_concurrent_writers_lose_no_round() {
         .map(|out| {
             let stdout = ok(out);
             let line = stdout.lines().next().expect("first line");
-            line.strip_prefix("recorded pair ")
+            line.strip_prefix("recorded round ")
                 .and_then(|r| r.split_whitespace().next())
                 .and_then(|k| k.parse().ok())
                 .unwrap_or_else(|| panic!("unexpected output: {stdout}"))
@@ -72,7 +72,7 @@ fn two_concurrent_writers_lose_no_round() {
         "--json".into(),
     ])))
     .expect("JSON document");
-    assert_eq!(doc["pairs_recorded"], 2 * rounds_each);
+    assert_eq!(doc["rounds_recorded"], 2 * rounds_each);
     assert_eq!(doc["model"]["count"], 3 + 4 * rounds_each);
     let supervised = doc["confidence"]["total_supervised"]
         .as_f64()

@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 
 use common::*;
 use tandem::Planner;
-use tandem::schedule::{Schedule, validate};
+use tandem::realtime::tol;
+use tandem::schedule::{Schedule, solve_exact, validate};
 
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -38,10 +39,16 @@ fn sanding_need(dir: &Path) -> PathBuf {
     write(dir, "need.csv", &need)
 }
 
-/// The pair-`k` files `tandem simulate --write` produced, as `record` arguments.
-fn pair_files(dir: &Path, k: usize) -> [[PathBuf; 3]; 2] {
+/// The round-`k` files `tandem simulate --write` produced, as `record` arguments.
+fn round_files(dir: &Path, k: usize) -> [[PathBuf; 3]; 2] {
+    files_named(dir, "round", k)
+}
+
+/// The files `{prefix}_{k}_robot_{1,2}` (`.csv`, `.reflog.csv`, `.corr.csv`) in `dir`, as
+/// `record` arguments (`fixtures/examples/` keeps its committed names `pair_1_robot_*`).
+fn files_named(dir: &Path, prefix: &str, k: usize) -> [[PathBuf; 3]; 2] {
     std::array::from_fn(|i| {
-        let stem = format!("pair_{k}_robot_{}", i + 1);
+        let stem = format!("{prefix}_{k}_robot_{}", i + 1);
         [
             dir.join(format!("{stem}.csv")),
             dir.join(format!("{stem}.reflog.csv")),
@@ -74,7 +81,7 @@ fn fixtures_fit_simulate_record_schedule() {
     let n_ref = fitted.model().n_ref();
     assert_eq!(n_ref, 9873, "demo_0.csv has 9873 samples");
 
-    // Simulate two pairs: a what-if that leaves the state alone.
+    // Simulate two rounds: a what-if that leaves the state alone.
     let need = sanding_need(&dir);
     let before = std::fs::read(&state).unwrap();
     let sim_dir = dir.join("sim");
@@ -83,7 +90,7 @@ fn fixtures_fit_simulate_record_schedule() {
         &s(&state),
         "--need",
         &s(&need),
-        "--pairs",
+        "--rounds",
         "2",
         "--seed",
         "7",
@@ -97,7 +104,7 @@ fn fixtures_fit_simulate_record_schedule() {
     );
     let predicted = simulated_t_totals(&stdout);
     assert_eq!(predicted.len(), 2, "{stdout}");
-    // Each pair row reports 0 ticks with both robots low-confidence.
+    // Each round's row reports 0 ticks with both robots low-confidence.
     for line in stdout
         .lines()
         .filter(|l| l.trim_start().starts_with(['1', '2']))
@@ -106,14 +113,14 @@ fn fixtures_fit_simulate_record_schedule() {
         assert_eq!(cols[5], "0", "overlap ticks: {line}");
     }
 
-    // Record both pairs from the written files.
+    // Record both rounds from the written files.
     for k in 1..=2 {
-        let [a, b] = pair_files(&sim_dir, k);
+        let [a, b] = round_files(&sim_dir, k);
         let stdout = ok(&tandem(record_args(&state, &a, &b)));
-        assert!(stdout.contains(&format!("recorded pair {k}")), "{stdout}");
+        assert!(stdout.contains(&format!("recorded round {k}")), "{stdout}");
     }
     let recorded = Planner::load(&state).unwrap();
-    assert_eq!(recorded.pairs_recorded(), 2);
+    assert_eq!(recorded.rounds_recorded(), 2);
     assert_eq!(recorded.model().count(), 6 + 4);
     assert!(recorded.observations().total_supervised() > 0.0);
     // The files round-trip exactly: `record` reproduces the simulation's own updates.
@@ -141,10 +148,23 @@ fn fixtures_fit_simulate_record_schedule() {
     assert!((t_total - schedule.t_total_s(recorded.model().dt_s())).abs() < 1e-9);
     assert!(t_total <= recorded.outcome().t_total_s + 1e-9);
     assert!(t_total <= doc["serial_t_total_s"].as_f64().unwrap() + 1e-9);
-    // The certificate: the proven margin-free lower bound and the gap to it.
+    // The certificate: the margin-free optimum `T*₀` of the state's problem (solved here
+    // again, independently of the command) and the gap to it. The bound is reported
+    // unclamped, so it may exceed `T_total` by the rounding `tol::BOUND_REL` (2e-9 relative)
+    // allows a valid schedule, never by more.
     let bound = doc["lower_bound_s"].as_f64().unwrap();
-    assert!(bound > 0.0 && bound <= t_total, "{bound} vs {t_total}");
+    let exact = solve_exact(recorded.problem(), &recorded.params().sampler.exact).unwrap();
+    assert!(exact.proven_optimal);
     assert_eq!(doc["bound_is_optimum"], true);
+    assert!(
+        (bound - exact.lower_bound_s).abs() <= 1e-12 * exact.lower_bound_s,
+        "reported bound {bound} vs T*₀ {}",
+        exact.lower_bound_s
+    );
+    assert!(
+        bound <= t_total * (1.0 + tol::BOUND_REL),
+        "{bound} vs {t_total}"
+    );
     assert!((doc["gap"].as_f64().unwrap() - (t_total - bound) / bound).abs() < 1e-9);
     assert_eq!(doc["offset_s"].as_f64().unwrap(), schedule.offsets_s[0]);
     // Low-confidence intervals of the two robots never overlap in global time.
@@ -185,7 +205,7 @@ fn fixtures_fit_simulate_record_schedule() {
             "saved schedule differs from the JSON by {worst}"
         );
     }
-    assert_eq!(saved.pairs_recorded(), 2);
+    assert_eq!(saved.rounds_recorded(), 2);
     assert_eq!(saved.model().count(), recorded.model().count());
 
     // Plot the recorded state: SVG and PNG of each figure.
@@ -223,7 +243,7 @@ fn documented_examples_work() {
     let p = Planner::load(&state).unwrap();
     assert_eq!(p.params().sampler.samples, 2000, "params.toml sets 2000");
     assert_eq!(p.params().fit.k_max, 2);
-    let [a, b] = pair_files(&ex, 1);
+    let [a, b] = files_named(&ex, "pair", 1);
     ok(&tandem(record_args(&state, &a, &b)));
     // The walk-through writes exactly the committed golden state file (`cargo xtask fixtures`).
     assert!(
@@ -232,7 +252,7 @@ fn documented_examples_work() {
         "tandem fit + record on fixtures/examples/ differ from fixtures/state/example.tandem"
     );
     let p = Planner::load(&state).unwrap();
-    assert_eq!(p.pairs_recorded(), 1);
+    assert_eq!(p.rounds_recorded(), 1);
     // 42 samples per execution, all supervised before the first update.
     assert_eq!(p.observations().total_supervised(), 84.0);
     ok(&tandem([
@@ -240,9 +260,40 @@ fn documented_examples_work() {
         &s(&state),
         "--need",
         &s(&ex.join("need.csv")),
-        "--pairs",
+        "--rounds",
         "1",
     ]));
+    // `--pairs` is the deprecated alias of `--rounds` (kept one release): the same run, and a
+    // deprecation line on stderr; the two together are refused.
+    let sim_with = |flag: &str| {
+        tandem([
+            "simulate",
+            &s(&state),
+            "--need",
+            &s(&ex.join("need.csv")),
+            flag,
+            "1",
+        ])
+    };
+    let (new, old) = (sim_with("--rounds"), sim_with("--pairs"));
+    assert_eq!(ok(&old), ok(&new));
+    let warned = String::from_utf8_lossy(&old.stderr);
+    assert!(
+        warned.contains("deprecated") && warned.contains("--rounds"),
+        "{warned}"
+    );
+    assert!(!String::from_utf8_lossy(&new.stderr).contains("deprecated"));
+    let both = tandem([
+        "simulate",
+        &s(&state),
+        "--need",
+        &s(&ex.join("need.csv")),
+        "--rounds",
+        "1",
+        "--pairs",
+        "1",
+    ]);
+    assert!(!both.status.success());
     // The text views print the certificate.
     let text = ok(&tandem(["inspect", &s(&state)]));
     assert!(
@@ -254,9 +305,19 @@ fn documented_examples_work() {
     assert!(text.contains("without margins") && text.contains("fastest serial"));
     let inspect: serde_json::Value =
         serde_json::from_str(&ok(&tandem(["inspect", &s(&state), "--json"]))).unwrap();
+    // `inspect` reports the stored certificate as stored (bit for bit through JSON), within
+    // the rounding `tol::BOUND_REL` allows of `T_total`.
+    let stored = Planner::load(&state).unwrap();
     let bound = inspect["schedule"]["lower_bound_s"].as_f64().unwrap();
-    assert!(bound <= inspect["schedule"]["t_total_s"].as_f64().unwrap());
-    assert_eq!(inspect["pairs_recorded"], 1);
+    assert_eq!(bound, stored.outcome().lower_bound_s);
+    assert_eq!(
+        inspect["schedule"]["gap"].as_f64().unwrap(),
+        stored.outcome().gap
+    );
+    assert!(bound <= inspect["schedule"]["t_total_s"].as_f64().unwrap() * (1.0 + tol::BOUND_REL));
+    assert_eq!(inspect["rounds_recorded"], 1);
+    // The deprecated duplicate key (kept one release) says the same.
+    assert_eq!(inspect["pairs_recorded"], inspect["rounds_recorded"]);
     assert_eq!(inspect["model"]["count"], 5);
     assert_eq!(inspect["model"]["n_ref"], 40);
     let _ = std::fs::remove_dir_all(&dir);
@@ -439,7 +500,7 @@ fn three_robots_fit_schedule_simulate_record() {
     ]));
     assert!(stdout.contains("wrote 9 files"), "{stdout}");
     let files = |robot: usize| {
-        let stem = format!("pair_1_robot_{robot}");
+        let stem = format!("round_1_robot_{robot}");
         [
             sim.join(format!("{stem}.csv")),
             sim.join(format!("{stem}.reflog.csv")),
@@ -471,7 +532,7 @@ fn three_robots_fit_schedule_simulate_record() {
     let stdout = ok(&tandem(args));
     assert!(stdout.contains("recorded round 1"), "{stdout}");
     let p = Planner::load(&state).unwrap();
-    assert_eq!((p.n_robots(), p.pairs_recorded()), (3, 1));
+    assert_eq!((p.n_robots(), p.rounds_recorded()), (3, 1));
 
     let mut bad = fit.clone();
     let k = bad.iter().position(|a| a == "3").unwrap();

@@ -45,8 +45,8 @@
 //!     supervised: planner.confidence().conf().iter().map(|c| !c).collect(),
 //!     corrected: vec![false; 40],
 //! };
-//! let report = planner.record_pair(&[record.clone(), record])?;
-//! assert_eq!(planner.pairs_recorded(), 1);
+//! let report = planner.record_round(&[record.clone(), record])?;
+//! assert_eq!(planner.rounds_recorded(), 1);
 //! assert_eq!(planner.model().count(), 5, "three demonstrations and two executions (Eq. 21)");
 //! assert_eq!(report.t_total_s, planner.outcome().t_total_s);
 //! // The new schedule runs at the tick it was checked with.
@@ -62,10 +62,24 @@ pub use error::{Error, Result};
 pub use planner::{ExecutionRecord, Planner, PlannerParams, RecordReport};
 
 /// A seed for item `index` of a seeded family (trial `k` of a study, the schedule after
-/// `k` recorded pairs): SplitMix64 of both, so items are independent of each other and of
+/// `k` recorded rounds): SplitMix64 of both, so items are independent of each other and of
 /// the order in which threads process them.
 pub fn derive_seed(seed: u64, index: u64) -> u64 {
     splitmix64(seed ^ splitmix64(index.wrapping_add(1)))
+}
+
+/// Offset of the seed streams of a re-schedule asked for without a seed (see
+/// [`reschedule_seed`]): past every stream `record_round` uses (one per recorded round).
+const RESCHEDULE_STREAM: u64 = 1 << 32;
+
+/// The seed of a re-schedule a user asks for without one (`tandem schedule` without
+/// `--seed`, Python `Planner.reschedule()` without `seed`) after `rounds_recorded` rounds,
+/// from the master seed `seed` (`[sampler] seed`): `derive_seed(seed, 2³² + rounds_recorded)`.
+/// [`Planner::record_round`] used stream `rounds_recorded` for the saved schedule, so a
+/// plain re-run draws new, still deterministic, candidates instead of repeating those; the
+/// command line and Python share this one rule, so both return the same schedule.
+pub fn reschedule_seed(seed: u64, rounds_recorded: usize) -> u64 {
+    derive_seed(seed, RESCHEDULE_STREAM + rounds_recorded as u64)
 }
 
 /// One SplitMix64 output for state `x` (Steele, Lea & Flood 2014).

@@ -162,7 +162,7 @@ impl Clone for Origin {
     }
 }
 
-/// What [`Planner::record_pair`] did.
+/// What [`Planner::record_round`] did.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RecordReport {
     /// Reference samples that became high-confidence (latched) in this update.
@@ -185,7 +185,7 @@ pub struct RecordReport {
 /// The loop of Fig. 2: the task model learned from demonstrations and executions, the
 /// correction observations, the latched confidence and the current schedule.
 ///
-/// After each pair of executions, [`Planner::record_pair`] adds both executions to the
+/// After each round of executions, [`Planner::record_round`] adds every execution to the
 /// model with their known reference-time logs (Eq. 21, no re-alignment), adds their
 /// supervised samples to the observations, updates the confidence (Eq. 9–12, with the
 /// latch: a high-confidence sample stays high) and re-schedules, warm-started by the
@@ -583,17 +583,22 @@ impl Planner {
         Ok(report)
     }
 
-    /// [`Planner::record_round`] for the paper's two robots.
+    /// [`Planner::record_round`] for the paper's two robots; deprecated: a round is one
+    /// execution of each of the `N` robots, and `record_round` takes any `N`.
     ///
     /// # Errors
     /// As [`Planner::record_round`].
+    #[deprecated(
+        since = "0.1.0",
+        note = "use `Planner::record_round` (a round of N robots)"
+    )]
     pub fn record_pair(&mut self, executions: &[ExecutionRecord; 2]) -> Result<RecordReport> {
         self.record_round(executions)
     }
 
     /// Re-runs the anytime sampler (§II-C) on the current problem with `sampler`, warm-started
     /// by the current schedule, and replaces the stored outcome by the result. Model,
-    /// observations, confidence, parameters and [`Planner::pairs_recorded`] are unchanged
+    /// observations, confidence, parameters and [`Planner::rounds_recorded`] are unchanged
     /// (`sampler` is used for this call only and not stored in [`Planner::params`]).
     ///
     /// `sampler.tick_s = None` keeps the current schedule's control tick
@@ -602,7 +607,7 @@ impl Planner {
     /// re-checked at that tick, so `T_total` (Eq. 13, s) never increases as long as the
     /// current schedule is valid at it: always so at the current schedule's own tick.
     /// Otherwise the sampler repairs it or falls back to the fastest serial schedule, as in
-    /// [`Planner::record_pair`]. The new schedule carries the tick: run it at that tick.
+    /// [`Planner::record_round`]. The new schedule carries the tick: run it at that tick.
     ///
     /// On error the planner is as before.
     ///
@@ -636,7 +641,7 @@ impl Planner {
 
     /// The real-time coordinator (Eq. 17–18, Alg. 1) of the current schedule on the current
     /// problem, at the control tick the schedule was checked with ([`Schedule::tick_s`]): what
-    /// runs the two robots until the next [`Planner::record_pair`].
+    /// runs the robots until the next [`Planner::record_round`].
     ///
     /// The schedule is checked on the problem first ([`Schedule::check`]: every constraint of
     /// Eq. 20 with this build's margin check), so that a coordinator never runs a schedule
@@ -697,9 +702,18 @@ impl Planner {
         &self.params
     }
 
-    /// Pairs of executions recorded so far.
-    pub fn pairs_recorded(&self) -> usize {
+    /// Rounds recorded so far (a round is one execution of each of the `N` robots).
+    pub fn rounds_recorded(&self) -> usize {
         self.pairs_recorded
+    }
+
+    /// [`Planner::rounds_recorded`] under its two-robot name; deprecated.
+    #[deprecated(
+        since = "0.1.0",
+        note = "use `Planner::rounds_recorded` (rounds of N robots)"
+    )]
+    pub fn pairs_recorded(&self) -> usize {
+        self.rounds_recorded()
     }
 
     /// Saves the planner to `path` as a versioned state file, atomically and under the
@@ -947,7 +961,7 @@ mod tests {
             err.to_string()
                 .contains("0 execution records for a round of 2 robots")
         );
-        assert_eq!(q.pairs_recorded(), 0);
+        assert_eq!(q.rounds_recorded(), 0);
     }
 
     #[test]
@@ -1049,7 +1063,7 @@ mod tests {
     #[test]
     fn reschedule_never_increases_t_total_and_stays_valid() {
         let mut p = small_planner(3);
-        let (conf, pairs) = (p.confidence().conf().to_vec(), p.pairs_recorded());
+        let (conf, pairs) = (p.confidence().conf().to_vec(), p.rounds_recorded());
         let mut t_prev = p.outcome().t_total_s;
         for seed in 10..14 {
             let sp = SamplerParams {
@@ -1065,7 +1079,7 @@ mod tests {
         }
         // Only the outcome changes.
         assert_eq!(p.confidence().conf(), &conf[..]);
-        assert_eq!(p.pairs_recorded(), pairs);
+        assert_eq!(p.rounds_recorded(), pairs);
         // Bad sampler parameters leave the planner as it was.
         let before = p.outcome().clone();
         let bad = SamplerParams {
@@ -1114,7 +1128,7 @@ mod tests {
         };
         p.reschedule(&sp).unwrap();
         assert_eq!(p.schedule().tick_s, 0.005);
-        p.record_pair(&round(&p, 0.0, 0.1, 1, 0.01)).unwrap();
+        p.record_round(&round(&p, 0.0, 0.1, 1, 0.01)).unwrap();
         assert_eq!(
             p.schedule().tick_s,
             0.005,
@@ -1134,23 +1148,23 @@ mod tests {
     fn the_same_round_recorded_twice_is_refused() {
         let mut p = small_planner(5);
         let first = round(&p, 0.0, 0.1, 1, 0.01);
-        p.record_pair(&first).unwrap();
-        let before = (p.pairs_recorded(), p.model().count(), p.outcome().clone());
+        p.record_round(&first).unwrap();
+        let before = (p.rounds_recorded(), p.model().count(), p.outcome().clone());
         let swapped = [first[1].clone(), first[0].clone()];
         for again in [first.clone(), swapped] {
-            let err = p.record_pair(&again).unwrap_err();
+            let err = p.record_round(&again).unwrap_err();
             assert!(matches!(err, Error::DuplicateRound { round: 1 }), "{err}");
             assert!(
                 err.to_string().contains("already recorded as round 1"),
                 "{err}"
             );
             assert_eq!(
-                (p.pairs_recorded(), p.model().count(), p.outcome().clone()),
+                (p.rounds_recorded(), p.model().count(), p.outcome().clone()),
                 before
             );
         }
         // Another round records; the fingerprints survive a save and a load.
-        p.record_pair(&round(&p, 0.2, 0.3, 1, 0.01)).unwrap();
+        p.record_round(&round(&p, 0.2, 0.3, 1, 0.01)).unwrap();
         let dir = std::env::temp_dir().join(format!("tandem-planner-dup-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
@@ -1158,7 +1172,7 @@ mod tests {
         p.save(&path).unwrap();
         let mut q = Planner::load(&path).unwrap();
         assert!(matches!(
-            q.record_pair(&first),
+            q.record_round(&first),
             Err(Error::DuplicateRound { round: 1 })
         ));
         std::fs::remove_dir_all(&dir).unwrap();
@@ -1170,11 +1184,11 @@ mod tests {
         let mut at_100hz = base.clone();
         let mut at_1khz = base.clone();
         let r100 = at_100hz
-            .record_pair(&round(&base, 0.0, 0.5, 1, 0.01))
+            .record_round(&round(&base, 0.0, 0.5, 1, 0.01))
             .unwrap();
         assert!(r100.notices.is_empty());
         let r1k = at_1khz
-            .record_pair(&round(&base, 0.0, 0.5, 10, 0.001))
+            .record_round(&round(&base, 0.0, 0.5, 10, 0.001))
             .unwrap();
         assert_eq!(r1k.notices.len(), 2);
         assert!(
@@ -1199,10 +1213,10 @@ mod tests {
         // the fix, and the planner is unchanged.
         let mut wrong = base.clone();
         let err = wrong
-            .record_pair(&round(&base, 0.0, 0.5, 10, 0.01))
+            .record_round(&round(&base, 0.0, 0.5, 10, 0.01))
             .unwrap_err();
         assert!(err.to_string().contains("give its sample period"), "{err}");
-        assert_eq!(wrong.pairs_recorded(), 0);
+        assert_eq!(wrong.rounds_recorded(), 0);
     }
 
     #[test]
@@ -1215,11 +1229,11 @@ mod tests {
         let mut mine = Planner::load(&path).unwrap();
         let mut theirs = Planner::load(&path).unwrap();
         theirs
-            .record_pair(&round(&theirs, 0.0, 0.1, 1, 0.01))
+            .record_round(&round(&theirs, 0.0, 0.1, 1, 0.01))
             .unwrap();
         theirs.save(&path).unwrap();
         let after_theirs = std::fs::read(&path).unwrap();
-        mine.record_pair(&round(&mine, 0.4, 0.5, 1, 0.01)).unwrap();
+        mine.record_round(&round(&mine, 0.4, 0.5, 1, 0.01)).unwrap();
         let err = mine.save(&path).unwrap_err();
         assert!(matches!(err, Error::Changed { .. }), "{err}");
         assert!(err.to_string().contains("load it again"), "{err}");
@@ -1231,10 +1245,10 @@ mod tests {
         // Saved elsewhere it goes through; a planner that saved keeps saving into its file.
         mine.save(dir.join("mine.tandem")).unwrap();
         theirs
-            .record_pair(&round(&theirs, 0.6, 0.7, 1, 0.01))
+            .record_round(&round(&theirs, 0.6, 0.7, 1, 0.01))
             .unwrap();
         theirs.save(&path).unwrap();
-        assert_eq!(Planner::load(&path).unwrap().pairs_recorded(), 2);
+        assert_eq!(Planner::load(&path).unwrap().rounds_recorded(), 2);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -1254,7 +1268,7 @@ mod tests {
                     let lock = StateLock::acquire(&path, state::DEFAULT_LOCK_TIMEOUT).unwrap();
                     let mut p = Planner::load(&path).unwrap();
                     let offset = (w * ROUNDS + k) as f64 * 1e-3;
-                    p.record_pair(&round(&p, offset, offset + 0.5, 1, 0.01))
+                    p.record_round(&round(&p, offset, offset + 0.5, 1, 0.01))
                         .unwrap();
                     p.save_locked(&lock).unwrap();
                 }
@@ -1264,7 +1278,7 @@ mod tests {
         a.join().unwrap();
         b.join().unwrap();
         let p = Planner::load(&path).unwrap();
-        assert_eq!(p.pairs_recorded(), 2 * ROUNDS);
+        assert_eq!(p.rounds_recorded(), 2 * ROUNDS);
         assert_eq!(p.model().count(), 3 + 4 * ROUNDS);
         // Every round is in the file: its fingerprint, computed from the same inputs.
         let mut want: Vec<u64> = (0..2 * ROUNDS)

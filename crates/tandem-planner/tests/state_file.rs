@@ -68,7 +68,7 @@ fn the_golden_state_file_loads_with_the_values_of_its_inputs() {
     assert!((model.dt_s() - 0.01).abs() < 1e-12, "{}", model.dt_s());
     assert_eq!(model.channel_names(), ["x", "force"]);
     assert_eq!(model.count(), 5);
-    assert_eq!(p.pairs_recorded(), 1);
+    assert_eq!(p.rounds_recorded(), 1);
     // Every demonstration and execution starts at x = 0 m with 5 N and ends at x = 1 m with
     // 5 N; warps and reference-time logs are pinned at both ends, so the mean is exactly that.
     assert_eq!(&model.mean()[..2], &[0.0, 5.0]);
@@ -140,7 +140,7 @@ fn a_version_4_file_loads_as_the_same_two_robot_schedule() {
     assert_eq!(old.model().mean(), new.model().mean());
     assert_eq!(old.model().count(), new.model().count());
     assert_eq!(old.confidence(), new.confidence());
-    assert_eq!(old.pairs_recorded(), new.pairs_recorded());
+    assert_eq!(old.rounds_recorded(), new.rounds_recorded());
     // The schedule: offset_s became offsets_s = [offset_s], the rest field for field.
     assert_eq!(old.schedule().offsets_s.len(), 1);
     assert_eq!(old.outcome(), new.outcome());
@@ -183,7 +183,7 @@ fn a_version_5_file_loads_as_the_same_planner_without_round_fingerprints() {
     assert_eq!(old.model().mean(), new.model().mean());
     assert_eq!(old.confidence(), new.confidence());
     assert_eq!(old.outcome(), new.outcome());
-    assert_eq!(old.pairs_recorded(), new.pairs_recorded());
+    assert_eq!(old.rounds_recorded(), new.rounds_recorded());
     // Version 6 only appends the fingerprints to version 5's payload: the golden payload
     // starts with the version 5 payload, then the list of one round fingerprint.
     let golden = std::fs::read(golden_path()).unwrap();

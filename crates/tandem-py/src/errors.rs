@@ -286,6 +286,8 @@ fn classify_schedule(e: &errors::Schedule) -> Kind {
         errors::Schedule::Invalid(v) => Kind::Schedule {
             violation: Some(violation_name(v)),
         },
+        // A wrong certificate bound is a bug in tandem, not in the caller's data.
+        errors::Schedule::BoundAboveSchedule { .. } => Kind::Internal,
         _ => SCHEDULE,
     }
 }
@@ -411,6 +413,18 @@ impl From<Error> for PyErr {
 pub(crate) fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
     let text = std::ffi::CString::new(message.replace('\0', " ")).expect("no NUL left");
     PyErr::warn(py, &py.get_type::<DataWarning>(), &text, 1)
+}
+
+/// Emits a Python `DeprecationWarning` with `message` (an old name kept one release; the
+/// message names its replacement).
+pub(crate) fn deprecated(py: Python<'_>, message: &str) -> PyResult<()> {
+    let text = std::ffi::CString::new(message.replace('\0', " ")).expect("no NUL left");
+    PyErr::warn(
+        py,
+        &py.get_type::<pyo3::exceptions::PyDeprecationWarning>(),
+        &text,
+        1,
+    )
 }
 
 /// Runs `f`, turning a panic into [`Error::Panic`] so that it reaches Python as

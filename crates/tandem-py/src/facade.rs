@@ -4,7 +4,7 @@ pub(crate) use tandem::confidence::{BetaParams, Observations, posterior, prior};
 pub(crate) use tandem::lfd::{DEFAULT_DT_S, Demonstration, Execution, TaskModel, length_warnings};
 pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{
-    Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, derive_seed,
+    Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, reschedule_seed,
 };
 pub(crate) use tandem::realtime::{Coordinator, Fault, MAX_ROBOTS, Operator, Tick, Timeline};
 pub(crate) use tandem::schedule::{

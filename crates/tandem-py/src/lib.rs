@@ -4,7 +4,7 @@
 //! What Python gets, NumPy arrays in and out, with shapes and units in every docstring:
 //!
 //! - `planner`: `tandem.fit` (demonstrations as arrays or the command line's CSV/JSON
-//!   files → the Fig. 2 loop), `tandem.Planner` (`record_pair`, `reschedule`, `save`/`load`
+//!   files → the Fig. 2 loop), `tandem.Planner` (`record_round`, `reschedule`, `save`/`load`
 //!   with the command line's state file, `command` of Eq. 7) and the per-sample arrays of
 //!   the model (`tandem.Model`: `μ̂`, `σ²_D`, `ψ̇min/ψ̇max`) and of the confidence
 //!   (`tandem.Confidence`: latched `conf`, Beta posterior, observations).

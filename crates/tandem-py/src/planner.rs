@@ -10,12 +10,12 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
 use crate::arrays::{flags, matrix, out_flags, out_matrix, out_vector, repr_list, vector};
-use crate::errors::{Error, Result, guard, warn};
+use crate::errors::{Error, Result, deprecated, guard, warn};
 use crate::facade::{BagOptions, Recording, extend_bag_schema, is_bag, read_bag};
 use crate::facade::{
     BetaParams, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, Demonstration, Execution, ExecutionRecord,
-    Observations, Planner, PlannerParams, RecordReport, StateLock, TaskModel, derive_seed, errors,
-    length_warnings, posterior, prior,
+    Observations, Planner, PlannerParams, RecordReport, StateLock, TaskModel, errors,
+    length_warnings, posterior, prior, reschedule_seed,
 };
 use crate::params::{from_py, serialize_to_py};
 use crate::schedule::PyProblem;
@@ -23,10 +23,6 @@ use crate::schedule::PySchedule;
 
 /// The default robot count (the paper's two robots): `tandem.fit(robots=...)`'s default.
 pub(crate) const N_ROBOTS: usize = 2;
-
-/// Offset of the seed streams `Planner.reschedule` uses without a seed: the streams of
-/// `tandem schedule` without `--seed`, so both draw the same candidates for the same state.
-const SCHEDULE_STREAM: u64 = 1 << 32;
 
 /// `e` with the in-memory source label replaced by `label` (the Python argument).
 fn relabel(e: errors::Lfd, label: &str) -> errors::Lfd {
@@ -280,7 +276,8 @@ pub(crate) fn default_params(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
 }
 
 /// The loop of the paper's Fig. 2: the task model, the correction observations, the
-/// latched confidence and the current schedule, updated after every pair of executions.
+/// latched confidence and the current schedule, updated after every round of executions
+/// (one execution of each robot).
 ///
 /// Make one with :func:`fit` or :meth:`Planner.load`. The state file is the command line's:
 /// a file saved here opens with ``tandem inspect``/``record``/``schedule`` and vice versa.
@@ -304,7 +301,7 @@ fn per_robot<'py>(x: &Bound<'py, PyAny>, what: &str, n: usize) -> Result<Vec<Bou
     Ok(v)
 }
 
-/// The report of a recorded pair as a dict.
+/// The report of a recorded round as a dict.
 fn report_dict<'py>(py: Python<'py>, r: &RecordReport) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("newly_high", r.newly_high)?;
@@ -489,8 +486,8 @@ impl PyPlanner {
         report_dict(py, &report)
     }
 
-    /// :meth:`record_round` under the paper's name, for a two-robot planner (the same
-    /// arguments, one entry per robot).
+    /// Deprecated: :meth:`record_round` under its two-robot name (the same arguments, one
+    /// entry per robot); emits a ``DeprecationWarning``. Kept for one release.
     #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None, dt_s=None))]
     #[expect(
         clippy::too_many_arguments,
@@ -506,6 +503,11 @@ impl PyPlanner {
         channels: Option<Vec<String>>,
         dt_s: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        deprecated(
+            py,
+            "Planner.record_pair is deprecated: use Planner.record_round (a round is one \
+             execution of each robot)",
+        )?;
         self.record_round(
             py,
             executions,
@@ -542,10 +544,8 @@ impl PyPlanner {
         let mut sp = self.inner.params().sampler.clone();
         sp.seed = match seed {
             Some(s) => s,
-            None => derive_seed(
-                sp.seed,
-                SCHEDULE_STREAM + self.inner.pairs_recorded() as u64,
-            ),
+            // The stream of `tandem schedule` without `--seed` (the planner's one rule).
+            None => reschedule_seed(sp.seed, self.inner.rounds_recorded()),
         };
         if let Some(n) = samples {
             sp.samples = n;
@@ -589,10 +589,21 @@ impl PyPlanner {
         serialize_to_py(py, self.inner.params())
     }
 
-    /// Rounds of executions (pairs for two robots) recorded so far.
+    /// Rounds recorded so far (a round is one execution of each robot).
     #[getter]
-    fn pairs_recorded(&self) -> usize {
-        self.inner.pairs_recorded()
+    fn rounds_recorded(&self) -> usize {
+        self.inner.rounds_recorded()
+    }
+
+    /// Deprecated: :attr:`rounds_recorded` under its two-robot name; emits a
+    /// ``DeprecationWarning``. Kept for one release.
+    #[getter]
+    fn pairs_recorded(&self, py: Python<'_>) -> PyResult<usize> {
+        deprecated(
+            py,
+            "Planner.pairs_recorded is deprecated: use Planner.rounds_recorded",
+        )?;
+        Ok(self.inner.rounds_recorded())
     }
 
     /// Number of robots the planner schedules.
@@ -619,10 +630,10 @@ impl PyPlanner {
     fn __repr__(&self) -> String {
         let m = self.inner.model();
         format!(
-            "Planner(n_ref={}, channels={}, pairs_recorded={}, high_share={:.3}, t_total_s={:.3})",
+            "Planner(n_ref={}, channels={}, rounds_recorded={}, high_share={:.3}, t_total_s={:.3})",
             m.n_ref(),
             repr_list(m.channel_names()),
-            self.inner.pairs_recorded(),
+            self.inner.rounds_recorded(),
             self.inner.confidence().high_share(),
             self.inner.outcome().t_total_s
         )

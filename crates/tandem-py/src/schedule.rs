@@ -413,8 +413,10 @@ impl PySchedule {
         self.certificate.map(|c| c.0)
     }
 
-    /// Relative gap ``(T_total − lower_bound_s) / lower_bound_s`` (≥ 0), or ``None`` without a
-    /// lower bound.
+    /// Relative gap ``(T_total − lower_bound_s) / lower_bound_s`` (dimensionless), or ``None``
+    /// without a lower bound. The bound is reported as computed (never clamped), so the gap is
+    /// ≥ 0 up to rounding: never below ``−2e-9`` (``tol::BOUND_REL``); e.g. ``−5.7e-15`` when
+    /// the schedule is the optimum.
     #[getter]
     fn gap(&self) -> Option<f64> {
         self.certificate.map(|c| c.1)

@@ -168,7 +168,8 @@ fn bench(c: &mut Criterion) {
             k
         })
     });
-    // One tick: the same run, one tick per iteration (the two-robot figure of issue #11).
+    // One tick: the same run, one tick per iteration (the two-robot figure of
+    // docs/decisions.md).
     bench_tick(c, "coordinator_tick/6000", r.to_vec(), tick_s);
     for n_robots in [2, 4, 8] {
         let id = format!("coordinator_tick_robots/{n_robots}");

@@ -23,6 +23,10 @@
 //!   error, never by a different tick.
 //! - **Empty measure** ([`MEASURE_ZERO_REL`]): the sampler treats a set of admissible offsets
 //!   shorter than `1e-12·max(1 s, |ψ_E1|)` as empty, erring on proposing no candidate.
+//! - **Certificates** ([`BOUND_REL`]): a correct lower bound on `T_total` may exceed the
+//!   `T_total` of a valid schedule by at most `2·GRADIENT_REL` relative (the gradient test's
+//!   slack plus summing the two in different orders); the bound is reported as computed, and
+//!   one above that is a bug, never a rounding.
 //!
 //! Everything else is compared exactly: the clock's breakpoints (one summation,
 //! [`clock_s`](crate::clock_s)), the coordinator's cursors and modes, the sampler's
@@ -41,6 +45,15 @@ pub const CLOCK_REL: f64 = 1e-9;
 /// Relative size (dimensionless) below which a set of offsets counts as empty (see the
 /// [module docs](self)).
 pub const MEASURE_ZERO_REL: f64 = 1e-12;
+
+/// Relative amount (dimensionless) by which a valid schedule's `T_total` may lie below a
+/// correct lower bound on it: `2·GRADIENT_REL`. A schedule's gradients may lie up to
+/// [`GRADIENT_REL`] outside their bounds and the mean (a schedule read back from text, the
+/// previous one), which shortens `T_total` by at most that much; the other `GRADIENT_REL`
+/// covers summing the bound and `T_total` in different orders. So a certificate's gap
+/// `(T_total − bound)/bound` is never below `−BOUND_REL` (up to its own rounding), and a gap
+/// of magnitude below it is zero (see the [module docs](self)).
+pub const BOUND_REL: f64 = 2.0 * GRADIENT_REL;
 
 /// `true` when `value` lies in `[lo, hi]` up to [`GRADIENT_REL`] of the bounds
 /// (`lo·(1 − 1e-9) ≤ value ≤ hi·(1 + 1e-9)`, for positive bounds); `false` for NaN.

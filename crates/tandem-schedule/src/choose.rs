@@ -86,39 +86,40 @@ pub struct Outcome {
     /// [`Outcome::bound_is_optimum`], else the simple bound of an unfinished search; for
     /// `N ≠ 2` robots [`crate::operator_bound_s`]. Reported as computed, never clamped: it is
     /// not above [`Outcome::t_total_s`] except by the rounding a valid schedule is allowed
-    /// (at most `2·tol::GRADIENT_REL` relative: `validate` accepts gradients that far outside
-    /// their bounds, and the bound and `T_total` are summed in different orders); a bound
-    /// above that is a bug, and an error (a panic) in debug builds.
+    /// (at most `tol::BOUND_REL` = `2·tol::GRADIENT_REL` relative: `validate` accepts
+    /// gradients that far outside their bounds, and the bound and `T_total` are summed in
+    /// different orders); a bound above that is a bug, and in debug builds the scheduler
+    /// returns [`Error::BoundAboveSchedule`] instead of the outcome.
     pub lower_bound_s: f64,
     /// Whether [`Outcome::lower_bound_s`] is the proven margin-free optimum `T*₀`.
     pub bound_is_optimum: bool,
     /// `(T_total − lower_bound_s)/lower_bound_s` (dimensionless; ≥ 0 up to the rounding of
-    /// [`Outcome::lower_bound_s`], so never below `−2·tol::GRADIENT_REL`): the schedule is at most
+    /// [`Outcome::lower_bound_s`], so never below `−tol::BOUND_REL`): the schedule is at most
     /// this much (relative) above the optimum of Eq. 20; what it is above `T*₀` is what the
     /// margins (constraint 5) cost, plus whatever the search left.
     pub gap: f64,
 }
 
-/// Relative amount (dimensionless) by which a valid schedule may be shorter than a correct
-/// lower bound: `validate` accepts gradients up to `tol::GRADIENT_REL` outside their bounds and
-/// the mean (a schedule read back from text, the previous one), which shortens `T_total` by at
-/// most that much; the other `GRADIENT_REL` covers summing the bound and `T_total` in
-/// different orders.
-const BOUND_SLACK_REL: f64 = 2.0 * tol::GRADIENT_REL;
-
 /// The certificate of a valid schedule of `t_total_s` seconds against the lower bound
 /// `bound_s` (s): `(lower_bound_s, gap)`, the bound as computed (no clamping) and
 /// `(T_total − bound)/bound`.
 ///
-/// # Panics
-/// In debug builds, if `bound_s` exceeds `t_total_s` by more than [`BOUND_SLACK_REL`]: the
-/// bound is wrong (a bug in the search or the bound), and a certificate must not hide it.
-fn certificate(bound_s: f64, t_total_s: f64) -> (f64, f64) {
-    debug_assert!(
-        bound_s <= t_total_s * (1.0 + BOUND_SLACK_REL),
-        "the lower bound {bound_s} s is above the T_total {t_total_s} s of a valid schedule"
-    );
-    (bound_s, (t_total_s - bound_s) / bound_s)
+/// # Errors
+/// In debug builds, [`Error::BoundAboveSchedule`] if `bound_s` exceeds `t_total_s` by more
+/// than [`tol::BOUND_REL`]: the bound is wrong (a bug in the search or the bound), and a
+/// certificate must not hide it. Release builds return the certificate as computed, whose
+/// negative gap shows the wrong bound to whoever reads it.
+fn certificate(bound_s: f64, t_total_s: f64) -> Result<(f64, f64)> {
+    if cfg!(debug_assertions) && bound_above(bound_s, t_total_s) {
+        return Err(Error::BoundAboveSchedule { bound_s, t_total_s });
+    }
+    Ok((bound_s, (t_total_s - bound_s) / bound_s))
+}
+
+/// `true` when the lower bound `bound_s` (s) lies above the `T_total` `t_total_s` (s) of a
+/// valid schedule by more than the rounding [`tol::BOUND_REL`] allows (or either is NaN).
+fn bound_above(bound_s: f64, t_total_s: f64) -> bool {
+    bound_s.is_nan() || t_total_s.is_nan() || bound_s > t_total_s * (1.0 + tol::BOUND_REL)
 }
 
 /// A schedule that passed every constraint of Eq. 20 at the scheduler's tick, with its
@@ -381,7 +382,7 @@ fn schedule_n(
         best = (schedule, t, Source::Completed);
     }
     let (schedule, t_total_s, source) = best;
-    let (lower_bound_s, gap) = certificate(bound.lower_bound_s, t_total_s);
+    let (lower_bound_s, gap) = certificate(bound.lower_bound_s, t_total_s)?;
     Ok(Outcome {
         schedule,
         t_total_s,
@@ -400,24 +401,51 @@ mod tests {
     #[test]
     fn the_certificate_reports_the_bound_as_computed() {
         // T_total 0.5 s against the bound 0.4 s: gap 0.1/0.4 = 0.25.
-        let (bound, gap) = certificate(0.4, 0.5);
+        let (bound, gap) = certificate(0.4, 0.5).unwrap();
         assert_eq!(bound, 0.4);
         assert!((gap - 0.25).abs() < 1e-15, "{gap}");
         // A schedule shorter than the bound by rounding (1e-12 relative, inside the slack)
         // keeps the bound as computed and a negative gap: nothing is clamped.
-        let (bound, gap) = certificate(1.0 + 1e-12, 1.0);
+        let (bound, gap) = certificate(1.0 + 1e-12, 1.0).unwrap();
         assert_eq!(bound, 1.0 + 1e-12);
         assert!(gap < 0.0 && gap > -2e-12, "{gap}");
         // The edge of the slack still passes.
-        let (_, gap) = certificate(1.0 + 1.5 * tol::GRADIENT_REL, 1.0);
+        let (_, gap) = certificate(1.0 + 0.75 * tol::BOUND_REL, 1.0).unwrap();
         assert!(gap < 0.0);
     }
 
     #[test]
-    #[cfg(debug_assertions)]
-    #[should_panic(expected = "above the T_total")]
     fn a_bound_above_t_total_is_an_error_in_debug_builds() {
         // 1e-6 relative above the schedule: far beyond rounding, a wrong bound.
-        let _ = certificate(0.5 * (1.0 + 1e-6), 0.5);
+        let wrong = certificate(0.5 * (1.0 + 1e-6), 0.5);
+        // Just beyond the allowance, and a NaN bound, are wrong too.
+        let edge = certificate(1.0 + 1.5 * tol::BOUND_REL, 1.0);
+        let nan = certificate(f64::NAN, 1.0);
+        if cfg!(debug_assertions) {
+            for (got, bound_s) in [
+                (wrong, 0.5 * (1.0 + 1e-6)),
+                (edge, 1.0 + 1.5 * tol::BOUND_REL),
+            ] {
+                match got {
+                    Err(Error::BoundAboveSchedule {
+                        bound_s: b,
+                        t_total_s: _,
+                    }) => assert_eq!(b, bound_s),
+                    other => panic!("expected BoundAboveSchedule, got {other:?}"),
+                }
+            }
+            assert!(
+                matches!(nan, Err(Error::BoundAboveSchedule { .. })),
+                "{nan:?}"
+            );
+        } else {
+            // Release builds report it as computed: the negative gap shows it.
+            let (bound, gap) = wrong.unwrap();
+            assert_eq!(bound, 0.5 * (1.0 + 1e-6));
+            assert!(gap < -9e-7, "{gap}");
+            assert!(edge.unwrap().1 < 0.0);
+        }
+        assert!(bound_above(1.0 + 3.0 * tol::BOUND_REL, 1.0));
+        assert!(!bound_above(1.0 + 0.5 * tol::BOUND_REL, 1.0));
     }
 }

@@ -72,6 +72,19 @@ pub enum Error {
     /// included), so it is not run ([`crate::Schedule::check`]).
     #[error("the schedule is not valid on its problem: {0}")]
     Invalid(Violation),
+    /// A certificate's lower bound lies above the `T_total` of the valid schedule it certifies
+    /// by more than the rounding `tandem_realtime::tol::BOUND_REL` allows: the bound is wrong
+    /// (a bug in the exact search or the operator bound). Returned by the scheduler in debug
+    /// builds only; release builds report the bound as computed, with its negative gap.
+    #[error(
+        "the lower bound {bound_s} s is above the T_total {t_total_s} s of a valid schedule (a wrong bound)"
+    )]
+    BoundAboveSchedule {
+        /// The bound as computed (s).
+        bound_s: f64,
+        /// The schedule's `T_total` (s, Eq. 13).
+        t_total_s: f64,
+    },
     /// The realtime crate (coordinator, margin check) rejected its input.
     #[error(transparent)]
     Realtime(#[from] tandem_realtime::Error),

@@ -199,11 +199,15 @@ pub(crate) fn validated_timeline(
 /// (a benchmark-only choice, see `SamplerBaselines`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum MarginCheck {
-    /// `tandem_realtime::sufficient_margins`: two worst-case simulations decide every pair.
+    /// `tandem_realtime::sufficient_margins`: for two robots two worst-case simulations
+    /// decide every pair of consecutive low-confidence regions; for three or more the lead
+    /// bound with sliding window extremes.
     #[default]
     SinglePass,
-    /// `tandem_realtime::sufficient_margins_per_pair`: one simulation per pair of consecutive
-    /// low-confidence regions (the straightforward reading of Alg. 2; a speed baseline).
+    /// `tandem_realtime::sufficient_margins_per_pair`, the same decisions computed the
+    /// straightforward way: for two robots one simulation per pair of consecutive
+    /// low-confidence regions (the plain reading of Alg. 2), for three or more the lead bound
+    /// with every window scanned sample by sample. A speed baseline, as safe as `SinglePass`.
     PerPair,
 }
 

@@ -336,7 +336,7 @@ fn fixture_problem_bound_matches_all_orders_and_the_certificate_passes() {
     check_certificate(&p, &out);
     assert!(out.bound_is_optimum);
     assert_eq!(out.source, Source::Completed);
-    // Issue #15 asks for 0.6 % on the problem it measured (the fixture before its
+    // The target is 0.6 % on the problem first measured (the fixture before its
     // regeneration: 0.45 % now); on the regenerated fixture, with wider gradient bounds, the
     // margins cost more (0.72 %, docs/decisions.md). 1 % catches a completion that falls apart.
     assert!(out.gap < 0.01, "{label}: gap {}", out.gap);

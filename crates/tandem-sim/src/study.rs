@@ -186,7 +186,9 @@ pub struct IterationRecord {
     pub lower_bound_s: f64,
     /// Whether [`IterationRecord::lower_bound_s`] is the proven margin-free optimum `T*₀`.
     pub bound_is_optimum: bool,
-    /// `(T_total − lower_bound_s) / lower_bound_s` (dimensionless, ≥ 0).
+    /// `(T_total − lower_bound_s) / lower_bound_s` (dimensionless; the bound is unclamped, so
+    /// ≥ 0 up to rounding: never below `−realtime::tol::BOUND_REL`, e.g. `−2.4e-16` when the
+    /// schedule is the optimum).
     pub gap: f64,
     /// Planned throughput: tasks per hour per operator, `N·3600 / T_total` (`N` robots each
     /// finish one task per `T_total` seconds of the schedule).
@@ -587,7 +589,7 @@ fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
     let outcome = planner.outcome();
     let n_robots = planner.n_robots();
     Ok(IterationRecord {
-        iteration: planner.pairs_recorded(),
+        iteration: planner.rounds_recorded(),
         t_total_s: outcome.t_total_s,
         offset_s: schedule.offsets_s.first().copied().unwrap_or(0.0),
         high_conf_pct: 100.0 * planner.confidence().high_share(),

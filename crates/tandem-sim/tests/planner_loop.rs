@@ -67,8 +67,8 @@ fn record_pair_updates_everything_and_keeps_schedules_valid() {
         .iter()
         .map(|r| r.supervised.iter().filter(|s| **s).count())
         .sum();
-    let report = p.record_pair(&records).unwrap();
-    assert_eq!(p.pairs_recorded(), 1);
+    let report = p.record_round(&records).unwrap();
+    assert_eq!(p.rounds_recorded(), 1);
     assert_eq!(
         p.model().count(),
         count0 + 2,
@@ -91,7 +91,7 @@ fn a_bad_record_is_rejected_and_changes_nothing() {
         p.observations().clone(),
         p.schedule().clone(),
     );
-    let err = p.record_pair(&records).unwrap_err();
+    let err = p.record_round(&records).unwrap_err();
     assert!(
         matches!(
             err,
@@ -110,7 +110,7 @@ fn a_bad_record_is_rejected_and_changes_nothing() {
         ),
         before
     );
-    assert_eq!(p.pairs_recorded(), 0);
+    assert_eq!(p.rounds_recorded(), 0);
 }
 
 fn same(a: &Planner, b: &Planner) {
@@ -118,7 +118,7 @@ fn same(a: &Planner, b: &Planner) {
     assert_eq!(a.outcome(), b.outcome());
     assert_eq!(a.confidence(), b.confidence());
     assert_eq!(a.observations(), b.observations());
-    assert_eq!(a.pairs_recorded(), b.pairs_recorded());
+    assert_eq!(a.rounds_recorded(), b.rounds_recorded());
     assert_eq!(a.params(), b.params());
     assert_eq!(a.problem(), b.problem());
     assert_eq!(a.model().mean(), b.model().mean());
@@ -131,7 +131,7 @@ fn state_round_trips_and_the_loaded_planner_continues_identically() {
     let dir = tmp_dir("roundtrip");
     let path = dir.join("cell.tandem");
     let mut p = planner();
-    p.record_pair(&pair(&p, 3)).unwrap();
+    p.record_round(&pair(&p, 3)).unwrap();
     p.save(&path).unwrap();
     let mut q = Planner::load(&path).unwrap();
     same(&p, &q);
@@ -144,8 +144,8 @@ fn state_round_trips_and_the_loaded_planner_continues_identically() {
     );
     // Both continue identically.
     let records = pair(&p, 4);
-    p.record_pair(&records).unwrap();
-    q.record_pair(&records).unwrap();
+    p.record_round(&records).unwrap();
+    q.record_round(&records).unwrap();
     same(&p, &q);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -73,7 +73,7 @@ fn reduced_study_never_overlaps_and_learns() {
 
 #[test]
 fn same_seed_same_bytes_on_one_and_two_threads() {
-    // The reduced study: 1 trial × 20 executions × 200 samples.
+    // The reduced study: 1 trial × 20 executions × 200 samples.
     let config = StudyConfig {
         trials: 1,
         executions: 20,

@@ -1,4 +1,5 @@
-//! Property test: more search effort never makes the alignment materially worse (issue #14).
+//! Property test: more search effort never makes the alignment materially worse (the
+//! "effort never coarsens the search" decision in docs/decisions.md).
 //!
 //! With the former solver, raising `coarse_nodes` from 48 to 200 multiplied the final objective by
 //! up to 23 and tripled the error against the true warp on the ground-truth benchmark

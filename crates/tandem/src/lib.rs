@@ -45,7 +45,7 @@
 //! // Record it (Eq. 21, Eq. 9–12) and get the next schedule (`record_round` takes one
 //! // record per robot; `Planner::with_robots` makes a planner of N robots).
 //! let report = planner.record_round(&pair.records(planner.model())?)?;
-//! assert_eq!(planner.pairs_recorded(), 1);
+//! assert_eq!(planner.rounds_recorded(), 1);
 //! assert_eq!(report.t_total_s, planner.outcome().t_total_s);
 //! // The new schedule satisfies every constraint of Eq. 20 on the updated problem.
 //! tandem::schedule::validate(planner.problem(), planner.schedule())?;
