@@ -26,6 +26,20 @@ pub struct PairStats {
     /// traversed a low-confidence sample, so that the operator was needed
     /// (`1 − operator_idle_share`; docs/study.md).
     pub operator_busy_share: f64,
+    /// Faults of the coordinator's run-time monitor in the round
+    /// ([`RoundRun::faults`](crate::workcell::RoundRun::faults); must be 0). Left out of the
+    /// JSON when 0, as it always is for the checked schedules a study runs.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub faults: usize,
+}
+
+/// Whether a count is 0 (for `skip_serializing_if`).
+#[expect(
+    clippy::trivially_copy_pass_by_ref,
+    reason = "serde passes the field by reference"
+)]
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// One iteration of a trial: a schedule and what running it gave.
@@ -334,6 +348,7 @@ mod tests {
                 supervised_ticks: 10,
                 corrected_ticks: 4,
                 operator_busy_share: 0.5,
+                faults: 0,
             }),
             lower_bound_s: t_total_s - 1.0,
             bound_is_optimum: iteration == 0,

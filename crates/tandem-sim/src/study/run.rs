@@ -171,6 +171,7 @@ pub fn run_trial_observed(
             supervised_ticks: count(|b| *b, |r| &r.supervised),
             corrected_ticks: count(|b| *b, |r| &r.corrected),
             operator_busy_share: run.operator_busy_share(),
+            faults: run.faults,
         });
         iterations.push(record);
         let report = planner.record_round(&records)?;

@@ -52,6 +52,10 @@
 //! 5. After the tick, `Tick::low_conf` says which robots traversed any low-confidence sample:
 //!    two or more at once is an *overlap* (a valid schedule never has one), none is operator
 //!    idle time, and any is operator busy time.
+//! 6. An overlap latches a fault of the coordinator's run-time monitor (`Tick::fault`), which
+//!    holds one robot in place; the round counts it (`RoundRun::faults`), the held robot
+//!    logs nothing while held, and the operator releases it (`Coordinator::clear_fault`)
+//!    after the first tick in which no robot is low-confidence, so every round finishes.
 
 mod operator;
 mod record;

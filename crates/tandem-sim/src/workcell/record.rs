@@ -74,6 +74,11 @@ pub struct RoundRun {
     pub overlap_ticks: usize,
     /// Ticks in which no robot traversed a low-confidence sample.
     pub idle_ticks: usize,
+    /// Faults latched by the coordinator's run-time monitor (two robots low-confidence in one
+    /// tick; `tandem_realtime::Fault`), each released by the simulated operator once no robot
+    /// was low-confidence (must be 0: a checked schedule never has one).
+    #[serde(default)]
+    pub faults: usize,
 }
 
 /// The two-robot round of the paper: a [`RoundRun`] with two robots ([`run_pair`](super::run_pair)).

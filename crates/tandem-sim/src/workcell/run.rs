@@ -4,7 +4,7 @@
 use rand::Rng;
 use tandem_lfd::TaskModel;
 use tandem_planner::Planner;
-use tandem_realtime::{Operator, Timeline, tol};
+use tandem_realtime::{Coordinator, Operator, Timeline, tol};
 use tandem_schedule::{Problem, Schedule};
 
 use super::operator::{Episodes, OperatorParams, correction_input, needs_correction};
@@ -137,18 +137,12 @@ pub(super) fn run_schedule(
     model: &TaskModel,
     problem: &Problem,
     schedule: &Schedule,
-    mut needs: impl FnMut(usize, usize) -> bool,
+    needs: impl FnMut(usize, usize) -> bool,
     params: &OperatorParams,
     rng: &mut impl Rng,
 ) -> Result<RoundRun> {
     params.validate()?;
     check_sizes(model, problem, schedule)?;
-    let n_ref = problem.n_ref();
-    let force_idx = model
-        .tangent_names()
-        .iter()
-        .position(|n| *n == params.force_channel)
-        .ok_or_else(|| Error::NoForceChannel(params.force_channel.clone()))?;
     let dt_s = problem.dt_s();
     if !tol::same_tick(schedule.tick_s, dt_s) {
         return Err(Error::TickMismatch {
@@ -156,7 +150,32 @@ pub(super) fn run_schedule(
             workcell_tick_s: dt_s,
         });
     }
-    let mut coord = schedule.coordinator(problem)?;
+    // The one place the workcell builds its coordinator (with the margin check).
+    let coord = schedule.coordinator(problem)?;
+    run_coordinator(model, problem, coord, needs, params, rng)
+}
+
+/// The control loop of the module docs on a coordinator of `problem`'s robots at its own
+/// tick (`Δt_s`; checked by the caller, as are the parameters and sizes). A tick that latches
+/// a fault of the coordinator's run-time monitor (two robots low-confidence at once, which a
+/// checked schedule never has) is counted in [`RoundRun::faults`]; the held robot logs no
+/// samples while held, and the simulated operator releases it
+/// ([`Coordinator::clear_fault`]) after the first tick in which no robot is low-confidence,
+/// so that every round finishes.
+pub(super) fn run_coordinator(
+    model: &TaskModel,
+    problem: &Problem,
+    mut coord: Coordinator,
+    mut needs: impl FnMut(usize, usize) -> bool,
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<RoundRun> {
+    let n_ref = problem.n_ref();
+    let force_idx = model
+        .tangent_names()
+        .iter()
+        .position(|n| *n == params.force_channel)
+        .ok_or_else(|| Error::NoForceChannel(params.force_channel.clone()))?;
     let tick_s = coord.tick_s();
 
     let m = model.channel_names().len();
@@ -177,7 +196,7 @@ pub(super) fn run_schedule(
     };
     let n_robots = coord.n_robots();
     let mut runs: Vec<RobotRun> = (0..n_robots).map(|_| empty()).collect();
-    let (mut ticks, mut overlap_ticks, mut idle_ticks) = (0, 0, 0);
+    let (mut ticks, mut overlap_ticks, mut idle_ticks, mut faults) = (0, 0, 0, 0);
     let max_end_s = coord
         .robots()
         .iter()
@@ -201,24 +220,46 @@ pub(super) fn run_schedule(
         params.false_correction_s / tick_s,
     );
     let mut in_episode = vec![false; n_robots];
+    // Each robot's reference sample `n_i` and reference time `t_i` at its schedule clock,
+    // kept across ticks: the sample through a monotone cursor (schedule clocks never
+    // decrease; the same sample as `Timeline::sample_at`), the time from the coordinator's
+    // `Tick::ref_time` (Eq. 15 at the clock after the tick, the same value as
+    // `Timeline::ref_time_at`), so that a tick needs no search.
+    let mut sample: Vec<usize> = coord
+        .robots()
+        .iter()
+        .zip(coord.clock_s())
+        .map(|(tl, &c)| tl.sample_at(c))
+        .collect();
+    let mut ref_now: Vec<f64> = coord
+        .robots()
+        .iter()
+        .zip(coord.clock_s())
+        .map(|(tl, &c)| tl.ref_time_at(c))
+        .collect();
 
     while !coord.is_finished() {
         if ticks >= budget {
             return Err(Error::DidNotFinish { ticks: budget });
         }
+        let held = coord.fault().map(|f| f.stopped);
         let clocks = coord.clock_s();
         let mut operator = Operator::Scheduled;
         for i in 0..n_robots {
             let tl = &coord.robots()[i];
             runs[i].clock_s.push(clocks[i]);
-            if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() {
+            if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() || held == Some(i) {
                 continue;
             }
             if runs[i].start_tick == usize::MAX {
                 runs[i].start_tick = ticks;
             }
-            let n = tl.sample_at(clocks[i]);
-            let ref_time = tl.ref_time_at(clocks[i]).min(last_ref);
+            let sample_clock_s = tl.sample_clock_s();
+            while sample[i] + 1 < n_ref && sample_clock_s[sample[i] + 1] <= clocks[i] {
+                sample[i] += 1;
+            }
+            let n = sample[i];
+            let ref_time = ref_now[i].min(last_ref);
             let supervised = !problem.conf()[n];
             let mut corrected = false;
             if supervised {
@@ -257,12 +298,19 @@ pub(super) fn run_schedule(
             run.corrected.push(corrected);
         }
         let tick = coord.tick(operator)?;
-        ticks += 1;
+        ref_now.copy_from_slice(&tick.ref_time);
         match tick.low_conf.count() {
             0 => idle_ticks += 1,
             1 => {}
             _ => overlap_ticks += 1,
         }
+        match tick.fault {
+            Some(f) if f.tick == ticks as u64 => faults += 1,
+            // The operator has dealt with the robot that kept running: release the held one.
+            Some(_) if tick.low_conf.count() == 0 => coord.clear_fault(),
+            _ => {}
+        }
+        ticks += 1;
     }
     for run in &mut runs {
         run.start_tick = run.start_tick.min(ticks);
@@ -273,5 +321,6 @@ pub(super) fn run_schedule(
         tick_s,
         overlap_ticks,
         idle_ticks,
+        faults,
     })
 }

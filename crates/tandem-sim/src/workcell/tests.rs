@@ -7,7 +7,7 @@ use tandem_lfd::{Demonstration, FitParams, TaskModel};
 use tandem_planner::Planner;
 use tandem_schedule::Problem;
 
-use super::run::run_schedule;
+use super::run::{run_coordinator, run_schedule};
 use super::*;
 use crate::Error;
 use crate::task::{Label, N_PASSES, Phase, Workpiece};
@@ -450,4 +450,81 @@ fn same_seed_same_run_and_mismatches_are_errors() {
             found: 5,
         }
     ));
+}
+
+#[test]
+fn an_unsafe_plan_latches_a_fault_that_the_operator_releases_and_the_round_finishes() {
+    let model = model();
+    let problem = problem(&model);
+    // Both robots start together: both reach the low-confidence samples 10..20 in the same
+    // ticks, which the margin check rejects.
+    let mut schedule = problem.serial_schedule(problem.dt_s()).unwrap();
+    schedule.offsets_s = vec![0.0];
+    let perfect = OperatorParams {
+        miss_rate: 0.0,
+        false_correction_rate: 0.0,
+        ..OperatorParams::default()
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let refused = run_schedule(
+        &model,
+        &problem,
+        &schedule,
+        painted_needs,
+        &perfect,
+        &mut rng,
+    );
+    assert!(
+        matches!(
+            refused,
+            Err(Error::Schedule(_) | Error::Realtime(tandem_realtime::Error::Unsafe { .. }))
+        ),
+        "{refused:?}"
+    );
+    let unchecked = tandem_realtime::Coordinator::new_unchecked(
+        schedule.timelines(&problem).unwrap(),
+        schedule.tick_s,
+    )
+    .unwrap();
+    let run = run_coordinator(
+        &model,
+        &problem,
+        unchecked,
+        painted_needs,
+        &perfect,
+        &mut rng,
+    )
+    .unwrap();
+    // The first overlap latches the fault and holds robot 2 (its stretch began in the same
+    // tick: the higher index on a tie) at once, so there is no second overlap tick; released
+    // once robot 1 has left its stretch, robot 2 runs to the end.
+    assert_eq!((run.overlap_ticks, run.faults), (1, 1));
+    for (i, r) in run.robots.iter().enumerate() {
+        let last = *r.ref_time_log.last().unwrap();
+        assert!(last > (N_REF - 2) as f64, "robot {i} ended at {last}");
+        assert!(r.ref_time_log.windows(2).all(|w| w[0] <= w[1]), "robot {i}");
+        assert_eq!(r.clock_s.len(), run.ticks, "robot {i}");
+    }
+    let [r1, r2] = &run.robots[..] else {
+        panic!("{} robots", run.robots.len())
+    };
+    // Held, robot 2's clock stood still and it logged no sample; it finished last, so it
+    // logged a sample in every other tick of the round.
+    let held = r2.clock_s.windows(2).filter(|w| w[0] == w[1]).count();
+    assert!(held > 0);
+    assert_eq!(r2.start_tick, 0);
+    assert_eq!(r2.ref_time_log.len() + held, run.ticks);
+    assert!(r1.start_tick + r1.ref_time_log.len() < run.ticks);
+    assert!(r2.supervised.iter().any(|s| *s));
+    // The safe plan of the same problem never faults.
+    let on_time = run_schedule(
+        &model,
+        &problem,
+        &problem.serial_schedule(problem.dt_s()).unwrap(),
+        painted_needs,
+        &perfect,
+        &mut ChaCha8Rng::seed_from_u64(9),
+    )
+    .unwrap();
+    assert_eq!((on_time.faults, on_time.overlap_ticks), (0, 0));
 }
