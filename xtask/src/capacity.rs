@@ -470,6 +470,7 @@ mod tests {
                 supervised_ticks: 300 * k,
                 corrected_ticks: 0,
                 operator_busy_share: k as f64 / 10.0,
+                faults: 0,
             }),
             lower_bound_s: t_total_s,
             bound_is_optimum: false,

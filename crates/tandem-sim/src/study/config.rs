@@ -1,0 +1,231 @@
+//! The study's configuration (`fixtures/study.toml`).
+
+use serde::{Deserialize, Serialize};
+use tandem_planner::PlannerParams;
+
+use crate::task::TaskParams;
+use crate::workcell::OperatorParams;
+use crate::{Error, Result};
+
+/// Study configuration (`fixtures/study.toml`, §III).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StudyConfig {
+    /// Independent trials (paper: 5). Default: 5.
+    pub trials: usize,
+    /// Executions per trial, run in rounds of [`StudyConfig::robots`] (one execution per
+    /// robot), so a positive multiple of `robots` (paper: 300, in pairs). Default: 300.
+    pub executions: usize,
+    /// Robots `N` run by the one operator, `1 ≤ N ≤` [`tandem_realtime::MAX_ROBOTS`]
+    /// (paper: 2). Default: 2.
+    pub robots: usize,
+    /// Sampler iterations per re-schedule (paper: 5000). Default: 5000.
+    pub samples: usize,
+    /// Master seed; trial `k` is seeded from `(seed, k)` only. Default: 2023.
+    pub seed: u64,
+    /// Probability that the simulated operator misses a needed correction (§III: 1 %).
+    /// Default: 0.01.
+    pub miss_rate: f64,
+    /// Probability that the operator corrects a sample that needs none (§III: 1 %).
+    /// Default: 0.01.
+    pub false_correction_rate: f64,
+    /// Mean duration (s) of one unneeded correction episode (see
+    /// [`OperatorParams::false_correction_s`]). Default: 0.5 s.
+    pub false_correction_s: f64,
+    /// Iterations whose schedules Fig. 5 draws as examples (trial 0). Default: 0, 25, 50, 100, 150.
+    pub example_iterations: Vec<usize>,
+    /// Model, confidence and sampler parameters. The sampler's `samples` and `seed` are
+    /// replaced by [`StudyConfig::samples`] and the trial's seed. Default: `PlannerParams::default()`.
+    pub planner: PlannerParams,
+    /// Task parameters for drawing each execution's workpiece (only `n_sections` matters);
+    /// must match the demonstrations'. Default: `TaskParams::default()` (the fixtures').
+    pub task: TaskParams,
+}
+
+impl Default for StudyConfig {
+    fn default() -> Self {
+        Self {
+            trials: 5,
+            executions: 300,
+            robots: 2,
+            samples: 5000,
+            seed: 2023,
+            miss_rate: 0.01,
+            false_correction_rate: 0.01,
+            false_correction_s: 0.5,
+            example_iterations: vec![0, 25, 50, 100, 150],
+            planner: PlannerParams::default(),
+            task: TaskParams::default(),
+        }
+    }
+}
+
+impl StudyConfig {
+    /// Number of rounds per trial (`executions / robots`; pairs for two robots).
+    pub fn n_rounds(&self) -> usize {
+        self.executions / self.robots.max(1)
+    }
+
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] naming the first invalid field.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name: &'static str, why: &'static str| Err(Error::BadParam { name, why });
+        if self.trials == 0 {
+            return bad("trials", "must be at least 1");
+        }
+        if !(1..=tandem_realtime::MAX_ROBOTS).contains(&self.robots) {
+            return bad(
+                "robots",
+                "must be between 1 and 8 (tandem_realtime::MAX_ROBOTS)",
+            );
+        }
+        if self.executions == 0 || self.executions % self.robots != 0 {
+            return bad(
+                "executions",
+                if self.robots == 2 {
+                    "must be a positive even number (executions run in pairs)"
+                } else {
+                    "must be a positive multiple of `robots` (executions run in rounds of one \
+                     execution per robot)"
+                },
+            );
+        }
+        if self.samples == 0 {
+            return bad("samples", "must be at least 1");
+        }
+        for (name, p) in [
+            ("miss_rate", self.miss_rate),
+            ("false_correction_rate", self.false_correction_rate),
+        ] {
+            if !(0.0..=1.0).contains(&p) {
+                return bad(name, "must be a probability in [0, 1]");
+            }
+        }
+        if self.false_correction_rate >= 1.0 {
+            return bad("false_correction_rate", "must be below 1");
+        }
+        if !(self.false_correction_s.is_finite() && self.false_correction_s >= 0.0) {
+            return bad("false_correction_s", "must be finite and ≥ 0");
+        }
+        self.planner.validate()?;
+        self.task.validate()?;
+        Ok(())
+    }
+
+    /// The operator of the workcell.
+    pub fn operator(&self) -> OperatorParams {
+        OperatorParams {
+            miss_rate: self.miss_rate,
+            false_correction_rate: self.false_correction_rate,
+            false_correction_s: self.false_correction_s,
+            ..OperatorParams::default()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_papers_study() {
+        let c = StudyConfig::default();
+        assert_eq!((c.trials, c.executions, c.samples), (5, 300, 5000));
+        assert_eq!((c.robots, c.n_rounds()), (2, 150));
+        assert_eq!((c.miss_rate, c.false_correction_rate), (0.01, 0.01));
+        c.validate().unwrap();
+    }
+
+    #[test]
+    fn bad_configs_name_the_field() {
+        let cases: [(StudyConfig, &str); 7] = [
+            (
+                StudyConfig {
+                    robots: 0,
+                    ..Default::default()
+                },
+                "robots",
+            ),
+            (
+                StudyConfig {
+                    robots: 9,
+                    ..Default::default()
+                },
+                "robots",
+            ),
+            (
+                StudyConfig {
+                    robots: 7,
+                    ..Default::default()
+                },
+                "executions",
+            ),
+            (
+                StudyConfig {
+                    trials: 0,
+                    ..Default::default()
+                },
+                "trials",
+            ),
+            (
+                StudyConfig {
+                    executions: 7,
+                    ..Default::default()
+                },
+                "executions",
+            ),
+            (
+                StudyConfig {
+                    samples: 0,
+                    ..Default::default()
+                },
+                "samples",
+            ),
+            (
+                StudyConfig {
+                    miss_rate: f64::NAN,
+                    ..Default::default()
+                },
+                "miss_rate",
+            ),
+        ];
+        // Rounds of N robots: 300 executions are 100 rounds of 3.
+        let three = StudyConfig {
+            robots: 3,
+            ..Default::default()
+        };
+        three.validate().unwrap();
+        assert_eq!(three.n_rounds(), 100);
+        for (c, name) in cases {
+            let err = c.validate().unwrap_err();
+            assert!(
+                matches!(err, Error::BadParam { name: n, .. } if n == name),
+                "{err}"
+            );
+        }
+    }
+
+    #[test]
+    fn config_reads_from_toml_with_defaults_and_rejects_unknown_keys() {
+        let c: StudyConfig = toml::from_str("trials = 2\nseed = 7\n").unwrap();
+        assert_eq!((c.trials, c.seed, c.executions), (2, 7, 300));
+        assert!(toml::from_str::<StudyConfig>("trails = 2\n").is_err());
+        let nested: StudyConfig = toml::from_str(
+            "[planner.sampler]\np_fastest = 0.5\n[planner.confidence]\ngamma_c = 0.9\n",
+        )
+        .unwrap();
+        assert_eq!(nested.planner.sampler.p_fastest, 0.5);
+        assert_eq!(nested.planner.confidence.gamma_c, 0.9);
+        assert!(toml::from_str::<StudyConfig>("[planner.sampler]\nbogus = 1\n").is_err());
+        // The committed configuration is the paper's study.
+        let committed = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/study.toml"
+        ))
+        .unwrap();
+        let c: StudyConfig = toml::from_str(&committed).unwrap();
+        assert_eq!(c, StudyConfig::default());
+    }
+}

@@ -1,0 +1,23 @@
+//! The simulated study of §III (Fig. 5): configuration, per-iteration records, summaries.
+//!
+//! A trial starts from the demonstrations, schedules, runs a pair of executions in the
+//! simulated workcell, records them (Eq. 21), re-schedules, and so on for
+//! `executions / 2` pairs. Iteration `k` is the schedule made after `k` recorded pairs
+//! (iteration 0: demonstrations only) together with the outcome of running the next pair
+//! under it (none for the last iteration).
+
+mod config;
+mod inputs;
+mod record;
+mod run;
+
+pub use config::StudyConfig;
+pub use inputs::{StudyInputs, read_labels};
+pub use record::{
+    IterationRecord, IterationSummary, PairStats, ScheduleSource, StudyResult, TrialResult,
+    mean_std, throughput_per_h,
+};
+pub use run::{
+    PhaseTimes, Progress, RoundView, run_study, run_study_observed, run_trial, run_trial_observed,
+    run_trials, run_trials_observed, trial_seed,
+};

@@ -1,0 +1,326 @@
+//! Running a study: trials of schedule, round, record (§III, Fig. 5), in parallel, with the
+//! time spent in each phase.
+
+use std::time::{Duration, Instant};
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use tandem_lfd::TaskModel;
+use tandem_planner::{Planner, derive_seed};
+use tandem_schedule::GlobalTimeline;
+
+use super::config::StudyConfig;
+use super::inputs::StudyInputs;
+use super::record::{IterationRecord, PairStats, StudyResult, TrialResult, throughput_per_h};
+use crate::task::{self, Label, Workpiece};
+use crate::workcell;
+use crate::{Error, Result};
+
+/// Seed of trial `trial` from the master `seed` ([`derive_seed`]), so trials are
+/// independent of each other and of the order in which threads run them.
+pub fn trial_seed(seed: u64, trial: usize) -> u64 {
+    derive_seed(seed, trial as u64)
+}
+
+/// Wall time spent in each phase of a study, summed over trials (trials run in parallel,
+/// so the sum can exceed the elapsed time).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhaseTimes {
+    /// Aligning the demonstrations and fitting the model (once per study, §II-B1).
+    pub alignment: Duration,
+    /// Adding executions to the model (Eq. 21).
+    pub model_update: Duration,
+    /// Recording observations and updating the confidence (Eq. 9–12).
+    pub confidence: Duration,
+    /// Sampling schedules (§II-C), the first one included.
+    pub scheduling: Duration,
+    /// Running the workcell (coordinator, operator, commands).
+    pub simulation: Duration,
+}
+
+impl PhaseTimes {
+    fn add(&mut self, other: &PhaseTimes) {
+        self.alignment += other.alignment;
+        self.model_update += other.model_update;
+        self.confidence += other.confidence;
+        self.scheduling += other.scheduling;
+        self.simulation += other.simulation;
+    }
+}
+
+/// Progress of a running study, reported after every recorded pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// Trial index.
+    pub trial: usize,
+    /// Pairs of this trial recorded so far.
+    pub pairs_done: usize,
+}
+
+/// The record of the planner's current schedule (no pair run yet).
+fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
+    let schedule = planner.schedule();
+    let timeline = GlobalTimeline::new(planner.problem(), schedule)?;
+    let lc_intervals_s = timeline
+        .lc_intervals()
+        .iter()
+        .map(|v| v.iter().map(|i| [i.start_s, i.end_s]).collect())
+        .collect();
+    let outcome = planner.outcome();
+    let n_robots = planner.n_robots();
+    Ok(IterationRecord {
+        iteration: planner.rounds_recorded(),
+        t_total_s: outcome.t_total_s,
+        offset_s: schedule.offsets_s.first().copied().unwrap_or(0.0),
+        high_conf_pct: 100.0 * planner.confidence().high_share(),
+        source: outcome.source.into(),
+        lc_intervals_s,
+        pair: None,
+        lower_bound_s: outcome.lower_bound_s,
+        bound_is_optimum: outcome.bound_is_optimum,
+        gap: outcome.gap,
+        throughput_per_h: throughput_per_h(n_robots, outcome.t_total_s),
+        offsets_s: schedule.offsets_s.clone(),
+    })
+}
+
+/// Runs trial `trial` of a study from a fitted model (see the module docs). Its seed is
+/// [`trial_seed`]`(config.seed, trial)`: schedules use `derive_seed(trial seed, k)`,
+/// workpieces and the operator a ChaCha8 stream of the trial seed.
+///
+/// # Errors
+/// Invalid configuration, or any stage's error.
+pub fn run_trial(
+    config: &StudyConfig,
+    model: &TaskModel,
+    reference_labels: &[Label],
+    trial: usize,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<(TrialResult, PhaseTimes)> {
+    run_trial_observed(config, model, reference_labels, trial, progress, &|_| {})
+}
+
+/// One simulated round of a study as it ran: what [`run_study_observed`]'s observer sees.
+#[derive(Clone, Copy, Debug)]
+pub struct RoundView<'a> {
+    /// The trial (0-based).
+    pub trial: usize,
+    /// The round within the trial (1-based; round `k` ran the schedule of iteration `k − 1`).
+    pub round: usize,
+    /// The planner the round ran under (its schedule), before the round is recorded.
+    pub planner: &'a Planner,
+    /// The round.
+    pub run: &'a workcell::RoundRun,
+}
+
+/// [`run_trial`] calling `observe` with every round after it ran and before it is recorded
+/// (to write chosen rounds out, e.g. as bags); the result is the same as without.
+///
+/// # Errors
+/// As [`run_trial`].
+pub fn run_trial_observed(
+    config: &StudyConfig,
+    model: &TaskModel,
+    reference_labels: &[Label],
+    trial: usize,
+    progress: &(dyn Fn(Progress) + Sync),
+    observe: &(dyn Fn(RoundView<'_>) + Sync),
+) -> Result<(TrialResult, PhaseTimes)> {
+    config.validate()?;
+    let seed = trial_seed(config.seed, trial);
+    let mut params = config.planner.clone();
+    params.sampler.samples = config.samples;
+    params.sampler.seed = seed;
+    let mut times = PhaseTimes::default();
+    let t = Instant::now();
+    let mut planner = Planner::from_model_with_robots(model.clone(), params, config.robots)?;
+    times.scheduling += t.elapsed();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(1);
+    let operator = config.operator();
+    let n_pairs = config.n_rounds();
+    let n_robots = planner.n_robots();
+    let mut iterations = Vec::with_capacity(n_pairs + 1);
+    for pair in 0..n_pairs {
+        let mut record = iteration_record(&planner)?;
+        let workpieces = (0..n_robots)
+            .map(|_| Workpiece::random(&config.task, &mut rng))
+            .collect::<Result<Vec<_>>>()?;
+        let t = Instant::now();
+        let run =
+            workcell::run_round(&planner, reference_labels, &workpieces, &operator, &mut rng)?;
+        let records = run.records(planner.model())?;
+        times.simulation += t.elapsed();
+        let count = |f: fn(&bool) -> bool, pick: fn(&workcell::RobotRun) -> &Vec<bool>| {
+            run.robots
+                .iter()
+                .map(|r| pick(r).iter().filter(|b| f(b)).count())
+                .sum()
+        };
+        observe(RoundView {
+            trial,
+            round: pair + 1,
+            planner: &planner,
+            run: &run,
+        });
+        record.pair = Some(PairStats {
+            overlap_ticks: run.overlap_ticks,
+            operator_idle_share: run.operator_idle_share(),
+            duration_s: run.duration_s(),
+            supervised_ticks: count(|b| *b, |r| &r.supervised),
+            corrected_ticks: count(|b| *b, |r| &r.corrected),
+            operator_busy_share: run.operator_busy_share(),
+            faults: run.faults,
+        });
+        iterations.push(record);
+        let report = planner.record_round(&records)?;
+        times.model_update += report.model_update;
+        times.confidence += report.confidence;
+        times.scheduling += report.scheduling;
+        progress(Progress {
+            trial,
+            pairs_done: pair + 1,
+        });
+    }
+    iterations.push(iteration_record(&planner)?);
+    Ok((
+        TrialResult {
+            trial,
+            seed,
+            iterations,
+        },
+        times,
+    ))
+}
+
+/// Runs the study (§III): fits the model once, then runs the trials ([`run_trials`]).
+///
+/// # Errors
+/// Invalid configuration or inputs, a fit whose reference is not demo 0 (the labels are
+/// demo 0's; call [`run_trials`] with the reference's labels), or any stage's error (the
+/// first trial's in order).
+pub fn run_study(
+    config: &StudyConfig,
+    inputs: &StudyInputs,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<(StudyResult, PhaseTimes)> {
+    run_study_observed(config, inputs, progress, &|_| {})
+}
+
+/// [`run_study`] calling `observe` with every round of every trial after it ran and before it
+/// is recorded ([`RoundView`]; from worker threads, in no particular order across trials);
+/// the result is the same as without.
+///
+/// # Errors
+/// As [`run_study`].
+pub fn run_study_observed(
+    config: &StudyConfig,
+    inputs: &StudyInputs,
+    progress: &(dyn Fn(Progress) + Sync),
+    observe: &(dyn Fn(RoundView<'_>) + Sync),
+) -> Result<(StudyResult, PhaseTimes)> {
+    config.validate()?;
+    inputs.check().map_err(|why| Error::BadInput {
+        path: "<study inputs>".into(),
+        why,
+    })?;
+    let t = Instant::now();
+    let model = TaskModel::fit(&inputs.demos, &config.planner.fit)?;
+    if model.reference_idx() != 0 {
+        // The labels are demo 0's; another reference needs its own labels (`run_trials`).
+        return Err(Error::BadInput {
+            path: "<study inputs>".into(),
+            why: format!(
+                "the fit chose demo {} as the reference (fit.reference = {}), but the \
+                 ground-truth labels are demo 0's",
+                model.reference_idx(),
+                config.planner.fit.reference
+            ),
+        });
+    }
+    model.prepare_corrections();
+    let alignment = t.elapsed();
+    let (result, mut times) =
+        run_trials_observed(config, &model, &inputs.reference_labels, progress, observe)?;
+    times.alignment = alignment;
+    Ok((result, times))
+}
+
+/// Runs every trial of a study from a fitted model, in parallel (rayon). Each trial
+/// depends only on `(config.seed, trial)`, so the result is the same for any number of
+/// threads. `progress` is called after every recorded pair, from worker threads.
+///
+/// # Errors
+/// Invalid configuration, labels that do not match the model's reference, or any stage's
+/// error (the first trial's in trial order).
+pub fn run_trials(
+    config: &StudyConfig,
+    model: &TaskModel,
+    reference_labels: &[Label],
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<(StudyResult, PhaseTimes)> {
+    run_trials_observed(config, model, reference_labels, progress, &|_| {})
+}
+
+/// [`run_trials`] with an observer of every round ([`run_trial_observed`]).
+///
+/// # Errors
+/// As [`run_trials`].
+pub fn run_trials_observed(
+    config: &StudyConfig,
+    model: &TaskModel,
+    reference_labels: &[Label],
+    progress: &(dyn Fn(Progress) + Sync),
+    observe: &(dyn Fn(RoundView<'_>) + Sync),
+) -> Result<(StudyResult, PhaseTimes)> {
+    config.validate()?;
+    if reference_labels.len() != model.n_ref() {
+        return Err(Error::BadInput {
+            path: "<reference labels>".into(),
+            why: format!(
+                "{} labels for {} reference samples",
+                reference_labels.len(),
+                model.n_ref()
+            ),
+        });
+    }
+    let outcomes: Vec<Result<(TrialResult, PhaseTimes)>> = (0..config.trials)
+        .into_par_iter()
+        .map(|k| run_trial_observed(config, model, reference_labels, k, progress, observe))
+        .collect();
+    let mut times = PhaseTimes::default();
+    let mut trials = Vec::with_capacity(config.trials);
+    for outcome in outcomes {
+        let (trial, t) = outcome?;
+        times.add(&t);
+        trials.push(trial);
+    }
+    Ok((
+        StudyResult {
+            config: config.clone(),
+            n_ref: model.n_ref(),
+            dt_s: model.dt_s(),
+            ground_truth_pct: 100.0 * task::ground_truth_share(reference_labels),
+            trials,
+        },
+        times,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trial_seeds_differ_and_are_stable() {
+        let seeds: Vec<u64> = (0..5).map(|k| trial_seed(2023, k)).collect();
+        for i in 0..5 {
+            for j in 0..i {
+                assert_ne!(seeds[i], seeds[j]);
+            }
+        }
+        assert_eq!(trial_seed(2023, 3), seeds[3]);
+        assert_ne!(trial_seed(2024, 0), seeds[0]);
+    }
+}

@@ -1,0 +1,68 @@
+//! The simulated workcell of the study (§III): the `N` robots of the planner's schedule
+//! (two in the paper) run one round, one execution each, through the real-time
+//! coordinator while a simulated operator supervises the low-confidence robot.
+//!
+//! # One control tick
+//!
+//! The control period is the reference sample period `Δt_s`, so every tick gives each
+//! running robot one execution sample, as in the demonstrations. The schedule must have been
+//! checked at that tick ([`Schedule::tick_s`](tandem_schedule::Schedule::tick_s), the tick of
+//! its margin check): a schedule made for another tick is rejected with
+//! [`Error::TickMismatch`](crate::Error::TickMismatch) rather than run at a period its safety
+//! check never saw.
+//!
+//! 1. Each running robot's position is read from the coordinator: its schedule clock
+//!    `s_i` gives its reference sample `n_i` and fractional reference time `t_i` (Eq. 15).
+//!    A robot whose sample `n_i` is low-confidence is *supervised* this tick; that is the
+//!    robot the coordinator will move at the operator's rate.
+//! 2. The operator decides for the supervised robot whether to correct. Whether the sample
+//!    *needs* a correction is the caller's `needs(i, round(t_i))` in [`run_round_with`]; on
+//!    the sanding task ([`run_round`]) it does when, on that robot's own workpiece, the
+//!    reference demonstration's label at `round(t_i)` is sanding in pass 1–3 over a painted
+//!    section. A needed correction is
+//!    given with probability `1 − miss_rate` (§III: 1 % misses). Unneeded corrections
+//!    cover `false_correction_rate` of the supervised time that needs none (§III: "1 % of
+//!    the time") in episodes of mean length `false_correction_s` (default 0.5 s): a person
+//!    who corrects by mistake holds the joystick for a moment, not for one 10 ms tick.
+//!    Why it matters for the study: drawn per tick, the 1 % leaves hundreds of isolated
+//!    one-sample low-confidence "islands" after 150 pairs (samples whose few observations
+//!    happened to include several false corrections); every island of one robot forbids
+//!    the other robot's low-confidence pass at that moment, so the schedule stays nearly
+//!    serial. Measured on the default study (5 × 300 executions, seed 2023; `cargo xtask
+//!    study`, and with `false_correction_s = 0` in its configuration for per-tick draws):
+//!    per-tick draws leave 92–116 low-confidence runs per robot and schedule after 150
+//!    pairs and end at `T_total` 136.63 ± 1.08 s; 0.5 s episodes leave 3–6 runs and end at
+//!    106.22 ± 11.04 s (serial: 191.81 s). Episodes give each sample about the same 1 %
+//!    chance per execution but make the islands contiguous and far fewer (docs/decisions.md,
+//!    "Unneeded corrections come in 0.5 s episodes", with the figures of earlier commits).
+//! 3. A correction is a joystick input `u` along the model's correction components
+//!    (`TaskModel::corrections_at`), `u_k = ±gain` with the sign that raises the force; a
+//!    component whose rate part would speed the robot up is left out when the combined
+//!    input would otherwise speed it up, so a correction presses harder *and* slows the
+//!    robot, as the expert did over paint. The command `x_f⁺ = μ̂⁺ + δx⁺(u)` (Eq. 7) comes
+//!    from `TaskModel::command`; its last component, the warp gradient, is clamped to
+//!    `[ψ̇min, ψ̇max]` at `n_i` and passed to `Coordinator::tick` as `Operator::Gradient`.
+//!    That is what perturbs the timing. Without a correction the operator's input is
+//!    `Operator::Scheduled` (the robot keeps its scheduled gradient, the mean on
+//!    low-confidence samples); a degenerate command (NaN rate) is an error, not "no
+//!    correction".
+//! 4. Every running robot logs the command at `t_i` (`u = 0` unless corrected) as its
+//!    execution sample, `t_i` in its reference-time log (Eq. 21), and its supervised and
+//!    corrected flags.
+//! 5. After the tick, `Tick::low_conf` says which robots traversed any low-confidence sample:
+//!    two or more at once is an *overlap* (a valid schedule never has one), none is operator
+//!    idle time, and any is operator busy time.
+//! 6. An overlap latches a fault of the coordinator's run-time monitor (`Tick::fault`), which
+//!    holds one robot in place; the round counts it (`RoundRun::faults`), the held robot
+//!    logs nothing while held, and the operator releases it (`Coordinator::clear_fault`)
+//!    after the first tick in which no robot is low-confidence, so every round finishes.
+
+mod operator;
+mod record;
+mod run;
+#[cfg(test)]
+mod tests;
+
+pub use operator::{OperatorParams, correction_input, needs_correction};
+pub use record::{PairRun, RobotRun, RoundRun};
+pub use run::{run_pair, run_pair_with, run_round, run_round_with};

@@ -1,0 +1,207 @@
+//! The simulated operator (§III): its parameters, which samples need a correction, unneeded
+//! corrections as episodes, and the joystick input of a correction (module docs of
+//! [`crate::workcell`], steps 2–3).
+
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+use tandem_lfd::TaskModel;
+
+use crate::task::{Label, N_PASSES, Phase, Workpiece};
+use crate::{Error, Result};
+
+/// The simulated operator (§III).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OperatorParams {
+    /// Probability of missing a needed correction, in `[0, 1]`. Default: 0.01 (§III).
+    pub miss_rate: f64,
+    /// Share of the supervised samples that need no correction on which the operator
+    /// corrects anyway, in `[0, 1)`. Default: 0.01 (§III: "1 % of the time").
+    pub false_correction_rate: f64,
+    /// Mean duration (s) of one unneeded correction: a person who corrects by mistake
+    /// holds the joystick for a while, so unneeded corrections come as episodes of
+    /// geometric length with this mean, started at the rate that makes them cover
+    /// `false_correction_rate` of the time. `0` (or anything up to one control tick) draws
+    /// every tick independently. Finite and `≥ 0`. Default: 0.5 s.
+    pub false_correction_s: f64,
+    /// Channel whose increase a correction aims at. Default: `"force"` (the sanding
+    /// task's normal force, N).
+    pub force_channel: String,
+    /// Joystick deflection `|u_k|` of a correction, in `(0, 1]`. The model's components
+    /// span ±3σ at `|u_k| = 1`, so the default 1/3 moves the command about one standard
+    /// deviation along each component: from the mean towards how the experts sanded over
+    /// paint, not to the edge of what they ever did. Default: 1/3.
+    pub gain: f64,
+}
+
+impl Default for OperatorParams {
+    fn default() -> Self {
+        Self {
+            miss_rate: 0.01,
+            false_correction_rate: 0.01,
+            false_correction_s: 0.5,
+            force_channel: "force".into(),
+            gain: 1.0 / 3.0,
+        }
+    }
+}
+
+impl OperatorParams {
+    /// Checks the rates.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] naming the field.
+    pub fn validate(&self) -> Result<()> {
+        for (name, p) in [
+            ("miss_rate", self.miss_rate),
+            ("false_correction_rate", self.false_correction_rate),
+        ] {
+            if !(0.0..=1.0).contains(&p) {
+                return Err(Error::BadParam {
+                    name,
+                    why: "must be a probability in [0, 1]",
+                });
+            }
+        }
+        if !(0.0..1.0).contains(&self.false_correction_rate) {
+            return Err(Error::BadParam {
+                name: "false_correction_rate",
+                why: "must be in [0, 1)",
+            });
+        }
+        if !(self.false_correction_s.is_finite() && self.false_correction_s >= 0.0) {
+            return Err(Error::BadParam {
+                name: "false_correction_s",
+                why: "must be finite and ≥ 0",
+            });
+        }
+        if !(self.gain > 0.0 && self.gain <= 1.0) {
+            return Err(Error::BadParam {
+                name: "gain",
+                why: "must be in (0, 1]",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Whether a reference sample with this label needs a correction on `workpiece`: sanding
+/// in passes 1–3 over a painted section (pass 4 is always painted and never needs one).
+#[must_use]
+pub fn needs_correction(label: &Label, workpiece: &Workpiece) -> bool {
+    label.phase == Phase::Sanding
+        && (1..N_PASSES).contains(&usize::from(label.pass))
+        && workpiece.painted_at(label)
+}
+
+/// Unneeded corrections as episodes of geometric length with mean `l ≥ 1` ticks: outside
+/// one, a tick starts one with probability `p_start`; each tick of an episode is followed
+/// by another with probability `1 − 1/l`. Off runs last `(1 − p_start)/p_start` ticks on
+/// average, so episodes cover `l·p_start / (l·p_start + 1 − p_start)` of the time, which
+/// `p_start = rate / (l·(1 − rate) + rate)` makes equal to `rate`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Episodes {
+    p_start: f64,
+    p_end: f64,
+    /// `l > 1`: episodes last more than one tick (else every tick is drawn alone).
+    lasting: bool,
+}
+
+impl Episodes {
+    /// `rate` in `[0, 1)`, mean length `ticks` (values below 1 mean 1).
+    pub(super) fn new(rate: f64, ticks: f64) -> Self {
+        let l = ticks.max(1.0);
+        Episodes {
+            p_start: rate / (l * (1.0 - rate) + rate),
+            p_end: 1.0 / l,
+            lasting: l > 1.0,
+        }
+    }
+
+    /// One supervised tick that needs no correction: `(corrected, in an episode after it)`
+    /// from the state before it, the tick's draw `draw ∈ [0, 1)` and, for the length of an
+    /// episode, one more draw from `rng`.
+    pub(super) fn tick(&self, in_episode: bool, draw: f64, rng: &mut impl Rng) -> (bool, bool) {
+        let corrected = in_episode || draw < self.p_start;
+        let goes_on = corrected && self.lasting && rng.random::<f64>() >= self.p_end;
+        (corrected, goes_on)
+    }
+}
+
+/// The simulated operator's joystick input for a force-raising, slowing correction at
+/// fractional reference time `ref_time` (see the module docs, step 3): fills `u` (one entry
+/// per correction component, [`TaskModel::n_components`]) with `±gain` or 0 and returns
+/// whether any entry is non-zero. `force_idx` is the force channel's index in
+/// [`TaskModel::tangent_names`]. The workcell passes `u` to [`TaskModel::command_into`]
+/// (Eq. 7); it is public so that a replay of a run can recompute the operator's input.
+///
+/// # Errors
+/// The model crate's error for `ref_time` outside `[0, T_ref − 1]`.
+pub fn correction_input(
+    model: &TaskModel,
+    force_idx: usize,
+    gain: f64,
+    ref_time: f64,
+    u: &mut [f64],
+) -> Result<bool> {
+    let corr = model.corrections_at(ref_time)?;
+    let rate_idx = model.tangent_names().len() - 1;
+    let mut rate_change = 0.0;
+    let mut any = false;
+    for (k, c) in corr.components.iter().enumerate() {
+        u[k] = if c[force_idx] > 0.0 {
+            gain
+        } else if c[force_idx] < 0.0 {
+            -gain
+        } else {
+            0.0
+        };
+        any |= u[k] != 0.0;
+        rate_change += u[k] * c[rate_idx];
+    }
+    if rate_change < 0.0 {
+        // Keep only the components that slow the robot down (or leave its rate alone).
+        for (k, c) in corr.components.iter().enumerate() {
+            if u[k] * c[rate_idx] < 0.0 {
+                u[k] = 0.0;
+            }
+        }
+        any = u.iter().any(|&x| x != 0.0);
+    }
+    Ok(any)
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+
+    use super::*;
+
+    #[test]
+    fn unneeded_corrections_cover_the_rate_in_episodes_of_the_mean_length() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for (rate, ticks) in [(0.01, 50.0), (0.01, 1.0), (0.2, 10.0)] {
+            let e = Episodes::new(rate, ticks);
+            let (mut state, mut on, mut starts) = (false, 0usize, 0usize);
+            let n = 2_000_000;
+            for _ in 0..n {
+                let before = state;
+                let draw: f64 = rng.random();
+                let (corrected, next) = e.tick(state, draw, &mut rng);
+                on += usize::from(corrected);
+                starts += usize::from(corrected && !before);
+                state = next;
+            }
+            let share = on as f64 / n as f64;
+            let mean_len = on as f64 / starts as f64;
+            assert!(
+                (share - rate).abs() < 0.1 * rate,
+                "{rate} {ticks}: share {share}"
+            );
+            assert!(
+                (mean_len - ticks).abs() < 0.1 * ticks,
+                "{rate} {ticks}: {mean_len}"
+            );
+        }
+    }
+}

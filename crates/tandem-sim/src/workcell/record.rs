@@ -1,0 +1,128 @@
+//! What a round records: one [`RobotRun`] per robot and the round's tick counts
+//! ([`RoundRun`]), and the execution records the planner takes from them (Eq. 21).
+
+use serde::{Deserialize, Serialize};
+use tandem_lfd::{Demonstration, Execution, TaskModel};
+use tandem_planner::ExecutionRecord;
+
+use crate::Result;
+
+/// One robot's execution as the system records it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RobotRun {
+    /// Commanded samples, sample-major (`m` channels in the model's channel order), one per
+    /// control tick in which the robot ran.
+    pub samples: Vec<f64>,
+    /// Reference time (reference samples, fractional, in `[0, T_ref − 1]`) of each sample.
+    pub ref_time_log: Vec<f64>,
+    /// Whether the robot was low-confidence (supervised) at each sample.
+    pub supervised: Vec<bool>,
+    /// Whether the operator corrected each sample (only ever true where supervised).
+    pub corrected: Vec<bool>,
+    /// Supervised samples that needed a correction.
+    pub needed: usize,
+    /// Needed corrections the operator missed.
+    pub missed: usize,
+    /// Corrections given where none was needed.
+    pub false_corrections: usize,
+    /// The robot's schedule clock `s_i` (global schedule time, s) at the start of every
+    /// control tick of the round, running or not (`RoundRun::ticks` entries): before the robot
+    /// starts it follows the pace of the running robots (its start shifts), after it finishes
+    /// it stays at its end.
+    pub clock_s: Vec<f64>,
+    /// The round's control tick (0-based) of the robot's first sample: ticks
+    /// `0..start_tick` it waited for its start, ticks `start_tick..start_tick + n` it ran
+    /// (`n` samples), later ticks it had finished. `RoundRun::ticks` when it never ran.
+    pub start_tick: usize,
+}
+
+impl RobotRun {
+    /// The execution record for
+    /// [`Planner::record_round`](tandem_planner::Planner::record_round) (Eq. 21): the
+    /// samples as a demonstration with `model`'s channel names and sample period, the
+    /// reference-time log, and the supervised and corrected flags.
+    ///
+    /// # Errors
+    /// The model crate's error if the samples do not form a valid demonstration.
+    pub fn record(&self, model: &TaskModel) -> Result<ExecutionRecord> {
+        let demonstration = Demonstration::new(
+            model.channel_names().to_vec(),
+            self.samples.clone(),
+            model.dt_s(),
+        )?;
+        Ok(ExecutionRecord {
+            execution: Execution {
+                demonstration,
+                ref_time_log: self.ref_time_log.clone(),
+            },
+            supervised: self.supervised.clone(),
+            corrected: self.corrected.clone(),
+        })
+    }
+}
+
+/// A round of executions, one per robot, run under one schedule.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RoundRun {
+    /// Robot 1, robot 2, …: one run per robot of the schedule.
+    pub robots: Vec<RobotRun>,
+    /// Control ticks until every robot finished.
+    pub ticks: usize,
+    /// Control period (s).
+    pub tick_s: f64,
+    /// Ticks in which two or more robots traversed a low-confidence sample (must be 0).
+    pub overlap_ticks: usize,
+    /// Ticks in which no robot traversed a low-confidence sample.
+    pub idle_ticks: usize,
+    /// Faults latched by the coordinator's run-time monitor (two robots low-confidence in one
+    /// tick; `tandem_realtime::Fault`), each released by the simulated operator once no robot
+    /// was low-confidence (must be 0: a checked schedule never has one).
+    #[serde(default)]
+    pub faults: usize,
+}
+
+/// The two-robot round of the paper: a [`RoundRun`] with two robots ([`run_pair`](super::run_pair)).
+pub type PairRun = RoundRun;
+
+impl RoundRun {
+    /// Every robot's execution record, robot 1 first, for
+    /// [`Planner::record_round`](tandem_planner::Planner::record_round) (see
+    /// [`RobotRun::record`]); `model` is the planner's model the round ran with.
+    ///
+    /// # Errors
+    /// The model crate's error if a robot's samples do not form a valid demonstration.
+    pub fn records(&self, model: &TaskModel) -> Result<Vec<ExecutionRecord>> {
+        self.robots.iter().map(|r| r.record(model)).collect()
+    }
+
+    /// Whether two or more robots were ever low-confidence in the same tick.
+    #[must_use]
+    pub fn overlapped(&self) -> bool {
+        self.overlap_ticks > 0
+    }
+
+    /// Operator idle time as a share of the round's duration (ticks), in `[0, 1]`.
+    #[must_use]
+    pub fn operator_idle_share(&self) -> f64 {
+        if self.ticks == 0 {
+            return 1.0;
+        }
+        self.idle_ticks as f64 / self.ticks as f64
+    }
+
+    /// Operator busy share, in `[0, 1]`: the share of the round's ticks in which at least
+    /// one robot traversed a low-confidence sample (`1 − idle share`, counted in ticks).
+    #[must_use]
+    pub fn operator_busy_share(&self) -> f64 {
+        if self.ticks == 0 {
+            return 0.0;
+        }
+        (self.ticks - self.idle_ticks) as f64 / self.ticks as f64
+    }
+
+    /// Actual duration of the round (s): ticks times the control period.
+    #[must_use]
+    pub fn duration_s(&self) -> f64 {
+        self.ticks as f64 * self.tick_s
+    }
+}

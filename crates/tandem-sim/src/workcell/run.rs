@@ -1,0 +1,326 @@
+//! Running a round: the control loop of the module docs of [`crate::workcell`], with the
+//! checks of its inputs.
+
+use rand::Rng;
+use tandem_lfd::TaskModel;
+use tandem_planner::Planner;
+use tandem_realtime::{Coordinator, Operator, Timeline, tol};
+use tandem_schedule::{Problem, Schedule};
+
+use super::operator::{Episodes, OperatorParams, correction_input, needs_correction};
+use super::record::{PairRun, RobotRun, RoundRun};
+use crate::task::{Label, Workpiece};
+use crate::{Error, Result};
+
+/// Runs every robot of the planner's current schedule to the end with a simulated operator
+/// on the sanding task (see the module docs): [`run_round_with`] where a sample needs a
+/// correction when [`needs_correction`] says so for the reference label at the sample and the
+/// robot's own workpiece. `labels` are the reference demonstration's labels (one per
+/// reference sample); `workpieces[i]` is robot `i`'s workpiece, one per robot of the
+/// schedule. Deterministic for the state of `rng`.
+///
+/// # Errors
+/// As [`run_round_with`], and [`Error::Mismatch`] for labels that are not one per reference
+/// sample or workpieces that are not one per robot.
+pub fn run_round(
+    planner: &Planner,
+    labels: &[Label],
+    workpieces: &[Workpiece],
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<RoundRun> {
+    let n_ref = planner.model().n_ref();
+    if labels.len() != n_ref {
+        return Err(Error::Mismatch {
+            what: "reference labels",
+            expected: n_ref,
+            found: labels.len(),
+        });
+    }
+    let n_robots = planner.n_robots();
+    if workpieces.len() != n_robots {
+        return Err(Error::Mismatch {
+            what: "workpieces (one per robot)",
+            expected: n_robots,
+            found: workpieces.len(),
+        });
+    }
+    run_round_with(
+        planner,
+        |robot, ref_idx| needs_correction(&labels[ref_idx], &workpieces[robot]),
+        params,
+        rng,
+    )
+}
+
+/// [`run_round`] for the paper's two robots: one workpiece per robot of a two-robot
+/// schedule.
+///
+/// # Errors
+/// As [`run_round`] ([`Error::Mismatch`] for a planner with another robot count).
+pub fn run_pair(
+    planner: &Planner,
+    labels: &[Label],
+    workpieces: &[Workpiece; 2],
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<PairRun> {
+    run_round(planner, labels, workpieces, params, rng)
+}
+
+/// Runs every robot of the planner's current schedule to the end with a simulated operator
+/// (see the module docs), the caller deciding which samples need a correction:
+/// `needs(robot, ref_idx)` says whether robot `robot` (`0..N`) needs the operator at
+/// reference sample `ref_idx` (`round(t_i)`, in `0..n_ref`). It is asked once per supervised
+/// sample, just before the operator's draw from `rng`; samples of high confidence are never
+/// asked about. Model, problem, schedule and control tick are the planner's, so they agree
+/// by construction. Deterministic for the state of `rng` (and a deterministic `needs`).
+///
+/// # Errors
+/// Invalid parameters, a model without the force channel, a schedule checked at a tick other
+/// than the workcell's ([`Error::TickMismatch`]), a degenerate command, or a round that does
+/// not finish ([`Error::DidNotFinish`]).
+pub fn run_round_with(
+    planner: &Planner,
+    needs: impl FnMut(usize, usize) -> bool,
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<RoundRun> {
+    run_schedule(
+        planner.model(),
+        planner.problem(),
+        planner.schedule(),
+        needs,
+        params,
+        rng,
+    )
+}
+
+/// [`run_round_with`] under its two-robot name.
+///
+/// # Errors
+/// As [`run_round_with`].
+pub fn run_pair_with(
+    planner: &Planner,
+    needs: impl FnMut(usize, usize) -> bool,
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<PairRun> {
+    run_round_with(planner, needs, params, rng)
+}
+
+/// Checks that the model and every robot's gradients have one entry per reference sample of
+/// `problem`, in that order.
+fn check_sizes(model: &TaskModel, problem: &Problem, schedule: &Schedule) -> Result<()> {
+    let n_ref = problem.n_ref();
+    let sizes = std::iter::once(("model reference samples", model.n_ref())).chain(
+        schedule
+            .grad_exec
+            .iter()
+            .map(|g| ("a robot's gradients", g.len())),
+    );
+    for (what, found) in sizes {
+        if found != n_ref {
+            return Err(Error::Mismatch {
+                what,
+                expected: n_ref,
+                found,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// [`run_round_with`] on the parts of a planner: `problem` must be the one `schedule` was
+/// made for, from `model`'s gradients (the unit tests build them by hand).
+pub(super) fn run_schedule(
+    model: &TaskModel,
+    problem: &Problem,
+    schedule: &Schedule,
+    needs: impl FnMut(usize, usize) -> bool,
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<RoundRun> {
+    params.validate()?;
+    check_sizes(model, problem, schedule)?;
+    let dt_s = problem.dt_s();
+    if !tol::same_tick(schedule.tick_s, dt_s) {
+        return Err(Error::TickMismatch {
+            schedule_tick_s: schedule.tick_s,
+            workcell_tick_s: dt_s,
+        });
+    }
+    // The one place the workcell builds its coordinator (with the margin check).
+    let coord = schedule.check(problem)?.coordinator()?;
+    run_coordinator(model, problem, coord, needs, params, rng)
+}
+
+/// The control loop of the module docs on a coordinator of `problem`'s robots at its own
+/// tick (`Δt_s`; checked by the caller, as are the parameters and sizes). A tick that latches
+/// a fault of the coordinator's run-time monitor (two robots low-confidence at once, which a
+/// checked schedule never has) is counted in [`RoundRun::faults`]; the held robot logs no
+/// samples while held, and the simulated operator releases it
+/// ([`Coordinator::clear_fault`]) after the first tick in which no robot is low-confidence,
+/// so that every round finishes.
+pub(super) fn run_coordinator(
+    model: &TaskModel,
+    problem: &Problem,
+    mut coord: Coordinator,
+    mut needs: impl FnMut(usize, usize) -> bool,
+    params: &OperatorParams,
+    rng: &mut impl Rng,
+) -> Result<RoundRun> {
+    let n_ref = problem.n_ref();
+    let force_idx = model
+        .tangent_names()
+        .iter()
+        .position(|n| *n == params.force_channel)
+        .ok_or_else(|| Error::NoForceChannel(params.force_channel.clone()))?;
+    let tick_s = coord.tick_s();
+
+    let m = model.channel_names().len();
+    let k = model.n_components();
+    let u_zero = vec![0.0; k];
+    let mut u_corr = vec![0.0; k];
+    let mut cmd = vec![0.0; m + 1];
+    let empty = || RobotRun {
+        samples: Vec::with_capacity(n_ref * m * 2),
+        ref_time_log: Vec::with_capacity(n_ref * 2),
+        supervised: Vec::with_capacity(n_ref * 2),
+        corrected: Vec::with_capacity(n_ref * 2),
+        needed: 0,
+        missed: 0,
+        false_corrections: 0,
+        clock_s: Vec::with_capacity(n_ref * 2),
+        start_tick: usize::MAX,
+    };
+    let n_robots = coord.n_robots();
+    let mut runs: Vec<RobotRun> = (0..n_robots).map(|_| empty()).collect();
+    let (mut ticks, mut overlap_ticks, mut idle_ticks, mut faults) = (0, 0, 0, 0);
+    let max_end_s = coord
+        .robots()
+        .iter()
+        .map(Timeline::end_s)
+        .fold(0.0, f64::max);
+    // The slowest admissible execution is bounded by ψ̇max/ψ̇min per sample; a generous cap
+    // on top of that only guards against a bug looping forever.
+    let max_ratio = problem
+        .grad_max()
+        .iter()
+        .zip(problem.grad_min())
+        .map(|(hi, lo)| hi / lo)
+        .fold(1.0, f64::max);
+    let budget = ((max_end_s / tick_s) * max_ratio * 2.0) as usize + 1000;
+    let last_ref = (n_ref - 1) as f64;
+    // Unneeded corrections as episodes of mean length `l` ticks: each tick of an episode
+    // ends it with probability 1/l; outside one, a new one starts with the probability that
+    // makes episodes cover `false_correction_rate` of the time (per tick when l = 1).
+    let episodes = Episodes::new(
+        params.false_correction_rate,
+        params.false_correction_s / tick_s,
+    );
+    let mut in_episode = vec![false; n_robots];
+    // Each robot's reference sample `n_i` and reference time `t_i` at its schedule clock,
+    // kept across ticks: the sample through a monotone cursor (schedule clocks never
+    // decrease; the same sample as `Timeline::sample_at`), the time from the coordinator's
+    // `Tick::ref_time` (Eq. 15 at the clock after the tick, the same value as
+    // `Timeline::ref_time_at`), so that a tick needs no search.
+    let mut sample: Vec<usize> = coord
+        .robots()
+        .iter()
+        .zip(coord.clock_s())
+        .map(|(tl, &c)| tl.sample_at(c))
+        .collect();
+    let mut ref_now: Vec<f64> = coord
+        .robots()
+        .iter()
+        .zip(coord.clock_s())
+        .map(|(tl, &c)| tl.ref_time_at(c))
+        .collect();
+
+    while !coord.is_finished() {
+        if ticks >= budget {
+            return Err(Error::DidNotFinish { ticks: budget });
+        }
+        let held = coord.fault().map(|f| f.stopped);
+        let clocks = coord.clock_s();
+        let mut operator = Operator::Scheduled;
+        for i in 0..n_robots {
+            let tl = &coord.robots()[i];
+            runs[i].clock_s.push(clocks[i]);
+            if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() || held == Some(i) {
+                continue;
+            }
+            if runs[i].start_tick == usize::MAX {
+                runs[i].start_tick = ticks;
+            }
+            let sample_clock_s = tl.sample_clock_s();
+            while sample[i] + 1 < n_ref && sample_clock_s[sample[i] + 1] <= clocks[i] {
+                sample[i] += 1;
+            }
+            let n = sample[i];
+            let ref_time = ref_now[i].min(last_ref);
+            let supervised = !problem.conf()[n];
+            let mut corrected = false;
+            if supervised {
+                let label_idx = (ref_time.round() as usize).min(n_ref - 1);
+                let needed = needs(i, label_idx);
+                let draw: f64 = rng.random();
+                let run = &mut runs[i];
+                if needed {
+                    in_episode[i] = false;
+                    run.needed += 1;
+                    corrected = draw >= params.miss_rate;
+                    run.missed += usize::from(!corrected);
+                } else {
+                    (corrected, in_episode[i]) = episodes.tick(in_episode[i], draw, rng);
+                    run.false_corrections += usize::from(corrected);
+                }
+            } else {
+                in_episode[i] = false;
+            }
+            let u = if corrected
+                && correction_input(model, force_idx, params.gain, ref_time, &mut u_corr)?
+            {
+                &u_corr
+            } else {
+                &u_zero
+            };
+            model.command_into(u, ref_time, &mut cmd)?;
+            if supervised && corrected {
+                operator =
+                    Operator::Gradient(cmd[m].clamp(problem.grad_min()[n], problem.grad_max()[n]));
+            }
+            let run = &mut runs[i];
+            run.samples.extend_from_slice(&cmd[..m]);
+            run.ref_time_log.push(ref_time);
+            run.supervised.push(supervised);
+            run.corrected.push(corrected);
+        }
+        let tick = coord.tick(operator)?;
+        ref_now.copy_from_slice(&tick.ref_time);
+        match tick.low_conf.count() {
+            0 => idle_ticks += 1,
+            1 => {}
+            _ => overlap_ticks += 1,
+        }
+        match tick.fault {
+            Some(f) if f.tick == ticks as u64 => faults += 1,
+            // The operator has dealt with the robot that kept running: release the held one.
+            Some(_) if tick.low_conf.count() == 0 => coord.clear_fault(),
+            _ => {}
+        }
+        ticks += 1;
+    }
+    for run in &mut runs {
+        run.start_tick = run.start_tick.min(ticks);
+    }
+    Ok(RoundRun {
+        robots: runs,
+        ticks,
+        tick_s,
+        overlap_ticks,
+        idle_ticks,
+        faults,
+    })
+}

@@ -1,0 +1,530 @@
+//! Tests of the workcell on a hand-made one-channel task (low confidence exactly where the
+//! demonstrations differ).
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use tandem_lfd::{Demonstration, FitParams, TaskModel};
+use tandem_planner::Planner;
+use tandem_schedule::Problem;
+
+use super::run::{run_coordinator, run_schedule};
+use super::*;
+use crate::Error;
+use crate::task::{Label, N_PASSES, Phase, Workpiece};
+
+const N_REF: usize = 60;
+
+/// Three demonstrations of a one-channel "force" task aligned by known warps: demo 0
+/// (the reference) and demo 2 press lightly (1 N) everywhere; demo 1 presses hard (9 N)
+/// over reference samples 10..20 and takes two samples per reference sample there.
+/// So samples 10..20 vary (low confidence), force rising with the warp gradient.
+fn model() -> TaskModel {
+    let names = vec!["force".to_string()];
+    let light = Demonstration::new(names.clone(), vec![1.0; N_REF], 0.01).unwrap();
+    let mut hard = Vec::new();
+    let mut warp1 = Vec::new();
+    for n in 0..N_REF {
+        warp1.push(hard.len() as f64);
+        let reps = if (10..20).contains(&n) { 2 } else { 1 };
+        for _ in 0..reps {
+            hard.push(if (10..20).contains(&n) { 9.0 } else { 1.0 });
+        }
+    }
+    let hard = Demonstration::new(names, hard, 0.01).unwrap();
+    let identity: Vec<f64> = (0..N_REF).map(|n| n as f64).collect();
+    TaskModel::fit_aligned(
+        &[light.clone(), hard, light],
+        &[identity.clone(), warp1, identity],
+        &FitParams::default(),
+    )
+    .unwrap()
+}
+
+fn problem(model: &TaskModel) -> Problem {
+    let conf = (0..N_REF).map(|n| !(10..20).contains(&n)).collect();
+    let (gmin, gmax) = (model.grad_min().to_vec(), model.grad_max().to_vec());
+    let gmean = model
+        .grad_mean()
+        .iter()
+        .zip(gmin.iter().zip(&gmax))
+        .map(|(g, (lo, hi))| g.clamp(*lo, *hi))
+        .collect();
+    Problem::new(conf, gmean, gmin, gmax, model.dt_s()).unwrap()
+}
+
+fn painted_labels() -> Vec<Label> {
+    vec![
+        Label {
+            pass: 1,
+            section: 0,
+            painted: true,
+            phase: Phase::Sanding,
+        };
+        N_REF
+    ]
+}
+
+fn all_painted() -> Workpiece {
+    Workpiece {
+        painted: vec![vec![true; 8]; N_PASSES],
+    }
+}
+
+/// Whether robot `robot` needs the operator at reference sample `ref_idx` on the
+/// painted labels and workpieces ([`run_pair`]'s rule).
+fn painted_needs(robot: usize, ref_idx: usize) -> bool {
+    needs_correction(
+        &painted_labels()[ref_idx],
+        &[all_painted(), all_painted()][robot],
+    )
+}
+
+/// The serial schedule of the hand-made problem, run with `params`: the pair and its
+/// planned `T_total` (s).
+fn run(params: &OperatorParams, seed: u64) -> (PairRun, f64) {
+    let model = model();
+    let problem = problem(&model);
+    let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
+    let planned_s = schedule.t_total_s(problem.dt_s());
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let run = run_schedule(&model, &problem, &schedule, painted_needs, params, &mut rng).unwrap();
+    (run, planned_s)
+}
+
+/// A planner on the hand-made model: low confidence exactly where the demonstrations
+/// differ (samples 10..20), a sampled schedule at the workcell's tick.
+fn planner() -> Planner {
+    let params = tandem_planner::PlannerParams {
+        sampler: tandem_schedule::SamplerParams {
+            samples: 50,
+            seed: 3,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    Planner::from_model(model(), params).unwrap()
+}
+
+#[test]
+fn only_painted_sanding_of_passes_one_to_three_needs_a_correction() {
+    let mut wp = all_painted();
+    wp.painted[1][3] = false;
+    let label = |pass, section, phase| Label {
+        pass,
+        section,
+        painted: true,
+        phase,
+    };
+    assert!(needs_correction(&label(1, 0, Phase::Sanding), &wp));
+    assert!(needs_correction(&label(3, 7, Phase::Sanding), &wp));
+    assert!(
+        !needs_correction(&label(2, 3, Phase::Sanding), &wp),
+        "unpainted"
+    );
+    assert!(
+        !needs_correction(&label(4, 0, Phase::Sanding), &wp),
+        "pass 4"
+    );
+    assert!(!needs_correction(&label(1, 0, Phase::Transition), &wp));
+}
+
+#[test]
+fn bad_rates_are_rejected() {
+    let p = OperatorParams {
+        miss_rate: 1.5,
+        ..OperatorParams::default()
+    };
+    assert!(matches!(
+        p.validate(),
+        Err(Error::BadParam {
+            name: "miss_rate",
+            ..
+        })
+    ));
+}
+
+#[test]
+fn a_perfect_operator_corrects_every_needed_sample_and_slows_the_robots() {
+    let perfect = OperatorParams {
+        miss_rate: 0.0,
+        false_correction_rate: 0.0,
+        ..OperatorParams::default()
+    };
+    let (run, planned_s) = run(&perfect, 1);
+    assert_eq!(run.overlap_ticks, 0);
+    let model = model();
+    for r in &run.robots {
+        let n = r.ref_time_log.len();
+        assert_eq!(r.samples.len(), n);
+        assert!(r.ref_time_log.windows(2).all(|w| w[0] <= w[1]));
+        assert!(
+            r.ref_time_log
+                .iter()
+                .all(|t| (0.0..=(N_REF - 1) as f64).contains(t))
+        );
+        assert_eq!(r.missed + r.false_corrections, 0);
+        for k in 0..n {
+            let t = r.ref_time_log[k];
+            assert_eq!(r.supervised[k], (10..20).contains(&(t as usize)), "t = {t}");
+            assert_eq!(r.corrected[k], r.supervised[k]);
+            // A correction presses harder than the mean. By hand, inside 10..19: one
+            // component c = 2·(8, 1)/√2 (±3σ of the normalised residuals, ranges 8 N
+            // and 1), admissible scale (4/3 − 1)/√2, u = 1/3: δforce = 8/9 N.
+            let mean = model.command(&[0.0, 0.0], t).unwrap()[0];
+            if r.corrected[k] {
+                if (10.0..=19.0).contains(&t) {
+                    assert!((r.samples[k] - mean - 8.0 / 9.0).abs() < 1e-9, "t = {t}");
+                }
+                assert!(r.samples[k] > mean + 0.1, "{} vs {mean}", r.samples[k]);
+            } else {
+                assert!((r.samples[k] - mean).abs() < 1e-9);
+            }
+        }
+        assert_eq!(r.needed, r.supervised.iter().filter(|s| **s).count());
+    }
+    // Slower than planned: the corrected gradient is 4/3 + 1/9 instead of 4/3 on the 10
+    // low-confidence samples, 10/9 samples (11 ms) more per robot, 22 ms in series.
+    assert!(
+        run.duration_s() > planned_s + 0.01,
+        "{} vs {planned_s}",
+        run.duration_s()
+    );
+    // The operator is idle while both robots are high-confidence.
+    assert!(run.idle_ticks > 0 && run.operator_idle_share() < 1.0);
+}
+
+#[test]
+fn without_corrections_the_pair_runs_on_schedule() {
+    let never = OperatorParams {
+        miss_rate: 1.0,
+        false_correction_rate: 0.0,
+        ..OperatorParams::default()
+    };
+    let (run, planned_s) = run(&never, 2);
+    assert_eq!(run.overlap_ticks, 0);
+    assert!(run.robots.iter().all(|r| r.corrected.iter().all(|c| !c)));
+    assert!(
+        run.robots
+            .iter()
+            .all(|r| r.missed == r.needed && r.needed > 0)
+    );
+    assert!(
+        (run.duration_s() - planned_s).abs() <= 2.0 * run.tick_s,
+        "{} vs {planned_s}",
+        run.duration_s()
+    );
+}
+
+#[test]
+fn a_round_of_three_robots_runs_each_once_and_busies_the_operator_for_each() {
+    let model = model();
+    let problem = problem(&model);
+    let schedule = problem.serial_schedule_n(3, problem.dt_s()).unwrap();
+    let perfect = OperatorParams {
+        miss_rate: 0.0,
+        false_correction_rate: 0.0,
+        ..OperatorParams::default()
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let run = run_schedule(
+        &model,
+        &problem,
+        &schedule,
+        painted_needs_n,
+        &perfect,
+        &mut rng,
+    )
+    .unwrap();
+    assert_eq!(run.robots.len(), 3);
+    assert_eq!(run.overlap_ticks, 0);
+    for r in &run.robots {
+        assert!(r.needed > 0 && r.corrected == r.supervised);
+    }
+    // Serial: the operator is busy exactly while one robot is supervised, so the busy
+    // ticks are the three robots' supervised ticks, up to one tick at each end of each
+    // robot's one low-confidence stretch (a tick that enters or leaves it is busy).
+    let supervised: usize = run
+        .robots
+        .iter()
+        .map(|r| r.supervised.iter().filter(|s| **s).count())
+        .sum();
+    let busy = run.ticks - run.idle_ticks;
+    assert!(busy.abs_diff(supervised) <= 6, "{busy} vs {supervised}");
+    assert!(
+        (run.operator_busy_share() - busy as f64 / run.ticks as f64).abs() < 1e-15
+            && (run.operator_busy_share() + run.operator_idle_share() - 1.0).abs() < 1e-15
+    );
+    assert_eq!(run.records(&model).unwrap().len(), 3);
+}
+
+#[test]
+fn every_robot_logs_its_clock_every_tick_and_runs_from_its_start_tick() {
+    let model = model();
+    let problem = problem(&model);
+    let schedule = problem.serial_schedule_n(3, problem.dt_s()).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(4);
+    let params = OperatorParams::default();
+    let run = run_schedule(
+        &model,
+        &problem,
+        &schedule,
+        painted_needs_n,
+        &params,
+        &mut rng,
+    )
+    .unwrap();
+    let starts: Vec<f64> = std::iter::once(0.0)
+        .chain(schedule.offsets_s.iter().copied())
+        .collect();
+    for (i, r) in run.robots.iter().enumerate() {
+        assert_eq!(r.clock_s.len(), run.ticks, "robot {i}: one clock per tick");
+        assert!(r.clock_s.windows(2).all(|w| w[0] <= w[1]), "robot {i}");
+        let n = r.ref_time_log.len();
+        assert!(n > 0 && r.start_tick + n <= run.ticks, "robot {i}");
+        // Waiting before its start tick (clock short of its start τ_i), running from it.
+        let tau = starts[i];
+        assert!(
+            r.clock_s[..r.start_tick].iter().all(|&c| c < tau),
+            "robot {i}"
+        );
+        assert!(r.clock_s[r.start_tick] >= tau, "robot {i}");
+    }
+    assert_eq!(run.robots[0].start_tick, 0);
+    // Serial: each robot starts once the one before it has finished.
+    for w in run.robots.windows(2) {
+        assert!(w[1].start_tick >= w[0].start_tick + w[0].ref_time_log.len());
+    }
+}
+
+/// [`painted_needs`] for any robot index (every workpiece painted).
+fn painted_needs_n(_robot: usize, ref_idx: usize) -> bool {
+    needs_correction(&painted_labels()[ref_idx], &all_painted())
+}
+
+#[test]
+fn run_pair_reads_everything_from_the_planner() {
+    let planner = planner();
+    let conf = planner.confidence().conf();
+    assert!(
+        (0..N_REF).all(|n| conf[n] != (10..20).contains(&n)),
+        "{conf:?}"
+    );
+    let p = OperatorParams::default();
+    let (labels, wp) = (painted_labels(), [all_painted(), all_painted()]);
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let by_labels = run_pair(&planner, &labels, &wp, &p, &mut rng).unwrap();
+    assert_eq!(by_labels.overlap_ticks, 0);
+    assert_eq!(by_labels.tick_s, planner.schedule().tick_s);
+    // The same as the caller's rule, and as the planner's parts run by hand.
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let by_rule = run_pair_with(&planner, painted_needs, &p, &mut rng).unwrap();
+    assert_eq!(by_rule, by_labels);
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let by_parts = run_schedule(
+        planner.model(),
+        planner.problem(),
+        planner.schedule(),
+        painted_needs,
+        &p,
+        &mut rng,
+    )
+    .unwrap();
+    assert_eq!(by_parts, by_labels);
+    // Its records are what the planner takes (Eq. 21): one per robot, flags per sample.
+    let records = by_labels.records(planner.model()).unwrap();
+    for (record, robot) in records.iter().zip(&by_labels.robots) {
+        assert_eq!(record.execution.ref_time_log, robot.ref_time_log);
+        assert_eq!(record.execution.demonstration.samples(), &robot.samples[..]);
+        assert_eq!(record.supervised, robot.supervised);
+        assert_eq!(record.corrected, robot.corrected);
+    }
+    let mut next = planner.clone();
+    next.record_round(&records).unwrap();
+    assert_eq!(next.model().count(), planner.model().count() + 2);
+}
+
+#[test]
+fn run_pair_with_asks_the_caller_only_about_supervised_samples() {
+    let model = model();
+    let problem = problem(&model);
+    let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    // Only robot 1 needs the operator; a perfect operator corrects exactly its
+    // supervised samples, and is asked about nothing but low-confidence samples.
+    let perfect = OperatorParams {
+        miss_rate: 0.0,
+        false_correction_rate: 0.0,
+        ..OperatorParams::default()
+    };
+    let mut asked = Vec::new();
+    let run = run_schedule(
+        &model,
+        &problem,
+        &schedule,
+        |i, n| {
+            asked.push((i, n));
+            i == 0
+        },
+        &perfect,
+        &mut rng,
+    )
+    .unwrap();
+    let [r1, r2] = &run.robots[..] else {
+        panic!("{} robots", run.robots.len())
+    };
+    assert!(r1.supervised.iter().any(|s| *s));
+    assert_eq!(r1.corrected, r1.supervised);
+    assert!(r2.supervised.iter().any(|s| *s));
+    assert!(r2.corrected.iter().all(|c| !c));
+    assert_eq!(r1.needed, r1.supervised.iter().filter(|s| **s).count());
+    assert_eq!(r2.needed, 0);
+    let supervised: usize = run
+        .robots
+        .iter()
+        .map(|r| r.supervised.iter().filter(|s| **s).count())
+        .sum();
+    assert_eq!(asked.len(), supervised);
+    assert!(
+        asked.iter().all(|&(_, n)| (10..=20).contains(&n)),
+        "{asked:?}"
+    );
+}
+
+#[test]
+fn a_schedule_checked_at_another_tick_is_rejected() {
+    let mut planner = planner();
+    let dt_s = planner.problem().dt_s();
+    // Re-scheduled at half the workcell's period: its margins say nothing about 10 ms ticks.
+    let half = tandem_schedule::SamplerParams {
+        tick_s: Some(dt_s / 2.0),
+        ..planner.params().sampler.clone()
+    };
+    planner.reschedule(&half).unwrap();
+    assert_eq!(planner.schedule().tick_s, dt_s / 2.0);
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    let p = OperatorParams::default();
+    let wp = [all_painted(), all_painted()];
+    let err = run_pair(&planner, &painted_labels(), &wp, &p, &mut rng).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            Error::TickMismatch {
+                schedule_tick_s,
+                workcell_tick_s,
+            } if schedule_tick_s == dt_s / 2.0 && workcell_tick_s == dt_s
+        ),
+        "{err}"
+    );
+    let msg = err.to_string();
+    assert!(msg.contains("0.005 s") && msg.contains("0.01 s"), "{msg}");
+    let err = run_pair_with(&planner, |_, _| true, &p, &mut rng);
+    assert!(matches!(err, Err(Error::TickMismatch { .. })));
+    // Re-scheduled at the workcell's own tick it runs (`tick_s: None` would keep the
+    // schedule's half tick: a re-schedule keeps the tick a user chose).
+    let own = tandem_schedule::SamplerParams {
+        tick_s: Some(dt_s),
+        ..half
+    };
+    planner.reschedule(&own).unwrap();
+    assert!(run_pair_with(&planner, |_, _| true, &p, &mut rng).is_ok());
+}
+
+#[test]
+fn same_seed_same_run_and_mismatches_are_errors() {
+    let p = OperatorParams::default();
+    assert_eq!(run(&p, 7).0, run(&p, 7).0);
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    let err = run_pair(
+        &planner(),
+        &painted_labels()[..5],
+        &[all_painted(), all_painted()],
+        &p,
+        &mut rng,
+    )
+    .unwrap_err();
+    assert!(matches!(
+        err,
+        Error::Mismatch {
+            what: "reference labels",
+            expected: N_REF,
+            found: 5,
+        }
+    ));
+}
+
+#[test]
+fn an_unsafe_plan_latches_a_fault_that_the_operator_releases_and_the_round_finishes() {
+    let model = model();
+    let problem = problem(&model);
+    // Both robots start together: both reach the low-confidence samples 10..20 in the same
+    // ticks, which the margin check rejects.
+    let mut schedule = problem.serial_schedule(problem.dt_s()).unwrap();
+    schedule.offsets_s = vec![0.0];
+    let perfect = OperatorParams {
+        miss_rate: 0.0,
+        false_correction_rate: 0.0,
+        ..OperatorParams::default()
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let refused = run_schedule(
+        &model,
+        &problem,
+        &schedule,
+        painted_needs,
+        &perfect,
+        &mut rng,
+    );
+    assert!(
+        matches!(
+            refused,
+            Err(Error::Schedule(_) | Error::Realtime(tandem_realtime::Error::Unsafe { .. }))
+        ),
+        "{refused:?}"
+    );
+    let unchecked = tandem_realtime::Coordinator::new_unchecked(
+        schedule.timelines(&problem).unwrap(),
+        schedule.tick_s,
+    )
+    .unwrap();
+    let run = run_coordinator(
+        &model,
+        &problem,
+        unchecked,
+        painted_needs,
+        &perfect,
+        &mut rng,
+    )
+    .unwrap();
+    // The first overlap latches the fault and holds robot 2 (its stretch began in the same
+    // tick: the higher index on a tie) at once, so there is no second overlap tick; released
+    // once robot 1 has left its stretch, robot 2 runs to the end.
+    assert_eq!((run.overlap_ticks, run.faults), (1, 1));
+    for (i, r) in run.robots.iter().enumerate() {
+        let last = *r.ref_time_log.last().unwrap();
+        assert!(last > (N_REF - 2) as f64, "robot {i} ended at {last}");
+        assert!(r.ref_time_log.windows(2).all(|w| w[0] <= w[1]), "robot {i}");
+        assert_eq!(r.clock_s.len(), run.ticks, "robot {i}");
+    }
+    let [r1, r2] = &run.robots[..] else {
+        panic!("{} robots", run.robots.len())
+    };
+    // Held, robot 2's clock stood still and it logged no sample; it finished last, so it
+    // logged a sample in every other tick of the round.
+    let held = r2.clock_s.windows(2).filter(|w| w[0] == w[1]).count();
+    assert!(held > 0);
+    assert_eq!(r2.start_tick, 0);
+    assert_eq!(r2.ref_time_log.len() + held, run.ticks);
+    assert!(r1.start_tick + r1.ref_time_log.len() < run.ticks);
+    assert!(r2.supervised.iter().any(|s| *s));
+    // The safe plan of the same problem never faults.
+    let on_time = run_schedule(
+        &model,
+        &problem,
+        &problem.serial_schedule(problem.dt_s()).unwrap(),
+        painted_needs,
+        &perfect,
+        &mut ChaCha8Rng::seed_from_u64(9),
+    )
+    .unwrap();
+    assert_eq!((on_time.faults, on_time.overlap_ticks), (0, 0));
+}
