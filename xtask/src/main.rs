@@ -66,7 +66,9 @@ enum Cmd {
         /// Total number of executions.
         #[arg(long, default_value_t = 1_000_000)]
         executions: u64,
-        /// Number of robots N (1 to 8); 2 schedules with the sampler, others draw schedules.
+        /// Number of robots N (1 to 8): half the problems from the test kit's families, every
+        /// shared-mask problem scheduled by the production scheduler (`sample_schedule_n`), the
+        /// rest tight at an acceptance edge of the margin check.
         #[arg(long, default_value_t = 2)]
         robots: usize,
         /// Seed of the random problems, the sampler and the operators.
