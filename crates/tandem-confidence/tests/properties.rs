@@ -53,7 +53,7 @@ proptest! {
         seed in any::<u64>(),
     ) {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let params = ConfidenceParams::default();
+        let params = ConfidenceParams::paper();
         let mut conf = Confidence::new(n_ref, params.clone()).unwrap();
         let mut obs = Observations::new(n_ref).unwrap();
         for _ in 0..steps {
