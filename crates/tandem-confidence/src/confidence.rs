@@ -201,12 +201,8 @@ impl Confidence {
                 });
             }
             let high = match shifted {
-                // `P(π < μ_c) ≤ I_{μ'_c}(α, β)`: only samples passing Eq. 12 at `μ'_c` can
-                // pass, and those are evaluated exactly.
-                Some((mu, screen)) if !rates.is_zero() => {
-                    screen.decide(alpha, beta, *mu, p.gamma_c)
-                        && decide_with_rates(alpha, beta, rates, p.mu_c, p.gamma_c)
-                }
+                // `P(π < μ_c | data) = I_{μ'_c}(α, β)`: Eq. 12 at `μ'_c`, with its own cache.
+                Some((mu, cache)) if !rates.is_zero() => cache.decide(alpha, beta, *mu, p.gamma_c),
                 _ => boundary.decide(alpha, beta, p.mu_c, p.gamma_c),
             };
             if high {

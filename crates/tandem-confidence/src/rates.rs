@@ -14,21 +14,21 @@
 //!
 //! The paper's `p_{c|t}` is `p_n` with `f = m = 0`. Its Beta prior (Eq. 10–11) and
 //! posterior (Eq. 9) stay on the observable `p_n`, whose likelihood is binomial in the
-//! recorded counts whatever `f` and `m` are; the operator model only says that `p_n` lies
-//! in `[f, 1 − m]`. The question of Eq. 12, "is the need below `μ_c`?", becomes
-//! `π_n < μ_c ⇔ p_n < μ'_c = f + (1 − f − m)·μ_c`, asked of the posterior conditioned on
-//! `p_n ≥ f`:
+//! recorded counts whatever `f` and `m` are. The question of Eq. 12, "is the need below
+//! `μ_c`?", becomes `π_n < μ_c ⇔ p_n < μ'_c = f + (1 − f − m)·μ_c`:
 //!
 //! ```text
-//! P(π_n < μ_c | data) = (I_{μ'_c}(α, β) − I_f(α, β)) / (1 − I_f(α, β)) > γ_c.
+//! P(π_n < μ_c | data) = P(p_n < μ'_c | data) = I_{μ'_c}(α, β) > γ_c.
 //! ```
 //!
-//! With `f = m = 0` this is Eq. 12 exactly (`μ'_c = μ_c`, `I_0 = 0`). Conditioning only on
-//! the lower end (not on `p_n ≤ 1 − m`) gives a smaller probability, so the rule is on the
-//! safe side of the fully conditioned one; and it is never larger than `I_{μ'_c}(α, β)`, so
-//! a sample that Eq. 12 at `μ'_c` leaves low stays low (the evaluation short cut).
-//! Few observations leave the posterior at the prior, as in the paper: the rates change how
-//! much one correction weighs, not whether evidence is needed.
+//! With `f = m = 0` this is Eq. 12 exactly (`μ'_c = μ_c`). Posterior mass below `f` (which
+//! the operator model excludes) is read as "no need" (`π_n = 0`), as the paper's prior
+//! means it: a sample whose demonstrations agree starts confident, whatever the operator's
+//! errors. (Conditioning on `p_n ≥ f` instead would turn exactly those samples low: their
+//! prior lies almost entirely below `f`.) Few observations leave the posterior at the
+//! prior, as in the paper: the rates change how much one correction weighs — `c`
+//! corrections in `s` observations are now compared with the `f·s` an operator makes by
+//! mistake — not whether evidence is needed.
 //!
 //! # The estimates
 //!
@@ -181,7 +181,8 @@ fn em_false_rate(obs: &Observations, f0: f64) -> f64 {
 }
 
 /// `P(π < μ_c | data) > γ_c` for the posterior `Beta(α, β)` of the correction probability
-/// and the operator's `rates` (module docs), evaluated with statrs. `α, β > 0` finite.
+/// and the operator's `rates` (module docs): Eq. 12 at `μ'_c`, evaluated with statrs.
+/// `α, β > 0` finite.
 pub(crate) fn decide_with_rates(
     alpha: f64,
     beta: f64,
@@ -189,30 +190,18 @@ pub(crate) fn decide_with_rates(
     mu_c: f64,
     gamma_c: f64,
 ) -> bool {
-    let mu = rates.shifted_mu_c(mu_c);
-    let reg = |x: f64| statrs::function::beta::checked_beta_reg(alpha, beta, x);
-    let f = rates.false_correction_rate;
-    match (reg(mu), if f > 0.0 { reg(f) } else { Ok(0.0) }) {
-        (Ok(upper), Ok(lower)) if lower < 1.0 => (upper - lower) / (1.0 - lower) > gamma_c,
-        // statrs cannot fail for these arguments; if it did, low is the safe side.
-        _ => false,
-    }
+    crate::beta::decide_exact(alpha, beta, rates.shifted_mu_c(mu_c), gamma_c)
 }
 
-/// The posterior probability `P(π < μ_c | data)` of the module docs (no threshold), in
-/// `[0, 1]`: what Eq. 12 compares with `γ_c`.
+/// The posterior probability `P(π < μ_c | data) = I_{μ'_c}(α, β)` of the module docs (no
+/// threshold), in `[0, 1]`: what Eq. 12 compares with `γ_c`.
 pub(crate) fn prob_need_below(
     alpha: f64,
     beta: f64,
     rates: &ErrorRates,
     mu_c: f64,
 ) -> Option<f64> {
-    let mu = rates.shifted_mu_c(mu_c);
-    let reg = |x: f64| statrs::function::beta::checked_beta_reg(alpha, beta, x).ok();
-    let f = rates.false_correction_rate;
-    let upper = reg(mu)?;
-    let lower = if f > 0.0 { reg(f)? } else { 0.0 };
-    (lower < 1.0).then(|| ((upper - lower) / (1.0 - lower)).clamp(0.0, 1.0))
+    statrs::function::beta::checked_beta_reg(alpha, beta, rates.shifted_mu_c(mu_c)).ok()
 }
 
 #[cfg(test)]
