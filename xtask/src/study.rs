@@ -242,6 +242,34 @@ fn fig5_data(result: &StudyResult, summary: &[IterationSummary]) -> Fig5Data {
     }
 }
 
+/// The ground truth per trial at the last iteration: low-confidence runs per robot,
+/// falsely trusted samples (at the end and summed over iterations), the operator's rates
+/// as estimated and as simulated.
+fn print_ground_truth(result: &StudyResult) {
+    let pct = |r: f64| 100.0 * r;
+    for t in &result.trials {
+        let Some(last) = t.iterations.last() else {
+            continue;
+        };
+        let summed: usize = t.iterations.iter().map(|r| r.falsely_trusted_samples).sum();
+        let sim = last.simulated_rates.unwrap_or_default();
+        println!(
+            "trial {}: low-confidence runs per robot {:?}, T_total {:.2} s (bound {:.2} s), \
+             falsely trusted {} at the end, {summed} summed over iterations; \
+             f {:.3} % estimated / {:.3} % simulated, m {:.3} % / {:.3} %",
+            t.trial,
+            last.lc_runs,
+            last.t_total_s,
+            last.lower_bound_s,
+            last.falsely_trusted_samples,
+            pct(last.error_rates.false_correction_rate),
+            pct(sim.false_correction_rate),
+            pct(last.error_rates.miss_rate),
+            pct(sim.miss_rate),
+        );
+    }
+}
+
 fn print_times(times: &PhaseTimes, wall: std::time::Duration) {
     println!("phase times (summed over trials; trials run in parallel):");
     for (name, d) in [
@@ -378,6 +406,7 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
             100.0 * busy
         );
     }
+    print_ground_truth(&result);
     println!(
         "overlapping low-confidence ticks: {}",
         result.total_overlap_ticks()

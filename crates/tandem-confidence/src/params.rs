@@ -214,7 +214,13 @@ mod tests {
                 ..d()
             };
             assert_eq!(name_of(&f), "false_correction_rate");
-            assert_eq!(name_of(&ConfidenceParams { miss_rate: v, ..d() }), "miss_rate");
+            assert_eq!(
+                name_of(&ConfidenceParams {
+                    miss_rate: v,
+                    ..d()
+                }),
+                "miss_rate"
+            );
         }
         for v in [0.0, 1.0, -0.5, 1.5, f64::NAN] {
             assert_eq!(name_of(&ConfidenceParams { mu_c: v, ..d() }), "mu_c");

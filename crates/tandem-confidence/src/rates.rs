@@ -195,18 +195,76 @@ pub(crate) fn decide_with_rates(
 
 /// The posterior probability `P(π < μ_c | data) = I_{μ'_c}(α, β)` of the module docs (no
 /// threshold), in `[0, 1]`: what Eq. 12 compares with `γ_c`.
-pub(crate) fn prob_need_below(
-    alpha: f64,
-    beta: f64,
-    rates: &ErrorRates,
-    mu_c: f64,
-) -> Option<f64> {
+pub(crate) fn prob_need_below(alpha: f64, beta: f64, rates: &ErrorRates, mu_c: f64) -> Option<f64> {
     statrs::function::beta::checked_beta_reg(alpha, beta, rates.shifted_mu_c(mu_c)).ok()
+}
+
+/// The demonstration variance `σ²*` at which the prior alone (Eq. 10–11, no observations)
+/// turns low-confidence: samples with `σ²_D ≤ σ²*` are high-confidence from the prior,
+/// those above need supervised evidence (dimensionless, like `σ²_D`). The decision uses
+/// the configured error rates (no data to estimate them from). `None` when even
+/// `σ²_D = 0` is low-confidence. Bisection to a relative width of 1e-9 on the decision
+/// itself, which falls with `σ²_D` (the prior's mean `g/2` rises while `σ²_MAX·g` lets
+/// it spread).
+///
+/// ```
+/// use tandem_confidence::{ConfidenceParams, Confidence, prior_low_threshold};
+/// let p = ConfidenceParams::paper();
+/// let s = prior_low_threshold(&p)?.unwrap();
+/// let conf = Confidence::from_prior(&[0.99 * s, 1.01 * s], p)?;
+/// assert_eq!(conf.conf(), &[true, false]);
+/// # Ok::<(), tandem_confidence::Error>(())
+/// ```
+///
+/// # Errors
+/// [`Error::BadParam`](crate::Error::BadParam) for invalid `params`.
+pub fn prior_low_threshold(params: &ConfidenceParams) -> Result<Option<f64>> {
+    params.validate()?;
+    let rates = ErrorRates::configured(params);
+    let mu = rates.shifted_mu_c(params.mu_c);
+    let high = |s2: f64| {
+        let (a, b) = crate::beta::prior_ab(s2, params);
+        a > 0.0 && b > 0.0 && crate::beta::decide_exact(a, b, mu, params.gamma_c)
+    };
+    if !high(0.0) {
+        return Ok(None);
+    }
+    let (mut lo, mut hi) = (0.0_f64, 1e-6_f64);
+    while high(hi) {
+        lo = hi;
+        hi *= 2.0;
+        if hi > 1e6 {
+            return Ok(Some(f64::INFINITY));
+        }
+    }
+    while hi - lo > 1e-9 * hi {
+        let mid = 0.5 * (lo + hi);
+        if high(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(Some(lo))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_prior_threshold_matches_the_front_page_table() {
+        // Lib docs: sigma2_d = 0.001 is high from the prior, 0.01 is not (paper's model).
+        let s = prior_low_threshold(&ConfidenceParams::paper())
+            .unwrap()
+            .unwrap();
+        assert!(s > 0.001 && s < 0.01, "{s}");
+        // The operator's errors raise the threshold mu'_c, so the prior trusts a little more.
+        let with = prior_low_threshold(&ConfidenceParams::default())
+            .unwrap()
+            .unwrap();
+        assert!(with > s, "{with} vs {s}");
+    }
 
     #[test]
     fn zero_rates_are_eq_12() {

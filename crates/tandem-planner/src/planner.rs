@@ -7,7 +7,9 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use tandem_confidence::{Confidence, ConfidenceParams, Observations};
+use tandem_confidence::{
+    Confidence, ConfidenceParams, ErrorRates, Observations, estimate_error_rates,
+};
 use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
@@ -742,6 +744,19 @@ impl Planner {
     /// The correction observations so far.
     pub fn observations(&self) -> &Observations {
         &self.observations
+    }
+
+    /// The operator's error rates the confidence decides with: estimated from the
+    /// observations when `params().confidence.estimate_error_rates`, else the configured
+    /// ones (`tandem_confidence::estimate_error_rates`; probabilities per control sample).
+    ///
+    /// # Errors
+    /// The confidence crate's error for invalid parameters (a loaded planner has valid ones).
+    pub fn error_rates(&self) -> Result<ErrorRates> {
+        Ok(estimate_error_rates(
+            &self.observations,
+            &self.params.confidence,
+        )?)
     }
 
     /// The latched confidence (`conf()[n]`: reference sample `n` is high-confidence).

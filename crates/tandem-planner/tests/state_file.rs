@@ -231,8 +231,14 @@ fn a_version_6_file_loads_with_the_papers_confidence_model() {
     assert_eq!(old.params().fit, new.params().fit);
     assert_eq!(old.params().sampler, new.params().sampler);
     assert_eq!(old.model().mean(), new.model().mean());
-    assert_eq!(old.observations().corrections(), new.observations().corrections());
-    assert_eq!(old.observations().supervised(), new.observations().supervised());
+    assert_eq!(
+        old.observations().corrections(),
+        new.observations().corrections()
+    );
+    assert_eq!(
+        old.observations().supervised(),
+        new.observations().supervised()
+    );
     assert_eq!(old.observations().miss_evidence(), MissEvidence::default());
     assert_eq!(old.pairs_recorded(), new.pairs_recorded());
     // Its confidence is the paper's decision on the same data, recomputed here.
@@ -241,7 +247,8 @@ fn a_version_6_file_loads_with_the_papers_confidence_model() {
         .collect();
     let fitted = TaskModel::fit(&demos, &old.params().fit).unwrap();
     let mut conf = Confidence::from_prior(fitted.sigma2_d(), paper).unwrap();
-    conf.update(old.model().sigma2_d(), old.observations()).unwrap();
+    conf.update(old.model().sigma2_d(), old.observations())
+        .unwrap();
     assert_eq!(old.confidence(), &conf);
     validate(old.problem(), old.schedule()).unwrap();
     // Saved again, it is the current version and loads as the same planner.

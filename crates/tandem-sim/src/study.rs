@@ -19,7 +19,10 @@ use tandem_lfd::{Demonstration, TaskModel};
 use tandem_planner::{Planner, PlannerParams, derive_seed};
 use tandem_schedule::{GlobalTimeline, Source};
 
+use tandem_confidence::ErrorRates;
+
 use crate::task::{self, Label, TaskParams, Workpiece};
+use crate::truth::{OperatorTally, falsely_trusted};
 use crate::workcell::{self, OperatorParams};
 use crate::{Error, Result};
 
@@ -194,6 +197,22 @@ pub struct IterationRecord {
     /// Planned start offsets `τ_2, …, τ_N` of robots 2..N (s, global time; `N − 1` values,
     /// `[offset_s]` for two robots).
     pub offsets_s: Vec<f64>,
+    /// Reference samples that truly need help ([`crate::truth::needs_help`]) but are
+    /// high-confidence in this iteration's confidence: sanded unsupervised.
+    #[serde(default)]
+    pub falsely_trusted_samples: usize,
+    /// Low-confidence runs of each robot's schedule, robot 1 first (the lengths of
+    /// [`IterationRecord::lc_intervals_s`]).
+    #[serde(default)]
+    pub lc_runs: Vec<usize>,
+    /// The operator's error rates this iteration's confidence was decided with (estimated
+    /// from the rounds recorded so far, or the configured ones; per control sample).
+    #[serde(default)]
+    pub error_rates: ErrorRates,
+    /// The simulated operator's actual rates over the rounds recorded so far
+    /// ([`OperatorTally::rates`]); `None` before any round.
+    #[serde(default)]
+    pub simulated_rates: Option<ErrorRates>,
 }
 
 /// Where a study iteration's schedule came from: the kind of [`tandem_schedule::Source`]
@@ -575,8 +594,13 @@ pub fn read_labels(path: &Path) -> Result<Vec<Label>> {
         .collect()
 }
 
-/// The record of the planner's current schedule (no pair run yet).
-fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
+/// The record of the planner's current schedule (no pair run yet), with the ground truth
+/// of `labels` and the operator's actual rates `tally` over the rounds recorded.
+fn iteration_record(
+    planner: &Planner,
+    labels: &[Label],
+    tally: &OperatorTally,
+) -> Result<IterationRecord> {
     let schedule = planner.schedule();
     let timeline = GlobalTimeline::new(planner.problem(), schedule)?;
     let lc_intervals_s = timeline
@@ -599,6 +623,10 @@ fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
         gap: outcome.gap,
         throughput_per_h: throughput_per_h(n_robots, outcome.t_total_s),
         offsets_s: schedule.offsets_s.clone(),
+        falsely_trusted_samples: falsely_trusted(planner.confidence().conf(), labels),
+        lc_runs: timeline.lc_intervals().iter().map(|v| v.len()).collect(),
+        error_rates: planner.error_rates()?,
+        simulated_rates: (planner.pairs_recorded() > 0).then(|| tally.rates()),
     })
 }
 
@@ -659,8 +687,9 @@ pub fn run_trial_observed(
     let n_pairs = config.n_rounds();
     let n_robots = planner.n_robots();
     let mut iterations = Vec::with_capacity(n_pairs + 1);
+    let mut tally = OperatorTally::default();
     for pair in 0..n_pairs {
-        let mut record = iteration_record(&planner)?;
+        let mut record = iteration_record(&planner, reference_labels, &tally)?;
         let workpieces = (0..n_robots)
             .map(|_| Workpiece::random(&config.task, &mut rng))
             .collect::<Result<Vec<_>>>()?;
@@ -669,6 +698,7 @@ pub fn run_trial_observed(
             workcell::run_round(&planner, reference_labels, &workpieces, &operator, &mut rng)?;
         let records = run.records(planner.model())?;
         times.simulation += t.elapsed();
+        tally.add(&run);
         let count = |f: fn(&bool) -> bool, pick: fn(&workcell::RobotRun) -> &Vec<bool>| {
             run.robots
                 .iter()
@@ -699,7 +729,7 @@ pub fn run_trial_observed(
             pairs_done: pair + 1,
         });
     }
-    iterations.push(iteration_record(&planner)?);
+    iterations.push(iteration_record(&planner, reference_labels, &tally)?);
     Ok((
         TrialResult {
             trial,
@@ -871,6 +901,10 @@ mod tests {
             gap: 1.0 / (t_total_s - 1.0),
             throughput_per_h: throughput_per_h(2, t_total_s),
             offsets_s: vec![1.0],
+            falsely_trusted_samples: 0,
+            lc_runs: vec![1, 2],
+            error_rates: ErrorRates::default(),
+            simulated_rates: None,
         }
     }
 
