@@ -235,6 +235,45 @@ impl Observations {
     /// [`Error::LengthMismatch`] if the slices differ in length;
     /// [`Error::RefTimeOutOfRange`] naming the first non-finite or out-of-range time.
     pub fn record(&mut self, supervised_ref_times: &[f64], corrected: &[bool]) -> Result<()> {
+        self.record_with(supervised_ref_times, corrected, false)
+    }
+
+    /// [`record`](Self::record) with *one vote per execution*: the execution's mass at each
+    /// reference sample is scaled down to at most one unit (corrections in proportion), so
+    /// that the control samples one execution spends on a reference sample count as one
+    /// observation, not as many.
+    ///
+    /// Why: the operator's decision at a reference sample holds for every control sample
+    /// the robot spends there — an unneeded correction is an episode of the joystick held
+    /// for a while, a needed one lasts the painted section — so where the robot moves
+    /// slower than the reference (and a correction slows it further) the paper's split
+    /// counts one decision several times, and a single slip weighs like several
+    /// independent ones. Executions are independent of each other; control samples of one
+    /// execution at one reference sample are not. Where the robot moves faster than the
+    /// reference (less than one unit per sample) nothing changes.
+    ///
+    /// ```
+    /// use tandem_confidence::Observations;
+    /// let mut obs = Observations::new(3)?;
+    /// // Four control samples on reference sample 1 (a slow robot), two of them corrected.
+    /// obs.record_votes(&[1.0, 1.0, 1.0, 1.0, 2.0], &[true, true, false, false, false])?;
+    /// assert_eq!(obs.supervised(), &[0.0, 1.0, 1.0]);
+    /// assert_eq!(obs.corrections(), &[0.0, 0.5, 0.0]);
+    /// # Ok::<(), tandem_confidence::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`record`](Self::record).
+    pub fn record_votes(&mut self, supervised_ref_times: &[f64], corrected: &[bool]) -> Result<()> {
+        self.record_with(supervised_ref_times, corrected, true)
+    }
+
+    fn record_with(
+        &mut self,
+        supervised_ref_times: &[f64],
+        corrected: &[bool],
+        one_vote: bool,
+    ) -> Result<()> {
         check_len(
             "supervised_ref_times",
             supervised_ref_times.len(),
@@ -253,24 +292,53 @@ impl Observations {
                 });
             }
         }
-        for (&t, &c) in supervised_ref_times.iter().zip(corrected) {
-            let (lo, w) = split(t, n_ref);
-            let w_lo = 1.0 - w;
-            self.supervised[lo] += w_lo;
-            if c {
-                self.corrections[lo] += w_lo;
+        if one_vote {
+            // This execution's own counts, then at most one unit per sample.
+            let (mut c_e, mut s_e) = (vec![0.0; n_ref], vec![0.0; n_ref]);
+            add_split(&mut c_e, &mut s_e, supervised_ref_times, corrected);
+            for ((c, s), (ce, se)) in self
+                .corrections
+                .iter_mut()
+                .zip(&mut self.supervised)
+                .zip(c_e.iter().zip(&s_e))
+            {
+                let scale = if *se > 1.0 { 1.0 / se } else { 1.0 };
+                // ce ≤ se, so the scaled counts keep 0 ≤ c ≤ s.
+                *s += se * scale;
+                *c += (ce * scale).min(se * scale);
             }
-            if w > 0.0 {
-                self.supervised[lo + 1] += w;
-                if c {
-                    self.corrections[lo + 1] += w;
-                }
-            }
+        } else {
+            add_split(
+                &mut self.corrections,
+                &mut self.supervised,
+                supervised_ref_times,
+                corrected,
+            );
         }
         let miss = MissEvidence::of_execution(corrected);
         self.miss.gap_samples += miss.gap_samples;
         self.miss.stretch_samples += miss.stretch_samples;
         Ok(())
+    }
+}
+
+/// Adds checked observations to `corrections` and `supervised`, each split linearly
+/// between its two neighbouring reference samples.
+fn add_split(corrections: &mut [f64], supervised: &mut [f64], times: &[f64], corrected: &[bool]) {
+    let n_ref = supervised.len();
+    for (&t, &c) in times.iter().zip(corrected) {
+        let (lo, w) = split(t, n_ref);
+        let w_lo = 1.0 - w;
+        supervised[lo] += w_lo;
+        if c {
+            corrections[lo] += w_lo;
+        }
+        if w > 0.0 {
+            supervised[lo + 1] += w;
+            if c {
+                corrections[lo + 1] += w;
+            }
+        }
     }
 }
 

@@ -70,6 +70,13 @@ pub struct ConfidenceParams {
     /// Default: `true`. The paper's model: `false` (with both rates 0 it is exactly
     /// Eq. 8–12; docs/decisions.md, "The operator's error rates in the confidence").
     pub estimate_error_rates: bool,
+    /// Whether one execution counts at most once per reference sample
+    /// ([`Observations::record_votes`](crate::Observations::record_votes)): the control
+    /// samples one execution spends on a reference sample share one decision of the
+    /// operator. Read by whoever records the observations (the planner). Default: `true`.
+    /// The paper's model: `false` (every control sample one observation, Eq. 9 with the
+    /// fractional split).
+    pub one_vote_per_execution: bool,
 }
 
 impl Default for ConfidenceParams {
@@ -83,28 +90,34 @@ impl Default for ConfidenceParams {
             false_correction_rate: 0.01,
             miss_rate: 0.01,
             estimate_error_rates: true,
+            one_vote_per_execution: true,
         }
     }
 }
 
 impl ConfidenceParams {
-    /// The paper's model (Eq. 8–12): the defaults with both error rates 0 and nothing
-    /// estimated, so that every recorded correction counts as evidence of need.
+    /// The paper's model (Eq. 8–12): the defaults with both error rates 0, nothing
+    /// estimated and every control sample one observation, so that every recorded
+    /// correction counts as evidence of need.
     #[must_use]
     pub fn paper() -> Self {
         Self {
             false_correction_rate: 0.0,
             miss_rate: 0.0,
             estimate_error_rates: false,
+            one_vote_per_execution: false,
             ..Self::default()
         }
     }
 
-    /// Whether this is the paper's model: both error rates 0 and not estimated (then the
-    /// decision is exactly Eq. 12).
+    /// Whether this is the paper's model: both error rates 0, not estimated, every control
+    /// sample an observation (then the decision is exactly Eq. 12).
     #[must_use]
     pub fn is_paper_model(&self) -> bool {
-        self.false_correction_rate == 0.0 && self.miss_rate == 0.0 && !self.estimate_error_rates
+        self.false_correction_rate == 0.0
+            && self.miss_rate == 0.0
+            && !self.estimate_error_rates
+            && !self.one_vote_per_execution
     }
 
     /// Checks every field against its documented domain.
@@ -174,8 +187,13 @@ mod tests {
             (10.0, 0.05, 1e-6, 0.05, 0.95)
         );
         assert_eq!(
-            (p.false_correction_rate, p.miss_rate, p.estimate_error_rates),
-            (0.01, 0.01, true)
+            (
+                p.false_correction_rate,
+                p.miss_rate,
+                p.estimate_error_rates,
+                p.one_vote_per_execution
+            ),
+            (0.01, 0.01, true, true)
         );
         p.validate().unwrap();
         assert!(!p.is_paper_model());
@@ -186,6 +204,7 @@ mod tests {
                 false_correction_rate: 0.0,
                 miss_rate: 0.0,
                 estimate_error_rates: false,
+                one_vote_per_execution: false,
                 ..p
             },
             paper

@@ -631,7 +631,11 @@ impl Planner {
         let mut observations = self.observations.clone();
         for e in &records {
             let (times, corrected) = e.observations()?;
-            observations.record(&times, &corrected)?;
+            if self.params.confidence.one_vote_per_execution {
+                observations.record_votes(&times, &corrected)?;
+            } else {
+                observations.record(&times, &corrected)?;
+            }
         }
         let mut confidence = self.confidence.clone();
         let newly_high = confidence.update(model.sigma2_d(), &observations)?;

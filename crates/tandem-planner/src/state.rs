@@ -89,9 +89,10 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 ///   recorded twice is refused. Version 4 and 5 files still load, with no fingerprints for
 ///   the rounds they hold.
 /// - 7: the confidence parameters gained the operator's error rates
-///   (`false_correction_rate`, `miss_rate`, `estimate_error_rates`) and the observations
+///   (`false_correction_rate`, `miss_rate`, `estimate_error_rates`) and
+///   `one_vote_per_execution`, and the observations
 ///   their evidence of misses (`MissEvidence`). Version 4 to 6 files still load, with the
-///   paper's model (both rates 0, not estimated: the decisions they were saved with) and no
+///   paper's model (`ConfidenceParams::paper()`: the decisions they were saved with) and no
 ///   evidence of misses.
 pub const FORMAT_VERSION: u32 = 7;
 
