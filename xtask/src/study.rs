@@ -45,6 +45,20 @@ pub(crate) struct StudyArgs {
     /// Master seed.
     #[arg(long)]
     seed: Option<u64>,
+    /// The simulated operator's miss rate (probability per needed control sample).
+    #[arg(long)]
+    miss_rate: Option<f64>,
+    /// The simulated operator's false-correction rate (share of the supervised time that
+    /// needs no correction).
+    #[arg(long)]
+    false_correction_rate: Option<f64>,
+    /// Mean length (s) of an unneeded correction episode; 0 draws every control tick alone.
+    #[arg(long)]
+    false_correction_s: Option<f64>,
+    /// Decide confidence with the paper's model (Eq. 8–12: zero error rates, nothing
+    /// estimated, every control sample one observation) instead of the configured one.
+    #[arg(long)]
+    paper_confidence: bool,
     /// Output folder (created if missing). Default: results/ in the workspace.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -205,6 +219,26 @@ fn config(args: &StudyArgs) -> anyhow::Result<StudyConfig> {
     }
     if let Some(v) = args.seed {
         config.seed = v;
+    }
+    if let Some(v) = args.miss_rate {
+        config.miss_rate = v;
+    }
+    if let Some(v) = args.false_correction_rate {
+        config.false_correction_rate = v;
+    }
+    if let Some(v) = args.false_correction_s {
+        config.false_correction_s = v;
+    }
+    if args.paper_confidence {
+        let c = &mut config.planner.confidence;
+        *c = tandem::confidence::ConfidenceParams {
+            gamma_p: c.gamma_p,
+            sigma2_max: c.sigma2_max,
+            epsilon: c.epsilon,
+            mu_c: c.mu_c,
+            gamma_c: c.gamma_c,
+            ..tandem::confidence::ConfidenceParams::paper()
+        };
     }
     config
         .validate()

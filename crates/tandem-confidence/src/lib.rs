@@ -96,5 +96,7 @@ pub use confidence::{Confidence, evaluate, prob_need_below_mu_c};
 pub use error::{Error, Result};
 pub use observations::{MissEvidence, Observations};
 pub use params::ConfidenceParams;
-pub use rates::{ErrorRates, RATE_PRIOR_SAMPLES, estimate_error_rates, prior_low_threshold};
+pub use rates::{
+    ErrorRates, MIN_OBSERVATIONS, RATE_PRIOR_SAMPLES, estimate_error_rates, prior_low_threshold,
+};
 pub use runs::{Run, low_regions, runs};

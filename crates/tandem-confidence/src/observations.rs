@@ -239,26 +239,31 @@ impl Observations {
     }
 
     /// [`record`](Self::record) with *one vote per execution*: the execution's mass at each
-    /// reference sample is scaled down to at most one unit (corrections in proportion), so
-    /// that the control samples one execution spends on a reference sample count as one
-    /// observation, not as many.
+    /// reference sample it touched is scaled to exactly one unit (corrections in
+    /// proportion), so that one execution passing a reference sample is one observation of
+    /// the operator there, however many control samples it spent on it.
     ///
     /// Why: the operator's decision at a reference sample holds for every control sample
     /// the robot spends there — an unneeded correction is an episode of the joystick held
     /// for a while, a needed one lasts the painted section — so where the robot moves
     /// slower than the reference (and a correction slows it further) the paper's split
     /// counts one decision several times, and a single slip weighs like several
-    /// independent ones. Executions are independent of each other; control samples of one
-    /// execution at one reference sample are not. Where the robot moves faster than the
-    /// reference (less than one unit per sample) nothing changes.
+    /// independent ones. Where it moves faster, one control sample spans several reference
+    /// samples and the split gives each a fraction of an observation, although the
+    /// operator watched the robot pass each of them: such samples needed several times
+    /// more executions to become high-confidence (measured in the study: the last
+    /// low-confidence islands at the tool's lift-off after pass 1). Executions are
+    /// independent of each other; control samples of one execution at one reference sample
+    /// are not.
     ///
     /// ```
     /// use tandem_confidence::Observations;
-    /// let mut obs = Observations::new(3)?;
-    /// // Four control samples on reference sample 1 (a slow robot), two of them corrected.
-    /// obs.record_votes(&[1.0, 1.0, 1.0, 1.0, 2.0], &[true, true, false, false, false])?;
-    /// assert_eq!(obs.supervised(), &[0.0, 1.0, 1.0]);
-    /// assert_eq!(obs.corrections(), &[0.0, 0.5, 0.0]);
+    /// let mut obs = Observations::new(4)?;
+    /// // Four control samples on reference sample 1 (a slow robot), two of them corrected;
+    /// // then one at 2.5 (a fast robot), corrected.
+    /// obs.record_votes(&[1.0, 1.0, 1.0, 1.0, 2.5], &[true, true, false, false, true])?;
+    /// assert_eq!(obs.supervised(), &[0.0, 1.0, 1.0, 1.0]);
+    /// assert_eq!(obs.corrections(), &[0.0, 0.5, 1.0, 1.0]);
     /// # Ok::<(), tandem_confidence::Error>(())
     /// ```
     ///
@@ -293,7 +298,7 @@ impl Observations {
             }
         }
         if one_vote {
-            // This execution's own counts, then at most one unit per sample.
+            // This execution's own counts, then one unit per sample it touched.
             let (mut c_e, mut s_e) = (vec![0.0; n_ref], vec![0.0; n_ref]);
             add_split(&mut c_e, &mut s_e, supervised_ref_times, corrected);
             for ((c, s), (ce, se)) in self
@@ -302,10 +307,11 @@ impl Observations {
                 .zip(&mut self.supervised)
                 .zip(c_e.iter().zip(&s_e))
             {
-                let scale = if *se > 1.0 { 1.0 / se } else { 1.0 };
-                // ce ≤ se, so the scaled counts keep 0 ≤ c ≤ s.
-                *s += se * scale;
-                *c += (ce * scale).min(se * scale);
+                if *se > 0.0 {
+                    // ce ≤ se, so the vote keeps 0 ≤ c ≤ s.
+                    *s += 1.0;
+                    *c += (ce / se).min(1.0);
+                }
             }
         } else {
             add_split(

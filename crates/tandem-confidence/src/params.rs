@@ -70,7 +70,7 @@ pub struct ConfidenceParams {
     /// Default: `true`. The paper's model: `false` (with both rates 0 it is exactly
     /// Eq. 8–12; docs/decisions.md, "The operator's error rates in the confidence").
     pub estimate_error_rates: bool,
-    /// Whether one execution counts at most once per reference sample
+    /// Whether one execution counts exactly once per reference sample it passed
     /// ([`Observations::record_votes`](crate::Observations::record_votes)): the control
     /// samples one execution spends on a reference sample share one decision of the
     /// operator. Read by whoever records the observations (the planner). Default: `true`.
