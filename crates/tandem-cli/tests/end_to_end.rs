@@ -233,8 +233,9 @@ fn documented_examples_work() {
     );
     let p = Planner::load(&state).unwrap();
     assert_eq!(p.pairs_recorded(), 1);
-    // 42 samples per execution, all supervised before the first update.
-    assert_eq!(p.observations().total_supervised(), 84.0);
+    // 42 samples per execution, all supervised before the first update; with one vote per
+    // execution (the default) each execution counts once on each of the 40 reference samples.
+    assert_eq!(p.observations().total_supervised(), 80.0);
     ok(&tandem([
         "simulate",
         &s(&state),
