@@ -231,7 +231,15 @@ class Confidence:
     def posterior_beta(self) -> F64: ...
     @property
     def p_below_mu_c(self) -> F64:
-        """``I_μc(α, β)``, the left side of Eq. 12, ``(T_ref,)``."""
+        """``P(π < μ_c) = I_μ'c(α, β)``, the left side of Eq. 12, ``(T_ref,)``."""
+    @property
+    def error_rates(self) -> Dict[str, float]:
+        """``{"false_correction_rate": f, "miss_rate": m}`` the confidence decides with."""
+    @property
+    def sigma2_d_prior_threshold(self) -> Optional[float]:
+        """``σ²_D`` above which the prior alone is low-confidence."""
+    def explain_low_confidence(self) -> List[Dict[str, Any]]:
+        """Each low-confidence region: interval, cause, channels, what would change it."""
     @property
     def observations(self) -> Observations: ...
 

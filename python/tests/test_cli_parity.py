@@ -136,3 +136,21 @@ def test_record_round_takes_execution_files_with_columns_in_any_order(tmp_path: 
     from_arrays.save(tmp_path / "a.state")
     from_files.save(tmp_path / "f.state")
     assert (tmp_path / "a.state").read_bytes() == (tmp_path / "f.state").read_bytes()
+
+
+def test_low_confidence_explanations_equal_tandem_inspect(
+    planner: tandem.Planner, tmp_path: Path
+) -> None:
+    planner.save(tmp_path / "py.state")
+    doc = json.loads(run_cli("inspect", tmp_path / "py.state", "--json"))
+    regions = planner.confidence.explain_low_confidence()
+    assert regions == doc["confidence"]["low_regions"]
+    starts = [r["ref_start"] for r in regions]
+    assert starts == [int(a) for a, _ in planner.confidence.low_regions]
+    assert all(r["cause"] in ("variance", "corrections") for r in regions)
+    assert planner.confidence.error_rates == doc["confidence"]["error_rates"]
+    t = planner.confidence.sigma2_d_prior_threshold
+    assert t == doc["confidence"]["sigma2_d_prior_threshold"]
+    # Where the prior alone is high, sigma2_d is at most the threshold (latched from the fit).
+    s2 = planner.model.sigma2_d
+    assert np.all(s2[planner.confidence.high] <= t)

@@ -477,6 +477,10 @@ mod tests {
             gap: 0.0,
             throughput_per_h: 3.0 * 3600.0 / t_total_s,
             offsets_s: vec![1.0, 2.0],
+            falsely_trusted_samples: 0,
+            lc_runs: vec![0; 3],
+            error_rates: Default::default(),
+            simulated_rates: None,
         };
         let trial = |k: usize, last_s: f64| TrialResult {
             trial: k,

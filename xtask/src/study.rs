@@ -45,6 +45,20 @@ pub(crate) struct StudyArgs {
     /// Master seed.
     #[arg(long)]
     seed: Option<u64>,
+    /// The simulated operator's miss rate (probability per needed control sample).
+    #[arg(long)]
+    miss_rate: Option<f64>,
+    /// The simulated operator's false-correction rate (share of the supervised time that
+    /// needs no correction).
+    #[arg(long)]
+    false_correction_rate: Option<f64>,
+    /// Mean length (s) of an unneeded correction episode; 0 draws every control tick alone.
+    #[arg(long)]
+    false_correction_s: Option<f64>,
+    /// Decide confidence with the paper's model (Eq. 8–12: zero error rates, nothing
+    /// estimated, every control sample one observation) instead of the configured one.
+    #[arg(long)]
+    paper_confidence: bool,
     /// Output folder (created if missing). Default: results/ in the workspace.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -206,6 +220,26 @@ fn config(args: &StudyArgs) -> anyhow::Result<StudyConfig> {
     if let Some(v) = args.seed {
         config.seed = v;
     }
+    if let Some(v) = args.miss_rate {
+        config.miss_rate = v;
+    }
+    if let Some(v) = args.false_correction_rate {
+        config.false_correction_rate = v;
+    }
+    if let Some(v) = args.false_correction_s {
+        config.false_correction_s = v;
+    }
+    if args.paper_confidence {
+        let c = &mut config.planner.confidence;
+        *c = tandem::confidence::ConfidenceParams {
+            gamma_p: c.gamma_p,
+            sigma2_max: c.sigma2_max,
+            epsilon: c.epsilon,
+            mu_c: c.mu_c,
+            gamma_c: c.gamma_c,
+            ..tandem::confidence::ConfidenceParams::paper()
+        };
+    }
     config
         .validate()
         .with_context(|| format!("study configuration {} with flags", path.display()))?;
@@ -239,6 +273,34 @@ fn fig5_data(result: &StudyResult, summary: &[IterationSummary]) -> Fig5Data {
         ground_truth_pct: result.ground_truth_pct,
         n_robots: result.config.robots,
         examples,
+    }
+}
+
+/// The ground truth per trial at the last iteration: low-confidence runs per robot,
+/// falsely trusted samples (at the end and summed over iterations), the operator's rates
+/// as estimated and as simulated.
+fn print_ground_truth(result: &StudyResult) {
+    let pct = |r: f64| 100.0 * r;
+    for t in &result.trials {
+        let Some(last) = t.iterations.last() else {
+            continue;
+        };
+        let summed: usize = t.iterations.iter().map(|r| r.falsely_trusted_samples).sum();
+        let sim = last.simulated_rates.unwrap_or_default();
+        println!(
+            "trial {}: low-confidence runs per robot {:?}, T_total {:.2} s (bound {:.2} s), \
+             falsely trusted {} at the end, {summed} summed over iterations; \
+             f {:.3} % estimated / {:.3} % simulated, m {:.3} % / {:.3} %",
+            t.trial,
+            last.lc_runs,
+            last.t_total_s,
+            last.lower_bound_s,
+            last.falsely_trusted_samples,
+            pct(last.error_rates.false_correction_rate),
+            pct(sim.false_correction_rate),
+            pct(last.error_rates.miss_rate),
+            pct(sim.miss_rate),
+        );
     }
 }
 
@@ -378,6 +440,7 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
             100.0 * busy
         );
     }
+    print_ground_truth(&result);
     println!(
         "overlapping low-confidence ticks: {}",
         result.total_overlap_ticks()

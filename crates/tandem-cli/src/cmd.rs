@@ -346,14 +346,12 @@ fn inspect(a: &InspectArgs) -> Result<()> {
     sorted.sort_by(f64::total_cmp);
     let q = |p: f64| sorted[((sorted.len() - 1) as f64 * p).round() as usize];
     let dt = model.dt_s();
-    let regions: Vec<_> = conf
-        .low_regions()
-        .iter()
-        .map(|r| {
-            json!({"ref_start": r.start, "ref_end": r.end,
-                        "start_s": r.start as f64 * dt, "end_s": r.end as f64 * dt})
-        })
-        .collect();
+    let explained = planner
+        .explain_low_confidence()
+        .context("cannot explain the low-confidence regions")?;
+    let regions = serde_json::to_value(&explained)?;
+    let rates = planner.error_rates()?;
+    let prior_threshold = tandem::confidence::prior_low_threshold(conf.params())?;
     let ranges: serde_json::Map<_, _> = model
         .tangent_names()
         .iter()
@@ -387,6 +385,8 @@ fn inspect(a: &InspectArgs) -> Result<()> {
             "high_share": conf.high_share(),
             "n_high": conf.n_high(),
             "low_regions": regions,
+            "error_rates": serde_json::to_value(rates)?,
+            "sigma2_d_prior_threshold": prior_threshold,
             "total_supervised": obs.total_supervised(),
             "total_corrections": obs.total_corrections(),
         },
@@ -448,12 +448,27 @@ fn inspect(a: &InspectArgs) -> Result<()> {
         p.gamma_p, p.sigma2_max, p.epsilon, p.mu_c, p.gamma_c
     ));
     out(&format!(
+        "  operator error rates: false corrections {:.3} %, misses {:.3} % ({})",
+        100.0 * rates.false_correction_rate,
+        100.0 * rates.miss_rate,
+        if p.estimate_error_rates {
+            "estimated from the executions"
+        } else {
+            "as configured"
+        }
+    ));
+    if let Some(t) = prior_threshold {
+        out(&format!(
+            "  the prior alone is low-confidence where σ²_D > {t:.3e}"
+        ));
+    }
+    out(&format!(
         "  observations: {:.0} supervised samples, {:.0} corrected",
         obs.total_supervised(),
         obs.total_corrections()
     ));
     summary_lines(&planner)?;
-    let lows = conf.low_regions();
+    let lows = &explained;
     const SHOWN: usize = 20;
     out(&format!(
         "low-confidence regions (reference time): {}",
@@ -462,11 +477,10 @@ fn inspect(a: &InspectArgs) -> Result<()> {
     for r in lows.iter().take(SHOWN) {
         out(&format!(
             "  {:>9.2} – {:>9.2} s   samples {:>6} – {:>6}",
-            r.start as f64 * dt,
-            r.end as f64 * dt,
-            r.start,
-            r.end
+            r.start_s, r.end_s, r.ref_start, r.ref_end
         ));
+        out(&format!("      why: {}", why_text(r)));
+        out(&format!("      would change it: {}", remedy_text(r)));
     }
     if lows.len() > SHOWN {
         out(&format!(
@@ -475,6 +489,60 @@ fn inspect(a: &InspectArgs) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// The cause of a low-confidence region in words (`tandem inspect`).
+fn why_text(r: &tandem::planner::LowRegion) -> String {
+    use tandem::planner::LowCause;
+    let channels: Vec<String> = r
+        .channels
+        .iter()
+        .map(|c| format!("{} {:.0} %", c.name, 100.0 * c.share))
+        .collect();
+    match r.cause {
+        LowCause::Corrections => format!(
+            "corrections: {:.0} of {:.0} supervised samples corrected, the operator's false \
+             corrections explain {:.1}",
+            r.corrections, r.supervised, r.expected_false_corrections
+        ),
+        LowCause::Variance => format!(
+            "demonstration variance: σ²_D up to {:.3e}{} ({}); {:.0} supervised samples, \
+             {:.0} corrected",
+            r.sigma2_d_max,
+            r.sigma2_d_prior_threshold
+                .map_or(String::new(), |t| format!(" against the prior's {t:.3e}")),
+            channels.join(", "),
+            r.supervised,
+            r.corrections
+        ),
+    }
+}
+
+/// What would change a low-confidence region, in words (`tandem inspect`).
+fn remedy_text(r: &tandem::planner::LowRegion) -> String {
+    use tandem::planner::LowCause;
+    if r.cause == LowCause::Corrections {
+        return "nothing but the task: the operator is needed here".into();
+    }
+    let mut parts = Vec::new();
+    if let Some(k) = r.clean_executions_needed {
+        parts.push(format!(
+            "{k} more supervised executions without a correction"
+        ));
+    }
+    for c in &r.channels {
+        if let Some(range) = c.range_for_prior {
+            parts.push(format!(
+                "a range of {range:.4} for {} (now {:.4}) if its variation there does not matter",
+                c.name, c.range
+            ));
+        }
+    }
+    if parts.is_empty() {
+        "more supervised executions without a correction".into()
+    } else {
+        parts.join("; or ")
+    }
 }
 
 fn plot_cmd(a: &PlotArgs) -> Result<()> {

@@ -289,13 +289,34 @@ impl Figure for ConfidenceFigure<'_> {
         // σ²_D on a log axis.
         let floor = 1e-9;
         let s2: Vec<f64> = model.sigma2_d().iter().map(|v| v.max(floor)).collect();
-        let hi = s2.iter().copied().fold(floor * 10.0, f64::max) * 2.0;
-        let lo = s2.iter().copied().fold(f64::INFINITY, f64::min).max(floor) / 2.0;
+        // The level above which the prior alone (no executions) is low-confidence.
+        let threshold = tandem::confidence::prior_low_threshold(conf.params())?
+            .filter(|t| t.is_finite())
+            .map(|t| t.max(floor));
+        let hi = s2
+            .iter()
+            .copied()
+            .chain(threshold)
+            .fold(floor * 10.0, f64::max)
+            * 2.0;
+        let lo = s2
+            .iter()
+            .copied()
+            .chain(threshold)
+            .fold(f64::INFINITY, f64::min)
+            .max(floor)
+            / 2.0;
+        let caption = match threshold {
+            Some(t) => format!(
+                "demonstration variance σ²_D(t) (Eq. 6, dimensionless); dashed: {t:.2e}, above \
+                 which the prior alone is low-confidence"
+            ),
+            None => "demonstration variance σ²_D(t) (Eq. 6, dimensionless); the prior alone is \
+                     low-confidence everywhere"
+                .to_owned(),
+        };
         let mut chart = ChartBuilder::on(&areas[0])
-            .caption(
-                "demonstration variance σ²_D(t) (Eq. 6, dimensionless)",
-                (FONT_FAMILY, 14),
-            )
+            .caption(caption, (FONT_FAMILY, 14))
             .margin(5)
             .x_label_area_size(30)
             .y_label_area_size(70)
@@ -317,6 +338,16 @@ impl Figure for ConfidenceFigure<'_> {
                 MEAN.stroke_width(1),
             ))
             .map_err(de)?;
+        if let Some(t) = threshold {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(0.0, t), (t_end, t)],
+                    6,
+                    4,
+                    BLACK.stroke_width(1),
+                ))
+                .map_err(de)?;
+        }
         // Confidence map and observed correction frequency.
         let mut chart = ChartBuilder::on(&areas[1])
             .caption(

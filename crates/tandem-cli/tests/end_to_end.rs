@@ -253,8 +253,9 @@ fn documented_examples_work() {
     );
     let p = Planner::load(&state).unwrap();
     assert_eq!(p.rounds_recorded(), 1);
-    // 42 samples per execution, all supervised before the first update.
-    assert_eq!(p.observations().total_supervised(), 84.0);
+    // 42 samples per execution, all supervised before the first update; with one vote per
+    // execution (the default) each execution counts once on each of the 40 reference samples.
+    assert_eq!(p.observations().total_supervised(), 80.0);
     ok(&tandem([
         "simulate",
         &s(&state),
@@ -320,7 +321,27 @@ fn documented_examples_work() {
     assert_eq!(inspect["pairs_recorded"], inspect["rounds_recorded"]);
     assert_eq!(inspect["model"]["count"], 5);
     assert_eq!(inspect["model"]["n_ref"], 40);
+    // Every low-confidence region says why it is low and where, in reference time.
+    let regions = inspect["confidence"]["low_regions"].as_array().unwrap();
+    assert!(!regions.is_empty());
+    for r in regions {
+        let (a, b) = (r["start_s"].as_f64().unwrap(), r["end_s"].as_f64().unwrap());
+        assert!(a < b && b <= 0.4 + 1e-9, "{r}");
+        let cause = r["cause"].as_str().unwrap();
+        assert!(cause == "variance" || cause == "corrections", "{r}");
+        assert!(r["channels"].as_array().is_some_and(|c| c.len() <= 3));
+    }
+    let f = inspect["confidence"]["error_rates"]["false_correction_rate"]
+        .as_f64()
+        .unwrap();
+    assert!((0.0..0.5).contains(&f));
+    assert!(text_inspect_explains(&ok(&tandem(["inspect", &s(&state)]))));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The text view gives each low-confidence region its cause and what would change it.
+fn text_inspect_explains(text: &str) -> bool {
+    text.contains("why: ") && text.contains("would change it: ")
 }
 
 #[test]

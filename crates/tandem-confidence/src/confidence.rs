@@ -6,7 +6,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::beta::{check_len, check_variance, decide, prior_ab};
 use crate::boundary::Boundary;
-use crate::{ConfidenceParams, Error, Observations, Result};
+use crate::rates::{decide_with_rates, prob_need_below};
+use crate::{ConfidenceParams, Error, ErrorRates, Observations, Result};
 
 /// `conf(t)` per reference sample, latched: once a sample is high-confidence it stays so.
 ///
@@ -22,7 +23,7 @@ use crate::{ConfidenceParams, Error, Observations, Result};
 /// ```
 /// use tandem_confidence::{Confidence, ConfidenceParams, Observations};
 /// let sigma2_d = [0.0, 10.0, 10.0, 0.0];
-/// let mut conf = Confidence::from_prior(&sigma2_d, ConfidenceParams::default())?;
+/// let mut conf = Confidence::from_prior(&sigma2_d, ConfidenceParams::paper())?;
 /// assert_eq!(conf.conf(), &[true, false, false, true]);
 /// assert_eq!(conf.low_regions(), vec![1..3]);
 /// assert_eq!(conf.high_share(), 0.5);
@@ -43,6 +44,10 @@ pub struct Confidence {
     /// Cache of certified points of the Eq. 12 boundary (speed only; see `boundary.rs`).
     #[serde(skip)]
     boundary: Boundary,
+    /// The same at the shifted threshold `μ'_c` of the last update with non-zero error
+    /// rates (speed only: it screens out samples that stay low).
+    #[serde(skip)]
+    shifted: Option<(f64, Boundary)>,
 }
 
 /// Equality of the model state (parameters and latched `conf`); the evaluation cache is
@@ -86,7 +91,9 @@ impl Confidence {
     /// As [`new`](Self::new) and [`update`](Self::update).
     pub fn from_prior(sigma2_d: &[f64], params: ConfidenceParams) -> Result<Self> {
         let mut conf = Self::new(sigma2_d.len(), params)?;
-        conf.latch(sigma2_d, |_| (0.0, 0.0))?;
+        // Without observations the rates are the configured ones.
+        let rates = ErrorRates::configured(&conf.params);
+        conf.latch(sigma2_d, &rates, |_| (0.0, 0.0))?;
         Ok(conf)
     }
 
@@ -104,6 +111,7 @@ impl Confidence {
             params,
             high,
             boundary: Boundary::default(),
+            shifted: None,
         })
     }
 
@@ -111,6 +119,12 @@ impl Confidence {
     /// demonstration variance `sigma2_d` (Eq. 6, dimensionless, one per reference sample)
     /// and all observations so far, and latches the samples that pass.
     /// Returns how many samples became high-confidence in this call.
+    ///
+    /// With non-zero operator error rates (estimated from `obs` when
+    /// [`ConfidenceParams::estimate_error_rates`], [`crate::estimate_error_rates`]) the test
+    /// is `P(π < μ_c | data) > γ_c` for the need `π` behind the corrections
+    /// ([`crate::rates`](crate::estimate_error_rates) module docs); with zero rates it is
+    /// Eq. 12 exactly.
     ///
     /// Every input is checked before the state changes: on error nothing is latched.
     ///
@@ -131,13 +145,19 @@ impl Confidence {
             "the confidence state",
             self.n_ref(),
         )?;
+        let rates = crate::estimate_error_rates(obs, &self.params)?;
         let (c, s) = (obs.corrections(), obs.supervised());
-        self.latch(sigma2_d, |n| (c[n], s[n]))
+        self.latch(sigma2_d, &rates, |n| (c[n], s[n]))
     }
 
     /// Shared body of [`update`](Self::update) and [`from_prior`](Self::from_prior):
     /// `counts(n)` gives `(corrections[n], supervised[n])`, with `0 ≤ c ≤ s` finite.
-    fn latch(&mut self, sigma2_d: &[f64], counts: impl Fn(usize) -> (f64, f64)) -> Result<usize> {
+    fn latch(
+        &mut self,
+        sigma2_d: &[f64],
+        rates: &ErrorRates,
+        counts: impl Fn(usize) -> (f64, f64),
+    ) -> Result<usize> {
         self.params.validate()?;
         check_len(
             "sigma2_d",
@@ -152,7 +172,12 @@ impl Confidence {
             params: p,
             high: latched,
             boundary,
+            shifted,
         } = self;
+        let mu_shifted = rates.shifted_mu_c(p.mu_c);
+        if !rates.is_zero() && shifted.as_ref().is_none_or(|(mu, _)| *mu != mu_shifted) {
+            *shifted = Some((mu_shifted, Boundary::default()));
+        }
         let mut newly = Vec::new();
         for (ref_idx, (&high, &s2)) in latched.iter().zip(sigma2_d).enumerate() {
             if high {
@@ -175,7 +200,12 @@ impl Confidence {
                     beta,
                 });
             }
-            if boundary.decide(alpha, beta, p.mu_c, p.gamma_c) {
+            let high = match shifted {
+                // `P(π < μ_c | data) = I_{μ'_c}(α, β)`: Eq. 12 at `μ'_c`, with its own cache.
+                Some((mu, cache)) if !rates.is_zero() => cache.decide(alpha, beta, *mu, p.gamma_c),
+                _ => boundary.decide(alpha, beta, p.mu_c, p.gamma_c),
+            };
+            if high {
                 newly.push(ref_idx);
             }
         }
@@ -224,7 +254,8 @@ impl Confidence {
 }
 
 /// Eq. 12 per reference sample without any latch: `I_{μ_c}(α, β) > γ_c` for the
-/// posterior of [`posterior`](crate::posterior). The decision is exactly statrs'
+/// posterior of [`posterior`](crate::posterior), or with non-zero operator error rates
+/// `P(π < μ_c | data) > γ_c` ([`Confidence::update`]). The decision is exactly statrs'
 /// (a Cantelli bound only skips evaluations it provably cannot change).
 ///
 /// # Errors
@@ -234,9 +265,34 @@ pub fn evaluate(
     obs: &Observations,
     params: &ConfidenceParams,
 ) -> Result<Vec<bool>> {
+    let rates = crate::estimate_error_rates(obs, params)?;
     Ok(crate::posterior(sigma2_d, obs, params)?
         .iter()
-        .map(|b| decide(b.alpha(), b.beta(), params.mu_c, params.gamma_c))
+        .map(|b| {
+            if rates.is_zero() {
+                decide(b.alpha(), b.beta(), params.mu_c, params.gamma_c)
+            } else {
+                decide_with_rates(b.alpha(), b.beta(), &rates, params.mu_c, params.gamma_c)
+            }
+        })
+        .collect())
+}
+
+/// `P(π < μ_c | data)` per reference sample: the posterior probability that the need for
+/// corrections is below `μ_c`, which Eq. 12 compares with `γ_c` (with zero error rates
+/// `I_{μ_c}(α, β)`; [`Confidence::update`]). `NaN` where statrs cannot evaluate it.
+///
+/// # Errors
+/// As [`posterior`](crate::posterior).
+pub fn prob_need_below_mu_c(
+    sigma2_d: &[f64],
+    obs: &Observations,
+    params: &ConfidenceParams,
+) -> Result<Vec<f64>> {
+    let rates = crate::estimate_error_rates(obs, params)?;
+    Ok(crate::posterior(sigma2_d, obs, params)?
+        .iter()
+        .map(|b| prob_need_below(b.alpha(), b.beta(), &rates, params.mu_c).unwrap_or(f64::NAN))
         .collect())
 }
 
@@ -246,7 +302,7 @@ mod tests {
 
     #[test]
     fn latch_holds_when_variance_increases() {
-        let p = ConfidenceParams::default();
+        let p = ConfidenceParams::paper();
         // Near-zero variance: high from the prior alone.
         let mut conf = Confidence::from_prior(&[0.0, 0.0], p.clone()).unwrap();
         assert_eq!(conf.conf(), &[true, true]);
@@ -268,7 +324,7 @@ mod tests {
 
     #[test]
     fn errors_leave_state_unchanged_and_name_lengths() {
-        let p = ConfidenceParams::default();
+        let p = ConfidenceParams::paper();
         let mut conf = Confidence::new(3, p).unwrap();
         let obs = Observations::new(3).unwrap();
         let err = conf.update(&[0.0, 0.0], &obs).unwrap_err();
@@ -307,7 +363,7 @@ mod tests {
         );
         assert_eq!(conf.conf(), &[false, false, false]);
         assert_eq!(
-            Confidence::new(0, ConfidenceParams::default()),
+            Confidence::new(0, ConfidenceParams::paper()),
             Err(Error::EmptyReference)
         );
         let bad = ConfidenceParams {
@@ -325,7 +381,7 @@ mod tests {
 
     #[test]
     fn summaries() {
-        let p = ConfidenceParams::default();
+        let p = ConfidenceParams::paper();
         let conf = Confidence::from_parts(p, vec![true, false, false, true, false]).unwrap();
         assert_eq!(conf.n_high(), 2);
         assert_eq!(conf.high_share(), 0.4);

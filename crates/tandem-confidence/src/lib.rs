@@ -62,7 +62,8 @@
 //! use tandem_confidence::{Confidence, ConfidenceParams, Observations};
 //!
 //! let sigma2_d = [10.0]; // one reference sample with large demonstration variance
-//! let mut conf = Confidence::from_prior(&sigma2_d, ConfidenceParams::default())?;
+//! // The paper's model: every correction is evidence of need (no operator errors).
+//! let mut conf = Confidence::from_prior(&sigma2_d, ConfidenceParams::paper())?;
 //! let mut obs = Observations::new(1)?;
 //! let mut executions = 0;
 //! while !conf.conf()[0] {
@@ -87,11 +88,15 @@ mod confidence;
 mod error;
 mod observations;
 mod params;
+mod rates;
 mod runs;
 
 pub use beta::{BetaParams, posterior, prior};
-pub use confidence::{Confidence, evaluate};
+pub use confidence::{Confidence, evaluate, prob_need_below_mu_c};
 pub use error::{Error, Result};
-pub use observations::Observations;
+pub use observations::{MissEvidence, Observations};
 pub use params::ConfidenceParams;
+pub use rates::{
+    ErrorRates, MIN_OBSERVATIONS, RATE_PRIOR_SAMPLES, estimate_error_rates, prior_low_threshold,
+};
 pub use runs::{Run, low_regions, runs};

@@ -32,6 +32,69 @@ use crate::{Error, Result};
 pub struct Observations {
     corrections: Vec<f64>,
     supervised: Vec<f64>,
+    /// Evidence of missed corrections, summed over executions ([`MissEvidence`]).
+    miss: MissEvidence,
+}
+
+/// Evidence of the operator's misses, from the time structure of each execution's
+/// corrections: a needed correction lasts (a painted section, a slip of the tool), so a
+/// *stretch* of corrections with short gaps is a stretch of need, and its gaps are misses.
+///
+/// A stretch is a maximal run of supervised control samples of one execution that starts
+/// and ends corrected, whose uncorrected gaps are at most [`MissEvidence::MAX_GAP`] samples
+/// long, and that holds at least [`MissEvidence::MIN_CORRECTED`] corrected samples.
+/// Misses at a stretch's two ends cannot be told from its end, so `gap_samples /
+/// stretch_samples` slightly underestimates the miss rate (by about two samples per
+/// stretch of a hundred or more).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MissEvidence {
+    /// Uncorrected control samples inside stretches (counts).
+    pub gap_samples: f64,
+    /// Control samples of the stretches, gaps included (counts).
+    pub stretch_samples: f64,
+}
+
+impl MissEvidence {
+    /// Longest run of uncorrected samples inside a stretch (control samples).
+    pub const MAX_GAP: usize = 3;
+    /// Fewest corrected samples of a stretch (control samples; 0.2 s at 100 Hz).
+    pub const MIN_CORRECTED: usize = 20;
+
+    /// The stretches of one execution's supervised samples (`corrected[k]` in time order).
+    #[must_use]
+    pub fn of_execution(corrected: &[bool]) -> Self {
+        let mut total = Self::default();
+        // The open stretch: (corrected, gaps, samples) and the uncorrected run after it.
+        let mut open: Option<(usize, usize, usize)> = None;
+        let mut pending = 0_usize;
+        let close = |st: Option<(usize, usize, usize)>, total: &mut Self| {
+            if let Some((c, g, n)) = st {
+                if c >= Self::MIN_CORRECTED {
+                    total.gap_samples += g as f64;
+                    total.stretch_samples += n as f64;
+                }
+            }
+        };
+        for &c in corrected {
+            if !c {
+                pending += 1;
+                continue;
+            }
+            open = match open {
+                Some((nc, g, n)) if pending <= Self::MAX_GAP => {
+                    Some((nc + 1, g + pending, n + pending + 1))
+                }
+                other => {
+                    close(other, &mut total);
+                    Some((1, 0, 1))
+                }
+            };
+            pending = 0;
+        }
+        close(open, &mut total);
+        total
+    }
 }
 
 /// Unchecked serde form of [`Observations`].
@@ -40,12 +103,14 @@ pub struct Observations {
 struct ObservationsData {
     corrections: Vec<f64>,
     supervised: Vec<f64>,
+    #[serde(default)]
+    miss: MissEvidence,
 }
 
 impl TryFrom<ObservationsData> for Observations {
     type Error = Error;
     fn try_from(d: ObservationsData) -> Result<Self> {
-        Self::from_counts(d.corrections, d.supervised)
+        Self::from_counts(d.corrections, d.supervised)?.with_miss_evidence(d.miss)
     }
 }
 
@@ -61,7 +126,32 @@ impl Observations {
         Ok(Self {
             corrections: vec![0.0; n_ref],
             supervised: vec![0.0; n_ref],
+            miss: MissEvidence::default(),
         })
+    }
+
+    /// The same observations with `miss` as their evidence of misses (e.g. a saved state).
+    ///
+    /// # Errors
+    /// [`Error::BadCounts`] (with `ref_idx` 0) unless `0 ≤ gap_samples ≤ stretch_samples`,
+    /// both finite.
+    pub fn with_miss_evidence(mut self, miss: MissEvidence) -> Result<Self> {
+        let (g, n) = (miss.gap_samples, miss.stretch_samples);
+        if !(g.is_finite() && n.is_finite() && g >= 0.0 && g <= n) {
+            return Err(Error::BadCounts {
+                ref_idx: 0,
+                corrections: g,
+                supervised: n,
+            });
+        }
+        self.miss = miss;
+        Ok(self)
+    }
+
+    /// Evidence of missed corrections over every execution recorded ([`MissEvidence`]).
+    #[must_use]
+    pub fn miss_evidence(&self) -> MissEvidence {
+        self.miss
     }
 
     /// Observations from stored per-sample counts (e.g. a saved state).
@@ -91,6 +181,7 @@ impl Observations {
         Ok(Self {
             corrections,
             supervised,
+            miss: MissEvidence::default(),
         })
     }
 
@@ -134,6 +225,9 @@ impl Observations {
     /// is split linearly between the two neighbouring reference samples. Samples the robot
     /// ran unsupervised (high confidence) must not be passed: they carry no information.
     ///
+    /// The supervised samples must be in the execution's time order: their corrections also
+    /// add to the evidence of misses ([`MissEvidence::of_execution`]).
+    ///
     /// All inputs are checked before anything is added, so an error leaves `self`
     /// unchanged.
     ///
@@ -141,6 +235,50 @@ impl Observations {
     /// [`Error::LengthMismatch`] if the slices differ in length;
     /// [`Error::RefTimeOutOfRange`] naming the first non-finite or out-of-range time.
     pub fn record(&mut self, supervised_ref_times: &[f64], corrected: &[bool]) -> Result<()> {
+        self.record_with(supervised_ref_times, corrected, false)
+    }
+
+    /// [`record`](Self::record) with *one vote per execution*: the execution's mass at each
+    /// reference sample it touched is scaled to exactly one unit (corrections in
+    /// proportion), so that one execution passing a reference sample is one observation of
+    /// the operator there, however many control samples it spent on it.
+    ///
+    /// Why: the operator's decision at a reference sample holds for every control sample
+    /// the robot spends there — an unneeded correction is an episode of the joystick held
+    /// for a while, a needed one lasts the painted section — so where the robot moves
+    /// slower than the reference (and a correction slows it further) the paper's split
+    /// counts one decision several times, and a single slip weighs like several
+    /// independent ones. Where it moves faster, one control sample spans several reference
+    /// samples and the split gives each a fraction of an observation, although the
+    /// operator watched the robot pass each of them: such samples needed several times
+    /// more executions to become high-confidence (measured in the study: the last
+    /// low-confidence islands at the tool's lift-off after pass 1). Executions are
+    /// independent of each other; control samples of one execution at one reference sample
+    /// are not.
+    ///
+    /// ```
+    /// use tandem_confidence::Observations;
+    /// let mut obs = Observations::new(4)?;
+    /// // Four control samples on reference sample 1 (a slow robot), two of them corrected;
+    /// // then one at 2.5 (a fast robot), corrected.
+    /// obs.record_votes(&[1.0, 1.0, 1.0, 1.0, 2.5], &[true, true, false, false, true])?;
+    /// assert_eq!(obs.supervised(), &[0.0, 1.0, 1.0, 1.0]);
+    /// assert_eq!(obs.corrections(), &[0.0, 0.5, 1.0, 1.0]);
+    /// # Ok::<(), tandem_confidence::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`record`](Self::record).
+    pub fn record_votes(&mut self, supervised_ref_times: &[f64], corrected: &[bool]) -> Result<()> {
+        self.record_with(supervised_ref_times, corrected, true)
+    }
+
+    fn record_with(
+        &mut self,
+        supervised_ref_times: &[f64],
+        corrected: &[bool],
+        one_vote: bool,
+    ) -> Result<()> {
         check_len(
             "supervised_ref_times",
             supervised_ref_times.len(),
@@ -159,21 +297,54 @@ impl Observations {
                 });
             }
         }
-        for (&t, &c) in supervised_ref_times.iter().zip(corrected) {
-            let (lo, w) = split(t, n_ref);
-            let w_lo = 1.0 - w;
-            self.supervised[lo] += w_lo;
-            if c {
-                self.corrections[lo] += w_lo;
-            }
-            if w > 0.0 {
-                self.supervised[lo + 1] += w;
-                if c {
-                    self.corrections[lo + 1] += w;
+        if one_vote {
+            // This execution's own counts, then one unit per sample it touched.
+            let (mut c_e, mut s_e) = (vec![0.0; n_ref], vec![0.0; n_ref]);
+            add_split(&mut c_e, &mut s_e, supervised_ref_times, corrected);
+            for ((c, s), (ce, se)) in self
+                .corrections
+                .iter_mut()
+                .zip(&mut self.supervised)
+                .zip(c_e.iter().zip(&s_e))
+            {
+                if *se > 0.0 {
+                    // ce ≤ se, so the vote keeps 0 ≤ c ≤ s.
+                    *s += 1.0;
+                    *c += (ce / se).min(1.0);
                 }
             }
+        } else {
+            add_split(
+                &mut self.corrections,
+                &mut self.supervised,
+                supervised_ref_times,
+                corrected,
+            );
         }
+        let miss = MissEvidence::of_execution(corrected);
+        self.miss.gap_samples += miss.gap_samples;
+        self.miss.stretch_samples += miss.stretch_samples;
         Ok(())
+    }
+}
+
+/// Adds checked observations to `corrections` and `supervised`, each split linearly
+/// between its two neighbouring reference samples.
+fn add_split(corrections: &mut [f64], supervised: &mut [f64], times: &[f64], corrected: &[bool]) {
+    let n_ref = supervised.len();
+    for (&t, &c) in times.iter().zip(corrected) {
+        let (lo, w) = split(t, n_ref);
+        let w_lo = 1.0 - w;
+        supervised[lo] += w_lo;
+        if c {
+            corrections[lo] += w_lo;
+        }
+        if w > 0.0 {
+            supervised[lo + 1] += w;
+            if c {
+                corrections[lo + 1] += w;
+            }
+        }
     }
 }
 
@@ -275,6 +446,42 @@ mod tests {
             Observations::from_counts(vec![], vec![]),
             Err(Error::EmptyReference)
         );
+    }
+
+    #[test]
+    fn gaps_inside_correction_stretches_are_misses() {
+        let run = |pattern: &str| {
+            let flags: Vec<bool> = pattern.chars().map(|c| c == '#').collect();
+            let e = MissEvidence::of_execution(&flags);
+            (e.gap_samples, e.stretch_samples)
+        };
+        let c20 = "#".repeat(20);
+        // 20 corrected samples in a row: a stretch without misses.
+        assert_eq!(run(&format!("..{c20}..")), (0.0, 20.0));
+        // Gaps of 1 and 3 inside are misses; a gap of 4 ends the stretch.
+        assert_eq!(run(&format!("{c20}.{c20}...#")), (4.0, 45.0));
+        assert_eq!(run(&format!("{c20}....{c20}")), (0.0, 40.0));
+        // Too few corrected samples: isolated (unneeded) corrections are no stretch.
+        assert_eq!(run("#.#.#.#.#.#.#.#.#.#"), (0.0, 0.0));
+        assert_eq!(run(""), (0.0, 0.0));
+        // Recorded executions add up; a stretch never spans two executions.
+        let mut obs = Observations::new(2).unwrap();
+        let flags: Vec<bool> = format!("{c20}.#").chars().map(|c| c == '#').collect();
+        let times = vec![0.5; flags.len()];
+        obs.record(&times, &flags).unwrap();
+        obs.record(&times, &flags).unwrap();
+        assert_eq!(
+            obs.miss_evidence(),
+            MissEvidence {
+                gap_samples: 2.0,
+                stretch_samples: 44.0
+            }
+        );
+        let bad = MissEvidence {
+            gap_samples: 2.0,
+            stretch_samples: 1.0,
+        };
+        assert!(obs.clone().with_miss_evidence(bad).is_err());
     }
 
     #[test]

@@ -54,6 +54,29 @@ pub struct ConfidenceParams {
     /// `γ_c` (Eq. 12): posterior mass `P(p_{c|t} < μ_c)` that must be exceeded for high
     /// confidence. Must be in (0, 1). Default: 0.95.
     pub gamma_c: f64,
+    /// `f`, the operator's false-correction rate: the probability that a supervised sample
+    /// that needs no correction is corrected anyway (per control sample). With
+    /// [`estimate_error_rates`](Self::estimate_error_rates) it is the prior mean (and the
+    /// value without data) of the estimate, otherwise the rate used as is. Must be in
+    /// `[0, 0.5)`. Default: 0.01 (§III's simulated operator). The paper's model: 0.
+    pub false_correction_rate: f64,
+    /// `m`, the operator's miss rate: the probability that a needed correction is not given
+    /// (per control sample). As for `false_correction_rate`. Must be in `[0, 0.5)`.
+    /// Default: 0.01 (§III). The paper's model: 0.
+    pub miss_rate: f64,
+    /// Whether `f` and `m` are estimated from the recorded executions at every update
+    /// ([`crate::estimate_error_rates`]: `f` by EM over every sample's latent "needs
+    /// help", `m` from the gaps inside correction stretches) instead of used as given.
+    /// Default: `true`. The paper's model: `false` (with both rates 0 it is exactly
+    /// Eq. 8–12; docs/decisions.md, "The operator's error rates in the confidence").
+    pub estimate_error_rates: bool,
+    /// Whether one execution counts exactly once per reference sample it passed
+    /// ([`Observations::record_votes`](crate::Observations::record_votes)): the control
+    /// samples one execution spends on a reference sample share one decision of the
+    /// operator. Read by whoever records the observations (the planner). Default: `true`.
+    /// The paper's model: `false` (every control sample one observation, Eq. 9 with the
+    /// fractional split).
+    pub one_vote_per_execution: bool,
 }
 
 impl Default for ConfidenceParams {
@@ -64,11 +87,39 @@ impl Default for ConfidenceParams {
             epsilon: 1e-6,
             mu_c: 0.05,
             gamma_c: 0.95,
+            false_correction_rate: 0.01,
+            miss_rate: 0.01,
+            estimate_error_rates: true,
+            one_vote_per_execution: true,
         }
     }
 }
 
 impl ConfidenceParams {
+    /// The paper's model (Eq. 8–12): the defaults with both error rates 0, nothing
+    /// estimated and every control sample one observation, so that every recorded
+    /// correction counts as evidence of need.
+    #[must_use]
+    pub fn paper() -> Self {
+        Self {
+            false_correction_rate: 0.0,
+            miss_rate: 0.0,
+            estimate_error_rates: false,
+            one_vote_per_execution: false,
+            ..Self::default()
+        }
+    }
+
+    /// Whether this is the paper's model: both error rates 0, not estimated, every control
+    /// sample an observation (then the decision is exactly Eq. 12).
+    #[must_use]
+    pub fn is_paper_model(&self) -> bool {
+        self.false_correction_rate == 0.0
+            && self.miss_rate == 0.0
+            && !self.estimate_error_rates
+            && !self.one_vote_per_execution
+    }
+
     /// Checks every field against its documented domain.
     ///
     /// # Errors
@@ -102,6 +153,17 @@ impl ConfidenceParams {
         if !(self.gamma_c > 0.0 && self.gamma_c < 1.0) {
             return bad("gamma_c", self.gamma_c, "must be in (0, 1)");
         }
+        if !(0.0..0.5).contains(&self.false_correction_rate) {
+            return bad(
+                "false_correction_rate",
+                self.false_correction_rate,
+                "must be in [0, 0.5): an operator who corrects at random half the time gives \
+                 no evidence",
+            );
+        }
+        if !(0.0..0.5).contains(&self.miss_rate) {
+            return bad("miss_rate", self.miss_rate, "must be in [0, 0.5)");
+        }
         Ok(())
     }
 }
@@ -124,7 +186,29 @@ mod tests {
             (p.gamma_p, p.sigma2_max, p.epsilon, p.mu_c, p.gamma_c),
             (10.0, 0.05, 1e-6, 0.05, 0.95)
         );
+        assert_eq!(
+            (
+                p.false_correction_rate,
+                p.miss_rate,
+                p.estimate_error_rates,
+                p.one_vote_per_execution
+            ),
+            (0.01, 0.01, true, true)
+        );
         p.validate().unwrap();
+        assert!(!p.is_paper_model());
+        let paper = ConfidenceParams::paper();
+        assert!(paper.is_paper_model());
+        assert_eq!(
+            ConfidenceParams {
+                false_correction_rate: 0.0,
+                miss_rate: 0.0,
+                estimate_error_rates: false,
+                one_vote_per_execution: false,
+                ..p
+            },
+            paper
+        );
     }
 
     #[test]
@@ -141,6 +225,20 @@ mod tests {
                     ..d()
                 }),
                 "sigma2_max"
+            );
+        }
+        for v in [0.5, 1.0, -0.01, f64::NAN, f64::INFINITY] {
+            let f = ConfidenceParams {
+                false_correction_rate: v,
+                ..d()
+            };
+            assert_eq!(name_of(&f), "false_correction_rate");
+            assert_eq!(
+                name_of(&ConfidenceParams {
+                    miss_rate: v,
+                    ..d()
+                }),
+                "miss_rate"
             );
         }
         for v in [0.0, 1.0, -0.5, 1.5, f64::NAN] {

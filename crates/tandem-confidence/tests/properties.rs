@@ -5,7 +5,9 @@
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tandem_confidence::{Confidence, ConfidenceParams, Observations, posterior};
+use tandem_confidence::{
+    Confidence, ConfidenceParams, Observations, estimate_error_rates, evaluate, posterior,
+};
 
 /// One execution over `n_ref` samples: supervised times (fractional) and corrections.
 fn execution(rng: &mut ChaCha8Rng, n_ref: usize, p_corr: f64) -> (Vec<f64>, Vec<bool>) {
@@ -53,7 +55,7 @@ proptest! {
         seed in any::<u64>(),
     ) {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let params = ConfidenceParams::default();
+        let params = ConfidenceParams::paper();
         let mut conf = Confidence::new(n_ref, params.clone()).unwrap();
         let mut obs = Observations::new(n_ref).unwrap();
         for _ in 0..steps {
@@ -81,6 +83,51 @@ proptest! {
                 count += usize::from(!before[n] && fresh);
             }
             prop_assert_eq!(newly, count);
+        }
+    }
+
+    #[test]
+    fn with_error_rates_the_latch_is_monotone_and_decisions_are_eq_12_at_the_shifted_mu(
+        n_ref in 1_usize..10,
+        steps in 1_usize..8,
+        p_corr in prop_oneof![Just(0.0), Just(0.01), Just(0.05), Just(0.3)],
+        votes in any::<bool>(),
+        seed in any::<u64>(),
+    ) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let params = ConfidenceParams::default();
+        let mut conf = Confidence::new(n_ref, params.clone()).unwrap();
+        let mut obs = Observations::new(n_ref).unwrap();
+        for _ in 0..steps {
+            let sigma2_d: Vec<f64> = (0..n_ref)
+                .map(|_| match rng.random_range(0..3) {
+                    0 => 0.0,
+                    1 => rng.random_range(0.0..0.2),
+                    _ => rng.random_range(0.0..20.0),
+                })
+                .collect();
+            for _ in 0..rng.random_range(0..40) {
+                let (times, corrected) = execution(&mut rng, n_ref, p_corr);
+                if votes {
+                    obs.record_votes(&times, &corrected).unwrap();
+                } else {
+                    obs.record(&times, &corrected).unwrap();
+                }
+            }
+            let rates = estimate_error_rates(&obs, &params).unwrap();
+            prop_assert!((0.0..0.5).contains(&rates.false_correction_rate));
+            prop_assert!((0.0..0.5).contains(&rates.miss_rate));
+            // Eq. 12 with mu_c replaced by mu'_c = f + (1 - f - m) mu_c, evaluated directly.
+            let shifted = ConfidenceParams { mu_c: rates.shifted_mu_c(params.mu_c), ..ConfidenceParams::paper() };
+            let before = conf.conf().to_vec();
+            conf.update(&sigma2_d, &obs).unwrap();
+            let post = posterior(&sigma2_d, &obs, &params).unwrap();
+            let unlatched = evaluate(&sigma2_d, &obs, &params).unwrap();
+            for n in 0..n_ref {
+                let fresh = post[n].is_high_confidence(&shifted).unwrap();
+                prop_assert_eq!(unlatched[n], fresh, "sample {}", n);
+                prop_assert_eq!(conf.conf()[n], before[n] || fresh, "sample {}", n);
+            }
         }
     }
 }

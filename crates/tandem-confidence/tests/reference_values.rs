@@ -20,7 +20,7 @@ fn assert_rel(got: f64, want: f64, rel: f64, what: &str) {
 
 #[test]
 fn prior_matches_mpmath() {
-    let p = ConfidenceParams::default();
+    let p = ConfidenceParams::paper();
     // (sigma2_d, alpha0, beta0, mean, variance)
     let cases = [
         (
@@ -100,7 +100,7 @@ fn incomplete_beta_matches_mpmath() {
 /// becomes high-confidence, through the public state machine.
 fn executions_to_high(s2: f64) -> usize {
     let sigma2_d = [s2];
-    let mut conf = Confidence::from_prior(&sigma2_d, ConfidenceParams::default()).unwrap();
+    let mut conf = Confidence::from_prior(&sigma2_d, ConfidenceParams::paper()).unwrap();
     let mut obs = Observations::new(1).unwrap();
     let mut n = 0;
     while !conf.conf()[0] {
@@ -124,7 +124,7 @@ fn conf_flips_where_the_cdf_crosses_gamma_c() {
         (0.5, 91, 0.949_874_055_353_369_2, 0.951_953_945_922_395),
         (10.0, 90, 0.947_863_597_068_323, 0.950_024_204_757_383_5),
     ];
-    let p = ConfidenceParams::default();
+    let p = ConfidenceParams::paper();
     for (s2, n, before, after) in cases {
         assert_eq!(executions_to_high(s2), n, "sigma2_d = {s2}");
         let b0 = prior(&[s2], &p).unwrap()[0];
@@ -152,7 +152,7 @@ fn conf_flips_where_the_cdf_crosses_gamma_c() {
 fn corrections_delay_confidence() {
     // mpmath: with one correction (Beta(3, 2 + m)) the crossing is at m = 120
     // (I = 0.94857918021338741 at 119, 0.95047022232131288 at 120); two: m = 148.
-    let p = ConfidenceParams::default();
+    let p = ConfidenceParams::paper();
     for (corrections, m, before, after) in [
         (1.0, 120.0, 0.948_579_180_213_387_4, 0.950_470_222_321_312_8),
         (2.0, 148.0, 0.948_835_481_928_303_9, 0.950_555_201_956_979_7),
@@ -168,7 +168,7 @@ fn corrections_delay_confidence() {
 
 #[test]
 fn posterior_after_known_observation_sequence() {
-    let p = ConfidenceParams::default();
+    let p = ConfidenceParams::paper();
     let sigma2_d = [10.0, 10.0, 10.0, 10.0];
     let mut obs = Observations::new(4).unwrap();
     // Execution 1 supervises reference times 0.5 (corrected) and 2.25 (not).

@@ -7,7 +7,9 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use tandem_confidence::{Confidence, ConfidenceParams, Observations};
+use tandem_confidence::{
+    Confidence, ConfidenceParams, ErrorRates, Observations, estimate_error_rates,
+};
 use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
@@ -231,21 +233,104 @@ struct PlannerState {
     rounds: Vec<u64>,
 }
 
-/// [`PlannerState`] as state format version 5 wrote it: the same without the round
+/// [`ConfidenceParams`] as state formats 4 to 6 wrote them: the paper's model, without the
+/// operator's error rates.
+#[derive(Deserialize)]
+struct ConfidenceParamsV6 {
+    gamma_p: f64,
+    sigma2_max: f64,
+    epsilon: f64,
+    mu_c: f64,
+    gamma_c: f64,
+}
+
+impl From<ConfidenceParamsV6> for ConfidenceParams {
+    /// The saved parameters with both error rates 0 and not estimated: the model the file's
+    /// confidence was decided with.
+    fn from(v6: ConfidenceParamsV6) -> Self {
+        ConfidenceParams {
+            gamma_p: v6.gamma_p,
+            sigma2_max: v6.sigma2_max,
+            epsilon: v6.epsilon,
+            mu_c: v6.mu_c,
+            gamma_c: v6.gamma_c,
+            ..ConfidenceParams::paper()
+        }
+    }
+}
+
+/// [`PlannerParams`] as state formats 4 to 6 wrote them.
+#[derive(Deserialize)]
+struct PlannerParamsV6 {
+    fit: FitParams,
+    confidence: ConfidenceParamsV6,
+    sampler: SamplerParams,
+}
+
+/// [`Confidence`] as state formats 4 to 6 wrote it.
+#[derive(Deserialize)]
+struct ConfidenceV6 {
+    params: ConfidenceParamsV6,
+    high: Vec<bool>,
+}
+
+/// [`Observations`] as state formats 4 to 6 wrote them (no evidence of misses).
+#[derive(Deserialize)]
+struct ObservationsV6 {
+    corrections: Vec<f64>,
+    supervised: Vec<f64>,
+}
+
+/// [`PlannerState`] as state format version 6 wrote it: the parts above in the paper's
+/// model.
+#[derive(Deserialize)]
+struct PlannerStateV6 {
+    params: PlannerParamsV6,
+    model: TaskModel,
+    observations: ObservationsV6,
+    confidence: ConfidenceV6,
+    outcome: Outcome,
+    pairs_recorded: usize,
+    rounds: Vec<u64>,
+}
+
+impl TryFrom<PlannerStateV6> for PlannerState {
+    type Error = Error;
+    fn try_from(v6: PlannerStateV6) -> Result<Self> {
+        Ok(PlannerState {
+            params: PlannerParams {
+                fit: v6.params.fit,
+                confidence: v6.params.confidence.into(),
+                sampler: v6.params.sampler,
+            },
+            model: v6.model,
+            observations: Observations::from_counts(
+                v6.observations.corrections,
+                v6.observations.supervised,
+            )?,
+            confidence: Confidence::from_parts(v6.confidence.params.into(), v6.confidence.high)?,
+            outcome: v6.outcome,
+            pairs_recorded: v6.pairs_recorded,
+            rounds: v6.rounds,
+        })
+    }
+}
+
+/// [`PlannerState`] as state format version 5 wrote it: version 6 without the round
 /// fingerprints.
 #[derive(Deserialize)]
 struct PlannerStateV5 {
-    params: PlannerParams,
+    params: PlannerParamsV6,
     model: TaskModel,
-    observations: Observations,
-    confidence: Confidence,
+    observations: ObservationsV6,
+    confidence: ConfidenceV6,
     outcome: Outcome,
     pairs_recorded: usize,
 }
 
-impl From<PlannerStateV5> for PlannerState {
+impl From<PlannerStateV5> for PlannerStateV6 {
     fn from(v5: PlannerStateV5) -> Self {
-        PlannerState {
+        PlannerStateV6 {
             params: v5.params,
             model: v5.model,
             observations: v5.observations,
@@ -257,14 +342,14 @@ impl From<PlannerStateV5> for PlannerState {
     }
 }
 
-/// [`PlannerState`] as state format version 4 wrote it: the same but for the two-robot
+/// [`PlannerState`] as state format version 4 wrote it: version 5 but for the two-robot
 /// schedule ([`ScheduleV4`]).
 #[derive(Deserialize)]
 struct PlannerStateV4 {
-    params: PlannerParams,
+    params: PlannerParamsV6,
     model: TaskModel,
-    observations: Observations,
-    confidence: Confidence,
+    observations: ObservationsV6,
+    confidence: ConfidenceV6,
     outcome: OutcomeV4,
     pairs_recorded: usize,
 }
@@ -290,7 +375,7 @@ struct ScheduleV4 {
     tick_s: f64,
 }
 
-impl From<PlannerStateV4> for PlannerState {
+impl From<PlannerStateV4> for PlannerStateV6 {
     fn from(v4: PlannerStateV4) -> Self {
         let OutcomeV4 {
             schedule,
@@ -301,7 +386,7 @@ impl From<PlannerStateV4> for PlannerState {
             bound_is_optimum,
             gap,
         } = v4.outcome;
-        PlannerState {
+        PlannerStateV6 {
             params: v4.params,
             model: v4.model,
             observations: v4.observations,
@@ -550,7 +635,11 @@ impl Planner {
         let mut observations = self.observations.clone();
         for e in &records {
             let (times, corrected) = e.observations()?;
-            observations.record(&times, &corrected)?;
+            if self.params.confidence.one_vote_per_execution {
+                observations.record_votes(&times, &corrected)?;
+            } else {
+                observations.record(&times, &corrected)?;
+            }
         }
         let mut confidence = self.confidence.clone();
         let newly_high = confidence.update(model.sigma2_d(), &observations)?;
@@ -692,6 +781,19 @@ impl Planner {
         &self.observations
     }
 
+    /// The operator's error rates the confidence decides with: estimated from the
+    /// observations when `params().confidence.estimate_error_rates`, else the configured
+    /// ones (`tandem_confidence::estimate_error_rates`; probabilities per control sample).
+    ///
+    /// # Errors
+    /// The confidence crate's error for invalid parameters (a loaded planner has valid ones).
+    pub fn error_rates(&self) -> Result<ErrorRates> {
+        Ok(estimate_error_rates(
+            &self.observations,
+            &self.params.confidence,
+        )?)
+    }
+
     /// The latched confidence (`conf()[n]`: reference sample `n` is high-confidence).
     pub fn confidence(&self) -> &Confidence {
         &self.confidence
@@ -763,7 +865,9 @@ impl Planner {
     /// Loads a planner saved by [`Planner::save`], of the current state format or an older one
     /// this build still reads (version 4: a two-robot schedule with one offset, converted to
     /// `offsets_s = [offset_s]`; versions 4 and 5 have no round fingerprints, so the rounds
-    /// they hold are not checked for repeats; saving writes the current version). Reading
+    /// they hold are not checked for repeats; versions 4 to 6 load with the paper's
+    /// confidence model, `ConfidenceParams::paper()` with their own `γ_p`, `σ²_MAX`, `ε`,
+    /// `μ_c`, `γ_c`, the model they were decided with; saving writes the current version). Reading
     /// takes no lock (saves are atomic renames); the planner remembers the file's content, so
     /// that saving into it again refuses to overwrite what another process saved meanwhile.
     ///
@@ -774,9 +878,16 @@ impl Planner {
         let path = path.as_ref();
         let bytes = state::read(path)?;
         let (version, payload) = state::checked_payload(&bytes, path)?;
+        let old = |v6: PlannerStateV6| {
+            PlannerState::try_from(v6).map_err(|e| Error::Corrupt {
+                path: path.to_path_buf(),
+                why: e.to_string(),
+            })
+        };
         let st: PlannerState = match version {
-            4 => state::decode_payload::<PlannerStateV4>(payload, path)?.into(),
-            5 => state::decode_payload::<PlannerStateV5>(payload, path)?.into(),
+            4 => old(state::decode_payload::<PlannerStateV4>(payload, path)?.into())?,
+            5 => old(state::decode_payload::<PlannerStateV5>(payload, path)?.into())?,
+            6 => old(state::decode_payload::<PlannerStateV6>(payload, path)?)?,
             _ => state::decode_payload(payload, path)?,
         };
         let mut planner = Self::from_state(st).map_err(|e| Error::Corrupt {

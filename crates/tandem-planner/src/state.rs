@@ -88,7 +88,13 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 /// - 6: the planner keeps a fingerprint of every round it recorded, so that the same round
 ///   recorded twice is refused. Version 4 and 5 files still load, with no fingerprints for
 ///   the rounds they hold.
-pub const FORMAT_VERSION: u32 = 6;
+/// - 7: the confidence parameters gained the operator's error rates
+///   (`false_correction_rate`, `miss_rate`, `estimate_error_rates`) and
+///   `one_vote_per_execution`, and the observations
+///   their evidence of misses (`MissEvidence`). Version 4 to 6 files still load, with the
+///   paper's model (`ConfidenceParams::paper()`: the decisions they were saved with) and no
+///   evidence of misses.
+pub const FORMAT_VERSION: u32 = 7;
 
 /// The oldest state format version this build reads (converting it on load).
 pub const OLDEST_READABLE_VERSION: u32 = 4;
@@ -599,7 +605,7 @@ mod tests {
     fn header_layout_is_as_documented() {
         let bytes = encode(&payload(4)).unwrap();
         assert_eq!(&bytes[..8], b"TANDEMST");
-        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 6);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 7);
         let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
         assert_eq!(len as usize, bytes.len() - HEADER_LEN);
         let crc = u32::from_le_bytes(bytes[20..24].try_into().unwrap());
@@ -684,18 +690,18 @@ mod tests {
     #[test]
     fn other_version_is_rejected_with_both_numbers() {
         let mut bytes = encode(&payload(3)).unwrap();
-        bytes[8..12].copy_from_slice(&7u32.to_le_bytes());
+        bytes[8..12].copy_from_slice(&8u32.to_le_bytes());
         let err = decode::<Payload>(&bytes, Path::new("v.tandem")).unwrap_err();
         assert!(matches!(
             err,
             Error::UnsupportedVersion {
-                found: 7,
+                found: 8,
                 expected: FORMAT_VERSION,
                 ..
             }
         ));
         let msg = err.to_string();
-        assert!(msg.contains("v.tandem") && msg.contains('7') && msg.contains("4 to 6"));
+        assert!(msg.contains("v.tandem") && msg.contains('8') && msg.contains("4 to 7"));
     }
 
     #[test]

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use tandem_confidence::Confidence;
+use tandem_confidence::{Confidence, ConfidenceParams, MissEvidence};
 use tandem_lfd::{Demonstration, TaskModel};
 use tandem_planner::state::{FORMAT_VERSION, OLDEST_READABLE_VERSION};
 use tandem_planner::{Error, Planner, PlannerParams};
@@ -83,8 +83,22 @@ fn the_golden_state_file_loads_with_the_values_of_its_inputs() {
         flag_rows("pair_1_robot_1.corr.csv", "1,1") + flag_rows("pair_1_robot_2.corr.csv", "1,1");
     assert_eq!((supervised, corrected), (84, 33));
     let obs = p.observations();
-    assert!((obs.total_supervised() - supervised as f64).abs() < 1e-9);
-    assert!((obs.total_corrections() - corrected as f64).abs() < 1e-9);
+    // With one vote per execution (the default) each of the two executions adds exactly one
+    // unit to every reference sample it touched (all 40: every sample was supervised before
+    // the update); the paper's model adds one unit per row (the version 6 file of the same
+    // inputs holds exactly 84 and 33).
+    assert!(p.params().confidence.one_vote_per_execution);
+    assert!(obs.supervised().iter().all(|&s| s == 2.0));
+    assert!(obs.total_corrections() < corrected as f64);
+    let paper = Planner::load(v6_path()).unwrap();
+    let paper_obs = paper.observations();
+    assert!((paper_obs.total_supervised() - supervised as f64).abs() < 1e-9);
+    assert!((paper_obs.total_corrections() - corrected as f64).abs() < 1e-9);
+    // The share of corrections per sample is the paper's split within each execution, so a
+    // sample is uncorrected with votes exactly where it is uncorrected in the paper's counts.
+    for (c, pc) in obs.corrections().iter().zip(paper_obs.corrections()) {
+        assert_eq!(*c == 0.0, *pc == 0.0);
+    }
 
     // The confidence is the prior of the three demonstrations, updated once with the new
     // model's variance and the observations (Eq. 9–12, latched).
@@ -134,8 +148,8 @@ fn a_version_4_file_loads_as_the_same_two_robot_schedule() {
     let bytes = std::fs::read(v4_path()).unwrap();
     assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 4);
     let old = Planner::load(v4_path()).unwrap();
-    let new = Planner::load(golden_path()).unwrap();
-    // The same planner: the current golden file is the same inputs written as version 6.
+    let new = Planner::load(v6_path()).unwrap();
+    // The same planner: the version 6 file is the same inputs written as version 6.
     assert_eq!(old.params(), new.params());
     assert_eq!(old.model().mean(), new.model().mean());
     assert_eq!(old.model().count(), new.model().count());
@@ -156,7 +170,7 @@ fn a_version_4_file_loads_as_the_same_two_robot_schedule() {
         std::fs::read(&again).unwrap() == std::fs::read(&v5_again).unwrap(),
         "a version 4 file saved again is not the version 5 file saved again"
     );
-    // A version 4 header on a version 5 payload does not decode: a clear error, no panic.
+    // A version 4 header on a version 7 payload does not decode: a clear error, no panic.
     let mut wrong = std::fs::read(golden_path()).unwrap();
     wrong[8..12].copy_from_slice(&4u32.to_le_bytes());
     let path = dir.join("wrong.tandem");
@@ -178,15 +192,15 @@ fn a_version_5_file_loads_as_the_same_planner_without_round_fingerprints() {
     let v5 = std::fs::read(v5_path()).unwrap();
     assert_eq!(u32::from_le_bytes(v5[8..12].try_into().unwrap()), 5);
     let old = Planner::load(v5_path()).unwrap();
-    let new = Planner::load(golden_path()).unwrap();
+    let new = Planner::load(v6_path()).unwrap();
     assert_eq!(old.params(), new.params());
     assert_eq!(old.model().mean(), new.model().mean());
     assert_eq!(old.confidence(), new.confidence());
     assert_eq!(old.outcome(), new.outcome());
     assert_eq!(old.rounds_recorded(), new.rounds_recorded());
-    // Version 6 only appends the fingerprints to version 5's payload: the golden payload
+    // Version 6 only appends the fingerprints to version 5's payload: the version 6 payload
     // starts with the version 5 payload, then the list of one round fingerprint.
-    let golden = std::fs::read(golden_path()).unwrap();
+    let golden = std::fs::read(v6_path()).unwrap();
     let (v5_payload, v6_payload) = (&v5[24..], &golden[24..]);
     assert!(v6_payload.starts_with(v5_payload));
     assert_eq!(v6_payload[v5_payload.len()], 1, "one round fingerprint");
@@ -199,7 +213,67 @@ fn a_version_5_file_loads_as_the_same_planner_without_round_fingerprints() {
         u32::from_le_bytes(bytes[8..12].try_into().unwrap()),
         FORMAT_VERSION
     );
-    assert_eq!(&bytes[24..], [v5_payload, &[0]].concat().as_slice());
+    let again = Planner::load(&again).unwrap();
+    assert_eq!(again.params(), old.params());
+    assert_eq!(again.confidence(), old.confidence());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `tests/fixtures/example_v6.tandem`: the golden state file as format version 6 wrote it
+/// (the paper's confidence parameters, no evidence of misses), copied before the format
+/// became version 7.
+fn v6_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/example_v6.tandem")
+}
+
+#[test]
+fn a_version_6_file_loads_with_the_papers_confidence_model() {
+    let v6 = std::fs::read(v6_path()).unwrap();
+    assert_eq!(u32::from_le_bytes(v6[8..12].try_into().unwrap()), 6);
+    let old = Planner::load(v6_path()).unwrap();
+    let new = Planner::load(golden_path()).unwrap();
+    // The same inputs: the parameters differ only in the confidence's error rates, which a
+    // version 6 file did not have (it was decided with the paper's model and keeps it).
+    let paper = ConfidenceParams {
+        false_correction_rate: 0.0,
+        miss_rate: 0.0,
+        estimate_error_rates: false,
+        one_vote_per_execution: false,
+        ..new.params().confidence.clone()
+    };
+    assert_eq!(paper, ConfidenceParams::paper());
+    assert_eq!(old.params().confidence, paper);
+    assert_eq!(old.params().fit, new.params().fit);
+    assert_eq!(old.params().sampler, new.params().sampler);
+    assert_eq!(old.model().mean(), new.model().mean());
+    // The observations: the paper's one unit per control sample (the golden file holds one
+    // vote per execution, checked in the golden test).
+    assert!((old.observations().total_supervised() - 84.0).abs() < 1e-9);
+    assert_eq!(old.observations().miss_evidence(), MissEvidence::default());
+    assert_eq!(old.rounds_recorded(), new.rounds_recorded());
+    // Its confidence is the paper's decision on the same data, recomputed here.
+    let demos: Vec<Demonstration> = (0..3)
+        .map(|i| Demonstration::from_csv_path(examples(&format!("demo_{i}.csv")), None).unwrap())
+        .collect();
+    let fitted = TaskModel::fit(&demos, &old.params().fit).unwrap();
+    let mut conf = Confidence::from_prior(fitted.sigma2_d(), paper).unwrap();
+    conf.update(old.model().sigma2_d(), old.observations())
+        .unwrap();
+    assert_eq!(old.confidence(), &conf);
+    validate(old.problem(), old.schedule()).unwrap();
+    // Saved again, it is the current version and loads as the same planner.
+    let dir = tmp_dir("v6");
+    let again = dir.join("again.tandem");
+    old.save(&again).unwrap();
+    let bytes = std::fs::read(&again).unwrap();
+    assert_eq!(
+        u32::from_le_bytes(bytes[8..12].try_into().unwrap()),
+        FORMAT_VERSION
+    );
+    let back = Planner::load(&again).unwrap();
+    assert_eq!(back.params(), old.params());
+    assert_eq!(back.confidence(), old.confidence());
+    assert_eq!(back.outcome(), old.outcome());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

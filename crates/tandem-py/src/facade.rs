@@ -1,6 +1,8 @@
 //! Every item this crate uses from the `tandem` facade, in one place.
 
-pub(crate) use tandem::confidence::{BetaParams, Observations, posterior, prior};
+pub(crate) use tandem::confidence::{
+    BetaParams, Observations, posterior, prior, prior_low_threshold, prob_need_below_mu_c,
+};
 pub(crate) use tandem::lfd::{DEFAULT_DT_S, Demonstration, Execution, TaskModel, length_warnings};
 pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{

@@ -15,7 +15,7 @@ use crate::facade::{BagOptions, Recording, extend_bag_schema, is_bag, read_bag};
 use crate::facade::{
     BetaParams, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, Demonstration, Execution, ExecutionRecord,
     Observations, Planner, PlannerParams, RecordReport, StateLock, TaskModel, errors,
-    length_warnings, posterior, prior, reschedule_seed,
+    length_warnings, posterior, prior, prior_low_threshold, prob_need_below_mu_c, reschedule_seed,
 };
 use crate::params::{from_py, serialize_to_py};
 use crate::schedule::PyProblem;
@@ -997,20 +997,53 @@ impl PyConfidence {
         self.beta_column(py, true, BetaParams::beta)
     }
 
-    /// ``P(p_c|t < μ_c | z_t) = I_μc(α, β)`` per reference sample, the left side of Eq. 12
-    /// for the posterior, ``(T_ref,)``. A sample is newly high-confidence when it exceeds
-    /// ``γ_c``; latched samples stay high whatever it says now.
+    /// ``P(π < μ_c | data)`` per reference sample, the left side of Eq. 12 for the
+    /// posterior, ``(T_ref,)``: ``I_μ'c(α, β)`` at ``μ'_c = f + (1 − f − m)·μ_c`` with the
+    /// operator's error rates ``f``, ``m`` (``I_μc(α, β)``, the paper's, when both are 0).
+    /// A sample is newly high-confidence when it exceeds ``γ_c``; latched samples stay high
+    /// whatever it says now.
     #[getter]
     fn p_below_mu_c<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let betas = self.betas(py, true)?;
-        let mu_c = self.with(py, |p| p.confidence().params().mu_c)?;
-        let cdf = guard(|| {
-            betas
-                .iter()
-                .map(|b| Ok(b.cdf(mu_c)?))
-                .collect::<Result<Vec<f64>>>()
-        })?;
-        Ok(out_vector(py, cdf))
+        let values = self.with(py, |p| {
+            guard(|| {
+                Ok(prob_need_below_mu_c(
+                    p.model().sigma2_d(),
+                    p.observations(),
+                    p.confidence().params(),
+                )?)
+            })
+        })??;
+        Ok(out_vector(py, values))
+    }
+
+    /// The operator's error rates the confidence decides with, a dict
+    /// ``{"false_correction_rate": f, "miss_rate": m}`` (per control sample): estimated
+    /// from the executions when ``params["estimate_error_rates"]``, else as configured.
+    #[getter]
+    fn error_rates<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let rates = self.with(py, |p| guard(|| Ok(p.error_rates()?)))??;
+        serialize_to_py(py, &rates)
+    }
+
+    /// The ``σ²_D`` above which the prior alone is low-confidence, or ``None`` when even 0
+    /// is (dimensionless).
+    #[getter]
+    fn sigma2_d_prior_threshold(&self, py: Python<'_>) -> PyResult<Option<f64>> {
+        Ok(self.with(py, |p| {
+            guard(|| Ok(prior_low_threshold(p.confidence().params())?))
+        })??)
+    }
+
+    /// Every low-confidence region with why it is low and what would change it, a list of
+    /// dicts in reference order (the records of ``tandem inspect --json``'s
+    /// ``confidence.low_regions``): ``ref_start``, ``ref_end``, ``start_s``, ``end_s``,
+    /// ``cause`` (``"variance"`` or ``"corrections"``), ``sigma2_d_max``,
+    /// ``sigma2_d_prior_threshold``, ``channels`` (name, sigma2, share, range,
+    /// range_for_prior), ``supervised``, ``corrections``, ``expected_false_corrections``,
+    /// ``clean_executions_needed``.
+    fn explain_low_confidence<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let regions = self.with(py, |p| guard(|| Ok(p.explain_low_confidence()?)))??;
+        serialize_to_py(py, &regions)
     }
 
     /// The correction observations (Eq. 9's counts per reference sample).

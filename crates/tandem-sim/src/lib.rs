@@ -45,6 +45,7 @@
 mod error;
 pub mod study;
 pub mod task;
+pub mod truth;
 pub mod workcell;
 
 pub use error::{Error, Result};

@@ -63,9 +63,23 @@ fn record_pair_updates_everything_and_keeps_schedules_valid() {
     let count0 = p.model().count();
     let high0 = p.confidence().n_high();
     let records = pair(&p, 1);
+    // One vote per execution (the default): each execution adds one unit of observation
+    // mass on every reference sample its supervised control samples touched (⌊t⌋, and
+    // ⌊t⌋ + 1 when t is not whole: the fractional split of Eq. 9).
+    assert!(p.params().confidence.one_vote_per_execution);
     let n_supervised: usize = records
         .iter()
-        .map(|r| r.supervised.iter().filter(|s| **s).count())
+        .map(|r| {
+            let (times, _) = r.observations().unwrap();
+            let mut touched = std::collections::BTreeSet::new();
+            for t in times {
+                touched.insert(t.floor() as usize);
+                if t.fract() > 0.0 {
+                    touched.insert(t.floor() as usize + 1);
+                }
+            }
+            touched.len()
+        })
         .sum();
     let report = p.record_round(&records).unwrap();
     assert_eq!(p.rounds_recorded(), 1);
@@ -74,7 +88,7 @@ fn record_pair_updates_everything_and_keeps_schedules_valid() {
         count0 + 2,
         "both executions join the model (Eq. 21)"
     );
-    // Every supervised sample adds one unit of observation mass (Eq. 9).
+    assert!(n_supervised > 0);
     assert!((p.observations().total_supervised() - n_supervised as f64).abs() < 1e-6);
     assert_eq!(p.confidence().n_high(), high0 + report.newly_high);
     assert!(validate(p.problem(), p.schedule()).is_ok());

@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
+use tandem_confidence::ErrorRates;
 use tandem_schedule::Source;
 
 use super::config::StudyConfig;
@@ -77,6 +78,22 @@ pub struct IterationRecord {
     /// Planned start offsets `τ_2, …, τ_N` of robots 2..N (s, global time; `N − 1` values,
     /// `[offset_s]` for two robots).
     pub offsets_s: Vec<f64>,
+    /// Reference samples that truly need help ([`crate::truth::needs_help`]) but are
+    /// high-confidence in this iteration's confidence: sanded unsupervised.
+    #[serde(default)]
+    pub falsely_trusted_samples: usize,
+    /// Low-confidence runs of each robot's schedule, robot 1 first (the lengths of
+    /// [`IterationRecord::lc_intervals_s`]).
+    #[serde(default)]
+    pub lc_runs: Vec<usize>,
+    /// The operator's error rates this iteration's confidence was decided with (estimated
+    /// from the rounds recorded so far, or the configured ones; per control sample).
+    #[serde(default)]
+    pub error_rates: ErrorRates,
+    /// The simulated operator's actual rates over the rounds recorded so far
+    /// ([`OperatorTally::rates`](crate::truth::OperatorTally::rates)); `None` before any round.
+    #[serde(default)]
+    pub simulated_rates: Option<ErrorRates>,
 }
 
 /// Where a study iteration's schedule came from: the kind of [`tandem_schedule::Source`]
@@ -357,6 +374,10 @@ mod tests {
             gap: 1.0 / (t_total_s - 1.0),
             throughput_per_h: throughput_per_h(2, t_total_s),
             offsets_s: vec![1.0],
+            falsely_trusted_samples: 0,
+            lc_runs: vec![1, 2],
+            error_rates: ErrorRates::default(),
+            simulated_rates: None,
         }
     }
 

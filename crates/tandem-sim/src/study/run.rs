@@ -14,6 +14,7 @@ use super::config::StudyConfig;
 use super::inputs::StudyInputs;
 use super::record::{IterationRecord, PairStats, StudyResult, TrialResult, throughput_per_h};
 use crate::task::{self, Label, Workpiece};
+use crate::truth::{OperatorTally, falsely_trusted};
 use crate::workcell;
 use crate::{Error, Result};
 
@@ -59,7 +60,11 @@ pub struct Progress {
 }
 
 /// The record of the planner's current schedule (no pair run yet).
-fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
+fn iteration_record(
+    planner: &Planner,
+    labels: &[Label],
+    tally: &OperatorTally,
+) -> Result<IterationRecord> {
     let schedule = planner.schedule();
     let timeline = GlobalTimeline::new(planner.problem(), schedule)?;
     let lc_intervals_s = timeline
@@ -82,6 +87,10 @@ fn iteration_record(planner: &Planner) -> Result<IterationRecord> {
         gap: outcome.gap,
         throughput_per_h: throughput_per_h(n_robots, outcome.t_total_s),
         offsets_s: schedule.offsets_s.clone(),
+        falsely_trusted_samples: falsely_trusted(planner.confidence().conf(), labels),
+        lc_runs: timeline.lc_intervals().iter().map(|v| v.len()).collect(),
+        error_rates: planner.error_rates()?,
+        simulated_rates: (planner.rounds_recorded() > 0).then(|| tally.rates()),
     })
 }
 
@@ -142,8 +151,9 @@ pub fn run_trial_observed(
     let n_pairs = config.n_rounds();
     let n_robots = planner.n_robots();
     let mut iterations = Vec::with_capacity(n_pairs + 1);
+    let mut tally = OperatorTally::default();
     for pair in 0..n_pairs {
-        let mut record = iteration_record(&planner)?;
+        let mut record = iteration_record(&planner, reference_labels, &tally)?;
         let workpieces = (0..n_robots)
             .map(|_| Workpiece::random(&config.task, &mut rng))
             .collect::<Result<Vec<_>>>()?;
@@ -152,6 +162,7 @@ pub fn run_trial_observed(
             workcell::run_round(&planner, reference_labels, &workpieces, &operator, &mut rng)?;
         let records = run.records(planner.model())?;
         times.simulation += t.elapsed();
+        tally.add(&run);
         let count = |f: fn(&bool) -> bool, pick: fn(&workcell::RobotRun) -> &Vec<bool>| {
             run.robots
                 .iter()
@@ -183,7 +194,7 @@ pub fn run_trial_observed(
             pairs_done: pair + 1,
         });
     }
-    iterations.push(iteration_record(&planner)?);
+    iterations.push(iteration_record(&planner, reference_labels, &tally)?);
     Ok((
         TrialResult {
             trial,
