@@ -132,6 +132,25 @@ pub(crate) enum Command {
     ///   tandem simulate cell.tandem --need need.csv --rounds 20 --bag run.mcap
     #[command(verbatim_doc_comment)]
     Simulate(SimulateArgs),
+    /// Write a need file for `tandem simulate --need` from reference-time intervals.
+    ///
+    /// A region START-END=LEVEL says that a workpiece needs the operator from START to END
+    /// (reference seconds, as `tandem inspect` prints them; START inclusive, END exclusive)
+    /// with probability LEVEL in [0, 1]: one draw per region and workpiece, so a defect
+    /// covers its whole region or none of it. Samples outside every region never need the
+    /// operator. Instead of regions: a label file with one row per reference sample
+    /// (--from-labels FILE --column NAME: each run of equal values is a region, the value its
+    /// level, or --level P wherever the value is not 0), or every current low-confidence
+    /// region of the state at one level (--low-confidence LEVEL).
+    /// The output is a new file; an existing one is replaced only with --force.
+    ///
+    /// Example:
+    ///
+    ///   tandem need cell.tandem --region 21.3-27.6=0.5 --region 40-52=0.25 -o need.csv
+    ///   tandem need cell.tandem --from-labels demo_0.labels.csv --column defect --level 0.5 -o need.csv
+    ///   tandem need cell.tandem --low-confidence 0.5 -o need.csv
+    #[command(verbatim_doc_comment)]
+    Need(NeedArgs),
     /// Print the default parameter file (TOML) for `tandem fit --params`.
     ///
     /// Example:
@@ -291,6 +310,40 @@ pub(crate) struct PlotArgs {
     /// Output folder.
     #[arg(short, long, value_name = "DIR")]
     pub(crate) output: PathBuf,
+}
+
+/// `tandem need`.
+#[derive(Debug, Args)]
+pub(crate) struct NeedArgs {
+    /// The state file (read only): its reference's length and sample period.
+    pub(crate) state: PathBuf,
+    /// A region START-END=LEVEL in reference seconds (repeatable; regions must not overlap).
+    #[arg(long, value_name = "START-END=LEVEL", conflicts_with_all = ["from_labels", "low_confidence"])]
+    pub(crate) region: Vec<String>,
+    /// A CSV file with one row per reference sample (e.g. the reference demonstration's labels).
+    #[arg(
+        long,
+        value_name = "CSV",
+        requires = "column",
+        conflicts_with = "low_confidence"
+    )]
+    pub(crate) from_labels: Option<PathBuf>,
+    /// With --from-labels: the column to read.
+    #[arg(long, value_name = "NAME", requires = "from_labels")]
+    pub(crate) column: Option<String>,
+    /// With --from-labels: the level of every sample whose value is not 0 (default: the
+    /// values are the levels, each in [0, 1]).
+    #[arg(long, value_name = "P", requires = "from_labels")]
+    pub(crate) level: Option<f64>,
+    /// Every current low-confidence region of the state, at this level.
+    #[arg(long, value_name = "LEVEL")]
+    pub(crate) low_confidence: Option<f64>,
+    /// The need file to write (a new file unless --force).
+    #[arg(short, long, value_name = "CSV")]
+    pub(crate) output: PathBuf,
+    /// Replace an existing output file.
+    #[arg(long)]
+    pub(crate) force: bool,
 }
 
 /// `tandem simulate`. The operator's defaults are the study's

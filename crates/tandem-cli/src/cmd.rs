@@ -13,7 +13,7 @@ use crate::cli::{
     Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
 };
 use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_json, source_name};
-use crate::{bag, input, plot, sim, state_io};
+use crate::{bag, input, need, plot, sim, state_io};
 
 /// Runs one command.
 pub(crate) fn run(cli: Cli) -> Result<()> {
@@ -24,6 +24,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         Command::Inspect(a) => inspect(&a),
         Command::Plot(a) => plot_cmd(&a),
         Command::Simulate(a) => sim::simulate(&a),
+        Command::Need(a) => need::need(&a),
         Command::Params => params(),
     }
 }

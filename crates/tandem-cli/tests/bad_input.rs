@@ -751,3 +751,109 @@ fn simulate_refuses_a_schedule_checked_at_another_tick() {
         Some(&state),
     );
 }
+
+/// `tandem need`: bad regions, label files and outputs name what is wrong and how to fix it;
+/// an existing output is never replaced without `--force`.
+#[test]
+fn bad_need_requests() {
+    let dir = scratch("bad-need-cmd");
+    let state = small_state(&dir);
+    let n = SMALL_N_REF;
+    let out_path = s(&dir.join("need.csv"));
+    let need = |extra: &[&str]| {
+        let mut v = vec!["need".to_string(), s(&state)];
+        v.extend(extra.iter().map(|x| x.to_string()));
+        v.extend(["-o".to_string(), out_path.clone()]);
+        v
+    };
+    let labels_short = s(&write(&dir, "short.labels.csv", "defect\n1\n0\n"));
+    let labels_prob = s(&write(
+        &dir,
+        "prob.labels.csv",
+        &format!("defect\n3\n{}", "0\n".repeat(n - 1)),
+    ));
+    // The small state's reference: SMALL_N_REF samples 0.01 s apart.
+    let duration = format!("lasts {} s", n as f64 * 0.01);
+    for (args, needles) in [
+        (
+            need(&["--region", "0.1-0.2"]),
+            vec!["START-END=LEVEL", "e.g. --region"],
+        ),
+        (
+            need(&["--region", "0.2-0.1=0.5"]),
+            vec!["region 1", "START < END"],
+        ),
+        (
+            need(&["--region", "0.1-0.2=1.5"]),
+            vec!["region 1", "not a probability"],
+        ),
+        (
+            need(&["--region", "0.1-9=0.5"]),
+            vec!["region 1", duration.as_str()],
+        ),
+        (
+            need(&["--region", "0.1-0.3=0.5", "--region", "0.2-0.4=0.5"]),
+            vec!["region 2", "overlaps region 1"],
+        ),
+        (
+            need(&["--from-labels", &labels_short, "--column", "pass"]),
+            vec![labels_short.as_str(), "--column pass", "no such column"],
+        ),
+        (
+            need(&["--from-labels", &labels_short, "--column", "defect"]),
+            vec![labels_short.as_str(), "2 rows", "one row per sample"],
+        ),
+        (
+            need(&["--from-labels", &labels_prob, "--column", "defect"]),
+            vec![&format!("{labels_prob}:2:1"), "--level P"],
+        ),
+        (
+            need(&[]),
+            vec!["--region START-END=LEVEL", "--low-confidence"],
+        ),
+    ] {
+        expect_user_error(&args, &needles, Some(&state));
+        assert!(!Path::new(&out_path).exists(), "{args:?} wrote a file");
+    }
+    // An existing file (not written by `tandem need`) is left alone without --force.
+    std::fs::write(&out_path, "my notes\n").unwrap();
+    expect_user_error(
+        &need(&["--region", "0.1-0.2=0.5"]),
+        &[&out_path, "exists", "--force"],
+        Some(&state),
+    );
+    assert_eq!(std::fs::read_to_string(&out_path).unwrap(), "my notes\n");
+    let mut forced = need(&["--region", "0.1-0.2=0.5"]);
+    forced.push("--force".into());
+    let out = tandem(&forced);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&out_path).unwrap();
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    assert_eq!(rows.len(), n);
+    // Samples 10..20 (0.10 s ≤ n·0.01 s < 0.20 s) form region 1 at level 0.5.
+    for (k, row) in rows.iter().enumerate() {
+        let want = if (10..20).contains(&k) {
+            "0.5,1"
+        } else {
+            "0,0"
+        };
+        assert_eq!(*row, want, "row {k}");
+    }
+    let out = tandem(&[
+        "simulate".to_string(),
+        s(&state),
+        "--need".into(),
+        out_path.clone(),
+        "--rounds".into(),
+        "1".into(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
