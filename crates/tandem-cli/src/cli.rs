@@ -6,12 +6,14 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use tandem::lfd::Reference;
 use tandem::sim::workcell::OperatorParams;
 
-/// Coordinated two-robot shared autonomy from your own demonstrations (Hagenow et al., RA-L 2023).
+/// Coordinated multi-robot shared autonomy from your own demonstrations: one operator, 1 to 8
+/// robots (2 by default, --robots N at fit) (Hagenow et al., RA-L 2023).
 ///
 /// Typical session:
 ///
-///   tandem fit demo_*.csv -o cell.tandem        # learn the task and a first schedule
+///   tandem fit demo_1.csv demo_2.csv demo_3.csv -o cell.tandem   # learn the task, first schedule
 ///   tandem schedule cell.tandem                 # show it (text Gantt; --json for robots)
+///   tandem need cell.tandem --region 21.3-27.6=0.5 -o need.csv   # where workpieces need help
 ///   tandem simulate cell.tandem --need need.csv --rounds 5   # what-if, nothing saved
 ///   tandem record cell.tandem --execution a.csv --log a.reflog.csv --corrections a.corr.csv \
 ///                             --execution b.csv --log b.reflog.csv --corrections b.corr.csv
@@ -20,7 +22,9 @@ use tandem::sim::workcell::OperatorParams;
 ///
 /// Every user error prints `error: ...` naming the file and the problem and exits with
 /// code 2; a failing command writes nothing and leaves the state file as it was.
-/// File formats: docs/formats.md; walk-through: docs/guide.md.
+/// File formats: docs/formats.md; walk-through: docs/guide.md ("Your own task, end to end"
+/// for a task of your own, from CSV files to the robot loop in Python; its "Glossary" explains
+/// every term tandem prints: certificate, latched, margin-aware, fallback, …).
 #[derive(Debug, Parser)]
 #[command(name = "tandem", version, verbatim_doc_comment)]
 pub(crate) struct Cli {
@@ -193,7 +197,8 @@ pub(crate) struct FitArgs {
     /// prints the defaults).
     #[arg(long, value_name = "FILE")]
     pub(crate) params: Option<PathBuf>,
-    /// Sample period (s) of demonstrations without a time column `t`. Default: 0.01.
+    /// Sample period (s) of demonstrations without a time column `t`. Default: 0.01. A file
+    /// with its own time (`t`, JSON `dt_s`) uses it; a --dt that disagrees is an error.
     #[arg(long, value_name = "SECONDS")]
     pub(crate) dt: Option<f64>,
     /// ROS 2 bags: rate (Hz) of the grid every topic is resampled onto. Default: each bag's

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use serde_json::json;
-use tandem::lfd::{Demonstration, Execution, Reference, TaskModel};
+use tandem::lfd::{Demonstration, Execution, PeriodSource, Reference, TaskModel};
 use tandem::planner::reschedule_seed;
 use tandem::schedule::SamplerParams;
 use tandem::{ExecutionRecord, Planner, PlannerParams};
@@ -92,6 +92,25 @@ fn fit(a: &FitArgs) -> Result<()> {
     for d in &demos {
         if let Some(n) = d.period_note() {
             note(&n);
+        }
+        // The file's own time wins over --dt; a --dt that contradicts it is refused.
+        if let Some(dt) = a.dt
+            && d.period_source() == PeriodSource::File
+        {
+            if (d.dt_s() - dt).abs() > tandem::lfd::DT_TOLERANCE * dt {
+                bail!(
+                    "{}: --dt {dt} s, but its own time (`t` column or `dt_s`) gives {} s: \
+                     remove --dt (it is only for files without a time column) or fix the file",
+                    d.source(),
+                    secs(d.dt_s())
+                );
+            }
+            note(&format!(
+                "{}: its own time gives {} s; --dt (the period of files without a time column) \
+                 agrees and is not used for it",
+                d.source(),
+                secs(d.dt_s())
+            ));
         }
     }
     for w in tandem::lfd::length_warnings(&demos) {

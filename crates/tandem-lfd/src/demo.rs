@@ -23,6 +23,16 @@ pub const MAX_ABS_VALUE: f64 = tandem_warp::MAX_ABS_VALUE;
 /// across demonstrations): 1 %.
 pub const DT_TOLERANCE: f64 = 0.01;
 
+/// Largest deviation of a `t` column's time from the file's even grid (first time plus
+/// multiples of the mean period), relative to the period, that a file may have: 25 % (a
+/// ±1.5 ms jitter at 100 Hz is 15 %; a dropped or repeated sample is at least 50 %).
+/// docs/decisions.md, "Timestamps: the mean period, jitter within 25 %".
+pub const JITTER_TOLERANCE: f64 = 0.25;
+
+/// Deviation from the even grid (relative to the period) above which the reader reports the
+/// worst one in [`Demonstration::period_note`]: 1 %.
+pub const JITTER_NOTE: f64 = 0.01;
+
 /// One demonstration `X_i ∈ R^{m × T_i}` (Eq. 1) in its own demo time.
 ///
 /// Samples are stored sample-major: sample `t` (demo samples), channel `j` at
@@ -40,6 +50,9 @@ pub struct Demonstration {
     samples: Vec<f64>,
     dt_s: f64,
     period: PeriodSource,
+    /// The `t` column's worst step deviation from the period (s) and its 1-based line, when
+    /// it exceeds [`JITTER_NOTE`] of the period (reported by [`Demonstration::period_note`]).
+    jitter: Option<(f64, usize)>,
 }
 
 /// Equal channels, samples, period and source label; where the period came from
@@ -88,6 +101,7 @@ impl Demonstration {
             samples,
             dt_s,
             period: PeriodSource::Given,
+            jitter: None,
         };
         demo.check()?;
         Ok(demo)
@@ -101,7 +115,25 @@ impl Demonstration {
     /// A sentence saying which sample period was assumed for a file without a time of its
     /// own ([`PeriodSource::Assumed`]), and how to state the real one; `None` otherwise.
     /// The command line prints it, the Python package raises it as a warning.
+    ///
+    /// For a `t` column whose times deviate from the even grid by more than [`JITTER_NOTE`]
+    /// of a period (but within [`JITTER_TOLERANCE`], else the file is refused), the sentence
+    /// gives the worst deviation and its line, and says that the samples are taken as evenly
+    /// spaced.
     pub fn period_note(&self) -> Option<String> {
+        if let (PeriodSource::File, Some((dev, line))) = (self.period, self.jitter) {
+            return Some(format!(
+                "{}:{line}: time column `t`: times deviate from the even grid of period {} s \
+                 ({} Hz) by up to {} ms here ({:.1} % of a period; tandem accepts up to {} %): \
+                 the samples are taken to be evenly spaced",
+                self.source,
+                round_s(self.dt_s),
+                round_s(1.0 / self.dt_s),
+                round_s(dev * 1e3),
+                100.0 * dev / self.dt_s,
+                100.0 * JITTER_TOLERANCE
+            ));
+        }
         (self.period == PeriodSource::Assumed).then(|| {
             format!(
                 "{}: no time column `t`: its samples are taken to be {} s apart ({} Hz); \
@@ -251,6 +283,7 @@ impl Demonstration {
             samples,
             dt_s: self.dt_s,
             period: self.period,
+            jitter: self.jitter,
         }))
     }
 
@@ -263,8 +296,11 @@ impl Demonstration {
     /// Parses CSV text: a header row of channel names, then one row of numbers per sample.
     ///
     /// A column named `t` (seconds) is optional; when present it is removed from the
-    /// channels, must be strictly increasing and evenly spaced within 1 %, and sets `Δt_s`
-    /// to its mean spacing. Otherwise `Δt_s` is `dt_s`, or [`DEFAULT_DT_S`] when `None`.
+    /// channels, must be strictly increasing with every time within [`JITTER_TOLERANCE`]
+    /// (25 %) of a period of the even grid of its mean spacing, and sets `Δt_s` to that
+    /// spacing, snapped to a whole rate in Hz within 0.1 % ([`period_from_times`]); `dt_s`
+    /// is then not used (the command line refuses a `--dt` that disagrees). Otherwise
+    /// `Δt_s` is `dt_s`, or [`DEFAULT_DT_S`] when `None`.
     /// The text is split by [`CsvTable`] (blank lines skipped, header names may be
     /// double-quoted); a value beyond `±`[`MAX_ABS_VALUE`] is rejected.
     /// `file` names the input in errors, which carry the 1-based line and field number.
@@ -316,12 +352,12 @@ impl Demonstration {
                 found: n,
             });
         }
-        let (dt_s, period) = match t_col {
+        let ((dt_s, jitter), period) = match t_col {
             Some(col) => (
                 time_column_period(&times, file, col + 1)?,
                 PeriodSource::File,
             ),
-            None => (dt_s.unwrap_or(DEFAULT_DT_S), PeriodSource::Assumed),
+            None => ((dt_s.unwrap_or(DEFAULT_DT_S), None), PeriodSource::Assumed),
         };
         let channel_names = names
             .iter()
@@ -329,9 +365,11 @@ impl Demonstration {
             .filter(|(j, _)| Some(*j) != t_col)
             .map(|(_, n)| n.clone())
             .collect();
-        Ok(Self::new(channel_names, samples, dt_s)?
+        let mut demo = Self::new(channel_names, samples, dt_s)?
             .with_source(file)
-            .with_period_source(period))
+            .with_period_source(period);
+        demo.jitter = jitter;
+        Ok(demo)
     }
 
     /// Reads a JSON file: see [`Demonstration::from_json_str`].
@@ -449,8 +487,37 @@ fn too_large_why(value: f64) -> String {
     )
 }
 
-/// Checks a `t` column and returns its mean spacing (seconds).
-fn time_column_period(times: &[(usize, f64)], file: &str, column: usize) -> Result<f64> {
+/// The sample period (s) of evenly spaced times `t_0 … t_{n−1}` (s): the mean spacing
+/// `(t_{n−1} − t_0)/(n − 1)`, snapped to `1/f` when it is within 0.1 % of the period of a
+/// whole rate `f ≥ 1` Hz (a 100 Hz log with jitter gives exactly 0.01 s), else rounded to
+/// the nanosecond. `None` for fewer than 2 times or a spacing that is not finite > 0.
+#[must_use]
+pub fn period_from_times(times: &[f64]) -> Option<f64> {
+    let n = times.len();
+    if n < 2 {
+        return None;
+    }
+    let mean = (times[n - 1] - times[0]) / (n - 1) as f64;
+    if !(mean.is_finite() && mean > 0.0) {
+        return None;
+    }
+    let rate = (1.0 / mean).round();
+    if rate >= 1.0 && (1.0 / rate - mean).abs() <= 1e-3 * mean {
+        return Some(1.0 / rate);
+    }
+    Some(round_s(mean))
+}
+
+/// Checks a `t` column and returns its period ([`period_from_times`]) and, when some time
+/// deviates from the even grid by more than [`JITTER_NOTE`] of a period, the worst deviation
+/// (s) and its line. The grid is `t_0 + i·p` with `p` the mean spacing (exactly the line
+/// through the first and the last time); every time must lie within [`JITTER_TOLERANCE`] of
+/// a period of it, which refuses a dropped or repeated sample (at least half a period off).
+fn time_column_period(
+    times: &[(usize, f64)],
+    file: &str,
+    column: usize,
+) -> Result<(f64, Option<(f64, usize)>)> {
     let bad = |line: usize, why: String| Error::BadTime {
         file: file.into(),
         line,
@@ -461,22 +528,40 @@ fn time_column_period(times: &[(usize, f64)], file: &str, column: usize) -> Resu
         if w[1].1 <= w[0].1 {
             return Err(bad(
                 w[1].0,
-                format!("{} does not increase after {}", w[1].1, w[0].1),
+                format!(
+                    "{} does not increase after {} (times must be strictly increasing; sort \
+                     the log or remove repeated rows)",
+                    w[1].1, w[0].1
+                ),
             ));
         }
     }
     let n = times.len();
-    let mean = (times[n - 1].1 - times[0].1) / (n - 1) as f64;
-    for w in times.windows(2) {
-        let step = w[1].1 - w[0].1;
-        if (step - mean).abs() > DT_TOLERANCE * mean {
-            return Err(bad(
-                w[1].0,
-                format!("step {step} s differs from the mean step {mean} s by more than 1 %"),
-            ));
-        }
+    let (t0, mean) = (times[0].1, (times[n - 1].1 - times[0].1) / (n - 1) as f64);
+    let (dev, line) = times
+        .iter()
+        .enumerate()
+        .map(|(i, &(line, t))| ((t - (t0 + i as f64 * mean)).abs(), line))
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .expect("at least 2 times");
+    if dev > JITTER_TOLERANCE * mean {
+        return Err(bad(
+            line,
+            format!(
+                "this time is {} ms off the even grid of the file's mean period {} s ({:.0} % \
+                 of a period; tandem accepts up to {} %: a dropped or repeated sample, or an \
+                 irregular log): resample the log onto an even grid, or remove the `t` column \
+                 and give the period with --dt",
+                round_s(dev * 1e3),
+                round_s(mean),
+                100.0 * dev / mean,
+                100.0 * JITTER_TOLERANCE
+            ),
+        ));
     }
-    Ok(mean)
+    let values: Vec<f64> = times.iter().map(|&(_, t)| t).collect();
+    let period = period_from_times(&values).expect("strictly increasing, at least 2 times");
+    Ok((period, (dev > JITTER_NOTE * mean).then_some((dev, line))))
 }
 
 /// 1-based (line, column) of the start of row `row` of the top-level `samples` array, or
@@ -699,6 +784,70 @@ mod tests {
         assert_eq!(d.samples(), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
         assert!((d.dt_s() - 0.02).abs() < 1e-15);
         assert_eq!(d.source(), "f.csv");
+    }
+
+    /// `n` rows `t,a` at 100 Hz with the times moved by `jitter(i)` seconds.
+    fn jittered(n: usize, jitter: impl Fn(usize) -> f64) -> String {
+        let mut text = String::from("t,a\n");
+        for i in 0..n {
+            text.push_str(&format!("{},{i}\n", i as f64 * 0.01 + jitter(i)));
+        }
+        text
+    }
+
+    #[test]
+    fn a_jittered_100_hz_log_is_read_at_exactly_0_01_s_with_a_note() {
+        // ±1.5 ms of deterministic jitter (15 % of a period), the last time on the grid.
+        let text = jittered(500, |i| {
+            if i == 0 || i == 499 {
+                0.0
+            } else {
+                0.0015 * (i as f64 * 2.4).sin()
+            }
+        });
+        let d = Demonstration::from_csv_str(&text, "j.csv", None).unwrap();
+        assert_eq!(d.dt_s(), 0.01, "snapped to 100 Hz");
+        let note = d.period_note().expect("a jitter note");
+        assert!(note.starts_with("j.csv:"), "{note}");
+        assert!(
+            note.contains("period 0.01 s (100 Hz)") && note.contains("up to 25 %"),
+            "{note}"
+        );
+        // Exactly even times: no note, and the period is 0.01 exactly, not 0.009999….
+        let even = Demonstration::from_csv_str(&jittered(300, |_| 0.0), "e.csv", None).unwrap();
+        assert_eq!(even.dt_s(), 0.01);
+        assert_eq!(even.period_note(), None);
+    }
+
+    #[test]
+    fn a_dropped_sample_or_an_irregular_log_is_refused_with_the_fix() {
+        // Sample 100 is missing: every later time is one period late.
+        let text = jittered(300, |i| if i >= 100 { 0.01 } else { 0.0 });
+        let e = Demonstration::from_csv_str(&text, "d.csv", None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("d.csv:") && e.contains("time column `t`"), "{e}");
+        assert!(e.contains("resample the log") && e.contains("--dt"), "{e}");
+        // 30 % of a period off at one time.
+        let text = jittered(50, |i| if i == 20 { 0.003 } else { 0.0 });
+        let e = Demonstration::from_csv_str(&text, "j.csv", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("j.csv:22:1:") && e.contains("30 % of a period"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn periods_snap_to_whole_rates_only_when_close() {
+        assert_eq!(period_from_times(&[0.0, 0.0100004, 0.0200008]), Some(0.01));
+        assert_eq!(period_from_times(&[0.0, 1.0 / 3.0]), Some(1.0 / 3.0));
+        // 0.0123 s is 81.3 Hz, 0.4 % from 81 Hz: rounded to the nanosecond, not snapped.
+        assert_eq!(period_from_times(&[0.0, 0.0123]), Some(0.0123));
+        assert_eq!(period_from_times(&[0.0, 2.5]), Some(2.5));
+        assert_eq!(period_from_times(&[1.0]), None);
+        assert_eq!(period_from_times(&[1.0, 1.0]), None);
     }
 
     #[test]

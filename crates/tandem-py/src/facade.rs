@@ -11,6 +11,7 @@ pub(crate) use tandem::schedule::{
     CheckedSchedule, GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, Violation,
     sample_schedule_n,
 };
+pub(crate) use tandem::sim::needs::{NeedProfile, NeedRegion};
 pub(crate) use tandem::sim::study::{
     PhaseTimes, StudyConfig, StudyInputs, read_labels, run_trial, run_trials,
 };
