@@ -15,8 +15,9 @@ position, m), ``grip`` (gripper opening, m) and ``fz`` (insertion force, N).
 
 The first demonstration (``peg_1.csv``, the reference of ``tandem fit``) has fixed phase
 durations, so its search runs over 1.00–2.50 s and its insertion over 3.50–5.00 s of reference
-time (the regions the guide's ``tandem need`` names); the others draw every duration, so they
-last from about 6 s to 9 s.
+time (the regions the guide's ``tandem need`` names); the others do the fixed phases at the
+reference's pace within ±3 % and draw the durations of the search and the insertion (1.2–2.6 s
+each), so they last from about 5.5 s to 8.3 s.
 """
 
 from __future__ import annotations
@@ -43,12 +44,14 @@ def smooth(u: np.ndarray) -> np.ndarray:
 def demonstration(rng: np.random.Generator, phases=None) -> np.ndarray:
     """One demonstration as ``(T, 6)`` rows ``t, px, py, pz, grip, fz``."""
     if phases is None:
+        # The fixed phases at the reference's pace within ±3 %, the variable ones freely.
+        fixed = lambda d: d * rng.uniform(0.97, 1.03)  # noqa: E731
         phases = (
-            rng.uniform(0.8, 1.3),
-            rng.uniform(1.2, 2.4),
-            rng.uniform(0.8, 1.2),
-            rng.uniform(1.2, 2.4),
-            rng.uniform(0.8, 1.2),
+            fixed(REFERENCE_PHASES[0]),
+            rng.uniform(1.2, 2.6),
+            fixed(REFERENCE_PHASES[2]),
+            rng.uniform(1.2, 2.6),
+            fixed(REFERENCE_PHASES[4]),
         )
     amp = rng.uniform(0.002, 0.015)
     turns = rng.integers(1, 4)
@@ -75,8 +78,8 @@ def demonstration(rng: np.random.Generator, phases=None) -> np.ndarray:
             fz = np.zeros(n)
         rows.append(np.column_stack([px, py, pz, grip, fz]))
     x = np.vstack(rows)
-    # A steady hand, not a perfect one: 0.2 mm and 0.1 N of noise.
-    x[:, :4] += rng.normal(0.0, 0.0002, (len(x), 4))
+    # Sensor noise: 30 µm on the positions, 0.1 N on the force.
+    x[:, :4] += rng.normal(0.0, 0.00003, (len(x), 4))
     x[:, 4] += rng.normal(0.0, 0.1, len(x))
     t = np.arange(len(x)) * DT_S
     return np.column_stack([t, x])

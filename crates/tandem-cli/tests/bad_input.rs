@@ -113,7 +113,66 @@ fn malformed_demonstrations() {
         (
             "other_channels.csv",
             small_demo(50, 1.0).replace("t,x,force", "t,x,torque"),
-            vec!["torque", "differ from the reference channels"],
+            vec![
+                "torque",
+                "differ from the reference channels",
+                "rename the columns",
+            ],
+        ),
+        // Another separator: say so, and how to convert (decimal commas too).
+        (
+            "semicolons.csv",
+            "t;x;force\n0.00;0;5\n0.01;0.5;5\n0.02;1;5\n".into(),
+            vec![
+                ":1:1",
+                "3 fields separated by semicolons",
+                "save the file as CSV with commas",
+            ],
+        ),
+        (
+            "decimal_comma.csv",
+            "t;x;force\n0,00;0;5\n0,01;0,5;5\n0,02;1;5\n".into(),
+            vec!["separated by semicolons", "decimal points"],
+        ),
+        (
+            "tabs.csv",
+            "t\tx\tforce\n0.00\t0\t5\n0.01\t0.5\t5\n0.02\t1\t5\n".into(),
+            vec![":1:1", "3 fields separated by tabs"],
+        ),
+        // A dropped sample in the `t` column: refused with the fix (resample, or --dt).
+        (
+            "dropped.csv",
+            small_demo(60, 1.0)
+                .lines()
+                .enumerate()
+                .filter(|(k, _)| *k != 30)
+                .map(|(_, l)| format!("{l}\n"))
+                .collect(),
+            vec![
+                "time column `t`",
+                "off the even grid",
+                "resample the log",
+                "--dt",
+            ],
+        ),
+        // Another rate than the reference's: the period is printed without float noise.
+        (
+            "rate.csv",
+            small_demo(40, 1.0)
+                .lines()
+                .enumerate()
+                .map(|(k, l)| match k {
+                    0 => format!("{l}\n"),
+                    _ => {
+                        let (_, rest) = l.split_once(',').expect("t,x,force rows");
+                        format!("{},{rest}\n", (k - 1) as f64 * 0.02)
+                    }
+                })
+                .collect(),
+            vec![
+                "sample period 0.02 s differs from the reference 0.01 s",
+                "resample it",
+            ],
         ),
         (
             "dup_header.csv",
@@ -188,6 +247,41 @@ fn malformed_demonstrations() {
         assert!(stderr.contains(part), "`{part}` missing in:\n{stderr}");
     }
     std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
+    // A UTF-8 byte-order mark (spreadsheet export) is skipped; a ±1.5 ms jitter at 100 Hz is
+    // accepted with its worst deviation in a note; the fit goes through.
+    let bom = write(&dir, "bom.csv", &format!("\u{feff}{}", small_demo(60, 1.0)));
+    ok(&tandem(fit_with(&dir, &bom, false)));
+    std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
+    let jitter: String = small_demo(60, 1.0)
+        .lines()
+        .enumerate()
+        .map(|(k, l)| match k {
+            0 => format!("{l}\n"),
+            _ => {
+                let (_, rest) = l.split_once(',').expect("t,x,force rows");
+                let wobble = if k == 1 || k == 60 {
+                    0.0
+                } else {
+                    0.0015 * (k as f64).sin()
+                };
+                format!("{},{rest}\n", (k - 1) as f64 * 0.01 + wobble)
+            }
+        })
+        .collect();
+    let jitter = write(&dir, "jitter.csv", &jitter);
+    let out = tandem(fit_with(&dir, &jitter, false));
+    ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&format!("note: {}:", s(&jitter)))
+            && stderr.contains("times deviate from the even grid of period 0.01 s"),
+        "{stderr}"
+    );
+    std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
+    // --dt contradicting a file's `t` column is refused, naming the file and both periods.
+    let mut args = fit_with(&dir, &jitter, false);
+    args.extend(["--dt".into(), "0.02".into()]);
+    expect_user_error(&args, &["--dt 0.02 s", "gives 0.01 s", "remove --dt"], None);
     // A missing file.
     let missing = dir.join("missing.csv");
     expect_user_error(
