@@ -124,12 +124,12 @@ impl Demonstration {
         if let (PeriodSource::File, Some((dev, line))) = (self.period, self.jitter) {
             return Some(format!(
                 "{}:{line}: time column `t`: times deviate from the even grid of period {} s \
-                 ({} Hz) by up to {} ms here ({:.1} % of a period; tandem accepts up to {} %): \
-                 the samples are taken to be evenly spaced",
+                 ({} Hz) by up to {:.3} ms here ({:.1} % of a period; tandem accepts up to {} \
+                 %): the samples are taken to be evenly spaced",
                 self.source,
                 round_s(self.dt_s),
                 round_s(1.0 / self.dt_s),
-                round_s(dev * 1e3),
+                dev * 1e3,
                 100.0 * dev / self.dt_s,
                 100.0 * JITTER_TOLERANCE
             ));
@@ -548,12 +548,12 @@ fn time_column_period(
         return Err(bad(
             line,
             format!(
-                "this time is {} ms off the even grid of the file's mean period {} s ({:.0} % \
-                 of a period; tandem accepts up to {} %: a dropped or repeated sample, or an \
-                 irregular log): resample the log onto an even grid, or remove the `t` column \
-                 and give the period with --dt",
-                round_s(dev * 1e3),
-                round_s(mean),
+                "this time is {:.3} ms off the even grid of the file's mean period {} s \
+                 ({:.1} % of a period; tandem accepts up to {} %: a dropped or repeated \
+                 sample, or an irregular log): resample the log onto an even grid, or remove \
+                 the `t` column and give the period with --dt",
+                dev * 1e3,
+                (mean * 1e6).round() / 1e6,
                 100.0 * dev / mean,
                 100.0 * JITTER_TOLERANCE
             ),
