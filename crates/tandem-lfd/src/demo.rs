@@ -834,7 +834,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.starts_with("j.csv:22:1:") && e.contains("30 % of a period"),
+            e.starts_with("j.csv:22:1:") && e.contains("30.0 % of a period"),
             "{e}"
         );
     }
