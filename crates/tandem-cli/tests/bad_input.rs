@@ -282,6 +282,40 @@ fn malformed_demonstrations() {
     let mut args = fit_with(&dir, &jitter, false);
     args.extend(["--dt".into(), "0.02".into()]);
     expect_user_error(&args, &["--dt 0.02 s", "gives 0.01 s", "remove --dt"], None);
+    // A zero quaternion: named by its 1-based line and its block's channels.
+    let quat_demo = |n: usize, zero_at: Option<usize>| {
+        let mut text = String::from("t,x,qx,qy,qz,qw\n");
+        for k in 0..n {
+            let q = if Some(k) == zero_at {
+                "0,0,0,0"
+            } else {
+                "0,0,0,1"
+            };
+            writeln!(text, "{:.2},{},{q}", k as f64 * 0.01, k as f64 / n as f64).unwrap();
+        }
+        text
+    };
+    let quats: Vec<String> = (0..3)
+        .map(|i| {
+            let zero = (i == 2).then_some(20);
+            s(&write(
+                &dir,
+                &format!("quat_{i}.csv"),
+                &quat_demo(50 + i, zero),
+            ))
+        })
+        .collect();
+    let mut args = vec!["fit".to_string()];
+    args.extend(quats.iter().cloned());
+    args.extend(["--samples", "50", "-o"].map(String::from));
+    args.push(s(&dir.join("out.tandem")));
+    // Sample 20 is on line 22 (the header is line 1).
+    let at = format!("{}:22", quats[2]);
+    expect_user_error(
+        &args,
+        &[&at, "quaternion block (qx, qy, qz, qw)", "norm"],
+        None,
+    );
     // A missing file.
     let missing = dir.join("missing.csv");
     expect_user_error(

@@ -50,6 +50,9 @@ pub struct Demonstration {
     samples: Vec<f64>,
     dt_s: f64,
     period: PeriodSource,
+    /// 1-based file line of each sample, for a demonstration read from CSV (errors about a
+    /// sample name its line, [`Demonstration::locate`]); `None` otherwise.
+    lines: Option<std::sync::Arc<[usize]>>,
     /// The `t` column's worst step deviation from the period (s) and its 1-based line, when
     /// it exceeds [`JITTER_NOTE`] of the period (reported by [`Demonstration::period_note`]).
     jitter: Option<(f64, usize)>,
@@ -101,10 +104,20 @@ impl Demonstration {
             samples,
             dt_s,
             period: PeriodSource::Given,
+            lines: None,
             jitter: None,
         };
         demo.check()?;
         Ok(demo)
+    }
+
+    /// Where sample `t` (0-based) is, for error messages: `file:line` when read from a CSV
+    /// file (1-based line), else `source, sample t (0-based)`.
+    pub fn locate(&self, t: usize) -> String {
+        match self.lines.as_deref().and_then(|l| l.get(t)) {
+            Some(line) => format!("{}:{line}", self.source),
+            None => format!("{}, sample {t} (0-based)", self.source),
+        }
     }
 
     /// Where [`Demonstration::dt_s`] came from (the file, the caller, or an assumption).
@@ -283,6 +296,7 @@ impl Demonstration {
             samples,
             dt_s: self.dt_s,
             period: self.period,
+            lines: self.lines.clone(),
             jitter: self.jitter,
         }))
     }
@@ -347,8 +361,10 @@ impl Demonstration {
         }
         let n = table.rows().len();
         if n < 2 {
+            // The last line the file has: its only data row, or the header.
+            let last = table.rows().last().map_or(table.header_line(), |r| r.line);
             return Err(Error::TooFewSamples {
-                at: format!("{file}:{}:1", table.end_line()),
+                at: format!("{file}:{last}:1"),
                 found: n,
             });
         }
@@ -369,6 +385,7 @@ impl Demonstration {
             .with_source(file)
             .with_period_source(period);
         demo.jitter = jitter;
+        demo.lines = Some(table.rows().iter().map(|r| r.line).collect());
         Ok(demo)
     }
 

@@ -149,11 +149,11 @@ fn channels_named_like_derived_coordinates_are_rejected() {
 fn csv_too_few_samples() {
     assert_eq!(
         csv_err("a,b\n1,2\n"),
-        "demo.csv:3:1: 1 sample(s); at least 2 are required"
+        "demo.csv:2:1: 1 sample(s); at least 2 are required"
     );
     assert_eq!(
         csv_err("a,b\n"),
-        "demo.csv:2:1: 0 sample(s); at least 2 are required"
+        "demo.csv:1:1: 0 sample(s); at least 2 are required"
     );
 }
 
