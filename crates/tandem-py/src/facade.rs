@@ -1,7 +1,9 @@
 //! Every item this crate uses from the `tandem` facade, in one place.
 
 pub(crate) use tandem::confidence::{BetaParams, Observations, posterior, prior};
-pub(crate) use tandem::lfd::{DEFAULT_DT_S, Demonstration, Execution, TaskModel, length_warnings};
+pub(crate) use tandem::lfd::{
+    DEFAULT_DT_S, DT_TOLERANCE, Demonstration, Execution, PeriodSource, TaskModel, length_warnings,
+};
 pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{
     Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, reschedule_seed,
