@@ -106,8 +106,9 @@ pub(crate) enum Command {
     ///
     /// Writes model.{svg,png} (mean ± one standard deviation per channel and the speed
     /// bounds over reference time), confidence.{svg,png} (σ²_D(t), the high-confidence
-    /// map and the correction observations) and schedule.{svg,png} (both robots in global
-    /// time; blue = robot 1 low-confidence, red = robot 2 low-confidence). The folder is
+    /// map and the correction observations) and schedule.{svg,png} (every robot in global
+    /// time; blue = robot 1 low-confidence, red = robot 2 low-confidence, …; the bottom row
+    /// is whom the operator supervises). The folder is
     /// created if missing; existing files of these names are replaced.
     ///
     /// Example:
