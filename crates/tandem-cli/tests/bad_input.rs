@@ -984,4 +984,33 @@ fn bad_need_requests() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // From a label column: two defects (runs of 1) become regions at --level; each run of
+    // equal values is one region.
+    let mut labels = String::from("pass,defect\n");
+    for k in 0..n {
+        let defect = u8::from((5..8).contains(&k) || (30..40).contains(&k));
+        writeln!(labels, "{},{defect}", k / 20).unwrap();
+    }
+    let labels = s(&write(&dir, "demo_0.labels.csv", &labels));
+    let mut args = need(&[
+        "--from-labels",
+        &labels,
+        "--column",
+        "defect",
+        "--level",
+        "0.25",
+    ]);
+    args.push("--force".into());
+    ok(&tandem(&args));
+    let text = std::fs::read_to_string(&out_path).unwrap();
+    for (k, row) in text.lines().skip(1).enumerate() {
+        let want = match k {
+            5..8 => "0.25,1",
+            8..30 => "0,2",
+            30..40 => "0.25,3",
+            40.. => "0,4",
+            _ => "0,0",
+        };
+        assert_eq!(row, want, "row {k}");
+    }
 }
