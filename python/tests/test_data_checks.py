@@ -198,7 +198,7 @@ def test_a_time_column_wins_and_a_contradicting_dt_s_is_refused(tmp_path: Path) 
     n = 1500
     t = np.arange(n) * 0.01 + np.where((np.arange(n) % 7 == 3), 0.0015, 0.0)
     rows = [",".join(["t", *channels])] + [
-        f"{ti!r}," + ",".join(repr(v) for v in xi) for ti, xi in zip(t, x[:n])
+        f"{float(ti)!r}," + ",".join(repr(float(v)) for v in xi) for ti, xi in zip(t, x[:n])
     ]
     jittered = tmp_path / "jittered.csv"
     jittered.write_text("\n".join(rows) + "\n")
@@ -206,7 +206,7 @@ def test_a_time_column_wins_and_a_contradicting_dt_s_is_refused(tmp_path: Path) 
     for k, p in enumerate(short):
         _, xk = load_arrays(DEMOS[k + 1])
         p.write_text("\n".join([",".join(["t", *channels])] + [
-            f"{i * 0.01:.2f}," + ",".join(repr(v) for v in xi) for i, xi in enumerate(xk[:n])
+            f"{i * 0.01:.2f}," + ",".join(repr(float(v)) for v in xi) for i, xi in enumerate(xk[:n])
         ]) + "\n")
     with pytest.warns(tandem.DataWarning, match=r"jittered\.csv:\d+: time column `t`: times deviate from the even grid of period 0\.01 s"):
         planner = tandem.fit([jittered, *short], params=PARAMS)
