@@ -202,6 +202,12 @@ pub(crate) struct FitArgs {
     /// with its own time (`t`, JSON `dt_s`) uses it; a --dt that disagrees is an error.
     #[arg(long, value_name = "SECONDS")]
     pub(crate) dt: Option<f64>,
+    /// Resample CSV demonstrations with an irregular `t` column (dropped samples, a drifting
+    /// logger) onto an even grid: period --dt, or each file's median step; channels are
+    /// interpolated linearly, 0/1 channels held; a gap over 3 periods is refused. Without it,
+    /// a `t` column must stay within 25 % of a period of its even grid.
+    #[arg(long)]
+    pub(crate) resample: bool,
     /// ROS 2 bags: rate (Hz) of the grid every topic is resampled onto. Default: each bag's
     /// slowest selected topic's median message rate.
     #[arg(long, value_name = "HZ")]

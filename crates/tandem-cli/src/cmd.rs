@@ -87,8 +87,14 @@ fn fit(a: &FitArgs) -> Result<()> {
         bail!("--robots {}: one operator runs 1 to {max} robots", a.robots);
     }
     state_io::check_file_target(&a.output)?;
-    let demos: Vec<Demonstration> =
-        bag::read_demos(&a.demos, a.dt, a.rate, &a.topics, &mut params.fit.schema)?;
+    let demos: Vec<Demonstration> = bag::read_demos(
+        &a.demos,
+        a.dt,
+        a.rate,
+        &a.topics,
+        &mut params.fit.schema,
+        a.resample,
+    )?;
     for d in &demos {
         if let Some(n) = d.period_note() {
             note(&n);
@@ -96,6 +102,7 @@ fn fit(a: &FitArgs) -> Result<()> {
         // The file's own time wins over --dt; a --dt that contradicts it is refused.
         if let Some(dt) = a.dt
             && d.period_source() == PeriodSource::File
+            && !a.resample
         {
             if (d.dt_s() - dt).abs() > tandem::lfd::DT_TOLERANCE * dt {
                 bail!(

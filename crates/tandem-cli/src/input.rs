@@ -26,6 +26,26 @@ pub(crate) fn read_demo(path: &Path, dt_s: Option<f64>) -> Result<Demonstration>
     })
 }
 
+/// Reads a CSV demonstration with an irregular `t` column resampled onto an even grid
+/// (`tandem fit --resample`, `Demonstration::from_csv_str_resampled`: period `dt_s` or the
+/// median step), printing what was done as a note. JSON files have no time column to
+/// resample and are refused.
+pub(crate) fn read_demo_resampled(path: &Path, dt_s: Option<f64>) -> Result<Demonstration> {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+    {
+        bail!(
+            "{}: --resample applies to CSV files with a `t` column; a JSON demonstration is \
+             already on an even grid (`dt_s`)",
+            path.display()
+        );
+    }
+    let (demo, what) = Demonstration::from_csv_path_resampled(path, dt_s)?;
+    crate::cmd::note(&what);
+    Ok(demo)
+}
+
 /// The text of `path` and the name errors use for it.
 fn read_text(path: &Path) -> Result<(String, String)> {
     let file = path.display().to_string();

@@ -151,7 +151,7 @@ fn malformed_demonstrations() {
             vec![
                 "time column `t`",
                 "off the even grid",
-                "resample the log",
+                "tandem fit --resample",
                 "--dt",
             ],
         ),
@@ -278,6 +278,40 @@ fn malformed_demonstrations() {
         "{stderr}"
     );
     std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
+    // --resample puts a log with a dropped sample back on its grid (with a note) and refuses
+    // a gap of more than 3 periods.
+    let dropped: String = small_demo(60, 1.0)
+        .lines()
+        .enumerate()
+        .filter(|(k, _)| *k != 30)
+        .map(|(_, l)| format!("{l}\n"))
+        .collect();
+    let dropped = write(&dir, "dropped_ok.csv", &dropped);
+    let mut args = fit_with(&dir, &dropped, false);
+    args.push("--resample".into());
+    let out = tandem(args);
+    ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&format!("note: {}: resampled 59 rows", s(&dropped)))
+            && stderr.contains("onto 60 samples 0.01 s apart"),
+        "{stderr}"
+    );
+    std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
+    let gap: String = small_demo(60, 1.0)
+        .lines()
+        .enumerate()
+        .filter(|(k, _)| !(20..25).contains(k))
+        .map(|(_, l)| format!("{l}\n"))
+        .collect();
+    let gap = write(&dir, "gap.csv", &gap);
+    let mut args = fit_with(&dir, &gap, false);
+    args.push("--resample".into());
+    expect_user_error(
+        &args,
+        &[&s(&gap), "a gap of 0.06 s", "record the task again"],
+        None,
+    );
     // --dt contradicting a file's `t` column is refused, naming the file and both periods.
     let mut args = fit_with(&dir, &jitter, false);
     args.extend(["--dt".into(), "0.02".into()]);

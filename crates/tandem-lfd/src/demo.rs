@@ -29,6 +29,10 @@ pub const DT_TOLERANCE: f64 = 0.01;
 /// docs/decisions.md, "Timestamps: the mean period, jitter within 25 %".
 pub const JITTER_TOLERANCE: f64 = 0.25;
 
+/// Longest gap between two rows of a log that [`Demonstration::from_csv_str_resampled`]
+/// interpolates over, in grid periods: 3.
+pub const MAX_RESAMPLE_GAP: f64 = 3.0;
+
 /// Deviation from the even grid (relative to the period) above which the reader reports the
 /// worst one in [`Demonstration::period_note`]: 1 %.
 pub const JITTER_NOTE: f64 = 0.01;
@@ -389,6 +393,178 @@ impl Demonstration {
         Ok(demo)
     }
 
+    /// Reads a CSV file resampled onto an even grid: see
+    /// [`Demonstration::from_csv_str_resampled`].
+    pub fn from_csv_path_resampled(
+        path: impl AsRef<Path>,
+        dt_s: Option<f64>,
+    ) -> Result<(Self, String)> {
+        let (text, file) = read_text(path.as_ref())?;
+        Self::from_csv_str_resampled(&text, &file, dt_s)
+    }
+
+    /// Parses CSV text with an irregular time column `t` (seconds) and resamples it onto the
+    /// even grid `t_0 + k·Δt_s` (`k = 0, 1, …` up to the last time): `Δt_s` is `dt_s`, or
+    /// the median step snapped like [`period_from_times`]. Every channel is interpolated
+    /// linearly between the two neighbouring rows, except a channel whose every value is 0
+    /// or 1 (an on/off signal), which holds the earlier row's value. Returns the
+    /// demonstration and a sentence saying what was done (for a note).
+    ///
+    /// Errors: as [`Demonstration::from_csv_str`] for the table and values; no `t` column;
+    /// times not strictly increasing; a gap longer than [`MAX_RESAMPLE_GAP`] grid periods
+    /// (resampling would invent the samples of a whole stretch).
+    pub fn from_csv_str_resampled(
+        text: &str,
+        file: &str,
+        dt_s: Option<f64>,
+    ) -> Result<(Self, String)> {
+        let table = CsvTable::parse(text, file)?;
+        if let Some(j) = table
+            .names()
+            .iter()
+            .position(|n| crate::checks::time_like(n))
+        {
+            return Err(Error::TimeLikeChannel {
+                file: file.into(),
+                line: Some(table.header_line()),
+                column: Some(j + 1),
+                channel: table.names()[j].clone(),
+            });
+        }
+        let Some(tc) = table.column("t") else {
+            return Err(Error::BadHeader {
+                file: file.into(),
+                line: table.header_line(),
+                column: 1,
+                why: "no time column `t`: resampling needs the time of every row".into(),
+            });
+        };
+        let n = table.rows().len();
+        let mut times = Vec::with_capacity(n);
+        for r in 0..n {
+            times.push(table.number(r, tc)?);
+        }
+        if n < 2 {
+            return Err(Error::TooFewSamples {
+                at: format!(
+                    "{file}:{}:1",
+                    table.rows().last().map_or(table.header_line(), |r| r.line)
+                ),
+                found: n,
+            });
+        }
+        let line = |k: usize| table.rows()[k].line;
+        for k in 1..n {
+            if times[k] <= times[k - 1] {
+                return Err(Error::BadTime {
+                    file: file.into(),
+                    line: line(k),
+                    column: tc + 1,
+                    why: format!(
+                        "{} does not increase after {} (times must be strictly increasing; \
+                         sort the log or remove repeated rows)",
+                        times[k],
+                        times[k - 1]
+                    ),
+                });
+            }
+        }
+        let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+        steps.sort_by(f64::total_cmp);
+        let median = steps[steps.len() / 2];
+        let period = match dt_s {
+            Some(p) => p,
+            None => period_from_times(&[0.0, median]).expect("median step > 0"),
+        };
+        if !(period.is_finite() && period > 0.0) {
+            return Err(Error::BadParam {
+                name: "dt_s",
+                why: format!("{period} s is not a finite period > 0"),
+            });
+        }
+        for k in 1..n {
+            let gap = times[k] - times[k - 1];
+            if gap > MAX_RESAMPLE_GAP * period {
+                return Err(Error::BadTime {
+                    file: file.into(),
+                    line: line(k),
+                    column: tc + 1,
+                    why: format!(
+                        "a gap of {} s after {} s ({:.1} periods of {} s): resampling would \
+                         invent more than {MAX_RESAMPLE_GAP} missing samples; record the task \
+                         again or cut the file there",
+                        round_s(gap),
+                        times[k - 1],
+                        gap / period,
+                        round_s(period)
+                    ),
+                });
+            }
+        }
+        let names: Vec<String> = table
+            .names()
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != tc)
+            .map(|(_, n)| n.clone())
+            .collect();
+        let cols: Vec<usize> = (0..table.names().len()).filter(|&j| j != tc).collect();
+        let mut values: Vec<Vec<f64>> = Vec::with_capacity(cols.len());
+        for &j in &cols {
+            let mut v = Vec::with_capacity(n);
+            for r in 0..n {
+                let x = table.number(r, j)?;
+                if x.abs() > MAX_ABS_VALUE {
+                    return Err(Error::TooLarge {
+                        file: file.into(),
+                        line: line(r),
+                        column: j + 1,
+                        channel: table.names()[j].clone(),
+                        text: table.rows()[r].fields[j].into(),
+                    });
+                }
+                v.push(x);
+            }
+            values.push(v);
+        }
+        let binary: Vec<bool> = values
+            .iter()
+            .map(|v| v.iter().all(|&x| x == 0.0 || x == 1.0))
+            .collect();
+        let t0 = times[0];
+        let count = ((times[n - 1] - t0) / period + 1e-9).floor() as usize + 1;
+        let mut samples = Vec::with_capacity(count * cols.len());
+        let mut seg = 0;
+        for k in 0..count {
+            let t = t0 + k as f64 * period;
+            while seg + 2 < n && times[seg + 1] <= t {
+                seg += 1;
+            }
+            let (ta, tb) = (times[seg], times[seg + 1]);
+            let u = ((t - ta) / (tb - ta)).clamp(0.0, 1.0);
+            for (c, v) in values.iter().enumerate() {
+                let (a, b) = (v[seg], v[seg + 1]);
+                samples.push(if binary[c] {
+                    if u >= 1.0 { b } else { a }
+                } else {
+                    a + u * (b - a)
+                });
+            }
+        }
+        let demo = Self::new(names, samples, period)?
+            .with_source(file)
+            .with_period_source(PeriodSource::File);
+        let note = format!(
+            "{file}: resampled {n} rows (steps {} – {} s) onto {count} samples {} s apart ({} \
+             Hz), channels interpolated linearly, 0/1 channels held",
+            round_s(steps[0]),
+            round_s(steps[steps.len() - 1]),
+            round_s(period),
+            round_s(1.0 / period)
+        );
+        Ok((demo, note))
+    }
+
     /// Reads a JSON file: see [`Demonstration::from_json_str`].
     pub fn from_json_path(path: impl AsRef<Path>, dt_s: Option<f64>) -> Result<Self> {
         let (text, file) = read_text(path.as_ref())?;
@@ -567,8 +743,8 @@ fn time_column_period(
             format!(
                 "this time is {:.3} ms off the even grid of the file's mean period {} s \
                  ({:.1} % of a period; tandem accepts up to {} %: a dropped or repeated \
-                 sample, or an irregular log): resample the log onto an even grid, or remove \
-                 the `t` column and give the period with --dt",
+                 sample, or an irregular log): resample the log onto an even grid (`tandem fit \
+                 --resample`), or remove the `t` column and give the period with --dt",
                 dev * 1e3,
                 (mean * 1e6).round() / 1e6,
                 100.0 * dev / mean,
@@ -854,6 +1030,36 @@ mod tests {
             e.starts_with("j.csv:22:1:") && e.contains("30.0 % of a period"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn an_irregular_log_is_resampled_onto_its_median_grid() {
+        // 0.01 s steps with sample 3 (t = 0.03) missing; `a` a ramp, `on` a 0/1 signal.
+        let text = "t,a,on\n0,0,0\n0.01,1,0\n0.02,2,1\n0.04,4,1\n0.05,5,0\n";
+        let (d, note) = Demonstration::from_csv_str_resampled(text, "r.csv", None).unwrap();
+        assert_eq!(d.dt_s(), 0.01);
+        assert_eq!(d.n_samples(), 6);
+        let a: Vec<f64> = (0..6).map(|k| d.sample(k)[0]).collect();
+        for (k, v) in a.iter().enumerate() {
+            assert!((v - k as f64).abs() < 1e-9, "a[{k}] = {v}");
+        }
+        let on: Vec<f64> = (0..6).map(|k| d.sample(k)[1]).collect();
+        assert_eq!(on, [0.0, 0.0, 1.0, 1.0, 1.0, 0.0], "held, not interpolated");
+        assert!(
+            note.contains("resampled 5 rows") && note.contains("6 samples 0.01 s apart"),
+            "{note}"
+        );
+        // A gap of 5 periods is not papered over.
+        let gap = "t,a\n0,0\n0.01,1\n0.06,6\n0.07,7\n";
+        let e = Demonstration::from_csv_str_resampled(gap, "g.csv", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("g.csv:4:1:") && e.contains("a gap of 0.05 s"),
+            "{e}"
+        );
+        let none = Demonstration::from_csv_str_resampled("a\n1\n2\n", "n.csv", None);
+        assert!(none.unwrap_err().to_string().contains("no time column `t`"));
     }
 
     #[test]

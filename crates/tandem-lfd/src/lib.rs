@@ -83,7 +83,8 @@ pub use checks::{
 pub use csv::{CsvRow, CsvTable};
 pub use demo::{
     ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, JITTER_NOTE,
-    JITTER_TOLERANCE, MAX_ABS_VALUE, PeriodSource, QuaternionBlock, period_from_times,
+    JITTER_TOLERANCE, MAX_ABS_VALUE, MAX_RESAMPLE_GAP, PeriodSource, QuaternionBlock,
+    period_from_times,
 };
 pub use error::{Error, Result};
 pub use model::{
