@@ -426,6 +426,15 @@ def sim_run_round(
 def sim_sanding_needs(
     labels: Path, seed: int, task: Optional[Mapping[str, Any]] = None, robots: int = 2
 ) -> Bool: ...
+def sim_needs(
+    n_ref: int,
+    dt_s: float,
+    robots: int,
+    seed: int,
+    regions: Optional[List[Tuple[float, float, float]]] = None,
+    levels: Optional[List[float]] = None,
+    need_file: Optional[str] = None,
+) -> Bool: ...
 def sim_correction_input(
     planner: Planner, ref_time: float, force_channel: str = "force", gain: float = ...
 ) -> Optional[F64]: ...

@@ -15,17 +15,25 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 from os import PathLike
-from typing import Any, Mapping, Optional, Union
+from typing import Any, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from ._tandem import Planner, sim_correction_input, sim_run_round, sim_sanding_needs
+from ._tandem import (
+    Planner,
+    sim_correction_input,
+    sim_needs,
+    sim_run_round,
+    sim_sanding_needs,
+)
 
 __all__ = [
     "PairRun",
     "RobotRun",
     "RoundRun",
     "correction_input",
+    "low_confidence_regions",
+    "needs",
     "run_pair",
     "run_round",
     "sanding_needs",
@@ -163,6 +171,80 @@ def sanding_needs(
         ``(N, T_ref)`` bool array.
     """
     return sim_sanding_needs(labels, seed, task, robots)
+
+
+def needs(
+    regions: Optional[Sequence[Tuple[float, float, float]]] = None,
+    *,
+    levels: Any = None,
+    need_file: Union[str, PathLike, None] = None,
+    planner: Optional[Planner] = None,
+    n_ref: Optional[int] = None,
+    dt_s: Optional[float] = None,
+    robots: Optional[int] = None,
+    seed: int = 0,
+) -> np.ndarray:
+    """Which reference samples need the operator on ``N`` workpieces of your own task: the
+    ``needs`` argument of :func:`run_round`, for any task (``tandem need`` and
+    ``tandem simulate --need`` on the command line).
+
+    Give exactly one need profile:
+
+    * ``regions``: ``[(start_s, end_s, level), …]`` in reference seconds (sample ``n`` is at
+      ``n · dt_s``; ``start_s`` inclusive, ``end_s`` exclusive; regions must not overlap):
+      the workpiece needs the operator over the whole region with probability ``level``;
+    * ``levels``: one probability per reference sample; every run of equal values is a region;
+    * ``need_file``: a need file (the CSV ``tandem need`` writes and ``tandem simulate --need``
+      reads).
+
+    Each region is drawn once per workpiece (a defect covers its whole region or none of it):
+    one uniform draw per region, robot 1 first (ChaCha8 seeded with ``seed``), in the order
+    ``tandem simulate`` draws a round.
+
+    Args:
+        planner: takes ``n_ref``, ``dt_s`` and ``robots`` from it (its model and robot count).
+        n_ref: ``T_ref``, reference samples (without ``planner``).
+        dt_s: reference sample period (s) (without ``planner``).
+        robots: ``N``, one workpiece per robot (default: the planner's, else 2).
+        seed: seed of the draw.
+
+    Returns:
+        ``(N, T_ref)`` bool array.
+
+    Raises:
+        InputError: a region, level or need-file row that is unusable (the message names it).
+        ParamError: not exactly one profile, or neither ``planner`` nor ``n_ref``/``dt_s``.
+    """
+    if planner is not None:
+        n_ref = planner.model.n_ref if n_ref is None else n_ref
+        dt_s = planner.model.dt_s if dt_s is None else dt_s
+        robots = planner.n_robots if robots is None else robots
+    if n_ref is None or dt_s is None:
+        from . import ParamError
+
+        raise ParamError("tandem.sim.needs: give planner=… or both n_ref=… and dt_s=…")
+    # The reference period without floating-point noise (0.01, not 0.009999999999999998), so
+    # that region bounds in printed seconds hit the samples they name.
+    dt_s = round(float(dt_s), 9)
+    lv = None if levels is None else [float(v) for v in np.asarray(levels, dtype=float).ravel()]
+    rg = None if regions is None else [(float(a), float(b), float(p)) for a, b, p in regions]
+    return sim_needs(
+        int(n_ref),
+        dt_s,
+        2 if robots is None else int(robots),
+        seed,
+        regions=rg,
+        levels=lv,
+        need_file=None if need_file is None else str(need_file),
+    )
+
+
+def low_confidence_regions(planner: Planner) -> list:
+    """The planner's current low-confidence regions as ``[(start_s, end_s), …]`` in reference
+    seconds (``end_s`` exclusive): where the operator may be needed, the starting point of a
+    need profile for :func:`needs` when you do not know yet where your task needs help."""
+    dt = round(planner.model.dt_s, 9)
+    return [(int(a) * dt, int(b) * dt) for a, b in planner.confidence.low_regions]
 
 
 def correction_input(

@@ -186,3 +186,28 @@ def test_the_state_file_is_locked_and_never_overwritten_by_accident(tmp_path: Pa
     with pytest.raises(tandem.StateFileError, match="refusing to overwrite.*not a tandem state file"):
         other.save(csv)
     assert csv.read_text() == DEMOS[3].read_text()
+
+
+def test_a_time_column_wins_and_a_contradicting_dt_s_is_refused(tmp_path: Path) -> None:
+    """A file's own ``t`` column sets the period; ``dt_s`` (for arrays and files without time)
+    that contradicts it is a ParamError naming the file, not silently ignored. A logger's
+    jitter within 25 % of a period is accepted with a warning naming the worst line."""
+    with pytest.raises(tandem.ParamError, match=r"dt_s.*0\.02 s, but .*demo_0\.csv has its own time .* 0\.01 s"):
+        tandem.fit(DEMOS[:3], params=PARAMS, dt_s=0.02)
+    channels, x = load_arrays(DEMOS[0])
+    n = 1500
+    t = np.arange(n) * 0.01 + np.where((np.arange(n) % 7 == 3), 0.0015, 0.0)
+    rows = [",".join(["t", *channels])] + [
+        f"{float(ti)!r}," + ",".join(repr(float(v)) for v in xi) for ti, xi in zip(t, x[:n])
+    ]
+    jittered = tmp_path / "jittered.csv"
+    jittered.write_text("\n".join(rows) + "\n")
+    short = [tmp_path / f"s{k}.csv" for k in range(2)]
+    for k, p in enumerate(short):
+        _, xk = load_arrays(DEMOS[k + 1])
+        p.write_text("\n".join([",".join(["t", *channels])] + [
+            f"{i * 0.01:.2f}," + ",".join(repr(float(v)) for v in xi) for i, xi in enumerate(xk[:n])
+        ]) + "\n")
+    with pytest.warns(tandem.DataWarning, match=r"jittered\.csv:\d+: time column `t`: times deviate from the even grid of period 0\.01 s"):
+        planner = tandem.fit([jittered, *short], params=PARAMS)
+    assert planner.model.dt_s == 0.01

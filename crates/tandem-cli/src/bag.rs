@@ -31,6 +31,7 @@ pub(crate) fn read_demos(
     rate_hz: Option<f64>,
     topic_list: &[String],
     schema: &mut ChannelSchema,
+    resample: bool,
 ) -> Result<Vec<Demonstration>> {
     if let Some(r) = rate_hz
         && !(r.is_finite() && r > 0.0)
@@ -54,7 +55,11 @@ pub(crate) fn read_demos(
             demos.push(rec.demonstration()?);
             recordings.push(rec);
         } else {
-            demos.push(input::read_demo(p, dt_s)?);
+            demos.push(if resample {
+                input::read_demo_resampled(p, dt_s)?
+            } else {
+                input::read_demo(p, dt_s)?
+            });
         }
     }
     extend_schema(schema, &recordings);

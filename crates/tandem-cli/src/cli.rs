@@ -6,12 +6,14 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use tandem::lfd::Reference;
 use tandem::sim::workcell::OperatorParams;
 
-/// Coordinated two-robot shared autonomy from your own demonstrations (Hagenow et al., RA-L 2023).
+/// Coordinated multi-robot shared autonomy from your own demonstrations: one operator, 1 to 8
+/// robots (2 by default, --robots N at fit) (Hagenow et al., RA-L 2023).
 ///
 /// Typical session:
 ///
-///   tandem fit demo_*.csv -o cell.tandem        # learn the task and a first schedule
+///   tandem fit demo_1.csv demo_2.csv demo_3.csv -o cell.tandem   # learn the task, first schedule
 ///   tandem schedule cell.tandem                 # show it (text Gantt; --json for robots)
+///   tandem need cell.tandem --region 21.3-27.6=0.5 -o need.csv   # where workpieces need help
 ///   tandem simulate cell.tandem --need need.csv --rounds 5   # what-if, nothing saved
 ///   tandem record cell.tandem --execution a.csv --log a.reflog.csv --corrections a.corr.csv \
 ///                             --execution b.csv --log b.reflog.csv --corrections b.corr.csv
@@ -20,7 +22,9 @@ use tandem::sim::workcell::OperatorParams;
 ///
 /// Every user error prints `error: ...` naming the file and the problem and exits with
 /// code 2; a failing command writes nothing and leaves the state file as it was.
-/// File formats: docs/formats.md; walk-through: docs/guide.md.
+/// File formats: docs/formats.md; walk-through: docs/guide.md ("Your own task, end to end"
+/// for a task of your own, from CSV files to the robot loop in Python; its "Glossary" explains
+/// every term tandem prints: certificate, latched, margin-aware, fallback, …).
 #[derive(Debug, Parser)]
 #[command(name = "tandem", version, verbatim_doc_comment)]
 pub(crate) struct Cli {
@@ -102,8 +106,9 @@ pub(crate) enum Command {
     ///
     /// Writes model.{svg,png} (mean ± one standard deviation per channel and the speed
     /// bounds over reference time), confidence.{svg,png} (σ²_D(t), the high-confidence
-    /// map and the correction observations) and schedule.{svg,png} (both robots in global
-    /// time; blue = robot 1 low-confidence, red = robot 2 low-confidence). The folder is
+    /// map and the correction observations) and schedule.{svg,png} (every robot in global
+    /// time; blue = robot 1 low-confidence, red = robot 2 low-confidence, …; the bottom row
+    /// is whom the operator supervises). The folder is
     /// created if missing; existing files of these names are replaced.
     ///
     /// Example:
@@ -132,6 +137,25 @@ pub(crate) enum Command {
     ///   tandem simulate cell.tandem --need need.csv --rounds 20 --bag run.mcap
     #[command(verbatim_doc_comment)]
     Simulate(SimulateArgs),
+    /// Write a need file for `tandem simulate --need` from reference-time intervals.
+    ///
+    /// A region START-END=LEVEL says that a workpiece needs the operator from START to END
+    /// (reference seconds, as `tandem inspect` prints them; START inclusive, END exclusive)
+    /// with probability LEVEL in [0, 1]: one draw per region and workpiece, so a defect
+    /// covers its whole region or none of it. Samples outside every region never need the
+    /// operator. Instead of regions: a label file with one row per reference sample
+    /// (--from-labels FILE --column NAME: each run of equal values is a region, the value its
+    /// level, or --level P wherever the value is not 0), or every current low-confidence
+    /// region of the state at one level (--low-confidence LEVEL).
+    /// The output is a new file; an existing one is replaced only with --force.
+    ///
+    /// Example:
+    ///
+    ///   tandem need cell.tandem --region 21.3-27.6=0.5 --region 40-52=0.25 -o need.csv
+    ///   tandem need cell.tandem --from-labels demo_0.labels.csv --column defect --level 0.5 -o need.csv
+    ///   tandem need cell.tandem --low-confidence 0.5 -o need.csv
+    #[command(verbatim_doc_comment)]
+    Need(NeedArgs),
     /// Print the default parameter file (TOML) for `tandem fit --params`.
     ///
     /// Example:
@@ -174,9 +198,16 @@ pub(crate) struct FitArgs {
     /// prints the defaults).
     #[arg(long, value_name = "FILE")]
     pub(crate) params: Option<PathBuf>,
-    /// Sample period (s) of demonstrations without a time column `t`. Default: 0.01.
+    /// Sample period (s) of demonstrations without a time column `t`. Default: 0.01. A file
+    /// with its own time (`t`, JSON `dt_s`) uses it; a --dt that disagrees is an error.
     #[arg(long, value_name = "SECONDS")]
     pub(crate) dt: Option<f64>,
+    /// Resample CSV demonstrations with an irregular `t` column (dropped samples, a drifting
+    /// logger) onto an even grid: period --dt, or each file's median step; channels are
+    /// interpolated linearly, 0/1 channels held; a gap over 3 periods is refused. Without it,
+    /// a `t` column must stay within 25 % of a period of its even grid.
+    #[arg(long)]
+    pub(crate) resample: bool,
     /// ROS 2 bags: rate (Hz) of the grid every topic is resampled onto. Default: each bag's
     /// slowest selected topic's median message rate.
     #[arg(long, value_name = "HZ")]
@@ -291,6 +322,40 @@ pub(crate) struct PlotArgs {
     /// Output folder.
     #[arg(short, long, value_name = "DIR")]
     pub(crate) output: PathBuf,
+}
+
+/// `tandem need`.
+#[derive(Debug, Args)]
+pub(crate) struct NeedArgs {
+    /// The state file (read only): its reference's length and sample period.
+    pub(crate) state: PathBuf,
+    /// A region START-END=LEVEL in reference seconds (repeatable; regions must not overlap).
+    #[arg(long, value_name = "START-END=LEVEL", conflicts_with_all = ["from_labels", "low_confidence"])]
+    pub(crate) region: Vec<String>,
+    /// A CSV file with one row per reference sample (e.g. the reference demonstration's labels).
+    #[arg(
+        long,
+        value_name = "CSV",
+        requires = "column",
+        conflicts_with = "low_confidence"
+    )]
+    pub(crate) from_labels: Option<PathBuf>,
+    /// With --from-labels: the column to read.
+    #[arg(long, value_name = "NAME", requires = "from_labels")]
+    pub(crate) column: Option<String>,
+    /// With --from-labels: the level of every sample whose value is not 0 (default: the
+    /// values are the levels, each in [0, 1]).
+    #[arg(long, value_name = "P", requires = "from_labels")]
+    pub(crate) level: Option<f64>,
+    /// Every current low-confidence region of the state, at this level.
+    #[arg(long, value_name = "LEVEL")]
+    pub(crate) low_confidence: Option<f64>,
+    /// The need file to write (a new file unless --force).
+    #[arg(short, long, value_name = "CSV")]
+    pub(crate) output: PathBuf,
+    /// Replace an existing output file.
+    #[arg(long)]
+    pub(crate) force: bool,
 }
 
 /// `tandem simulate`. The operator's defaults are the study's

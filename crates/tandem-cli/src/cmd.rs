@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use serde_json::json;
-use tandem::lfd::{Demonstration, Execution, Reference, TaskModel};
+use tandem::lfd::{Demonstration, Execution, PeriodSource, Reference, TaskModel};
 use tandem::planner::reschedule_seed;
 use tandem::schedule::SamplerParams;
 use tandem::{ExecutionRecord, Planner, PlannerParams};
@@ -13,7 +13,7 @@ use crate::cli::{
     Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
 };
 use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_json, source_name};
-use crate::{bag, input, plot, sim, state_io};
+use crate::{bag, input, need, plot, sim, state_io};
 
 /// Runs one command.
 pub(crate) fn run(cli: Cli) -> Result<()> {
@@ -24,6 +24,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         Command::Inspect(a) => inspect(&a),
         Command::Plot(a) => plot_cmd(&a),
         Command::Simulate(a) => sim::simulate(&a),
+        Command::Need(a) => need::need(&a),
         Command::Params => params(),
     }
 }
@@ -86,11 +87,37 @@ fn fit(a: &FitArgs) -> Result<()> {
         bail!("--robots {}: one operator runs 1 to {max} robots", a.robots);
     }
     state_io::check_file_target(&a.output)?;
-    let demos: Vec<Demonstration> =
-        bag::read_demos(&a.demos, a.dt, a.rate, &a.topics, &mut params.fit.schema)?;
+    let demos: Vec<Demonstration> = bag::read_demos(
+        &a.demos,
+        a.dt,
+        a.rate,
+        &a.topics,
+        &mut params.fit.schema,
+        a.resample,
+    )?;
     for d in &demos {
         if let Some(n) = d.period_note() {
             note(&n);
+        }
+        // The file's own time wins over --dt; a --dt that contradicts it is refused.
+        if let Some(dt) = a.dt
+            && d.period_source() == PeriodSource::File
+            && !a.resample
+        {
+            if (d.dt_s() - dt).abs() > tandem::lfd::DT_TOLERANCE * dt {
+                bail!(
+                    "{}: --dt {dt} s, but its own time (`t` column or `dt_s`) gives {} s: \
+                     remove --dt (it is only for files without a time column) or fix the file",
+                    d.source(),
+                    secs(d.dt_s())
+                );
+            }
+            note(&format!(
+                "{}: its own time gives {} s; --dt (the period of files without a time column) \
+                 agrees and is not used for it",
+                d.source(),
+                secs(d.dt_s())
+            ));
         }
     }
     for w in tandem::lfd::length_warnings(&demos) {

@@ -9,6 +9,7 @@ use std::path::Path;
 use anyhow::{Context, Result, anyhow, bail};
 use tandem::PlannerParams;
 use tandem::lfd::{CsvTable, Demonstration};
+use tandem::sim::needs::NeedProfile;
 
 /// Reads a demonstration or execution: JSON when the extension is `.json`, CSV otherwise.
 /// `dt_s` is the sample period for files without a time column (CSV) or `dt_s` key (JSON).
@@ -23,6 +24,26 @@ pub(crate) fn read_demo(path: &Path, dt_s: Option<f64>) -> Result<Demonstration>
     } else {
         Demonstration::from_csv_path(path, dt_s)?
     })
+}
+
+/// Reads a CSV demonstration with an irregular `t` column resampled onto an even grid
+/// (`tandem fit --resample`, `Demonstration::from_csv_str_resampled`: period `dt_s` or the
+/// median step), printing what was done as a note. JSON files have no time column to
+/// resample and are refused.
+pub(crate) fn read_demo_resampled(path: &Path, dt_s: Option<f64>) -> Result<Demonstration> {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+    {
+        bail!(
+            "{}: --resample applies to CSV files with a `t` column; a JSON demonstration is \
+             already on an even grid (`dt_s`)",
+            path.display()
+        );
+    }
+    let (demo, what) = Demonstration::from_csv_path_resampled(path, dt_s)?;
+    crate::cmd::note(&what);
+    Ok(demo)
 }
 
 /// The text of `path` and the name errors use for it.
@@ -154,84 +175,12 @@ pub(crate) fn read_corrections(path: &Path) -> Result<(Vec<bool>, Vec<bool>)> {
     Ok((supervised, corrected))
 }
 
-/// Need probabilities per reference sample and the region of each sample.
-pub(crate) struct Need {
-    /// Probability in `[0, 1]` that reference sample `n` needs a correction on a workpiece.
-    pub(crate) p: Vec<f64>,
-    /// Region of each sample, numbered densely from 0: samples of one region share one
-    /// draw per workpiece.
-    pub(crate) region: Vec<usize>,
-}
-
-/// Reads a need file: column `need` in `[0, 1]` per reference sample (`n_ref` rows),
-/// optional integer column `region` (≥ 0) grouping samples into one draw; without it every
-/// maximal run of consecutive equal values is a region. All samples of a region must have
-/// the same probability.
-pub(crate) fn read_need(path: &Path, n_ref: usize) -> Result<Need> {
+/// Reads a need file (docs/formats.md; `tandem::sim::needs::NeedProfile::parse_csv`): column
+/// `need` in `[0, 1]` per reference sample (`n_ref` rows), optional whole-number column
+/// `region` grouping samples into one draw.
+pub(crate) fn read_need(path: &Path, n_ref: usize) -> Result<NeedProfile> {
     let (text, file) = read_text(path)?;
-    let t = Table::new(&text, &file)?;
-    t.only(&["need", "region"])?;
-    let p = t.numbers(t.column("need")?)?;
-    if p.len() != n_ref {
-        bail!(
-            "{}: {} rows, the model has {n_ref} reference samples (one row per reference sample)",
-            t.file(),
-            p.len()
-        );
-    }
-    if let Some(k) = p.iter().position(|v| !(0.0..=1.0).contains(v)) {
-        bail!(
-            "{}:{}:{}: `need` = {} is not a probability in [0, 1]",
-            t.file(),
-            t.line(k),
-            t.column("need")? + 1,
-            p[k]
-        );
-    }
-    let region = match t.csv.column("region") {
-        Some(j) => {
-            let ids = t.numbers(j)?;
-            let mut out = Vec::with_capacity(ids.len());
-            // User id → (dense index, first line, probability).
-            let mut seen: BTreeMap<u64, (usize, usize, f64)> = BTreeMap::new();
-            for (k, &v) in ids.iter().enumerate() {
-                if !(v >= 0.0 && v.fract() == 0.0 && v < 1e15) {
-                    bail!(
-                        "{}:{}:{}: `region` = {v} is not a whole number ≥ 0",
-                        t.file(),
-                        t.line(k),
-                        j + 1
-                    );
-                }
-                let id = v as u64;
-                let next = seen.len();
-                let (dense, line0, p0) = *seen.entry(id).or_insert((next, t.line(k), p[k]));
-                if p0 != p[k] {
-                    bail!(
-                        "{}:{}: region {id} has need {} here but {p0} on line {line0} (one \
-                         probability per region)",
-                        t.file(),
-                        t.line(k),
-                        p[k]
-                    );
-                }
-                out.push(dense);
-            }
-            out
-        }
-        None => {
-            let mut out = Vec::with_capacity(p.len());
-            let mut id = 0;
-            for k in 0..p.len() {
-                if k > 0 && p[k] != p[k - 1] {
-                    id += 1;
-                }
-                out.push(id);
-            }
-            out
-        }
-    };
-    Ok(Need { p, region })
+    Ok(NeedProfile::parse_csv(&text, &file, n_ref)?)
 }
 
 /// Reads a parameter file (TOML with sections `[fit]`, `[confidence]`, `[sampler]`) and
@@ -288,23 +237,6 @@ mod tests {
 
     fn names(v: &[&str]) -> Vec<String> {
         v.iter().map(|s| s.to_string()).collect()
-    }
-
-    #[test]
-    fn need_regions_are_dense_whatever_the_ids() {
-        let dir = std::env::temp_dir().join(format!("tandem-cli-need-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("need.csv");
-        std::fs::write(
-            &path,
-            "need,region\n0.5,900000000000\n0,3\n0.5,900000000000\n",
-        )
-        .unwrap();
-        let need = read_need(&path, 3).unwrap();
-        assert_eq!(need.region, [0, 1, 0]);
-        std::fs::write(&path, "need\n0\n0.5\n0.5\n0\n").unwrap();
-        assert_eq!(read_need(&path, 4).unwrap().region, [0, 1, 1, 2]);
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

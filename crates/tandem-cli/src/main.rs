@@ -10,6 +10,8 @@
 //! - `tandem inspect` and `tandem plot` show the model, the confidence and the schedule;
 //! - `tandem simulate` runs a simulated operator on the model (what-if) and can write the
 //!   executions in the formats `tandem record` reads;
+//! - `tandem need` writes a need file (the simulated operator's input) from reference-time
+//!   intervals;
 //! - `tandem params` prints the default parameter file.
 //!
 //! File formats: `docs/formats.md`. Walk-through: `docs/guide.md`.
@@ -21,6 +23,7 @@ mod cli;
 mod cmd;
 mod gantt;
 mod input;
+mod need;
 mod plot;
 mod sim;
 mod state_io;

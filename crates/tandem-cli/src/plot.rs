@@ -13,6 +13,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use tandem::Planner;
+use tandem::lfd::ChannelKind;
 use tandem::schedule::GlobalTimeline;
 use tandem_plot::{FONT_FAMILY, HIGH_CONFIDENCE, MEAN, NEITHER_LC, ROBOT_LC_N};
 /// Figure width (px, SVG user units).
@@ -125,6 +126,17 @@ fn padded(lo: f64, hi: f64) -> (f64, f64) {
     (lo - 0.05 * span, hi + 0.05 * span)
 }
 
+/// The y-axis unit of a channel of kind `kind`: metres and newtons as ROS and the fixtures
+/// record them; a plain channel is drawn in the units it was recorded in.
+fn unit_of(kind: ChannelKind) -> &'static str {
+    match kind {
+        ChannelKind::Position => "m",
+        ChannelKind::Force => "N",
+        ChannelKind::Binary => "0 = off, 1 = on",
+        _ => "as recorded",
+    }
+}
+
 /// One panel: a band and a line over reference time (s).
 struct Panel {
     title: String,
@@ -156,7 +168,11 @@ impl ModelFigure {
                     } else {
                         n.clone()
                     },
-                    unit: if rot { "deg".into() } else { String::new() },
+                    unit: if rot {
+                        "deg".into()
+                    } else {
+                        unit_of(planner.params().fit.schema.kind(n)).into()
+                    },
                     line: Vec::with_capacity(n_ref),
                     lo: Vec::with_capacity(n_ref),
                     hi: Vec::with_capacity(n_ref),
@@ -203,27 +219,30 @@ impl Figure for ModelFigure {
         root.fill(&WHITE).map_err(de)?;
         let (top, body) = root.split_vertically(40);
         top.titled(
-            "task model: mean ± 1 standard deviation over reference time",
+            "task model: mean ± 1 standard deviation over reference time (s)",
             (FONT_FAMILY, 20),
         )
         .map_err(de)?;
         let areas = body.split_evenly((self.panels.len(), 1));
         let t_end = self.panels[0].line.len().saturating_sub(1).max(1) as f64 * self.dt_s;
-        for (p, area) in self.panels.iter().zip(&areas) {
+        let last = self.panels.len() - 1;
+        for (k, (p, area)) in self.panels.iter().zip(&areas).enumerate() {
             let lo = p.lo.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = p.hi.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             let (y0, y1) = padded(lo, hi);
+            // Tick labels on every panel; the axis description only under the last one,
+            // with room below its tick labels (it was drawn over them).
             let mut chart = ChartBuilder::on(area)
                 .caption(&p.title, (FONT_FAMILY, 14))
                 .margin(5)
-                .x_label_area_size(22)
+                .x_label_area_size(if k == last { 40 } else { 22 })
                 .y_label_area_size(70)
                 .build_cartesian_2d(0.0..t_end, y0..y1)
                 .map_err(de)?;
             chart
                 .configure_mesh()
                 .light_line_style(WHITE)
-                .x_desc("reference time (s)")
+                .x_desc(if k == last { "reference time (s)" } else { "" })
                 .y_desc(p.unit.as_str())
                 .label_style((FONT_FAMILY, 11))
                 .draw()
@@ -443,7 +462,7 @@ impl Figure for ScheduleFigure {
         "schedule"
     }
     fn height(&self) -> u32 {
-        60 + 100 * self.spans.len() as u32
+        60 + 100 * (self.spans.len() as u32 + 1)
     }
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
         root.fill(&WHITE).map_err(de)?;
@@ -452,8 +471,18 @@ impl Figure for ScheduleFigure {
             .margin(10)
             .x_label_area_size(40)
             .y_label_area_size(10)
-            .build_cartesian_2d(0.0..self.t_total_s.max(1e-9), 0.0..self.spans.len() as f64)
+            .build_cartesian_2d(
+                0.0..self.t_total_s.max(1e-9),
+                0.0..(self.spans.len() + 1) as f64,
+            )
             .map_err(de)?;
+        // An interval narrower than two pixels is drawn two pixels wide, so that a
+        // one-sample low-confidence island is visible at the committed size.
+        let min_w = 2.0 * self.t_total_s.max(1e-9) / f64::from(WIDTH);
+        let widened = |(s, e): (f64, f64)| {
+            let pad = ((min_w - (e - s)) / 2.0).max(0.0);
+            (s - pad, e + pad)
+        };
         chart
             .configure_mesh()
             .disable_y_mesh()
@@ -468,8 +497,33 @@ impl Figure for ScheduleFigure {
             .draw()
             .map_err(de)?;
         let n = self.spans.len();
+        // The operator row (bottom): whom the operator supervises, in that robot's colour.
+        chart
+            .draw_series(std::iter::once(Text::new(
+                "operator: supervises the robot of that colour (white = nobody)",
+                (0.0, 0.83),
+                (FONT_FAMILY, 13)
+                    .into_font()
+                    .color(&BLACK)
+                    .pos(Pos::new(HPos::Left, VPos::Bottom)),
+            )))
+            .map_err(de)?;
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [(0.0, 0.2), (self.t_total_s, 0.8)],
+                BLACK.stroke_width(1),
+            )))
+            .map_err(de)?;
         for (i, colour) in ROBOT_LC_N.iter().take(n).enumerate() {
-            let y = (n - i) as f64 - 0.5;
+            chart
+                .draw_series(self.lc[i].iter().map(|&iv| {
+                    let (s, e) = widened(iv);
+                    Rectangle::new([(s, 0.2), (e, 0.8)], colour.filled())
+                }))
+                .map_err(de)?;
+        }
+        for (i, colour) in ROBOT_LC_N.iter().take(n).enumerate() {
+            let y = (n + 1 - i) as f64 - 0.5;
             let (a, b) = self.spans[i];
             chart
                 .draw_series(std::iter::once(Rectangle::new(
@@ -494,11 +548,10 @@ impl Figure for ScheduleFigure {
                 )))
                 .map_err(de)?;
             chart
-                .draw_series(
-                    self.lc[i].iter().map(|&(s, e)| {
-                        Rectangle::new([(s, y - 0.3), (e, y + 0.3)], colour.filled())
-                    }),
-                )
+                .draw_series(self.lc[i].iter().map(|&iv| {
+                    let (s, e) = widened(iv);
+                    Rectangle::new([(s, y - 0.3), (e, y + 0.3)], colour.filled())
+                }))
                 .map_err(de)?;
         }
         Ok(())

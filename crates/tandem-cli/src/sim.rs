@@ -151,23 +151,13 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
         Some(path) => Some(bag::RunBag::create(path, &planner)?),
         None => None,
     };
-    let n_regions = need.region.iter().copied().max().unwrap_or(0) + 1;
-    let mut region_p = vec![0.0; n_regions];
-    for (&r, &p) in need.region.iter().zip(&need.p) {
-        region_p[r] = p;
-    }
     let mut files: Vec<(PathBuf, String)> = Vec::new();
     out(
         "round  T_total ran (s)  actual (s)  supervised  corrected  overlap  → high-conf %  next T_total (s)",
     );
     for k in 0..rounds {
         let mut rng = ChaCha8Rng::seed_from_u64(derive_seed(a.seed, k as u64));
-        let needed: Vec<Vec<bool>> = (0..planner.n_robots())
-            .map(|_| {
-                let hit: Vec<bool> = region_p.iter().map(|&p| rng.random::<f64>() < p).collect();
-                need.region.iter().map(|&r| hit[r]).collect()
-            })
-            .collect();
+        let needed = need.draw(planner.n_robots(), &mut rng);
         let t_ran = planner.outcome().t_total_s;
         let round = run_round(&planner, &needed, &op, &mut rng)
             .with_context(|| format!("simulating round {}", k + 1))?;

@@ -113,7 +113,66 @@ fn malformed_demonstrations() {
         (
             "other_channels.csv",
             small_demo(50, 1.0).replace("t,x,force", "t,x,torque"),
-            vec!["torque", "differ from the reference channels"],
+            vec![
+                "torque",
+                "differ from the reference channels",
+                "rename the columns",
+            ],
+        ),
+        // Another separator: say so, and how to convert (decimal commas too).
+        (
+            "semicolons.csv",
+            "t;x;force\n0.00;0;5\n0.01;0.5;5\n0.02;1;5\n".into(),
+            vec![
+                ":1:1",
+                "3 fields separated by semicolons",
+                "save the file as CSV with commas",
+            ],
+        ),
+        (
+            "decimal_comma.csv",
+            "t;x;force\n0,00;0;5\n0,01;0,5;5\n0,02;1;5\n".into(),
+            vec!["separated by semicolons", "decimal points"],
+        ),
+        (
+            "tabs.csv",
+            "t\tx\tforce\n0.00\t0\t5\n0.01\t0.5\t5\n0.02\t1\t5\n".into(),
+            vec![":1:1", "3 fields separated by tabs"],
+        ),
+        // A dropped sample in the `t` column: refused with the fix (resample, or --dt).
+        (
+            "dropped.csv",
+            small_demo(60, 1.0)
+                .lines()
+                .enumerate()
+                .filter(|(k, _)| *k != 30)
+                .map(|(_, l)| format!("{l}\n"))
+                .collect(),
+            vec![
+                "time column `t`",
+                "off the even grid",
+                "tandem fit --resample",
+                "--dt",
+            ],
+        ),
+        // Another rate than the reference's: the period is printed without float noise.
+        (
+            "rate.csv",
+            small_demo(40, 1.0)
+                .lines()
+                .enumerate()
+                .map(|(k, l)| match k {
+                    0 => format!("{l}\n"),
+                    _ => {
+                        let (_, rest) = l.split_once(',').expect("t,x,force rows");
+                        format!("{},{rest}\n", (k - 1) as f64 * 0.02)
+                    }
+                })
+                .collect(),
+            vec![
+                "sample period 0.02 s differs from the reference 0.01 s",
+                "resample it",
+            ],
         ),
         (
             "dup_header.csv",
@@ -188,6 +247,109 @@ fn malformed_demonstrations() {
         assert!(stderr.contains(part), "`{part}` missing in:\n{stderr}");
     }
     std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
+    // A UTF-8 byte-order mark (spreadsheet export) is skipped; a ±1.5 ms jitter at 100 Hz is
+    // accepted with its worst deviation in a note; the fit goes through.
+    let bom = write(&dir, "bom.csv", &format!("\u{feff}{}", small_demo(60, 1.0)));
+    ok(&tandem(fit_with(&dir, &bom, false)));
+    std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
+    let jitter: String = small_demo(60, 1.0)
+        .lines()
+        .enumerate()
+        .map(|(k, l)| match k {
+            0 => format!("{l}\n"),
+            _ => {
+                let (_, rest) = l.split_once(',').expect("t,x,force rows");
+                let wobble = if k == 1 || k == 60 {
+                    0.0
+                } else {
+                    0.0015 * (k as f64).sin()
+                };
+                format!("{},{rest}\n", (k - 1) as f64 * 0.01 + wobble)
+            }
+        })
+        .collect();
+    let jitter = write(&dir, "jitter.csv", &jitter);
+    let out = tandem(fit_with(&dir, &jitter, false));
+    ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&format!("note: {}:", s(&jitter)))
+            && stderr.contains("times deviate from the even grid of period 0.01 s"),
+        "{stderr}"
+    );
+    std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
+    // --resample puts a log with a dropped sample back on its grid (with a note) and refuses
+    // a gap of more than 3 periods.
+    let dropped: String = small_demo(60, 1.0)
+        .lines()
+        .enumerate()
+        .filter(|(k, _)| *k != 30)
+        .map(|(_, l)| format!("{l}\n"))
+        .collect();
+    let dropped = write(&dir, "dropped_ok.csv", &dropped);
+    let mut args = fit_with(&dir, &dropped, false);
+    args.push("--resample".into());
+    let out = tandem(args);
+    ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&format!("note: {}: resampled 59 rows", s(&dropped)))
+            && stderr.contains("onto 60 samples 0.01 s apart"),
+        "{stderr}"
+    );
+    std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
+    let gap: String = small_demo(60, 1.0)
+        .lines()
+        .enumerate()
+        .filter(|(k, _)| !(20..25).contains(k))
+        .map(|(_, l)| format!("{l}\n"))
+        .collect();
+    let gap = write(&dir, "gap.csv", &gap);
+    let mut args = fit_with(&dir, &gap, false);
+    args.push("--resample".into());
+    expect_user_error(
+        &args,
+        &[&s(&gap), "a gap of 0.06 s", "record the task again"],
+        None,
+    );
+    // --dt contradicting a file's `t` column is refused, naming the file and both periods.
+    let mut args = fit_with(&dir, &jitter, false);
+    args.extend(["--dt".into(), "0.02".into()]);
+    expect_user_error(&args, &["--dt 0.02 s", "gives 0.01 s", "remove --dt"], None);
+    // A zero quaternion: named by its 1-based line and its block's channels.
+    let quat_demo = |n: usize, zero_at: Option<usize>| {
+        let mut text = String::from("t,x,qx,qy,qz,qw\n");
+        for k in 0..n {
+            let q = if Some(k) == zero_at {
+                "0,0,0,0"
+            } else {
+                "0,0,0,1"
+            };
+            writeln!(text, "{:.2},{},{q}", k as f64 * 0.01, k as f64 / n as f64).unwrap();
+        }
+        text
+    };
+    let quats: Vec<String> = (0..3)
+        .map(|i| {
+            let zero = (i == 2).then_some(20);
+            s(&write(
+                &dir,
+                &format!("quat_{i}.csv"),
+                &quat_demo(50 + i, zero),
+            ))
+        })
+        .collect();
+    let mut args = vec!["fit".to_string()];
+    args.extend(quats.iter().cloned());
+    args.extend(["--samples", "50", "-o"].map(String::from));
+    args.push(s(&dir.join("out.tandem")));
+    // Sample 20 is on line 22 (the header is line 1).
+    let at = format!("{}:22", quats[2]);
+    expect_user_error(
+        &args,
+        &[&at, "quaternion block (qx, qy, qz, qw)", "norm"],
+        None,
+    );
     // A missing file.
     let missing = dir.join("missing.csv");
     expect_user_error(
@@ -750,4 +912,139 @@ fn simulate_refuses_a_schedule_checked_at_another_tick() {
         &["0.005 s", "re-schedule"],
         Some(&state),
     );
+}
+
+/// `tandem need`: bad regions, label files and outputs name what is wrong and how to fix it;
+/// an existing output is never replaced without `--force`.
+#[test]
+fn bad_need_requests() {
+    let dir = scratch("bad-need-cmd");
+    let state = small_state(&dir);
+    let n = SMALL_N_REF;
+    let out_path = s(&dir.join("need.csv"));
+    let need = |extra: &[&str]| {
+        let mut v = vec!["need".to_string(), s(&state)];
+        v.extend(extra.iter().map(|x| x.to_string()));
+        v.extend(["-o".to_string(), out_path.clone()]);
+        v
+    };
+    let labels_short = s(&write(&dir, "short.labels.csv", "defect\n1\n0\n"));
+    let labels_prob = s(&write(
+        &dir,
+        "prob.labels.csv",
+        &format!("defect\n3\n{}", "0\n".repeat(n - 1)),
+    ));
+    // The small state's reference: SMALL_N_REF samples 0.01 s apart.
+    let duration = format!("lasts {} s", n as f64 * 0.01);
+    for (args, needles) in [
+        (
+            need(&["--region", "0.1-0.2"]),
+            vec!["START-END=LEVEL", "e.g. --region"],
+        ),
+        (
+            need(&["--region", "0.2-0.1=0.5"]),
+            vec!["region 1", "START < END"],
+        ),
+        (
+            need(&["--region", "0.1-0.2=1.5"]),
+            vec!["region 1", "not a probability"],
+        ),
+        (
+            need(&["--region", "0.1-9=0.5"]),
+            vec!["region 1", duration.as_str()],
+        ),
+        (
+            need(&["--region", "0.1-0.3=0.5", "--region", "0.2-0.4=0.5"]),
+            vec!["region 2", "overlaps region 1"],
+        ),
+        (
+            need(&["--from-labels", &labels_short, "--column", "pass"]),
+            vec![labels_short.as_str(), "--column pass", "no such column"],
+        ),
+        (
+            need(&["--from-labels", &labels_short, "--column", "defect"]),
+            vec![labels_short.as_str(), "2 rows", "one row per sample"],
+        ),
+        (
+            need(&["--from-labels", &labels_prob, "--column", "defect"]),
+            vec![&format!("{labels_prob}:2:1"), "--level P"],
+        ),
+        (
+            need(&[]),
+            vec!["--region START-END=LEVEL", "--low-confidence"],
+        ),
+    ] {
+        expect_user_error(&args, &needles, Some(&state));
+        assert!(!Path::new(&out_path).exists(), "{args:?} wrote a file");
+    }
+    // An existing file (not written by `tandem need`) is left alone without --force.
+    std::fs::write(&out_path, "my notes\n").unwrap();
+    expect_user_error(
+        &need(&["--region", "0.1-0.2=0.5"]),
+        &[&out_path, "exists", "--force"],
+        Some(&state),
+    );
+    assert_eq!(std::fs::read_to_string(&out_path).unwrap(), "my notes\n");
+    let mut forced = need(&["--region", "0.1-0.2=0.5"]);
+    forced.push("--force".into());
+    let out = tandem(&forced);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&out_path).unwrap();
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    assert_eq!(rows.len(), n);
+    // Samples 10..20 (0.10 s ≤ n·0.01 s < 0.20 s) form region 1 at level 0.5.
+    for (k, row) in rows.iter().enumerate() {
+        let want = if (10..20).contains(&k) {
+            "0.5,1"
+        } else {
+            "0,0"
+        };
+        assert_eq!(*row, want, "row {k}");
+    }
+    let out = tandem(&[
+        "simulate".to_string(),
+        s(&state),
+        "--need".into(),
+        out_path.clone(),
+        "--rounds".into(),
+        "1".into(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // From a label column: two defects (runs of 1) become regions at --level; each run of
+    // equal values is one region.
+    let mut labels = String::from("pass,defect\n");
+    for k in 0..n {
+        let defect = u8::from((5..8).contains(&k) || (30..40).contains(&k));
+        writeln!(labels, "{},{defect}", k / 20).unwrap();
+    }
+    let labels = s(&write(&dir, "demo_0.labels.csv", &labels));
+    let mut args = need(&[
+        "--from-labels",
+        &labels,
+        "--column",
+        "defect",
+        "--level",
+        "0.25",
+    ]);
+    args.push("--force".into());
+    ok(&tandem(&args));
+    let text = std::fs::read_to_string(&out_path).unwrap();
+    for (k, row) in text.lines().skip(1).enumerate() {
+        let want = match k {
+            5..8 => "0.25,1",
+            8..30 => "0,2",
+            30..40 => "0.25,3",
+            40.. => "0,4",
+            _ => "0,0",
+        };
+        assert_eq!(row, want, "row {k}");
+    }
 }

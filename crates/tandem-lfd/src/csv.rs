@@ -7,6 +7,9 @@
 //! non-blank line is a row of fields split at `,` and trimmed, with exactly as many fields
 //! as the header. Blank lines are skipped; line numbers count them (1-based).
 //! There is no quoting of fields: tandem's files hold numbers and names without commas.
+//! A UTF-8 byte-order mark (BOM, as spreadsheet programs write) before the header is
+//! skipped. A header of one column that contains `;` or a tab is a file in another
+//! separator: it is refused with [`Error::Separator`], saying how to convert it.
 
 use crate::{Error, Result};
 
@@ -32,10 +35,12 @@ impl<'a> CsvTable<'a> {
     /// Splits `text`; `file` names it in errors.
     ///
     /// # Errors
-    /// [`Error::EmptyFile`] without a header line, [`Error::BadHeader`] for an empty or
+    /// [`Error::EmptyFile`] without a header line, [`Error::Separator`] for a file separated
+    /// by `;` or tabs, [`Error::BadHeader`] for an empty or
     /// repeated column name, [`Error::RaggedRow`] for a row whose field count differs from
     /// the header's; each with the file, the 1-based line and the 1-based column.
     pub fn parse(text: &'a str, file: &str) -> Result<Self> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut lines = text
             .lines()
             .enumerate()
@@ -48,6 +53,24 @@ impl<'a> CsvTable<'a> {
             .split(',')
             .map(|f| f.trim().trim_matches('"').to_owned())
             .collect();
+        if names.len() == 1
+            && let Some((sep, name)) = [(';', "semicolons"), ('\t', "tabs")]
+                .into_iter()
+                .find(|(c, _)| header.contains(*c))
+        {
+            return Err(Error::Separator {
+                file: file.into(),
+                line: header_line,
+                separator: name,
+                columns: header.split(sep).count(),
+                decimal_comma: sep == ';'
+                    && text
+                        .lines()
+                        .skip(header_line)
+                        .take(3)
+                        .any(|l| l.contains(',')),
+            });
+        }
         let bad_header = |column: usize, why: String| Error::BadHeader {
             file: file.into(),
             line: header_line,

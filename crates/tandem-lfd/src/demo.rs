@@ -23,6 +23,20 @@ pub const MAX_ABS_VALUE: f64 = tandem_warp::MAX_ABS_VALUE;
 /// across demonstrations): 1 %.
 pub const DT_TOLERANCE: f64 = 0.01;
 
+/// Largest deviation of a `t` column's time from the file's even grid (first time plus
+/// multiples of the mean period), relative to the period, that a file may have: 25 % (a
+/// ±1.5 ms jitter at 100 Hz is 15 %; a dropped or repeated sample is at least 50 %).
+/// docs/decisions.md, "Timestamps: the mean period, jitter within 25 %".
+pub const JITTER_TOLERANCE: f64 = 0.25;
+
+/// Longest gap between two rows of a log that [`Demonstration::from_csv_str_resampled`]
+/// interpolates over, in grid periods: 3.
+pub const MAX_RESAMPLE_GAP: f64 = 3.0;
+
+/// Deviation from the even grid (relative to the period) above which the reader reports the
+/// worst one in [`Demonstration::period_note`]: 1 %.
+pub const JITTER_NOTE: f64 = 0.01;
+
 /// One demonstration `X_i ∈ R^{m × T_i}` (Eq. 1) in its own demo time.
 ///
 /// Samples are stored sample-major: sample `t` (demo samples), channel `j` at
@@ -40,6 +54,12 @@ pub struct Demonstration {
     samples: Vec<f64>,
     dt_s: f64,
     period: PeriodSource,
+    /// 1-based file line of each sample, for a demonstration read from CSV (errors about a
+    /// sample name its line, [`Demonstration::locate`]); `None` otherwise.
+    lines: Option<std::sync::Arc<[usize]>>,
+    /// The `t` column's worst step deviation from the period (s) and its 1-based line, when
+    /// it exceeds [`JITTER_NOTE`] of the period (reported by [`Demonstration::period_note`]).
+    jitter: Option<(f64, usize)>,
 }
 
 /// Equal channels, samples, period and source label; where the period came from
@@ -88,9 +108,20 @@ impl Demonstration {
             samples,
             dt_s,
             period: PeriodSource::Given,
+            lines: None,
+            jitter: None,
         };
         demo.check()?;
         Ok(demo)
+    }
+
+    /// Where sample `t` (0-based) is, for error messages: `file:line` when read from a CSV
+    /// file (1-based line), else `source, sample t (0-based)`.
+    pub fn locate(&self, t: usize) -> String {
+        match self.lines.as_deref().and_then(|l| l.get(t)) {
+            Some(line) => format!("{}:{line}", self.source),
+            None => format!("{}, sample {t} (0-based)", self.source),
+        }
     }
 
     /// Where [`Demonstration::dt_s`] came from (the file, the caller, or an assumption).
@@ -101,7 +132,25 @@ impl Demonstration {
     /// A sentence saying which sample period was assumed for a file without a time of its
     /// own ([`PeriodSource::Assumed`]), and how to state the real one; `None` otherwise.
     /// The command line prints it, the Python package raises it as a warning.
+    ///
+    /// For a `t` column whose times deviate from the even grid by more than [`JITTER_NOTE`]
+    /// of a period (but within [`JITTER_TOLERANCE`], else the file is refused), the sentence
+    /// gives the worst deviation and its line, and says that the samples are taken as evenly
+    /// spaced.
     pub fn period_note(&self) -> Option<String> {
+        if let (PeriodSource::File, Some((dev, line))) = (self.period, self.jitter) {
+            return Some(format!(
+                "{}:{line}: time column `t`: times deviate from the even grid of period {} s \
+                 ({} Hz) by up to {:.3} ms here ({:.1} % of a period; tandem accepts up to {} \
+                 %): the samples are taken to be evenly spaced",
+                self.source,
+                round_s(self.dt_s),
+                round_s(1.0 / self.dt_s),
+                dev * 1e3,
+                100.0 * dev / self.dt_s,
+                100.0 * JITTER_TOLERANCE
+            ));
+        }
         (self.period == PeriodSource::Assumed).then(|| {
             format!(
                 "{}: no time column `t`: its samples are taken to be {} s apart ({} Hz); \
@@ -251,6 +300,8 @@ impl Demonstration {
             samples,
             dt_s: self.dt_s,
             period: self.period,
+            lines: self.lines.clone(),
+            jitter: self.jitter,
         }))
     }
 
@@ -263,8 +314,11 @@ impl Demonstration {
     /// Parses CSV text: a header row of channel names, then one row of numbers per sample.
     ///
     /// A column named `t` (seconds) is optional; when present it is removed from the
-    /// channels, must be strictly increasing and evenly spaced within 1 %, and sets `Δt_s`
-    /// to its mean spacing. Otherwise `Δt_s` is `dt_s`, or [`DEFAULT_DT_S`] when `None`.
+    /// channels, must be strictly increasing with every time within [`JITTER_TOLERANCE`]
+    /// (25 %) of a period of the even grid of its mean spacing, and sets `Δt_s` to that
+    /// spacing, snapped to a whole rate in Hz within 0.1 % ([`period_from_times`]); `dt_s`
+    /// is then not used (the command line refuses a `--dt` that disagrees). Otherwise
+    /// `Δt_s` is `dt_s`, or [`DEFAULT_DT_S`] when `None`.
     /// The text is split by [`CsvTable`] (blank lines skipped, header names may be
     /// double-quoted); a value beyond `±`[`MAX_ABS_VALUE`] is rejected.
     /// `file` names the input in errors, which carry the 1-based line and field number.
@@ -311,17 +365,19 @@ impl Demonstration {
         }
         let n = table.rows().len();
         if n < 2 {
+            // The last line the file has: its only data row, or the header.
+            let last = table.rows().last().map_or(table.header_line(), |r| r.line);
             return Err(Error::TooFewSamples {
-                at: format!("{file}:{}:1", table.end_line()),
+                at: format!("{file}:{last}:1"),
                 found: n,
             });
         }
-        let (dt_s, period) = match t_col {
+        let ((dt_s, jitter), period) = match t_col {
             Some(col) => (
                 time_column_period(&times, file, col + 1)?,
                 PeriodSource::File,
             ),
-            None => (dt_s.unwrap_or(DEFAULT_DT_S), PeriodSource::Assumed),
+            None => ((dt_s.unwrap_or(DEFAULT_DT_S), None), PeriodSource::Assumed),
         };
         let channel_names = names
             .iter()
@@ -329,9 +385,184 @@ impl Demonstration {
             .filter(|(j, _)| Some(*j) != t_col)
             .map(|(_, n)| n.clone())
             .collect();
-        Ok(Self::new(channel_names, samples, dt_s)?
+        let mut demo = Self::new(channel_names, samples, dt_s)?
             .with_source(file)
-            .with_period_source(period))
+            .with_period_source(period);
+        demo.jitter = jitter;
+        demo.lines = Some(table.rows().iter().map(|r| r.line).collect());
+        Ok(demo)
+    }
+
+    /// Reads a CSV file resampled onto an even grid: see
+    /// [`Demonstration::from_csv_str_resampled`].
+    pub fn from_csv_path_resampled(
+        path: impl AsRef<Path>,
+        dt_s: Option<f64>,
+    ) -> Result<(Self, String)> {
+        let (text, file) = read_text(path.as_ref())?;
+        Self::from_csv_str_resampled(&text, &file, dt_s)
+    }
+
+    /// Parses CSV text with an irregular time column `t` (seconds) and resamples it onto the
+    /// even grid `t_0 + k·Δt_s` (`k = 0, 1, …` up to the last time): `Δt_s` is `dt_s`, or
+    /// the median step snapped like [`period_from_times`]. Every channel is interpolated
+    /// linearly between the two neighbouring rows, except a channel whose every value is 0
+    /// or 1 (an on/off signal), which holds the earlier row's value. Returns the
+    /// demonstration and a sentence saying what was done (for a note).
+    ///
+    /// Errors: as [`Demonstration::from_csv_str`] for the table and values; no `t` column;
+    /// times not strictly increasing; a gap longer than [`MAX_RESAMPLE_GAP`] grid periods
+    /// (resampling would invent the samples of a whole stretch).
+    pub fn from_csv_str_resampled(
+        text: &str,
+        file: &str,
+        dt_s: Option<f64>,
+    ) -> Result<(Self, String)> {
+        let table = CsvTable::parse(text, file)?;
+        if let Some(j) = table
+            .names()
+            .iter()
+            .position(|n| crate::checks::time_like(n))
+        {
+            return Err(Error::TimeLikeChannel {
+                file: file.into(),
+                line: Some(table.header_line()),
+                column: Some(j + 1),
+                channel: table.names()[j].clone(),
+            });
+        }
+        let Some(tc) = table.column("t") else {
+            return Err(Error::BadHeader {
+                file: file.into(),
+                line: table.header_line(),
+                column: 1,
+                why: "no time column `t`: resampling needs the time of every row".into(),
+            });
+        };
+        let n = table.rows().len();
+        let mut times = Vec::with_capacity(n);
+        for r in 0..n {
+            times.push(table.number(r, tc)?);
+        }
+        if n < 2 {
+            return Err(Error::TooFewSamples {
+                at: format!(
+                    "{file}:{}:1",
+                    table.rows().last().map_or(table.header_line(), |r| r.line)
+                ),
+                found: n,
+            });
+        }
+        let line = |k: usize| table.rows()[k].line;
+        for k in 1..n {
+            if times[k] <= times[k - 1] {
+                return Err(Error::BadTime {
+                    file: file.into(),
+                    line: line(k),
+                    column: tc + 1,
+                    why: format!(
+                        "{} does not increase after {} (times must be strictly increasing; \
+                         sort the log or remove repeated rows)",
+                        times[k],
+                        times[k - 1]
+                    ),
+                });
+            }
+        }
+        let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+        steps.sort_by(f64::total_cmp);
+        let median = steps[steps.len() / 2];
+        let period = match dt_s {
+            Some(p) => p,
+            None => period_from_times(&[0.0, median]).expect("median step > 0"),
+        };
+        if !(period.is_finite() && period > 0.0) {
+            return Err(Error::BadParam {
+                name: "dt_s",
+                why: format!("{period} s is not a finite period > 0"),
+            });
+        }
+        for k in 1..n {
+            let gap = times[k] - times[k - 1];
+            if gap > MAX_RESAMPLE_GAP * period {
+                return Err(Error::BadTime {
+                    file: file.into(),
+                    line: line(k),
+                    column: tc + 1,
+                    why: format!(
+                        "a gap of {} s after {} s ({:.1} periods of {} s): resampling would \
+                         invent more than {MAX_RESAMPLE_GAP} missing samples; record the task \
+                         again or cut the file there",
+                        round_s(gap),
+                        times[k - 1],
+                        gap / period,
+                        round_s(period)
+                    ),
+                });
+            }
+        }
+        let names: Vec<String> = table
+            .names()
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != tc)
+            .map(|(_, n)| n.clone())
+            .collect();
+        let cols: Vec<usize> = (0..table.names().len()).filter(|&j| j != tc).collect();
+        let mut values: Vec<Vec<f64>> = Vec::with_capacity(cols.len());
+        for &j in &cols {
+            let mut v = Vec::with_capacity(n);
+            for r in 0..n {
+                let x = table.number(r, j)?;
+                if x.abs() > MAX_ABS_VALUE {
+                    return Err(Error::TooLarge {
+                        file: file.into(),
+                        line: line(r),
+                        column: j + 1,
+                        channel: table.names()[j].clone(),
+                        text: table.rows()[r].fields[j].into(),
+                    });
+                }
+                v.push(x);
+            }
+            values.push(v);
+        }
+        let binary: Vec<bool> = values
+            .iter()
+            .map(|v| v.iter().all(|&x| x == 0.0 || x == 1.0))
+            .collect();
+        let t0 = times[0];
+        let count = ((times[n - 1] - t0) / period + 1e-9).floor() as usize + 1;
+        let mut samples = Vec::with_capacity(count * cols.len());
+        let mut seg = 0;
+        for k in 0..count {
+            let t = t0 + k as f64 * period;
+            while seg + 2 < n && times[seg + 1] <= t {
+                seg += 1;
+            }
+            let (ta, tb) = (times[seg], times[seg + 1]);
+            let u = ((t - ta) / (tb - ta)).clamp(0.0, 1.0);
+            for (c, v) in values.iter().enumerate() {
+                let (a, b) = (v[seg], v[seg + 1]);
+                samples.push(if binary[c] {
+                    if u >= 1.0 { b } else { a }
+                } else {
+                    a + u * (b - a)
+                });
+            }
+        }
+        let demo = Self::new(names, samples, period)?
+            .with_source(file)
+            .with_period_source(PeriodSource::File);
+        let note = format!(
+            "{file}: resampled {n} rows (steps {} – {} s) onto {count} samples {} s apart ({} \
+             Hz), channels interpolated linearly, 0/1 channels held",
+            round_s(steps[0]),
+            round_s(steps[steps.len() - 1]),
+            round_s(period),
+            round_s(1.0 / period)
+        );
+        Ok((demo, note))
     }
 
     /// Reads a JSON file: see [`Demonstration::from_json_str`].
@@ -449,8 +680,37 @@ fn too_large_why(value: f64) -> String {
     )
 }
 
-/// Checks a `t` column and returns its mean spacing (seconds).
-fn time_column_period(times: &[(usize, f64)], file: &str, column: usize) -> Result<f64> {
+/// The sample period (s) of evenly spaced times `t_0 … t_{n−1}` (s): the mean spacing
+/// `(t_{n−1} − t_0)/(n − 1)`, snapped to `1/f` when it is within 0.1 % of the period of a
+/// whole rate `f ≥ 1` Hz (a 100 Hz log with jitter gives exactly 0.01 s), else rounded to
+/// the nanosecond. `None` for fewer than 2 times or a spacing that is not finite > 0.
+#[must_use]
+pub fn period_from_times(times: &[f64]) -> Option<f64> {
+    let n = times.len();
+    if n < 2 {
+        return None;
+    }
+    let mean = (times[n - 1] - times[0]) / (n - 1) as f64;
+    if !(mean.is_finite() && mean > 0.0) {
+        return None;
+    }
+    let rate = (1.0 / mean).round();
+    if rate >= 1.0 && (1.0 / rate - mean).abs() <= 1e-3 * mean {
+        return Some(1.0 / rate);
+    }
+    Some(round_s(mean))
+}
+
+/// Checks a `t` column and returns its period ([`period_from_times`]) and, when some time
+/// deviates from the even grid by more than [`JITTER_NOTE`] of a period, the worst deviation
+/// (s) and its line. The grid is `t_0 + i·p` with `p` the mean spacing (exactly the line
+/// through the first and the last time); every time must lie within [`JITTER_TOLERANCE`] of
+/// a period of it, which refuses a dropped or repeated sample (at least half a period off).
+fn time_column_period(
+    times: &[(usize, f64)],
+    file: &str,
+    column: usize,
+) -> Result<(f64, Option<(f64, usize)>)> {
     let bad = |line: usize, why: String| Error::BadTime {
         file: file.into(),
         line,
@@ -461,22 +721,40 @@ fn time_column_period(times: &[(usize, f64)], file: &str, column: usize) -> Resu
         if w[1].1 <= w[0].1 {
             return Err(bad(
                 w[1].0,
-                format!("{} does not increase after {}", w[1].1, w[0].1),
+                format!(
+                    "{} does not increase after {} (times must be strictly increasing; sort \
+                     the log or remove repeated rows)",
+                    w[1].1, w[0].1
+                ),
             ));
         }
     }
     let n = times.len();
-    let mean = (times[n - 1].1 - times[0].1) / (n - 1) as f64;
-    for w in times.windows(2) {
-        let step = w[1].1 - w[0].1;
-        if (step - mean).abs() > DT_TOLERANCE * mean {
-            return Err(bad(
-                w[1].0,
-                format!("step {step} s differs from the mean step {mean} s by more than 1 %"),
-            ));
-        }
+    let (t0, mean) = (times[0].1, (times[n - 1].1 - times[0].1) / (n - 1) as f64);
+    let (dev, line) = times
+        .iter()
+        .enumerate()
+        .map(|(i, &(line, t))| ((t - (t0 + i as f64 * mean)).abs(), line))
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .expect("at least 2 times");
+    if dev > JITTER_TOLERANCE * mean {
+        return Err(bad(
+            line,
+            format!(
+                "this time is {:.3} ms off the even grid of the file's mean period {} s \
+                 ({:.1} % of a period; tandem accepts up to {} %: a dropped or repeated \
+                 sample, or an irregular log): resample the log onto an even grid (`tandem fit \
+                 --resample`), or remove the `t` column and give the period with --dt",
+                dev * 1e3,
+                (mean * 1e6).round() / 1e6,
+                100.0 * dev / mean,
+                100.0 * JITTER_TOLERANCE
+            ),
+        ));
     }
-    Ok(mean)
+    let values: Vec<f64> = times.iter().map(|&(_, t)| t).collect();
+    let period = period_from_times(&values).expect("strictly increasing, at least 2 times");
+    Ok((period, (dev > JITTER_NOTE * mean).then_some((dev, line))))
 }
 
 /// 1-based (line, column) of the start of row `row` of the top-level `samples` array, or
@@ -699,6 +977,100 @@ mod tests {
         assert_eq!(d.samples(), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
         assert!((d.dt_s() - 0.02).abs() < 1e-15);
         assert_eq!(d.source(), "f.csv");
+    }
+
+    /// `n` rows `t,a` at 100 Hz with the times moved by `jitter(i)` seconds.
+    fn jittered(n: usize, jitter: impl Fn(usize) -> f64) -> String {
+        let mut text = String::from("t,a\n");
+        for i in 0..n {
+            text.push_str(&format!("{},{i}\n", i as f64 * 0.01 + jitter(i)));
+        }
+        text
+    }
+
+    #[test]
+    fn a_jittered_100_hz_log_is_read_at_exactly_0_01_s_with_a_note() {
+        // ±1.5 ms of deterministic jitter (15 % of a period), the last time on the grid.
+        let text = jittered(500, |i| {
+            if i == 0 || i == 499 {
+                0.0
+            } else {
+                0.0015 * (i as f64 * 2.4).sin()
+            }
+        });
+        let d = Demonstration::from_csv_str(&text, "j.csv", None).unwrap();
+        assert_eq!(d.dt_s(), 0.01, "snapped to 100 Hz");
+        let note = d.period_note().expect("a jitter note");
+        assert!(note.starts_with("j.csv:"), "{note}");
+        assert!(
+            note.contains("period 0.01 s (100 Hz)") && note.contains("up to 25 %"),
+            "{note}"
+        );
+        // Exactly even times: no note, and the period is 0.01 exactly, not 0.009999….
+        let even = Demonstration::from_csv_str(&jittered(300, |_| 0.0), "e.csv", None).unwrap();
+        assert_eq!(even.dt_s(), 0.01);
+        assert_eq!(even.period_note(), None);
+    }
+
+    #[test]
+    fn a_dropped_sample_or_an_irregular_log_is_refused_with_the_fix() {
+        // Sample 100 is missing: every later time is one period late.
+        let text = jittered(300, |i| if i >= 100 { 0.01 } else { 0.0 });
+        let e = Demonstration::from_csv_str(&text, "d.csv", None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("d.csv:") && e.contains("time column `t`"), "{e}");
+        assert!(e.contains("resample the log") && e.contains("--dt"), "{e}");
+        // 30 % of a period off at one time.
+        let text = jittered(50, |i| if i == 20 { 0.003 } else { 0.0 });
+        let e = Demonstration::from_csv_str(&text, "j.csv", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("j.csv:22:1:") && e.contains("30.0 % of a period"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn an_irregular_log_is_resampled_onto_its_median_grid() {
+        // 0.01 s steps with sample 3 (t = 0.03) missing; `a` a ramp, `on` a 0/1 signal.
+        let text = "t,a,on\n0,0,0\n0.01,1,0\n0.02,2,1\n0.04,4,1\n0.05,5,0\n";
+        let (d, note) = Demonstration::from_csv_str_resampled(text, "r.csv", None).unwrap();
+        assert_eq!(d.dt_s(), 0.01);
+        assert_eq!(d.n_samples(), 6);
+        let a: Vec<f64> = (0..6).map(|k| d.sample(k)[0]).collect();
+        for (k, v) in a.iter().enumerate() {
+            assert!((v - k as f64).abs() < 1e-9, "a[{k}] = {v}");
+        }
+        let on: Vec<f64> = (0..6).map(|k| d.sample(k)[1]).collect();
+        assert_eq!(on, [0.0, 0.0, 1.0, 1.0, 1.0, 0.0], "held, not interpolated");
+        assert!(
+            note.contains("resampled 5 rows") && note.contains("6 samples 0.01 s apart"),
+            "{note}"
+        );
+        // A gap of 5 periods is not papered over.
+        let gap = "t,a\n0,0\n0.01,1\n0.06,6\n0.07,7\n";
+        let e = Demonstration::from_csv_str_resampled(gap, "g.csv", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("g.csv:4:1:") && e.contains("a gap of 0.05 s"),
+            "{e}"
+        );
+        let none = Demonstration::from_csv_str_resampled("a\n1\n2\n", "n.csv", None);
+        assert!(none.unwrap_err().to_string().contains("no time column `t`"));
+    }
+
+    #[test]
+    fn periods_snap_to_whole_rates_only_when_close() {
+        assert_eq!(period_from_times(&[0.0, 0.0100004, 0.0200008]), Some(0.01));
+        assert_eq!(period_from_times(&[0.0, 1.0 / 3.0]), Some(1.0 / 3.0));
+        // 0.0123 s is 81.3 Hz, 0.4 % from 81 Hz: rounded to the nanosecond, not snapped.
+        assert_eq!(period_from_times(&[0.0, 0.0123]), Some(0.0123));
+        assert_eq!(period_from_times(&[0.0, 2.5]), Some(2.5));
+        assert_eq!(period_from_times(&[1.0]), None);
+        assert_eq!(period_from_times(&[1.0, 1.0]), None);
     }
 
     #[test]

@@ -107,6 +107,28 @@ pub enum Error {
         /// What is wrong.
         why: String,
     },
+    /// A CSV file separated by `;` or tabs instead of commas (its header is one column).
+    #[error(
+        "{file}:{line}:1: the header is one column, but it holds {columns} fields separated by \
+         {separator}: tandem reads comma-separated files; save the file as CSV with commas{}",
+        if *decimal_comma {
+            " and decimal points (its numbers seem to use decimal commas)"
+        } else {
+            " (e.g. `tr ';\\t' ',,' < in.csv > out.csv`)"
+        }
+    )]
+    Separator {
+        /// The file.
+        file: String,
+        /// 1-based line of the header.
+        line: usize,
+        /// The separator found: `"semicolons"` or `"tabs"`.
+        separator: &'static str,
+        /// Number of fields the header would have with that separator.
+        columns: usize,
+        /// Whether the data rows also hold commas (decimal commas, `1,5;2,0`).
+        decimal_comma: bool,
+    },
     /// A JSON document could not be parsed or has the wrong shape.
     #[error("{file}:{line}:{column}: {why}")]
     Json {
@@ -135,7 +157,11 @@ pub enum Error {
         found: usize,
     },
     /// A demonstration's channel set differs from the reference demonstration's.
-    #[error("{file}: channels {found:?} differ from the reference channels {expected:?}")]
+    #[error(
+        "{file}: channels {found:?} differ from the reference channels {expected:?} (every \
+         demonstration needs the same channel names, in any order: rename the columns or \
+         leave the file out)"
+    )]
     ChannelMismatch {
         /// The file or source label of the offending demonstration.
         file: String,
@@ -209,7 +235,11 @@ pub enum Error {
     },
     /// Sample periods differ by more than 1 %.
     #[error(
-        "{file}: sample period {found_s} s differs from the reference {expected_s} s by more than 1 %"
+        "{file}: sample period {} s differs from the reference {} s by more than 1 % (resample \
+         it to the reference's rate; for a file without a `t` column the period is --dt, \
+         default 0.01 s)",
+        (found_s * 1e9).round() / 1e9,
+        (expected_s * 1e9).round() / 1e9
     )]
     SamplePeriodMismatch {
         /// The file or source label.

@@ -43,7 +43,8 @@
 //!   computed lazily on first use after a fit, load or update (an update alone stays cheap).
 //! - **Executions.** An execution's warp is the inverse of its reference-time log
 //!   ([`TaskModel::execution_warp`]); no re-alignment. All demonstrations and executions must
-//!   share `Δt_s` within 1 %.
+//!   share `Δt_s` within 1 %; a `t` column may jitter by up to 25 % of a period around its
+//!   even grid.
 //! - **Reference.** [`Reference::First`] (default) keeps the user's choice; with
 //!   [`Reference::Medoid`] every demonstration is tried as the reference and the one with
 //!   the least total alignment objective wins, and the model no longer depends on the order
@@ -81,8 +82,9 @@ pub use checks::{
 };
 pub use csv::{CsvRow, CsvTable};
 pub use demo::{
-    ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, MAX_ABS_VALUE,
-    PeriodSource, QuaternionBlock,
+    ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, JITTER_NOTE,
+    JITTER_TOLERANCE, MAX_ABS_VALUE, MAX_RESAMPLE_GAP, PeriodSource, QuaternionBlock,
+    period_from_times,
 };
 pub use error::{Error, Result};
 pub use model::{

@@ -235,6 +235,7 @@ fn classify_lfd(e: &errors::Lfd) -> Kind {
             file, line, column, ..
         } => located(file, *line, *column),
         E::EmptyFile { file } => located(file, 1, 1),
+        E::Separator { file, line, .. } => located(file, *line, 1),
         E::TimeLikeChannel {
             file,
             line: Some(line),

@@ -3,7 +3,9 @@
 pub(crate) use tandem::confidence::{
     BetaParams, Observations, posterior, prior, prior_low_threshold, prob_need_below_mu_c,
 };
-pub(crate) use tandem::lfd::{DEFAULT_DT_S, Demonstration, Execution, TaskModel, length_warnings};
+pub(crate) use tandem::lfd::{
+    DEFAULT_DT_S, DT_TOLERANCE, Demonstration, Execution, PeriodSource, TaskModel, length_warnings,
+};
 pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{
     Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, reschedule_seed,
@@ -13,6 +15,7 @@ pub(crate) use tandem::schedule::{
     CheckedSchedule, GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, Violation,
     sample_schedule_n,
 };
+pub(crate) use tandem::sim::needs::{NeedProfile, NeedRegion};
 pub(crate) use tandem::sim::study::{
     PhaseTimes, StudyConfig, StudyInputs, read_labels, run_trial, run_trials,
 };

@@ -62,7 +62,7 @@ mod _tandem {
     #[pymodule_export]
     use crate::schedule::{PyProblem, PySchedule};
     #[pymodule_export]
-    use crate::sim::{sim_correction_input, sim_run_round, sim_sanding_needs};
+    use crate::sim::{sim_correction_input, sim_needs, sim_run_round, sim_sanding_needs};
     #[pymodule_export]
     use crate::study::{PyStudyTask, study_config, study_prepare, study_run, study_run_trial};
     #[pymodule_export]

@@ -13,9 +13,10 @@ use crate::arrays::{flags, matrix, out_flags, out_matrix, out_vector, repr_list,
 use crate::errors::{Error, Result, deprecated, guard, warn};
 use crate::facade::{BagOptions, Recording, extend_bag_schema, is_bag, read_bag};
 use crate::facade::{
-    BetaParams, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, Demonstration, Execution, ExecutionRecord,
-    Observations, Planner, PlannerParams, RecordReport, StateLock, TaskModel, errors,
-    length_warnings, posterior, prior, prior_low_threshold, prob_need_below_mu_c, reschedule_seed,
+    BetaParams, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, DT_TOLERANCE, Demonstration, Execution,
+    ExecutionRecord, Observations, PeriodSource, Planner, PlannerParams, RecordReport, StateLock,
+    TaskModel, errors, length_warnings, posterior, prior, prior_low_threshold,
+    prob_need_below_mu_c, reschedule_seed,
 };
 use crate::params::{from_py, serialize_to_py};
 use crate::schedule::PyProblem;
@@ -163,7 +164,24 @@ fn demonstrations(
                 array: channels,
                 file: channels,
             };
-            demonstration(d, &format!("demos[{k}]"), both, dt_s, Some(&mut recordings))
+            let demo = demonstration(d, &format!("demos[{k}]"), both, dt_s, Some(&mut recordings))?;
+            // A file's own time wins over dt_s; a dt_s that contradicts it is refused.
+            if let Some(dt) = dt_s
+                && demo.period_source() == PeriodSource::File
+                && (demo.dt_s() - dt).abs() > DT_TOLERANCE * dt
+            {
+                return Err(Error::param(
+                    "dt_s",
+                    format!(
+                        "{dt} s, but {} has its own time (`t` column or `dt_s`) giving {} s: \
+                         leave dt_s out (it is for arrays and files without a time column) or \
+                         fix the file",
+                        demo.source(),
+                        (demo.dt_s() * 1e9).round() / 1e9
+                    ),
+                ));
+            }
+            Ok(demo)
         })
         .collect::<Result<Vec<_>>>()?;
     extend_bag_schema(&mut params.fit.schema, &recordings);

@@ -12,8 +12,8 @@ use rand_chacha::ChaCha8Rng;
 use crate::arrays::{flag_matrix, out_flags, out_matrix, out_vector};
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
-    MAX_ROBOTS, OperatorParams, RoundRun, TaskParams, Workpiece, correction_input,
-    needs_correction, read_labels, run_round_with,
+    MAX_ROBOTS, NeedProfile, NeedRegion, OperatorParams, RoundRun, TaskParams, Workpiece,
+    correction_input, needs_correction, read_labels, run_round_with,
 };
 use crate::params::from_py;
 use crate::planner::{N_ROBOTS, PyPlanner};
@@ -116,6 +116,74 @@ pub(crate) fn sim_sanding_needs<'py>(
         Ok((out, labels.len()))
     })?;
     Ok(out_matrix(py, flat.0, flat.1)?)
+}
+
+/// Which reference samples need the operator on `robots` workpieces (`tandem.sim.needs`):
+/// a `(robots, n_ref)` bool array drawn from a need profile (`tandem_sim::needs`), one draw
+/// per region and workpiece (ChaCha8 seeded with `seed`; robot 1 first, regions in order, as
+/// `tandem simulate` draws each round). The profile comes from exactly one of `regions`
+/// (`(start_s, end_s, level)` in reference seconds, end exclusive), `levels` (one
+/// probability per reference sample; runs of equal values are regions) or `need_file` (the
+/// CSV `tandem simulate --need` reads).
+#[pyfunction]
+#[pyo3(signature = (n_ref, dt_s, robots, seed, regions=None, levels=None, need_file=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn sim_needs<'py>(
+    py: Python<'py>,
+    n_ref: usize,
+    dt_s: f64,
+    robots: usize,
+    seed: u64,
+    regions: Option<Vec<(f64, f64, f64)>>,
+    levels: Option<Vec<f64>>,
+    need_file: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyArray2<bool>>> {
+    if !(1..=MAX_ROBOTS).contains(&robots) {
+        return Err(Error::param("robots", format!("{robots}: must be 1 to {MAX_ROBOTS}")).into());
+    }
+    let given = usize::from(regions.is_some())
+        + usize::from(levels.is_some())
+        + usize::from(need_file.is_some());
+    if given != 1 {
+        return Err(Error::param(
+            "needs",
+            "give exactly one of regions=[(start_s, end_s, level), …], levels=…, need_file=…",
+        )
+        .into());
+    }
+    let flat = guard(|| {
+        let profile = if let Some(regions) = regions {
+            let regions: Vec<NeedRegion> = regions
+                .into_iter()
+                .map(|(start_s, end_s, level)| NeedRegion {
+                    start_s,
+                    end_s,
+                    level,
+                })
+                .collect();
+            NeedProfile::from_regions(&regions, n_ref, dt_s)?
+        } else if let Some(levels) = levels {
+            if levels.len() != n_ref {
+                return Err(Error::input(
+                    "levels",
+                    format!(
+                        "{} values, expected one per reference sample ({n_ref})",
+                        levels.len()
+                    ),
+                ));
+            }
+            NeedProfile::from_levels(&levels)?
+        } else {
+            let path = need_file.expect("exactly one source is given (checked above)");
+            let file = path.display().to_string();
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| Error::input(file.clone(), format!("cannot read: {e}")))?;
+            NeedProfile::parse_csv(&text, &file, n_ref)?
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        Ok(profile.draw(robots, &mut rng).concat())
+    })?;
+    Ok(out_matrix(py, flat, n_ref)?)
 }
 
 /// The simulated operator's joystick input `u` (shape `(K,)`) for a correction at

@@ -71,6 +71,14 @@ pub enum Error {
         /// What is wrong.
         why: String,
     },
+    /// Need profile (`crate::needs`): a region, level or need-file row is unusable.
+    #[error("{at}: {why}")]
+    Need {
+        /// Where: `file:line:column` of a need file, or `region K (…)` of a region list.
+        at: String,
+        /// What is wrong and how to fix it.
+        why: String,
+    },
     /// Workcell and study: the task model (commands, corrections, executions, the fit).
     #[error(transparent)]
     Lfd(#[from] tandem_lfd::Error),

@@ -13,6 +13,8 @@
 //! ([`workcell::run_pair`]`(&planner, …)` reads model, problem, schedule and control tick from
 //! the one `tandem_planner::Planner`), and turns the pair into the planner's execution records
 //! ([`workcell::PairRun::records`]).
+//! A need profile ([`needs`]) says where a workpiece needs the operator, for any task: from
+//! reference-time regions, per-sample levels or a need file.
 //! The [`study`] is the paper's §III loop (Fig. 5): per trial, schedule, run a pair, record
 //! it, re-schedule, 150 times; trials in parallel, the same bytes for a seed on any number of
 //! threads.
@@ -43,6 +45,7 @@
 //! ```
 
 mod error;
+pub mod needs;
 pub mod study;
 pub mod task;
 pub mod truth;

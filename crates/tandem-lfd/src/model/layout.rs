@@ -140,11 +140,13 @@ impl Layout {
                     let s = demo.sample(t);
                     let q = cols.map(|c| s[c]);
                     if quat::norm(&q) < 1e-6 {
+                        let names = cols.map(|c| demo.channel_names()[c].as_str());
                         return Err(Error::BadData {
-                            what: demo.source().into(),
+                            what: demo.locate(t),
                             why: format!(
-                                "sample {t}: quaternion `{}` has norm {} (≈ 0)",
-                                demo.channel_names()[cols[0]],
+                                "quaternion block ({}) has norm {:e} (≈ 0), which is no \
+                                 orientation: check the export of these columns",
+                                names.join(", "),
                                 quat::norm(&q)
                             ),
                         });
