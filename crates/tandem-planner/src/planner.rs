@@ -1005,6 +1005,14 @@ mod tests {
     use super::*;
     use crate::state::{CrashPoint, encode, write_atomic_with};
 
+    /// An empty folder `<temp>/<name>-<pid>` for one test's files.
+    fn scratch(name: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
     /// A small planner: three 1-channel demonstrations, aligned by the identity warp, whose
     /// force differs only on reference samples 10..20 (low confidence there).
     fn small_planner(seed: u64) -> Planner {
@@ -1077,9 +1085,7 @@ mod tests {
 
     #[test]
     fn a_crash_while_saving_keeps_the_previous_state() {
-        let dir = std::env::temp_dir().join(format!("tandem-planner-crash-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("tandem-planner-crash");
         let path = dir.join("cell.tandem");
         let old = small_planner(1);
         old.save(&path).unwrap();
@@ -1099,10 +1105,7 @@ mod tests {
 
     #[test]
     fn a_stored_schedule_that_fails_the_check_is_replaced_on_load_never_run() {
-        let dir =
-            std::env::temp_dir().join(format!("tandem-planner-recheck-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("tandem-planner-recheck");
         let path = dir.join("cell.tandem");
         let p = small_planner(1);
         p.save(&path).unwrap();
@@ -1276,9 +1279,7 @@ mod tests {
         }
         // Another round records; the fingerprints survive a save and a load.
         p.record_round(&round(&p, 0.2, 0.3, 1, 0.01)).unwrap();
-        let dir = std::env::temp_dir().join(format!("tandem-planner-dup-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("tandem-planner-dup");
         let path = dir.join("cell.tandem");
         p.save(&path).unwrap();
         let mut q = Planner::load(&path).unwrap();
@@ -1332,9 +1333,7 @@ mod tests {
 
     #[test]
     fn a_save_refuses_to_overwrite_what_another_process_saved_since_the_load() {
-        let dir = std::env::temp_dir().join(format!("tandem-planner-cas-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("tandem-planner-cas");
         let path = dir.join("cell.tandem");
         small_planner(7).save(&path).unwrap();
         let mut mine = Planner::load(&path).unwrap();
@@ -1365,9 +1364,7 @@ mod tests {
 
     #[test]
     fn two_concurrent_writers_lose_no_round() {
-        let dir = std::env::temp_dir().join(format!("tandem-planner-two-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("tandem-planner-two");
         let path = dir.join("cell.tandem");
         let start = small_planner(8);
         start.save(&path).unwrap();
