@@ -41,6 +41,14 @@ pub enum Error {
         /// `ψ̇max`.
         max: f64,
     },
+    /// A hold point is out of range or out of order ([`crate::Problem::with_holds`]).
+    #[error("hold point at reference sample {ref_idx} {why}")]
+    BadHold {
+        /// The offending hold (reference sample).
+        ref_idx: usize,
+        /// What is wrong with it.
+        why: &'static str,
+    },
     /// A parameter is out of range.
     #[error("parameter `{name}` {why}")]
     BadParam {

@@ -22,6 +22,7 @@ pub struct Problem {
     grad_max: Vec<f64>,
     dt_s: f64,
     runs: Vec<Run>,
+    holds: Vec<usize>,
 }
 
 /// Serialized form of [`Problem`]; deserialization goes through [`Problem::new`].
@@ -33,12 +34,15 @@ struct ProblemData {
     grad_min: Vec<f64>,
     grad_max: Vec<f64>,
     dt_s: f64,
+    /// Absent in problems written before hold points existed: no holds.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    holds: Vec<usize>,
 }
 
 impl TryFrom<ProblemData> for Problem {
     type Error = Error;
     fn try_from(d: ProblemData) -> Result<Self> {
-        Problem::new(d.conf, d.grad_mean, d.grad_min, d.grad_max, d.dt_s)
+        Problem::new(d.conf, d.grad_mean, d.grad_min, d.grad_max, d.dt_s)?.with_holds(d.holds)
     }
 }
 
@@ -50,6 +54,7 @@ impl From<Problem> for ProblemData {
             grad_min: p.grad_min,
             grad_max: p.grad_max,
             dt_s: p.dt_s,
+            holds: p.holds,
         }
     }
 }
@@ -119,7 +124,52 @@ impl Problem {
             grad_max,
             dt_s,
             runs,
+            holds: Vec::new(),
         })
+    }
+
+    /// The same problem with hold points: reference samples `n` at which a robot may dwell
+    /// for any time (its execution clock stopped at sample `n`) without harm, e.g. where the
+    /// tool is lifted between passes (§II-C: "stop certain robots"). The task start is always
+    /// one and is not listed: it is the start offset `τ_i`.
+    ///
+    /// `holds` must be strictly increasing reference-sample indices `< T_ref`. A hold on a
+    /// low-confidence sample is kept but inactive while that sample is low-confidence: a
+    /// robot that needs the operator is never stopped there. An empty list is the problem
+    /// without holds, bit for bit.
+    ///
+    /// # Errors
+    /// [`Error::BadHold`] naming the first hold out of range or out of order.
+    pub fn with_holds(mut self, holds: Vec<usize>) -> Result<Self> {
+        let n_ref = self.n_ref();
+        for (i, &h) in holds.iter().enumerate() {
+            if h >= n_ref {
+                return Err(Error::BadHold {
+                    ref_idx: h,
+                    why: "is past the last reference sample",
+                });
+            }
+            if i > 0 && holds[i - 1] >= h {
+                return Err(Error::BadHold {
+                    ref_idx: h,
+                    why: "is not after the hold before it (holds must be strictly increasing)",
+                });
+            }
+        }
+        self.holds = holds;
+        Ok(self)
+    }
+
+    /// Hold points (reference samples, strictly increasing, `< T_ref`; see
+    /// [`Problem::with_holds`]); empty for a problem without holds.
+    pub fn holds(&self) -> &[usize] {
+        &self.holds
+    }
+
+    /// The hold points at which a robot may dwell now: those on high-confidence samples
+    /// (reference samples, increasing).
+    pub fn active_holds(&self) -> impl Iterator<Item = usize> + '_ {
+        self.holds.iter().copied().filter(|&h| self.conf[h])
     }
 
     /// Number of reference samples `T_ref` (≥ 1).
@@ -258,6 +308,27 @@ mod tests {
 
     fn ok() -> Problem {
         hllh(0.01)
+    }
+
+    #[test]
+    fn holds_are_checked_kept_through_serde_and_inactive_on_low_confidence() {
+        // hllh: samples 0 and 3 high-confidence, 1 and 2 low.
+        let p = ok().with_holds(vec![0, 2, 3]).unwrap();
+        assert_eq!(p.holds(), &[0, 2, 3]);
+        assert_eq!(p.active_holds().collect::<Vec<_>>(), vec![0, 3]);
+        let back: Problem = serde_json::from_str(&serde_json::to_string(&p).unwrap()).unwrap();
+        assert_eq!(back.holds(), &[0, 2, 3]);
+        // Without holds the serialized form is the one written before holds existed.
+        let json = serde_json::to_string(&ok()).unwrap();
+        assert!(!json.contains("holds"), "{json}");
+        assert!(matches!(
+            ok().with_holds(vec![4]),
+            Err(Error::BadHold { ref_idx: 4, .. })
+        ));
+        assert!(matches!(
+            ok().with_holds(vec![2, 2]),
+            Err(Error::BadHold { ref_idx: 2, .. })
+        ));
     }
 
     #[test]
