@@ -110,3 +110,70 @@ fn variance_and_first_component_follow_the_task_structure() {
         assert!(model.grad_mean()[n] <= model.grad_max()[n] + 1e-12);
     }
 }
+
+/// The operator's rule of the simulated study: `u_k = ±gain` with the sign that raises the
+/// force, 0 where component `k` does not move it.
+fn force_raising(components: &[Vec<f64>], force: usize) -> Vec<f64> {
+    components
+        .iter()
+        .map(|c| {
+            if c[force] > 0.0 {
+                0.5
+            } else if c[force] < 0.0 {
+                -0.5
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn local_frame_gives_the_task_frames_commands_bit_for_bit() {
+    let model = TaskModel::fit(&load_demos(), &FitParams::default()).unwrap();
+    // A clone made before any correction is computed: its local look-ups decompose one
+    // sample at a time, the table of `model` decomposes all at once.
+    let lazy = model.clone();
+    let force = model
+        .tangent_names()
+        .iter()
+        .position(|n| n == "force")
+        .unwrap();
+    let m = model.channel_names().len();
+    let last = (model.n_ref() - 1) as f64;
+    let (mut flipped, mut kept) = (0, 0);
+    let (mut a, mut b) = (vec![0.0; m + 1], vec![0.0; m + 1]);
+    for step in 0..=(4 * (model.n_ref() - 1)) {
+        let t = (step as f64 * 0.25).min(last);
+        let local = lazy.local_corrections_at(t).unwrap();
+        let task = model.corrections_at(t).unwrap();
+        assert_eq!(local.scale.to_bits(), task.scale.to_bits(), "t {t}");
+        for (l, c) in local.components.iter().zip(&task.components) {
+            if l == c {
+                kept += 1;
+            } else {
+                assert!(
+                    l.iter().zip(c).all(|(x, y)| *x == -y),
+                    "t {t}: {l:?} vs {c:?}"
+                );
+                flipped += 1;
+            }
+        }
+        lazy.local_command_into(&force_raising(&local.components, force), t, &mut a)
+            .unwrap();
+        model
+            .command_into(&force_raising(&task.components, force), t, &mut b)
+            .unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&a), bits(&b), "t {t}");
+    }
+    // Both frames occur, so the comparison is not between identical tables.
+    assert!(flipped > 0 && kept > 0, "flipped {flipped}, kept {kept}");
+    // The table built from the samples decomposed one at a time is the one built at once.
+    for t in [0.0, 1234.5, last] {
+        assert_eq!(
+            lazy.corrections_at(t).unwrap(),
+            model.corrections_at(t).unwrap()
+        );
+    }
+}

@@ -7,10 +7,11 @@ use std::path::PathBuf;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use tandem_lfd::TaskModel;
 use tandem_planner::{Error, ExecutionRecord, Planner, PlannerParams};
 use tandem_schedule::{SamplerParams, validate};
 use tandem_sim::task::{TaskParams, Workpiece};
-use tandem_sim::workcell::{OperatorParams, run_pair};
+use tandem_sim::workcell::{OperatorParams, correction_input, run_pair};
 
 use common::fixtures;
 
@@ -162,4 +163,52 @@ fn state_round_trips_and_the_loaded_planner_continues_identically() {
     q.record_round(&records).unwrap();
     same(&p, &q);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A round right after an update runs on the local correction frame (only the samples it
+/// corrects at are decomposed); replaying it with the public operator input along
+/// `corrections_at` and `command_into` gives every logged sample bit for bit.
+#[test]
+fn a_round_replays_exactly_with_the_public_operator_input() {
+    let mut planner = planner();
+    planner.record_round(&pair(&planner, 11)).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let task = TaskParams::default();
+    let workpieces = [
+        Workpiece::random(&task, &mut rng).unwrap(),
+        Workpiece::random(&task, &mut rng).unwrap(),
+    ];
+    let operator = OperatorParams::default();
+    let run = run_pair(
+        &planner,
+        &fixtures().0.reference_labels,
+        &workpieces,
+        &operator,
+        &mut rng,
+    )
+    .unwrap();
+    // A fresh copy of the model: the replay builds the whole task frame's table.
+    let model: TaskModel = planner.model().clone();
+    let force = model
+        .tangent_names()
+        .iter()
+        .position(|n| n == "force")
+        .unwrap();
+    let (m, k) = (model.channel_names().len(), model.n_components());
+    let mut cmd = vec![0.0; m + 1];
+    let mut corrected = 0;
+    for robot in &run.robots {
+        for (i, &t) in robot.ref_time_log.iter().enumerate() {
+            let mut u = vec![0.0; k];
+            if robot.corrected[i] {
+                corrected += 1;
+                correction_input(&model, force, operator.gain, t, &mut u).unwrap();
+            }
+            model.command_into(&u, t, &mut cmd).unwrap();
+            let logged = &robot.samples[i * m..(i + 1) * m];
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(logged), bits(&cmd[..m]), "sample {i} at t {t}");
+        }
+    }
+    assert!(corrected > 100, "{corrected} corrected samples");
 }

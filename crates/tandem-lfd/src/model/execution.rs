@@ -1,10 +1,9 @@
 //! Executions recorded by the system and the incremental update with them (Eq. 21).
 
-use std::sync::OnceLock;
-
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::corrections::CorrectionCache;
 use super::stats::{derive_at, observe_at, packed_len, welford_add};
 use super::{PAR_MIN_LEN, TaskModel, check_dt};
 use crate::demo::{DT_TOLERANCE, Demonstration};
@@ -106,7 +105,7 @@ impl TaskModel {
                 },
             );
         data.count += 1;
-        self.corrections = OnceLock::new();
+        self.corrections = CorrectionCache::new(self.data.n_ref);
         Ok(())
     }
 

@@ -38,8 +38,6 @@
 //! demo time (demo samples, fractional) at every reference sample. `d` is the tangent
 //! dimension, `m` the channel count, `coord` an index into the tangent layout.
 
-use std::sync::OnceLock;
-
 use serde::{Deserialize, Serialize};
 
 use crate::demo::{DT_TOLERANCE, Demonstration};
@@ -57,7 +55,7 @@ pub use corrections::Corrections;
 pub use execution::{EXECUTION_DURATION_RATIO, Execution, Resampled};
 pub use params::{FitParams, Reference};
 
-use corrections::CorrectionTable;
+use corrections::CorrectionCache;
 use layout::Layout;
 use stats::packed_len;
 
@@ -73,7 +71,7 @@ pub struct TaskModel {
     mean: Vec<f64>,
     grad_mean: Vec<f64>,
     sigma2_d: Vec<f64>,
-    corrections: OnceLock<CorrectionTable>,
+    corrections: CorrectionCache,
 }
 
 /// The persisted part of a [`TaskModel`].
@@ -165,12 +163,13 @@ fn check_dt(demo: &Demonstration, dt_ref: f64) -> Result<()> {
 
 impl TaskModel {
     fn from_data(data: ModelData) -> Self {
+        let corrections = CorrectionCache::new(data.n_ref);
         let mut model = Self {
             data,
             mean: Vec::new(),
             grad_mean: Vec::new(),
             sigma2_d: Vec::new(),
-            corrections: OnceLock::new(),
+            corrections,
         };
         model.refresh_derived();
         model

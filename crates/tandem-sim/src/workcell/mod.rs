@@ -36,11 +36,16 @@
 //!    chance per execution but make the islands contiguous and far fewer (docs/decisions.md,
 //!    "Unneeded corrections come in 0.5 s episodes", with the figures of earlier commits).
 //! 3. A correction is a joystick input `u` along the model's correction components
-//!    (`TaskModel::corrections_at`), `u_k = ±gain` with the sign that raises the force; a
+//!    (`TaskModel::local_corrections_at`: the components of `TaskModel::corrections_at` up to
+//!    each one's sign, from the two reference samples around `t_i` only, so that a round right
+//!    after a model update decomposes only the samples it corrects at), `u_k = ±gain` with the
+//!    sign that raises the force; a
 //!    component whose rate part would speed the robot up is left out when the combined
 //!    input would otherwise speed it up, so a correction presses harder *and* slows the
 //!    robot, as the expert did over paint. The command `x_f⁺ = μ̂⁺ + δx⁺(u)` (Eq. 7) comes
-//!    from `TaskModel::command`; its last component, the warp gradient, is clamped to
+//!    from `TaskModel::local_command_into` (the same frame; the same command as
+//!    `TaskModel::command` gives for the input chosen along `corrections_at`, since the rule
+//!    is odd in each component); its last component, the warp gradient, is clamped to
 //!    `[ψ̇min, ψ̇max]` at `n_i` and passed to `Coordinator::tick` as `Operator::Gradient`.
 //!    That is what perturbs the timing. Without a correction the operator's input is
 //!    `Operator::Scheduled` (the robot keeps its scheduled gradient, the mean on

@@ -132,8 +132,11 @@ impl Episodes {
 /// fractional reference time `ref_time` (see the module docs, step 3): fills `u` (one entry
 /// per correction component, [`TaskModel::n_components`]) with `±gain` or 0 and returns
 /// whether any entry is non-zero. `force_idx` is the force channel's index in
-/// [`TaskModel::tangent_names`]. The workcell passes `u` to [`TaskModel::command_into`]
-/// (Eq. 7); it is public so that a replay of a run can recompute the operator's input.
+/// [`TaskModel::tangent_names`]. `u` is along the components of
+/// [`TaskModel::corrections_at`], for [`TaskModel::command_into`] (Eq. 7); the workcell itself
+/// chooses the same input in the frame of [`TaskModel::local_corrections_at`] and passes it
+/// to [`TaskModel::local_command_into`], which gives the same command. Public so that a
+/// replay of a run can recompute the operator's input.
 ///
 /// # Errors
 /// The model crate's error for `ref_time` outside `[0, T_ref − 1]`.
@@ -145,10 +148,36 @@ pub fn correction_input(
     u: &mut [f64],
 ) -> Result<bool> {
     let corr = model.corrections_at(ref_time)?;
-    let rate_idx = model.tangent_names().len() - 1;
+    Ok(input_along(&corr.components, force_idx, gain, u))
+}
+
+/// [`correction_input`] along the components of [`TaskModel::local_corrections_at`], for
+/// [`TaskModel::local_command_into`]: only the two reference samples around `ref_time` are
+/// decomposed.
+///
+/// # Errors
+/// As [`correction_input`].
+pub(super) fn local_correction_input(
+    model: &TaskModel,
+    force_idx: usize,
+    gain: f64,
+    ref_time: f64,
+    u: &mut [f64],
+) -> Result<bool> {
+    let corr = model.local_corrections_at(ref_time)?;
+    Ok(input_along(&corr.components, force_idx, gain, u))
+}
+
+/// The operator's rule of [`correction_input`] on the given components (`d` values each,
+/// the rate last): `u_k = ±gain` with the sign of component `k`'s force entry, then, if the
+/// combined input would speed the robot up, only the components that slow it down (or leave
+/// its rate alone). Odd in each component: negating component `k` negates `u_k` alone, so
+/// every product `u_k·c_k` is unchanged.
+fn input_along(components: &[Vec<f64>], force_idx: usize, gain: f64, u: &mut [f64]) -> bool {
     let mut rate_change = 0.0;
     let mut any = false;
-    for (k, c) in corr.components.iter().enumerate() {
+    for (k, c) in components.iter().enumerate() {
+        let rate_idx = c.len() - 1;
         u[k] = if c[force_idx] > 0.0 {
             gain
         } else if c[force_idx] < 0.0 {
@@ -161,14 +190,14 @@ pub fn correction_input(
     }
     if rate_change < 0.0 {
         // Keep only the components that slow the robot down (or leave its rate alone).
-        for (k, c) in corr.components.iter().enumerate() {
-            if u[k] * c[rate_idx] < 0.0 {
+        for (k, c) in components.iter().enumerate() {
+            if u[k] * c[c.len() - 1] < 0.0 {
                 u[k] = 0.0;
             }
         }
         any = u.iter().any(|&x| x != 0.0);
     }
-    Ok(any)
+    any
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use tandem_planner::Planner;
 use tandem_realtime::{Coordinator, Operator, Timeline, tol};
 use tandem_schedule::{Problem, Schedule};
 
-use super::operator::{Episodes, OperatorParams, correction_input, needs_correction};
+use super::operator::{Episodes, OperatorParams, local_correction_input, needs_correction};
 use super::record::{PairRun, RobotRun, RoundRun};
 use crate::task::{Label, Workpiece};
 use crate::{Error, Result};
@@ -279,14 +279,15 @@ pub(super) fn run_coordinator(
             } else {
                 in_episode[i] = false;
             }
-            let u = if corrected
-                && correction_input(model, force_idx, params.gain, ref_time, &mut u_corr)?
+            // The input in the frame of the two reference samples around `ref_time` (only
+            // they are decomposed); the command equals the task frame's bit for bit.
+            if corrected
+                && local_correction_input(model, force_idx, params.gain, ref_time, &mut u_corr)?
             {
-                &u_corr
+                model.local_command_into(&u_corr, ref_time, &mut cmd)?;
             } else {
-                &u_zero
-            };
-            model.command_into(u, ref_time, &mut cmd)?;
+                model.command_into(&u_zero, ref_time, &mut cmd)?;
+            }
             if supervised && corrected {
                 operator =
                     Operator::Gradient(cmd[m].clamp(problem.grad_min()[n], problem.grad_max()[n]));
