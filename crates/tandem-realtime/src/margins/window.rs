@@ -1,12 +1,15 @@
 //! A sliding extreme (maximum or minimum) over index windows whose ends never decrease: the
 //! conservative rate look-ups of the margin checks (amortized O(1) per query).
 
-use std::collections::VecDeque;
-
 /// Sliding extreme (max or min) over index windows whose ends never decrease.
 #[derive(Default)]
 pub(super) struct Sliding {
-    dq: VecDeque<usize>,
+    /// The monotone queue `queue[head..]`: candidate indices with their values, values
+    /// strictly monotone from the front (each value read once, when its index enters the
+    /// window). Entries before `head` have left the window; the buffer grows to at most one
+    /// entry per index.
+    queue: Vec<(usize, f64)>,
+    head: usize,
     next: usize,
 }
 
@@ -22,21 +25,21 @@ impl Sliding {
     ) -> f64 {
         while self.next <= hi {
             let v = val(self.next);
-            while let Some(&b) = self.dq.back() {
-                let vb = val(b);
+            while self.queue.len() > self.head {
+                let vb = self.queue[self.queue.len() - 1].1;
                 if (max && vb <= v) || (!max && vb >= v) {
-                    self.dq.pop_back();
+                    self.queue.pop();
                 } else {
                     break;
                 }
             }
-            self.dq.push_back(self.next);
+            self.queue.push((self.next, v));
             self.next += 1;
         }
-        while self.dq.front().is_some_and(|&f| f < lo) {
-            self.dq.pop_front();
+        while self.head < self.queue.len() && self.queue[self.head].0 < lo {
+            self.head += 1;
         }
-        self.dq.front().map_or(1.0, |&f| val(f))
+        self.queue.get(self.head).map_or(1.0, |&(_, v)| v)
     }
 }
 
@@ -55,5 +58,22 @@ mod tests {
             assert_eq!(mx.query(lo, hi, |n| v[n], true), bmax);
             assert_eq!(mn.query(lo, hi, |n| v[n], false), bmin);
         }
+    }
+
+    #[test]
+    fn sliding_extremes_match_brute_force_on_long_windows_with_ties() {
+        // Values with many ties (0..5) and windows whose ends advance by 0..3 each query.
+        let v: Vec<f64> = (0..2000u64).map(|i| ((i * 7919) % 11 % 5) as f64).collect();
+        let (mut mx, mut mn) = (Sliding::default(), Sliding::default());
+        let (mut lo, mut hi) = (0, 0);
+        for q in 0..1500u64 {
+            hi = (hi + (q * 31 % 4) as usize).min(v.len() - 1);
+            lo = (lo + (q * 17 % 3) as usize).min(hi);
+            let bmax = v[lo..=hi].iter().copied().fold(f64::MIN, f64::max);
+            let bmin = v[lo..=hi].iter().copied().fold(f64::MAX, f64::min);
+            assert_eq!(mx.query(lo, hi, |n| v[n], true), bmax, "{lo}..={hi}");
+            assert_eq!(mn.query(lo, hi, |n| v[n], false), bmin, "{lo}..={hi}");
+        }
+        assert!(hi > 1000, "the windows reach far: {hi}");
     }
 }
