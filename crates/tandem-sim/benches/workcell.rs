@@ -8,11 +8,11 @@
 //! - `workcell_tick/prepared`: [`run_round`] on a model whose correction directions are
 //!   already computed, divided by the round's ticks (the per-tick cost proper);
 //! - `workcell_tick/after_update`: the same right after a model update, as every round of the
-//!   study runs, so that computing the correction directions (one eigendecomposition per
-//!   reference sample) is part of the round;
-//! - `round_parts/prepare_corrections` and `round_parts/coordinator_checked`: the per-round
-//!   costs that do not scale with the ticks (the correction directions after an update; the
-//!   coordinator with its margin check);
+//!   study runs, so that computing the correction directions is part of the round (one
+//!   eigendecomposition per reference sample the operator corrects at, on first use);
+//! - `round_parts/prepare_corrections` and `round_parts/coordinator_checked`: costs that do
+//!   not scale with the ticks (every sample's correction directions and their task-wide
+//!   table, which a round no longer needs; the coordinator with its margin check);
 //! - `coordinator_tick/scheduled`: one `Coordinator::tick` with the scheduled operator input
 //!   on the same schedule (the floor the workcell is compared with).
 

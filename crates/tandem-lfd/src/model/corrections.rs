@@ -5,6 +5,15 @@
 //! `K = min(n − 1, k_max, d)` components, each stored as a ±3σ displacement
 //! `c_k = 3·s_k/√n · v_k ⊙ r`, signs kept continuous in time. A name with the suffix `_t`
 //! is a value interpolated at one fractional reference time `t`.
+//!
+//! Each sample is decomposed when first needed and cached until the next fit, load or
+//! update. Two sign frames: the *task* frame ([`TaskModel::corrections_at`],
+//! [`TaskModel::command_into`]) continues every sign from the first reference sample, which
+//! needs every sample; the *local* frame ([`TaskModel::local_corrections_at`],
+//! [`TaskModel::local_command_into`]) fixes the signs from the two samples around `t`. The
+//! relative sign of two neighbours is the same in both (the sign of the dot product of
+//! their eigenvectors; where it is 0 or not finite the local frame takes the task frame's),
+//! so a component of one frame is the other's or its negation, exactly.
 
 use std::sync::OnceLock;
 
