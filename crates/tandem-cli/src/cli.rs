@@ -89,6 +89,8 @@ pub(crate) enum Command {
     ///   tandem record cell.tandem \
     ///     --execution run1_robot1.csv --log run1_robot1.reflog.csv --corrections run1_robot1.corr.csv \
     ///     --execution run1_robot2.csv --log run1_robot2.reflog.csv --corrections run1_robot2.corr.csv
+    ///   tandem record cell.tandem --resample --execution a.csv --log a.reflog.csv \
+    ///     --corrections a.corr.csv …                          # irregular `t` (own clock)
     ///   tandem record cell.tandem round1.mcap                 # a ROS 2 bag of the round
     ///   tandem record cell.tandem run.mcap --round 3          # round 3 of simulate --bag
     #[command(verbatim_doc_comment)]
