@@ -403,8 +403,12 @@ fn channel_sets_the_model_rejects() {
             args.extend(demos.iter().cloned());
             args.extend(extra.iter().map(|x| x.to_string()));
             args.extend(["-o".to_string(), out.clone()]);
-            // Named at the header line and the channel's column (`rate`, `qx`: column 3).
-            let at = format!("{}:1:3: ", demos[0]);
+            // Named at the header line (`rate`: and its column, 3).
+            let at = if k == 0 {
+                format!("{}:1:3: ", demos[0])
+            } else {
+                format!("{}:1: ", demos[0])
+            };
             let mut needles = needles.to_vec();
             needles.push(&at);
             expect_user_error(&args, &needles, None);

@@ -179,15 +179,13 @@ pub enum Error {
     #[error(
         "{}: quaternion block `{block}` is incomplete: {missing:?} missing, {present:?} \
          present (give all four channels, or none, or change `schema.quaternions`)",
-        at(file, *line, *column)
+        at(file, *line, None)
     )]
     PartialQuaternionBlock {
         /// The file or source label of the demonstration whose channels are checked.
         file: String,
-        /// 1-based line of its header, where known (CSV).
+        /// 1-based line of its header, where known (CSV); the channels are named.
         line: Option<usize>,
-        /// 1-based column of the block's first channel present, where known.
-        column: Option<usize>,
         /// Name of the block.
         block: String,
         /// Its channels that are present.

@@ -111,7 +111,7 @@ fn a_partial_quaternion_block_is_an_error_naming_the_file() {
     let e = d.tangent_names(&ChannelSchema::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "part.csv:1:2: quaternion block `q` is incomplete: [\"qy\", \"qw\"] missing, [\"qx\", \
+        "part.csv:1: quaternion block `q` is incomplete: [\"qy\", \"qw\"] missing, [\"qx\", \
          \"qz\"] present (give all four channels, or none, or change `schema.quaternions`)"
     );
     // The fit reports the same error.

@@ -242,9 +242,6 @@ fn classify_lfd(e: &errors::Lfd) -> Kind {
         | E::ChannelMismatch {
             file, line, column, ..
         }
-        | E::PartialQuaternionBlock {
-            file, line, column, ..
-        }
         | E::ReservedChannelName {
             file, line, column, ..
         }
@@ -261,6 +258,11 @@ fn classify_lfd(e: &errors::Lfd) -> Kind {
         | E::ExecutionDuration { file, .. }
         | E::CoarseExecution { file, .. }
         | E::BadLog { file, .. } => input_at(Some(file)),
+        E::PartialQuaternionBlock { file, line, .. } => Kind::Input {
+            file: Some(file.clone()),
+            line: *line,
+            column: None,
+        },
         E::BadData { what, .. } => input_at(Some(what)),
         E::TooFewSamples { at, .. } => input_at(Some(at)),
         E::BadParam { name, .. } => param(name),

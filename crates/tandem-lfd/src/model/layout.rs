@@ -50,11 +50,10 @@ impl Layout {
             if !missing.is_empty() {
                 let names =
                     |axes: Vec<usize>| axes.iter().map(|&a| block.channels[a].clone()).collect();
-                let (line, column) = demo.header_at(Some(&block.channels[present[0]]));
+                let (line, _) = demo.header_at(None);
                 return Err(Error::PartialQuaternionBlock {
                     file: demo.source().into(),
                     line,
-                    column,
                     block: block.name.clone(),
                     present: names(present),
                     missing: names(missing),
