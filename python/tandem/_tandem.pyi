@@ -109,10 +109,13 @@ class Planner:
         corrected: Sequence[ArrayLike],
         channels: Optional[Sequence[str]] = None,
         dt_s: Optional[float] = None,
+        resample: bool = False,
     ) -> Dict[str, Any]:
         """Records one execution per robot (``N`` of each argument; Eq. 21, 9–12) and
         re-schedules (§II-C). ``dt_s``: the logs' sample period (default: the schedule's
-        tick); a finer log is resampled to the model's period."""
+        tick); a finer log is resampled to the model's period. ``resample``: CSV executions
+        with an irregular ``t`` column are put on an even grid first, their logs and flags
+        (one entry per row) with them."""
     def record_pair(
         self,
         executions: Sequence[Demo],

@@ -70,6 +70,66 @@ def test_a_1_khz_log_is_resampled_never_a_model_whose_mean_execution_triples() -
     )
 
 
+def stamped_at_250hz(args: dict, channels: list, tmp: Path, rng: np.random.Generator) -> dict:
+    """A simulated round as a 250 Hz logger with its own clock would have written it: each
+    robot's execution a CSV file with a `t` column (stamps ±1.2 ms off their 4 ms grid, 30 %
+    of a period, and three rows dropped), its log and flags arrays with one entry per row
+    (flags of the nearest 10 ms tick)."""
+    out = {k: [] for k in ("executions", "ref_time_logs", "supervised", "corrected")}
+    for i, (x, log, sup, cor) in enumerate(
+        zip(args["executions"], args["ref_time_logs"], args["supervised"], args["corrected"])
+    ):
+        n = len(log)
+        m = int(round((n - 1) * 0.01 / 0.004))
+        t = 0.004 * np.arange(m + 1)
+        t[1:-1] += rng.uniform(-0.0012, 0.0012, m - 1)
+        keep = np.ones(m + 1, bool)
+        keep[rng.choice(np.arange(10, m - 10), 3, replace=False)] = False
+        t = t[keep]
+        tick = np.minimum(t / 0.01, n - 1)
+        cols = [np.interp(tick, np.arange(n), x[:, j]) for j in range(x.shape[1])]
+        path = tmp / f"robot_{i + 1}.csv"
+        np.savetxt(path, np.column_stack([t] + cols), delimiter=",", header=",".join(["t"] + channels), comments="")
+        nearest = np.rint(tick).astype(int)
+        out["executions"].append(path)
+        out["ref_time_logs"].append(np.interp(tick, np.arange(n), log))
+        out["supervised"].append(np.asarray(sup)[nearest])
+        out["corrected"].append(np.asarray(cor)[nearest])
+    return out
+
+
+def test_a_250_hz_log_with_its_own_jittered_clock_is_recorded_with_resample(tmp_path: Path) -> None:
+    planner = tandem.fit(DEMOS, params=PARAMS)
+    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=6), seed=6)
+    args = run.record_args()
+    stamped = stamped_at_250hz(args, list(planner.model.channels), tmp_path, np.random.default_rng(6))
+    reference = tandem.fit(DEMOS, params=PARAMS)
+    reference.record_round(**args)
+    # The dropped rows put stamps half a period off the grid: refused, naming the option.
+    with pytest.raises(tandem.InputError, match=r"off the even grid.*resample=True") as e:
+        planner.record_round(**stamped)
+    assert e.value.file == str(stamped["executions"][0])
+    assert planner.rounds_recorded == 0
+    with pytest.warns(tandem.DataWarning) as caught:
+        report = planner.record_round(**stamped, resample=True)
+    said = [str(w.message) for w in caught]
+    assert any("its log and flags put on the same grid" in m for m in said), said
+    assert any("resampled to the model's 0.01 s" in m for m in said), said
+    assert len(report["notices"]) == 2
+    # The same round as the 100 Hz logger's, within what interpolation changes.
+    assert abs(mean_execution_s(planner) - mean_execution_s(reference)) < 0.01 * mean_execution_s(reference)
+    obs, ref = planner.confidence.observations, reference.confidence.observations
+    np.testing.assert_allclose(obs.supervised.sum(), ref.supervised.sum(), rtol=0.02)
+    assert obs.total_corrections > 0 and ref.total_corrections > 0
+    # Arrays carry no times to resample.
+    with pytest.raises(tandem.InputError, match="resample=True needs the time of every row"):
+        reference.record_round(**args, resample=True)
+    # One log entry per row of the file, not per grid sample.
+    short = {**stamped, "ref_time_logs": [v[:-1] for v in stamped["ref_time_logs"]]}
+    with pytest.raises(tandem.InputError, match="one per row"):
+        reference.record_round(**short, resample=True)
+
+
 def test_a_coarser_log_is_refused() -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
     args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=1), seed=1).record_args()

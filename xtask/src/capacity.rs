@@ -29,7 +29,7 @@ use tandem::realtime::MAX_ROBOTS;
 use tandem::sim::study::{
     StudyConfig, StudyInputs, StudyResult, mean_std, run_study, throughput_per_h,
 };
-use tandem_plot::{FONT_FAMILY, GROUND_TRUTH, MEAN, ROBOT_LC};
+use tandem_plot::{FONT_FAMILY, GROUND_TRUTH, MEAN, OPERATOR};
 
 use crate::study::read_config;
 use crate::workspace_root;
@@ -385,7 +385,8 @@ fn draw_on<DB: DrawingBackend>(
         .iter()
         .map(|r| (r.robots as f64, 100.0 * r.operator_busy_share))
         .collect();
-    let busy_colour = ROBOT_LC[1];
+    // Not a robot's colour: the busy share is the operator's.
+    let busy_colour = OPERATOR;
     chart
         .draw_secondary_series(LineSeries::new(busy.clone(), busy_colour.stroke_width(3)))
         .map_err(err("busy share"))?

@@ -89,6 +89,8 @@ pub(crate) enum Command {
     ///   tandem record cell.tandem \
     ///     --execution run1_robot1.csv --log run1_robot1.reflog.csv --corrections run1_robot1.corr.csv \
     ///     --execution run1_robot2.csv --log run1_robot2.reflog.csv --corrections run1_robot2.corr.csv
+    ///   tandem record cell.tandem --resample --execution a.csv --log a.reflog.csv \
+    ///     --corrections a.corr.csv …                          # irregular `t` (own clock)
     ///   tandem record cell.tandem round1.mcap                 # a ROS 2 bag of the round
     ///   tandem record cell.tandem run.mcap --round 3          # round 3 of simulate --bag
     #[command(verbatim_doc_comment)]
@@ -203,7 +205,8 @@ pub(crate) struct FitArgs {
     #[arg(long, value_name = "SECONDS")]
     pub(crate) dt: Option<f64>,
     /// Resample CSV demonstrations with an irregular `t` column (dropped samples, a drifting
-    /// logger) onto an even grid: period --dt, or each file's median step; channels are
+    /// logger) onto an even grid: period --dt, or each file's logger period (the span over
+    /// its steps, each counted in median steps); channels are
     /// interpolated linearly, 0/1 channels held; a gap over 3 periods is refused. Without it,
     /// a `t` column must stay within 25 % of a period of its even grid.
     #[arg(long)]
@@ -302,6 +305,13 @@ pub(crate) struct RecordArgs {
         required_unless_present = "bags"
     )]
     pub(crate) corrections: Vec<PathBuf>,
+    /// Resample execution CSVs with an irregular `t` column (jitter beyond a quarter
+    /// period, dropped samples) onto the even grid of their logger's period, as `fit
+    /// --resample` does; the log and the flags (one row per execution row) follow: log
+    /// interpolated, a sample supervised where the nearest row was, corrected where any row
+    /// of its period was. A grid finer than the model's is then resampled to it as usual.
+    #[arg(long, conflicts_with = "bags")]
+    pub(crate) resample: bool,
 }
 
 /// `tandem inspect`.

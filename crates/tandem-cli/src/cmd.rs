@@ -246,23 +246,40 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
 /// One robot's three files, read and checked as the planner takes them in
 /// ([`Planner::check_execution`]: resampled to the model's period if logged finer, the whole
 /// task covered, a plausible duration). An execution without a `t` column is taken to be
-/// logged once per control tick of the schedule it ran (stated on stderr).
+/// logged once per control tick of the schedule it ran (stated on stderr). With `resample`
+/// (`--resample`) an irregular `t` column is first put on an even grid, the log and flags
+/// with it ([`ExecutionRecord::from_regridded`]).
 fn read_execution(
     planner: &Planner,
     robot: usize,
     exec: &Path,
     log: &Path,
     corr: &Path,
+    resample: bool,
 ) -> Result<ExecutionRecord> {
-    let demonstration = input::read_demo(exec, Some(planner.schedule().tick_s))?;
+    let (demonstration, grid) = if resample {
+        let grid = input::regrid_execution(exec)?;
+        (grid.demonstration.clone(), Some(grid))
+    } else {
+        (
+            input::read_demo(exec, Some(planner.schedule().tick_s))?,
+            None,
+        )
+    };
     if let Some(n) = demonstration.period_note() {
-        note(&format!(
-            "{n} (the assumed period is the control tick of the schedule it ran)"
-        ));
+        if demonstration.period_source() == PeriodSource::Assumed {
+            note(&format!(
+                "{n} (the assumed period is the control tick of the schedule it ran)"
+            ));
+        } else {
+            note(&n);
+        }
     }
     let ref_time_log = input::read_log(log)?;
     let (supervised, corrected) = input::read_corrections(corr)?;
-    let n = demonstration.n_samples();
+    let n = grid
+        .as_ref()
+        .map_or(demonstration.n_samples(), |g| g.n_rows());
     if ref_time_log.len() != n {
         bail!(
             "{}: {} rows, but execution {} has {n} samples (one log row per sample)",
@@ -279,13 +296,16 @@ fn read_execution(
             exec.display()
         );
     }
-    let record = ExecutionRecord {
-        execution: Execution {
-            demonstration,
-            ref_time_log,
+    let record = match grid {
+        Some(g) => ExecutionRecord::from_regridded(g, &ref_time_log, &supervised, &corrected)?,
+        None => ExecutionRecord {
+            execution: Execution {
+                demonstration,
+                ref_time_log,
+            },
+            supervised,
+            corrected,
         },
-        supervised,
-        corrected,
     };
     planner.check_execution(&record).with_context(|| {
         format!(
@@ -326,6 +346,7 @@ fn record(a: &RecordArgs) -> Result<()> {
             &a.execution[i],
             &a.log[i],
             &a.corrections[i],
+            a.resample,
         )
     };
     let round = if a.bags.is_empty() {

@@ -46,6 +46,30 @@ pub(crate) fn read_demo_resampled(path: &Path, dt_s: Option<f64>) -> Result<Demo
     Ok(demo)
 }
 
+/// Reads an execution CSV with an irregular `t` column onto the even grid of its logger's
+/// period (`tandem record --resample`, `Demonstration::regrid_csv_str`), keeping how its rows
+/// map onto the grid for the log and flags beside it, and prints what was done as a note.
+/// JSON files have no time column to resample and are refused.
+pub(crate) fn regrid_execution(path: &Path) -> Result<tandem::lfd::Regridded> {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+    {
+        bail!(
+            "{}: --resample applies to CSV files with a `t` column; a JSON execution is \
+             already on an even grid (`dt_s`)",
+            path.display()
+        );
+    }
+    let grid = Demonstration::regrid_csv_path(path, None)?;
+    crate::cmd::note(&format!(
+        "{}; its log and flags put on the same grid (log interpolated, a sample supervised \
+         where the nearest row was, corrected where any row of its period was)",
+        grid.note
+    ));
+    Ok(grid)
+}
+
 /// The text of `path` and the name errors use for it.
 fn read_text(path: &Path) -> Result<(String, String)> {
     let file = path.display().to_string();

@@ -234,7 +234,9 @@ impl Figure for ModelFigure {
             // with room below its tick labels (it was drawn over them).
             let mut chart = ChartBuilder::on(area)
                 .caption(&p.title, (FONT_FAMILY, 14))
+                // Room on the right for the last tick label (it was cut off at the edge).
                 .margin(5)
+                .margin_right(20)
                 .x_label_area_size(if k == last { 40 } else { 22 })
                 .y_label_area_size(70)
                 .build_cartesian_2d(0.0..t_end, y0..y1)
@@ -297,9 +299,14 @@ impl Figure for ConfidenceFigure<'_> {
         let (top, body) = root.split_vertically(40);
         top.titled(
             &format!(
-                "confidence: {:.1} % of reference samples high-confidence after {} recorded rounds",
+                "confidence: {:.1} % of reference samples high-confidence after {} recorded {}",
                 100.0 * conf.high_share(),
-                self.planner.rounds_recorded()
+                self.planner.rounds_recorded(),
+                if self.planner.rounds_recorded() == 1 {
+                    "round"
+                } else {
+                    "rounds"
+                }
             ),
             (FONT_FAMILY, 20),
         )
@@ -337,6 +344,7 @@ impl Figure for ConfidenceFigure<'_> {
         let mut chart = ChartBuilder::on(&areas[0])
             .caption(caption, (FONT_FAMILY, 14))
             .margin(5)
+            .margin_right(20)
             .x_label_area_size(30)
             .y_label_area_size(70)
             .build_cartesian_2d(0.0..t_end, (lo..hi).log_scale())
@@ -374,6 +382,7 @@ impl Figure for ConfidenceFigure<'_> {
                 (FONT_FAMILY, 14),
             )
             .margin(5)
+            .margin_right(20)
             .x_label_area_size(30)
             .y_label_area_size(70)
             .build_cartesian_2d(0.0..t_end, -0.05..1.05)
@@ -469,6 +478,7 @@ impl Figure for ScheduleFigure {
         let mut chart = ChartBuilder::on(root)
             .caption(&self.title, (FONT_FAMILY, 18))
             .margin(10)
+            .margin_right(20)
             .x_label_area_size(40)
             .y_label_area_size(10)
             .build_cartesian_2d(

@@ -151,7 +151,7 @@ fn malformed_demonstrations() {
             vec![
                 "time column `t`",
                 "off the even grid",
-                "tandem fit --resample",
+                "`--resample` of `tandem fit` or `tandem record`",
                 "--dt",
             ],
         ),
@@ -170,7 +170,7 @@ fn malformed_demonstrations() {
                 })
                 .collect(),
             vec![
-                "sample period 0.02 s differs from the reference 0.01 s",
+                "rate.csv:1:1: sample period 0.02 s differs from the reference 0.01 s",
                 "resample it",
             ],
         ),
@@ -403,8 +403,14 @@ fn channel_sets_the_model_rejects() {
             args.extend(demos.iter().cloned());
             args.extend(extra.iter().map(|x| x.to_string()));
             args.extend(["-o".to_string(), out.clone()]);
+            // Named at the header line (`rate`: and its column, 3).
+            let at = if k == 0 {
+                format!("{}:1:3: ", demos[0])
+            } else {
+                format!("{}:1: ", demos[0])
+            };
             let mut needles = needles.to_vec();
-            needles.push(&demos[0]);
+            needles.push(&at);
             expect_user_error(&args, &needles, None);
             assert!(!dir.join("out.tandem").exists());
         }
@@ -680,7 +686,7 @@ fn malformed_executions() {
             "channels.csv",
             0,
             small_demo(n, 0.0).replace("t,x,force", "t,x,torque"),
-            vec!["torque", "differ from the reference channels"],
+            vec![":1:3: ", "torque", "differ from the reference channels"],
         ),
         (
             "text.csv",
@@ -795,6 +801,87 @@ fn malformed_executions() {
         s(&timed)
     );
     assert!(stderr.contains(&want), "`{want}` missing in:\n{stderr}");
+    // A 250 Hz execution stamped by its own clock: every 7th stamp 1.1 ms late (27 % of a
+    // period, beyond the quarter period taken as jitter) and row 80 dropped; reference time
+    // 100·t (the demonstrated speed), one correction on row 60.
+    let (mut exec, mut log, mut corr) = (
+        String::from("t,x,force\n"),
+        String::from("ref_sample\n"),
+        String::from("supervised,corrected\n"),
+    );
+    let last = 148; // 0.592 s: the reference's 59 samples at 100 Hz, 250 Hz rows.
+    let mut rows = 0;
+    for k in (0..=last).filter(|&k| k != 80) {
+        let late = if k % 7 == 3 && k != last { 0.0011 } else { 0.0 };
+        let t = 0.004 * k as f64 + late;
+        let r = (100.0 * t).min((n - 1) as f64);
+        writeln!(exec, "{t:.4},{:.6},5.0000", r / (n - 1) as f64).expect("write to string");
+        writeln!(log, "{r:.4}").expect("write to string");
+        writeln!(corr, "1,{}", u8::from(k == 60)).expect("write to string");
+        rows += 1;
+    }
+    let stamped = [
+        write(&dir, "stamped_250.csv", &exec),
+        write(&dir, "stamped_250.reflog.csv", &log),
+        write(&dir, "stamped_250.corr.csv", &corr),
+    ];
+    let other_b = [dir.join("other.csv"), good_b[1].clone(), good_b[2].clone()];
+    expect_user_error(
+        &record_args(&state, &stamped, &other_b),
+        &[
+            &s(&stamped[0]),
+            "off the even grid",
+            "`--resample` of `tandem fit` or `tandem record`",
+        ],
+        Some(&state),
+    );
+    // With --resample: on the 250 Hz grid (log and flags with it), then to the model's 10 ms.
+    let mut args = record_args(&state, &stamped, &other_b);
+    args.push("--resample".into());
+    let out = tandem(args);
+    ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    for want in [
+        format!(
+            "note: {}: resampled {rows} rows (steps 0.0029 – 0.008 s) onto {} samples 0.004 s \
+             apart (250 Hz)",
+            s(&stamped[0]),
+            last + 1
+        ),
+        "its log and flags put on the same grid".into(),
+        format!(
+            "note: {}: logged 0.004 s apart, resampled to the model's 0.01 s ({} → {} samples)",
+            s(&stamped[0]),
+            last + 1,
+            n + 1
+        ),
+    ] {
+        assert!(stderr.contains(&want), "`{want}` missing in:\n{stderr}");
+    }
+    let json = tandem(["inspect".into(), state.clone(), "--json".into()]);
+    ok(&json);
+    let doc: serde_json::Value = serde_json::from_slice(&json.stdout).expect("inspect JSON");
+    assert_eq!(doc["rounds_recorded"], 3);
+    // The one correction (row 60) survives both resamplings: one vote for robot 1's execution.
+    assert!(
+        doc["confidence"]["total_corrections"]
+            .as_f64()
+            .expect("number")
+            > 0.0
+    );
+    // A JSON execution has no times to resample.
+    let mut args = record_args(&state, &good_a, &good_b);
+    args[3] = write(
+        &dir,
+        "exec.json",
+        r#"{"channels":["x","force"],"samples":[[0,5],[1,5]]}"#,
+    );
+    args.push("--resample".into());
+    expect_user_error(
+        &args,
+        &["exec.json", "--resample applies to CSV files"],
+        Some(&state),
+    );
 }
 
 /// Need files for `simulate`.

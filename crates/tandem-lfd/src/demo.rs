@@ -60,6 +60,76 @@ pub struct Demonstration {
     /// The `t` column's worst step deviation from the period (s) and its 1-based line, when
     /// it exceeds [`JITTER_NOTE`] of the period (reported by [`Demonstration::period_note`]).
     jitter: Option<(f64, usize)>,
+    /// Where the header is, for a demonstration read from CSV (errors about its channel set
+    /// or period name the header's line and the column, [`Demonstration::header_at`]).
+    header: Option<Header>,
+}
+
+/// The header of a CSV demonstration: its 1-based line, the 1-based column (field number)
+/// of each channel in channel order, and of the `t` column if there is one.
+#[derive(Clone, Debug)]
+struct Header {
+    line: usize,
+    columns: std::sync::Arc<[usize]>,
+    t_column: Option<usize>,
+}
+
+/// A log with its own times put on an even grid ([`Demonstration::regrid_csv_str`], what
+/// `tandem fit --resample` and `tandem record --resample` do), with the map from the file's
+/// rows to the grid's samples: a series logged one value per row beside the file is put on
+/// the same grid through it ([`Regridded::interpolate`] for a quantity, [`Regridded::bin_of`]
+/// for events, [`Regridded::nearest`] for states), as the model's own
+/// [`crate::TaskModel::resample_execution`] does for a log finer than the model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Regridded {
+    /// The demonstration on the grid `t_0 + k·Δt_s`.
+    pub demonstration: Demonstration,
+    /// One sentence saying what was done (rows, step range, grid), for a note.
+    pub note: String,
+    /// For every row `r` of the file, the grid sample nearest to its time
+    /// (`round((t_r − t_0)/Δt_s)`): per-row events are merged through it.
+    pub bin_of: Vec<usize>,
+    /// For every grid sample `k`, the row nearest to it in time: per-row states are read
+    /// through it.
+    pub nearest: Vec<usize>,
+    /// For every grid sample, the row at or before it and the fraction `u ∈ [0, 1]` of the
+    /// way to the next row (the linear interpolation of the channels).
+    segments: Vec<(usize, f64)>,
+}
+
+impl Regridded {
+    /// Number of rows of the file that was regridded.
+    #[must_use]
+    pub fn n_rows(&self) -> usize {
+        self.bin_of.len()
+    }
+
+    /// A series logged one value per row of the file (an execution's reference-time log),
+    /// interpolated linearly at the grid times, as the channels are.
+    ///
+    /// # Errors
+    /// [`Error::BadData`] when `per_row` does not have one value per row.
+    pub fn interpolate(&self, what: &str, per_row: &[f64]) -> Result<Vec<f64>> {
+        if per_row.len() != self.n_rows() {
+            return Err(Error::BadData {
+                what: what.into(),
+                why: format!(
+                    "{} values, but {} has {} rows (one value per row)",
+                    per_row.len(),
+                    self.demonstration.source(),
+                    self.n_rows()
+                ),
+            });
+        }
+        Ok(self
+            .segments
+            .iter()
+            .map(|&(a, u)| {
+                let b = (a + 1).min(per_row.len() - 1);
+                per_row[a] + u * (per_row[b] - per_row[a])
+            })
+            .collect())
+    }
 }
 
 /// Equal channels, samples, period and source label; where the period came from
@@ -110,6 +180,7 @@ impl Demonstration {
             period: PeriodSource::Given,
             lines: None,
             jitter: None,
+            header: None,
         };
         demo.check()?;
         Ok(demo)
@@ -122,6 +193,23 @@ impl Demonstration {
             Some(line) => format!("{}:{line}", self.source),
             None => format!("{}, sample {t} (0-based)", self.source),
         }
+    }
+
+    /// Where the header of a demonstration read from CSV is, for errors about its channels
+    /// or its period: the 1-based line of the header and the 1-based column of `channel`
+    /// (`Some(name)`), of the `t` column (`None`), or `None` when there is no such column.
+    /// `(None, None)` for a demonstration not read from CSV.
+    pub fn header_at(&self, channel: Option<&str>) -> (Option<usize>, Option<usize>) {
+        let Some(h) = &self.header else {
+            return (None, None);
+        };
+        let column = match channel {
+            Some(name) => self
+                .channel_index(name)
+                .and_then(|j| h.columns.get(j).copied()),
+            None => h.t_column,
+        };
+        (Some(h.line), column)
     }
 
     /// Where [`Demonstration::dt_s`] came from (the file, the caller, or an assumption).
@@ -277,8 +365,17 @@ impl Demonstration {
         if self.channel_names == names {
             return Ok(Cow::Borrowed(self));
         }
+        // The header's first column whose name the reference does not have, if any.
+        let stranger = self
+            .channel_names
+            .iter()
+            .find(|c| !names.contains(c))
+            .map(String::as_str);
+        let (line, column) = self.header_at(stranger);
         let mismatch = || Error::ChannelMismatch {
             file: self.source.clone(),
+            line,
+            column: stranger.and(column),
             expected: names.to_vec(),
             found: self.channel_names.clone(),
         };
@@ -302,6 +399,10 @@ impl Demonstration {
             period: self.period,
             lines: self.lines.clone(),
             jitter: self.jitter,
+            header: self.header.as_ref().map(|h| Header {
+                columns: map.iter().map(|&j| h.columns[j]).collect(),
+                ..h.clone()
+            }),
         }))
     }
 
@@ -390,6 +491,14 @@ impl Demonstration {
             .with_period_source(period);
         demo.jitter = jitter;
         demo.lines = Some(table.rows().iter().map(|r| r.line).collect());
+        demo.header = Some(Header {
+            line: table.header_line(),
+            columns: (0..names.len())
+                .filter(|&j| Some(j) != t_col)
+                .map(|j| j + 1)
+                .collect(),
+            t_column: t_col.map(|j| j + 1),
+        });
         Ok(demo)
     }
 
@@ -405,7 +514,10 @@ impl Demonstration {
 
     /// Parses CSV text with an irregular time column `t` (seconds) and resamples it onto the
     /// even grid `t_0 + k·Δt_s` (`k = 0, 1, …` up to the last time): `Δt_s` is `dt_s`, or
-    /// the median step snapped like [`period_from_times`]. Every channel is interpolated
+    /// the logger's period: the span `t_last − t_0` over the number of periods it holds
+    /// (each step counted as its whole number of median steps, at least one, so a dropped
+    /// sample counts two and jitter averages out), snapped like [`period_from_times`].
+    /// Every channel is interpolated
     /// linearly between the two neighbouring rows, except a channel whose every value is 0
     /// or 1 (an on/off signal), which holds the earlier row's value. Returns the
     /// demonstration and a sentence saying what was done (for a note).
@@ -418,6 +530,24 @@ impl Demonstration {
         file: &str,
         dt_s: Option<f64>,
     ) -> Result<(Self, String)> {
+        let r = Self::regrid_csv_str(text, file, dt_s)?;
+        Ok((r.demonstration, r.note))
+    }
+
+    /// Reads a CSV file onto an even grid with the row mapping: see
+    /// [`Demonstration::regrid_csv_str`].
+    pub fn regrid_csv_path(path: impl AsRef<Path>, dt_s: Option<f64>) -> Result<Regridded> {
+        let (text, file) = read_text(path.as_ref())?;
+        Self::regrid_csv_str(&text, &file, dt_s)
+    }
+
+    /// [`Demonstration::from_csv_str_resampled`], keeping how the file's rows map onto the
+    /// grid ([`Regridded`]), so that series logged beside the file, one value per row (an
+    /// execution's reference-time log and correction flags), can be put on the same grid.
+    ///
+    /// # Errors
+    /// As [`Demonstration::from_csv_str_resampled`].
+    pub fn regrid_csv_str(text: &str, file: &str, dt_s: Option<f64>) -> Result<Regridded> {
         let table = CsvTable::parse(text, file)?;
         if let Some(j) = table
             .names()
@@ -474,7 +604,20 @@ impl Demonstration {
         let median = steps[steps.len() / 2];
         let period = match dt_s {
             Some(p) => p,
-            None => period_from_times(&[0.0, median]).expect("median step > 0"),
+            // The logger's period: every step counted as its whole number of median steps
+            // (a dropped sample is two, a short step one), the span divided by their sum,
+            // snapped like `period_from_times`. Jitter averages out over the log (the median
+            // step alone is off by a fraction of the jitter); the count is exact while the
+            // jitter stays within a quarter period, and beyond it can only grow, so the
+            // grid is never coarser than the mean step.
+            None => {
+                let periods: f64 = times
+                    .windows(2)
+                    .map(|w| ((w[1] - w[0]) / median).round().max(1.0))
+                    .sum();
+                period_from_times(&[0.0, (times[n - 1] - times[0]) / periods])
+                    .expect("a span > 0 over at least one median step")
+            }
         };
         if !(period.is_finite() && period > 0.0) {
             return Err(Error::BadParam {
@@ -534,6 +677,8 @@ impl Demonstration {
         let t0 = times[0];
         let count = ((times[n - 1] - t0) / period + 1e-9).floor() as usize + 1;
         let mut samples = Vec::with_capacity(count * cols.len());
+        let mut segments = Vec::with_capacity(count);
+        let mut nearest = Vec::with_capacity(count);
         let mut seg = 0;
         for k in 0..count {
             let t = t0 + k as f64 * period;
@@ -542,6 +687,8 @@ impl Demonstration {
             }
             let (ta, tb) = (times[seg], times[seg + 1]);
             let u = ((t - ta) / (tb - ta)).clamp(0.0, 1.0);
+            segments.push((seg, u));
+            nearest.push(if u < 0.5 { seg } else { seg + 1 });
             for (c, v) in values.iter().enumerate() {
                 let (a, b) = (v[seg], v[seg + 1]);
                 samples.push(if binary[c] {
@@ -551,9 +698,14 @@ impl Demonstration {
                 });
             }
         }
-        let demo = Self::new(names, samples, period)?
+        let mut demo = Self::new(names, samples, period)?
             .with_source(file)
             .with_period_source(PeriodSource::File);
+        demo.header = Some(Header {
+            line: table.header_line(),
+            columns: cols.iter().map(|&j| j + 1).collect(),
+            t_column: Some(tc + 1),
+        });
         let note = format!(
             "{file}: resampled {n} rows (steps {} – {} s) onto {count} samples {} s apart ({} \
              Hz), channels interpolated linearly, 0/1 channels held",
@@ -562,7 +714,17 @@ impl Demonstration {
             round_s(period),
             round_s(1.0 / period)
         );
-        Ok((demo, note))
+        let bin_of = times
+            .iter()
+            .map(|&t| (((t - t0) / period).round() as usize).min(count - 1))
+            .collect();
+        Ok(Regridded {
+            demonstration: demo,
+            note,
+            bin_of,
+            nearest,
+            segments,
+        })
     }
 
     /// Reads a JSON file: see [`Demonstration::from_json_str`].
@@ -743,8 +905,10 @@ fn time_column_period(
             format!(
                 "this time is {:.3} ms off the even grid of the file's mean period {} s \
                  ({:.1} % of a period; tandem accepts up to {} %: a dropped or repeated \
-                 sample, or an irregular log): resample the log onto an even grid (`tandem fit \
-                 --resample`), or remove the `t` column and give the period with --dt",
+                 sample, or an irregular log): resample the log onto an even grid (`--resample` \
+                 of `tandem fit` or `tandem record`, `resample=True` in Python's \
+                 `record_round`), or remove the `t` column and give the period (`tandem fit \
+                 --dt`)",
                 dev * 1e3,
                 (mean * 1e6).round() / 1e6,
                 100.0 * dev / mean,
@@ -1060,6 +1224,73 @@ mod tests {
         );
         let none = Demonstration::from_csv_str_resampled("a\n1\n2\n", "n.csv", None);
         assert!(none.unwrap_err().to_string().contains("no time column `t`"));
+    }
+
+    #[test]
+    fn the_period_of_a_jittered_log_with_dropped_rows_is_the_loggers_rate() {
+        // 100 Hz for 10 s, ±1.5 ms jitter (a fixed pseudo-random sequence), rows 200 and
+        // 700 dropped: the median step alone is off by a fraction of the jitter,
+        // the span over the counted periods is 0.01 s.
+        let jitter = |k: u64, amp: f64| {
+            let mut h = k.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            h = (h ^ (h >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            h = (h ^ (h >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            h ^= h >> 31;
+            2.0 * amp * ((h % 1001) as f64 / 1000.0 - 0.5)
+        };
+        let log = |amp: f64| {
+            let mut text = String::from("t,a\n");
+            for k in 0..=1000u64 {
+                if [200, 700].contains(&k) {
+                    continue;
+                }
+                let j = if k == 0 || k == 1000 {
+                    0.0
+                } else {
+                    jitter(k, amp)
+                };
+                text.push_str(&format!("{},{}\n", 0.01 * k as f64 + j, k));
+            }
+            text
+        };
+        let (d, note) = Demonstration::from_csv_str_resampled(&log(0.0015), "j.csv", None).unwrap();
+        assert_eq!(d.dt_s(), 0.01, "{note}");
+        assert_eq!(d.n_samples(), 1001);
+        assert!(note.contains("999 rows") && note.contains("1001 samples 0.01 s apart (100 Hz)"));
+        // Jitter beyond a quarter period blurs a drop and a late row: the count can only
+        // grow, so the grid is finer than the mean step, never coarser.
+        let (d, _) = Demonstration::from_csv_str_resampled(&log(0.004), "h.csv", None).unwrap();
+        assert!(d.dt_s() <= 10.0 / 997.0, "{}", d.dt_s());
+    }
+
+    #[test]
+    fn a_regridded_log_maps_its_rows_for_series_logged_beside_it() {
+        // Rows at 0, 0.012, 0.018, 0.03 s (jitter) onto the 0.01 s grid (median step 0.012
+        // would snap to 0.012; give the grid): grid times 0, 0.01, 0.02, 0.03.
+        let text = "t,a\n0,0\n0.012,12\n0.018,18\n0.03,30\n";
+        let r = Demonstration::regrid_csv_str(text, "j.csv", Some(0.01)).unwrap();
+        assert_eq!(r.n_rows(), 4);
+        assert_eq!(r.demonstration.n_samples(), 4);
+        // Each row's nearest grid sample: 0 → 0, 0.012 → 1, 0.018 → 2, 0.03 → 3.
+        assert_eq!(r.bin_of, [0, 1, 2, 3]);
+        // Each grid sample's nearest row: 0.01 is 0.002 from row 1, 0.02 is 0.002 from row 2.
+        assert_eq!(r.nearest, [0, 1, 2, 3]);
+        // A ramp logged beside the file is interpolated as the channel `a` is (a = 1000·t).
+        let log = r.interpolate("log", &[0.0, 1.2, 1.8, 3.0]).unwrap();
+        for (k, v) in log.iter().enumerate() {
+            assert!((v - k as f64).abs() < 1e-9, "log[{k}] = {v}");
+            assert!((r.demonstration.sample(k)[0] - 10.0 * k as f64).abs() < 1e-9);
+        }
+        let short = r.interpolate("j.reflog.csv", &[0.0, 1.0]).unwrap_err();
+        assert!(
+            short.to_string().contains("2 values, but j.csv has 4 rows"),
+            "{short}"
+        );
+        // Two rows in one grid period share its bin: an event on either is kept.
+        let dense = "t,a\n0,0\n0.004,0\n0.006,0\n0.01,0\n";
+        let r = Demonstration::regrid_csv_str(dense, "d.csv", Some(0.01)).unwrap();
+        assert_eq!(r.bin_of, [0, 0, 1, 1]);
+        assert_eq!(r.nearest, [0, 3]);
     }
 
     #[test]

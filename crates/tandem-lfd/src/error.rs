@@ -158,13 +158,18 @@ pub enum Error {
     },
     /// A demonstration's channel set differs from the reference demonstration's.
     #[error(
-        "{file}: channels {found:?} differ from the reference channels {expected:?} (every \
+        "{}: channels {found:?} differ from the reference channels {expected:?} (every \
          demonstration needs the same channel names, in any order: rename the columns or \
-         leave the file out)"
+         leave the file out)",
+        at(file, *line, *column)
     )]
     ChannelMismatch {
         /// The file or source label of the offending demonstration.
         file: String,
+        /// 1-based line of its header, where known (CSV).
+        line: Option<usize>,
+        /// 1-based column of its first channel the reference does not have, where known.
+        column: Option<usize>,
         /// The reference channel names.
         expected: Vec<String>,
         /// This demonstration's channel names.
@@ -172,12 +177,15 @@ pub enum Error {
     },
     /// A quaternion block of the schema has some but not all of its four channels.
     #[error(
-        "{file}: quaternion block `{block}` is incomplete: {missing:?} missing, {present:?} \
-         present (give all four channels, or none, or change `schema.quaternions`)"
+        "{}: quaternion block `{block}` is incomplete: {missing:?} missing, {present:?} \
+         present (give all four channels, or none, or change `schema.quaternions`)",
+        at(file, *line, None)
     )]
     PartialQuaternionBlock {
         /// The file or source label of the demonstration whose channels are checked.
         file: String,
+        /// 1-based line of its header, where known (CSV); the channels are named.
+        line: Option<usize>,
         /// Name of the block.
         block: String,
         /// Its channels that are present.
@@ -188,12 +196,17 @@ pub enum Error {
     /// A channel has the name of a coordinate the model derives (`rate`, or
     /// `<block>.rx|ry|rz` of a quaternion block).
     #[error(
-        "{file}: channel `{channel}` has the name of a coordinate the model derives: \
-         {derived}; rename the channel"
+        "{}: channel `{channel}` has the name of a coordinate the model derives: \
+         {derived}; rename the channel",
+        at(file, *line, *column)
     )]
     ReservedChannelName {
         /// The file or source label of the demonstration whose channels are checked.
         file: String,
+        /// 1-based line of its header, where known (CSV).
+        line: Option<usize>,
+        /// 1-based column of the channel, where known (CSV).
+        column: Option<usize>,
         /// The channel name.
         channel: String,
         /// What the model derives under that name.
@@ -235,15 +248,20 @@ pub enum Error {
     },
     /// Sample periods differ by more than 1 %.
     #[error(
-        "{file}: sample period {} s differs from the reference {} s by more than 1 % (resample \
+        "{}: sample period {} s differs from the reference {} s by more than 1 % (resample \
          it to the reference's rate; for a file without a `t` column the period is --dt, \
          default 0.01 s)",
+        at(file, *line, *column),
         (found_s * 1e9).round() / 1e9,
         (expected_s * 1e9).round() / 1e9
     )]
     SamplePeriodMismatch {
         /// The file or source label.
         file: String,
+        /// 1-based line of its header, where known (CSV).
+        line: Option<usize>,
+        /// 1-based column of its `t` column, where the period came from one (CSV).
+        column: Option<usize>,
         /// The reference period Δt_s, seconds.
         expected_s: f64,
         /// This demonstration's period, seconds.
@@ -336,6 +354,15 @@ pub enum Error {
 }
 
 /// `file:line:column`, or `file` alone where the position is unknown.
+/// `file:line:column`, `file:line` or `file`, as much as is known.
+fn at(file: &str, line: Option<usize>, column: Option<usize>) -> String {
+    match (line, column) {
+        (Some(l), Some(c)) => format!("{file}:{l}:{c}"),
+        (Some(l), None) => format!("{file}:{l}"),
+        _ => file.to_owned(),
+    }
+}
+
 fn located(file: &str, line: Option<usize>, column: Option<usize>) -> String {
     match (line, column) {
         (Some(l), Some(c)) => format!("{file}:{l}:{c}"),

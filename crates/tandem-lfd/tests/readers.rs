@@ -111,7 +111,7 @@ fn a_partial_quaternion_block_is_an_error_naming_the_file() {
     let e = d.tangent_names(&ChannelSchema::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "part.csv: quaternion block `q` is incomplete: [\"qy\", \"qw\"] missing, [\"qx\", \
+        "part.csv:1: quaternion block `q` is incomplete: [\"qy\", \"qw\"] missing, [\"qx\", \
          \"qz\"] present (give all four channels, or none, or change `schema.quaternions`)"
     );
     // The fit reports the same error.
@@ -126,7 +126,7 @@ fn channels_named_like_derived_coordinates_are_rejected() {
     let rate = Demonstration::from_csv_str("t,x,rate\n0,0,1\n0.01,1,1\n", "r.csv", None).unwrap();
     assert_eq!(
         rate.tangent_names(&schema).unwrap_err().to_string(),
-        "r.csv: channel `rate` has the name of a coordinate the model derives: the warp \
+        "r.csv:1:3: channel `rate` has the name of a coordinate the model derives: the warp \
          gradient (speed); rename the channel"
     );
     let id = vec![0.0, 1.0];
@@ -284,7 +284,7 @@ fn demonstration_sets_are_checked() {
     assert!(matches!(e, Error::ChannelMismatch { .. }));
     assert!(
         e.to_string()
-            .starts_with("b.csv: channels [\"a\", \"c\"] differ"),
+            .starts_with("b.csv:1:2: channels [\"a\", \"c\"] differ"),
         "{e}"
     );
     let e = TaskModel::fit_aligned(
@@ -310,4 +310,24 @@ fn demonstration_sets_are_checked() {
     )
     .unwrap_err();
     assert!(matches!(e, Error::SamplePeriodMismatch { .. }), "{e}");
+    // Named at its header's `t` column, where the period came from.
+    assert!(
+        e.to_string()
+            .starts_with("slow.csv:1:1: sample period 0.1 s"),
+        "{e}"
+    );
+    // A header after a blank line: its own line; a channel missing (no stranger column):
+    // the header line alone.
+    let d = Demonstration::from_csv_str("\nt,a\n0,1\n0.01,3\n", "d.csv", None).unwrap();
+    let e = d.conform_to(&["a".into(), "b".into()]).unwrap_err();
+    assert!(
+        e.to_string().starts_with("d.csv:2: channels [\"a\"]"),
+        "{e}"
+    );
+    assert_eq!(d.header_at(Some("a")), (Some(2), Some(2)));
+    // In memory there is no header to point at.
+    let m = Demonstration::new(vec!["a".into()], vec![1.0, 2.0], 0.01).unwrap();
+    assert_eq!(m.header_at(Some("a")), (None, None));
+    let e = m.conform_to(&["b".into()]).unwrap_err();
+    assert!(e.to_string().starts_with("<memory>: channels"), "{e}");
 }

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use tandem_confidence::{
     Confidence, ConfidenceParams, ErrorRates, Observations, estimate_error_rates,
 };
-use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
+use tandem_lfd::{Demonstration, Execution, FitParams, Regridded, TaskModel};
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
     CheckedSchedule, Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source,
@@ -19,6 +19,27 @@ use tandem_schedule::{
 
 use crate::state::{Stamp, StateLock};
 use crate::{Error, Result, derive_seed, state};
+
+/// Correction flags of the samples of a log put on a new grid. Supervision is a state: read
+/// at the original sample nearest to each new one (`nearest`), as a logger at the new period
+/// would have. A correction is an event: kept if any original sample of the new sample's
+/// period had one (`bin_of`, original → new), and then the sample counts as supervised.
+fn merge_flags(
+    supervised: &[bool],
+    corrected: &[bool],
+    nearest: &[usize],
+    bin_of: &[usize],
+) -> (Vec<bool>, Vec<bool>) {
+    let mut sup: Vec<bool> = nearest.iter().map(|&k| supervised[k]).collect();
+    let mut cor = vec![false; nearest.len()];
+    for (k, &j) in bin_of.iter().enumerate() {
+        cor[j] |= corrected[k];
+    }
+    for (s, c) in sup.iter_mut().zip(&cor) {
+        *s |= *c;
+    }
+    (sup, cor)
+}
 
 /// Parameters of a [`Planner`]: one block per stage of Fig. 2.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -87,6 +108,50 @@ impl ExecutionRecord {
             }
         }
         Ok((times, corrected))
+    }
+
+    /// An execution logged with its own times (`tandem record --resample`: jitter, dropped
+    /// samples), put on the even grid of [`Demonstration::regrid_csv_str`] with the series
+    /// logged beside it, one entry per row of the file: the reference-time log interpolated
+    /// linearly like the channels ([`Regridded::interpolate`]); the flags as
+    /// [`Planner::check_execution`] merges them (a grid sample supervised if the row nearest
+    /// to it in time was, corrected, and then supervised, if any row of its period was, so
+    /// no correction is lost). The record is then taken in like any other (resampled to the
+    /// model's period if its grid is finer).
+    ///
+    /// # Errors
+    /// [`Error::BadExecution`] when the log or a flag vector does not have one entry per row.
+    pub fn from_regridded(
+        grid: Regridded,
+        ref_time_log: &[f64],
+        supervised: &[bool],
+        corrected: &[bool],
+    ) -> Result<Self> {
+        let rows = grid.n_rows();
+        let source = grid.demonstration.source().to_owned();
+        for (what, len) in [
+            ("ref_time_log", ref_time_log.len()),
+            ("supervised", supervised.len()),
+            ("corrected", corrected.len()),
+        ] {
+            if len != rows {
+                return Err(Error::BadExecution {
+                    what,
+                    why: format!("{len} entries for the {rows} rows of {source} (one per row)"),
+                });
+            }
+        }
+        let log = grid.interpolate("ref_time_log", ref_time_log)?;
+        let (supervised, corrected) =
+            merge_flags(supervised, corrected, &grid.nearest, &grid.bin_of);
+        Ok(Self {
+            execution: Execution {
+                demonstration: grid.demonstration,
+                ref_time_log: log,
+            },
+            supervised,
+            corrected,
+        })
     }
 
     /// FNV-1a (64 bit) of the samples (in their channel order), the log and the flags: what
@@ -553,21 +618,12 @@ impl Planner {
         let (supervised, corrected, note) = if resampled.bin_of.len() == n_new {
             (record.supervised.clone(), record.corrected.clone(), None)
         } else {
-            // Supervision is a state: read at the nearest original sample, as a logger at
-            // the model's period would have. A correction is an event: kept if any original
-            // sample of the period had one (and then the sample counts as supervised).
-            let mut sup: Vec<bool> = resampled
-                .nearest
-                .iter()
-                .map(|&k| record.supervised[k])
-                .collect();
-            let mut cor = vec![false; n_new];
-            for (k, &j) in resampled.bin_of.iter().enumerate() {
-                cor[j] |= record.corrected[k];
-            }
-            for (s, c) in sup.iter_mut().zip(&cor) {
-                *s |= *c;
-            }
+            let (sup, cor) = merge_flags(
+                &record.supervised,
+                &record.corrected,
+                &resampled.nearest,
+                &resampled.bin_of,
+            );
             let note = format!(
                 "{}: logged {} s apart, resampled to the model's {} s ({n} → {n_new} samples)",
                 demo.source(),
@@ -1329,6 +1385,78 @@ mod tests {
             .unwrap_err();
         assert!(err.to_string().contains("give its sample period"), "{err}");
         assert_eq!(wrong.rounds_recorded(), 0);
+    }
+
+    #[test]
+    fn an_execution_logged_with_jitter_and_a_dropped_row_is_regridded_then_recorded() {
+        // 250 Hz rows (t = 0.004·k ± 0.8 ms, row 50 dropped) over the 0.39 s task at the
+        // demonstrated speed: reference time = 100·t (clamped to the last sample, 39).
+        let base = small_planner(8);
+        let mut text = String::from("t,force\n");
+        let (mut log, mut sup, mut cor) = (Vec::new(), Vec::new(), Vec::new());
+        for k in 0..=98usize {
+            if k == 50 {
+                continue;
+            }
+            // A fixed pseudo-random jitter in ±0.8 ms (splitmix64's finalizer of k).
+            let mut h = (k as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+            h = (h ^ (h >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            h = (h ^ (h >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            h ^= h >> 31;
+            let jitter = if k == 0 || k == 98 {
+                0.0
+            } else {
+                0.0016 * ((h % 1001) as f64 / 1000.0 - 0.5)
+            };
+            let t = 0.004 * k as f64 + jitter;
+            let r = (100.0 * t).min(39.0);
+            let force = if (10.0..20.0).contains(&r) { 5.0 } else { 1.0 };
+            text.push_str(&format!("{t},{force}\n"));
+            log.push(r);
+            sup.push((10.0..20.0).contains(&r));
+            // One correction, on a single 250 Hz row mid-region.
+            cor.push(k == 37);
+        }
+        // Without resampling the dropped row is refused with the fix.
+        let e = Demonstration::from_csv_str(&text, "j.csv", None).unwrap_err();
+        assert!(e.to_string().contains("resample"), "{e}");
+        let grid = Demonstration::regrid_csv_str(&text, "j.csv", None).unwrap();
+        assert_eq!(grid.demonstration.dt_s(), 0.004, "the logger's 250 Hz");
+        assert_eq!(grid.demonstration.n_samples(), 99);
+        let short = ExecutionRecord::from_regridded(grid.clone(), &log[1..], &sup, &cor);
+        assert!(
+            matches!(
+                short,
+                Err(Error::BadExecution {
+                    what: "ref_time_log",
+                    ..
+                })
+            ),
+            "{short:?}"
+        );
+        let record = ExecutionRecord::from_regridded(grid, &log, &sup, &cor).unwrap();
+        assert_eq!(record.corrected.iter().filter(|&&c| c).count(), 1);
+        assert!(
+            record
+                .supervised
+                .iter()
+                .zip(&record.corrected)
+                .all(|(s, c)| *s || !*c)
+        );
+        let log = &record.execution.ref_time_log;
+        assert!(log.windows(2).all(|w| w[1] >= w[0]) && log[log.len() - 1] == 39.0);
+        // Taken in like any finer log: resampled to the model's 10 ms, the correction kept.
+        let (at_model, note) = base.check_execution(&record).unwrap();
+        assert_eq!(at_model.execution.demonstration.n_samples(), 41);
+        assert!(
+            note.unwrap()
+                .contains("logged 0.004 s apart, resampled to the model's 0.01 s (99 → 41")
+        );
+        assert_eq!(at_model.corrected.iter().filter(|&&c| c).count(), 1);
+        let mut p = base.clone();
+        p.record_round(&[record.clone(), record]).unwrap();
+        assert_eq!(p.rounds_recorded(), 1);
+        assert!(p.observations().total_corrections() > 0.0);
     }
 
     #[test]

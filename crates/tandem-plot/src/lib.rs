@@ -69,6 +69,10 @@ pub const GROUND_TRUTH: RGBColor = RGBColor(110, 110, 110);
 /// The high-confidence map of `tandem plot` (green).
 pub const HIGH_CONFIDENCE: RGBColor = RGBColor(44, 160, 44);
 
+/// The operator's own quantities (the busy share of `cargo xtask capacity`): a dark teal
+/// that no robot has, so a reader does not take the operator's line for robot 2's.
+pub const OPERATOR: RGBColor = RGBColor(0, 121, 107);
+
 /// What can go wrong in `tandem-plot`.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -109,7 +113,14 @@ mod tests {
     #[test]
     fn the_palette_tells_the_robots_and_the_violation_apart() {
         assert_eq!(ROBOT_LC, [ROBOT_LC_N[0], ROBOT_LC_N[1]]);
-        let mut all = vec![MEAN, NEITHER_LC, BOTH_LC, GROUND_TRUTH, HIGH_CONFIDENCE];
+        let mut all = vec![
+            MEAN,
+            NEITHER_LC,
+            BOTH_LC,
+            GROUND_TRUTH,
+            HIGH_CONFIDENCE,
+            OPERATOR,
+        ];
         all.extend(ROBOT_LC_N);
         for (i, a) in all.iter().enumerate() {
             for b in &all[..i] {

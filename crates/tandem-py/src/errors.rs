@@ -237,22 +237,32 @@ fn classify_lfd(e: &errors::Lfd) -> Kind {
         E::EmptyFile { file } => located(file, 1, 1),
         E::Separator { file, line, .. } => located(file, *line, 1),
         E::TimeLikeChannel {
-            file,
-            line: Some(line),
-            column: Some(column),
-            ..
-        } => located(file, *line, *column),
-        E::TimeLikeChannel { file, .. } => input_at(Some(file)),
+            file, line, column, ..
+        }
+        | E::ChannelMismatch {
+            file, line, column, ..
+        }
+        | E::ReservedChannelName {
+            file, line, column, ..
+        }
+        | E::SamplePeriodMismatch {
+            file, line, column, ..
+        } => Kind::Input {
+            file: Some(file.clone()),
+            line: *line,
+            column: *column,
+        },
         E::Io { file, .. }
         | E::DemonstrationLength { file, .. }
         | E::TruncatedExecution { file, .. }
         | E::ExecutionDuration { file, .. }
         | E::CoarseExecution { file, .. }
-        | E::ChannelMismatch { file, .. }
-        | E::PartialQuaternionBlock { file, .. }
-        | E::ReservedChannelName { file, .. }
-        | E::SamplePeriodMismatch { file, .. }
         | E::BadLog { file, .. } => input_at(Some(file)),
+        E::PartialQuaternionBlock { file, line, .. } => Kind::Input {
+            file: Some(file.clone()),
+            line: *line,
+            column: None,
+        },
         E::BadData { what, .. } => input_at(Some(what)),
         E::TooFewSamples { at, .. } => input_at(Some(at)),
         E::BadParam { name, .. } => param(name),

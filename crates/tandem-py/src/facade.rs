@@ -4,7 +4,8 @@ pub(crate) use tandem::confidence::{
     BetaParams, Observations, posterior, prior, prior_low_threshold, prob_need_below_mu_c,
 };
 pub(crate) use tandem::lfd::{
-    DEFAULT_DT_S, DT_TOLERANCE, Demonstration, Execution, PeriodSource, TaskModel, length_warnings,
+    DEFAULT_DT_S, DT_TOLERANCE, Demonstration, Execution, PeriodSource, Regridded, TaskModel,
+    length_warnings,
 };
 pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{

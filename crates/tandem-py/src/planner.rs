@@ -14,8 +14,8 @@ use crate::errors::{Error, Result, deprecated, guard, warn};
 use crate::facade::{BagOptions, Recording, extend_bag_schema, is_bag, read_bag};
 use crate::facade::{
     BetaParams, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, DT_TOLERANCE, Demonstration, Execution,
-    ExecutionRecord, Observations, PeriodSource, Planner, PlannerParams, RecordReport, StateLock,
-    TaskModel, errors, length_warnings, posterior, prior, prior_low_threshold,
+    ExecutionRecord, Observations, PeriodSource, Planner, PlannerParams, RecordReport, Regridded,
+    StateLock, TaskModel, errors, length_warnings, posterior, prior, prior_low_threshold,
     prob_need_below_mu_c, reschedule_seed,
 };
 use crate::params::{from_py, serialize_to_py};
@@ -116,6 +116,58 @@ fn demonstration(
     let demo = Demonstration::new(names.to_vec(), values, dt_s.unwrap_or(DEFAULT_DT_S))
         .map_err(|e| relabel(e, label))?;
     Ok(demo.with_source(label))
+}
+
+/// An execution CSV with its own times put on the even grid of its logger's period
+/// (`record_round(resample=True)`, `Demonstration::regrid_csv_str`), keeping how its rows map
+/// onto the grid for the log and flags given beside it. Arrays (no times), JSON and bags
+/// are refused; `channels.file`, when given, must match the header.
+fn regridded_execution(
+    x: &Bound<'_, PyAny>,
+    label: &str,
+    channels: Channels<'_>,
+) -> Result<Regridded> {
+    let is_path = x.is_instance_of::<PyString>() || x.hasattr("__fspath__").unwrap_or(false);
+    if !is_path {
+        return Err(Error::input(
+            label,
+            "resample=True needs the time of every row: give the execution as a CSV file \
+             with a `t` column (an array has no times; give it at dt_s instead)",
+        ));
+    }
+    let path: PathBuf = x
+        .extract()
+        .map_err(|e| Error::input(label, format!("not a path: {e}")))?;
+    let other = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json") || e.eq_ignore_ascii_case("mcap"));
+    if other {
+        return Err(Error::Input {
+            what: label.to_owned(),
+            why: format!(
+                "{}: resample=True applies to CSV files with a `t` column; a JSON file or a \
+                 bag is already on an even grid",
+                path.display()
+            ),
+            file: Some(path.display().to_string()),
+        });
+    }
+    let grid = Demonstration::regrid_csv_path(&path, None)?;
+    if let Some(names) = channels.file
+        && names != grid.demonstration.channel_names()
+    {
+        return Err(Error::Input {
+            what: label.to_owned(),
+            why: format!(
+                "{}: columns {} differ from channels={}",
+                path.display(),
+                repr_list(grid.demonstration.channel_names()),
+                repr_list(names)
+            ),
+            file: Some(path.display().to_string()),
+        });
+    }
+    Ok(grid)
 }
 
 /// The items of a Python sequence argument (not a string or a single array).
@@ -418,6 +470,13 @@ impl PyPlanner {
     ///         sample per tick of the schedule the round ran). A log finer than the model's
     ///         ``Δt_s`` is resampled to it (a ``DataWarning`` says so); a coarser one is
     ///         refused.
+    ///     resample: put executions given as CSV files with an irregular ``t`` column
+    ///         (jitter beyond a quarter period, dropped samples) on the even grid of their
+    ///         logger's period first, as ``tandem record --resample`` does: the log and flags
+    ///         (one entry per row of the file) follow, the log interpolated, a sample
+    ///         supervised where the nearest row was, corrected where any row of its period
+    ///         was; a ``DataWarning`` says what was done. Arrays have no times and are
+    ///         refused with it. Default: ``False``.
     ///
     /// Every execution must cover the whole task and last no less than half the fastest and
     /// no more than twice the slowest demonstrated execution (a log taken at another rate
@@ -427,10 +486,10 @@ impl PyPlanner {
     ///     dict: ``newly_high`` (samples latched high-confidence), ``source`` of the new
     ///     schedule, its ``t_total_s`` (Eq. 13, s), wall times ``model_update_s``,
     ///     ``confidence_s``, ``scheduling_s``, and ``notices`` (what was resampled).
-    #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None, dt_s=None))]
+    #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None, dt_s=None, resample=false))]
     #[expect(
         clippy::too_many_arguments,
-        reason = "the Python signature: one list per robot and two keywords"
+        reason = "the Python signature: one list per robot and three keywords"
     )]
     fn record_round<'py>(
         &mut self,
@@ -441,6 +500,7 @@ impl PyPlanner {
         corrected: &Bound<'py, PyAny>,
         channels: Option<Vec<String>>,
         dt_s: Option<f64>,
+        resample: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         if let Some(dt) = dt_s
             && !(dt.is_finite() && dt > 0.0)
@@ -464,6 +524,27 @@ impl PyPlanner {
         );
         let mut records = Vec::with_capacity(n);
         for i in 0..n {
+            if resample {
+                let label = format!("executions[{i}]");
+                let grid = regridded_execution(&execs[i], &label, names)?;
+                warn(
+                    py,
+                    &format!(
+                        "{}; its log and flags put on the same grid (log interpolated, a sample \
+                         supervised where the nearest row was, corrected where any row of its \
+                         period was)",
+                        grid.note
+                    ),
+                )?;
+                let per_row = "one entry per row of the execution file";
+                let log = vector(&logs[i], &format!("ref_time_logs[{i}]"), per_row)?;
+                let sup = flags(&sups[i], &format!("supervised[{i}]"), per_row)?;
+                let cor = flags(&cors[i], &format!("corrected[{i}]"), per_row)?;
+                records.push(
+                    ExecutionRecord::from_regridded(grid, &log, &sup, &cor).map_err(Error::from)?,
+                );
+                continue;
+            }
             let demonstration = demonstration(
                 &execs[i],
                 &format!("executions[{i}]"),
@@ -534,6 +615,7 @@ impl PyPlanner {
             corrected,
             channels,
             dt_s,
+            false,
         )
     }
 

@@ -50,8 +50,10 @@ impl Layout {
             if !missing.is_empty() {
                 let names =
                     |axes: Vec<usize>| axes.iter().map(|&a| block.channels[a].clone()).collect();
+                let (line, _) = demo.header_at(None);
                 return Err(Error::PartialQuaternionBlock {
                     file: demo.source().into(),
+                    line,
                     block: block.name.clone(),
                     present: names(present),
                     missing: names(missing),
@@ -75,10 +77,11 @@ impl Layout {
             })
         };
         if let Some(channel) = channels.iter().find(|n| crate::checks::time_like(n)) {
+            let (line, column) = demo.header_at(Some(channel));
             return Err(Error::TimeLikeChannel {
                 file: demo.source().into(),
-                line: None,
-                column: None,
+                line,
+                column,
                 channel: channel.clone(),
             });
         }
@@ -86,8 +89,11 @@ impl Layout {
             .iter()
             .find_map(|name| derived(name).map(|why| (name, why)))
         {
+            let (line, column) = demo.header_at(Some(channel));
             return Err(Error::ReservedChannelName {
                 file: demo.source().into(),
+                line,
+                column,
                 channel: channel.clone(),
                 derived: why,
             });

@@ -152,8 +152,11 @@ const PAR_MIN_LEN: usize = 512;
 /// Rejects a demonstration whose sample period differs from `dt_ref` by more than 1 %.
 fn check_dt(demo: &Demonstration, dt_ref: f64) -> Result<()> {
     if (demo.dt_s() - dt_ref).abs() > DT_TOLERANCE * dt_ref {
+        let (line, column) = demo.header_at(None);
         return Err(Error::SamplePeriodMismatch {
             file: demo.source().into(),
+            line,
+            column,
             expected_s: dt_ref,
             found_s: demo.dt_s(),
         });
