@@ -58,6 +58,7 @@
 pub mod adversary;
 mod coordinator;
 mod error;
+pub mod holds;
 pub mod margins;
 mod robots;
 pub mod strategy;
@@ -68,6 +69,7 @@ pub mod tol;
 
 pub use coordinator::{Coordinator, Fault, Operator, Tick};
 pub use error::{Error, Result};
+pub use holds::{After, Hold};
 pub use margins::{PairSlack, pair_slacks, sufficient_margins, sufficient_margins_per_pair};
 pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};
 pub use strategy::{high_conf_steps, response_step};

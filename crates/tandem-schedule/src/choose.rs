@@ -171,6 +171,7 @@ pub(crate) fn repair(problem: &Problem, previous: &Schedule, tick_s: f64) -> Opt
         grad_exec: warps,
         offsets_s,
         tick_s,
+        holds: Vec::new(),
     })
 }
 

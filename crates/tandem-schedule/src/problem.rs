@@ -269,6 +269,7 @@ impl Problem {
             grad_exec: vec![warp; n_robots],
             offsets_s,
             tick_s,
+            holds: Vec::new(),
         })
     }
 }

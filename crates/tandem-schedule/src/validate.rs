@@ -30,6 +30,24 @@ pub enum Violation {
         /// `N − 1`.
         expected: usize,
     },
+    /// The schedule has holds ([`Schedule::holds`]) but not one list per robot.
+    #[error(
+        "the schedule has hold lists for {found} robots, expected {expected} (one per robot, or none)"
+    )]
+    HoldCount {
+        /// Number of hold lists.
+        found: usize,
+        /// `N`.
+        expected: usize,
+    },
+    /// A hold of the schedule is not on an active hold of the problem, is next to a
+    /// low-confidence sample, has a bad dwell or a release rule naming no valid robot or
+    /// sample (the realtime crate's check, `tandem_realtime::holds::check_holds`).
+    #[error("{source}")]
+    Hold {
+        /// What is wrong, naming the robot and the hold.
+        source: tandem_realtime::Error,
+    },
     /// A warp does not have one gradient per reference sample.
     #[error(
         "robot {robot}: execution warp has {len} gradients, the problem has {expected} reference samples"
@@ -260,6 +278,7 @@ pub(crate) fn validate_cheap(
         .timelines_of(problem)
         .map_err(|(robot, source)| Violation::Timeline { robot, source })?
         .into();
+    check_holds(problem, schedule, &timeline)?;
     if let Some(o) = timeline.first_lc_overlap() {
         let [a, b] = o.intervals;
         return Err(Violation::BothLowConfidence {
@@ -283,6 +302,35 @@ pub(crate) fn validate_cheap(
         }
     }
     Ok(timeline)
+}
+
+/// The schedule's holds: each robot's ([`tandem_realtime::holds::check_holds`]) on an active
+/// hold of the problem ([`Problem::active_holds`]).
+fn check_holds(
+    problem: &Problem,
+    schedule: &Schedule,
+    timeline: &GlobalTimeline,
+) -> Result<(), Violation> {
+    let robots = timeline.timelines();
+    for (robot, holds) in schedule.holds.iter().enumerate() {
+        tandem_realtime::holds::check_holds(robot, holds, &robots[robot], robots.len(), |r| {
+            robots[r].n_ref()
+        })
+        .map_err(|source| Violation::Hold { source })?;
+        if let Some(h) = holds
+            .iter()
+            .find(|h| problem.holds().binary_search(&h.ref_idx).is_err())
+        {
+            return Err(Violation::Hold {
+                source: tandem_realtime::Error::BadHold {
+                    robot,
+                    ref_idx: h.ref_idx,
+                    why: "is not a hold point of the problem",
+                },
+            });
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -28,6 +28,7 @@ pub(crate) fn uniform_schedule(
         grad_exec: Vec::from(warps),
         offsets_s: vec![times.tau_s],
         tick_s,
+        holds: Vec::new(),
     }
 }
 

@@ -242,6 +242,7 @@ impl Sampler<'_> {
             grad_exec: warps,
             offsets_s: scratch.offsets_s,
             tick_s: self.tick_s,
+            holds: Vec::new(),
         })
     }
 
