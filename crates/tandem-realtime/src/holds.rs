@@ -45,10 +45,13 @@ pub struct After {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Hold {
-    /// Reference sample `n` (`1 ≤ n < T_ref`) at whose start the robot stops. Samples `n − 1`
-    /// and `n` must be high-confidence: a robot that needs the operator is never stopped, and
-    /// a robot waiting at the boundary of a low-confidence sample would be reported
-    /// low-confidence in the tick in which it leaves.
+    /// Reference sample `n` (`0 ≤ n < T_ref`) at whose start the robot stops. For `n ≥ 1`
+    /// samples `n − 1` and `n` must be high-confidence: a robot that needs the operator is
+    /// never stopped, and a robot waiting at the boundary of a low-confidence sample would be
+    /// reported low-confidence in the tick in which it leaves. `n = 0` is the task start (a
+    /// hold on any sample, since the robot has not moved): listed only to give the start
+    /// release rules, with dwell 0 (the start offset `τ_i` is its planned dwell); it does not
+    /// split the plan.
     pub ref_idx: usize,
     /// Planned dwell (schedule-clock s, finite, ≥ 0): how long the schedule plans the robot to
     /// wait here. Every later breakpoint of the robot's clock is this much later. Default 0.
@@ -98,13 +101,22 @@ pub fn check_holds(
     let conf = tl.conf();
     for (k, h) in holds.iter().enumerate() {
         let n = h.ref_idx;
-        if n == 0 || n >= n_ref {
-            return Err(bad(n, "must be in 1..T_ref (the start is always a hold)"));
+        if n >= n_ref {
+            return Err(bad(
+                n,
+                "is past the last reference sample (must be < T_ref)",
+            ));
         }
         if k > 0 && holds[k - 1].ref_idx >= n {
             return Err(bad(n, "is not after the hold before it"));
         }
-        if !(conf[n - 1] && conf[n]) {
+        if n == 0 && h.dwell_s != 0.0 {
+            return Err(bad(
+                n,
+                "is the start, whose dwell is the start offset (dwell must be 0)",
+            ));
+        }
+        if n > 0 && !(conf[n - 1] && conf[n]) {
             return Err(bad(
                 n,
                 "is next to a low-confidence sample (samples n − 1 and n must be high-confidence)",
@@ -145,6 +157,7 @@ pub fn legs(tl: &Timeline, holds: &[Hold]) -> Result<Vec<Timeline>> {
     let mut start_s = tl.start_s();
     for bound in holds
         .iter()
+        .filter(|h| h.ref_idx > 0)
         .map(|h| (h.ref_idx, h.dwell_s))
         .chain(std::iter::once((tl.n_ref(), 0.0)))
     {
@@ -172,6 +185,254 @@ pub fn held_clock_end_s(grad_exec: &[f64], start_s: f64, dt_s: f64, holds: &[Hol
         c += g * dt_s;
     }
     c
+}
+
+/// The hold samples of a plan usable for a [`Hold`]: those of `available` (e.g. a problem's
+/// hold points) with samples `n − 1` and `n` high-confidence, `n ≥ 1`.
+#[must_use]
+pub fn usable_holds(conf: &[bool], available: &[usize]) -> Vec<usize> {
+    available
+        .iter()
+        .copied()
+        .filter(|&n| n >= 1 && n < conf.len() && conf[n - 1] && conf[n])
+        .collect()
+}
+
+/// Release rules from the schedule's order of low-confidence stretches: the low-confidence
+/// regions of all robots (`robots` split at the holds `base`, with their dwells; `base` empty
+/// for none) merged by their scheduled start; for every two consecutive regions `X` of robot
+/// `a` and `Y` of robot `b ≠ a`, robot `b` gets the latest of its usable holds `usable[b]`
+/// (increasing; see [`usable_holds`]) after its own region before `Y` (or the start, when `Y`
+/// is its first) and before `Y`, with the rule "once `a` has passed the end of `X`"
+/// ([`After`]); a hold of `base` there keeps its dwell. A pair without such a hold gets no
+/// rule (the margin check decides it). A rule whose awaited leg would not start strictly
+/// before the held leg (it would wait forever: legs start in order) is dropped. Returns one
+/// list per robot, or `base` itself when no rule was made.
+#[must_use]
+pub fn release_rules(
+    robots: &[Timeline],
+    base: &[Vec<Hold>],
+    usable: &[Vec<usize>],
+) -> Vec<Vec<Hold>> {
+    let n = robots.len();
+    let none: &[Hold] = &[];
+    let base_of = |i: usize| base.get(i).map_or(none, Vec::as_slice);
+    // Each robot's regions with their scheduled clock (dwells included).
+    let mut regions: Vec<(f64, usize, crate::LcInterval)> = Vec::new();
+    for (i, r) in robots.iter().enumerate() {
+        let Ok(legs) = legs(r, base_of(i)) else {
+            return base.to_vec();
+        };
+        let mut ref0 = 0;
+        for leg in &legs {
+            for iv in leg.lc_intervals() {
+                let iv = crate::LcInterval {
+                    ref_start: iv.ref_start + ref0,
+                    ref_end: iv.ref_end + ref0,
+                    ..*iv
+                };
+                regions.push((iv.start_s, i, iv));
+            }
+            ref0 += leg.n_ref();
+        }
+    }
+    regions.sort_by(|x, y| {
+        x.0.total_cmp(&y.0)
+            .then((x.1, x.2.ref_start).cmp(&(y.1, y.2.ref_start)))
+    });
+    let no_usable: &[usize] = &[];
+    // (held robot, hold sample, awaited robot, awaited sample)
+    let mut wanted: Vec<(usize, usize, usize, usize)> = Vec::new();
+    for w in regions.windows(2) {
+        let ((_, a, x), (_, b, y)) = (w[0], w[1]);
+        if a == b {
+            continue;
+        }
+        let prev_end = regions
+            .iter()
+            .filter(|(_, r, iv)| *r == b && iv.ref_end <= y.ref_start)
+            .map(|(_, _, iv)| iv.ref_end)
+            .max();
+        let cands = usable.get(b).map_or(no_usable, Vec::as_slice);
+        let hold = cands
+            .iter()
+            .rev()
+            .copied()
+            .find(|&h| h < y.ref_start && prev_end.is_none_or(|e| h > e))
+            .or(prev_end.is_none().then_some(0));
+        if let Some(h) = hold {
+            wanted.push((b, h, a, x.ref_end));
+        }
+    }
+    if wanted.is_empty() {
+        return base.to_vec();
+    }
+    let mut holds: Vec<Vec<Hold>> = (0..n).map(|i| base_of(i).to_vec()).collect();
+    for &(b, h, _, _) in &wanted {
+        if !holds[b].iter().any(|x| x.ref_idx == h) {
+            holds[b].push(Hold::at(h));
+        }
+    }
+    for list in &mut holds {
+        list.sort_by_key(|h| h.ref_idx);
+    }
+    // Leg starts with these holds: the clock at which the leg holding a sample starts.
+    let leg_starts: Vec<Vec<(usize, f64)>> = robots
+        .iter()
+        .zip(&holds)
+        .map(|(r, h)| {
+            let mut ref0 = 0;
+            legs(r, h)
+                .map(|ls| {
+                    ls.iter()
+                        .map(|l| {
+                            let out = (ref0, l.start_s());
+                            ref0 += l.n_ref();
+                            out
+                        })
+                        .collect()
+                })
+                .unwrap_or_default()
+        })
+        .collect();
+    let start_of_leg_with = |robot: usize, last_sample: usize| {
+        leg_starts[robot]
+            .iter()
+            .rev()
+            .find(|(r0, _)| *r0 <= last_sample)
+            .map_or(f64::INFINITY, |&(_, s)| s)
+    };
+    for &(b, h, a, m) in &wanted {
+        if start_of_leg_with(a, m - 1) >= start_of_leg_with(b, h) {
+            continue;
+        }
+        let hold = holds[b]
+            .iter_mut()
+            .find(|x| x.ref_idx == h)
+            .expect("pushed above");
+        let rule = After {
+            robot: a,
+            ref_idx: m,
+        };
+        if !hold.after.contains(&rule) {
+            hold.after.push(rule);
+        }
+    }
+    holds
+}
+
+/// A release rule in clock terms: robot `robot` has passed `threshold_s` on its leg `leg`
+/// (index into [`Plans::legs`]): its current leg is later, or it is on that leg with its
+/// clock at the leg's end or at least `tol` past `threshold_s`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Rule {
+    /// The robot awaited.
+    pub(crate) robot: usize,
+    /// Its leg containing the last sample it must have passed.
+    pub(crate) leg: usize,
+    /// The clock (s, on that leg) of the sample boundary it must have passed.
+    pub(crate) threshold_s: f64,
+}
+
+/// The robots' plans split into legs, with each leg's release rules: what the coordinator
+/// runs and the margin check checks (one construction for both).
+#[derive(Clone, Debug)]
+pub(crate) struct Plans {
+    /// Every robot's legs, robot 0's first, each robot's in order.
+    pub(crate) legs: Vec<Timeline>,
+    /// The robot of each leg.
+    pub(crate) robot_of: Vec<usize>,
+    /// The first reference sample of each leg (in its robot's reference).
+    pub(crate) ref0: Vec<usize>,
+    /// Per robot, its legs `first_leg[i]..first_leg[i + 1]`.
+    pub(crate) first_leg: Vec<usize>,
+    /// Per leg, its release rules `rules[rule_start[l]..rule_start[l + 1]]`.
+    pub(crate) rule_start: Vec<usize>,
+    /// The release rules of every leg, in leg order.
+    pub(crate) rules: Vec<Rule>,
+}
+
+impl Plans {
+    /// Splits `robots` at `holds` (one list per robot, or none at all) after checking them
+    /// ([`check_holds`]).
+    ///
+    /// # Errors
+    /// [`Error::BadHold`], or [`Error::LengthMismatch`] for a number of hold lists that is
+    /// neither 0 nor `N`.
+    pub(crate) fn new(robots: &[Timeline], holds: &[Vec<Hold>]) -> Result<Plans> {
+        let n = robots.len();
+        if !holds.is_empty() && holds.len() != n {
+            return Err(Error::LengthMismatch {
+                what: "holds",
+                expected: n,
+                found: holds.len(),
+            });
+        }
+        let none: &[Hold] = &[];
+        let holds_of = |i: usize| holds.get(i).map_or(none, Vec::as_slice);
+        let mut plans = Plans {
+            legs: Vec::new(),
+            robot_of: Vec::new(),
+            ref0: Vec::new(),
+            first_leg: Vec::with_capacity(n + 1),
+            rule_start: Vec::new(),
+            rules: Vec::new(),
+        };
+        for (i, tl) in robots.iter().enumerate() {
+            check_holds(i, holds_of(i), tl, n, |r| robots[r].n_ref())?;
+            plans.first_leg.push(plans.legs.len());
+            let mut from = 0;
+            for leg in legs(tl, holds_of(i))? {
+                let n_ref = leg.n_ref();
+                plans.legs.push(leg);
+                plans.robot_of.push(i);
+                plans.ref0.push(from);
+                from += n_ref;
+            }
+        }
+        plans.first_leg.push(plans.legs.len());
+        for (l, &i) in plans.robot_of.clone().iter().enumerate() {
+            plans.rule_start.push(plans.rules.len());
+            let ref0 = plans.ref0[l];
+            // Leg 0 takes the rules of a start hold, a later leg those of the hold it starts at.
+            let Some(h) = holds_of(i).iter().find(|h| h.ref_idx == ref0) else {
+                continue;
+            };
+            for a in &h.after {
+                let legs_of_a = plans.first_leg[a.robot]..plans.first_leg[a.robot + 1];
+                let leg = legs_of_a
+                    .clone()
+                    .rev()
+                    .find(|&la| plans.ref0[la] < a.ref_idx)
+                    .expect("ref_idx ≥ 1 lies in a leg of the robot awaited");
+                if plans.legs[leg].start_s() >= plans.legs[l].start_s() {
+                    return Err(Error::BadHold {
+                        robot: i,
+                        ref_idx: ref0,
+                        why: "waits for a leg of another robot that starts no earlier on schedule (legs start in order of their starts: it would wait forever)",
+                    });
+                }
+                let local = a.ref_idx - plans.ref0[leg];
+                plans.rules.push(Rule {
+                    robot: a.robot,
+                    leg,
+                    threshold_s: plans.legs[leg].sample_clock_s()[local],
+                });
+            }
+        }
+        plans.rule_start.push(plans.rules.len());
+        Ok(plans)
+    }
+
+    /// Whether any robot has more than one leg or any leg a release rule.
+    pub(crate) fn has_holds(&self) -> bool {
+        self.legs.len() > self.robot_of.last().map_or(0, |&r| r + 1) || !self.rules.is_empty()
+    }
+
+    /// The release rules of leg `l`.
+    pub(crate) fn rules_of(&self, l: usize) -> &[Rule] {
+        &self.rules[self.rule_start[l]..self.rule_start[l + 1]]
+    }
 }
 
 #[cfg(test)]
@@ -215,8 +476,13 @@ mod tests {
         let n = |_| 6;
         let check = |h: &[Hold]| check_holds(1, h, &t, 2, n);
         assert!(check(&[Hold::at(1), Hold::at(5)]).is_ok());
+        assert!(check(&[Hold::at(0), Hold::at(2)]).is_ok());
+        let start_dwell = Hold {
+            dwell_s: 1.0,
+            ..Hold::at(0)
+        };
+        assert!(check(&[start_dwell]).is_err());
         for (holds, at) in [
-            (vec![Hold::at(0)], 0),
             (vec![Hold::at(6)], 6),
             (vec![Hold::at(2), Hold::at(2)], 2),
             (vec![Hold::at(3)], 3),

@@ -73,6 +73,13 @@ impl CheckedSchedule {
     /// None in practice (the tick was checked); [`Error::Realtime`] is kept for the
     /// coordinator's own argument checks.
     pub fn coordinator(&self) -> Result<Coordinator> {
+        if self.schedule.has_holds() {
+            return Ok(Coordinator::with_holds_unchecked(
+                self.timelines.clone(),
+                &self.schedule.holds,
+                self.schedule.tick_s,
+            )?);
+        }
         Ok(Coordinator::new_unchecked(
             self.timelines.clone(),
             self.schedule.tick_s,

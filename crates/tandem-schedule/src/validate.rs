@@ -202,9 +202,14 @@ pub(crate) fn validated_timeline(
     }
     let timeline = validate_cheap(problem, schedule)?;
     let robots = timeline.timelines();
-    let decided = match check {
-        MarginCheck::SinglePass => tandem_realtime::sufficient_margins(robots, tick_s),
-        MarginCheck::PerPair => tandem_realtime::sufficient_margins_per_pair(robots, tick_s),
+    let decided = if schedule.has_holds() {
+        // The lead bound on the robots' legs with their release rules (one implementation).
+        tandem_realtime::sufficient_margins_with_holds(robots, &schedule.holds, tick_s)
+    } else {
+        match check {
+            MarginCheck::SinglePass => tandem_realtime::sufficient_margins(robots, tick_s),
+            MarginCheck::PerPair => tandem_realtime::sufficient_margins_per_pair(robots, tick_s),
+        }
     };
     match decided {
         Ok(true) => Ok(timeline),
@@ -279,7 +284,30 @@ pub(crate) fn validate_cheap(
         .map_err(|(robot, source)| Violation::Timeline { robot, source })?
         .into();
     check_holds(problem, schedule, &timeline)?;
-    if let Some(o) = timeline.first_lc_overlap() {
+    // With planned dwells the robots' later regions move: constraint 3 on their legs (a
+    // robot's legs never overlap one another in time).
+    let dwelling = schedule.holds.iter().flatten().any(|h| h.dwell_s > 0.0);
+    let overlap = if dwelling {
+        let mut robot_of = Vec::new();
+        let mut all = Vec::new();
+        for (robot, tl) in timeline.timelines().iter().enumerate() {
+            let legs = tandem_realtime::holds::legs(tl, schedule.holds_of(robot))
+                .map_err(|source| Violation::Timeline { robot, source })?;
+            robot_of.extend(std::iter::repeat_n(robot, legs.len()));
+            all.extend(legs);
+        }
+        GlobalTimeline::from(all).first_lc_overlap().map(|mut o| {
+            o.robots = o.robots.map(|l| robot_of[l]);
+            if o.robots[0] > o.robots[1] {
+                o.robots.swap(0, 1);
+                o.intervals.swap(0, 1);
+            }
+            o
+        })
+    } else {
+        timeline.first_lc_overlap()
+    };
+    if let Some(o) = overlap {
         let [a, b] = o.intervals;
         return Err(Violation::BothLowConfidence {
             robots: o.robots,
@@ -319,7 +347,7 @@ fn check_holds(
         .map_err(|source| Violation::Hold { source })?;
         if let Some(h) = holds
             .iter()
-            .find(|h| problem.holds().binary_search(&h.ref_idx).is_err())
+            .find(|h| h.ref_idx > 0 && problem.holds().binary_search(&h.ref_idx).is_err())
         {
             return Err(Violation::Hold {
                 source: tandem_realtime::Error::BadHold {
