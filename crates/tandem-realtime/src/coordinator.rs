@@ -307,6 +307,11 @@ impl Coordinator {
         })
     }
 
+    /// Whether the plans have hold points or release rules (`crate::holds`).
+    pub fn has_holds(&self) -> bool {
+        self.plans.has_holds()
+    }
+
     /// Whether robot `robot` is stopped at a hold (not its start): its current leg, after the
     /// first, has not started moving. Always `false` without holds.
     pub fn at_hold(&self, robot: usize) -> bool {
