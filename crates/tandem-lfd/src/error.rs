@@ -348,6 +348,23 @@ pub enum Error {
         /// The model's period `Δt_s`, seconds.
         model_s: f64,
     },
+    /// A hold rule (`<channel><op><value>`, [`crate::HoldRule`]) is malformed or names a
+    /// channel it cannot use.
+    #[error("hold rule `{rule}`: {why}")]
+    BadHoldRule {
+        /// The rule as written.
+        rule: String,
+        /// What is wrong.
+        why: String,
+    },
+    /// A hold's reference time ([`crate::HoldSpec::at_s`]) is not a time of the task.
+    #[error("hold at {at_s} s (reference time): {why}")]
+    BadHoldTime {
+        /// The reference time given, seconds.
+        at_s: f64,
+        /// What is wrong.
+        why: String,
+    },
     /// The time-warping crate failed.
     #[error("alignment failed: {0}")]
     Warp(#[from] tandem_warp::Error),

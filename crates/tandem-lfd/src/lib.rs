@@ -16,6 +16,8 @@
 //!   `x_f⁺ = μ̂⁺ + δx⁺` (Eq. 7).
 //! - [`TaskModel::update`]: adds an execution with its known reference-time log (Eq. 21)
 //!   through per-sample sufficient statistics, without re-alignment.
+//! - [`HoldSpec`]: hold points the user declares (reference times `at_s` and channel rules
+//!   [`HoldRule`] such as `tool<0.5` on the mean trajectory), resolved to reference samples.
 //!
 //! Time frames: all per-time arrays are indexed by *reference sample* `n ∈ 0..n_ref()`
 //! (the reference's samples, period `dt_s()`); warps map reference samples to demo samples.
@@ -88,5 +90,6 @@ pub use demo::{
 };
 pub use error::{Error, Result};
 pub use model::{
-    Corrections, EXECUTION_DURATION_RATIO, Execution, FitParams, Reference, Resampled, TaskModel,
+    Comparison, Corrections, EXECUTION_DURATION_RATIO, Execution, FitParams, HoldRule, HoldSpec,
+    Reference, Resampled, TaskModel,
 };

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use tandem_confidence::{
     Confidence, ConfidenceParams, ErrorRates, Observations, estimate_error_rates,
 };
-use tandem_lfd::{Demonstration, Execution, FitParams, Regridded, TaskModel};
+use tandem_lfd::{Demonstration, Execution, FitParams, HoldSpec, Regridded, TaskModel};
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
     CheckedSchedule, Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source,
@@ -52,6 +52,13 @@ pub struct PlannerParams {
     /// Anytime sampler (§II-C). Its `seed` is the master seed: the schedule made after
     /// `k` recorded pairs uses `derive_seed(seed, k)`. Default: `SamplerParams::default()`.
     pub sampler: SamplerParams,
+    /// Hold points (reference samples where a robot may dwell, its clock stopped): reference
+    /// times and channel rules, resolved on the model whenever the problem is (re)built
+    /// (`crate::holds`). A hold declared where the demonstrations predict the operator is
+    /// needed is refused when the planner is made ([`Error::HoldInLowConfidence`]). Default:
+    /// none (the task start is always a hold and is never listed), and a planner without
+    /// holds schedules exactly as before hold points existed.
+    pub holds: HoldSpec,
 }
 
 impl PlannerParams {
@@ -63,6 +70,7 @@ impl PlannerParams {
         self.fit.validate()?;
         self.confidence.validate()?;
         self.sampler.validate()?;
+        self.holds.validate()?;
         Ok(())
     }
 }
@@ -298,6 +306,46 @@ struct PlannerState {
     rounds: Vec<u64>,
 }
 
+/// [`PlannerParams`] as state format 7 wrote them: without hold points.
+#[derive(Deserialize)]
+struct PlannerParamsV7 {
+    fit: FitParams,
+    confidence: ConfidenceParams,
+    sampler: SamplerParams,
+}
+
+/// [`PlannerState`] as state format version 7 wrote it: the parameters without hold points.
+#[derive(Deserialize)]
+struct PlannerStateV7 {
+    params: PlannerParamsV7,
+    model: TaskModel,
+    observations: Observations,
+    confidence: Confidence,
+    outcome: Outcome,
+    pairs_recorded: usize,
+    rounds: Vec<u64>,
+}
+
+impl From<PlannerStateV7> for PlannerState {
+    /// The saved planner with no hold points (none could be declared then).
+    fn from(v7: PlannerStateV7) -> Self {
+        PlannerState {
+            params: PlannerParams {
+                fit: v7.params.fit,
+                confidence: v7.params.confidence,
+                sampler: v7.params.sampler,
+                holds: HoldSpec::default(),
+            },
+            model: v7.model,
+            observations: v7.observations,
+            confidence: v7.confidence,
+            outcome: v7.outcome,
+            pairs_recorded: v7.pairs_recorded,
+            rounds: v7.rounds,
+        }
+    }
+}
+
 /// [`ConfidenceParams`] as state formats 4 to 6 wrote them: the paper's model, without the
 /// operator's error rates.
 #[derive(Deserialize)]
@@ -367,6 +415,7 @@ impl TryFrom<PlannerStateV6> for PlannerState {
                 fit: v6.params.fit,
                 confidence: v6.params.confidence.into(),
                 sampler: v6.params.sampler,
+                holds: HoldSpec::default(),
             },
             model: v6.model,
             observations: Observations::from_counts(
@@ -461,6 +510,7 @@ impl From<PlannerStateV4> for PlannerStateV6 {
                     grad_exec: Vec::from(schedule.grad_exec),
                     offsets_s: vec![schedule.offset_s],
                     tick_s: schedule.tick_s,
+                    holds: Vec::new(),
                 },
                 t_total_s,
                 source,
@@ -480,7 +530,10 @@ impl From<PlannerStateV4> for PlannerStateV6 {
 /// `ψ̇̄` is clamped into `[ψ̇min, ψ̇max]` sample by sample: the mean of the same values that
 /// define the bounds lies between them, but its floating-point update (Welford) can
 /// overshoot by a rounding error.
-fn problem_for(model: &TaskModel, confidence: &Confidence) -> Result<Problem> {
+///
+/// The hold points are `holds` resolved on `model` ([`HoldSpec::resolve`]); without a
+/// declaration the problem is the one built before hold points existed.
+fn problem_for(model: &TaskModel, confidence: &Confidence, holds: &HoldSpec) -> Result<Problem> {
     let (gmin, gmax) = (model.grad_min(), model.grad_max());
     let gmean = model
         .grad_mean()
@@ -488,13 +541,17 @@ fn problem_for(model: &TaskModel, confidence: &Confidence) -> Result<Problem> {
         .zip(gmin.iter().zip(gmax))
         .map(|(&g, (&lo, &hi))| if lo <= hi { g.clamp(lo, hi) } else { g })
         .collect();
-    Ok(Problem::new(
+    let problem = Problem::new(
         confidence.conf().to_vec(),
         gmean,
         gmin.to_vec(),
         gmax.to_vec(),
         model.dt_s(),
-    )?)
+    )?;
+    if holds.is_empty() {
+        return Ok(problem);
+    }
+    Ok(problem.with_holds(crate::holds::resolve(holds, model, confidence.params())?)?)
 }
 
 /// [`Error::RobotCount`] unless `1 ≤ n_robots ≤ MAX_ROBOTS`.
@@ -557,9 +614,10 @@ impl Planner {
     ) -> Result<Self> {
         check_robot_count(n_robots)?;
         params.validate()?;
+        crate::holds::check_declared(&params.holds, &model, &params.confidence)?;
         let confidence = Confidence::from_prior(model.sigma2_d(), params.confidence.clone())?;
         let observations = Observations::new(model.n_ref())?;
-        let problem = problem_for(&model, &confidence)?;
+        let problem = problem_for(&model, &confidence, &params.holds)?;
         let outcome =
             sample_schedule_n(&problem, n_robots, &Self::sampler_params(&params, 0), None)?;
         Ok(Self {
@@ -699,7 +757,7 @@ impl Planner {
         }
         let mut confidence = self.confidence.clone();
         let newly_high = confidence.update(model.sigma2_d(), &observations)?;
-        let problem = problem_for(&model, &confidence)?;
+        let problem = problem_for(&model, &confidence, &self.params.holds)?;
         let t2 = Instant::now();
         let pairs_recorded = self.pairs_recorded + 1;
         let sampler = SamplerParams {
@@ -923,7 +981,8 @@ impl Planner {
     /// `offsets_s = [offset_s]`; versions 4 and 5 have no round fingerprints, so the rounds
     /// they hold are not checked for repeats; versions 4 to 6 load with the paper's
     /// confidence model, `ConfidenceParams::paper()` with their own `γ_p`, `σ²_MAX`, `ε`,
-    /// `μ_c`, `γ_c`, the model they were decided with; saving writes the current version). Reading
+    /// `μ_c`, `γ_c`, the model they were decided with; versions 4 to 7 load without hold points;
+    /// saving writes the current version). Reading
     /// takes no lock (saves are atomic renames); the planner remembers the file's content, so
     /// that saving into it again refuses to overwrite what another process saved meanwhile.
     ///
@@ -944,6 +1003,7 @@ impl Planner {
             4 => old(state::decode_payload::<PlannerStateV4>(payload, path)?.into())?,
             5 => old(state::decode_payload::<PlannerStateV5>(payload, path)?.into())?,
             6 => old(state::decode_payload::<PlannerStateV6>(payload, path)?)?,
+            7 => state::decode_payload::<PlannerStateV7>(payload, path)?.into(),
             _ => state::decode_payload(payload, path)?,
         };
         let mut planner = Self::from_state(st).map_err(|e| Error::Corrupt {
@@ -1040,7 +1100,7 @@ impl Planner {
                 ),
             });
         }
-        let problem = problem_for(&st.model, &st.confidence)?;
+        let problem = problem_for(&st.model, &st.confidence, &st.params.holds)?;
         Ok(Self {
             params: st.params,
             model: st.model,

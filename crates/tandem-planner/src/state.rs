@@ -94,7 +94,10 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 ///   their evidence of misses (`MissEvidence`). Version 4 to 6 files still load, with the
 ///   paper's model (`ConfidenceParams::paper()`: the decisions they were saved with) and no
 ///   evidence of misses.
-pub const FORMAT_VERSION: u32 = 7;
+/// - 8: the planner parameters gained the hold points the user declared
+///   (`PlannerParams::holds`: reference times and channel rules). Version 4 to 7 files still
+///   load, with no hold points.
+pub const FORMAT_VERSION: u32 = 8;
 
 /// The oldest state format version this build reads (converting it on load).
 pub const OLDEST_READABLE_VERSION: u32 = 4;

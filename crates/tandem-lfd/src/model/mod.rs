@@ -47,12 +47,14 @@ use crate::{Error, Result};
 mod corrections;
 mod execution;
 mod fit;
+mod holds;
 mod layout;
 mod params;
 mod stats;
 
 pub use corrections::Corrections;
 pub use execution::{EXECUTION_DURATION_RATIO, Execution, Resampled};
+pub use holds::{Comparison, HoldRule, HoldSpec};
 pub use params::{FitParams, Reference};
 
 use corrections::CorrectionCache;
