@@ -608,7 +608,7 @@ mod tests {
     fn header_layout_is_as_documented() {
         let bytes = encode(&payload(4)).unwrap();
         assert_eq!(&bytes[..8], b"TANDEMST");
-        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 7);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 8);
         let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
         assert_eq!(len as usize, bytes.len() - HEADER_LEN);
         let crc = u32::from_le_bytes(bytes[20..24].try_into().unwrap());
@@ -693,18 +693,18 @@ mod tests {
     #[test]
     fn other_version_is_rejected_with_both_numbers() {
         let mut bytes = encode(&payload(3)).unwrap();
-        bytes[8..12].copy_from_slice(&8u32.to_le_bytes());
+        bytes[8..12].copy_from_slice(&9u32.to_le_bytes());
         let err = decode::<Payload>(&bytes, Path::new("v.tandem")).unwrap_err();
         assert!(matches!(
             err,
             Error::UnsupportedVersion {
-                found: 8,
+                found: 9,
                 expected: FORMAT_VERSION,
                 ..
             }
         ));
         let msg = err.to_string();
-        assert!(msg.contains("v.tandem") && msg.contains('8') && msg.contains("4 to 7"));
+        assert!(msg.contains("v.tandem") && msg.contains('9') && msg.contains("4 to 8"));
     }
 
     #[test]
