@@ -74,6 +74,11 @@ enum Cmd {
         /// Seed of the random problems, the sampler and the operators.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Give every problem hold points (the middle of each high-confidence run of at least
+        /// three samples): the scheduler uses them (release rules, dwells), per-robot plans get
+        /// interleaved starts with release rules accepted by the margin check with holds.
+        #[arg(long)]
+        holds: bool,
     },
 }
 
@@ -88,7 +93,8 @@ fn main() -> anyhow::Result<()> {
             executions,
             robots,
             seed,
-        } => stress::run(executions, seed, robots),
+            holds,
+        } => stress::run(executions, seed, robots, holds),
         Cmd::ReferenceOrder(args) => reference_order::run(&args),
         Cmd::Test(args) => test::run_all(&args),
     }

@@ -1,4 +1,5 @@
-//! `cargo xtask stress --executions E [--robots N] [--seed S]`: the safety invariant under load.
+//! `cargo xtask stress --executions E [--robots N] [--seed S] [--holds]`: the safety invariant
+//! under load.
 //!
 //! Draws random problems and schedules each at a random control tick, then runs `E` executions
 //! in all through each schedule's own `Coordinator` (at the tick it was checked with) under the
@@ -18,6 +19,12 @@
 //! (`tandem::schedule::sample_schedule_n`, for any `N`); per-robot plans, which no
 //! `tandem-schedule` problem describes, get a tight schedule at an edge of
 //! `sufficient_margins`' acceptance (`testkit::tight_starts`).
+//!
+//! With `--holds` every problem gets hold points in the middle of each high-confidence run of
+//! at least three samples (`hold_points`): the scheduler plans with them (release rules on its
+//! candidates, the exact optimum with dwells for two robots), and per-robot plans get
+//! interleaved random starts with release rules (`tandem::realtime::holds::release_rules`)
+//! accepted by `sufficient_margins_with_holds` (20 draws, else the tight schedule without holds).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -27,8 +34,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use tandem::realtime::adversary::{Adversary, AdversaryRun, adversary_set, run_adversary};
+use tandem::realtime::holds::{release_rules, usable_holds};
 use tandem::realtime::testkit::{self, Family};
-use tandem::realtime::{Coordinator, Timeline, sufficient_margins};
+use tandem::realtime::{Coordinator, Timeline, sufficient_margins, sufficient_margins_with_holds};
 use tandem::schedule::{Problem, SamplerParams, Source, sample_schedule_n};
 
 /// Executions per scheduled problem (the number of problems is `N / this`, at least 1 and at
@@ -88,6 +96,31 @@ fn random_problem(rng: &mut ChaCha8Rng) -> anyhow::Result<Problem> {
     Ok(Problem::new(conf, mean, min, max, DT_S)?)
 }
 
+/// Hold points of a plan of confidence `conf`: the middle sample of every high-confidence run
+/// of at least three samples.
+fn hold_points(conf: &[bool]) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    for n in 1..=conf.len() {
+        if n == conf.len() || conf[n] != conf[start] {
+            if conf[start] && n - start >= 3 {
+                out.push((start + n) / 2);
+            }
+            start = n;
+        }
+    }
+    out
+}
+
+/// `problem` with hold points ([`hold_points`]) when `holds`.
+fn with_holds(problem: Problem, holds: bool) -> anyhow::Result<Problem> {
+    if !holds {
+        return Ok(problem);
+    }
+    let points = hold_points(problem.conf());
+    Ok(problem.with_holds(points)?)
+}
+
 /// How the schedule of a case was made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Made {
@@ -112,19 +145,45 @@ fn scheduled(
         ..SamplerParams::default()
     };
     let out = sample_schedule_n(problem, n_robots, &params, None)?;
-    let sampled = matches!(out.source, Source::Sampled { .. } | Source::Completed);
+    let sampled = matches!(
+        out.source,
+        Source::Sampled { .. } | Source::Completed | Source::Held
+    );
     Ok((out.schedule.check(problem)?.coordinator()?, sampled))
+}
+
+/// Per-robot plans with holds: up to 20 draws of interleaved starts (each robot at a random
+/// point of the span of the robots before it) with release rules on the plans' hold points,
+/// the first that `sufficient_margins_with_holds` accepts; `None` if none is.
+fn held_plans(case: &testkit::Case, rng: &mut ChaCha8Rng) -> anyhow::Result<Option<Coordinator>> {
+    for _ in 0..20 {
+        let mut starts = vec![0.0];
+        for _ in 1..case.plans.len() {
+            let end = last_end_s(&case.robots_at(&starts));
+            starts.push(end * rng.random::<f64>());
+        }
+        let robots = case.robots_at(&starts);
+        let usable: Vec<Vec<usize>> = robots
+            .iter()
+            .map(|r| usable_holds(r.conf(), &hold_points(r.conf())))
+            .collect();
+        let holds = release_rules(&robots, &[], &usable);
+        if !holds.is_empty() && sufficient_margins_with_holds(&robots, &holds, case.tick_s)? {
+            return Ok(Some(Coordinator::with_holds(robots, &holds, case.tick_s)?));
+        }
+    }
+    Ok(None)
 }
 
 /// Problem `index` of the run: even indices are this task's random problems, odd ones cycle
 /// through the test kit's families (`tandem::realtime::testkit::Family`). Shared-mask problems
 /// are scheduled by the production scheduler; per-robot plans (which no `tandem-schedule`
 /// problem describes) get a tight schedule at an acceptance edge of `sufficient_margins`.
-fn make_case(seed: u64, index: u64, n_robots: usize) -> anyhow::Result<Case> {
+fn make_case(seed: u64, index: u64, n_robots: usize, holds: bool) -> anyhow::Result<Case> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(index);
     let (coordinator, overlapping, family, made) = if index % 2 == 0 {
-        let problem = random_problem(&mut rng)?;
+        let problem = with_holds(random_problem(&mut rng)?, holds)?;
         let tick_s = DT_S * rng.random_range(0.25..=1.0);
         let (c, o) = scheduled(&problem, n_robots, tick_s, &mut rng)?;
         (c, o, "stress", Made::Scheduled)
@@ -132,9 +191,15 @@ fn make_case(seed: u64, index: u64, n_robots: usize) -> anyhow::Result<Case> {
         let family = Family::ALL[((index / 2) % Family::ALL.len() as u64) as usize];
         let case = testkit::Case::random(family, n_robots, &mut rng);
         if let Some(m) = case.shared_mask() {
-            let problem = Problem::new(m.conf, m.mean, m.lo, m.hi, m.dt_s)?;
+            let problem = with_holds(Problem::new(m.conf, m.mean, m.lo, m.hi, m.dt_s)?, holds)?;
             let (c, o) = scheduled(&problem, n_robots, case.tick_s, &mut rng)?;
             (c, o, family.name(), Made::Scheduled)
+        } else if let Some(c) = holds
+            .then(|| held_plans(&case, &mut rng))
+            .transpose()?
+            .flatten()
+        {
+            (c, true, family.name(), Made::Tight)
         } else {
             let check: testkit::Check = sufficient_margins;
             let (starts, o) = testkit::tight_starts(&case, check, &mut rng)
@@ -155,9 +220,13 @@ fn make_case(seed: u64, index: u64, n_robots: usize) -> anyhow::Result<Case> {
         all(Timeline::grad_min).fold(f64::INFINITY, f64::min),
         all(Timeline::grad_max).fold(0.0, f64::max),
     ];
-    let ticks = (last_end_s(robots) / tick_s) as u64;
+    // With holds the legs carry the planned dwells: the latest leg end of each robot.
+    let dwell_s: f64 = (0..coordinator.n_robots())
+        .map(|i| coordinator.current_plan(i).end_s() - robots[i].end_s())
+        .fold(0.0, f64::max);
+    let ticks = ((last_end_s(robots) + dwell_s) / tick_s) as u64;
     Ok(Case {
-        max_ticks: (2.0 * slowest_s / tick_s) as u64 + 100,
+        max_ticks: (2.0 * (slowest_s + dwell_s) / tick_s) as u64 + 100,
         adversaries: adversary_set(n_robots, grad_range, ticks, &mut rng),
         coordinator,
         overlapping,
@@ -185,7 +254,7 @@ fn execute(case: &Case, op: Adversary, seed: u64, exec: u64) -> anyhow::Result<A
 
 /// Runs the stress test with `n_robots` robots; fails if any tick had two or more robots
 /// low-confidence.
-pub(crate) fn run(executions: u64, seed: u64, n_robots: usize) -> anyhow::Result<()> {
+pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> anyhow::Result<()> {
     if executions == 0 {
         bail!("--executions must be ≥ 1");
     }
@@ -196,14 +265,17 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize) -> anyhow::Result
     let n_problems = (executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS);
     let cases: Vec<Case> = (0..n_problems)
         .into_par_iter()
-        .map(|i| make_case(seed, i, n_robots).with_context(|| format!("scheduling problem {i}")))
+        .map(|i| {
+            make_case(seed, i, n_robots, holds).with_context(|| format!("scheduling problem {i}"))
+        })
         .collect::<anyhow::Result<_>>()?;
     let count = |f: &dyn Fn(&Case) -> bool| cases.iter().filter(|c| f(c)).count();
     let n_overlapping = count(&|c| c.overlapping);
     println!(
-        "stress: {n_robots} robots, {n_problems} random problems: {} scheduled by the production \
+        "stress: {n_robots} robots{}, {n_problems} random problems: {} scheduled by the production \
          scheduler ({SAMPLES} candidates), {} tight at an acceptance edge (per-robot plans); \
          {n_overlapping} with overlapping executions, {} serial; scheduling took {:.1} s",
+        if holds { " with hold points" } else { "" },
         count(&|c| c.made == Made::Scheduled),
         count(&|c| c.made == Made::Tight),
         n_problems as usize - n_overlapping,
@@ -220,6 +292,12 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize) -> anyhow::Result
         })
         .collect();
     println!("  overlapping/all per family: {}", per_family.join(", "));
+    if holds {
+        println!(
+            "  {} of {n_problems} schedules run with hold points or release rules",
+            count(&|c| c.coordinator.has_holds())
+        );
+    }
     let set_size = cases[0].adversaries.len() as u64;
     let run_start = Instant::now();
     let (ticks, overlap_ticks, overlap_runs, unfinished) = (

@@ -18,6 +18,7 @@ pub(crate) fn source_name(source: &Source) -> String {
         Source::Previous => "previous schedule (still valid, nothing better found)".into(),
         Source::RepairedPrevious => "previous schedule, repaired for the new model".into(),
         Source::Serial => "fastest serial schedule (fallback)".into(),
+        Source::Held => "exact optimum with hold points and release rules".into(),
     }
 }
 

@@ -445,6 +445,7 @@ impl From<PlannerStateV4> for PlannerStateV6 {
                     grad_exec: Vec::from(schedule.grad_exec),
                     offsets_s: vec![schedule.offset_s],
                     tick_s: schedule.tick_s,
+                    holds: Vec::new(),
                 },
                 t_total_s,
                 source,

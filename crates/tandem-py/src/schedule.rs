@@ -289,6 +289,7 @@ impl PySchedule {
             grad_exec: g.chunks_exact(n_ref).map(<[f64]>::to_vec).collect(),
             offsets_s: offsets.to_vec(),
             tick_s,
+            holds: Vec::new(),
         };
         Ok(Self::new(
             problem.inner.clone(),

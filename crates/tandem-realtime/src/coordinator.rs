@@ -3,6 +3,7 @@
 use std::sync::Arc;
 
 use crate::error::{Error, Result};
+use crate::holds::{Hold, Plans};
 use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
 use crate::strategy::{Member, Mode, advance, first_waiting_start};
 use crate::timeline::Timeline;
@@ -147,9 +148,19 @@ pub struct Coordinator {
     /// The plans, shared: cloning a coordinator (to run the same schedule again, or to search
     /// over operator sequences) copies only its clocks.
     robots: Arc<[Timeline]>,
+    /// The plans split at their holds (`crate::holds`): one leg per robot without holds.
+    plans: Arc<Plans>,
     tick_s: f64,
     tol_s: f64,
+    /// Each robot's schedule clock on its current leg.
     clock_s: [f64; MAX_ROBOTS],
+    /// Each robot's current leg (index into `plans.legs`).
+    leg: [usize; MAX_ROBOTS],
+    /// Whether each robot's current leg has had its release rules met (latched).
+    released: RobotFlags,
+    /// The clock of every leg not yet started (they all follow the same rule 3, so they
+    /// share it): the clock a robot's next leg has when its current leg ends.
+    wait_clock_s: f64,
     cursors: [Cursors; MAX_ROBOTS],
     /// Ticks run since the start or the last reset.
     ticks: u64,
@@ -179,6 +190,42 @@ impl Coordinator {
         Ok(c)
     }
 
+    /// [`Coordinator::new`] for plans with hold points (`crate::holds`): robot `i` stops at
+    /// each of `holds[i]` and leaves as a robot starts, once its release rules hold; `holds`
+    /// is empty (no holds: exactly [`Coordinator::new`]) or has one list per robot. The margin
+    /// check is [`sufficient_margins_with_holds`](crate::margins::sufficient_margins_with_holds).
+    ///
+    /// # Errors
+    /// As [`Coordinator::new`]; [`Error::BadHold`] or [`Error::LengthMismatch`] for holds
+    /// that [`crate::holds::check_holds`] rejects or a wrong number of hold lists.
+    pub fn with_holds(
+        robots: impl Into<Vec<Timeline>>,
+        holds: &[Vec<Hold>],
+        tick_s: f64,
+    ) -> Result<Coordinator> {
+        let c = Coordinator::with_holds_unchecked(robots, holds, tick_s)?;
+        if !crate::margins::check_plans(&c.plans, c.robots.len(), tick_s)? {
+            return Err(Error::Unsafe { tick_s });
+        }
+        Ok(c)
+    }
+
+    /// [`Coordinator::with_holds`] without the margin check (see
+    /// [`Coordinator::new_unchecked`]): the run-time rules of the holds apply all the same.
+    ///
+    /// # Errors
+    /// As [`Coordinator::with_holds`], but never [`Error::Unsafe`].
+    pub fn with_holds_unchecked(
+        robots: impl Into<Vec<Timeline>>,
+        holds: &[Vec<Hold>],
+        tick_s: f64,
+    ) -> Result<Coordinator> {
+        let robots: Vec<Timeline> = robots.into();
+        check_count(robots.len())?;
+        let plans = Plans::new(&robots, holds)?;
+        Coordinator::build(robots.into(), plans, tick_s)
+    }
+
     /// [`Coordinator::new`] without the margin check: for tests and studies of what a schedule
     /// the check rejects does at run time, and for callers that have just run the check on the
     /// same plans and tick (`tandem_schedule::CheckedSchedule`). The run-time monitor still
@@ -188,21 +235,28 @@ impl Coordinator {
     /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] if `tick_s` is
     /// not finite and > 0.
     pub fn new_unchecked(robots: impl Into<Vec<Timeline>>, tick_s: f64) -> Result<Coordinator> {
-        let robots: Arc<[Timeline]> = robots.into().into();
-        check_count(robots.len())?;
+        Coordinator::with_holds_unchecked(robots, &[], tick_s)
+    }
+
+    fn build(robots: Arc<[Timeline]>, plans: Plans, tick_s: f64) -> Result<Coordinator> {
         if !(tick_s.is_finite() && tick_s > 0.0) {
             return Err(Error::BadParam {
                 name: "tick_s",
                 why: "must be finite and > 0",
             });
         }
-        let tol_s = clock_tolerance_s(&robots, tick_s);
+        // Without holds the legs are the robots' timelines: the same tolerance.
+        let tol_s = clock_tolerance_s(&plans.legs, tick_s);
         let n = robots.len();
         let mut c = Coordinator {
             robots,
+            plans: Arc::new(plans),
             tick_s,
             tol_s,
             clock_s: [0.0; MAX_ROBOTS],
+            leg: [0; MAX_ROBOTS],
+            released: RobotFlags::new(n),
+            wait_clock_s: 0.0,
             cursors: [Cursors::default(); MAX_ROBOTS],
             ticks: 0,
             lc_since: [0; MAX_ROBOTS],
@@ -240,17 +294,70 @@ impl Coordinator {
         self.tick_s
     }
 
-    /// Each robot's schedule clock `s_i` (s, global/schedule-clock frame).
+    /// Each robot's schedule clock `s_i` (s, global/schedule-clock frame; with holds, on its
+    /// current leg, which includes the planned dwells before it).
     pub fn clock_s(&self) -> &[f64] {
         &self.clock_s[..self.robots.len()]
     }
 
-    /// Whether every robot has finished.
+    /// Whether every robot has finished (with holds: its last leg).
     pub fn is_finished(&self) -> bool {
-        self.robots
-            .iter()
-            .zip(&self.clock_s)
-            .all(|(r, &s)| s >= r.end_s())
+        (0..self.robots.len()).all(|i| {
+            self.leg[i] + 1 == self.plans.first_leg[i + 1] && self.clock_s[i] >= self.cur(i).end_s()
+        })
+    }
+
+    /// Whether the plans have hold points or release rules (`crate::holds`).
+    pub fn has_holds(&self) -> bool {
+        self.plans.has_holds()
+    }
+
+    /// Whether robot `robot` is stopped at a hold (not its start): its current leg, after the
+    /// first, has not started moving. Always `false` without holds.
+    pub fn at_hold(&self, robot: usize) -> bool {
+        robot < self.robots.len()
+            && self.leg[robot] > self.plans.first_leg[robot]
+            && (self.clock_s[robot] < self.cur(robot).start_s() || !self.released[robot])
+    }
+
+    /// The plan robot `robot` is on now: its timeline, or with holds its current leg (reference
+    /// samples numbered from the leg's first, schedule clock including the dwells before it).
+    ///
+    /// # Panics
+    /// If `robot ≥ N`.
+    pub fn current_plan(&self, robot: usize) -> &Timeline {
+        assert!(
+            robot < self.robots.len(),
+            "robot {robot} of {}",
+            self.robots.len()
+        );
+        self.cur(robot)
+    }
+
+    /// The current leg of robot `i`.
+    fn cur(&self, i: usize) -> &Timeline {
+        &self.plans.legs[self.leg[i]]
+    }
+
+    /// Latches `released` for every robot whose current leg's release rules hold on the
+    /// robots' states now (between ticks: at the next tick start). O(rules of the current
+    /// legs).
+    fn update_released(&mut self) {
+        for i in 0..self.robots.len() {
+            if !self.released[i] && self.rules_met(i) {
+                self.released.set(i, true);
+            }
+        }
+    }
+
+    /// Whether every release rule of robot `i`'s current leg holds now.
+    fn rules_met(&self, i: usize) -> bool {
+        self.plans.rules_of(self.leg[i]).iter().all(|r| {
+            let (a, s) = (r.robot, self.clock_s[r.robot]);
+            self.leg[a] > r.leg
+                || (self.leg[a] == r.leg
+                    && (s >= self.plans.legs[r.leg].end_s() || s >= r.threshold_s + self.tol_s))
+        })
     }
 
     /// Puts every schedule clock back at the earliest start, as [`Coordinator::new`] left them
@@ -262,6 +369,13 @@ impl Coordinator {
             .map(Timeline::start_s)
             .fold(f64::INFINITY, f64::min);
         self.clock_s = [t0; MAX_ROBOTS];
+        self.wait_clock_s = t0;
+        let n = self.robots.len();
+        for i in 0..n {
+            self.leg[i] = self.plans.first_leg[i];
+        }
+        self.released = RobotFlags::new(n);
+        self.update_released();
         self.cursors = [Cursors::default(); MAX_ROBOTS];
         self.ticks = 0;
         self.lc_since = [0; MAX_ROBOTS];
@@ -274,23 +388,22 @@ impl Coordinator {
     /// operator's rate. O(N), no allocation.
     pub fn low_conf_now(&self) -> RobotFlags {
         let mut out = RobotFlags::new(self.robots.len());
-        for (i, (r, (&s, cur))) in self
-            .robots
-            .iter()
-            .zip(self.clock_s.iter().zip(&self.cursors))
-            .enumerate()
-        {
-            out.set(i, s >= r.start_s() && s < r.end_s() && !r.conf()[cur.at]);
+        for i in 0..self.robots.len() {
+            let (r, s, cur) = (self.cur(i), self.clock_s[i], &self.cursors[i]);
+            out.set(
+                i,
+                s >= r.start_s() && s < r.end_s() && self.released[i] && !r.conf()[cur.at],
+            );
         }
         out
     }
 
     fn phase(&mut self, i: usize) -> Phase {
-        let r = &self.robots[i];
+        let r = &self.plans.legs[self.leg[i]];
         let s = self.clock_s[i];
         if s >= r.end_s() {
             Phase::Finished
-        } else if s < r.start_s() {
+        } else if s < r.start_s() || !self.released[i] {
             Phase::Waiting
         } else {
             let n = r.advance_cursor(&mut self.cursors[i].at, s);
@@ -302,7 +415,7 @@ impl Coordinator {
 
     /// Schedule-clock step of robot `i` commanded by the operator.
     fn operator_step(&self, i: usize, op: Operator) -> f64 {
-        let r = &self.robots[i];
+        let r = self.cur(i);
         let n = self.cursors[i].at;
         let (lo, hi) = (r.grad_min()[n], r.grad_max()[n]);
         let g = match op {
@@ -345,7 +458,7 @@ impl Coordinator {
                 Phase::Active { low_conf: false } => Member {
                     clock_s: s,
                     mode: Mode::High,
-                    rates: self.robots[i].rates(self.cursors[i].at),
+                    rates: self.cur(i).rates(self.cursors[i].at),
                 },
             };
         }
@@ -356,9 +469,33 @@ impl Coordinator {
             running: RobotFlags::new(n),
             fault: None,
         };
-        let first_waiting_start = first_waiting_start(&members[..n], |i| self.robots[i].start_s());
+        let mut first_waiting_start = first_waiting_start(&members[..n], |i| self.cur(i).start_s());
+        let has_holds = self.plans.has_holds();
+        if has_holds {
+            // Legs not started yet wait too (rule 3 for every leg): a robot's next leg is due
+            // at its start.
+            for (i, m) in members[..n].iter().enumerate() {
+                let next = self.leg[i] + 1;
+                if m.mode != Mode::Waiting && next < self.plans.first_leg[i + 1] {
+                    first_waiting_start = first_waiting_start.min(self.plans.legs[next].start_s());
+                }
+            }
+            // The clock of the legs not started: rule 3's follow clock, capped.
+            let follow = members[..n]
+                .iter()
+                .zip(&next_s[..n])
+                .filter(|(m, _)| matches!(m.mode, Mode::High | Mode::Low))
+                .map(|(_, &x)| x)
+                .fold(f64::INFINITY, f64::min);
+            let follow = if follow.is_finite() {
+                follow
+            } else {
+                self.wait_clock_s + self.tick_s
+            };
+            self.wait_clock_s = follow.min(first_waiting_start).max(self.wait_clock_s);
+        }
         for (i, m) in members[..n].iter().enumerate() {
-            let r = &self.robots[i];
+            let r = &self.plans.legs[self.leg[i]];
             let s_old = self.clock_s[i];
             let waiting = m.mode == Mode::Waiting;
             let cap = if waiting {
@@ -382,8 +519,18 @@ impl Coordinator {
                 out.low_conf.set(i, r.any_low_conf(lo, hi));
             }
             let at = r.advance_cursor(&mut self.cursors[i].at, s_new);
-            out.ref_time.as_mut_slice()[i] = r.ref_time_in(at, s_new);
+            out.ref_time.as_mut_slice()[i] =
+                r.ref_time_in(at, s_new) + self.plans.ref0[self.leg[i]] as f64;
+            if has_holds && s_new >= r.end_s() && self.leg[i] + 1 < self.plans.first_leg[i + 1] {
+                // The leg ended at a hold: the robot's next leg is current, at the clock every
+                // leg not yet started has.
+                self.leg[i] += 1;
+                self.clock_s[i] = self.wait_clock_s;
+                self.cursors[i] = Cursors::default();
+                self.released.set(i, false);
+            }
         }
+        self.update_released();
         self.monitor(&out);
         out.fault = self.fault;
         self.ticks += 1;

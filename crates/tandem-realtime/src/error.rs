@@ -60,6 +60,18 @@ pub enum Error {
         /// The control tick checked (real s).
         tick_s: f64,
     },
+    /// A hold of a robot's plan is out of range, out of order, next to a low-confidence sample,
+    /// has a bad dwell or a release rule naming no valid robot or sample
+    /// (`crate::holds::check_holds`).
+    #[error("robot {}: hold at reference sample {ref_idx} {why}", robot + 1)]
+    BadHold {
+        /// The robot (0-based; shown 1-based).
+        robot: usize,
+        /// The hold's reference sample.
+        ref_idx: usize,
+        /// What is wrong.
+        why: &'static str,
+    },
     /// A scalar parameter is out of its valid range.
     #[error("parameter `{name}` {why}")]
     BadParam {

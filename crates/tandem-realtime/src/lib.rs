@@ -58,6 +58,7 @@
 pub mod adversary;
 mod coordinator;
 mod error;
+pub mod holds;
 pub mod margins;
 mod robots;
 pub mod strategy;
@@ -68,7 +69,11 @@ pub mod tol;
 
 pub use coordinator::{Coordinator, Fault, Operator, Tick};
 pub use error::{Error, Result};
-pub use margins::{PairSlack, pair_slacks, sufficient_margins, sufficient_margins_per_pair};
+pub use holds::{After, Hold};
+pub use margins::{
+    PairSlack, pair_slacks, pair_slacks_with_holds, sufficient_margins,
+    sufficient_margins_per_pair, sufficient_margins_with_holds,
+};
 pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};
 pub use strategy::{high_conf_steps, response_step};
 pub use timeline::{LcInterval, Rates, Timeline, clock_end_s, clock_s};

@@ -693,14 +693,31 @@ pub fn find_overlap(
     adversaries: &[Adversary],
     rng: &mut ChaCha8Rng,
 ) -> Option<(Adversary, u64)> {
+    find_overlap_with_holds(robots, &[], tick_s, adversaries, rng)
+}
+
+/// [`find_overlap`] for plans with holds (`crate::holds`; `holds` empty: no holds), run by
+/// [`Coordinator::with_holds_unchecked`]; the budget counts the planned dwells too.
+///
+/// # Panics
+/// As [`find_overlap`], and for holds the coordinator rejects.
+pub fn find_overlap_with_holds(
+    robots: &[Timeline],
+    holds: &[Vec<crate::Hold>],
+    tick_s: f64,
+    adversaries: &[Adversary],
+    rng: &mut ChaCha8Rng,
+) -> Option<(Adversary, u64)> {
     let first_start = robots
         .iter()
         .map(Timeline::start_s)
         .fold(f64::INFINITY, f64::min);
-    let total = last_end_s(robots) - first_start;
+    let dwell: f64 = holds.iter().flatten().map(|h| h.dwell_s).sum();
+    let total = last_end_s(robots) + dwell - first_start;
     let budget = (total / tick_s * 40.0).ceil() as u64 + 100;
     for &a in adversaries {
-        let c = Coordinator::new_unchecked(robots.to_vec(), tick_s).expect("valid tick");
+        let c = Coordinator::with_holds_unchecked(robots.to_vec(), holds, tick_s)
+            .expect("valid tick and holds");
         let run = run_adversary(c, a, rng, budget).expect("admissible adversaries");
         assert!(run.finished, "coordinator did not finish under {a:?}");
         if let Some(k) = run.first_overlap {

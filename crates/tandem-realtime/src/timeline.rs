@@ -220,6 +220,32 @@ impl Timeline {
         })
     }
 
+    /// The plan of reference samples `from..to` (`from < to ≤ T_ref`) alone, started at
+    /// `start_s` (s): the leg of a plan with holds (`crate::holds::legs`). Its reference
+    /// samples are numbered from 0 (sample `from` of this plan is its sample 0). Started at
+    /// this plan's `c_from` it has this plan's breakpoints `c_from..=c_to` bit for bit (the
+    /// clock is summed in the same order).
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for an empty or out-of-range `from..to`, [`Error::NonFinite`] for a
+    /// start or end that is not finite.
+    pub fn sub(&self, from: usize, to: usize, start_s: f64) -> Result<Timeline> {
+        if !(from < to && to <= self.n_ref()) {
+            return Err(Error::BadParam {
+                name: "from..to",
+                why: "must be a non-empty range of reference samples",
+            });
+        }
+        Timeline::new(
+            &self.conf[from..to],
+            &self.grad_exec[from..to],
+            &self.grad_min[from..to],
+            &self.grad_max[from..to],
+            start_s,
+            self.dt_s,
+        )
+    }
+
     /// `τ_i`: global time (s) at which the robot starts.
     pub fn start_s(&self) -> f64 {
         self.clock_s[0]

@@ -23,7 +23,7 @@ use crate::{Error, Result};
 /// // Two samples of 1 s, the first low-confidence; bounds [½, 2] around gradient 1.
 /// let problem = Problem::new(vec![false, true], vec![1.0; 2], vec![0.5; 2], vec![2.0; 2], 1.0)?;
 /// // Robot 2 starting at 0 would be low-confidence together with robot 1: refused.
-/// let together = Schedule { grad_exec: vec![vec![1.0; 2]; 2], offsets_s: vec![0.0], tick_s: 1.0 };
+/// let together = Schedule { grad_exec: vec![vec![1.0; 2]; 2], offsets_s: vec![0.0], tick_s: 1.0, holds: vec![] };
 /// assert!(together.check(&problem).is_err());
 /// // Serial (robot 2 starts where robot 1 ends) passes, and runs at its tick.
 /// let serial = Schedule { offsets_s: vec![2.0], ..together };
@@ -73,6 +73,13 @@ impl CheckedSchedule {
     /// None in practice (the tick was checked); [`Error::Realtime`] is kept for the
     /// coordinator's own argument checks.
     pub fn coordinator(&self) -> Result<Coordinator> {
+        if self.schedule.has_holds() {
+            return Ok(Coordinator::with_holds_unchecked(
+                self.timelines.clone(),
+                &self.schedule.holds,
+                self.schedule.tick_s,
+            )?);
+        }
         Ok(Coordinator::new_unchecked(
             self.timelines.clone(),
             self.schedule.tick_s,

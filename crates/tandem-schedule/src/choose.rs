@@ -52,11 +52,16 @@ pub enum Source {
     RepairedPrevious,
     /// The fastest serial schedule ([`Problem::serial_schedule`]).
     Serial,
+    /// The exact optimum with hold points (two robots: the margin-free optimum of
+    /// [`crate::solve_exact`] on a problem with holds, planned dwells included) with release
+    /// rules from its order of low-confidence stretches ([`Problem::with_release_rules`]),
+    /// which enforce that order at run time instead of margins.
+    Held,
 }
 
 impl Source {
     /// The short name of the source in records (the study's JSON and CSV, the Python
-    /// package): `sampled`, `completed`, `previous`, `repaired` or `serial`.
+    /// package): `sampled`, `completed`, `previous`, `repaired`, `serial` or `held`.
     pub fn name(self) -> &'static str {
         match self {
             Source::Sampled { .. } => "sampled",
@@ -64,6 +69,7 @@ impl Source {
             Source::Previous => "previous",
             Source::RepairedPrevious => "repaired",
             Source::Serial => "serial",
+            Source::Held => "held",
         }
     }
 }
@@ -171,6 +177,7 @@ pub(crate) fn repair(problem: &Problem, previous: &Schedule, tick_s: f64) -> Opt
         grad_exec: warps,
         offsets_s,
         tick_s,
+        holds: Vec::new(),
     })
 }
 
@@ -380,6 +387,21 @@ fn schedule_n(
         && validate(problem, &schedule).is_ok()
     {
         best = (schedule, t, Source::Completed);
+    }
+    // With hold points, the margin-free optimum itself with release rules (two robots).
+    if let Some(optimum) = bound.schedule.as_ref().filter(|_| two)
+        && !problem.usable_holds().is_empty()
+    {
+        let timed = Schedule {
+            tick_s,
+            ..optimum.clone()
+        };
+        if let Ok(held) = problem.with_release_rules(&timed) {
+            let t = held.t_total_s(problem.dt_s());
+            if t < best.1 && validate(problem, &held).is_ok() {
+                best = (held, t, Source::Held);
+            }
+        }
     }
     let (schedule, t_total_s, source) = best;
     let (lower_bound_s, gap) = certificate(bound.lower_bound_s, t_total_s)?;

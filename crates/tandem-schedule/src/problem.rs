@@ -172,6 +172,36 @@ impl Problem {
         self.holds.iter().copied().filter(|&h| self.conf[h])
     }
 
+    /// The active holds a schedule can use ([`Schedule::holds`]): those whose sample before is
+    /// high-confidence too (`tandem_realtime::holds::usable_holds`), increasing.
+    pub fn usable_holds(&self) -> Vec<usize> {
+        tandem_realtime::holds::usable_holds(&self.conf, &self.holds)
+    }
+
+    /// `schedule` with release rules from its order of low-confidence stretches on the usable
+    /// holds of this problem (`tandem_realtime::holds::release_rules`), keeping its own holds
+    /// and dwells; unchanged when the problem has no usable hold or no pair of stretches gets
+    /// a rule.
+    ///
+    /// # Errors
+    /// As [`Schedule::timelines`].
+    pub fn with_release_rules(&self, schedule: &Schedule) -> Result<Schedule> {
+        let usable = self.usable_holds();
+        if usable.is_empty() {
+            return Ok(schedule.clone());
+        }
+        let robots = schedule.timelines(self)?;
+        let holds = tandem_realtime::holds::release_rules(
+            &robots,
+            &schedule.holds,
+            &vec![usable; schedule.n_robots()],
+        );
+        Ok(Schedule {
+            holds,
+            ..schedule.clone()
+        })
+    }
+
     /// Number of reference samples `T_ref` (≥ 1).
     pub fn n_ref(&self) -> usize {
         self.conf.len()
@@ -269,6 +299,7 @@ impl Problem {
             grad_exec: vec![warp; n_robots],
             offsets_s,
             tick_s,
+            holds: Vec::new(),
         })
     }
 }

@@ -5,7 +5,7 @@
 //! intervals agree to the last bit with what the margin check and the coordinator use.
 
 use serde::{Deserialize, Serialize};
-use tandem_realtime::{LcInterval, MAX_ROBOTS, Timeline, clock_end_s, tol};
+use tandem_realtime::{Hold, LcInterval, MAX_ROBOTS, Timeline, clock_end_s, holds, tol};
 
 use crate::problem::Problem;
 use crate::validate::Violation;
@@ -35,9 +35,35 @@ pub struct Schedule {
     /// run it: the check's guarantee (never two robots low-confidence in one tick) holds for
     /// this tick, not for another.
     pub tick_s: f64,
+    /// Hold points per robot (§II-C, "stop certain robots"; `tandem_realtime::holds`): empty
+    /// for a schedule without holds (serialized exactly as before holds existed), otherwise
+    /// one list per robot (`N` lists, robot `i` at index `i`), each strictly increasing in
+    /// [`Hold::ref_idx`]. Robot `i` stops at the start of each listed reference sample, dwells
+    /// there for [`Hold::dwell_s`] on schedule (every later time of that robot is that much
+    /// later) and leaves as a robot starts: once every running robot has reached its leg's
+    /// start and every robot named in [`Hold::after`] has passed the named sample. The holds
+    /// must be on the problem's active holds ([`Problem::active_holds`]) with a
+    /// high-confidence sample before them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub holds: Vec<Vec<Hold>>,
 }
 
 impl Schedule {
+    /// The holds of robot `robot` (empty when the schedule has none).
+    pub fn holds_of(&self, robot: usize) -> &[Hold] {
+        self.holds.get(robot).map_or(&[], Vec::as_slice)
+    }
+
+    /// Whether any robot has a hold.
+    pub fn has_holds(&self) -> bool {
+        self.holds.iter().any(|h| !h.is_empty())
+    }
+
+    /// Planned dwell (s) of robot `robot` over all its holds.
+    pub fn dwell_s(&self, robot: usize) -> f64 {
+        self.holds_of(robot).iter().map(|h| h.dwell_s).sum()
+    }
+
     /// Number of robots `N` (the number of warps).
     pub fn n_robots(&self) -> usize {
         self.grad_exec.len()
@@ -70,6 +96,12 @@ impl Schedule {
             return Err(Violation::OffsetCount {
                 found: self.offsets_s.len(),
                 expected: n - 1,
+            });
+        }
+        if !self.holds.is_empty() && self.holds.len() != n {
+            return Err(Violation::HoldCount {
+                found: self.holds.len(),
+                expected: n,
             });
         }
         Ok(())
@@ -111,6 +143,23 @@ impl Schedule {
             .collect()
     }
 
+    /// Each robot's plan split at its holds into legs ([`holds::legs`]; one leg per robot
+    /// without holds, its [`Timeline`] as [`Schedule::timelines`] gives it): robot `i`'s legs
+    /// at index `i`, in order, each starting after the planned dwell of its hold.
+    ///
+    /// # Errors
+    /// As [`Schedule::timelines`].
+    pub fn legs(&self, problem: &Problem) -> Result<Vec<Vec<Timeline>>> {
+        self.timelines(problem)?
+            .iter()
+            .enumerate()
+            .map(|(robot, tl)| {
+                holds::legs(tl, self.holds_of(robot))
+                    .map_err(|source| Error::Timeline { robot, source })
+            })
+            .collect()
+    }
+
     /// Checks this schedule on `problem` ([`validate`](crate::validate): every constraint of
     /// Eq. 20, with this build's margin check of Alg. 2 at [`Schedule::tick_s`]) and, if it
     /// passes, returns it as a [`CheckedSchedule`](crate::CheckedSchedule), the only form
@@ -130,10 +179,20 @@ impl Schedule {
     /// Execution durations `|ψ_Ei|` (s) per robot for reference sample period `dt_s` (s): the
     /// end of each warp's clock started at 0 ([`clock_end_s`]).
     pub fn durations_s(&self, dt_s: f64) -> Vec<f64> {
-        self.grad_exec
-            .iter()
-            .map(|g| clock_end_s(g, 0.0, dt_s))
+        (0..self.n_robots())
+            .map(|i| self.clock_end_of(i, 0.0, dt_s))
             .collect()
+    }
+
+    /// The end of robot `robot`'s clock started at `start_s`: [`clock_end_s`], or with holds
+    /// [`holds::held_clock_end_s`] (which adds the dwells; the same sum without them).
+    fn clock_end_of(&self, robot: usize, start_s: f64, dt_s: f64) -> f64 {
+        let holds = self.holds_of(robot);
+        if holds.is_empty() {
+            clock_end_s(&self.grad_exec[robot], start_s, dt_s)
+        } else {
+            holds::held_clock_end_s(&self.grad_exec[robot], start_s, dt_s, holds)
+        }
     }
 
     /// Global time (s) at which each robot ends on schedule, `τ_i + |ψ_Ei|`, for sample period
@@ -146,7 +205,7 @@ impl Schedule {
     /// Global time (s) at which robot `robot` ends on schedule, `τ_i + |ψ_Ei|`, for sample
     /// period `dt_s` (s) (one entry of [`Schedule::ends_s`]).
     pub fn end_s(&self, robot: usize, dt_s: f64) -> f64 {
-        clock_end_s(&self.grad_exec[robot], self.start_s(robot), dt_s)
+        self.clock_end_of(robot, self.start_s(robot), dt_s)
     }
 
     /// `T_total = max_i(τ_i + |ψ_Ei|)` (Eq. 13), global time (s), for sample period `dt_s`:
@@ -329,6 +388,7 @@ mod tests {
             grad_exec: vec![vec![2.0, 1.0, 1.0, 0.5], vec![0.5, 1.0, 1.0, 2.0]],
             offsets_s: vec![offset_s],
             tick_s: 0.5,
+            holds: Vec::new(),
         }
     }
 
@@ -448,6 +508,50 @@ mod tests {
         assert!(json.contains("\"tick_s\":0.5"), "{json}");
         let back: Schedule = serde_json::from_str(&json).unwrap();
         assert_eq!(back, s);
+    }
+
+    #[test]
+    fn holds_serialize_only_when_present_and_add_their_dwell() {
+        let s = schedule(2.25);
+        let json = serde_json::to_string(&s).unwrap();
+        assert!(!json.contains("holds"), "{json}");
+        let mut h = s.clone();
+        h.holds = vec![
+            vec![],
+            vec![Hold {
+                dwell_s: 0.5,
+                after: vec![tandem_realtime::After {
+                    robot: 0,
+                    ref_idx: 3,
+                }],
+                ..Hold::at(3)
+            }],
+        ];
+        let json = serde_json::to_string(&h).unwrap();
+        assert!(
+            json.contains("\"holds\":[[],[{\"ref_idx\":3,\"dwell_s\":0.5"),
+            "{json}"
+        );
+        let back: Schedule = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, h);
+        // Robot 2's end moves by its dwell; robot 1's does not.
+        assert_eq!(h.ends_s(0.5), [2.25, 5.0]);
+        assert_eq!(h.t_total_s(0.5), s.t_total_s(0.5) + 0.5);
+        assert_eq!(h.dwell_s(1), 0.5);
+        let p = problem().with_holds(vec![3]).unwrap();
+        let legs = h.legs(&p).unwrap();
+        assert_eq!(legs[1].len(), 2);
+        assert_eq!(legs[1][1].start_s(), legs[1][0].end_s() + 0.5);
+        assert_eq!(legs[1][1].end_s(), h.end_s(1, 0.5));
+        // Holds must be one list per robot.
+        h.holds.pop();
+        assert!(matches!(
+            h.check_shape(),
+            Err(Violation::HoldCount {
+                found: 1,
+                expected: 2
+            })
+        ));
     }
 
     #[test]

@@ -30,6 +30,24 @@ pub enum Violation {
         /// `N − 1`.
         expected: usize,
     },
+    /// The schedule has holds ([`Schedule::holds`]) but not one list per robot.
+    #[error(
+        "the schedule has hold lists for {found} robots, expected {expected} (one per robot, or none)"
+    )]
+    HoldCount {
+        /// Number of hold lists.
+        found: usize,
+        /// `N`.
+        expected: usize,
+    },
+    /// A hold of the schedule is not on an active hold of the problem, is next to a
+    /// low-confidence sample, has a bad dwell or a release rule naming no valid robot or
+    /// sample (the realtime crate's check, `tandem_realtime::holds::check_holds`).
+    #[error("{source}")]
+    Hold {
+        /// What is wrong, naming the robot and the hold.
+        source: tandem_realtime::Error,
+    },
     /// A warp does not have one gradient per reference sample.
     #[error(
         "robot {robot}: execution warp has {len} gradients, the problem has {expected} reference samples"
@@ -184,9 +202,14 @@ pub(crate) fn validated_timeline(
     }
     let timeline = validate_cheap(problem, schedule)?;
     let robots = timeline.timelines();
-    let decided = match check {
-        MarginCheck::SinglePass => tandem_realtime::sufficient_margins(robots, tick_s),
-        MarginCheck::PerPair => tandem_realtime::sufficient_margins_per_pair(robots, tick_s),
+    let decided = if schedule.has_holds() {
+        // The lead bound on the robots' legs with their release rules (one implementation).
+        tandem_realtime::sufficient_margins_with_holds(robots, &schedule.holds, tick_s)
+    } else {
+        match check {
+            MarginCheck::SinglePass => tandem_realtime::sufficient_margins(robots, tick_s),
+            MarginCheck::PerPair => tandem_realtime::sufficient_margins_per_pair(robots, tick_s),
+        }
     };
     match decided {
         Ok(true) => Ok(timeline),
@@ -260,7 +283,31 @@ pub(crate) fn validate_cheap(
         .timelines_of(problem)
         .map_err(|(robot, source)| Violation::Timeline { robot, source })?
         .into();
-    if let Some(o) = timeline.first_lc_overlap() {
+    check_holds(problem, schedule, &timeline)?;
+    // With planned dwells the robots' later regions move: constraint 3 on their legs (a
+    // robot's legs never overlap one another in time).
+    let dwelling = schedule.holds.iter().flatten().any(|h| h.dwell_s > 0.0);
+    let overlap = if dwelling {
+        let mut robot_of = Vec::new();
+        let mut all = Vec::new();
+        for (robot, tl) in timeline.timelines().iter().enumerate() {
+            let legs = tandem_realtime::holds::legs(tl, schedule.holds_of(robot))
+                .map_err(|source| Violation::Timeline { robot, source })?;
+            robot_of.extend(std::iter::repeat_n(robot, legs.len()));
+            all.extend(legs);
+        }
+        GlobalTimeline::from(all).first_lc_overlap().map(|mut o| {
+            o.robots = o.robots.map(|l| robot_of[l]);
+            if o.robots[0] > o.robots[1] {
+                o.robots.swap(0, 1);
+                o.intervals.swap(0, 1);
+            }
+            o
+        })
+    } else {
+        timeline.first_lc_overlap()
+    };
+    if let Some(o) = overlap {
         let [a, b] = o.intervals;
         return Err(Violation::BothLowConfidence {
             robots: o.robots,
@@ -283,6 +330,35 @@ pub(crate) fn validate_cheap(
         }
     }
     Ok(timeline)
+}
+
+/// The schedule's holds: each robot's ([`tandem_realtime::holds::check_holds`]) on an active
+/// hold of the problem ([`Problem::active_holds`]).
+fn check_holds(
+    problem: &Problem,
+    schedule: &Schedule,
+    timeline: &GlobalTimeline,
+) -> Result<(), Violation> {
+    let robots = timeline.timelines();
+    for (robot, holds) in schedule.holds.iter().enumerate() {
+        tandem_realtime::holds::check_holds(robot, holds, &robots[robot], robots.len(), |r| {
+            robots[r].n_ref()
+        })
+        .map_err(|source| Violation::Hold { source })?;
+        if let Some(h) = holds
+            .iter()
+            .find(|h| h.ref_idx > 0 && problem.holds().binary_search(&h.ref_idx).is_err())
+        {
+            return Err(Violation::Hold {
+                source: tandem_realtime::Error::BadHold {
+                    robot,
+                    ref_idx: h.ref_idx,
+                    why: "is not a hold point of the problem",
+                },
+            });
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

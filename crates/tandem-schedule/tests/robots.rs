@@ -167,6 +167,7 @@ fn the_operator_bound_by_hand_and_tight_for_one_lc_run() {
             grad_exec: vec![p.fastest_warp(); n],
             offsets_s: (1..n).map(|i| 0.1 * i as f64).collect(),
             tick_s: p.dt_s(),
+            holds: Vec::new(),
         };
         let free = validate(&p, &s);
         assert!(
@@ -223,6 +224,7 @@ fn the_operator_bound_is_below_every_margin_free_schedule() {
                         grad_exec,
                         offsets_s: vec![0.0, 0.0],
                         tick_s: p.dt_s(),
+                        holds: Vec::new(),
                     };
                     let end0 = s.end_s(0, p.dt_s());
                     for a in 0..=grid {

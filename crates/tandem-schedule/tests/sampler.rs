@@ -251,6 +251,7 @@ fn previous_schedule_is_repaired_after_the_model_moves() {
         grad_exec: vec![vec![1.0; 3], vec![1.0; 3]],
         offsets_s: vec![0.0],
         tick_s: 0.01,
+        holds: Vec::new(),
     };
     let out = sample_schedule(&q, &params(10, 6), Some(&junk)).unwrap();
     assert_eq!(validate(&q, &out.schedule), Ok(()));

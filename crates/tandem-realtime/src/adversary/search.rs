@@ -25,7 +25,10 @@ const CHOICES: [Operator; 3] = [Operator::Fastest, Operator::Slowest, Operator::
 /// at equal speeds, `j` would enter before `i` leaves; `+∞` without such a pair.
 #[must_use]
 pub fn min_clearance_s(coordinator: &Coordinator) -> f64 {
-    let robots = coordinator.robots();
+    // With holds, each robot's current leg (without, its timeline).
+    let robots: Vec<&Timeline> = (0..coordinator.n_robots())
+        .map(|i| coordinator.current_plan(i))
+        .collect();
     let clocks = coordinator.clock_s();
     // Regions are in time order: binary searches.
     let current = |r: &Timeline, s: f64| {
@@ -37,9 +40,9 @@ pub fn min_clearance_s(coordinator: &Coordinator) -> f64 {
         ivs.get(ivs.partition_point(|iv| iv.start_s <= s)).copied()
     };
     let mut best = f64::INFINITY;
-    for (i, (ri, &si)) in robots.iter().zip(clocks).enumerate() {
+    for (i, (&ri, &si)) in robots.iter().zip(clocks).enumerate() {
         let Some(a) = current(ri, si) else { continue };
-        for (j, (rj, &sj)) in robots.iter().zip(clocks).enumerate() {
+        for (j, (&rj, &sj)) in robots.iter().zip(clocks).enumerate() {
             if i == j || sj >= rj.end_s() {
                 continue;
             }

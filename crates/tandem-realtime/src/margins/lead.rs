@@ -5,6 +5,7 @@
 
 use super::window::Sliding;
 use super::{PairSlack, Windows};
+use crate::holds::Plans;
 use crate::timeline::Timeline;
 
 /// The bound of one ordered pair `(p, c)` on `p`'s sample grid: for every tick start at which
@@ -24,6 +25,11 @@ impl Lead {
     /// Where the analysis starts: the later start of `p` and `c` (s).
     pub(super) fn start_s(&self) -> f64 {
         self.u_s[0]
+    }
+
+    /// Whether the pair has been integrated.
+    fn is_done(&self) -> bool {
+        !self.u_s.is_empty()
     }
 
     /// The largest `c`-clock (s) at any tick start with `p`'s clock below `u` (or at the start
@@ -309,10 +315,60 @@ pub(super) fn slacks(
     windows: Windows,
     stop_at_first: bool,
 ) -> Vec<PairSlack> {
+    let robot_of: Vec<usize> = (0..robots.len()).collect();
+    slacks_of_legs(
+        &Legs {
+            legs: robots,
+            robot_of: &robot_of,
+            plans: None,
+        },
+        max_step_of,
+        eps,
+        windows,
+        stop_at_first,
+    )
+}
+
+/// The virtual robots the lead bound runs on: every robot's legs (`crate::holds`), each of
+/// which starts as a robot starts, with the release rules of the plans (none without holds:
+/// then the legs are the robots).
+pub(super) struct Legs<'a> {
+    /// The legs.
+    pub(super) legs: &'a [Timeline],
+    /// The robot of each leg.
+    pub(super) robot_of: &'a [usize],
+    /// The plans with their release rules (`None`: one leg per robot, no rules).
+    pub(super) plans: Option<&'a Plans>,
+}
+
+/// [`slacks`] of the legs of plans with holds ([`Legs`]), the pairs' indices being legs. The
+/// additions to the lead bound (docs/decisions.md, "Hold points: a wait instead of a margin"):
+/// - only legs of different robots pair up, and "a robot other than `p` and `c` may run"
+///   counts only legs of other robots (a robot's legs never run at once);
+/// - a leg `p` delayed by release rules starts at the first tick start at which they hold; at
+///   the tick start before, some rule did not: robot `a` was on a leg `m ≤ l_a` with its clock
+///   below the rule's threshold (`+ tol`) or that leg's end, so `c` was at most at
+///   `reach_mc` below that clock (or, for `c` a leg of `a`, at that clock itself), and then
+///   moves at most `M_c`;
+/// - a pair `(P, C)` whose order a chain of release rules enforces ([`enforced`]) is safe
+///   whatever the margins: its slack is `+∞`.
+pub(super) fn slacks_of_legs(
+    legs: &Legs<'_>,
+    max_step_of: &[f64],
+    eps: f64,
+    windows: Windows,
+    stop_at_first: bool,
+) -> Vec<PairSlack> {
+    let robots = legs.legs;
+    let robot_of = legs.robot_of;
     let n = robots.len();
     let start = |i: usize| robots[i].start_s();
     let mut order: Vec<(usize, usize)> = (0..n)
-        .flat_map(|p| (0..n).filter(move |&c| c != p).map(move |c| (p, c)))
+        .flat_map(|p| {
+            (0..n)
+                .filter(move |&c| robot_of[c] != robot_of[p])
+                .map(move |c| (p, c))
+        })
         .collect();
     order.sort_by(|&(p, c), &(q, d)| {
         start(p)
@@ -322,25 +378,73 @@ pub(super) fn slacks(
     });
     let tables: Vec<RateTable> = robots.iter().map(RateTable::new).collect();
     let mut leads = vec![Lead::default(); n * n];
+    let enforced = legs.plans.map(enforced);
+    let tol = eps / 4.0;
     let mut out = Vec::new();
     for (p, c) in order {
         let (tau_p, tau_c) = (start(p), start(c));
-        let lead0_s = if tau_c >= tau_p {
+        let rules = legs.plans.map_or(&[][..], |pl| pl.rules_of(p));
+        let lead0_s = if tau_c > tau_p || (tau_c == tau_p && rules.is_empty()) {
             // c starts at τ_c once every running robot, p included, has reached τ_c.
             0.0
         } else {
             // p starts at τ_p in the tick in which the running robot furthest behind, m, passes
             // τ_p: at that tick's start s_m < τ_p and c is at most at reach_mc below τ_p (or
             // m = c, below τ_p), and c then moves at most M_c.
+            let reach = |m: usize, u: f64| -> f64 {
+                let lead = &leads[m * n + c];
+                if lead.is_done() {
+                    lead.reach_below(u)
+                } else {
+                    f64::INFINITY
+                }
+            };
             let behind = (0..n)
-                .filter(|&m| m != p && m != c && start(m) < tau_p)
+                .filter(|&m| m != p && m != c && robot_of[m] != robot_of[c] && start(m) < tau_p)
                 .filter(|&m| robots[m].end_s() > start(m).max(tau_c))
-                .map(|m| leads[m * n + c].reach_below(tau_p.min(robots[m].end_s())) - tau_p)
+                .map(|m| reach(m, tau_p.min(robots[m].end_s())) - tau_p)
                 .fold(0.0, f64::max);
-            max_step_of[c] + behind
+            // Release rules: at the tick start before p moves, some rule did not hold.
+            let plans = legs.plans;
+            let delayed = rules
+                .iter()
+                .map(|r| {
+                    let pl = plans.expect("rules come from plans");
+                    let below = |m: usize| {
+                        if m == r.leg {
+                            (r.threshold_s + tol).min(robots[m].end_s())
+                        } else {
+                            robots[m].end_s()
+                        }
+                    };
+                    (pl.first_leg[r.robot]..=r.leg)
+                        .map(|m| {
+                            if m == c {
+                                below(m)
+                            } else if robot_of[m] == robot_of[c] {
+                                // Another leg of c's robot runs while a is on leg m: c has
+                                // not started, so it is at most at its waiting clock, which
+                                // is at most p's start.
+                                tau_p
+                            } else if start(m) >= tau_p {
+                                f64::INFINITY
+                            } else {
+                                reach(m, below(m))
+                            }
+                        })
+                        .fold(f64::NEG_INFINITY, f64::max)
+                        .max(if robot_of[c] == r.robot && c > r.leg {
+                            tau_p
+                        } else {
+                            f64::NEG_INFINITY
+                        })
+                        - tau_p
+                })
+                .fold(0.0, f64::max);
+            max_step_of[c] + behind.max(delayed)
         };
         let third_start_s = (0..n)
-            .filter(|&r| r != p && r != c)
+            .filter(|&r| robot_of[r] != robot_of[p] && robot_of[r] != robot_of[c])
             .map(start)
             .fold(f64::INFINITY, f64::min);
         let inputs = PairInputs {
@@ -364,7 +468,10 @@ pub(super) fn slacks(
             }
             let Some(&c_iv) = cur.get(j) else { break };
             let u_max = (prev.end_s + eps).min(end_p);
-            let slack_s = if u_max <= lead.start_s() {
+            let is_enforced = enforced
+                .as_ref()
+                .is_some_and(|e| e.holds(p, &prev, c, &c_iv));
+            let slack_s = if is_enforced || u_max <= lead.start_s() {
                 f64::INFINITY
             } else {
                 (c_iv.start_s - eps) - (lead.reach_below(u_max) + max_step_of[c])
@@ -389,4 +496,119 @@ pub(super) fn slacks(
             .then(x.prev.start_s.total_cmp(&y.prev.start_s))
     });
     out
+}
+
+/// The pairs of low-confidence regions whose order the release rules enforce: `(P, C)` when
+/// robot `c` can traverse `C` only after robot `p` has left `P`, at every tick start from the
+/// first at which `C` can be traversed (docs/decisions.md, "Hold points: a wait instead of a
+/// margin").
+///
+/// A region `C` of leg `l` is gated by every rule of its robot's legs up to `l` (the robot has
+/// left each of those holds before it moves on leg `l`); a rule "robot `a` has passed
+/// `threshold` on leg `l_a`" puts every region of `a` that ends at or before it (on `l_a` or an
+/// earlier leg) before `C`, and with them everything before those; so does every earlier region
+/// of `C`'s own robot (the robot traversed it before `C`, so what had to be left before that
+/// had been left then). Clocks never decrease, so each of these holds at every later tick.
+pub(super) struct Enforced {
+    /// Per leg, the index of its first region in the flat list of regions (and the total at
+    /// the end).
+    first: Vec<usize>,
+    /// Per region, the set of regions left before it can be entered (bit set, `words` words
+    /// per region).
+    before: Vec<u64>,
+    words: usize,
+    /// Per leg, the start clocks of its regions (to find a region's index).
+    starts: Vec<Vec<f64>>,
+}
+
+impl Enforced {
+    /// Whether region `prev` of leg `p` is left before region `cur` of leg `c` is entered.
+    fn holds(&self, p: usize, prev: &crate::LcInterval, c: usize, cur: &crate::LcInterval) -> bool {
+        let (Some(i), Some(j)) = (self.index(p, prev), self.index(c, cur)) else {
+            return false;
+        };
+        self.bit(j, i)
+    }
+
+    fn index(&self, leg: usize, iv: &crate::LcInterval) -> Option<usize> {
+        let k = self.starts[leg].iter().position(|&x| x == iv.start_s)?;
+        Some(self.first[leg] + k)
+    }
+
+    fn bit(&self, j: usize, i: usize) -> bool {
+        self.before[j * self.words + i / 64] >> (i % 64) & 1 == 1
+    }
+}
+
+/// The regions [`Enforced`] knows, for `plans`: a fixed point of the rules of its docs
+/// (each pass only adds; at most one pass per region).
+pub(super) fn enforced(plans: &Plans) -> Enforced {
+    let n_legs = plans.legs.len();
+    let mut first = Vec::with_capacity(n_legs + 1);
+    let mut starts = Vec::with_capacity(n_legs);
+    let mut region_leg = Vec::new();
+    for (l, leg) in plans.legs.iter().enumerate() {
+        first.push(region_leg.len());
+        starts.push(
+            leg.lc_intervals()
+                .iter()
+                .map(|iv| iv.start_s)
+                .collect::<Vec<_>>(),
+        );
+        region_leg.extend(std::iter::repeat_n(l, leg.lc_intervals().len()));
+    }
+    first.push(region_leg.len());
+    let n = region_leg.len();
+    let words = n.div_ceil(64).max(1);
+    let mut before = vec![0_u64; n * words];
+    // The direct predecessors of each region: what its gating rules name and its robot's
+    // earlier regions.
+    let mut direct: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (j, &l) in region_leg.iter().enumerate() {
+        let robot = plans.robot_of[l];
+        direct[j].extend(first[plans.first_leg[robot]]..j);
+        for gate in plans.first_leg[robot]..=l {
+            for r in plans.rules_of(gate) {
+                let legs_of_a = plans.first_leg[r.robot]..=r.leg;
+                for (m, (leg, &first_m)) in legs_of_a.clone().zip(
+                    plans.legs[legs_of_a]
+                        .iter()
+                        .zip(&first[plans.first_leg[r.robot]..]),
+                ) {
+                    for (k, iv) in leg.lc_intervals().iter().enumerate() {
+                        if m < r.leg || iv.end_s <= r.threshold_s {
+                            direct[j].push(first_m + k);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let mut changed = true;
+    while changed {
+        changed = false;
+        for j in 0..n {
+            for &i in &direct[j] {
+                // before(j) ∪= {i} ∪ before(i)
+                let mut add = vec![0_u64; words];
+                add[i / 64] |= 1 << (i % 64);
+                for w in 0..words {
+                    add[w] |= before[i * words + w];
+                }
+                for (w, a) in add.into_iter().enumerate() {
+                    let cell = &mut before[j * words + w];
+                    if *cell | a != *cell {
+                        *cell |= a;
+                        changed = true;
+                    }
+                }
+            }
+        }
+    }
+    Enforced {
+        first,
+        before,
+        words,
+        starts,
+    }
 }

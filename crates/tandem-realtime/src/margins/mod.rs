@@ -258,6 +258,91 @@ pub fn pair_slacks(robots: &[Timeline], tick_s: f64) -> Result<Vec<PairSlack>> {
     }
 }
 
+/// [`sufficient_margins`] for plans with hold points (`crate::holds`): `holds` is empty (then
+/// exactly [`sufficient_margins`]) or one list per robot. With holds, the lead bound runs on
+/// the robots' legs with their release rules (docs/decisions.md, "Hold points: a wait instead
+/// of a margin"), for any `1 ≤ N ≤ MAX_ROBOTS`.
+///
+/// # Errors
+/// As [`sufficient_margins`]; [`Error::BadHold`] or [`Error::LengthMismatch`] for holds that
+/// `crate::holds::check_holds` rejects or a wrong number of hold lists.
+pub fn sufficient_margins_with_holds(
+    robots: &[Timeline],
+    holds: &[Vec<crate::Hold>],
+    tick_s: f64,
+) -> Result<bool> {
+    check_count(robots.len())?;
+    let plans = crate::holds::Plans::new(robots, holds)?;
+    check_plans(&plans, robots.len(), tick_s)
+}
+
+/// [`pair_slacks`] for plans with hold points (see [`sufficient_margins_with_holds`]); with
+/// holds, `prev_robot`/`cur_robot` are robots (not legs) and a pair whose order the release
+/// rules enforce has slack `+∞`.
+///
+/// # Errors
+/// As [`sufficient_margins_with_holds`].
+pub fn pair_slacks_with_holds(
+    robots: &[Timeline],
+    holds: &[Vec<crate::Hold>],
+    tick_s: f64,
+) -> Result<Vec<PairSlack>> {
+    check_count(robots.len())?;
+    let plans = crate::holds::Plans::new(robots, holds)?;
+    if !plans.has_holds() {
+        return pair_slacks(robots, tick_s);
+    }
+    let mut out = plan_slacks(&plans, tick_s, false)?;
+    for s in &mut out {
+        s.prev_robot = plans.robot_of[s.prev_robot];
+        s.cur_robot = plans.robot_of[s.cur_robot];
+    }
+    Ok(out)
+}
+
+/// The margin check of split plans: without holds [`sufficient_margins`] on the robots.
+pub(crate) fn check_plans(
+    plans: &crate::holds::Plans,
+    n_robots: usize,
+    tick_s: f64,
+) -> Result<bool> {
+    check_count(n_robots)?;
+    if !plans.has_holds() {
+        return sufficient_margins(&plans.legs, tick_s);
+    }
+    Ok(plan_slacks(plans, tick_s, true)?
+        .iter()
+        .all(|s| s.slack_s > 0.0))
+}
+
+/// The lead bound's slacks on the legs of `plans` (leg indices).
+fn plan_slacks(
+    plans: &crate::holds::Plans,
+    tick_s: f64,
+    stop_at_first: bool,
+) -> Result<Vec<PairSlack>> {
+    if !(tick_s.is_finite() && tick_s > 0.0) {
+        return Err(Error::BadParam {
+            name: "tick_s",
+            why: "must be finite and > 0",
+        });
+    }
+    let legs = &plans.legs;
+    let max_step_of: Vec<f64> = legs.iter().map(|r| tick_s * r.max_rate_fast()).collect();
+    let eps = 4.0 * clock_tolerance_s(legs, tick_s);
+    Ok(lead::slacks_of_legs(
+        &lead::Legs {
+            legs,
+            robot_of: &plans.robot_of,
+            plans: Some(plans),
+        },
+        &max_step_of,
+        eps,
+        Windows::Sliding,
+        stop_at_first,
+    ))
+}
+
 /// How the lead bound reads its rate windows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Windows {

@@ -19,6 +19,10 @@ pub(crate) struct Chain {
     pub(crate) lc_ref: Vec<(usize, usize)>,
     /// Reference samples of HC gap `g` (empty range for a missing run).
     pub(crate) gap_ref: Vec<(usize, usize)>,
+    /// Per HC gap, the latest usable hold point inside it (`Problem::usable_holds`) when the
+    /// chain was built with holds ([`Chain::with_holds`]): the gap has no upper duration
+    /// bound, a robot may dwell there. `None` everywhere for [`Chain::new`].
+    pub(crate) gap_hold: Vec<Option<usize>>,
 }
 
 impl Chain {
@@ -32,6 +36,7 @@ impl Chain {
             gap_s: Vec::new(),
             lc_ref: Vec::new(),
             gap_ref: Vec::new(),
+            gap_hold: Vec::new(),
         };
         let mut pending_gap: Option<(usize, usize)> = None;
         for run in problem.runs() {
@@ -49,6 +54,25 @@ impl Chain {
         let (a, b) = pending_gap.unwrap_or((n_ref, n_ref));
         chain.gap_ref.push((a, b));
         chain.gap_s.push((sum(gmin, a, b), sum(gmax, a, b)));
+        chain.gap_hold = vec![None; chain.gap_s.len()];
+        chain
+    }
+
+    /// The chain of `problem` with its hold points: an HC gap that contains a usable hold
+    /// (`Problem::usable_holds`, at a sample after the gap's first) may last any time, which
+    /// the search sees as the upper bound `max(b_g, max_gap_s)` (`max_gap_s`, s: at least the
+    /// incumbent's `T_total`, beyond which no gap of a better schedule lasts). The latest such
+    /// hold of each gap is where the schedule plans the dwell. Without usable holds it is
+    /// [`Chain::new`].
+    pub(crate) fn with_holds(problem: &Problem, max_gap_s: f64) -> Chain {
+        let mut chain = Chain::new(problem);
+        let usable = problem.usable_holds();
+        for (g, &(a, b)) in chain.gap_ref.iter().enumerate() {
+            if let Some(&h) = usable.iter().rev().find(|&&h| h > a && h < b) {
+                chain.gap_hold[g] = Some(h);
+                chain.gap_s[g].1 = chain.gap_s[g].1.max(max_gap_s);
+            }
+        }
         chain
     }
 

@@ -217,8 +217,23 @@ pub struct MarginFree {
 /// [`Error::BadParam`] for invalid parameters.
 pub fn solve_exact(problem: &Problem, params: &ExactParams) -> Result<MarginFree> {
     params.validate()?;
-    let chain = chain::Chain::new(problem);
-    Ok(margin_free(problem, &chain, params.max_pieces))
+    Ok(margin_free(
+        problem,
+        &bound_chain(problem),
+        params.max_pieces,
+    ))
+}
+
+/// The chain the bound is computed on: with the problem's usable hold points an HC run that
+/// contains one has no upper duration bound ([`chain::Chain::with_holds`], capped at the
+/// serial incumbent `2 × fastest`, which no gap of a better schedule exceeds), so `T*₀` is
+/// the optimum with holds; without them [`chain::Chain::new`].
+fn bound_chain(problem: &Problem) -> chain::Chain {
+    let plain = chain::Chain::new(problem);
+    if problem.usable_holds().is_empty() {
+        return plain;
+    }
+    chain::Chain::with_holds(problem, 2.0 * plain.fastest_s())
 }
 
 fn margin_free(problem: &Problem, chain: &chain::Chain, max_pieces: usize) -> MarginFree {
@@ -349,7 +364,7 @@ pub fn earliest_schedule(problem: &Problem, order: &[usize]) -> Result<Option<Sc
 
 /// The margin-free bound of `problem` (see [`solve_exact`]).
 pub(crate) fn bound(problem: &Problem, params: &ExactParams) -> MarginFree {
-    margin_free(problem, &chain::Chain::new(problem), params.max_pieces)
+    margin_free(problem, &bound_chain(problem), params.max_pieces)
 }
 
 /// The margin-aware completion (see the [module docs](self)) at control tick `tick_s` (s):

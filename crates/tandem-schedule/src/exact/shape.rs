@@ -66,6 +66,7 @@ pub(crate) fn shaped_schedule(
         grad_exec: Vec::from(warps),
         offsets_s: vec![times.tau_s],
         tick_s,
+        holds: Vec::new(),
     }
 }
 

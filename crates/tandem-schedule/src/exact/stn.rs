@@ -233,6 +233,7 @@ mod tests {
             gap_s: vec![(0.0, 0.0), (0.5, 2.0), (0.0, 0.0)],
             lc_ref: vec![(0, 1), (2, 3)],
             gap_ref: vec![(0, 0), (1, 2), (3, 3)],
+            gap_hold: vec![None; 3],
         }
     }
 
@@ -268,6 +269,7 @@ mod tests {
             gap_s: vec![(a0, a0), (0.005, 0.005), (0.003, 0.01), (0.0075, 0.025)],
             lc_ref: vec![(1, 4), (5, 11), (13, 16)],
             gap_ref: vec![(0, 1), (4, 5), (11, 13), (16, 21)],
+            gap_hold: vec![None; 4],
         };
         let t = earliest(&c, &[0, 0, 0, 1, 1, 1], &Clearance::zero()).unwrap();
         assert!((t.tau_s - 0.068).abs() < 1e-15, "{}", t.tau_s);

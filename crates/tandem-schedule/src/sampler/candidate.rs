@@ -66,6 +66,7 @@ impl<'a> Sampler<'a> {
             suffix_min_s,
             tick_s,
             warm,
+            has_holds: !problem.usable_holds().is_empty(),
         }
     }
 }
@@ -242,13 +243,24 @@ impl Sampler<'_> {
             grad_exec: warps,
             offsets_s: scratch.offsets_s,
             tick_s: self.tick_s,
+            holds: Vec::new(),
         })
     }
 
     /// Full constraints of candidate `k`: the schedule and its `T_total` if feasible.
     pub(super) fn full(&self, k: u64) -> Option<(Schedule, f64)> {
-        let s = self.materialize(k)?;
-        let ok = validate_full(self.problem, &s, self.margin_check).is_ok();
+        let mut s = self.materialize(k)?;
+        let mut ok = validate_full(self.problem, &s, self.margin_check).is_ok();
+        if !ok && self.has_holds {
+            // With hold points the order of the stretches can be enforced at run time: the
+            // same candidate with release rules (no dwell, so the same T_total).
+            if let Ok(held) = self.problem.with_release_rules(&s)
+                && held.has_holds()
+            {
+                ok = validate_full(self.problem, &held, self.margin_check).is_ok();
+                s = held;
+            }
+        }
         ok.then(|| {
             let t = s.t_total_s(self.problem.dt_s());
             (s, t)

@@ -137,6 +137,9 @@ struct Sampler<'a> {
     offset: OffsetSampling,
     /// Margin-check implementation.
     margin_check: MarginCheck,
+    /// Whether the problem has usable hold points: a candidate the margins reject is tried
+    /// again with release rules (`Problem::with_release_rules`).
+    has_holds: bool,
     pieces: Vec<Piece>,
     /// `suffix_min_s[p]`: shortest duration (s) of pieces `p..` (`0` past the last).
     suffix_min_s: Vec<f64>,

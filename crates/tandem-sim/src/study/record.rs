@@ -113,6 +113,8 @@ pub enum ScheduleSource {
     Repaired,
     /// The fastest serial schedule (`Source::Serial`): `serial`.
     Serial,
+    /// The exact optimum with hold points and release rules (`Source::Held`): `held`.
+    Held,
 }
 
 impl ScheduleSource {
@@ -124,6 +126,7 @@ impl ScheduleSource {
             Self::Previous => "previous",
             Self::Repaired => "repaired",
             Self::Serial => "serial",
+            Self::Held => "held",
         }
     }
 }
@@ -136,6 +139,7 @@ impl From<Source> for ScheduleSource {
             Source::Previous => Self::Previous,
             Source::RepairedPrevious => Self::Repaired,
             Source::Serial => Self::Serial,
+            Source::Held => Self::Held,
         }
     }
 }

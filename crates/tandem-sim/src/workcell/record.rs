@@ -32,11 +32,26 @@ pub struct RobotRun {
     pub clock_s: Vec<f64>,
     /// The round's control tick (0-based) of the robot's first sample: ticks
     /// `0..start_tick` it waited for its start, ticks `start_tick..start_tick + n` it ran
-    /// (`n` samples), later ticks it had finished. `RoundRun::ticks` when it never ran.
+    /// (`n` samples, minus its ticks at holds), later ticks it had finished. `RoundRun::ticks`
+    /// when it never ran.
     pub start_tick: usize,
+    /// Control ticks the robot stood at a hold point of the schedule (`Schedule::holds`),
+    /// waiting for its release rules or for the robots behind it (0 without holds, and then
+    /// not serialized).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub hold_ticks: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl RobotRun {
+    /// Time (real s) the robot stood at hold points, for control tick `tick_s` (s).
+    pub fn hold_wait_s(&self, tick_s: f64) -> f64 {
+        self.hold_ticks as f64 * tick_s
+    }
+
     /// The execution record for
     /// [`Planner::record_round`](tandem_planner::Planner::record_round) (Eq. 21): the
     /// samples as a demonstration with `model`'s channel names and sample period, the

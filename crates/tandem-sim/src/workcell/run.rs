@@ -193,6 +193,7 @@ pub(super) fn run_coordinator(
         false_corrections: 0,
         clock_s: Vec::with_capacity(n_ref * 2),
         start_tick: usize::MAX,
+        hold_ticks: 0,
     };
     let n_robots = coord.n_robots();
     let mut runs: Vec<RobotRun> = (0..n_robots).map(|_| empty()).collect();
@@ -210,7 +211,12 @@ pub(super) fn run_coordinator(
         .zip(problem.grad_min())
         .map(|(hi, lo)| hi / lo)
         .fold(1.0, f64::max);
-    let budget = ((max_end_s / tick_s) * max_ratio * 2.0) as usize + 1000;
+    let mut budget = ((max_end_s / tick_s) * max_ratio * 2.0) as usize + 1000;
+    if coord.has_holds() {
+        // A robot at a hold waits at most for the others to run (and its planned dwells,
+        // which a schedule caps at the serial schedule's length).
+        budget *= n_robots + 2;
+    }
     let last_ref = (n_ref - 1) as f64;
     // Unneeded corrections as episodes of mean length `l` ticks: each tick of an episode
     // ends it with probability 1/l; outside one, a new one starts with the probability that
@@ -238,6 +244,7 @@ pub(super) fn run_coordinator(
         .map(|(tl, &c)| tl.ref_time_at(c))
         .collect();
 
+    let has_holds = coord.has_holds();
     while !coord.is_finished() {
         if ticks >= budget {
             return Err(Error::DidNotFinish { ticks: budget });
@@ -246,19 +253,34 @@ pub(super) fn run_coordinator(
         let clocks = coord.clock_s();
         let mut operator = Operator::Scheduled;
         for i in 0..n_robots {
-            let tl = &coord.robots()[i];
             runs[i].clock_s.push(clocks[i]);
-            if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() || held == Some(i) {
-                continue;
-            }
+            let n = if has_holds {
+                // With hold points the clock is the current leg's (dwells included, and
+                // the clock of legs not started while the robot stands at a hold): the leg
+                // says whether it runs, the coordinator's reference time which sample.
+                let leg = coord.current_plan(i);
+                if coord.at_hold(i) {
+                    runs[i].hold_ticks += 1;
+                    continue;
+                }
+                if clocks[i] < leg.start_s() || clocks[i] >= leg.end_s() || held == Some(i) {
+                    continue;
+                }
+                (ref_now[i].floor() as usize).min(n_ref - 1)
+            } else {
+                let tl = &coord.robots()[i];
+                if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() || held == Some(i) {
+                    continue;
+                }
+                let sample_clock_s = tl.sample_clock_s();
+                while sample[i] + 1 < n_ref && sample_clock_s[sample[i] + 1] <= clocks[i] {
+                    sample[i] += 1;
+                }
+                sample[i]
+            };
             if runs[i].start_tick == usize::MAX {
                 runs[i].start_tick = ticks;
             }
-            let sample_clock_s = tl.sample_clock_s();
-            while sample[i] + 1 < n_ref && sample_clock_s[sample[i] + 1] <= clocks[i] {
-                sample[i] += 1;
-            }
-            let n = sample[i];
             let ref_time = ref_now[i].min(last_ref);
             let supervised = !problem.conf()[n];
             let mut corrected = false;

@@ -1,0 +1,243 @@
+//! Hold points (`tandem_realtime::holds`): a plan that the margin check accepts with its holds
+//! and release rules never has two robots low-confidence in one tick, for any operator of the
+//! full adversary set (Alg. 2's worst case with each robot as the current one, extremes, random
+//! and switching sequences, the beam search), for N = 2…5 robots over the test kit's problem
+//! families; and the release rule is what makes it safe: dropped, the same plans overlap.
+
+use std::cell::Cell;
+
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+use rand::Rng;
+use tandem_realtime::holds::{release_rules, usable_holds};
+use tandem_realtime::testkit::{Case, Family, find_overlap, find_overlap_with_holds, rng};
+use tandem_realtime::{
+    After, Coordinator, Error, Hold, Operator, Timeline, sufficient_margins,
+    sufficient_margins_with_holds,
+};
+
+/// [HC, LC, HC], gradients 1, bounds [½, 2], Δt_s = 1: the three-sample case of
+/// docs/decisions.md ("Alg. 2 as printed is not sound on a tick grid"), robot 2 at `tau`.
+fn three_sample(tau: f64) -> Vec<Timeline> {
+    let conf = [true, false, true];
+    let (g, lo, hi) = ([1.0; 3], [0.5; 3], [2.0; 3]);
+    vec![
+        Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap(),
+        Timeline::new(&conf, &g, &lo, &hi, tau, 1.0).unwrap(),
+    ]
+}
+
+/// Drag, then rush: the sequence that makes the three-sample case overlap at τ = 3/2.
+fn drag_then_rush(c: &mut Coordinator) -> bool {
+    let mut overlap = false;
+    for op in [Operator::Fastest, Operator::Slowest, Operator::Fastest] {
+        overlap |= c.tick(op).unwrap().overlap();
+    }
+    while !c.is_finished() {
+        let t = c.tick(Operator::Fastest).unwrap();
+        overlap |= t.overlap();
+        if t.fault.is_some() {
+            c.clear_fault();
+        }
+    }
+    overlap
+}
+
+#[test]
+fn a_start_rule_makes_the_three_sample_case_safe_and_dropping_it_overlaps() {
+    let robots = three_sample(1.5);
+    // "Robot 2 starts once robot 1 has passed reference sample 2 (left its LC sample)."
+    let holds = vec![
+        vec![],
+        vec![Hold {
+            after: vec![After {
+                robot: 0,
+                ref_idx: 2,
+            }],
+            ..Hold::at(0)
+        }],
+    ];
+    // Without the rule: rejected by the margin check, and it overlaps.
+    assert!(!sufficient_margins(&robots, 1.0).unwrap());
+    assert!(matches!(
+        Coordinator::new(robots.clone(), 1.0),
+        Err(Error::Unsafe { .. })
+    ));
+    assert!(drag_then_rush(
+        &mut Coordinator::new_unchecked(robots.clone(), 1.0).unwrap()
+    ));
+    // With it: accepted, and the same operator (or any of the set) cannot make it overlap.
+    assert!(sufficient_margins_with_holds(&robots, &holds, 1.0).unwrap());
+    let mut c = Coordinator::with_holds(robots.clone(), &holds, 1.0).unwrap();
+    assert!(!drag_then_rush(&mut c));
+    let mut r = rng(7);
+    let set = tandem_realtime::adversary::adversary_set(2, [0.5, 2.0], 20, &mut r);
+    assert_eq!(
+        find_overlap_with_holds(&robots, &holds, 1.0, &set, &mut r),
+        None
+    );
+    assert!(find_overlap(&robots, 1.0, &set, &mut r).is_some());
+}
+
+#[test]
+fn held_robots_wait_at_their_holds_until_the_rules_hold_then_leave_as_a_start() {
+    // Six samples of 1 s, LC at 1 and 4, a hold at 3 (samples 2 and 3 HC); robot 2 at τ = 2.
+    // Order on schedule: robot 1's LC [1, 2), robot 2's [3, 4), robot 1's [4, 5), robot 2's
+    // [6, 7). The derived rules: robot 2 starts once robot 1 has passed sample 2; robot 1
+    // leaves its hold at 3 once robot 2 has passed sample 2; robot 2 leaves its hold once
+    // robot 1 has passed sample 5.
+    let conf = [true, false, true, true, false, true];
+    let (g, lo, hi) = ([1.0; 6], [0.5; 6], [2.0; 6]);
+    let robots = vec![
+        Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap(),
+        Timeline::new(&conf, &g, &lo, &hi, 2.0, 1.0).unwrap(),
+    ];
+    let holds = release_rules(&robots, &[], &[vec![3], vec![3]]);
+    let rule = |robot, ref_idx| After { robot, ref_idx };
+    assert_eq!(
+        holds,
+        vec![
+            vec![Hold {
+                after: vec![rule(1, 2)],
+                ..Hold::at(3)
+            }],
+            vec![
+                Hold {
+                    after: vec![rule(0, 2)],
+                    ..Hold::at(0)
+                },
+                Hold {
+                    after: vec![rule(0, 5)],
+                    ..Hold::at(3)
+                },
+            ],
+        ]
+    );
+    // No margin at all between robot 2's first region and robot 1's second: rejected without
+    // the rules, accepted with them.
+    assert!(!sufficient_margins(&robots, 0.5).unwrap());
+    assert!(sufficient_margins_with_holds(&robots, &holds, 0.5).unwrap());
+    for op in [Operator::Slowest, Operator::Fastest, Operator::Scheduled] {
+        let mut c = Coordinator::with_holds(robots.clone(), &holds, 0.5).unwrap();
+        let mut held = [0, 0];
+        for _ in 0..200 {
+            if c.is_finished() {
+                break;
+            }
+            let before = [c.at_hold(0), c.at_hold(1)];
+            let t = c.tick(op).unwrap();
+            assert!(!t.overlap() && t.fault.is_none(), "{op:?}: {t:?}");
+            for (i, h) in held.iter_mut().enumerate() {
+                if before[i] && c.at_hold(i) {
+                    *h += 1;
+                    // A robot at its hold stands at the start of sample 3 and does not run.
+                    assert_eq!(t.ref_time[i], 3.0);
+                    assert!(!t.running[i] && !t.low_conf[i]);
+                }
+            }
+        }
+        assert!(c.is_finished(), "{op:?}");
+        // Dragged, robot 1's stretches take twice as long: robot 2 waits at its hold.
+        if op == Operator::Slowest {
+            assert!(held[1] >= 1, "{held:?}");
+        }
+    }
+}
+
+/// Random usable holds of each robot's plan (each usable sample with probability ¼).
+fn random_usable(robots: &[Timeline], r: &mut impl Rng) -> Vec<Vec<usize>> {
+    robots
+        .iter()
+        .map(|tl| {
+            let all: Vec<usize> = (1..tl.n_ref()).collect();
+            usable_holds(tl.conf(), &all)
+                .into_iter()
+                .filter(|_| r.random_bool(0.25))
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn plans_accepted_with_holds_never_overlap_and_need_their_rules() {
+    let cases: u32 = std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(100);
+    for n in 2..=5usize {
+        let (accepted, needs_rules, rejected_without) = (Cell::new(0), Cell::new(0), Cell::new(0));
+        let config = Config {
+            cases,
+            failure_persistence: None,
+            ..Config::default()
+        };
+        let mut runner =
+            TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+        let result = runner.run(&any::<u64>(), |seed| {
+            let mut r = rng(seed);
+            let case = Case::random(Family::of_seed(seed), n, &mut r);
+            // Starts that interleave the robots: each robot at a random point of the span of
+            // the robots before it.
+            let mut starts = vec![0.0];
+            for _ in 1..n {
+                let end = case
+                    .robots_at(&starts)
+                    .iter()
+                    .map(Timeline::end_s)
+                    .fold(0.0, f64::max);
+                starts.push(end * r.random::<f64>());
+            }
+            let robots = case.robots_at(&starts);
+            let usable = random_usable(&robots, &mut r);
+            let holds = release_rules(&robots, &[], &usable);
+            if holds.is_empty()
+                || !sufficient_margins_with_holds(&robots, &holds, case.tick_s).unwrap()
+            {
+                return Ok(());
+            }
+            accepted.set(accepted.get() + 1);
+            let set = case.adversaries(&robots, &mut r);
+            let hit = find_overlap_with_holds(&robots, &holds, case.tick_s, &set, &mut r);
+            prop_assert!(
+                hit.is_none(),
+                "N = {n}, family {}, seed {seed}: {hit:?} overlaps with holds {holds:?}",
+                case.family.name()
+            );
+            if !sufficient_margins(&robots, case.tick_s).unwrap() {
+                rejected_without.set(rejected_without.get() + 1);
+                // Dropping the rules (keeping the holds' re-synchronization) or the holds
+                // altogether: some operator of the set finds an overlap in most such plans.
+                let no_rules: Vec<Vec<Hold>> = holds
+                    .iter()
+                    .map(|l| l.iter().map(|h| Hold::at(h.ref_idx)).collect())
+                    .collect();
+                if find_overlap_with_holds(&robots, &no_rules, case.tick_s, &set, &mut r).is_some()
+                {
+                    needs_rules.set(needs_rules.get() + 1);
+                }
+            }
+            Ok(())
+        });
+        if let Err(e) = result {
+            panic!("{e}");
+        }
+        let (a, w, nr) = (accepted.get(), rejected_without.get(), needs_rules.get());
+        // Not vacuous: holds make plans acceptable that the check without them rejects, and in
+        // some of those the rule is what prevents an overlap.
+        assert!(
+            a >= cases / 4,
+            "N = {n}: only {a} of {cases} plans accepted with holds"
+        );
+        assert!(
+            w >= a / 4,
+            "N = {n}: only {w} of {a} accepted plans need the holds"
+        );
+        assert!(
+            nr >= 1,
+            "N = {n}: no accepted plan overlaps once its rules are dropped ({w} checked)"
+        );
+        eprintln!(
+            "N = {n}: {a} accepted with holds, {w} rejected without, {nr} overlap without rules"
+        );
+    }
+}
