@@ -236,9 +236,147 @@ struct PlannerState {
     model: TaskModel,
     observations: Observations,
     confidence: Confidence,
+    #[serde(with = "outcome_state")]
     outcome: Outcome,
     pairs_recorded: usize,
     rounds: Vec<u64>,
+}
+
+/// The state file's form of an [`Outcome`] (format 8): every field of the schedule and its
+/// holds always written. The schedule's own serde form leaves out empty holds, zero dwells
+/// and empty release lists (so that its JSON is the one of before hold points), which a
+/// format that is not self-describing (postcard) cannot read back.
+mod outcome_state {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+    use tandem_realtime::{After, Hold};
+    use tandem_schedule::{Outcome, SamplerStats, Schedule, Source};
+
+    #[derive(Serialize, Deserialize)]
+    struct HoldState {
+        ref_idx: usize,
+        dwell_s: f64,
+        after: Vec<After>,
+    }
+
+    #[derive(Serialize, Deserialize)]
+    struct ScheduleState {
+        grad_exec: Vec<Vec<f64>>,
+        offsets_s: Vec<f64>,
+        tick_s: f64,
+        holds: Vec<Vec<HoldState>>,
+    }
+
+    #[derive(Serialize, Deserialize)]
+    struct OutcomeState {
+        schedule: ScheduleState,
+        t_total_s: f64,
+        source: Source,
+        stats: SamplerStats,
+        lower_bound_s: f64,
+        bound_is_optimum: bool,
+        gap: f64,
+    }
+
+    pub(super) fn serialize<S: Serializer>(o: &Outcome, s: S) -> Result<S::Ok, S::Error> {
+        let sch = &o.schedule;
+        OutcomeState {
+            schedule: ScheduleState {
+                grad_exec: sch.grad_exec.clone(),
+                offsets_s: sch.offsets_s.clone(),
+                tick_s: sch.tick_s,
+                holds: sch
+                    .holds
+                    .iter()
+                    .map(|hs| {
+                        hs.iter()
+                            .map(|h| HoldState {
+                                ref_idx: h.ref_idx,
+                                dwell_s: h.dwell_s,
+                                after: h.after.clone(),
+                            })
+                            .collect()
+                    })
+                    .collect(),
+            },
+            t_total_s: o.t_total_s,
+            source: o.source.clone(),
+            stats: o.stats.clone(),
+            lower_bound_s: o.lower_bound_s,
+            bound_is_optimum: o.bound_is_optimum,
+            gap: o.gap,
+        }
+        .serialize(s)
+    }
+
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Outcome, D::Error> {
+        let o = OutcomeState::deserialize(d)?;
+        let sch = o.schedule;
+        Ok(Outcome {
+            schedule: Schedule {
+                grad_exec: sch.grad_exec,
+                offsets_s: sch.offsets_s,
+                tick_s: sch.tick_s,
+                holds: sch
+                    .holds
+                    .into_iter()
+                    .map(|hs| {
+                        hs.into_iter()
+                            .map(|h| Hold {
+                                ref_idx: h.ref_idx,
+                                dwell_s: h.dwell_s,
+                                after: h.after,
+                            })
+                            .collect()
+                    })
+                    .collect(),
+            },
+            t_total_s: o.t_total_s,
+            source: o.source,
+            stats: o.stats,
+            lower_bound_s: o.lower_bound_s,
+            bound_is_optimum: o.bound_is_optimum,
+            gap: o.gap,
+        })
+    }
+}
+
+/// The [`Schedule`] of state formats 5 to 7: without holds.
+#[derive(Deserialize)]
+struct ScheduleV7 {
+    grad_exec: Vec<Vec<f64>>,
+    offsets_s: Vec<f64>,
+    tick_s: f64,
+}
+
+/// [`Outcome`] as state formats 5 to 7 wrote it: the schedule without holds.
+#[derive(Deserialize)]
+struct OutcomeV7 {
+    schedule: ScheduleV7,
+    t_total_s: f64,
+    source: Source,
+    stats: SamplerStats,
+    lower_bound_s: f64,
+    bound_is_optimum: bool,
+    gap: f64,
+}
+
+impl From<OutcomeV7> for Outcome {
+    fn from(v7: OutcomeV7) -> Self {
+        Outcome {
+            schedule: Schedule {
+                grad_exec: v7.schedule.grad_exec,
+                offsets_s: v7.schedule.offsets_s,
+                tick_s: v7.schedule.tick_s,
+                holds: Vec::new(),
+            },
+            t_total_s: v7.t_total_s,
+            source: v7.source,
+            stats: v7.stats,
+            lower_bound_s: v7.lower_bound_s,
+            bound_is_optimum: v7.bound_is_optimum,
+            gap: v7.gap,
+        }
+    }
 }
 
 /// [`PlannerParams`] as state format 7 wrote them: without hold points.
@@ -256,7 +394,7 @@ struct PlannerStateV7 {
     model: TaskModel,
     observations: Observations,
     confidence: Confidence,
-    outcome: Outcome,
+    outcome: OutcomeV7,
     pairs_recorded: usize,
     rounds: Vec<u64>,
 }
@@ -274,7 +412,7 @@ impl From<PlannerStateV7> for PlannerState {
             model: v7.model,
             observations: v7.observations,
             confidence: v7.confidence,
-            outcome: v7.outcome,
+            outcome: v7.outcome.into(),
             pairs_recorded: v7.pairs_recorded,
             rounds: v7.rounds,
         }
@@ -337,7 +475,7 @@ struct PlannerStateV6 {
     model: TaskModel,
     observations: ObservationsV6,
     confidence: ConfidenceV6,
-    outcome: Outcome,
+    outcome: OutcomeV7,
     pairs_recorded: usize,
     rounds: Vec<u64>,
 }
@@ -358,7 +496,7 @@ impl TryFrom<PlannerStateV6> for PlannerState {
                 v6.observations.supervised,
             )?,
             confidence: Confidence::from_parts(v6.confidence.params.into(), v6.confidence.high)?,
-            outcome: v6.outcome,
+            outcome: v6.outcome.into(),
             pairs_recorded: v6.pairs_recorded,
             rounds: v6.rounds,
         })
@@ -373,7 +511,7 @@ struct PlannerStateV5 {
     model: TaskModel,
     observations: ObservationsV6,
     confidence: ConfidenceV6,
-    outcome: Outcome,
+    outcome: OutcomeV7,
     pairs_recorded: usize,
 }
 
@@ -440,12 +578,11 @@ impl From<PlannerStateV4> for PlannerStateV6 {
             model: v4.model,
             observations: v4.observations,
             confidence: v4.confidence,
-            outcome: Outcome {
-                schedule: Schedule {
+            outcome: OutcomeV7 {
+                schedule: ScheduleV7 {
                     grad_exec: Vec::from(schedule.grad_exec),
                     offsets_s: vec![schedule.offset_s],
                     tick_s: schedule.tick_s,
-                    holds: Vec::new(),
                 },
                 t_total_s,
                 source,

@@ -95,8 +95,9 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 ///   paper's model (`ConfidenceParams::paper()`: the decisions they were saved with) and no
 ///   evidence of misses.
 /// - 8: the planner parameters gained the hold points the user declared
-///   (`PlannerParams::holds`: reference times and channel rules). Version 4 to 7 files still
-///   load, with no hold points.
+///   (`PlannerParams::holds`: reference times and channel rules) and the schedule its holds
+///   (`Schedule::holds`: per robot the hold, its planned dwell and release rules; every field
+///   written, also when empty). Version 4 to 7 files still load, with no hold points.
 pub const FORMAT_VERSION: u32 = 8;
 
 /// The oldest state format version this build reads (converting it on load).

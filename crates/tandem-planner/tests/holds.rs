@@ -126,6 +126,25 @@ fn a_hold_at_a_time_is_the_nearest_sample_and_survives_save_and_load() {
     let back = Planner::load(&path).unwrap();
     assert_eq!(back.params().holds, p.params().holds);
     assert_eq!(back.problem().holds(), &[40, 60]);
+    assert_eq!(back.outcome(), p.outcome());
+    assert!(back.load_notice().is_none());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_schedule_with_holds_survives_save_and_load() {
+    // Three robots with the carry as hold points: the scheduler plans holds (dwells and
+    // release rules), which the state file keeps field for field, empty ones included.
+    let p = Planner::with_robots(&demos(), params(spec(&[], &["gripper>0.5"])), 3).unwrap();
+    assert!(p.schedule().has_holds(), "{:?}", p.schedule().holds);
+    let dir = std::env::temp_dir().join(format!("tandem-holds-3-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("pick3.tandem");
+    p.save(&path).unwrap();
+    let back = Planner::load(&path).unwrap();
+    assert_eq!(back.outcome(), p.outcome());
+    assert!(back.load_notice().is_none());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
