@@ -222,8 +222,8 @@ pub(crate) struct FitArgs {
     pub(crate) robots: usize,
     /// Hold points at these reference times (s, the reference demonstration's clock), each at
     /// its nearest reference sample: places where a robot may wait as long as needed (the
-    /// tool lifted, a part held). A time where the demonstrations vary (the operator is
-    /// needed there) is refused. Replaces the parameter file's `[holds] at_s`.
+    /// tool lifted, a part held); a hold on a low-confidence sample is inactive until the
+    /// sample is trusted. Replaces the parameter file's `[holds] at_s`.
     #[arg(
         long,
         value_name = "SECONDS,…",
@@ -233,7 +233,7 @@ pub(crate) struct FitArgs {
     pub(crate) hold_at: Vec<f64>,
     /// Hold points wherever the mean of a channel satisfies a comparison, e.g.
     /// `--hold-where "tool<0.5"` or `gripper>=0.5` (`<`, `<=`, `>`, `>=`; quote it in a
-    /// shell); samples where the demonstrations vary are left out. Repeatable; replaces the
+    /// shell); a rule that holds nowhere is refused. Repeatable; replaces the
     /// parameter file's `[holds] rules`.
     #[arg(long, value_name = "RULE")]
     pub(crate) hold_where: Vec<HoldRule>,
