@@ -236,108 +236,10 @@ struct PlannerState {
     model: TaskModel,
     observations: Observations,
     confidence: Confidence,
-    #[serde(with = "outcome_state")]
+    #[serde(with = "state::outcome_form")]
     outcome: Outcome,
     pairs_recorded: usize,
     rounds: Vec<u64>,
-}
-
-/// The state file's form of an [`Outcome`] (format 8): every field of the schedule and its
-/// holds always written. The schedule's own serde form leaves out empty holds, zero dwells
-/// and empty release lists (so that its JSON is the one of before hold points), which a
-/// format that is not self-describing (postcard) cannot read back.
-mod outcome_state {
-    use serde::{Deserialize, Deserializer, Serialize, Serializer};
-    use tandem_realtime::{After, Hold};
-    use tandem_schedule::{Outcome, SamplerStats, Schedule, Source};
-
-    #[derive(Serialize, Deserialize)]
-    struct HoldState {
-        ref_idx: usize,
-        dwell_s: f64,
-        after: Vec<After>,
-    }
-
-    #[derive(Serialize, Deserialize)]
-    struct ScheduleState {
-        grad_exec: Vec<Vec<f64>>,
-        offsets_s: Vec<f64>,
-        tick_s: f64,
-        holds: Vec<Vec<HoldState>>,
-    }
-
-    #[derive(Serialize, Deserialize)]
-    struct OutcomeState {
-        schedule: ScheduleState,
-        t_total_s: f64,
-        source: Source,
-        stats: SamplerStats,
-        lower_bound_s: f64,
-        bound_is_optimum: bool,
-        gap: f64,
-    }
-
-    pub(super) fn serialize<S: Serializer>(o: &Outcome, s: S) -> Result<S::Ok, S::Error> {
-        let sch = &o.schedule;
-        OutcomeState {
-            schedule: ScheduleState {
-                grad_exec: sch.grad_exec.clone(),
-                offsets_s: sch.offsets_s.clone(),
-                tick_s: sch.tick_s,
-                holds: sch
-                    .holds
-                    .iter()
-                    .map(|hs| {
-                        hs.iter()
-                            .map(|h| HoldState {
-                                ref_idx: h.ref_idx,
-                                dwell_s: h.dwell_s,
-                                after: h.after.clone(),
-                            })
-                            .collect()
-                    })
-                    .collect(),
-            },
-            t_total_s: o.t_total_s,
-            source: o.source.clone(),
-            stats: o.stats.clone(),
-            lower_bound_s: o.lower_bound_s,
-            bound_is_optimum: o.bound_is_optimum,
-            gap: o.gap,
-        }
-        .serialize(s)
-    }
-
-    pub(super) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Outcome, D::Error> {
-        let o = OutcomeState::deserialize(d)?;
-        let sch = o.schedule;
-        Ok(Outcome {
-            schedule: Schedule {
-                grad_exec: sch.grad_exec,
-                offsets_s: sch.offsets_s,
-                tick_s: sch.tick_s,
-                holds: sch
-                    .holds
-                    .into_iter()
-                    .map(|hs| {
-                        hs.into_iter()
-                            .map(|h| Hold {
-                                ref_idx: h.ref_idx,
-                                dwell_s: h.dwell_s,
-                                after: h.after,
-                            })
-                            .collect()
-                    })
-                    .collect(),
-            },
-            t_total_s: o.t_total_s,
-            source: o.source,
-            stats: o.stats,
-            lower_bound_s: o.lower_bound_s,
-            bound_is_optimum: o.bound_is_optimum,
-            gap: o.gap,
-        })
-    }
 }
 
 /// The [`Schedule`] of state formats 5 to 7: without holds.
