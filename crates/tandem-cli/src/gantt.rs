@@ -281,8 +281,8 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
     for c in 0..GANTT_COLUMNS {
         let t = (c as f64 + 0.5) / GANTT_COLUMNS as f64 * t_total;
         let mut supervised = Vec::new();
-        for i in 0..n {
-            rows[i].push(match layout.running_conf(i, t) {
+        for (i, row) in rows.iter_mut().take(n).enumerate() {
+            row.push(match layout.running_conf(i, t) {
                 None if layout.waiting(i, t) => 'h',
                 None => ' ',
                 Some(true) => '=',
