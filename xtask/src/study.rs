@@ -68,6 +68,10 @@ pub(crate) struct StudyArgs {
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
+    /// Ignore the configuration's hold points (`[planner.holds]`): the study as before hold
+    /// points existed.
+    #[arg(long)]
+    no_holds: bool,
     /// Write chosen rounds as ROS 2 bags (MCAP, for Foxglove) into this folder, one file per
     /// round: `trial_<T>_round_<K>.mcap` (replaced if present).
     #[arg(long, value_name = "DIR")]
@@ -228,6 +232,9 @@ fn config(args: &StudyArgs) -> anyhow::Result<StudyConfig> {
     }
     if let Some(v) = args.false_correction_s {
         config.false_correction_s = v;
+    }
+    if args.no_holds {
+        config.planner.holds = Default::default();
     }
     if args.paper_confidence {
         let c = &mut config.planner.confidence;

@@ -5,7 +5,9 @@
 //! `{"n_robots", "t_total_s", "lower_bound_s", "bound_is_optimum", "gap", "serial_t_total_s",
 //! "source", "wall_ms", "accepted"}` (`accepted`: `validate` passes).
 //!
-//! `cargo run --release -p tandem-schedule --example robots`
+//! `cargo run --release -p tandem-schedule --example robots [-- --holds]`: with `--holds`
+//! every sample of the transitions between passes (the `phase` column of the fixture) is a
+//! hold point of the problem (the tool is off and lifted), the scheduler plans with them.
 #![allow(clippy::print_stdout, reason = "an example prints its measurements")]
 
 #[path = "../benches/support/fixture.rs"]
@@ -16,7 +18,24 @@ use std::time::Instant;
 use tandem_schedule::{SamplerParams, sample_schedule_n, validate};
 
 fn main() -> Result<(), tandem_schedule::Error> {
-    let (problem, label) = fixture::mid_study_problem();
+    let (mut problem, mut label) = fixture::mid_study_problem();
+    if std::env::args().any(|a| a == "--holds") {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/sanding/problem.csv"
+        );
+        let text = std::fs::read_to_string(path).expect("the fixture problem is in the repository");
+        let holds: Vec<usize> = text
+            .lines()
+            .skip(1)
+            .filter(|l| !l.trim().is_empty())
+            .enumerate()
+            .filter(|(_, l)| l.trim().ends_with(",transition"))
+            .map(|(n, _)| n)
+            .collect();
+        label = format!("{label}, {} hold points (the transitions)", holds.len());
+        problem = problem.with_holds(holds)?;
+    }
     println!("# {label}, T_ref = {}", problem.n_ref());
     let params = SamplerParams {
         samples: 5000,

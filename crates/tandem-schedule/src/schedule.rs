@@ -19,8 +19,7 @@ use crate::{Error, Result};
 /// `τ_{i+1} = offsets_s[i − 1]`; for two robots `offsets_s = [τ]`. Check a schedule against a
 /// [`Problem`] with [`crate::validate`] (at its own tick); [`Schedule::check`] does the same
 /// and returns the [`crate::CheckedSchedule`] whose coordinator runs it (at its own tick).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Schedule {
     /// Execution warp gradients `ψ̇_Ei[n]` per robot `i` (`N ≥ 1` warps, each of length `T_ref`)
     /// and reference sample `n` (execution samples per reference sample; robot `i` spends
@@ -44,8 +43,81 @@ pub struct Schedule {
     /// start and every robot named in [`Hold::after`] has passed the named sample. The holds
     /// must be on the problem's active holds ([`Problem::active_holds`]) with a
     /// high-confidence sample before them.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub holds: Vec<Vec<Hold>>,
+}
+
+/// The serialized form of a [`Schedule`] in text formats (JSON, TOML): `holds` only when
+/// present, so a schedule without holds reads and writes exactly as before holds existed.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ScheduleText {
+    grad_exec: Vec<Vec<f64>>,
+    offsets_s: Vec<f64>,
+    tick_s: f64,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    holds: Vec<Vec<Hold>>,
+}
+
+/// The serialized form of a [`Schedule`] in binary formats (the state file's postcard, which
+/// has no optional fields): the layout of before holds existed, **without the holds**. A
+/// schedule with holds read back from a binary format has lost them; this build's check then
+/// rejects it (its margins relied on the holds) and the planner replaces it, never runs it.
+/// Storing holds in the state file is a change of its format.
+#[derive(Serialize, Deserialize)]
+struct ScheduleBinary {
+    grad_exec: Vec<Vec<f64>>,
+    offsets_s: Vec<f64>,
+    tick_s: f64,
+}
+
+impl Serialize for Schedule {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        let (grad_exec, offsets_s, tick_s) =
+            (self.grad_exec.clone(), self.offsets_s.clone(), self.tick_s);
+        if serializer.is_human_readable() {
+            ScheduleText {
+                grad_exec,
+                offsets_s,
+                tick_s,
+                holds: self.holds.clone(),
+            }
+            .serialize(serializer)
+        } else {
+            ScheduleBinary {
+                grad_exec,
+                offsets_s,
+                tick_s,
+            }
+            .serialize(serializer)
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Schedule {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        if deserializer.is_human_readable() {
+            let t = ScheduleText::deserialize(deserializer)?;
+            Ok(Schedule {
+                grad_exec: t.grad_exec,
+                offsets_s: t.offsets_s,
+                tick_s: t.tick_s,
+                holds: t.holds,
+            })
+        } else {
+            let b = ScheduleBinary::deserialize(deserializer)?;
+            Ok(Schedule {
+                grad_exec: b.grad_exec,
+                offsets_s: b.offsets_s,
+                tick_s: b.tick_s,
+                holds: Vec::new(),
+            })
+        }
+    }
 }
 
 impl Schedule {

@@ -5,7 +5,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use tandem_lfd::{Demonstration, FitParams, TaskModel};
 use tandem_planner::Planner;
-use tandem_schedule::Problem;
+use tandem_schedule::{Problem, Schedule};
 
 use super::run::{run_coordinator, run_schedule};
 use super::*;
@@ -527,4 +527,46 @@ fn an_unsafe_plan_latches_a_fault_that_the_operator_releases_and_the_round_finis
     )
     .unwrap();
     assert_eq!((on_time.faults, on_time.overlap_ticks), (0, 0));
+}
+
+#[test]
+fn a_robot_waits_at_its_hold_while_the_operator_drags_the_other_and_never_overlaps() {
+    // The hand-made problem with a hold at sample 5 (before the LC run 10..20). Robot 2
+    // starts so that its LC run begins exactly when robot 1's ends on schedule: no margin at
+    // all, rejected without holds; with the rule "robot 2 leaves its hold at 5 once robot 1
+    // has passed sample 20" it is accepted, and a perfect operator (whose corrections slow
+    // the LC robot down) makes robot 2 wait there instead of overlapping.
+    let model = model();
+    let problem = problem(&model).with_holds(vec![5]).unwrap();
+    let dt_s = problem.dt_s();
+    let serial = problem.serial_schedule(dt_s).unwrap();
+    let clock = |n: usize| tandem_realtime::clock_end_s(&serial.grad_exec[0][..n], 0.0, dt_s);
+    let plain = Schedule {
+        offsets_s: vec![clock(20) - clock(10)],
+        ..serial
+    };
+    assert!(tandem_schedule::validate(&problem, &plain).is_err());
+    let held = problem.with_release_rules(&plain).unwrap();
+    assert_eq!(held.holds_of(1)[0].ref_idx, 5);
+    tandem_schedule::validate(&problem, &held).unwrap();
+    let perfect = OperatorParams {
+        miss_rate: 0.0,
+        false_correction_rate: 0.0,
+        ..OperatorParams::default()
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let run = run_schedule(&model, &problem, &held, painted_needs, &perfect, &mut rng).unwrap();
+    assert_eq!(run.overlap_ticks, 0);
+    assert_eq!(run.faults, 0);
+    assert_eq!(run.robots[0].hold_ticks, 0);
+    assert!(run.robots[1].hold_ticks > 0, "{}", run.robots[1].hold_ticks);
+    assert_eq!(
+        run.robots[1].hold_wait_s(run.tick_s),
+        run.robots[1].hold_ticks as f64 * run.tick_s
+    );
+    // Every robot ran its whole task, one sample per running tick.
+    for r in &run.robots {
+        assert!(r.needed > 0 && r.corrected == r.supervised);
+        assert_eq!(r.ref_time_log.len(), r.supervised.len());
+    }
 }
