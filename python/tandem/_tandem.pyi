@@ -61,9 +61,12 @@ def fit(
     params: Params = None,
     dt_s: Optional[float] = None,
     robots: int = 2,
+    holds: Optional[Union[Sequence[Union[float, str]], Dict[str, Any]]] = None,
 ) -> Planner:
     """Learns the task from demonstrations (paths or ``(T_i, C)`` arrays) and makes the first
-    schedule (Fig. 2); the same inputs and parameters as ``tandem fit`` give the same state."""
+    schedule (Fig. 2); the same inputs and parameters as ``tandem fit`` give the same state.
+    ``holds``: reference times (s) and rules (``"gripper>0.5"``) where a robot may wait, as
+    ``tandem fit --hold-at/--hold-where``; ``[]`` declares none, ``None`` keeps ``params``'."""
 
 def read_bag(
     path: Path,
@@ -101,6 +104,11 @@ class Planner:
     def save(self, path: Path, timeout_s: Optional[float] = None) -> None:
         """Saves the state file atomically under its lock (the previous file survives any
         error); never replaces a non-state file or what another process saved since the load."""
+    def set_holds(
+        self, holds: Union[Sequence[Union[float, str]], Dict[str, Any]]
+    ) -> Schedule:
+        """Declares hold points (as ``fit``'s ``holds``) and re-schedules; a hold where the
+        recorded corrections show the operator is needed is refused."""
     def record_round(
         self,
         executions: Sequence[Demo],
@@ -276,6 +284,12 @@ class Problem:
     @property
     def conf(self) -> Bool: ...
     @property
+    def holds(self) -> List[int]:
+        """Hold points: reference samples where a robot may dwell (without the start)."""
+    @property
+    def active_holds(self) -> List[int]:
+        """The hold points on high-confidence samples (where a robot may dwell now)."""
+    @property
     def grad_mean(self) -> F64: ...
     @property
     def grad_min(self) -> F64: ...
@@ -314,6 +328,12 @@ class Schedule:
     @property
     def t_total_s(self) -> float:
         """Eq. 13, s."""
+    @property
+    def holds(self) -> List[List[Dict[str, Any]]]:
+        """Per robot its holds: ``{"ref_idx", "dwell_s", "after": [(robot, ref_idx), …]}``."""
+    @property
+    def dwells_s(self) -> F64:
+        """Planned waiting at hold points per robot, ``(N,)``, s."""
     @property
     def durations_s(self) -> F64: ...
     @property

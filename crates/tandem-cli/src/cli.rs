@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use tandem::lfd::Reference;
+use tandem::lfd::{HoldRule, Reference};
 use tandem::sim::workcell::OperatorParams;
 
 /// Coordinated multi-robot shared autonomy from your own demonstrations: one operator, 1 to 8
@@ -223,6 +223,27 @@ pub(crate) struct FitArgs {
     /// `tandem record` takes N executions per round. Stored in the state file.
     #[arg(long, value_name = "N", default_value_t = 2)]
     pub(crate) robots: usize,
+    /// Hold points at these reference times (s, the reference demonstration's clock), each at
+    /// its nearest reference sample: places where a robot may wait as long as needed (the
+    /// tool lifted, a part held); a hold on a low-confidence sample is inactive until the
+    /// sample is trusted. Replaces the parameter file's `[holds] at_s`.
+    #[arg(
+        long,
+        value_name = "SECONDS,…",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    pub(crate) hold_at: Vec<f64>,
+    /// Hold points wherever the mean of a channel satisfies a comparison, e.g.
+    /// `--hold-where "tool<0.5"` or `gripper>=0.5` (`<`, `<=`, `>`, `>=`; quote it in a
+    /// shell); a rule that holds nowhere is refused. Repeatable; replaces the
+    /// parameter file's `[holds] rules`.
+    #[arg(long, value_name = "RULE")]
+    pub(crate) hold_where: Vec<HoldRule>,
+    /// No hold points, also none from the parameter file: the schedule of before hold
+    /// points existed, bit for bit.
+    #[arg(long, conflicts_with_all = ["hold_at", "hold_where"])]
+    pub(crate) no_holds: bool,
     /// Sampler overrides.
     #[command(flatten)]
     pub(crate) sampler: SamplerArgs,

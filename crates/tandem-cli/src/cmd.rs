@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use serde_json::json;
-use tandem::lfd::{Demonstration, Execution, PeriodSource, Reference, TaskModel};
+use tandem::lfd::{Demonstration, Execution, HoldSpec, PeriodSource, Reference, TaskModel};
 use tandem::planner::reschedule_seed;
 use tandem::schedule::SamplerParams;
 use tandem::{ExecutionRecord, Planner, PlannerParams};
@@ -76,6 +76,23 @@ fn fit(a: &FitArgs) -> Result<()> {
     params.sampler = apply_sampler(params.sampler, &a.sampler)?;
     if let Some(reference) = a.reference {
         params.fit.reference = reference.into();
+    }
+    if a.no_holds {
+        params.holds = HoldSpec::default();
+    }
+    if !a.hold_at.is_empty() {
+        params.holds.at_s = a.hold_at.clone();
+    }
+    if !a.hold_where.is_empty() {
+        params.holds.rules = a.hold_where.clone();
+    }
+    if let Some(t) = params
+        .holds
+        .at_s
+        .iter()
+        .find(|t| !t.is_finite() || **t < 0.0)
+    {
+        bail!("--hold-at {t}: a hold's reference time must be a finite number of seconds ≥ 0");
     }
     if let Some(dt) = a.dt
         && !(dt.is_finite() && dt > 0.0)
@@ -178,6 +195,99 @@ fn fit(a: &FitArgs) -> Result<()> {
     Ok(())
 }
 
+/// One stretch of consecutive hold points of the same activity.
+struct HoldRun {
+    /// First reference sample.
+    start: usize,
+    /// Last reference sample (inclusive).
+    last: usize,
+    /// Whether its samples are high-confidence, so a robot may dwell there now.
+    active: bool,
+}
+
+/// The planner's hold points (`Problem::holds`) as stretches of consecutive samples with the
+/// same activity, in reference order.
+fn hold_runs(planner: &Planner) -> Vec<HoldRun> {
+    let conf = planner.problem().conf();
+    let mut runs: Vec<HoldRun> = Vec::new();
+    for &n in planner.problem().holds() {
+        match runs.last_mut() {
+            Some(r) if r.last + 1 == n && r.active == conf[n] => r.last = n,
+            _ => runs.push(HoldRun {
+                start: n,
+                last: n,
+                active: conf[n],
+            }),
+        }
+    }
+    runs
+}
+
+/// `1.50–3.95 s (samples 30–79, active)` or `2.00 s (sample 40, inactive)`.
+fn hold_run_text(r: &HoldRun, dt: f64) -> String {
+    let state = if r.active { "active" } else { "inactive" };
+    if r.start == r.last {
+        format!("{:.2} s (sample {}, {state})", r.start as f64 * dt, r.start)
+    } else {
+        format!(
+            "{:.2}–{:.2} s (samples {}–{}, {state})",
+            r.start as f64 * dt,
+            r.last as f64 * dt,
+            r.start,
+            r.last
+        )
+    }
+}
+
+/// `tandem inspect --json`'s `holds`: the declaration, the resolved samples and their
+/// stretches.
+fn holds_json(planner: &Planner) -> serde_json::Value {
+    let dt = planner.model().dt_s();
+    let conf = planner.problem().conf();
+    let holds = planner.problem().holds();
+    let runs: Vec<_> = hold_runs(planner)
+        .iter()
+        .map(|r| {
+            json!({
+                "ref_start": r.start,
+                "ref_last": r.last,
+                "start_s": r.start as f64 * dt,
+                "last_s": r.last as f64 * dt,
+                "active": r.active,
+            })
+        })
+        .collect();
+    json!({
+        "declared": serde_json::to_value(&planner.params().holds).unwrap_or_default(),
+        "samples": holds,
+        "active_samples": holds.iter().filter(|&&n| conf[n]).count(),
+        "stretches": runs,
+    })
+}
+
+/// The hold-point lines of `fit`, `record` and `inspect`; nothing without a declaration.
+fn hold_lines(planner: &Planner) {
+    let spec = &planner.params().holds;
+    if spec.is_empty() {
+        return;
+    }
+    let holds = planner.problem().holds();
+    let active = planner.problem().active_holds().count();
+    let runs = hold_runs(planner);
+    let mut declared: Vec<String> = spec.at_s.iter().map(|t| format!("at {t} s")).collect();
+    declared.extend(spec.rules.iter().map(|r| format!("where {r}")));
+    out(&format!(
+        "hold points ({}): {} samples, {active} active (high-confidence: a robot may wait \
+         there)",
+        declared.join(", "),
+        holds.len()
+    ));
+    let dt = planner.model().dt_s();
+    for r in &runs {
+        out(&format!("  {}", hold_run_text(r, dt)));
+    }
+}
+
 /// Confidence and schedule lines shared by `fit`, `record` and `inspect`.
 fn summary_lines(planner: &Planner) -> Result<()> {
     let conf = planner.confidence();
@@ -188,6 +298,7 @@ fn summary_lines(planner: &Planner) -> Result<()> {
         conf.n_ref(),
         conf.low_regions().len()
     ));
+    hold_lines(planner);
     out(&format!(
         "schedule: {}",
         certificate_line(planner.problem(), planner.outcome())?
@@ -439,6 +550,7 @@ fn inspect(a: &InspectArgs) -> Result<()> {
             "total_corrections": obs.total_corrections(),
         },
         "schedule": schedule_json(planner.problem(), planner.outcome())?,
+        "holds": holds_json(&planner),
     });
     if a.json {
         out(&serde_json::to_string_pretty(&doc)?);

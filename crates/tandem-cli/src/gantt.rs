@@ -4,8 +4,8 @@ use std::fmt::Write as _;
 
 use anyhow::Result;
 use serde_json::{Value, json};
-use tandem::realtime::tol;
-use tandem::schedule::{GlobalTimeline, LcInterval, Outcome, Problem, Schedule, Source};
+use tandem::realtime::{After, Timeline, tol};
+use tandem::schedule::{LcInterval, Outcome, Problem, Schedule, Source};
 
 /// Columns of the text Gantt's bars.
 const GANTT_COLUMNS: usize = 72;
@@ -79,17 +79,150 @@ pub(crate) fn gap_text(gap: f64) -> String {
     format!("{pct:+.2} %")
 }
 
+/// One planned wait of a robot at a hold point, in global time.
+pub(crate) struct Dwell {
+    /// The robot (0-based).
+    pub(crate) robot: usize,
+    /// The hold's reference sample (the robot has done samples `0..ref_idx`).
+    pub(crate) ref_idx: usize,
+    /// Global time (s) the robot reaches the hold on schedule.
+    pub(crate) start_s: f64,
+    /// Global time (s) it leaves on schedule (`start_s` plus the planned dwell).
+    pub(crate) end_s: f64,
+    /// Its release rules (robot `robot` 0-based has passed reference sample `ref_idx`).
+    pub(crate) after: Vec<After>,
+}
+
+/// A schedule laid out in global time with its holds: every robot's legs
+/// (`Schedule::legs`: one leg per robot without holds, its timeline) and planned dwells.
+pub(crate) struct Layout {
+    /// Per robot, its legs in order.
+    pub(crate) legs: Vec<Vec<Timeline>>,
+    /// Per robot, the first reference sample of each leg (a leg's own reference samples
+    /// count from its start: add this to them).
+    pub(crate) leg_from: Vec<Vec<usize>>,
+    /// Every hold of the schedule with its planned wait, by robot then reference sample
+    /// (a hold at the task start waits from `τ_i` to `τ_i`: the offset is its dwell).
+    pub(crate) dwells: Vec<Dwell>,
+}
+
+impl Layout {
+    pub(crate) fn new(problem: &Problem, schedule: &Schedule) -> Result<Self> {
+        let legs = schedule.legs(problem)?;
+        let leg_from = (0..legs.len())
+            .map(|robot| {
+                std::iter::once(0)
+                    .chain(
+                        schedule
+                            .holds_of(robot)
+                            .iter()
+                            .map(|h| h.ref_idx)
+                            .filter(|&n| n > 0),
+                    )
+                    .collect()
+            })
+            .collect();
+        let mut dwells = Vec::new();
+        for (robot, robot_legs) in legs.iter().enumerate() {
+            let mut k = 0;
+            for h in schedule.holds_of(robot) {
+                let (start_s, end_s) = if h.ref_idx == 0 {
+                    let t = schedule.start_s(robot);
+                    (t, t)
+                } else {
+                    // Hold k (of those after the start) joins leg k and leg k + 1.
+                    let s = (robot_legs[k].end_s(), robot_legs[k + 1].start_s());
+                    k += 1;
+                    s
+                };
+                dwells.push(Dwell {
+                    robot,
+                    ref_idx: h.ref_idx,
+                    start_s,
+                    end_s,
+                    after: h.after.clone(),
+                });
+            }
+        }
+        Ok(Layout {
+            legs,
+            leg_from,
+            dwells,
+        })
+    }
+
+    /// `T_total` (s, global time): the latest end of a leg.
+    fn t_total_s(&self) -> f64 {
+        self.legs
+            .iter()
+            .flatten()
+            .map(Timeline::end_s)
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// What robot `robot` does at global time `t` (s): `Some(true)` running high-confidence,
+    /// `Some(false)` running low-confidence, `None` not running (before its start, waiting
+    /// at a hold, or done).
+    fn running_conf(&self, robot: usize, t: f64) -> Option<bool> {
+        self.legs[robot]
+            .iter()
+            .find(|l| t >= l.start_s() && t < l.end_s())
+            .map(|l| l.conf_at(t))
+    }
+
+    /// Whether robot `robot` waits at a hold at global time `t` (s).
+    fn waiting(&self, robot: usize, t: f64) -> bool {
+        self.dwells
+            .iter()
+            .any(|d| d.robot == robot && t >= d.start_s && t < d.end_s)
+    }
+}
+
 /// Every robot's low-confidence intervals with their robot index (0-based), sorted by start
 /// (the lower robot first on a tie).
-fn sorted_intervals(tl: &GlobalTimeline) -> Vec<(usize, LcInterval)> {
-    let mut out: Vec<(usize, LcInterval)> = tl
-        .lc_intervals()
+fn sorted_intervals(layout: &Layout) -> Vec<(usize, LcInterval)> {
+    let mut out: Vec<(usize, LcInterval)> = layout
+        .legs
         .iter()
+        .zip(&layout.leg_from)
         .enumerate()
-        .flat_map(|(robot, ivs)| ivs.iter().map(move |iv| (robot, *iv)))
+        .flat_map(|(robot, (legs, from))| {
+            legs.iter().zip(from).flat_map(move |(l, &from)| {
+                l.lc_intervals().iter().map(move |iv| {
+                    let mut iv = *iv;
+                    iv.ref_start += from;
+                    iv.ref_end += from;
+                    (robot, iv)
+                })
+            })
+        })
         .collect();
     out.sort_by(|a, b| a.1.start_s.total_cmp(&b.1.start_s));
     out
+}
+
+/// The schedule's holds as JSON (robots 1-based, times in global s).
+fn holds_json(layout: &Layout, dt_s: f64) -> Vec<Value> {
+    layout
+        .dwells
+        .iter()
+        .map(|d| {
+            let after: Vec<Value> = d
+                .after
+                .iter()
+                .map(|a| json!({"robot": a.robot + 1, "ref_idx": a.ref_idx}))
+                .collect();
+            json!({
+                "robot": d.robot + 1,
+                "ref_idx": d.ref_idx,
+                "ref_s": d.ref_idx as f64 * dt_s,
+                "start_s": d.start_s,
+                "end_s": d.end_s,
+                "dwell_s": d.end_s - d.start_s,
+                "after": after,
+            })
+        })
+        .collect()
 }
 
 /// The schedule as JSON: robot count, offsets, per-robot gradients and durations,
@@ -97,9 +230,9 @@ fn sorted_intervals(tl: &GlobalTimeline) -> Vec<(usize, LcInterval)> {
 /// optimum, the gap) (all times in seconds of global time; gradients in execution samples per
 /// reference sample). `schedule` is exactly `tandem::schedule::Schedule`'s serde form.
 pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Value> {
-    let tl = GlobalTimeline::new(problem, &outcome.schedule)?;
+    let layout = Layout::new(problem, &outcome.schedule)?;
     let dt = problem.dt_s();
-    let intervals: Vec<Value> = sorted_intervals(&tl)
+    let intervals: Vec<Value> = sorted_intervals(&layout)
         .iter()
         .map(|(robot, iv)| {
             json!({
@@ -112,7 +245,7 @@ pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Valu
         })
         .collect();
     let s = &outcome.schedule;
-    Ok(json!({
+    let mut doc = json!({
         "t_total_s": outcome.t_total_s,
         "lower_bound_s": outcome.lower_bound_s,
         "bound_is_optimum": outcome.bound_is_optimum,
@@ -128,28 +261,32 @@ pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Valu
         "source": source_name(&outcome.source),
         "lc_intervals": intervals,
         "schedule": serde_json::to_value(s)?,
-    }))
+    });
+    if s.has_holds() {
+        // Only with holds, so that a schedule without them prints as before hold points.
+        doc["holds"] = json!(holds_json(&layout, dt));
+        doc["dwells_s"] = json!((0..s.n_robots()).map(|i| s.dwell_s(i)).collect::<Vec<_>>());
+    }
+    Ok(doc)
 }
 
 /// The text Gantt chart: one bar per robot over `[0, T_total]` (`=` running high-confidence,
 /// `#` running low-confidence, blank not running) and the operator's row (`1`…`8`: which
 /// robot is supervised, `.` idle, `!` two or more), followed by the low-confidence intervals.
 pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String> {
-    let tl = GlobalTimeline::new(problem, &outcome.schedule)?;
-    let t_total = tl.t_total_s();
-    let spans = tl.spans_s();
+    let layout = Layout::new(problem, &outcome.schedule)?;
+    let t_total = layout.t_total_s();
     let n = outcome.schedule.n_robots();
     let mut rows = vec![String::new(); n + 1];
     for c in 0..GANTT_COLUMNS {
         let t = (c as f64 + 0.5) / GANTT_COLUMNS as f64 * t_total;
-        let conf = tl.conf_at(t);
         let mut supervised = Vec::new();
-        for i in 0..n {
-            let running = t >= spans[i].0 && t < spans[i].1;
-            rows[i].push(match (running, conf[i]) {
-                (false, _) => ' ',
-                (true, true) => '=',
-                (true, false) => {
+        for (i, row) in rows.iter_mut().take(n).enumerate() {
+            row.push(match layout.running_conf(i, t) {
+                None if layout.waiting(i, t) => 'h',
+                None => ' ',
+                Some(true) => '=',
+                Some(false) => {
                     supervised.push(i);
                     '#'
                 }
@@ -205,7 +342,13 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
         out,
         "          = high confidence (unsupervised)   # low confidence (operator supervises)"
     )?;
-    let intervals = sorted_intervals(&tl);
+    if outcome.schedule.has_holds() {
+        writeln!(
+            out,
+            "          h waiting at a hold point (planned; at run time until its release rule holds)"
+        )?;
+    }
+    let intervals = sorted_intervals(&layout);
     writeln!(out)?;
     writeln!(
         out,
@@ -230,6 +373,39 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
             "  … {} more (tandem schedule --json lists all)",
             intervals.len() - SHOWN
         )?;
+    }
+    if outcome.schedule.has_holds() {
+        let dt = problem.dt_s();
+        writeln!(out)?;
+        writeln!(
+            out,
+            "{} holds (global time; reference sample; the robot leaves once):",
+            layout.dwells.len()
+        )?;
+        for d in layout.dwells.iter().take(SHOWN) {
+            let after: Vec<String> = d
+                .after
+                .iter()
+                .map(|a| format!("robot {} passed ref {}", a.robot + 1, a.ref_idx))
+                .collect();
+            writeln!(
+                out,
+                "  robot {}  {:>9.2} – {:>9.2} s   ref {:>6} ({:.2} s)   {}",
+                d.robot + 1,
+                d.start_s,
+                d.end_s,
+                d.ref_idx,
+                d.ref_idx as f64 * dt,
+                if after.is_empty() {
+                    "the others reach their leg's start".to_string()
+                } else {
+                    after.join(", ")
+                }
+            )?;
+        }
+        if layout.dwells.len() > SHOWN {
+            writeln!(out, "  … {} more", layout.dwells.len() - SHOWN)?;
+        }
     }
     Ok(out)
 }

@@ -14,7 +14,6 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use tandem::Planner;
 use tandem::lfd::ChannelKind;
-use tandem::schedule::GlobalTimeline;
 use tandem_plot::{FONT_FAMILY, HIGH_CONFIDENCE, MEAN, NEITHER_LC, ROBOT_LC_N};
 /// Figure width (px, SVG user units).
 const WIDTH: u32 = 1200;
@@ -430,17 +429,39 @@ struct ScheduleFigure {
     t_total_s: f64,
     spans: Vec<(f64, f64)>,
     lc: Vec<Vec<(f64, f64)>>,
+    /// Per robot, its holds in global time: where it reaches the hold and where it leaves on
+    /// schedule (equal for a hold without planned dwell).
+    dwells: Vec<Vec<(f64, f64)>>,
     title: String,
 }
 
 impl ScheduleFigure {
     fn new(planner: &Planner) -> Result<Self> {
-        let tl = GlobalTimeline::new(planner.problem(), planner.schedule())?;
-        let lc = tl
-            .lc_intervals()
+        let layout = crate::gantt::Layout::new(planner.problem(), planner.schedule())?;
+        let lc = layout
+            .legs
             .iter()
-            .map(|v| v.iter().map(|iv| (iv.start_s, iv.end_s)).collect())
+            .map(|legs| {
+                legs.iter()
+                    .flat_map(|l| l.lc_intervals().iter().map(|iv| (iv.start_s, iv.end_s)))
+                    .collect()
+            })
             .collect();
+        let spans: Vec<(f64, f64)> = layout
+            .legs
+            .iter()
+            .map(|legs| {
+                let first = legs.first().map_or(0.0, |l| l.start_s());
+                (first, legs.last().map_or(first, |l| l.end_s()))
+            })
+            .collect();
+        let t_total_s = spans.iter().map(|s| s.1).fold(f64::NEG_INFINITY, f64::max);
+        let mut dwells = vec![Vec::new(); spans.len()];
+        for d in &layout.dwells {
+            if d.ref_idx > 0 {
+                dwells[d.robot].push((d.start_s, d.end_s));
+            }
+        }
         let schedule = planner.schedule();
         let serial = crate::gantt::serial_t_total_s(
             planner.problem(),
@@ -453,14 +474,22 @@ impl ScheduleFigure {
             Some(t) if n == 2 => format!(", robot 2 starts at τ = {t} s"),
             Some(t) => format!(", robots 2–{n} start at τ = {t} s"),
         };
+        let holds = if schedule.has_holds() {
+            let waits: f64 = (0..n).map(|i| schedule.dwell_s(i)).sum();
+            format!(
+                "; {} holds (black ticks), {waits:.2} s planned waiting (white)",
+                dwells.iter().map(Vec::len).sum::<usize>()
+            )
+        } else {
+            String::new()
+        };
         Ok(Self {
-            t_total_s: tl.t_total_s(),
-            spans: tl.spans_s(),
+            t_total_s,
+            spans,
             lc,
+            dwells,
             title: format!(
-                "schedule: T_total {:.2} s (fastest serial {:.2} s){starts}",
-                tl.t_total_s(),
-                serial,
+                "schedule: T_total {t_total_s:.2} s (fastest serial {serial:.2} s){starts}{holds}"
             ),
         })
     }
@@ -561,6 +590,25 @@ impl Figure for ScheduleFigure {
                 .draw_series(self.lc[i].iter().map(|&iv| {
                     let (s, e) = widened(iv);
                     Rectangle::new([(s, y - 0.3), (e, y + 0.3)], colour.filled())
+                }))
+                .map_err(de)?;
+            // Planned waits at hold points: white inside a black outline; every hold a
+            // black tick where the robot reaches it.
+            chart
+                .draw_series(
+                    self.dwells[i].iter().filter(|d| d.1 > d.0).map(|&(s, e)| {
+                        Rectangle::new([(s, y - 0.3), (e, y + 0.3)], WHITE.filled())
+                    }),
+                )
+                .map_err(de)?;
+            chart
+                .draw_series(self.dwells[i].iter().filter(|d| d.1 > d.0).map(|&(s, e)| {
+                    Rectangle::new([(s, y - 0.3), (e, y + 0.3)], BLACK.stroke_width(1))
+                }))
+                .map_err(de)?;
+            chart
+                .draw_series(self.dwells[i].iter().map(|&(s, _)| {
+                    PathElement::new(vec![(s, y - 0.38), (s, y + 0.38)], BLACK.stroke_width(2))
                 }))
                 .map_err(de)?;
         }

@@ -489,6 +489,67 @@ fn bad_parameters_and_outputs() {
     );
 }
 
+/// Bad hold declarations (`--hold-at`, `--hold-where`, `[holds]`): each names the hold and
+/// what is wrong, and writes nothing.
+#[test]
+fn bad_hold_declarations() {
+    let dir = scratch("bad-holds");
+    let demos: Vec<String> = small_demos(&dir).iter().map(|p| s(p)).collect();
+    let out = s(&dir.join("out.tandem"));
+    let fit = |extra: &[&str]| {
+        let mut v = vec!["fit".to_string()];
+        v.extend(demos.iter().cloned());
+        v.extend(["--samples", "50", "-o", &out].map(String::from));
+        v.extend(extra.iter().map(|x| x.to_string()));
+        v
+    };
+    let p_rule = s(&write(&dir, "rule.toml", "[holds]\nrules = [\"force\"]\n"));
+    let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
+        (
+            fit(&["--hold-where", "torque<3"]),
+            vec![
+                "hold rule `torque<3`",
+                "no channel `torque`",
+                "[\"x\", \"force\"]",
+            ],
+        ),
+        (
+            fit(&["--hold-where", "force=3"]),
+            vec!["--hold-where", "`=` is not a comparison"],
+        ),
+        (
+            fit(&["--hold-where", "force<"]),
+            vec!["--hold-where", "no value after the comparison"],
+        ),
+        (
+            fit(&["--hold-where", "force>1e9"]),
+            vec!["hold rule `force>1000000000`", "holds nowhere"],
+        ),
+        (
+            fit(&["--hold-at", "100"]),
+            vec!["hold at 100 s", "outside the task", "0 to 0.59 s"],
+        ),
+        (fit(&["--hold-at", "-1"]), vec!["--hold-at -1", "≥ 0"]),
+        (fit(&["--hold-at", "nan"]), vec!["--hold-at NaN", "finite"]),
+        (fit(&["--hold-at", "abc"]), vec!["--hold-at", "abc"]),
+        (
+            fit(&["--no-holds", "--hold-at", "0.1"]),
+            vec!["--no-holds", "--hold-at"],
+        ),
+        (
+            fit(&["--params", &p_rule]),
+            vec![&p_rule, "hold rule `force`", "no comparison"],
+        ),
+    ];
+    for (args, needles) in &cases {
+        expect_user_error(args, needles, None);
+        assert!(
+            !dir.join("out.tandem").exists(),
+            "{args:?}: no output on error"
+        );
+    }
+}
+
 /// Damaged state files: every command that reads one reports the file and the damage.
 #[test]
 fn damaged_state_files() {

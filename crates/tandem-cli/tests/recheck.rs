@@ -16,7 +16,8 @@ fn s(p: &std::path::Path) -> String {
     p.display().to_string()
 }
 
-/// The state file's payload, field for field (state format 6): the test edits its schedule.
+/// The state file's payload, field for field (state format 8, the outcome in the state
+/// file's form): the test edits its schedule.
 /// A change of the format makes `state::load` fail here, loudly.
 #[derive(Serialize, Deserialize)]
 struct Payload {
@@ -24,6 +25,7 @@ struct Payload {
     model: TaskModel,
     observations: Observations,
     confidence: Confidence,
+    #[serde(with = "state::outcome_form")]
     outcome: Outcome,
     rounds_recorded: usize,
     rounds: Vec<u64>,

@@ -117,17 +117,17 @@ pub enum Error {
         /// [`tandem_realtime::MAX_ROBOTS`].
         max: usize,
     },
-    /// A hold point declared where the demonstrations themselves predict the operator is
-    /// needed (`σ²_D ≥ σ²_hold`, [`crate::demonstrated_need_level`]).
+    /// A hold point declared inside a low-confidence stretch that the recorded corrections
+    /// show needs the operator (`LowCause::Corrections`).
     #[error(
         "{hold} falls at {at_s:.3} s (reference time), inside the low-confidence stretch \
-         {start_s:.3}–{end_s:.3} s where the demonstrations vary too much to trust \
-         (σ²_D = {sigma2_d:.4} ≥ {level:.4}, the variance from which the prior expects more \
-         corrections than μ_c): a robot must not wait where the operator is needed; declare \
-         the hold before or after that stretch"
+         {start_s:.3}–{end_s:.3} s, which the operator corrected ({corrections:.0} corrections \
+         in {supervised:.0} supervised samples, more than their false corrections explain): a \
+         robot must not wait where the operator is needed; declare the hold before or after \
+         that stretch"
     )]
     HoldInLowConfidence {
-        /// The declaration (`the hold at 3.2 s`, `the hold rule `tool<0.5``).
+        /// The declaration (`the hold at 3.2 s`, ``the hold rule `tool<0.5` ``).
         hold: String,
         /// Reference time of the refused hold sample, seconds.
         at_s: f64,
@@ -135,10 +135,10 @@ pub enum Error {
         start_s: f64,
         /// End of the stretch (reference time, s, exclusive).
         end_s: f64,
-        /// `σ²_D` at the hold (dimensionless).
-        sigma2_d: f64,
-        /// `σ²_hold` (dimensionless).
-        level: f64,
+        /// Corrected observation mass in the stretch (control samples).
+        corrections: f64,
+        /// Supervised observation mass in the stretch (control samples).
+        supervised: f64,
     },
     /// A hold rule that holds on no reference sample of the task (after the start).
     #[error("hold rule `{rule}` holds nowhere in the task ({why}): change its threshold")]

@@ -62,7 +62,6 @@ pub mod state;
 
 pub use error::{Error, Result};
 pub use explain::{ChannelShare, LowCause, LowRegion};
-pub use holds::demonstrated_need_level;
 pub use planner::{ExecutionRecord, Planner, PlannerParams, RecordReport};
 
 /// A seed for item `index` of a seeded family (trial `k` of a study, the schedule after

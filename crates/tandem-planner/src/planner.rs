@@ -54,8 +54,8 @@ pub struct PlannerParams {
     pub sampler: SamplerParams,
     /// Hold points (reference samples where a robot may dwell, its clock stopped): reference
     /// times and channel rules, resolved on the model whenever the problem is (re)built
-    /// (`crate::holds`). A hold declared where the demonstrations predict the operator is
-    /// needed is refused when the planner is made ([`Error::HoldInLowConfidence`]). Default:
+    /// (`crate::holds`); [`Planner::set_holds`] refuses a hold where the recorded corrections
+    /// show the operator is needed ([`Error::HoldInLowConfidence`]). Default:
     /// none (the task start is always a hold and is never listed), and a planner without
     /// holds schedules exactly as before hold points existed.
     pub holds: HoldSpec,
@@ -301,9 +301,49 @@ struct PlannerState {
     model: TaskModel,
     observations: Observations,
     confidence: Confidence,
+    #[serde(with = "state::outcome_form")]
     outcome: Outcome,
     pairs_recorded: usize,
     rounds: Vec<u64>,
+}
+
+/// The [`Schedule`] of state formats 5 to 7: without holds.
+#[derive(Deserialize)]
+struct ScheduleV7 {
+    grad_exec: Vec<Vec<f64>>,
+    offsets_s: Vec<f64>,
+    tick_s: f64,
+}
+
+/// [`Outcome`] as state formats 5 to 7 wrote it: the schedule without holds.
+#[derive(Deserialize)]
+struct OutcomeV7 {
+    schedule: ScheduleV7,
+    t_total_s: f64,
+    source: Source,
+    stats: SamplerStats,
+    lower_bound_s: f64,
+    bound_is_optimum: bool,
+    gap: f64,
+}
+
+impl From<OutcomeV7> for Outcome {
+    fn from(v7: OutcomeV7) -> Self {
+        Outcome {
+            schedule: Schedule {
+                grad_exec: v7.schedule.grad_exec,
+                offsets_s: v7.schedule.offsets_s,
+                tick_s: v7.schedule.tick_s,
+                holds: Vec::new(),
+            },
+            t_total_s: v7.t_total_s,
+            source: v7.source,
+            stats: v7.stats,
+            lower_bound_s: v7.lower_bound_s,
+            bound_is_optimum: v7.bound_is_optimum,
+            gap: v7.gap,
+        }
+    }
 }
 
 /// [`PlannerParams`] as state format 7 wrote them: without hold points.
@@ -321,7 +361,7 @@ struct PlannerStateV7 {
     model: TaskModel,
     observations: Observations,
     confidence: Confidence,
-    outcome: Outcome,
+    outcome: OutcomeV7,
     pairs_recorded: usize,
     rounds: Vec<u64>,
 }
@@ -339,7 +379,7 @@ impl From<PlannerStateV7> for PlannerState {
             model: v7.model,
             observations: v7.observations,
             confidence: v7.confidence,
-            outcome: v7.outcome,
+            outcome: v7.outcome.into(),
             pairs_recorded: v7.pairs_recorded,
             rounds: v7.rounds,
         }
@@ -402,7 +442,7 @@ struct PlannerStateV6 {
     model: TaskModel,
     observations: ObservationsV6,
     confidence: ConfidenceV6,
-    outcome: Outcome,
+    outcome: OutcomeV7,
     pairs_recorded: usize,
     rounds: Vec<u64>,
 }
@@ -423,7 +463,7 @@ impl TryFrom<PlannerStateV6> for PlannerState {
                 v6.observations.supervised,
             )?,
             confidence: Confidence::from_parts(v6.confidence.params.into(), v6.confidence.high)?,
-            outcome: v6.outcome,
+            outcome: v6.outcome.into(),
             pairs_recorded: v6.pairs_recorded,
             rounds: v6.rounds,
         })
@@ -438,7 +478,7 @@ struct PlannerStateV5 {
     model: TaskModel,
     observations: ObservationsV6,
     confidence: ConfidenceV6,
-    outcome: Outcome,
+    outcome: OutcomeV7,
     pairs_recorded: usize,
 }
 
@@ -505,12 +545,11 @@ impl From<PlannerStateV4> for PlannerStateV6 {
             model: v4.model,
             observations: v4.observations,
             confidence: v4.confidence,
-            outcome: Outcome {
-                schedule: Schedule {
+            outcome: OutcomeV7 {
+                schedule: ScheduleV7 {
                     grad_exec: Vec::from(schedule.grad_exec),
                     offsets_s: vec![schedule.offset_s],
                     tick_s: schedule.tick_s,
-                    holds: Vec::new(),
                 },
                 t_total_s,
                 source,
@@ -551,7 +590,7 @@ fn problem_for(model: &TaskModel, confidence: &Confidence, holds: &HoldSpec) -> 
     if holds.is_empty() {
         return Ok(problem);
     }
-    Ok(problem.with_holds(crate::holds::resolve(holds, model, confidence.params())?)?)
+    Ok(problem.with_holds(crate::holds::resolve(holds, model)?)?)
 }
 
 /// [`Error::RobotCount`] unless `1 ≤ n_robots ≤ MAX_ROBOTS`.
@@ -614,7 +653,7 @@ impl Planner {
     ) -> Result<Self> {
         check_robot_count(n_robots)?;
         params.validate()?;
-        crate::holds::check_declared(&params.holds, &model, &params.confidence)?;
+        crate::holds::check_declared(&params.holds, &model)?;
         let confidence = Confidence::from_prior(model.sigma2_d(), params.confidence.clone())?;
         let observations = Observations::new(model.n_ref())?;
         let problem = problem_for(&model, &confidence, &params.holds)?;
@@ -827,6 +866,38 @@ impl Planner {
             &sampler,
             Some(&self.outcome.schedule),
         )?;
+        self.outcome = outcome;
+        Ok(&self.outcome)
+    }
+
+    /// Declares the hold points `holds` on this planner in place of its own
+    /// ([`PlannerParams::holds`]) and re-schedules (warm-started by the current schedule, at
+    /// its tick, with the seed of a plain re-schedule, [`crate::reschedule_seed`], so the same
+    /// call gives the same schedule). Model, observations, confidence and
+    /// [`Planner::rounds_recorded`] are unchanged. On error the planner is as before.
+    ///
+    /// # Errors
+    /// As the declaration check of [`Planner::new`] (a malformed hold, a time outside the task,
+    /// an unknown channel, a rule that holds nowhere), and [`Error::HoldInLowConfidence`] for a
+    /// hold inside a low-confidence stretch that the recorded corrections show needs the
+    /// operator (see `crate::holds`).
+    pub fn set_holds(&mut self, holds: HoldSpec) -> Result<&Outcome> {
+        crate::holds::check_declared(&holds, &self.model)?;
+        crate::holds::check_evidence(&holds, &self.model, &self.explain_low_confidence()?)?;
+        let problem = problem_for(&self.model, &self.confidence, &holds)?;
+        let sampler = SamplerParams {
+            tick_s: Some(self.schedule().tick_s),
+            seed: crate::reschedule_seed(self.params.sampler.seed, self.pairs_recorded),
+            ..self.params.sampler.clone()
+        };
+        let outcome = sample_schedule_n(
+            &problem,
+            self.n_robots(),
+            &sampler,
+            Some(&self.outcome.schedule),
+        )?;
+        self.params.holds = holds;
+        self.problem = problem;
         self.outcome = outcome;
         Ok(&self.outcome)
     }
@@ -1346,6 +1417,64 @@ mod tests {
             }
         };
         [record(a), record(b)]
+    }
+
+    #[test]
+    fn holds_are_refused_where_the_operator_corrected_and_kept_inactive_where_untested() {
+        let mut p = small_planner(2);
+        let spec = |t: f64| HoldSpec {
+            at_s: vec![t],
+            rules: Vec::new(),
+        };
+        // Before any round the stretch 0.10–0.20 s is low-confidence for lack of executions
+        // only: a hold there is kept, inactive.
+        p.set_holds(spec(0.15)).unwrap();
+        assert_eq!(p.problem().holds(), &[15]);
+        assert_eq!(p.problem().active_holds().count(), 0);
+        // Two rounds in which the operator corrects the whole stretch.
+        for k in 0..2 {
+            let mut r = round(&p, 0.01 * k as f64, 0.02 + 0.01 * k as f64, 1, 0.01);
+            for e in &mut r {
+                e.corrected = e.supervised.clone();
+            }
+            p.record_round(&r).unwrap();
+        }
+        let regions = p.explain_low_confidence().unwrap();
+        assert!(
+            regions
+                .iter()
+                .any(|r| r.cause == crate::LowCause::Corrections)
+        );
+        // The hold declared before stays (never refused after a round), inactive.
+        assert_eq!(p.problem().holds(), &[15]);
+        assert_eq!(p.problem().active_holds().count(), 0);
+        // Declared now, it is refused naming the stretch; the planner is unchanged.
+        let before = p.outcome().clone();
+        let err = p.set_holds(spec(0.12)).unwrap_err();
+        let Error::HoldInLowConfidence {
+            at_s,
+            start_s,
+            end_s,
+            ..
+        } = err
+        else {
+            panic!("{err}");
+        };
+        assert!((at_s - 0.12).abs() < 1e-9 && start_s <= 0.12 && end_s > 0.12);
+        let msg = p.set_holds(spec(0.12)).unwrap_err().to_string();
+        assert!(
+            msg.contains("the hold at 0.12 s") && msg.contains("corrected"),
+            "{msg}"
+        );
+        assert_eq!(p.outcome(), &before);
+        assert_eq!(p.params().holds, spec(0.15));
+        // Outside the stretch, high-confidence: accepted and active.
+        p.set_holds(spec(0.3)).unwrap();
+        assert_eq!(p.problem().holds(), &[30]);
+        assert_eq!(p.problem().active_holds().collect::<Vec<_>>(), vec![30]);
+        // No holds again: the problem without them.
+        p.set_holds(HoldSpec::default()).unwrap();
+        assert!(p.problem().holds().is_empty());
     }
 
     #[test]

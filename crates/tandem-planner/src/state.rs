@@ -65,6 +65,113 @@ use serde::de::DeserializeOwned;
 
 use crate::{Error, Result};
 
+/// The state file's form of a `tandem_schedule::Outcome` (format 8), for
+/// `#[serde(with = "tandem_planner::state::outcome_form")]`: every field of the schedule and
+/// its holds always written. The schedule's own serde form leaves out empty holds, zero dwells
+/// and empty release lists (so that its JSON is the one of before hold points), which a
+/// format that is not self-describing (postcard) cannot read back.
+pub mod outcome_form {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+    use tandem_realtime::{After, Hold};
+    use tandem_schedule::{Outcome, SamplerStats, Schedule, Source};
+
+    #[derive(Serialize, Deserialize)]
+    struct HoldState {
+        ref_idx: usize,
+        dwell_s: f64,
+        after: Vec<After>,
+    }
+
+    #[derive(Serialize, Deserialize)]
+    struct ScheduleState {
+        grad_exec: Vec<Vec<f64>>,
+        offsets_s: Vec<f64>,
+        tick_s: f64,
+        holds: Vec<Vec<HoldState>>,
+    }
+
+    #[derive(Serialize, Deserialize)]
+    struct OutcomeState {
+        schedule: ScheduleState,
+        t_total_s: f64,
+        source: Source,
+        stats: SamplerStats,
+        lower_bound_s: f64,
+        bound_is_optimum: bool,
+        gap: f64,
+    }
+
+    /// Writes `o` in the state file's form.
+    ///
+    /// # Errors
+    /// The serializer's.
+    pub fn serialize<S: Serializer>(o: &Outcome, s: S) -> Result<S::Ok, S::Error> {
+        let sch = &o.schedule;
+        OutcomeState {
+            schedule: ScheduleState {
+                grad_exec: sch.grad_exec.clone(),
+                offsets_s: sch.offsets_s.clone(),
+                tick_s: sch.tick_s,
+                holds: sch
+                    .holds
+                    .iter()
+                    .map(|hs| {
+                        hs.iter()
+                            .map(|h| HoldState {
+                                ref_idx: h.ref_idx,
+                                dwell_s: h.dwell_s,
+                                after: h.after.clone(),
+                            })
+                            .collect()
+                    })
+                    .collect(),
+            },
+            t_total_s: o.t_total_s,
+            source: o.source,
+            stats: o.stats,
+            lower_bound_s: o.lower_bound_s,
+            bound_is_optimum: o.bound_is_optimum,
+            gap: o.gap,
+        }
+        .serialize(s)
+    }
+
+    /// Reads an outcome written by [`serialize`].
+    ///
+    /// # Errors
+    /// The deserializer's.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Outcome, D::Error> {
+        let o = OutcomeState::deserialize(d)?;
+        let sch = o.schedule;
+        Ok(Outcome {
+            schedule: Schedule {
+                grad_exec: sch.grad_exec,
+                offsets_s: sch.offsets_s,
+                tick_s: sch.tick_s,
+                holds: sch
+                    .holds
+                    .into_iter()
+                    .map(|hs| {
+                        hs.into_iter()
+                            .map(|h| Hold {
+                                ref_idx: h.ref_idx,
+                                dwell_s: h.dwell_s,
+                                after: h.after,
+                            })
+                            .collect()
+                    })
+                    .collect(),
+            },
+            t_total_s: o.t_total_s,
+            source: o.source,
+            stats: o.stats,
+            lower_bound_s: o.lower_bound_s,
+            bound_is_optimum: o.bound_is_optimum,
+            gap: o.gap,
+        })
+    }
+}
+
 /// Magic bytes at the start of every state file.
 pub const MAGIC: [u8; 8] = *b"TANDEMST";
 
@@ -95,8 +202,9 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 ///   paper's model (`ConfidenceParams::paper()`: the decisions they were saved with) and no
 ///   evidence of misses.
 /// - 8: the planner parameters gained the hold points the user declared
-///   (`PlannerParams::holds`: reference times and channel rules). Version 4 to 7 files still
-///   load, with no hold points.
+///   (`PlannerParams::holds`: reference times and channel rules) and the schedule its holds
+///   (`Schedule::holds`: per robot the hold, its planned dwell and release rules; every field
+///   written, also when empty). Version 4 to 7 files still load, with no hold points.
 pub const FORMAT_VERSION: u32 = 8;
 
 /// The oldest state format version this build reads (converting it on load).
@@ -608,7 +716,7 @@ mod tests {
     fn header_layout_is_as_documented() {
         let bytes = encode(&payload(4)).unwrap();
         assert_eq!(&bytes[..8], b"TANDEMST");
-        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 7);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 8);
         let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
         assert_eq!(len as usize, bytes.len() - HEADER_LEN);
         let crc = u32::from_le_bytes(bytes[20..24].try_into().unwrap());
@@ -693,18 +801,18 @@ mod tests {
     #[test]
     fn other_version_is_rejected_with_both_numbers() {
         let mut bytes = encode(&payload(3)).unwrap();
-        bytes[8..12].copy_from_slice(&8u32.to_le_bytes());
+        bytes[8..12].copy_from_slice(&9u32.to_le_bytes());
         let err = decode::<Payload>(&bytes, Path::new("v.tandem")).unwrap_err();
         assert!(matches!(
             err,
             Error::UnsupportedVersion {
-                found: 8,
+                found: 9,
                 expected: FORMAT_VERSION,
                 ..
             }
         ));
         let msg = err.to_string();
-        assert!(msg.contains("v.tandem") && msg.contains('8') && msg.contains("4 to 7"));
+        assert!(msg.contains("v.tandem") && msg.contains('9') && msg.contains("4 to 8"));
     }
 
     #[test]

@@ -294,10 +294,11 @@ fn a_version_7_file_loads_without_holds_and_saves_as_the_golden_file() {
     assert_eq!(old.params(), new.params());
     assert_eq!(old.outcome(), new.outcome());
     // The same inputs without holds: version 8 adds only the empty declaration (two empty
-    // lists, one byte each), and saving the old file writes the golden file's bytes, so a
-    // planner without holds is the planner of before, bit for bit.
+    // lists) and the schedule's empty holds (one list), one byte each, and saving the old
+    // file writes the golden file's bytes, so a planner without holds is the planner of
+    // before, bit for bit.
     let golden = std::fs::read(golden_path()).unwrap();
-    assert_eq!(golden.len(), v7.len() + 2);
+    assert_eq!(golden.len(), v7.len() + 3);
     let dir = tmp_dir("v7");
     let again = dir.join("again.tandem");
     old.save(&again).unwrap();

@@ -266,6 +266,7 @@ fn classify_lfd(e: &errors::Lfd) -> Kind {
         E::BadData { what, .. } => input_at(Some(what)),
         E::TooFewSamples { at, .. } => input_at(Some(at)),
         E::BadParam { name, .. } => param(name),
+        E::BadHoldRule { .. } | E::BadHoldTime { .. } => param("holds"),
         E::Warp(w) => classify_warp(w),
         _ => input_at(None),
     }
@@ -340,6 +341,7 @@ fn classify_facade(e: &Facade) -> Kind {
         },
         Facade::BadExecution { .. } | Facade::DuplicateRound { .. } => input_at(None),
         Facade::RobotCount { .. } => param("robots"),
+        Facade::HoldInLowConfidence { .. } | Facade::HoldMatchesNothing { .. } => param("holds"),
         Facade::Lfd(l) => classify_lfd(l),
         Facade::Confidence(c) => classify_confidence(c),
         Facade::Realtime(r) => classify_realtime(r),

@@ -4,8 +4,8 @@ pub(crate) use tandem::confidence::{
     BetaParams, Observations, posterior, prior, prior_low_threshold, prob_need_below_mu_c,
 };
 pub(crate) use tandem::lfd::{
-    DEFAULT_DT_S, DT_TOLERANCE, Demonstration, Execution, PeriodSource, Regridded, TaskModel,
-    length_warnings,
+    DEFAULT_DT_S, DT_TOLERANCE, Demonstration, Execution, HoldRule, HoldSpec, PeriodSource,
+    Regridded, TaskModel, length_warnings,
 };
 pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{
@@ -13,8 +13,8 @@ pub(crate) use tandem::planner::{
 };
 pub(crate) use tandem::realtime::{Coordinator, Fault, MAX_ROBOTS, Operator, Tick, Timeline};
 pub(crate) use tandem::schedule::{
-    CheckedSchedule, GlobalTimeline, Outcome, Problem, SamplerParams, Schedule, Source, Violation,
-    sample_schedule_n,
+    CheckedSchedule, GlobalTimeline, LcInterval, Outcome, Problem, SamplerParams, Schedule, Source,
+    Violation, sample_schedule_n,
 };
 pub(crate) use tandem::sim::needs::{NeedProfile, NeedRegion};
 pub(crate) use tandem::sim::study::{

@@ -14,9 +14,9 @@ use crate::errors::{Error, Result, deprecated, guard, warn};
 use crate::facade::{BagOptions, Recording, extend_bag_schema, is_bag, read_bag};
 use crate::facade::{
     BetaParams, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, DT_TOLERANCE, Demonstration, Execution,
-    ExecutionRecord, Observations, PeriodSource, Planner, PlannerParams, RecordReport, Regridded,
-    StateLock, TaskModel, errors, length_warnings, posterior, prior, prior_low_threshold,
-    prob_need_below_mu_c, reschedule_seed,
+    ExecutionRecord, HoldRule, HoldSpec, Observations, PeriodSource, Planner, PlannerParams,
+    RecordReport, Regridded, StateLock, TaskModel, errors, length_warnings, posterior, prior,
+    prior_low_threshold, prob_need_below_mu_c, reschedule_seed,
 };
 use crate::params::{from_py, serialize_to_py};
 use crate::schedule::PyProblem;
@@ -274,6 +274,40 @@ fn planner_params(params: Option<&Bound<'_, PyAny>>) -> Result<PlannerParams> {
     Ok(p)
 }
 
+/// The hold points `holds` of `fit` (see its docs): `None` keeps `params`' declaration, a
+/// dict is a `HoldSpec` (`{"at_s": [...], "rules": [...]}`), a list mixes reference times
+/// (numbers, s) and rules (strings such as `"gripper>0.5"`); an empty list declares none.
+fn hold_spec(holds: &Bound<'_, PyAny>) -> Result<HoldSpec> {
+    if holds.is_instance_of::<pyo3::types::PyDict>() {
+        return from_py(Some(holds), "holds");
+    }
+    if holds.extract::<String>().is_ok() {
+        return Err(Error::param(
+            "holds",
+            "expected a list of reference times (s) and rules (e.g. [2.5, \"gripper>0.5\"]) or \
+             a dict {\"at_s\": [...], \"rules\": [...]}, got a single string",
+        ));
+    }
+    let mut spec = HoldSpec::default();
+    for (k, item) in items(holds, "holds")?.iter().enumerate() {
+        if let Ok(rule) = item.extract::<String>() {
+            let rule: HoldRule = rule
+                .parse()
+                .map_err(|e: errors::Lfd| Error::param(format!("holds[{k}]"), e.to_string()))?;
+            spec.rules.push(rule);
+        } else if let Ok(t) = item.extract::<f64>() {
+            spec.at_s.push(t);
+        } else {
+            return Err(Error::param(
+                format!("holds[{k}]"),
+                "expected a reference time (a number of seconds) or a rule (a string such as \
+                 \"gripper>0.5\")",
+            ));
+        }
+    }
+    Ok(spec)
+}
+
 /// Learns the task from demonstrations and makes the first schedule (paper Fig. 2).
 ///
 /// Aligns every demonstration to the reference (GDTW, Eq. 2–3; demo 0, or the medoid with
@@ -296,12 +330,21 @@ fn planner_params(params: Option<&Bound<'_, PyAny>>) -> Result<PlannerParams> {
 ///     dt_s: sample period (s) of arrays and of files without a ``t`` column (default 0.01).
 ///     robots: robots ``N`` run by the one operator, 1 to 8 (default 2, the paper's): every
 ///         schedule has ``N`` warps and :meth:`Planner.record_round` takes ``N`` executions.
+///     holds: hold points, places where a robot may wait as long as needed (``tandem fit
+///         --hold-at``/``--hold-where``): a list of reference times (numbers, s, each at its
+///         nearest reference sample) and rules (strings ``"<channel><op><value>"`` with
+///         ``<``, ``<=``, ``>``, ``>=``, every sample where the channel's mean satisfies it,
+///         e.g. ``[2.5, "gripper>0.5"]``), or a dict ``{"at_s": […], "rules": […]}``.
+///         ``None`` (default) keeps ``params["holds"]``; ``[]`` declares none (the
+///         schedule of before hold points, as ``--no-holds``). A hold on a low-confidence
+///         sample is inactive until the sample is trusted.
 ///
 /// Raises:
 ///     InputError: a bad demonstration (with ``file``/``line`` for files).
-///     ParamError: a bad parameter or robot count.
+///     ParamError: a bad parameter or robot count, a malformed hold, a hold outside the task
+///         a rule on an unknown channel or one that holds nowhere.
 #[pyfunction]
-#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, robots=N_ROBOTS))]
+#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, robots=N_ROBOTS, holds=None))]
 pub(crate) fn fit(
     py: Python<'_>,
     demos: &Bound<'_, PyAny>,
@@ -309,8 +352,13 @@ pub(crate) fn fit(
     params: Option<&Bound<'_, PyAny>>,
     dt_s: Option<f64>,
     robots: usize,
+    holds: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyPlanner> {
     let mut params = planner_params(params)?;
+    if let Some(holds) = holds.filter(|h| !h.is_none()) {
+        params.holds = hold_spec(holds)?;
+        params.validate().map_err(Error::from)?;
+    }
     let demos = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
     warn_demonstrations(py, &demos)?;
     let planner = py.detach(|| guard(|| Ok(Planner::with_robots(&demos, params, robots)?)))?;
@@ -654,6 +702,25 @@ impl PyPlanner {
         sp.tick_s = tick_s;
         let inner = &mut self.inner;
         py.detach(|| guard(|| Ok(inner.reschedule(&sp).map(|_| ())?)))?;
+        Ok(self.current_schedule())
+    }
+
+    /// Declares hold points on this planner in place of its own and re-schedules (Rust
+    /// ``Planner::set_holds``): ``holds`` as :func:`fit` takes it (a list of reference times
+    /// and rules, or a dict; ``[]`` none). A hold inside a low-confidence stretch that the
+    /// recorded corrections show needs the operator is refused, naming the stretch; on error
+    /// the planner is unchanged.
+    ///
+    /// Returns:
+    ///     Schedule: the new current schedule.
+    ///
+    /// Raises:
+    ///     ParamError: a malformed hold, a time outside the task, an unknown channel, a rule
+    ///         that holds nowhere, or a hold where the operator corrected.
+    fn set_holds(&mut self, py: Python<'_>, holds: &Bound<'_, PyAny>) -> PyResult<PySchedule> {
+        let spec = hold_spec(holds)?;
+        let inner = &mut self.inner;
+        py.detach(|| guard(|| Ok(inner.set_holds(spec).map(|_| ())?)))?;
         Ok(self.current_schedule())
     }
 

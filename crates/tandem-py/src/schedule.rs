@@ -9,8 +9,8 @@ use pyo3::types::{PyDict, PyList};
 use crate::arrays::{flags, matrix, out_flags, out_matrix, out_vector, vector};
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
-    CheckedSchedule, GlobalTimeline, MAX_ROBOTS, Outcome, Problem, SamplerParams, Schedule, Source,
-    sample_schedule_n,
+    CheckedSchedule, GlobalTimeline, LcInterval, MAX_ROBOTS, Outcome, Problem, SamplerParams,
+    Schedule, Source, sample_schedule_n,
 };
 use crate::planner::N_ROBOTS;
 
@@ -81,6 +81,20 @@ impl PyProblem {
     #[getter]
     fn grad_mean<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         out_vector(py, self.inner.grad_mean().to_vec())
+    }
+
+    /// The hold points: reference samples where a robot may dwell, its clock stopped
+    /// (increasing, without the task start, which always is one); empty without holds.
+    #[getter]
+    fn holds(&self) -> Vec<usize> {
+        self.inner.holds().to_vec()
+    }
+
+    /// The hold points on high-confidence samples, where a robot may dwell now (a hold on a
+    /// low-confidence sample is inactive until the sample is trusted).
+    #[getter]
+    fn active_holds(&self) -> Vec<usize> {
+        self.inner.active_holds().collect()
     }
 
     /// ``ψ̇min(n)`` (Eq. 14), ``(T_ref,)``.
@@ -182,6 +196,37 @@ pub(crate) struct PySchedule {
 }
 
 impl PySchedule {
+    /// Every robot's low-confidence intervals in global time, from its legs (the plan split at
+    /// its holds, each leg after its planned dwell; one leg without holds).
+    fn lc_by_robot(&self) -> Result<Vec<Vec<LcInterval>>> {
+        let legs = self.schedule.legs(&self.problem)?;
+        Ok(legs
+            .iter()
+            .enumerate()
+            .map(|(robot, legs)| {
+                // A leg counts its reference samples from its hold.
+                let from = std::iter::once(0).chain(
+                    self.schedule
+                        .holds_of(robot)
+                        .iter()
+                        .map(|h| h.ref_idx)
+                        .filter(|&n| n > 0),
+                );
+                legs.iter()
+                    .zip(from)
+                    .flat_map(|(l, from)| {
+                        l.lc_intervals().iter().map(move |iv| {
+                            let mut iv = *iv;
+                            iv.ref_start += from;
+                            iv.ref_end += from;
+                            iv
+                        })
+                    })
+                    .collect()
+            })
+            .collect())
+    }
+
     fn new(
         problem: Arc<Problem>,
         schedule: Schedule,
@@ -344,6 +389,36 @@ impl PySchedule {
         self.schedule.t_total_s(self.problem.dt_s())
     }
 
+    /// The hold points of the schedule per robot (empty lists without holds): a list of
+    /// ``N`` lists of dicts ``{"ref_idx": n, "dwell_s": planned wait (s), "after": [(robot,
+    /// ref_idx), …]}``; robot ``i`` stops at the start of reference sample ``n`` and leaves
+    /// once every robot named in ``after`` (0-based) has passed that reference sample.
+    #[getter]
+    fn holds<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let list = PyList::empty(py);
+        for robot in 0..self.schedule.n_robots() {
+            let per = PyList::empty(py);
+            for h in self.schedule.holds_of(robot) {
+                let d = PyDict::new(py);
+                d.set_item("ref_idx", h.ref_idx)?;
+                d.set_item("dwell_s", h.dwell_s)?;
+                let after: Vec<(usize, usize)> =
+                    h.after.iter().map(|a| (a.robot, a.ref_idx)).collect();
+                d.set_item("after", after)?;
+                per.append(d)?;
+            }
+            list.append(per)?;
+        }
+        Ok(list)
+    }
+
+    /// Planned waiting at hold points per robot, ``(N,)``, s (zeros without holds).
+    #[getter]
+    fn dwells_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let n = self.schedule.n_robots();
+        out_vector(py, (0..n).map(|i| self.schedule.dwell_s(i)).collect())
+    }
+
     /// Execution durations ``|ψ_Ei|``, ``(N,)``, s.
     #[getter]
     fn durations_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
@@ -360,9 +435,8 @@ impl PySchedule {
     /// ``(k_i, 2)``, ``[start_s, end_s)`` in s of global time.
     #[getter]
     fn lc_intervals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let tl = self.timeline()?;
         let list = PyList::empty(py);
-        for robot in tl.lc_intervals() {
+        for robot in self.lc_by_robot()? {
             let flat: Vec<f64> = robot.iter().flat_map(|i| [i.start_s, i.end_s]).collect();
             list.append(out_matrix(py, flat, 2)?)?;
         }
@@ -373,9 +447,8 @@ impl PySchedule {
     /// ``[ref_start, ref_end)``.
     #[getter]
     fn lc_ref_intervals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let tl = self.timeline()?;
         let list = PyList::empty(py);
-        for robot in tl.lc_intervals() {
+        for robot in self.lc_by_robot()? {
             let flat: Vec<i64> = robot
                 .iter()
                 .flat_map(|i| [i.ref_start as i64, i.ref_end as i64])
