@@ -199,32 +199,7 @@ impl PySchedule {
     /// Every robot's low-confidence intervals in global time, from its legs (the plan split at
     /// its holds, each leg after its planned dwell; one leg without holds).
     fn lc_by_robot(&self) -> Result<Vec<Vec<LcInterval>>> {
-        let legs = self.schedule.legs(&self.problem)?;
-        Ok(legs
-            .iter()
-            .enumerate()
-            .map(|(robot, legs)| {
-                // A leg counts its reference samples from its hold.
-                let from = std::iter::once(0).chain(
-                    self.schedule
-                        .holds_of(robot)
-                        .iter()
-                        .map(|h| h.ref_idx)
-                        .filter(|&n| n > 0),
-                );
-                legs.iter()
-                    .zip(from)
-                    .flat_map(|(l, from)| {
-                        l.lc_intervals().iter().map(move |iv| {
-                            let mut iv = *iv;
-                            iv.ref_start += from;
-                            iv.ref_end += from;
-                            iv
-                        })
-                    })
-                    .collect()
-            })
-            .collect())
+        Ok(self.schedule.lc_intervals(&self.problem)?)
     }
 
     fn new(

@@ -232,6 +232,39 @@ impl Schedule {
             .collect()
     }
 
+    /// Every robot's low-confidence intervals in global time (s) as the robot runs them: from
+    /// its [`Schedule::legs`], each leg after its planned dwell, with reference samples counted
+    /// from the task start (a leg counts from its hold). Without holds these are the
+    /// intervals of [`GlobalTimeline::lc_intervals`], bit for bit.
+    ///
+    /// # Errors
+    /// As [`Schedule::legs`].
+    pub fn lc_intervals(&self, problem: &Problem) -> Result<Vec<Vec<LcInterval>>> {
+        let legs = self.legs(problem)?;
+        Ok(legs
+            .iter()
+            .enumerate()
+            .map(|(robot, legs)| {
+                let from = std::iter::once(0).chain(
+                    self.holds_of(robot)
+                        .iter()
+                        .map(|h| h.ref_idx)
+                        .filter(|&n| n > 0),
+                );
+                legs.iter()
+                    .zip(from)
+                    .flat_map(|(leg, from)| {
+                        leg.lc_intervals().iter().map(move |iv| LcInterval {
+                            ref_start: iv.ref_start + from,
+                            ref_end: iv.ref_end + from,
+                            ..*iv
+                        })
+                    })
+                    .collect()
+            })
+            .collect())
+    }
+
     /// Checks this schedule on `problem` ([`validate`](crate::validate): every constraint of
     /// Eq. 20, with this build's margin check of Alg. 2 at [`Schedule::tick_s`]) and, if it
     /// passes, returns it as a [`CheckedSchedule`](crate::CheckedSchedule), the only form

@@ -8,7 +8,6 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use tandem_lfd::TaskModel;
 use tandem_planner::{Planner, derive_seed};
-use tandem_schedule::GlobalTimeline;
 
 use super::config::StudyConfig;
 use super::inputs::StudyInputs;
@@ -66,9 +65,9 @@ fn iteration_record(
     tally: &OperatorTally,
 ) -> Result<IterationRecord> {
     let schedule = planner.schedule();
-    let timeline = GlobalTimeline::new(planner.problem(), schedule)?;
-    let lc_intervals_s = timeline
-        .lc_intervals()
+    // As the robots run it: after a hold, a robot's intervals come after its planned dwell.
+    let lc = schedule.lc_intervals(planner.problem())?;
+    let lc_intervals_s = lc
         .iter()
         .map(|v| v.iter().map(|i| [i.start_s, i.end_s]).collect())
         .collect();
@@ -88,7 +87,7 @@ fn iteration_record(
         throughput_per_h: throughput_per_h(n_robots, outcome.t_total_s),
         offsets_s: schedule.offsets_s.clone(),
         falsely_trusted_samples: falsely_trusted(planner.confidence().conf(), labels),
-        lc_runs: timeline.lc_intervals().iter().map(|v| v.len()).collect(),
+        lc_runs: lc.iter().map(Vec::len).collect(),
         error_rates: planner.error_rates()?,
         simulated_rates: (planner.rounds_recorded() > 0).then(|| tally.rates()),
     })
