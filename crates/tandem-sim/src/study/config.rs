@@ -219,13 +219,24 @@ mod tests {
         assert_eq!(nested.planner.sampler.p_fastest, 0.5);
         assert_eq!(nested.planner.confidence.gamma_c, 0.9);
         assert!(toml::from_str::<StudyConfig>("[planner.sampler]\nbogus = 1\n").is_err());
-        // The committed configuration is the paper's study.
+        // The committed configuration is the paper's study with the sanding task's hold
+        // points (the tool off between passes) declared; nothing else differs from the default.
         let committed = std::fs::read_to_string(concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../fixtures/study.toml"
         ))
         .unwrap();
-        let c: StudyConfig = toml::from_str(&committed).unwrap();
+        let mut c: StudyConfig = toml::from_str(&committed).unwrap();
+        let rules: Vec<String> = c
+            .planner
+            .holds
+            .rules
+            .iter()
+            .map(|r| r.to_string())
+            .collect();
+        assert_eq!(rules, ["tool<0.5"]);
+        assert!(c.planner.holds.at_s.is_empty());
+        c.planner.holds = Default::default();
         assert_eq!(c, StudyConfig::default());
     }
 }
