@@ -315,7 +315,7 @@ fn schedule_doc(planner: &Planner, round: usize, start_ns: i64, ticks: usize) ->
     let tl = GlobalTimeline::new(problem, s)?;
     let mut intervals = Vec::new();
     for (robot, ivs) in tl.lc_intervals().iter().enumerate() {
-        for iv in *ivs {
+        for iv in ivs {
             intervals.push(json!({
                 "robot": robot + 1,
                 "ref_start": iv.ref_start,

@@ -235,34 +235,42 @@ impl Schedule {
     /// Every robot's low-confidence intervals in global time (s) as the robot runs them: from
     /// its [`Schedule::legs`], each leg after its planned dwell, with reference samples counted
     /// from the task start (a leg counts from its hold). Without holds these are the
-    /// intervals of [`GlobalTimeline::lc_intervals`], bit for bit.
+    /// intervals of each robot's [`Timeline`], bit for bit. The same as
+    /// [`GlobalTimeline::lc_intervals`].
     ///
     /// # Errors
     /// As [`Schedule::legs`].
     pub fn lc_intervals(&self, problem: &Problem) -> Result<Vec<Vec<LcInterval>>> {
-        let legs = self.legs(problem)?;
-        Ok(legs
+        Ok(GlobalTimeline::new(problem, self)?.lc_intervals())
+    }
+
+    /// Robot `robot`'s legs ([`holds::legs`]) with the reference sample each starts at (0,
+    /// then each hold's); `None` when the schedule plans no dwell, so that the legs run
+    /// exactly as the robot's timeline (a hold lies on high-confidence samples, so no
+    /// low-confidence interval is ever cut at one).
+    fn legs_from(
+        &self,
+        timelines: &[Timeline],
+    ) -> std::result::Result<Option<Vec<Vec<Leg>>>, (usize, tandem_realtime::Error)> {
+        if !self.holds.iter().flatten().any(|h| h.dwell_s > 0.0) {
+            return Ok(None);
+        }
+        timelines
             .iter()
             .enumerate()
-            .map(|(robot, legs)| {
-                let from = std::iter::once(0).chain(
-                    self.holds_of(robot)
-                        .iter()
-                        .map(|h| h.ref_idx)
-                        .filter(|&n| n > 0),
-                );
-                legs.iter()
+            .map(|(robot, tl)| {
+                let holds = self.holds_of(robot);
+                let from =
+                    std::iter::once(0).chain(holds.iter().map(|h| h.ref_idx).filter(|&n| n > 0));
+                Ok(holds::legs(tl, holds)
+                    .map_err(|e| (robot, e))?
+                    .into_iter()
                     .zip(from)
-                    .flat_map(|(leg, from)| {
-                        leg.lc_intervals().iter().map(move |iv| LcInterval {
-                            ref_start: iv.ref_start + from,
-                            ref_end: iv.ref_end + from,
-                            ..*iv
-                        })
-                    })
-                    .collect()
+                    .map(|(tl, from)| Leg { from, tl })
+                    .collect())
             })
-            .collect())
+            .collect::<std::result::Result<Vec<_>, _>>()
+            .map(Some)
     }
 
     /// Checks this schedule on `problem` ([`validate`](crate::validate): every constraint of
@@ -322,20 +330,35 @@ impl Schedule {
     }
 }
 
-/// The global timeline of a schedule (Eq. 15–16, 19): a view of every robot's [`Timeline`]
-/// (built once by [`Schedule::timelines`]) that says where each robot is in the reference at
-/// any global time, its confidence then, and every low-confidence interval in global time.
+/// The global timeline of a schedule (Eq. 15–16, 19): where each robot is in the reference
+/// at any global time, its confidence then, and every low-confidence interval in global time,
+/// as the robots run the schedule: with planned dwells at hold points, each robot's plan is
+/// its legs ([`Schedule::legs`]), each starting after its dwell, and a robot dwelling at a
+/// hold stays at the hold's reference sample (high confidence).
 ///
 /// Reference sample `n` of robot `i` occupies global time `[c_n, c_{n+1})` of its clock
-/// ([`tandem_realtime::clock_s`], started at `τ_i`).
+/// ([`tandem_realtime::clock_s`], started at `τ_i`, and after a hold at the end of its dwell).
 #[derive(Clone, Debug)]
 pub struct GlobalTimeline {
+    /// Every robot's plan as one timeline without the dwells (the margin check's input).
     robots: Vec<Timeline>,
+    /// With planned dwells, every robot's legs as run; `None` without dwells (the legs are
+    /// then `robots` themselves).
+    legs: Option<Vec<Vec<Leg>>>,
+}
+
+/// One leg of a robot's plan: its timeline (reference samples counted from the leg's first)
+/// and the reference sample of the task it starts at.
+#[derive(Clone, Debug)]
+struct Leg {
+    from: usize,
+    tl: Timeline,
 }
 
 impl From<Vec<Timeline>> for GlobalTimeline {
+    /// The timelines as robots without dwells.
     fn from(robots: Vec<Timeline>) -> Self {
-        GlobalTimeline { robots }
+        GlobalTimeline { robots, legs: None }
     }
 }
 
@@ -363,14 +386,27 @@ impl LcOverlap {
 }
 
 impl GlobalTimeline {
-    /// Lays `schedule` out in global time for `problem` ([`Schedule::timelines`]).
+    /// Lays `schedule` out in global time for `problem` ([`Schedule::timelines`], split into
+    /// [`Schedule::legs`] when it plans dwells).
     ///
     /// # Errors
     /// As [`Schedule::timelines`]: a schedule of the wrong shape, or [`Error::Timeline`]
     /// naming the robot whose warp has the wrong length, a non-finite value, or a gradient
     /// outside its bounds.
     pub fn new(problem: &Problem, schedule: &Schedule) -> Result<Self> {
-        Ok(schedule.timelines(problem)?.into())
+        schedule.check_shape().map_err(Error::Shape)?;
+        Self::of(problem, schedule).map_err(|(robot, source)| Error::Timeline { robot, source })
+    }
+
+    /// [`GlobalTimeline::new`] of a schedule of valid shape, with the failing robot's index
+    /// beside the realtime error.
+    pub(crate) fn of(
+        problem: &Problem,
+        schedule: &Schedule,
+    ) -> std::result::Result<Self, (usize, tandem_realtime::Error)> {
+        let robots = schedule.timelines_of(problem)?;
+        let legs = schedule.legs_from(&robots)?;
+        Ok(GlobalTimeline { robots, legs })
     }
 
     /// Number of robots `N`.
@@ -378,7 +414,9 @@ impl GlobalTimeline {
         self.robots.len()
     }
 
-    /// Every robot's timeline (robot 1 first).
+    /// Every robot's plan as one timeline (robot 1 first), *without* the planned dwells: the
+    /// input of the margin check, which adds the dwells itself (`tandem_realtime::holds`).
+    /// Without dwells it is exactly how the robots run.
     pub fn timelines(&self) -> &[Timeline] {
         &self.robots
     }
@@ -388,40 +426,82 @@ impl GlobalTimeline {
         self.robots
     }
 
-    /// Each robot's `[start, end]` in global time (s).
+    /// Robot `robot`'s legs as run, each with the reference sample it starts at.
+    fn legs_of(&self, robot: usize) -> impl Iterator<Item = (usize, &Timeline)> + '_ {
+        let (one, many) = match &self.legs {
+            None => (Some((0, &self.robots[robot])), None),
+            Some(legs) => (None, Some(legs[robot].iter().map(|l| (l.from, &l.tl)))),
+        };
+        one.into_iter().chain(many.into_iter().flatten())
+    }
+
+    /// The leg of robot `robot` that is current at global time `t_global_s`: the last one
+    /// that has started, or the first before the robot starts.
+    fn leg_at(&self, robot: usize, t_global_s: f64) -> (usize, &Timeline) {
+        let mut legs = self.legs_of(robot);
+        let mut cur = legs.next().expect("a robot has at least one leg");
+        for leg in legs {
+            if leg.1.start_s() > t_global_s {
+                break;
+            }
+            cur = leg;
+        }
+        cur
+    }
+
+    /// Each robot's `[start, end]` in global time (s), dwells included.
     pub fn spans_s(&self) -> Vec<(f64, f64)> {
-        self.robots
-            .iter()
-            .map(|r| (r.start_s(), r.end_s()))
+        (0..self.robots.len())
+            .map(|i| {
+                let start = self.robots[i].start_s();
+                let end = self.legs_of(i).last().map_or(start, |(_, l)| l.end_s());
+                (start, end)
+            })
             .collect()
     }
 
-    /// `T_total` (Eq. 13), global time (s): the latest end.
+    /// `T_total` (Eq. 13), global time (s): the latest end, dwells included.
     pub fn t_total_s(&self) -> f64 {
-        self.robots
+        self.spans_s()
             .iter()
-            .map(Timeline::end_s)
+            .map(|&(_, end)| end)
             .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// Eq. 15: robot `robot`'s fractional reference time (reference samples, in `[0, T_ref]`)
     /// at global time `t_global_s`: 0 before its start, `T_ref` after its end, linear within
-    /// each reference sample in between. `robot ≥ N` is treated as the last robot.
+    /// each reference sample in between, and a hold's sample while the robot dwells there.
+    /// `robot ≥ N` is treated as the last robot.
     pub fn ref_time(&self, robot: usize, t_global_s: f64) -> f64 {
-        self.robots[robot.min(self.robots.len() - 1)].ref_time_at(t_global_s)
+        let (from, leg) = self.leg_at(robot.min(self.robots.len() - 1), t_global_s);
+        from as f64 + leg.ref_time_at(t_global_s)
     }
 
     /// Eq. 16: `conf_i(t)` of every robot at global time `t_global_s` (`true` = high
-    /// confidence; a robot that is not running, `t < τ_i` or `t ≥ τ_i + |ψ_Ei|`, counts as
-    /// high).
+    /// confidence; a robot that is not running, `t < τ_i` or `t ≥ τ_i + |ψ_Ei|`, or that
+    /// dwells at a hold, counts as high).
     pub fn conf_at(&self, t_global_s: f64) -> Vec<bool> {
-        self.robots.iter().map(|r| r.conf_at(t_global_s)).collect()
+        (0..self.robots.len())
+            .map(|i| self.leg_at(i, t_global_s).1.conf_at(t_global_s))
+            .collect()
     }
 
     /// Each robot's low-confidence intervals in global time, in time order (Eq. 19: their
-    /// union is `T_lc`).
-    pub fn lc_intervals(&self) -> Vec<&[LcInterval]> {
-        self.robots.iter().map(Timeline::lc_intervals).collect()
+    /// union is `T_lc`), reference samples counted from the task start.
+    pub fn lc_intervals(&self) -> Vec<Vec<LcInterval>> {
+        (0..self.robots.len())
+            .map(|i| {
+                self.legs_of(i)
+                    .flat_map(|(from, leg)| {
+                        leg.lc_intervals().iter().map(move |iv| LcInterval {
+                            ref_start: iv.ref_start + from,
+                            ref_end: iv.ref_end + from,
+                            ..*iv
+                        })
+                    })
+                    .collect()
+            })
+            .collect()
     }
 
     /// The first stretch of global time in which two robots are scheduled low-confidence
@@ -433,15 +513,17 @@ impl GlobalTimeline {
     /// treated as rounding and ignored.
     pub fn first_lc_overlap(&self) -> Option<LcOverlap> {
         let eps = tol::overlap_tolerance_s(self.t_total_s());
+        let owned;
+        let intervals: Vec<&[LcInterval]> = if self.legs.is_some() {
+            owned = self.lc_intervals();
+            owned.iter().map(Vec::as_slice).collect()
+        } else {
+            self.robots.iter().map(Timeline::lc_intervals).collect()
+        };
         let mut first: Option<LcOverlap> = None;
-        for i in 0..self.robots.len() {
-            for j in i + 1..self.robots.len() {
-                let found = first_overlap_of(
-                    self.robots[i].lc_intervals(),
-                    self.robots[j].lc_intervals(),
-                    eps,
-                );
-                if let Some((a, b)) = found {
+        for i in 0..intervals.len() {
+            for j in i + 1..intervals.len() {
+                if let Some((a, b)) = first_overlap_of(intervals[i], intervals[j], eps) {
                     let o = LcOverlap {
                         robots: [i, j],
                         intervals: [a, b],
@@ -538,7 +620,8 @@ mod tests {
         // Robot 1: sample 0 takes 1 s, LC samples 1..3 take 0.5 s each → [1, 2).
         // Robot 2 (τ = 1.25): sample 0 takes 0.25 s → LC [1.5, 2.5).
         let g = GlobalTimeline::new(&problem(), &schedule(1.25)).unwrap();
-        let [a, b] = g.lc_intervals()[..] else {
+        let ivs = g.lc_intervals();
+        let [a, b] = &ivs[..] else {
             panic!("two robots")
         };
         assert_eq!((a[0].start_s, a[0].end_s), (1.0, 2.0));
@@ -681,5 +764,81 @@ mod tests {
             s.check(&problem()),
             Err(Error::Invalid(Violation::InvalidTick { .. }))
         ));
+    }
+
+    /// [HC, HC, LC, HC], gradients 1 in [0.5, 2], dt = 0.5 s, a hold point at sample 1.
+    fn held_problem() -> Problem {
+        Problem::new(
+            vec![true, true, false, true],
+            vec![1.0; 4],
+            vec![0.5; 4],
+            vec![2.0; 4],
+            0.5,
+        )
+        .unwrap()
+        .with_holds(vec![1])
+        .unwrap()
+    }
+
+    /// Robot 1 dwells `dwell_s` at sample 1; robot 2 starts with it and never dwells.
+    fn held_schedule(dwell_s: f64) -> Schedule {
+        Schedule {
+            grad_exec: vec![vec![1.0; 4], vec![1.0; 4]],
+            offsets_s: vec![0.0],
+            tick_s: 0.5,
+            holds: vec![
+                vec![Hold {
+                    ref_idx: 1,
+                    dwell_s,
+                    after: Vec::new(),
+                }],
+                Vec::new(),
+            ],
+        }
+    }
+
+    #[test]
+    fn the_global_timeline_runs_the_planned_dwells() {
+        // Robot 1: sample 0 in [0, 0.5), the dwell at sample 1 in [0.5, 1.5), sample 1 in
+        // [1.5, 2), its LC sample 2 in [2, 2.5), sample 3 in [2.5, 3). Robot 2: LC in [1, 1.5).
+        let (p, s) = (held_problem(), held_schedule(1.0));
+        let g = GlobalTimeline::new(&p, &s).unwrap();
+        assert_eq!(g.spans_s(), [(0.0, 3.0), (0.0, 2.0)]);
+        assert_eq!(g.t_total_s(), 3.0);
+        assert_eq!(g.t_total_s(), s.t_total_s(0.5));
+        assert_eq!(g.spans_s()[0].1, s.ends_s(0.5)[0]);
+        // Eq. 15 while dwelling: the hold's sample; after it, one sample per 0.5 s again.
+        for (t, r) in [
+            (0.25, 0.5),
+            (0.5, 1.0),
+            (1.0, 1.0),
+            (1.75, 1.5),
+            (2.25, 2.5),
+        ] {
+            assert_eq!(g.ref_time(0, t), r, "robot 1 at {t} s");
+        }
+        assert_eq!(g.ref_time(0, 10.0), 4.0);
+        assert_eq!(g.ref_time(1, 1.25), 2.5);
+        // Eq. 16: dwelling counts as high confidence; robot 1 is low in [2, 2.5).
+        assert_eq!(g.conf_at(1.25), [true, false]);
+        assert_eq!(g.conf_at(2.25), [false, true]);
+        // Eq. 19: robot 1's interval after its dwell, counted from the task start.
+        let ivs = g.lc_intervals();
+        assert_eq!(
+            (ivs[0].len(), ivs[0][0].ref_start, ivs[0][0].ref_end),
+            (1, 2, 3)
+        );
+        assert_eq!((ivs[0][0].start_s, ivs[0][0].end_s), (2.0, 2.5));
+        assert_eq!((ivs[1][0].start_s, ivs[1][0].end_s), (1.0, 1.5));
+        assert_eq!(s.lc_intervals(&p).unwrap(), ivs);
+        // The dwell moves robot 1's region out of robot 2's: no overlap; without it, one.
+        assert_eq!(g.first_lc_overlap(), None);
+        let o = GlobalTimeline::new(&p, &held_schedule(0.0))
+            .unwrap()
+            .first_lc_overlap()
+            .unwrap();
+        assert_eq!((o.robots, o.start_s(), o.end_s()), ([0, 1], 1.0, 1.5));
+        // The margin check's input stays the plan without the dwells.
+        assert_eq!(g.timelines()[0].end_s(), 2.0);
     }
 }

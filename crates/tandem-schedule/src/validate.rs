@@ -279,35 +279,11 @@ pub(crate) fn validate_cheap(
         }
         latest_end_s = latest_end_s.max(schedule.end_s(robot, dt_s));
     }
-    let timeline: GlobalTimeline = schedule
-        .timelines_of(problem)
-        .map_err(|(robot, source)| Violation::Timeline { robot, source })?
-        .into();
+    let timeline = GlobalTimeline::of(problem, schedule)
+        .map_err(|(robot, source)| Violation::Timeline { robot, source })?;
     check_holds(problem, schedule, &timeline)?;
-    // With planned dwells the robots' later regions move: constraint 3 on their legs (a
-    // robot's legs never overlap one another in time).
-    let dwelling = schedule.holds.iter().flatten().any(|h| h.dwell_s > 0.0);
-    let overlap = if dwelling {
-        let mut robot_of = Vec::new();
-        let mut all = Vec::new();
-        for (robot, tl) in timeline.timelines().iter().enumerate() {
-            let legs = tandem_realtime::holds::legs(tl, schedule.holds_of(robot))
-                .map_err(|source| Violation::Timeline { robot, source })?;
-            robot_of.extend(std::iter::repeat_n(robot, legs.len()));
-            all.extend(legs);
-        }
-        GlobalTimeline::from(all).first_lc_overlap().map(|mut o| {
-            o.robots = o.robots.map(|l| robot_of[l]);
-            if o.robots[0] > o.robots[1] {
-                o.robots.swap(0, 1);
-                o.intervals.swap(0, 1);
-            }
-            o
-        })
-    } else {
-        timeline.first_lc_overlap()
-    };
-    if let Some(o) = overlap {
+    // With planned dwells the robots' later regions move: the timeline lays out their legs.
+    if let Some(o) = timeline.first_lc_overlap() {
         let [a, b] = o.intervals;
         return Err(Violation::BothLowConfidence {
             robots: o.robots,
