@@ -53,6 +53,7 @@
 
 mod checked;
 mod choose;
+pub mod cyclic;
 mod error;
 pub mod exact;
 mod problem;
@@ -63,6 +64,10 @@ mod validate;
 pub use checked::CheckedSchedule;
 pub use choose::{
     Outcome, Source, sample_schedule, sample_schedule_n, sample_schedule_with_baselines,
+};
+pub use cyclic::{
+    CycleRatio, CyclicParams, CyclicPlan, Stretch, cyclic_plan, cyclic_plan_for_order,
+    max_cycle_ratio, period_lower_bound_s,
 };
 pub use error::{Error, Result};
 pub use exact::{
