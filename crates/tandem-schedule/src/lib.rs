@@ -15,7 +15,9 @@
 //! and the gap to it. A schedule carries the control tick it was checked at
 //! ([`Schedule::tick_s`]); [`Schedule::check`] re-checks it on its problem and the
 //! [`CheckedSchedule`] it returns is the only form the runtime coordinator is built from, at
-//! that tick.
+//! that tick. For a continuous cell (robots repeating the task, no rounds), [`cyclic`] gives
+//! the repeated plan of one operator order, its exact least period ([`max_cycle_ratio`]),
+//! the order search ([`cyclic_plan`]) and the period's lower bound.
 //!
 //! ```
 //! use tandem_schedule::{

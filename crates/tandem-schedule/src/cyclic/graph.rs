@@ -199,8 +199,16 @@ pub(crate) fn check_order(order: &[Stretch], n_robots: usize, m: usize) -> Resul
 /// [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS` or an order that does not
 /// list every stretch once with each robot's stretches in task order around the cycle.
 pub fn event_graph(problem: &Problem, n_robots: usize, order: &[Stretch]) -> Result<EventGraph> {
+    graph_of_shape(TaskShape::new(problem), n_robots, order)
+}
+
+/// [`event_graph`] of a task shape already cut from its problem.
+pub(crate) fn graph_of_shape(
+    shape: TaskShape,
+    n_robots: usize,
+    order: &[Stretch],
+) -> Result<EventGraph> {
     check_robot_count(n_robots)?;
-    let shape = TaskShape::new(problem);
     let m = shape.n_lc();
     check_order(order, n_robots, m)?;
     let per = m + 1;

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::graph::{EventGraph, Stretch, TaskShape, event_graph};
+use super::graph::{EventGraph, Stretch, TaskShape, event_graph, graph_of_shape};
 use super::ratio::max_cycle_ratio;
 use crate::problem::check_robot_count;
 use crate::{Problem, Result};
@@ -122,11 +122,11 @@ pub fn cyclic_plan_for_order(
 
 /// The period of one order, or `None` if no period admits it (for the search).
 pub(crate) fn period_of(
-    problem: &Problem,
+    shape: &TaskShape,
     n_robots: usize,
     order: &[Stretch],
 ) -> Result<Option<f64>> {
-    let graph = event_graph(problem, n_robots, order)?;
+    let graph = graph_of_shape(shape.clone(), n_robots, order)?;
     match max_cycle_ratio(graph.events.len(), &graph.arcs) {
         Ok(r) => Ok(Some(r.period_s)),
         Err(crate::Error::InfeasibleCycle { .. }) => Ok(None),

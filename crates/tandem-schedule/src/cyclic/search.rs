@@ -105,13 +105,14 @@ pub fn cyclic_plan(
 ) -> Result<CyclicPlan> {
     params.validate()?;
     check_robot_count(n_robots)?;
-    let m = TaskShape::new(problem).n_lc();
+    let shape = TaskShape::new(problem);
+    let m = shape.n_lc();
     let count = order_count(n_robots, m);
     let (order, evaluated, exhaustive) = if count <= params.max_enumerated {
-        let (order, evaluated) = enumerate(problem, n_robots, m)?;
+        let (order, evaluated) = enumerate(&shape, n_robots, m)?;
         (order, evaluated, true)
     } else {
-        let (order, evaluated) = local_search(problem, n_robots, m, params)?;
+        let (order, evaluated) = local_search(&shape, n_robots, m, params)?;
         (order, evaluated, false)
     };
     let mut plan = cyclic_plan_for_order(problem, n_robots, &order)?;
@@ -135,7 +136,7 @@ fn better(p: Option<f64>, best: Option<f64>) -> bool {
     }
 }
 
-fn enumerate(problem: &Problem, n_robots: usize, m: usize) -> Result<(Vec<Stretch>, usize)> {
+fn enumerate(shape: &TaskShape, n_robots: usize, m: usize) -> Result<(Vec<Stretch>, usize)> {
     if m == 0 {
         return Ok((Vec::new(), 1));
     }
@@ -181,7 +182,7 @@ fn enumerate(problem: &Problem, n_robots: usize, m: usize) -> Result<(Vec<Stretc
                 seen[r] += 1;
             }
             evaluated += 1;
-            let p = period_of(problem, n_robots, &order)?;
+            let p = period_of(shape, n_robots, &order)?;
             if better(p, best.0) {
                 best = (p, order.clone());
             }
@@ -206,7 +207,7 @@ fn enumerate(problem: &Problem, n_robots: usize, m: usize) -> Result<(Vec<Stretc
 }
 
 fn local_search(
-    problem: &Problem,
+    shape: &TaskShape,
     n_robots: usize,
     m: usize,
     params: &CyclicParams,
@@ -226,7 +227,7 @@ fn local_search(
     let mut best: (Option<f64>, Vec<Stretch>) = (None, serial(n_robots, m));
     for seed in [round_robin, staggered, serial(n_robots, m)] {
         let mut cur = seed;
-        let mut p = period_of(problem, n_robots, &cur)?;
+        let mut p = period_of(shape, n_robots, &cur)?;
         evaluated += 1;
         let len = cur.len();
         for _ in 0..params.max_swap_passes {
@@ -237,7 +238,7 @@ fn local_search(
                     continue;
                 }
                 cur.swap(q, q2);
-                let pq = period_of(problem, n_robots, &cur)?;
+                let pq = period_of(shape, n_robots, &cur)?;
                 evaluated += 1;
                 cur.swap(q, q2);
                 if better(pq, step.map_or(p, |s| s.1)) {
