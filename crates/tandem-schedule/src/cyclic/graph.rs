@@ -98,6 +98,22 @@ impl TaskShape {
         self.lc_s.iter().sum()
     }
 
+    /// `I` (s): the operator's forced idle time per task — the sum of the fastest durations
+    /// of the gaps between two stretches that have no hold and are shorter, even at their
+    /// slowest (`Σψ̇max·Δt_s`), than the shortest stretch: no stretch of another robot fits
+    /// in such a gap, so the operator supervises nothing during it
+    /// ([`crate::cyclic::period_lower_bound_s`]).
+    #[must_use]
+    pub fn idle_s(&self) -> f64 {
+        let shortest = self.lc_s.iter().copied().fold(f64::INFINITY, f64::min);
+        let m = self.n_lc();
+        (1..m)
+            .map(|k| self.gaps[k])
+            .filter(|g| g.hold.is_none() && g.max_s < shortest)
+            .map(|g| g.min_s)
+            .sum()
+    }
+
     /// `D_min` (s): the fastest task (every high-confidence sample at `ψ̇min`, low-confidence
     /// ones at `ψ̇̄`), summed as the robot's cycle in the event graph sums it.
     #[must_use]

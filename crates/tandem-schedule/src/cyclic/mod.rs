@@ -34,9 +34,9 @@
 //! `a`'s next task against robot `b`'s current one, across cycle boundaries — is not part of
 //! this module yet, nor a continuous coordinator.
 //!
-//! **The certificate.** [`period_lower_bound_s`] `= max(N·L, D_min)` holds for every order
-//! (the operator's and every robot's cycle are in every order's graph); the plan reports its
-//! gap to it.
+//! **The certificate.** [`period_lower_bound_s`] `= max(N·(L + I), D_min)` holds for every
+//! order: the operator's load `N·L`, its forced idle time `N·I` in gaps without hold too
+//! short for any stretch, and a robot's fastest task `D_min`; the plan reports its gap to it.
 //!
 //! ```
 //! use tandem_schedule::{Problem, cyclic_plan, CyclicParams};

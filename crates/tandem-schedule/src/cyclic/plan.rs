@@ -75,15 +75,29 @@ pub struct GapPlan {
 }
 
 /// A lower bound (s) on the period of every 1-periodic plan of `n_robots` robots on `problem`,
-/// whatever the operator order: `max(N·L, D_min)`.
+/// whatever the operator order: `max(N·(L + I), D_min)` ([`TaskShape::lc_total_s`],
+/// [`TaskShape::idle_s`], [`TaskShape::fastest_s`]). Divided by `k` it also bounds the period
+/// per task and robot of a plan with `k` tasks per robot per period.
 ///
-/// **Why.** In one period the operator supervises every robot's every low-confidence stretch
-/// once, each for its fixed duration at `ψ̇̄`, one at a time: `P ≥ N·L` (the operator's cycle
-/// of the event graph has weight `N·L` and one token). Each robot does one task per period and
-/// starts its next only after the last one's end; a task takes at least `D_min` (every
-/// high-confidence sample at `ψ̇min`, low-confidence ones at `ψ̇̄`): `P ≥ D_min` (the robot's
-/// cycle has weight `D_min` and one token). Both are cycles of every order's event graph, so
-/// the least period of every order is at least their ratios.
+/// **Why.**
+/// 1. In one period the operator supervises every robot's every low-confidence stretch once,
+///    each for its fixed duration at `ψ̇̄`, one at a time: `N·L` seconds.
+/// 2. Let `G = (g₁, g₂)` be a gap of robot `r` between two of its stretches, without a hold
+///    and lasting at most `Σψ̇max·Δt_s < L_min` (the shortest stretch). No stretch of another
+///    robot meets `G`: one that crossed `g₁` or `g₂` would overlap `r`'s stretch ending at
+///    `g₁` or starting at `g₂`, and one inside `G` would be shorter than `L_min`. So the
+///    operator is idle during `G`, for at least its fastest duration. Two such gaps of
+///    different robots are disjoint: if `g₁ ≤ h₁ < g₂` for another's gap `(h₁, h₂)`, that
+///    robot's stretch ending at `h₁` meets `G` (or, when `h₁ = g₁`, overlaps `r`'s stretch
+///    ending at the same instant). So the operator is idle at least `N·I` per period, and
+///    busy `N·L`: `P ≥ N·(L + I)`. (The head and the tail are not counted: a robot may wait
+///    at its task start instead.)
+/// 3. Each robot does one task per period and starts its next only after the last one's
+///    end; a task takes at least `D_min` (every high-confidence sample at `ψ̇min`,
+///    low-confidence ones at `ψ̇̄`): `P ≥ D_min` (the robot's cycle of the event graph).
+///
+/// None of these uses the order, so they bound every order, and they count per task, so
+/// they bound plans with more tasks per robot per period as well.
 ///
 /// # Errors
 /// [`crate::Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS`.
@@ -93,7 +107,7 @@ pub fn period_lower_bound_s(problem: &Problem, n_robots: usize) -> Result<f64> {
 }
 
 pub(crate) fn bound_of(shape: &TaskShape, n_robots: usize) -> f64 {
-    (n_robots as f64 * shape.lc_total_s()).max(shape.fastest_s())
+    (n_robots as f64 * (shape.lc_total_s() + shape.idle_s())).max(shape.fastest_s())
 }
 
 /// The cyclic plan of `n_robots` robots on `problem` with the operator's cyclic order `order`
