@@ -80,7 +80,10 @@ const REL_TOL: f64 = 1e-12;
 ///   infeasible): the period is not bounded below;
 /// - [`Error::InfeasibleCycle`] with a cycle that no period satisfies: `Σh = 0` and `Σw > 0`
 ///   (e.g. contradictory exact durations), or `Σh < 0` with a ratio below that of a cycle with
-///   tokens (maximum lags that the least period already breaks).
+///   tokens (maximum lags that the least period already breaks);
+/// - [`Error::BadArc`] naming arc 0 if the longest paths do not settle within `2n + 2`
+///   passes without a cycle in the predecessor graph, which only rounding of weights many
+///   orders of magnitude apart can cause.
 pub fn max_cycle_ratio(n_nodes: usize, arcs: &[Arc]) -> Result<CycleRatio> {
     for (i, a) in arcs.iter().enumerate() {
         if a.from >= n_nodes || a.to >= n_nodes {
