@@ -93,6 +93,31 @@ pub enum Error {
         /// The schedule's `T_total` (s, Eq. 13).
         t_total_s: f64,
     },
+    /// An arc of an event graph names a node that does not exist or has a non-finite weight
+    /// ([`crate::max_cycle_ratio`]).
+    #[error("arc {arc} {why}")]
+    BadArc {
+        /// Index of the arc.
+        arc: usize,
+        /// What is wrong with it.
+        why: &'static str,
+    },
+    /// No cycle of the event graph carries tokens, so no period is bounded below
+    /// ([`crate::max_cycle_ratio`]).
+    #[error("no cycle of the event graph carries a token: the period is not bounded below")]
+    NoTokenCycle,
+    /// No period satisfies the event graph: a cycle with `Σh = 0` tokens and weight `Σw > 0`
+    /// (e.g. contradictory exact durations), or with `Σh < 0` (maximum lags across period
+    /// boundaries) whose bound lies below the least period ([`crate::max_cycle_ratio`]).
+    #[error("no period is feasible: a cycle of {tokens} tokens and weight {weight_s} s ({arcs:?})")]
+    InfeasibleCycle {
+        /// The cycle's arcs (indices, in traversal order).
+        arcs: Vec<usize>,
+        /// Its weight `Σw` (s).
+        weight_s: f64,
+        /// Its tokens `Σh`.
+        tokens: i64,
+    },
     /// The realtime crate (coordinator, margin check) rejected its input.
     #[error(transparent)]
     Realtime(#[from] tandem_realtime::Error),

@@ -15,7 +15,9 @@
 //! and the gap to it. A schedule carries the control tick it was checked at
 //! ([`Schedule::tick_s`]); [`Schedule::check`] re-checks it on its problem and the
 //! [`CheckedSchedule`] it returns is the only form the runtime coordinator is built from, at
-//! that tick.
+//! that tick. For a continuous cell (robots repeating the task, no rounds), [`cyclic`] gives
+//! the repeated plan of one operator order, its exact least period ([`max_cycle_ratio`]),
+//! the order search ([`cyclic_plan`]) and the period's lower bound.
 //!
 //! ```
 //! use tandem_schedule::{
@@ -53,6 +55,7 @@
 
 mod checked;
 mod choose;
+pub mod cyclic;
 mod error;
 pub mod exact;
 mod problem;
@@ -63,6 +66,10 @@ mod validate;
 pub use checked::CheckedSchedule;
 pub use choose::{
     Outcome, Source, sample_schedule, sample_schedule_n, sample_schedule_with_baselines,
+};
+pub use cyclic::{
+    CycleRatio, CyclicParams, CyclicPlan, Stretch, cyclic_plan, cyclic_plan_for_order,
+    max_cycle_ratio, period_lower_bound_s,
 };
 pub use error::{Error, Result};
 pub use exact::{

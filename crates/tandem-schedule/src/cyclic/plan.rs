@@ -1,0 +1,224 @@
+//! The cyclic plan of one operator order: the event graph's least period laid out per robot.
+
+use serde::{Deserialize, Serialize};
+
+use super::graph::{EventGraph, Stretch, TaskShape, event_graph, graph_of_shape};
+use super::ratio::max_cycle_ratio;
+use crate::problem::check_robot_count;
+use crate::{Problem, Result};
+
+/// A repeated (1-periodic) plan of `N` robots repeating one task with one operator (module
+/// docs of [`crate::cyclic`]): every period of `period_s` seconds each robot does one task and
+/// the operator supervises the `N·m` low-confidence stretches once each, in `order`.
+///
+/// Times are schedule-clock seconds. The period assumes that the operator follows `ψ̇̄` on
+/// low-confidence stretches and that the robots run at their planned rates; it is not yet
+/// checked against correction drift across cycle boundaries (no margin check here).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CyclicPlan {
+    /// Number of robots `N` (`1..=MAX_ROBOTS`).
+    pub n_robots: usize,
+    /// The operator's cyclic order of low-confidence stretches within one period (empty for a
+    /// task without low confidence).
+    pub order: Vec<Stretch>,
+    /// The least period `P` (s) of this order: `N` tasks per period.
+    pub period_s: f64,
+    /// Duration (s) of each low-confidence stretch at `ψ̇̄`, by stretch index.
+    pub lc_s: Vec<f64>,
+    /// Per robot, the task that starts in period 0 (it repeats every `period_s`).
+    pub robots: Vec<RobotCycle>,
+    /// Throughput (tasks per hour): `3600·N/P`.
+    pub tasks_per_hour: f64,
+    /// The operator's busy share: `N·L/P` in `[0, 1]`, `L` the task's total low-confidence
+    /// duration at `ψ̇̄`.
+    pub operator_share: f64,
+    /// A lower bound (s) on the period of every 1-periodic plan of `N` robots, whatever the
+    /// order: [`period_lower_bound_s`].
+    pub lower_bound_s: f64,
+    /// `period_s / lower_bound_s − 1` (0 when the plan is at the bound, up to rounding).
+    pub gap: f64,
+    /// Whether `order` is the best of all orders (the search enumerated every order), so
+    /// `period_s` is the least period of every 1-periodic plan; `false` for a given order or
+    /// a heuristic search.
+    pub order_exhaustive: bool,
+    /// Orders whose period was computed to choose this one (1 for a given order).
+    pub orders_evaluated: usize,
+}
+
+/// One robot's task within a [`CyclicPlan`] (schedule clock, s).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RobotCycle {
+    /// When it leaves its task start (reference sample 0) for the task of period 0: its phase,
+    /// in `[0, P)`.
+    pub start_s: f64,
+    /// When it enters each low-confidence stretch of that task (≥ `start_s`, possibly past
+    /// `P` when the task straddles the period's end; the phase is this modulo `P`).
+    pub lc_start_s: Vec<f64>,
+    /// Its high-confidence gaps as planned (see `TaskShape::gaps`: head, between stretches,
+    /// tail), with the waits at hold points.
+    pub gaps: Vec<GapPlan>,
+    /// The wait (s) at the task start before `start_s`: the period minus the task as planned
+    /// (tail at its fastest), so that its next task starts `P` later.
+    pub start_wait_s: f64,
+}
+
+/// One high-confidence gap of a robot's task as planned.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GapPlan {
+    /// Its planned duration (s), between `Σψ̇min·Δt_s` and `Σψ̇max·Δt_s`, or more with a hold.
+    pub duration_s: f64,
+    /// The part of it spent waiting at `hold` (s): what exceeds `Σψ̇max·Δt_s` (the robot
+    /// slows to `ψ̇max` first); 0 without a hold.
+    pub wait_s: f64,
+    /// The hold point where it waits (reference sample), if the gap has one.
+    pub hold: Option<usize>,
+}
+
+/// A lower bound (s) on the period of every 1-periodic plan of `n_robots` robots on `problem`,
+/// whatever the operator order: `max(N·(L + I), D_min)` ([`TaskShape::lc_total_s`],
+/// [`TaskShape::idle_s`], [`TaskShape::fastest_s`]). Divided by `k` it also bounds the period
+/// per task and robot of a plan with `k` tasks per robot per period.
+///
+/// **Why.**
+/// 1. In one period the operator supervises every robot's every low-confidence stretch once,
+///    each for its fixed duration at `ψ̇̄`, one at a time: `N·L` seconds.
+/// 2. Let `G = (g₁, g₂)` be a gap of robot `r` between two of its stretches, without a hold
+///    and lasting at most `Σψ̇max·Δt_s < L_min` (the shortest stretch). No stretch of another
+///    robot meets `G`: one that crossed `g₁` or `g₂` would overlap `r`'s stretch ending at
+///    `g₁` or starting at `g₂`, and one inside `G` would be shorter than `L_min`. So the
+///    operator is idle during `G`, for at least its fastest duration. Two such gaps of
+///    different robots are disjoint: if `g₁ ≤ h₁ < g₂` for another's gap `(h₁, h₂)`, that
+///    robot's stretch ending at `h₁` meets `G` (or, when `h₁ = g₁`, overlaps `r`'s stretch
+///    ending at the same instant). So the operator is idle at least `N·I` per period, and
+///    busy `N·L`: `P ≥ N·(L + I)`. (The head and the tail are not counted: a robot may wait
+///    at its task start instead.)
+/// 3. Each robot does one task per period and starts its next only after the last one's
+///    end; a task takes at least `D_min` (every high-confidence sample at `ψ̇min`,
+///    low-confidence ones at `ψ̇̄`): `P ≥ D_min` (the robot's cycle of the event graph).
+///
+/// None of these uses the order, so they bound every order, and they count per task, so
+/// they bound plans with more tasks per robot per period as well.
+///
+/// # Errors
+/// [`crate::Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS`.
+pub fn period_lower_bound_s(problem: &Problem, n_robots: usize) -> Result<f64> {
+    check_robot_count(n_robots)?;
+    Ok(bound_of(&TaskShape::new(problem), n_robots))
+}
+
+pub(crate) fn bound_of(shape: &TaskShape, n_robots: usize) -> f64 {
+    (n_robots as f64 * (shape.lc_total_s() + shape.idle_s())).max(shape.fastest_s())
+}
+
+/// The cyclic plan of `n_robots` robots on `problem` with the operator's cyclic order `order`
+/// (each robot's stretches in task order around the cycle, starting anywhere): the least
+/// period of its event graph ([`event_graph`], [`max_cycle_ratio`]) and each robot's times.
+///
+/// # Errors
+/// [`crate::Error::BadParam`] for `n_robots` or a malformed order;
+/// [`crate::Error::InfeasibleCycle`] when no period admits the order (it would need a robot
+/// to wait inside a gap without a hold point).
+pub fn cyclic_plan_for_order(
+    problem: &Problem,
+    n_robots: usize,
+    order: &[Stretch],
+) -> Result<CyclicPlan> {
+    let graph = event_graph(problem, n_robots, order)?;
+    let ratio = max_cycle_ratio(graph.events.len(), &graph.arcs)?;
+    Ok(layout(
+        &graph,
+        n_robots,
+        order,
+        ratio.period_s,
+        &ratio.times_s,
+    ))
+}
+
+/// The period of one order, or `None` if no period admits it (for the search).
+pub(crate) fn period_of(
+    shape: &TaskShape,
+    n_robots: usize,
+    order: &[Stretch],
+) -> Result<Option<f64>> {
+    let graph = graph_of_shape(shape.clone(), n_robots, order)?;
+    match max_cycle_ratio(graph.events.len(), &graph.arcs) {
+        Ok(r) => Ok(Some(r.period_s)),
+        Err(crate::Error::InfeasibleCycle { .. }) => Ok(None),
+        Err(e) => Err(e),
+    }
+}
+
+fn layout(
+    graph: &EventGraph,
+    n_robots: usize,
+    order: &[Stretch],
+    period_s: f64,
+    times_s: &[f64],
+) -> CyclicPlan {
+    let shape = &graph.shape;
+    let m = shape.n_lc();
+    let robots = (0..n_robots)
+        .map(|r| {
+            let a = times_s[graph.task_start_node(r)];
+            let shift = (a / period_s).floor() * period_s;
+            let start_s = a - shift;
+            let lc_start_s: Vec<f64> = (0..m)
+                .map(|lc| {
+                    times_s[graph.stretch_node(Stretch { robot: r, lc })]
+                        + f64::from(graph.wrapped[r][lc]) * period_s
+                        - shift
+                })
+                .collect();
+            let gap_plan = |k: usize, duration_s: f64| {
+                let g = shape.gaps[k];
+                GapPlan {
+                    duration_s,
+                    wait_s: if g.hold.is_some() {
+                        (duration_s - g.max_s).max(0.0)
+                    } else {
+                        0.0
+                    },
+                    hold: g.hold,
+                }
+            };
+            let mut gaps = Vec::with_capacity(m + 1);
+            let (start_wait_s, tail_end);
+            if m == 0 {
+                gaps.push(gap_plan(0, shape.gaps[0].min_s));
+                tail_end = start_s + shape.gaps[0].min_s;
+            } else {
+                gaps.push(gap_plan(0, lc_start_s[0] - start_s));
+                for k in 1..m {
+                    gaps.push(gap_plan(
+                        k,
+                        lc_start_s[k] - (lc_start_s[k - 1] + shape.lc_s[k - 1]),
+                    ));
+                }
+                gaps.push(gap_plan(m, shape.gaps[m].min_s));
+                tail_end = lc_start_s[m - 1] + shape.lc_s[m - 1] + shape.gaps[m].min_s;
+            }
+            start_wait_s = (start_s + period_s - tail_end).max(0.0);
+            RobotCycle {
+                start_s,
+                lc_start_s,
+                gaps,
+                start_wait_s,
+            }
+        })
+        .collect();
+    let lower_bound_s = bound_of(shape, n_robots);
+    let n = n_robots as f64;
+    CyclicPlan {
+        n_robots,
+        order: order.to_vec(),
+        period_s,
+        lc_s: shape.lc_s.clone(),
+        robots,
+        tasks_per_hour: 3600.0 * n / period_s,
+        operator_share: n * shape.lc_total_s() / period_s,
+        lower_bound_s,
+        gap: period_s / lower_bound_s - 1.0,
+        order_exhaustive: false,
+        orders_evaluated: 1,
+    }
+}

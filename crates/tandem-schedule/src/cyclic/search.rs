@@ -1,0 +1,261 @@
+//! The operator order: enumerated while the orders are few, else seeded local search.
+
+use super::graph::{Stretch, TaskShape};
+use super::plan::{CyclicPlan, cyclic_plan_for_order, period_of};
+use crate::problem::check_robot_count;
+use crate::{Error, Problem, Result};
+
+/// Parameters of the order search of [`cyclic_plan`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct CyclicParams {
+    /// Enumerate every order (up to rotation) when there are at most this many; otherwise
+    /// search locally. Must be ≥ 1. Default 100 000: every order for two robots with up to 8
+    /// low-confidence stretches (51 480 orders) and three robots with up to 3 (5 040).
+    pub max_enumerated: u64,
+    /// Passes of the adjacent-swap local search per seed (each pass takes the best improving
+    /// swap of two neighbouring stretches of different robots, or stops). Default 200.
+    pub max_swap_passes: usize,
+}
+
+impl Default for CyclicParams {
+    fn default() -> Self {
+        CyclicParams {
+            max_enumerated: 100_000,
+            max_swap_passes: 200,
+        }
+    }
+}
+
+impl CyclicParams {
+    /// Checks the parameters.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for `max_enumerated == 0`.
+    pub fn validate(&self) -> Result<()> {
+        if self.max_enumerated == 0 {
+            return Err(Error::BadParam {
+                name: "max_enumerated",
+                why: "must be ≥ 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Number of operator orders up to rotation for `n` robots with `m` stretches each: robot
+/// 0's stretch 0 first, the other `N·m − 1` positions a multiset permutation, and each other
+/// robot's stretches starting at any of its `m` stretches: `(Nm − 1)!/((m − 1)!·m!^(N−1)) ·
+/// m^(N−1)`; saturating.
+#[must_use]
+pub fn order_count(n_robots: usize, m: usize) -> u64 {
+    if m == 0 || n_robots == 0 {
+        return 1;
+    }
+    // Multinomial as a product of binomials: place robot 0's m − 1, then each other robot's m.
+    let mut count: u128 = 1;
+    let mut free = (n_robots * m - 1) as u128;
+    let mut take = |k: u128, count: &mut u128| {
+        let mut c: u128 = 1;
+        for i in 0..k {
+            c = c * (free - i) / (i + 1);
+            if c > u128::from(u64::MAX) {
+                return false;
+            }
+        }
+        free -= k;
+        *count = count.saturating_mul(c);
+        true
+    };
+    if !take((m - 1) as u128, &mut count) {
+        return u64::MAX;
+    }
+    for _ in 1..n_robots {
+        if !take(m as u128, &mut count) {
+            return u64::MAX;
+        }
+        count = count.saturating_mul(m as u128);
+    }
+    u64::try_from(count).unwrap_or(u64::MAX)
+}
+
+/// The cyclic plan of `n_robots` robots repeating `problem`'s task: the operator order with
+/// the least period, found by
+///
+/// - **enumeration** when [`order_count`] is at most `params.max_enumerated`: every order up
+///   to rotation (robot 0's stretch 0 first; the first order in lexicographic order of robot
+///   labels and rotations wins ties), so the plan's period is the least of every 1-periodic
+///   plan ([`CyclicPlan::order_exhaustive`]). Two robots are enumerated up to 8 stretches
+///   per task at the default.
+/// - **local search** beyond: three seeds — round robin by stretch (every robot's stretch 0,
+///   then every robot's stretch 1, …), the staggered round robin (robot `r` begins at
+///   stretch `r mod m`) and the serial order (robot by robot, always feasible) — each
+///   improved by best-improving swaps of two neighbouring stretches of different robots
+///   (the wrap included) until no swap shortens the period or `max_swap_passes`; the best
+///   wins, the earlier seed on ties. Deterministic.
+///
+/// A task without low-confidence stretches has the empty order and the period `D_min`; one
+/// robot has its own task's order and period `D_min`.
+///
+/// # Errors
+/// [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS` or bad `params`.
+pub fn cyclic_plan(
+    problem: &Problem,
+    n_robots: usize,
+    params: &CyclicParams,
+) -> Result<CyclicPlan> {
+    params.validate()?;
+    check_robot_count(n_robots)?;
+    let shape = TaskShape::new(problem);
+    let m = shape.n_lc();
+    let count = order_count(n_robots, m);
+    let (order, evaluated, exhaustive) = if count <= params.max_enumerated {
+        let (order, evaluated) = enumerate(&shape, n_robots, m)?;
+        (order, evaluated, true)
+    } else {
+        let (order, evaluated) = local_search(&shape, n_robots, m, params)?;
+        (order, evaluated, false)
+    };
+    let mut plan = cyclic_plan_for_order(problem, n_robots, &order)?;
+    plan.order_exhaustive = exhaustive;
+    plan.orders_evaluated = evaluated;
+    Ok(plan)
+}
+
+/// The serial order: robot by robot, each robot's stretches in task order.
+fn serial(n_robots: usize, m: usize) -> Vec<Stretch> {
+    (0..n_robots)
+        .flat_map(|robot| (0..m).map(move |lc| Stretch { robot, lc }))
+        .collect()
+}
+
+fn better(p: Option<f64>, best: Option<f64>) -> bool {
+    match (p, best) {
+        (Some(p), Some(b)) => p < b * (1.0 - 1e-12),
+        (Some(_), None) => true,
+        _ => false,
+    }
+}
+
+fn enumerate(shape: &TaskShape, n_robots: usize, m: usize) -> Result<(Vec<Stretch>, usize)> {
+    if m == 0 {
+        return Ok((Vec::new(), 1));
+    }
+    let len = n_robots * m;
+    let mut labels = vec![0usize; len];
+    let mut left = vec![m; n_robots];
+    left[0] = m - 1;
+    let mut rot = vec![0usize; n_robots];
+    let mut best: (Option<f64>, Vec<Stretch>) = (None, serial(n_robots, m));
+    let mut evaluated = 0;
+    let mut order = Vec::with_capacity(len);
+    // Depth-first over the labels of positions 1..len, then over the rotations.
+    fn labels_at(
+        q: usize,
+        labels: &mut [usize],
+        left: &mut [usize],
+        visit: &mut dyn FnMut(&[usize]) -> Result<()>,
+    ) -> Result<()> {
+        if q == labels.len() {
+            return visit(labels);
+        }
+        for r in 0..left.len() {
+            if left[r] > 0 {
+                left[r] -= 1;
+                labels[q] = r;
+                labels_at(q + 1, labels, left, visit)?;
+                left[r] += 1;
+            }
+        }
+        Ok(())
+    }
+    let mut visit = |labels: &[usize]| -> Result<()> {
+        // Every rotation of robots 1..N (robot 0 starts at its stretch 0).
+        rot.fill(0);
+        loop {
+            order.clear();
+            let mut seen = vec![0usize; n_robots];
+            for &r in labels {
+                order.push(Stretch {
+                    robot: r,
+                    lc: (rot[r] + seen[r]) % m,
+                });
+                seen[r] += 1;
+            }
+            evaluated += 1;
+            let p = period_of(shape, n_robots, &order)?;
+            if better(p, best.0) {
+                best = (p, order.clone());
+            }
+            // Next rotation (odometer over robots 1..N).
+            let mut r = 1;
+            while r < n_robots {
+                rot[r] += 1;
+                if rot[r] < m {
+                    break;
+                }
+                rot[r] = 0;
+                r += 1;
+            }
+            if r == n_robots {
+                return Ok(());
+            }
+        }
+    };
+    labels[0] = 0;
+    labels_at(1, &mut labels, &mut left, &mut visit)?;
+    Ok((best.1, evaluated))
+}
+
+fn local_search(
+    shape: &TaskShape,
+    n_robots: usize,
+    m: usize,
+    params: &CyclicParams,
+) -> Result<(Vec<Stretch>, usize)> {
+    let round_robin: Vec<Stretch> = (0..m)
+        .flat_map(|lc| (0..n_robots).map(move |robot| Stretch { robot, lc }))
+        .collect();
+    let staggered: Vec<Stretch> = (0..m)
+        .flat_map(|j| {
+            (0..n_robots).map(move |robot| Stretch {
+                robot,
+                lc: (j + robot) % m,
+            })
+        })
+        .collect();
+    let mut evaluated = 0;
+    let mut best: (Option<f64>, Vec<Stretch>) = (None, serial(n_robots, m));
+    for seed in [round_robin, staggered, serial(n_robots, m)] {
+        let mut cur = seed;
+        let mut p = period_of(shape, n_robots, &cur)?;
+        evaluated += 1;
+        let len = cur.len();
+        for _ in 0..params.max_swap_passes {
+            let mut step: Option<(usize, Option<f64>)> = None;
+            for q in 0..len {
+                let q2 = (q + 1) % len;
+                if cur[q].robot == cur[q2].robot {
+                    continue;
+                }
+                cur.swap(q, q2);
+                let pq = period_of(shape, n_robots, &cur)?;
+                evaluated += 1;
+                cur.swap(q, q2);
+                if better(pq, step.map_or(p, |s| s.1)) {
+                    step = Some((q, pq));
+                }
+            }
+            match step {
+                Some((q, pq)) => {
+                    cur.swap(q, (q + 1) % len);
+                    p = pq;
+                }
+                None => break,
+            }
+        }
+        if better(p, best.0) {
+            best = (p, cur);
+        }
+    }
+    Ok((best.1, evaluated))
+}
