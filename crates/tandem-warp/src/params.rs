@@ -50,8 +50,10 @@ pub const DEFAULT_NODE_SPACING: usize = 4;
 /// The alignment is done on the caller's scale: the benchmark, like `tandem-lfd`, divides
 /// every channel by its range (`W = diag(1/r²)` on raw data).
 /// The defaults align two ~10 000-sample, 9-channel fixture demonstrations in under 20 ms on one
-/// core (bench `align_fixture`: 13.4–14.4 ms on the quiet 2-core build machine, against 11.3 ms
-/// for the former solver in the same session). To solve "the same problem" as the authors'
+/// core (bench `align_fixture`: 17.2 and 18.6 ms under a load average of 4–5 on the 2-core
+/// build machine, against 14.6 and 15.7 ms for the solver before the band-edge fix and the
+/// noise term in the same session; the `align` example, interleaved, 14.8 against 16.2 ms).
+/// To solve "the same problem" as the authors'
 /// `gdtw` package, use `n_nodes = Some(T_ref)` (one node per reference sample) and
 /// `n_candidates = 301`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
