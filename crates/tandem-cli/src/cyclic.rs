@@ -63,6 +63,36 @@ fn stretch_name(robot: usize, lc: usize) -> String {
     format!("r{}s{}", robot + 1, lc + 1)
 }
 
+/// The operator's order as text, `r1s1 → r2s1 → r1s2–4 → …`: a run of one robot's
+/// consecutive stretches is written once.
+fn order_text(plan: &CyclicPlan) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    let mut k = 0;
+    while k < plan.order.len() {
+        let first = plan.order[k];
+        let mut last = first;
+        while let Some(next) = plan.order.get(k + 1) {
+            if next.robot == last.robot && next.lc == last.lc + 1 {
+                last = *next;
+                k += 1;
+            } else {
+                break;
+            }
+        }
+        let name = stretch_name(first.robot, first.lc);
+        parts.push(if last.lc == first.lc {
+            name
+        } else {
+            format!("{name}–{}", last.lc + 1)
+        });
+        k += 1;
+    }
+    parts.join(" → ")
+}
+
+/// Stretch start times listed per robot in the text; `--json` has all of them.
+const STRETCHES_SHOWN: usize = 8;
+
 /// The plan as text: period, throughput and busy share, the certificate, how the order was
 /// found, the operator's order, what the plan assumes, the Gantt of two periods and each
 /// robot's times.
@@ -121,16 +151,11 @@ pub(crate) fn plan_text(problem: &Problem, plan: &CyclicPlan) -> Result<String> 
             "operator's order: none (the task has no low-confidence stretch: nothing to supervise)"
         )?;
     } else {
-        let order: Vec<String> = plan
-            .order
-            .iter()
-            .map(|s| stretch_name(s.robot, s.lc))
-            .collect();
         writeln!(
             out,
             "operator's order per period: {} (rRsK: robot R's low-confidence stretch K of {m}, in \
-             task order; then again)",
-            order.join(" → ")
+             task order; rRsJ–K: its stretches J to K in a row; then again)",
+            order_text(plan)
         )?;
         let lc: Vec<String> = plan.lc_s.iter().map(|&d| secs_text(d)).collect();
         writeln!(out, "stretch durations at ψ̇̄: {} s", lc.join(", "))?;
@@ -167,7 +192,18 @@ fn robot_line(problem: &Problem, robot: usize, cycle: &RobotCycle) -> String {
         .map(|(k, &at)| format!("{} {}", stretch_name(robot, k), t(at)))
         .collect();
     if !starts.is_empty() {
-        let _ = write!(s, "; {}", starts.join(", "));
+        let _ = write!(
+            s,
+            "; {}",
+            starts[..starts.len().min(STRETCHES_SHOWN)].join(", ")
+        );
+        if starts.len() > STRETCHES_SHOWN {
+            let _ = write!(
+                s,
+                ", … {} more (--json lists all)",
+                starts.len() - STRETCHES_SHOWN
+            );
+        }
     }
     for g in &cycle.gaps {
         if let (Some(h), true) = (g.hold, g.wait_s > 0.0) {
@@ -324,6 +360,26 @@ mod tests {
         let conf: Vec<bool> = (0..300).map(|n| !(100..200).contains(&n)).collect();
         Problem::new(conf, vec![1.0; 300], vec![0.5; 300], vec![2.0; 300], 0.01)
             .expect("a valid problem")
+    }
+
+    #[test]
+    fn runs_of_one_robot_in_the_order_are_written_once() {
+        use tandem::schedule::Stretch;
+        let st = |robot, lc| Stretch { robot, lc };
+        let plan = CyclicPlan {
+            n_robots: 2,
+            order: vec![st(0, 0), st(1, 2), st(0, 1), st(0, 2), st(1, 0), st(1, 1)],
+            period_s: 1.0,
+            lc_s: vec![0.1; 3],
+            robots: Vec::new(),
+            tasks_per_hour: 7200.0,
+            operator_share: 0.6,
+            lower_bound_s: 1.0,
+            gap: 0.0,
+            order_exhaustive: true,
+            orders_evaluated: 1,
+        };
+        assert_eq!(order_text(&plan), "r1s1 → r2s3 → r1s2–3 → r2s1–2");
     }
 
     #[test]
