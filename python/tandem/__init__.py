@@ -10,6 +10,8 @@ NumPy arrays in and out (docs/python.md):
   :attr:`Planner.confidence`, :attr:`Planner.schedule`, :meth:`Planner.record_round`,
   :meth:`Planner.reschedule`, :meth:`Planner.save` / :meth:`Planner.load` (the command
   line's state file), :meth:`Planner.command` (Eq. 7).
+- :meth:`Planner.cyclic_plan` / :func:`cyclic_plan` → :class:`CyclicPlan`: the plan of a
+  continuous cell (no rounds): its period, throughput, the operator's order and busy share.
 - :class:`Coordinator`: the real-time coordinator of a schedule (§II-B5), one control tick
   per :meth:`Coordinator.tick`.
 - :mod:`tandem.study`: the simulated study of §III; :mod:`tandem.sim`: its workcell.
@@ -27,6 +29,7 @@ from ._tandem import (
     N_ROBOTS,
     Confidence,
     Coordinator,
+    CyclicPlan,
     DataWarning,
     InputError,
     InternalError,
@@ -44,6 +47,7 @@ from ._tandem import (
     Warp,
     __version__,
     align,
+    cyclic_plan,
     default_params,
     fit,
     fit_model,
@@ -56,6 +60,7 @@ __all__ = [
     "N_ROBOTS",
     "Confidence",
     "Coordinator",
+    "CyclicPlan",
     "DataWarning",
     "InputError",
     "InternalError",
@@ -73,6 +78,7 @@ __all__ = [
     "Warp",
     "__version__",
     "align",
+    "cyclic_plan",
     "default_params",
     "fit",
     "fit_model",

@@ -142,6 +142,9 @@ class Planner:
         tick_s: Optional[float] = None,
     ) -> Schedule:
         """Re-runs the sampler warm-started by the current schedule and keeps the result."""
+    def cyclic_plan(self, max_enumerated: Optional[int] = None) -> CyclicPlan:
+        """The plan of a continuous cell (no rounds) on the current problem for this
+        planner's robots; does not change the planner (``tandem schedule --cell continuous``)."""
     @property
     def schedule(self) -> Schedule:
         """The current schedule (a snapshot)."""
@@ -304,6 +307,67 @@ class Problem:
         previous: Optional[Schedule] = None,
         robots: int = 2,
     ) -> Schedule: ...
+
+class CyclicPlan:
+    """The plan of a continuous cell: ``N`` robots repeating the task, one operator, one task
+    per robot every period ``period_s``. Times in s from period 0's start; robots and
+    stretches 0-based; ``m`` low-confidence stretches per task. Assumes the operator follows
+    the demonstrated mean speed; not yet margin-checked across cycles."""
+
+    @property
+    def n_robots(self) -> int: ...
+    @property
+    def period_s(self) -> float:
+        """The period ``P`` (s), exact for :attr:`order`."""
+    @property
+    def tasks_per_hour(self) -> float:
+        """``3600·N / P``."""
+    @property
+    def operator_share(self) -> float:
+        """The operator's busy share ``N·L / P`` in ``[0, 1]``."""
+    @property
+    def lower_bound_s(self) -> float:
+        """A lower bound (s) on the period of every order: ``max(N·(L + I), D_min)``."""
+    @property
+    def gap(self) -> float:
+        """``period_s / lower_bound_s − 1``."""
+    @property
+    def order_exhaustive(self) -> bool:
+        """Whether every operator order was searched."""
+    @property
+    def orders_evaluated(self) -> int: ...
+    @property
+    def order(self) -> List[Tuple[int, int]]:
+        """The operator's cyclic order: ``N·m`` pairs ``(robot, stretch)``, 0-based."""
+    @property
+    def lc_s(self) -> F64:
+        """``(m,)`` stretch durations at ``ψ̇̄`` (s)."""
+    @property
+    def start_s(self) -> F64:
+        """``(N,)`` each robot's task start in period 0 (s, in ``[0, P)``)."""
+    @property
+    def lc_start_s(self) -> F64:
+        """``(N, m)`` when each robot enters each stretch of that task (s; may exceed ``P``)."""
+    @property
+    def gap_duration_s(self) -> F64:
+        """``(N, m + 1)`` planned gap durations (head, between stretches, tail), waits included (s)."""
+    @property
+    def gap_wait_s(self) -> F64:
+        """``(N, m + 1)`` the part of each gap spent waiting at its hold (s)."""
+    @property
+    def gap_hold(self) -> List[Optional[int]]:
+        """``m + 1`` entries: each gap's hold point (reference sample) or ``None``."""
+    @property
+    def start_wait_s(self) -> F64:
+        """``(N,)`` each robot's wait at its task start before the next task (s)."""
+    def to_json(self) -> str:
+        """The plan as ``tandem schedule --cell continuous --json`` prints it."""
+
+def cyclic_plan(
+    problem: Problem, robots: int = 2, max_enumerated: Optional[int] = None
+) -> CyclicPlan:
+    """The cyclic plan of ``robots`` robots on ``problem`` (every order searched up to
+    ``max_enumerated``, default 100 000; a local search beyond)."""
 
 class Schedule:
     """Execution warps ``(N, T_ref)``, ``N − 1`` start offsets and the control tick."""

@@ -69,11 +69,19 @@ pub(crate) enum Command {
     /// The JSON (--json) has the offset τ, per-robot execution gradients, every
     /// low-confidence interval in global time and T_total: give it to the robots.
     ///
+    /// With --cell continuous it shows instead the plan of a continuous cell (no rounds:
+    /// each robot starts its next task as soon as the plan allows): the period, tasks per
+    /// hour, the operator's busy share, a lower bound on the period and the gap to it, the
+    /// operator's order of low-confidence stretches and a text Gantt of two periods. It
+    /// assumes the operator follows the demonstrated mean speed; the run-time coordinator of
+    /// a continuous cell is in progress, and `record` still learns from rounds.
+    ///
     /// Example:
     ///
     ///   tandem schedule cell.tandem
     ///   tandem schedule cell.tandem --samples 20000 --seed 3 --save
     ///   tandem schedule cell.tandem --json > schedule.json
+    ///   tandem schedule cell.tandem --cell continuous
     #[command(verbatim_doc_comment)]
     Schedule(ScheduleArgs),
     /// Add an executed round (one execution of each robot) (Eq. 21),
@@ -284,6 +292,21 @@ pub(crate) struct ScheduleArgs {
     /// Save the re-optimized schedule into the state file (atomically).
     #[arg(long)]
     pub(crate) save: bool,
+    /// How the cell runs: `rounds` (every robot starts together, the next round when the last
+    /// one is done; the schedule `record` and the coordinator run) or `continuous` (each
+    /// robot repeats the task on its own, one period per task: the cyclic plan, shown, never
+    /// saved).
+    #[arg(long, value_name = "MODE", value_enum, default_value_t = CellArg::Rounds)]
+    pub(crate) cell: CellArg,
+}
+
+/// `tandem schedule --cell`: how the robots repeat the task.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum CellArg {
+    /// Rounds: all robots start together; the next round starts when the last one finishes.
+    Rounds,
+    /// A continuous cell: each robot starts its next task once the cyclic plan lets it.
+    Continuous,
 }
 
 /// `tandem record`.

@@ -10,10 +10,10 @@ use tandem::schedule::SamplerParams;
 use tandem::{ExecutionRecord, Planner, PlannerParams};
 
 use crate::cli::{
-    Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
+    CellArg, Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
 };
 use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_json, source_name};
-use crate::{bag, input, need, plot, sim, state_io};
+use crate::{bag, cyclic, input, need, plot, sim, state_io};
 
 /// Runs one command.
 pub(crate) fn run(cli: Cli) -> Result<()> {
@@ -314,6 +314,9 @@ fn summary_lines(planner: &Planner) -> Result<()> {
 }
 
 fn schedule(a: &ScheduleArgs) -> Result<()> {
+    if a.cell == CellArg::Continuous {
+        return cyclic::schedule_continuous(a);
+    }
     // With --save this is a read–modify–write: hold the state file's lock throughout.
     let lock = a.save.then(|| state_io::lock(&a.state)).transpose()?;
     let mut planner = state_io::load(&a.state)?;

@@ -5,7 +5,8 @@
 //!
 //! - `tandem fit` learns the task model (alignment, statistics, corrections, confidence
 //!   prior; §II-B1–3) and the first schedule (§II-B4–6, §II-C) and saves a state file;
-//! - `tandem schedule` re-optimizes and shows the schedule (text Gantt or JSON);
+//! - `tandem schedule` re-optimizes and shows the schedule (text Gantt or JSON); with
+//!   `--cell continuous` it shows the cyclic plan of a continuous cell instead (`cyclic`);
 //! - `tandem record` adds an executed pair (Eq. 21), updates the confidence, re-schedules;
 //! - `tandem inspect` and `tandem plot` show the model, the confidence and the schedule;
 //! - `tandem simulate` runs a simulated operator on the model (what-if) and can write the
@@ -21,6 +22,7 @@
 mod bag;
 mod cli;
 mod cmd;
+mod cyclic;
 mod gantt;
 mod input;
 mod need;

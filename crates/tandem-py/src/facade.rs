@@ -12,9 +12,10 @@ pub(crate) use tandem::planner::{
     Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, reschedule_seed,
 };
 pub(crate) use tandem::realtime::{Coordinator, Fault, MAX_ROBOTS, Operator, Tick, Timeline};
+pub(crate) use tandem::schedule::cyclic::GapPlan;
 pub(crate) use tandem::schedule::{
-    CheckedSchedule, GlobalTimeline, LcInterval, Outcome, Problem, SamplerParams, Schedule, Source,
-    Violation, sample_schedule_n,
+    CheckedSchedule, CyclicParams, CyclicPlan, GlobalTimeline, LcInterval, Outcome, Problem,
+    SamplerParams, Schedule, Source, Violation, cyclic_plan, sample_schedule_n,
 };
 pub(crate) use tandem::sim::needs::{NeedProfile, NeedRegion};
 pub(crate) use tandem::sim::study::{

@@ -10,6 +10,9 @@
 //!   (`tandem.Confidence`: latched `conf`, Beta posterior, observations).
 //! - `schedule`: `tandem.Problem` and `tandem.Schedule` (offsets, gradients,
 //!   low-confidence intervals, `T_total`, tick; `validate` against Eq. 20).
+//! - `cyclic`: `tandem.CyclicPlan`, the plan of a continuous cell (no rounds: its period,
+//!   throughput, the operator's order and busy share, a lower bound), from
+//!   `Planner.cyclic_plan` or `tandem.cyclic_plan`.
 //! - `coordinator`: `tandem.Coordinator`, the Rust real-time coordinator itself (not a
 //!   re-implementation), one control tick per `tick(operator)`.
 //! - `study` and `sim`: the simulated study of §III and its workcell.
@@ -30,6 +33,7 @@
 mod arrays;
 mod bag;
 mod coordinator;
+mod cyclic;
 mod errors;
 mod facade;
 mod params;
@@ -49,6 +53,8 @@ mod _tandem {
     use crate::bag::read_bag;
     #[pymodule_export]
     use crate::coordinator::{PyCoordinator, PyTick};
+    #[pymodule_export]
+    use crate::cyclic::{PyCyclicPlan, cyclic_plan};
     #[pymodule_export]
     use crate::errors::{
         DataWarning, InputError, InternalError, ParamError, ScheduleError, StateFileError,

@@ -724,6 +724,29 @@ impl PyPlanner {
         Ok(self.current_schedule())
     }
 
+    /// The plan of a continuous cell on the current problem for this planner's robots
+    /// (:func:`cyclic_plan`): no rounds, each robot repeating the task, one period per task.
+    /// A snapshot, computed now (``tandem schedule --cell continuous`` shows the same plan);
+    /// it does not change the planner, whose schedule stays the rounds one it records from.
+    /// ``max_enumerated`` (default 100 000): search every operator order while there are at
+    /// most this many.
+    ///
+    /// Raises:
+    ///     ParamError: ``max_enumerated`` 0.
+    #[pyo3(signature = (max_enumerated=None))]
+    fn cyclic_plan(
+        &self,
+        py: Python<'_>,
+        max_enumerated: Option<u64>,
+    ) -> PyResult<crate::cyclic::PyCyclicPlan> {
+        crate::cyclic::compute(
+            py,
+            self.inner.problem(),
+            self.inner.n_robots(),
+            max_enumerated,
+        )
+    }
+
     /// The current schedule (a snapshot: it does not change when the planner does).
     #[getter]
     fn schedule(&self) -> PySchedule {

@@ -1,0 +1,243 @@
+//! `tandem.CyclicPlan` and `tandem.cyclic_plan`: the plan of a continuous cell (issue 21;
+//! Rust `tandem::schedule::cyclic`), also `Planner.cyclic_plan`.
+
+use numpy::ndarray::Array2;
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+
+use crate::arrays::out_vector;
+use crate::errors::{Error, Result, guard};
+use crate::facade::{CyclicParams, CyclicPlan, GapPlan, Problem, cyclic_plan as plan_of};
+use crate::planner::N_ROBOTS;
+use crate::schedule::PyProblem;
+
+/// The cyclic plan of `n_robots` robots on `problem` ([`plan_of`]), with `max_enumerated`
+/// replacing [`CyclicParams::max_enumerated`] when given, the GIL released.
+pub(crate) fn compute(
+    py: Python<'_>,
+    problem: &Problem,
+    n_robots: usize,
+    max_enumerated: Option<u64>,
+) -> PyResult<PyCyclicPlan> {
+    let mut params = CyclicParams::default();
+    if let Some(k) = max_enumerated {
+        params.max_enumerated = k;
+    }
+    let plan = py.detach(|| guard(|| Ok(plan_of(problem, n_robots, &params)?)))?;
+    Ok(PyCyclicPlan { plan })
+}
+
+/// The plan of a continuous cell (no rounds): ``N`` robots repeating the task with one
+/// operator, one task per robot every period. Read-only; times in seconds of the schedule
+/// clock, measured from the start of period 0; robots and stretches 0-based.
+///
+/// It assumes that the operator supervises every low-confidence stretch at the demonstrated
+/// mean speed ``ψ̇̄`` and that the robots run at their planned rates: a plan, not yet checked
+/// against correction drift across cycle boundaries (rounds remain what the planner records
+/// and the :class:`Coordinator` runs). Make one with :meth:`Planner.cyclic_plan` or
+/// :func:`cyclic_plan`.
+#[pyclass(module = "tandem", name = "CyclicPlan", frozen)]
+pub(crate) struct PyCyclicPlan {
+    plan: CyclicPlan,
+}
+
+impl PyCyclicPlan {
+    /// Per robot, one value per gap of its task (head, between stretches, tail): an
+    /// ``(N, m + 1)`` array.
+    fn per_gap<'py>(
+        &self,
+        py: Python<'py>,
+        value: impl Fn(&GapPlan) -> f64,
+    ) -> Result<Bound<'py, PyArray2<f64>>> {
+        let cols = self.plan.robots.first().map_or(0, |r| r.gaps.len());
+        let values: Vec<f64> = self
+            .plan
+            .robots
+            .iter()
+            .flat_map(|r| r.gaps.iter().map(&value))
+            .collect();
+        matrix_out(py, values, self.plan.robots.len(), cols)
+    }
+}
+
+/// A `rows × cols` array from row-major `values`, also with zero columns (a task without
+/// low-confidence stretches).
+fn matrix_out(
+    py: Python<'_>,
+    values: Vec<f64>,
+    rows: usize,
+    cols: usize,
+) -> Result<Bound<'_, PyArray2<f64>>> {
+    let a = Array2::from_shape_vec((rows, cols), values)
+        .map_err(|e| Error::Panic(format!("cyclic plan array {rows} × {cols}: {e}")))?;
+    Ok(PyArray2::from_owned_array(py, a))
+}
+
+#[pymethods]
+impl PyCyclicPlan {
+    /// Number of robots ``N``.
+    #[getter]
+    fn n_robots(&self) -> usize {
+        self.plan.n_robots
+    }
+
+    /// The period ``P`` (s): every period each robot does one task and the operator
+    /// supervises each of the ``N·m`` low-confidence stretches once. The least period of
+    /// :attr:`order` (exact).
+    #[getter]
+    fn period_s(&self) -> f64 {
+        self.plan.period_s
+    }
+
+    /// Throughput (tasks per hour): ``3600·N / P``.
+    #[getter]
+    fn tasks_per_hour(&self) -> f64 {
+        self.plan.tasks_per_hour
+    }
+
+    /// The operator's busy share ``N·L / P`` in ``[0, 1]`` (``L``: a task's low-confidence
+    /// time at ``ψ̇̄``, s).
+    #[getter]
+    fn operator_share(&self) -> f64 {
+        self.plan.operator_share
+    }
+
+    /// A lower bound (s) on the period of every repeated plan of ``N`` robots, whatever the
+    /// operator's order: ``max(N·(L + I), D_min)`` (the operator's load and forced idle time,
+    /// a robot's fastest task).
+    #[getter]
+    fn lower_bound_s(&self) -> f64 {
+        self.plan.lower_bound_s
+    }
+
+    /// ``period_s / lower_bound_s − 1`` (dimensionless; 0 when the plan is at its bound).
+    #[getter]
+    fn gap(&self) -> f64 {
+        self.plan.gap
+    }
+
+    /// Whether every operator order was searched, so that no repeated plan with one task per
+    /// robot per period has a shorter period; ``False`` after the local search (too many
+    /// orders to enumerate).
+    #[getter]
+    fn order_exhaustive(&self) -> bool {
+        self.plan.order_exhaustive
+    }
+
+    /// Operator orders whose period was computed to choose this one.
+    #[getter]
+    fn orders_evaluated(&self) -> usize {
+        self.plan.orders_evaluated
+    }
+
+    /// The operator's cyclic order within one period: a list of ``N·m`` pairs
+    /// ``(robot, stretch)``, both 0-based (``stretch``: the robot's ``k``-th low-confidence
+    /// stretch in task order); empty for a task without low confidence.
+    #[getter]
+    fn order(&self) -> Vec<(usize, usize)> {
+        self.plan.order.iter().map(|s| (s.robot, s.lc)).collect()
+    }
+
+    /// Duration (s) of each low-confidence stretch at ``ψ̇̄``, ``(m,)``.
+    #[getter]
+    fn lc_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        out_vector(py, self.plan.lc_s.clone())
+    }
+
+    /// When each robot leaves its task start for the task of period 0 (its phase, s, in
+    /// ``[0, P)``), ``(N,)``; it starts again every ``P``.
+    #[getter]
+    fn start_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        out_vector(py, self.plan.robots.iter().map(|r| r.start_s).collect())
+    }
+
+    /// When each robot enters each low-confidence stretch of that task (s), ``(N, m)``;
+    /// may exceed ``P`` when the task straddles the period's end (the phase is modulo ``P``).
+    #[getter]
+    fn lc_start_s<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let m = self.plan.lc_s.len();
+        let values = self
+            .plan
+            .robots
+            .iter()
+            .flat_map(|r| r.lc_start_s.iter().copied())
+            .collect();
+        Ok(matrix_out(py, values, self.plan.robots.len(), m)?)
+    }
+
+    /// Planned duration (s) of each robot's high-confidence gaps (head, between stretches,
+    /// tail), waits included, ``(N, m + 1)``.
+    #[getter]
+    fn gap_duration_s<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(self.per_gap(py, |g| g.duration_s)?)
+    }
+
+    /// The part of each gap spent waiting at its hold point (s), ``(N, m + 1)``; 0 in a gap
+    /// without a hold.
+    #[getter]
+    fn gap_wait_s<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(self.per_gap(py, |g| g.wait_s)?)
+    }
+
+    /// Per gap, the hold point where the robot may wait (reference sample) or ``None``; the
+    /// same for every robot (``m + 1`` entries).
+    #[getter]
+    fn gap_hold(&self) -> Vec<Option<usize>> {
+        self.plan
+            .robots
+            .first()
+            .map(|r| r.gaps.iter().map(|g| g.hold).collect())
+            .unwrap_or_default()
+    }
+
+    /// Each robot's wait at its task start before its next task (s), ``(N,)``.
+    #[getter]
+    fn start_wait_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        out_vector(
+            py,
+            self.plan.robots.iter().map(|r| r.start_wait_s).collect(),
+        )
+    }
+
+    /// The plan as JSON, exactly what ``tandem schedule --cell continuous --json`` prints
+    /// (docs/formats.md).
+    fn to_json(&self) -> PyResult<String> {
+        serde_json::to_string_pretty(&self.plan)
+            .map_err(|e| Error::Panic(format!("cannot write the cyclic plan as JSON: {e}")).into())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "CyclicPlan(n_robots={}, period_s={:.3}, tasks_per_hour={:.2}, operator_share={:.3}, \
+             gap={:.4}, order_exhaustive={})",
+            self.plan.n_robots,
+            self.plan.period_s,
+            self.plan.tasks_per_hour,
+            self.plan.operator_share,
+            self.plan.gap,
+            if self.plan.order_exhaustive {
+                "True"
+            } else {
+                "False"
+            }
+        )
+    }
+}
+
+/// The cyclic plan of a continuous cell of ``robots`` robots (1 to 8, default 2) on
+/// ``problem``: the operator order with the least period, every order searched while there
+/// are at most ``max_enumerated`` (default 100 000), a local search beyond (see
+/// :attr:`CyclicPlan.order_exhaustive`).
+///
+/// Raises:
+///     ParamError: ``robots`` outside 1…8 or ``max_enumerated`` 0.
+#[pyfunction]
+#[pyo3(signature = (problem, robots=N_ROBOTS, max_enumerated=None))]
+pub(crate) fn cyclic_plan(
+    py: Python<'_>,
+    problem: PyRef<'_, PyProblem>,
+    robots: usize,
+    max_enumerated: Option<u64>,
+) -> PyResult<PyCyclicPlan> {
+    compute(py, &problem.inner, robots, max_enumerated)
+}
