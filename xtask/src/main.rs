@@ -79,6 +79,15 @@ enum Cmd {
         /// interleaved starts with release rules accepted by the margin check with holds.
         #[arg(long)]
         holds: bool,
+        /// `rounds` (default): one execution is one round of the N robots, as above.
+        /// `continuous`: the continuous cell — every problem's cyclic plan
+        /// (`cyclic_plan`, runnable orders) run by its `ContinuousCoordinator`, each execution
+        /// until every robot has completed `--tasks` tasks, under the adversary policies.
+        #[arg(long, default_value = "rounds", value_parser = ["rounds", "continuous"])]
+        cell: String,
+        /// With `--cell continuous`: tasks every robot completes per execution.
+        #[arg(long, default_value_t = 50)]
+        tasks: u64,
     },
 }
 
@@ -94,7 +103,15 @@ fn main() -> anyhow::Result<()> {
             robots,
             seed,
             holds,
-        } => stress::run(executions, seed, robots, holds),
+            cell,
+            tasks,
+        } => {
+            if cell == "continuous" {
+                stress::run_continuous(executions, seed, robots, tasks)
+            } else {
+                stress::run(executions, seed, robots, holds)
+            }
+        }
         Cmd::ReferenceOrder(args) => reference_order::run(&args),
         Cmd::Test(args) => test::run_all(&args),
     }

@@ -25,6 +25,15 @@
 //! candidates, the exact optimum with dwells for two robots), and per-robot plans get
 //! interleaved random starts with release rules (`tandem::realtime::holds::release_rules`)
 //! accepted by `sufficient_margins_with_holds` (20 draws, else the tight schedule without holds).
+//!
+//! `--cell continuous [--tasks K]` stresses the continuous cell instead ([`run_continuous`]):
+//! random problems (this task's, with hold points on two problems of three, and the test
+//! kit's shared-mask families with hold points), each planned by `cyclic_plan` (runnable
+//! orders) and run by `CyclicPlan::coordinator` at a random tick; every execution runs one
+//! adversary policy (`tandem::realtime::continuous::run_cell`: the policies of the adversary
+//! set, the beam search replaced by a switching favourite) until every robot has completed
+//! `K` tasks (default 50), so the clocks' drift runs across many cycles. It counts the ticks
+//! with two or more robots low-confidence (expected 0) and the tasks per robot.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -34,10 +43,13 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use tandem::realtime::adversary::{Adversary, AdversaryRun, adversary_set, run_adversary};
+use tandem::realtime::continuous::{ContinuousCoordinator, run_cell};
 use tandem::realtime::holds::{release_rules, usable_holds};
 use tandem::realtime::testkit::{self, Family};
 use tandem::realtime::{Coordinator, Timeline, sufficient_margins, sufficient_margins_with_holds};
-use tandem::schedule::{Problem, SamplerParams, Source, sample_schedule_n};
+use tandem::schedule::{
+    CyclicParams, Problem, SamplerParams, Source, cyclic_plan, sample_schedule_n,
+};
 
 /// Executions per scheduled problem (the number of problems is `N / this`, at least 1 and at
 /// most [`MAX_PROBLEMS`]).
@@ -346,6 +358,184 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> a
          seed {seed}), {ticks} ticks, {threads} threads: {overlap_ticks} ticks with two or more \
          robots low-confidence (expected 0) in {overlap_runs} executions; {unfinished} \
          unfinished; {secs:.1} s, {:.0} executions/s, {:.1} M ticks/s",
+        executions as f64 / secs,
+        ticks as f64 / secs / 1e6,
+        threads = rayon::current_num_threads(),
+    );
+    if overlap_ticks > 0 || unfinished > 0 {
+        bail!(
+            "safety invariant broken: {overlap_ticks} overlap ticks, {unfinished} unfinished executions"
+        );
+    }
+    Ok(())
+}
+
+/// One planned random problem of the continuous stress run.
+struct CellCase {
+    cell: ContinuousCoordinator,
+    adversaries: Vec<Adversary>,
+    max_ticks: u64,
+    family: &'static str,
+    /// The plan's throughput (tasks/h), for the report.
+    plan_per_h: f64,
+}
+
+/// Problem `index` of the continuous run: index mod 3 = 0 this task's random problem with
+/// hold points, 1 without, 2 a test kit family with a shared mask (with hold points; the
+/// per-robot families, which no `Problem` describes, fall back to this task's problem with
+/// hold points). Planned by `cyclic_plan` (runnable orders), run at a random tick.
+fn make_cell_case(seed: u64, index: u64, n_robots: usize, tasks: u64) -> anyhow::Result<CellCase> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x00c0_ffee);
+    rng.set_stream(index);
+    let mut family = "stress";
+    let problem = match index % 3 {
+        0 => with_holds(random_problem(&mut rng)?, true)?,
+        1 => random_problem(&mut rng)?,
+        _ => {
+            let f = Family::ALL[((index / 3) % Family::ALL.len() as u64) as usize];
+            let case = testkit::Case::random(f, n_robots, &mut rng);
+            if let Some(m) = case.shared_mask() {
+                family = f.name();
+                with_holds(Problem::new(m.conf, m.mean, m.lo, m.hi, m.dt_s)?, true)?
+            } else {
+                with_holds(random_problem(&mut rng)?, true)?
+            }
+        }
+    };
+    let dt_s = problem.dt_s();
+    let tick_s = dt_s * rng.random_range(0.25..=1.0);
+    let plan = cyclic_plan(&problem, n_robots, &CyclicParams::default())?;
+    let cell = plan.coordinator(&problem, tick_s)?;
+    let grad_range = [
+        problem
+            .grad_min()
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min),
+        problem.grad_max().iter().copied().fold(0.0, f64::max),
+    ];
+    // A task at its slowest (high confidence on plan, low at ψ̇max), in ticks, per robot and
+    // task, plus a tick per sample: a generous bound on the run.
+    let slow_s: f64 = (0..problem.n_ref())
+        .map(|k| {
+            if problem.conf()[k] {
+                cell.task().grad_exec()[k]
+            } else {
+                problem.grad_max()[k]
+            }
+        })
+        .sum::<f64>()
+        * dt_s;
+    let per_task = slow_s / tick_s + problem.n_ref() as f64;
+    let max_ticks = ((tasks + 2) as f64 * n_robots as f64 * per_task) as u64 + 1000;
+    Ok(CellCase {
+        adversaries: adversary_set(
+            n_robots,
+            grad_range,
+            (per_task * tasks as f64) as u64,
+            &mut rng,
+        ),
+        cell,
+        max_ticks,
+        family,
+        plan_per_h: plan.tasks_per_hour,
+    })
+}
+
+/// `cargo xtask stress --cell continuous`: `executions` executions of the continuous cell of
+/// `n_robots` robots, each until every robot has completed `tasks` tasks; fails on any tick
+/// with two or more robots low-confidence, or an execution that does not complete its tasks.
+pub(crate) fn run_continuous(
+    executions: u64,
+    seed: u64,
+    n_robots: usize,
+    tasks: u64,
+) -> anyhow::Result<()> {
+    if executions == 0 || tasks == 0 {
+        bail!("--executions and --tasks must be ≥ 1");
+    }
+    if !(1..=tandem::realtime::MAX_ROBOTS).contains(&n_robots) {
+        bail!("--robots must be in 1..={}", tandem::realtime::MAX_ROBOTS);
+    }
+    let start = Instant::now();
+    let n_problems = (executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS);
+    let cases: Vec<CellCase> = (0..n_problems)
+        .into_par_iter()
+        .map(|i| {
+            make_cell_case(seed, i, n_robots, tasks)
+                .with_context(|| format!("planning problem {i}"))
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let mut families: Vec<&str> = cases.iter().map(|c| c.family).collect();
+    families.sort_unstable();
+    families.dedup();
+    let mean_plan = cases.iter().map(|c| c.plan_per_h).sum::<f64>() / cases.len() as f64;
+    println!(
+        "stress --cell continuous: {n_robots} robots, {n_problems} random problems ({}), cyclic plans of {:.1} tasks/h on average; planning took {:.1} s",
+        families.join(", "),
+        mean_plan,
+        start.elapsed().as_secs_f64()
+    );
+    let set_size = cases[0].adversaries.len() as u64;
+    let run_start = Instant::now();
+    let (ticks, overlap_ticks, overlap_runs, unfinished, tasks_done) = (
+        AtomicU64::new(0),
+        AtomicU64::new(0),
+        AtomicU64::new(0),
+        AtomicU64::new(0),
+        AtomicU64::new(0),
+    );
+    let min_tasks = AtomicU64::new(u64::MAX);
+    let mut last_report = Instant::now();
+    let mut done = 0;
+    let batch = (BATCH / 50).max(1);
+    while done < executions {
+        let end = (done + batch).min(executions);
+        (done..end).into_par_iter().try_for_each(|e| {
+            let case = &cases[(e % n_problems) as usize];
+            let op = case.adversaries[((e / n_problems) % set_size) as usize];
+            let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
+            rng.set_stream(e);
+            let mut cell = case.cell.clone();
+            let r = run_cell(&mut cell, op, &mut rng, tasks, case.max_ticks)?;
+            ticks.fetch_add(r.ticks, Ordering::Relaxed);
+            tasks_done.fetch_add(cell.tasks_completed().iter().sum(), Ordering::Relaxed);
+            min_tasks.fetch_min(r.min_tasks, Ordering::Relaxed);
+            if r.overlap_ticks > 0 {
+                overlap_ticks.fetch_add(r.overlap_ticks, Ordering::Relaxed);
+                overlap_runs.fetch_add(1, Ordering::Relaxed);
+            }
+            if !r.finished {
+                unfinished.fetch_add(1, Ordering::Relaxed);
+            }
+            anyhow::Ok(())
+        })?;
+        done = end;
+        if last_report.elapsed().as_secs_f64() >= 10.0 && done < executions {
+            let rate = done as f64 / run_start.elapsed().as_secs_f64();
+            println!(
+                "  {done}/{executions} executions, {} overlap ticks, {rate:.0} executions/s",
+                overlap_ticks.load(Ordering::Relaxed)
+            );
+            last_report = Instant::now();
+        }
+    }
+    let secs = run_start.elapsed().as_secs_f64();
+    let (ticks, overlap_ticks, overlap_runs, unfinished, tasks_done, min_tasks) = (
+        ticks.into_inner(),
+        overlap_ticks.into_inner(),
+        overlap_runs.into_inner(),
+        unfinished.into_inner(),
+        tasks_done.into_inner(),
+        min_tasks.into_inner(),
+    );
+    println!(
+        "stress --cell continuous: {executions} executions of {n_robots} robots ({set_size} \
+         operator policies, seed {seed}), {ticks} ticks, {threads} threads: {overlap_ticks} \
+         ticks with two or more robots low-confidence (expected 0) in {overlap_runs} \
+         executions; tasks per robot per execution: at least {min_tasks}, {:.1} on average; \
+         {unfinished} unfinished; {secs:.1} s, {:.0} executions/s, {:.1} M ticks/s",
+        tasks_done as f64 / (executions * n_robots as u64) as f64,
         executions as f64 / secs,
         ticks as f64 / secs / 1e6,
         threads = rayon::current_num_threads(),

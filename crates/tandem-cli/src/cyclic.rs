@@ -164,9 +164,11 @@ pub(crate) fn plan_text(problem: &Problem, plan: &CyclicPlan) -> Result<String> 
     writeln!(
         out,
         "This is a plan: it assumes the operator supervises every low-confidence stretch at the \
-         demonstrated mean speed ψ̇̄ and the robots run at their planned rates. It is not yet \
-         margin-checked across cycle boundaries, and the run-time coordinator of a continuous \
-         cell is in progress. `tandem record` learns from rounds (--cell rounds, the default)."
+         demonstrated mean speed ψ̇̄ and the robots run at their planned rates. At run time \
+         (Rust: CyclicPlan::coordinator) a robot waits at the hold before its low-confidence \
+         stretch until the operator's previous stretch has ended, so no two robots need the \
+         operator at once whatever the operator does; the throughput then depends on where the \
+         holds are. `tandem record` learns from rounds (--cell rounds, the default)."
     )?;
     writeln!(out)?;
     out.push_str(&gantt(problem, plan));

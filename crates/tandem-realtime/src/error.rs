@@ -72,6 +72,24 @@ pub enum Error {
         /// What is wrong.
         why: &'static str,
     },
+    /// A hold given to a continuous cell (`crate::continuous::groups`) is out of range, out of
+    /// order, or inside or next to a low-confidence stretch: a robot cannot wait there.
+    #[error("gate at reference sample {ref_idx} {why}")]
+    BadGate {
+        /// The hold's reference sample.
+        ref_idx: usize,
+        /// What is wrong.
+        why: &'static str,
+    },
+    /// The operator's cyclic order of a continuous cell (`crate::continuous::token_sequence`)
+    /// is malformed or not runnable.
+    #[error("operator order, position {position}: {why}")]
+    BadOrder {
+        /// Position in the order (0-based).
+        position: usize,
+        /// What is wrong.
+        why: &'static str,
+    },
     /// A scalar parameter is out of its valid range.
     #[error("parameter `{name}` {why}")]
     BadParam {

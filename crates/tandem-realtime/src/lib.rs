@@ -56,6 +56,7 @@
 //! ```
 
 pub mod adversary;
+pub mod continuous;
 mod coordinator;
 mod error;
 pub mod holds;
@@ -67,6 +68,7 @@ pub mod testkit;
 mod timeline;
 pub mod tol;
 
+pub use continuous::{CellTick, ContinuousCoordinator};
 pub use coordinator::{Coordinator, Fault, Operator, Tick};
 pub use error::{Error, Result};
 pub use holds::{After, Hold};

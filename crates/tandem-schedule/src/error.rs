@@ -118,6 +118,23 @@ pub enum Error {
         /// Its tokens `Σh`.
         tokens: i64,
     },
+    /// A cyclic plan's order cannot run on the continuous coordinator
+    /// ([`crate::cyclic::is_runnable`]): another robot's stretch comes right before stretch
+    /// `lc` of robot `robot`, at `position` of the order, and that robot has no usable hold
+    /// between its stretches `lc − 1` and `lc` to wait for it. Plan with
+    /// `CyclicParams::runnable_only` (the default).
+    #[error(
+        "the operator order is not runnable: at position {position}, robot {robot}'s stretch {lc} does not follow its stretch {} and there is no usable hold between them to wait at",
+        lc - 1
+    )]
+    NotRunnable {
+        /// Position in the order (0-based).
+        position: usize,
+        /// The robot (0-based).
+        robot: usize,
+        /// The stretch (index of the low-confidence run, ≥ 1).
+        lc: usize,
+    },
     /// The realtime crate (coordinator, margin check) rejected its input.
     #[error(transparent)]
     Realtime(#[from] tandem_realtime::Error),

@@ -386,12 +386,21 @@ fn a_gap_without_hold_forbids_interleaving_and_a_hold_allows_it() {
     // bound counts that idle time: max(2·(4 + 0.5), 5.5) = 9 s, so the plan is optimal.
     let p = two_passes(vec![]);
     assert_eq!(order_count(2, 2), 6);
-    let plan = cyclic_plan(&p, 2, &CyclicParams::default()).unwrap();
+    let every_order = CyclicParams {
+        runnable_only: false,
+        ..CyclicParams::default()
+    };
+    let plan = cyclic_plan(&p, 2, &every_order).unwrap();
     assert!((plan.period_s - 9.0).abs() < 1e-12, "{}", plan.period_s);
     assert!((plan.lower_bound_s - 9.0).abs() < 1e-12);
     assert!(plan.gap.abs() < 1e-12);
     assert!(plan.order_exhaustive && plan.orders_evaluated == 6);
     check_plan(&p, &plan);
+    // Only the serial order keeps each robot's two stretches together (runnable, the
+    // default): the same plan, from one order.
+    let runnable = cyclic_plan(&p, 2, &CyclicParams::default()).unwrap();
+    assert_eq!(runnable.order, plan.order);
+    assert!(runnable.order_exhaustive && runnable.orders_evaluated == 1);
     let interleaved = [st(0, 0), st(1, 0), st(0, 1), st(1, 1)];
     assert!(matches!(
         cyclic_plan_for_order(&p, 2, &interleaved),
@@ -628,7 +637,13 @@ fn two_tasks_per_robot_can_beat_one_without_holds() {
         1.0,
         vec![],
     );
-    let one = cyclic_plan(&p, 3, &CyclicParams::default()).unwrap();
+    // The orders that interleave the robots inside a gap without hold are plans, not
+    // runnable by the continuous coordinator: searched with `runnable_only: false`.
+    let every_order = CyclicParams {
+        runnable_only: false,
+        ..CyclicParams::default()
+    };
+    let one = cyclic_plan(&p, 3, &every_order).unwrap();
     assert!(one.order_exhaustive);
     assert!((one.lower_bound_s - 6.0).abs() < 1e-12);
     assert!((one.period_s - 6.5).abs() < 1e-12, "{}", one.period_s);
@@ -674,8 +689,12 @@ fn two_tasks_per_robot_never_lose_and_rarely_win_for_two_robots() {
     // On random small problems the best 1-periodic plan of the doubled task (two tasks per
     // robot) is never slower than twice the best 1-periodic plan (it contains that order
     // twice over), both searched exhaustively. How often it is faster is reported.
+    // Every order, runnable or not: the question is the plan's.
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(8);
-    let params = CyclicParams::default();
+    let params = CyclicParams {
+        runnable_only: false,
+        ..CyclicParams::default()
+    };
     for hold_p in [0.0, 0.5, 1.0] {
         let (mut wins, mut cases, mut at_bound) = (0, 0, 0);
         for _ in 0..60 {
@@ -702,6 +721,7 @@ fn two_tasks_per_robot_win_for_three_robots_only_where_a_gap_has_no_hold() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
     let params = CyclicParams {
         max_enumerated: 200_000,
+        runnable_only: false,
         ..CyclicParams::default()
     };
     for hold_p in [0.0, 1.0] {

@@ -30,9 +30,12 @@
 //!
 //! **What the period assumes.** The operator follows `ψ̇̄` on every low-confidence stretch
 //! and the robots run at their planned rates; the period is the plan's, not a run-time
-//! guarantee. Soundness at run time under correction drift — the margin check of robot
-//! `a`'s next task against robot `b`'s current one, across cycle boundaries — is not part of
-//! this module yet, nor a continuous coordinator.
+//! guarantee. At run time [`CyclicPlan::coordinator`] runs the plan with the token rule of
+//! `tandem_realtime::continuous` (a robot waits at the gate of its next group of stretches
+//! until the previous group in the order has been left), which is sound across cycle
+//! boundaries by construction, for any operator and any number of tasks; it needs a
+//! *runnable* order ([`is_runnable`]), which [`cyclic_plan`] searches by default
+//! ([`CyclicParams::runnable_only`]).
 //!
 //! **The certificate.** [`period_lower_bound_s`] `= max(N·(L + I), D_min)` holds for every
 //! order: the operator's load `N·L`, its forced idle time `N·I` in gaps without hold too
@@ -59,11 +62,13 @@
 mod graph;
 mod plan;
 mod ratio;
+mod run;
 mod search;
 
 pub use graph::{Event, EventGraph, Gap, Stretch, TaskShape, event_graph};
 pub use plan::{CyclicPlan, GapPlan, RobotCycle, cyclic_plan_for_order, period_lower_bound_s};
 pub use ratio::{Arc, CycleRatio, max_cycle_ratio};
+pub use run::is_runnable;
 pub use search::{CyclicParams, cyclic_plan, order_count};
 
 #[cfg(doc)]

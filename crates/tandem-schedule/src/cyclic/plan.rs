@@ -12,8 +12,10 @@ use crate::{Problem, Result};
 /// the operator supervises the `N·m` low-confidence stretches once each, in `order`.
 ///
 /// Times are schedule-clock seconds. The period assumes that the operator follows `ψ̇̄` on
-/// low-confidence stretches and that the robots run at their planned rates; it is not yet
-/// checked against correction drift across cycle boundaries (no margin check here).
+/// low-confidence stretches and that the robots run at their planned rates. At run time
+/// [`CyclicPlan::coordinator`] runs it soundly under any drift by the token rule (robots wait
+/// at gates instead of relying on margins), for a runnable order; the period is then not
+/// guaranteed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CyclicPlan {
     /// Number of robots `N` (`1..=MAX_ROBOTS`).

@@ -2,6 +2,7 @@
 
 use super::graph::{Stretch, TaskShape};
 use super::plan::{CyclicPlan, cyclic_plan_for_order, period_of};
+use super::run::runnable;
 use crate::problem::check_robot_count;
 use crate::{Error, Problem, Result};
 
@@ -15,6 +16,12 @@ pub struct CyclicParams {
     /// Passes of the adjacent-swap local search per seed (each pass takes the best improving
     /// swap of two neighbouring stretches of different robots, or stops). Default 200.
     pub max_swap_passes: usize,
+    /// Consider only orders the continuous coordinator can run ([`crate::cyclic::is_runnable`]:
+    /// no other robot's stretch between two stretches of one robot with no usable hold
+    /// between them), so that [`CyclicPlan::coordinator`] accepts the plan. The enumeration
+    /// skips the others; the local search moves whole groups (the stretches between two holds)
+    /// instead of single stretches. `false`: every order, as a plan only. Default `true`.
+    pub runnable_only: bool,
 }
 
 impl Default for CyclicParams {
@@ -22,6 +29,7 @@ impl Default for CyclicParams {
         CyclicParams {
             max_enumerated: 100_000,
             max_swap_passes: 200,
+            runnable_only: true,
         }
     }
 }
@@ -84,14 +92,18 @@ pub fn order_count(n_robots: usize, m: usize) -> u64 {
 /// - **enumeration** when [`order_count`] is at most `params.max_enumerated`: every order up
 ///   to rotation (robot 0's stretch 0 first; the first order in lexicographic order of robot
 ///   labels and rotations wins ties), so the plan's period is the least of every 1-periodic
-///   plan ([`CyclicPlan::order_exhaustive`]). Two robots are enumerated up to 8 stretches
-///   per task at the default.
+///   plan ([`CyclicPlan::order_exhaustive`]) — of every runnable one with
+///   [`CyclicParams::runnable_only`], which skips the others. Two robots are enumerated up to
+///   8 stretches per task at the default.
 /// - **local search** beyond: three seeds — round robin by stretch (every robot's stretch 0,
 ///   then every robot's stretch 1, …), the staggered round robin (robot `r` begins at
 ///   stretch `r mod m`) and the serial order (robot by robot, always feasible) — each
 ///   improved by best-improving swaps of two neighbouring stretches of different robots
 ///   (the wrap included) until no swap shortens the period or `max_swap_passes`; the best
-///   wins, the earlier seed on ties. Deterministic.
+///   wins, the earlier seed on ties. Deterministic. With `runnable_only` the units are the
+///   task's groups (the stretches between two usable holds) instead of single stretches:
+///   seeds and swaps are the same on groups, so every order visited is runnable (with a hold
+///   in every gap, groups are stretches and nothing changes).
 ///
 /// A task without low-confidence stretches has the empty order and the period `D_min`; one
 /// robot has its own task's order and period `D_min`.
@@ -109,10 +121,10 @@ pub fn cyclic_plan(
     let m = shape.n_lc();
     let count = order_count(n_robots, m);
     let (order, evaluated, exhaustive) = if count <= params.max_enumerated {
-        let (order, evaluated) = enumerate(&shape, n_robots, m)?;
+        let (order, evaluated) = enumerate(&shape, n_robots, m, params.runnable_only)?;
         (order, evaluated, true)
     } else {
-        let (order, evaluated) = local_search(&shape, n_robots, m, params)?;
+        let (order, evaluated) = local_search(&shape, n_robots, params)?;
         (order, evaluated, false)
     };
     let mut plan = cyclic_plan_for_order(problem, n_robots, &order)?;
@@ -136,7 +148,12 @@ fn better(p: Option<f64>, best: Option<f64>) -> bool {
     }
 }
 
-fn enumerate(shape: &TaskShape, n_robots: usize, m: usize) -> Result<(Vec<Stretch>, usize)> {
+fn enumerate(
+    shape: &TaskShape,
+    n_robots: usize,
+    m: usize,
+    runnable_only: bool,
+) -> Result<(Vec<Stretch>, usize)> {
     if m == 0 {
         return Ok((Vec::new(), 1));
     }
@@ -181,10 +198,12 @@ fn enumerate(shape: &TaskShape, n_robots: usize, m: usize) -> Result<(Vec<Stretc
                 });
                 seen[r] += 1;
             }
-            evaluated += 1;
-            let p = period_of(shape, n_robots, &order)?;
-            if better(p, best.0) {
-                best = (p, order.clone());
+            if !runnable_only || runnable(shape, &order) {
+                evaluated += 1;
+                let p = period_of(shape, n_robots, &order)?;
+                if better(p, best.0) {
+                    best = (p, order.clone());
+                }
             }
             // Next rotation (odometer over robots 1..N).
             let mut r = 1;
@@ -206,39 +225,61 @@ fn enumerate(shape: &TaskShape, n_robots: usize, m: usize) -> Result<(Vec<Stretc
     Ok((best.1, evaluated))
 }
 
+/// The units of the local search: `(first, end)` stretch ranges — single stretches, or with
+/// `runnable_only` the task's groups (a new group at stretch 0 and after every gap with a
+/// usable hold).
+fn units(shape: &TaskShape, runnable_only: bool) -> Vec<(usize, usize)> {
+    let m = shape.n_lc();
+    let mut out: Vec<(usize, usize)> = Vec::new();
+    for k in 0..m {
+        if k == 0 || !runnable_only || shape.gaps[k].hold.is_some() {
+            out.push((k, k + 1));
+        } else {
+            out.last_mut().expect("stretch 0 opened a unit").1 = k + 1;
+        }
+    }
+    out
+}
+
 fn local_search(
     shape: &TaskShape,
     n_robots: usize,
-    m: usize,
     params: &CyclicParams,
 ) -> Result<(Vec<Stretch>, usize)> {
-    let round_robin: Vec<Stretch> = (0..m)
-        .flat_map(|lc| (0..n_robots).map(move |robot| Stretch { robot, lc }))
+    let units = units(shape, params.runnable_only);
+    let u = units.len();
+    // Orders of units `(robot, unit)`, flattened to stretches for the period.
+    let flat = |order: &[(usize, usize)]| -> Vec<Stretch> {
+        order
+            .iter()
+            .flat_map(|&(robot, k)| (units[k].0..units[k].1).map(move |lc| Stretch { robot, lc }))
+            .collect()
+    };
+    let round_robin: Vec<(usize, usize)> = (0..u)
+        .flat_map(|k| (0..n_robots).map(move |robot| (robot, k)))
         .collect();
-    let staggered: Vec<Stretch> = (0..m)
-        .flat_map(|j| {
-            (0..n_robots).map(move |robot| Stretch {
-                robot,
-                lc: (j + robot) % m,
-            })
-        })
+    let staggered: Vec<(usize, usize)> = (0..u)
+        .flat_map(|j| (0..n_robots).map(move |robot| (robot, (j + robot) % u)))
+        .collect();
+    let serial_units: Vec<(usize, usize)> = (0..n_robots)
+        .flat_map(|robot| (0..u).map(move |k| (robot, k)))
         .collect();
     let mut evaluated = 0;
-    let mut best: (Option<f64>, Vec<Stretch>) = (None, serial(n_robots, m));
-    for seed in [round_robin, staggered, serial(n_robots, m)] {
+    let mut best: (Option<f64>, Vec<Stretch>) = (None, flat(&serial_units));
+    for seed in [round_robin, staggered, serial_units] {
         let mut cur = seed;
-        let mut p = period_of(shape, n_robots, &cur)?;
+        let mut p = period_of(shape, n_robots, &flat(&cur))?;
         evaluated += 1;
         let len = cur.len();
         for _ in 0..params.max_swap_passes {
             let mut step: Option<(usize, Option<f64>)> = None;
             for q in 0..len {
                 let q2 = (q + 1) % len;
-                if cur[q].robot == cur[q2].robot {
+                if cur[q].0 == cur[q2].0 {
                     continue;
                 }
                 cur.swap(q, q2);
-                let pq = period_of(shape, n_robots, &cur)?;
+                let pq = period_of(shape, n_robots, &flat(&cur))?;
                 evaluated += 1;
                 cur.swap(q, q2);
                 if better(pq, step.map_or(p, |s| s.1)) {
@@ -254,7 +295,7 @@ fn local_search(
             }
         }
         if better(p, best.0) {
-            best = (p, cur);
+            best = (p, flat(&cur));
         }
     }
     Ok((best.1, evaluated))

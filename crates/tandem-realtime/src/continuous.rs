@@ -1,0 +1,832 @@
+//! A continuous cell at run time (issue 21): `N` robots each repeat the same task for ever,
+//! one operator supervises their low-confidence stretches in a fixed cyclic order, and no
+//! robot waits for a round to end.
+//!
+//! **The task and its groups.** Every robot runs the same task plan (a [`Timeline`] started at
+//! schedule clock 0, typically the fastest warp: `ψ̇min` on high-confidence samples, `ψ̇̄` on
+//! low-confidence ones). Its maximal low-confidence runs are the *stretches* `0..m`, in
+//! reference order. Consecutive stretches with no usable hold between them (a hold at sample
+//! `h` with `ref_end(k) < h < ref_start(k + 1)`, samples `h − 1` and `h` high-confidence) form
+//! one [`Group`]: a robot cannot stop between them. Before each group lies its *gate*: the
+//! last usable hold before the group's first stretch, or the task start (sample 0, always a
+//! hold). So a robot between two groups, or waiting at a gate, is on high-confidence samples
+//! only.
+//!
+//! **The token rule.** The operator's cyclic order of stretches `(robot, lc)` becomes a cyclic
+//! sequence of [`Token`]s `(robot, group)` ([`token_sequence`]). At run time:
+//! - a robot whose next group is not the current token's waits at that group's gate (clock
+//!   stopped, high-confidence);
+//! - the token's robot may pass its gate, but not the gate of its following group;
+//! - when the token's robot has *left* its group (its schedule clock at least `tol` past the
+//!   end of the group's last low-confidence sample, `tol` = the clock tolerance of
+//!   [`crate::tol`], or at the task's end), the token moves to the next entry, at the end of
+//!   the tick;
+//! - a robot that finishes task `k` is at sample 0 of task `k + 1` (the start hold) at the end
+//!   of that tick and goes on as far as its gate.
+//!
+//! In the first pass through the sequence the entries of a robot that precede its group 0 are
+//! skipped: in the cyclic plan they belong to the task it started one period earlier, which
+//! at run time does not exist.
+//!
+//! **Why it is sound, for any number of tasks and any operator.** Call a robot *inside* from
+//! the tick start at which it holds the token for its next group until the tick end at which
+//! it leaves that group. The token has one holder, and it moves only at a tick end, once its
+//! holder has left; so at most one robot is inside during any tick. A robot that is not
+//! inside is, during the whole tick, between the point `tol` past the end of its previous
+//! group's last low-confidence sample and its next gate (the clock is capped there), or
+//! waiting at the start; the samples it can traverse, even widened by `tol` on both sides,
+//! are high-confidence (the gate's sample and the one before it are high-confidence, and no
+//! low-confidence sample lies between a group and the next gate). So every low-confidence tick
+//! (any low-confidence sample in the traversed interval `[s_old − tol, s_new + tol]`, the
+//! rounds coordinator's conservative definition) is a tick of the one robot inside: two robots
+//! are never low-confidence in one tick. Nothing here depends on the operator's rates, on the
+//! number of tasks, or on where a task ends — the drift of the clocks never matters, because
+//! the robots never rely on a margin: they wait.
+//!
+//! **Runnable orders.** The rule needs each group to be contiguous in the order: between two
+//! stretches of one robot with no usable hold between them no other robot's stretch may come
+//! (the robot cannot wait there for it). [`is_runnable`] checks it; [`token_sequence`] rejects
+//! other orders. Each robot's stretches must also come in task order around the cycle.
+//!
+//! **Liveness.** Each robot's tokens come in its task order (group 0, 1, …, then group 0 of its
+//! next task), which is the order in which it reaches its gates; so the token's robot always
+//! reaches the token's gate (it runs on high-confidence samples at least at `S·tick_s > 0`
+//! per tick) and leaves the group (the operator's rate is at least `S` too). No deadlock.
+//!
+//! **The period.** Under the planned operator (`Operator::Scheduled`) the cell settles into
+//! the cyclic plan's rhythm minus what the rule costs: a robot starts moving from its gate only
+//! once the token is its, so each hand-over costs the operator the travel from the gate to the
+//! stretch (one sample when the gate is next to the stretch) plus the tick quantization.
+//! Under drift the period is not guaranteed; only soundness is.
+//!
+//! ```
+//! use tandem_realtime::continuous::ContinuousCoordinator;
+//! use tandem_realtime::{Operator, Timeline};
+//!
+//! // [HC, LC, HC] at Δt_s = 1 s, ψ̇ = 1 everywhere: a task of 3 s with one 1 s stretch.
+//! let task = Timeline::new(&[true, false, true], &[1.0; 3], &[0.5; 3], &[2.0; 3], 0.0, 1.0)?;
+//! // Two robots, the operator's order: robot 0's stretch, then robot 1's. Gates at the start.
+//! let mut cell = ContinuousCoordinator::new(task, &[], &[(0, 0), (1, 0)], 2, 1.0)?;
+//! let t = cell.tick(Operator::Scheduled)?; // robot 0 moves to 1 s, robot 1 waits at 0
+//! assert_eq!((t.ref_time[0], t.ref_time[1]), (1.0, 0.0));
+//! assert!(t.at_gate[1] && !t.running[1]);
+//! for _ in 0..1000 {
+//!     assert!(!cell.tick(Operator::Fastest)?.overlap());
+//! }
+//! assert!(cell.tasks_completed().iter().all(|&k| k > 100));
+//! # Ok::<(), tandem_realtime::Error>(())
+//! ```
+
+use std::sync::Arc;
+
+use rand::Rng;
+
+use crate::adversary::Adversary;
+use crate::coordinator::{Fault, Operator};
+use crate::error::{Error, Result};
+use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
+use crate::timeline::Timeline;
+use crate::tol::clock_tolerance_s;
+
+/// Consecutive stretches of the task with no usable hold between them: a robot passes them
+/// without stopping, so one robot at a time is in a group ([module docs](self)).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Group {
+    /// The gate: the reference sample at whose start a robot waits for the group's token (the
+    /// last usable hold before the group's first stretch, or 0, the task start).
+    pub gate: usize,
+    /// The group's stretches are `first_lc..end_lc` (indices of the task's low-confidence
+    /// runs, in reference order).
+    pub first_lc: usize,
+    /// One past the group's last stretch.
+    pub end_lc: usize,
+    /// First reference sample of the group's first stretch.
+    pub ref_start: usize,
+    /// One past the group's last low-confidence sample: a robot has left the group once its
+    /// clock is past the start of this sample.
+    pub ref_end: usize,
+}
+
+/// One entry of the token sequence: robot `robot` may go through its group `group`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Token {
+    /// The robot (0-based).
+    pub robot: usize,
+    /// Its group (index into [`groups`]' result).
+    pub group: usize,
+}
+
+/// The groups of a task of confidence `conf` (`true` = high) with usable holds `holds`
+/// (reference samples, strictly increasing, each in `1..T_ref` with samples `h − 1` and `h`
+/// high-confidence, as [`crate::holds::usable_holds`] returns them). Empty for a task without
+/// low confidence.
+///
+/// # Errors
+/// [`Error::BadGate`] for a hold out of range, out of order, or inside or next to a stretch.
+pub fn groups(conf: &[bool], holds: &[usize]) -> Result<Vec<Group>> {
+    for (k, &h) in holds.iter().enumerate() {
+        let bad = |why| Err(Error::BadGate { ref_idx: h, why });
+        if h == 0 || h >= conf.len() {
+            return bad("is outside 1..T_ref");
+        }
+        if k > 0 && holds[k - 1] >= h {
+            return bad("is not after the hold before it");
+        }
+        if !(conf[h - 1] && conf[h]) {
+            return bad("is inside or next to a low-confidence stretch");
+        }
+    }
+    // The stretches (start, end) in reference order.
+    let mut stretches = Vec::new();
+    let mut n = 0;
+    while n < conf.len() {
+        if conf[n] {
+            n += 1;
+            continue;
+        }
+        let start = n;
+        while n < conf.len() && !conf[n] {
+            n += 1;
+        }
+        stretches.push((start, n));
+    }
+    let mut out: Vec<Group> = Vec::new();
+    for (k, &(start, end)) in stretches.iter().enumerate() {
+        let after = if k == 0 { 0 } else { stretches[k - 1].1 };
+        let hold = holds
+            .iter()
+            .copied()
+            .rfind(|&h| (k == 0 || h > after) && h < start);
+        match (k, hold) {
+            (0, _) | (_, Some(_)) => out.push(Group {
+                gate: hold.unwrap_or(0),
+                first_lc: k,
+                end_lc: k + 1,
+                ref_start: start,
+                ref_end: end,
+            }),
+            (_, None) => {
+                let g = out.last_mut().expect("stretch 0 opened a group");
+                g.end_lc = k + 1;
+                g.ref_end = end;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The group of each stretch.
+fn group_of(groups: &[Group]) -> Vec<usize> {
+    groups
+        .iter()
+        .enumerate()
+        .flat_map(|(g, gr)| std::iter::repeat_n(g, gr.end_lc - gr.first_lc))
+        .collect()
+}
+
+/// Whether the operator's cyclic `order` of stretches `(robot, lc)` of `n_robots` robots can
+/// run under the token rule on a task with `groups`: every robot's every stretch once, each
+/// robot's in task order around the cycle, and every group contiguous (no other robot's
+/// stretch between two stretches of one robot with no usable hold between them).
+#[must_use]
+pub fn is_runnable(order: &[(usize, usize)], groups: &[Group], n_robots: usize) -> bool {
+    token_sequence(order, groups, n_robots).is_ok()
+}
+
+/// The cyclic token sequence of a runnable `order` ([`is_runnable`]): the order cut into its
+/// groups, one [`Token`] per group, starting at the first entry of `order` that opens a group;
+/// and, per token, whether the first pass skips it (it precedes its robot's group 0: it
+/// belongs to the task before the robot's first).
+///
+/// # Errors
+/// [`Error::BadOrder`] naming the position in `order` and what is wrong.
+pub fn token_sequence(
+    order: &[(usize, usize)],
+    groups: &[Group],
+    n_robots: usize,
+) -> Result<(Vec<Token>, Vec<bool>)> {
+    let m = groups.last().map_or(0, |g| g.end_lc);
+    let len = order.len();
+    if len != n_robots * m {
+        return Err(Error::BadOrder {
+            position: len.min(n_robots * m),
+            why: "does not list each robot's each stretch exactly once (length N·m)",
+        });
+    }
+    if m == 0 {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let gof = group_of(groups);
+    let mut seen = vec![false; n_robots * m];
+    let mut last: Vec<Option<usize>> = vec![None; n_robots];
+    for (q, &(r, lc)) in order.iter().enumerate() {
+        let bad = |why| Err(Error::BadOrder { position: q, why });
+        if r >= n_robots || lc >= m {
+            return bad("names a robot or a stretch that does not exist");
+        }
+        if std::mem::replace(&mut seen[r * m + lc], true) {
+            return bad("repeats a stretch");
+        }
+        if last[r].is_some_and(|l| (l + 1) % m != lc) {
+            return bad("breaks its robot's task order around the cycle");
+        }
+        last[r] = Some(lc);
+        let first = groups[gof[lc]].first_lc == lc;
+        if !first && order[(q + len - 1) % len] != (r, lc - 1) {
+            return bad(
+                "is not runnable: another robot's stretch comes between it and the stretch \
+                 before it, with no usable hold between them",
+            );
+        }
+    }
+    let opens = |q: usize| {
+        let (_, lc) = order[q];
+        groups[gof[lc]].first_lc == lc
+    };
+    let start = (0..len)
+        .find(|&q| opens(q))
+        .expect("stretch 0 opens a group");
+    let tokens: Vec<Token> = (0..len)
+        .map(|k| (start + k) % len)
+        .filter(|&q| opens(q))
+        .map(|q| Token {
+            robot: order[q].0,
+            group: gof[order[q].1],
+        })
+        .collect();
+    let first_zero: Vec<usize> = (0..n_robots)
+        .map(|r| {
+            tokens
+                .iter()
+                .position(|t| t.robot == r && t.group == 0)
+                .expect("every robot has a group 0")
+        })
+        .collect();
+    let skip = tokens
+        .iter()
+        .enumerate()
+        .map(|(k, t)| k < first_zero[t.robot])
+        .collect();
+    Ok((tokens, skip))
+}
+
+/// What one [`ContinuousCoordinator::tick`] did, one value per robot (robot `i` at index `i`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CellTick {
+    /// Each robot's fractional reference time (reference samples, in `[0, T_ref)`) in its
+    /// current task at the end of the tick (a robot that finished a task in this tick is at 0
+    /// of the next).
+    pub ref_time: PerRobot<f64>,
+    /// Each robot's number of completed tasks at the end of the tick.
+    pub tasks: PerRobot<u64>,
+    /// Whether each robot traversed any low-confidence sample during the tick (the interval
+    /// `[s_old − tol, s_new + tol]` of its schedule clock, as the rounds coordinator counts).
+    pub low_conf: RobotFlags,
+    /// Whether each robot's schedule clock moved during the tick.
+    pub running: RobotFlags,
+    /// Whether each robot waits at the gate of its next group at the end of the tick (the
+    /// token is another's).
+    pub at_gate: RobotFlags,
+    /// The latched fault, if any ([`Fault`]; it never happens under the token rule).
+    pub fault: Option<Fault>,
+}
+
+impl CellTick {
+    /// Whether two or more robots traversed a low-confidence sample in this tick.
+    #[must_use]
+    pub fn overlap(&self) -> bool {
+        self.low_conf.count() >= 2
+    }
+}
+
+/// Monotone cursors of one robot into the task, reset at each task start.
+#[derive(Clone, Copy, Debug, Default)]
+struct Cursors {
+    at: usize,
+    lo: usize,
+    hi: usize,
+}
+
+/// The run-time coordinator of a continuous cell ([module docs](self)): `1 ≤ N ≤ MAX_ROBOTS`
+/// robots repeating one task plan for ever under the token rule, one control period
+/// `tick_s` (real s) per [`tick`](ContinuousCoordinator::tick).
+///
+/// Per tick, robot `i` steps from its schedule clock `s` (task-plan clock, s, reset to 0 at
+/// each task start) read at its sample at the tick start: on a high-confidence sample it runs
+/// its plan (`tick_s` of schedule clock); on a low-confidence one at the operator's rate, the
+/// [`Operator`]'s gradient `g` clamped to `[ψ̇min, ψ̇max]` giving `(ψ̇_E/g)·tick_s`
+/// ([`Operator::Scheduled`]: `tick_s`). The step is capped at the gate it may not pass and at
+/// the task's end. `tick` is O(N) (amortized; the first pass may skip tokens) and never
+/// allocates.
+#[derive(Clone, Debug)]
+pub struct ContinuousCoordinator {
+    task: Arc<Timeline>,
+    groups: Arc<[Group]>,
+    /// Schedule clock (s) of each group's gate.
+    gate_s: Arc<[f64]>,
+    /// Schedule clock (s) at which each group is left (start of its `ref_end` sample).
+    leave_s: Arc<[f64]>,
+    tokens: Arc<[Token]>,
+    skip_first: Arc<[bool]>,
+    n: usize,
+    tick_s: f64,
+    tol_s: f64,
+    clock_s: [f64; MAX_ROBOTS],
+    /// Each robot's next group in its current task (`groups.len()`: none left).
+    next_group: [usize; MAX_ROBOTS],
+    tasks: [u64; MAX_ROBOTS],
+    cursors: [Cursors; MAX_ROBOTS],
+    /// Index of the current token.
+    pos: usize,
+    /// Completed passes through the token sequence.
+    passes: u64,
+    ticks: u64,
+    lc_since: [u64; MAX_ROBOTS],
+    lc_last: RobotFlags,
+    fault: Option<Fault>,
+}
+
+impl ContinuousCoordinator {
+    /// A continuous cell of `n_robots` robots repeating `task` (its plan; re-based to start at
+    /// schedule clock 0), waiting at the usable holds `holds` ([`groups`]), the operator taking
+    /// the stretches `(robot, lc)` in the cyclic `order` ([`token_sequence`]), at a control
+    /// tick of `tick_s` real seconds. Every robot starts at sample 0 of its first task.
+    ///
+    /// # Errors
+    /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] for a `tick_s`
+    /// not finite and > 0; [`Error::BadGate`] for a bad hold; [`Error::BadOrder`] for an
+    /// order that is malformed or not runnable.
+    pub fn new(
+        task: Timeline,
+        holds: &[usize],
+        order: &[(usize, usize)],
+        n_robots: usize,
+        tick_s: f64,
+    ) -> Result<ContinuousCoordinator> {
+        check_count(n_robots)?;
+        if !(tick_s.is_finite() && tick_s > 0.0) {
+            return Err(Error::BadParam {
+                name: "tick_s",
+                why: "must be finite and > 0",
+            });
+        }
+        let task = task.sub(0, task.n_ref(), 0.0)?;
+        let groups = groups(task.conf(), holds)?;
+        let (tokens, skip_first) = token_sequence(order, &groups, n_robots)?;
+        let c = task.sample_clock_s();
+        let gate_s: Vec<f64> = groups.iter().map(|g| c[g.gate]).collect();
+        let leave_s: Vec<f64> = groups.iter().map(|g| c[g.ref_end]).collect();
+        let tol_s = clock_tolerance_s(std::slice::from_ref(&task), tick_s);
+        let mut out = ContinuousCoordinator {
+            task: Arc::new(task),
+            groups: groups.into(),
+            gate_s: gate_s.into(),
+            leave_s: leave_s.into(),
+            tokens: tokens.into(),
+            skip_first: skip_first.into(),
+            n: n_robots,
+            tick_s,
+            tol_s,
+            clock_s: [0.0; MAX_ROBOTS],
+            next_group: [0; MAX_ROBOTS],
+            tasks: [0; MAX_ROBOTS],
+            cursors: [Cursors::default(); MAX_ROBOTS],
+            pos: 0,
+            passes: 0,
+            ticks: 0,
+            lc_since: [0; MAX_ROBOTS],
+            lc_last: RobotFlags::new(n_robots),
+            fault: None,
+        };
+        out.reset();
+        Ok(out)
+    }
+
+    /// Every robot back at sample 0 of its first task, the token at its first entry, the
+    /// counters and the fault cleared (no allocation).
+    pub fn reset(&mut self) {
+        self.clock_s = [0.0; MAX_ROBOTS];
+        self.next_group = [0; MAX_ROBOTS];
+        self.tasks = [0; MAX_ROBOTS];
+        self.cursors = [Cursors::default(); MAX_ROBOTS];
+        self.pos = 0;
+        self.passes = 0;
+        while !self.tokens.is_empty() && self.skip_first[self.pos] {
+            self.pos += 1;
+        }
+        self.ticks = 0;
+        self.lc_since = [0; MAX_ROBOTS];
+        self.lc_last = RobotFlags::new(self.n);
+        self.fault = None;
+    }
+
+    /// Number of robots `N`.
+    pub fn n_robots(&self) -> usize {
+        self.n
+    }
+
+    /// Control period (real s).
+    pub fn tick_s(&self) -> f64 {
+        self.tick_s
+    }
+
+    /// The task plan every robot repeats (schedule clock from 0).
+    pub fn task(&self) -> &Timeline {
+        &self.task
+    }
+
+    /// The task's groups ([`groups`]).
+    pub fn groups(&self) -> &[Group] {
+        &self.groups
+    }
+
+    /// The cyclic token sequence ([`token_sequence`]).
+    pub fn tokens(&self) -> &[Token] {
+        &self.tokens
+    }
+
+    /// Whether the first pass skips token `k` ([`token_sequence`]).
+    pub fn skipped_in_first_pass(&self, k: usize) -> bool {
+        self.skip_first.get(k).copied().unwrap_or(false)
+    }
+
+    /// The current token (`None` for a task without low confidence).
+    pub fn token(&self) -> Option<Token> {
+        self.tokens.get(self.pos).copied()
+    }
+
+    /// Index of the current token in [`tokens`](Self::tokens) and the number of completed
+    /// passes through the sequence.
+    pub fn token_position(&self) -> (usize, u64) {
+        (self.pos, self.passes)
+    }
+
+    /// Each robot's number of completed tasks.
+    pub fn tasks_completed(&self) -> &[u64] {
+        &self.tasks[..self.n]
+    }
+
+    /// Each robot's schedule clock in its current task (s, task-plan clock from 0).
+    pub fn clock_s(&self) -> &[f64] {
+        &self.clock_s[..self.n]
+    }
+
+    /// Ticks run since the start or the last reset.
+    pub fn ticks(&self) -> u64 {
+        self.ticks
+    }
+
+    /// The latched fault, if any.
+    pub fn fault(&self) -> Option<Fault> {
+        self.fault
+    }
+
+    /// Clears the latched fault: the held robot moves again from the next tick.
+    pub fn clear_fault(&mut self) {
+        self.fault = None;
+    }
+
+    /// Whether each robot is on a low-confidence sample and may move (it holds the token) at
+    /// the tick start: the robot the next tick moves at the operator's rate. O(N).
+    pub fn low_conf_now(&self) -> RobotFlags {
+        let mut out = RobotFlags::new(self.n);
+        let tok = self.token();
+        for i in 0..self.n {
+            let holder = tok.is_some_and(|t| t.robot == i && t.group == self.next_group[i]);
+            out.set(i, holder && !self.task.conf()[self.cursors[i].at]);
+        }
+        out
+    }
+
+    /// Advances every robot one control period with the operator's input `operator` for the
+    /// low-confidence robot. Never allocates; O(N).
+    ///
+    /// # Errors
+    /// [`Error::BadOperator`] for an [`Operator::Gradient`] that is NaN, infinite or ≤ 0; the
+    /// coordinator is then unchanged.
+    pub fn tick(&mut self, operator: Operator) -> Result<CellTick> {
+        let op = operator.validate()?;
+        let n = self.n;
+        let n_groups = self.groups.len();
+        let task = Arc::clone(&self.task);
+        let end_s = task.end_s();
+        let tok = self.token();
+        let held = self.fault.map(|f| f.stopped);
+        let mut out = CellTick {
+            ref_time: PerRobot::new(n),
+            tasks: PerRobot::new(n),
+            low_conf: RobotFlags::new(n),
+            running: RobotFlags::new(n),
+            at_gate: RobotFlags::new(n),
+            fault: None,
+        };
+        for i in 0..n {
+            if held == Some(i) {
+                continue;
+            }
+            let s_old = self.clock_s[i];
+            let g = self.next_group[i];
+            let holder = tok.is_some_and(|t| t.robot == i && t.group == g);
+            let cap = if g >= n_groups {
+                end_s
+            } else if holder {
+                self.gate_s.get(g + 1).copied().unwrap_or(end_s)
+            } else {
+                self.gate_s[g]
+            };
+            let cur = &mut self.cursors[i];
+            let at = task.advance_cursor(&mut cur.at, s_old);
+            let step = if task.conf()[at] {
+                self.tick_s
+            } else {
+                let (lo, hi, e) = (
+                    task.grad_min()[at],
+                    task.grad_max()[at],
+                    task.grad_exec()[at],
+                );
+                let grad = match op {
+                    Operator::Scheduled => e,
+                    Operator::Gradient(x) => x.clamp(lo, hi),
+                    Operator::Fastest => lo,
+                    Operator::Slowest => hi,
+                };
+                e / grad * self.tick_s
+            };
+            let s_new = (s_old + step).min(cap).max(s_old);
+            if s_new > s_old {
+                out.running.set(i, true);
+                let lo = task.advance_cursor(&mut cur.lo, s_old - self.tol_s);
+                let hi = task.advance_cursor(&mut cur.hi, s_new + self.tol_s);
+                out.low_conf.set(i, task.any_low_conf(lo, hi));
+            }
+            self.clock_s[i] = s_new;
+        }
+        // The token moves once its robot has left its group.
+        if let Some(t) = tok {
+            let (r, g) = (t.robot, t.group);
+            let s = self.clock_s[r];
+            if self.next_group[r] == g && (s >= end_s || s - self.tol_s >= self.leave_s[g]) {
+                self.next_group[r] = g + 1;
+                self.advance_token();
+            }
+        }
+        let tok = self.token();
+        for i in 0..n {
+            if self.clock_s[i] >= end_s && self.next_group[i] >= n_groups {
+                self.tasks[i] += 1;
+                self.clock_s[i] = 0.0;
+                self.cursors[i] = Cursors::default();
+                self.next_group[i] = 0;
+            }
+            let s = self.clock_s[i];
+            let at = task.advance_cursor(&mut self.cursors[i].at, s);
+            out.ref_time.as_mut_slice()[i] = task.ref_time_in(at, s);
+            out.tasks.as_mut_slice()[i] = self.tasks[i];
+            let g = self.next_group[i];
+            let waits = g < n_groups
+                && s >= self.gate_s[g]
+                && !tok.is_some_and(|t| t.robot == i && t.group == g);
+            out.at_gate.set(i, waits);
+        }
+        self.monitor(&out);
+        out.fault = self.fault;
+        self.ticks += 1;
+        Ok(out)
+    }
+
+    fn advance_token(&mut self) {
+        let len = self.tokens.len();
+        loop {
+            self.pos += 1;
+            if self.pos == len {
+                self.pos = 0;
+                self.passes += 1;
+            }
+            if self.passes > 0 || !self.skip_first[self.pos] {
+                return;
+            }
+        }
+    }
+
+    /// The run-time monitor (as the rounds coordinator's): latches a [`Fault`] in a tick with
+    /// two or more robots low-confidence and holds the one whose run of low-confidence ticks
+    /// began last (the highest index on a tie). O(N).
+    fn monitor(&mut self, tick: &CellTick) {
+        for i in 0..self.n {
+            if tick.low_conf[i] && !self.lc_last[i] {
+                self.lc_since[i] = self.ticks;
+            }
+        }
+        self.lc_last = tick.low_conf;
+        if self.fault.is_some() || !tick.overlap() {
+            return;
+        }
+        let stopped = (0..self.n)
+            .filter(|&i| tick.low_conf[i])
+            .max_by_key(|&i| (self.lc_since[i], i))
+            .expect("an overlap has low-confidence robots");
+        self.fault = Some(Fault {
+            tick: self.ticks,
+            low_conf: tick.low_conf,
+            stopped,
+        });
+    }
+}
+
+/// What [`run_cell`] measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CellRun {
+    /// Control ticks run.
+    pub ticks: u64,
+    /// Ticks with two or more robots low-confidence (0 under the token rule).
+    pub overlap_ticks: u64,
+    /// The fewest tasks any robot completed.
+    pub min_tasks: u64,
+    /// Whether every robot completed `min_tasks` of the call within the tick budget.
+    pub finished: bool,
+}
+
+/// Runs `cell` from its current state until every robot has completed `min_tasks` tasks (or
+/// for at most `max_ticks` ticks) with the operator inputs of the policy `adversary` (the
+/// policies of [`crate::adversary`], reproduced here for the continuous cell; the beam search
+/// [`Adversary::Beam`] is not a policy and runs as [`Adversary::SwitchFavourite`] with holds up
+/// to 50 ticks), drawing from `rng`. A fault is counted and cleared. Allocates nothing.
+///
+/// # Errors
+/// [`Error::BadOperator`] for a policy producing an inadmissible gradient.
+pub fn run_cell(
+    cell: &mut ContinuousCoordinator,
+    adversary: Adversary,
+    rng: &mut impl Rng,
+    min_tasks: u64,
+    max_ticks: u64,
+) -> Result<CellRun> {
+    let mut run = CellRun::default();
+    let n = cell.n_robots();
+    let (mut hold, mut current, mut favourite) = (0_u32, Operator::Fastest, 0_usize);
+    let mut per_robot = [Operator::Slowest; MAX_ROBOTS];
+    per_robot[0] = Operator::Fastest;
+    let mut last_lc = None;
+    let extreme = |fast: bool| {
+        if fast {
+            Operator::Fastest
+        } else {
+            Operator::Slowest
+        }
+    };
+    let uniform = |rng: &mut dyn rand::RngCore, lo: f64, hi: f64| {
+        if lo < hi && lo.is_finite() && hi.is_finite() {
+            rng.random_range(lo..=hi)
+        } else {
+            lo
+        }
+    };
+    let min_done = |c: &ContinuousCoordinator| c.tasks_completed().iter().copied().min();
+    while min_done(cell).unwrap_or(0) < min_tasks {
+        if run.ticks >= max_ticks {
+            run.min_tasks = min_done(cell).unwrap_or(0);
+            return Ok(run);
+        }
+        let k = run.ticks;
+        let lc = cell.low_conf_now().first();
+        let op = match adversary {
+            Adversary::Nominal => Operator::Scheduled,
+            Adversary::Fastest => Operator::Fastest,
+            Adversary::Slowest => Operator::Slowest,
+            Adversary::Periodic { period, phase } => {
+                extreme(((k + u64::from(phase)) / u64::from(period.max(1))) % 2 == 0)
+            }
+            Adversary::SwitchOnce { at, rev } => extreme((k < at) != rev),
+            Adversary::RandomSwitching { max_hold } => {
+                if hold == 0 {
+                    current = extreme(current != Operator::Fastest);
+                    hold = rng.random_range(1..=max_hold.max(1));
+                }
+                hold -= 1;
+                current
+            }
+            Adversary::RandomExtreme => extreme(rng.random_bool(0.5)),
+            Adversary::Random { lo, hi } => Operator::Gradient(uniform(rng, lo, hi)),
+            Adversary::RandomHeld { lo, hi, max_hold } => {
+                if hold == 0 {
+                    current = Operator::Gradient(uniform(rng, lo, hi));
+                    hold = rng.random_range(1..=max_hold.max(1));
+                }
+                hold -= 1;
+                current
+            }
+            Adversary::RushRobot { rush } => extreme(lc == Some(rush)),
+            Adversary::SwitchFavourite { max_hold } | Adversary::Beam { width: max_hold } => {
+                let max_hold = if matches!(adversary, Adversary::Beam { .. }) {
+                    50
+                } else {
+                    max_hold
+                };
+                if hold == 0 {
+                    favourite = rng.random_range(0..n.max(1));
+                    hold = rng.random_range(1..=max_hold.max(1));
+                }
+                hold -= 1;
+                extreme(lc == Some(favourite))
+            }
+            Adversary::RandomPerRobot => {
+                if lc != last_lc
+                    && let Some(i) = lc
+                {
+                    per_robot[i] = extreme(rng.random_bool(0.5));
+                }
+                lc.map_or(Operator::Scheduled, |i| per_robot[i])
+            }
+        };
+        last_lc = lc;
+        let t = cell.tick(op)?;
+        if t.overlap() {
+            run.overlap_ticks += 1;
+        }
+        if t.fault.is_some() {
+            cell.clear_fault();
+        }
+        run.ticks += 1;
+    }
+    run.min_tasks = min_done(cell).unwrap_or(0);
+    run.finished = true;
+    Ok(run)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn groups_by_hand() {
+        // HC HC LC HC HC HC LC LC HC LC HC HC: stretches (2,3), (6,8), (9,10).
+        let conf = [
+            true, true, false, true, true, true, false, false, true, false, true, true,
+        ];
+        // No holds: one group of three stretches, gated at the start.
+        let g = groups(&conf, &[]).unwrap();
+        assert_eq!(g.len(), 1);
+        assert_eq!((g[0].gate, g[0].first_lc, g[0].end_lc), (0, 0, 3));
+        assert_eq!((g[0].ref_start, g[0].ref_end), (2, 10));
+        // A hold at 1 (before stretch 0) and at 5 (between stretches 0 and 1).
+        let g = groups(&conf, &[1, 5]).unwrap();
+        assert_eq!(g.len(), 2);
+        assert_eq!((g[0].gate, g[0].end_lc, g[0].ref_end), (1, 1, 3));
+        assert_eq!((g[1].gate, g[1].first_lc, g[1].end_lc), (5, 1, 3));
+        assert!(matches!(
+            groups(&conf, &[3]),
+            Err(Error::BadGate { ref_idx: 3, .. })
+        ));
+        assert!(groups(&conf, &[5, 4]).is_err() && groups(&conf, &[12]).is_err());
+        assert!(groups(&[true; 4], &[]).unwrap().is_empty());
+    }
+
+    #[test]
+    fn token_sequences_by_hand() {
+        // Two groups per task: {0}, {1, 2}.
+        let g = [
+            Group {
+                gate: 0,
+                first_lc: 0,
+                end_lc: 1,
+                ref_start: 2,
+                ref_end: 3,
+            },
+            Group {
+                gate: 5,
+                first_lc: 1,
+                end_lc: 3,
+                ref_start: 6,
+                ref_end: 10,
+            },
+        ];
+        // Robot 1 starts at its stretch 1 and its group {1, 2} straddles the wrap.
+        let order = [(1, 2), (0, 0), (1, 0), (0, 1), (0, 2), (1, 1)];
+        let (tokens, skip) = token_sequence(&order, &g, 2).unwrap();
+        let t = |robot, group| Token { robot, group };
+        assert_eq!(tokens, [t(0, 0), t(1, 0), t(0, 1), t(1, 1)]);
+        assert_eq!(skip, [false; 4]);
+        // Robot 1 first in its group 1: skipped in the first pass.
+        let order = [(1, 1), (1, 2), (0, 0), (1, 0), (0, 1), (0, 2)];
+        let (tokens, skip) = token_sequence(&order, &g, 2).unwrap();
+        assert_eq!(tokens, [t(1, 1), t(0, 0), t(1, 0), t(0, 1)]);
+        assert_eq!(skip, [true, false, false, false]);
+        // Robot 0 between robot 1's stretches 1 and 2: not runnable.
+        let bad = [(1, 1), (0, 0), (1, 2), (1, 0), (0, 1), (0, 2)];
+        assert!(matches!(
+            token_sequence(&bad, &g, 2),
+            Err(Error::BadOrder { position: 2, .. })
+        ));
+        assert!(!is_runnable(&bad, &g, 2));
+        // Out of task order, repeated, wrong length, unknown robot.
+        let cases: [&[(usize, usize)]; 4] = [
+            &[(0, 0), (1, 0), (1, 1), (1, 2), (0, 2), (0, 1)],
+            &[(0, 0), (0, 0), (1, 0), (1, 1), (1, 2), (0, 1)],
+            &[(0, 0), (0, 1), (0, 2)],
+            &[(0, 0), (2, 0), (1, 1), (1, 2), (0, 1), (0, 2)],
+        ];
+        for c in cases {
+            assert!(!is_runnable(c, &g, 2), "{c:?}");
+        }
+    }
+}

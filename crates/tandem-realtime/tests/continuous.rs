@@ -1,0 +1,413 @@
+//! The continuous cell (`tandem_realtime::continuous`): hand-derived runs of the token rule,
+//! the errors of its constructor, and a property test over random tasks with holds, N = 2…5,
+//! random runnable orders and operators that rush, drag, alternate and switch at random:
+//! never two robots low-confidence in one tick, the tokens visited in the order's sequence,
+//! every robot completing ≥ 50 tasks within a tick bound (no deadlock).
+
+use proptest::prelude::*;
+use proptest::test_runner::RngSeed;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use tandem_realtime::adversary::adversary_set;
+use tandem_realtime::continuous::{ContinuousCoordinator, Token, groups, run_cell};
+use tandem_realtime::holds::usable_holds;
+use tandem_realtime::{Error, MAX_ROBOTS, Operator, Timeline};
+
+/// A task of confidence `conf` at Δt_s = 1 s, ψ̇ = 1, bounds [½, 2].
+fn task(conf: &[bool]) -> Timeline {
+    let n = conf.len();
+    Timeline::new(conf, &vec![1.0; n], &vec![0.5; n], &vec![2.0; n], 0.0, 1.0).unwrap()
+}
+
+#[test]
+fn the_second_robot_waits_at_the_start_until_the_first_leaves() {
+    // [HC, LC, HC], tick 1 s, no hold: both gates at the start.
+    let mut c =
+        ContinuousCoordinator::new(task(&[true, false, true]), &[], &[(0, 0), (1, 0)], 2, 1.0)
+            .unwrap();
+    assert_eq!(c.token(), Some(Token { robot: 0, group: 0 }));
+    // Tick 0: robot 0 runs to 1 s (the tolerance reaches its LC sample: LC); robot 1 waits.
+    let t = c.tick(Operator::Scheduled).unwrap();
+    assert_eq!(t.ref_time, [1.0, 0.0]);
+    assert_eq!(
+        (t.low_conf, t.running, t.at_gate),
+        (
+            [true, false].into_flags(),
+            [true, false].into_flags(),
+            [false, true].into_flags()
+        )
+    );
+    // Tick 1: robot 0 crosses its LC sample to exactly 2 s — not yet `tol` past it.
+    let t = c.tick(Operator::Scheduled).unwrap();
+    assert_eq!(t.ref_time, [2.0, 0.0]);
+    assert!(t.at_gate[1] && c.token() == Some(Token { robot: 0, group: 0 }));
+    // Tick 2: robot 0 reaches its end (LC: the interval starts at 2 − tol), the token moves
+    // to robot 1 at the tick end and robot 0 is at sample 0 of task 1, waiting at its gate.
+    let t = c.tick(Operator::Scheduled).unwrap();
+    assert_eq!(t.tasks, [1, 0]);
+    assert_eq!(t.low_conf, [true, false]);
+    assert_eq!(t.at_gate, [true, false]);
+    assert_eq!(c.token(), Some(Token { robot: 1, group: 0 }));
+    // Tick 3: robot 1 moves for the first time.
+    let t = c.tick(Operator::Scheduled).unwrap();
+    assert_eq!(t.running, [false, true]);
+    assert_eq!(t.ref_time, [0.0, 1.0]);
+    // Three ticks per task and robot, one after the other: after K ticks robot 0 has
+    // completed ⌊(K + 3)/6⌋ tasks (at ticks 2, 8, 14, …), robot 1 ⌊K/6⌋ (at 5, 11, …).
+    for k in 4..200_u64 {
+        let t = c.tick(Operator::Scheduled).unwrap();
+        let ticks = k + 1;
+        assert_eq!(t.tasks, [(ticks + 3) / 6, ticks / 6], "after {ticks} ticks");
+        assert!(!t.overlap() && t.fault.is_none());
+    }
+    assert_eq!(c.tasks_completed(), [33, 33]);
+    assert_eq!(c.token_position(), (0, 33));
+}
+
+/// `[bool; 2]` as `RobotFlags` for comparisons.
+trait IntoFlags {
+    fn into_flags(self) -> tandem_realtime::RobotFlags;
+}
+impl IntoFlags for [bool; 2] {
+    fn into_flags(self) -> tandem_realtime::RobotFlags {
+        tandem_realtime::RobotFlags::from_slice(&self)
+    }
+}
+
+/// [HC, HC, LC, LC, HC, HC] with a hold at sample 1: robot 1 waits at its gate (1 s) until
+/// robot 0 has left; how long depends on the operator, by hand.
+fn ticks_waiting_at_the_gate(op: Operator) -> usize {
+    let conf = [true, true, false, false, true, true];
+    let mut c = ContinuousCoordinator::new(task(&conf), &[1], &[(0, 0), (1, 0)], 2, 1.0).unwrap();
+    assert_eq!(c.groups()[0].gate, 1);
+    let mut waiting = 0;
+    loop {
+        let t = c.tick(op).unwrap();
+        assert!(!t.overlap());
+        if !t.at_gate[1] {
+            // It never moved before: it waited at its gate, clock 1 s.
+            assert_eq!(c.clock_s()[1], 1.0);
+            assert!(c.clock_s()[0] - 1e-9 >= 4.0);
+            let next = c.tick(op).unwrap();
+            assert!(next.running[1] && next.low_conf[1] && !next.low_conf[0]);
+            return waiting;
+        }
+        waiting += 1;
+    }
+}
+
+#[test]
+fn the_gate_holds_the_second_robot_for_as_long_as_the_operator_takes() {
+    // Tick 0: both robots move 0 → 1 (robot 1 reaches its gate). Robot 0: 1 → 2 (LC by the
+    // tolerance), then its two LC samples at the operator's step, then one HC tick past 4 s.
+    // Scheduled: steps 1, 1 → at 4 after tick 3, past it after tick 4: waits in ticks 0–3.
+    assert_eq!(ticks_waiting_at_the_gate(Operator::Scheduled), 4);
+    // Dragged (step ½): four LC ticks, at 4 after tick 5: waits in ticks 0–5.
+    assert_eq!(ticks_waiting_at_the_gate(Operator::Slowest), 6);
+    // Rushed (step 2): one LC tick to 4 after tick 2: waits in ticks 0–2.
+    assert_eq!(ticks_waiting_at_the_gate(Operator::Fastest), 3);
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let conf = [true, true, false, true, true, false, true];
+    let t = task(&conf);
+    let order = [(0, 0), (0, 1), (1, 0), (1, 1)];
+    let new = |holds: &[usize], order: &[(usize, usize)], n: usize, tick: f64| {
+        ContinuousCoordinator::new(t.clone(), holds, order, n, tick)
+    };
+    assert!(new(&[], &order, 2, 0.5).is_ok());
+    // A gate inside or next to a stretch, out of range, out of order.
+    for holds in [&[2][..], &[3], &[0], &[7], &[4, 1]] {
+        assert!(
+            matches!(new(holds, &order, 2, 0.5), Err(Error::BadGate { .. })),
+            "{holds:?}"
+        );
+    }
+    // Robot 1 between robot 0's stretches without a hold between them: not runnable; with
+    // the hold at 4 it is.
+    let interleaved = [(0, 0), (1, 0), (0, 1), (1, 1)];
+    assert!(matches!(
+        new(&[], &interleaved, 2, 0.5),
+        Err(Error::BadOrder { position: 2, .. })
+    ));
+    assert!(new(&[4], &interleaved, 2, 0.5).is_ok());
+    // Wrong robot count for the order, no robots, too many, bad ticks.
+    assert!(matches!(
+        new(&[], &order, 3, 0.5),
+        Err(Error::BadOrder { .. })
+    ));
+    assert!(matches!(
+        new(&[], &[], 0, 0.5),
+        Err(Error::RobotCount { n: 0, .. })
+    ));
+    assert!(matches!(
+        new(&[], &order, MAX_ROBOTS + 1, 0.5),
+        Err(Error::RobotCount { n: 9, .. })
+    ));
+    for tick in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            new(&[], &order, 2, tick),
+            Err(Error::BadParam { name: "tick_s", .. })
+        ));
+    }
+    // A NaN operator gradient is an error and leaves the cell unchanged.
+    let mut c = new(&[], &order, 2, 0.5).unwrap();
+    c.tick(Operator::Scheduled).unwrap();
+    let before = c.clock_s().to_vec();
+    assert!(matches!(
+        c.tick(Operator::Gradient(f64::NAN)),
+        Err(Error::BadOperator { .. })
+    ));
+    assert_eq!(c.clock_s(), before);
+    // A task without low confidence: no tokens, every robot runs on its own.
+    let mut free = ContinuousCoordinator::new(task(&[true; 3]), &[], &[], 3, 1.0).unwrap();
+    for _ in 0..9 {
+        free.tick(Operator::Slowest).unwrap();
+    }
+    assert_eq!(free.tasks_completed(), [3, 3, 3]);
+    assert_eq!(free.token(), None);
+}
+
+#[test]
+fn a_robot_whose_first_token_is_a_later_group_skips_it_in_the_first_pass() {
+    // Two groups ({0}, {1}) with a hold at 4; robot 1's cyclic order starts at stretch 1.
+    let conf = [true, true, false, true, true, false, true];
+    let order = [(1, 1), (0, 0), (1, 0), (0, 1)];
+    let mut c = ContinuousCoordinator::new(task(&conf), &[4], &order, 2, 0.5).unwrap();
+    assert_eq!(c.tokens()[0], Token { robot: 1, group: 1 });
+    assert!(c.skipped_in_first_pass(0) && !c.skipped_in_first_pass(1));
+    assert_eq!(c.token(), Some(Token { robot: 0, group: 0 }));
+    // Robot 1 does not move before robot 0 has left its group 0 (clock 3 s + tol: one HC
+    // tick of ½ s past it, at 3.5 s), although its own first token would be its group 1.
+    let mut first_move = None;
+    for k in 0..400 {
+        let t = c.tick(Operator::Fastest).unwrap();
+        assert!(!t.overlap());
+        if t.running[1] && first_move.is_none() {
+            first_move = Some(k);
+            assert!(c.clock_s()[0] >= 3.5, "{:?}", c.clock_s());
+        }
+    }
+    assert!(first_move.is_some());
+    // 200 s of ticks; a task takes 7 s of HC and LC at the operator's rate: both robots keep
+    // going, within one task of each other.
+    let done = c.tasks_completed();
+    assert!(
+        done.iter().all(|&k| k >= 19) && done[0].abs_diff(done[1]) <= 1,
+        "{done:?}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------
+// Property test.
+
+/// A random task: 6–60 samples in runs (HC 1–8, LC 1–5), ψ̇̄ per sample in [0.5, 2], bounds
+/// factors in [0.3, 1] and [1, 3], Δt_s 0.05; holds on a random subset of the usable samples.
+fn random_task(rng: &mut ChaCha8Rng) -> (Timeline, Vec<usize>) {
+    let mut conf = Vec::new();
+    let mut hc = rng.random_bool(0.5);
+    let len = rng.random_range(6..=60);
+    while conf.len() < len {
+        let run = if hc {
+            rng.random_range(1..=8)
+        } else {
+            rng.random_range(1..=5)
+        };
+        conf.extend(std::iter::repeat_n(hc, run));
+        hc = !hc;
+    }
+    if conf.iter().all(|&c| c) {
+        conf[0] = false;
+    }
+    let n = conf.len();
+    let mean: Vec<f64> = (0..n).map(|_| rng.random_range(0.5..2.0)).collect();
+    let lo: Vec<f64> = mean
+        .iter()
+        .map(|m| m * rng.random_range(0.3..1.0))
+        .collect();
+    let hi: Vec<f64> = mean
+        .iter()
+        .map(|m| m * rng.random_range(1.0..3.0))
+        .collect();
+    let p = rng.random_range(0.0..1.0);
+    let candidates: Vec<usize> = (1..n).filter(|_| rng.random_bool(p)).collect();
+    let holds = usable_holds(&conf, &candidates);
+    // High confidence at its fastest (ψ̇min), low confidence at ψ̇̄.
+    let exec: Vec<f64> = (0..n)
+        .map(|k| if conf[k] { lo[k] } else { mean[k] })
+        .collect();
+    (
+        Timeline::new(&conf, &exec, &lo, &hi, 0.0, 0.05).unwrap(),
+        holds,
+    )
+}
+
+/// A random runnable order: each robot's groups in task order from a random first group,
+/// interleaved at random as whole groups, flattened to stretches.
+fn random_order(
+    groups: &[tandem_realtime::continuous::Group],
+    n: usize,
+    rng: &mut ChaCha8Rng,
+) -> Vec<(usize, usize)> {
+    let g = groups.len();
+    let first: Vec<usize> = (0..n).map(|_| rng.random_range(0..g)).collect();
+    let mut taken = vec![0; n];
+    let mut out = Vec::new();
+    while taken.iter().any(|&k| k < g) {
+        let r = loop {
+            let r = rng.random_range(0..n);
+            if taken[r] < g {
+                break r;
+            }
+        };
+        let gr = groups[(first[r] + taken[r]) % g];
+        out.extend((gr.first_lc..gr.end_lc).map(|lc| (r, lc)));
+        taken[r] += 1;
+    }
+    out
+}
+
+/// The operator policies of the property test, per tick.
+#[derive(Clone, Copy, Debug)]
+enum Policy {
+    Rush,
+    Drag,
+    Alternate,
+    RandomExtreme,
+    RandomGradient,
+    /// Rush the favoured robot, drag the others; the favourite changes at random.
+    Favourite,
+}
+
+fn cell_runs_soundly(seed: u64, n: usize, policy: Policy) -> Result<(), TestCaseError> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let (task, holds) = random_task(&mut rng);
+    let gs = groups(task.conf(), &holds).unwrap();
+    let order = random_order(&gs, n, &mut rng);
+    let tick_s = 0.05 * rng.random_range(0.2..2.0);
+    let mut c = ContinuousCoordinator::new(task.clone(), &holds, &order, n, tick_s).unwrap();
+    // The bound: per pass of the tokens every robot does one task; the holder's task at its
+    // slowest (HC on plan, LC at ψ̇max) in ticks, plus a tick per sample and per gate.
+    let slow_s: f64 = (0..task.n_ref())
+        .map(|k| {
+            if task.conf()[k] {
+                task.grad_exec()[k]
+            } else {
+                task.grad_max()[k]
+            }
+        })
+        .sum::<f64>()
+        * task.dt_s();
+    let per_task = slow_s / tick_s + (task.n_ref() + 2 * gs.len() + 2) as f64;
+    let bound = (52.0 * n as f64 * per_task) as u64;
+    let len = c.tokens().len();
+    let mut favourite = 0;
+    let mut ticks = 0_u64;
+    while c.tasks_completed().iter().any(|&k| k < 50) {
+        prop_assert!(
+            ticks < bound,
+            "deadlock? {ticks} ticks, {:?}",
+            c.tasks_completed()
+        );
+        let k = ticks;
+        let lc = c.low_conf_now().first();
+        let op = match policy {
+            Policy::Rush => Operator::Fastest,
+            Policy::Drag => Operator::Slowest,
+            Policy::Alternate if k % 2 == 0 => Operator::Fastest,
+            Policy::Alternate => Operator::Slowest,
+            Policy::RandomExtreme if rng.random_bool(0.5) => Operator::Fastest,
+            Policy::RandomExtreme => Operator::Slowest,
+            Policy::RandomGradient => Operator::Gradient(rng.random_range(0.1..6.0)),
+            Policy::Favourite => {
+                if rng.random_bool(0.02) {
+                    favourite = rng.random_range(0..n);
+                }
+                if lc == Some(favourite) {
+                    Operator::Fastest
+                } else {
+                    Operator::Slowest
+                }
+            }
+        };
+        let before = (c.token().unwrap(), c.token_position());
+        let t = c.tick(op).unwrap();
+        prop_assert!(!t.overlap() && t.fault.is_none(), "tick {k}: {t:?}");
+        // Only the token's robot is ever low-confidence.
+        if let Some(i) = t.low_conf.first() {
+            prop_assert_eq!(i, before.0.robot);
+        }
+        // The token moves to the next entry of the sequence (skipping, in the first pass,
+        // the entries before a robot's group 0), never elsewhere.
+        let (pos, passes) = c.token_position();
+        if (pos, passes) != before.1 {
+            let mut want = (before.1.0 + 1, before.1.1);
+            loop {
+                if want.0 == len {
+                    want = (0, want.1 + 1);
+                }
+                if want.1 > 0 || !c.skipped_in_first_pass(want.0) {
+                    break;
+                }
+                want.0 += 1;
+            }
+            prop_assert_eq!((pos, passes), want);
+        }
+        ticks += 1;
+    }
+    // Every robot has done ≥ 50 tasks; as the tokens go round robin-per-pass, no robot is
+    // more than two tasks ahead of another.
+    let done = c.tasks_completed();
+    let (lo, hi) = (done.iter().min().unwrap(), done.iter().max().unwrap());
+    prop_assert!(*lo >= 50 && hi - lo <= 2, "{done:?}");
+    Ok(())
+}
+
+fn fixed(cases: u32) -> ProptestConfig {
+    ProptestConfig {
+        cases,
+        rng_seed: RngSeed::Fixed(21),
+        ..ProptestConfig::default()
+    }
+}
+
+proptest! {
+    #![proptest_config(fixed(256))]
+
+    #[test]
+    fn never_two_robots_low_confidence_and_every_robot_progresses(
+        seed in any::<u64>(),
+        n in 2_usize..=5,
+        policy in prop_oneof![
+            Just(Policy::Rush),
+            Just(Policy::Drag),
+            Just(Policy::Alternate),
+            Just(Policy::RandomExtreme),
+            Just(Policy::RandomGradient),
+            Just(Policy::Favourite),
+        ],
+    ) {
+        cell_runs_soundly(seed, n, policy)?;
+    }
+}
+
+#[test]
+fn the_full_adversary_set_never_overlaps() {
+    // The policies of `adversary_set` (the beam search runs as a switching favourite) on 20
+    // random tasks, N = 2…5, each until every robot has done 50 tasks.
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    for case in 0..20 {
+        let n = 2 + case % 4;
+        let (task, holds) = random_task(&mut rng);
+        let gs = groups(task.conf(), &holds).unwrap();
+        let order = random_order(&gs, n, &mut rng);
+        let cell = ContinuousCoordinator::new(task, &holds, &order, n, 0.03).unwrap();
+        for a in adversary_set(n, [0.1, 6.0], 5000, &mut rng) {
+            let mut c = cell.clone();
+            let run = run_cell(&mut c, a, &mut rng, 50, 50_000_000).unwrap();
+            assert!(run.finished && run.min_tasks >= 50, "{case} {a:?} {run:?}");
+            assert_eq!(run.overlap_ticks, 0, "{case} {a:?}");
+        }
+    }
+}
