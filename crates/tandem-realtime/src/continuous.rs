@@ -81,7 +81,7 @@ use std::sync::Arc;
 
 use rand::Rng;
 
-use crate::adversary::Adversary;
+use crate::adversary::{Adversary, PolicyState};
 use crate::coordinator::{Fault, Operator};
 use crate::error::{Error, Result};
 use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
@@ -648,7 +648,7 @@ pub struct CellRun {
 
 /// Runs `cell` from its current state until every robot has completed `min_tasks` tasks (or
 /// for at most `max_ticks` ticks) with the operator inputs of the policy `adversary` (the
-/// policies of [`crate::adversary`], reproduced here for the continuous cell; the beam search
+/// policies of [`crate::adversary`], the same implementation as for rounds; the beam search
 /// [`Adversary::Beam`] is not a policy and runs as [`Adversary::SwitchFavourite`] with holds up
 /// to 50 ticks), drawing from `rng`. A fault is counted and cleared. Allocates nothing.
 ///
@@ -662,25 +662,7 @@ pub fn run_cell(
     max_ticks: u64,
 ) -> Result<CellRun> {
     let mut run = CellRun::default();
-    let n = cell.n_robots();
-    let (mut hold, mut current, mut favourite) = (0_u32, Operator::Fastest, 0_usize);
-    let mut per_robot = [Operator::Slowest; MAX_ROBOTS];
-    per_robot[0] = Operator::Fastest;
-    let mut last_lc = None;
-    let extreme = |fast: bool| {
-        if fast {
-            Operator::Fastest
-        } else {
-            Operator::Slowest
-        }
-    };
-    let uniform = |rng: &mut dyn rand::RngCore, lo: f64, hi: f64| {
-        if lo < hi && lo.is_finite() && hi.is_finite() {
-            rng.random_range(lo..=hi)
-        } else {
-            lo
-        }
-    };
+    let mut policy = PolicyState::new(cell.n_robots());
     let min_done = |c: &ContinuousCoordinator| c.tasks_completed().iter().copied().min();
     while min_done(cell).unwrap_or(0) < min_tasks {
         if run.ticks >= max_ticks {
@@ -689,56 +671,13 @@ pub fn run_cell(
         }
         let k = run.ticks;
         let lc = cell.low_conf_now().first();
-        let op = match adversary {
-            Adversary::Nominal => Operator::Scheduled,
-            Adversary::Fastest => Operator::Fastest,
-            Adversary::Slowest => Operator::Slowest,
-            Adversary::Periodic { period, phase } => {
-                extreme(((k + u64::from(phase)) / u64::from(period.max(1))) % 2 == 0)
-            }
-            Adversary::SwitchOnce { at, rev } => extreme((k < at) != rev),
-            Adversary::RandomSwitching { max_hold } => {
-                if hold == 0 {
-                    current = extreme(current != Operator::Fastest);
-                    hold = rng.random_range(1..=max_hold.max(1));
-                }
-                hold -= 1;
-                current
-            }
-            Adversary::RandomExtreme => extreme(rng.random_bool(0.5)),
-            Adversary::Random { lo, hi } => Operator::Gradient(uniform(rng, lo, hi)),
-            Adversary::RandomHeld { lo, hi, max_hold } => {
-                if hold == 0 {
-                    current = Operator::Gradient(uniform(rng, lo, hi));
-                    hold = rng.random_range(1..=max_hold.max(1));
-                }
-                hold -= 1;
-                current
-            }
-            Adversary::RushRobot { rush } => extreme(lc == Some(rush)),
-            Adversary::SwitchFavourite { max_hold } | Adversary::Beam { width: max_hold } => {
-                let max_hold = if matches!(adversary, Adversary::Beam { .. }) {
-                    50
-                } else {
-                    max_hold
-                };
-                if hold == 0 {
-                    favourite = rng.random_range(0..n.max(1));
-                    hold = rng.random_range(1..=max_hold.max(1));
-                }
-                hold -= 1;
-                extreme(lc == Some(favourite))
-            }
-            Adversary::RandomPerRobot => {
-                if lc != last_lc
-                    && let Some(i) = lc
-                {
-                    per_robot[i] = extreme(rng.random_bool(0.5));
-                }
-                lc.map_or(Operator::Scheduled, |i| per_robot[i])
-            }
+        // The one owner of the policies; the beam search is not a policy and runs as a
+        // switching favourite with holds up to 50 ticks.
+        let policy_of = match adversary {
+            Adversary::Beam { .. } => Adversary::SwitchFavourite { max_hold: 50 },
+            other => other,
         };
-        last_lc = lc;
+        let op = policy.next(policy_of, k, lc, rng);
         let t = cell.tick(op)?;
         if t.overlap() {
             run.overlap_ticks += 1;

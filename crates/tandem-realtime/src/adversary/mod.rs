@@ -213,7 +213,7 @@ fn random_extreme(rng: &mut impl Rng) -> Operator {
 }
 
 /// An adversary's memory between ticks (holds, per-robot choices).
-struct PolicyState {
+pub(crate) struct PolicyState {
     /// Ticks left in the current hold.
     hold: u32,
     /// The input being held.
@@ -229,7 +229,7 @@ struct PolicyState {
 }
 
 impl PolicyState {
-    fn new(n_robots: usize) -> Self {
+    pub(crate) fn new(n_robots: usize) -> Self {
         let mut per_robot = [Operator::Slowest; MAX_ROBOTS];
         per_robot[0] = Operator::Fastest;
         PolicyState {
@@ -243,7 +243,7 @@ impl PolicyState {
     }
 
     /// The input of tick `k` given the low-confidence robot at its start, `lc`.
-    fn next(
+    pub(crate) fn next(
         &mut self,
         adversary: Adversary,
         k: u64,
