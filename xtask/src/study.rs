@@ -16,7 +16,10 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
-use tandem::sim::study::{IterationSummary, PhaseTimes, StudyConfig, StudyInputs, StudyResult};
+use tandem::sim::study::{
+    Cell, CellStudyResult, CellSummary, IterationSummary, PhaseTimes, StudyConfig, StudyInputs,
+    StudyResult,
+};
 
 use crate::fig5::{ExampleSchedule, Fig5Data, draw_fig5};
 use crate::workspace_root;
@@ -68,6 +71,12 @@ pub(crate) struct StudyArgs {
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
+    /// How the robots run: `rounds` (the paper: all start together, the next round when the
+    /// last finishes) or `continuous` (each robot starts its next task as soon as it is safe;
+    /// writes the steady throughput in study.json's summary). Default: the configuration's
+    /// (rounds).
+    #[arg(long, value_enum)]
+    cell: Option<CellArg>,
     /// Ignore the configuration's hold points (`[planner.holds]`): the study as before hold
     /// points existed.
     #[arg(long)]
@@ -82,6 +91,24 @@ pub(crate) struct StudyArgs {
     /// With --bag: the rounds to write (1-based). Default: the first and the last.
     #[arg(long, value_name = "K,…", value_delimiter = ',', requires = "bag")]
     bag_rounds: Vec<usize>,
+}
+
+/// `--cell`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum CellArg {
+    /// Rounds of N executions (the paper).
+    Rounds,
+    /// A continuous cell.
+    Continuous,
+}
+
+impl From<CellArg> for Cell {
+    fn from(c: CellArg) -> Cell {
+        match c {
+            CellArg::Rounds => Cell::Rounds,
+            CellArg::Continuous => Cell::Continuous,
+        }
+    }
 }
 
 /// Writes the rounds `--bag` chose as they run (from worker threads); remembers the files
@@ -167,6 +194,103 @@ struct StudyFile<'a> {
     result: &'a StudyResult,
 }
 
+/// What `study.json` holds for a continuous cell.
+#[derive(Serialize)]
+struct CellStudyFile<'a> {
+    /// `git describe --always --dirty` of the workspace, or "unknown".
+    git_revision: String,
+    /// "continuous".
+    cell: &'static str,
+    /// Across trials: the steady throughput (last 10 % of tasks), busy and waiting shares,
+    /// the last plan's figures, overlaps and faults.
+    summary: CellSummary,
+    /// Everything else: configuration, trials, plans, completions.
+    result: &'a CellStudyResult,
+}
+
+/// The continuous study (`--cell continuous`): runs it with a progress bar, writes
+/// `study.json` and prints the summary.
+fn run_continuous(
+    config: &StudyConfig,
+    inputs: &StudyInputs,
+    out: &Path,
+    root: &Path,
+    wall: Instant,
+) -> anyhow::Result<()> {
+    let n_plans = config.n_rounds();
+    let bar = ProgressBar::new((config.trials * n_plans) as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {pos}/{len} re-plans (every N tasks), {msg} (eta {eta})",
+        )
+        .context("progress bar template")?
+        .progress_chars("=> "),
+    );
+    let trials_done = AtomicUsize::new(0);
+    bar.set_message(format!("0/{} trials done", config.trials));
+    let progress = |p: tandem::sim::study::Progress| {
+        bar.inc(1);
+        if p.pairs_done == n_plans {
+            let done = trials_done.fetch_add(1, Ordering::Relaxed) + 1;
+            bar.set_message(format!("{done}/{} trials done", config.trials));
+        }
+    };
+    let (result, times) = tandem::sim::study::run_cell_study(config, inputs, &progress)?;
+    bar.finish();
+    let summary = result.summary();
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let file = CellStudyFile {
+        git_revision: git_revision(root),
+        cell: "continuous",
+        summary: summary.clone(),
+        result: &result,
+    };
+    let path = out.join("study.json");
+    std::fs::write(&path, serde_json::to_string(&file)? + "\n")
+        .with_context(|| format!("writing {}", path.display()))?;
+    println!(
+        "continuous cell: {} trials × {} tasks, {} robots, re-planned every {} tasks, seed {}",
+        config.trials, config.executions, config.robots, config.robots, config.seed
+    );
+    for t in &result.trials {
+        let last = t.iterations.last().expect("the first plan at least");
+        println!(
+            "  trial {}: steady {:.1} tasks/h, operator busy {:.1} %, robots waiting {:.1} %; \
+             last plan {:.1} tasks/h (bound {:.1}, {} stretches), {} hand-overs",
+            t.trial,
+            t.steady.throughput_per_h,
+            100.0 * t.steady.operator_busy_share,
+            100.0 * t.steady.robot_wait_share,
+            last.tasks_per_hour,
+            3600.0 * config.robots as f64 / last.lower_bound_s,
+            last.lc_stretches,
+            t.stats.hand_overs
+        );
+    }
+    println!(
+        "steady throughput (last 10 % of tasks): {:.1} ± {:.1} tasks/h per operator, operator \
+         busy {:.1} %, robots waiting at gates {:.1} % of their time",
+        summary.steady_throughput_per_h,
+        summary.steady_throughput_std_per_h,
+        100.0 * summary.steady_operator_busy_share,
+        100.0 * summary.steady_robot_wait_share
+    );
+    println!(
+        "last plan: {:.1} tasks/h planned, bound {:.1} tasks/h",
+        summary.last_plan_tasks_per_hour, summary.last_plan_bound_tasks_per_hour
+    );
+    println!(
+        "overlapping low-confidence ticks: {}, faults: {}",
+        summary.overlap_ticks, summary.faults
+    );
+    println!("wrote {}", path.display());
+    print_times(&times, wall.elapsed());
+    if summary.overlap_ticks > 0 || summary.faults > 0 {
+        bail!("two robots were low-confidence in the same tick: the cell is unsafe");
+    }
+    Ok(())
+}
+
 fn git_revision(root: &Path) -> String {
     std::process::Command::new("git")
         .args(["describe", "--always", "--dirty"])
@@ -235,6 +359,9 @@ fn config(args: &StudyArgs) -> anyhow::Result<StudyConfig> {
     }
     if args.no_holds {
         config.planner.holds = Default::default();
+    }
+    if let Some(c) = args.cell {
+        config.cell = c.into();
     }
     if args.paper_confidence {
         let c = &mut config.planner.confidence;
@@ -346,6 +473,12 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
     let inputs = StudyInputs::from_dir(&fixtures)
         .with_context(|| format!("reading demonstrations from {}", fixtures.display()))?;
     let out = args.out.clone().unwrap_or_else(|| root.join("results"));
+    if config.cell == Cell::Continuous {
+        if args.bag.is_some() {
+            bail!("--bag writes rounds; a continuous cell has none (use --cell rounds)");
+        }
+        return run_continuous(&config, &inputs, &out, &root, wall);
+    }
 
     let n_rounds = config.n_rounds();
     let bar = ProgressBar::new((config.trials * n_rounds) as u64);

@@ -315,8 +315,13 @@ struct Cursors {
 /// each task start) read at its sample at the tick start: on a high-confidence sample it runs
 /// its plan (`tick_s` of schedule clock); on a low-confidence one at the operator's rate, the
 /// [`Operator`]'s gradient `g` clamped to `[ψ̇min, ψ̇max]` giving `(ψ̇_E/g)·tick_s`
-/// ([`Operator::Scheduled`]: `tick_s`). The step is capped at the gate it may not pass and at
-/// the task's end. `tick` is O(N) (amortized; the first pass may skip tokens) and never
+/// ([`Operator::Scheduled`]: `tick_s`). The step is capped at the gate it may not pass, at
+/// the task's end, and, from a high-confidence sample, at the start of the next
+/// low-confidence sample: a robot never crosses a low-confidence sample (a one-sample island,
+/// say) inside a tick that started on high-confidence ground, so every low-confidence sample
+/// it passes is supervised at the operator's rate for at least one tick (without the cap a
+/// robot running fast on high confidence jumps over short stretches, which then get no
+/// observation and never clear). `tick` is O(N) (amortized; the first pass may skip tokens) and never
 /// allocates.
 #[derive(Clone, Debug)]
 pub struct ContinuousCoordinator {
@@ -326,6 +331,11 @@ pub struct ContinuousCoordinator {
     gate_s: Arc<[f64]>,
     /// Schedule clock (s) at which each group is left (start of its `ref_end` sample).
     leave_s: Arc<[f64]>,
+    /// Per reference sample `k`, the schedule clock (s) of the start of the first
+    /// low-confidence sample after `k` (the task's end if none): a robot on high-confidence
+    /// ground stops there at the end of its tick, so that no low-confidence sample is crossed
+    /// without a tick that starts on it (the operator supervises every one).
+    next_lc_s: Arc<[f64]>,
     tokens: Arc<[Token]>,
     skip_first: Arc<[bool]>,
     n: usize,
@@ -376,12 +386,22 @@ impl ContinuousCoordinator {
         let c = task.sample_clock_s();
         let gate_s: Vec<f64> = groups.iter().map(|g| c[g.gate]).collect();
         let leave_s: Vec<f64> = groups.iter().map(|g| c[g.ref_end]).collect();
+        let n_ref = task.n_ref();
+        let mut next_lc_s = vec![task.end_s(); n_ref];
+        for k in (0..n_ref.saturating_sub(1)).rev() {
+            next_lc_s[k] = if task.conf()[k + 1] {
+                next_lc_s[k + 1]
+            } else {
+                c[k + 1]
+            };
+        }
         let tol_s = clock_tolerance_s(std::slice::from_ref(&task), tick_s);
         let mut out = ContinuousCoordinator {
             task: Arc::new(task),
             groups: groups.into(),
             gate_s: gate_s.into(),
             leave_s: leave_s.into(),
+            next_lc_s: next_lc_s.into(),
             tokens: tokens.into(),
             skip_first: skip_first.into(),
             n: n_robots,
@@ -498,6 +518,21 @@ impl ContinuousCoordinator {
         out
     }
 
+    /// Whether each robot waits at the gate of its next group at the tick start (the token is
+    /// another's): the next tick does not move it. O(N).
+    pub fn at_gate_now(&self) -> RobotFlags {
+        let mut out = RobotFlags::new(self.n);
+        let tok = self.token();
+        for i in 0..self.n {
+            let g = self.next_group[i];
+            let waits = g < self.groups.len()
+                && self.clock_s[i] >= self.gate_s[g]
+                && !tok.is_some_and(|t| t.robot == i && t.group == g);
+            out.set(i, waits);
+        }
+        out
+    }
+
     /// Advances every robot one control period with the operator's input `operator` for the
     /// low-confidence robot. Never allocates; O(N).
     ///
@@ -552,6 +587,13 @@ impl ContinuousCoordinator {
                 };
                 e / grad * self.tick_s
             };
+            // On high-confidence ground the robot stops at the next low-confidence sample:
+            // the tick after starts on it, at the operator's rate.
+            let cap = if task.conf()[at] {
+                cap.min(self.next_lc_s[at])
+            } else {
+                cap
+            };
             let s_new = (s_old + step).min(cap).max(s_old);
             if s_new > s_old {
                 out.running.set(i, true);
@@ -592,6 +634,113 @@ impl ContinuousCoordinator {
         out.fault = self.fault;
         self.ticks += 1;
         Ok(out)
+    }
+
+    /// Hands a running cell over to this coordinator, a new plan of the same task (after the
+    /// confidence changed, say): every robot of `old` continues from where it is, in
+    /// reference time, on this coordinator's task plan, groups and token order; the tasks
+    /// completed carry over. `self`'s own state is replaced; `old` is not changed.
+    ///
+    /// It succeeds only at a *hand-over point* of the new plan: for every robot, its
+    /// reference position `p` in `old` has left every group of the new plan that ends at or
+    /// before `p` (by the clock tolerance) and is not past the gate of its next new group
+    /// (schedule clock at most the gate's). So no robot is inside a group, every robot is
+    /// on high-confidence samples of the new plan, and the state is one the token rule's
+    /// argument covers (module docs), exactly as at the start: the hand-over keeps the
+    /// guarantee, whatever the old plan's confidence was. Every tick at which the token
+    /// moves is such a point for a new plan whose low-confidence samples are among the old
+    /// plan's and whose usable holds include the old plan's (a refinement by recorded
+    /// executions: the latch makes it so), since then each robot is at most at its old next
+    /// gate, which is at or before its new one; a caller tries each tick until it succeeds.
+    ///
+    /// The token sequence is rotated to start at the entry for some robot's next group (the
+    /// one that skips the fewest entries), and in the first pass a robot's entries before its
+    /// next group's are skipped, as at the start ([`token_sequence`]). Allocates (the rotated
+    /// sequence); O(N·len) for a token sequence of `len` entries.
+    ///
+    /// # Errors
+    /// [`Error::HandOver`] when `old` has another robot count, task length or control tick,
+    /// has a latched fault, or a robot is not at a hand-over point; `self` is then unchanged.
+    pub fn take_over(&mut self, old: &ContinuousCoordinator) -> Result<()> {
+        let bad = |robot, why| Err(Error::HandOver { robot, why });
+        if old.n != self.n {
+            return bad(0, "the new plan has another number of robots");
+        }
+        if old.task.n_ref() != self.task.n_ref() {
+            return bad(
+                0,
+                "the new plan's task has another number of reference samples",
+            );
+        }
+        if (old.tick_s - self.tick_s).abs() > 1e-12 * self.tick_s.max(old.tick_s) {
+            return bad(0, "the new plan runs at another control tick");
+        }
+        if let Some(f) = old.fault {
+            return bad(f.stopped, "the old cell has a latched fault");
+        }
+        let n_groups = self.groups.len();
+        let c = self.task.sample_clock_s();
+        let mut clock = [0.0; MAX_ROBOTS];
+        let mut next = [0usize; MAX_ROBOTS];
+        for i in 0..self.n {
+            // The robot's reference position in `old`, and the same position's clock here.
+            let s_old = old.clock_s[i];
+            let mut at = 0;
+            let n = old.task.advance_cursor(&mut at, s_old);
+            let p = old.task.ref_time_in(n, s_old);
+            let s = if p <= 0.0 {
+                0.0
+            } else if p >= self.task.n_ref() as f64 {
+                self.task.end_s()
+            } else {
+                let k = p.floor() as usize;
+                c[k] + (p - k as f64) * (c[k + 1] - c[k])
+            };
+            // Its next group here: the first it has not left.
+            let g = (0..n_groups)
+                .find(|&g| s - self.tol_s < self.leave_s[g])
+                .unwrap_or(n_groups);
+            if g < n_groups && s > self.gate_s[g] {
+                return bad(
+                    i,
+                    "is inside or past the gate of a low-confidence group of the new plan",
+                );
+            }
+            clock[i] = s;
+            next[i] = g;
+        }
+        let len = self.tokens.len();
+        // The robot's first token: its next group, or group 0 of its next task.
+        let wants = |t: &Token| t.group == next[t.robot] % n_groups.max(1);
+        let (start, skip) = (0..len)
+            .filter(|&q| wants(&self.tokens[q]))
+            .map(|q| {
+                let mut found = [false; MAX_ROBOTS];
+                let skip: Vec<bool> = (0..len)
+                    .map(|k| {
+                        let t = self.tokens[(q + k) % len];
+                        found[t.robot] |= wants(&t);
+                        !found[t.robot]
+                    })
+                    .collect();
+                (q, skip)
+            })
+            .min_by_key(|(q, skip)| (skip.iter().filter(|&&b| b).count(), *q))
+            .unwrap_or((0, Vec::new()));
+        let tokens: Vec<Token> = (0..len).map(|k| self.tokens[(start + k) % len]).collect();
+        self.tokens = tokens.into();
+        self.skip_first = skip.into();
+        self.clock_s = clock;
+        self.next_group = next;
+        self.tasks = old.tasks;
+        self.cursors = [Cursors::default(); MAX_ROBOTS];
+        self.pos = 0;
+        self.passes = 0;
+        self.ticks = old.ticks;
+        self.lc_since = [0; MAX_ROBOTS];
+        self.lc_last = RobotFlags::new(self.n);
+        self.fault = None;
+        Ok(())
     }
 
     fn advance_token(&mut self) {

@@ -90,6 +90,16 @@ pub enum Error {
         /// What is wrong.
         why: &'static str,
     },
+    /// A continuous cell cannot be handed over to a new plan now
+    /// (`crate::continuous::ContinuousCoordinator::take_over`): a robot is inside, or past
+    /// the gate of, a group of the new plan, or the two cells do not match.
+    #[error("cannot hand the cell over to the new plan now: robot {}: {why}", robot + 1)]
+    HandOver {
+        /// The robot (0-based; shown 1-based).
+        robot: usize,
+        /// What is wrong.
+        why: &'static str,
+    },
     /// A scalar parameter is out of its valid range.
     #[error("parameter `{name}` {why}")]
     BadParam {

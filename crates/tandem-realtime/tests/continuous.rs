@@ -411,3 +411,34 @@ fn the_full_adversary_set_never_overlaps() {
         }
     }
 }
+
+#[test]
+fn a_fast_robot_stops_at_a_one_sample_island_so_that_it_is_supervised() {
+    // [HC × 8, LC, HC × 8] at Δt_s = 1 s: high confidence planned at ψ̇ = 0.3 (a tick of 1 s
+    // crosses more than three samples), the island at ψ̇̄ = 0.5 (0.5 s of clock, [2.4, 2.9]). Without the cap at the
+    // next low-confidence sample the robot would cross the island inside a tick that started
+    // on high confidence, and no tick would start on it.
+    let mut conf = vec![true; 17];
+    conf[8] = false;
+    let exec: Vec<f64> = conf.iter().map(|&c| if c { 0.3 } else { 0.5 }).collect();
+    let t = Timeline::new(&conf, &exec, &[0.25; 17], &[2.0; 17], 0.0, 1.0).unwrap();
+    let mut c = ContinuousCoordinator::new(t, &[], &[(0, 0)], 1, 1.0).unwrap();
+    let mut ticks_on_island = 0;
+    for _ in 0..20 {
+        let on = c.low_conf_now()[0];
+        let tick = c.tick(Operator::Fastest).unwrap();
+        if on {
+            ticks_on_island += 1;
+            // The tick that starts on the island moves at the operator's rate (ψ̇min 0.25:
+            // twice the planned rate), across it.
+            assert!(tick.low_conf[0]);
+        }
+        if tick.tasks[0] == 1 {
+            break;
+        }
+    }
+    // 8 samples × 0.3 s = 2.4 s to the island: ticks 0–1 run to 2 s, tick 2 stops at 2.4 s
+    // (uncapped it would end at 3 s, past the island), tick 3 starts on it.
+    assert_eq!(ticks_on_island, 1);
+    assert_eq!(c.tasks_completed(), [1]);
+}

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use tandem_confidence::ErrorRates;
 
 use crate::task::{Label, N_PASSES, Phase};
-use crate::workcell::RoundRun;
+use crate::workcell::{RobotRun, RoundRun};
 
 /// Whether a reference sample with this label ever needs a correction: sanding in passes
 /// 1–3 (on a painted section of the workpiece at hand, which half of them are).
@@ -46,12 +46,17 @@ impl OperatorTally {
     /// Adds every robot of a round.
     pub fn add(&mut self, run: &RoundRun) {
         for r in &run.robots {
-            let supervised = r.supervised.iter().filter(|&&s| s).count();
-            self.needed += r.needed;
-            self.missed += r.missed;
-            self.unneeded += supervised - r.needed;
-            self.false_corrections += r.false_corrections;
+            self.add_run(r);
         }
+    }
+
+    /// Adds one robot's execution (a round's or a continuous cell's task).
+    pub fn add_run(&mut self, r: &RobotRun) {
+        let supervised = r.supervised.iter().filter(|&&s| s).count();
+        self.needed += r.needed;
+        self.missed += r.missed;
+        self.unneeded += supervised - r.needed;
+        self.false_corrections += r.false_corrections;
     }
 
     /// The rates the operator made: `missed / needed` and `false_corrections / unneeded`

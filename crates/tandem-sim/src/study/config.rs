@@ -40,6 +40,31 @@ pub struct StudyConfig {
     /// Task parameters for drawing each execution's workpiece (only `n_sections` matters);
     /// must match the demonstrations'. Default: `TaskParams::default()` (the fixtures').
     pub task: TaskParams,
+    /// How the robots run: in rounds (the paper; `run_study`) or as a continuous cell
+    /// (`run_cell_study`). Default: rounds (not written when it is).
+    #[serde(skip_serializing_if = "Cell::is_rounds")]
+    pub cell: Cell,
+}
+
+/// How the robots of a study run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Cell {
+    /// All `N` robots start a round together; the next round starts when the last finishes
+    /// (the paper).
+    #[default]
+    Rounds,
+    /// Each robot starts its next task as soon as it is safe, under the continuous
+    /// coordinator (issue 21).
+    Continuous,
+}
+
+impl Cell {
+    /// Whether it is [`Cell::Rounds`].
+    #[must_use]
+    pub fn is_rounds(&self) -> bool {
+        *self == Cell::Rounds
+    }
 }
 
 impl Default for StudyConfig {
@@ -56,6 +81,7 @@ impl Default for StudyConfig {
             example_iterations: vec![0, 25, 50, 100, 150],
             planner: PlannerParams::default(),
             task: TaskParams::default(),
+            cell: Cell::Rounds,
         }
     }
 }

@@ -6,12 +6,17 @@
 //! (iteration 0: demonstrations only) together with the outcome of running the next pair
 //! under it (none for the last iteration).
 
+mod cell;
 mod config;
 mod inputs;
 mod record;
 mod run;
 
-pub use config::StudyConfig;
+pub use cell::{
+    CellCompletion, CellIteration, CellStudyResult, CellSummary, CellTrialResult, Steady,
+    run_cell_study, run_cell_trial, run_cell_trials,
+};
+pub use config::{Cell, StudyConfig};
 pub use inputs::{StudyInputs, read_labels};
 pub use record::{
     IterationRecord, IterationSummary, PairStats, ScheduleSource, StudyResult, TrialResult,

@@ -40,7 +40,7 @@ pub struct PhaseTimes {
 }
 
 impl PhaseTimes {
-    fn add(&mut self, other: &PhaseTimes) {
+    pub(super) fn add(&mut self, other: &PhaseTimes) {
         self.alignment += other.alignment;
         self.model_update += other.model_update;
         self.confidence += other.confidence;
@@ -230,6 +230,22 @@ pub fn run_study_observed(
     progress: &(dyn Fn(Progress) + Sync),
     observe: &(dyn Fn(RoundView<'_>) + Sync),
 ) -> Result<(StudyResult, PhaseTimes)> {
+    let (model, alignment) = fit_study_model(config, inputs)?;
+    let (result, mut times) =
+        run_trials_observed(config, &model, &inputs.reference_labels, progress, observe)?;
+    times.alignment = alignment;
+    Ok((result, times))
+}
+
+/// The study's model: the configuration and inputs checked, the demonstrations fitted
+/// (§II-B1), the correction directions prepared; and the time it took.
+///
+/// # Errors
+/// As [`run_study`].
+pub(super) fn fit_study_model(
+    config: &StudyConfig,
+    inputs: &StudyInputs,
+) -> Result<(TaskModel, Duration)> {
     config.validate()?;
     inputs.check().map_err(|why| Error::BadInput {
         path: "<study inputs>".into(),
@@ -250,11 +266,7 @@ pub fn run_study_observed(
         });
     }
     model.prepare_corrections();
-    let alignment = t.elapsed();
-    let (result, mut times) =
-        run_trials_observed(config, &model, &inputs.reference_labels, progress, observe)?;
-    times.alignment = alignment;
-    Ok((result, times))
+    Ok((model, t.elapsed()))
 }
 
 /// Runs every trial of a study from a fitted model, in parallel (rayon). Each trial

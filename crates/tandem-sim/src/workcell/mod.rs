@@ -62,12 +62,14 @@
 //!    logs nothing while held, and the operator releases it (`Coordinator::clear_fault`)
 //!    after the first tick in which no robot is low-confidence, so every round finishes.
 
+mod cell;
 mod operator;
 mod record;
 mod run;
 #[cfg(test)]
 mod tests;
 
+pub use cell::{CellSim, CellStats, FinishedTask};
 pub use operator::{OperatorParams, correction_input, needs_correction};
 pub use record::{PairRun, RobotRun, RoundRun};
 pub use run::{run_pair, run_pair_with, run_round, run_round_with};

@@ -171,32 +171,10 @@ pub(super) fn run_coordinator(
     rng: &mut impl Rng,
 ) -> Result<RoundRun> {
     let n_ref = problem.n_ref();
-    let force_idx = model
-        .tangent_names()
-        .iter()
-        .position(|n| *n == params.force_channel)
-        .ok_or_else(|| Error::NoForceChannel(params.force_channel.clone()))?;
     let tick_s = coord.tick_s();
-
-    let m = model.channel_names().len();
-    let k = model.n_components();
-    let u_zero = vec![0.0; k];
-    let mut u_corr = vec![0.0; k];
-    let mut cmd = vec![0.0; m + 1];
-    let empty = || RobotRun {
-        samples: Vec::with_capacity(n_ref * m * 2),
-        ref_time_log: Vec::with_capacity(n_ref * 2),
-        supervised: Vec::with_capacity(n_ref * 2),
-        corrected: Vec::with_capacity(n_ref * 2),
-        needed: 0,
-        missed: 0,
-        false_corrections: 0,
-        clock_s: Vec::with_capacity(n_ref * 2),
-        start_tick: usize::MAX,
-        hold_ticks: 0,
-    };
+    let mut op = Operate::new(model, params, tick_s)?;
     let n_robots = coord.n_robots();
-    let mut runs: Vec<RobotRun> = (0..n_robots).map(|_| empty()).collect();
+    let mut runs: Vec<RobotRun> = (0..n_robots).map(|_| op.empty_run(n_ref)).collect();
     let (mut ticks, mut overlap_ticks, mut idle_ticks, mut faults) = (0, 0, 0, 0);
     let max_end_s = coord
         .robots()
@@ -217,14 +195,6 @@ pub(super) fn run_coordinator(
         // which a schedule caps at the serial schedule's length).
         budget *= n_robots + 2;
     }
-    let last_ref = (n_ref - 1) as f64;
-    // Unneeded corrections as episodes of mean length `l` ticks: each tick of an episode
-    // ends it with probability 1/l; outside one, a new one starts with the probability that
-    // makes episodes cover `false_correction_rate` of the time (per tick when l = 1).
-    let episodes = Episodes::new(
-        params.false_correction_rate,
-        params.false_correction_s / tick_s,
-    );
     let mut in_episode = vec![false; n_robots];
     // Each robot's reference sample `n_i` and reference time `t_i` at its schedule clock,
     // kept across ticks: the sample through a monotone cursor (schedule clocks never
@@ -281,44 +251,19 @@ pub(super) fn run_coordinator(
             if runs[i].start_tick == usize::MAX {
                 runs[i].start_tick = ticks;
             }
-            let ref_time = ref_now[i].min(last_ref);
-            let supervised = !problem.conf()[n];
-            let mut corrected = false;
-            if supervised {
-                let label_idx = (ref_time.round() as usize).min(n_ref - 1);
-                let needed = needs(i, label_idx);
-                let draw: f64 = rng.random();
-                let run = &mut runs[i];
-                if needed {
-                    in_episode[i] = false;
-                    run.needed += 1;
-                    corrected = draw >= params.miss_rate;
-                    run.missed += usize::from(!corrected);
-                } else {
-                    (corrected, in_episode[i]) = episodes.tick(in_episode[i], draw, rng);
-                    run.false_corrections += usize::from(corrected);
-                }
-            } else {
-                in_episode[i] = false;
+            let bounds =
+                (!problem.conf()[n]).then(|| (problem.grad_min()[n], problem.grad_max()[n]));
+            if let Some(op_input) = op.robot_tick(
+                model,
+                &mut runs[i],
+                &mut in_episode[i],
+                ref_now[i],
+                bounds,
+                |idx| needs(i, idx),
+                rng,
+            )? {
+                operator = op_input;
             }
-            // The input in the frame of the two reference samples around `ref_time` (only
-            // they are decomposed); the command equals the task frame's bit for bit.
-            if corrected
-                && local_correction_input(model, force_idx, params.gain, ref_time, &mut u_corr)?
-            {
-                model.local_command_into(&u_corr, ref_time, &mut cmd)?;
-            } else {
-                model.command_into(&u_zero, ref_time, &mut cmd)?;
-            }
-            if supervised && corrected {
-                operator =
-                    Operator::Gradient(cmd[m].clamp(problem.grad_min()[n], problem.grad_max()[n]));
-            }
-            let run = &mut runs[i];
-            run.samples.extend_from_slice(&cmd[..m]);
-            run.ref_time_log.push(ref_time);
-            run.supervised.push(supervised);
-            run.corrected.push(corrected);
         }
         let tick = coord.tick(operator)?;
         ref_now.copy_from_slice(&tick.ref_time);
@@ -346,4 +291,123 @@ pub(super) fn run_coordinator(
         idle_ticks,
         faults,
     })
+}
+
+/// The simulated operator and the robot's logging, one robot and tick at a time (steps 2–4
+/// of the module docs of [`crate::workcell`]): the one implementation for rounds and for the
+/// continuous cell.
+#[derive(Debug)]
+pub(super) struct Operate {
+    params: OperatorParams,
+    force_idx: usize,
+    /// Unneeded corrections as episodes of mean length `l` ticks: each tick of an episode
+    /// ends it with probability 1/l; outside one, a new one starts with the probability that
+    /// makes episodes cover `false_correction_rate` of the time (per tick when l = 1).
+    episodes: Episodes,
+    u_zero: Vec<f64>,
+    u_corr: Vec<f64>,
+    cmd: Vec<f64>,
+}
+
+impl Operate {
+    /// The operator `params` on `model` at a control tick of `tick_s` (s).
+    pub(super) fn new(model: &TaskModel, params: &OperatorParams, tick_s: f64) -> Result<Self> {
+        let force_idx = model
+            .tangent_names()
+            .iter()
+            .position(|n| *n == params.force_channel)
+            .ok_or_else(|| Error::NoForceChannel(params.force_channel.clone()))?;
+        let k = model.n_components();
+        Ok(Operate {
+            params: params.clone(),
+            force_idx,
+            episodes: Episodes::new(
+                params.false_correction_rate,
+                params.false_correction_s / tick_s,
+            ),
+            u_zero: vec![0.0; k],
+            u_corr: vec![0.0; k],
+            cmd: vec![0.0; model.channel_names().len() + 1],
+        })
+    }
+
+    /// An empty run with room for about two executions of `n_ref` samples.
+    pub(super) fn empty_run(&self, n_ref: usize) -> RobotRun {
+        let m = self.cmd.len() - 1;
+        RobotRun {
+            samples: Vec::with_capacity(n_ref * m * 2),
+            ref_time_log: Vec::with_capacity(n_ref * 2),
+            supervised: Vec::with_capacity(n_ref * 2),
+            corrected: Vec::with_capacity(n_ref * 2),
+            needed: 0,
+            missed: 0,
+            false_corrections: 0,
+            clock_s: Vec::with_capacity(n_ref * 2),
+            start_tick: usize::MAX,
+            hold_ticks: 0,
+        }
+    }
+
+    /// One running robot's tick at fractional reference time `ref_time` (capped at the last
+    /// sample): with `bounds = Some((ψ̇min, ψ̇max))` of its sample it is supervised (its sample
+    /// is low-confidence) and the operator decides — `needs(round(t))` asked once, then the
+    /// draw from `rng` — whether to correct; the command is logged into `run` with its flags.
+    /// Returns the operator's input for the coordinator when it corrected (the command's rate,
+    /// clamped to `bounds`), else `None` (`Operator::Scheduled`).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn robot_tick(
+        &mut self,
+        model: &TaskModel,
+        run: &mut RobotRun,
+        in_episode: &mut bool,
+        ref_time: f64,
+        bounds: Option<(f64, f64)>,
+        needs: impl FnOnce(usize) -> bool,
+        rng: &mut impl Rng,
+    ) -> Result<Option<Operator>> {
+        let n_ref = model.n_ref();
+        let ref_time = ref_time.min((n_ref - 1) as f64);
+        let supervised = bounds.is_some();
+        let mut corrected = false;
+        if supervised {
+            let label_idx = (ref_time.round() as usize).min(n_ref - 1);
+            let needed = needs(label_idx);
+            let draw: f64 = rng.random();
+            if needed {
+                *in_episode = false;
+                run.needed += 1;
+                corrected = draw >= self.params.miss_rate;
+                run.missed += usize::from(!corrected);
+            } else {
+                (corrected, *in_episode) = self.episodes.tick(*in_episode, draw, rng);
+                run.false_corrections += usize::from(corrected);
+            }
+        } else {
+            *in_episode = false;
+        }
+        // The input in the frame of the two reference samples around `ref_time` (only they
+        // are decomposed); the command equals the task frame's bit for bit.
+        let m = self.cmd.len() - 1;
+        if corrected
+            && local_correction_input(
+                model,
+                self.force_idx,
+                self.params.gain,
+                ref_time,
+                &mut self.u_corr,
+            )?
+        {
+            model.local_command_into(&self.u_corr, ref_time, &mut self.cmd)?;
+        } else {
+            model.command_into(&self.u_zero, ref_time, &mut self.cmd)?;
+        }
+        run.samples.extend_from_slice(&self.cmd[..m]);
+        run.ref_time_log.push(ref_time);
+        run.supervised.push(supervised);
+        run.corrected.push(corrected);
+        Ok(match bounds {
+            Some((lo, hi)) if corrected => Some(Operator::Gradient(self.cmd[m].clamp(lo, hi))),
+            _ => None,
+        })
+    }
 }

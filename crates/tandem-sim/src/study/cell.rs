@@ -1,0 +1,420 @@
+//! The study in a continuous cell (issue 21, `cargo xtask study --cell continuous`): the
+//! learning loop of §III without rounds.
+//!
+//! A trial fits the planner as for rounds, plans the cell (`tandem_schedule::cyclic_plan`:
+//! the operator's cyclic order of low-confidence stretches and its least period) and runs it
+//! through the continuous coordinator ([`crate::workcell::CellSim`]). Every robot draws a new
+//! workpiece for every task. Each completed task's execution is kept; every `N` completed
+//! tasks (whichever robots did them) the planner records them as one round of `N`
+//! executions (Eq. 21, Eq. 9–12: the planner's unit of learning, the same number of
+//! executions per update as rounds), the cell is re-planned on the new problem, and the new
+//! plan takes over the running cell at the next hand-over point (at the latest when the
+//! operator's token next moves; `ContinuousCoordinator::take_over`). So the robots never
+//! stop for a re-plan, and a trial of `executions` tasks makes `executions / N` plans after
+//! the first, as many as the rounds study makes schedules.
+//!
+//! Why every `N` tasks and not after every task: a re-plan after one task would record
+//! "rounds" of one execution, which the planner does not take (`Planner::record_round`
+//! records one execution per robot), and the plan a single execution changes differs little;
+//! every `N` tasks is once per period of the cell in steady state, so the plan is never more
+//! than a period behind what was learnt.
+//!
+//! The steady throughput ([`Steady`]) is measured over the last 10 % of tasks: tasks
+//! completed in that window per hour of cell time, with the operator's busy share and the
+//! robots' waiting share over the same ticks.
+
+use std::time::Instant;
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use tandem_lfd::TaskModel;
+use tandem_planner::Planner;
+use tandem_schedule::{CyclicParams, CyclicPlan, cyclic_plan};
+
+use super::config::StudyConfig;
+use super::inputs::StudyInputs;
+use super::record::mean_std;
+use super::run::{PhaseTimes, Progress, fit_study_model, trial_seed};
+use crate::task::{self, Label, Workpiece};
+use crate::truth::falsely_trusted;
+use crate::workcell::{CellSim, CellStats, needs_correction};
+use crate::{Error, Result};
+
+/// The cell's plan after some recorded tasks: one per re-plan of a trial.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CellIteration {
+    /// Tasks recorded into the planner when the plan was made (0: demonstrations only).
+    pub tasks_recorded: usize,
+    /// The cell's tick (control ticks of `Δt_s` from the trial start) at which it was made.
+    pub tick: u64,
+    /// The plan's least period `P` (s) for its operator order: `N` tasks per period.
+    pub period_s: f64,
+    /// The plan's throughput `3600·N/P` (tasks per hour per operator).
+    pub tasks_per_hour: f64,
+    /// The plan's operator busy share `N·L/P`, in `[0, 1]`.
+    pub operator_share: f64,
+    /// The period's lower bound (s) over every order (`CyclicPlan::lower_bound_s`).
+    pub lower_bound_s: f64,
+    /// `period_s / lower_bound_s − 1`.
+    pub gap: f64,
+    /// Whether every operator order was enumerated (the period is the least of every
+    /// 1-periodic plan).
+    pub order_exhaustive: bool,
+    /// Percent of reference samples of high confidence.
+    pub high_conf_pct: f64,
+    /// Low-confidence stretches `m` of the task.
+    pub lc_stretches: usize,
+    /// The stretches as reference-sample intervals `[start, end)`, in order.
+    pub lc_ref: Vec<[usize; 2]>,
+    /// The usable hold points (reference samples) the cell waits at.
+    pub holds: Vec<usize>,
+    /// Reference samples that truly need help but are high-confidence ([`falsely_trusted`]).
+    pub falsely_trusted_samples: usize,
+}
+
+/// A completed task of a trial.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CellCompletion {
+    /// The robot (0-based).
+    pub robot: usize,
+    /// Cell ticks run when it finished.
+    pub tick: u64,
+    /// Ticks with the operator busy until then (cumulative).
+    pub busy_ticks: u64,
+    /// Ticks the robots waited at gates until then (cumulative, summed over robots).
+    pub gate_ticks: u64,
+}
+
+/// The steady state of a continuous cell: the last 10 % of its tasks.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Steady {
+    /// Tasks in the window (`max(1, ⌈10 % of the tasks⌉)`).
+    pub tasks: usize,
+    /// Its length (s of cell time): from the completion before the window (or the start)
+    /// to the last completion.
+    pub duration_s: f64,
+    /// Tasks per hour per operator over the window.
+    pub throughput_per_h: f64,
+    /// Share of the window's ticks in which a robot was low-confidence, in `[0, 1]`.
+    pub operator_busy_share: f64,
+    /// Share of the robots' time in the window spent waiting at a gate for the operator's
+    /// token, in `[0, 1]` (robot-ticks waiting over `N ×` the window's ticks).
+    pub robot_wait_share: f64,
+}
+
+impl Steady {
+    /// The steady state of `completions` (in completion order) of `n_robots` robots at a
+    /// control tick of `tick_s` (s); `None` without completions.
+    #[must_use]
+    pub fn of(completions: &[CellCompletion], n_robots: usize, tick_s: f64) -> Option<Steady> {
+        let total = completions.len();
+        if total == 0 {
+            return None;
+        }
+        let k = total.div_ceil(10).max(1);
+        let last = completions[total - 1];
+        let before = (total > k).then(|| completions[total - k - 1]);
+        let (t0, b0, g0) = before.map_or((0, 0, 0), |c| (c.tick, c.busy_ticks, c.gate_ticks));
+        let ticks = (last.tick - t0).max(1) as f64;
+        let duration_s = ticks * tick_s;
+        Some(Steady {
+            tasks: k,
+            duration_s,
+            throughput_per_h: k as f64 * 3600.0 / duration_s,
+            operator_busy_share: (last.busy_ticks - b0) as f64 / ticks,
+            robot_wait_share: (last.gate_ticks - g0) as f64 / (ticks * n_robots as f64),
+        })
+    }
+}
+
+/// One trial of the continuous study.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CellTrialResult {
+    /// Trial index `k`.
+    pub trial: usize,
+    /// Seed of the trial ([`trial_seed`]).
+    pub seed: u64,
+    /// The plans, the first one (demonstrations only) first.
+    pub iterations: Vec<CellIteration>,
+    /// Every completed task, in completion order.
+    pub completions: Vec<CellCompletion>,
+    /// What the cell did (ticks, overlaps, faults, hand-overs, waiting per robot).
+    pub stats: CellStats,
+    /// The last 10 % of the tasks.
+    pub steady: Steady,
+}
+
+/// The continuous study: everything its JSON output holds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CellStudyResult {
+    /// The configuration it ran with.
+    pub config: StudyConfig,
+    /// Reference samples of the task (`T_ref`).
+    pub n_ref: usize,
+    /// Reference sample period `Δt_s` (s), the cell's control tick.
+    pub dt_s: f64,
+    /// Ground truth (§III): percent of reference samples outside the sanding of passes 1–3.
+    pub ground_truth_pct: f64,
+    /// The trials, in trial order.
+    pub trials: Vec<CellTrialResult>,
+}
+
+/// The continuous study across trials.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CellSummary {
+    /// Mean steady throughput across trials (tasks per hour per operator, [`Steady`]).
+    pub steady_throughput_per_h: f64,
+    /// Its sample standard deviation across trials.
+    pub steady_throughput_std_per_h: f64,
+    /// Mean operator busy share in the steady window, in `[0, 1]`.
+    pub steady_operator_busy_share: f64,
+    /// Mean share of the robots' time spent waiting at gates in the steady window.
+    pub steady_robot_wait_share: f64,
+    /// Mean planned throughput of the last plan (tasks per hour per operator).
+    pub last_plan_tasks_per_hour: f64,
+    /// Mean operator-limited bound of the last plan, `3600·N / lower_bound_s` (tasks per hour).
+    pub last_plan_bound_tasks_per_hour: f64,
+    /// Mean low-confidence stretches of the last plan's task.
+    pub last_plan_lc_stretches: f64,
+    /// Overlap ticks over every trial (must be 0).
+    pub overlap_ticks: u64,
+    /// Faults over every trial (must be 0).
+    pub faults: u64,
+    /// Plans that took over a running cell, over every trial.
+    pub hand_overs: u64,
+}
+
+impl CellStudyResult {
+    /// The summary across trials.
+    #[must_use]
+    pub fn summary(&self) -> CellSummary {
+        let last: Vec<&CellIteration> = self
+            .trials
+            .iter()
+            .filter_map(|t| t.iterations.last())
+            .collect();
+        let (steady, steady_std) = mean_std(self.trials.iter().map(|t| t.steady.throughput_per_h));
+        let n = self.config.robots as f64;
+        CellSummary {
+            steady_throughput_per_h: steady,
+            steady_throughput_std_per_h: steady_std,
+            steady_operator_busy_share: mean_std(
+                self.trials.iter().map(|t| t.steady.operator_busy_share),
+            )
+            .0,
+            steady_robot_wait_share: mean_std(
+                self.trials.iter().map(|t| t.steady.robot_wait_share),
+            )
+            .0,
+            last_plan_tasks_per_hour: mean_std(last.iter().map(|i| i.tasks_per_hour)).0,
+            last_plan_bound_tasks_per_hour: mean_std(
+                last.iter().map(|i| 3600.0 * n / i.lower_bound_s),
+            )
+            .0,
+            last_plan_lc_stretches: mean_std(last.iter().map(|i| i.lc_stretches as f64)).0,
+            overlap_ticks: self.trials.iter().map(|t| t.stats.overlap_ticks).sum(),
+            faults: self.trials.iter().map(|t| t.stats.faults).sum(),
+            hand_overs: self.trials.iter().map(|t| t.stats.hand_overs).sum(),
+        }
+    }
+}
+
+/// The cell's plan on the planner's problem and its record.
+fn plan_of(
+    planner: &Planner,
+    labels: &[Label],
+    tasks_recorded: usize,
+    tick: u64,
+) -> Result<(CyclicPlan, CellIteration)> {
+    let plan = cyclic_plan(
+        planner.problem(),
+        planner.n_robots(),
+        &CyclicParams::default(),
+    )?;
+    let iteration = CellIteration {
+        tasks_recorded,
+        tick,
+        period_s: plan.period_s,
+        tasks_per_hour: plan.tasks_per_hour,
+        operator_share: plan.operator_share,
+        lower_bound_s: plan.lower_bound_s,
+        gap: plan.gap,
+        order_exhaustive: plan.order_exhaustive,
+        high_conf_pct: 100.0 * planner.confidence().high_share(),
+        lc_stretches: plan.lc_s.len(),
+        lc_ref: tandem_confidence::runs(planner.problem().conf())
+            .iter()
+            .filter(|r| !r.high_conf)
+            .map(|r| [r.start, r.end])
+            .collect(),
+        holds: planner.problem().usable_holds(),
+        falsely_trusted_samples: falsely_trusted(planner.confidence().conf(), labels),
+    };
+    Ok((plan, iteration))
+}
+
+/// Runs trial `trial` of the continuous study from a fitted model (module docs). Seeds as
+/// for rounds ([`super::run_trial`]): the planner's sampler `derive_seed(trial seed, k)`,
+/// workpieces and the operator a ChaCha8 stream of the trial seed.
+///
+/// # Errors
+/// Invalid configuration, or any stage's error; [`Error::DidNotFinish`] for a cell that does
+/// not complete its tasks within a generous tick budget (a bug).
+pub fn run_cell_trial(
+    config: &StudyConfig,
+    model: &TaskModel,
+    labels: &[Label],
+    trial: usize,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<(CellTrialResult, PhaseTimes)> {
+    config.validate()?;
+    let seed = trial_seed(config.seed, trial);
+    let mut params = config.planner.clone();
+    params.sampler.samples = config.samples;
+    params.sampler.seed = seed;
+    let mut times = PhaseTimes::default();
+    let t = Instant::now();
+    let mut planner = Planner::from_model_with_robots(model.clone(), params, config.robots)?;
+    let n = planner.n_robots();
+    let dt_s = planner.problem().dt_s();
+    let (plan, first) = plan_of(&planner, labels, 0, 0)?;
+    let coord = plan.coordinator(planner.problem(), dt_s)?;
+    times.scheduling += t.elapsed();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(1);
+    let mut sim = CellSim::new(planner.model(), coord, &config.operator())?;
+    let mut workpieces = (0..n)
+        .map(|_| Workpiece::random(&config.task, &mut rng))
+        .collect::<Result<Vec<_>>>()?;
+    let total = config.executions;
+    // A task lasts at most Σ max(ψ̇min, ψ̇max) ticks plus one per sample (tick = Δt_s); even
+    // one robot at a time, the cell does its tasks within twice that each.
+    let slow_ticks: f64 =
+        planner.problem().grad_max().iter().sum::<f64>() + planner.problem().n_ref() as f64;
+    let budget = (total as f64 + 2.0 * n as f64) * (slow_ticks + 10.0) * 2.0 + 10_000.0;
+    let mut iterations = vec![first];
+    let mut completions = Vec::with_capacity(total + n);
+    let mut batch = Vec::with_capacity(n);
+    let mut recorded = 0;
+    while completions.len() < total {
+        if sim.stats().ticks as f64 >= budget {
+            return Err(Error::DidNotFinish {
+                ticks: budget as usize,
+            });
+        }
+        let t = Instant::now();
+        let finished = sim.tick(
+            planner.model(),
+            |robot, idx| needs_correction(&labels[idx], &workpieces[robot]),
+            &mut rng,
+        )?;
+        times.simulation += t.elapsed();
+        for f in finished {
+            let stats = sim.stats();
+            completions.push(CellCompletion {
+                robot: f.robot,
+                tick: f.tick,
+                busy_ticks: stats.busy_ticks,
+                gate_ticks: stats.gate_ticks.iter().sum(),
+            });
+            workpieces[f.robot] = Workpiece::random(&config.task, &mut rng)?;
+            batch.push(f.run.record(planner.model())?);
+            if batch.len() < n || recorded + n > total {
+                continue;
+            }
+            let report = planner.record_round(&batch)?;
+            batch.clear();
+            recorded += n;
+            times.model_update += report.model_update;
+            times.confidence += report.confidence;
+            times.scheduling += report.scheduling;
+            let t = Instant::now();
+            let (plan, iteration) = plan_of(&planner, labels, recorded, sim.stats().ticks)?;
+            let next = plan.coordinator(planner.problem(), dt_s)?;
+            times.scheduling += t.elapsed();
+            sim.replan(planner.model(), next)?;
+            iterations.push(iteration);
+            progress(Progress {
+                trial,
+                pairs_done: recorded / n,
+            });
+        }
+    }
+    completions.truncate(total);
+    let steady = Steady::of(&completions, n, dt_s).expect("at least one task");
+    Ok((
+        CellTrialResult {
+            trial,
+            seed,
+            iterations,
+            completions,
+            stats: sim.stats().clone(),
+            steady,
+        },
+        times,
+    ))
+}
+
+/// Runs every trial of the continuous study from a fitted model, in parallel (rayon); the
+/// result is the same for any number of threads.
+///
+/// # Errors
+/// Invalid configuration, labels that do not match the model's reference, or any stage's
+/// error (the first trial's in trial order).
+pub fn run_cell_trials(
+    config: &StudyConfig,
+    model: &TaskModel,
+    labels: &[Label],
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<(CellStudyResult, PhaseTimes)> {
+    config.validate()?;
+    if labels.len() != model.n_ref() {
+        return Err(Error::BadInput {
+            path: "<reference labels>".into(),
+            why: format!(
+                "{} labels for {} reference samples",
+                labels.len(),
+                model.n_ref()
+            ),
+        });
+    }
+    let outcomes: Vec<Result<(CellTrialResult, PhaseTimes)>> = (0..config.trials)
+        .into_par_iter()
+        .map(|k| run_cell_trial(config, model, labels, k, progress))
+        .collect();
+    let mut times = PhaseTimes::default();
+    let mut trials = Vec::with_capacity(config.trials);
+    for outcome in outcomes {
+        let (trial, t) = outcome?;
+        times.add(&t);
+        trials.push(trial);
+    }
+    Ok((
+        CellStudyResult {
+            config: config.clone(),
+            n_ref: model.n_ref(),
+            dt_s: model.dt_s(),
+            ground_truth_pct: 100.0 * task::ground_truth_share(labels),
+            trials,
+        },
+        times,
+    ))
+}
+
+/// Runs the continuous study: fits the model once ([`super::run_study`]'s fit), then runs
+/// the trials ([`run_cell_trials`]).
+///
+/// # Errors
+/// As [`super::run_study`].
+pub fn run_cell_study(
+    config: &StudyConfig,
+    inputs: &StudyInputs,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<(CellStudyResult, PhaseTimes)> {
+    let (model, alignment) = fit_study_model(config, inputs)?;
+    let (result, mut times) = run_cell_trials(config, &model, &inputs.reference_labels, progress)?;
+    times.alignment = alignment;
+    Ok((result, times))
+}

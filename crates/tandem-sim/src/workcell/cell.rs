@@ -1,0 +1,258 @@
+//! The continuous cell in the simulated workcell (issue 21): `N` robots repeat the task
+//! without rounds under a [`ContinuousCoordinator`] (the token rule), while the simulated
+//! operator of the rounds supervises the one robot inside a low-confidence group, and a new
+//! plan can take over while the cell runs ([`CellSim::replan`]).
+//!
+//! Per control tick, as for rounds (module docs of [`crate::workcell`]): every robot that the
+//! coordinator will move (not waiting at its gate, not held by a fault) gets the operator's
+//! decision and logs one execution sample at its reference time; the operator's input drives
+//! the low-confidence robot; a robot that completes its task in the tick hands back its
+//! execution ([`FinishedTask`]) and starts the next at the task start. A robot waiting at its
+//! gate logs nothing (its clock does not move), as a robot at a hold of a round.
+
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+use tandem_lfd::TaskModel;
+use tandem_realtime::continuous::ContinuousCoordinator;
+use tandem_realtime::{Operator, tol};
+
+use super::operator::OperatorParams;
+use super::record::RobotRun;
+use super::run::Operate;
+use crate::{Error, Result};
+
+/// What a continuous cell did so far (control ticks of `tick_s`).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CellStats {
+    /// Control ticks run.
+    pub ticks: u64,
+    /// Ticks in which two or more robots traversed a low-confidence sample (must be 0).
+    pub overlap_ticks: u64,
+    /// Ticks in which a robot traversed a low-confidence sample: the operator was busy.
+    pub busy_ticks: u64,
+    /// Faults latched by the coordinator's monitor (must be 0), each cleared once no robot
+    /// was low-confidence.
+    pub faults: u64,
+    /// New plans that took over the running cell ([`CellSim::replan`]).
+    pub hand_overs: u64,
+    /// Per robot, ticks it waited at a gate for the operator's token.
+    pub gate_ticks: Vec<u64>,
+}
+
+/// A task a robot completed in a tick of [`CellSim::tick`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct FinishedTask {
+    /// The robot (0-based).
+    pub robot: usize,
+    /// Ticks run when it finished (the tick it finished in is the `tick`-th, 1-based).
+    pub tick: u64,
+    /// Its execution ([`RobotRun::record`] makes the planner's record of it); `start_tick`
+    /// is the cell's tick of its first sample.
+    pub run: RobotRun,
+}
+
+/// A simulated continuous cell: the coordinator, the operator, each robot's task in progress.
+#[derive(Debug)]
+pub struct CellSim {
+    coord: ContinuousCoordinator,
+    pending: Option<ContinuousCoordinator>,
+    op: Operate,
+    runs: Vec<RobotRun>,
+    in_episode: Vec<bool>,
+    ref_now: Vec<f64>,
+    n_ref: usize,
+    stats: CellStats,
+}
+
+impl CellSim {
+    /// A cell running `coord` with the operator `params` on `model`'s task; every robot where
+    /// the coordinator has it (at the task start for a new one).
+    ///
+    /// # Errors
+    /// Invalid parameters; a model without the force channel; a coordinator for another
+    /// number of reference samples ([`Error::Mismatch`]) or another control tick than the
+    /// model's `Δt_s` ([`Error::TickMismatch`]).
+    pub fn new(
+        model: &TaskModel,
+        coord: ContinuousCoordinator,
+        params: &OperatorParams,
+    ) -> Result<CellSim> {
+        params.validate()?;
+        check(model, &coord)?;
+        let op = Operate::new(model, params, coord.tick_s())?;
+        let n = coord.n_robots();
+        let n_ref = model.n_ref();
+        let ref_now = ref_times(&coord);
+        Ok(CellSim {
+            runs: (0..n).map(|_| op.empty_run(n_ref)).collect(),
+            op,
+            in_episode: vec![false; n],
+            ref_now,
+            n_ref,
+            stats: CellStats {
+                gate_ticks: vec![0; n],
+                ..CellStats::default()
+            },
+            coord,
+            pending: None,
+        })
+    }
+
+    /// The coordinator running the cell.
+    pub fn coordinator(&self) -> &ContinuousCoordinator {
+        &self.coord
+    }
+
+    /// What the cell did so far.
+    pub fn stats(&self) -> &CellStats {
+        &self.stats
+    }
+
+    /// Whether a new plan waits to take over ([`replan`](Self::replan)).
+    pub fn has_pending(&self) -> bool {
+        self.pending.is_some()
+    }
+
+    /// Gives the cell a new plan: it takes over
+    /// ([`ContinuousCoordinator::take_over`]) now if the robots are at a hand-over point of
+    /// it, else at the end of the first tick at which they are (for a plan refined by
+    /// recorded executions, at the latest when the operator's token next moves). A plan
+    /// still waiting is replaced. Returns whether it took over now.
+    ///
+    /// # Errors
+    /// As [`CellSim::new`] for a coordinator that does not match the model.
+    pub fn replan(&mut self, model: &TaskModel, next: ContinuousCoordinator) -> Result<bool> {
+        check(model, &next)?;
+        if next.n_robots() != self.coord.n_robots() {
+            return Err(Error::Mismatch {
+                what: "robots of the new plan",
+                expected: self.coord.n_robots(),
+                found: next.n_robots(),
+            });
+        }
+        self.pending = Some(next);
+        Ok(self.try_hand_over())
+    }
+
+    fn try_hand_over(&mut self) -> bool {
+        let Some(next) = self.pending.as_mut() else {
+            return false;
+        };
+        if next.take_over(&self.coord).is_err() {
+            return false;
+        }
+        self.coord = self.pending.take().expect("checked above");
+        self.stats.hand_overs += 1;
+        true
+    }
+
+    /// One control tick (module docs): `needs(robot, ref_idx)` says whether robot `robot`
+    /// needs the operator at reference sample `ref_idx`, asked once per supervised sample just
+    /// before the operator's draw from `rng`. `model` is the one that commands the robots
+    /// now (the planner's latest). Returns the tasks completed in this tick.
+    ///
+    /// # Errors
+    /// A model of another size than the cell's, or a degenerate command.
+    pub fn tick(
+        &mut self,
+        model: &TaskModel,
+        mut needs: impl FnMut(usize, usize) -> bool,
+        rng: &mut impl Rng,
+    ) -> Result<Vec<FinishedTask>> {
+        if model.n_ref() != self.n_ref {
+            return Err(Error::Mismatch {
+                what: "model reference samples",
+                expected: self.n_ref,
+                found: model.n_ref(),
+            });
+        }
+        let n = self.coord.n_robots();
+        let at_gate = self.coord.at_gate_now();
+        let held = self.coord.fault().map(|f| f.stopped);
+        let before = self.coord.tasks_completed().to_vec();
+        let mut operator = Operator::Scheduled;
+        let task = self.coord.task();
+        for i in 0..n {
+            if at_gate[i] {
+                self.stats.gate_ticks[i] += 1;
+                continue;
+            }
+            if held == Some(i) {
+                continue;
+            }
+            let run = &mut self.runs[i];
+            if run.start_tick == usize::MAX {
+                run.start_tick = self.stats.ticks as usize;
+            }
+            let k = (self.ref_now[i].floor() as usize).min(self.n_ref - 1);
+            let bounds = (!task.conf()[k]).then(|| (task.grad_min()[k], task.grad_max()[k]));
+            if let Some(input) = self.op.robot_tick(
+                model,
+                run,
+                &mut self.in_episode[i],
+                self.ref_now[i],
+                bounds,
+                |idx| needs(i, idx),
+                rng,
+            )? {
+                operator = input;
+            }
+        }
+        let t = self.coord.tick(operator)?;
+        self.stats.ticks += 1;
+        self.ref_now.copy_from_slice(&t.ref_time);
+        match t.low_conf.count() {
+            0 => {}
+            1 => self.stats.busy_ticks += 1,
+            _ => {
+                self.stats.busy_ticks += 1;
+                self.stats.overlap_ticks += 1;
+            }
+        }
+        match t.fault {
+            Some(f) if f.tick + 1 == self.coord.ticks() => self.stats.faults += 1,
+            Some(_) if t.low_conf.count() == 0 => self.coord.clear_fault(),
+            _ => {}
+        }
+        let mut done = Vec::new();
+        for (i, &k) in before.iter().enumerate() {
+            if t.tasks[i] > k {
+                let run = std::mem::replace(&mut self.runs[i], self.op.empty_run(self.n_ref));
+                done.push(FinishedTask {
+                    robot: i,
+                    tick: self.stats.ticks,
+                    run,
+                });
+            }
+        }
+        self.try_hand_over();
+        Ok(done)
+    }
+}
+
+/// Each robot's reference time at its clock.
+fn ref_times(coord: &ContinuousCoordinator) -> Vec<f64> {
+    let task = coord.task();
+    coord
+        .clock_s()
+        .iter()
+        .map(|&c| task.ref_time_at(c).min(task.n_ref() as f64))
+        .collect()
+}
+
+fn check(model: &TaskModel, coord: &ContinuousCoordinator) -> Result<()> {
+    if coord.task().n_ref() != model.n_ref() {
+        return Err(Error::Mismatch {
+            what: "reference samples of the cell's task",
+            expected: model.n_ref(),
+            found: coord.task().n_ref(),
+        });
+    }
+    if !tol::same_tick(coord.tick_s(), model.dt_s()) {
+        return Err(Error::TickMismatch {
+            schedule_tick_s: coord.tick_s(),
+            workcell_tick_s: model.dt_s(),
+        });
+    }
+    Ok(())
+}
