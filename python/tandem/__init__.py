@@ -14,6 +14,9 @@ NumPy arrays in and out (docs/python.md):
   continuous cell (no rounds): its period, throughput, the operator's order and busy share.
 - :class:`Coordinator`: the real-time coordinator of a schedule (§II-B5), one control tick
   per :meth:`Coordinator.tick`.
+- :class:`ContinuousCoordinator`: the run-time coordinator of a continuous cell (the token
+  rule), from :meth:`CyclicPlan.coordinator` or :meth:`Planner.continuous_coordinator`, one
+  control tick per :meth:`ContinuousCoordinator.tick` (a :class:`CellTick`).
 - :mod:`tandem.study`: the simulated study of §III; :mod:`tandem.sim`: its workcell.
 - :func:`align`: GDTW time warping (Eq. 2–3).
 - :func:`read_bag`: a ROS 2 bag (rosbag2 MCAP) on one grid; :func:`fit` takes ``.mcap`` paths.
@@ -27,7 +30,9 @@ demonstration of unusual length) raises a :class:`DataWarning`.
 from ._tandem import (
     MAX_ROBOTS,
     N_ROBOTS,
+    CellTick,
     Confidence,
+    ContinuousCoordinator,
     Coordinator,
     CyclicPlan,
     DataWarning,
@@ -58,7 +63,9 @@ from . import sim, study
 __all__ = [
     "MAX_ROBOTS",
     "N_ROBOTS",
+    "CellTick",
     "Confidence",
+    "ContinuousCoordinator",
     "Coordinator",
     "CyclicPlan",
     "DataWarning",

@@ -145,6 +145,11 @@ class Planner:
     def cyclic_plan(self, max_enumerated: Optional[int] = None) -> CyclicPlan:
         """The plan of a continuous cell (no rounds) on the current problem for this
         planner's robots; does not change the planner (``tandem schedule --cell continuous``)."""
+    def continuous_coordinator(
+        self, max_enumerated: Optional[int] = None, tick_s: Optional[float] = None
+    ) -> ContinuousCoordinator:
+        """:meth:`cyclic_plan` run on the current problem by :meth:`CyclicPlan.coordinator`;
+        ``tick_s`` defaults to the current schedule's tick."""
     @property
     def schedule(self) -> Schedule:
         """The current schedule (a snapshot)."""
@@ -360,14 +365,91 @@ class CyclicPlan:
     @property
     def start_wait_s(self) -> F64:
         """``(N,)`` each robot's wait at its task start before the next task (s)."""
+    def coordinator(
+        self, problem: Problem, tick_s: Optional[float] = None
+    ) -> ContinuousCoordinator:
+        """The continuous coordinator running this plan on ``problem`` (the problem it was
+        planned for) at ``tick_s`` real s (default ``problem.dt_s``); ``ScheduleError``
+        (``violation == "NotRunnable"``) for an order the token rule cannot run."""
+    def is_runnable(self, problem: Problem) -> bool:
+        """Whether :meth:`coordinator` can run this plan's order on ``problem``."""
     def to_json(self) -> str:
         """The plan as ``tandem schedule --cell continuous --json`` prints it."""
 
 def cyclic_plan(
-    problem: Problem, robots: int = 2, max_enumerated: Optional[int] = None
+    problem: Problem,
+    robots: int = 2,
+    max_enumerated: Optional[int] = None,
+    *,
+    runnable_only: bool = True,
+    order: Optional[Sequence[Tuple[int, int]]] = None,
 ) -> CyclicPlan:
     """The cyclic plan of ``robots`` robots on ``problem`` (every order searched up to
-    ``max_enumerated``, default 100 000; a local search beyond)."""
+    ``max_enumerated``, default 100 000; a local search beyond); ``runnable_only``: only
+    orders :meth:`CyclicPlan.coordinator` can run; ``order``: the plan of that order, no
+    search."""
+
+class ContinuousCoordinator:
+    """The Rust run-time coordinator of a continuous cell (the token rule), one control tick
+    per call; from :meth:`CyclicPlan.coordinator` or :meth:`Planner.continuous_coordinator`."""
+
+    def tick(self, operator: Union[None, float, str] = None) -> CellTick:
+        """One tick; ``operator``: None, a gradient, ``"fastest"``, ``"slowest"``."""
+    def reset(self) -> None: ...
+    @property
+    def fault(self) -> Optional[Dict[str, Any]]:
+        """``{"tick", "low_conf", "stopped"}`` once two robots were low-confidence in a tick."""
+    def clear_fault(self) -> None: ...
+    @property
+    def n_robots(self) -> int: ...
+    @property
+    def tick_s(self) -> float: ...
+    @property
+    def ticks(self) -> int: ...
+    @property
+    def task_s(self) -> float:
+        """One task on the fastest warp (s of schedule clock), without waits."""
+    @property
+    def tasks_completed(self) -> I64:
+        """``(N,)`` tasks each robot has completed."""
+    @property
+    def clock_s(self) -> F64:
+        """``(N,)`` each robot's schedule clock in its current task (s)."""
+    @property
+    def ref_time_now(self) -> F64: ...
+    @property
+    def sample_now(self) -> List[int]: ...
+    @property
+    def low_conf_now(self) -> Bool: ...
+    @property
+    def token(self) -> Optional[Tuple[int, int]]:
+        """``(robot, group)`` that may go through its group now, or ``None``."""
+    @property
+    def token_position(self) -> Tuple[int, int]:
+        """``(index into tokens, completed passes)``."""
+    @property
+    def tokens(self) -> List[Tuple[int, int]]: ...
+    @property
+    def groups(self) -> List[Dict[str, int]]:
+        """Per group ``{"gate", "first_lc", "end_lc", "ref_start", "ref_end"}``."""
+
+class CellTick:
+    """What one continuous tick did, per robot."""
+
+    @property
+    def ref_time(self) -> F64: ...
+    @property
+    def tasks(self) -> I64: ...
+    @property
+    def low_conf(self) -> Bool: ...
+    @property
+    def running(self) -> Bool: ...
+    @property
+    def at_gate(self) -> Bool: ...
+    @property
+    def overlap(self) -> bool: ...
+    @property
+    def fault(self) -> Optional[Dict[str, Any]]: ...
 
 class Schedule:
     """Execution warps ``(N, T_ref)``, ``N − 1`` start offsets and the control tick."""

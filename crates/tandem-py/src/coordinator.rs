@@ -12,7 +12,7 @@ use crate::schedule::PySchedule;
 
 /// The operator's input from Python: `None`/`"scheduled"`, a gradient, `"fastest"` or
 /// `"slowest"`.
-fn operator(x: Option<&Bound<'_, PyAny>>) -> Result<Operator> {
+pub(crate) fn operator(x: Option<&Bound<'_, PyAny>>) -> Result<Operator> {
     let Some(x) = x.filter(|x| !x.is_none()) else {
         return Ok(Operator::Scheduled);
     };
@@ -210,7 +210,7 @@ impl PyCoordinator {
 }
 
 /// A fault as the dict :attr:`Coordinator.fault` returns.
-fn fault_dict<'py>(py: Python<'py>, f: &Fault) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn fault_dict<'py>(py: Python<'py>, f: &Fault) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("tick", f.tick)?;
     d.set_item("low_conf", out_flags(py, f.low_conf.iter().collect()))?;

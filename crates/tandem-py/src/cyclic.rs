@@ -6,20 +6,29 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 
 use crate::arrays::out_vector;
+use crate::continuous::{self, PyContinuousCoordinator};
 use crate::errors::{Error, Result, guard};
-use crate::facade::{CyclicParams, CyclicPlan, GapPlan, Problem, cyclic_plan as plan_of};
+use crate::facade::{
+    CyclicParams, CyclicPlan, GapPlan, Problem, Stretch, cyclic_plan as plan_of,
+    cyclic_plan_for_order,
+};
 use crate::planner::N_ROBOTS;
 use crate::schedule::PyProblem;
 
 /// The cyclic plan of `n_robots` robots on `problem` ([`plan_of`]), with `max_enumerated`
-/// replacing [`CyclicParams::max_enumerated`] when given, the GIL released.
+/// replacing [`CyclicParams::max_enumerated`] when given and `runnable_only`
+/// [`CyclicParams::runnable_only`], the GIL released.
 pub(crate) fn compute(
     py: Python<'_>,
     problem: &Problem,
     n_robots: usize,
     max_enumerated: Option<u64>,
+    runnable_only: bool,
 ) -> PyResult<PyCyclicPlan> {
-    let mut params = CyclicParams::default();
+    let mut params = CyclicParams {
+        runnable_only,
+        ..CyclicParams::default()
+    };
     if let Some(k) = max_enumerated {
         params.max_enumerated = k;
     }
@@ -42,6 +51,11 @@ pub(crate) struct PyCyclicPlan {
 }
 
 impl PyCyclicPlan {
+    /// The Rust plan.
+    pub(crate) fn plan(&self) -> &CyclicPlan {
+        &self.plan
+    }
+
     /// Per robot, one value per gap of its task (head, between stretches, tail): an
     /// ``(N, m + 1)`` array.
     fn per_gap<'py>(
@@ -199,6 +213,41 @@ impl PyCyclicPlan {
         )
     }
 
+    /// The continuous coordinator that runs this plan on ``problem`` (the problem it was
+    /// planned for) at a control tick of ``tick_s`` real seconds (default: ``problem.dt_s``):
+    /// every robot on the fastest warp, waiting at the usable hold points, the operator's
+    /// token passed in :attr:`order`; every robot at sample 0 of its first task.
+    ///
+    /// Under the planned operator (``tick(None)``) its steady throughput is
+    /// :attr:`tasks_per_hour` less the hand-over cost (a robot leaves its gate only once the
+    /// previous group has been left, plus the tick quantization); under drift only
+    /// soundness is guaranteed: two robots are never low-confidence in one tick.
+    ///
+    /// Raises:
+    ///     ScheduleError: an order the token rule cannot run (``violation`` is
+    ///         ``"NotRunnable"``: another robot's stretch between two stretches of one robot
+    ///         with no usable hold between them; only a plan made with
+    ///         ``runnable_only=False`` or a given ``order`` can have one), or another
+    ///         malformed order.
+    ///     ParamError: ``tick_s`` not finite and > 0 (``name`` is ``"tick_s"``), or a
+    ///         ``problem`` with another number of low-confidence stretches than the plan's
+    ///         (``name`` is ``"problem"``).
+    #[pyo3(signature = (problem, tick_s=None))]
+    fn coordinator(
+        &self,
+        problem: PyRef<'_, PyProblem>,
+        tick_s: Option<f64>,
+    ) -> PyResult<PyContinuousCoordinator> {
+        Ok(continuous::make(&self.plan, &problem.inner, tick_s)?)
+    }
+
+    /// Whether the continuous coordinator can run this plan's order on ``problem`` (no
+    /// other robot's stretch between two stretches of one robot with no usable hold between
+    /// them); always ``True`` for a plan searched with ``runnable_only=True``, the default.
+    fn is_runnable(&self, problem: PyRef<'_, PyProblem>) -> bool {
+        self.plan.is_runnable(&problem.inner)
+    }
+
     /// The plan as JSON, exactly what ``tandem schedule --cell continuous --json`` prints
     /// (docs/formats.md).
     fn to_json(&self) -> PyResult<String> {
@@ -224,20 +273,51 @@ impl PyCyclicPlan {
     }
 }
 
+/// The operator order from Python: a sequence of `(robot, stretch)` pairs.
+fn order_of(order: &Bound<'_, PyAny>) -> Result<Vec<Stretch>> {
+    let pairs: Vec<(usize, usize)> = order.extract().map_err(|_| {
+        Error::input(
+            "order",
+            "expected a sequence of (robot, stretch) pairs of non-negative ints",
+        )
+    })?;
+    Ok(pairs
+        .into_iter()
+        .map(|(robot, lc)| Stretch { robot, lc })
+        .collect())
+}
+
 /// The cyclic plan of a continuous cell of ``robots`` robots (1 to 8, default 2) on
 /// ``problem``: the operator order with the least period, every order searched while there
 /// are at most ``max_enumerated`` (default 100 000), a local search beyond (see
 /// :attr:`CyclicPlan.order_exhaustive`).
 ///
+/// ``runnable_only`` (default ``True``): search only the orders the continuous coordinator
+/// can run (:meth:`CyclicPlan.coordinator`); ``False`` searches every order, as a plan only.
+/// ``order``: instead of a search, the plan of this cyclic order, a sequence of ``N·m``
+/// pairs ``(robot, stretch)`` (0-based; each robot's stretches in task order around the
+/// cycle); ``max_enumerated`` and ``runnable_only`` are then not used.
+///
 /// Raises:
 ///     ParamError: ``robots`` outside 1…8 or ``max_enumerated`` 0.
+///     InputError: an ``order`` that is not a sequence of pairs of non-negative ints.
+///     ScheduleError: an ``order`` that does not list each robot's each stretch once in task
+///         order, or that no period admits.
 #[pyfunction]
-#[pyo3(signature = (problem, robots=N_ROBOTS, max_enumerated=None))]
+#[pyo3(signature = (problem, robots=N_ROBOTS, max_enumerated=None, *, runnable_only=true, order=None))]
 pub(crate) fn cyclic_plan(
     py: Python<'_>,
     problem: PyRef<'_, PyProblem>,
     robots: usize,
     max_enumerated: Option<u64>,
+    runnable_only: bool,
+    order: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyCyclicPlan> {
-    compute(py, &problem.inner, robots, max_enumerated)
+    let Some(order) = order.filter(|o| !o.is_none()) else {
+        return compute(py, &problem.inner, robots, max_enumerated, runnable_only);
+    };
+    let order = order_of(order)?;
+    let problem = &*problem.inner;
+    let plan = py.detach(|| guard(|| Ok(cyclic_plan_for_order(problem, robots, &order)?)))?;
+    Ok(PyCyclicPlan { plan })
 }

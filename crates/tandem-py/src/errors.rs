@@ -7,7 +7,7 @@
 //! | `InputError` | demonstrations, executions, arrays, CSV/JSON files, ROS 2 bags, labels, operator input | `file`, `line`, `column` (`None` where unknown; `file` is the argument, e.g. `demos[2]`, for an array) |
 //! | `ParamError` | a parameter out of range, an unknown or ill-typed key | `name` |
 //! | `StateFileError` | a state file that is missing, foreign, truncated, corrupt, of another version, inconsistent, or cannot be written | `path` |
-//! | `ScheduleError` | an infeasible problem, a schedule that violates Eq. 20, a schedule run at another tick | `violation` (the broken rule's name, or `None`) |
+//! | `ScheduleError` | an infeasible problem, a schedule that violates Eq. 20, a schedule run at another tick, an operator order the continuous coordinator cannot run | `violation` (the broken rule's name, `NotRunnable`, or `None`) |
 //! | `InternalError` | a panic caught at the boundary: a bug in tandem, never the user's input | — |
 //!
 //! A Rust panic never unwinds into Python: [`guard`] turns it into an `InternalError`.
@@ -53,8 +53,9 @@ pyo3::create_exception!(
     tandem,
     ScheduleError,
     TandemError,
-    "An infeasible scheduling problem, a schedule that violates Eq. 20, or a schedule run\n\
-     at another control tick than the one its margins were checked at.\n\n\
+    "An infeasible scheduling problem, a schedule that violates Eq. 20, a schedule run at\n\
+     another control tick than the one its margins were checked at, or an operator order the\n\
+     continuous coordinator cannot run.\n\n\
      Attribute: ``violation`` (name of the broken rule, e.g. ``GradientOutOfBounds``, or ``None``)."
 );
 pyo3::create_exception!(
@@ -297,6 +298,9 @@ fn classify_schedule(e: &errors::Schedule) -> Kind {
         errors::Schedule::Realtime(r) => classify_realtime(r),
         errors::Schedule::Invalid(v) => Kind::Schedule {
             violation: Some(violation_name(v)),
+        },
+        errors::Schedule::NotRunnable { .. } => Kind::Schedule {
+            violation: Some("NotRunnable".to_owned()),
         },
         // A wrong certificate bound is a bug in tandem, not in the caller's data.
         errors::Schedule::BoundAboveSchedule { .. } => Kind::Internal,

@@ -15,6 +15,9 @@
 //!   `Planner.cyclic_plan` or `tandem.cyclic_plan`.
 //! - `coordinator`: `tandem.Coordinator`, the Rust real-time coordinator itself (not a
 //!   re-implementation), one control tick per `tick(operator)`.
+//! - `continuous`: `tandem.ContinuousCoordinator`, the Rust coordinator of a continuous cell
+//!   (the token rule), from `CyclicPlan.coordinator` or `Planner.continuous_coordinator`,
+//!   one control tick per `tick(operator)`.
 //! - `study` and `sim`: the simulated study of §III and its workcell.
 //! - `warp`: `tandem.align`, GDTW (Eq. 2–3).
 //! - `bag`: `tandem.read_bag`, a ROS 2 bag (rosbag2 MCAP) on one grid; `tandem.fit` takes
@@ -32,6 +35,7 @@
 
 mod arrays;
 mod bag;
+mod continuous;
 mod coordinator;
 mod cyclic;
 mod errors;
@@ -51,6 +55,8 @@ use pyo3::prelude::*;
 mod _tandem {
     #[pymodule_export]
     use crate::bag::read_bag;
+    #[pymodule_export]
+    use crate::continuous::{PyCellTick, PyContinuousCoordinator};
     #[pymodule_export]
     use crate::coordinator::{PyCoordinator, PyTick};
     #[pymodule_export]

@@ -744,7 +744,30 @@ impl PyPlanner {
             self.inner.problem(),
             self.inner.n_robots(),
             max_enumerated,
+            true,
         )
+    }
+
+    /// The continuous coordinator of this planner's cell: :meth:`cyclic_plan` (with
+    /// ``max_enumerated``) run on the current problem by :meth:`CyclicPlan.coordinator` at a
+    /// control tick of ``tick_s`` real seconds (default: the current schedule's
+    /// ``tick_s``, the cell's control tick). A snapshot: it does not change the planner and
+    /// does not follow it.
+    ///
+    /// Raises:
+    ///     ParamError: ``max_enumerated`` 0, or ``tick_s`` not finite and > 0.
+    #[pyo3(signature = (max_enumerated=None, tick_s=None))]
+    fn continuous_coordinator(
+        &self,
+        py: Python<'_>,
+        max_enumerated: Option<u64>,
+        tick_s: Option<f64>,
+    ) -> PyResult<crate::continuous::PyContinuousCoordinator> {
+        let problem = self.inner.problem();
+        let plan =
+            crate::cyclic::compute(py, problem, self.inner.n_robots(), max_enumerated, true)?;
+        let tick_s = tick_s.unwrap_or(self.inner.schedule().tick_s);
+        Ok(crate::continuous::make(plan.plan(), problem, Some(tick_s))?)
     }
 
     /// The current schedule (a snapshot: it does not change when the planner does).
