@@ -80,28 +80,32 @@ def test_the_doc_example_by_hand() -> None:
 
 def test_the_fastest_warp_on_the_doc_problem_by_hand() -> None:
     # ψ̇min = 0.5 on the high-confidence samples: the fastest warp takes samples 0 and 2 in
-    # 0.5 s, the stretch (sample 1) in 1 s at ψ̇̄; a task takes 2 s.
+    # 0.5 s, the stretch (sample 1, clock 0.5–1.5 s) in 1 s at ψ̇̄; a task takes 2 s. From a
+    # high-confidence sample a step stops at the next low-confidence sample's start.
     problem = doc_problem()
     cell = tandem.cyclic_plan(problem, 2).coordinator(problem)
     assert cell.task_s == pytest.approx(2.0)
-    # Tick 1: robot 0's clock 0 → 1 s, half-way through sample 1 (1 + 0.5/1).
+    # Tick 1: robot 0's clock 0 → 0.5 s (capped at the stretch's start), robot 1 at its gate.
     t = cell.tick()
-    assert t.ref_time.tolist() == [1.5, 0.0]
+    assert t.ref_time.tolist() == [1.0, 0.0]
     assert t.at_gate.tolist() == [False, True] and t.running.tolist() == [True, False]
-    # Tick 2: from the stretch at ψ̇̄ robot 0 would reach 2 s, the task's end: it has done a
-    # task and is back at its task start, where it waits; the token is robot 1's.
+    # Tick 2: across the stretch at ψ̇̄, 0.5 → 1.5 s (its end, not yet left by the tolerance).
+    t = cell.tick()
+    assert t.ref_time.tolist() == [2.0, 0.0] and cell.token == (0, 0)
+    # Tick 3: sample 2 to the task's end (2 s): robot 0 has done a task and is back at its
+    # task start, where it waits; the token is robot 1's.
     t = cell.tick()
     assert t.ref_time.tolist() == [0.0, 0.0]
     assert t.tasks.tolist() == [1, 0]
     assert t.at_gate.tolist() == [True, False]
     assert cell.token == (1, 0) and cell.token_position == (1, 0)
-    # Tick 3: robot 1 goes; robot 0 waits.
+    # Tick 4: robot 1 goes to the stretch's start; robot 0 waits.
     t = cell.tick()
-    assert t.ref_time.tolist() == [0.0, 1.5] and t.running.tolist() == [False, True]
+    assert t.ref_time.tolist() == [0.0, 1.0] and t.running.tolist() == [False, True]
     # A slower operator on the stretch: ψ̇max = 2 halves the rate, 0.5 s of clock per tick.
     t = cell.tick("slowest")
-    assert t.ref_time.tolist() == [0.0, 2.0] and t.tasks.tolist() == [1, 0]
-    # Tick 5: robot 1 leaves the stretch (1.5 s → 2 s, the task's end).
+    assert t.ref_time.tolist() == [0.0, 1.5] and t.tasks.tolist() == [1, 0]
+    # Tick 6: from the stretch at ψ̇̄, 1.0 → 2.0 s, the task's end.
     t = cell.tick()
     assert t.tasks.tolist() == [1, 1] and cell.token == (0, 0)
     assert cell.token_position == (0, 1)
