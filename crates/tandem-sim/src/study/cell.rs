@@ -27,7 +27,6 @@ use std::time::Instant;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use tandem_lfd::TaskModel;
 use tandem_planner::Planner;
@@ -36,7 +35,7 @@ use tandem_schedule::{CyclicParams, CyclicPlan, cyclic_plan};
 use super::config::StudyConfig;
 use super::inputs::StudyInputs;
 use super::record::mean_std;
-use super::run::{PhaseTimes, Progress, fit_study_model, trial_seed};
+use super::run::{PhaseTimes, Progress, fit_study_model, par_trials, trial_seed};
 use crate::task::{self, Label, Workpiece};
 use crate::truth::falsely_trusted;
 use crate::workcell::{CellSim, CellStats, needs_correction};
@@ -369,28 +368,9 @@ pub fn run_cell_trials(
     labels: &[Label],
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<(CellStudyResult, PhaseTimes)> {
-    config.validate()?;
-    if labels.len() != model.n_ref() {
-        return Err(Error::BadInput {
-            path: "<reference labels>".into(),
-            why: format!(
-                "{} labels for {} reference samples",
-                labels.len(),
-                model.n_ref()
-            ),
-        });
-    }
-    let outcomes: Vec<Result<(CellTrialResult, PhaseTimes)>> = (0..config.trials)
-        .into_par_iter()
-        .map(|k| run_cell_trial(config, model, labels, k, progress))
-        .collect();
-    let mut times = PhaseTimes::default();
-    let mut trials = Vec::with_capacity(config.trials);
-    for outcome in outcomes {
-        let (trial, t) = outcome?;
-        times.add(&t);
-        trials.push(trial);
-    }
+    let (trials, times) = par_trials(config, model, labels, |k| {
+        run_cell_trial(config, model, labels, k, progress)
+    })?;
     Ok((
         CellStudyResult {
             config: config.clone(),

@@ -40,7 +40,7 @@ pub struct PhaseTimes {
 }
 
 impl PhaseTimes {
-    pub(super) fn add(&mut self, other: &PhaseTimes) {
+    fn add(&mut self, other: &PhaseTimes) {
         self.alignment += other.alignment;
         self.model_update += other.model_update;
         self.confidence += other.confidence;
@@ -296,28 +296,9 @@ pub fn run_trials_observed(
     progress: &(dyn Fn(Progress) + Sync),
     observe: &(dyn Fn(RoundView<'_>) + Sync),
 ) -> Result<(StudyResult, PhaseTimes)> {
-    config.validate()?;
-    if reference_labels.len() != model.n_ref() {
-        return Err(Error::BadInput {
-            path: "<reference labels>".into(),
-            why: format!(
-                "{} labels for {} reference samples",
-                reference_labels.len(),
-                model.n_ref()
-            ),
-        });
-    }
-    let outcomes: Vec<Result<(TrialResult, PhaseTimes)>> = (0..config.trials)
-        .into_par_iter()
-        .map(|k| run_trial_observed(config, model, reference_labels, k, progress, observe))
-        .collect();
-    let mut times = PhaseTimes::default();
-    let mut trials = Vec::with_capacity(config.trials);
-    for outcome in outcomes {
-        let (trial, t) = outcome?;
-        times.add(&t);
-        trials.push(trial);
-    }
+    let (trials, times) = par_trials(config, model, reference_labels, |k| {
+        run_trial_observed(config, model, reference_labels, k, progress, observe)
+    })?;
     Ok((
         StudyResult {
             config: config.clone(),
@@ -328,6 +309,43 @@ pub fn run_trials_observed(
         },
         times,
     ))
+}
+
+/// Runs `trial(k)` for every trial `k` of `config` in parallel (rayon), after checking the
+/// configuration and that `labels` are one per reference sample of `model`: the trials in
+/// trial order and their phase times summed. Each trial depends only on `(config.seed, k)`,
+/// so the result is the same for any number of threads.
+///
+/// # Errors
+/// Invalid configuration, mismatched labels, or the first failing trial's error in trial
+/// order.
+pub(super) fn par_trials<T: Send>(
+    config: &StudyConfig,
+    model: &TaskModel,
+    labels: &[Label],
+    trial: impl Fn(usize) -> Result<(T, PhaseTimes)> + Sync,
+) -> Result<(Vec<T>, PhaseTimes)> {
+    config.validate()?;
+    if labels.len() != model.n_ref() {
+        return Err(Error::BadInput {
+            path: "<reference labels>".into(),
+            why: format!(
+                "{} labels for {} reference samples",
+                labels.len(),
+                model.n_ref()
+            ),
+        });
+    }
+    let outcomes: Vec<Result<(T, PhaseTimes)>> =
+        (0..config.trials).into_par_iter().map(&trial).collect();
+    let mut times = PhaseTimes::default();
+    let mut trials = Vec::with_capacity(config.trials);
+    for outcome in outcomes {
+        let (t, phase) = outcome?;
+        times.add(&phase);
+        trials.push(t);
+    }
+    Ok((trials, times))
 }
 
 #[cfg(test)]

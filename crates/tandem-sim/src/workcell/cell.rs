@@ -60,6 +60,8 @@ pub struct CellSim {
     runs: Vec<RobotRun>,
     in_episode: Vec<bool>,
     ref_now: Vec<f64>,
+    /// Each robot's completed tasks at the end of the last tick.
+    tasks: Vec<u64>,
     n_ref: usize,
     stats: CellStats,
 }
@@ -88,6 +90,7 @@ impl CellSim {
             op,
             in_episode: vec![false; n],
             ref_now,
+            tasks: coord.tasks_completed().to_vec(),
             n_ref,
             stats: CellStats {
                 gate_ticks: vec![0; n],
@@ -169,7 +172,6 @@ impl CellSim {
         let n = self.coord.n_robots();
         let at_gate = self.coord.at_gate_now();
         let held = self.coord.fault().map(|f| f.stopped);
-        let before = self.coord.tasks_completed().to_vec();
         let mut operator = Operator::Scheduled;
         let task = self.coord.task();
         for i in 0..n {
@@ -215,8 +217,9 @@ impl CellSim {
             _ => {}
         }
         let mut done = Vec::new();
-        for (i, &k) in before.iter().enumerate() {
-            if t.tasks[i] > k {
+        for (i, k) in self.tasks.iter_mut().enumerate() {
+            if t.tasks[i] > *k {
+                *k = t.tasks[i];
                 let run = std::mem::replace(&mut self.runs[i], self.op.empty_run(self.n_ref));
                 done.push(FinishedTask {
                     robot: i,
