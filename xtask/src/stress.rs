@@ -60,6 +60,8 @@ const MAX_PROBLEMS: u64 = 200;
 const SAMPLES: usize = 500;
 /// Executions per parallel batch (a progress line may follow each batch).
 const BATCH: u64 = 50_000;
+/// Executions per parallel batch of the continuous cell (each runs `--tasks` tasks per robot).
+const CELL_BATCH: u64 = BATCH / 50;
 /// Reference sample period of this task's random problems (s).
 const DT_S: f64 = 0.01;
 
@@ -318,34 +320,20 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> a
         AtomicU64::new(0),
         AtomicU64::new(0),
     );
-    let mut last_report = Instant::now();
-    let mut done = 0;
-    while done < executions {
-        let end = (done + BATCH).min(executions);
-        (done..end).into_par_iter().try_for_each(|e| {
-            let case = &cases[(e % n_problems) as usize];
-            let op = case.adversaries[((e / n_problems) % set_size) as usize];
-            let r = execute(case, op, seed, e)?;
-            ticks.fetch_add(r.ticks, Ordering::Relaxed);
-            if r.overlap_ticks > 0 {
-                overlap_ticks.fetch_add(r.overlap_ticks, Ordering::Relaxed);
-                overlap_runs.fetch_add(1, Ordering::Relaxed);
-            }
-            if !r.finished {
-                unfinished.fetch_add(1, Ordering::Relaxed);
-            }
-            anyhow::Ok(())
-        })?;
-        done = end;
-        if last_report.elapsed().as_secs_f64() >= 5.0 && done < executions {
-            let rate = done as f64 / run_start.elapsed().as_secs_f64();
-            println!(
-                "  {done}/{executions} executions, {} overlap ticks, {rate:.0} executions/s",
-                overlap_ticks.load(Ordering::Relaxed)
-            );
-            last_report = Instant::now();
+    run_batches(executions, BATCH, 5.0, &overlap_ticks, |e| {
+        let case = &cases[(e % n_problems) as usize];
+        let op = case.adversaries[((e / n_problems) % set_size) as usize];
+        let r = execute(case, op, seed, e)?;
+        ticks.fetch_add(r.ticks, Ordering::Relaxed);
+        if r.overlap_ticks > 0 {
+            overlap_ticks.fetch_add(r.overlap_ticks, Ordering::Relaxed);
+            overlap_runs.fetch_add(1, Ordering::Relaxed);
         }
-    }
+        if !r.finished {
+            unfinished.fetch_add(1, Ordering::Relaxed);
+        }
+        Ok(())
+    })?;
     let secs = run_start.elapsed().as_secs_f64();
     let (ticks, overlap_ticks, overlap_runs, unfinished) = (
         ticks.into_inner(),
@@ -366,6 +354,36 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> a
         bail!(
             "safety invariant broken: {overlap_ticks} overlap ticks, {unfinished} unfinished executions"
         );
+    }
+    Ok(())
+}
+
+/// Runs executions `0..executions` through `run_one` in parallel batches of `batch` (the
+/// order of the batches is fixed; the results must not depend on the order within one) and
+/// prints a progress line, with the overlap ticks counted so far, after a batch when
+/// `report_s` seconds have passed since the last one. Stops at the first batch with an error.
+fn run_batches(
+    executions: u64,
+    batch: u64,
+    report_s: f64,
+    overlap_ticks: &AtomicU64,
+    run_one: impl Fn(u64) -> anyhow::Result<()> + Sync,
+) -> anyhow::Result<()> {
+    let start = Instant::now();
+    let mut last_report = Instant::now();
+    let mut done = 0;
+    while done < executions {
+        let end = (done + batch).min(executions);
+        (done..end).into_par_iter().try_for_each(&run_one)?;
+        done = end;
+        if last_report.elapsed().as_secs_f64() >= report_s && done < executions {
+            let rate = done as f64 / start.elapsed().as_secs_f64();
+            println!(
+                "  {done}/{executions} executions, {} overlap ticks, {rate:.0} executions/s",
+                overlap_ticks.load(Ordering::Relaxed)
+            );
+            last_report = Instant::now();
+        }
     }
     Ok(())
 }
@@ -486,40 +504,25 @@ pub(crate) fn run_continuous(
         AtomicU64::new(0),
     );
     let min_tasks = AtomicU64::new(u64::MAX);
-    let mut last_report = Instant::now();
-    let mut done = 0;
-    let batch = (BATCH / 50).max(1);
-    while done < executions {
-        let end = (done + batch).min(executions);
-        (done..end).into_par_iter().try_for_each(|e| {
-            let case = &cases[(e % n_problems) as usize];
-            let op = case.adversaries[((e / n_problems) % set_size) as usize];
-            let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
-            rng.set_stream(e);
-            let mut cell = case.cell.clone();
-            let r = run_cell(&mut cell, op, &mut rng, tasks, case.max_ticks)?;
-            ticks.fetch_add(r.ticks, Ordering::Relaxed);
-            tasks_done.fetch_add(cell.tasks_completed().iter().sum(), Ordering::Relaxed);
-            min_tasks.fetch_min(r.min_tasks, Ordering::Relaxed);
-            if r.overlap_ticks > 0 {
-                overlap_ticks.fetch_add(r.overlap_ticks, Ordering::Relaxed);
-                overlap_runs.fetch_add(1, Ordering::Relaxed);
-            }
-            if !r.finished {
-                unfinished.fetch_add(1, Ordering::Relaxed);
-            }
-            anyhow::Ok(())
-        })?;
-        done = end;
-        if last_report.elapsed().as_secs_f64() >= 10.0 && done < executions {
-            let rate = done as f64 / run_start.elapsed().as_secs_f64();
-            println!(
-                "  {done}/{executions} executions, {} overlap ticks, {rate:.0} executions/s",
-                overlap_ticks.load(Ordering::Relaxed)
-            );
-            last_report = Instant::now();
+    run_batches(executions, CELL_BATCH, 10.0, &overlap_ticks, |e| {
+        let case = &cases[(e % n_problems) as usize];
+        let op = case.adversaries[((e / n_problems) % set_size) as usize];
+        let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
+        rng.set_stream(e);
+        let mut cell = case.cell.clone();
+        let r = run_cell(&mut cell, op, &mut rng, tasks, case.max_ticks)?;
+        ticks.fetch_add(r.ticks, Ordering::Relaxed);
+        tasks_done.fetch_add(cell.tasks_completed().iter().sum(), Ordering::Relaxed);
+        min_tasks.fetch_min(r.min_tasks, Ordering::Relaxed);
+        if r.overlap_ticks > 0 {
+            overlap_ticks.fetch_add(r.overlap_ticks, Ordering::Relaxed);
+            overlap_runs.fetch_add(1, Ordering::Relaxed);
         }
-    }
+        if !r.finished {
+            unfinished.fetch_add(1, Ordering::Relaxed);
+        }
+        Ok(())
+    })?;
     let secs = run_start.elapsed().as_secs_f64();
     let (ticks, overlap_ticks, overlap_runs, unfinished, tasks_done, min_tasks) = (
         ticks.into_inner(),
