@@ -217,25 +217,8 @@ fn run_continuous(
     root: &Path,
     wall: Instant,
 ) -> anyhow::Result<()> {
-    let n_plans = config.n_rounds();
-    let bar = ProgressBar::new((config.trials * n_plans) as u64);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {pos}/{len} re-plans (every N tasks), {msg} (eta {eta})",
-        )
-        .context("progress bar template")?
-        .progress_chars("=> "),
-    );
-    let trials_done = AtomicUsize::new(0);
-    bar.set_message(format!("0/{} trials done", config.trials));
-    let progress = |p: tandem::sim::study::Progress| {
-        bar.inc(1);
-        if p.pairs_done == n_plans {
-            let done = trials_done.fetch_add(1, Ordering::Relaxed) + 1;
-            bar.set_message(format!("{done}/{} trials done", config.trials));
-        }
-    };
-    let (result, times) = tandem::sim::study::run_cell_study(config, inputs, &progress)?;
+    let bar = TrialBar::new(config, "re-plans (every N tasks)")?;
+    let (result, times) = tandem::sim::study::run_cell_study(config, inputs, &|p| bar.step(p))?;
     bar.finish();
     let summary = result.summary();
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
@@ -289,6 +272,57 @@ fn run_continuous(
         bail!("two robots were low-confidence in the same tick: the cell is unsafe");
     }
     Ok(())
+}
+
+/// The progress bar of a study's trials: one step per round (or re-plan) of every trial,
+/// with the trials done as its message.
+pub(crate) struct TrialBar {
+    bar: ProgressBar,
+    trials: usize,
+    steps_per_trial: usize,
+    trials_done: AtomicUsize,
+}
+
+impl TrialBar {
+    /// A bar of `config.trials × config.n_rounds()` steps named `unit`.
+    pub(crate) fn new(config: &StudyConfig, unit: &str) -> anyhow::Result<TrialBar> {
+        let steps_per_trial = config.n_rounds();
+        let bar = ProgressBar::new((config.trials * steps_per_trial) as u64);
+        bar.set_style(
+            ProgressStyle::with_template(&format!(
+                "{{elapsed_precise}} [{{bar:40}}] {{pos}}/{{len}} {unit}, {{msg}} (eta {{eta}})"
+            ))
+            .context("progress bar template")?
+            .progress_chars("=> "),
+        );
+        bar.set_message(format!("0/{} trials done", config.trials));
+        Ok(TrialBar {
+            bar,
+            trials: config.trials,
+            steps_per_trial,
+            trials_done: AtomicUsize::new(0),
+        })
+    }
+
+    /// One step of a trial (the study's progress callback; called from worker threads).
+    pub(crate) fn step(&self, p: tandem::sim::study::Progress) {
+        self.bar.inc(1);
+        if p.pairs_done == self.steps_per_trial {
+            let done = self.trials_done.fetch_add(1, Ordering::Relaxed) + 1;
+            self.bar
+                .set_message(format!("{done}/{} trials done", self.trials));
+        }
+    }
+
+    /// Leaves the bar at its end.
+    pub(crate) fn finish(&self) {
+        self.bar.finish();
+    }
+
+    /// Removes the bar (a caller that prints its own line per study).
+    pub(crate) fn clear(&self) {
+        self.bar.finish_and_clear();
+    }
 }
 
 fn git_revision(root: &Path) -> String {
@@ -480,32 +514,15 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
         return run_continuous(&config, &inputs, &out, &root, wall);
     }
 
-    let n_rounds = config.n_rounds();
-    let bar = ProgressBar::new((config.trials * n_rounds) as u64);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {pos}/{len} rounds, {msg} (eta {eta})",
-        )
-        .context("progress bar template")?
-        .progress_chars("=> "),
-    );
-    let trials_done = AtomicUsize::new(0);
-    bar.set_message(format!("0/{} trials done", config.trials));
+    let bar = TrialBar::new(&config, "rounds")?;
     let sink = BagSink::new(args, &config)?;
     let observe = |view: tandem::sim::study::RoundView<'_>| {
         if let Some(s) = &sink {
             s.observe(view);
         }
     };
-    let progress = |p: tandem::sim::study::Progress| {
-        bar.inc(1);
-        if p.pairs_done == n_rounds {
-            let done = trials_done.fetch_add(1, Ordering::Relaxed) + 1;
-            bar.set_message(format!("{done}/{} trials done", config.trials));
-        }
-    };
     let (result, times) =
-        tandem::sim::study::run_study_observed(&config, &inputs, &progress, &observe)?;
+        tandem::sim::study::run_study_observed(&config, &inputs, &|p| bar.step(p), &observe)?;
     bar.finish();
     if let Some(s) = sink {
         if let Some(e) = s.error.into_inner().expect("no panic holds it") {
