@@ -53,6 +53,7 @@ class RobotRun:
         needed: supervised samples that needed a correction.
         missed: needed corrections the operator missed.
         false_corrections: corrections given where none was needed.
+        hold_ticks: control ticks the robot stood at a hold point of the schedule.
     """
 
     samples: np.ndarray
@@ -62,6 +63,7 @@ class RobotRun:
     needed: int
     missed: int
     false_corrections: int
+    hold_ticks: int = 0
 
 
 @dataclass(frozen=True)
@@ -79,6 +81,9 @@ class RoundRun:
         operator_idle_share: ``idle_ticks / ticks``.
         operator_busy_share: ``1 − idle_ticks / ticks``: the share of the round's ticks in
             which some robot was low-confidence (the operator was needed).
+        robot_wait_share: the share of the robots' time (robot-ticks over ``N · ticks``) in
+            which they did not move along the task: waiting for their start, standing at a
+            hold point, or done before the round's last robot.
     """
 
     robots: list
@@ -89,6 +94,7 @@ class RoundRun:
     duration_s: float
     operator_idle_share: float
     operator_busy_share: float
+    robot_wait_share: float = 0.0
 
     def record_args(self) -> dict:
         """The keyword arguments of :meth:`tandem.Planner.record_round` (and

@@ -24,6 +24,10 @@ def three() -> tandem.Planner:
         run = tandem.sim.run_round(p, needs, seed=k)
         assert len(run.robots) == 3 and run.overlap_ticks == 0
         assert 0.0 < run.operator_busy_share <= 1.0
+        # A robot moves one sample per tick it runs; every other robot-tick it waits.
+        moving = sum(len(r.ref_time_log) for r in run.robots)
+        assert run.robot_wait_share == pytest.approx(1.0 - moving / (3 * run.ticks))
+        assert 0.0 < run.robot_wait_share < 1.0
         p.record_round(**run.record_args())
     return p
 

@@ -28,6 +28,7 @@ fn run_dict<'py>(py: Python<'py>, run: RoundRun, channels: usize) -> PyResult<Bo
     d.set_item("duration_s", run.duration_s())?;
     d.set_item("operator_idle_share", run.operator_idle_share())?;
     d.set_item("operator_busy_share", run.operator_busy_share())?;
+    d.set_item("robot_wait_share", run.robot_wait_share())?;
     let robots = PyList::empty(py);
     for r in run.robots {
         let rd = PyDict::new(py);
@@ -38,6 +39,7 @@ fn run_dict<'py>(py: Python<'py>, run: RoundRun, channels: usize) -> PyResult<Bo
         rd.set_item("needed", r.needed)?;
         rd.set_item("missed", r.missed)?;
         rd.set_item("false_corrections", r.false_corrections)?;
+        rd.set_item("hold_ticks", r.hold_ticks)?;
         robots.append(rd)?;
     }
     d.set_item("robots", robots)?;

@@ -32,6 +32,16 @@ pub struct PairStats {
     /// JSON when 0, as it always is for the checked schedules a study runs.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub faults: usize,
+    /// Share of the robots' time in the round spent waiting (start offsets, holds, done
+    /// before the last robot), in `[0, 1]`
+    /// ([`RoundRun::robot_wait_share`](crate::workcell::RoundRun::robot_wait_share)); 0 in
+    /// files written before it was recorded.
+    #[serde(default)]
+    pub robot_wait_share: f64,
+    /// Control ticks the robots stood at hold points, summed over robots (0 without holds,
+    /// and then left out of the JSON).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub hold_ticks: usize,
 }
 
 /// Whether a count is 0 (for `skip_serializing_if`).
@@ -372,6 +382,8 @@ mod tests {
                 corrected_ticks: 4,
                 operator_busy_share: 0.5,
                 faults: 0,
+                robot_wait_share: 0.25,
+                hold_ticks: 0,
             }),
             lower_bound_s: t_total_s - 1.0,
             bound_is_optimum: iteration == 0,

@@ -182,6 +182,8 @@ pub fn run_trial_observed(
             corrected_ticks: count(|b| *b, |r| &r.corrected),
             operator_busy_share: run.operator_busy_share(),
             faults: run.faults,
+            robot_wait_share: run.robot_wait_share(),
+            hold_ticks: run.robots.iter().map(|r| r.hold_ticks).sum(),
         });
         iterations.push(record);
         let report = planner.record_round(&records)?;

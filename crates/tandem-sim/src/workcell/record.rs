@@ -135,6 +135,21 @@ impl RoundRun {
         (self.ticks - self.idle_ticks) as f64 / self.ticks as f64
     }
 
+    /// Share of the robots' time in the round spent not moving along their tasks, in
+    /// `[0, 1]`: waiting for a start offset, standing at a hold point, or done before the
+    /// round's last robot (robot-ticks without a sample over `N ×` the round's ticks). The
+    /// rounds counterpart of the continuous cell's gate waiting
+    /// ([`CellStats`](super::CellStats)).
+    #[must_use]
+    pub fn robot_wait_share(&self) -> f64 {
+        let n = self.robots.len();
+        if self.ticks == 0 || n == 0 {
+            return 0.0;
+        }
+        let moving: usize = self.robots.iter().map(|r| r.ref_time_log.len()).sum();
+        1.0 - moving as f64 / (n * self.ticks) as f64
+    }
+
     /// Actual duration of the round (s): ticks times the control period.
     #[must_use]
     pub fn duration_s(&self) -> f64 {

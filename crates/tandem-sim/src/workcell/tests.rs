@@ -294,6 +294,13 @@ fn every_robot_logs_its_clock_every_tick_and_runs_from_its_start_tick() {
     for w in run.robots.windows(2) {
         assert!(w[1].start_tick >= w[0].start_tick + w[0].ref_time_log.len());
     }
+    // So the round lasts at least the three robots' running ticks, and each robot waits
+    // for the other two: at least 2/3 of the robots' time is waiting.
+    let moving: usize = run.robots.iter().map(|r| r.ref_time_log.len()).sum();
+    assert!(run.ticks >= moving);
+    let wait = run.robot_wait_share();
+    assert!((wait - (1.0 - moving as f64 / (3 * run.ticks) as f64)).abs() < 1e-15);
+    assert!((2.0 / 3.0 - 1e-15..1.0).contains(&wait), "{wait}");
 }
 
 /// [`painted_needs`] for any robot index (every workpiece painted).
