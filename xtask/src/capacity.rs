@@ -3,21 +3,30 @@
 //! Runs the study of §III (`tandem::sim::study`) once per robot count `N = 1..=max_robots`
 //! with reduced sizes (defaults: 3 trials, 240 executions per trial rounded down to a
 //! multiple of `N`, 2000 sampler candidates per re-schedule, the configuration file's seed;
-//! see [`CapacityArgs`]), and reports at the end of learning, per `N`:
+//! see [`CapacityArgs`]), in rounds (the paper's cell, `run_study`), in a continuous cell
+//! (`run_cell_study`: each robot starts its next task as soon as it is safe), or both
+//! (`--cell rounds|continuous|both`, default both), and reports at the end of learning, per
+//! `N`:
 //!
-//! - `T_total` of the final schedule (mean ± std over trials, s);
-//! - the planned throughput `N·3600 / T_total` (tasks per hour per operator), mean over trials;
-//! - the operator busy share (share of a round's control ticks in which some robot was
-//!   low-confidence) and the supervised seconds per task, both averaged over the rounds of
-//!   the last [`END_SHARE`] of each trial (at least one round) and over trials;
-//! - overlapping low-confidence ticks over every round of every trial (must be 0).
+//! - the steady throughput: tasks completed per hour of cell time over the last
+//!   [`END_SHARE`] of each trial (rounds: its last rounds; continuous: its last tasks,
+//!   `tandem::sim::study::Steady`), mean over trials — what one operator gets;
+//! - rounds also: `T_total` of the final schedule (mean ± std over trials, s) and its planned
+//!   throughput `N·3600 / T_total`; continuous also: the last plan's period as tasks per hour
+//!   and its certificate's bound `3600·N / P_lower`;
+//! - the operator busy share (share of the control ticks in which some robot was
+//!   low-confidence) and the supervised seconds per task over the same window;
+//! - the robots' waiting share over the same window: robot time not moving along the task
+//!   (rounds: start offsets, holds and the wait for the round's last robot; continuous: the
+//!   gates, where a robot waits for the operator's token);
+//! - overlapping low-confidence ticks over every trial (must be 0).
 //!
 //! The operator-limited bound is `3600 / E[low-confidence seconds per task]`: one operator
 //! supervising one robot at a time can support at most that many tasks per hour, however many
-//! robots run. `E[·]` pools the end-of-learning supervised seconds per task of every `N`.
+//! robots run. `E[·]` pools the end-of-learning supervised seconds per task of every row.
 //!
 //! Writes `capacity.json`, `capacity.svg` and `capacity.png` under the output folder
-//! (default `results/capacity/`) and prints the table (docs/study.md quotes it).
+//! (default `results/capacity/`) and prints the tables (docs/study.md quotes them).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -27,16 +36,29 @@ use plotters::prelude::*;
 use serde::Serialize;
 use tandem::realtime::MAX_ROBOTS;
 use tandem::sim::study::{
-    StudyConfig, StudyInputs, StudyResult, mean_std, run_study, throughput_per_h,
+    Cell, CellStudyResult, StudyConfig, StudyInputs, StudyResult, mean_std, run_cell_study,
+    run_study, throughput_per_h,
 };
 use tandem_plot::{FONT_FAMILY, GROUND_TRUTH, MEAN, OPERATOR};
 
-use crate::study::read_config;
+use crate::study::{TrialBar, read_config};
 use crate::workspace_root;
 
-/// Share of a trial's rounds, at its end, over which the busy share and the supervised time
-/// per task are averaged ("the end of learning").
+/// Share of a trial's rounds (or tasks, in a continuous cell), at its end, over which the
+/// throughput, busy share, waiting and supervised time per task are measured ("the end of
+/// learning"); the continuous study's `Steady` window is the same share.
 pub(crate) const END_SHARE: f64 = 0.1;
+
+/// `--cell` of `cargo xtask capacity`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum CellChoice {
+    /// Rounds of N executions (the paper).
+    Rounds,
+    /// A continuous cell.
+    Continuous,
+    /// Both, on one figure.
+    Both,
+}
 
 /// Flags of `cargo xtask capacity`.
 #[derive(clap::Args, Debug)]
@@ -47,12 +69,15 @@ pub(crate) struct CapacityArgs {
     /// Trials per robot count.
     #[arg(long, default_value_t = 3)]
     trials: usize,
-    /// Executions per trial, rounded down to a multiple of N for each N.
+    /// Executions (tasks) per trial, rounded down to a multiple of N for each N.
     #[arg(long, default_value_t = 240)]
     executions: usize,
-    /// Sampler candidates per re-schedule.
+    /// Sampler candidates per re-schedule (rounds).
     #[arg(long, default_value_t = 2000)]
     samples: usize,
+    /// Which cell to run: rounds, a continuous cell, or both on one figure.
+    #[arg(long, value_enum, default_value = "both")]
+    cell: CellChoice,
     /// Master seed (default: the configuration file's).
     #[arg(long)]
     seed: Option<u64>,
@@ -64,7 +89,7 @@ pub(crate) struct CapacityArgs {
     out: Option<PathBuf>,
 }
 
-/// One robot count's result at the end of learning.
+/// One robot count's result in rounds, at the end of learning.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub(crate) struct CapacityRow {
     /// Robots `N`.
@@ -80,12 +105,50 @@ pub(crate) struct CapacityRow {
     /// Mean planned throughput of the final schedules, `N·3600 / T_total` (tasks per hour per
     /// operator).
     pub throughput_per_h: f64,
+    /// Mean measured throughput over the last rounds: their tasks per hour of their actual
+    /// durations (tasks per hour per operator).
+    pub steady_throughput_per_h: f64,
     /// Mean operator busy share over the last rounds (in [0, 1]).
     pub operator_busy_share: f64,
+    /// Mean share of the robots' time spent waiting over the last rounds (in [0, 1]).
+    pub robot_wait_share: f64,
     /// Mean supervised (low-confidence) seconds per task over the last rounds (s).
     pub lc_s_per_task: f64,
     /// Overlapping low-confidence ticks over every round of every trial (must be 0).
     pub overlap_ticks: usize,
+    /// Mean percent of high-confidence reference samples at the end.
+    pub high_conf_pct: f64,
+    /// Wall time of this robot count's study (s).
+    pub wall_s: f64,
+}
+
+/// One robot count's result in a continuous cell, at the end of learning.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub(crate) struct CellRow {
+    /// Robots `N`.
+    pub robots: usize,
+    /// Tasks per trial (a multiple of `N`).
+    pub tasks: usize,
+    /// Mean steady throughput over the last tasks (tasks per hour per operator).
+    pub steady_throughput_per_h: f64,
+    /// Its sample standard deviation across trials.
+    pub steady_throughput_std_per_h: f64,
+    /// Mean operator busy share over the last tasks (in [0, 1]).
+    pub operator_busy_share: f64,
+    /// Mean share of the robots' time spent waiting at gates over the last tasks (in [0, 1]).
+    pub robot_wait_share: f64,
+    /// Mean supervised (low-confidence) seconds per task over the last tasks (s).
+    pub lc_s_per_task: f64,
+    /// Mean planned throughput of the last plans, `3600·N / P` (tasks per hour per operator).
+    pub plan_per_h: f64,
+    /// Mean bound of the last plans' certificates, `3600·N / P_lower` (tasks per hour).
+    pub bound_per_h: f64,
+    /// Mean low-confidence stretches of the last plans' task.
+    pub lc_stretches: f64,
+    /// Overlapping low-confidence ticks over every trial (must be 0).
+    pub overlap_ticks: u64,
+    /// Faults of the coordinator's monitor over every trial (must be 0).
+    pub faults: u64,
     /// Mean percent of high-confidence reference samples at the end.
     pub high_conf_pct: f64,
     /// Wall time of this robot count's study (s).
@@ -101,10 +164,13 @@ struct CapacityFile<'a> {
     end_share: f64,
     /// `3600 / E[low-confidence seconds per task]` (tasks per hour per operator).
     operator_limited_per_h: f64,
+    /// Rounds, per `N` (empty with `--cell continuous`).
     rows: &'a [CapacityRow],
+    /// The continuous cell, per `N` (empty with `--cell rounds`).
+    continuous: &'a [CellRow],
 }
 
-/// The end-of-learning row of one study.
+/// The end-of-learning row of one study in rounds.
 pub(crate) fn row(result: &StudyResult, wall_s: f64) -> anyhow::Result<CapacityRow> {
     let config = &result.config;
     let n = config.robots;
@@ -120,16 +186,23 @@ pub(crate) fn row(result: &StudyResult, wall_s: f64) -> anyhow::Result<CapacityR
     let (t_mean, t_std) = mean_std(finals.iter().map(|r| r.t_total_s));
     let rounds = config.n_rounds();
     let last = ((END_SHARE * rounds as f64).ceil() as usize).clamp(1, rounds);
-    let end_rounds: Vec<_> = result
-        .trials
-        .iter()
-        .flat_map(|t| {
-            t.iterations
-                .iter()
-                .filter_map(|r| r.pair.as_ref())
-                .skip(rounds - last)
-        })
-        .collect();
+    fn end_rounds(
+        t: &tandem::sim::study::TrialResult,
+        skip: usize,
+    ) -> impl Iterator<Item = &tandem::sim::study::PairStats> {
+        t.iterations
+            .iter()
+            .filter_map(|r| r.pair.as_ref())
+            .skip(skip)
+    }
+    let end_rounds = |t| end_rounds(t, rounds - last);
+    let all_end: Vec<_> = result.trials.iter().flat_map(end_rounds).collect();
+    // Per trial, its last rounds' tasks per hour of their actual durations.
+    let steady = result.trials.iter().map(|t| {
+        let pairs: Vec<_> = end_rounds(t).collect();
+        let s: f64 = pairs.iter().map(|p| p.duration_s).sum();
+        throughput_per_h(n * pairs.len(), s)
+    });
     let tick_s = result.dt_s;
     Ok(CapacityRow {
         robots: n,
@@ -138,9 +211,11 @@ pub(crate) fn row(result: &StudyResult, wall_s: f64) -> anyhow::Result<CapacityR
         t_total_mean_s: t_mean,
         t_total_std_s: t_std,
         throughput_per_h: mean_std(finals.iter().map(|r| r.throughput_per_h)).0,
-        operator_busy_share: mean_std(end_rounds.iter().map(|p| p.operator_busy_share)).0,
+        steady_throughput_per_h: mean_std(steady).0,
+        operator_busy_share: mean_std(all_end.iter().map(|p| p.operator_busy_share)).0,
+        robot_wait_share: mean_std(all_end.iter().map(|p| p.robot_wait_share)).0,
         lc_s_per_task: mean_std(
-            end_rounds
+            all_end
                 .iter()
                 .map(|p| p.supervised_ticks as f64 * tick_s / n as f64),
         )
@@ -151,29 +226,101 @@ pub(crate) fn row(result: &StudyResult, wall_s: f64) -> anyhow::Result<CapacityR
     })
 }
 
-/// `3600 / E[low-confidence seconds per task]` pooled over the rows (tasks per hour): the
-/// throughput of one operator busy all the time, each task taking its low-confidence seconds.
-pub(crate) fn operator_limited_per_h(rows: &[CapacityRow]) -> f64 {
-    throughput_per_h(1, mean_std(rows.iter().map(|r| r.lc_s_per_task)).0)
+/// The end-of-learning row of one continuous study.
+pub(crate) fn cell_row(result: &CellStudyResult, wall_s: f64) -> anyhow::Result<CellRow> {
+    let n = result.config.robots;
+    let summary = result.summary();
+    let last: Vec<_> = result
+        .trials
+        .iter()
+        .map(|t| {
+            t.iterations
+                .last()
+                .ok_or_else(|| anyhow!("a continuous trial without plans"))
+        })
+        .collect::<anyhow::Result<_>>()?;
+    Ok(CellRow {
+        robots: n,
+        tasks: result.config.executions,
+        steady_throughput_per_h: summary.steady_throughput_per_h,
+        steady_throughput_std_per_h: summary.steady_throughput_std_per_h,
+        operator_busy_share: summary.steady_operator_busy_share,
+        robot_wait_share: summary.steady_robot_wait_share,
+        // Busy seconds of the window over its tasks: each busy tick supervises one robot.
+        lc_s_per_task: mean_std(
+            result.trials.iter().map(|t| {
+                t.steady.operator_busy_share * t.steady.duration_s / t.steady.tasks as f64
+            }),
+        )
+        .0,
+        plan_per_h: summary.last_plan_tasks_per_hour,
+        bound_per_h: summary.last_plan_bound_tasks_per_hour,
+        lc_stretches: summary.last_plan_lc_stretches,
+        overlap_ticks: summary.overlap_ticks,
+        faults: summary.faults,
+        high_conf_pct: mean_std(last.iter().map(|i| i.high_conf_pct)).0,
+        wall_s,
+    })
 }
 
-/// The table as Markdown (docs/study.md).
+/// `3600 / E[low-confidence seconds per task]` pooled over the rows of both cells (tasks per
+/// hour): the throughput of one operator busy all the time, each task taking its
+/// low-confidence seconds.
+pub(crate) fn operator_limited_per_h(rows: &[CapacityRow], cells: &[CellRow]) -> f64 {
+    let lc = rows
+        .iter()
+        .map(|r| r.lc_s_per_task)
+        .chain(cells.iter().map(|r| r.lc_s_per_task));
+    throughput_per_h(1, mean_std(lc).0)
+}
+
+/// The rounds table as Markdown (docs/study.md).
 pub(crate) fn table(rows: &[CapacityRow]) -> String {
     let mut out = String::from(
-        "| N | executions (rounds) | `T_total` (s) | throughput (tasks/h) | operator busy | \
-         LC s per task | high confidence (%) | overlaps |\n|---|---|---|---|---|---|---|---|\n",
+        "| N | executions (rounds) | `T_total` (s) | planned (tasks/h) | measured (tasks/h) | \
+         operator busy | robots waiting | LC s per task | high confidence (%) | overlaps |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         out += &format!(
-            "| {} | {} ({}) | {:.1} ± {:.1} | {:.1} | {:.0} % | {:.1} | {:.1} | {} |\n",
+            "| {} | {} ({}) | {:.1} ± {:.1} | {:.1} | {:.1} | {:.0} % | {:.0} % | {:.1} | {:.1} | {} |\n",
             r.robots,
             r.executions,
             r.rounds,
             r.t_total_mean_s,
             r.t_total_std_s,
             r.throughput_per_h,
+            r.steady_throughput_per_h,
             100.0 * r.operator_busy_share,
+            100.0 * r.robot_wait_share,
             r.lc_s_per_task,
+            r.high_conf_pct,
+            r.overlap_ticks
+        );
+    }
+    out
+}
+
+/// The continuous cell's table as Markdown (docs/study.md).
+pub(crate) fn cell_table(rows: &[CellRow]) -> String {
+    let mut out = String::from(
+        "| N | tasks | measured (tasks/h) | last plan (tasks/h) | plan bound (tasks/h) | \
+         operator busy | robots waiting | LC s per task | LC stretches | high confidence (%) \
+         | overlaps |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        out += &format!(
+            "| {} | {} | {:.1} ± {:.1} | {:.1} | {:.1} | {:.0} % | {:.0} % | {:.1} | {:.1} | {:.1} | {} |\n",
+            r.robots,
+            r.tasks,
+            r.steady_throughput_per_h,
+            r.steady_throughput_std_per_h,
+            r.plan_per_h,
+            r.bound_per_h,
+            100.0 * r.operator_busy_share,
+            100.0 * r.robot_wait_share,
+            r.lc_s_per_task,
+            r.lc_stretches,
             r.high_conf_pct,
             r.overlap_ticks
         );
@@ -195,10 +342,20 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| root.join("results/capacity"));
     let seed = args.seed.unwrap_or(base.seed);
+    let (do_rounds, do_cell) = match args.cell {
+        CellChoice::Rounds => (true, false),
+        CellChoice::Continuous => (false, true),
+        CellChoice::Both => (true, true),
+    };
     println!(
-        "capacity: N = 1..={} robots, {} trials × up to {} executions (rounded down to a \
-         multiple of N), {} samples per schedule, seed {seed}; end of learning = final \
-         schedule, busy share over the last {:.0} % of rounds",
+        "capacity ({}): N = 1..={} robots, {} trials × up to {} executions (rounded down to a \
+         multiple of N), {} samples per schedule, seed {seed}; end of learning = the last \
+         {:.0} % of rounds or tasks",
+        match args.cell {
+            CellChoice::Rounds => "rounds",
+            CellChoice::Continuous => "continuous cell",
+            CellChoice::Both => "rounds and continuous cell",
+        },
         args.max_robots,
         args.trials,
         args.executions,
@@ -206,7 +363,7 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
         100.0 * END_SHARE
     );
     let wall = Instant::now();
-    let mut rows = Vec::new();
+    let (mut rows, mut cells) = (Vec::new(), Vec::new());
     for n in 1..=args.max_robots {
         let config = StudyConfig {
             trials: args.trials,
@@ -219,25 +376,69 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
         config
             .validate()
             .with_context(|| format!("{} with N = {n}", path.display()))?;
-        let t = Instant::now();
-        let (result, _) = run_study(&config, &inputs, &|_| {})
-            .with_context(|| format!("the study with N = {n} robots"))?;
-        let r = row(&result, t.elapsed().as_secs_f64())?;
-        println!(
-            "N = {n}: T_total {:.1} ± {:.1} s, {:.1} tasks/h, operator busy {:.0} %, \
-             {} overlapping ticks ({:.1} s)",
-            r.t_total_mean_s,
-            r.t_total_std_s,
-            r.throughput_per_h,
-            100.0 * r.operator_busy_share,
-            r.overlap_ticks,
-            r.wall_s
-        );
-        rows.push(r);
+        if do_rounds {
+            let config = StudyConfig {
+                cell: Cell::Rounds,
+                ..config.clone()
+            };
+            let t = Instant::now();
+            let bar = TrialBar::new(&config, &format!("rounds of N = {n}"))?;
+            let (result, _) = run_study(&config, &inputs, &|p| bar.step(p))
+                .with_context(|| format!("the study with N = {n} robots in rounds"))?;
+            bar.clear();
+            let r = row(&result, t.elapsed().as_secs_f64())?;
+            println!(
+                "N = {n}, rounds: T_total {:.1} ± {:.1} s, {:.1} tasks/h planned, {:.1} \
+                 measured, operator busy {:.0} %, robots waiting {:.0} %, {} overlapping \
+                 ticks ({:.1} s)",
+                r.t_total_mean_s,
+                r.t_total_std_s,
+                r.throughput_per_h,
+                r.steady_throughput_per_h,
+                100.0 * r.operator_busy_share,
+                100.0 * r.robot_wait_share,
+                r.overlap_ticks,
+                r.wall_s
+            );
+            rows.push(r);
+        }
+        if do_cell {
+            let config = StudyConfig {
+                cell: Cell::Continuous,
+                ..config
+            };
+            let t = Instant::now();
+            let bar = TrialBar::new(&config, &format!("re-plans of N = {n} (continuous)"))?;
+            let (result, _) = run_cell_study(&config, &inputs, &|p| bar.step(p))
+                .with_context(|| format!("the continuous study with N = {n} robots"))?;
+            bar.clear();
+            let r = cell_row(&result, t.elapsed().as_secs_f64())?;
+            println!(
+                "N = {n}, continuous: {:.1} ± {:.1} tasks/h measured, last plan {:.1} (bound \
+                 {:.1}), operator busy {:.0} %, robots waiting {:.0} %, {} overlapping ticks, \
+                 {} faults ({:.1} s)",
+                r.steady_throughput_per_h,
+                r.steady_throughput_std_per_h,
+                r.plan_per_h,
+                r.bound_per_h,
+                100.0 * r.operator_busy_share,
+                100.0 * r.robot_wait_share,
+                r.overlap_ticks,
+                r.faults,
+                r.wall_s
+            );
+            cells.push(r);
+        }
     }
-    let bound = operator_limited_per_h(&rows);
-    println!();
-    print!("{}", table(&rows));
+    let bound = operator_limited_per_h(&rows, &cells);
+    if !rows.is_empty() {
+        println!("\nrounds:");
+        print!("{}", table(&rows));
+    }
+    if !cells.is_empty() {
+        println!("\ncontinuous cell:");
+        print!("{}", cell_table(&cells));
+    }
     println!(
         "operator-limited bound: {bound:.1} tasks per hour (3600 / {:.1} s low-confidence \
          per task)",
@@ -251,12 +452,14 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
         end_share: END_SHARE,
         operator_limited_per_h: bound,
         rows: &rows,
+        continuous: &cells,
     };
     let json_path = out.join("capacity.json");
     std::fs::write(&json_path, serde_json::to_string_pretty(&file)? + "\n")
         .with_context(|| format!("writing {}", json_path.display()))?;
     draw_capacity(
         &rows,
+        &cells,
         bound,
         &out.join("capacity.svg"),
         &out.join("capacity.png"),
@@ -266,41 +469,54 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
         out.display(),
         wall.elapsed().as_secs_f64()
     );
-    let overlaps: usize = rows.iter().map(|r| r.overlap_ticks).sum();
+    let overlaps = rows.iter().map(|r| r.overlap_ticks as u64).sum::<u64>()
+        + cells
+            .iter()
+            .map(|r| r.overlap_ticks + r.faults)
+            .sum::<u64>();
     if overlaps > 0 {
         bail!("{overlaps} ticks had two or more robots low-confidence: a schedule is unsafe");
     }
     Ok(())
 }
 
-/// Image size (pixels; SVG user units).
-const SIZE_PX: (u32, u32) = (1000, 620);
+/// Image size (pixels; SVG user units): two panels side by side.
+const SIZE_PX: (u32, u32) = (1500, 640);
 
-/// Draws throughput (left axis) and operator busy share (right axis) against `N`, with the
-/// operator-limited bound as a dashed line, as SVG and PNG.
+/// Colour of the continuous cell's series (rounds use [`MEAN`]).
+const CONTINUOUS: RGBColor = OPERATOR;
+
+/// One series of the figure: its points `(N, value)`.
+type Series = Vec<(f64, f64)>;
+
+/// Draws, against `N`, the measured throughput of rounds and of the continuous cell with the
+/// operator-limited bound (dashed) and the continuous plans' bounds (dotted) on the left, and
+/// the operator's busy share and the robots' waiting share of both cells on the right, as SVG
+/// and PNG.
 ///
 /// # Errors
-/// No rows, or a failure to render or write a file.
+/// No rows at all, or a failure to render or write a file.
 pub(crate) fn draw_capacity(
     rows: &[CapacityRow],
+    cells: &[CellRow],
     bound_per_h: f64,
     svg: &Path,
     png: &Path,
 ) -> anyhow::Result<()> {
-    if rows.is_empty() {
+    if rows.is_empty() && cells.is_empty() {
         bail!("capacity figure: no robot counts to draw");
     }
     tandem_plot::register_font()?;
     let mut svg_text = String::new();
     {
         let root = SVGBackend::with_string(&mut svg_text, SIZE_PX).into_drawing_area();
-        draw_on(&root, rows, bound_per_h)?;
+        draw_on(&root, rows, cells, bound_per_h)?;
         root.present()
             .map_err(|e| anyhow!("finishing the capacity SVG: {e}"))?;
     }
     {
         let root = BitMapBackend::new(png, SIZE_PX).into_drawing_area();
-        draw_on(&root, rows, bound_per_h)?;
+        draw_on(&root, rows, cells, bound_per_h)?;
         root.present()
             .map_err(|e| anyhow!("writing {}: {e}", png.display()))?;
     }
@@ -308,9 +524,22 @@ pub(crate) fn draw_capacity(
     Ok(())
 }
 
+/// A dashed line's legend mark in `colour` (a closure for `SeriesAnno::legend`).
+macro_rules! dashed_mark {
+    ($colour:expr) => {{
+        let colour: RGBColor = $colour;
+        move |(x, y)| {
+            EmptyElement::at((x, y))
+                + PathElement::new(vec![(0, 0), (8, 0)], colour.stroke_width(3))
+                + PathElement::new(vec![(14, 0), (22, 0)], colour.stroke_width(3))
+        }
+    }};
+}
+
 fn draw_on<DB: DrawingBackend>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     rows: &[CapacityRow],
+    cells: &[CellRow],
     bound_per_h: f64,
 ) -> anyhow::Result<()> {
     let err = |what: &'static str| {
@@ -319,23 +548,46 @@ fn draw_on<DB: DrawingBackend>(
         }
     };
     root.fill(&WHITE).map_err(err("background"))?;
-    let n_max = rows.iter().map(|r| r.robots).max().unwrap_or(1) as f64;
-    let top = rows
+    let (left, right) = root.split_horizontally(SIZE_PX.0 / 2 + 40);
+    let n_max = rows
         .iter()
-        .map(|r| r.throughput_per_h)
+        .map(|r| r.robots)
+        .chain(cells.iter().map(|r| r.robots))
+        .max()
+        .unwrap_or(1) as f64;
+    let x_range = 0.5..n_max + 0.5;
+    let n_labels = n_max as usize;
+
+    // Left: throughput.
+    let rounds_tp: Series = rows
+        .iter()
+        .map(|r| (r.robots as f64, r.steady_throughput_per_h))
+        .collect();
+    let cell_tp: Series = cells
+        .iter()
+        .map(|r| (r.robots as f64, r.steady_throughput_per_h))
+        .collect();
+    let cell_bound: Series = cells
+        .iter()
+        .map(|r| (r.robots as f64, r.bound_per_h))
+        .collect();
+    let top = rounds_tp
+        .iter()
+        .chain(&cell_tp)
+        .chain(&cell_bound)
+        .map(|p| p.1)
         .fold(bound_per_h, f64::max);
-    let y_max = crate::fig5::nice_ceiling(top * 1.35);
-    let mut chart = ChartBuilder::on(root)
+    let y_max = crate::fig5::nice_ceiling(top * 1.45);
+    let mut chart = ChartBuilder::on(&left)
         .margin(20)
+        .caption("throughput", (FONT_FAMILY, 24))
         .x_label_area_size(60)
         .y_label_area_size(80)
-        .right_y_label_area_size(80)
-        .build_cartesian_2d(0.5..n_max + 0.5, 0.0..y_max)
-        .map_err(err("axes"))?
-        .set_secondary_coord(0.5..n_max + 0.5, 0.0..100.0);
+        .build_cartesian_2d(x_range.clone(), 0.0..y_max)
+        .map_err(err("throughput axes"))?;
     chart
         .configure_mesh()
-        .x_labels(rows.len())
+        .x_labels(n_labels)
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(&|v| format!("{v:.0}"))
         .x_desc("robots N run by one operator")
@@ -345,28 +597,41 @@ fn draw_on<DB: DrawingBackend>(
         .light_line_style(WHITE.mix(0.0))
         .bold_line_style(BLACK.mix(0.12))
         .draw()
-        .map_err(err("mesh"))?;
-    chart
-        .configure_secondary_axes()
-        .y_label_formatter(&|v| format!("{v:.0}"))
-        .y_desc("operator busy share (%)")
-        .label_style((FONT_FAMILY, 18))
-        .axis_desc_style((FONT_FAMILY, 20))
-        .draw()
-        .map_err(err("secondary axis"))?;
-
-    let throughput: Vec<(f64, f64)> = rows
-        .iter()
-        .map(|r| (r.robots as f64, r.throughput_per_h))
-        .collect();
-    chart
-        .draw_series(LineSeries::new(throughput.clone(), MEAN.stroke_width(3)))
-        .map_err(err("throughput"))?
-        .label("throughput N·3600 / T_total")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], MEAN.stroke_width(3)));
-    chart
-        .draw_series(throughput.iter().map(|&p| Circle::new(p, 5, MEAN.filled())))
-        .map_err(err("throughput points"))?;
+        .map_err(err("throughput mesh"))?;
+    for (series, colour, label) in [
+        (&rounds_tp, MEAN, "rounds (measured, last 10 %)"),
+        (
+            &cell_tp,
+            CONTINUOUS,
+            "continuous cell (measured, last 10 %)",
+        ),
+    ] {
+        if series.is_empty() {
+            continue;
+        }
+        chart
+            .draw_series(LineSeries::new(series.clone(), colour.stroke_width(3)))
+            .map_err(err("throughput"))?
+            .label(label)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
+            });
+        chart
+            .draw_series(series.iter().map(|&p| Circle::new(p, 5, colour.filled())))
+            .map_err(err("throughput points"))?;
+    }
+    if !cell_bound.is_empty() {
+        chart
+            .draw_series(DashedLineSeries::new(
+                cell_bound.clone(),
+                3,
+                5,
+                CONTINUOUS.stroke_width(2),
+            ))
+            .map_err(err("plan bound"))?
+            .label("continuous plan's bound 3600·N / P_lower")
+            .legend(dashed_mark!(CONTINUOUS));
+    }
     chart
         .draw_series(DashedLineSeries::new(
             [(0.5, bound_per_h), (n_max + 0.5, bound_per_h)],
@@ -376,40 +641,128 @@ fn draw_on<DB: DrawingBackend>(
         ))
         .map_err(err("bound"))?
         .label("operator-limited bound 3600 / E[LC s per task]")
-        .legend(|(x, y)| {
-            EmptyElement::at((x, y))
-                + PathElement::new(vec![(0, 0), (8, 0)], GROUND_TRUTH.stroke_width(3))
-                + PathElement::new(vec![(14, 0), (22, 0)], GROUND_TRUTH.stroke_width(3))
-        });
-    let busy: Vec<(f64, f64)> = rows
-        .iter()
-        .map(|r| (r.robots as f64, 100.0 * r.operator_busy_share))
-        .collect();
-    // Not a robot's colour: the busy share is the operator's.
-    let busy_colour = OPERATOR;
-    chart
-        .draw_secondary_series(LineSeries::new(busy.clone(), busy_colour.stroke_width(3)))
-        .map_err(err("busy share"))?
-        .label("operator busy share (right axis)")
-        .legend(move |(x, y)| {
-            PathElement::new(vec![(x, y), (x + 24, y)], busy_colour.stroke_width(3))
-        });
-    chart
-        .draw_secondary_series(
-            busy.iter()
-                .map(|&p| TriangleMarker::new(p, 7, busy_colour.filled())),
-        )
-        .map_err(err("busy share points"))?;
+        .legend(dashed_mark!(GROUND_TRUTH));
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperLeft)
         .margin(12)
         .legend_area_size(30)
-        .label_font((FONT_FAMILY, 18))
+        .label_font((FONT_FAMILY, 17))
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK.mix(0.5))
         .draw()
-        .map_err(err("legend"))?;
+        .map_err(err("throughput legend"))?;
+
+    // Right: the operator's busy share and the robots' waiting share.
+    let pct = |v: f64| 100.0 * v;
+    let mut chart = ChartBuilder::on(&right)
+        .margin(20)
+        .caption("operator and robots", (FONT_FAMILY, 24))
+        .x_label_area_size(60)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x_range, 0.0..140.0)
+        .map_err(err("share axes"))?;
+    chart
+        .configure_mesh()
+        .x_labels(n_labels)
+        .y_labels(8)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| {
+            if *v <= 100.0 {
+                format!("{v:.0}")
+            } else {
+                String::new()
+            }
+        })
+        .x_desc("robots N run by one operator")
+        .y_desc("share of time (%)")
+        .label_style((FONT_FAMILY, 18))
+        .axis_desc_style((FONT_FAMILY, 20))
+        .light_line_style(WHITE.mix(0.0))
+        .bold_line_style(BLACK.mix(0.12))
+        .draw()
+        .map_err(err("share mesh"))?;
+    let shares: [(Series, RGBColor, bool, &str); 4] = [
+        (
+            rows.iter()
+                .map(|r| (r.robots as f64, pct(r.operator_busy_share)))
+                .collect(),
+            MEAN,
+            true,
+            "operator busy, rounds",
+        ),
+        (
+            cells
+                .iter()
+                .map(|r| (r.robots as f64, pct(r.operator_busy_share)))
+                .collect(),
+            CONTINUOUS,
+            true,
+            "operator busy, continuous",
+        ),
+        (
+            rows.iter()
+                .map(|r| (r.robots as f64, pct(r.robot_wait_share)))
+                .collect(),
+            MEAN,
+            false,
+            "robots waiting, rounds",
+        ),
+        (
+            cells
+                .iter()
+                .map(|r| (r.robots as f64, pct(r.robot_wait_share)))
+                .collect(),
+            CONTINUOUS,
+            false,
+            "robots waiting, continuous",
+        ),
+    ];
+    for (series, colour, busy, label) in shares {
+        if series.is_empty() {
+            continue;
+        }
+        if busy {
+            chart
+                .draw_series(LineSeries::new(series.clone(), colour.stroke_width(3)))
+                .map_err(err("busy share"))?
+                .label(label)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
+                });
+            chart
+                .draw_series(series.iter().map(|&p| Circle::new(p, 5, colour.filled())))
+                .map_err(err("busy share points"))?;
+        } else {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    series.clone(),
+                    8,
+                    6,
+                    colour.stroke_width(3),
+                ))
+                .map_err(err("waiting share"))?
+                .label(label)
+                .legend(dashed_mark!(colour));
+            chart
+                .draw_series(
+                    series
+                        .iter()
+                        .map(|&p| TriangleMarker::new(p, 7, colour.filled())),
+                )
+                .map_err(err("waiting share points"))?;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .margin(12)
+        .legend_area_size(30)
+        .label_font((FONT_FAMILY, 17))
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK.mix(0.5))
+        .draw()
+        .map_err(err("share legend"))?;
     Ok(())
 }
 
@@ -425,9 +778,30 @@ mod tests {
             t_total_mean_s: t,
             t_total_std_s: 0.0,
             throughput_per_h: robots as f64 * 3600.0 / t,
+            steady_throughput_per_h: robots as f64 * 3600.0 / (t + 10.0),
             operator_busy_share: busy,
+            robot_wait_share: 0.25,
             lc_s_per_task: lc,
             overlap_ticks: 0,
+            high_conf_pct: 60.0,
+            wall_s: 1.0,
+        }
+    }
+
+    fn c(robots: usize, lc: f64) -> CellRow {
+        CellRow {
+            robots,
+            tasks: 240,
+            steady_throughput_per_h: 80.0,
+            steady_throughput_std_per_h: 1.0,
+            operator_busy_share: 0.95,
+            robot_wait_share: 0.2,
+            lc_s_per_task: lc,
+            plan_per_h: 85.0,
+            bound_per_h: 90.0,
+            lc_stretches: 3.0,
+            overlap_ticks: 0,
+            faults: 0,
             high_conf_pct: 60.0,
             wall_s: 1.0,
         }
@@ -437,14 +811,29 @@ mod tests {
     fn the_operator_limited_bound_is_3600_over_the_mean_lc_time_per_task() {
         // 30 s and 50 s of supervision per task: 40 s on average, 90 tasks per hour.
         let rows = [r(1, 100.0, 0.3, 30.0), r(2, 120.0, 0.6, 50.0)];
-        assert_eq!(operator_limited_per_h(&rows), 90.0);
+        assert_eq!(operator_limited_per_h(&rows, &[]), 90.0);
+        // A continuous row's 60 s pools with them: (30 + 50 + 60) / 3 s per task.
+        let cells = [c(2, 60.0)];
+        assert!((operator_limited_per_h(&rows, &cells) - 3600.0 * 3.0 / 140.0).abs() < 1e-9);
         let t = table(&rows);
+        // 3600 / 110 = 32.7 and 2·3600 / 130 = 55.4 tasks per hour measured.
         assert!(
-            t.contains("| 1 | 12 (12) | 100.0 ± 0.0 | 36.0 | 30 % | 30.0 | 60.0 | 0 |"),
+            t.contains(
+                "| 1 | 12 (12) | 100.0 ± 0.0 | 36.0 | 32.7 | 30 % | 25 % | 30.0 | 60.0 | 0 |"
+            ),
             "{t}"
         );
         assert!(
-            t.contains("| 2 | 12 (6) | 120.0 ± 0.0 | 60.0 | 60 % | 50.0 | 60.0 | 0 |"),
+            t.contains(
+                "| 2 | 12 (6) | 120.0 ± 0.0 | 60.0 | 55.4 | 60 % | 25 % | 50.0 | 60.0 | 0 |"
+            ),
+            "{t}"
+        );
+        let t = cell_table(&cells);
+        assert!(
+            t.contains(
+                "| 2 | 240 | 80.0 ± 1.0 | 85.0 | 90.0 | 95 % | 20 % | 60.0 | 3.0 | 60.0 | 0 |"
+            ),
             "{t}"
         );
     }
@@ -472,6 +861,8 @@ mod tests {
                 corrected_ticks: 0,
                 operator_busy_share: k as f64 / 10.0,
                 faults: 0,
+                robot_wait_share: k as f64 / 20.0,
+                hold_ticks: 0,
             }),
             lower_bound_s: t_total_s,
             bound_is_optimum: false,
@@ -509,6 +900,9 @@ mod tests {
         assert_eq!(row.throughput_per_h, 81.0);
         assert!((row.operator_busy_share - 0.9).abs() < 1e-15);
         assert!((row.lc_s_per_task - 9.0).abs() < 1e-12);
+        assert!((row.robot_wait_share - 0.45).abs() < 1e-15);
+        // The last round of each trial (round 9) took 500 s for three tasks: 21.6 per hour.
+        assert!((row.steady_throughput_per_h - 21.6).abs() < 1e-12);
         assert_eq!(row.overlap_ticks, 0);
     }
 
@@ -518,14 +912,18 @@ mod tests {
         let rows: Vec<CapacityRow> = (1..=4)
             .map(|n| r(n, 90.0 + 20.0 * n as f64, 0.2 * n as f64, 30.0))
             .collect();
+        let cells: Vec<CellRow> = (1..=4).map(|n| c(n, 30.0)).collect();
         let (svg, png) = (dir.join("c.svg"), dir.join("c.png"));
-        draw_capacity(&rows, 120.0, &svg, &png).unwrap();
+        draw_capacity(&rows, &cells, 120.0, &svg, &png).unwrap();
         let text = std::fs::read_to_string(&svg).unwrap();
         for label in [
             "robots N run by one operator",
             "throughput (tasks per hour per operator)",
-            "operator busy share (%)",
+            "share of time (%)",
             "operator-limited bound",
+            "continuous cell (measured, last 10 %)",
+            "robots waiting, rounds",
+            "operator busy, continuous",
         ] {
             assert!(text.contains(label), "{label}");
         }
@@ -533,7 +931,9 @@ mod tests {
             crate::fig5::tests::png_size(&std::fs::read(&png).unwrap()),
             SIZE_PX
         );
-        assert!(draw_capacity(&[], 1.0, &svg, &png).is_err());
+        // One cell alone draws too.
+        draw_capacity(&[], &cells, 120.0, &svg, &png).unwrap();
+        assert!(draw_capacity(&[], &[], 1.0, &svg, &png).is_err());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
