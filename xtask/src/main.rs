@@ -6,6 +6,7 @@
 
 mod bags;
 mod capacity;
+mod cellfig;
 mod fig5;
 mod fixtures;
 mod reference_order;

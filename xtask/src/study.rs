@@ -231,6 +231,7 @@ fn run_continuous(
     let path = out.join("study.json");
     std::fs::write(&path, serde_json::to_string(&file)? + "\n")
         .with_context(|| format!("writing {}", path.display()))?;
+    crate::cellfig::draw_cell_study(&result, &out.join("cell.svg"), &out.join("cell.png"))?;
     println!(
         "continuous cell: {} trials × {} tasks, {} robots, re-planned every {} tasks, seed {}",
         config.trials, config.executions, config.robots, config.robots, config.seed
@@ -266,7 +267,12 @@ fn run_continuous(
         "overlapping low-confidence ticks: {}, faults: {}",
         summary.overlap_ticks, summary.faults
     );
-    println!("wrote {}", path.display());
+    println!(
+        "wrote {}, cell.svg, cell.png in {}",
+        path.file_name()
+            .map_or("study.json".into(), |f| f.to_string_lossy()),
+        out.display()
+    );
     print_times(&times, wall.elapsed());
     if summary.overlap_ticks > 0 || summary.faults > 0 {
         bail!("two robots were low-confidence in the same tick: the cell is unsafe");
