@@ -187,10 +187,42 @@ fn group_of(groups: &[Group]) -> Vec<usize> {
 /// Whether the operator's cyclic `order` of stretches `(robot, lc)` of `n_robots` robots can
 /// run under the token rule on a task with `groups`: every robot's every stretch once, each
 /// robot's in task order around the cycle, and every group contiguous (no other robot's
-/// stretch between two stretches of one robot with no usable hold between them).
+/// stretch between two stretches of one robot with no usable hold between them:
+/// [`first_split_group`]).
 #[must_use]
 pub fn is_runnable(order: &[(usize, usize)], groups: &[Group], n_robots: usize) -> bool {
     token_sequence(order, groups, n_robots).is_ok()
+}
+
+/// The first position of the cyclic `order` of stretches `(robot, lc)` that splits one of
+/// `groups`, or `None` when every group is contiguous: the contiguity rule of
+/// [`is_runnable`], and its one implementation (`tandem-schedule`'s order search and
+/// `cyclic::is_runnable` use it). Entry `q`, stretch `(r, lc)`, splits its group when it is
+/// not the group's first (no usable hold lies between stretches `lc − 1` and `lc`: the robot
+/// cannot wait there) and the entry before it, cyclically, is not `(r, lc − 1)`. Checks only
+/// this condition, not that `order` is well formed (a stretch outside the groups splits
+/// nothing; [`token_sequence`] checks the rest, and this rule with the same code).
+/// O(len·log(groups)), no allocation: the check of an order search, which visits
+/// well-formed orders only.
+#[must_use]
+pub fn first_split_group<T: Copy + Into<(usize, usize)>>(
+    order: &[T],
+    groups: &[Group],
+) -> Option<usize> {
+    (0..order.len()).find(|&q| splits_group(order, q, groups))
+}
+
+/// Whether entry `q` of `order` splits its group ([`first_split_group`]).
+fn splits_group<T: Copy + Into<(usize, usize)>>(order: &[T], q: usize, groups: &[Group]) -> bool {
+    let len = order.len();
+    let (r, lc) = order[q].into();
+    let m = groups.last().map_or(0, |g| g.end_lc);
+    // A group's first stretch (stretch 0 always), or one outside the groups, splits nothing.
+    if lc == 0 || lc >= m || groups.binary_search_by_key(&lc, |g| g.first_lc).is_ok() {
+        return false;
+    }
+    let prev: (usize, usize) = order[(q + len - 1) % len].into();
+    prev != (r, lc - 1)
 }
 
 /// The cyclic token sequence of a runnable `order` ([`is_runnable`]): the order cut into its
@@ -213,7 +245,7 @@ pub fn token_sequence(
             why: "does not list each robot's each stretch exactly once (length N·m)",
         });
     }
-    if m == 0 {
+    if m == 0 || n_robots == 0 {
         return Ok((Vec::new(), Vec::new()));
     }
     let gof = group_of(groups);
@@ -231,8 +263,7 @@ pub fn token_sequence(
             return bad("breaks its robot's task order around the cycle");
         }
         last[r] = Some(lc);
-        let first = groups[gof[lc]].first_lc == lc;
-        if !first && order[(q + len - 1) % len] != (r, lc - 1) {
+        if splits_group(order, q, groups) {
             return bad(
                 "is not runnable: another robot's stretch comes between it and the stretch \
                  before it, with no usable hold between them",
@@ -906,6 +937,10 @@ mod tests {
             Err(Error::BadOrder { position: 2, .. })
         ));
         assert!(!is_runnable(&bad, &g, 2));
+        assert_eq!(first_split_group(&bad, &g), Some(2));
+        assert_eq!(first_split_group(&order, &g), None);
+        // No robots: the empty order, nothing to run.
+        assert!(is_runnable(&[], &g, 0));
         // Out of task order, repeated, wrong length, unknown robot.
         let cases: [&[(usize, usize)]; 4] = [
             &[(0, 0), (1, 0), (1, 1), (1, 2), (0, 2), (0, 1)],

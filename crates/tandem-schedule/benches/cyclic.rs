@@ -1,16 +1,28 @@
 //! Benchmark: the cyclic plan (issue 21) on a synthetic problem shaped like the sanding task
 //! — 6000 reference samples at 10 ms, three low-confidence passes of 12.8 s at `ψ̇̄ = 1` and
 //! 21.6 s of high confidence (29.0 s at `ψ̇̄ = 1.343`, 21.6 s at `ψ̇min = 1`) in a head, two
-//! transitions and a tail, a hold point in the middle of each transition — for `N = 2, 4, 8`:
-//! the period of one fixed order (round robin by stretch) and the full order search. Results:
-//! `docs/decisions.md` ("A continuous cell: the cyclic plan and its exact period").
+//! transitions and a tail, a hold point in the middle of each transition — for
+//! `N = 2, 3, 4, 8`: the period of one fixed order (round robin by stretch) and the full order
+//! search; and what the continuous study does at each re-plan (`replan/N`): the order search
+//! (`cyclic_plan`), the new plan's coordinator at the problem's tick
+//! (`CyclicPlan::coordinator`, `tick_s = Δt_s` = 10 ms) and the hand-over of the running cell
+//! to it (`ContinuousCoordinator::take_over`); and the hand-over alone (`take_over/N`). The
+//! running cell is the coordinator of the previous plan, of the same problem with one more
+//! low-confidence sample (the head's last, sample 599, which the refinement turned high), run
+//! under `Operator::Scheduled` for 10 000 ticks (100 s: the robots are mid-task) and then on to
+//! the first tick at which the new plan can take over (outside the timing).
+//! Results: `docs/decisions.md` ("A continuous cell: the cyclic plan and its exact period").
 #![allow(clippy::print_stdout, reason = "a bench reports the plans it timed")]
 #![allow(
     missing_docs,
     reason = "criterion_group! generates an undocumented pub fn"
 )]
 
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use criterion::measurement::WallTime;
+use criterion::{
+    BatchSize, BenchmarkGroup, BenchmarkId, Criterion, criterion_group, criterion_main,
+};
+use tandem_realtime::Operator;
 use tandem_schedule::{
     CyclicParams, Problem, Stretch, cyclic_plan, cyclic_plan_for_order, max_cycle_ratio,
 };
@@ -18,6 +30,12 @@ use tandem_schedule::{
 /// Head 600, pass 1280, transition 480, pass 1280, transition 480, pass 1280, tail 600
 /// samples; holds at the middle of both transitions (or none).
 fn sanding_like(holds: bool) -> Problem {
+    sanding_like_flipped(holds, None)
+}
+
+/// [`sanding_like`] with the confidence of reference sample `flip` inverted (and its rates
+/// those of its new confidence).
+fn sanding_like_flipped(holds: bool, flip: Option<usize>) -> Problem {
     let runs = [
         (600, true),
         (1280, false),
@@ -27,10 +45,13 @@ fn sanding_like(holds: bool) -> Problem {
         (1280, false),
         (600, true),
     ];
-    let conf: Vec<bool> = runs
+    let mut conf: Vec<bool> = runs
         .iter()
         .flat_map(|&(l, c)| std::iter::repeat_n(c, l))
         .collect();
+    if let Some(k) = flip {
+        conf[k] = !conf[k];
+    }
     let pick =
         |hc: f64, lc: f64| -> Vec<f64> { conf.iter().map(|&c| if c { hc } else { lc }).collect() };
     let (mean, min, max) = (pick(1.343, 1.0), pick(1.0, 1.0), pick(2.0, 1.0));
@@ -83,7 +104,7 @@ fn bench(c: &mut Criterion) {
         );
     }
     let mut group = c.benchmark_group("cyclic");
-    for n in [2usize, 4, 8] {
+    for n in [2usize, 3, 4, 8] {
         let order = round_robin(n, 3);
         let graph = tandem_schedule::cyclic::event_graph(&problem, n, &order).expect("valid order");
         group.bench_with_input(BenchmarkId::new("max_cycle_ratio", n), &graph, |b, g| {
@@ -96,7 +117,64 @@ fn bench(c: &mut Criterion) {
             b.iter(|| cyclic_plan(&problem, n, &params).expect("valid problem"));
         });
     }
+    replan(&mut group, &problem, &params);
     group.finish();
+}
+
+/// Ticks the previous plan's cell runs before the re-plan (100 s at 10 ms: mid-task).
+const RUN_TICKS: u64 = 10_000;
+
+/// The continuous study's re-plan: search, coordinator, hand-over (module docs).
+fn replan(group: &mut BenchmarkGroup<'_, WallTime>, problem: &Problem, params: &CyclicParams) {
+    let tick_s = problem.dt_s();
+    // The previous plan's problem: the head's last sample still low-confidence (the pass
+    // began one sample earlier); the new problem's low-confidence samples are among its own.
+    let previous = sanding_like_flipped(true, Some(599));
+    for n in [2usize, 3, 4, 8] {
+        let old_plan = cyclic_plan(&previous, n, params).expect("valid problem");
+        let mut old = old_plan
+            .coordinator(&previous, tick_s)
+            .expect("a runnable plan");
+        for _ in 0..RUN_TICKS {
+            old.tick(Operator::Scheduled).expect("a valid operator");
+        }
+        let new = cyclic_plan(problem, n, params)
+            .expect("valid problem")
+            .coordinator(problem, tick_s)
+            .expect("a runnable plan");
+        // On to the first hand-over point of the new plan (at the latest the token's move).
+        let mut waited = 0_u64;
+        while new.clone().take_over(&old).is_err() {
+            old.tick(Operator::Scheduled).expect("a valid operator");
+            waited += 1;
+            assert!(waited < 1_000_000, "no hand-over point");
+        }
+        println!(
+            "replan N = {n}: hand-over after {RUN_TICKS} + {waited} ticks, tasks {:?}, clocks {:.2?} s",
+            old.tasks_completed(),
+            old.clock_s()
+        );
+        group.bench_with_input(BenchmarkId::new("replan", n), &n, |b, &n| {
+            b.iter(|| {
+                let mut next = cyclic_plan(problem, n, params)
+                    .expect("valid problem")
+                    .coordinator(problem, tick_s)
+                    .expect("a runnable plan");
+                next.take_over(&old).expect("a hand-over point");
+                next
+            });
+        });
+        group.bench_with_input(BenchmarkId::new("take_over", n), &new, |b, new| {
+            b.iter_batched(
+                || new.clone(),
+                |mut next| {
+                    next.take_over(&old).expect("a hand-over point");
+                    next
+                },
+                BatchSize::SmallInput,
+            );
+        });
+    }
 }
 
 criterion_group! {

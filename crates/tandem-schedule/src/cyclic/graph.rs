@@ -18,6 +18,13 @@ pub struct Stretch {
     pub lc: usize,
 }
 
+/// The stretch as `tandem_realtime::continuous` names it: `(robot, lc)`.
+impl From<Stretch> for (usize, usize) {
+    fn from(s: Stretch) -> (usize, usize) {
+        (s.robot, s.lc)
+    }
+}
+
 /// What a node of an [`EventGraph`] is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Event {

@@ -1,8 +1,10 @@
 //! The operator order: enumerated while the orders are few, else seeded local search.
 
+use tandem_realtime::continuous::{Group, first_split_group};
+
 use super::graph::{Stretch, TaskShape};
 use super::plan::{CyclicPlan, cyclic_plan_for_order, period_of};
-use super::run::runnable;
+use super::run::groups_of;
 use crate::problem::check_robot_count;
 use crate::{Error, Problem, Result};
 
@@ -119,12 +121,20 @@ pub fn cyclic_plan(
     check_robot_count(n_robots)?;
     let shape = TaskShape::new(problem);
     let m = shape.n_lc();
+    // The coordinator's groups, which a runnable order keeps contiguous; not needed (every
+    // order is runnable, every group one stretch) when a usable hold lies between every two
+    // stretches, which spares cutting the task a second time.
+    let groups = if params.runnable_only && (1..m).any(|k| shape.gaps[k].hold.is_none()) {
+        Some(groups_of(problem)?)
+    } else {
+        None
+    };
     let count = order_count(n_robots, m);
     let (order, evaluated, exhaustive) = if count <= params.max_enumerated {
-        let (order, evaluated) = enumerate(&shape, n_robots, m, params.runnable_only)?;
+        let (order, evaluated) = enumerate(&shape, n_robots, m, groups.as_deref())?;
         (order, evaluated, true)
     } else {
-        let (order, evaluated) = local_search(&shape, n_robots, params)?;
+        let (order, evaluated) = local_search(&shape, n_robots, params, groups.as_deref())?;
         (order, evaluated, false)
     };
     let mut plan = cyclic_plan_for_order(problem, n_robots, &order)?;
@@ -148,11 +158,13 @@ fn better(p: Option<f64>, best: Option<f64>) -> bool {
     }
 }
 
+/// Every order up to rotation ([`cyclic_plan`]); with `groups` (runnable orders only) those
+/// that keep every group contiguous (`continuous::first_split_group`, the coordinator's rule).
 fn enumerate(
     shape: &TaskShape,
     n_robots: usize,
     m: usize,
-    runnable_only: bool,
+    groups: Option<&[Group]>,
 ) -> Result<(Vec<Stretch>, usize)> {
     if m == 0 {
         return Ok((Vec::new(), 1));
@@ -198,7 +210,7 @@ fn enumerate(
                 });
                 seen[r] += 1;
             }
-            if !runnable_only || runnable(shape, &order) {
+            if groups.is_none_or(|g| first_split_group(&order, g).is_none()) {
                 evaluated += 1;
                 let p = period_of(shape, n_robots, &order)?;
                 if better(p, best.0) {
@@ -225,28 +237,23 @@ fn enumerate(
     Ok((best.1, evaluated))
 }
 
-/// The units of the local search: `(first, end)` stretch ranges — single stretches, or with
-/// `runnable_only` the task's groups (a new group at stretch 0 and after every gap with a
-/// usable hold).
-fn units(shape: &TaskShape, runnable_only: bool) -> Vec<(usize, usize)> {
-    let m = shape.n_lc();
-    let mut out: Vec<(usize, usize)> = Vec::new();
-    for k in 0..m {
-        if k == 0 || !runnable_only || shape.gaps[k].hold.is_some() {
-            out.push((k, k + 1));
-        } else {
-            out.last_mut().expect("stretch 0 opened a unit").1 = k + 1;
-        }
+/// The units of the local search: `(first, end)` stretch ranges — single stretches of the
+/// `m`, or the coordinator's `groups` (runnable orders only: a new group at stretch 0 and
+/// after every gap with a usable hold).
+fn units(m: usize, groups: Option<&[Group]>) -> Vec<(usize, usize)> {
+    match groups {
+        Some(groups) => groups.iter().map(|g| (g.first_lc, g.end_lc)).collect(),
+        None => (0..m).map(|k| (k, k + 1)).collect(),
     }
-    out
 }
 
 fn local_search(
     shape: &TaskShape,
     n_robots: usize,
     params: &CyclicParams,
+    groups: Option<&[Group]>,
 ) -> Result<(Vec<Stretch>, usize)> {
-    let units = units(shape, params.runnable_only);
+    let units = units(shape.n_lc(), groups);
     let u = units.len();
     // Orders of units `(robot, unit)`, flattened to stretches for the period.
     let flat = |order: &[(usize, usize)]| -> Vec<Stretch> {
