@@ -235,7 +235,7 @@ impl Observations {
     /// [`Error::LengthMismatch`] if the slices differ in length;
     /// [`Error::RefTimeOutOfRange`] naming the first non-finite or out-of-range time.
     pub fn record(&mut self, supervised_ref_times: &[f64], corrected: &[bool]) -> Result<()> {
-        self.record_with(supervised_ref_times, corrected, false)
+        self.record_with(supervised_ref_times, None, corrected, false)
     }
 
     /// [`record`](Self::record) with *one vote per execution*: the execution's mass at each
@@ -270,12 +270,50 @@ impl Observations {
     /// # Errors
     /// As [`record`](Self::record).
     pub fn record_votes(&mut self, supervised_ref_times: &[f64], corrected: &[bool]) -> Result<()> {
-        self.record_with(supervised_ref_times, corrected, true)
+        self.record_with(supervised_ref_times, None, corrected, true)
+    }
+
+    /// [`record_votes`](Self::record_votes) where each supervised control sample also covers
+    /// the reference samples its robot swept during the control tick: `swept_to[k] ≥
+    /// supervised_ref_times[k]` is the reference time at which the robot ended the tick of
+    /// observation `k` (the next logged sample's time). Every reference sample after
+    /// `⌊t_k⌋` and before `⌊swept_to[k]⌋` (those no control sample starts on) is touched too,
+    /// with observation `k`'s correction flag, and gets its vote. Where a robot moves at most
+    /// one reference sample per tick nothing changes; a fast robot no longer leaves the
+    /// samples it passed under supervision without a vote (a one-sample low-confidence island
+    /// crossed inside one tick, say).
+    ///
+    /// ```
+    /// use tandem_confidence::Observations;
+    /// let mut obs = Observations::new(6)?;
+    /// // One control sample at 0.5 whose tick ended at 4.2: samples 0 to 3 are touched.
+    /// obs.record_votes_swept(&[0.5], &[4.2], &[false])?;
+    /// assert_eq!(obs.supervised(), &[1.0, 1.0, 1.0, 1.0, 0.0, 0.0]);
+    /// # Ok::<(), tandem_confidence::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`record`](Self::record), and [`Error::LengthMismatch`] or
+    /// [`Error::RefTimeOutOfRange`] for `swept_to` (each must lie in `[t_k, T_ref − 1]`).
+    pub fn record_votes_swept(
+        &mut self,
+        supervised_ref_times: &[f64],
+        swept_to: &[f64],
+        corrected: &[bool],
+    ) -> Result<()> {
+        check_len(
+            "supervised_ref_times",
+            supervised_ref_times.len(),
+            "swept_to",
+            swept_to.len(),
+        )?;
+        self.record_with(supervised_ref_times, Some(swept_to), corrected, true)
     }
 
     fn record_with(
         &mut self,
         supervised_ref_times: &[f64],
+        swept_to: Option<&[f64]>,
         corrected: &[bool],
         one_vote: bool,
     ) -> Result<()> {
@@ -297,10 +335,32 @@ impl Observations {
                 });
             }
         }
+        if let Some(ends) = swept_to {
+            for (obs_idx, (&end, &t)) in ends.iter().zip(supervised_ref_times).enumerate() {
+                if !(end >= t && end <= t_max) {
+                    return Err(Error::RefTimeOutOfRange {
+                        obs_idx,
+                        ref_time: end,
+                        n_ref,
+                    });
+                }
+            }
+        }
         if one_vote {
             // This execution's own counts, then one unit per sample it touched.
             let (mut c_e, mut s_e) = (vec![0.0; n_ref], vec![0.0; n_ref]);
             add_split(&mut c_e, &mut s_e, supervised_ref_times, corrected);
+            if let Some(ends) = swept_to {
+                for ((&t, &end), &c) in supervised_ref_times.iter().zip(ends).zip(corrected) {
+                    // Checked above: 0 ≤ t ≤ end ≤ T_ref − 1.
+                    for j in (t.floor() as usize + 1)..(end.floor() as usize) {
+                        s_e[j] += 1.0;
+                        if c {
+                            c_e[j] += 1.0;
+                        }
+                    }
+                }
+            }
             for ((c, s), (ce, se)) in self
                 .corrections
                 .iter_mut()

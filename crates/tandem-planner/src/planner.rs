@@ -118,6 +118,23 @@ impl ExecutionRecord {
         Ok((times, corrected))
     }
 
+    /// [`observations`](Self::observations) with, for each supervised sample, the reference
+    /// time at which its control tick ended (the next logged sample's; the sample's own for
+    /// the last): `(times, swept_to, corrected)`, for
+    /// [`Observations::record_votes_swept`](tandem_confidence::Observations::record_votes_swept).
+    ///
+    /// # Errors
+    /// As [`observations`](Self::observations).
+    pub fn observation_spans(&self) -> Result<(Vec<f64>, Vec<f64>, Vec<bool>)> {
+        let (times, corrected) = self.observations()?;
+        let log = &self.execution.ref_time_log;
+        let ends = (0..log.len())
+            .filter(|&k| self.supervised[k])
+            .map(|k| log.get(k + 1).copied().unwrap_or(log[k]).max(log[k]))
+            .collect();
+        Ok((times, ends, corrected))
+    }
+
     /// An execution logged with its own times (`tandem record --resample`: jitter, dropped
     /// samples), put on the even grid of [`Demonstration::regrid_csv_str`] with the series
     /// logged beside it, one entry per row of the file: the reference-time log interpolated
@@ -787,10 +804,11 @@ impl Planner {
         let t1 = Instant::now();
         let mut observations = self.observations.clone();
         for e in &records {
-            let (times, corrected) = e.observations()?;
             if self.params.confidence.one_vote_per_execution {
-                observations.record_votes(&times, &corrected)?;
+                let (times, swept_to, corrected) = e.observation_spans()?;
+                observations.record_votes_swept(&times, &swept_to, &corrected)?;
             } else {
+                let (times, corrected) = e.observations()?;
                 observations.record(&times, &corrected)?;
             }
         }

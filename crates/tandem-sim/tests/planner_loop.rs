@@ -66,18 +66,20 @@ fn record_pair_updates_everything_and_keeps_schedules_valid() {
     let records = pair(&p, 1);
     // One vote per execution (the default): each execution adds one unit of observation
     // mass on every reference sample its supervised control samples touched (⌊t⌋, and
-    // ⌊t⌋ + 1 when t is not whole: the fractional split of Eq. 9).
+    // ⌊t⌋ + 1 when t is not whole: the fractional split of Eq. 9; and every sample the robot
+    // swept during the tick, before the next logged sample's ⌊t⌋).
     assert!(p.params().confidence.one_vote_per_execution);
     let n_supervised: usize = records
         .iter()
         .map(|r| {
-            let (times, _) = r.observations().unwrap();
+            let (times, swept_to, _) = r.observation_spans().unwrap();
             let mut touched = std::collections::BTreeSet::new();
-            for t in times {
+            for (t, end) in times.into_iter().zip(swept_to) {
                 touched.insert(t.floor() as usize);
                 if t.fract() > 0.0 {
                     touched.insert(t.floor() as usize + 1);
                 }
+                touched.extend(t.floor() as usize + 1..end.floor() as usize);
             }
             touched.len()
         })

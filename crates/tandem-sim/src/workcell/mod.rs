@@ -56,7 +56,12 @@
 //!    corrected flags.
 //! 5. After the tick, `Tick::low_conf` says which robots traversed any low-confidence sample:
 //!    two or more at once is an *overlap* (a valid schedule never has one), none is operator
-//!    idle time, and any is operator busy time.
+//!    idle time, and any is operator busy time. A robot that started the tick on a
+//!    high-confidence sample but crossed whole low-confidence samples inside it (a fast
+//!    robot over a one-sample island) is supervised after the fact: the operator decides at
+//!    the crossed samples and the tick's sample is recorded as supervised (its command
+//!    unchanged), so that the island gets an observation (docs/decisions.md, "Rounds: a
+//!    one-sample island is never jumped unobserved").
 //! 6. An overlap latches a fault of the coordinator's run-time monitor (`Tick::fault`), which
 //!    holds one robot in place; the round counts it (`RoundRun::faults`), the held robot
 //!    logs nothing while held, and the operator releases it (`Coordinator::clear_fault`)

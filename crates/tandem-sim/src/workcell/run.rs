@@ -215,6 +215,9 @@ pub(super) fn run_coordinator(
         .collect();
 
     let has_holds = coord.has_holds();
+    // Whether each robot logged an unsupervised sample this tick (it started the tick on a
+    // high-confidence sample), and that sample's reference time.
+    let mut unsupervised_at: Vec<Option<f64>> = vec![None; n_robots];
     while !coord.is_finished() {
         if ticks >= budget {
             return Err(Error::DidNotFinish { ticks: budget });
@@ -253,6 +256,9 @@ pub(super) fn run_coordinator(
             }
             let bounds =
                 (!problem.conf()[n]).then(|| (problem.grad_min()[n], problem.grad_max()[n]));
+            if problem.conf()[n] {
+                unsupervised_at[i] = Some(ref_now[i]);
+            }
             if let Some(op_input) = op.robot_tick(
                 model,
                 &mut runs[i],
@@ -266,6 +272,25 @@ pub(super) fn run_coordinator(
             }
         }
         let tick = coord.tick(operator)?;
+        for i in 0..n_robots {
+            // A robot that started the tick on high-confidence ground may have crossed
+            // whole low-confidence samples inside it (a one-sample island, say, under a fast
+            // warp): no tick starts on them, so without this they are never supervised, get
+            // no observation and never clear. The coordinator reports the tick low-confidence
+            // (the operator watches it); the operator decides at the crossed samples, and
+            // the tick's sample is recorded as supervised (docs/decisions.md, "Rounds: a
+            // one-sample island is never jumped").
+            if let Some(t0) = unsupervised_at[i].take() {
+                if tick.low_conf[i] {
+                    let mut crossed = crossed_lc_samples(problem.conf(), t0, tick.ref_time[i]);
+                    if let Some(first) = crossed.next() {
+                        // Asked once per crossed sample (any that needs one is a need).
+                        let needed = needs(i, first) | crossed.fold(false, |a, j| a | needs(i, j));
+                        op.supervise_crossing(&mut runs[i], &mut in_episode[i], needed, rng);
+                    }
+                }
+            }
+        }
         ref_now.copy_from_slice(&tick.ref_time);
         match tick.low_conf.count() {
             0 => idle_ticks += 1,
@@ -291,6 +316,20 @@ pub(super) fn run_coordinator(
         idle_ticks,
         faults,
     })
+}
+
+/// The low-confidence reference samples a robot crossed whole inside one tick, from reference
+/// time `t0` at the tick start to `t1` at its end: the samples after `⌊t0⌋` and before `⌊t1⌋`
+/// (no tick starts on them), empty when there are none.
+pub(super) fn crossed_lc_samples(
+    conf: &[bool],
+    t0: f64,
+    t1: f64,
+) -> impl Iterator<Item = usize> + '_ {
+    let last = conf.len().saturating_sub(1);
+    let lo = (t0.max(0.0).floor() as usize).min(last) + 1;
+    let hi = (t1.max(0.0).floor() as usize).min(last);
+    (lo..hi).filter(|&j| !conf[j])
 }
 
 /// The simulated operator and the robot's logging, one robot and tick at a time (steps 2–4
@@ -345,6 +384,38 @@ impl Operate {
             clock_s: Vec::with_capacity(n_ref * 2),
             start_tick: usize::MAX,
             hold_ticks: 0,
+        }
+    }
+
+    /// The operator's decision for a tick that the robot started on a high-confidence sample
+    /// and in which it crossed whole low-confidence samples (`needed`: any of them needs a
+    /// correction): drawn as for a supervised sample, and the tick's logged sample (the last
+    /// of `run`) becomes supervised with that decision. Its command is not changed: the robot
+    /// started the tick on high confidence, so neither its rate nor its command took the
+    /// operator's input; the record keeps what the operator would have done there.
+    pub(super) fn supervise_crossing(
+        &mut self,
+        run: &mut RobotRun,
+        in_episode: &mut bool,
+        needed: bool,
+        rng: &mut impl Rng,
+    ) {
+        let draw: f64 = rng.random();
+        let corrected = if needed {
+            *in_episode = false;
+            run.needed += 1;
+            let corrected = draw >= self.params.miss_rate;
+            run.missed += usize::from(!corrected);
+            corrected
+        } else {
+            let corrected;
+            (corrected, *in_episode) = self.episodes.tick(*in_episode, draw, rng);
+            run.false_corrections += usize::from(corrected);
+            corrected
+        };
+        if let (Some(s), Some(c)) = (run.supervised.last_mut(), run.corrected.last_mut()) {
+            *s = true;
+            *c = corrected;
         }
     }
 

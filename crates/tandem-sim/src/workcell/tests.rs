@@ -577,3 +577,68 @@ fn a_robot_waits_at_its_hold_while_the_operator_drags_the_other_and_never_overla
         assert_eq!(r.ref_time_log.len(), r.supervised.len());
     }
 }
+
+#[test]
+fn a_fast_robot_crossing_a_one_sample_island_in_one_tick_gets_it_supervised() {
+    // High confidence everywhere but a one-sample island at 30; every sample is planned at
+    // ψ̇ = 0.35 (the fastest), so a robot sweeps 1/0.35 ≈ 2.86 reference samples per tick and
+    // crosses the island inside the tick from 28.57 to 31.43: no tick starts on it. The
+    // coordinator reports that tick low-confidence; the record must supervise it and the
+    // island must get its vote (issue 22), else it never clears.
+    let model = model();
+    let island = 30;
+    let conf: Vec<bool> = (0..N_REF).map(|n| n != island).collect();
+    let problem = Problem::new(
+        conf,
+        vec![0.35; N_REF],
+        vec![0.35; N_REF],
+        vec![2.0; N_REF],
+        model.dt_s(),
+    )
+    .unwrap();
+    let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
+    let perfect = OperatorParams {
+        miss_rate: 0.0,
+        false_correction_rate: 0.0,
+        ..OperatorParams::default()
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let run = run_schedule(
+        &model,
+        &problem,
+        &schedule,
+        painted_needs,
+        &perfect,
+        &mut rng,
+    )
+    .unwrap();
+    assert_eq!(run.overlap_ticks, 0);
+    for r in &run.robots {
+        // The robot never starts a tick on the island: it jumps it.
+        assert!(
+            r.ref_time_log.iter().all(|t| t.floor() as usize != island),
+            "{:?}",
+            r.ref_time_log
+        );
+        // The tick that crossed it is supervised, and the operator (needed: painted) corrected.
+        let k = r
+            .ref_time_log
+            .windows(2)
+            .position(|w| w[0] < island as f64 && w[1] >= (island + 1) as f64)
+            .unwrap();
+        assert!(r.supervised[k] && r.corrected[k], "row {k}");
+        assert_eq!(r.supervised.iter().filter(|s| **s).count(), 1);
+        assert_eq!((r.needed, r.missed), (1, 0));
+        // The planner's vote reaches the island.
+        let (times, swept_to, corrected) = r.record(&model).unwrap().observation_spans().unwrap();
+        let mut obs = tandem_confidence::Observations::new(N_REF).unwrap();
+        obs.record_votes_swept(&times, &swept_to, &corrected)
+            .unwrap();
+        assert_eq!(obs.supervised()[island], 1.0);
+        assert_eq!(obs.corrections()[island], 1.0);
+        // The split of the tick's sample alone (at 28.57: samples 28 and 29) would not.
+        let mut split = tandem_confidence::Observations::new(N_REF).unwrap();
+        split.record_votes(&times, &corrected).unwrap();
+        assert_eq!(split.supervised()[island], 0.0);
+    }
+}
