@@ -19,9 +19,9 @@
 //! every `N` tasks is once per period of the cell in steady state, so the plan is never more
 //! than a period behind what was learnt.
 //!
-//! The steady throughput ([`Steady`]) is measured over the last 10 % of tasks: tasks
-//! completed in that window per hour of cell time, with the operator's busy share and the
-//! robots' waiting share over the same ticks.
+//! The steady throughput ([`Steady`]) is measured over the last 10 % of tasks, rounded up to
+//! a multiple of `N` (whole periods): tasks completed in that window per hour of cell time,
+//! with the operator's busy share and the robots' waiting share over the same ticks.
 
 use std::time::Instant;
 
@@ -86,10 +86,15 @@ pub struct CellCompletion {
     pub gate_ticks: u64,
 }
 
-/// The steady state of a continuous cell: the last 10 % of its tasks.
+/// The steady state of a continuous cell: the last 10 % of its tasks, rounded up to whole
+/// periods.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Steady {
-    /// Tasks in the window (`max(1, ⌈10 % of the tasks⌉)`).
+    /// Tasks in the window: `⌈10 % of the tasks⌉` rounded up to a multiple of `N` (at most
+    /// all tasks). In a periodic steady state the robots complete `N` tasks per period, in
+    /// bunches; a window of whole periods spans the same time wherever it starts, while one
+    /// of, say, 24 tasks of 7 robots spans 3 or 4 periods depending on where the bunches fall
+    /// (±15 % on the throughput).
     pub tasks: usize,
     /// Its length (s of cell time): from the completion before the window (or the start)
     /// to the last completion.
@@ -112,7 +117,12 @@ impl Steady {
         if total == 0 {
             return None;
         }
-        let k = total.div_ceil(10).max(1);
+        let k = total
+            .div_ceil(10)
+            .max(1)
+            .div_ceil(n_robots.max(1))
+            .saturating_mul(n_robots.max(1))
+            .min(total);
         let last = completions[total - 1];
         let before = (total > k).then(|| completions[total - k - 1]);
         let (t0, b0, g0) = before.map_or((0, 0, 0), |c| (c.tick, c.busy_ticks, c.gate_ticks));
@@ -397,4 +407,44 @@ pub fn run_cell_study(
     let (result, mut times) = run_cell_trials(config, &model, &inputs.reference_labels, progress)?;
     times.alignment = alignment;
     Ok((result, times))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Seven robots in a periodic steady state: a period of 700 ticks of 10 ms, in which the
+    /// robots complete their tasks in a bunch, 10 ticks apart (task `i` at tick
+    /// `700·(⌊i/7⌋ + 1) + 10·(i mod 7)`): 7 tasks per 7 s, 3600 tasks per hour.
+    fn bunched(total: usize) -> Vec<CellCompletion> {
+        (0..total)
+            .map(|i| CellCompletion {
+                robot: i % 7,
+                tick: 700 * (i as u64 / 7 + 1) + 10 * (i as u64 % 7),
+                busy_ticks: 0,
+                gate_ticks: 0,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_steady_window_is_whole_periods_so_bunches_do_not_bias_it() {
+        // 238 tasks: 10 % is 24, rounded up to 28 (four periods of 7 s): 28 tasks in 28 s.
+        let s = Steady::of(&bunched(238), 7, 0.01).unwrap();
+        assert_eq!(s.tasks, 28);
+        assert!((s.duration_s - 28.0).abs() < 1e-9, "{}", s.duration_s);
+        assert!((s.throughput_per_h - 3600.0).abs() < 1e-9);
+        // Wherever the last task falls in its bunch, whole periods measure the true rate
+        // (24 tasks would span 21.3 s here: 4056 tasks per hour).
+        for total in 8..=238 {
+            let s = Steady::of(&bunched(total), 7, 0.01).unwrap();
+            assert_eq!(s.tasks % 7, 0, "{total}");
+            assert!((s.throughput_per_h - 3600.0).abs() < 1e-9, "{total}: {s:?}");
+        }
+        // Fewer tasks than a period: all of them, from the start.
+        let s = Steady::of(&bunched(5), 7, 0.01).unwrap();
+        assert_eq!(s.tasks, 5);
+        assert!((s.duration_s - 7.4).abs() < 1e-9);
+        assert!(Steady::of(&[], 7, 0.01).is_none());
+    }
 }
