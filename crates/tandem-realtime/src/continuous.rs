@@ -687,7 +687,9 @@ impl ContinuousCoordinator {
     /// The token sequence is rotated to start at the entry for some robot's next group (the
     /// one that skips the fewest entries), and in the first pass a robot's entries before its
     /// next group's are skipped, as at the start ([`token_sequence`]). Allocates (the rotated
-    /// sequence); O(N·len) for a token sequence of `len` entries.
+    /// sequence); O(N·len) for a token sequence of `len` entries, plus O(log T_ref) per robot
+    /// to place its cursors (a few microseconds for `N ≤ 8`, `benches/cyclic.rs` in
+    /// tandem-schedule).
     ///
     /// # Errors
     /// [`Error::HandOver`] when `old` has another robot count, task length or control tick,
@@ -716,7 +718,9 @@ impl ContinuousCoordinator {
         for i in 0..self.n {
             // The robot's reference position in `old`, and the same position's clock here.
             let s_old = old.clock_s[i];
-            let mut at = 0;
+            // `old`'s cursor is at or before the sample of its clock (it only advances to
+            // the clock, and both reset together), so this is O(1) amortized, not O(position).
+            let mut at = old.cursors[i].at;
             let n = old.task.advance_cursor(&mut at, s_old);
             let p = old.task.ref_time_in(n, s_old);
             let s = if p <= 0.0 {
@@ -764,7 +768,21 @@ impl ContinuousCoordinator {
         self.clock_s = clock;
         self.next_group = next;
         self.tasks = old.tasks;
+        // Cursors at or before each robot's sample (the tolerance below it), so the next
+        // tick advances them by a few samples instead of from the task start.
+        let last = self.task.n_ref() - 1;
         self.cursors = [Cursors::default(); MAX_ROBOTS];
+        for (cur, &s) in self.cursors.iter_mut().zip(&clock).take(self.n) {
+            let k = c
+                .partition_point(|&x| x <= s - self.tol_s)
+                .saturating_sub(1)
+                .min(last);
+            *cur = Cursors {
+                at: k,
+                lo: k,
+                hi: k,
+            };
+        }
         self.pos = 0;
         self.passes = 0;
         self.ticks = old.ticks;
