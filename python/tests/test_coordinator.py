@@ -17,7 +17,7 @@ def replay(planner: tandem.Planner, run: tandem.sim.RoundRun) -> dict:
     Python's reference times are the ones the Rust run logged, and counts like the workcell."""
     coord = tandem.Coordinator(planner.schedule)
     problem = planner.problem
-    gmin, gmax = problem.grad_min, problem.grad_max
+    gmin, gmax, conf = problem.grad_min, problem.grad_max, problem.conf
     last_ref = planner.model.n_ref - 1
     k = [0] * coord.n_robots
     ticks = overlap = idle = 0
@@ -25,6 +25,7 @@ def replay(planner: tandem.Planner, run: tandem.sim.RoundRun) -> dict:
         running, ref_now = coord.running_now, coord.ref_time_now
         sample, low_now = coord.sample_now, coord.low_conf_now
         operator = None
+        started_high = []
         for i in range(coord.n_robots):
             if not running[i]:
                 assert not low_now[i]
@@ -32,14 +33,26 @@ def replay(planner: tandem.Planner, run: tandem.sim.RoundRun) -> dict:
             robot = run.robots[i]
             ref_time = min(ref_now[i], last_ref)
             assert ref_time == robot.ref_time_log[k[i]], (ticks, i)
-            assert low_now[i] == robot.supervised[k[i]], (ticks, i)
-            if robot.supervised[k[i]] and robot.corrected[k[i]]:
-                u = tandem.sim.correction_input(planner, ref_time)
-                rate = planner.command(ref_time, u)[-1]
-                n = sample[i]
-                operator = min(max(rate, gmin[n]), gmax[n])
+            if low_now[i]:
+                assert robot.supervised[k[i]], (ticks, i)
+                if robot.corrected[k[i]]:
+                    u = tandem.sim.correction_input(planner, ref_time)
+                    rate = planner.command(ref_time, u)[-1]
+                    n = sample[i]
+                    operator = min(max(rate, gmin[n]), gmax[n])
+            else:
+                started_high.append((i, k[i], ref_now[i]))
             k[i] += 1
         tick = coord.tick(operator)
+        # A tick started on high confidence is supervised after the fact exactly when the tick
+        # was low-confidence and the robot crossed whole low-confidence samples inside it (the
+        # samples after the start's and before the end's; docs/decisions.md, "Rounds: a
+        # one-sample island is never jumped unobserved"); the operator's input did not apply.
+        for i, row, t0 in started_high:
+            lo = min(int(np.floor(t0)), last_ref) + 1
+            hi = min(int(np.floor(tick.ref_time[i])), last_ref)
+            crossed = bool(tick.low_conf[i]) and any(not conf[j] for j in range(lo, hi))
+            assert run.robots[i].supervised[row] == crossed, (ticks, i)
         ticks += 1
         overlap += bool(tick.low_conf.all())
         idle += bool(not tick.low_conf.any())
