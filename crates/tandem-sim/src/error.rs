@@ -79,6 +79,17 @@ pub enum Error {
         /// What is wrong and how to fix it.
         why: String,
     },
+    /// Study: a stage failed in a trial's round; says where, wraps what.
+    #[error("trial {trial}, round {round}: {source}")]
+    InTrial {
+        /// Trial index `k` (0-based).
+        trial: usize,
+        /// The round (1-based) whose run or record failed.
+        round: usize,
+        /// The stage's error.
+        #[source]
+        source: Box<Error>,
+    },
     /// Workcell and study: the task model (commands, corrections, executions, the fit).
     #[error(transparent)]
     Lfd(#[from] tandem_lfd::Error),

@@ -157,8 +157,13 @@ pub fn run_trial_observed(
             .map(|_| Workpiece::random(&config.task, &mut rng))
             .collect::<Result<Vec<_>>>()?;
         let t = Instant::now();
-        let run =
-            workcell::run_round(&planner, reference_labels, &workpieces, &operator, &mut rng)?;
+        let at = |e: Error| Error::InTrial {
+            trial,
+            round: pair + 1,
+            source: Box::new(e),
+        };
+        let run = workcell::run_round(&planner, reference_labels, &workpieces, &operator, &mut rng)
+            .map_err(at)?;
         let records = run.records(planner.model())?;
         times.simulation += t.elapsed();
         tally.add(&run);
@@ -186,7 +191,7 @@ pub fn run_trial_observed(
             hold_ticks: run.robots.iter().map(|r| r.hold_ticks).sum(),
         });
         iterations.push(record);
-        let report = planner.record_round(&records)?;
+        let report = planner.record_round(&records).map_err(|e| at(e.into()))?;
         times.model_update += report.model_update;
         times.confidence += report.confidence;
         times.scheduling += report.scheduling;
