@@ -21,10 +21,13 @@ use tandem_plot::{FONT_FAMILY, GROUND_TRUTH, HIGH_CONFIDENCE, MEAN, OPERATOR};
 const SIZE_PX: (u32, u32) = (1200, 640);
 
 /// The moving window of measured throughput for a trial of `tasks` tasks of `n_robots`
-/// robots: a twentieth of the tasks, at least one task per robot.
+/// robots: a twentieth of the tasks, rounded up to whole periods (a multiple of `N`, as the
+/// study's steady window: the robots complete their tasks in bunches, and a window of a
+/// fraction of a period zig-zags with where the bunches fall).
 #[must_use]
 pub(crate) fn window(tasks: usize, n_robots: usize) -> usize {
-    (tasks / 20).max(n_robots).max(1)
+    let n = n_robots.max(1);
+    (tasks / 20).max(1).div_ceil(n) * n
 }
 
 /// What the figure draws, one value per point.
@@ -327,6 +330,8 @@ mod tests {
         assert_eq!(d.high_conf_pct, vec![30.0, 45.0]);
         // 40 tasks of 2 robots: a window of 2 tasks, a point every task from the second.
         assert_eq!(d.window, 2);
+        // 300 tasks of 2 robots: 15 rounded up to 16; of 3 robots, 15.
+        assert_eq!((window(300, 2), window(300, 3), window(10, 4)), (16, 15, 4));
         assert_eq!(d.measured_tasks.first(), Some(&2.0));
         assert_eq!(d.measured_tasks.last(), Some(&40.0));
         // One task per second, whatever the window.
