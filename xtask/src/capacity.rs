@@ -524,18 +524,6 @@ pub(crate) fn draw_capacity(
     Ok(())
 }
 
-/// A dashed line's legend mark in `colour` (a closure for `SeriesAnno::legend`).
-macro_rules! dashed_mark {
-    ($colour:expr) => {{
-        let colour: RGBColor = $colour;
-        move |(x, y)| {
-            EmptyElement::at((x, y))
-                + PathElement::new(vec![(0, 0), (8, 0)], colour.stroke_width(3))
-                + PathElement::new(vec![(14, 0), (22, 0)], colour.stroke_width(3))
-        }
-    }};
-}
-
 fn draw_on<DB: DrawingBackend>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     rows: &[CapacityRow],
@@ -642,16 +630,12 @@ fn draw_on<DB: DrawingBackend>(
         .map_err(err("bound"))?
         .label("operator-limited bound 3600 / E[LC s per task]")
         .legend(dashed_mark!(GROUND_TRUTH));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .margin(12)
-        .legend_area_size(30)
-        .label_font((FONT_FAMILY, 17))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK.mix(0.5))
-        .draw()
-        .map_err(err("throughput legend"))?;
+    draw_legend!(
+        chart,
+        SeriesLabelPosition::UpperLeft,
+        17,
+        err("throughput legend")
+    )?;
 
     // Right: the operator's busy share and the robots' waiting share.
     let pct = |v: f64| 100.0 * v;
@@ -753,16 +737,12 @@ fn draw_on<DB: DrawingBackend>(
                 .map_err(err("waiting share points"))?;
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .margin(12)
-        .legend_area_size(30)
-        .label_font((FONT_FAMILY, 17))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK.mix(0.5))
-        .draw()
-        .map_err(err("share legend"))?;
+    draw_legend!(
+        chart,
+        SeriesLabelPosition::UpperLeft,
+        17,
+        err("share legend")
+    )?;
     Ok(())
 }
 

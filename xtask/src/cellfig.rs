@@ -221,11 +221,7 @@ fn draw_on<DB: DrawingBackend>(
         ))
         .map_err(err("bound"))?
         .label("certificate bound 3600·N / P_lower")
-        .legend(|(x, y)| {
-            EmptyElement::at((x, y))
-                + PathElement::new(vec![(0, 0), (8, 0)], GROUND_TRUTH.stroke_width(3))
-                + PathElement::new(vec![(14, 0), (22, 0)], GROUND_TRUTH.stroke_width(3))
-        });
+        .legend(dashed_mark!(GROUND_TRUTH));
     chart
         .draw_secondary_series(LineSeries::new(
             zip(&d.plan_tasks, &d.high_conf_pct),
@@ -251,16 +247,7 @@ fn draw_on<DB: DrawingBackend>(
                 + PathElement::new(vec![(8, 0), (11, 0)], HIGH_CONFIDENCE.stroke_width(2))
                 + PathElement::new(vec![(16, 0), (19, 0)], HIGH_CONFIDENCE.stroke_width(2))
         });
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .margin(12)
-        .legend_area_size(30)
-        .label_font((FONT_FAMILY, 17))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK.mix(0.5))
-        .draw()
-        .map_err(err("legend"))?;
+    draw_legend!(chart, SeriesLabelPosition::UpperLeft, 17, err("legend"))?;
     Ok(())
 }
 

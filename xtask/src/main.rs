@@ -4,6 +4,8 @@
 //! dispatches, so that tasks added by different changes do not touch each other's code.
 #![allow(clippy::print_stdout, reason = "xtask reports to the terminal")]
 
+#[macro_use]
+mod legend;
 mod bags;
 mod capacity;
 mod cellfig;

@@ -314,33 +314,16 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> a
     }
     let set_size = cases[0].adversaries.len() as u64;
     let run_start = Instant::now();
-    let (ticks, overlap_ticks, overlap_runs, unfinished) = (
-        AtomicU64::new(0),
-        AtomicU64::new(0),
-        AtomicU64::new(0),
-        AtomicU64::new(0),
-    );
-    run_batches(executions, BATCH, 5.0, &overlap_ticks, |e| {
+    let tally = Tally::default();
+    run_batches(executions, BATCH, 5.0, &tally, |e| {
         let case = &cases[(e % n_problems) as usize];
         let op = case.adversaries[((e / n_problems) % set_size) as usize];
         let r = execute(case, op, seed, e)?;
-        ticks.fetch_add(r.ticks, Ordering::Relaxed);
-        if r.overlap_ticks > 0 {
-            overlap_ticks.fetch_add(r.overlap_ticks, Ordering::Relaxed);
-            overlap_runs.fetch_add(1, Ordering::Relaxed);
-        }
-        if !r.finished {
-            unfinished.fetch_add(1, Ordering::Relaxed);
-        }
+        tally.add(r.ticks, r.overlap_ticks, r.finished);
         Ok(())
     })?;
     let secs = run_start.elapsed().as_secs_f64();
-    let (ticks, overlap_ticks, overlap_runs, unfinished) = (
-        ticks.into_inner(),
-        overlap_ticks.into_inner(),
-        overlap_runs.into_inner(),
-        unfinished.into_inner(),
-    );
+    let (ticks, overlap_ticks, overlap_runs, unfinished) = tally.into_counts();
     println!(
         "stress: {executions} executions of {n_robots} robots ({set_size} operator policies, \
          seed {seed}), {ticks} ticks, {threads} threads: {overlap_ticks} ticks with two or more \
@@ -358,15 +341,50 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> a
     Ok(())
 }
 
+/// What the executions of a stress run add up to, from worker threads.
+#[derive(Default)]
+struct Tally {
+    ticks: AtomicU64,
+    overlap_ticks: AtomicU64,
+    overlap_runs: AtomicU64,
+    unfinished: AtomicU64,
+}
+
+impl Tally {
+    /// One execution: its ticks, its ticks with two or more robots low-confidence, whether
+    /// it finished.
+    fn add(&self, ticks: u64, overlap_ticks: u64, finished: bool) {
+        self.ticks.fetch_add(ticks, Ordering::Relaxed);
+        if overlap_ticks > 0 {
+            self.overlap_ticks
+                .fetch_add(overlap_ticks, Ordering::Relaxed);
+            self.overlap_runs.fetch_add(1, Ordering::Relaxed);
+        }
+        if !finished {
+            self.unfinished.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    /// Ticks, overlap ticks, executions with overlaps, unfinished executions.
+    fn into_counts(self) -> (u64, u64, u64, u64) {
+        (
+            self.ticks.into_inner(),
+            self.overlap_ticks.into_inner(),
+            self.overlap_runs.into_inner(),
+            self.unfinished.into_inner(),
+        )
+    }
+}
+
 /// Runs executions `0..executions` through `run_one` in parallel batches of `batch` (the
 /// order of the batches is fixed; the results must not depend on the order within one) and
-/// prints a progress line, with the overlap ticks counted so far, after a batch when
+/// prints a progress line, with the overlap ticks `tally` counted so far, after a batch when
 /// `report_s` seconds have passed since the last one. Stops at the first batch with an error.
 fn run_batches(
     executions: u64,
     batch: u64,
     report_s: f64,
-    overlap_ticks: &AtomicU64,
+    tally: &Tally,
     run_one: impl Fn(u64) -> anyhow::Result<()> + Sync,
 ) -> anyhow::Result<()> {
     let start = Instant::now();
@@ -380,7 +398,7 @@ fn run_batches(
             let rate = done as f64 / start.elapsed().as_secs_f64();
             println!(
                 "  {done}/{executions} executions, {} overlap ticks, {rate:.0} executions/s",
-                overlap_ticks.load(Ordering::Relaxed)
+                tally.overlap_ticks.load(Ordering::Relaxed)
             );
             last_report = Instant::now();
         }
@@ -496,42 +514,23 @@ pub(crate) fn run_continuous(
     );
     let set_size = cases[0].adversaries.len() as u64;
     let run_start = Instant::now();
-    let (ticks, overlap_ticks, overlap_runs, unfinished, tasks_done) = (
-        AtomicU64::new(0),
-        AtomicU64::new(0),
-        AtomicU64::new(0),
-        AtomicU64::new(0),
-        AtomicU64::new(0),
-    );
+    let (tally, tasks_done) = (Tally::default(), AtomicU64::new(0));
     let min_tasks = AtomicU64::new(u64::MAX);
-    run_batches(executions, CELL_BATCH, 10.0, &overlap_ticks, |e| {
+    run_batches(executions, CELL_BATCH, 10.0, &tally, |e| {
         let case = &cases[(e % n_problems) as usize];
         let op = case.adversaries[((e / n_problems) % set_size) as usize];
         let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
         rng.set_stream(e);
         let mut cell = case.cell.clone();
         let r = run_cell(&mut cell, op, &mut rng, tasks, case.max_ticks)?;
-        ticks.fetch_add(r.ticks, Ordering::Relaxed);
+        tally.add(r.ticks, r.overlap_ticks, r.finished);
         tasks_done.fetch_add(cell.tasks_completed().iter().sum(), Ordering::Relaxed);
         min_tasks.fetch_min(r.min_tasks, Ordering::Relaxed);
-        if r.overlap_ticks > 0 {
-            overlap_ticks.fetch_add(r.overlap_ticks, Ordering::Relaxed);
-            overlap_runs.fetch_add(1, Ordering::Relaxed);
-        }
-        if !r.finished {
-            unfinished.fetch_add(1, Ordering::Relaxed);
-        }
         Ok(())
     })?;
     let secs = run_start.elapsed().as_secs_f64();
-    let (ticks, overlap_ticks, overlap_runs, unfinished, tasks_done, min_tasks) = (
-        ticks.into_inner(),
-        overlap_ticks.into_inner(),
-        overlap_runs.into_inner(),
-        unfinished.into_inner(),
-        tasks_done.into_inner(),
-        min_tasks.into_inner(),
-    );
+    let (ticks, overlap_ticks, overlap_runs, unfinished) = tally.into_counts();
+    let (tasks_done, min_tasks) = (tasks_done.into_inner(), min_tasks.into_inner());
     println!(
         "stress --cell continuous: {executions} executions of {n_robots} robots ({set_size} \
          operator policies, seed {seed}), {ticks} ticks, {threads} threads: {overlap_ticks} \

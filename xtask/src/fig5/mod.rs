@@ -471,16 +471,7 @@ fn draw_legend<'a, DB: DrawingBackend + 'a>(
     position: SeriesLabelPosition,
     what: &str,
 ) -> anyhow::Result<()> {
-    chart
-        .configure_series_labels()
-        .position(position)
-        .margin(12)
-        .legend_area_size(30)
-        .label_font((FONT_FAMILY, LEGEND_FONT))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK.mix(0.5))
-        .draw()
-        .map_err(draw_err(what))?;
+    draw_legend!(chart, position, LEGEND_FONT, draw_err(what))?;
     Ok(())
 }
 
