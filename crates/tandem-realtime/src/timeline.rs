@@ -412,6 +412,38 @@ impl Timeline {
             .map(|n| self.rate_slow(n))
             .fold(1.0, f64::min)
     }
+
+    /// An upper bound on the ticks of `tick_s` (s) a clock spends in `[from_s, to_s]`
+    /// (schedule clock, s) if every tick moves it by at least `tick_s · S_n` for some sample `n`
+    /// of this timeline within `pad_s` (s) of it: `Σ_n ((|I_n ∩ [from_s, to_s]| + 2·pad_s) /
+    /// (tick_s·S_n) + 1)` over the samples whose interval `I_n = [c_n, c_{n+1})` (the last one
+    /// open to the right) comes within `pad_s` of `[from_s, to_s]`. Unlike
+    /// `(to_s − from_s)/(tick_s·S_min)` it charges a sample with a tiny `S` (a dwell in a
+    /// demonstration, `ψ̇max ≫ ψ̇_E`) only for the clock time near that sample.
+    pub(crate) fn slow_crossing_ticks(
+        &self,
+        from_s: f64,
+        to_s: f64,
+        pad_s: f64,
+        tick_s: f64,
+    ) -> f64 {
+        let n_ref = self.n_ref();
+        let mut ticks = 0.0;
+        for n in 0..n_ref {
+            let lo = self.clock_s[n];
+            let hi = if n + 1 == n_ref {
+                f64::INFINITY
+            } else {
+                self.clock_s[n + 1]
+            };
+            if hi < from_s - pad_s || lo > to_s + pad_s {
+                continue;
+            }
+            let inside = (hi.min(to_s) - lo.max(from_s)).max(0.0);
+            ticks += (inside + 2.0 * pad_s) / (tick_s * self.rate_slow(n)) + 1.0;
+        }
+        ticks
+    }
 }
 
 /// The two rates of Eq. 17 at one reference sample: schedule-clock seconds covered per real

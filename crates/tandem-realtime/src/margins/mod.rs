@@ -180,7 +180,9 @@ use sim::Variant;
 ///
 /// # Errors
 /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] for `tick_s` not
-/// finite and > 0, or (two robots) so small that the simulation would need more than 1e8 ticks.
+/// finite and > 0, or (two robots) so small that the horizon spans more than 1e8 ticks. A
+/// simulation still undecided after 1e8 ticks (extreme demonstrated rates, e.g. a sample one
+/// demonstration dwelt on) rejects the schedule: `Ok(false)`.
 pub fn sufficient_margins(robots: &[Timeline], tick_s: f64) -> Result<bool> {
     match robots.len() {
         0..=2 => sim::check_single_pass(robots, tick_s, Variant::Conservative),

@@ -9,7 +9,9 @@ use crate::strategy::{Member, Mode, advance, first_waiting_start, response_step}
 use crate::timeline::{LcInterval, Rates, Timeline};
 use crate::tol::clock_tolerance_s;
 
-/// Upper bound on simulated ticks per role; a `tick_s` needing more is rejected as invalid.
+/// Upper bound on simulated ticks per role: a `tick_s` for which the horizon alone spans more
+/// is rejected as invalid; a role still undecided after this many ticks (extreme rates) is
+/// rejected as unsafe.
 const MAX_SIM_TICKS: f64 = 1e8;
 
 /// A pair of consecutive LC regions of different robots: the previous robot's region `prev`
@@ -63,8 +65,41 @@ struct Setup {
     max_step_of: Vec<f64>,
     /// Comparison tolerance of the checks (schedule-clock s).
     eps: f64,
+    /// Upper bound on the ticks any role's simulation needs ([`tick_budget`]).
+    tick_budget: f64,
     /// Pairs per ordered role `(p, c)`, at index `p·N + c`.
     pairs: Vec<Vec<Pair>>,
+}
+
+/// Upper bound on the ticks a role's simulation started at `sim_from_s` (s) needs until every
+/// running robot is a step `max_step_s` (s) past the latest end: the lesser of two bounds.
+/// - `(horizon + M)/(tick_s·S_min)`: every tick moves every running robot by at least
+///   `S_min·tick_s`.
+/// - Per sample ([`Timeline::slow_crossing_ticks`], summed over the robots): a tick moves the
+///   running robot furthest behind by at least `tick_s · S` of some sample within its look-up
+///   window (one step plus `eps_s`) plus the one step it moves, so each sample is charged only
+///   for the clock time near it. A sample with a tiny slow rate — a dwell in one demonstration,
+///   `ψ̇max ≫ ψ̇_E` — costs ticks only where it is, not over the whole horizon: one such sample
+///   (`S ≈ 6·10⁻⁵`, high-confidence in the paper-confidence study) made the first bound exceed
+///   1e8 ticks and every schedule, the serial one included, fail to be checked (decisions.md).
+///
+/// A budget that runs out rejects the schedule, so a too small one is safe; this one is never
+/// smaller than the ticks the simulation can take. [`Setup::new`] caps it at 1e8.
+fn tick_budget(
+    robots: &[Timeline],
+    sim_from_s: f64,
+    max_step_s: f64,
+    eps_s: f64,
+    tick_s: f64,
+) -> f64 {
+    let to_s = max_end_s(robots) + max_step_s;
+    let global = (to_s - sim_from_s) / (min_rate_slow(robots) * tick_s);
+    let pad_s = 2.0 * max_step_s + eps_s;
+    let per_sample: f64 = robots
+        .iter()
+        .map(|r| r.slow_crossing_ticks(sim_from_s, to_s, pad_s, tick_s))
+        .sum();
+    global.min(per_sample).max(0.0).ceil() + 4.0
 }
 
 /// Schedule-clock time (s) at which the simulation of role `(p, c)` starts: the later start `τ`
@@ -119,13 +154,21 @@ impl Setup {
                 sim_from = sim_from.min(role_start(robots, p, c, true));
             }
         }
-        let horizon = max_end_s(robots) - sim_from;
-        if horizon / (min_rate_slow(robots) * tick_s) > MAX_SIM_TICKS {
+        let max_step = max_step_of
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
+        let eps = 4.0 * clock_tolerance_s(robots, tick_s);
+        let tick_budget = tick_budget(robots, sim_from, max_step, eps, tick_s);
+        // A tick too small for the horizon is an input error; extreme rates (a dwell or a skip
+        // in one demonstration) only cap the budget, which then rejects what it cannot decide.
+        if (max_end_s(robots) + max_step - sim_from) / tick_s > MAX_SIM_TICKS {
             return Err(Error::BadParam {
                 name: "tick_s",
                 why: "too small: the margin simulation would need more than 1e8 ticks",
             });
         }
+        let tick_budget = tick_budget.min(MAX_SIM_TICKS);
         let mut regions: Vec<(LcInterval, usize)> = Vec::new();
         for (i, r) in robots.iter().enumerate() {
             regions.extend(r.lc_intervals().iter().map(|&iv| (iv, i)));
@@ -140,12 +183,10 @@ impl Setup {
         }
         Ok(Setup {
             n,
-            max_step: max_step_of
-                .iter()
-                .copied()
-                .fold(f64::NEG_INFINITY, f64::max),
+            max_step,
             max_step_of,
-            eps: 4.0 * clock_tolerance_s(robots, tick_s),
+            eps,
+            tick_budget,
             pairs,
         })
     }
@@ -534,12 +575,14 @@ impl<'a> RoleSim<'a> {
     }
 }
 
-/// Simulation budget of a role started at `t_start_s`: every step moves every running robot by
-/// at least `S_min·tick_s > 0`.
+/// Simulation budget of a role started at `t_start_s`: the lesser of [`Setup::tick_budget`]
+/// and `(horizon + M)/(tick_s·S_min)` from `t_start_s` (every step moves every running robot
+/// by at least `S_min·tick_s > 0`).
 fn step_budget(robots: &[Timeline], setup: &Setup, t_start_s: f64, tick_s: f64) -> u64 {
     let horizon = max_end_s(robots) + setup.max_step - t_start_s;
+    let global = (horizon / (min_rate_slow(robots) * tick_s)).ceil().max(0.0) + 4.0;
     // Bounded by MAX_SIM_TICKS (checked in Setup::new), so the cast cannot overflow.
-    (horizon / (min_rate_slow(robots) * tick_s)).ceil().max(0.0) as u64 + 4
+    global.min(setup.tick_budget) as u64
 }
 
 /// Runs one role's simulation over `pairs` (already ordered) with a pointer; `false` as soon as
@@ -548,31 +591,49 @@ fn run_role(
     variant: Variant,
     robots: &[Timeline],
     setup: &Setup,
-    (p, c): (usize, usize),
+    role: (usize, usize),
     pairs: &[Pair],
     tick_s: f64,
 ) -> bool {
+    let t_start = role_start(robots, role.0, role.1, variant.with_thirds());
+    let budget = step_budget(robots, setup, t_start, tick_s);
+    // A budget that runs out is unreachable for valid timelines (it covers every running
+    // robot passing the latest end); reject to stay safe.
+    decide_role(variant, robots, setup, role, pairs, tick_s, budget)
+        .0
+        .unwrap_or(false)
+}
+
+/// [`run_role`] with at most `budget` simulated ticks: the verdict (`None` if the budget ran
+/// out first) and the ticks simulated.
+fn decide_role(
+    variant: Variant,
+    robots: &[Timeline],
+    setup: &Setup,
+    (p, c): (usize, usize),
+    pairs: &[Pair],
+    tick_s: f64,
+    budget: u64,
+) -> (Option<bool>, u64) {
     if pairs.is_empty() {
-        return true;
+        return (Some(true), 0);
     }
     let mut sim = RoleSim::new(variant, robots, setup, p, c, tick_s);
     let mut live = Vec::new();
     let mut ready = false;
     if sim.both_started() {
         match sim.admit(pairs, setup) {
-            None => return false,
-            Some(l) if l.is_empty() => return true,
+            None => return (Some(false), 0),
+            Some(l) if l.is_empty() => return (Some(true), 0),
             Some(l) => (live, ready) = (l, true),
         }
     }
-    let t_start = role_start(robots, p, c, variant.with_thirds());
-    let budget = step_budget(robots, setup, t_start, tick_s);
     let mut k = 0;
-    for _ in 0..budget {
+    for ticks in 1..=budget {
         if sim.step() {
             match sim.admit(pairs, setup) {
-                None => return false,
-                Some(l) if l.is_empty() => return true,
+                None => return (Some(false), ticks),
+                Some(l) if l.is_empty() => return (Some(true), ticks),
                 Some(l) => (live, ready) = (l, true),
             }
             continue;
@@ -582,17 +643,16 @@ fn run_role(
         }
         while k < live.len() {
             match sim.test(live[k], setup.eps) {
-                Some(false) => return false,
+                Some(false) => return (Some(false), ticks),
                 Some(true) => k += 1,
                 None => break,
             }
         }
         if k == live.len() {
-            return true;
+            return (Some(true), ticks);
         }
     }
-    // Unreachable for valid timelines (the budget covers p reaching its end); reject to stay safe.
-    false
+    (None, budget)
 }
 
 /// Every ordered role `(p, c)` of `setup`, in the order the checks decide them.
@@ -799,6 +859,87 @@ mod tests {
         let r = three_sample(3.0);
         assert!(sufficient_margins(&r, 1.0).unwrap());
         assert!(sufficient_margins_per_pair(&r, 1.0).unwrap());
+    }
+
+    /// Two robots of 400 samples (10 ms each), robot 0 low-confidence at samples 100..150 and
+    /// robot 1 at 270..290, each with one sample `d` that one demonstration dwelt on
+    /// (`ψ̇max = 20·ψ̇_E`, `S = 0.05`, against 0.5 elsewhere); robot 1 starts at `tau` (s).
+    fn dwelling(d: usize, tau: f64) -> [Timeline; 2] {
+        let g = vec![1.0; 400];
+        let lo = vec![0.5; 400];
+        let mut hi = vec![2.0; 400];
+        hi[d] = 20.0;
+        let conf = |lc: std::ops::Range<usize>| -> Vec<bool> {
+            (0..400).map(|n| !lc.contains(&n)).collect()
+        };
+        [
+            Timeline::new(&conf(100..150), &g, &lo, &hi, 0.0, 0.01).unwrap(),
+            Timeline::new(&conf(270..290), &g, &lo, &hi, tau, 0.01).unwrap(),
+        ]
+    }
+
+    #[test]
+    fn tick_budget_covers_every_simulation() {
+        let tick_s = 0.01;
+        let mut longest = 0;
+        for d in [20, 99, 120, 149, 200, 280] {
+            for step in 0..=80 {
+                let r = dwelling(d, 0.025 * f64::from(step));
+                let setup = Setup::new(&r, tick_s).unwrap();
+                for role in roles(2) {
+                    let pairs = setup.role_pairs(role.0, role.1);
+                    for variant in [Variant::Pairwise, Variant::Conservative] {
+                        let (verdict, ticks) =
+                            decide_role(variant, &r, &setup, role, pairs, tick_s, 10_000_000);
+                        assert!(verdict.is_some(), "d {d}, τ step {step}: undecided");
+                        assert!(
+                            (ticks as f64) <= setup.tick_budget,
+                            "d {d}, τ step {step}, role {role:?}: {ticks} ticks > budget {}",
+                            setup.tick_budget
+                        );
+                        longest = longest.max(ticks);
+                    }
+                }
+                pair_slacks(&r, tick_s).unwrap();
+            }
+        }
+        // Some case drags robot 0 through its LC run (≥ 100 ticks at S = 0.5) and the dwell in
+        // it (≈ 100 more).
+        assert!(longest >= 200, "longest {longest} ticks");
+    }
+
+    /// Regression (the paper-confidence study, trial 0, round 132 at seed 2023): one
+    /// high-confidence sample with `S ≈ 6·10⁻⁵` made the whole-horizon tick bound exceed 1e8,
+    /// and the check of every schedule, the serial one included, failed with "`tick_s` too
+    /// small".
+    #[test]
+    fn one_extreme_dwell_sample_still_checks() {
+        let n = 10_000;
+        let conf: Vec<bool> = (0..n).map(|k| !(4000..5000).contains(&k)).collect();
+        let g = vec![1.0; n];
+        let lo = vec![0.5; n];
+        let mut hi = vec![2.0; n];
+        hi[3205] = 1.6e4;
+        let tl = |tau| Timeline::new(&conf, &g, &lo, &hi, tau, 0.01).unwrap();
+        // Whole horizon 100 s / (6.25·10⁻⁵ · 10 ms) = 1.6·10⁸ ticks.
+        let serial = [tl(0.0), tl(100.0)];
+        assert!(sufficient_margins(&serial, 0.01).unwrap());
+        // Robot 1 10 s behind: its LC run starts at 50 s, robot 0's ends at 50 s.
+        assert!(!sufficient_margins(&[tl(0.0), tl(10.0)], 0.01).unwrap());
+        // 60 s behind: robot 0 has left its LC run long before robot 1 can reach its own.
+        assert!(sufficient_margins(&[tl(0.0), tl(60.0)], 0.01).unwrap());
+        // And one LC sample that one demonstration skipped through (`F = 1530`, so `M` =
+        // 15.3 s): even per sample the bound is 1.3·10⁸ ticks. Capped at 1e8: the serial
+        // schedule is still accepted (no simulation needed), and a check that would need more
+        // rejects.
+        let mut lo = lo.clone();
+        lo[4500] = 1.0 / 1530.0;
+        let tl = |tau| Timeline::new(&conf, &g, &lo, &hi, tau, 0.01).unwrap();
+        let setup = Setup::new(&[tl(0.0), tl(100.0)], 0.01).unwrap();
+        assert_eq!(setup.tick_budget, MAX_SIM_TICKS);
+        assert!(sufficient_margins(&[tl(0.0), tl(100.0)], 0.01).unwrap());
+        assert!(!sufficient_margins(&[tl(0.0), tl(10.0)], 0.01).unwrap());
+        let _ = sufficient_margins(&[tl(0.0), tl(60.0)], 0.01).unwrap();
     }
 
     #[test]
