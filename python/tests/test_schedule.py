@@ -41,7 +41,7 @@ def test_planner_schedule_passes_validate_and_has_n_robot_shapes(
     for fresh in others[1:]:
         assert fresh.lower_bound_s == pytest.approx(bound, rel=1e-12)
     assert s.gap == pytest.approx((s.t_total_s - s.lower_bound_s) / s.lower_bound_s, rel=1e-12)
-    assert s.source in ("sampled", "completed", "previous", "repaired", "serial")
+    assert s.source in ("sampled", "completed", "previous", "repaired", "serial", "held", "staggered")
     assert set(s.stats) == {"candidates", "cheap_feasible", "margin_checks"}
 
 

@@ -23,7 +23,7 @@ def test_result_arrays_have_the_documented_shapes(study: tandem.study.StudyResul
         assert t.iteration.tolist() == [0, 1, 2, 3]
         assert t.n_pairs == 3 and t.overlap_ticks.shape == (3,)
         assert len(t.lc_intervals_s) == 4 and all(len(i) == 2 for i in t.lc_intervals_s)
-        assert all(s in ("sampled", "completed", "previous", "repaired", "serial") for s in t.source)
+        assert all(s in ("sampled", "completed", "previous", "repaired", "serial", "held", "staggered") for s in t.source)
         assert ((0 <= t.operator_idle_share) & (t.operator_idle_share <= 1)).all()
     assert study.total_overlap_ticks == 0
     assert study.config["trials"] == 2 and study.config["miss_rate"] == 0.01

@@ -161,7 +161,7 @@ fn scheduled(
     let out = sample_schedule_n(problem, n_robots, &params, None)?;
     let sampled = matches!(
         out.source,
-        Source::Sampled { .. } | Source::Completed | Source::Held
+        Source::Sampled { .. } | Source::Completed | Source::Held | Source::Staggered
     );
     Ok((out.schedule.check(problem)?.coordinator()?, sampled))
 }

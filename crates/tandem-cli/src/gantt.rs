@@ -19,6 +19,7 @@ pub(crate) fn source_name(source: &Source) -> String {
         Source::RepairedPrevious => "previous schedule, repaired for the new model".into(),
         Source::Serial => "fastest serial schedule (fallback)".into(),
         Source::Held => "exact optimum with hold points and release rules".into(),
+        Source::Staggered => "staggered (fastest warps, least starts the check accepts)".into(),
     }
 }
 

@@ -30,6 +30,7 @@ use crate::exact;
 use crate::problem::{Problem, check_robot_count};
 use crate::sampler::{self, SamplerBaselines, SamplerParams, SamplerStats};
 use crate::schedule::Schedule;
+use crate::stagger;
 use crate::validate::{Violation, validate};
 use crate::{Error, Result};
 
@@ -53,15 +54,21 @@ pub enum Source {
     /// The fastest serial schedule ([`Problem::serial_schedule`]).
     Serial,
     /// The exact optimum with hold points (two robots: the margin-free optimum of
-    /// [`crate::solve_exact`] on a problem with holds, planned dwells included) with release
-    /// rules from its order of low-confidence stretches ([`Problem::with_release_rules`]),
-    /// which enforce that order at run time instead of margins.
+    /// [`crate::solve_exact`] on a problem with holds, planned dwells included; `N ≥ 3`: the
+    /// best order of the `N`-robot search, see [`crate::exact`]) with release rules from its
+    /// order of low-confidence stretches ([`Problem::with_release_rules`]), which enforce that
+    /// order at run time instead of margins.
     Held,
+    /// `N ≥ 3` robots on their fastest warps at the least start offsets the full check accepts
+    /// (greedy robot by robot, or equally spaced), tried when no other candidate overlaps the
+    /// robots (`stagger.rs`; docs/decisions.md, "N robots in the margin-free search").
+    Staggered,
 }
 
 impl Source {
     /// The short name of the source in records (the study's JSON and CSV, the Python
-    /// package): `sampled`, `completed`, `previous`, `repaired`, `serial` or `held`.
+    /// package): `sampled`, `completed`, `previous`, `repaired`, `serial`, `held` or
+    /// `staggered`.
     pub fn name(self) -> &'static str {
         match self {
             Source::Sampled { .. } => "sampled",
@@ -70,6 +77,7 @@ impl Source {
             Source::RepairedPrevious => "repaired",
             Source::Serial => "serial",
             Source::Held => "held",
+            Source::Staggered => "staggered",
         }
     }
 }
@@ -90,7 +98,8 @@ pub struct Outcome {
     /// A lower bound (s) on the `T_total` of every schedule satisfying Eq. 20: the margin-free
     /// optimum `T*₀` (constraints 1–4, [`crate::solve_exact`]) when
     /// [`Outcome::bound_is_optimum`], else the simple bound of an unfinished search; for
-    /// `N ≠ 2` robots [`crate::operator_bound_s`]. Reported as computed, never clamped: it is
+    /// one robot its fastest execution; for `N ≥ 3` the `N`-robot search's optimum when it
+    /// finished, else [`crate::operator_bound_s`]. Reported as computed, never clamped: it is
     /// not above [`Outcome::t_total_s`] except by the rounding a valid schedule is allowed
     /// (at most `tol::BOUND_REL` = `2·tol::GRADIENT_REL` relative: `validate` accepts
     /// gradients that far outside their bounds, and the bound and `T_total` are summed in
@@ -257,9 +266,13 @@ pub fn sample_schedule(
 /// intervals (one widening `w` per candidate), its offset at most the latest end before it;
 /// candidates are checked in `(T_total, k)` order as for two robots. The warm start keeps
 /// robot 1 of the previous schedule (whatever its robot count). For `N = 2` the margin-aware
-/// completion runs beside the sampler and the bound is the exact margin-free optimum `T*₀`;
-/// for `N ≠ 2` there is no completion and the bound is [`crate::operator_bound_s`] (the
-/// optimum itself for `N = 1`). Deterministic for a seed whatever the thread count.
+/// completion runs beside the sampler and the bound is the exact margin-free optimum `T*₀`.
+/// For `N ≥ 3` there is no margin-aware completion; the bound is the margin-free optimum of the
+/// `N`-robot branch and bound when it finishes within its node budget, else
+/// [`crate::operator_bound_s`] (see "N robots" in [`crate::exact`]); with hold points the
+/// best order it found, with release rules ([`Problem::with_release_rules`]), is a candidate
+/// too ([`Source::Held`]). For `N = 1` the bound is the optimum itself, the fastest execution.
+/// Deterministic for a seed whatever the thread count.
 ///
 /// # Errors
 /// As [`sample_schedule`]; [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS`.
@@ -344,8 +357,11 @@ fn schedule_n(
             }
         },
         || {
-            if !two {
+            if n_robots == 1 {
                 return (exact::operator_bound(problem, n_robots), (None, 0));
+            }
+            if !two {
+                return (exact::bound_n(problem, n_robots), (None, 0));
             }
             let bound = exact::bound(problem, &params.exact);
             let done = if bound.lower_bound_s < cap_s {
@@ -380,7 +396,6 @@ fn schedule_n(
             best = (s, t, Source::Sampled { candidate: k });
         }
     }
-    stats.completion_margin_checks = checks;
     stats.search = bound.stats;
     if let Some((schedule, t)) = completed
         && t < best.1
@@ -388,8 +403,9 @@ fn schedule_n(
     {
         best = (schedule, t, Source::Completed);
     }
-    // With hold points, the margin-free optimum itself with release rules (two robots).
-    if let Some(optimum) = bound.schedule.as_ref().filter(|_| two)
+    // With hold points, the margin-free optimum itself with release rules (for `N ≥ 3` the
+    // best order the search found, proven or not).
+    if let Some(optimum) = bound.schedule.as_ref()
         && !problem.usable_holds().is_empty()
     {
         let timed = Schedule {
@@ -403,6 +419,22 @@ fn schedule_n(
             }
         }
     }
+    // For `N ≥ 3`, when no candidate so far overlaps the robots (nothing beats the serial
+    // schedule), the staggered one: its checks see all robots and cost most at large `N`, so
+    // it runs only where the sampler found nothing.
+    if n_robots >= 3
+        && best.1
+            >= problem
+                .serial_schedule_n(n_robots, tick_s)?
+                .t_total_s(problem.dt_s())
+        && let Some((schedule, t, used)) = stagger::staggered(problem, n_robots, tick_s)
+    {
+        checks += used;
+        if t < best.1 {
+            best = (schedule, t, Source::Staggered);
+        }
+    }
+    stats.completion_margin_checks = checks;
     let (schedule, t_total_s, source) = best;
     let (lower_bound_s, gap) = certificate(bound.lower_bound_s, t_total_s)?;
     Ok(Outcome {

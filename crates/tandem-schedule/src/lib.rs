@@ -61,6 +61,7 @@ pub mod exact;
 mod problem;
 mod sampler;
 mod schedule;
+mod stagger;
 mod validate;
 
 pub use checked::CheckedSchedule;

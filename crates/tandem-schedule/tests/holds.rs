@@ -97,8 +97,10 @@ fn three_robots_overlap_on_a_task_with_two_variable_sections() {
         "{} vs serial {serial_s}",
         out.t_total_s
     );
-    // The bound for N = 3 is the operator-limited one.
-    assert_eq!(out.lower_bound_s, operator_bound_s(&held, 3).unwrap());
+    // The bound for N = 3 is the margin-free optimum with holds: at least the operator-limited
+    // bound, at most what the scheduler reached.
+    assert!(out.lower_bound_s >= operator_bound_s(&held, 3).unwrap() - 1e-9);
+    assert!(out.lower_bound_s <= out.t_total_s + 1e-9);
     // A grid search over the two offsets finds nothing better (by more than 1 %).
     let grid = grid_best(&held, 40);
     assert!(
@@ -106,17 +108,21 @@ fn three_robots_overlap_on_a_task_with_two_variable_sections() {
         "scheduler {} vs grid {grid}",
         out.t_total_s
     );
-    // Without holds the same scheduler is more than 10 % slower here.
+    // Without holds the robots overlap too (the staggered candidate: the sampler's widenings
+    // are too small for the inserts' worst case), as well as the grid finds, and holds are no
+    // worse.
     let without = sample_schedule_n(&plain, 3, &params(1), None).unwrap();
     assert!(!without.schedule.has_holds());
+    validate(&plain, &without.schedule).unwrap();
+    let plain_grid = grid_best(&plain, 40);
     assert!(
-        without.t_total_s > 1.1 * out.t_total_s,
-        "{} vs {}",
-        without.t_total_s,
-        out.t_total_s
+        without.t_total_s < 0.8 * serial_s && without.t_total_s <= plain_grid * 1.01,
+        "{} vs grid {plain_grid}, serial {serial_s}",
+        without.t_total_s
     );
+    assert!(out.t_total_s <= without.t_total_s + 1e-9);
     eprintln!(
-        "three robots: with holds {:.3} s (grid {grid:.3} s, bound {:.3} s), without {:.3} s, serial {serial_s:.3} s",
+        "three robots: with holds {:.3} s (grid {grid:.3} s, bound {:.3} s), without {:.3} s (grid {plain_grid:.3} s), serial {serial_s:.3} s",
         out.t_total_s, out.lower_bound_s, without.t_total_s
     );
     // At run time: the checked coordinator, the full adversary set, no overlap.

@@ -49,7 +49,13 @@ proptest! {
         // The certificate is the operator bound, as computed (no clamping). The bound and the
         // clock sum the same durations in other orders: the schedule is never shorter than
         // the bound by more than rounding (here exact gradients, so far below 1e-12).
-        prop_assert_eq!(out.lower_bound_s, operator_bound_s(&p, n).unwrap());
+        // For `N ≥ 3` it is the N-robot search's optimum or the operator bound: never below
+        // the latter (up to the same rounding).
+        let operator = operator_bound_s(&p, n).unwrap();
+        prop_assert!(out.lower_bound_s >= operator * (1.0 - 1e-12), "{} vs {}", out.lower_bound_s, operator);
+        if !out.bound_is_optimum {
+            prop_assert_eq!(out.lower_bound_s, operator);
+        }
         prop_assert!(
             out.lower_bound_s <= out.t_total_s * (1.0 + 1e-12) && out.gap >= -1e-12,
             "bound {} T_total {} gap {:e}", out.lower_bound_s, out.t_total_s, out.gap
@@ -81,14 +87,15 @@ fn most_random_problems_get_sampled_n_robot_schedules() {
             ..SamplerParams::default()
         };
         let out = sample_schedule_n(&p, n, &params, None).unwrap();
-        if matches!(out.source, Source::Sampled { .. }) {
+        // Overlapping schedules come from the sampler or the staggered candidate.
+        if matches!(out.source, Source::Sampled { .. } | Source::Staggered) {
             sampled += 1;
             let serial = p.serial_schedule_n(n, p.dt_s()).unwrap();
             assert!(out.t_total_s < serial.t_total_s(p.dt_s()));
         }
     }
-    eprintln!("{sampled} of 30 sampled");
-    assert!(sampled >= 15, "only {sampled} of 30 sampled");
+    eprintln!("{sampled} of 30 sampled or staggered");
+    assert!(sampled >= 15, "only {sampled} of 30 sampled or staggered");
 
     // Three robots at once in one LC stretch: validate names it, the coordinator sees it.
     let conf: Vec<bool> = (0..30).map(|n| !(10..20).contains(&n)).collect();

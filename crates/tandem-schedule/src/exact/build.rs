@@ -17,33 +17,49 @@ pub(crate) fn uniform_schedule(
     times: &Times,
     tick_s: f64,
 ) -> Schedule {
-    let mut holds: Vec<Vec<Hold>> = vec![Vec::new(); 2];
-    let warps = [0, 1].map(|r| {
-        let gaps = times.gaps_s(chain, r);
-        let mut warp = problem.grad_mean().to_vec();
-        for (g, &(a, b)) in chain.gap_ref.iter().enumerate() {
-            fill_uniform(problem, &mut warp[a..b], a, gaps[g]);
-            // A gap longer than its slowest speeds allow (only a gap with a hold may be, in a
-            // chain built with holds): the rest is a planned dwell at its hold.
-            if let Some(h) = chain.gap_hold[g] {
-                let filled_s = tandem_realtime::clock_end_s(&warp[a..b], 0.0, problem.dt_s());
-                let dwell_s = gaps[g] - filled_s;
-                if dwell_s > 0.0 {
-                    holds[r].push(Hold {
-                        dwell_s,
-                        ..Hold::at(h)
-                    });
+    let gaps = [0, 1].map(|r| times.gaps_s(chain, r));
+    gap_schedule(problem, chain, &gaps, vec![times.tau_s], tick_s)
+}
+
+/// The schedule of `N = gaps_s.len()` robots whose HC gap `g` of robot `r` lasts `gaps_s[r][g]`
+/// (s), robots 2..N starting at `offsets_s`: the mean gradient on LC samples and one speed
+/// factor per HC run as [`uniform_schedule`]; a gap longer than its slowest speeds allow (only
+/// a gap with a hold may be) gets the rest as a planned dwell at its hold.
+pub(crate) fn gap_schedule(
+    problem: &Problem,
+    chain: &Chain,
+    gaps_s: &[Vec<f64>],
+    offsets_s: Vec<f64>,
+    tick_s: f64,
+) -> Schedule {
+    let mut holds: Vec<Vec<Hold>> = vec![Vec::new(); gaps_s.len()];
+    let warps: Vec<Vec<f64>> = gaps_s
+        .iter()
+        .zip(&mut holds)
+        .map(|(gaps, holds)| {
+            let mut warp = problem.grad_mean().to_vec();
+            for (g, &(a, b)) in chain.gap_ref.iter().enumerate() {
+                fill_uniform(problem, &mut warp[a..b], a, gaps[g]);
+                if let Some(h) = chain.gap_hold[g] {
+                    let filled_s = tandem_realtime::clock_end_s(&warp[a..b], 0.0, problem.dt_s());
+                    let dwell_s = gaps[g] - filled_s;
+                    if dwell_s > 0.0 {
+                        holds.push(Hold {
+                            dwell_s,
+                            ..Hold::at(h)
+                        });
+                    }
                 }
             }
-        }
-        warp
-    });
+            warp
+        })
+        .collect();
     if holds.iter().all(Vec::is_empty) {
         holds.clear();
     }
     Schedule {
-        grad_exec: Vec::from(warps),
-        offsets_s: vec![times.tau_s],
+        grad_exec: warps,
+        offsets_s,
         tick_s,
         holds,
     }

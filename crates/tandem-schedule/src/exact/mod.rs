@@ -54,6 +54,20 @@
 //! the simple one, `max(a_0 + 2·Σ L_k + a_m, fastest execution)` (the operator's LC time, with
 //! the fastest head before and tail after), marked as not proven optimal.
 //!
+//! # N robots
+//! For `N ≥ 3` robots (`many.rs`) the dynamic program's state, one lead, no longer suffices.
+//! A depth-first branch and bound over machine orders places one LC run at a time (the
+//! operator's next), keeping each node's earliest times by incremental longest paths over
+//! the same difference constraints (a positive cycle: the order is infeasible). A node's times
+//! are the least in every variable, so `max(latest end, operator free + LC time left + fastest
+//! tail)` bounds every completion and prunes against the best found. Robots are
+//! interchangeable, so their first LC runs come in robot order; children are tried earliest
+//! start first. Finished within [`MAX_SEARCH_NODES`] nodes, its optimum is the certificate's
+//! bound; otherwise the bound is [`operator_bound_s`]. With hold points the chain's gaps that
+//! contain one are unbounded (capped at `N × fastest`), and the best order, with planned
+//! dwells and release rules, is the scheduler's `Held` candidate for every `N`
+//! (docs/decisions.md, "N robots in the margin-free search").
+//!
 //! # Margin-aware completion
 //! The optimum packs LC runs back to back, which the worst-case margin check
 //! (`tandem_realtime::sufficient_margins`, Alg. 2) rejects: it simulates, from `τ`, the current
@@ -129,6 +143,7 @@
 mod build;
 mod chain;
 mod complete;
+mod many;
 mod pl;
 mod search;
 mod shape;
@@ -219,21 +234,22 @@ pub fn solve_exact(problem: &Problem, params: &ExactParams) -> Result<MarginFree
     params.validate()?;
     Ok(margin_free(
         problem,
-        &bound_chain(problem),
+        &bound_chain(problem, 2),
         params.max_pieces,
     ))
 }
 
-/// The chain the bound is computed on: with the problem's usable hold points an HC run that
-/// contains one has no upper duration bound ([`chain::Chain::with_holds`], capped at the
-/// serial incumbent `2 × fastest`, which no gap of a better schedule exceeds), so `T*₀` is
-/// the optimum with holds; without them [`chain::Chain::new`].
-fn bound_chain(problem: &Problem) -> chain::Chain {
+/// The chain the bound of `n_robots` robots is computed on: with the problem's usable hold
+/// points an HC run that contains one has no upper duration bound
+/// ([`chain::Chain::with_holds`], capped at the serial incumbent `N × fastest`, which no gap
+/// of a better schedule exceeds), so `T*₀` is the optimum with holds; without them
+/// [`chain::Chain::new`].
+fn bound_chain(problem: &Problem, n_robots: usize) -> chain::Chain {
     let plain = chain::Chain::new(problem);
     if problem.usable_holds().is_empty() {
         return plain;
     }
-    chain::Chain::with_holds(problem, 2.0 * plain.fastest_s())
+    chain::Chain::with_holds(problem, n_robots as f64 * plain.fastest_s())
 }
 
 fn margin_free(problem: &Problem, chain: &chain::Chain, max_pieces: usize) -> MarginFree {
@@ -364,7 +380,50 @@ pub fn earliest_schedule(problem: &Problem, order: &[usize]) -> Result<Option<Sc
 
 /// The margin-free bound of `problem` (see [`solve_exact`]).
 pub(crate) fn bound(problem: &Problem, params: &ExactParams) -> MarginFree {
-    margin_free(problem, &bound_chain(problem), params.max_pieces)
+    margin_free(problem, &bound_chain(problem, 2), params.max_pieces)
+}
+
+/// Node budget of the `N`-robot search (see "N robots" in the [module docs](self)): the
+/// fixture problem needs 25–76 nodes for `N = 3…8`; the budget bounds the work on fragmented
+/// confidence (docs/decisions.md, "N robots in the margin-free search").
+pub const MAX_SEARCH_NODES: usize = 200_000;
+
+/// The margin-free bound of `n_robots ≥ 3` robots (see "N robots" in the [module docs](self)):
+/// the branch and bound over machine orders on the chain with the problem's usable holds; when
+/// it finishes within [`MAX_SEARCH_NODES`] nodes the bound is the optimum `T*₀` (with holds,
+/// if any), else the operator-limited bound ([`operator_bound_s`]), never above it. The
+/// schedule is the best order found (with planned dwells at holds), proven or not; `order` its
+/// robots in time order.
+pub(crate) fn bound_n(problem: &Problem, n_robots: usize) -> MarginFree {
+    let chain = bound_chain(problem, n_robots);
+    let plain = operator_bound(problem, n_robots);
+    let (found, proven, nodes) = many::search(&chain, n_robots, f64::INFINITY, MAX_SEARCH_NODES);
+    let stats = SearchStats {
+        states: nodes,
+        ..plain.stats
+    };
+    let Some(f) = found else {
+        return MarginFree { stats, ..plain };
+    };
+    let gaps: Vec<Vec<f64>> = (0..n_robots).map(|r| f.times.gaps_s(&chain, r)).collect();
+    let schedule = build::gap_schedule(
+        problem,
+        &chain,
+        &gaps,
+        f.times.start_s[1..].to_vec(),
+        problem.dt_s(),
+    );
+    MarginFree {
+        lower_bound_s: if proven {
+            f.t_total_s.max(plain.lower_bound_s)
+        } else {
+            plain.lower_bound_s
+        },
+        proven_optimal: proven,
+        schedule: Some(schedule),
+        order: f.order,
+        stats,
+    }
 }
 
 /// The margin-aware completion (see the [module docs](self)) at control tick `tick_s` (s):

@@ -125,6 +125,9 @@ pub enum ScheduleSource {
     Serial,
     /// The exact optimum with hold points and release rules (`Source::Held`): `held`.
     Held,
+    /// `N ≥ 3` robots staggered at the least starts the check accepts
+    /// (`Source::Staggered`): `staggered`.
+    Staggered,
 }
 
 impl ScheduleSource {
@@ -137,6 +140,7 @@ impl ScheduleSource {
             Self::Repaired => "repaired",
             Self::Serial => "serial",
             Self::Held => "held",
+            Self::Staggered => "staggered",
         }
     }
 }
@@ -150,6 +154,7 @@ impl From<Source> for ScheduleSource {
             Source::RepairedPrevious => Self::Repaired,
             Source::Serial => Self::Serial,
             Source::Held => Self::Held,
+            Source::Staggered => Self::Staggered,
         }
     }
 }
