@@ -16,6 +16,9 @@
 //! with robots 2..N placed in turn); the figures and their ratio to N = 2 are in
 //! docs/decisions.md, "N robots in the schedule"
 //! (`cargo bench -p tandem-schedule --bench reschedule_5000 -- robots`).
+//! `reschedule_5000_robots_holds` is the same with the fixture's transitions as hold points
+//! (N ≥ 2: the exact optimum with holds and release rules is a candidate; docs/decisions.md,
+//! "N robots in the margin-free search").
 #![allow(clippy::print_stdout, reason = "a bench reports which problem it used")]
 #![allow(
     missing_docs,
@@ -86,17 +89,25 @@ fn bench(c: &mut Criterion) {
 
 fn bench_robots(c: &mut Criterion) {
     let (problem, label) = fixture::mid_study_problem();
+    robots_group(c, "reschedule_5000_robots", &problem, &label);
+    let (held, label, n) = fixture::mid_study_problem_with_holds();
+    let label = format!("{label} with {n} hold points");
+    robots_group(c, "reschedule_5000_robots_holds", &held, &label);
+}
+
+/// The group `name`: `sample_schedule_n` on `problem` for N = 2, 4, 8.
+fn robots_group(c: &mut Criterion, name: &str, problem: &tandem_schedule::Problem, label: &str) {
     let params = SamplerParams {
         samples: 5000,
         seed: 1,
         ..SamplerParams::default()
     };
-    let mut group = c.benchmark_group("reschedule_5000_robots");
+    let mut group = c.benchmark_group(name);
     group.sample_size(10);
     for n in [2, 4, 8] {
-        let out = sample_schedule_n(&problem, n, &params, None).expect("the fixture is valid");
+        let out = sample_schedule_n(problem, n, &params, None).expect("the fixture is valid");
         println!(
-            "reschedule_5000_robots on {label}: N = {n}, T_total = {:.2} s, lower bound {:.2} s \
+            "{name} on {label}: N = {n}, T_total = {:.2} s, lower bound {:.2} s \
              (gap {:.1} %), serial {:.2} s, source {}",
             out.t_total_s,
             out.lower_bound_s,
@@ -108,7 +119,7 @@ fn bench_robots(c: &mut Criterion) {
             out.source.name(),
         );
         group.bench_with_input(BenchmarkId::from_parameter(n), &n, |bch, &n| {
-            bch.iter(|| sample_schedule_n(&problem, n, &params, None))
+            bch.iter(|| sample_schedule_n(problem, n, &params, None))
         });
     }
     group.finish();

@@ -18,24 +18,15 @@ use std::time::Instant;
 use tandem_schedule::{SamplerParams, sample_schedule_n, validate};
 
 fn main() -> Result<(), tandem_schedule::Error> {
-    let (mut problem, mut label) = fixture::mid_study_problem();
-    if std::env::args().any(|a| a == "--holds") {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../fixtures/sanding/problem.csv"
-        );
-        let text = std::fs::read_to_string(path).expect("the fixture problem is in the repository");
-        let holds: Vec<usize> = text
-            .lines()
-            .skip(1)
-            .filter(|l| !l.trim().is_empty())
-            .enumerate()
-            .filter(|(_, l)| l.trim().ends_with(",transition"))
-            .map(|(n, _)| n)
-            .collect();
-        label = format!("{label}, {} hold points (the transitions)", holds.len());
-        problem = problem.with_holds(holds)?;
-    }
+    let (problem, label) = if std::env::args().any(|a| a == "--holds") {
+        let (problem, label, n) = fixture::mid_study_problem_with_holds();
+        (
+            problem,
+            format!("{label}, {n} hold points (the transitions)"),
+        )
+    } else {
+        fixture::mid_study_problem()
+    };
     println!("# {label}, T_ref = {}", problem.n_ref());
     let params = SamplerParams {
         samples: 5000,

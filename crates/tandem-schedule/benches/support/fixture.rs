@@ -23,6 +23,32 @@ pub(crate) fn mid_study_problem() -> (Problem, String) {
     }
 }
 
+/// [`mid_study_problem`] with every sample of the fixture's transitions between passes (its
+/// `phase` column) a hold point (the tool is off and lifted); the synthetic fallback's
+/// transitions (its high-confidence samples between passes) likewise. Returns the problem,
+/// the label and the number of hold points.
+#[allow(dead_code, reason = "not every bench or example plans with holds")]
+pub(crate) fn mid_study_problem_with_holds() -> (Problem, String, usize) {
+    let (problem, label) = mid_study_problem();
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/sanding/problem.csv");
+    let holds: Vec<usize> = match std::fs::read_to_string(&path) {
+        Ok(text) => text
+            .lines()
+            .skip(1)
+            .filter(|l| !l.trim().is_empty())
+            .enumerate()
+            .filter(|(_, l)| l.trim().ends_with(",transition"))
+            .map(|(n, _)| n)
+            .collect(),
+        Err(_) => (900..1600).chain(2500..3200).chain(4100..4800).collect(),
+    };
+    let n = holds.len();
+    let problem = problem
+        .with_holds(holds)
+        .expect("the transitions are high-confidence samples");
+    (problem, label, n)
+}
+
 fn parse(text: &str) -> Result<Problem, String> {
     let mut lines = text.lines();
     let header = lines.next().ok_or("empty file")?.trim();
