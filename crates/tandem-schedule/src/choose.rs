@@ -194,15 +194,15 @@ pub(crate) fn repair(problem: &Problem, previous: &Schedule, tick_s: f64) -> Opt
 /// why the serial schedule failed.
 fn incumbent(
     problem: &Problem,
-    n_robots: usize,
+    serial: &Schedule,
     previous: Option<&Schedule>,
     tick_s: f64,
-) -> Result<std::result::Result<Candidate, Violation>> {
+) -> std::result::Result<Candidate, Violation> {
     let dt_s = problem.dt_s();
     let mut found: Option<Candidate> = None;
     // A previous schedule of another robot count is no incumbent (the sampler still starts
     // from its robot 1).
-    if let Some(prev) = previous.filter(|p| p.n_robots() == n_robots) {
+    if let Some(prev) = previous.filter(|p| p.n_robots() == serial.n_robots()) {
         // The previous schedule is valid at its own tick; re-check it at this one.
         let prev = Schedule {
             tick_s,
@@ -218,18 +218,15 @@ fn incumbent(
             found = Some((fixed, t, Source::RepairedPrevious));
         }
     }
-    let serial = problem.serial_schedule_n(n_robots, tick_s)?;
     let serial_t = serial.t_total_s(dt_s);
     if found.as_ref().is_none_or(|inc| serial_t < inc.1) {
-        match validate(problem, &serial) {
-            Ok(()) => found = Some((serial, serial_t, Source::Serial)),
-            Err(v) if found.is_none() => return Ok(Err(v)),
+        match validate(problem, serial) {
+            Ok(()) => found = Some((serial.clone(), serial_t, Source::Serial)),
+            Err(v) if found.is_none() => return Err(v),
             Err(_) => {}
         }
     }
-    Ok(Ok(found.expect(
-        "the serial schedule or an earlier incumbent was kept",
-    )))
+    Ok(found.expect("the serial schedule or an earlier incumbent was kept"))
 }
 
 /// The scheduler (see the module docs): the least-`T_total` schedule among the incumbent
@@ -324,7 +321,8 @@ fn schedule_n(
         });
     }
     let tick_s = params.tick_s.unwrap_or(problem.dt_s());
-    let incumbent = match incumbent(problem, n_robots, previous, tick_s)? {
+    let serial = problem.serial_schedule_n(n_robots, tick_s)?;
+    let incumbent = match incumbent(problem, &serial, previous, tick_s) {
         Ok(inc) => inc,
         Err(serial) => return Err(Error::NoFeasibleSchedule { serial }),
     };
@@ -423,11 +421,8 @@ fn schedule_n(
     // schedule), the staggered one: its checks see all robots and cost most at large `N`, so
     // it runs only where the sampler found nothing.
     if n_robots >= 3
-        && best.1
-            >= problem
-                .serial_schedule_n(n_robots, tick_s)?
-                .t_total_s(problem.dt_s())
-        && let Some((schedule, t, used)) = stagger::staggered(problem, n_robots, tick_s)
+        && best.1 >= serial.t_total_s(problem.dt_s())
+        && let Some((schedule, t, used)) = stagger::staggered(problem, &serial)
     {
         checks += used;
         if t < best.1 {

@@ -319,18 +319,19 @@ pub(crate) fn check_robot_count(n_robots: usize) -> Result<()> {
     }
 }
 
+/// Unit-test problem shared by this crate's modules: confidence `conf` (`true` = high), every
+/// demonstrated gradient 1 within `[lo, hi]`, reference period `dt_s` (s).
+#[cfg(test)]
+pub(crate) fn unit_gradients(conf: Vec<bool>, (lo, hi): (f64, f64), dt_s: f64) -> Problem {
+    let n = conf.len();
+    Problem::new(conf, vec![1.0; n], vec![lo; n], vec![hi; n], dt_s).expect("valid by construction")
+}
+
 /// Unit-test problem shared by this crate's modules: `[HC, LC, LC, HC]`, gradients 1 within
 /// `[0.5, 2]`, reference period `dt_s`.
 #[cfg(test)]
 pub(crate) fn hllh(dt_s: f64) -> Problem {
-    Problem::new(
-        vec![true, false, false, true],
-        vec![1.0; 4],
-        vec![0.5; 4],
-        vec![2.0; 4],
-        dt_s,
-    )
-    .expect("valid by construction")
+    unit_gradients(vec![true, false, false, true], (0.5, 2.0), dt_s)
 }
 
 #[cfg(test)]

@@ -37,18 +37,15 @@ const MAX_BASES: usize = 64;
 /// "too close behind one robot" and "too close ahead of another" can be), up to `2¹⁶` ticks.
 const LADDER_STEPS: usize = 64;
 
-/// The staggered schedule of `n_robots ≥ 2` on `problem` at tick `tick_s` (s), if it passes
-/// [`crate::validate`] and some robot overlaps the one before it (else it is the serial
-/// schedule, which the scheduler has already), with its `T_total` (s) and the checks used.
-/// `None` also for a problem without low-confidence samples (every robot at 0 is then the
-/// optimum, which the sampler finds).
-pub(crate) fn staggered(
-    problem: &Problem,
-    n_robots: usize,
-    tick_s: f64,
-) -> Option<(Schedule, f64, usize)> {
+/// The staggered schedule of the `N ≥ 2` robots of `serial` (the fastest serial schedule,
+/// [`Problem::serial_schedule_n`], at its tick) on `problem`, if it passes [`crate::validate`]
+/// and some robot overlaps the one before it (else it is the serial schedule, which the
+/// scheduler has already), with its `T_total` (s) and the checks used. `None` also for a
+/// problem without low-confidence samples (every robot at 0 is then the optimum, which the
+/// sampler finds).
+pub(crate) fn staggered(problem: &Problem, serial: &Schedule) -> Option<(Schedule, f64, usize)> {
     let dt_s = problem.dt_s();
-    let serial = problem.serial_schedule_n(n_robots, tick_s).ok()?;
+    let (n_robots, tick_s) = (serial.n_robots(), serial.tick_s);
     let warp = serial.grad_exec[0].clone();
     let one = Schedule {
         grad_exec: vec![warp.clone()],
@@ -75,15 +72,27 @@ pub(crate) fn staggered(
     let mut latest_end_s = duration_s;
     let mut checks = 0;
     let mut overlapped = false;
-    let passes = |offsets: &[f64], checks: &mut usize| {
+    // One schedule of every robot on the fastest warp, checked with its first
+    // `offsets.len() + 1` robots: the warps are cloned once, not per check.
+    let mut checked = Schedule {
+        grad_exec: vec![warp.clone(); n_robots],
+        offsets_s: Vec::with_capacity(n_robots - 1),
+        tick_s,
+        holds: Vec::new(),
+    };
+    let mut spare: Vec<Vec<f64>> = Vec::with_capacity(n_robots);
+    let mut passes = |offsets: &[f64], checks: &mut usize| {
         *checks += 1;
-        let s = Schedule {
-            grad_exec: vec![warp.clone(); offsets.len() + 1],
-            offsets_s: offsets.to_vec(),
-            tick_s,
-            holds: Vec::new(),
-        };
-        validate(problem, &s).is_ok()
+        let k = offsets.len() + 1;
+        while checked.grad_exec.len() > k {
+            spare.extend(checked.grad_exec.pop());
+        }
+        while checked.grad_exec.len() < k {
+            checked.grad_exec.extend(spare.pop());
+        }
+        checked.offsets_s.clear();
+        checked.offsets_s.extend_from_slice(offsets);
+        validate(problem, &checked).is_ok()
     };
     // Equal spacing `τ_i = i·s`, the least `s` on a grid of `duration/SPACING_STEPS` that
     // passes, bisected down to a tick: a joint placement, for when the greedy one leaves a

@@ -163,8 +163,7 @@ mod tests {
         }
         let n = conf.len();
         let holds: Vec<usize> = (0..n).filter(|_| rng.random_bool(hold_p)).collect();
-        Problem::new(conf, vec![1.0; n], vec![0.5; n], vec![2.0; n], 0.1)
-            .unwrap()
+        crate::problem::unit_gradients(conf, (0.5, 2.0), 0.1)
             .with_holds(holds)
             .unwrap()
     }

@@ -110,15 +110,11 @@ mod tests {
 
     #[test]
     fn missing_head_and_tail_are_empty_gaps() {
-        let p = Problem::new(
+        let c = Chain::new(&crate::problem::unit_gradients(
             vec![false, true, false],
-            vec![1.0; 3],
-            vec![0.5; 3],
-            vec![2.0; 3],
+            (0.5, 2.0),
             1.0,
-        )
-        .unwrap();
-        let c = Chain::new(&p);
+        ));
         assert_eq!(c.lc_s, vec![1.0, 1.0]);
         assert_eq!(c.gap_s, vec![(0.0, 0.0), (0.5, 2.0), (0.0, 0.0)]);
         assert_eq!(c.gap_ref, vec![(0, 0), (1, 2), (3, 3)]);

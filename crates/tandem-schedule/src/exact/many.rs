@@ -328,14 +328,22 @@ fn relabel(net: &Net, order: &[usize], x: &[f64], proven: bool, nodes: usize) ->
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::problem::Problem;
+    use crate::problem::{Problem, unit_gradients};
 
     /// [LC, HC, LC] with gradients 1 in [0.5, 2] at 10 samples of 10 ms each: LC runs of 0.1 s,
     /// an HC gap of [0.05, 0.2] s, no head or tail.
     fn lhl() -> Chain {
         let conf: Vec<bool> = (0..30).map(|n| (10..20).contains(&n)).collect();
-        let p = Problem::new(conf, vec![1.0; 30], vec![0.5; 30], vec![2.0; 30], 0.01).unwrap();
-        Chain::new(&p)
+        Chain::new(&unit_gradients(conf, (0.5, 2.0), 0.01))
+    }
+
+    /// The search's optimum of [`lhl`] for `n` robots: proven, `expected` (s), and feasible.
+    fn by_hand(n: usize, expected: f64) {
+        let (found, proven, _) = search(&lhl(), n, f64::INFINITY, 1_000_000);
+        let f = found.unwrap();
+        assert!(proven);
+        assert!((f.t_total_s - expected).abs() < 1e-12, "{}", f.t_total_s);
+        check(&lhl(), &f);
     }
 
     #[test]
@@ -343,11 +351,7 @@ mod tests {
         // Six LC runs of 0.1 s on one operator: at least 0.6 s. Robot A's gap must last
         // [0.05, 0.2] s, so its second run is at most 0.2 s after its first ends: with three
         // robots, A B C A B C back to back has A's gap 0.2 s, exactly its longest. 0.6 s.
-        let (found, proven, _) = search(&lhl(), 3, f64::INFINITY, 100_000);
-        let f = found.unwrap();
-        assert!(proven);
-        assert!((f.t_total_s - 0.6).abs() < 1e-12, "{}", f.t_total_s);
-        check(&lhl(), &f);
+        by_hand(3, 0.6);
     }
 
     /// The times satisfy the chain and one operator: robot 0 starts at 0, the others at
@@ -381,11 +385,7 @@ mod tests {
         // Four robots: A's gap would have to cover three runs, 0.3 s > 0.2 s. The best keeps
         // every gap ≤ 0.2 s. By hand: pairs (A B)(C D) each as for two robots: A B A B takes
         // 0.4 s with A's gap 0.1 s; C D C D back to back after it: 0.8 s, operator never idle.
-        let (found, proven, _) = search(&lhl(), 4, f64::INFINITY, 1_000_000);
-        let f = found.unwrap();
-        assert!(proven);
-        assert!((f.t_total_s - 0.8).abs() < 1e-12, "{}", f.t_total_s);
-        check(&lhl(), &f);
+        by_hand(4, 0.8);
     }
 
     #[test]
@@ -525,18 +525,10 @@ mod tests {
         // [0.07, 0.08] [0.10, 0.11], B ends at 0.12 s. No order does better (B cannot start
         // before A's first run ends, 0.03 − 0.01). The dynamic program returns 0.18 s here
         // (every run touching the next, rounding on zero-width windows); kept as found.
-        let p = Problem::new(
-            [
-                true, false, false, true, true, false, true, true, false, true,
-            ]
-            .into_iter()
-            .collect(),
-            vec![1.0; 10],
-            vec![1.0; 10],
-            vec![1.0; 10],
-            0.01,
-        )
-        .unwrap();
+        let conf = [
+            true, false, false, true, true, false, true, true, false, true,
+        ];
+        let p = unit_gradients(conf.to_vec(), (1.0, 1.0), 0.01);
         let chain = Chain::new(&p);
         assert_eq!(chain.lc_s.len(), 3);
         let (found, proven, _) = search(&chain, 2, f64::INFINITY, 1_000_000);

@@ -159,7 +159,7 @@ mod tests {
     /// 1 s, HC 1–4 s, LC 1 s.
     fn three_runs() -> Problem {
         let conf: Vec<bool> = (0..40).map(|n| (10..30).contains(&n)).collect();
-        Problem::new(conf, vec![1.0; 40], vec![0.5; 40], vec![2.0; 40], 0.1).unwrap()
+        crate::problem::unit_gradients(conf, (0.5, 2.0), 0.1)
     }
 
     #[test]
