@@ -241,3 +241,54 @@ fn plans_accepted_with_holds_never_overlap_and_need_their_rules() {
         );
     }
 }
+
+#[test]
+fn a_fault_with_holds_stops_the_later_robot_where_it_is_until_cleared() {
+    // The six-sample case of the test above with robot 2 at τ = 0.5 and holds at 3 but no
+    // release rules (run unchecked): robot 1's LC sample [1, 2) and robot 2's [1.5, 2.5)
+    // overlap in the scheduled run. The monitor latches a fault and holds robot 2 (its LC run
+    // began last) where it is, on its first leg, while robot 1 goes on through its hold and
+    // finishes; cleared, robot 2 finishes too.
+    let conf = [true, false, true, true, false, true];
+    let (g, lo, hi) = ([1.0; 6], [0.5; 6], [2.0; 6]);
+    let robots = vec![
+        Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap(),
+        Timeline::new(&conf, &g, &lo, &hi, 0.5, 1.0).unwrap(),
+    ];
+    let holds = vec![vec![Hold::at(3)], vec![Hold::at(3)]];
+    let mut c = Coordinator::with_holds_unchecked(robots, &holds, 0.25).unwrap();
+    let fault = loop {
+        let t = c.tick(Operator::Scheduled).unwrap();
+        if let Some(f) = t.fault {
+            assert!(t.overlap());
+            break f;
+        }
+        assert!(!c.is_finished(), "the plans overlap, so a fault must come");
+    };
+    assert_eq!(fault.stopped, 1);
+    let clock = c.clock_s()[1];
+    let mut ticks = 0;
+    let mut ref_time = None;
+    loop {
+        let t = c.tick(Operator::Slowest).unwrap();
+        // The fault stays latched and robot 2 does not move, run, or turn low-confidence.
+        assert_eq!(t.fault, Some(fault));
+        assert_eq!(c.clock_s()[1], clock);
+        assert_eq!(*ref_time.get_or_insert(t.ref_time[1]), t.ref_time[1]);
+        assert!(t.ref_time[1] < 3.0, "held on its first leg: {t:?}");
+        assert!(!t.running[1] && !t.low_conf[1]);
+        ticks += 1;
+        assert!(ticks < 1000, "robot 1 must finish while robot 2 is held");
+        if t.ref_time[0] >= 6.0 {
+            break;
+        }
+    }
+    assert!(!c.is_finished());
+    c.clear_fault();
+    while !c.is_finished() {
+        let t = c.tick(Operator::Slowest).unwrap();
+        assert!(t.fault.is_none() && !t.overlap(), "{t:?}");
+        ticks += 1;
+        assert!(ticks < 2000);
+    }
+}
