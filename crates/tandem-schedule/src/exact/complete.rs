@@ -9,7 +9,7 @@ use tandem_realtime::pair_slacks;
 
 use super::chain::Chain;
 use super::search::{self, Clearance, Robot};
-use super::shape::{Shaping, shaped_schedule};
+use super::shape::shaped_schedule;
 use super::stn;
 use crate::problem::Problem;
 use crate::schedule::Schedule;
@@ -21,7 +21,7 @@ pub(crate) struct Completed {
     pub(crate) t_total_s: f64,
 }
 
-/// Tilts of the HC body shaping tried from a cold start ([`Shaping::tilt`]): one factor per
+/// Tilts of the HC body shaping tried from a cold start (`shape::shaped_schedule`): one factor per
 /// run, and two steps towards "slow first, fast last".
 const FIRST_TILTS: [f64; 3] = [0.0, 0.25, 0.5];
 
@@ -198,10 +198,7 @@ impl<'a> Completion<'a> {
     /// move each pair's clearance towards a slack of a tenth of `M` ([`PairState::update`]);
     /// keep the best schedule whose pairs all pass. Stops when no clearance moves.
     fn iterate(&self, trial: &mut Trial, cap_s: f64, until: usize) {
-        let shaping = Shaping {
-            edge_s: 2.0 * self.max_step_s,
-            tilt: trial.tilt,
-        };
+        let tilt = trial.tilt;
         let target = 0.1 * self.max_step_s;
         let Trial {
             clear,
@@ -229,7 +226,7 @@ impl<'a> Completion<'a> {
             else {
                 break;
             };
-            let schedule = shaped_schedule(self.problem, self.chain, &times, &shaping, self.tick_s);
+            let schedule = shaped_schedule(self.problem, self.chain, &times, tilt, self.tick_s);
             *checks += 1;
             let Some(slacks) = schedule
                 .timelines(self.problem)

@@ -93,16 +93,15 @@
 //!    run from one untried switch to the next. The best schedule whose pairs all pass is kept.
 //! 2. **Speed shaping within HC runs** (`shape.rs`). A run's duration is fixed by the times;
 //!    how it is spread over the run's samples decides how much lead the worst case builds.
-//!    Next to the robot's own LC runs the check's windows decide: over the last `2M` of clock
-//!    before its LC run the robot runs at `ψ̇min` (`F = 1`: as `c` it has no rush room beyond its
-//!    LC run's own), over the first `2M` after one it runs no faster than the run left it (as
-//!    `p` it drags at the smallest `S` in its window, which stays the LC run's). In between,
-//!    one speed factor per sample `u_i = u₀ + θ·(1 − 2i/(N − 1))` (clamped to `[0, 1]`, between
+//!    One speed factor per sample `u_i = u₀ + θ·(1 − 2i/(N − 1))` (clamped to `[0, 1]`, between
 //!    `ψ̇min` and `ψ̇max`) with `u₀` set by the duration: at tilt `θ = 0` one factor for the
 //!    whole run; at `θ > 0` slow first, fast last — slow early helps the robot, as `p`, follow
 //!    the other robot rushing through the LC run this HC run spans, fast late gives it, as `c`,
 //!    room to slow down while the other drags out of it. The tilt trades the two roles'
-//!    leads and the best one is problem-dependent.
+//!    leads and the best one is problem-dependent. (Edges of fixed speed next to the robot's
+//!    own LC runs, `ψ̇min` before and slow after, are gone: they left the responding robot
+//!    less room in the run's body, and late in the study no clearance passed; docs/decisions.md,
+//!    "The margin-aware completion".)
 //! 3. **Starts.** Iterations start cold (every clearance at `M`) at the tilts `θ ∈ {0, ¼, ½}`,
 //!    and warm from a schedule that already passes — the previous schedule, and the sampler's
 //!    winner once it is known — at its own clearances, no other pair allowed, so the search
