@@ -259,3 +259,57 @@ fn the_operator_bound_is_below_every_margin_free_schedule() {
     }
     assert!(feasible_seen > 1000, "{feasible_seen}");
 }
+
+/// Issue "hold points", item 4: three robots overlap wherever a plain grid search over the two
+/// start offsets (every robot on its fastest warp, `τ_2, τ_3` on a grid of a twelfth of one
+/// execution) finds a schedule that passes `validate` and beats the serial one; the scheduler
+/// then returns a schedule shorter than serial too (sampled, staggered or otherwise).
+#[test]
+fn three_robots_overlap_wherever_a_grid_search_finds_an_overlap() {
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    let strategy = random_problem();
+    let (mut grid_found, mut checked) = (0, 0);
+    for seed in 0..60 {
+        let p = strategy.new_tree(&mut runner).unwrap().current();
+        let serial = p.serial_schedule_n(3, p.dt_s()).unwrap();
+        let serial_t = serial.t_total_s(p.dt_s());
+        let one = serial.grad_exec[0]
+            .iter()
+            .map(|g| g * p.dt_s())
+            .sum::<f64>();
+        const G: usize = 12;
+        let mut best_grid = f64::INFINITY;
+        for i in 0..=2 * G {
+            for j in 0..=2 * G {
+                let mut s = serial.clone();
+                s.offsets_s = vec![i as f64 * one / G as f64, j as f64 * one / G as f64];
+                if validate(&p, &s).is_ok() {
+                    best_grid = best_grid.min(s.t_total_s(p.dt_s()));
+                }
+            }
+        }
+        checked += 1;
+        if best_grid >= serial_t * (1.0 - 1e-9) {
+            continue;
+        }
+        grid_found += 1;
+        let params = SamplerParams {
+            samples: 100,
+            seed,
+            ..SamplerParams::default()
+        };
+        let out = sample_schedule_n(&p, 3, &params, None).unwrap();
+        assert!(
+            out.t_total_s < serial_t * (1.0 - 1e-9),
+            "problem {seed}: the grid overlaps at {best_grid} s, the scheduler returns serial \
+             {} s ({:?})",
+            out.t_total_s,
+            out.source
+        );
+    }
+    eprintln!("{grid_found} of {checked} problems overlap on the grid");
+    assert!(
+        grid_found >= 20,
+        "only {grid_found} of {checked} overlap on the grid"
+    );
+}
