@@ -79,6 +79,17 @@ fn a_start_rule_makes_the_three_sample_case_safe_and_dropping_it_overlaps() {
     assert!(find_overlap(&robots, 1.0, &set, &mut r).is_some());
 }
 
+/// Six samples of 1 s, LC at 1 and 4 (samples 2 and 3 HC, where a hold fits), gradients 1,
+/// bounds [½, 2]; robot 2 at `tau`.
+fn six_sample(tau: f64) -> Vec<Timeline> {
+    let conf = [true, false, true, true, false, true];
+    let (g, lo, hi) = ([1.0; 6], [0.5; 6], [2.0; 6]);
+    vec![
+        Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap(),
+        Timeline::new(&conf, &g, &lo, &hi, tau, 1.0).unwrap(),
+    ]
+}
+
 #[test]
 fn held_robots_wait_at_their_holds_until_the_rules_hold_then_leave_as_a_start() {
     // Six samples of 1 s, LC at 1 and 4, a hold at 3 (samples 2 and 3 HC); robot 2 at τ = 2.
@@ -86,12 +97,7 @@ fn held_robots_wait_at_their_holds_until_the_rules_hold_then_leave_as_a_start() 
     // [6, 7). The derived rules: robot 2 starts once robot 1 has passed sample 2; robot 1
     // leaves its hold at 3 once robot 2 has passed sample 2; robot 2 leaves its hold once
     // robot 1 has passed sample 5.
-    let conf = [true, false, true, true, false, true];
-    let (g, lo, hi) = ([1.0; 6], [0.5; 6], [2.0; 6]);
-    let robots = vec![
-        Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap(),
-        Timeline::new(&conf, &g, &lo, &hi, 2.0, 1.0).unwrap(),
-    ];
+    let robots = six_sample(2.0);
     let holds = release_rules(&robots, &[], &[vec![3], vec![3]]);
     let rule = |robot, ref_idx| After { robot, ref_idx };
     assert_eq!(
@@ -249,12 +255,7 @@ fn a_fault_with_holds_stops_the_later_robot_where_it_is_until_cleared() {
     // overlap in the scheduled run. The monitor latches a fault and holds robot 2 (its LC run
     // began last) where it is, on its first leg, while robot 1 goes on through its hold and
     // finishes; cleared, robot 2 finishes too.
-    let conf = [true, false, true, true, false, true];
-    let (g, lo, hi) = ([1.0; 6], [0.5; 6], [2.0; 6]);
-    let robots = vec![
-        Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap(),
-        Timeline::new(&conf, &g, &lo, &hi, 0.5, 1.0).unwrap(),
-    ];
+    let robots = six_sample(0.5);
     let holds = vec![vec![Hold::at(3)], vec![Hold::at(3)]];
     let mut c = Coordinator::with_holds_unchecked(robots, &holds, 0.25).unwrap();
     let fault = loop {

@@ -30,13 +30,13 @@ pub(crate) fn shaped_schedule(
         let mut warp = problem.grad_mean().to_vec();
         for (g, &(a, b)) in chain.gap_ref.iter().enumerate() {
             if b > a {
-                let run = Body {
+                let body = Body {
                     problem,
                     start: a,
                     end: b,
                     tilt,
                 };
-                run.fill_run(&mut warp[a..b], gaps[g]);
+                body.fill_run(&mut warp[a..b], gaps[g]);
             }
         }
         warp
