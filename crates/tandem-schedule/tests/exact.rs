@@ -336,10 +336,35 @@ fn fixture_problem_bound_matches_all_orders_and_the_certificate_passes() {
     check_certificate(&p, &out);
     assert!(out.bound_is_optimum);
     assert_eq!(out.source, Source::Completed);
-    // The target is 0.6 % on the problem first measured (the fixture before its
-    // regeneration: 0.45 % now); on the regenerated fixture, with wider gradient bounds, the
-    // margins cost more (0.72 %, docs/decisions.md). 1 % catches a completion that falls apart.
-    assert!(out.gap < 0.01, "{label}: gap {}", out.gap);
+    // The worst-case margins' cost depends on the demonstrated speed range, which the warp
+    // and fit decide (on the fixture since tandem-warp's band-edge fix: 3.96 %, pass 1's
+    // fastest samples, docs/decisions.md "The margin-aware completion"); the completion's own
+    // target is checked on the pinned problem below.
+    let serial = p.serial_schedule(0.01).unwrap().t_total_s(0.01);
+    assert!(
+        out.t_total_s < serial,
+        "{label}: {} ≥ serial {serial}",
+        out.t_total_s
+    );
+}
+
+#[test]
+fn pinned_mid_study_problem_is_completed_within_one_percent_of_its_bound() {
+    // The fixture problem as the fit made it on 2026-12-01, before tandem-warp's band-edge fix,
+    // pinned so that the completion's target does not move with the warp. The target is 0.6 %
+    // on the problem first measured (the fixture before an earlier regeneration: 0.45 % now);
+    // on this one, with wider gradient bounds, the margins cost more (0.72 %). 1 % catches a
+    // completion that falls apart.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/mid_study_problem_2026-12-01.csv");
+    let p = fixture::mid_study_problem_at(&path);
+    let free = solve_exact(&p, &ExactParams::default()).unwrap();
+    assert!(free.proven_optimal);
+    let out = complete(&p, ExactParams::default());
+    check_certificate(&p, &out);
+    assert!(out.bound_is_optimum);
+    assert_eq!(out.source, Source::Completed);
+    assert!(out.gap < 0.01, "gap {}", out.gap);
 }
 
 #[test]

@@ -49,6 +49,14 @@ pub(crate) fn mid_study_problem_with_holds() -> (Problem, String, usize) {
     (problem, label, n)
 }
 
+/// The problem in the fixture format at `path` with the mid-study confidence pattern of
+/// [`mid_study_problem`] (panics naming the file on a read or parse error: test data).
+#[allow(dead_code, reason = "only the tests pin a problem file")]
+pub(crate) fn mid_study_problem_at(path: &std::path::Path) -> Problem {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    parse(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 fn parse(text: &str) -> Result<Problem, String> {
     let mut lines = text.lines();
     let header = lines.next().ok_or("empty file")?.trim();
