@@ -37,8 +37,8 @@ mod solver;
 mod warp;
 
 pub use error::{Error, Result};
-pub use objective::objective_of;
-pub use params::{DEFAULT_NODE_SPACING, WarpParams};
+pub use objective::{effective_lambda_inst, objective_of};
+pub use params::{DEFAULT_NODE_SPACING, NOISE_PENALTY, WarpParams};
 pub use signal::{MAX_ABS_VALUE, SignalRef};
 pub use solver::{
     COARSE_POINTS_PER_SEGMENT, COARSE_SLOPE_STEP, POLISH_RADIUS, POLISH_STEPS,

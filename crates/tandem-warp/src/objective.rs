@@ -1,6 +1,6 @@
 //! The discretized GDTW objective and its direct evaluation.
 
-use crate::params::WarpParams;
+use crate::params::{NOISE_PENALTY, WarpParams};
 use crate::signal::SignalRef;
 use crate::warp::check_values;
 use crate::{Error, Result};
@@ -27,7 +27,7 @@ pub(crate) struct Prepared<'a> {
     pub(crate) h: f64,
     /// Query samples per unit of normalized query time, `T_query − 1`.
     pub(crate) qscale: f64,
-    /// `λ_inst`.
+    /// `λ_inst` in effect: `params.lambda_inst + NOISE_PENALTY · ν̂` ([`noise_floor`]).
     pub(crate) lambda_inst: f64,
     /// `λ_cum`.
     pub(crate) lambda_cum: f64,
@@ -77,6 +77,7 @@ impl<'a> Prepared<'a> {
             .map(|d| d.iter().zip(&w).map(|(d, w)| w * d * d).sum())
             .collect();
         let (h, qscale) = (1.0 / (nr - 1) as f64, (nq - 1) as f64);
+        let lambda_inst = params.lambda_inst + NOISE_PENALTY * noise_floor(r, q, nc, &w);
         Ok(Self {
             r,
             q,
@@ -88,7 +89,7 @@ impl<'a> Prepared<'a> {
             nq,
             h,
             qscale,
-            lambda_inst: params.lambda_inst,
+            lambda_inst,
             lambda_cum: params.lambda_cum,
         })
     }
@@ -159,6 +160,57 @@ impl<'a> Prepared<'a> {
         }
         total
     }
+}
+
+/// `ν̂ = Σ_c W_c (σ̂²_{1,c} + σ̂²_{2,c})`, the estimated noise floor of the loss: the expected
+/// `ℓ` of two perfectly aligned signals whose channels carry independent white noise of
+/// standard deviations `σ_{1,c}` (reference) and `σ_{2,c}` (query). Per signal and channel,
+/// `σ̂` is the median absolute second difference `|x[t+1] − 2 x[t] + x[t−1]|` divided by
+/// `0.6745 √6`: white noise's second differences have standard deviation `√6 σ` and, being
+/// Gaussian, median absolute value `0.6745` times that; smooth motion adds only its second
+/// derivative times the squared sample period, and steps (a gripper) or spikes are too rare to
+/// move the median. Signals of fewer than 4 samples count as noise-free.
+fn noise_floor(r: &[f64], q: &[f64], nc: usize, w: &[f64]) -> f64 {
+    let mut d: Vec<f64> = Vec::new();
+    let mut total = 0.0;
+    for x in [r, q] {
+        let n = x.len() / nc;
+        if n < 4 {
+            continue;
+        }
+        for (c, &wc) in w.iter().enumerate() {
+            if wc == 0.0 {
+                continue;
+            }
+            d.clear();
+            d.extend(
+                (1..n - 1).map(|t| {
+                    (x[(t + 1) * nc + c] - 2.0 * x[t * nc + c] + x[(t - 1) * nc + c]).abs()
+                }),
+            );
+            let mid = d.len() / 2;
+            let (_, median, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
+            let sigma = *median / (0.6745 * 6f64.sqrt());
+            total += wc * sigma * sigma;
+        }
+    }
+    total
+}
+
+/// The `λ_inst` an alignment of `query` to `reference` uses: `params.lambda_inst +
+/// NOISE_PENALTY · ν̂` ([`crate::NOISE_PENALTY`]), with `ν̂` the estimated noise floor of the loss (the expected `ℓ`
+/// of the two signals perfectly aligned: `Σ_c W_c (σ̂²_{ref,c} + σ̂²_{query,c})`, each `σ̂` from
+/// the median absolute second difference of that signal's channel, `/ (0.6745 √6)`).
+/// [`crate::align`] and [`objective_of`] both use it in place of `λ_inst`.
+///
+/// # Errors
+/// Signal and parameter errors as for [`crate::align`].
+pub fn effective_lambda_inst(
+    reference: SignalRef<'_>,
+    query: SignalRef<'_>,
+    params: &WarpParams,
+) -> Result<f64> {
+    Ok(Prepared::new(reference, query, params, "query")?.lambda_inst)
 }
 
 /// Evaluates the GDTW objective `J(ψ)` of a warp given at every reference sample.

@@ -41,25 +41,84 @@ pub const POLISH_RADIUS: usize = 1;
 /// Largest candidate count of one node (back pointers are `u16`).
 pub(crate) const MAX_CANDIDATES: usize = 65535;
 
-/// Candidate grid of one pass: node `i` sits at reference sample `nodes[i]` and has candidates
-/// `lo[i] + j * step[i]` (query samples), `j < count[i]`; `center[i]` is the candidate equal to
-/// the previous pass's solution (0 in the first pass).
+/// Candidate grid of one pass: node `i` sits at reference sample `nodes[i]` and has `count[i]`
+/// candidates `lo[i] + j * step[i]` (query samples), except that the outermost ones may be
+/// moved inwards onto the edges of the feasible band: candidate 0 is `bottom[i]` and candidate
+/// `count[i] − 1` is `top[i]` (see [`snap_to_band`]). `center[i]` is the candidate equal to
+/// the previous pass's solution (the identity's in the first pass).
 struct Grid {
     nodes: Vec<usize>,
     lo: Vec<f64>,
     step: Vec<f64>,
     count: Vec<usize>,
     center: Vec<usize>,
+    bottom: Vec<f64>,
+    top: Vec<f64>,
 }
 
 impl Grid {
+    /// A grid of `n` nodes with one candidate each (filled in by the grid builders).
+    fn with_nodes(nodes: Vec<usize>, lo: Vec<f64>) -> Self {
+        let n = nodes.len();
+        Self {
+            bottom: lo.clone(),
+            top: lo.clone(),
+            lo,
+            step: vec![0.0; n],
+            count: vec![1; n],
+            center: vec![0; n],
+            nodes,
+        }
+    }
+
     #[inline]
     fn cand(&self, i: usize, j: usize) -> f64 {
-        let jf = j as f64;
-        self.lo[i] + jf * self.step[i]
+        if j == 0 {
+            self.bottom[i]
+        } else if j + 1 == self.count[i] {
+            self.top[i]
+        } else {
+            let jf = j as f64;
+            self.lo[i] + jf * self.step[i]
+        }
     }
     fn hi(&self, i: usize) -> f64 {
-        self.cand(i, self.count[i] - 1)
+        self.top[i]
+    }
+}
+
+/// Makes the edges of the feasible band `[l, u]` candidates of node `i` where its candidate
+/// range ends less than one spacing inside them: the outermost candidate on that side is moved
+/// onto the edge if it is within a millionth of a spacing of it, and otherwise one candidate is
+/// added there (closer to its neighbour than the spacing); the centre candidate never moves.
+/// Without this, a path along an edge (slope `s_max` from `(0, 0)`, or `s_min` into `(1, 1)`) is
+/// not on the grid, and the grid's nearest path at the bounding slope loses up to one spacing at
+/// every node, which adds up along the edge: rounding in the band's bounds then excludes valid
+/// paths, as it did in the initial bounds `l₀`, `u₀` of an independent GDTW implementation.
+fn snap_to_band(g: &mut Grid, i: usize, (l, u): (f64, f64)) {
+    let step = g.step[i];
+    g.bottom[i] = g.lo[i];
+    g.top[i] = g.lo[i] + (g.count[i] - 1) as f64 * step;
+    if step <= 0.0 {
+        return;
+    }
+    let tiny = 1e-6 * step;
+    let gap = g.bottom[i] - l;
+    if gap.abs() <= tiny && g.center[i] > 0 {
+        g.bottom[i] = l;
+    } else if gap > tiny && gap < step && g.count[i] < MAX_CANDIDATES {
+        g.lo[i] -= step;
+        g.count[i] += 1;
+        g.center[i] += 1;
+        g.bottom[i] = l;
+    }
+    let last = g.count[i] - 1;
+    let gap = u - (g.lo[i] + last as f64 * step);
+    if gap.abs() <= tiny && last != g.center[i] {
+        g.top[i] = u;
+    } else if gap > tiny && gap < step && g.count[i] < MAX_CANDIDATES {
+        g.count[i] += 1;
+        g.top[i] = u;
     }
 }
 
@@ -97,17 +156,13 @@ fn first_grid(
     s: (f64, f64),
 ) -> Grid {
     let n = nodes.len();
-    let mut g = Grid {
-        lo: vec![0.0; n],
-        step: vec![0.0; n],
-        count: vec![1; n],
-        center: vec![0; n],
-        nodes,
-    };
+    let mut g = Grid::with_nodes(nodes, vec![0.0; n]);
     for i in 0..n {
         let (l, u) = band(prep, s.0, s.1, g.nodes[i]);
         let c = (g.nodes[i] as f64 * prep.h * prep.qscale).clamp(l, u);
         g.lo[i] = c;
+        g.bottom[i] = c;
+        g.top[i] = c;
         if u - l > 1e-9 {
             // at most MAX_CANDIDATES candidates: back pointers are u16
             let step = ((u - l) / (m - 1) as f64)
@@ -120,6 +175,7 @@ fn first_grid(
             g.step[i] = step;
             g.count[i] = down + up + 1;
             g.center[i] = down;
+            snap_to_band(&mut g, i, (l, u));
         }
     }
     g
@@ -161,13 +217,7 @@ fn tube_grid(
     s: (f64, f64),
 ) -> Grid {
     let n = nodes.len();
-    let mut g = Grid {
-        lo: centers.to_vec(),
-        step: vec![0.0; n],
-        count: vec![1; n],
-        center: vec![0; n],
-        nodes,
-    };
+    let mut g = Grid::with_nodes(nodes, centers.to_vec());
     for i in 0..n {
         let (l, u) = band(prep, s.0, s.1, g.nodes[i]);
         let st = step[i];
@@ -181,6 +231,7 @@ fn tube_grid(
         g.step[i] = st;
         g.count[i] = d + steps(u - c).min(up) + 1;
         g.center[i] = d;
+        snap_to_band(&mut g, i, (l, u));
     }
     g
 }
@@ -327,12 +378,22 @@ fn solve_pass(
             let (mut k_lo, mut k_hi) = if cb == 1 || step_b <= 0.0 {
                 (0usize, 0usize)
             } else {
+                // exact for the inner candidates; the outermost ones may sit up to one spacing
+                // inside their uniform positions (snapped to the band), so each is also tried
+                // when its neighbour is the first one out of range, and the slope check below
+                // decides
                 let lo = ((p + dmin - tol - lo_b) / step_b).ceil();
                 let hi = ((p + dmax + tol - lo_b) / step_b).floor();
                 if hi < 0.0 || lo > (cb - 1) as f64 {
                     continue;
                 }
-                (lo.max(0.0) as usize, (hi as usize).min(cb - 1))
+                let k_lo = if lo == 1.0 { 0 } else { lo.max(0.0) as usize };
+                let k_hi = if hi == (cb - 2) as f64 {
+                    cb - 1
+                } else {
+                    (hi as usize).min(cb - 1)
+                };
+                (k_lo, k_hi)
             };
             if let Some(kj) = max_jump {
                 // relative offsets from the previous solution: (k − center_b) vs (j − center_a)

@@ -224,7 +224,12 @@ fn reported_objective_equals_direct_evaluation() {
             SignalRef::new(&q, 3).unwrap(),
         );
         let w = align(rs, qs, &params).unwrap();
-        let direct = direct_objective(&r, &q, 3, w.values(), &params);
+        // the documented objective at the slope penalty in effect (noise-dependent)
+        let in_effect = WarpParams {
+            lambda_inst: tandem_warp::effective_lambda_inst(rs, qs, &params).unwrap(),
+            ..params.clone()
+        };
+        let direct = direct_objective(&r, &q, 3, w.values(), &in_effect);
         assert!(
             (w.objective() - direct).abs() <= 1e-9 * direct,
             "{} vs {direct}",
@@ -234,7 +239,7 @@ fn reported_objective_equals_direct_evaluation() {
         assert!((via_api - direct).abs() <= 1e-9 * direct);
         // the optimum beats the linear warp
         let lin: Vec<f64> = (0..400).map(|n| n as f64 * 519.0 / 399.0).collect();
-        assert!(w.objective() < direct_objective(&r, &q, 3, &lin, &params));
+        assert!(w.objective() < direct_objective(&r, &q, 3, &lin, &in_effect));
     }
 }
 
@@ -408,4 +413,71 @@ fn align_many_matches_align_in_order_and_across_thread_counts() {
         let many = pool.install(|| align_many(rs, &qs, &p)).unwrap();
         assert_eq!(many, single, "{threads} threads");
     }
+}
+
+#[test]
+fn the_slope_penalty_grows_with_the_estimated_noise() {
+    use tandem_warp::{NOISE_PENALTY, effective_lambda_inst};
+    // Smooth signals with white noise of standard deviation 0.05 (channel 0) and 0.02 (channel
+    // 1) on both: the loss's noise floor is Σ_c W_c (σ²_c + σ²_c) = 2 (0.05² + 0.02²) = 0.0058.
+    let n = 20_000;
+    let mut rng = Rng(99);
+    let mut noisy = |scale: f64| -> Vec<f64> {
+        (0..n)
+            .flat_map(|i| {
+                let u = i as f64 / (n - 1) as f64;
+                [
+                    (6.0 * u).sin() + 0.05 * scale * rng.normal(),
+                    u * u + 0.02 * scale * rng.normal(),
+                ]
+            })
+            .collect()
+    };
+    let (r, q, clean) = (noisy(1.0), noisy(1.0), noisy(0.0));
+    let (rs, qs, cs) = (
+        SignalRef::new(&r, 2).unwrap(),
+        SignalRef::new(&q, 2).unwrap(),
+        SignalRef::new(&clean, 2).unwrap(),
+    );
+    let p = WarpParams {
+        lambda_inst: 0.01,
+        ..Default::default()
+    };
+    let floor = (effective_lambda_inst(rs, qs, &p).unwrap() - 0.01) / NOISE_PENALTY;
+    assert!((floor / 0.0058 - 1.0).abs() < 0.05, "noise floor {floor}");
+    // noise-free smooth signals keep λ_inst (their second differences are below 1e-7, so the
+    // floor is below 1e-13)
+    let lam = effective_lambda_inst(cs, cs, &p).unwrap();
+    assert!((lam - 0.01).abs() < 1e-12, "{lam}");
+    // the floor is W-weighted
+    let weighted = WarpParams {
+        weights: Some(vec![4.0, 0.0]),
+        ..p.clone()
+    };
+    let floor_w = (effective_lambda_inst(rs, qs, &weighted).unwrap() - 0.01) / NOISE_PENALTY;
+    assert!(
+        (floor_w / (4.0 * 2.0 * 0.0025) - 1.0).abs() < 0.05,
+        "{floor_w}"
+    );
+    // align and objective_of use the effective value: the objective equals the documented one
+    // at λ_inst = effective_lambda_inst
+    let short: Vec<f64> = r[..2 * 400].to_vec();
+    let shorter: Vec<f64> = q[..2 * 350].to_vec();
+    let (a, b) = (
+        SignalRef::new(&short, 2).unwrap(),
+        SignalRef::new(&shorter, 2).unwrap(),
+    );
+    let w = align(a, b, &p).unwrap();
+    let fixed = WarpParams {
+        lambda_inst: effective_lambda_inst(a, b, &p).unwrap(),
+        ..p.clone()
+    };
+    assert!(
+        fixed.lambda_inst > 0.01 + NOISE_PENALTY * 0.004,
+        "{}",
+        fixed.lambda_inst
+    );
+    assert_eq!(objective_of(a, b, w.values(), &p).unwrap(), w.objective());
+    let direct = direct_objective(&short, &shorter, 2, w.values(), &fixed);
+    assert!((direct - w.objective()).abs() <= 1e-9 * direct);
 }

@@ -44,7 +44,11 @@ pub struct FitParams {
     /// When `warp.weights` is `None` (default), the weights are derived from the ranges:
     /// `1/r_j²` per scalar channel and `4/r_q²` per quaternion component (a small rotation
     /// `δr` moves a unit quaternion by `|δr|/2`), so the alignment uses the same `W` as
-    /// the statistics. Default: `WarpParams::default()`.
+    /// the statistics. Default: `WarpParams::default()` with `lambda_inst = 0.02` (four times
+    /// the alignment crate's default): the model reads the warps' gradients too (the rate
+    /// channel of `σ²_D`, the speed bounds), and a weaker slope penalty makes them follow
+    /// every speed wobble, so that on the fixtures the variance contrast between the sanding
+    /// passes and pass 4 falls from 3.13 to 2.84 (docs/decisions.md, "tandem-warp defaults").
     pub warp: tandem_warp::WarpParams,
     /// Per tangent-coordinate ranges `r_j` (length `d`, warp gradient last; physical units:
     /// channel units, radians for rotation vectors, demo samples per reference sample for
@@ -69,7 +73,10 @@ pub struct FitParams {
 impl Default for FitParams {
     fn default() -> Self {
         Self {
-            warp: tandem_warp::WarpParams::default(),
+            warp: tandem_warp::WarpParams {
+                lambda_inst: 0.02,
+                ..tandem_warp::WarpParams::default()
+            },
             ranges: None,
             min_range: 1e-9,
             k_max: 3,
