@@ -10,7 +10,9 @@ use serde::{Deserialize, Serialize};
 use tandem_confidence::{
     Confidence, ConfidenceParams, ErrorRates, Observations, estimate_error_rates,
 };
-use tandem_lfd::{Demonstration, Execution, FitParams, HoldSpec, Regridded, TaskModel};
+use tandem_lfd::{
+    ChannelSchema, Demonstration, Execution, FitParams, HoldSpec, Reference, Regridded, TaskModel,
+};
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
     CheckedSchedule, Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source,
@@ -324,6 +326,106 @@ struct PlannerState {
     rounds: Vec<u64>,
 }
 
+/// `tandem_warp::WarpParams` as state formats 4 to 8 wrote them: without `smooth_width`.
+#[derive(Deserialize)]
+struct WarpParamsV8 {
+    n_nodes: Option<usize>,
+    n_candidates: usize,
+    lambda_inst: f64,
+    lambda_cum: f64,
+    slope_min: f64,
+    slope_max: f64,
+    refinements: usize,
+    refine_radius: f64,
+    max_jump: Option<usize>,
+    coarse_nodes: usize,
+    coarse_candidates: usize,
+    weights: Option<Vec<f64>>,
+}
+
+/// [`FitParams`] as state formats 4 to 8 wrote them: the warp parameters without
+/// `smooth_width`.
+#[derive(Deserialize)]
+struct FitParamsV8 {
+    warp: WarpParamsV8,
+    ranges: Option<Vec<f64>>,
+    min_range: f64,
+    k_max: usize,
+    schema: ChannelSchema,
+    reference: Reference,
+}
+
+impl From<FitParamsV8> for FitParams {
+    /// The saved parameters with `smooth_width = 1`: the signals were aligned unsmoothed (the
+    /// alignment the file's model was fitted with).
+    fn from(v8: FitParamsV8) -> Self {
+        let w = v8.warp;
+        FitParams {
+            warp: tandem_warp::WarpParams {
+                n_nodes: w.n_nodes,
+                n_candidates: w.n_candidates,
+                lambda_inst: w.lambda_inst,
+                lambda_cum: w.lambda_cum,
+                slope_min: w.slope_min,
+                slope_max: w.slope_max,
+                refinements: w.refinements,
+                refine_radius: w.refine_radius,
+                max_jump: w.max_jump,
+                coarse_nodes: w.coarse_nodes,
+                coarse_candidates: w.coarse_candidates,
+                weights: w.weights,
+                smooth_width: 1,
+            },
+            ranges: v8.ranges,
+            min_range: v8.min_range,
+            k_max: v8.k_max,
+            schema: v8.schema,
+            reference: v8.reference,
+        }
+    }
+}
+
+/// [`PlannerParams`] as state format 8 wrote them: the fit's warp without `smooth_width`.
+#[derive(Deserialize)]
+struct PlannerParamsV8 {
+    fit: FitParamsV8,
+    confidence: ConfidenceParams,
+    sampler: SamplerParams,
+    holds: HoldSpec,
+}
+
+/// [`PlannerState`] as state format version 8 wrote it: [`PlannerParamsV8`].
+#[derive(Deserialize)]
+struct PlannerStateV8 {
+    params: PlannerParamsV8,
+    model: TaskModel,
+    observations: Observations,
+    confidence: Confidence,
+    #[serde(with = "state::outcome_form")]
+    outcome: Outcome,
+    pairs_recorded: usize,
+    rounds: Vec<u64>,
+}
+
+impl From<PlannerStateV8> for PlannerState {
+    fn from(v8: PlannerStateV8) -> Self {
+        PlannerState {
+            params: PlannerParams {
+                fit: v8.params.fit.into(),
+                confidence: v8.params.confidence,
+                sampler: v8.params.sampler,
+                holds: v8.params.holds,
+            },
+            model: v8.model,
+            observations: v8.observations,
+            confidence: v8.confidence,
+            outcome: v8.outcome,
+            pairs_recorded: v8.pairs_recorded,
+            rounds: v8.rounds,
+        }
+    }
+}
+
 /// The [`Schedule`] of state formats 5 to 7: without holds.
 #[derive(Deserialize)]
 struct ScheduleV7 {
@@ -366,7 +468,7 @@ impl From<OutcomeV7> for Outcome {
 /// [`PlannerParams`] as state format 7 wrote them: without hold points.
 #[derive(Deserialize)]
 struct PlannerParamsV7 {
-    fit: FitParams,
+    fit: FitParamsV8,
     confidence: ConfidenceParams,
     sampler: SamplerParams,
 }
@@ -388,7 +490,7 @@ impl From<PlannerStateV7> for PlannerState {
     fn from(v7: PlannerStateV7) -> Self {
         PlannerState {
             params: PlannerParams {
-                fit: v7.params.fit,
+                fit: v7.params.fit.into(),
                 confidence: v7.params.confidence,
                 sampler: v7.params.sampler,
                 holds: HoldSpec::default(),
@@ -432,7 +534,7 @@ impl From<ConfidenceParamsV6> for ConfidenceParams {
 /// [`PlannerParams`] as state formats 4 to 6 wrote them.
 #[derive(Deserialize)]
 struct PlannerParamsV6 {
-    fit: FitParams,
+    fit: FitParamsV8,
     confidence: ConfidenceParamsV6,
     sampler: SamplerParams,
 }
@@ -469,7 +571,7 @@ impl TryFrom<PlannerStateV6> for PlannerState {
     fn try_from(v6: PlannerStateV6) -> Result<Self> {
         Ok(PlannerState {
             params: PlannerParams {
-                fit: v6.params.fit,
+                fit: v6.params.fit.into(),
                 confidence: v6.params.confidence.into(),
                 sampler: v6.params.sampler,
                 holds: HoldSpec::default(),
@@ -1093,6 +1195,7 @@ impl Planner {
             5 => old(state::decode_payload::<PlannerStateV5>(payload, path)?.into())?,
             6 => old(state::decode_payload::<PlannerStateV6>(payload, path)?)?,
             7 => state::decode_payload::<PlannerStateV7>(payload, path)?.into(),
+            8 => state::decode_payload::<PlannerStateV8>(payload, path)?.into(),
             _ => state::decode_payload(payload, path)?,
         };
         let mut planner = Self::from_state(st).map_err(|e| Error::Corrupt {

@@ -294,17 +294,49 @@ fn a_version_7_file_loads_without_holds_and_saves_as_the_golden_file() {
     assert_eq!(old.params(), new.params());
     assert_eq!(old.outcome(), new.outcome());
     // The same inputs without holds: version 8 adds only the empty declaration (two empty
-    // lists) and the schedule's empty holds (one list), one byte each, and saving the old
-    // file writes the golden file's bytes, so a planner without holds is the planner of
-    // before, bit for bit.
+    // lists) and the schedule's empty holds (one list), one byte each, version 9 the fit's
+    // `smooth_width` (1, one byte), and saving the old file writes the golden file's bytes,
+    // so a planner without holds is the planner of before, bit for bit.
     let golden = std::fs::read(golden_path()).unwrap();
-    assert_eq!(golden.len(), v7.len() + 3);
+    assert_eq!(golden.len(), v7.len() + 4);
     let dir = tmp_dir("v7");
     let again = dir.join("again.tandem");
     old.save(&again).unwrap();
     assert!(
         std::fs::read(&again).unwrap() == golden,
         "a version 7 file saved again differs from the golden file of the same inputs"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `tests/fixtures/example_v8.tandem`: the golden state file as format version 8 wrote it
+/// (the fit's warp parameters without `smooth_width`), copied before the format became
+/// version 9.
+fn v8_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/example_v8.tandem")
+}
+
+#[test]
+fn a_version_8_file_loads_unsmoothed_and_saves_as_the_golden_file() {
+    let v8 = std::fs::read(v8_path()).unwrap();
+    assert_eq!(u32::from_le_bytes(v8[8..12].try_into().unwrap()), 8);
+    let old = Planner::load(v8_path()).unwrap();
+    // Fitted before smoothing existed: loaded as unsmoothed, which is also what the golden
+    // file's fit (the default `FitParams`) uses.
+    assert_eq!(old.params().fit.warp.smooth_width, 1);
+    let new = Planner::load(golden_path()).unwrap();
+    assert_eq!(old.params(), new.params());
+    assert_eq!(old.outcome(), new.outcome());
+    // Version 9 adds one byte (`smooth_width = 1`); saving the old file writes the golden
+    // file's bytes.
+    let golden = std::fs::read(golden_path()).unwrap();
+    assert_eq!(golden.len(), v8.len() + 1);
+    let dir = tmp_dir("v8");
+    let again = dir.join("again.tandem");
+    old.save(&again).unwrap();
+    assert!(
+        std::fs::read(&again).unwrap() == golden,
+        "a version 8 file saved again differs from the golden file of the same inputs"
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }

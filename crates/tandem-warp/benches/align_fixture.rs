@@ -1,4 +1,5 @@
-//! Criterion bench: align one fixture demonstration (demo 1) to demo 0 with the crate defaults.
+//! Criterion bench: align one fixture demonstration (demo 1) to demo 0 with the crate defaults,
+//! and without smoothing (`smooth_width = 1`).
 //!
 //! Fixtures are found at `CARGO_MANIFEST_DIR/../../fixtures/sanding/demo_{0,1}.csv`.
 #![expect(
@@ -59,6 +60,15 @@ fn bench(c: &mut Criterion) {
     );
     c.bench_function(&id, |b| {
         b.iter(|| align(black_box(reference), black_box(query), &params).expect("aligns"));
+    });
+    // The same alignment without smoothing: what the smoothing of both signals costs (or
+    // saves: smoother signals can take other paths through the search).
+    let unsmoothed = WarpParams {
+        smooth_width: 1,
+        ..params
+    };
+    c.bench_function(&format!("{id}/unsmoothed"), |b| {
+        b.iter(|| align(black_box(reference), black_box(query), &unsmoothed).expect("aligns"));
     });
 }
 

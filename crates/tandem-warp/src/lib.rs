@@ -33,6 +33,7 @@ mod error;
 mod objective;
 mod params;
 mod signal;
+mod smooth;
 mod solver;
 mod warp;
 
@@ -40,6 +41,7 @@ pub use error::{Error, Result};
 pub use objective::{effective_lambda_inst, objective_of};
 pub use params::{DEFAULT_NODE_SPACING, NOISE_PENALTY, WarpParams};
 pub use signal::{MAX_ABS_VALUE, SignalRef};
+pub use smooth::{MAX_SMOOTH_WIDTH, smooth_sigma};
 pub use solver::{
     COARSE_POINTS_PER_SEGMENT, COARSE_SLOPE_STEP, POLISH_RADIUS, POLISH_STEPS,
     REFINE_SPACING_RATIO, align, align_many,

@@ -1,16 +1,19 @@
 //! The discretized GDTW objective and its direct evaluation.
 
+use std::borrow::Cow;
+
 use crate::params::{NOISE_PENALTY, WarpParams};
 use crate::signal::SignalRef;
+use crate::smooth::smooth;
 use crate::warp::check_values;
 use crate::{Error, Result};
 
 /// Reference and query prepared for fast loss evaluation (one alignment).
 pub(crate) struct Prepared<'a> {
-    /// Reference samples, sample-major.
-    pub(crate) r: &'a [f64],
-    /// Query samples, sample-major.
-    pub(crate) q: &'a [f64],
+    /// Reference samples, sample-major, smoothed ([`WarpParams::smooth_width`]).
+    pub(crate) r: Cow<'a, [f64]>,
+    /// Query samples, sample-major, smoothed ([`WarpParams::smooth_width`]).
+    pub(crate) q: Cow<'a, [f64]>,
     /// Query forward differences `q[s+1] − q[s]`, sample-major, `n_query − 1` samples.
     pub(crate) dq: Vec<f64>,
     /// `Σ_c W_c dq[s, c]²` per query sample `s < n_query − 1`.
@@ -27,7 +30,10 @@ pub(crate) struct Prepared<'a> {
     pub(crate) h: f64,
     /// Query samples per unit of normalized query time, `T_query − 1`.
     pub(crate) qscale: f64,
-    /// `λ_inst` in effect: `params.lambda_inst + NOISE_PENALTY · ν̂` ([`noise_floor`]).
+    /// `λ_inst` in effect: `params.lambda_inst + NOISE_PENALTY · ν̂` ([`noise_floor`] of the
+    /// signals as given, before smoothing: the smoothing removes the noise finer than the warp
+    /// can follow, the penalty is for the coarser noise it leaves, which the white noise's
+    /// power measures; docs/decisions.md, "tandem-warp: smoothing before alignment").
     pub(crate) lambda_inst: f64,
     /// `λ_cum`.
     pub(crate) lambda_cum: f64,
@@ -69,15 +75,24 @@ impl<'a> Prepared<'a> {
             }
         }
         let w = params.weight_vec(nc);
-        let (r, q) = (reference.data(), query.data());
+        let width = params.smooth_width;
+        let smoothed = |x: &'a [f64]| -> Cow<'a, [f64]> {
+            if width > 1 {
+                Cow::Owned(smooth(x, nc, width))
+            } else {
+                Cow::Borrowed(x)
+            }
+        };
+        let (r, q) = (smoothed(reference.data()), smoothed(query.data()));
         let (nr, nq) = (reference.n_samples(), query.n_samples());
-        let dq: Vec<f64> = q[nc..].iter().zip(q).map(|(b, a)| b - a).collect();
+        let dq: Vec<f64> = q[nc..].iter().zip(q.iter()).map(|(b, a)| b - a).collect();
         let d2 = dq
             .chunks_exact(nc)
             .map(|d| d.iter().zip(&w).map(|(d, w)| w * d * d).sum())
             .collect();
         let (h, qscale) = (1.0 / (nr - 1) as f64, (nq - 1) as f64);
-        let lambda_inst = params.lambda_inst + NOISE_PENALTY * noise_floor(r, q, nc, &w);
+        let lambda_inst = params.lambda_inst
+            + NOISE_PENALTY * noise_floor(reference.data(), query.data(), nc, &w);
         Ok(Self {
             r,
             q,
@@ -198,10 +213,12 @@ fn noise_floor(r: &[f64], q: &[f64], nc: usize, w: &[f64]) -> f64 {
 }
 
 /// The `λ_inst` an alignment of `query` to `reference` uses: `params.lambda_inst +
-/// NOISE_PENALTY · ν̂` ([`crate::NOISE_PENALTY`]), with `ν̂` the estimated noise floor of the loss (the expected `ℓ`
-/// of the two signals perfectly aligned: `Σ_c W_c (σ̂²_{ref,c} + σ̂²_{query,c})`, each `σ̂` from
-/// the median absolute second difference of that signal's channel, `/ (0.6745 √6)`).
-/// [`crate::align`] and [`objective_of`] both use it in place of `λ_inst`.
+/// NOISE_PENALTY · ν̂` ([`crate::NOISE_PENALTY`]), with `ν̂` the estimated noise floor of the
+/// loss (the expected `ℓ` of the two signals perfectly aligned: `Σ_c W_c (σ̂²_{ref,c} +
+/// σ̂²_{query,c})`, each `σ̂` from the median absolute second difference of that signal's
+/// channel, `/ (0.6745 √6)`), estimated on the signals as given, before the smoothing of
+/// [`WarpParams::smooth_width`]. [`crate::align`] and [`objective_of`] both use it in place of
+/// `λ_inst`.
 ///
 /// # Errors
 /// Signal and parameter errors as for [`crate::align`].

@@ -122,6 +122,18 @@ pub struct WarpParams {
     pub coarse_candidates: usize,
     /// Diagonal of `W`: one weight ≥ 0 (finite) per channel. `None` (default) = all 1.
     pub weights: Option<Vec<f64>>,
+    /// Width `w` (samples, odd) of the smoothing of both signals before they are compared:
+    /// every channel passes three times through a centred running mean of `w` samples (of the
+    /// reference and of the query alike; ends repeat their value), a kernel close to a Gaussian
+    /// of standard deviation [`smooth_sigma`](crate::smooth_sigma)`(w) = √((w² − 1)/4)`
+    /// samples that keeps every feature where it is. The loss, the noise floor of
+    /// [`NOISE_PENALTY`] and [`crate::objective_of`] all see the smoothed signals. `1` = no
+    /// smoothing. Must be odd and at most [`MAX_SMOOTH_WIDTH`](crate::MAX_SMOOTH_WIDTH).
+    /// Default: 7 (σ ≈ 3.5 samples), chosen on the families benchmark (docs/decisions.md,
+    /// "tandem-warp: smoothing before alignment"): sensor noise, ripple and vibration are
+    /// finer than the warp can follow at its default node spacing, and fitting them moves it.
+    /// `tandem-lfd` fits with 1 (its model was measured without).
+    pub smooth_width: usize,
 }
 
 impl Default for WarpParams {
@@ -139,6 +151,7 @@ impl Default for WarpParams {
             coarse_nodes: 48,
             coarse_candidates: 97,
             weights: None,
+            smooth_width: 7,
         }
     }
 }
@@ -219,6 +232,16 @@ impl WarpParams {
                 format!("must be >= 2 (got {})", self.coarse_nodes),
             ));
         }
+        if self.smooth_width % 2 == 0 || self.smooth_width > crate::MAX_SMOOTH_WIDTH {
+            return Err(bad(
+                "smooth_width",
+                format!(
+                    "must be odd and at most {} (1 = no smoothing; got {})",
+                    crate::MAX_SMOOTH_WIDTH,
+                    self.smooth_width
+                ),
+            ));
+        }
         if let Some(w) = &self.weights {
             if let Some((i, v)) = w
                 .iter()
@@ -278,6 +301,7 @@ mod tests {
         p.validate().unwrap();
         assert_eq!(p.n_candidates, 15);
         assert_eq!((p.lambda_inst, p.lambda_cum), (0.005, 0.001));
+        assert_eq!(p.smooth_width, 7);
         assert_eq!(p.nodes_for(9), 3);
         assert_eq!(p.nodes_for(10), 4);
         assert_eq!(p.nodes_for(2), 2);
@@ -292,6 +316,27 @@ mod tests {
                     ..Default::default()
                 },
                 "n_nodes",
+            ),
+            (
+                WarpParams {
+                    smooth_width: 0,
+                    ..Default::default()
+                },
+                "smooth_width",
+            ),
+            (
+                WarpParams {
+                    smooth_width: 8,
+                    ..Default::default()
+                },
+                "smooth_width",
+            ),
+            (
+                WarpParams {
+                    smooth_width: crate::MAX_SMOOTH_WIDTH + 2,
+                    ..Default::default()
+                },
+                "smooth_width",
             ),
             (
                 WarpParams {

@@ -13,8 +13,30 @@
 //! Each test states the property in the crate's terms and is sensitive to the pitfall: it
 //! derives the number by hand, or shows that the quantity it holds fixed does move when the
 //! parameter the pitfall would leak does.
+//!
+//! The pitfalls are of the objective and its discretization, so every test here aligns the
+//! signals as given ([`UNSMOOTHED`]): the default smoothing ([`WarpParams::smooth_width`]) is
+//! over a number of *samples*, like the default node spacing, so it changes the signals
+//! themselves with the sampling rate, which these tests hold fixed.
 
 use tandem_warp::{SignalRef, Warp, WarpParams, align, objective_of};
+
+/// The defaults without smoothing (checked against [`WarpParams::default`] below).
+const UNSMOOTHED: WarpParams = WarpParams {
+    n_nodes: None,
+    n_candidates: 15,
+    lambda_inst: 0.005,
+    lambda_cum: 0.001,
+    slope_min: 0.25,
+    slope_max: 4.0,
+    refinements: 4,
+    refine_radius: 2.5,
+    max_jump: Some(3),
+    coarse_nodes: 48,
+    coarse_candidates: 97,
+    weights: None,
+    smooth_width: 1,
+};
 
 /// A smooth 2-channel signal of task time `u ∈ [0, 1]`.
 fn shape(u: f64) -> [f64; 2] {
@@ -85,7 +107,7 @@ fn the_slope_penalty_is_measured_against_slope_one() {
     let p = |li: f64, lc: f64| WarpParams {
         lambda_inst: li,
         lambda_cum: lc,
-        ..Default::default()
+        ..UNSMOOTHED
     };
     assert_eq!(objective_of(s, s, &identity, &p(1.0, 1.0)).unwrap(), 0.0);
     // slope 2 on [0, ½], then 0: ∫(φ' − 1)² = ½·1 + ½·1 = 1 and
@@ -116,7 +138,7 @@ fn the_objective_is_an_integral_not_a_sum() {
     let params = WarpParams {
         lambda_inst: 0.05,
         lambda_cum: 0.01,
-        ..Default::default()
+        ..UNSMOOTHED
     };
     let mut objectives = Vec::new();
     for n_ref in [300, 600, 1200] {
@@ -152,7 +174,7 @@ fn the_warp_does_not_depend_on_the_sampling_rate() {
     let base = WarpParams {
         lambda_inst: 20.0,
         lambda_cum: 0.05,
-        ..Default::default()
+        ..UNSMOOTHED
     };
     let run = |n_ref: usize, p: &WarpParams| {
         let n_query = n_ref * 5 / 4;
@@ -216,7 +238,7 @@ fn a_warp_on_the_edge_of_the_slope_band_stays_feasible() {
                     lambda_inst: 0.0,
                     lambda_cum: 0.0,
                     n_nodes,
-                    ..Default::default()
+                    ..UNSMOOTHED
                 };
                 let w = align2(&r, &q, &p);
                 let worst = w
@@ -246,7 +268,7 @@ fn one_grid_point_more_changes_the_answer_only_by_the_discretization_error() {
     let base = WarpParams {
         lambda_inst: 0.05,
         lambda_cum: 0.01,
-        ..Default::default()
+        ..UNSMOOTHED
     };
     let variants: Vec<WarpParams> = vec![
         WarpParams {
@@ -298,4 +320,15 @@ fn one_grid_point_more_changes_the_answer_only_by_the_discretization_error() {
             "{nr} -> {nq}: moved {moved} samples, {rel:+e}"
         );
     }
+}
+
+#[test]
+fn unsmoothed_is_the_defaults_without_smoothing() {
+    assert_eq!(
+        UNSMOOTHED,
+        WarpParams {
+            smooth_width: 1,
+            ..WarpParams::default()
+        }
+    );
 }

@@ -48,7 +48,9 @@ pub struct FitParams {
     /// the alignment crate's default): the model reads the warps' gradients too (the rate
     /// channel of `σ²_D`, the speed bounds), and a weaker slope penalty makes them follow
     /// every speed wobble, so that on the fixtures the variance contrast between the sanding
-    /// passes and pass 4 falls from 3.13 to 2.84 (docs/decisions.md, "tandem-warp defaults").
+    /// passes and pass 4 falls from 3.13 to 2.84 (docs/decisions.md, "tandem-warp defaults");
+    /// and `smooth_width = 1` (no smoothing before alignment, the crate's default smooths over
+    /// 7 samples): the model's gradients and statistics were measured without it.
     pub warp: tandem_warp::WarpParams,
     /// Per tangent-coordinate ranges `r_j` (length `d`, warp gradient last; physical units:
     /// channel units, radians for rotation vectors, demo samples per reference sample for
@@ -75,6 +77,7 @@ impl Default for FitParams {
         Self {
             warp: tandem_warp::WarpParams {
                 lambda_inst: 0.02,
+                smooth_width: 1,
                 ..tandem_warp::WarpParams::default()
             },
             ranges: None,
