@@ -10,8 +10,10 @@
 //!
 //! subject to `s_min ≤ φ' ≤ s_max`, `φ(0) = 0`, `φ(1) = 1`; the candidate grid is then refined
 //! around the solution ([`WarpParams`]). `x₁` is the reference, `x₂` the query, linearly
-//! interpolated at fractional times, and `W` a diagonal weight matrix. The result is a [`Warp`]
-//! holding the query time (in query samples) at every reference sample.
+//! interpolated at fractional times, and `W` a diagonal weight matrix. Before they are compared,
+//! both signals are smoothed over a few samples ([`WarpParams::smooth_width`], default 7;
+//! 1 = none), which keeps sensor noise and vibration from steering the warp. The result is a
+//! [`Warp`] holding the query time (in query samples) at every reference sample.
 //!
 //! ```
 //! use tandem_warp::{align, SignalRef, WarpParams};

@@ -46,16 +46,19 @@ pub const DEFAULT_NODE_SPACING: usize = 4;
 /// vibration, long dwells, abrupt speed changes, very different lengths, channels of very
 /// different scales; docs/decisions.md, "tandem-warp defaults"), by the worst family's ratio
 /// to the authors' `gdtw` at its most accurate setting: `λ_inst = 0.005` plus
-/// [`NOISE_PENALTY`] times the estimated noise floor, `λ_cum = 0.001`.
+/// [`NOISE_PENALTY`] times the estimated noise floor, `λ_cum = 0.001`; and the smoothing
+/// [`smooth_width`](Self::smooth_width) = 7 by the worst family's change against no smoothing
+/// (docs/decisions.md, "tandem-warp: smoothing before alignment").
 /// The alignment is done on the caller's scale: the benchmark, like `tandem-lfd`, divides
 /// every channel by its range (`W = diag(1/r²)` on raw data).
-/// The defaults align two ~10 000-sample, 9-channel fixture demonstrations in under 20 ms on one
-/// core (bench `align_fixture`: 17.2 and 18.6 ms under a load average of 4–5 on the 2-core
-/// build machine, against 14.6 and 15.7 ms for the solver before the band-edge fix and the
-/// noise term in the same session; the `align` example, interleaved, 14.8 against 16.2 ms).
+/// The defaults align two ~10 000-sample, 9-channel fixture demonstrations in about 20 ms on
+/// one core (bench `align_fixture`: 17.2 and 18.6 ms under a load average of 4–5 on the 2-core
+/// build machine before the smoothing, against 14.6 and 15.7 ms for the solver before the
+/// band-edge fix and the noise term in the same session; in a later, slower session 20.35 ms
+/// with the smoothing against 19.97 ms without, in one run).
 /// To solve "the same problem" as the authors'
-/// `gdtw` package, use `n_nodes = Some(T_ref)` (one node per reference sample) and
-/// `n_candidates = 301`.
+/// `gdtw` package, use `n_nodes = Some(T_ref)` (one node per reference sample),
+/// `n_candidates = 301` and `smooth_width = 1`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct WarpParams {

@@ -5,8 +5,14 @@
 /// Largest accepted [`WarpParams::smooth_width`](crate::WarpParams::smooth_width) (samples).
 pub const MAX_SMOOTH_WIDTH: usize = 10_001;
 
-/// Standard deviation (samples) of the kernel of [`smooth`] at odd width `w`: three running
+/// Standard deviation (samples) of the smoothing kernel of
+/// [`WarpParams::smooth_width`](crate::WarpParams::smooth_width) `= w` (odd): three running
 /// means of `w` samples, each of variance `(w² − 1)/12`, so `√((w² − 1)/4)`.
+///
+/// ```
+/// assert!((tandem_warp::smooth_sigma(7) - 12f64.sqrt()).abs() < 1e-12); // ≈ 3.46 samples
+/// assert_eq!(tandem_warp::smooth_sigma(1), 0.0); // width 1: no smoothing
+/// ```
 #[must_use]
 pub fn smooth_sigma(w: usize) -> f64 {
     let w = w as f64;
