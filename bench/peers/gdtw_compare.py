@@ -171,6 +171,7 @@ def main():
             "lambda_cum": LAMBDA_CUM, "slope_min": S_MIN, "slope_max": S_MAX,
             "refinements": args.refinements, "max_jump": args.max_jump,
             "refine_radius": args.refine_radius,
+            "smooth_width": 1,  # gdtw compares the signals as given
         }
         psi_t, wall_t, obj_rust = run_tandem(x_ref, x_q, names, exe, tp, args.tandem_repeat)
         # the crate's fast defaults on the same data and lambdas / slope bounds

@@ -52,3 +52,29 @@ def test_params_and_errors() -> None:
         tandem.align(ref, bad)
     with pytest.raises(tandem.InputError):
         tandem.align(ref, query[:, :3])
+
+
+def test_smoothing_is_a_parameter_and_helps_on_noisy_signals() -> None:
+    # A known time change under white noise of a twentieth of each channel's amplitude: the
+    # default smoothing (smooth_width 7) recovers the warp with clearly less error than none
+    # (smooth_width 1): 1.46 against 2.65 query samples on this seed (2.08 against 3.22 on
+    # seed 6).
+    rng = np.random.default_rng(5)
+    t = np.linspace(0.0, 1.0, 1500)
+    clean = np.column_stack([np.sin(9 * t), np.cos(5 * t) * (0.5 + t)])
+    true_map = 0.5 * t**2 + 0.5 * t
+    query_t = np.linspace(0.0, 1.0, 1800)
+    query = np.column_stack([np.interp(query_t, true_map, clean[:, c]) for c in range(2)])
+    reference = clean + rng.normal(0.0, 0.05, clean.shape)
+    query = query + rng.normal(0.0, 0.05, query.shape)
+    expected = true_map * 1799.0
+    err = {
+        w: np.abs(tandem.align(reference, query, params={"smooth_width": w}).values - expected).mean()
+        for w in (1, 7)
+    }
+    default = np.abs(tandem.align(reference, query).values - expected).mean()
+    assert default == err[7]
+    assert err[7] < 0.8 * err[1], err
+    with pytest.raises(tandem.ParamError) as e:
+        tandem.align(reference, query, params={"smooth_width": 4})
+    assert e.value.name == "smooth_width"
