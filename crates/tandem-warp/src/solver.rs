@@ -236,6 +236,20 @@ fn tube_grid(
     g
 }
 
+/// A feasible candidate `j` of node `i` in [`solve_pass`]: its DP value `fj`, query time `p`
+/// (query samples), offset `da = p/(T_query − 1) − t_i` from the identity (normalized time), the
+/// candidates `k_lo..=k_hi` of node `i + 1` it may move to, and the one tried first.
+#[derive(Clone, Copy)]
+struct Source {
+    j: usize,
+    fj: f64,
+    p: f64,
+    da: f64,
+    k_lo: usize,
+    k_hi: usize,
+    first: usize,
+}
+
 /// Scratch for the per-segment cost table: `ℓ(n, s)` for interior reference samples `n` and
 /// integer query samples `s` in a window.
 struct Table {
@@ -270,6 +284,7 @@ fn solve_pass(
     let mut f_next: Vec<f64> = Vec::new();
     let mut rows: Vec<(usize, f64)> = Vec::new();
     let mut cum_b: Vec<f64> = Vec::new();
+    let mut sources: Vec<Source> = Vec::new();
     let mut table = Table {
         e: Vec::new(),
         s0: 0,
@@ -368,12 +383,14 @@ fn solve_pass(
         f_next.resize(cb, f64::INFINITY);
         let back_b = &mut back[off[i + 1]..off[i + 2]];
         let (lo_b, step_b) = (grid.lo[i + 1], grid.step[i + 1]);
+        // the transitions of every feasible candidate j of node i: its k range and the k that
+        // keeps its offset from the previous solution (tried first, see below)
+        sources.clear();
         for (j, &fj) in f_prev.iter().enumerate() {
             if !fj.is_finite() {
                 continue;
             }
             let p = grid.cand(i, j);
-            let da = p / prep.qscale - ta;
             // candidates k of node i+1 satisfying the slope bounds
             let (mut k_lo, mut k_hi) = if cb == 1 || step_b <= 0.0 {
                 (0usize, 0usize)
@@ -395,9 +412,9 @@ fn solve_pass(
                 };
                 (k_lo, k_hi)
             };
+            // relative offsets from the previous solution: (k − center_b) vs (j − center_a)
+            let rel = j as isize - grid.center[i] as isize + grid.center[i + 1] as isize;
             if let Some(kj) = max_jump {
-                // relative offsets from the previous solution: (k − center_b) vs (j − center_a)
-                let rel = j as isize - grid.center[i] as isize + grid.center[i + 1] as isize;
                 let lo = (rel - kj as isize).max(0) as usize;
                 let hi = rel + kj as isize;
                 if hi < 0 {
@@ -406,49 +423,92 @@ fn solve_pass(
                 k_lo = k_lo.max(lo);
                 k_hi = k_hi.min(hi as usize);
             }
-            for k in k_lo..=k_hi.min(cb - 1) {
-                let qv = grid.cand(i + 1, k);
-                let d = qv - p;
-                if d < dmin - tol || d > dmax + tol {
-                    continue;
-                }
-                let slope_m1 = d * kappa - 1.0;
-                let db = cum_b[k];
-                let mut cost =
-                    fj + inst_c * slope_m1 * slope_m1 + cum_c * (da * da + da * db + db * db);
-                if !rows.is_empty() {
-                    let mut acc = 0.0;
-                    if stride == 1 {
-                        let e = &table.e;
-                        for (r, &(_, alpha)) in rows.iter().enumerate() {
-                            let tau = p + d * alpha;
-                            let sq = (tau.max(0.0) as usize).clamp(s0, s1 - 1);
-                            let f = tau - sq as f64;
-                            let base = r * width + (sq - s0);
-                            let (e0, e1) = (e[base], e[base + 1]);
-                            acc += e0 + f * (e1 - e0) - f * (1.0 - f) * prep.d2[sq];
-                        }
-                    } else if stride > 1 {
-                        let (e, cols) = (&table.e, table.width);
-                        let s0f = s0 as f64;
-                        for (r, &(_, alpha)) in rows.iter().enumerate() {
-                            let u = ((p + d * alpha - s0f) * inv_stride).max(0.0);
-                            let c = (u as usize).min(cols - 2);
-                            let f = u - c as f64;
-                            let base = r * cols + c;
-                            acc += e[base] + f * (e[base + 1] - e[base]);
-                        }
-                    } else {
-                        for &(n, alpha) in &rows {
-                            acc += prep.loss(n, p + d * alpha);
+            let k_hi = k_hi.min(cb - 1);
+            if k_lo > k_hi {
+                continue;
+            }
+            let first = rel.clamp(k_lo as isize, k_hi as isize) as usize;
+            sources.push(Source {
+                j,
+                fj,
+                p,
+                da: p / prep.qscale - ta,
+                k_lo,
+                k_hi,
+                first,
+            });
+        }
+        // Every transition is tried, in two sweeps: first each j's transition that keeps its
+        // offset from the previous solution (usually close to the best into its k), then the
+        // others. A transition wins its k if its cost is lower, or equal with a lower j, so the
+        // result is the same as in any order (ties go to the lowest j). With the costs of the
+        // first sweep as bounds, the direct evaluation stops adding a transition's loss (which
+        // is never negative) as soon as the sum exceeds the best cost into its k.
+        let mut edge = |src: &Source, k: usize| {
+            let Source { j, fj, p, da, .. } = *src;
+            let qv = grid.cand(i + 1, k);
+            let d = qv - p;
+            if d < dmin - tol || d > dmax + tol {
+                return;
+            }
+            let slope_m1 = d * kappa - 1.0;
+            let db = cum_b[k];
+            let mut cost =
+                fj + inst_c * slope_m1 * slope_m1 + cum_c * (da * da + da * db + db * db);
+            let bound = f_next[k];
+            if !rows.is_empty() {
+                let mut acc = 0.0;
+                if stride == 1 {
+                    let e = &table.e;
+                    for (r, &(_, alpha)) in rows.iter().enumerate() {
+                        let tau = p + d * alpha;
+                        let sq = (tau.max(0.0) as usize).clamp(s0, s1 - 1);
+                        let f = tau - sq as f64;
+                        let base = r * width + (sq - s0);
+                        let (e0, e1) = (e[base], e[base + 1]);
+                        acc += e0 + f * (e1 - e0) - f * (1.0 - f) * prep.d2[sq];
+                    }
+                } else if stride > 1 {
+                    // each term interpolates two losses (f in [0, 1]): never negative
+                    if cost > bound {
+                        return;
+                    }
+                    let (e, cols) = (&table.e, table.width);
+                    let s0f = s0 as f64;
+                    for (r, &(_, alpha)) in rows.iter().enumerate() {
+                        let u = ((p + d * alpha - s0f) * inv_stride).max(0.0);
+                        let c = (u as usize).min(cols - 2);
+                        let f = u - c as f64;
+                        let base = r * cols + c;
+                        acc += e[base] + f * (e[base + 1] - e[base]);
+                    }
+                } else {
+                    // ℓ ≥ 0, and adding or scaling by non-negative numbers never lowers a sum
+                    // in floating point: a partial sum above the bound cannot win
+                    if cost > bound {
+                        return;
+                    }
+                    for &(n, alpha) in &rows {
+                        acc += prep.loss(n, p + d * alpha);
+                        if cost + w_int * acc > bound {
+                            return;
                         }
                     }
-                    cost += w_int * acc;
                 }
-                if cost < f_next[k] {
-                    f_next[k] = cost;
-                    let jj = j as u16;
-                    back_b[k] = jj;
+                cost += w_int * acc;
+            }
+            if cost < bound || (cost == bound && usize::from(back_b[k]) > j) {
+                f_next[k] = cost;
+                back_b[k] = j as u16;
+            }
+        };
+        for src in &sources {
+            edge(src, src.first);
+        }
+        for src in &sources {
+            for k in src.k_lo..=src.k_hi {
+                if k != src.first {
+                    edge(src, k);
                 }
             }
         }
