@@ -78,3 +78,30 @@ def test_smoothing_is_a_parameter_and_helps_on_noisy_signals() -> None:
     with pytest.raises(tandem.ParamError) as e:
         tandem.align(reference, query, params={"smooth_width": 4})
     assert e.value.name == "smooth_width"
+
+
+def test_flat_stretches_are_filled_unless_fill_length_is_zero() -> None:
+    # Two channels that stop moving from task time 0.3 to 0.7 (a dwell), and a query that runs
+    # through the task at a smoothly varying speed: inside the dwell no channel identifies the
+    # warp, the slope penalty alone draws a straight line, and the default fill continues the
+    # speed ratio instead (crates/tandem-warp/tests/fill.rs has the same task: 2.09 against
+    # 3.84 query samples of error inside the dwell). Outside the dwell nothing changes.
+    def task(u: np.ndarray) -> np.ndarray:
+        v = np.where(u < 0.3, u, np.where(u < 0.7, 0.3, u - 0.4))
+        return np.column_stack([np.sin(4 * np.pi * v), np.cos(3 * np.pi * v) * (0.5 + v)])
+
+    t = np.linspace(0.0, 1.0, 1000)
+    true_phi = t + 0.06 * np.sin(2 * np.pi * t)
+    tau = np.linspace(0.0, 1.0, 800)
+    reference, query = task(t), task(np.interp(tau, true_phi, t))
+    truth = true_phi * 799.0
+    plain = tandem.align(reference, query, params={"fill_length": 0.0}).values
+    filled = tandem.align(reference, query).values
+    dwell = (t >= 0.3) & (t <= 0.7)
+    assert np.array_equal(plain[~dwell], filled[~dwell])
+    err_plain = np.abs(plain - truth)[dwell].mean()
+    err_filled = np.abs(filled - truth)[dwell].mean()
+    assert err_filled < 0.7 * err_plain, (err_filled, err_plain)
+    with pytest.raises(tandem.ParamError) as e:
+        tandem.align(reference, query, params={"fill_length": -0.1})
+    assert e.value.name == "fill_length"

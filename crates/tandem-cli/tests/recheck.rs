@@ -16,7 +16,7 @@ fn s(p: &std::path::Path) -> String {
     p.display().to_string()
 }
 
-/// The state file's payload, field for field (state format 9, the outcome in the state
+/// The state file's payload, field for field (the current state format, the outcome in the state
 /// file's form): the test edits its schedule.
 /// A change of the format makes `state::load` fail here, loudly.
 #[derive(Serialize, Deserialize)]

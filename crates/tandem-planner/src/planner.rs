@@ -326,7 +326,8 @@ struct PlannerState {
     rounds: Vec<u64>,
 }
 
-/// `tandem_warp::WarpParams` as state formats 4 to 8 wrote them: without `smooth_width`.
+/// `tandem_warp::WarpParams` as state formats 4 to 8 wrote them: without `smooth_width` and
+/// `fill_length`.
 #[derive(Deserialize)]
 struct WarpParamsV8 {
     n_nodes: Option<usize>,
@@ -343,11 +344,76 @@ struct WarpParamsV8 {
     weights: Option<Vec<f64>>,
 }
 
-/// [`FitParams`] as state formats 4 to 8 wrote them: the warp parameters without
-/// `smooth_width`.
+/// `tandem_warp::WarpParams` as state format 9 wrote them: without `fill_length` (field for
+/// field: postcard has no field names, so `#[serde(flatten)]` cannot share [`WarpParamsV8`]).
 #[derive(Deserialize)]
-struct FitParamsV8 {
-    warp: WarpParamsV8,
+struct WarpParamsV9 {
+    n_nodes: Option<usize>,
+    n_candidates: usize,
+    lambda_inst: f64,
+    lambda_cum: f64,
+    slope_min: f64,
+    slope_max: f64,
+    refinements: usize,
+    refine_radius: f64,
+    max_jump: Option<usize>,
+    coarse_nodes: usize,
+    coarse_candidates: usize,
+    weights: Option<Vec<f64>>,
+    smooth_width: usize,
+}
+
+impl From<WarpParamsV9> for tandem_warp::WarpParams {
+    /// The saved parameters with `fill_length = 0`: flat stretches were not filled (the
+    /// alignment the file's model was fitted with).
+    fn from(w: WarpParamsV9) -> Self {
+        tandem_warp::WarpParams {
+            n_nodes: w.n_nodes,
+            n_candidates: w.n_candidates,
+            lambda_inst: w.lambda_inst,
+            lambda_cum: w.lambda_cum,
+            slope_min: w.slope_min,
+            slope_max: w.slope_max,
+            refinements: w.refinements,
+            refine_radius: w.refine_radius,
+            max_jump: w.max_jump,
+            coarse_nodes: w.coarse_nodes,
+            coarse_candidates: w.coarse_candidates,
+            weights: w.weights,
+            smooth_width: w.smooth_width,
+            fill_length: 0.0,
+        }
+    }
+}
+
+impl From<WarpParamsV8> for tandem_warp::WarpParams {
+    /// The saved parameters with `smooth_width = 1` and `fill_length = 0`: the signals were
+    /// aligned unsmoothed and unfilled (the alignment the file's model was fitted with).
+    fn from(w: WarpParamsV8) -> Self {
+        WarpParamsV9 {
+            n_nodes: w.n_nodes,
+            n_candidates: w.n_candidates,
+            lambda_inst: w.lambda_inst,
+            lambda_cum: w.lambda_cum,
+            slope_min: w.slope_min,
+            slope_max: w.slope_max,
+            refinements: w.refinements,
+            refine_radius: w.refine_radius,
+            max_jump: w.max_jump,
+            coarse_nodes: w.coarse_nodes,
+            coarse_candidates: w.coarse_candidates,
+            weights: w.weights,
+            smooth_width: 1,
+        }
+        .into()
+    }
+}
+
+/// [`FitParams`] as state formats 4 to 9 wrote them, with the warp parameters `W` of that
+/// format ([`WarpParamsV8`], [`WarpParamsV9`]).
+#[derive(Deserialize)]
+struct FitParamsOld<W> {
+    warp: W,
     ranges: Option<Vec<f64>>,
     min_range: f64,
     k_max: usize,
@@ -355,49 +421,36 @@ struct FitParamsV8 {
     reference: Reference,
 }
 
-impl From<FitParamsV8> for FitParams {
-    /// The saved parameters with `smooth_width = 1`: the signals were aligned unsmoothed (the
-    /// alignment the file's model was fitted with).
-    fn from(v8: FitParamsV8) -> Self {
-        let w = v8.warp;
+/// [`FitParams`] as state formats 4 to 8 wrote them.
+type FitParamsV8 = FitParamsOld<WarpParamsV8>;
+
+impl<W: Into<tandem_warp::WarpParams>> From<FitParamsOld<W>> for FitParams {
+    fn from(old: FitParamsOld<W>) -> Self {
         FitParams {
-            warp: tandem_warp::WarpParams {
-                n_nodes: w.n_nodes,
-                n_candidates: w.n_candidates,
-                lambda_inst: w.lambda_inst,
-                lambda_cum: w.lambda_cum,
-                slope_min: w.slope_min,
-                slope_max: w.slope_max,
-                refinements: w.refinements,
-                refine_radius: w.refine_radius,
-                max_jump: w.max_jump,
-                coarse_nodes: w.coarse_nodes,
-                coarse_candidates: w.coarse_candidates,
-                weights: w.weights,
-                smooth_width: 1,
-            },
-            ranges: v8.ranges,
-            min_range: v8.min_range,
-            k_max: v8.k_max,
-            schema: v8.schema,
-            reference: v8.reference,
+            warp: old.warp.into(),
+            ranges: old.ranges,
+            min_range: old.min_range,
+            k_max: old.k_max,
+            schema: old.schema,
+            reference: old.reference,
         }
     }
 }
 
-/// [`PlannerParams`] as state format 8 wrote them: the fit's warp without `smooth_width`.
+/// [`PlannerParams`] as state formats 8 and 9 wrote them: the fit's warp parameters of that
+/// format ([`FitParamsOld`]).
 #[derive(Deserialize)]
-struct PlannerParamsV8 {
-    fit: FitParamsV8,
+struct PlannerParamsOld<F> {
+    fit: F,
     confidence: ConfidenceParams,
     sampler: SamplerParams,
     holds: HoldSpec,
 }
 
-/// [`PlannerState`] as state format version 8 wrote it: [`PlannerParamsV8`].
+/// [`PlannerState`] as state formats 8 and 9 wrote it: [`PlannerParamsOld`].
 #[derive(Deserialize)]
-struct PlannerStateV8 {
-    params: PlannerParamsV8,
+struct PlannerStateOld<F> {
+    params: PlannerParamsOld<F>,
     model: TaskModel,
     observations: Observations,
     confidence: Confidence,
@@ -407,21 +460,28 @@ struct PlannerStateV8 {
     rounds: Vec<u64>,
 }
 
-impl From<PlannerStateV8> for PlannerState {
-    fn from(v8: PlannerStateV8) -> Self {
+/// [`PlannerState`] as state format 8 wrote it (the fit's warp without `smooth_width` and
+/// `fill_length`).
+type PlannerStateV8 = PlannerStateOld<FitParamsV8>;
+
+/// [`PlannerState`] as state format 9 wrote it (the fit's warp without `fill_length`).
+type PlannerStateV9 = PlannerStateOld<FitParamsOld<WarpParamsV9>>;
+
+impl<F: Into<FitParams>> From<PlannerStateOld<F>> for PlannerState {
+    fn from(old: PlannerStateOld<F>) -> Self {
         PlannerState {
             params: PlannerParams {
-                fit: v8.params.fit.into(),
-                confidence: v8.params.confidence,
-                sampler: v8.params.sampler,
-                holds: v8.params.holds,
+                fit: old.params.fit.into(),
+                confidence: old.params.confidence,
+                sampler: old.params.sampler,
+                holds: old.params.holds,
             },
-            model: v8.model,
-            observations: v8.observations,
-            confidence: v8.confidence,
-            outcome: v8.outcome,
-            pairs_recorded: v8.pairs_recorded,
-            rounds: v8.rounds,
+            model: old.model,
+            observations: old.observations,
+            confidence: old.confidence,
+            outcome: old.outcome,
+            pairs_recorded: old.pairs_recorded,
+            rounds: old.rounds,
         }
     }
 }
@@ -1173,6 +1233,7 @@ impl Planner {
     /// they hold are not checked for repeats; versions 4 to 6 load with the paper's
     /// confidence model, `ConfidenceParams::paper()` with their own `γ_p`, `σ²_MAX`, `ε`,
     /// `μ_c`, `γ_c`, the model they were decided with; versions 4 to 7 load without hold points;
+    /// versions 4 to 8 unsmoothed and 4 to 9 without the fill of flat stretches;
     /// saving writes the current version). Reading
     /// takes no lock (saves are atomic renames); the planner remembers the file's content, so
     /// that saving into it again refuses to overwrite what another process saved meanwhile.
@@ -1196,6 +1257,7 @@ impl Planner {
             6 => old(state::decode_payload::<PlannerStateV6>(payload, path)?)?,
             7 => state::decode_payload::<PlannerStateV7>(payload, path)?.into(),
             8 => state::decode_payload::<PlannerStateV8>(payload, path)?.into(),
+            9 => state::decode_payload::<PlannerStateV9>(payload, path)?.into(),
             _ => state::decode_payload(payload, path)?,
         };
         let mut planner = Self::from_state(st).map_err(|e| Error::Corrupt {

@@ -208,7 +208,10 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 /// - 9: the fit's warp parameters gained `smooth_width` (`tandem_warp::WarpParams`: the
 ///   signals are smoothed before they are aligned). Version 4 to 8 files still load, with
 ///   `smooth_width = 1`: unsmoothed, the alignment they were fitted with.
-pub const FORMAT_VERSION: u32 = 9;
+/// - 10: the fit's warp parameters gained `fill_length` (`tandem_warp::WarpParams`: flat
+///   stretches filled by the smoothest continuation of the warp). Version 4 to 9 files still
+///   load, with `fill_length = 0`: unfilled, the alignment they were fitted with.
+pub const FORMAT_VERSION: u32 = 10;
 
 /// The oldest state format version this build reads (converting it on load).
 pub const OLDEST_READABLE_VERSION: u32 = 4;
@@ -719,7 +722,7 @@ mod tests {
     fn header_layout_is_as_documented() {
         let bytes = encode(&payload(4)).unwrap();
         assert_eq!(&bytes[..8], b"TANDEMST");
-        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 9);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 10);
         let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
         assert_eq!(len as usize, bytes.len() - HEADER_LEN);
         let crc = u32::from_le_bytes(bytes[20..24].try_into().unwrap());
@@ -804,18 +807,18 @@ mod tests {
     #[test]
     fn other_version_is_rejected_with_both_numbers() {
         let mut bytes = encode(&payload(3)).unwrap();
-        bytes[8..12].copy_from_slice(&10u32.to_le_bytes());
+        bytes[8..12].copy_from_slice(&11u32.to_le_bytes());
         let err = decode::<Payload>(&bytes, Path::new("v.tandem")).unwrap_err();
         assert!(matches!(
             err,
             Error::UnsupportedVersion {
-                found: 10,
+                found: 11,
                 expected: FORMAT_VERSION,
                 ..
             }
         ));
         let msg = err.to_string();
-        assert!(msg.contains("v.tandem") && msg.contains("10") && msg.contains("4 to 9"));
+        assert!(msg.contains("v.tandem") && msg.contains("11") && msg.contains("4 to 10"));
     }
 
     #[test]

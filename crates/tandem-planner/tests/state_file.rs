@@ -295,10 +295,11 @@ fn a_version_7_file_loads_without_holds_and_saves_as_the_golden_file() {
     assert_eq!(old.outcome(), new.outcome());
     // The same inputs without holds: version 8 adds only the empty declaration (two empty
     // lists) and the schedule's empty holds (one list), one byte each, version 9 the fit's
-    // `smooth_width` (1, one byte), and saving the old file writes the golden file's bytes,
-    // so a planner without holds is the planner of before, bit for bit.
+    // `smooth_width` (1, one byte), version 10 its `fill_length` (0.0, eight bytes), and
+    // saving the old file writes the golden file's bytes, so a planner without holds is the
+    // planner of before, bit for bit.
     let golden = std::fs::read(golden_path()).unwrap();
-    assert_eq!(golden.len(), v7.len() + 4);
+    assert_eq!(golden.len(), v7.len() + 12);
     let dir = tmp_dir("v7");
     let again = dir.join("again.tandem");
     old.save(&again).unwrap();
@@ -327,16 +328,48 @@ fn a_version_8_file_loads_unsmoothed_and_saves_as_the_golden_file() {
     let new = Planner::load(golden_path()).unwrap();
     assert_eq!(old.params(), new.params());
     assert_eq!(old.outcome(), new.outcome());
-    // Version 9 adds one byte (`smooth_width = 1`); saving the old file writes the golden
-    // file's bytes.
+    // Version 9 adds one byte (`smooth_width = 1`), version 10 eight (`fill_length = 0.0`);
+    // saving the old file writes the golden file's bytes.
     let golden = std::fs::read(golden_path()).unwrap();
-    assert_eq!(golden.len(), v8.len() + 1);
+    assert_eq!(golden.len(), v8.len() + 9);
     let dir = tmp_dir("v8");
     let again = dir.join("again.tandem");
     old.save(&again).unwrap();
     assert!(
         std::fs::read(&again).unwrap() == golden,
         "a version 8 file saved again differs from the golden file of the same inputs"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `tests/fixtures/example_v9.tandem`: the golden state file as format version 9 wrote it
+/// (the fit's warp parameters without `fill_length`), copied before the format became
+/// version 10.
+fn v9_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/example_v9.tandem")
+}
+
+#[test]
+fn a_version_9_file_loads_unfilled_and_saves_as_the_golden_file() {
+    let v9 = std::fs::read(v9_path()).unwrap();
+    assert_eq!(u32::from_le_bytes(v9[8..12].try_into().unwrap()), 9);
+    let old = Planner::load(v9_path()).unwrap();
+    // Fitted before the fill of flat stretches existed: loaded without it, which is also what
+    // the golden file's fit (the default `FitParams`) uses.
+    assert_eq!(old.params().fit.warp.fill_length, 0.0);
+    let new = Planner::load(golden_path()).unwrap();
+    assert_eq!(old.params(), new.params());
+    assert_eq!(old.outcome(), new.outcome());
+    // Version 10 adds eight bytes (`fill_length = 0.0`, an f64); saving the old file writes
+    // the golden file's bytes.
+    let golden = std::fs::read(golden_path()).unwrap();
+    assert_eq!(golden.len(), v9.len() + 8);
+    let dir = tmp_dir("v9");
+    let again = dir.join("again.tandem");
+    old.save(&again).unwrap();
+    assert!(
+        std::fs::read(&again).unwrap() == golden,
+        "a version 9 file saved again differs from the golden file of the same inputs"
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -19,7 +19,8 @@ use crate::params::from_py;
 ///     params: ``None`` (defaults) or a dict of ``tandem_warp::WarpParams`` (``n_nodes``,
 ///         ``n_candidates``, ``lambda_inst``, ``lambda_cum``, ``slope_min``, ``slope_max``,
 ///         ``refinements``, ``refine_radius``, ``max_jump``, ``coarse_nodes``,
-///         ``coarse_candidates``, ``weights``, ``smooth_width``), or the path of a TOML file.
+///         ``coarse_candidates``, ``weights``, ``smooth_width``, ``fill_length``), or the path
+///         of a TOML file.
 ///
 /// Returns:
 ///     Warp: ``values`` (query samples at each reference sample) and ``objective``.

@@ -12,8 +12,12 @@
 //! around the solution ([`WarpParams`]). `x₁` is the reference, `x₂` the query, linearly
 //! interpolated at fractional times, and `W` a diagonal weight matrix. Before they are compared,
 //! both signals are smoothed over a few samples ([`WarpParams::smooth_width`], default 7;
-//! 1 = none), which keeps sensor noise and vibration from steering the warp. The result is a
-//! [`Warp`] holding the query time (in query samples) at every reference sample.
+//! 1 = none), which keeps sensor noise and vibration from steering the warp. Where neither
+//! signal moves beyond its noise (a dwell), no channel identifies the warp and the slope
+//! penalty alone would draw a straight line; there the warp is replaced by its smoothest
+//! continuation from the warp around it ([`WarpParams::fill_length`], default 0.1; 0 = none).
+//! The result is a [`Warp`] holding the query time (in query samples) at every reference
+//! sample.
 //!
 //! ```
 //! use tandem_warp::{align, SignalRef, WarpParams};
@@ -32,6 +36,7 @@
 //! ```
 
 mod error;
+mod fill;
 mod objective;
 mod params;
 mod signal;
@@ -40,6 +45,7 @@ mod solver;
 mod warp;
 
 pub use error::{Error, Result};
+pub use fill::{FLAT_HALF_WINDOW, FLAT_NOISE_MULTIPLE, FLAT_RANGE_FRACTION};
 pub use objective::{effective_lambda_inst, objective_of};
 pub use params::{DEFAULT_NODE_SPACING, NOISE_PENALTY, WarpParams};
 pub use signal::{MAX_ABS_VALUE, SignalRef};

@@ -14,6 +14,15 @@ pub(crate) struct Prepared<'a> {
     pub(crate) r: Cow<'a, [f64]>,
     /// Query samples, sample-major, smoothed ([`WarpParams::smooth_width`]).
     pub(crate) q: Cow<'a, [f64]>,
+    /// Reference samples as given (sample-major, unsmoothed).
+    pub(crate) r_raw: &'a [f64],
+    /// Query samples as given (sample-major, unsmoothed).
+    pub(crate) q_raw: &'a [f64],
+    /// Estimated white-noise standard deviation of every reference channel as given
+    /// ([`noise_sd`]; 0 for channels of weight 0), in the channel's units.
+    pub(crate) sd_r: Vec<f64>,
+    /// The same for the query.
+    pub(crate) sd_q: Vec<f64>,
     /// Query forward differences `q[s+1] − q[s]`, sample-major, `n_query − 1` samples.
     pub(crate) dq: Vec<f64>,
     /// `Σ_c W_c dq[s, c]²` per query sample `s < n_query − 1`.
@@ -91,11 +100,18 @@ impl<'a> Prepared<'a> {
             .map(|d| d.iter().zip(&w).map(|(d, w)| w * d * d).sum())
             .collect();
         let (h, qscale) = (1.0 / (nr - 1) as f64, (nq - 1) as f64);
-        let lambda_inst = params.lambda_inst
-            + NOISE_PENALTY * noise_floor(reference.data(), query.data(), nc, &w);
+        let (sd_r, sd_q) = (
+            noise_sd(reference.data(), nc, &w),
+            noise_sd(query.data(), nc, &w),
+        );
+        let lambda_inst = params.lambda_inst + NOISE_PENALTY * noise_floor(&sd_r, &sd_q, &w);
         Ok(Self {
             r,
             q,
+            r_raw: reference.data(),
+            q_raw: query.data(),
+            sd_r,
+            sd_q,
             dq,
             d2,
             w,
@@ -179,37 +195,43 @@ impl<'a> Prepared<'a> {
 
 /// `ν̂ = Σ_c W_c (σ̂²_{1,c} + σ̂²_{2,c})`, the estimated noise floor of the loss: the expected
 /// `ℓ` of two perfectly aligned signals whose channels carry independent white noise of
-/// standard deviations `σ_{1,c}` (reference) and `σ_{2,c}` (query). Per signal and channel,
-/// `σ̂` is the median absolute second difference `|x[t+1] − 2 x[t] + x[t−1]|` divided by
-/// `0.6745 √6`: white noise's second differences have standard deviation `√6 σ` and, being
-/// Gaussian, median absolute value `0.6745` times that; smooth motion adds only its second
-/// derivative times the squared sample period, and steps (a gripper) or spikes are too rare to
-/// move the median. Signals of fewer than 4 samples count as noise-free.
-fn noise_floor(r: &[f64], q: &[f64], nc: usize, w: &[f64]) -> f64 {
-    let mut d: Vec<f64> = Vec::new();
-    let mut total = 0.0;
-    for x in [r, q] {
-        let n = x.len() / nc;
-        if n < 4 {
+/// standard deviations `σ_{1,c}` (reference) and `σ_{2,c}` (query), each estimated by
+/// [`noise_sd`].
+fn noise_floor(sd_r: &[f64], sd_q: &[f64], w: &[f64]) -> f64 {
+    w.iter()
+        .zip(sd_r.iter().zip(sd_q))
+        .map(|(wc, (a, b))| wc * (a * a + b * b))
+        .sum()
+}
+
+/// Estimated white-noise standard deviation `σ̂_c` of every channel of the sample-major `x`
+/// (`nc` channels), in the channel's units: the median absolute second difference
+/// `|x[t+1] − 2 x[t] + x[t−1]|` divided by `0.6745 √6`. White noise's second differences have
+/// standard deviation `√6 σ` and, being Gaussian, median absolute value `0.6745` times that;
+/// smooth motion adds only its second derivative times the squared sample period, and steps (a
+/// gripper) or spikes are too rare to move the median. Channels of weight 0 and signals of
+/// fewer than 4 samples get 0.
+pub(crate) fn noise_sd(x: &[f64], nc: usize, w: &[f64]) -> Vec<f64> {
+    let n = x.len() / nc;
+    let mut out = vec![0.0; nc];
+    if n < 4 {
+        return out;
+    }
+    let mut d: Vec<f64> = Vec::with_capacity(n - 2);
+    for (c, (&wc, sd)) in w.iter().zip(out.iter_mut()).enumerate() {
+        if wc == 0.0 {
             continue;
         }
-        for (c, &wc) in w.iter().enumerate() {
-            if wc == 0.0 {
-                continue;
-            }
-            d.clear();
-            d.extend(
-                (1..n - 1).map(|t| {
-                    (x[(t + 1) * nc + c] - 2.0 * x[t * nc + c] + x[(t - 1) * nc + c]).abs()
-                }),
-            );
-            let mid = d.len() / 2;
-            let (_, median, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
-            let sigma = *median / (0.6745 * 6f64.sqrt());
-            total += wc * sigma * sigma;
-        }
+        d.clear();
+        d.extend(
+            (1..n - 1)
+                .map(|t| (x[(t + 1) * nc + c] - 2.0 * x[t * nc + c] + x[(t - 1) * nc + c]).abs()),
+        );
+        let mid = d.len() / 2;
+        let (_, median, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
+        *sd = *median / (0.6745 * 6f64.sqrt());
     }
-    total
+    out
 }
 
 /// The `λ_inst` an alignment of `query` to `reference` uses: `params.lambda_inst +

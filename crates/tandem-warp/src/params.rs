@@ -48,7 +48,9 @@ pub const DEFAULT_NODE_SPACING: usize = 4;
 /// to the authors' `gdtw` at its most accurate setting: `λ_inst = 0.005` plus
 /// [`NOISE_PENALTY`] times the estimated noise floor, `λ_cum = 0.001`; and the smoothing
 /// [`smooth_width`](Self::smooth_width) = 7 by the worst family's change against no smoothing
-/// (docs/decisions.md, "tandem-warp: smoothing before alignment").
+/// (docs/decisions.md, "tandem-warp: smoothing before alignment"); the fill of flat stretches
+/// [`fill_length`](Self::fill_length) = 0.1 by the worst family's ratio to `gdtw` again
+/// (docs/decisions.md, "tandem-warp: flat stretches").
 /// The alignment is done on the caller's scale: the benchmark, like `tandem-lfd`, divides
 /// every channel by its range (`W = diag(1/r²)` on raw data).
 /// The defaults align two ~10 000-sample, 9-channel fixture demonstrations in about 20 ms on
@@ -58,7 +60,7 @@ pub const DEFAULT_NODE_SPACING: usize = 4;
 /// with the smoothing against 19.97 ms without, in one run).
 /// To solve "the same problem" as the authors'
 /// `gdtw` package, use `n_nodes = Some(T_ref)` (one node per reference sample),
-/// `n_candidates = 301` and `smooth_width = 1`.
+/// `n_candidates = 301`, `smooth_width = 1` and `fill_length = 0`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct WarpParams {
@@ -137,6 +139,19 @@ pub struct WarpParams {
     /// finer than the warp can follow at its default node spacing, and fitting them moves it.
     /// `tandem-lfd` fits with 1 (its model was measured without).
     pub smooth_width: usize,
+    /// `ℓ`, in normalized reference time (a fraction of the reference's length), of the fill
+    /// of flat stretches: where neither signal moves beyond its noise (see
+    /// [`FLAT_NOISE_MULTIPLE`](crate::FLAT_NOISE_MULTIPLE)), no channel identifies the warp
+    /// and the slope penalty alone would draw a straight line between the stretch's edges;
+    /// there the warp is replaced by the minimizer of the slope penalty plus `λ_inst ℓ² ∫ φ''²`
+    /// held by the loss's Gauss–Newton curvature wherever the signals move, so the speed ratio
+    /// at a flat stretch's edges carries on for about `ℓ` into it instead of jumping. Only
+    /// samples inside flat stretches change, and only within the slope bounds;
+    /// [`crate::Warp::objective`] is that of the returned warp. `0` = no fill: the minimizer of
+    /// [`crate::objective_of`] alone. Must be finite and ≥ 0. Default: 0.1, chosen on the
+    /// families benchmark (docs/decisions.md, "tandem-warp: flat stretches"). `tandem-lfd` fits
+    /// with 0 (its model was measured without).
+    pub fill_length: f64,
 }
 
 impl Default for WarpParams {
@@ -155,6 +170,7 @@ impl Default for WarpParams {
             coarse_candidates: 97,
             weights: None,
             smooth_width: 7,
+            fill_length: 0.1,
         }
     }
 }
@@ -245,6 +261,15 @@ impl WarpParams {
                 ),
             ));
         }
+        if !(self.fill_length.is_finite() && self.fill_length >= 0.0) {
+            return Err(bad(
+                "fill_length",
+                format!(
+                    "must be finite and >= 0 (0 = no fill; got {})",
+                    self.fill_length
+                ),
+            ));
+        }
         if let Some(w) = &self.weights {
             if let Some((i, v)) = w
                 .iter()
@@ -305,6 +330,7 @@ mod tests {
         assert_eq!(p.n_candidates, 15);
         assert_eq!((p.lambda_inst, p.lambda_cum), (0.005, 0.001));
         assert_eq!(p.smooth_width, 7);
+        assert_eq!(p.fill_length, 0.1);
         assert_eq!(p.nodes_for(9), 3);
         assert_eq!(p.nodes_for(10), 4);
         assert_eq!(p.nodes_for(2), 2);
@@ -340,6 +366,20 @@ mod tests {
                     ..Default::default()
                 },
                 "smooth_width",
+            ),
+            (
+                WarpParams {
+                    fill_length: -0.1,
+                    ..Default::default()
+                },
+                "fill_length",
+            ),
+            (
+                WarpParams {
+                    fill_length: f64::NAN,
+                    ..Default::default()
+                },
+                "fill_length",
             ),
             (
                 WarpParams {

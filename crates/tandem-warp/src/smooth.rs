@@ -19,6 +19,23 @@ pub fn smooth_sigma(w: usize) -> f64 {
     (0.25 * (w * w - 1.0)).sqrt()
 }
 
+/// `‖k‖₂`, the root of the sum of squares of the smoothing kernel of width `w` (three running
+/// means of `w` samples, see [`smooth`]; 1 for `w = 1`): white noise of standard deviation `σ`
+/// has standard deviation `‖k‖₂ σ` after the smoothing (away from the signal's ends).
+pub(crate) fn kernel_l2(w: usize) -> f64 {
+    let mut k = vec![1.0];
+    for _ in 0..3 {
+        let mut next = vec![0.0; k.len() + w - 1];
+        for (i, v) in k.iter().enumerate() {
+            for n in &mut next[i..i + w] {
+                *n += v / w as f64;
+            }
+        }
+        k = next;
+    }
+    k.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
 /// The sample-major `data` (`nc` channels) with every channel passed three times through a
 /// centred running mean of odd width `w` samples, samples beyond either end repeating the end
 /// value: a kernel close to a Gaussian of standard deviation [`smooth_sigma`]`(w)`, symmetric,
@@ -127,6 +144,19 @@ mod tests {
         assert!(s[99 - reach + 1] > 0.0 && s[100 + reach - 1] < 1.0);
         // Width 1 is the identity.
         assert_eq!(smooth(&x, 2, 1), x);
+    }
+
+    #[test]
+    fn the_kernel_norm_is_that_of_the_impulse_response() {
+        // width 3: (1, 3, 6, 7, 6, 3, 1)/27, Σ k² = 141/729
+        assert!((kernel_l2(3) - (141.0f64 / 729.0).sqrt()).abs() < 1e-15);
+        assert_eq!(kernel_l2(1), 1.0);
+        // the same as the impulse response of `smooth` away from the ends
+        let mut x = vec![0.0; 101];
+        x[50] = 1.0;
+        let y = smooth(&x, 1, 7);
+        let direct = y.iter().map(|v| v * v).sum::<f64>().sqrt();
+        assert!((kernel_l2(7) - direct).abs() < 1e-12);
     }
 
     #[test]

@@ -3,6 +3,7 @@
 use rayon::prelude::*;
 
 use crate::Result;
+use crate::fill;
 use crate::objective::Prepared;
 use crate::params::WarpParams;
 use crate::signal::SignalRef;
@@ -667,12 +668,28 @@ fn align_prepared(prep: &Prepared<'_>, params: &WarpParams) -> Warp {
             best.offer(prep, &expand(&grid.nodes, &vals, prep.nr));
         }
     }
-    Warp::from_parts(best.values, best.objective)
+    // the smoothest continuation inside flat stretches (WarpParams::fill_length)
+    let Best {
+        mut values,
+        mut objective,
+    } = best;
+    if fill::fill_flats(
+        prep,
+        &mut values,
+        params.fill_length,
+        params.smooth_width,
+        s,
+    ) {
+        objective = prep.objective(&values);
+    }
+    Warp::from_parts(values, objective)
 }
 
 /// Aligns `query` to `reference` with GDTW (paper §II-B1, Eq. 2–3): finds the warp
 /// `ψ: reference samples → query samples` minimizing [`crate::objective_of`] under the
-/// slope bounds of `params`. Single-threaded and deterministic (ties go to the lowest index).
+/// slope bounds of `params`, then fills its flat stretches
+/// ([`WarpParams::fill_length`]; the minimizer itself with `fill_length = 0`).
+/// Single-threaded and deterministic (ties go to the lowest index).
 ///
 /// # Errors
 /// [`crate::Error::ChannelMismatch`], [`crate::Error::NonFinite`], [`crate::Error::BadParam`],

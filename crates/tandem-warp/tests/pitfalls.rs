@@ -15,14 +15,17 @@
 //! parameter the pitfall would leak does.
 //!
 //! The pitfalls are of the objective and its discretization, so every test here aligns the
-//! signals as given ([`UNSMOOTHED`]): the default smoothing ([`WarpParams::smooth_width`]) is
-//! over a number of *samples*, like the default node spacing, so it changes the signals
-//! themselves with the sampling rate, which these tests hold fixed.
+//! signals as given and returns the objective's minimizer ([`PLAIN`]): the default smoothing
+//! ([`WarpParams::smooth_width`]) is over a number of *samples*, like the default node spacing,
+//! so it changes the signals themselves with the sampling rate, which these tests hold fixed;
+//! and the fill of flat stretches ([`WarpParams::fill_length`]) replaces the minimizer where no
+//! channel identifies it.
 
 use tandem_warp::{SignalRef, Warp, WarpParams, align, objective_of};
 
-/// The defaults without smoothing (checked against [`WarpParams::default`] below).
-const UNSMOOTHED: WarpParams = WarpParams {
+/// The defaults without smoothing and without the fill of flat stretches (checked against
+/// [`WarpParams::default`] below).
+const PLAIN: WarpParams = WarpParams {
     n_nodes: None,
     n_candidates: 15,
     lambda_inst: 0.005,
@@ -36,6 +39,7 @@ const UNSMOOTHED: WarpParams = WarpParams {
     coarse_candidates: 97,
     weights: None,
     smooth_width: 1,
+    fill_length: 0.0,
 };
 
 /// A smooth 2-channel signal of task time `u ∈ [0, 1]`.
@@ -107,7 +111,7 @@ fn the_slope_penalty_is_measured_against_slope_one() {
     let p = |li: f64, lc: f64| WarpParams {
         lambda_inst: li,
         lambda_cum: lc,
-        ..UNSMOOTHED
+        ..PLAIN
     };
     assert_eq!(objective_of(s, s, &identity, &p(1.0, 1.0)).unwrap(), 0.0);
     // slope 2 on [0, ½], then 0: ∫(φ' − 1)² = ½·1 + ½·1 = 1 and
@@ -138,7 +142,7 @@ fn the_objective_is_an_integral_not_a_sum() {
     let params = WarpParams {
         lambda_inst: 0.05,
         lambda_cum: 0.01,
-        ..UNSMOOTHED
+        ..PLAIN
     };
     let mut objectives = Vec::new();
     for n_ref in [300, 600, 1200] {
@@ -174,7 +178,7 @@ fn the_warp_does_not_depend_on_the_sampling_rate() {
     let base = WarpParams {
         lambda_inst: 20.0,
         lambda_cum: 0.05,
-        ..UNSMOOTHED
+        ..PLAIN
     };
     let run = |n_ref: usize, p: &WarpParams| {
         let n_query = n_ref * 5 / 4;
@@ -238,7 +242,7 @@ fn a_warp_on_the_edge_of_the_slope_band_stays_feasible() {
                     lambda_inst: 0.0,
                     lambda_cum: 0.0,
                     n_nodes,
-                    ..UNSMOOTHED
+                    ..PLAIN
                 };
                 let w = align2(&r, &q, &p);
                 let worst = w
@@ -268,7 +272,7 @@ fn one_grid_point_more_changes_the_answer_only_by_the_discretization_error() {
     let base = WarpParams {
         lambda_inst: 0.05,
         lambda_cum: 0.01,
-        ..UNSMOOTHED
+        ..PLAIN
     };
     let variants: Vec<WarpParams> = vec![
         WarpParams {
@@ -323,11 +327,12 @@ fn one_grid_point_more_changes_the_answer_only_by_the_discretization_error() {
 }
 
 #[test]
-fn unsmoothed_is_the_defaults_without_smoothing() {
+fn plain_is_the_defaults_without_smoothing_and_fill() {
     assert_eq!(
-        UNSMOOTHED,
+        PLAIN,
         WarpParams {
             smooth_width: 1,
+            fill_length: 0.0,
             ..WarpParams::default()
         }
     );

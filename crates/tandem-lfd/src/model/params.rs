@@ -49,8 +49,10 @@ pub struct FitParams {
     /// channel of `σ²_D`, the speed bounds), and a weaker slope penalty makes them follow
     /// every speed wobble, so that on the fixtures the variance contrast between the sanding
     /// passes and pass 4 falls from 3.13 to 2.84 (docs/decisions.md, "tandem-warp defaults");
-    /// and `smooth_width = 1` (no smoothing before alignment, the crate's default smooths over
-    /// 7 samples): the model's gradients and statistics were measured without it.
+    /// `smooth_width = 1` (no smoothing before alignment, the crate's default smooths over
+    /// 7 samples) and `fill_length = 0` (flat stretches keep the straight line of the slope
+    /// penalty, the crate's default fills them): the model's gradients and statistics were
+    /// measured without either.
     pub warp: tandem_warp::WarpParams,
     /// Per tangent-coordinate ranges `r_j` (length `d`, warp gradient last; physical units:
     /// channel units, radians for rotation vectors, demo samples per reference sample for
@@ -78,6 +80,7 @@ impl Default for FitParams {
             warp: tandem_warp::WarpParams {
                 lambda_inst: 0.02,
                 smooth_width: 1,
+                fill_length: 0.0,
                 ..tandem_warp::WarpParams::default()
             },
             ranges: None,
