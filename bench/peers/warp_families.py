@@ -9,8 +9,10 @@ samples at every reference sample: mean and 95th percentile over all samples of 
 the samples outside dwells, where every channel is flat and the warp is not identifiable).
 
 Seeds: every family draws its cases from NumPy's `default_rng([2027, family index, seed])`.
-Seeds 0-7 (SELECT_SEEDS) are the ones tandem-warp's defaults were chosen on; seeds 1000-1005
-(HELD_OUT_SEEDS) were used for nothing but the reported table.
+Seeds 0-7 (SELECT_SEEDS) are the ones tandem-warp's defaults were chosen on; seeds 1000-1023
+were used for nothing but the reported tables: 1000-1005 (HELD_OUT_SEEDS, `--seeds held-out`)
+and all 24 (HELD_OUT_SEEDS_24, `--seeds held-out-24`), six cases per family giving a noisy ratio
+where single cases differ a lot (the dwell family).
 
 Scaling and weights, as tandem-lfd aligns demonstrations: every channel is divided by its range
 over both demonstrations (tandem-lfd's `W = diag(1/r_j^2)` with `r_j` the range over all
@@ -47,6 +49,7 @@ from gdtw_compare import ROOT, build_tandem  # noqa: E402
 
 SELECT_SEEDS = list(range(0, 8))
 HELD_OUT_SEEDS = list(range(1000, 1006))
+HELD_OUT_SEEDS_24 = list(range(1000, 1024))
 T_REF = 3000
 S_MIN, S_MAX = 0.25, 4.0  # tandem-warp's slope bounds
 TRUE_SLOPE = (0.3, 3.6)  # every true warp's slope stays inside
@@ -78,6 +81,8 @@ BASE = {
     "slowdowns": (2, 3, 0.5, 0.7),  # count range, depth range (fraction of speed removed)
     "abrupt": (0.3, 3.0, 4, 8),   # abrupt profile: speed factor range, segment count range
     "length": ((0.7, 1.4),),      # T_query / T_ref drawn uniformly from one of these intervals
+    "pauses": None,               # (lo, hi): the query stays in every dwell lo..hi times as long
+    "segments": None,             # (lo, hi): both take every dwell and reach at their own pace
 }
 FAMILIES = {
     # warp_truth.py's task: 3-D reaches, a contact force with small ripples, a gripper, dwells
@@ -102,6 +107,15 @@ FAMILIES = {
     # mid-reach; after range scaling the small channels' noise is large and the binary step sharp
     "scales": {"box": (0.6, 0.006, 0.6), "force": (10.0, 50.0), "torque": (0.05, 0.01),
                "grip_in_reach": True},
+    # pauses of independent length: the query stays in every dwell 0.5-2 times as long as its
+    # speed profile says (drawn per dwell), so the speed ratio jumps at every dwell's edges and is
+    # constant inside it; there the straight line of the slope penalty is right
+    "pauses": {"pauses": (0.5, 2.0)},
+    # every segment at its own pace: both demonstrations take every dwell and every reach 0.5-2
+    # times as long (drawn per segment and demonstration) at an otherwise constant speed, so the
+    # speed ratio is constant inside each segment and jumps at every edge, as when a demonstrator
+    # times each motion separately; a smooth speed ratio is the wrong prior here
+    "segments": {"harmonics": 0.0, "slowdowns": (0, 0, 0.5, 0.7), "segments": (0.5, 2.0)},
 }
 
 
@@ -199,12 +213,28 @@ def time_map(rng, p, abrupt=False, fine=200_001):
     return s, u / u[-1]
 
 
+def with_pauses(s, u, dwells, factors):
+    """The time map `(s, u)` (own time, task time, fine grid) of a demonstration that stays in
+    task-time interval `dwells[k]` `factors[k]` times as long: the own time spent on every step
+    inside it is scaled, and own time normalized again to [0, 1]."""
+    ds = np.diff(s)
+    mid = 0.5 * (u[1:] + u[:-1])
+    g = np.ones_like(ds)
+    for (a, b), f in zip(dwells, factors):
+        g[(mid >= a) & (mid <= b)] = f
+    s2 = np.concatenate([[0.0], np.cumsum(ds * g)])
+    return s2 / s2[-1], u
+
+
 def make_case(family, seed):
     """One case of a family: scaled reference and query (samples x channels), the true warp
     (query samples at every reference sample) and the dwell mask (per reference sample)."""
     p = family_params(family)
     rng = np.random.default_rng([2027, list(FAMILIES).index(family), seed])
     f, dwells = make_task(rng, p)
+    # every segment of the task, dwells and reaches, in task time
+    edges = sorted({e for d in dwells for e in d})
+    segments = list(zip(edges[:-1], edges[1:]))
     intervals = p["length"]
     lo, hi = intervals[int(rng.integers(len(intervals)))]
     t_query = int(round(T_REF * rng.uniform(lo, hi)))
@@ -212,6 +242,11 @@ def make_case(family, seed):
         # draw both speed profiles again until the true warp's slope stays in TRUE_SLOPE
         s_r, u_r = time_map(rng, p)
         s_q, u_q = time_map(rng, p, abrupt=p["profile"] == "abrupt")
+        if p["pauses"]:
+            s_q, u_q = with_pauses(s_q, u_q, dwells, rng.uniform(*p["pauses"], len(dwells)))
+        if p["segments"]:
+            s_r, u_r = with_pauses(s_r, u_r, segments, rng.uniform(*p["segments"], len(segments)))
+            s_q, u_q = with_pauses(s_q, u_q, segments, rng.uniform(*p["segments"], len(segments)))
         u_ref = np.interp(np.linspace(0, 1, T_REF), s_r, u_r)
         truth = np.interp(u_ref, u_q, s_q) * (t_query - 1)  # psi(n) = s_q^-1(u_ref(n))
         slope = np.diff(truth) * (T_REF - 1) / (t_query - 1)
@@ -287,6 +322,8 @@ def parse_seeds(text):
         return SELECT_SEEDS
     if text == "held-out":
         return HELD_OUT_SEEDS
+    if text == "held-out-24":
+        return HELD_OUT_SEEDS_24
     out = []
     for part in text.split(","):
         a, _, b = part.partition("-")
@@ -304,8 +341,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--families", default=",".join(FAMILIES), help="comma-separated families")
     ap.add_argument("--seeds", default="held-out",
-                    help="'select' (0-7, defaults chosen on them), 'held-out' (1000-1005), or a "
-                         "list such as 0-3,9")
+                    help="'select' (0-7, defaults chosen on them), 'held-out' (1000-1005), "
+                         "'held-out-24' (1000-1023), or a list such as 0-3,9")
     ap.add_argument("--tandem", action="append", default=None, metavar="JSON",
                     help="tandem-warp WarpParams as JSON (repeatable; default: the crate defaults)")
     ap.add_argument("--gdtw", action="append", default=[], choices=sorted(GDTW_SETTINGS) + ["all"],

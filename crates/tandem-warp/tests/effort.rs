@@ -12,7 +12,8 @@
 //! rise by more than a tolerance. The signals come in the families of
 //! `bench/peers/warp_families.py` ([`Family`]: clean and noisy sensors, ripple and vibration,
 //! long dwells, abrupt speed changes, very different lengths, channels of very different
-//! scales), one test per family.
+//! scales, pauses of their own length, every segment at its own pace), one test per family,
+//! at the defaults (so with the smoothing and the fill of flat stretches).
 //!
 //! Why a tolerance, and why in units of the noise: the search is a chain of local passes, and a
 //! chain that searches more can end in another local optimum; an exact "never rises" would need
@@ -58,6 +59,13 @@ enum Family {
     Length,
     /// The second channel moves a tenth as far (same absolute noise); weights `1/range²`.
     Scales,
+    /// The query stays in every dwell 0.5–2 times as long as its smooth time map says (drawn per
+    /// dwell): the speed ratio jumps at the dwells' edges.
+    Pauses,
+    /// No smooth speed change: both demonstrations take every dwell and every reach 0.6–1.6
+    /// times as long (drawn per segment and demonstration), so the speed ratio is constant
+    /// inside every segment and jumps at every edge.
+    Segments,
 }
 
 /// A reference and a query of one task, with their channel count.
@@ -99,6 +107,20 @@ impl Task {
         (1.0 - self.dwell * (k + 1) as f64) / k as f64
     }
 
+    /// The task-time edges of its segments, `0 = e₀ < e₁ < … = 1`: dwell, reach, …, dwell.
+    fn edges(&self) -> Vec<f64> {
+        let k = self.waypoints.len() - 1;
+        let mut edges = vec![0.0];
+        for i in 0..=k {
+            edges.push(self.dwell * (i + 1) as f64 + self.reach() * i as f64);
+            if i < k {
+                edges.push(self.dwell * (i + 1) as f64 + self.reach() * (i + 1) as f64);
+            }
+        }
+        *edges.last_mut().unwrap() = 1.0;
+        edges
+    }
+
     /// Whether task time `u` lies in a dwell (all channels flat: the warp is not identifiable).
     fn in_dwell(&self, u: f64) -> bool {
         let period = self.dwell + self.reach();
@@ -134,12 +156,22 @@ enum TimeMap {
     Smooth { a: f64, centre: f64, depth: f64 },
     /// Piecewise-constant speeds, one per equal piece of own time.
     Abrupt(Vec<f64>),
+    /// `base`, but every task-time segment takes its own factor times as much of the
+    /// demonstration's own time as `base` gives it (then normalized): own time at task time
+    /// `j / (len − 1)` tabulated, linear in between ([`TimeMap::stretched`]).
+    Stretched(Vec<f64>),
 }
 
 impl TimeMap {
     fn task_time(&self, s: f64) -> f64 {
         use std::f64::consts::PI;
         match self {
+            Self::Stretched(own) => {
+                // the inverse of the tabulated own time (increasing)
+                let j = own.partition_point(|&o| o < s).clamp(1, own.len() - 1);
+                let f = ((s - own[j - 1]) / (own[j] - own[j - 1])).clamp(0.0, 1.0);
+                (j as f64 - 1.0 + f) / (own.len() - 1) as f64
+            }
             Self::Smooth { a, centre, depth } => {
                 // ∫ speed, speed = 1 + a cos(2π s) − depth · bump(s − centre), normalized to end at 1
                 let width = 0.05;
@@ -163,8 +195,32 @@ impl TimeMap {
         }
     }
 
+    /// `base` with task-time segment `edges[i]..edges[i + 1]` taking `factors[i]` times as much
+    /// own time, tabulated at 4001 task times.
+    fn stretched(base: &TimeMap, edges: &[f64], factors: &[f64]) -> Self {
+        let spent = |u: f64| -> f64 {
+            edges
+                .windows(2)
+                .zip(factors)
+                .map(|(e, f)| f * (base.own_time(u.clamp(e[0], e[1])) - base.own_time(e[0])))
+                .sum()
+        };
+        let total = spent(1.0);
+        let m = 4000;
+        Self::Stretched(
+            (0..=m)
+                .map(|j| spent(j as f64 / m as f64) / total)
+                .collect(),
+        )
+    }
+
     /// Own normalized time at task time `u` (bisection; the map is increasing).
     fn own_time(&self, u: f64) -> f64 {
+        if let Self::Stretched(own) = self {
+            let x = u.clamp(0.0, 1.0) * (own.len() - 1) as f64;
+            let j = (x as usize).min(own.len() - 2);
+            return own[j] + (x - j as f64) * (own[j + 1] - own[j]);
+        }
         let (mut lo, mut hi) = (0.0, 1.0);
         for _ in 0..60 {
             let mid = 0.5 * (lo + hi);
@@ -218,16 +274,22 @@ fn signals(family: Family) -> impl Strategy<Value = Pair> {
         (smooth_map(), query_map),
         (40.0f64..80.0, 60.0f64..120.0, 60.0f64..120.0, 0.0f64..6.3),
         prop::collection::vec(-1.0f64..1.0, 3 * 700),
+        // per-segment factors of the reference and of the query (Pauses, Segments)
+        (
+            prop::collection::vec(0.6f64..1.6, 11),
+            prop::collection::vec(0.5f64..2.0, 11),
+        ),
     )
         .prop_map(
-            move |((k, n_ref, ratio, dwell), points, (r_map, q_map), ripple, noise)| {
+            move |((k, n_ref, ratio, dwell), points, maps, ripple, noise, factors)| {
                 make_pair(
                     family,
                     (k, n_ref, ratio, dwell),
                     &points,
-                    (r_map, q_map),
+                    maps,
                     ripple,
                     noise,
+                    factors,
                 )
             },
         )
@@ -242,6 +304,7 @@ fn make_pair(
     (r_map, q_map): (TimeMap, TimeMap),
     (ripple_f, vib_r, vib_q, phase): (f64, f64, f64, f64),
     noise: Vec<f64>,
+    (factors_r, factors_q): (Vec<f64>, Vec<f64>),
 ) -> Pair {
     // each reach moves 0.3–0.6 in a random direction (the second channel a tenth of that in
     // the Scales family)
@@ -258,6 +321,35 @@ fn make_pair(
         waypoints,
         toggles: points.iter().take(k).map(|p| p.2).collect(),
         dwell,
+    };
+    let edges = task.edges();
+    let stretch = |base: TimeMap, factors: Vec<f64>| TimeMap::stretched(&base, &edges, &factors);
+    let steady = || TimeMap::Smooth {
+        a: 0.0,
+        centre: 0.5,
+        depth: 0.0,
+    };
+    let n_seg = edges.len() - 1;
+    let (r_map, q_map) = match family {
+        // the query's dwells (even segments) 0.5–2 times as long, its reaches as they were
+        Family::Pauses => {
+            let f = (0..n_seg)
+                .map(|i| if i % 2 == 0 { factors_q[i] } else { 1.0 })
+                .collect();
+            (r_map, stretch(q_map, f))
+        }
+        // every segment of both at its own pace, 0.6–1.6 (the query's 0.5–2 mapped onto it)
+        Family::Segments => (
+            stretch(steady(), factors_r[..n_seg].to_vec()),
+            stretch(
+                steady(),
+                factors_q[..n_seg]
+                    .iter()
+                    .map(|f| 0.6 + (f - 0.5) / 1.5)
+                    .collect(),
+            ),
+        ),
+        _ => (r_map, q_map),
     };
     let ratio = match family {
         Family::Length if ratio < 0.5 => 0.6 + 0.2 * ratio,
@@ -466,6 +558,20 @@ proptest! {
     #[test]
     fn more_effort_helps_with_channels_of_different_scales(
         pair in signals(Family::Scales), (less, more) in efforts()
+    ) {
+        check(&pair, less, more)?;
+    }
+
+    #[test]
+    fn more_effort_helps_with_pauses_of_their_own_length(
+        pair in signals(Family::Pauses), (less, more) in efforts()
+    ) {
+        check(&pair, less, more)?;
+    }
+
+    #[test]
+    fn more_effort_helps_when_every_segment_has_its_own_pace(
+        pair in signals(Family::Segments), (less, more) in efforts()
     ) {
         check(&pair, less, more)?;
     }
