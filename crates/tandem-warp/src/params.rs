@@ -53,11 +53,10 @@ pub const DEFAULT_NODE_SPACING: usize = 4;
 /// (docs/decisions.md, "tandem-warp: flat stretches").
 /// The alignment is done on the caller's scale: the benchmark, like `tandem-lfd`, divides
 /// every channel by its range (`W = diag(1/r²)` on raw data).
-/// The defaults align two ~10 000-sample, 9-channel fixture demonstrations in about 20 ms on
-/// one core (bench `align_fixture`: 17.2 and 18.6 ms under a load average of 4–5 on the 2-core
-/// build machine before the smoothing, against 14.6 and 15.7 ms for the solver before the
-/// band-edge fix and the noise term in the same session; in a later, slower session 20.35 ms
-/// with the smoothing against 19.97 ms without, in one run).
+/// The defaults align two ~10 000-sample, 9-channel fixture demonstrations in about 14 ms on
+/// one core (bench `align_fixture` on the 2-core build machine: 14.1 and 13.7 ms, against 16.6
+/// and 15.9 ms for the build before the fill and the bounded transitions in the same session;
+/// docs/decisions.md, "tandem-warp: flat stretches").
 /// To solve "the same problem" as the authors'
 /// `gdtw` package, use `n_nodes = Some(T_ref)` (one node per reference sample),
 /// `n_candidates = 301`, `smooth_width = 1` and `fill_length = 0`.
