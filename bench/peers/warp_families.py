@@ -213,14 +213,14 @@ def time_map(rng, p, abrupt=False, fine=200_001):
     return s, u / u[-1]
 
 
-def with_pauses(s, u, dwells, factors):
+def stretched(s, u, intervals, factors):
     """The time map `(s, u)` (own time, task time, fine grid) of a demonstration that stays in
-    task-time interval `dwells[k]` `factors[k]` times as long: the own time spent on every step
+    task-time interval `intervals[k]` `factors[k]` times as long: the own time spent on every step
     inside it is scaled, and own time normalized again to [0, 1]."""
     ds = np.diff(s)
     mid = 0.5 * (u[1:] + u[:-1])
     g = np.ones_like(ds)
-    for (a, b), f in zip(dwells, factors):
+    for (a, b), f in zip(intervals, factors):
         g[(mid >= a) & (mid <= b)] = f
     s2 = np.concatenate([[0.0], np.cumsum(ds * g)])
     return s2 / s2[-1], u
@@ -243,10 +243,10 @@ def make_case(family, seed):
         s_r, u_r = time_map(rng, p)
         s_q, u_q = time_map(rng, p, abrupt=p["profile"] == "abrupt")
         if p["pauses"]:
-            s_q, u_q = with_pauses(s_q, u_q, dwells, rng.uniform(*p["pauses"], len(dwells)))
+            s_q, u_q = stretched(s_q, u_q, dwells, rng.uniform(*p["pauses"], len(dwells)))
         if p["segments"]:
-            s_r, u_r = with_pauses(s_r, u_r, segments, rng.uniform(*p["segments"], len(segments)))
-            s_q, u_q = with_pauses(s_q, u_q, segments, rng.uniform(*p["segments"], len(segments)))
+            s_r, u_r = stretched(s_r, u_r, segments, rng.uniform(*p["segments"], len(segments)))
+            s_q, u_q = stretched(s_q, u_q, segments, rng.uniform(*p["segments"], len(segments)))
         u_ref = np.interp(np.linspace(0, 1, T_REF), s_r, u_r)
         truth = np.interp(u_ref, u_q, s_q) * (t_query - 1)  # psi(n) = s_q^-1(u_ref(n))
         slope = np.diff(truth) * (T_REF - 1) / (t_query - 1)

@@ -344,29 +344,20 @@ struct WarpParamsV8 {
     weights: Option<Vec<f64>>,
 }
 
-/// `tandem_warp::WarpParams` as state format 9 wrote them: without `fill_length` (field for
-/// field: postcard has no field names, so `#[serde(flatten)]` cannot share [`WarpParamsV8`]).
+/// `tandem_warp::WarpParams` as state format 9 wrote them: format 8's fields, then
+/// `smooth_width` (postcard writes a nested struct as its fields in order, so nesting
+/// [`WarpParamsV8`] reads the same bytes), without `fill_length`.
 #[derive(Deserialize)]
 struct WarpParamsV9 {
-    n_nodes: Option<usize>,
-    n_candidates: usize,
-    lambda_inst: f64,
-    lambda_cum: f64,
-    slope_min: f64,
-    slope_max: f64,
-    refinements: usize,
-    refine_radius: f64,
-    max_jump: Option<usize>,
-    coarse_nodes: usize,
-    coarse_candidates: usize,
-    weights: Option<Vec<f64>>,
+    v8: WarpParamsV8,
     smooth_width: usize,
 }
 
 impl From<WarpParamsV9> for tandem_warp::WarpParams {
     /// The saved parameters with `fill_length = 0`: flat stretches were not filled (the
     /// alignment the file's model was fitted with).
-    fn from(w: WarpParamsV9) -> Self {
+    fn from(v9: WarpParamsV9) -> Self {
+        let w = v9.v8;
         tandem_warp::WarpParams {
             n_nodes: w.n_nodes,
             n_candidates: w.n_candidates,
@@ -380,7 +371,7 @@ impl From<WarpParamsV9> for tandem_warp::WarpParams {
             coarse_nodes: w.coarse_nodes,
             coarse_candidates: w.coarse_candidates,
             weights: w.weights,
-            smooth_width: w.smooth_width,
+            smooth_width: v9.smooth_width,
             fill_length: 0.0,
         }
     }
@@ -389,20 +380,9 @@ impl From<WarpParamsV9> for tandem_warp::WarpParams {
 impl From<WarpParamsV8> for tandem_warp::WarpParams {
     /// The saved parameters with `smooth_width = 1` and `fill_length = 0`: the signals were
     /// aligned unsmoothed and unfilled (the alignment the file's model was fitted with).
-    fn from(w: WarpParamsV8) -> Self {
+    fn from(v8: WarpParamsV8) -> Self {
         WarpParamsV9 {
-            n_nodes: w.n_nodes,
-            n_candidates: w.n_candidates,
-            lambda_inst: w.lambda_inst,
-            lambda_cum: w.lambda_cum,
-            slope_min: w.slope_min,
-            slope_max: w.slope_max,
-            refinements: w.refinements,
-            refine_radius: w.refine_radius,
-            max_jump: w.max_jump,
-            coarse_nodes: w.coarse_nodes,
-            coarse_candidates: w.coarse_candidates,
-            weights: w.weights,
+            v8,
             smooth_width: 1,
         }
         .into()

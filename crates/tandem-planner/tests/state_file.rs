@@ -277,101 +277,66 @@ fn a_version_6_file_loads_with_the_papers_confidence_model() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// `tests/fixtures/example_v7.tandem`: the golden state file as format version 7 wrote it
-/// (no hold points), copied before the format became version 8.
-fn v7_path() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/example_v7.tandem")
+/// `tests/fixtures/example_v<version>.tandem`: the golden state file as that format version
+/// wrote it, copied before the format changed.
+fn old_golden_path(version: u32) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/example_v{version}.tandem"))
+}
+
+/// Loads the old golden file of `version`, checks that it is of that version, loads as the
+/// planner of the current golden file (same parameters and outcome), is `added` bytes shorter,
+/// and saves as the current golden file's bytes; returns the loaded planner.
+fn old_golden_loads_and_saves_as_the_golden_file(version: u32, added: usize) -> Planner {
+    let old_bytes = std::fs::read(old_golden_path(version)).unwrap();
+    assert_eq!(
+        u32::from_le_bytes(old_bytes[8..12].try_into().unwrap()),
+        version
+    );
+    let old = Planner::load(old_golden_path(version)).unwrap();
+    let new = Planner::load(golden_path()).unwrap();
+    assert_eq!(old.params(), new.params());
+    assert_eq!(old.outcome(), new.outcome());
+    let golden = std::fs::read(golden_path()).unwrap();
+    assert_eq!(golden.len(), old_bytes.len() + added);
+    let dir = tmp_dir(&format!("v{version}"));
+    let again = dir.join("again.tandem");
+    old.save(&again).unwrap();
+    assert!(
+        std::fs::read(&again).unwrap() == golden,
+        "a version {version} file saved again differs from the golden file of the same inputs"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    old
 }
 
 #[test]
 fn a_version_7_file_loads_without_holds_and_saves_as_the_golden_file() {
-    let v7 = std::fs::read(v7_path()).unwrap();
-    assert_eq!(u32::from_le_bytes(v7[8..12].try_into().unwrap()), 7);
-    let old = Planner::load(v7_path()).unwrap();
+    // No hold points (format 7 had none). The same inputs without holds: version 8 adds only
+    // the empty declaration (two empty lists) and the schedule's empty holds (one list), one
+    // byte each, version 9 the fit's `smooth_width` (1, one byte), version 10 its
+    // `fill_length` (0.0, eight bytes), and saving the old file writes the golden file's
+    // bytes, so a planner without holds is the planner of before, bit for bit.
+    let old = old_golden_loads_and_saves_as_the_golden_file(7, 12);
     assert!(old.params().holds.is_empty());
     assert!(old.problem().holds().is_empty());
-    let new = Planner::load(golden_path()).unwrap();
-    assert_eq!(old.params(), new.params());
-    assert_eq!(old.outcome(), new.outcome());
-    // The same inputs without holds: version 8 adds only the empty declaration (two empty
-    // lists) and the schedule's empty holds (one list), one byte each, version 9 the fit's
-    // `smooth_width` (1, one byte), version 10 its `fill_length` (0.0, eight bytes), and
-    // saving the old file writes the golden file's bytes, so a planner without holds is the
-    // planner of before, bit for bit.
-    let golden = std::fs::read(golden_path()).unwrap();
-    assert_eq!(golden.len(), v7.len() + 12);
-    let dir = tmp_dir("v7");
-    let again = dir.join("again.tandem");
-    old.save(&again).unwrap();
-    assert!(
-        std::fs::read(&again).unwrap() == golden,
-        "a version 7 file saved again differs from the golden file of the same inputs"
-    );
-    std::fs::remove_dir_all(&dir).unwrap();
-}
-
-/// `tests/fixtures/example_v8.tandem`: the golden state file as format version 8 wrote it
-/// (the fit's warp parameters without `smooth_width`), copied before the format became
-/// version 9.
-fn v8_path() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/example_v8.tandem")
 }
 
 #[test]
 fn a_version_8_file_loads_unsmoothed_and_saves_as_the_golden_file() {
-    let v8 = std::fs::read(v8_path()).unwrap();
-    assert_eq!(u32::from_le_bytes(v8[8..12].try_into().unwrap()), 8);
-    let old = Planner::load(v8_path()).unwrap();
     // Fitted before smoothing existed: loaded as unsmoothed, which is also what the golden
-    // file's fit (the default `FitParams`) uses.
+    // file's fit (the default `FitParams`) uses. Version 9 adds one byte (`smooth_width = 1`),
+    // version 10 eight (`fill_length = 0.0`).
+    let old = old_golden_loads_and_saves_as_the_golden_file(8, 9);
     assert_eq!(old.params().fit.warp.smooth_width, 1);
-    let new = Planner::load(golden_path()).unwrap();
-    assert_eq!(old.params(), new.params());
-    assert_eq!(old.outcome(), new.outcome());
-    // Version 9 adds one byte (`smooth_width = 1`), version 10 eight (`fill_length = 0.0`);
-    // saving the old file writes the golden file's bytes.
-    let golden = std::fs::read(golden_path()).unwrap();
-    assert_eq!(golden.len(), v8.len() + 9);
-    let dir = tmp_dir("v8");
-    let again = dir.join("again.tandem");
-    old.save(&again).unwrap();
-    assert!(
-        std::fs::read(&again).unwrap() == golden,
-        "a version 8 file saved again differs from the golden file of the same inputs"
-    );
-    std::fs::remove_dir_all(&dir).unwrap();
-}
-
-/// `tests/fixtures/example_v9.tandem`: the golden state file as format version 9 wrote it
-/// (the fit's warp parameters without `fill_length`), copied before the format became
-/// version 10.
-fn v9_path() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/example_v9.tandem")
 }
 
 #[test]
 fn a_version_9_file_loads_unfilled_and_saves_as_the_golden_file() {
-    let v9 = std::fs::read(v9_path()).unwrap();
-    assert_eq!(u32::from_le_bytes(v9[8..12].try_into().unwrap()), 9);
-    let old = Planner::load(v9_path()).unwrap();
     // Fitted before the fill of flat stretches existed: loaded without it, which is also what
-    // the golden file's fit (the default `FitParams`) uses.
+    // the golden file's fit (the default `FitParams`) uses. Version 10 adds eight bytes
+    // (`fill_length = 0.0`, an f64).
+    let old = old_golden_loads_and_saves_as_the_golden_file(9, 8);
     assert_eq!(old.params().fit.warp.fill_length, 0.0);
-    let new = Planner::load(golden_path()).unwrap();
-    assert_eq!(old.params(), new.params());
-    assert_eq!(old.outcome(), new.outcome());
-    // Version 10 adds eight bytes (`fill_length = 0.0`, an f64); saving the old file writes
-    // the golden file's bytes.
-    let golden = std::fs::read(golden_path()).unwrap();
-    assert_eq!(golden.len(), v9.len() + 8);
-    let dir = tmp_dir("v9");
-    let again = dir.join("again.tandem");
-    old.save(&again).unwrap();
-    assert!(
-        std::fs::read(&again).unwrap() == golden,
-        "a version 9 file saved again differs from the golden file of the same inputs"
-    );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -202,10 +202,13 @@ pub(crate) fn fill_flats(
     // normal equations of the quadratic above over all nr samples (bands of a symmetric
     // pentadiagonal matrix), then the two pinned ends eliminated
     let (qs, h) = (prep.qscale, prep.h);
-    let q = &prep.q;
-    let slope_at = |t: usize, c: usize| {
-        let (a, b) = (t.saturating_sub(1), (t + 1).min(nq - 1));
-        (q[b * nc + c] - q[a * nc + c]) / (b - a) as f64
+    // the smoothed query's central difference at sample t, from its forward differences
+    // (one-sided at both ends)
+    let dq = &prep.dq;
+    let slope_at = |t: usize, c: usize| match (t.checked_sub(1), t + 1 < nq) {
+        (Some(a), true) => 0.5 * (dq[a * nc + c] + dq[t * nc + c]),
+        (Some(a), false) => dq[a * nc + c],
+        (None, _) => dq[c],
     };
     let mut d0 = vec![0.0; nr];
     let mut d1 = vec![0.0; nr];
