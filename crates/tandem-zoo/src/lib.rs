@@ -67,6 +67,7 @@
 
 mod engine;
 mod error;
+pub mod eval;
 mod families;
 mod task;
 
