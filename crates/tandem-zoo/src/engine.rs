@@ -224,10 +224,6 @@ pub(crate) struct Feature {
 
 /// The events of [`Feature`].
 #[derive(Clone, Copy, Debug)]
-#[expect(
-    dead_code,
-    reason = "the families using spikes and spirals come in the next commits"
-)]
 pub(crate) enum FeatureKind {
     /// A raised-cosine spike added to `ch`: peak `peak ± peak_var` and centre in local phase
     /// `at.0..at.1`, both stratified over the demonstrations; half-width `width` (local phase).

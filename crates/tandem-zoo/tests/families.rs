@@ -18,7 +18,7 @@ fn tasks() -> impl Iterator<Item = ZooTask> {
 #[test]
 fn at_least_eight_families_with_unique_names() {
     let names: Vec<&str> = families().iter().map(|f| f.name).collect();
-    assert!(!names.is_empty(), "{names:?}"); // eight once every family is in
+    assert!(names.len() >= 8, "{names:?}");
     let mut sorted = names.clone();
     sorted.sort_unstable();
     sorted.dedup();
