@@ -303,6 +303,9 @@ pub(crate) struct Script {
     pub(crate) jitter: f64,
     /// Total length spread, fraction (`T_i = T_nominal·(1 ± length_var)`).
     pub(crate) length_var: f64,
+    /// How unsteady the demonstrator's pace is: every segment's `wobble` is multiplied by it
+    /// (0.5: a steady hand, ±15 % speed within a free move; 1: ±30 %).
+    pub(crate) wobble_scale: f64,
 }
 
 /// Draws the family's per-seed choices: a ChaCha8 stream from the seed and the family's name
@@ -417,8 +420,11 @@ impl Script {
         if !(1.0..=10_000.0).contains(&self.rate_hz) || !(0.0..=0.12).contains(&self.jitter) {
             return Err(self.bad(format!("rate {} Hz, jitter {}", self.rate_hz, self.jitter)));
         }
-        if !(0.0..0.5).contains(&self.length_var) {
-            return Err(self.bad(format!("length_var {}", self.length_var)));
+        if !(0.0..0.5).contains(&self.length_var) || !(0.0..=1.0).contains(&self.wobble_scale) {
+            return Err(self.bad(format!(
+                "length_var {}, wobble_scale {}",
+                self.length_var, self.wobble_scale
+            )));
         }
         if let Some(q) = self.quat
             && (q + 4 > m
@@ -621,7 +627,7 @@ pub(crate) fn render(script: &Script, rng: &mut ChaCha8Rng) -> Result<ZooTask> {
             .segments
             .iter()
             .map(|s| {
-                let a = s.wobble * uniform(rng, -1.0, 1.0);
+                let a = s.wobble * script.wobble_scale * uniform(rng, -1.0, 1.0);
                 let m = if rng.random::<bool>() { 1.0 } else { 2.0 };
                 (a, m)
             })

@@ -25,8 +25,10 @@
 //!
 //! Every demonstration of a seed follows one underlying mean path through the task's
 //! segments; they differ by (a) speed — each segment's duration drawn independently per
-//! demonstration (`±8 %` for motions, `±40–60 %` for pauses and dwells), a monotone speed
-//! wobble inside each segment, and a total length within `±(5–8.5) %` of nominal; (b) sensor
+//! demonstration (`±8–20 %` for motions, `±30–60 %` for pauses and dwells), a monotone speed
+//! wobble inside each segment (up to ±10 % of the pace within a free move for the careful
+//! tasks, screw driving and deburring, ±15 % for most, ±21 % for pick-and-place, ±24 % for
+//! cable routing), and a total length within `±(5–8.5) %` of nominal; (b) sensor
 //! noise — white noise and a smooth tremor, about 0.5 % of each channel's range; and (c)
 //! *variable sections* — per-demonstration offsets or waves in some channels over a span of
 //! progress (a part placed elsewhere, a cable lying differently), and local events that

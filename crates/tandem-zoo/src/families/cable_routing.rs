@@ -20,6 +20,9 @@ const QZ: usize = 5;
 const GRIPPER: usize = 7;
 const TENSION: usize = 8;
 
+/// How unsteady the demonstrator's pace is ([`Script::wobble_scale`]): a hand pulling a cable, uneven (±24 % within a free move).
+const WOBBLE: f64 = 0.8;
+
 /// Generates the task for `seed`.
 pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let mut rng = rng_for(NAME, seed);
@@ -178,6 +181,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
         rate_hz,
         jitter,
         length_var,
+        wobble_scale: WOBBLE,
     };
     render(&script, &mut rng)
 }

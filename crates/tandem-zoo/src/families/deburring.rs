@@ -21,6 +21,9 @@ const FY: usize = 8;
 const FZ: usize = 9;
 const SPINDLE: usize = 10;
 
+/// How unsteady the demonstrator's pace is ([`Script::wobble_scale`]): a steady, careful pace (±10 % within a free move).
+const WOBBLE: f64 = 0.35;
+
 /// Generates the task for `seed`.
 pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let mut rng = rng_for(NAME, seed);
@@ -140,6 +143,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
         rate_hz,
         jitter,
         length_var,
+        wobble_scale: WOBBLE,
     };
     render(&script, &mut rng)
 }

@@ -22,6 +22,9 @@ const SPRAY: usize = 8;
 /// Number of strokes; stroke `k` is segment `1 + 2k`.
 const N_STROKES: usize = 6;
 
+/// How unsteady the demonstrator's pace is ([`Script::wobble_scale`]): an ordinary hand (±15 % within a free move).
+const WOBBLE: f64 = 0.5;
+
 /// Generates the task for `seed`.
 pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let mut rng = rng_for(NAME, seed);
@@ -130,6 +133,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
         rate_hz,
         jitter,
         length_var,
+        wobble_scale: WOBBLE,
     };
     render(&script, &mut rng)
 }

@@ -22,6 +22,9 @@ const GRIPPER: usize = 7;
 /// Segments per object.
 const PER_OBJECT: usize = 8;
 
+/// How unsteady the demonstrator's pace is ([`Script::wobble_scale`]): a quick, uneven hand (±21 % within a free move).
+const WOBBLE: f64 = 0.7;
+
 /// Generates the task for `seed`.
 pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let mut rng = rng_for(NAME, seed);
@@ -122,6 +125,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
         rate_hz,
         jitter,
         length_var,
+        wobble_scale: WOBBLE,
     };
     render(&script, &mut rng)
 }
