@@ -99,7 +99,7 @@
 //! ## polishing
 //!
 //! Five raster strokes under a 15 N contact force, with a pad change after the third (the
-//! tool lifts, turns the pad 0.5 rad towards the operator and waits ±50 %). 24.7 s nominal
+//! tool lifts, turns the pad 0.5 rad towards the operator and waits ±50 %). 23.7 s nominal
 //! at 100 or 200 Hz, 3–12 demonstrations; channels: position (m), orientation (quaternion),
 //! `force` (N), `tool` (0/1). Need, by seed: the first contact and first stroke (how hard the
 //! pad bites before the force settles: ±6 N as a wave; p 0.4–0.8; the task's start) and/or

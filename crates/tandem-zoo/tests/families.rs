@@ -418,3 +418,101 @@ fn the_zoo_covers_what_users_vary() {
         "{with_holds} with holds"
     );
 }
+
+#[test]
+fn the_crate_docs_table_is_true() {
+    // (family, channels, rates, demonstration counts, nominal duration in s per rate)
+    type Row = (
+        &'static str,
+        &'static str,
+        &'static [f64],
+        (usize, usize),
+        fn(f64) -> f64,
+    );
+    let table: [Row; 8] = [
+        (
+            "dispensing",
+            "x,y,z,qx,qy,qz,qw,flow,valve",
+            &[100.0, 125.0, 200.0],
+            (4, 10),
+            |_| 22.8,
+        ),
+        (
+            "peg_insertion",
+            "x,y,z,qx,qy,qz,qw,fx,fy,fz",
+            &[250.0, 500.0],
+            (3, 8),
+            |_| 9.5,
+        ),
+        (
+            "screw_driving",
+            "x,y,z,torque,fz,spindle",
+            &[500.0, 1000.0],
+            (3, 8),
+            |r| {
+                if r == 1000.0 { 5.1 } else { 7.4 }
+            },
+        ),
+        (
+            "polishing",
+            "x,y,z,qx,qy,qz,qw,force,tool",
+            &[100.0, 200.0],
+            (3, 12),
+            |_| 23.7,
+        ),
+        (
+            "pick_and_place",
+            "x,y,z,qx,qy,qz,qw,gripper",
+            &[50.0, 100.0],
+            (3, 12),
+            |_| 26.4,
+        ),
+        (
+            "painting",
+            "x,y,z,qx,qy,qz,qw,flow,spray",
+            &[50.0, 100.0],
+            (3, 12),
+            |_| 28.2,
+        ),
+        (
+            "deburring",
+            "x,y,z,qx,qy,qz,qw,fx,fy,fz,spindle",
+            &[200.0, 250.0],
+            (3, 10),
+            |_| 20.4,
+        ),
+        (
+            "cable_routing",
+            "x,y,z,qx,qy,qz,qw,gripper,tension",
+            &[50.0],
+            (3, 12),
+            |_| 36.0,
+        ),
+    ];
+    let names: Vec<&str> = families().iter().map(|f| f.name).collect();
+    assert_eq!(
+        names,
+        table.map(|r| r.0),
+        "the docs list the families in this order"
+    );
+    for (name, channels, rates, (lo, hi), nominal_s) in table {
+        for seed in SELECTION_SEEDS {
+            let task = (family(name).unwrap().generate)(seed).unwrap();
+            let what = format!("{name} seed {seed}");
+            let header = task.files[0].1.lines().next().unwrap();
+            assert_eq!(header, format!("t,{channels}"), "{what}");
+            assert!(rates.contains(&task.rate_hz), "{what}: {} Hz", task.rate_hz);
+            assert!(
+                (lo..=hi).contains(&task.n_demos()),
+                "{what}: {}",
+                task.n_demos()
+            );
+            let nominal = nominal_s(task.rate_hz);
+            for p in &task.progress {
+                let duration_s = (p.len() - 1) as f64 / task.rate_hz;
+                let ratio = duration_s / nominal;
+                assert!((0.91..=1.09).contains(&ratio), "{what}: {duration_s} s");
+            }
+        }
+    }
+}
