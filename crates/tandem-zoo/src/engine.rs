@@ -32,6 +32,9 @@
 //! at `i·Δt` plus a jitter uniform in `±jitter·Δt` (`jitter ≤ 0.12`, inside the loader's 25 %
 //! of a period around the even grid through the first and last times, docs/decisions.md,
 //! "Timestamps: the mean period, jitter within 25 %"). Values are taken at the jittered time.
+//! For half the seeds the stamps are the controller's clock: each demonstration's `t` starts
+//! at its own offset of 1–60 min (whole milliseconds), as a log cut from a longer recording
+//! does; for the others `t` starts at 0.
 
 use std::f64::consts::TAU;
 use std::fmt::Write as _;
@@ -597,6 +600,14 @@ pub(crate) fn render(script: &Script, rng: &mut ChaCha8Rng) -> Result<ZooTask> {
         })
         .collect();
 
+    let clock_offsets_s: Vec<f64> = if rng.random::<bool>() {
+        (0..n)
+            .map(|_| (uniform(rng, 60.0, 3600.0) * 1000.0).round() / 1000.0)
+            .collect()
+    } else {
+        vec![0.0; n]
+    };
+
     let header = {
         let mut h = String::from("t");
         for c in &script.channels {
@@ -764,7 +775,7 @@ pub(crate) fn render(script: &Script, rng: &mut ChaCha8Rng) -> Result<ZooTask> {
                 }
             }
 
-            write_row(&mut text, t, &values, script);
+            write_row(&mut text, clock_offsets_s[i] + t, &values, script);
         }
         files.push((format!("demo_{i}.csv"), text));
         progress.push(prog);
@@ -783,7 +794,7 @@ pub(crate) fn render(script: &Script, rng: &mut ChaCha8Rng) -> Result<ZooTask> {
     })
 }
 
-/// Appends one CSV row: `t` with 6 decimals (microseconds), then every channel.
+/// Appends one CSV row: the stamp `t` (s) with 6 decimals (microseconds), then every channel.
 fn write_row(text: &mut String, t: f64, values: &[f64], script: &Script) {
     let _ = write!(text, "{t:.6}");
     let quat = script.quat.map(|q| {

@@ -4,7 +4,8 @@
 //! The sanding fixture (`tandem_sim::task`) is one task; the defaults, the scheduler and the
 //! tests must hold on the tasks users bring. Each [`Family`] here models one kind of task from
 //! its own physics and practice, and generates for a seed what a user's recorder would write:
-//! 3–12 demonstrations as CSV files (a `t` column with time-stamp jitter, then the channels),
+//! 3–12 demonstrations as CSV files (a `t` column with time-stamp jitter, starting at 0 or,
+//! for half the seeds, at the controller's clock, then the channels),
 //! at 50 Hz – 1 kHz, of lengths within ±20 % of each other, with speed profiles that differ
 //! segment by segment, pauses of independent length and sensor noise. With them comes the
 //! truth ([`ZooTask`]): each row's true task progress (so the true warp between any two

@@ -516,3 +516,30 @@ fn the_crate_docs_table_is_true() {
         }
     }
 }
+
+#[test]
+fn some_logs_start_at_the_controllers_clock() {
+    // Seeds where every file's first stamp is 0 and seeds where none is: both occur, and the
+    // loader reads both at the task's rate (checked with every task above).
+    let first_stamps = |seed| {
+        let task = (families()[0].generate)(seed).unwrap();
+        task.files
+            .iter()
+            .map(|(_, text)| {
+                let row = text.lines().nth(1).unwrap();
+                row.split(',').next().unwrap().parse::<f64>().unwrap()
+            })
+            .collect::<Vec<f64>>()
+    };
+    let stamps: Vec<Vec<f64>> = SELECTION_SEEDS.map(first_stamps).collect();
+    assert!(
+        stamps.iter().any(|s| s.iter().all(|&t| t == 0.0)),
+        "{stamps:?}"
+    );
+    assert!(
+        stamps
+            .iter()
+            .any(|s| s.iter().all(|&t| (60.0..=3600.0).contains(&t))),
+        "{stamps:?}"
+    );
+}
