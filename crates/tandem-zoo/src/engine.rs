@@ -214,12 +214,12 @@ pub(crate) struct Variation {
 }
 
 /// A local event of one segment that differs between demonstrations; the operator is needed
-/// over the segment with probability `need_p`.
+/// with probability `need_p` over the part of the segment where it can happen.
 #[derive(Clone, Debug)]
 pub(crate) struct Feature {
     /// The segment.
     pub(crate) seg: usize,
-    /// p(need) over the segment.
+    /// p(need) where the event can happen.
     pub(crate) need_p: f64,
     /// What happens.
     pub(crate) kind: FeatureKind,
@@ -257,6 +257,20 @@ pub(crate) enum FeatureKind {
         /// Force channels and friction magnitude (N).
         friction: Option<(usize, usize, f64)>,
     },
+}
+
+impl FeatureKind {
+    /// The local phase over which the event can differ between demonstrations: a spike's
+    /// possible centres widened by its half-width, the whole segment for a spiral (its
+    /// direction, so its friction force, differs throughout).
+    fn span_u(self) -> (f64, f64) {
+        match self {
+            FeatureKind::Spike { at, width, .. } => {
+                ((at.0 - width).max(0.0), (at.1 + width).min(1.0))
+            }
+            FeatureKind::Spiral { .. } => (0.0, 1.0),
+        }
+    }
 }
 
 /// The operator is needed with probability `p` over local phase `from_u..to_u` of segment
@@ -511,8 +525,11 @@ impl Script {
             variable.push((p[v.first], p[v.last + 1]));
         }
         for f in &self.features {
-            parts.push((p[f.seg], p[f.seg + 1], f.need_p, true));
-            variable.push((p[f.seg], p[f.seg + 1]));
+            let (u0, u1) = f.kind.span_u();
+            let w = p[f.seg + 1] - p[f.seg];
+            let (a, b) = (p[f.seg] + w * u0, p[f.seg] + w * u1);
+            parts.push((a, b, f.need_p, true));
+            variable.push((a, b));
         }
         for a in &self.agreed {
             let w = p[a.seg + 1] - p[a.seg];

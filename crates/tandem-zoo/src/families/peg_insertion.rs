@@ -118,7 +118,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
                 ch: FZ,
                 peak: -10.0,
                 peak_var: 5.0,
-                at: (0.2, 0.7),
+                at: (0.12, 0.7),
                 width: 0.12,
             },
         },
