@@ -90,11 +90,11 @@ pub struct FitReport {
     /// Low-confidence runs after the fit.
     pub fit_lc_runs: usize,
     /// Reference samples that need the operator (need > 0) and are high-confidence after the
-    /// fit, where the demonstrations vary (a learnable need span).
+    /// fit, where the demonstrations vary (a variable section, [`ZooTask::is_variable`]).
     pub fit_falsely_trusted: usize,
-    /// The same where every demonstration agrees (an unlearnable need span: only corrections
-    /// can reveal it).
-    pub fit_falsely_trusted_unlearnable: usize,
+    /// The same where every demonstration agrees (no variance can reveal the need there: only
+    /// corrections can).
+    pub fit_falsely_trusted_agreeing: usize,
     /// The reference-choice spread (`None` when not measured).
     pub spread: Option<ReferenceSpread>,
 }
@@ -114,8 +114,8 @@ pub struct Prepared {
     pub planner: PlannerParams,
     /// The truth on the model's reference samples.
     pub truth: ProfileTruth,
-    /// Per reference sample: `Some(learnable)` where the operator can be needed (need > 0),
-    /// `None` elsewhere.
+    /// Per reference sample: where the operator can be needed (need > 0), `Some(varies)`:
+    /// whether the demonstrations vary there ([`ZooTask::is_variable`]); `None` elsewhere.
     pub need_kind: Vec<Option<bool>>,
     /// What the fit shows.
     pub report: FitReport,
@@ -138,14 +138,6 @@ pub fn correction_channel(model: &TaskModel) -> String {
         .or_else(|| names.first())
         .cloned()
         .unwrap_or_default()
-}
-
-/// The need span containing `progress` (the last span includes progress 1), as
-/// [`ZooTask::need_at`] finds it.
-fn span_at(task: &ZooTask, progress: f64) -> Option<&crate::NeedSpan> {
-    task.need
-        .iter()
-        .find(|s| s.from <= progress && (progress < s.to || s.to >= 1.0 && progress <= 1.0))
 }
 
 /// High confidence (%) after a fit: the prior alone with the default confidence parameters.
@@ -241,13 +233,13 @@ pub fn prepare(
     let levels: Vec<f64> = progress.iter().map(|&p| task.need_at(p)).collect();
     let need_kind: Vec<Option<bool>> = progress
         .iter()
-        .map(|&p| span_at(&task, p).filter(|s| s.p > 0.0).map(|s| s.learnable))
+        .map(|&p| (task.need_at(p) > 0.0).then(|| task.is_variable(p)))
         .collect();
     let channel = correction_channel(&model);
     let truth = ProfileTruth::new(NeedProfile::from_levels(&levels)?, channel.clone())?;
     let conf = Confidence::from_prior(model.sigma2_d(), planner.confidence.clone())
         .map_err(tandem_planner::Error::from)?;
-    let (fit_falsely_trusted, fit_falsely_trusted_unlearnable) =
+    let (fit_falsely_trusted, fit_falsely_trusted_agreeing) =
         falsely_trusted_split(conf.conf(), &need_kind);
     let spread = if spread {
         Some(reference_spread(
@@ -276,7 +268,7 @@ pub fn prepare(
             .filter(|run| !run.high_conf)
             .count(),
         fit_falsely_trusted,
-        fit_falsely_trusted_unlearnable,
+        fit_falsely_trusted_agreeing,
         spread,
     };
     Ok(Prepared {
@@ -291,8 +283,8 @@ pub fn prepare(
     })
 }
 
-/// High-confidence samples where the operator can be needed: `(learnable, unlearnable)`
-/// (where the demonstrations vary, where they all agree).
+/// High-confidence samples where the operator can be needed: `(varying, agreeing)` (where
+/// the demonstrations vary, where they all agree), from [`Prepared::need_kind`].
 #[must_use]
 pub fn falsely_trusted_split(conf: &[bool], need_kind: &[Option<bool>]) -> (usize, usize) {
     conf.iter()

@@ -42,10 +42,10 @@ pub struct RunReport {
     /// Truth: percent of the reference that never needs the operator.
     pub truth_high_pct: f64,
     /// High-confidence reference samples where the operator can be needed and the
-    /// demonstrations vary (learnable), after the last round.
+    /// demonstrations vary (a variable section), after the last round.
     pub falsely_trusted: usize,
-    /// The same where every demonstration agrees (unlearnable from demonstrations).
-    pub falsely_trusted_unlearnable: usize,
+    /// The same where every demonstration agrees (no variance reveals the need there).
+    pub falsely_trusted_agreeing: usize,
     /// Rounds recorded before the first schedule in which the robots overlap (its `T_total`
     /// is below the serial schedule's on the same problem by more than half a tick); `None`
     /// when no schedule did, or for a continuous cell (not measured).
@@ -230,7 +230,7 @@ pub fn run_rounds(
     let (planned_last, realized_last) = ran.last().copied().unwrap_or((f64::NAN, f64::NAN));
     let per_h = |t: f64| 3600.0 * robots as f64 / t;
     let last = its.last().expect("a trial has its first schedule");
-    let (falsely_trusted, falsely_trusted_unlearnable) =
+    let (falsely_trusted, falsely_trusted_agreeing) =
         falsely_trusted_split(run.planner.confidence().conf(), &prep.need_kind);
     let pairs = its.iter().filter_map(|i| i.pair.as_ref());
     Ok(RunReport {
@@ -245,7 +245,7 @@ pub fn run_rounds(
         serial_s: last_serial,
         truth_high_pct: prep.report.truth_high_pct,
         falsely_trusted,
-        falsely_trusted_unlearnable,
+        falsely_trusted_agreeing,
         first_overlap_round,
         max_increase_s,
         max_increase_at,
@@ -297,7 +297,7 @@ pub fn run_continuous(
     let last = its.last().expect("a trial has its first plan");
     let realized_per_h = run.result.steady.throughput_per_h;
     let ratio = last.tasks_per_hour / realized_per_h;
-    let (falsely_trusted, falsely_trusted_unlearnable) =
+    let (falsely_trusted, falsely_trusted_agreeing) =
         falsely_trusted_split(run.planner.confidence().conf(), &prep.need_kind);
     Ok(RunReport {
         family: prep.family.to_string(),
@@ -311,7 +311,7 @@ pub fn run_continuous(
         serial_s: serial_s(&run.planner)?,
         truth_high_pct: prep.report.truth_high_pct,
         falsely_trusted,
-        falsely_trusted_unlearnable,
+        falsely_trusted_agreeing,
         first_overlap_round: None,
         max_increase_s,
         max_increase_at,

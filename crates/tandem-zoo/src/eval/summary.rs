@@ -40,7 +40,7 @@ pub struct FamilyRow {
     /// Samples falsely trusted where the demonstrations vary (mean).
     pub falsely_trusted: f64,
     /// Samples falsely trusted where every demonstration agrees (mean).
-    pub falsely_trusted_unlearnable: f64,
+    pub falsely_trusted_agreeing: f64,
     /// Mean rounds until the robots first overlap, over the seeds where they did.
     pub first_overlap_round: Option<f64>,
     /// Seeds in which the robots never overlapped (rounds only).
@@ -146,7 +146,7 @@ fn row(family: String, robots: usize, cell: Cell, runs: &[&RunReport]) -> Family
             .map(|r| (r.final_high_pct() - r.truth_high_pct).abs())
             .fold(0.0, f64::max),
         falsely_trusted: m(&|r| r.falsely_trusted as f64),
-        falsely_trusted_unlearnable: m(&|r| r.falsely_trusted_unlearnable as f64),
+        falsely_trusted_agreeing: m(&|r| r.falsely_trusted_agreeing as f64),
         first_overlap_round: (!overlapped.is_empty()).then(|| mean(overlapped.iter().copied())),
         never_overlapped: if cell == Cell::Rounds {
             runs.len() - overlapped.len()
