@@ -207,12 +207,7 @@ pub(super) fn run_coordinator(
         .zip(coord.clock_s())
         .map(|(tl, &c)| tl.sample_at(c))
         .collect();
-    let mut ref_now: Vec<f64> = coord
-        .robots()
-        .iter()
-        .zip(coord.clock_s())
-        .map(|(tl, &c)| tl.ref_time_at(c))
-        .collect();
+    let mut ref_now: Vec<f64> = coord.ref_time_now().to_vec();
 
     let has_holds = coord.has_holds();
     // Whether each robot logged an unsupervised sample this tick (it started the tick on a
