@@ -197,6 +197,12 @@ impl TaskModel {
         crate::checks::check_lengths(&demos)?;
         let alignment = choose_alignment(&demos, &layout, params)?;
         let ordered: Vec<&Demonstration> = alignment.order.iter().map(|&i| &demos[i]).collect();
+        crate::checks::check_reaches_end(
+            &ordered,
+            &alignment.warps,
+            params.warp.slope_min,
+            params.warp.slope_max,
+        )?;
         let mut model = Self::fit_from_warps(
             &ordered,
             &alignment.warps,
