@@ -265,6 +265,55 @@ impl TaskModel {
             .collect())
     }
 
+    /// The warp (reference sample → sample of `demo`, `n_ref()` values) with which a fit with
+    /// `params` whose reference was `reference` aligns `demo`: the same signals (quaternion
+    /// blocks sign-aligned to the reference's first orientation), the model's ranges as the
+    /// channel weights (unless `params.warp.weights` gives them) and `params.warp`. Used to
+    /// carry reference times from another reference onto this model's (the planner's refit
+    /// that keeps recorded rounds).
+    ///
+    /// # Errors
+    /// `reference` is not `n_ref()` samples long or either has other channels or another
+    /// sample period than the model; bad warp parameters; alignment failure.
+    pub fn align_demonstration(
+        &self,
+        reference: &Demonstration,
+        demo: &Demonstration,
+        params: &FitParams,
+    ) -> Result<Vec<f64>> {
+        let names = &self.data.channel_names;
+        let reference = reference.conform_to(names)?;
+        let demo = demo.conform_to(names)?;
+        check_dt(&reference, self.data.dt_s)?;
+        check_dt(&demo, self.data.dt_s)?;
+        if reference.n_samples() != self.data.n_ref {
+            return Err(Error::BadData {
+                what: "reference".into(),
+                why: format!(
+                    "{} samples for a model of {} reference samples",
+                    reference.n_samples(),
+                    self.data.n_ref
+                ),
+            });
+        }
+        let layout = &self.data.layout;
+        let d = layout.dim();
+        let m = names.len();
+        let mut warp_params = params.warp.clone();
+        if warp_params.weights.is_none() {
+            warp_params.weights = Some(layout.warp_weights(&self.data.ranges[..d - 1], m));
+        }
+        let orientations = layout.first_orientations(&reference);
+        let a = layout.sign_aligned(&reference, &orientations);
+        let b = layout.sign_aligned(&demo, &orientations);
+        let aligned = tandem_warp::align_many(
+            tandem_warp::SignalRef::new(&a, m)?,
+            &[tandem_warp::SignalRef::new(&b, m)?],
+            &warp_params,
+        )?;
+        Ok(aligned[0].values().to_vec())
+    }
+
     /// The statistics of checked demonstrations, reference first, from their warps.
     /// `non_rate_ranges`: the ranges of the non-rate coordinates (explicit or default).
     fn fit_from_warps(
