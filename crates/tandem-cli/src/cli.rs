@@ -228,9 +228,10 @@ pub(crate) struct FitArgs {
     #[arg(long, value_name = "/A,/B", value_delimiter = ',')]
     pub(crate) topics: Vec<String>,
     /// Robots run by the one operator, 1 to 8 (the paper: 2): every schedule has N warps and
-    /// `tandem record` takes N executions per round. Stored in the state file.
-    #[arg(long, value_name = "N", default_value_t = 2)]
-    pub(crate) robots: usize,
+    /// `tandem record` takes N executions per round. Stored in the state file. Default: 2,
+    /// or with --keep-rounds the state's.
+    #[arg(long, value_name = "N")]
+    pub(crate) robots: Option<usize>,
     /// Hold points at these reference times (s, the reference demonstration's clock), each at
     /// its nearest reference sample: places where a robot may wait as long as needed (the
     /// tool lifted, a part held); a hold on a low-confidence sample is inactive until the
@@ -255,9 +256,21 @@ pub(crate) struct FitArgs {
     /// Sampler overrides.
     #[command(flatten)]
     pub(crate) sampler: SamplerArgs,
-    /// The state file to write (replaced atomically if it exists).
+    /// The state file to write (atomically). An existing state file that holds recorded
+    /// rounds (the operator's corrections) is replaced only with --keep-rounds or --force.
     #[arg(short, long, value_name = "STATE")]
     pub(crate) output: PathBuf,
+    /// Keep the rounds recorded in the state file -o: fit the new demonstrations, then replay
+    /// every recorded round onto the new model in its order (executions, reference-time logs
+    /// carried onto the new reference, supervised and corrected flags), as if recorded
+    /// after a fresh fit. Rounds recorded by a tandem older than state format 11 cannot be
+    /// replayed (their executions were not kept): refused, use --force.
+    #[arg(long, conflicts_with = "force")]
+    pub(crate) keep_rounds: bool,
+    /// Replace the state file -o even if it holds recorded rounds, discarding them (says how
+    /// many).
+    #[arg(long)]
+    pub(crate) force: bool,
 }
 
 /// `tandem fit --reference`: `tandem::lfd::Reference` by its parameter-file names.

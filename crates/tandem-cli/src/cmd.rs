@@ -100,10 +100,55 @@ fn fit(a: &FitArgs) -> Result<()> {
         bail!("--dt {dt}: the sample period must be finite and > 0 seconds");
     }
     let max = tandem::realtime::MAX_ROBOTS;
-    if !(1..=max).contains(&a.robots) {
-        bail!("--robots {}: one operator runs 1 to {max} robots", a.robots);
+    if let Some(r) = a.robots
+        && !(1..=max).contains(&r)
+    {
+        bail!("--robots {r}: one operator runs 1 to {max} robots");
     }
     state_io::check_file_target(&a.output)?;
+    // Recorded rounds are never discarded without consent; decided before any work.
+    let held = if a.force {
+        0
+    } else {
+        Planner::rounds_at(&a.output).with_context(|| {
+            format!(
+                "{}: cannot tell whether it holds recorded rounds; write to another file, or \
+                 replace it with --force",
+                a.output.display()
+            )
+        })?
+    };
+    if held > 0 && !a.keep_rounds {
+        bail!(
+            "{}: holds {held} recorded round(s) (the operator's corrections), which a new fit \
+             would discard; nothing was written. Keep them: add --keep-rounds (they are \
+             replayed onto the new fit); discard them: add --force; or write the new fit to \
+             another file (-o)",
+            a.output.display()
+        );
+    }
+    // With --keep-rounds: a read–modify–write of the state under its lock, as `record`.
+    let kept = if a.keep_rounds && a.output.is_file() {
+        let lock = state_io::lock(&a.output)?;
+        let old = state_io::load(&a.output)?;
+        if let Some(r) = a.robots
+            && r != old.n_robots()
+        {
+            bail!(
+                "--robots {r}: the rounds recorded in {} are of {} robots; with --keep-rounds \
+                 the new fit has the state's robot count (leave --robots out)",
+                a.output.display(),
+                old.n_robots()
+            );
+        }
+        Some((lock, old))
+    } else {
+        None
+    };
+    let robots = match &kept {
+        Some((_, old)) => old.n_robots(),
+        None => a.robots.unwrap_or(2),
+    };
     let demos: Vec<Demonstration> = bag::read_demos(
         &a.demos,
         a.dt,
@@ -163,15 +208,50 @@ fn fit(a: &FitArgs) -> Result<()> {
         }
         params.fit.ranges = Some(ranges);
     }
-    let planner =
-        Planner::with_robots(&demos, params, a.robots).with_context(|| match &a.params {
-            Some(p) => format!(
-                "cannot fit the task model (parameters from {})",
-                p.display()
-            ),
-            None => "cannot fit the task model".into(),
-        })?;
-    planner.save(&a.output)?;
+    let fit_context = || match &a.params {
+        Some(p) => format!(
+            "cannot fit the task model (parameters from {})",
+            p.display()
+        ),
+        None => "cannot fit the task model".into(),
+    };
+    let mut kept_line = None;
+    let planner = if let Some((lock, old)) = &kept {
+        let (planner, report) = old.refit(&demos, params).with_context(fit_context)?;
+        planner.save_locked(lock)?;
+        kept_line = Some(format!(
+            "kept {} recorded round(s): replayed onto the new fit in their order{} (high \
+             confidence before the refit: {:.1} %)",
+            report.rounds,
+            if report.reference_changed {
+                ", their reference times carried onto the new reference through its alignment \
+                 to the old one"
+            } else {
+                " on the same reference"
+            },
+            100.0 * report.high_share_before
+        ));
+        planner
+    } else {
+        let planner = Planner::with_robots(&demos, params, robots).with_context(fit_context)?;
+        if a.force {
+            let lock = state_io::lock_new(&a.output)?;
+            kept_line = match planner.save_locked_discarding(&lock)? {
+                Some(0) => None,
+                Some(n) => Some(format!(
+                    "replaced {}: discarded its {n} recorded round(s) (--force)",
+                    a.output.display()
+                )),
+                None => Some(format!(
+                    "replaced {}, a state file this build cannot read (--force)",
+                    a.output.display()
+                )),
+            };
+        } else {
+            planner.save(&a.output)?;
+        }
+        planner
+    };
     let model = planner.model();
     let files: Vec<String> = a.demos.iter().map(|p| p.display().to_string()).collect();
     out(&format!(
@@ -191,6 +271,9 @@ fn fit(a: &FitArgs) -> Result<()> {
         model.channel_names().join(", ")
     ));
     summary_lines(&planner)?;
+    if let Some(line) = kept_line {
+        out(&line);
+    }
     out(&format!("saved {}", a.output.display()));
     Ok(())
 }

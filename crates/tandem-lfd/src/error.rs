@@ -246,6 +246,22 @@ pub enum Error {
         /// `duration_s / median_s`.
         ratio: f64,
     },
+    /// A demonstration does not reach the end of the task: its alignment to the reference
+    /// ends pinned at a slope bound over a long run ([`crate::END_RUN_REFUSE_SHARE`]).
+    #[error(
+        "{file}: does not reach the end of the task (it ends about {ends_at_pct:.0} % of the \
+         way through): {why}; a demonstration cut off before the end would teach the model a \
+         wrong end and widen its variance and speed bounds: demonstrate the whole task again, \
+         trim the recording to whole tasks, or leave it out"
+    )]
+    TruncatedDemonstration {
+        /// The file or source label.
+        file: String,
+        /// Where on the reference (% of the task) its end is aligned.
+        ends_at_pct: f64,
+        /// What its alignment shows.
+        why: String,
+    },
     /// Sample periods differ by more than 1 %.
     #[error(
         "{}: sample period {} s differs from the reference {} s by more than 1 % (resample \

@@ -276,6 +276,48 @@ pub struct RecordReport {
     pub notices: Vec<String>,
 }
 
+/// What [`Planner::refit`] did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefitReport {
+    /// Rounds replayed into the new planner (all the old one recorded).
+    pub rounds: usize,
+    /// Whether the new reference differs from the old one, so that the recorded reference
+    /// times were carried through the alignment of the old reference to the new one.
+    pub reference_changed: bool,
+    /// The old planner's share of high-confidence reference samples (`Confidence::high_share`).
+    pub high_share_before: f64,
+}
+
+/// Whether two demonstrations are the same signal: channels, period and samples (the source
+/// label aside).
+fn same_signal(a: &Demonstration, b: &Demonstration) -> bool {
+    a.channel_names() == b.channel_names() && a.dt_s() == b.dt_s() && a.samples() == b.samples()
+}
+
+/// A reference-time log on an old reference carried onto a new one: `warp[n]` is the old
+/// reference's time (samples) at new reference sample `n` (monotone, pinned at both ends);
+/// each entry becomes the new reference time whose warp value it is (linear between samples;
+/// the first sample of a flat stretch), clamped to `[0, warp.len() − 1]`. Monotone logs stay
+/// monotone.
+fn carry_log(warp: &[f64], log: &[f64]) -> Vec<f64> {
+    let last = warp.len() - 1;
+    log.iter()
+        .map(|&v| {
+            // First n with warp[n] ≥ v.
+            let hi = warp.partition_point(|&w| w < v);
+            if hi == 0 {
+                return 0.0;
+            }
+            if hi > last {
+                return last as f64;
+            }
+            let (a, b) = (warp[hi - 1], warp[hi]);
+            let frac = if b > a { (v - a) / (b - a) } else { 1.0 };
+            ((hi - 1) as f64 + frac).clamp(0.0, last as f64)
+        })
+        .collect()
+}
+
 /// The loop of Fig. 2: the task model learned from demonstrations and executions, the
 /// correction observations, the latched confidence and the current schedule.
 ///
@@ -308,6 +350,14 @@ pub struct Planner {
     pairs_recorded: usize,
     /// Fingerprints of the rounds recorded since the state format had them (version 6).
     rounds: Vec<u64>,
+    /// The reference demonstration the model's time axis is (its samples in the model's
+    /// channel order), kept since state format 11 so that a refit can carry the recorded
+    /// reference times onto another reference; `None` for a planner made from a model.
+    reference: Option<Demonstration>,
+    /// Every round recorded since state format 11, in order: the executions as
+    /// [`Planner::check_execution`] took them in (at the model's period), for
+    /// [`Planner::refit`].
+    records: Vec<Vec<ExecutionRecord>>,
     origin: Origin,
     /// Set by [`Planner::load`] when it replaced a stored schedule that failed the check.
     load_notice: Option<String>,
@@ -324,6 +374,41 @@ struct PlannerState {
     outcome: Outcome,
     pairs_recorded: usize,
     rounds: Vec<u64>,
+    reference: Option<Demonstration>,
+    records: Vec<Vec<StoredRecord>>,
+}
+
+/// An [`ExecutionRecord`] as the state file keeps it (format 11).
+#[derive(Serialize, Deserialize)]
+struct StoredRecord {
+    demonstration: Demonstration,
+    ref_time_log: Vec<f64>,
+    supervised: Vec<bool>,
+    corrected: Vec<bool>,
+}
+
+impl From<&ExecutionRecord> for StoredRecord {
+    fn from(r: &ExecutionRecord) -> Self {
+        StoredRecord {
+            demonstration: r.execution.demonstration.clone(),
+            ref_time_log: r.execution.ref_time_log.clone(),
+            supervised: r.supervised.clone(),
+            corrected: r.corrected.clone(),
+        }
+    }
+}
+
+impl From<StoredRecord> for ExecutionRecord {
+    fn from(r: StoredRecord) -> Self {
+        ExecutionRecord {
+            execution: Execution {
+                demonstration: r.demonstration,
+                ref_time_log: r.ref_time_log,
+            },
+            supervised: r.supervised,
+            corrected: r.corrected,
+        }
+    }
 }
 
 /// `tandem_warp::WarpParams` as state formats 4 to 8 wrote them: without `smooth_width` and
@@ -427,7 +512,8 @@ struct PlannerParamsOld<F> {
     holds: HoldSpec,
 }
 
-/// [`PlannerState`] as state formats 8 and 9 wrote it: [`PlannerParamsOld`].
+/// [`PlannerState`] as state formats 8 to 10 wrote it: [`PlannerParamsOld`], without the
+/// reference demonstration and the recorded executions (format 11).
 #[derive(Deserialize)]
 struct PlannerStateOld<F> {
     params: PlannerParamsOld<F>,
@@ -447,6 +533,10 @@ type PlannerStateV8 = PlannerStateOld<FitParamsV8>;
 /// [`PlannerState`] as state format 9 wrote it (the fit's warp without `fill_length`).
 type PlannerStateV9 = PlannerStateOld<FitParamsOld<WarpParamsV9>>;
 
+/// [`PlannerState`] as state format 10 wrote it: today's parameters, without the reference
+/// demonstration and the recorded executions.
+type PlannerStateV10 = PlannerStateOld<FitParams>;
+
 impl<F: Into<FitParams>> From<PlannerStateOld<F>> for PlannerState {
     fn from(old: PlannerStateOld<F>) -> Self {
         PlannerState {
@@ -462,6 +552,8 @@ impl<F: Into<FitParams>> From<PlannerStateOld<F>> for PlannerState {
             outcome: old.outcome,
             pairs_recorded: old.pairs_recorded,
             rounds: old.rounds,
+            reference: None,
+            records: Vec::new(),
         }
     }
 }
@@ -541,6 +633,8 @@ impl From<PlannerStateV7> for PlannerState {
             outcome: v7.outcome.into(),
             pairs_recorded: v7.pairs_recorded,
             rounds: v7.rounds,
+            reference: None,
+            records: Vec::new(),
         }
     }
 }
@@ -625,6 +719,8 @@ impl TryFrom<PlannerStateV6> for PlannerState {
             outcome: v6.outcome.into(),
             pairs_recorded: v6.pairs_recorded,
             rounds: v6.rounds,
+            reference: None,
+            records: Vec::new(),
         })
     }
 }
@@ -789,7 +885,12 @@ impl Planner {
         check_robot_count(n_robots)?;
         params.validate()?;
         let model = TaskModel::fit(demos, &params.fit)?;
-        Self::from_model_with_robots(model, params, n_robots)
+        let reference = demos[model.reference_idx()]
+            .conform_to(model.channel_names())?
+            .into_owned();
+        let mut planner = Self::from_model_with_robots(model, params, n_robots)?;
+        planner.reference = Some(reference);
+        Ok(planner)
     }
 
     /// As [`Planner::new`] from an already fitted model (e.g. to run several trials from
@@ -827,6 +928,8 @@ impl Planner {
             outcome,
             pairs_recorded: 0,
             rounds: Vec::new(),
+            reference: None,
+            records: Vec::new(),
             origin: Origin::default(),
             load_notice: None,
         })
@@ -982,7 +1085,102 @@ impl Planner {
         self.outcome = outcome;
         self.pairs_recorded = pairs_recorded;
         self.rounds.push(fingerprint);
+        self.records.push(records);
         Ok(report)
+    }
+
+    /// Fits the task again from `demos` with `params` (as [`Planner::with_robots`], for this
+    /// planner's robot count) and replays every round this planner recorded, in their
+    /// original order, so that the operator's corrections are kept: the returned planner is
+    /// the one a fresh fit would be after recording the same rounds.
+    ///
+    /// Each recorded execution keeps its samples and its supervised/corrected flags (per
+    /// execution sample); only its reference-time log changes frame. When the new model's
+    /// reference is the old one (the same samples), the logs are kept as recorded; otherwise
+    /// the old reference is aligned to the new one as the fit aligns every demonstration
+    /// ([`TaskModel::align_demonstration`]) and each log entry is carried through that warp
+    /// (the inverse of new reference → old reference). Every round then goes through
+    /// [`Planner::record_round`] (the checks of [`Planner::check_execution`], the model update
+    /// of Eq. 21, the observations, the latched confidence and a schedule with the seed of
+    /// that round), so the confidence, model and schedule are those of a fresh fit with the
+    /// same rounds recorded. The round fingerprints are the recorded ones (a round given
+    /// again is still refused). The new planner saves into the file this one was loaded from
+    /// (the check that no other process saved into it meanwhile applies) and nowhere else
+    /// that holds rounds ([`Planner::save_locked`]). This planner is not changed.
+    ///
+    /// # Errors
+    /// As [`Planner::with_robots`]; [`Error::CannotReplay`] when rounds were recorded by a
+    /// build older than state format 11 (their executions were not kept), when the planner
+    /// has no reference demonstration ([`Planner::from_model`]), or when a recorded execution
+    /// fails the new model's checks (other channels, period, coverage, duration).
+    pub fn refit(
+        &self,
+        demos: &[Demonstration],
+        params: PlannerParams,
+    ) -> Result<(Planner, RefitReport)> {
+        let rounds = self.pairs_recorded;
+        if self.records.len() < rounds {
+            return Err(Error::CannotReplay {
+                why: format!(
+                    "{} of its {rounds} rounds were recorded by a tandem older than state \
+                     format 11, which did not keep the executions, so they cannot be replayed",
+                    rounds - self.records.len()
+                ),
+            });
+        }
+        let old_reference = match (&self.reference, rounds) {
+            (_, 0) => None,
+            (Some(r), _) => Some(r),
+            (None, _) => {
+                return Err(Error::CannotReplay {
+                    why: "the planner was made from a fitted model without its reference \
+                          demonstration (Planner::from_model), so its reference times cannot \
+                          be carried onto a new reference"
+                        .into(),
+                });
+            }
+        };
+        let mut planner = Self::with_robots(demos, params, self.n_robots())?;
+        let new_reference = planner
+            .reference
+            .clone()
+            .expect("with_robots keeps the reference");
+        let warp = match old_reference {
+            Some(old) if !same_signal(old, &new_reference) => Some(
+                planner
+                    .model
+                    .align_demonstration(&new_reference, old, &planner.params.fit)
+                    .map_err(|e| Error::CannotReplay {
+                        why: format!("the recorded reference does not align to the new one ({e})"),
+                    })?,
+            ),
+            _ => None,
+        };
+        for (k, round) in self.records.iter().enumerate() {
+            let carried: Vec<ExecutionRecord> = round
+                .iter()
+                .map(|r| {
+                    let mut r = r.clone();
+                    if let Some(w) = &warp {
+                        r.execution.ref_time_log = carry_log(w, &r.execution.ref_time_log);
+                    }
+                    r
+                })
+                .collect();
+            planner
+                .record_round(&carried)
+                .map_err(|e| Error::CannotReplay {
+                    why: format!("round {} does not replay on the new model: {e}", k + 1),
+                })?;
+        }
+        planner.rounds.clone_from(&self.rounds);
+        planner.origin = self.origin.clone();
+        let report = RefitReport {
+            rounds,
+            reference_changed: warp.is_some(),
+            high_share_before: self.confidence.high_share(),
+        };
+        Ok((planner, report))
     }
 
     /// [`Planner::record_round`] for the paper's two robots; deprecated: a round is one
@@ -1187,24 +1385,59 @@ impl Planner {
     /// [`Error::WouldOverwrite`], [`Error::Changed`], [`Error::Io`] naming the file or
     /// directory, [`Error::Encode`].
     pub fn save_locked(&self, lock: &StateLock) -> Result<()> {
+        self.save_checked(lock, false).map(|_| ())
+    }
+
+    /// [`Planner::save_locked`] that replaces a state file holding rounds this planner does
+    /// not hold, discarding them on purpose (`tandem fit --force`, Python
+    /// `save(path, force=True)`). Returns how many rounds the replaced file held (0 when there
+    /// was none, or when this planner was loaded from that file and holds them all); the
+    /// count is `None` when the file there is a state file this build cannot read.
+    ///
+    /// # Errors
+    /// As [`Planner::save_locked`] but [`Error::WouldDiscardRounds`].
+    pub fn save_locked_discarding(&self, lock: &StateLock) -> Result<Option<usize>> {
+        self.save_checked(lock, true)
+    }
+
+    /// The save of [`Planner::save_locked`]; `discard`: replace a file holding rounds this
+    /// planner does not hold. Returns the rounds discarded.
+    fn save_checked(&self, lock: &StateLock, discard: bool) -> Result<Option<usize>> {
         let path = lock.state_path();
         state::check_target(path)?;
         let here = state::resolved(path);
-        if let Some((from, stamp)) = self.origin.get()
-            && from == here
+        let origin = self.origin.get();
+        if let Some((from, stamp)) = &origin
+            && *from == here
             && let Some(now) = state::stamp_at(path)?
-            && now != stamp
+            && now != *stamp
         {
             return Err(Error::Changed {
                 path: path.to_path_buf(),
             });
+        }
+        // A file this planner did not come from: its rounds would be lost.
+        let mut discarded = Some(0);
+        if origin.is_none_or(|(from, _)| from != here) {
+            match Self::rounds_at(path) {
+                Ok(0) => {}
+                Ok(rounds) if !discard => {
+                    return Err(Error::WouldDiscardRounds {
+                        path: path.to_path_buf(),
+                        rounds,
+                    });
+                }
+                Ok(rounds) => discarded = Some(rounds),
+                Err(_) if discard => discarded = None,
+                Err(e) => return Err(e),
+            }
         }
         let bytes = state::encode(&self.to_state())?;
         state::write_atomic(path, &bytes)?;
         if let Some(stamp) = state::stamp_of(&bytes) {
             self.origin.set(here, stamp);
         }
-        Ok(())
+        Ok(discarded)
     }
 
     /// Loads a planner saved by [`Planner::save`], of the current state format or an older one
@@ -1224,7 +1457,46 @@ impl Planner {
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let bytes = state::read(path)?;
-        let (version, payload) = state::checked_payload(&bytes, path)?;
+        let st = Self::decode_state(&bytes, path)?;
+        let mut planner = Self::from_state(st).map_err(|e| Error::Corrupt {
+            path: path.to_path_buf(),
+            why: e.to_string(),
+        })?;
+        planner.recheck_schedule()?;
+        if let Some(stamp) = state::stamp_of(&bytes) {
+            planner.origin.set(state::resolved(path), stamp);
+        }
+        Ok(planner)
+    }
+
+    /// The rounds recorded in the state file at `path` ([`Planner::rounds_recorded`] of the
+    /// planner saved there); 0 when there is no file or an empty one. What a save of another
+    /// planner over that file would discard.
+    ///
+    /// # Errors
+    /// As [`Planner::load`] for a file that is there but cannot be read as a state file.
+    pub fn rounds_at(path: impl AsRef<Path>) -> Result<usize> {
+        let path = path.as_ref();
+        let bytes = match std::fs::read(path) {
+            Ok(b) => b,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(0),
+            Err(source) => {
+                return Err(Error::Io {
+                    path: path.to_path_buf(),
+                    op: "read state file",
+                    source,
+                });
+            }
+        };
+        if bytes.is_empty() {
+            return Ok(0);
+        }
+        Ok(Self::decode_state(&bytes, path)?.pairs_recorded)
+    }
+
+    /// The state in a file image read from `path`, of any readable format version.
+    fn decode_state(bytes: &[u8], path: &Path) -> Result<PlannerState> {
+        let (version, payload) = state::checked_payload(bytes, path)?;
         let old = |v6: PlannerStateV6| {
             PlannerState::try_from(v6).map_err(|e| Error::Corrupt {
                 path: path.to_path_buf(),
@@ -1238,17 +1510,10 @@ impl Planner {
             7 => state::decode_payload::<PlannerStateV7>(payload, path)?.into(),
             8 => state::decode_payload::<PlannerStateV8>(payload, path)?.into(),
             9 => state::decode_payload::<PlannerStateV9>(payload, path)?.into(),
+            10 => state::decode_payload::<PlannerStateV10>(payload, path)?.into(),
             _ => state::decode_payload(payload, path)?,
         };
-        let mut planner = Self::from_state(st).map_err(|e| Error::Corrupt {
-            path: path.to_path_buf(),
-            why: e.to_string(),
-        })?;
-        planner.recheck_schedule()?;
-        if let Some(stamp) = state::stamp_of(&bytes) {
-            planner.origin.set(state::resolved(path), stamp);
-        }
-        Ok(planner)
+        Ok(st)
     }
 
     /// Re-checks the stored schedule on the stored problem with this build's check
@@ -1284,6 +1549,12 @@ impl Planner {
             outcome: self.outcome.clone(),
             pairs_recorded: self.pairs_recorded,
             rounds: self.rounds.clone(),
+            reference: self.reference.clone(),
+            records: self
+                .records
+                .iter()
+                .map(|round| round.iter().map(StoredRecord::from).collect())
+                .collect(),
         }
     }
 
@@ -1334,6 +1605,24 @@ impl Planner {
                 ),
             });
         }
+        if st.records.len() > st.pairs_recorded {
+            return Err(Error::Inconsistent {
+                what: "records",
+                why: format!(
+                    "{} stored rounds for {} recorded rounds",
+                    st.records.len(),
+                    st.pairs_recorded
+                ),
+            });
+        }
+        if let Some(r) = &st.reference
+            && r.n_samples() != n_ref
+        {
+            return Err(Error::Inconsistent {
+                what: "reference",
+                why: format!("{} samples, the model has {n_ref}", r.n_samples()),
+            });
+        }
         let problem = problem_for(&st.model, &st.confidence, &st.params.holds)?;
         Ok(Self {
             params: st.params,
@@ -1344,6 +1633,12 @@ impl Planner {
             outcome: st.outcome,
             pairs_recorded: st.pairs_recorded,
             rounds: st.rounds,
+            reference: st.reference,
+            records: st
+                .records
+                .into_iter()
+                .map(|round| round.into_iter().map(ExecutionRecord::from).collect())
+                .collect(),
             origin: Origin::default(),
             load_notice: None,
         })

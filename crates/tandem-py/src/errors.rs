@@ -255,6 +255,7 @@ fn classify_lfd(e: &errors::Lfd) -> Kind {
         },
         E::Io { file, .. }
         | E::DemonstrationLength { file, .. }
+        | E::TruncatedDemonstration { file, .. }
         | E::TruncatedExecution { file, .. }
         | E::ExecutionDuration { file, .. }
         | E::CoarseExecution { file, .. }

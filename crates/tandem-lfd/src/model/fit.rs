@@ -197,6 +197,12 @@ impl TaskModel {
         crate::checks::check_lengths(&demos)?;
         let alignment = choose_alignment(&demos, &layout, params)?;
         let ordered: Vec<&Demonstration> = alignment.order.iter().map(|&i| &demos[i]).collect();
+        crate::checks::check_reaches_end(
+            &ordered,
+            &alignment.warps,
+            params.warp.slope_min,
+            params.warp.slope_max,
+        )?;
         let mut model = Self::fit_from_warps(
             &ordered,
             &alignment.warps,
@@ -257,6 +263,55 @@ impl TaskModel {
             .iter()
             .map(|c| c.cost)
             .collect())
+    }
+
+    /// The warp (reference sample → sample of `demo`, `n_ref()` values) with which a fit with
+    /// `params` whose reference was `reference` aligns `demo`: the same signals (quaternion
+    /// blocks sign-aligned to the reference's first orientation), the model's ranges as the
+    /// channel weights (unless `params.warp.weights` gives them) and `params.warp`. Used to
+    /// carry reference times from another reference onto this model's (the planner's refit
+    /// that keeps recorded rounds).
+    ///
+    /// # Errors
+    /// `reference` is not `n_ref()` samples long or either has other channels or another
+    /// sample period than the model; bad warp parameters; alignment failure.
+    pub fn align_demonstration(
+        &self,
+        reference: &Demonstration,
+        demo: &Demonstration,
+        params: &FitParams,
+    ) -> Result<Vec<f64>> {
+        let names = &self.data.channel_names;
+        let reference = reference.conform_to(names)?;
+        let demo = demo.conform_to(names)?;
+        check_dt(&reference, self.data.dt_s)?;
+        check_dt(&demo, self.data.dt_s)?;
+        if reference.n_samples() != self.data.n_ref {
+            return Err(Error::BadData {
+                what: "reference".into(),
+                why: format!(
+                    "{} samples for a model of {} reference samples",
+                    reference.n_samples(),
+                    self.data.n_ref
+                ),
+            });
+        }
+        let layout = &self.data.layout;
+        let d = layout.dim();
+        let m = names.len();
+        let mut warp_params = params.warp.clone();
+        if warp_params.weights.is_none() {
+            warp_params.weights = Some(layout.warp_weights(&self.data.ranges[..d - 1], m));
+        }
+        let orientations = layout.first_orientations(&reference);
+        let a = layout.sign_aligned(&reference, &orientations);
+        let b = layout.sign_aligned(&demo, &orientations);
+        let aligned = tandem_warp::align_many(
+            tandem_warp::SignalRef::new(&a, m)?,
+            &[tandem_warp::SignalRef::new(&b, m)?],
+            &warp_params,
+        )?;
+        Ok(aligned[0].values().to_vec())
     }
 
     /// The statistics of checked demonstrations, reference first, from their warps.
