@@ -43,6 +43,29 @@ fn merge_flags(
     (sup, cor)
 }
 
+/// The rule of every execution record, whoever made it (CSV files, bags, Python arrays): the
+/// operator corrects only what they supervise, so `corrected[k]` implies `supervised[k]`.
+/// A correction on an unsupervised sample would be dropped from the observations (Eq. 9
+/// counts supervised samples only) and lost without a word. `source` names the execution,
+/// `unit` what an index counts (`"sample"`, or `"row"` of a file's rows).
+fn check_corrections_supervised(
+    source: &str,
+    unit: &str,
+    supervised: &[bool],
+    corrected: &[bool],
+) -> Result<()> {
+    match (0..supervised.len().min(corrected.len())).find(|&k| corrected[k] && !supervised[k]) {
+        Some(k) => Err(Error::BadExecution {
+            what: "corrected",
+            why: format!(
+                "{source}: {unit} {k}: `corrected` is 1 but `supervised` is 0 (only a supervised, \
+                 low-confidence sample can be corrected)"
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Parameters of a [`Planner`]: one block per stage of Fig. 2.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -147,7 +170,8 @@ impl ExecutionRecord {
     /// model's period if its grid is finer).
     ///
     /// # Errors
-    /// [`Error::BadExecution`] when the log or a flag vector does not have one entry per row.
+    /// [`Error::BadExecution`] when the log or a flag vector does not have one entry per row,
+    /// or a row is corrected but not supervised (as [`Planner::check_execution`]).
     pub fn from_regridded(
         grid: Regridded,
         ref_time_log: &[f64],
@@ -168,6 +192,7 @@ impl ExecutionRecord {
                 });
             }
         }
+        check_corrections_supervised(&source, "row", supervised, corrected)?;
         let log = grid.interpolate("ref_time_log", ref_time_log)?;
         let (supervised, corrected) =
             merge_flags(supervised, corrected, &grid.nearest, &grid.bin_of);
@@ -261,6 +286,11 @@ impl Clone for Origin {
 pub struct RecordReport {
     /// Reference samples that became high-confidence (latched) in this update.
     pub newly_high: usize,
+    /// Latched (high-confidence) samples that this round's corrections turned low-confidence
+    /// again ([`Confidence::update_round`]): rounds recorded out of order bring corrections
+    /// of samples latched since they ran; in order, a supervised sample's split and sweep
+    /// reach a latched sample at the edge of a supervised stretch.
+    pub reopened: usize,
     /// Where the new schedule came from (sampled, previous, repaired previous, serial).
     pub source: Source,
     /// The new schedule's `T_total` (Eq. 13), s.
@@ -324,8 +354,8 @@ fn carry_log(warp: &[f64], log: &[f64]) -> Vec<f64> {
 /// After each round of executions, [`Planner::record_round`] adds every execution to the
 /// model with their known reference-time logs (Eq. 21, no re-alignment), adds their
 /// supervised samples to the observations, updates the confidence (Eq. 9–12, with the
-/// latch: a high-confidence sample stays high) and re-schedules, warm-started by the
-/// previous schedule.
+/// latch: a high-confidence sample stays high unless the round's corrections of it make its
+/// totals fail) and re-schedules, warm-started by the previous schedule.
 ///
 /// # The previous schedule as fallback
 ///
@@ -953,8 +983,11 @@ impl Planner {
     /// record at the model's period and, when it was resampled, a sentence saying so.
     ///
     /// # Errors
-    /// [`Error::BadExecution`] for flag vectors of the wrong length; the model crate's errors
-    /// (`CoarseExecution`, `TruncatedExecution`, `ExecutionDuration`, channels, log).
+    /// [`Error::BadExecution`] for flag vectors of the wrong length and for a sample
+    /// corrected but not supervised (the operator corrects only what they supervise: such a
+    /// correction would be dropped without a word; every front end gets this check here); the
+    /// model crate's errors (`CoarseExecution`, `TruncatedExecution`, `ExecutionDuration`,
+    /// channels, log).
     pub fn check_execution(
         &self,
         record: &ExecutionRecord,
@@ -972,6 +1005,12 @@ impl Planner {
                 });
             }
         }
+        check_corrections_supervised(
+            demo.source(),
+            "sample",
+            &record.supervised,
+            &record.corrected,
+        )?;
         let resampled = self.model.resample_execution(&record.execution)?;
         let n_new = resampled.execution.demonstration.n_samples();
         let (supervised, corrected, note) = if resampled.bin_of.len() == n_new {
@@ -1058,7 +1097,10 @@ impl Planner {
             }
         }
         let mut confidence = self.confidence.clone();
-        let newly_high = confidence.update(model.sigma2_d(), &observations)?;
+        // The totals' decision; the latch yields only to this round's corrections (rounds
+        // recorded out of order: docs/decisions.md, "The same rounds in any order").
+        let latching =
+            confidence.update_round(model.sigma2_d(), &self.observations, &observations)?;
         let problem = problem_for(&model, &confidence, &self.params.holds)?;
         let t2 = Instant::now();
         let pairs_recorded = self.pairs_recorded + 1;
@@ -1070,7 +1112,8 @@ impl Planner {
             sample_schedule_n(&problem, n_robots, &sampler, Some(&self.outcome.schedule))?;
         let t3 = Instant::now();
         let report = RecordReport {
-            newly_high,
+            newly_high: latching.newly_high,
+            reopened: latching.reopened,
             source: outcome.source,
             t_total_s: outcome.t_total_s,
             model_update: t1 - t0,
@@ -2180,6 +2223,49 @@ mod tests {
         got.sort_unstable();
         assert_eq!(got, want);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_correction_of_an_unsupervised_sample_is_refused_naming_it() {
+        let mut p = small_planner(8);
+        let mut r = round(&p, 0.0, 0.1, 1, 0.01);
+        // Sample 25 ran unsupervised (high-confidence) and is flagged corrected.
+        r[1].corrected[25] = true;
+        let before = (p.rounds_recorded(), p.observations().clone());
+        let err = p.record_round(&r).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::BadExecution {
+                    what: "corrected",
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        let msg = err.to_string();
+        assert!(
+            msg.contains("sample 25: `corrected` is 1 but `supervised` is 0")
+                && msg.contains("only a supervised, low-confidence sample can be corrected"),
+            "{msg}"
+        );
+        assert_eq!((p.rounds_recorded(), p.observations().clone()), before);
+        // The same on the rows of a log put on a grid (before the flags are merged, which
+        // would otherwise make the row supervised).
+        let text = "t,force\n0.0,1\n0.01,1\n0.02,1\n";
+        let grid = Demonstration::regrid_csv_str(text, "exec.csv", None).unwrap();
+        let err = ExecutionRecord::from_regridded(
+            grid,
+            &[0.0, 1.0, 2.0],
+            &[true, false, true],
+            &[false, true, false],
+        )
+        .unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("exec.csv: row 1: `corrected` is 1 but `supervised` is 0"),
+            "{err}"
+        );
     }
 
     #[test]
