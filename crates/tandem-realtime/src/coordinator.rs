@@ -373,6 +373,21 @@ impl Coordinator {
         })
     }
 
+    /// Robot `robot`'s planned end (schedule clock, s): the end of its last leg, the planned
+    /// dwells at its holds included (without holds, its timeline's end `τ_i + |ψ_E|`). The
+    /// latest of them is the schedule's `T_total` (Eq. 13) when the first robot starts at 0.
+    ///
+    /// # Panics
+    /// If `robot ≥ N`.
+    pub fn planned_end_s(&self, robot: usize) -> f64 {
+        assert!(
+            robot < self.robots.len(),
+            "robot {robot} of {}",
+            self.robots.len()
+        );
+        self.plans.legs[self.plans.first_leg[robot + 1] - 1].end_s()
+    }
+
     /// Whether the plans have hold points or release rules (`crate::holds`).
     pub fn has_holds(&self) -> bool {
         self.plans.has_holds()

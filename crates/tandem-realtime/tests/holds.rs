@@ -98,7 +98,11 @@ fn held_robots_wait_at_their_holds_until_the_rules_hold_then_leave_as_a_start() 
     // Order on schedule: robot 1's LC [1, 2), robot 2's [3, 4), robot 1's [4, 5), robot 2's
     // [6, 7). The derived rules: robot 2 starts once robot 1 has passed sample 2; robot 1
     // leaves its hold at 3 once robot 2 has passed sample 2; robot 2 leaves its hold once
-    // robot 1 has passed sample 5.
+    // robot 1 has passed sample 5. The waits they impose are planned as dwells: robot 1
+    // arrives at its hold at 3 s and robot 2 passes sample 2 at 2 + 2 = 4 s (dwell 1 s);
+    // robot 2 arrives at its hold at 2 + 3 = 5 s and robot 1, its dwell included, passes
+    // sample 5 at 4 + 2 = 6 s (dwell 1 s). Robot 2's start rule costs nothing: robot 1 passes
+    // sample 2 at 2 s, robot 2's start.
     let robots = six_sample(2.0);
     let holds = release_rules(&robots, &[], &[vec![3], vec![3]]);
     let rule = |robot, ref_idx| After { robot, ref_idx };
@@ -106,6 +110,7 @@ fn held_robots_wait_at_their_holds_until_the_rules_hold_then_leave_as_a_start() 
         holds,
         vec![
             vec![Hold {
+                dwell_s: 1.0,
                 after: vec![rule(1, 2)],
                 ..Hold::at(3)
             }],
@@ -115,6 +120,7 @@ fn held_robots_wait_at_their_holds_until_the_rules_hold_then_leave_as_a_start() 
                     ..Hold::at(0)
                 },
                 Hold {
+                    dwell_s: 1.0,
                     after: vec![rule(0, 5)],
                     ..Hold::at(3)
                 },
