@@ -101,9 +101,23 @@ class Planner:
     def locked(path: Path, timeout_s: Optional[float] = None) -> StateEdit:
         """``with Planner.locked(path) as planner:`` loads, and saves at the end, under the
         state file's lock (waiting up to ``timeout_s``, default 60 s, for another writer)."""
-    def save(self, path: Path, timeout_s: Optional[float] = None) -> None:
+    def save(
+        self, path: Path, timeout_s: Optional[float] = None, force: bool = False
+    ) -> None:
         """Saves the state file atomically under its lock (the previous file survives any
-        error); never replaces a non-state file or what another process saved since the load."""
+        error); never replaces a non-state file or what another process saved since the load,
+        nor, without ``force=True``, a state file holding rounds this planner does not hold."""
+    def refit(
+        self,
+        demos: Sequence[Demo],
+        channels: Optional[Sequence[str]] = None,
+        params: Params = None,
+        dt_s: Optional[float] = None,
+        holds: Optional[Union[Sequence[Union[float, str]], Dict[str, Any]]] = None,
+    ) -> Planner:
+        """Fits the task again from ``demos`` and replays every recorded round onto the new
+        fit (the operator's corrections kept); returns the new planner, which saves into the
+        file this one was loaded from."""
     def set_holds(
         self, holds: Union[Sequence[Union[float, str]], Dict[str, Any]]
     ) -> Schedule:

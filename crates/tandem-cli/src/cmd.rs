@@ -224,8 +224,7 @@ fn fit(a: &FitArgs) -> Result<()> {
              confidence before the refit: {:.1} %)",
             report.rounds,
             if report.reference_changed {
-                ", their reference times carried onto the new reference through its alignment \
-                 to the old one"
+                ", each execution aligned to the new reference for its reference times"
             } else {
                 " on the same reference"
             },

@@ -74,11 +74,11 @@ fn a_fit_over_recorded_rounds_needs_consent() {
         "{}",
         stderr(&out)
     );
-    // With another first demonstration (another reference): the round is carried over.
+    // With another first demonstration (another reference): the round is replayed by alignment.
     let reordered = [demos[1].clone(), demos[0].clone(), demos[2].clone()];
     let text = ok(&tandem(fit_args(&reordered, &state, &["--keep-rounds"])));
     assert!(text.contains("kept 1 recorded round(s)"), "{text}");
-    assert!(text.contains("carried onto the new reference"), "{text}");
+    assert!(text.contains("aligned to the new reference"), "{text}");
     let inspect = ok(&tandem([OsString::from("inspect"), state.clone().into()]));
     assert!(
         inspect.contains("5 demonstrations and executions, 1 rounds recorded"),

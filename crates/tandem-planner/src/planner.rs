@@ -311,8 +311,9 @@ pub struct RecordReport {
 pub struct RefitReport {
     /// Rounds replayed into the new planner (all the old one recorded).
     pub rounds: usize,
-    /// Whether the new reference differs from the old one, so that the recorded reference
-    /// times were carried through the alignment of the old reference to the new one.
+    /// Whether the new reference differs from the old one (or the old one is unknown: a
+    /// planner made from a model), so that each recorded execution was aligned to the new
+    /// reference for its reference-time log instead of keeping the recorded one.
     pub reference_changed: bool,
     /// The old planner's share of high-confidence reference samples (`Confidence::high_share`).
     pub high_share_before: f64,
@@ -324,15 +325,16 @@ fn same_signal(a: &Demonstration, b: &Demonstration) -> bool {
     a.channel_names() == b.channel_names() && a.dt_s() == b.dt_s() && a.samples() == b.samples()
 }
 
-/// A reference-time log on an old reference carried onto a new one: `warp[n]` is the old
-/// reference's time (samples) at new reference sample `n` (monotone, pinned at both ends);
-/// each entry becomes the new reference time whose warp value it is (linear between samples;
-/// the first sample of a flat stretch), clamped to `[0, warp.len() − 1]`. Monotone logs stay
+/// The reference-time log of an execution of `n_samples` samples from its warp (`warp[n]`:
+/// the execution's sample, fractional, at reference sample `n`; monotone, pinned at both
+/// ends): for each sample `k` the reference time whose warp value it is (linear between
+/// reference samples; the first sample of a flat stretch), in `[0, warp.len() − 1]`;
 /// monotone.
-fn carry_log(warp: &[f64], log: &[f64]) -> Vec<f64> {
+fn log_from_warp(warp: &[f64], n_samples: usize) -> Vec<f64> {
     let last = warp.len() - 1;
-    log.iter()
-        .map(|&v| {
+    (0..n_samples)
+        .map(|k| {
+            let v = k as f64;
             // First n with warp[n] ≥ v.
             let hi = warp.partition_point(|&w| w < v);
             if hi == 0 {
@@ -1139,10 +1141,10 @@ impl Planner {
     ///
     /// Each recorded execution keeps its samples and its supervised/corrected flags (per
     /// execution sample); only its reference-time log changes frame. When the new model's
-    /// reference is the old one (the same samples), the logs are kept as recorded; otherwise
-    /// the old reference is aligned to the new one as the fit aligns every demonstration
-    /// ([`TaskModel::align_demonstration`]) and each log entry is carried through that warp
-    /// (the inverse of new reference → old reference). Every round then goes through
+    /// reference is the old one (the same samples), the logs are kept as recorded (the
+    /// coordinator's exact clock); otherwise each execution is aligned to the new reference
+    /// as the fit aligns every demonstration ([`TaskModel::align_demonstration`]) and its log
+    /// is the inverse of that warp. Every round then goes through
     /// [`Planner::record_round`] (the checks of [`Planner::check_execution`], the model update
     /// of Eq. 21, the observations, the latched confidence and a schedule with the seed of
     /// that round), so the confidence, model and schedule are those of a fresh fit with the
@@ -1153,9 +1155,9 @@ impl Planner {
     ///
     /// # Errors
     /// As [`Planner::with_robots`]; [`Error::CannotReplay`] when rounds were recorded by a
-    /// build older than state format 11 (their executions were not kept), when the planner
-    /// has no reference demonstration ([`Planner::from_model`]), or when a recorded execution
-    /// fails the new model's checks (other channels, period, coverage, duration).
+    /// build older than state format 11 (their executions were not kept), or when a recorded
+    /// execution does not align to the new reference or fails the new model's checks (other
+    /// channels, period, coverage, duration).
     pub fn refit(
         &self,
         demos: &[Demonstration],
@@ -1171,45 +1173,37 @@ impl Planner {
                 ),
             });
         }
-        let old_reference = match (&self.reference, rounds) {
-            (_, 0) => None,
-            (Some(r), _) => Some(r),
-            (None, _) => {
-                return Err(Error::CannotReplay {
-                    why: "the planner was made from a fitted model without its reference \
-                          demonstration (Planner::from_model), so its reference times cannot \
-                          be carried onto a new reference"
-                        .into(),
-                });
-            }
-        };
         let mut planner = Self::with_robots(demos, params, self.n_robots())?;
         let new_reference = planner
             .reference
             .clone()
             .expect("with_robots keeps the reference");
-        let warp = match old_reference {
-            Some(old) if !same_signal(old, &new_reference) => Some(
-                planner
-                    .model
-                    .align_demonstration(&new_reference, old, &planner.params.fit)
-                    .map_err(|e| Error::CannotReplay {
-                        why: format!("the recorded reference does not align to the new one ({e})"),
-                    })?,
-            ),
-            _ => None,
-        };
+        // The recorded logs hold on the new model when its reference is the old one.
+        let same_reference = self
+            .reference
+            .as_ref()
+            .is_some_and(|old| same_signal(old, &new_reference));
         for (k, round) in self.records.iter().enumerate() {
-            let carried: Vec<ExecutionRecord> = round
-                .iter()
-                .map(|r| {
-                    let mut r = r.clone();
-                    if let Some(w) = &warp {
-                        r.execution.ref_time_log = carry_log(w, &r.execution.ref_time_log);
-                    }
-                    r
-                })
-                .collect();
+            let mut carried = Vec::with_capacity(round.len());
+            for (robot, r) in round.iter().enumerate() {
+                let mut r = r.clone();
+                if !same_reference {
+                    let demo = &r.execution.demonstration;
+                    let warp = planner
+                        .model
+                        .align_demonstration(&new_reference, demo, &planner.params.fit)
+                        .map_err(|e| Error::CannotReplay {
+                            why: format!(
+                                "round {}, robot {}: the execution does not align to the new \
+                                 reference ({e})",
+                                k + 1,
+                                robot + 1
+                            ),
+                        })?;
+                    r.execution.ref_time_log = log_from_warp(&warp, demo.n_samples());
+                }
+                carried.push(r);
+            }
             planner
                 .record_round(&carried)
                 .map_err(|e| Error::CannotReplay {
@@ -1220,7 +1214,7 @@ impl Planner {
         planner.origin = self.origin.clone();
         let report = RefitReport {
             rounds,
-            reference_changed: warp.is_some(),
+            reference_changed: !same_reference,
             high_share_before: self.confidence.high_share(),
         };
         Ok((planner, report))

@@ -340,10 +340,13 @@ fn classify_facade(e: &Facade) -> Kind {
         | Facade::Corrupt { path, .. }
         | Facade::Locked { path, .. }
         | Facade::WouldOverwrite { path, .. }
-        | Facade::Changed { path } => Kind::StateFile { path: path.clone() },
-        Facade::Inconsistent { .. } | Facade::Encode { .. } => Kind::StateFile {
-            path: PathBuf::new(),
-        },
+        | Facade::Changed { path }
+        | Facade::WouldDiscardRounds { path, .. } => Kind::StateFile { path: path.clone() },
+        Facade::Inconsistent { .. } | Facade::Encode { .. } | Facade::CannotReplay { .. } => {
+            Kind::StateFile {
+                path: PathBuf::new(),
+            }
+        }
         Facade::BadExecution { .. } | Facade::DuplicateRound { .. } => input_at(None),
         Facade::RobotCount { .. } => param("robots"),
         Facade::HoldInLowConfidence { .. } | Facade::HoldMatchesNothing { .. } => param("holds"),

@@ -479,20 +479,91 @@ impl PyPlanner {
     /// Refuses to replace a file that is not a state file, and, when this planner was loaded
     /// from (or saved to) ``path``, a file another process saved into since.
     ///
+    /// Recorded rounds are never discarded without consent: a state file at ``path`` that
+    /// holds rounds this planner does not hold (a fresh :func:`fit` saved over a cell's
+    /// state, or a planner loaded from another file) is refused unless ``force=True``, which
+    /// replaces it and warns (``DataWarning``) how many rounds went; to keep them, refit with
+    /// :meth:`refit` on the planner loaded from it.
+    ///
     /// Raises:
     ///     StateFileError: the file cannot be written, is not a state file, changed since the
-    ///         load, or stays locked (``path`` names it).
-    #[pyo3(signature = (path, timeout_s=None))]
-    fn save(&self, py: Python<'_>, path: PathBuf, timeout_s: Option<f64>) -> PyResult<()> {
+    ///         load, holds rounds this planner does not (without ``force``), or stays locked
+    ///         (``path`` names it).
+    #[pyo3(signature = (path, timeout_s=None, force=false))]
+    fn save(
+        &self,
+        py: Python<'_>,
+        path: PathBuf,
+        timeout_s: Option<f64>,
+        force: bool,
+    ) -> PyResult<()> {
         let timeout = lock_timeout(timeout_s)?;
         let inner = &self.inner;
-        py.detach(|| {
+        let discarded = py.detach(|| {
             guard(|| {
                 let lock = StateLock::acquire(&path, timeout)?;
-                Ok(inner.save_locked(&lock)?)
+                if force {
+                    Ok(inner.save_locked_discarding(&lock)?)
+                } else {
+                    inner.save_locked(&lock)?;
+                    Ok(Some(0))
+                }
             })
         })?;
-        Ok(())
+        match discarded {
+            Some(0) => Ok(()),
+            Some(n) => crate::errors::warn(
+                py,
+                &format!(
+                    "{}: replaced, discarding its {n} recorded round(s) (force=True)",
+                    path.display()
+                ),
+            ),
+            None => crate::errors::warn(
+                py,
+                &format!(
+                    "{}: replaced a state file this build cannot read (force=True)",
+                    path.display()
+                ),
+            ),
+        }
+    }
+
+    /// Fits the task again from ``demos`` (as :func:`fit`, for this planner's robot count)
+    /// and replays every round this planner recorded onto the new fit, in their order: the
+    /// operator's corrections are kept. Each execution keeps its samples and flags; its
+    /// reference-time log is carried onto the new reference (kept as recorded when the
+    /// reference is the same, else through the alignment of the old reference to the new
+    /// one), then the rounds are recorded as :meth:`record_round` would. Returns the new
+    /// planner; this one is unchanged. The new planner saves into the file this one was
+    /// loaded from (``save(path)``, no ``force`` needed).
+    ///
+    /// Raises:
+    ///     InputError: a bad demonstration.
+    ///     ParamError: a bad parameter or hold.
+    ///     StateFileError: the rounds cannot be replayed (recorded by a tandem older than
+    ///         state format 11, which did not keep the executions, or refused by the new
+    ///         model's checks): keep the old state, or fit and ``save(..., force=True)``.
+    #[pyo3(signature = (demos, channels=None, params=None, dt_s=None, holds=None))]
+    fn refit(
+        &self,
+        py: Python<'_>,
+        demos: &Bound<'_, PyAny>,
+        channels: Option<Vec<String>>,
+        params: Option<&Bound<'_, PyAny>>,
+        dt_s: Option<f64>,
+        holds: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyPlanner> {
+        let mut params = planner_params(params)?;
+        if let Some(holds) = holds.filter(|h| !h.is_none()) {
+            params.holds = hold_spec(holds)?;
+            params.validate().map_err(Error::from)?;
+        }
+        let demos = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
+        warn_demonstrations(py, &demos)?;
+        let old = &self.inner;
+        let (planner, _) = py.detach(|| guard(|| Ok(old.refit(&demos, params)?)))?;
+        Ok(PyPlanner { inner: planner })
     }
 
     /// Records a round of executions, one per robot (robot 1 first), and re-schedules (Eq. 21,
