@@ -20,11 +20,11 @@ use anyhow::{Context, anyhow, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
-use tandem::sim::study::Cell;
+use tandem::sim::study::{Cell, StudyInputs};
 use tandem_plot::{FONT_FAMILY, GROUND_TRUTH, HIGH_CONFIDENCE, ROBOT_LC_N};
 use tandem_zoo::eval::{
-    EvalParams, FamilyRow, FitRow, Step, Thresholds, ZooReport, check, evaluate, family_rows,
-    fit_rows,
+    EvalParams, FamilyRow, FitRow, SANDING, Step, Thresholds, ZooReport, check, evaluate,
+    family_rows, fit_rows, prepare_sanding,
 };
 
 use crate::workspace_root;
@@ -36,7 +36,9 @@ pub(crate) struct ZooArgs {
     /// chosen), `held-out` (1000..1008, never tuned on) or a comma-separated list.
     #[arg(long, default_value = "held-out")]
     seeds: String,
-    /// Families (comma-separated; default: every family).
+    /// Families (comma-separated; default: every family). `sanding` is the sanding fixture
+    /// (fixtures/sanding, with the study's hold rules from fixtures/study.toml), run by the
+    /// same loop beside the zoo (one seed: the fixture).
     #[arg(long, value_delimiter = ',')]
     families: Vec<String>,
     /// Robot counts N (comma-separated).
@@ -180,15 +182,20 @@ pub(crate) fn run(args: &ZooArgs) -> anyhow::Result<()> {
 
 /// Runs the evaluation the flags ask for, with a progress bar.
 fn run_zoo(args: &ZooArgs) -> anyhow::Result<(ZooReport, String)> {
-    let (seeds, seed_set) = seeds(&args.seeds)?;
+    let (seeds, mut seed_set) = seeds(&args.seeds)?;
+    let sanding = args.families.iter().any(|f| f == SANDING);
     let families: Vec<&tandem_zoo::Family> = if args.families.is_empty() {
         tandem_zoo::families().iter().collect()
     } else {
         args.families
             .iter()
-            .map(|f| tandem_zoo::family(f).map_err(|e| anyhow!("--families: {e}")))
+            .filter(|f| *f != SANDING)
+            .map(|f| tandem_zoo::family(f).map_err(|e| anyhow!("--families: {e} (or `{SANDING}`)")))
             .collect::<anyhow::Result<_>>()?
     };
+    if sanding && families.is_empty() {
+        seed_set = SANDING.into();
+    }
     let cells = match args.cell.as_str() {
         "rounds" => vec![Cell::Rounds],
         "continuous" => vec![Cell::Continuous],
@@ -203,7 +210,26 @@ fn run_zoo(args: &ZooArgs) -> anyhow::Result<(ZooReport, String)> {
         ..EvalParams::default()
     };
     params.validate().map_err(|e| anyhow!("{e}"))?;
-    let bar = ProgressBar::new(tandem_zoo::eval::steps(&params, families.len()));
+    let extra = if sanding {
+        let root = workspace_root();
+        let inputs = StudyInputs::from_dir(&root.join("fixtures/sanding"))?;
+        let (config, _) = crate::study::read_config(None)?;
+        let holds: Vec<String> = config
+            .planner
+            .holds
+            .rules
+            .iter()
+            .map(|r| r.to_string())
+            .collect();
+        vec![prepare_sanding(&inputs, &holds, &params.planner)?]
+    } else {
+        Vec::new()
+    };
+    let bar = ProgressBar::new(tandem_zoo::eval::steps(
+        &params,
+        families.len(),
+        extra.len(),
+    ));
     bar.set_style(
         ProgressStyle::with_template(
             "{spinner} zoo [{elapsed_precise}] {bar:40} {pos}/{len} fits and rounds (eta {eta})",
@@ -214,7 +240,7 @@ fn run_zoo(args: &ZooArgs) -> anyhow::Result<(ZooReport, String)> {
         .num_threads(args.threads.unwrap_or(0))
         .build()
         .context("building the thread pool")?;
-    let report = pool.install(|| evaluate(&families, &params, &|_: Step| bar.inc(1)))?;
+    let report = pool.install(|| evaluate(&families, extra, &params, &|_: Step| bar.inc(1)))?;
     bar.finish_and_clear();
     Ok((report, seed_set))
 }

@@ -51,33 +51,39 @@ pub trait TaskTruth: Sync {
 /// The sanding task's truth (module docs): a workpiece is [`Workpiece::random`] under
 /// `task`, a sample needs the operator where [`needs_correction`] says so for the
 /// reference label there; samples [`needs_help`] can need it; corrections raise `force`.
-#[derive(Clone, Debug)]
-pub struct SandingTruth<'a> {
-    labels: &'a [Label],
-    task: &'a TaskParams,
+#[derive(Clone, Debug, PartialEq)]
+pub struct SandingTruth {
+    labels: Vec<Label>,
+    task: TaskParams,
     can_need: Vec<bool>,
 }
 
-impl<'a> SandingTruth<'a> {
+impl SandingTruth {
     /// The truth of a reference with these labels (one per reference sample) and workpieces
     /// drawn under `task`.
     #[must_use]
-    pub fn new(labels: &'a [Label], task: &'a TaskParams) -> Self {
+    pub fn new(labels: Vec<Label>, task: TaskParams) -> Self {
         Self {
+            can_need: labels.iter().map(needs_help).collect(),
             labels,
             task,
-            can_need: labels.iter().map(needs_help).collect(),
         }
+    }
+
+    /// The reference's labels.
+    #[must_use]
+    pub fn labels(&self) -> &[Label] {
+        &self.labels
     }
 }
 
-impl TaskTruth for SandingTruth<'_> {
+impl TaskTruth for SandingTruth {
     fn n_ref(&self) -> usize {
         self.labels.len()
     }
 
     fn draw(&self, rng: &mut ChaCha8Rng) -> Result<Vec<bool>> {
-        let workpiece = Workpiece::random(self.task, rng)?;
+        let workpiece = Workpiece::random(&self.task, rng)?;
         Ok(self
             .labels
             .iter()

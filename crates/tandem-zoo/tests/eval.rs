@@ -24,14 +24,14 @@ fn run(params: &EvalParams, threads: usize) -> ZooReport {
     let steps = std::sync::atomic::AtomicU64::new(0);
     let report = pool
         .install(|| {
-            evaluate(&[family], params, &|_: Step| {
+            evaluate(&[family], Vec::new(), params, &|_: Step| {
                 steps.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             })
         })
         .unwrap();
     assert_eq!(
         steps.into_inner(),
-        tandem_zoo::eval::steps(params, 1),
+        tandem_zoo::eval::steps(params, 1, 0),
         "every step is reported once"
     );
     report

@@ -280,7 +280,7 @@ pub fn run_cell_trial(
     trial: usize,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<(CellTrialResult, PhaseTimes)> {
-    let truth = SandingTruth::new(labels, &config.task);
+    let truth = SandingTruth::new(labels.to_vec(), config.task.clone());
     let run = run_cell_trial_on(config, model, &truth, trial, progress, &|_| {})?;
     Ok((run.result, run.times))
 }

@@ -136,7 +136,7 @@ pub fn run_trial_observed(
     progress: &(dyn Fn(Progress) + Sync),
     observe: &(dyn Fn(RoundView<'_>) + Sync),
 ) -> Result<(TrialResult, PhaseTimes)> {
-    let truth = SandingTruth::new(reference_labels, &config.task);
+    let truth = SandingTruth::new(reference_labels.to_vec(), config.task.clone());
     let run = run_trial_on(config, model, &truth, trial, progress, observe)?;
     Ok((run.result, run.times))
 }

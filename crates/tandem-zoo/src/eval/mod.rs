@@ -34,7 +34,8 @@ use tandem_planner::PlannerParams;
 use tandem_sim::study::Cell;
 
 pub use prepare::{
-    FitReport, Prepared, ReferenceSpread, correction_channel, falsely_trusted_split, prepare,
+    FitReport, Prepared, ReferenceSpread, SANDING, correction_channel, falsely_trusted_split,
+    prepare, prepare_sanding,
 };
 pub use run::{RunReport, run_continuous, run_rounds};
 pub use summary::{Breach, FamilyRow, FitRow, Thresholds, check, family_rows, fit_rows};
@@ -130,20 +131,25 @@ pub enum Step {
     Round,
 }
 
-/// How many [`Step`]s [`evaluate`] reports for `n_families` families.
+/// How many [`Step`]s [`evaluate`] reports for `n_families` families and `n_extra` extra
+/// tasks.
 #[must_use]
-pub fn steps(params: &EvalParams, n_families: usize) -> u64 {
+pub fn steps(params: &EvalParams, n_families: usize, n_extra: usize) -> u64 {
     let tasks = (n_families * params.seeds.len()) as u64;
-    tasks + tasks * (params.robots.len() * params.cells.len() * params.rounds) as u64
+    let runs = tasks + n_extra as u64;
+    tasks + runs * (params.robots.len() * params.cells.len() * params.rounds) as u64
 }
 
 /// Evaluates `families` (module docs): fits every family and seed, then runs every `N` and
-/// cell, in parallel; `progress` is called with every [`Step`] from worker threads.
+/// cell, in parallel; `progress` is called with every [`Step`] from worker threads. `extra`
+/// tasks prepared elsewhere (the sanding fixture, [`prepare_sanding`]) run after the
+/// families' (their fits are not reported as steps).
 ///
 /// # Errors
 /// Invalid parameters; the first failing fit or run's error, in report order.
 pub fn evaluate(
     families: &[&Family],
+    extra: Vec<Prepared>,
     params: &EvalParams,
     progress: &(dyn Fn(Step) + Sync),
 ) -> Result<ZooReport> {
@@ -152,7 +158,7 @@ pub fn evaluate(
         .iter()
         .flat_map(|f| params.seeds.iter().map(move |&s| (*f, s)))
         .collect();
-    let prepared: Vec<Prepared> = tasks
+    let mut prepared: Vec<Prepared> = tasks
         .par_iter()
         .map(|(family, seed)| {
             let p = prepare(family, *seed, &params.planner, params.reference_spread);
@@ -162,6 +168,13 @@ pub fn evaluate(
         .collect::<Vec<Result<Prepared>>>()
         .into_iter()
         .collect::<Result<_>>()?;
+    let mut names: Vec<String> = families.iter().map(|f| f.name.to_string()).collect();
+    for p in extra {
+        if !names.iter().any(|n| n == p.family) {
+            names.push(p.family.to_string());
+        }
+        prepared.push(p);
+    }
     let jobs: Vec<(usize, usize, Cell)> = (0..prepared.len())
         .flat_map(|t| {
             params
@@ -192,7 +205,7 @@ pub fn evaluate(
     let runs = done.into_iter().map(|(_, r)| r).collect::<Result<_>>()?;
     Ok(ZooReport {
         params: params.clone(),
-        families: families.iter().map(|f| f.name.to_string()).collect(),
+        families: names,
         fits: prepared.into_iter().map(|p| p.report).collect(),
         runs,
     })

@@ -8,7 +8,9 @@ use tandem_confidence::{Confidence, ConfidenceParams};
 use tandem_lfd::{Demonstration, FitParams, HoldRule, HoldSpec, Reference, TaskModel};
 use tandem_planner::PlannerParams;
 use tandem_sim::needs::NeedProfile;
-use tandem_sim::truth::ProfileTruth;
+use tandem_sim::study::StudyInputs;
+use tandem_sim::task::{TaskParams, ground_truth_share};
+use tandem_sim::truth::{ProfileTruth, SandingTruth, TaskTruth, needs_help};
 
 use crate::{Error, Family, Result, ZooTask};
 
@@ -100,20 +102,17 @@ pub struct FitReport {
 }
 
 /// A task ready for the loop.
-#[derive(Debug)]
 pub struct Prepared {
     /// The family's name.
     pub family: &'static str,
     /// The seed.
     pub seed: u64,
-    /// The generated task.
-    pub task: ZooTask,
     /// The model fitted with the defaults (corrections prepared).
     pub model: TaskModel,
     /// The planner parameters: the defaults with the family's hold rules declared.
     pub planner: PlannerParams,
     /// The truth on the model's reference samples.
-    pub truth: ProfileTruth,
+    pub truth: Box<dyn TaskTruth + Send + Sync>,
     /// Per reference sample: where the operator can be needed (need > 0), `Some(varies)`:
     /// whether the demonstrations vary there ([`ZooTask::is_variable`]); `None` elsewhere.
     pub need_kind: Vec<Option<bool>>,
@@ -189,6 +188,85 @@ fn reference_spread(
     })
 }
 
+/// The hold rules `rules` as the planner takes them (`--hold-where`).
+fn hold_spec(rules: &[String]) -> Result<HoldSpec> {
+    Ok(HoldSpec {
+        at_s: Vec::new(),
+        rules: rules
+            .iter()
+            .map(|r| r.parse::<HoldRule>())
+            .collect::<std::result::Result<_, _>>()?,
+    })
+}
+
+/// The name the sanding fixture has among the families of a report.
+pub const SANDING: &str = "sanding";
+
+/// The sanding fixture (`inputs`: its demonstrations and the reference's labels) made ready
+/// for the same loop: fitted with `params` and the hold rules `holds` (the study's
+/// `tool<0.5`), its truth the study's ([`SandingTruth`]: a random half of the sections of
+/// passes 1–3 painted per workpiece; every sample that can need the operator varies between
+/// demonstrations). No reference-choice spread: only the reference's labels are known
+/// (`cargo xtask reference-order` measures it on the fixture).
+///
+/// # Errors
+/// The fit's or the planner's errors; [`Error::Eval`] when the fit's reference is not demo
+/// 0 (the labels are demo 0's).
+pub fn prepare_sanding(
+    inputs: &StudyInputs,
+    holds: &[String],
+    params: &PlannerParams,
+) -> Result<Prepared> {
+    let mut planner = params.clone();
+    planner.holds = hold_spec(holds)?;
+    let model = TaskModel::fit(&inputs.demos, &planner.fit)?;
+    model.prepare_corrections();
+    if model.reference_idx() != 0 || inputs.reference_labels.len() != model.n_ref() {
+        return Err(Error::Eval {
+            what: SANDING.into(),
+            why: "the labels are demo 0's: fit with the reference `first`".into(),
+        });
+    }
+    let labels = &inputs.reference_labels;
+    let need_kind: Vec<Option<bool>> = labels
+        .iter()
+        .map(|l| needs_help(l).then_some(true))
+        .collect();
+    let conf = Confidence::from_prior(model.sigma2_d(), planner.confidence.clone())
+        .map_err(tandem_planner::Error::from)?;
+    let (fit_falsely_trusted, fit_falsely_trusted_agreeing) =
+        falsely_trusted_split(conf.conf(), &need_kind);
+    let dt_s = model.dt_s();
+    let report = FitReport {
+        family: SANDING.into(),
+        seed: 0,
+        n_demos: inputs.demos.len(),
+        rate_hz: 1.0 / dt_s,
+        n_ref: model.n_ref(),
+        reference_idx: 0,
+        holds: holds.to_vec(),
+        correction_channel: "force".into(),
+        truth_high_pct: 100.0 * ground_truth_share(labels),
+        fit_high_pct: 100.0 * conf.high_share(),
+        fit_lc_runs: tandem_confidence::runs(conf.conf())
+            .iter()
+            .filter(|run| !run.high_conf)
+            .count(),
+        fit_falsely_trusted,
+        fit_falsely_trusted_agreeing,
+        spread: None,
+    };
+    Ok(Prepared {
+        family: SANDING,
+        seed: 0,
+        model,
+        planner,
+        truth: Box::new(SandingTruth::new(labels.clone(), TaskParams::default())),
+        need_kind,
+        report,
+    })
+}
+
 /// Generates `family` at `seed`, fits it with `params` (the defaults plus the family's hold
 /// rules) and maps the truth onto the reference; with `spread`, also measures the
 /// reference-choice spread.
@@ -205,14 +283,7 @@ pub fn prepare(
     let task = (family.generate)(seed)?;
     let demos = task.demos()?;
     let mut planner = params.clone();
-    planner.holds = HoldSpec {
-        at_s: Vec::new(),
-        rules: task
-            .holds
-            .iter()
-            .map(|r| r.parse::<HoldRule>())
-            .collect::<std::result::Result<_, _>>()?,
-    };
+    planner.holds = hold_spec(&task.holds)?;
     let model = TaskModel::fit(&demos, &planner.fit)?;
     model.prepare_corrections();
     let r = model.reference_idx();
@@ -236,7 +307,10 @@ pub fn prepare(
         .map(|&p| (task.need_at(p) > 0.0).then(|| task.is_variable(p)))
         .collect();
     let channel = correction_channel(&model);
-    let truth = ProfileTruth::new(NeedProfile::from_levels(&levels)?, channel.clone())?;
+    let truth = Box::new(ProfileTruth::new(
+        NeedProfile::from_levels(&levels)?,
+        channel.clone(),
+    )?);
     let conf = Confidence::from_prior(model.sigma2_d(), planner.confidence.clone())
         .map_err(tandem_planner::Error::from)?;
     let (fit_falsely_trusted, fit_falsely_trusted_agreeing) =
@@ -274,7 +348,6 @@ pub fn prepare(
     Ok(Prepared {
         family: family.name,
         seed,
-        task,
         model,
         planner,
         truth,

@@ -201,7 +201,7 @@ pub fn run_rounds(
     let run = run_trial_on(
         &config,
         &prep.model,
-        &prep.truth,
+        prep.truth.as_ref(),
         0,
         &|_| progress(),
         &observe,
@@ -285,7 +285,7 @@ pub fn run_continuous(
     let run = run_cell_trial_on(
         &config,
         &prep.model,
-        &prep.truth,
+        prep.truth.as_ref(),
         0,
         &|_| progress(),
         &observe,
