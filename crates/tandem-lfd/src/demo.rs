@@ -893,7 +893,11 @@ fn repeated_row(file: &str, line: usize, previous: usize, column: usize) -> Erro
 /// increase. Used by [`Demonstration::regrid_csv_str`] and for the topics of a ROS 2 bag.
 #[must_use]
 pub fn logger_period(times: &[f64]) -> Option<f64> {
-    if times.len() < 2 || times.windows(2).any(|w| !(w[1] > w[0])) {
+    if times.len() < 2
+        || times
+            .windows(2)
+            .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+    {
         return None;
     }
     let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
