@@ -31,6 +31,11 @@ pub(crate) struct Cli {
     /// The command.
     #[command(subcommand)]
     pub(crate) command: Command,
+    /// Print the full lists that are otherwise summarized: every hold-point stretch, one
+    /// note per file (periods, jitter, bag grids), every stretch and the whole operator's
+    /// order of a continuous plan.
+    #[arg(short, long, global = true)]
+    pub(crate) verbose: bool,
 }
 
 /// The subcommands.
@@ -73,8 +78,10 @@ pub(crate) enum Command {
     /// each robot starts its next task as soon as the plan allows): the period, tasks per
     /// hour, the operator's busy share, a lower bound on the period and the gap to it, the
     /// operator's order of low-confidence stretches and a text Gantt of two periods. It
-    /// assumes the operator follows the demonstrated mean speed; the run-time coordinator of
-    /// a continuous cell is in progress, and `record` still learns from rounds.
+    /// assumes the operator follows the demonstrated mean speed; at run time
+    /// `CyclicPlan::coordinator` (Python: `planner.continuous_coordinator()`) runs it, and
+    /// `record` still learns from rounds. Many stretches and a long operator's order are
+    /// summarized; --verbose prints them all.
     ///
     /// Example:
     ///

@@ -170,8 +170,26 @@ fn malformed_demonstrations() {
                 })
                 .collect(),
             vec![
-                "rate.csv:1:1: sample period 0.02 s differs from the reference 0.01 s",
+                "rate.csv:1:1: sample period 0.02 s differs from 0.01 s, the period of 3 of the 4 \
+                 demonstrations (",
                 "resample it",
+            ],
+        ),
+        // A row written twice by the logger: named with its twin and the fix.
+        (
+            "dup_row.csv",
+            small_demo(60, 1.0)
+                .lines()
+                .enumerate()
+                .flat_map(|(k, l)| {
+                    let times = if k == 10 { 2 } else { 1 };
+                    std::iter::repeat_n(format!("{l}\n"), times)
+                })
+                .collect(),
+            vec![
+                ":12:1",
+                "line 12 repeats line 11 exactly",
+                "uniq FILE > FIXED",
             ],
         ),
         (
@@ -691,6 +709,17 @@ fn malformed_executions() {
             1,
             format!("ref_sample\n{}", "0\n".repeat(n)),
             vec!["ends at reference sample 0", "end of"],
+        ),
+        // A log that stops moving early, its last step 1.2055098163 reference samples: the
+        // message rounds the numbers to a thousandth.
+        (
+            "stops.reflog.csv",
+            1,
+            format!(
+                "ref_sample\n{}",
+                lines(&|k| format!("{}\n", k.min(33) as f64 * 1.205_509_816_3))
+            ),
+            vec!["ends at reference sample 39.782 (expected within 1.206 of the end of the task"],
         ),
         (
             "late.reflog.csv",

@@ -264,12 +264,13 @@ pub enum Error {
     },
     /// Sample periods differ by more than 1 %.
     #[error(
-        "{}: sample period {} s differs from the reference {} s by more than 1 % (resample \
-         it to the reference's rate; for a file without a `t` column the period is --dt, \
+        "{}: sample period {} s differs from {} s, the period of {}, by more than 1 % \
+         (resample it to that rate; for a file without a `t` column the period is --dt, \
          default 0.01 s)",
         at(file, *line, *column),
         (found_s * 1e9).round() / 1e9,
-        (expected_s * 1e9).round() / 1e9
+        (expected_s * 1e9).round() / 1e9,
+        expected_from
     )]
     SamplePeriodMismatch {
         /// The file or source label.
@@ -278,8 +279,12 @@ pub enum Error {
         line: Option<usize>,
         /// 1-based column of its `t` column, where the period came from one (CSV).
         column: Option<usize>,
-        /// The reference period Δt_s, seconds.
+        /// The period the others share, seconds: the model's `Δt_s`, or at fit the period of
+        /// most demonstrations (ties: the first file's).
         expected_s: f64,
+        /// Whose period `expected_s` is, in words (`the model`, `2 of the 3 demonstrations
+        /// (b.csv, c.csv)`).
+        expected_from: String,
         /// This demonstration's period, seconds.
         found_s: f64,
     },

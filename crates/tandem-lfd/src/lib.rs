@@ -87,7 +87,7 @@ pub use csv::{CsvRow, CsvTable};
 pub use demo::{
     ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, JITTER_NOTE,
     JITTER_TOLERANCE, MAX_ABS_VALUE, MAX_RESAMPLE_GAP, PeriodSource, QuaternionBlock, Regridded,
-    period_from_times,
+    logger_period, period_from_times,
 };
 pub use error::{Error, Result};
 pub use model::{

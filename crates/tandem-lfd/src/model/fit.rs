@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use super::layout::{Item, Layout, quat_at};
 use super::stats::{batch_statistics, observe};
 use super::{FitParams, ModelData, Reference, TaskModel, check_dt};
-use crate::demo::Demonstration;
+use crate::demo::{DT_TOLERANCE, Demonstration};
 use crate::{Error, Result};
 
 /// Checks the demonstration set; returns it with every channel order equal to demo 0's
@@ -19,10 +19,37 @@ fn check_demos(demos: &[Demonstration]) -> Result<Cow<'_, [Demonstration]>> {
         return Err(Error::TooFewDemonstrations { found: demos.len() });
     }
     let names = demos[0].channel_names();
-    let dt = demos[0].dt_s();
+    // The period most demonstrations share decides which one is the odd one out (a 1 kHz
+    // file given first is named, not the good file after it); ties go to the earlier file.
+    let agree = |a: &Demonstration, b: &Demonstration| {
+        (a.dt_s() - b.dt_s()).abs() <= DT_TOLERANCE * b.dt_s()
+    };
+    let shared = |d: &Demonstration| demos.iter().filter(|o| agree(o, d)).count();
+    let majority = demos
+        .iter()
+        .enumerate()
+        .max_by(|(i, a), (j, b)| shared(a).cmp(&shared(b)).then(j.cmp(i)))
+        .map_or(0, |(i, _)| i);
+    let dt = demos[majority].dt_s();
+    let whose = || {
+        let with: Vec<&str> = demos
+            .iter()
+            .filter(|o| agree(o, &demos[majority]))
+            .map(Demonstration::source)
+            .collect();
+        match with[..] {
+            [one] => one.to_owned(),
+            _ => format!(
+                "{} of the {} demonstrations ({})",
+                with.len(),
+                demos.len(),
+                with.join(", ")
+            ),
+        }
+    };
     let mut reordered = false;
     for demo in demos {
-        check_dt(demo, dt)?;
+        check_dt(demo, dt, &whose)?;
         reordered |= matches!(demo.conform_to(names)?, Cow::Owned(_));
     }
     if !reordered {
