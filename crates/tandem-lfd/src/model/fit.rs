@@ -311,8 +311,8 @@ impl TaskModel {
         let names = &self.data.channel_names;
         let reference = reference.conform_to(names)?;
         let demo = demo.conform_to(names)?;
-        check_dt(&reference, self.data.dt_s)?;
-        check_dt(&demo, self.data.dt_s)?;
+        check_dt(&reference, self.data.dt_s, &|| "the model".into())?;
+        check_dt(&demo, self.data.dt_s, &|| "the model".into())?;
         if reference.n_samples() != self.data.n_ref {
             return Err(Error::BadData {
                 what: "reference".into(),
