@@ -284,6 +284,7 @@ fn fit(a: &FitArgs) -> Result<()> {
         a.resample,
     )?;
     period_notes(&demos.iter().collect::<Vec<_>>(), "");
+    let mut dt_notes: Vec<(String, String)> = Vec::new();
     for d in &demos {
         // The file's own time wins over --dt; a --dt that contradicts it is refused.
         if let Some(dt) = a.dt
@@ -298,14 +299,17 @@ fn fit(a: &FitArgs) -> Result<()> {
                     secs(d.dt_s())
                 );
             }
-            note(&format!(
-                "{}: its own time gives {} s; --dt (the period of files without a time column) \
-                 agrees and is not used for it",
-                d.source(),
-                secs(d.dt_s())
+            dt_notes.push((
+                d.source().to_owned(),
+                format!(
+                    "its own time gives {} s; --dt (the period of files without a time column) \
+                     agrees and is not used for it",
+                    secs(d.dt_s())
+                ),
             ));
         }
     }
+    grouped_notes(&dt_notes);
     for w in tandem::lfd::length_warnings(&demos) {
         note(&w);
     }

@@ -284,3 +284,30 @@ fn a_rosbag2_folder_is_read_through_its_mcap_and_the_grid_note_is_said_once() {
     }
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+#[test]
+fn a_dt_that_agrees_with_every_file_is_one_note() {
+    let dir = scratch("out-dt");
+    let demos = small_demos(&dir);
+    let mut args: Vec<String> = vec!["fit".into()];
+    args.extend(demos.iter().map(|p| s(p)));
+    args.extend(["--dt", "0.01", "--samples", "50", "-o"].map(String::from));
+    args.push(s(&dir.join("cell.tandem")));
+    let out = tandem(&args);
+    ok(&out);
+    let err = stderr(&out);
+    let notes: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains("its own time gives"))
+        .collect();
+    assert_eq!(notes.len(), 1, "{err}");
+    assert!(
+        notes[0].starts_with("note: 3 files (")
+            && notes[0].ends_with(
+                "): its own time gives 0.01 s; --dt (the period of files without a time column) \
+                 agrees and is not used for it"
+            ),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
