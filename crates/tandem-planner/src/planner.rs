@@ -15,7 +15,7 @@ use tandem_lfd::{
 };
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
-    CheckedSchedule, Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source,
+    CheckedSchedule, Outcome, PreviousFate, Problem, SamplerParams, SamplerStats, Schedule, Source,
     sample_schedule_n, validate,
 };
 
@@ -295,6 +295,13 @@ pub struct RecordReport {
     pub source: Source,
     /// The new schedule's `T_total` (Eq. 13), s.
     pub t_total_s: f64,
+    /// The `T_total` (Eq. 13, s) of the schedule the round ran (the previous one).
+    pub previous_t_total_s: f64,
+    /// What became of the previous schedule on the updated problem: still valid, re-timed
+    /// for the updated model, or invalid and why ([`PreviousFate::describe`] says it in one
+    /// sentence). While it is `Valid` or `Repaired`, [`RecordReport::t_total_s`] is at most
+    /// that schedule's `T_total`.
+    pub previous: PreviousFate,
     /// Wall time of the model update (Eq. 21).
     pub model_update: Duration,
     /// Wall time of recording the observations and updating the confidence (Eq. 9–12).
@@ -366,11 +373,13 @@ fn log_from_warp(warp: &[f64], n_samples: usize) -> Vec<f64> {
 /// `ψ̇̄_D` and widens `[ψ̇min, ψ̇max]`, and Eq. 20 requires low-confidence samples to run at
 /// the *new* mean. So the previous schedule is offered to the sampler
 /// ([`tandem_schedule::sample_schedule`]) as it is, and the sampler re-validates it against
-/// the new problem; if it fails, the sampler re-projects it (low-confidence samples at the
-/// new mean, high-confidence gradients clamped into the new bounds, `τ` clamped into
-/// `[0, |ψ_E1|]`) and validates that again (all constraints of Eq. 20 including the margin
-/// check) before using it as incumbent. If neither passes, the fastest serial schedule
-/// is the incumbent. [`RecordReport::source`] says which one won.
+/// the new problem; if it fails, the sampler re-times it for the new problem (its order of
+/// low-confidence runs, its clearances and its holds kept, low-confidence samples at the new
+/// mean, no event earlier than before) and validates that again (all constraints of Eq. 20
+/// including the margin check) before using it as incumbent, so the new `T_total` is at most
+/// the re-timed one. If nothing passes, the fastest serial schedule is the incumbent.
+/// [`RecordReport::source`] says which one won and [`RecordReport::previous`] what became of
+/// the previous schedule (docs/decisions.md, "Learning never makes the plan worse").
 #[derive(Clone, Debug)]
 pub struct Planner {
     params: PlannerParams,
@@ -625,6 +634,8 @@ impl From<OutcomeV7> for Outcome {
             lower_bound_s: v7.lower_bound_s,
             bound_is_optimum: v7.bound_is_optimum,
             gap: v7.gap,
+            margin_free_s: None,
+            previous: PreviousFate::NotGiven,
         }
     }
 }
@@ -1118,6 +1129,8 @@ impl Planner {
             reopened: latching.reopened,
             source: outcome.source,
             t_total_s: outcome.t_total_s,
+            previous_t_total_s: self.outcome.t_total_s,
+            previous: outcome.previous.clone(),
             model_update: t1 - t0,
             confidence: t2 - t1,
             scheduling: t3 - t2,
@@ -1996,6 +2009,40 @@ mod tests {
         p.reschedule(&plain).unwrap();
         assert_eq!(p.schedule().tick_s, 0.005);
         assert_eq!(p.coordinator().unwrap().tick_s(), 0.005);
+    }
+
+    #[test]
+    fn a_round_reports_what_became_of_the_previous_schedule() {
+        // Replays at the demonstrated speed: the mean gradient stays 1, confidence only grows,
+        // so the schedule the round ran stays valid and bounds the new one.
+        let mut p = small_planner(5);
+        for k in 0..4 {
+            let before = p.outcome().t_total_s;
+            let dt = p.model().dt_s();
+            let r = round(&p, 0.01 * k as f64, 0.02 + 0.01 * k as f64, 1, dt);
+            let report = p.record_round(&r).unwrap();
+            assert_eq!(report.previous_t_total_s, before);
+            match &report.previous {
+                PreviousFate::Valid { t_total_s } => {
+                    assert_eq!(*t_total_s, before);
+                    assert!(report.t_total_s <= before, "round {k}");
+                }
+                PreviousFate::Repaired { t_total_s, .. } => {
+                    assert!(report.t_total_s <= *t_total_s, "round {k}");
+                }
+                other => panic!("round {k}: {other:?}"),
+            }
+            assert!(report.previous.describe().is_some());
+            assert_eq!(report.previous, p.outcome().previous);
+        }
+        // A reloaded outcome knows nothing of a previous schedule.
+        let dir = scratch("previous-fate");
+        let path = dir.join("s.tandem");
+        p.save(&path).unwrap();
+        let loaded = Planner::load(&path).unwrap();
+        assert_eq!(loaded.outcome().previous, PreviousFate::NotGiven);
+        assert_eq!(loaded.outcome().margin_free_s, None);
+        assert_eq!(loaded.outcome().t_total_s, p.outcome().t_total_s);
     }
 
     #[test]

@@ -168,6 +168,9 @@ pub mod outcome_form {
             lower_bound_s: o.lower_bound_s,
             bound_is_optimum: o.bound_is_optimum,
             gap: o.gap,
+            // Not stored: a loaded outcome has no previous schedule and no split of its gap.
+            margin_free_s: None,
+            previous: tandem_schedule::PreviousFate::NotGiven,
         })
     }
 }
