@@ -102,3 +102,24 @@ def test_200_hz_arrays_are_only_right_with_their_period() -> None:
         assumed = tandem.fit_model(arrays, channels=channels)
     assert right.dt_s == 0.005 and assumed.dt_s == 0.01
     assert right.n_ref == assumed.n_ref
+
+
+def test_rounds_run_concurrently_give_one_confidence_in_any_order(tmp_path: Path) -> None:
+    """The issue's scenario in the workcell: six rounds run with the schedule of one state
+    (several cells recording into one file, so in any order), recorded in three orders, give
+    one confidence (docs/decisions.md, "The same rounds in any order")."""
+    start = tandem.fit(DEMOS, params={**PARAMS, "confidence": QUICK_CONFIDENCE})
+    start.save(tmp_path / "start.tandem")
+    runs = [
+        tandem.sim.run_round(start, tandem.sim.sanding_needs(LABELS, seed=k), seed=k)
+        for k in range(6)
+    ]
+    highs = []
+    for order in ([0, 1, 2, 3, 4, 5], [5, 4, 3, 2, 1, 0], [2, 5, 0, 3, 1, 4]):
+        planner = tandem.Planner.load(tmp_path / "start.tandem")
+        for k in order:
+            planner.record_round(**runs[k].record_args())
+        highs.append(np.asarray(planner.confidence.high))
+    assert highs[0].any() and not highs[0].all()
+    for other in highs[1:]:
+        np.testing.assert_array_equal(other, highs[0])
