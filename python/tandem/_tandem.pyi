@@ -66,7 +66,9 @@ def fit(
     """Learns the task from demonstrations (paths or ``(T_i, C)`` arrays) and makes the first
     schedule (Fig. 2); the same inputs and parameters as ``tandem fit`` give the same state.
     ``holds``: reference times (s) and rules (``"gripper>0.5"``) where a robot may wait, as
-    ``tandem fit --hold-at/--hold-where``; ``[]`` declares none, ``None`` keeps ``params``'."""
+    ``tandem fit --hold-at/--hold-where``; ``[]`` declares none, ``None`` keeps ``params``'.
+    ``dt_s``: the arrays' sample period (s); without it arrays are taken to be 0.01 s apart
+    with a ``DataWarning`` (deprecated)."""
 
 def read_bag(
     path: Path,
@@ -137,7 +139,9 @@ class Planner:
         re-schedules (§II-C). ``dt_s``: the logs' sample period (default: the schedule's
         tick); a finer log is resampled to the model's period. ``resample``: CSV executions
         with an irregular ``t`` column are put on an even grid first, their logs and flags
-        (one entry per row) with them."""
+        (one entry per row) with them. A sample ``corrected`` but not ``supervised`` is an
+        ``InputError``. The dict's ``reopened`` counts latched samples the round's
+        corrections turned low-confidence again (e.g. rounds recorded out of order)."""
     def record_pair(
         self,
         executions: Sequence[Demo],
