@@ -227,6 +227,64 @@ impl OperatorTally {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// The sanding truth draws the workpiece the study drew before it existed, from the same
+    /// stream: the same masks, and the stream left where `Workpiece::random` leaves it, so a
+    /// study's operator draws what they drew before.
+    #[test]
+    fn the_sanding_truth_draws_the_studys_workpieces_from_the_same_stream() {
+        let params = TaskParams::default();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let demo = crate::task::demonstrate(
+            &params,
+            &Workpiece::random(&params, &mut rng).unwrap(),
+            &mut rng,
+        )
+        .unwrap();
+        let truth = SandingTruth::new(demo.labels.clone(), params.clone());
+        assert_eq!(truth.n_ref(), demo.labels.len());
+        assert_eq!(truth.correction_channel(), "force");
+        let (mut a, mut b) = (ChaCha8Rng::seed_from_u64(9), ChaCha8Rng::seed_from_u64(9));
+        for _ in 0..4 {
+            let mask = truth.draw(&mut a).unwrap();
+            let wp = Workpiece::random(&params, &mut b).unwrap();
+            let expected: Vec<bool> = demo
+                .labels
+                .iter()
+                .map(|l| needs_correction(l, &wp))
+                .collect();
+            assert_eq!(mask, expected);
+            assert!(mask.iter().zip(truth.can_need()).all(|(m, c)| !m || *c));
+        }
+        assert_eq!(
+            a.random::<u64>(),
+            b.random::<u64>(),
+            "the same stream position"
+        );
+        let share = truth.never_needed_share();
+        assert!((share - crate::task::ground_truth_share(&demo.labels)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_profile_truth_draws_one_robot_of_the_profile() {
+        let profile = NeedProfile::from_levels(&[0.0, 0.0, 1.0, 1.0, 0.5, 0.0]).unwrap();
+        let truth = ProfileTruth::new(profile.clone(), "flow").unwrap();
+        assert_eq!(truth.can_need(), [false, false, true, true, true, false]);
+        assert_eq!(truth.never_needed_share(), 0.5);
+        assert_eq!(truth.correction_channel(), "flow");
+        let (mut a, mut b) = (ChaCha8Rng::seed_from_u64(1), ChaCha8Rng::seed_from_u64(1));
+        for _ in 0..8 {
+            let mask = truth.draw(&mut a).unwrap();
+            assert_eq!(mask, profile.draw(1, &mut b)[0]);
+            assert!(mask[2] && mask[3] && !mask[0] && !mask[5]);
+        }
+        assert!(ProfileTruth::new(profile, "").is_err());
+        assert_eq!(
+            falsely_trusted_where(&[true, true, false], &[true, false, true]),
+            1
+        );
+    }
 
     fn label(pass: u8, phase: Phase) -> Label {
         Label {

@@ -84,3 +84,28 @@ fn a_short_loop_reports_consistent_numbers_on_any_number_of_threads() {
         "{breaches:?}"
     );
 }
+
+/// A task with three demonstrations has two correction components after the fit and three
+/// once a round is recorded; the continuous cell keeps its simulated operator across re-plans
+/// and failed with "parameter `u` has 2 entries, the model has 3 components" (found by the
+/// zoo: pick_and_place, held-out seed 1007, every N) until the operator's inputs followed the
+/// model that commands.
+#[test]
+fn a_continuous_cell_follows_a_model_that_gains_correction_components() {
+    let family = tandem_zoo::family("pick_and_place").unwrap();
+    let prep = tandem_zoo::eval::prepare(
+        family,
+        1007,
+        &tandem_planner::PlannerParams::default(),
+        false,
+    )
+    .unwrap();
+    assert_eq!(
+        prep.report.n_demos, 3,
+        "the witness has three demonstrations"
+    );
+    assert_eq!(prep.model.n_components(), 2);
+    let run = tandem_zoo::eval::run_continuous(&prep, 2, 2, &|| {}).unwrap();
+    assert_eq!(run.rounds, 2);
+    assert_eq!(run.overlap_ticks + run.faults, 0);
+}

@@ -453,6 +453,15 @@ impl Operate {
         rng: &mut impl Rng,
     ) -> Result<Option<Operator>> {
         let n_ref = model.n_ref();
+        // A model update can add correction components (`K = min(n − 1, k_max, d)` grows
+        // with the executions recorded while a task has fewer than `k_max + 1`
+        // demonstrations): a continuous cell keeps its operator across re-plans, so the
+        // inputs follow the model that commands now (allocates only when `K` changes).
+        let k = model.n_components();
+        if self.u_zero.len() != k {
+            self.u_zero.resize(k, 0.0);
+            self.u_corr.resize(k, 0.0);
+        }
         let ref_time = ref_time.min((n_ref - 1) as f64);
         let supervised = bounds.is_some();
         let mut corrected = false;
