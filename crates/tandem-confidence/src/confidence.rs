@@ -18,7 +18,9 @@ use crate::{ConfidenceParams, Error, ErrorRates, Observations, Result};
 /// `Beta(2, 2)`) or a later correction cannot turn it back to low confidence. The paper's
 /// claim that "the previous scheduling solution will always remain valid" rests on this:
 /// a schedule that was feasible for one confidence map is feasible for any map with
-/// more high-confidence samples.
+/// more high-confidence samples. [`update_round`](Confidence::update_round), which the
+/// planner uses, keeps that latch against the prior and the error rates but not against
+/// corrections recorded after it, so that the same rounds give the same map in any order.
 ///
 /// ```
 /// use tandem_confidence::{Confidence, ConfidenceParams, Observations};

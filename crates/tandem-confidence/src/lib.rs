@@ -18,7 +18,9 @@
 //! 4. **Decision** (Eq. 12): high confidence iff `P(p_{c|t} < μ_c) = I_{μ_c}(α, β) > γ_c`,
 //!    with the regularized incomplete beta function of `statrs`.
 //! 5. **Latch** ([`Confidence`]): a sample that became high-confidence stays so, even if a
-//!    later variance update moves its prior, so a previous schedule stays valid.
+//!    later variance update moves its prior, so a previous schedule stays valid;
+//!    [`Confidence::update_round`] decides a latched sample again when a round brings
+//!    corrections of it, so the same rounds give the same confidence in any order.
 //!
 //! # Worked example: how long until a variable but never-corrected sample is trusted?
 //!

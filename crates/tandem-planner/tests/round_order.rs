@@ -238,6 +238,14 @@ proptest! {
             order.shuffle(&mut rng);
             let (p, _) = record(&base, &all, &order);
             prop_assert_eq!(p.confidence().conf(), want.as_slice(), "order {:?}", order);
+            // The model's update (Eq. 21) and the observations are sums: another order
+            // changes their last bits only.
+            for (a, b) in p.model().sigma2_d().iter().zip(first.model().sigma2_d()) {
+                prop_assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()), "{} vs {}", a, b);
+            }
+            for (a, b) in p.observations().corrections().iter().zip(first.observations().corrections()) {
+                prop_assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()), "{} vs {}", a, b);
+            }
         }
     }
 }
