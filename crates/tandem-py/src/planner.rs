@@ -596,7 +596,10 @@ impl PyPlanner {
             params.holds = hold_spec(holds)?;
             params.validate().map_err(Error::from)?;
         }
-        let demos = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
+        let (demos, assumed) = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
+        if !assumed.is_empty() {
+            warn(py, &assumed_period_warning(&assumed))?;
+        }
         warn_demonstrations(py, &demos)?;
         let old = &self.inner;
         let (planner, _) = py.detach(|| guard(|| Ok(old.refit(&demos, params)?)))?;
