@@ -21,6 +21,14 @@ pub const LENGTH_WARN_RATIO: f64 = 1.5;
 /// the end of the task").
 pub const END_RUN_REFUSE_SHARE: f64 = 0.05;
 
+/// Over the final run, the signal whose part is missing must move: some channel must vary by
+/// more than this share of its range over the whole demonstration (a run over a stretch
+/// where both signals rest, a final pause of independent length, is not a missing part):
+/// 0.05, the run's own threshold ([`END_RUN_REFUSE_SHARE`]), so that on a task moving at an
+/// even pace the two agree. A resting channel varies by its noise, far below it (the
+/// alignment's flat stretches: 1 % of the range, `tandem_warp::FLAT_RANGE_FRACTION`).
+pub const END_RUN_MOTION_SHARE: f64 = 0.05;
+
 /// How close to a slope bound a warp's slope counts as "at the bound": within 5 % of it.
 pub const END_RUN_SLOPE_TOLERANCE: f64 = 0.05;
 
@@ -130,6 +138,35 @@ fn end_run_share(warp: &[f64], t_i: usize, slope: f64, at_min: bool) -> f64 {
     run as f64 / (n_ref - 1) as f64
 }
 
+/// Whether some channel of `demo` varies over its samples `from..` by more than
+/// [`END_RUN_MOTION_SHARE`] of its range over the whole demonstration.
+fn moves_after(demo: &Demonstration, from: usize) -> bool {
+    let m = demo.n_channels();
+    let spread = |rows: &[f64], c: usize| {
+        let (lo, hi) = rows
+            .chunks_exact(m)
+            .map(|r| r[c])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+        hi - lo
+    };
+    let all = demo.samples();
+    let tail = &all[from.min(demo.n_samples() - 1) * m..];
+    (0..m).any(|c| {
+        let range = spread(all, c);
+        range > 0.0 && spread(tail, c) > END_RUN_MOTION_SHARE * range
+    })
+}
+
+/// The reference sample from which motion over a final run of `run` (share of the reference)
+/// counts: the run's start plus a tenth of its length, so that the last feature both signals
+/// share, where the run begins, is not taken for motion inside it.
+fn inner_start(n_ref: usize, run: f64) -> usize {
+    let len = (run * (n_ref - 1) as f64).round() as usize;
+    (n_ref - 1 - len + len / 10).min(n_ref - 1)
+}
+
 /// Refuses a demonstration that does not reach the end of the task, the check executions
 /// get from their reference-time log (`TaskModel::update`), made on the alignment: a
 /// demonstration cut off before the end is aligned to the reference with its last samples
@@ -137,10 +174,13 @@ fn end_run_share(warp: &[f64], t_i: usize, slope: f64, at_min: bool) -> f64 {
 /// (`slope_min`, pinned at the end), so its warp ends with a long run at that bound; a
 /// complete one, faster, slower or pausing, does not (the sanding fixtures: none; cut at
 /// 55 %, 80 % and 90 %: 39 %, 17 % and 11 % of the task). A run over
-/// [`END_RUN_REFUSE_SHARE`] of the reference is refused. When the reference itself is the
+/// [`END_RUN_REFUSE_SHARE`] of the reference over which the reference moves
+/// ([`END_RUN_MOTION_SHARE`], after the run's first tenth, where the last shared feature
+/// sits) is refused: where the reference rests over the run (both end at rest, for lengths
+/// of their own) nothing is missing. When the reference itself is the
 /// short one, every other demonstration's warp ends with a run at the upper bound
-/// (`slope_max`: the rest of their task squeezed into its last sample); that is refused
-/// naming the reference. `demos` and `warps` are in model order, the reference first
+/// (`slope_max`: the rest of their task squeezed into its last sample) over which they
+/// move; that is refused naming the reference. `demos` and `warps` are in model order, the reference first
 /// (its warp is the identity and is not checked). Called by [`crate::TaskModel::fit`].
 ///
 /// # Errors
@@ -155,7 +195,7 @@ pub(crate) fn check_reaches_end(
     let reference = demos[0].source();
     for (demo, warp) in demos.iter().zip(warps).skip(1) {
         let run = end_run_share(warp, demo.n_samples(), slope_min, true);
-        if run > END_RUN_REFUSE_SHARE {
+        if run > END_RUN_REFUSE_SHARE && moves_after(demos[0], inner_start(warp.len(), run)) {
             return Err(Error::TruncatedDemonstration {
                 file: demo.source().into(),
                 ends_at_pct: 100.0 * (1.0 - run),
@@ -171,7 +211,12 @@ pub(crate) fn check_reaches_end(
         .iter()
         .zip(warps)
         .skip(1)
-        .map(|(demo, warp)| end_run_share(warp, demo.n_samples(), slope_max, false))
+        .map(|(demo, warp)| {
+            let run = end_run_share(warp, demo.n_samples(), slope_max, false);
+            // The other's samples squeezed into the run.
+            let from = warp[inner_start(warp.len(), run)].floor().max(0.0) as usize;
+            if moves_after(demo, from) { run } else { 0.0 }
+        })
         .collect();
     let shortest = others.iter().copied().fold(f64::INFINITY, f64::min);
     if !others.is_empty() && shortest > END_RUN_REFUSE_SHARE {
@@ -270,6 +315,13 @@ mod tests {
             .with_source(format!("d{n}"))
     }
 
+    /// A demonstration of `n` samples moving all along (a ramp), labelled `d<n>`.
+    fn ramp(n: usize) -> Demonstration {
+        Demonstration::new(vec!["a".into()], (0..n).map(|k| k as f64).collect(), 0.01)
+            .unwrap()
+            .with_source(format!("d{n}"))
+    }
+
     /// A warp of `n_ref` values onto `t_i` samples: the identity pace up to share `cut` of
     /// the reference, then the rest at normalized slope `end_slope`.
     fn warp_with_end(n_ref: usize, t_i: usize, cut: f64, end_slope: f64) -> Vec<f64> {
@@ -291,8 +343,8 @@ mod tests {
     #[test]
     fn a_warp_ending_at_the_slope_bound_is_a_demonstration_that_stops_short() {
         let (n_ref, t_i) = (201, 121);
-        let d = demo(t_i);
-        let r = demo(n_ref);
+        let d = ramp(t_i);
+        let r = ramp(n_ref);
         let identity: Vec<f64> = (0..n_ref).map(|n| n as f64).collect();
         // Cut at 55 %: the last 45 % at s_min = 0.25 → run 0.45 > 0.05, ends at 55 %.
         let cut = warp_with_end(n_ref, t_i, 0.55, 0.25);
@@ -342,7 +394,17 @@ mod tests {
         assert!(err.to_string().contains("reference"), "{err}");
         // One of two at s_max is not enough to blame the reference.
         let plain = warp_with_end(n_ref, t_i, 0.5, 1.0);
-        check_reaches_end(&[&r, &d, &d], &[identity, fast, plain], 0.25, 4.0).unwrap();
+        check_reaches_end(&[&r, &d, &d], &[identity.clone(), fast, plain], 0.25, 4.0).unwrap();
+        // Where both rest over the run (the reference flat from 50 %: a final pause of a
+        // length of its own), the run at the bound misses nothing: accepted.
+        let resting = Demonstration::new(
+            vec!["a".into()],
+            (0..n_ref).map(|k| (k.min(100)) as f64).collect(),
+            0.01,
+        )
+        .unwrap();
+        let cut = warp_with_end(n_ref, t_i, 0.55, 0.25);
+        check_reaches_end(&[&resting, &d], &[identity, cut], 0.25, 4.0).unwrap();
     }
 
     #[test]

@@ -80,8 +80,8 @@ mod model;
 mod quat;
 
 pub use checks::{
-    END_RUN_REFUSE_SHARE, END_RUN_SLOPE_TOLERANCE, LENGTH_REFUSE_RATIO, LENGTH_WARN_RATIO,
-    check_lengths, length_warnings, time_like,
+    END_RUN_MOTION_SHARE, END_RUN_REFUSE_SHARE, END_RUN_SLOPE_TOLERANCE, LENGTH_REFUSE_RATIO,
+    LENGTH_WARN_RATIO, check_lengths, length_warnings, time_like,
 };
 pub use csv::{CsvRow, CsvTable};
 pub use demo::{
