@@ -214,12 +214,25 @@ pub(crate) fn retime(
     if holds_out.iter().all(Vec::is_empty) {
         holds_out.clear();
     }
-    Some(Schedule {
+    let mut out = Schedule {
         grad_exec: warps,
         offsets_s: (1..n_robots).map(|i| x[start_var(i)]).collect(),
         tick_s,
         holds: holds_out,
-    })
+    };
+    // Constraint 2: no robot starts after every robot before it has ended. A robot pushed
+    // past that (the serial schedule, whose robot 2 starts at robot 1's end, after robot 1's
+    // runs lengthened) starts at the latest end instead, read from the same clock the check
+    // reads, so "starts when the other ended" stays exact.
+    for i in 1..n_robots {
+        let latest_s = (0..i)
+            .map(|j| out.end_s(j, dt))
+            .fold(f64::NEG_INFINITY, f64::max);
+        if out.offsets_s[i - 1] > latest_s {
+            out.offsets_s[i - 1] = latest_s;
+        }
+    }
+    Some(out)
 }
 
 /// Writes the gradients of the HC gap `a..b` into `warp` so that it lasts `dur_s` (s): the
