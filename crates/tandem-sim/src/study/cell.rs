@@ -71,7 +71,7 @@ pub struct CellIteration {
     pub lc_ref: Vec<[usize; 2]>,
     /// The usable hold points (reference samples) the cell waits at.
     pub holds: Vec<usize>,
-    /// Reference samples that truly need help but are high-confidence ([`falsely_trusted`]).
+    /// Reference samples that truly need help but are high-confidence ([`crate::truth::falsely_trusted`]).
     pub falsely_trusted_samples: usize,
 }
 

@@ -121,7 +121,7 @@ pub struct Prepared {
 }
 
 /// The channel the simulated operator's corrections raise on `model`: the first of
-/// [`CORRECTION_CHANNELS`] the model has, else its first scalar channel that is not a
+/// `CORRECTION_CHANNELS` the model has, else its first scalar channel that is not a
 /// position, else its first tangent coordinate.
 #[must_use]
 pub fn correction_channel(model: &TaskModel) -> String {
