@@ -270,7 +270,19 @@ fn merge(paths: &[PathBuf]) -> anyhow::Result<(ZooReport, String)> {
                         m.families.push(f);
                     }
                 }
-                m.fits.extend(file.report.fits);
+                // A task fitted in two files (its rounds and its continuous cell run apart)
+                // counts once, with its reference-choice spread where one file measured it.
+                for fit in file.report.fits {
+                    match m
+                        .fits
+                        .iter_mut()
+                        .find(|f| f.family == fit.family && f.seed == fit.seed)
+                    {
+                        Some(f) if f.spread.is_none() => *f = fit,
+                        Some(_) => {}
+                        None => m.fits.push(fit),
+                    }
+                }
                 m.runs.extend(file.report.runs);
             }
         }
@@ -417,7 +429,7 @@ fn write_docs(root: &Path, file: &ZooFile, tables: &str, out: &Path) -> anyhow::
 }
 
 /// Image size (pixels; SVG user units).
-const SIZE_PX: (u32, u32) = (1400, 620);
+const SIZE_PX: (u32, u32) = (1600, 620);
 
 /// Draws the figure (module docs) as SVG and PNG.
 fn draw(file: &ZooFile, svg: &Path, png: &Path) -> anyhow::Result<()> {
@@ -475,7 +487,7 @@ fn draw_on<DB: DrawingBackend>(
     let mut chart = ChartBuilder::on(&left)
         .margin(20)
         .caption("final T_total / margin-free bound", (FONT_FAMILY, 22))
-        .x_label_area_size(90)
+        .x_label_area_size(50)
         .y_label_area_size(70)
         .build_cartesian_2d(-0.5..nf - 0.5, 0.9..y_max)
         .map_err(err("left axes"))?;
@@ -483,11 +495,7 @@ fn draw_on<DB: DrawingBackend>(
         .configure_mesh()
         .x_labels(families.len())
         .x_label_formatter(&label)
-        .x_label_style(
-            (FONT_FAMILY, 15)
-                .into_font()
-                .transform(FontTransform::Rotate90),
-        )
+        .x_label_style((FONT_FAMILY, 13))
         .y_label_formatter(&|v| format!("{v:.2}"))
         .y_desc("T_total / bound (mean over seeds)")
         .label_style((FONT_FAMILY, 16))
@@ -549,7 +557,7 @@ fn draw_on<DB: DrawingBackend>(
     let mut chart = ChartBuilder::on(&right)
         .margin(20)
         .caption("high confidence against the truth", (FONT_FAMILY, 22))
-        .x_label_area_size(90)
+        .x_label_area_size(50)
         .y_label_area_size(60)
         .build_cartesian_2d(-0.5..nf - 0.5, 0.0..110.0)
         .map_err(err("right axes"))?;
@@ -557,11 +565,7 @@ fn draw_on<DB: DrawingBackend>(
         .configure_mesh()
         .x_labels(families.len())
         .x_label_formatter(&label)
-        .x_label_style(
-            (FONT_FAMILY, 15)
-                .into_font()
-                .transform(FontTransform::Rotate90),
-        )
+        .x_label_style((FONT_FAMILY, 13))
         .y_label_formatter(&|v| {
             if *v <= 100.0 {
                 format!("{v:.0}")

@@ -220,14 +220,19 @@ pub struct Thresholds {
 }
 
 impl Thresholds {
-    /// What CI checks today (measured on the held-out seeds, with a margin).
+    /// What CI checks today: limits every held-out seed met alone (CI runs one seed, so a
+    /// family's "mean" there is one seed's value), with a margin. Measured at commit f67bc36
+    /// (docs/zoo.md, rounds, 30 rounds): the worst seed of any family 58.2 % above its bound
+    /// with two robots (polishing), family means up to 50.0 % with three and 123.5 % with
+    /// four robots (screw driving), high confidence at most 16.4 pp from the truth (peg
+    /// insertion).
     pub const CI: Thresholds = Thresholds {
         max_backward_steps: 0,
         max_overlap_ticks: 0,
-        max_gap_pct_n2: 60.0,
-        max_gap_pct_n3: 120.0,
-        max_gap_pct_n4: 150.0,
-        max_high_vs_truth_pp: 30.0,
+        max_gap_pct_n2: 75.0,
+        max_gap_pct_n3: 100.0,
+        max_gap_pct_n4: 200.0,
+        max_high_vs_truth_pp: 25.0,
     };
 
     /// Issue 38's targets: within 5 % of the bound for two robots, 10 % for three, high
