@@ -74,6 +74,30 @@ pub(crate) struct Channel {
 }
 
 impl Channel {
+    /// A pose as a recorder logs it, `x, y, z` (m, `pos_decimals` decimals) and the quaternion
+    /// `qx, qy, qz` (6 decimals) with `qw` (noise-free, the generator normalizes), each with
+    /// its `(white, tremor)` noise, followed by the family's own `rest` channels.
+    pub(crate) fn pose_then<const K: usize>(
+        pos_decimals: usize,
+        (pos_white, pos_tremor): (f64, f64),
+        (rot_white, rot_tremor): (f64, f64),
+        rest: [Channel; K],
+    ) -> Vec<Channel> {
+        let pos = |name| Channel::real(name, pos_decimals, pos_white, pos_tremor);
+        let rot = |name| Channel::real(name, 6, rot_white, rot_tremor);
+        let mut out = vec![
+            pos("x"),
+            pos("y"),
+            pos("z"),
+            rot("qx"),
+            rot("qy"),
+            rot("qz"),
+            Channel::real("qw", 6, 0.0, 0.0),
+        ];
+        out.extend(rest);
+        out
+    }
+
     /// A real channel.
     pub(crate) fn real(name: &'static str, decimals: usize, white_sd: f64, tremor_sd: f64) -> Self {
         Self {

@@ -37,19 +37,15 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let route_p = pick(&mut rng, &[0.4, 0.6, 0.8, 1.0]);
     let connector_p = pick(&mut rng, &[0.5, 0.7]);
 
-    let pos = |name| Channel::real(name, 5, 0.000_2, 0.000_6);
-    let rot = |name| Channel::real(name, 6, 0.000_5, 0.003);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        Channel::binary("gripper"),
-        Channel::real("tension", 3, 0.05, 0.08),
-    ];
+    let channels = Channel::pose_then(
+        5,
+        (0.000_2, 0.000_6),
+        (0.000_5, 0.003),
+        [
+            Channel::binary("gripper"),
+            Channel::real("tension", 3, 0.05, 0.08),
+        ],
+    );
     let start = vec![0.3, 0.3, 0.2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let segments = vec![
         seg(

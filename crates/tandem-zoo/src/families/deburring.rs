@@ -34,22 +34,18 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let need_p = pick(&mut rng, &[0.6, 0.8, 1.0]);
     let shape = pick(&mut rng, &[Shape::Offset, Shape::Wavy { cycles: 2.0 }]);
 
-    let pos = |name| Channel::real(name, 6, 0.000_05, 0.000_2);
-    let rot = |name| Channel::real(name, 6, 0.000_3, 0.002);
     let force = |name| Channel::real(name, 3, 0.04, 0.05);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        force("fx"),
-        force("fy"),
-        force("fz"),
-        Channel::binary("spindle"),
-    ];
+    let channels = Channel::pose_then(
+        6,
+        (0.000_05, 0.000_2),
+        (0.000_3, 0.002),
+        [
+            force("fx"),
+            force("fy"),
+            force("fz"),
+            Channel::binary("spindle"),
+        ],
+    );
     let start = vec![0.3, 0.2, 0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let segments = vec![
         seg(

@@ -39,19 +39,12 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     // Across the bead's travel: y for the beads along x, x for the bead along y.
     let across = if seam_bead == 6 { X } else { Y };
 
-    let pos = |name| Channel::real(name, 6, 0.000_2, 0.000_6);
-    let rot = |name| Channel::real(name, 6, 0.000_5, 0.003);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        Channel::non_neg("flow", 4, 0.02),
-        Channel::binary("valve"),
-    ];
+    let channels = Channel::pose_then(
+        6,
+        (0.000_2, 0.000_6),
+        (0.000_5, 0.003),
+        [Channel::non_neg("flow", 4, 0.02), Channel::binary("valve")],
+    );
     let start = vec![0.0, 0.0, 0.15, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let segments = vec![
         seg(

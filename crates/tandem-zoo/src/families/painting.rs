@@ -37,19 +37,12 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let (first, last) = pick(&mut rng, &[(0, 0), (2, 3), (4, 5)]);
     let need_p = pick(&mut rng, &[0.4, 0.6, 0.8, 1.0]);
 
-    let pos = |name| Channel::real(name, 5, 0.000_2, 0.000_5);
-    let rot = |name| Channel::real(name, 6, 0.000_3, 0.0015);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        Channel::non_neg("flow", 3, 0.015),
-        Channel::binary("spray"),
-    ];
+    let channels = Channel::pose_then(
+        5,
+        (0.000_2, 0.000_5),
+        (0.000_3, 0.0015),
+        [Channel::non_neg("flow", 3, 0.015), Channel::binary("spray")],
+    );
     let start = vec![0.3, -0.1, 0.4, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let mut segments: Vec<Segment> = vec![seg(
         "approach",

@@ -34,21 +34,13 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let insert_p = pick(&mut rng, &[0.4, 0.6]);
     let turns = pick(&mut rng, &[2.0, 3.0]);
 
-    let pos = |name| Channel::real(name, 6, 0.000_1, 0.000_3);
-    let rot = |name| Channel::real(name, 6, 0.000_2, 0.001);
     let force = |name| Channel::real(name, 3, 0.03, 0.05);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        force("fx"),
-        force("fy"),
-        Channel::real("fz", 3, 0.15, 0.2),
-    ];
+    let channels = Channel::pose_then(
+        6,
+        (0.000_1, 0.000_3),
+        (0.000_2, 0.001),
+        [force("fx"), force("fy"), Channel::real("fz", 3, 0.15, 0.2)],
+    );
     let start = vec![0.0, 0.0, 0.12, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let segments = vec![
         seg(

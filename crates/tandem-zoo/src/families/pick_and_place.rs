@@ -35,18 +35,12 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     // Which of the three objects a person puts down by hand (the others come in a fixture).
     let loose: &[usize] = pick(&mut rng, &[&[0][..], &[0, 2], &[2], &[1]]);
 
-    let pos = |name| Channel::real(name, 6, 0.000_2, 0.000_5);
-    let rot = |name| Channel::real(name, 6, 0.000_5, 0.003);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        Channel::binary("gripper"),
-    ];
+    let channels = Channel::pose_then(
+        6,
+        (0.000_2, 0.000_5),
+        (0.000_5, 0.003),
+        [Channel::binary("gripper")],
+    );
     let start = vec![0.3, 0.15, 0.2, 0.0, 0.0, 0.0, 0.0, 0.0];
     let mut segments: Vec<Segment> = Vec::new();
     for j in 0..3 {

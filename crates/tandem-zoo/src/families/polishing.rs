@@ -35,19 +35,12 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let length_var = uniform(&mut rng, 0.05, 0.085);
     let where_ = pick(&mut rng, &["start", "end", "both"]);
 
-    let pos = |name| Channel::real(name, 6, 0.000_1, 0.000_4);
-    let rot = |name| Channel::real(name, 6, 0.000_2, 0.001);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        Channel::real("force", 3, 0.2, 0.3),
-        Channel::binary("tool"),
-    ];
+    let channels = Channel::pose_then(
+        6,
+        (0.000_1, 0.000_4),
+        (0.000_2, 0.001),
+        [Channel::real("force", 3, 0.2, 0.3), Channel::binary("tool")],
+    );
     let start = vec![0.0, 0.0, 0.10, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let stroke = |x: f64| seg("stroke", 2.6, 0.08, 0.25, vec![to(X, x, Linear)]);
     let turn = |y: f64, tilt: f64| {
