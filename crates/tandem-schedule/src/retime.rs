@@ -308,35 +308,8 @@ mod tests {
     use crate::choose::repair;
     use crate::{SamplerParams, sample_schedule_n, validate};
 
-    /// 20 s at 20 Hz: two low-confidence inserts (samples 60..100 and 260..300) between
-    /// high-confidence moves whose speeds may vary within `[0.8, 1.25]` of the mean (the inserts
-    /// `[0.7, 1.4]`); with `holds`, hold points in the approach, the transfer and the retract.
-    fn pegs(holds: bool) -> Problem {
-        let n = 400;
-        let conf: Vec<bool> = (0..n)
-            .map(|k| !((60..100).contains(&k) || (260..300).contains(&k)))
-            .collect();
-        let mean: Vec<f64> = (0..n)
-            .map(|k| 1.0 + 0.1 * (k as f64 * 0.03).sin())
-            .collect();
-        let (lo, hi) = mean
-            .iter()
-            .zip(&conf)
-            .map(|(&m, &hc)| {
-                if hc {
-                    (0.8 * m, 1.25 * m)
-                } else {
-                    (0.7 * m, 1.4 * m)
-                }
-            })
-            .unzip();
-        let p = Problem::new(conf, mean, lo, hi, 0.05).unwrap();
-        if holds {
-            p.with_holds(vec![30, 150, 200, 340]).unwrap()
-        } else {
-            p
-        }
-    }
+    // `pegs`: the peg-in-hole problem the integration tests with hold points share.
+    include!("../tests/common/pegs.rs");
 
     /// `p` after a model update that slowed its low-confidence samples by `factor` (the mean
     /// gradient times `factor`, the bounds widened to keep it inside), same confidence and holds.

@@ -5,42 +5,14 @@
 //! reach the exact optimum with holds, which is the certificate's bound; a problem without
 //! holds schedules exactly as before.
 
+#[allow(dead_code, reason = "the random problems are for other test files")]
+mod common;
+use common::pegs;
 use tandem_realtime::testkit::{find_overlap_with_holds, rng};
 use tandem_schedule::{
     Problem, SamplerParams, Schedule, Source, operator_bound_s, sample_schedule_n, solve_exact,
     validate,
 };
-
-/// 20 s at 20 Hz: approach (3 s), insert peg 1 (2 s, low confidence), transfer (8 s), insert
-/// peg 2 (2 s, low confidence), retract (5 s). High-confidence speeds within
-/// `[0.8, 1.25]` of the mean, the inserts at their mean (bounds `[0.7, 1.4]`). Holds in the
-/// approach, twice in the transfer and in the retract (gripper open, arm in free space).
-fn pegs(with_holds: bool) -> Problem {
-    let n = 400;
-    let conf: Vec<bool> = (0..n)
-        .map(|k| !((60..100).contains(&k) || (260..300).contains(&k)))
-        .collect();
-    let mean: Vec<f64> = (0..n)
-        .map(|k| 1.0 + 0.1 * (k as f64 * 0.03).sin())
-        .collect();
-    let (lo, hi): (Vec<f64>, Vec<f64>) = mean
-        .iter()
-        .zip(&conf)
-        .map(|(&m, &hc)| {
-            if hc {
-                (0.8 * m, 1.25 * m)
-            } else {
-                (0.7 * m, 1.4 * m)
-            }
-        })
-        .unzip();
-    let p = Problem::new(conf, mean, lo, hi, 0.05).unwrap();
-    if with_holds {
-        p.with_holds(vec![30, 150, 200, 340]).unwrap()
-    } else {
-        p
-    }
-}
 
 fn params(seed: u64) -> SamplerParams {
     SamplerParams {

@@ -5,6 +5,7 @@
 //! the plan worse").
 
 mod common;
+use common::pegs;
 #[allow(
     dead_code,
     reason = "the runs without the check are for other test files"
@@ -42,34 +43,6 @@ fn learned(p: &Problem, conf: Vec<bool>, factor: f64) -> Problem {
         .unwrap()
         .with_holds(p.holds().to_vec())
         .unwrap()
-}
-
-/// 20 s at 20 Hz, two low-confidence inserts, holds in the moves (as `tests/holds.rs`).
-fn pegs(holds: bool) -> Problem {
-    let n = 400;
-    let conf: Vec<bool> = (0..n)
-        .map(|k| !((60..100).contains(&k) || (260..300).contains(&k)))
-        .collect();
-    let mean: Vec<f64> = (0..n)
-        .map(|k| 1.0 + 0.1 * (k as f64 * 0.03).sin())
-        .collect();
-    let (lo, hi) = mean
-        .iter()
-        .zip(&conf)
-        .map(|(&m, &hc)| {
-            if hc {
-                (0.8 * m, 1.25 * m)
-            } else {
-                (0.7 * m, 1.4 * m)
-            }
-        })
-        .unzip();
-    let p = Problem::new(conf, mean, lo, hi, 0.05).unwrap();
-    if holds {
-        p.with_holds(vec![30, 150, 200, 340]).unwrap()
-    } else {
-        p
-    }
 }
 
 /// The property every re-schedule keeps (see the module docs), for `before` on the old
