@@ -73,6 +73,22 @@ pub(crate) struct Channel {
     pub(crate) tremor_tau_s: f64,
 }
 
+/// The columns of the pose block [`Channel::pose_then`] puts first: `x, y, z, qx, qy, qz, qw`.
+pub(crate) mod pose {
+    /// Column of `x` (m).
+    pub(crate) const X: usize = 0;
+    /// Column of `y` (m).
+    pub(crate) const Y: usize = 1;
+    /// Column of `z` (m).
+    pub(crate) const Z: usize = 2;
+    /// Column of the quaternion's `qx`.
+    pub(crate) const QX: usize = 3;
+    /// Column of the quaternion's `qy`.
+    pub(crate) const QY: usize = 4;
+    /// Column of the quaternion's `qz`.
+    pub(crate) const QZ: usize = 5;
+}
+
 impl Channel {
     /// A pose as a recorder logs it, `x, y, z` (m, `pos_decimals` decimals) and the quaternion
     /// `qx, qy, qz` (6 decimals) with `qw` (noise-free, the generator normalizes), each with

@@ -3,6 +3,7 @@
 use rand::Rng;
 
 use crate::Result;
+use crate::engine::pose::*;
 use crate::engine::{
     Agreed, Channel, Feature, FeatureKind, Interp::*, Script, Shape, Variation, pick, render,
     rng_for, seg, to, uniform,
@@ -12,11 +13,6 @@ use crate::task::ZooTask;
 /// The family's name.
 pub(crate) const NAME: &str = "cable_routing";
 
-const X: usize = 0;
-const Y: usize = 1;
-const Z: usize = 2;
-const QX: usize = 3;
-const QZ: usize = 5;
 const GRIPPER: usize = 7;
 const TENSION: usize = 8;
 

@@ -3,6 +3,7 @@
 use rand::Rng;
 
 use crate::Result;
+use crate::engine::pose::*;
 use crate::engine::{
     Channel, Interp::*, Script, Shape, Variation, pick, render, rng_for, seg, to, uniform,
 };
@@ -11,11 +12,6 @@ use crate::task::ZooTask;
 /// The family's name.
 pub(crate) const NAME: &str = "dispensing";
 
-const X: usize = 0;
-const Y: usize = 1;
-const Z: usize = 2;
-const QX: usize = 3;
-const QY: usize = 4;
 const FLOW: usize = 7;
 const VALVE: usize = 8;
 

@@ -3,6 +3,7 @@
 use rand::Rng;
 
 use crate::Result;
+use crate::engine::pose::*;
 use crate::engine::{
     Channel, Feature, FeatureKind, Interp::*, Script, pick, render, rng_for, seg, to, uniform,
 };
@@ -11,11 +12,6 @@ use crate::task::ZooTask;
 /// The family's name.
 pub(crate) const NAME: &str = "peg_insertion";
 
-const X: usize = 0;
-const Y: usize = 1;
-const Z: usize = 2;
-const QX: usize = 3;
-const QZ: usize = 5;
 const FX: usize = 7;
 const FY: usize = 8;
 const FZ: usize = 9;
