@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use tandem_confidence::{Confidence, ConfidenceParams, MissEvidence};
 use tandem_lfd::{Demonstration, TaskModel};
-use tandem_planner::state::{FORMAT_VERSION, OLDEST_READABLE_VERSION};
+use tandem_planner::state::{self, FORMAT_VERSION, OLDEST_READABLE_VERSION};
 use tandem_planner::{Error, Planner, PlannerParams};
 use tandem_schedule::validate;
 
@@ -459,5 +459,22 @@ fn damaged_state_files_give_clear_errors() {
 
     // None of this touched the committed file.
     assert!(std::fs::read(golden_path()).unwrap() == bytes);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_golden_state_file_saves_again_byte_for_byte() {
+    let dir = tmp_dir("golden-again");
+    let golden = std::fs::read(golden_path()).unwrap();
+    // Through the planner.
+    let again = dir.join("again.tandem");
+    Planner::load(golden_path()).unwrap().save(&again).unwrap();
+    assert!(std::fs::read(&again).unwrap() == golden);
+    // Through the wire types alone.
+    let wire = dir.join("wire.tandem");
+    let (payload, extras) = state::load_payload(&golden_path()).unwrap();
+    assert!(extras.is_empty());
+    state::save_payload(&wire, &payload, &extras).unwrap();
+    assert!(std::fs::read(&wire).unwrap() == golden);
     std::fs::remove_dir_all(&dir).unwrap();
 }
