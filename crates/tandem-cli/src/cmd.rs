@@ -475,7 +475,8 @@ fn holds_json(planner: &Planner) -> serde_json::Value {
         })
         .collect();
     json!({
-        "declared": serde_json::to_value(&planner.params().holds).unwrap_or_default(),
+        "declared": crate::json::value(&crate::json::HoldSpecOut::from(&planner.params().holds))
+            .unwrap_or_default(),
         "samples": holds,
         "active_samples": holds.iter().filter(|&&n| conf[n]).count(),
         "stretches": runs,
@@ -810,7 +811,12 @@ fn inspect(a: &InspectArgs) -> Result<()> {
     let explained = planner
         .explain_low_confidence()
         .context("cannot explain the low-confidence regions")?;
-    let regions = serde_json::to_value(&explained)?;
+    let regions = crate::json::value(
+        &explained
+            .iter()
+            .map(crate::json::LowRegionOut::from)
+            .collect::<Vec<_>>(),
+    )?;
     let rates = planner.error_rates()?;
     let prior_threshold = tandem::confidence::prior_low_threshold(conf.params())?;
     let ranges: serde_json::Map<_, _> = model
@@ -842,11 +848,11 @@ fn inspect(a: &InspectArgs) -> Result<()> {
             "slowest_duration_s": model.grad_max().iter().sum::<f64>() * dt,
         },
         "confidence": {
-            "params": serde_json::to_value(conf.params())?,
+            "params": crate::json::value(&crate::json::ConfidenceParamsOut::from(conf.params()))?,
             "high_share": conf.high_share(),
             "n_high": conf.n_high(),
             "low_regions": regions,
-            "error_rates": serde_json::to_value(rates)?,
+            "error_rates": crate::json::value(&crate::json::ErrorRatesOut::from(rates))?,
             "sigma2_d_prior_threshold": prior_threshold,
             "total_supervised": obs.total_supervised(),
             "total_corrections": obs.total_corrections(),

@@ -37,7 +37,9 @@ pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
     let plan = cyclic_plan(problem, planner.n_robots(), &CyclicParams::default())
         .with_context(|| format!("{file}: cannot compute the cyclic plan"))?;
     if a.json {
-        out(&serde_json::to_string_pretty(&plan)?);
+        out(&serde_json::to_string_pretty(
+            &crate::json::CyclicPlanOut::from(&plan),
+        )?);
     } else {
         out(&plan_text(problem, &plan, crate::cmd::verbose())?);
     }

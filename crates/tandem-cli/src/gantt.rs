@@ -229,7 +229,7 @@ fn holds_json(layout: &Layout, dt_s: f64) -> Vec<Value> {
 /// The schedule as JSON: robot count, offsets, per-robot gradients and durations,
 /// low-confidence intervals in global time, `T_total` and its certificate (the margin-free lower bound, whether it is the proven
 /// optimum, the gap) (all times in seconds of global time; gradients in execution samples per
-/// reference sample). `schedule` is exactly `tandem::schedule::Schedule`'s serde form.
+/// reference sample). `schedule` is [`crate::json::ScheduleOut`].
 pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Value> {
     let layout = Layout::new(problem, &outcome.schedule)?;
     let dt = problem.dt_s();
@@ -261,7 +261,7 @@ pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Valu
         "n_ref": problem.n_ref(),
         "source": source_name(&outcome.source),
         "lc_intervals": intervals,
-        "schedule": serde_json::to_value(s)?,
+        "schedule": crate::json::value(&crate::json::ScheduleOut::from(s))?,
     });
     if s.has_holds() {
         // Only with holds, so that a schedule without them prints as before hold points.

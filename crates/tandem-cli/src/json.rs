@@ -1,0 +1,376 @@
+//! The documented JSON outputs of the command line (docs/formats.md) as types of their own,
+//! apart from the library types they show: a library field renamed or added changes no
+//! output (each conversion names every field of the library type, so a field added fails to
+//! compile here until it is decided on), and `tests/json_outputs.rs` pins every output's
+//! keys against a committed golden shape.
+//!
+//! The top-level documents of `schedule --json` and `inspect --json` spell their keys in
+//! `cmd.rs` and `gantt.rs`; what they used to take from a library type's serde form is here:
+//! the schedule ([`ScheduleOut`]), the declared hold points ([`HoldSpecOut`]), the confidence
+//! parameters ([`ConfidenceParamsOut`]), the operator's error rates ([`ErrorRatesOut`]) and
+//! the low-confidence regions ([`LowRegionOut`]); `schedule --cell continuous --json` is
+//! [`CyclicPlanOut`], printed directly (keys in the order declared here, the documented
+//! one). The other documents are printed through a `serde_json::Value` (keys in
+//! alphabetical order).
+
+use serde::Serialize;
+use tandem::confidence::{ConfidenceParams, ErrorRates};
+use tandem::lfd::HoldSpec;
+use tandem::planner::{ChannelShare, LowCause, LowRegion};
+use tandem::realtime::{After, Hold};
+use tandem::schedule::Schedule;
+use tandem::schedule::cyclic::{CyclicPlan, GapPlan, RobotCycle, Stretch};
+
+/// `schedule` of `tandem schedule --json` and `tandem inspect --json`: the warps, start
+/// offsets and tick of the schedule, and its holds only when it has any (so a schedule
+/// without holds prints as before hold points).
+#[derive(Serialize)]
+pub(crate) struct ScheduleOut {
+    /// Per robot, execution samples per reference sample (`N` lists of `n_ref` values).
+    grad_exec: Vec<Vec<f64>>,
+    /// Start offsets `τ_2 … τ_N` (s).
+    offsets_s: Vec<f64>,
+    /// The control tick of its margin check (s).
+    tick_s: f64,
+    /// Per robot, its holds (robots 0-based); left out when no robot has one.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    holds: Vec<Vec<HoldOut>>,
+}
+
+/// One hold of [`ScheduleOut::holds`].
+#[derive(Serialize)]
+pub(crate) struct HoldOut {
+    /// The reference sample at whose start the robot stops.
+    ref_idx: usize,
+    /// Planned dwell (s); left out when 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    dwell_s: f64,
+    /// Release rules; left out when empty.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    after: Vec<AfterOut>,
+}
+
+/// A release rule of [`HoldOut`]: robot `robot` (0-based) has passed reference sample
+/// `ref_idx`.
+#[derive(Serialize)]
+pub(crate) struct AfterOut {
+    robot: usize,
+    ref_idx: usize,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+impl From<&Hold> for HoldOut {
+    fn from(h: &Hold) -> Self {
+        let Hold {
+            ref_idx,
+            dwell_s,
+            after,
+        } = h;
+        HoldOut {
+            ref_idx: *ref_idx,
+            dwell_s: *dwell_s,
+            after: after
+                .iter()
+                .map(|&After { robot, ref_idx }| AfterOut { robot, ref_idx })
+                .collect(),
+        }
+    }
+}
+
+impl From<&Schedule> for ScheduleOut {
+    fn from(s: &Schedule) -> Self {
+        let Schedule {
+            grad_exec,
+            offsets_s,
+            tick_s,
+            holds,
+        } = s;
+        ScheduleOut {
+            grad_exec: grad_exec.clone(),
+            offsets_s: offsets_s.clone(),
+            tick_s: *tick_s,
+            holds: holds
+                .iter()
+                .map(|hs| hs.iter().map(HoldOut::from).collect())
+                .collect(),
+        }
+    }
+}
+
+/// `holds.declared` of `tandem inspect --json`: the declared hold points (reference times,
+/// s) and rules (as written: `gripper>0.5`).
+#[derive(Serialize)]
+pub(crate) struct HoldSpecOut {
+    at_s: Vec<f64>,
+    rules: Vec<String>,
+}
+
+impl From<&HoldSpec> for HoldSpecOut {
+    fn from(h: &HoldSpec) -> Self {
+        let HoldSpec { at_s, rules } = h;
+        HoldSpecOut {
+            at_s: at_s.clone(),
+            rules: rules.iter().map(ToString::to_string).collect(),
+        }
+    }
+}
+
+/// `confidence.params` of `tandem inspect --json` (meaning: `ConfidenceParams`, Eq. 10–12).
+#[allow(clippy::struct_excessive_bools)]
+#[derive(Serialize)]
+pub(crate) struct ConfidenceParamsOut {
+    gamma_p: f64,
+    sigma2_max: f64,
+    epsilon: f64,
+    mu_c: f64,
+    gamma_c: f64,
+    false_correction_rate: f64,
+    miss_rate: f64,
+    estimate_error_rates: bool,
+    one_vote_per_execution: bool,
+}
+
+impl From<&ConfidenceParams> for ConfidenceParamsOut {
+    fn from(p: &ConfidenceParams) -> Self {
+        let ConfidenceParams {
+            gamma_p,
+            sigma2_max,
+            epsilon,
+            mu_c,
+            gamma_c,
+            false_correction_rate,
+            miss_rate,
+            estimate_error_rates,
+            one_vote_per_execution,
+        } = *p;
+        ConfidenceParamsOut {
+            gamma_p,
+            sigma2_max,
+            epsilon,
+            mu_c,
+            gamma_c,
+            false_correction_rate,
+            miss_rate,
+            estimate_error_rates,
+            one_vote_per_execution,
+        }
+    }
+}
+
+/// `confidence.error_rates` of `tandem inspect --json`: the operator's rates the confidence
+/// decides with, per control sample.
+#[derive(Serialize)]
+pub(crate) struct ErrorRatesOut {
+    false_correction_rate: f64,
+    miss_rate: f64,
+}
+
+impl From<ErrorRates> for ErrorRatesOut {
+    fn from(r: ErrorRates) -> Self {
+        let ErrorRates {
+            false_correction_rate,
+            miss_rate,
+        } = r;
+        ErrorRatesOut {
+            false_correction_rate,
+            miss_rate,
+        }
+    }
+}
+
+/// One of `confidence.low_regions` of `tandem inspect --json` (meaning: docs/formats.md).
+#[derive(Serialize)]
+pub(crate) struct LowRegionOut {
+    ref_start: usize,
+    ref_end: usize,
+    start_s: f64,
+    end_s: f64,
+    /// `"variance"` or `"corrections"`.
+    cause: &'static str,
+    sigma2_d_max: f64,
+    sigma2_d_prior_threshold: Option<f64>,
+    channels: Vec<ChannelShareOut>,
+    supervised: f64,
+    corrections: f64,
+    expected_false_corrections: f64,
+    clean_executions_needed: Option<usize>,
+}
+
+/// One of [`LowRegionOut::channels`].
+#[derive(Serialize)]
+pub(crate) struct ChannelShareOut {
+    name: String,
+    sigma2: f64,
+    share: f64,
+    range: f64,
+    range_for_prior: Option<f64>,
+}
+
+impl From<&LowRegion> for LowRegionOut {
+    fn from(r: &LowRegion) -> Self {
+        let LowRegion {
+            ref_start,
+            ref_end,
+            start_s,
+            end_s,
+            cause,
+            sigma2_d_max,
+            sigma2_d_prior_threshold,
+            channels,
+            supervised,
+            corrections,
+            expected_false_corrections,
+            clean_executions_needed,
+        } = r;
+        LowRegionOut {
+            ref_start: *ref_start,
+            ref_end: *ref_end,
+            start_s: *start_s,
+            end_s: *end_s,
+            cause: match cause {
+                LowCause::Variance => "variance",
+                LowCause::Corrections => "corrections",
+            },
+            sigma2_d_max: *sigma2_d_max,
+            sigma2_d_prior_threshold: *sigma2_d_prior_threshold,
+            channels: channels
+                .iter()
+                .map(|c| {
+                    let ChannelShare {
+                        name,
+                        sigma2,
+                        share,
+                        range,
+                        range_for_prior,
+                    } = c;
+                    ChannelShareOut {
+                        name: name.clone(),
+                        sigma2: *sigma2,
+                        share: *share,
+                        range: *range,
+                        range_for_prior: *range_for_prior,
+                    }
+                })
+                .collect(),
+            supervised: *supervised,
+            corrections: *corrections,
+            expected_false_corrections: *expected_false_corrections,
+            clean_executions_needed: *clean_executions_needed,
+        }
+    }
+}
+
+/// `tandem schedule --cell continuous --json`: the cyclic plan of a continuous cell
+/// (meaning of every field: docs/formats.md, "Cyclic plan JSON").
+#[derive(Serialize)]
+pub(crate) struct CyclicPlanOut {
+    n_robots: usize,
+    order: Vec<StretchOut>,
+    period_s: f64,
+    lc_s: Vec<f64>,
+    robots: Vec<RobotCycleOut>,
+    tasks_per_hour: f64,
+    operator_share: f64,
+    lower_bound_s: f64,
+    gap: f64,
+    order_exhaustive: bool,
+    orders_evaluated: usize,
+}
+
+/// One of [`CyclicPlanOut::order`]: robot and low-confidence stretch, both 0-based.
+#[derive(Serialize)]
+pub(crate) struct StretchOut {
+    robot: usize,
+    lc: usize,
+}
+
+/// One of [`CyclicPlanOut::robots`].
+#[derive(Serialize)]
+pub(crate) struct RobotCycleOut {
+    start_s: f64,
+    lc_start_s: Vec<f64>,
+    gaps: Vec<GapOut>,
+    start_wait_s: f64,
+}
+
+/// One of [`RobotCycleOut::gaps`].
+#[derive(Serialize)]
+pub(crate) struct GapOut {
+    duration_s: f64,
+    wait_s: f64,
+    hold: Option<usize>,
+}
+
+impl From<&CyclicPlan> for CyclicPlanOut {
+    fn from(p: &CyclicPlan) -> Self {
+        let CyclicPlan {
+            n_robots,
+            order,
+            period_s,
+            lc_s,
+            robots,
+            tasks_per_hour,
+            operator_share,
+            lower_bound_s,
+            gap,
+            order_exhaustive,
+            orders_evaluated,
+        } = p;
+        CyclicPlanOut {
+            n_robots: *n_robots,
+            order: order
+                .iter()
+                .map(|&Stretch { robot, lc }| StretchOut { robot, lc })
+                .collect(),
+            period_s: *period_s,
+            lc_s: lc_s.clone(),
+            robots: robots
+                .iter()
+                .map(|r| {
+                    let RobotCycle {
+                        start_s,
+                        lc_start_s,
+                        gaps,
+                        start_wait_s,
+                    } = r;
+                    RobotCycleOut {
+                        start_s: *start_s,
+                        lc_start_s: lc_start_s.clone(),
+                        gaps: gaps
+                            .iter()
+                            .map(
+                                |&GapPlan {
+                                     duration_s,
+                                     wait_s,
+                                     hold,
+                                 }| GapOut {
+                                    duration_s,
+                                    wait_s,
+                                    hold,
+                                },
+                            )
+                            .collect(),
+                        start_wait_s: *start_wait_s,
+                    }
+                })
+                .collect(),
+            tasks_per_hour: *tasks_per_hour,
+            operator_share: *operator_share,
+            lower_bound_s: *lower_bound_s,
+            gap: *gap,
+            order_exhaustive: *order_exhaustive,
+            orders_evaluated: *orders_evaluated,
+        }
+    }
+}
+
+/// `value` as a JSON value (keys in alphabetical order, as every document is printed).
+///
+/// # Errors
+/// serde_json's (none for these types: every key is a string).
+pub(crate) fn value<T: Serialize>(value: &T) -> serde_json::Result<serde_json::Value> {
+    serde_json::to_value(value)
+}
