@@ -4,9 +4,9 @@
 //! compile here until it is decided on), and `tests/json_outputs.rs` pins every output's
 //! keys against a committed golden shape.
 //!
-//! The top-level documents of `schedule --json` and `inspect --json` spell their keys in
-//! `cmd.rs` and `gantt.rs`; what they used to take from a library type's serde form is here:
-//! the schedule ([`ScheduleOut`]), the declared hold points ([`HoldSpecOut`]), the confidence
+//! `schedule --json` is [`ScheduleDoc`]; the top-level document of `inspect --json` spells
+//! its keys in `cmd.rs`; what it used to take from a library type's serde form is here:
+//! the schedule ([`ScheduleDoc`], [`ScheduleOut`]), the declared hold points ([`HoldSpecOut`]), the confidence
 //! parameters ([`ConfidenceParamsOut`]), the operator's error rates ([`ErrorRatesOut`]) and
 //! the low-confidence regions ([`LowRegionOut`]); `schedule --cell continuous --json` is
 //! [`CyclicPlanOut`], printed directly (keys in the order declared here, the documented
@@ -21,7 +21,78 @@ use tandem::realtime::{After, Hold};
 use tandem::schedule::Schedule;
 use tandem::schedule::cyclic::{CyclicPlan, GapPlan, RobotCycle, Stretch};
 
-/// `schedule` of `tandem schedule --json` and `tandem inspect --json`: the warps, start
+/// The document of `tandem schedule --json` (without `saved` and `previous_t_total_s`, which
+/// `schedule` adds) and `schedule` of `tandem inspect --json` (docs/formats.md, "Schedule
+/// JSON"): times in seconds of global time, robots 1-based.
+#[derive(Serialize)]
+pub(crate) struct ScheduleDoc {
+    /// Eq. 13: `max_i(τ_i + |ψ_Ei|)` (s).
+    pub(crate) t_total_s: f64,
+    /// The certificate: no schedule of Eq. 20 is shorter (s).
+    pub(crate) lower_bound_s: f64,
+    /// Whether the bound is the proven margin-free optimum.
+    pub(crate) bound_is_optimum: bool,
+    /// `(t_total_s − lower_bound_s) / lower_bound_s`.
+    pub(crate) gap: f64,
+    /// The fastest serial schedule's `T_total` (s).
+    pub(crate) serial_t_total_s: f64,
+    /// `N`.
+    pub(crate) n_robots: usize,
+    /// `τ` of robot 2 (s); `null` for one robot.
+    pub(crate) offset_s: Option<f64>,
+    /// `τ_2 … τ_N` (s).
+    pub(crate) offsets_s: Vec<f64>,
+    /// `|ψ_E1| … |ψ_EN|` (s).
+    pub(crate) durations_s: Vec<f64>,
+    /// The reference sample period `Δt_s` (s).
+    pub(crate) dt_s: f64,
+    /// The control tick the schedule was checked with (s).
+    pub(crate) tick_s: f64,
+    /// Reference samples.
+    pub(crate) n_ref: usize,
+    /// Where the schedule came from, as text.
+    pub(crate) source: String,
+    /// Every low-confidence stretch, sorted by start.
+    pub(crate) lc_intervals: Vec<LcIntervalOut>,
+    /// The schedule itself.
+    pub(crate) schedule: ScheduleOut,
+    /// Its holds with global times; only when it has any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) holds: Option<Vec<ScheduleHoldOut>>,
+    /// The planned waiting per robot (s); only when it has holds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) dwells_s: Option<Vec<f64>>,
+}
+
+/// One of [`ScheduleDoc::lc_intervals`]: reference samples `ref_start ≤ n < ref_end` of robot
+/// `robot` (1-based), from `start_s` to `end_s` (global time, s).
+#[allow(missing_docs)]
+#[derive(Serialize)]
+pub(crate) struct LcIntervalOut {
+    pub(crate) robot: usize,
+    pub(crate) ref_start: usize,
+    pub(crate) ref_end: usize,
+    pub(crate) start_s: f64,
+    pub(crate) end_s: f64,
+}
+
+/// One of [`ScheduleDoc::holds`]: robot `robot` (1-based) stops at reference sample
+/// `ref_idx` (reference time `ref_s`), from `start_s` to `end_s` (global time, s; `dwell_s`
+/// the difference), and leaves once every `after` rule holds (robots 1-based; always
+/// written).
+#[allow(missing_docs)]
+#[derive(Serialize)]
+pub(crate) struct ScheduleHoldOut {
+    pub(crate) robot: usize,
+    pub(crate) ref_idx: usize,
+    pub(crate) ref_s: f64,
+    pub(crate) start_s: f64,
+    pub(crate) end_s: f64,
+    pub(crate) dwell_s: f64,
+    pub(crate) after: Vec<AfterOut>,
+}
+
+/// `schedule` of [`ScheduleDoc`]: the warps, start
 /// offsets and tick of the schedule, and its holds only when it has any (so a schedule
 /// without holds prints as before hold points).
 #[derive(Serialize)]
@@ -54,8 +125,8 @@ pub(crate) struct HoldOut {
 /// `ref_idx`.
 #[derive(Serialize)]
 pub(crate) struct AfterOut {
-    robot: usize,
-    ref_idx: usize,
+    pub(crate) robot: usize,
+    pub(crate) ref_idx: usize,
 }
 
 fn is_zero(x: &f64) -> bool {
