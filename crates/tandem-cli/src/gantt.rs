@@ -3,7 +3,6 @@
 use std::fmt::Write as _;
 
 use anyhow::Result;
-use serde_json::Value;
 
 use crate::json::{AfterOut, LcIntervalOut, ScheduleDoc, ScheduleHoldOut, ScheduleOut};
 use tandem::realtime::{After, Timeline, tol};
@@ -228,11 +227,11 @@ fn holds_out(layout: &Layout, dt_s: f64) -> Vec<ScheduleHoldOut> {
         .collect()
 }
 
-/// The schedule as JSON: robot count, offsets, per-robot gradients and durations,
-/// low-confidence intervals in global time, `T_total` and its certificate (the margin-free lower bound, whether it is the proven
-/// optimum, the gap) (all times in seconds of global time; gradients in execution samples per
-/// reference sample). `schedule` is [`crate::json::ScheduleOut`].
-pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Value> {
+/// The schedule as JSON ([`ScheduleDoc`]): robot count, offsets, per-robot gradients and
+/// durations, low-confidence intervals in global time, `T_total` and its certificate (the
+/// margin-free lower bound, whether it is the proven optimum, the gap) (all times in seconds
+/// of global time; gradients in execution samples per reference sample).
+pub(crate) fn schedule_doc(problem: &Problem, outcome: &Outcome) -> Result<ScheduleDoc> {
     let layout = Layout::new(problem, &outcome.schedule)?;
     let dt = problem.dt_s();
     let s = &outcome.schedule;
@@ -249,7 +248,7 @@ pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Valu
     // Holds and dwells only with holds, so that a schedule without them prints as before
     // hold points.
     let with_holds = s.has_holds();
-    let doc = ScheduleDoc {
+    Ok(ScheduleDoc {
         t_total_s: outcome.t_total_s,
         lower_bound_s: outcome.lower_bound_s,
         bound_is_optimum: outcome.bound_is_optimum,
@@ -267,8 +266,9 @@ pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Valu
         schedule: ScheduleOut::from(s),
         holds: with_holds.then(|| holds_out(&layout, dt)),
         dwells_s: with_holds.then(|| (0..s.n_robots()).map(|i| s.dwell_s(i)).collect()),
-    };
-    Ok(crate::json::value(&doc)?)
+        saved: None,
+        previous_t_total_s: None,
+    })
 }
 
 /// The text Gantt chart: one bar per robot over `[0, T_total]` (`=` running high-confidence,

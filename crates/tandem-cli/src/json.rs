@@ -4,9 +4,8 @@
 //! compile here until it is decided on), and `tests/json_outputs.rs` pins every output's
 //! keys against a committed golden shape.
 //!
-//! `schedule --json` is [`ScheduleDoc`]; the top-level document of `inspect --json` spells
-//! its keys in `cmd.rs`; what it used to take from a library type's serde form is here:
-//! the schedule ([`ScheduleDoc`], [`ScheduleOut`]), the declared hold points ([`HoldSpecOut`]), the confidence
+//! `schedule --json` is [`ScheduleDoc`], `inspect --json` [`InspectDoc`]; what they used to
+//! take from a library type's serde form is here too: the schedule ([`ScheduleOut`]), the declared hold points ([`HoldSpecOut`]), the confidence
 //! parameters ([`ConfidenceParamsOut`]), the operator's error rates ([`ErrorRatesOut`]) and
 //! the low-confidence regions ([`LowRegionOut`]); `schedule --cell continuous --json` is
 //! [`CyclicPlanOut`], printed directly (keys in the order declared here, the documented
@@ -21,9 +20,8 @@ use tandem::realtime::{After, Hold};
 use tandem::schedule::Schedule;
 use tandem::schedule::cyclic::{CyclicPlan, GapPlan, RobotCycle, Stretch};
 
-/// The document of `tandem schedule --json` (without `saved` and `previous_t_total_s`, which
-/// `schedule` adds) and `schedule` of `tandem inspect --json` (docs/formats.md, "Schedule
-/// JSON"): times in seconds of global time, robots 1-based.
+/// The document of `tandem schedule --json` and `schedule` of `tandem inspect --json`
+/// (docs/formats.md, "Schedule JSON"): times in seconds of global time, robots 1-based.
 #[derive(Serialize)]
 pub(crate) struct ScheduleDoc {
     /// Eq. 13: `max_i(τ_i + |ψ_Ei|)` (s).
@@ -62,6 +60,12 @@ pub(crate) struct ScheduleDoc {
     /// The planned waiting per robot (s); only when it has holds.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub(crate) dwells_s: Option<Vec<f64>>,
+    /// `schedule` only: whether `--save` wrote it into the state file.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) saved: Option<bool>,
+    /// `schedule` only: `T_total` of the state file's schedule before this run (s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) previous_t_total_s: Option<f64>,
 }
 
 /// One of [`ScheduleDoc::lc_intervals`]: reference samples `ref_start ≤ n < ref_end` of robot
@@ -444,4 +448,101 @@ impl From<&CyclicPlan> for CyclicPlanOut {
 /// serde_json's (none for these types: every key is a string).
 pub(crate) fn value<T: Serialize>(value: &T) -> serde_json::Result<serde_json::Value> {
     serde_json::to_value(value)
+}
+
+/// The document of `tandem inspect STATE --json` (docs/formats.md, "Schedule JSON": the
+/// paragraphs on `inspect`).
+#[derive(Serialize)]
+pub(crate) struct InspectDoc {
+    /// The state file, as given.
+    pub(crate) state: String,
+    /// Rounds recorded (one execution of each robot).
+    pub(crate) rounds_recorded: usize,
+    /// Deprecated duplicate of `rounds_recorded` (the two-robot name), kept one release.
+    pub(crate) pairs_recorded: usize,
+    /// The task model.
+    pub(crate) model: ModelOut,
+    /// The confidence and the observations.
+    pub(crate) confidence: ConfidenceOut,
+    /// The schedule, as `tandem schedule --json` prints it (without `saved` and
+    /// `previous_t_total_s`).
+    pub(crate) schedule: ScheduleDoc,
+    /// The hold points.
+    pub(crate) holds: HoldsOut,
+}
+
+/// `model` of [`InspectDoc`].
+#[allow(missing_docs)]
+#[derive(Serialize)]
+pub(crate) struct ModelOut {
+    pub(crate) channels: Vec<String>,
+    pub(crate) reference: ReferenceOut,
+    pub(crate) n_ref: usize,
+    pub(crate) dt_s: f64,
+    pub(crate) reference_duration_s: f64,
+    /// Demonstrations and executions in the statistics.
+    pub(crate) count: usize,
+    pub(crate) correction_components: usize,
+    /// The range `r_j` of every tangent coordinate, by name.
+    pub(crate) ranges: std::collections::BTreeMap<String, f64>,
+    pub(crate) sigma2_d: QuantilesOut,
+    pub(crate) mean_duration_s: f64,
+    pub(crate) fastest_duration_s: f64,
+    pub(crate) slowest_duration_s: f64,
+}
+
+/// `model.reference` of [`InspectDoc`]: how the reference was chosen (`first`, `medoid`) and
+/// which demonstration of the fit it is (0-based).
+#[allow(missing_docs)]
+#[derive(Serialize)]
+pub(crate) struct ReferenceOut {
+    pub(crate) choice: String,
+    pub(crate) demo_idx: usize,
+}
+
+/// Quantiles of a per-sample value (`model.sigma2_d`).
+#[allow(missing_docs)]
+#[derive(Serialize)]
+pub(crate) struct QuantilesOut {
+    pub(crate) min: f64,
+    pub(crate) median: f64,
+    pub(crate) p90: f64,
+    pub(crate) max: f64,
+}
+
+/// `confidence` of [`InspectDoc`].
+#[allow(missing_docs)]
+#[derive(Serialize)]
+pub(crate) struct ConfidenceOut {
+    pub(crate) params: ConfidenceParamsOut,
+    pub(crate) high_share: f64,
+    pub(crate) n_high: usize,
+    pub(crate) low_regions: Vec<LowRegionOut>,
+    pub(crate) error_rates: ErrorRatesOut,
+    pub(crate) sigma2_d_prior_threshold: Option<f64>,
+    pub(crate) total_supervised: f64,
+    pub(crate) total_corrections: f64,
+}
+
+/// `holds` of [`InspectDoc`]: the declaration, the resolved samples, how many of them are
+/// high-confidence (a robot may dwell there now), and their stretches.
+#[allow(missing_docs)]
+#[derive(Serialize)]
+pub(crate) struct HoldsOut {
+    pub(crate) declared: HoldSpecOut,
+    pub(crate) samples: Vec<usize>,
+    pub(crate) active_samples: usize,
+    pub(crate) stretches: Vec<HoldStretchOut>,
+}
+
+/// One of [`HoldsOut::stretches`]: consecutive hold samples `ref_start..=ref_last` (reference
+/// time `start_s..=last_s`) of the same activity.
+#[allow(missing_docs)]
+#[derive(Serialize)]
+pub(crate) struct HoldStretchOut {
+    pub(crate) ref_start: usize,
+    pub(crate) ref_last: usize,
+    pub(crate) start_s: f64,
+    pub(crate) last_s: f64,
+    pub(crate) active: bool,
 }
