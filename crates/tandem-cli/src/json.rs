@@ -4,13 +4,14 @@
 //! compile here until it is decided on), and `tests/json_outputs.rs` pins every output's
 //! keys against a committed golden shape.
 //!
-//! `schedule --json` is [`ScheduleDoc`], `inspect --json` [`InspectDoc`]; what they used to
-//! take from a library type's serde form is here too: the schedule ([`ScheduleOut`]), the declared hold points ([`HoldSpecOut`]), the confidence
-//! parameters ([`ConfidenceParamsOut`]), the operator's error rates ([`ErrorRatesOut`]) and
-//! the low-confidence regions ([`LowRegionOut`]); `schedule --cell continuous --json` is
-//! [`CyclicPlanOut`], printed directly (keys in the order declared here, the documented
-//! one). The other documents are printed through a `serde_json::Value` (keys in
-//! alphabetical order).
+//! `schedule --json` is [`ScheduleDoc`], `inspect --json` [`InspectDoc`], `schedule --cell
+//! continuous --json` [`CyclicPlanOut`] and `inspect BAG --json` [`BagDoc`]. What the state
+//! documents used to take from a library type's serde form is here too: the schedule
+//! ([`ScheduleOut`]), the declared hold points ([`HoldSpecOut`]), the confidence parameters
+//! ([`ConfidenceParamsOut`]), the operator's error rates ([`ErrorRatesOut`]) and the
+//! low-confidence regions ([`LowRegionOut`]). The cyclic plan is printed directly (keys in
+//! the order declared here, the documented one); the other documents through a
+//! `serde_json::Value` (keys in alphabetical order).
 
 use serde::Serialize;
 use tandem::confidence::{ConfidenceParams, ErrorRates};
@@ -545,4 +546,42 @@ pub(crate) struct HoldStretchOut {
     pub(crate) start_s: f64,
     pub(crate) last_s: f64,
     pub(crate) active: bool,
+}
+
+/// The document of `tandem inspect BAG --json`: the bag, its rounds and its topics.
+#[derive(Serialize)]
+pub(crate) struct BagDoc {
+    /// The bag, as given.
+    pub(crate) bag: String,
+    /// Rounds recorded in it (`/tandem/round` markers).
+    pub(crate) rounds: usize,
+    /// Every topic.
+    pub(crate) topics: Vec<BagTopicOut>,
+}
+
+/// One of [`BagDoc::topics`] (docs/formats.md, "ROS 2 bags").
+#[derive(Serialize)]
+pub(crate) struct BagTopicOut {
+    /// Topic name.
+    pub(crate) topic: String,
+    /// Its schema (message type) name, if any.
+    pub(crate) r#type: Option<String>,
+    /// Whether tandem reads its message type.
+    pub(crate) supported: bool,
+    /// Number of messages.
+    pub(crate) messages: usize,
+    /// The channels it gives.
+    pub(crate) channels: Vec<String>,
+    /// Median period between messages (s).
+    pub(crate) median_period_s: Option<f64>,
+    /// The period it is read at (s).
+    pub(crate) period_s: Option<f64>,
+    /// First and last message time (s).
+    pub(crate) start_s: Option<f64>,
+    #[allow(missing_docs)]
+    pub(crate) end_s: Option<f64>,
+    /// `"log time"` or `"header stamp"`: which time is used.
+    pub(crate) time: &'static str,
+    /// Its role (`channel`, …).
+    pub(crate) role: &'static str,
 }

@@ -1,7 +1,8 @@
 //! The documented JSON outputs (docs/formats.md) keep their shape: every key path and the
 //! JSON type of its values, for `schedule --json`, `inspect --json` and `schedule --cell
 //! continuous --json`, on the guide's example task (two robots, three robots, and with hold
-//! points and a hold rule), against the committed golden shapes in `tests/data/json/`.
+//! points and a hold rule), and for `inspect BAG --json` on an example bag, against the
+//! committed golden shapes in `tests/data/json/`.
 //!
 //! A library field renamed or added cannot change an output silently: the outputs are the
 //! command line's own types (`src/json.rs`), and a change of a shape fails here. The numbers
@@ -200,4 +201,14 @@ fn hold_points_and_a_hold_rule() {
         serde_json::json!(["x<0.05"])
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_bag() {
+    let bag = repo().join("fixtures/examples/ros2/demo_0.mcap");
+    let doc = run(&["inspect", &bag.display().to_string(), "--json"]);
+    check_shape("inspect_bag", &doc);
+    let v: Value = serde_json::from_str(&doc).unwrap();
+    assert_eq!(v["rounds"], 0);
+    assert_eq!(v["topics"][0]["role"], "channel");
 }
