@@ -71,7 +71,6 @@ pub(crate) struct ScheduleDoc {
 
 /// One of [`ScheduleDoc::lc_intervals`]: reference samples `ref_start ≤ n < ref_end` of robot
 /// `robot` (1-based), from `start_s` to `end_s` (global time, s).
-#[allow(missing_docs)]
 #[derive(Serialize)]
 pub(crate) struct LcIntervalOut {
     pub(crate) robot: usize,
@@ -85,7 +84,6 @@ pub(crate) struct LcIntervalOut {
 /// `ref_idx` (reference time `ref_s`), from `start_s` to `end_s` (global time, s; `dwell_s`
 /// the difference), and leaves once every `after` rule holds (robots 1-based; always
 /// written).
-#[allow(missing_docs)]
 #[derive(Serialize)]
 pub(crate) struct ScheduleHoldOut {
     pub(crate) robot: usize,
@@ -195,7 +193,6 @@ impl From<&HoldSpec> for HoldSpecOut {
 }
 
 /// `confidence.params` of `tandem inspect --json` (meaning: `ConfidenceParams`, Eq. 10–12).
-#[allow(clippy::struct_excessive_bools)]
 #[derive(Serialize)]
 pub(crate) struct ConfidenceParamsOut {
     gamma_p: f64,
@@ -473,7 +470,6 @@ pub(crate) struct InspectDoc {
 }
 
 /// `model` of [`InspectDoc`].
-#[allow(missing_docs)]
 #[derive(Serialize)]
 pub(crate) struct ModelOut {
     pub(crate) channels: Vec<String>,
@@ -494,7 +490,6 @@ pub(crate) struct ModelOut {
 
 /// `model.reference` of [`InspectDoc`]: how the reference was chosen (`first`, `medoid`) and
 /// which demonstration of the fit it is (0-based).
-#[allow(missing_docs)]
 #[derive(Serialize)]
 pub(crate) struct ReferenceOut {
     pub(crate) choice: String,
@@ -502,7 +497,6 @@ pub(crate) struct ReferenceOut {
 }
 
 /// Quantiles of a per-sample value (`model.sigma2_d`).
-#[allow(missing_docs)]
 #[derive(Serialize)]
 pub(crate) struct QuantilesOut {
     pub(crate) min: f64,
@@ -512,7 +506,6 @@ pub(crate) struct QuantilesOut {
 }
 
 /// `confidence` of [`InspectDoc`].
-#[allow(missing_docs)]
 #[derive(Serialize)]
 pub(crate) struct ConfidenceOut {
     pub(crate) params: ConfidenceParamsOut,
@@ -527,7 +520,6 @@ pub(crate) struct ConfidenceOut {
 
 /// `holds` of [`InspectDoc`]: the declaration, the resolved samples, how many of them are
 /// high-confidence (a robot may dwell there now), and their stretches.
-#[allow(missing_docs)]
 #[derive(Serialize)]
 pub(crate) struct HoldsOut {
     pub(crate) declared: HoldSpecOut,
@@ -538,7 +530,6 @@ pub(crate) struct HoldsOut {
 
 /// One of [`HoldsOut::stretches`]: consecutive hold samples `ref_start..=ref_last` (reference
 /// time `start_s..=last_s`) of the same activity.
-#[allow(missing_docs)]
 #[derive(Serialize)]
 pub(crate) struct HoldStretchOut {
     pub(crate) ref_start: usize,
@@ -578,7 +569,6 @@ pub(crate) struct BagTopicOut {
     pub(crate) period_s: Option<f64>,
     /// First and last message time (s).
     pub(crate) start_s: Option<f64>,
-    #[allow(missing_docs)]
     pub(crate) end_s: Option<f64>,
     /// `"log time"` or `"header stamp"`: which time is used.
     pub(crate) time: &'static str,

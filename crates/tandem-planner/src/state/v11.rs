@@ -69,7 +69,10 @@ pub struct PlannerParams {
 }
 
 /// [`lfd::FitParams`] as format 11 writes them.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FitParams {
     pub warp: WarpParams,
@@ -81,7 +84,10 @@ pub struct FitParams {
 }
 
 /// [`warp::WarpParams`] as formats 10 and 11 write them (the fields' meaning: there).
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WarpParams {
     pub n_nodes: Option<usize>,
@@ -101,7 +107,10 @@ pub struct WarpParams {
 }
 
 /// [`lfd::ChannelSchema`] as format 11 writes it.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ChannelSchema {
     pub kinds: BTreeMap<String, ChannelKind>,
@@ -109,7 +118,10 @@ pub struct ChannelSchema {
 }
 
 /// [`lfd::ChannelKind`] as format 11 writes it (the variant's index is the format).
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum ChannelKind {
     Position,
@@ -120,7 +132,10 @@ pub enum ChannelKind {
 }
 
 /// [`lfd::QuaternionBlock`] as format 11 writes it.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct QuaternionBlock {
     pub name: String,
@@ -128,7 +143,10 @@ pub struct QuaternionBlock {
 }
 
 /// [`lfd::Reference`] as format 11 writes it (the variant's index is the format).
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Reference {
     First,
@@ -136,7 +154,10 @@ pub enum Reference {
 }
 
 /// [`conf::ConfidenceParams`] as formats 7 to 11 write them.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ConfidenceParams {
     pub gamma_p: f64,
@@ -151,7 +172,10 @@ pub struct ConfidenceParams {
 }
 
 /// [`sched::SamplerParams`] as formats 4 to 11 write them.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SamplerParams {
     pub samples: usize,
@@ -165,7 +189,10 @@ pub struct SamplerParams {
 }
 
 /// [`sched::ExactParams`] as formats 4 to 11 write them.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ExactParams {
     pub max_pieces: usize,
@@ -173,7 +200,10 @@ pub struct ExactParams {
 }
 
 /// [`lfd::HoldSpec`] as formats 8 to 11 write it: the rules as their text.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct HoldSpec {
     pub at_s: Vec<f64>,
@@ -181,7 +211,10 @@ pub struct HoldSpec {
 }
 
 /// [`conf::Observations`] as formats 7 to 11 write them.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Observations {
     pub corrections: Vec<f64>,
@@ -190,7 +223,10 @@ pub struct Observations {
 }
 
 /// [`conf::MissEvidence`] as formats 7 to 11 write it.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MissEvidence {
     pub gap_samples: f64,
@@ -198,7 +234,10 @@ pub struct MissEvidence {
 }
 
 /// [`conf::Confidence`] as formats 7 to 11 write it: its parameters and the latched flags.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Confidence {
     pub params: ConfidenceParams,
@@ -209,7 +248,10 @@ pub struct Confidence {
 /// always written (the schedule's own serde form leaves out empty holds, zero dwells and
 /// empty release lists, which postcard cannot read back); not the previous schedule's fate
 /// nor the split of the gap (a loaded outcome has neither).
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Outcome {
     pub schedule: Schedule,
@@ -222,7 +264,10 @@ pub struct Outcome {
 }
 
 /// [`sched::Schedule`] as formats 8 to 11 write it.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Schedule {
     pub grad_exec: Vec<Vec<f64>>,
@@ -232,7 +277,10 @@ pub struct Schedule {
 }
 
 /// [`rt::Hold`] as formats 8 to 11 write it.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Hold {
     pub ref_idx: usize,
@@ -241,7 +289,10 @@ pub struct Hold {
 }
 
 /// [`rt::After`] as formats 8 to 11 write it.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct After {
     pub robot: usize,
@@ -249,7 +300,10 @@ pub struct After {
 }
 
 /// [`sched::Source`] as formats 8 to 11 write it (the variant's index is the format).
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Source {
     Sampled { candidate: u64 },
@@ -262,7 +316,10 @@ pub enum Source {
 }
 
 /// [`sched::SamplerStats`] as formats 4 to 11 write them.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct SamplerStats {
     pub candidates: usize,
@@ -273,7 +330,10 @@ pub struct SamplerStats {
 }
 
 /// [`sched::SearchStats`] as formats 4 to 11 write them.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct SearchStats {
     pub lc_runs: usize,
@@ -283,7 +343,10 @@ pub struct SearchStats {
 
 /// [`lfd::Demonstration`] as format 11 writes it: channel names, the period (always
 /// written, `Some`) and the samples row by row; not its source label.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Demonstration {
     pub channels: Vec<String>,
@@ -292,7 +355,10 @@ pub struct Demonstration {
 }
 
 /// [`ExecutionRecord`] as format 11 writes it.
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "a field for field copy of the library type named above, whose fields are documented"
+)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Record {
     pub demonstration: Demonstration,
