@@ -35,7 +35,11 @@
 //! until the previous group in the order has been left), which is sound across cycle
 //! boundaries by construction, for any operator and any number of tasks; it needs a
 //! *runnable* order ([`is_runnable`]), which [`cyclic_plan`] searches by default
-//! ([`CyclicParams::runnable_only`]).
+//! ([`CyclicParams::runnable_only`]). The rule costs the operator, at every hand-over to
+//! another robot's group, the travel from the group's gate to its first stretch and about a
+//! tick; with [`CyclicParams::handover_tick_s`] (the cell's control tick) the operator arc
+//! into such a stretch carries that cost ([`TaskShape::entry_s`] plus one tick), so the period
+//! is what the cell does under the planned operator and the search optimizes it.
 //!
 //! **The certificate.** [`period_lower_bound_s`] `= max(N·(L + I), D_min)` holds for every
 //! order: the operator's load `N·L`, its forced idle time `N·I` in gaps without hold too

@@ -125,7 +125,21 @@ pub fn cyclic_plan_for_order(
     n_robots: usize,
     order: &[Stretch],
 ) -> Result<CyclicPlan> {
-    let graph = event_graph(problem, n_robots, order)?;
+    plan_for_order(problem, n_robots, order, None)
+}
+
+/// [`cyclic_plan_for_order`], counting the token rule's hand-overs at the control tick
+/// `handover_tick_s` when given ([`crate::CyclicParams::handover_tick_s`]).
+pub(crate) fn plan_for_order(
+    problem: &Problem,
+    n_robots: usize,
+    order: &[Stretch],
+    handover_tick_s: Option<f64>,
+) -> Result<CyclicPlan> {
+    let graph = match handover_tick_s {
+        None => event_graph(problem, n_robots, order)?,
+        Some(_) => graph_of_shape(TaskShape::new(problem), n_robots, order, handover_tick_s)?,
+    };
     let ratio = max_cycle_ratio(graph.events.len(), &graph.arcs)?;
     Ok(layout(
         &graph,
@@ -141,8 +155,9 @@ pub(crate) fn period_of(
     shape: &TaskShape,
     n_robots: usize,
     order: &[Stretch],
+    handover_tick_s: Option<f64>,
 ) -> Result<Option<f64>> {
-    let graph = graph_of_shape(shape.clone(), n_robots, order)?;
+    let graph = graph_of_shape(shape.clone(), n_robots, order, handover_tick_s)?;
     match max_cycle_ratio(graph.events.len(), &graph.arcs) {
         Ok(r) => Ok(Some(r.period_s)),
         Err(crate::Error::InfeasibleCycle { .. }) => Ok(None),
