@@ -162,6 +162,13 @@ fn gates_far_from_the_passes_cost_the_travel_from_the_gate_at_every_hand_over() 
             "{} vs {expected}",
             plan.tasks_per_hour
         );
+        // The bound counts every pass, its entry and one tick per robot: N·49.21 s.
+        let bound = n as f64 * (38.4 + 6.0 + 2.0 * 2.4 + 0.01);
+        assert!(
+            (plan.lower_bound_s - bound).abs() < 1e-9,
+            "{}",
+            plan.lower_bound_s
+        );
         let mut cell = plan.coordinator(&p, 0.01).unwrap();
         let (per_h, overlaps) = steady_throughput(&mut cell, Operator::Scheduled, 50);
         println!(
@@ -318,6 +325,15 @@ fn planned_and_realized(seed: u64, n_robots: usize, holds: bool, handover: bool)
         ..CyclicParams::default()
     };
     let plan = cyclic_plan(&p, n_robots, &params).unwrap();
+    // The certificate holds (with the hand-overs, `handover_bound_s`, at least the former).
+    assert!(
+        plan.period_s >= plan.lower_bound_s * (1.0 - 1e-12),
+        "seed {seed}: {plan:?}"
+    );
+    if handover {
+        let former = tandem_schedule::period_lower_bound_s(&p, n_robots).unwrap();
+        assert!(plan.lower_bound_s >= former * (1.0 - 1e-12), "seed {seed}");
+    }
     let mut cell = plan.coordinator(&p, DT_S).unwrap();
     let mut done: Vec<Vec<u64>> = vec![Vec::new(); n_robots];
     let mut k = 0_u64;
@@ -430,6 +446,14 @@ fn the_hand_over_arc_by_hand() {
     assert!((alone.period_s - 3.0).abs() < 1e-9);
     let three = cyclic_plan(&p, 3, &at(Some(0.01))).unwrap();
     assert!((three.period_s - 4.53).abs() < 1e-9, "{}", three.period_s);
+    // Its bound: 3·(1 s stretch + 0.5 s entry + a tick), the plan's period (the order alone:
+    // 3·1 s).
+    assert!((three.lower_bound_s - 4.53).abs() < 1e-9 && three.gap.abs() < 1e-9);
+    assert!((alone.lower_bound_s - 3.0).abs() < 1e-9);
+    assert!(
+        (tandem_schedule::handover_bound_s(&p, 3, 0.01).unwrap() - 4.53).abs() < 1e-9
+            && (tandem_schedule::handover_bound_s(&p, 1, 0.01).unwrap() - 2.0).abs() < 1e-9
+    );
     // The run: the plan's throughput to a tick per hand-over.
     let mut cell = three.coordinator(&p, 0.01).unwrap();
     let (per_h, overlaps) = steady_throughput(&mut cell, Operator::Scheduled, 50);

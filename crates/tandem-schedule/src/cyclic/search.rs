@@ -161,7 +161,13 @@ pub fn cyclic_plan(
         let (order, evaluated) = local_search(&shape, n_robots, params, groups.as_deref())?;
         (order, evaluated, false)
     };
-    let mut plan = plan_for_order(problem, n_robots, &order, params.handover_tick_s)?;
+    let mut plan = plan_for_order(
+        problem,
+        n_robots,
+        &order,
+        params.handover_tick_s,
+        params.runnable_only,
+    )?;
     plan.order_exhaustive = exhaustive;
     plan.orders_evaluated = evaluated;
     Ok(plan)
