@@ -55,6 +55,7 @@
 
 mod checked;
 mod choose;
+mod complete_n;
 pub mod cyclic;
 mod error;
 pub mod exact;
