@@ -19,6 +19,11 @@
 //!    the sampler's winner. The sampler and the completion run exactly as they would alone
 //!    (same seed, same incumbent, same budget), so the result is never worse than either's.
 //!
+//! For `N` robots ([`sample_schedule_n`]) the bound, the completion and the candidates are one
+//! row of `STRATEGIES` per robot count (`N = 1`, `2`, `≥ 3`): for `N ≥ 3` the bound of
+//! `exact::bound_many` and the staggered candidate (`stagger.rs`) in every re-schedule, no
+//! margin-aware completion.
+//!
 //! Every candidate is checked with [`crate::validate`] at the tick before it can win. The
 //! [`Outcome`] carries the schedule, its `T_total`, where it came from, and its certificate:
 //! the bound and the gap `(T_total − bound)/bound`.
@@ -26,7 +31,6 @@
 use serde::{Deserialize, Serialize};
 use tandem_realtime::{clock_end_s, tol};
 
-use crate::complete_n;
 use crate::exact;
 use crate::problem::{Problem, check_robot_count};
 use crate::retime::retime;
@@ -45,8 +49,7 @@ pub enum Source {
         candidate: u64,
     },
     /// The margin-aware completion of the exact margin-free optimum
-    /// ([`crate::exact`], "Margin-aware completion"; for `N ≥ 3` robots the search's best
-    /// order re-timed with the least uniform clearance the check accepts, `complete_n.rs`).
+    /// ([`crate::exact`], "Margin-aware completion"; two robots).
     Completed,
     /// The previous schedule's warps and offset, unchanged (still valid at the scheduler's
     /// tick, nothing better found).
@@ -480,9 +483,9 @@ pub fn sample_schedule(
 /// completion runs beside the sampler and the bound is the exact margin-free optimum `T*₀`.
 /// For `N ≥ 3` the bound is the maximum of the `k`-robot bounds, `k ≤ N` (the margin-free
 /// optimum of the `N`-robot branch and bound when it finishes within its node budget, else
-/// [`crate::operator_bound_s`]; see "N robots" in [`crate::exact`]); the search's best order
-/// re-timed with the least uniform clearance the check accepts ([`Source::Completed`]) and the
-/// staggered schedule ([`Source::Staggered`]) are candidates, and with hold points the best
+/// [`crate::operator_bound_s`]; see "N robots" in [`crate::exact`]); there is no margin-aware
+/// completion; the staggered schedule ([`Source::Staggered`]) is a candidate in every
+/// re-schedule, and with hold points the best
 /// order with release rules ([`Problem::with_release_rules`], [`Source::Held`]). For `N = 1`
 /// the bound is the optimum itself, the fastest execution. Which strategies run for which
 /// robot count is one table (`STRATEGIES` in `choose.rs`).
@@ -549,14 +552,13 @@ pub(crate) enum BoundBy {
 /// The margin-aware completion of a row of [`STRATEGIES`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum CompleteBy {
-    /// None (one robot: nothing to keep apart).
+    /// None: one robot has nothing to keep apart; for `N ≥ 3` no completion has won a
+    /// re-schedule yet (docs/decisions.md, "An N-robot margin-aware completion, the staggered
+    /// candidate always, and the strategies as a table").
     Nothing,
     /// The two-robot completion ([`exact::completion`]: per-pair clearances through the exact
     /// search, cold and warm from the incumbent, then warm from the sampler's winner).
     Pair,
-    /// The `N`-robot completion ([`complete_n::complete`]: the margin-free optimum's order
-    /// re-timed with the least uniform clearance the check accepts).
-    Many,
 }
 
 /// The scheduler's strategies per robot count (issue 40, item 5): row `min(N, 3) − 1`.
@@ -576,7 +578,7 @@ pub(crate) const STRATEGIES: [Strategies; 3] = [
     // N ≥ 3.
     Strategies {
         bound: BoundBy::Many,
-        completion: CompleteBy::Many,
+        completion: CompleteBy::Nothing,
         staggered: true,
     },
 ];
@@ -678,17 +680,6 @@ fn schedule_n(
             }
         }
         best = (s, t, Source::Sampled { candidate: k });
-    }
-    // The `N`-robot completion of the search's best order, below the best so far.
-    if plan.completion == CompleteBy::Many
-        && let Some(optimum) = bound.schedule.as_ref()
-        && bound.lower_bound_s < best.1
-    {
-        let (found, used) = complete_n::complete(problem, optimum, tick_s, best.1);
-        checks += used;
-        if let Some(c) = found {
-            completed = Some(c);
-        }
     }
     stats.search = bound.stats;
     if let Some((schedule, t)) = completed
@@ -810,7 +801,11 @@ mod tests {
         assert_eq!(row(1), (BoundBy::Fastest, CompleteBy::Nothing, false));
         assert_eq!(row(2), (BoundBy::Pair, CompleteBy::Pair, false));
         for n in 3..=tandem_realtime::MAX_ROBOTS {
-            assert_eq!(row(n), (BoundBy::Many, CompleteBy::Many, true), "N = {n}");
+            assert_eq!(
+                row(n),
+                (BoundBy::Many, CompleteBy::Nothing, true),
+                "N = {n}"
+            );
         }
     }
 }

@@ -55,7 +55,6 @@
 
 mod checked;
 mod choose;
-mod complete_n;
 pub mod cyclic;
 mod error;
 pub mod exact;

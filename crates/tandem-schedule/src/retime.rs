@@ -51,20 +51,6 @@ pub(crate) fn retime(
     tick_s: f64,
     extra_clear_s: f64,
 ) -> Option<Schedule> {
-    retime_delayed(problem, previous, tick_s, extra_clear_s, &[])
-}
-
-/// [`retime`] with events held back: `delays_s[i]` (s, ≥ 0; empty: none) holds robot `i`'s
-/// start (entry 0) and the start of its LC run `k` of the new problem (entry `1 + k`) at
-/// least that much later than before (the `N`-robot completion, `complete_n.rs`, raises the
-/// runs the margin check finds too close).
-pub(crate) fn retime_delayed(
-    problem: &Problem,
-    previous: &Schedule,
-    tick_s: f64,
-    extra_clear_s: f64,
-    delays_s: &[Vec<f64>],
-) -> Option<Schedule> {
     let n_ref = problem.n_ref();
     let n_robots = previous.n_robots();
     if previous.check_shape().is_err()
@@ -153,14 +139,9 @@ pub(crate) fn retime_delayed(
     let n_vars = n_robots + n_robots * m;
     let mut edges: Vec<Edge> = Vec::with_capacity(4 * n_vars + 4);
     let mut push = |from: usize, to: usize, w: f64| edges.push(Edge { from, to, w });
-    let delay = |i: usize, e: usize| delays_s.get(i).and_then(|d| d.get(e)).map_or(0.0, |&d| d);
     for (i, at) in old_at.iter().enumerate() {
         if i > 0 {
-            push(
-                ORIGIN,
-                start_var(i),
-                previous.start_s(i).max(0.0) + delay(i, 0),
-            );
+            push(ORIGIN, start_var(i), previous.start_s(i).max(0.0));
         }
         let mut prev = (start_var(i), 0.0);
         for (k, &(p, _)) in lc.iter().enumerate() {
@@ -168,7 +149,7 @@ pub(crate) fn retime_delayed(
             if !gap_held(i, k) {
                 push(lc_var(i, k), prev.0, -(prev.1 + gap_hi[k]));
             }
-            push(ORIGIN, lc_var(i, k), at[p] + delay(i, 1 + k));
+            push(ORIGIN, lc_var(i, k), at[p]);
             prev = (lc_var(i, k), lc_s[k]);
         }
     }
