@@ -62,6 +62,8 @@ const TERMS: &[(&str, &str)] = &[
     ("latched", "latched"),
     ("tick", "tick"),
     ("overlap", "overlap"),
+    ("over plan", "over / under plan"),
+    ("needed but unsupervised", "needed but unsupervised"),
     ("high-conf %", "high / low confidence"),
     ("grid of", "grid (of a bag)"),
     ("jitter", "jitter"),
