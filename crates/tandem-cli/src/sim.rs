@@ -194,7 +194,7 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
             .map(|r| r.corrected.iter().filter(|s| **s).count())
             .sum();
         unsupervised_needed += round.needed_unsupervised(|robot, n| needed[robot][n]);
-        gaps.push(round.plan_gap.clone());
+        gaps.push(round.plan_gap);
         let report = planner
             .record_round(&records)
             .with_context(|| format!("recording simulated round {}", k + 1))?;
@@ -210,7 +210,7 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
             report.t_total_s
         ));
         if verbose() {
-            out(&format!("       {}", describe_gap(&round.plan_gap)));
+            out(&format!("       gap: {}", describe_gap(&round.plan_gap)));
         }
     }
     for line in realization_summary(&gaps, planner.n_robots(), unsupervised_needed) {
@@ -355,7 +355,7 @@ mod tests {
             describe_gap(&gap),
             "1.00 s over plan (+10.0 %): corrections +0.75, strategy +0.30, grid -0.05 s"
         );
-        let lines = realization_summary(&[gap.clone(), gap], 2, 7);
+        let lines = realization_summary(&[gap, gap], 2, 7);
         assert_eq!(
             lines[0],
             "realized against planned over 2 round(s): 22.00 s against 20.00 s, 2.00 s over \

@@ -64,6 +64,8 @@ const TERMS: &[(&str, &str)] = &[
     ("overlap", "overlap"),
     ("over plan", "over / under plan"),
     ("needed but unsupervised", "needed but unsupervised"),
+    ("reopened:", "reopened"),
+    ("previous schedule: ", "previous schedule: …"),
     ("high-conf %", "high / low confidence"),
     ("grid of", "grid (of a bag)"),
     ("jitter", "jitter"),

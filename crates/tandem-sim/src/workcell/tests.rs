@@ -594,6 +594,57 @@ fn a_robot_waits_at_its_hold_while_the_operator_drags_the_other_and_never_overla
 }
 
 #[test]
+fn a_round_gap_adds_up_for_any_operator_with_and_without_a_hold() {
+    // The hand-made problem, serial and with a hold at 5 and its release rule, under
+    // operators who miss and correct by mistake: the parts always sum to realized − planned,
+    // the grid stays within a tick per leg, and only corrections and holds make the round
+    // longer than planned by more than the grid.
+    let model = model();
+    let plain_problem = problem(&model);
+    let held_problem = plain_problem.clone().with_holds(vec![5]).unwrap();
+    let dt_s = plain_problem.dt_s();
+    let serial = plain_problem.serial_schedule(dt_s).unwrap();
+    let clock = |n: usize| tandem_realtime::clock_end_s(&serial.grad_exec[0][..n], 0.0, dt_s);
+    let overlapping = Schedule {
+        offsets_s: vec![clock(20) - clock(10)],
+        ..serial.clone()
+    };
+    let held = held_problem.with_release_rules(&overlapping).unwrap();
+    let cases = [(&plain_problem, &serial, 1), (&held_problem, &held, 2)];
+    for (problem, schedule, legs) in cases {
+        for seed in 0..6_u64 {
+            let op = OperatorParams {
+                miss_rate: 0.3,
+                false_correction_rate: 0.2,
+                ..OperatorParams::default()
+            };
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let run =
+                run_schedule(&model, problem, schedule, painted_needs, &op, &mut rng).unwrap();
+            let gap = &run.plan_gap;
+            assert!(
+                (gap.parts_sum_s() - run.over_plan_s()).abs() < 1e-9,
+                "seed {seed}: {gap:?} against {}",
+                run.over_plan_s()
+            );
+            assert_eq!((gap.faults_s, run.faults), (0.0, 0));
+            let tick = run.tick_s;
+            assert!(
+                gap.grid_s >= -tick && gap.grid_s <= legs as f64 * tick + 1e-9,
+                "seed {seed}, {legs} leg(s): {gap:?}"
+            );
+            let corrected: usize = run
+                .robots
+                .iter()
+                .map(|r| r.corrected.iter().filter(|&&c| c).count())
+                .sum();
+            assert!(corrected > 0, "seed {seed}: the operator corrected");
+            assert_ne!(gap.corrections_s, 0.0, "seed {seed}: {gap:?}");
+        }
+    }
+}
+
+#[test]
 fn a_round_gap_splits_realized_minus_planned_into_its_causes_exactly() {
     // A hand-built round, τ = 1 s, T_ref = 4, every sample planned at 1 s. Robot 1 starts at
     // 0 and runs its four samples on plan. Robot 2 is planned to start at 2 and to dwell 1 s
@@ -666,6 +717,11 @@ fn a_round_gap_splits_realized_minus_planned_into_its_causes_exactly() {
     assert_eq!((gap.faults_s, gap.critical_path_s), (0.0, 0.0));
     assert!(close(gap.parts_sum_s(), 3.0));
     assert_eq!(gap.dominant().0, "grid");
+    assert_eq!(
+        gap.describe(),
+        "3.00 s over plan (+42.9 %): corrections +1.00 s (33 %), holds +1.00 s (33 %), \
+         strategy -0.20 s (-7 %), grid +1.20 s (40 %)"
+    );
     // Robot 1 planned to end last (at 7.5, its plan padded with a 3.5 s dwell it never
     // needed), robot 2 planned at 6.5 (a 0.5 s dwell): robot 2 still ended the round, its
     // hold took 1.5 s more than planned, and the plan's critical path was 0.5 s longer.
