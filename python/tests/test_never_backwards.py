@@ -68,3 +68,20 @@ def test_the_guide_s_control_loop_records_its_round(witness):
         corrected=[np.zeros(len(log["ref"]), dtype=bool) for log in logs],
     )
     assert report["t_total_s"] > 0.0
+
+
+def test_the_coordinator_s_planned_ends_include_the_dwells_at_holds(witness):
+    """``Coordinator.ends_s`` is the Rust coordinator's planned end (``planned_end_s``): start,
+    execution and the planned dwells at holds, as ``Schedule.ends_s`` says; it used to be the
+    end of the timeline without the dwells."""
+    schedule = witness.schedule
+    coordinator = tandem.Coordinator(schedule)
+    ends = coordinator.ends_s
+    assert ends.shape == (witness.n_robots,)
+    assert ends == pytest.approx(schedule.ends_s, abs=1e-9)
+    # The schedule's durations include the dwells; the witness plans waits at its holds, so
+    # the end of a timeline without them (what ``ends_s`` said before) is earlier.
+    assert ends == pytest.approx(coordinator.starts_s + schedule.durations_s, abs=1e-9)
+    dwells = np.array([sum(h["dwell_s"] for h in robot) for robot in schedule.holds])
+    assert dwells.max() > 0.0
+    assert max(ends) == pytest.approx(schedule.t_total_s, abs=1e-9)

@@ -843,6 +843,8 @@ mod tests {
                 faults: 0,
                 robot_wait_share: k as f64 / 20.0,
                 hold_ticks: 0,
+                plan_gap: tandem::sim::workcell::PlanGap::default(),
+                needed_unsupervised: 0,
             }),
             lower_bound_s: t_total_s,
             bound_is_optimum: false,

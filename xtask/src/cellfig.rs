@@ -285,6 +285,8 @@ mod tests {
                     tick: 100 * j as u64,
                     busy_ticks: 0,
                     gate_ticks: 0,
+                    plan_gap: tandem::sim::workcell::PlanGap::default(),
+                    needed_unsupervised: 0,
                 })
                 .collect(),
             stats: CellStats::default(),
@@ -294,6 +296,8 @@ mod tests {
                 throughput_per_h: 3600.0,
                 operator_busy_share: 0.0,
                 robot_wait_share: 0.0,
+                plan_gap: tandem::sim::workcell::PlanGap::default(),
+                needed_unsupervised: 0,
             },
         };
         CellStudyResult {

@@ -263,6 +263,18 @@ fn run_continuous(
         "last plan: {:.1} tasks/h planned, bound {:.1} tasks/h",
         summary.last_plan_tasks_per_hour, summary.last_plan_bound_tasks_per_hour
     );
+    let gap = &summary.steady_plan_gap_per_task;
+    println!(
+        "steady tasks against the plan's period (per task): {}; planned / realized throughput \
+         {:.3}; needed but unsupervised: {:.2} samples per task",
+        gap.describe(),
+        if gap.realized_s > 0.0 {
+            gap.planned_s / gap.realized_s
+        } else {
+            f64::NAN
+        },
+        summary.steady_needed_unsupervised_per_task
+    );
     println!(
         "overlapping low-confidence ticks: {}, faults: {}",
         summary.overlap_ticks, summary.faults
@@ -604,6 +616,15 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
             100.0 * busy
         );
     }
+    let (gap, unsupervised) = result.plan_gap_total(0);
+    let rounds = config.trials * config.n_rounds();
+    println!(
+        "realized against planned T_total, {rounds} rounds: {}; needed but unsupervised: {} \
+         samples ({:.1} per round)",
+        gap.describe(),
+        unsupervised,
+        unsupervised as f64 / rounds.max(1) as f64
+    );
     print_ground_truth(&result);
     println!(
         "overlapping low-confidence ticks: {}",

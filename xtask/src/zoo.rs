@@ -376,6 +376,33 @@ fn markdown(file: &ZooFile) -> String {
         ));
     }
     s.push_str(
+        "\nRealized against planned, by cause (percent of planned time, mean over seeds; rounds: \
+         every round's realized − planned `T_total`; continuous: the steady window's tasks \
+         against the plan's period, where `holds` are the waits at gates for the operator's \
+         token). The causes add up to the first column (`PlanGap`, docs/decisions.md, \
+         \"Plans that say how optimistic they are\"); needed but unsupervised: samples run at \
+         high confidence where the truth needed the operator.\n\n\
+         | family | N | cell | over plan % | corrections | holds | strategy | grid | faults | \
+         critical path | needed but unsupervised |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in &file.family_rows {
+        let [c, h, st, g, f, cp] = r.cause_pct;
+        s.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            r.family,
+            r.robots,
+            cell_name(r.cell),
+            num(r.over_plan_pct, 1),
+            num(c, 1),
+            num(h, 1),
+            num(st, 1),
+            num(g, 1),
+            num(f, 1),
+            num(cp, 1),
+            num(r.needed_unsupervised, 1),
+        ));
+    }
+    s.push_str(
         "\nThe fit alone (defaults, before any round): high confidence of the prior against the \
          truth on the reference's time axis, low-confidence runs, and the reference-choice \
          spread (largest − smallest high confidence over every choice of first file; the medoid \

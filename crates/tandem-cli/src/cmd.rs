@@ -784,10 +784,20 @@ fn record(a: &RecordArgs) -> Result<()> {
         100.0 * before_high,
         100.0 * planner.confidence().high_share()
     ));
+    if report.reopened > 0 {
+        out(&format!(
+            "reopened: {} latched reference samples are low-confidence again (this round's \
+             corrections reached them)",
+            report.reopened
+        ));
+    }
     out(&format!(
         "T_total: {before_t:.2} s → {:.2} s",
         report.t_total_s
     ));
+    if let Some(fate) = report.previous.describe() {
+        out(&format!("previous schedule: {fate}"));
+    }
     summary_lines(&planner)?;
     Ok(())
 }

@@ -104,6 +104,7 @@ fn fixtures_fit_simulate_record_schedule() {
     );
     let predicted = simulated_t_totals(&stdout);
     assert_eq!(predicted.len(), 2, "{stdout}");
+    let stdout_sim = stdout.clone();
     // Each round's row reports 0 ticks with both robots low-confidence.
     for line in stdout
         .lines()
@@ -118,7 +119,23 @@ fn fixtures_fit_simulate_record_schedule() {
         let [a, b] = round_files(&sim_dir, k);
         let stdout = ok(&tandem(record_args(&state, &a, &b)));
         assert!(stdout.contains(&format!("recorded round {k}")), "{stdout}");
+        // What became of the schedule the round ran: kept, re-timed or invalidated.
+        assert!(
+            stdout
+                .lines()
+                .any(|l| l.starts_with("previous schedule: the previous schedule")),
+            "{stdout}"
+        );
     }
+    // The simulation says how far the rounds ran from their plans, and why.
+    assert!(
+        stdout_sim.contains("realized against planned over 2 round(s)"),
+        "{stdout_sim}"
+    );
+    assert!(
+        stdout_sim.contains("needed but unsupervised: "),
+        "{stdout_sim}"
+    );
     let recorded = Planner::load(&state).unwrap();
     assert_eq!(recorded.rounds_recorded(), 2);
     assert_eq!(recorded.model().count(), 6 + 4);

@@ -165,10 +165,13 @@ impl PyCoordinator {
         out_vector(py, self.per_robot(|r, _| r.start_s()))
     }
 
-    /// Scheduled end of every robot, ``(N,)``, s of global time.
+    /// Planned end of every robot, ``(N,)``, s of global time: its start, its execution and
+    /// the planned dwells at its holds (the Rust coordinator's ``planned_end_s``; the same as
+    /// ``Schedule.ends_s``). Without holds, the end of its timeline.
     #[getter]
     fn ends_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        out_vector(py, self.per_robot(|r, _| r.end_s()))
+        let n = self.inner.n_robots();
+        out_vector(py, (0..n).map(|i| self.inner.planned_end_s(i)).collect())
     }
 
     /// Whether each robot is running now (its clock in ``[start, end)`` of its current leg,

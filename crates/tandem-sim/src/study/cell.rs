@@ -31,6 +31,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use tandem_lfd::TaskModel;
 use tandem_planner::Planner;
+use tandem_realtime::Timeline;
 use tandem_schedule::{CyclicParams, CyclicPlan, cyclic_plan};
 
 use super::config::StudyConfig;
@@ -41,7 +42,7 @@ use super::run::{
 };
 use crate::task::{self, Label};
 use crate::truth::{SandingTruth, TaskTruth, falsely_trusted_where};
-use crate::workcell::{CellSim, CellStats, FinishedTask};
+use crate::workcell::{CellSim, CellStats, FinishedTask, PlanGap, RobotPlan, RobotRun};
 use crate::{Error, Result};
 
 /// The cell's plan after some recorded tasks: one per re-plan of a trial.
@@ -77,7 +78,7 @@ pub struct CellIteration {
 }
 
 /// A completed task of a trial.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CellCompletion {
     /// The robot (0-based).
     pub robot: usize,
@@ -87,6 +88,74 @@ pub struct CellCompletion {
     pub busy_ticks: u64,
     /// Ticks the robots waited at gates until then (cumulative, summed over robots).
     pub gate_ticks: u64,
+    /// Where the task's time went against the plan in force ([`task_gap`]): its realized
+    /// duration (since the robot's previous completion) against the plan's period, split
+    /// into corrections, waits at gates (`holds_s`), response strategy, tick grid and faults.
+    /// All 0 in files written before it was recorded.
+    #[serde(default)]
+    pub plan_gap: PlanGap,
+    /// The task's samples run at high confidence where the truth needed the operator.
+    #[serde(default)]
+    pub needed_unsupervised: usize,
+}
+
+/// Where one task of a continuous cell spent its time against the plan
+/// (docs/decisions.md, "Plans that say how optimistic they are"): the task took
+/// `realized_ticks` ticks of `tick_s` (from the robot's previous completion, or the cell's
+/// start, to this one), of which `gate_ticks` waiting at gates for the operator's token; the
+/// plan in force gives every robot one task per `period_s` (s) and runs it on `task`'s
+/// clock. The [`PlanGap`] has `realized_s = realized_ticks·τ`, `planned_s = period_s`, and
+/// the parts, which add up to their difference exactly:
+///
+/// - each running tick, from the logged reference time `t` to the next (or `T_ref`):
+///   `τ − (P(t') − P(t))` with `P` the task's planned clock, to corrections when the robot
+///   was corrected in it, to the grid for the task's last tick, else to the strategy (the
+///   coordinator's own rates);
+/// - gates (`holds_s`): the waiting ticks minus the plan's waiting per task, `P − |task|`;
+/// - faults: ticks neither running nor at a gate (held by the fault monitor);
+/// - grid also takes `−P(t_first)`: what the task had covered before its first logged
+///   sample (carried over from the previous task's last tick).
+///
+/// A plan that took over while the task ran is charged for the whole task (the plan in force
+/// at the completion).
+#[must_use]
+pub fn task_gap(
+    run: &RobotRun,
+    realized_ticks: u64,
+    gate_ticks: u64,
+    tick_s: f64,
+    period_s: f64,
+    task: &Timeline,
+) -> PlanGap {
+    let plan = RobotPlan {
+        start_s: task.start_s(),
+        end_s: task.start_s() + period_s,
+        sample_clock_s: task.sample_clock_s().to_vec(),
+    };
+    let n_ref = task.n_ref() as f64;
+    let mut gap = PlanGap {
+        realized_s: realized_ticks as f64 * tick_s,
+        planned_s: period_s,
+        ..PlanGap::default()
+    };
+    let log = &run.ref_time_log;
+    for (j, &t) in log.iter().enumerate() {
+        let next = log.get(j + 1).copied().unwrap_or(n_ref);
+        let d = tick_s - (plan.clock_at(next) - plan.clock_at(t));
+        if j + 1 == log.len() {
+            gap.grid_s += d;
+        } else if run.corrected.get(j).copied().unwrap_or(false) {
+            gap.corrections_s += d;
+        } else {
+            gap.strategy_s += d;
+        }
+    }
+    let run_s = plan.clock_at(n_ref);
+    gap.holds_s = gate_ticks as f64 * tick_s - (period_s - run_s);
+    let held = realized_ticks.saturating_sub(gate_ticks + log.len() as u64);
+    gap.faults_s = held as f64 * tick_s;
+    gap.grid_s -= plan.clock_at(log.first().copied().unwrap_or(n_ref));
+    gap
 }
 
 /// The steady state of a continuous cell: the last 10 % of its tasks, rounded up to whole
@@ -109,6 +178,15 @@ pub struct Steady {
     /// Share of the robots' time in the window spent waiting at a gate for the operator's
     /// token, in `[0, 1]` (robot-ticks waiting over `N ×` the window's ticks).
     pub robot_wait_share: f64,
+    /// The window's tasks' [`CellCompletion::plan_gap`]s summed: realized task time against
+    /// the planned periods and its causes (s). Planned over realized throughput of the
+    /// robots is `planned_s / realized_s`, and each cause's share of the difference is its
+    /// share of the lost throughput. All 0 in older files.
+    #[serde(default)]
+    pub plan_gap: PlanGap,
+    /// The window's samples run at high confidence where the truth needed the operator.
+    #[serde(default)]
+    pub needed_unsupervised: usize,
 }
 
 impl Steady {
@@ -137,6 +215,11 @@ impl Steady {
             throughput_per_h: k as f64 * 3600.0 / duration_s,
             operator_busy_share: (last.busy_ticks - b0) as f64 / ticks,
             robot_wait_share: (last.gate_ticks - g0) as f64 / (ticks * n_robots as f64),
+            plan_gap: PlanGap::sum(completions[total - k..].iter().map(|c| &c.plan_gap)),
+            needed_unsupervised: completions[total - k..]
+                .iter()
+                .map(|c| c.needed_unsupervised)
+                .sum(),
         })
     }
 }
@@ -196,6 +279,13 @@ pub struct CellSummary {
     pub faults: u64,
     /// Plans that took over a running cell, over every trial.
     pub hand_overs: u64,
+    /// The steady windows' [`Steady::plan_gap`] per task, averaged over trials (s): how much
+    /// longer a task took than the plan's period, and why.
+    #[serde(default)]
+    pub steady_plan_gap_per_task: PlanGap,
+    /// The steady windows' needed-but-unsupervised samples per task, averaged over trials.
+    #[serde(default)]
+    pub steady_needed_unsupervised_per_task: f64,
 }
 
 impl CellStudyResult {
@@ -209,6 +299,17 @@ impl CellStudyResult {
             .collect();
         let (steady, steady_std) = mean_std(self.trials.iter().map(|t| t.steady.throughput_per_h));
         let n = self.config.robots as f64;
+        let per_task: Vec<(PlanGap, f64)> = self
+            .trials
+            .iter()
+            .map(|t| {
+                let k = t.steady.tasks.max(1) as f64;
+                (
+                    t.steady.plan_gap.scaled(1.0 / k),
+                    t.steady.needed_unsupervised as f64 / k,
+                )
+            })
+            .collect();
         CellSummary {
             steady_throughput_per_h: steady,
             steady_throughput_std_per_h: steady_std,
@@ -229,6 +330,11 @@ impl CellStudyResult {
             overlap_ticks: self.trials.iter().map(|t| t.stats.overlap_ticks).sum(),
             faults: self.trials.iter().map(|t| t.stats.faults).sum(),
             hand_overs: self.trials.iter().map(|t| t.stats.hand_overs).sum(),
+            steady_plan_gap_per_task: PlanGap::mean(
+                per_task.iter().map(|(g, _)| g).collect::<Vec<_>>(),
+            )
+            .unwrap_or_default(),
+            steady_needed_unsupervised_per_task: mean_std(per_task.iter().map(|(_, u)| *u)).0,
         }
     }
 }
@@ -350,6 +456,12 @@ pub fn run_cell_trial_on(
     let mut completions = Vec::with_capacity(total + n);
     let mut batch = Vec::with_capacity(n);
     let mut recorded = 0;
+    // The period of the plan in force (a new plan may wait for its hand-over), each robot's
+    // last completion tick and its gate ticks then (for each task's PlanGap).
+    let mut period_s = iterations[0].period_s;
+    let mut pending_period_s: Option<f64> = None;
+    let mut last_done = vec![0_u64; n];
+    let mut gates_then = vec![0_u64; n];
     while completions.len() < total {
         if sim.stats().ticks as f64 >= budget {
             return Err(Error::DidNotFinish {
@@ -359,13 +471,38 @@ pub fn run_cell_trial_on(
         let t = Instant::now();
         let finished = sim.tick(planner.model(), |robot, idx| needed[robot][idx], &mut rng)?;
         times.simulation += t.elapsed();
+        if !sim.has_pending() {
+            if let Some(p) = pending_period_s.take() {
+                period_s = p;
+            }
+        }
         for f in finished {
             let stats = sim.stats();
+            let i = f.robot;
+            let gates = stats.gate_ticks[i];
+            let plan_gap = task_gap(
+                &f.run,
+                f.tick - last_done[i],
+                gates - gates_then[i],
+                dt_s,
+                period_s,
+                sim.coordinator().task(),
+            );
+            (last_done[i], gates_then[i]) = (f.tick, gates);
+            let unsupervised = f
+                .run
+                .ref_time_log
+                .iter()
+                .zip(&f.run.supervised)
+                .filter(|&(&t, &sup)| !sup && needed[i][t.max(0.0).round() as usize])
+                .count();
             completions.push(CellCompletion {
                 robot: f.robot,
                 tick: f.tick,
                 busy_ticks: stats.busy_ticks,
                 gate_ticks: stats.gate_ticks.iter().sum(),
+                plan_gap,
+                needed_unsupervised: unsupervised,
             });
             observe(&f);
             needed[f.robot] = truth.draw(&mut rng)?;
@@ -383,7 +520,12 @@ pub fn run_cell_trial_on(
             let (plan, iteration) = plan_of(&planner, can_need, recorded, sim.stats().ticks)?;
             let next = plan.coordinator(planner.problem(), dt_s)?;
             times.scheduling += t.elapsed();
-            sim.replan(planner.model(), next)?;
+            if sim.replan(planner.model(), next)? {
+                period_s = iteration.period_s;
+                pending_period_s = None;
+            } else {
+                pending_period_s = Some(iteration.period_s);
+            }
             iterations.push(iteration);
             progress(Progress {
                 trial,
@@ -464,8 +606,56 @@ mod tests {
                 tick: 700 * (i as u64 / 7 + 1) + 10 * (i as u64 % 7),
                 busy_ticks: 0,
                 gate_ticks: 0,
+                plan_gap: PlanGap {
+                    realized_s: 7.0,
+                    planned_s: 6.0,
+                    holds_s: 1.0,
+                    ..PlanGap::default()
+                },
+                needed_unsupervised: i % 2,
             })
             .collect()
+    }
+
+    #[test]
+    fn a_task_gap_splits_the_task_time_against_the_period_exactly() {
+        // A task of four reference samples at 1 s each (τ = 1 s), planned once per 6 s
+        // period: 4 s running, 2 s waiting at its gate. It took 9 ticks: 5 running, 3 at
+        // the gate, 1 held. Running 0 → 1 (on plan), 1 → 1.5 (0.5 s behind: strategy),
+        // 1.5 → 2 corrected (0.5 s: corrections), 2 → 3.5 (0.5 s ahead: strategy), 3.5 → 4
+        // and done (0.5 s of the last tick unused: grid). Gates 3 s against the planned 2 s:
+        // +1 s; held 1 s. 9 − 6 = 3 = 0.5 + 0 + 0.5 + 1 + 1.
+        let task = Timeline::new(&[true; 4], &[1.0; 4], &[0.5; 4], &[2.0; 4], 0.0, 1.0).unwrap();
+        let log = vec![0.0, 1.0, 1.5, 2.0, 3.5];
+        let run = RobotRun {
+            samples: vec![0.0; 5],
+            supervised: vec![false, false, true, false, false],
+            corrected: vec![false, false, true, false, false],
+            ref_time_log: log,
+            needed: 1,
+            missed: 0,
+            false_corrections: 0,
+            clock_s: Vec::new(),
+            start_tick: 0,
+            hold_ticks: 0,
+            phases: Vec::new(),
+        };
+        let gap = task_gap(&run, 9, 3, 1.0, 6.0, &task);
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert_eq!((gap.realized_s, gap.planned_s), (9.0, 6.0));
+        assert!(close(gap.corrections_s, 0.5), "{gap:?}");
+        assert!(close(gap.strategy_s, 0.0), "{gap:?}");
+        assert!(close(gap.grid_s, 0.5), "{gap:?}");
+        assert!(close(gap.holds_s, 1.0), "{gap:?}");
+        assert!(close(gap.faults_s, 1.0), "{gap:?}");
+        assert!(close(gap.parts_sum_s(), 3.0), "{gap:?}");
+        // A task that began 0.25 samples in (carried over from the previous task's last
+        // tick) got that for free: the grid takes −0.25 s.
+        let mut carried = run.clone();
+        carried.ref_time_log[0] = 0.25;
+        let gap = task_gap(&carried, 9, 3, 1.0, 6.0, &task);
+        assert!(close(gap.parts_sum_s(), 3.0), "{gap:?}");
+        assert!(close(gap.grid_s, 0.25), "{gap:?}");
     }
 
     #[test]
@@ -475,6 +665,13 @@ mod tests {
         assert_eq!(s.tasks, 28);
         assert!((s.duration_s - 28.0).abs() < 1e-9, "{}", s.duration_s);
         assert!((s.throughput_per_h - 3600.0).abs() < 1e-9);
+        // The window's gaps and unsupervised samples are its 28 tasks' sums.
+        assert_eq!(
+            (s.plan_gap.realized_s, s.plan_gap.planned_s),
+            (196.0, 168.0)
+        );
+        assert_eq!(s.plan_gap.holds_s, 28.0);
+        assert_eq!(s.needed_unsupervised, 14);
         // Wherever the last task falls in its bunch, whole periods measure the true rate
         // (24 tasks would span 21.3 s here: 4056 tasks per hour).
         for total in 8..=238 {

@@ -14,7 +14,7 @@ mod run;
 
 pub use cell::{
     CellCompletion, CellIteration, CellStudyResult, CellSummary, CellTrialResult, CellTrialRun,
-    Steady, run_cell_study, run_cell_trial, run_cell_trial_on, run_cell_trials,
+    Steady, run_cell_study, run_cell_trial, run_cell_trial_on, run_cell_trials, task_gap,
 };
 pub use config::{Cell, StudyConfig};
 pub use inputs::{StudyInputs, read_labels};

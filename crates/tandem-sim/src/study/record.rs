@@ -8,6 +8,7 @@ use tandem_confidence::ErrorRates;
 use tandem_schedule::Source;
 
 use super::config::StudyConfig;
+use crate::workcell::PlanGap;
 
 /// What happened when a pair of executions ran under one schedule.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -42,6 +43,16 @@ pub struct PairStats {
     /// and then left out of the JSON).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub hold_ticks: usize,
+    /// Where the round's time went against its plan: realized minus planned `T_total` split
+    /// into corrections, holds, response strategy, tick grid, faults and critical path
+    /// ([`RoundRun::plan_gap`](crate::workcell::RoundRun::plan_gap); all 0 in files written
+    /// before it was recorded).
+    #[serde(default)]
+    pub plan_gap: PlanGap,
+    /// Samples the robots ran at high confidence (unsupervised) where the truth says the
+    /// operator is needed ([`RoundRun::needed_unsupervised`](crate::workcell::RoundRun::needed_unsupervised)).
+    #[serde(default)]
+    pub needed_unsupervised: usize,
 }
 
 /// Whether a count is 0 (for `skip_serializing_if`).
@@ -219,6 +230,14 @@ pub struct IterationSummary {
     /// schedule ([`PairStats::operator_busy_share`], in [0, 1]); `None` for the last
     /// iteration, after which no round runs.
     pub operator_busy_share_mean: Option<f64>,
+    /// Mean across trials of the round's [`PairStats::plan_gap`] (realized against planned
+    /// `T_total` and its causes, s); `None` for the last iteration.
+    #[serde(default)]
+    pub plan_gap_mean: Option<PlanGap>,
+    /// Mean across trials of the round's [`PairStats::needed_unsupervised`]; `None` for the
+    /// last iteration.
+    #[serde(default)]
+    pub needed_unsupervised_mean: Option<f64>,
 }
 
 impl StudyResult {
@@ -260,9 +279,39 @@ impl StudyResult {
                             .collect();
                         (!busy.is_empty()).then(|| mean_std(busy.into_iter()).0)
                     },
+                    plan_gap_mean: PlanGap::mean(
+                        recs.iter()
+                            .filter_map(|r| r.pair.as_ref())
+                            .map(|p| &p.plan_gap),
+                    ),
+                    needed_unsupervised_mean: {
+                        let n: Vec<f64> = recs
+                            .iter()
+                            .filter_map(|r| r.pair.as_ref())
+                            .map(|p| p.needed_unsupervised as f64)
+                            .collect();
+                        (!n.is_empty()).then(|| mean_std(n.into_iter()).0)
+                    },
                 }
             })
             .collect()
+    }
+
+    /// The gaps of every round of every trial from iteration `from` on, summed cause by
+    /// cause ([`PairStats::plan_gap`]), and the needed-but-unsupervised samples summed over
+    /// the same rounds: how optimistic the plans were, and why.
+    pub fn plan_gap_total(&self, from: usize) -> (PlanGap, usize) {
+        let pairs: Vec<&PairStats> = self
+            .trials
+            .iter()
+            .flat_map(|t| &t.iterations)
+            .filter(|r| r.iteration >= from)
+            .filter_map(|r| r.pair.as_ref())
+            .collect();
+        (
+            PlanGap::sum(pairs.iter().map(|p| &p.plan_gap)),
+            pairs.iter().map(|p| p.needed_unsupervised).sum(),
+        )
     }
 
     /// Total overlap ticks over every pair of every trial (must be 0).
@@ -389,6 +438,14 @@ mod tests {
                 faults: 0,
                 robot_wait_share: 0.25,
                 hold_ticks: 0,
+                plan_gap: PlanGap {
+                    realized_s: t_total_s + 1.0,
+                    planned_s: t_total_s,
+                    corrections_s: 0.75,
+                    strategy_s: 0.25,
+                    ..PlanGap::default()
+                },
+                needed_unsupervised: iteration + 3,
             }),
             lower_bound_s: t_total_s - 1.0,
             bound_is_optimum: iteration == 0,
@@ -465,6 +522,21 @@ mod tests {
         // A round ran at iteration 0 only.
         assert_eq!(s[0].operator_busy_share_mean, Some(0.5));
         assert_eq!(s[1].operator_busy_share_mean, None);
+        // The plans' optimism: each round ran 1 s over (0.75 s corrections, 0.25 s
+        // strategy); planned 10 and 12 s, mean 11.
+        let gap = s[0].plan_gap_mean.as_ref().unwrap();
+        assert_eq!((gap.planned_s, gap.realized_s), (11.0, 12.0));
+        assert_eq!((gap.corrections_s, gap.strategy_s), (0.75, 0.25));
+        assert_eq!(s[0].needed_unsupervised_mean, Some(3.0));
+        assert_eq!(
+            (s[1].plan_gap_mean.as_ref(), s[1].needed_unsupervised_mean),
+            (None, None)
+        );
+        let (total, unsupervised) = result().plan_gap_total(0);
+        assert_eq!((total.planned_s, total.realized_s), (22.0, 24.0));
+        assert!((total.parts_sum_s() - total.total_s()).abs() < 1e-12);
+        assert_eq!(unsupervised, 6);
+        assert_eq!(result().plan_gap_total(1).0, PlanGap::default());
     }
 
     #[test]

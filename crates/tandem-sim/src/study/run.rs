@@ -252,6 +252,8 @@ pub fn run_trial_on(
             faults: run.faults,
             robot_wait_share: run.robot_wait_share(),
             hold_ticks: run.robots.iter().map(|r| r.hold_ticks).sum(),
+            plan_gap: run.plan_gap,
+            needed_unsupervised: run.needed_unsupervised(|robot, n| needed[robot][n]),
         });
         iterations.push(record);
         let report = planner.record_round(&records).map_err(|e| at(e.into()))?;

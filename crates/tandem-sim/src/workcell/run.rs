@@ -8,7 +8,7 @@ use tandem_realtime::{Coordinator, Operator, Timeline, tol};
 use tandem_schedule::{Problem, Schedule};
 
 use super::operator::{Episodes, OperatorParams, local_correction_input, needs_correction};
-use super::record::{PairRun, RobotRun, RoundRun, TickPhase};
+use super::record::{PairRun, PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
 use crate::task::{Label, Workpiece};
 use crate::{Error, Result};
 
@@ -213,6 +213,8 @@ pub(super) fn run_coordinator(
     // Whether each robot logged an unsupervised sample this tick (it started the tick on a
     // high-confidence sample), and that sample's reference time.
     let mut unsupervised_at: Vec<Option<f64>> = vec![None; n_robots];
+    // Whether the operator's input in each tick was a correction (for the round's PlanGap).
+    let mut corrected_tick: Vec<bool> = Vec::new();
     while !coord.is_finished() {
         if ticks >= budget {
             return Err(Error::DidNotFinish { ticks: budget });
@@ -278,6 +280,7 @@ pub(super) fn run_coordinator(
                 operator = op_input;
             }
         }
+        corrected_tick.push(!matches!(operator, Operator::Scheduled));
         let tick = coord.tick(operator)?;
         for i in 0..n_robots {
             // A robot that started the tick on high-confidence ground may have crossed
@@ -321,7 +324,17 @@ pub(super) fn run_coordinator(
         .map(Timeline::start_s)
         .fold(f64::INFINITY, f64::min);
     let planned_ends_s: Vec<f64> = (0..n_robots).map(|i| coord.planned_end_s(i) - t0).collect();
-    Ok(RoundRun {
+    let plans: Vec<RobotPlan> = (0..n_robots)
+        .map(|i| {
+            let tl = &coord.robots()[i];
+            RobotPlan {
+                start_s: tl.start_s(),
+                end_s: coord.planned_end_s(i),
+                sample_clock_s: tl.sample_clock_s().to_vec(),
+            }
+        })
+        .collect();
+    let mut round = RoundRun {
         robots: runs,
         ticks,
         tick_s,
@@ -330,7 +343,10 @@ pub(super) fn run_coordinator(
         faults,
         planned_t_total_s: planned_ends_s.iter().copied().fold(0.0, f64::max),
         planned_ends_s,
-    })
+        plan_gap: PlanGap::default(),
+    };
+    round.plan_gap = plan_gap(&round, &plans, &corrected_tick);
+    Ok(round)
 }
 
 /// The low-confidence reference samples a robot crossed whole inside one tick, from reference

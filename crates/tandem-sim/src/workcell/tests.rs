@@ -576,6 +576,170 @@ fn a_robot_waits_at_its_hold_while_the_operator_drags_the_other_and_never_overla
         assert!(r.needed > 0 && r.corrected == r.supervised);
         assert_eq!(r.ref_time_log.len(), r.supervised.len());
     }
+    // Where the time went: the parts add up to realized − planned, and the corrections
+    // (which slow the LC robot, so that robot 2 waits at its hold) explain a positive share.
+    let gap = &run.plan_gap;
+    assert!(
+        (gap.parts_sum_s() - run.over_plan_s()).abs() < 1e-9,
+        "{gap:?} against {}",
+        run.over_plan_s()
+    );
+    assert_eq!(gap.faults_s, 0.0);
+    assert!(gap.corrections_s + gap.holds_s > 0.0, "{gap:?}");
+    // Every sample needs the operator on the painted workpieces, but only 10..20 is
+    // low-confidence: each robot runs the 50 high-confidence samples (one tick each at
+    // ψ̇ = 1) unsupervised where the truth needs it.
+    assert_eq!(run.needed_unsupervised(painted_needs), 2 * 50);
+    assert_eq!(run.needed_unsupervised(|_, n| (10..20).contains(&n)), 0);
+}
+
+#[test]
+fn a_round_gap_adds_up_for_any_operator_with_and_without_a_hold() {
+    // The hand-made problem, serial and with a hold at 5 and its release rule, under
+    // operators who miss and correct by mistake: the parts always sum to realized − planned,
+    // the grid stays within a tick per leg, and only corrections and holds make the round
+    // longer than planned by more than the grid.
+    let model = model();
+    let plain_problem = problem(&model);
+    let held_problem = plain_problem.clone().with_holds(vec![5]).unwrap();
+    let dt_s = plain_problem.dt_s();
+    let serial = plain_problem.serial_schedule(dt_s).unwrap();
+    let clock = |n: usize| tandem_realtime::clock_end_s(&serial.grad_exec[0][..n], 0.0, dt_s);
+    let overlapping = Schedule {
+        offsets_s: vec![clock(20) - clock(10)],
+        ..serial.clone()
+    };
+    let held = held_problem.with_release_rules(&overlapping).unwrap();
+    let cases = [(&plain_problem, &serial, 1), (&held_problem, &held, 2)];
+    for (problem, schedule, legs) in cases {
+        for seed in 0..6_u64 {
+            let op = OperatorParams {
+                miss_rate: 0.3,
+                false_correction_rate: 0.2,
+                ..OperatorParams::default()
+            };
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let run =
+                run_schedule(&model, problem, schedule, painted_needs, &op, &mut rng).unwrap();
+            let gap = &run.plan_gap;
+            assert!(
+                (gap.parts_sum_s() - run.over_plan_s()).abs() < 1e-9,
+                "seed {seed}: {gap:?} against {}",
+                run.over_plan_s()
+            );
+            assert_eq!((gap.faults_s, run.faults), (0.0, 0));
+            let tick = run.tick_s;
+            assert!(
+                gap.grid_s >= -tick && gap.grid_s <= legs as f64 * tick + 1e-9,
+                "seed {seed}, {legs} leg(s): {gap:?}"
+            );
+            let corrected: usize = run
+                .robots
+                .iter()
+                .map(|r| r.corrected.iter().filter(|&&c| c).count())
+                .sum();
+            assert!(corrected > 0, "seed {seed}: the operator corrected");
+            assert_ne!(gap.corrections_s, 0.0, "seed {seed}: {gap:?}");
+        }
+    }
+}
+
+#[test]
+fn a_round_gap_splits_realized_minus_planned_into_its_causes_exactly() {
+    // A hand-built round, τ = 1 s, T_ref = 4, every sample planned at 1 s. Robot 1 starts at
+    // 0 and runs its four samples on plan. Robot 2 is planned to start at 2 and to dwell 1 s
+    // at a hold after sample 2: planned end 2 + 4 + 1 = 7 = T_total. It ran:
+    //   k0 waiting, the operator correcting robot 1: its clock advanced 0.5 (0.5 s lost);
+    //   k1, k2 waiting at full pace (clock 0.5 → 2.5); k3 running 0.5 → 1.5 (on plan);
+    //   k4 running 1.5 → 2 and reaching the hold half-way (0.5 s grid);
+    //   k5, k6 at the hold (2 s, planned 1 s: 1 s holds);
+    //   k7 running 2 → 2.5 corrected (0.5 s corrections); k8 running 2.5 → 3.7 ahead of the
+    //   warp (−0.2 s strategy); k9 running 3.7 → 4 and finishing (0.7 s grid).
+    // Realized 10 s, planned 7 s: 3 s = 1 (corrections) + 1 (holds) − 0.2 (strategy) +
+    // 1.2 (grid).
+    use TickPhase::{AtHold, Finished, Running, Waiting};
+    let robot = |phases: Vec<TickPhase>, ref_time_log: Vec<f64>, clock_s: Vec<f64>| {
+        let n = ref_time_log.len();
+        RobotRun {
+            samples: vec![0.0; n],
+            supervised: vec![false; n],
+            corrected: vec![false; n],
+            ref_time_log,
+            needed: 0,
+            missed: 0,
+            false_corrections: 0,
+            clock_s,
+            start_tick: phases.iter().position(|&p| p == Running).unwrap(),
+            hold_ticks: phases.iter().filter(|&&p| p == AtHold).count(),
+            phases,
+        }
+    };
+    let r1 = robot(
+        [vec![Running; 4], vec![Finished; 6]].concat(),
+        vec![0.0, 1.0, 2.0, 3.0],
+        (0..10).map(f64::from).collect(),
+    );
+    let r2 = robot(
+        vec![
+            Waiting, Waiting, Waiting, Running, Running, AtHold, AtHold, Running, Running, Running,
+        ],
+        vec![0.5, 1.5, 2.0, 2.5, 3.7],
+        vec![0.0, 0.5, 1.5, 2.5, 3.5, 4.0, 4.0, 5.0, 5.5, 6.7],
+    );
+    let mut round = RoundRun {
+        robots: vec![r1, r2],
+        ticks: 10,
+        tick_s: 1.0,
+        overlap_ticks: 0,
+        idle_ticks: 10,
+        faults: 0,
+        planned_t_total_s: 7.0,
+        planned_ends_s: vec![4.0, 7.0],
+        plan_gap: PlanGap::default(),
+    };
+    let plan = |start_s: f64, end_s: f64| RobotPlan {
+        start_s,
+        end_s,
+        sample_clock_s: (0..5).map(|n| start_s + f64::from(n)).collect(),
+    };
+    let mut plans = vec![plan(0.0, 4.0), plan(2.0, 7.0)];
+    let mut corrected_tick = vec![false; 10];
+    corrected_tick[0] = true;
+    corrected_tick[7] = true;
+    let gap = plan_gap(&round, &plans, &corrected_tick);
+    let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+    assert_eq!(gap.critical_robot, 1);
+    assert_eq!((gap.realized_s, gap.planned_s), (10.0, 7.0));
+    assert!(close(gap.corrections_s, 1.0), "{gap:?}");
+    assert!(close(gap.holds_s, 1.0), "{gap:?}");
+    assert!(close(gap.strategy_s, -0.2), "{gap:?}");
+    assert!(close(gap.grid_s, 1.2), "{gap:?}");
+    assert_eq!((gap.faults_s, gap.critical_path_s), (0.0, 0.0));
+    assert!(close(gap.parts_sum_s(), 3.0));
+    assert_eq!(gap.dominant().0, "grid");
+    assert_eq!(
+        gap.describe(),
+        "3.00 s over plan (+42.9 %): corrections +1.00 s (33 %), holds +1.00 s (33 %), \
+         strategy -0.20 s (-7 %), grid +1.20 s (40 %)"
+    );
+    // Robot 1 planned to end last (at 7.5, its plan padded with a 3.5 s dwell it never
+    // needed), robot 2 planned at 6.5 (a 0.5 s dwell): robot 2 still ended the round, its
+    // hold took 1.5 s more than planned, and the plan's critical path was 0.5 s longer.
+    plans[0].end_s = 7.5;
+    plans[1].end_s = 6.5;
+    round.planned_t_total_s = 7.5;
+    let gap = plan_gap(&round, &plans, &corrected_tick);
+    assert_eq!(gap.critical_robot, 1);
+    assert!(close(gap.holds_s, 1.5), "{gap:?}");
+    assert!(close(gap.critical_path_s, -1.0), "{gap:?}");
+    assert!(close(gap.parts_sum_s(), gap.total_s()), "{gap:?}");
+    assert!(close(gap.total_s(), 2.5));
+    // Needed but unsupervised: robot 2 needs the operator at reference samples 2 and 4
+    // (round(t)): its samples at 1.5 and 2.0 round to 2, at 3.7 to 4; nothing supervised.
+    let needs = |robot: usize, idx: usize| robot == 1 && (idx == 2 || idx == 4);
+    assert_eq!(round.needed_unsupervised(needs), 3);
+    round.robots[1].supervised[1] = true;
+    assert_eq!(round.needed_unsupervised(needs), 2);
 }
 
 #[test]
@@ -638,6 +802,17 @@ fn a_nominal_round_with_a_hold_ends_on_plan_and_records_where_its_time_went() {
             (end_s - run.planned_ends_s[i]).abs() <= grid_s,
             "robot {i}: {end_s}"
         );
+    }
+    // The gap's parts add up to realized − planned; no correction was given, so none is
+    // charged to corrections, and the rest is within the tick grid.
+    let gap = &run.plan_gap;
+    assert!(
+        (gap.parts_sum_s() - run.over_plan_s()).abs() < 1e-9,
+        "{gap:?}"
+    );
+    assert_eq!((gap.corrections_s, gap.faults_s), (0.0, 0.0), "{gap:?}");
+    for (name, s) in gap.parts() {
+        assert!(s.abs() <= grid_s, "{name}: {s} s ({gap:?})");
     }
     // Robot 2 stands at its hold for its planned dwell (to within a tick).
     let waited_s = run.robots[1].hold_wait_s(run.tick_s);

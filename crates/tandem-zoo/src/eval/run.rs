@@ -7,7 +7,7 @@ use std::sync::{Mutex, PoisonError};
 use serde::{Deserialize, Serialize};
 use tandem_planner::{Planner, derive_seed};
 use tandem_sim::study::{Cell, RoundView, StudyConfig, run_cell_trial_on, run_trial_on};
-use tandem_sim::workcell::FinishedTask;
+use tandem_sim::workcell::{FinishedTask, PlanGap};
 
 use super::prepare::{Prepared, falsely_trusted_split};
 use crate::Result;
@@ -64,6 +64,15 @@ pub struct RunReport {
     pub planned_per_h: f64,
     /// Its realized throughput (tasks per hour per operator; continuous: the steady window).
     pub realized_per_h: f64,
+    /// Realized against planned time and its causes (s; `tandem_sim::workcell::PlanGap`):
+    /// rounds: every round's gap summed (realized − planned `T_total`); continuous: the
+    /// steady window's tasks against the plan's period (`Steady::plan_gap`).
+    #[serde(default)]
+    pub plan_gap: PlanGap,
+    /// Samples run at high confidence where the truth needed the operator: over every round
+    /// (continuous: the steady window).
+    #[serde(default)]
+    pub needed_unsupervised: usize,
     /// Ticks in which a robot's reference time decreased, over every robot and round (must
     /// be 0), counted from the reference-time logs.
     pub backward_steps: usize,
@@ -253,6 +262,8 @@ pub fn run_rounds(
         realized_over_planned_last: realized_last / planned_last,
         planned_per_h: per_h(planned_last),
         realized_per_h: per_h(realized_last),
+        plan_gap: PlanGap::sum(pairs.clone().map(|p| &p.plan_gap)),
+        needed_unsupervised: pairs.clone().map(|p| p.needed_unsupervised).sum(),
         backward_steps: trace.backward.0,
         max_backward_samples: trace.backward.1,
         overlap_ticks: pairs.clone().map(|p| p.overlap_ticks as u64).sum(),
@@ -319,6 +330,8 @@ pub fn run_continuous(
         realized_over_planned_last: ratio,
         planned_per_h: last.tasks_per_hour,
         realized_per_h,
+        plan_gap: run.result.steady.plan_gap,
+        needed_unsupervised: run.result.steady.needed_unsupervised,
         backward_steps: trace.backward.0,
         max_backward_samples: trace.backward.1,
         overlap_ticks: run.result.stats.overlap_ticks,

@@ -55,6 +55,20 @@ pub struct FamilyRow {
     pub planned_per_h: f64,
     /// Realized throughput of the last round (continuous: steady), tasks/h per operator.
     pub realized_per_h: f64,
+    /// Realized minus planned time as a percent of planned (mean over seeds of
+    /// `100·(realized − planned) / planned` of every round summed; continuous: the steady
+    /// window's tasks against the plan's period): the sum of the cause columns below.
+    #[serde(default)]
+    pub over_plan_pct: f64,
+    /// The causes' shares of planned time, percent, in the order of
+    /// `PlanGap::parts` (corrections, holds (continuous: gates), strategy, grid, faults,
+    /// critical path); they add up to [`FamilyRow::over_plan_pct`].
+    #[serde(default)]
+    pub cause_pct: [f64; 6],
+    /// Samples run at high confidence where the truth needed the operator (mean over seeds;
+    /// rounds: summed over every round; continuous: the steady window).
+    #[serde(default)]
+    pub needed_unsupervised: f64,
     /// Backward steps of reference time, summed over seeds (must be 0).
     pub backward_steps: usize,
     /// Largest backward step (reference samples).
@@ -158,6 +172,9 @@ fn row(family: String, robots: usize, cell: Cell, runs: &[&RunReport]) -> Family
         realized_over_planned: m(&|r| r.realized_over_planned),
         planned_per_h: m(&|r| r.planned_per_h),
         realized_per_h: m(&|r| r.realized_per_h),
+        over_plan_pct: m(&|r| pct_of_plan(r, r.plan_gap.total_s())),
+        cause_pct: std::array::from_fn(|k| m(&|r| pct_of_plan(r, r.plan_gap.parts()[k].1))),
+        needed_unsupervised: m(&|r| r.needed_unsupervised as f64),
         backward_steps: runs.iter().map(|r| r.backward_steps).sum(),
         max_backward_samples: runs
             .iter()
@@ -165,6 +182,15 @@ fn row(family: String, robots: usize, cell: Cell, runs: &[&RunReport]) -> Family
             .fold(0.0, f64::max),
         overlap_ticks: runs.iter().map(|r| r.overlap_ticks).sum(),
         faults: runs.iter().map(|r| r.faults).sum(),
+    }
+}
+
+/// `s` as a percent of the run's planned time (0 when nothing was planned).
+fn pct_of_plan(r: &RunReport, s: f64) -> f64 {
+    if r.plan_gap.planned_s > 0.0 {
+        100.0 * s / r.plan_gap.planned_s
+    } else {
+        0.0
     }
 }
 
