@@ -555,7 +555,7 @@ fn schedule_n(
         .then_some(&incumbent.0)
         .into_iter()
         .collect();
-    let ((winner, mut stats), (bound, (done, mut checks))) = rayon::join(
+    let ((winner, mut stats), (bound, (done, mut checks), held_done)) = rayon::join(
         || {
             if baselines.completion_only {
                 (None, SamplerStats::default())
@@ -567,11 +567,16 @@ fn schedule_n(
         },
         || {
             if n_robots == 1 {
-                return (exact::operator_bound(problem, n_robots), (None, 0));
+                return (
+                    exact::operator_bound(problem, n_robots),
+                    (None, 0),
+                    (None, 0),
+                );
             }
             if !two {
                 return (
                     exact::bound_many(problem, n_robots, &params.exact),
+                    (None, 0),
                     (None, 0),
                 );
             }
@@ -581,7 +586,15 @@ fn schedule_n(
             } else {
                 (None, 0)
             };
-            (bound, done)
+            // With hold points, the held completion: release rules instead of margins on
+            // the switches into a run with a hold, their waits planned as dwells.
+            let cap = done.0.as_ref().map_or(cap_s, |d| d.t_total_s.min(cap_s));
+            let held = if bound.lower_bound_s < cap {
+                exact::held_completion(problem, &params.exact, tick_s, cap, budget)
+            } else {
+                (None, 0)
+            };
+            (bound, done, held)
         },
     );
     let mut best = incumbent;
@@ -614,6 +627,13 @@ fn schedule_n(
         && validate(problem, &schedule).is_ok()
     {
         best = (schedule, t, Source::Completed);
+    }
+    checks += held_done.1;
+    if let Some(h) = held_done.0
+        && h.t_total_s < best.1
+        && validate(problem, &h.schedule).is_ok()
+    {
+        best = (h.schedule, h.t_total_s, Source::Held);
     }
     // With hold points, the margin-free optimum itself with release rules (for `N ≥ 3` the
     // best order the search found, proven or not).

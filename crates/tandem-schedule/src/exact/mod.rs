@@ -463,6 +463,29 @@ pub(crate) fn bound_many(problem: &Problem, n_robots: usize, params: &ExactParam
     }
 }
 
+/// The held completion (`complete::Completion::held`) of a problem with usable hold points
+/// at control tick `tick_s` (s): the best schedule with planned dwells and release rules it
+/// finds that passes the margin check and beats `cap_s` (s), with at most `budget` margin
+/// checks; with the number of checks spent. `(None, 0)` without usable holds.
+pub(crate) fn held_completion(
+    problem: &Problem,
+    params: &ExactParams,
+    tick_s: f64,
+    cap_s: f64,
+    budget: usize,
+) -> (Option<complete::Completed>, usize) {
+    if problem.usable_holds().is_empty() || budget == 0 {
+        return (None, 0);
+    }
+    let chain = bound_chain(problem, 2);
+    complete::Completion::held(problem, &chain, tick_s, params.max_pieces).run(
+        cap_s,
+        budget,
+        true,
+        &[],
+    )
+}
+
 /// The margin-aware completion (see the [module docs](self)) at control tick `tick_s` (s):
 /// the best schedule it finds that passes the margin check and beats `cap_s` (s), with at
 /// most `budget` margin checks, from every clearance at `M` when `cold` and from the

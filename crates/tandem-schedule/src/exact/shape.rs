@@ -49,6 +49,65 @@ pub(crate) fn shaped_schedule(
     }
 }
 
+/// [`shaped_schedule`] with hold points (`chain` built by `Chain::with_holds`): each HC run
+/// that holds a usable hold `h` (`chain.gap_hold`) runs its samples from `h` to the next LC run
+/// at the fastest speeds (`ψ̇min`), so that a release rule on `h` costs only that travel after
+/// the awaited run ends, and spreads the rest of its duration over the samples before `h`
+/// (shaped at the tilt); what the slowest speeds there cannot fill is a planned dwell at `h`.
+/// A run too short for that (shorter than the fastest samples before `h` plus the fastest
+/// travel after it cannot be, by `a_g`) runs the samples before `h` fastest and slows the
+/// travel to fill it.
+/// Returns the schedule with its dwells as holds (no release rules yet).
+pub(crate) fn held_schedule(
+    problem: &Problem,
+    chain: &Chain,
+    times: &Times,
+    tilt: f64,
+    tick_s: f64,
+) -> Schedule {
+    let mut schedule = shaped_schedule(problem, chain, times, tilt, tick_s);
+    let dt = problem.dt_s();
+    let (gmin, gmax) = (problem.grad_min(), problem.grad_max());
+    let sum = |v: &[f64], a: usize, b: usize| v[a..b].iter().sum::<f64>() * dt;
+    let mut holds: Vec<Vec<tandem_realtime::Hold>> = vec![Vec::new(); 2];
+    for (r, robot_holds) in holds.iter_mut().enumerate() {
+        let gaps = times.gaps_s(chain, r);
+        let warp = &mut schedule.grad_exec[r];
+        for (g, &(a, b)) in chain.gap_ref.iter().enumerate() {
+            let Some(h) = chain.gap_hold[g] else {
+                continue;
+            };
+            let travel_s = sum(gmin, h, b);
+            let pre_s = (gaps[g] - travel_s).clamp(sum(gmin, a, h), sum(gmax, a, h));
+            warp[h..b].copy_from_slice(&gmin[h..b]);
+            if gaps[g] - travel_s < pre_s {
+                // Too short for the fastest travel after the fastest samples before: the
+                // travel takes the rest.
+                fill_uniform(problem, &mut warp[h..b], h, gaps[g] - pre_s);
+            }
+            Body {
+                problem,
+                start: a,
+                end: h,
+                tilt,
+            }
+            .fill_run(&mut warp[a..h], pre_s);
+            let filled_s = tandem_realtime::clock_end_s(&warp[a..b], 0.0, dt);
+            let dwell_s = gaps[g] - filled_s;
+            if dwell_s > 0.0 {
+                robot_holds.push(tandem_realtime::Hold {
+                    dwell_s,
+                    ..tandem_realtime::Hold::at(h)
+                });
+            }
+        }
+    }
+    if holds.iter().any(|h| !h.is_empty()) {
+        schedule.holds = holds;
+    }
+    schedule
+}
+
 /// An HC run: reference samples `start..end` with a tilted speed factor.
 struct Body<'a> {
     problem: &'a Problem,
@@ -208,6 +267,49 @@ mod tests {
                     assert!(u(16) > u(44), "tilt {tilt}: {} ≤ {}", u(16), u(44));
                 }
             }
+        }
+    }
+
+    #[test]
+    fn a_held_run_travels_fastest_from_its_hold_and_dwells_what_it_cannot_fill() {
+        // [HC ×4, LC ×4, HC ×2], gradients 1 in [0.5, 2], 0.1 s, a hold at sample 3: the head
+        // of robot 2 lasts 1.5 s. Sample 3 (after the hold) at its fastest, 0.05 s; samples
+        // 0..3 at most 3 · 0.2 = 0.6 s; the rest, 1.5 − 0.65 = 0.85 s, is the dwell at 3.
+        // Robot 1's head of 0.2 s is 0.15 + 0.05 s: every sample fastest, no dwell.
+        let conf: Vec<bool> = (0..10).map(|n| !(4..8).contains(&n)).collect();
+        let p = Problem::new(conf, vec![1.0; 10], vec![0.5; 10], vec![2.0; 10], 0.1)
+            .unwrap()
+            .with_holds(vec![3])
+            .unwrap();
+        let chain = Chain::with_holds(&p, 10.0);
+        assert_eq!(chain.gap_hold, vec![Some(3), None]);
+        let times = stn::Times {
+            tau_s: 0.0,
+            lc_start_s: [vec![0.2], vec![1.5]],
+            end_s: [0.7, 2.0],
+        };
+        for tilt in [0.0, 0.5] {
+            let s = held_schedule(&p, &chain, &times, tilt, 0.1);
+            let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9);
+            assert!(
+                close(&s.grad_exec[1][..4], &[2.0, 2.0, 2.0, 0.5]),
+                "{:?}",
+                s.grad_exec[1]
+            );
+            assert!(
+                close(&s.grad_exec[0][..4], &[0.5; 4]),
+                "{:?}",
+                s.grad_exec[0]
+            );
+            assert!(s.holds[0].is_empty());
+            assert_eq!(s.holds[1].len(), 1);
+            assert_eq!(s.holds[1][0].ref_idx, 3);
+            assert!(
+                (s.holds[1][0].dwell_s - 0.85).abs() < 1e-9,
+                "{:?}",
+                s.holds[1]
+            );
+            assert!((s.t_total_s(0.1) - 2.0).abs() < 1e-9);
         }
     }
 }
