@@ -58,7 +58,9 @@ pub enum Source {
     /// [`crate::solve_exact`] on a problem with holds, planned dwells included; `N ≥ 3`: the
     /// best order of the `N`-robot search, see [`crate::exact`]) with release rules from its
     /// order of low-confidence stretches ([`Problem::with_release_rules`]), which enforce that
-    /// order at run time instead of margins.
+    /// order at run time instead of margins; for two robots also the held completion (release
+    /// rules on the switches into a run with a hold, margins on the others, every rule's wait
+    /// planned; "Margin-aware completion" in [`crate::exact`]).
     Held,
     /// `N ≥ 3` robots on their fastest warps at the least start offsets the full check accepts
     /// (greedy robot by robot, or equally spaced), tried when no other candidate overlaps the

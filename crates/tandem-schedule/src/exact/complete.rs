@@ -133,18 +133,24 @@ impl<'a> Completion<'a> {
         }
     }
 
-    /// The clearances of the release rules ([`Clearance::rules`]): per LC run `k`, the fastest
-    /// travel (s) from the hold of gap `k` to the run; `+∞` for run 0 without a hold; `None`
-    /// elsewhere. Empty for the completion without holds.
+    /// The clearances of the release rules ([`Clearance::rules`]): per LC run `k`, the travel
+    /// (s) from the hold of gap `k` to the run as `shape::held_schedule` plans it (its fastest
+    /// plus one control tick of room, at most its slowest); `+∞` for run 0 without a hold;
+    /// `None` elsewhere. Empty for the completion without holds.
     fn rule_clearances(&self) -> Vec<Option<f64>> {
         if !self.held {
             return Vec::new();
         }
         let dt = self.problem.dt_s();
-        let gmin = self.problem.grad_min();
+        let (gmin, gmax) = (self.problem.grad_min(), self.problem.grad_max());
         (0..self.chain.n_lc())
             .map(|k| match self.chain.gap_hold[k] {
-                Some(h) => Some(gmin[h..self.chain.lc_ref[k].0].iter().sum::<f64>() * dt),
+                Some(h) => {
+                    let run = h..self.chain.lc_ref[k].0;
+                    let fastest = gmin[run.clone()].iter().sum::<f64>() * dt;
+                    let slowest = gmax[run].iter().sum::<f64>() * dt;
+                    Some((fastest + self.tick_s).min(slowest))
+                }
                 None if k == 0 => Some(f64::INFINITY),
                 None => None,
             })

@@ -109,6 +109,20 @@
 //!    parallel; the two most promising continue with the rest of the budget
 //!    ([`ExactParams::max_margin_checks`]).
 //!
+//! 4. **With hold points** (two robots) the completion runs a second time on the chain with
+//!    the problem's usable holds: a robot entering LC run `k` right after the other robot's
+//!    run waits at the hold of gap `k` until that run has ended (the release rule
+//!    `tandem_realtime::holds::release_rules` makes) and then travels to run `k` at its fastest
+//!    speeds, so that pair's clearance is fixed at that travel and the check accepts it without
+//!    a margin; the pairs without a hold iterate as above, on the margin check with holds,
+//!    each step starting from the room the schedule kept between the pair (other lags may keep
+//!    it further apart than its clearance). Robot 2 entering the first run after robot 1's,
+//!    without a hold in gap 0, starts after that run ends (its start rule cannot be a dwell).
+//!    The held runs' samples after the hold run fastest, the rest is spread before it and what
+//!    the slowest speeds cannot fill is a planned dwell; the release rules' waits are planned
+//!    too, so the candidate's `T_total` ([`crate::Source::Held`]) is what the cell does
+//!    (docs/decisions.md, "Two robots with holds near their bound").
+//!
 //! Every schedule the scheduler returns passes [`crate::validate`] at its own tick
 //! (`Schedule::tick_s`); the completion is one of its candidates ([`crate::sample_schedule`]),
 //! beside the sampler and the previous or serial schedule, and the returned
