@@ -63,7 +63,9 @@ pub enum Source {
     /// [`crate::solve_exact`] on a problem with holds, planned dwells included; `N ≥ 3`: the
     /// best order of the `N`-robot search, see [`crate::exact`]) with release rules from its
     /// order of low-confidence stretches ([`Problem::with_release_rules`]), which enforce that
-    /// order at run time instead of margins.
+    /// order at run time instead of margins; for two robots also the held completion (release
+    /// rules on the switches into a run with a hold, margins on the others, every rule's wait
+    /// planned; "Margin-aware completion" in [`crate::exact`]).
     Held,
     /// `N ≥ 3` robots on their fastest warps at the least start offsets the full check accepts
     /// (greedy robot by robot, or equally spaced), tried in every re-schedule of `N ≥ 3`
@@ -630,7 +632,7 @@ fn schedule_n(
         .then_some(&incumbent.0)
         .into_iter()
         .collect();
-    let ((winner, mut stats), (bound, (done, mut checks))) = rayon::join(
+    let ((winner, mut stats), (bound, (done, mut checks), held_done)) = rayon::join(
         || {
             if baselines.completion_only {
                 (None, SamplerStats::default())
@@ -641,9 +643,14 @@ fn schedule_n(
             }
         },
         || match plan.bound {
-            BoundBy::Fastest => (exact::operator_bound(problem, n_robots), (None, 0)),
+            BoundBy::Fastest => (
+                exact::operator_bound(problem, n_robots),
+                (None, 0),
+                (None, 0),
+            ),
             BoundBy::Many => (
                 exact::bound_many(problem, n_robots, &params.exact),
+                (None, 0),
                 (None, 0),
             ),
             BoundBy::Pair => {
@@ -653,7 +660,15 @@ fn schedule_n(
                 } else {
                     (None, 0)
                 };
-                (bound, done)
+                // With hold points, the held completion: release rules instead of margins on
+                // the switches into a run with a hold, their waits planned as dwells.
+                let cap = done.0.as_ref().map_or(cap_s, |d| d.t_total_s.min(cap_s));
+                let held = if pair && bound.lower_bound_s < cap {
+                    exact::held_completion(problem, &params.exact, tick_s, cap, budget)
+                } else {
+                    (None, 0)
+                };
+                (bound, done, held)
             }
         },
     );
@@ -687,6 +702,13 @@ fn schedule_n(
         && validate(problem, &schedule).is_ok()
     {
         best = (schedule, t, Source::Completed);
+    }
+    checks += held_done.1;
+    if let Some(h) = held_done.0
+        && h.t_total_s < best.1
+        && validate(problem, &h.schedule).is_ok()
+    {
+        best = (h.schedule, h.t_total_s, Source::Held);
     }
     // With hold points, the margin-free optimum itself with release rules (for `N ≥ 3` the
     // best order the search found, proven or not).

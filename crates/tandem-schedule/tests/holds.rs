@@ -156,3 +156,69 @@ fn without_holds_nothing_changes() {
     assert!(!json.contains("holds"), "{json}");
     assert_ne!(out.source, Source::Held);
 }
+
+/// [HC ×4, LC ×4, HC ×2], gradients 1 in [0.25, 2], `Δt = 0.1` s, a hold point at sample 3.
+fn one_stretch_with_a_hold() -> Problem {
+    let conf: Vec<bool> = (0..10).map(|n| !(4..8).contains(&n)).collect();
+    Problem::new(conf, vec![1.0; 10], vec![0.25; 10], vec![2.0; 10], 0.1)
+        .unwrap()
+        .with_holds(vec![3])
+        .unwrap()
+}
+
+#[test]
+fn a_switch_into_a_stretch_with_a_hold_costs_the_fastest_travel_from_it_and_a_tick() {
+    // By hand: the LC stretch lasts L = 0.4 s, the head [0.1, 0.8] s, the tail [0.05, 0.4] s.
+    // The bound: robot 1 reaches the stretch at 0.1 s and leaves it at 0.5 s; robot 2 enters
+    // it then and ends at 0.5 + 0.4 + 0.05 = 0.95 s (= a_0 + 2L + a_m). Without a margin the
+    // order is only safe with a release rule: robot 2 waits at its hold (sample 3) until robot
+    // 1 has left the stretch and travels sample 3 in its fastest time, 0.25 · 0.1 = 0.025 s,
+    // plus one tick (0.05 s) of room for leaving the hold at a tick start: it enters at
+    // 0.575 s and ends at 1.025 s. (The margin-free optimum with the rule's wait planned after
+    // it, which the scheduler offered before, runs the head at one speed, 0.125 s a sample,
+    // and so travels 0.125 s after the wait: 1.075 s. A margin instead of the rule costs at
+    // least the largest step of a tick, 0.05 · 4 = 0.2 s: 1.15 s.)
+    let p = one_stretch_with_a_hold();
+    let params = SamplerParams {
+        samples: 200,
+        seed: 3,
+        tick_s: Some(0.05),
+        ..SamplerParams::default()
+    };
+    let out = sample_schedule_n(&p, 2, &params, None).unwrap();
+    validate(&p, &out.schedule).unwrap();
+    assert!(
+        (out.lower_bound_s - 0.95).abs() < 1e-9,
+        "{}",
+        out.lower_bound_s
+    );
+    assert!(out.bound_is_optimum);
+    assert_eq!(out.source, Source::Held);
+    assert!((out.t_total_s - 1.025).abs() < 1e-9, "{}", out.t_total_s);
+    // The robot that goes second (both may start at 0: either) runs sample 3 in 0.075 s
+    // (gradient 0.75) and waits at the hold for the other's sample 8.
+    let s = &out.schedule;
+    let w = (0..2).find(|&r| !s.holds_of(r).is_empty()).unwrap();
+    assert!(
+        (s.grad_exec[w][3] - 0.75).abs() < 1e-9,
+        "{:?}",
+        s.grad_exec[w]
+    );
+    let hold = &s.holds_of(w)[0];
+    assert_eq!(hold.ref_idx, 3);
+    assert_eq!(
+        hold.after,
+        vec![tandem_realtime::After {
+            robot: 1 - w,
+            ref_idx: 8
+        }]
+    );
+    // The plan is what the cell does: its planned wait ends as the other robot leaves the
+    // stretch.
+    let legs = s.legs(&p).unwrap();
+    assert!(
+        (legs[w][1].start_s() - 0.5).abs() < 1e-9,
+        "{}",
+        legs[w][1].start_s()
+    );
+}

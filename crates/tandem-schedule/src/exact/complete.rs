@@ -5,11 +5,11 @@
 use std::collections::BTreeMap;
 
 use rayon::prelude::*;
-use tandem_realtime::pair_slacks;
+use tandem_realtime::{pair_slacks, pair_slacks_with_holds};
 
 use super::chain::Chain;
 use super::search::{self, Clearance, Robot};
-use super::shape::shaped_schedule;
+use super::shape::{held_schedule, shaped_schedule};
 use super::stn;
 use crate::problem::Problem;
 use crate::schedule::Schedule;
@@ -42,7 +42,15 @@ pub(crate) struct Completion<'a> {
     after_start_s: f64,
     /// Piece budget of each search.
     max_pieces: usize,
+    /// The held completion ([`Completion::held`]): `chain` has the usable holds, every switch
+    /// into a run whose gap holds one is a release rule, the schedules plan their dwells.
+    held: bool,
 }
+
+/// One pair of LC regions the margin check measured: the previous robot, the runs `(j, k)` of
+/// the previous and the current region (`None` where not found), the slack (s) and the time
+/// (s) from the end of the previous region to the start of the current one on schedule.
+type Measured = (usize, Option<usize>, Option<usize>, f64, f64);
 
 /// One clearance iteration (at one tilt, from one start), resumable: its clearances, every
 /// pair's search state, the last order, the best schedule found and the checks spent.
@@ -99,7 +107,126 @@ impl<'a> Completion<'a> {
             max_step_s: tick_s * f_lc,
             after_start_s: 1e-6 * scale,
             max_pieces,
+            held: false,
         }
+    }
+
+    /// The held completion of `problem`, whose chain with its usable holds is `chain`
+    /// (`Chain::with_holds`): as [`Completion::new`], but a robot entering LC run `k` right
+    /// after the other robot's run waits for it at the hold of gap `k` (the release rule of
+    /// `tandem_realtime::holds::release_rules`) and travels from there at its fastest speeds,
+    /// so the pair's clearance is that travel and the margin check accepts it without margin;
+    /// the clearances of the other pairs are iterated on the margin check with holds as
+    /// without. Robot 2 entering the first run after robot 1's without a hold in gap 0 starts
+    /// after that run (a start rule cannot be planned as a dwell). Every schedule carries its
+    /// dwells and release rules ([`Problem::with_release_rules`]), so its `T_total` is what a
+    /// cell whose operator never corrects does.
+    pub(crate) fn held(
+        problem: &'a Problem,
+        chain: &'a Chain,
+        tick_s: f64,
+        max_pieces: usize,
+    ) -> Self {
+        Completion {
+            held: true,
+            ..Completion::new(problem, chain, tick_s, max_pieces)
+        }
+    }
+
+    /// The clearances of the release rules ([`Clearance::rules`]): per LC run `k`, the travel
+    /// (s) from the hold of gap `k` to the run as `shape::held_schedule` plans it (its fastest
+    /// plus one control tick of room, at most its slowest); `+∞` for run 0 without a hold;
+    /// `None` elsewhere. Empty for the completion without holds.
+    fn rule_clearances(&self) -> Vec<Option<f64>> {
+        if !self.held {
+            return Vec::new();
+        }
+        let dt = self.problem.dt_s();
+        let (gmin, gmax) = (self.problem.grad_min(), self.problem.grad_max());
+        (0..self.chain.n_lc())
+            .map(|k| match self.chain.gap_hold[k] {
+                Some(h) => {
+                    let run = h..self.chain.lc_ref[k].0;
+                    let fastest = gmin[run.clone()].iter().sum::<f64>() * dt;
+                    let slowest = gmax[run].iter().sum::<f64>() * dt;
+                    Some((fastest + self.tick_s).min(slowest))
+                }
+                None if k == 0 => Some(f64::INFINITY),
+                None => None,
+            })
+            .collect()
+    }
+
+    /// The schedule of `times` at `tilt`: shaped HC speeds; with holds, the planned dwells
+    /// and the release rules (`None` if they cannot be made).
+    fn schedule_of(&self, times: &stn::Times, tilt: f64) -> Option<Schedule> {
+        if !self.held {
+            return Some(shaped_schedule(
+                self.problem,
+                self.chain,
+                times,
+                tilt,
+                self.tick_s,
+            ));
+        }
+        let bare = held_schedule(self.problem, self.chain, times, tilt, self.tick_s);
+        self.problem.with_release_rules(&bare).ok()
+    }
+
+    /// Every pair's slack from the margin check (with holds, the check with holds; a pair
+    /// whose order a release rule enforces is left out), by the runs of its regions.
+    fn measure(&self, schedule: &Schedule) -> Option<Vec<Measured>> {
+        let tl = schedule.timelines(self.problem).ok()?;
+        if !self.held || !schedule.has_holds() {
+            let slacks = pair_slacks(&tl, self.tick_s).ok()?;
+            return Some(
+                slacks
+                    .iter()
+                    .filter(|s| s.slack_s < f64::INFINITY)
+                    .map(|s| {
+                        (
+                            s.prev_robot,
+                            self.lc_index(s.prev.ref_start),
+                            self.lc_index(s.cur.ref_start),
+                            s.slack_s,
+                            s.cur.start_s - s.prev.end_s,
+                        )
+                    })
+                    .collect(),
+            );
+        }
+        let slacks = pair_slacks_with_holds(&tl, &schedule.holds, self.tick_s).ok()?;
+        // The regions' runs: the check reports them on the robots' legs (a leg's samples
+        // count from its hold), found back by robot and schedule-clock start.
+        let mut run_of: BTreeMap<(usize, u64), usize> = BTreeMap::new();
+        for (r, t) in tl.iter().enumerate() {
+            let mut ref0 = 0;
+            for leg in tandem_realtime::holds::legs(t, schedule.holds_of(r)).ok()? {
+                for iv in leg.lc_intervals() {
+                    if let Some(k) = self.lc_index(iv.ref_start + ref0) {
+                        run_of.insert((r, iv.start_s.to_bits()), k);
+                    }
+                }
+                ref0 += leg.n_ref();
+            }
+        }
+        Some(
+            slacks
+                .iter()
+                .filter(|s| s.slack_s < f64::INFINITY)
+                .map(|s| {
+                    (
+                        s.prev_robot,
+                        run_of
+                            .get(&(s.prev_robot, s.prev.start_s.to_bits()))
+                            .copied(),
+                        run_of.get(&(s.cur_robot, s.cur.start_s.to_bits())).copied(),
+                        s.slack_s,
+                        s.cur.start_s - s.prev.end_s,
+                    )
+                })
+                .collect(),
+        )
     }
 
     /// The least-`T_total` schedule this completion finds that the margin check accepts and
@@ -120,13 +247,18 @@ impl<'a> Completion<'a> {
     ) -> (Option<Completed>, usize) {
         let mut trials: Vec<Trial> = Vec::new();
         if cold {
-            let all = Clearance::uniform(self.max_step_s, Some(self.after_start_s));
+            let all = Clearance {
+                rules: self.rule_clearances(),
+                ..Clearance::uniform(self.max_step_s, Some(self.after_start_s))
+            };
             trials.extend(FIRST_TILTS.iter().map(|&t| Trial::new(t, all.clone())));
         }
-        trials.extend(
-            warm.iter()
-                .filter_map(|s| Some(Trial::new(0.0, self.clearances_of(s)?))),
-        );
+        if !self.held {
+            trials.extend(
+                warm.iter()
+                    .filter_map(|s| Some(Trial::new(0.0, self.clearances_of(s)?))),
+            );
+        }
         if budget == 0 || trials.is_empty() {
             return (None, 0);
         }
@@ -226,17 +358,15 @@ impl<'a> Completion<'a> {
             else {
                 break;
             };
-            let schedule = shaped_schedule(self.problem, self.chain, &times, tilt, self.tick_s);
+            let Some(schedule) = self.schedule_of(&times, tilt) else {
+                break;
+            };
             *checks += 1;
-            let Some(slacks) = schedule
-                .timelines(self.problem)
-                .ok()
-                .and_then(|tl| pair_slacks(&tl, self.tick_s).ok())
-            else {
+            let Some(slacks) = self.measure(&schedule) else {
                 break;
             };
             let t = schedule.t_total_s(self.problem.dt_s());
-            let passes = slacks.iter().all(|s| s.slack_s > 0.0);
+            let passes = slacks.iter().all(|s| s.3 > 0.0);
             if passes && t < cap_s && best.as_ref().is_none_or(|b| t < b.t_total_s) {
                 *best = Some(Completed {
                     schedule,
@@ -249,23 +379,31 @@ impl<'a> Completion<'a> {
             // double their clearance per round.
             let mut failed = [false; 2];
             let mut raised: Vec<f64> = Vec::new();
-            for s in slacks.iter().filter(|s| s.slack_s < f64::INFINITY) {
-                let (Some(j), Some(k)) = (
-                    self.lc_index(s.prev.ref_start),
-                    self.lc_index(s.cur.ref_start),
-                ) else {
+            for &(prev_robot, j, k, slack, apart_s) in &slacks {
+                let (Some(j), Some(k)) = (j, k) else {
                     continue;
                 };
-                let slack = s.slack_s.max(-self.chain.slowest_s());
+                if clear.is_rule(k) {
+                    continue;
+                }
+                let slack = slack.max(-self.chain.slowest_s());
                 // Raise failing pairs; once all pass, lower those with room to spare.
                 let aim = slack <= 0.0 || (passes && slack > 2.0 * target);
                 let delta = clear.between(j, k);
-                let max_growth = if failed[s.prev_robot] {
+                // With holds, the clearance the schedule kept (other lags can keep the pair
+                // further apart than its clearance asks): steps start from there, not from a
+                // clearance that did not bind.
+                let delta = if self.held && apart_s.is_finite() {
+                    delta.max(apart_s)
+                } else {
+                    delta
+                };
+                let max_growth = if failed[prev_robot] {
                     2.0
                 } else {
                     f64::INFINITY
                 };
-                failed[s.prev_robot] |= slack <= 0.0;
+                failed[prev_robot] |= slack <= 0.0;
                 let next = pairs.entry((j, k)).or_insert(PairState::NEW).update(
                     delta,
                     slack,

@@ -109,6 +109,20 @@
 //!    parallel; the two most promising continue with the rest of the budget
 //!    ([`ExactParams::max_margin_checks`]).
 //!
+//! 4. **With hold points** (two robots) the completion runs a second time on the chain with
+//!    the problem's usable holds: a robot entering LC run `k` right after the other robot's
+//!    run waits at the hold of gap `k` until that run has ended (the release rule
+//!    `tandem_realtime::holds::release_rules` makes) and then travels to run `k` at its fastest
+//!    speeds, so that pair's clearance is fixed at that travel and the check accepts it without
+//!    a margin; the pairs without a hold iterate as above, on the margin check with holds,
+//!    each step starting from the room the schedule kept between the pair (other lags may keep
+//!    it further apart than its clearance). Robot 2 entering the first run after robot 1's,
+//!    without a hold in gap 0, starts after that run ends (its start rule cannot be a dwell).
+//!    The held runs' samples after the hold run fastest, the rest is spread before it and what
+//!    the slowest speeds cannot fill is a planned dwell; the release rules' waits are planned
+//!    too, so the candidate's `T_total` ([`crate::Source::Held`]) is what the cell does
+//!    (docs/decisions.md, "Two robots with holds near their bound").
+//!
 //! Every schedule the scheduler returns passes [`crate::validate`] at its own tick
 //! (`Schedule::tick_s`); the completion is one of its candidates ([`crate::sample_schedule`]),
 //! beside the sampler and the previous or serial schedule, and the returned
@@ -461,6 +475,29 @@ pub(crate) fn bound_many(problem: &Problem, n_robots: usize, params: &ExactParam
     } else {
         own
     }
+}
+
+/// The held completion (`complete::Completion::held`) of a problem with usable hold points
+/// at control tick `tick_s` (s): the best schedule with planned dwells and release rules it
+/// finds that passes the margin check and beats `cap_s` (s), with at most `budget` margin
+/// checks; with the number of checks spent. `(None, 0)` without usable holds.
+pub(crate) fn held_completion(
+    problem: &Problem,
+    params: &ExactParams,
+    tick_s: f64,
+    cap_s: f64,
+    budget: usize,
+) -> (Option<complete::Completed>, usize) {
+    if problem.usable_holds().is_empty() || budget == 0 {
+        return (None, 0);
+    }
+    let chain = bound_chain(problem, 2);
+    complete::Completion::held(problem, &chain, tick_s, params.max_pieces).run(
+        cap_s,
+        budget,
+        true,
+        &[],
+    )
 }
 
 /// The margin-aware completion (see the [module docs](self)) at control tick `tick_s` (s):

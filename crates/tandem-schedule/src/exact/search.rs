@@ -23,6 +23,14 @@ pub(crate) struct Clearance {
     /// Clearance (s) of every pair not in [`Clearance::pairs`].
     pub(crate) base: f64,
     pub(crate) after_start: Option<f64>,
+    /// Release rules (s), per LC run `k` (empty: none): `Some(c)` fixes the clearance of
+    /// every pair `(j, k)` at `c` whatever [`Clearance::pairs`] says. With hold points
+    /// (`complete.rs`, the held completion) a robot entering run `k` right after the other
+    /// robot's run waits at the hold of gap `k` until that run has ended (a release rule,
+    /// `tandem_realtime::holds::release_rules`), then travels to run `k`: `c` is that travel
+    /// at the fastest speeds; `+∞` for a run the robot entering it cannot wait for (gap 0 without
+    /// a hold: only robot 2's start may wait, by the `after_start` exception).
+    pub(crate) rules: Vec<Option<f64>>,
 }
 
 impl Clearance {
@@ -37,12 +45,21 @@ impl Clearance {
             pairs: BTreeMap::new(),
             base: base_s,
             after_start,
+            rules: Vec::new(),
         }
     }
 
     /// Clearance (s) before LC run `k` placed right after the other robot's LC run `j`.
     pub(crate) fn between(&self, j: usize, k: usize) -> f64 {
+        if let Some(&Some(rule)) = self.rules.get(k) {
+            return rule;
+        }
         self.pairs.get(&(j, k)).copied().unwrap_or(self.base)
+    }
+
+    /// Whether run `k`'s clearance is fixed by a release rule ([`Clearance::rules`]).
+    pub(crate) fn is_rule(&self, k: usize) -> bool {
+        matches!(self.rules.get(k), Some(Some(_)))
     }
 
     /// Per LC run `k ∈ 0..m`, the least clearance it can need after any run of the other robot.
@@ -51,6 +68,11 @@ impl Clearance {
         for (&(_, k), &v) in &self.pairs {
             if k < m {
                 least[k] = least[k].min(v);
+            }
+        }
+        for (k, rule) in self.rules.iter().enumerate().take(m) {
+            if let Some(v) = rule {
+                least[k] = *v;
             }
         }
         least
@@ -287,8 +309,9 @@ fn dist(p: &Piece, y: f64) -> f64 {
 }
 
 /// Cross transition: `y + min_{x ∈ [a − y, b − y]} pred(x)` for `y ≥ y_min`.
+/// An infinite `y_min` (a pair a release rule forbids) gives the empty function.
 fn cross(pred: &[Piece], a: f64, b: f64, y_min: f64) -> Vec<Piece> {
-    if pred.is_empty() {
+    if pred.is_empty() || y_min == f64::INFINITY {
         return Vec::new();
     }
     let r = pl::reflect(pred);

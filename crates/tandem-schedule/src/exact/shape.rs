@@ -49,6 +49,70 @@ pub(crate) fn shaped_schedule(
     }
 }
 
+/// [`shaped_schedule`] with hold points (`chain` built by `Chain::with_holds`): each HC run
+/// that holds a usable hold `h` (`chain.gap_hold`) travels from `h` to the next LC run in one
+/// control tick `tick_s` more than its fastest speeds need (at one speed factor; all of the
+/// run's slowest if shorter), so that a release rule on `h` costs that travel after the awaited
+/// run ends (`Clearance::rules` counts the same), and spreads the rest of its duration over
+/// the samples before `h` (shaped at the tilt); what their slowest speeds cannot fill is a
+/// planned dwell at `h`. Returns the schedule with its dwells as holds (no release rules yet).
+///
+/// **Why a tick more than the fastest travel.** A robot leaves its hold at a tick start, up to
+/// a tick after the awaited robot has passed. Planned at its fastest it could not make that
+/// up, and since the pace of Alg. 1 is the clock every running robot can reach, its lag holds
+/// the other robot back too, whose next release is then late in turn: along the switches of
+/// a round the ticks add up (+1.1–1.5 % over the plan on random problems with holds,
+/// `tandem-sim`'s `plan_is_what_the_cell_does`). With a tick of room it runs its fastest and
+/// reaches the LC run on time.
+pub(crate) fn held_schedule(
+    problem: &Problem,
+    chain: &Chain,
+    times: &Times,
+    tilt: f64,
+    tick_s: f64,
+) -> Schedule {
+    let mut schedule = shaped_schedule(problem, chain, times, tilt, tick_s);
+    let dt = problem.dt_s();
+    let (gmin, gmax) = (problem.grad_min(), problem.grad_max());
+    let sum = |v: &[f64], a: usize, b: usize| v[a..b].iter().sum::<f64>() * dt;
+    let mut holds: Vec<Vec<tandem_realtime::Hold>> = vec![Vec::new(); 2];
+    for (r, robot_holds) in holds.iter_mut().enumerate() {
+        let gaps = times.gaps_s(chain, r);
+        let warp = &mut schedule.grad_exec[r];
+        for (g, &(a, b)) in chain.gap_ref.iter().enumerate() {
+            let Some(h) = chain.gap_hold[g] else {
+                continue;
+            };
+            let (pre_min, pre_max) = (sum(gmin, a, h), sum(gmax, a, h));
+            let travel_s = (sum(gmin, h, b) + tick_s).min(sum(gmax, h, b));
+            // A run too short for the travel with its room and the fastest samples before the
+            // hold (it cannot be shorter than both at their fastest) travels with less room.
+            let travel_s = travel_s.min(gaps[g] - pre_min).max(sum(gmin, h, b));
+            let pre_s = (gaps[g] - travel_s).clamp(pre_min, pre_max);
+            fill_uniform(problem, &mut warp[h..b], h, travel_s);
+            Body {
+                problem,
+                start: a,
+                end: h,
+                tilt,
+            }
+            .fill_run(&mut warp[a..h], pre_s);
+            let filled_s = tandem_realtime::clock_end_s(&warp[a..b], 0.0, dt);
+            let dwell_s = gaps[g] - filled_s;
+            if dwell_s > 0.0 {
+                robot_holds.push(tandem_realtime::Hold {
+                    dwell_s,
+                    ..tandem_realtime::Hold::at(h)
+                });
+            }
+        }
+    }
+    if holds.iter().any(|h| !h.is_empty()) {
+        schedule.holds = holds;
+    }
+    schedule
+}
+
 /// An HC run: reference samples `start..end` with a tilted speed factor.
 struct Body<'a> {
     problem: &'a Problem,
@@ -208,6 +272,50 @@ mod tests {
                     assert!(u(16) > u(44), "tilt {tilt}: {} ≤ {}", u(16), u(44));
                 }
             }
+        }
+    }
+
+    #[test]
+    fn a_held_run_travels_from_its_hold_with_a_tick_of_room_and_dwells_the_rest() {
+        // [HC ×4, LC ×4, HC ×2], gradients 1 in [0.5, 2], 0.1 s, a hold at sample 3, a tick of
+        // 0.05 s: the head of robot 2 lasts 1.5 s. Sample 3 (after the hold) in its fastest
+        // 0.05 s plus a tick, 0.1 s (gradient 1); samples 0..3 at most 3 · 0.2 = 0.6 s; the
+        // rest, 1.5 − 0.7 = 0.8 s, is the dwell at 3. Robot 1's head of 0.2 s is too short for
+        // the room: 0.15 + 0.05 s, every sample fastest, no dwell.
+        let conf: Vec<bool> = (0..10).map(|n| !(4..8).contains(&n)).collect();
+        let p = Problem::new(conf, vec![1.0; 10], vec![0.5; 10], vec![2.0; 10], 0.1)
+            .unwrap()
+            .with_holds(vec![3])
+            .unwrap();
+        let chain = Chain::with_holds(&p, 10.0);
+        assert_eq!(chain.gap_hold, vec![Some(3), None]);
+        let times = stn::Times {
+            tau_s: 0.0,
+            lc_start_s: [vec![0.2], vec![1.5]],
+            end_s: [0.7, 2.0],
+        };
+        for tilt in [0.0, 0.5] {
+            let s = held_schedule(&p, &chain, &times, tilt, 0.05);
+            let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9);
+            assert!(
+                close(&s.grad_exec[1][..4], &[2.0, 2.0, 2.0, 1.0]),
+                "{:?}",
+                s.grad_exec[1]
+            );
+            assert!(
+                close(&s.grad_exec[0][..4], &[0.5; 4]),
+                "{:?}",
+                s.grad_exec[0]
+            );
+            assert!(s.holds[0].is_empty());
+            assert_eq!(s.holds[1].len(), 1);
+            assert_eq!(s.holds[1][0].ref_idx, 3);
+            assert!(
+                (s.holds[1][0].dwell_s - 0.8).abs() < 1e-9,
+                "{:?}",
+                s.holds[1]
+            );
+            assert!((s.t_total_s(0.1) - 2.0).abs() < 1e-9);
         }
     }
 }

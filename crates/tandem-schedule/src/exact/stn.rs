@@ -131,6 +131,10 @@ fn solve(chain: &Chain, order: &[Robot], clear: &Clearance, after_start: bool) -
             } else {
                 end_prev + clear.between(pk, k)
             };
+            if w == f64::INFINITY {
+                // A pair a release rule forbids (`Clearance::rules`).
+                return None;
+            }
             edges.push(Edge {
                 from: lc(pr, pk),
                 to: lc(r, k),
