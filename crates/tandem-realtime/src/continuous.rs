@@ -749,8 +749,8 @@ impl ContinuousCoordinator {
     /// completing tasks: between two of a robot's services another robot is served at most
     /// `(N − 1)·G` times (`G` the most groups a plan has), the bound and its proof in
     /// docs/decisions.md, "Hand-over liveness". Allocates (the rotated
-    /// sequence); O(N·len) for a token sequence of `len` entries, plus O(log T_ref) per robot
-    /// to place its cursors (a few microseconds for `N ≤ 8`, `benches/cyclic.rs` in
+    /// sequence); O(N + len) for a token sequence of `len` entries, plus O(log T_ref) per
+    /// robot to place its cursors (a few microseconds for `N ≤ 8`, `benches/cyclic.rs` in
     /// tandem-schedule).
     ///
     /// # Errors
