@@ -53,8 +53,9 @@
 //! reaches the token's gate (it runs on high-confidence samples at least at `S·tick_s > 0`
 //! per tick) and leaves the group (the operator's rate is at least `S` too). No deadlock.
 //! Across hand-overs to new plans ([`ContinuousCoordinator::take_over`]) the token goes to the
-//! robot served least recently, so however often the plan changes, between two of a robot's
-//! passages through a group another robot passes at most `(N − 1)·G` groups (`G` per task):
+//! robot whose turn it was, or to the robot served least recently once one has waited a
+//! whole pass, so however often the plan changes, between two of a robot's passages through
+//! a group another robot passes at most `(2N − 1)·G` groups (`G` per task):
 //! docs/decisions.md, "Hand-over liveness".
 //!
 //! **The period.** Under the planned operator (`Operator::Scheduled`) the cell settles into
@@ -740,14 +741,17 @@ impl ContinuousCoordinator {
     /// executions: the latch makes it so), since then each robot is at most at its old next
     /// gate, which is at or before its new one; a caller tries each tick until it succeeds.
     ///
-    /// The new plan's token goes to the robot served least recently (the one whose last
-    /// group, in whichever plan, was left the longest ago; a robot never served ranks by its
-    /// first token at the start): the token sequence is rotated to start at that robot's
-    /// entry for its next group (or group 0 of its next task), and in the first pass a
-    /// robot's entries before its next group's are skipped, as at the start
+    /// The new plan's token goes to the robot whose turn it was in the old plan (its token's
+    /// robot), so the plan's flow goes on; but once some robot has seen `(N − 1)·G` services
+    /// of others (`G` the new plan's groups per task; a service is the token moving on after
+    /// its robot left a group) since its own last one, to the robot served least recently
+    /// (the one whose last group, in whichever plan, was left the longest ago; a robot never
+    /// served ranks by its first token at the start). The token sequence is rotated to start
+    /// at that robot's entry for its next group (or group 0 of its next task), and in the
+    /// first pass a robot's entries before its next group's are skipped, as at the start
     /// ([`token_sequence`]). So however often the plan is handed over, every robot keeps
     /// completing tasks: between two of a robot's services another robot is served at most
-    /// `(N − 1)·G` times (`G` the most groups a plan has), the bound and its proof in
+    /// `(2N − 1)·G` times (`G` the most groups a plan has), the bound and its proof in
     /// docs/decisions.md, "Hand-over liveness". Allocates (the rotated
     /// sequence); O(N + len) for a token sequence of `len` entries, plus O(log T_ref) per
     /// robot to place its cursors (a few microseconds for `N ≤ 8`, `benches/cyclic.rs` in
@@ -815,11 +819,19 @@ impl ContinuousCoordinator {
         let len = self.tokens.len();
         // The robot's first token: its next group, or group 0 of its next task.
         let wants = |t: &Token| t.group == next[t.robot] % n_groups.max(1);
-        // The token goes to the least recently served robot (fairness: docs/decisions.md,
-        // "Hand-over liveness"): the sequence starts at its first token.
+        // The token goes to the robot whose turn it was in the old plan (the plan's flow
+        // goes on), unless some robot has seen a whole pass's worth of others' services,
+        // `(N − 1)·G`, since its own last one: then to the least recently served robot
+        // (fairness: docs/decisions.md, "Hand-over liveness"). The sequence starts at the
+        // chosen robot's first token.
         let lru = (0..self.n)
             .min_by_key(|&r| old.served[r])
             .expect("N ≥ 1 robots");
+        let waited = old.stamp - 1 - old.served[lru];
+        let lru = match old.token() {
+            Some(t) if waited < ((self.n - 1) * n_groups) as u64 => t.robot,
+            _ => lru,
+        };
         let start = (0..len)
             .find(|&q| self.tokens[q].robot == lru && wants(&self.tokens[q]))
             .unwrap_or(0);

@@ -3,9 +3,9 @@
 //! groups ([`ContinuousCoordinator::take_over`]), whatever the operator does, every robot
 //! keeps completing tasks, within the proven bounds:
 //! - between two consecutive services of robot `i` (its token moving on after it left a
-//!   group), another robot is served at most `(N − 1)·G` times (`G` groups per task);
+//!   group), another robot is served at most `(2N − 1)·G` times (`G` groups per task);
 //! - in a run of ticks in which robot `i` completes no task (up to and including the tick of
-//!   its next completion), another robot completes at most `(G + 1)(N − 1) + 1` tasks.
+//!   its next completion), another robot completes at most `(G + 1)(2N − 1) + 1` tasks.
 //!
 //! The property test runs random cells (N = 2…6, tasks with and without holds, three random
 //! runnable orders of the same task to switch between) under every policy of the adversary
@@ -70,8 +70,8 @@ fn run(
     let mut cell = plans[0].clone();
     let n = cell.n_robots();
     let (n64, g64) = (n as u64, g as u64);
-    let service_bound = (n64 - 1) * g64;
-    let task_bound = (g64 + 1) * (n64 - 1) + 1;
+    let service_bound = (2 * n64 - 1) * g64;
+    let task_bound = (g64 + 1) * (2 * n64 - 1) + 1;
     let policy_of = match adversary {
         Adversary::Beam { .. } => Adversary::SwitchFavourite { max_hold: 50 },
         other => other,
@@ -100,7 +100,7 @@ fn run(
                     prop_assert!(
                         row[j] <= service_bound,
                         "{replan:?} {adversary:?}, tick {k}: robot {j} served {} times since \
-                         robot {i} was (bound (N − 1)·G = {service_bound})",
+                         robot {i} was (bound (2N − 1)·G = {service_bound})",
                         row[j]
                     );
                 }
@@ -119,7 +119,7 @@ fn run(
                     prop_assert!(
                         row[j] <= task_bound,
                         "{replan:?} {adversary:?}, tick {k}: robot {j} completed {} tasks \
-                         while robot {i} completed none (bound (G + 1)(N − 1) + 1 = \
+                         while robot {i} completed none (bound (G + 1)(2N − 1) + 1 = \
                          {task_bound}); tasks {:?}",
                         row[j],
                         cell.tasks_completed()
@@ -174,8 +174,8 @@ fn a_plan_handed_over_to_itself_after_every_task_starves_no_robot() {
     // 2; each robot takes 3 ticks per task (to the stretch, across it, to the end), one after
     // the other, so robot r completes at ticks 2 + 3r + 9k: 1111 tasks each in 10 000 ticks.
     // Handed over to the same plan after every completed task, the old rule gave the token
-    // back to robot 0 every time (the lowest position of a tie): [3333, 0, 0]. The least
-    // recently served robot gets it: the plan's own rhythm, tick for tick.
+    // back to robot 0 every time (the lowest position of a tie): [3333, 0, 0]. The robot
+    // whose turn it was gets it: the plan's own rhythm, tick for tick.
     let plan = ContinuousCoordinator::new(three_samples(), &[], &[(0, 0), (1, 0), (2, 0)], 3, 1.0)
         .unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(40);
@@ -211,11 +211,12 @@ fn a_plan_handed_over_to_itself_after_every_task_starves_no_robot() {
 }
 
 #[test]
-fn alternating_orders_that_follow_the_old_turn_would_starve_robot_2() {
+fn alternating_orders_that_followed_only_the_old_turn_would_starve_robot_2() {
     // Two plans of the three-sample task with the orders 0, 1, 2 and 0, 2, 1, switched after
     // every task. Following the old plan's turn, robots 0 and 1 alternate for ever and robot
     // 2 never moves (after 0: turn 1 in the first plan; in the second, 1 then 0; in the
-    // first, 0 then 1; …). The least recently served robot is 2 after 0 and 1: round robin.
+    // first, 0 then 1; …). Once robot 2 has seen (N − 1)·G = 2 services of others since its
+    // last, the token goes to it as the least recently served robot: round robin.
     let task = three_samples();
     let a =
         ContinuousCoordinator::new(task.clone(), &[], &[(0, 0), (1, 0), (2, 0)], 3, 1.0).unwrap();
@@ -366,10 +367,10 @@ fn cell_is_fair(seed: u64, n: usize, worst: &mut Worst) -> Result<(), TestCaseEr
         prop_assert!(min >= 1, "{replan:?} {a:?}: {:?}", seen.tasks);
         worst.services = worst
             .services
-            .max(seen.worst_services as f64 / ((nf - 1.0) * g));
+            .max(seen.worst_services as f64 / ((2.0 * nf - 1.0) * g));
         worst.tasks = worst
             .tasks
-            .max(seen.worst_tasks as f64 / ((g + 1.0) * (nf - 1.0) + 1.0));
+            .max(seen.worst_tasks as f64 / ((g + 1.0) * (2.0 * nf - 1.0) + 1.0));
         worst.runs += 1;
         worst.hand_overs += seen.hand_overs;
     }
