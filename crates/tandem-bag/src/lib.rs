@@ -14,8 +14,9 @@
 //!   one) at a chosen rate (default: the rate of the slowest topic that is interpolated,
 //!   every type but `Bool`, its period snapped as for a CSV `t` column, and
 //!   [`Recording::grid_note`] says which topic that was; an execution: the model's `Δt_s`)
-//!   and interpolates each topic onto it: linearly, orientations by slerp, `Bool` flags
-//!   held. Times are header stamps (log times where there is no header). A gap
+//!   and interpolates each topic onto it by the one resampling policy of
+//!   `tandem_lfd::resample` (as CSV logs and executions): linearly, orientations by slerp,
+//!   flags (`Bool`, any channel whose every value is 0 or 1) held. Times are header stamps (log times where there is no header). A gap
 //!   or a late start or early end of more than [`GAP_FACTOR`] × a topic's median period is an
 //!   error, not interpolated across.
 //! - **Writing** ([`RunWriter`], [`BagWriter`], [`write_demonstration`]). A simulated run

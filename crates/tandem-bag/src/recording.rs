@@ -9,8 +9,9 @@ use tandem_planner::ExecutionRecord;
 
 use crate::msg::MsgType;
 use crate::read::{RawTopic, Role, SCHEDULE_TOPIC, Selection, Series, read_topics, series, under};
-use crate::resample::{Grid, Interp, grid, resample_into};
+use crate::resample::{Grid, grid, resample_into};
 use crate::{Error, Result};
+use tandem_lfd::resample::{Interpolation, is_flag};
 
 /// How to read a bag as a demonstration.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -219,18 +220,22 @@ pub fn extend_schema(schema: &mut ChannelSchema, recordings: &[Recording]) {
     }
 }
 
-/// The resampling plan of a topic's columns.
-fn plan(t: &RawTopic) -> Vec<Interp> {
-    match t.msg_type {
-        Some(MsgType::PoseStamped) => vec![
-            Interp::Linear,
-            Interp::Linear,
-            Interp::Linear,
-            Interp::Slerp,
-        ],
-        Some(MsgType::Bool) => vec![Interp::Hold],
-        _ => vec![Interp::Linear; t.width()],
-    }
+/// How a topic's columns are resampled (series `s` of topic `t`): the one policy of
+/// [`tandem_lfd::resample`], a pose's orientation as its quaternion block, a column whose
+/// every value is 0 or 1 (a `Bool`, say) held.
+fn plan(t: &RawTopic, s: &Series) -> Interpolation {
+    let w = t.width();
+    let quats: &[[usize; 4]] = match t.msg_type {
+        Some(MsgType::PoseStamped) => &[[3, 4, 5, 6]],
+        _ => &[],
+    };
+    let flags: Vec<usize> = (0..w)
+        .filter(|&c| {
+            !quats.iter().flatten().any(|&d| d == c)
+                && is_flag(s.values.iter().skip(c).step_by(w).copied())
+        })
+        .collect();
+    Interpolation::new(w, &flags, quats).expect("a topic's columns")
 }
 
 /// The description of topic `t` read as `s` (or not read).
@@ -315,7 +320,7 @@ fn grid_topics(
     let mut offset = 0;
     for (s, &k) in series.iter().zip(chosen) {
         let w = topics[k].width();
-        resample_into(s, w, &plan(&topics[k]), &g, &mut values, width, offset);
+        resample_into(s, w, &plan(&topics[k], s), &g, &mut values, width, offset);
         blocks.push((offset, w));
         offset += w;
     }
@@ -416,7 +421,8 @@ fn round_hz(hz: f64) -> f64 {
 /// all zero). The grid runs from the latest first message to the earliest last one at
 /// `rate_hz` (default: the rate of the slowest topic that is interpolated, see
 /// [`BagOptions::rate_hz`] and [`Recording::grid_note`]); values are interpolated linearly,
-/// orientations by slerp, `Bool` flags held.
+/// orientations by slerp, flags (`Bool`, any channel whose every value is 0 or 1) held: the
+/// one resampling policy of [`tandem_lfd::resample`], as for CSV logs.
 ///
 /// # Errors
 /// The file cannot be read or is not MCAP ([`Error::NotMcap`]), is truncated or corrupt; a

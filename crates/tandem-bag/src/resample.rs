@@ -1,5 +1,9 @@
 //! Topics of different rates onto one grid: the grid over the span every topic covers, and
-//! per column linear interpolation, slerp for a quaternion, or sample-and-hold for a flag.
+//! the one resampling policy of tandem-lfd ([`tandem_lfd::resample`]: linear, slerp for a
+//! quaternion, the earlier value held for a flag), so a bag and a CSV file of one recording
+//! give the same samples.
+
+use tandem_lfd::resample::Interpolation;
 
 use crate::read::Series;
 use crate::{Error, GAP_FACTOR, Result};
@@ -9,18 +13,6 @@ use crate::{Error, GAP_FACTOR, Result};
 /// the messages' own period (a run tandem wrote, an execution at the model's period) would
 /// otherwise mix in a 1e-7 share of the neighbouring message from rounding alone.
 pub const SNAP_NS: i64 = 1_000;
-
-/// How one group of columns is resampled.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Interp {
-    /// Linear interpolation between the two messages around the grid time.
-    Linear,
-    /// The last message at or before the grid time (a flag holds until it changes).
-    Hold,
-    /// Four columns `x, y, z, w` of a unit quaternion: spherical linear interpolation on the
-    /// shorter arc, in the earlier message's hemisphere.
-    Slerp,
-}
 
 /// The grid: `n` times `t0 + round(j · period_ns)` (ns), `j = 0..n`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -109,13 +101,13 @@ pub(crate) fn grid(series: &[&Series], names: &[&str], file: &str, period_ns: f6
     Ok(g)
 }
 
-/// Resamples one series (`width` columns, resampled group by group as `plan` says: each
-/// entry covers 1 column, 4 for [`Interp::Slerp`]) onto `grid`, writing its columns at
-/// `offset` of every row of `out` (`grid.n` rows of `row_width`).
+/// Resamples one series (`width` columns, interpolated as `plan` says) onto `grid`, writing
+/// its columns at `offset` of every row of `out` (`grid.n` rows of `row_width`). A grid time
+/// within [`SNAP_NS`] of a message takes its values as they are.
 pub(crate) fn resample_into(
     s: &Series,
     width: usize,
-    plan: &[Interp],
+    plan: &Interpolation,
     grid: &Grid,
     out: &mut [f64],
     row_width: usize,
@@ -142,48 +134,8 @@ pub(crate) fn resample_into(
             continue;
         }
         let f = (t - times[k]) as f64 / (times[k + 1] - times[k]) as f64;
-        let mut c = 0;
-        for interp in plan {
-            match interp {
-                Interp::Linear => {
-                    row[c] = a[c] + f * (b[c] - a[c]);
-                    c += 1;
-                }
-                Interp::Hold => {
-                    row[c] = a[c];
-                    c += 1;
-                }
-                Interp::Slerp => {
-                    let q = slerp(&a[c..c + 4], &b[c..c + 4], f);
-                    row[c..c + 4].copy_from_slice(&q);
-                    c += 4;
-                }
-            }
-        }
+        plan.row(a, b, f, row);
     }
-}
-
-/// Spherical linear interpolation from unit quaternion `a` (at `f = 0`) to `b` (at `f = 1`)
-/// along the shorter arc; the result is normalized and in `a`'s hemisphere.
-pub(crate) fn slerp(a: &[f64], b: &[f64], f: f64) -> [f64; 4] {
-    let norm = |q: [f64; 4]| {
-        let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-        q.map(|x| x / n)
-    };
-    let a = norm([a[0], a[1], a[2], a[3]]);
-    let mut b = norm([b[0], b[1], b[2], b[3]]);
-    let mut dot: f64 = (0..4).map(|i| a[i] * b[i]).sum();
-    if dot < 0.0 {
-        b = b.map(|x| -x);
-        dot = -dot;
-    }
-    if dot > 1.0 - 1e-12 {
-        return norm([0, 1, 2, 3].map(|i| a[i] + f * (b[i] - a[i])));
-    }
-    let theta = dot.min(1.0).acos();
-    let s = theta.sin();
-    let (wa, wb) = (((1.0 - f) * theta).sin() / s, (f * theta).sin() / s);
-    norm([0, 1, 2, 3].map(|i| wa * a[i] + wb * b[i]))
 }
 
 #[cfg(test)]
@@ -210,7 +162,8 @@ mod tests {
         let g = grid(&[&s], &["a"], "f", 5e6).unwrap();
         assert_eq!(g.n, 5);
         let mut out = vec![0.0; 10];
-        resample_into(&s, 2, &[Interp::Linear, Interp::Hold], &g, &mut out, 2, 0);
+        let plan = Interpolation::new(2, &[1], &[]).unwrap();
+        resample_into(&s, 2, &plan, &g, &mut out, 2, 0);
         assert_eq!(out, [0.0, 1.0, 5.0, 1.0, 10.0, 20.0, 7.0, 20.0, 4.0, 0.0]);
     }
 
@@ -219,29 +172,9 @@ mod tests {
         let s = series(&[0, 10_000_001, 20_000_000], &[0.1, 0.2, 0.3]);
         let g = grid(&[&s], &["a"], "f", 1e7).unwrap();
         let mut out = vec![0.0; 3];
-        resample_into(&s, 1, &[Interp::Linear], &g, &mut out, 1, 0);
+        let plan = Interpolation::new(1, &[], &[]).unwrap();
+        resample_into(&s, 1, &plan, &g, &mut out, 1, 0);
         assert_eq!(out, [0.1, 0.2, 0.3]);
-    }
-
-    #[test]
-    fn slerp_halfway_is_the_half_angle_and_takes_the_short_arc() {
-        let h = std::f64::consts::FRAC_1_SQRT_2;
-        // Identity to 90° about z: halfway is 45° about z.
-        let q = slerp(&[0.0, 0.0, 0.0, 1.0], &[0.0, 0.0, h, h], 0.5);
-        let (s, c) = (
-            std::f64::consts::FRAC_PI_8.sin(),
-            std::f64::consts::FRAC_PI_8.cos(),
-        );
-        assert!(
-            (q[2] - s).abs() < 1e-12 && (q[3] - c).abs() < 1e-12,
-            "{q:?}"
-        );
-        // The same rotation given as −q: still the short way, in a's hemisphere.
-        let q2 = slerp(&[0.0, 0.0, 0.0, 1.0], &[0.0, 0.0, -h, -h], 0.5);
-        assert!(
-            (q2[2] - s).abs() < 1e-12 && (q2[3] - c).abs() < 1e-12,
-            "{q2:?}"
-        );
     }
 
     #[test]

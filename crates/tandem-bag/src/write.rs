@@ -16,8 +16,9 @@ use crate::msg::{
     TwoVectorsStamped, Vector3,
 };
 use crate::read::{FIELDS_KEY, ROLE_KEY, Role};
-use crate::resample::{Grid, Interp, resample_into};
+use crate::resample::{Grid, resample_into};
 use crate::{Error, Result};
+use tandem_lfd::resample::{Interpolation, is_flag};
 
 /// One message to write.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -488,9 +489,9 @@ pub fn write_demonstration(
             },
         };
         let mut all = vec![0.0; grid.n * m];
-        // Orientation channels of a pose are slerped as a block when they are consecutive in
-        // the demonstration; otherwise linearly and renormalized below.
-        let plan = slerp_plan(vec![Interp::Linear; m], spec, &cols);
+        // The one resampling policy (`tandem_lfd::resample`): a pose's orientation channels
+        // by slerp as a block (when all four are given), 0/1 channels held, the rest linear.
+        let plan = write_plan(demo, spec, &cols)?;
         resample_into(&demo_series, m, &plan, &grid, &mut all, m, 0);
         // No tandem metadata: the bag looks like any rosbag2 recording, and its channels are
         // named from the topics.
@@ -536,23 +537,26 @@ pub fn write_demonstration(
     bag.finish()
 }
 
-/// `plan` (one linear entry per demonstration channel) with the four orientation channels of
-/// a pose spec replaced by one slerp entry when they are consecutive `x, y, z, w` channels.
-fn slerp_plan(plan: Vec<Interp>, spec: &TopicSpec, cols: &[Option<usize>]) -> Vec<Interp> {
-    if spec.msg_type != MsgType::PoseStamped {
-        return plan;
-    }
-    let (Some(a), Some(b), Some(c), Some(d)) = (cols[3], cols[4], cols[5], cols[6]) else {
-        return plan;
+/// How the demonstration's channels are resampled for topic `spec` (channel `cols[c]` for
+/// the topic's column `c`): the one policy of [`tandem_lfd::resample`], the pose's
+/// orientation channels as one quaternion block when all four are given.
+fn write_plan(
+    demo: &Demonstration,
+    spec: &TopicSpec,
+    cols: &[Option<usize>],
+) -> Result<Interpolation> {
+    let m = demo.n_channels();
+    let quats: Vec<[usize; 4]> = match (spec.msg_type, cols.get(3..7)) {
+        (MsgType::PoseStamped, Some(&[Some(a), Some(b), Some(c), Some(d)])) => vec![[a, b, c, d]],
+        _ => Vec::new(),
     };
-    if !(b == a + 1 && c == a + 2 && d == a + 3) {
-        return plan;
-    }
-    let mut out = Vec::with_capacity(plan.len() - 3);
-    out.extend_from_slice(&plan[..a]);
-    out.push(Interp::Slerp);
-    out.extend_from_slice(&plan[a + 4..]);
-    out
+    let flags: Vec<usize> = (0..m)
+        .filter(|&c| {
+            !quats.iter().flatten().any(|&d| d == c)
+                && is_flag((0..demo.n_samples()).map(|k| demo.sample(k)[c]))
+        })
+        .collect();
+    Ok(Interpolation::new(m, &flags, &quats)?)
 }
 
 /// The metadata of a tandem-written topic: its channel names and its role.

@@ -222,7 +222,9 @@ pub(crate) struct FitArgs {
     /// Resample CSV demonstrations with an irregular `t` column (dropped samples, a drifting
     /// logger) onto an even grid: period --dt, or each file's logger period (the span over
     /// its steps, each counted in median steps); channels are
-    /// interpolated linearly, 0/1 channels held; a gap over 3 periods is refused. Without it,
+    /// interpolated linearly, quaternions (`qx, qy, qz, qw`) by slerp, 0/1 channels held (the
+    /// one resampling policy, as for executions and bags); a gap over 3 periods is refused.
+    /// Without it,
     /// a `t` column must stay within 25 % of a period of its even grid.
     #[arg(long)]
     pub(crate) resample: bool,

@@ -8,6 +8,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::csv::CsvTable;
+use crate::resample::{self, Interpolation};
 use crate::{Error, Result};
 
 /// Sample period used when a file carries neither a `t` column nor a `dt_s` field and the
@@ -532,8 +533,11 @@ impl Demonstration {
     /// (each step counted as its whole number of median steps, at least one, so a dropped
     /// sample counts two and jitter averages out), snapped like [`period_from_times`].
     /// Every channel is interpolated
-    /// linearly between the two neighbouring rows, except a channel whose every value is 0
-    /// or 1 (an on/off signal), which holds the earlier row's value. Returns the
+    /// linearly between the two neighbouring rows, except a quaternion block of the default
+    /// [`ChannelSchema`] (`qx, qy, qz, qw`), interpolated by slerp, and a channel whose every
+    /// value is 0 or 1 (an on/off signal), which holds the earlier row's value: the one
+    /// resampling policy ([`crate::resample`]; a row within 1e-9 of a step from a grid time
+    /// is taken as it is). Returns the
     /// demonstration and a sentence saying what was done (for a note).
     ///
     /// Errors: as [`Demonstration::from_csv_str`] for the table and values; no `t` column;
@@ -562,6 +566,21 @@ impl Demonstration {
     /// # Errors
     /// As [`Demonstration::from_csv_str_resampled`].
     pub fn regrid_csv_str(text: &str, file: &str, dt_s: Option<f64>) -> Result<Regridded> {
+        Self::regrid_csv_str_with(text, file, dt_s, &ChannelSchema::default())
+    }
+
+    /// [`Demonstration::regrid_csv_str`] with the quaternion blocks of `schema` (the
+    /// default's is `qx, qy, qz, qw`) interpolated by slerp: the one resampling policy
+    /// ([`crate::resample`]), as for executions and bags.
+    ///
+    /// # Errors
+    /// As [`Demonstration::from_csv_str_resampled`].
+    pub fn regrid_csv_str_with(
+        text: &str,
+        file: &str,
+        dt_s: Option<f64>,
+        schema: &ChannelSchema,
+    ) -> Result<Regridded> {
         let table = CsvTable::parse(text, file)?;
         if let Some(j) = table
             .names()
@@ -675,10 +694,13 @@ impl Demonstration {
             }
             values.push(v);
         }
-        let binary: Vec<bool> = values
-            .iter()
-            .map(|v| v.iter().all(|&x| x == 0.0 || x == 1.0))
-            .collect();
+        // The one resampling policy: quaternion blocks of the schema by slerp, 0/1 channels
+        // held, the rest linear (`crate::resample`).
+        let policy = Interpolation::for_channels(&names, schema, |c| {
+            resample::is_flag(values[c].iter().copied())
+        });
+        let width = cols.len();
+        let (mut ra, mut rb, mut row) = (vec![0.0; width], vec![0.0; width], vec![0.0; width]);
         let t0 = times[0];
         let count = ((times[n - 1] - t0) / period + 1e-9).floor() as usize + 1;
         let mut samples = Vec::with_capacity(count * cols.len());
@@ -695,13 +717,10 @@ impl Demonstration {
             segments.push((seg, u));
             nearest.push(if u < 0.5 { seg } else { seg + 1 });
             for (c, v) in values.iter().enumerate() {
-                let (a, b) = (v[seg], v[seg + 1]);
-                samples.push(if binary[c] {
-                    if u >= 1.0 { b } else { a }
-                } else {
-                    a + u * (b - a)
-                });
+                (ra[c], rb[c]) = (v[seg], v[seg + 1]);
             }
+            policy.row(&ra, &rb, u, &mut row);
+            samples.extend_from_slice(&row);
         }
         let mut demo = Self::new(names, samples, period)?
             .with_source(file)
@@ -713,7 +732,7 @@ impl Demonstration {
         });
         let note = format!(
             "{file}: resampled {n} rows (steps {} – {} s) onto {count} samples {} s apart ({} \
-             Hz), channels interpolated linearly, 0/1 channels held",
+             Hz), channels interpolated linearly, quaternions by slerp, 0/1 channels held",
             round_s(steps[0]),
             round_s(steps[steps.len() - 1]),
             round_s(period),

@@ -78,6 +78,7 @@ mod demo;
 mod error;
 mod model;
 mod quat;
+pub mod resample;
 
 pub use checks::{
     END_RUN_MOTION_SHARE, END_RUN_REFUSE_SHARE, END_RUN_SLOPE_TOLERANCE, LENGTH_REFUSE_RATIO,

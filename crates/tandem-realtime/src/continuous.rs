@@ -52,6 +52,11 @@
 //! next task), which is the order in which it reaches its gates; so the token's robot always
 //! reaches the token's gate (it runs on high-confidence samples at least at `S·tick_s > 0`
 //! per tick) and leaves the group (the operator's rate is at least `S` too). No deadlock.
+//! Across hand-overs to new plans ([`ContinuousCoordinator::take_over`]) the token goes to the
+//! robot whose turn it was, or to the robot served least recently once one has waited a
+//! whole pass, so however often the plan changes, between two of a robot's passages through
+//! a group another robot passes at most `(2N − 1)·G` groups (`G` per task):
+//! docs/decisions.md, "Hand-over liveness".
 //!
 //! **The period.** Under the planned operator (`Operator::Scheduled`) the cell settles into
 //! the cyclic plan's rhythm minus what the rule costs: a robot starts moving from its gate only
@@ -383,6 +388,14 @@ pub struct ContinuousCoordinator {
     pos: usize,
     /// Completed passes through the token sequence.
     passes: u64,
+    /// Per robot, the stamp of its last *service* (the token moving on after it left a
+    /// group): larger is more recent. Before its first service a robot's stamp is its rank
+    /// among the robots' first tokens at the start (`0..N`); services stamp `N, N + 1, …`.
+    /// Carried over by [`take_over`](Self::take_over), which gives the new plan's token to
+    /// the least recently served robot (liveness, docs/decisions.md).
+    served: [u64; MAX_ROBOTS],
+    /// The next service's stamp.
+    stamp: u64,
     ticks: u64,
     lc_since: [u64; MAX_ROBOTS],
     lc_last: RobotFlags,
@@ -446,6 +459,8 @@ impl ContinuousCoordinator {
             cursors: [Cursors::default(); MAX_ROBOTS],
             pos: 0,
             passes: 0,
+            served: [0; MAX_ROBOTS],
+            stamp: 0,
             ticks: 0,
             lc_since: [0; MAX_ROBOTS],
             lc_last: RobotFlags::new(n_robots),
@@ -467,6 +482,20 @@ impl ContinuousCoordinator {
         while !self.tokens.is_empty() && self.skip_first[self.pos] {
             self.pos += 1;
         }
+        // Before any service, the robots rank by their first token: an immediate hand-over
+        // to the same plan keeps the token where it is.
+        let mut rank = 0;
+        let mut ranked = [false; MAX_ROBOTS];
+        let first_tokens = (self.pos..self.tokens.len())
+            .filter(|&k| !self.skip_first[k])
+            .map(|k| self.tokens[k].robot);
+        for r in first_tokens.chain(0..self.n) {
+            if !std::mem::replace(&mut ranked[r], true) {
+                self.served[r] = rank;
+                rank += 1;
+            }
+        }
+        self.stamp = rank;
         self.ticks = 0;
         self.lc_since = [0; MAX_ROBOTS];
         self.lc_last = RobotFlags::new(self.n);
@@ -654,6 +683,8 @@ impl ContinuousCoordinator {
             let s = self.clock_s[r];
             if self.next_group[r] == g && (s >= end_s || s - self.tol_s >= self.leave_s[g]) {
                 self.next_group[r] = g + 1;
+                self.served[r] = self.stamp;
+                self.stamp += 1;
                 self.advance_token();
             }
         }
@@ -720,11 +751,20 @@ impl ContinuousCoordinator {
     /// executions: the latch makes it so), since then each robot is at most at its old next
     /// gate, which is at or before its new one; a caller tries each tick until it succeeds.
     ///
-    /// The token sequence is rotated to start at the entry for some robot's next group (the
-    /// one that skips the fewest entries), and in the first pass a robot's entries before its
-    /// next group's are skipped, as at the start ([`token_sequence`]). Allocates (the rotated
-    /// sequence); O(N·len) for a token sequence of `len` entries, plus O(log T_ref) per robot
-    /// to place its cursors (a few microseconds for `N ≤ 8`, `benches/cyclic.rs` in
+    /// The new plan's token goes to the robot whose turn it was in the old plan (its token's
+    /// robot), so the plan's flow goes on; but once some robot has seen `(N − 1)·G` services
+    /// of others (`G` the new plan's groups per task; a service is the token moving on after
+    /// its robot left a group) since its own last one, to the robot served least recently
+    /// (the one whose last group, in whichever plan, was left the longest ago; a robot never
+    /// served ranks by its first token at the start). The token sequence is rotated to start
+    /// at that robot's entry for its next group (or group 0 of its next task), and in the
+    /// first pass a robot's entries before its next group's are skipped, as at the start
+    /// ([`token_sequence`]). So however often the plan is handed over, every robot keeps
+    /// completing tasks: between two of a robot's services another robot is served at most
+    /// `(2N − 1)·G` times (`G` the most groups a plan has), the bound and its proof in
+    /// docs/decisions.md, "Hand-over liveness". Allocates (the rotated
+    /// sequence); O(N + len) for a token sequence of `len` entries, plus O(log T_ref) per
+    /// robot to place its cursors (a few microseconds for `N ≤ 8`, `benches/cyclic.rs` in
     /// tandem-schedule).
     ///
     /// # Errors
@@ -789,21 +829,31 @@ impl ContinuousCoordinator {
         let len = self.tokens.len();
         // The robot's first token: its next group, or group 0 of its next task.
         let wants = |t: &Token| t.group == next[t.robot] % n_groups.max(1);
-        let (start, skip) = (0..len)
-            .filter(|&q| wants(&self.tokens[q]))
-            .map(|q| {
-                let mut found = [false; MAX_ROBOTS];
-                let skip: Vec<bool> = (0..len)
-                    .map(|k| {
-                        let t = self.tokens[(q + k) % len];
-                        found[t.robot] |= wants(&t);
-                        !found[t.robot]
-                    })
-                    .collect();
-                (q, skip)
+        // The token goes to the robot whose turn it was in the old plan (the plan's flow
+        // goes on), unless some robot has seen a whole pass's worth of others' services,
+        // `(N − 1)·G`, since its own last one: then to the least recently served robot
+        // (fairness: docs/decisions.md, "Hand-over liveness"). The sequence starts at the
+        // chosen robot's first token.
+        let lru = (0..self.n)
+            .min_by_key(|&r| old.served[r])
+            .expect("N ≥ 1 robots");
+        let waited = old.stamp - 1 - old.served[lru];
+        let lru = match old.token() {
+            Some(t) if waited < ((self.n - 1) * n_groups) as u64 => t.robot,
+            _ => lru,
+        };
+        let start = (0..len)
+            .find(|&q| self.tokens[q].robot == lru && wants(&self.tokens[q]))
+            .unwrap_or(0);
+        // In the first pass, each robot's entries before its first token are skipped.
+        let mut found = [false; MAX_ROBOTS];
+        let skip: Vec<bool> = (0..len)
+            .map(|k| {
+                let t = self.tokens[(start + k) % len];
+                found[t.robot] |= wants(&t);
+                !found[t.robot]
             })
-            .min_by_key(|(q, skip)| (skip.iter().filter(|&&b| b).count(), *q))
-            .unwrap_or((0, Vec::new()));
+            .collect();
         let tokens: Vec<Token> = (0..len).map(|k| self.tokens[(start + k) % len]).collect();
         self.tokens = tokens.into();
         self.skip_first = skip.into();
@@ -827,6 +877,8 @@ impl ContinuousCoordinator {
         }
         self.pos = 0;
         self.passes = 0;
+        self.served = old.served;
+        self.stamp = old.stamp;
         self.ticks = old.ticks;
         self.lc_since = [0; MAX_ROBOTS];
         self.lc_last = RobotFlags::new(self.n);
@@ -940,6 +992,9 @@ pub fn run_cell(
     run.finished = true;
     Ok(run)
 }
+
+#[cfg(test)]
+mod liveness;
 
 #[cfg(test)]
 mod tests {

@@ -485,10 +485,13 @@ fn by_hand_a_robot_inside_a_group_blocks_the_hand_over_and_the_positions_carry_o
     new.take_over(&old).unwrap();
     assert_eq!(new.clock_s(), [4.0, 1.0]);
     assert_eq!(new.tasks_completed(), old.tasks_completed());
-    // The new plan's token: robot 0's group (the first entry of the order, nothing skipped).
+    // The new plan's token goes to the robot served least recently: robot 1, which has not
+    // been through a group yet (robot 0 left its group 0 at tick 3), although robot 0's
+    // entry comes first in the new order; robot 0 waits at gate 4.
+    assert_eq!(new.token(), Some(Token { robot: 1, group: 0 }));
     let t = new.tick(Operator::Scheduled).unwrap();
-    assert_eq!(t.running, [true, true]);
-    assert_eq!(new.clock_s(), [5.0, 2.0]);
+    assert_eq!(t.running, [false, true]);
+    assert_eq!(new.clock_s(), [4.0, 2.0]);
     // A plan in which a robot's position is inside a group is refused: the old plan
     // itself, taken over from a cell in which robot 0 is on its stretch.
     let mut old2 = ContinuousCoordinator::new(task(&conf), &[4], &order, 2, 1.0).unwrap();

@@ -7,6 +7,7 @@ use super::corrections::CorrectionCache;
 use super::stats::{derive_at, observe_at, packed_len, welford_add};
 use super::{PAR_MIN_LEN, TaskModel, check_dt};
 use crate::demo::{DT_TOLERANCE, Demonstration};
+use crate::resample::{self, Interpolation};
 use crate::{Error, Result};
 
 /// An execution recorded by the system (Eq. 21): its samples and, per sample, the
@@ -240,7 +241,8 @@ impl TaskModel {
     /// when its period is within 1 % of `Δt_s`; otherwise, for a finer log (a control loop
     /// faster than the demonstrations), sample `j` is the execution at time `j·Δt_s`
     /// (clamped to its last sample, which is kept): scalar channels and the reference-time
-    /// log interpolated linearly, quaternion blocks by nlerp. [`Resampled::bin_of`] maps
+    /// log interpolated linearly, quaternion blocks by slerp, 0/1 channels held (the one
+    /// resampling policy, [`crate::resample`]). [`Resampled::bin_of`] maps
     /// every original sample to the new sample nearest in time, for per-sample flags.
     ///
     /// # Errors
@@ -281,24 +283,34 @@ impl TaskModel {
         let last = (t_e - 1) as f64;
         let n_new = (last / ratio - 1e-9).ceil().max(1.0) as usize + 1;
         let m = demo.n_channels();
-        let mut samples = Vec::with_capacity(n_new * m);
+        // The one resampling policy (`crate::resample`): the model's quaternion blocks by
+        // slerp, 0/1 channels held, the rest linear.
+        let quats: Vec<[usize; 4]> = self
+            .data
+            .layout
+            .items
+            .iter()
+            .filter_map(|item| match item {
+                super::layout::Item::Quat(cols, _) => Some(*cols),
+                super::layout::Item::Scalar(_) => None,
+            })
+            .collect();
+        let flags: Vec<usize> = (0..m)
+            .filter(|&c| {
+                !quats.iter().flatten().any(|&d| d == c)
+                    && resample::is_flag((0..t_e).map(|k| demo.sample(k)[c]))
+            })
+            .collect();
+        let policy = Interpolation::new(m, &flags, &quats)?;
+        let mut samples = vec![0.0; n_new * m];
         let mut new_log = Vec::with_capacity(n_new);
         for j in 0..n_new {
             let pos = (j as f64 * ratio).min(last);
             let lo = (pos.floor() as usize).min(t_e - 1);
             let hi = (lo + 1).min(t_e - 1);
             let alpha = pos - lo as f64;
-            let start = samples.len();
             let (a, b) = (demo.sample(lo), demo.sample(hi));
-            samples.extend(a.iter().zip(b).map(|(x, y)| x + alpha * (y - x)));
-            for item in &self.data.layout.items {
-                if let super::layout::Item::Quat(cols, _) = item {
-                    let q = super::layout::quat_at(&demo, cols, pos);
-                    for (axis, &c) in cols.iter().enumerate() {
-                        samples[start + c] = q[axis];
-                    }
-                }
-            }
+            policy.row(a, b, alpha, &mut samples[j * m..(j + 1) * m]);
             new_log.push(log[lo] + alpha * (log[hi] - log[lo]));
         }
         let bin_of = (0..t_e)
