@@ -88,7 +88,7 @@ def main() -> None:
     ap.add_argument("--state", type=Path, help="a planner's state file (default: fit the fixtures)")
     ap.add_argument("--tick-s", type=float, default=0.001, help="control period (s)")
     ap.add_argument("--samples", type=int, default=300, help="sampler candidates")
-    ap.add_argument("--calls", type=int, help="ticks to run (default: until both robots finish)")
+    ap.add_argument("--calls", type=int, help="ticks to run (default: until every robot finishes)")
     ap.add_argument("--realtime", action="store_true", help="sleep to hold the control period")
     ap.add_argument("--seed", type=int, default=1, help="seed of the simulated operator")
     args = ap.parse_args()
@@ -140,8 +140,10 @@ def main() -> None:
             else:
                 time.sleep((deadline - now) / 1e9)
             deadline += period_ns
-    print(f"{len(tick_ns)} ticks, {executions} complete runs of the pair, {corrected} corrected ticks, "
-          f"{overlaps} ticks with two robots low-confidence")
+    n = planner.n_robots
+    robots = "the robot" if n == 1 else ("both robots" if n == 2 else f"all {n} robots")
+    print(f"{len(tick_ns)} ticks, {executions} complete rounds ({robots} to the end), "
+          f"{corrected} corrected ticks, {overlaps} ticks with two robots low-confidence")
     print(f"Coordinator.tick: {percentiles(tick_ns)}")
     print(f"whole iteration (commands + tick): {percentiles(loop_ns)}")
     if args.realtime:

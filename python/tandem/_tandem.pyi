@@ -66,7 +66,9 @@ def fit(
     """Learns the task from demonstrations (paths or ``(T_i, C)`` arrays) and makes the first
     schedule (Fig. 2); the same inputs and parameters as ``tandem fit`` give the same state.
     ``holds``: reference times (s) and rules (``"gripper>0.5"``) where a robot may wait, as
-    ``tandem fit --hold-at/--hold-where``; ``[]`` declares none, ``None`` keeps ``params``'."""
+    ``tandem fit --hold-at/--hold-where``; ``[]`` declares none, ``None`` keeps ``params``'.
+    ``dt_s``: the arrays' sample period (s); without it arrays are taken to be 0.01 s apart
+    with a ``DataWarning`` (deprecated)."""
 
 def read_bag(
     path: Path,
@@ -101,9 +103,23 @@ class Planner:
     def locked(path: Path, timeout_s: Optional[float] = None) -> StateEdit:
         """``with Planner.locked(path) as planner:`` loads, and saves at the end, under the
         state file's lock (waiting up to ``timeout_s``, default 60 s, for another writer)."""
-    def save(self, path: Path, timeout_s: Optional[float] = None) -> None:
+    def save(
+        self, path: Path, timeout_s: Optional[float] = None, force: bool = False
+    ) -> None:
         """Saves the state file atomically under its lock (the previous file survives any
-        error); never replaces a non-state file or what another process saved since the load."""
+        error); never replaces a non-state file or what another process saved since the load,
+        nor, without ``force=True``, a state file holding rounds this planner does not hold."""
+    def refit(
+        self,
+        demos: Sequence[Demo],
+        channels: Optional[Sequence[str]] = None,
+        params: Params = None,
+        dt_s: Optional[float] = None,
+        holds: Optional[Union[Sequence[Union[float, str]], Dict[str, Any]]] = None,
+    ) -> Planner:
+        """Fits the task again from ``demos`` and replays every recorded round onto the new
+        fit (the operator's corrections kept); returns the new planner, which saves into the
+        file this one was loaded from."""
     def set_holds(
         self, holds: Union[Sequence[Union[float, str]], Dict[str, Any]]
     ) -> Schedule:
@@ -123,7 +139,9 @@ class Planner:
         re-schedules (§II-C). ``dt_s``: the logs' sample period (default: the schedule's
         tick); a finer log is resampled to the model's period. ``resample``: CSV executions
         with an irregular ``t`` column are put on an even grid first, their logs and flags
-        (one entry per row) with them."""
+        (one entry per row) with them. A sample ``corrected`` but not ``supervised`` is an
+        ``InputError``. The dict's ``reopened`` counts latched samples the round's
+        corrections turned low-confidence again (e.g. rounds recorded out of order)."""
     def record_pair(
         self,
         executions: Sequence[Demo],

@@ -170,10 +170,11 @@ def test_outlier_demonstrations_are_refused_or_warned_with_the_fix() -> None:
     # 0.4 s: 40 samples of a ~99 s task.
     with pytest.raises(tandem.InputError, match=r"0\.39 s long, 0\.00× the median.*leave it out"):
         tandem.fit_model(demos + [demo0[:40]], channels=channels, dt_s=0.01)
-    # Half the task: 0.53× the median, inside the refusal band; said, with the fix.
+    # Half the task: 0.53× the median, inside the length band (a warning), but it does not
+    # reach the end of the task: refused with the fix (issue 39).
     with pytest.warns(tandem.DataWarning, match=r"demos\[6\]: .* 0\.53× the median demonstration .*trim it or leave it out"):
-        model = tandem.fit_model(demos + [demos[1][: len(demos[1]) // 2]], channels=channels, dt_s=0.01)
-    assert model.count == 7
+        with pytest.raises(tandem.InputError, match=r"demos\[6\]: does not reach the end of the task.*demonstrate the whole task again"):
+            tandem.fit_model(demos + [demos[1][: len(demos[1]) // 2]], channels=channels, dt_s=0.01)
     # The fixtures themselves raise no warning.
     with warnings.catch_warnings():
         warnings.simplefilter("error")

@@ -164,3 +164,15 @@ def test_the_two_robot_names_are_deprecated_aliases(tmp_path: Path) -> None:
     new.save(tmp_path / "new.tandem")
     old.save(tmp_path / "old.tandem")
     assert (tmp_path / "new.tandem").read_bytes() == (tmp_path / "old.tandem").read_bytes()
+
+
+def test_a_header_only_file_is_located_by_path_and_line(tmp_path: Path) -> None:
+    """The file field is the path itself and the line is set (it was ``"…csv:1:1"`` with
+    ``line`` None)."""
+    header_only = tmp_path / "header_only.csv"
+    header_only.write_text("t,force,speed\n")
+    with pytest.raises(tandem.InputError, match="0 sample") as e:
+        tandem.fit([DEMOS[0], header_only])
+    assert e.value.file == str(header_only)
+    assert (e.value.line, e.value.column) == (1, 1)
+    assert str(e.value).startswith(f"{header_only}:1:1: ")

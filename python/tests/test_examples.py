@@ -35,5 +35,8 @@ def test_quickstart(tmp_path: Path) -> None:
 def test_control_loop_reports_latency_and_no_overlap() -> None:
     out = run("control_loop.py", "--calls", "20000", "--samples", "100")
     assert "20000 ticks" in out
+    # Rounds of every robot, never "the pair" (the loop runs any number of robots).
+    assert re.search(r"\d+ complete rounds \(both robots to the end\)", out), out
+    assert "pair" not in out
     assert "0 ticks with two robots low-confidence" in out
     assert re.search(r"Coordinator\.tick: p50 [\d.]+ µs, p99 [\d.]+ µs", out), out

@@ -6,7 +6,8 @@
 //!    topics at their own rates and phases: `/pose` (`PoseStamped`, 100 Hz, from 0 ms),
 //!    `/wrench` (`WrenchStamped`, 250 Hz, from 2 ms; the normal force as `fz`) and `/tool`
 //!    (`Bool`, 50 Hz, from 5 ms), by `tandem::bag::write_demonstration`. The bags are read
-//!    back (at 100 Hz, and at the default rate of the slowest topic, 50 Hz) and fitted with
+//!    back (at 100 Hz, and at the default rate, the pose's 100 Hz: the slowest topic that is
+//!    interpolated, the `Bool` being held) and fitted with
 //!    the planner's defaults, and the first schedule's `T_total`, the high-confidence share
 //!    and the model's durations and `σ²_D` are compared with the fit of the CSV files; a
 //!    second parameter set (`mu_c = 0.25`, which trusts the least variable samples from the

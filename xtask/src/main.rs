@@ -16,6 +16,7 @@ mod reference_order;
 mod stress;
 mod study;
 mod test;
+mod zoo;
 
 use std::path::{Path, PathBuf};
 
@@ -68,6 +69,10 @@ enum Cmd {
     /// virtual environment under target/ with the pinned packages of
     /// python/requirements-dev.txt and run pytest on python/tests (the README's test command).
     Test(test::TestArgs),
+    /// The whole loop on every family of the task zoo (tandem-zoo): fit with the defaults,
+    /// learn with a simulated operator who follows each family's truth, for N robots in rounds
+    /// and in a continuous cell; tables in results/zoo/zoo.md and docs/zoo.md (--docs).
+    Zoo(zoo::ZooArgs),
     /// Run E Coordinator executions of random schedules of N robots under adversarial operators
     /// and count ticks with two or more robots low-confidence (expected 0).
     Stress {
@@ -123,5 +128,6 @@ fn main() -> anyhow::Result<()> {
         Cmd::ReferenceOrder(args) => reference_order::run(&args),
         Cmd::FitDefaults(args) => fit_defaults::run(&args),
         Cmd::Test(args) => test::run_all(&args),
+        Cmd::Zoo(args) => zoo::run(&args),
     }
 }

@@ -8,7 +8,9 @@
 //! at random times, switching every tick, periodic, one switch, random switching, random
 //! extremes per tick and per robot, random gradients per tick and held, and the beam search over
 //! per-tick choices), in parallel, and counts ticks in which two or more robots were
-//! low-confidence (expected: 0). Every number depends only on `E`, `N` and the seed.
+//! low-confidence and ticks in which a robot moved backwards (its reference time or its clock
+//! decreased; `AdversaryRun::backward_steps`); it fails on any of either (expected: 0). Every
+//! number depends only on `E`, `N` and the seed.
 //!
 //! Half the problems are this task's own (200–400 samples in runs, a smooth mean, per-run bound
 //! factors); the other half cycle through the test kit's eight families
@@ -33,7 +35,8 @@
 //! adversary policy (`tandem::realtime::continuous::run_cell`: the policies of the adversary
 //! set, the beam search replaced by a switching favourite) until every robot has completed
 //! `K` tasks (default 50), so the clocks' drift runs across many cycles. It counts the ticks
-//! with two or more robots low-confidence (expected 0) and the tasks per robot.
+//! with two or more robots low-confidence and the ticks in which a robot moved backwards
+//! (expected 0 of both; `CellRun::backward_steps`) and the tasks per robot.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -320,22 +323,26 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> a
         let op = case.adversaries[((e / n_problems) % set_size) as usize];
         let r = execute(case, op, seed, e)?;
         tally.add(r.ticks, r.overlap_ticks, r.finished);
+        tally.add_backward(r.backward_steps);
         Ok(())
     })?;
     let secs = run_start.elapsed().as_secs_f64();
+    let backward = tally.backward_steps.load(Ordering::Relaxed);
     let (ticks, overlap_ticks, overlap_runs, unfinished) = tally.into_counts();
     println!(
         "stress: {executions} executions of {n_robots} robots ({set_size} operator policies, \
          seed {seed}), {ticks} ticks, {threads} threads: {overlap_ticks} ticks with two or more \
-         robots low-confidence (expected 0) in {overlap_runs} executions; {unfinished} \
-         unfinished; {secs:.1} s, {:.0} executions/s, {:.1} M ticks/s",
+         robots low-confidence (expected 0) in {overlap_runs} executions; {backward} ticks with \
+         a robot moving backwards (expected 0); {unfinished} unfinished; {secs:.1} s, {:.0} \
+         executions/s, {:.1} M ticks/s",
         executions as f64 / secs,
         ticks as f64 / secs / 1e6,
         threads = rayon::current_num_threads(),
     );
-    if overlap_ticks > 0 || unfinished > 0 {
+    if overlap_ticks > 0 || unfinished > 0 || backward > 0 {
         bail!(
-            "safety invariant broken: {overlap_ticks} overlap ticks, {unfinished} unfinished executions"
+            "safety invariant broken: {overlap_ticks} overlap ticks, {backward} backward steps, \
+             {unfinished} unfinished executions"
         );
     }
     Ok(())
@@ -348,6 +355,8 @@ struct Tally {
     overlap_ticks: AtomicU64,
     overlap_runs: AtomicU64,
     unfinished: AtomicU64,
+    /// Ticks in which a robot moved backwards.
+    backward_steps: AtomicU64,
 }
 
 impl Tally {
@@ -363,6 +372,11 @@ impl Tally {
         if !finished {
             self.unfinished.fetch_add(1, Ordering::Relaxed);
         }
+    }
+
+    /// One execution's ticks in which a robot moved backwards.
+    fn add_backward(&self, steps: u64) {
+        self.backward_steps.fetch_add(steps, Ordering::Relaxed);
     }
 
     /// Ticks, overlap ticks, executions with overlaps, unfinished executions.
@@ -397,8 +411,10 @@ fn run_batches(
         if last_report.elapsed().as_secs_f64() >= report_s && done < executions {
             let rate = done as f64 / start.elapsed().as_secs_f64();
             println!(
-                "  {done}/{executions} executions, {} overlap ticks, {rate:.0} executions/s",
-                tally.overlap_ticks.load(Ordering::Relaxed)
+                "  {done}/{executions} executions, {} overlap ticks, {} backward steps, \
+                 {rate:.0} executions/s",
+                tally.overlap_ticks.load(Ordering::Relaxed),
+                tally.backward_steps.load(Ordering::Relaxed)
             );
             last_report = Instant::now();
         }
@@ -524,27 +540,30 @@ pub(crate) fn run_continuous(
         let mut cell = case.cell.clone();
         let r = run_cell(&mut cell, op, &mut rng, tasks, case.max_ticks)?;
         tally.add(r.ticks, r.overlap_ticks, r.finished);
+        tally.add_backward(r.backward_steps);
         tasks_done.fetch_add(cell.tasks_completed().iter().sum(), Ordering::Relaxed);
         min_tasks.fetch_min(r.min_tasks, Ordering::Relaxed);
         Ok(())
     })?;
     let secs = run_start.elapsed().as_secs_f64();
+    let backward = tally.backward_steps.load(Ordering::Relaxed);
     let (ticks, overlap_ticks, overlap_runs, unfinished) = tally.into_counts();
     let (tasks_done, min_tasks) = (tasks_done.into_inner(), min_tasks.into_inner());
     println!(
         "stress --cell continuous: {executions} executions of {n_robots} robots ({set_size} \
          operator policies, seed {seed}), {ticks} ticks, {threads} threads: {overlap_ticks} \
          ticks with two or more robots low-confidence (expected 0) in {overlap_runs} \
-         executions; tasks per robot per execution: at least {min_tasks}, {:.1} on average; \
+         executions; {backward} ticks with a robot moving backwards (expected 0); tasks per robot per execution: at least {min_tasks}, {:.1} on average; \
          {unfinished} unfinished; {secs:.1} s, {:.0} executions/s, {:.1} M ticks/s",
         tasks_done as f64 / (executions * n_robots as u64) as f64,
         executions as f64 / secs,
         ticks as f64 / secs / 1e6,
         threads = rayon::current_num_threads(),
     );
-    if overlap_ticks > 0 || unfinished > 0 {
+    if overlap_ticks > 0 || unfinished > 0 || backward > 0 {
         bail!(
-            "safety invariant broken: {overlap_ticks} overlap ticks, {unfinished} unfinished executions"
+            "safety invariant broken: {overlap_ticks} overlap ticks, {backward} backward steps, \
+             {unfinished} unfinished executions"
         );
     }
     Ok(())

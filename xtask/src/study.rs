@@ -331,7 +331,8 @@ impl TrialBar {
     }
 }
 
-fn git_revision(root: &Path) -> String {
+/// `git describe --always --dirty` of the workspace at `root`, or "unknown".
+pub(crate) fn git_revision(root: &Path) -> String {
     std::process::Command::new("git")
         .args(["describe", "--always", "--dirty"])
         .current_dir(root)

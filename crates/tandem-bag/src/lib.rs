@@ -11,9 +11,11 @@
 //!   the channel record's [`FIELDS_KEY`] metadata that tandem writes.
 //! - **Resampling.** Every topic keeps its own rate in the bag; the reader lays one grid over
 //!   the span all selected topics cover (from the latest first message to the earliest last
-//!   one) at a chosen rate (default: the slowest topic's median rate; an execution: the
-//!   model's `Δt_s`) and interpolates each topic onto it: linearly, orientations by slerp,
-//!   `Bool` flags held. Times are header stamps (log times where there is no header). A gap
+//!   one) at a chosen rate (default: the rate of the slowest topic that is interpolated,
+//!   every type but `Bool`, its period snapped as for a CSV `t` column, and
+//!   [`Recording::grid_note`] says which topic that was; an execution: the model's `Δt_s`)
+//!   and interpolates each topic onto it: linearly, orientations by slerp, `Bool` flags
+//!   held. Times are header stamps (log times where there is no header). A gap
 //!   or a late start or early end of more than [`GAP_FACTOR`] × a topic's median period is an
 //!   error, not interpolated across.
 //! - **Writing** ([`RunWriter`], [`BagWriter`], [`write_demonstration`]). A simulated run
@@ -42,11 +44,14 @@
 //!     bag.write(tool, k * 100_000_000, &Message::Bool(k >= 5))?;
 //! }
 //! bag.finish()?;
-//! // The default grid is the slowest topic's rate (10 Hz): 11 samples.
+//! // The default grid is the rate of the slowest topic that is interpolated: the force's
+//! // 100 Hz (the 10 Hz flag is held between its messages): 101 samples.
 //! let rec = read_bag(&path, &BagOptions::default())?;
 //! assert_eq!(rec.channel_names, ["force", "tool"]);
-//! assert_eq!((rec.n_samples(), rec.dt_s), (11, 0.1));
-//! assert_eq!(&rec.samples[10..12], &[50.0, 1.0]); // t = 0.5 s
+//! assert_eq!((rec.n_samples(), rec.dt_s), (101, 0.01));
+//! assert_eq!(rec.grid_topic.as_deref(), Some("/force"));
+//! assert_eq!(&rec.samples[2 * 50..2 * 51], &[50.0, 1.0]); // t = 0.5 s
+//! assert_eq!(&rec.samples[2 * 49..2 * 50], &[49.0, 0.0]); // t = 0.49 s: the flag held
 //! // At 40 Hz the force is interpolated and the flag held.
 //! let rec = read_bag(&path, &BagOptions { rate_hz: Some(40.0), ..Default::default() })?;
 //! assert_eq!(rec.n_samples(), 41);
@@ -85,4 +90,59 @@ pub const GAP_FACTOR: f64 = 3.0;
 pub fn is_bag(path: &std::path::Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
+}
+
+/// The MCAP file `path` names: `path` itself unless it is a folder; for a folder (a rosbag2
+/// recording: `ros2 bag record -s mcap -o demo_0` writes `demo_0/metadata.yaml` and
+/// `demo_0/demo_0_0.mcap`) the one `.mcap` file in it.
+///
+/// # Errors
+/// [`Error::Layout`] for a folder with no `.mcap` file, or with several (a recording split
+/// into parts), naming what it holds and the fix; [`Error::Io`] when it cannot be listed.
+pub fn bag_file(path: &std::path::Path) -> Result<std::path::PathBuf> {
+    if !path.is_dir() {
+        return Ok(path.to_path_buf());
+    }
+    let file = path.display().to_string();
+    let entries = std::fs::read_dir(path).map_err(|source| Error::Io {
+        file: file.clone(),
+        what: "cannot list the folder",
+        source,
+    })?;
+    let mut mcaps: Vec<std::path::PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && is_bag(p))
+        .collect();
+    mcaps.sort();
+    let rosbag2 = path.join("metadata.yaml").is_file();
+    match &mcaps[..] {
+        [one] => Ok(one.clone()),
+        [] => Err(Error::Layout {
+            file,
+            why: format!(
+                "a folder{}, without an .mcap file in it: give a file (a demonstration is a \
+                 CSV, .json or .mcap file; tandem reads rosbag2 recordings made with `ros2 bag \
+                 record -s mcap`)",
+                if rosbag2 {
+                    " (a rosbag2 recording: metadata.yaml)"
+                } else {
+                    ""
+                }
+            ),
+        }),
+        several => Err(Error::Layout {
+            file,
+            why: format!(
+                "a folder with {} .mcap files ({}): a recording split into parts, or several \
+                 recordings; give one .mcap file per demonstration (`ros2 bag convert` merges \
+                 the parts of one recording into one file)",
+                several.len(),
+                several
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        }),
+    }
 }

@@ -534,6 +534,11 @@ pub(crate) struct Series {
     pub(crate) values: Vec<f64>,
     /// The topic's median message period (ns).
     pub(crate) median_ns: i64,
+    /// The topic's message period (ns) as for a CSV `t` column: the span over the steps
+    /// counted in median periods, snapped to a whole rate within 0.1 %
+    /// ([`tandem_lfd::logger_period`]), so a 50 Hz topic whose stamps run 0.07 % slow has a
+    /// period of exactly 20 ms.
+    pub(crate) period_ns: f64,
 }
 
 /// The messages of topic `t` with log time in `window` (`[start, end)`
@@ -596,11 +601,15 @@ pub(crate) fn series(
             });
         }
     }
+    let secs: Vec<f64> = times_ns.iter().map(|&t| t as f64 / 1e9).collect();
+    let period_ns = tandem_lfd::logger_period(&secs)
+        .map_or(median_ns as f64, |p| (p * 1e9 * 1e3).round() / 1e3);
     Ok(Series {
         times_ns,
         log_time: use_log,
         values,
         median_ns,
+        period_ns,
     })
 }
 

@@ -19,8 +19,10 @@ pub struct BagOptions {
     /// a supported type, in the file's order (topics tandem wrote for viewing only, such as a
     /// run's schedule clock, are left out).
     pub topics: Option<Vec<String>>,
-    /// Rate of the common grid (Hz, finite > 0); `None`: the slowest selected topic's median
-    /// message rate.
+    /// Rate of the common grid (Hz, finite > 0); `None`: the rate of the slowest selected
+    /// topic that is interpolated (every type but `Bool`, whose flags are held; when every
+    /// topic is a `Bool`, the slowest one), its period estimated and snapped as for a CSV
+    /// `t` column ([`tandem_lfd::logger_period`]). [`Recording::grid_topic`] names it.
     pub rate_hz: Option<f64>,
     /// Read only the topics under this namespace (`/robot_1`) and name the channels relative
     /// to it; `None`: every topic, named from the root.
@@ -73,6 +75,10 @@ pub struct TopicInfo {
     pub channels: Vec<String>,
     /// Median message period (s), when read with at least 2 messages.
     pub median_period_s: Option<f64>,
+    /// Message period (s) as the grid would use it, when read: the span over the steps
+    /// counted in median periods, snapped to a whole rate within 0.1 %
+    /// ([`tandem_lfd::logger_period`]; 0.02 s for 50 Hz stamps that run 0.07 % slow).
+    pub period_s: Option<f64>,
     /// Bag time (s) of its first and last message, when read.
     pub span_s: Option<(f64, f64)>,
     /// Whether its times are log times (no header, or all header stamps zero) rather than
@@ -93,6 +99,9 @@ pub struct Recording {
     pub samples: Vec<f64>,
     /// Grid period `Δt_s` (s).
     pub dt_s: f64,
+    /// The topic whose rate set the grid (`None`: the rate was given,
+    /// [`BagOptions::rate_hz`]); see [`Recording::grid_note`].
+    pub grid_topic: Option<String>,
     /// Bag time (s) of sample 0: the latest first message of the selected topics.
     pub start_s: f64,
     /// The topics read, in column order.
@@ -108,6 +117,62 @@ impl Recording {
     #[must_use]
     pub fn n_samples(&self) -> usize {
         self.samples.len() / self.channel_names.len().max(1)
+    }
+
+    /// Why the grid has its rate, in one sentence without the file name (for a note; the
+    /// command line prints it once for every bag it applies to): the topic whose rate set
+    /// it, the `Bool` topics held rather than interpolated, and how to choose another rate.
+    /// `None` when the rate was given.
+    #[must_use]
+    pub fn grid_reason(&self) -> Option<String> {
+        let topic = self.grid_topic.as_deref()?;
+        let rate = |p: f64| round_hz(1.0 / p);
+        let of = |t: &TopicInfo| {
+            let short = t
+                .schema
+                .as_deref()
+                .unwrap_or("?")
+                .rsplit('/')
+                .next()
+                .unwrap_or("?");
+            match t.period_s {
+                Some(p) => format!("{} ({short}, {} Hz)", t.topic, rate(p)),
+                None => format!("{} ({short})", t.topic),
+            }
+        };
+        let chosen = self.topics.iter().find(|t| t.topic == topic)?;
+        let flags: Vec<String> = self
+            .topics
+            .iter()
+            .filter(|t| t.msg_type == Some(MsgType::Bool) && t.topic != topic)
+            .map(of)
+            .collect();
+        let held = if flags.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; {} held between messages, not interpolated, so not setting it",
+                flags.join(", ")
+            )
+        };
+        let why = if chosen.msg_type == Some(MsgType::Bool) {
+            "the slowest topic (every topic is a Bool)"
+        } else {
+            "the slowest topic that is interpolated"
+        };
+        Some(format!(
+            "grid of {} Hz ({} s), the rate of {}, {why}{held}; for another grid give --rate HZ \
+             (Python: rate=)",
+            rate(self.dt_s),
+            (self.dt_s * 1e9).round() / 1e9,
+            of(chosen),
+        ))
+    }
+
+    /// [`Recording::grid_reason`] with the file in front.
+    #[must_use]
+    pub fn grid_note(&self) -> Option<String> {
+        self.grid_reason().map(|r| format!("{}: {r}", self.source))
     }
 
     /// The recording as a demonstration (named by its file).
@@ -181,6 +246,7 @@ fn info(t: &RawTopic, s: Option<&Series>, namespace: Option<&str>) -> TopicInfo 
             Vec::new()
         },
         median_period_s: s.map(|s| s.median_ns as f64 / 1e9),
+        period_s: s.map(|s| s.period_ns / 1e9),
         span_s: s.map(|s| {
             (
                 s.times_ns[0] as f64 / 1e9,
@@ -202,21 +268,44 @@ struct Gridded {
     width: usize,
 }
 
+/// Which of the series sets the default grid: the slowest (longest [`Series::period_ns`],
+/// the earlier on a tie) of those that are interpolated, every type but `Bool` (a flag is
+/// held between its messages, so a 50 Hz valve need not coarsen a 100 Hz pose); the
+/// slowest of all when every one is a `Bool`.
+fn grid_setter(topics: &[RawTopic], chosen: &[usize], series: &[Series]) -> usize {
+    let interpolated: Vec<usize> = (0..chosen.len())
+        .filter(|&b| topics[chosen[b]].msg_type != Some(MsgType::Bool))
+        .collect();
+    let candidates = if interpolated.is_empty() {
+        (0..chosen.len()).collect()
+    } else {
+        interpolated
+    };
+    candidates
+        .into_iter()
+        .rev()
+        .max_by(|&a, &b| series[a].period_ns.total_cmp(&series[b].period_ns))
+        .expect("at least one topic")
+}
+
 /// Resamples the `chosen` topics (indices into `topics`) onto one grid of period `period_ns`
-/// (`None`: the slowest topic's median period) within `window`.
+/// (`None`: the period of the topic [`grid_setter`] picks) within `window`. Returns the
+/// grid, the series and, when the period was not given, the block of the topic that set it.
 fn grid_topics(
     topics: &[RawTopic],
     chosen: &[usize],
     file: &str,
     window: Option<(i64, i64)>,
     period_ns: Option<f64>,
-) -> Result<(Gridded, Vec<Series>)> {
+) -> Result<(Gridded, Vec<Series>, Option<usize>)> {
     let series: Vec<Series> = chosen
         .iter()
         .map(|&k| series(&topics[k], file, window, false))
         .collect::<Result<_>>()?;
-    let period_ns = period_ns
-        .unwrap_or_else(|| series.iter().map(|s| s.median_ns).max().expect("non-empty") as f64);
+    let setter = period_ns
+        .is_none()
+        .then(|| grid_setter(topics, chosen, &series));
+    let period_ns = period_ns.unwrap_or_else(|| series[setter.expect("no period given")].period_ns);
     let refs: Vec<&Series> = series.iter().collect();
     let names: Vec<&str> = chosen.iter().map(|&k| topics[k].topic.as_str()).collect();
     let g = grid(&refs, &names, file, period_ns)?;
@@ -238,6 +327,7 @@ fn grid_topics(
             width,
         },
         series,
+        setter,
     ))
 }
 
@@ -313,13 +403,19 @@ fn quaternion_blocks(
         .collect()
 }
 
+/// A rate in Hz without floating-point noise (`50`, `33.333`).
+fn round_hz(hz: f64) -> f64 {
+    (hz * 1e3).round() / 1e3
+}
+
 /// Reads a rosbag2 MCAP file as one demonstration: the selected topics (by default every
 /// topic of a supported type) resampled onto one grid, channel names from the topic and the
 /// field (docs/formats.md, "ROS 2 bags").
 ///
 /// Times are the header stamps (log times for `Float64`, `Bool` and topics whose stamps are
 /// all zero). The grid runs from the latest first message to the earliest last one at
-/// `rate_hz` (default: the slowest topic's median rate); values are interpolated linearly,
+/// `rate_hz` (default: the rate of the slowest topic that is interpolated, see
+/// [`BagOptions::rate_hz`] and [`Recording::grid_note`]); values are interpolated linearly,
 /// orientations by slerp, `Bool` flags held.
 ///
 /// # Errors
@@ -343,7 +439,7 @@ pub fn read_bag(path: impl AsRef<Path>, options: &BagOptions) -> Result<Recordin
         t.selected && t.msg_type.is_some()
     });
     let period = options.rate_hz.map(|r| 1e9 / r);
-    let (g, series) = grid_topics(&topics, &chosen, &file, None, period)?;
+    let (g, series, setter) = grid_topics(&topics, &chosen, &file, None, period)?;
     let (channel_names, samples) = channels(&topics, &chosen, &g, &file, namespace)?;
     let topics_info = chosen
         .iter()
@@ -355,6 +451,7 @@ pub fn read_bag(path: impl AsRef<Path>, options: &BagOptions) -> Result<Recordin
         channel_names,
         samples,
         dt_s: g.grid.period_ns / 1e9,
+        grid_topic: setter.map(|b| topics[chosen[b]].topic.clone()),
         start_s: g.grid.t0_ns as f64 / 1e9,
         topics: topics_info,
         quaternions: quaternion_blocks(&topics, &chosen, namespace),
@@ -577,7 +674,7 @@ fn read_robot(
         role_topic(Role::Supervised)?,
         role_topic(Role::Corrected)?,
     );
-    let (g, _) = grid_topics(topics, &chosen, file, window, Some(options.dt_s * 1e9))?;
+    let (g, _, _) = grid_topics(topics, &chosen, file, window, Some(options.dt_s * 1e9))?;
     let block = |k: usize| chosen.iter().position(|&c| c == k).expect("chosen");
     let ref_time_log = g.column(block(log_k), 0);
     let supervised: Vec<bool> = g

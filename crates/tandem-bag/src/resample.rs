@@ -196,6 +196,7 @@ mod tests {
             log_time: true,
             values: values.to_vec(),
             median_ns: times[1] - times[0],
+            period_ns: (times[1] - times[0]) as f64,
         }
     }
 

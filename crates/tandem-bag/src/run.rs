@@ -9,6 +9,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde_json::json;
+use tandem_lfd::ChannelKind;
 use tandem_planner::Planner;
 use tandem_schedule::GlobalTimeline;
 use tandem_sim::workcell::RoundRun;
@@ -50,6 +51,9 @@ enum Slot {
     Pose(TopicId, [Option<usize>; 7]),
     /// A `Float64` of model channel `c`.
     Channel(TopicId, usize),
+    /// A `Bool` of model channel `c`, a binary channel ([`ChannelKind::Binary`]): true where
+    /// the commanded value is at least 0.5.
+    Flag(TopicId, usize),
 }
 
 /// A robot's topics.
@@ -94,7 +98,10 @@ fn topic_token(name: &str) -> String {
 /// Layout (docs/formats.md, "Runs as bags"), for robot `i` under `/robot_<i>`:
 /// one `geometry_msgs/msg/PoseStamped` per quaternion block of the model whose four channels
 /// it has (`tool_pose` for the block `q`; position from the channels `x, y, z` beside it,
-/// 0 where missing), a `std_msgs/msg/Float64` per other channel, `ref_sample` (`Float64`,
+/// 0 where missing), a `std_msgs/msg/Bool` per binary channel of the fit's channel schema
+/// ([`ChannelKind::Binary`]: a bag's `Bool` topics, a CSV's `tool`; true where the command is
+/// at least 0.5, as a valve is driven, so such a channel reads back as 0 or 1), a
+/// `std_msgs/msg/Float64` per other channel, `ref_sample` (`Float64`,
 /// reference samples), `supervised` and `corrected` (`std_msgs/msg/Bool`), one message each
 /// per control tick the robot ran; `schedule_clock` (`Float64`, s) and `waiting` (`Bool`)
 /// at every tick of the round. `/tandem/schedule` holds one JSON message per round at its
@@ -175,12 +182,21 @@ impl RunWriter {
                     t if t.is_empty() => format!("channel_{c}"),
                     t => t,
                 };
+                let binary = schema.kind(name) == ChannelKind::Binary;
                 let id = bag.add_topic(
                     &unique(token),
-                    MsgType::Float64,
+                    if binary {
+                        MsgType::Bool
+                    } else {
+                        MsgType::Float64
+                    },
                     &metadata(std::slice::from_ref(name), Role::Channel),
                 )?;
-                slots.push(Slot::Channel(id, c));
+                slots.push(if binary {
+                    Slot::Flag(id, c)
+                } else {
+                    Slot::Channel(id, c)
+                });
             }
             let mut flag = |name: &str, t: MsgType, role: Role| {
                 let topic = unique(name.to_owned());
@@ -274,6 +290,9 @@ impl RunWriter {
                         }
                         Slot::Channel(id, c) => {
                             self.bag.write(*id, t, &Message::Float64(row[*c]))?;
+                        }
+                        Slot::Flag(id, c) => {
+                            self.bag.write(*id, t, &Message::Bool(row[*c] >= 0.5))?;
                         }
                     }
                 }

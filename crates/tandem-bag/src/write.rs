@@ -437,6 +437,7 @@ pub fn write_demonstration(
         log_time: true,
         values: demo.samples().to_vec(),
         median_ns: dt_ns.round() as i64,
+        period_ns: dt_ns,
     };
     for spec in topics {
         if !(spec.rate_hz.is_finite() && spec.rate_hz > 0.0) || spec.start_ns < 0 {

@@ -92,7 +92,16 @@ fn assert_same(read: &ExecutionRecord, sim: &ExecutionRecord, what: &str) {
     assert_eq!(a.channel_names(), b.channel_names(), "{what}");
     assert_eq!(a.dt_s().to_bits(), b.dt_s().to_bits(), "{what}");
     assert_eq!(a.n_samples(), b.n_samples(), "{what}");
+    // The binary channel `tool` goes out as a `std_msgs/Bool`, true where the command is at
+    // least 0.5 (as a valve is driven); every other value bit for bit.
+    let tool = b.channel_index("tool").expect("a tool channel");
+    let m = b.n_channels();
     for (k, (x, y)) in a.samples().iter().zip(b.samples()).enumerate() {
+        let y = if k % m == tool {
+            f64::from(u8::from(*y >= 0.5))
+        } else {
+            *y
+        };
         assert_eq!(x.to_bits(), y.to_bits(), "{what}: value {k}: {x} vs {y}");
     }
     assert_eq!(
@@ -176,6 +185,10 @@ fn a_run_reads_back_to_the_same_executions_for_one_two_and_three_robots() {
             .unwrap();
         assert_eq!(pose.msg_type, Some(MsgType::PoseStamped));
         assert_eq!(pose.channels, ["x", "y", "z", "qx", "qy", "qz", "qw"]);
+        // A binary channel is a Bool topic, a scalar one a Float64.
+        let ty = |name: &str| topics.iter().find(|t| t.topic == name).unwrap().msg_type;
+        assert_eq!(ty("/robot_1/tool"), Some(MsgType::Bool));
+        assert_eq!(ty("/robot_1/force"), Some(MsgType::Float64));
         assert!(
             topics
                 .iter()

@@ -7,14 +7,14 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use serde_json::json;
 use tandem::bag::{
-    BagOptions, ExecutionOptions, Existing, Recording, Role, RunWriter, count_rounds,
+    BagOptions, ExecutionOptions, Existing, Recording, Role, RunWriter, bag_file, count_rounds,
     extend_schema, inspect, is_bag, read_bag, read_executions,
 };
 use tandem::lfd::{ChannelSchema, Demonstration};
 use tandem::sim::workcell::RoundRun;
 use tandem::{ExecutionRecord, Planner};
 
-use crate::cmd::out;
+use crate::cmd::{grouped_notes, out};
 use crate::input;
 
 /// `--topics /a,/b` as the reader's selection (`None` when not given).
@@ -39,6 +39,7 @@ pub(crate) fn read_demos(
         bail!("--rate {r}: the grid rate must be finite and > 0 Hz");
     }
     let any_bag = paths.iter().any(|p| is_bag(p));
+    let any_bag = any_bag || paths.iter().any(|p| p.is_dir());
     if !any_bag && (rate_hz.is_some() || !topic_list.is_empty()) {
         bail!("--rate and --topics apply to ROS 2 bags (.mcap); no demonstration is one");
     }
@@ -50,8 +51,10 @@ pub(crate) fn read_demos(
     let mut recordings: Vec<Recording> = Vec::new();
     let mut demos = Vec::with_capacity(paths.len());
     for p in paths {
-        if is_bag(p) {
-            let rec = read_bag(p, &options)?;
+        // A folder is a rosbag2 recording: its one .mcap file is read (or the folder is
+        // refused with what it holds and the fix).
+        if is_bag(p) || p.is_dir() {
+            let rec = read_bag(bag_file(p)?, &options)?;
             demos.push(rec.demonstration()?);
             recordings.push(rec);
         } else {
@@ -62,6 +65,12 @@ pub(crate) fn read_demos(
             });
         }
     }
+    // Which topic set each bag's grid, once for every bag it applies to.
+    let grids: Vec<(String, String)> = recordings
+        .iter()
+        .filter_map(|r| Some((r.source.clone(), r.grid_reason()?)))
+        .collect();
+    grouped_notes(&grids);
     extend_schema(schema, &recordings);
     schema
         .validate()
@@ -80,14 +89,17 @@ pub(crate) fn read_round(
 ) -> Result<Vec<ExecutionRecord>> {
     let n = planner.n_robots();
     let model = planner.model();
+    let mut files = Vec::with_capacity(bags.len());
     for b in bags {
-        if !is_bag(b) {
+        if !is_bag(b) && !b.is_dir() {
             bail!(
                 "{}: not a bag (.mcap); give CSV executions with --execution/--log/--corrections",
                 b.display()
             );
         }
+        files.push(bag_file(b)?);
     }
+    let bags = &files[..];
     let per_bag: Vec<(PathBuf, Vec<usize>)> = match bags.len() {
         1 => vec![(bags[0].clone(), (1..=n).collect())],
         k if k == n => bags
@@ -133,6 +145,8 @@ fn check_coverage(
 
 /// `tandem inspect BAG`: every topic, its type, messages, rate and the channels it gives.
 pub(crate) fn inspect_bag(path: &Path, as_json: bool) -> Result<()> {
+    let file = bag_file(path)?;
+    let path = file.as_path();
     let topics = inspect(path)?;
     let rounds = count_rounds(path)?;
     if as_json {
@@ -146,6 +160,7 @@ pub(crate) fn inspect_bag(path: &Path, as_json: bool) -> Result<()> {
                     "messages": t.messages,
                     "channels": t.channels,
                     "median_period_s": t.median_period_s,
+                    "period_s": t.period_s,
                     "start_s": t.span_s.map(|s| s.0),
                     "end_s": t.span_s.map(|s| s.1),
                     "time": if t.log_time { "log time" } else { "header stamp" },
@@ -165,7 +180,7 @@ pub(crate) fn inspect_bag(path: &Path, as_json: bool) -> Result<()> {
     }
     for t in &topics {
         let ty = t.schema.as_deref().unwrap_or("no schema");
-        let Some(period) = t.median_period_s else {
+        let Some(period) = t.period_s else {
             out(&format!(
                 "  {}  {ty}  {} messages  (not read: {})",
                 t.topic,
@@ -180,10 +195,10 @@ pub(crate) fn inspect_bag(path: &Path, as_json: bool) -> Result<()> {
         };
         let (a, b) = t.span_s.unwrap_or((0.0, 0.0));
         out(&format!(
-            "  {}  {ty}  {} messages  {:.2} Hz  {:.3}–{:.3} s ({})  role {}",
+            "  {}  {ty}  {} messages  {} Hz  {:.3}–{:.3} s ({})  role {}",
             t.topic,
             t.messages,
-            1.0 / period,
+            rate_text(period),
             a,
             b,
             if t.log_time {
@@ -196,6 +211,12 @@ pub(crate) fn inspect_bag(path: &Path, as_json: bool) -> Result<()> {
         out(&format!("    channels: {}", t.channels.join(", ")));
     }
     Ok(())
+}
+
+/// A topic's rate from its period: `100.00` for whole rates (the period snapped to one), two
+/// decimals otherwise.
+fn rate_text(period_s: f64) -> String {
+    format!("{:.2}", 1.0 / period_s)
 }
 
 /// `tandem simulate --bag`: the run's rounds written as they are simulated, the file put in

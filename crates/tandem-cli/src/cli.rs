@@ -31,6 +31,11 @@ pub(crate) struct Cli {
     /// The command.
     #[command(subcommand)]
     pub(crate) command: Command,
+    /// Print the full lists that are otherwise summarized: every hold-point stretch, one
+    /// note per file (periods, jitter, bag grids), every stretch and the whole operator's
+    /// order of a continuous plan.
+    #[arg(short, long, global = true)]
+    pub(crate) verbose: bool,
 }
 
 /// The subcommands.
@@ -73,8 +78,10 @@ pub(crate) enum Command {
     /// each robot starts its next task as soon as the plan allows): the period, tasks per
     /// hour, the operator's busy share, a lower bound on the period and the gap to it, the
     /// operator's order of low-confidence stretches and a text Gantt of two periods. It
-    /// assumes the operator follows the demonstrated mean speed; the run-time coordinator of
-    /// a continuous cell is in progress, and `record` still learns from rounds.
+    /// assumes the operator follows the demonstrated mean speed; at run time
+    /// `CyclicPlan::coordinator` (Python: `planner.continuous_coordinator()`) runs it, and
+    /// `record` still learns from rounds. Many stretches and a long operator's order are
+    /// summarized; --verbose prints them all.
     ///
     /// Example:
     ///
@@ -228,9 +235,10 @@ pub(crate) struct FitArgs {
     #[arg(long, value_name = "/A,/B", value_delimiter = ',')]
     pub(crate) topics: Vec<String>,
     /// Robots run by the one operator, 1 to 8 (the paper: 2): every schedule has N warps and
-    /// `tandem record` takes N executions per round. Stored in the state file.
-    #[arg(long, value_name = "N", default_value_t = 2)]
-    pub(crate) robots: usize,
+    /// `tandem record` takes N executions per round. Stored in the state file. Default: 2,
+    /// or with --keep-rounds the state's.
+    #[arg(long, value_name = "N")]
+    pub(crate) robots: Option<usize>,
     /// Hold points at these reference times (s, the reference demonstration's clock), each at
     /// its nearest reference sample: places where a robot may wait as long as needed (the
     /// tool lifted, a part held); a hold on a low-confidence sample is inactive until the
@@ -255,9 +263,21 @@ pub(crate) struct FitArgs {
     /// Sampler overrides.
     #[command(flatten)]
     pub(crate) sampler: SamplerArgs,
-    /// The state file to write (replaced atomically if it exists).
+    /// The state file to write (atomically). An existing state file that holds recorded
+    /// rounds (the operator's corrections) is replaced only with --keep-rounds or --force.
     #[arg(short, long, value_name = "STATE")]
     pub(crate) output: PathBuf,
+    /// Keep the rounds recorded in the state file -o: fit the new demonstrations, then replay
+    /// every recorded round onto the new model in its order (executions, reference-time logs
+    /// carried onto the new reference, supervised and corrected flags), as if recorded
+    /// after a fresh fit. Rounds recorded by a tandem older than state format 11 cannot be
+    /// replayed (their executions were not kept): refused, use --force.
+    #[arg(long, conflicts_with = "force")]
+    pub(crate) keep_rounds: bool,
+    /// Replace the state file -o even if it holds recorded rounds, discarding them (says how
+    /// many).
+    #[arg(long)]
+    pub(crate) force: bool,
 }
 
 /// `tandem fit --reference`: `tandem::lfd::Reference` by its parameter-file names.

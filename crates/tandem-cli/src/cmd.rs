@@ -15,8 +15,18 @@ use crate::cli::{
 use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_json, source_name};
 use crate::{bag, cyclic, input, need, plot, sim, state_io};
 
+/// Whether `--verbose` was given: the full lists instead of their summaries. Set once by
+/// [`run`] before any command runs; read by the printing code of every command.
+static VERBOSE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+
+/// Whether `--verbose` was given (see [`VERBOSE`]).
+pub(crate) fn verbose() -> bool {
+    VERBOSE.get().copied().unwrap_or(false)
+}
+
 /// Runs one command.
 pub(crate) fn run(cli: Cli) -> Result<()> {
+    let _ = VERBOSE.set(cli.verbose);
     match cli.command {
         Command::Fit(a) => fit(&a),
         Command::Schedule(a) => schedule(&a),
@@ -43,6 +53,122 @@ pub(crate) fn out(text: &str) {
 /// `--json`): how a file was read, or something that looks wrong but is not refused.
 pub(crate) fn note(text: &str) {
     eprintln!("note: {text}");
+}
+
+/// Prints one note per group of files that share it: `what` maps each file to the rest of
+/// its note; a note several files share is printed once, naming them (the first
+/// [`FILES_NAMED`] and how many more), unless `--verbose` asks for one note per file.
+pub(crate) fn grouped_notes(what: &[(String, String)]) {
+    let mut groups: Vec<(&str, Vec<&str>)> = Vec::new();
+    for (file, rest) in what {
+        match groups.iter_mut().find(|(r, _)| *r == rest.as_str()) {
+            Some((_, files)) if !verbose() => files.push(file.as_str()),
+            _ => groups.push((rest.as_str(), vec![file.as_str()])),
+        }
+    }
+    for (rest, files) in groups {
+        note(&format!("{}: {rest}", files_text(&files)));
+    }
+}
+
+/// Files named in one note before `… and K more`.
+pub(crate) const FILES_NAMED: usize = 3;
+
+/// `a.csv`, or `3 files (a.csv, b.csv, c.csv)`, or `6 files (a.csv, b.csv, c.csv and 3
+/// more)`.
+pub(crate) fn files_text(files: &[&str]) -> String {
+    match files {
+        [one] => (*one).to_owned(),
+        _ => {
+            let named = files[..files.len().min(FILES_NAMED)].join(", ");
+            let more = files.len().saturating_sub(FILES_NAMED);
+            if more == 0 {
+                format!("{} files ({named})", files.len())
+            } else {
+                format!("{} files ({named} and {more} more)", files.len())
+            }
+        }
+    }
+}
+
+/// The period notes of files read (demonstrations, executions): one line per kind for all
+/// files (the files without a time column, the files whose `t` jitters), or with
+/// `--verbose` each file's own note ([`Demonstration::period_note`]). `assumed_suffix` is
+/// added to the note of files without a time column (why that period).
+pub(crate) fn period_notes(demos: &[&Demonstration], assumed_suffix: &str) {
+    let with_note: Vec<&Demonstration> = demos
+        .iter()
+        .copied()
+        .filter(|d| d.period_note().is_some())
+        .collect();
+    let assumed: Vec<&Demonstration> = with_note
+        .iter()
+        .copied()
+        .filter(|d| d.period_source() == PeriodSource::Assumed)
+        .collect();
+    let jittered: Vec<&Demonstration> = with_note
+        .iter()
+        .copied()
+        .filter(|d| d.period_source() == PeriodSource::File && d.jitter().is_some())
+        .collect();
+    let own = |d: &Demonstration| {
+        let n = d.period_note().unwrap_or_default();
+        if d.period_source() == PeriodSource::Assumed {
+            format!("{n}{assumed_suffix}")
+        } else {
+            n
+        }
+    };
+    if verbose() || with_note.len() == 1 {
+        for d in with_note {
+            note(&own(d));
+        }
+        return;
+    }
+    match assumed[..] {
+        [] => {}
+        [one] => note(&own(one)),
+        _ => {
+            let files: Vec<&str> = assumed.iter().map(|d| d.source()).collect();
+            let periods: Vec<f64> = assumed.iter().map(|d| secs(d.dt_s())).collect();
+            let same = periods.iter().all(|p| *p == periods[0]);
+            let apart = if same {
+                format!("{} s apart ({} Hz)", periods[0], secs(1.0 / periods[0]))
+            } else {
+                "the period given for them apart".into()
+            };
+            note(&format!(
+                "{}: no time column `t`: their samples are taken to be {apart}; if they were \
+                 logged at another rate, add a column `t` (seconds){assumed_suffix} (--verbose: \
+                 one note per file)",
+                files_text(&files)
+            ));
+        }
+    }
+    match jittered[..] {
+        [] => {}
+        [one] => note(&own(one)),
+        _ => {
+            let files: Vec<&str> = jittered.iter().map(|d| d.source()).collect();
+            let share = |d: &Demonstration| d.jitter().map_or(0.0, |(dev, _)| dev / d.dt_s());
+            let worst: &Demonstration = jittered
+                .iter()
+                .copied()
+                .max_by(|a, b| share(a).total_cmp(&share(b)))
+                .expect("at least two files");
+            let (dev, line) = worst.jitter().expect("a jittered file");
+            note(&format!(
+                "{}: time column `t`: times deviate from each file's even grid by up to {:.3} \
+                 ms ({:.1} % of a period, at {}:{line}; tandem accepts up to {} %): the samples \
+                 are taken to be evenly spaced (--verbose: one note per file)",
+                files_text(&files),
+                dev * 1e3,
+                100.0 * share(worst),
+                worst.source(),
+                100.0 * tandem::lfd::JITTER_TOLERANCE
+            ));
+        }
+    }
 }
 
 /// Prints a deprecation line on stderr: an old flag or name, kept one release, and what
@@ -100,10 +226,55 @@ fn fit(a: &FitArgs) -> Result<()> {
         bail!("--dt {dt}: the sample period must be finite and > 0 seconds");
     }
     let max = tandem::realtime::MAX_ROBOTS;
-    if !(1..=max).contains(&a.robots) {
-        bail!("--robots {}: one operator runs 1 to {max} robots", a.robots);
+    if let Some(r) = a.robots
+        && !(1..=max).contains(&r)
+    {
+        bail!("--robots {r}: one operator runs 1 to {max} robots");
     }
     state_io::check_file_target(&a.output)?;
+    // Recorded rounds are never discarded without consent; decided before any work.
+    let held = if a.force {
+        0
+    } else {
+        Planner::rounds_at(&a.output).with_context(|| {
+            format!(
+                "{}: cannot tell whether it holds recorded rounds; write to another file, or \
+                 replace it with --force",
+                a.output.display()
+            )
+        })?
+    };
+    if held > 0 && !a.keep_rounds {
+        bail!(
+            "{}: holds {held} recorded round(s) (the operator's corrections), which a new fit \
+             would discard; nothing was written. Keep them: add --keep-rounds (they are \
+             replayed onto the new fit); discard them: add --force; or write the new fit to \
+             another file (-o)",
+            a.output.display()
+        );
+    }
+    // With --keep-rounds: a read–modify–write of the state under its lock, as `record`.
+    let kept = if a.keep_rounds && a.output.is_file() {
+        let lock = state_io::lock(&a.output)?;
+        let old = state_io::load(&a.output)?;
+        if let Some(r) = a.robots
+            && r != old.n_robots()
+        {
+            bail!(
+                "--robots {r}: the rounds recorded in {} are of {} robots; with --keep-rounds \
+                 the new fit has the state's robot count (leave --robots out)",
+                a.output.display(),
+                old.n_robots()
+            );
+        }
+        Some((lock, old))
+    } else {
+        None
+    };
+    let robots = match &kept {
+        Some((_, old)) => old.n_robots(),
+        None => a.robots.unwrap_or(2),
+    };
     let demos: Vec<Demonstration> = bag::read_demos(
         &a.demos,
         a.dt,
@@ -112,10 +283,9 @@ fn fit(a: &FitArgs) -> Result<()> {
         &mut params.fit.schema,
         a.resample,
     )?;
+    period_notes(&demos.iter().collect::<Vec<_>>(), "");
+    let mut dt_notes: Vec<(String, String)> = Vec::new();
     for d in &demos {
-        if let Some(n) = d.period_note() {
-            note(&n);
-        }
         // The file's own time wins over --dt; a --dt that contradicts it is refused.
         if let Some(dt) = a.dt
             && d.period_source() == PeriodSource::File
@@ -129,14 +299,17 @@ fn fit(a: &FitArgs) -> Result<()> {
                     secs(d.dt_s())
                 );
             }
-            note(&format!(
-                "{}: its own time gives {} s; --dt (the period of files without a time column) \
-                 agrees and is not used for it",
-                d.source(),
-                secs(d.dt_s())
+            dt_notes.push((
+                d.source().to_owned(),
+                format!(
+                    "its own time gives {} s; --dt (the period of files without a time column) \
+                     agrees and is not used for it",
+                    secs(d.dt_s())
+                ),
             ));
         }
     }
+    grouped_notes(&dt_notes);
     for w in tandem::lfd::length_warnings(&demos) {
         note(&w);
     }
@@ -163,15 +336,49 @@ fn fit(a: &FitArgs) -> Result<()> {
         }
         params.fit.ranges = Some(ranges);
     }
-    let planner =
-        Planner::with_robots(&demos, params, a.robots).with_context(|| match &a.params {
-            Some(p) => format!(
-                "cannot fit the task model (parameters from {})",
-                p.display()
-            ),
-            None => "cannot fit the task model".into(),
-        })?;
-    planner.save(&a.output)?;
+    let fit_context = || match &a.params {
+        Some(p) => format!(
+            "cannot fit the task model (parameters from {})",
+            p.display()
+        ),
+        None => "cannot fit the task model".into(),
+    };
+    let mut kept_line = None;
+    let planner = if let Some((lock, old)) = &kept {
+        let (planner, report) = old.refit(&demos, params).with_context(fit_context)?;
+        planner.save_locked(lock)?;
+        kept_line = Some(format!(
+            "kept {} recorded round(s): replayed onto the new fit in their order{} (high \
+             confidence before the refit: {:.1} %)",
+            report.rounds,
+            if report.reference_changed {
+                ", each execution aligned to the new reference for its reference times"
+            } else {
+                " on the same reference"
+            },
+            100.0 * report.high_share_before
+        ));
+        planner
+    } else {
+        let planner = Planner::with_robots(&demos, params, robots).with_context(fit_context)?;
+        if a.force {
+            let lock = state_io::lock_new(&a.output)?;
+            kept_line = match planner.save_locked_discarding(&lock)? {
+                Some(0) => None,
+                Some(n) => Some(format!(
+                    "replaced {}: discarded its {n} recorded round(s) (--force)",
+                    a.output.display()
+                )),
+                None => Some(format!(
+                    "replaced {}, a state file this build cannot read (--force)",
+                    a.output.display()
+                )),
+            };
+        } else {
+            planner.save(&a.output)?;
+        }
+        planner
+    };
     let model = planner.model();
     let files: Vec<String> = a.demos.iter().map(|p| p.display().to_string()).collect();
     out(&format!(
@@ -191,6 +398,9 @@ fn fit(a: &FitArgs) -> Result<()> {
         model.channel_names().join(", ")
     ));
     summary_lines(&planner)?;
+    if let Some(line) = kept_line {
+        out(&line);
+    }
     out(&format!("saved {}", a.output.display()));
     Ok(())
 }
@@ -203,6 +413,13 @@ struct HoldRun {
     last: usize,
     /// Whether its samples are high-confidence, so a robot may dwell there now.
     active: bool,
+}
+
+impl HoldRun {
+    /// Its number of reference samples.
+    fn len(&self) -> usize {
+        self.last + 1 - self.start
+    }
 }
 
 /// The planner's hold points (`Problem::holds`) as stretches of consecutive samples with the
@@ -277,14 +494,97 @@ fn hold_lines(planner: &Planner) {
     let mut declared: Vec<String> = spec.at_s.iter().map(|t| format!("at {t} s")).collect();
     declared.extend(spec.rules.iter().map(|r| format!("where {r}")));
     out(&format!(
-        "hold points ({}): {} samples, {active} active (high-confidence: a robot may wait \
-         there)",
+        "hold points ({}): {} samples in {} stretch{}, {active} active (high-confidence: a \
+         robot may wait there)",
         declared.join(", "),
-        holds.len()
+        holds.len(),
+        runs.len(),
+        if runs.len() == 1 { "" } else { "es" }
     ));
-    let dt = planner.model().dt_s();
-    for r in &runs {
-        out(&format!("  {}", hold_run_text(r, dt)));
+    for line in hold_run_lines(&runs, planner.model().dt_s(), verbose()) {
+        out(&line);
+    }
+}
+
+/// Hold-point stretches listed one per line before a summary takes over (`--verbose` lists
+/// them all).
+const HOLD_RUNS_LISTED: usize = 5;
+
+/// Longest stretches named in a summary.
+const HOLD_RUNS_LONGEST: usize = 3;
+
+/// Inactive stretches of at most this many samples are counted as slivers in a summary:
+/// they sit at the edges of low-confidence regions, where the mean of the channel crosses
+/// the rule's value while the confidence is still low.
+const HOLD_SLIVER_SAMPLES: usize = 4;
+
+/// The lines under the hold-point line: every stretch when there are few (or `all`),
+/// otherwise per activity the count, the samples, the longest few and what makes an
+/// inactive one active.
+fn hold_run_lines(runs: &[HoldRun], dt: f64, all: bool) -> Vec<String> {
+    if all || runs.len() <= HOLD_RUNS_LISTED {
+        return runs
+            .iter()
+            .map(|r| format!("  {}", hold_run_text(r, dt)))
+            .collect();
+    }
+    let mut lines = Vec::new();
+    for active in [true, false] {
+        let mut mine: Vec<&HoldRun> = runs.iter().filter(|r| r.active == active).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        let samples: usize = mine.iter().map(|r| r.len()).sum();
+        let slivers = mine
+            .iter()
+            .filter(|r| r.len() <= HOLD_SLIVER_SAMPLES)
+            .count();
+        // Longest first; ties in reference order.
+        mine.sort_by(|a, b| b.len().cmp(&a.len()).then(a.start.cmp(&b.start)));
+        let longest: Vec<String> = mine
+            .iter()
+            .take(HOLD_RUNS_LONGEST)
+            .map(|r| hold_run_span(r, dt))
+            .collect();
+        let (state, what) = if active {
+            ("active", "a robot may wait there now")
+        } else {
+            (
+                "inactive",
+                "low-confidence: each becomes active once recorded rounds make its samples \
+                 trusted",
+            )
+        };
+        let sliver_text = if !active && slivers > 0 {
+            format!(
+                "; {slivers} of them {HOLD_SLIVER_SAMPLES} samples or shorter, at the edges of \
+                 low-confidence regions"
+            )
+        } else {
+            String::new()
+        };
+        lines.push(format!(
+            "  {state}: {} stretch{}, {samples} samples ({what}); longest: {}{sliver_text}",
+            mine.len(),
+            if mine.len() == 1 { "" } else { "es" },
+            longest.join(", ")
+        ));
+    }
+    lines.push("  (--verbose lists every stretch; inspect --json has them all)".into());
+    lines
+}
+
+/// `11.02–32.07 s (2106 samples)` or `2.00 s (1 sample)`.
+fn hold_run_span(r: &HoldRun, dt: f64) -> String {
+    let n = r.len();
+    if n == 1 {
+        format!("{:.2} s (1 sample)", r.start as f64 * dt)
+    } else {
+        format!(
+            "{:.2}–{:.2} s ({n} samples)",
+            r.start as f64 * dt,
+            r.last as f64 * dt
+        )
     }
 }
 
@@ -360,7 +660,8 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
 /// One robot's three files, read and checked as the planner takes them in
 /// ([`Planner::check_execution`]: resampled to the model's period if logged finer, the whole
 /// task covered, a plausible duration). An execution without a `t` column is taken to be
-/// logged once per control tick of the schedule it ran (stated on stderr). With `resample`
+/// logged once per control tick of the schedule it ran (`record` says so on stderr for the
+/// whole round, [`period_notes`]). With `resample`
 /// (`--resample`) an irregular `t` column is first put on an even grid, the log and flags
 /// with it ([`ExecutionRecord::from_regridded`]).
 fn read_execution(
@@ -380,15 +681,6 @@ fn read_execution(
             None,
         )
     };
-    if let Some(n) = demonstration.period_note() {
-        if demonstration.period_source() == PeriodSource::Assumed {
-            note(&format!(
-                "{n} (the assumed period is the control tick of the schedule it ran)"
-            ));
-        } else {
-            note(&n);
-        }
-    }
     let ref_time_log = input::read_log(log)?;
     let (supervised, corrected) = input::read_corrections(corr)?;
     let n = grid
@@ -464,7 +756,13 @@ fn record(a: &RecordArgs) -> Result<()> {
         )
     };
     let round = if a.bags.is_empty() {
-        (0..n).map(r).collect::<Result<Vec<_>>>()?
+        let round = (0..n).map(r).collect::<Result<Vec<_>>>()?;
+        let demos: Vec<&Demonstration> = round.iter().map(|r| &r.execution.demonstration).collect();
+        period_notes(
+            &demos,
+            " (the assumed period is the control tick of the schedule it ran)",
+        );
+        round
     } else {
         bag::read_round(&planner, &a.bags, a.round, &a.topics)?
     };
@@ -496,7 +794,8 @@ fn record(a: &RecordArgs) -> Result<()> {
 }
 
 fn inspect(a: &InspectArgs) -> Result<()> {
-    if tandem::bag::is_bag(&a.state) {
+    // A folder can only be a rosbag2 recording (or is refused as one, with what it holds).
+    if tandem::bag::is_bag(&a.state) || a.state.is_dir() {
         return bag::inspect_bag(&a.state, a.json);
     }
     let planner = state_io::load(&a.state)?;
@@ -725,4 +1024,69 @@ fn params() -> Result<()> {
     out("# Sections: [fit] alignment and model, [confidence] Eq. 10–12, [sampler] §II-C.");
     out(&text);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(start: usize, len: usize, active: bool) -> HoldRun {
+        HoldRun {
+            start,
+            last: start + len - 1,
+            active,
+        }
+    }
+
+    #[test]
+    fn many_hold_stretches_are_summarized_and_few_are_listed() {
+        // 23 stretches as on a partly trusted task: 9 active (lengths 10..=90), 14 inactive of
+        // which 10 are slivers of 2–4 samples and 4 longer (100, 200, 300, 5 samples).
+        let mut runs = Vec::new();
+        let mut at = 0;
+        let mut push = |len: usize, active: bool| {
+            runs.push(run(at, len, active));
+            at += len + 10;
+        };
+        for k in 1..=9 {
+            push(10 * k, true);
+        }
+        for k in 0..10 {
+            push(2 + k % 3, false);
+        }
+        for len in [100, 200, 300, 5] {
+            push(len, false);
+        }
+        let lines = hold_run_lines(&runs, 0.01, false);
+        assert_eq!(lines.len(), 3, "{lines:#?}");
+        // Active: 9 stretches, 10 + 20 + … + 90 = 450 samples, the longest three first.
+        assert!(
+            lines[0].starts_with(
+                "  active: 9 stretches, 450 samples (a robot may wait there now); longest: "
+            ),
+            "{}",
+            lines[0]
+        );
+        assert!(lines[0].contains("(90 samples), "), "{}", lines[0]);
+        // Inactive: 14 stretches; slivers 4×2 + 3×3 + 3×4 = 29 samples, plus 605.
+        assert!(
+            lines[1].starts_with("  inactive: 14 stretches, 634 samples (low-confidence"),
+            "{}",
+            lines[1]
+        );
+        assert!(lines[1].contains("(300 samples), "), "{}", lines[1]);
+        assert!(
+            lines[1].ends_with(
+                "; 10 of them 4 samples or shorter, at the edges of low-confidence regions"
+            ),
+            "{}",
+            lines[1]
+        );
+        assert!(lines[2].contains("--verbose"));
+        // --verbose, or five stretches or fewer: one line each.
+        assert_eq!(hold_run_lines(&runs, 0.01, true).len(), 23);
+        let few = hold_run_lines(&runs[..5], 0.01, false);
+        assert_eq!(few.len(), 5);
+        assert_eq!(few[0], "  0.00–0.09 s (samples 0–9, active)");
+    }
 }

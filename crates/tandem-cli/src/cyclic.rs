@@ -39,7 +39,7 @@ pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
     if a.json {
         out(&serde_json::to_string_pretty(&plan)?);
     } else {
-        out(&plan_text(problem, &plan)?);
+        out(&plan_text(problem, &plan, crate::cmd::verbose())?);
     }
     Ok(())
 }
@@ -63,9 +63,9 @@ fn stretch_name(robot: usize, lc: usize) -> String {
     format!("r{}s{}", robot + 1, lc + 1)
 }
 
-/// The operator's order as text, `r1s1 → r2s1 → r1s2–4 → …`: a run of one robot's
-/// consecutive stretches is written once.
-fn order_text(plan: &CyclicPlan) -> String {
+/// The operator's order as turns, `r1s1`, `r2s1`, `r1s2–4`, …: a run of one robot's
+/// consecutive stretches is one turn.
+fn order_turns(plan: &CyclicPlan) -> Vec<String> {
     let mut parts: Vec<String> = Vec::new();
     let mut k = 0;
     while k < plan.order.len() {
@@ -87,7 +87,54 @@ fn order_text(plan: &CyclicPlan) -> String {
         });
         k += 1;
     }
-    parts.join(" → ")
+    parts
+}
+
+/// Turns of the operator's order printed in full; a longer order is shown by its first
+/// [`ORDER_HEAD`] turns and its last one (`--verbose` prints all, `--json` has it).
+const ORDER_TURNS_SHOWN: usize = 12;
+
+/// Turns shown at the head of a long order.
+const ORDER_HEAD: usize = 8;
+
+/// Stretch durations printed one by one; beyond, their count, total and the longest few.
+const DURATIONS_SHOWN: usize = 8;
+
+/// The operator's order as text (`r1s1 → r2s1 → r1s2–4 → …`), whole when short or `all`.
+fn order_text(turns: &[String], all: bool) -> String {
+    if all || turns.len() <= ORDER_TURNS_SHOWN {
+        return turns.join(" → ");
+    }
+    format!(
+        "{} → … ({} turns in all) → {}",
+        turns[..ORDER_HEAD].join(" → "),
+        turns.len(),
+        turns[turns.len() - 1]
+    )
+}
+
+/// The stretch durations (s, at the mean speed) as text: each one when few or `all`,
+/// otherwise the count, the total, the longest few (`s5 3.21 s`: stretch 5 of the task)
+/// and how many are shorter than a second.
+fn durations_text(lc_s: &[f64], all: bool) -> String {
+    if all || lc_s.len() <= DURATIONS_SHOWN {
+        let lc: Vec<String> = lc_s.iter().map(|&d| secs_text(d)).collect();
+        return format!("{} s", lc.join(", "));
+    }
+    let mut order: Vec<usize> = (0..lc_s.len()).collect();
+    order.sort_by(|&a, &b| lc_s[b].total_cmp(&lc_s[a]).then(a.cmp(&b)));
+    let longest: Vec<String> = order
+        .iter()
+        .take(3)
+        .map(|&k| format!("s{} {} s", k + 1, secs_text(lc_s[k])))
+        .collect();
+    let short = lc_s.iter().filter(|&&d| d < 1.0).count();
+    format!(
+        "{} stretches per task, {} s in all; longest {}; {short} shorter than 1 s",
+        lc_s.len(),
+        secs_text(lc_s.iter().sum()),
+        longest.join(", ")
+    )
 }
 
 /// Stretch start times listed per robot in the text; `--json` has all of them.
@@ -95,8 +142,9 @@ const STRETCHES_SHOWN: usize = 8;
 
 /// The plan as text: period, throughput and busy share, the certificate, how the order was
 /// found, the operator's order, what the plan assumes, the Gantt of two periods and each
-/// robot's times.
-pub(crate) fn plan_text(problem: &Problem, plan: &CyclicPlan) -> Result<String> {
+/// robot's times. A long order and many stretch durations are summarized unless `all`
+/// (`--verbose`).
+pub(crate) fn plan_text(problem: &Problem, plan: &CyclicPlan, all: bool) -> Result<String> {
     let shape = TaskShape::new(problem);
     let n = plan.n_robots;
     let m = plan.lc_s.len();
@@ -151,14 +199,25 @@ pub(crate) fn plan_text(problem: &Problem, plan: &CyclicPlan) -> Result<String> 
             "operator's order: none (the task has no low-confidence stretch: nothing to supervise)"
         )?;
     } else {
+        let turns = order_turns(plan);
         writeln!(
             out,
             "operator's order per period: {} (rRsK: robot R's low-confidence stretch K of {m}, in \
              task order; rRsJ–K: its stretches J to K in a row; then again)",
-            order_text(plan)
+            order_text(&turns, all)
         )?;
-        let lc: Vec<String> = plan.lc_s.iter().map(|&d| secs_text(d)).collect();
-        writeln!(out, "stretch durations at ψ̇̄: {} s", lc.join(", "))?;
+        writeln!(
+            out,
+            "stretch durations at ψ̇̄: {}",
+            durations_text(&plan.lc_s, all)
+        )?;
+        if !all && (turns.len() > ORDER_TURNS_SHOWN || m > DURATIONS_SHOWN) {
+            writeln!(
+                out,
+                "             (--verbose prints the whole order and every duration; --json has \
+                 them all)"
+            )?;
+        }
     }
     writeln!(out)?;
     writeln!(
@@ -381,7 +440,31 @@ mod tests {
             order_exhaustive: true,
             orders_evaluated: 1,
         };
-        assert_eq!(order_text(&plan), "r1s1 → r2s3 → r1s2–3 → r2s1–2");
+        assert_eq!(
+            order_text(&order_turns(&plan), false),
+            "r1s1 → r2s3 → r1s2–3 → r2s1–2"
+        );
+    }
+
+    #[test]
+    fn a_long_order_and_many_stretches_are_summarized_unless_verbose() {
+        // 40 turns: robots alternating stretch by stretch over 20 stretches per task.
+        let turns: Vec<String> = (0..40).map(|k| stretch_name(k % 2, k / 2)).collect();
+        assert_eq!(
+            order_text(&turns, false),
+            "r1s1 → r2s1 → r1s2 → r2s2 → r1s3 → r2s3 → r1s4 → r2s4 → … (40 turns in all) → r2s20"
+        );
+        assert_eq!(order_text(&turns, true).matches(" → ").count(), 39);
+        // 23 durations: the count, the total, the three longest, the short ones.
+        let mut lc = vec![0.5; 20];
+        lc.extend([3.21, 2.5, 7.0]);
+        assert_eq!(
+            durations_text(&lc, false),
+            "23 stretches per task, 22.71 s in all; longest s23 7.00 s, s21 3.21 s, s22 2.50 s; \
+             20 shorter than 1 s"
+        );
+        assert_eq!(durations_text(&lc, true).matches(", ").count(), 22);
+        assert_eq!(durations_text(&lc[..3], false), "0.500, 0.500, 0.500 s");
     }
 
     #[test]

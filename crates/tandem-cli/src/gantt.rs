@@ -413,6 +413,54 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
 
 #[cfg(test)]
 mod tests {
+
+    mod glossary {
+        include!(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/support/glossary.rs"
+        ));
+    }
+
+    /// One of every schedule source. The match fails to compile when a source is added, until
+    /// it is handled there (and then listed here, and explained in the glossary).
+    fn every_source() -> Vec<Source> {
+        let all = vec![
+            Source::Sampled { candidate: 0 },
+            Source::Completed,
+            Source::Previous,
+            Source::RepairedPrevious,
+            Source::Serial,
+            Source::Held,
+            Source::Staggered,
+        ];
+        for s in &all {
+            match s {
+                Source::Sampled { .. }
+                | Source::Completed
+                | Source::Previous
+                | Source::RepairedPrevious
+                | Source::Serial
+                | Source::Held
+                | Source::Staggered => {}
+            }
+        }
+        all
+    }
+
+    #[test]
+    fn every_schedule_source_is_explained_in_the_glossary() {
+        let glossary = glossary::glossary();
+        for s in every_source() {
+            // The phrase `schedule:` lines print, in bold, followed by the short name records
+            // use (`Source::name`, the study's JSON and CSV, Python).
+            let label = source_name(&s).replace("candidate 0", "candidate k");
+            let entry = format!("**{label}** (`{}`)", s.name());
+            assert!(
+                glossary.contains(&entry),
+                "docs/guide.md's glossary lacks `{entry}`"
+            );
+        }
+    }
     use super::*;
 
     #[test]

@@ -17,6 +17,12 @@ pub(crate) fn lock(path: &Path) -> Result<StateLock> {
     Ok(StateLock::acquire(path, DEFAULT_LOCK_TIMEOUT)?)
 }
 
+/// Locks the state file `path` for a write that does not read it first (the file may be
+/// missing), waiting up to [`DEFAULT_LOCK_TIMEOUT`].
+pub(crate) fn lock_new(path: &Path) -> Result<StateLock> {
+    Ok(StateLock::acquire(path, DEFAULT_LOCK_TIMEOUT)?)
+}
+
 /// Loads a planner, naming the file in every error.
 pub(crate) fn load(path: &Path) -> Result<Planner> {
     if path.is_dir() {

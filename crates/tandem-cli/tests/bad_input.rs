@@ -170,8 +170,26 @@ fn malformed_demonstrations() {
                 })
                 .collect(),
             vec![
-                "rate.csv:1:1: sample period 0.02 s differs from the reference 0.01 s",
+                "rate.csv:1:1: sample period 0.02 s differs from 0.01 s, the period of 3 of the 4 \
+                 demonstrations (",
                 "resample it",
+            ],
+        ),
+        // A row written twice by the logger: named with its twin and the fix.
+        (
+            "dup_row.csv",
+            small_demo(60, 1.0)
+                .lines()
+                .enumerate()
+                .flat_map(|(k, l)| {
+                    let times = if k == 10 { 2 } else { 1 };
+                    std::iter::repeat_n(format!("{l}\n"), times)
+                })
+                .collect(),
+            vec![
+                ":12:1",
+                "line 12 repeats line 11 exactly",
+                "uniq FILE > FIXED",
             ],
         ),
         (
@@ -226,27 +244,29 @@ fn malformed_demonstrations() {
             "{name}: no output on error"
         );
     }
-    // Half the task (30 of 60 samples: 0.51× the median) is not refused, but said, with the
-    // fix; the fit goes through.
+    // Half the task (30 of 60 samples: 0.51× the median): inside the length band (a note),
+    // but it does not reach the end of the task: refused with the fix (issue 39; it was
+    // accepted with the note alone).
     let half: String = small_demo(60, 1.0)
         .lines()
         .take(31)
         .map(|l| format!("{l}\n"))
         .collect();
     let half = write(&dir, "half.csv", &half);
-    let out = tandem(fit_with(&dir, &half, false));
-    ok(&out);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    for part in [
-        &format!(
-            "note: {}: 0.29 s long, 0.51× the median demonstration",
-            s(&half)
-        ),
-        "trim it or leave it out",
-    ] {
-        assert!(stderr.contains(part), "`{part}` missing in:\n{stderr}");
-    }
-    std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
+    let args = fit_with(&dir, &half, false);
+    expect_user_error(
+        &args,
+        &[
+            &format!(
+                "note: {}: 0.29 s long, 0.51× the median demonstration",
+                s(&half)
+            ),
+            &format!("{}: does not reach the end of the task", s(&half)),
+            "demonstrate the whole task again",
+        ],
+        None,
+    );
+    assert!(!dir.join("out.tandem").exists());
     // A UTF-8 byte-order mark (spreadsheet export) is skipped; a ±1.5 ms jitter at 100 Hz is
     // accepted with its worst deviation in a note; the fit goes through.
     let bom = write(&dir, "bom.csv", &format!("\u{feff}{}", small_demo(60, 1.0)));
@@ -689,6 +709,17 @@ fn malformed_executions() {
             1,
             format!("ref_sample\n{}", "0\n".repeat(n)),
             vec!["ends at reference sample 0", "end of"],
+        ),
+        // A log that stops moving early, its last step 1.2055098163 reference samples: the
+        // message rounds the numbers to a thousandth.
+        (
+            "stops.reflog.csv",
+            1,
+            format!(
+                "ref_sample\n{}",
+                lines(&|k| format!("{}\n", k.min(33) as f64 * 1.205_509_816_3))
+            ),
+            vec!["ends at reference sample 39.782 (expected within 1.206 of the end of the task"],
         ),
         (
             "late.reflog.csv",
@@ -1195,4 +1226,56 @@ fn bad_need_requests() {
         };
         assert_eq!(row, want, "row {k}");
     }
+}
+
+#[test]
+fn demonstrations_cut_off_before_the_end_and_fits_over_recorded_rounds() {
+    let dir = scratch("truncated-demos");
+    let state = small_state(&dir);
+    let a = small_execution(&dir, "r1");
+    let b = small_execution(&dir, "r2");
+    ok(&tandem(record_args(&state, &a, &b)));
+    let demos: Vec<PathBuf> = (0..3).map(|i| dir.join(format!("demo_{i}.csv"))).collect();
+    // A fourth demonstration cut off at 55 % or 80 % of the task: refused, naming it.
+    let full = small_demo(SMALL_N_REF, 3.0);
+    for (share, name) in [(0.55, "cut55.csv"), (0.8, "cut80.csv")] {
+        let rows = (SMALL_N_REF as f64 * share) as usize;
+        let text: String = full
+            .lines()
+            .take(rows + 1)
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let cut = write(&dir, name, &text);
+        let mut args: Vec<String> = vec!["fit".into()];
+        args.extend(demos.iter().map(|p| s(p)));
+        args.push(s(&cut));
+        args.extend(["-o".into(), s(&dir.join("new.tandem"))]);
+        expect_user_error(
+            &args,
+            &[
+                name,
+                "does not reach the end of the task",
+                "demonstrate the whole task",
+            ],
+            None,
+        );
+        assert!(!dir.join("new.tandem").exists());
+    }
+    // A fit over the state holding a round: refused, naming the count and both ways on.
+    let mut args: Vec<String> = vec!["fit".into()];
+    args.extend(demos.iter().map(|p| s(p)));
+    args.extend(["-o".into(), s(&state)]);
+    expect_user_error(
+        &args,
+        &[
+            "cell.tandem",
+            "holds 1 recorded round(s)",
+            "--keep-rounds",
+            "--force",
+        ],
+        Some(&state),
+    );
+    args.extend(["--keep-rounds".into(), "--force".into()]);
+    expect_user_error(&args, &["--keep-rounds", "--force"], Some(&state));
+    std::fs::remove_dir_all(&dir).unwrap();
 }

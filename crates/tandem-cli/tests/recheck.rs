@@ -8,7 +8,7 @@ use common::*;
 use serde::{Deserialize, Serialize};
 use tandem::PlannerParams;
 use tandem::confidence::{Confidence, Observations};
-use tandem::lfd::TaskModel;
+use tandem::lfd::{Demonstration, TaskModel};
 use tandem::planner::state;
 use tandem::schedule::{Outcome, validate};
 
@@ -29,6 +29,17 @@ struct Payload {
     outcome: Outcome,
     rounds_recorded: usize,
     rounds: Vec<u64>,
+    reference: Option<Demonstration>,
+    records: Vec<Vec<Record>>,
+}
+
+/// A recorded execution as the state file keeps it (format 11).
+#[derive(Serialize, Deserialize)]
+struct Record {
+    demonstration: Demonstration,
+    ref_time_log: Vec<f64>,
+    supervised: Vec<bool>,
+    corrected: Vec<bool>,
 }
 
 #[test]

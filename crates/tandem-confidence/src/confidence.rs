@@ -18,7 +18,9 @@ use crate::{ConfidenceParams, Error, ErrorRates, Observations, Result};
 /// `Beta(2, 2)`) or a later correction cannot turn it back to low confidence. The paper's
 /// claim that "the previous scheduling solution will always remain valid" rests on this:
 /// a schedule that was feasible for one confidence map is feasible for any map with
-/// more high-confidence samples.
+/// more high-confidence samples. [`update_round`](Confidence::update_round), which the
+/// planner uses, keeps that latch against the prior and the error rates but not against
+/// corrections recorded after it, so that the same rounds give the same map in any order.
 ///
 /// ```
 /// use tandem_confidence::{Confidence, ConfidenceParams, Observations};
@@ -71,6 +73,16 @@ impl TryFrom<ConfidenceData> for Confidence {
     fn try_from(d: ConfidenceData) -> Result<Self> {
         Self::from_parts(d.params, d.high)
     }
+}
+
+/// What [`Confidence::update_round`] changed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RoundUpdate {
+    /// Samples that became high-confidence (latched) in this update.
+    pub newly_high: usize,
+    /// Latched samples that the round's corrections turned low-confidence again (their
+    /// totals no longer pass Eq. 12).
+    pub reopened: usize,
 }
 
 impl Confidence {
@@ -150,6 +162,103 @@ impl Confidence {
         self.latch(sigma2_d, &rates, |n| (c[n], s[n]))
     }
 
+    /// [`update`](Self::update) after one round of executions, whose observations took the
+    /// totals from `before` to `after`: the decision is the one the totals `after` give
+    /// (Eq. 9–12 on `sigma2_d` and the error rates estimated from `after`), and the latch
+    /// holds against everything but the operator's corrections. A latched sample that the
+    /// round gave correction mass (`after.corrections()[n] > before.corrections()[n]`) is
+    /// decided again on the totals, and is low-confidence again if they do not pass.
+    ///
+    /// Why (docs/decisions.md, "The same rounds in any order: the latch yields to
+    /// corrections"): the paper latches because "high-confidence time steps cannot transition
+    /// back to low-confidence time steps (i.e., cannot be given corrections)". The premise
+    /// fails twice: rounds recorded out of order (several cells or processes running the
+    /// schedules of older states) bring corrections of samples latched since they ran, and in
+    /// order the observation of a supervised sample reaches a latched neighbour at the edge of
+    /// a supervised stretch (the split of Eq. 9's fractional times, the sweep of
+    /// [`Observations::record_votes_swept`]). A latch that ignored those corrections kept a
+    /// sample trusted by the luck of having its clean rounds recorded first. With the latch
+    /// yielding to corrections, the confidence after a set of rounds is the totals' decision
+    /// whatever their order, except where the prior (`σ²_D`, which Eq. 21 moves) or the
+    /// estimated error rates were more favourable at an earlier round at which the sample's
+    /// whole correction record already passed: there the latch still holds, as the paper
+    /// wants it to against a widening `σ²_D`.
+    ///
+    /// With `before == after` this is [`update`](Self::update).
+    ///
+    /// ```
+    /// use tandem_confidence::{Confidence, ConfidenceParams, Observations};
+    /// let sigma2_d = [10.0];
+    /// let p = ConfidenceParams::paper();
+    /// let clean = |obs: &mut Observations| obs.record(&[0.0; 90], &[false; 90]);
+    /// // 90 clean observations latch the sample; then 10 corrected ones arrive.
+    /// let (mut a, mut obs) = (Confidence::from_prior(&sigma2_d, p.clone())?, Observations::new(1)?);
+    /// let before = obs.clone();
+    /// clean(&mut obs)?;
+    /// assert_eq!(a.update_round(&sigma2_d, &before, &obs)?.newly_high, 1);
+    /// let before = obs.clone();
+    /// obs.record(&[0.0; 10], &[true; 10])?;
+    /// assert_eq!(a.update_round(&sigma2_d, &before, &obs)?.reopened, 1);
+    /// assert!(!a.conf()[0]);
+    /// // The other order ends the same: the corrections first, then the clean rounds.
+    /// let (mut b, mut obs) = (Confidence::from_prior(&sigma2_d, p)?, Observations::new(1)?);
+    /// for step in 0..2 {
+    ///     let before = obs.clone();
+    ///     if step == 0 { obs.record(&[0.0; 10], &[true; 10])? } else { clean(&mut obs)? }
+    ///     b.update_round(&sigma2_d, &before, &obs)?;
+    /// }
+    /// assert_eq!(a, b);
+    /// # Ok::<(), tandem_confidence::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`update`](Self::update); [`Error::LengthMismatch`] if `before` has another
+    /// length; [`Error::NotEarlier`] naming the first sample where `before` holds more mass
+    /// than `after` (it is not an earlier state of the same observations).
+    pub fn update_round(
+        &mut self,
+        sigma2_d: &[f64],
+        before: &Observations,
+        after: &Observations,
+    ) -> Result<RoundUpdate> {
+        check_len(
+            "observations",
+            after.n_ref(),
+            "the confidence state",
+            self.n_ref(),
+        )?;
+        check_len(
+            "observations before the round",
+            before.n_ref(),
+            "observations after it",
+            after.n_ref(),
+        )?;
+        let (c0, s0) = (before.corrections(), before.supervised());
+        let (c, s) = (after.corrections(), after.supervised());
+        for ref_idx in 0..c.len() {
+            for (what, b, a) in [
+                ("correction", c0[ref_idx], c[ref_idx]),
+                ("supervised", s0[ref_idx], s[ref_idx]),
+            ] {
+                if b > a {
+                    return Err(Error::NotEarlier {
+                        ref_idx,
+                        what,
+                        before: b,
+                        after: a,
+                    });
+                }
+            }
+        }
+        let rates = crate::estimate_error_rates(after, &self.params)?;
+        let (newly_high, reopened) =
+            self.latch_reopening(sigma2_d, &rates, |n| (c[n], s[n]), |n| c[n] > c0[n])?;
+        Ok(RoundUpdate {
+            newly_high,
+            reopened,
+        })
+    }
+
     /// Shared body of [`update`](Self::update) and [`from_prior`](Self::from_prior):
     /// `counts(n)` gives `(corrections[n], supervised[n])`, with `0 ≤ c ≤ s` finite.
     fn latch(
@@ -158,6 +267,18 @@ impl Confidence {
         rates: &ErrorRates,
         counts: impl Fn(usize) -> (f64, f64),
     ) -> Result<usize> {
+        Ok(self.latch_reopening(sigma2_d, rates, counts, |_| false)?.0)
+    }
+
+    /// [`latch`](Self::latch) where the latched samples with `reopen(n)` are decided again
+    /// too: `(newly high, latched samples that turned low)`.
+    fn latch_reopening(
+        &mut self,
+        sigma2_d: &[f64],
+        rates: &ErrorRates,
+        counts: impl Fn(usize) -> (f64, f64),
+        reopen: impl Fn(usize) -> bool,
+    ) -> Result<(usize, usize)> {
         self.params.validate()?;
         check_len(
             "sigma2_d",
@@ -178,9 +299,9 @@ impl Confidence {
         if !rates.is_zero() && shifted.as_ref().is_none_or(|(mu, _)| *mu != mu_shifted) {
             *shifted = Some((mu_shifted, Boundary::default()));
         }
-        let mut newly = Vec::new();
+        let (mut newly, mut lowered) = (Vec::new(), Vec::new());
         for (ref_idx, (&high, &s2)) in latched.iter().zip(sigma2_d).enumerate() {
-            if high {
+            if high && !reopen(ref_idx) {
                 continue;
             }
             let (alpha0, beta0) = prior_ab(s2, p);
@@ -200,19 +321,25 @@ impl Confidence {
                     beta,
                 });
             }
+            let was_high = high;
             let high = match shifted {
                 // `P(π < μ_c | data) = I_{μ'_c}(α, β)`: Eq. 12 at `μ'_c`, with its own cache.
                 Some((mu, cache)) if !rates.is_zero() => cache.decide(alpha, beta, *mu, p.gamma_c),
                 _ => boundary.decide(alpha, beta, p.mu_c, p.gamma_c),
             };
-            if high {
-                newly.push(ref_idx);
+            match (was_high, high) {
+                (false, true) => newly.push(ref_idx),
+                (true, false) => lowered.push(ref_idx),
+                _ => {}
             }
         }
         for &ref_idx in &newly {
             self.high[ref_idx] = true;
         }
-        Ok(newly.len())
+        for &ref_idx in &lowered {
+            self.high[ref_idx] = false;
+        }
+        Ok((newly.len(), lowered.len()))
     }
 
     /// The parameters this state was built with.

@@ -82,6 +82,22 @@ pub enum Error {
         /// Supervised mass at that sample.
         supervised: f64,
     },
+    /// The observations given as "before the round" hold more mass at a sample than those
+    /// after it ([`Confidence::update_round`](crate::Confidence::update_round)).
+    #[error(
+        "observations at reference sample {ref_idx}: {what} mass {before} before the round but \
+         {after} after it: pass the observations as they were before this round"
+    )]
+    NotEarlier {
+        /// Reference sample where the mass decreased.
+        ref_idx: usize,
+        /// `"correction"` or `"supervised"`.
+        what: &'static str,
+        /// Mass before the round.
+        before: f64,
+        /// Mass after it.
+        after: f64,
+    },
     /// Two per-sample inputs that must have the same length do not.
     #[error("length mismatch: {left_name} has {left} entries but {right_name} has {right}")]
     LengthMismatch {

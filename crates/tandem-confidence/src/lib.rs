@@ -18,7 +18,9 @@
 //! 4. **Decision** (Eq. 12): high confidence iff `P(p_{c|t} < μ_c) = I_{μ_c}(α, β) > γ_c`,
 //!    with the regularized incomplete beta function of `statrs`.
 //! 5. **Latch** ([`Confidence`]): a sample that became high-confidence stays so, even if a
-//!    later variance update moves its prior, so a previous schedule stays valid.
+//!    later variance update moves its prior, so a previous schedule stays valid;
+//!    [`Confidence::update_round`] decides a latched sample again when a round brings
+//!    corrections of it, so the same rounds give the same confidence in any order.
 //!
 //! # Worked example: how long until a variable but never-corrected sample is trusted?
 //!
@@ -92,7 +94,7 @@ mod rates;
 mod runs;
 
 pub use beta::{BetaParams, posterior, prior};
-pub use confidence::{Confidence, evaluate, prob_need_below_mu_c};
+pub use confidence::{Confidence, RoundUpdate, evaluate, prob_need_below_mu_c};
 pub use error::{Error, Result};
 pub use observations::{MissEvidence, Observations};
 pub use params::ConfidenceParams;

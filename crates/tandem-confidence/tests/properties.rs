@@ -3,6 +3,7 @@
 //! evaluation of Eq. 12.
 
 use proptest::prelude::*;
+use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tandem_confidence::{
@@ -128,6 +129,81 @@ proptest! {
                 prop_assert_eq!(unlatched[n], fresh, "sample {}", n);
                 prop_assert_eq!(conf.conf()[n], before[n] || fresh, "sample {}", n);
             }
+        }
+    }
+
+    /// The same executions, each its own round, in any order: with a fixed prior and fixed
+    /// error rates the latch that yields to corrections ends at the totals' decision, which
+    /// no order changes (Eq. 12 rises with clean mass at fixed corrections, so a sample
+    /// latched before its last correction is decided again on the totals, and one latched
+    /// after it passes on the totals too).
+    #[test]
+    fn with_a_fixed_prior_and_rates_any_order_ends_at_the_totals_decision(
+        n_ref in 1_usize..8,
+        n_exec in 1_usize..40,
+        p_corr in prop_oneof![Just(0.05), Just(0.2), Just(0.5)],
+        votes in any::<bool>(),
+        seed in any::<u64>(),
+    ) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let params = ConfidenceParams {
+            mu_c: 0.3,
+            gamma_c: 0.5,
+            estimate_error_rates: false,
+            ..ConfidenceParams::default()
+        };
+        let sigma2_d: Vec<f64> = (0..n_ref).map(|_| rng.random_range(0.0..1.0)).collect();
+        let executions: Vec<_> = (0..n_exec)
+            .map(|_| execution(&mut rng, n_ref, p_corr))
+            .collect();
+        let record = |obs: &mut Observations, (t, c): &(Vec<f64>, Vec<bool>)| {
+            if votes { obs.record_votes(t, c) } else { obs.record(t, c) }
+        };
+        let mut order: Vec<usize> = (0..n_exec).collect();
+        let mut finals = Vec::new();
+        for _ in 0..20 {
+            let mut conf = Confidence::from_prior(&sigma2_d, params.clone()).unwrap();
+            let mut obs = Observations::new(n_ref).unwrap();
+            for &k in &order {
+                let before = obs.clone();
+                record(&mut obs, &executions[k]).unwrap();
+                conf.update_round(&sigma2_d, &before, &obs).unwrap();
+            }
+            // Sums in another order differ in the last bits only: the decision is the
+            // totals' whichever order summed them.
+            let totals = evaluate(&sigma2_d, &obs, &params).unwrap();
+            prop_assert_eq!(conf.conf(), totals.as_slice(), "order {:?}", order);
+            finals.push(conf.conf().to_vec());
+            order.shuffle(&mut rng);
+        }
+        prop_assert!(finals.windows(2).all(|w| w[0] == w[1]));
+    }
+
+    #[test]
+    fn update_round_without_new_observations_is_update(
+        n_ref in 1_usize..10,
+        seed in any::<u64>(),
+    ) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let params = ConfidenceParams::default();
+        let sigma2_d: Vec<f64> = (0..n_ref).map(|_| rng.random_range(0.0..2.0)).collect();
+        let mut obs = Observations::new(n_ref).unwrap();
+        for _ in 0..rng.random_range(0..60) {
+            let (t, c) = execution(&mut rng, n_ref, 0.1);
+            obs.record_votes(&t, &c).unwrap();
+        }
+        let mut a = Confidence::from_prior(&sigma2_d, params.clone()).unwrap();
+        let mut b = a.clone();
+        let newly = a.update(&sigma2_d, &obs).unwrap();
+        let round = b.update_round(&sigma2_d, &obs, &obs).unwrap();
+        prop_assert_eq!(&a, &b);
+        prop_assert_eq!(round.newly_high, newly);
+        prop_assert_eq!(round.reopened, 0);
+        // `before` that is not an earlier state is refused, naming the sample.
+        if obs.total_supervised() > 0.0 {
+            let empty = Observations::new(n_ref).unwrap();
+            let err = b.update_round(&sigma2_d, &obs, &empty).unwrap_err();
+            prop_assert!(err.to_string().contains("pass the observations as they were before"), "{}", err);
         }
     }
 }

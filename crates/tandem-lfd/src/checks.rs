@@ -14,6 +14,24 @@ pub const LENGTH_REFUSE_RATIO: f64 = 2.0;
 /// times the median (but inside the refusal band) is warned about ([`length_warnings`]): 1.5.
 pub const LENGTH_WARN_RATIO: f64 = 1.5;
 
+/// A demonstration whose alignment to the reference ends with a run of the lower slope bound
+/// (`WarpParams::slope_min`, within [`END_RUN_SLOPE_TOLERANCE`]) longer than this share of the
+/// reference is refused as not reaching the end of the task
+/// ([`Error::TruncatedDemonstration`]): 0.05 (docs/decisions.md, "A demonstration must reach
+/// the end of the task").
+pub const END_RUN_REFUSE_SHARE: f64 = 0.05;
+
+/// Over the final run, the signal whose part is missing must move: some channel must vary by
+/// more than this share of its range over the whole demonstration (a run over a stretch
+/// where both signals rest, a final pause of independent length, is not a missing part):
+/// 0.05, the run's own threshold ([`END_RUN_REFUSE_SHARE`]), so that on a task moving at an
+/// even pace the two agree. A resting channel varies by its noise, far below it (the
+/// alignment's flat stretches: 1 % of the range, `tandem_warp::FLAT_RANGE_FRACTION`).
+pub const END_RUN_MOTION_SHARE: f64 = 0.05;
+
+/// How close to a slope bound a warp's slope counts as "at the bound": within 5 % of it.
+pub const END_RUN_SLOPE_TOLERANCE: f64 = 0.05;
+
 /// Units a time column is given in, as a last name token (`t_ms`, `stamp.sec`).
 const TIME_UNITS: [&str; 13] = [
     "s", "sec", "secs", "second", "seconds", "ms", "msec", "us", "usec", "ns", "nsec", "nsecs",
@@ -91,6 +109,128 @@ pub fn check_lengths(demos: &[Demonstration]) -> Result<()> {
                 ratio,
             });
         }
+    }
+    Ok(())
+}
+
+/// Length of the final run of `warp` (reference sample → demo sample, `n_ref` values ending at
+/// `t_i − 1`) whose slope in normalized time (`ψ̇·(n_ref − 1)/(t_i − 1)`) is at a bound:
+/// `at_min` for the lower bound `slope_min`, else the upper `slope_max`; as a share of the
+/// reference's span `n_ref − 1`.
+fn end_run_share(warp: &[f64], t_i: usize, slope: f64, at_min: bool) -> f64 {
+    let n_ref = warp.len();
+    if n_ref < 2 || t_i < 2 {
+        return 0.0;
+    }
+    let scale = (n_ref - 1) as f64 / (t_i - 1) as f64;
+    let run = warp
+        .windows(2)
+        .rev()
+        .take_while(|w| {
+            let s = (w[1] - w[0]) * scale;
+            if at_min {
+                s <= slope * (1.0 + END_RUN_SLOPE_TOLERANCE)
+            } else {
+                s >= slope / (1.0 + END_RUN_SLOPE_TOLERANCE)
+            }
+        })
+        .count();
+    run as f64 / (n_ref - 1) as f64
+}
+
+/// Whether some channel of `demo` varies over its samples `from..` by more than
+/// [`END_RUN_MOTION_SHARE`] of its range over the whole demonstration.
+fn moves_after(demo: &Demonstration, from: usize) -> bool {
+    let m = demo.n_channels();
+    let spread = |rows: &[f64], c: usize| {
+        let (lo, hi) = rows
+            .chunks_exact(m)
+            .map(|r| r[c])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+        hi - lo
+    };
+    let all = demo.samples();
+    let tail = &all[from.min(demo.n_samples() - 1) * m..];
+    (0..m).any(|c| {
+        let range = spread(all, c);
+        range > 0.0 && spread(tail, c) > END_RUN_MOTION_SHARE * range
+    })
+}
+
+/// The reference sample from which motion over a final run of `run` (share of the reference)
+/// counts: the run's start plus a tenth of its length, so that the last feature both signals
+/// share, where the run begins, is not taken for motion inside it.
+fn inner_start(n_ref: usize, run: f64) -> usize {
+    let len = (run * (n_ref - 1) as f64).round() as usize;
+    (n_ref - 1 - len + len / 10).min(n_ref - 1)
+}
+
+/// Refuses a demonstration that does not reach the end of the task, the check executions
+/// get from their reference-time log (`TaskModel::update`), made on the alignment: a
+/// demonstration cut off before the end is aligned to the reference with its last samples
+/// spread over the rest of the task at the slowest slope the alignment allows
+/// (`slope_min`, pinned at the end), so its warp ends with a long run at that bound; a
+/// complete one, faster, slower or pausing, does not (the sanding fixtures: none; cut at
+/// 55 %, 80 % and 90 %: 39 %, 17 % and 11 % of the task). A run over
+/// [`END_RUN_REFUSE_SHARE`] of the reference over which the reference moves
+/// ([`END_RUN_MOTION_SHARE`], after the run's first tenth, where the last shared feature
+/// sits) is refused: where the reference rests over the run (both end at rest, for lengths
+/// of their own) nothing is missing. When the reference itself is the
+/// short one, every other demonstration's warp ends with a run at the upper bound
+/// (`slope_max`: the rest of their task squeezed into its last sample) over which they
+/// move; that is refused naming the reference. `demos` and `warps` are in model order, the reference first
+/// (its warp is the identity and is not checked). Called by [`crate::TaskModel::fit`].
+///
+/// # Errors
+/// [`Error::TruncatedDemonstration`] for the first demonstration (or the reference) that
+/// stops short, naming it, where it ends on the reference and the fix.
+pub(crate) fn check_reaches_end(
+    demos: &[&Demonstration],
+    warps: &[Vec<f64>],
+    slope_min: f64,
+    slope_max: f64,
+) -> Result<()> {
+    let reference = demos[0].source();
+    for (demo, warp) in demos.iter().zip(warps).skip(1) {
+        let run = end_run_share(warp, demo.n_samples(), slope_min, true);
+        if run > END_RUN_REFUSE_SHARE && moves_after(demos[0], inner_start(warp.len(), run)) {
+            return Err(Error::TruncatedDemonstration {
+                file: demo.source().into(),
+                ends_at_pct: 100.0 * (1.0 - run),
+                why: format!(
+                    "aligned to the reference ({reference}), its last samples are spread over \
+                     the last {:.0} % of the task at the slowest pace the alignment allows",
+                    100.0 * run
+                ),
+            });
+        }
+    }
+    let others: Vec<f64> = demos
+        .iter()
+        .zip(warps)
+        .skip(1)
+        .map(|(demo, warp)| {
+            let run = end_run_share(warp, demo.n_samples(), slope_max, false);
+            // The other's samples squeezed into the run.
+            let from = warp[inner_start(warp.len(), run)].floor().max(0.0) as usize;
+            if moves_after(demo, from) { run } else { 0.0 }
+        })
+        .collect();
+    let shortest = others.iter().copied().fold(f64::INFINITY, f64::min);
+    if !others.is_empty() && shortest > END_RUN_REFUSE_SHARE {
+        return Err(Error::TruncatedDemonstration {
+            file: reference.into(),
+            ends_at_pct: 100.0 * (1.0 - shortest),
+            why: format!(
+                "it is the reference, and every other demonstration's alignment to it ends with \
+                 at least the last {:.0} % of the task squeezed into its last sample (make \
+                 another demonstration the reference if this one is kept: give it first, or \
+                 `--reference medoid`)",
+                100.0 * shortest
+            ),
+        });
     }
     Ok(())
 }
@@ -173,6 +313,98 @@ mod tests {
         Demonstration::new(vec!["a".into()], vec![0.0; n], 0.01)
             .unwrap()
             .with_source(format!("d{n}"))
+    }
+
+    /// A demonstration of `n` samples moving all along (a ramp), labelled `d<n>`.
+    fn ramp(n: usize) -> Demonstration {
+        Demonstration::new(vec!["a".into()], (0..n).map(|k| k as f64).collect(), 0.01)
+            .unwrap()
+            .with_source(format!("d{n}"))
+    }
+
+    /// A warp of `n_ref` values onto `t_i` samples: the identity pace up to share `cut` of
+    /// the reference, then the rest at normalized slope `end_slope`.
+    fn warp_with_end(n_ref: usize, t_i: usize, cut: f64, end_slope: f64) -> Vec<f64> {
+        let scale = (t_i - 1) as f64 / (n_ref - 1) as f64;
+        let knee = (cut * (n_ref - 1) as f64).round() as usize;
+        let end_len = (n_ref - 1 - knee) as f64 * end_slope * scale;
+        let head = (t_i - 1) as f64 - end_len;
+        (0..n_ref)
+            .map(|n| {
+                if n <= knee {
+                    head * n as f64 / knee as f64
+                } else {
+                    head + (n - knee) as f64 * end_slope * scale
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_warp_ending_at_the_slope_bound_is_a_demonstration_that_stops_short() {
+        let (n_ref, t_i) = (201, 121);
+        let d = ramp(t_i);
+        let r = ramp(n_ref);
+        let identity: Vec<f64> = (0..n_ref).map(|n| n as f64).collect();
+        // Cut at 55 %: the last 45 % at s_min = 0.25 → run 0.45 > 0.05, ends at 55 %.
+        let cut = warp_with_end(n_ref, t_i, 0.55, 0.25);
+        assert!((end_run_share(&cut, t_i, 0.25, true) - 0.45).abs() < 1e-9);
+        let err = check_reaches_end(&[&r, &d], &[identity.clone(), cut], 0.25, 4.0).unwrap_err();
+        let Error::TruncatedDemonstration {
+            ref file,
+            ends_at_pct,
+            ..
+        } = err
+        else {
+            panic!("{err}");
+        };
+        assert_eq!(file, "d121");
+        assert!((ends_at_pct - 55.0).abs() < 1e-9);
+        let msg = err.to_string();
+        for part in [
+            "d121",
+            "55 %",
+            "d201",
+            "last 45 %",
+            "demonstrate the whole task",
+        ] {
+            assert!(msg.contains(part), "`{part}` missing: {msg}");
+        }
+        // A run of 5 % exactly is accepted, 6 % refused.
+        let five = warp_with_end(n_ref, t_i, 0.95, 0.25);
+        check_reaches_end(&[&r, &d], &[identity.clone(), five], 0.25, 4.0).unwrap();
+        let six = warp_with_end(n_ref, t_i, 0.94, 0.25);
+        assert!(check_reaches_end(&[&r, &d], &[identity.clone(), six], 0.25, 4.0).is_err());
+        // A slow but not bound-pinned end (slope 0.3, 1.2× the bound) is accepted.
+        let slow = warp_with_end(n_ref, t_i, 0.5, 0.3);
+        check_reaches_end(&[&r, &d], &[identity.clone(), slow], 0.25, 4.0).unwrap();
+        // Every other demonstration ending at s_max: the reference stops short.
+        let fast = warp_with_end(n_ref, t_i, 0.9, 4.0);
+        let err = check_reaches_end(
+            &[&r, &d, &d],
+            &[identity.clone(), fast.clone(), fast.clone()],
+            0.25,
+            4.0,
+        )
+        .unwrap_err();
+        assert!(
+            matches!(err, Error::TruncatedDemonstration { ref file, .. } if file == "d201"),
+            "{err}"
+        );
+        assert!(err.to_string().contains("reference"), "{err}");
+        // One of two at s_max is not enough to blame the reference.
+        let plain = warp_with_end(n_ref, t_i, 0.5, 1.0);
+        check_reaches_end(&[&r, &d, &d], &[identity.clone(), fast, plain], 0.25, 4.0).unwrap();
+        // Where both rest over the run (the reference flat from 50 %: a final pause of a
+        // length of its own), the run at the bound misses nothing: accepted.
+        let resting = Demonstration::new(
+            vec!["a".into()],
+            (0..n_ref).map(|k| (k.min(100)) as f64).collect(),
+            0.01,
+        )
+        .unwrap();
+        let cut = warp_with_end(n_ref, t_i, 0.55, 0.25);
+        check_reaches_end(&[&resting, &d], &[identity, cut], 0.25, 4.0).unwrap();
     }
 
     #[test]

@@ -250,6 +250,13 @@ impl Demonstration {
         })
     }
 
+    /// The `t` column's worst deviation from its even grid (s) and the 1-based line where it
+    /// is, when it exceeds [`JITTER_NOTE`] of a period (what [`Demonstration::period_note`]
+    /// reports); `None` otherwise.
+    pub fn jitter(&self) -> Option<(f64, usize)> {
+        self.jitter
+    }
+
     fn with_period_source(mut self, period: PeriodSource) -> Self {
         self.period = period;
         self
@@ -473,6 +480,13 @@ impl Demonstration {
                 found: n,
             });
         }
+        let rows = table.rows();
+        if let (Some(col), Some(k)) = (
+            t_col,
+            (1..n).find(|&k| rows[k].fields == rows[k - 1].fields),
+        ) {
+            return Err(repeated_row(file, rows[k].line, rows[k - 1].line, col + 1));
+        }
         let ((dt_s, jitter), period) = match t_col {
             Some(col) => (
                 time_column_period(&times, file, col + 1)?,
@@ -585,6 +599,9 @@ impl Demonstration {
         }
         let line = |k: usize| table.rows()[k].line;
         for k in 1..n {
+            if table.rows()[k].fields == table.rows()[k - 1].fields {
+                return Err(repeated_row(file, line(k), line(k - 1), tc + 1));
+            }
             if times[k] <= times[k - 1] {
                 return Err(Error::BadTime {
                     file: file.into(),
@@ -601,23 +618,11 @@ impl Demonstration {
         }
         let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
         steps.sort_by(f64::total_cmp);
-        let median = steps[steps.len() / 2];
         let period = match dt_s {
             Some(p) => p,
-            // The logger's period: every step counted as its whole number of median steps
-            // (a dropped sample is two, a short step one), the span divided by their sum,
-            // snapped like `period_from_times`. Jitter averages out over the log (the median
-            // step alone is off by a fraction of the jitter); the count is exact while the
-            // jitter stays within a quarter period, and beyond it can only grow, so the
-            // grid is never coarser than the mean step.
-            None => {
-                let periods: f64 = times
-                    .windows(2)
-                    .map(|w| ((w[1] - w[0]) / median).round().max(1.0))
-                    .sum();
-                period_from_times(&[0.0, (times[n - 1] - times[0]) / periods])
-                    .expect("a span > 0 over at least one median step")
-            }
+            // The logger's period (`logger_period`: the span over the steps counted in
+            // median steps, snapped); the grid is never coarser than the mean step.
+            None => logger_period(&times).expect("at least 2 strictly increasing times"),
         };
         if !(period.is_finite() && period > 0.0) {
             return Err(Error::BadParam {
@@ -861,6 +866,48 @@ pub fn period_from_times(times: &[f64]) -> Option<f64> {
         return Some(1.0 / rate);
     }
     Some(round_s(mean))
+}
+
+/// The error for a row that repeats the row before it field for field (a logger that wrote
+/// one sample twice), at line `line` (the earlier at `previous`), column `column` (`t`).
+fn repeated_row(file: &str, line: usize, previous: usize, column: usize) -> Error {
+    Error::BadTime {
+        file: file.into(),
+        line,
+        column,
+        why: format!(
+            "line {line} repeats line {previous} exactly (the logger wrote one sample twice): \
+             remove the repeated line (`uniq FILE > FIXED` drops repeated consecutive lines; \
+             remove the same row of any file logged beside it)"
+        ),
+    }
+}
+
+/// The period (s) of a logger whose stamps `times` (s, strictly increasing) may jitter and
+/// miss samples: the span `t_last − t_0` over the number of periods it holds, each step
+/// counted as its whole number of median steps (at least one, so a dropped sample counts
+/// two), snapped like [`period_from_times`]. Jitter averages out over the log (the median
+/// step alone is off by a fraction of the jitter); the count is exact while every stamp is
+/// within a quarter period of its grid, and beyond that it can only grow, so the period is
+/// never longer than the mean step. `None` for fewer than 2 times or times that do not
+/// increase. Used by [`Demonstration::regrid_csv_str`] and for the topics of a ROS 2 bag.
+#[must_use]
+pub fn logger_period(times: &[f64]) -> Option<f64> {
+    if times.len() < 2
+        || times
+            .windows(2)
+            .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+    {
+        return None;
+    }
+    let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+    steps.sort_by(f64::total_cmp);
+    let median = steps[steps.len() / 2];
+    let periods: f64 = times
+        .windows(2)
+        .map(|w| ((w[1] - w[0]) / median).round().max(1.0))
+        .sum();
+    period_from_times(&[0.0, (times[times.len() - 1] - times[0]) / periods])
 }
 
 /// Checks a `t` column and returns its period ([`period_from_times`]) and, when some time
@@ -1261,6 +1308,38 @@ mod tests {
         // grow, so the grid is finer than the mean step, never coarser.
         let (d, _) = Demonstration::from_csv_str_resampled(&log(0.004), "h.csv", None).unwrap();
         assert!(d.dt_s() <= 10.0 / 997.0, "{}", d.dt_s());
+    }
+
+    #[test]
+    fn a_repeated_row_is_named_with_its_twin_and_the_fix() {
+        // Line 4 repeats line 3 field for field (a logger that wrote a sample twice): named,
+        // with the fix, read plainly and with --resample alike.
+        let text = "t,a\n0,0\n0.01,1\n0.01,1\n0.02,2\n0.03,3\n";
+        let plain = Demonstration::from_csv_str(text, "r.csv", None).unwrap_err();
+        let resampled = Demonstration::from_csv_str_resampled(text, "r.csv", None).unwrap_err();
+        for e in [plain, resampled] {
+            let msg = e.to_string();
+            assert!(
+                msg.starts_with("r.csv:4:1: ") && msg.contains("line 4 repeats line 3 exactly"),
+                "{msg}"
+            );
+            assert!(msg.contains("uniq FILE > FIXED"), "{msg}");
+        }
+        // Without a time column equal rows are data (the robot held still).
+        let still = Demonstration::from_csv_str("a\n0\n1\n1\n2\n", "s.csv", None).unwrap();
+        assert_eq!(still.n_samples(), 4);
+    }
+
+    #[test]
+    fn the_logger_period_counts_dropped_steps_and_snaps() {
+        // 50 Hz stamps with one dropped message and a 0.07 % slow clock: 0.02 s exactly.
+        let times: Vec<f64> = (0..100)
+            .filter(|&k| k != 40)
+            .map(|k| k as f64 * 0.020_014)
+            .collect();
+        assert_eq!(logger_period(&times), Some(0.02));
+        assert_eq!(logger_period(&[0.0]), None);
+        assert_eq!(logger_period(&[0.0, 0.0]), None);
     }
 
     #[test]

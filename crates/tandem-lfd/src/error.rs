@@ -246,14 +246,31 @@ pub enum Error {
         /// `duration_s / median_s`.
         ratio: f64,
     },
+    /// A demonstration does not reach the end of the task: its alignment to the reference
+    /// ends pinned at a slope bound over a long run ([`crate::END_RUN_REFUSE_SHARE`]).
+    #[error(
+        "{file}: does not reach the end of the task (it ends about {ends_at_pct:.0} % of the \
+         way through): {why}; a demonstration cut off before the end would teach the model a \
+         wrong end and widen its variance and speed bounds: demonstrate the whole task again, \
+         trim the recording to whole tasks, or leave it out"
+    )]
+    TruncatedDemonstration {
+        /// The file or source label.
+        file: String,
+        /// Where on the reference (% of the task) its end is aligned.
+        ends_at_pct: f64,
+        /// What its alignment shows.
+        why: String,
+    },
     /// Sample periods differ by more than 1 %.
     #[error(
-        "{}: sample period {} s differs from the reference {} s by more than 1 % (resample \
-         it to the reference's rate; for a file without a `t` column the period is --dt, \
+        "{}: sample period {} s differs from {} s, the period of {}, by more than 1 % \
+         (resample it to that rate; for a file without a `t` column the period is --dt, \
          default 0.01 s)",
         at(file, *line, *column),
         (found_s * 1e9).round() / 1e9,
-        (expected_s * 1e9).round() / 1e9
+        (expected_s * 1e9).round() / 1e9,
+        expected_from
     )]
     SamplePeriodMismatch {
         /// The file or source label.
@@ -262,8 +279,12 @@ pub enum Error {
         line: Option<usize>,
         /// 1-based column of its `t` column, where the period came from one (CSV).
         column: Option<usize>,
-        /// The reference period Δt_s, seconds.
+        /// The period the others share, seconds: the model's `Δt_s`, or at fit the period of
+        /// most demonstrations (ties: the first file's).
         expected_s: f64,
+        /// Whose period `expected_s` is, in words (`the model`, `2 of the 3 demonstrations
+        /// (b.csv, c.csv)`).
+        expected_from: String,
         /// This demonstration's period, seconds.
         found_s: f64,
     },

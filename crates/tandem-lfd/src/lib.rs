@@ -84,13 +84,14 @@ mod model;
 mod quat;
 
 pub use checks::{
-    LENGTH_REFUSE_RATIO, LENGTH_WARN_RATIO, check_lengths, length_warnings, time_like,
+    END_RUN_MOTION_SHARE, END_RUN_REFUSE_SHARE, END_RUN_SLOPE_TOLERANCE, LENGTH_REFUSE_RATIO,
+    LENGTH_WARN_RATIO, check_lengths, length_warnings, time_like,
 };
 pub use csv::{CsvRow, CsvTable};
 pub use demo::{
     ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, JITTER_NOTE,
     JITTER_TOLERANCE, MAX_ABS_VALUE, MAX_RESAMPLE_GAP, PeriodSource, QuaternionBlock, Regridded,
-    period_from_times,
+    logger_period, period_from_times,
 };
 pub use error::{Error, Result};
 pub use model::{

@@ -316,6 +316,37 @@ fn demonstration_sets_are_checked() {
             .starts_with("slow.csv:1:1: sample period 0.1 s"),
         "{e}"
     );
+    // Two files against one: the majority's period decides, so a 1 kHz file given first is
+    // the one named (not the good file after it), and the message says whose period it is.
+    let khz = Demonstration::from_csv_str("t,a,b\n0,1,2\n0.001,3,4\n", "khz.csv", None).unwrap();
+    let b = Demonstration::from_csv_str("t,a,b\n0,1,2\n0.01,3,4\n", "b.csv", None).unwrap();
+    let c = Demonstration::from_csv_str("t,a,b\n0,1,2\n0.01,3,4\n", "c.csv", None).unwrap();
+    let e = TaskModel::fit_aligned(
+        &[khz.clone(), b.clone(), c],
+        &[vec![0.0, 1.0], vec![0.0, 1.0], vec![0.0, 1.0]],
+        &FitParams::default(),
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().starts_with(
+            "khz.csv:1:1: sample period 0.001 s differs from 0.01 s, the period of 2 of the 3 \
+             demonstrations (b.csv, c.csv), by more than 1 %"
+        ),
+        "{e}"
+    );
+    // One against one: the first file's period is kept and both files are named.
+    let e = TaskModel::fit_aligned(
+        &[khz, b],
+        &[vec![0.0, 1.0], vec![0.0, 1.0]],
+        &FitParams::default(),
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().starts_with(
+            "b.csv:1:1: sample period 0.01 s differs from 0.001 s, the period of khz.csv"
+        ),
+        "{e}"
+    );
     // A header after a blank line: its own line; a channel missing (no stranger column):
     // the header line alone.
     let d = Demonstration::from_csv_str("\nt,a\n0,1\n0.01,3\n", "d.csv", None).unwrap();

@@ -91,6 +91,31 @@ pub enum Error {
         /// The state file.
         path: PathBuf,
     },
+    /// A save would replace a state file holding recorded rounds that this planner does not
+    /// hold (a fresh fit saved over a cell's state): the operator's corrections would be lost.
+    #[error(
+        "{}: holds {rounds} recorded round(s) (the operator's corrections) that this planner \
+         does not hold; nothing was written: refit keeping them (`tandem fit --keep-rounds`, \
+         Python `Planner.refit`), save under another name, or replace the file and discard them \
+         on purpose (`tandem fit --force`, Python `save(path, force=True)`)",
+        path.display()
+    )]
+    WouldDiscardRounds {
+        /// The state file.
+        path: PathBuf,
+        /// Rounds it holds.
+        rounds: usize,
+    },
+    /// A refit cannot replay the recorded rounds ([`crate::Planner::refit`]).
+    #[error(
+        "cannot keep the recorded rounds: {why}; nothing was written: keep the state as it is, \
+         or fit without the rounds on purpose (`tandem fit --force`, Python \
+         `save(path, force=True)`)"
+    )]
+    CannotReplay {
+        /// What cannot be replayed and why.
+        why: String,
+    },
     /// The round was recorded before (the same executions, logs and flags).
     #[error(
         "this round was already recorded as round {round} (the same executions, logs and \

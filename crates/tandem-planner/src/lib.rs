@@ -62,7 +62,7 @@ pub mod state;
 
 pub use error::{Error, Result};
 pub use explain::{ChannelShare, LowCause, LowRegion};
-pub use planner::{ExecutionRecord, Planner, PlannerParams, RecordReport};
+pub use planner::{ExecutionRecord, Planner, PlannerParams, RecordReport, RefitReport};
 
 /// A seed for item `index` of a seeded family (trial `k` of a study, the schedule after
 /// `k` recorded rounds): SplitMix64 of both, so items are independent of each other and of

@@ -15,7 +15,7 @@ use tandem_lfd::{
 };
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
-    CheckedSchedule, Outcome, Problem, SamplerParams, SamplerStats, Schedule, Source,
+    CheckedSchedule, Outcome, PreviousFate, Problem, SamplerParams, SamplerStats, Schedule, Source,
     sample_schedule_n, validate,
 };
 
@@ -41,6 +41,29 @@ fn merge_flags(
         *s |= *c;
     }
     (sup, cor)
+}
+
+/// The rule of every execution record, whoever made it (CSV files, bags, Python arrays): the
+/// operator corrects only what they supervise, so `corrected[k]` implies `supervised[k]`.
+/// A correction on an unsupervised sample would be dropped from the observations (Eq. 9
+/// counts supervised samples only) and lost without a word. `source` names the execution,
+/// `unit` what an index counts (`"sample"`, or `"row"` of a file's rows).
+fn check_corrections_supervised(
+    source: &str,
+    unit: &str,
+    supervised: &[bool],
+    corrected: &[bool],
+) -> Result<()> {
+    match (0..supervised.len().min(corrected.len())).find(|&k| corrected[k] && !supervised[k]) {
+        Some(k) => Err(Error::BadExecution {
+            what: "corrected",
+            why: format!(
+                "{source}: {unit} {k}: `corrected` is 1 but `supervised` is 0 (only a supervised, \
+                 low-confidence sample can be corrected)"
+            ),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// Parameters of a [`Planner`]: one block per stage of Fig. 2.
@@ -147,7 +170,8 @@ impl ExecutionRecord {
     /// model's period if its grid is finer).
     ///
     /// # Errors
-    /// [`Error::BadExecution`] when the log or a flag vector does not have one entry per row.
+    /// [`Error::BadExecution`] when the log or a flag vector does not have one entry per row,
+    /// or a row is corrected but not supervised (as [`Planner::check_execution`]).
     pub fn from_regridded(
         grid: Regridded,
         ref_time_log: &[f64],
@@ -168,6 +192,7 @@ impl ExecutionRecord {
                 });
             }
         }
+        check_corrections_supervised(&source, "row", supervised, corrected)?;
         let log = grid.interpolate("ref_time_log", ref_time_log)?;
         let (supervised, corrected) =
             merge_flags(supervised, corrected, &grid.nearest, &grid.bin_of);
@@ -261,10 +286,22 @@ impl Clone for Origin {
 pub struct RecordReport {
     /// Reference samples that became high-confidence (latched) in this update.
     pub newly_high: usize,
+    /// Latched (high-confidence) samples that this round's corrections turned low-confidence
+    /// again ([`Confidence::update_round`]): rounds recorded out of order bring corrections
+    /// of samples latched since they ran; in order, a supervised sample's split and sweep
+    /// reach a latched sample at the edge of a supervised stretch.
+    pub reopened: usize,
     /// Where the new schedule came from (sampled, previous, repaired previous, serial).
     pub source: Source,
     /// The new schedule's `T_total` (Eq. 13), s.
     pub t_total_s: f64,
+    /// The `T_total` (Eq. 13, s) of the schedule the round ran (the previous one).
+    pub previous_t_total_s: f64,
+    /// What became of the previous schedule on the updated problem: still valid, re-timed
+    /// for the updated model, or invalid and why ([`PreviousFate::describe`] says it in one
+    /// sentence). While it is `Valid` or `Repaired`, [`RecordReport::t_total_s`] is at most
+    /// that schedule's `T_total`.
+    pub previous: PreviousFate,
     /// Wall time of the model update (Eq. 21).
     pub model_update: Duration,
     /// Wall time of recording the observations and updating the confidence (Eq. 9–12).
@@ -276,14 +313,58 @@ pub struct RecordReport {
     pub notices: Vec<String>,
 }
 
+/// What [`Planner::refit`] did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefitReport {
+    /// Rounds replayed into the new planner (all the old one recorded).
+    pub rounds: usize,
+    /// Whether the new reference differs from the old one (or the old one is unknown: a
+    /// planner made from a model), so that each recorded execution was aligned to the new
+    /// reference for its reference-time log instead of keeping the recorded one.
+    pub reference_changed: bool,
+    /// The old planner's share of high-confidence reference samples (`Confidence::high_share`).
+    pub high_share_before: f64,
+}
+
+/// Whether two demonstrations are the same signal: channels, period and samples (the source
+/// label aside).
+fn same_signal(a: &Demonstration, b: &Demonstration) -> bool {
+    a.channel_names() == b.channel_names() && a.dt_s() == b.dt_s() && a.samples() == b.samples()
+}
+
+/// The reference-time log of an execution of `n_samples` samples from its warp (`warp[n]`:
+/// the execution's sample, fractional, at reference sample `n`; monotone, pinned at both
+/// ends): for each sample `k` the reference time whose warp value it is (linear between
+/// reference samples; the first sample of a flat stretch), in `[0, warp.len() − 1]`;
+/// monotone.
+fn log_from_warp(warp: &[f64], n_samples: usize) -> Vec<f64> {
+    let last = warp.len() - 1;
+    (0..n_samples)
+        .map(|k| {
+            let v = k as f64;
+            // First n with warp[n] ≥ v.
+            let hi = warp.partition_point(|&w| w < v);
+            if hi == 0 {
+                return 0.0;
+            }
+            if hi > last {
+                return last as f64;
+            }
+            let (a, b) = (warp[hi - 1], warp[hi]);
+            let frac = if b > a { (v - a) / (b - a) } else { 1.0 };
+            ((hi - 1) as f64 + frac).clamp(0.0, last as f64)
+        })
+        .collect()
+}
+
 /// The loop of Fig. 2: the task model learned from demonstrations and executions, the
 /// correction observations, the latched confidence and the current schedule.
 ///
 /// After each round of executions, [`Planner::record_round`] adds every execution to the
 /// model with their known reference-time logs (Eq. 21, no re-alignment), adds their
 /// supervised samples to the observations, updates the confidence (Eq. 9–12, with the
-/// latch: a high-confidence sample stays high) and re-schedules, warm-started by the
-/// previous schedule.
+/// latch: a high-confidence sample stays high unless the round's corrections of it make its
+/// totals fail) and re-schedules, warm-started by the previous schedule.
 ///
 /// # The previous schedule as fallback
 ///
@@ -292,11 +373,13 @@ pub struct RecordReport {
 /// `ψ̇̄_D` and widens `[ψ̇min, ψ̇max]`, and Eq. 20 requires low-confidence samples to run at
 /// the *new* mean. So the previous schedule is offered to the sampler
 /// ([`tandem_schedule::sample_schedule`]) as it is, and the sampler re-validates it against
-/// the new problem; if it fails, the sampler re-projects it (low-confidence samples at the
-/// new mean, high-confidence gradients clamped into the new bounds, `τ` clamped into
-/// `[0, |ψ_E1|]`) and validates that again (all constraints of Eq. 20 including the margin
-/// check) before using it as incumbent. If neither passes, the fastest serial schedule
-/// is the incumbent. [`RecordReport::source`] says which one won.
+/// the new problem; if it fails, the sampler re-times it for the new problem (its order of
+/// low-confidence runs, its clearances and its holds kept, low-confidence samples at the new
+/// mean, no event earlier than before) and validates that again (all constraints of Eq. 20
+/// including the margin check) before using it as incumbent, so the new `T_total` is at most
+/// the re-timed one. If nothing passes, the fastest serial schedule is the incumbent.
+/// [`RecordReport::source`] says which one won and [`RecordReport::previous`] what became of
+/// the previous schedule (docs/decisions.md, "Learning never makes the plan worse").
 #[derive(Clone, Debug)]
 pub struct Planner {
     params: PlannerParams,
@@ -308,6 +391,14 @@ pub struct Planner {
     pairs_recorded: usize,
     /// Fingerprints of the rounds recorded since the state format had them (version 6).
     rounds: Vec<u64>,
+    /// The reference demonstration the model's time axis is (its samples in the model's
+    /// channel order), kept since state format 11 so that a refit can carry the recorded
+    /// reference times onto another reference; `None` for a planner made from a model.
+    reference: Option<Demonstration>,
+    /// Every round recorded since state format 11, in order: the executions as
+    /// [`Planner::check_execution`] took them in (at the model's period), for
+    /// [`Planner::refit`].
+    records: Vec<Vec<ExecutionRecord>>,
     origin: Origin,
     /// Set by [`Planner::load`] when it replaced a stored schedule that failed the check.
     load_notice: Option<String>,
@@ -324,6 +415,41 @@ struct PlannerState {
     outcome: Outcome,
     pairs_recorded: usize,
     rounds: Vec<u64>,
+    reference: Option<Demonstration>,
+    records: Vec<Vec<StoredRecord>>,
+}
+
+/// An [`ExecutionRecord`] as the state file keeps it (format 11).
+#[derive(Serialize, Deserialize)]
+struct StoredRecord {
+    demonstration: Demonstration,
+    ref_time_log: Vec<f64>,
+    supervised: Vec<bool>,
+    corrected: Vec<bool>,
+}
+
+impl From<&ExecutionRecord> for StoredRecord {
+    fn from(r: &ExecutionRecord) -> Self {
+        StoredRecord {
+            demonstration: r.execution.demonstration.clone(),
+            ref_time_log: r.execution.ref_time_log.clone(),
+            supervised: r.supervised.clone(),
+            corrected: r.corrected.clone(),
+        }
+    }
+}
+
+impl From<StoredRecord> for ExecutionRecord {
+    fn from(r: StoredRecord) -> Self {
+        ExecutionRecord {
+            execution: Execution {
+                demonstration: r.demonstration,
+                ref_time_log: r.ref_time_log,
+            },
+            supervised: r.supervised,
+            corrected: r.corrected,
+        }
+    }
 }
 
 /// `tandem_warp::WarpParams` as state formats 4 to 8 wrote them: without `smooth_width` and
@@ -427,7 +553,8 @@ struct PlannerParamsOld<F> {
     holds: HoldSpec,
 }
 
-/// [`PlannerState`] as state formats 8 and 9 wrote it: [`PlannerParamsOld`].
+/// [`PlannerState`] as state formats 8 to 10 wrote it: [`PlannerParamsOld`], without the
+/// reference demonstration and the recorded executions (format 11).
 #[derive(Deserialize)]
 struct PlannerStateOld<F> {
     params: PlannerParamsOld<F>,
@@ -447,6 +574,10 @@ type PlannerStateV8 = PlannerStateOld<FitParamsV8>;
 /// [`PlannerState`] as state format 9 wrote it (the fit's warp without `fill_length`).
 type PlannerStateV9 = PlannerStateOld<FitParamsOld<WarpParamsV9>>;
 
+/// [`PlannerState`] as state format 10 wrote it: today's parameters, without the reference
+/// demonstration and the recorded executions.
+type PlannerStateV10 = PlannerStateOld<FitParams>;
+
 impl<F: Into<FitParams>> From<PlannerStateOld<F>> for PlannerState {
     fn from(old: PlannerStateOld<F>) -> Self {
         PlannerState {
@@ -462,6 +593,8 @@ impl<F: Into<FitParams>> From<PlannerStateOld<F>> for PlannerState {
             outcome: old.outcome,
             pairs_recorded: old.pairs_recorded,
             rounds: old.rounds,
+            reference: None,
+            records: Vec::new(),
         }
     }
 }
@@ -501,6 +634,8 @@ impl From<OutcomeV7> for Outcome {
             lower_bound_s: v7.lower_bound_s,
             bound_is_optimum: v7.bound_is_optimum,
             gap: v7.gap,
+            margin_free_s: None,
+            previous: PreviousFate::NotGiven,
         }
     }
 }
@@ -541,6 +676,8 @@ impl From<PlannerStateV7> for PlannerState {
             outcome: v7.outcome.into(),
             pairs_recorded: v7.pairs_recorded,
             rounds: v7.rounds,
+            reference: None,
+            records: Vec::new(),
         }
     }
 }
@@ -625,6 +762,8 @@ impl TryFrom<PlannerStateV6> for PlannerState {
             outcome: v6.outcome.into(),
             pairs_recorded: v6.pairs_recorded,
             rounds: v6.rounds,
+            reference: None,
+            records: Vec::new(),
         })
     }
 }
@@ -789,7 +928,12 @@ impl Planner {
         check_robot_count(n_robots)?;
         params.validate()?;
         let model = TaskModel::fit(demos, &params.fit)?;
-        Self::from_model_with_robots(model, params, n_robots)
+        let reference = demos[model.reference_idx()]
+            .conform_to(model.channel_names())?
+            .into_owned();
+        let mut planner = Self::from_model_with_robots(model, params, n_robots)?;
+        planner.reference = Some(reference);
+        Ok(planner)
     }
 
     /// As [`Planner::new`] from an already fitted model (e.g. to run several trials from
@@ -827,6 +971,8 @@ impl Planner {
             outcome,
             pairs_recorded: 0,
             rounds: Vec::new(),
+            reference: None,
+            records: Vec::new(),
             origin: Origin::default(),
             load_notice: None,
         })
@@ -850,8 +996,11 @@ impl Planner {
     /// record at the model's period and, when it was resampled, a sentence saying so.
     ///
     /// # Errors
-    /// [`Error::BadExecution`] for flag vectors of the wrong length; the model crate's errors
-    /// (`CoarseExecution`, `TruncatedExecution`, `ExecutionDuration`, channels, log).
+    /// [`Error::BadExecution`] for flag vectors of the wrong length and for a sample
+    /// corrected but not supervised (the operator corrects only what they supervise: such a
+    /// correction would be dropped without a word; every front end gets this check here); the
+    /// model crate's errors (`CoarseExecution`, `TruncatedExecution`, `ExecutionDuration`,
+    /// channels, log).
     pub fn check_execution(
         &self,
         record: &ExecutionRecord,
@@ -869,6 +1018,12 @@ impl Planner {
                 });
             }
         }
+        check_corrections_supervised(
+            demo.source(),
+            "sample",
+            &record.supervised,
+            &record.corrected,
+        )?;
         let resampled = self.model.resample_execution(&record.execution)?;
         let n_new = resampled.execution.demonstration.n_samples();
         let (supervised, corrected, note) = if resampled.bin_of.len() == n_new {
@@ -955,7 +1110,10 @@ impl Planner {
             }
         }
         let mut confidence = self.confidence.clone();
-        let newly_high = confidence.update(model.sigma2_d(), &observations)?;
+        // The totals' decision; the latch yields only to this round's corrections (rounds
+        // recorded out of order: docs/decisions.md, "The same rounds in any order").
+        let latching =
+            confidence.update_round(model.sigma2_d(), &self.observations, &observations)?;
         let problem = problem_for(&model, &confidence, &self.params.holds)?;
         let t2 = Instant::now();
         let pairs_recorded = self.pairs_recorded + 1;
@@ -967,9 +1125,12 @@ impl Planner {
             sample_schedule_n(&problem, n_robots, &sampler, Some(&self.outcome.schedule))?;
         let t3 = Instant::now();
         let report = RecordReport {
-            newly_high,
+            newly_high: latching.newly_high,
+            reopened: latching.reopened,
             source: outcome.source,
             t_total_s: outcome.t_total_s,
+            previous_t_total_s: self.outcome.t_total_s,
+            previous: outcome.previous.clone(),
             model_update: t1 - t0,
             confidence: t2 - t1,
             scheduling: t3 - t2,
@@ -982,7 +1143,94 @@ impl Planner {
         self.outcome = outcome;
         self.pairs_recorded = pairs_recorded;
         self.rounds.push(fingerprint);
+        self.records.push(records);
         Ok(report)
+    }
+
+    /// Fits the task again from `demos` with `params` (as [`Planner::with_robots`], for this
+    /// planner's robot count) and replays every round this planner recorded, in their
+    /// original order, so that the operator's corrections are kept: the returned planner is
+    /// the one a fresh fit would be after recording the same rounds.
+    ///
+    /// Each recorded execution keeps its samples and its supervised/corrected flags (per
+    /// execution sample); only its reference-time log changes frame. When the new model's
+    /// reference is the old one (the same samples), the logs are kept as recorded (the
+    /// coordinator's exact clock); otherwise each execution is aligned to the new reference
+    /// as the fit aligns every demonstration ([`TaskModel::align_demonstration`]) and its log
+    /// is the inverse of that warp. Every round then goes through
+    /// [`Planner::record_round`] (the checks of [`Planner::check_execution`], the model update
+    /// of Eq. 21, the observations, the latched confidence and a schedule with the seed of
+    /// that round), so the confidence, model and schedule are those of a fresh fit with the
+    /// same rounds recorded. The round fingerprints are the recorded ones (a round given
+    /// again is still refused). The new planner saves into the file this one was loaded from
+    /// (the check that no other process saved into it meanwhile applies) and nowhere else
+    /// that holds rounds ([`Planner::save_locked`]). This planner is not changed.
+    ///
+    /// # Errors
+    /// As [`Planner::with_robots`]; [`Error::CannotReplay`] when rounds were recorded by a
+    /// build older than state format 11 (their executions were not kept), or when a recorded
+    /// execution does not align to the new reference or fails the new model's checks (other
+    /// channels, period, coverage, duration).
+    pub fn refit(
+        &self,
+        demos: &[Demonstration],
+        params: PlannerParams,
+    ) -> Result<(Planner, RefitReport)> {
+        let rounds = self.pairs_recorded;
+        if self.records.len() < rounds {
+            return Err(Error::CannotReplay {
+                why: format!(
+                    "{} of its {rounds} rounds were recorded by a tandem older than state \
+                     format 11, which did not keep the executions, so they cannot be replayed",
+                    rounds - self.records.len()
+                ),
+            });
+        }
+        let mut planner = Self::with_robots(demos, params, self.n_robots())?;
+        let new_reference = planner
+            .reference
+            .clone()
+            .expect("with_robots keeps the reference");
+        // The recorded logs hold on the new model when its reference is the old one.
+        let same_reference = self
+            .reference
+            .as_ref()
+            .is_some_and(|old| same_signal(old, &new_reference));
+        for (k, round) in self.records.iter().enumerate() {
+            let mut carried = Vec::with_capacity(round.len());
+            for (robot, r) in round.iter().enumerate() {
+                let mut r = r.clone();
+                if !same_reference {
+                    let demo = &r.execution.demonstration;
+                    let warp = planner
+                        .model
+                        .align_demonstration(&new_reference, demo, &planner.params.fit)
+                        .map_err(|e| Error::CannotReplay {
+                            why: format!(
+                                "round {}, robot {}: the execution does not align to the new \
+                                 reference ({e})",
+                                k + 1,
+                                robot + 1
+                            ),
+                        })?;
+                    r.execution.ref_time_log = log_from_warp(&warp, demo.n_samples());
+                }
+                carried.push(r);
+            }
+            planner
+                .record_round(&carried)
+                .map_err(|e| Error::CannotReplay {
+                    why: format!("round {} does not replay on the new model: {e}", k + 1),
+                })?;
+        }
+        planner.rounds.clone_from(&self.rounds);
+        planner.origin = self.origin.clone();
+        let report = RefitReport {
+            rounds,
+            reference_changed: !same_reference,
+            high_share_before: self.confidence.high_share(),
+        };
+        Ok((planner, report))
     }
 
     /// [`Planner::record_round`] for the paper's two robots; deprecated: a round is one
@@ -1187,24 +1435,59 @@ impl Planner {
     /// [`Error::WouldOverwrite`], [`Error::Changed`], [`Error::Io`] naming the file or
     /// directory, [`Error::Encode`].
     pub fn save_locked(&self, lock: &StateLock) -> Result<()> {
+        self.save_checked(lock, false).map(|_| ())
+    }
+
+    /// [`Planner::save_locked`] that replaces a state file holding rounds this planner does
+    /// not hold, discarding them on purpose (`tandem fit --force`, Python
+    /// `save(path, force=True)`). Returns how many rounds the replaced file held (0 when there
+    /// was none, or when this planner was loaded from that file and holds them all); the
+    /// count is `None` when the file there is a state file this build cannot read.
+    ///
+    /// # Errors
+    /// As [`Planner::save_locked`] but [`Error::WouldDiscardRounds`].
+    pub fn save_locked_discarding(&self, lock: &StateLock) -> Result<Option<usize>> {
+        self.save_checked(lock, true)
+    }
+
+    /// The save of [`Planner::save_locked`]; `discard`: replace a file holding rounds this
+    /// planner does not hold. Returns the rounds discarded.
+    fn save_checked(&self, lock: &StateLock, discard: bool) -> Result<Option<usize>> {
         let path = lock.state_path();
         state::check_target(path)?;
         let here = state::resolved(path);
-        if let Some((from, stamp)) = self.origin.get()
-            && from == here
+        let origin = self.origin.get();
+        if let Some((from, stamp)) = &origin
+            && *from == here
             && let Some(now) = state::stamp_at(path)?
-            && now != stamp
+            && now != *stamp
         {
             return Err(Error::Changed {
                 path: path.to_path_buf(),
             });
+        }
+        // A file this planner did not come from: its rounds would be lost.
+        let mut discarded = Some(0);
+        if origin.is_none_or(|(from, _)| from != here) {
+            match Self::rounds_at(path) {
+                Ok(0) => {}
+                Ok(rounds) if !discard => {
+                    return Err(Error::WouldDiscardRounds {
+                        path: path.to_path_buf(),
+                        rounds,
+                    });
+                }
+                Ok(rounds) => discarded = Some(rounds),
+                Err(_) if discard => discarded = None,
+                Err(e) => return Err(e),
+            }
         }
         let bytes = state::encode(&self.to_state())?;
         state::write_atomic(path, &bytes)?;
         if let Some(stamp) = state::stamp_of(&bytes) {
             self.origin.set(here, stamp);
         }
-        Ok(())
+        Ok(discarded)
     }
 
     /// Loads a planner saved by [`Planner::save`], of the current state format or an older one
@@ -1224,7 +1507,46 @@ impl Planner {
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let bytes = state::read(path)?;
-        let (version, payload) = state::checked_payload(&bytes, path)?;
+        let st = Self::decode_state(&bytes, path)?;
+        let mut planner = Self::from_state(st).map_err(|e| Error::Corrupt {
+            path: path.to_path_buf(),
+            why: e.to_string(),
+        })?;
+        planner.recheck_schedule()?;
+        if let Some(stamp) = state::stamp_of(&bytes) {
+            planner.origin.set(state::resolved(path), stamp);
+        }
+        Ok(planner)
+    }
+
+    /// The rounds recorded in the state file at `path` ([`Planner::rounds_recorded`] of the
+    /// planner saved there); 0 when there is no file or an empty one. What a save of another
+    /// planner over that file would discard.
+    ///
+    /// # Errors
+    /// As [`Planner::load`] for a file that is there but cannot be read as a state file.
+    pub fn rounds_at(path: impl AsRef<Path>) -> Result<usize> {
+        let path = path.as_ref();
+        let bytes = match std::fs::read(path) {
+            Ok(b) => b,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(0),
+            Err(source) => {
+                return Err(Error::Io {
+                    path: path.to_path_buf(),
+                    op: "read state file",
+                    source,
+                });
+            }
+        };
+        if bytes.is_empty() {
+            return Ok(0);
+        }
+        Ok(Self::decode_state(&bytes, path)?.pairs_recorded)
+    }
+
+    /// The state in a file image read from `path`, of any readable format version.
+    fn decode_state(bytes: &[u8], path: &Path) -> Result<PlannerState> {
+        let (version, payload) = state::checked_payload(bytes, path)?;
         let old = |v6: PlannerStateV6| {
             PlannerState::try_from(v6).map_err(|e| Error::Corrupt {
                 path: path.to_path_buf(),
@@ -1238,17 +1560,10 @@ impl Planner {
             7 => state::decode_payload::<PlannerStateV7>(payload, path)?.into(),
             8 => state::decode_payload::<PlannerStateV8>(payload, path)?.into(),
             9 => state::decode_payload::<PlannerStateV9>(payload, path)?.into(),
+            10 => state::decode_payload::<PlannerStateV10>(payload, path)?.into(),
             _ => state::decode_payload(payload, path)?,
         };
-        let mut planner = Self::from_state(st).map_err(|e| Error::Corrupt {
-            path: path.to_path_buf(),
-            why: e.to_string(),
-        })?;
-        planner.recheck_schedule()?;
-        if let Some(stamp) = state::stamp_of(&bytes) {
-            planner.origin.set(state::resolved(path), stamp);
-        }
-        Ok(planner)
+        Ok(st)
     }
 
     /// Re-checks the stored schedule on the stored problem with this build's check
@@ -1284,6 +1599,12 @@ impl Planner {
             outcome: self.outcome.clone(),
             pairs_recorded: self.pairs_recorded,
             rounds: self.rounds.clone(),
+            reference: self.reference.clone(),
+            records: self
+                .records
+                .iter()
+                .map(|round| round.iter().map(StoredRecord::from).collect())
+                .collect(),
         }
     }
 
@@ -1334,6 +1655,24 @@ impl Planner {
                 ),
             });
         }
+        if st.records.len() > st.pairs_recorded {
+            return Err(Error::Inconsistent {
+                what: "records",
+                why: format!(
+                    "{} stored rounds for {} recorded rounds",
+                    st.records.len(),
+                    st.pairs_recorded
+                ),
+            });
+        }
+        if let Some(r) = &st.reference
+            && r.n_samples() != n_ref
+        {
+            return Err(Error::Inconsistent {
+                what: "reference",
+                why: format!("{} samples, the model has {n_ref}", r.n_samples()),
+            });
+        }
         let problem = problem_for(&st.model, &st.confidence, &st.params.holds)?;
         Ok(Self {
             params: st.params,
@@ -1344,6 +1683,12 @@ impl Planner {
             outcome: st.outcome,
             pairs_recorded: st.pairs_recorded,
             rounds: st.rounds,
+            reference: st.reference,
+            records: st
+                .records
+                .into_iter()
+                .map(|round| round.into_iter().map(ExecutionRecord::from).collect())
+                .collect(),
             origin: Origin::default(),
             load_notice: None,
         })
@@ -1667,6 +2012,40 @@ mod tests {
     }
 
     #[test]
+    fn a_round_reports_what_became_of_the_previous_schedule() {
+        // Replays at the demonstrated speed: the mean gradient stays 1, confidence only grows,
+        // so the schedule the round ran stays valid and bounds the new one.
+        let mut p = small_planner(5);
+        for k in 0..4 {
+            let before = p.outcome().t_total_s;
+            let dt = p.model().dt_s();
+            let r = round(&p, 0.01 * k as f64, 0.02 + 0.01 * k as f64, 1, dt);
+            let report = p.record_round(&r).unwrap();
+            assert_eq!(report.previous_t_total_s, before);
+            match &report.previous {
+                PreviousFate::Valid { t_total_s } => {
+                    assert_eq!(*t_total_s, before);
+                    assert!(report.t_total_s <= before, "round {k}");
+                }
+                PreviousFate::Repaired { t_total_s, .. } => {
+                    assert!(report.t_total_s <= *t_total_s, "round {k}");
+                }
+                other => panic!("round {k}: {other:?}"),
+            }
+            assert!(report.previous.describe().is_some());
+            assert_eq!(report.previous, p.outcome().previous);
+        }
+        // A reloaded outcome knows nothing of a previous schedule.
+        let dir = scratch("previous-fate");
+        let path = dir.join("s.tandem");
+        p.save(&path).unwrap();
+        let loaded = Planner::load(&path).unwrap();
+        assert_eq!(loaded.outcome().previous, PreviousFate::NotGiven);
+        assert_eq!(loaded.outcome().margin_free_s, None);
+        assert_eq!(loaded.outcome().t_total_s, p.outcome().t_total_s);
+    }
+
+    #[test]
     fn the_same_round_recorded_twice_is_refused() {
         let mut p = small_planner(5);
         let first = round(&p, 0.0, 0.1, 1, 0.01);
@@ -1885,6 +2264,49 @@ mod tests {
         got.sort_unstable();
         assert_eq!(got, want);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_correction_of_an_unsupervised_sample_is_refused_naming_it() {
+        let mut p = small_planner(8);
+        let mut r = round(&p, 0.0, 0.1, 1, 0.01);
+        // Sample 25 ran unsupervised (high-confidence) and is flagged corrected.
+        r[1].corrected[25] = true;
+        let before = (p.rounds_recorded(), p.observations().clone());
+        let err = p.record_round(&r).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::BadExecution {
+                    what: "corrected",
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        let msg = err.to_string();
+        assert!(
+            msg.contains("sample 25: `corrected` is 1 but `supervised` is 0")
+                && msg.contains("only a supervised, low-confidence sample can be corrected"),
+            "{msg}"
+        );
+        assert_eq!((p.rounds_recorded(), p.observations().clone()), before);
+        // The same on the rows of a log put on a grid (before the flags are merged, which
+        // would otherwise make the row supervised).
+        let text = "t,force\n0.0,1\n0.01,1\n0.02,1\n";
+        let grid = Demonstration::regrid_csv_str(text, "exec.csv", None).unwrap();
+        let err = ExecutionRecord::from_regridded(
+            grid,
+            &[0.0, 1.0, 2.0],
+            &[true, false, true],
+            &[false, true, false],
+        )
+        .unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("exec.csv: row 1: `corrected` is 1 but `supervised` is 0"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -168,6 +168,9 @@ pub mod outcome_form {
             lower_bound_s: o.lower_bound_s,
             bound_is_optimum: o.bound_is_optimum,
             gap: o.gap,
+            // Not stored: a loaded outcome has no previous schedule and no split of its gap.
+            margin_free_s: None,
+            previous: tandem_schedule::PreviousFate::NotGiven,
         })
     }
 }
@@ -211,7 +214,11 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 /// - 10: the fit's warp parameters gained `fill_length` (`tandem_warp::WarpParams`: flat
 ///   stretches filled by the smoothest continuation of the warp). Version 4 to 9 files still
 ///   load, with `fill_length = 0`: unfilled, the alignment they were fitted with.
-pub const FORMAT_VERSION: u32 = 10;
+/// - 11: the planner keeps its reference demonstration and every recorded round's executions
+///   (samples, reference-time log, supervised and corrected flags, as taken in), so that a
+///   refit can replay them (`Planner::refit`). Version 4 to 10 files still load, without
+///   them: their rounds cannot be replayed.
+pub const FORMAT_VERSION: u32 = 11;
 
 /// The oldest state format version this build reads (converting it on load).
 pub const OLDEST_READABLE_VERSION: u32 = 4;
@@ -722,7 +729,7 @@ mod tests {
     fn header_layout_is_as_documented() {
         let bytes = encode(&payload(4)).unwrap();
         assert_eq!(&bytes[..8], b"TANDEMST");
-        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 10);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 11);
         let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
         assert_eq!(len as usize, bytes.len() - HEADER_LEN);
         let crc = u32::from_le_bytes(bytes[20..24].try_into().unwrap());
@@ -807,18 +814,18 @@ mod tests {
     #[test]
     fn other_version_is_rejected_with_both_numbers() {
         let mut bytes = encode(&payload(3)).unwrap();
-        bytes[8..12].copy_from_slice(&11u32.to_le_bytes());
+        bytes[8..12].copy_from_slice(&12u32.to_le_bytes());
         let err = decode::<Payload>(&bytes, Path::new("v.tandem")).unwrap_err();
         assert!(matches!(
             err,
             Error::UnsupportedVersion {
-                found: 11,
+                found: 12,
                 expected: FORMAT_VERSION,
                 ..
             }
         ));
         let msg = err.to_string();
-        assert!(msg.contains("v.tandem") && msg.contains("11") && msg.contains("4 to 10"));
+        assert!(msg.contains("v.tandem") && msg.contains("12") && msg.contains("4 to 11"));
     }
 
     #[test]

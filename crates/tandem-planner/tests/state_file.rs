@@ -283,9 +283,26 @@ fn old_golden_path(version: u32) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/example_v{version}.tandem"))
 }
 
+/// The bytes of the version 10 golden file (`tests/fixtures/example_v10.tandem`) loaded and
+/// saved again: the current format without a reference demonstration or stored executions
+/// (the version 10 payload followed by `None` and an empty list, one byte each).
+/// `tag` names the scratch folder (tests run in parallel).
+fn v10_saved_again(tag: &str) -> Vec<u8> {
+    let dir = tmp_dir(&format!("v10-again-{tag}"));
+    let again = dir.join("again.tandem");
+    Planner::load(old_golden_path(10))
+        .unwrap()
+        .save(&again)
+        .unwrap();
+    let bytes = std::fs::read(&again).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    bytes
+}
+
 /// Loads the old golden file of `version`, checks that it is of that version, loads as the
-/// planner of the current golden file (same parameters and outcome), is `added` bytes shorter,
-/// and saves as the current golden file's bytes; returns the loaded planner.
+/// planner of the current golden file (same parameters and outcome), is `added` bytes shorter
+/// than the version 10 golden file, and saves as that file saved again ([`v10_saved_again`]);
+/// returns the loaded planner.
 fn old_golden_loads_and_saves_as_the_golden_file(version: u32, added: usize) -> Planner {
     let old_bytes = std::fs::read(old_golden_path(version)).unwrap();
     assert_eq!(
@@ -296,17 +313,48 @@ fn old_golden_loads_and_saves_as_the_golden_file(version: u32, added: usize) -> 
     let new = Planner::load(golden_path()).unwrap();
     assert_eq!(old.params(), new.params());
     assert_eq!(old.outcome(), new.outcome());
-    let golden = std::fs::read(golden_path()).unwrap();
-    assert_eq!(golden.len(), old_bytes.len() + added);
+    let v10 = std::fs::read(old_golden_path(10)).unwrap();
+    assert_eq!(v10.len(), old_bytes.len() + added);
     let dir = tmp_dir(&format!("v{version}"));
     let again = dir.join("again.tandem");
     old.save(&again).unwrap();
     assert!(
-        std::fs::read(&again).unwrap() == golden,
-        "a version {version} file saved again differs from the golden file of the same inputs"
+        std::fs::read(&again).unwrap() == v10_saved_again(&format!("v{version}")),
+        "a version {version} file saved again differs from the version 10 file of the same inputs"
     );
     std::fs::remove_dir_all(&dir).unwrap();
     old
+}
+
+#[test]
+fn a_version_10_file_loads_without_stored_rounds_and_its_payload_leads_the_golden_file() {
+    // Format 11 appends the reference demonstration and the recorded executions: the version
+    // 10 payload is the start of the golden file's, and the version 10 file saved again is
+    // its payload followed by `None` and an empty list.
+    let v10 = std::fs::read(old_golden_path(10)).unwrap();
+    let golden = std::fs::read(golden_path()).unwrap();
+    const HEADER: usize = tandem_planner::state::HEADER_LEN;
+    assert!(golden[HEADER..].starts_with(&v10[HEADER..]));
+    let again = v10_saved_again("v10");
+    assert_eq!(&again[HEADER..again.len() - 2], &v10[HEADER..]);
+    assert_eq!(&again[again.len() - 2..], &[0, 0]);
+    // Its round cannot be replayed (its executions were not kept); the golden file's can.
+    let old = Planner::load(old_golden_path(10)).unwrap();
+    assert_eq!(old.rounds_recorded(), 1);
+    let demos: Vec<Demonstration> = (0..3)
+        .map(|i| Demonstration::from_csv_path(examples(&format!("demo_{i}.csv")), None).unwrap())
+        .collect();
+    let err = old.refit(&demos, old.params().clone()).unwrap_err();
+    assert!(matches!(err, Error::CannotReplay { .. }), "{err}");
+    assert!(
+        err.to_string().contains("older than state format 11"),
+        "{err}"
+    );
+    let p = Planner::load(golden_path()).unwrap();
+    let (refit, report) = p.refit(&demos, p.params().clone()).unwrap();
+    assert_eq!((report.rounds, report.reference_changed), (1, false));
+    assert_eq!(refit.confidence(), p.confidence());
+    assert_eq!(refit.model().mean(), p.model().mean());
 }
 
 #[test]

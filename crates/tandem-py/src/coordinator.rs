@@ -171,11 +171,12 @@ impl PyCoordinator {
         out_vector(py, self.per_robot(|r, _| r.end_s()))
     }
 
-    /// Whether each robot is running now (its clock in ``[start, end)``), ``(N,)`` bool:
-    /// the robots that execute a sample in the next tick.
+    /// Whether each robot is running now (its clock in ``[start, end)`` of its current leg,
+    /// not at a hold, not held by the fault monitor), ``(N,)`` bool: the robots that execute
+    /// a sample in the next tick.
     #[getter]
     fn running_now<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        out_flags(py, self.per_robot(|r, s| s >= r.start_s() && s < r.end_s()))
+        out_flags(py, self.inner.running_now().iter().collect())
     }
 
     /// Whether each robot is running and low-confidence now (Eq. 16 at the tick start),
@@ -185,17 +186,18 @@ impl PyCoordinator {
         out_flags(py, self.inner.low_conf_now().iter().collect())
     }
 
-    /// Each robot's fractional reference time now (Eq. 15 at its clock), ``(N,)``,
-    /// reference samples in ``[0, T_ref]``: where to read its command (:meth:`Planner.command`).
+    /// Each robot's fractional reference time now (Eq. 15 at its clock, on its current leg
+    /// with holds), ``(N,)``, reference samples in ``[0, T_ref]``, never decreasing: where to
+    /// read its command (:meth:`Planner.command`).
     #[getter]
     fn ref_time_now<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        out_vector(py, self.per_robot(Timeline::ref_time_at))
+        out_vector(py, self.inner.ref_time_now().to_vec())
     }
 
     /// Each robot's reference sample now (the sample its clock is in), a list of ``N`` ints.
     #[getter]
     fn sample_now(&self) -> Vec<usize> {
-        self.per_robot(Timeline::sample_at)
+        self.inner.sample_now().to_vec()
     }
 
     fn __repr__(&self) -> String {

@@ -194,6 +194,19 @@ fn located(file: &str, line: usize, column: usize) -> Kind {
     }
 }
 
+/// An input error at a location given as text: `file:line:column` (a file read from disk,
+/// [`errors::Lfd::TooFewSamples`]) split into its parts, so that `InputError.file` is the
+/// path and `.line`/`.column` are set; any other label (`demos[1]`) is the file alone.
+fn split_location(at: &str) -> Kind {
+    let mut parts = at.rsplitn(3, ':');
+    if let (Some(column), Some(line), Some(file)) = (parts.next(), parts.next(), parts.next())
+        && let (Ok(line), Ok(column)) = (line.parse::<usize>(), column.parse::<usize>())
+    {
+        return located(file, line, column);
+    }
+    input_at(Some(at))
+}
+
 fn param(name: &str) -> Kind {
     Kind::Param {
         name: Some(name.to_owned()),
@@ -255,6 +268,7 @@ fn classify_lfd(e: &errors::Lfd) -> Kind {
         },
         E::Io { file, .. }
         | E::DemonstrationLength { file, .. }
+        | E::TruncatedDemonstration { file, .. }
         | E::TruncatedExecution { file, .. }
         | E::ExecutionDuration { file, .. }
         | E::CoarseExecution { file, .. }
@@ -265,7 +279,7 @@ fn classify_lfd(e: &errors::Lfd) -> Kind {
             column: None,
         },
         E::BadData { what, .. } => input_at(Some(what)),
-        E::TooFewSamples { at, .. } => input_at(Some(at)),
+        E::TooFewSamples { at, .. } => split_location(at),
         E::BadParam { name, .. } => param(name),
         E::BadHoldRule { .. } | E::BadHoldTime { .. } => param("holds"),
         E::Warp(w) => classify_warp(w),
@@ -339,10 +353,13 @@ fn classify_facade(e: &Facade) -> Kind {
         | Facade::Corrupt { path, .. }
         | Facade::Locked { path, .. }
         | Facade::WouldOverwrite { path, .. }
-        | Facade::Changed { path } => Kind::StateFile { path: path.clone() },
-        Facade::Inconsistent { .. } | Facade::Encode { .. } => Kind::StateFile {
-            path: PathBuf::new(),
-        },
+        | Facade::Changed { path }
+        | Facade::WouldDiscardRounds { path, .. } => Kind::StateFile { path: path.clone() },
+        Facade::Inconsistent { .. } | Facade::Encode { .. } | Facade::CannotReplay { .. } => {
+            Kind::StateFile {
+                path: PathBuf::new(),
+            }
+        }
         Facade::BadExecution { .. } | Facade::DuplicateRound { .. } => input_at(None),
         Facade::RobotCount { .. } => param("robots"),
         Facade::HoldInLowConfidence { .. } | Facade::HoldMatchesNothing { .. } => param("holds"),

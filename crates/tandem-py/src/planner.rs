@@ -190,13 +190,14 @@ fn items<'py>(x: &Bound<'py, PyAny>, what: &str) -> Result<Vec<Bound<'py, PyAny>
 }
 
 /// Demonstrations from `demos` (paths or arrays, see [`demonstration`]), with the bags'
-/// orientations added to `params`' channel schema as quaternion blocks.
+/// orientations added to `params`' channel schema as quaternion blocks, and the labels of
+/// the arrays that took the default period because `dt_s` was not given.
 fn demonstrations(
     demos: &Bound<'_, PyAny>,
     channels: Option<&[String]>,
     dt_s: Option<f64>,
     params: &mut PlannerParams,
-) -> Result<Vec<Demonstration>> {
+) -> Result<(Vec<Demonstration>, Vec<String>)> {
     let list = items(demos, "demos")?;
     if list.len() < 2 {
         return Err(Error::input(
@@ -208,6 +209,7 @@ fn demonstrations(
         ));
     }
     let mut recordings = Vec::new();
+    let mut assumed = Vec::new();
     let out = list
         .iter()
         .enumerate()
@@ -216,7 +218,13 @@ fn demonstrations(
                 array: channels,
                 file: channels,
             };
-            let demo = demonstration(d, &format!("demos[{k}]"), both, dt_s, Some(&mut recordings))?;
+            let label = format!("demos[{k}]");
+            let is_path =
+                d.is_instance_of::<PyString>() || d.hasattr("__fspath__").unwrap_or(false);
+            if dt_s.is_none() && !is_path {
+                assumed.push(label.clone());
+            }
+            let demo = demonstration(d, &label, both, dt_s, Some(&mut recordings))?;
             // A file's own time wins over dt_s; a dt_s that contradicts it is refused.
             if let Some(dt) = dt_s
                 && demo.period_source() == PeriodSource::File
@@ -238,7 +246,27 @@ fn demonstrations(
         .collect::<Result<Vec<_>>>()?;
     extend_bag_schema(&mut params.fit.schema, &recordings);
     params.validate()?;
-    Ok(out)
+    Ok((out, assumed))
+}
+
+/// The `DataWarning` for arrays given without `dt_s` (`labels`, non-empty): an array carries
+/// no time, so the default period was assumed; relying on it is deprecated (docs/decisions.md,
+/// "Arrays without a period: a warning now, an error later").
+fn assumed_period_warning(labels: &[String]) -> String {
+    let which = match labels {
+        [one] => format!("{one} is an array"),
+        [a, b] => format!("{a} and {b} are arrays"),
+        [a, b, rest @ ..] => format!("{a}, {b} and {} more are arrays", rest.len()),
+        [] => "no array".to_owned(),
+    };
+    let hz = (1.0 / DEFAULT_DT_S).round();
+    format!(
+        "{which} without dt_s: an array carries no time, so its samples were taken to be \
+         {DEFAULT_DT_S} s apart ({hz} Hz), the default; if they were logged at another rate, \
+         every duration and speed of the model is off by the ratio. Pass dt_s= (the sample \
+         period in seconds, e.g. dt_s=0.005 for 200 Hz). Relying on the default is deprecated: \
+         a later release refuses arrays without dt_s"
+    )
 }
 
 /// Raises the `DataWarning`s of a set of demonstrations: the period assumed for a file
@@ -327,7 +355,9 @@ fn hold_spec(holds: &Bound<'_, PyAny>) -> Result<HoldSpec> {
 ///     params: ``None`` (defaults), a nested dict ``{"fit": …, "confidence": …,
 ///         "sampler": …}`` or the path of a TOML file (``tandem params`` prints the
 ///         defaults).
-///     dt_s: sample period (s) of arrays and of files without a ``t`` column (default 0.01).
+///     dt_s: sample period (s) of arrays and of files without a ``t`` column. Give it for
+///         arrays: without it they are taken to be 0.01 s apart with a ``DataWarning`` naming
+///         them (deprecated: a later release refuses arrays without ``dt_s``).
 ///     robots: robots ``N`` run by the one operator, 1 to 8 (default 2, the paper's): every
 ///         schedule has ``N`` warps and :meth:`Planner.record_round` takes ``N`` executions.
 ///     holds: hold points, places where a robot may wait as long as needed (``tandem fit
@@ -359,7 +389,10 @@ pub(crate) fn fit(
         params.holds = hold_spec(holds)?;
         params.validate().map_err(Error::from)?;
     }
-    let demos = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
+    let (demos, assumed) = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
+    if !assumed.is_empty() {
+        warn(py, &assumed_period_warning(&assumed))?;
+    }
     warn_demonstrations(py, &demos)?;
     let planner = py.detach(|| guard(|| Ok(Planner::with_robots(&demos, params, robots)?)))?;
     Ok(PyPlanner { inner: planner })
@@ -378,7 +411,10 @@ pub(crate) fn fit_model(
     dt_s: Option<f64>,
 ) -> PyResult<PyModel> {
     let mut params = planner_params(params)?;
-    let demos = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
+    let (demos, assumed) = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
+    if !assumed.is_empty() {
+        warn(py, &assumed_period_warning(&assumed))?;
+    }
     warn_demonstrations(py, &demos)?;
     let model = py.detach(|| guard(|| Ok(TaskModel::fit(&demos, &params.fit)?)))?;
     Ok(PyModel {
@@ -423,6 +459,7 @@ fn per_robot<'py>(x: &Bound<'py, PyAny>, what: &str, n: usize) -> Result<Vec<Bou
 fn report_dict<'py>(py: Python<'py>, r: &RecordReport) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("newly_high", r.newly_high)?;
+    d.set_item("reopened", r.reopened)?;
     d.set_item("source", crate::schedule::source_name(r.source))?;
     d.set_item("t_total_s", r.t_total_s)?;
     d.set_item("model_update_s", r.model_update.as_secs_f64())?;
@@ -479,20 +516,94 @@ impl PyPlanner {
     /// Refuses to replace a file that is not a state file, and, when this planner was loaded
     /// from (or saved to) ``path``, a file another process saved into since.
     ///
+    /// Recorded rounds are never discarded without consent: a state file at ``path`` that
+    /// holds rounds this planner does not hold (a fresh :func:`fit` saved over a cell's
+    /// state, or a planner loaded from another file) is refused unless ``force=True``, which
+    /// replaces it and warns (``DataWarning``) how many rounds went; to keep them, refit with
+    /// :meth:`refit` on the planner loaded from it.
+    ///
     /// Raises:
     ///     StateFileError: the file cannot be written, is not a state file, changed since the
-    ///         load, or stays locked (``path`` names it).
-    #[pyo3(signature = (path, timeout_s=None))]
-    fn save(&self, py: Python<'_>, path: PathBuf, timeout_s: Option<f64>) -> PyResult<()> {
+    ///         load, holds rounds this planner does not (without ``force``), or stays locked
+    ///         (``path`` names it).
+    #[pyo3(signature = (path, timeout_s=None, force=false))]
+    fn save(
+        &self,
+        py: Python<'_>,
+        path: PathBuf,
+        timeout_s: Option<f64>,
+        force: bool,
+    ) -> PyResult<()> {
         let timeout = lock_timeout(timeout_s)?;
         let inner = &self.inner;
-        py.detach(|| {
+        let discarded = py.detach(|| {
             guard(|| {
                 let lock = StateLock::acquire(&path, timeout)?;
-                Ok(inner.save_locked(&lock)?)
+                if force {
+                    Ok(inner.save_locked_discarding(&lock)?)
+                } else {
+                    inner.save_locked(&lock)?;
+                    Ok(Some(0))
+                }
             })
         })?;
-        Ok(())
+        match discarded {
+            Some(0) => Ok(()),
+            Some(n) => crate::errors::warn(
+                py,
+                &format!(
+                    "{}: replaced, discarding its {n} recorded round(s) (force=True)",
+                    path.display()
+                ),
+            ),
+            None => crate::errors::warn(
+                py,
+                &format!(
+                    "{}: replaced a state file this build cannot read (force=True)",
+                    path.display()
+                ),
+            ),
+        }
+    }
+
+    /// Fits the task again from ``demos`` (as :func:`fit`, for this planner's robot count)
+    /// and replays every round this planner recorded onto the new fit, in their order: the
+    /// operator's corrections are kept. Each execution keeps its samples and flags; its
+    /// reference-time log is carried onto the new reference (kept as recorded when the
+    /// reference is the same, else through the alignment of the old reference to the new
+    /// one), then the rounds are recorded as :meth:`record_round` would. Returns the new
+    /// planner; this one is unchanged. The new planner saves into the file this one was
+    /// loaded from (``save(path)``, no ``force`` needed).
+    ///
+    /// Raises:
+    ///     InputError: a bad demonstration.
+    ///     ParamError: a bad parameter or hold.
+    ///     StateFileError: the rounds cannot be replayed (recorded by a tandem older than
+    ///         state format 11, which did not keep the executions, or refused by the new
+    ///         model's checks): keep the old state, or fit and ``save(..., force=True)``.
+    #[pyo3(signature = (demos, channels=None, params=None, dt_s=None, holds=None))]
+    fn refit(
+        &self,
+        py: Python<'_>,
+        demos: &Bound<'_, PyAny>,
+        channels: Option<Vec<String>>,
+        params: Option<&Bound<'_, PyAny>>,
+        dt_s: Option<f64>,
+        holds: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyPlanner> {
+        let mut params = planner_params(params)?;
+        if let Some(holds) = holds.filter(|h| !h.is_none()) {
+            params.holds = hold_spec(holds)?;
+            params.validate().map_err(Error::from)?;
+        }
+        let (demos, assumed) = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
+        if !assumed.is_empty() {
+            warn(py, &assumed_period_warning(&assumed))?;
+        }
+        warn_demonstrations(py, &demos)?;
+        let old = &self.inner;
+        let (planner, _) = py.detach(|| guard(|| Ok(old.refit(&demos, params)?)))?;
+        Ok(PyPlanner { inner: planner })
     }
 
     /// Records a round of executions, one per robot (robot 1 first), and re-schedules (Eq. 21,
@@ -528,10 +639,14 @@ impl PyPlanner {
     ///
     /// Every execution must cover the whole task and last no less than half the fastest and
     /// no more than twice the slowest demonstrated execution (a log taken at another rate
-    /// than ``dt_s`` says fails this); the same round recorded twice is refused.
+    /// than ``dt_s`` says fails this); the same round recorded twice is refused; a sample
+    /// flagged ``corrected`` must be ``supervised`` (the operator corrects only what they
+    /// supervise), as ``tandem record`` checks: otherwise ``InputError``.
     ///
     /// Returns:
-    ///     dict: ``newly_high`` (samples latched high-confidence), ``source`` of the new
+    ///     dict: ``newly_high`` (samples latched high-confidence), ``reopened`` (latched
+    ///     samples this round's corrections turned low-confidence again, e.g. rounds recorded
+    ///     out of order), ``source`` of the new
     ///     schedule, its ``t_total_s`` (Eq. 13, s), wall times ``model_update_s``,
     ///     ``confidence_s``, ``scheduling_s``, and ``notices`` (what was resampled).
     #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None, dt_s=None, resample=false))]

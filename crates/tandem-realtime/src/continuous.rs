@@ -573,6 +573,10 @@ impl ContinuousCoordinator {
     pub fn tick(&mut self, operator: Operator) -> Result<CellTick> {
         let op = operator.validate()?;
         let n = self.n;
+        // "A robot never moves backwards", checked in debug builds: each robot's (tasks
+        // completed, reference time) at the tick end is at least that at its start.
+        #[cfg(debug_assertions)]
+        let before = self.position_now();
         let n_groups = self.groups.len();
         let task = Arc::clone(&self.task);
         let end_s = task.end_s();
@@ -661,10 +665,32 @@ impl ContinuousCoordinator {
                 && !tok.is_some_and(|t| t.robot == i && t.group == g);
             out.at_gate.set(i, waits);
         }
+        #[cfg(debug_assertions)]
+        for i in 0..n {
+            let after = (out.tasks[i], out.ref_time[i]);
+            debug_assert!(
+                after.0 > before[i].0 || (after.0 == before[i].0 && after.1 >= before[i].1),
+                "robot {i} moved backwards in tick {}: (task, reference time) {:?} -> {after:?}",
+                self.ticks,
+                before[i]
+            );
+        }
         self.monitor(&out);
         out.fault = self.fault;
         self.ticks += 1;
         Ok(out)
+    }
+
+    /// Each robot's position now: (tasks completed, reference time in its current task,
+    /// reference samples in `[0, T_ref)`), the value the last [`CellTick`] reported. Never
+    /// decreases (lexicographically) from tick to tick, nor at a
+    /// [`take_over`](Self::take_over). O(N log T_ref).
+    pub fn position_now(&self) -> PerRobot<(u64, f64)> {
+        let mut out = PerRobot::new(self.n);
+        for (i, p) in out.as_mut_slice().iter_mut().enumerate() {
+            *p = (self.tasks[i], self.task.ref_time_at(self.clock_s[i]));
+        }
+        out
     }
 
     /// Hands a running cell over to this coordinator, a new plan of the same task (after the
@@ -723,7 +749,7 @@ impl ContinuousCoordinator {
             let mut at = old.cursors[i].at;
             let n = old.task.advance_cursor(&mut at, s_old);
             let p = old.task.ref_time_in(n, s_old);
-            let s = if p <= 0.0 {
+            let mut s = if p <= 0.0 {
                 0.0
             } else if p >= self.task.n_ref() as f64 {
                 self.task.end_s()
@@ -731,6 +757,12 @@ impl ContinuousCoordinator {
                 let k = p.floor() as usize;
                 c[k] + (p - k as f64) * (c[k + 1] - c[k])
             };
+            // The interpolation rounds: never place the robot behind where it is (a robot
+            // never moves backwards, not even by a rounding error at a hand-over).
+            while self.task.ref_time_at(s) < p && s < self.task.end_s() {
+                // The next float up (`s ≥ 0`; `f64::next_up` is newer than the MSRV).
+                s = f64::from_bits(s.to_bits() + 1);
+            }
             // Its next group here: the first it has not left.
             let g = (0..n_groups)
                 .find(|&g| s - self.tol_s < self.leave_s[g])
@@ -842,6 +874,9 @@ pub struct CellRun {
     pub min_tasks: u64,
     /// Whether every robot completed `min_tasks` of the call within the tick budget.
     pub finished: bool,
+    /// Ticks in which some robot moved backwards: its (tasks completed, reference time)
+    /// decreased (0: a robot never moves backwards; debug builds assert it in every tick).
+    pub backward_steps: u64,
 }
 
 /// Runs `cell` from its current state until every robot has completed `min_tasks` tasks (or
@@ -861,6 +896,7 @@ pub fn run_cell(
 ) -> Result<CellRun> {
     let mut run = CellRun::default();
     let mut policy = PolicyState::new(cell.n_robots());
+    let mut last = cell.position_now();
     let min_done = |c: &ContinuousCoordinator| c.tasks_completed().iter().copied().min();
     while min_done(cell).unwrap_or(0) < min_tasks {
         if run.ticks >= max_ticks {
@@ -880,6 +916,11 @@ pub fn run_cell(
         if t.overlap() {
             run.overlap_ticks += 1;
         }
+        let now = cell.position_now();
+        let back =
+            (0..cell.n_robots()).any(|i| now[i] < last[i] || now[i] != (t.tasks[i], t.ref_time[i]));
+        run.backward_steps += u64::from(back);
+        last = now;
         if t.fault.is_some() {
             cell.clear_fault();
         }

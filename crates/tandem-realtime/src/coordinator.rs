@@ -152,8 +152,16 @@ pub struct Coordinator {
     plans: Arc<Plans>,
     tick_s: f64,
     tol_s: f64,
-    /// Each robot's schedule clock on its current leg.
+    /// Each robot's rule clock on its current leg: the clock the rules of the tick move (at a
+    /// hold, the clock of the legs not started, which follows the robots behind and may be
+    /// below where the robot's previous leg ended).
     clock_s: [f64; MAX_ROBOTS],
+    /// Each robot's schedule clock as reported ([`Coordinator::clock_s`]): its rule clock, but
+    /// never below `floor_s` — non-decreasing from tick to tick.
+    shown_s: [f64; MAX_ROBOTS],
+    /// Per robot, the clock at which its previous leg ended (`−∞` on its first leg): where it
+    /// stands on schedule while it waits at the hold.
+    floor_s: [f64; MAX_ROBOTS],
     /// Each robot's current leg (index into `plans.legs`).
     leg: [usize; MAX_ROBOTS],
     /// Whether each robot's current leg has had its release rules met (latched).
@@ -254,6 +262,8 @@ impl Coordinator {
             tick_s,
             tol_s,
             clock_s: [0.0; MAX_ROBOTS],
+            shown_s: [0.0; MAX_ROBOTS],
+            floor_s: [f64::NEG_INFINITY; MAX_ROBOTS],
             leg: [0; MAX_ROBOTS],
             released: RobotFlags::new(n),
             wait_clock_s: 0.0,
@@ -295,9 +305,65 @@ impl Coordinator {
     }
 
     /// Each robot's schedule clock `s_i` (s, global/schedule-clock frame; with holds, on its
-    /// current leg, which includes the planned dwells before it).
+    /// current leg, which includes the planned dwells before it). Non-decreasing from tick to
+    /// tick: at a hold it stays between the clock at which the robot's previous leg ended and
+    /// the start of its next leg (the planned dwell), however far behind the robots it waits
+    /// for are. Read a robot's reference time with [`Coordinator::ref_time_now`], not through
+    /// [`Coordinator::robots`]: with holds that plan has no dwells.
     pub fn clock_s(&self) -> &[f64] {
+        &self.shown_s[..self.robots.len()]
+    }
+
+    /// The clocks the rules move (the beam search's progress and clearance): with holds, a
+    /// robot at a hold has the clock of the legs not started (rule 3).
+    pub(crate) fn rule_clock_s(&self) -> &[f64] {
         &self.clock_s[..self.robots.len()]
+    }
+
+    /// Each robot's fractional reference time now (reference samples of its whole plan, in
+    /// `[0, T_ref]`): Eq. 15 at its clock on its current leg, plus the leg's first sample. A
+    /// robot at a hold is at the hold's sample. The value [`Tick::ref_time`] reported for
+    /// the last tick (0 at the start); never decreases from tick to tick. O(N).
+    pub fn ref_time_now(&self) -> PerRobot<f64> {
+        let mut out = PerRobot::new(self.robots.len());
+        for (i, t) in out.as_mut_slice().iter_mut().enumerate() {
+            *t = self.ref_time_of(i);
+        }
+        out
+    }
+
+    /// Each robot's reference sample now: the sample containing [`Coordinator::ref_time_now`]
+    /// (its last sample once it has finished). O(N).
+    pub fn sample_now(&self) -> PerRobot<usize> {
+        let mut out = PerRobot::new(self.robots.len());
+        for (i, n) in out.as_mut_slice().iter_mut().enumerate() {
+            let last = self.robots[i].n_ref() - 1;
+            *n = (self.ref_time_of(i).floor() as usize).min(last);
+        }
+        out
+    }
+
+    /// Whether each robot runs in the next tick if it moves: started on its current leg,
+    /// released, not finished and not held by the fault monitor. A robot at a hold, waiting
+    /// for its start or finished executes no sample (a control loop sends it no command and
+    /// logs nothing for it). O(N).
+    pub fn running_now(&self) -> RobotFlags {
+        let mut out = RobotFlags::new(self.robots.len());
+        let held = self.fault.map(|f| f.stopped);
+        for i in 0..self.robots.len() {
+            let (r, s) = (self.cur(i), self.clock_s[i]);
+            out.set(
+                i,
+                s >= r.start_s() && s < r.end_s() && self.released[i] && held != Some(i),
+            );
+        }
+        out
+    }
+
+    /// Robot `i`'s reference time (its cursor `at` is the sample of its rule clock).
+    fn ref_time_of(&self, i: usize) -> f64 {
+        let r = self.cur(i);
+        r.ref_time_in(self.cursors[i].at, self.clock_s[i]) + self.plans.ref0[self.leg[i]] as f64
     }
 
     /// Whether every robot has finished (with holds: its last leg).
@@ -305,6 +371,21 @@ impl Coordinator {
         (0..self.robots.len()).all(|i| {
             self.leg[i] + 1 == self.plans.first_leg[i + 1] && self.clock_s[i] >= self.cur(i).end_s()
         })
+    }
+
+    /// Robot `robot`'s planned end (schedule clock, s): the end of its last leg, the planned
+    /// dwells at its holds included (without holds, its timeline's end `τ_i + |ψ_E|`). The
+    /// latest of them is the schedule's `T_total` (Eq. 13) when the first robot starts at 0.
+    ///
+    /// # Panics
+    /// If `robot ≥ N`.
+    pub fn planned_end_s(&self, robot: usize) -> f64 {
+        assert!(
+            robot < self.robots.len(),
+            "robot {robot} of {}",
+            self.robots.len()
+        );
+        self.plans.legs[self.plans.first_leg[robot + 1] - 1].end_s()
     }
 
     /// Whether the plans have hold points or release rules (`crate::holds`).
@@ -369,6 +450,8 @@ impl Coordinator {
             .map(Timeline::start_s)
             .fold(f64::INFINITY, f64::min);
         self.clock_s = [t0; MAX_ROBOTS];
+        self.shown_s = [t0; MAX_ROBOTS];
+        self.floor_s = [f64::NEG_INFINITY; MAX_ROBOTS];
         self.wait_clock_s = t0;
         let n = self.robots.len();
         for i in 0..n {
@@ -436,6 +519,11 @@ impl Coordinator {
     pub fn tick(&mut self, operator: Operator) -> Result<Tick> {
         let g = operator.validate()?;
         let n = self.robots.len();
+        // The invariant "a robot never moves backwards", checked in debug builds: every
+        // robot's reference time and reported clock at the tick end are at least those at
+        // its start (docs/decisions.md, "A robot never moves backwards").
+        #[cfg(debug_assertions)]
+        let before = (self.ref_time_now(), self.shown_s);
         let mut members = [Member::idle(0.0, Mode::Finished); MAX_ROBOTS];
         let mut next_s = [0.0_f64; MAX_ROBOTS];
         let mut pace_robot = None;
@@ -518,17 +606,34 @@ impl Coordinator {
                 let hi = r.advance_cursor(&mut cur.hi, s_new + self.tol_s);
                 out.low_conf.set(i, r.any_low_conf(lo, hi));
             }
-            let at = r.advance_cursor(&mut self.cursors[i].at, s_new);
-            out.ref_time.as_mut_slice()[i] =
-                r.ref_time_in(at, s_new) + self.plans.ref0[self.leg[i]] as f64;
+            r.advance_cursor(&mut self.cursors[i].at, s_new);
             if has_holds && s_new >= r.end_s() && self.leg[i] + 1 < self.plans.first_leg[i + 1] {
-                // The leg ended at a hold: the robot's next leg is current, at the clock every
-                // leg not yet started has.
+                // The leg ended at a hold: the robot's next leg is current, its rule clock the
+                // one every leg not yet started has (rule 3: it follows the running robot
+                // furthest behind, so it may be below `s_new`). The robot stands at the hold's
+                // sample; its reported clock stays at `s_new` until the rule clock passes it.
+                self.floor_s[i] = s_new;
                 self.leg[i] += 1;
                 self.clock_s[i] = self.wait_clock_s;
                 self.cursors[i] = Cursors::default();
+                let next = &self.plans.legs[self.leg[i]];
+                next.advance_cursor(&mut self.cursors[i].at, self.wait_clock_s);
                 self.released.set(i, false);
             }
+            self.shown_s[i] = self.clock_s[i].max(self.floor_s[i]);
+            out.ref_time.as_mut_slice()[i] = self.ref_time_of(i);
+        }
+        #[cfg(debug_assertions)]
+        for i in 0..n {
+            debug_assert!(
+                out.ref_time[i] >= before.0[i] && self.shown_s[i] >= before.1[i],
+                "robot {i} moved backwards in tick {}: reference time {} -> {}, clock {} -> {}",
+                self.ticks,
+                before.0[i],
+                out.ref_time[i],
+                before.1[i],
+                self.shown_s[i]
+            );
         }
         self.update_released();
         self.monitor(&out);
@@ -629,6 +734,70 @@ mod tests {
         // A reset clears everything.
         c.reset();
         assert_eq!(c.fault(), None);
+    }
+
+    /// Robot 0: six HC samples but sample 4, bounds [1, 1] (it can neither rush nor drag),
+    /// a hold at 3 with a planned dwell of 1 s, released once robot 1 has passed sample 4;
+    /// robot 1: LC on samples 1–3, bounds [½, 2]. Both start at 0, Δt_s = 1, tick ½.
+    fn held_ahead() -> Coordinator {
+        let g = [1.0; 6];
+        let r0 = Timeline::new(&[true, true, true, true, false, true], &g, &g, &g, 0.0, 1.0);
+        let conf1 = [true, false, false, false, true, true];
+        let r1 = Timeline::new(&conf1, &g, &[0.5; 6], &[2.0; 6], 0.0, 1.0);
+        let hold = Hold {
+            dwell_s: 1.0,
+            after: vec![crate::After {
+                robot: 1,
+                ref_idx: 4,
+            }],
+            ..Hold::at(3)
+        };
+        let holds = [vec![hold], vec![]];
+        Coordinator::with_holds_unchecked([r0.unwrap(), r1.unwrap()], &holds, 0.5).unwrap()
+    }
+
+    #[test]
+    fn a_robot_at_a_hold_never_moves_backwards() {
+        let mut c = held_ahead();
+        // Ticks 0–1: level, HC, both at robot 0's pace (its F = 1). Ticks 2–5: robot 1 is
+        // dragged (step ¼), robot 0 cannot go slower than ½ and ends its leg at 3 in tick 5.
+        let mut t = c.tick(Operator::Slowest).unwrap();
+        for _ in 1..6 {
+            t = c.tick(Operator::Slowest).unwrap();
+        }
+        assert!(c.at_hold(0));
+        assert_eq!(t.ref_time, [3.0, 2.0]);
+        // Cause 1: the held leg's rule clock is that of the legs not started, which follows
+        // robot 1 (at 2); the reported clock stays where robot 0 is on schedule, 3.
+        assert_eq!(c.rule_clock_s(), [2.0, 2.0]);
+        assert_eq!(c.clock_s(), [3.0, 2.0]);
+        assert_eq!(c.ref_time_now(), t.ref_time);
+        assert_eq!(c.running_now(), [false, true]);
+        assert_eq!(c.sample_now(), [3, 2]);
+        let (mut last_ref, mut last_clock) = (c.ref_time_now(), c.clock_s().to_vec());
+        let mut dwelt = 0;
+        while !c.is_finished() {
+            let t = c.tick(Operator::Slowest).unwrap();
+            assert_eq!(t.ref_time, c.ref_time_now());
+            for i in 0..2 {
+                assert!(t.ref_time[i] >= last_ref[i] && c.clock_s()[i] >= last_clock[i]);
+            }
+            if c.at_hold(0) {
+                assert_eq!(t.ref_time[0], 3.0);
+                assert!(!c.running_now()[0]);
+                // Cause 2: inside the dwell (clock in (3, 4]) the robot's plan without dwells
+                // would place it past its hold.
+                if c.clock_s()[0] > 3.0 {
+                    dwelt += 1;
+                    assert!(c.robots()[0].ref_time_at(c.clock_s()[0]) > 3.0);
+                }
+            }
+            (last_ref, last_clock) = (t.ref_time, c.clock_s().to_vec());
+        }
+        assert!(dwelt > 0);
+        assert_eq!(c.ref_time_now(), [6.0, 6.0]);
+        // The leg after the hold ends one dwell later than the plan without it.
+        assert_eq!(c.clock_s()[0], c.robots()[0].end_s() + 1.0);
     }
 
     #[test]

@@ -318,7 +318,96 @@ pub fn release_rules(
             hold.after.push(rule);
         }
     }
+    plan_rule_waits(robots, &mut holds);
     holds
+}
+
+/// The clock (s) at which robot `robot`, on its legs `legs` (its plan split at its holds,
+/// dwells included), is planned to reach the start of reference sample `ref_idx`
+/// (`1..=T_ref`): the threshold of a release rule awaiting it ([`Plans::new`]).
+fn planned_clock_at(legs: &[Timeline], ref_idx: usize) -> f64 {
+    let mut ref0 = 0;
+    for leg in legs {
+        if ref_idx <= ref0 + leg.n_ref() {
+            return leg.sample_clock_s()[ref_idx - ref0];
+        }
+        ref0 += leg.n_ref();
+    }
+    legs.last().map_or(f64::INFINITY, Timeline::end_s)
+}
+
+/// Plans the waits the release rules impose: raises the planned dwell of every hold (after
+/// the start) to at least the time its robot must wait there on schedule, from its arrival
+/// (the end of its previous leg) to the planned clock at which the last robot it awaits passes
+/// the awaited sample — so that the schedule's times, and its `T_total`, are what a cell
+/// whose operator works at the planned speed does (docs/decisions.md, "A plan is what the
+/// cell does"). A dwell is never lowered. The awaited clocks move with the awaited robots'
+/// own dwells, so this iterates to a fixed point (at most once per hold, plus one; dwells
+/// only grow). A rule on the start hold (sample 0) cannot be planned by a dwell (the start
+/// offset is the start's dwell) and is left as it is; a rule whose awaited leg no longer
+/// starts strictly before the held leg once the waits are planned is dropped (it would wait
+/// forever: legs start in order), as when the rules are made.
+fn plan_rule_waits(robots: &[Timeline], holds: &mut [Vec<Hold>]) {
+    let rounds = holds.iter().map(Vec::len).sum::<usize>() + 1;
+    for _ in 0..rounds {
+        let Ok(legs_of) = robots
+            .iter()
+            .zip(holds.iter())
+            .map(|(r, h)| legs(r, h))
+            .collect::<Result<Vec<_>>>()
+        else {
+            return;
+        };
+        let mut changed = false;
+        for (b, list) in holds.iter_mut().enumerate() {
+            let mut leg = 0;
+            for h in list.iter_mut().filter(|h| h.ref_idx > 0) {
+                leg += 1;
+                let arrive_s = legs_of[b][leg - 1].end_s();
+                let due_s = h
+                    .after
+                    .iter()
+                    .map(|a| planned_clock_at(&legs_of[a.robot], a.ref_idx))
+                    .fold(arrive_s + h.dwell_s, f64::max);
+                // Raise only by more than rounding: `arrive + dwell` may differ from `due`
+                // by an ulp once the legs are rebuilt.
+                let eps = 1e-12 * due_s.abs().max(1.0);
+                if due_s > arrive_s + h.dwell_s + eps {
+                    h.dwell_s = due_s - arrive_s;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    // Rules whose awaited leg does not start strictly before the held leg any more.
+    let Ok(legs_of) = robots
+        .iter()
+        .zip(holds.iter())
+        .map(|(r, h)| legs(r, h))
+        .collect::<Result<Vec<_>>>()
+    else {
+        return;
+    };
+    let start_of_leg_with = |robot: usize, sample: usize| {
+        let mut ref0 = 0;
+        for leg in &legs_of[robot] {
+            if sample < ref0 + leg.n_ref() {
+                return leg.start_s();
+            }
+            ref0 += leg.n_ref();
+        }
+        f64::INFINITY
+    };
+    for (b, list) in holds.iter_mut().enumerate() {
+        for h in list.iter_mut() {
+            let held_start = start_of_leg_with(b, h.ref_idx);
+            h.after
+                .retain(|a| start_of_leg_with(a.robot, a.ref_idx - 1) < held_start);
+        }
+    }
 }
 
 /// A release rule in clock terms: robot `robot` has passed `threshold_s` on its leg `leg`

@@ -414,6 +414,10 @@ fn the_full_adversary_set_never_overlaps() {
             let run = run_cell(&mut c, a, &mut rng, 50, 50_000_000).unwrap();
             assert!(run.finished && run.min_tasks >= 50, "{case} {a:?} {run:?}");
             assert_eq!(run.overlap_ticks, 0, "{case} {a:?}");
+            assert_eq!(
+                run.backward_steps, 0,
+                "{case} {a:?}: a robot moved backwards"
+            );
         }
     }
 }
@@ -605,6 +609,18 @@ fn hand_over_is_sound(seed: u64, n: usize, policy: u8) -> Result<(), TestCaseErr
         prop_assert!(tries < 1_000_000, "no hand-over point");
     }
     prop_assert_eq!(new.tasks_completed(), old.tasks_completed());
+    // Every robot continues where it is: never behind (a robot never moves backwards, not
+    // even by the rounding of the clock's interpolation), ahead by rounding at most.
+    let (was, is) = (old.position_now(), new.position_now());
+    for i in 0..n {
+        prop_assert!(
+            is[i] >= was[i] && is[i].1 - was[i].1 < 1e-9,
+            "robot {}: {:?} -> {:?}",
+            i,
+            was[i],
+            is[i]
+        );
+    }
     // The new plan runs until every robot has done 20 more tasks, soundly.
     let target: Vec<u64> = old.tasks_completed().iter().map(|k| k + 20).collect();
     let mut ticks = 0_u64;

@@ -28,6 +28,7 @@ use tandem_realtime::{clock_end_s, tol};
 
 use crate::exact;
 use crate::problem::{Problem, check_robot_count};
+use crate::retime::retime;
 use crate::sampler::{self, SamplerBaselines, SamplerParams, SamplerStats};
 use crate::schedule::Schedule;
 use crate::stagger;
@@ -83,7 +84,12 @@ impl Source {
 }
 
 /// A re-schedule's result: the schedule and its certificate.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+///
+/// Two outcomes are equal (`==`) when what the state file stores is: the schedule, `T_total`,
+/// source, counts and certificate. [`Outcome::margin_free_s`] and [`Outcome::previous`]
+/// describe the run that made the outcome and are not compared (a saved and reloaded outcome
+/// equals the original).
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Outcome {
     /// The schedule; its [`Schedule::tick_s`] is the scheduler's tick, at which it passes
     /// [`crate::validate`].
@@ -113,6 +119,60 @@ pub struct Outcome {
     /// this much (relative) above the optimum of Eq. 20; what it is above `T*₀` is what the
     /// margins (constraint 5) cost, plus whatever the search left.
     pub gap: f64,
+    /// The least `T_total` (s) known of a schedule satisfying Eq. 20 constraints 1–4 (no
+    /// margins): the margin-free search's best schedule (for `N ≥ 3` its best order, proven
+    /// or not), or [`Outcome::t_total_s`] if that is less (a valid schedule satisfies them
+    /// too). The margin-free optimum `T*₀` lies in `[lower_bound_s, margin_free_s]`: equal to
+    /// the bound when it is proven. `None` for an outcome read from a state file (not stored).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub margin_free_s: Option<f64>,
+    /// What became of the previous schedule given to the scheduler: still valid, re-timed
+    /// for the new problem, or invalid and why. While it (or its re-timing) is valid the
+    /// returned `T_total` is never above its `T_total`. Not serialized (the state file keeps
+    /// its format; a loaded or deserialized outcome reads [`PreviousFate::NotGiven`]).
+    #[serde(skip)]
+    pub previous: PreviousFate,
+}
+
+impl PartialEq for Outcome {
+    fn eq(&self, other: &Self) -> bool {
+        self.schedule == other.schedule
+            && self.t_total_s == other.t_total_s
+            && self.source == other.source
+            && self.stats == other.stats
+            && self.lower_bound_s == other.lower_bound_s
+            && self.bound_is_optimum == other.bound_is_optimum
+            && self.gap == other.gap
+    }
+}
+
+/// Where the certificate's gap goes ([`Outcome::gap_split`]), both relative to
+/// [`Outcome::lower_bound_s`] like [`Outcome::gap`], which is their sum.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GapSplit {
+    /// `(margin_free_s − lower_bound_s)/lower_bound_s`: how far the margin-free search left
+    /// the optimum `T*₀` open (0 when it finished: the bound is `T*₀`). Time that may or may
+    /// not be lost: a longer search, not a better schedule, would tell.
+    pub search: f64,
+    /// `(T_total − margin_free_s)/lower_bound_s`: what the schedule costs above the best
+    /// schedule known without margins: the worst-case margins between the robots' low-confidence
+    /// stretches (Eq. 20 constraint 5) or the waits of their release rules, plus whatever the
+    /// scheduler did not find.
+    pub margins: f64,
+}
+
+impl Outcome {
+    /// The gap split into the search's share and the margins' share (see [`GapSplit`]);
+    /// `None` for an outcome read from a state file ([`Outcome::margin_free_s`] is not
+    /// stored).
+    pub fn gap_split(&self) -> Option<GapSplit> {
+        let free = self.margin_free_s?;
+        let bound = self.lower_bound_s;
+        Some(GapSplit {
+            search: (free - bound) / bound,
+            margins: (self.t_total_s - free) / bound,
+        })
+    }
 }
 
 /// The certificate of a valid schedule of `t_total_s` seconds against the lower bound
@@ -190,16 +250,78 @@ pub(crate) fn repair(problem: &Problem, previous: &Schedule, tick_s: f64) -> Opt
     })
 }
 
-/// The incumbent at control tick `tick_s` (see the module docs, step 1), or, if there is none,
-/// why the serial schedule failed.
+/// What became of the previous schedule in a re-schedule ([`Outcome::previous`]): whether it
+/// (or its re-timing for the new problem) was still valid, and so bounded the result, or why
+/// not. Never stored in the state file (a loaded outcome reads [`PreviousFate::NotGiven`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum PreviousFate {
+    /// No previous schedule of this robot count was given (a first schedule, a load, or a
+    /// previous schedule of another robot count).
+    #[default]
+    NotGiven,
+    /// The previous schedule passes every constraint of Eq. 20 on the new problem at the
+    /// scheduler's tick as it is; the result is never longer.
+    Valid {
+        /// Its `T_total` (Eq. 13, s) on the new problem.
+        t_total_s: f64,
+    },
+    /// The previous schedule no longer passes on the new problem (`why`: the model update
+    /// moved the mean gradient of its low-confidence samples, Eq. 20 constraint 4, or its
+    /// bounds), but its re-timing or repair for the new problem does; the result is never
+    /// longer than that.
+    Repaired {
+        /// The first constraint the previous schedule broke as it was.
+        why: Violation,
+        /// `T_total` (Eq. 13, s) of the valid re-timed schedule (the least of the tries).
+        t_total_s: f64,
+    },
+    /// Neither the previous schedule nor any re-timing or repair of it passes on the new
+    /// problem: the result is not bounded by the previous schedule and may be longer.
+    Invalid {
+        /// The first constraint the previous schedule broke as it was.
+        why: Violation,
+        /// The first constraint its re-timing broke (`None` when it could not be re-timed:
+        /// robot 1 would have to start later, or the shape does not fit the problem).
+        retimed_why: Option<Violation>,
+    },
+}
+
+impl PreviousFate {
+    /// One sentence for a report: whether the previous schedule bounded the new one, and why
+    /// not. `None` for [`PreviousFate::NotGiven`].
+    pub fn describe(&self) -> Option<String> {
+        match self {
+            PreviousFate::NotGiven => None,
+            PreviousFate::Valid { t_total_s } => Some(format!(
+                "the previous schedule is still valid ({t_total_s:.3} s)"
+            )),
+            PreviousFate::Repaired { why, t_total_s } => Some(format!(
+                "the previous schedule no longer fits the updated model ({why}); re-timed it \
+                 passes ({t_total_s:.3} s)"
+            )),
+            PreviousFate::Invalid { why, retimed_why } => Some(match retimed_why {
+                Some(r) => format!(
+                    "the previous schedule became invalid ({why}), and so did its re-timing ({r})"
+                ),
+                None => format!(
+                    "the previous schedule became invalid ({why}) and could not be re-timed"
+                ),
+            }),
+        }
+    }
+}
+
+/// The incumbent at control tick `tick_s` (see the module docs, step 1), and what became of
+/// the previous schedule; or, if there is no incumbent, why the serial schedule failed.
 fn incumbent(
     problem: &Problem,
     serial: &Schedule,
     previous: Option<&Schedule>,
     tick_s: f64,
-) -> std::result::Result<Candidate, Violation> {
+) -> std::result::Result<(Candidate, PreviousFate), Violation> {
     let dt_s = problem.dt_s();
     let mut found: Option<Candidate> = None;
+    let mut fate = PreviousFate::NotGiven;
     // A previous schedule of another robot count is no incumbent (the sampler still starts
     // from its robot 1).
     if let Some(prev) = previous.filter(|p| p.n_robots() == serial.n_robots()) {
@@ -208,14 +330,20 @@ fn incumbent(
             tick_s,
             ..prev.clone()
         };
-        if validate(problem, &prev).is_ok() {
-            let t = prev.t_total_s(dt_s);
-            found = Some((prev, t, Source::Previous));
-        } else if let Some(fixed) = repair(problem, &prev, tick_s)
-            && validate(problem, &fixed).is_ok()
-        {
-            let t = fixed.t_total_s(dt_s);
-            found = Some((fixed, t, Source::RepairedPrevious));
+        match validate(problem, &prev) {
+            Ok(()) => {
+                let t = prev.t_total_s(dt_s);
+                fate = PreviousFate::Valid { t_total_s: t };
+                found = Some((prev, t, Source::Previous));
+            }
+            Err(why) => {
+                let (best, retimed_why) = repaired(problem, &prev, tick_s);
+                fate = match &best {
+                    Some((_, t)) => PreviousFate::Repaired { why, t_total_s: *t },
+                    None => PreviousFate::Invalid { why, retimed_why },
+                };
+                found = best.map(|(s, t)| (s, t, Source::RepairedPrevious));
+            }
         }
     }
     let serial_t = serial.t_total_s(dt_s);
@@ -226,7 +354,90 @@ fn incumbent(
             Err(_) => {}
         }
     }
-    Ok(found.expect("the serial schedule or an earlier incumbent was kept"))
+    Ok((
+        found.expect("the serial schedule or an earlier incumbent was kept"),
+        fate,
+    ))
+}
+
+/// The least-`T_total` valid schedule among the re-timings of the previous schedule `prev` for
+/// `problem` ([`retime`], with the old clearances and with them raised by one and by four
+/// maximal steps `M` of the margin check; with holds, each also with its release rules
+/// re-derived from its order, [`Problem::with_release_rules`]) and its plain [`repair`] (with
+/// its holds, and without); with the first violation of the plain re-timing when none
+/// passes.
+fn repaired(
+    problem: &Problem,
+    prev: &Schedule,
+    tick_s: f64,
+) -> (Option<(Schedule, f64)>, Option<Violation>) {
+    let dt_s = problem.dt_s();
+    let step_s = max_step_s(problem, tick_s);
+    let mut tries: Vec<Schedule> = Vec::new();
+    for extra in [0.0, step_s, 4.0 * step_s] {
+        let Some(re) = retime(problem, prev, tick_s, extra) else {
+            continue;
+        };
+        // Re-timed dwells can reorder the legs a release rule relies on (a rule that would
+        // wait for a leg starting no earlier is refused): the rules re-derived from the
+        // re-timed order are tried too.
+        let rederived = re.has_holds().then(|| {
+            let bare = Schedule {
+                holds: re
+                    .holds
+                    .iter()
+                    .map(|hs| {
+                        hs.iter()
+                            .map(|h| tandem_realtime::Hold {
+                                after: Vec::new(),
+                                ..h.clone()
+                            })
+                            .collect()
+                    })
+                    .collect(),
+                ..re.clone()
+            };
+            problem.with_release_rules(&bare).ok()
+        });
+        tries.push(re);
+        tries.extend(rederived.flatten());
+    }
+    let retimed = !tries.is_empty();
+    if let Some(fixed) = repair(problem, prev, tick_s) {
+        if prev.has_holds() {
+            tries.push(Schedule {
+                holds: prev.holds.clone(),
+                ..fixed.clone()
+            });
+        }
+        tries.push(fixed);
+    }
+    let mut best: Option<(Schedule, f64)> = None;
+    let mut first_why = None;
+    for (q, s) in tries.into_iter().enumerate() {
+        let t = s.t_total_s(dt_s);
+        if best.as_ref().is_some_and(|b| b.1 <= t) {
+            continue;
+        }
+        match validate(problem, &s) {
+            Ok(()) => best = Some((s, t)),
+            Err(v) if q == 0 && retimed => first_why = Some(v),
+            Err(_) => {}
+        }
+    }
+    (best, first_why)
+}
+
+/// `M` (schedule-clock s): `tick_s · max(1, largest ψ̇̄/ψ̇min of a low-confidence sample)`, the
+/// least maximal step in one tick of any schedule of `problem` (its LC samples run at the
+/// mean): the margin check's unit of room.
+pub(crate) fn max_step_s(problem: &Problem, tick_s: f64) -> f64 {
+    let (gmean, gmin) = (problem.grad_mean(), problem.grad_min());
+    tick_s
+        * (0..problem.n_ref())
+            .filter(|&n| !problem.conf()[n])
+            .map(|n| gmean[n] / gmin[n])
+            .fold(1.0, f64::max)
 }
 
 /// The scheduler (see the module docs): the least-`T_total` schedule among the incumbent
@@ -322,7 +533,7 @@ fn schedule_n(
     }
     let tick_s = params.tick_s.unwrap_or(problem.dt_s());
     let serial = problem.serial_schedule_n(n_robots, tick_s)?;
-    let incumbent = match incumbent(problem, &serial, previous, tick_s) {
+    let (incumbent, previous_fate) = match incumbent(problem, &serial, previous, tick_s) {
         Ok(inc) => inc,
         Err(serial) => return Err(Error::NoFeasibleSchedule { serial }),
     };
@@ -359,7 +570,10 @@ fn schedule_n(
                 return (exact::operator_bound(problem, n_robots), (None, 0));
             }
             if !two {
-                return (exact::bound_n(problem, n_robots), (None, 0));
+                return (
+                    exact::bound_many(problem, n_robots, &params.exact),
+                    (None, 0),
+                );
             }
             let bound = exact::bound(problem, &params.exact);
             let done = if bound.lower_bound_s < cap_s {
@@ -431,6 +645,11 @@ fn schedule_n(
     }
     stats.completion_margin_checks = checks;
     let (schedule, t_total_s, source) = best;
+    let margin_free_s = bound
+        .schedule
+        .as_ref()
+        .map_or(t_total_s, |s| s.t_total_s(problem.dt_s()).min(t_total_s))
+        .max(bound.lower_bound_s.min(t_total_s));
     let (lower_bound_s, gap) = certificate(bound.lower_bound_s, t_total_s)?;
     Ok(Outcome {
         schedule,
@@ -440,6 +659,8 @@ fn schedule_n(
         lower_bound_s,
         bound_is_optimum: bound.proven_optimal,
         gap,
+        margin_free_s: Some(margin_free_s),
+        previous: previous_fate,
     })
 }
 

@@ -59,6 +59,7 @@ pub mod cyclic;
 mod error;
 pub mod exact;
 mod problem;
+mod retime;
 mod sampler;
 mod schedule;
 mod stagger;
@@ -66,7 +67,8 @@ mod validate;
 
 pub use checked::CheckedSchedule;
 pub use choose::{
-    Outcome, Source, sample_schedule, sample_schedule_n, sample_schedule_with_baselines,
+    GapSplit, Outcome, PreviousFate, Source, sample_schedule, sample_schedule_n,
+    sample_schedule_with_baselines,
 };
 pub use cyclic::{
     CycleRatio, CyclicParams, CyclicPlan, Stretch, cyclic_plan, cyclic_plan_for_order,

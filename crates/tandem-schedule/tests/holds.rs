@@ -5,42 +5,14 @@
 //! reach the exact optimum with holds, which is the certificate's bound; a problem without
 //! holds schedules exactly as before.
 
+#[allow(dead_code, reason = "the random problems are for other test files")]
+mod common;
+use common::pegs;
 use tandem_realtime::testkit::{find_overlap_with_holds, rng};
 use tandem_schedule::{
     Problem, SamplerParams, Schedule, Source, operator_bound_s, sample_schedule_n, solve_exact,
     validate,
 };
-
-/// 20 s at 20 Hz: approach (3 s), insert peg 1 (2 s, low confidence), transfer (8 s), insert
-/// peg 2 (2 s, low confidence), retract (5 s). High-confidence speeds within
-/// `[0.8, 1.25]` of the mean, the inserts at their mean (bounds `[0.7, 1.4]`). Holds in the
-/// approach, twice in the transfer and in the retract (gripper open, arm in free space).
-fn pegs(with_holds: bool) -> Problem {
-    let n = 400;
-    let conf: Vec<bool> = (0..n)
-        .map(|k| !((60..100).contains(&k) || (260..300).contains(&k)))
-        .collect();
-    let mean: Vec<f64> = (0..n)
-        .map(|k| 1.0 + 0.1 * (k as f64 * 0.03).sin())
-        .collect();
-    let (lo, hi): (Vec<f64>, Vec<f64>) = mean
-        .iter()
-        .zip(&conf)
-        .map(|(&m, &hc)| {
-            if hc {
-                (0.8 * m, 1.25 * m)
-            } else {
-                (0.7 * m, 1.4 * m)
-            }
-        })
-        .unzip();
-    let p = Problem::new(conf, mean, lo, hi, 0.05).unwrap();
-    if with_holds {
-        p.with_holds(vec![30, 150, 200, 340]).unwrap()
-    } else {
-        p
-    }
-}
 
 fn params(seed: u64) -> SamplerParams {
     SamplerParams {
@@ -120,7 +92,11 @@ fn three_robots_overlap_on_a_task_with_two_variable_sections() {
         "{} vs grid {plain_grid}, serial {serial_s}",
         without.t_total_s
     );
-    assert!(out.t_total_s <= without.t_total_s + 1e-9);
+    // Not asserted since the release rules' waits are planned as dwells (docs/decisions.md,
+    // "A plan is what the cell does"): holds used to look no worse (21.205 s planned) but that
+    // plan ran 29.45 s with an operator who never corrects; planned honestly it is 29.4 s,
+    // above the staggered schedule without holds (22.485 s), which the scheduler does not try
+    // once a candidate with holds overlaps the robots (open, issue 38).
     eprintln!(
         "three robots: with holds {:.3} s (grid {grid:.3} s, bound {:.3} s), without {:.3} s (grid {plain_grid:.3} s), serial {serial_s:.3} s",
         out.t_total_s, out.lower_bound_s, without.t_total_s
@@ -150,8 +126,11 @@ fn two_robots_reach_the_exact_optimum_with_holds_and_it_is_the_bound() {
     validate(&held, &out.schedule).unwrap();
     assert!(out.bound_is_optimum);
     assert_eq!(out.lower_bound_s, opt.lower_bound_s);
-    assert!(out.gap < 1e-6, "gap {} ({:?})", out.gap, out.source);
-    assert_eq!(out.source, Source::Held);
+    // The margin-free optimum with holds is the bound, but its schedule with release rules is
+    // no longer at it: the rules' waits are planned as dwells (docs/decisions.md, "A plan is
+    // what the cell does"; at the bound, 19.042 s, it ran 22.90 s with an operator who never
+    // corrects). The scheduler's schedule is within 1 % of the bound.
+    assert!(out.gap < 0.01, "gap {} ({:?})", out.gap, out.source);
     let robots = out.schedule.timelines(&held).unwrap();
     let mut r = rng(4);
     let ticks = (out.t_total_s / 0.05) as u64;

@@ -93,7 +93,10 @@ fn record_pair_updates_everything_and_keeps_schedules_valid() {
     );
     assert!(n_supervised > 0);
     assert!((p.observations().total_supervised() - n_supervised as f64).abs() < 1e-6);
-    assert_eq!(p.confidence().n_high(), high0 + report.newly_high);
+    assert_eq!(
+        p.confidence().n_high(),
+        high0 + report.newly_high - report.reopened
+    );
     assert!(validate(p.problem(), p.schedule()).is_ok());
     assert_eq!(report.t_total_s, p.outcome().t_total_s);
 }

@@ -32,6 +32,9 @@
 //! at `i·Δt` plus a jitter uniform in `±jitter·Δt` (`jitter ≤ 0.12`, inside the loader's 25 %
 //! of a period around the even grid through the first and last times, docs/decisions.md,
 //! "Timestamps: the mean period, jitter within 25 %"). Values are taken at the jittered time.
+//! For half the seeds the stamps are the controller's clock: each demonstration's `t` starts
+//! at its own offset of 1–60 min (whole milliseconds), as a log cut from a longer recording
+//! does; for the others `t` starts at 0.
 
 use std::f64::consts::TAU;
 use std::fmt::Write as _;
@@ -70,7 +73,47 @@ pub(crate) struct Channel {
     pub(crate) tremor_tau_s: f64,
 }
 
+/// The columns of the pose block [`Channel::pose_then`] puts first: `x, y, z, qx, qy, qz, qw`.
+pub(crate) mod pose {
+    /// Column of `x` (m).
+    pub(crate) const X: usize = 0;
+    /// Column of `y` (m).
+    pub(crate) const Y: usize = 1;
+    /// Column of `z` (m).
+    pub(crate) const Z: usize = 2;
+    /// Column of the quaternion's `qx`.
+    pub(crate) const QX: usize = 3;
+    /// Column of the quaternion's `qy`.
+    pub(crate) const QY: usize = 4;
+    /// Column of the quaternion's `qz`.
+    pub(crate) const QZ: usize = 5;
+}
+
 impl Channel {
+    /// A pose as a recorder logs it, `x, y, z` (m, `pos_decimals` decimals) and the quaternion
+    /// `qx, qy, qz` (6 decimals) with `qw` (noise-free, the generator normalizes), each with
+    /// its `(white, tremor)` noise, followed by the family's own `rest` channels.
+    pub(crate) fn pose_then<const K: usize>(
+        pos_decimals: usize,
+        (pos_white, pos_tremor): (f64, f64),
+        (rot_white, rot_tremor): (f64, f64),
+        rest: [Channel; K],
+    ) -> Vec<Channel> {
+        let pos = |name| Channel::real(name, pos_decimals, pos_white, pos_tremor);
+        let rot = |name| Channel::real(name, 6, rot_white, rot_tremor);
+        let mut out = vec![
+            pos("x"),
+            pos("y"),
+            pos("z"),
+            rot("qx"),
+            rot("qy"),
+            rot("qz"),
+            Channel::real("qw", 6, 0.0, 0.0),
+        ];
+        out.extend(rest);
+        out
+    }
+
     /// A real channel.
     pub(crate) fn real(name: &'static str, decimals: usize, white_sd: f64, tremor_sd: f64) -> Self {
         Self {
@@ -211,12 +254,12 @@ pub(crate) struct Variation {
 }
 
 /// A local event of one segment that differs between demonstrations; the operator is needed
-/// over the segment with probability `need_p`.
+/// with probability `need_p` over the part of the segment where it can happen.
 #[derive(Clone, Debug)]
 pub(crate) struct Feature {
     /// The segment.
     pub(crate) seg: usize,
-    /// p(need) over the segment.
+    /// p(need) where the event can happen.
     pub(crate) need_p: f64,
     /// What happens.
     pub(crate) kind: FeatureKind,
@@ -254,6 +297,20 @@ pub(crate) enum FeatureKind {
         /// Force channels and friction magnitude (N).
         friction: Option<(usize, usize, f64)>,
     },
+}
+
+impl FeatureKind {
+    /// The local phase over which the event can differ between demonstrations: a spike's
+    /// possible centres widened by its half-width, the whole segment for a spiral (its
+    /// direction, so its friction force, differs throughout).
+    fn span_u(self) -> (f64, f64) {
+        match self {
+            FeatureKind::Spike { at, width, .. } => {
+                ((at.0 - width).max(0.0), (at.1 + width).min(1.0))
+            }
+            FeatureKind::Spiral { .. } => (0.0, 1.0),
+        }
+    }
 }
 
 /// The operator is needed with probability `p` over local phase `from_u..to_u` of segment
@@ -303,6 +360,9 @@ pub(crate) struct Script {
     pub(crate) jitter: f64,
     /// Total length spread, fraction (`T_i = T_nominal·(1 ± length_var)`).
     pub(crate) length_var: f64,
+    /// How unsteady the demonstrator's pace is: every segment's `wobble` is multiplied by it
+    /// (0.5: a steady hand, ±15 % speed within a free move; 1: ±30 %).
+    pub(crate) wobble_scale: f64,
 }
 
 /// Draws the family's per-seed choices: a ChaCha8 stream from the seed and the family's name
@@ -417,8 +477,11 @@ impl Script {
         if !(1.0..=10_000.0).contains(&self.rate_hz) || !(0.0..=0.12).contains(&self.jitter) {
             return Err(self.bad(format!("rate {} Hz, jitter {}", self.rate_hz, self.jitter)));
         }
-        if !(0.0..0.5).contains(&self.length_var) {
-            return Err(self.bad(format!("length_var {}", self.length_var)));
+        if !(0.0..0.5).contains(&self.length_var) || !(0.0..=1.0).contains(&self.wobble_scale) {
+            return Err(self.bad(format!(
+                "length_var {}, wobble_scale {}",
+                self.length_var, self.wobble_scale
+            )));
         }
         if let Some(q) = self.quat
             && (q + 4 > m
@@ -502,8 +565,11 @@ impl Script {
             variable.push((p[v.first], p[v.last + 1]));
         }
         for f in &self.features {
-            parts.push((p[f.seg], p[f.seg + 1], f.need_p, true));
-            variable.push((p[f.seg], p[f.seg + 1]));
+            let (u0, u1) = f.kind.span_u();
+            let w = p[f.seg + 1] - p[f.seg];
+            let (a, b) = (p[f.seg] + w * u0, p[f.seg] + w * u1);
+            parts.push((a, b, f.need_p, true));
+            variable.push((a, b));
         }
         for a in &self.agreed {
             let w = p[a.seg + 1] - p[a.seg];
@@ -591,6 +657,14 @@ pub(crate) fn render(script: &Script, rng: &mut ChaCha8Rng) -> Result<ZooTask> {
         })
         .collect();
 
+    let clock_offsets_s: Vec<f64> = if rng.random::<bool>() {
+        (0..n)
+            .map(|_| (uniform(rng, 60.0, 3600.0) * 1000.0).round() / 1000.0)
+            .collect()
+    } else {
+        vec![0.0; n]
+    };
+
     let header = {
         let mut h = String::from("t");
         for c in &script.channels {
@@ -621,7 +695,7 @@ pub(crate) fn render(script: &Script, rng: &mut ChaCha8Rng) -> Result<ZooTask> {
             .segments
             .iter()
             .map(|s| {
-                let a = s.wobble * uniform(rng, -1.0, 1.0);
+                let a = s.wobble * script.wobble_scale * uniform(rng, -1.0, 1.0);
                 let m = if rng.random::<bool>() { 1.0 } else { 2.0 };
                 (a, m)
             })
@@ -758,7 +832,7 @@ pub(crate) fn render(script: &Script, rng: &mut ChaCha8Rng) -> Result<ZooTask> {
                 }
             }
 
-            write_row(&mut text, t, &values, script);
+            write_row(&mut text, clock_offsets_s[i] + t, &values, script);
         }
         files.push((format!("demo_{i}.csv"), text));
         progress.push(prog);
@@ -777,7 +851,7 @@ pub(crate) fn render(script: &Script, rng: &mut ChaCha8Rng) -> Result<ZooTask> {
     })
 }
 
-/// Appends one CSV row: `t` with 6 decimals (microseconds), then every channel.
+/// Appends one CSV row: the stamp `t` (s) with 6 decimals (microseconds), then every channel.
 fn write_row(text: &mut String, t: f64, values: &[f64], script: &Script) {
     let _ = write!(text, "{t:.6}");
     let quat = script.quat.map(|q| {

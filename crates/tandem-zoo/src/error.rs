@@ -44,6 +44,20 @@ pub enum Error {
     /// Encoding the truth file failed.
     #[error("truth.json: cannot encode: {0}")]
     Json(#[from] serde_json::Error),
+    /// The evaluation's simulated rounds or cell failed ([`crate::eval`]).
+    #[error(transparent)]
+    Sim(#[from] tandem_sim::Error),
+    /// The evaluation's planner failed ([`crate::eval`]).
+    #[error(transparent)]
+    Planner(#[from] tandem_planner::Error),
+    /// The evaluation was asked for something it cannot do ([`crate::eval`]): what and why.
+    #[error("zoo evaluation: {what}: {why}")]
+    Eval {
+        /// The parameter or task.
+        what: String,
+        /// What is wrong and how to fix it.
+        why: String,
+    },
 }
 
 /// The crate's result type.

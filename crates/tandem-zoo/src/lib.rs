@@ -4,7 +4,8 @@
 //! The sanding fixture (`tandem_sim::task`) is one task; the defaults, the scheduler and the
 //! tests must hold on the tasks users bring. Each [`Family`] here models one kind of task from
 //! its own physics and practice, and generates for a seed what a user's recorder would write:
-//! 3–12 demonstrations as CSV files (a `t` column with time-stamp jitter, then the channels),
+//! 3–12 demonstrations as CSV files (a `t` column with time-stamp jitter, starting at 0 or,
+//! for half the seeds, at the controller's clock, then the channels),
 //! at 50 Hz – 1 kHz, of lengths within ±20 % of each other, with speed profiles that differ
 //! segment by segment, pauses of independent length and sensor noise. With them comes the
 //! truth ([`ZooTask`]): each row's true task progress (so the true warp between any two
@@ -25,8 +26,10 @@
 //!
 //! Every demonstration of a seed follows one underlying mean path through the task's
 //! segments; they differ by (a) speed — each segment's duration drawn independently per
-//! demonstration (`±8 %` for motions, `±40–60 %` for pauses and dwells), a monotone speed
-//! wobble inside each segment, and a total length within `±(5–8.5) %` of nominal; (b) sensor
+//! demonstration (`±8–20 %` for motions, `±30–60 %` for pauses and dwells), a monotone speed
+//! wobble inside each segment (up to ±10 % of the pace within a free move for the careful
+//! tasks, screw driving and deburring, ±15 % for most, ±21 % for pick-and-place, ±24 % for
+//! cable routing), and a total length within `±(5–8.5) %` of nominal; (b) sensor
 //! noise — white noise and a smooth tremor, about 0.5 % of each channel's range; and (c)
 //! *variable sections* — per-demonstration offsets or waves in some channels over a span of
 //! progress (a part placed elsewhere, a cable lying differently), and local events that
@@ -97,7 +100,7 @@
 //! ## polishing
 //!
 //! Five raster strokes under a 15 N contact force, with a pad change after the third (the
-//! tool lifts, turns the pad 0.5 rad towards the operator and waits ±50 %). 24.7 s nominal
+//! tool lifts, turns the pad 0.5 rad towards the operator and waits ±50 %). 23.7 s nominal
 //! at 100 or 200 Hz, 3–12 demonstrations; channels: position (m), orientation (quaternion),
 //! `force` (N), `tool` (0/1). Need, by seed: the first contact and first stroke (how hard the
 //! pad bites before the force settles: ±6 N as a wave; p 0.4–0.8; the task's start) and/or
@@ -151,6 +154,7 @@
 
 mod engine;
 mod error;
+pub mod eval;
 mod families;
 mod task;
 

@@ -10,8 +10,9 @@ use crate::{Error, Result};
 /// Where the operator is needed: `p(need)` over the progress span `[from, to)` (the span that
 /// ends the task includes progress 1).
 ///
-/// `p` is the probability that an execution needs a correction somewhere in the span (the
-/// simulated operator's truth), graded from 0.2 (rarely) to 1 (always).
+/// `p` is the probability that an execution needs the operator in the span, graded from 0.2
+/// (rarely) to 1 (always): an operator who follows the truth draws once per execution and
+/// span, and when the draw says so, corrects the robot over the span; elsewhere never.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct NeedSpan {
     /// Start, progress in `[0, 1)`.
@@ -104,6 +105,15 @@ impl ZooTask {
             .map_or(0.0, |s| s.p)
     }
 
+    /// Whether `progress` lies in a variable section ([`ZooTask::variable`]): the
+    /// demonstrations differ there, so a sample the model trusts there is falsely trusted.
+    #[must_use]
+    pub fn is_variable(&self, progress: f64) -> bool {
+        self.variable
+            .iter()
+            .any(|&(a, b)| a <= progress && (progress < b || b >= 1.0 && progress <= 1.0))
+    }
+
     /// The need per row of demonstration `i`.
     ///
     /// # Panics
@@ -147,6 +157,9 @@ impl ZooTask {
             }
         }
         let (pr, pd) = (&self.progress[reference], &self.progress[demo]);
+        if pd.len() < 2 {
+            return Ok(vec![0.0; pr.len()]);
+        }
         let mut j = 0;
         let last = pd.len() - 1;
         Ok(pr
@@ -258,6 +271,7 @@ mod tests {
         assert_eq!(t.true_high_share(0), 0.5);
         // Demo 1: midpoints 0.25 (need) and 0.75 (need).
         assert_eq!(t.true_high_share(1), 0.0);
+        assert!(t.is_variable(0.25) && t.is_variable(0.49) && !t.is_variable(0.5));
     }
 
     #[test]

@@ -125,7 +125,7 @@ impl TaskModel {
         let demo = &execution.demonstration;
         let log = &execution.ref_time_log;
         demo.conform_to(&self.data.channel_names)?;
-        check_dt(demo, self.data.dt_s)?;
+        check_dt(demo, self.data.dt_s, &|| "the model".into())?;
         self.data.layout.check_quaternion_norms(demo)?;
         let bad = |why: String| Error::BadLog {
             file: demo.source().into(),
@@ -191,16 +191,23 @@ impl TaskModel {
             file: file.into(),
             why,
         };
+        // Reference samples in messages to a thousandth (`within 1.206`, not
+        // `1.205509816341646`).
+        let r = |v: f64| (v * 1e3).round() / 1e3;
         if first >= start_gap {
             return Err(bad(format!(
-                "starts at reference sample {first} (expected below {start_gap}, one step from \
-                 the beginning)"
+                "starts at reference sample {} (expected below {}, one step from the \
+                 beginning)",
+                r(first),
+                r(start_gap)
             )));
         }
         if last_ref - last > end_gap {
             return Err(bad(format!(
-                "ends at reference sample {last} (expected within {end_gap} of the end of the \
-                 task, reference sample {last_ref})"
+                "ends at reference sample {} (expected within {} of the end of the task, \
+                 reference sample {last_ref})",
+                r(last),
+                r(end_gap)
             )));
         }
         Ok(())
@@ -381,6 +388,11 @@ mod tests {
         for (exec, part) in [
             (run(16, 0.01, 5.0, 20.0), "starts at reference sample 5"),
             (run(11, 0.01, 0.0, 10.0), "ends at reference sample 10"),
+            // A step of 12/7 reference samples is printed to a thousandth.
+            (
+                run(8, 0.01, 0.0, 12.0),
+                "ends at reference sample 12 (expected within 1.714 of the end",
+            ),
         ] {
             let err = model.execution_warp(&exec).unwrap_err();
             assert!(matches!(err, Error::TruncatedExecution { .. }), "{err}");

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use super::layout::{Item, Layout, quat_at};
 use super::stats::{batch_statistics, observe};
 use super::{FitParams, ModelData, Reference, TaskModel, check_dt};
-use crate::demo::Demonstration;
+use crate::demo::{DT_TOLERANCE, Demonstration};
 use crate::{Error, Result};
 
 /// Checks the demonstration set; returns it with every channel order equal to demo 0's
@@ -19,10 +19,37 @@ fn check_demos(demos: &[Demonstration]) -> Result<Cow<'_, [Demonstration]>> {
         return Err(Error::TooFewDemonstrations { found: demos.len() });
     }
     let names = demos[0].channel_names();
-    let dt = demos[0].dt_s();
+    // The period most demonstrations share decides which one is the odd one out (a 1 kHz
+    // file given first is named, not the good file after it); ties go to the earlier file.
+    let agree = |a: &Demonstration, b: &Demonstration| {
+        (a.dt_s() - b.dt_s()).abs() <= DT_TOLERANCE * b.dt_s()
+    };
+    let shared = |d: &Demonstration| demos.iter().filter(|o| agree(o, d)).count();
+    let majority = demos
+        .iter()
+        .enumerate()
+        .max_by(|(i, a), (j, b)| shared(a).cmp(&shared(b)).then(j.cmp(i)))
+        .map_or(0, |(i, _)| i);
+    let dt = demos[majority].dt_s();
+    let whose = || {
+        let with: Vec<&str> = demos
+            .iter()
+            .filter(|o| agree(o, &demos[majority]))
+            .map(Demonstration::source)
+            .collect();
+        match with[..] {
+            [one] => one.to_owned(),
+            _ => format!(
+                "{} of the {} demonstrations ({})",
+                with.len(),
+                demos.len(),
+                with.join(", ")
+            ),
+        }
+    };
     let mut reordered = false;
     for demo in demos {
-        check_dt(demo, dt)?;
+        check_dt(demo, dt, &whose)?;
         reordered |= matches!(demo.conform_to(names)?, Cow::Owned(_));
     }
     if !reordered {
@@ -228,6 +255,12 @@ impl TaskModel {
         layout: Layout,
     ) -> Result<Self> {
         let ordered: Vec<&Demonstration> = alignment.order.iter().map(|&i| &demos[i]).collect();
+        crate::checks::check_reaches_end(
+            &ordered,
+            &alignment.warps,
+            params.warp.slope_min,
+            params.warp.slope_max,
+        )?;
         let mut model = Self::fit_from_warps(
             &ordered,
             &alignment.warps,
@@ -279,6 +312,55 @@ impl TaskModel {
             .into_iter()
             .map(|(_, criterion)| criterion)
             .collect())
+    }
+
+    /// The warp (reference sample → sample of `demo`, `n_ref()` values) with which a fit with
+    /// `params` whose reference was `reference` aligns `demo`: the same signals (quaternion
+    /// blocks sign-aligned to the reference's first orientation), the model's ranges as the
+    /// channel weights (unless `params.warp.weights` gives them) and `params.warp`. Used to
+    /// carry reference times from another reference onto this model's (the planner's refit
+    /// that keeps recorded rounds).
+    ///
+    /// # Errors
+    /// `reference` is not `n_ref()` samples long or either has other channels or another
+    /// sample period than the model; bad warp parameters; alignment failure.
+    pub fn align_demonstration(
+        &self,
+        reference: &Demonstration,
+        demo: &Demonstration,
+        params: &FitParams,
+    ) -> Result<Vec<f64>> {
+        let names = &self.data.channel_names;
+        let reference = reference.conform_to(names)?;
+        let demo = demo.conform_to(names)?;
+        check_dt(&reference, self.data.dt_s, &|| "the model".into())?;
+        check_dt(&demo, self.data.dt_s, &|| "the model".into())?;
+        if reference.n_samples() != self.data.n_ref {
+            return Err(Error::BadData {
+                what: "reference".into(),
+                why: format!(
+                    "{} samples for a model of {} reference samples",
+                    reference.n_samples(),
+                    self.data.n_ref
+                ),
+            });
+        }
+        let layout = &self.data.layout;
+        let d = layout.dim();
+        let m = names.len();
+        let mut warp_params = params.warp.clone();
+        if warp_params.weights.is_none() {
+            warp_params.weights = Some(layout.warp_weights(&self.data.ranges[..d - 1], m));
+        }
+        let orientations = layout.first_orientations(&reference);
+        let a = layout.sign_aligned(&reference, &orientations);
+        let b = layout.sign_aligned(&demo, &orientations);
+        let aligned = tandem_warp::align_many(
+            tandem_warp::SignalRef::new(&a, m)?,
+            &[tandem_warp::SignalRef::new(&b, m)?],
+            &warp_params,
+        )?;
+        Ok(aligned[0].values().to_vec())
     }
 
     /// The statistics of checked demonstrations, reference first, from their warps.

@@ -151,8 +151,9 @@ fn bracket(t: f64, n: usize) -> (usize, usize, f64) {
 /// on the split).
 const PAR_MIN_LEN: usize = 512;
 
-/// Rejects a demonstration whose sample period differs from `dt_ref` by more than 1 %.
-fn check_dt(demo: &Demonstration, dt_ref: f64) -> Result<()> {
+/// Rejects a demonstration whose sample period differs from `dt_ref` by more than 1 %;
+/// `whose` names where `dt_ref` came from in the error (`the model`).
+fn check_dt(demo: &Demonstration, dt_ref: f64, whose: &dyn Fn() -> String) -> Result<()> {
     if (demo.dt_s() - dt_ref).abs() > DT_TOLERANCE * dt_ref {
         let (line, column) = demo.header_at(None);
         return Err(Error::SamplePeriodMismatch {
@@ -160,6 +161,7 @@ fn check_dt(demo: &Demonstration, dt_ref: f64) -> Result<()> {
             line,
             column,
             expected_s: dt_ref,
+            expected_from: whose(),
             found_s: demo.dt_s(),
         });
     }

@@ -192,6 +192,48 @@ pub struct AdversaryRun {
     pub first_overlap: Option<u64>,
     /// Whether every robot finished within the tick budget.
     pub finished: bool,
+    /// Ticks in which some robot moved backwards: its reference time
+    /// ([`Tick::ref_time`](crate::Tick::ref_time)) or its clock
+    /// ([`Coordinator::clock_s`]) decreased (0: a robot never moves backwards; debug builds
+    /// assert it in every tick).
+    pub backward_steps: u64,
+}
+
+/// The check "a robot never moves backwards" from outside the coordinator: each robot's
+/// reference time and clock at the end of the previous tick (or at the start), compared with
+/// those at the end of the next.
+#[derive(Clone, Copy, Debug)]
+pub struct Backward {
+    ref_time: crate::PerRobot<f64>,
+    clock_s: crate::PerRobot<f64>,
+}
+
+impl Backward {
+    /// The robots' positions now ([`Coordinator::ref_time_now`], [`Coordinator::clock_s`]).
+    #[must_use]
+    pub fn new(coordinator: &Coordinator) -> Backward {
+        Backward {
+            ref_time: coordinator.ref_time_now(),
+            clock_s: crate::PerRobot::from_slice(coordinator.clock_s()),
+        }
+    }
+
+    /// After a tick of `coordinator` that returned `tick`: whether some robot's reference
+    /// time or clock decreased since the last call (or [`Backward::new`]), and remember the new
+    /// positions. Also checks that the tick reported the reference time the coordinator
+    /// reports now (a mismatch counts as a backward step: a caller reading one or the other
+    /// would see the robot elsewhere).
+    pub fn step(&mut self, coordinator: &Coordinator, tick: &crate::Tick) -> bool {
+        let now = Backward::new(coordinator);
+        let mut back = false;
+        for i in 0..coordinator.n_robots() {
+            back |= now.ref_time[i] < self.ref_time[i]
+                || now.clock_s[i] < self.clock_s[i]
+                || tick.ref_time[i] != now.ref_time[i];
+        }
+        *self = now;
+        back
+    }
 }
 
 /// Uniform in `[lo, hi]`; `lo` itself when the range is empty or not finite.
@@ -331,6 +373,7 @@ pub fn run_adversary(
     }
     let mut run = AdversaryRun::default();
     let mut state = PolicyState::new(coordinator.n_robots());
+    let mut backward = Backward::new(&coordinator);
     while !coordinator.is_finished() {
         if run.ticks >= max_ticks {
             return Ok(run);
@@ -338,6 +381,7 @@ pub fn run_adversary(
         let lc = coordinator.low_conf_now().first();
         let op = state.next(adversary, run.ticks, lc, rng);
         let tick = coordinator.tick(op)?;
+        run.backward_steps += u64::from(backward.step(&coordinator, &tick));
         if tick.overlap() {
             run.first_overlap.get_or_insert(run.ticks);
             run.overlap_ticks += 1;

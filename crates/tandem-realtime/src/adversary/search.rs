@@ -12,7 +12,7 @@
 
 use std::collections::BTreeMap;
 
-use super::AdversaryRun;
+use super::{AdversaryRun, Backward};
 use crate::{Coordinator, Operator, Result, Timeline};
 
 /// The operator inputs the search tries at every tick.
@@ -29,7 +29,7 @@ pub fn min_clearance_s(coordinator: &Coordinator) -> f64 {
     let robots: Vec<&Timeline> = (0..coordinator.n_robots())
         .map(|i| coordinator.current_plan(i))
         .collect();
-    let clocks = coordinator.clock_s();
+    let clocks = coordinator.rule_clock_s();
     // Regions are in time order: binary searches.
     let current = |r: &Timeline, s: f64| {
         let ivs = r.lc_intervals();
@@ -64,6 +64,8 @@ struct Candidate {
     now_s: f64,
     /// The smallest [`min_clearance_s`] along the sequence so far.
     worst_s: f64,
+    /// Ticks of the sequence in which a robot moved backwards ([`super::Backward`]).
+    backward_steps: u64,
 }
 
 /// The run of a sequence that overlapped at tick `first`: continued without corrections to the
@@ -73,11 +75,15 @@ fn finish(
     mut ticks: u64,
     first: u64,
     max_ticks: u64,
+    mut backward_steps: u64,
 ) -> Result<AdversaryRun> {
     let mut overlap_ticks = 1;
+    let mut backward = Backward::new(&coordinator);
     while !coordinator.is_finished() && ticks < max_ticks {
         coordinator.clear_fault();
-        overlap_ticks += u64::from(coordinator.tick(Operator::Scheduled)?.overlap());
+        let tick = coordinator.tick(Operator::Scheduled)?;
+        overlap_ticks += u64::from(tick.overlap());
+        backward_steps += u64::from(backward.step(&coordinator, &tick));
         ticks += 1;
     }
     Ok(AdversaryRun {
@@ -85,6 +91,7 @@ fn finish(
         overlap_ticks,
         first_overlap: Some(first),
         finished: coordinator.is_finished(),
+        backward_steps,
     })
 }
 
@@ -100,7 +107,7 @@ pub fn beam_search(coordinator: Coordinator, width: usize, max_ticks: u64) -> Re
     let width = width.max(1);
     // One cell per nominal tick of progress: every robot one tick on schedule.
     let cell_s = coordinator.tick_s() * coordinator.n_robots() as f64;
-    let progress = |c: &Coordinator| (c.clock_s().iter().sum::<f64>() / cell_s).floor() as i64;
+    let progress = |c: &Coordinator| (c.rule_clock_s().iter().sum::<f64>() / cell_s).floor() as i64;
     let mut cells: BTreeMap<i64, Vec<Candidate>> = BTreeMap::new();
     let clearance = min_clearance_s(&coordinator);
     let start = Candidate {
@@ -108,6 +115,7 @@ pub fn beam_search(coordinator: Coordinator, width: usize, max_ticks: u64) -> Re
         worst_s: clearance,
         coordinator,
         ticks: 0,
+        backward_steps: 0,
     };
     cells
         .entry(progress(&start.coordinator))
@@ -133,10 +141,18 @@ pub fn beam_search(coordinator: Coordinator, width: usize, max_ticks: u64) -> Re
             }
             for op in CHOICES {
                 let mut next = cand.clone();
+                let mut backward = Backward::new(&next.coordinator);
                 let tick = next.coordinator.tick(op)?;
                 next.ticks += 1;
+                next.backward_steps += u64::from(backward.step(&next.coordinator, &tick));
                 if tick.overlap() {
-                    return finish(next.coordinator, next.ticks, cand.ticks, max_ticks);
+                    return finish(
+                        next.coordinator,
+                        next.ticks,
+                        cand.ticks,
+                        max_ticks,
+                        next.backward_steps,
+                    );
                 }
                 next.now_s = min_clearance_s(&next.coordinator);
                 next.worst_s = next.worst_s.min(next.now_s);
@@ -153,6 +169,7 @@ pub fn beam_search(coordinator: Coordinator, width: usize, max_ticks: u64) -> Re
             overlap_ticks: 0,
             first_overlap: None,
             finished: b.coordinator.is_finished(),
+            backward_steps: b.backward_steps,
         }),
     )
 }

@@ -146,7 +146,7 @@ mod many;
 mod pl;
 mod search;
 mod shape;
-mod stn;
+pub(crate) mod stn;
 
 use serde::{Deserialize, Serialize};
 
@@ -422,6 +422,44 @@ pub(crate) fn bound_n(problem: &Problem, n_robots: usize) -> MarginFree {
         schedule: Some(schedule),
         order: f.order,
         stats,
+    }
+}
+
+/// The certificate's bound for `n_robots ≥ 3` robots, never below the bound of fewer robots:
+/// `B(N) = max(own(N), B(N − 1))` with `own(k)` the `k`-robot search's bound ([`bound_n`]) and
+/// `B(2)` the two-robot margin-free bound ([`bound`]); the schedule, order and counts are
+/// `own(N)`'s, and it is marked optimal only when `own(N)` is proven and not exceeded.
+///
+/// **Why it is a lower bound.** Take any schedule of `N` robots that satisfies Eq. 20
+/// constraints 1–4 (with holds: with any dwells at usable holds) and keep its robots `1..k`
+/// (their warps, dwells and start offsets). Constraints 1 and 4 are per robot; constraint 2
+/// bounds `τ_i` by the robots before `i` only; constraint 3 forbids overlaps between pairs of
+/// robots, and a subset of pairwise disjoint intervals is pairwise disjoint. So the `k` robots
+/// form a schedule of the same problem, and its `T_total`, the latest of fewer ends, is not
+/// above the `N`-robot one. Every lower bound on `k`-robot schedules is therefore one on
+/// `N`-robot schedules, and so is the maximum of them. (The searches cap gaps with a hold at
+/// `k × fastest`; a `k`-robot schedule with a longer gap lasts longer than `k × fastest`, the
+/// serial schedule, which no margin-free optimum exceeds, so the cap loses nothing.) Hence
+/// `B(N + 1) ≥ B(N)` by construction, where the searches alone are not monotone: the
+/// `N`-robot search may run out of its node budget where the `(N − 1)`-robot one finished,
+/// leaving the operator-limited bound, lower than the proven `(N − 1)`-robot optimum.
+pub(crate) fn bound_many(problem: &Problem, n_robots: usize, params: &ExactParams) -> MarginFree {
+    let mut below = bound(problem, params).lower_bound_s;
+    for k in 3..n_robots {
+        below = below.max(bound_n(problem, k).lower_bound_s);
+    }
+    let own = bound_n(problem, n_robots);
+    if below > own.lower_bound_s {
+        // A proven `N`-robot optimum is never below the `(N − 1)`-robot one but by the
+        // rounding of the two searches' sums.
+        let rounding = below <= own.lower_bound_s * (1.0 + tandem_realtime::tol::BOUND_REL);
+        MarginFree {
+            lower_bound_s: below,
+            proven_optimal: own.proven_optimal && rounding,
+            ..own
+        }
+    } else {
+        own
     }
 }
 

@@ -38,10 +38,10 @@ impl Times {
 
 /// One difference constraint `x[to] ≥ x[from] + w`.
 #[derive(Clone, Copy, Debug)]
-struct Edge {
-    from: usize,
-    to: usize,
-    w: f64,
+pub(crate) struct Edge {
+    pub(crate) from: usize,
+    pub(crate) to: usize,
+    pub(crate) w: f64,
 }
 
 /// The earliest times of the machine order `order` (robot per LC run in time order, `m` of
@@ -161,7 +161,7 @@ fn solve(chain: &Chain, order: &[Robot], clear: &Clearance, after_start: bool) -
 /// Longest paths from the origin (variable 0, pinned at 0) over the `n` variables by
 /// Bellman–Ford, relaxing an edge only for a gain above `eps` (s); `None` on a positive cycle
 /// (a relaxation still happening in round `n + 1`, or one that would move the origin).
-fn longest_paths(edges: &[Edge], n: usize, eps: f64) -> Option<Vec<f64>> {
+pub(crate) fn longest_paths(edges: &[Edge], n: usize, eps: f64) -> Option<Vec<f64>> {
     const ORIGIN: usize = 0;
     let mut x = vec![f64::NEG_INFINITY; n];
     x[ORIGIN] = 0.0;
@@ -217,7 +217,7 @@ fn longest_paths(edges: &[Edge], n: usize, eps: f64) -> Option<Vec<f64>> {
 /// most 4e-13 s, and that, through the margin check and the supervised samples, changed
 /// one trial's outcome (docs/decisions.md, "Certified schedules", "Rounding in the
 /// earliest-times network").
-fn relax_tolerance(edges: &[Edge], n: usize) -> f64 {
+pub(crate) fn relax_tolerance(edges: &[Edge], n: usize) -> f64 {
     let scale: f64 = edges.iter().map(|e| e.w.abs()).sum();
     4.0 * n as f64 * f64::EPSILON * scale
 }

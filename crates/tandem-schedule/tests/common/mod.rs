@@ -1,6 +1,8 @@
 //! Random problems shared by the integration tests.
 
 use proptest::prelude::*;
+
+include!("pegs.rs");
 use tandem_schedule::Problem;
 
 /// `n` random gradient triples `(mean, min factor, max factor)`: mean in `[0.5, 2)`,

@@ -35,10 +35,12 @@ use tandem_schedule::{CyclicParams, CyclicPlan, cyclic_plan};
 use super::config::StudyConfig;
 use super::inputs::StudyInputs;
 use super::record::mean_std;
-use super::run::{PhaseTimes, Progress, fit_study_model, par_trials, trial_seed};
-use crate::task::{self, Label, Workpiece};
-use crate::truth::falsely_trusted;
-use crate::workcell::{CellSim, CellStats, needs_correction};
+use super::run::{
+    PhaseTimes, Progress, check_truth, fit_study_model, par_trials, trial_seed, truth_operator,
+};
+use crate::task::{self, Label};
+use crate::truth::{SandingTruth, TaskTruth, falsely_trusted_where};
+use crate::workcell::{CellSim, CellStats, FinishedTask};
 use crate::{Error, Result};
 
 /// The cell's plan after some recorded tasks: one per re-plan of a trial.
@@ -69,7 +71,7 @@ pub struct CellIteration {
     pub lc_ref: Vec<[usize; 2]>,
     /// The usable hold points (reference samples) the cell waits at.
     pub holds: Vec<usize>,
-    /// Reference samples that truly need help but are high-confidence ([`falsely_trusted`]).
+    /// Reference samples that truly need help but are high-confidence ([`crate::truth::falsely_trusted`]).
     pub falsely_trusted_samples: usize,
 }
 
@@ -233,7 +235,7 @@ impl CellStudyResult {
 /// The cell's plan on the planner's problem and its record.
 fn plan_of(
     planner: &Planner,
-    labels: &[Label],
+    can_need: &[bool],
     tasks_recorded: usize,
     tick: u64,
 ) -> Result<(CyclicPlan, CellIteration)> {
@@ -259,7 +261,7 @@ fn plan_of(
             .map(|r| [r.start, r.end])
             .collect(),
         holds: planner.problem().usable_holds(),
-        falsely_trusted_samples: falsely_trusted(planner.confidence().conf(), labels),
+        falsely_trusted_samples: falsely_trusted_where(planner.confidence().conf(), can_need),
     };
     Ok((plan, iteration))
 }
@@ -278,7 +280,45 @@ pub fn run_cell_trial(
     trial: usize,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<(CellTrialResult, PhaseTimes)> {
+    let truth = SandingTruth::new(labels.to_vec(), config.task.clone());
+    let run = run_cell_trial_on(config, model, &truth, trial, progress, &|_| {})?;
+    Ok((run.result, run.times))
+}
+
+/// A continuous trial as it ended ([`run_cell_trial_on`]): its record, the time spent in each
+/// phase, and the planner after the last recorded round.
+#[derive(Debug)]
+pub struct CellTrialRun {
+    /// The trial's record.
+    pub result: CellTrialResult,
+    /// Wall time per phase.
+    pub times: PhaseTimes,
+    /// The planner after the last recorded round of `N` tasks.
+    pub planner: Planner,
+}
+
+/// [`run_cell_trial`] on any task: every workpiece is drawn from `truth`
+/// ([`TaskTruth::draw`]; the first `N` in robot order, then one for each completed task),
+/// the operator corrects [`TaskTruth::correction_channel`], falsely trusted samples are
+/// counted against [`TaskTruth::can_need`]. On the sanding task ([`SandingTruth`]) it is the
+/// continuous study's trial, bit for bit. `observe` sees every completed task as it
+/// completes (in completion order, the tasks completed in the tick of the last counted one
+/// included), before it is recorded; the result is the same as without.
+///
+/// # Errors
+/// As [`run_cell_trial`], and [`Error::Mismatch`] for a truth on another number of
+/// reference samples than the model's.
+pub fn run_cell_trial_on(
+    config: &StudyConfig,
+    model: &TaskModel,
+    truth: &dyn TaskTruth,
+    trial: usize,
+    progress: &(dyn Fn(Progress) + Sync),
+    observe: &(dyn Fn(&FinishedTask) + Sync),
+) -> Result<CellTrialRun> {
     config.validate()?;
+    check_truth(model, truth)?;
+    let can_need = truth.can_need();
     let seed = trial_seed(config.seed, trial);
     let mut params = config.planner.clone();
     params.sampler.samples = config.samples;
@@ -288,14 +328,14 @@ pub fn run_cell_trial(
     let mut planner = Planner::from_model_with_robots(model.clone(), params, config.robots)?;
     let n = planner.n_robots();
     let dt_s = planner.problem().dt_s();
-    let (plan, first) = plan_of(&planner, labels, 0, 0)?;
+    let (plan, first) = plan_of(&planner, can_need, 0, 0)?;
     let coord = plan.coordinator(planner.problem(), dt_s)?;
     times.scheduling += t.elapsed();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(1);
-    let mut sim = CellSim::new(planner.model(), coord, &config.operator())?;
-    let mut workpieces = (0..n)
-        .map(|_| Workpiece::random(&config.task, &mut rng))
+    let mut sim = CellSim::new(planner.model(), coord, &truth_operator(config, truth))?;
+    let mut needed = (0..n)
+        .map(|_| truth.draw(&mut rng))
         .collect::<Result<Vec<_>>>()?;
     let total = config.executions;
     // A task lasts at most Σ max(ψ̇min, ψ̇max) ticks plus one per sample (tick = Δt_s); even
@@ -314,11 +354,7 @@ pub fn run_cell_trial(
             });
         }
         let t = Instant::now();
-        let finished = sim.tick(
-            planner.model(),
-            |robot, idx| needs_correction(&labels[idx], &workpieces[robot]),
-            &mut rng,
-        )?;
+        let finished = sim.tick(planner.model(), |robot, idx| needed[robot][idx], &mut rng)?;
         times.simulation += t.elapsed();
         for f in finished {
             let stats = sim.stats();
@@ -328,7 +364,8 @@ pub fn run_cell_trial(
                 busy_ticks: stats.busy_ticks,
                 gate_ticks: stats.gate_ticks.iter().sum(),
             });
-            workpieces[f.robot] = Workpiece::random(&config.task, &mut rng)?;
+            observe(&f);
+            needed[f.robot] = truth.draw(&mut rng)?;
             batch.push(f.run.record(planner.model())?);
             if batch.len() < n || recorded + n > total {
                 continue;
@@ -340,7 +377,7 @@ pub fn run_cell_trial(
             times.confidence += report.confidence;
             times.scheduling += report.scheduling;
             let t = Instant::now();
-            let (plan, iteration) = plan_of(&planner, labels, recorded, sim.stats().ticks)?;
+            let (plan, iteration) = plan_of(&planner, can_need, recorded, sim.stats().ticks)?;
             let next = plan.coordinator(planner.problem(), dt_s)?;
             times.scheduling += t.elapsed();
             sim.replan(planner.model(), next)?;
@@ -353,8 +390,8 @@ pub fn run_cell_trial(
     }
     completions.truncate(total);
     let steady = Steady::of(&completions, n, dt_s).expect("at least one task");
-    Ok((
-        CellTrialResult {
+    Ok(CellTrialRun {
+        result: CellTrialResult {
             trial,
             seed,
             iterations,
@@ -363,7 +400,8 @@ pub fn run_cell_trial(
             steady,
         },
         times,
-    ))
+        planner,
+    })
 }
 
 /// Runs every trial of the continuous study from a fitted model, in parallel (rayon); the

@@ -13,8 +13,8 @@ mod record;
 mod run;
 
 pub use cell::{
-    CellCompletion, CellIteration, CellStudyResult, CellSummary, CellTrialResult, Steady,
-    run_cell_study, run_cell_trial, run_cell_trials,
+    CellCompletion, CellIteration, CellStudyResult, CellSummary, CellTrialResult, CellTrialRun,
+    Steady, run_cell_study, run_cell_trial, run_cell_trial_on, run_cell_trials,
 };
 pub use config::{Cell, StudyConfig};
 pub use inputs::{StudyInputs, read_labels};
@@ -23,6 +23,6 @@ pub use record::{
     mean_std, throughput_per_h,
 };
 pub use run::{
-    PhaseTimes, Progress, RoundView, run_study, run_study_observed, run_trial, run_trial_observed,
-    run_trials, run_trials_observed, trial_seed,
+    PhaseTimes, Progress, RoundView, TrialRun, run_study, run_study_observed, run_trial,
+    run_trial_observed, run_trial_on, run_trials, run_trials_observed, trial_seed,
 };

@@ -12,9 +12,9 @@ use tandem_planner::{Planner, derive_seed};
 use super::config::StudyConfig;
 use super::inputs::StudyInputs;
 use super::record::{IterationRecord, PairStats, StudyResult, TrialResult, throughput_per_h};
-use crate::task::{self, Label, Workpiece};
-use crate::truth::{OperatorTally, falsely_trusted};
-use crate::workcell;
+use crate::task::{self, Label};
+use crate::truth::{OperatorTally, SandingTruth, TaskTruth, falsely_trusted_where};
+use crate::workcell::{self, OperatorParams};
 use crate::{Error, Result};
 
 /// Seed of trial `trial` from the master `seed` ([`derive_seed`]), so trials are
@@ -58,10 +58,11 @@ pub struct Progress {
     pub pairs_done: usize,
 }
 
-/// The record of the planner's current schedule (no pair run yet).
+/// The record of the planner's current schedule (no pair run yet); `can_need` per reference
+/// sample ([`TaskTruth::can_need`]).
 fn iteration_record(
     planner: &Planner,
-    labels: &[Label],
+    can_need: &[bool],
     tally: &OperatorTally,
 ) -> Result<IterationRecord> {
     let schedule = planner.schedule();
@@ -86,7 +87,7 @@ fn iteration_record(
         gap: outcome.gap,
         throughput_per_h: throughput_per_h(n_robots, outcome.t_total_s),
         offsets_s: schedule.offsets_s.clone(),
-        falsely_trusted_samples: falsely_trusted(planner.confidence().conf(), labels),
+        falsely_trusted_samples: falsely_trusted_where(planner.confidence().conf(), can_need),
         lc_runs: lc.iter().map(Vec::len).collect(),
         error_rates: planner.error_rates()?,
         simulated_rates: (planner.rounds_recorded() > 0).then(|| tally.rates()),
@@ -135,7 +136,64 @@ pub fn run_trial_observed(
     progress: &(dyn Fn(Progress) + Sync),
     observe: &(dyn Fn(RoundView<'_>) + Sync),
 ) -> Result<(TrialResult, PhaseTimes)> {
+    let truth = SandingTruth::new(reference_labels.to_vec(), config.task.clone());
+    let run = run_trial_on(config, model, &truth, trial, progress, observe)?;
+    Ok((run.result, run.times))
+}
+
+/// A trial as it ended ([`run_trial_on`]): its record, the time spent in each phase, and the
+/// planner after the last round (its model, confidence and schedule).
+#[derive(Debug)]
+pub struct TrialRun {
+    /// The trial's record.
+    pub result: TrialResult,
+    /// Wall time per phase.
+    pub times: PhaseTimes,
+    /// The planner after the last recorded round.
+    pub planner: Planner,
+}
+
+/// The simulated operator of a study on `truth`'s task: the configuration's rates, corrections
+/// that raise [`TaskTruth::correction_channel`].
+pub(super) fn truth_operator(config: &StudyConfig, truth: &dyn TaskTruth) -> OperatorParams {
+    OperatorParams {
+        force_channel: truth.correction_channel().to_string(),
+        ..config.operator()
+    }
+}
+
+/// Checks that `truth` is given on `model`'s reference samples.
+pub(super) fn check_truth(model: &TaskModel, truth: &dyn TaskTruth) -> Result<()> {
+    if truth.n_ref() != model.n_ref() {
+        return Err(Error::Mismatch {
+            what: "ground truth (one value per reference sample)",
+            expected: model.n_ref(),
+            found: truth.n_ref(),
+        });
+    }
+    Ok(())
+}
+
+/// [`run_trial_observed`] on any task: every robot's workpiece of every round is drawn from
+/// `truth` ([`TaskTruth::draw`], robot 1 first), the simulated operator corrects
+/// [`TaskTruth::correction_channel`], and falsely trusted samples are counted against
+/// [`TaskTruth::can_need`]. On the sanding task ([`SandingTruth`]) it is the study's trial,
+/// bit for bit. Returns the planner after the last round beside the record.
+///
+/// # Errors
+/// As [`run_trial`], and [`Error::Mismatch`] for a truth on another number of reference
+/// samples than the model's.
+pub fn run_trial_on(
+    config: &StudyConfig,
+    model: &TaskModel,
+    truth: &dyn TaskTruth,
+    trial: usize,
+    progress: &(dyn Fn(Progress) + Sync),
+    observe: &(dyn Fn(RoundView<'_>) + Sync),
+) -> Result<TrialRun> {
     config.validate()?;
+    check_truth(model, truth)?;
+    let can_need = truth.can_need();
     let seed = trial_seed(config.seed, trial);
     let mut params = config.planner.clone();
     params.sampler.samples = config.samples;
@@ -146,15 +204,15 @@ pub fn run_trial_observed(
     times.scheduling += t.elapsed();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(1);
-    let operator = config.operator();
+    let operator = truth_operator(config, truth);
     let n_pairs = config.n_rounds();
     let n_robots = planner.n_robots();
     let mut iterations = Vec::with_capacity(n_pairs + 1);
     let mut tally = OperatorTally::default();
     for pair in 0..n_pairs {
-        let mut record = iteration_record(&planner, reference_labels, &tally)?;
-        let workpieces = (0..n_robots)
-            .map(|_| Workpiece::random(&config.task, &mut rng))
+        let mut record = iteration_record(&planner, can_need, &tally)?;
+        let needed = (0..n_robots)
+            .map(|_| truth.draw(&mut rng))
             .collect::<Result<Vec<_>>>()?;
         let t = Instant::now();
         let at = |e: Error| Error::InTrial {
@@ -162,8 +220,13 @@ pub fn run_trial_observed(
             round: pair + 1,
             source: Box::new(e),
         };
-        let run = workcell::run_round(&planner, reference_labels, &workpieces, &operator, &mut rng)
-            .map_err(at)?;
+        let run = workcell::run_round_with(
+            &planner,
+            |robot, ref_idx| needed[robot][ref_idx],
+            &operator,
+            &mut rng,
+        )
+        .map_err(at)?;
         let records = run.records(planner.model())?;
         times.simulation += t.elapsed();
         tally.add(&run);
@@ -200,15 +263,16 @@ pub fn run_trial_observed(
             pairs_done: pair + 1,
         });
     }
-    iterations.push(iteration_record(&planner, reference_labels, &tally)?);
-    Ok((
-        TrialResult {
+    iterations.push(iteration_record(&planner, can_need, &tally)?);
+    Ok(TrialRun {
+        result: TrialResult {
             trial,
             seed,
             iterations,
         },
         times,
-    ))
+        planner,
+    })
 }
 
 /// Runs the study (§III): fits the model once, then runs the trials ([`run_trials`]).

@@ -76,5 +76,5 @@ mod tests;
 
 pub use cell::{CellSim, CellStats, FinishedTask};
 pub use operator::{OperatorParams, correction_input, needs_correction};
-pub use record::{PairRun, RobotRun, RoundRun};
+pub use record::{PairRun, RobotRun, RoundRun, TickPhase};
 pub use run::{run_pair, run_pair_with, run_round, run_round_with};

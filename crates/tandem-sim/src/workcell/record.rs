@@ -40,6 +40,30 @@ pub struct RobotRun {
     /// not serialized).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub hold_ticks: usize,
+    /// What the robot did in every control tick of the round (`RoundRun::ticks` entries, read
+    /// at the tick start, beside [`RobotRun::clock_s`]): waiting for its start, running (one
+    /// sample of [`RobotRun::ref_time_log`] per such tick), standing at a hold, held by the
+    /// fault monitor, or finished. Where the round's time went, tick by tick; the waits at
+    /// holds are the [`TickPhase::AtHold`] ticks ([`RobotRun::hold_ticks`] counts them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub phases: Vec<TickPhase>,
+}
+
+/// What one robot did in one control tick of a round ([`RobotRun::phases`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum TickPhase {
+    /// Not started: it waits for its start (the start offset, shifted by the robots before
+    /// it, and its start rules).
+    Waiting,
+    /// Running: it executed one sample.
+    Running,
+    /// Standing at a hold point: for its planned dwell, its release rules or the robots
+    /// behind it.
+    AtHold,
+    /// Held by the coordinator's fault monitor (two robots were low-confidence at once).
+    Held,
+    /// Finished its task.
+    Finished,
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -50,6 +74,22 @@ impl RobotRun {
     /// Time (real s) the robot stood at hold points, for control tick `tick_s` (s).
     pub fn hold_wait_s(&self, tick_s: f64) -> f64 {
         self.hold_ticks as f64 * tick_s
+    }
+
+    /// Control ticks of the round the robot spent in `phase` ([`RobotRun::phases`]).
+    #[must_use]
+    pub fn ticks_in(&self, phase: TickPhase) -> usize {
+        self.phases.iter().filter(|&&p| p == phase).count()
+    }
+
+    /// The round's control tick at whose start the robot had finished (the number of ticks
+    /// it took, waits included), or the round's length if it never finished in it.
+    #[must_use]
+    pub fn end_tick(&self) -> usize {
+        self.phases
+            .iter()
+            .position(|&p| p == TickPhase::Finished)
+            .unwrap_or(self.phases.len())
     }
 
     /// The execution record for
@@ -94,6 +134,16 @@ pub struct RoundRun {
     /// was low-confidence (must be 0: a checked schedule never has one).
     #[serde(default)]
     pub faults: usize,
+    /// The schedule's planned `T_total` (s, Eq. 13, planned dwells included), measured from
+    /// the earliest start as the round's ticks are: [`RoundRun::duration_s`] is what the
+    /// cell did against it ([`RoundRun::over_plan_s`]). 0 in records written before it was
+    /// kept.
+    #[serde(default)]
+    pub planned_t_total_s: f64,
+    /// Each robot's planned end (s, from the earliest start, planned dwells included): its
+    /// realized end is [`RobotRun::end_tick`] times the tick. Empty in older records.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub planned_ends_s: Vec<f64>,
 }
 
 /// The two-robot round of the paper: a [`RoundRun`] with two robots ([`run_pair`](super::run_pair)).
@@ -154,5 +204,13 @@ impl RoundRun {
     #[must_use]
     pub fn duration_s(&self) -> f64 {
         self.ticks as f64 * self.tick_s
+    }
+
+    /// How much longer the round took than planned (s): [`RoundRun::duration_s`] minus
+    /// [`RoundRun::planned_t_total_s`] (negative when it ended early, e.g. when the robots
+    /// ran high-confidence stretches faster than planned, Alg. 1).
+    #[must_use]
+    pub fn over_plan_s(&self) -> f64 {
+        self.duration_s() - self.planned_t_total_s
     }
 }

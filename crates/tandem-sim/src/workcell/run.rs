@@ -8,7 +8,7 @@ use tandem_realtime::{Coordinator, Operator, Timeline, tol};
 use tandem_schedule::{Problem, Schedule};
 
 use super::operator::{Episodes, OperatorParams, local_correction_input, needs_correction};
-use super::record::{PairRun, RobotRun, RoundRun};
+use super::record::{PairRun, RobotRun, RoundRun, TickPhase};
 use crate::task::{Label, Workpiece};
 use crate::{Error, Result};
 
@@ -207,12 +207,7 @@ pub(super) fn run_coordinator(
         .zip(coord.clock_s())
         .map(|(tl, &c)| tl.sample_at(c))
         .collect();
-    let mut ref_now: Vec<f64> = coord
-        .robots()
-        .iter()
-        .zip(coord.clock_s())
-        .map(|(tl, &c)| tl.ref_time_at(c))
-        .collect();
+    let mut ref_now: Vec<f64> = coord.ref_time_now().to_vec();
 
     let has_holds = coord.has_holds();
     // Whether each robot logged an unsupervised sample this tick (it started the tick on a
@@ -224,9 +219,21 @@ pub(super) fn run_coordinator(
         }
         let held = coord.fault().map(|f| f.stopped);
         let clocks = coord.clock_s();
+        let running = coord.running_now();
         let mut operator = Operator::Scheduled;
         for i in 0..n_robots {
             runs[i].clock_s.push(clocks[i]);
+            runs[i].phases.push(if held == Some(i) {
+                TickPhase::Held
+            } else if coord.at_hold(i) {
+                TickPhase::AtHold
+            } else if running[i] {
+                TickPhase::Running
+            } else if ref_now[i] >= n_ref as f64 {
+                TickPhase::Finished
+            } else {
+                TickPhase::Waiting
+            });
             let n = if has_holds {
                 // With hold points the clock is the current leg's (dwells included, and
                 // the clock of legs not started while the robot stands at a hold): the leg
@@ -308,6 +315,12 @@ pub(super) fn run_coordinator(
     for run in &mut runs {
         run.start_tick = run.start_tick.min(ticks);
     }
+    let t0 = coord
+        .robots()
+        .iter()
+        .map(Timeline::start_s)
+        .fold(f64::INFINITY, f64::min);
+    let planned_ends_s: Vec<f64> = (0..n_robots).map(|i| coord.planned_end_s(i) - t0).collect();
     Ok(RoundRun {
         robots: runs,
         ticks,
@@ -315,6 +328,8 @@ pub(super) fn run_coordinator(
         overlap_ticks,
         idle_ticks,
         faults,
+        planned_t_total_s: planned_ends_s.iter().copied().fold(0.0, f64::max),
+        planned_ends_s,
     })
 }
 
@@ -384,6 +399,7 @@ impl Operate {
             clock_s: Vec::with_capacity(n_ref * 2),
             start_tick: usize::MAX,
             hold_ticks: 0,
+            phases: Vec::with_capacity(n_ref * 2),
         }
     }
 
@@ -437,6 +453,15 @@ impl Operate {
         rng: &mut impl Rng,
     ) -> Result<Option<Operator>> {
         let n_ref = model.n_ref();
+        // A model update can add correction components (`K = min(n − 1, k_max, d)` grows
+        // with the executions recorded while a task has fewer than `k_max + 1`
+        // demonstrations): a continuous cell keeps its operator across re-plans, so the
+        // inputs follow the model that commands now (allocates only when `K` changes).
+        let k = model.n_components();
+        if self.u_zero.len() != k {
+            self.u_zero.resize(k, 0.0);
+            self.u_corr.resize(k, 0.0);
+        }
         let ref_time = ref_time.min((n_ref - 1) as f64);
         let supervised = bounds.is_some();
         let mut corrected = false;

@@ -579,6 +579,75 @@ fn a_robot_waits_at_its_hold_while_the_operator_drags_the_other_and_never_overla
 }
 
 #[test]
+fn a_nominal_round_with_a_hold_ends_on_plan_and_records_where_its_time_went() {
+    // The schedule of the test above (robot 2 leaves its hold at 5 once robot 1 has passed
+    // sample 20, its LC run 10..20 planned right after robot 1's): the rule's wait is planned
+    // as a dwell, so an operator who never corrects (nothing needed, no false corrections)
+    // ends the round on plan. Before the wait was planned the round ran the travel from the
+    // hold to the LC run (samples 5..10) over its plan.
+    let model = model();
+    let problem = problem(&model).with_holds(vec![5]).unwrap();
+    let dt_s = problem.dt_s();
+    let serial = problem.serial_schedule(dt_s).unwrap();
+    let grad = serial.grad_exec[0].clone();
+    let clock = |n: usize| tandem_realtime::clock_end_s(&grad[..n], 0.0, dt_s);
+    let plain = Schedule {
+        offsets_s: vec![clock(20) - clock(10)],
+        ..serial
+    };
+    let held = problem.with_release_rules(&plain).unwrap();
+    // The dwell: robot 2 arrives at its hold at τ + c_5 and robot 1 passes sample 20 at c_20.
+    let tau = plain.offsets_s[0];
+    let dwell = held.holds_of(1)[0].dwell_s;
+    assert!(
+        (dwell - (clock(20) - (tau + clock(5)))).abs() < 1e-12,
+        "{dwell}"
+    );
+    assert!((held.t_total_s(dt_s) - (plain.t_total_s(dt_s) + dwell)).abs() < 1e-12);
+    let nominal = OperatorParams {
+        miss_rate: 0.0,
+        false_correction_rate: 0.0,
+        ..OperatorParams::default()
+    };
+    let never = |_: usize, _: usize| false;
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let run = run_schedule(&model, &problem, &held, never, &nominal, &mut rng).unwrap();
+    assert_eq!((run.overlap_ticks, run.faults), (0, 0));
+    assert_eq!(run.planned_t_total_s, held.t_total_s(dt_s));
+    assert_eq!(run.planned_ends_s, held.ends_s(dt_s));
+    // On plan to the tick grid (an 82-tick round: 1 % is less than a tick): the round ends
+    // at a tick boundary, and robot 2 leaves its hold at the first tick start after robot 1
+    // passed sample 20 (both at most a tick later than planned).
+    let grid_s = 2.0 * run.tick_s;
+    assert!(
+        run.over_plan_s().abs() <= grid_s,
+        "realized {} s against planned {} s",
+        run.duration_s(),
+        run.planned_t_total_s
+    );
+    // Every tick of every robot is accounted for: waiting for its start, running (one logged
+    // sample each), at its hold, finished.
+    for (i, r) in run.robots.iter().enumerate() {
+        assert_eq!(r.phases.len(), run.ticks, "robot {i}");
+        assert_eq!(r.ticks_in(TickPhase::Running), r.ref_time_log.len());
+        assert_eq!(r.ticks_in(TickPhase::AtHold), r.hold_ticks);
+        assert_eq!(r.ticks_in(TickPhase::Waiting), r.start_tick);
+        assert_eq!(r.ticks_in(TickPhase::Held), 0);
+        let end_s = r.end_tick() as f64 * run.tick_s;
+        assert!(
+            (end_s - run.planned_ends_s[i]).abs() <= grid_s,
+            "robot {i}: {end_s}"
+        );
+    }
+    // Robot 2 stands at its hold for its planned dwell (to within a tick).
+    let waited_s = run.robots[1].hold_wait_s(run.tick_s);
+    assert!(
+        (waited_s - dwell).abs() <= run.tick_s,
+        "{waited_s} vs {dwell}"
+    );
+}
+
+#[test]
 fn a_fast_robot_crossing_a_one_sample_island_in_one_tick_gets_it_supervised() {
     // High confidence everywhere but a one-sample island at 30; every sample is planned at
     // ψ̇ = 0.35 (the fastest), so a robot sweeps 1/0.35 ≈ 2.86 reference samples per tick and

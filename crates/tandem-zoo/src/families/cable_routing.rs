@@ -3,6 +3,7 @@
 use rand::Rng;
 
 use crate::Result;
+use crate::engine::pose::*;
 use crate::engine::{
     Agreed, Channel, Feature, FeatureKind, Interp::*, Script, Shape, Variation, pick, render,
     rng_for, seg, to, uniform,
@@ -12,13 +13,11 @@ use crate::task::ZooTask;
 /// The family's name.
 pub(crate) const NAME: &str = "cable_routing";
 
-const X: usize = 0;
-const Y: usize = 1;
-const Z: usize = 2;
-const QX: usize = 3;
-const QZ: usize = 5;
 const GRIPPER: usize = 7;
 const TENSION: usize = 8;
+
+/// How unsteady the demonstrator's pace is ([`Script::wobble_scale`]): a hand pulling a cable, uneven (±24 % within a free move).
+const WOBBLE: f64 = 0.8;
 
 /// Generates the task for `seed`.
 pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
@@ -34,19 +33,15 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let route_p = pick(&mut rng, &[0.4, 0.6, 0.8, 1.0]);
     let connector_p = pick(&mut rng, &[0.5, 0.7]);
 
-    let pos = |name| Channel::real(name, 5, 0.000_2, 0.000_6);
-    let rot = |name| Channel::real(name, 6, 0.000_5, 0.003);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        Channel::binary("gripper"),
-        Channel::real("tension", 3, 0.05, 0.08),
-    ];
+    let channels = Channel::pose_then(
+        5,
+        (0.000_2, 0.000_6),
+        (0.000_5, 0.003),
+        [
+            Channel::binary("gripper"),
+            Channel::real("tension", 3, 0.05, 0.08),
+        ],
+    );
     let start = vec![0.3, 0.3, 0.2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let segments = vec![
         seg(
@@ -178,6 +173,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
         rate_hz,
         jitter,
         length_var,
+        wobble_scale: WOBBLE,
     };
     render(&script, &mut rng)
 }

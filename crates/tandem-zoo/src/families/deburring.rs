@@ -4,6 +4,7 @@
 use rand::Rng;
 
 use crate::Result;
+use crate::engine::pose::*;
 use crate::engine::{
     Channel, Interp::*, Script, Shape, Variation, pick, render, rng_for, seg, to, uniform,
 };
@@ -12,14 +13,13 @@ use crate::task::ZooTask;
 /// The family's name.
 pub(crate) const NAME: &str = "deburring";
 
-const X: usize = 0;
-const Y: usize = 1;
-const Z: usize = 2;
-const QX: usize = 3;
 const FX: usize = 7;
 const FY: usize = 8;
 const FZ: usize = 9;
 const SPINDLE: usize = 10;
+
+/// How unsteady the demonstrator's pace is ([`Script::wobble_scale`]): a steady, careful pace (±10 % within a free move).
+const WOBBLE: f64 = 0.35;
 
 /// Generates the task for `seed`.
 pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
@@ -31,22 +31,18 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let need_p = pick(&mut rng, &[0.6, 0.8, 1.0]);
     let shape = pick(&mut rng, &[Shape::Offset, Shape::Wavy { cycles: 2.0 }]);
 
-    let pos = |name| Channel::real(name, 6, 0.000_05, 0.000_2);
-    let rot = |name| Channel::real(name, 6, 0.000_3, 0.002);
     let force = |name| Channel::real(name, 3, 0.04, 0.05);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        force("fx"),
-        force("fy"),
-        force("fz"),
-        Channel::binary("spindle"),
-    ];
+    let channels = Channel::pose_then(
+        6,
+        (0.000_05, 0.000_2),
+        (0.000_3, 0.002),
+        [
+            force("fx"),
+            force("fy"),
+            force("fz"),
+            Channel::binary("spindle"),
+        ],
+    );
     let start = vec![0.3, 0.2, 0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let segments = vec![
         seg(
@@ -140,6 +136,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
         rate_hz,
         jitter,
         length_var,
+        wobble_scale: WOBBLE,
     };
     render(&script, &mut rng)
 }

@@ -3,6 +3,7 @@
 use rand::Rng;
 
 use crate::Result;
+use crate::engine::pose::*;
 use crate::engine::{
     Channel, Interp::*, Script, Shape, Variation, pick, render, rng_for, seg, to, uniform,
 };
@@ -11,16 +12,14 @@ use crate::task::ZooTask;
 /// The family's name.
 pub(crate) const NAME: &str = "dispensing";
 
-const X: usize = 0;
-const Y: usize = 1;
-const Z: usize = 2;
-const QX: usize = 3;
-const QY: usize = 4;
 const FLOW: usize = 7;
 const VALVE: usize = 8;
 
 /// Segment indices of the three beads (A along +x, B along +y, C along −x).
 const BEADS: [usize; 3] = [4, 6, 8];
+
+/// How unsteady the demonstrator's pace is ([`Script::wobble_scale`]): an ordinary hand (±15 % within a free move).
+const WOBBLE: f64 = 0.5;
 
 /// Generates the task for `seed`.
 pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
@@ -36,19 +35,12 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     // Across the bead's travel: y for the beads along x, x for the bead along y.
     let across = if seam_bead == 6 { X } else { Y };
 
-    let pos = |name| Channel::real(name, 6, 0.000_2, 0.000_6);
-    let rot = |name| Channel::real(name, 6, 0.000_5, 0.003);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        Channel::non_neg("flow", 4, 0.02),
-        Channel::binary("valve"),
-    ];
+    let channels = Channel::pose_then(
+        6,
+        (0.000_2, 0.000_6),
+        (0.000_5, 0.003),
+        [Channel::non_neg("flow", 4, 0.02), Channel::binary("valve")],
+    );
     let start = vec![0.0, 0.0, 0.15, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let segments = vec![
         seg(
@@ -195,6 +187,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
         rate_hz,
         jitter,
         length_var,
+        wobble_scale: WOBBLE,
     };
     render(&script, &mut rng)
 }

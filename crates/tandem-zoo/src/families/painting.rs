@@ -3,6 +3,7 @@
 use rand::Rng;
 
 use crate::Result;
+use crate::engine::pose::*;
 use crate::engine::{
     Channel, Interp::*, Script, Segment, Shape, Variation, pick, render, rng_for, seg, to, uniform,
 };
@@ -11,16 +12,14 @@ use crate::task::ZooTask;
 /// The family's name.
 pub(crate) const NAME: &str = "painting";
 
-const X: usize = 0;
-const Y: usize = 1;
-const Z: usize = 2;
-const QX: usize = 3;
-const QY: usize = 4;
 const FLOW: usize = 7;
 const SPRAY: usize = 8;
 
 /// Number of strokes; stroke `k` is segment `1 + 2k`.
 const N_STROKES: usize = 6;
+
+/// How unsteady the demonstrator's pace is ([`Script::wobble_scale`]): an ordinary hand (±15 % within a free move).
+const WOBBLE: f64 = 0.5;
 
 /// Generates the task for `seed`.
 pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
@@ -34,19 +33,12 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let (first, last) = pick(&mut rng, &[(0, 0), (2, 3), (4, 5)]);
     let need_p = pick(&mut rng, &[0.4, 0.6, 0.8, 1.0]);
 
-    let pos = |name| Channel::real(name, 5, 0.000_2, 0.000_5);
-    let rot = |name| Channel::real(name, 6, 0.000_3, 0.0015);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        Channel::non_neg("flow", 3, 0.015),
-        Channel::binary("spray"),
-    ];
+    let channels = Channel::pose_then(
+        5,
+        (0.000_2, 0.000_5),
+        (0.000_3, 0.0015),
+        [Channel::non_neg("flow", 3, 0.015), Channel::binary("spray")],
+    );
     let start = vec![0.3, -0.1, 0.4, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let mut segments: Vec<Segment> = vec![seg(
         "approach",
@@ -130,6 +122,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
         rate_hz,
         jitter,
         length_var,
+        wobble_scale: WOBBLE,
     };
     render(&script, &mut rng)
 }

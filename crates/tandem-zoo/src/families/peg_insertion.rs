@@ -3,6 +3,7 @@
 use rand::Rng;
 
 use crate::Result;
+use crate::engine::pose::*;
 use crate::engine::{
     Channel, Feature, FeatureKind, Interp::*, Script, pick, render, rng_for, seg, to, uniform,
 };
@@ -11,14 +12,12 @@ use crate::task::ZooTask;
 /// The family's name.
 pub(crate) const NAME: &str = "peg_insertion";
 
-const X: usize = 0;
-const Y: usize = 1;
-const Z: usize = 2;
-const QX: usize = 3;
-const QZ: usize = 5;
 const FX: usize = 7;
 const FY: usize = 8;
 const FZ: usize = 9;
+
+/// How unsteady the demonstrator's pace is ([`Script::wobble_scale`]): an ordinary hand (±15 % within a free move).
+const WOBBLE: f64 = 0.5;
 
 /// Generates the task for `seed`.
 pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
@@ -31,21 +30,13 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let insert_p = pick(&mut rng, &[0.4, 0.6]);
     let turns = pick(&mut rng, &[2.0, 3.0]);
 
-    let pos = |name| Channel::real(name, 6, 0.000_1, 0.000_3);
-    let rot = |name| Channel::real(name, 6, 0.000_2, 0.001);
     let force = |name| Channel::real(name, 3, 0.03, 0.05);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        force("fx"),
-        force("fy"),
-        Channel::real("fz", 3, 0.15, 0.2),
-    ];
+    let channels = Channel::pose_then(
+        6,
+        (0.000_1, 0.000_3),
+        (0.000_2, 0.001),
+        [force("fx"), force("fy"), Channel::real("fz", 3, 0.15, 0.2)],
+    );
     let start = vec![0.0, 0.0, 0.12, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let segments = vec![
         seg(
@@ -115,7 +106,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
                 ch: FZ,
                 peak: -10.0,
                 peak_var: 5.0,
-                at: (0.2, 0.7),
+                at: (0.12, 0.7),
                 width: 0.12,
             },
         },
@@ -135,6 +126,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
         rate_hz,
         jitter,
         length_var,
+        wobble_scale: WOBBLE,
     };
     render(&script, &mut rng)
 }

@@ -4,6 +4,7 @@
 use rand::Rng;
 
 use crate::Result;
+use crate::engine::pose::*;
 use crate::engine::{
     Channel, Interp::*, Script, Segment, Shape, Variation, pick, render, rng_for, seg, to, uniform,
 };
@@ -12,15 +13,13 @@ use crate::task::ZooTask;
 /// The family's name.
 pub(crate) const NAME: &str = "pick_and_place";
 
-const X: usize = 0;
-const Y: usize = 1;
-const Z: usize = 2;
-const QX: usize = 3;
-const QZ: usize = 5;
 const GRIPPER: usize = 7;
 
 /// Segments per object.
 const PER_OBJECT: usize = 8;
+
+/// How unsteady the demonstrator's pace is ([`Script::wobble_scale`]): a quick, uneven hand (±21 % within a free move).
+const WOBBLE: f64 = 0.7;
 
 /// Generates the task for `seed`.
 pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
@@ -32,18 +31,12 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     // Which of the three objects a person puts down by hand (the others come in a fixture).
     let loose: &[usize] = pick(&mut rng, &[&[0][..], &[0, 2], &[2], &[1]]);
 
-    let pos = |name| Channel::real(name, 6, 0.000_2, 0.000_5);
-    let rot = |name| Channel::real(name, 6, 0.000_5, 0.003);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        Channel::binary("gripper"),
-    ];
+    let channels = Channel::pose_then(
+        6,
+        (0.000_2, 0.000_5),
+        (0.000_5, 0.003),
+        [Channel::binary("gripper")],
+    );
     let start = vec![0.3, 0.15, 0.2, 0.0, 0.0, 0.0, 0.0, 0.0];
     let mut segments: Vec<Segment> = Vec::new();
     for j in 0..3 {
@@ -122,6 +115,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
         rate_hz,
         jitter,
         length_var,
+        wobble_scale: WOBBLE,
     };
     render(&script, &mut rng)
 }

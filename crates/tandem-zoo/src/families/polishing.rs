@@ -3,6 +3,7 @@
 use rand::Rng;
 
 use crate::Result;
+use crate::engine::pose::*;
 use crate::engine::{
     Agreed, Channel, Interp::*, Script, Shape, Variation, pick, render, rng_for, seg, to, uniform,
 };
@@ -11,17 +12,15 @@ use crate::task::ZooTask;
 /// The family's name.
 pub(crate) const NAME: &str = "polishing";
 
-const X: usize = 0;
-const Y: usize = 1;
-const Z: usize = 2;
-const QX: usize = 3;
-const QY: usize = 4;
 const FORCE: usize = 7;
 const TOOL: usize = 8;
 
 /// Index of stroke 1 (the first contact) and stroke 5 (the part's far edge).
 const FIRST_STROKE: usize = 2;
 const LAST_STROKE: usize = 12;
+
+/// How unsteady the demonstrator's pace is ([`Script::wobble_scale`]): an ordinary hand (±15 % within a free move).
+const WOBBLE: f64 = 0.5;
 
 /// Generates the task for `seed`.
 pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
@@ -32,19 +31,12 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
     let length_var = uniform(&mut rng, 0.05, 0.085);
     let where_ = pick(&mut rng, &["start", "end", "both"]);
 
-    let pos = |name| Channel::real(name, 6, 0.000_1, 0.000_4);
-    let rot = |name| Channel::real(name, 6, 0.000_2, 0.001);
-    let channels = vec![
-        pos("x"),
-        pos("y"),
-        pos("z"),
-        rot("qx"),
-        rot("qy"),
-        rot("qz"),
-        Channel::real("qw", 6, 0.0, 0.0),
-        Channel::real("force", 3, 0.2, 0.3),
-        Channel::binary("tool"),
-    ];
+    let channels = Channel::pose_then(
+        6,
+        (0.000_1, 0.000_4),
+        (0.000_2, 0.001),
+        [Channel::real("force", 3, 0.2, 0.3), Channel::binary("tool")],
+    );
     let start = vec![0.0, 0.0, 0.10, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let stroke = |x: f64| seg("stroke", 2.6, 0.08, 0.25, vec![to(X, x, Linear)]);
     let turn = |y: f64, tilt: f64| {
@@ -176,6 +168,7 @@ pub(crate) fn generate(seed: u64) -> Result<ZooTask> {
         rate_hz,
         jitter,
         length_var,
+        wobble_scale: WOBBLE,
     };
     render(&script, &mut rng)
 }

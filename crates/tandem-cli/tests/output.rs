@@ -1,0 +1,313 @@
+//! Output a person reads: what grows with the task or the number of files is summarized
+//! (hold-point stretches, period notes, bag grid notes), `--verbose` lists it all; the rate
+//! error names the odd file out; a rosbag2 folder is read through its `.mcap` file.
+
+mod common;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use common::{ok, scratch, small_demo, small_demos, tandem, write};
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn s(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// stderr of a run.
+fn stderr(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// `small_demo(n, bump)` with every time moved by `shift(row)` seconds (rows from 0).
+fn shifted(n: usize, bump: f64, shift: impl Fn(usize) -> f64) -> String {
+    small_demo(n, bump)
+        .lines()
+        .enumerate()
+        .map(|(k, l)| match k {
+            0 => format!("{l}\n"),
+            _ => {
+                let (t, rest) = l.split_once(',').expect("t,x,force rows");
+                let t: f64 = t.parse().expect("a time");
+                format!("{:.4},{rest}\n", t + shift(k - 1))
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn period_notes_are_one_line_for_all_files_unless_verbose() {
+    let dir = scratch("out-notes");
+    // Three files whose `t` jitters by 1–2 ms at one row each (10–20 % of a period).
+    let files: Vec<PathBuf> = [(60, 0.0, 0.001), (66, 6.0, 0.002), (56, 12.0, 0.0015)]
+        .iter()
+        .enumerate()
+        .map(|(i, &(n, bump, dev))| {
+            let text = shifted(n, bump, |row| if row == 20 { dev } else { 0.0 });
+            write(&dir, &format!("j{i}.csv"), &text)
+        })
+        .collect();
+    let state = dir.join("cell.tandem");
+    let mut args: Vec<String> = vec!["fit".into()];
+    args.extend(files.iter().map(|p| s(p)));
+    args.extend(["--samples", "50", "-o"].map(String::from));
+    args.push(s(&state));
+    let out = tandem(&args);
+    ok(&out);
+    let err = stderr(&out);
+    let timing = |l: &&str| l.starts_with("note: ") && l.contains("time column `t`");
+    let notes: Vec<&str> = err.lines().filter(timing).collect();
+    assert_eq!(notes.len(), 1, "{err}");
+    // The worst deviation (2 ms, 20 % of a period) and where it is.
+    for part in [
+        "3 files (",
+        "deviate from each file's even grid by up to 2.000 ms (20.0 % of a period, at ",
+        &format!("{}:22;", s(&files[1])),
+        "(--verbose: one note per file)",
+    ] {
+        assert!(notes[0].contains(part), "`{part}` missing: {err}");
+    }
+    std::fs::remove_file(&state).expect("remove");
+    args.insert(1, "--verbose".into());
+    let out = tandem(&args);
+    ok(&out);
+    let err = stderr(&out);
+    assert_eq!(err.lines().filter(timing).count(), 3, "{err}");
+    // `record` of two executions without a time column: one note for both.
+    let ex = repo().join("fixtures/examples");
+    let cell = dir.join("example.tandem");
+    let demos: Vec<String> = (0..3)
+        .map(|i| s(&ex.join(format!("demo_{i}.csv"))))
+        .collect();
+    let mut fit = vec!["fit".to_string()];
+    fit.extend(demos);
+    fit.extend(["--samples", "50", "-o"].map(String::from));
+    fit.push(s(&cell));
+    ok(&tandem(&fit));
+    let mut rec = vec!["record".to_string(), s(&cell)];
+    for i in 1..=2 {
+        for (flag, kind) in [
+            ("--execution", ""),
+            ("--log", ".reflog"),
+            ("--corrections", ".corr"),
+        ] {
+            rec.push(flag.into());
+            rec.push(s(&ex.join(format!("pair_1_robot_{i}{kind}.csv"))));
+        }
+    }
+    let out = tandem(&rec);
+    ok(&out);
+    let err = stderr(&out);
+    let notes: Vec<&str> = err.lines().filter(timing).collect();
+    assert_eq!(notes.len(), 1, "{err}");
+    assert!(
+        notes[0].contains("2 files (")
+            && notes[0].contains("no time column `t`: their samples are taken to be 0.01 s apart")
+            && notes[0].contains("the control tick of the schedule it ran"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
+
+#[test]
+fn many_hold_stretches_are_summarized_and_verbose_lists_them() {
+    let dir = scratch("out-holds");
+    // Three demonstrations of 120 samples whose `gripper` opens and closes every 10 samples:
+    // six stretches where it is open (gripper < 0.5); the force differs over the middle.
+    let demo = |bump: f64| {
+        let mut text = String::from("t,x,force,gripper\n");
+        for k in 0..120 {
+            let u = k as f64 / 119.0;
+            let force = if (40..80).contains(&k) {
+                5.0 + bump
+            } else {
+                5.0
+            };
+            let gripper = u8::from((k / 10) % 2 == 1);
+            writeln!(text, "{:.2},{u:.6},{force:.4},{gripper}", k as f64 * 0.01).expect("text");
+        }
+        text
+    };
+    let files: Vec<String> = [0.0, 4.0, 8.0]
+        .iter()
+        .enumerate()
+        .map(|(i, &b)| s(&write(&dir, &format!("g{i}.csv"), &demo(b))))
+        .collect();
+    let state = s(&dir.join("cell.tandem"));
+    let mut args: Vec<&str> = vec!["fit"];
+    args.extend(files.iter().map(String::as_str));
+    args.extend([
+        "--hold-where",
+        "gripper<0.5",
+        "--samples",
+        "50",
+        "-o",
+        &state,
+    ]);
+    let text = ok(&tandem(&args));
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("hold points (where gripper<0.5): "))
+        .unwrap_or_else(|| panic!("no hold line:\n{text}"));
+    let stretches: usize = line
+        .split(" samples in ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no stretch count: {line}"));
+    assert!(stretches > 5, "{text}");
+    let listed = |text: &str| {
+        text.lines()
+            .filter(|l| l.starts_with("  ") && l.contains(" (sample"))
+            .count()
+    };
+    assert_eq!(listed(&text), 0, "{text}");
+    assert!(
+        text.contains("longest: ") && text.contains("(--verbose lists every stretch"),
+        "{text}"
+    );
+    // `inspect` summarizes the same way; `--verbose` lists every stretch.
+    let inspect = ok(&tandem(["inspect", &state]));
+    assert_eq!(listed(&inspect), 0, "{inspect}");
+    let verbose = ok(&tandem(["inspect", &state, "--verbose"]));
+    assert_eq!(listed(&verbose), stretches, "{verbose}");
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
+
+#[test]
+fn a_rate_mismatch_names_the_odd_file_even_when_it_comes_first() {
+    let dir = scratch("out-rate");
+    let demos = small_demos(&dir);
+    // The first file logged at 1 kHz: 60 rows 1 ms apart.
+    let khz = write(
+        &dir,
+        "khz.csv",
+        &shifted(60, 0.0, |row| -0.009 * row as f64),
+    );
+    let out = tandem([
+        "fit",
+        &s(&khz),
+        &s(&demos[1]),
+        &s(&demos[2]),
+        "-o",
+        &s(&dir.join("out.tandem")),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(
+        err.contains(&format!(
+            "{}:1:1: sample period 0.001 s differs from 0.01 s, the period of 2 of the 3 \
+             demonstrations ({}, {})",
+            s(&khz),
+            s(&demos[1]),
+            s(&demos[2])
+        )),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
+
+#[test]
+fn a_rosbag2_folder_is_read_through_its_mcap_and_the_grid_note_is_said_once() {
+    let dir = scratch("out-folder");
+    let ros2 = repo().join("fixtures/examples/ros2");
+    let folders: Vec<PathBuf> = (0..3)
+        .map(|i| {
+            let f = dir.join(format!("demo_{i}"));
+            std::fs::create_dir_all(&f).expect("folder");
+            std::fs::write(f.join("metadata.yaml"), "rosbag2_bagfile_information: {}\n")
+                .expect("metadata");
+            std::fs::copy(
+                ros2.join(format!("demo_{i}.mcap")),
+                f.join(format!("demo_{i}_0.mcap")),
+            )
+            .expect("copy the bag");
+            f
+        })
+        .collect();
+    let state = s(&dir.join("cell.tandem"));
+    let mut args: Vec<String> = vec!["fit".into()];
+    args.extend(folders.iter().map(|p| s(p)));
+    args.extend(["--samples", "50", "-o"].map(String::from));
+    args.push(state.clone());
+    let out = tandem(&args);
+    let text = ok(&out);
+    // Named as given (the folder).
+    assert!(
+        text.contains(&format!("(reference: {}, the first file)", s(&folders[0]))),
+        "{text}"
+    );
+    // The grid note: once for the three bags, naming the topic that set it.
+    let err = stderr(&out);
+    let notes: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("note: ") && l.contains("grid of"))
+        .collect();
+    assert_eq!(notes.len(), 1, "{err}");
+    assert!(
+        notes[0].contains("3 files (")
+            && notes[0].contains(": grid of 100 Hz (0.01 s), the rate of /tool_pose")
+            && notes[0].contains("--rate HZ"),
+        "{err}"
+    );
+    ok(&tandem(["inspect", &s(&folders[0])]));
+    // A folder without an .mcap file, and one with two: refused with what they hold.
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(&empty).expect("folder");
+    std::fs::write(empty.join("metadata.yaml"), "x: 1\n").expect("metadata");
+    let two = &folders[1];
+    std::fs::copy(ros2.join("demo_2.mcap"), two.join("demo_1_1.mcap")).expect("copy");
+    for (folder, part) in [
+        (
+            &empty,
+            "a folder (a rosbag2 recording: metadata.yaml), without an .mcap file",
+        ),
+        (two, "a folder with 2 .mcap files"),
+    ] {
+        let out = tandem([
+            "fit",
+            &s(folder),
+            &s(&folders[0]),
+            "-o",
+            &s(&dir.join("other.tandem")),
+        ]);
+        assert_eq!(out.status.code(), Some(2));
+        let err = stderr(&out);
+        assert!(
+            err.contains(&format!("error: {}: {part}", s(folder))),
+            "{err}"
+        );
+        assert!(!err.contains("Is a directory"), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
+
+#[test]
+fn a_dt_that_agrees_with_every_file_is_one_note() {
+    let dir = scratch("out-dt");
+    let demos = small_demos(&dir);
+    let mut args: Vec<String> = vec!["fit".into()];
+    args.extend(demos.iter().map(|p| s(p)));
+    args.extend(["--dt", "0.01", "--samples", "50", "-o"].map(String::from));
+    args.push(s(&dir.join("cell.tandem")));
+    let out = tandem(&args);
+    ok(&out);
+    let err = stderr(&out);
+    let notes: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains("its own time gives"))
+        .collect();
+    assert_eq!(notes.len(), 1, "{err}");
+    assert!(
+        notes[0].starts_with("note: 3 files (")
+            && notes[0].ends_with(
+                "): its own time gives 0.01 s; --dt (the period of files without a time column) \
+                 agrees and is not used for it"
+            ),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}

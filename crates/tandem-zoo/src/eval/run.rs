@@ -1,0 +1,353 @@
+//! One run of the loop: a prepared task, `N` robots, rounds or a continuous cell, through the
+//! study's own loops (`tandem_sim::study::run_trial_on`, `run_cell_trial_on`), with what the
+//! report needs read from the study's records and from every round's per-tick logs.
+
+use std::sync::{Mutex, PoisonError};
+
+use serde::{Deserialize, Serialize};
+use tandem_planner::{Planner, derive_seed};
+use tandem_sim::study::{Cell, RoundView, StudyConfig, run_cell_trial_on, run_trial_on};
+use tandem_sim::workcell::FinishedTask;
+
+use super::prepare::{Prepared, falsely_trusted_split};
+use crate::Result;
+
+/// What one run of the loop did (one family, seed, robot count and cell). Times in seconds;
+/// for a continuous cell the "`T_total`" of a plan is its period `P` (the time of `N` tasks,
+/// one per robot, as a round's `T_total` is).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunReport {
+    /// The family.
+    pub family: String,
+    /// The seed.
+    pub seed: u64,
+    /// Robots `N`.
+    pub robots: usize,
+    /// Rounds or continuous.
+    pub cell: Cell,
+    /// Rounds recorded (continuous: re-plans after `N` completed tasks each).
+    pub rounds: usize,
+    /// `T_total` (rounds) or period (continuous) of every plan, the fit's first.
+    pub t_total_s: Vec<f64>,
+    /// High confidence (%) of every plan.
+    pub high_pct: Vec<f64>,
+    /// The last plan's lower bound (s): the margin-free bound of its certificate
+    /// (`Outcome::lower_bound_s`; continuous: `CyclicPlan::lower_bound_s`).
+    pub bound_s: f64,
+    /// Whether that bound is the proven margin-free optimum (rounds only; `false` for a cell).
+    pub bound_is_optimum: bool,
+    /// The serial schedule's `T_total` on the last plan's problem (`N` fastest executions one
+    /// after the other, `Problem::serial_schedule_n`).
+    pub serial_s: f64,
+    /// Truth: percent of the reference that never needs the operator.
+    pub truth_high_pct: f64,
+    /// High-confidence reference samples where the operator can be needed and the
+    /// demonstrations vary (a variable section), after the last round.
+    pub falsely_trusted: usize,
+    /// The same where every demonstration agrees (no variance reveals the need there).
+    pub falsely_trusted_agreeing: usize,
+    /// Rounds recorded before the first schedule in which the robots overlap (its `T_total`
+    /// is below the serial schedule's on the same problem by more than half a tick); `None`
+    /// when no schedule did, or for a continuous cell (not measured).
+    pub first_overlap_round: Option<usize>,
+    /// The largest increase of `T_total` (period) from one plan to the next (s; ≤ 0 when it
+    /// never increased).
+    pub max_increase_s: f64,
+    /// The plan after which that increase came (rounds recorded; `None` with a single plan).
+    pub max_increase_at: Option<usize>,
+    /// Mean over rounds of realized duration over planned `T_total` (continuous: the last
+    /// plan's planned throughput over the steady realized one).
+    pub realized_over_planned: f64,
+    /// The same for the last round alone (continuous: as `realized_over_planned`).
+    pub realized_over_planned_last: f64,
+    /// Planned throughput of the last round run (tasks per hour per operator).
+    pub planned_per_h: f64,
+    /// Its realized throughput (tasks per hour per operator; continuous: the steady window).
+    pub realized_per_h: f64,
+    /// Ticks in which a robot's reference time decreased, over every robot and round (must
+    /// be 0), counted from the reference-time logs.
+    pub backward_steps: usize,
+    /// The largest such decrease (reference samples; 0 without one).
+    pub max_backward_samples: f64,
+    /// Ticks with two or more robots low-confidence (must be 0).
+    pub overlap_ticks: u64,
+    /// Faults of the coordinators' monitors (must be 0).
+    pub faults: u64,
+    /// Control tick (s).
+    pub tick_s: f64,
+}
+
+impl RunReport {
+    /// The last plan's `T_total` (period).
+    #[must_use]
+    pub fn final_t_s(&self) -> f64 {
+        self.t_total_s.last().copied().unwrap_or(f64::NAN)
+    }
+
+    /// The last plan's high confidence (%).
+    #[must_use]
+    pub fn final_high_pct(&self) -> f64 {
+        self.high_pct.last().copied().unwrap_or(f64::NAN)
+    }
+
+    /// `T_total / bound − 1`, percent.
+    #[must_use]
+    pub fn gap_pct(&self) -> f64 {
+        100.0 * (self.final_t_s() / self.bound_s - 1.0)
+    }
+}
+
+/// Backward steps of the reference-time logs: `(count, largest decrease)`.
+fn backward_steps<'a>(logs: impl IntoIterator<Item = &'a [f64]>) -> (usize, f64) {
+    logs.into_iter()
+        .flat_map(|log| log.windows(2))
+        .filter(|w| w[1] < w[0])
+        .fold((0, 0.0), |(n, max), w| (n + 1, f64::max(max, w[0] - w[1])))
+}
+
+/// The serial schedule's `T_total` on the planner's problem, at its schedule's tick.
+fn serial_s(planner: &Planner) -> Result<f64> {
+    let problem = planner.problem();
+    let schedule = problem
+        .serial_schedule_n(planner.n_robots(), planner.schedule().tick_s)
+        .map_err(tandem_sim::Error::from)?;
+    Ok(schedule.t_total_s(problem.dt_s()))
+}
+
+/// The study seed of a run: the task's seed, the family and the robot count, mixed
+/// (`derive_seed`), so that every run has its own sampler and operator streams and none
+/// depends on which other runs are made.
+fn run_seed(prep: &Prepared, robots: usize, cell: Cell) -> u64 {
+    let family = prep.family.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    });
+    let cell = match cell {
+        Cell::Rounds => 0,
+        Cell::Continuous => 1,
+    };
+    derive_seed(derive_seed(family, prep.seed), (robots as u64) << 1 | cell)
+}
+
+/// The study configuration of a run: one trial of `rounds` rounds (`rounds·N` tasks), the
+/// prepared planner parameters (the defaults with the family's holds), the sampler's default
+/// number of samples, the study's simulated operator.
+fn config(prep: &Prepared, robots: usize, cell: Cell, rounds: usize) -> StudyConfig {
+    StudyConfig {
+        trials: 1,
+        executions: rounds * robots,
+        robots,
+        samples: prep.planner.sampler.samples,
+        seed: run_seed(prep, robots, cell),
+        example_iterations: Vec::new(),
+        planner: prep.planner.clone(),
+        cell,
+        ..StudyConfig::default()
+    }
+}
+
+/// What the observers collect while a run goes.
+#[derive(Default)]
+struct Trace {
+    serial_s: Vec<f64>,
+    backward: (usize, f64),
+    error: Option<crate::Error>,
+}
+
+impl Trace {
+    fn add_backward(&mut self, (n, max): (usize, f64)) {
+        self.backward.0 += n;
+        self.backward.1 = self.backward.1.max(max);
+    }
+}
+
+/// The largest increase from one value to the next and after which value it came (`(0,
+/// None)` for fewer than two values).
+fn max_increase(t: &[f64]) -> (f64, Option<usize>) {
+    t.windows(2).enumerate().fold((0.0, None), |best, (k, w)| {
+        let d = w[1] - w[0];
+        if best.1.is_none() || d > best.0 {
+            (d, Some(k))
+        } else {
+            best
+        }
+    })
+}
+
+/// Runs `rounds` rounds of `robots` robots on the prepared task; `progress` is called after
+/// every recorded round.
+///
+/// # Errors
+/// The study's errors.
+pub fn run_rounds(
+    prep: &Prepared,
+    robots: usize,
+    rounds: usize,
+    progress: &(dyn Fn() + Sync),
+) -> Result<RunReport> {
+    let config = config(prep, robots, Cell::Rounds, rounds);
+    let trace = Mutex::new(Trace::default());
+    let observe = |view: RoundView<'_>| {
+        let serial = serial_s(view.planner);
+        let backward = backward_steps(view.run.robots.iter().map(|r| &r.ref_time_log[..]));
+        let mut t = trace.lock().unwrap_or_else(PoisonError::into_inner);
+        t.add_backward(backward);
+        match serial {
+            Ok(s) => t.serial_s.push(s),
+            Err(e) => {
+                t.error.get_or_insert(e);
+            }
+        }
+    };
+    let run = run_trial_on(
+        &config,
+        &prep.model,
+        prep.truth.as_ref(),
+        0,
+        &|_| progress(),
+        &observe,
+    )?;
+    let mut trace = trace.into_inner().unwrap_or_else(PoisonError::into_inner);
+    if let Some(e) = trace.error.take() {
+        return Err(e);
+    }
+    let last_serial = serial_s(&run.planner)?;
+    trace.serial_s.push(last_serial);
+    let its = &run.result.iterations;
+    let t_total_s: Vec<f64> = its.iter().map(|i| i.t_total_s).collect();
+    let tick_s = run.planner.schedule().tick_s;
+    let first_overlap_round = t_total_s
+        .iter()
+        .zip(&trace.serial_s)
+        .position(|(t, s)| *t < s - 0.5 * tick_s);
+    let (max_increase_s, max_increase_at) = max_increase(&t_total_s);
+    let ran: Vec<(f64, f64)> = its
+        .iter()
+        .filter_map(|i| i.pair.as_ref().map(|p| (i.t_total_s, p.duration_s)))
+        .collect();
+    let ratio = |(planned, realized): (f64, f64)| realized / planned;
+    let realized_over_planned =
+        ran.iter().copied().map(ratio).sum::<f64>() / ran.len().max(1) as f64;
+    let (planned_last, realized_last) = ran.last().copied().unwrap_or((f64::NAN, f64::NAN));
+    let per_h = |t: f64| 3600.0 * robots as f64 / t;
+    let last = its.last().expect("a trial has its first schedule");
+    let (falsely_trusted, falsely_trusted_agreeing) =
+        falsely_trusted_split(run.planner.confidence().conf(), &prep.need_kind);
+    let pairs = its.iter().filter_map(|i| i.pair.as_ref());
+    Ok(RunReport {
+        family: prep.family.to_string(),
+        seed: prep.seed,
+        robots,
+        cell: Cell::Rounds,
+        rounds,
+        high_pct: its.iter().map(|i| i.high_conf_pct).collect(),
+        bound_s: last.lower_bound_s,
+        bound_is_optimum: last.bound_is_optimum,
+        serial_s: last_serial,
+        truth_high_pct: prep.report.truth_high_pct,
+        falsely_trusted,
+        falsely_trusted_agreeing,
+        first_overlap_round,
+        max_increase_s,
+        max_increase_at,
+        realized_over_planned,
+        realized_over_planned_last: realized_last / planned_last,
+        planned_per_h: per_h(planned_last),
+        realized_per_h: per_h(realized_last),
+        backward_steps: trace.backward.0,
+        max_backward_samples: trace.backward.1,
+        overlap_ticks: pairs.clone().map(|p| p.overlap_ticks as u64).sum(),
+        faults: pairs.map(|p| p.faults as u64).sum(),
+        tick_s,
+        t_total_s,
+    })
+}
+
+/// Runs a continuous cell of `robots` robots on the prepared task for `rounds·N` tasks,
+/// re-planned every `N` tasks; `progress` is called after every re-plan.
+///
+/// # Errors
+/// The study's errors.
+pub fn run_continuous(
+    prep: &Prepared,
+    robots: usize,
+    rounds: usize,
+    progress: &(dyn Fn() + Sync),
+) -> Result<RunReport> {
+    let config = config(prep, robots, Cell::Continuous, rounds);
+    let trace = Mutex::new(Trace::default());
+    let observe = |task: &FinishedTask| {
+        let backward = backward_steps([&task.run.ref_time_log[..]]);
+        trace
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .add_backward(backward);
+    };
+    let run = run_cell_trial_on(
+        &config,
+        &prep.model,
+        prep.truth.as_ref(),
+        0,
+        &|_| progress(),
+        &observe,
+    )?;
+    let trace = trace.into_inner().unwrap_or_else(PoisonError::into_inner);
+    let its = &run.result.iterations;
+    let t_total_s: Vec<f64> = its.iter().map(|i| i.period_s).collect();
+    let (max_increase_s, max_increase_at) = max_increase(&t_total_s);
+    let last = its.last().expect("a trial has its first plan");
+    let realized_per_h = run.result.steady.throughput_per_h;
+    let ratio = last.tasks_per_hour / realized_per_h;
+    let (falsely_trusted, falsely_trusted_agreeing) =
+        falsely_trusted_split(run.planner.confidence().conf(), &prep.need_kind);
+    Ok(RunReport {
+        family: prep.family.to_string(),
+        seed: prep.seed,
+        robots,
+        cell: Cell::Continuous,
+        rounds: its.len() - 1,
+        high_pct: its.iter().map(|i| i.high_conf_pct).collect(),
+        bound_s: last.lower_bound_s,
+        bound_is_optimum: false,
+        serial_s: serial_s(&run.planner)?,
+        truth_high_pct: prep.report.truth_high_pct,
+        falsely_trusted,
+        falsely_trusted_agreeing,
+        first_overlap_round: None,
+        max_increase_s,
+        max_increase_at,
+        realized_over_planned: ratio,
+        realized_over_planned_last: ratio,
+        planned_per_h: last.tasks_per_hour,
+        realized_per_h,
+        backward_steps: trace.backward.0,
+        max_backward_samples: trace.backward.1,
+        overlap_ticks: run.result.stats.overlap_ticks,
+        faults: run.result.stats.faults,
+        tick_s: prep.model.dt_s(),
+        t_total_s,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn backward_steps_count_every_decrease() {
+        let a = [0.0, 1.0, 0.75, 2.0, 2.0, 1.0];
+        let b = [0.0, 0.5, 1.0];
+        assert_eq!(backward_steps([&a[..], &b[..]]), (2, 1.0));
+        assert_eq!(backward_steps([&b[..]]), (0, 0.0));
+    }
+
+    #[test]
+    fn the_largest_increase_and_where() {
+        assert_eq!(
+            max_increase(&[30.0, 19.5, 30.3, 25.0]),
+            (30.3 - 19.5, Some(1))
+        );
+        let (d, at) = max_increase(&[3.0, 2.0, 1.0]);
+        assert_eq!((d, at), (-1.0, Some(0)));
+        assert_eq!(max_increase(&[3.0]), (0.0, None));
+    }
+}
