@@ -179,21 +179,87 @@ fn medoid_criterion(model: &TaskModel) -> f64 {
     *s2.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
-/// Every demonstration tried as the reference ([`all_candidates`]), each fitted: the model
-/// and its [`medoid_criterion`], in input order.
+/// One candidate reference of the medoid: its model and [`medoid_criterion`], or the
+/// demonstration (input index) that looks cut off on its time axis and the error saying so.
+type Candidate = std::result::Result<(TaskModel, f64), (usize, Error)>;
+
+/// Every demonstration tried as the reference ([`all_candidates`]), each fitted, in input
+/// order; an error other than a demonstration looking cut off ends the fit.
 fn candidate_models(
     demos: &[Demonstration],
     layout: &Layout,
     params: &FitParams,
-) -> Result<Vec<(TaskModel, f64)>> {
+) -> Result<Vec<Candidate>> {
     all_candidates(demos, layout, params)?
         .into_par_iter()
         .map(|alignment| {
+            let ordered: Vec<&Demonstration> = alignment.order.iter().map(|&i| &demos[i]).collect();
+            if let Some((k, e)) = crate::checks::reaches_end_failure(
+                &ordered,
+                &alignment.warps,
+                params.warp.slope_min,
+                params.warp.slope_max,
+            ) {
+                return Ok(Err((alignment.order[k], e)));
+            }
             let model = TaskModel::from_alignment(demos, alignment, params, layout.clone())?;
             let criterion = medoid_criterion(&model);
-            Ok((model, criterion))
+            Ok(Ok((model, criterion)))
         })
         .collect()
+}
+
+/// The medoid ([`Reference::Medoid`]): of the candidates of [`candidate_models`] (in input
+/// order) on whose axis every demonstration reaches the end, the one with the least
+/// criterion, a tie going to the demonstration first in content order (so that the choice
+/// does not depend on the order of the input either).
+///
+/// A demonstration is refused as cut off when it looks so on the time axes of more than
+/// half of the other demonstrations (the error of the candidate first in content order that
+/// refuses it): one that does not reach the end looks cut off on every other axis, while on
+/// a legitimate set one odd candidate (a long pause of its own at the end) may make another
+/// look cut off (`tests/demo_coverage.rs`).
+fn medoid(demos: &[Demonstration], candidates: Vec<Candidate>) -> Result<TaskModel> {
+    let n = demos.len();
+    let by_content = |a: usize, b: usize| content_order(&demos[a], &demos[b]);
+    let mut votes = vec![0usize; n];
+    let mut refusal: Option<(usize, usize, Error)> = None;
+    let mut best: Option<(TaskModel, f64)> = None;
+    for (i, c) in candidates.into_iter().enumerate() {
+        match c {
+            Err((refused, e)) => {
+                votes[refused] += 1;
+                if 2 * votes[refused] > n - 1
+                    && refusal
+                        .as_ref()
+                        .is_none_or(|(j, ..)| by_content(i, *j).is_lt())
+                {
+                    refusal = Some((i, refused, e));
+                }
+            }
+            Ok(c) => {
+                best = Some(match best {
+                    None => c,
+                    Some(b) => {
+                        let closer =
+                            c.1.total_cmp(&b.1)
+                                .then_with(|| by_content(c.0.reference_idx(), b.0.reference_idx()));
+                        if closer.is_lt() { c } else { b }
+                    }
+                });
+            }
+        }
+    }
+    match (refusal, best) {
+        (Some((.., e)), _) => Err(e),
+        (None, Some((model, _))) => Ok(model),
+        (None, None) => Err(Error::BadData {
+            what: "demonstrations".into(),
+            why: "on the time axis of each of them another looks cut off: give the one that \
+                  reaches the end of the task first and fit with `--reference first`"
+                .into(),
+        }),
+    }
 }
 
 /// The checks every fit starts with: parameters, the demonstration set (returned with
@@ -213,8 +279,8 @@ fn checked<'a>(
 }
 
 impl TaskModel {
-    /// Fits the model: chooses the reference ([`FitParams::reference`]: demo 0 by default,
-    /// or the medoid), aligns every demonstration to it with GDTW
+    /// Fits the model: chooses the reference ([`FitParams::reference`]: the medoid by
+    /// default, or demo 0), aligns every demonstration to it with GDTW
     /// (`tandem_warp::align_many`, in parallel), then computes the statistics as
     /// [`TaskModel::fit_aligned`] does. `n_ref() = T_ref`, the reference's sample count;
     /// [`TaskModel::reference_idx`] says which demonstration it was. The model's channel
@@ -232,18 +298,7 @@ impl TaskModel {
                 let alignment = align_to(&demos, (0..demos.len()).collect(), &layout, params)?;
                 Self::from_alignment(&demos, alignment, params, layout)
             }
-            // The least criterion; a tie goes to the demonstration first in content order,
-            // so that the choice does not depend on the order of the input either.
-            Reference::Medoid => Ok(candidate_models(&demos, &layout, params)?
-                .into_iter()
-                .reduce(|best, c| {
-                    let closer = c.1.total_cmp(&best.1).then_with(|| {
-                        content_order(&demos[c.0.reference_idx()], &demos[best.0.reference_idx()])
-                    });
-                    if closer.is_lt() { c } else { best }
-                })
-                .expect("at least two demonstrations")
-                .0),
+            Reference::Medoid => medoid(&demos, candidate_models(&demos, &layout, params)?),
         }
     }
 
@@ -298,20 +353,28 @@ impl TaskModel {
         Self::fit_from_warps(&ordered, warps, params, layout, non_rate_ranges)
     }
 
-    /// The medoid's criterion for every demonstration, in input order: the time average of
+    /// The medoid's criterion for every demonstration, in input order: the median of
     /// `σ²_D` (Eq. 6) of the model fitted with it as the reference (all the others aligned
-    /// to it with the weights it would have as the reference). [`Reference::Medoid`] picks
-    /// the smallest; how far apart the values are says how clear that choice is. Ignores
+    /// to it with the weights it would have as the reference); infinite for a candidate on
+    /// whose time axis another demonstration looks cut off (refused as the medoid refuses). [`Reference::Medoid`] picks the
+    /// smallest; how far apart the values are says how clear that choice is. Ignores
     /// [`FitParams::reference`].
     ///
     /// # Errors
-    /// As [`TaskModel::fit`].
+    /// As [`TaskModel::fit`] (a demonstration cut off whatever the reference included).
     pub fn reference_costs(demos: &[Demonstration], params: &FitParams) -> Result<Vec<f64>> {
         let (demos, layout) = checked(demos, params)?;
-        Ok(candidate_models(&demos, &layout, params)?
-            .into_iter()
-            .map(|(_, criterion)| criterion)
-            .collect())
+        let candidates = candidate_models(&demos, &layout, params)?;
+        let costs = candidates
+            .iter()
+            .map(|c| {
+                c.as_ref()
+                    .map_or(f64::INFINITY, |(_, criterion)| *criterion)
+            })
+            .collect();
+        // The medoid's refusals are the costs' too.
+        medoid(&demos, candidates)?;
+        Ok(costs)
     }
 
     /// The warp (reference sample → sample of `demo`, `n_ref()` values) with which a fit with
@@ -427,6 +490,7 @@ impl TaskModel {
             scatter: stats.scatter,
             grad_min: stats.grad_min,
             grad_max: stats.grad_max,
+            rate_term: super::RateTerm::Relative,
         };
         Ok(Self::from_data(data))
     }

@@ -332,6 +332,15 @@ impl TaskModel {
     pub(super) fn add_rate_terms(&mut self) {
         let data = &self.data;
         let d = data.layout.dim();
+        if data.rate_term == super::RateTerm::Absolute {
+            // The models saved before the relative term: `var_n(ψ̇) / r_rate²` per sample.
+            let pl = packed_len(d);
+            let inv = 1.0 / (data.ranges[d - 1] * data.ranges[d - 1] * (data.count - 1) as f64);
+            for (n, s2) in self.sigma2_d.iter_mut().enumerate() {
+                *s2 += data.scatter[n * pl + packed_idx(d, d - 1, d - 1)] * inv;
+            }
+            return;
+        }
         let terms = rate_terms(
             &data.scatter,
             &data.tangent_mean,
