@@ -46,7 +46,8 @@ pub(crate) struct FitDefaultsArgs {
     /// Only this family (default: all eight).
     #[arg(long)]
     family: Option<String>,
-    /// Write the default fit's per-sample detail of one task, `FAMILY:SEED`.
+    /// Write the default fit's per-sample detail of one task, `FAMILY:SEED`, or of every task
+    /// measured, `all`.
     #[arg(long)]
     detail: Option<String>,
     /// Output folder (created if missing). Default: results/ in the workspace.
@@ -263,12 +264,14 @@ fn measure_task(task: &ZooTask, detail: Option<&PathBuf>) -> anyhow::Result<Task
     let write = |view: &FitView, model: &TaskModel, conf: &Confidence| {
         let progress = &task.progress[view.reference_demo];
         let need: Vec<f64> = progress.iter().map(|&p| task.need_at(p)).collect();
+        let variable = task.variable(view.reference_demo);
         let name = format!("{}_{}", task.family, task.seed);
         write_detail(
             detail.expect("called with a folder"),
             &name,
             progress,
             &need,
+            &variable,
             model,
             conf,
         )
@@ -312,11 +315,13 @@ fn measure_sanding(detail: Option<&PathBuf>) -> anyhow::Result<TaskRow> {
             .iter()
             .map(|l| f64::from(u8::from(needs_help(l))))
             .collect();
+        let variable = truth.variable(view.reference_demo);
         write_detail(
             detail.expect("called with a folder"),
             "sanding",
             &progress,
             &need,
+            &variable,
             model,
             conf,
         )
@@ -338,26 +343,29 @@ fn measure_sanding(detail: Option<&PathBuf>) -> anyhow::Result<TaskRow> {
     })
 }
 
-/// The default fit's per-sample detail: reference progress, need, `σ²_D`, its rate term and
-/// the confidence.
+/// The default fit's per-sample detail: reference progress, need, whether the sample lies on a
+/// variable span, `σ²_D`, its rate term (the gradients' variance over the squared rate range,
+/// before the local pace and the filter) and the confidence.
 fn write_detail(
     dir: &std::path::Path,
     name: &str,
     progress: &[f64],
     need: &[f64],
+    variable: &[bool],
     model: &TaskModel,
     conf: &Confidence,
 ) -> anyhow::Result<()> {
     let d = model.tangent_names().len();
     let rate_range = model.ranges()[d - 1];
-    let mut text = String::from("n,progress,need,sigma2_d,rate_term,grad_mean,high\n");
+    let mut text = String::from("n,progress,need,variable,sigma2_d,rate_term,grad_mean,high\n");
     for n in 0..model.n_ref() {
         let cov = model.covariance(n);
         let rate_term = cov[d * d - 1] / (rate_range * rate_range);
         text.push_str(&format!(
-            "{n},{:.6},{},{:.6e},{:.6e},{:.4},{}\n",
+            "{n},{:.6},{},{},{:.6e},{:.6e},{:.4},{}\n",
             progress[n],
             need[n],
+            u8::from(variable[n]),
             model.sigma2_d()[n],
             rate_term,
             model.grad_mean()[n],
@@ -432,6 +440,7 @@ pub(crate) fn run(args: &FitDefaultsArgs) -> anyhow::Result<()> {
         None => tandem_zoo::families().iter().collect(),
     };
     let detail: Option<(String, u64)> = match &args.detail {
+        Some(spec) if spec == "all" => None,
         Some(spec) => {
             let (family, seed) = spec
                 .split_once(':')
@@ -457,9 +466,10 @@ pub(crate) fn run(args: &FitDefaultsArgs) -> anyhow::Result<()> {
         let mut rows = Vec::new();
         for seed in seeds.clone() {
             let task = (family.generate)(seed)?;
-            let want_detail = detail
-                .as_ref()
-                .is_some_and(|(f, s)| f == family.name && *s == seed);
+            let want_detail = args.detail.as_deref() == Some("all")
+                || detail
+                    .as_ref()
+                    .is_some_and(|(f, s)| f == family.name && *s == seed);
             let row = measure_task(&task, want_detail.then_some(&out))?;
             eprintln!(
                 "{} seed {seed}: {} demos, HC first {:.1}–{:.1} %, medoid {:.1} %, default {:.1} % \
