@@ -401,11 +401,13 @@ def cyclic_plan(
     *,
     runnable_only: bool = True,
     order: Optional[Sequence[Tuple[int, int]]] = None,
+    tick_s: Optional[float] = None,
 ) -> CyclicPlan:
     """The cyclic plan of ``robots`` robots on ``problem`` (every order searched up to
     ``max_enumerated``, default 100 000; a local search beyond); ``runnable_only``: only
     orders :meth:`CyclicPlan.coordinator` can run; ``order``: the plan of that order, no
-    search."""
+    search; ``tick_s``: the control tick of the cell that will run it, to count the token
+    rule's hand-overs (:meth:`Planner.cyclic_plan` uses the planner's)."""
 
 class ContinuousCoordinator:
     """The Rust run-time coordinator of a continuous cell (the token rule), one control tick

@@ -5,7 +5,6 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use serde_json::json;
 use tandem::bag::{
     BagOptions, ExecutionOptions, Existing, Recording, Role, RunWriter, bag_file, count_rounds,
     extend_schema, inspect, is_bag, read_bag, read_executions,
@@ -150,26 +149,31 @@ pub(crate) fn inspect_bag(path: &Path, as_json: bool) -> Result<()> {
     let topics = inspect(path)?;
     let rounds = count_rounds(path)?;
     if as_json {
-        let list: Vec<_> = topics
-            .iter()
-            .map(|t| {
-                json!({
-                    "topic": t.topic,
-                    "type": t.schema,
-                    "supported": t.msg_type.is_some(),
-                    "messages": t.messages,
-                    "channels": t.channels,
-                    "median_period_s": t.median_period_s,
-                    "period_s": t.period_s,
-                    "start_s": t.span_s.map(|s| s.0),
-                    "end_s": t.span_s.map(|s| s.1),
-                    "time": if t.log_time { "log time" } else { "header stamp" },
-                    "role": t.role.name(),
+        let doc = crate::json::BagDoc {
+            bag: path.display().to_string(),
+            rounds,
+            topics: topics
+                .iter()
+                .map(|t| crate::json::BagTopicOut {
+                    topic: t.topic.clone(),
+                    r#type: t.schema.clone(),
+                    supported: t.msg_type.is_some(),
+                    messages: t.messages,
+                    channels: t.channels.clone(),
+                    median_period_s: t.median_period_s,
+                    period_s: t.period_s,
+                    start_s: t.span_s.map(|s| s.0),
+                    end_s: t.span_s.map(|s| s.1),
+                    time: if t.log_time {
+                        "log time"
+                    } else {
+                        "header stamp"
+                    },
+                    role: t.role.name(),
                 })
-            })
-            .collect();
-        let doc = json!({"bag": path.display().to_string(), "rounds": rounds, "topics": list});
-        out(&serde_json::to_string_pretty(&doc)?);
+                .collect(),
+        };
+        out(&serde_json::to_string_pretty(&crate::json::value(&doc)?)?);
         return Ok(());
     }
     out(&format!("bag {}: {} topics", path.display(), topics.len()));

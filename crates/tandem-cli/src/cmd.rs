@@ -3,7 +3,6 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use serde_json::json;
 use tandem::lfd::{Demonstration, Execution, HoldSpec, PeriodSource, Reference, TaskModel};
 use tandem::planner::reschedule_seed;
 use tandem::schedule::SamplerParams;
@@ -12,7 +11,8 @@ use tandem::{ExecutionRecord, Planner, PlannerParams};
 use crate::cli::{
     CellArg, Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
 };
-use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_json, source_name};
+use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_doc, source_name};
+use crate::json;
 use crate::{bag, cyclic, input, need, plot, sim, state_io};
 
 /// Whether `--verbose` was given: the full lists instead of their summaries. Set once by
@@ -458,28 +458,25 @@ fn hold_run_text(r: &HoldRun, dt: f64) -> String {
 
 /// `tandem inspect --json`'s `holds`: the declaration, the resolved samples and their
 /// stretches.
-fn holds_json(planner: &Planner) -> serde_json::Value {
+fn holds_out(planner: &Planner) -> json::HoldsOut {
     let dt = planner.model().dt_s();
     let conf = planner.problem().conf();
     let holds = planner.problem().holds();
-    let runs: Vec<_> = hold_runs(planner)
-        .iter()
-        .map(|r| {
-            json!({
-                "ref_start": r.start,
-                "ref_last": r.last,
-                "start_s": r.start as f64 * dt,
-                "last_s": r.last as f64 * dt,
-                "active": r.active,
+    json::HoldsOut {
+        declared: json::HoldSpecOut::from(&planner.params().holds),
+        samples: holds.to_vec(),
+        active_samples: holds.iter().filter(|&&n| conf[n]).count(),
+        stretches: hold_runs(planner)
+            .iter()
+            .map(|r| json::HoldStretchOut {
+                ref_start: r.start,
+                ref_last: r.last,
+                start_s: r.start as f64 * dt,
+                last_s: r.last as f64 * dt,
+                active: r.active,
             })
-        })
-        .collect();
-    json!({
-        "declared": serde_json::to_value(&planner.params().holds).unwrap_or_default(),
-        "samples": holds,
-        "active_samples": holds.iter().filter(|&&n| conf[n]).count(),
-        "stretches": runs,
-    })
+            .collect(),
+    }
 }
 
 /// The hold-point lines of `fit`, `record` and `inspect`; nothing without a declaration.
@@ -638,10 +635,12 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
             .with_context(|| format!("cannot save the schedule into {}", a.state.display()))?;
     }
     if a.json {
-        let mut doc = schedule_json(planner.problem(), planner.outcome())?;
-        doc["saved"] = json!(a.save);
-        doc["previous_t_total_s"] = json!(previous_t_total_s);
-        out(&serde_json::to_string_pretty(&doc)?);
+        let doc = json::ScheduleDoc {
+            saved: Some(a.save),
+            previous_t_total_s: Some(previous_t_total_s),
+            ..schedule_doc(planner.problem(), planner.outcome())?
+        };
+        out(&serde_json::to_string_pretty(&json::value(&doc)?)?);
     } else {
         out(&gantt_text(planner.problem(), planner.outcome())?);
         out(&format!(
@@ -810,52 +809,55 @@ fn inspect(a: &InspectArgs) -> Result<()> {
     let explained = planner
         .explain_low_confidence()
         .context("cannot explain the low-confidence regions")?;
-    let regions = serde_json::to_value(&explained)?;
     let rates = planner.error_rates()?;
     let prior_threshold = tandem::confidence::prior_low_threshold(conf.params())?;
-    let ranges: serde_json::Map<_, _> = model
+    let ranges = model
         .tangent_names()
         .iter()
         .zip(model.ranges())
-        .map(|(n, r)| (n.clone(), json!(r)))
+        .map(|(n, &r)| (n.clone(), r))
         .collect();
-    let doc = json!({
-        "state": a.state.display().to_string(),
-        "rounds_recorded": planner.rounds_recorded(),
-        // Deprecated duplicate of `rounds_recorded` (the two-robot name), kept one release.
-        "pairs_recorded": planner.rounds_recorded(),
-        "model": {
-            "channels": model.channel_names(),
-            "reference": {
-                "choice": planner.params().fit.reference.to_string(),
-                "demo_idx": model.reference_idx(),
+    let doc = json::InspectDoc {
+        state: a.state.display().to_string(),
+        rounds_recorded: planner.rounds_recorded(),
+        pairs_recorded: planner.rounds_recorded(),
+        model: json::ModelOut {
+            channels: model.channel_names().to_vec(),
+            reference: json::ReferenceOut {
+                choice: planner.params().fit.reference.to_string(),
+                demo_idx: model.reference_idx(),
             },
-            "n_ref": model.n_ref(),
-            "dt_s": dt,
-            "reference_duration_s": model.n_ref() as f64 * dt,
-            "count": model.count(),
-            "correction_components": model.n_components(),
-            "ranges": ranges,
-            "sigma2_d": {"min": q(0.0), "median": q(0.5), "p90": q(0.9), "max": q(1.0)},
-            "mean_duration_s": model.grad_mean().iter().sum::<f64>() * dt,
-            "fastest_duration_s": model.grad_min().iter().sum::<f64>() * dt,
-            "slowest_duration_s": model.grad_max().iter().sum::<f64>() * dt,
+            n_ref: model.n_ref(),
+            dt_s: dt,
+            reference_duration_s: model.n_ref() as f64 * dt,
+            count: model.count(),
+            correction_components: model.n_components(),
+            ranges,
+            sigma2_d: json::QuantilesOut {
+                min: q(0.0),
+                median: q(0.5),
+                p90: q(0.9),
+                max: q(1.0),
+            },
+            mean_duration_s: model.grad_mean().iter().sum::<f64>() * dt,
+            fastest_duration_s: model.grad_min().iter().sum::<f64>() * dt,
+            slowest_duration_s: model.grad_max().iter().sum::<f64>() * dt,
         },
-        "confidence": {
-            "params": serde_json::to_value(conf.params())?,
-            "high_share": conf.high_share(),
-            "n_high": conf.n_high(),
-            "low_regions": regions,
-            "error_rates": serde_json::to_value(rates)?,
-            "sigma2_d_prior_threshold": prior_threshold,
-            "total_supervised": obs.total_supervised(),
-            "total_corrections": obs.total_corrections(),
+        confidence: json::ConfidenceOut {
+            params: json::ConfidenceParamsOut::from(conf.params()),
+            high_share: conf.high_share(),
+            n_high: conf.n_high(),
+            low_regions: explained.iter().map(json::LowRegionOut::from).collect(),
+            error_rates: json::ErrorRatesOut::from(rates),
+            sigma2_d_prior_threshold: prior_threshold,
+            total_supervised: obs.total_supervised(),
+            total_corrections: obs.total_corrections(),
         },
-        "schedule": schedule_json(planner.problem(), planner.outcome())?,
-        "holds": holds_json(&planner),
-    });
+        schedule: schedule_doc(planner.problem(), planner.outcome())?,
+        holds: holds_out(&planner),
+    };
     if a.json {
-        out(&serde_json::to_string_pretty(&doc)?);
+        out(&serde_json::to_string_pretty(&json::value(&doc)?)?);
         return Ok(());
     }
     out(&format!("state file {}", a.state.display()));
@@ -875,13 +877,7 @@ fn inspect(a: &InspectArgs) -> Result<()> {
     ));
     out(&format!(
         "  execution length: mean {:.2} s, fastest {:.2} s, slowest {:.2} s (demonstrated speed bounds)",
-        doc["model"]["mean_duration_s"].as_f64().unwrap_or(f64::NAN),
-        doc["model"]["fastest_duration_s"]
-            .as_f64()
-            .unwrap_or(f64::NAN),
-        doc["model"]["slowest_duration_s"]
-            .as_f64()
-            .unwrap_or(f64::NAN),
+        doc.model.mean_duration_s, doc.model.fastest_duration_s, doc.model.slowest_duration_s,
     ));
     let ranges_txt: Vec<String> = model
         .tangent_names()

@@ -34,10 +34,18 @@ pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
     }
     let planner = crate::state_io::load(&a.state)?;
     let problem = planner.problem();
-    let plan = cyclic_plan(problem, planner.n_robots(), &CyclicParams::default())
+    // The cell runs at the schedule's control tick: the plan counts the token rule's
+    // hand-overs at it, so its period is what the cell does with the planned operator.
+    let params = CyclicParams {
+        handover_tick_s: Some(planner.schedule().tick_s),
+        ..CyclicParams::default()
+    };
+    let plan = cyclic_plan(problem, planner.n_robots(), &params)
         .with_context(|| format!("{file}: cannot compute the cyclic plan"))?;
     if a.json {
-        out(&serde_json::to_string_pretty(&plan)?);
+        out(&serde_json::to_string_pretty(
+            &crate::json::CyclicPlanOut::from(&plan),
+        )?);
     } else {
         out(&plan_text(problem, &plan, crate::cmd::verbose())?);
     }

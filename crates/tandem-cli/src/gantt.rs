@@ -3,7 +3,8 @@
 use std::fmt::Write as _;
 
 use anyhow::Result;
-use serde_json::{Value, json};
+
+use crate::json::{AfterOut, LcIntervalOut, ScheduleDoc, ScheduleHoldOut, ScheduleOut};
 use tandem::realtime::{After, Timeline, tol};
 use tandem::schedule::{LcInterval, Outcome, Problem, Schedule, Source};
 
@@ -202,73 +203,72 @@ fn sorted_intervals(layout: &Layout) -> Vec<(usize, LcInterval)> {
     out
 }
 
-/// The schedule's holds as JSON (robots 1-based, times in global s).
-fn holds_json(layout: &Layout, dt_s: f64) -> Vec<Value> {
+/// The schedule's holds for JSON (robots 1-based, times in global s).
+fn holds_out(layout: &Layout, dt_s: f64) -> Vec<ScheduleHoldOut> {
     layout
         .dwells
         .iter()
-        .map(|d| {
-            let after: Vec<Value> = d
+        .map(|d| ScheduleHoldOut {
+            robot: d.robot + 1,
+            ref_idx: d.ref_idx,
+            ref_s: d.ref_idx as f64 * dt_s,
+            start_s: d.start_s,
+            end_s: d.end_s,
+            dwell_s: d.end_s - d.start_s,
+            after: d
                 .after
                 .iter()
-                .map(|a| json!({"robot": a.robot + 1, "ref_idx": a.ref_idx}))
-                .collect();
-            json!({
-                "robot": d.robot + 1,
-                "ref_idx": d.ref_idx,
-                "ref_s": d.ref_idx as f64 * dt_s,
-                "start_s": d.start_s,
-                "end_s": d.end_s,
-                "dwell_s": d.end_s - d.start_s,
-                "after": after,
-            })
+                .map(|a| AfterOut {
+                    robot: a.robot + 1,
+                    ref_idx: a.ref_idx,
+                })
+                .collect(),
         })
         .collect()
 }
 
-/// The schedule as JSON: robot count, offsets, per-robot gradients and durations,
-/// low-confidence intervals in global time, `T_total` and its certificate (the margin-free lower bound, whether it is the proven
-/// optimum, the gap) (all times in seconds of global time; gradients in execution samples per
-/// reference sample). `schedule` is exactly `tandem::schedule::Schedule`'s serde form.
-pub(crate) fn schedule_json(problem: &Problem, outcome: &Outcome) -> Result<Value> {
+/// The schedule as JSON ([`ScheduleDoc`]): robot count, offsets, per-robot gradients and
+/// durations, low-confidence intervals in global time, `T_total` and its certificate (the
+/// margin-free lower bound, whether it is the proven optimum, the gap) (all times in seconds
+/// of global time; gradients in execution samples per reference sample).
+pub(crate) fn schedule_doc(problem: &Problem, outcome: &Outcome) -> Result<ScheduleDoc> {
     let layout = Layout::new(problem, &outcome.schedule)?;
     let dt = problem.dt_s();
-    let intervals: Vec<Value> = sorted_intervals(&layout)
+    let s = &outcome.schedule;
+    let lc_intervals = sorted_intervals(&layout)
         .iter()
-        .map(|(robot, iv)| {
-            json!({
-                "robot": robot + 1,
-                "ref_start": iv.ref_start,
-                "ref_end": iv.ref_end,
-                "start_s": iv.start_s,
-                "end_s": iv.end_s,
-            })
+        .map(|(robot, iv)| LcIntervalOut {
+            robot: robot + 1,
+            ref_start: iv.ref_start,
+            ref_end: iv.ref_end,
+            start_s: iv.start_s,
+            end_s: iv.end_s,
         })
         .collect();
-    let s = &outcome.schedule;
-    let mut doc = json!({
-        "t_total_s": outcome.t_total_s,
-        "lower_bound_s": outcome.lower_bound_s,
-        "bound_is_optimum": outcome.bound_is_optimum,
-        "gap": outcome.gap,
-        "serial_t_total_s": serial_t_total_s(problem, s.n_robots(), s.tick_s)?,
-        "n_robots": s.n_robots(),
-        "offset_s": s.offsets_s.first(),
-        "offsets_s": s.offsets_s,
-        "durations_s": s.durations_s(dt),
-        "dt_s": dt,
-        "tick_s": s.tick_s,
-        "n_ref": problem.n_ref(),
-        "source": source_name(&outcome.source),
-        "lc_intervals": intervals,
-        "schedule": serde_json::to_value(s)?,
-    });
-    if s.has_holds() {
-        // Only with holds, so that a schedule without them prints as before hold points.
-        doc["holds"] = json!(holds_json(&layout, dt));
-        doc["dwells_s"] = json!((0..s.n_robots()).map(|i| s.dwell_s(i)).collect::<Vec<_>>());
-    }
-    Ok(doc)
+    // Holds and dwells only with holds, so that a schedule without them prints as before
+    // hold points.
+    let with_holds = s.has_holds();
+    Ok(ScheduleDoc {
+        t_total_s: outcome.t_total_s,
+        lower_bound_s: outcome.lower_bound_s,
+        bound_is_optimum: outcome.bound_is_optimum,
+        gap: outcome.gap,
+        serial_t_total_s: serial_t_total_s(problem, s.n_robots(), s.tick_s)?,
+        n_robots: s.n_robots(),
+        offset_s: s.offsets_s.first().copied(),
+        offsets_s: s.offsets_s.clone(),
+        durations_s: s.durations_s(dt),
+        dt_s: dt,
+        tick_s: s.tick_s,
+        n_ref: problem.n_ref(),
+        source: source_name(&outcome.source),
+        lc_intervals,
+        schedule: ScheduleOut::from(s),
+        holds: with_holds.then(|| holds_out(&layout, dt)),
+        dwells_s: with_holds.then(|| (0..s.n_robots()).map(|i| s.dwell_s(i)).collect()),
+        saved: None,
+        previous_t_total_s: None,
+    })
 }
 
 /// The text Gantt chart: one bar per robot over `[0, T_total]` (`=` running high-confidence,

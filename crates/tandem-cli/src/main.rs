@@ -25,6 +25,7 @@ mod cmd;
 mod cyclic;
 mod gantt;
 mod input;
+mod json;
 mod need;
 mod plot;
 mod sim;

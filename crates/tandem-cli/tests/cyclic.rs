@@ -19,9 +19,15 @@ fn s(p: &Path) -> String {
 }
 
 /// The plan `cyclic_plan` computes for the state file's problem and robot count.
+/// The plan `tandem schedule --cell continuous` shows: the token rule's hand-overs counted
+/// at the schedule's control tick, the tick the cell runs at.
 fn plan_of(state: &Path) -> CyclicPlan {
     let p = Planner::load(state).expect("the state loads");
-    cyclic_plan(p.problem(), p.n_robots(), &CyclicParams::default()).expect("a cyclic plan")
+    let params = CyclicParams {
+        handover_tick_s: Some(p.schedule().tick_s),
+        ..CyclicParams::default()
+    };
+    cyclic_plan(p.problem(), p.n_robots(), &params).expect("a cyclic plan")
 }
 
 /// The number after `prefix` in `text` (up to the next space), and how many decimals it has.

@@ -5,41 +5,11 @@
 mod common;
 
 use common::*;
-use serde::{Deserialize, Serialize};
-use tandem::PlannerParams;
-use tandem::confidence::{Confidence, Observations};
-use tandem::lfd::{Demonstration, TaskModel};
 use tandem::planner::state;
-use tandem::schedule::{Outcome, validate};
+use tandem::schedule::{Schedule, validate};
 
 fn s(p: &std::path::Path) -> String {
     p.display().to_string()
-}
-
-/// The state file's payload, field for field (the current state format, the outcome in the state
-/// file's form): the test edits its schedule.
-/// A change of the format makes `state::load` fail here, loudly.
-#[derive(Serialize, Deserialize)]
-struct Payload {
-    params: PlannerParams,
-    model: TaskModel,
-    observations: Observations,
-    confidence: Confidence,
-    #[serde(with = "state::outcome_form")]
-    outcome: Outcome,
-    rounds_recorded: usize,
-    rounds: Vec<u64>,
-    reference: Option<Demonstration>,
-    records: Vec<Vec<Record>>,
-}
-
-/// A recorded execution as the state file keeps it (format 11).
-#[derive(Serialize, Deserialize)]
-struct Record {
-    demonstration: Demonstration,
-    ref_time_log: Vec<f64>,
-    supervised: Vec<bool>,
-    corrected: Vec<bool>,
 }
 
 #[test]
@@ -51,14 +21,16 @@ fn an_edited_schedule_that_fails_the_check_is_replaced_with_a_notice() {
     ok(&out);
     assert!(!String::from_utf8_lossy(&out.stderr).contains("notice"));
     // Robot 2 starts with robot 1: both low-confidence at once (Eq. 20, constraint 3).
-    let mut payload: Payload = state::load(&state_path).unwrap();
+    // Edited through the planner's wire types of the state file (`state::v11`).
+    let (mut payload, extras) = state::load_payload(&state_path).unwrap();
     let problem = tandem::Planner::load(&state_path)
         .unwrap()
         .problem()
         .clone();
     payload.outcome.schedule.offsets_s = vec![0.0];
-    assert!(validate(&problem, &payload.outcome.schedule).is_err());
-    state::save(&state_path, &payload).unwrap();
+    let edited_schedule = Schedule::from(payload.outcome.schedule.clone());
+    assert!(validate(&problem, &edited_schedule).is_err());
+    state::save_payload(&state_path, &payload, &extras).unwrap();
     let edited = std::fs::read(&state_path).unwrap();
 
     // A read-only command runs the replacement and says why; the file is unchanged.

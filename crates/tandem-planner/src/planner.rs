@@ -10,16 +10,14 @@ use serde::{Deserialize, Serialize};
 use tandem_confidence::{
     Confidence, ConfidenceParams, ErrorRates, Observations, estimate_error_rates,
 };
-use tandem_lfd::{
-    ChannelSchema, Demonstration, Execution, FitParams, HoldSpec, Reference, Regridded, TaskModel,
-};
+use tandem_lfd::{Demonstration, Execution, FitParams, HoldSpec, Regridded, TaskModel};
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
-    CheckedSchedule, Outcome, PreviousFate, Problem, SamplerParams, SamplerStats, Schedule, Source,
+    CheckedSchedule, Outcome, PreviousFate, Problem, SamplerParams, Schedule, Source,
     sample_schedule_n, validate,
 };
 
-use crate::state::{Stamp, StateLock};
+use crate::state::{PlannerState, Stamp, StateLock};
 use crate::{Error, Result, derive_seed, state};
 
 /// Correction flags of the samples of a log put on a new grid. Supervision is a state: read
@@ -402,464 +400,6 @@ pub struct Planner {
     origin: Origin,
     /// Set by [`Planner::load`] when it replaced a stored schedule that failed the check.
     load_notice: Option<String>,
-}
-
-/// The serialized part of a [`Planner`] (the problem is rebuilt on load).
-#[derive(Serialize, Deserialize)]
-struct PlannerState {
-    params: PlannerParams,
-    model: TaskModel,
-    observations: Observations,
-    confidence: Confidence,
-    #[serde(with = "state::outcome_form")]
-    outcome: Outcome,
-    pairs_recorded: usize,
-    rounds: Vec<u64>,
-    reference: Option<Demonstration>,
-    records: Vec<Vec<StoredRecord>>,
-}
-
-/// An [`ExecutionRecord`] as the state file keeps it (format 11).
-#[derive(Serialize, Deserialize)]
-struct StoredRecord {
-    demonstration: Demonstration,
-    ref_time_log: Vec<f64>,
-    supervised: Vec<bool>,
-    corrected: Vec<bool>,
-}
-
-impl From<&ExecutionRecord> for StoredRecord {
-    fn from(r: &ExecutionRecord) -> Self {
-        StoredRecord {
-            demonstration: r.execution.demonstration.clone(),
-            ref_time_log: r.execution.ref_time_log.clone(),
-            supervised: r.supervised.clone(),
-            corrected: r.corrected.clone(),
-        }
-    }
-}
-
-impl From<StoredRecord> for ExecutionRecord {
-    fn from(r: StoredRecord) -> Self {
-        ExecutionRecord {
-            execution: Execution {
-                demonstration: r.demonstration,
-                ref_time_log: r.ref_time_log,
-            },
-            supervised: r.supervised,
-            corrected: r.corrected,
-        }
-    }
-}
-
-/// `tandem_warp::WarpParams` as state formats 4 to 8 wrote them: without `smooth_width` and
-/// `fill_length`.
-#[derive(Deserialize)]
-struct WarpParamsV8 {
-    n_nodes: Option<usize>,
-    n_candidates: usize,
-    lambda_inst: f64,
-    lambda_cum: f64,
-    slope_min: f64,
-    slope_max: f64,
-    refinements: usize,
-    refine_radius: f64,
-    max_jump: Option<usize>,
-    coarse_nodes: usize,
-    coarse_candidates: usize,
-    weights: Option<Vec<f64>>,
-}
-
-/// `tandem_warp::WarpParams` as state format 9 wrote them: format 8's fields, then
-/// `smooth_width` (postcard writes a nested struct as its fields in order, so nesting
-/// [`WarpParamsV8`] reads the same bytes), without `fill_length`.
-#[derive(Deserialize)]
-struct WarpParamsV9 {
-    v8: WarpParamsV8,
-    smooth_width: usize,
-}
-
-impl From<WarpParamsV9> for tandem_warp::WarpParams {
-    /// The saved parameters with `fill_length = 0`: flat stretches were not filled (the
-    /// alignment the file's model was fitted with).
-    fn from(v9: WarpParamsV9) -> Self {
-        let w = v9.v8;
-        tandem_warp::WarpParams {
-            n_nodes: w.n_nodes,
-            n_candidates: w.n_candidates,
-            lambda_inst: w.lambda_inst,
-            lambda_cum: w.lambda_cum,
-            slope_min: w.slope_min,
-            slope_max: w.slope_max,
-            refinements: w.refinements,
-            refine_radius: w.refine_radius,
-            max_jump: w.max_jump,
-            coarse_nodes: w.coarse_nodes,
-            coarse_candidates: w.coarse_candidates,
-            weights: w.weights,
-            smooth_width: v9.smooth_width,
-            fill_length: 0.0,
-        }
-    }
-}
-
-impl From<WarpParamsV8> for tandem_warp::WarpParams {
-    /// The saved parameters with `smooth_width = 1` and `fill_length = 0`: the signals were
-    /// aligned unsmoothed and unfilled (the alignment the file's model was fitted with).
-    fn from(v8: WarpParamsV8) -> Self {
-        WarpParamsV9 {
-            v8,
-            smooth_width: 1,
-        }
-        .into()
-    }
-}
-
-/// [`FitParams`] as state formats 4 to 9 wrote them, with the warp parameters `W` of that
-/// format ([`WarpParamsV8`], [`WarpParamsV9`]).
-#[derive(Deserialize)]
-struct FitParamsOld<W> {
-    warp: W,
-    ranges: Option<Vec<f64>>,
-    min_range: f64,
-    k_max: usize,
-    schema: ChannelSchema,
-    reference: Reference,
-}
-
-/// [`FitParams`] as state formats 4 to 8 wrote them.
-type FitParamsV8 = FitParamsOld<WarpParamsV8>;
-
-impl<W: Into<tandem_warp::WarpParams>> From<FitParamsOld<W>> for FitParams {
-    fn from(old: FitParamsOld<W>) -> Self {
-        FitParams {
-            warp: old.warp.into(),
-            ranges: old.ranges,
-            min_range: old.min_range,
-            k_max: old.k_max,
-            schema: old.schema,
-            reference: old.reference,
-        }
-    }
-}
-
-/// [`PlannerParams`] as state formats 8 and 9 wrote them: the fit's warp parameters of that
-/// format ([`FitParamsOld`]).
-#[derive(Deserialize)]
-struct PlannerParamsOld<F> {
-    fit: F,
-    confidence: ConfidenceParams,
-    sampler: SamplerParams,
-    holds: HoldSpec,
-}
-
-/// [`PlannerState`] as state formats 8 to 10 wrote it: [`PlannerParamsOld`], without the
-/// reference demonstration and the recorded executions (format 11).
-#[derive(Deserialize)]
-struct PlannerStateOld<F> {
-    params: PlannerParamsOld<F>,
-    model: TaskModel,
-    observations: Observations,
-    confidence: Confidence,
-    #[serde(with = "state::outcome_form")]
-    outcome: Outcome,
-    pairs_recorded: usize,
-    rounds: Vec<u64>,
-}
-
-/// [`PlannerState`] as state format 8 wrote it (the fit's warp without `smooth_width` and
-/// `fill_length`).
-type PlannerStateV8 = PlannerStateOld<FitParamsV8>;
-
-/// [`PlannerState`] as state format 9 wrote it (the fit's warp without `fill_length`).
-type PlannerStateV9 = PlannerStateOld<FitParamsOld<WarpParamsV9>>;
-
-/// [`PlannerState`] as state format 10 wrote it: today's parameters, without the reference
-/// demonstration and the recorded executions.
-type PlannerStateV10 = PlannerStateOld<FitParams>;
-
-impl<F: Into<FitParams>> From<PlannerStateOld<F>> for PlannerState {
-    fn from(old: PlannerStateOld<F>) -> Self {
-        PlannerState {
-            params: PlannerParams {
-                fit: old.params.fit.into(),
-                confidence: old.params.confidence,
-                sampler: old.params.sampler,
-                holds: old.params.holds,
-            },
-            model: old.model,
-            observations: old.observations,
-            confidence: old.confidence,
-            outcome: old.outcome,
-            pairs_recorded: old.pairs_recorded,
-            rounds: old.rounds,
-            reference: None,
-            records: Vec::new(),
-        }
-    }
-}
-
-/// The [`Schedule`] of state formats 5 to 7: without holds.
-#[derive(Deserialize)]
-struct ScheduleV7 {
-    grad_exec: Vec<Vec<f64>>,
-    offsets_s: Vec<f64>,
-    tick_s: f64,
-}
-
-/// [`Outcome`] as state formats 5 to 7 wrote it: the schedule without holds.
-#[derive(Deserialize)]
-struct OutcomeV7 {
-    schedule: ScheduleV7,
-    t_total_s: f64,
-    source: Source,
-    stats: SamplerStats,
-    lower_bound_s: f64,
-    bound_is_optimum: bool,
-    gap: f64,
-}
-
-impl From<OutcomeV7> for Outcome {
-    fn from(v7: OutcomeV7) -> Self {
-        Outcome {
-            schedule: Schedule {
-                grad_exec: v7.schedule.grad_exec,
-                offsets_s: v7.schedule.offsets_s,
-                tick_s: v7.schedule.tick_s,
-                holds: Vec::new(),
-            },
-            t_total_s: v7.t_total_s,
-            source: v7.source,
-            stats: v7.stats,
-            lower_bound_s: v7.lower_bound_s,
-            bound_is_optimum: v7.bound_is_optimum,
-            gap: v7.gap,
-            margin_free_s: None,
-            previous: PreviousFate::NotGiven,
-        }
-    }
-}
-
-/// [`PlannerParams`] as state format 7 wrote them: without hold points.
-#[derive(Deserialize)]
-struct PlannerParamsV7 {
-    fit: FitParamsV8,
-    confidence: ConfidenceParams,
-    sampler: SamplerParams,
-}
-
-/// [`PlannerState`] as state format version 7 wrote it: the parameters without hold points.
-#[derive(Deserialize)]
-struct PlannerStateV7 {
-    params: PlannerParamsV7,
-    model: TaskModel,
-    observations: Observations,
-    confidence: Confidence,
-    outcome: OutcomeV7,
-    pairs_recorded: usize,
-    rounds: Vec<u64>,
-}
-
-impl From<PlannerStateV7> for PlannerState {
-    /// The saved planner with no hold points (none could be declared then).
-    fn from(v7: PlannerStateV7) -> Self {
-        PlannerState {
-            params: PlannerParams {
-                fit: v7.params.fit.into(),
-                confidence: v7.params.confidence,
-                sampler: v7.params.sampler,
-                holds: HoldSpec::default(),
-            },
-            model: v7.model,
-            observations: v7.observations,
-            confidence: v7.confidence,
-            outcome: v7.outcome.into(),
-            pairs_recorded: v7.pairs_recorded,
-            rounds: v7.rounds,
-            reference: None,
-            records: Vec::new(),
-        }
-    }
-}
-
-/// [`ConfidenceParams`] as state formats 4 to 6 wrote them: the paper's model, without the
-/// operator's error rates.
-#[derive(Deserialize)]
-struct ConfidenceParamsV6 {
-    gamma_p: f64,
-    sigma2_max: f64,
-    epsilon: f64,
-    mu_c: f64,
-    gamma_c: f64,
-}
-
-impl From<ConfidenceParamsV6> for ConfidenceParams {
-    /// The saved parameters with both error rates 0 and not estimated: the model the file's
-    /// confidence was decided with.
-    fn from(v6: ConfidenceParamsV6) -> Self {
-        ConfidenceParams {
-            gamma_p: v6.gamma_p,
-            sigma2_max: v6.sigma2_max,
-            epsilon: v6.epsilon,
-            mu_c: v6.mu_c,
-            gamma_c: v6.gamma_c,
-            ..ConfidenceParams::paper()
-        }
-    }
-}
-
-/// [`PlannerParams`] as state formats 4 to 6 wrote them.
-#[derive(Deserialize)]
-struct PlannerParamsV6 {
-    fit: FitParamsV8,
-    confidence: ConfidenceParamsV6,
-    sampler: SamplerParams,
-}
-
-/// [`Confidence`] as state formats 4 to 6 wrote it.
-#[derive(Deserialize)]
-struct ConfidenceV6 {
-    params: ConfidenceParamsV6,
-    high: Vec<bool>,
-}
-
-/// [`Observations`] as state formats 4 to 6 wrote them (no evidence of misses).
-#[derive(Deserialize)]
-struct ObservationsV6 {
-    corrections: Vec<f64>,
-    supervised: Vec<f64>,
-}
-
-/// [`PlannerState`] as state format version 6 wrote it: the parts above in the paper's
-/// model.
-#[derive(Deserialize)]
-struct PlannerStateV6 {
-    params: PlannerParamsV6,
-    model: TaskModel,
-    observations: ObservationsV6,
-    confidence: ConfidenceV6,
-    outcome: OutcomeV7,
-    pairs_recorded: usize,
-    rounds: Vec<u64>,
-}
-
-impl TryFrom<PlannerStateV6> for PlannerState {
-    type Error = Error;
-    fn try_from(v6: PlannerStateV6) -> Result<Self> {
-        Ok(PlannerState {
-            params: PlannerParams {
-                fit: v6.params.fit.into(),
-                confidence: v6.params.confidence.into(),
-                sampler: v6.params.sampler,
-                holds: HoldSpec::default(),
-            },
-            model: v6.model,
-            observations: Observations::from_counts(
-                v6.observations.corrections,
-                v6.observations.supervised,
-            )?,
-            confidence: Confidence::from_parts(v6.confidence.params.into(), v6.confidence.high)?,
-            outcome: v6.outcome.into(),
-            pairs_recorded: v6.pairs_recorded,
-            rounds: v6.rounds,
-            reference: None,
-            records: Vec::new(),
-        })
-    }
-}
-
-/// [`PlannerState`] as state format version 5 wrote it: version 6 without the round
-/// fingerprints.
-#[derive(Deserialize)]
-struct PlannerStateV5 {
-    params: PlannerParamsV6,
-    model: TaskModel,
-    observations: ObservationsV6,
-    confidence: ConfidenceV6,
-    outcome: OutcomeV7,
-    pairs_recorded: usize,
-}
-
-impl From<PlannerStateV5> for PlannerStateV6 {
-    fn from(v5: PlannerStateV5) -> Self {
-        PlannerStateV6 {
-            params: v5.params,
-            model: v5.model,
-            observations: v5.observations,
-            confidence: v5.confidence,
-            outcome: v5.outcome,
-            pairs_recorded: v5.pairs_recorded,
-            rounds: Vec::new(),
-        }
-    }
-}
-
-/// [`PlannerState`] as state format version 4 wrote it: version 5 but for the two-robot
-/// schedule ([`ScheduleV4`]).
-#[derive(Deserialize)]
-struct PlannerStateV4 {
-    params: PlannerParamsV6,
-    model: TaskModel,
-    observations: ObservationsV6,
-    confidence: ConfidenceV6,
-    outcome: OutcomeV4,
-    pairs_recorded: usize,
-}
-
-/// [`Outcome`] as state format version 4 wrote it (field for field, the schedule
-/// [`ScheduleV4`]).
-#[derive(Deserialize)]
-struct OutcomeV4 {
-    schedule: ScheduleV4,
-    t_total_s: f64,
-    source: Source,
-    stats: SamplerStats,
-    lower_bound_s: f64,
-    bound_is_optimum: bool,
-    gap: f64,
-}
-
-/// The two-robot [`Schedule`] of state format version 4: two warps and robot 2's offset.
-#[derive(Deserialize)]
-struct ScheduleV4 {
-    grad_exec: [Vec<f64>; 2],
-    offset_s: f64,
-    tick_s: f64,
-}
-
-impl From<PlannerStateV4> for PlannerStateV6 {
-    fn from(v4: PlannerStateV4) -> Self {
-        let OutcomeV4 {
-            schedule,
-            t_total_s,
-            source,
-            stats,
-            lower_bound_s,
-            bound_is_optimum,
-            gap,
-        } = v4.outcome;
-        PlannerStateV6 {
-            params: v4.params,
-            model: v4.model,
-            observations: v4.observations,
-            confidence: v4.confidence,
-            outcome: OutcomeV7 {
-                schedule: ScheduleV7 {
-                    grad_exec: Vec::from(schedule.grad_exec),
-                    offsets_s: vec![schedule.offset_s],
-                    tick_s: schedule.tick_s,
-                },
-                t_total_s,
-                source,
-                stats,
-                lower_bound_s,
-                bound_is_optimum,
-                gap,
-            },
-            pairs_recorded: v4.pairs_recorded,
-            rounds: Vec::new(),
-        }
-    }
 }
 
 /// The scheduling problem for the current model and confidence (Eq. 12, 14).
@@ -1482,7 +1022,7 @@ impl Planner {
                 Err(e) => return Err(e),
             }
         }
-        let bytes = state::encode(&self.to_state())?;
+        let bytes = state::encode_state(&self.to_state())?;
         state::write_atomic(path, &bytes)?;
         if let Some(stamp) = state::stamp_of(&bytes) {
             self.origin.set(here, stamp);
@@ -1507,7 +1047,7 @@ impl Planner {
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let bytes = state::read(path)?;
-        let st = Self::decode_state(&bytes, path)?;
+        let st = state::decode_state(&bytes, path)?;
         let mut planner = Self::from_state(st).map_err(|e| Error::Corrupt {
             path: path.to_path_buf(),
             why: e.to_string(),
@@ -1541,29 +1081,7 @@ impl Planner {
         if bytes.is_empty() {
             return Ok(0);
         }
-        Ok(Self::decode_state(&bytes, path)?.pairs_recorded)
-    }
-
-    /// The state in a file image read from `path`, of any readable format version.
-    fn decode_state(bytes: &[u8], path: &Path) -> Result<PlannerState> {
-        let (version, payload) = state::checked_payload(bytes, path)?;
-        let old = |v6: PlannerStateV6| {
-            PlannerState::try_from(v6).map_err(|e| Error::Corrupt {
-                path: path.to_path_buf(),
-                why: e.to_string(),
-            })
-        };
-        let st: PlannerState = match version {
-            4 => old(state::decode_payload::<PlannerStateV4>(payload, path)?.into())?,
-            5 => old(state::decode_payload::<PlannerStateV5>(payload, path)?.into())?,
-            6 => old(state::decode_payload::<PlannerStateV6>(payload, path)?)?,
-            7 => state::decode_payload::<PlannerStateV7>(payload, path)?.into(),
-            8 => state::decode_payload::<PlannerStateV8>(payload, path)?.into(),
-            9 => state::decode_payload::<PlannerStateV9>(payload, path)?.into(),
-            10 => state::decode_payload::<PlannerStateV10>(payload, path)?.into(),
-            _ => state::decode_payload(payload, path)?,
-        };
-        Ok(st)
+        Ok(state::decode_any(&bytes, path)?.0.rounds_recorded)
     }
 
     /// Re-checks the stored schedule on the stored problem with this build's check
@@ -1597,14 +1115,10 @@ impl Planner {
             observations: self.observations.clone(),
             confidence: self.confidence.clone(),
             outcome: self.outcome.clone(),
-            pairs_recorded: self.pairs_recorded,
+            rounds_recorded: self.pairs_recorded,
             rounds: self.rounds.clone(),
             reference: self.reference.clone(),
-            records: self
-                .records
-                .iter()
-                .map(|round| round.iter().map(StoredRecord::from).collect())
-                .collect(),
+            records: self.records.clone(),
         }
     }
 
@@ -1645,23 +1159,23 @@ impl Planner {
                 });
             }
         }
-        if st.rounds.len() > st.pairs_recorded {
+        if st.rounds.len() > st.rounds_recorded {
             return Err(Error::Inconsistent {
                 what: "rounds",
                 why: format!(
                     "{} round fingerprints for {} recorded rounds",
                     st.rounds.len(),
-                    st.pairs_recorded
+                    st.rounds_recorded
                 ),
             });
         }
-        if st.records.len() > st.pairs_recorded {
+        if st.records.len() > st.rounds_recorded {
             return Err(Error::Inconsistent {
                 what: "records",
                 why: format!(
                     "{} stored rounds for {} recorded rounds",
                     st.records.len(),
-                    st.pairs_recorded
+                    st.rounds_recorded
                 ),
             });
         }
@@ -1681,14 +1195,10 @@ impl Planner {
             confidence: st.confidence,
             problem,
             outcome: st.outcome,
-            pairs_recorded: st.pairs_recorded,
+            pairs_recorded: st.rounds_recorded,
             rounds: st.rounds,
             reference: st.reference,
-            records: st
-                .records
-                .into_iter()
-                .map(|round| round.into_iter().map(ExecutionRecord::from).collect())
-                .collect(),
+            records: st.records,
             origin: Origin::default(),
             load_notice: None,
         })
@@ -1698,7 +1208,7 @@ impl Planner {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::{CrashPoint, encode, write_atomic_with};
+    use crate::state::{CrashPoint, write_atomic_with};
 
     /// An empty folder `<temp>/<name>-<pid>` for one test's files.
     fn scratch(name: &str) -> std::path::PathBuf {
@@ -1785,7 +1295,7 @@ mod tests {
         let old = small_planner(1);
         old.save(&path).unwrap();
         let newer = small_planner(2);
-        let bytes = encode(&newer.to_state()).unwrap();
+        let bytes = crate::state::encode_state(&newer.to_state()).unwrap();
         for crash in [CrashPoint::MidWrite, CrashPoint::BeforeRename] {
             let tmp = write_atomic_with(&path, &bytes, crash).unwrap();
             assert!(tmp.exists());
@@ -1821,7 +1331,7 @@ mod tests {
             validate(p.problem(), &edited),
             Err(tandem_schedule::Violation::InsufficientMargins { .. })
         ));
-        crate::state::write_atomic(&path, &encode(&st).unwrap()).unwrap();
+        crate::state::write_atomic(&path, &crate::state::encode_state(&st).unwrap()).unwrap();
         let loaded = Planner::load(&path).unwrap();
         let notice = loaded.load_notice().expect("a notice");
         assert!(
@@ -1836,9 +1346,11 @@ mod tests {
         assert_eq!(c.robots()[1].start_s(), loaded.schedule().offsets_s[0]);
         // The file is untouched until a command saves.
         assert_eq!(
-            Planner::from_state(crate::state::load(&path).unwrap())
-                .unwrap()
-                .schedule(),
+            Planner::from_state(
+                crate::state::decode_state(&std::fs::read(&path).unwrap(), &path).unwrap()
+            )
+            .unwrap()
+            .schedule(),
             &edited
         );
         // And a planner holding a failing schedule (built in memory) gives no coordinator.

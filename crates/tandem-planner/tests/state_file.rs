@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use tandem_confidence::{Confidence, ConfidenceParams, MissEvidence};
 use tandem_lfd::{Demonstration, TaskModel};
-use tandem_planner::state::{FORMAT_VERSION, OLDEST_READABLE_VERSION};
+use tandem_planner::state::{self, FORMAT_VERSION, OLDEST_READABLE_VERSION};
 use tandem_planner::{Error, Planner, PlannerParams};
 use tandem_schedule::validate;
 
@@ -499,4 +499,69 @@ fn damaged_state_files_give_clear_errors() {
     // None of this touched the committed file.
     assert!(std::fs::read(golden_path()).unwrap() == bytes);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_golden_state_file_saves_again_byte_for_byte() {
+    let dir = tmp_dir("golden-again");
+    let golden = std::fs::read(golden_path()).unwrap();
+    // Through the planner.
+    let again = dir.join("again.tandem");
+    Planner::load(golden_path()).unwrap().save(&again).unwrap();
+    assert!(std::fs::read(&again).unwrap() == golden);
+    // Through the wire types alone.
+    let wire = dir.join("wire.tandem");
+    let (payload, extras) = state::load_payload(&golden_path()).unwrap();
+    assert!(extras.is_empty());
+    state::save_payload(&wire, &payload, &extras).unwrap();
+    assert!(std::fs::read(&wire).unwrap() == golden);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn old_payloads_convert_into_the_current_wire_types_with_what_they_were_made_with() {
+    use tandem_planner::state::v11;
+    let wire = |v: u32| state::load_payload(&old_golden_path(v)).unwrap();
+    let (golden, _) = state::load_payload(&golden_path()).unwrap();
+    for v in OLDEST_READABLE_VERSION..FORMAT_VERSION {
+        let (p, extras) = wire(v);
+        assert!(extras.is_empty(), "version {v}");
+        // No format before 11 kept the reference demonstration or the executions.
+        assert!(p.reference.is_none() && p.records.is_empty(), "version {v}");
+        assert_eq!(p.rounds_recorded, 1, "version {v}");
+        // Formats before 6 kept no round fingerprints.
+        assert_eq!(p.rounds.len(), usize::from(v >= 6), "version {v}");
+        assert_eq!(p.outcome.schedule.offsets_s.len(), 1, "version {v}");
+        // Formats before 8 had no hold points.
+        assert_eq!(
+            p.outcome.schedule.holds, golden.outcome.schedule.holds,
+            "version {v}"
+        );
+    }
+    // Formats 4 to 6: the paper's confidence model, no evidence of misses.
+    let paper = v11::ConfidenceParams::from(&ConfidenceParams::paper());
+    for v in 4..=6 {
+        let (p, _) = wire(v);
+        assert_eq!(p.confidence.params, paper, "version {v}");
+        assert_eq!(
+            p.observations.miss,
+            v11::MissEvidence::default(),
+            "version {v}"
+        );
+    }
+    // Formats 4 to 8: unsmoothed and unfilled; 9: unfilled.
+    for v in 4..=9 {
+        let (p, _) = wire(v);
+        let w = &p.params.fit.warp;
+        let smooth = if v <= 8 { 1 } else { w.smooth_width };
+        assert_eq!(
+            (w.smooth_width, w.fill_length),
+            (smooth, 0.0),
+            "version {v}"
+        );
+    }
+    // Format 10 is format 11 without the reference and the executions.
+    let (p10, _) = wire(10);
+    assert_eq!(p10.params, golden.params);
+    assert_eq!(p10.outcome, golden.outcome);
 }

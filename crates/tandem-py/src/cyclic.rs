@@ -16,17 +16,20 @@ use crate::planner::N_ROBOTS;
 use crate::schedule::PyProblem;
 
 /// The cyclic plan of `n_robots` robots on `problem` ([`plan_of`]), with `max_enumerated`
-/// replacing [`CyclicParams::max_enumerated`] when given and `runnable_only`
-/// [`CyclicParams::runnable_only`], the GIL released.
+/// replacing [`CyclicParams::max_enumerated`] when given, `runnable_only`
+/// [`CyclicParams::runnable_only`] and `handover_tick_s` (the tick of the cell that will run
+/// it, when known) [`CyclicParams::handover_tick_s`], the GIL released.
 pub(crate) fn compute(
     py: Python<'_>,
     problem: &Problem,
     n_robots: usize,
     max_enumerated: Option<u64>,
     runnable_only: bool,
+    handover_tick_s: Option<f64>,
 ) -> PyResult<PyCyclicPlan> {
     let mut params = CyclicParams {
         runnable_only,
+        handover_tick_s,
         ..CyclicParams::default()
     };
     if let Some(k) = max_enumerated {
@@ -297,14 +300,18 @@ fn order_of(order: &Bound<'_, PyAny>) -> Result<Vec<Stretch>> {
 /// ``order``: instead of a search, the plan of this cyclic order, a sequence of ``N·m``
 /// pairs ``(robot, stretch)`` (0-based; each robot's stretches in task order around the
 /// cycle); ``max_enumerated`` and ``runnable_only`` are then not used.
+/// ``tick_s``: the control tick (real s) of the cell that will run the plan; when given, the
+/// token rule's hand-overs are counted (a hand-over to another robot's group costs its travel
+/// from the gate plus a tick), so the period is what the cell does with the planned operator
+/// (:meth:`Planner.cyclic_plan` gives the planner's tick). Default: not counted.
 ///
 /// Raises:
-///     ParamError: ``robots`` outside 1…8 or ``max_enumerated`` 0.
+///     ParamError: ``robots`` outside 1…8, ``max_enumerated`` 0 or ``tick_s`` not finite and > 0.
 ///     InputError: an ``order`` that is not a sequence of pairs of non-negative ints.
 ///     ScheduleError: an ``order`` that does not list each robot's each stretch once in task
 ///         order, or that no period admits.
 #[pyfunction]
-#[pyo3(signature = (problem, robots=N_ROBOTS, max_enumerated=None, *, runnable_only=true, order=None))]
+#[pyo3(signature = (problem, robots=N_ROBOTS, max_enumerated=None, *, runnable_only=true, order=None, tick_s=None))]
 pub(crate) fn cyclic_plan(
     py: Python<'_>,
     problem: PyRef<'_, PyProblem>,
@@ -312,9 +319,17 @@ pub(crate) fn cyclic_plan(
     max_enumerated: Option<u64>,
     runnable_only: bool,
     order: Option<&Bound<'_, PyAny>>,
+    tick_s: Option<f64>,
 ) -> PyResult<PyCyclicPlan> {
     let Some(order) = order.filter(|o| !o.is_none()) else {
-        return compute(py, &problem.inner, robots, max_enumerated, runnable_only);
+        return compute(
+            py,
+            &problem.inner,
+            robots,
+            max_enumerated,
+            runnable_only,
+            tick_s,
+        );
     };
     let order = order_of(order)?;
     let problem = &*problem.inner;

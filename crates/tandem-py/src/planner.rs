@@ -840,7 +840,9 @@ impl PyPlanner {
     }
 
     /// The plan of a continuous cell on the current problem for this planner's robots
-    /// (:func:`cyclic_plan`): no rounds, each robot repeating the task, one period per task.
+    /// (:func:`cyclic_plan`): no rounds, each robot repeating the task, one period per task,
+    /// the token rule's hand-overs counted at the current schedule's control tick (the cell's
+    /// tick), so its period is what the cell does with the planned operator.
     /// A snapshot, computed now (``tandem schedule --cell continuous`` shows the same plan);
     /// it does not change the planner, whose schedule stays the rounds one it records from.
     /// ``max_enumerated`` (default 100 000): search every operator order while there are at
@@ -860,6 +862,7 @@ impl PyPlanner {
             self.inner.n_robots(),
             max_enumerated,
             true,
+            Some(self.inner.schedule().tick_s),
         )
     }
 
@@ -879,9 +882,16 @@ impl PyPlanner {
         tick_s: Option<f64>,
     ) -> PyResult<crate::continuous::PyContinuousCoordinator> {
         let problem = self.inner.problem();
-        let plan =
-            crate::cyclic::compute(py, problem, self.inner.n_robots(), max_enumerated, true)?;
         let tick_s = tick_s.unwrap_or(self.inner.schedule().tick_s);
+        let plan = crate::cyclic::compute(
+            py,
+            problem,
+            self.inner.n_robots(),
+            max_enumerated,
+            true,
+            // A bad tick is refused by the coordinator below, as a ParamError.
+            (tick_s.is_finite() && tick_s > 0.0).then_some(tick_s),
+        )?;
         Ok(crate::continuous::make(plan.plan(), problem, Some(tick_s))?)
     }
 

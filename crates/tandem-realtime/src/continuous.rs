@@ -56,7 +56,9 @@
 //! **The period.** Under the planned operator (`Operator::Scheduled`) the cell settles into
 //! the cyclic plan's rhythm minus what the rule costs: a robot starts moving from its gate only
 //! once the token is its, so each hand-over costs the operator the travel from the gate to the
-//! stretch (one sample when the gate is next to the stretch) plus the tick quantization.
+//! stretch (one sample when the gate is next to the stretch) plus the tick quantization
+//! (about a tick). `tandem-schedule`'s cyclic plan counts both when it is given the cell's
+//! tick (`CyclicParams::handover_tick_s`), so its period is then the cell's.
 //! Under drift the period is not guaranteed; only soundness is.
 //!
 //! ```
@@ -629,7 +631,15 @@ impl ContinuousCoordinator {
             } else {
                 cap
             };
-            let s_new = (s_old + step).min(cap).max(s_old);
+            let mut s_new = (s_old + step).min(cap).max(s_old);
+            // A rounding error never costs a tick: a robot that ends within the clock
+            // tolerance short of its cap (k steps of `tick_s` summing a few ulps below the
+            // sample clock of a gate or a stretch) is at the cap, where the next tick would
+            // only have moved it by that error. The cap is the furthest it may go this tick,
+            // so the token rule's argument is unchanged.
+            if s_new < cap && cap - s_new <= self.tol_s {
+                s_new = cap;
+            }
             if s_new > s_old {
                 out.running.set(i, true);
                 let lo = task.advance_cursor(&mut cur.lo, s_old - self.tol_s);

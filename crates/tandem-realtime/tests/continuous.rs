@@ -657,3 +657,22 @@ proptest! {
         hand_over_is_sound(seed, n, policy)?;
     }
 }
+
+/// A rounding error never costs a tick: 100 high-confidence samples at `ψ̇ = 0.5` and 10 ms
+/// (0.5 s of clock, 50 ticks of 10 ms), then a stretch. The sample clock of the stretch's
+/// start and fifty steps of 0.01 s differ by ulps; the robot is at the stretch after exactly
+/// 50 ticks (without the snap to the cap it stopped a few ulps short and spent tick 51 on
+/// them), and the tick after moves it into the stretch.
+#[test]
+fn a_rounding_error_never_costs_a_tick() {
+    let conf: Vec<bool> = (0..300).map(|n| !(100..200).contains(&n)).collect();
+    let plan = Timeline::new(&conf, &[0.5; 300], &[0.5; 300], &[2.0; 300], 0.0, 0.01).unwrap();
+    let start_lc = plan.sample_clock_s()[100];
+    let mut cell = ContinuousCoordinator::new(plan, &[], &[(0, 0), (1, 0)], 2, 0.01).unwrap();
+    for _ in 0..50 {
+        cell.tick(Operator::Scheduled).unwrap();
+    }
+    assert_eq!(cell.clock_s()[0], start_lc);
+    let t = cell.tick(Operator::Scheduled).unwrap();
+    assert!(t.ref_time[0] > 100.0 && t.low_conf[0], "{t:?}");
+}

@@ -19,6 +19,11 @@
 //!    the sampler's winner. The sampler and the completion run exactly as they would alone
 //!    (same seed, same incumbent, same budget), so the result is never worse than either's.
 //!
+//! For `N` robots ([`sample_schedule_n`]) the bound, the completion and the candidates are one
+//! row of `STRATEGIES` per robot count (`N = 1`, `2`, `≥ 3`): for `N ≥ 3` the bound of
+//! `exact::bound_many` and the staggered candidate (`stagger.rs`) in every re-schedule, no
+//! margin-aware completion.
+//!
 //! Every candidate is checked with [`crate::validate`] at the tick before it can win. The
 //! [`Outcome`] carries the schedule, its `T_total`, where it came from, and its certificate:
 //! the bound and the gap `(T_total − bound)/bound`.
@@ -44,7 +49,7 @@ pub enum Source {
         candidate: u64,
     },
     /// The margin-aware completion of the exact margin-free optimum
-    /// ([`crate::exact`], "Margin-aware completion").
+    /// ([`crate::exact`], "Margin-aware completion"; two robots).
     Completed,
     /// The previous schedule's warps and offset, unchanged (still valid at the scheduler's
     /// tick, nothing better found).
@@ -61,8 +66,9 @@ pub enum Source {
     /// order at run time instead of margins.
     Held,
     /// `N ≥ 3` robots on their fastest warps at the least start offsets the full check accepts
-    /// (greedy robot by robot, or equally spaced), tried when no other candidate overlaps the
-    /// robots (`stagger.rs`; docs/decisions.md, "N robots in the margin-free search").
+    /// (greedy robot by robot, or equally spaced), tried in every re-schedule of `N ≥ 3`
+    /// robots (`stagger.rs`; docs/decisions.md, "N robots in the margin-free search", "An
+    /// N-robot margin-aware completion").
     Staggered,
 }
 
@@ -475,11 +481,14 @@ pub fn sample_schedule(
 /// candidates are checked in `(T_total, k)` order as for two robots. The warm start keeps
 /// robot 1 of the previous schedule (whatever its robot count). For `N = 2` the margin-aware
 /// completion runs beside the sampler and the bound is the exact margin-free optimum `T*₀`.
-/// For `N ≥ 3` there is no margin-aware completion; the bound is the margin-free optimum of the
-/// `N`-robot branch and bound when it finishes within its node budget, else
-/// [`crate::operator_bound_s`] (see "N robots" in [`crate::exact`]); with hold points the
-/// best order it found, with release rules ([`Problem::with_release_rules`]), is a candidate
-/// too ([`Source::Held`]). For `N = 1` the bound is the optimum itself, the fastest execution.
+/// For `N ≥ 3` the bound is the maximum of the `k`-robot bounds, `k ≤ N` (the margin-free
+/// optimum of the `N`-robot branch and bound when it finishes within its node budget, else
+/// [`crate::operator_bound_s`]; see "N robots" in [`crate::exact`]); there is no margin-aware
+/// completion; the staggered schedule ([`Source::Staggered`]) is a candidate in every
+/// re-schedule, and with hold points the best
+/// order with release rules ([`Problem::with_release_rules`], [`Source::Held`]). For `N = 1`
+/// the bound is the optimum itself, the fastest execution. Which strategies run for which
+/// robot count is one table (`STRATEGIES` in `choose.rs`).
 /// Deterministic for a seed whatever the thread count.
 ///
 /// # Errors
@@ -513,8 +522,74 @@ pub fn sample_schedule_with_baselines(
     schedule_n(problem, 2, params, baselines, previous)
 }
 
+/// How the scheduler bounds and completes for one robot count: a row of [`STRATEGIES`].
+///
+/// Every row runs the incumbent (previous schedule, its re-timing or repair, the fastest
+/// serial schedule) and the sampler, and with usable hold points the bound's margin-free
+/// schedule with release rules ([`Source::Held`]); the row adds its bound, its completion and
+/// whether the staggered candidate runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Strategies {
+    /// The certificate's lower bound (and its margin-free schedule).
+    pub(crate) bound: BoundBy,
+    /// The margin-aware completion.
+    pub(crate) completion: CompleteBy,
+    /// Whether the staggered candidate ([`Source::Staggered`], `stagger.rs`) is tried.
+    pub(crate) staggered: bool,
+}
+
+/// The lower bound of a row of [`STRATEGIES`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum BoundBy {
+    /// One robot: its fastest execution, the optimum itself ([`exact::operator_bound`]).
+    Fastest,
+    /// Two robots: the exact margin-free optimum `T*₀` ([`exact::bound`]).
+    Pair,
+    /// `N ≥ 3` robots: the maximum of the `k`-robot bounds ([`exact::bound_many`]).
+    Many,
+}
+
+/// The margin-aware completion of a row of [`STRATEGIES`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum CompleteBy {
+    /// None: one robot has nothing to keep apart; for `N ≥ 3` no completion has won a
+    /// re-schedule yet (docs/decisions.md, "An N-robot margin-aware completion, the staggered
+    /// candidate always, and the strategies as a table").
+    Nothing,
+    /// The two-robot completion ([`exact::completion`]: per-pair clearances through the exact
+    /// search, cold and warm from the incumbent, then warm from the sampler's winner).
+    Pair,
+}
+
+/// The scheduler's strategies per robot count (issue 40, item 5): row `min(N, 3) − 1`.
+pub(crate) const STRATEGIES: [Strategies; 3] = [
+    // N = 1.
+    Strategies {
+        bound: BoundBy::Fastest,
+        completion: CompleteBy::Nothing,
+        staggered: false,
+    },
+    // N = 2.
+    Strategies {
+        bound: BoundBy::Pair,
+        completion: CompleteBy::Pair,
+        staggered: false,
+    },
+    // N ≥ 3.
+    Strategies {
+        bound: BoundBy::Many,
+        completion: CompleteBy::Nothing,
+        staggered: true,
+    },
+];
+
+/// The row of [`STRATEGIES`] for `n_robots ≥ 1` robots.
+pub(crate) fn strategies(n_robots: usize) -> Strategies {
+    STRATEGIES[n_robots.clamp(1, STRATEGIES.len()) - 1]
+}
+
 /// [`sample_schedule_n`] with benchmark-only baselines (for two robots only, the default
-/// otherwise).
+/// otherwise): the strategies of [`strategies`]`(n_robots)`, the least `T_total` winning.
 fn schedule_n(
     problem: &Problem,
     n_robots: usize,
@@ -524,8 +599,8 @@ fn schedule_n(
 ) -> Result<Outcome> {
     params.validate()?;
     check_robot_count(n_robots)?;
-    let two = n_robots == 2;
-    if !two && *baselines != SamplerBaselines::default() {
+    let plan = strategies(n_robots);
+    if plan.bound != BoundBy::Pair && *baselines != SamplerBaselines::default() {
         return Err(Error::BadParam {
             name: "baselines",
             why: "the benchmark baselines are for two robots only",
@@ -538,8 +613,8 @@ fn schedule_n(
         Err(serial) => return Err(Error::NoFeasibleSchedule { serial }),
     };
     let cap_s = incumbent.1;
-    // The margin-aware completion is for two robots only.
-    let budget = if baselines.sampler_only || !two {
+    let pair = plan.completion == CompleteBy::Pair;
+    let budget = if baselines.sampler_only || !pair {
         0
     } else {
         params.exact.max_margin_checks
@@ -565,29 +640,29 @@ fn schedule_n(
                 )
             }
         },
-        || {
-            if n_robots == 1 {
-                return (exact::operator_bound(problem, n_robots), (None, 0));
+        || match plan.bound {
+            BoundBy::Fastest => (exact::operator_bound(problem, n_robots), (None, 0)),
+            BoundBy::Many => (
+                exact::bound_many(problem, n_robots, &params.exact),
+                (None, 0),
+            ),
+            BoundBy::Pair => {
+                let bound = exact::bound(problem, &params.exact);
+                let done = if pair && bound.lower_bound_s < cap_s {
+                    exact::completion(problem, &params.exact, tick_s, cap_s, budget, true, &warm)
+                } else {
+                    (None, 0)
+                };
+                (bound, done)
             }
-            if !two {
-                return (
-                    exact::bound_many(problem, n_robots, &params.exact),
-                    (None, 0),
-                );
-            }
-            let bound = exact::bound(problem, &params.exact);
-            let done = if bound.lower_bound_s < cap_s {
-                exact::completion(problem, &params.exact, tick_s, cap_s, budget, true, &warm)
-            } else {
-                (None, 0)
-            };
-            (bound, done)
         },
     );
     let mut best = incumbent;
     let mut completed = done.map(|d| (d.schedule, d.t_total_s));
-    if let Some((s, t, k)) = winner {
-        if t < best.1 && two {
+    if let Some((s, t, k)) = winner
+        && t < best.1
+    {
+        if pair {
             // The sampler's winner as a warm start: the completion tightens its clearances.
             let cap = completed.as_ref().map_or(t, |c| c.1.min(t));
             let (better, more) = exact::completion(
@@ -603,10 +678,8 @@ fn schedule_n(
             if let Some(b) = better {
                 completed = Some((b.schedule, b.t_total_s));
             }
-            best = (s, t, Source::Sampled { candidate: k });
-        } else if t < best.1 {
-            best = (s, t, Source::Sampled { candidate: k });
         }
+        best = (s, t, Source::Sampled { candidate: k });
     }
     stats.search = bound.stats;
     if let Some((schedule, t)) = completed
@@ -631,11 +704,11 @@ fn schedule_n(
             }
         }
     }
-    // For `N ≥ 3`, when no candidate so far overlaps the robots (nothing beats the serial
-    // schedule), the staggered one: its checks see all robots and cost most at large `N`, so
-    // it runs only where the sampler found nothing.
-    if n_robots >= 3
-        && best.1 >= serial.t_total_s(problem.dt_s())
+    // The staggered candidate, always (its checks see all robots: at most
+    // `MAX_STAGGER_CHECKS` of them). Before, it ran only when nothing beat the serial
+    // schedule, and a schedule with holds that overlapped the robots hid a shorter staggered
+    // one without holds (docs/decisions.md, "An N-robot margin-aware completion").
+    if plan.staggered
         && let Some((schedule, t, used)) = stagger::staggered(problem, &serial)
     {
         checks += used;
@@ -717,5 +790,22 @@ mod tests {
         }
         assert!(bound_above(1.0 + 3.0 * tol::BOUND_REL, 1.0));
         assert!(!bound_above(1.0 + 0.5 * tol::BOUND_REL, 1.0));
+    }
+
+    #[test]
+    fn one_row_of_strategies_per_robot_count() {
+        let row = |n| {
+            let s = strategies(n);
+            (s.bound, s.completion, s.staggered)
+        };
+        assert_eq!(row(1), (BoundBy::Fastest, CompleteBy::Nothing, false));
+        assert_eq!(row(2), (BoundBy::Pair, CompleteBy::Pair, false));
+        for n in 3..=tandem_realtime::MAX_ROBOTS {
+            assert_eq!(
+                row(n),
+                (BoundBy::Many, CompleteBy::Nothing, true),
+                "N = {n}"
+            );
+        }
     }
 }

@@ -72,7 +72,7 @@ pub use choose::{
 };
 pub use cyclic::{
     CycleRatio, CyclicParams, CyclicPlan, Stretch, cyclic_plan, cyclic_plan_for_order,
-    max_cycle_ratio, period_lower_bound_s,
+    handover_bound_s, max_cycle_ratio, period_lower_bound_s,
 };
 pub use error::{Error, Result};
 pub use exact::{

@@ -118,13 +118,20 @@ proptest! {
 }
 
 /// The spread, for the record (`cargo test -p tandem-sim --test plan_is_what_the_cell_does
-/// -- --nocapture`): realized against planned over 24 seeds per case.
+/// -- --nocapture`): realized against planned over 24 seeds per case (with holds, more until
+/// three schedules use them).
 #[test]
 fn realized_against_planned_by_case() {
     for holds in [false, true] {
         for n_robots in 2..=4 {
             let (mut lo, mut hi, mut with_holds) = (f64::INFINITY, f64::NEG_INFINITY, 0);
-            for seed in 0..24 {
+            // 24 seeds, and with holds more (up to 96) until three schedules use them: the
+            // staggered candidate (no holds) runs in every re-schedule of N ≥ 3 robots and
+            // often wins (docs/decisions.md, "N ≥ 3 robots: the staggered candidate always").
+            let mut seeds = 0_u64;
+            while seeds < 24 || (holds && with_holds < 3 && seeds < 96) {
+                let seed = seeds;
+                seeds += 1;
                 let (planned, realized, held) = planned_and_realized(seed, n_robots, holds);
                 let r = realized / planned - 1.0;
                 (lo, hi) = (lo.min(r), hi.max(r));
@@ -134,10 +141,10 @@ fn realized_against_planned_by_case() {
             // Not vacuous: the scheduler uses holds on some of these problems.
             assert!(
                 !holds || with_holds >= 3,
-                "N = {n_robots}: {with_holds} with holds"
+                "N = {n_robots}: {with_holds} of {seeds} with holds"
             );
             eprintln!(
-                "holds {holds}, N = {n_robots}: realized − planned from {:+.2} % to {:+.2} % ({with_holds} of 24 schedules with holds)",
+                "holds {holds}, N = {n_robots}: realized − planned from {:+.2} % to {:+.2} % ({with_holds} of {seeds} schedules with holds)",
                 lo * 100.0,
                 hi * 100.0
             );

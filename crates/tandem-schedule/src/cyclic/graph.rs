@@ -47,6 +47,13 @@ pub struct TaskShape {
     /// head (before the first run), gap `k` lies between runs `k − 1` and `k`, gap `m` is the
     /// tail. Without low-confidence runs there is one gap, the whole task.
     pub gaps: Vec<Gap>,
+    /// Per stretch `k`, when it opens a group of the token rule (`k = 0`, or a usable hold in
+    /// gap `k`: `tandem_realtime::continuous::groups`), the fastest travel (s, `Σψ̇min·Δt_s`
+    /// over the samples from its gate to its first sample) from its gate — the latest usable
+    /// hold before it, or the task start — to its start; 0 for a stretch inside a group. At a
+    /// hand-over the token's robot leaves its gate only once the previous group has been
+    /// left, so the operator waits this long ([`crate::CyclicParams::handover_tick_s`]).
+    pub entry_s: Vec<f64>,
 }
 
 /// One high-confidence gap of the task (see [`TaskShape::gaps`]); empty gaps have zero
@@ -83,14 +90,34 @@ impl TaskShape {
         };
         let mut lc_s = Vec::new();
         let mut gaps = Vec::new();
+        let mut entry_s = Vec::new();
         let mut from = 0;
         for run in problem.runs().iter().filter(|r| !r.high_conf) {
-            gaps.push(gap(from, run.start));
+            let g = gap(from, run.start);
+            // The gate of a group's first stretch: its gap's hold, or the task start for the
+            // first stretch; a stretch after a gap without a hold continues a group.
+            entry_s.push(match (gaps.is_empty(), g.hold) {
+                (_, Some(h)) => sum(problem.grad_min(), h, run.start),
+                (true, None) => g.min_s,
+                (false, None) => 0.0,
+            });
+            gaps.push(g);
             lc_s.push(sum(problem.grad_mean(), run.start, run.end));
             from = run.end;
         }
         gaps.push(gap(from, problem.n_ref()));
-        TaskShape { lc_s, gaps }
+        TaskShape {
+            lc_s,
+            gaps,
+            entry_s,
+        }
+    }
+
+    /// Whether stretch `k` opens a group of the token rule: the first stretch, or one after a
+    /// gap with a usable hold (the robot may wait before it).
+    #[must_use]
+    pub fn opens_group(&self, k: usize) -> bool {
+        k == 0 || self.gaps.get(k).is_some_and(|g| g.hold.is_some())
     }
 
     /// Number of low-confidence runs `m`.
@@ -222,14 +249,18 @@ pub(crate) fn check_order(order: &[Stretch], n_robots: usize, m: usize) -> Resul
 /// [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS` or an order that does not
 /// list every stretch once with each robot's stretches in task order around the cycle.
 pub fn event_graph(problem: &Problem, n_robots: usize, order: &[Stretch]) -> Result<EventGraph> {
-    graph_of_shape(TaskShape::new(problem), n_robots, order)
+    graph_of_shape(TaskShape::new(problem), n_robots, order, None)
 }
 
-/// [`event_graph`] of a task shape already cut from its problem.
+/// [`event_graph`] of a task shape already cut from its problem; with `handover_tick_s`
+/// (the control tick of the token-rule cell, s) every operator arc into a stretch that opens
+/// a group of another robot also carries the hand-over: the stretch's
+/// [`TaskShape::entry_s`] plus one tick ([`crate::CyclicParams::handover_tick_s`]).
 pub(crate) fn graph_of_shape(
     shape: TaskShape,
     n_robots: usize,
     order: &[Stretch],
+    handover_tick_s: Option<f64>,
 ) -> Result<EventGraph> {
     check_robot_count(n_robots)?;
     let m = shape.n_lc();
@@ -297,10 +328,18 @@ pub(crate) fn graph_of_shape(
     for q in 0..len {
         let (from, to) = (order[q], order[(q + 1) % len]);
         let node = |s: Stretch| s.robot * per + 1 + s.lc;
+        // The token rule: `to`'s robot leaves its gate once `from`'s group has been left
+        // (detected at a tick's end), then travels to the stretch.
+        let handover = match handover_tick_s {
+            Some(tick_s) if to.robot != from.robot && shape.opens_group(to.lc) => {
+                shape.entry_s[to.lc] + tick_s
+            }
+            _ => 0.0,
+        };
         push(
             node(from),
             node(to),
-            shape.lc_s[from.lc],
+            shape.lc_s[from.lc] + handover,
             i32::from(q + 1 == len),
         );
     }

@@ -35,11 +35,18 @@
 //! until the previous group in the order has been left), which is sound across cycle
 //! boundaries by construction, for any operator and any number of tasks; it needs a
 //! *runnable* order ([`is_runnable`]), which [`cyclic_plan`] searches by default
-//! ([`CyclicParams::runnable_only`]).
+//! ([`CyclicParams::runnable_only`]). The rule costs the operator, at every hand-over to
+//! another robot's group, the travel from the group's gate to its first stretch and about a
+//! tick; with [`CyclicParams::handover_tick_s`] (the cell's control tick) the operator arc
+//! into such a stretch carries that cost ([`TaskShape::entry_s`] plus one tick), so the period
+//! is what the cell does under the planned operator and the search optimizes it.
 //!
 //! **The certificate.** [`period_lower_bound_s`] `= max(N·(L + I), D_min)` holds for every
 //! order: the operator's load `N·L`, its forced idle time `N·I` in gaps without hold too
 //! short for any stretch, and a robot's fastest task `D_min`; the plan reports its gap to it.
+//! A plan searched among runnable orders with the hand-overs counted reports its gap to
+//! [`handover_bound_s`] instead, the bound of every such plan (each group's span and entry,
+//! and a tick per robot change).
 //!
 //! ```
 //! use tandem_schedule::{Problem, cyclic_plan, CyclicParams};
@@ -66,7 +73,9 @@ mod run;
 mod search;
 
 pub use graph::{Event, EventGraph, Gap, Stretch, TaskShape, event_graph};
-pub use plan::{CyclicPlan, GapPlan, RobotCycle, cyclic_plan_for_order, period_lower_bound_s};
+pub use plan::{
+    CyclicPlan, GapPlan, RobotCycle, cyclic_plan_for_order, handover_bound_s, period_lower_bound_s,
+};
 pub use ratio::{Arc, CycleRatio, max_cycle_ratio};
 pub use run::is_runnable;
 pub use search::{CyclicParams, cyclic_plan, order_count};

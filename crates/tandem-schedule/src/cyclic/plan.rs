@@ -35,7 +35,9 @@ pub struct CyclicPlan {
     /// duration at `ψ̇̄`.
     pub operator_share: f64,
     /// A lower bound (s) on the period of every 1-periodic plan of `N` robots, whatever the
-    /// order: [`period_lower_bound_s`].
+    /// order: [`period_lower_bound_s`]; for a plan searched with the hand-overs counted
+    /// ([`crate::CyclicParams::handover_tick_s`]) among runnable orders, the bound of every
+    /// such plan, [`handover_bound_s`] (at least the former).
     pub lower_bound_s: f64,
     /// `period_s / lower_bound_s − 1` (0 when the plan is at the bound, up to rounding).
     pub gap: f64,
@@ -112,6 +114,58 @@ pub(crate) fn bound_of(shape: &TaskShape, n_robots: usize) -> f64 {
     (n_robots as f64 * (shape.lc_total_s() + shape.idle_s())).max(shape.fastest_s())
 }
 
+/// A lower bound (s) on the period of every 1-periodic plan of `n_robots` robots on
+/// `problem` whose order is runnable ([`crate::cyclic::is_runnable`]) and whose hand-overs
+/// are counted at the control tick `tick_s` ([`crate::CyclicParams::handover_tick_s`]):
+/// for `N ≥ 2`, `max(N·(Σ_g (S_g + E_g) + tick_s), D_min)` over the task's groups `g` (its
+/// stretches between two usable holds), `S_g` the group's span at its fastest (its
+/// stretches at `ψ̇̄` and the gaps between them at `ψ̇min`), `E_g` the travel from its gate
+/// to its first stretch ([`TaskShape::entry_s`]); for one robot, [`period_lower_bound_s`].
+/// It is at least [`period_lower_bound_s`] (the spans hold every stretch and every gap that
+/// `I` counts).
+///
+/// **Why.** In a runnable order each group's stretches are consecutive, so from the start of
+/// a group's first stretch to the end of its last the operator supervises that group only,
+/// for at least `S_g` (the robot's own arcs). From there to the start of the next entry of
+/// the order, a group `h`: if `h` is another robot's, the hand-over arc gives `E_h + tick_s`;
+/// if it is the same robot's (its next group, or group 0 of its next task through the task
+/// start), the robot's own arc gives at least the gap before `h` at its fastest, which holds
+/// the travel from `h`'s gate: `≥ E_h`. Summed around one period, which holds every group of
+/// every robot once, `P ≥ N·Σ_g (S_g + E_g) + c·tick_s`, where `c ≥ N` is the number of
+/// robot changes in the order (each robot's entries form at least one block when `N ≥ 2`).
+/// And `P ≥ D_min` as before.
+///
+/// # Errors
+/// [`crate::Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS`.
+pub fn handover_bound_s(problem: &Problem, n_robots: usize, tick_s: f64) -> Result<f64> {
+    check_robot_count(n_robots)?;
+    Ok(handover_bound_of(
+        &TaskShape::new(problem),
+        n_robots,
+        tick_s,
+    ))
+}
+
+pub(crate) fn handover_bound_of(shape: &TaskShape, n_robots: usize, tick_s: f64) -> f64 {
+    let old = bound_of(shape, n_robots);
+    let m = shape.n_lc();
+    if n_robots < 2 || m == 0 {
+        return old;
+    }
+    // Σ_g (S_g + E_g): every stretch, every gap inside a group, every group's entry.
+    let per_task: f64 = (0..m)
+        .map(|k| {
+            let before = if shape.opens_group(k) {
+                shape.entry_s[k]
+            } else {
+                shape.gaps[k].min_s
+            };
+            shape.lc_s[k] + before
+        })
+        .sum();
+    (n_robots as f64 * (per_task + tick_s)).max(old)
+}
+
 /// The cyclic plan of `n_robots` robots on `problem` with the operator's cyclic order `order`
 /// (each robot's stretches in task order around the cycle, starting anywhere): the least
 /// period of its event graph ([`event_graph`], [`max_cycle_ratio`]) and each robot's times.
@@ -125,14 +179,36 @@ pub fn cyclic_plan_for_order(
     n_robots: usize,
     order: &[Stretch],
 ) -> Result<CyclicPlan> {
-    let graph = event_graph(problem, n_robots, order)?;
+    plan_for_order(problem, n_robots, order, None, false)
+}
+
+/// [`cyclic_plan_for_order`], counting the token rule's hand-overs at the control tick
+/// `handover_tick_s` when given ([`crate::CyclicParams::handover_tick_s`]); with
+/// `runnable_only` (the order was searched among runnable orders) and a tick, the plan's
+/// bound is [`handover_bound_s`].
+pub(crate) fn plan_for_order(
+    problem: &Problem,
+    n_robots: usize,
+    order: &[Stretch],
+    handover_tick_s: Option<f64>,
+    runnable_only: bool,
+) -> Result<CyclicPlan> {
+    let graph = match handover_tick_s {
+        None => event_graph(problem, n_robots, order)?,
+        Some(_) => graph_of_shape(TaskShape::new(problem), n_robots, order, handover_tick_s)?,
+    };
     let ratio = max_cycle_ratio(graph.events.len(), &graph.arcs)?;
+    let lower_bound_s = match handover_tick_s {
+        Some(tick_s) if runnable_only => handover_bound_of(&graph.shape, n_robots, tick_s),
+        _ => bound_of(&graph.shape, n_robots),
+    };
     Ok(layout(
         &graph,
         n_robots,
         order,
         ratio.period_s,
         &ratio.times_s,
+        lower_bound_s,
     ))
 }
 
@@ -141,8 +217,9 @@ pub(crate) fn period_of(
     shape: &TaskShape,
     n_robots: usize,
     order: &[Stretch],
+    handover_tick_s: Option<f64>,
 ) -> Result<Option<f64>> {
-    let graph = graph_of_shape(shape.clone(), n_robots, order)?;
+    let graph = graph_of_shape(shape.clone(), n_robots, order, handover_tick_s)?;
     match max_cycle_ratio(graph.events.len(), &graph.arcs) {
         Ok(r) => Ok(Some(r.period_s)),
         Err(crate::Error::InfeasibleCycle { .. }) => Ok(None),
@@ -156,6 +233,7 @@ fn layout(
     order: &[Stretch],
     period_s: f64,
     times_s: &[f64],
+    lower_bound_s: f64,
 ) -> CyclicPlan {
     let shape = &graph.shape;
     let m = shape.n_lc();
@@ -208,7 +286,6 @@ fn layout(
             }
         })
         .collect();
-    let lower_bound_s = bound_of(shape, n_robots);
     let n = n_robots as f64;
     CyclicPlan {
         n_robots,

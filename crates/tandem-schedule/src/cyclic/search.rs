@@ -3,7 +3,7 @@
 use tandem_realtime::continuous::{Group, first_split_group};
 
 use super::graph::{Stretch, TaskShape};
-use super::plan::{CyclicPlan, cyclic_plan_for_order, period_of};
+use super::plan::{CyclicPlan, period_of, plan_for_order};
 use super::run::groups_of;
 use crate::problem::check_robot_count;
 use crate::{Error, Problem, Result};
@@ -24,6 +24,19 @@ pub struct CyclicParams {
     /// skips the others; the local search moves whole groups (the stretches between two holds)
     /// instead of single stretches. `false`: every order, as a plan only. Default `true`.
     pub runnable_only: bool,
+    /// The control tick (real s) of the cell that will run the plan
+    /// ([`CyclicPlan::coordinator`]), to plan the token rule's hand-overs: when given, the
+    /// operator arc into a stretch that opens a group of another robot also carries the
+    /// stretch's [`crate::cyclic::TaskShape::entry_s`] (the token's robot leaves its gate
+    /// only once the previous group has been left, then travels to the stretch at `ψ̇min`)
+    /// plus one tick (the leave is detected at a tick's end, and the arrival at the stretch
+    /// and the leave each fall on the tick grid: half a tick each on average, a tick each
+    /// when the clocks fall on the grid). So the period is what a token-rule cell with the
+    /// planned operator does, and the search optimizes it (docs/decisions.md, "A plan is
+    /// what the continuous cell does"). `None`: the operator's order alone (the model of
+    /// the module docs), which a cell reaches only with gates next to the stretches.
+    /// Must be finite and > 0. Default `None`.
+    pub handover_tick_s: Option<f64>,
 }
 
 impl Default for CyclicParams {
@@ -32,6 +45,7 @@ impl Default for CyclicParams {
             max_enumerated: 100_000,
             max_swap_passes: 200,
             runnable_only: true,
+            handover_tick_s: None,
         }
     }
 }
@@ -40,12 +54,22 @@ impl CyclicParams {
     /// Checks the parameters.
     ///
     /// # Errors
-    /// [`Error::BadParam`] for `max_enumerated == 0`.
+    /// [`Error::BadParam`] for `max_enumerated == 0` or a `handover_tick_s` not finite and
+    /// > 0.
     pub fn validate(&self) -> Result<()> {
         if self.max_enumerated == 0 {
             return Err(Error::BadParam {
                 name: "max_enumerated",
                 why: "must be ≥ 1",
+            });
+        }
+        if self
+            .handover_tick_s
+            .is_some_and(|t| !(t.is_finite() && t > 0.0))
+        {
+            return Err(Error::BadParam {
+                name: "handover_tick_s",
+                why: "must be finite and > 0",
             });
         }
         Ok(())
@@ -131,13 +155,19 @@ pub fn cyclic_plan(
     };
     let count = order_count(n_robots, m);
     let (order, evaluated, exhaustive) = if count <= params.max_enumerated {
-        let (order, evaluated) = enumerate(&shape, n_robots, m, groups.as_deref())?;
+        let (order, evaluated) = enumerate(&shape, n_robots, m, groups.as_deref(), params)?;
         (order, evaluated, true)
     } else {
         let (order, evaluated) = local_search(&shape, n_robots, params, groups.as_deref())?;
         (order, evaluated, false)
     };
-    let mut plan = cyclic_plan_for_order(problem, n_robots, &order)?;
+    let mut plan = plan_for_order(
+        problem,
+        n_robots,
+        &order,
+        params.handover_tick_s,
+        params.runnable_only,
+    )?;
     plan.order_exhaustive = exhaustive;
     plan.orders_evaluated = evaluated;
     Ok(plan)
@@ -165,6 +195,7 @@ fn enumerate(
     n_robots: usize,
     m: usize,
     groups: Option<&[Group]>,
+    params: &CyclicParams,
 ) -> Result<(Vec<Stretch>, usize)> {
     if m == 0 {
         return Ok((Vec::new(), 1));
@@ -212,7 +243,7 @@ fn enumerate(
             }
             if groups.is_none_or(|g| first_split_group(&order, g).is_none()) {
                 evaluated += 1;
-                let p = period_of(shape, n_robots, &order)?;
+                let p = period_of(shape, n_robots, &order, params.handover_tick_s)?;
                 if better(p, best.0) {
                     best = (p, order.clone());
                 }
@@ -275,7 +306,7 @@ fn local_search(
     let mut best: (Option<f64>, Vec<Stretch>) = (None, flat(&serial_units));
     for seed in [round_robin, staggered, serial_units] {
         let mut cur = seed;
-        let mut p = period_of(shape, n_robots, &flat(&cur))?;
+        let mut p = period_of(shape, n_robots, &flat(&cur), params.handover_tick_s)?;
         evaluated += 1;
         let len = cur.len();
         for _ in 0..params.max_swap_passes {
@@ -286,7 +317,7 @@ fn local_search(
                     continue;
                 }
                 cur.swap(q, q2);
-                let pq = period_of(shape, n_robots, &flat(&cur))?;
+                let pq = period_of(shape, n_robots, &flat(&cur), params.handover_tick_s)?;
                 evaluated += 1;
                 cur.swap(q, q2);
                 if better(pq, step.map_or(p, |s| s.1)) {

@@ -2,7 +2,8 @@
 //! learning loop of §III without rounds.
 //!
 //! A trial fits the planner as for rounds, plans the cell (`tandem_schedule::cyclic_plan`:
-//! the operator's cyclic order of low-confidence stretches and its least period) and runs it
+//! the operator's cyclic order of low-confidence stretches and its least period, counting the
+//! token rule's hand-overs at the cell's tick: `CyclicParams::handover_tick_s`) and runs it
 //! through the continuous coordinator ([`crate::workcell::CellSim`]). Every robot draws a new
 //! workpiece for every task. Each completed task's execution is kept; every `N` completed
 //! tasks (whichever robots did them) the planner records them as one round of `N`
@@ -239,11 +240,13 @@ fn plan_of(
     tasks_recorded: usize,
     tick: u64,
 ) -> Result<(CyclicPlan, CellIteration)> {
-    let plan = cyclic_plan(
-        planner.problem(),
-        planner.n_robots(),
-        &CyclicParams::default(),
-    )?;
+    // The cell runs at one tick per reference sample: the plan counts the token rule's
+    // hand-overs at that tick, so its period is what the cell does with the planned operator.
+    let params = CyclicParams {
+        handover_tick_s: Some(planner.problem().dt_s()),
+        ..CyclicParams::default()
+    };
+    let plan = cyclic_plan(planner.problem(), planner.n_robots(), &params)?;
     let iteration = CellIteration {
         tasks_recorded,
         tick,

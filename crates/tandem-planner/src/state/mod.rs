@@ -9,13 +9,55 @@
 //! | 8..12 | format version, `u32` little endian |
 //! | 12..20 | payload length in bytes, `u64` little endian |
 //! | 20..24 | CRC-32 (IEEE) of the payload, `u32` little endian |
-//! | 24.. | payload: the state encoded with `postcard` |
+//! | 24.. | payload: the state encoded with `postcard` ([`v11::Payload`]), then, only when a planner uses a parameter added after format 11, the list of such parameters by name ([`Extras`]) |
 //!
 //! Reading checks, in this order: the file can be read, it is at least a header long and
 //! starts with the magic bytes, the version is one this build reads
 //! ([`OLDEST_READABLE_VERSION`]`..=`[`FORMAT_VERSION`]), the payload has
 //! exactly the announced length (shorter = truncated, longer = trailing garbage), the
-//! checksum matches, and `postcard` decodes the payload using every byte.
+//! checksum matches, and `postcard` decodes the payload using every byte (in format 11, the
+//! bytes after the [`v11::Payload`] must decode as an [`Extras`] list using every byte).
+//!
+//! # Wire types apart from library types
+//!
+//! The payload is its own set of plain types, never a library type's serde form (postcard is
+//! positional: a library field renamed, reordered or added would silently change the
+//! format):
+//!
+//! - [`v11`]: the current payload, [`v11::Payload`], one wire type per stored library type
+//!   with explicit conversions both ways (`From`/`TryFrom`; a library field added fails to
+//!   compile there until it is decided on). The one library type stored in its own serde form
+//!   is the fitted `TaskModel` (statistics only `tandem-lfd` can build, no parameters).
+//! - `legacy`: the payloads of formats 4 to 10, each converted into [`v11::Payload`] on
+//!   load; nothing writes them.
+//! - [`extras`]: parameters added to the library after the format, stored by name.
+//!
+//! A planner is saved as `Planner` → library state → [`v11::Payload`] (+ [`Extras`]) →
+//! bytes, and loaded the other way, every version through [`v11::Payload`].
+//! [`load_payload`] and [`save_payload`] give tools and tests the wire types of a file.
+//!
+//! # Adding a library parameter
+//!
+//! A parameter added to `PlannerParams`, `FitParams`, `WarpParams`, `ConfidenceParams` or
+//! `SamplerParams` with a default does **not** change the format. The build fails in
+//! [`v11`] (the conversion from the library type names every field): there
+//!
+//! 1. in the library → wire conversion, ignore the field (`new_field: _`) and in
+//!    `v11::Payload::from_state` store it by name: `extras.put("fit.warp.new_field",
+//!    &params.fit.warp.new_field, &ABSENT)?`, where `ABSENT` is the value that reproduces
+//!    what builds before it did (usually its default);
+//! 2. in the wire → library conversion, set it to `ABSENT`, and in `v11::Payload::into_state`
+//!    read it: `params.fit.warp.new_field = extras.take("fit.warp.new_field", ABSENT)?`
+//!    before `extras.finish()`.
+//!
+//! A planner at `ABSENT` then saves the very bytes of a build without the parameter; every
+//! older file loads with `ABSENT`; a planner off it writes one entry after the payload
+//! (still format 11), which this build reads back and a build without the parameter
+//! refuses, naming it (never drops it). The test `a_new_parameter_at_its_default_does_not_
+//! change_the_format` in [`v11`] does exactly this with a test-only parameter.
+//! A new format version is needed only when the shape of what is stored changes otherwise
+//! (a new kind of data, a changed meaning): then `v11.rs` moves to `legacy` with a
+//! conversion into the new `v12.rs`, and only then does the golden file change.
 //! Each failure is its own [`Error`] variant naming the file.
 //! A file of another version is refused ([`Error::UnsupportedVersion`] says whether it is
 //! older or newer than the build). A file of an older readable version is decoded with that
@@ -65,114 +107,32 @@ use serde::de::DeserializeOwned;
 
 use crate::{Error, Result};
 
-/// The state file's form of a `tandem_schedule::Outcome` (format 8), for
-/// `#[serde(with = "tandem_planner::state::outcome_form")]`: every field of the schedule and
-/// its holds always written. The schedule's own serde form leaves out empty holds, zero dwells
-/// and empty release lists (so that its JSON is the one of before hold points), which a
-/// format that is not self-describing (postcard) cannot read back.
-pub mod outcome_form {
-    use serde::{Deserialize, Deserializer, Serialize, Serializer};
-    use tandem_realtime::{After, Hold};
-    use tandem_schedule::{Outcome, SamplerStats, Schedule, Source};
+pub mod extras;
+mod legacy;
+pub mod v11;
 
-    #[derive(Serialize, Deserialize)]
-    struct HoldState {
-        ref_idx: usize,
-        dwell_s: f64,
-        after: Vec<After>,
-    }
+pub use extras::Extras;
 
-    #[derive(Serialize, Deserialize)]
-    struct ScheduleState {
-        grad_exec: Vec<Vec<f64>>,
-        offsets_s: Vec<f64>,
-        tick_s: f64,
-        holds: Vec<Vec<HoldState>>,
-    }
+use tandem_confidence::{Confidence, Observations};
+use tandem_lfd::{Demonstration, TaskModel};
+use tandem_schedule::Outcome;
 
-    #[derive(Serialize, Deserialize)]
-    struct OutcomeState {
-        schedule: ScheduleState,
-        t_total_s: f64,
-        source: Source,
-        stats: SamplerStats,
-        lower_bound_s: f64,
-        bound_is_optimum: bool,
-        gap: f64,
-    }
+use crate::PlannerParams;
+use crate::planner::ExecutionRecord;
 
-    /// Writes `o` in the state file's form.
-    ///
-    /// # Errors
-    /// The serializer's.
-    pub fn serialize<S: Serializer>(o: &Outcome, s: S) -> Result<S::Ok, S::Error> {
-        let sch = &o.schedule;
-        OutcomeState {
-            schedule: ScheduleState {
-                grad_exec: sch.grad_exec.clone(),
-                offsets_s: sch.offsets_s.clone(),
-                tick_s: sch.tick_s,
-                holds: sch
-                    .holds
-                    .iter()
-                    .map(|hs| {
-                        hs.iter()
-                            .map(|h| HoldState {
-                                ref_idx: h.ref_idx,
-                                dwell_s: h.dwell_s,
-                                after: h.after.clone(),
-                            })
-                            .collect()
-                    })
-                    .collect(),
-            },
-            t_total_s: o.t_total_s,
-            source: o.source,
-            stats: o.stats,
-            lower_bound_s: o.lower_bound_s,
-            bound_is_optimum: o.bound_is_optimum,
-            gap: o.gap,
-        }
-        .serialize(s)
-    }
-
-    /// Reads an outcome written by [`serialize`].
-    ///
-    /// # Errors
-    /// The deserializer's.
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Outcome, D::Error> {
-        let o = OutcomeState::deserialize(d)?;
-        let sch = o.schedule;
-        Ok(Outcome {
-            schedule: Schedule {
-                grad_exec: sch.grad_exec,
-                offsets_s: sch.offsets_s,
-                tick_s: sch.tick_s,
-                holds: sch
-                    .holds
-                    .into_iter()
-                    .map(|hs| {
-                        hs.into_iter()
-                            .map(|h| Hold {
-                                ref_idx: h.ref_idx,
-                                dwell_s: h.dwell_s,
-                                after: h.after,
-                            })
-                            .collect()
-                    })
-                    .collect(),
-            },
-            t_total_s: o.t_total_s,
-            source: o.source,
-            stats: o.stats,
-            lower_bound_s: o.lower_bound_s,
-            bound_is_optimum: o.bound_is_optimum,
-            gap: o.gap,
-            // Not stored: a loaded outcome has no previous schedule and no split of its gap.
-            margin_free_s: None,
-            previous: tandem_schedule::PreviousFate::NotGiven,
-        })
-    }
+/// The serialized part of a [`crate::Planner`] in library types (its problem is rebuilt on
+/// load): what [`v11::Payload`] converts from and to.
+#[derive(Clone, Debug)]
+pub(crate) struct PlannerState {
+    pub(crate) params: PlannerParams,
+    pub(crate) model: TaskModel,
+    pub(crate) observations: Observations,
+    pub(crate) confidence: Confidence,
+    pub(crate) outcome: Outcome,
+    pub(crate) rounds_recorded: usize,
+    pub(crate) rounds: Vec<u64>,
+    pub(crate) reference: Option<Demonstration>,
+    pub(crate) records: Vec<Vec<ExecutionRecord>>,
 }
 
 /// Magic bytes at the start of every state file.
@@ -180,7 +140,8 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 
 /// The state format version this build writes and reads.
 /// Bump it whenever the serialized payload changes shape, and regenerate the golden file
-/// (`cargo xtask fixtures`, see the module docs).
+/// (`cargo xtask fixtures`, see the module docs). A library parameter added with a default
+/// does not change the shape (module docs, "Adding a library parameter").
 ///
 /// - 1: first format.
 /// - 2: the sampler parameters gained `OffsetSampling::Fitted` and `max_margin_checks`.
@@ -229,13 +190,18 @@ pub const HEADER_LEN: usize = 24;
 /// Encode `value` as a complete state file image (header + payload).
 pub(crate) fn encode<T: Serialize>(value: &T) -> Result<Vec<u8>> {
     let payload = postcard::to_allocvec(value).map_err(|source| Error::Encode { source })?;
+    Ok(with_header(&payload))
+}
+
+/// The state file image of `payload`: the header of the current version, then the payload.
+fn with_header(payload: &[u8]) -> Vec<u8> {
     let mut bytes = Vec::with_capacity(HEADER_LEN + payload.len());
     bytes.extend_from_slice(&MAGIC);
     bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
     bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    bytes.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
-    bytes.extend_from_slice(&payload);
-    Ok(bytes)
+    bytes.extend_from_slice(&crc32fast::hash(payload).to_le_bytes());
+    bytes.extend_from_slice(payload);
+    bytes
 }
 
 /// Decode a state file image of the current version read from `path` (used only in error
@@ -322,6 +288,89 @@ pub(crate) fn decode_payload<T: DeserializeOwned>(payload: &[u8], path: &Path) -
         });
     }
     Ok(value)
+}
+
+/// The payload bytes of `payload` and the parameters stored by name after it: postcard of
+/// the payload, then, only when there is any, postcard of the [`Extras`] list.
+fn payload_bytes(payload: &v11::Payload, extras: &Extras) -> Result<Vec<u8>> {
+    let mut bytes = postcard::to_allocvec(payload).map_err(|source| Error::Encode { source })?;
+    if !extras.is_empty() {
+        bytes.extend(postcard::to_allocvec(extras).map_err(|source| Error::Encode { source })?);
+    }
+    Ok(bytes)
+}
+
+/// A complete state file image (header + payload) of `payload` and `extras`.
+fn encode_payload(payload: &v11::Payload, extras: &Extras) -> Result<Vec<u8>> {
+    Ok(with_header(&payload_bytes(payload, extras)?))
+}
+
+/// The complete state file image of a planner's state: [`v11::Payload::from_state`], then
+/// the current format.
+pub(crate) fn encode_state(state: &PlannerState) -> Result<Vec<u8>> {
+    let (payload, extras) = v11::Payload::from_state(state)?;
+    encode_payload(&payload, &extras)
+}
+
+/// The payload of a state file image read from `path` (only for error messages), of any
+/// readable version: a current one with the parameters stored by name after it, an older
+/// one converted (`legacy::upgrade`, no parameters by name).
+///
+/// # Errors
+/// As [`load`].
+pub(crate) fn decode_any(bytes: &[u8], path: &Path) -> Result<(v11::Payload, Extras)> {
+    let (version, payload) = checked_payload(bytes, path)?;
+    if version < FORMAT_VERSION {
+        return Ok((legacy::upgrade(version, payload, path)?, Extras::default()));
+    }
+    let (value, rest) =
+        postcard::take_from_bytes::<v11::Payload>(payload).map_err(|e| Error::Corrupt {
+            path: path.to_path_buf(),
+            why: format!("payload does not decode: {e}"),
+        })?;
+    let extras = if rest.is_empty() {
+        Extras::default()
+    } else {
+        decode_payload::<Extras>(rest, path)?
+    };
+    Ok((value, extras))
+}
+
+/// The planner state in a state file image read from `path`, of any readable version.
+///
+/// # Errors
+/// As [`load`]; [`Error::Corrupt`] naming `path` when the parts do not convert into the
+/// library's types (counts, flags, a demonstration, a parameter stored by name that this
+/// build does not know).
+pub(crate) fn decode_state(bytes: &[u8], path: &Path) -> Result<PlannerState> {
+    let (payload, extras) = decode_any(bytes, path)?;
+    payload.into_state(extras).map_err(|e| Error::Corrupt {
+        path: path.to_path_buf(),
+        why: e.to_string(),
+    })
+}
+
+/// The payload of the planner's state file at `path` as wire types ([`v11::Payload`], an
+/// older version converted) and the parameters stored after it by name: for tools and tests
+/// that read or edit a state file below the [`crate::Planner`] (which checks what it loads).
+///
+/// # Errors
+/// As [`load`].
+pub fn load_payload(path: &Path) -> Result<(v11::Payload, Extras)> {
+    decode_any(&read(path)?, path)
+}
+
+/// Saves a payload and the parameters stored by name after it ([`load_payload`]) to `path`
+/// as a current-version state file, atomically and under the file's lock, as [`save`]. The
+/// payload is not checked: [`crate::Planner::load`] checks it when it is read.
+///
+/// # Errors
+/// As [`save`].
+pub fn save_payload(path: &Path, payload: &v11::Payload, extras: &Extras) -> Result<()> {
+    let bytes = encode_payload(payload, extras)?;
+    let _lock = StateLock::acquire(path, DEFAULT_LOCK_TIMEOUT)?;
+    check_target(path)?;
+    write_atomic(path, &bytes)
 }
 
 /// Where a simulated crash interrupts [`write_atomic_with`] (tests only).
