@@ -560,8 +560,10 @@ fn old_payloads_convert_into_the_current_wire_types_with_what_they_were_made_wit
             "version {v}"
         );
     }
-    // Format 10 is format 11 without the reference and the executions.
+    // Format 10 is format 11 without the reference and the executions: the same parameters.
+    // (Not the same outcome: the golden file's model has this build's relative rate term, the
+    // version 10 file keeps the absolute one it was fitted with, and so its confidence and
+    // schedule; `a_version_6_file_loads_with_the_papers_confidence_model` checks that.)
     let (p10, _) = wire(10);
     assert_eq!(p10.params, golden.params);
-    assert_eq!(p10.outcome, golden.outcome);
 }
