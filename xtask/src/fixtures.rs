@@ -228,7 +228,12 @@ fn problem_csv(files: &[(String, Vec<u8>)], reference: &TaskDemo) -> anyhow::Res
             demos.push(tandem::lfd::Demonstration::from_csv_str(text, name, None)?);
         }
     }
-    let model = tandem::lfd::TaskModel::fit(&demos, &tandem::lfd::FitParams::default())
+    // Demo 0's labels: demo 0 is the reference.
+    let params = tandem::lfd::FitParams {
+        reference: tandem::lfd::Reference::First,
+        ..tandem::lfd::FitParams::default()
+    };
+    let model = tandem::lfd::TaskModel::fit(&demos, &params)
         .context("fitting the task model on the fixture demonstrations")?;
     anyhow::ensure!(
         model.n_ref() == reference.labels.len(),

@@ -10,6 +10,7 @@ mod bags;
 mod capacity;
 mod cellfig;
 mod fig5;
+mod fit_defaults;
 mod fixtures;
 mod reference_order;
 mod stress;
@@ -60,6 +61,10 @@ enum Cmd {
     /// medoid) and run a reduced study on each: how much the order of the demonstrations
     /// changes σ²_D, the speed bounds and the confidence (docs/decisions.md).
     ReferenceOrder(reference_order::ReferenceOrderArgs),
+    /// Fit every zoo task with every choice of first file, the medoid and the default
+    /// reference: high confidence from the prior, low-confidence regions and short islands
+    /// against the truth (docs/decisions.md, "Fit defaults measured on the task zoo").
+    FitDefaults(fit_defaults::FitDefaultsArgs),
     /// Run every test: `cargo test --workspace`, then build the Python wheel (maturin) into a
     /// virtual environment under target/ with the pinned packages of
     /// python/requirements-dev.txt and run pytest on python/tests (the README's test command).
@@ -121,6 +126,7 @@ fn main() -> anyhow::Result<()> {
             }
         }
         Cmd::ReferenceOrder(args) => reference_order::run(&args),
+        Cmd::FitDefaults(args) => fit_defaults::run(&args),
         Cmd::Test(args) => test::run_all(&args),
         Cmd::Zoo(args) => zoo::run(&args),
     }

@@ -47,8 +47,9 @@ pub(crate) enum Command {
     /// variability σ²_D(t), the demonstrated speed bounds and the admissible corrections,
     /// sets the confidence from the demonstrations alone (the prior) and samples a first
     /// schedule. The model's time axis is the reference's sample index. The reference is
-    /// the first file, or with --reference medoid the demonstration closest to all the
-    /// others (then the model does not depend on the order of the files).
+    /// the medoid, the demonstration on whose time axis the demonstrations agree best (the
+    /// model does not depend on the order of the files), or with --reference first the
+    /// first file.
     ///
     /// Demonstrations are CSV (header of channel names, optional time column `t` in seconds),
     /// JSON ({"channels", "dt_s", "samples"}, extension `.json`), or ROS 2 bags (rosbag2
@@ -60,7 +61,7 @@ pub(crate) enum Command {
     ///
     ///   tandem fit fixtures/sanding/demo_?.csv -o cell.tandem
     ///   tandem fit a.csv b.csv c.csv --ranges force=20,x=0.5 --params params.toml --samples 2000 -o cell.tandem
-    ///   tandem fit fixtures/sanding/demo_?.csv --reference medoid -o cell.tandem
+    ///   tandem fit fixtures/sanding/demo_?.csv --reference first -o cell.tandem
     ///   tandem fit fixtures/sanding/demo_?.csv --robots 3 -o cell3.tandem
     ///   tandem fit fixtures/examples/ros2/demo_?.mcap -o cell.tandem
     #[command(verbatim_doc_comment)]
@@ -201,9 +202,9 @@ pub(crate) struct FitArgs {
     #[arg(required = true, value_name = "DEMO")]
     pub(crate) demos: Vec<PathBuf>,
     /// Which demonstration is the reference, whose samples are the model's time axis:
-    /// `first` (the first file) or `medoid` (the one whose alignments to all the others cost
-    /// least; n alignment passes instead of one). Default: from the parameters (`[fit]
-    /// reference`, `first`).
+    /// `medoid` (the one whose model has the least median σ²_D; n alignment passes instead
+    /// of one) or `first` (the first file). Default: from the parameters (`[fit]
+    /// reference`, `medoid`).
     #[arg(long, value_name = "CHOICE", value_enum)]
     pub(crate) reference: Option<ReferenceArg>,
     /// Per-coordinate ranges r_j of the weights W = diag(1/r_j²), as NAME=VALUE pairs
@@ -287,7 +288,7 @@ pub(crate) struct FitArgs {
 pub(crate) enum ReferenceArg {
     /// The first demonstration file.
     First,
-    /// The demonstration with the least total alignment cost to the others.
+    /// The demonstration whose model has the least median σ²_D.
     Medoid,
 }
 

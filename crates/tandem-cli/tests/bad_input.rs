@@ -517,9 +517,10 @@ fn bad_hold_declarations() {
     let demos: Vec<String> = small_demos(&dir).iter().map(|p| s(p)).collect();
     let out = s(&dir.join("out.tandem"));
     let fit = |extra: &[&str]| {
+        // Demo 0 is the reference: the messages name its duration.
         let mut v = vec!["fit".to_string()];
         v.extend(demos.iter().cloned());
-        v.extend(["--samples", "50", "-o", &out].map(String::from));
+        v.extend(["--reference", "first", "--samples", "50", "-o", &out].map(String::from));
         v.extend(extra.iter().map(|x| x.to_string()));
         v
     };
@@ -1061,7 +1062,7 @@ fn simulate_refuses_a_schedule_checked_at_another_tick() {
         "[sampler]\nsamples = 200\ntick_s = 0.005\n",
     );
     let state = dir.join("cell.tandem");
-    let mut fit = vec!["fit".to_string()];
+    let mut fit = vec!["fit".to_string(), "--reference".into(), "first".into()];
     fit.extend(demos.iter().map(|p| s(p)));
     fit.extend(["--params".into(), s(&params), "-o".into(), s(&state)]);
     ok(&tandem(&fit));

@@ -70,9 +70,10 @@ fn simulated_t_totals(stdout: &str) -> Vec<f64> {
 fn fixtures_fit_simulate_record_schedule() {
     let dir = scratch("e2e");
     let state = dir.join("cell.tandem");
+    // Demo 0 is the reference (`--reference first`): the fixtures' labels are on its axis.
     let mut fit = vec!["fit".to_string()];
     fit.extend((0..6).map(|i| s(&repo().join(format!("fixtures/sanding/demo_{i}.csv")))));
-    fit.extend(["--samples", "200", "-o"].map(String::from));
+    fit.extend(["--reference", "first", "--samples", "200", "-o"].map(String::from));
     fit.push(s(&state));
     let stdout = ok(&tandem(&fit));
     assert!(stdout.contains("fitted 6 demonstrations"), "{stdout}");
@@ -467,8 +468,11 @@ fn medoid_reference_does_not_depend_on_the_order_of_the_files() {
     let p = write(&dir, "medoid.toml", "[fit]\nreference = \"medoid\"\n");
     let (_, c) = fit(&[1, 2, 0], &["--params", &s(&p)], "c.tandem");
     assert_eq!(c.model().sigma2_d(), a.model().sigma2_d());
-    // `first` (the default) takes the first file.
-    let (out_d, d) = fit(&[1, 2, 0], &[], "d.tandem");
+    // The medoid is the default.
+    let (_, e) = fit(&[1, 2, 0], &[], "e.tandem");
+    assert_eq!(e.model().sigma2_d(), a.model().sigma2_d());
+    // `first` takes the first file.
+    let (out_d, d) = fit(&[1, 2, 0], &["--reference", "first"], "d.tandem");
     assert_eq!(d.model().reference_idx(), 0);
     assert!(out_d.contains(&format!("reference: {}, the first file", demos[1])));
     let _ = std::fs::remove_dir_all(&dir);

@@ -82,9 +82,10 @@ fn period_notes_are_one_line_for_all_files_unless_verbose() {
     let demos: Vec<String> = (0..3)
         .map(|i| s(&ex.join(format!("demo_{i}.csv"))))
         .collect();
+    // Demo 0 is the reference: the example executions are logged on its axis.
     let mut fit = vec!["fit".to_string()];
     fit.extend(demos);
-    fit.extend(["--samples", "50", "-o"].map(String::from));
+    fit.extend(["--reference", "first", "--samples", "50", "-o"].map(String::from));
     fit.push(s(&cell));
     ok(&tandem(&fit));
     let mut rec = vec!["record".to_string(), s(&cell)];
@@ -231,7 +232,7 @@ fn a_rosbag2_folder_is_read_through_its_mcap_and_the_grid_note_is_said_once() {
     let state = s(&dir.join("cell.tandem"));
     let mut args: Vec<String> = vec!["fit".into()];
     args.extend(folders.iter().map(|p| s(p)));
-    args.extend(["--samples", "50", "-o"].map(String::from));
+    args.extend(["--reference", "first", "--samples", "50", "-o"].map(String::from));
     args.push(state.clone());
     let out = tandem(&args);
     let text = ok(&out);

@@ -12,7 +12,8 @@ use common::*;
 fn fit_args(demos: &[PathBuf], out: &Path, extra: &[&str]) -> Vec<OsString> {
     let mut v: Vec<OsString> = vec!["fit".into()];
     v.extend(demos.iter().map(|p| p.clone().into_os_string()));
-    v.extend(["--samples", "200"].map(OsString::from));
+    // The first file is the reference, as in `small_state` (the medoid is the default).
+    v.extend(["--reference", "first", "--samples", "200"].map(OsString::from));
     v.extend(extra.iter().map(OsString::from));
     v.push("-o".into());
     v.push(out.as_os_str().to_owned());

@@ -192,19 +192,36 @@ pub(crate) fn check_reaches_end(
     slope_min: f64,
     slope_max: f64,
 ) -> Result<()> {
+    match reaches_end_failure(demos, warps, slope_min, slope_max) {
+        Some((_, e)) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// [`check_reaches_end`]'s refusal with the position in `demos` of the demonstration it
+/// refuses (0: the reference itself), or `None`.
+pub(crate) fn reaches_end_failure(
+    demos: &[&Demonstration],
+    warps: &[Vec<f64>],
+    slope_min: f64,
+    slope_max: f64,
+) -> Option<(usize, Error)> {
     let reference = demos[0].source();
-    for (demo, warp) in demos.iter().zip(warps).skip(1) {
+    for (k, (demo, warp)) in demos.iter().zip(warps).enumerate().skip(1) {
         let run = end_run_share(warp, demo.n_samples(), slope_min, true);
         if run > END_RUN_REFUSE_SHARE && moves_after(demos[0], inner_start(warp.len(), run)) {
-            return Err(Error::TruncatedDemonstration {
-                file: demo.source().into(),
-                ends_at_pct: 100.0 * (1.0 - run),
-                why: format!(
-                    "aligned to the reference ({reference}), its last samples are spread over \
+            return Some((
+                k,
+                Error::TruncatedDemonstration {
+                    file: demo.source().into(),
+                    ends_at_pct: 100.0 * (1.0 - run),
+                    why: format!(
+                        "aligned to the reference ({reference}), its last samples are spread over \
                      the last {:.0} % of the task at the slowest pace the alignment allows",
-                    100.0 * run
-                ),
-            });
+                        100.0 * run
+                    ),
+                },
+            ));
         }
     }
     let others: Vec<f64> = demos
@@ -220,19 +237,22 @@ pub(crate) fn check_reaches_end(
         .collect();
     let shortest = others.iter().copied().fold(f64::INFINITY, f64::min);
     if !others.is_empty() && shortest > END_RUN_REFUSE_SHARE {
-        return Err(Error::TruncatedDemonstration {
-            file: reference.into(),
-            ends_at_pct: 100.0 * (1.0 - shortest),
-            why: format!(
-                "it is the reference, and every other demonstration's alignment to it ends with \
+        return Some((
+            0,
+            Error::TruncatedDemonstration {
+                file: reference.into(),
+                ends_at_pct: 100.0 * (1.0 - shortest),
+                why: format!(
+                    "it is the reference, and every other demonstration's alignment to it ends with \
                  at least the last {:.0} % of the task squeezed into its last sample (make \
                  another demonstration the reference if this one is kept: give it first, or \
                  `--reference medoid`)",
-                100.0 * shortest
-            ),
-        });
+                    100.0 * shortest
+                ),
+            },
+        ));
     }
-    Ok(())
+    None
 }
 
 /// One sentence per demonstration whose length is outside `[2/3, 3/2]` times the median

@@ -8,7 +8,7 @@
 //!   will have; an incomplete quaternion block or a channel named like a derived
 //!   coordinate (`rate`, `<block>.rx|ry|rz`) is a located error here and in the fit.
 //! - [`TaskModel`]: every demonstration aligned to the reference (GDTW, `tandem-warp`):
-//!   demo 0, or the medoid ([`FitParams::reference`], [`Reference`]); then per
+//!   the medoid, or demo 0 ([`FitParams::reference`], [`Reference`]); then per
 //!   reference sample the mean behaviour `μ̂`, the augmented mean `μ̂⁺` (Eq. 4–5), the
 //!   weighted variance `σ²_D` (Eq. 6), the warp-gradient bounds `ψ̇min/ψ̇max` (Eq. 14), and
 //!   the admissible corrections: principal components of the weighted augmented residuals,
@@ -25,8 +25,8 @@
 //! # Decisions
 //!
 //! - **Weights.** `W⁺ = diag(1/r_j²)` with `r_j` a per-coordinate range (default: the
-//!   channel's range over all demonstrations; for the rate, the range of all warp
-//!   gradients; ranges below `min_range` become 1), so `σ²_D` is dimensionless. The same
+//!   channel's range over all demonstrations; for the rate, `(s_max − 1)` times the mean
+//!   warp gradient; ranges below `min_range` become 1), so `σ²_D` is dimensionless. The same
 //!   ranges weight the alignment (`1/r_j²`, and `4/r_q²` on each quaternion component since
 //!   a small rotation `δr` moves a unit quaternion by `|δr|/2`). Ranges are fixed at fit
 //!   time; updates keep them so `σ²_D` stays comparable across iterations.
@@ -47,11 +47,15 @@
 //!   ([`TaskModel::execution_warp`]); no re-alignment. All demonstrations and executions must
 //!   share `Δt_s` within 1 %; a `t` column may jitter by up to 25 % of a period around its
 //!   even grid.
-//! - **Reference.** [`Reference::First`] (default) keeps the user's choice; with
-//!   [`Reference::Medoid`] every demonstration is tried as the reference and the one with
-//!   the least total alignment objective wins, and the model no longer depends on the order
-//!   of the demonstrations (measured with `cargo xtask reference-order`, see
-//!   docs/decisions.md).
+//! - **Reference.** With [`Reference::Medoid`] (default) every demonstration is tried as
+//!   the reference and the one whose model has the least median `σ²_D` wins, and the model
+//!   does not depend on the order of the demonstrations; [`Reference::First`] keeps the
+//!   user's choice (measured with `cargo xtask fit-defaults` and `cargo xtask
+//!   reference-order`, see docs/decisions.md).
+//! - **Rate.** The warp gradient's term of `σ²_D` weighs relative speed differences (its
+//!   range counts at the mean pace and scales with the local one; default `(s_max − 1)` times
+//!   the mean pace) and is opened over 13 reference samples, so that a change of speed the
+//!   alignment places a few samples apart in different demonstrations leaves no island.
 //! - **Eigendecompositions.** nalgebra's `SymmetricEigen`; faer gives the same results to
 //!   1e-12 on the fixtures but was slower on these 9 × 9 matrices (`benches/eigen.rs`,
 //!   docs/decisions.md).

@@ -52,7 +52,12 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn variance_and_first_component_follow_the_task_structure() {
     let demos = load_demos();
     let labels = reference_labels();
-    let model = TaskModel::fit(&demos, &FitParams::default()).unwrap();
+    // Demo 0's labels: demo 0 is the reference (the default medoid is demo 2).
+    let params = FitParams {
+        reference: tandem_lfd::Reference::First,
+        ..FitParams::default()
+    };
+    let model = TaskModel::fit(&demos, &params).unwrap();
     assert_eq!(model.n_ref(), labels.len());
     assert!((model.dt_s() - 0.01).abs() < 1e-12);
     let per = |which: Label| -> Vec<usize> {

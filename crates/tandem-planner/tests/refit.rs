@@ -58,14 +58,18 @@ fn demo(i: usize) -> Demonstration {
         .with_source(format!("demo_{i}"))
 }
 
+/// The defaults with 50 sampler candidates and the first demonstration as the reference
+/// (these tests choose the reference by the order of the demonstrations).
 fn params() -> PlannerParams {
-    PlannerParams {
+    let mut p = PlannerParams {
         sampler: SamplerParams {
             samples: 50,
             ..SamplerParams::default()
         },
         ..PlannerParams::default()
-    }
+    };
+    p.fit.reference = tandem_lfd::Reference::First;
+    p
 }
 
 /// Round `r` of two robots on a planner whose reference is demonstration `reference`: each

@@ -17,15 +17,19 @@ use common::fixtures;
 
 const ROUNDS: u64 = 8;
 
+/// The defaults with 100 sampler candidates, seed 5, and the first demonstration as the
+/// reference (the labels are on its axis; the medoid is the default).
 fn params() -> PlannerParams {
-    PlannerParams {
+    let mut p = PlannerParams {
         sampler: SamplerParams {
             samples: 100,
             seed: 5,
             ..SamplerParams::default()
         },
         ..PlannerParams::default()
-    }
+    };
+    p.fit.reference = tandem_lfd::Reference::First;
+    p
 }
 
 /// One round of two robots in the simulated workcell (seeded workpieces and operator), the

@@ -75,13 +75,15 @@ pub(crate) fn small_demos(dir: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
-/// Fits the small task into `dir/cell.tandem` (200 sampler candidates) and returns its path.
+/// Fits the small task into `dir/cell.tandem` (200 sampler candidates) with demo 0 as the
+/// reference (`--reference first`: the executions and need files of these tests are on its
+/// time axis) and returns its path.
 pub(crate) fn small_state(dir: &Path) -> PathBuf {
     let demos = small_demos(dir);
     let state = dir.join("cell.tandem");
     let mut args: Vec<&OsStr> = vec![OsStr::new("fit")];
     args.extend(demos.iter().map(|p| p.as_os_str()));
-    args.extend(["--samples", "200", "-o"].map(OsStr::new));
+    args.extend(["--reference", "first", "--samples", "200", "-o"].map(OsStr::new));
     args.push(state.as_os_str());
     ok(&tandem(args));
     state

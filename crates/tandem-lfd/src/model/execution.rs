@@ -106,6 +106,7 @@ impl TaskModel {
                 },
             );
         data.count += 1;
+        self.add_rate_terms();
         self.corrections = CorrectionCache::new(self.data.n_ref);
         Ok(())
     }

@@ -94,9 +94,6 @@ struct Alignment {
     non_rate_ranges: Vec<f64>,
     /// One warp per demonstration in model order (the reference's is the identity).
     warps: Vec<Vec<f64>>,
-    /// Total GDTW objective of the non-reference alignments (Eq. 3), summed in ascending
-    /// order so that it does not depend on the order of the others.
-    cost: f64,
 }
 
 /// Aligns every demonstration of `demos` to `demos[order[0]]` with the weights the fit
@@ -129,8 +126,6 @@ fn align_to(
         .map(|s| tandem_warp::SignalRef::new(s, m))
         .collect::<std::result::Result<Vec<_>, _>>()?;
     let aligned = tandem_warp::align_many(refs[0], &refs[1..], &warp_params)?;
-    let mut objectives: Vec<f64> = aligned.iter().map(tandem_warp::Warp::objective).collect();
-    objectives.sort_by(f64::total_cmp);
     let mut warps: Vec<Vec<f64>> = Vec::with_capacity(order.len());
     warps.push((0..reference.n_samples()).map(|n| n as f64).collect());
     warps.extend(aligned.iter().map(|w| w.values().to_vec()));
@@ -138,7 +133,6 @@ fn align_to(
         order,
         non_rate_ranges,
         warps,
-        cost: objectives.iter().sum(),
     })
 }
 
@@ -175,19 +169,96 @@ fn all_candidates(
         .collect()
 }
 
-/// The alignment the fit uses: to demo 0 ([`Reference::First`]), or to each demonstration
-/// in turn keeping the cheapest ([`Reference::Medoid`]; ties go to the earlier one).
-fn choose_alignment(
+/// The medoid's criterion of a model fitted on a candidate reference: the median of `σ²_D`
+/// (Eq. 6) over its reference samples (the upper one of an even count), how much the
+/// demonstrations disagree at a typical instant of the candidate's time axis
+/// (docs/decisions.md, "The reference demonstration: the medoid by default").
+fn medoid_criterion(model: &TaskModel) -> f64 {
+    let mut s2 = model.sigma2_d().to_vec();
+    let mid = s2.len() / 2;
+    *s2.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// One candidate reference of the medoid: its model and [`medoid_criterion`], or the
+/// demonstration (input index) that looks cut off on its time axis and the error saying so.
+type Candidate = std::result::Result<(TaskModel, f64), (usize, Error)>;
+
+/// Every demonstration tried as the reference ([`all_candidates`]), each fitted, in input
+/// order; an error other than a demonstration looking cut off ends the fit.
+fn candidate_models(
     demos: &[Demonstration],
     layout: &Layout,
     params: &FitParams,
-) -> Result<Alignment> {
-    match params.reference {
-        Reference::First => align_to(demos, (0..demos.len()).collect(), layout, params),
-        Reference::Medoid => Ok(all_candidates(demos, layout, params)?
-            .into_iter()
-            .reduce(|best, c| if c.cost < best.cost { c } else { best })
-            .expect("at least two demonstrations")),
+) -> Result<Vec<Candidate>> {
+    all_candidates(demos, layout, params)?
+        .into_par_iter()
+        .map(|alignment| {
+            let ordered: Vec<&Demonstration> = alignment.order.iter().map(|&i| &demos[i]).collect();
+            if let Some((k, e)) = crate::checks::reaches_end_failure(
+                &ordered,
+                &alignment.warps,
+                params.warp.slope_min,
+                params.warp.slope_max,
+            ) {
+                return Ok(Err((alignment.order[k], e)));
+            }
+            let model = TaskModel::from_alignment(demos, alignment, params, layout.clone())?;
+            let criterion = medoid_criterion(&model);
+            Ok(Ok((model, criterion)))
+        })
+        .collect()
+}
+
+/// The medoid ([`Reference::Medoid`]): of the candidates of [`candidate_models`] (in input
+/// order) on whose axis every demonstration reaches the end, the one with the least
+/// criterion, a tie going to the demonstration first in content order (so that the choice
+/// does not depend on the order of the input either).
+///
+/// A demonstration is refused as cut off when it looks so on the time axes of more than
+/// half of the other demonstrations (the error of the candidate first in content order that
+/// refuses it): one that does not reach the end looks cut off on every other axis, while on
+/// a legitimate set one odd candidate (a long pause of its own at the end) may make another
+/// look cut off (`tests/demo_coverage.rs`).
+fn medoid(demos: &[Demonstration], candidates: Vec<Candidate>) -> Result<TaskModel> {
+    let n = demos.len();
+    let by_content = |a: usize, b: usize| content_order(&demos[a], &demos[b]);
+    let mut votes = vec![0usize; n];
+    let mut refusal: Option<(usize, usize, Error)> = None;
+    let mut best: Option<(TaskModel, f64)> = None;
+    for (i, c) in candidates.into_iter().enumerate() {
+        match c {
+            Err((refused, e)) => {
+                votes[refused] += 1;
+                if 2 * votes[refused] > n - 1
+                    && refusal
+                        .as_ref()
+                        .is_none_or(|(j, ..)| by_content(i, *j).is_lt())
+                {
+                    refusal = Some((i, refused, e));
+                }
+            }
+            Ok(c) => {
+                best = Some(match best {
+                    None => c,
+                    Some(b) => {
+                        let closer =
+                            c.1.total_cmp(&b.1)
+                                .then_with(|| by_content(c.0.reference_idx(), b.0.reference_idx()));
+                        if closer.is_lt() { c } else { b }
+                    }
+                });
+            }
+        }
+    }
+    match (refusal, best) {
+        (Some((.., e)), _) => Err(e),
+        (None, Some((model, _))) => Ok(model),
+        (None, None) => Err(Error::BadData {
+            what: "demonstrations".into(),
+            why: "on the time axis of each of them another looks cut off: give the one that \
+                  reaches the end of the task first and fit with `--reference first`"
+                .into(),
+        }),
     }
 }
 
@@ -208,8 +279,8 @@ fn checked<'a>(
 }
 
 impl TaskModel {
-    /// Fits the model: chooses the reference ([`FitParams::reference`]: demo 0 by default,
-    /// or the medoid), aligns every demonstration to it with GDTW
+    /// Fits the model: chooses the reference ([`FitParams::reference`]: the medoid by
+    /// default, or demo 0), aligns every demonstration to it with GDTW
     /// (`tandem_warp::align_many`, in parallel), then computes the statistics as
     /// [`TaskModel::fit_aligned`] does. `n_ref() = T_ref`, the reference's sample count;
     /// [`TaskModel::reference_idx`] says which demonstration it was. The model's channel
@@ -222,7 +293,22 @@ impl TaskModel {
     pub fn fit(demos: &[Demonstration], params: &FitParams) -> Result<Self> {
         let (demos, layout) = checked(demos, params)?;
         crate::checks::check_lengths(&demos)?;
-        let alignment = choose_alignment(&demos, &layout, params)?;
+        match params.reference {
+            Reference::First => {
+                let alignment = align_to(&demos, (0..demos.len()).collect(), &layout, params)?;
+                Self::from_alignment(&demos, alignment, params, layout)
+            }
+            Reference::Medoid => medoid(&demos, candidate_models(&demos, &layout, params)?),
+        }
+    }
+
+    /// The model of one alignment: its statistics, its reference's index.
+    fn from_alignment(
+        demos: &[Demonstration],
+        alignment: Alignment,
+        params: &FitParams,
+        layout: Layout,
+    ) -> Result<Self> {
         let ordered: Vec<&Demonstration> = alignment.order.iter().map(|&i| &demos[i]).collect();
         crate::checks::check_reaches_end(
             &ordered,
@@ -243,8 +329,8 @@ impl TaskModel {
 
     /// Fits the model from known warps: `warps[i][n]` is demo `i`'s time (demo samples,
     /// fractional) at reference sample `n`. Demo 0 is the reference (`warps[0]` is normally
-    /// the identity `0, 1, …, T_0 − 1`), so [`FitParams::reference`] must be
-    /// [`Reference::First`].
+    /// the identity `0, 1, …, T_0 − 1`) whatever [`FitParams::reference`] says: the warps
+    /// chose it.
     ///
     /// Per reference sample it computes the mean `μ̂(n)`, the mean warp gradient and the
     /// augmented mean `μ̂⁺` (Eq. 5), the weighted variance `σ²_D(n)` (Eq. 6) and the gradient
@@ -252,21 +338,12 @@ impl TaskModel {
     ///
     /// # Errors
     /// As [`TaskModel::fit`], plus a warp of the wrong length, non-finite, decreasing, or
-    /// outside `[0, T_i − 1]`, and [`Error::BadParam`] for another reference choice.
+    /// outside `[0, T_i − 1]`.
     pub fn fit_aligned(
         demos: &[Demonstration],
         warps: &[Vec<f64>],
         params: &FitParams,
     ) -> Result<Self> {
-        if params.reference != Reference::First {
-            return Err(Error::BadParam {
-                name: "reference",
-                why: format!(
-                    "is `{}`, but fit_aligned takes warps onto demo 0 (use `first`)",
-                    params.reference
-                ),
-            });
-        }
         let (demos, layout) = checked(demos, params)?;
         let non_rate_ranges = match &params.ranges {
             Some(r) => r[..r.len() - 1].to_vec(),
@@ -276,20 +353,28 @@ impl TaskModel {
         Self::fit_from_warps(&ordered, warps, params, layout, non_rate_ranges)
     }
 
-    /// The medoid's criterion for every demonstration, in input order: the total GDTW
-    /// objective (Eq. 3, on normalized time) of aligning all the others to it, with the
-    /// weights it would have as the reference. [`Reference::Medoid`] picks the smallest;
-    /// how far apart the costs are says how clear that choice is. Ignores
+    /// The medoid's criterion for every demonstration, in input order: the median of
+    /// `σ²_D` (Eq. 6) of the model fitted with it as the reference (all the others aligned
+    /// to it with the weights it would have as the reference); infinite for a candidate on
+    /// whose time axis another demonstration looks cut off (refused as the medoid refuses). [`Reference::Medoid`] picks the
+    /// smallest; how far apart the values are says how clear that choice is. Ignores
     /// [`FitParams::reference`].
     ///
     /// # Errors
-    /// As [`TaskModel::fit`].
+    /// As [`TaskModel::fit`] (a demonstration cut off whatever the reference included).
     pub fn reference_costs(demos: &[Demonstration], params: &FitParams) -> Result<Vec<f64>> {
         let (demos, layout) = checked(demos, params)?;
-        Ok(all_candidates(&demos, &layout, params)?
+        let candidates = candidate_models(&demos, &layout, params)?;
+        let costs = candidates
             .iter()
-            .map(|c| c.cost)
-            .collect())
+            .map(|c| {
+                c.as_ref()
+                    .map_or(f64::INFINITY, |(_, criterion)| *criterion)
+            })
+            .collect();
+        // The medoid's refusals are the costs' too.
+        medoid(&demos, candidates)?;
+        Ok(costs)
     }
 
     /// The warp (reference sample → sample of `demo`, `n_ref()` values) with which a fit with
@@ -379,19 +464,14 @@ impl TaskModel {
             Some(r) => r.clone(),
             None => {
                 let mut r = non_rate_ranges;
-                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-                for o in &obs {
-                    for g in o.iter().skip(d - 1).step_by(d) {
-                        lo = lo.min(*g);
-                        hi = hi.max(*g);
-                    }
-                }
-                let rate_range = hi - lo;
-                r.push(if rate_range < params.min_range {
-                    1.0
-                } else {
-                    rate_range
-                });
+                let rate_range = super::stats::default_rate_range(&obs, d, &params.warp);
+                r.push(
+                    if rate_range < params.min_range || !rate_range.is_finite() {
+                        1.0
+                    } else {
+                        rate_range
+                    },
+                );
                 r
             }
         };
@@ -410,6 +490,7 @@ impl TaskModel {
             scatter: stats.scatter,
             grad_min: stats.grad_min,
             grad_max: stats.grad_max,
+            rate_term: super::RateTerm::Relative,
         };
         Ok(Self::from_data(data))
     }
@@ -425,17 +506,22 @@ mod tests {
         let model = three_demo_model();
         assert_eq!(model.n_ref(), 3);
         assert_eq!(model.tangent_names(), ["force", "rate"]);
-        // Force range 20 N; gradients {1, 1.5, 2.5} → rate range 1.5.
-        assert_eq!(model.ranges(), [20.0, 1.5]);
+        // Force range 20 N. Gradients per demonstration 1, 1, 1 | 1.5, 2.5, 2.5 | 1, 1, 1:
+        // mean pace 12.5/9 = 25/18, rate range (s_max − 1)·25/18 = 3·25/18 = 25/6.
+        assert_eq!(model.ranges()[0], 20.0);
+        assert!(close(model.ranges()[1], 25.0 / 6.0));
         // n = 1: forces 10, 7.5, 10 (demo 1 at its time 1.5); gradients 1, 2.5, 1.
         assert!(close(model.mean()[1], 55.0 / 6.0));
         assert!(close(model.grad_mean()[1], 1.5));
         assert_eq!((model.grad_min()[1], model.grad_max()[1]), (1.0, 2.5));
-        // σ²_D = [ (25+100+25)/36 / 20² + 1.5 / 1.5² ] / 2 = (1/96 + 2/3) / 2 = 65/192.
-        assert!(close(model.sigma2_d()[1], 65.0 / 192.0));
-        // n = 0: forces all 0, gradients 1, 1.5, 1 → rate residuals −1/6, 1/3, −1/6.
+        // The rate's range at sample n is 25/6 · ψ̄̇(n)/(25/18) = 3·ψ̄̇(n), so its raw term is
+        // var(n)/(9·ψ̄̇(n)²): n = 0: gradients 1, 1.5, 1, mean 7/6, var 1/12 → 1/147;
+        // n = 1 and 2: gradients 1, 2.5, 1, var 0.75 → 1/27. The opening over 13 samples
+        // takes the least of the three everywhere: 1/147.
         assert!(close(model.grad_mean()[0], 7.0 / 6.0));
-        assert!(close(model.sigma2_d()[0], (1.0 / 6.0) / 2.25 / 2.0));
+        assert!(close(model.sigma2_d()[0], 1.0 / 147.0));
+        // σ²_D(1) = (25+100+25)/36 / 20² / 2 + 1/147 = 1/192 + 1/147.
+        assert!(close(model.sigma2_d()[1], 1.0 / 192.0 + 1.0 / 147.0));
         // n = 2: last gradient repeats the previous: 1, 2.5, 1.
         assert_eq!(model.grad_max()[2], 2.5);
         assert_eq!(model.n_components(), 2);

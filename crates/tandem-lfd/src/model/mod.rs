@@ -76,6 +76,21 @@ pub struct TaskModel {
     corrections: CorrectionCache,
 }
 
+/// How the rate coordinate (the warp gradient) enters `σ²_D` (Eq. 6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) enum RateTerm {
+    /// `var_n(ψ̇) / r_rate²`, per sample: the term of the models fitted before the relative
+    /// term existed. A state file's model without the marker below loads with it, so that
+    /// it is the model it was saved as.
+    #[default]
+    Absolute,
+    /// Relative to the local mean pace and opened over [`stats::RATE_OPENING`] samples
+    /// ([`stats::rate_terms`]): every fit of this build. Persisted as one more entry after
+    /// the `d` ranges, the opening's width in reference samples (docs/decisions.md, "Fit
+    /// defaults on the task zoo": how an old state file keeps its model).
+    Relative,
+}
+
 /// The persisted part of a [`TaskModel`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -97,12 +112,32 @@ struct ModelData {
     scatter: Vec<f64>,
     grad_min: Vec<f64>,
     grad_max: Vec<f64>,
+    /// Not a field of the wire format: [`RateTerm::Relative`] is written as one more entry
+    /// of `ranges` ([`TaskModel`]'s conversions to and from this struct).
+    #[serde(skip)]
+    rate_term: RateTerm,
 }
 
 impl TryFrom<ModelData> for TaskModel {
     type Error = Error;
-    fn try_from(data: ModelData) -> Result<Self> {
+    fn try_from(mut data: ModelData) -> Result<Self> {
         let d = data.layout.dim();
+        // One entry after the `d` ranges marks the relative rate term (`RateTerm`); without
+        // it the model was saved by a build with the absolute term and keeps it.
+        data.rate_term = RateTerm::Absolute;
+        if data.ranges.len() == d + 1 {
+            let width = data.ranges.pop().expect("d + 1 entries");
+            if width != stats::RATE_OPENING as f64 {
+                return Err(Error::BadData {
+                    what: "task model".into(),
+                    why: format!(
+                        "the rate term's opening is {width} samples, this build knows {} only",
+                        stats::RATE_OPENING
+                    ),
+                });
+            }
+            data.rate_term = RateTerm::Relative;
+        }
         let n = data.n_ref;
         let ok = n >= 2
             && data.count >= 2
@@ -135,7 +170,11 @@ impl TryFrom<ModelData> for TaskModel {
 
 impl From<TaskModel> for ModelData {
     fn from(model: TaskModel) -> Self {
-        model.data
+        let mut data = model.data;
+        if data.rate_term == RateTerm::Relative {
+            data.ranges.push(stats::RATE_OPENING as f64);
+        }
+        data
     }
 }
 
@@ -278,6 +317,42 @@ mod tests {
     pub(super) fn three_demo_model() -> TaskModel {
         let (demos, warps) = three_demos();
         TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap()
+    }
+
+    #[test]
+    fn a_model_saved_without_the_rate_terms_marker_keeps_the_absolute_term() {
+        let model = three_demo_model();
+        let data = ModelData::from(model.clone());
+        // The relative term is persisted as one entry after the d = 2 ranges: the opening's
+        // width. Loaded back, the same model.
+        assert_eq!(data.ranges.len(), 3);
+        assert_eq!(data.ranges[2], 13.0);
+        let again = TaskModel::try_from(data.clone()).unwrap();
+        assert_eq!(again.sigma2_d(), model.sigma2_d());
+        assert_eq!(again.ranges(), model.ranges());
+        // Without it (a model saved before the relative term), the absolute term with the
+        // stored rate range 25/6: n = 0, gradients 1, 1.5, 1, var 1/12 → (1/12)·36/625 =
+        // 3/625; n = 1, gradients 1, 2.5, 1, var 3/4 → 27/625, plus the force's 1/192.
+        let mut legacy = data;
+        legacy.ranges.pop();
+        let old = TaskModel::try_from(legacy).unwrap();
+        assert!(close(old.sigma2_d()[0], 3.0 / 625.0));
+        assert!(close(old.sigma2_d()[1], 1.0 / 192.0 + 27.0 / 625.0));
+        // It stays absolute when saved again, and after an update (Eq. 21).
+        assert_eq!(ModelData::from(old.clone()).ranges.len(), 2);
+        let mut updated = old.clone();
+        updated
+            .update(&crate::Execution {
+                demonstration: demo(&["force"], vec![0.0, 10.0, 20.0]),
+                ref_time_log: vec![0.0, 1.0, 2.0],
+            })
+            .unwrap();
+        assert_eq!(ModelData::from(updated).ranges.len(), 2);
+        // A marker this build does not know is refused.
+        let mut other = ModelData::from(model);
+        other.ranges[2] = 7.0;
+        let err = TaskModel::try_from(other).unwrap_err().to_string();
+        assert!(err.contains("opening is 7 samples"), "{err}");
     }
 
     /// The model of two 2-sample demonstrations holding the constant orientations `a` and

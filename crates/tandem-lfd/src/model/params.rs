@@ -12,17 +12,18 @@ use crate::{Error, Result};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Reference {
-    /// The first demonstration given (default; the model then depends on which file the
-    /// user names first).
-    #[default]
+    /// The first demonstration given (the model then depends on which file the user names
+    /// first).
     First,
-    /// The medoid: the demonstration whose alignments to all the others have the least
-    /// total GDTW objective (`Σ_j J(ψ_j)` of Eq. 3, each `J` on normalized time, so
-    /// demonstrations of different lengths compare fairly), each candidate aligned with the
-    /// weights it would have as the reference. Costs `n_demos` alignment passes instead of
-    /// one. Ties go to the earlier demonstration; the others enter the statistics in a
-    /// fixed order of their content, so the fitted model does not depend on the order in
-    /// which the demonstrations are given.
+    /// The medoid (default): every demonstration is tried as the reference (all the others
+    /// aligned to it with the weights it would have as the reference, and the statistics
+    /// fitted), and the one whose model has the least median `σ²_D` (Eq. 6) over its
+    /// reference samples wins: the time axis on which the demonstrations agree best at a
+    /// typical instant. Costs `n_demos` alignment passes instead of one. Ties go to the
+    /// demonstration first in a fixed order of their content, and the others enter the
+    /// statistics in that order, so the fitted model is bit-identical for any order in which
+    /// the demonstrations are given (docs/decisions.md, "Fit defaults on the task zoo").
+    #[default]
     Medoid,
 }
 
@@ -59,7 +60,12 @@ pub struct FitParams {
     /// the rate); `W⁺ = diag(1/r_j²)` (Eq. 6). `None` (default): each scalar channel's
     /// range over all demonstrations' samples; for a quaternion block, the largest
     /// component range of the rotation vectors relative to the reference's first
-    /// orientation; for the rate, the range of all demonstrations' warp gradients.
+    /// orientation; for the rate, the largest speed-up the alignment admits at the
+    /// demonstrations' mean pace, `(warp.slope_max − 1) · ψ̄̇₀` (`ψ̄̇₀` the mean warp gradient).
+    /// The rate's term of `σ²_D` divides its range by the local mean pace over `ψ̄̇₀`, so it
+    /// weighs relative speed differences, and is opened over 13 reference samples (a rise
+    /// narrower than the alignment can place a change of speed is removed; docs/decisions.md,
+    /// "Fit defaults on the task zoo").
     pub ranges: Option<Vec<f64>>,
     /// Ranges below this are replaced by 1 (constant channels). Default: 1e-9.
     pub min_range: f64,
@@ -69,8 +75,8 @@ pub struct FitParams {
     /// Channel kinds and quaternion blocks. Default: [`ChannelSchema::default`].
     pub schema: ChannelSchema,
     /// Which demonstration is the reference (its samples are the model's time axis).
-    /// Default: [`Reference::First`]. [`TaskModel::fit_aligned`](crate::TaskModel::fit_aligned)
-    /// takes warps onto demo 0 and accepts only `First`.
+    /// Default: [`Reference::Medoid`]. [`TaskModel::fit_aligned`](crate::TaskModel::fit_aligned)
+    /// takes warps onto demo 0, whose samples are then the time axis whatever this says.
     pub reference: Reference,
 }
 
@@ -87,7 +93,7 @@ impl Default for FitParams {
             min_range: 1e-9,
             k_max: 3,
             schema: ChannelSchema::default(),
-            reference: Reference::First,
+            reference: Reference::Medoid,
         }
     }
 }

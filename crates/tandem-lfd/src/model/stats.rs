@@ -79,6 +79,28 @@ pub(super) fn observe(
     out
 }
 
+/// The default range of the rate coordinate (demo samples per reference sample): the largest
+/// speed-up the alignment admits, `s_max − 1` (normalized time, [`tandem_warp::WarpParams`];
+/// 3 at its default), at the demonstrations' mean pace (the mean warp gradient over every
+/// observation of `obs`, one `n_ref × d` array per demonstration, rate last). With
+/// [`rate_terms`]' weighting the rate's term of `σ²_D` is then the squared coefficient of
+/// variation of the demonstrations' speeds over `(s_max − 1)²`, whichever demonstration is
+/// the reference (docs/decisions.md, "Fit defaults on the task zoo: the rate term").
+pub(super) fn default_rate_range(
+    obs: &[Vec<f64>],
+    d: usize,
+    warp: &tandem_warp::WarpParams,
+) -> f64 {
+    let mut paces: Vec<f64> = obs
+        .iter()
+        .flat_map(|o| o.iter().skip(d - 1).step_by(d).copied())
+        .collect();
+    // Summed in ascending order: the same bits for any order of the demonstrations.
+    paces.sort_by(f64::total_cmp);
+    let mean_pace = paces.iter().sum::<f64>() / paces.len() as f64;
+    (warp.slope_max - 1.0) * mean_pace
+}
+
 /// The statistics of a set of aligned demonstrations, every array per reference sample.
 pub(super) struct BatchStats {
     /// `n_ref × d` tangent means.
@@ -166,8 +188,10 @@ pub(super) fn welford_add(
 }
 
 /// Derived values at one reference sample from its statistics: the physical mean into
-/// `out` (`m` values, quaternions `anchor ⊗ exp(r̄)`), and returns (mean rate, `σ²_D`) with
-/// `σ²_D = Σ_j scatter_jj / r_j² / denom` (Eq. 6, `denom = n − 1`; `inv_w[j] = 1/r_j²`).
+/// `out` (`m` values, quaternions `anchor ⊗ exp(r̄)`), and returns (mean rate, the channels'
+/// part of `σ²_D`) with that part `Σ_{j < d−1} scatter_jj / r_j² / denom` (Eq. 6,
+/// `denom = n − 1`; `inv_w[j] = 1/r_j²`): every coordinate but the rate, whose term
+/// [`rate_terms`] adds.
 pub(super) fn derive_at(
     layout: &Layout,
     anchors_n: &[Quat],
@@ -195,11 +219,68 @@ pub(super) fn derive_at(
             }
         }
     }
-    let s2 = (0..d)
+    let s2 = (0..d - 1)
         .map(|i| scatter_n[packed_idx(d, i, i)] * inv_w[i])
         .sum::<f64>()
         / denom;
     (mean_n[d - 1], s2)
+}
+
+/// Width of the rate term's opening, reference samples: three node spacings of the
+/// alignment's default grid ([`tandem_warp::DEFAULT_NODE_SPACING`]) and one, the stretch over
+/// which two warps may place one change of speed at different nodes (docs/decisions.md, "Fit
+/// defaults on the task zoo: the rate term").
+pub(super) const RATE_OPENING: usize = 3 * tandem_warp::DEFAULT_NODE_SPACING + 1;
+
+/// The rate's term of `σ²_D` per reference sample: the variance of the warp gradients
+/// relative to the local mean pace, `var_n(ψ̇) / (r_rate · ψ̄̇(n) / ψ̄̇₀)²` with `ψ̄̇₀` the mean
+/// of `ψ̄̇` over the reference (so the rate range `r_rate` counts at the task's mean pace,
+/// and a speed difference of 10 % weighs the same wherever the reference itself was fast
+/// or slow), then opened (a running minimum, then a running maximum, over
+/// [`RATE_OPENING`] samples): a rise of the term narrower than the alignment can place a
+/// change of speed is removed, a wider one kept as it is.
+///
+/// `scatter`, `tangent_mean`: the model's statistics (`n_ref` rows); `denom = n − 1`.
+pub(super) fn rate_terms(
+    scatter: &[f64],
+    tangent_mean: &[f64],
+    d: usize,
+    rate_range: f64,
+    denom: f64,
+) -> Vec<f64> {
+    let pl = packed_len(d);
+    let n_ref = tangent_mean.len() / d;
+    let pace = |n: usize| tangent_mean[n * d + d - 1];
+    let mean_pace = (0..n_ref).map(pace).sum::<f64>() / n_ref as f64;
+    let raw: Vec<f64> = (0..n_ref)
+        .map(|n| {
+            let var = scatter[n * pl + packed_idx(d, d - 1, d - 1)] / denom;
+            // A pace of 0 (or a mean pace of 0, no demonstrated motion) falls back to the
+            // range as given.
+            let local = if pace(n) > 0.0 && mean_pace > 0.0 {
+                rate_range * pace(n) / mean_pace
+            } else {
+                rate_range
+            };
+            var / (local * local)
+        })
+        .collect();
+    let eroded = running(&raw, RATE_OPENING / 2, f64::min);
+    running(&eroded, RATE_OPENING / 2, f64::max)
+}
+
+/// `out[n] = fold(v[n − h..=n + h])` (clipped at the ends) for an associative, commutative
+/// `fold` such as `f64::min`.
+fn running(v: &[f64], h: usize, fold: fn(f64, f64) -> f64) -> Vec<f64> {
+    (0..v.len())
+        .map(|n| {
+            v[n.saturating_sub(h)..(n + h + 1).min(v.len())]
+                .iter()
+                .copied()
+                .reduce(fold)
+                .expect("a window holds its centre")
+        })
+        .collect()
 }
 
 impl TaskModel {
@@ -243,6 +324,33 @@ impl TaskModel {
         self.mean = mean;
         self.grad_mean = grad_mean;
         self.sigma2_d = sigma2;
+        self.add_rate_terms();
+    }
+
+    /// Adds the rate's term ([`rate_terms`]) to `σ²_D`, whose channels' part
+    /// [`derive_at`] wrote.
+    pub(super) fn add_rate_terms(&mut self) {
+        let data = &self.data;
+        let d = data.layout.dim();
+        if data.rate_term == super::RateTerm::Absolute {
+            // The models saved before the relative term: `var_n(ψ̇) / r_rate²` per sample.
+            let pl = packed_len(d);
+            let inv = 1.0 / (data.ranges[d - 1] * data.ranges[d - 1] * (data.count - 1) as f64);
+            for (n, s2) in self.sigma2_d.iter_mut().enumerate() {
+                *s2 += data.scatter[n * pl + packed_idx(d, d - 1, d - 1)] * inv;
+            }
+            return;
+        }
+        let terms = rate_terms(
+            &data.scatter,
+            &data.tangent_mean,
+            d,
+            data.ranges[d - 1],
+            (data.count - 1) as f64,
+        );
+        for (s2, t) in self.sigma2_d.iter_mut().zip(terms) {
+            *s2 += t;
+        }
     }
 
     /// Mean tangent statistics at reference sample `n` (`d` values; rotation vectors

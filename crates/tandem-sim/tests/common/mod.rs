@@ -12,7 +12,12 @@ pub(crate) fn fixtures() -> &'static (StudyInputs, TaskModel) {
     CELL.get_or_init(|| {
         let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/sanding");
         let inputs = StudyInputs::from_dir(&dir).expect("the committed fixtures load");
-        let model = TaskModel::fit(&inputs.demos, &FitParams::default()).expect("fit");
+        // The labels are demo 0's: demo 0 is the reference (the fit's default is the medoid).
+        let params = FitParams {
+            reference: tandem_lfd::Reference::First,
+            ..FitParams::default()
+        };
+        let model = TaskModel::fit(&inputs.demos, &params).expect("fit");
         (inputs, model)
     })
 }
