@@ -24,7 +24,7 @@ use tandem::sim::study::{Cell, StudyInputs};
 use tandem_plot::{FONT_FAMILY, GROUND_TRUTH, HIGH_CONFIDENCE, ROBOT_LC_N};
 use tandem_zoo::eval::{
     EvalParams, FamilyRow, FitRow, SANDING, Step, Thresholds, ZooReport, check, evaluate,
-    family_rows, fit_rows, prepare_sanding,
+    export_alignments, family_rows, fit_rows, prepare_sanding,
 };
 
 use crate::workspace_root;
@@ -83,6 +83,44 @@ pub(crate) struct ZooArgs {
     /// Limit of a family's mean |high confidence − truth| (percentage points).
     #[arg(long, default_value_t = Thresholds::CI.max_high_vs_truth_pp)]
     max_hc_pp: f64,
+    /// Instead of running: generate and fit the families at the seeds and write, per task,
+    /// the demonstrations as the fit's alignment sees them (weighted), their true progress and
+    /// the fit's warps into DIR/<family>/<seed>/, for `bench/peers/zoo_gdtw.py`.
+    #[arg(long, value_name = "DIR")]
+    export_alignments: Option<PathBuf>,
+    /// A peer aligner's errors against the known warps (the JSON files
+    /// `bench/peers/zoo_gdtw.py` writes), shown beside the fit's in the fit table.
+    #[arg(long, value_delimiter = ',', value_name = "JSON")]
+    peer_warps: Vec<PathBuf>,
+}
+
+/// A peer aligner's error against the known warps on one task (written by
+/// `bench/peers/zoo_gdtw.py`; the same definition as `tandem_zoo::eval::WarpError`).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct PeerTask {
+    /// The family.
+    family: String,
+    /// The seed.
+    seed: u64,
+    /// Demonstrations scored.
+    pairs: usize,
+    /// Mean error, reference samples.
+    mean_samples: f64,
+    /// Largest error, reference samples.
+    max_samples: f64,
+    /// The peer's wall time over the task's pairs, seconds.
+    wall_s: f64,
+}
+
+/// A peer aligner's errors: what `bench/peers/zoo_gdtw.py` writes.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct PeerWarps {
+    /// The tool and version (e.g. `gdtw 1.2.1`).
+    tool: String,
+    /// Its setting (e.g. `default`).
+    setting: String,
+    /// Per task.
+    tasks: Vec<PeerTask>,
 }
 
 /// What `zoo.json` holds.
@@ -98,6 +136,9 @@ struct ZooFile {
     fit_rows: Vec<FitRow>,
     /// Everything: parameters, every fit and run.
     report: ZooReport,
+    /// Peer aligners' errors against the known warps (`--peer-warps`), if given.
+    #[serde(default)]
+    peer_warps: Vec<PeerWarps>,
 }
 
 /// The seeds of `--seeds` and the seed set's name.
@@ -133,17 +174,33 @@ pub(crate) fn run(args: &ZooArgs) -> anyhow::Result<()> {
         ..Thresholds::CI
     };
     let wall = Instant::now();
-    let (report, seed_set) = if args.from.is_empty() {
-        run_zoo(args)?
+    if let Some(dir) = &args.export_alignments {
+        return export(args, dir);
+    }
+    let (report, seed_set, mut peer_warps) = if args.from.is_empty() {
+        let (report, set) = run_zoo(args)?;
+        (report, set, Vec::new())
     } else {
         merge(&args.from)?
     };
+    for path in &args.peer_warps {
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        let peer: PeerWarps = serde_json::from_str(&text).with_context(|| {
+            format!(
+                "{}: not a peer-warp file of bench/peers/zoo_gdtw.py",
+                path.display()
+            )
+        })?;
+        add_peer(&mut peer_warps, peer);
+    }
     let file = ZooFile {
         git_revision: crate::study::git_revision(&root),
         seed_set: seed_set.clone(),
         family_rows: family_rows(&report),
         fit_rows: fit_rows(&report),
         report,
+        peer_warps,
     };
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let json = out.join("zoo.json");
@@ -180,19 +237,76 @@ pub(crate) fn run(args: &ZooArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Adds `peer`'s tasks to the entry of `peers` with the same tool and setting (one column
+/// per setting however many files it came in; a task given twice counts once, the later
+/// file's), or appends it.
+fn add_peer(peers: &mut Vec<PeerWarps>, peer: PeerWarps) {
+    match peers
+        .iter_mut()
+        .find(|p| p.tool == peer.tool && p.setting == peer.setting)
+    {
+        Some(p) => {
+            for t in peer.tasks {
+                p.tasks
+                    .retain(|u| !(u.family == t.family && u.seed == t.seed));
+                p.tasks.push(t);
+            }
+        }
+        None => peers.push(peer),
+    }
+}
+
+/// The families of `--families` (every family when none is given; `sanding` left out).
+fn zoo_families(args: &ZooArgs) -> anyhow::Result<Vec<&'static tandem_zoo::Family>> {
+    if args.families.is_empty() {
+        return Ok(tandem_zoo::families().iter().collect());
+    }
+    args.families
+        .iter()
+        .filter(|f| *f != SANDING)
+        .map(|f| tandem_zoo::family(f).map_err(|e| anyhow!("--families: {e} (or `{SANDING}`)")))
+        .collect()
+}
+
+/// `--export-alignments DIR`: the families' demonstrations, true progress and fitted warps
+/// for a peer aligner.
+fn export(args: &ZooArgs, dir: &Path) -> anyhow::Result<()> {
+    let (seeds, _) = seeds(&args.seeds)?;
+    let families = zoo_families(args)?;
+    if families.is_empty() {
+        bail!("--export-alignments: the sanding fixture has no known warps; name zoo families");
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .context("building the thread pool")?;
+    let planner = EvalParams::default().planner;
+    let metas = pool.install(|| export_alignments(&families, &seeds, &planner, dir))?;
+    for m in &metas {
+        println!(
+            "{} seed {}: {} demonstrations, reference {}; fit's warp error {:.2} mean, {:.1} max \
+             (reference samples)",
+            m.family,
+            m.seed,
+            m.n_demos,
+            m.reference_idx,
+            m.tandem.mean_samples,
+            m.tandem.max_samples
+        );
+    }
+    println!(
+        "wrote {} tasks into {}; run bench/peers/zoo_gdtw.py on it",
+        metas.len(),
+        dir.display()
+    );
+    Ok(())
+}
+
 /// Runs the evaluation the flags ask for, with a progress bar.
 fn run_zoo(args: &ZooArgs) -> anyhow::Result<(ZooReport, String)> {
     let (seeds, mut seed_set) = seeds(&args.seeds)?;
     let sanding = args.families.iter().any(|f| f == SANDING);
-    let families: Vec<&tandem_zoo::Family> = if args.families.is_empty() {
-        tandem_zoo::families().iter().collect()
-    } else {
-        args.families
-            .iter()
-            .filter(|f| *f != SANDING)
-            .map(|f| tandem_zoo::family(f).map_err(|e| anyhow!("--families: {e} (or `{SANDING}`)")))
-            .collect::<anyhow::Result<_>>()?
-    };
+    let families = zoo_families(args)?;
     if sanding && families.is_empty() {
         seed_set = SANDING.into();
     }
@@ -247,13 +361,17 @@ fn run_zoo(args: &ZooArgs) -> anyhow::Result<(ZooReport, String)> {
 
 /// Reads saved reports and puts their fits and runs together (the first one's parameters,
 /// with every seed, robot count and cell of any).
-fn merge(paths: &[PathBuf]) -> anyhow::Result<(ZooReport, String)> {
+fn merge(paths: &[PathBuf]) -> anyhow::Result<(ZooReport, String, Vec<PeerWarps>)> {
     let mut merged: Option<(ZooReport, String)> = None;
+    let mut peers: Vec<PeerWarps> = Vec::new();
     for path in paths {
         let text =
             std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
         let file: ZooFile = serde_json::from_str(&text)
             .with_context(|| format!("{}: not a zoo.json of this version", path.display()))?;
+        for peer in file.peer_warps {
+            add_peer(&mut peers, peer);
+        }
         match &mut merged {
             None => merged = Some((file.report, file.seed_set)),
             Some((m, set)) => {
@@ -301,7 +419,7 @@ fn merge(paths: &[PathBuf]) -> anyhow::Result<(ZooReport, String)> {
     report
         .runs
         .sort_by_key(|r| (rank(&r.family), r.seed, r.robots, cell(r.cell)));
-    Ok((report, set))
+    Ok((report, set, peers))
 }
 
 /// A number with `d` decimals, or "—" when it is not finite.
@@ -323,18 +441,24 @@ fn cell_name(c: Cell) -> &'static str {
 /// The Markdown tables of a report.
 fn markdown(file: &ZooFile) -> String {
     let p = &file.report.params;
+    let tasks = if file.seed_set == SANDING {
+        "The sanding fixture (`fixtures/sanding`, the study's hold rules; one task)".to_string()
+    } else {
+        format!(
+            "Seeds `{}` ({})",
+            file.seed_set,
+            p.seeds
+                .iter()
+                .map(u64::to_string)
+                .collect::<Vec<_>>()
+                .join(",")
+        )
+    };
     let mut s = format!(
-        "Seeds `{}` ({}), {} rounds per run (continuous: re-plans after N tasks each), git `{}`.\n\
+        "{tasks}, {} rounds per run (continuous: re-plans after N tasks each), git `{}`.\n\
          Means over seeds; for a continuous cell `T_total` is the plan's period `P` (N tasks) and \
          the bound its `lower_bound_s`.\n\n",
-        file.seed_set,
-        p.seeds
-            .iter()
-            .map(u64::to_string)
-            .collect::<Vec<_>>()
-            .join(","),
-        p.rounds,
-        file.git_revision
+        p.rounds, file.git_revision
     );
     s.push_str(
         "| family | N | cell | T_total (s) | bound (s) | gap % (max) | T/serial | HC % | truth % | \
@@ -404,15 +528,34 @@ fn markdown(file: &ZooFile) -> String {
     }
     s.push_str(
         "\nThe fit alone (defaults, before any round): high confidence of the prior against the \
-         truth on the reference's time axis, low-confidence runs, and the reference-choice \
+         truth on the reference's time axis, low-confidence runs, the reference-choice \
          spread (largest − smallest high confidence over every choice of first file; the medoid \
-         against the best single file).\n\n\
-         | family | seeds | truth % | HC after fit % | LC runs after fit | spread pp (max) | \
-         medoid − best pp |\n|---|---|---|---|---|---|---|\n",
+         against the best single file), and the alignment's error against the known warps \
+         (`|τ(ψ̂(n)) − n|` in reference samples over every reference sample of every \
+         demonstration but the reference: mean over seeds, the largest in brackets)",
     );
+    let mut header = String::from(
+        "| family | seeds | truth % | HC after fit % | LC runs after fit | spread pp (max) | \
+         medoid − best pp | warp error: fit |",
+    );
+    let mut rule = String::from("|---|---|---|---|---|---|---|---|");
+    for peer in &file.peer_warps {
+        header.push_str(&format!(" warp error: {} ({}) |", peer.tool, peer.setting));
+        rule.push_str("---|");
+    }
+    if file.peer_warps.is_empty() {
+        s.push_str(".\n\n");
+    } else {
+        s.push_str(
+            ", beside a peer's on the same demonstrations with the same weights \
+             (`bench/peers/zoo_gdtw.py`; the fit's on the same seeds after \"fit\" where the \
+             peer ran fewer).\n\n",
+        );
+    }
+    s.push_str(&format!("{header}\n{rule}\n"));
     for f in &file.fit_rows {
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} ({}) | {} |\n",
+            "| {} | {} | {} | {} | {} | {} ({}) | {} | {} |",
             f.family,
             f.seeds,
             num(f.truth_pct, 1),
@@ -421,9 +564,83 @@ fn markdown(file: &ZooFile) -> String {
             f.spread_pp.map_or("—".into(), |v| num(v, 1)),
             f.spread_max_pp.map_or("—".into(), |v| num(v, 1)),
             f.medoid_vs_best_pp.map_or("—".into(), |v| num(v, 1)),
+            match (f.warp_mean_samples, f.warp_max_samples) {
+                (Some(m), Some(x)) => format!("{} ({})", num(m, 2), num(x, 1)),
+                _ => "—".into(),
+            },
+        ));
+        for peer in &file.peer_warps {
+            s.push_str(&format!(" {} |", peer_cell(file, f, peer)));
+        }
+        s.push('\n');
+    }
+    let unmeasured: Vec<&str> = file
+        .fit_rows
+        .iter()
+        .filter(|f| f.spread_pp.is_none() && f.family != SANDING)
+        .map(|f| f.family.as_str())
+        .collect();
+    if !unmeasured.is_empty() {
+        s.push_str(&format!(
+            "\nReference-choice spread not measured for {} (every run of it was made with \
+             `--no-spread`; `scripts/zoo_heldout.sh` measures it with each family's rounds).\n",
+            unmeasured.join(", ")
         ));
     }
     s
+}
+
+/// Mean of the means and largest of the maxima of `(mean, max)` pairs; `None` for none.
+fn mean_max(v: &[(f64, f64)]) -> Option<(f64, f64)> {
+    (!v.is_empty()).then(|| {
+        (
+            v.iter().map(|p| p.0).sum::<f64>() / v.len() as f64,
+            v.iter().map(|p| p.1).fold(0.0, f64::max),
+        )
+    })
+}
+
+/// The fit table's cell of `peer` for the family of `row`: its error over the seeds it ran,
+/// and the fit's on the same seeds when those are fewer than the row's.
+fn peer_cell(file: &ZooFile, row: &FitRow, peer: &PeerWarps) -> String {
+    let tasks: Vec<&PeerTask> = peer
+        .tasks
+        .iter()
+        .filter(|t| t.family == row.family)
+        .collect();
+    let Some((mean, max)) = mean_max(
+        &tasks
+            .iter()
+            .map(|t| (t.mean_samples, t.max_samples))
+            .collect::<Vec<_>>(),
+    ) else {
+        return "—".into();
+    };
+    let cell = format!("{} ({})", num(mean, 2), num(max, 1));
+    if tasks.len() >= row.seeds {
+        return cell;
+    }
+    let fit: Vec<(f64, f64)> = file
+        .report
+        .fits
+        .iter()
+        .filter(|f| f.family == row.family && tasks.iter().any(|t| t.seed == f.seed))
+        .filter_map(|f| f.warp_error.as_ref())
+        .map(|w| (w.mean_samples, w.max_samples))
+        .collect();
+    let seeds = tasks
+        .iter()
+        .map(|t| t.seed.to_string())
+        .collect::<Vec<_>>()
+        .join(",");
+    match mean_max(&fit) {
+        Some((fm, fx)) => format!(
+            "{cell} on seeds {seeds}; fit {} ({})",
+            num(fm, 2),
+            num(fx, 1)
+        ),
+        None => format!("{cell} on seeds {seeds}"),
+    }
 }
 
 /// Replaces the section of docs/zoo.md between `<!-- zoo:<set> -->` and
@@ -456,7 +673,7 @@ fn write_docs(root: &Path, file: &ZooFile, tables: &str, out: &Path) -> anyhow::
 }
 
 /// Image size (pixels; SVG user units).
-const SIZE_PX: (u32, u32) = (1600, 620);
+const SIZE_PX: (u32, u32) = (1760, 620);
 
 /// Draws the figure (module docs) as SVG and PNG.
 fn draw(file: &ZooFile, svg: &Path, png: &Path) -> anyhow::Result<()> {
@@ -490,7 +707,8 @@ fn draw_on<DB: DrawingBackend>(
     root.fill(&WHITE).map_err(err("background"))?;
     let families = &file.report.families;
     let nf = families.len().max(1) as f64;
-    let (left, right) = root.split_horizontally(SIZE_PX.0 * 11 / 20);
+    // Two panels of equal width: at 45 % the right one's family names ran into each other.
+    let (left, right) = root.split_horizontally(SIZE_PX.0 / 2);
     let rows = &file.family_rows;
     let x_of = |family: &str| families.iter().position(|f| f == family).unwrap_or(0) as f64;
     let robots: Vec<usize> = file.report.params.robots.clone();
@@ -592,7 +810,7 @@ fn draw_on<DB: DrawingBackend>(
         .configure_mesh()
         .x_labels(families.len())
         .x_label_formatter(&label)
-        .x_label_style((FONT_FAMILY, 13))
+        .x_label_style((FONT_FAMILY, 12))
         .y_label_formatter(&|v| {
             if *v <= 100.0 {
                 format!("{v:.0}")
@@ -677,6 +895,45 @@ mod tests {
         assert_eq!(seeds("3,1001").unwrap().1, "custom");
         let e = seeds("1,x").unwrap_err().to_string();
         assert!(e.contains("--seeds 1,x") && e.contains("held-out"), "{e}");
+    }
+
+    #[test]
+    fn peer_files_of_one_setting_make_one_column() {
+        let task = |family: &str, seed, mean_samples| PeerTask {
+            family: family.into(),
+            seed,
+            pairs: 2,
+            mean_samples,
+            max_samples: 2.0 * mean_samples,
+            wall_s: 1.0,
+        };
+        let file = |setting: &str, tasks| PeerWarps {
+            tool: "gdtw 1.2.1".into(),
+            setting: setting.into(),
+            tasks,
+        };
+        let mut peers = Vec::new();
+        add_peer(
+            &mut peers,
+            file("default", vec![task("painting", 1000, 1.0)]),
+        );
+        add_peer(
+            &mut peers,
+            file(
+                "default",
+                vec![task("deburring", 1000, 3.0), task("painting", 1000, 4.0)],
+            ),
+        );
+        add_peer(&mut peers, file("best", vec![task("painting", 1000, 5.0)]));
+        assert_eq!(peers.len(), 2);
+        let means: Vec<(&str, f64)> = peers[0]
+            .tasks
+            .iter()
+            .map(|t| (t.family.as_str(), t.mean_samples))
+            .collect();
+        assert_eq!(means, [("deburring", 3.0), ("painting", 4.0)]);
+        assert_eq!(mean_max(&[(1.0, 3.0), (2.0, 5.0)]), Some((1.5, 5.0)));
+        assert_eq!(mean_max(&[]), None);
     }
 
     #[test]

@@ -284,6 +284,20 @@ impl TaskModel {
     pub fn ranges(&self) -> &[f64] {
         &self.data.ranges
     }
+
+    /// Per channel (model channel order, [`TaskModel::channel_names`]) the weight `W_jj` with
+    /// which the fit aligned every demonstration to the reference (Eq. 3), and
+    /// [`TaskModel::align_demonstration`] aligns one, when `FitParams::warp.weights` does not
+    /// give them: `1/r_j²` for a scalar channel, `4/r²` for each channel of a quaternion block
+    /// (`r` the largest of the block's rotation ranges). Read-only; for peers that must align
+    /// the same data with the same weights (the task zoo's alignment comparison).
+    #[must_use]
+    pub fn warp_weights(&self) -> Vec<f64> {
+        let d = self.data.layout.dim();
+        self.data
+            .layout
+            .warp_weights(&self.data.ranges[..d - 1], self.data.channel_names.len())
+    }
 }
 
 #[cfg(test)]
@@ -366,6 +380,12 @@ mod tests {
             &FitParams::default(),
         )
         .unwrap()
+    }
+
+    #[test]
+    fn warp_weights_are_the_inverse_squared_ranges() {
+        // force spans 0..20 over the demonstrations: W = 1/20².
+        assert_eq!(three_demo_model().warp_weights(), [1.0 / 400.0]);
     }
 
     #[test]

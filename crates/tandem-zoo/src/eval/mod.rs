@@ -19,17 +19,21 @@
 //! demonstrations vary, and apart where they all agree); rounds until the robots first
 //! overlap; the largest round-to-round increase of `T_total`; realized against planned time
 //! and throughput; backward steps of reference time and overlapping ticks (from the per-tick
-//! records; must be 0); the reference-choice spread. [`Thresholds`] is the one place the
-//! acceptance limits live ([`check`]).
+//! records; must be 0); the reference-choice spread; the alignment's error against the
+//! family's known warps ([`WarpError`]; [`export_alignments`] writes the same data for a peer
+//! aligner). [`Thresholds`] is the one place the acceptance limits live ([`check`]).
 
 mod prepare;
 mod run;
 mod summary;
+mod warps;
 
+use std::path::Path;
 use std::sync::Mutex;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use tandem_lfd::TaskModel;
 use tandem_planner::PlannerParams;
 use tandem_sim::study::Cell;
 
@@ -39,6 +43,7 @@ pub use prepare::{
 };
 pub use run::{RunReport, run_continuous, run_rounds};
 pub use summary::{Breach, FamilyRow, FitRow, Thresholds, check, family_rows, fit_rows};
+pub use warps::{ExportMeta, WarpError, export_alignment, fitted_warps, warp_error, warp_errors};
 
 use crate::{Error, Family, Result};
 
@@ -209,4 +214,39 @@ pub fn evaluate(
         fits: prepared.into_iter().map(|p| p.report).collect(),
         runs,
     })
+}
+
+/// Generates and fits (as [`prepare`] does: the defaults of `planner.fit`) every family of
+/// `families` at every seed, and writes what a peer aligner needs to align the same
+/// demonstrations with the same weights into `dir/<family>/<seed>/` ([`export_alignment`]),
+/// in parallel. Returns every task's [`ExportMeta`] in family, then seed order.
+///
+/// # Errors
+/// The generator's, the fit's or the alignment's errors; [`Error::Io`] naming a file that
+/// could not be written.
+pub fn export_alignments(
+    families: &[&Family],
+    seeds: &[u64],
+    planner: &PlannerParams,
+    dir: &Path,
+) -> Result<Vec<ExportMeta>> {
+    let tasks: Vec<(&Family, u64)> = families
+        .iter()
+        .flat_map(|f| seeds.iter().map(move |&s| (*f, s)))
+        .collect();
+    tasks
+        .par_iter()
+        .map(|(family, seed)| {
+            let task = (family.generate)(*seed)?;
+            let demos = task.demos()?;
+            let model = TaskModel::fit(&demos, &planner.fit)?;
+            export_alignment(
+                &task,
+                &demos,
+                &model,
+                &planner.fit,
+                &dir.join(family.name).join(seed.to_string()),
+            )
+        })
+        .collect()
 }

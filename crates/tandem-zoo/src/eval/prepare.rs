@@ -12,6 +12,7 @@ use tandem_sim::study::StudyInputs;
 use tandem_sim::task::{TaskParams, ground_truth_share};
 use tandem_sim::truth::{ProfileTruth, SandingTruth, TaskTruth, needs_help};
 
+use super::warps::{WarpError, fitted_warps, warp_error};
 use crate::{Error, Family, Result, ZooTask};
 
 /// Channels a simulated operator's correction aims at, in order of preference: the task's
@@ -99,6 +100,11 @@ pub struct FitReport {
     pub fit_falsely_trusted_agreeing: usize,
     /// The reference-choice spread (`None` when not measured).
     pub spread: Option<ReferenceSpread>,
+    /// The fit's alignment against the family's known warps ([`super::warps`]; `None` for
+    /// the sanding fixture, whose true warps are not known, and in reports written before it
+    /// was measured).
+    #[serde(default)]
+    pub warp_error: Option<WarpError>,
 }
 
 /// A task ready for the loop.
@@ -255,6 +261,7 @@ pub fn prepare_sanding(
         fit_falsely_trusted,
         fit_falsely_trusted_agreeing,
         spread: None,
+        warp_error: None,
     };
     Ok(Prepared {
         family: SANDING,
@@ -326,6 +333,8 @@ pub fn prepare(
     } else {
         None
     };
+    let warps = fitted_warps(&model, &demos, &planner.fit)?;
+    let warp_error = Some(warp_error(&task, r, &warps)?);
     let report = FitReport {
         family: family.name.to_string(),
         seed,
@@ -344,6 +353,7 @@ pub fn prepare(
         fit_falsely_trusted,
         fit_falsely_trusted_agreeing,
         spread,
+        warp_error,
     };
     Ok(Prepared {
         family: family.name,

@@ -99,6 +99,13 @@ pub struct FitRow {
     pub spread_max_pp: Option<f64>,
     /// Mean of the medoid's high confidence minus the best single file's, pp.
     pub medoid_vs_best_pp: Option<f64>,
+    /// The alignment's error against the known warps (`WarpError::mean_samples`), mean over
+    /// the seeds that measured it, reference samples; `None` when none did.
+    #[serde(default)]
+    pub warp_mean_samples: Option<f64>,
+    /// The largest `WarpError::max_samples` of a seed, reference samples.
+    #[serde(default)]
+    pub warp_max_samples: Option<f64>,
 }
 
 fn mean(v: impl IntoIterator<Item = f64>) -> f64 {
@@ -207,6 +214,8 @@ pub fn fit_rows(report: &ZooReport) -> Vec<FitRow> {
             }
             let spreads: Vec<_> = fits.iter().filter_map(|f| f.spread.as_ref()).collect();
             let measured = !spreads.is_empty();
+            let warps: Vec<_> = fits.iter().filter_map(|f| f.warp_error.as_ref()).collect();
+            let aligned = !warps.is_empty();
             Some(FitRow {
                 family: family.clone(),
                 seeds: fits.len(),
@@ -218,6 +227,9 @@ pub fn fit_rows(report: &ZooReport) -> Vec<FitRow> {
                     .then(|| spreads.iter().map(|s| s.spread_pp()).fold(0.0, f64::max)),
                 medoid_vs_best_pp: measured
                     .then(|| mean(spreads.iter().map(|s| s.medoid_vs_best_pp()))),
+                warp_mean_samples: aligned.then(|| mean(warps.iter().map(|w| w.mean_samples))),
+                warp_max_samples: aligned
+                    .then(|| warps.iter().map(|w| w.max_samples).fold(0.0, f64::max)),
             })
         })
         .collect()
