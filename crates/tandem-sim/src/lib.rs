@@ -8,14 +8,14 @@
 //! Every demonstration comes with per-sample ground-truth labels (pass, section, painted, phase)
 //! that the simulated study uses to decide whether a sample needs the operator's correction.
 //!
-//! The [`workcell`] runs a planner's schedule on two robots through the real-time coordinator
-//! while a simulated operator supervises the low-confidence robot
-//! ([`workcell::run_pair`]`(&planner, …)` reads model, problem, schedule and control tick from
-//! the one `tandem_planner::Planner`), and turns the pair into the planner's execution records
-//! ([`workcell::PairRun::records`]).
+//! The [`workcell`] runs a planner's schedule on its `N` robots through the real-time
+//! coordinator while a simulated operator supervises the low-confidence robot
+//! ([`workcell::run_round`]`(&planner, …)` reads model, problem, schedule and control tick from
+//! the one `tandem_planner::Planner`), and turns the round into the planner's execution records
+//! ([`workcell::RoundRun::records`]); [`workcell::CellSim`] runs a continuous cell.
 //! A need profile ([`needs`]) says where a workpiece needs the operator, for any task: from
 //! reference-time regions, per-sample levels or a need file.
-//! The [`study`] is the paper's §III loop (Fig. 5): per trial, schedule, run a pair, record
+//! The [`study`] is the paper's §III loop (Fig. 5): per trial, schedule, run a round, record
 //! it, re-schedule, 150 times; trials in parallel, the same bytes for a seed on any number of
 //! threads.
 //!

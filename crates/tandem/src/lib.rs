@@ -14,14 +14,16 @@
 //! | [`sim`] | `tandem-sim` | §III, sanding task, simulated workcell and operator, the study |
 //! | [`bag`] | `tandem-bag` | ROS 2 bags: MCAP recordings as demonstrations and executions, runs as MCAP |
 //!
-//! The loop of Fig. 2: learn from demonstrations, run a pair of executions under the
-//! schedule, record it, get the next schedule.
+//! The loop of Fig. 2: learn from demonstrations, run a round (one execution per robot)
+//! under the schedule, record it, get the next schedule. A continuous cell, where each robot
+//! starts its next task as soon as it is done, runs the cyclic plan of
+//! [`schedule::cyclic`] through [`realtime::continuous`].
 //!
 //! ```
 //! use rand::SeedableRng;
 //! use tandem::lfd::Demonstration;
 //! use tandem::schedule::SamplerParams;
-//! use tandem::sim::workcell::{OperatorParams, run_pair_with};
+//! use tandem::sim::workcell::{OperatorParams, run_round_with};
 //! use tandem::{Planner, PlannerParams};
 //!
 //! // Three demonstrations of a one-channel task (force, N) at 10 ms. Over samples 10..20
@@ -35,16 +37,16 @@
 //! let mut planner = Planner::new(&demos, PlannerParams { sampler, ..PlannerParams::default() })?;
 //! let first_t_total_s = planner.outcome().t_total_s;
 //!
-//! // Run a pair under the schedule in the simulated workcell: robot 1's workpiece needs the
-//! // operator over samples 10..20, robot 2's nowhere.
+//! // Run a round under the schedule in the simulated workcell (two robots, the default):
+//! // robot 1's workpiece needs the operator over samples 10..20, robot 2's nowhere.
 //! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
 //! let needs = |robot: usize, n: usize| robot == 0 && (10..20).contains(&n);
-//! let pair = run_pair_with(&planner, needs, &OperatorParams::default(), &mut rng)?;
-//! assert!(!pair.overlapped(), "never two low-confidence robots in one tick");
+//! let round = run_round_with(&planner, needs, &OperatorParams::default(), &mut rng)?;
+//! assert!(!round.overlapped(), "never two low-confidence robots in one tick");
 //!
 //! // Record it (Eq. 21, Eq. 9–12) and get the next schedule (`record_round` takes one
 //! // record per robot; `Planner::with_robots` makes a planner of N robots).
-//! let report = planner.record_round(&pair.records(planner.model())?)?;
+//! let report = planner.record_round(&round.records(planner.model())?)?;
 //! assert_eq!(planner.rounds_recorded(), 1);
 //! assert_eq!(report.t_total_s, planner.outcome().t_total_s);
 //! // The new schedule satisfies every constraint of Eq. 20 on the updated problem.
