@@ -85,7 +85,7 @@ pub(crate) struct ZooArgs {
     max_hc_pp: f64,
     /// Instead of running: generate and fit the families at the seeds and write, per task,
     /// the demonstrations as the fit's alignment sees them (weighted), their true progress and
-    /// the fit's warps into DIR/<family>/<seed>/, for `bench/peers/zoo_gdtw.py`.
+    /// the fit's warps into `DIR/<family>/<seed>/`, for `bench/peers/zoo_gdtw.py`.
     #[arg(long, value_name = "DIR")]
     export_alignments: Option<PathBuf>,
     /// A peer aligner's errors against the known warps (the JSON files
