@@ -726,3 +726,65 @@ pub fn find_overlap_with_holds(
     }
     None
 }
+
+/// How [`random_cell_task`] draws its hold points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CellHolds {
+    /// Each sample after the first a candidate with one probability `p ~ U[0, 1)` per task.
+    Uniform,
+    /// As [`CellHolds::Uniform`], but with probability ⅓ no hold at all (`p = 0`).
+    NoneOneThird,
+}
+
+/// A random task for a continuous cell: `6..=max_len` samples in runs of alternating
+/// confidence (high 1–8 samples, low 1–5, at least one low sample), `ψ̇̄` per sample in
+/// `[0.5, 2]`, bound factors in `[0.3, 1]` and `[1, 3]`, high confidence planned at its fastest
+/// (`ψ̇min`) and low confidence at `ψ̇̄`, `Δt_s` 0.05 s; and its usable holds
+/// ([`crate::holds::usable_holds`]) on a random subset of the samples, drawn as `holds` says.
+///
+/// # Panics
+/// Never for `max_len ≥ 6` (the timeline it builds is valid by construction).
+pub fn random_cell_task(
+    rng: &mut ChaCha8Rng,
+    max_len: usize,
+    holds: CellHolds,
+) -> (Timeline, Vec<usize>) {
+    let mut conf = Vec::new();
+    let mut hc = rng.random_bool(0.5);
+    let len = rng.random_range(6..=max_len);
+    while conf.len() < len {
+        let run = if hc {
+            rng.random_range(1..=8)
+        } else {
+            rng.random_range(1..=5)
+        };
+        conf.extend(std::iter::repeat_n(hc, run));
+        hc = !hc;
+    }
+    if conf.iter().all(|&c| c) {
+        conf[0] = false;
+    }
+    let n = conf.len();
+    let mean: Vec<f64> = (0..n).map(|_| rng.random_range(0.5..2.0)).collect();
+    let lo: Vec<f64> = mean
+        .iter()
+        .map(|m| m * rng.random_range(0.3..1.0))
+        .collect();
+    let hi: Vec<f64> = mean
+        .iter()
+        .map(|m| m * rng.random_range(1.0..3.0))
+        .collect();
+    let p = match holds {
+        CellHolds::NoneOneThird if rng.random_bool(1.0 / 3.0) => 0.0,
+        _ => rng.random_range(0.0..1.0),
+    };
+    let candidates: Vec<usize> = (1..n).filter(|_| rng.random_bool(p)).collect();
+    let holds = crate::holds::usable_holds(&conf, &candidates);
+    let exec: Vec<f64> = (0..n)
+        .map(|k| if conf[k] { lo[k] } else { mean[k] })
+        .collect();
+    (
+        Timeline::new(&conf, &exec, &lo, &hi, 0.0, 0.05).expect("a valid random timeline"),
+        holds,
+    )
+}

@@ -17,6 +17,7 @@ use rand_chacha::ChaCha8Rng;
 use tandem_realtime::adversary::adversary_set;
 use tandem_realtime::continuous::{ContinuousCoordinator, Token, groups, run_cell};
 use tandem_realtime::holds::usable_holds;
+use tandem_realtime::testkit::{CellHolds, random_cell_task};
 use tandem_realtime::{Error, MAX_ROBOTS, Operator, Timeline};
 
 /// A task of confidence `conf` at Δt_s = 1 s, ψ̇ = 1, bounds [½, 2].
@@ -208,47 +209,6 @@ fn a_robot_whose_first_token_is_a_later_group_skips_it_in_the_first_pass() {
 // ---------------------------------------------------------------------------------------
 // Property test.
 
-/// A random task: 6–60 samples in runs (HC 1–8, LC 1–5), ψ̇̄ per sample in [0.5, 2], bounds
-/// factors in [0.3, 1] and [1, 3], Δt_s 0.05; holds on a random subset of the usable samples.
-fn random_task(rng: &mut ChaCha8Rng) -> (Timeline, Vec<usize>) {
-    let mut conf = Vec::new();
-    let mut hc = rng.random_bool(0.5);
-    let len = rng.random_range(6..=60);
-    while conf.len() < len {
-        let run = if hc {
-            rng.random_range(1..=8)
-        } else {
-            rng.random_range(1..=5)
-        };
-        conf.extend(std::iter::repeat_n(hc, run));
-        hc = !hc;
-    }
-    if conf.iter().all(|&c| c) {
-        conf[0] = false;
-    }
-    let n = conf.len();
-    let mean: Vec<f64> = (0..n).map(|_| rng.random_range(0.5..2.0)).collect();
-    let lo: Vec<f64> = mean
-        .iter()
-        .map(|m| m * rng.random_range(0.3..1.0))
-        .collect();
-    let hi: Vec<f64> = mean
-        .iter()
-        .map(|m| m * rng.random_range(1.0..3.0))
-        .collect();
-    let p = rng.random_range(0.0..1.0);
-    let candidates: Vec<usize> = (1..n).filter(|_| rng.random_bool(p)).collect();
-    let holds = usable_holds(&conf, &candidates);
-    // High confidence at its fastest (ψ̇min), low confidence at ψ̇̄.
-    let exec: Vec<f64> = (0..n)
-        .map(|k| if conf[k] { lo[k] } else { mean[k] })
-        .collect();
-    (
-        Timeline::new(&conf, &exec, &lo, &hi, 0.0, 0.05).unwrap(),
-        holds,
-    )
-}
-
 /// A random runnable order: each robot's groups in task order from a random first group,
 /// interleaved at random as whole groups, flattened to stretches.
 fn random_order(
@@ -288,7 +248,7 @@ enum Policy {
 
 fn cell_runs_soundly(seed: u64, n: usize, policy: Policy) -> Result<(), TestCaseError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let (task, holds) = random_task(&mut rng);
+    let (task, holds) = random_cell_task(&mut rng, 60, CellHolds::Uniform);
     let gs = groups(task.conf(), &holds).unwrap();
     let order = random_order(&gs, n, &mut rng);
     let tick_s = 0.05 * rng.random_range(0.2..2.0);
@@ -405,7 +365,7 @@ fn the_full_adversary_set_never_overlaps() {
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     for case in 0..20 {
         let n = 2 + case % 4;
-        let (task, holds) = random_task(&mut rng);
+        let (task, holds) = random_cell_task(&mut rng, 60, CellHolds::Uniform);
         let gs = groups(task.conf(), &holds).unwrap();
         let order = random_order(&gs, n, &mut rng);
         let cell = ContinuousCoordinator::new(task, &holds, &order, n, 0.03).unwrap();

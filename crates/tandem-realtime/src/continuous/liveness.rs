@@ -21,7 +21,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::adversary::{Adversary, PolicyState, adversary_set};
 use crate::continuous::{ContinuousCoordinator, Group, groups};
-use crate::holds::usable_holds;
+use crate::testkit::{CellHolds, random_cell_task};
 use crate::{MAX_ROBOTS, Operator, Timeline};
 
 /// When the cell is handed over to a new plan (tried each tick until it succeeds: a robot
@@ -246,50 +246,6 @@ fn alternating_orders_that_followed_only_the_old_turn_would_starve_robot_2() {
     assert_eq!(cell.tasks_completed(), [100, 100, 100]);
 }
 
-/// A random task: 6–40 samples in runs (HC 1–8, LC 1–5), ψ̇̄ per sample in [0.5, 2], bounds
-/// factors in [0.3, 1] and [1, 3], Δt_s 0.05; holds on a random subset of the usable samples
-/// (none with probability ⅓).
-fn random_task(rng: &mut ChaCha8Rng) -> (Timeline, Vec<usize>) {
-    let mut conf = Vec::new();
-    let mut hc = rng.random_bool(0.5);
-    let len = rng.random_range(6..=40);
-    while conf.len() < len {
-        let run = if hc {
-            rng.random_range(1..=8)
-        } else {
-            rng.random_range(1..=5)
-        };
-        conf.extend(std::iter::repeat_n(hc, run));
-        hc = !hc;
-    }
-    if conf.iter().all(|&c| c) {
-        conf[0] = false;
-    }
-    let n = conf.len();
-    let mean: Vec<f64> = (0..n).map(|_| rng.random_range(0.5..2.0)).collect();
-    let lo: Vec<f64> = mean
-        .iter()
-        .map(|m| m * rng.random_range(0.3..1.0))
-        .collect();
-    let hi: Vec<f64> = mean
-        .iter()
-        .map(|m| m * rng.random_range(1.0..3.0))
-        .collect();
-    let p = if rng.random_bool(1.0 / 3.0) {
-        0.0
-    } else {
-        rng.random_range(0.0..1.0)
-    };
-    let candidates: Vec<usize> = (1..n).filter(|_| rng.random_bool(p)).collect();
-    let exec: Vec<f64> = (0..n)
-        .map(|k| if conf[k] { lo[k] } else { mean[k] })
-        .collect();
-    (
-        Timeline::new(&conf, &exec, &lo, &hi, 0.0, 0.05).unwrap(),
-        usable_holds(&conf, &candidates),
-    )
-}
-
 /// A random runnable order: each robot's groups in task order from a random first group,
 /// interleaved at random as whole groups, flattened to stretches.
 fn random_order(groups: &[Group], n: usize, rng: &mut ChaCha8Rng) -> Vec<(usize, usize)> {
@@ -325,7 +281,7 @@ struct Worst {
 /// frequencies (cycling through them from `seed`); every robot completes tasks.
 fn cell_is_fair(seed: u64, n: usize, worst: &mut Worst) -> Result<(), TestCaseError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let (task, holds) = random_task(&mut rng);
+    let (task, holds) = random_cell_task(&mut rng, 40, CellHolds::NoneOneThird);
     let gs = groups(task.conf(), &holds).unwrap();
     let g = gs.len() as f64;
     let tick_s = 0.05 * rng.random_range(0.3..2.0);
