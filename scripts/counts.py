@@ -91,7 +91,7 @@ def duplicates_between(names):
 
 CONCEPTS = {
     'fault latch (hold the later robot)': r'fn\s+(latch_fault|raise_fault|on_overlap)\b|fault\s*=\s*Some\(',
-    'a Cell enum (rounds | continuous)': r'\benum\s+\w*Cell\w*\b',
+    'a Cell enum (rounds | continuous)': r'\benum\s+(\w*Cell|Cell(Arg|Kind|Mode)?)\b',
     'resampling onto a grid': r'fn\s+resample\w*\s*[<(]',
     'robot count checked (an error made)': r'RobotCount\s*[{(]|(>|<|>=|<=)\s*MAX_ROBOTS\b',
     'the cyclic plan built from a planner': r'cyclic_plan(_for_order)?\s*\(',
