@@ -100,7 +100,7 @@ pub struct FitReport {
     pub fit_falsely_trusted_agreeing: usize,
     /// The reference-choice spread (`None` when not measured).
     pub spread: Option<ReferenceSpread>,
-    /// The fit's alignment against the family's known warps ([`super::warps`]; `None` for
+    /// The fit's alignment against the family's known warps (`eval::warps`; `None` for
     /// the sanding fixture, whose true warps are not known, and in reports written before it
     /// was measured).
     #[serde(default)]

@@ -249,7 +249,7 @@ pub struct ExportMeta {
 
 /// Writes what a peer aligner needs to align `task`'s demonstrations exactly as the fit did,
 /// into `dir` (created if missing): `signal_<i>.npy` per demonstration (rows × channels,
-/// weighted as [`weighted_signal`] says: unweighted squared distances are the fit's weighted
+/// weighted as `weighted_signal` says: unweighted squared distances are the fit's weighted
 /// ones), `progress_<i>.npy` (the true progress per row), `tandem_<i>.npy` (the fit's warp
 /// `ψ̂_i`, one value per reference sample, for every demo but the reference) and `meta.json`
 /// ([`ExportMeta`]). Returns the meta.
