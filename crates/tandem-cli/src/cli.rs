@@ -203,8 +203,8 @@ pub(crate) struct FitArgs {
     pub(crate) demos: Vec<PathBuf>,
     /// Which demonstration is the reference, whose samples are the model's time axis:
     /// `medoid` (the one whose model has the least median σ²_D; n alignment passes instead
-    /// of one) or `first` (the first file). Default: from the parameters (`[fit]
-    /// reference`, `medoid`).
+    /// of one; the model is the same for any order of the files) or `first` (the first
+    /// file). Default: from the parameters (`[fit] reference`, `first`).
     #[arg(long, value_name = "CHOICE", value_enum)]
     pub(crate) reference: Option<ReferenceArg>,
     /// Per-coordinate ranges r_j of the weights W = diag(1/r_j²), as NAME=VALUE pairs
