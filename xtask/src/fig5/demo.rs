@@ -161,7 +161,7 @@ fn the_demo_figure_renders_in_both_formats() {
     let (svg, png) = (dir.join("fig5-demo.svg"), dir.join("fig5-demo.png"));
     draw_fig5(&demo_data(), &svg, &png).unwrap();
     let svg_text = std::fs::read_to_string(&svg).unwrap();
-    assert!(svg_text.contains("iteration (pairs of executions)"));
+    assert!(svg_text.contains("iteration (rounds of 2 executions)"));
     assert_eq!(
         png_size(&std::fs::read(&png).unwrap()),
         (WIDTH_PX, HEIGHT_PX)

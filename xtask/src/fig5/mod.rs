@@ -638,11 +638,10 @@ fn draw_high_conf_panel<DB: DrawingBackend>(
         .configure_mesh()
         .x_label_formatter(&iteration_label)
         .y_label_formatter(&|v| format!("{v:.0}"))
-        .x_desc(if data.n_robots == 2 {
-            "iteration (pairs of executions)".to_string()
-        } else {
-            format!("iteration (rounds of {} executions)", data.n_robots)
-        })
+        .x_desc(format!(
+            "iteration (rounds of {} executions)",
+            data.n_robots
+        ))
         .y_desc("high-confidence samples (%)")
         .label_style((FONT_FAMILY, TICK_FONT))
         .axis_desc_style((FONT_FAMILY, AXIS_FONT))
@@ -765,7 +764,7 @@ pub(crate) mod tests {
         for label in [
             "task length T_total (s)",
             "high-confidence samples (%)",
-            "iteration (pairs of executions)",
+            "iteration (rounds of 2 executions)",
             "robot 1 low-confidence",
             "robot 2 low-confidence",
             "neither low-confidence",
