@@ -314,15 +314,16 @@ def test_bad_parameter_values_and_outputs(folder: Path) -> None:
     assert_worded(cli_error(["fit", *demos, "--samples", 50, "-o", folder]),
                   py_error(lambda: planner.save(folder), tandem.StateFileError),
                   [str(folder), "is a folder"])
-    # KNOWN GAP (left to the owner of Planner.save): into a folder that does not exist, or
-    # under a file, the command line checks the target first ("folder … does not exist or is
-    # not a folder"), Planner.save fails taking the lock ("….lock: cannot create the lock file
-    # of the state file: No such file or directory" / "Not a directory"). Both refuse and
-    # name the folder; nothing is written.
-    for target in (folder / "no/such/folder/cell.tandem", demos[0] / "cell.tandem"):
+    # Into a folder that does not exist, or under a file: the command line checks the target
+    # first ("folder … does not exist or is not a folder"), Planner.save names the folder and
+    # the fix ("…: cannot save the state file there: the folder does not exist: create it
+    # first …" / "it is a file, not a folder …"). Both refuse; nothing is written.
+    for target, why in ((folder / "no/such/folder/cell.tandem", "the folder does not exist"),
+                        (demos[0] / "cell.tandem", "it is a file, not a folder")):
         assert_worded(cli_error(["fit", *demos, "--samples", 50, "-o", target]),
                       py_error(lambda: planner.save(target), tandem.StateFileError),
                       [str(target.parent)])
+        assert why in py_error(lambda: planner.save(target), tandem.StateFileError)
     assert not (folder / "no").exists() and demos[0].is_file()
 
 
@@ -401,12 +402,11 @@ def test_damaged_state_files(folder: Path) -> None:
     missing = folder / "missing.tandem"
     assert_same(cli_error(["inspect", missing]),
                 py_error(lambda: tandem.Planner.load(missing), tandem.StateFileError))
-    # KNOWN GAP (left to the owner of Planner.load): a folder is "is a folder, not a state
-    # file" on the command line (its own check), the operating system's "Is a directory
-    # (os error 21)" from Planner.load. Both refuse and name the folder.
+    # A folder: "is a folder, not a state file" on the command line (its own check) and from
+    # Planner.load; both name the folder.
     assert_worded(cli_error(["schedule", folder]),
                   py_error(lambda: tandem.Planner.load(folder), tandem.StateFileError),
-                  [str(folder)])
+                  [str(folder), "is a folder, not a state file"])
     planner = tandem.Planner.load(state)
     assert_worded(cli_error(["schedule", state, "--samples", 0]),
                   py_error(lambda: planner.reschedule(samples=0), tandem.ParamError),

@@ -548,11 +548,19 @@ impl Drop for StateLock {
 ///
 /// # Errors
 /// [`Error::WouldOverwrite`] for a folder or a file of other content; [`Error::Io`] when an
-/// existing file cannot be read.
+/// existing file cannot be read, or when the folder to save into does not exist or is a
+/// file (naming that folder and the fix).
 pub fn check_target(path: &Path) -> Result<()> {
     let meta = match fs::metadata(path) {
         Ok(m) => m,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e)
+            if matches!(
+                e.kind(),
+                std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
+            ) =>
+        {
+            return check_folder(path);
+        }
         Err(source) => {
             return Err(Error::Io {
                 path: path.to_path_buf(),
@@ -582,6 +590,28 @@ pub fn check_target(path: &Path) -> Result<()> {
         });
     }
     Ok(())
+}
+
+/// The folder `path` would be saved into exists and is a folder; else [`Error::Io`] naming
+/// it and the fix (instead of the operating system's error on the lock file).
+fn check_folder(path: &Path) -> Result<()> {
+    let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) else {
+        return Ok(());
+    };
+    let why = match fs::metadata(parent) {
+        Ok(m) if m.is_dir() => return Ok(()),
+        Ok(_) => "it is a file, not a folder: give a path in an existing folder",
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            "the folder does not exist: create it first or give a path in an existing folder"
+        }
+        // Anything else (permissions, say) is reported where the save meets it.
+        Err(_) => return Ok(()),
+    };
+    Err(Error::Io {
+        path: parent.to_path_buf(),
+        op: "save the state file there",
+        source: std::io::Error::other(why),
+    })
 }
 
 /// What identifies the content of a state file: its payload length and checksum (header
@@ -714,6 +744,13 @@ fn sync_parent_dir(_path: &Path) -> Result<()> {
 
 /// Read a state file image from `path`.
 pub(crate) fn read(path: &Path) -> Result<Vec<u8>> {
+    if path.is_dir() {
+        return Err(Error::Io {
+            path: path.to_path_buf(),
+            op: "read state file",
+            source: std::io::Error::other("it is a folder, not a state file: give the file's path"),
+        });
+    }
     fs::read(path).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         op: "read state file",
@@ -765,6 +802,44 @@ mod tests {
             values: (0..n).map(|i| i as f64 * 0.5).collect(),
             flags: (0..n).map(|i| i % 3 == 0).collect(),
         }
+    }
+
+    #[test]
+    fn a_missing_folder_a_file_as_folder_and_a_folder_as_file_are_named_with_the_fix() {
+        let dir = tmp_dir("folders");
+        let missing = dir.join("no/such/folder/cell.tandem");
+        let err = check_target(&missing).unwrap_err().to_string();
+        assert_eq!(
+            err,
+            format!(
+                "{}: cannot save the state file there: the folder does not exist: create it first or give a path in an existing folder",
+                dir.join("no/such/folder").display()
+            )
+        );
+        let file = dir.join("demo.csv");
+        fs::write(&file, "t,x\n").unwrap();
+        let err = check_target(&file.join("cell.tandem"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with(&format!(
+                "{}: cannot save the state file there: it is a file",
+                file.display()
+            )),
+            "{err}"
+        );
+        let err = read(&dir).unwrap_err().to_string();
+        assert_eq!(
+            err,
+            format!(
+                "{}: cannot read state file: it is a folder, not a state file: give the file's path",
+                dir.display()
+            )
+        );
+        // A bare file name saves into the working folder: nothing to check.
+        assert!(check_target(Path::new("cell-that-does-not-exist.tandem")).is_ok());
+        assert!(!dir.join("no").exists());
+        let _ = fs::remove_dir_all(&dir);
     }
 
     fn tmp_dir(tag: &str) -> PathBuf {
