@@ -481,6 +481,9 @@ impl StateLock {
     /// [`Error::Locked`] when the lock is still held after `timeout`; [`Error::Io`] when the
     /// lock file cannot be created or locked (e.g. the folder does not exist).
     pub fn acquire(path: &Path, timeout: Duration) -> Result<Self> {
+        // The lock file lives beside the state file: a folder that is not there is named
+        // with the fix, not as the operating system's error on the lock file.
+        check_folder(path)?;
         let lock_path = lock_path(path)?;
         let file = OpenOptions::new()
             .read(true)
@@ -816,6 +819,12 @@ mod tests {
                 dir.join("no/such/folder").display()
             )
         );
+        // Taking the lock (before any save) says the same, not the lock file's OS error.
+        let err = StateLock::acquire(&missing, Duration::from_millis(10))
+            .err()
+            .expect("no lock in a missing folder")
+            .to_string();
+        assert!(err.contains("the folder does not exist"), "{err}");
         let file = dir.join("demo.csv");
         fs::write(&file, "t,x\n").unwrap();
         let err = check_target(&file.join("cell.tandem"))
