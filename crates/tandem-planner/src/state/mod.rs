@@ -820,10 +820,10 @@ mod tests {
             )
         );
         // Taking the lock (before any save) says the same, not the lock file's OS error.
-        let err = StateLock::acquire(&missing, Duration::from_millis(10))
-            .err()
-            .expect("no lock in a missing folder")
-            .to_string();
+        let Err(err) = StateLock::acquire(&missing, Duration::from_millis(10)) else {
+            panic!("a lock in a missing folder");
+        };
+        let err = err.to_string();
         assert!(err.contains("the folder does not exist"), "{err}");
         let file = dir.join("demo.csv");
         fs::write(&file, "t,x\n").unwrap();
