@@ -262,6 +262,21 @@ impl Case {
         }
     }
 
+    /// Start offsets (schedule clock, s) that interleave the `n` robots: robot 0 at 0, each
+    /// later robot at a uniform random point of the span of the robots before it.
+    pub fn interleaved_starts(&self, n: usize, r: &mut ChaCha8Rng) -> Vec<f64> {
+        let mut starts = vec![0.0];
+        for _ in 1..n {
+            let end = self
+                .robots_at(&starts)
+                .iter()
+                .map(Timeline::end_s)
+                .fold(0.0, f64::max);
+            starts.push(end * r.random::<f64>());
+        }
+        starts
+    }
+
     /// Every robot's timeline, robot `i` starting at `starts_s[i]` (schedule clock, s).
     #[must_use]
     pub fn robots_at(&self, starts_s: &[f64]) -> Vec<Timeline> {

@@ -192,15 +192,7 @@ fn plans_accepted_with_holds_never_overlap_and_need_their_rules() {
             let case = Case::random(Family::of_seed(seed), n, &mut r);
             // Starts that interleave the robots: each robot at a random point of the span of
             // the robots before it.
-            let mut starts = vec![0.0];
-            for _ in 1..n {
-                let end = case
-                    .robots_at(&starts)
-                    .iter()
-                    .map(Timeline::end_s)
-                    .fold(0.0, f64::max);
-                starts.push(end * r.random::<f64>());
-            }
+            let starts = case.interleaved_starts(n, &mut r);
             let robots = case.robots_at(&starts);
             let usable = random_usable(&robots, &mut r);
             let holds = release_rules(&robots, &[], &usable);
@@ -351,15 +343,7 @@ fn no_robot_moves_backwards_with_holds_for_any_operator() {
         let result = runner.run(&any::<u64>(), |seed| {
             let mut r = rng(seed);
             let case = Case::random(Family::of_seed(seed), n, &mut r);
-            let mut starts = vec![0.0];
-            for _ in 1..n {
-                let end = case
-                    .robots_at(&starts)
-                    .iter()
-                    .map(Timeline::end_s)
-                    .fold(0.0, f64::max);
-                starts.push(end * r.random::<f64>());
-            }
+            let starts = case.interleaved_starts(n, &mut r);
             let robots = case.robots_at(&starts);
             let usable = random_usable(&robots, &mut r);
             let mut holds = release_rules(&robots, &[], &usable);

@@ -55,15 +55,7 @@ fn every_robot_finishes_its_round_with_holds_under_every_adversary() {
         let result = runner.run(&any::<u64>(), |seed| {
             let mut r = rng(seed);
             let case = Case::random(Family::of_seed(seed), n, &mut r);
-            let mut starts = vec![0.0];
-            for _ in 1..n {
-                let end = case
-                    .robots_at(&starts)
-                    .iter()
-                    .map(Timeline::end_s)
-                    .fold(0.0, f64::max);
-                starts.push(end * r.random::<f64>());
-            }
+            let starts = case.interleaved_starts(n, &mut r);
             let robots = case.robots_at(&starts);
             let usable: Vec<Vec<usize>> = robots
                 .iter()
