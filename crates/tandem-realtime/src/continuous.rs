@@ -90,7 +90,9 @@ use rand::Rng;
 
 use crate::adversary::{Adversary, PolicyState};
 use crate::coordinator::{Fault, Operator};
+use crate::cursor::{Cursors, operator_step};
 use crate::error::{Error, Result};
+use crate::monitor::Monitor;
 use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
 use crate::timeline::Timeline;
 use crate::tol::clock_tolerance_s;
@@ -333,16 +335,8 @@ impl CellTick {
     /// Whether two or more robots traversed a low-confidence sample in this tick.
     #[must_use]
     pub fn overlap(&self) -> bool {
-        self.low_conf.count() >= 2
+        crate::monitor::overlap(&self.low_conf)
     }
-}
-
-/// Monotone cursors of one robot into the task, reset at each task start.
-#[derive(Clone, Copy, Debug, Default)]
-struct Cursors {
-    at: usize,
-    lo: usize,
-    hi: usize,
 }
 
 /// The run-time coordinator of a continuous cell ([module docs](self)): `1 ≤ N ≤ MAX_ROBOTS`
@@ -396,10 +390,9 @@ pub struct ContinuousCoordinator {
     served: [u64; MAX_ROBOTS],
     /// The next service's stamp.
     stamp: u64,
-    ticks: u64,
-    lc_since: [u64; MAX_ROBOTS],
-    lc_last: RobotFlags,
-    fault: Option<Fault>,
+    /// The run-time fault monitor (its tick count is the ticks run since the start or the
+    /// last reset, carried over by a hand-over).
+    monitor: Monitor,
 }
 
 impl ContinuousCoordinator {
@@ -461,10 +454,7 @@ impl ContinuousCoordinator {
             passes: 0,
             served: [0; MAX_ROBOTS],
             stamp: 0,
-            ticks: 0,
-            lc_since: [0; MAX_ROBOTS],
-            lc_last: RobotFlags::new(n_robots),
-            fault: None,
+            monitor: Monitor::new(n_robots),
         };
         out.reset();
         Ok(out)
@@ -496,10 +486,7 @@ impl ContinuousCoordinator {
             }
         }
         self.stamp = rank;
-        self.ticks = 0;
-        self.lc_since = [0; MAX_ROBOTS];
-        self.lc_last = RobotFlags::new(self.n);
-        self.fault = None;
+        self.monitor.reset();
     }
 
     /// Number of robots `N`.
@@ -555,17 +542,17 @@ impl ContinuousCoordinator {
 
     /// Ticks run since the start or the last reset.
     pub fn ticks(&self) -> u64 {
-        self.ticks
+        self.monitor.ticks()
     }
 
     /// The latched fault, if any.
     pub fn fault(&self) -> Option<Fault> {
-        self.fault
+        self.monitor.fault()
     }
 
     /// Clears the latched fault: the held robot moves again from the next tick.
     pub fn clear_fault(&mut self) {
-        self.fault = None;
+        self.monitor.clear();
     }
 
     /// Whether each robot is on a low-confidence sample and may move (it holds the token) at
@@ -612,7 +599,7 @@ impl ContinuousCoordinator {
         let task = Arc::clone(&self.task);
         let end_s = task.end_s();
         let tok = self.token();
-        let held = self.fault.map(|f| f.stopped);
+        let held = self.monitor.held();
         let mut out = CellTick {
             ref_time: PerRobot::new(n),
             tasks: PerRobot::new(n),
@@ -640,18 +627,7 @@ impl ContinuousCoordinator {
             let step = if task.conf()[at] {
                 self.tick_s
             } else {
-                let (lo, hi, e) = (
-                    task.grad_min()[at],
-                    task.grad_max()[at],
-                    task.grad_exec()[at],
-                );
-                let grad = match op {
-                    Operator::Scheduled => e,
-                    Operator::Gradient(x) => x.clamp(lo, hi),
-                    Operator::Fastest => lo,
-                    Operator::Slowest => hi,
-                };
-                e / grad * self.tick_s
+                operator_step(&task, at, op, self.tick_s)
             };
             // On high-confidence ground the robot stops at the next low-confidence sample:
             // the tick after starts on it, at the operator's rate.
@@ -712,13 +688,11 @@ impl ContinuousCoordinator {
             debug_assert!(
                 after.0 > before[i].0 || (after.0 == before[i].0 && after.1 >= before[i].1),
                 "robot {i} moved backwards in tick {}: (task, reference time) {:?} -> {after:?}",
-                self.ticks,
+                self.monitor.ticks(),
                 before[i]
             );
         }
-        self.monitor(&out);
-        out.fault = self.fault;
-        self.ticks += 1;
+        out.fault = self.monitor.observe(out.low_conf);
         Ok(out)
     }
 
@@ -784,7 +758,7 @@ impl ContinuousCoordinator {
         if (old.tick_s - self.tick_s).abs() > 1e-12 * self.tick_s.max(old.tick_s) {
             return bad(0, "the new plan runs at another control tick");
         }
-        if let Some(f) = old.fault {
+        if let Some(f) = old.monitor.fault() {
             return bad(f.stopped, "the old cell has a latched fault");
         }
         let n_groups = self.groups.len();
@@ -869,20 +843,13 @@ impl ContinuousCoordinator {
                 .partition_point(|&x| x <= s - self.tol_s)
                 .saturating_sub(1)
                 .min(last);
-            *cur = Cursors {
-                at: k,
-                lo: k,
-                hi: k,
-            };
+            *cur = Cursors::at(k);
         }
         self.pos = 0;
         self.passes = 0;
         self.served = old.served;
         self.stamp = old.stamp;
-        self.ticks = old.ticks;
-        self.lc_since = [0; MAX_ROBOTS];
-        self.lc_last = RobotFlags::new(self.n);
-        self.fault = None;
+        self.monitor = Monitor::resumed_at(self.n, old.monitor.ticks());
         Ok(())
     }
 
@@ -898,30 +865,6 @@ impl ContinuousCoordinator {
                 return;
             }
         }
-    }
-
-    /// The run-time monitor (as the rounds coordinator's): latches a [`Fault`] in a tick with
-    /// two or more robots low-confidence and holds the one whose run of low-confidence ticks
-    /// began last (the highest index on a tie). O(N).
-    fn monitor(&mut self, tick: &CellTick) {
-        for i in 0..self.n {
-            if tick.low_conf[i] && !self.lc_last[i] {
-                self.lc_since[i] = self.ticks;
-            }
-        }
-        self.lc_last = tick.low_conf;
-        if self.fault.is_some() || !tick.overlap() {
-            return;
-        }
-        let stopped = (0..self.n)
-            .filter(|&i| tick.low_conf[i])
-            .max_by_key(|&i| (self.lc_since[i], i))
-            .expect("an overlap has low-confidence robots");
-        self.fault = Some(Fault {
-            tick: self.ticks,
-            low_conf: tick.low_conf,
-            stopped,
-        });
     }
 }
 

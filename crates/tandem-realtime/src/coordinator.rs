@@ -2,8 +2,11 @@
 
 use std::sync::Arc;
 
+use crate::cursor::{Cursors, operator_step};
 use crate::error::{Error, Result};
 use crate::holds::{Hold, Plans};
+pub use crate::monitor::Fault;
+use crate::monitor::Monitor;
 use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
 use crate::strategy::{Member, Mode, advance, first_waiting_start};
 use crate::timeline::Timeline;
@@ -60,42 +63,14 @@ pub struct Tick {
     pub fault: Option<Fault>,
 }
 
-/// A latched fault of the run-time monitor: in tick `tick` two or more robots traversed a
-/// low-confidence sample (`low_conf`), a state [`sufficient_margins`](crate::sufficient_margins)
-/// excludes. The coordinator fails safe instead of carrying on: it holds `stopped`, the robot
-/// whose low-confidence stretch began last (the highest index on a tie), where it is — its
-/// schedule clock no longer advances — until the caller clears the fault, so that the operator
-/// has one robot to help. The fault is reported in every later [`Tick`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Fault {
-    /// Index of the tick (counted from the coordinator's start or last reset) in which it
-    /// happened.
-    pub tick: u64,
-    /// The robots low-confidence in that tick.
-    pub low_conf: RobotFlags,
-    /// The robot held (index `0..N`).
-    pub stopped: usize,
-}
-
 impl Tick {
     /// Whether two or more robots traversed a low-confidence sample in this tick: the operator
     /// was needed by two robots at once (a schedule that
     /// [`sufficient_margins`](crate::sufficient_margins) accepts never has such a tick).
     #[must_use]
     pub fn overlap(&self) -> bool {
-        self.low_conf.count() >= 2
+        crate::monitor::overlap(&self.low_conf)
     }
-}
-
-/// Per-robot monotone cursors into its timeline (all O(1) amortized).
-#[derive(Clone, Copy, Debug, Default)]
-struct Cursors {
-    /// Sample containing the schedule clock (mode and rates are read here).
-    at: usize,
-    /// Sample containing `clock − tol` (first sample a tick may traverse).
-    lo: usize,
-    /// Sample containing `clock + tol` (last sample a tick may traverse).
-    hi: usize,
 }
 
 /// Phase of one robot at the start of a tick.
@@ -170,14 +145,9 @@ pub struct Coordinator {
     /// share it): the clock a robot's next leg has when its current leg ends.
     wait_clock_s: f64,
     cursors: [Cursors; MAX_ROBOTS],
-    /// Ticks run since the start or the last reset.
-    ticks: u64,
-    /// Per robot, the tick at which its current run of low-confidence ticks began.
-    lc_since: [u64; MAX_ROBOTS],
-    /// Whether each robot was low-confidence in the previous tick.
-    lc_last: RobotFlags,
-    /// The latched fault.
-    fault: Option<Fault>,
+    /// The run-time fault monitor (its tick count is the ticks run since the start or the
+    /// last reset).
+    monitor: Monitor,
 }
 
 impl Coordinator {
@@ -268,10 +238,7 @@ impl Coordinator {
             released: RobotFlags::new(n),
             wait_clock_s: 0.0,
             cursors: [Cursors::default(); MAX_ROBOTS],
-            ticks: 0,
-            lc_since: [0; MAX_ROBOTS],
-            lc_last: RobotFlags::new(n),
-            fault: None,
+            monitor: Monitor::new(n),
         };
         c.reset();
         Ok(c)
@@ -280,13 +247,13 @@ impl Coordinator {
     /// The latched fault, if two robots have been low-confidence in one tick since the start,
     /// the last reset or the last [`Coordinator::clear_fault`].
     pub fn fault(&self) -> Option<Fault> {
-        self.fault
+        self.monitor.fault()
     }
 
     /// Clears the latched fault: the held robot moves again from the next tick on (once the
     /// operator has dealt with the robot that kept running).
     pub fn clear_fault(&mut self) {
-        self.fault = None;
+        self.monitor.clear();
     }
 
     /// The timelines, robot `i` at index `i`.
@@ -349,7 +316,7 @@ impl Coordinator {
     /// logs nothing for it). O(N).
     pub fn running_now(&self) -> RobotFlags {
         let mut out = RobotFlags::new(self.robots.len());
-        let held = self.fault.map(|f| f.stopped);
+        let held = self.monitor.held();
         for i in 0..self.robots.len() {
             let (r, s) = (self.cur(i), self.clock_s[i]);
             out.set(
@@ -460,10 +427,7 @@ impl Coordinator {
         self.released = RobotFlags::new(n);
         self.update_released();
         self.cursors = [Cursors::default(); MAX_ROBOTS];
-        self.ticks = 0;
-        self.lc_since = [0; MAX_ROBOTS];
-        self.lc_last = RobotFlags::new(self.robots.len());
-        self.fault = None;
+        self.monitor.reset();
     }
 
     /// Whether each robot is running and low-confidence at its current schedule clock (Eq. 16
@@ -496,20 +460,6 @@ impl Coordinator {
         }
     }
 
-    /// Schedule-clock step of robot `i` commanded by the operator.
-    fn operator_step(&self, i: usize, op: Operator) -> f64 {
-        let r = self.cur(i);
-        let n = self.cursors[i].at;
-        let (lo, hi) = (r.grad_min()[n], r.grad_max()[n]);
-        let g = match op {
-            Operator::Scheduled => r.grad_exec()[n],
-            Operator::Gradient(g) => g.clamp(lo, hi),
-            Operator::Fastest => lo,
-            Operator::Slowest => hi,
-        };
-        r.grad_exec()[n] / g * self.tick_s
-    }
-
     /// Advances one control period with the operator's input `operator` for the
     /// low-confidence robot (ignored when no robot is low-confidence). Never allocates; O(N).
     ///
@@ -527,7 +477,7 @@ impl Coordinator {
         let mut members = [Member::idle(0.0, Mode::Finished); MAX_ROBOTS];
         let mut next_s = [0.0_f64; MAX_ROBOTS];
         let mut pace_robot = None;
-        let held = self.fault.map(|f| f.stopped);
+        let held = self.monitor.held();
         for i in 0..n {
             let s = self.clock_s[i];
             if held == Some(i) {
@@ -539,7 +489,7 @@ impl Coordinator {
                 Phase::Waiting => Member::idle(s, Mode::Waiting),
                 Phase::Finished => Member::idle(s, Mode::Finished),
                 Phase::Active { low_conf: true } => {
-                    next_s[i] = s + self.operator_step(i, g);
+                    next_s[i] = s + operator_step(self.cur(i), self.cursors[i].at, g, self.tick_s);
                     pace_robot.get_or_insert(i);
                     Member::idle(s, Mode::Low)
                 }
@@ -628,7 +578,7 @@ impl Coordinator {
             debug_assert!(
                 out.ref_time[i] >= before.0[i] && self.shown_s[i] >= before.1[i],
                 "robot {i} moved backwards in tick {}: reference time {} -> {}, clock {} -> {}",
-                self.ticks,
+                self.monitor.ticks(),
                 before.0[i],
                 out.ref_time[i],
                 before.1[i],
@@ -636,35 +586,8 @@ impl Coordinator {
             );
         }
         self.update_released();
-        self.monitor(&out);
-        out.fault = self.fault;
-        self.ticks += 1;
+        out.fault = self.monitor.observe(out.low_conf);
         Ok(out)
-    }
-
-    /// The run-time monitor, after each tick: keeps when each robot's run of low-confidence
-    /// ticks began and latches a [`Fault`] (holding the robot whose run began last) in a tick
-    /// with two or more robots low-confidence, unless a fault is already latched. O(N).
-    fn monitor(&mut self, tick: &Tick) {
-        let n = self.robots.len();
-        for i in 0..n {
-            if tick.low_conf[i] && !self.lc_last[i] {
-                self.lc_since[i] = self.ticks;
-            }
-        }
-        self.lc_last = tick.low_conf;
-        if self.fault.is_some() || !tick.overlap() {
-            return;
-        }
-        let stopped = (0..n)
-            .filter(|&i| tick.low_conf[i])
-            .max_by_key(|&i| (self.lc_since[i], i))
-            .expect("an overlap has low-confidence robots");
-        self.fault = Some(Fault {
-            tick: self.ticks,
-            low_conf: tick.low_conf,
-            stopped,
-        });
     }
 }
 

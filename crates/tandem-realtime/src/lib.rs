@@ -58,9 +58,11 @@
 pub mod adversary;
 pub mod continuous;
 mod coordinator;
+mod cursor;
 mod error;
 pub mod holds;
 pub mod margins;
+mod monitor;
 mod robots;
 pub mod strategy;
 #[cfg(feature = "testkit")]
