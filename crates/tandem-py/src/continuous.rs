@@ -10,7 +10,7 @@ use pyo3::types::{PyDict, PyList};
 use crate::arrays::{out_flags, out_vector, repr_list};
 use crate::coordinator::{fault_dict, operator};
 use crate::errors::{Result, guard};
-use crate::facade::{CellTick, ContinuousCoordinator, CyclicPlan, Group, Problem, Token};
+use crate::facade::{ContinuousCoordinator, CyclicPlan, Group, Problem, Tick, Token};
 
 /// The continuous coordinator of `plan` on `problem` at `tick_s` (default: the problem's
 /// `dt_s`), through [`CyclicPlan::coordinator`].
@@ -250,7 +250,7 @@ fn repr_counts(counts: &[u64]) -> String {
 /// What one :meth:`ContinuousCoordinator.tick` did, per robot.
 #[pyclass(module = "tandem", name = "CellTick", frozen)]
 pub(crate) struct PyCellTick {
-    inner: CellTick,
+    inner: Tick,
 }
 
 #[pymethods]
@@ -286,7 +286,7 @@ impl PyCellTick {
     /// token is another robot's), ``(N,)`` bool.
     #[getter]
     fn at_gate<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        out_flags(py, self.inner.at_gate.iter().collect())
+        out_flags(py, self.inner.waiting.iter().collect())
     }
 
     /// Whether more than one robot was low-confidence in this tick (never, under the token
@@ -310,7 +310,7 @@ impl PyCellTick {
             repr_counts(&self.inner.tasks),
             repr_list(&self.inner.low_conf.iter().collect::<Vec<_>>()),
             repr_list(&self.inner.running.iter().collect::<Vec<_>>()),
-            repr_list(&self.inner.at_gate.iter().collect::<Vec<_>>())
+            repr_list(&self.inner.waiting.iter().collect::<Vec<_>>())
         )
     }
 }

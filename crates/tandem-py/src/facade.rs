@@ -11,7 +11,7 @@ pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{
     Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, reschedule_seed,
 };
-pub(crate) use tandem::realtime::continuous::{CellTick, ContinuousCoordinator, Group, Token};
+pub(crate) use tandem::realtime::continuous::{ContinuousCoordinator, Group, Token};
 pub(crate) use tandem::realtime::{Coordinator, Fault, MAX_ROBOTS, Operator, Tick, Timeline};
 pub(crate) use tandem::schedule::cyclic::{GapPlan, Stretch};
 pub(crate) use tandem::schedule::{

@@ -76,7 +76,7 @@
 //! let mut cell = ContinuousCoordinator::new(task, &[], &[(0, 0), (1, 0)], 2, 1.0)?;
 //! let t = cell.tick(Operator::Scheduled)?; // robot 0 moves to 1 s, robot 1 waits at 0
 //! assert_eq!((t.ref_time[0], t.ref_time[1]), (1.0, 0.0));
-//! assert!(t.at_gate[1] && !t.running[1]);
+//! assert!(t.waiting[1] && !t.running[1]);
 //! for _ in 0..1000 {
 //!     assert!(!cell.tick(Operator::Fastest)?.overlap());
 //! }
@@ -89,9 +89,10 @@ use std::sync::Arc;
 use rand::Rng;
 
 use crate::adversary::{Adversary, PolicyState};
-use crate::coordinator::{Fault, Operator};
+use crate::contract::{Controller, Operator, Tick, check_tick};
 use crate::cursor::{Cursors, operator_step};
 use crate::error::{Error, Result};
+use crate::monitor::Fault;
 use crate::monitor::Monitor;
 use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
 use crate::timeline::Timeline;
@@ -310,34 +311,12 @@ pub fn token_sequence(
     Ok((tokens, skip))
 }
 
-/// What one [`ContinuousCoordinator::tick`] did, one value per robot (robot `i` at index `i`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CellTick {
-    /// Each robot's fractional reference time (reference samples, in `[0, T_ref)`) in its
-    /// current task at the end of the tick (a robot that finished a task in this tick is at 0
-    /// of the next).
-    pub ref_time: PerRobot<f64>,
-    /// Each robot's number of completed tasks at the end of the tick.
-    pub tasks: PerRobot<u64>,
-    /// Whether each robot traversed any low-confidence sample during the tick (the interval
-    /// `[s_old − tol, s_new + tol]` of its schedule clock, as the rounds coordinator counts).
-    pub low_conf: RobotFlags,
-    /// Whether each robot's schedule clock moved during the tick.
-    pub running: RobotFlags,
-    /// Whether each robot waits at the gate of its next group at the end of the tick (the
-    /// token is another's).
-    pub at_gate: RobotFlags,
-    /// The latched fault, if any ([`Fault`]; it never happens under the token rule).
-    pub fault: Option<Fault>,
-}
-
-impl CellTick {
-    /// Whether two or more robots traversed a low-confidence sample in this tick.
-    #[must_use]
-    pub fn overlap(&self) -> bool {
-        crate::monitor::overlap(&self.low_conf)
-    }
-}
+/// What one [`ContinuousCoordinator::tick`] did: the one [`Tick`] of every controller (its
+/// `at_gate` is [`Tick::waiting`]).
+#[deprecated(
+    note = "the one tick type of every controller is `tandem_realtime::Tick` (`at_gate` is its `waiting`)"
+)]
+pub type CellTick = Tick;
 
 /// The run-time coordinator of a continuous cell ([module docs](self)): `1 ≤ N ≤ MAX_ROBOTS`
 /// robots repeating one task plan for ever under the token rule, one control period
@@ -413,12 +392,7 @@ impl ContinuousCoordinator {
         tick_s: f64,
     ) -> Result<ContinuousCoordinator> {
         check_count(n_robots)?;
-        if !(tick_s.is_finite() && tick_s > 0.0) {
-            return Err(Error::BadParam {
-                name: "tick_s",
-                why: "must be finite and > 0",
-            });
-        }
+        check_tick(tick_s)?;
         let task = task.sub(0, task.n_ref(), 0.0)?;
         let groups = groups(task.conf(), holds)?;
         let (tokens, skip_first) = token_sequence(order, &groups, n_robots)?;
@@ -582,13 +556,24 @@ impl ContinuousCoordinator {
         out
     }
 
+    /// Whether each robot moves in the next tick if the rules let it: not at its gate and not
+    /// held by the fault monitor (a robot of the cell never finishes). O(N).
+    pub fn running_now(&self) -> RobotFlags {
+        let mut out = self.at_gate_now();
+        let held = self.monitor.held();
+        for i in 0..self.n {
+            out.set(i, !out[i] && held != Some(i));
+        }
+        out
+    }
+
     /// Advances every robot one control period with the operator's input `operator` for the
     /// low-confidence robot. Never allocates; O(N).
     ///
     /// # Errors
     /// [`Error::BadOperator`] for an [`Operator::Gradient`] that is NaN, infinite or ≤ 0; the
     /// coordinator is then unchanged.
-    pub fn tick(&mut self, operator: Operator) -> Result<CellTick> {
+    pub fn tick(&mut self, operator: Operator) -> Result<Tick> {
         let op = operator.validate()?;
         let n = self.n;
         // "A robot never moves backwards", checked in debug builds: each robot's (tasks
@@ -600,12 +585,12 @@ impl ContinuousCoordinator {
         let end_s = task.end_s();
         let tok = self.token();
         let held = self.monitor.held();
-        let mut out = CellTick {
+        let mut out = Tick {
             ref_time: PerRobot::new(n),
             tasks: PerRobot::new(n),
             low_conf: RobotFlags::new(n),
             running: RobotFlags::new(n),
-            at_gate: RobotFlags::new(n),
+            waiting: RobotFlags::new(n),
             fault: None,
         };
         for i in 0..n {
@@ -680,7 +665,7 @@ impl ContinuousCoordinator {
             let waits = g < n_groups
                 && s >= self.gate_s[g]
                 && !tok.is_some_and(|t| t.robot == i && t.group == g);
-            out.at_gate.set(i, waits);
+            out.waiting.set(i, waits);
         }
         #[cfg(debug_assertions)]
         for i in 0..n {
@@ -697,7 +682,7 @@ impl ContinuousCoordinator {
     }
 
     /// Each robot's position now: (tasks completed, reference time in its current task,
-    /// reference samples in `[0, T_ref)`), the value the last [`CellTick`] reported. Never
+    /// reference samples in `[0, T_ref)`), the value the last [`Tick`] reported. Never
     /// decreases (lexicographically) from tick to tick, nor at a
     /// [`take_over`](Self::take_over). O(N log T_ref).
     pub fn position_now(&self) -> PerRobot<(u64, f64)> {
@@ -865,6 +850,66 @@ impl ContinuousCoordinator {
                 return;
             }
         }
+    }
+}
+
+impl Controller for ContinuousCoordinator {
+    fn n_robots(&self) -> usize {
+        ContinuousCoordinator::n_robots(self)
+    }
+
+    fn tick_s(&self) -> f64 {
+        ContinuousCoordinator::tick_s(self)
+    }
+
+    fn tick(&mut self, operator: Operator) -> Result<Tick> {
+        ContinuousCoordinator::tick(self, operator)
+    }
+
+    fn reset(&mut self) {
+        ContinuousCoordinator::reset(self);
+    }
+
+    fn fault(&self) -> Option<Fault> {
+        ContinuousCoordinator::fault(self)
+    }
+
+    fn clear_fault(&mut self) {
+        ContinuousCoordinator::clear_fault(self);
+    }
+
+    fn low_conf_now(&self) -> RobotFlags {
+        ContinuousCoordinator::low_conf_now(self)
+    }
+
+    fn running_now(&self) -> RobotFlags {
+        ContinuousCoordinator::running_now(self)
+    }
+
+    fn waiting_now(&self) -> RobotFlags {
+        self.at_gate_now()
+    }
+
+    /// O(N log T_ref): each robot's reference time at its clock ([`Self::position_now`]).
+    fn ref_time_now(&self) -> PerRobot<f64> {
+        let mut out = PerRobot::new(self.n);
+        for (i, t) in out.as_mut_slice().iter_mut().enumerate() {
+            *t = self.task.ref_time_at(self.clock_s[i]);
+        }
+        out
+    }
+
+    fn tasks_now(&self) -> PerRobot<u64> {
+        PerRobot::from_slice(self.tasks_completed())
+    }
+
+    fn clock_s(&self) -> &[f64] {
+        ContinuousCoordinator::clock_s(self)
+    }
+
+    /// Never: the robots repeat the task for ever.
+    fn is_finished(&self) -> bool {
+        false
     }
 }
 

@@ -2,76 +2,17 @@
 
 use std::sync::Arc;
 
+use crate::contract::{Controller, check_tick};
+use crate::contract::{Operator, Tick};
 use crate::cursor::{Cursors, operator_step};
 use crate::error::{Error, Result};
 use crate::holds::{Hold, Plans};
-pub use crate::monitor::Fault;
+use crate::monitor::Fault;
 use crate::monitor::Monitor;
 use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
 use crate::strategy::{Member, Mode, advance, first_waiting_start};
 use crate::timeline::Timeline;
 use crate::tol::clock_tolerance_s;
-
-/// The operator's input to one control tick (§II-B5): how the correction given to the
-/// low-confidence robot sets its timing. Ignored when no robot is low-confidence.
-///
-/// The three conventions that used to encode this in one `f64` (0 for fastest, a huge value
-/// or infinity for slowest, NaN for "no correction") are gone: a NaN from a degenerate
-/// command is now an error ([`Error::BadOperator`]), not a silent "no correction".
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Operator {
-    /// No correction: the low-confidence robot keeps its scheduled gradient `ψ̇_E`.
-    Scheduled,
-    /// The correction commands execution gradient `g` (execution samples per reference
-    /// sample; finite and > 0), clamped to `[ψ̇min, ψ̇max]` at the robot's current sample.
-    Gradient(f64),
-    /// As fast as the demonstrations allow: the gradient `ψ̇min` (the operator rushes).
-    Fastest,
-    /// As slowly as the demonstrations allow: the gradient `ψ̇max` (the operator drags).
-    Slowest,
-}
-
-impl Operator {
-    /// Checks a [`Operator::Gradient`]: finite and > 0.
-    ///
-    /// # Errors
-    /// [`Error::BadOperator`] with the gradient.
-    pub fn validate(self) -> Result<Self> {
-        match self {
-            Operator::Gradient(g) if !(g.is_finite() && g > 0.0) => {
-                Err(Error::BadOperator { gradient: g })
-            }
-            op => Ok(op),
-        }
-    }
-}
-
-/// What one [`Coordinator::tick`] did, one value per robot (robot `i` at index `i`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Tick {
-    /// Each robot's fractional reference time (reference samples, in `[0, T_ref]`) at the end of
-    /// the tick (Eq. 15 applied to its schedule clock).
-    pub ref_time: PerRobot<f64>,
-    /// Whether each robot traversed ANY low-confidence reference sample during this tick
-    /// (see [`Coordinator`] for the exact, conservative definition).
-    pub low_conf: RobotFlags,
-    /// Whether each robot is running (started and not finished) during the tick: its schedule
-    /// clock moved inside `[τ_i, τ_i + |ψ_E|)`.
-    pub running: RobotFlags,
-    /// The latched fault, if any (this tick's or an earlier one's, until
-    /// [`Coordinator::clear_fault`]): see [`Fault`].
-    pub fault: Option<Fault>,
-}
-
-impl Tick {
-    /// Whether two or more robots traversed a low-confidence sample in this tick: the operator
-    /// was needed by two robots at once (a schedule that
-    /// [`sufficient_margins`](crate::sufficient_margins) accepts never has such a tick).
-    #[must_use]
-    pub fn overlap(&self) -> bool {
-        crate::monitor::overlap(&self.low_conf)
-    }
-}
 
 /// Phase of one robot at the start of a tick.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -217,12 +158,7 @@ impl Coordinator {
     }
 
     fn build(robots: Arc<[Timeline]>, plans: Plans, tick_s: f64) -> Result<Coordinator> {
-        if !(tick_s.is_finite() && tick_s > 0.0) {
-            return Err(Error::BadParam {
-                name: "tick_s",
-                why: "must be finite and > 0",
-            });
-        }
+        check_tick(tick_s)?;
         // Without holds the legs are the robots' timelines: the same tolerance.
         let tol_s = clock_tolerance_s(&plans.legs, tick_s);
         let n = robots.len();
@@ -335,9 +271,32 @@ impl Coordinator {
 
     /// Whether every robot has finished (with holds: its last leg).
     pub fn is_finished(&self) -> bool {
-        (0..self.robots.len()).all(|i| {
-            self.leg[i] + 1 == self.plans.first_leg[i + 1] && self.clock_s[i] >= self.cur(i).end_s()
-        })
+        (0..self.robots.len()).all(|i| self.finished(i))
+    }
+
+    /// Whether robot `i` has finished its last leg.
+    fn finished(&self, i: usize) -> bool {
+        self.leg[i] + 1 == self.plans.first_leg[i + 1] && self.clock_s[i] >= self.cur(i).end_s()
+    }
+
+    /// Each robot's completed tasks ([`Tick::tasks`]): 1 once it has finished its last leg,
+    /// else 0. O(N).
+    pub fn tasks_now(&self) -> PerRobot<u64> {
+        let mut out = PerRobot::new(self.robots.len());
+        for (i, k) in out.as_mut_slice().iter_mut().enumerate() {
+            *k = u64::from(self.finished(i));
+        }
+        out
+    }
+
+    /// Whether each robot is stopped at a hold ([`Coordinator::at_hold`], [`Tick::waiting`]).
+    /// O(N).
+    pub fn waiting_now(&self) -> RobotFlags {
+        let mut out = RobotFlags::new(self.robots.len());
+        for i in 0..self.robots.len() {
+            out.set(i, self.at_hold(i));
+        }
+        out
     }
 
     /// Robot `robot`'s planned end (schedule clock, s): the end of its last leg, the planned
@@ -503,8 +462,10 @@ impl Coordinator {
         advance(&members[..n], pace_robot, self.tick_s, &mut next_s[..n]);
         let mut out = Tick {
             ref_time: PerRobot::new(n),
+            tasks: PerRobot::new(n),
             low_conf: RobotFlags::new(n),
             running: RobotFlags::new(n),
+            waiting: RobotFlags::new(n),
             fault: None,
         };
         let mut first_waiting_start = first_waiting_start(&members[..n], |i| self.cur(i).start_s());
@@ -586,8 +547,66 @@ impl Coordinator {
             );
         }
         self.update_released();
+        for i in 0..n {
+            out.tasks.as_mut_slice()[i] = u64::from(self.finished(i));
+            out.waiting.set(i, self.at_hold(i));
+        }
         out.fault = self.monitor.observe(out.low_conf);
         Ok(out)
+    }
+}
+
+impl Controller for Coordinator {
+    fn n_robots(&self) -> usize {
+        Coordinator::n_robots(self)
+    }
+
+    fn tick_s(&self) -> f64 {
+        Coordinator::tick_s(self)
+    }
+
+    fn tick(&mut self, operator: Operator) -> Result<Tick> {
+        Coordinator::tick(self, operator)
+    }
+
+    fn reset(&mut self) {
+        Coordinator::reset(self);
+    }
+
+    fn fault(&self) -> Option<Fault> {
+        Coordinator::fault(self)
+    }
+
+    fn clear_fault(&mut self) {
+        Coordinator::clear_fault(self);
+    }
+
+    fn low_conf_now(&self) -> RobotFlags {
+        Coordinator::low_conf_now(self)
+    }
+
+    fn running_now(&self) -> RobotFlags {
+        Coordinator::running_now(self)
+    }
+
+    fn waiting_now(&self) -> RobotFlags {
+        Coordinator::waiting_now(self)
+    }
+
+    fn ref_time_now(&self) -> PerRobot<f64> {
+        Coordinator::ref_time_now(self)
+    }
+
+    fn tasks_now(&self) -> PerRobot<u64> {
+        Coordinator::tasks_now(self)
+    }
+
+    fn clock_s(&self) -> &[f64] {
+        Coordinator::clock_s(self)
+    }
+
+    fn is_finished(&self) -> bool {
+        Coordinator::is_finished(self)
     }
 }
 
@@ -690,6 +709,10 @@ mod tests {
         }
         assert!(c.at_hold(0));
         assert_eq!(t.ref_time, [3.0, 2.0]);
+        // The tick reports robot 0 waiting at its hold, no task done yet.
+        assert_eq!(t.waiting, [true, false]);
+        assert_eq!(t.tasks, [0, 0]);
+        assert_eq!(c.waiting_now(), t.waiting);
         // Cause 1: the held leg's rule clock is that of the legs not started, which follows
         // robot 1 (at 2); the reported clock stays where robot 0 is on schedule, 3.
         assert_eq!(c.rule_clock_s(), [2.0, 2.0]);
@@ -719,6 +742,8 @@ mod tests {
         }
         assert!(dwelt > 0);
         assert_eq!(c.ref_time_now(), [6.0, 6.0]);
+        assert_eq!(c.tasks_now(), [1, 1]);
+        assert_eq!(c.waiting_now(), [false, false]);
         // The leg after the hold ends one dwell later than the plan without it.
         assert_eq!(c.clock_s()[0], c.robots()[0].end_s() + 1.0);
     }

@@ -57,6 +57,7 @@
 
 pub mod adversary;
 pub mod continuous;
+mod contract;
 mod coordinator;
 mod cursor;
 mod error;
@@ -70,14 +71,18 @@ pub mod testkit;
 mod timeline;
 pub mod tol;
 
-pub use continuous::{CellTick, ContinuousCoordinator};
-pub use coordinator::{Coordinator, Fault, Operator, Tick};
+#[allow(deprecated)]
+pub use continuous::CellTick;
+pub use continuous::ContinuousCoordinator;
+pub use contract::{Controller, Operator, Tick};
+pub use coordinator::Coordinator;
 pub use error::{Error, Result};
 pub use holds::{After, Hold};
 pub use margins::{
     PairSlack, pair_slacks, pair_slacks_with_holds, sufficient_margins,
     sufficient_margins_per_pair, sufficient_margins_with_holds,
 };
+pub use monitor::Fault;
 pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};
 pub use strategy::{high_conf_steps, response_step};
 pub use timeline::{LcInterval, Rates, Timeline, clock_end_s, clock_s};

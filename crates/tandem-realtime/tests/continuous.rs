@@ -37,7 +37,7 @@ fn the_second_robot_waits_at_the_start_until_the_first_leaves() {
     let t = c.tick(Operator::Scheduled).unwrap();
     assert_eq!(t.ref_time, [1.0, 0.0]);
     assert_eq!(
-        (t.low_conf, t.running, t.at_gate),
+        (t.low_conf, t.running, t.waiting),
         (
             [true, false].into_flags(),
             [true, false].into_flags(),
@@ -47,13 +47,13 @@ fn the_second_robot_waits_at_the_start_until_the_first_leaves() {
     // Tick 1: robot 0 crosses its LC sample to exactly 2 s — not yet `tol` past it.
     let t = c.tick(Operator::Scheduled).unwrap();
     assert_eq!(t.ref_time, [2.0, 0.0]);
-    assert!(t.at_gate[1] && c.token() == Some(Token { robot: 0, group: 0 }));
+    assert!(t.waiting[1] && c.token() == Some(Token { robot: 0, group: 0 }));
     // Tick 2: robot 0 reaches its end (LC: the interval starts at 2 − tol), the token moves
     // to robot 1 at the tick end and robot 0 is at sample 0 of task 1, waiting at its gate.
     let t = c.tick(Operator::Scheduled).unwrap();
     assert_eq!(t.tasks, [1, 0]);
     assert_eq!(t.low_conf, [true, false]);
-    assert_eq!(t.at_gate, [true, false]);
+    assert_eq!(t.waiting, [true, false]);
     assert_eq!(c.token(), Some(Token { robot: 1, group: 0 }));
     // Tick 3: robot 1 moves for the first time.
     let t = c.tick(Operator::Scheduled).unwrap();
@@ -91,7 +91,7 @@ fn ticks_waiting_at_the_gate(op: Operator) -> usize {
     loop {
         let t = c.tick(op).unwrap();
         assert!(!t.overlap());
-        if !t.at_gate[1] {
+        if !t.waiting[1] {
             // It never moved before: it waited at its gate, clock 1 s.
             assert_eq!(c.clock_s()[1], 1.0);
             assert!(c.clock_s()[0] - 1e-9 >= 4.0);
