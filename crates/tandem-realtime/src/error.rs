@@ -72,7 +72,7 @@ pub enum Error {
         /// What is wrong.
         why: &'static str,
     },
-    /// A hold given to a continuous cell (`crate::continuous::groups`) is out of range, out of
+    /// A hold given to a continuous cell (`crate::cell::groups`) is out of range, out of
     /// order, or inside or next to a low-confidence stretch: a robot cannot wait there.
     #[error("gate at reference sample {ref_idx} {why}")]
     BadGate {
@@ -81,7 +81,7 @@ pub enum Error {
         /// What is wrong.
         why: &'static str,
     },
-    /// The operator's cyclic order of a continuous cell (`crate::continuous::token_sequence`)
+    /// The operator's cyclic order of a continuous cell (`crate::cell::token_sequence`)
     /// is malformed or not runnable.
     #[error("operator order, position {position}: {why}")]
     BadOrder {
@@ -91,7 +91,7 @@ pub enum Error {
         why: &'static str,
     },
     /// A continuous cell cannot be handed over to a new plan now
-    /// (`crate::continuous::ContinuousCoordinator::take_over`): a robot is inside, or past
+    /// (`crate::cell::ContinuousCoordinator::take_over`): a robot is inside, or past
     /// the gate of, a group of the new plan, or the two cells do not match.
     #[error("cannot hand the cell over to the new plan now: robot {}: {why}", robot + 1)]
     HandOver {

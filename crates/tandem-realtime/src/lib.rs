@@ -16,6 +16,12 @@
 //! Time frames: reference sample index `n` (period `Δt_s`), schedule-clock/global time in
 //! seconds, control tick `tick_s` in real seconds.
 //!
+//! One run-time contract: the rounds [`Coordinator`] and the
+//! continuous cell's [`ContinuousCoordinator`] ([`cell`]) both implement [`Controller`] — one
+//! [`Operator`] input and one [`Tick`] out per control tick, one fault monitor ([`Fault`]),
+//! each robot's reference time, tasks and state — and [`adversary::run_adversary`] drives
+//! either (docs/decisions.md, "One run-time contract").
+//!
 //! One owner per concept: [`clock_s`] is the only summation of the schedule clock (every
 //! timeline, duration and `T_total` reads it); [`LcInterval`] is the one low-confidence
 //! interval type; [`tol`] holds every tolerance and says which way each errs; the operator's
@@ -56,15 +62,20 @@
 //! ```
 
 pub mod adversary;
-pub mod continuous;
+pub mod cell;
+/// The continuous cell's former path: every public item of [`cell`], for the code that names it.
+pub mod continuous {
+    #[allow(deprecated)]
+    pub use crate::cell::*;
+}
 mod contract;
-mod coordinator;
 mod cursor;
 mod error;
 pub mod holds;
 pub mod margins;
 mod monitor;
 mod robots;
+mod rounds;
 pub mod strategy;
 #[cfg(feature = "testkit")]
 pub mod testkit;
@@ -72,10 +83,9 @@ mod timeline;
 pub mod tol;
 
 #[allow(deprecated)]
-pub use continuous::CellTick;
-pub use continuous::ContinuousCoordinator;
+pub use cell::CellTick;
+pub use cell::ContinuousCoordinator;
 pub use contract::{Controller, Operator, Tick};
-pub use coordinator::Coordinator;
 pub use error::{Error, Result};
 pub use holds::{After, Hold};
 pub use margins::{
@@ -84,5 +94,6 @@ pub use margins::{
 };
 pub use monitor::Fault;
 pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};
+pub use rounds::Coordinator;
 pub use strategy::{high_conf_steps, response_step};
 pub use timeline::{LcInterval, Rates, Timeline, clock_end_s, clock_s};

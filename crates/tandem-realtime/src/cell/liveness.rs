@@ -20,7 +20,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::adversary::{Adversary, PolicyState, adversary_set};
-use crate::continuous::{ContinuousCoordinator, Group, groups};
+use crate::cell::{ContinuousCoordinator, Group, groups};
 use crate::testkit::{CellHolds, random_cell_task};
 use crate::{MAX_ROBOTS, Operator, Timeline};
 
@@ -56,7 +56,7 @@ struct Seen {
 }
 
 /// Runs `plans[0]` for `ticks` ticks under the policy `adversary` (the beam search runs as a
-/// switching favourite, as in [`crate::continuous::run_cell`]), handing it over to a plan
+/// switching favourite, as in [`crate::cell::run_cell`]), handing it over to a plan
 /// drawn from `plans` as `replan` says, and asserts at every tick: no overlap, no fault, and
 /// the two bounds of the module docs (`g` groups per task).
 fn run(

@@ -1,4 +1,5 @@
-//! Runtime coordinator: advances N robots one control tick at a time (§II-B5).
+//! Rounds at run time: the [`Coordinator`] advances N robots, each doing its one task, one
+//! control tick at a time (§II-B5), under the run-time contract ([`Controller`]).
 
 use std::sync::Arc;
 

@@ -1,315 +1,19 @@
-//! A continuous cell at run time (issue 21): `N` robots each repeat the same task for ever,
-//! one operator supervises their low-confidence stretches in a fixed cyclic order, and no
-//! robot waits for a round to end.
-//!
-//! **The task and its groups.** Every robot runs the same task plan (a [`Timeline`] started at
-//! schedule clock 0, typically the fastest warp: `ψ̇min` on high-confidence samples, `ψ̇̄` on
-//! low-confidence ones). Its maximal low-confidence runs are the *stretches* `0..m`, in
-//! reference order. Consecutive stretches with no usable hold between them (a hold at sample
-//! `h` with `ref_end(k) < h < ref_start(k + 1)`, samples `h − 1` and `h` high-confidence) form
-//! one [`Group`]: a robot cannot stop between them. Before each group lies its *gate*: the
-//! last usable hold before the group's first stretch, or the task start (sample 0, always a
-//! hold). So a robot between two groups, or waiting at a gate, is on high-confidence samples
-//! only.
-//!
-//! **The token rule.** The operator's cyclic order of stretches `(robot, lc)` becomes a cyclic
-//! sequence of [`Token`]s `(robot, group)` ([`token_sequence`]). At run time:
-//! - a robot whose next group is not the current token's waits at that group's gate (clock
-//!   stopped, high-confidence);
-//! - the token's robot may pass its gate, but not the gate of its following group;
-//! - when the token's robot has *left* its group (its schedule clock at least `tol` past the
-//!   end of the group's last low-confidence sample, `tol` = the clock tolerance of
-//!   [`crate::tol`], or at the task's end), the token moves to the next entry, at the end of
-//!   the tick;
-//! - a robot that finishes task `k` is at sample 0 of task `k + 1` (the start hold) at the end
-//!   of that tick and goes on as far as its gate.
-//!
-//! In the first pass through the sequence the entries of a robot that precede its group 0 are
-//! skipped: in the cyclic plan they belong to the task it started one period earlier, which
-//! at run time does not exist.
-//!
-//! **Why it is sound, for any number of tasks and any operator.** Call a robot *inside* from
-//! the tick start at which it holds the token for its next group until the tick end at which
-//! it leaves that group. The token has one holder, and it moves only at a tick end, once its
-//! holder has left; so at most one robot is inside during any tick. A robot that is not
-//! inside is, during the whole tick, between the point `tol` past the end of its previous
-//! group's last low-confidence sample and its next gate (the clock is capped there), or
-//! waiting at the start; the samples it can traverse, even widened by `tol` on both sides,
-//! are high-confidence (the gate's sample and the one before it are high-confidence, and no
-//! low-confidence sample lies between a group and the next gate). So every low-confidence tick
-//! (any low-confidence sample in the traversed interval `[s_old − tol, s_new + tol]`, the
-//! rounds coordinator's conservative definition) is a tick of the one robot inside: two robots
-//! are never low-confidence in one tick. Nothing here depends on the operator's rates, on the
-//! number of tasks, or on where a task ends — the drift of the clocks never matters, because
-//! the robots never rely on a margin: they wait.
-//!
-//! **Runnable orders.** The rule needs each group to be contiguous in the order: between two
-//! stretches of one robot with no usable hold between them no other robot's stretch may come
-//! (the robot cannot wait there for it). [`is_runnable`] checks it; [`token_sequence`] rejects
-//! other orders. Each robot's stretches must also come in task order around the cycle.
-//!
-//! **Liveness.** Each robot's tokens come in its task order (group 0, 1, …, then group 0 of its
-//! next task), which is the order in which it reaches its gates; so the token's robot always
-//! reaches the token's gate (it runs on high-confidence samples at least at `S·tick_s > 0`
-//! per tick) and leaves the group (the operator's rate is at least `S` too). No deadlock.
-//! Across hand-overs to new plans ([`ContinuousCoordinator::take_over`]) the token goes to the
-//! robot whose turn it was, or to the robot served least recently once one has waited a
-//! whole pass, so however often the plan changes, between two of a robot's passages through
-//! a group another robot passes at most `(2N − 1)·G` groups (`G` per task):
-//! docs/decisions.md, "Hand-over liveness".
-//!
-//! **The period.** Under the planned operator (`Operator::Scheduled`) the cell settles into
-//! the cyclic plan's rhythm minus what the rule costs: a robot starts moving from its gate only
-//! once the token is its, so each hand-over costs the operator the travel from the gate to the
-//! stretch (one sample when the gate is next to the stretch) plus the tick quantization
-//! (about a tick). `tandem-schedule`'s cyclic plan counts both when it is given the cell's
-//! tick (`CyclicParams::handover_tick_s`), so its period is then the cell's.
-//! Under drift the period is not guaranteed; only soundness is.
-//!
-//! ```
-//! use tandem_realtime::continuous::ContinuousCoordinator;
-//! use tandem_realtime::{Operator, Timeline};
-//!
-//! // [HC, LC, HC] at Δt_s = 1 s, ψ̇ = 1 everywhere: a task of 3 s with one 1 s stretch.
-//! let task = Timeline::new(&[true, false, true], &[1.0; 3], &[0.5; 3], &[2.0; 3], 0.0, 1.0)?;
-//! // Two robots, the operator's order: robot 0's stretch, then robot 1's. Gates at the start.
-//! let mut cell = ContinuousCoordinator::new(task, &[], &[(0, 0), (1, 0)], 2, 1.0)?;
-//! let t = cell.tick(Operator::Scheduled)?; // robot 0 moves to 1 s, robot 1 waits at 0
-//! assert_eq!((t.ref_time[0], t.ref_time[1]), (1.0, 0.0));
-//! assert!(t.waiting[1] && !t.running[1]);
-//! for _ in 0..1000 {
-//!     assert!(!cell.tick(Operator::Fastest)?.overlap());
-//! }
-//! assert!(cell.tasks_completed().iter().all(|&k| k > 100));
-//! # Ok::<(), tandem_realtime::Error>(())
-//! ```
+//! The continuous cell's run-time coordinator, [`ContinuousCoordinator`] (the token rule of
+//! [the cell's docs](crate::cell)), and its adversary run [`run_cell`].
 
 use std::sync::Arc;
 
 use rand::Rng;
 
+use super::groups::{Group, Token, groups, token_sequence};
 use crate::adversary::{Adversary, PolicyState};
 use crate::contract::{Controller, Operator, Tick, check_tick};
 use crate::cursor::{Cursors, operator_step};
 use crate::error::{Error, Result};
-use crate::monitor::Fault;
-use crate::monitor::Monitor;
+use crate::monitor::{Fault, Monitor};
 use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
 use crate::timeline::Timeline;
 use crate::tol::clock_tolerance_s;
-
-/// Consecutive stretches of the task with no usable hold between them: a robot passes them
-/// without stopping, so one robot at a time is in a group ([module docs](self)).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Group {
-    /// The gate: the reference sample at whose start a robot waits for the group's token (the
-    /// last usable hold before the group's first stretch, or 0, the task start).
-    pub gate: usize,
-    /// The group's stretches are `first_lc..end_lc` (indices of the task's low-confidence
-    /// runs, in reference order).
-    pub first_lc: usize,
-    /// One past the group's last stretch.
-    pub end_lc: usize,
-    /// First reference sample of the group's first stretch.
-    pub ref_start: usize,
-    /// One past the group's last low-confidence sample: a robot has left the group once its
-    /// clock is past the start of this sample.
-    pub ref_end: usize,
-}
-
-/// One entry of the token sequence: robot `robot` may go through its group `group`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Token {
-    /// The robot (0-based).
-    pub robot: usize,
-    /// Its group (index into [`groups`]' result).
-    pub group: usize,
-}
-
-/// The groups of a task of confidence `conf` (`true` = high) with usable holds `holds`
-/// (reference samples, strictly increasing, each in `1..T_ref` with samples `h − 1` and `h`
-/// high-confidence, as [`crate::holds::usable_holds`] returns them). Empty for a task without
-/// low confidence.
-///
-/// # Errors
-/// [`Error::BadGate`] for a hold out of range, out of order, or inside or next to a stretch.
-pub fn groups(conf: &[bool], holds: &[usize]) -> Result<Vec<Group>> {
-    for (k, &h) in holds.iter().enumerate() {
-        let bad = |why| Err(Error::BadGate { ref_idx: h, why });
-        if h == 0 || h >= conf.len() {
-            return bad("is outside 1..T_ref");
-        }
-        if k > 0 && holds[k - 1] >= h {
-            return bad("is not after the hold before it");
-        }
-        if !(conf[h - 1] && conf[h]) {
-            return bad("is inside or next to a low-confidence stretch");
-        }
-    }
-    // The stretches (start, end) in reference order.
-    let mut stretches = Vec::new();
-    let mut n = 0;
-    while n < conf.len() {
-        if conf[n] {
-            n += 1;
-            continue;
-        }
-        let start = n;
-        while n < conf.len() && !conf[n] {
-            n += 1;
-        }
-        stretches.push((start, n));
-    }
-    let mut out: Vec<Group> = Vec::new();
-    for (k, &(start, end)) in stretches.iter().enumerate() {
-        let after = if k == 0 { 0 } else { stretches[k - 1].1 };
-        let hold = holds
-            .iter()
-            .copied()
-            .rfind(|&h| (k == 0 || h > after) && h < start);
-        match (k, hold) {
-            (0, _) | (_, Some(_)) => out.push(Group {
-                gate: hold.unwrap_or(0),
-                first_lc: k,
-                end_lc: k + 1,
-                ref_start: start,
-                ref_end: end,
-            }),
-            (_, None) => {
-                let g = out.last_mut().expect("stretch 0 opened a group");
-                g.end_lc = k + 1;
-                g.ref_end = end;
-            }
-        }
-    }
-    Ok(out)
-}
-
-/// The group of each stretch.
-fn group_of(groups: &[Group]) -> Vec<usize> {
-    groups
-        .iter()
-        .enumerate()
-        .flat_map(|(g, gr)| std::iter::repeat_n(g, gr.end_lc - gr.first_lc))
-        .collect()
-}
-
-/// Whether the operator's cyclic `order` of stretches `(robot, lc)` of `n_robots` robots can
-/// run under the token rule on a task with `groups`: every robot's every stretch once, each
-/// robot's in task order around the cycle, and every group contiguous (no other robot's
-/// stretch between two stretches of one robot with no usable hold between them:
-/// [`first_split_group`]).
-#[must_use]
-pub fn is_runnable(order: &[(usize, usize)], groups: &[Group], n_robots: usize) -> bool {
-    token_sequence(order, groups, n_robots).is_ok()
-}
-
-/// The first position of the cyclic `order` of stretches `(robot, lc)` that splits one of
-/// `groups`, or `None` when every group is contiguous: the contiguity rule of
-/// [`is_runnable`], and its one implementation (`tandem-schedule`'s order search and
-/// `cyclic::is_runnable` use it). Entry `q`, stretch `(r, lc)`, splits its group when it is
-/// not the group's first (no usable hold lies between stretches `lc − 1` and `lc`: the robot
-/// cannot wait there) and the entry before it, cyclically, is not `(r, lc − 1)`. Checks only
-/// this condition, not that `order` is well formed (a stretch outside the groups splits
-/// nothing; [`token_sequence`] checks the rest, and this rule with the same code).
-/// O(len·log(groups)), no allocation: the check of an order search, which visits
-/// well-formed orders only.
-#[must_use]
-pub fn first_split_group<T: Copy + Into<(usize, usize)>>(
-    order: &[T],
-    groups: &[Group],
-) -> Option<usize> {
-    (0..order.len()).find(|&q| splits_group(order, q, groups))
-}
-
-/// Whether entry `q` of `order` splits its group ([`first_split_group`]).
-fn splits_group<T: Copy + Into<(usize, usize)>>(order: &[T], q: usize, groups: &[Group]) -> bool {
-    let len = order.len();
-    let (r, lc) = order[q].into();
-    let m = groups.last().map_or(0, |g| g.end_lc);
-    // A group's first stretch (stretch 0 always), or one outside the groups, splits nothing.
-    if lc == 0 || lc >= m || groups.binary_search_by_key(&lc, |g| g.first_lc).is_ok() {
-        return false;
-    }
-    let prev: (usize, usize) = order[(q + len - 1) % len].into();
-    prev != (r, lc - 1)
-}
-
-/// The cyclic token sequence of a runnable `order` ([`is_runnable`]): the order cut into its
-/// groups, one [`Token`] per group, starting at the first entry of `order` that opens a group;
-/// and, per token, whether the first pass skips it (it precedes its robot's group 0: it
-/// belongs to the task before the robot's first).
-///
-/// # Errors
-/// [`Error::BadOrder`] naming the position in `order` and what is wrong.
-pub fn token_sequence(
-    order: &[(usize, usize)],
-    groups: &[Group],
-    n_robots: usize,
-) -> Result<(Vec<Token>, Vec<bool>)> {
-    let m = groups.last().map_or(0, |g| g.end_lc);
-    let len = order.len();
-    if len != n_robots * m {
-        return Err(Error::BadOrder {
-            position: len.min(n_robots * m),
-            why: "does not list each robot's each stretch exactly once (length N·m)",
-        });
-    }
-    if m == 0 || n_robots == 0 {
-        return Ok((Vec::new(), Vec::new()));
-    }
-    let gof = group_of(groups);
-    let mut seen = vec![false; n_robots * m];
-    let mut last: Vec<Option<usize>> = vec![None; n_robots];
-    for (q, &(r, lc)) in order.iter().enumerate() {
-        let bad = |why| Err(Error::BadOrder { position: q, why });
-        if r >= n_robots || lc >= m {
-            return bad("names a robot or a stretch that does not exist");
-        }
-        if std::mem::replace(&mut seen[r * m + lc], true) {
-            return bad("repeats a stretch");
-        }
-        if last[r].is_some_and(|l| (l + 1) % m != lc) {
-            return bad("breaks its robot's task order around the cycle");
-        }
-        last[r] = Some(lc);
-        if splits_group(order, q, groups) {
-            return bad(
-                "is not runnable: another robot's stretch comes between it and the stretch \
-                 before it, with no usable hold between them",
-            );
-        }
-    }
-    let opens = |q: usize| {
-        let (_, lc) = order[q];
-        groups[gof[lc]].first_lc == lc
-    };
-    let start = (0..len)
-        .find(|&q| opens(q))
-        .expect("stretch 0 opens a group");
-    let tokens: Vec<Token> = (0..len)
-        .map(|k| (start + k) % len)
-        .filter(|&q| opens(q))
-        .map(|q| Token {
-            robot: order[q].0,
-            group: gof[order[q].1],
-        })
-        .collect();
-    let first_zero: Vec<usize> = (0..n_robots)
-        .map(|r| {
-            tokens
-                .iter()
-                .position(|t| t.robot == r && t.group == 0)
-                .expect("every robot has a group 0")
-        })
-        .collect();
-    let skip = tokens
-        .iter()
-        .enumerate()
-        .map(|(k, t)| k < first_zero[t.robot])
-        .collect();
-    Ok((tokens, skip))
-}
 
 /// What one [`ContinuousCoordinator::tick`] did: the one [`Tick`] of every controller (its
 /// `at_gate` is [`Tick::waiting`]).
@@ -318,7 +22,7 @@ pub fn token_sequence(
 )]
 pub type CellTick = Tick;
 
-/// The run-time coordinator of a continuous cell ([module docs](self)): `1 ≤ N ≤ MAX_ROBOTS`
+/// The run-time coordinator of a continuous cell ([cell docs](crate::cell)): `1 ≤ N ≤ MAX_ROBOTS`
 /// robots repeating one task plan for ever under the token rule, one control period
 /// `tick_s` (real s) per [`tick`](ContinuousCoordinator::tick).
 ///
@@ -355,7 +59,7 @@ pub struct ContinuousCoordinator {
     clock_s: [f64; MAX_ROBOTS],
     /// Each robot's next group in its current task (`groups.len()`: none left).
     next_group: [usize; MAX_ROBOTS],
-    tasks: [u64; MAX_ROBOTS],
+    pub(super) tasks: [u64; MAX_ROBOTS],
     cursors: [Cursors; MAX_ROBOTS],
     /// Index of the current token.
     pos: usize,
@@ -366,7 +70,7 @@ pub struct ContinuousCoordinator {
     /// among the robots' first tokens at the start (`0..N`); services stamp `N, N + 1, …`.
     /// Carried over by [`take_over`](Self::take_over), which gives the new plan's token to
     /// the least recently served robot (liveness, docs/decisions.md).
-    served: [u64; MAX_ROBOTS],
+    pub(super) served: [u64; MAX_ROBOTS],
     /// The next service's stamp.
     stamp: u64,
     /// The run-time fault monitor (its tick count is the ticks run since the start or the
@@ -979,89 +683,4 @@ pub fn run_cell(
     run.min_tasks = min_done(cell).unwrap_or(0);
     run.finished = true;
     Ok(run)
-}
-
-#[cfg(test)]
-mod liveness;
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn groups_by_hand() {
-        // HC HC LC HC HC HC LC LC HC LC HC HC: stretches (2,3), (6,8), (9,10).
-        let conf = [
-            true, true, false, true, true, true, false, false, true, false, true, true,
-        ];
-        // No holds: one group of three stretches, gated at the start.
-        let g = groups(&conf, &[]).unwrap();
-        assert_eq!(g.len(), 1);
-        assert_eq!((g[0].gate, g[0].first_lc, g[0].end_lc), (0, 0, 3));
-        assert_eq!((g[0].ref_start, g[0].ref_end), (2, 10));
-        // A hold at 1 (before stretch 0) and at 5 (between stretches 0 and 1).
-        let g = groups(&conf, &[1, 5]).unwrap();
-        assert_eq!(g.len(), 2);
-        assert_eq!((g[0].gate, g[0].end_lc, g[0].ref_end), (1, 1, 3));
-        assert_eq!((g[1].gate, g[1].first_lc, g[1].end_lc), (5, 1, 3));
-        assert!(matches!(
-            groups(&conf, &[3]),
-            Err(Error::BadGate { ref_idx: 3, .. })
-        ));
-        assert!(groups(&conf, &[5, 4]).is_err() && groups(&conf, &[12]).is_err());
-        assert!(groups(&[true; 4], &[]).unwrap().is_empty());
-    }
-
-    #[test]
-    fn token_sequences_by_hand() {
-        // Two groups per task: {0}, {1, 2}.
-        let g = [
-            Group {
-                gate: 0,
-                first_lc: 0,
-                end_lc: 1,
-                ref_start: 2,
-                ref_end: 3,
-            },
-            Group {
-                gate: 5,
-                first_lc: 1,
-                end_lc: 3,
-                ref_start: 6,
-                ref_end: 10,
-            },
-        ];
-        // Robot 1 starts at its stretch 1 and its group {1, 2} straddles the wrap.
-        let order = [(1, 2), (0, 0), (1, 0), (0, 1), (0, 2), (1, 1)];
-        let (tokens, skip) = token_sequence(&order, &g, 2).unwrap();
-        let t = |robot, group| Token { robot, group };
-        assert_eq!(tokens, [t(0, 0), t(1, 0), t(0, 1), t(1, 1)]);
-        assert_eq!(skip, [false; 4]);
-        // Robot 1 first in its group 1: skipped in the first pass.
-        let order = [(1, 1), (1, 2), (0, 0), (1, 0), (0, 1), (0, 2)];
-        let (tokens, skip) = token_sequence(&order, &g, 2).unwrap();
-        assert_eq!(tokens, [t(1, 1), t(0, 0), t(1, 0), t(0, 1)]);
-        assert_eq!(skip, [true, false, false, false]);
-        // Robot 0 between robot 1's stretches 1 and 2: not runnable.
-        let bad = [(1, 1), (0, 0), (1, 2), (1, 0), (0, 1), (0, 2)];
-        assert!(matches!(
-            token_sequence(&bad, &g, 2),
-            Err(Error::BadOrder { position: 2, .. })
-        ));
-        assert!(!is_runnable(&bad, &g, 2));
-        assert_eq!(first_split_group(&bad, &g), Some(2));
-        assert_eq!(first_split_group(&order, &g), None);
-        // No robots: the empty order, nothing to run.
-        assert!(is_runnable(&[], &g, 0));
-        // Out of task order, repeated, wrong length, unknown robot.
-        let cases: [&[(usize, usize)]; 4] = [
-            &[(0, 0), (1, 0), (1, 1), (1, 2), (0, 2), (0, 1)],
-            &[(0, 0), (0, 0), (1, 0), (1, 1), (1, 2), (0, 1)],
-            &[(0, 0), (0, 1), (0, 2)],
-            &[(0, 0), (2, 0), (1, 1), (1, 2), (0, 1), (0, 2)],
-        ];
-        for c in cases {
-            assert!(!is_runnable(c, &g, 2), "{c:?}");
-        }
-    }
 }

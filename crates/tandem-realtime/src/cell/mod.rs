@@ -1,0 +1,95 @@
+//! A continuous cell at run time (issue 21): `N` robots each repeat the same task for ever,
+//! one operator supervises their low-confidence stretches in a fixed cyclic order, and no
+//! robot waits for a round to end.
+//!
+//! **The task and its groups.** Every robot runs the same task plan (a [`Timeline`](crate::Timeline) started at
+//! schedule clock 0, typically the fastest warp: `ψ̇min` on high-confidence samples, `ψ̇̄` on
+//! low-confidence ones). Its maximal low-confidence runs are the *stretches* `0..m`, in
+//! reference order. Consecutive stretches with no usable hold between them (a hold at sample
+//! `h` with `ref_end(k) < h < ref_start(k + 1)`, samples `h − 1` and `h` high-confidence) form
+//! one [`Group`]: a robot cannot stop between them. Before each group lies its *gate*: the
+//! last usable hold before the group's first stretch, or the task start (sample 0, always a
+//! hold). So a robot between two groups, or waiting at a gate, is on high-confidence samples
+//! only.
+//!
+//! **The token rule.** The operator's cyclic order of stretches `(robot, lc)` becomes a cyclic
+//! sequence of [`Token`]s `(robot, group)` ([`token_sequence`]). At run time:
+//! - a robot whose next group is not the current token's waits at that group's gate (clock
+//!   stopped, high-confidence);
+//! - the token's robot may pass its gate, but not the gate of its following group;
+//! - when the token's robot has *left* its group (its schedule clock at least `tol` past the
+//!   end of the group's last low-confidence sample, `tol` = the clock tolerance of
+//!   [`crate::tol`], or at the task's end), the token moves to the next entry, at the end of
+//!   the tick;
+//! - a robot that finishes task `k` is at sample 0 of task `k + 1` (the start hold) at the end
+//!   of that tick and goes on as far as its gate.
+//!
+//! In the first pass through the sequence the entries of a robot that precede its group 0 are
+//! skipped: in the cyclic plan they belong to the task it started one period earlier, which
+//! at run time does not exist.
+//!
+//! **Why it is sound, for any number of tasks and any operator.** Call a robot *inside* from
+//! the tick start at which it holds the token for its next group until the tick end at which
+//! it leaves that group. The token has one holder, and it moves only at a tick end, once its
+//! holder has left; so at most one robot is inside during any tick. A robot that is not
+//! inside is, during the whole tick, between the point `tol` past the end of its previous
+//! group's last low-confidence sample and its next gate (the clock is capped there), or
+//! waiting at the start; the samples it can traverse, even widened by `tol` on both sides,
+//! are high-confidence (the gate's sample and the one before it are high-confidence, and no
+//! low-confidence sample lies between a group and the next gate). So every low-confidence tick
+//! (any low-confidence sample in the traversed interval `[s_old − tol, s_new + tol]`, the
+//! rounds coordinator's conservative definition) is a tick of the one robot inside: two robots
+//! are never low-confidence in one tick. Nothing here depends on the operator's rates, on the
+//! number of tasks, or on where a task ends — the drift of the clocks never matters, because
+//! the robots never rely on a margin: they wait.
+//!
+//! **Runnable orders.** The rule needs each group to be contiguous in the order: between two
+//! stretches of one robot with no usable hold between them no other robot's stretch may come
+//! (the robot cannot wait there for it). [`is_runnable`] checks it; [`token_sequence`] rejects
+//! other orders. Each robot's stretches must also come in task order around the cycle.
+//!
+//! **Liveness.** Each robot's tokens come in its task order (group 0, 1, …, then group 0 of its
+//! next task), which is the order in which it reaches its gates; so the token's robot always
+//! reaches the token's gate (it runs on high-confidence samples at least at `S·tick_s > 0`
+//! per tick) and leaves the group (the operator's rate is at least `S` too). No deadlock.
+//! Across hand-overs to new plans ([`ContinuousCoordinator::take_over`]) the token goes to the
+//! robot whose turn it was, or to the robot served least recently once one has waited a
+//! whole pass, so however often the plan changes, between two of a robot's passages through
+//! a group another robot passes at most `(2N − 1)·G` groups (`G` per task):
+//! docs/decisions.md, "Hand-over liveness".
+//!
+//! **The period.** Under the planned operator (`Operator::Scheduled`) the cell settles into
+//! the cyclic plan's rhythm minus what the rule costs: a robot starts moving from its gate only
+//! once the token is its, so each hand-over costs the operator the travel from the gate to the
+//! stretch (one sample when the gate is next to the stretch) plus the tick quantization
+//! (about a tick). `tandem-schedule`'s cyclic plan counts both when it is given the cell's
+//! tick (`CyclicParams::handover_tick_s`), so its period is then the cell's.
+//! Under drift the period is not guaranteed; only soundness is.
+//!
+//! ```
+//! use tandem_realtime::cell::ContinuousCoordinator;
+//! use tandem_realtime::{Operator, Timeline};
+//!
+//! // [HC, LC, HC] at Δt_s = 1 s, ψ̇ = 1 everywhere: a task of 3 s with one 1 s stretch.
+//! let task = Timeline::new(&[true, false, true], &[1.0; 3], &[0.5; 3], &[2.0; 3], 0.0, 1.0)?;
+//! // Two robots, the operator's order: robot 0's stretch, then robot 1's. Gates at the start.
+//! let mut cell = ContinuousCoordinator::new(task, &[], &[(0, 0), (1, 0)], 2, 1.0)?;
+//! let t = cell.tick(Operator::Scheduled)?; // robot 0 moves to 1 s, robot 1 waits at 0
+//! assert_eq!((t.ref_time[0], t.ref_time[1]), (1.0, 0.0));
+//! assert!(t.waiting[1] && !t.running[1]);
+//! for _ in 0..1000 {
+//!     assert!(!cell.tick(Operator::Fastest)?.overlap());
+//! }
+//! assert!(cell.tasks_completed().iter().all(|&k| k > 100));
+//! # Ok::<(), tandem_realtime::Error>(())
+//! ```
+
+mod coordinator;
+mod groups;
+#[cfg(test)]
+mod liveness;
+
+#[allow(deprecated)]
+pub use coordinator::{CellRun, CellTick};
+pub use coordinator::{ContinuousCoordinator, run_cell};
+pub use groups::{Group, Token, first_split_group, groups, is_runnable, token_sequence};
