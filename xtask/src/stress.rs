@@ -36,7 +36,7 @@
 //! set, the beam search replaced by a switching favourite) until every robot has completed
 //! `K` tasks (default 50), so the clocks' drift runs across many cycles. It counts the ticks
 //! with two or more robots low-confidence and the ticks in which a robot moved backwards
-//! (expected 0 of both; `CellRun::backward_steps`) and the tasks per robot.
+//! (expected 0 of both; `AdversaryRun::backward_steps`) and the tasks per robot.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;

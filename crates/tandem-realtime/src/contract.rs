@@ -5,6 +5,7 @@
 //! one [`Operator`] input per tick, one [`Tick`] out, one fault monitor ([`Fault`]), and each
 //! robot's position and state ([`Controller`]; docs/decisions.md, "One run-time contract").
 
+use crate::adversary::AdversaryRun;
 use crate::error::{Error, Result};
 use crate::monitor::Fault;
 use crate::robots::{PerRobot, RobotFlags};
@@ -148,6 +149,19 @@ pub trait Controller {
     /// Whether every robot has finished: rounds, once every robot has done its task; the
     /// continuous cell, never.
     fn is_finished(&self) -> bool;
+
+    /// The run of the worst operator sequence the beam search of
+    /// [`Adversary::Beam`](crate::adversary::Adversary::Beam) finds from this state, for a
+    /// controller that has one (rounds: [`beam_search`](crate::adversary::search::beam_search));
+    /// `None`, the default: [`run_adversary`](crate::adversary::run_adversary) runs the beam as
+    /// a switching policy. `self` is not changed.
+    ///
+    /// # Errors
+    /// Those of the search (none in practice).
+    fn beam_search(&self, width: u32, max_ticks: u64) -> Option<Result<AdversaryRun>> {
+        let _ = (width, max_ticks);
+        None
+    }
 }
 
 /// Checks a control period: finite and > 0 (the one check of every controller's `tick_s`).
@@ -228,6 +242,58 @@ mod tests {
             "{:?}",
             last[1].tasks
         );
+    }
+
+    /// The same forced overlap in both controllers: two robots of `[LC, LC, HC, HC]` (Δt_s = 1,
+    /// bounds [½, 2], tick 1 s) both on their first low-confidence sample at the start —
+    /// rounds started together without the margin check, and a cell whose robot 1 is placed
+    /// inside the group without the token (as if it had already been let through).
+    fn forced_overlaps() -> [Box<dyn Controller>; 2] {
+        let conf = [false, false, true, true];
+        let (g, lo, hi) = ([1.0; 4], [0.5; 4], [2.0; 4]);
+        let task = Timeline::new(&conf, &g, &lo, &hi, 0.0, 1.0).unwrap();
+        let rounds = Coordinator::new_unchecked([task.clone(), task.clone()], 1.0).unwrap();
+        let mut cell = ContinuousCoordinator::new(task, &[], &[(0, 0), (1, 0)], 2, 1.0).unwrap();
+        // One group (gate 0); robot 0 has its token; robot 1 "has left" it: no cap.
+        cell.place_unchecked(1, 0.0, 1);
+        [Box::new(rounds), Box::new(cell)]
+    }
+
+    /// Both controllers' faults and the held robot's clock over two ticks of dragging.
+    fn faults_of(mut c: Box<dyn Controller>) -> (Option<Fault>, bool) {
+        // (The cell reports only its token's robot as the one to supervise.)
+        assert!(c.low_conf_now()[0]);
+        let t = c.tick(Operator::Slowest).unwrap();
+        assert!(t.overlap());
+        let held = t.fault.expect("an overlap latches a fault").stopped;
+        let before = c.clock_s()[held];
+        let t2 = c.tick(Operator::Slowest).unwrap();
+        assert_eq!(t2.fault, t.fault);
+        // The held robot does not move; the other one does.
+        let still = c.clock_s()[held] == before && !t2.running[held] && t2.running[1 - held];
+        (t.fault, still)
+    }
+
+    #[test]
+    fn one_monitor_two_controllers() {
+        // The policy: hold the robot whose run began last, the higher index on a tie (here
+        // both runs begin in tick 0).
+        let want = |stopped| {
+            Some(Fault {
+                tick: 0,
+                low_conf: RobotFlags::from_slice(&[true, true]),
+                stopped,
+            })
+        };
+        for c in forced_overlaps() {
+            assert_eq!(faults_of(c), (want(1), true));
+        }
+        // A change of the policy in one place — the monitor's tie rule, through its test
+        // hook — changes both controllers alike.
+        crate::monitor::hold_lowest_on_tie(true);
+        let changed: Vec<_> = forced_overlaps().into_iter().map(faults_of).collect();
+        crate::monitor::hold_lowest_on_tie(false);
+        assert_eq!(changed, [(want(0), true), (want(0), true)]);
     }
 
     #[test]

@@ -3,6 +3,7 @@
 
 use std::sync::Arc;
 
+use crate::adversary::AdversaryRun;
 use crate::contract::{Controller, check_tick};
 use crate::contract::{Operator, Tick};
 use crate::cursor::{Cursors, operator_step};
@@ -608,6 +609,14 @@ impl Controller for Coordinator {
 
     fn is_finished(&self) -> bool {
         Coordinator::is_finished(self)
+    }
+
+    fn beam_search(&self, width: u32, max_ticks: u64) -> Option<Result<AdversaryRun>> {
+        Some(crate::adversary::search::beam_search(
+            self.clone(),
+            width as usize,
+            max_ticks,
+        ))
     }
 }
 

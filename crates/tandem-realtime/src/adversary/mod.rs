@@ -15,6 +15,8 @@
 //! clearance between regions ([`search`]).
 //! [`adversary_set`] returns the full set for one case of `N` robots, [`run_adversary`] runs one
 //! execution under one adversary and counts the ticks with two or more robots low-confidence.
+//! The driver is the one for every controller ([`Controller`]: rounds and the continuous cell,
+//! [`run_adversary_on`] for a number of tasks).
 //!
 //! ```
 //! use rand::SeedableRng;
@@ -40,7 +42,7 @@ pub mod search;
 
 use rand::Rng;
 
-use crate::{Coordinator, MAX_ROBOTS, Operator, Result};
+use crate::{Controller, MAX_ROBOTS, Operator, Result};
 
 /// An operator policy: which [`Operator`] input the operator gives at each control tick.
 /// Extremes are clamped by the coordinator to the low-confidence robot's `[ψ̇min, ψ̇max]` at
@@ -190,46 +192,56 @@ pub struct AdversaryRun {
     pub overlap_ticks: u64,
     /// Index of the first such tick.
     pub first_overlap: Option<u64>,
-    /// Whether every robot finished within the tick budget.
+    /// Whether the run reached its goal within the tick budget: every robot finished (rounds),
+    /// or completed the tasks asked ([`run_adversary_on`]).
     pub finished: bool,
-    /// Ticks in which some robot moved backwards: its reference time
-    /// ([`Tick::ref_time`](crate::Tick::ref_time)) or its clock
-    /// ([`Coordinator::clock_s`]) decreased (0: a robot never moves backwards; debug builds
-    /// assert it in every tick).
+    /// Ticks in which some robot moved backwards: its (tasks completed, reference time)
+    /// ([`Tick`](crate::Tick)) or its (tasks completed, clock) ([`Controller::clock_s`])
+    /// decreased (0: a robot never moves backwards; debug builds assert it in every tick).
     pub backward_steps: u64,
+    /// The fewest tasks any robot completed at the end ([`Controller::tasks_now`]; rounds: 1
+    /// once every robot has finished).
+    pub min_tasks: u64,
 }
 
-/// The check "a robot never moves backwards" from outside the coordinator: each robot's
-/// reference time and clock at the end of the previous tick (or at the start), compared with
-/// those at the end of the next.
+/// The check "a robot never moves backwards" from outside a controller: each robot's tasks
+/// completed, reference time and clock at the end of the previous tick (or at the start),
+/// compared with those at the end of the next.
 #[derive(Clone, Copy, Debug)]
 pub struct Backward {
+    tasks: crate::PerRobot<u64>,
     ref_time: crate::PerRobot<f64>,
     clock_s: crate::PerRobot<f64>,
 }
 
 impl Backward {
-    /// The robots' positions now ([`Coordinator::ref_time_now`], [`Coordinator::clock_s`]).
+    /// The robots' positions now ([`Controller::tasks_now`], [`Controller::ref_time_now`],
+    /// [`Controller::clock_s`]).
     #[must_use]
-    pub fn new(coordinator: &Coordinator) -> Backward {
+    pub fn new<C: Controller + ?Sized>(controller: &C) -> Backward {
         Backward {
-            ref_time: coordinator.ref_time_now(),
-            clock_s: crate::PerRobot::from_slice(coordinator.clock_s()),
+            tasks: controller.tasks_now(),
+            ref_time: controller.ref_time_now(),
+            clock_s: crate::PerRobot::from_slice(controller.clock_s()),
         }
     }
 
-    /// After a tick of `coordinator` that returned `tick`: whether some robot's reference
-    /// time or clock decreased since the last call (or [`Backward::new`]), and remember the new
-    /// positions. Also checks that the tick reported the reference time the coordinator
-    /// reports now (a mismatch counts as a backward step: a caller reading one or the other
-    /// would see the robot elsewhere).
-    pub fn step(&mut self, coordinator: &Coordinator, tick: &crate::Tick) -> bool {
-        let now = Backward::new(coordinator);
+    /// After a tick of `controller` that returned `tick`: whether some robot's (tasks
+    /// completed, reference time) or (tasks completed, clock) decreased lexicographically since
+    /// the last call (or [`Backward::new`]), and remember the new positions. Also checks that
+    /// the tick reported the tasks and reference time the controller reports now (a mismatch
+    /// counts as a backward step: a caller reading one or the other would see the robot
+    /// elsewhere).
+    pub fn step<C: Controller + ?Sized>(&mut self, controller: &C, tick: &crate::Tick) -> bool {
+        let now = Backward::new(controller);
         let mut back = false;
-        for i in 0..coordinator.n_robots() {
-            back |= now.ref_time[i] < self.ref_time[i]
-                || now.clock_s[i] < self.clock_s[i]
-                || tick.ref_time[i] != now.ref_time[i];
+        for i in 0..controller.n_robots() {
+            let same_task = now.tasks[i] == self.tasks[i];
+            back |= now.tasks[i] < self.tasks[i]
+                || (same_task
+                    && (now.ref_time[i] < self.ref_time[i] || now.clock_s[i] < self.clock_s[i]))
+                || tick.ref_time[i] != now.ref_time[i]
+                || tick.tasks[i] != now.tasks[i];
         }
         *self = now;
         back
@@ -354,34 +366,67 @@ impl PolicyState {
     }
 }
 
-/// Runs `coordinator` to the end (or for at most `max_ticks` ticks) with the operator inputs
-/// of `adversary`, drawing from `rng` (deterministic for its state). [`Adversary::Beam`] runs
-/// the search instead and reports its worst sequence. A [`Fault`](crate::Fault) the
-/// coordinator latches is counted and cleared at once, so that the run goes on to the end.
+/// Runs `controller` until every robot has done its task — rounds: to the end; the continuous
+/// cell: until every robot has completed one task — or for at most `max_ticks` ticks, with the
+/// operator inputs of `adversary`, drawing from `rng` (deterministic for its state):
+/// [`run_adversary_on`] with one task. [`Adversary::Beam`] runs the search instead where the
+/// controller has one ([`Controller::beam_search`]: rounds) and reports its worst sequence.
 ///
 /// # Errors
 /// [`crate::Error::BadOperator`] when the adversary produces an inadmissible gradient (a
 /// [`Adversary::Random`] range reaching 0 or beyond).
-pub fn run_adversary(
-    mut coordinator: Coordinator,
+pub fn run_adversary<C: Controller>(
+    mut controller: C,
     adversary: Adversary,
     rng: &mut impl Rng,
     max_ticks: u64,
 ) -> Result<AdversaryRun> {
-    if let Adversary::Beam { width } = adversary {
-        return search::beam_search(coordinator, width as usize, max_ticks);
+    if let Adversary::Beam { width } = adversary
+        && let Some(run) = controller.beam_search(width, max_ticks)
+    {
+        return run;
     }
+    run_adversary_on(&mut controller, adversary, rng, 1, max_ticks)
+}
+
+/// THE adversary driver of every controller: runs `controller` from its current state until it
+/// has finished ([`Controller::is_finished`]) or every robot has completed `min_tasks` tasks
+/// ([`Controller::tasks_now`]), or for at most `max_ticks` ticks, with the operator inputs of
+/// the policy `adversary` (given the robot low-confidence at each tick start,
+/// [`Controller::low_conf_now`]), drawing from `rng`. The beam search [`Adversary::Beam`] is
+/// not a policy and runs here as [`Adversary::SwitchFavourite`] with holds up to 50 ticks
+/// ([`run_adversary`] runs the search itself where there is one). A [`Fault`](crate::Fault)
+/// the controller latches is counted and cleared at once, so that the run goes on; a backward
+/// step is counted ([`Backward`]). Allocates nothing; O(N) per tick (the cell's reference
+/// times O(N log T_ref)).
+///
+/// # Errors
+/// [`crate::Error::BadOperator`] when the adversary produces an inadmissible gradient.
+pub fn run_adversary_on<C: Controller + ?Sized>(
+    controller: &mut C,
+    adversary: Adversary,
+    rng: &mut impl Rng,
+    min_tasks: u64,
+    max_ticks: u64,
+) -> Result<AdversaryRun> {
     let mut run = AdversaryRun::default();
-    let mut state = PolicyState::new(coordinator.n_robots());
-    let mut backward = Backward::new(&coordinator);
-    while !coordinator.is_finished() {
+    let mut state = PolicyState::new(controller.n_robots());
+    let mut backward = Backward::new(controller);
+    let fewest = |c: &C| c.tasks_now().iter().copied().min().unwrap_or(0);
+    // The beam search is not a policy: a switching favourite with holds up to 50 ticks.
+    let policy = match adversary {
+        Adversary::Beam { .. } => Adversary::SwitchFavourite { max_hold: 50 },
+        other => other,
+    };
+    while !(controller.is_finished() || fewest(controller) >= min_tasks) {
         if run.ticks >= max_ticks {
+            run.min_tasks = fewest(controller);
             return Ok(run);
         }
-        let lc = coordinator.low_conf_now().first();
-        let op = state.next(adversary, run.ticks, lc, rng);
-        let tick = coordinator.tick(op)?;
-        run.backward_steps += u64::from(backward.step(&coordinator, &tick));
+        let lc = controller.low_conf_now().first();
+        let op = state.next(policy, run.ticks, lc, rng);
+        let tick = controller.tick(op)?;
+        run.backward_steps += u64::from(backward.step(controller, &tick));
         if tick.overlap() {
             run.first_overlap.get_or_insert(run.ticks);
             run.overlap_ticks += 1;
@@ -389,10 +434,11 @@ pub fn run_adversary(
         // A measurement runs to the end: the fault a run-time monitor latches (and the robot it
         // holds) is recorded above and released.
         if tick.fault.is_some() {
-            coordinator.clear_fault();
+            controller.clear_fault();
         }
         run.ticks += 1;
     }
+    run.min_tasks = fewest(controller);
     run.finished = true;
     Ok(run)
 }
@@ -445,7 +491,7 @@ mod tests {
     #[test]
     fn a_bad_random_range_is_an_error_and_the_set_is_complete() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
-        let c = Coordinator::new_unchecked(robots(), 1.0).unwrap();
+        let c = crate::Coordinator::new_unchecked(robots(), 1.0).unwrap();
         let bad = Adversary::Random { lo: -1.0, hi: -0.5 };
         assert!(matches!(
             run_adversary(c, bad, &mut rng, 100),
@@ -464,10 +510,46 @@ mod tests {
         }
         // Both robots are LC together from the start: every policy sees the overlap.
         for a in set {
-            let c = Coordinator::new_unchecked(robots(), 1.0).unwrap();
+            let c = crate::Coordinator::new_unchecked(robots(), 1.0).unwrap();
             let run = run_adversary(c, a, &mut rng, 100).unwrap();
             assert!(run.finished && run.first_overlap.is_some(), "{a:?}");
         }
+    }
+
+    #[test]
+    fn one_driver_runs_both_controllers() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2);
+        let (g, lo, hi) = ([1.0; 3], [0.5; 3], [2.0; 3]);
+        let task = Timeline::new(&[true, false, true], &g, &lo, &hi, 0.0, 1.0).unwrap();
+        let cell = crate::ContinuousCoordinator::new(task, &[], &[(0, 0), (1, 0)], 2, 1.0).unwrap();
+        // One task each (a robot completes at most one task per tick: exactly one at the end).
+        let run = run_adversary(cell.clone(), Adversary::Slowest, &mut rng, 1000).unwrap();
+        assert!(run.finished && run.min_tasks == 1, "{run:?}");
+        assert_eq!(
+            (run.overlap_ticks, run.backward_steps, run.first_overlap),
+            (0, 0, None)
+        );
+        // Five tasks, through a trait object.
+        let mut boxed: Box<dyn Controller> = Box::new(cell);
+        let run = run_adversary_on(&mut *boxed, Adversary::RandomExtreme, &mut rng, 5, 1000);
+        let run = run.unwrap();
+        assert!(
+            run.finished && run.min_tasks == 5 && run.overlap_ticks == 0,
+            "{run:?}"
+        );
+        assert_eq!(boxed.tasks_now().iter().min(), Some(&5));
+        // A tick budget too small: not finished, the tasks done so far.
+        boxed.reset();
+        let run = run_adversary_on(&mut *boxed, Adversary::Fastest, &mut rng, 5, 3).unwrap();
+        assert_eq!((run.finished, run.ticks, run.min_tasks), (false, 3, 0));
+        // Rounds run to the end: every robot's one task (the unsafe plan overlaps, the fault is
+        // counted and cleared).
+        let c = crate::Coordinator::new_unchecked(robots(), 1.0).unwrap();
+        let run = run_adversary(c, Adversary::Slowest, &mut rng, 100).unwrap();
+        assert!(
+            run.finished && run.min_tasks == 1 && run.overlap_ticks > 0,
+            "{run:?}"
+        );
     }
 
     #[test]

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use rand::Rng;
 
 use super::groups::{Group, Token, groups, token_sequence};
-use crate::adversary::{Adversary, PolicyState};
+use crate::adversary::{Adversary, AdversaryRun};
 use crate::contract::{Controller, Operator, Tick, check_tick};
 use crate::cursor::{Cursors, operator_step};
 use crate::error::{Error, Result};
@@ -542,6 +542,16 @@ impl ContinuousCoordinator {
         Ok(())
     }
 
+    /// Test only: puts robot `robot` at schedule clock `clock_s` of its current task with
+    /// `next_group` its next group (cursors from the task start), whatever the token rule
+    /// allows — the way to a state the rule excludes (two robots inside groups at once).
+    #[cfg(test)]
+    pub(crate) fn place_unchecked(&mut self, robot: usize, clock_s: f64, next_group: usize) {
+        self.clock_s[robot] = clock_s;
+        self.next_group[robot] = next_group;
+        self.cursors[robot] = Cursors::default();
+    }
+
     fn advance_token(&mut self) {
         let len = self.tokens.len();
         loop {
@@ -617,27 +627,18 @@ impl Controller for ContinuousCoordinator {
     }
 }
 
-/// What [`run_cell`] measured.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct CellRun {
-    /// Control ticks run.
-    pub ticks: u64,
-    /// Ticks with two or more robots low-confidence (0 under the token rule).
-    pub overlap_ticks: u64,
-    /// The fewest tasks any robot completed.
-    pub min_tasks: u64,
-    /// Whether every robot completed `min_tasks` of the call within the tick budget.
-    pub finished: bool,
-    /// Ticks in which some robot moved backwards: its (tasks completed, reference time)
-    /// decreased (0: a robot never moves backwards; debug builds assert it in every tick).
-    pub backward_steps: u64,
-}
+/// What [`run_cell`] measured: the one [`AdversaryRun`] of every controller.
+#[deprecated(
+    note = "the one run of the adversary driver is `tandem_realtime::adversary::AdversaryRun`"
+)]
+pub type CellRun = AdversaryRun;
 
 /// Runs `cell` from its current state until every robot has completed `min_tasks` tasks (or
-/// for at most `max_ticks` ticks) with the operator inputs of the policy `adversary` (the
-/// policies of [`crate::adversary`], the same implementation as for rounds; the beam search
-/// [`Adversary::Beam`] is not a policy and runs as [`Adversary::SwitchFavourite`] with holds up
-/// to 50 ticks), drawing from `rng`. A fault is counted and cleared. Allocates nothing.
+/// for at most `max_ticks` ticks) with the operator inputs of the policy `adversary`, drawing
+/// from `rng`: the one adversary driver of every controller,
+/// [`run_adversary_on`](crate::adversary::run_adversary_on) (the beam search
+/// [`Adversary::Beam`] runs as [`Adversary::SwitchFavourite`] with holds up to 50 ticks; a
+/// fault is counted and cleared). Allocates nothing.
 ///
 /// # Errors
 /// [`Error::BadOperator`] for a policy producing an inadmissible gradient.
@@ -647,40 +648,6 @@ pub fn run_cell(
     rng: &mut impl Rng,
     min_tasks: u64,
     max_ticks: u64,
-) -> Result<CellRun> {
-    let mut run = CellRun::default();
-    let mut policy = PolicyState::new(cell.n_robots());
-    let mut last = cell.position_now();
-    let min_done = |c: &ContinuousCoordinator| c.tasks_completed().iter().copied().min();
-    while min_done(cell).unwrap_or(0) < min_tasks {
-        if run.ticks >= max_ticks {
-            run.min_tasks = min_done(cell).unwrap_or(0);
-            return Ok(run);
-        }
-        let k = run.ticks;
-        let lc = cell.low_conf_now().first();
-        // The one owner of the policies; the beam search is not a policy and runs as a
-        // switching favourite with holds up to 50 ticks.
-        let policy_of = match adversary {
-            Adversary::Beam { .. } => Adversary::SwitchFavourite { max_hold: 50 },
-            other => other,
-        };
-        let op = policy.next(policy_of, k, lc, rng);
-        let t = cell.tick(op)?;
-        if t.overlap() {
-            run.overlap_ticks += 1;
-        }
-        let now = cell.position_now();
-        let back =
-            (0..cell.n_robots()).any(|i| now[i] < last[i] || now[i] != (t.tasks[i], t.ref_time[i]));
-        run.backward_steps += u64::from(back);
-        last = now;
-        if t.fault.is_some() {
-            cell.clear_fault();
-        }
-        run.ticks += 1;
-    }
-    run.min_tasks = min_done(cell).unwrap_or(0);
-    run.finished = true;
-    Ok(run)
+) -> Result<AdversaryRun> {
+    crate::adversary::run_adversary_on(cell, adversary, rng, min_tasks, max_ticks)
 }
