@@ -17,6 +17,9 @@ NumPy arrays in and out (docs/python.md):
 - :class:`ContinuousCoordinator`: the run-time coordinator of a continuous cell (the token
   rule), from :meth:`CyclicPlan.coordinator` or :meth:`Planner.continuous_coordinator`, one
   control tick per :meth:`ContinuousCoordinator.tick` (a :class:`CellTick`).
+- :meth:`Planner.plan` / :meth:`Planner.controller` with ``cell="rounds"`` or
+  ``"continuous"``: the plan of either kind of cell and its run-time coordinator (a
+  :class:`Controller`), both at the schedule's control tick.
 - :mod:`tandem.study`: the simulated study of §III; :mod:`tandem.sim`: its workcell.
 - :func:`align`: GDTW time warping (Eq. 2–3).
 - :func:`read_bag`: a ROS 2 bag (rosbag2 MCAP) on one grid; :func:`fit` takes ``.mcap`` paths.
@@ -26,6 +29,8 @@ Every error is a :class:`TandemError`: :class:`InputError`, :class:`ParamError`,
 not as given (a period assumed for a file without time column, a resampled execution, a
 demonstration of unusual length) raises a :class:`DataWarning`.
 """
+
+import abc
 
 from ._tandem import (
     MAX_ROBOTS,
@@ -60,12 +65,30 @@ from ._tandem import (
 )
 from . import sim, study
 
+
+class Controller(abc.ABC):
+    """The run-time coordinator of a cell of either kind, as :meth:`Planner.controller` gives
+    it: a :class:`Coordinator` (rounds) or a :class:`ContinuousCoordinator` (a continuous
+    cell); both are registered as its subclasses, so ``isinstance(c, tandem.Controller)``
+    holds for either. What they share: :meth:`tick` (one control tick of :attr:`tick_s` real
+    seconds, the operator's input for the low-confidence robot), :meth:`reset`,
+    :attr:`fault` and :meth:`clear_fault`, :attr:`n_robots`, :attr:`clock_s`,
+    :attr:`ref_time_now`, :attr:`sample_now` and :attr:`low_conf_now`.
+    """
+
+    __slots__ = ()
+
+
+Controller.register(Coordinator)
+Controller.register(ContinuousCoordinator)
+
 __all__ = [
     "MAX_ROBOTS",
     "N_ROBOTS",
     "CellTick",
     "Confidence",
     "ContinuousCoordinator",
+    "Controller",
     "Coordinator",
     "CyclicPlan",
     "DataWarning",

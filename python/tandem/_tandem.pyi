@@ -160,6 +160,14 @@ class Planner:
         tick_s: Optional[float] = None,
     ) -> Schedule:
         """Re-runs the sampler warm-started by the current schedule and keeps the result."""
+    def plan(self, cell: str = "rounds") -> Union[Schedule, CyclicPlan]:
+        """The plan of this planner's ``cell`` (``"rounds"``: the current schedule, checked;
+        ``"continuous"``: the cyclic plan), at the current schedule's tick; a snapshot."""
+    def controller(
+        self, cell: str = "rounds"
+    ) -> Union[Coordinator, ContinuousCoordinator]:
+        """The run-time coordinator of :meth:`plan` (a ``tandem.Controller``), at the
+        current schedule's tick, every robot at its start."""
     def cyclic_plan(self, max_enumerated: Optional[int] = None) -> CyclicPlan:
         """The plan of a continuous cell (no rounds) on the current problem for this
         planner's robots; does not change the planner (``tandem schedule --cell continuous``)."""
@@ -340,6 +348,9 @@ class CyclicPlan:
     @property
     def n_robots(self) -> int: ...
     @property
+    def tick_s(self) -> Optional[float]:
+        """The cell's control tick it was checked at (a planner's plan), else ``None``."""
+    @property
     def period_s(self) -> float:
         """The period ``P`` (s), exact for :attr:`order`."""
     @property
@@ -387,7 +398,7 @@ class CyclicPlan:
         self, problem: Problem, tick_s: Optional[float] = None
     ) -> ContinuousCoordinator:
         """The continuous coordinator running this plan on ``problem`` (the problem it was
-        planned for) at ``tick_s`` real s (default ``problem.dt_s``); ``ScheduleError``
+        planned for) at ``tick_s`` real s (default :attr:`tick_s`, else ``problem.dt_s``); ``ScheduleError``
         (``violation == "NotRunnable"``) for an order the token rule cannot run."""
     def is_runnable(self, problem: Problem) -> bool:
         """Whether :meth:`coordinator` can run this plan's order on ``problem``."""

@@ -169,6 +169,34 @@ def test_the_planner_cell_is_its_cyclic_plan(sanding) -> None:
         assert a["end_lc"] == b["first_lc"] and a["ref_end"] <= b["gate"]
 
 
+def test_the_planner_plans_and_runs_both_cells_at_its_schedules_tick(sanding) -> None:
+    tick_s = sanding.schedule.tick_s
+    rounds = sanding.plan()
+    assert isinstance(rounds, tandem.Schedule)
+    assert rounds.to_json() == sanding.schedule.to_json()
+    assert sanding.plan(cell="rounds").to_json() == rounds.to_json()
+    continuous = sanding.plan(cell="continuous")
+    assert isinstance(continuous, tandem.CyclicPlan)
+    # The cyclic plan of the planner, checked at (and carrying) the schedule's tick; a free
+    # plan carries none.
+    assert continuous.tick_s == tick_s and sanding.cyclic_plan().tick_s == tick_s
+    assert continuous.to_json() == sanding.cyclic_plan().to_json()
+    assert tandem.cyclic_plan(sanding.problem, sanding.n_robots).tick_s is None
+    # Its coordinator runs at that tick by default.
+    assert continuous.coordinator(sanding.problem).tick_s == tick_s
+    for cell, kind in (("rounds", tandem.Coordinator), ("continuous", tandem.ContinuousCoordinator)):
+        c = sanding.controller(cell=cell)
+        assert isinstance(c, kind) and isinstance(c, tandem.Controller)
+        assert (c.tick_s, c.n_robots) == (tick_s, sanding.n_robots)
+    cell = sanding.controller(cell="continuous")
+    same = sanding.continuous_coordinator()
+    assert (cell.tokens, cell.groups) == (same.tokens, same.groups)
+    with pytest.raises(tandem.ParamError) as e:
+        sanding.plan(cell="Continuous")
+    assert e.value.name == "cell"
+    assert "give `rounds` or `continuous`" in str(e.value)
+
+
 def test_the_holds_make_groups(holds_planner) -> None:
     cell = holds_planner.continuous_coordinator()
     holds = holds_planner.problem.active_holds

@@ -14,6 +14,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, bail};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use tandem::sim::study::{
@@ -75,8 +76,8 @@ pub(crate) struct StudyArgs {
     /// last finishes) or `continuous` (each robot starts its next task as soon as it is safe;
     /// writes the steady throughput in study.json's summary). Default: the configuration's
     /// (rounds).
-    #[arg(long, value_enum)]
-    cell: Option<CellArg>,
+    #[arg(long, value_name = "CELL", value_parser = cell_parser())]
+    cell: Option<Cell>,
     /// Ignore the configuration's hold points (`[planner.holds]`): the study as before hold
     /// points existed.
     #[arg(long)]
@@ -93,22 +94,11 @@ pub(crate) struct StudyArgs {
     bag_rounds: Vec<usize>,
 }
 
-/// `--cell`.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum CellArg {
-    /// Rounds of N executions (the paper).
-    Rounds,
-    /// A continuous cell.
-    Continuous,
-}
-
-impl From<CellArg> for Cell {
-    fn from(c: CellArg) -> Cell {
-        match c {
-            CellArg::Rounds => Cell::Rounds,
-            CellArg::Continuous => Cell::Continuous,
-        }
-    }
+/// `--cell`'s parser: the planner's `Cell` by its name (`rounds`, `continuous`), each value
+/// with its help (`Cell::help`).
+pub(crate) fn cell_parser() -> impl TypedValueParser<Value = Cell> {
+    PossibleValuesParser::new(Cell::ALL.map(|c| PossibleValue::new(c.name()).help(c.help())))
+        .try_map(|name| name.parse::<Cell>())
 }
 
 /// Writes the rounds `--bag` chose as they run (from worker threads); remembers the files
@@ -224,7 +214,7 @@ fn run_continuous(
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let file = CellStudyFile {
         git_revision: git_revision(root),
-        cell: "continuous",
+        cell: Cell::Continuous.name(),
         summary: summary.clone(),
         result: &result,
     };
@@ -414,7 +404,7 @@ fn config(args: &StudyArgs) -> anyhow::Result<StudyConfig> {
         config.planner.holds = Default::default();
     }
     if let Some(c) = args.cell {
-        config.cell = c.into();
+        config.cell = c;
     }
     if args.paper_confidence {
         let c = &mut config.planner.confidence;

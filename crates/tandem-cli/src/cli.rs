@@ -2,8 +2,10 @@
 
 use std::path::PathBuf;
 
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use tandem::lfd::{HoldRule, Reference};
+use tandem::planner::Cell;
 use tandem::sim::workcell::OperatorParams;
 
 /// Coordinated multi-robot shared autonomy from your own demonstrations: one operator, 1 to 8
@@ -319,17 +321,15 @@ pub(crate) struct ScheduleArgs {
     /// one is done; the schedule `record` and the coordinator run) or `continuous` (each
     /// robot repeats the task on its own, one period per task: the cyclic plan, shown, never
     /// saved).
-    #[arg(long, value_name = "MODE", value_enum, default_value_t = CellArg::Rounds)]
-    pub(crate) cell: CellArg,
+    #[arg(long, value_name = "MODE", value_parser = cell_parser(), default_value = "rounds")]
+    pub(crate) cell: Cell,
 }
 
-/// `tandem schedule --cell`: how the robots repeat the task.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub(crate) enum CellArg {
-    /// Rounds: all robots start together; the next round starts when the last one finishes.
-    Rounds,
-    /// A continuous cell: each robot starts its next task once the cyclic plan lets it.
-    Continuous,
+/// `--cell`'s parser: the planner's [`Cell`] by its name, each value with its help
+/// ([`Cell::help`]).
+pub(crate) fn cell_parser() -> impl TypedValueParser<Value = Cell> {
+    PossibleValuesParser::new(Cell::ALL.map(|c| PossibleValue::new(c.name()).help(c.help())))
+        .try_map(|name| name.parse::<Cell>())
 }
 
 /// `tandem record`.

@@ -4,12 +4,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use tandem::lfd::{Demonstration, Execution, HoldSpec, PeriodSource, Reference, TaskModel};
-use tandem::planner::reschedule_seed;
+use tandem::planner::{Cell, reschedule_seed};
 use tandem::schedule::SamplerParams;
 use tandem::{ExecutionRecord, Planner, PlannerParams};
 
 use crate::cli::{
-    CellArg, Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
+    Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
 };
 use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_doc, source_name};
 use crate::json;
@@ -611,7 +611,7 @@ fn summary_lines(planner: &Planner) -> Result<()> {
 }
 
 fn schedule(a: &ScheduleArgs) -> Result<()> {
-    if a.cell == CellArg::Continuous {
+    if a.cell == Cell::Continuous {
         return cyclic::schedule_continuous(a);
     }
     // With --save this is a read–modify–write: hold the state file's lock throughout.

@@ -5,8 +5,10 @@
 use std::fmt::Write as _;
 
 use anyhow::{Context, Result, bail};
+use tandem::planner::Cell;
+use tandem::schedule::CheckedCyclicPlan;
 use tandem::schedule::Problem;
-use tandem::schedule::cyclic::{CyclicParams, CyclicPlan, RobotCycle, TaskShape, cyclic_plan};
+use tandem::schedule::cyclic::{CyclicPlan, RobotCycle, TaskShape};
 
 use crate::cli::ScheduleArgs;
 use crate::cmd::out;
@@ -16,7 +18,8 @@ use crate::gantt::gap_text;
 pub(crate) const COLUMNS_PER_PERIOD: usize = 36;
 
 /// `tandem schedule STATE --cell continuous`: loads the state, computes the cyclic plan of
-/// its problem for its robot count ([`cyclic_plan`], default [`CyclicParams`]) and prints it.
+/// its problem for its robot count (`Planner::plan`: the default `CyclicParams`, at the
+/// schedule's tick) and prints it.
 /// Nothing is saved; the rounds sampler's flags are refused (they would do nothing).
 pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
     let file = a.state.display();
@@ -34,20 +37,20 @@ pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
     }
     let planner = crate::state_io::load(&a.state)?;
     let problem = planner.problem();
-    // The cell runs at the schedule's control tick: the plan counts the token rule's
-    // hand-overs at it, so its period is what the cell does with the planned operator.
-    let params = CyclicParams {
-        handover_tick_s: Some(planner.schedule().tick_s),
-        ..CyclicParams::default()
-    };
-    let plan = cyclic_plan(problem, planner.n_robots(), &params)
+    // The planner's plan of the cell, at the schedule's control tick (its hand-overs counted
+    // at it, so its period is what the cell does with the planned operator).
+    let checked = planner
+        .plan(Cell::Continuous)
         .with_context(|| format!("{file}: cannot compute the cyclic plan"))?;
+    let Some(plan) = checked.as_continuous().map(CheckedCyclicPlan::plan) else {
+        bail!("{file}: the planner gave no cyclic plan for a continuous cell (a bug)");
+    };
     if a.json {
         out(&serde_json::to_string_pretty(
-            &crate::json::CyclicPlanOut::from(&plan),
+            &crate::json::CyclicPlanOut::from(plan),
         )?);
     } else {
-        out(&plan_text(problem, &plan, crate::cmd::verbose())?);
+        out(&plan_text(problem, plan, crate::cmd::verbose())?);
     }
     Ok(())
 }
@@ -422,6 +425,7 @@ pub(crate) fn gantt(problem: &Problem, plan: &CyclicPlan) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use tandem::schedule::cyclic::{CyclicParams, cyclic_plan};
 
     /// The doc example of `tandem_schedule::cyclic`: 1 s high (0.5 s at the fastest), 1 s low,
     /// 1 s high, at 10 ms.

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use common::{ok, scratch, small_demos, tandem, write};
 use tandem::Planner;
+use tandem::planner::Cell;
 use tandem::schedule::{CyclicParams, CyclicPlan, cyclic_plan};
 
 fn repo() -> PathBuf {
@@ -262,4 +263,50 @@ fn continuous_cell_errors_name_the_file_and_exit_2() {
         assert!(!stderr.contains("panicked"), "{stderr}");
         assert!(out.stdout.is_empty(), "{full:?}");
     }
+}
+
+/// The tick default is the planner's for the command line too: a state whose schedule ticks
+/// at 20 ms (`[sampler] tick_s`, not `Δt_s`) shows `Planner::plan(Cell::Continuous)`, the
+/// plan with its hand-overs counted at 20 ms, which differs from the one at `Δt_s`.
+#[test]
+fn continuous_cell_plans_at_the_schedules_tick_as_the_planner_does() {
+    let dir = scratch("cyclic-tick");
+    let demos = small_demos(&dir);
+    let params = write(&dir, "params.toml", "[sampler]\ntick_s = 0.02\n");
+    let state = dir.join("cell.tandem");
+    let mut args: Vec<String> = vec!["fit".into()];
+    args.extend(demos.iter().map(|p| s(p)));
+    args.extend(["--samples", "200", "--params"].map(String::from));
+    args.push(s(&params));
+    args.push("-o".into());
+    args.push(s(&state));
+    ok(&tandem(&args));
+    let planner = Planner::load(&state).expect("the state loads");
+    let tick_s = planner.schedule().tick_s;
+    assert_eq!(tick_s, 0.02);
+    assert!(planner.problem().dt_s() < tick_s);
+    let planned = planner.plan(Cell::Continuous).expect("a plan");
+    assert_eq!(planned.tick_s(), tick_s);
+    let plan = planned.as_continuous().expect("a cyclic plan").plan();
+    assert_eq!(plan, &plan_of(&state));
+    let json = ok(&tandem([
+        "schedule",
+        &s(&state),
+        "--cell",
+        "continuous",
+        "--json",
+    ]));
+    assert_eq!(json.trim_end(), serde_json::to_string_pretty(plan).unwrap());
+    // At Δt_s the hand-overs cost less: another period, so the tick matters.
+    let at_dt = CyclicParams {
+        handover_tick_s: Some(planner.problem().dt_s()),
+        ..CyclicParams::default()
+    };
+    let other = cyclic_plan(planner.problem(), planner.n_robots(), &at_dt).expect("a plan");
+    assert!(
+        other.period_s < plan.period_s,
+        "{} vs {}",
+        other.period_s,
+        plan.period_s
+    );
 }

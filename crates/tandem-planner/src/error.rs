@@ -181,6 +181,12 @@ pub enum Error {
         /// What is wrong.
         why: String,
     },
+    /// A cell kind that is neither `rounds` nor `continuous` ([`crate::Cell`]).
+    #[error("unknown cell `{given}`: give `rounds` or `continuous`")]
+    UnknownCell {
+        /// The name given.
+        given: String,
+    },
     /// Demonstrations, executions or the task model (§II-B1/2), alignment included.
     #[error(transparent)]
     Lfd(#[from] tandem_lfd::Error),

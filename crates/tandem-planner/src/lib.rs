@@ -54,12 +54,14 @@
 //! # Ok::<(), tandem_planner::Error>(())
 //! ```
 
+mod cell;
 mod error;
 mod explain;
 mod holds;
 mod planner;
 pub mod state;
 
+pub use cell::{AnyController, Cell, Plan};
 pub use error::{Error, Result};
 pub use explain::{ChannelShare, LowCause, LowRegion};
 pub use planner::{ExecutionRecord, Planner, PlannerParams, RecordReport, RefitReport};

@@ -73,6 +73,14 @@ pub(crate) struct PyContinuousCoordinator {
     inner: ContinuousCoordinator,
 }
 
+impl PyContinuousCoordinator {
+    /// The Python object of a Rust continuous coordinator (`Planner.controller`,
+    /// `Planner.continuous_coordinator`).
+    pub(crate) fn from_inner(inner: ContinuousCoordinator) -> Self {
+        Self { inner }
+    }
+}
+
 #[pymethods]
 impl PyContinuousCoordinator {
     /// Advances one control tick.

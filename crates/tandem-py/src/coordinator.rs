@@ -57,6 +57,11 @@ pub(crate) struct PyCoordinator {
 }
 
 impl PyCoordinator {
+    /// The Python object of a Rust coordinator (`Planner.controller`).
+    pub(crate) fn from_inner(inner: Coordinator) -> Self {
+        Self { inner }
+    }
+
     /// `f(timeline, schedule clock)` for every robot.
     fn per_robot<T>(&self, f: impl Fn(&Timeline, f64) -> T) -> Vec<T> {
         let clock = self.inner.clock_s();

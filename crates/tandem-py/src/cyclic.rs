@@ -9,11 +9,29 @@ use crate::arrays::out_vector;
 use crate::continuous::{self, PyContinuousCoordinator};
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
-    CyclicParams, CyclicPlan, GapPlan, Problem, Stretch, cyclic_plan as plan_of,
+    CheckedCyclicPlan, CyclicParams, CyclicPlan, GapPlan, Problem, Stretch, cyclic_plan as plan_of,
     cyclic_plan_for_order,
 };
 use crate::planner::N_ROBOTS;
 use crate::schedule::PyProblem;
+
+/// The search's parameters from Python: the defaults, with `max_enumerated`,
+/// `runnable_only` and `handover_tick_s` as [`compute`] takes them.
+pub(crate) fn params(
+    max_enumerated: Option<u64>,
+    runnable_only: bool,
+    handover_tick_s: Option<f64>,
+) -> CyclicParams {
+    let mut params = CyclicParams {
+        runnable_only,
+        handover_tick_s,
+        ..CyclicParams::default()
+    };
+    if let Some(k) = max_enumerated {
+        params.max_enumerated = k;
+    }
+    params
+}
 
 /// The cyclic plan of `n_robots` robots on `problem` ([`plan_of`]), with `max_enumerated`
 /// replacing [`CyclicParams::max_enumerated`] when given, `runnable_only`
@@ -27,16 +45,9 @@ pub(crate) fn compute(
     runnable_only: bool,
     handover_tick_s: Option<f64>,
 ) -> PyResult<PyCyclicPlan> {
-    let mut params = CyclicParams {
-        runnable_only,
-        handover_tick_s,
-        ..CyclicParams::default()
-    };
-    if let Some(k) = max_enumerated {
-        params.max_enumerated = k;
-    }
+    let params = params(max_enumerated, runnable_only, handover_tick_s);
     let plan = py.detach(|| guard(|| Ok(plan_of(problem, n_robots, &params)?)))?;
-    Ok(PyCyclicPlan { plan })
+    Ok(PyCyclicPlan { plan, tick_s: None })
 }
 
 /// The plan of a continuous cell (no rounds): ``N`` robots repeating the task with one
@@ -51,12 +62,19 @@ pub(crate) fn compute(
 #[pyclass(module = "tandem", name = "CyclicPlan", frozen)]
 pub(crate) struct PyCyclicPlan {
     plan: CyclicPlan,
+    /// The cell's tick it was checked at (a planner's plan), `None` for one of
+    /// [`cyclic_plan`].
+    tick_s: Option<f64>,
 }
 
 impl PyCyclicPlan {
-    /// The Rust plan.
-    pub(crate) fn plan(&self) -> &CyclicPlan {
-        &self.plan
+    /// A plan the planner checked at its cell's tick (`Planner::cyclic_plan`).
+    pub(crate) fn checked(checked: CheckedCyclicPlan) -> Self {
+        let tick_s = Some(checked.tick_s());
+        PyCyclicPlan {
+            plan: checked.into_plan(),
+            tick_s,
+        }
     }
 
     /// Per robot, one value per gap of its task (head, between stretches, tail): an
@@ -217,7 +235,8 @@ impl PyCyclicPlan {
     }
 
     /// The continuous coordinator that runs this plan on ``problem`` (the problem it was
-    /// planned for) at a control tick of ``tick_s`` real seconds (default: ``problem.dt_s``):
+    /// planned for) at a control tick of ``tick_s`` real seconds (default: :attr:`tick_s`,
+    /// the planner's tick, for a plan of :meth:`Planner.plan`; ``problem.dt_s`` otherwise):
     /// every robot on the fastest warp, waiting at the usable hold points, the operator's
     /// token passed in :attr:`order`; every robot at sample 0 of its first task.
     ///
@@ -241,7 +260,19 @@ impl PyCyclicPlan {
         problem: PyRef<'_, PyProblem>,
         tick_s: Option<f64>,
     ) -> PyResult<PyContinuousCoordinator> {
-        Ok(continuous::make(&self.plan, &problem.inner, tick_s)?)
+        Ok(continuous::make(
+            &self.plan,
+            &problem.inner,
+            tick_s.or(self.tick_s),
+        )?)
+    }
+
+    /// The control tick (real s) of the cell the plan was checked for, its hand-overs
+    /// counted at it: the planner's schedule's tick for a plan of :meth:`Planner.plan`
+    /// (and :meth:`Planner.cyclic_plan`); ``None`` for a plan of :func:`cyclic_plan`.
+    #[getter]
+    fn tick_s(&self) -> Option<f64> {
+        self.tick_s
     }
 
     /// Whether the continuous coordinator can run this plan's order on ``problem`` (no
@@ -334,5 +365,5 @@ pub(crate) fn cyclic_plan(
     let order = order_of(order)?;
     let problem = &*problem.inner;
     let plan = py.detach(|| guard(|| Ok(cyclic_plan_for_order(problem, robots, &order)?)))?;
-    Ok(PyCyclicPlan { plan })
+    Ok(PyCyclicPlan { plan, tick_s: None })
 }

@@ -362,6 +362,7 @@ fn classify_facade(e: &Facade) -> Kind {
         }
         Facade::BadExecution { .. } | Facade::DuplicateRound { .. } => input_at(None),
         Facade::RobotCount { .. } => param("robots"),
+        Facade::UnknownCell { .. } => param("cell"),
         Facade::HoldInLowConfidence { .. } | Facade::HoldMatchesNothing { .. } => param("holds"),
         Facade::Lfd(l) => classify_lfd(l),
         Facade::Confidence(c) => classify_confidence(c),

@@ -9,15 +9,16 @@ pub(crate) use tandem::lfd::{
 };
 pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{
-    Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, reschedule_seed,
+    AnyController, Cell, Error as TandemError, ExecutionRecord, Plan, Planner, PlannerParams,
+    RecordReport, reschedule_seed,
 };
 pub(crate) use tandem::realtime::continuous::{ContinuousCoordinator, Group, Token};
 pub(crate) use tandem::realtime::{Coordinator, Fault, MAX_ROBOTS, Operator, Tick, Timeline};
 pub(crate) use tandem::schedule::cyclic::{GapPlan, Stretch};
 pub(crate) use tandem::schedule::{
-    CheckedSchedule, CyclicParams, CyclicPlan, GlobalTimeline, LcInterval, Outcome, Problem,
-    SamplerParams, Schedule, Source, Violation, cyclic_plan, cyclic_plan_for_order,
-    sample_schedule_n,
+    CheckedCyclicPlan, CheckedSchedule, CyclicParams, CyclicPlan, GlobalTimeline, LcInterval,
+    Outcome, Problem, SamplerParams, Schedule, Source, Violation, cyclic_plan,
+    cyclic_plan_for_order, sample_schedule_n,
 };
 pub(crate) use tandem::sim::needs::{NeedProfile, NeedRegion};
 pub(crate) use tandem::sim::study::{

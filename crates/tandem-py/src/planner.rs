@@ -11,13 +11,13 @@ use pyo3::types::{PyDict, PyString};
 
 use crate::arrays::{flags, matrix, out_flags, out_matrix, out_vector, repr_list, vector};
 use crate::errors::{Error, Result, deprecated, guard, warn};
-use crate::facade::{BagOptions, Recording, extend_bag_schema, is_bag, read_bag};
 use crate::facade::{
-    BetaParams, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, DT_TOLERANCE, Demonstration, Execution,
-    ExecutionRecord, HoldRule, HoldSpec, Observations, PeriodSource, Planner, PlannerParams,
-    RecordReport, Regridded, StateLock, TaskModel, errors, length_warnings, posterior, prior,
-    prior_low_threshold, prob_need_below_mu_c, reschedule_seed,
+    AnyController, BetaParams, Cell, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, DT_TOLERANCE,
+    Demonstration, Execution, ExecutionRecord, HoldRule, HoldSpec, Observations, PeriodSource,
+    Plan, Planner, PlannerParams, RecordReport, Regridded, StateLock, TaskModel, errors,
+    length_warnings, posterior, prior, prior_low_threshold, prob_need_below_mu_c, reschedule_seed,
 };
+use crate::facade::{BagOptions, Recording, extend_bag_schema, is_bag, read_bag};
 use crate::params::{from_py, serialize_to_py};
 use crate::schedule::PyProblem;
 use crate::schedule::PySchedule;
@@ -839,14 +839,60 @@ impl PyPlanner {
         Ok(self.current_schedule())
     }
 
-    /// The plan of a continuous cell on the current problem for this planner's robots
-    /// (:func:`cyclic_plan`): no rounds, each robot repeating the task, one period per task,
-    /// the token rule's hand-overs counted at the current schedule's control tick (the cell's
-    /// tick), so its period is what the cell does with the planned operator.
-    /// A snapshot, computed now (``tandem schedule --cell continuous`` shows the same plan);
-    /// it does not change the planner, whose schedule stays the rounds one it records from.
-    /// ``max_enumerated`` (default 100 000): search every operator order while there are at
-    /// most this many.
+    /// The plan of this planner's ``cell`` on the current problem (Rust ``Planner::plan``):
+    /// ``"rounds"`` (default) the current :class:`Schedule` (checked on the problem), or
+    /// ``"continuous"`` the :class:`CyclicPlan` of a continuous cell (no rounds: each robot
+    /// repeating the task, one period per task), the token rule's hand-overs counted at the
+    /// current schedule's control tick, the cell's tick (:attr:`CyclicPlan.tick_s`), so its
+    /// period is what the cell does with the planned operator. Both kinds of cell run at that
+    /// one tick. A snapshot, computed now (``tandem schedule --cell continuous`` shows the same
+    /// plan); it does not change the planner, whose schedule stays the rounds one it records
+    /// from.
+    ///
+    /// Raises:
+    ///     ParamError: a ``cell`` other than ``"rounds"`` or ``"continuous"`` (``name`` is
+    ///         ``"cell"``).
+    ///     ScheduleError: a current schedule that fails this build's check (never for a
+    ///         planner made by :func:`fit` or :meth:`load`).
+    #[pyo3(signature = (cell="rounds"))]
+    fn plan(&self, py: Python<'_>, cell: &str) -> PyResult<Py<PyAny>> {
+        let cell = parse_cell(cell)?;
+        let inner = &self.inner;
+        let plan = py.detach(|| guard(|| Ok(inner.plan(cell)?)))?;
+        Ok(match plan {
+            Plan::Rounds(_) => Py::new(py, self.current_schedule())?.into_any(),
+            Plan::Continuous(c) => Py::new(py, crate::cyclic::PyCyclicPlan::checked(c))?.into_any(),
+        })
+    }
+
+    /// The run-time coordinator of :meth:`plan` (Rust ``Planner::controller``): for
+    /// ``"rounds"`` (default) a :class:`Coordinator` of the current schedule, for
+    /// ``"continuous"`` a :class:`ContinuousCoordinator` of the cyclic plan; both at the
+    /// current schedule's control tick, every robot at its start. A snapshot: it does not
+    /// follow the planner.
+    ///
+    /// Raises:
+    ///     ParamError: a ``cell`` other than ``"rounds"`` or ``"continuous"``.
+    #[pyo3(signature = (cell="rounds"))]
+    fn controller(&self, py: Python<'_>, cell: &str) -> PyResult<Py<PyAny>> {
+        let cell = parse_cell(cell)?;
+        let inner = &self.inner;
+        let controller = py.detach(|| guard(|| Ok(inner.controller(cell)?)))?;
+        Ok(match controller {
+            AnyController::Rounds(c) => {
+                Py::new(py, crate::coordinator::PyCoordinator::from_inner(c))?.into_any()
+            }
+            AnyController::Continuous(c) => Py::new(
+                py,
+                crate::continuous::PyContinuousCoordinator::from_inner(c),
+            )?
+            .into_any(),
+        })
+    }
+
+    /// The plan of a continuous cell on the current problem for this planner's robots:
+    /// :meth:`plan` ``(cell="continuous")``, with ``max_enumerated`` (default 100 000):
+    /// search every operator order while there are at most this many.
     ///
     /// Raises:
     ///     ParamError: ``max_enumerated`` 0.
@@ -856,21 +902,18 @@ impl PyPlanner {
         py: Python<'_>,
         max_enumerated: Option<u64>,
     ) -> PyResult<crate::cyclic::PyCyclicPlan> {
-        crate::cyclic::compute(
-            py,
-            self.inner.problem(),
-            self.inner.n_robots(),
-            max_enumerated,
-            true,
-            Some(self.inner.schedule().tick_s),
-        )
+        let params = crate::cyclic::params(max_enumerated, true, None);
+        let inner = &self.inner;
+        let plan = py.detach(|| guard(|| Ok(inner.cyclic_plan(&params, None)?)))?;
+        Ok(crate::cyclic::PyCyclicPlan::checked(plan))
     }
 
     /// The continuous coordinator of this planner's cell: :meth:`cyclic_plan` (with
-    /// ``max_enumerated``) run on the current problem by :meth:`CyclicPlan.coordinator` at a
-    /// control tick of ``tick_s`` real seconds (default: the current schedule's
-    /// ``tick_s``, the cell's control tick). A snapshot: it does not change the planner and
-    /// does not follow it.
+    /// ``max_enumerated``) run on the current problem at a control tick of ``tick_s`` real
+    /// seconds (default: the current schedule's ``tick_s``, the cell's control tick; the
+    /// plan's hand-overs are counted at it): :meth:`controller` ``(cell="continuous")`` when
+    /// both are left to their defaults. A snapshot: it does not change the planner and does
+    /// not follow it.
     ///
     /// Raises:
     ///     ParamError: ``max_enumerated`` 0, or ``tick_s`` not finite and > 0.
@@ -881,18 +924,12 @@ impl PyPlanner {
         max_enumerated: Option<u64>,
         tick_s: Option<f64>,
     ) -> PyResult<crate::continuous::PyContinuousCoordinator> {
-        let problem = self.inner.problem();
-        let tick_s = tick_s.unwrap_or(self.inner.schedule().tick_s);
-        let plan = crate::cyclic::compute(
-            py,
-            problem,
-            self.inner.n_robots(),
-            max_enumerated,
-            true,
-            // A bad tick is refused by the coordinator below, as a ParamError.
-            (tick_s.is_finite() && tick_s > 0.0).then_some(tick_s),
-        )?;
-        Ok(crate::continuous::make(plan.plan(), problem, Some(tick_s))?)
+        let params = crate::cyclic::params(max_enumerated, true, None);
+        let inner = &self.inner;
+        let plan = py.detach(|| guard(|| Ok(inner.cyclic_plan(&params, tick_s)?)))?;
+        Ok(crate::continuous::PyContinuousCoordinator::from_inner(
+            plan.coordinator(),
+        ))
     }
 
     /// The current schedule (a snapshot: it does not change when the planner does).
@@ -1051,6 +1088,12 @@ impl PyPlanner {
     fn current_schedule(&self) -> PySchedule {
         PySchedule::from_outcome(Arc::new(self.inner.problem().clone()), self.inner.outcome())
     }
+}
+
+/// A cell kind from Python (`"rounds"` or `"continuous"`, the planner's `Cell` names); a
+/// `ParamError` naming `cell` otherwise.
+fn parse_cell(cell: &str) -> Result<Cell> {
+    Ok(cell.parse::<Cell>()?)
 }
 
 /// Eq. 7 on `model`; `u = None` is no correction.

@@ -66,12 +66,14 @@
 //! # Ok::<(), tandem_schedule::Error>(())
 //! ```
 
+mod checked;
 mod graph;
 mod plan;
 mod ratio;
 mod run;
 mod search;
 
+pub use checked::CheckedCyclicPlan;
 pub use graph::{Event, EventGraph, Gap, Stretch, TaskShape, event_graph};
 pub use plan::{
     CyclicPlan, GapPlan, RobotCycle, cyclic_plan_for_order, handover_bound_s, period_lower_bound_s,

@@ -1,9 +1,10 @@
 //! The study in a continuous cell (issue 21, `cargo xtask study --cell continuous`): the
 //! learning loop of §III without rounds.
 //!
-//! A trial fits the planner as for rounds, plans the cell (`tandem_schedule::cyclic_plan`:
-//! the operator's cyclic order of low-confidence stretches and its least period, counting the
-//! token rule's hand-overs at the cell's tick: `CyclicParams::handover_tick_s`) and runs it
+//! A trial fits the planner as for rounds, plans the cell (`Planner::cyclic_plan`, the
+//! planner's plan of a continuous cell: the operator's cyclic order of low-confidence
+//! stretches and its least period, counting the token rule's hand-overs at the cell's tick,
+//! the schedule's: `CyclicParams::handover_tick_s`) and runs it
 //! through the continuous coordinator ([`crate::workcell::CellSim`]). Every robot draws a new
 //! workpiece for every task. Each completed task's execution is kept; every `N` completed
 //! tasks (whichever robots did them) the planner records them as one round of `N`
@@ -32,7 +33,7 @@ use serde::{Deserialize, Serialize};
 use tandem_lfd::TaskModel;
 use tandem_planner::Planner;
 use tandem_realtime::Timeline;
-use tandem_schedule::{CyclicParams, CyclicPlan, cyclic_plan};
+use tandem_schedule::{CheckedCyclicPlan, CyclicParams};
 
 use super::config::StudyConfig;
 use super::inputs::StudyInputs;
@@ -339,20 +340,17 @@ impl CellStudyResult {
     }
 }
 
-/// The cell's plan on the planner's problem and its record.
+/// The cell's plan on the planner's problem and its record: the planner's plan of a
+/// continuous cell (`Planner::cyclic_plan`, what `Planner::plan` gives: the token rule's hand-overs counted at the schedule's
+/// tick, the cell's, so its period is what the cell does with the planned operator).
 fn plan_of(
     planner: &Planner,
     can_need: &[bool],
     tasks_recorded: usize,
     tick: u64,
-) -> Result<(CyclicPlan, CellIteration)> {
-    // The cell runs at one tick per reference sample: the plan counts the token rule's
-    // hand-overs at that tick, so its period is what the cell does with the planned operator.
-    let params = CyclicParams {
-        handover_tick_s: Some(planner.problem().dt_s()),
-        ..CyclicParams::default()
-    };
-    let plan = cyclic_plan(planner.problem(), planner.n_robots(), &params)?;
+) -> Result<(CheckedCyclicPlan, CellIteration)> {
+    let checked = planner.cyclic_plan(&CyclicParams::default(), None)?;
+    let plan = checked.plan();
     let iteration = CellIteration {
         tasks_recorded,
         tick,
@@ -372,7 +370,7 @@ fn plan_of(
         holds: planner.problem().usable_holds(),
         falsely_trusted_samples: falsely_trusted_where(planner.confidence().conf(), can_need),
     };
-    Ok((plan, iteration))
+    Ok((checked, iteration))
 }
 
 /// Runs trial `trial` of the continuous study from a fitted model (module docs). Seeds as
@@ -436,9 +434,10 @@ pub fn run_cell_trial_on(
     let t = Instant::now();
     let mut planner = Planner::from_model_with_robots(model.clone(), params, config.robots)?;
     let n = planner.n_robots();
-    let dt_s = planner.problem().dt_s();
     let (plan, first) = plan_of(&planner, can_need, 0, 0)?;
-    let coord = plan.coordinator(planner.problem(), dt_s)?;
+    // The cell's tick: the plan's, the schedule's (`Δt_s` unless the sampler sets a tick).
+    let dt_s = plan.tick_s();
+    let coord = plan.coordinator();
     times.scheduling += t.elapsed();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(1);
@@ -518,7 +517,7 @@ pub fn run_cell_trial_on(
             times.scheduling += report.scheduling;
             let t = Instant::now();
             let (plan, iteration) = plan_of(&planner, can_need, recorded, sim.stats().ticks)?;
-            let next = plan.coordinator(planner.problem(), dt_s)?;
+            let next = plan.coordinator();
             times.scheduling += t.elapsed();
             if sim.replan(planner.model(), next)? {
                 period_s = iteration.period_s;

@@ -47,26 +47,9 @@ pub struct StudyConfig {
     pub cell: Cell,
 }
 
-/// How the robots of a study run.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Cell {
-    /// All `N` robots start a round together; the next round starts when the last finishes
-    /// (the paper).
-    #[default]
-    Rounds,
-    /// Each robot starts its next task as soon as it is safe, under the continuous
-    /// coordinator (issue 21).
-    Continuous,
-}
-
-impl Cell {
-    /// Whether it is [`Cell::Rounds`].
-    #[must_use]
-    pub fn is_rounds(&self) -> bool {
-        *self == Cell::Rounds
-    }
-}
+/// How the robots of a study run: the planner's one cell type (`rounds` or `continuous`),
+/// re-exported where the study's configuration names it.
+pub use tandem_planner::Cell;
 
 impl Default for StudyConfig {
     fn default() -> Self {

@@ -1,0 +1,302 @@
+//! How the robots repeat the task ([`Cell`]), the plan of either kind of cell ([`Plan`]) and
+//! its run-time coordinator ([`AnyController`]), as [`Planner::plan`] and
+//! [`Planner::controller`] make them (issue 40: the planner owns the plan, and every front
+//! end — CLI, Python, the simulator's study, xtask — asks it instead of building one).
+//!
+//! **One tick.** Both kinds of cell run at the current schedule's control tick
+//! ([`Schedule::tick_s`](tandem_schedule::Schedule::tick_s): `ScheduleParams`' tick, `Δt_s`
+//! by default), the tick the rounds schedule was checked at; the continuous plan counts the
+//! token rule's hand-overs at it ([`CheckedCyclicPlan::search`]), so its period is what the
+//! cell does at that tick (docs/decisions.md, "The planner owns the plan: one cell type, one
+//! tick").
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+use tandem_realtime::{ContinuousCoordinator, Coordinator, Fault, RobotFlags};
+use tandem_schedule::{CheckedCyclicPlan, CheckedSchedule, CyclicParams};
+
+use crate::{Error, Planner, Result};
+
+/// How the robots of a cell repeat the task. Its text form (serde, the CLI's `--cell`,
+/// Python's `cell=`, a study's `cell = "…"`) is the lowercase name: `rounds`, `continuous`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Cell {
+    /// In rounds (the paper): all `N` robots start a round together; the next round starts
+    /// when the last one finishes. Planned by the schedule (Eq. 20), run by the coordinator of
+    /// §II-B5.
+    #[default]
+    Rounds,
+    /// A continuous cell (issue 21): each robot starts its next task as soon as it is safe.
+    /// Planned by the cyclic plan, run by the token rule's continuous coordinator.
+    Continuous,
+}
+
+impl Cell {
+    /// Every kind, rounds first.
+    pub const ALL: [Cell; 2] = [Cell::Rounds, Cell::Continuous];
+
+    /// Its text form: `rounds` or `continuous`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Cell::Rounds => "rounds",
+            Cell::Continuous => "continuous",
+        }
+    }
+
+    /// A one-line description for a command line's help.
+    #[must_use]
+    pub fn help(self) -> &'static str {
+        match self {
+            Cell::Rounds => {
+                "Rounds: all robots start together; the next round starts when the last one \
+                 finishes"
+            }
+            Cell::Continuous => {
+                "A continuous cell: each robot starts its next task once the cyclic plan lets it"
+            }
+        }
+    }
+
+    /// Whether it is [`Cell::Rounds`].
+    #[must_use]
+    pub fn is_rounds(&self) -> bool {
+        *self == Cell::Rounds
+    }
+}
+
+impl fmt::Display for Cell {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Cell {
+    type Err = Error;
+
+    /// `rounds` or `continuous` (exactly; [`Error::UnknownCell`] otherwise).
+    fn from_str(s: &str) -> Result<Cell> {
+        Cell::ALL
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| Error::UnknownCell {
+                given: s.to_string(),
+            })
+    }
+}
+
+/// The plan of a cell on the planner's current problem ([`Planner::plan`]), checked on it at
+/// the tick it runs at.
+#[derive(Clone, Debug)]
+pub enum Plan {
+    /// In rounds: the current schedule, checked ([`Planner::checked_schedule`]).
+    Rounds(CheckedSchedule),
+    /// A continuous cell: the cyclic plan of the planner's robots, checked at the schedule's
+    /// tick ([`Planner::cyclic_plan`]).
+    Continuous(CheckedCyclicPlan),
+}
+
+impl Plan {
+    /// The kind of cell it plans.
+    #[must_use]
+    pub fn cell(&self) -> Cell {
+        match self {
+            Plan::Rounds(_) => Cell::Rounds,
+            Plan::Continuous(_) => Cell::Continuous,
+        }
+    }
+
+    /// The control tick (real s) it was checked at and runs at.
+    #[must_use]
+    pub fn tick_s(&self) -> f64 {
+        match self {
+            Plan::Rounds(s) => s.schedule().tick_s,
+            Plan::Continuous(c) => c.tick_s(),
+        }
+    }
+
+    /// Robots `N` it plans.
+    #[must_use]
+    pub fn n_robots(&self) -> usize {
+        match self {
+            Plan::Rounds(s) => s.schedule().n_robots(),
+            Plan::Continuous(c) => c.n_robots(),
+        }
+    }
+
+    /// Its run-time coordinator, every robot at its start, at [`Plan::tick_s`].
+    ///
+    /// # Errors
+    /// None in practice (the plan was checked); the coordinator's own argument checks for
+    /// rounds ([`CheckedSchedule::coordinator`]).
+    pub fn controller(&self) -> Result<AnyController> {
+        Ok(match self {
+            Plan::Rounds(s) => AnyController::Rounds(s.coordinator()?),
+            Plan::Continuous(c) => AnyController::Continuous(c.coordinator()),
+        })
+    }
+
+    /// The rounds schedule, if it is one.
+    #[must_use]
+    pub fn as_rounds(&self) -> Option<&CheckedSchedule> {
+        match self {
+            Plan::Rounds(s) => Some(s),
+            Plan::Continuous(_) => None,
+        }
+    }
+
+    /// The cyclic plan, if it is one.
+    #[must_use]
+    pub fn as_continuous(&self) -> Option<&CheckedCyclicPlan> {
+        match self {
+            Plan::Rounds(_) => None,
+            Plan::Continuous(c) => Some(c),
+        }
+    }
+}
+
+/// The run-time coordinator of either kind of cell ([`Planner::controller`]), with what both
+/// share forwarded; each tick is its own coordinator's (`tick` of the variant).
+#[derive(Clone, Debug)]
+pub enum AnyController {
+    /// Rounds: the coordinator of §II-B5 (Eq. 17–18, Alg. 1).
+    Rounds(Coordinator),
+    /// A continuous cell: the token rule's coordinator.
+    Continuous(ContinuousCoordinator),
+}
+
+impl AnyController {
+    /// The kind of cell it runs.
+    #[must_use]
+    pub fn cell(&self) -> Cell {
+        match self {
+            AnyController::Rounds(_) => Cell::Rounds,
+            AnyController::Continuous(_) => Cell::Continuous,
+        }
+    }
+
+    /// Robots `N`.
+    #[must_use]
+    pub fn n_robots(&self) -> usize {
+        match self {
+            AnyController::Rounds(c) => c.n_robots(),
+            AnyController::Continuous(c) => c.n_robots(),
+        }
+    }
+
+    /// Real seconds per tick.
+    #[must_use]
+    pub fn tick_s(&self) -> f64 {
+        match self {
+            AnyController::Rounds(c) => c.tick_s(),
+            AnyController::Continuous(c) => c.tick_s(),
+        }
+    }
+
+    /// Which robots are on a low-confidence sample now.
+    #[must_use]
+    pub fn low_conf_now(&self) -> RobotFlags {
+        match self {
+            AnyController::Rounds(c) => c.low_conf_now(),
+            AnyController::Continuous(c) => c.low_conf_now(),
+        }
+    }
+
+    /// The latched fault, if any.
+    #[must_use]
+    pub fn fault(&self) -> Option<Fault> {
+        match self {
+            AnyController::Rounds(c) => c.fault(),
+            AnyController::Continuous(c) => c.fault(),
+        }
+    }
+
+    /// Clears the latched fault.
+    pub fn clear_fault(&mut self) {
+        match self {
+            AnyController::Rounds(c) => c.clear_fault(),
+            AnyController::Continuous(c) => c.clear_fault(),
+        }
+    }
+
+    /// Every robot back at its start, the counters and the fault cleared.
+    pub fn reset(&mut self) {
+        match self {
+            AnyController::Rounds(c) => c.reset(),
+            AnyController::Continuous(c) => c.reset(),
+        }
+    }
+
+    /// The rounds coordinator, if it is one.
+    #[must_use]
+    pub fn as_rounds(&self) -> Option<&Coordinator> {
+        match self {
+            AnyController::Rounds(c) => Some(c),
+            AnyController::Continuous(_) => None,
+        }
+    }
+
+    /// The continuous coordinator, if it is one.
+    #[must_use]
+    pub fn as_continuous(&self) -> Option<&ContinuousCoordinator> {
+        match self {
+            AnyController::Rounds(_) => None,
+            AnyController::Continuous(c) => Some(c),
+        }
+    }
+}
+
+impl Planner {
+    /// The plan of a `cell` of this planner's robots on the current problem, at the current
+    /// schedule's control tick ([`Schedule::tick_s`](tandem_schedule::Schedule::tick_s), the
+    /// one tick of both kinds of cell: the tick the rounds schedule was checked at, and the
+    /// continuous plan counts the token rule's hand-overs at it): in rounds the current schedule
+    /// checked on the problem ([`Planner::checked_schedule`]), for a continuous cell the
+    /// cyclic plan ([`Planner::cyclic_plan`] with the default [`CyclicParams`]). A snapshot:
+    /// the planner is not changed, and the state file keeps the rounds schedule it records
+    /// from.
+    ///
+    /// # Errors
+    /// As [`Planner::checked_schedule`] and [`Planner::cyclic_plan`].
+    pub fn plan(&self, cell: Cell) -> Result<Plan> {
+        Ok(match cell {
+            Cell::Rounds => Plan::Rounds(self.checked_schedule()?),
+            Cell::Continuous => Plan::Continuous(self.cyclic_plan(&CyclicParams::default(), None)?),
+        })
+    }
+
+    /// The run-time coordinator of [`Planner::plan`]`(cell)`: every robot at its start, one
+    /// control tick of the schedule's `tick_s` per tick. For rounds it is
+    /// [`Planner::coordinator`].
+    ///
+    /// # Errors
+    /// As [`Planner::plan`].
+    pub fn controller(&self, cell: Cell) -> Result<AnyController> {
+        self.plan(cell)?.controller()
+    }
+
+    /// The cyclic plan of a continuous cell of this planner's robots on the current problem
+    /// (`tandem_schedule::cyclic_plan` with `params`), its hand-overs counted at and checked
+    /// for the cell's tick: `tick_s` (real s), by default the current schedule's
+    /// ([`CheckedCyclicPlan::search`]).
+    ///
+    /// # Errors
+    /// The schedule crate's [`tandem_schedule::Error::BadParam`] for bad `params` or a
+    /// `tick_s` not finite and > 0 (naming it).
+    pub fn cyclic_plan(
+        &self,
+        params: &CyclicParams,
+        tick_s: Option<f64>,
+    ) -> Result<CheckedCyclicPlan> {
+        let tick_s = tick_s.unwrap_or(self.schedule().tick_s);
+        Ok(CheckedCyclicPlan::search(
+            self.problem(),
+            self.n_robots(),
+            params,
+            tick_s,
+        )?)
+    }
+}
