@@ -73,8 +73,8 @@ pub use coordinator::{Coordinator, Fault, Operator, Tick};
 pub use error::{Error, Result};
 pub use holds::{After, Hold};
 pub use margins::{
-    PairSlack, pair_slacks, pair_slacks_with_holds, sufficient_margins,
-    sufficient_margins_per_pair, sufficient_margins_with_holds,
+    MarginParams, PairSlack, check_margins, margin_slacks, pair_slacks, pair_slacks_with_holds,
+    sufficient_margins, sufficient_margins_per_pair, sufficient_margins_with_holds, switch_ticks,
 };
 pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};
 pub use strategy::{high_conf_steps, response_step};

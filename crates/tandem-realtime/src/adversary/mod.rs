@@ -197,6 +197,50 @@ pub struct AdversaryRun {
     /// ([`Coordinator::clock_s`]) decreased (0: a robot never moves backwards; debug builds
     /// assert it in every tick).
     pub backward_steps: u64,
+    /// The shortest switch seen ([`SwitchGaps`]): the fewest ticks between a tick in which one
+    /// robot traversed a low-confidence sample and a later tick in which another robot did, in
+    /// which neither did (`None`: no such pair of ticks, or [`Adversary::Beam`], which does not
+    /// keep its sequence's ticks). A schedule that
+    /// [`check_margins`](crate::check_margins) accepts with switch time `δ` keeps it
+    /// `≥ switch_ticks(δ, tick_s)`.
+    pub min_switch_gap_ticks: Option<u64>,
+}
+
+/// The switches of one run, measured on the ticks the robots actually traversed: for each tick
+/// in which a robot is low-confidence, the ticks since the last tick in which *another* robot
+/// was (a tick with two low-confidence robots is an overlap, counted apart, not a switch).
+#[derive(Clone, Debug, Default)]
+pub struct SwitchGaps {
+    /// Per robot, the last tick (index) in which it was low-confidence.
+    last_lc: [Option<u64>; MAX_ROBOTS],
+    /// The shortest gap so far (ticks).
+    min_gap: Option<u64>,
+}
+
+impl SwitchGaps {
+    /// Records tick `tick` (index, increasing) with its low-confidence robots.
+    pub fn record(&mut self, tick: u64, low_conf: &crate::RobotFlags) {
+        for r in (0..low_conf.len()).filter(|&r| low_conf.get(r)) {
+            let other_last = (0..low_conf.len())
+                .filter(|&q| q != r)
+                .filter_map(|q| self.last_lc[q])
+                .filter(|&t| t < tick)
+                .max();
+            if let Some(t) = other_last {
+                let gap = tick - t - 1;
+                self.min_gap = Some(self.min_gap.map_or(gap, |g| g.min(gap)));
+            }
+        }
+        for r in (0..low_conf.len()).filter(|&r| low_conf.get(r)) {
+            self.last_lc[r] = Some(tick);
+        }
+    }
+
+    /// The shortest gap recorded (ticks), `None` if no robot followed another.
+    #[must_use]
+    pub fn min_gap_ticks(&self) -> Option<u64> {
+        self.min_gap
+    }
 }
 
 /// The check "a robot never moves backwards" from outside the coordinator: each robot's
@@ -374,14 +418,17 @@ pub fn run_adversary(
     let mut run = AdversaryRun::default();
     let mut state = PolicyState::new(coordinator.n_robots());
     let mut backward = Backward::new(&coordinator);
+    let mut gaps = SwitchGaps::default();
     while !coordinator.is_finished() {
         if run.ticks >= max_ticks {
+            run.min_switch_gap_ticks = gaps.min_gap_ticks();
             return Ok(run);
         }
         let lc = coordinator.low_conf_now().first();
         let op = state.next(adversary, run.ticks, lc, rng);
         let tick = coordinator.tick(op)?;
         run.backward_steps += u64::from(backward.step(&coordinator, &tick));
+        gaps.record(run.ticks, &tick.low_conf);
         if tick.overlap() {
             run.first_overlap.get_or_insert(run.ticks);
             run.overlap_ticks += 1;
@@ -394,6 +441,7 @@ pub fn run_adversary(
         run.ticks += 1;
     }
     run.finished = true;
+    run.min_switch_gap_ticks = gaps.min_gap_ticks();
     Ok(run)
 }
 

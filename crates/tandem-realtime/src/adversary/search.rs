@@ -92,6 +92,7 @@ fn finish(
         first_overlap: Some(first),
         finished: coordinator.is_finished(),
         backward_steps,
+        min_switch_gap_ticks: None,
     })
 }
 
@@ -170,6 +171,7 @@ pub fn beam_search(coordinator: Coordinator, width: usize, max_ticks: u64) -> Re
             first_overlap: None,
             finished: b.coordinator.is_finished(),
             backward_steps: b.backward_steps,
+            min_switch_gap_ticks: None,
         }),
     )
 }
