@@ -114,6 +114,49 @@ pub(crate) fn bound_of(shape: &TaskShape, n_robots: usize) -> f64 {
     (n_robots as f64 * (shape.lc_total_s() + shape.idle_s())).max(shape.fastest_s())
 }
 
+/// [`period_lower_bound_s`] with the operator's switch time `switch_s` (real s, ≥ 0): for
+/// `N ≥ 2` robots and `m ≥ 1` stretches, `max(N·(L + I + δ), D_min)`; otherwise
+/// [`period_lower_bound_s`].
+///
+/// **Why.** One period of the operator is its `N·m` stretches and the intervals between
+/// consecutive ones (cyclically). Each robot's stretches form at least one block of the cyclic
+/// order, so with `N ≥ 2` robots the robot changes at least `N` times around the cycle, and each
+/// change's interval lasts at least `δ`. The forced idle gaps of `I` (item 2 of
+/// [`period_lower_bound_s`]) lie between two consecutive stretches of one robot (no other
+/// robot's stretch meets them), so they are other intervals than the changes: the three sums
+/// add, `P ≥ N·L + N·I + N·δ`. `P ≥ D_min` as before.
+///
+/// # Errors
+/// [`crate::Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS` or a `switch_s` not
+/// finite and ≥ 0.
+pub fn period_lower_bound_with_switch_s(
+    problem: &Problem,
+    n_robots: usize,
+    switch_s: f64,
+) -> Result<f64> {
+    check_robot_count(n_robots)?;
+    if !(switch_s.is_finite() && switch_s >= 0.0) {
+        return Err(crate::Error::BadParam {
+            name: "switch_s",
+            why: "must be finite and >= 0 (the operator's switch time in seconds; 0 for none)",
+        });
+    }
+    Ok(switch_bound_of(
+        &TaskShape::new(problem),
+        n_robots,
+        switch_s,
+    ))
+}
+
+/// [`period_lower_bound_with_switch_s`] of a task shape.
+pub(crate) fn switch_bound_of(shape: &TaskShape, n_robots: usize, switch_s: f64) -> f64 {
+    if switch_s > 0.0 && n_robots >= 2 && shape.n_lc() > 0 {
+        (n_robots as f64 * (shape.lc_total_s() + shape.idle_s() + switch_s)).max(shape.fastest_s())
+    } else {
+        bound_of(shape, n_robots)
+    }
+}
+
 /// A lower bound (s) on the period of every 1-periodic plan of `n_robots` robots on
 /// `problem` whose order is runnable ([`crate::cyclic::is_runnable`]) and whose hand-overs
 /// are counted at the control tick `tick_s` ([`crate::CyclicParams::handover_tick_s`]):
@@ -179,7 +222,7 @@ pub fn cyclic_plan_for_order(
     n_robots: usize,
     order: &[Stretch],
 ) -> Result<CyclicPlan> {
-    plan_for_order(problem, n_robots, order, None, false)
+    plan_for_order(problem, n_robots, order, None, false, 0.0)
 }
 
 /// [`cyclic_plan_for_order`], counting the token rule's hand-overs at the control tick
@@ -192,15 +235,27 @@ pub(crate) fn plan_for_order(
     order: &[Stretch],
     handover_tick_s: Option<f64>,
     runnable_only: bool,
+    switch_s: f64,
 ) -> Result<CyclicPlan> {
-    let graph = match handover_tick_s {
-        None => event_graph(problem, n_robots, order)?,
-        Some(_) => graph_of_shape(TaskShape::new(problem), n_robots, order, handover_tick_s)?,
+    let graph = match (handover_tick_s, switch_s > 0.0) {
+        (None, false) => event_graph(problem, n_robots, order)?,
+        _ => graph_of_shape(
+            TaskShape::new(problem),
+            n_robots,
+            order,
+            handover_tick_s,
+            switch_s,
+        )?,
     };
     let ratio = max_cycle_ratio(graph.events.len(), &graph.arcs)?;
     let lower_bound_s = match handover_tick_s {
         Some(tick_s) if runnable_only => handover_bound_of(&graph.shape, n_robots, tick_s),
         _ => bound_of(&graph.shape, n_robots),
+    };
+    let lower_bound_s = if switch_s > 0.0 {
+        lower_bound_s.max(switch_bound_of(&graph.shape, n_robots, switch_s))
+    } else {
+        lower_bound_s
     };
     Ok(layout(
         &graph,
@@ -218,8 +273,9 @@ pub(crate) fn period_of(
     n_robots: usize,
     order: &[Stretch],
     handover_tick_s: Option<f64>,
+    switch_s: f64,
 ) -> Result<Option<f64>> {
-    let graph = graph_of_shape(shape.clone(), n_robots, order, handover_tick_s)?;
+    let graph = graph_of_shape(shape.clone(), n_robots, order, handover_tick_s, switch_s)?;
     match max_cycle_ratio(graph.events.len(), &graph.arcs) {
         Ok(r) => Ok(Some(r.period_s)),
         Err(crate::Error::InfeasibleCycle { .. }) => Ok(None),
