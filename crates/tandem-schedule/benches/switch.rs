@@ -5,7 +5,8 @@
 //! the scheduler's two-robot schedule (`validate_with_switch`: constraints 1–4, the scheduled
 //! switch gaps and the margin check with the switch time). It prints the bounds for
 //! `δ ∈ {0, 0.5, 2, 7}` s and `N = 2, 3, 4` (docs/decisions.md, "The switch time in the
-//! scheduler's bounds (issue 41)"). `cargo bench -p tandem-schedule --bench switch` re-measures.
+//! scheduler's bounds (issue 41)"), and the continuous cell's plan with the switch time and
+//! the load cap. `cargo bench -p tandem-schedule --bench switch` re-measures.
 #![allow(
     clippy::print_stdout,
     reason = "a bench reports its problem and bounds"
@@ -20,7 +21,8 @@ mod fixture;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use tandem_schedule::{
-    ExactParams, SamplerParams, margin_free_bound, sample_schedule, validate_with_switch,
+    CyclicParams, ExactParams, SamplerParams, cyclic_plan, margin_free_bound, sample_schedule,
+    validate_with_switch,
 };
 
 fn bench(c: &mut Criterion) {
@@ -33,6 +35,28 @@ fn bench(c: &mut Criterion) {
             println!(
                 "  N = {n}, δ = {switch_s} s: bound {:.3} s (proven {}, order {:?})",
                 b.lower_bound_s, b.proven_optimal, b.order
+            );
+        }
+    }
+    // The continuous cell's plan with the switch time and the load cap (the token rule's
+    // hand-overs counted at Δt_s, as the study's cell).
+    for n in [2usize, 3] {
+        for (switch_s, cap) in [(0.0, 1.0), (2.0, 1.0), (0.0, 0.7), (2.0, 0.7)] {
+            let params = CyclicParams {
+                handover_tick_s: Some(problem.dt_s()),
+                switch_s,
+                max_busy_share: cap,
+                ..CyclicParams::default()
+            };
+            let plan = cyclic_plan(&problem, n, &params).expect("valid");
+            println!(
+                "  cyclic N = {n}, δ = {switch_s} s, u_max = {cap}: period {:.3} s, {:.2} \
+                 tasks/h, bound {:.3} s (gap {:.2} %), supervised share {:.3}",
+                plan.period_s,
+                plan.tasks_per_hour,
+                plan.lower_bound_s,
+                100.0 * plan.gap,
+                plan.operator_share
             );
         }
     }

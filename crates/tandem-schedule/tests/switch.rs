@@ -217,3 +217,47 @@ fn the_cyclic_period_with_a_switch_time_by_hand() {
     assert!(cyclic_plan(&p, 2, &with(-1.0)).is_err());
     assert!(period_lower_bound_with_switch_s(&p, 2, f64::NAN).is_err());
 }
+
+/// The load cap on the cyclic plan, by hand on the same task: the busy share is the operator's
+/// stretches plus a switch time per change of robot, over the period.
+#[test]
+fn the_cyclic_load_cap_by_hand() {
+    use tandem_schedule::{CyclicParams, cyclic_plan};
+    let conf: Vec<bool> = (0..300).map(|n| !(100..200).contains(&n)).collect();
+    let p = Problem::new(conf, vec![1.0; 300], vec![0.5; 300], vec![2.0; 300], 0.01).unwrap();
+    let capped = |switch_s, max_busy_share| CyclicParams {
+        switch_s,
+        max_busy_share,
+        ..CyclicParams::default()
+    };
+    // Two robots, no switch time, u_max = 0.8: 2 × 1 s busy needs P ≥ 2.5 s (else 2 s).
+    // With δ = 0.2 s: 2 × 1 + 2 × 0.2 = 2.4 s busy, P ≥ 3 s. Three robots at 0.7: 3/0.7 s.
+    for (n, switch_s, cap, want) in [
+        (2usize, 0.0, 0.8, 2.5),
+        (2, 0.2, 0.8, 3.0),
+        (3, 0.0, 0.7, 3.0 / 0.7),
+        (1, 0.0, 0.5, 2.0),
+    ] {
+        let plan = cyclic_plan(&p, n, &capped(switch_s, cap)).unwrap();
+        assert!(
+            (plan.period_s - want).abs() < 1e-9,
+            "N = {n}: {}",
+            plan.period_s
+        );
+        assert!(plan.gap.abs() < 1e-9, "N = {n}: gap {}", plan.gap);
+        let busy = n as f64 * 1.0 + if n >= 2 { n as f64 * switch_s } else { 0.0 };
+        assert!(busy / plan.period_s <= cap + 1e-12, "N = {n}");
+        // The robots' times are a plan of that period: each robot's task within it.
+        for r in &plan.robots {
+            assert!(r.start_s >= 0.0 && r.start_s < plan.period_s);
+        }
+    }
+    // No cap: the plan without it.
+    assert_eq!(
+        cyclic_plan(&p, 2, &capped(0.0, 1.0)).unwrap(),
+        cyclic_plan(&p, 2, &CyclicParams::default()).unwrap()
+    );
+    for bad in [0.0, -0.5, 1.5, f64::NAN] {
+        assert!(cyclic_plan(&p, 2, &capped(0.0, bad)).is_err());
+    }
+}

@@ -148,6 +148,35 @@ pub fn period_lower_bound_with_switch_s(
     ))
 }
 
+/// The least period (s) at which the operator's busy share of `order` is at most
+/// `max_busy_share`: `(N·L + c·δ)/u_max`, `c` the changes of robot around the cyclic order
+/// (each costs the switch time `δ` of the operator's attention).
+fn capped_period_s(
+    graph: &EventGraph,
+    n_robots: usize,
+    order: &[Stretch],
+    switch_s: f64,
+    max_busy_share: f64,
+) -> f64 {
+    let len = order.len();
+    let changes = (0..len)
+        .filter(|&q| order[q].robot != order[(q + 1) % len].robot)
+        .count();
+    (n_robots as f64 * graph.shape.lc_total_s() + changes as f64 * switch_s) / max_busy_share
+}
+
+/// The load cap's bound (s): every plan whose busy share, switches included, is at most
+/// `max_busy_share` has `P ≥ (N·L + c·δ)/u_max` with `c ≥ N` changes of robot for `N ≥ 2`
+/// (the argument of [`period_lower_bound_with_switch_s`]), `c ≥ 0` for one robot.
+fn cap_bound_of(shape: &TaskShape, n_robots: usize, switch_s: f64, max_busy_share: f64) -> f64 {
+    let changes = if n_robots >= 2 && shape.n_lc() > 0 {
+        n_robots as f64
+    } else {
+        0.0
+    };
+    (n_robots as f64 * shape.lc_total_s() + changes * switch_s) / max_busy_share
+}
+
 /// [`period_lower_bound_with_switch_s`] of a task shape.
 pub(crate) fn switch_bound_of(shape: &TaskShape, n_robots: usize, switch_s: f64) -> f64 {
     if switch_s > 0.0 && n_robots >= 2 && shape.n_lc() > 0 {
@@ -222,7 +251,7 @@ pub fn cyclic_plan_for_order(
     n_robots: usize,
     order: &[Stretch],
 ) -> Result<CyclicPlan> {
-    plan_for_order(problem, n_robots, order, None, false, 0.0)
+    plan_for_order(problem, n_robots, order, None, false, 0.0, 1.0)
 }
 
 /// [`cyclic_plan_for_order`], counting the token rule's hand-overs at the control tick
@@ -236,6 +265,7 @@ pub(crate) fn plan_for_order(
     handover_tick_s: Option<f64>,
     runnable_only: bool,
     switch_s: f64,
+    max_busy_share: f64,
 ) -> Result<CyclicPlan> {
     let graph = match (handover_tick_s, switch_s > 0.0) {
         (None, false) => event_graph(problem, n_robots, order)?,
@@ -247,13 +277,36 @@ pub(crate) fn plan_for_order(
             switch_s,
         )?,
     };
-    let ratio = max_cycle_ratio(graph.events.len(), &graph.arcs)?;
+    let mut ratio = max_cycle_ratio(graph.events.len(), &graph.arcs)?;
+    if max_busy_share < 1.0 {
+        let capped = capped_period_s(&graph, n_robots, order, switch_s, max_busy_share);
+        if capped > ratio.period_s {
+            ratio.times_s = super::ratio::times_at(graph.events.len(), &graph.arcs, capped).ok_or(
+                crate::Error::BadParam {
+                    name: "max_busy_share",
+                    why: "no period of this order keeps the operator's busy share under the cap \
+                          (a robot would wait too long inside a gap without a hold point)",
+                },
+            )?;
+            ratio.period_s = capped;
+        }
+    }
     let lower_bound_s = match handover_tick_s {
         Some(tick_s) if runnable_only => handover_bound_of(&graph.shape, n_robots, tick_s),
         _ => bound_of(&graph.shape, n_robots),
     };
     let lower_bound_s = if switch_s > 0.0 {
         lower_bound_s.max(switch_bound_of(&graph.shape, n_robots, switch_s))
+    } else {
+        lower_bound_s
+    };
+    let lower_bound_s = if max_busy_share < 1.0 {
+        lower_bound_s.max(cap_bound_of(
+            &graph.shape,
+            n_robots,
+            switch_s,
+            max_busy_share,
+        ))
     } else {
         lower_bound_s
     };
@@ -274,9 +327,20 @@ pub(crate) fn period_of(
     order: &[Stretch],
     handover_tick_s: Option<f64>,
     switch_s: f64,
+    max_busy_share: f64,
 ) -> Result<Option<f64>> {
     let graph = graph_of_shape(shape.clone(), n_robots, order, handover_tick_s, switch_s)?;
     match max_cycle_ratio(graph.events.len(), &graph.arcs) {
+        Ok(r) if max_busy_share < 1.0 => {
+            let capped = capped_period_s(&graph, n_robots, order, switch_s, max_busy_share);
+            if capped <= r.period_s {
+                Ok(Some(r.period_s))
+            } else if super::ratio::times_at(graph.events.len(), &graph.arcs, capped).is_some() {
+                Ok(Some(capped))
+            } else {
+                Ok(None)
+            }
+        }
         Ok(r) => Ok(Some(r.period_s)),
         Err(crate::Error::InfeasibleCycle { .. }) => Ok(None),
         Err(e) => Err(e),

@@ -45,6 +45,14 @@ pub struct CyclicParams {
     /// "The switch time in the scheduler's bounds (issue 41)"). Default 0: the plan without it, the same
     /// float operations.
     pub switch_s: f64,
+    /// The load cap `u_max` (issue 41): the operator's busy share per period, its supervised
+    /// stretches plus `switch_s` per change of robot (`(N·L + c·δ)/P`), must not exceed it, so
+    /// the period of an order is `max(λ*, (N·L + c·δ)/u_max)` (an order whose event graph
+    /// admits no such period is skipped) and the plan's bound is at least
+    /// `(N·L + N·δ)/u_max` (docs/decisions.md, "The switch time in the scheduler's bounds
+    /// (issue 41)"). Over the cycle, not a rolling window: the plan repeats, so every window of
+    /// whole periods has this share. In `(0, 1]`; default 1: no cap, the same float operations.
+    pub max_busy_share: f64,
 }
 
 impl Default for CyclicParams {
@@ -55,6 +63,7 @@ impl Default for CyclicParams {
             runnable_only: true,
             handover_tick_s: None,
             switch_s: 0.0,
+            max_busy_share: 1.0,
         }
     }
 }
@@ -64,7 +73,7 @@ impl CyclicParams {
     ///
     /// # Errors
     /// [`Error::BadParam`] for `max_enumerated == 0`, a `handover_tick_s` not finite and
-    /// > 0, or a `switch_s` not finite and ≥ 0.
+    /// > 0, a `switch_s` not finite and ≥ 0, or a `max_busy_share` outside `(0, 1]`.
     pub fn validate(&self) -> Result<()> {
         if self.max_enumerated == 0 {
             return Err(Error::BadParam {
@@ -85,6 +94,12 @@ impl CyclicParams {
             return Err(Error::BadParam {
                 name: "switch_s",
                 why: "must be finite and >= 0 (the operator's switch time in seconds; 0 for none)",
+            });
+        }
+        if !(self.max_busy_share > 0.0 && self.max_busy_share <= 1.0) {
+            return Err(Error::BadParam {
+                name: "max_busy_share",
+                why: "must be in (0, 1] (the operator's largest busy share; 1 for no cap)",
             });
         }
         Ok(())
@@ -183,6 +198,7 @@ pub fn cyclic_plan(
         params.handover_tick_s,
         params.runnable_only,
         params.switch_s,
+        params.max_busy_share,
     )?;
     plan.order_exhaustive = exhaustive;
     plan.orders_evaluated = evaluated;
@@ -265,6 +281,7 @@ fn enumerate(
                     &order,
                     params.handover_tick_s,
                     params.switch_s,
+                    params.max_busy_share,
                 )?;
                 if better(p, best.0) {
                     best = (p, order.clone());
@@ -334,6 +351,7 @@ fn local_search(
             &flat(&cur),
             params.handover_tick_s,
             params.switch_s,
+            params.max_busy_share,
         )?;
         evaluated += 1;
         let len = cur.len();
@@ -351,6 +369,7 @@ fn local_search(
                     &flat(&cur),
                     params.handover_tick_s,
                     params.switch_s,
+                    params.max_busy_share,
                 )?;
                 evaluated += 1;
                 cur.swap(q, q2);
