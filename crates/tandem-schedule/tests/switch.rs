@@ -214,6 +214,30 @@ fn the_cyclic_period_with_a_switch_time_by_hand() {
             period_lower_bound_s(&p, n).unwrap().to_bits()
         );
     }
+    // With the token rule's hand-overs counted at 10 ms (the gate is the task start, 0.5 s
+    // before the stretch at the fastest): each change costs max(0.5 + 0.01, δ); the plan
+    // reaches the hand-over bound with the switch time, and it is never above the plan.
+    for (switch_s, per_change) in [(0.2, 0.51), (2.0, 2.0)] {
+        for n in [2usize, 3] {
+            let params = CyclicParams {
+                handover_tick_s: Some(0.01),
+                switch_s,
+                ..CyclicParams::default()
+            };
+            let plan = cyclic_plan(&p, n, &params).unwrap();
+            let want = n as f64 * (1.0 + per_change);
+            assert!(
+                (plan.period_s - want).abs() < 1e-9,
+                "N = {n}, δ = {switch_s}: {}",
+                plan.period_s
+            );
+            assert!(
+                plan.gap.abs() < 1e-9,
+                "N = {n}, δ = {switch_s}: gap {}",
+                plan.gap
+            );
+        }
+    }
     assert!(cyclic_plan(&p, 2, &with(-1.0)).is_err());
     assert!(period_lower_bound_with_switch_s(&p, 2, f64::NAN).is_err());
 }

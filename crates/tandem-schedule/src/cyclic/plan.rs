@@ -224,8 +224,12 @@ pub(crate) fn handover_bound_of(shape: &TaskShape, n_robots: usize, tick_s: f64)
     if n_robots < 2 || m == 0 {
         return old;
     }
-    // Σ_g (S_g + E_g): every stretch, every gap inside a group, every group's entry.
-    let per_task: f64 = (0..m)
+    (n_robots as f64 * (groups_per_task_s(shape) + tick_s)).max(old)
+}
+
+/// `Σ_g (S_g + E_g)` (s): every stretch, every gap inside a group, every group's entry.
+fn groups_per_task_s(shape: &TaskShape) -> f64 {
+    (0..shape.n_lc())
         .map(|k| {
             let before = if shape.opens_group(k) {
                 shape.entry_s[k]
@@ -234,8 +238,32 @@ pub(crate) fn handover_bound_of(shape: &TaskShape, n_robots: usize, tick_s: f64)
             };
             shape.lc_s[k] + before
         })
-        .sum();
-    (n_robots as f64 * (per_task + tick_s)).max(old)
+        .sum()
+}
+
+/// [`handover_bound_of`] with the operator's switch time `switch_s > 0`, for plans whose
+/// operator arcs into another robot's group carry `max(E_h + tick, δ)`
+/// ([`crate::CyclicParams::switch_s`]): `max(N·(Σ_g (S_g + E_g) + min_h max(tick, δ − E_h)),
+/// N·(L + I + δ), D_min)`. The argument of [`handover_bound_s`] with each of the `c ≥ N`
+/// changes of robot costing `max(E_h + tick, δ) = E_h + max(tick, δ − E_h)` instead of
+/// `E_h + tick`, `h` the group it enters (in a runnable order a change enters a group at its
+/// first stretch).
+fn handover_switch_bound_of(shape: &TaskShape, n_robots: usize, tick_s: f64, switch_s: f64) -> f64 {
+    let old = switch_bound_of(shape, n_robots, switch_s);
+    let m = shape.n_lc();
+    if n_robots < 2 || m == 0 {
+        return old;
+    }
+    let per_change = (0..m)
+        .filter(|&k| shape.opens_group(k))
+        .map(|k| tick_s.max(switch_s - shape.entry_s[k]))
+        .fold(f64::INFINITY, f64::min);
+    let per_change = if per_change.is_finite() {
+        per_change
+    } else {
+        tick_s
+    };
+    (n_robots as f64 * (groups_per_task_s(shape) + per_change)).max(old)
 }
 
 /// The cyclic plan of `n_robots` robots on `problem` with the operator's cyclic order `order`
@@ -292,6 +320,9 @@ pub(crate) fn plan_for_order(
         }
     }
     let lower_bound_s = match handover_tick_s {
+        Some(tick_s) if runnable_only && switch_s > 0.0 => {
+            handover_switch_bound_of(&graph.shape, n_robots, tick_s, switch_s)
+        }
         Some(tick_s) if runnable_only => handover_bound_of(&graph.shape, n_robots, tick_s),
         _ => bound_of(&graph.shape, n_robots),
     };
