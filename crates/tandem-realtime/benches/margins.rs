@@ -6,7 +6,8 @@
 use criterion::{BenchmarkId, Criterion, black_box, criterion_main};
 use tandem_realtime::margins::baseline;
 use tandem_realtime::{
-    Coordinator, Operator, Tick, Timeline, sufficient_margins, sufficient_margins_per_pair,
+    Coordinator, MarginParams, Operator, Tick, Timeline, check_margins, margin_slacks,
+    sufficient_margins, sufficient_margins_per_pair,
 };
 
 /// A deterministic problem of `n_ref` samples with 16 evenly spaced LC regions (a sixth of each
@@ -149,6 +150,28 @@ fn bench(c: &mut Criterion) {
             &interleaved,
             |b, r| b.iter(|| baseline::greedy_pace(black_box(r), tick_s)),
         );
+    }
+    g.finish();
+    // The operator's switch time (issue 41): the check and every pair's slack without and with
+    // δ = 0.5 s and 2 s, same run, two robots (the simulation) and four staggered (the lead
+    // bound). The slacks do the same work whatever the verdict; the check stops at the first
+    // rejection.
+    let mut g = c.benchmark_group("margins_switch");
+    let cases: [(&str, Vec<Timeline>); 2] = [
+        ("2", robots(6000).to_vec()),
+        ("4_staggered", robots_staggered(6000, 4)),
+    ];
+    for (label, r) in &cases {
+        for switch_s in [0.0, 0.5, 2.0] {
+            let params = MarginParams::new(tick_s).with_switch_s(switch_s);
+            let id = format!("{label}/delta_{switch_s}");
+            g.bench_with_input(BenchmarkId::new("check", &id), r, |b, r| {
+                b.iter(|| check_margins(black_box(r), &[], &params))
+            });
+            g.bench_with_input(BenchmarkId::new("slacks", &id), r, |b, r| {
+                b.iter(|| margin_slacks(black_box(r), &[], &params))
+            });
+        }
     }
     g.finish();
     let r = robots(6000);

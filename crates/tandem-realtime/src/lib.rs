@@ -89,8 +89,8 @@ pub use contract::{Controller, Operator, Tick};
 pub use error::{Error, Result};
 pub use holds::{After, Hold};
 pub use margins::{
-    PairSlack, pair_slacks, pair_slacks_with_holds, sufficient_margins,
-    sufficient_margins_per_pair, sufficient_margins_with_holds,
+    MarginParams, PairSlack, check_margins, margin_slacks, pair_slacks, pair_slacks_with_holds,
+    sufficient_margins, sufficient_margins_per_pair, sufficient_margins_with_holds, switch_ticks,
 };
 pub use monitor::Fault;
 pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};

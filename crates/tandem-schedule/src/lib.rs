@@ -71,16 +71,17 @@ pub use choose::{
     sample_schedule_with_baselines,
 };
 pub use cyclic::{
-    CheckedCyclicPlan, CycleRatio, CyclicParams, CyclicPlan, Stretch, cyclic_plan,
-    cyclic_plan_for_order, handover_bound_s, max_cycle_ratio, period_lower_bound_s,
+    CheckedCyclicPlan, CycleRatio, CyclicParams, CyclicPlan, Stretch, cyclic_plan, cyclic_plan_for_order,
+    handover_bound_s, max_cycle_ratio, period_lower_bound_s, period_lower_bound_with_switch_s,
 };
 pub use error::{Error, Result};
 pub use exact::{
-    ExactParams, MarginFree, SearchStats, earliest_schedule, operator_bound_s, solve_exact,
+    ExactParams, MarginFree, SearchStats, earliest_schedule, margin_free_bound, operator_bound_s,
+    operator_bound_with_switch_s, solve_exact, solve_exact_with_switch,
 };
 pub use problem::Problem;
 pub use sampler::{DrawnOffset, SamplerBaselines, SamplerParams, SamplerStats};
 pub use schedule::{GlobalTimeline, LcOverlap, Schedule};
 pub use tandem_confidence::Run;
 pub use tandem_realtime::LcInterval;
-pub use validate::{MarginCheck, Violation, validate};
+pub use validate::{MarginCheck, Violation, validate, validate_with_switch};

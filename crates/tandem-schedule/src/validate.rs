@@ -129,6 +129,36 @@ pub enum Violation {
         /// Control tick (s) the check ran with.
         tick_s: f64,
     },
+    /// With the operator's switch time ([`validate_with_switch`]): one robot's scheduled
+    /// low-confidence interval starts less than `switch_s` after another robot's ended
+    /// (global time).
+    #[error(
+        "robot {} starts a low-confidence run at global time {start_s} s, only {} s after robot {} left its own at {end_s} s; the operator needs {switch_s} s to switch (schedule with a smaller switch time or later offsets)",
+        .robots[1] + 1, .start_s - .end_s, .robots[0] + 1
+    )]
+    SwitchTooShort {
+        /// The robot that left its interval, then the robot that enters its own (0-based).
+        robots: [usize; 2],
+        /// Global time (s) at which the first robot's interval ends.
+        end_s: f64,
+        /// Global time (s) at which the second robot's interval starts.
+        start_s: f64,
+        /// The switch time (s).
+        switch_s: f64,
+    },
+    /// With the operator's switch time ([`validate_with_switch`]): the margin check accepts the
+    /// schedule without a switch time but not with `switch_s`: some admissible operator can
+    /// make one robot low-confidence within `switch_s` of another
+    /// (`tandem_realtime::check_margins`).
+    #[error(
+        "insufficient margins for the operator's switch time of {switch_s} s at control tick {tick_s} s: an operator can make two robots need them within {switch_s} s (Eq. 20, constraint 5 with a switch time)"
+    )]
+    InsufficientSwitchTime {
+        /// Control tick (s) the check ran with.
+        tick_s: f64,
+        /// The switch time (s).
+        switch_s: f64,
+    },
     /// The schedule's control tick ([`Schedule::tick_s`]) is not finite and > 0.
     #[error("control tick {tick_s} s must be finite and > 0")]
     InvalidTick {
@@ -178,6 +208,77 @@ pub enum Violation {
 /// [`Violation::MarginCheck`] with the realtime crate's error when a check cannot run.
 pub fn validate(problem: &Problem, schedule: &Schedule) -> Result<(), Violation> {
     validate_full(problem, schedule, MarginCheck::SinglePass)
+}
+
+/// [`validate`] with the operator's switch time `switch_s` (real s, ≥ 0; docs/decisions.md,
+/// "The operator's switch time in the margin check (issue 41)"): after constraints 1–4,
+/// (3δ) no robot's scheduled low-confidence interval starts less than `switch_s` after another
+/// robot's ended (global time; consecutive intervals of one robot need no switch time; up to
+/// `CLOCK_REL·switch_s` plus rounding, accepting), and (5δ) the margin check with the switch
+/// time, `tandem_realtime::check_margins`, at the schedule's tick: no admissible operator can
+/// make one robot low-confidence within `switch_ticks(switch_s, tick_s)` ticks of another. A
+/// schedule that fails only (5δ) is [`Violation::InsufficientSwitchTime`]; one that fails the
+/// check without the switch time too, [`Violation::InsufficientMargins`]. `switch_s = 0` is
+/// [`validate`].
+///
+/// # Errors
+/// As [`validate`], and [`Violation::SwitchTooShort`], [`Violation::InsufficientSwitchTime`];
+/// [`Violation::MarginCheck`] for a `switch_s` not finite and ≥ 0.
+pub fn validate_with_switch(
+    problem: &Problem,
+    schedule: &Schedule,
+    switch_s: f64,
+) -> Result<(), Violation> {
+    if switch_s == 0.0 {
+        return validate(problem, schedule);
+    }
+    let tick_s = schedule.tick_s;
+    if !(tick_s.is_finite() && tick_s > 0.0) {
+        return Err(Violation::InvalidTick { tick_s });
+    }
+    let params = tandem_realtime::MarginParams::new(tick_s).with_switch_s(switch_s);
+    params
+        .switch_ticks()
+        .map_err(|source| Violation::MarginCheck { tick_s, source })?;
+    let timeline = validate_cheap(problem, schedule)?;
+    if let Some(v) = first_short_switch(&timeline, switch_s) {
+        return Err(v);
+    }
+    let robots = timeline.timelines();
+    match tandem_realtime::check_margins(robots, &schedule.holds, &params) {
+        Ok(true) => Ok(()),
+        Ok(false) => match validate(problem, schedule) {
+            Ok(()) => Err(Violation::InsufficientSwitchTime { tick_s, switch_s }),
+            Err(v) => Err(v),
+        },
+        Err(source) => Err(Violation::MarginCheck { tick_s, source }),
+    }
+}
+
+/// The first place (in time) where one robot's scheduled LC interval starts less than
+/// `switch_s` after another robot's ended: the intervals of all robots merged by start
+/// (disjoint, constraint 3), each next to the one before it when their robots differ. Pairs
+/// further apart are implied: between an interval `A` and a later `B` of another robot, the
+/// first interval of a robot other than `A`'s starts at least `switch_s` after the one before
+/// it, which ends no earlier than `A`.
+fn first_short_switch(timeline: &GlobalTimeline, switch_s: f64) -> Option<Violation> {
+    let mut all: Vec<(f64, f64, usize)> = timeline
+        .lc_intervals()
+        .iter()
+        .enumerate()
+        .flat_map(|(r, ivs)| ivs.iter().map(move |iv| (iv.start_s, iv.end_s, r)))
+        .collect();
+    all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+    let slack = tol::CLOCK_REL * switch_s + 4.0 * f64::EPSILON * timeline.t_total_s();
+    all.windows(2).find_map(|w| {
+        let ((_, end_s, a), (start_s, _, b)) = (w[0], w[1]);
+        (a != b && start_s - end_s < switch_s - slack).then_some(Violation::SwitchTooShort {
+            robots: [a, b],
+            end_s,
+            start_s,
+            switch_s,
+        })
+    })
 }
 
 /// Every constraint of Eq. 20 (see [`validate`]) with margin-check implementation `check`.

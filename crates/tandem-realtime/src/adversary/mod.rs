@@ -202,6 +202,50 @@ pub struct AdversaryRun {
     /// The fewest tasks any robot completed at the end ([`Controller::tasks_now`]; rounds: 1
     /// once every robot has finished).
     pub min_tasks: u64,
+    /// The shortest switch seen ([`SwitchGaps`]): the fewest ticks between a tick in which one
+    /// robot traversed a low-confidence sample and a later tick in which another robot did, in
+    /// which neither did (`None`: no such pair of ticks, or [`Adversary::Beam`], which does not
+    /// keep its sequence's ticks). A schedule that
+    /// [`check_margins`](crate::check_margins) accepts with switch time `δ` keeps it
+    /// `≥ switch_ticks(δ, tick_s)`.
+    pub min_switch_gap_ticks: Option<u64>,
+}
+
+/// The switches of one run, measured on the ticks the robots actually traversed: for each tick
+/// in which a robot is low-confidence, the ticks since the last tick in which *another* robot
+/// was (a tick with two low-confidence robots is an overlap, counted apart, not a switch).
+#[derive(Clone, Debug, Default)]
+pub struct SwitchGaps {
+    /// Per robot, the last tick (index) in which it was low-confidence.
+    last_lc: [Option<u64>; MAX_ROBOTS],
+    /// The shortest gap so far (ticks).
+    min_gap: Option<u64>,
+}
+
+impl SwitchGaps {
+    /// Records tick `tick` (index, increasing) with its low-confidence robots.
+    pub fn record(&mut self, tick: u64, low_conf: &crate::RobotFlags) {
+        for r in (0..low_conf.len()).filter(|&r| low_conf.get(r)) {
+            let other_last = (0..low_conf.len())
+                .filter(|&q| q != r)
+                .filter_map(|q| self.last_lc[q])
+                .filter(|&t| t < tick)
+                .max();
+            if let Some(t) = other_last {
+                let gap = tick - t - 1;
+                self.min_gap = Some(self.min_gap.map_or(gap, |g| g.min(gap)));
+            }
+        }
+        for r in (0..low_conf.len()).filter(|&r| low_conf.get(r)) {
+            self.last_lc[r] = Some(tick);
+        }
+    }
+
+    /// The shortest gap recorded (ticks), `None` if no robot followed another.
+    #[must_use]
+    pub fn min_gap_ticks(&self) -> Option<u64> {
+        self.min_gap
+    }
 }
 
 /// The check "a robot never moves backwards" from outside a controller: each robot's tasks
@@ -412,6 +456,7 @@ pub fn run_adversary_on<C: Controller + ?Sized>(
     let mut run = AdversaryRun::default();
     let mut state = PolicyState::new(controller.n_robots());
     let mut backward = Backward::new(controller);
+    let mut gaps = SwitchGaps::default();
     let fewest = |c: &C| c.tasks_now().iter().copied().min().unwrap_or(0);
     // The beam search is not a policy: a switching favourite with holds up to 50 ticks.
     let policy = match adversary {
@@ -421,12 +466,14 @@ pub fn run_adversary_on<C: Controller + ?Sized>(
     while !(controller.is_finished() || fewest(controller) >= min_tasks) {
         if run.ticks >= max_ticks {
             run.min_tasks = fewest(controller);
+            run.min_switch_gap_ticks = gaps.min_gap_ticks();
             return Ok(run);
         }
         let lc = controller.low_conf_now().first();
         let op = state.next(policy, run.ticks, lc, rng);
         let tick = controller.tick(op)?;
         run.backward_steps += u64::from(backward.step(controller, &tick));
+        gaps.record(run.ticks, &tick.low_conf);
         if tick.overlap() {
             run.first_overlap.get_or_insert(run.ticks);
             run.overlap_ticks += 1;
@@ -440,6 +487,7 @@ pub fn run_adversary_on<C: Controller + ?Sized>(
     }
     run.min_tasks = fewest(controller);
     run.finished = true;
+    run.min_switch_gap_ticks = gaps.min_gap_ticks();
     Ok(run)
 }
 

@@ -93,6 +93,7 @@ fn finish(
         finished: coordinator.is_finished(),
         backward_steps,
         min_tasks: u64::from(coordinator.is_finished()),
+        min_switch_gap_ticks: None,
     })
 }
 
@@ -172,6 +173,7 @@ pub fn beam_search(coordinator: Coordinator, width: usize, max_ticks: u64) -> Re
             finished: b.coordinator.is_finished(),
             backward_steps: b.backward_steps,
             min_tasks: u64::from(b.coordinator.is_finished()),
+            min_switch_gap_ticks: None,
         }),
     )
 }

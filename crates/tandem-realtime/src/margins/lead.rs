@@ -314,6 +314,7 @@ pub(super) fn slacks(
     eps: f64,
     windows: Windows,
     stop_at_first: bool,
+    switch_ticks: u64,
 ) -> Vec<PairSlack> {
     let robot_of: Vec<usize> = (0..robots.len()).collect();
     slacks_of_legs(
@@ -321,6 +322,7 @@ pub(super) fn slacks(
             legs: robots,
             robot_of: &robot_of,
             plans: None,
+            switch_ticks,
         },
         max_step_of,
         eps,
@@ -339,6 +341,8 @@ pub(super) struct Legs<'a> {
     pub(super) robot_of: &'a [usize],
     /// The plans with their release rules (`None`: one leg per robot, no rules).
     pub(super) plans: Option<&'a Plans>,
+    /// `k`: the operator's switch time in whole ticks (`super::switch_ticks`; 0: none).
+    pub(super) switch_ticks: u64,
 }
 
 /// [`slacks`] of the legs of plans with holds ([`Legs`]), the pairs' indices being legs. The
@@ -471,10 +475,24 @@ pub(super) fn slacks_of_legs(
             let is_enforced = enforced
                 .as_ref()
                 .is_some_and(|e| e.holds(p, &prev, c, &c_iv));
-            let slack_s = if is_enforced || u_max <= lead.start_s() {
-                f64::INFINITY
-            } else {
-                (c_iv.start_s - eps) - (lead.reach_below(u_max) + max_step_of[c])
+            let slack_s = match switch_extra_s(legs.switch_ticks, max_step_of[c]) {
+                None if is_enforced || u_max <= lead.start_s() => f64::INFINITY,
+                None => (c_iv.start_s - eps) - (lead.reach_below(u_max) + max_step_of[c]),
+                // The switch time (docs/decisions.md, "The operator's switch time in the margin
+                // check"): `c` stays out of `C` for `k` more ticks after `p`'s exit tick. A
+                // release rule orders the regions but gives no switch time under the release at
+                // the exit tick, so it exempts nothing.
+                Some(_) if u_max <= lead.start_s() => super::started_after_exit_slack(
+                    super::SwitchRoom {
+                        ticks: legs.switch_ticks,
+                        step_p: max_step_of[p],
+                        step_c: max_step_of[c],
+                    },
+                    u_max,
+                    (tau_c, end_p),
+                    c_iv.start_s - eps,
+                ),
+                Some(x) => (c_iv.start_s - eps) - ((lead.reach_below(u_max) + max_step_of[c]) + x),
             };
             out.push(PairSlack {
                 prev_robot: p,
@@ -496,6 +514,11 @@ pub(super) fn slacks_of_legs(
             .then(x.prev.start_s.total_cmp(&y.prev.start_s))
     });
     out
+}
+
+/// The switch time's room `k·M_c` (schedule-clock s), `None` without a switch time.
+fn switch_extra_s(switch_ticks: u64, max_step_c: f64) -> Option<f64> {
+    (switch_ticks > 0).then_some(switch_ticks as f64 * max_step_c)
 }
 
 /// The pairs of low-confidence regions whose order the release rules enforce: `(P, C)` when

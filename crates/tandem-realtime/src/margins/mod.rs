@@ -153,6 +153,16 @@
 //! simulation is uniformly tighter (docs/decisions.md, "The N-robot margin check: a lead bound
 //! per unit of progress"), so two robots keep the simulation, bit for bit.
 //!
+//! # The operator's switch time
+//! [`check_margins`] takes a switch time `δ` ([`MarginParams::switch_s`], real s): between a
+//! tick in which one robot traverses a low-confidence sample and a later tick in which another
+//! does, at least `k` = [`switch_ticks`]`(δ, h)` ticks pass. Each test above then keeps `c` a
+//! further `k·M_c` short of its region when `p` has left its own (`c` moves at most `M_c` a
+//! tick), a pair decided before the later robot starts counts the ticks `p` needed to reach that
+//! start, and with holds a release rule no longer exempts a pair (it releases in the exit tick).
+//! With `δ = 0` no term is added: the same float operations (docs/decisions.md, "The operator's
+//! switch time in the margin check (issue 41)").
+//!
 //! # Slacks
 //! [`pair_slacks`] reports, per pair, the room rule 1 (two robots) or the test (d) (three or
 //! more) leaves: `> 0` exactly when the pair is accepted, its negative the clearance missing. A
@@ -185,7 +195,7 @@ use sim::Variant;
 /// demonstration dwelt on) rejects the schedule: `Ok(false)`.
 pub fn sufficient_margins(robots: &[Timeline], tick_s: f64) -> Result<bool> {
     match robots.len() {
-        0..=2 => sim::check_single_pass(robots, tick_s, Variant::Conservative),
+        0..=2 => sim::check_single_pass(robots, tick_s, Variant::Conservative, 0),
         _ => lead_bound(robots, tick_s),
     }
 }
@@ -200,7 +210,7 @@ pub fn sufficient_margins(robots: &[Timeline], tick_s: f64) -> Result<bool> {
 pub fn sufficient_margins_per_pair(robots: &[Timeline], tick_s: f64) -> Result<bool> {
     match robots.len() {
         0..=2 => sim::check_per_pair(robots, tick_s, Variant::Conservative),
-        _ => Ok(lead_slacks(robots, tick_s, false, Windows::Scanned)?
+        _ => Ok(lead_slacks(robots, tick_s, false, Windows::Scanned, 0)?
             .iter()
             .all(|s| s.slack_s > 0.0)),
     }
@@ -216,7 +226,7 @@ pub fn sufficient_margins_per_pair(robots: &[Timeline], tick_s: f64) -> Result<b
 /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] for `tick_s` not
 /// finite and > 0.
 pub fn lead_bound(robots: &[Timeline], tick_s: f64) -> Result<bool> {
-    Ok(lead_slacks(robots, tick_s, true, Windows::Sliding)?
+    Ok(lead_slacks(robots, tick_s, true, Windows::Sliding, 0)?
         .iter()
         .all(|s| s.slack_s > 0.0))
 }
@@ -255,8 +265,8 @@ pub struct PairSlack {
 /// As [`sufficient_margins`].
 pub fn pair_slacks(robots: &[Timeline], tick_s: f64) -> Result<Vec<PairSlack>> {
     match robots.len() {
-        0..=2 => sim::pair_slacks(robots, tick_s),
-        _ => lead_slacks(robots, tick_s, false, Windows::Sliding),
+        0..=2 => sim::pair_slacks(robots, tick_s, 0),
+        _ => lead_slacks(robots, tick_s, false, Windows::Sliding, 0),
     }
 }
 
@@ -294,7 +304,16 @@ pub fn pair_slacks_with_holds(
     if !plans.has_holds() {
         return pair_slacks(robots, tick_s);
     }
-    let mut out = plan_slacks(&plans, tick_s, false)?;
+    robot_slacks_of_plans(&plans, tick_s, 0)
+}
+
+/// The slacks of split plans with holds, the pairs' indices being robots (not legs).
+fn robot_slacks_of_plans(
+    plans: &crate::holds::Plans,
+    tick_s: f64,
+    switch_ticks: u64,
+) -> Result<Vec<PairSlack>> {
+    let mut out = plan_slacks(plans, tick_s, false, switch_ticks)?;
     for s in &mut out {
         s.prev_robot = plans.robot_of[s.prev_robot];
         s.cur_robot = plans.robot_of[s.cur_robot];
@@ -308,11 +327,31 @@ pub(crate) fn check_plans(
     n_robots: usize,
     tick_s: f64,
 ) -> Result<bool> {
+    check_plans_switch(plans, n_robots, tick_s, 0)
+}
+
+/// [`check_plans`] with the operator's switch time, `switch_ticks` whole ticks (0: none, the
+/// same float operations as [`check_plans`]).
+fn check_plans_switch(
+    plans: &crate::holds::Plans,
+    n_robots: usize,
+    tick_s: f64,
+    switch_ticks: u64,
+) -> Result<bool> {
     check_count(n_robots)?;
     if !plans.has_holds() {
-        return sufficient_margins(&plans.legs, tick_s);
+        return match plans.legs.len() {
+            0..=2 => {
+                sim::check_single_pass(&plans.legs, tick_s, Variant::Conservative, switch_ticks)
+            }
+            _ => Ok(
+                lead_slacks(&plans.legs, tick_s, true, Windows::Sliding, switch_ticks)?
+                    .iter()
+                    .all(|s| s.slack_s > 0.0),
+            ),
+        };
     }
-    Ok(plan_slacks(plans, tick_s, true)?
+    Ok(plan_slacks(plans, tick_s, true, switch_ticks)?
         .iter()
         .all(|s| s.slack_s > 0.0))
 }
@@ -322,6 +361,7 @@ fn plan_slacks(
     plans: &crate::holds::Plans,
     tick_s: f64,
     stop_at_first: bool,
+    switch_ticks: u64,
 ) -> Result<Vec<PairSlack>> {
     if !(tick_s.is_finite() && tick_s > 0.0) {
         return Err(Error::BadParam {
@@ -337,6 +377,7 @@ fn plan_slacks(
             legs,
             robot_of: &plans.robot_of,
             plans: Some(plans),
+            switch_ticks,
         },
         &max_step_of,
         eps,
@@ -373,6 +414,7 @@ fn lead_slacks(
     tick_s: f64,
     stop_at_first: bool,
     windows: Windows,
+    switch_ticks: u64,
 ) -> Result<Vec<PairSlack>> {
     let (max_step_of, eps) = steps_and_eps(robots, tick_s)?;
     Ok(lead::slacks(
@@ -381,7 +423,178 @@ fn lead_slacks(
         eps,
         windows,
         stop_at_first,
+        switch_ticks,
     ))
+}
+
+/// The inputs of a margin check besides the robots and their holds: the control tick and the
+/// operator's switch time (docs/decisions.md, "The operator's switch time in the margin
+/// check").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MarginParams {
+    /// Control tick `h` (real s per `Coordinator::tick`), finite and > 0: the guarantee holds
+    /// at this tick only.
+    pub tick_s: f64,
+    /// The operator's switch time `δ` (real s), finite and ≥ 0: between the end of one robot's
+    /// low-confidence stretch and the start of another robot's, at least `δ` seconds pass, in
+    /// whole ticks ([`switch_ticks`]). Default 0: today's invariant, decided by exactly the same
+    /// float operations as [`sufficient_margins`].
+    pub switch_s: f64,
+}
+
+impl MarginParams {
+    /// The check at `tick_s` with no switch time (`switch_s = 0`).
+    #[must_use]
+    pub fn new(tick_s: f64) -> MarginParams {
+        MarginParams {
+            tick_s,
+            switch_s: 0.0,
+        }
+    }
+
+    /// The same with switch time `switch_s` (real s).
+    #[must_use]
+    pub fn with_switch_s(self, switch_s: f64) -> MarginParams {
+        MarginParams { switch_s, ..self }
+    }
+
+    /// `k`, the switch time in whole ticks ([`switch_ticks`]).
+    ///
+    /// # Errors
+    /// As [`switch_ticks`].
+    pub fn switch_ticks(&self) -> Result<u64> {
+        switch_ticks(self.switch_s, self.tick_s)
+    }
+}
+
+/// Largest switch time, in control ticks, that a check accepts.
+const MAX_SWITCH_TICKS: f64 = 1e8;
+
+/// The switch time `δ = switch_s` (real s) at control tick `h = tick_s` (real s) in whole ticks:
+/// the smallest `k ≥ 0` with `k·h ≥ δ` in floating point (0 for `δ = 0`). A run keeps the
+/// switch time when between a tick in which one robot traverses a low-confidence sample and a
+/// later tick in which another robot does, at least `k` ticks pass in which neither does: the
+/// gap `k·h` (real s) then is at least `δ` as the run measures it (tick count times tick).
+///
+/// # Errors
+/// [`Error::BadParam`] for `tick_s` not finite and > 0, `switch_s` not finite and ≥ 0, or a
+/// switch time of more than 1e8 ticks.
+pub fn switch_ticks(switch_s: f64, tick_s: f64) -> Result<u64> {
+    if !(tick_s.is_finite() && tick_s > 0.0) {
+        return Err(Error::BadParam {
+            name: "tick_s",
+            why: "must be finite and > 0",
+        });
+    }
+    if !(switch_s.is_finite() && switch_s >= 0.0) {
+        return Err(Error::BadParam {
+            name: "switch_s",
+            why: "must be finite and >= 0 (the operator's switch time in seconds; 0 for none)",
+        });
+    }
+    let q = switch_s / tick_s;
+    if q > MAX_SWITCH_TICKS {
+        return Err(Error::BadParam {
+            name: "switch_s",
+            why: "too large: more than 1e8 control ticks",
+        });
+    }
+    // Bounded by 1e8 above, so the cast is exact; then the rounding of `q` is corrected so that
+    // `k` is the smallest with `k·h ≥ δ` as computed.
+    let mut k = q.ceil() as u64;
+    while (k as f64) * tick_s < switch_s {
+        k += 1;
+    }
+    while k > 0 && ((k - 1) as f64) * tick_s >= switch_s {
+        k -= 1;
+    }
+    Ok(k)
+}
+
+/// The margin check with the operator's switch time: `true` when no admissible operator can
+/// make two robots low-confidence in one control tick of `params.tick_s`, nor make one robot's
+/// low-confidence stretch start fewer than [`switch_ticks`] ticks after another robot's ended.
+/// `holds` is empty (no holds) or one list per robot (as [`sufficient_margins_with_holds`]).
+/// With `switch_s = 0` it is [`sufficient_margins_with_holds`], bit for bit.
+///
+/// Two robots without holds: the simulation, `c` a further `k·M_c` short of its region when `p`
+/// has left its own; otherwise the lead bound with the same room. With holds and `k > 0`, a
+/// release rule no longer exempts a pair (a held robot leaves its hold in the tick the other
+/// robot left its stretch, which gives no switch time).
+///
+/// # Errors
+/// As [`sufficient_margins_with_holds`]; [`Error::BadParam`] for a bad `switch_s`
+/// ([`switch_ticks`]).
+pub fn check_margins(
+    robots: &[Timeline],
+    holds: &[Vec<crate::Hold>],
+    params: &MarginParams,
+) -> Result<bool> {
+    check_count(robots.len())?;
+    let k = params.switch_ticks()?;
+    let plans = crate::holds::Plans::new(robots, holds)?;
+    check_plans_switch(&plans, robots.len(), params.tick_s, k)
+}
+
+/// Every pair's slack under [`check_margins`]: [`pair_slacks_with_holds`] with the switch
+/// time's room taken off (`check_margins` is `true` exactly when every `slack_s > 0`). With
+/// `switch_s = 0` it is [`pair_slacks_with_holds`], bit for bit.
+///
+/// # Errors
+/// As [`check_margins`].
+pub fn margin_slacks(
+    robots: &[Timeline],
+    holds: &[Vec<crate::Hold>],
+    params: &MarginParams,
+) -> Result<Vec<PairSlack>> {
+    check_count(robots.len())?;
+    let k = params.switch_ticks()?;
+    let plans = crate::holds::Plans::new(robots, holds)?;
+    if plans.has_holds() {
+        return robot_slacks_of_plans(&plans, params.tick_s, k);
+    }
+    match robots.len() {
+        0..=2 => sim::pair_slacks(robots, params.tick_s, k),
+        _ => lead_slacks(robots, params.tick_s, false, Windows::Sliding, k),
+    }
+}
+
+/// The switch time of a check on one pair `(p, c)`: `k` whole ticks and the two robots'
+/// largest steps (schedule-clock s).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SwitchRoom {
+    /// `k ≥ 1`.
+    pub(super) ticks: u64,
+    /// `M_p`.
+    pub(super) step_p: f64,
+    /// `M_c`.
+    pub(super) step_c: f64,
+}
+
+/// The room (schedule-clock s, `> 0` when safe) of a pair whose previous robot `p` left its
+/// region before the current robot `c` started, under the switch time: `p`'s exit tick starts
+/// with `p` below `u_max_s`, and `c` starts at `τ_c` (`tau_c_s`) only at a tick start at which
+/// `p` has reached `min(τ_c, end_p)` (`end_p_s`), i.e. at least `e = ⌊(min(τ_c, end_p) −
+/// u_max)/M_p⌋` and at least one tick after the exit tick's start. In the `k` ticks after the
+/// exit tick `c` then runs at most `k + 1 − max(e, 1)` ticks from `τ_c`, so it cannot enter its
+/// region at `t_c_lim_s = T_c − ε` when `τ_c + (k + 1 − max(e, 1))·M_c < T_c − ε`; `+∞` when it
+/// does not run at all in them. `e` rounds down: a floor of a quotient off by an ulp is still
+/// at most the true count.
+pub(super) fn started_after_exit_slack(
+    room: SwitchRoom,
+    u_max_s: f64,
+    (tau_c_s, end_p_s): (f64, f64),
+    t_c_lim_s: f64,
+) -> f64 {
+    let elapsed = ((tau_c_s.min(end_p_s) - u_max_s) / room.step_p)
+        .floor()
+        .max(1.0);
+    let k = room.ticks as f64;
+    if elapsed > k {
+        f64::INFINITY
+    } else {
+        t_c_lim_s - (tau_c_s + (k + 1.0 - elapsed) * room.step_c)
+    }
 }
 
 /// Margin checks that are **not safe**, kept by name so that tests can show what they miss and
@@ -413,7 +626,7 @@ pub mod baseline {
     /// # Errors
     /// As [`sufficient_margins`](super::sufficient_margins).
     pub fn pairwise(robots: &[Timeline], tick_s: f64) -> Result<bool> {
-        sim::check_single_pass(robots, tick_s, Variant::Pairwise)
+        sim::check_single_pass(robots, tick_s, Variant::Pairwise, 0)
     }
 
     /// The worst-case simulation extended to N robots by choosing, at every simulated tick in
@@ -429,6 +642,6 @@ pub mod baseline {
     /// # Errors
     /// As [`sufficient_margins`](super::sufficient_margins).
     pub fn greedy_pace(robots: &[Timeline], tick_s: f64) -> Result<bool> {
-        sim::check_single_pass(robots, tick_s, Variant::Conservative)
+        sim::check_single_pass(robots, tick_s, Variant::Conservative, 0)
     }
 }

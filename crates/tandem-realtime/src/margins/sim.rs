@@ -69,6 +69,9 @@ struct Setup {
     tick_budget: f64,
     /// Pairs per ordered role `(p, c)`, at index `p·N + c`.
     pairs: Vec<Vec<Pair>>,
+    /// `k`: whole control ticks of the operator's switch time ([`super::switch_ticks`]); 0
+    /// (no switch time) leaves every float operation of the check as without it.
+    switch_ticks: u64,
 }
 
 /// Upper bound on the ticks a role's simulation started at or after `sim_from_s` (s) needs
@@ -136,7 +139,7 @@ fn max_end_s(robots: &[Timeline]) -> f64 {
 }
 
 impl Setup {
-    fn new(robots: &[Timeline], tick_s: f64) -> Result<Setup> {
+    fn new(robots: &[Timeline], tick_s: f64, switch_ticks: u64) -> Result<Setup> {
         check_count(robots.len())?;
         if !(tick_s.is_finite() && tick_s > 0.0) {
             return Err(Error::BadParam {
@@ -186,6 +189,7 @@ impl Setup {
             eps,
             tick_budget,
             pairs,
+            switch_ticks,
         })
     }
 
@@ -261,10 +265,17 @@ impl<'a> Side<'a> {
 }
 
 /// Fix 4's verdict on a pair when the later of its two robots starts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 enum Admission {
     /// `p` had already left its region: accepted without simulation.
     Left,
+    /// `p` had already left its region, but `c`, just started, may reach its own within the
+    /// switch time: rejected outright, with this slack (`(T_c − ε) − (τ_c + k·M_c) ≤ 0`,
+    /// schedule-clock s). Only with a switch time.
+    SwitchTooSoon {
+        /// The room missing, negated.
+        slack_s: f64,
+    },
     /// The regions overlap on schedule (`T_c < T_p + ε`): rejected outright.
     Overlapping,
     /// Decided by the simulation.
@@ -286,6 +297,12 @@ struct RoleSim<'a> {
     /// The largest step of a robot running before the later of `p` and `c` starts
     /// (schedule-clock s): `M_pc` if only `p` and `c` run before it.
     step_before: f64,
+    /// The switch time's room `k·M_c` (schedule-clock s; `None` when `k = 0`): `c` must stay
+    /// out of its region for `k` more ticks after `p`'s exit tick, moving at most `M_c` in each
+    /// (docs/decisions.md, "The operator's switch time in the margin check").
+    switch_extra_s: Option<f64>,
+    /// `(k, M_p, M_c)` when `k > 0`: for pairs `p` had left before `c` started.
+    switch: Option<(u64, f64, f64)>,
 }
 
 impl<'a> RoleSim<'a> {
@@ -323,6 +340,15 @@ impl<'a> RoleSim<'a> {
         for (s, side) in started.iter_mut().zip(&sides) {
             *s = side.tl.start_s() <= t0;
         }
+        let switch_extra_s =
+            (setup.switch_ticks > 0).then(|| setup.switch_ticks as f64 * setup.max_step_of[c]);
+        let switch = (setup.switch_ticks > 0).then(|| {
+            (
+                setup.switch_ticks,
+                setup.max_step_of[p],
+                setup.max_step_of[c],
+            )
+        });
         let mut sim = RoleSim {
             variant,
             sides,
@@ -331,6 +357,8 @@ impl<'a> RoleSim<'a> {
             tick_s,
             step_pc,
             step_before,
+            switch_extra_s,
+            switch,
         };
         if variant != Variant::Printed && sim.both_started() {
             let (start_p, start_c) = (robots[p].start_s(), robots[c].start_s());
@@ -503,11 +531,31 @@ impl<'a> RoleSim<'a> {
     /// Fix 4: once both `p` and `c` run, the pairs that need no simulation. `None` if one is
     /// rejected (its regions already overlap on schedule), else the pairs left to simulate.
     /// Fix 4 for one pair, read when the later of `p` and `c` has started.
+    ///
+    /// With a switch time (`k > 0`) a pair is accepted without simulation only when `c`, which
+    /// has just started at `τ_c` and did not run in `p`'s exit tick, cannot reach its region in
+    /// the `k` ticks after it either ([`super::started_after_exit_slack`]); otherwise it is
+    /// rejected ([`Admission::SwitchTooSoon`]).
     fn admission(&self, pair: Pair, setup: &Setup) -> Admission {
         let t_p = self.clock_s[0];
         let end_p = self.sides[0].tl.end_s();
-        if pair.t_p_end() + setup.eps <= t_p || (pair.t_p_end() >= end_p && end_p <= t_p) {
+        let left = pair.t_p_end() + setup.eps <= t_p || (pair.t_p_end() >= end_p && end_p <= t_p);
+        let switch_slack = self.switch.map(|(k, step_p, step_c)| {
+            super::started_after_exit_slack(
+                super::SwitchRoom {
+                    ticks: k,
+                    step_p,
+                    step_c,
+                },
+                (pair.t_p_end() + setup.eps).min(end_p),
+                (self.sides[1].tl.start_s(), end_p),
+                pair.t_c_start() - setup.eps,
+            )
+        });
+        if left && switch_slack.is_none_or(|s| s > 0.0) {
             Admission::Left
+        } else if let (true, Some(slack_s)) = (left, switch_slack) {
+            Admission::SwitchTooSoon { slack_s }
         } else if pair.t_c_start() < pair.t_p_end() + setup.eps {
             Admission::Overlapping
         } else {
@@ -528,7 +576,7 @@ impl<'a> RoleSim<'a> {
         for &pair in pairs {
             match self.admission(pair, setup) {
                 Admission::Left => {}
-                Admission::Overlapping => return None,
+                Admission::Overlapping | Admission::SwitchTooSoon { .. } => return None,
                 Admission::Live => live.push(pair),
             }
         }
@@ -536,9 +584,12 @@ impl<'a> RoleSim<'a> {
     }
 
     /// Rule 1's room left for `c` (conservative check): `(T_c − ε) − (t_c + M)`, schedule-clock
-    /// s; `c` is a full step short of its region while this is > 0.
+    /// s; `c` is a full step short of its region while this is > 0. With a switch time (`k > 0`)
+    /// `(T_c − ε) − ((t_c + M) + k·M_c)`: `c` stays out for `k` more ticks.
     fn slack(&self, pair: Pair, eps: f64) -> f64 {
-        (pair.t_c_start() - eps) - (self.clock_s[1] + self.step_pc)
+        let reach = self.clock_s[1] + self.step_pc;
+        let reach = self.switch_extra_s.map_or(reach, |x| reach + x);
+        (pair.t_c_start() - eps) - reach
     }
 
     /// Rule 1's acceptance (conservative check): `p` has left its region, `t_p ≥ T_p + ε`.
@@ -659,12 +710,14 @@ fn roles(n: usize) -> impl Iterator<Item = (usize, usize)> {
 }
 
 /// Runs `variant` with one single-pass simulation per ordered role.
+/// `switch_ticks`: the operator's switch time in whole ticks (0: none).
 pub(super) fn check_single_pass(
     robots: &[Timeline],
     tick_s: f64,
     variant: Variant,
+    switch_ticks: u64,
 ) -> Result<bool> {
-    let setup = Setup::new(robots, tick_s)?;
+    let setup = Setup::new(robots, tick_s, switch_ticks)?;
     for role in roles(setup.n) {
         let pairs = setup.role_pairs(role.0, role.1);
         if !run_role(variant, robots, &setup, role, pairs, tick_s) {
@@ -676,7 +729,7 @@ pub(super) fn check_single_pass(
 
 /// Runs `variant` with one fresh simulation per pair.
 pub(super) fn check_per_pair(robots: &[Timeline], tick_s: f64, variant: Variant) -> Result<bool> {
-    let setup = Setup::new(robots, tick_s)?;
+    let setup = Setup::new(robots, tick_s, 0)?;
     for role in roles(setup.n) {
         for pair in setup.role_pairs(role.0, role.1) {
             if !run_role(variant, robots, &setup, role, &[*pair], tick_s) {
@@ -688,9 +741,14 @@ pub(super) fn check_per_pair(robots: &[Timeline], tick_s: f64, variant: Variant)
 }
 
 /// Every pair's slack from the conservative simulation (fixes 1–6), in the order of the
-/// current regions' starts (see [`PairSlack::slack_s`] for two robots).
-pub(super) fn pair_slacks(robots: &[Timeline], tick_s: f64) -> Result<Vec<PairSlack>> {
-    let setup = Setup::new(robots, tick_s)?;
+/// current regions' starts (see [`PairSlack::slack_s`] for two robots); `switch_ticks`: the
+/// operator's switch time in whole ticks (0: none).
+pub(super) fn pair_slacks(
+    robots: &[Timeline],
+    tick_s: f64,
+    switch_ticks: u64,
+) -> Result<Vec<PairSlack>> {
+    let setup = Setup::new(robots, tick_s, switch_ticks)?;
     let mut out = Vec::new();
     for (p, c) in roles(setup.n) {
         let pairs = setup.role_pairs(p, c);
@@ -739,6 +797,8 @@ fn role_slacks(
         while k < pairs.len() {
             if adm[k] == Admission::Left {
                 slack[k] = f64::INFINITY;
+            } else if let Admission::SwitchTooSoon { slack_s } = adm[k] {
+                slack[k] = slack_s;
             } else if sim.p_is_out(pairs[k], setup.eps) {
                 slack[k] = sim.slack(pairs[k], setup.eps);
             } else {
@@ -757,6 +817,7 @@ fn role_slacks(
                 Admission::Overlapping => {
                     *s = s.min(pair.t_c_start() - (pair.t_p_end() + setup.eps));
                 }
+                Admission::SwitchTooSoon { slack_s } => *s = *slack_s,
                 Admission::Live => {}
             }
         }
@@ -786,7 +847,7 @@ mod tests {
     #[test]
     fn pairs_of_three_sample_case() {
         let r = three_sample(1.5);
-        let s = Setup::new(&r, 1.0).unwrap();
+        let s = Setup::new(&r, 1.0, 0).unwrap();
         assert_eq!(role_start(&r, 0, 1, true), 1.5);
         assert_eq!(s.max_step, 2.0);
         let iv = |start_s, end_s| LcInterval {
@@ -829,7 +890,7 @@ mod tests {
         // c rushing (t_c = 3.5, p follows to 3.5) and p dragging (both to 2.0) leave c level,
         // so the tie keeps the rush. p is then out (3.5 ≥ T_p = 2): slack = 2.5 − (3.5 + 2) = −3
         // (less ε).
-        let s = pair_slacks(&three_sample(1.5), 1.0).unwrap();
+        let s = pair_slacks(&three_sample(1.5), 1.0, 0).unwrap();
         assert_eq!(s.len(), 1);
         assert_eq!(
             (
@@ -846,9 +907,9 @@ mod tests {
             s[0].slack_s
         );
         // Serial: fix 4 accepts the pair without simulating it.
-        let s = pair_slacks(&three_sample(3.0), 1.0).unwrap();
+        let s = pair_slacks(&three_sample(3.0), 1.0, 0).unwrap();
         assert_eq!(s[0].slack_s, f64::INFINITY);
-        assert!(pair_slacks(&three_sample(1.5), 0.0).is_err());
+        assert!(pair_slacks(&three_sample(1.5), 0.0, 0).is_err());
     }
 
     #[test]
@@ -883,7 +944,7 @@ mod tests {
         for d in [20, 99, 120, 149, 200, 280] {
             for step in 0..=80 {
                 let r = dwelling(d, 0.025 * f64::from(step));
-                let setup = Setup::new(&r, tick_s).unwrap();
+                let setup = Setup::new(&r, tick_s, 0).unwrap();
                 for role in roles(2) {
                     let pairs = setup.role_pairs(role.0, role.1);
                     for variant in [Variant::Pairwise, Variant::Conservative] {
@@ -898,7 +959,7 @@ mod tests {
                         longest = longest.max(ticks);
                     }
                 }
-                pair_slacks(&r, tick_s).unwrap();
+                pair_slacks(&r, tick_s, 0).unwrap();
             }
         }
         // Some case drags robot 0 through its LC run (≥ 100 ticks at S = 0.5) and the dwell in
@@ -933,7 +994,7 @@ mod tests {
         let mut lo = lo.clone();
         lo[4500] = 1.0 / 1530.0;
         let tl = |tau| Timeline::new(&conf, &g, &lo, &hi, tau, 0.01).unwrap();
-        let setup = Setup::new(&[tl(0.0), tl(100.0)], 0.01).unwrap();
+        let setup = Setup::new(&[tl(0.0), tl(100.0)], 0.01, 0).unwrap();
         assert_eq!(setup.tick_budget, MAX_SIM_TICKS);
         assert!(sufficient_margins(&[tl(0.0), tl(100.0)], 0.01).unwrap());
         assert!(!sufficient_margins(&[tl(0.0), tl(10.0)], 0.01).unwrap());

@@ -249,18 +249,21 @@ pub(crate) fn check_order(order: &[Stretch], n_robots: usize, m: usize) -> Resul
 /// [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS` or an order that does not
 /// list every stretch once with each robot's stretches in task order around the cycle.
 pub fn event_graph(problem: &Problem, n_robots: usize, order: &[Stretch]) -> Result<EventGraph> {
-    graph_of_shape(TaskShape::new(problem), n_robots, order, None)
+    graph_of_shape(TaskShape::new(problem), n_robots, order, None, 0.0)
 }
 
 /// [`event_graph`] of a task shape already cut from its problem; with `handover_tick_s`
 /// (the control tick of the token-rule cell, s) every operator arc into a stretch that opens
 /// a group of another robot also carries the hand-over: the stretch's
-/// [`TaskShape::entry_s`] plus one tick ([`crate::CyclicParams::handover_tick_s`]).
+/// [`TaskShape::entry_s`] plus one tick ([`crate::CyclicParams::handover_tick_s`]). With the
+/// operator's switch time `switch_s > 0` every operator arc between stretches of different
+/// robots carries at least `switch_s` ([`crate::CyclicParams::switch_s`]).
 pub(crate) fn graph_of_shape(
     shape: TaskShape,
     n_robots: usize,
     order: &[Stretch],
     handover_tick_s: Option<f64>,
+    switch_s: f64,
 ) -> Result<EventGraph> {
     check_robot_count(n_robots)?;
     let m = shape.n_lc();
@@ -335,6 +338,13 @@ pub(crate) fn graph_of_shape(
                 shape.entry_s[to.lc] + tick_s
             }
             _ => 0.0,
+        };
+        // The operator's switch time: the next stretch of another robot starts at least δ
+        // after this one ended (the larger of δ and the hand-over, both counted from the end).
+        let handover = if switch_s > 0.0 && to.robot != from.robot {
+            handover.max(switch_s)
+        } else {
+            handover
         };
         push(
             node(from),

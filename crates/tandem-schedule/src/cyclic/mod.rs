@@ -77,6 +77,7 @@ pub use checked::CheckedCyclicPlan;
 pub use graph::{Event, EventGraph, Gap, Stretch, TaskShape, event_graph};
 pub use plan::{
     CyclicPlan, GapPlan, RobotCycle, cyclic_plan_for_order, handover_bound_s, period_lower_bound_s,
+    period_lower_bound_with_switch_s,
 };
 pub use ratio::{Arc, CycleRatio, max_cycle_ratio};
 pub use run::is_runnable;

@@ -114,6 +114,78 @@ pub(crate) fn bound_of(shape: &TaskShape, n_robots: usize) -> f64 {
     (n_robots as f64 * (shape.lc_total_s() + shape.idle_s())).max(shape.fastest_s())
 }
 
+/// [`period_lower_bound_s`] with the operator's switch time `switch_s` (real s, ≥ 0): for
+/// `N ≥ 2` robots and `m ≥ 1` stretches, `max(N·(L + I + δ), D_min)`; otherwise
+/// [`period_lower_bound_s`].
+///
+/// **Why.** One period of the operator is its `N·m` stretches and the intervals between
+/// consecutive ones (cyclically). Each robot's stretches form at least one block of the cyclic
+/// order, so with `N ≥ 2` robots the robot changes at least `N` times around the cycle, and each
+/// change's interval lasts at least `δ`. The forced idle gaps of `I` (item 2 of
+/// [`period_lower_bound_s`]) lie between two consecutive stretches of one robot (no other
+/// robot's stretch meets them), so they are other intervals than the changes: the three sums
+/// add, `P ≥ N·L + N·I + N·δ`. `P ≥ D_min` as before.
+///
+/// # Errors
+/// [`crate::Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS` or a `switch_s` not
+/// finite and ≥ 0.
+pub fn period_lower_bound_with_switch_s(
+    problem: &Problem,
+    n_robots: usize,
+    switch_s: f64,
+) -> Result<f64> {
+    check_robot_count(n_robots)?;
+    if !(switch_s.is_finite() && switch_s >= 0.0) {
+        return Err(crate::Error::BadParam {
+            name: "switch_s",
+            why: "must be finite and >= 0 (the operator's switch time in seconds; 0 for none)",
+        });
+    }
+    Ok(switch_bound_of(
+        &TaskShape::new(problem),
+        n_robots,
+        switch_s,
+    ))
+}
+
+/// The least period (s) at which the operator's busy share of `order` is at most
+/// `max_busy_share`: `(N·L + c·δ)/u_max`, `c` the changes of robot around the cyclic order
+/// (each costs the switch time `δ` of the operator's attention).
+fn capped_period_s(
+    graph: &EventGraph,
+    n_robots: usize,
+    order: &[Stretch],
+    switch_s: f64,
+    max_busy_share: f64,
+) -> f64 {
+    let len = order.len();
+    let changes = (0..len)
+        .filter(|&q| order[q].robot != order[(q + 1) % len].robot)
+        .count();
+    (n_robots as f64 * graph.shape.lc_total_s() + changes as f64 * switch_s) / max_busy_share
+}
+
+/// The load cap's bound (s): every plan whose busy share, switches included, is at most
+/// `max_busy_share` has `P ≥ (N·L + c·δ)/u_max` with `c ≥ N` changes of robot for `N ≥ 2`
+/// (the argument of [`period_lower_bound_with_switch_s`]), `c ≥ 0` for one robot.
+fn cap_bound_of(shape: &TaskShape, n_robots: usize, switch_s: f64, max_busy_share: f64) -> f64 {
+    let changes = if n_robots >= 2 && shape.n_lc() > 0 {
+        n_robots as f64
+    } else {
+        0.0
+    };
+    (n_robots as f64 * shape.lc_total_s() + changes * switch_s) / max_busy_share
+}
+
+/// [`period_lower_bound_with_switch_s`] of a task shape.
+pub(crate) fn switch_bound_of(shape: &TaskShape, n_robots: usize, switch_s: f64) -> f64 {
+    if switch_s > 0.0 && n_robots >= 2 && shape.n_lc() > 0 {
+        (n_robots as f64 * (shape.lc_total_s() + shape.idle_s() + switch_s)).max(shape.fastest_s())
+    } else {
+        bound_of(shape, n_robots)
+    }
+}
+
 /// A lower bound (s) on the period of every 1-periodic plan of `n_robots` robots on
 /// `problem` whose order is runnable ([`crate::cyclic::is_runnable`]) and whose hand-overs
 /// are counted at the control tick `tick_s` ([`crate::CyclicParams::handover_tick_s`]):
@@ -152,8 +224,12 @@ pub(crate) fn handover_bound_of(shape: &TaskShape, n_robots: usize, tick_s: f64)
     if n_robots < 2 || m == 0 {
         return old;
     }
-    // Σ_g (S_g + E_g): every stretch, every gap inside a group, every group's entry.
-    let per_task: f64 = (0..m)
+    (n_robots as f64 * (groups_per_task_s(shape) + tick_s)).max(old)
+}
+
+/// `Σ_g (S_g + E_g)` (s): every stretch, every gap inside a group, every group's entry.
+fn groups_per_task_s(shape: &TaskShape) -> f64 {
+    (0..shape.n_lc())
         .map(|k| {
             let before = if shape.opens_group(k) {
                 shape.entry_s[k]
@@ -162,8 +238,32 @@ pub(crate) fn handover_bound_of(shape: &TaskShape, n_robots: usize, tick_s: f64)
             };
             shape.lc_s[k] + before
         })
-        .sum();
-    (n_robots as f64 * (per_task + tick_s)).max(old)
+        .sum()
+}
+
+/// [`handover_bound_of`] with the operator's switch time `switch_s > 0`, for plans whose
+/// operator arcs into another robot's group carry `max(E_h + tick, δ)`
+/// ([`crate::CyclicParams::switch_s`]): `max(N·(Σ_g (S_g + E_g) + min_h max(tick, δ − E_h)),
+/// N·(L + I + δ), D_min)`. The argument of [`handover_bound_s`] with each of the `c ≥ N`
+/// changes of robot costing `max(E_h + tick, δ) = E_h + max(tick, δ − E_h)` instead of
+/// `E_h + tick`, `h` the group it enters (in a runnable order a change enters a group at its
+/// first stretch).
+fn handover_switch_bound_of(shape: &TaskShape, n_robots: usize, tick_s: f64, switch_s: f64) -> f64 {
+    let old = switch_bound_of(shape, n_robots, switch_s);
+    let m = shape.n_lc();
+    if n_robots < 2 || m == 0 {
+        return old;
+    }
+    let per_change = (0..m)
+        .filter(|&k| shape.opens_group(k))
+        .map(|k| tick_s.max(switch_s - shape.entry_s[k]))
+        .fold(f64::INFINITY, f64::min);
+    let per_change = if per_change.is_finite() {
+        per_change
+    } else {
+        tick_s
+    };
+    (n_robots as f64 * (groups_per_task_s(shape) + per_change)).max(old)
 }
 
 /// The cyclic plan of `n_robots` robots on `problem` with the operator's cyclic order `order`
@@ -179,7 +279,7 @@ pub fn cyclic_plan_for_order(
     n_robots: usize,
     order: &[Stretch],
 ) -> Result<CyclicPlan> {
-    plan_for_order(problem, n_robots, order, None, false)
+    plan_for_order(problem, n_robots, order, None, false, 0.0, 1.0)
 }
 
 /// [`cyclic_plan_for_order`], counting the token rule's hand-overs at the control tick
@@ -192,15 +292,54 @@ pub(crate) fn plan_for_order(
     order: &[Stretch],
     handover_tick_s: Option<f64>,
     runnable_only: bool,
+    switch_s: f64,
+    max_busy_share: f64,
 ) -> Result<CyclicPlan> {
-    let graph = match handover_tick_s {
-        None => event_graph(problem, n_robots, order)?,
-        Some(_) => graph_of_shape(TaskShape::new(problem), n_robots, order, handover_tick_s)?,
+    let graph = match (handover_tick_s, switch_s > 0.0) {
+        (None, false) => event_graph(problem, n_robots, order)?,
+        _ => graph_of_shape(
+            TaskShape::new(problem),
+            n_robots,
+            order,
+            handover_tick_s,
+            switch_s,
+        )?,
     };
-    let ratio = max_cycle_ratio(graph.events.len(), &graph.arcs)?;
+    let mut ratio = max_cycle_ratio(graph.events.len(), &graph.arcs)?;
+    if max_busy_share < 1.0 {
+        let capped = capped_period_s(&graph, n_robots, order, switch_s, max_busy_share);
+        if capped > ratio.period_s {
+            ratio.times_s = super::ratio::times_at(graph.events.len(), &graph.arcs, capped).ok_or(
+                crate::Error::BadParam {
+                    name: "max_busy_share",
+                    why: "no period of this order keeps the operator's busy share under the cap \
+                          (a robot would wait too long inside a gap without a hold point)",
+                },
+            )?;
+            ratio.period_s = capped;
+        }
+    }
     let lower_bound_s = match handover_tick_s {
+        Some(tick_s) if runnable_only && switch_s > 0.0 => {
+            handover_switch_bound_of(&graph.shape, n_robots, tick_s, switch_s)
+        }
         Some(tick_s) if runnable_only => handover_bound_of(&graph.shape, n_robots, tick_s),
         _ => bound_of(&graph.shape, n_robots),
+    };
+    let lower_bound_s = if switch_s > 0.0 {
+        lower_bound_s.max(switch_bound_of(&graph.shape, n_robots, switch_s))
+    } else {
+        lower_bound_s
+    };
+    let lower_bound_s = if max_busy_share < 1.0 {
+        lower_bound_s.max(cap_bound_of(
+            &graph.shape,
+            n_robots,
+            switch_s,
+            max_busy_share,
+        ))
+    } else {
+        lower_bound_s
     };
     Ok(layout(
         &graph,
@@ -218,9 +357,21 @@ pub(crate) fn period_of(
     n_robots: usize,
     order: &[Stretch],
     handover_tick_s: Option<f64>,
+    switch_s: f64,
+    max_busy_share: f64,
 ) -> Result<Option<f64>> {
-    let graph = graph_of_shape(shape.clone(), n_robots, order, handover_tick_s)?;
+    let graph = graph_of_shape(shape.clone(), n_robots, order, handover_tick_s, switch_s)?;
     match max_cycle_ratio(graph.events.len(), &graph.arcs) {
+        Ok(r) if max_busy_share < 1.0 => {
+            let capped = capped_period_s(&graph, n_robots, order, switch_s, max_busy_share);
+            if capped <= r.period_s {
+                Ok(Some(r.period_s))
+            } else if super::ratio::times_at(graph.events.len(), &graph.arcs, capped).is_some() {
+                Ok(Some(capped))
+            } else {
+                Ok(None)
+            }
+        }
         Ok(r) => Ok(Some(r.period_s)),
         Err(crate::Error::InfeasibleCycle { .. }) => Ok(None),
         Err(e) => Err(e),

@@ -180,6 +180,30 @@ fn finish(
     })
 }
 
+/// Event times (s, the least 0) of a 1-periodic schedule at the given period `period_s` (s):
+/// Bellman–Ford longest paths under the weights `w − P·h`, with the rounding tolerance of
+/// [`max_cycle_ratio`]; `None` when a cycle is positive at that period (it is not feasible,
+/// e.g. above a maximum time lag across the period boundary).
+pub(crate) fn times_at(n_nodes: usize, arcs: &[Arc], period_s: f64) -> Option<Vec<f64>> {
+    let mut dist = vec![0.0_f64; n_nodes];
+    let tol = tolerance(arcs, period_s) * 4.0;
+    for _ in 0..=n_nodes {
+        let mut changed = false;
+        for a in arcs {
+            let c = dist[a.from] + a.weight_s - period_s * f64::from(a.tokens);
+            if c > dist[a.to] + tol {
+                dist[a.to] = c;
+                changed = true;
+            }
+        }
+        if !changed {
+            let min = dist.iter().copied().fold(f64::INFINITY, f64::min);
+            return Some(dist.iter().map(|d| d - min).collect());
+        }
+    }
+    None
+}
+
 fn tolerance(arcs: &[Arc], lambda: f64) -> f64 {
     let scale: f64 = arcs
         .iter()

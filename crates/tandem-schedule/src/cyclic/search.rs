@@ -37,6 +37,22 @@ pub struct CyclicParams {
     /// the module docs), which a cell reaches only with gates next to the stretches.
     /// Must be finite and > 0. Default `None`.
     pub handover_tick_s: Option<f64>,
+    /// The operator's switch time `δ` (real s, ≥ 0; issue 41): the operator arc from a
+    /// stretch to the next of *another* robot carries at least `δ` after the stretch's end
+    /// (the larger of `δ` and the hand-over when that is counted; consecutive stretches of one
+    /// robot need none), so the period and the search account for it, and the plan's bound is
+    /// [`crate::cyclic::period_lower_bound_with_switch_s`] when larger (docs/decisions.md,
+    /// "The switch time in the scheduler's bounds (issue 41)"). Default 0: the plan without it, the same
+    /// float operations.
+    pub switch_s: f64,
+    /// The load cap `u_max` (issue 41): the operator's busy share per period, its supervised
+    /// stretches plus `switch_s` per change of robot (`(N·L + c·δ)/P`), must not exceed it, so
+    /// the period of an order is `max(λ*, (N·L + c·δ)/u_max)` (an order whose event graph
+    /// admits no such period is skipped) and the plan's bound is at least
+    /// `(N·L + N·δ)/u_max` (docs/decisions.md, "The switch time in the scheduler's bounds
+    /// (issue 41)"). Over the cycle, not a rolling window: the plan repeats, so every window of
+    /// whole periods has this share. In `(0, 1]`; default 1: no cap, the same float operations.
+    pub max_busy_share: f64,
 }
 
 impl Default for CyclicParams {
@@ -46,6 +62,8 @@ impl Default for CyclicParams {
             max_swap_passes: 200,
             runnable_only: true,
             handover_tick_s: None,
+            switch_s: 0.0,
+            max_busy_share: 1.0,
         }
     }
 }
@@ -54,8 +72,8 @@ impl CyclicParams {
     /// Checks the parameters.
     ///
     /// # Errors
-    /// [`Error::BadParam`] for `max_enumerated == 0` or a `handover_tick_s` not finite and
-    /// > 0.
+    /// [`Error::BadParam`] for `max_enumerated == 0`, a `handover_tick_s` not finite and
+    /// > 0, a `switch_s` not finite and ≥ 0, or a `max_busy_share` outside `(0, 1]`.
     pub fn validate(&self) -> Result<()> {
         if self.max_enumerated == 0 {
             return Err(Error::BadParam {
@@ -70,6 +88,18 @@ impl CyclicParams {
             return Err(Error::BadParam {
                 name: "handover_tick_s",
                 why: "must be finite and > 0",
+            });
+        }
+        if !(self.switch_s.is_finite() && self.switch_s >= 0.0) {
+            return Err(Error::BadParam {
+                name: "switch_s",
+                why: "must be finite and >= 0 (the operator's switch time in seconds; 0 for none)",
+            });
+        }
+        if !(self.max_busy_share > 0.0 && self.max_busy_share <= 1.0) {
+            return Err(Error::BadParam {
+                name: "max_busy_share",
+                why: "must be in (0, 1] (the operator's largest busy share; 1 for no cap)",
             });
         }
         Ok(())
@@ -167,6 +197,8 @@ pub fn cyclic_plan(
         &order,
         params.handover_tick_s,
         params.runnable_only,
+        params.switch_s,
+        params.max_busy_share,
     )?;
     plan.order_exhaustive = exhaustive;
     plan.orders_evaluated = evaluated;
@@ -243,7 +275,14 @@ fn enumerate(
             }
             if groups.is_none_or(|g| first_split_group(&order, g).is_none()) {
                 evaluated += 1;
-                let p = period_of(shape, n_robots, &order, params.handover_tick_s)?;
+                let p = period_of(
+                    shape,
+                    n_robots,
+                    &order,
+                    params.handover_tick_s,
+                    params.switch_s,
+                    params.max_busy_share,
+                )?;
                 if better(p, best.0) {
                     best = (p, order.clone());
                 }
@@ -306,7 +345,14 @@ fn local_search(
     let mut best: (Option<f64>, Vec<Stretch>) = (None, flat(&serial_units));
     for seed in [round_robin, staggered, serial_units] {
         let mut cur = seed;
-        let mut p = period_of(shape, n_robots, &flat(&cur), params.handover_tick_s)?;
+        let mut p = period_of(
+            shape,
+            n_robots,
+            &flat(&cur),
+            params.handover_tick_s,
+            params.switch_s,
+            params.max_busy_share,
+        )?;
         evaluated += 1;
         let len = cur.len();
         for _ in 0..params.max_swap_passes {
@@ -317,7 +363,14 @@ fn local_search(
                     continue;
                 }
                 cur.swap(q, q2);
-                let pq = period_of(shape, n_robots, &flat(&cur), params.handover_tick_s)?;
+                let pq = period_of(
+                    shape,
+                    n_robots,
+                    &flat(&cur),
+                    params.handover_tick_s,
+                    params.switch_s,
+                    params.max_busy_share,
+                )?;
                 evaluated += 1;
                 cur.swap(q, q2);
                 if better(pq, step.map_or(p, |s| s.1)) {

@@ -249,7 +249,49 @@ pub fn solve_exact(problem: &Problem, params: &ExactParams) -> Result<MarginFree
         problem,
         &bound_chain(problem, 2),
         params.max_pieces,
+        0.0,
     ))
+}
+
+/// [`solve_exact`] with the operator's switch time `switch_s` (s, ≥ 0): the margin-free
+/// problem plus "an LC run of one robot starts at least `switch_s` after the other robot's
+/// previous LC run ended" (consecutive runs of one robot need none), which every schedule that
+/// [`crate::validate_with_switch`] accepts meets. The search is the same dynamic program with
+/// the uniform clearance `switch_s` between the two robots' runs (the clearance the completion
+/// already uses for its margins), from no incumbent. Its value is a lower bound on every such
+/// schedule (docs/decisions.md, "The switch time in the scheduler's bounds (issue 41)"); it is marked
+/// optimal, with its schedule, only when that schedule also meets `τ ≤ |ψ_E1|` (Eq. 20
+/// constraint 2, which the program leaves out and which a switch time can break). Without LC
+/// runs the bound is the fastest execution; past the piece budget it is
+/// [`operator_bound_with_switch_s`] for two robots. `switch_s = 0` is [`solve_exact`].
+///
+/// # Errors
+/// [`Error::BadParam`] for invalid parameters or a `switch_s` not finite and ≥ 0.
+pub fn solve_exact_with_switch(
+    problem: &Problem,
+    params: &ExactParams,
+    switch_s: f64,
+) -> Result<MarginFree> {
+    params.validate()?;
+    check_switch(switch_s)?;
+    Ok(margin_free(
+        problem,
+        &bound_chain(problem, 2),
+        params.max_pieces,
+        switch_s,
+    ))
+}
+
+/// `Err` unless `switch_s` is finite and ≥ 0.
+fn check_switch(switch_s: f64) -> Result<()> {
+    if switch_s.is_finite() && switch_s >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::BadParam {
+            name: "switch_s",
+            why: "must be finite and >= 0 (the operator's switch time in seconds; 0 for none)",
+        })
+    }
 }
 
 /// The chain the bound of `n_robots` robots is computed on: with the problem's usable hold
@@ -265,12 +307,26 @@ fn bound_chain(problem: &Problem, n_robots: usize) -> chain::Chain {
     chain::Chain::with_holds(problem, n_robots as f64 * plain.fastest_s())
 }
 
-fn margin_free(problem: &Problem, chain: &chain::Chain, max_pieces: usize) -> MarginFree {
+fn margin_free(
+    problem: &Problem,
+    chain: &chain::Chain,
+    max_pieces: usize,
+    switch_s: f64,
+) -> MarginFree {
     let m = chain.n_lc();
-    let zero = search::Clearance::zero();
+    let zero = if switch_s > 0.0 {
+        search::Clearance::uniform(switch_s, None)
+    } else {
+        search::Clearance::zero()
+    };
     // The incumbent: the fastest serial schedule, 2 × the fastest execution (feasible for the
-    // margin-free problem, so the optimum is never above it).
-    let serial_s = 2.0 * chain.fastest_s();
+    // margin-free problem, so the optimum is never above it). With a switch time the serial
+    // order may not be feasible (robot 1 ending and robot 2 starting low-confidence): none.
+    let serial_s = if switch_s > 0.0 {
+        f64::INFINITY
+    } else {
+        2.0 * chain.fastest_s()
+    };
     let (outcome, counts) = search::search(chain, &zero, serial_s, max_pieces);
     let stats = SearchStats {
         lc_runs: m,
@@ -281,6 +337,21 @@ fn margin_free(problem: &Problem, chain: &chain::Chain, max_pieces: usize) -> Ma
         search::Outcome::Done(found) => found,
         search::Outcome::OutOfBudget => None,
     };
+    // With a switch time the program's optimum may start robot 2 after robot 1's end (its
+    // network, which keeps `τ ≤ |ψ_E1|`, is then infeasible): still the optimum of a
+    // relaxation, so a lower bound, but neither a schedule nor proven.
+    if switch_s > 0.0
+        && let Some(f) = &found
+        && stn::earliest(chain, &f.order, &zero).is_none()
+    {
+        return MarginFree {
+            lower_bound_s: f.t_total_s.max(operator_bound_of(chain, 2, switch_s)),
+            proven_optimal: false,
+            schedule: None,
+            order: f.order.iter().map(|&r| usize::from(r)).collect(),
+            stats,
+        };
+    }
     let exact = found.and_then(|f| {
         let times = stn::earliest(chain, &f.order, &zero)?;
         Some((f, times))
@@ -299,7 +370,7 @@ fn margin_free(problem: &Problem, chain: &chain::Chain, max_pieces: usize) -> Ma
             stats,
         },
         None => MarginFree {
-            lower_bound_s: simple_bound(chain),
+            lower_bound_s: operator_bound_of(chain, 2, switch_s),
             proven_optimal: false,
             schedule: None,
             order: Vec::new(),
@@ -308,18 +379,18 @@ fn margin_free(problem: &Problem, chain: &chain::Chain, max_pieces: usize) -> Ma
     }
 }
 
-/// `max(a_0 + 2·Σ L_k + a_m, fastest execution)` (s): the operator serves `2·Σ L_k` of LC time,
-/// not before the fastest head and followed by at least the fastest tail; and each robot needs
-/// its fastest execution ([`operator_bound_of`] for two robots).
-fn simple_bound(chain: &chain::Chain) -> f64 {
-    operator_bound_of(chain, 2)
-}
-
-/// [`operator_bound_s`] of the chain of runs.
-fn operator_bound_of(chain: &chain::Chain, n_robots: usize) -> f64 {
+/// [`operator_bound_s`] of the chain of runs (for two robots the simple bound of
+/// [`solve_exact`]), with the switch time `switch_s` ([`operator_bound_with_switch_s`]; 0: none,
+/// the same float operations).
+fn operator_bound_of(chain: &chain::Chain, n_robots: usize, switch_s: f64) -> f64 {
     let m = chain.n_lc();
     let operator = if m == 0 {
         0.0
+    } else if switch_s > 0.0 {
+        chain.gap_s[0].0
+            + n_robots as f64 * chain.lc_s.iter().sum::<f64>()
+            + (n_robots - 1) as f64 * switch_s
+            + chain.gap_s[m].0
     } else {
         chain.gap_s[0].0 + n_robots as f64 * chain.lc_s.iter().sum::<f64>() + chain.gap_s[m].0
     };
@@ -348,7 +419,68 @@ fn operator_bound_of(chain: &chain::Chain, n_robots: usize) -> f64 {
 /// [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS`.
 pub fn operator_bound_s(problem: &Problem, n_robots: usize) -> Result<f64> {
     crate::problem::check_robot_count(n_robots)?;
-    Ok(operator_bound_of(&chain::Chain::new(problem), n_robots))
+    Ok(operator_bound_of(
+        &chain::Chain::new(problem),
+        n_robots,
+        0.0,
+    ))
+}
+
+/// [`operator_bound_s`] with the operator's switch time `switch_s` (s, ≥ 0):
+/// `max(a_0 + N·Σ_k L_k + (N − 1)·δ + a_m, fastest execution)` with `m ≥ 1` LC runs.
+///
+/// **Why it is a lower bound** on every schedule that [`crate::validate_with_switch`] accepts.
+/// Order the `N·m` LC intervals of such a schedule in time (they are disjoint, constraint 3).
+/// Every robot has intervals, so grouping consecutive intervals of one robot gives at least
+/// `N` groups and `N − 1` places where the robot changes; at each, the next interval starts at
+/// least `δ` after the previous one ends (the scheduled switch time), and these gaps are
+/// disjoint from the intervals and from each other. So the last interval ends at or after
+/// `a_0 + N·Σ L_k + (N − 1)·δ`, and its robot still needs the fastest tail `a_m`, as in
+/// [`operator_bound_s`]. (Consecutive runs of one robot need no switch time.)
+///
+/// # Errors
+/// [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS` or a `switch_s` not finite and
+/// ≥ 0.
+pub fn operator_bound_with_switch_s(
+    problem: &Problem,
+    n_robots: usize,
+    switch_s: f64,
+) -> Result<f64> {
+    crate::problem::check_robot_count(n_robots)?;
+    check_switch(switch_s)?;
+    Ok(operator_bound_of(
+        &chain::Chain::new(problem),
+        n_robots,
+        switch_s,
+    ))
+}
+
+/// The certificate's lower bound with the operator's switch time `switch_s` (s, ≥ 0) for
+/// `n_robots` robots: one robot the fastest execution, two the margin-free search with the
+/// switch time ([`solve_exact_with_switch`]), three or more the maximum of the `k`-robot
+/// bounds (`k = 2…N`), each the branch and bound over machine orders with the switch time, or
+/// [`operator_bound_with_switch_s`] past its node budget. A lower bound on the `T_total` of
+/// every schedule that [`crate::validate_with_switch`] accepts (docs/decisions.md, "The switch
+/// time in the scheduler's bounds (issue 41)"); `switch_s = 0` gives the certificate's bound of
+/// [`crate::sample_schedule_n`].
+///
+/// # Errors
+/// [`Error::BadParam`] for invalid parameters, `n_robots` outside `1..=MAX_ROBOTS` or a
+/// `switch_s` not finite and ≥ 0.
+pub fn margin_free_bound(
+    problem: &Problem,
+    n_robots: usize,
+    params: &ExactParams,
+    switch_s: f64,
+) -> Result<MarginFree> {
+    crate::problem::check_robot_count(n_robots)?;
+    params.validate()?;
+    check_switch(switch_s)?;
+    Ok(match n_robots {
+        1 => operator_bound(problem, 1),
+        2 => bound_switch(problem, params, switch_s),
+        _ => bound_many_switch(problem, n_robots, params, switch_s),
+    })
 }
 
 /// The certificate of the scheduler for `n_robots ≠ 2` robots: [`operator_bound_s`], marked
@@ -356,7 +488,7 @@ pub fn operator_bound_s(problem: &Problem, n_robots: usize) -> Result<f64> {
 pub(crate) fn operator_bound(problem: &Problem, n_robots: usize) -> MarginFree {
     let chain = chain::Chain::new(problem);
     MarginFree {
-        lower_bound_s: operator_bound_of(&chain, n_robots),
+        lower_bound_s: operator_bound_of(&chain, n_robots, 0.0),
         proven_optimal: n_robots == 1,
         schedule: None,
         order: Vec::new(),
@@ -393,7 +525,17 @@ pub fn earliest_schedule(problem: &Problem, order: &[usize]) -> Result<Option<Sc
 
 /// The margin-free bound of `problem` (see [`solve_exact`]).
 pub(crate) fn bound(problem: &Problem, params: &ExactParams) -> MarginFree {
-    margin_free(problem, &bound_chain(problem, 2), params.max_pieces)
+    bound_switch(problem, params, 0.0)
+}
+
+/// [`bound`] with the switch time `switch_s` (s, ≥ 0; see [`solve_exact_with_switch`]).
+fn bound_switch(problem: &Problem, params: &ExactParams, switch_s: f64) -> MarginFree {
+    margin_free(
+        problem,
+        &bound_chain(problem, 2),
+        params.max_pieces,
+        switch_s,
+    )
 }
 
 /// Node budget of the `N`-robot search (see "N robots" in the [module docs](self)): the
@@ -407,10 +549,18 @@ pub const MAX_SEARCH_NODES: usize = 200_000;
 /// if any), else the operator-limited bound ([`operator_bound_s`]), never above it. The
 /// schedule is the best order found (with planned dwells at holds), proven or not; `order` its
 /// robots in time order.
-pub(crate) fn bound_n(problem: &Problem, n_robots: usize) -> MarginFree {
+///
+/// With the switch time `switch_s` (s, ≥ 0; 0: none) the search places a switch's runs
+/// `switch_s` apart ([`many::search_with_switch`]) and the fallback is
+/// [`operator_bound_with_switch_s`].
+fn bound_n_switch(problem: &Problem, n_robots: usize, switch_s: f64) -> MarginFree {
     let chain = bound_chain(problem, n_robots);
-    let plain = operator_bound(problem, n_robots);
-    let (found, proven, nodes) = many::search(&chain, n_robots, f64::INFINITY, MAX_SEARCH_NODES);
+    let mut plain = operator_bound(problem, n_robots);
+    if switch_s > 0.0 {
+        plain.lower_bound_s = operator_bound_of(&chain::Chain::new(problem), n_robots, switch_s);
+    }
+    let (found, proven, nodes) =
+        many::search_with_switch(&chain, n_robots, f64::INFINITY, MAX_SEARCH_NODES, switch_s);
     let stats = SearchStats {
         states: nodes,
         ..plain.stats
@@ -440,7 +590,7 @@ pub(crate) fn bound_n(problem: &Problem, n_robots: usize) -> MarginFree {
 }
 
 /// The certificate's bound for `n_robots ≥ 3` robots, never below the bound of fewer robots:
-/// `B(N) = max(own(N), B(N − 1))` with `own(k)` the `k`-robot search's bound ([`bound_n`]) and
+/// `B(N) = max(own(N), B(N − 1))` with `own(k)` the `k`-robot search's bound ([`bound_n_switch`]) and
 /// `B(2)` the two-robot margin-free bound ([`bound`]); the schedule, order and counts are
 /// `own(N)`'s, and it is marked optimal only when `own(N)` is proven and not exceeded.
 ///
@@ -458,11 +608,24 @@ pub(crate) fn bound_n(problem: &Problem, n_robots: usize) -> MarginFree {
 /// `N`-robot search may run out of its node budget where the `(N − 1)`-robot one finished,
 /// leaving the operator-limited bound, lower than the proven `(N − 1)`-robot optimum.
 pub(crate) fn bound_many(problem: &Problem, n_robots: usize, params: &ExactParams) -> MarginFree {
-    let mut below = bound(problem, params).lower_bound_s;
+    bound_many_switch(problem, n_robots, params, 0.0)
+}
+
+/// [`bound_many`] with the switch time `switch_s` (s, ≥ 0): the same maximum over `k = 2…N`
+/// of the bounds with the switch time (a subset of the robots of a schedule that keeps the
+/// switch time keeps it too: any two LC intervals of different robots are at least `switch_s`
+/// apart, whichever robots are kept).
+fn bound_many_switch(
+    problem: &Problem,
+    n_robots: usize,
+    params: &ExactParams,
+    switch_s: f64,
+) -> MarginFree {
+    let mut below = bound_switch(problem, params, switch_s).lower_bound_s;
     for k in 3..n_robots {
-        below = below.max(bound_n(problem, k).lower_bound_s);
+        below = below.max(bound_n_switch(problem, k, switch_s).lower_bound_s);
     }
-    let own = bound_n(problem, n_robots);
+    let own = bound_n_switch(problem, n_robots, switch_s);
     if below > own.lower_bound_s {
         // A proven `N`-robot optimum is never below the `(N − 1)`-robot one but by the
         // rounding of the two searches' sums.

@@ -1,0 +1,98 @@
+//! Benchmark: the operator's switch time `δ` (issue 41) in the scheduler, on the fixture problem
+//! (`fixtures/sanding/problem.csv`, passes 1–3 sanding low-confidence, tick = `Δt_s`), with
+//! against without `δ`, same run: the certificate's bound (`margin_free_bound`: for two robots
+//! the exact search, for four the branch and bound over machine orders) and the validation of
+//! the scheduler's two-robot schedule (`validate_with_switch`: constraints 1–4, the scheduled
+//! switch gaps and the margin check with the switch time). It prints the bounds for
+//! `δ ∈ {0, 0.5, 2, 7}` s and `N = 2, 3, 4` (docs/decisions.md, "The switch time in the
+//! scheduler's bounds (issue 41)"), and the continuous cell's plan with the switch time and
+//! the load cap. `cargo bench -p tandem-schedule --bench switch` re-measures.
+#![allow(
+    clippy::print_stdout,
+    reason = "a bench reports its problem and bounds"
+)]
+#![allow(
+    missing_docs,
+    reason = "criterion_group! generates an undocumented pub fn"
+)]
+
+#[path = "support/fixture.rs"]
+mod fixture;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use tandem_schedule::{
+    CyclicParams, ExactParams, SamplerParams, cyclic_plan, margin_free_bound, sample_schedule,
+    validate_with_switch,
+};
+
+fn bench(c: &mut Criterion) {
+    let (problem, label) = fixture::mid_study_problem();
+    let exact = ExactParams::default();
+    println!("switch on {label}: T_ref = {}", problem.n_ref());
+    for n in [2usize, 3, 4] {
+        for switch_s in [0.0, 0.5, 2.0, 7.0] {
+            let b = margin_free_bound(&problem, n, &exact, switch_s).expect("valid");
+            println!(
+                "  N = {n}, δ = {switch_s} s: bound {:.3} s (proven {}, order {:?})",
+                b.lower_bound_s, b.proven_optimal, b.order
+            );
+        }
+    }
+    // The continuous cell's plan with the switch time and the load cap (the token rule's
+    // hand-overs counted at Δt_s, as the study's cell).
+    for n in [2usize, 3] {
+        for (switch_s, cap) in [(0.0, 1.0), (2.0, 1.0), (0.0, 0.7), (2.0, 0.7)] {
+            let params = CyclicParams {
+                handover_tick_s: Some(problem.dt_s()),
+                switch_s,
+                max_busy_share: cap,
+                ..CyclicParams::default()
+            };
+            let plan = cyclic_plan(&problem, n, &params).expect("valid");
+            println!(
+                "  cyclic N = {n}, δ = {switch_s} s, u_max = {cap}: period {:.3} s, {:.2} \
+                 tasks/h, bound {:.3} s (gap {:.2} %), supervised share {:.3}",
+                plan.period_s,
+                plan.tasks_per_hour,
+                plan.lower_bound_s,
+                100.0 * plan.gap,
+                plan.operator_share
+            );
+        }
+    }
+    let scheduler = SamplerParams {
+        samples: 5000,
+        seed: 1,
+        ..SamplerParams::default()
+    };
+    let out = sample_schedule(&problem, &scheduler, None).expect("the fixture problem is valid");
+    for switch_s in [0.0, 0.5, 2.0] {
+        println!(
+            "  the scheduler's schedule ({:.3} s) at δ = {switch_s} s: {:?}",
+            out.t_total_s,
+            validate_with_switch(&problem, &out.schedule, switch_s).map_err(|v| v.to_string())
+        );
+    }
+    let mut g = c.benchmark_group("switch");
+    g.sample_size(20);
+    for n in [2usize, 4] {
+        for switch_s in [0.0, 2.0] {
+            g.bench_with_input(
+                BenchmarkId::new(format!("bound_{n}"), switch_s),
+                &switch_s,
+                |b, &d| b.iter(|| margin_free_bound(&problem, n, &exact, d)),
+            );
+        }
+    }
+    for switch_s in [0.0, 2.0] {
+        g.bench_with_input(
+            BenchmarkId::new("validate_2", switch_s),
+            &switch_s,
+            |b, &d| b.iter(|| validate_with_switch(&problem, &out.schedule, d)),
+        );
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
