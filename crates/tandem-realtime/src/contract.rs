@@ -150,6 +150,11 @@ pub trait Controller {
     /// continuous cell, never.
     fn is_finished(&self) -> bool;
 
+    /// Ticks run since the start or the last reset: the index the next tick will have (a
+    /// [`Fault::tick`] counts in it, so a fault latched in the last tick has `tick + 1 ==
+    /// ticks()`).
+    fn ticks(&self) -> u64;
+
     /// The run of the worst operator sequence the beam search of
     /// [`Adversary::Beam`](crate::adversary::Adversary::Beam) finds from this state, for a
     /// controller that has one (rounds: [`beam_search`](crate::adversary::search::beam_search));
@@ -199,6 +204,7 @@ mod tests {
             assert_eq!(t.ref_time, c.ref_time_now());
             assert_eq!(t.tasks, c.tasks_now());
             assert_eq!(t.waiting, c.waiting_now());
+            assert!(c.ticks() >= 1);
             let now: Vec<_> = (0..c.n_robots())
                 .map(|i| (t.tasks[i], c.clock_s()[i], t.ref_time[i]))
                 .collect();
@@ -231,6 +237,7 @@ mod tests {
             assert_eq!(c.running_now(), [true, false]);
             last.push(drive(c, 200));
             c.reset();
+            assert_eq!(c.ticks(), 0);
             assert_eq!(c.tasks_now(), [0, 0]);
             assert_eq!(c.ref_time_now(), [0.0, 0.0]);
         }

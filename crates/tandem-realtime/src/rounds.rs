@@ -271,6 +271,11 @@ impl Coordinator {
         r.ref_time_in(self.cursors[i].at, self.clock_s[i]) + self.plans.ref0[self.leg[i]] as f64
     }
 
+    /// Ticks run since the start or the last reset ([`Controller::ticks`]).
+    pub fn ticks(&self) -> u64 {
+        self.monitor.ticks()
+    }
+
     /// Whether every robot has finished (with holds: its last leg).
     pub fn is_finished(&self) -> bool {
         (0..self.robots.len()).all(|i| self.finished(i))
@@ -609,6 +614,10 @@ impl Controller for Coordinator {
 
     fn is_finished(&self) -> bool {
         Coordinator::is_finished(self)
+    }
+
+    fn ticks(&self) -> u64 {
+        Coordinator::ticks(self)
     }
 
     fn beam_search(&self, width: u32, max_ticks: u64) -> Option<Result<AdversaryRun>> {

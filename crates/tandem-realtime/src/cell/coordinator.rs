@@ -625,6 +625,10 @@ impl Controller for ContinuousCoordinator {
     fn is_finished(&self) -> bool {
         false
     }
+
+    fn ticks(&self) -> u64 {
+        ContinuousCoordinator::ticks(self)
+    }
 }
 
 /// What [`run_cell`] measured: the one [`AdversaryRun`] of every controller.
