@@ -14,7 +14,10 @@ use std::fmt;
 use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
-use tandem_realtime::{ContinuousCoordinator, Coordinator, Fault, RobotFlags};
+use tandem_realtime::adversary::AdversaryRun;
+use tandem_realtime::{
+    ContinuousCoordinator, Controller, Coordinator, Fault, Operator, PerRobot, RobotFlags, Tick,
+};
 use tandem_schedule::{CheckedCyclicPlan, CheckedSchedule, CyclicParams};
 
 use crate::{Error, Planner, Result};
@@ -178,58 +181,6 @@ impl AnyController {
         }
     }
 
-    /// Robots `N`.
-    #[must_use]
-    pub fn n_robots(&self) -> usize {
-        match self {
-            AnyController::Rounds(c) => c.n_robots(),
-            AnyController::Continuous(c) => c.n_robots(),
-        }
-    }
-
-    /// Real seconds per tick.
-    #[must_use]
-    pub fn tick_s(&self) -> f64 {
-        match self {
-            AnyController::Rounds(c) => c.tick_s(),
-            AnyController::Continuous(c) => c.tick_s(),
-        }
-    }
-
-    /// Which robots are on a low-confidence sample now.
-    #[must_use]
-    pub fn low_conf_now(&self) -> RobotFlags {
-        match self {
-            AnyController::Rounds(c) => c.low_conf_now(),
-            AnyController::Continuous(c) => c.low_conf_now(),
-        }
-    }
-
-    /// The latched fault, if any.
-    #[must_use]
-    pub fn fault(&self) -> Option<Fault> {
-        match self {
-            AnyController::Rounds(c) => c.fault(),
-            AnyController::Continuous(c) => c.fault(),
-        }
-    }
-
-    /// Clears the latched fault.
-    pub fn clear_fault(&mut self) {
-        match self {
-            AnyController::Rounds(c) => c.clear_fault(),
-            AnyController::Continuous(c) => c.clear_fault(),
-        }
-    }
-
-    /// Every robot back at its start, the counters and the fault cleared.
-    pub fn reset(&mut self) {
-        match self {
-            AnyController::Rounds(c) => c.reset(),
-            AnyController::Continuous(c) => c.reset(),
-        }
-    }
-
     /// The rounds coordinator, if it is one.
     #[must_use]
     pub fn as_rounds(&self) -> Option<&Coordinator> {
@@ -246,6 +197,68 @@ impl AnyController {
             AnyController::Rounds(_) => None,
             AnyController::Continuous(c) => Some(c),
         }
+    }
+}
+
+/// Both kinds of cell behind the one run-time contract: every method is the variant's own.
+macro_rules! each {
+    ($self:expr, $c:ident => $e:expr) => {
+        match $self {
+            AnyController::Rounds($c) => $e,
+            AnyController::Continuous($c) => $e,
+        }
+    };
+}
+
+impl Controller for AnyController {
+    fn n_robots(&self) -> usize {
+        each!(self, c => c.n_robots())
+    }
+    fn tick_s(&self) -> f64 {
+        each!(self, c => c.tick_s())
+    }
+    fn tick(&mut self, operator: Operator) -> tandem_realtime::Result<Tick> {
+        each!(self, c => Controller::tick(c, operator))
+    }
+    fn reset(&mut self) {
+        each!(self, c => Controller::reset(c))
+    }
+    fn fault(&self) -> Option<Fault> {
+        each!(self, c => Controller::fault(c))
+    }
+    fn clear_fault(&mut self) {
+        each!(self, c => Controller::clear_fault(c))
+    }
+    fn low_conf_now(&self) -> RobotFlags {
+        each!(self, c => Controller::low_conf_now(c))
+    }
+    fn running_now(&self) -> RobotFlags {
+        each!(self, c => Controller::running_now(c))
+    }
+    fn waiting_now(&self) -> RobotFlags {
+        each!(self, c => Controller::waiting_now(c))
+    }
+    fn ref_time_now(&self) -> PerRobot<f64> {
+        each!(self, c => Controller::ref_time_now(c))
+    }
+    fn tasks_now(&self) -> PerRobot<u64> {
+        each!(self, c => Controller::tasks_now(c))
+    }
+    fn clock_s(&self) -> &[f64] {
+        each!(self, c => Controller::clock_s(c))
+    }
+    fn is_finished(&self) -> bool {
+        each!(self, c => Controller::is_finished(c))
+    }
+    fn ticks(&self) -> u64 {
+        each!(self, c => Controller::ticks(c))
+    }
+    fn beam_search(
+        &self,
+        width: u32,
+        max_ticks: u64,
+    ) -> Option<tandem_realtime::Result<AdversaryRun>> {
+        each!(self, c => Controller::beam_search(c, width, max_ticks))
     }
 }
 

@@ -4,7 +4,7 @@
 
 use tandem_lfd::Demonstration;
 use tandem_planner::{AnyController, Cell, Error, Plan, Planner, PlannerParams};
-use tandem_realtime::Operator;
+use tandem_realtime::{Controller, Operator};
 use tandem_schedule::{CheckedCyclicPlan, CyclicParams, SamplerParams};
 
 /// The crate docs' task: three demonstrations of one channel at 10 ms that agree except over

@@ -71,8 +71,9 @@ pub use choose::{
     sample_schedule_with_baselines,
 };
 pub use cyclic::{
-    CheckedCyclicPlan, CycleRatio, CyclicParams, CyclicPlan, Stretch, cyclic_plan, cyclic_plan_for_order,
-    handover_bound_s, max_cycle_ratio, period_lower_bound_s, period_lower_bound_with_switch_s,
+    CheckedCyclicPlan, CycleRatio, CyclicParams, CyclicPlan, Stretch, cyclic_plan,
+    cyclic_plan_for_order, handover_bound_s, max_cycle_ratio, period_lower_bound_s,
+    period_lower_bound_with_switch_s,
 };
 pub use error::{Error, Result};
 pub use exact::{
