@@ -529,7 +529,7 @@ pub fn run_cell_trial_on(
             iterations.push(iteration);
             progress(Progress {
                 trial,
-                pairs_done: recorded / n,
+                rounds_done: recorded / n,
             });
         }
     }
