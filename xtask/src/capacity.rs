@@ -330,9 +330,7 @@ pub(crate) fn cell_table(rows: &[CellRow]) -> String {
 
 /// Runs `cargo xtask capacity`.
 pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
-    if !(1..=MAX_ROBOTS).contains(&args.max_robots) {
-        bail!("--max-robots must be between 1 and {MAX_ROBOTS}");
-    }
+    tandem::realtime::RobotCount::new(args.max_robots).map_err(|e| anyhow!("--max-robots: {e}"))?;
     let root = workspace_root();
     let (base, path) = read_config(args.config.as_deref())?;
     let inputs = StudyInputs::from_dir(&root.join("fixtures/sanding"))

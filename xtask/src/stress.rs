@@ -275,9 +275,7 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> a
     if executions == 0 {
         bail!("--executions must be ≥ 1");
     }
-    if !(1..=tandem::realtime::MAX_ROBOTS).contains(&n_robots) {
-        bail!("--robots must be in 1..={}", tandem::realtime::MAX_ROBOTS);
-    }
+    tandem::realtime::RobotCount::new(n_robots).map_err(|e| anyhow::anyhow!("--robots: {e}"))?;
     let start = Instant::now();
     let n_problems = (executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS);
     let cases: Vec<Case> = (0..n_problems)
@@ -506,9 +504,7 @@ pub(crate) fn run_continuous(
     if executions == 0 || tasks == 0 {
         bail!("--executions and --tasks must be ≥ 1");
     }
-    if !(1..=tandem::realtime::MAX_ROBOTS).contains(&n_robots) {
-        bail!("--robots must be in 1..={}", tandem::realtime::MAX_ROBOTS);
-    }
+    tandem::realtime::RobotCount::new(n_robots).map_err(|e| anyhow::anyhow!("--robots: {e}"))?;
     let start = Instant::now();
     let n_problems = (executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS);
     let cases: Vec<CellCase> = (0..n_problems)

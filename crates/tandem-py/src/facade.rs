@@ -12,7 +12,9 @@ pub(crate) use tandem::planner::{
     Error as TandemError, ExecutionRecord, Planner, PlannerParams, RecordReport, reschedule_seed,
 };
 pub(crate) use tandem::realtime::continuous::{CellTick, ContinuousCoordinator, Group, Token};
-pub(crate) use tandem::realtime::{Coordinator, Fault, MAX_ROBOTS, Operator, Tick, Timeline};
+pub(crate) use tandem::realtime::{
+    Coordinator, Fault, MAX_ROBOTS, Operator, RobotCount, Tick, Timeline,
+};
 pub(crate) use tandem::schedule::cyclic::{GapPlan, Stretch};
 pub(crate) use tandem::schedule::{
     CheckedSchedule, CyclicParams, CyclicPlan, GlobalTimeline, LcInterval, Outcome, Problem,

@@ -76,6 +76,6 @@ pub use margins::{
     PairSlack, pair_slacks, pair_slacks_with_holds, sufficient_margins,
     sufficient_margins_per_pair, sufficient_margins_with_holds,
 };
-pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};
+pub use robots::{MAX_ROBOTS, PerRobot, RobotCount, RobotFlags};
 pub use strategy::{high_conf_steps, response_step};
 pub use timeline::{LcInterval, Rates, Timeline, clock_end_s, clock_s};
