@@ -1,9 +1,10 @@
 """The simulated study of the paper's §III (Fig. 5), as ``cargo xtask study`` runs it.
 
-A trial starts from the demonstrations, schedules, runs a pair of executions in the simulated
-workcell (:mod:`tandem.sim`), records them (Eq. 21), re-schedules, and so on for
-``executions / 2`` pairs. Iteration ``k`` is the schedule made after ``k`` recorded pairs
-(iteration 0: demonstrations only) with the outcome of running the next pair under it.
+A trial starts from the demonstrations, schedules, runs a round (one execution of each of the
+``N`` robots, a pair in the paper) in the simulated workcell (:mod:`tandem.sim`), records it
+(Eq. 21), re-schedules, and so on for ``executions / N`` rounds. Iteration ``k`` is the schedule
+made after ``k`` recorded rounds (iteration 0: demonstrations only) with the outcome of running
+the next round under it (``"pair"`` in each iteration of ``study.json``, the files' name).
 
 The configuration is the one of ``fixtures/study.toml`` (``tandem::study::StudyConfig``): a
 dict, the path of such a TOML file, or ``None`` for the paper's study (5 trials × 300
@@ -23,6 +24,7 @@ from __future__ import annotations
 
 import functools
 import json
+import warnings
 from os import PathLike, fspath
 from typing import Any, Dict, List, Mapping, Optional, Union
 
@@ -34,7 +36,7 @@ __all__ = ["StudyResult", "TrialResult", "default_config", "run", "run_trial"]
 
 Config = Union[None, Mapping[str, Any], str, PathLike]
 
-_PAIR_FIELDS = (
+_ROUND_FIELDS = (
     "overlap_ticks",
     "operator_idle_share",
     "duration_s",
@@ -74,16 +76,16 @@ class TrialResult:
         trial: the trial index ``k``.
         seed: the trial's seed, derived from ``(config seed, k)``.
         data: the trial as a dict (the ``trials[k]`` entry of ``study.json``).
-        iteration: ``(n_pairs + 1,)`` int: pairs recorded before each schedule.
-        t_total_s: ``(n_pairs + 1,)`` planned ``T_total`` (Eq. 13, s).
-        offset_s: ``(n_pairs + 1,)`` planned offset ``τ`` of robot 2 (s).
-        high_conf_pct: ``(n_pairs + 1,)`` percent of high-confidence reference samples.
+        iteration: ``(n_rounds + 1,)`` int: rounds recorded before each schedule.
+        t_total_s: ``(n_rounds + 1,)`` planned ``T_total`` (Eq. 13, s).
+        offset_s: ``(n_rounds + 1,)`` planned offset ``τ`` of robot 2 (s).
+        high_conf_pct: ``(n_rounds + 1,)`` percent of high-confidence reference samples.
         source: where each schedule came from (``sampled``, ``completed``, ``previous``, ``repaired``,
             ``serial``).
         lc_intervals_s: per iteration, a list of one ``(k_i, 2)`` array per robot: planned
             low-confidence intervals ``[start, end)`` in s of global time.
         overlap_ticks, operator_idle_share, duration_s, supervised_ticks, corrected_ticks:
-            ``(n_pairs,)`` arrays, what running the pair under each schedule gave (the last
+            ``(n_rounds,)`` arrays, what running the round under each schedule gave (the last
             schedule is not run).
     """
 
@@ -101,15 +103,27 @@ class TrialResult:
             [np.array(robot, dtype=np.float64).reshape(-1, 2) for robot in r["lc_intervals_s"]]
             for r in its
         ]
-        pairs = [r["pair"] for r in its if r["pair"] is not None]
-        for name in _PAIR_FIELDS:
+        rounds = [r["pair"] for r in its if r["pair"] is not None]
+        for name in _ROUND_FIELDS:
             dtype = np.float64 if name in ("operator_idle_share", "duration_s") else np.int64
-            setattr(self, name, np.array([p[name] for p in pairs], dtype=dtype))
+            setattr(self, name, np.array([p[name] for p in rounds], dtype=dtype))
+
+    @property
+    def n_rounds(self) -> int:
+        """Rounds run in the trial (one execution of each robot each)."""
+        return len(self.overlap_ticks)
 
     @property
     def n_pairs(self) -> int:
-        """Pairs run in the trial."""
-        return len(self.overlap_ticks)
+        """Deprecated (kept one release): :attr:`n_rounds` under its two-robot name; emits a
+        ``DeprecationWarning``."""
+        warnings.warn(
+            "TrialResult.n_pairs is deprecated: use TrialResult.n_rounds (a round is one "
+            "execution of each robot)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return self.n_rounds
 
     def to_dict(self) -> dict:
         """The trial as a dict (JSON-compatible)."""
@@ -117,7 +131,7 @@ class TrialResult:
 
     def to_pandas(self) -> Any:
         """One row per iteration (``iteration``, ``t_total_s``, ``offset_s``,
-        ``high_conf_pct``, ``source`` and the pair columns, NaN for the last iteration).
+        ``high_conf_pct``, ``source`` and the round columns, NaN for the last iteration).
         Needs pandas."""
         pd = _pandas()
         frame = pd.DataFrame(
@@ -130,14 +144,14 @@ class TrialResult:
                 "source": self.source,
             }
         )
-        for name in _PAIR_FIELDS:
+        for name in _ROUND_FIELDS:
             values = getattr(self, name).astype(np.float64)
             frame[name] = np.append(values, np.nan)
         return frame
 
     def __repr__(self) -> str:
         return (
-            f"TrialResult(trial={self.trial}, pairs={self.n_pairs}, "
+            f"TrialResult(trial={self.trial}, rounds={self.n_rounds}, "
             f"t_total_s {self.t_total_s[0]:.1f} -> {self.t_total_s[-1]:.1f})"
         )
 
@@ -153,11 +167,11 @@ class StudyResult:
         summary: per iteration across trials (Fig. 5): ``iteration``, ``t_total_mean_s``,
             ``t_total_std_s`` (sample standard deviation, 0 for one trial),
             ``high_conf_pct_mean``, ``high_conf_pct_std``, ``overlap_ticks``; arrays of
-            shape ``(n_pairs + 1,)``.
+            shape ``(n_rounds + 1,)``.
         phase_times: wall time (s) per phase summed over trials: ``alignment_s``,
             ``model_update_s``, ``confidence_s``, ``scheduling_s``, ``simulation_s``.
         ground_truth_pct: percent of reference samples that never need the operator.
-        t_total_s, high_conf_pct, offset_s: ``(n_trials, n_pairs + 1)`` arrays.
+        t_total_s, high_conf_pct, offset_s: ``(n_trials, n_rounds + 1)`` arrays.
     """
 
     def __init__(
@@ -183,7 +197,7 @@ class StudyResult:
 
     @property
     def total_overlap_ticks(self) -> int:
-        """Ticks with two robots low-confidence over every pair of every trial (must be 0)."""
+        """Ticks with two robots low-confidence over every round of every trial (must be 0)."""
         return int(sum(int(t.overlap_ticks.sum()) for t in self.trials))
 
     def to_dict(self) -> dict:

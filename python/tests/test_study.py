@@ -21,7 +21,9 @@ def test_result_arrays_have_the_documented_shapes(study: tandem.study.StudyResul
     assert study.t_total_s.shape == study.high_conf_pct.shape == (2, 4)
     for t in study.trials:
         assert t.iteration.tolist() == [0, 1, 2, 3]
-        assert t.n_pairs == 3 and t.overlap_ticks.shape == (3,)
+        assert t.n_rounds == 3 and t.overlap_ticks.shape == (3,)
+        with pytest.warns(DeprecationWarning, match="n_rounds"):
+            assert t.n_pairs == 3
         assert len(t.lc_intervals_s) == 4 and all(len(i) == 2 for i in t.lc_intervals_s)
         assert all(s in ("sampled", "completed", "previous", "repaired", "serial", "held", "staggered") for s in t.source)
         assert ((0 <= t.operator_idle_share) & (t.operator_idle_share <= 1)).all()

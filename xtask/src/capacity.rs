@@ -189,10 +189,10 @@ pub(crate) fn row(result: &StudyResult, wall_s: f64) -> anyhow::Result<CapacityR
     fn end_rounds(
         t: &tandem::sim::study::TrialResult,
         skip: usize,
-    ) -> impl Iterator<Item = &tandem::sim::study::PairStats> {
+    ) -> impl Iterator<Item = &tandem::sim::study::RoundStats> {
         t.iterations
             .iter()
-            .filter_map(|r| r.pair.as_ref())
+            .filter_map(|r| r.round.as_ref())
             .skip(skip)
     }
     let end_rounds = |t| end_rounds(t, rounds - last);
@@ -330,9 +330,7 @@ pub(crate) fn cell_table(rows: &[CellRow]) -> String {
 
 /// Runs `cargo xtask capacity`.
 pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
-    if !(1..=MAX_ROBOTS).contains(&args.max_robots) {
-        bail!("--max-robots must be between 1 and {MAX_ROBOTS}");
-    }
+    tandem::realtime::RobotCount::new(args.max_robots).map_err(|e| anyhow!("--max-robots: {e}"))?;
     let root = workspace_root();
     let (base, path) = read_config(args.config.as_deref())?;
     let inputs = StudyInputs::from_dir(&root.join("fixtures/sanding"))
@@ -821,7 +819,7 @@ mod tests {
     #[test]
     fn the_row_takes_the_final_schedule_and_the_last_tenth_of_the_rounds() {
         use tandem::sim::study::{
-            IterationRecord, PairStats, ScheduleSource, StudyConfig, StudyResult, TrialResult,
+            IterationRecord, RoundStats, ScheduleSource, StudyConfig, StudyResult, TrialResult,
         };
         // Three robots, 30 executions: 10 rounds, the last 10 % is round 9 alone. Round k
         // keeps the operator busy k/10 of the time and supervises 300·k ticks (10 ms) over the
@@ -833,7 +831,7 @@ mod tests {
             high_conf_pct: 60.0,
             source: ScheduleSource::Sampled,
             lc_intervals_s: vec![vec![]; 3],
-            pair: (k < 10).then(|| PairStats {
+            round: (k < 10).then(|| RoundStats {
                 overlap_ticks: 0,
                 operator_idle_share: 1.0 - k as f64 / 10.0,
                 duration_s: t_total_s,

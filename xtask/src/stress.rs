@@ -23,7 +23,7 @@
 //! `sufficient_margins`' acceptance (`testkit::tight_starts`).
 //!
 //! With `--holds` every problem gets hold points in the middle of each high-confidence run of
-//! at least three samples (`hold_points`): the scheduler plans with them (release rules on its
+//! at least three samples (`tandem_schedule::testkit::hold_points`): the scheduler plans with them (release rules on its
 //! candidates, the exact optimum with dwells for two robots), and per-robot plans get
 //! interleaved random starts with release rules (`tandem::realtime::holds::release_rules`)
 //! accepted by `sufficient_margins_with_holds` (20 draws, else the tight schedule without holds).
@@ -53,6 +53,7 @@ use tandem::realtime::{Coordinator, Timeline, sufficient_margins, sufficient_mar
 use tandem::schedule::{
     CyclicParams, Problem, SamplerParams, Source, cyclic_plan, sample_schedule_n,
 };
+use tandem_schedule::testkit::hold_points;
 
 /// Executions per scheduled problem (the number of problems is `N / this`, at least 1 and at
 /// most [`MAX_PROBLEMS`]).
@@ -86,47 +87,14 @@ struct Case {
     made: Made,
 }
 
-/// A random problem: 200–400 samples, confidence in runs (LC runs 5–60 samples, HC runs 5–80),
-/// a smooth random mean gradient and random per-run bound factors.
+/// A random problem of 200–400 samples ([`tandem_schedule::testkit::random_problem`], the
+/// generator of the property tests).
 fn random_problem(rng: &mut ChaCha8Rng) -> anyhow::Result<Problem> {
-    let n_ref = rng.random_range(200..=400);
-    let (mut conf, mut mean, mut min, mut max) = (vec![], vec![], vec![], vec![]);
-    let mut hc = rng.random_bool(0.5);
-    let (freq, phase) = (rng.random_range(0.01..0.2), rng.random_range(0.0..6.3));
-    while conf.len() < n_ref {
-        let len = if hc {
-            rng.random_range(5..=80)
-        } else {
-            rng.random_range(5..=60)
-        };
-        let lo = rng.random_range(0.3..1.0);
-        let hi = rng.random_range(1.0..2.5);
-        for _ in 0..len.min(n_ref - conf.len()) {
-            let m = 1.0 + 0.5 * (freq * conf.len() as f64 + phase).sin();
-            conf.push(hc);
-            mean.push(m);
-            min.push(lo * m);
-            max.push(hi * m);
-        }
-        hc = !hc;
-    }
-    Ok(Problem::new(conf, mean, min, max, DT_S)?)
-}
-
-/// Hold points of a plan of confidence `conf`: the middle sample of every high-confidence run
-/// of at least three samples.
-fn hold_points(conf: &[bool]) -> Vec<usize> {
-    let mut out = Vec::new();
-    let mut start = 0;
-    for n in 1..=conf.len() {
-        if n == conf.len() || conf[n] != conf[start] {
-            if conf[start] && n - start >= 3 {
-                out.push((start + n) / 2);
-            }
-            start = n;
-        }
-    }
-    out
+    Ok(tandem_schedule::testkit::random_problem(
+        rng,
+        200..=400,
+        DT_S,
+    )?)
 }
 
 /// `problem` with hold points ([`hold_points`]) when `holds`.
@@ -275,9 +243,7 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> a
     if executions == 0 {
         bail!("--executions must be ≥ 1");
     }
-    if !(1..=tandem::realtime::MAX_ROBOTS).contains(&n_robots) {
-        bail!("--robots must be in 1..={}", tandem::realtime::MAX_ROBOTS);
-    }
+    tandem::realtime::RobotCount::new(n_robots).map_err(|e| anyhow::anyhow!("--robots: {e}"))?;
     let start = Instant::now();
     let n_problems = (executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS);
     let cases: Vec<Case> = (0..n_problems)
@@ -506,9 +472,7 @@ pub(crate) fn run_continuous(
     if executions == 0 || tasks == 0 {
         bail!("--executions and --tasks must be ≥ 1");
     }
-    if !(1..=tandem::realtime::MAX_ROBOTS).contains(&n_robots) {
-        bail!("--robots must be in 1..={}", tandem::realtime::MAX_ROBOTS);
-    }
+    tandem::realtime::RobotCount::new(n_robots).map_err(|e| anyhow::anyhow!("--robots: {e}"))?;
     let start = Instant::now();
     let n_problems = (executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS);
     let cases: Vec<CellCase> = (0..n_problems)

@@ -315,7 +315,7 @@ impl TrialBar {
     /// One step of a trial (the study's progress callback; called from worker threads).
     pub(crate) fn step(&self, p: tandem::sim::study::Progress) {
         self.bar.inc(1);
-        if p.pairs_done == self.steps_per_trial {
+        if p.rounds_done == self.steps_per_trial {
             let done = self.trials_done.fetch_add(1, Ordering::Relaxed) + 1;
             self.bar
                 .set_message(format!("{done}/{} trials done", self.trials));

@@ -225,11 +225,10 @@ fn fit(a: &FitArgs) -> Result<()> {
     {
         bail!("--dt {dt}: the sample period must be finite and > 0 seconds");
     }
-    let max = tandem::realtime::MAX_ROBOTS;
     if let Some(r) = a.robots
-        && !(1..=max).contains(&r)
+        && let Err(e) = tandem::realtime::RobotCount::new(r)
     {
-        bail!("--robots {r}: one operator runs 1 to {max} robots");
+        bail!("--robots {r}: {e}");
     }
     state_io::check_file_target(&a.output)?;
     // Recorded rounds are never discarded without consent; decided before any work.

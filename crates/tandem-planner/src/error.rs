@@ -133,15 +133,6 @@ pub enum Error {
         /// What is wrong.
         why: String,
     },
-    /// A robot count outside `1..=MAX_ROBOTS` (one operator supervises at most
-    /// [`tandem_realtime::MAX_ROBOTS`] robots).
-    #[error("{n_robots} robots: a planner schedules 1 to {max} robots for its one operator")]
-    RobotCount {
-        /// The robot count asked for.
-        n_robots: usize,
-        /// [`tandem_realtime::MAX_ROBOTS`].
-        max: usize,
-    },
     /// A hold point declared inside a low-confidence stretch that the recorded corrections
     /// show needs the operator (`LowCause::Corrections`).
     #[error(

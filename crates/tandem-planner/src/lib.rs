@@ -3,8 +3,9 @@
 //! A [`Planner`] holds what the system has learned so far: the task model fitted on the
 //! expert demonstrations (`tandem_lfd`, §II-B1/2), the operator's correction observations
 //! and the latched confidence (`tandem_confidence`, Eq. 8–12), the scheduling problem and the
-//! current schedule (`tandem_schedule`, §II-B4/6, §II-C). After every pair of executions,
-//! [`Planner::record_pair`] adds both executions to the model with their known
+//! current schedule (`tandem_schedule`, §II-B4/6, §II-C). After every round (one execution of
+//! each of the `N` robots, two in the paper), [`Planner::record_round`] adds the round's
+//! executions to the model with their known
 //! reference-time logs (Eq. 21), adds their supervised samples to the observations, updates
 //! the confidence and re-schedules, warm-started by the previous schedule. The robots run the
 //! schedule through [`Planner::coordinator`] (`tandem_realtime`, Eq. 17–18, Alg. 1/2), at the
@@ -35,7 +36,7 @@
 //! let low = planner.confidence().conf().iter().filter(|c| !**c).count();
 //! assert!(low >= 10);
 //!
-//! // A pair of executions that replay the reference demonstration, supervised on the
+//! // A round of two executions that replay the reference demonstration, supervised on the
 //! // low-confidence samples, never corrected: the operator was not needed there.
 //! let record = ExecutionRecord {
 //!     execution: Execution {

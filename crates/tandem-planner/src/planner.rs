@@ -431,14 +431,14 @@ fn problem_for(model: &TaskModel, confidence: &Confidence, holds: &HoldSpec) -> 
     Ok(problem.with_holds(crate::holds::resolve(holds, model)?)?)
 }
 
-/// [`Error::RobotCount`] unless `1 ≤ n_robots ≤ MAX_ROBOTS`.
+/// [`tandem_realtime::RobotCount::new`], the one check of a robot count: `1 ≤ n_robots ≤
+/// MAX_ROBOTS`.
+///
+/// # Errors
+/// [`Error::Realtime`] with `tandem_realtime::Error::RobotCount` otherwise.
 fn check_robot_count(n_robots: usize) -> Result<()> {
-    let max = tandem_realtime::MAX_ROBOTS;
-    if (1..=max).contains(&n_robots) {
-        Ok(())
-    } else {
-        Err(Error::RobotCount { n_robots, max })
-    }
+    tandem_realtime::RobotCount::new(n_robots)?;
+    Ok(())
 }
 
 impl Planner {
@@ -459,7 +459,8 @@ impl Planner {
     /// paper's `N = 2`. The state file stores `N` (as the schedule's robot count).
     ///
     /// # Errors
-    /// [`Error::RobotCount`] for `n_robots` outside `1..=MAX_ROBOTS`, and as [`Planner::new`].
+    /// [`Error::Realtime`] (`RobotCount`) for `n_robots` outside `1..=MAX_ROBOTS`, and as
+    /// [`Planner::new`].
     pub fn with_robots(
         demos: &[Demonstration],
         params: PlannerParams,
@@ -488,7 +489,7 @@ impl Planner {
     /// As [`Planner::from_model`] for `n_robots` robots (see [`Planner::with_robots`]).
     ///
     /// # Errors
-    /// [`Error::RobotCount`], and as [`Planner::from_model`].
+    /// [`Error::Realtime`] (`RobotCount`), and as [`Planner::from_model`].
     pub fn from_model_with_robots(
         model: TaskModel,
         params: PlannerParams,
@@ -1264,7 +1265,11 @@ mod tests {
             let err = Planner::from_model_with_robots(p.model().clone(), p.params().clone(), n)
                 .unwrap_err();
             assert!(
-                matches!(err, Error::RobotCount { n_robots, max: 8 } if n_robots == n),
+                matches!(
+                    err,
+                    Error::Realtime(tandem_realtime::Error::RobotCount { n: count, max: 8 })
+                        if count == n
+                ),
                 "{err}"
             );
             assert!(err.to_string().contains("1 to 8 robots"), "{err}");

@@ -297,6 +297,8 @@ fn classify_confidence(e: &errors::Confidence) -> Kind {
 fn classify_realtime(e: &errors::Realtime) -> Kind {
     match e {
         errors::Realtime::BadOperator { .. } => input_at(None),
+        // The planner's and the simulator's robot counts are the argument `robots`.
+        errors::Realtime::RobotCount { .. } => param("robots"),
         errors::Realtime::BadParam { name, .. } => param(name),
         _ => SCHEDULE,
     }
@@ -309,6 +311,8 @@ fn classify_schedule(e: &errors::Schedule) -> Kind {
         | errors::Schedule::LengthMismatch { .. }
         | errors::Schedule::NonFinite { .. }
         | errors::Schedule::BadBounds { .. } => input_at(None),
+        // The scheduling functions (e.g. `cyclic_plan`) take the robot count as `n_robots`.
+        errors::Schedule::Realtime(errors::Realtime::RobotCount { .. }) => param("n_robots"),
         errors::Schedule::Realtime(r) => classify_realtime(r),
         errors::Schedule::Invalid(v) => Kind::Schedule {
             violation: Some(violation_name(v)),
@@ -361,7 +365,6 @@ fn classify_facade(e: &Facade) -> Kind {
             }
         }
         Facade::BadExecution { .. } | Facade::DuplicateRound { .. } => input_at(None),
-        Facade::RobotCount { .. } => param("robots"),
         Facade::UnknownCell { .. } => param("cell"),
         Facade::HoldInLowConfidence { .. } | Facade::HoldMatchesNothing { .. } => param("holds"),
         Facade::Lfd(l) => classify_lfd(l),

@@ -12,7 +12,7 @@ use rand_chacha::ChaCha8Rng;
 use crate::arrays::{flag_matrix, out_flags, out_matrix, out_vector};
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
-    MAX_ROBOTS, NeedProfile, NeedRegion, OperatorParams, RoundRun, TaskParams, Workpiece,
+    NeedProfile, NeedRegion, OperatorParams, RobotCount, RoundRun, TaskParams, Workpiece,
     correction_input, needs_correction, read_labels, run_round_with,
 };
 use crate::params::from_py;
@@ -103,9 +103,7 @@ pub(crate) fn sim_sanding_needs<'py>(
     robots: usize,
 ) -> PyResult<Bound<'py, PyArray2<bool>>> {
     let params: TaskParams = from_py(task, "task")?;
-    if !(1..=MAX_ROBOTS).contains(&robots) {
-        return Err(Error::param("robots", format!("{robots}: must be 1 to {MAX_ROBOTS}")).into());
-    }
+    RobotCount::new(robots).map_err(|e| Error::param("robots", e.to_string()))?;
     let flat = guard(|| {
         params.validate()?;
         let labels = read_labels(&labels)?;
@@ -140,9 +138,7 @@ pub(crate) fn sim_needs<'py>(
     levels: Option<Vec<f64>>,
     need_file: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyArray2<bool>>> {
-    if !(1..=MAX_ROBOTS).contains(&robots) {
-        return Err(Error::param("robots", format!("{robots}: must be 1 to {MAX_ROBOTS}")).into());
-    }
+    RobotCount::new(robots).map_err(|e| Error::param("robots", e.to_string()))?;
     let given = usize::from(regions.is_some())
         + usize::from(levels.is_some())
         + usize::from(need_file.is_some());

@@ -42,10 +42,11 @@ pub enum Error {
         /// The gradient given (execution samples per reference sample).
         gradient: f64,
     },
-    /// The number of robots is not in `1..=MAX_ROBOTS`.
-    #[error("{n} robots: a coordinator and the margin check take 1 to {max} robots")]
+    /// The number of robots is not in `1..=MAX_ROBOTS` ([`RobotCount::new`](crate::RobotCount::new),
+    /// the one check of a robot count in the workspace).
+    #[error("{n} robots: one operator supervises 1 to {max} robots")]
     RobotCount {
-        /// Number of timelines given.
+        /// The robot count given.
         n: usize,
         /// The largest count, [`MAX_ROBOTS`](crate::MAX_ROBOTS).
         max: usize,

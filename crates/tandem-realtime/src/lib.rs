@@ -93,7 +93,7 @@ pub use margins::{
     sufficient_margins, sufficient_margins_per_pair, sufficient_margins_with_holds, switch_ticks,
 };
 pub use monitor::Fault;
-pub use robots::{MAX_ROBOTS, PerRobot, RobotFlags};
+pub use robots::{MAX_ROBOTS, PerRobot, RobotCount, RobotFlags};
 pub use rounds::Coordinator;
 pub use strategy::{high_conf_steps, response_step};
 pub use timeline::{LcInterval, Rates, Timeline, clock_end_s, clock_s};

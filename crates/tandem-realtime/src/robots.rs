@@ -12,16 +12,63 @@ use crate::error::{Error, Result};
 /// arrays of this size).
 pub const MAX_ROBOTS: usize = 8;
 
-/// Checks a robot count: `1 ≤ n ≤ MAX_ROBOTS`.
+/// A checked robot count `N`, `1 ≤ N ≤` [`MAX_ROBOTS`]: the one place the workspace checks
+/// how many robots one operator may supervise, and the one error it gives
+/// ([`Error::RobotCount`]). The schedule, the cyclic plan, the planner and the front ends
+/// convert a count they are given into it where it enters (their own errors wrap this one),
+/// so the rule and its message live here only.
+///
+/// ```
+/// use tandem_realtime::{Error, MAX_ROBOTS, RobotCount};
+/// assert_eq!(RobotCount::new(3)?.get(), 3);
+/// assert!(matches!(RobotCount::new(0), Err(Error::RobotCount { n: 0, .. })));
+/// let err = RobotCount::new(MAX_ROBOTS + 1).unwrap_err();
+/// assert_eq!(err.to_string(), "9 robots: one operator supervises 1 to 8 robots");
+/// # Ok::<(), Error>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct RobotCount(u8);
+
+impl RobotCount {
+    /// The count `n` once checked.
+    ///
+    /// # Errors
+    /// [`Error::RobotCount`] with `n` unless `1 ≤ n ≤ MAX_ROBOTS`.
+    pub fn new(n: usize) -> Result<Self> {
+        if (1..=MAX_ROBOTS).contains(&n) {
+            Ok(RobotCount(n as u8))
+        } else {
+            Err(Error::RobotCount { n, max: MAX_ROBOTS })
+        }
+    }
+
+    /// The number of robots, in `1..=MAX_ROBOTS`.
+    #[must_use]
+    pub const fn get(self) -> usize {
+        self.0 as usize
+    }
+}
+
+impl TryFrom<usize> for RobotCount {
+    type Error = Error;
+
+    fn try_from(n: usize) -> Result<Self> {
+        RobotCount::new(n)
+    }
+}
+
+impl From<RobotCount> for usize {
+    fn from(n: RobotCount) -> usize {
+        n.get()
+    }
+}
+
+/// Checks a robot count ([`RobotCount::new`], the count dropped).
 ///
 /// # Errors
 /// [`Error::RobotCount`] with the count.
 pub(crate) fn check_count(n: usize) -> Result<()> {
-    if (1..=MAX_ROBOTS).contains(&n) {
-        Ok(())
-    } else {
-        Err(Error::RobotCount { n, max: MAX_ROBOTS })
-    }
+    RobotCount::new(n).map(drop)
 }
 
 /// One value per robot (robot `i` at index `i`), for the `n ≤ MAX_ROBOTS` robots of one
@@ -228,5 +275,24 @@ mod tests {
         assert_ne!(f, [false, false, true, false]);
         assert_eq!(RobotFlags::new(2).first(), None);
         assert!(check_count(1).is_ok() && check_count(MAX_ROBOTS).is_ok());
+    }
+
+    #[test]
+    fn a_robot_count_is_checked_once_and_reads_back() {
+        for n in 1..=MAX_ROBOTS {
+            let count = RobotCount::new(n).unwrap();
+            assert_eq!((count.get(), usize::from(count)), (n, n));
+            assert_eq!(RobotCount::try_from(n), Ok(count));
+        }
+        for n in [0, MAX_ROBOTS + 1, usize::MAX] {
+            assert_eq!(
+                RobotCount::new(n),
+                Err(Error::RobotCount { n, max: MAX_ROBOTS })
+            );
+        }
+        assert_eq!(
+            RobotCount::new(0).unwrap_err().to_string(),
+            "0 robots: one operator supervises 1 to 8 robots"
+        );
     }
 }

@@ -494,7 +494,7 @@ pub fn sample_schedule(
 /// Deterministic for a seed whatever the thread count.
 ///
 /// # Errors
-/// As [`sample_schedule`]; [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS`.
+/// As [`sample_schedule`]; [`Error::Realtime`] (`RobotCount`) for `n_robots` outside `1..=MAX_ROBOTS`.
 pub fn sample_schedule_n(
     problem: &Problem,
     n_robots: usize,

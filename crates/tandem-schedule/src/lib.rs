@@ -63,6 +63,8 @@ mod retime;
 mod sampler;
 mod schedule;
 mod stagger;
+#[cfg(feature = "testkit")]
+pub mod testkit;
 mod validate;
 
 pub use checked::CheckedSchedule;

@@ -269,8 +269,8 @@ impl Problem {
     /// possible, since each robot starts only once the one before it has finished.
     ///
     /// # Errors
-    /// [`Error::BadParam`] for a `tick_s` that is not finite and > 0, or `n_robots` not in
-    /// `1..=MAX_ROBOTS`.
+    /// [`Error::BadParam`] for a `tick_s` that is not finite and > 0; [`Error::Realtime`]
+    /// (`RobotCount`) for `n_robots` not in `1..=MAX_ROBOTS`.
     pub fn serial_schedule_n(&self, n_robots: usize, tick_s: f64) -> Result<Schedule> {
         if !(tick_s.is_finite() && tick_s > 0.0) {
             return Err(Error::BadParam {
@@ -304,19 +304,14 @@ impl Problem {
     }
 }
 
-/// Checks a robot count `N`: `1 ≤ N ≤ MAX_ROBOTS` (`tandem_realtime::MAX_ROBOTS`).
+/// Checks a robot count `N` where it enters the crate: [`tandem_realtime::RobotCount::new`],
+/// the one check and the one error of a robot count (`1 ≤ N ≤ MAX_ROBOTS`).
 ///
 /// # Errors
-/// [`Error::BadParam`] naming `n_robots`.
+/// [`Error::Realtime`] with `tandem_realtime::Error::RobotCount`.
 pub(crate) fn check_robot_count(n_robots: usize) -> Result<()> {
-    if (1..=tandem_realtime::MAX_ROBOTS).contains(&n_robots) {
-        Ok(())
-    } else {
-        Err(Error::BadParam {
-            name: "n_robots",
-            why: "must be in 1..=8 (tandem_realtime::MAX_ROBOTS)",
-        })
-    }
+    tandem_realtime::RobotCount::new(n_robots)?;
+    Ok(())
 }
 
 /// Unit-test problem shared by this crate's modules: confidence `conf` (`true` = high), every
@@ -426,10 +421,7 @@ mod tests {
         for bad in [0, tandem_realtime::MAX_ROBOTS + 1] {
             assert!(matches!(
                 ok().serial_schedule_n(bad, 0.01),
-                Err(Error::BadParam {
-                    name: "n_robots",
-                    ..
-                })
+                Err(Error::Realtime(tandem_realtime::Error::RobotCount { n, .. })) if n == bad
             ));
         }
     }

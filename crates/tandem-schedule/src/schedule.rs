@@ -5,13 +5,13 @@
 //! intervals agree to the last bit with what the margin check and the coordinator use.
 
 use serde::{Deserialize, Serialize};
-use tandem_realtime::{Hold, LcInterval, MAX_ROBOTS, Timeline, clock_end_s, holds, tol};
+use tandem_realtime::{Hold, LcInterval, Timeline, clock_end_s, holds, tol};
 
 use crate::problem::Problem;
 use crate::validate::Violation;
 use crate::{Error, Result};
 
-/// A schedule of `N` robots (`1 ≤ N ≤` [`MAX_ROBOTS`]) doing the same task under one
+/// A schedule of `N` robots (`1 ≤ N ≤` [`MAX_ROBOTS`](tandem_realtime::MAX_ROBOTS)) doing the same task under one
 /// operator: one execution warp per robot, the start offsets of robots 2..N (§II-B4; robot 1
 /// starts at 0) and the control tick it was checked with.
 ///
@@ -151,19 +151,14 @@ impl Schedule {
         }
     }
 
-    /// Checks the schedule's shape: `1 ≤ N ≤` [`MAX_ROBOTS`] warps and `N − 1` offsets (the
+    /// Checks the schedule's shape: `1 ≤ N ≤` [`MAX_ROBOTS`](tandem_realtime::MAX_ROBOTS) warps and `N − 1` offsets (the
     /// offsets' range, Eq. 20 constraint 2, and the warps' lengths are [`crate::validate`]'s).
     ///
     /// # Errors
     /// [`Violation::RobotCount`] or [`Violation::OffsetCount`].
     pub fn check_shape(&self) -> std::result::Result<(), Violation> {
         let n = self.n_robots();
-        if !(1..=MAX_ROBOTS).contains(&n) {
-            return Err(Violation::RobotCount {
-                n_robots: n,
-                max: MAX_ROBOTS,
-            });
-        }
+        tandem_realtime::RobotCount::new(n).map_err(Violation::RobotCount)?;
         if self.offsets_s.len() + 1 != n {
             return Err(Violation::OffsetCount {
                 found: self.offsets_s.len(),

@@ -12,14 +12,11 @@ use crate::schedule::{GlobalTimeline, Schedule};
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum Violation {
-    /// The schedule has no robot or more than `MAX_ROBOTS` (`tandem_realtime::MAX_ROBOTS`).
-    #[error("the schedule has {n_robots} robots; 1 to {max} are supported")]
-    RobotCount {
-        /// Number of warps in the schedule.
-        n_robots: usize,
-        /// The largest supported count.
-        max: usize,
-    },
+    /// The schedule has no robot or more than `MAX_ROBOTS` (`tandem_realtime::MAX_ROBOTS`):
+    /// the one robot-count error, `tandem_realtime::Error::RobotCount`, with the number of
+    /// warps in the schedule.
+    #[error("the schedule's warps: {0}")]
+    RobotCount(tandem_realtime::Error),
     /// The schedule does not have one start offset per robot after the first.
     #[error(
         "the schedule has {found} start offsets, expected {expected} (one per robot after the first)"
@@ -554,14 +551,20 @@ mod tests {
         bad.offsets_s.clear();
         assert!(matches!(
             validate(&p, &bad),
-            Err(Violation::RobotCount { n_robots: 0, .. })
+            Err(Violation::RobotCount(tandem_realtime::Error::RobotCount {
+                n: 0,
+                ..
+            }))
         ));
         let mut bad = s.clone();
         bad.grad_exec = vec![bad.grad_exec[0].clone(); 9];
         bad.offsets_s = vec![0.0; 8];
         assert!(matches!(
             validate(&p, &bad),
-            Err(Violation::RobotCount { n_robots: 9, .. })
+            Err(Violation::RobotCount(tandem_realtime::Error::RobotCount {
+                n: 9,
+                ..
+            }))
         ));
         // Robot 3 may start no later than the latest end before it, 3 s (robot 2's end).
         let mut bad = s.clone();

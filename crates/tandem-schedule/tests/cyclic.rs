@@ -340,17 +340,17 @@ fn a_task_without_low_confidence_runs_at_its_fastest() {
     }
     assert!(matches!(
         cyclic_plan(&p, 0, &CyclicParams::default()),
-        Err(Error::BadParam {
-            name: "n_robots",
-            ..
-        })
+        Err(Error::Realtime(tandem_realtime::Error::RobotCount {
+            n: 0,
+            max: 8
+        }))
     ));
     assert!(matches!(
         cyclic_plan(&p, 9, &CyclicParams::default()),
-        Err(Error::BadParam {
-            name: "n_robots",
-            ..
-        })
+        Err(Error::Realtime(tandem_realtime::Error::RobotCount {
+            n: 9,
+            max: 8
+        }))
     ));
 }
 
@@ -436,7 +436,7 @@ fn a_gap_without_hold_forbids_interleaving_and_a_hold_allows_it() {
     }
     assert!(matches!(
         period_lower_bound_s(&held, 9),
-        Err(Error::BadParam { .. })
+        Err(Error::Realtime(tandem_realtime::Error::RobotCount { n: 9, .. }))
     ));
 }
 

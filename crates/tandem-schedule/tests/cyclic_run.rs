@@ -10,13 +10,15 @@
 
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use tandem_realtime::Operator;
 use tandem_realtime::adversary::adversary_set;
 use tandem_realtime::continuous::{ContinuousCoordinator, run_cell};
 use tandem_schedule::cyclic::is_runnable;
-use tandem_schedule::{CyclicParams, Error, Problem, Stretch, cyclic_plan, cyclic_plan_for_order};
+use tandem_schedule::{
+    CyclicParams, Error, Problem, Stretch, cyclic_plan, cyclic_plan_for_order, testkit,
+};
 
 /// Head 600, pass 1280, transition 480, pass 1280, transition 480, pass 1280, tail 600
 /// samples at 10 ms (the bench's sanding-shaped task): high confidence at `ψ̇min = 1`
@@ -270,43 +272,13 @@ const DT_S: f64 = 0.01;
 /// `tandem-sim`'s `plan_is_what_the_cell_does` and `xtask stress`, shorter); with `holds`, a
 /// hold in the middle of every high-confidence run of at least three samples.
 fn random_problem(seed: u64, holds: bool) -> Problem {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let n_ref = rng.random_range(300..=700);
-    let (mut conf, mut mean, mut min, mut max) = (vec![], vec![], vec![], vec![]);
-    let mut hc = rng.random_bool(0.5);
-    let (freq, phase) = (rng.random_range(0.01..0.2), rng.random_range(0.0..6.3));
-    while conf.len() < n_ref {
-        let len = if hc {
-            rng.random_range(5..=80)
-        } else {
-            rng.random_range(5..=60)
-        };
-        let (lo, hi) = (rng.random_range(0.3..1.0), rng.random_range(1.0..2.5));
-        for _ in 0..len.min(n_ref - conf.len()) {
-            let m = 1.0 + 0.5 * (freq * conf.len() as f64 + phase).sin();
-            conf.push(hc);
-            mean.push(m);
-            min.push(lo * m);
-            max.push(hi * m);
-        }
-        hc = !hc;
-    }
-    let mut points = Vec::new();
-    if holds {
-        let mut start = 0;
-        for n in 1..=conf.len() {
-            if n == conf.len() || conf[n] != conf[start] {
-                if conf[start] && n - start >= 3 {
-                    points.push((start + n) / 2);
-                }
-                start = n;
-            }
-        }
-    }
-    Problem::new(conf, mean, min, max, DT_S)
-        .unwrap()
-        .with_holds(points)
-        .unwrap()
+    let p = testkit::random_problem(&mut ChaCha8Rng::seed_from_u64(seed), 300..=700, DT_S).unwrap();
+    let points = if holds {
+        testkit::hold_points(p.conf())
+    } else {
+        Vec::new()
+    };
+    p.with_holds(points).unwrap()
 }
 
 /// Tasks per robot run, and the steady window: each robot's completions from this one on.

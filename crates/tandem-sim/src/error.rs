@@ -46,7 +46,7 @@ pub enum Error {
     NoForceChannel(String),
     /// Workcell: the robots did not finish within the tick budget (a bug or a degenerate
     /// schedule).
-    #[error("the pair did not finish within {ticks} control ticks")]
+    #[error("the round did not finish within {ticks} control ticks")]
     DidNotFinish {
         /// The tick budget.
         ticks: usize,

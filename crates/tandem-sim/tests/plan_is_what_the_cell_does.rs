@@ -12,61 +12,20 @@
 
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use tandem_realtime::Operator;
-use tandem_schedule::{Problem, SamplerParams, sample_schedule_n};
+use tandem_schedule::{SamplerParams, sample_schedule_n, testkit};
 
 /// Reference sample period and control tick (s).
 const DT_S: f64 = 0.01;
 
-/// A random problem: 600–1200 samples (6–12 s), confidence in runs (low 5–60 samples, high 5–80), a
-/// smooth random mean gradient, per-run bound factors (`xtask stress`'s problems).
-fn random_problem(rng: &mut ChaCha8Rng) -> Problem {
-    let n_ref = rng.random_range(600..=1200);
-    let (mut conf, mut mean, mut min, mut max) = (vec![], vec![], vec![], vec![]);
-    let mut hc = rng.random_bool(0.5);
-    let (freq, phase) = (rng.random_range(0.01..0.2), rng.random_range(0.0..6.3));
-    while conf.len() < n_ref {
-        let len = if hc {
-            rng.random_range(5..=80)
-        } else {
-            rng.random_range(5..=60)
-        };
-        let (lo, hi) = (rng.random_range(0.3..1.0), rng.random_range(1.0..2.5));
-        for _ in 0..len.min(n_ref - conf.len()) {
-            let m = 1.0 + 0.5 * (freq * conf.len() as f64 + phase).sin();
-            conf.push(hc);
-            mean.push(m);
-            min.push(lo * m);
-            max.push(hi * m);
-        }
-        hc = !hc;
-    }
-    Problem::new(conf, mean, min, max, DT_S).unwrap()
-}
-
-/// Hold points in the middle of every high-confidence run of at least three samples.
-fn hold_points(conf: &[bool]) -> Vec<usize> {
-    let mut out = Vec::new();
-    let mut start = 0;
-    for n in 1..=conf.len() {
-        if n == conf.len() || conf[n] != conf[start] {
-            if conf[start] && n - start >= 3 {
-                out.push((start + n) / 2);
-            }
-            start = n;
-        }
-    }
-    out
-}
-
 /// The planned and the realized `T_total` (s) of a round under the nominal operator.
 fn planned_and_realized(seed: u64, n_robots: usize, holds: bool) -> (f64, f64, bool) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut problem = random_problem(&mut rng);
+    let mut problem = testkit::random_problem(&mut rng, 600..=1200, DT_S).unwrap();
     if holds {
-        let points = hold_points(problem.conf());
+        let points = testkit::hold_points(problem.conf());
         problem = problem.with_holds(points).unwrap();
     }
     let params = SamplerParams {

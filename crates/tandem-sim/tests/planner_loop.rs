@@ -11,7 +11,7 @@ use tandem_lfd::TaskModel;
 use tandem_planner::{Error, ExecutionRecord, Planner, PlannerParams};
 use tandem_schedule::{SamplerParams, validate};
 use tandem_sim::task::{TaskParams, Workpiece};
-use tandem_sim::workcell::{OperatorParams, correction_input, run_pair};
+use tandem_sim::workcell::{OperatorParams, correction_input, run_round};
 
 use common::fixtures;
 
@@ -38,7 +38,7 @@ fn pair(planner: &Planner, seed: u64) -> [ExecutionRecord; 2] {
         Workpiece::random(&task, &mut rng).unwrap(),
         Workpiece::random(&task, &mut rng).unwrap(),
     ];
-    let run = run_pair(
+    let run = run_round(
         planner,
         &fixtures().0.reference_labels,
         &workpieces,
@@ -184,7 +184,7 @@ fn a_round_replays_exactly_with_the_public_operator_input() {
         Workpiece::random(&task, &mut rng).unwrap(),
     ];
     let operator = OperatorParams::default();
-    let run = run_pair(
+    let run = run_round(
         &planner,
         &fixtures().0.reference_labels,
         &workpieces,

@@ -25,7 +25,7 @@ fn reduced_study_never_overlaps_and_learns() {
     for (k, r) in its.iter().enumerate() {
         assert_eq!(r.iteration, k);
         assert_eq!(
-            r.pair.is_some(),
+            r.round.is_some(),
             k < 30,
             "a pair ran under every schedule but the last"
         );
@@ -64,7 +64,7 @@ fn reduced_study_never_overlaps_and_learns() {
     );
     // Operator idle share is a share; executions are logged.
     for r in &its[..30] {
-        let p = r.pair.as_ref().unwrap();
+        let p = r.round.as_ref().unwrap();
         assert!((0.0..=1.0).contains(&p.operator_idle_share));
         assert!(p.corrected_ticks <= p.supervised_ticks);
         assert!(p.duration_s > 0.0);

@@ -246,7 +246,8 @@ pub(crate) fn check_order(order: &[Stretch], n_robots: usize, m: usize) -> Resul
 /// order `order` (module docs of [`crate::cyclic`]).
 ///
 /// # Errors
-/// [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS` or an order that does not
+/// [`Error::Realtime`] (`RobotCount`) for `n_robots` outside `1..=MAX_ROBOTS`;
+/// [`Error::BadParam`] for an order that does not
 /// list every stretch once with each robot's stretches in task order around the cycle.
 pub fn event_graph(problem: &Problem, n_robots: usize, order: &[Stretch]) -> Result<EventGraph> {
     graph_of_shape(TaskShape::new(problem), n_robots, order, None, 0.0)

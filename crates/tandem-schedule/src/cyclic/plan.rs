@@ -104,7 +104,7 @@ pub struct GapPlan {
 /// they bound plans with more tasks per robot per period as well.
 ///
 /// # Errors
-/// [`crate::Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS`.
+/// [`crate::Error::Realtime`] (`RobotCount`) for `n_robots` outside `1..=MAX_ROBOTS`.
 pub fn period_lower_bound_s(problem: &Problem, n_robots: usize) -> Result<f64> {
     check_robot_count(n_robots)?;
     Ok(bound_of(&TaskShape::new(problem), n_robots))
@@ -208,7 +208,7 @@ pub(crate) fn switch_bound_of(shape: &TaskShape, n_robots: usize, switch_s: f64)
 /// And `P ≥ D_min` as before.
 ///
 /// # Errors
-/// [`crate::Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS`.
+/// [`crate::Error::Realtime`] (`RobotCount`) for `n_robots` outside `1..=MAX_ROBOTS`.
 pub fn handover_bound_s(problem: &Problem, n_robots: usize, tick_s: f64) -> Result<f64> {
     check_robot_count(n_robots)?;
     Ok(handover_bound_of(

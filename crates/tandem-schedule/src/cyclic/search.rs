@@ -165,7 +165,8 @@ pub fn order_count(n_robots: usize, m: usize) -> u64 {
 /// robot has its own task's order and period `D_min`.
 ///
 /// # Errors
-/// [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS` or bad `params`.
+/// [`Error::Realtime`] (`RobotCount`) for `n_robots` outside `1..=MAX_ROBOTS`;
+/// [`Error::BadParam`] for bad `params`.
 pub fn cyclic_plan(
     problem: &Problem,
     n_robots: usize,

@@ -416,7 +416,7 @@ fn operator_bound_of(chain: &chain::Chain, n_robots: usize, switch_s: f64) -> f6
 /// up to `tol::GRADIENT_REL`, so a valid schedule can be shorter by that relative rounding.)
 ///
 /// # Errors
-/// [`Error::BadParam`] for `n_robots` outside `1..=MAX_ROBOTS`.
+/// [`Error::Realtime`] (`RobotCount`) for `n_robots` outside `1..=MAX_ROBOTS`.
 pub fn operator_bound_s(problem: &Problem, n_robots: usize) -> Result<f64> {
     crate::problem::check_robot_count(n_robots)?;
     Ok(operator_bound_of(

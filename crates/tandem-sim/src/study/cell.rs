@@ -528,7 +528,7 @@ pub fn run_cell_trial_on(
             iterations.push(iteration);
             progress(Progress {
                 trial,
-                pairs_done: recorded / n,
+                rounds_done: recorded / n,
             });
         }
     }

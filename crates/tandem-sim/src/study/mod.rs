@@ -1,10 +1,10 @@
 //! The simulated study of §III (Fig. 5): configuration, per-iteration records, summaries.
 //!
-//! A trial starts from the demonstrations, schedules, runs a pair of executions in the
-//! simulated workcell, records them (Eq. 21), re-schedules, and so on for
-//! `executions / 2` pairs. Iteration `k` is the schedule made after `k` recorded pairs
-//! (iteration 0: demonstrations only) together with the outcome of running the next pair
-//! under it (none for the last iteration).
+//! A trial starts from the demonstrations, schedules, runs a round (one execution of each of
+//! the `N` robots, a pair in the paper) in the simulated workcell, records it (Eq. 21),
+//! re-schedules, and so on for `executions / N` rounds. Iteration `k` is the schedule made
+//! after `k` recorded rounds (iteration 0: demonstrations only) together with the outcome of
+//! running the next round under it ([`RoundStats`]; none for the last iteration).
 
 mod cell;
 mod config;
@@ -19,9 +19,12 @@ pub use cell::{
 pub use config::{Cell, StudyConfig};
 pub use inputs::{StudyInputs, read_labels};
 pub use record::{
-    IterationRecord, IterationSummary, PairStats, ScheduleSource, StudyResult, TrialResult,
+    IterationRecord, IterationSummary, RoundStats, ScheduleSource, StudyResult, TrialResult,
     mean_std, throughput_per_h,
 };
+// The two-robot name of one release ago, deprecated at the crate's public edge only.
+#[expect(deprecated, reason = "re-exported for one release at the public edge")]
+pub use record::PairStats;
 pub use run::{
     PhaseTimes, Progress, RoundView, TrialRun, run_study, run_study_observed, run_trial,
     run_trial_observed, run_trial_on, run_trials, run_trials_observed, trial_seed,

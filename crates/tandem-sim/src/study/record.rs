@@ -10,18 +10,19 @@ use tandem_schedule::Source;
 use super::config::StudyConfig;
 use crate::workcell::PlanGap;
 
-/// What happened when a pair of executions ran under one schedule.
+/// What happened when a round (one execution of each robot) ran under one schedule.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PairStats {
-    /// Control ticks in which both robots traversed a low-confidence sample (must be 0).
+pub struct RoundStats {
+    /// Control ticks in which two or more robots traversed a low-confidence sample (must be 0).
     pub overlap_ticks: usize,
-    /// Share of the pair's duration (ticks) in which no robot was low-confidence, in [0, 1].
+    /// Share of the round's duration (ticks) in which no robot was low-confidence, in [0, 1].
     pub operator_idle_share: f64,
-    /// Actual duration of the pair (s, global time), from the start until both finished.
+    /// Actual duration of the round (s, global time), from the start until every robot
+    /// finished.
     pub duration_s: f64,
-    /// Ticks in which a robot was low-confidence (supervised), both robots together.
+    /// Ticks in which a robot was low-confidence (supervised), all robots together.
     pub supervised_ticks: usize,
-    /// Supervised ticks in which the operator corrected, both robots together.
+    /// Supervised ticks in which the operator corrected, all robots together.
     pub corrected_ticks: usize,
     /// Operator busy share, in [0, 1]: the share of the round's control ticks (from the
     /// first robot's start until the last robot finished) in which at least one robot
@@ -55,6 +56,11 @@ pub struct PairStats {
     pub needed_unsupervised: usize,
 }
 
+/// Deprecated: [`RoundStats`] under its two-robot name. Kept for one release at the crate's
+/// public edge.
+#[deprecated(note = "use `RoundStats` (a round is one execution of each robot)")]
+pub type PairStats = RoundStats;
+
 /// Whether a count is 0 (for `skip_serializing_if`).
 #[expect(
     clippy::trivially_copy_pass_by_ref,
@@ -67,7 +73,7 @@ fn is_zero(n: &usize) -> bool {
 /// One iteration of a trial: a schedule and what running it gave.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct IterationRecord {
-    /// Pairs recorded before this schedule was made (0 = demonstrations only).
+    /// Rounds recorded before this schedule was made (0 = demonstrations only).
     pub iteration: usize,
     /// Planned `T_total` (Eq. 13, s).
     pub t_total_s: f64,
@@ -80,8 +86,10 @@ pub struct IterationRecord {
     /// Planned low-confidence intervals `[start_s, end_s)` of each robot, robot 1 first
     /// (global time, s).
     pub lc_intervals_s: Vec<Vec<[f64; 2]>>,
-    /// The outcome of running the next pair under this schedule (`None` for the last one).
-    pub pair: Option<PairStats>,
+    /// The outcome of running the next round under this schedule (`None` for the last one;
+    /// `pair` in the JSON, the name of the files written so far).
+    #[serde(rename = "pair")]
+    pub round: Option<RoundStats>,
     /// The schedule's certificate ([`tandem_schedule::Outcome::lower_bound_s`]): a lower
     /// bound (s, global time) on the `T_total` of every schedule of Eq. 20 for this
     /// iteration's problem, the margin-free optimum `T*₀` when
@@ -183,7 +191,7 @@ pub struct TrialResult {
     pub trial: usize,
     /// Seed of the trial, derived from `(seed, k)` by [`trial_seed`](super::trial_seed).
     pub seed: u64,
-    /// Iterations `0..=n_pairs`.
+    /// Iterations `0..=n_rounds`: the schedule before each round, and the last one.
     pub iterations: Vec<IterationRecord>,
 }
 
@@ -205,7 +213,7 @@ pub struct StudyResult {
 /// Per-iteration statistics across trials.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct IterationSummary {
-    /// Iteration index (pairs recorded).
+    /// Iteration index (rounds recorded).
     pub iteration: usize,
     /// Mean planned `T_total` across trials (s).
     pub t_total_mean_s: f64,
@@ -227,14 +235,14 @@ pub struct IterationSummary {
     /// [`IterationRecord::throughput_per_h`]).
     pub throughput_mean_per_h: f64,
     /// Mean operator busy share across trials of the round run under this iteration's
-    /// schedule ([`PairStats::operator_busy_share`], in [0, 1]); `None` for the last
+    /// schedule ([`RoundStats::operator_busy_share`], in [0, 1]); `None` for the last
     /// iteration, after which no round runs.
     pub operator_busy_share_mean: Option<f64>,
-    /// Mean across trials of the round's [`PairStats::plan_gap`] (realized against planned
+    /// Mean across trials of the round's [`RoundStats::plan_gap`] (realized against planned
     /// `T_total` and its causes, s); `None` for the last iteration.
     #[serde(default)]
     pub plan_gap_mean: Option<PlanGap>,
-    /// Mean across trials of the round's [`PairStats::needed_unsupervised`]; `None` for the
+    /// Mean across trials of the round's [`RoundStats::needed_unsupervised`]; `None` for the
     /// last iteration.
     #[serde(default)]
     pub needed_unsupervised_mean: Option<f64>,
@@ -263,7 +271,7 @@ impl StudyResult {
                     high_conf_pct_std: hc_std,
                     overlap_ticks: recs
                         .iter()
-                        .filter_map(|r| r.pair.as_ref())
+                        .filter_map(|r| r.round.as_ref())
                         .map(|p| p.overlap_ticks)
                         .sum(),
                     lower_bound_mean_s: mean_std(recs.iter().map(|r| r.lower_bound_s)).0,
@@ -274,20 +282,20 @@ impl StudyResult {
                     operator_busy_share_mean: {
                         let busy: Vec<f64> = recs
                             .iter()
-                            .filter_map(|r| r.pair.as_ref())
+                            .filter_map(|r| r.round.as_ref())
                             .map(|p| p.operator_busy_share)
                             .collect();
                         (!busy.is_empty()).then(|| mean_std(busy.into_iter()).0)
                     },
                     plan_gap_mean: PlanGap::mean(
                         recs.iter()
-                            .filter_map(|r| r.pair.as_ref())
+                            .filter_map(|r| r.round.as_ref())
                             .map(|p| &p.plan_gap),
                     ),
                     needed_unsupervised_mean: {
                         let n: Vec<f64> = recs
                             .iter()
-                            .filter_map(|r| r.pair.as_ref())
+                            .filter_map(|r| r.round.as_ref())
                             .map(|p| p.needed_unsupervised as f64)
                             .collect();
                         (!n.is_empty()).then(|| mean_std(n.into_iter()).0)
@@ -298,28 +306,28 @@ impl StudyResult {
     }
 
     /// The gaps of every round of every trial from iteration `from` on, summed cause by
-    /// cause ([`PairStats::plan_gap`]), and the needed-but-unsupervised samples summed over
+    /// cause ([`RoundStats::plan_gap`]), and the needed-but-unsupervised samples summed over
     /// the same rounds: how optimistic the plans were, and why.
     pub fn plan_gap_total(&self, from: usize) -> (PlanGap, usize) {
-        let pairs: Vec<&PairStats> = self
+        let rounds: Vec<&RoundStats> = self
             .trials
             .iter()
             .flat_map(|t| &t.iterations)
             .filter(|r| r.iteration >= from)
-            .filter_map(|r| r.pair.as_ref())
+            .filter_map(|r| r.round.as_ref())
             .collect();
         (
-            PlanGap::sum(pairs.iter().map(|p| &p.plan_gap)),
-            pairs.iter().map(|p| p.needed_unsupervised).sum(),
+            PlanGap::sum(rounds.iter().map(|p| &p.plan_gap)),
+            rounds.iter().map(|p| p.needed_unsupervised).sum(),
         )
     }
 
-    /// Total overlap ticks over every pair of every trial (must be 0).
+    /// Total overlap ticks over every round of every trial (must be 0).
     pub fn total_overlap_ticks(&self) -> usize {
         self.trials
             .iter()
             .flat_map(|t| &t.iterations)
-            .filter_map(|r| r.pair.as_ref())
+            .filter_map(|r| r.round.as_ref())
             .map(|p| p.overlap_ticks)
             .sum()
     }
@@ -349,7 +357,7 @@ impl StudyResult {
         out.push('\n');
         for t in &self.trials {
             for r in &t.iterations {
-                let pair = match &r.pair {
+                let round = match &r.round {
                     Some(p) => format!(
                         "{},{},{},{},{},{}",
                         p.overlap_ticks,
@@ -371,7 +379,7 @@ impl StudyResult {
                     r.offset_s,
                     r.high_conf_pct,
                     r.source,
-                    pair,
+                    round,
                     r.lower_bound_s,
                     r.bound_is_optimum,
                     r.gap,
@@ -420,7 +428,7 @@ mod tests {
     use super::*;
     use crate::study::trial_seed;
 
-    fn record(iteration: usize, t_total_s: f64, pair: bool) -> IterationRecord {
+    fn record(iteration: usize, t_total_s: f64, round: bool) -> IterationRecord {
         IterationRecord {
             iteration,
             t_total_s,
@@ -428,7 +436,7 @@ mod tests {
             high_conf_pct: 10.0 * iteration as f64,
             source: ScheduleSource::Sampled,
             lc_intervals_s: vec![vec![[0.0, 1.5]], vec![[2.0, 2.25], [3.0, 4.0]]],
-            pair: pair.then_some(PairStats {
+            round: round.then_some(RoundStats {
                 overlap_ticks: 0,
                 operator_idle_share: 0.5,
                 duration_s: t_total_s,

@@ -11,7 +11,7 @@ use tandem_planner::{Planner, derive_seed};
 
 use super::config::StudyConfig;
 use super::inputs::StudyInputs;
-use super::record::{IterationRecord, PairStats, StudyResult, TrialResult, throughput_per_h};
+use super::record::{IterationRecord, RoundStats, StudyResult, TrialResult, throughput_per_h};
 use crate::task::{self, Label};
 use crate::truth::{OperatorTally, SandingTruth, TaskTruth, falsely_trusted_where};
 use crate::workcell::{self, OperatorParams};
@@ -49,16 +49,16 @@ impl PhaseTimes {
     }
 }
 
-/// Progress of a running study, reported after every recorded pair.
+/// Progress of a running study, reported after every recorded round.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Progress {
     /// Trial index.
     pub trial: usize,
-    /// Pairs of this trial recorded so far.
-    pub pairs_done: usize,
+    /// Rounds of this trial recorded so far.
+    pub rounds_done: usize,
 }
 
-/// The record of the planner's current schedule (no pair run yet); `can_need` per reference
+/// The record of the planner's current schedule (no round run yet); `can_need` per reference
 /// sample ([`TaskTruth::can_need`]).
 fn iteration_record(
     planner: &Planner,
@@ -81,7 +81,7 @@ fn iteration_record(
         high_conf_pct: 100.0 * planner.confidence().high_share(),
         source: outcome.source.into(),
         lc_intervals_s,
-        pair: None,
+        round: None,
         lower_bound_s: outcome.lower_bound_s,
         bound_is_optimum: outcome.bound_is_optimum,
         gap: outcome.gap,
@@ -205,11 +205,11 @@ pub fn run_trial_on(
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(1);
     let operator = truth_operator(config, truth);
-    let n_pairs = config.n_rounds();
+    let n_rounds = config.n_rounds();
     let n_robots = planner.n_robots();
-    let mut iterations = Vec::with_capacity(n_pairs + 1);
+    let mut iterations = Vec::with_capacity(n_rounds + 1);
     let mut tally = OperatorTally::default();
-    for pair in 0..n_pairs {
+    for round in 0..n_rounds {
         let mut record = iteration_record(&planner, can_need, &tally)?;
         let needed = (0..n_robots)
             .map(|_| truth.draw(&mut rng))
@@ -217,7 +217,7 @@ pub fn run_trial_on(
         let t = Instant::now();
         let at = |e: Error| Error::InTrial {
             trial,
-            round: pair + 1,
+            round: round + 1,
             source: Box::new(e),
         };
         let run = workcell::run_round_with(
@@ -238,11 +238,11 @@ pub fn run_trial_on(
         };
         observe(RoundView {
             trial,
-            round: pair + 1,
+            round: round + 1,
             planner: &planner,
             run: &run,
         });
-        record.pair = Some(PairStats {
+        record.round = Some(RoundStats {
             overlap_ticks: run.overlap_ticks,
             operator_idle_share: run.operator_idle_share(),
             duration_s: run.duration_s(),
@@ -262,7 +262,7 @@ pub fn run_trial_on(
         times.scheduling += report.scheduling;
         progress(Progress {
             trial,
-            pairs_done: pair + 1,
+            rounds_done: round + 1,
         });
     }
     iterations.push(iteration_record(&planner, can_need, &tally)?);
@@ -344,7 +344,7 @@ pub(super) fn fit_study_model(
 
 /// Runs every trial of a study from a fitted model, in parallel (rayon). Each trial
 /// depends only on `(config.seed, trial)`, so the result is the same for any number of
-/// threads. `progress` is called after every recorded pair, from worker threads.
+/// threads. `progress` is called after every recorded round, from worker threads.
 ///
 /// # Errors
 /// Invalid configuration, labels that do not match the model's reference, or any stage's

@@ -25,13 +25,13 @@
 //!    the time") in episodes of mean length `false_correction_s` (default 0.5 s): a person
 //!    who corrects by mistake holds the joystick for a moment, not for one 10 ms tick.
 //!    Why it matters for the study: drawn per tick, the 1 % leaves hundreds of isolated
-//!    one-sample low-confidence "islands" after 150 pairs (samples whose few observations
+//!    one-sample low-confidence "islands" after 150 rounds (samples whose few observations
 //!    happened to include several false corrections); every island of one robot forbids
 //!    the other robot's low-confidence pass at that moment, so the schedule stays nearly
 //!    serial. Measured on the default study (5 × 300 executions, seed 2023; `cargo xtask
 //!    study`, and with `false_correction_s = 0` in its configuration for per-tick draws):
 //!    per-tick draws leave 92–116 low-confidence runs per robot and schedule after 150
-//!    pairs and end at `T_total` 136.63 ± 1.08 s; 0.5 s episodes leave 3–6 runs and end at
+//!    rounds and end at `T_total` 136.63 ± 1.08 s; 0.5 s episodes leave 3–6 runs and end at
 //!    106.22 ± 11.04 s (serial: 191.81 s). Episodes give each sample about the same 1 %
 //!    chance per execution but make the islands contiguous and far fewer (docs/decisions.md,
 //!    "Unneeded corrections come in 0.5 s episodes", with the figures of earlier commits).
@@ -76,5 +76,8 @@ mod tests;
 
 pub use cell::{CellSim, CellStats, FinishedTask};
 pub use operator::{OperatorParams, correction_input, needs_correction};
-pub use record::{PairRun, PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
-pub use run::{run_pair, run_pair_with, run_round, run_round_with};
+pub use record::{PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
+pub use run::{run_round, run_round_with};
+// The two-robot names of one release ago, deprecated at the crate's public edge only.
+#[expect(deprecated, reason = "re-exported for one release at the public edge")]
+pub use {record::PairRun, run::run_pair, run::run_pair_with};

@@ -151,7 +151,9 @@ pub struct RoundRun {
     pub plan_gap: PlanGap,
 }
 
-/// The two-robot round of the paper: a [`RoundRun`] with two robots ([`run_pair`](super::run_pair)).
+/// Deprecated: [`RoundRun`] under its two-robot name (a round is one execution of each
+/// robot, two in the paper). Kept for one release at the crate's public edge.
+#[deprecated(note = "use `RoundRun` (a round is one execution of each robot)")]
 pub type PairRun = RoundRun;
 
 impl RoundRun {

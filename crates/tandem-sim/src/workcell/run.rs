@@ -8,7 +8,7 @@ use tandem_realtime::{Coordinator, Operator, Timeline, tol};
 use tandem_schedule::{Problem, Schedule};
 
 use super::operator::{Episodes, OperatorParams, local_correction_input, needs_correction};
-use super::record::{PairRun, PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
+use super::record::{PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
 use crate::task::{Label, Workpiece};
 use crate::{Error, Result};
 
@@ -53,18 +53,19 @@ pub fn run_round(
     )
 }
 
-/// [`run_round`] for the paper's two robots: one workpiece per robot of a two-robot
-/// schedule.
+/// Deprecated: [`run_round`] under its two-robot name (one workpiece per robot of a
+/// two-robot schedule). Kept for one release at the crate's public edge.
 ///
 /// # Errors
 /// As [`run_round`] ([`Error::Mismatch`] for a planner with another robot count).
+#[deprecated(note = "use `run_round` (a round is one execution of each robot)")]
 pub fn run_pair(
     planner: &Planner,
     labels: &[Label],
     workpieces: &[Workpiece; 2],
     params: &OperatorParams,
     rng: &mut impl Rng,
-) -> Result<PairRun> {
+) -> Result<RoundRun> {
     run_round(planner, labels, workpieces, params, rng)
 }
 
@@ -96,16 +97,18 @@ pub fn run_round_with(
     )
 }
 
-/// [`run_round_with`] under its two-robot name.
+/// Deprecated: [`run_round_with`] under its two-robot name. Kept for one release at the
+/// crate's public edge.
 ///
 /// # Errors
 /// As [`run_round_with`].
+#[deprecated(note = "use `run_round_with` (a round is one execution of each robot)")]
 pub fn run_pair_with(
     planner: &Planner,
     needs: impl FnMut(usize, usize) -> bool,
     params: &OperatorParams,
     rng: &mut impl Rng,
-) -> Result<PairRun> {
+) -> Result<RoundRun> {
     run_round_with(planner, needs, params, rng)
 }
 

@@ -71,7 +71,7 @@ fn all_painted() -> Workpiece {
 }
 
 /// Whether robot `robot` needs the operator at reference sample `ref_idx` on the
-/// painted labels and workpieces ([`run_pair`]'s rule).
+/// painted labels and workpieces ([`run_round`]'s rule).
 fn painted_needs(robot: usize, ref_idx: usize) -> bool {
     needs_correction(
         &painted_labels()[ref_idx],
@@ -79,9 +79,9 @@ fn painted_needs(robot: usize, ref_idx: usize) -> bool {
     )
 }
 
-/// The serial schedule of the hand-made problem, run with `params`: the pair and its
+/// The serial schedule of the hand-made problem, run with `params`: the round and its
 /// planned `T_total` (s).
-fn run(params: &OperatorParams, seed: u64) -> (PairRun, f64) {
+fn run(params: &OperatorParams, seed: u64) -> (RoundRun, f64) {
     let model = model();
     let problem = problem(&model);
     let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
@@ -194,7 +194,7 @@ fn a_perfect_operator_corrects_every_needed_sample_and_slows_the_robots() {
 }
 
 #[test]
-fn without_corrections_the_pair_runs_on_schedule() {
+fn without_corrections_the_round_runs_on_schedule() {
     let never = OperatorParams {
         miss_rate: 1.0,
         false_correction_rate: 0.0,
@@ -309,7 +309,7 @@ fn painted_needs_n(_robot: usize, ref_idx: usize) -> bool {
 }
 
 #[test]
-fn run_pair_reads_everything_from_the_planner() {
+fn run_round_reads_everything_from_the_planner() {
     let planner = planner();
     let conf = planner.confidence().conf();
     assert!(
@@ -319,12 +319,12 @@ fn run_pair_reads_everything_from_the_planner() {
     let p = OperatorParams::default();
     let (labels, wp) = (painted_labels(), [all_painted(), all_painted()]);
     let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let by_labels = run_pair(&planner, &labels, &wp, &p, &mut rng).unwrap();
+    let by_labels = run_round(&planner, &labels, &wp, &p, &mut rng).unwrap();
     assert_eq!(by_labels.overlap_ticks, 0);
     assert_eq!(by_labels.tick_s, planner.schedule().tick_s);
     // The same as the caller's rule, and as the planner's parts run by hand.
     let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let by_rule = run_pair_with(&planner, painted_needs, &p, &mut rng).unwrap();
+    let by_rule = run_round_with(&planner, painted_needs, &p, &mut rng).unwrap();
     assert_eq!(by_rule, by_labels);
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let by_parts = run_schedule(
@@ -350,8 +350,45 @@ fn run_pair_reads_everything_from_the_planner() {
     assert_eq!(next.model().count(), planner.model().count() + 2);
 }
 
+/// The deprecated two-robot names at the public edge run the very same round.
 #[test]
-fn run_pair_with_asks_the_caller_only_about_supervised_samples() {
+#[expect(
+    deprecated,
+    reason = "the deprecated public-edge names are what is tested"
+)]
+fn the_deprecated_pair_names_run_the_same_round() {
+    let planner = planner();
+    let p = OperatorParams::default();
+    let (labels, wp) = (painted_labels(), [all_painted(), all_painted()]);
+    let round = run_round(
+        &planner,
+        &labels,
+        &wp,
+        &p,
+        &mut ChaCha8Rng::seed_from_u64(7),
+    )
+    .unwrap();
+    let pair: PairRun = run_pair(
+        &planner,
+        &labels,
+        &wp,
+        &p,
+        &mut ChaCha8Rng::seed_from_u64(7),
+    )
+    .unwrap();
+    assert_eq!(pair, round);
+    let with = run_pair_with(
+        &planner,
+        painted_needs,
+        &p,
+        &mut ChaCha8Rng::seed_from_u64(7),
+    )
+    .unwrap();
+    assert_eq!(with, round);
+}
+
+#[test]
+fn run_round_with_asks_the_caller_only_about_supervised_samples() {
     let model = model();
     let problem = problem(&model);
     let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
@@ -411,7 +448,7 @@ fn a_schedule_checked_at_another_tick_is_rejected() {
     let mut rng = ChaCha8Rng::seed_from_u64(0);
     let p = OperatorParams::default();
     let wp = [all_painted(), all_painted()];
-    let err = run_pair(&planner, &painted_labels(), &wp, &p, &mut rng).unwrap_err();
+    let err = run_round(&planner, &painted_labels(), &wp, &p, &mut rng).unwrap_err();
     assert!(
         matches!(
             err,
@@ -424,7 +461,7 @@ fn a_schedule_checked_at_another_tick_is_rejected() {
     );
     let msg = err.to_string();
     assert!(msg.contains("0.005 s") && msg.contains("0.01 s"), "{msg}");
-    let err = run_pair_with(&planner, |_, _| true, &p, &mut rng);
+    let err = run_round_with(&planner, |_, _| true, &p, &mut rng);
     assert!(matches!(err, Err(Error::TickMismatch { .. })));
     // Re-scheduled at the workcell's own tick it runs (`tick_s: None` would keep the
     // schedule's half tick: a re-schedule keeps the tick a user chose).
@@ -433,7 +470,7 @@ fn a_schedule_checked_at_another_tick_is_rejected() {
         ..half
     };
     planner.reschedule(&own).unwrap();
-    assert!(run_pair_with(&planner, |_, _| true, &p, &mut rng).is_ok());
+    assert!(run_round_with(&planner, |_, _| true, &p, &mut rng).is_ok());
 }
 
 #[test]
@@ -441,7 +478,7 @@ fn same_seed_same_run_and_mismatches_are_errors() {
     let p = OperatorParams::default();
     assert_eq!(run(&p, 7).0, run(&p, 7).0);
     let mut rng = ChaCha8Rng::seed_from_u64(0);
-    let err = run_pair(
+    let err = run_round(
         &planner(),
         &painted_labels()[..5],
         &[all_painted(), all_painted()],

@@ -231,7 +231,7 @@ pub fn run_rounds(
     let (max_increase_s, max_increase_at) = max_increase(&t_total_s);
     let ran: Vec<(f64, f64)> = its
         .iter()
-        .filter_map(|i| i.pair.as_ref().map(|p| (i.t_total_s, p.duration_s)))
+        .filter_map(|i| i.round.as_ref().map(|p| (i.t_total_s, p.duration_s)))
         .collect();
     let ratio = |(planned, realized): (f64, f64)| realized / planned;
     let realized_over_planned =
@@ -241,7 +241,7 @@ pub fn run_rounds(
     let last = its.last().expect("a trial has its first schedule");
     let (falsely_trusted, falsely_trusted_agreeing) =
         falsely_trusted_split(run.planner.confidence().conf(), &prep.need_kind);
-    let pairs = its.iter().filter_map(|i| i.pair.as_ref());
+    let run_stats = its.iter().filter_map(|i| i.round.as_ref());
     Ok(RunReport {
         family: prep.family.to_string(),
         seed: prep.seed,
@@ -262,12 +262,12 @@ pub fn run_rounds(
         realized_over_planned_last: realized_last / planned_last,
         planned_per_h: per_h(planned_last),
         realized_per_h: per_h(realized_last),
-        plan_gap: PlanGap::sum(pairs.clone().map(|p| &p.plan_gap)),
-        needed_unsupervised: pairs.clone().map(|p| p.needed_unsupervised).sum(),
+        plan_gap: PlanGap::sum(run_stats.clone().map(|p| &p.plan_gap)),
+        needed_unsupervised: run_stats.clone().map(|p| p.needed_unsupervised).sum(),
         backward_steps: trace.backward.0,
         max_backward_samples: trace.backward.1,
-        overlap_ticks: pairs.clone().map(|p| p.overlap_ticks as u64).sum(),
-        faults: pairs.map(|p| p.faults as u64).sum(),
+        overlap_ticks: run_stats.clone().map(|p| p.overlap_ticks as u64).sum(),
+        faults: run_stats.map(|p| p.faults as u64).sum(),
         tick_s,
         t_total_s,
     })
