@@ -436,6 +436,73 @@ fn repaired(
     (best, first_why)
 }
 
+/// Clearance steps of [`cleared_optimum`]: `M·2^k` for `k = 0..CLEAR_STEPS`.
+const CLEAR_STEPS: i32 = 8;
+
+/// `held`, the margin-free optimum of `N ≥ 3` robots with its release rules, when it fails the
+/// margin check: re-timed ([`retime`]) with every clearance between two consecutive
+/// low-confidence runs of different robots raised by `M·2^k` (`k = 0, 1, …`, `M` of
+/// [`max_step_s`]), each with its release rules re-derived from the re-timed order and as it
+/// is; the first that passes [`validate`] with `T_total` below `cap_s` (s), and the checks
+/// used. Stops at the first re-timing not below `cap_s` (larger clearances only delay).
+///
+/// Why (docs/decisions.md, "The stuck incumbent"): when learning makes a stretch
+/// high-confidence, the optimum drops below the re-timed incumbent, whose events never move
+/// earlier; if the optimum itself fails the margins, no other `N ≥ 3` candidate is built from
+/// it, and the incumbent stays far above the bound for every later round.
+fn cleared_optimum(
+    problem: &Problem,
+    held: &Schedule,
+    tick_s: f64,
+    cap_s: f64,
+) -> (Option<(Schedule, f64)>, usize) {
+    let dt_s = problem.dt_s();
+    let step_s = max_step_s(problem, tick_s);
+    let mut checks = 0;
+    for k in 0..CLEAR_STEPS {
+        let Some(re) = retime(problem, held, tick_s, step_s * 2f64.powi(k)) else {
+            continue;
+        };
+        if re.t_total_s(dt_s) >= cap_s {
+            break;
+        }
+        let rederived = re
+            .has_holds()
+            .then(|| problem.with_release_rules(&without_rules(&re)).ok())
+            .flatten();
+        for s in rederived.into_iter().chain([re]) {
+            let t = s.t_total_s(dt_s);
+            if t >= cap_s {
+                continue;
+            }
+            checks += 1;
+            if validate(problem, &s).is_ok() {
+                return (Some((s, t)), checks);
+            }
+        }
+    }
+    (None, checks)
+}
+
+/// `schedule` with every hold's release rules removed (the holds and dwells kept).
+fn without_rules(schedule: &Schedule) -> Schedule {
+    Schedule {
+        holds: schedule
+            .holds
+            .iter()
+            .map(|hs| {
+                hs.iter()
+                    .map(|h| tandem_realtime::Hold {
+                        after: Vec::new(),
+                        ..h.clone()
+                    })
+                    .collect()
+            })
+            .collect(),
+        ..schedule.clone()
+    }
+}
+
 /// `M` (schedule-clock s): `tick_s · max(1, largest ψ̇̄/ψ̇min of a low-confidence sample)`, the
 /// least maximal step in one tick of any schedule of `problem` (its LC samples run at the
 /// mean): the margin check's unit of room.
@@ -721,8 +788,18 @@ fn schedule_n(
         };
         if let Ok(held) = problem.with_release_rules(&timed) {
             let t = held.t_total_s(problem.dt_s());
-            if t < best.1 && validate(problem, &held).is_ok() {
-                best = (held, t, Source::Held);
+            if t < best.1 {
+                if validate(problem, &held).is_ok() {
+                    best = (held, t, Source::Held);
+                } else if plan.bound == BoundBy::Many {
+                    // N ≥ 3: the optimum re-timed with growing clearances, its rules
+                    // re-derived (docs/decisions.md, "The stuck incumbent").
+                    let (cleared, used) = cleared_optimum(problem, &held, tick_s, best.1);
+                    checks += used;
+                    if let Some((s, t)) = cleared {
+                        best = (s, t, Source::Held);
+                    }
+                }
             }
         }
     }

@@ -43,12 +43,16 @@ impl Lead {
 
 /// What one pair's analysis needs besides the two timelines.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct PairInputs {
+pub(super) struct PairInputs<'a> {
     /// `M_p`: the largest step of `p` in one tick (schedule-clock s).
     pub(super) max_step_p: f64,
-    /// Earliest start `τ_r` of a robot other than `p` and `c` (s; `+∞` if there is none): from
-    /// `u = τ_r` on another robot may set the pace.
-    pub(super) third_start_s: f64,
+    /// Per robot `r` other than `p` and `c`, the `p`-clocks (s) between which `r` may run at
+    /// a tick start, `(τ_r, R_rp)`: from `u = τ_r` on (a robot that runs started when every
+    /// running robot had reached its start) up to `R_rp`, the largest `p`-clock at a tick
+    /// start at which `r` still runs (`+∞` in the first pass, the reach of `Λ_rp` below `r`'s
+    /// end in the second: a robot at or past its end is finished and sets no pace). Empty
+    /// when only `p` and `c` run.
+    pub(super) thirds: &'a [(f64, f64)],
     /// Where the analysis starts (s): `max(τ_p, τ_c)`.
     pub(super) u0_s: f64,
     /// The lead of `c` over `p` there (s).
@@ -219,7 +223,7 @@ pub(super) fn integrate(
 ) -> Lead {
     let PairInputs {
         max_step_p: mp,
-        third_start_s,
+        thirds,
         u0_s,
         lead0_s,
     } = inputs;
@@ -264,6 +268,10 @@ pub(super) fn integrate(
         let c_read = c_win.read(tc, near_lo, c_top_s);
         let c_lc = tc.any_low_conf(c_read.lo, c_read.hi);
         let c_hc = tc.any_high_conf(c_read.lo, c_read.hi);
+        // A robot other than p and c may run at a tick start with p in [u_a − M_p, u_b].
+        let third_runs = thirds
+            .iter()
+            .any(|&(from, until)| from <= u_b && until >= left && from <= until);
         let mut rho = f64::NEG_INFINITY;
         if c_lc {
             rho = rho.max(c_read.fast_lc / f_p - 1.0);
@@ -274,7 +282,7 @@ pub(super) fn integrate(
                 rho = rho.max(drag);
             }
             if p_hc {
-                if third_start_s <= u_b {
+                if third_runs {
                     rho = rho.max(drag).max(c_read.fast_hc / f_p - 1.0);
                 } else {
                     rho = rho.max(c_read.slow_hc / f_p - 1.0);
@@ -314,6 +322,7 @@ pub(super) fn slacks(
     eps: f64,
     windows: Windows,
     stop_at_first: bool,
+    passes: Passes,
     switch_ticks: u64,
 ) -> Vec<PairSlack> {
     let robot_of: Vec<usize> = (0..robots.len()).collect();
@@ -328,7 +337,19 @@ pub(super) fn slacks(
         eps,
         windows,
         stop_at_first,
+        passes,
     )
+}
+
+/// Which passes of the lead bound run ([`slacks_of_legs`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Passes {
+    /// Both: the second, where the first rejects, ends other robots' running where the first
+    /// pass's bounds say they have finished.
+    Both,
+    /// The first only: every other robot may set the pace from its start on (the check before
+    /// docs/decisions.md, "Robots that have finished set no pace"; a sound, looser baseline).
+    First,
 }
 
 /// The virtual robots the lead bound runs on: every robot's legs (`crate::holds`), each of
@@ -362,6 +383,7 @@ pub(super) fn slacks_of_legs(
     eps: f64,
     windows: Windows,
     stop_at_first: bool,
+    passes: Passes,
 ) -> Vec<PairSlack> {
     let robots = legs.legs;
     let robot_of = legs.robot_of;
@@ -381,11 +403,82 @@ pub(super) fn slacks_of_legs(
             .then((p, c).cmp(&(q, d)))
     });
     let tables: Vec<RateTable> = robots.iter().map(RateTable::new).collect();
-    let mut leads = vec![Lead::default(); n * n];
     let enforced = legs.plans.map(enforced);
+    let setup = Setup {
+        legs,
+        order: &order,
+        tables: &tables,
+        enforced: enforced.as_ref(),
+        max_step_of,
+        eps,
+        windows,
+    };
+    // Robots other than p and c exist only with three or more robots; then the second pass
+    // may end their running where the first pass's bounds say they are finished.
+    let mut robots_seen: Vec<usize> = robot_of.to_vec();
+    robots_seen.sort_unstable();
+    robots_seen.dedup();
+    let thirds_exist = robots_seen.len() >= 3 && passes == Passes::Both;
+    let (mut out, first_leads) = pass(&setup, None, stop_at_first && !thirds_exist);
+    if thirds_exist && out.iter().any(|s| s.slack_s <= 0.0) {
+        // The finished-robot pass (docs/decisions.md, "Robots that have finished set no
+        // pace"): every bound of the first pass is sound, so each robot's reach below its
+        // end bounds the clocks at which it can still run.
+        let (second, _) = pass(&setup, Some((&first_leads, &out)), stop_at_first);
+        out = second;
+    }
+    out.sort_by(|x, y| {
+        x.cur
+            .start_s
+            .total_cmp(&y.cur.start_s)
+            .then(x.prev.start_s.total_cmp(&y.prev.start_s))
+    });
+    out
+}
+
+/// What both passes of [`slacks_of_legs`] share.
+struct Setup<'a, 'b> {
+    legs: &'a Legs<'b>,
+    /// The ordered pairs, by their later start.
+    order: &'a [(usize, usize)],
+    tables: &'a [RateTable],
+    enforced: Option<&'a Enforced>,
+    max_step_of: &'a [f64],
+    eps: f64,
+    windows: Windows,
+}
+
+/// One pass of the lead bound over every ordered pair of `setup.order`: the slacks in pair
+/// order (unsorted) and the pairs' bounds (`n × n`, row `p`).
+///
+/// `prior`: the first pass's bounds and slacks (in the same pair order, complete). Without it
+/// another robot `r` may set the pace from its start on; with it, only while `p`'s clock is at
+/// most `R_rp`, the largest `p`-clock the first pass allows at a tick start with `r` below its
+/// end (a robot at its end is finished, `coordinator::phase`, and sets no pace, strategy rule
+/// 4); every lead read at a start is the smaller of the two passes' (both are sound), and so is
+/// every slack (its larger value).
+fn pass(
+    setup: &Setup<'_, '_>,
+    prior: Option<(&[Lead], &[PairSlack])>,
+    stop_at_first: bool,
+) -> (Vec<PairSlack>, Vec<Lead>) {
+    let Setup {
+        legs,
+        order,
+        tables,
+        enforced,
+        max_step_of,
+        eps,
+        windows,
+    } = *setup;
+    let robots = legs.legs;
+    let robot_of = legs.robot_of;
+    let n = robots.len();
+    let start = |i: usize| robots[i].start_s();
+    let mut leads = vec![Lead::default(); n * n];
     let tol = eps / 4.0;
     let mut out = Vec::new();
-    for (p, c) in order {
+    for &(p, c) in order {
         let (tau_p, tau_c) = (start(p), start(c));
         let rules = legs.plans.map_or(&[][..], |pl| pl.rules_of(p));
         let lead0_s = if tau_c > tau_p || (tau_c == tau_p && rules.is_empty()) {
@@ -397,11 +490,12 @@ pub(super) fn slacks_of_legs(
             // m = c, below τ_p), and c then moves at most M_c.
             let reach = |m: usize, u: f64| -> f64 {
                 let lead = &leads[m * n + c];
-                if lead.is_done() {
+                let now = if lead.is_done() {
                     lead.reach_below(u)
                 } else {
                     f64::INFINITY
-                }
+                };
+                prior.map_or(now, |(first, _)| now.min(first[m * n + c].reach_below(u)))
             };
             let behind = (0..n)
                 .filter(|&m| m != p && m != c && robot_of[m] != robot_of[c] && start(m) < tau_p)
@@ -447,13 +541,20 @@ pub(super) fn slacks_of_legs(
                 .fold(0.0, f64::max);
             max_step_of[c] + behind.max(delayed)
         };
-        let third_start_s = (0..n)
+        let thirds: Vec<(f64, f64)> = (0..n)
             .filter(|&r| robot_of[r] != robot_of[p] && robot_of[r] != robot_of[c])
-            .map(start)
-            .fold(f64::INFINITY, f64::min);
+            .map(|r| {
+                // r runs only below its end, where s_p ≤ R_rp; ε covers the coordinator's
+                // clock rounding (a larger `until` only lets r run longer).
+                let until = prior.map_or(f64::INFINITY, |(first, _)| {
+                    first[r * n + p].reach_below(robots[r].end_s()) + eps
+                });
+                (start(r), until)
+            })
+            .collect();
         let inputs = PairInputs {
             max_step_p: max_step_of[p],
-            third_start_s,
+            thirds: &thirds,
             u0_s: tau_p.max(tau_c),
             lead0_s,
         };
@@ -472,10 +573,8 @@ pub(super) fn slacks_of_legs(
             }
             let Some(&c_iv) = cur.get(j) else { break };
             let u_max = (prev.end_s + eps).min(end_p);
-            let is_enforced = enforced
-                .as_ref()
-                .is_some_and(|e| e.holds(p, &prev, c, &c_iv));
-            let slack_s = match switch_extra_s(legs.switch_ticks, max_step_of[c]) {
+            let is_enforced = enforced.is_some_and(|e| e.holds(p, &prev, c, &c_iv));
+            let mut slack_s = match switch_extra_s(legs.switch_ticks, max_step_of[c]) {
                 None if is_enforced || u_max <= lead.start_s() => f64::INFINITY,
                 None => (c_iv.start_s - eps) - (lead.reach_below(u_max) + max_step_of[c]),
                 // The switch time (docs/decisions.md, "The operator's switch time in the margin
@@ -494,6 +593,10 @@ pub(super) fn slacks_of_legs(
                 ),
                 Some(x) => (c_iv.start_s - eps) - ((lead.reach_below(u_max) + max_step_of[c]) + x),
             };
+            if let Some((_, first)) = prior {
+                // The same pair in the same place of the same order.
+                slack_s = slack_s.max(first[out.len()].slack_s);
+            }
             out.push(PairSlack {
                 prev_robot: p,
                 cur_robot: c,
@@ -502,18 +605,12 @@ pub(super) fn slacks_of_legs(
                 slack_s,
             });
             if stop_at_first && slack_s <= 0.0 {
-                return out;
+                return (out, leads);
             }
         }
         leads[p * n + c] = lead;
     }
-    out.sort_by(|x, y| {
-        x.cur
-            .start_s
-            .total_cmp(&y.cur.start_s)
-            .then(x.prev.start_s.total_cmp(&y.prev.start_s))
-    });
-    out
+    (out, leads)
 }
 
 /// The switch time's room `k·M_c` (schedule-clock s), `None` without a switch time.

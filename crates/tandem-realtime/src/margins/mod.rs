@@ -147,6 +147,20 @@
 //! test; a region of `c` starting before `P` is the pair `(c, p)`. Cost: `O(N² · T_ref)` with
 //! sliding extremes, independent of the tick.
 //!
+//! **(f) Finished robots set no pace (a second pass).** A robot whose clock is at or past its
+//! end at a tick start is finished (`coordinator`, `phase`): it does not move and sets nothing
+//! (strategy rule 4); one not yet started follows (rule 3). So in a tick in which no robot
+//! other than `p` and `c` runs, (b)'s two-robot cases apply even after a third robot started.
+//! The first pass assumes a third robot `r` may run from `τ_r` to the end of the task. Its
+//! bounds are sound, and `r` runs only while `s_r < end_r`, where `s_p ≤ R_rp`: the largest
+//! `u + Λ_rp(u)` for `u ≤ end_r` (`+ ε` for the coordinator's clock rounding; a larger `R_rp`
+//! only lets `r` run longer). Where the first pass rejects, a second pass integrates every
+//! pair again with "another robot may run in the cell `[u_a, u_b]`" read as: some `r` has
+//! `τ_r ≤ u_b` and `R_rp ≥ u_a − M_p` (a tick covering the cell starts with `p` in
+//! `[u_a − M_p, u_b]`). Every lead read at a start (d) is the smaller of the two passes' and
+//! every slack the larger: the minimum of two sound bounds is sound. Two robots have no third
+//! robot, and their check is unchanged.
+//!
 //! This is a proof on paper, checked by search (the property tests `tests/safety_n.rs` over the
 //! test kit's problem families, the search adversary, `cargo xtask stress`), not a
 //! machine-checked one. For two robots [`lead_bound`] is sound too, but neither it nor the
@@ -363,6 +377,17 @@ fn plan_slacks(
     stop_at_first: bool,
     switch_ticks: u64,
 ) -> Result<Vec<PairSlack>> {
+    plan_slacks_with(plans, tick_s, stop_at_first, lead::Passes::Both, switch_ticks)
+}
+
+/// [`plan_slacks`] with the passes of the lead bound chosen.
+fn plan_slacks_with(
+    plans: &crate::holds::Plans,
+    tick_s: f64,
+    stop_at_first: bool,
+    passes: lead::Passes,
+    switch_ticks: u64,
+) -> Result<Vec<PairSlack>> {
     if !(tick_s.is_finite() && tick_s > 0.0) {
         return Err(Error::BadParam {
             name: "tick_s",
@@ -383,6 +408,7 @@ fn plan_slacks(
         eps,
         Windows::Sliding,
         stop_at_first,
+        passes,
     ))
 }
 
@@ -423,6 +449,7 @@ fn lead_slacks(
         eps,
         windows,
         stop_at_first,
+        lead::Passes::Both,
         switch_ticks,
     ))
 }
@@ -595,6 +622,41 @@ pub(super) fn started_after_exit_slack(
     } else {
         t_c_lim_s - (tau_c_s + (k + 1.0 - elapsed) * room.step_c)
     }
+
+/// The lead bound's first pass alone, with or without hold points (`holds` empty or one list
+/// per robot): every robot other than `p` and `c` may set the pace from its start to the end
+/// of the task, as [`sufficient_margins`] assumed for `N ≥ 3` before the finished-robot pass
+/// (docs/decisions.md, "Robots that have finished set no pace"). Sound, and for three or more
+/// robots looser: whatever it accepts, [`sufficient_margins_with_holds`] accepts (for two
+/// robots without holds that check is the simulation, neither tighter nor looser). Kept for
+/// tests and benchmarks.
+///
+/// # Errors
+/// As [`sufficient_margins_with_holds`].
+pub fn lead_bound_first_pass(
+    robots: &[Timeline],
+    holds: &[Vec<crate::Hold>],
+    tick_s: f64,
+) -> Result<bool> {
+    check_count(robots.len())?;
+    let plans = crate::holds::Plans::new(robots, holds)?;
+    if !plans.has_holds() {
+        let (max_step_of, eps) = steps_and_eps(robots, tick_s)?;
+        return Ok(lead::slacks(
+            robots,
+            &max_step_of,
+            eps,
+            Windows::Sliding,
+            true,
+            lead::Passes::First,
+            0,
+        )
+        .iter()
+        .all(|s| s.slack_s > 0.0));
+    }
+    Ok(plan_slacks_with(&plans, tick_s, true, lead::Passes::First, 0)?
+        .iter()
+        .all(|s| s.slack_s > 0.0))
 }
 
 /// Margin checks that are **not safe**, kept by name so that tests can show what they miss and
