@@ -13,7 +13,9 @@ pub(crate) use tandem::planner::{
     RecordReport, reschedule_seed,
 };
 pub(crate) use tandem::realtime::continuous::{ContinuousCoordinator, Group, Token};
-pub(crate) use tandem::realtime::{Coordinator, Fault, MAX_ROBOTS, Operator, RobotCount, Tick, Timeline};
+pub(crate) use tandem::realtime::{
+    Coordinator, Fault, MAX_ROBOTS, Operator, RobotCount, Tick, Timeline,
+};
 pub(crate) use tandem::schedule::cyclic::{GapPlan, Stretch};
 pub(crate) use tandem::schedule::{
     CheckedCyclicPlan, CheckedSchedule, CyclicParams, CyclicPlan, GlobalTimeline, LcInterval,

@@ -436,7 +436,10 @@ fn a_gap_without_hold_forbids_interleaving_and_a_hold_allows_it() {
     }
     assert!(matches!(
         period_lower_bound_s(&held, 9),
-        Err(Error::Realtime(tandem_realtime::Error::RobotCount { n: 9, .. }))
+        Err(Error::Realtime(tandem_realtime::Error::RobotCount {
+            n: 9,
+            ..
+        }))
     ));
 }
 

@@ -377,7 +377,13 @@ fn plan_slacks(
     stop_at_first: bool,
     switch_ticks: u64,
 ) -> Result<Vec<PairSlack>> {
-    plan_slacks_with(plans, tick_s, stop_at_first, lead::Passes::Both, switch_ticks)
+    plan_slacks_with(
+        plans,
+        tick_s,
+        stop_at_first,
+        lead::Passes::Both,
+        switch_ticks,
+    )
 }
 
 /// [`plan_slacks`] with the passes of the lead bound chosen.
@@ -622,6 +628,7 @@ pub(super) fn started_after_exit_slack(
     } else {
         t_c_lim_s - (tau_c_s + (k + 1.0 - elapsed) * room.step_c)
     }
+}
 
 /// The lead bound's first pass alone, with or without hold points (`holds` empty or one list
 /// per robot): every robot other than `p` and `c` may set the pace from its start to the end
@@ -654,9 +661,11 @@ pub fn lead_bound_first_pass(
         .iter()
         .all(|s| s.slack_s > 0.0));
     }
-    Ok(plan_slacks_with(&plans, tick_s, true, lead::Passes::First, 0)?
-        .iter()
-        .all(|s| s.slack_s > 0.0))
+    Ok(
+        plan_slacks_with(&plans, tick_s, true, lead::Passes::First, 0)?
+            .iter()
+            .all(|s| s.slack_s > 0.0),
+    )
 }
 
 /// Margin checks that are **not safe**, kept by name so that tests can show what they miss and
