@@ -476,6 +476,12 @@ impl TaskModel {
             }
         };
         let stats = batch_statistics(&obs, n_ref, d);
+        let (duration_mean, duration_scatter) = match params.rate_term {
+            super::RateTerm::Relative { window, .. } if window > 0 => {
+                super::stats::duration_statistics(warps, window)
+            }
+            _ => (Vec::new(), Vec::new()),
+        };
         let data = ModelData {
             channel_names: demos[0].channel_names().to_vec(),
             layout,
@@ -490,7 +496,9 @@ impl TaskModel {
             scatter: stats.scatter,
             grad_min: stats.grad_min,
             grad_max: stats.grad_max,
-            rate_term: super::RateTerm::Relative,
+            rate_term: params.rate_term,
+            duration_mean,
+            duration_scatter,
         };
         Ok(Self::from_data(data))
     }
