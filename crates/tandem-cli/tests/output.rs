@@ -352,7 +352,10 @@ fn strokes(scale: &[f64]) -> String {
 }
 
 #[test]
-fn fit_says_once_which_rate_range_would_merge_its_short_islands() {
+fn fit_gives_no_range_note_without_short_islands_from_the_speeds() {
+    // The stroke task's speeds differ by up to 15 % per stroke: under the defaults its prior
+    // trusts every sample, and with a small rate range its low-confidence regions are long
+    // stretches, not islands narrower than the opening: no range is advisable either way.
     let dir = scratch("range-advice");
     let scales: [[f64; 6]; 5] = [
         [1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
@@ -369,45 +372,18 @@ fn fit_says_once_which_rate_range_would_merge_its_short_islands() {
     let fit = |extra: &[&str]| {
         let mut args = vec!["fit".to_string()];
         args.extend(demos.iter().cloned());
-        args.extend(["--reference", "first", "--samples", "50", "-o"].map(String::from));
+        args.extend(["--reference", "first", "--samples", "50", "--force", "-o"].map(String::from));
         args.push(s(&dir.join("cell.tandem")));
         args.extend(extra.iter().map(|x| x.to_string()));
         ok(&tandem(&args))
     };
-    let first = fit(&[]);
-    let notes: Vec<&str> = first.lines().filter(|l| l.starts_with("range: ")).collect();
-    assert_eq!(notes.len(), 1, "one note:\n{first}");
-    let note = notes[0];
-    assert!(note.contains("channel `rate`: "), "{note}");
-    let advised = note
-        .split("`--ranges rate=")
-        .nth(1)
-        .and_then(|r| r.split('`').next())
-        .expect("the note names the range");
-    let value: f64 = advised.parse().expect("a number");
-    let now: f64 = note
-        .split("(now ")
-        .nth(1)
-        .and_then(|r| r.split(')').next())
-        .and_then(|v| v.parse().ok())
-        .expect("the note names the range now");
-    assert!(value > now, "{note}");
-    // The regions the note predicts are the fit's with that range, and no island is left
-    // to advise on.
-    let predicted = note
-        .split(", ")
-        .last()
-        .and_then(|r| r.split(" → ").nth(1))
-        .and_then(|r| r.split(' ').next())
-        .expect("the note predicts the regions");
-    let again = fit(&["--ranges", &format!("rate={advised}"), "--force"]);
-    assert!(
-        !again.lines().any(|l| l.starts_with("range: ")),
-        "no note with the advised range:\n{again}"
-    );
-    assert!(
-        again.contains(&format!(", {predicted} low-confidence regions")),
-        "predicted {predicted} regions:\n{again}"
-    );
+    for extra in [&[][..], &["--ranges", "rate=1.3"][..]] {
+        let text = fit(extra);
+        assert!(text.contains("high confidence: "), "{text}");
+        assert!(
+            !text.lines().any(|l| l.starts_with("range: ")),
+            "{extra:?}: no range note:\n{text}"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -401,10 +401,15 @@ mod tests {
 
     #[test]
     fn a_model_saved_without_the_rate_terms_marker_keeps_the_absolute_term() {
-        let model = three_demo_model();
+        let (demos, warps) = three_demos();
+        let params = FitParams {
+            rate_term: RateTerm::RELATIVE_WITHOUT_WINDOW,
+            ..FitParams::default()
+        };
+        let model = TaskModel::fit_aligned(&demos, &warps, &params).unwrap();
         let data = ModelData::from(model.clone());
-        // The relative term is persisted as one entry after the d = 2 ranges: the opening's
-        // width. Loaded back, the same model.
+        // The relative term without a duration window is persisted as one entry after the
+        // d = 2 ranges: the opening's width. Loaded back, the same model.
         assert_eq!(data.ranges.len(), 3);
         assert_eq!(data.ranges[2], 13.0);
         let again = TaskModel::try_from(data.clone()).unwrap();

@@ -73,9 +73,10 @@ impl RateTerm {
     /// alignment's default grid ([`tandem_warp::DEFAULT_NODE_SPACING`]) and one, the stretch
     /// over which two warps may place one change of speed at different nodes.
     pub const DEFAULT_OPENING: usize = 3 * tandem_warp::DEFAULT_NODE_SPACING + 1;
-    /// The duration window's default width, reference samples (docs/decisions.md,
-    /// "Timing-only variable sections: the duration term").
-    pub const DEFAULT_WINDOW: usize = 0;
+    /// The duration window's default width, reference samples: 97 (24 node spacings of the
+    /// alignment's default grid and one), chosen on the task zoo's selection seeds among 25, 49,
+    /// 97 and 193 (docs/decisions.md, "Timing-only variable sections: the duration term").
+    pub const DEFAULT_WINDOW: usize = 97;
 
     /// The relative form with the default widths.
     pub const DEFAULT: RateTerm = RateTerm::Relative {
@@ -330,6 +331,13 @@ mod tests {
                 RateTerm::Relative {
                     opening: 13,
                     window: 49,
+                },
+            ),
+            (
+                "relative:opening=7",
+                RateTerm::Relative {
+                    opening: 7,
+                    window: 97,
                 },
             ),
             (
