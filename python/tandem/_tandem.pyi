@@ -62,13 +62,16 @@ def fit(
     dt_s: Optional[float] = None,
     robots: int = 2,
     holds: Optional[Union[Sequence[Union[float, str]], Dict[str, Any]]] = None,
+    rate_term: Optional[str] = None,
 ) -> Planner:
     """Learns the task from demonstrations (paths or ``(T_i, C)`` arrays) and makes the first
     schedule (Fig. 2); the same inputs and parameters as ``tandem fit`` give the same state.
     ``holds``: reference times (s) and rules (``"gripper>0.5"``) where a robot may wait, as
     ``tandem fit --hold-at/--hold-where``; ``[]`` declares none, ``None`` keeps ``params``'.
     ``dt_s``: the arrays' sample period (s); without it arrays are taken to be 0.01 s apart
-    with a ``DataWarning`` (deprecated)."""
+    with a ``DataWarning`` (deprecated). ``rate_term``: how the speeds enter ``σ²_D``
+    (``"relative"``, ``"absolute"``, ``"relative:opening=13,window=49"``), as
+    ``tandem fit --rate-term``; ``None`` keeps ``params``'."""
 
 def read_bag(
     path: Path,
@@ -84,6 +87,7 @@ def fit_model(
     channels: Optional[Sequence[str]] = None,
     params: Params = None,
     dt_s: Optional[float] = None,
+    rate_term: Optional[str] = None,
 ) -> Model:
     """The task model alone (alignment and statistics, §II-B1/2)."""
 

@@ -25,7 +25,7 @@ use anyhow::Context;
 use rayon::prelude::*;
 use serde::Serialize;
 use tandem::confidence::{Confidence, ConfidenceParams, runs};
-use tandem::lfd::{Demonstration, FitParams, Reference, TaskModel};
+use tandem::lfd::{Demonstration, FitParams, RateTerm, Reference, TaskModel};
 use tandem::sim::study::read_labels;
 use tandem::sim::task::Label;
 use tandem::sim::truth::needs_help;
@@ -53,6 +53,10 @@ pub(crate) struct FitDefaultsArgs {
     /// Output folder (created if missing). Default: results/ in the workspace.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Fit with this rate term instead of the default (`absolute`, `relative`,
+    /// `relative:opening=N,window=M`), the sanding row too: a variant to compare.
+    #[arg(long, value_name = "FORM")]
+    rate_term: Option<RateTerm>,
 }
 
 /// What one fit shows the user.
@@ -259,7 +263,11 @@ fn measure(
 }
 
 /// Every fit of one zoo task.
-fn measure_task(task: &ZooTask, detail: Option<&PathBuf>) -> anyhow::Result<TaskRow> {
+fn measure_task(
+    task: &ZooTask,
+    detail: Option<&PathBuf>,
+    rate_term: Option<RateTerm>,
+) -> anyhow::Result<TaskRow> {
     let demos = task.demos()?;
     let write = |view: &FitView, model: &TaskModel, conf: &Confidence| {
         let progress = &task.progress[view.reference_demo];
@@ -279,7 +287,10 @@ fn measure_task(task: &ZooTask, detail: Option<&PathBuf>) -> anyhow::Result<Task
     let (first, medoid, default) = measure(
         task,
         &demos,
-        &FitParams::default(),
+        &FitParams {
+            rate_term: rate_term.unwrap_or_default(),
+            ..FitParams::default()
+        },
         detail.is_some().then_some(&write as _),
     )?;
     Ok(TaskRow {
@@ -294,9 +305,15 @@ fn measure_task(task: &ZooTask, detail: Option<&PathBuf>) -> anyhow::Result<Task
 }
 
 /// Every fit of the sanding fixtures with the study's fit parameters.
-fn measure_sanding(detail: Option<&PathBuf>) -> anyhow::Result<TaskRow> {
+fn measure_sanding(
+    detail: Option<&PathBuf>,
+    rate_term: Option<RateTerm>,
+) -> anyhow::Result<TaskRow> {
     let root = workspace_root();
-    let (config, _) = read_config(None)?;
+    let (mut config, _) = read_config(None)?;
+    if let Some(rate_term) = rate_term {
+        config.planner.fit.rate_term = rate_term;
+    }
     let dir = root.join("fixtures/sanding");
     let n_demos = 6;
     let demos = (0..n_demos)
@@ -449,6 +466,9 @@ pub(crate) fn run(args: &FitDefaultsArgs) -> anyhow::Result<()> {
         }
         None => None,
     };
+    if let Some(rate_term) = args.rate_term {
+        println!("rate term: {rate_term}");
+    }
     println!(
         "seeds {}..{} ({}), short island < {SHORT_ISLAND} samples",
         seeds.start,
@@ -470,7 +490,7 @@ pub(crate) fn run(args: &FitDefaultsArgs) -> anyhow::Result<()> {
                 || detail
                     .as_ref()
                     .is_some_and(|(f, s)| f == family.name && *s == seed);
-            let row = measure_task(&task, want_detail.then_some(&out))?;
+            let row = measure_task(&task, want_detail.then_some(&out), args.rate_term)?;
             eprintln!(
                 "{} seed {seed}: {} demos, HC first {:.1}–{:.1} %, medoid {:.1} %, default {:.1} % \
                  (truth {:.1} %), LC regions {} ({} short){}",
@@ -495,7 +515,7 @@ pub(crate) fn run(args: &FitDefaultsArgs) -> anyhow::Result<()> {
         all.extend(rows);
     }
     let sanding_detail = detail.as_ref().is_some_and(|(f, _)| f == "sanding");
-    let sanding = measure_sanding(sanding_detail.then_some(&out))?;
+    let sanding = measure_sanding(sanding_detail.then_some(&out), args.rate_term)?;
     eprintln!(
         "sanding: HC first {:.1}–{:.1} %, medoid {:.1} %, default {:.1} % (truth {:.1} %), \
          LC regions {} ({} short), falsely trusted {}",

@@ -53,6 +53,10 @@ pub(crate) struct ZooArgs {
     /// Skip the reference-choice spread (one more fit per demonstration, and the medoid).
     #[arg(long)]
     no_spread: bool,
+    /// Fit with this rate term instead of the default (`absolute`, `relative`,
+    /// `relative:opening=N,window=M`): a variant to compare.
+    #[arg(long, value_name = "FORM")]
+    rate_term: Option<tandem::lfd::RateTerm>,
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
@@ -315,7 +319,7 @@ fn run_zoo(args: &ZooArgs) -> anyhow::Result<(ZooReport, String)> {
         "continuous" => vec![Cell::Continuous],
         _ => vec![Cell::Rounds, Cell::Continuous],
     };
-    let params = EvalParams {
+    let mut params = EvalParams {
         seeds,
         robots: args.robots.clone(),
         cells,
@@ -323,6 +327,9 @@ fn run_zoo(args: &ZooArgs) -> anyhow::Result<(ZooReport, String)> {
         reference_spread: !args.no_spread,
         ..EvalParams::default()
     };
+    if let Some(rate_term) = args.rate_term {
+        params.planner.fit.rate_term = rate_term;
+    }
     params.validate().map_err(|e| anyhow!("{e}"))?;
     let extra = if sanding {
         let root = workspace_root();

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use tandem::lfd::{HoldRule, Reference};
+use tandem::lfd::{HoldRule, RateTerm, Reference};
 use tandem::planner::Cell;
 use tandem::sim::workcell::OperatorParams;
 
@@ -214,6 +214,13 @@ pub(crate) struct FitArgs {
     /// coordinates keep their automatic range (spread over all demonstrations).
     #[arg(long, value_name = "NAME=VALUE,…", value_delimiter = ',')]
     pub(crate) ranges: Vec<String>,
+    /// How the demonstrations' speeds enter σ²_D: `relative` (speed differences relative to
+    /// the local pace, opened over 13 samples, with the duration term over the default
+    /// window), `absolute` (the paper's variance of the warp gradients), or
+    /// `relative:opening=N,window=M` (odd widths in reference samples; window 0: no
+    /// duration term). Default: from the parameters (`[fit] rate_term`, `relative`).
+    #[arg(long, value_name = "FORM", value_parser = parse_rate_term)]
+    pub(crate) rate_term: Option<RateTerm>,
     /// Parameter file (TOML, sections `[fit]`, `[confidence]`, `[sampler]`; `tandem params`
     /// prints the defaults).
     #[arg(long, value_name = "FILE")]
@@ -283,6 +290,15 @@ pub(crate) struct FitArgs {
     /// many).
     #[arg(long)]
     pub(crate) force: bool,
+}
+
+/// `tandem fit --rate-term`: `tandem::lfd::RateTerm` by its parameter-file spelling; the error
+/// names the choices (clap adds the flag).
+fn parse_rate_term(s: &str) -> Result<RateTerm, String> {
+    s.parse::<RateTerm>().map_err(|e| match e {
+        tandem::lfd::Error::BadParam { why, .. } => why,
+        other => other.to_string(),
+    })
 }
 
 /// `tandem fit --reference`: `tandem::lfd::Reference` by its parameter-file names.

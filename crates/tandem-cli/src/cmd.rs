@@ -203,6 +203,9 @@ fn fit(a: &FitArgs) -> Result<()> {
     if let Some(reference) = a.reference {
         params.fit.reference = reference.into();
     }
+    if let Some(rate_term) = a.rate_term {
+        params.fit.rate_term = rate_term;
+    }
     if a.no_holds {
         params.holds = HoldSpec::default();
     }
@@ -397,11 +400,104 @@ fn fit(a: &FitArgs) -> Result<()> {
         model.channel_names().join(", ")
     ));
     summary_lines(&planner)?;
+    if let Some(line) = range_advice(&planner)? {
+        out(&line);
+    }
     if let Some(line) = kept_line {
         out(&line);
     }
     out(&format!("saved {}", a.output.display()));
     Ok(())
+}
+
+/// A low-confidence region of the prior shorter than this many reference samples is a short
+/// island (the rate term's opening: a region narrower than the alignment can place a change
+/// of speed).
+const SHORT_ISLAND: usize = tandem::lfd::RateTerm::DEFAULT_OPENING;
+
+/// `fit`'s note when a range is still advisable: the short low-confidence islands of the
+/// prior that the demonstrations' speeds alone make (high confidence without the rate's part
+/// of `σ²_D`), and the rate range from which every one of them is high-confidence. The rate's
+/// part scales as `1/r²` with the range `r` and the alignment does not depend on it, so the
+/// prior with `--ranges rate=r` is computed here exactly, for the same reference
+/// (docs/decisions.md, "Timing-only variable sections: the duration term").
+fn range_advice(planner: &Planner) -> Result<Option<String>> {
+    use tandem::confidence::Confidence;
+    let model = planner.model();
+    let params = planner.params().confidence.clone();
+    let sigma2 = model.sigma2_d();
+    let rate = model.sigma2_d_rate();
+    let channels: Vec<f64> = sigma2
+        .iter()
+        .zip(&rate)
+        .map(|(s, r)| (s - r).max(0.0))
+        .collect();
+    let prior = Confidence::from_prior(sigma2, params.clone())?;
+    let without_rate = Confidence::from_prior(&channels, params.clone())?;
+    let islands: Vec<std::ops::Range<usize>> = prior
+        .low_regions()
+        .into_iter()
+        .filter(|r| r.len() < SHORT_ISLAND && r.clone().all(|n| without_rate.conf()[n]))
+        .collect();
+    if islands.is_empty() {
+        return Ok(None);
+    }
+    let samples: Vec<usize> = islands.iter().flat_map(Clone::clone).collect();
+    // High confidence on every island sample with the rate's part scaled by `s`.
+    let all_high = |s: f64| -> Result<bool> {
+        let v: Vec<f64> = samples.iter().map(|&n| channels[n] + s * rate[n]).collect();
+        Ok(Confidence::from_prior(&v, params.clone())?
+            .conf()
+            .iter()
+            .all(|&h| h))
+    };
+    // Bisection on the scale (1: the model's range, 0: no rate term, where all are high).
+    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if all_high(mid)? {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let d = model.ranges().len();
+    let now = model.ranges()[d - 1];
+    // The range for the scale `lo`, rounded up to three significant digits (a larger range
+    // only lowers the rate's part).
+    let needed = now / lo.max(f64::MIN_POSITIVE).sqrt();
+    let digits = 10f64.powi(needed.log10().floor() as i32 - 2);
+    let advised = (needed / digits).ceil() * digits;
+    let scale = (now / advised).powi(2);
+    if !all_high(scale)? {
+        return Ok(None);
+    }
+    let with: Vec<f64> = channels
+        .iter()
+        .zip(&rate)
+        .map(|(c, r)| c + scale * r)
+        .collect();
+    let after = Confidence::from_prior(&with, params)?;
+    Ok(Some(format!(
+        "range: channel `rate`: {} low-confidence island{} shorter than {SHORT_ISLAND} samples \
+         from the demonstrations' speeds alone; `--ranges rate={}` (now {}) would make {} \
+         high-confidence ({:.1} % → {:.1} % of the task, {} → {} low-confidence regions)",
+        islands.len(),
+        if islands.len() == 1 { "" } else { "s" },
+        fmt_range(advised),
+        fmt_range(now),
+        if islands.len() == 1 { "it" } else { "them" },
+        100.0 * prior.high_share(),
+        100.0 * after.high_share(),
+        prior.low_regions().len(),
+        after.low_regions().len(),
+    )))
+}
+
+/// A range with three significant digits and no floating-point noise.
+fn fmt_range(v: f64) -> String {
+    let digits = (2 - v.log10().floor() as i32).max(0) as usize;
+    format!("{v:.digits$}")
 }
 
 /// One stretch of consecutive hold points of the same activity.

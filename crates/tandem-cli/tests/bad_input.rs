@@ -455,6 +455,7 @@ fn bad_parameters_and_outputs() {
     let p_syntax = params("syntax.toml", "[sampler\nsamples = 10\n");
     let p_type = params("type.toml", "[sampler]\nsamples = \"many\"\n");
     let p_len = params("len.toml", "[fit]\nranges = [1.0, 2.0]\n");
+    let p_rate = params("rate.toml", "[fit]\nrate_term = \"relative:window=4\"\n");
     let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
         (
             fit(&["--params", &p_range, "-o", &out]),
@@ -469,6 +470,22 @@ fn bad_parameters_and_outputs() {
         (
             fit(&["--params", &p_len, "-o", &out]),
             vec![&p_len, "ranges", "has 2 entries"],
+        ),
+        (
+            fit(&["--params", &p_rate, "-o", &out]),
+            vec![&p_rate, "rate_term", "odd number of samples ≥ 3, got 4"],
+        ),
+        (
+            fit(&["--rate-term", "quadratic", "-o", &out]),
+            vec![
+                "--rate-term",
+                "`quadratic` is not a rate term",
+                "`absolute`, `relative` or `relative:opening=N,window=M`",
+            ],
+        ),
+        (
+            fit(&["--rate-term", "relative:opening=4", "-o", &out]),
+            vec!["--rate-term", "odd number of samples ≥ 1, got 4"],
         ),
         (fit(&["--samples", "0", "-o", &out]), vec!["samples"]),
         (fit(&["--dt=-1", "-o", &out]), vec!["--dt"]),

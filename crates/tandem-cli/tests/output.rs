@@ -312,3 +312,78 @@ fn a_dt_that_agrees_with_every_file_is_one_note() {
     );
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+/// A reaching task of six strokes between waypoints of `x` and `y` (smooth cosine ramps,
+/// 100 Hz), each demonstration with its own stroke durations (`scale[k]` times the nominal):
+/// the speeds differ by up to 15 % per stroke, so the warps' gradients change at every
+/// stroke boundary.
+fn strokes(scale: &[f64]) -> String {
+    const WAY: [(f64, f64); 7] = [
+        (0.0, 0.0),
+        (0.4, 0.1),
+        (0.5, 0.5),
+        (0.1, 0.6),
+        (0.2, 0.9),
+        (0.7, 0.8),
+        (0.9, 0.2),
+    ];
+    const NOMINAL: [f64; 6] = [80.0, 60.0, 100.0, 70.0, 90.0, 50.0];
+    let mut text = String::from("t,x,y\n");
+    let mut k = 0usize;
+    for (stroke, (&len, &f)) in NOMINAL.iter().zip(scale).enumerate() {
+        let n = (len * f).round() as usize;
+        let ((x0, y0), (x1, y1)) = (WAY[stroke], WAY[stroke + 1]);
+        for j in 0..n {
+            let u = 0.5 - 0.5 * (std::f64::consts::PI * j as f64 / n as f64).cos();
+            writeln!(
+                text,
+                "{:.2},{:.6},{:.6}",
+                k as f64 * 0.01,
+                x0 + u * (x1 - x0),
+                y0 + u * (y1 - y0)
+            )
+            .expect("write to string");
+            k += 1;
+        }
+    }
+    let (x, y) = WAY[6];
+    writeln!(text, "{:.2},{x:.6},{y:.6}", k as f64 * 0.01).expect("write to string");
+    text
+}
+
+#[test]
+fn fit_gives_no_range_note_without_short_islands_from_the_speeds() {
+    // The stroke task's speeds differ by up to 15 % per stroke: under the defaults its prior
+    // trusts every sample, and with a small rate range its low-confidence regions are long
+    // stretches, not islands narrower than the opening: no range is advisable either way.
+    let dir = scratch("range-advice");
+    let scales: [[f64; 6]; 5] = [
+        [1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
+        [1.12, 0.9, 1.05, 0.87, 1.1, 0.95],
+        [0.88, 1.1, 0.93, 1.14, 0.9, 1.08],
+        [1.06, 0.86, 1.13, 0.95, 0.88, 1.15],
+        [0.94, 1.13, 0.89, 1.07, 1.12, 0.86],
+    ];
+    let demos: Vec<String> = scales
+        .iter()
+        .enumerate()
+        .map(|(i, sc)| s(&write(&dir, &format!("demo_{i}.csv"), &strokes(sc))))
+        .collect();
+    let fit = |extra: &[&str]| {
+        let mut args = vec!["fit".to_string()];
+        args.extend(demos.iter().cloned());
+        args.extend(["--reference", "first", "--samples", "50", "--force", "-o"].map(String::from));
+        args.push(s(&dir.join("cell.tandem")));
+        args.extend(extra.iter().map(|x| x.to_string()));
+        ok(&tandem(&args))
+    };
+    for extra in [&[][..], &["--ranges", "rate=1.3"][..]] {
+        let text = fit(extra);
+        assert!(text.contains("high confidence: "), "{text}");
+        assert!(
+            !text.lines().any(|l| l.starts_with("range: ")),
+            "{extra:?}: no range note:\n{text}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -97,5 +97,5 @@ pub use demo::{
 pub use error::{Error, Result};
 pub use model::{
     Comparison, Corrections, EXECUTION_DURATION_RATIO, Execution, FitParams, HoldRule, HoldSpec,
-    Reference, Resampled, TaskModel,
+    RateTerm, Reference, Resampled, TaskModel,
 };

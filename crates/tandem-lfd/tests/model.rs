@@ -2,7 +2,7 @@
 //! incremental updates equal to a refit, alignment with `tandem-warp`.
 
 use proptest::prelude::*;
-use tandem_lfd::{Demonstration, Execution, FitParams, Reference, TaskModel};
+use tandem_lfd::{Demonstration, Execution, FitParams, RateTerm, Reference, TaskModel};
 
 const NAMES: [&str; 7] = ["x", "qx", "qy", "qz", "qw", "force", "tool"];
 
@@ -126,11 +126,30 @@ fn execution_from(demo: &Demonstration, warp: &[f64]) -> Execution {
 
 #[test]
 fn update_equals_refit() {
+    // Every form of the rate term: the window durations are sufficient statistics too.
+    for rate_term in [
+        RateTerm::DEFAULT,
+        RateTerm::Absolute,
+        RateTerm::Relative {
+            opening: 5,
+            window: 9,
+        },
+    ] {
+        update_equals_refit_with(rate_term);
+    }
+}
+
+fn update_equals_refit_with(rate_term: RateTerm) {
     let (demos, warps) = data(&[0.0, 1.0, -0.5], &[40, 55, 31], &[0.0, 0.6, -0.4]);
-    let mut model = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+    let fit_params = FitParams {
+        rate_term,
+        ..FitParams::default()
+    };
+    let mut model = TaskModel::fit_aligned(&demos, &warps, &fit_params).unwrap();
+    assert_eq!(model.rate_term(), rate_term);
     let params = FitParams {
         ranges: Some(model.ranges().to_vec()),
-        ..FitParams::default()
+        ..fit_params
     };
     let mut all_demos = demos.clone();
     let mut all_warps = warps.clone();
@@ -148,6 +167,11 @@ fn update_equals_refit() {
         all_warps.push(values);
         let refit = TaskModel::fit_aligned(&all_demos, &all_warps, &params).unwrap();
         assert_same_statistics(&model, &refit);
+        // And the same model through its serde form (the window durations included).
+        let back: TaskModel =
+            serde_json::from_str(&serde_json::to_string(&model).unwrap()).unwrap();
+        assert_eq!(back.rate_term(), rate_term);
+        assert_eq!(back.sigma2_d(), model.sigma2_d());
         assert_eq!(
             model.command(&[0.3, -0.2, 0.9], 17.5).unwrap().len(),
             NAMES.len() + 1
@@ -211,13 +235,18 @@ proptest! {
         // faster than half the fastest is refused (`EXECUTION_DURATION_RATIO`).
         len in 20usize..60,
         bend in -0.9f64..0.9,
+        window in prop::sample::select(vec![0usize, 3, 7, 13]),
     ) {
         let (demos, warps) = data(&[0.0, 1.0], &[30, 44], &[0.0, 0.5]);
-        let mut model = TaskModel::fit_aligned(&demos, &warps, &FitParams::default()).unwrap();
+        let fit_params = FitParams {
+            rate_term: RateTerm::Relative { opening: RateTerm::DEFAULT_OPENING, window },
+            ..FitParams::default()
+        };
+        let mut model = TaskModel::fit_aligned(&demos, &warps, &fit_params).unwrap();
         let exec = execution_from(&synthetic(len, shape), &warp(30, len, bend));
         let values = model.execution_warp(&exec).unwrap();
         model.update(&exec).unwrap();
-        let params = FitParams { ranges: Some(model.ranges().to_vec()), ..FitParams::default() };
+        let params = FitParams { ranges: Some(model.ranges().to_vec()), ..fit_params };
         let refit = TaskModel::fit_aligned(
             &[demos[0].clone(), demos[1].clone(), exec.demonstration.clone()],
             &[warps[0].clone(), warps[1].clone(), values],

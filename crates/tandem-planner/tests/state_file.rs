@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use tandem_confidence::{Confidence, ConfidenceParams, MissEvidence};
-use tandem_lfd::{Demonstration, TaskModel};
+use tandem_lfd::{Demonstration, RateTerm, TaskModel};
 use tandem_planner::state::{self, FORMAT_VERSION, OLDEST_READABLE_VERSION};
 use tandem_planner::{Error, Planner, PlannerParams};
 use tandem_schedule::validate;
@@ -50,6 +50,7 @@ fn the_golden_state_file_loads_with_the_values_of_its_inputs() {
          and review the diff"
     );
     let p = Planner::load(golden_path()).unwrap();
+    assert_eq!(p.params().fit.rate_term, p.model().rate_term());
 
     // The parameters are fixtures/examples/params.toml's.
     let text = std::fs::read_to_string(examples("params.toml")).unwrap();
@@ -139,6 +140,14 @@ fn the_golden_state_file_loads_with_the_values_of_its_inputs() {
 
 /// `tests/fixtures/example_v4.tandem`: the golden state file as format version 4 wrote it
 /// (two warps and one offset `offset_s`), copied before the format became version 5.
+/// The parameters with the default rate term (an old file's parameters carry the form of its
+/// model, `tandem_planner::state::v11::FIT_RATE_TERM`).
+fn but_rate_term(p: &PlannerParams) -> PlannerParams {
+    let mut p = p.clone();
+    p.fit.rate_term = RateTerm::DEFAULT;
+    p
+}
+
 fn v4_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/example_v4.tandem")
 }
@@ -243,7 +252,14 @@ fn a_version_6_file_loads_with_the_papers_confidence_model() {
     };
     assert_eq!(paper, ConfidenceParams::paper());
     assert_eq!(old.params().confidence, paper);
-    assert_eq!(old.params().fit, new.params().fit);
+    // Its fit parameters keep the rate term its model was fitted with (a refit reproduces
+    // it): the absolute one; the rest are the golden file's.
+    assert_eq!(old.params().fit.rate_term, RateTerm::Absolute);
+    assert_eq!(old.model().rate_term(), RateTerm::Absolute);
+    assert_eq!(
+        but_rate_term(old.params()).fit,
+        but_rate_term(new.params()).fit
+    );
     assert_eq!(old.params().sampler, new.params().sampler);
     assert_eq!(old.model().mean(), new.model().mean());
     // The observations: the paper's one unit per control sample (the golden file holds one
@@ -349,7 +365,9 @@ fn old_golden_loads_and_saves_as_the_golden_file(version: u32, added: usize) -> 
     let old = Planner::load(old_golden_path(version)).unwrap();
     let new = Planner::load(golden_path()).unwrap();
     let v10_planner = Planner::load(old_golden_path(10)).unwrap();
-    assert_eq!(old.params(), new.params());
+    // The rate term of the parameters is the one the file's model was fitted with.
+    assert_eq!(old.params().fit.rate_term, old.model().rate_term());
+    assert_eq!(but_rate_term(old.params()), but_rate_term(new.params()));
     assert_eq!(old.params(), v10_planner.params());
     assert_eq!(old.model().sigma2_d(), v10_planner.model().sigma2_d());
     assert_eq!(old.outcome(), v10_planner.outcome());

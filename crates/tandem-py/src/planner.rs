@@ -14,7 +14,7 @@ use crate::errors::{Error, Result, deprecated, guard, warn};
 use crate::facade::{
     AnyController, BetaParams, Cell, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, DT_TOLERANCE,
     Demonstration, Execution, ExecutionRecord, HoldRule, HoldSpec, Observations, PeriodSource,
-    Plan, Planner, PlannerParams, RecordReport, Regridded, StateLock, TaskModel, errors,
+    Plan, Planner, PlannerParams, RateTerm, RecordReport, Regridded, StateLock, TaskModel, errors,
     length_warnings, posterior, prior, prior_low_threshold, prob_need_below_mu_c, reschedule_seed,
 };
 use crate::facade::{BagOptions, Recording, extend_bag_schema, is_bag, read_bag};
@@ -374,7 +374,11 @@ fn hold_spec(holds: &Bound<'_, PyAny>) -> Result<HoldSpec> {
 ///     ParamError: a bad parameter or robot count, a malformed hold, a hold outside the task
 ///         a rule on an unknown channel or one that holds nowhere.
 #[pyfunction]
-#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, robots=N_ROBOTS, holds=None))]
+#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, robots=N_ROBOTS, holds=None, rate_term=None))]
+#[expect(
+    clippy::too_many_arguments,
+    reason = "the keyword arguments of the Python function, each documented above"
+)]
 pub(crate) fn fit(
     py: Python<'_>,
     demos: &Bound<'_, PyAny>,
@@ -383,8 +387,10 @@ pub(crate) fn fit(
     dt_s: Option<f64>,
     robots: usize,
     holds: Option<&Bound<'_, PyAny>>,
+    rate_term: Option<String>,
 ) -> PyResult<PyPlanner> {
     let mut params = planner_params(params)?;
+    apply_rate_term(&mut params, rate_term.as_deref())?;
     if let Some(holds) = holds.filter(|h| !h.is_none()) {
         params.holds = hold_spec(holds)?;
         params.validate().map_err(Error::from)?;
@@ -398,19 +404,36 @@ pub(crate) fn fit(
     Ok(PyPlanner { inner: planner })
 }
 
+/// ``rate_term=`` of :func:`fit` and :func:`fit_model`: the fit's rate term
+/// (`tandem_lfd::RateTerm`'s spelling), a `ParamError` naming `rate_term` and the choices.
+fn apply_rate_term(params: &mut PlannerParams, rate_term: Option<&str>) -> Result<()> {
+    if let Some(text) = rate_term {
+        params.fit.rate_term = text.parse::<RateTerm>().map_err(|e| Error::Param {
+            what: "rate_term".into(),
+            why: match e {
+                errors::Lfd::BadParam { why, .. } => why,
+                other => other.to_string(),
+            },
+        })?;
+    }
+    Ok(())
+}
+
 /// The task model alone (alignment and statistics, §II-B1/2), without confidence or
 /// schedule: as :func:`fit` but returns a :class:`Model`. ``params`` takes the same form as
-/// :func:`fit`'s; only its ``"fit"`` block is used.
+/// :func:`fit`'s; only its ``"fit"`` block is used; ``rate_term`` as :func:`fit`'s.
 #[pyfunction]
-#[pyo3(signature = (demos, channels=None, params=None, dt_s=None))]
+#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, rate_term=None))]
 pub(crate) fn fit_model(
     py: Python<'_>,
     demos: &Bound<'_, PyAny>,
     channels: Option<Vec<String>>,
     params: Option<&Bound<'_, PyAny>>,
     dt_s: Option<f64>,
+    rate_term: Option<String>,
 ) -> PyResult<PyModel> {
     let mut params = planner_params(params)?;
+    apply_rate_term(&mut params, rate_term.as_deref())?;
     let (demos, assumed) = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
     if !assumed.is_empty() {
         warn(py, &assumed_period_warning(&assumed))?;

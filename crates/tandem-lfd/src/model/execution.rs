@@ -105,6 +105,23 @@ impl TaskModel {
                     (*g, *s2) = derive_at(layout, anchors_n, &inv_w, denom, mean_n, scatter_n, out);
                 },
             );
+        if let super::RateTerm::Relative { window, .. } = data.rate_term
+            && window > 0
+        {
+            // The Welford step of the window durations, as for the tangent statistics.
+            let durations = super::stats::window_durations(&warp, window);
+            let new_count = count as f64 + 1.0;
+            for ((mean, scatter), x) in data
+                .duration_mean
+                .iter_mut()
+                .zip(data.duration_scatter.iter_mut())
+                .zip(durations)
+            {
+                let delta = x - *mean;
+                *mean += delta / new_count;
+                *scatter += delta * delta * (count as f64 / new_count);
+            }
+        }
         data.count += 1;
         self.add_rate_terms();
         self.corrections = CorrectionCache::new(self.data.n_ref);

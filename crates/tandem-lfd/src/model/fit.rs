@@ -6,6 +6,8 @@ use std::cmp::Ordering;
 
 use rayon::prelude::*;
 
+#[cfg(test)]
+use super::RateTerm;
 use super::layout::{Item, Layout, quat_at};
 use super::stats::{batch_statistics, observe};
 use super::{FitParams, ModelData, Reference, TaskModel, check_dt};
@@ -476,6 +478,12 @@ impl TaskModel {
             }
         };
         let stats = batch_statistics(&obs, n_ref, d);
+        let (duration_mean, duration_scatter) = match params.rate_term {
+            super::RateTerm::Relative { window, .. } if window > 0 => {
+                super::stats::duration_statistics(warps, window)
+            }
+            _ => (Vec::new(), Vec::new()),
+        };
         let data = ModelData {
             channel_names: demos[0].channel_names().to_vec(),
             layout,
@@ -490,7 +498,9 @@ impl TaskModel {
             scatter: stats.scatter,
             grad_min: stats.grad_min,
             grad_max: stats.grad_max,
-            rate_term: super::RateTerm::Relative,
+            rate_term: params.rate_term,
+            duration_mean,
+            duration_scatter,
         };
         Ok(Self::from_data(data))
     }
@@ -519,9 +529,25 @@ mod tests {
         // n = 1 and 2: gradients 1, 2.5, 1, var 0.75 → 1/27. The opening over 13 samples
         // takes the least of the three everywhere: 1/147.
         assert!(close(model.grad_mean()[0], 7.0 / 6.0));
-        assert!(close(model.sigma2_d()[0], 1.0 / 147.0));
-        // σ²_D(1) = (25+100+25)/36 / 20² / 2 + 1/147 = 1/192 + 1/147.
-        assert!(close(model.sigma2_d()[1], 1.0 / 192.0 + 1.0 / 147.0));
+        // The duration window (97 samples) covers the whole reference at every sample: the
+        // durations are 2, 4, 2 (mean 8/3, var 4/3), a term of (4/3)/(3·8/3)² = 1/48, larger
+        // than the opened rate term, so the rate's part is 1/48 everywhere.
+        assert!(close(model.sigma2_d()[0], 1.0 / 48.0));
+        // σ²_D(1) = (25+100+25)/36 / 20² / 2 + 1/48 = 1/192 + 1/48.
+        assert!(close(model.sigma2_d()[1], 1.0 / 192.0 + 1.0 / 48.0));
+        // Without the duration term, the opened rate term alone.
+        let (demos, warps) = three_demos();
+        let without = TaskModel::fit_aligned(
+            &demos,
+            &warps,
+            &FitParams {
+                rate_term: RateTerm::RELATIVE_WITHOUT_WINDOW,
+                ..FitParams::default()
+            },
+        )
+        .unwrap();
+        assert!(close(without.sigma2_d()[0], 1.0 / 147.0));
+        assert!(close(without.sigma2_d()[1], 1.0 / 192.0 + 1.0 / 147.0));
         // n = 2: last gradient repeats the previous: 1, 2.5, 1.
         assert_eq!(model.grad_max()[2], 2.5);
         assert_eq!(model.n_components(), 2);

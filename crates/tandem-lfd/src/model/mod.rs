@@ -55,7 +55,7 @@ mod stats;
 pub use corrections::Corrections;
 pub use execution::{EXECUTION_DURATION_RATIO, Execution, Resampled};
 pub use holds::{Comparison, HoldRule, HoldSpec};
-pub use params::{FitParams, Reference};
+pub use params::{FitParams, RateTerm, Reference};
 
 use corrections::CorrectionCache;
 use layout::Layout;
@@ -74,21 +74,6 @@ pub struct TaskModel {
     grad_mean: Vec<f64>,
     sigma2_d: Vec<f64>,
     corrections: CorrectionCache,
-}
-
-/// How the rate coordinate (the warp gradient) enters `σ²_D` (Eq. 6).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub(crate) enum RateTerm {
-    /// `var_n(ψ̇) / r_rate²`, per sample: the term of the models fitted before the relative
-    /// term existed. A state file's model without the marker below loads with it, so that
-    /// it is the model it was saved as.
-    #[default]
-    Absolute,
-    /// Relative to the local mean pace and opened over [`stats::RATE_OPENING`] samples
-    /// ([`stats::rate_terms`]): every fit of this build. Persisted as one more entry after
-    /// the `d` ranges, the opening's width in reference samples (docs/decisions.md, "Fit
-    /// defaults on the task zoo": how an old state file keeps its model).
-    Relative,
 }
 
 /// The persisted part of a [`TaskModel`].
@@ -112,32 +97,89 @@ struct ModelData {
     scatter: Vec<f64>,
     grad_min: Vec<f64>,
     grad_max: Vec<f64>,
-    /// Not a field of the wire format: [`RateTerm::Relative`] is written as one more entry
-    /// of `ranges` ([`TaskModel`]'s conversions to and from this struct).
+    /// How the rate enters `σ²_D`. Not a field of the wire format: it is written after the
+    /// `d` ranges of `ranges` (see [`ModelData::split_rate_term`]).
     #[serde(skip)]
     rate_term: RateTerm,
+    /// With a duration window ([`RateTerm::Relative`]`::window > 0`): per reference sample
+    /// the mean time the demonstrations and executions spent on the window around it (demo
+    /// samples), `n_ref` values; empty otherwise. Written after the rate term's widths.
+    #[serde(skip)]
+    duration_mean: Vec<f64>,
+    /// The scatter (sum of squared deviations) of those durations, `n_ref` values; empty
+    /// without a duration window.
+    #[serde(skip)]
+    duration_scatter: Vec<f64>,
+}
+
+impl ModelData {
+    /// Reads the rate term out of the entries after the `d` ranges (how a model is stored
+    /// without a change of the state format: docs/decisions.md, "Fit defaults on the task
+    /// zoo", "An old state file keeps its model", and "Timing-only variable sections: the
+    /// duration term"):
+    ///
+    /// - none: [`RateTerm::Absolute`], a model saved before the relative term;
+    /// - one, the opening's width: [`RateTerm::Relative`] without a duration window (every
+    ///   model saved before the duration term, with an opening of 13);
+    /// - `2 + 2·n_ref`: the opening's width, the window's width, then the window durations'
+    ///   means and scatters.
+    ///
+    /// A build from before the duration term refuses the last kind as inconsistent (its
+    /// ranges are too long) rather than misreading it.
+    fn split_rate_term(&mut self) -> Result<()> {
+        let d = self.layout.dim();
+        let bad = |why: String| Error::BadData {
+            what: "task model".into(),
+            why,
+        };
+        let width = |v: f64, what: &str| -> Result<usize> {
+            if v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v <= 1e9 {
+                Ok(v as usize)
+            } else {
+                Err(bad(format!(
+                    "the rate term's {what} {v} is not a number of samples"
+                )))
+            }
+        };
+        self.rate_term = RateTerm::Absolute;
+        self.duration_mean.clear();
+        self.duration_scatter.clear();
+        if self.ranges.len() <= d {
+            return Ok(());
+        }
+        let tail = self.ranges.split_off(d);
+        let n = self.n_ref;
+        if tail.len() == 1 {
+            self.rate_term = RateTerm::Relative {
+                opening: width(tail[0], "opening")?,
+                window: 0,
+            };
+        } else if tail.len() == 2 + 2 * n {
+            let window = width(tail[1], "window")?;
+            if window == 0 {
+                return Err(bad("a duration window of 0 samples with durations".into()));
+            }
+            self.rate_term = RateTerm::Relative {
+                opening: width(tail[0], "opening")?,
+                window,
+            };
+            self.duration_mean = tail[2..2 + n].to_vec();
+            self.duration_scatter = tail[2 + n..].to_vec();
+        } else {
+            return Err(bad(format!(
+                "{} entries after the {d} ranges, which are no rate term",
+                tail.len()
+            )));
+        }
+        self.rate_term.validate().map_err(|e| bad(e.to_string()))
+    }
 }
 
 impl TryFrom<ModelData> for TaskModel {
     type Error = Error;
     fn try_from(mut data: ModelData) -> Result<Self> {
         let d = data.layout.dim();
-        // One entry after the `d` ranges marks the relative rate term (`RateTerm`); without
-        // it the model was saved by a build with the absolute term and keeps it.
-        data.rate_term = RateTerm::Absolute;
-        if data.ranges.len() == d + 1 {
-            let width = data.ranges.pop().expect("d + 1 entries");
-            if width != stats::RATE_OPENING as f64 {
-                return Err(Error::BadData {
-                    what: "task model".into(),
-                    why: format!(
-                        "the rate term's opening is {width} samples, this build knows {} only",
-                        stats::RATE_OPENING
-                    ),
-                });
-            }
-            data.rate_term = RateTerm::Relative;
-        }
+        data.split_rate_term()?;
         let n = data.n_ref;
         let ok = n >= 2
             && data.count >= 2
@@ -156,6 +198,8 @@ impl TryFrom<ModelData> for TaskModel {
                 .tangent_mean
                 .iter()
                 .chain(&data.scatter)
+                .chain(&data.duration_mean)
+                .chain(&data.duration_scatter)
                 .all(|v| v.is_finite())
             && data.anchors.iter().flatten().all(|v| v.is_finite());
         if !ok {
@@ -171,8 +215,13 @@ impl TryFrom<ModelData> for TaskModel {
 impl From<TaskModel> for ModelData {
     fn from(model: TaskModel) -> Self {
         let mut data = model.data;
-        if data.rate_term == RateTerm::Relative {
-            data.ranges.push(stats::RATE_OPENING as f64);
+        if let RateTerm::Relative { opening, window } = data.rate_term {
+            data.ranges.push(opening as f64);
+            if window > 0 {
+                data.ranges.push(window as f64);
+                data.ranges.extend(&data.duration_mean);
+                data.ranges.extend(&data.duration_scatter);
+            }
         }
         data
     }
@@ -265,6 +314,15 @@ impl TaskModel {
         &self.sigma2_d
     }
 
+    /// The rate's part of [`TaskModel::sigma2_d`] per reference sample (dimensionless, as
+    /// [`TaskModel::rate_term`] says; the rest is the channels' part): it scales as
+    /// `1/r_rate²` with the rate's range, so a range `r` instead of the model's gives
+    /// `σ²_D − part + part · (r_model / r)²`.
+    #[must_use]
+    pub fn sigma2_d_rate(&self) -> Vec<f64> {
+        self.rate_part()
+    }
+
     /// Mean warp gradient `ψ̄̇_D(n)` (Eq. 5), demo samples per reference sample.
     pub fn grad_mean(&self) -> &[f64] {
         &self.grad_mean
@@ -278,6 +336,14 @@ impl TaskModel {
     /// Maximum warp gradient `ψ̇max(n)` (Eq. 14), demo samples per reference sample.
     pub fn grad_max(&self) -> &[f64] {
         &self.data.grad_max
+    }
+
+    /// How the demonstrations' speeds enter [`TaskModel::sigma2_d`]: the form the model was
+    /// fitted with ([`FitParams::rate_term`]; [`RateTerm::Absolute`] for a model saved
+    /// before the relative term, [`RateTerm::Relative`] without a duration window for one
+    /// saved before the duration term).
+    pub fn rate_term(&self) -> RateTerm {
+        self.data.rate_term
     }
 
     /// Ranges `r_j` of the tangent coordinates; `W⁺ = diag(1/r_j²)`.
@@ -335,10 +401,15 @@ mod tests {
 
     #[test]
     fn a_model_saved_without_the_rate_terms_marker_keeps_the_absolute_term() {
-        let model = three_demo_model();
+        let (demos, warps) = three_demos();
+        let params = FitParams {
+            rate_term: RateTerm::RELATIVE_WITHOUT_WINDOW,
+            ..FitParams::default()
+        };
+        let model = TaskModel::fit_aligned(&demos, &warps, &params).unwrap();
         let data = ModelData::from(model.clone());
-        // The relative term is persisted as one entry after the d = 2 ranges: the opening's
-        // width. Loaded back, the same model.
+        // The relative term without a duration window is persisted as one entry after the
+        // d = 2 ranges: the opening's width. Loaded back, the same model.
         assert_eq!(data.ranges.len(), 3);
         assert_eq!(data.ranges[2], 13.0);
         let again = TaskModel::try_from(data.clone()).unwrap();
@@ -362,11 +433,47 @@ mod tests {
             })
             .unwrap();
         assert_eq!(ModelData::from(updated).ranges.len(), 2);
-        // A marker this build does not know is refused.
+        // An opening that is no width is refused, naming it.
         let mut other = ModelData::from(model);
-        other.ranges[2] = 7.0;
+        other.ranges[2] = 8.0;
         let err = TaskModel::try_from(other).unwrap_err().to_string();
-        assert!(err.contains("opening is 7 samples"), "{err}");
+        assert!(err.contains("opening must be an odd number"), "{err}");
+    }
+
+    #[test]
+    fn the_duration_term_by_hand_and_through_the_serde_form() {
+        let (demos, warps) = three_demos();
+        let params = FitParams {
+            rate_term: RateTerm::Relative {
+                opening: 13,
+                window: 3,
+            },
+            ..FitParams::default()
+        };
+        let model = TaskModel::fit_aligned(&demos, &warps, &params).unwrap();
+        // Windows of 3 samples: n = 0 spans [0, 1], durations 1, 1.5, 1 (mean 7/6, variance
+        // 1/12); n = 1 spans [0, 2]: 2, 4, 2 (mean 8/3, variance 4/3); n = 2 spans [1, 2]:
+        // 1, 2.5, 1 (mean 3/2, variance 3/4). The term is var / (r_rate · D̄ / ψ̄̇₀)² with
+        // r_rate/ψ̄̇₀ = 3: 1/147, 1/48, 1/27; the opened rate term is 1/147 everywhere
+        // (`hand_derived_statistics`), so the rate's part is the larger of the two.
+        let part = model.sigma2_d_rate();
+        assert!(close(part[0], 1.0 / 147.0));
+        assert!(close(part[1], 1.0 / 48.0));
+        assert!(close(part[2], 1.0 / 27.0));
+        assert!(close(model.sigma2_d()[1], 1.0 / 192.0 + 1.0 / 48.0));
+        // Persisted after the ranges: the widths, then 3 means and 3 scatters.
+        let data = ModelData::from(model.clone());
+        assert_eq!(data.ranges.len(), 2 + 2 + 2 * 3);
+        assert_eq!(&data.ranges[2..4], &[13.0, 3.0]);
+        assert!(close(data.ranges[5], 8.0 / 3.0) && close(data.ranges[8], 8.0 / 3.0));
+        let again = TaskModel::try_from(data.clone()).unwrap();
+        assert_eq!(again.rate_term(), model.rate_term());
+        assert_eq!(again.sigma2_d(), model.sigma2_d());
+        // A tail of another length is refused, naming what it holds.
+        let mut cut = data;
+        cut.ranges.pop();
+        let err = TaskModel::try_from(cut).unwrap_err().to_string();
+        assert!(err.contains("which are no rate term"), "{err}");
     }
 
     /// The model of two 2-sample demonstrations holding the constant orientations `a` and

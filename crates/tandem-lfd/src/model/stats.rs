@@ -226,19 +226,26 @@ pub(super) fn derive_at(
     (mean_n[d - 1], s2)
 }
 
-/// Width of the rate term's opening, reference samples: three node spacings of the
-/// alignment's default grid ([`tandem_warp::DEFAULT_NODE_SPACING`]) and one, the stretch over
-/// which two warps may place one change of speed at different nodes (docs/decisions.md, "Fit
-/// defaults on the task zoo: the rate term").
-pub(super) const RATE_OPENING: usize = 3 * tandem_warp::DEFAULT_NODE_SPACING + 1;
+/// The mean pace `ψ̄̇₀` (mean warp gradient over the reference) and the local pace
+/// `ψ̄̇(n)` of the statistics (`tangent_mean`, `n_ref × d`, rate last).
+fn paces(tangent_mean: &[f64], d: usize) -> (Vec<f64>, f64) {
+    let pace: Vec<f64> = tangent_mean
+        .iter()
+        .skip(d - 1)
+        .step_by(d)
+        .copied()
+        .collect();
+    let mean_pace = pace.iter().sum::<f64>() / pace.len() as f64;
+    (pace, mean_pace)
+}
 
-/// The rate's term of `σ²_D` per reference sample: the variance of the warp gradients
-/// relative to the local mean pace, `var_n(ψ̇) / (r_rate · ψ̄̇(n) / ψ̄̇₀)²` with `ψ̄̇₀` the mean
-/// of `ψ̄̇` over the reference (so the rate range `r_rate` counts at the task's mean pace,
-/// and a speed difference of 10 % weighs the same wherever the reference itself was fast
-/// or slow), then opened (a running minimum, then a running maximum, over
-/// [`RATE_OPENING`] samples): a rise of the term narrower than the alignment can place a
-/// change of speed is removed, a wider one kept as it is.
+/// The rate's term of `σ²_D` per reference sample, [`RateTerm::Relative`](super::RateTerm):
+/// the variance of the warp gradients relative to the local mean pace,
+/// `var_n(ψ̇) / (r_rate · ψ̄̇(n) / ψ̄̇₀)²` with `ψ̄̇₀` the mean of `ψ̄̇` over the reference (so
+/// the rate range `r_rate` counts at the task's mean pace, and a speed difference of 10 %
+/// weighs the same wherever the reference itself was fast or slow), then opened (a running
+/// minimum, then a running maximum, over `opening` samples): a rise of the term narrower
+/// than the alignment can place a change of speed is removed, a wider one kept as it is.
 ///
 /// `scatter`, `tangent_mean`: the model's statistics (`n_ref` rows); `denom = n − 1`.
 pub(super) fn rate_terms(
@@ -247,26 +254,97 @@ pub(super) fn rate_terms(
     d: usize,
     rate_range: f64,
     denom: f64,
+    opening: usize,
 ) -> Vec<f64> {
     let pl = packed_len(d);
-    let n_ref = tangent_mean.len() / d;
-    let pace = |n: usize| tangent_mean[n * d + d - 1];
-    let mean_pace = (0..n_ref).map(pace).sum::<f64>() / n_ref as f64;
-    let raw: Vec<f64> = (0..n_ref)
-        .map(|n| {
+    let (pace, mean_pace) = paces(tangent_mean, d);
+    let raw: Vec<f64> = pace
+        .iter()
+        .enumerate()
+        .map(|(n, &p)| {
             let var = scatter[n * pl + packed_idx(d, d - 1, d - 1)] / denom;
             // A pace of 0 (or a mean pace of 0, no demonstrated motion) falls back to the
             // range as given.
-            let local = if pace(n) > 0.0 && mean_pace > 0.0 {
-                rate_range * pace(n) / mean_pace
+            let local = if p > 0.0 && mean_pace > 0.0 {
+                rate_range * p / mean_pace
             } else {
                 rate_range
             };
             var / (local * local)
         })
         .collect();
-    let eroded = running(&raw, RATE_OPENING / 2, f64::min);
-    running(&eroded, RATE_OPENING / 2, f64::max)
+    let eroded = running(&raw, opening / 2, f64::min);
+    running(&eroded, opening / 2, f64::max)
+}
+
+/// The reference samples `[a, b]` of the duration window of width `window` around `n`
+/// (clipped to the reference's `n_ref` samples).
+fn window_at(n: usize, window: usize, n_ref: usize) -> (usize, usize) {
+    let h = window / 2;
+    (n.saturating_sub(h), (n + h).min(n_ref - 1))
+}
+
+/// Per reference sample the time (demo samples) a warp spent on the duration window of
+/// width `window` around it: `ψ(b) − ψ(a)` ([`window_at`]).
+pub(super) fn window_durations(warp: &[f64], window: usize) -> Vec<f64> {
+    (0..warp.len())
+        .map(|n| {
+            let (a, b) = window_at(n, window, warp.len());
+            warp[b] - warp[a]
+        })
+        .collect()
+}
+
+/// Two-pass mean and scatter (sum of squared deviations) per reference sample of the
+/// window durations of `warps` ([`window_durations`]).
+pub(super) fn duration_statistics(warps: &[Vec<f64>], window: usize) -> (Vec<f64>, Vec<f64>) {
+    let durations: Vec<Vec<f64>> = warps
+        .par_iter()
+        .map(|w| window_durations(w, window))
+        .collect();
+    let n_ref = warps[0].len();
+    let count = durations.len() as f64;
+    (0..n_ref)
+        .into_par_iter()
+        .map(|n| {
+            let mean = durations.iter().map(|d| d[n]).sum::<f64>() / count;
+            let scatter = durations.iter().map(|d| (d[n] - mean).powi(2)).sum::<f64>();
+            (mean, scatter)
+        })
+        .unzip()
+}
+
+/// The duration term of `σ²_D` per reference sample ([`RateTerm::Relative`](super::RateTerm)
+/// with a window): the variance over the demonstrations and executions of the time each
+/// spent on the window around the sample, relative to its mean as the rate term weighs a
+/// pace, `var_n(D) / (r_rate · D̄(n) / ψ̄̇₀)²` (a window of `k` steps spent at the mean pace
+/// everywhere has `D̄ = k·ψ̄̇₀`, and the term is then the rate term of the window's mean
+/// speed). Where a variable stretch was absorbed by the alignment as one steep step of
+/// some warps, the per-sample rate term sees a rise narrower than its opening and drops it;
+/// the window durations see the whole difference wherever in the window it was placed.
+pub(super) fn duration_terms(
+    duration_mean: &[f64],
+    duration_scatter: &[f64],
+    tangent_mean: &[f64],
+    d: usize,
+    rate_range: f64,
+    denom: f64,
+    window: usize,
+) -> Vec<f64> {
+    let (_, mean_pace) = paces(tangent_mean, d);
+    let n_ref = duration_mean.len();
+    (0..n_ref)
+        .map(|n| {
+            let var = duration_scatter[n] / denom;
+            let (a, b) = window_at(n, window, n_ref);
+            let local = if duration_mean[n] > 0.0 && mean_pace > 0.0 {
+                rate_range * duration_mean[n] / mean_pace
+            } else {
+                rate_range * (b - a).max(1) as f64
+            };
+            var / (local * local)
+        })
+        .collect()
 }
 
 /// `out[n] = fold(v[n − h..=n + h])` (clipped at the ends) for an associative, commutative
@@ -327,28 +405,57 @@ impl TaskModel {
         self.add_rate_terms();
     }
 
-    /// Adds the rate's term ([`rate_terms`]) to `σ²_D`, whose channels' part
-    /// [`derive_at`] wrote.
-    pub(super) fn add_rate_terms(&mut self) {
+    /// The rate's part of `σ²_D` per reference sample, as the model's
+    /// [`RateTerm`](super::RateTerm) says: `var_n(ψ̇)/r_rate²` (absolute), or the relative
+    /// term ([`rate_terms`]), with a duration window the larger of it and the duration term
+    /// ([`duration_terms`]).
+    pub(super) fn rate_part(&self) -> Vec<f64> {
         let data = &self.data;
         let d = data.layout.dim();
-        if data.rate_term == super::RateTerm::Absolute {
-            // The models saved before the relative term: `var_n(ψ̇) / r_rate²` per sample.
-            let pl = packed_len(d);
-            let inv = 1.0 / (data.ranges[d - 1] * data.ranges[d - 1] * (data.count - 1) as f64);
-            for (n, s2) in self.sigma2_d.iter_mut().enumerate() {
-                *s2 += data.scatter[n * pl + packed_idx(d, d - 1, d - 1)] * inv;
+        let pl = packed_len(d);
+        let rate_range = data.ranges[d - 1];
+        let denom = (data.count - 1) as f64;
+        match data.rate_term {
+            super::RateTerm::Absolute => {
+                // The models saved before the relative term: `var_n(ψ̇) / r_rate²` per sample.
+                let inv = 1.0 / (rate_range * rate_range * denom);
+                (0..data.n_ref)
+                    .map(|n| data.scatter[n * pl + packed_idx(d, d - 1, d - 1)] * inv)
+                    .collect()
             }
-            return;
+            super::RateTerm::Relative { opening, window } => {
+                let mut terms = rate_terms(
+                    &data.scatter,
+                    &data.tangent_mean,
+                    d,
+                    rate_range,
+                    denom,
+                    opening,
+                );
+                if window > 0 {
+                    let durations = duration_terms(
+                        &data.duration_mean,
+                        &data.duration_scatter,
+                        &data.tangent_mean,
+                        d,
+                        rate_range,
+                        denom,
+                        window,
+                    );
+                    for (t, u) in terms.iter_mut().zip(durations) {
+                        *t = t.max(u);
+                    }
+                }
+                terms
+            }
         }
-        let terms = rate_terms(
-            &data.scatter,
-            &data.tangent_mean,
-            d,
-            data.ranges[d - 1],
-            (data.count - 1) as f64,
-        );
-        for (s2, t) in self.sigma2_d.iter_mut().zip(terms) {
+    }
+
+    /// Adds the rate's part ([`TaskModel::rate_part`]) to `σ²_D`, whose channels' part
+    /// [`derive_at`] wrote.
+    pub(super) fn add_rate_terms(&mut self) {
+        let part = self.rate_part();
+        for (s2, t) in self.sigma2_d.iter_mut().zip(part) {
             *s2 += t;
         }
     }

@@ -68,6 +68,13 @@ pub struct PlannerParams {
     pub holds: HoldSpec,
 }
 
+/// The name under which [`lfd::FitParams::rate_term`] is stored ([`Extras`], its spelling
+/// `relative:opening=13,window=0` as a string) when it differs
+/// from the form of the stored model (absent: that form, so every file written before the
+/// parameter existed loads with the form its model was fitted with: absolute before the
+/// relative term, relative without a duration window before the duration term).
+pub const FIT_RATE_TERM: &str = "fit.rate_term";
+
 /// [`lfd::FitParams`] as format 11 writes them.
 #[expect(
     missing_docs,
@@ -513,6 +520,8 @@ impl From<&lfd::FitParams> for FitParams {
             k_max,
             schema,
             reference,
+            // Stored by name (`FIT_RATE_TERM`).
+            rate_term: _,
         } = p;
         FitParams {
             warp: warp.into(),
@@ -534,6 +543,9 @@ impl From<FitParams> for lfd::FitParams {
             k_max: f.k_max,
             schema: f.schema.into(),
             reference: f.reference.into(),
+            // Stored by name (`FIT_RATE_TERM`): `Payload::into_state` reads it, absent the
+            // form the stored model was fitted with.
+            rate_term: lfd::RateTerm::DEFAULT,
         }
     }
 }
@@ -1004,7 +1016,14 @@ impl Payload {
             reference,
             records,
         } = state;
-        let extras = Extras::default();
+        let mut extras = Extras::default();
+        // Absent: the form of the stored model, which every planner of a build without the
+        // parameter was fitted with.
+        extras.put(
+            FIT_RATE_TERM,
+            &params.fit.rate_term.to_string(),
+            &model.rate_term().to_string(),
+        )?;
         let payload = Payload {
             params: params.into(),
             model: model.clone(),
@@ -1028,8 +1047,13 @@ impl Payload {
     /// A part the library refuses (counts, flags, a demonstration, a hold rule), or
     /// [`Error::Inconsistent`] for a parameter stored by name that this build does not know
     /// (the file was written by a newer build).
-    pub(crate) fn into_state(self, extras: Extras) -> Result<super::PlannerState> {
-        let params = self.params.try_into()?;
+    pub(crate) fn into_state(self, mut extras: Extras) -> Result<super::PlannerState> {
+        let mut params: crate::PlannerParams = self.params.try_into()?;
+        let rate_term: String = extras.take(FIT_RATE_TERM, self.model.rate_term().to_string())?;
+        params.fit.rate_term = rate_term.parse().map_err(|e| Error::Inconsistent {
+            what: "parameters stored by name",
+            why: format!("`{FIT_RATE_TERM}` = `{rate_term}`: {e}"),
+        })?;
         extras.finish()?;
         Ok(super::PlannerState {
             params,
@@ -1112,6 +1136,45 @@ mod tests {
         let state = payload.into_state(extras).unwrap();
         let (again, extras) = Payload::from_state(&state).unwrap();
         assert_eq!(encode_payload(&again, &extras).unwrap(), bytes);
+    }
+
+    #[test]
+    fn the_rate_term_is_stored_by_name_only_off_its_models_form() {
+        let (path, bytes) = golden();
+        let (payload, extras) = decode_any(&bytes, &path).unwrap();
+        let mut state = payload.into_state(extras).unwrap();
+        // Absent from the file: the form its model was fitted with.
+        assert_eq!(state.params.fit.rate_term, state.model.rate_term());
+        // Another form is written after the payload, by name, and read back.
+        let other = lfd::RateTerm::Relative {
+            opening: 5,
+            window: 49,
+        };
+        state.params.fit.rate_term = other;
+        let (payload, extras) = Payload::from_state(&state).unwrap();
+        assert_eq!(extras.names().collect::<Vec<_>>(), [FIT_RATE_TERM]);
+        let file = encode_payload(&payload, &extras).unwrap();
+        assert_eq!(&file[HEADER_LEN..bytes.len()], &bytes[HEADER_LEN..]);
+        let (payload, extras) = decode_any(&file, &path).unwrap();
+        assert_eq!(
+            payload.into_state(extras).unwrap().params.fit.rate_term,
+            other
+        );
+        // A stored value this build cannot read is refused, naming the parameter and the
+        // choices.
+        let mut bad = Extras::default();
+        bad.put(
+            FIT_RATE_TERM,
+            &"relative:window=4".to_owned(),
+            &String::new(),
+        )
+        .unwrap();
+        let (payload, _) = decode_any(&bytes, &path).unwrap();
+        let err = payload.into_state(bad).unwrap_err().to_string();
+        assert!(
+            err.contains(FIT_RATE_TERM) && err.contains("odd number of samples ≥ 3, got 4"),
+            "{err}"
+        );
     }
 
     /// What a build whose warp parameters gained a parameter with a default would write and
