@@ -77,7 +77,7 @@ def write_execution(folder: Path, robot: int, run, channels) -> list:
 def test_record_round_equals_tandem_record(tmp_path: Path) -> None:
     cli_fit(tmp_path / "cli.state")
     py = tandem.fit(DEMOS, params=PARAMS)
-    run = tandem.sim.run_round(py, tandem.sim.sanding_needs(LABELS, seed=1), seed=1)
+    run = tandem.sim.run_round(py, tandem.sim.sanding_needs(LABELS, seed=1, planner=py), seed=1)
     files = [write_execution(tmp_path, i, run, py.model.channels) for i in range(2)]
     run_cli(
         "record", tmp_path / "cli.state",
@@ -122,7 +122,7 @@ def test_memory_layout_of_arrays_does_not_matter() -> None:
 def test_record_round_takes_execution_files_with_columns_in_any_order(tmp_path: Path) -> None:
     from_arrays = tandem.fit(DEMOS, params=PARAMS)
     from_files = tandem.fit(DEMOS, params=PARAMS)
-    run = tandem.sim.run_round(from_arrays, tandem.sim.sanding_needs(LABELS, seed=2), seed=2)
+    run = tandem.sim.run_round(from_arrays, tandem.sim.sanding_needs(LABELS, seed=2, planner=from_arrays), seed=2)
     channels = from_arrays.model.channels
     files = []
     for i, r in enumerate(run.robots):
