@@ -73,7 +73,7 @@ def planner_for(args: argparse.Namespace) -> tandem.Planner:
         params={"sampler": {"samples": args.samples}, "confidence": {"mu_c": 0.3, "gamma_c": 0.5}},
     )
     for k in range(2):
-        run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(SANDING / "demo_0.labels.csv", k), k)
+        run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(SANDING, k, planner=planner), k)
         planner.record_round(**run.record_args())
     return planner
 

@@ -9,10 +9,12 @@ schedule shorten as the planner learns where the operator is needed.
 
 The demonstrations are by default the repository's ``fixtures/sanding/demo_{0..5}.csv`` (4
 sanding passes, 100 Hz, channels x, y, z, qx, qy, qz, qw, force, tool), whose ground-truth
-labels (``demo_0.labels.csv``) say which samples of a random workpiece need the operator.
+labels (``demo_<i>.labels.csv``, one file per demonstration; the simulation reads those of the
+model's reference) say which samples of a random workpiece need the operator.
 With ``--demos-dir`` any folder of demonstrations works: its ``demo_<digits>.csv`` files if
 there are any, else every ``*.csv`` in it except label, log and correction files (in name
-order, shorter names first, so ``peg_2`` before ``peg_10``; the first is the reference). Where the workpieces need
+order, shorter names first, so ``peg_2`` before ``peg_10``; the fit's reference is the medoid, the
+demonstration the others agree with best, so the order does not change the model). Where the workpieces need
 the operator then comes from ``--need`` (a need file, ``tandem need`` writes one), or else
 from the model's low-confidence regions right after the fit, each needed on a workpiece with
 probability ``--need-level``. After every round (one
@@ -58,13 +60,14 @@ def main() -> None:
     if channel not in model.channels:
         raise SystemExit(f"the model has no channel `{channel}` for the simulated operator to "
                          f"raise: give --channel NAME (channels: {', '.join(model.channels)})")
-    labels = args.demos_dir / "demo_0.labels.csv"
+    # One labels file per demonstration, demo_<i>.labels.csv for the i-th file given to the fit.
+    labels = [d.with_name(d.stem + ".labels.csv") for d in demos]
     if args.need is not None:
         source = {"need_file": args.need}
         print(f"needs: {args.need}")
-    elif labels.exists() and demos[0].name == "demo_0.csv":
+    elif all(f.exists() for f in labels):
         source = None
-        print(f"needs: sanding labels {labels}")
+        print(f"needs: sanding labels {labels[model.reference_idx]} (the reference's)")
     else:
         regions = tandem.sim.low_confidence_regions(planner)
         if not regions:
@@ -78,7 +81,7 @@ def main() -> None:
     for k in range(1, args.rounds + 1):
         # Fresh workpieces, one per robot, and one run of the schedule.
         if source is None:
-            needs = tandem.sim.sanding_needs(labels, seed=k, robots=planner.n_robots)
+            needs = tandem.sim.sanding_needs(labels, seed=k, planner=planner)
         else:
             needs = tandem.sim.needs(planner=planner, seed=k, **source)
         run = tandem.sim.run_round(planner, needs, seed=k, operator=operator)

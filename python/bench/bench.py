@@ -50,7 +50,7 @@ def bench_tick(calls: int) -> None:
         DEMOS, params={"sampler": {"samples": 300}, "confidence": {"mu_c": 0.3, "gamma_c": 0.5}}
     )
     for k in range(2):
-        run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(SANDING / "demo_0.labels.csv", k), k)
+        run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(SANDING, k, planner=planner), k)
         planner.record_round(**run.record_args())
     coord = tandem.Coordinator(planner.schedule)
     ops = [None, 0.9, "fastest", "slowest"]

@@ -628,7 +628,11 @@ def sim_run_round(
     operator: Optional[Mapping[str, Any]] = None,
 ) -> Dict[str, Any]: ...
 def sim_sanding_needs(
-    labels: Path, seed: int, task: Optional[Mapping[str, Any]] = None, robots: int = 2
+    labels: List[Path],
+    seed: int,
+    task: Optional[Mapping[str, Any]] = None,
+    robots: int = 2,
+    planner: Optional[Planner] = None,
 ) -> Bool: ...
 def sim_needs(
     n_ref: int,

@@ -156,27 +156,50 @@ def run_pair(
 
 
 def sanding_needs(
-    labels: Union[str, PathLike],
+    labels: Union[str, PathLike, Sequence[Union[str, PathLike]]],
     seed: int,
     task: Optional[Mapping[str, Any]] = None,
-    robots: int = 2,
+    robots: Optional[int] = None,
+    planner: Optional[Planner] = None,
 ) -> np.ndarray:
     """Which reference samples need a correction on ``N`` random sanding workpieces (§III).
 
     A sample needs one when it is sanding in passes 1–3 over a painted section of the robot's
     own workpiece (half the sections of passes 1–3 are painted at random).
 
+    The needs are per sample of the model's reference demonstration, so they come from that
+    demonstration's labels: with ``planner``, the labels of the demonstration its fit chose as
+    the reference (``planner.model.reference_idx``; the default reference is the medoid, which
+    need not be the first file). Each demonstration of the fixtures has its own labels file,
+    so every reference choice has exact ground truth (nothing is mapped through a warp).
+
     Args:
-        labels: the reference demonstration's labels file (``demo_0.labels.csv`` of the
-            fixtures' layout: ``pass,section,painted,phase``).
+        labels: the ground-truth labels (CSV ``pass,section,painted,phase``, one row per
+            sample): the folder with ``demo_<i>.labels.csv`` of the fixtures' layout
+            (``demo_<i>`` the ``i``-th demonstration given to the fit, counted from 0), a list
+            of labels files, one per demonstration in the fit's order, or the reference
+            demonstration's own labels file. A folder or a list needs ``planner``.
         seed: seed of the workpieces' draw.
         task: task parameters (dict; only ``n_sections`` matters).
-        robots: ``N``, one workpiece per robot (1 to 8; default 2).
+        robots: ``N``, one workpiece per robot (1 to 8; default: the planner's, else 2).
+        planner: the planner whose model the needs are for; picks its reference's labels and
+            checks that they are one per reference sample.
 
     Returns:
         ``(N, T_ref)`` bool array.
+
+    Raises:
+        InputError: a labels file that cannot be read, or labels that are not one per sample
+            of the planner's reference (the message names the file and the demonstration).
+        ParamError: a folder or a list without ``planner``, or ``robots`` out of range.
     """
-    return sim_sanding_needs(labels, seed, task, robots)
+    if isinstance(labels, (list, tuple)):
+        files = [str(f) for f in labels]
+    else:
+        files = [str(labels)]
+    if robots is None:
+        robots = planner.n_robots if planner is not None else 2
+    return sim_sanding_needs(files, seed, task, int(robots), planner)
 
 
 def needs(

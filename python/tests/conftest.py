@@ -14,7 +14,9 @@ import tandem
 ROOT = Path(__file__).resolve().parents[2]
 SANDING = ROOT / "fixtures" / "sanding"
 DEMOS = [SANDING / f"demo_{i}.csv" for i in range(6)]
-LABELS = SANDING / "demo_0.labels.csv"
+#: The ground-truth labels, one file per demonstration: `tandem.sim.sanding_needs` takes the
+#: planner's reference's (the fit's default reference is the medoid, not demo 0).
+LABELS = SANDING
 
 #: Sampler size of the tests' planners (the paper's 5000 is not needed to test the plumbing).
 SAMPLES = 200
@@ -42,7 +44,7 @@ def load_arrays(path: Path):
 def record_rounds(planner: tandem.Planner, rounds: int, seed0: int = 0) -> None:
     """Runs and records ``rounds`` rounds in the simulated workcell."""
     for k in range(seed0, seed0 + rounds):
-        needs = tandem.sim.sanding_needs(LABELS, seed=k)
+        needs = tandem.sim.sanding_needs(LABELS, seed=k, planner=planner)
         run = tandem.sim.run_round(planner, needs, seed=k)
         planner.record_round(**run.record_args())
 

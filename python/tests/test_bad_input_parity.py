@@ -369,7 +369,9 @@ def test_a_hold_rule_without_comparison_in_a_parameter_file(folder: Path) -> Non
 
 def small_state(folder: Path) -> Path:
     state = folder / "cell.tandem"
-    out = run_cli(["fit", *small_demos(folder), "--samples", 200, "-o", state])
+    # Demo 0 is the reference, as in the CLI tests' `common::small_state` (the executions
+    # below replay demo 0 on its own axis; the default reference is the medoid).
+    out = run_cli(["fit", *small_demos(folder), "--reference", "first", "--samples", 200, "-o", state])
     assert out.returncode == 0, out.stderr
     return state
 
@@ -596,7 +598,8 @@ def test_overlapping_need_regions(folder: Path) -> None:
 
 def test_a_schedule_checked_at_another_tick_is_not_simulated(folder: Path) -> None:
     demos = small_demos(folder)
-    params = write(folder, "half_tick.toml", "[sampler]\nsamples = 200\ntick_s = 0.005\n")
+    params = write(folder, "half_tick.toml",
+                   "[fit]\nreference = \"first\"\n[sampler]\nsamples = 200\ntick_s = 0.005\n")
     state = folder / "cell.tandem"
     assert run_cli(["fit", *demos, "--params", params, "-o", state]).returncode == 0
     need = write(folder, "need.csv", "need\n" + "0.5\n" * SMALL_N_REF)

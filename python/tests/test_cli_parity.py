@@ -77,7 +77,7 @@ def write_execution(folder: Path, robot: int, run, channels) -> list:
 def test_record_round_equals_tandem_record(tmp_path: Path) -> None:
     cli_fit(tmp_path / "cli.state")
     py = tandem.fit(DEMOS, params=PARAMS)
-    run = tandem.sim.run_round(py, tandem.sim.sanding_needs(LABELS, seed=1), seed=1)
+    run = tandem.sim.run_round(py, tandem.sim.sanding_needs(LABELS, seed=1, planner=py), seed=1)
     files = [write_execution(tmp_path, i, run, py.model.channels) for i in range(2)]
     run_cli(
         "record", tmp_path / "cli.state",
@@ -108,13 +108,16 @@ def test_memory_layout_of_arrays_does_not_matter() -> None:
     t = np.linspace(0.0, 1.0, 60)
     demos = [np.column_stack([np.sin(3 * t + k), t**2, np.cos(t * k)]) for k in range(3)]
     channels = ["a", "b", "c"]
-    reference = tandem.fit_model(demos, channels=channels)
+    # Three unrelated signals, not one task: demo 0 is the reference (on another's axis it
+    # would look cut off); the test is about the arrays' layout, not the reference choice.
+    first = {"fit": {"reference": "first"}}
+    reference = tandem.fit_model(demos, channels=channels, params=first)
     fortran = [np.asfortranarray(d) for d in demos]
     strided = [np.repeat(d, 2, axis=0)[::2] for d in demos]
     transposed = [np.ascontiguousarray(d.T).T for d in demos]
     as_lists = [d.tolist() for d in demos]
     for variant in (fortran, strided, transposed, as_lists):
-        other = tandem.fit_model(variant, channels=channels)
+        other = tandem.fit_model(variant, channels=channels, params=first)
         np.testing.assert_array_equal(other.mean, reference.mean)
         np.testing.assert_array_equal(other.sigma2_d, reference.sigma2_d)
 
@@ -122,7 +125,7 @@ def test_memory_layout_of_arrays_does_not_matter() -> None:
 def test_record_round_takes_execution_files_with_columns_in_any_order(tmp_path: Path) -> None:
     from_arrays = tandem.fit(DEMOS, params=PARAMS)
     from_files = tandem.fit(DEMOS, params=PARAMS)
-    run = tandem.sim.run_round(from_arrays, tandem.sim.sanding_needs(LABELS, seed=2), seed=2)
+    run = tandem.sim.run_round(from_arrays, tandem.sim.sanding_needs(LABELS, seed=2, planner=from_arrays), seed=2)
     channels = from_arrays.model.channels
     files = []
     for i, r in enumerate(run.robots):

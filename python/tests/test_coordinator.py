@@ -63,9 +63,8 @@ def replay(planner: tandem.Planner, run: tandem.sim.RoundRun) -> dict:
 def test_python_coordinator_reproduces_a_rust_workcell_run(
     overlapping_planner: tandem.Planner, seed: int
 ) -> None:
-    run = tandem.sim.run_round(
-        overlapping_planner, tandem.sim.sanding_needs(LABELS, seed=seed), seed=seed
-    )
+    needs = tandem.sim.sanding_needs(LABELS, seed=seed, planner=overlapping_planner)
+    run = tandem.sim.run_round(overlapping_planner, needs, seed=seed)
     corrected = sum(int(r.corrected.sum()) for r in run.robots)
     assert corrected > 0, "the run exercises the operator's gradients"
     got = replay(overlapping_planner, run)

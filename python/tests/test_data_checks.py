@@ -45,7 +45,7 @@ def at_1khz(args: dict) -> dict:
 def test_a_1_khz_log_is_resampled_never_a_model_whose_mean_execution_triples() -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
     before = mean_execution_s(planner)
-    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=4), seed=4)
+    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=4, planner=planner), seed=4)
     args = run.record_args()
     fast = at_1khz(args)
     # The same round at 100 Hz, for comparison.
@@ -100,7 +100,7 @@ def stamped_at_250hz(args: dict, channels: list, tmp: Path, rng: np.random.Gener
 
 def test_a_250_hz_log_with_its_own_jittered_clock_is_recorded_with_resample(tmp_path: Path) -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
-    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=6), seed=6)
+    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=6, planner=planner), seed=6)
     args = run.record_args()
     stamped = stamped_at_250hz(args, list(planner.model.channels), tmp_path, np.random.default_rng(6))
     reference = tandem.fit(DEMOS, params=PARAMS)
@@ -132,7 +132,7 @@ def test_a_250_hz_log_with_its_own_jittered_clock_is_recorded_with_resample(tmp_
 
 def test_a_coarser_log_is_refused() -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
-    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=1), seed=1).record_args()
+    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=1, planner=planner), seed=1).record_args()
     with pytest.raises(tandem.InputError, match="coarser than the model's 0.01 s") as e:
         planner.record_round(**{**args, "dt_s": 0.02})
     assert e.value.file == "executions[0]"
@@ -142,7 +142,7 @@ def test_a_coarser_log_is_refused() -> None:
 
 def test_a_truncated_execution_is_refused() -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
-    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=2), seed=2).record_args()
+    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=2, planner=planner), seed=2).record_args()
     half = len(args["ref_time_logs"][1]) // 2
     cut = {k: [v[0], v[1][:half]] for k, v in args.items()}
     with pytest.raises(tandem.InputError, match=r"ends at reference sample .*whole task") as e:
@@ -153,7 +153,7 @@ def test_a_truncated_execution_is_refused() -> None:
 
 def test_the_same_round_twice_is_refused() -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
-    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=3), seed=3).record_args()
+    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=3, planner=planner), seed=3).record_args()
     planner.record_round(**args)
     before = planner.schedule.t_total_s
     with pytest.raises(tandem.InputError, match="already recorded as round 1"):
@@ -197,7 +197,7 @@ def test_a_time_column_under_another_name_is_refused(tmp_path: Path) -> None:
 
 def test_a_file_without_t_states_its_assumed_period(tmp_path: Path) -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
-    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=5), seed=5)
+    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=5, planner=planner), seed=5)
     args = run.record_args()
     files = []
     for i, x in enumerate(args["executions"]):
@@ -210,7 +210,7 @@ def test_a_file_without_t_states_its_assumed_period(tmp_path: Path) -> None:
 
 def test_the_tick_a_user_chose_survives_record_round() -> None:
     planner = tandem.fit(DEMOS, params=PARAMS)
-    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=6), seed=6).record_args()
+    args = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=6, planner=planner), seed=6).record_args()
     planner.reschedule(tick_s=0.005)
     assert planner.schedule.tick_s == 0.005
     planner.record_round(**args, dt_s=0.01)  # logged at the 10 ms tick it ran at
@@ -222,7 +222,8 @@ def test_the_tick_a_user_chose_survives_record_round() -> None:
 def test_the_state_file_is_locked_and_never_overwritten_by_accident(tmp_path: Path) -> None:
     path = tmp_path / "cell.tandem"
     tandem.fit(DEMOS, params=PARAMS).save(path)
-    args = tandem.sim.run_round(tandem.Planner.load(path), tandem.sim.sanding_needs(LABELS, seed=7), seed=7).record_args()
+    loaded = tandem.Planner.load(path)
+    args = tandem.sim.run_round(loaded, tandem.sim.sanding_needs(LABELS, seed=7, planner=loaded), seed=7).record_args()
     with tandem.Planner.locked(path) as planner:
         planner.record_round(**args)
         # Another writer waits for the lock, then gives up with a clear error.

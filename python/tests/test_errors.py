@@ -125,7 +125,7 @@ def test_a_failed_record_round_leaves_planner_and_file_intact(tmp_path: Path) ->
     tandem.fit(DEMOS, params={"sampler": {"samples": SAMPLES}}).save(path)
     before = path.read_bytes()
     planner = tandem.Planner.load(path)
-    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=3), seed=3)
+    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=3, planner=planner), seed=3)
     args = run.record_args()
     n = len(args["ref_time_logs"][1])
     bad_cases = [
@@ -154,7 +154,7 @@ def test_the_two_robot_names_are_deprecated_aliases(tmp_path: Path) -> None:
     fitted = tandem.fit(DEMOS, params={"sampler": {"samples": SAMPLES}})
     fitted.save(tmp_path / "base.tandem")
     new, old = (tandem.Planner.load(tmp_path / "base.tandem") for _ in range(2))
-    run = tandem.sim.run_round(new, tandem.sim.sanding_needs(LABELS, seed=4), seed=4)
+    run = tandem.sim.run_round(new, tandem.sim.sanding_needs(LABELS, seed=4, planner=new), seed=4)
     new.record_round(**run.record_args())
     with pytest.warns(DeprecationWarning, match="use Planner.record_round"):
         old.record_pair(**run.record_args())

@@ -19,7 +19,7 @@ def rounds_of(planner: tandem.Planner, seeds: range) -> list[dict]:
     """Runs and records one simulated round per seed; returns their ``record_round`` args."""
     args = []
     for k in seeds:
-        run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=k), seed=k)
+        run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=k, planner=planner), seed=k)
         args.append(run.record_args())
         planner.record_round(**args[-1])
     return args

@@ -20,7 +20,7 @@ def three() -> tandem.Planner:
         robots=3,
     )
     for k in range(2):
-        needs = tandem.sim.sanding_needs(LABELS, seed=k, robots=3)
+        needs = tandem.sim.sanding_needs(LABELS, seed=k, planner=p)
         run = tandem.sim.run_round(p, needs, seed=k)
         assert len(run.robots) == 3 and run.overlap_ticks == 0
         assert 0.0 < run.operator_busy_share <= 1.0
@@ -92,7 +92,7 @@ def test_the_planner_coordinates_its_three_robots(three: tandem.Planner) -> None
 
 
 def test_rounds_take_one_execution_per_robot(three: tandem.Planner) -> None:
-    needs = tandem.sim.sanding_needs(LABELS, seed=9, robots=3)
+    needs = tandem.sim.sanding_needs(LABELS, seed=9, planner=three)
     run = tandem.sim.run_round(three, needs, seed=9)
     args = run.record_args()
     short = {k: v[:2] for k, v in args.items()}
@@ -101,7 +101,7 @@ def test_rounds_take_one_execution_per_robot(three: tandem.Planner) -> None:
         three.record_round(**short)
     assert three.rounds_recorded == before
     with pytest.raises(tandem.InputError):
-        tandem.sim.run_round(three, tandem.sim.sanding_needs(LABELS, seed=9), seed=9)
+        tandem.sim.run_round(three, tandem.sim.sanding_needs(LABELS, seed=9, planner=three, robots=2), seed=9)
     with pytest.raises(tandem.ParamError):
         tandem.fit(DEMOS[:2], robots=9)
     assert np.array_equal(needs.shape, (3, three.model.n_ref))

@@ -20,7 +20,7 @@ def test_a_correction_on_an_unsupervised_sample_is_refused(tmp_path: Path) -> No
     # Two rounds with a quick confidence, so that the schedule runs samples unsupervised.
     planner = tandem.fit(DEMOS, params={**PARAMS, "confidence": QUICK_CONFIDENCE})
     record_rounds(planner, 2)
-    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=9), seed=9)
+    run = tandem.sim.run_round(planner, tandem.sim.sanding_needs(LABELS, seed=9, planner=planner), seed=9)
     args = run.record_args()
     unsupervised = np.flatnonzero(~np.asarray(args["supervised"][1]))
     assert unsupervised.size, "the schedule runs some samples unsupervised"
@@ -111,7 +111,7 @@ def test_rounds_run_concurrently_give_one_confidence_in_any_order(tmp_path: Path
     start = tandem.fit(DEMOS, params={**PARAMS, "confidence": QUICK_CONFIDENCE})
     start.save(tmp_path / "start.tandem")
     runs = [
-        tandem.sim.run_round(start, tandem.sim.sanding_needs(LABELS, seed=k), seed=k)
+        tandem.sim.run_round(start, tandem.sim.sanding_needs(LABELS, seed=k, planner=start), seed=k)
         for k in range(6)
     ]
     highs = []

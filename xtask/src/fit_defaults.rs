@@ -254,8 +254,18 @@ fn measure(
         reference: Reference::Medoid,
         ..base.clone()
     };
-    let (medoid, ..) = view(truth, demos, &identity, &medoid_fit, "medoid".into())?;
-    let (default, model, conf) = view(truth, demos, &identity, base, "default".into())?;
+    let (medoid, medoid_model, medoid_conf) =
+        view(truth, demos, &identity, &medoid_fit, "medoid".into())?;
+    let (default, model, conf) = if base.reference == Reference::Medoid {
+        // The default fit is the medoid's: the same model, not fitted twice.
+        let default = FitView {
+            choice: "default".into(),
+            ..medoid.clone()
+        };
+        (default, medoid_model, medoid_conf)
+    } else {
+        view(truth, demos, &identity, base, "default".into())?
+    };
     if let Some(write) = detail {
         write(&default, &model, &conf)?;
     }

@@ -66,7 +66,8 @@ pub(crate) struct StudyArgs {
     /// Output folder (created if missing). Default: results/ in the workspace.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Folder with demo_{i}.csv and demo_0.labels.csv. Default: fixtures/sanding/.
+    /// Folder with demo_{i}.csv and each one's demo_{i}.labels.csv (the truth is the labels of
+    /// the fit's reference). Default: fixtures/sanding/.
     #[arg(long)]
     fixtures: Option<PathBuf>,
     /// Worker threads (default: all cores). Results do not depend on it.

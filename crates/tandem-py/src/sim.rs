@@ -13,7 +13,7 @@ use crate::arrays::{flag_matrix, out_flags, out_matrix, out_vector};
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
     NeedProfile, NeedRegion, OperatorParams, RobotCount, RoundRun, TaskParams, Workpiece,
-    correction_input, needs_correction, read_labels, run_round_with,
+    correction_input, needs_correction, read_labels, reference_labels, run_round_with,
 };
 use crate::params::from_py;
 use crate::planner::{N_ROBOTS, PyPlanner};
@@ -89,33 +89,76 @@ pub(crate) fn sim_run_round<'py>(
 }
 
 /// Which reference samples need a correction on each of `N` random sanding workpieces
-/// (§III: sanding in passes 1–3 over a painted section), from the reference
-/// demonstration's labels file (`demo_0.labels.csv` of the fixtures' layout): a `(N, T_ref)`
-/// bool array. `task` holds the task parameters (dict; only `n_sections` matters); `robots`
-/// is `N` (1 to 8, default 2). Deterministic for `seed`.
+/// (§III: sanding in passes 1–3 over a painted section): a `(N, T_ref)` bool array. `labels`
+/// is one labels file, one folder with `demo_<i>.labels.csv` (the fixtures' layout), or one
+/// labels file per demonstration in the fit's order. With `planner`, the labels of its
+/// reference demonstration (`tandem::sim::study::reference_labels`, the one owner of that
+/// choice), checked to be one per reference sample; without, `labels` must be one file.
+/// `task` holds the task parameters (dict; only `n_sections` matters); `robots` is `N` (1 to
+/// 8, default 2). Deterministic for `seed`.
 #[pyfunction]
-#[pyo3(signature = (labels, seed, task=None, robots=N_ROBOTS))]
+#[pyo3(signature = (labels, seed, task=None, robots=N_ROBOTS, planner=None))]
 pub(crate) fn sim_sanding_needs<'py>(
     py: Python<'py>,
-    labels: PathBuf,
+    labels: Vec<PathBuf>,
     seed: u64,
     task: Option<&Bound<'py, PyAny>>,
     robots: usize,
+    planner: Option<PyRef<'py, PyPlanner>>,
 ) -> PyResult<Bound<'py, PyArray2<bool>>> {
     let params: TaskParams = from_py(task, "task")?;
     RobotCount::new(robots).map_err(|e| Error::param("robots", e.to_string()))?;
+    let folder = match labels.as_slice() {
+        [one] if one.is_dir() => Some(one.clone()),
+        _ => None,
+    };
+    let labels = guard(|| {
+        let Some(planner) = planner.as_ref() else {
+            return match (labels.as_slice(), &folder) {
+                ([file], None) => Ok(read_labels(file)?),
+                _ => Err(Error::param(
+                    "labels",
+                    "a folder or a list of labels files needs planner=…, whose reference \
+                     demonstration's labels are taken",
+                )),
+            };
+        };
+        // The file of demonstration `k`: in the folder, the `k`-th of the list, or the one
+        // file given (which must then be the reference's: its length is checked).
+        let file_of = |k: usize| -> Result<PathBuf> {
+            match (&folder, labels.as_slice()) {
+                (Some(dir), _) => Ok(dir.join(format!("demo_{k}.labels.csv"))),
+                (None, [one]) => Ok(one.clone()),
+                (None, many) => many.get(k).cloned().ok_or_else(|| {
+                    Error::input(
+                        "labels",
+                        format!(
+                            "{} labels files, but the planner's reference is demonstration \
+                             {k} of the fit (counted from 0): give one file per \
+                             demonstration, in the order given to the fit",
+                            many.len()
+                        ),
+                    )
+                }),
+            }
+        };
+        let model = planner.inner.model();
+        let path = file_of(model.reference_idx())?;
+        Ok(reference_labels(model, |_| {
+            Ok((path.clone(), read_labels(&path)?))
+        })?)
+    })?;
     let flat = guard(|| {
         params.validate()?;
-        let labels = read_labels(&labels)?;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let mut out = Vec::with_capacity(robots * labels.len());
         for _ in 0..robots {
             let wp = Workpiece::random(&params, &mut rng)?;
             out.extend(labels.iter().map(|l| needs_correction(l, &wp)));
         }
-        Ok((out, labels.len()))
+        Ok(out)
     })?;
-    Ok(out_matrix(py, flat.0, flat.1)?)
+    Ok(out_matrix(py, flat, labels.len())?)
 }
 
 /// Which reference samples need the operator on `robots` workpieces (`tandem.sim.needs`):

@@ -19,7 +19,7 @@ use rand_chacha::ChaCha8Rng;
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
     FIXTURE_SEED, Label, N_FIXTURE_DEMOS, PhaseTimes, StudyConfig, StudyInputs, TaskDemo,
-    TaskModel, demonstrations, read_labels, run_trial, run_trials,
+    TaskModel, demonstrations, run_trial, run_trials,
 };
 use crate::params::{from_py, serialize_to_py};
 
@@ -50,48 +50,23 @@ pub(crate) struct PyStudyTask {
     alignment: Duration,
 }
 
-/// Where the labels of each demonstration come from.
-enum LabelSource {
-    /// `demo_<k>.labels.csv` in this folder; demo 0's already read.
-    Folder(PathBuf, Vec<Label>),
-    /// The generated demonstrations' own labels.
-    Generated(Vec<TaskDemo>),
-}
-
-impl LabelSource {
-    /// The labels of demonstration `k`.
-    fn labels(self, k: usize) -> Result<Vec<Label>> {
-        match self {
-            LabelSource::Folder(_, first) if k == 0 => Ok(first),
-            LabelSource::Folder(dir, _) => {
-                Ok(read_labels(&dir.join(format!("demo_{k}.labels.csv")))?)
-            }
-            LabelSource::Generated(mut demos) => Ok(std::mem::take(&mut demos[k].labels)),
-        }
-    }
-}
-
-/// Reads or generates the demonstrations, fits the model with `config.planner.fit` and
-/// picks the labels of whichever demonstration the fit chose as the reference.
+/// Reads or generates the demonstrations (each with its labels), fits the model with
+/// `config.planner.fit` and takes the labels of whichever demonstration the fit chose as the
+/// reference (`StudyInputs::reference_labels`).
 fn prepare(config: &StudyConfig, demos_dir: Option<&Path>) -> Result<PyStudyTask> {
     let t = Instant::now();
-    let (demos, source) = match demos_dir {
-        Some(dir) => {
-            let inputs = StudyInputs::from_dir(dir)?;
-            let source = LabelSource::Folder(dir.to_path_buf(), inputs.reference_labels);
-            (inputs.demos, source)
-        }
+    let inputs = match demos_dir {
+        Some(dir) => StudyInputs::from_dir(dir)?,
         None => {
             let mut rng = ChaCha8Rng::seed_from_u64(FIXTURE_SEED);
             let set = demonstrations(&config.task, N_FIXTURE_DEMOS, &mut rng)?;
             let task_demos: Vec<TaskDemo> = set.into_iter().map(|(_, d)| d).collect();
-            let inputs = StudyInputs::from_task_demos(&task_demos)?;
-            (inputs.demos, LabelSource::Generated(task_demos))
+            StudyInputs::from_task_demos(&task_demos)?
         }
     };
-    let model = TaskModel::fit(&demos, &config.planner.fit)?;
+    let model = TaskModel::fit(&inputs.demos, &config.planner.fit)?;
     model.prepare_corrections();
-    let labels = source.labels(model.reference_idx())?;
+    let labels = inputs.reference_labels(&model)?;
     Ok(PyStudyTask {
         model: Arc::new(model),
         labels: Arc::new(labels),

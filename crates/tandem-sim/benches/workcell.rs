@@ -48,6 +48,9 @@ fn setup() -> Setup {
     params.sampler.samples = 200;
     params.sampler.seed = 2023;
     let model = TaskModel::fit(&inputs.demos, &params.fit).expect("the fixtures fit");
+    let labels = inputs
+        .reference_labels(&model)
+        .expect("every fixture has its labels");
     let mut planner = Planner::from_model_with_robots(model, params, 2).expect("plans");
     let operator = OperatorParams::default();
     let task = TaskParams::default();
@@ -59,15 +62,14 @@ fn setup() -> Setup {
     };
     for _ in 0..ROUNDS {
         let wp = draw(&mut rng);
-        let run =
-            run_round(&planner, &inputs.reference_labels, &wp, &operator, &mut rng).expect("runs");
+        let run = run_round(&planner, &labels, &wp, &operator, &mut rng).expect("runs");
         let records = run.records(planner.model()).expect("valid records");
         planner.record_round(&records).expect("records");
     }
     Setup {
         planner,
         workpieces: draw(&mut rng),
-        labels: inputs.reference_labels,
+        labels,
         operator,
     }
 }

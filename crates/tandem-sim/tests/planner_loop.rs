@@ -40,7 +40,7 @@ fn pair(planner: &Planner, seed: u64) -> [ExecutionRecord; 2] {
     ];
     let run = run_round(
         planner,
-        &fixtures().0.reference_labels,
+        common::labels(),
         &workpieces,
         &OperatorParams::default(),
         &mut rng,
@@ -184,14 +184,7 @@ fn a_round_replays_exactly_with_the_public_operator_input() {
         Workpiece::random(&task, &mut rng).unwrap(),
     ];
     let operator = OperatorParams::default();
-    let run = run_round(
-        &planner,
-        &fixtures().0.reference_labels,
-        &workpieces,
-        &operator,
-        &mut rng,
-    )
-    .unwrap();
+    let run = run_round(&planner, common::labels(), &workpieces, &operator, &mut rng).unwrap();
     // A fresh copy of the model: the replay builds the whole task frame's table.
     let model: TaskModel = planner.model().clone();
     let force = model

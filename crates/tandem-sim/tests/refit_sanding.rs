@@ -9,7 +9,6 @@ use rand_chacha::ChaCha8Rng;
 use tandem_lfd::Demonstration;
 use tandem_planner::{ExecutionRecord, Planner, PlannerParams};
 use tandem_schedule::SamplerParams;
-use tandem_sim::study::read_labels;
 use tandem_sim::task::{Label, TaskParams, Workpiece};
 use tandem_sim::workcell::{OperatorParams, run_round};
 
@@ -75,7 +74,7 @@ fn run_rounds(planner: &mut Planner, labels: &[Label]) -> Vec<Vec<ExecutionRecor
 fn a_refit_of_the_sanding_cell_keeps_its_rounds() {
     // The cell: demonstrations 0–2, eight simulated rounds.
     let mut cell = Planner::new(&demos(&[0, 1, 2]), params()).unwrap();
-    let rounds = run_rounds(&mut cell, &fixtures().0.reference_labels);
+    let rounds = run_rounds(&mut cell, &fixtures().0.labels[0]);
 
     // Refit with a fourth demonstration (the reference stays demo 0) against a fresh fit of
     // the four with the same rounds recorded: the same confidence, sample for sample.
@@ -107,14 +106,10 @@ fn a_refit_of_the_sanding_cell_keeps_its_rounds() {
     let (moved, report) = cell.refit(&order, params()).unwrap();
     assert!(report.reference_changed);
     assert_eq!(moved.rounds_recorded(), ROUNDS as usize);
-    let labels_1 = read_labels(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../fixtures/sanding/demo_1.labels.csv"),
-    )
-    .unwrap();
+    let labels_1 = &fixtures().0.labels[1];
     let mut rerun = Planner::new(&order, params()).unwrap();
     let prior = rerun.confidence().high_share();
-    run_rounds(&mut rerun, &labels_1);
+    run_rounds(&mut rerun, labels_1);
     let (a, b) = (moved.confidence().conf(), rerun.confidence().conf());
     let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
     eprintln!(

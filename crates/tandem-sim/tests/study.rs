@@ -5,8 +5,8 @@ mod common;
 use tandem_sim::study::{ScheduleSource, StudyConfig, StudyResult, run_trials};
 
 fn run(config: &StudyConfig) -> StudyResult {
-    let (inputs, model) = common::fixtures();
-    run_trials(config, model, &inputs.reference_labels, &|_| {})
+    let (_, model) = common::fixtures();
+    run_trials(config, model, common::labels(), &|_| {})
         .expect("the study runs")
         .0
 }
@@ -99,30 +99,45 @@ fn same_seed_same_bytes_on_one_and_two_threads() {
     assert_ne!(serde_json::to_string(&other).unwrap(), one);
 }
 
-/// `run_study` reads the ground truth of demo 0: a fit that chose another reference (the
-/// medoid of the fixtures is demo 2) is refused instead of pairing the model with the wrong
-/// labels; `run_trials` with the reference's own labels runs.
+/// The study's truth follows the fit's reference: with the default (the medoid, demo 2 of the
+/// fixtures) `run_study` takes demo 2's own labels, with `first` demo 0's; labels of another
+/// demonstration than the reference are refused, naming where they came from.
 #[test]
-fn a_study_needs_the_labels_of_its_reference() {
-    let (inputs, _) = common::fixtures();
+fn a_study_takes_the_labels_of_its_reference() {
+    let (inputs, model) = common::fixtures();
+    assert_eq!(model.reference_idx(), 2, "the fixtures' medoid");
     let mut config = StudyConfig {
         trials: 1,
         executions: 2,
         samples: 20,
         ..StudyConfig::default()
     };
-    config.planner.fit.reference = tandem_lfd::Reference::Medoid;
-    let e = tandem_sim::study::run_study(&config, inputs, &|_| {}).unwrap_err();
+    for (reference, demo) in [
+        (tandem_lfd::Reference::Medoid, 2),
+        (tandem_lfd::Reference::First, 0),
+    ] {
+        config.planner.fit.reference = reference;
+        let (result, _) = tandem_sim::study::run_study(&config, inputs, &|_| {}).unwrap();
+        let labels = &inputs.labels[demo];
+        assert_eq!(result.n_ref, labels.len(), "{reference}");
+        assert_eq!(
+            result.ground_truth_pct,
+            100.0 * tandem_sim::task::ground_truth_share(labels),
+            "{reference}"
+        );
+    }
+    assert_eq!(inputs.reference_labels(model).unwrap(), inputs.labels[2]);
+    let e = tandem_sim::study::reference_labels(model, |_| {
+        Ok(("demo_0.labels.csv".into(), inputs.labels[0].clone()))
+    })
+    .unwrap_err();
+    let msg = e.to_string();
     assert!(
-        e.to_string().contains("chose demo 2 as the reference"),
-        "{e}"
+        msg.starts_with("demo_0.labels.csv: 9873 labels")
+            && msg.contains("demonstration 2 of the fit")
+            && msg.contains("8196 samples"),
+        "{msg}"
     );
-    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/sanding");
-    let labels = tandem_sim::study::read_labels(&dir.join("demo_2.labels.csv")).unwrap();
-    let model = tandem_lfd::TaskModel::fit(&inputs.demos, &config.planner.fit).unwrap();
-    assert_eq!(model.n_ref(), labels.len());
-    let (result, _) = run_trials(&config, &model, &labels, &|_| {}).unwrap();
-    assert_eq!(result.n_ref, labels.len());
 }
 
 /// The observer sees every round of every trial once, with the planner whose schedule the round
@@ -138,19 +153,18 @@ fn an_observed_study_is_the_same_study_and_shows_every_round() {
         seed: 13,
         ..StudyConfig::default()
     };
-    let (inputs, model) = common::fixtures();
+    let (_, model) = common::fixtures();
     let seen = Mutex::new(Vec::new());
-    let (observed, _) =
-        run_trials_observed(&config, model, &inputs.reference_labels, &|_| {}, &|v| {
-            // The round ran the planner's current schedule: its T_total is the iteration's.
-            seen.lock().unwrap().push((
-                v.trial,
-                v.round,
-                v.planner.outcome().t_total_s,
-                v.run.robots.len(),
-            ));
-        })
-        .unwrap();
+    let (observed, _) = run_trials_observed(&config, model, common::labels(), &|_| {}, &|v| {
+        // The round ran the planner's current schedule: its T_total is the iteration's.
+        seen.lock().unwrap().push((
+            v.trial,
+            v.round,
+            v.planner.outcome().t_total_s,
+            v.run.robots.len(),
+        ));
+    })
+    .unwrap();
     let plain = run(&config);
     assert_eq!(
         serde_json::to_string(&observed).unwrap(),

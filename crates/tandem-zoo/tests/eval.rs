@@ -51,12 +51,14 @@ fn a_short_loop_reports_consistent_numbers_on_any_number_of_threads() {
     let fit = &report.fits[0];
     let spread = fit.spread.as_ref().unwrap();
     assert_eq!(spread.first_high_pct.len(), fit.n_demos);
-    // Rotation 0 is the default fit itself (the default reference is the first file).
+    // The default fit is the medoid's (the default reference), whichever file comes first.
     assert_eq!(
         tandem_lfd::FitParams::default().reference,
-        tandem_lfd::Reference::First
+        tandem_lfd::Reference::Medoid
     );
-    assert_eq!(spread.first_high_pct[0], fit.fit_high_pct);
+    assert_eq!(spread.medoid_high_pct, fit.fit_high_pct);
+    assert_eq!(spread.medoid_idx, fit.reference_idx);
+    assert_eq!(spread.medoid_truth_pct, fit.truth_high_pct);
     for r in &report.runs {
         // One plan per round recorded, the fit's first.
         assert_eq!(r.t_total_s.len(), r.rounds + 1, "{:?}", r.cell);

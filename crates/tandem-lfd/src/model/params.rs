@@ -12,19 +12,20 @@ use crate::{Error, Result};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Reference {
-    /// The first demonstration given (default; the model then depends on which file the
-    /// user names first, by 5.8 pp of high confidence on the task zoo's selection seeds,
+    /// The first demonstration given (the model then depends on which file the user names
+    /// first, by 5.8 pp of high confidence on the task zoo's selection seeds,
     /// docs/decisions.md, "Fit defaults on the task zoo").
-    #[default]
     First,
-    /// The medoid: every demonstration is tried as the reference (all the others
+    /// The medoid (default): every demonstration is tried as the reference (all the others
     /// aligned to it with the weights it would have as the reference, and the statistics
     /// fitted), and the one whose model has the least median `σ²_D` (Eq. 6) over its
     /// reference samples wins: the time axis on which the demonstrations agree best at a
     /// typical instant. Costs `n_demos` alignment passes instead of one. Ties go to the
     /// demonstration first in a fixed order of their content, and the others enter the
     /// statistics in that order, so the fitted model is bit-identical for any order in which
-    /// the demonstrations are given (docs/decisions.md, "Fit defaults on the task zoo").
+    /// the demonstrations are given (docs/decisions.md, "Fit defaults on the task zoo"; the
+    /// default since "The medoid reference by default: labels follow the reference").
+    #[default]
     Medoid,
 }
 
@@ -245,9 +246,9 @@ pub struct FitParams {
     /// Channel kinds and quaternion blocks. Default: [`ChannelSchema::default`].
     pub schema: ChannelSchema,
     /// Which demonstration is the reference (its samples are the model's time axis).
-    /// Default: [`Reference::First`] (the medoid is the better choice on the task zoo, but
-    /// the simulated study's and the Python examples' labels are demo 0's; docs/decisions.md,
-    /// "Fit defaults on the task zoo"). [`TaskModel::fit_aligned`](crate::TaskModel::fit_aligned)
+    /// Default: [`Reference::Medoid`] (the model does not depend on the order of the files;
+    /// docs/decisions.md, "The medoid reference by default: labels follow the reference").
+    /// [`TaskModel::fit_aligned`](crate::TaskModel::fit_aligned)
     /// takes warps onto demo 0, whose samples are then the time axis whatever this says.
     pub reference: Reference,
 }
@@ -266,7 +267,7 @@ impl Default for FitParams {
             min_range: 1e-9,
             k_max: 3,
             schema: ChannelSchema::default(),
-            reference: Reference::First,
+            reference: Reference::Medoid,
         }
     }
 }

@@ -586,7 +586,8 @@ pub fn run_cell_study(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<(CellStudyResult, PhaseTimes)> {
     let (model, alignment) = fit_study_model(config, inputs)?;
-    let (result, mut times) = run_cell_trials(config, &model, &inputs.reference_labels, progress)?;
+    let labels = inputs.reference_labels(&model)?;
+    let (result, mut times) = run_cell_trials(config, &model, &labels, progress)?;
     times.alignment = alignment;
     Ok((result, times))
 }

@@ -36,7 +36,8 @@ pub struct StudyConfig {
     pub example_iterations: Vec<usize>,
     /// Model, confidence and sampler parameters. The sampler's `samples` and `seed` are
     /// replaced by [`StudyConfig::samples`] and the trial's seed. Default: `PlannerParams::default()`
-    /// with `fit.reference = first` (the ground-truth labels are demo 0's).
+    /// (the fit's reference is the medoid; the truth is its own labels,
+    /// [`super::StudyInputs::reference_labels`]).
     pub planner: PlannerParams,
     /// Task parameters for drawing each execution's workpiece (only `n_sections` matters);
     /// must match the demonstrations'. Default: `TaskParams::default()` (the fixtures').
@@ -63,14 +64,7 @@ impl Default for StudyConfig {
             false_correction_rate: 0.01,
             false_correction_s: 0.5,
             example_iterations: vec![0, 25, 50, 100, 150],
-            // The study's ground-truth labels are demo 0's: demo 0 is the reference.
-            planner: PlannerParams {
-                fit: tandem_lfd::FitParams {
-                    reference: tandem_lfd::Reference::First,
-                    ..tandem_lfd::FitParams::default()
-                },
-                ..PlannerParams::default()
-            },
+            planner: PlannerParams::default(),
             task: TaskParams::default(),
             cell: Cell::Rounds,
         }

@@ -17,7 +17,7 @@ pub use cell::{
     Steady, run_cell_study, run_cell_trial, run_cell_trial_on, run_cell_trials, task_gap,
 };
 pub use config::{Cell, StudyConfig};
-pub use inputs::{StudyInputs, read_labels};
+pub use inputs::{StudyInputs, read_labels, reference_labels};
 pub use record::{
     IterationRecord, IterationSummary, RoundStats, ScheduleSource, StudyResult, TrialResult,
     mean_std, throughput_per_h,

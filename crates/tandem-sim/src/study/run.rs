@@ -280,9 +280,9 @@ pub fn run_trial_on(
 /// Runs the study (§III): fits the model once, then runs the trials ([`run_trials`]).
 ///
 /// # Errors
-/// Invalid configuration or inputs, a fit whose reference is not demo 0 (the labels are
-/// demo 0's; call [`run_trials`] with the reference's labels), or any stage's error (the
-/// first trial's in order).
+/// Invalid configuration or inputs, or any stage's error (the first trial's in order). The
+/// truth is the labels of whichever demonstration the fit chose as the reference
+/// ([`StudyInputs::reference_labels`]).
 pub fn run_study(
     config: &StudyConfig,
     inputs: &StudyInputs,
@@ -304,8 +304,8 @@ pub fn run_study_observed(
     observe: &(dyn Fn(RoundView<'_>) + Sync),
 ) -> Result<(StudyResult, PhaseTimes)> {
     let (model, alignment) = fit_study_model(config, inputs)?;
-    let (result, mut times) =
-        run_trials_observed(config, &model, &inputs.reference_labels, progress, observe)?;
+    let labels = inputs.reference_labels(&model)?;
+    let (result, mut times) = run_trials_observed(config, &model, &labels, progress, observe)?;
     times.alignment = alignment;
     Ok((result, times))
 }
@@ -326,18 +326,6 @@ pub(super) fn fit_study_model(
     })?;
     let t = Instant::now();
     let model = TaskModel::fit(&inputs.demos, &config.planner.fit)?;
-    if model.reference_idx() != 0 {
-        // The labels are demo 0's; another reference needs its own labels (`run_trials`).
-        return Err(Error::BadInput {
-            path: "<study inputs>".into(),
-            why: format!(
-                "the fit chose demo {} as the reference (fit.reference = {}), but the \
-                 ground-truth labels are demo 0's",
-                model.reference_idx(),
-                config.planner.fit.reference
-            ),
-        });
-    }
     model.prepare_corrections();
     Ok((model, t.elapsed()))
 }

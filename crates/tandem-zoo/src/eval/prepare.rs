@@ -177,13 +177,18 @@ fn reference_spread(
         };
         first_high_pct.push(pct);
     }
-    let medoid = TaskModel::fit(
-        demos,
-        &FitParams {
-            reference: Reference::Medoid,
-            ..fit.clone()
-        },
-    )?;
+    let medoid = if fit.reference == Reference::Medoid {
+        // The default fit is the medoid's (any order gives the same model).
+        first_fit.clone()
+    } else {
+        TaskModel::fit(
+            demos,
+            &FitParams {
+                reference: Reference::Medoid,
+                ..fit.clone()
+            },
+        )?
+    };
     let medoid_idx = medoid.reference_idx();
     Ok(ReferenceSpread {
         first_high_pct,
@@ -208,16 +213,16 @@ fn hold_spec(rules: &[String]) -> Result<HoldSpec> {
 /// The name the sanding fixture has among the families of a report.
 pub const SANDING: &str = "sanding";
 
-/// The sanding fixture (`inputs`: its demonstrations and the reference's labels) made ready
-/// for the same loop: fitted with `params` and the hold rules `holds` (the study's
-/// `tool<0.5`), its truth the study's ([`SandingTruth`]: a random half of the sections of
-/// passes 1–3 painted per workpiece; every sample that can need the operator varies between
-/// demonstrations). No reference-choice spread: only the reference's labels are known
-/// (`cargo xtask reference-order` measures it on the fixture).
+/// The sanding fixture (`inputs`: its demonstrations and each one's labels) made ready for
+/// the same loop: fitted with `params` and the hold rules `holds` (the study's `tool<0.5`),
+/// its truth the study's ([`SandingTruth`] on the labels of the fit's reference,
+/// `StudyInputs::reference_labels`: a random half of the sections of passes 1–3 painted per
+/// workpiece; every sample that can need the operator varies between demonstrations). No
+/// reference-choice spread here (`cargo xtask reference-order` measures it on the fixture).
 ///
 /// # Errors
-/// The fit's or the planner's errors; [`Error::Eval`] when the fit's reference is not demo
-/// 0 (the labels are demo 0's).
+/// The fit's or the planner's errors; [`Error::Eval`] when the labels are not one per sample
+/// of the reference.
 pub fn prepare_sanding(
     inputs: &StudyInputs,
     holds: &[String],
@@ -227,13 +232,11 @@ pub fn prepare_sanding(
     planner.holds = hold_spec(holds)?;
     let model = TaskModel::fit(&inputs.demos, &planner.fit)?;
     model.prepare_corrections();
-    if model.reference_idx() != 0 || inputs.reference_labels.len() != model.n_ref() {
-        return Err(Error::Eval {
-            what: SANDING.into(),
-            why: "the labels are demo 0's: fit with the reference `first`".into(),
-        });
-    }
-    let labels = &inputs.reference_labels;
+    // The truth is the labels of whichever demonstration the fit chose as the reference.
+    let labels = &inputs.reference_labels(&model).map_err(|e| Error::Eval {
+        what: SANDING.into(),
+        why: e.to_string(),
+    })?;
     let need_kind: Vec<Option<bool>> = labels
         .iter()
         .map(|l| needs_help(l).then_some(true))
@@ -249,7 +252,7 @@ pub fn prepare_sanding(
         n_demos: inputs.demos.len(),
         rate_hz: 1.0 / dt_s,
         n_ref: model.n_ref(),
-        reference_idx: 0,
+        reference_idx: model.reference_idx(),
         holds: holds.to_vec(),
         correction_channel: "force".into(),
         truth_high_pct: 100.0 * ground_truth_share(labels),
