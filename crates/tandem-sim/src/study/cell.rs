@@ -27,8 +27,6 @@
 
 use std::time::Instant;
 
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use tandem_lfd::TaskModel;
 use tandem_planner::Planner;
@@ -38,9 +36,7 @@ use tandem_schedule::{CheckedCyclicPlan, CyclicParams};
 use super::config::StudyConfig;
 use super::inputs::StudyInputs;
 use super::record::mean_std;
-use super::run::{
-    PhaseTimes, Progress, check_truth, fit_study_model, par_trials, trial_seed, truth_operator,
-};
+use super::run::{PhaseTimes, Progress, fit_study_model, par_trials, start_trial, truth_operator};
 use crate::task::{self, Label};
 use crate::truth::{SandingTruth, TaskTruth, falsely_trusted_where};
 use crate::workcell::{CellSim, CellStats, FinishedTask, PlanGap, RobotPlan, RobotRun};
@@ -230,7 +226,7 @@ impl Steady {
 pub struct CellTrialResult {
     /// Trial index `k`.
     pub trial: usize,
-    /// Seed of the trial ([`trial_seed`]).
+    /// Seed of the trial ([`trial_seed`](super::trial_seed)).
     pub seed: u64,
     /// The plans, the first one (demonstrations only) first.
     pub iterations: Vec<CellIteration>,
@@ -423,24 +419,16 @@ pub fn run_cell_trial_on(
     progress: &(dyn Fn(Progress) + Sync),
     observe: &(dyn Fn(&FinishedTask) + Sync),
 ) -> Result<CellTrialRun> {
-    config.validate()?;
-    check_truth(model, truth)?;
     let can_need = truth.can_need();
-    let seed = trial_seed(config.seed, trial);
-    let mut params = config.planner.clone();
-    params.sampler.samples = config.samples;
-    params.sampler.seed = seed;
     let mut times = PhaseTimes::default();
     let t = Instant::now();
-    let mut planner = Planner::from_model_with_robots(model.clone(), params, config.robots)?;
+    let (seed, mut planner, mut rng) = start_trial(config, model, truth, trial)?;
     let n = planner.n_robots();
     let (plan, first) = plan_of(&planner, can_need, 0, 0)?;
     // The cell's tick: the plan's, the schedule's (`Δt_s` unless the sampler sets a tick).
     let dt_s = plan.tick_s();
     let coord = plan.coordinator();
     times.scheduling += t.elapsed();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream(1);
     let mut sim = CellSim::new(planner.model(), coord, &truth_operator(config, truth))?;
     let mut needed = (0..n)
         .map(|_| truth.draw(&mut rng))

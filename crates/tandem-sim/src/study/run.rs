@@ -162,6 +162,29 @@ pub(super) fn truth_operator(config: &StudyConfig, truth: &dyn TaskTruth) -> Ope
     }
 }
 
+/// The start of every trial, of rounds ([`run_trial_on`]) and of the continuous cell
+/// ([`run_cell_trial_on`](super::run_cell_trial_on)): checks the configuration and the truth,
+/// and returns the trial's seed ([`trial_seed`]), its planner on `model` (the sampler seeded
+/// with that seed, `config.samples` samples, `config.robots` robots) and the simulation's
+/// random stream (ChaCha8 from the seed, stream 1).
+pub(super) fn start_trial(
+    config: &StudyConfig,
+    model: &TaskModel,
+    truth: &dyn TaskTruth,
+    trial: usize,
+) -> Result<(u64, Planner, ChaCha8Rng)> {
+    config.validate()?;
+    check_truth(model, truth)?;
+    let seed = trial_seed(config.seed, trial);
+    let mut params = config.planner.clone();
+    params.sampler.samples = config.samples;
+    params.sampler.seed = seed;
+    let planner = Planner::from_model_with_robots(model.clone(), params, config.robots)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(1);
+    Ok((seed, planner, rng))
+}
+
 /// Checks that `truth` is given on `model`'s reference samples.
 pub(super) fn check_truth(model: &TaskModel, truth: &dyn TaskTruth) -> Result<()> {
     if truth.n_ref() != model.n_ref() {
@@ -191,19 +214,11 @@ pub fn run_trial_on(
     progress: &(dyn Fn(Progress) + Sync),
     observe: &(dyn Fn(RoundView<'_>) + Sync),
 ) -> Result<TrialRun> {
-    config.validate()?;
-    check_truth(model, truth)?;
     let can_need = truth.can_need();
-    let seed = trial_seed(config.seed, trial);
-    let mut params = config.planner.clone();
-    params.sampler.samples = config.samples;
-    params.sampler.seed = seed;
     let mut times = PhaseTimes::default();
     let t = Instant::now();
-    let mut planner = Planner::from_model_with_robots(model.clone(), params, config.robots)?;
+    let (seed, mut planner, mut rng) = start_trial(config, model, truth, trial)?;
     times.scheduling += t.elapsed();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream(1);
     let operator = truth_operator(config, truth);
     let n_rounds = config.n_rounds();
     let n_robots = planner.n_robots();

@@ -14,11 +14,11 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 use tandem_lfd::TaskModel;
 use tandem_realtime::continuous::ContinuousCoordinator;
-use tandem_realtime::{Operator, tol};
+use tandem_realtime::tol;
 
 use super::operator::OperatorParams;
 use super::record::RobotRun;
-use super::run::Operate;
+use super::run::{Operate, Robots, step};
 use crate::{Error, Result};
 
 /// What a continuous cell did so far (control ticks of `tick_s`).
@@ -57,9 +57,7 @@ pub struct CellSim {
     coord: ContinuousCoordinator,
     pending: Option<ContinuousCoordinator>,
     op: Operate,
-    runs: Vec<RobotRun>,
-    in_episode: Vec<bool>,
-    ref_now: Vec<f64>,
+    robots: Robots,
     /// Each robot's completed tasks at the end of the last tick.
     tasks: Vec<u64>,
     n_ref: usize,
@@ -86,10 +84,12 @@ impl CellSim {
         let n_ref = model.n_ref();
         let ref_now = ref_times(&coord);
         Ok(CellSim {
-            runs: (0..n).map(|_| op.empty_run(n_ref)).collect(),
+            robots: Robots {
+                runs: (0..n).map(|_| op.empty_run(n_ref)).collect(),
+                in_episode: vec![false; n],
+                ref_now,
+            },
             op,
-            in_episode: vec![false; n],
-            ref_now,
             tasks: coord.tasks_completed().to_vec(),
             n_ref,
             stats: CellStats {
@@ -169,40 +169,24 @@ impl CellSim {
                 found: model.n_ref(),
             });
         }
-        let n = self.coord.n_robots();
         let at_gate = self.coord.at_gate_now();
-        let held = self.coord.fault().map(|f| f.stopped);
-        let mut operator = Operator::Scheduled;
-        let task = self.coord.task();
-        for i in 0..n {
-            if at_gate[i] {
-                self.stats.gate_ticks[i] += 1;
-                continue;
-            }
-            if held == Some(i) {
-                continue;
-            }
-            let run = &mut self.runs[i];
-            if run.start_tick == usize::MAX {
-                run.start_tick = self.stats.ticks as usize;
-            }
-            let k = (self.ref_now[i].floor() as usize).min(self.n_ref - 1);
-            let bounds = (!task.conf()[k]).then(|| (task.grad_min()[k], task.grad_max()[k]));
-            if let Some(input) = self.op.robot_tick(
-                model,
-                run,
-                &mut self.in_episode[i],
-                self.ref_now[i],
-                bounds,
-                |idx| needs(i, idx),
-                rng,
-            )? {
-                operator = input;
-            }
+        for (i, k) in self.stats.gate_ticks.iter_mut().enumerate() {
+            *k += u64::from(at_gate[i]);
         }
-        let t = self.coord.tick(operator)?;
+        // The cell observes no crossings (`None`): its token rule stops a robot at the gate
+        // of every low-confidence group it does not hold (docs/decisions.md).
+        let (t, _) = step(
+            &mut self.coord,
+            model,
+            &mut self.op,
+            |c, n| (c.task().grad_min()[n], c.task().grad_max()[n]),
+            None,
+            &mut self.robots,
+            self.stats.ticks as usize,
+            &mut needs,
+            rng,
+        )?;
         self.stats.ticks += 1;
-        self.ref_now.copy_from_slice(&t.ref_time);
         match t.low_conf.count() {
             0 => {}
             1 => self.stats.busy_ticks += 1,
@@ -220,7 +204,8 @@ impl CellSim {
         for (i, k) in self.tasks.iter_mut().enumerate() {
             if t.tasks[i] > *k {
                 *k = t.tasks[i];
-                let run = std::mem::replace(&mut self.runs[i], self.op.empty_run(self.n_ref));
+                let run =
+                    std::mem::replace(&mut self.robots.runs[i], self.op.empty_run(self.n_ref));
                 done.push(FinishedTask {
                     robot: i,
                     tick: self.stats.ticks,

@@ -11,10 +11,13 @@
 //! [`Error::TickMismatch`](crate::Error::TickMismatch) rather than run at a period its safety
 //! check never saw.
 //!
-//! 1. Each running robot's position is read from the coordinator: its schedule clock
-//!    `s_i` gives its reference sample `n_i` and fractional reference time `t_i` (Eq. 15).
-//!    A robot whose sample `n_i` is low-confidence is *supervised* this tick; that is the
-//!    robot the coordinator will move at the operator's rate.
+//! 1. Each robot the coordinator will move (`Controller::running_now`) has its fractional
+//!    reference time `t_i` (Eq. 15) from the coordinator's last tick, and its sample
+//!    `n_i = ⌊t_i⌋`. The robot the coordinator reports low-confidence
+//!    (`Controller::low_conf_now`) is *supervised* this tick; that is the robot the
+//!    coordinator will move at the operator's rate. The one tick of rounds and of the
+//!    continuous cell ([`CellSim`]) is the same function, generic over
+//!    `tandem_realtime::Controller`.
 //! 2. The operator decides for the supervised robot whether to correct. Whether the sample
 //!    *needs* a correction is the caller's `needs(i, round(t_i))` in [`run_round_with`]; on
 //!    the sanding task ([`run_round`]) it does when, on that robot's own workpiece, the

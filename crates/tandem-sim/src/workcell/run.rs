@@ -4,7 +4,7 @@
 use rand::Rng;
 use tandem_lfd::TaskModel;
 use tandem_planner::Planner;
-use tandem_realtime::{Coordinator, Operator, Timeline, tol};
+use tandem_realtime::{Controller, Coordinator, Operator, Tick, Timeline, tol};
 use tandem_schedule::{Problem, Schedule};
 
 use super::operator::{Episodes, OperatorParams, local_correction_input, needs_correction};
@@ -177,7 +177,7 @@ pub(super) fn run_coordinator(
     let tick_s = coord.tick_s();
     let mut op = Operate::new(model, params, tick_s)?;
     let n_robots = coord.n_robots();
-    let mut runs: Vec<RobotRun> = (0..n_robots).map(|_| op.empty_run(n_ref)).collect();
+    let runs: Vec<RobotRun> = (0..n_robots).map(|_| op.empty_run(n_ref)).collect();
     let (mut ticks, mut overlap_ticks, mut idle_ticks, mut faults) = (0, 0, 0, 0);
     let max_end_s = coord
         .robots()
@@ -198,24 +198,11 @@ pub(super) fn run_coordinator(
         // which a schedule caps at the serial schedule's length).
         budget *= n_robots + 2;
     }
-    let mut in_episode = vec![false; n_robots];
-    // Each robot's reference sample `n_i` and reference time `t_i` at its schedule clock,
-    // kept across ticks: the sample through a monotone cursor (schedule clocks never
-    // decrease; the same sample as `Timeline::sample_at`), the time from the coordinator's
-    // `Tick::ref_time` (Eq. 15 at the clock after the tick, the same value as
-    // `Timeline::ref_time_at`), so that a tick needs no search.
-    let mut sample: Vec<usize> = coord
-        .robots()
-        .iter()
-        .zip(coord.clock_s())
-        .map(|(tl, &c)| tl.sample_at(c))
-        .collect();
-    let mut ref_now: Vec<f64> = coord.ref_time_now().to_vec();
-
-    let has_holds = coord.has_holds();
-    // Whether each robot logged an unsupervised sample this tick (it started the tick on a
-    // high-confidence sample), and that sample's reference time.
-    let mut unsupervised_at: Vec<Option<f64>> = vec![None; n_robots];
+    let mut robots = Robots {
+        runs,
+        in_episode: vec![false; n_robots],
+        ref_now: coord.ref_time_now().to_vec(),
+    };
     // Whether the operator's input in each tick was a correction (for the round's PlanGap).
     let mut corrected_tick: Vec<bool> = Vec::new();
     while !coord.is_finished() {
@@ -225,86 +212,34 @@ pub(super) fn run_coordinator(
         let held = coord.fault().map(|f| f.stopped);
         let clocks = coord.clock_s();
         let running = coord.running_now();
-        let mut operator = Operator::Scheduled;
-        for i in 0..n_robots {
-            runs[i].clock_s.push(clocks[i]);
-            runs[i].phases.push(if held == Some(i) {
+        for (i, run) in robots.runs.iter_mut().enumerate() {
+            run.clock_s.push(clocks[i]);
+            let at_hold = coord.at_hold(i);
+            run.hold_ticks += usize::from(at_hold);
+            run.phases.push(if held == Some(i) {
                 TickPhase::Held
-            } else if coord.at_hold(i) {
+            } else if at_hold {
                 TickPhase::AtHold
             } else if running[i] {
                 TickPhase::Running
-            } else if ref_now[i] >= n_ref as f64 {
+            } else if robots.ref_now[i] >= n_ref as f64 {
                 TickPhase::Finished
             } else {
                 TickPhase::Waiting
             });
-            let n = if has_holds {
-                // With hold points the clock is the current leg's (dwells included, and
-                // the clock of legs not started while the robot stands at a hold): the leg
-                // says whether it runs, the coordinator's reference time which sample.
-                let leg = coord.current_plan(i);
-                if coord.at_hold(i) {
-                    runs[i].hold_ticks += 1;
-                    continue;
-                }
-                if clocks[i] < leg.start_s() || clocks[i] >= leg.end_s() || held == Some(i) {
-                    continue;
-                }
-                (ref_now[i].floor() as usize).min(n_ref - 1)
-            } else {
-                let tl = &coord.robots()[i];
-                if clocks[i] < tl.start_s() || clocks[i] >= tl.end_s() || held == Some(i) {
-                    continue;
-                }
-                let sample_clock_s = tl.sample_clock_s();
-                while sample[i] + 1 < n_ref && sample_clock_s[sample[i] + 1] <= clocks[i] {
-                    sample[i] += 1;
-                }
-                sample[i]
-            };
-            if runs[i].start_tick == usize::MAX {
-                runs[i].start_tick = ticks;
-            }
-            let bounds =
-                (!problem.conf()[n]).then(|| (problem.grad_min()[n], problem.grad_max()[n]));
-            if problem.conf()[n] {
-                unsupervised_at[i] = Some(ref_now[i]);
-            }
-            if let Some(op_input) = op.robot_tick(
-                model,
-                &mut runs[i],
-                &mut in_episode[i],
-                ref_now[i],
-                bounds,
-                |idx| needs(i, idx),
-                rng,
-            )? {
-                operator = op_input;
-            }
         }
-        corrected_tick.push(!matches!(operator, Operator::Scheduled));
-        let tick = coord.tick(operator)?;
-        for i in 0..n_robots {
-            // A robot that started the tick on high-confidence ground may have crossed
-            // whole low-confidence samples inside it (a one-sample island, say, under a fast
-            // warp): no tick starts on them, so without this they are never supervised, get
-            // no observation and never clear. The coordinator reports the tick low-confidence
-            // (the operator watches it); the operator decides at the crossed samples, and
-            // the tick's sample is recorded as supervised (docs/decisions.md, "Rounds: a
-            // one-sample island is never jumped").
-            if let Some(t0) = unsupervised_at[i].take() {
-                if tick.low_conf[i] {
-                    let mut crossed = crossed_lc_samples(problem.conf(), t0, tick.ref_time[i]);
-                    if let Some(first) = crossed.next() {
-                        // Asked once per crossed sample (any that needs one is a need).
-                        let needed = needs(i, first) | crossed.fold(false, |a, j| a | needs(i, j));
-                        op.supervise_crossing(&mut runs[i], &mut in_episode[i], needed, rng);
-                    }
-                }
-            }
-        }
-        ref_now.copy_from_slice(&tick.ref_time);
+        let (tick, corrected) = step(
+            &mut coord,
+            model,
+            &mut op,
+            |_, n| (problem.grad_min()[n], problem.grad_max()[n]),
+            Some(problem.conf()),
+            &mut robots,
+            ticks,
+            &mut needs,
+            rng,
+        )?;
+        corrected_tick.push(corrected);
         match tick.low_conf.count() {
             0 => idle_ticks += 1,
             1 => {}
@@ -318,6 +253,7 @@ pub(super) fn run_coordinator(
         }
         ticks += 1;
     }
+    let mut runs = robots.runs;
     for run in &mut runs {
         run.start_tick = run.start_tick.min(ticks);
     }
@@ -364,6 +300,104 @@ pub(super) fn crossed_lc_samples(
     let lo = (t0.max(0.0).floor() as usize).min(last) + 1;
     let hi = (t1.max(0.0).floor() as usize).min(last);
     (lo..hi).filter(|&j| !conf[j])
+}
+
+/// Each robot's side of the simulated operator across ticks, for [`step`]: its execution in
+/// progress, whether an unneeded-correction episode is running, and its fractional reference
+/// time (reference samples) at the tick start, as the controller's last [`Tick::ref_time`].
+#[derive(Debug)]
+pub(super) struct Robots {
+    /// Each robot's execution in progress.
+    pub(super) runs: Vec<RobotRun>,
+    /// Whether an unneeded-correction episode runs for each robot.
+    pub(super) in_episode: Vec<bool>,
+    /// Each robot's fractional reference time at the tick start.
+    pub(super) ref_now: Vec<f64>,
+}
+
+/// One control tick of the simulated workcell on any controller (steps 1–5 of the module
+/// docs of [`crate::workcell`]), the one loop body of rounds ([`run_coordinator`]) and of the
+/// continuous cell ([`CellSim::tick`](super::CellSim::tick)): every robot the controller will
+/// move ([`Controller::running_now`]) logs one execution sample at its reference time; the
+/// robot the controller reports low-confidence ([`Controller::low_conf_now`]) is supervised,
+/// with `bounds(coord, n)` the `(ψ̇min, ψ̇max)` of reference sample `n`, and the operator's
+/// input drives it. With `crossings = Some(conf)` (rounds), a robot that started the tick
+/// unsupervised but traversed low-confidence samples of `conf` inside it is supervised after
+/// the fact (step 5). `ticks` is the tick's index (a run's `start_tick`). Returns the tick
+/// and whether the operator's input was a correction; `robots.ref_now` is updated.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn step<C: Controller + ?Sized>(
+    coord: &mut C,
+    model: &TaskModel,
+    op: &mut Operate,
+    bounds: impl Fn(&C, usize) -> (f64, f64),
+    crossings: Option<&[bool]>,
+    robots: &mut Robots,
+    ticks: usize,
+    needs: &mut impl FnMut(usize, usize) -> bool,
+    rng: &mut impl Rng,
+) -> Result<(Tick, bool)> {
+    let n_ref = model.n_ref();
+    let running = coord.running_now();
+    let low_conf = coord.low_conf_now();
+    let mut operator = Operator::Scheduled;
+    // Each robot that logged an unsupervised sample this tick, and that sample's reference
+    // time (for the crossings of step 5).
+    let mut unsupervised_at = [None; tandem_realtime::MAX_ROBOTS];
+    for i in 0..coord.n_robots() {
+        if !running[i] {
+            continue;
+        }
+        let run = &mut robots.runs[i];
+        if run.start_tick == usize::MAX {
+            run.start_tick = ticks;
+        }
+        let ref_now = robots.ref_now[i];
+        let n = (ref_now.floor() as usize).min(n_ref - 1);
+        let supervised = low_conf[i].then(|| bounds(coord, n));
+        if supervised.is_none() {
+            unsupervised_at[i] = Some(ref_now);
+        }
+        if let Some(input) = op.robot_tick(
+            model,
+            run,
+            &mut robots.in_episode[i],
+            ref_now,
+            supervised,
+            |idx| needs(i, idx),
+            rng,
+        )? {
+            operator = input;
+        }
+    }
+    let corrected = !matches!(operator, Operator::Scheduled);
+    let tick = coord.tick(operator)?;
+    if let Some(conf) = crossings {
+        for (i, t0) in unsupervised_at.iter().enumerate().take(coord.n_robots()) {
+            // A robot that started the tick on high-confidence ground may have crossed
+            // whole low-confidence samples inside it (a one-sample island, say, under a fast
+            // warp): no tick starts on them, so without this they are never supervised, get
+            // no observation and never clear. The coordinator reports the tick low-confidence
+            // (the operator watches it); the operator decides at the crossed samples, and
+            // the tick's sample is recorded as supervised (docs/decisions.md, "Rounds: a
+            // one-sample island is never jumped").
+            if let (Some(t0), true) = (*t0, tick.low_conf[i]) {
+                let mut crossed = crossed_lc_samples(conf, t0, tick.ref_time[i]);
+                if let Some(first) = crossed.next() {
+                    // Asked once per crossed sample (any that needs one is a need).
+                    let needed = needs(i, first) | crossed.fold(false, |a, j| a | needs(i, j));
+                    op.supervise_crossing(
+                        &mut robots.runs[i],
+                        &mut robots.in_episode[i],
+                        needed,
+                        rng,
+                    );
+                }
+            }
+        }
+    }
+    robots.ref_now.copy_from_slice(&tick.ref_time);
+    Ok((tick, corrected))
 }
 
 /// The simulated operator and the robot's logging, one robot and tick at a time (steps 2–4
