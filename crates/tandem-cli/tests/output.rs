@@ -351,6 +351,93 @@ fn strokes(scale: &[f64]) -> String {
     text
 }
 
+/// The `(high, total, regions)` of the first `high confidence: …` line of `text`.
+fn confidence_counts(text: &str) -> (usize, usize, usize) {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("high confidence: "))
+        .unwrap_or_else(|| panic!("no confidence line:\n{text}"));
+    let inner = line.split_once('(').expect("`(h of n)`").1;
+    let (h, rest) = inner.split_once(" of ").expect("`h of n`");
+    let (n, rest) = rest.split_once("), ").expect("`n), k regions`");
+    let k = rest.split_once(' ').expect("`k low-confidence regions`").0;
+    let num = |x: &str| x.parse::<usize>().unwrap_or_else(|_| panic!("{x}: {line}"));
+    (num(h), num(n), num(k))
+}
+
+#[test]
+fn fit_says_once_which_rate_range_would_merge_its_short_islands() {
+    // The stroke task with a rate range of 2.3 (the default, 3 × the mean pace, trusts every
+    // sample): the speeds' part of `σ²_D` peaks just above `σ²_MAX` over a few samples, so the
+    // prior's only low-confidence region is an island narrower than the opening (13 samples)
+    // with the position channels alone high-confidence. `fit` names the range from which it
+    // is high-confidence; fitted with that range the task is all high-confidence and the
+    // note is gone.
+    let dir = scratch("range-advice-positive");
+    let scales: [[f64; 6]; 5] = [
+        [1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
+        [1.12, 0.9, 1.05, 0.87, 1.1, 0.95],
+        [0.88, 1.1, 0.93, 1.14, 0.9, 1.08],
+        [1.06, 0.86, 1.13, 0.95, 0.88, 1.15],
+        [0.94, 1.13, 0.89, 1.07, 1.12, 0.86],
+    ];
+    let demos: Vec<String> = scales
+        .iter()
+        .enumerate()
+        .map(|(i, sc)| s(&write(&dir, &format!("demo_{i}.csv"), &strokes(sc))))
+        .collect();
+    let fit = |rate: &str| {
+        let mut args = vec!["fit".to_string()];
+        args.extend(demos.iter().cloned());
+        args.extend(["--samples", "50", "--force", "-o"].map(String::from));
+        args.push(s(&dir.join("cell.tandem")));
+        args.extend(["--ranges".to_string(), format!("rate={rate}")]);
+        ok(&tandem(&args))
+    };
+    let text = fit("2.3");
+    let notes: Vec<&str> = text.lines().filter(|l| l.starts_with("range: ")).collect();
+    assert_eq!(notes.len(), 1, "one range note:\n{text}");
+    let note = notes[0];
+    // One low-confidence region, and it is shorter than the opening: the island.
+    let (high, n_ref, regions) = confidence_counts(&text);
+    assert_eq!(regions, 1, "{text}");
+    assert!(n_ref - high < 13, "{text}");
+    for part in [
+        "range: channel `rate`: 1 low-confidence island shorter than 13 samples from the \
+         demonstrations' speeds alone; `--ranges rate=",
+        "(now 2.30) would make it high-confidence (",
+        "→ 100.0 % of the task, 1 → 0 low-confidence regions)",
+    ] {
+        assert!(note.contains(part), "`{part}` missing: {note}");
+    }
+    let advised = note
+        .split_once("`--ranges rate=")
+        .and_then(|(_, r)| r.split_once('`'))
+        .expect("the advised range")
+        .0;
+    let value: f64 = advised.parse().expect("a number");
+    // Larger than the range in force, rounded up to three significant digits.
+    assert!(value > 2.3 && value < 2.4, "{note}");
+    assert_eq!(advised.len(), 4, "three significant digits: {note}");
+    // The note's prediction (`1 → 0` regions, every sample high) is the refit's summary.
+    let predicted: usize = note
+        .rsplit_once("→ ")
+        .and_then(|(_, r)| r.split_once(' '))
+        .expect("`→ y low-confidence regions`")
+        .0
+        .parse()
+        .expect("a count");
+    let refit = fit(advised);
+    let (high, n_ref_after, regions) = confidence_counts(&refit);
+    assert_eq!(n_ref_after, n_ref, "the same reference:\n{refit}");
+    assert_eq!((high, regions), (n_ref, predicted), "{refit}");
+    assert!(
+        !refit.lines().any(|l| l.starts_with("range: ")),
+        "no note once the islands are gone:\n{refit}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn fit_gives_no_range_note_without_short_islands_from_the_speeds() {
     // The stroke task's speeds differ by up to 15 % per stroke: under the defaults its prior
