@@ -471,8 +471,14 @@ fn medoid_reference_does_not_depend_on_the_order_of_the_files() {
     // The default is the medoid (docs/decisions.md, "The medoid reference by default: labels
     // follow the reference"): the same model as asked for by name, in any order.
     let (out_e, e) = fit(&[1, 2, 0], &[], "e.tandem");
-    assert_eq!(&[1, 2, 0].map(|i| &demos[i])[e.model().reference_idx()], &medoid);
-    assert!(out_e.contains(&format!("reference: {medoid}, the medoid")), "{out_e}");
+    assert_eq!(
+        &[1, 2, 0].map(|i| &demos[i])[e.model().reference_idx()],
+        &medoid
+    );
+    assert!(
+        out_e.contains(&format!("reference: {medoid}, the medoid")),
+        "{out_e}"
+    );
     assert_eq!(e.model().sigma2_d(), a.model().sigma2_d());
     // `first` takes the first file.
     let (out_d, d) = fit(&[1, 2, 0], &["--reference", "first"], "d.tandem");
