@@ -365,6 +365,23 @@ fn confidence_counts(text: &str) -> (usize, usize, usize) {
     (num(h), num(n), num(k))
 }
 
+/// The stroke task's five demonstrations (`strokes`), written into `dir`: each stroke's speed
+/// scaled by up to ±15 % per demonstration (the first at the nominal speed); their paths.
+fn stroke_demos(dir: &std::path::Path) -> Vec<String> {
+    let scales: [[f64; 6]; 5] = [
+        [1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
+        [1.12, 0.9, 1.05, 0.87, 1.1, 0.95],
+        [0.88, 1.1, 0.93, 1.14, 0.9, 1.08],
+        [1.06, 0.86, 1.13, 0.95, 0.88, 1.15],
+        [0.94, 1.13, 0.89, 1.07, 1.12, 0.86],
+    ];
+    scales
+        .iter()
+        .enumerate()
+        .map(|(i, sc)| s(&write(dir, &format!("demo_{i}.csv"), &strokes(sc))))
+        .collect()
+}
+
 #[test]
 fn fit_says_once_which_rate_range_would_merge_its_short_islands() {
     // The stroke task with a rate range of 2.3 (the default, 3 × the mean pace, trusts every
@@ -374,18 +391,7 @@ fn fit_says_once_which_rate_range_would_merge_its_short_islands() {
     // is high-confidence; fitted with that range the task is all high-confidence and the
     // note is gone.
     let dir = scratch("range-advice-positive");
-    let scales: [[f64; 6]; 5] = [
-        [1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
-        [1.12, 0.9, 1.05, 0.87, 1.1, 0.95],
-        [0.88, 1.1, 0.93, 1.14, 0.9, 1.08],
-        [1.06, 0.86, 1.13, 0.95, 0.88, 1.15],
-        [0.94, 1.13, 0.89, 1.07, 1.12, 0.86],
-    ];
-    let demos: Vec<String> = scales
-        .iter()
-        .enumerate()
-        .map(|(i, sc)| s(&write(&dir, &format!("demo_{i}.csv"), &strokes(sc))))
-        .collect();
+    let demos = stroke_demos(&dir);
     let fit = |rate: &str| {
         let mut args = vec!["fit".to_string()];
         args.extend(demos.iter().cloned());
@@ -444,18 +450,7 @@ fn fit_gives_no_range_note_without_short_islands_from_the_speeds() {
     // trusts every sample, and with a small rate range its low-confidence regions are long
     // stretches, not islands narrower than the opening: no range is advisable either way.
     let dir = scratch("range-advice");
-    let scales: [[f64; 6]; 5] = [
-        [1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
-        [1.12, 0.9, 1.05, 0.87, 1.1, 0.95],
-        [0.88, 1.1, 0.93, 1.14, 0.9, 1.08],
-        [1.06, 0.86, 1.13, 0.95, 0.88, 1.15],
-        [0.94, 1.13, 0.89, 1.07, 1.12, 0.86],
-    ];
-    let demos: Vec<String> = scales
-        .iter()
-        .enumerate()
-        .map(|(i, sc)| s(&write(&dir, &format!("demo_{i}.csv"), &strokes(sc))))
-        .collect();
+    let demos = stroke_demos(&dir);
     let fit = |extra: &[&str]| {
         let mut args = vec!["fit".to_string()];
         args.extend(demos.iter().cloned());
