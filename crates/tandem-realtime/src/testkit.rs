@@ -803,3 +803,52 @@ pub fn random_cell_task(
         holds,
     )
 }
+
+/// A random quarter of each robot's usable hold points (`holds::usable_holds` over every
+/// reference sample but the first), each kept with probability 0.25 in sample order: the
+/// hold points of the property tests with holds.
+pub fn random_usable(robots: &[Timeline], r: &mut impl Rng) -> Vec<Vec<usize>> {
+    robots
+        .iter()
+        .map(|tl| {
+            let all: Vec<usize> = (1..tl.n_ref()).collect();
+            crate::holds::usable_holds(tl.conf(), &all)
+                .into_iter()
+                .filter(|_| r.random_bool(0.25))
+                .collect()
+        })
+        .collect()
+}
+
+/// `rules` (release rules per robot) with planned dwells on some holds: each hold after the
+/// first sample gets, with probability 1/2, a dwell of up to 0.2 × the latest robot's end (s);
+/// the dwelt plan when a coordinator at `tick_s` accepts it (its legs still start in order),
+/// else `rules` unchanged. The draws are made in robot, then hold order.
+pub fn with_random_dwells(
+    robots: &[Timeline],
+    rules: Vec<Vec<crate::Hold>>,
+    tick_s: f64,
+    r: &mut impl Rng,
+) -> Vec<Vec<crate::Hold>> {
+    let span = robots.iter().map(Timeline::end_s).fold(0.0, f64::max);
+    let dwelt: Vec<Vec<crate::Hold>> = rules
+        .iter()
+        .map(|l| {
+            l.iter()
+                .map(|h| crate::Hold {
+                    dwell_s: if h.ref_idx > 0 && r.random_bool(0.5) {
+                        r.random_range(0.0..0.2) * span
+                    } else {
+                        0.0
+                    },
+                    ..h.clone()
+                })
+                .collect()
+        })
+        .collect();
+    if Coordinator::with_holds_unchecked(robots.to_vec(), &dwelt, tick_s).is_ok() {
+        dwelt
+    } else {
+        rules
+    }
+}

@@ -11,8 +11,10 @@ use std::cell::Cell;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use rand::Rng;
-use tandem_realtime::holds::{release_rules, usable_holds};
-use tandem_realtime::testkit::{Case, Family, find_overlap, find_overlap_with_holds, rng};
+use tandem_realtime::holds::release_rules;
+use tandem_realtime::testkit::{
+    Case, Family, find_overlap, find_overlap_with_holds, random_usable, rng, with_random_dwells,
+};
 use tandem_realtime::{
     After, Coordinator, Error, Hold, Operator, Timeline, sufficient_margins,
     sufficient_margins_with_holds,
@@ -156,20 +158,6 @@ fn held_robots_wait_at_their_holds_until_the_rules_hold_then_leave_as_a_start() 
             assert!(held[1] >= 1, "{held:?}");
         }
     }
-}
-
-/// Random usable holds of each robot's plan (each usable sample with probability ¼).
-fn random_usable(robots: &[Timeline], r: &mut impl Rng) -> Vec<Vec<usize>> {
-    robots
-        .iter()
-        .map(|tl| {
-            let all: Vec<usize> = (1..tl.n_ref()).collect();
-            usable_holds(tl.conf(), &all)
-                .into_iter()
-                .filter(|_| r.random_bool(0.25))
-                .collect()
-        })
-        .collect()
 }
 
 #[test]
@@ -346,31 +334,14 @@ fn no_robot_moves_backwards_with_holds_for_any_operator() {
             let starts = case.interleaved_starts(n, &mut r);
             let robots = case.robots_at(&starts);
             let usable = random_usable(&robots, &mut r);
-            let mut holds = release_rules(&robots, &[], &usable);
-            if holds.iter().all(Vec::is_empty) {
+            let rules = release_rules(&robots, &[], &usable);
+            if rules.iter().all(Vec::is_empty) {
                 return Ok(());
             }
             // Planned dwells on some holds, kept when the rules still let the legs start in
             // order (else the plan without them).
+            let holds = with_random_dwells(&robots, rules, case.tick_s, &mut r);
             let span = robots.iter().map(Timeline::end_s).fold(0.0, f64::max);
-            let dwelt: Vec<Vec<Hold>> = holds
-                .iter()
-                .map(|l| {
-                    l.iter()
-                        .map(|h| Hold {
-                            dwell_s: if h.ref_idx > 0 && r.random_bool(0.5) {
-                                r.random_range(0.0..0.2) * span
-                            } else {
-                                0.0
-                            },
-                            ..h.clone()
-                        })
-                        .collect()
-                })
-                .collect();
-            if Coordinator::with_holds_unchecked(robots.clone(), &dwelt, case.tick_s).is_ok() {
-                holds = dwelt;
-            }
             let coordinator =
                 Coordinator::with_holds_unchecked(robots.clone(), &holds, case.tick_s).unwrap();
             let dwell: f64 = holds.iter().flatten().map(|h| h.dwell_s).sum();

@@ -12,10 +12,9 @@ use std::cell::Cell;
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
-use rand::Rng;
 use tandem_realtime::adversary::{Adversary, run_adversary};
-use tandem_realtime::holds::{release_rules, usable_holds};
-use tandem_realtime::testkit::{Case, Family, rng};
+use tandem_realtime::holds::release_rules;
+use tandem_realtime::testkit::{Case, Family, random_usable, rng, with_random_dwells};
 use tandem_realtime::{Coordinator, Hold, Timeline};
 
 /// The ticks of the round run serially at the slowest admissible rates: each robot's plan
@@ -57,42 +56,12 @@ fn every_robot_finishes_its_round_with_holds_under_every_adversary() {
             let case = Case::random(Family::of_seed(seed), n, &mut r);
             let starts = case.interleaved_starts(n, &mut r);
             let robots = case.robots_at(&starts);
-            let usable: Vec<Vec<usize>> = robots
-                .iter()
-                .map(|tl| {
-                    let all: Vec<usize> = (1..tl.n_ref()).collect();
-                    usable_holds(tl.conf(), &all)
-                        .into_iter()
-                        .filter(|_| r.random_bool(0.25))
-                        .collect()
-                })
-                .collect();
+            let usable = random_usable(&robots, &mut r);
             let rules = release_rules(&robots, &[], &usable);
             if rules.iter().all(Vec::is_empty) {
                 return Ok(());
             }
-            let span = robots.iter().map(Timeline::end_s).fold(0.0, f64::max);
-            let dwelt: Vec<Vec<Hold>> = rules
-                .iter()
-                .map(|l| {
-                    l.iter()
-                        .map(|h| Hold {
-                            dwell_s: if h.ref_idx > 0 && r.random_bool(0.5) {
-                                r.random_range(0.0..0.2) * span
-                            } else {
-                                0.0
-                            },
-                            ..h.clone()
-                        })
-                        .collect()
-                })
-                .collect();
-            let holds =
-                if Coordinator::with_holds_unchecked(robots.clone(), &dwelt, case.tick_s).is_ok() {
-                    dwelt
-                } else {
-                    rules
-                };
+            let holds = with_random_dwells(&robots, rules, case.tick_s, &mut r);
             let coordinator =
                 Coordinator::with_holds_unchecked(robots.clone(), &holds, case.tick_s).unwrap();
             let bound = serial_bound(&robots, &holds, case.tick_s);
