@@ -268,7 +268,9 @@ impl Planner {
     /// one tick of both kinds of cell: the tick the rounds schedule was checked at, and the
     /// continuous plan counts the token rule's hand-overs at it): in rounds the current schedule
     /// checked on the problem ([`Planner::checked_schedule`]), for a continuous cell the
-    /// cyclic plan ([`Planner::cyclic_plan`] with the default [`CyclicParams`]). A snapshot:
+    /// cyclic plan ([`Planner::cyclic_plan`] with the default [`CyclicParams`] and the
+    /// operator's switch time and load cap of the sampler's parameters,
+    /// [`tandem_schedule::SamplerParams::switch_s`] and `max_busy_share`). A snapshot:
     /// the planner is not changed, and the state file keeps the rounds schedule it records
     /// from.
     ///
@@ -277,7 +279,14 @@ impl Planner {
     pub fn plan(&self, cell: Cell) -> Result<Plan> {
         Ok(match cell {
             Cell::Rounds => Plan::Rounds(self.checked_schedule()?),
-            Cell::Continuous => Plan::Continuous(self.cyclic_plan(&CyclicParams::default(), None)?),
+            Cell::Continuous => {
+                let params = CyclicParams {
+                    switch_s: self.params().sampler.switch_s,
+                    max_busy_share: self.params().sampler.max_busy_share,
+                    ..CyclicParams::default()
+                };
+                Plan::Continuous(self.cyclic_plan(&params, None)?)
+            }
         })
     }
 

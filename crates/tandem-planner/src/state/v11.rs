@@ -75,6 +75,15 @@ pub struct PlannerParams {
 /// relative term, relative without a duration window before the duration term).
 pub const FIT_RATE_TERM: &str = "fit.rate_term";
 
+/// The name under which [`sched::SamplerParams::switch_s`] (the operator's switch time, s) is
+/// stored ([`Extras`], an `f64`) when it is not 0 (absent: 0, the planner of every file written
+/// before the parameter existed).
+pub const SAMPLER_SWITCH_S: &str = "sampler.switch_s";
+
+/// The name under which [`sched::SamplerParams::max_busy_share`] (the operator's load cap) is
+/// stored ([`Extras`], an `f64`) when it is not 1 (absent: 1, no cap).
+pub const SAMPLER_MAX_BUSY_SHARE: &str = "sampler.max_busy_share";
+
 /// [`lfd::FitParams`] as format 11 writes them.
 #[expect(
     missing_docs,
@@ -604,6 +613,10 @@ impl From<&sched::SamplerParams> for SamplerParams {
             widen_max,
             max_margin_checks,
             exact,
+            // Added after format 11: stored by name ([`SAMPLER_SWITCH_S`]).
+            switch_s: _,
+            // Added after format 11: stored by name ([`SAMPLER_MAX_BUSY_SHARE`]).
+            max_busy_share: _,
         } = p;
         let sched::ExactParams {
             max_pieces,
@@ -639,6 +652,8 @@ impl From<SamplerParams> for sched::SamplerParams {
                 max_pieces: p.exact.max_pieces,
                 max_margin_checks: p.exact.max_margin_checks,
             },
+            // Stored by name after the payload; set by `Payload::into_state`.
+            ..sched::SamplerParams::default()
         }
     }
 }
@@ -1024,6 +1039,8 @@ impl Payload {
             &params.fit.rate_term.to_string(),
             &model.rate_term().to_string(),
         )?;
+        extras.put(SAMPLER_SWITCH_S, &params.sampler.switch_s, &0.0)?;
+        extras.put(SAMPLER_MAX_BUSY_SHARE, &params.sampler.max_busy_share, &1.0)?;
         let payload = Payload {
             params: params.into(),
             model: model.clone(),
@@ -1054,6 +1071,9 @@ impl Payload {
             what: "parameters stored by name",
             why: format!("`{FIT_RATE_TERM}` = `{rate_term}`: {e}"),
         })?;
+        params.sampler.switch_s = extras.take(SAMPLER_SWITCH_S, 0.0)?;
+        params.sampler.max_busy_share = extras.take(SAMPLER_MAX_BUSY_SHARE, 1.0)?;
+        params.sampler.validate()?;
         extras.finish()?;
         Ok(super::PlannerState {
             params,
@@ -1175,6 +1195,35 @@ mod tests {
             err.contains(FIT_RATE_TERM) && err.contains("odd number of samples ≥ 3, got 4"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn the_operators_switch_time_and_load_cap_are_stored_by_name_only_off_their_defaults() {
+        let (path, bytes) = golden();
+        let (payload, extras) = decode_any(&bytes, &path).unwrap();
+        let mut state = payload.into_state(extras).unwrap();
+        // Absent from the file: no switch time, no cap.
+        assert_eq!(state.params.sampler.switch_s, 0.0);
+        assert_eq!(state.params.sampler.max_busy_share, 1.0);
+        state.params.sampler.switch_s = 2.5;
+        state.params.sampler.max_busy_share = 0.7;
+        let (payload, extras) = Payload::from_state(&state).unwrap();
+        assert_eq!(
+            extras.names().collect::<Vec<_>>(),
+            [SAMPLER_SWITCH_S, SAMPLER_MAX_BUSY_SHARE]
+        );
+        let file = encode_payload(&payload, &extras).unwrap();
+        // The payload's bytes are those of the golden file; only the list after it is new.
+        assert_eq!(&file[HEADER_LEN..bytes.len()], &bytes[HEADER_LEN..]);
+        let (payload, extras) = decode_any(&file, &path).unwrap();
+        let back = payload.into_state(extras).unwrap().params.sampler;
+        assert_eq!((back.switch_s, back.max_busy_share), (2.5, 0.7));
+        // A stored value the library refuses is a clear error naming it.
+        let mut bad = Extras::default();
+        bad.put(SAMPLER_MAX_BUSY_SHARE, &1.5_f64, &1.0).unwrap();
+        let (payload, _) = decode_any(&bytes, &path).unwrap();
+        let err = payload.into_state(bad).unwrap_err().to_string();
+        assert!(err.contains("max_busy_share"), "{err}");
     }
 
     /// What a build whose warp parameters gained a parameter with a default would write and

@@ -47,6 +47,19 @@ pub struct SamplerParams {
     /// certified against) and the margin-aware completion run beside the sampler as its
     /// second opinion. Default: `ExactParams::default()`.
     pub exact: ExactParams,
+    /// The operator's switch time `δ` (real s, issue 41), finite and ≥ 0: every schedule this
+    /// planner makes leaves at least `δ` between the end of one robot's low-confidence
+    /// stretch and the start of *another* robot's, in the worst case (the margin check with
+    /// `tandem_realtime::MarginParams::switch_s`), and a continuous cell's cyclic plan counts
+    /// it per change of robot ([`crate::CyclicParams::switch_s`]). One source for rounds and
+    /// the continuous cell. Stored in the state file by name (only when not 0). Default 0:
+    /// today's schedules, the same float operations.
+    pub switch_s: f64,
+    /// The load cap `u_max` (issue 41), in `(0, 1]`: the operator's busy share (supervised
+    /// time plus `switch_s` per change of robot, over a round's `T_total` or a continuous
+    /// cell's period) must not exceed it ([`crate::CyclicParams::max_busy_share`]). Stored in
+    /// the state file by name (only when not 1). Default 1: no cap.
+    pub max_busy_share: f64,
 }
 
 impl Default for SamplerParams {
@@ -60,6 +73,8 @@ impl Default for SamplerParams {
             widen_max: 0.1,
             max_margin_checks: Some(64),
             exact: ExactParams::default(),
+            switch_s: 0.0,
+            max_busy_share: 1.0,
         }
     }
 }
@@ -107,6 +122,18 @@ impl SamplerParams {
             return Err(Error::BadParam {
                 name: "p_fastest",
                 why: "must be in [0, 1]",
+            });
+        }
+        if !(self.switch_s.is_finite() && self.switch_s >= 0.0) {
+            return Err(Error::BadParam {
+                name: "switch_s",
+                why: "must be finite and ≥ 0 (seconds; 0: no switch time)",
+            });
+        }
+        if !(self.max_busy_share > 0.0 && self.max_busy_share <= 1.0) {
+            return Err(Error::BadParam {
+                name: "max_busy_share",
+                why: "must be in (0, 1] (1: no cap)",
             });
         }
         Ok(())
