@@ -195,6 +195,21 @@ pub(crate) struct SamplerArgs {
     /// Master seed of the sampler. Default: from the parameters (0).
     #[arg(long, value_name = "S")]
     pub(crate) seed: Option<u64>,
+    /// The operator's switch time δ in seconds (finite, ≥ 0; issue 41): at least this long
+    /// between the end of one robot's low-confidence stretch and the start of another
+    /// robot's, in the worst case (rounds and the continuous cell). Stored in the state file.
+    /// Default: from the parameters (0: no switch time).
+    #[arg(
+        long = "switch-s",
+        value_name = "SECONDS",
+        allow_negative_numbers = true
+    )]
+    pub(crate) switch_s: Option<f64>,
+    /// The operator's load cap u_max, a share of the time in (0, 1]: the operator's busy
+    /// share (supervised time plus the switch time per change of robot) may not exceed it.
+    /// Stored in the state file. Default: from the parameters (1: no cap).
+    #[arg(long = "max-busy", value_name = "SHARE", allow_negative_numbers = true)]
+    pub(crate) max_busy: Option<f64>,
 }
 
 /// `tandem fit`.

@@ -182,16 +182,59 @@ pub(crate) fn secs(v: f64) -> f64 {
     (v * 1e9).round() / 1e9
 }
 
-/// Applies `--samples`/`--seed` to sampler parameters and checks them.
-fn apply_sampler(mut p: SamplerParams, a: &SamplerArgs) -> Result<SamplerParams> {
+/// Applies `--samples`/`--seed`/`--switch-s`/`--max-busy` to sampler parameters and checks
+/// them: a bad operator parameter is refused naming its flag and the valid range.
+pub(crate) fn apply_sampler(mut p: SamplerParams, a: &SamplerArgs) -> Result<SamplerParams> {
     if let Some(n) = a.samples {
         p.samples = n;
     }
     if let Some(s) = a.seed {
         p.seed = s;
     }
-    p.validate().context("--samples/--seed")?;
+    if let Some(d) = a.switch_s {
+        if !(d.is_finite() && d >= 0.0) {
+            bail!(
+                "--switch-s {d}: the operator's switch time must be a finite number of seconds \
+                 ≥ 0 (0: no switch time)"
+            );
+        }
+        p.switch_s = d;
+    }
+    if let Some(u) = a.max_busy {
+        if !(u > 0.0 && u <= 1.0) {
+            bail!(
+                "--max-busy {u}: the operator's load cap is a share of the time in (0, 1] \
+                 (0.7: busy at most 70 % of the time; 1: no cap)"
+            );
+        }
+        p.max_busy_share = u;
+    }
+    p.validate()
+        .context("--samples/--seed/--switch-s/--max-busy")?;
     Ok(p)
+}
+
+/// The operator's line of the summaries (`fit`, `record`, `inspect`, `schedule`): the switch
+/// time and load cap the schedules honour, when either is not its default (`None` otherwise:
+/// the output of a planner without them is unchanged).
+pub(crate) fn operator_line(p: &SamplerParams) -> Option<String> {
+    if p.switch_s == 0.0 && p.max_busy_share == 1.0 {
+        return None;
+    }
+    let cap = if p.max_busy_share == 1.0 {
+        "no load cap".to_owned()
+    } else {
+        format!(
+            "load cap u_max {} (busy at most {} % of the time, switches included)",
+            p.max_busy_share,
+            secs(100.0 * p.max_busy_share)
+        )
+    };
+    Some(format!(
+        "operator: switch time δ {} s (at least δ between one robot's low-confidence stretch \
+         and another's); {cap}",
+        secs(p.switch_s)
+    ))
 }
 
 fn fit(a: &FitArgs) -> Result<()> {
@@ -691,6 +734,9 @@ fn summary_lines(planner: &Planner) -> Result<()> {
         conf.low_regions().len()
     ));
     hold_lines(planner);
+    if let Some(line) = operator_line(&planner.params().sampler) {
+        out(&line);
+    }
     out(&format!(
         "schedule: {}",
         certificate_line(planner.problem(), planner.outcome())?
@@ -721,6 +767,11 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
         sp.seed = reschedule_seed(sp.seed, planner.rounds_recorded());
     }
     let sp = apply_sampler(sp, &a.sampler)?;
+    // The operator's parameters are the planner's own (later rounds honour them): set, and
+    // stored with --save.
+    planner
+        .set_operator(sp.switch_s, sp.max_busy_share)
+        .context("--switch-s/--max-busy")?;
     let previous_t_total_s = planner.outcome().t_total_s;
     planner.reschedule(&sp).context("cannot schedule")?;
     if let Some(lock) = &lock {
@@ -738,6 +789,9 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
         out(&serde_json::to_string_pretty(&json::value(&doc)?)?);
     } else {
         out(&gantt_text(planner.problem(), planner.outcome())?);
+        if let Some(line) = operator_line(&planner.params().sampler) {
+            out(&line);
+        }
         out(&format!(
             "saved schedule: T_total {:.2} s; {}",
             previous_t_total_s,
@@ -1123,6 +1177,10 @@ fn params() -> Result<()> {
         .context("cannot print the default parameters")?;
     out("# tandem parameters (defaults). Use with: tandem fit --params FILE …");
     out("# Sections: [fit] alignment and model, [confidence] Eq. 10–12, [sampler] §II-C.");
+    out(
+        "# [sampler] switch_s: the operator's switch time δ in seconds (≥ 0; 0: none); \
+         max_busy_share: the operator's load cap u_max, a share of the time in (0, 1] (1: no cap).",
+    );
     out(&text);
     Ok(())
 }

@@ -35,7 +35,12 @@ pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
              nothing (its period is computed exactly for every operator order it searches)"
         );
     }
-    let planner = crate::state_io::load(&a.state)?;
+    let mut planner = crate::state_io::load(&a.state)?;
+    // --switch-s/--max-busy plan this cell with them (shown, not saved: --save is refused).
+    let sp = crate::cmd::apply_sampler(planner.params().sampler.clone(), &a.sampler)?;
+    planner
+        .set_operator(sp.switch_s, sp.max_busy_share)
+        .context("--switch-s/--max-busy")?;
     let problem = planner.problem();
     // The planner's plan of the cell, at the schedule's control tick (its hand-overs counted
     // at it, so its period is what the cell does with the planned operator).
@@ -50,7 +55,13 @@ pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
             &crate::json::CyclicPlanOut::from(plan),
         )?);
     } else {
-        out(&plan_text(problem, plan, crate::cmd::verbose())?);
+        let sp = &planner.params().sampler;
+        out(&plan_text(
+            problem,
+            plan,
+            (sp.switch_s, sp.max_busy_share),
+            crate::cmd::verbose(),
+        )?);
     }
     Ok(())
 }
@@ -154,8 +165,15 @@ const STRETCHES_SHOWN: usize = 8;
 /// The plan as text: period, throughput and busy share, the certificate, how the order was
 /// found, the operator's order, what the plan assumes, the Gantt of two periods and each
 /// robot's times. A long order and many stretch durations are summarized unless `all`
-/// (`--verbose`).
-pub(crate) fn plan_text(problem: &Problem, plan: &CyclicPlan, all: bool) -> Result<String> {
+/// (`--verbose`). `operator` is the switch time `δ` (s) and load cap `u_max` the plan was
+/// made with (`(0.0, 1.0)`: neither): when either is not its default the busy share with the
+/// switches and the δ-bound's terms are printed too.
+pub(crate) fn plan_text(
+    problem: &Problem,
+    plan: &CyclicPlan,
+    operator: (f64, f64),
+    all: bool,
+) -> Result<String> {
     let shape = TaskShape::new(problem);
     let n = plan.n_robots;
     let m = plan.lc_s.len();
@@ -174,16 +192,43 @@ pub(crate) fn plan_text(problem: &Problem, plan: &CyclicPlan, all: bool) -> Resu
         plan.tasks_per_hour,
         100.0 * plan.operator_share
     )?;
-    writeln!(
-        out,
-        "certificate: P ≥ {} s = max(N·(L + I) = {n} × ({} + {}) s, fastest task D_min {} s); \
-         gap {}",
-        t(plan.lower_bound_s),
-        t(shape.lc_total_s()),
-        t(shape.idle_s()),
-        t(shape.fastest_s()),
-        gap_text(plan.gap)
-    )?;
+    let (switch_s, max_busy_share) = operator;
+    if switch_s == 0.0 && max_busy_share == 1.0 {
+        writeln!(
+            out,
+            "certificate: P ≥ {} s = max(N·(L + I) = {n} × ({} + {}) s, fastest task D_min {} \
+             s); gap {}",
+            t(plan.lower_bound_s),
+            t(shape.lc_total_s()),
+            t(shape.idle_s()),
+            t(shape.fastest_s()),
+            gap_text(plan.gap)
+        )?;
+    } else {
+        let (busy, changes) = busy_with_switches(plan, shape.lc_total_s(), switch_s);
+        writeln!(
+            out,
+            "operator: switch time δ {} s per change of robot ({changes} per period), load cap \
+             u_max {max_busy_share}: busy {:.1} % of the time with the switches",
+            t(switch_s),
+            100.0 * busy
+        )?;
+        // For N ≥ 2 robots every cyclic order changes robot at least N times.
+        let c = if n >= 2 && m > 0 { n as f64 } else { 0.0 };
+        let delta = if c > 0.0 { switch_s } else { 0.0 };
+        writeln!(
+            out,
+            "certificate: P ≥ {} s, the δ-bound: at least N·(L + I + δ) = {n} × ({} + {} + {}) \
+             s, (N·L + N·δ)/u_max = {} s and the fastest task D_min {} s; gap {}",
+            t(plan.lower_bound_s),
+            t(shape.lc_total_s()),
+            t(shape.idle_s()),
+            t(delta),
+            t((n as f64 * shape.lc_total_s() + c * switch_s) / max_busy_share),
+            t(shape.fastest_s()),
+            gap_text(plan.gap)
+        )?;
+    }
     writeln!(
         out,
         "             (L: the operator's supervised time per task; I: its forced idle time per \
@@ -251,6 +296,21 @@ pub(crate) fn plan_text(problem: &Problem, plan: &CyclicPlan, all: bool) -> Resu
         out.push_str(&robot_line(problem, r, cycle));
     }
     Ok(out)
+}
+
+/// The operator's busy share of `plan` with the switches, `(N·L + c·δ)/P`, and the number `c`
+/// of changes of robot around its cyclic order (`lc_total_s` = `L`, `switch_s` = `δ`).
+pub(crate) fn busy_with_switches(
+    plan: &CyclicPlan,
+    lc_total_s: f64,
+    switch_s: f64,
+) -> (f64, usize) {
+    let len = plan.order.len();
+    let changes = (0..len)
+        .filter(|&q| plan.order[q].robot != plan.order[(q + 1) % len].robot)
+        .count();
+    let busy = (plan.n_robots as f64 * lc_total_s + changes as f64 * switch_s) / plan.period_s;
+    (busy, changes)
 }
 
 /// One robot's times: its start, its stretches, its waits at holds and at the task start.

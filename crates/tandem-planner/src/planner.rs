@@ -938,6 +938,27 @@ impl Planner {
         &self.params
     }
 
+    /// Sets the operator's switch time `δ = switch_s` (real s, finite and ≥ 0) and load cap
+    /// `u_max = max_busy_share` (in `(0, 1]`) of [`PlannerParams::sampler`] (issue 41): the
+    /// parameters every later schedule of this planner honours ([`Planner::record_round`],
+    /// [`Planner::plan`]) and the state file stores. The current schedule is not changed:
+    /// call [`Planner::reschedule`] with them to re-plan now. On error the planner is as
+    /// before.
+    ///
+    /// # Errors
+    /// [`Error::Schedule`] (`BadParam` naming `switch_s` or `max_busy_share`) for a value
+    /// outside its range.
+    pub fn set_operator(&mut self, switch_s: f64, max_busy_share: f64) -> Result<()> {
+        let sampler = SamplerParams {
+            switch_s,
+            max_busy_share,
+            ..self.params.sampler.clone()
+        };
+        sampler.validate()?;
+        self.params.sampler = sampler;
+        Ok(())
+    }
+
     /// Rounds recorded so far (a round is one execution of each of the `N` robots).
     pub fn rounds_recorded(&self) -> usize {
         self.pairs_recorded
