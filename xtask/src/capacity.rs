@@ -843,6 +843,7 @@ mod tests {
                 hold_ticks: 0,
                 plan_gap: tandem::sim::workcell::PlanGap::default(),
                 needed_unsupervised: 0,
+                switch_missed: 0,
             }),
             lower_bound_s: t_total_s,
             bound_is_optimum: false,

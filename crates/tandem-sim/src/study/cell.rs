@@ -622,6 +622,7 @@ mod tests {
             ref_time_log: log,
             needed: 1,
             missed: 0,
+            switch_missed: 0,
             false_corrections: 0,
             clock_s: Vec::new(),
             start_tick: 0,

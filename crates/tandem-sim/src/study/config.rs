@@ -46,6 +46,49 @@ pub struct StudyConfig {
     /// (`run_cell_study`). Default: rounds (not written when it is).
     #[serde(skip_serializing_if = "Cell::is_rounds")]
     pub cell: Cell,
+    /// The operator as a person (issue 41), `[operator]`: the switch time and load cap the
+    /// schedules are planned with, and the simulated operator's own switch time. Default:
+    /// none of them (not written when so, so a study without them records as before).
+    #[serde(skip_serializing_if = "StudyOperator::is_default")]
+    pub operator: StudyOperator,
+}
+
+/// The `[operator]` table of the study's configuration (issue 41): what the schedules plan
+/// for and what the simulated operator needs, set apart so that a study can run a plan that
+/// ignores the operator's switch time (`switch_s = 0`) with an operator who has one
+/// (`switch_true_s = 2`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StudyOperator {
+    /// The switch time `δ` (real s, finite and ≥ 0) the schedules are planned with: the
+    /// planner's [`tandem_schedule::SamplerParams::switch_s`] (set here, not in
+    /// `[planner.sampler]`). Default: 0.
+    pub switch_s: f64,
+    /// The load cap `u_max` in `(0, 1]` the schedules are planned with: the planner's
+    /// [`tandem_schedule::SamplerParams::max_busy_share`] (set here, not in
+    /// `[planner.sampler]`). Default: 1 (no cap).
+    pub max_busy_share: f64,
+    /// The simulated operator's own switch time `δ_true` (real s, finite and ≥ 0):
+    /// [`OperatorParams::switch_true_s`]; needed corrections in its first `δ_true` after
+    /// another robot's stretch ended are missed and counted. Default: 0 (the operator of §III).
+    pub switch_true_s: f64,
+}
+
+impl Default for StudyOperator {
+    fn default() -> Self {
+        StudyOperator {
+            switch_s: 0.0,
+            max_busy_share: 1.0,
+            switch_true_s: 0.0,
+        }
+    }
+}
+
+impl StudyOperator {
+    /// Whether every field is its default (then the table is not written).
+    pub fn is_default(&self) -> bool {
+        *self == StudyOperator::default()
+    }
 }
 
 /// How the robots of a study run: the planner's one cell type (`rounds` or `continuous`),
@@ -67,6 +110,7 @@ impl Default for StudyConfig {
             planner: PlannerParams::default(),
             task: TaskParams::default(),
             cell: Cell::Rounds,
+            operator: StudyOperator::default(),
         }
     }
 }
@@ -120,9 +164,46 @@ impl StudyConfig {
         if !(self.false_correction_s.is_finite() && self.false_correction_s >= 0.0) {
             return bad("false_correction_s", "must be finite and ≥ 0");
         }
+        let op = &self.operator;
+        if !(op.switch_s.is_finite() && op.switch_s >= 0.0) {
+            return bad(
+                "operator.switch_s",
+                "must be finite and ≥ 0 (the planned switch time in seconds; 0: none)",
+            );
+        }
+        if !(op.max_busy_share > 0.0 && op.max_busy_share <= 1.0) {
+            return bad(
+                "operator.max_busy_share",
+                "must be in (0, 1] (the operator's load cap; 1: no cap)",
+            );
+        }
+        if !(op.switch_true_s.is_finite() && op.switch_true_s >= 0.0) {
+            return bad(
+                "operator.switch_true_s",
+                "must be finite and ≥ 0 (the simulated operator's switch time in seconds; 0: none)",
+            );
+        }
+        let sampler = &self.planner.sampler;
+        if sampler.switch_s != 0.0 || sampler.max_busy_share != 1.0 {
+            return bad(
+                "planner.sampler",
+                "sets switch_s or max_busy_share: a study sets them in its [operator] table \
+                 (one place for the operator), leave them out of [planner.sampler]",
+            );
+        }
         self.planner.validate()?;
         self.task.validate()?;
         Ok(())
+    }
+
+    /// The planner's parameters of every trial: [`StudyConfig::planner`] with the planned
+    /// switch time and load cap of [`StudyConfig::operator`] (the sampler's `samples` and
+    /// `seed` are set per trial).
+    pub fn planner_params(&self) -> PlannerParams {
+        let mut params = self.planner.clone();
+        params.sampler.switch_s = self.operator.switch_s;
+        params.sampler.max_busy_share = self.operator.max_busy_share;
+        params
     }
 
     /// The operator of the workcell.
@@ -131,6 +212,7 @@ impl StudyConfig {
             miss_rate: self.miss_rate,
             false_correction_rate: self.false_correction_rate,
             false_correction_s: self.false_correction_s,
+            switch_true_s: self.operator.switch_true_s,
             ..OperatorParams::default()
         }
     }
@@ -249,5 +331,45 @@ mod tests {
         assert!(c.planner.holds.at_s.is_empty());
         c.planner.holds = Default::default();
         assert_eq!(c, StudyConfig::default());
+    }
+
+    #[test]
+    fn the_operator_table_sets_the_planner_and_the_simulated_operator() {
+        let c: StudyConfig = toml::from_str(
+            "[operator]\nswitch_s = 2.0\nmax_busy_share = 0.7\nswitch_true_s = 1.5\n",
+        )
+        .unwrap();
+        c.validate().unwrap();
+        let p = c.planner_params();
+        assert_eq!((p.sampler.switch_s, p.sampler.max_busy_share), (2.0, 0.7));
+        assert_eq!(c.operator().switch_true_s, 1.5);
+        // Written back only when set.
+        let text = toml::to_string(&c).unwrap();
+        assert!(text.contains("[operator]"), "{text}");
+        assert!(
+            !toml::to_string(&StudyConfig::default())
+                .unwrap()
+                .contains("[operator]")
+        );
+        assert!(toml::from_str::<StudyConfig>("[operator]\nswitch = 1\n").is_err());
+        for (text, name) in [
+            ("[operator]\nswitch_s = -1.0\n", "operator.switch_s"),
+            (
+                "[operator]\nmax_busy_share = 0.0\n",
+                "operator.max_busy_share",
+            ),
+            (
+                "[operator]\nswitch_true_s = inf\n",
+                "operator.switch_true_s",
+            ),
+            ("[planner.sampler]\nswitch_s = 2.0\n", "planner.sampler"),
+        ] {
+            let c: StudyConfig = toml::from_str(text).unwrap();
+            let err = c.validate().unwrap_err();
+            assert!(
+                matches!(err, Error::BadParam { name: n, .. } if n == name),
+                "{text}: {err}"
+            );
+        }
     }
 }

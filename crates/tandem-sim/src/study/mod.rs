@@ -16,7 +16,7 @@ pub use cell::{
     CellCompletion, CellIteration, CellStudyResult, CellSummary, CellTrialResult, CellTrialRun,
     Steady, run_cell_study, run_cell_trial, run_cell_trial_on, run_cell_trials, task_gap,
 };
-pub use config::{Cell, StudyConfig};
+pub use config::{Cell, StudyConfig, StudyOperator};
 pub use inputs::{StudyInputs, read_labels, reference_labels};
 pub use record::{
     IterationRecord, IterationSummary, RoundStats, ScheduleSource, StudyResult, TrialResult,

@@ -54,6 +54,12 @@ pub struct RoundStats {
     /// operator is needed ([`RoundRun::needed_unsupervised`](crate::workcell::RoundRun::needed_unsupervised)).
     #[serde(default)]
     pub needed_unsupervised: usize,
+    /// Needed corrections the simulated operator missed because it was still switching its
+    /// attention from another robot (its switch time `δ_true`, issue 41), summed over the
+    /// round's executions ([`RobotRun::switch_missed`](crate::workcell::RobotRun::switch_missed)).
+    /// Left out of the JSON when 0, as it always is without a switch time.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub switch_missed: usize,
 }
 
 /// Deprecated: [`RoundStats`] under its two-robot name. Kept for one release at the crate's
@@ -322,6 +328,19 @@ impl StudyResult {
         )
     }
 
+    /// Needed corrections missed while the simulated operator was switching its attention
+    /// (issue 41), summed over every round of every trial
+    /// ([`RoundStats::switch_missed`]; 0 without a switch time), and the rounds run.
+    pub fn switch_missed_total(&self) -> (usize, usize) {
+        let rounds: Vec<&RoundStats> = self
+            .trials
+            .iter()
+            .flat_map(|t| &t.iterations)
+            .filter_map(|r| r.round.as_ref())
+            .collect();
+        (rounds.iter().map(|p| p.switch_missed).sum(), rounds.len())
+    }
+
     /// Total overlap ticks over every round of every trial (must be 0).
     pub fn total_overlap_ticks(&self) -> usize {
         self.trials
@@ -454,6 +473,7 @@ mod tests {
                     ..PlanGap::default()
                 },
                 needed_unsupervised: iteration + 3,
+                switch_missed: 0,
             }),
             lower_bound_s: t_total_s - 1.0,
             bound_is_optimum: iteration == 0,

@@ -176,7 +176,7 @@ pub(super) fn start_trial(
     config.validate()?;
     check_truth(model, truth)?;
     let seed = trial_seed(config.seed, trial);
-    let mut params = config.planner.clone();
+    let mut params = config.planner_params();
     params.sampler.samples = config.samples;
     params.sampler.seed = seed;
     let planner = Planner::from_model_with_robots(model.clone(), params, config.robots)?;
@@ -269,6 +269,7 @@ pub fn run_trial_on(
             hold_ticks: run.robots.iter().map(|r| r.hold_ticks).sum(),
             plan_gap: run.plan_gap,
             needed_unsupervised: run.needed_unsupervised(|robot, n| needed[robot][n]),
+            switch_missed: run.robots.iter().map(|r| r.switch_missed).sum(),
         });
         iterations.push(record);
         let report = planner.record_round(&records).map_err(|e| at(e.into()))?;

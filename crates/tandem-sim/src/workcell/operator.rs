@@ -32,6 +32,24 @@ pub struct OperatorParams {
     /// deviation along each component: from the mean towards how the experts sanded over
     /// paint, not to the edge of what they ever did. Default: 1/3.
     pub gain: f64,
+    /// The operator's own switch time `δ_true` (real s, finite and ≥ 0; issue 41): a person
+    /// needs this long after the end of one robot's supervision before corrections on
+    /// *another* robot are effective ([`Attention`]); a correction needed earlier is missed
+    /// ([`crate::workcell::RobotRun::switch_missed`]). Independent of the switch time the
+    /// schedule was planned with (`tandem_schedule::SamplerParams::switch_s`), so a study can
+    /// run a plan that ignores it. Default 0: no switch time, the operator of before (the
+    /// same draws, bit for bit); not serialized when 0.
+    #[serde(skip_serializing_if = "is_zero_s")]
+    pub switch_true_s: f64,
+}
+
+/// Whether a duration is 0 (for `skip_serializing_if`).
+#[expect(
+    clippy::trivially_copy_pass_by_ref,
+    reason = "serde passes the field by reference"
+)]
+fn is_zero_s(v: &f64) -> bool {
+    *v == 0.0
 }
 
 impl Default for OperatorParams {
@@ -42,6 +60,7 @@ impl Default for OperatorParams {
             false_correction_s: 0.5,
             force_channel: "force".into(),
             gain: 1.0 / 3.0,
+            switch_true_s: 0.0,
         }
     }
 }
@@ -81,7 +100,46 @@ impl OperatorParams {
                 why: "must be in (0, 1]",
             });
         }
+        if !(self.switch_true_s.is_finite() && self.switch_true_s >= 0.0) {
+            return Err(Error::BadParam {
+                name: "switch_true_s",
+                why: "must be finite and ≥ 0 (the operator's own switch time in seconds; 0: none)",
+            });
+        }
         Ok(())
+    }
+}
+
+/// Where the simulated operator's attention is (issue 41): the robot it supervised last, the
+/// last control tick it did, and the first tick from which its corrections on that robot are
+/// effective. With a switch time of `k` ticks (`δ_true` rounded up to whole ticks,
+/// [`tandem_realtime::switch_ticks`]): when robot `j` is supervised in tick `t` and the
+/// attention was on another robot `i`, last supervised in tick `L` (its stretch ended at the
+/// end of tick `L`), the operator is ready for `j` from tick `L + 1 + k` on, `k·Δt ≥ δ_true`
+/// after `i`'s stretch ended: a needed correction in a tick before that is missed. The
+/// operator turns to the next robot as soon as the previous one leaves its stretch (a display
+/// tells it which robot comes next), so a schedule that leaves at least `δ_true` between two
+/// robots' stretches loses nothing; back-to-back stretches lose the first `δ_true` of the
+/// second. The first robot a fresh operator supervises (a round's first, a cell's first) is
+/// no switch. Supervising the same robot again, after a pause or not, is no switch either.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Attention {
+    /// `(robot, last supervised tick, first effective tick)`, `None` before the first.
+    on: Option<(usize, usize, usize)>,
+}
+
+impl Attention {
+    /// Robot `robot` is supervised in tick `tick` by an operator with a switch time of
+    /// `switch_ticks` ticks: returns whether the operator is still switching to it (its
+    /// corrections in this tick are not effective). Ticks must not decrease.
+    pub(super) fn supervise(&mut self, robot: usize, tick: usize, switch_ticks: usize) -> bool {
+        let ready = match self.on {
+            Some((r, _, ready)) if r == robot => ready,
+            Some((_, last, _)) => last + 1 + switch_ticks,
+            None => tick,
+        };
+        self.on = Some((robot, tick, ready));
+        tick < ready
     }
 }
 
@@ -205,6 +263,32 @@ mod tests {
     use rand::SeedableRng;
 
     use super::*;
+
+    #[test]
+    fn attention_needs_the_switch_time_after_another_robots_stretch() {
+        // A switch time of 3 ticks.
+        let mut a = Attention::default();
+        // The first robot is no switch; robot 0 supervised in ticks 0..=4.
+        for t in 0..5 {
+            assert!(!a.supervise(0, t, 3), "tick {t}");
+        }
+        // Robot 1 right after (tick 5): its stretch ended at the end of tick 4, so the
+        // operator is ready from tick 4 + 1 + 3 = 8 on.
+        let switching: Vec<bool> = (5..10).map(|t| a.supervise(1, t, 3)).collect();
+        assert_eq!(switching, [true, true, true, false, false]);
+        // Back to robot 0 after a pause of 3 ticks (10, 11, 12 unsupervised): ready at
+        // 9 + 1 + 3 = 13, the tick it starts.
+        assert!(!a.supervise(0, 13, 3));
+        // Robot 1 again after a pause of 2 ticks: one tick of switching left.
+        assert!(a.supervise(1, 16, 3));
+        assert!(!a.supervise(1, 17, 3));
+        // The same robot after any pause: no switch.
+        assert!(!a.supervise(1, 40, 3));
+        // No switch time: never switching.
+        let mut b = Attention::default();
+        assert!(!b.supervise(0, 0, 0));
+        assert!(!b.supervise(1, 1, 0));
+    }
 
     #[test]
     fn unneeded_corrections_cover_the_rate_in_episodes_of_the_mean_length() {

@@ -21,8 +21,14 @@ pub struct RobotRun {
     pub corrected: Vec<bool>,
     /// Supervised samples that needed a correction.
     pub needed: usize,
-    /// Needed corrections the operator missed.
+    /// Needed corrections the operator missed (by its miss rate, or while switching).
     pub missed: usize,
+    /// Of [`RobotRun::missed`], those missed because the operator was still switching its
+    /// attention to this robot (its switch time `δ_true`,
+    /// [`OperatorParams::switch_true_s`](crate::workcell::OperatorParams::switch_true_s);
+    /// issue 41). 0 without a switch time, and then not serialized.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub switch_missed: usize,
     /// Corrections given where none was needed.
     pub false_corrections: usize,
     /// The robot's schedule clock `s_i` (global schedule time, s) at the start of every

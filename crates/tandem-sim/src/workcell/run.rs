@@ -7,7 +7,9 @@ use tandem_planner::Planner;
 use tandem_realtime::{Controller, Coordinator, Operator, Tick, Timeline, tol};
 use tandem_schedule::{Problem, Schedule};
 
-use super::operator::{Episodes, OperatorParams, local_correction_input, needs_correction};
+use super::operator::{
+    Attention, Episodes, OperatorParams, local_correction_input, needs_correction,
+};
 use super::record::{PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
 use crate::task::{Label, Workpiece};
 use crate::{Error, Result};
@@ -358,12 +360,14 @@ pub(super) fn step<C: Controller + ?Sized>(
         if supervised.is_none() {
             unsupervised_at[i] = Some(ref_now);
         }
+        let switching = low_conf[i] && op.attend(i, ticks);
         if let Some(input) = op.robot_tick(
             model,
             run,
             &mut robots.in_episode[i],
             ref_now,
             supervised,
+            switching,
             |idx| needs(i, idx),
             rng,
         )? {
@@ -386,10 +390,12 @@ pub(super) fn step<C: Controller + ?Sized>(
                 if let Some(first) = crossed.next() {
                     // Asked once per crossed sample (any that needs one is a need).
                     let needed = needs(i, first) | crossed.fold(false, |a, j| a | needs(i, j));
+                    let switching = op.attend(i, ticks);
                     op.supervise_crossing(
                         &mut robots.runs[i],
                         &mut robots.in_episode[i],
                         needed,
+                        switching,
                         rng,
                     );
                 }
@@ -414,6 +420,11 @@ pub(super) struct Operate {
     u_zero: Vec<f64>,
     u_corr: Vec<f64>,
     cmd: Vec<f64>,
+    /// The operator's switch time `δ_true` in whole control ticks
+    /// ([`OperatorParams::switch_true_s`], [`tandem_realtime::switch_ticks`]); 0: none.
+    switch_ticks: usize,
+    /// Where its attention is (only kept with a switch time).
+    attention: Attention,
 }
 
 impl Operate {
@@ -425,6 +436,7 @@ impl Operate {
             .position(|n| *n == params.force_channel)
             .ok_or_else(|| Error::NoForceChannel(params.force_channel.clone()))?;
         let k = model.n_components();
+        let switch_ticks = tandem_realtime::switch_ticks(params.switch_true_s, tick_s)? as usize;
         Ok(Operate {
             params: params.clone(),
             force_idx,
@@ -435,7 +447,17 @@ impl Operate {
             u_zero: vec![0.0; k],
             u_corr: vec![0.0; k],
             cmd: vec![0.0; model.channel_names().len() + 1],
+            switch_ticks,
+            attention: Attention::default(),
         })
+    }
+
+    /// Robot `robot` is supervised in control tick `tick` (the run's tick index, not
+    /// decreasing): whether the operator is still switching its attention to it, so that its
+    /// corrections this tick are not effective ([`Attention`]). Always `false` without a
+    /// switch time (and nothing is kept).
+    pub(super) fn attend(&mut self, robot: usize, tick: usize) -> bool {
+        self.switch_ticks > 0 && self.attention.supervise(robot, tick, self.switch_ticks)
     }
 
     /// An empty run with room for about two executions of `n_ref` samples.
@@ -448,6 +470,7 @@ impl Operate {
             corrected: Vec::with_capacity(n_ref * 2),
             needed: 0,
             missed: 0,
+            switch_missed: 0,
             false_corrections: 0,
             clock_s: Vec::with_capacity(n_ref * 2),
             start_tick: usize::MAX,
@@ -458,8 +481,9 @@ impl Operate {
 
     /// The operator's decision for a tick that the robot started on a high-confidence sample
     /// and in which it crossed whole low-confidence samples (`needed`: any of them needs a
-    /// correction): drawn as for a supervised sample, and the tick's logged sample (the last
-    /// of `run`) becomes supervised with that decision. Its command is not changed: the robot
+    /// correction): drawn as for a supervised sample (`switching`: the operator is still
+    /// switching to the robot, so a needed correction is missed and no unneeded one given),
+    /// and the tick's logged sample (the last of `run`) becomes supervised with that decision. Its command is not changed: the robot
     /// started the tick on high confidence, so neither its rate nor its command took the
     /// operator's input; the record keeps what the operator would have done there.
     pub(super) fn supervise_crossing(
@@ -467,10 +491,19 @@ impl Operate {
         run: &mut RobotRun,
         in_episode: &mut bool,
         needed: bool,
+        switching: bool,
         rng: &mut impl Rng,
     ) {
         let draw: f64 = rng.random();
-        let corrected = if needed {
+        let corrected = if switching {
+            // Still turning to this robot: the draw is taken (the same stream as without the
+            // switch), a needed correction is missed, no episode runs.
+            *in_episode = false;
+            run.needed += usize::from(needed);
+            run.missed += usize::from(needed);
+            run.switch_missed += usize::from(needed);
+            false
+        } else if needed {
             *in_episode = false;
             run.needed += 1;
             let corrected = draw >= self.params.miss_rate;
@@ -491,7 +524,8 @@ impl Operate {
     /// One running robot's tick at fractional reference time `ref_time` (capped at the last
     /// sample): with `bounds = Some((ψ̇min, ψ̇max))` of its sample it is supervised (its sample
     /// is low-confidence) and the operator decides — `needs(round(t))` asked once, then the
-    /// draw from `rng` — whether to correct; the command is logged into `run` with its flags.
+    /// draw from `rng` — whether to correct (never while `switching` to the robot: a needed
+    /// correction is then missed and counted in [`RobotRun::switch_missed`]); the command is logged into `run` with its flags.
     /// Returns the operator's input for the coordinator when it corrected (the command's rate,
     /// clamped to `bounds`), else `None` (`Operator::Scheduled`).
     #[allow(clippy::too_many_arguments)]
@@ -502,6 +536,7 @@ impl Operate {
         in_episode: &mut bool,
         ref_time: f64,
         bounds: Option<(f64, f64)>,
+        switching: bool,
         needs: impl FnOnce(usize) -> bool,
         rng: &mut impl Rng,
     ) -> Result<Option<Operator>> {
@@ -522,7 +557,13 @@ impl Operate {
             let label_idx = (ref_time.round() as usize).min(n_ref - 1);
             let needed = needs(label_idx);
             let draw: f64 = rng.random();
-            if needed {
+            if switching {
+                // Still turning to this robot (see `supervise_crossing`).
+                *in_episode = false;
+                run.needed += usize::from(needed);
+                run.missed += usize::from(needed);
+                run.switch_missed += usize::from(needed);
+            } else if needed {
                 *in_episode = false;
                 run.needed += 1;
                 corrected = draw >= self.params.miss_rate;

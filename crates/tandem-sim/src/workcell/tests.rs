@@ -704,6 +704,7 @@ fn a_round_gap_splits_realized_minus_planned_into_its_causes_exactly() {
             ref_time_log,
             needed: 0,
             missed: 0,
+            switch_missed: 0,
             false_corrections: 0,
             clock_s,
             start_tick: phases.iter().position(|&p| p == Running).unwrap(),
@@ -922,4 +923,96 @@ fn a_fast_robot_crossing_a_one_sample_island_in_one_tick_gets_it_supervised() {
         split.record_votes(&times, &corrected).unwrap();
         assert_eq!(split.supervised()[island], 0.0);
     }
+}
+
+/// The ticks (of the round) in which `run` logged a supervised sample.
+fn supervised_ticks(run: &RobotRun) -> Vec<usize> {
+    run.phases
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| **p == TickPhase::Running)
+        .map(|(t, _)| t)
+        .zip(&run.supervised)
+        .filter(|(_, s)| **s)
+        .map(|(t, _)| t)
+        .collect()
+}
+
+/// An operator with a switch time `δ_true` (issue 41) misses exactly the needed corrections of
+/// the second robot's stretch that come less than `δ_true` (in whole ticks) after the first
+/// robot's stretch ended; the first robot, and an operator without a switch time, miss none.
+#[test]
+fn an_operator_with_a_switch_time_misses_the_corrections_right_after_another_robots_stretch() {
+    let perfect = OperatorParams {
+        miss_rate: 0.0,
+        false_correction_rate: 0.0,
+        ..OperatorParams::default()
+    };
+    let (base, _) = run(&perfect, 11);
+    for r in &base.robots {
+        assert_eq!((r.missed, r.switch_missed), (0, 0));
+        assert!(r.needed > 0);
+    }
+    // 0.6 s at 10 ms ticks: 60 ticks, more than the serial schedule's 50 ticks between the
+    // two robots' stretches.
+    let switch_s = 0.6;
+    let k = tandem_realtime::switch_ticks(switch_s, 0.01).unwrap() as usize;
+    assert_eq!(k, 60);
+    let slow = OperatorParams {
+        switch_true_s: switch_s,
+        ..perfect.clone()
+    };
+    let (round, _) = run(&slow, 11);
+    let ticks: Vec<Vec<usize>> = round.robots.iter().map(supervised_ticks).collect();
+    // The serial schedule: one robot's stretch, then the other's.
+    let (first, second) = if ticks[0][0] < ticks[1][0] {
+        (0, 1)
+    } else {
+        (1, 0)
+    };
+    let last = *ticks[first].last().unwrap();
+    assert!(last < ticks[second][0]);
+    let expected = ticks[second].iter().filter(|&&t| t < last + 1 + k).count();
+    assert!(
+        expected > 0,
+        "the stretches are {} ticks apart",
+        ticks[second][0] - last - 1
+    );
+    assert_eq!(round.robots[first].switch_missed, 0);
+    assert_eq!(round.robots[first].missed, 0);
+    // Every low-confidence sample needs a correction (all painted): each one in the switch is
+    // missed, none after it.
+    assert_eq!(round.robots[second].switch_missed, expected);
+    assert_eq!(round.robots[second].missed, expected);
+    let corrected: Vec<bool> = round.robots[second]
+        .corrected
+        .iter()
+        .zip(&round.robots[second].supervised)
+        .filter(|(_, s)| **s)
+        .map(|(c, _)| *c)
+        .collect();
+    assert!(corrected[..expected].iter().all(|c| !c));
+    assert!(corrected[expected..].iter().all(|c| *c));
+    // A switch time no longer than the gap between the stretches costs nothing.
+    let gap_ticks = ticks[second][0] - last - 1;
+    if gap_ticks > 0 {
+        let short = OperatorParams {
+            switch_true_s: gap_ticks as f64 * 0.01,
+            ..perfect.clone()
+        };
+        let (round, _) = run(&short, 11);
+        assert!(round.robots.iter().all(|r| r.switch_missed == 0));
+    }
+    // A bad switch time is refused by name.
+    let bad = OperatorParams {
+        switch_true_s: -1.0,
+        ..perfect
+    };
+    assert!(matches!(
+        bad.validate(),
+        Err(Error::BadParam {
+            name: "switch_true_s",
+            ..
+        })
+    ));
 }
