@@ -87,6 +87,20 @@ pub(crate) struct CapacityArgs {
     /// Output folder. Default: results/capacity/ in the workspace.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Smallest robot count (runs N = this..=max-robots).
+    #[arg(long, default_value_t = 1)]
+    min_robots: usize,
+    /// The operator's switch time δ (s, ≥ 0) the schedules are planned with (issue 41), or
+    /// several, comma-separated (`0,1,2,5,7`): a sweep, every robot count at every δ, drawn
+    /// against δ in `capacity_switch.svg`/`.png`. Default: the configuration's
+    /// (`[operator] switch_s`, 0).
+    #[arg(
+        long = "switch-s",
+        value_name = "S,…",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    switch_s: Vec<f64>,
 }
 
 /// One robot count's result in rounds, at the end of learning.
@@ -94,6 +108,8 @@ pub(crate) struct CapacityArgs {
 pub(crate) struct CapacityRow {
     /// Robots `N`.
     pub robots: usize,
+    /// The switch time `δ` (s) the schedules were planned with (`[operator] switch_s`).
+    pub switch_s: f64,
     /// Executions per trial actually run (a multiple of `N`).
     pub executions: usize,
     /// Rounds per trial.
@@ -105,6 +121,10 @@ pub(crate) struct CapacityRow {
     /// Mean planned throughput of the final schedules, `N·3600 / T_total` (tasks per hour per
     /// operator).
     pub throughput_per_h: f64,
+    /// Mean bound of the final schedules' certificates, `N·3600 / T*` (tasks per hour; `T*`
+    /// the lower bound `IterationRecord::lower_bound_s`, with the switch time when the
+    /// scheduler counts it).
+    pub bound_per_h: f64,
     /// Mean measured throughput over the last rounds: their tasks per hour of their actual
     /// durations (tasks per hour per operator).
     pub steady_throughput_per_h: f64,
@@ -127,6 +147,8 @@ pub(crate) struct CapacityRow {
 pub(crate) struct CellRow {
     /// Robots `N`.
     pub robots: usize,
+    /// The switch time `δ` (s) the plans were made with (`[operator] switch_s`).
+    pub switch_s: f64,
     /// Tasks per trial (a multiple of `N`).
     pub tasks: usize,
     /// Mean steady throughput over the last tasks (tasks per hour per operator).
@@ -206,11 +228,13 @@ pub(crate) fn row(result: &StudyResult, wall_s: f64) -> anyhow::Result<CapacityR
     let tick_s = result.dt_s;
     Ok(CapacityRow {
         robots: n,
+        switch_s: config.operator.switch_s,
         executions: config.executions,
         rounds,
         t_total_mean_s: t_mean,
         t_total_std_s: t_std,
         throughput_per_h: mean_std(finals.iter().map(|r| r.throughput_per_h)).0,
+        bound_per_h: mean_std(finals.iter().map(|r| throughput_per_h(n, r.lower_bound_s))).0,
         steady_throughput_per_h: mean_std(steady).0,
         operator_busy_share: mean_std(all_end.iter().map(|p| p.operator_busy_share)).0,
         robot_wait_share: mean_std(all_end.iter().map(|p| p.robot_wait_share)).0,
@@ -241,6 +265,7 @@ pub(crate) fn cell_row(result: &CellStudyResult, wall_s: f64) -> anyhow::Result<
         .collect::<anyhow::Result<_>>()?;
     Ok(CellRow {
         robots: n,
+        switch_s: result.config.operator.switch_s,
         tasks: result.config.executions,
         steady_throughput_per_h: summary.steady_throughput_per_h,
         steady_throughput_std_per_h: summary.steady_throughput_std_per_h,
@@ -362,8 +387,26 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
     );
     let wall = Instant::now();
     let (mut rows, mut cells) = (Vec::new(), Vec::new());
-    for n in 1..=args.max_robots {
-        let config = StudyConfig {
+    let deltas = if args.switch_s.is_empty() {
+        vec![base.operator.switch_s]
+    } else {
+        args.switch_s.clone()
+    };
+    if let Some(d) = deltas.iter().find(|d| !(d.is_finite() && **d >= 0.0)) {
+        bail!("--switch-s {d}: a switch time is a finite number of seconds ≥ 0 (0: none)");
+    }
+    if !(1..=args.max_robots).contains(&args.min_robots) {
+        bail!(
+            "--min-robots {}: must be between 1 and --max-robots ({})",
+            args.min_robots,
+            args.max_robots
+        );
+    }
+    let runs = deltas
+        .iter()
+        .flat_map(|&d| (args.min_robots..=args.max_robots).map(move |n| (d, n)));
+    for (delta, n) in runs {
+        let mut config = StudyConfig {
             trials: args.trials,
             executions: args.executions / n * n,
             robots: n,
@@ -371,9 +414,15 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
             seed,
             ..base.clone()
         };
+        config.operator.switch_s = delta;
+        let n_text = if deltas.len() > 1 || delta != 0.0 {
+            format!("{n} at δ = {delta} s")
+        } else {
+            n.to_string()
+        };
         config
             .validate()
-            .with_context(|| format!("{} with N = {n}", path.display()))?;
+            .with_context(|| format!("{} with N = {n_text}", path.display()))?;
         if do_rounds {
             let config = StudyConfig {
                 cell: Cell::Rounds,
@@ -386,7 +435,7 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
             bar.clear();
             let r = row(&result, t.elapsed().as_secs_f64())?;
             println!(
-                "N = {n}, rounds: T_total {:.1} ± {:.1} s, {:.1} tasks/h planned, {:.1} \
+                "N = {n_text}, rounds: T_total {:.1} ± {:.1} s, {:.1} tasks/h planned, {:.1} \
                  measured, operator busy {:.0} %, robots waiting {:.0} %, {} overlapping \
                  ticks ({:.1} s)",
                 r.t_total_mean_s,
@@ -412,7 +461,7 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
             bar.clear();
             let r = cell_row(&result, t.elapsed().as_secs_f64())?;
             println!(
-                "N = {n}, continuous: {:.1} ± {:.1} tasks/h measured, last plan {:.1} (bound \
+                "N = {n_text}, continuous: {:.1} ± {:.1} tasks/h measured, last plan {:.1} (bound \
                  {:.1}), operator busy {:.0} %, robots waiting {:.0} %, {} overlapping ticks, \
                  {} faults ({:.1} s)",
                 r.steady_throughput_per_h,
@@ -442,6 +491,11 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
          per task)",
         3600.0 / bound
     );
+    let sweep = deltas.len() > 1 || deltas.iter().any(|&d| d != 0.0);
+    if sweep {
+        println!("\nthroughput against its proven bound, per switch time δ:");
+        print!("{}", switch_table(&rows, &cells));
+    }
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let file = CapacityFile {
         trials: args.trials,
@@ -455,18 +509,32 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
     let json_path = out.join("capacity.json");
     std::fs::write(&json_path, serde_json::to_string_pretty(&file)? + "\n")
         .with_context(|| format!("writing {}", json_path.display()))?;
-    draw_capacity(
-        &rows,
-        &cells,
-        bound,
-        &out.join("capacity.svg"),
-        &out.join("capacity.png"),
-    )?;
-    println!(
-        "wrote capacity.json, capacity.svg, capacity.png in {} ({:.1} s wall)",
-        out.display(),
-        wall.elapsed().as_secs_f64()
-    );
+    if deltas.len() > 1 {
+        draw_switch(
+            &rows,
+            &cells,
+            &out.join("capacity_switch.svg"),
+            &out.join("capacity_switch.png"),
+        )?;
+        println!(
+            "wrote capacity.json, capacity_switch.svg, capacity_switch.png in {} ({:.1} s wall)",
+            out.display(),
+            wall.elapsed().as_secs_f64()
+        );
+    } else {
+        draw_capacity(
+            &rows,
+            &cells,
+            bound,
+            &out.join("capacity.svg"),
+            &out.join("capacity.png"),
+        )?;
+        println!(
+            "wrote capacity.json, capacity.svg, capacity.png in {} ({:.1} s wall)",
+            out.display(),
+            wall.elapsed().as_secs_f64()
+        );
+    }
     let overlaps = rows.iter().map(|r| r.overlap_ticks as u64).sum::<u64>()
         + cells
             .iter()
@@ -744,6 +812,284 @@ fn draw_on<DB: DrawingBackend>(
     Ok(())
 }
 
+/// Throughput against its proven bound per switch time `δ` as Markdown: per cell, robot count
+/// and `δ`, the measured throughput (last 10 %), the bound of the final plan's certificate
+/// (rounds: `N·3600 / T*`; continuous: `3600·N / P_lower`, with the switch time in it), the
+/// measured throughput as a share of that bound, and the operator's busy share.
+pub(crate) fn switch_table(rows: &[CapacityRow], cells: &[CellRow]) -> String {
+    let mut out = String::from(
+        "| cell | N | δ (s) | measured (tasks/h) | planned (tasks/h) | proven bound (tasks/h) | \
+         measured / bound | operator busy |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    let line = |cell: &str, n: usize, d: f64, m: f64, p: f64, b: f64, busy: f64| {
+        format!(
+            "| {cell} | {n} | {d} | {m:.1} | {p:.1} | {b:.1} | {:.1} % | {:.0} % |\n",
+            100.0 * m / b,
+            100.0 * busy
+        )
+    };
+    for r in rows {
+        out += &line(
+            "rounds",
+            r.robots,
+            r.switch_s,
+            r.steady_throughput_per_h,
+            r.throughput_per_h,
+            r.bound_per_h,
+            r.operator_busy_share,
+        );
+    }
+    for r in cells {
+        out += &line(
+            "continuous",
+            r.robots,
+            r.switch_s,
+            r.steady_throughput_per_h,
+            r.plan_per_h,
+            r.bound_per_h,
+            r.operator_busy_share,
+        );
+    }
+    out
+}
+
+/// Colours of the robot counts in the switch-time figure, cycled.
+const N_COLOURS: [RGBColor; 4] = [MEAN, OPERATOR, GROUND_TRUTH, RGBColor(120, 120, 120)];
+
+/// Draws, against the switch time `δ`, the measured throughput (solid, points) and the proven
+/// bound (dashed) of every cell and robot count on the left, and the operator's busy share on
+/// the right, as SVG and PNG (`cargo xtask capacity --switch-s 0,1,2,…`). Rounds are drawn
+/// with circles, the continuous cell with triangles; one colour per robot count.
+///
+/// # Errors
+/// No rows at all, or a failure to render or write a file.
+pub(crate) fn draw_switch(
+    rows: &[CapacityRow],
+    cells: &[CellRow],
+    svg: &Path,
+    png: &Path,
+) -> anyhow::Result<()> {
+    if rows.is_empty() && cells.is_empty() {
+        bail!("switch-time figure: no rows to draw");
+    }
+    tandem_plot::register_font()?;
+    let mut svg_text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg_text, SIZE_PX).into_drawing_area();
+        draw_switch_on(&root, rows, cells)?;
+        root.present()
+            .map_err(|e| anyhow!("finishing the switch-time SVG: {e}"))?;
+    }
+    {
+        let root = BitMapBackend::new(png, SIZE_PX).into_drawing_area();
+        draw_switch_on(&root, rows, cells)?;
+        root.present()
+            .map_err(|e| anyhow!("writing {}: {e}", png.display()))?;
+    }
+    std::fs::write(svg, svg_text).with_context(|| format!("writing {}", svg.display()))?;
+    Ok(())
+}
+
+/// One line of the switch-time figure: its label, colour, whether continuous, and its
+/// points `(δ, measured, bound, busy share)` in order of `δ`.
+type SwitchLine = (String, RGBColor, bool, Vec<(f64, f64, f64, f64)>);
+
+/// The lines of the switch-time figure, one per cell and robot count.
+fn switch_lines(rows: &[CapacityRow], cells: &[CellRow]) -> Vec<SwitchLine> {
+    let mut lines: Vec<SwitchLine> = Vec::new();
+    let mut robots: Vec<usize> = rows
+        .iter()
+        .map(|r| r.robots)
+        .chain(cells.iter().map(|r| r.robots))
+        .collect();
+    robots.sort_unstable();
+    robots.dedup();
+    for (k, &n) in robots.iter().enumerate() {
+        let colour = N_COLOURS[k % N_COLOURS.len()];
+        let mut pts: Vec<(f64, f64, f64, f64)> = rows
+            .iter()
+            .filter(|r| r.robots == n)
+            .map(|r| {
+                (
+                    r.switch_s,
+                    r.steady_throughput_per_h,
+                    r.bound_per_h,
+                    r.operator_busy_share,
+                )
+            })
+            .collect();
+        if !pts.is_empty() {
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            lines.push((format!("rounds, N = {n}"), colour, false, pts));
+        }
+        let mut pts: Vec<(f64, f64, f64, f64)> = cells
+            .iter()
+            .filter(|r| r.robots == n)
+            .map(|r| {
+                (
+                    r.switch_s,
+                    r.steady_throughput_per_h,
+                    r.bound_per_h,
+                    r.operator_busy_share,
+                )
+            })
+            .collect();
+        if !pts.is_empty() {
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            lines.push((format!("continuous, N = {n}"), colour, true, pts));
+        }
+    }
+    lines
+}
+
+fn draw_switch_on<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    rows: &[CapacityRow],
+    cells: &[CellRow],
+) -> anyhow::Result<()> {
+    let err = |what: &'static str| {
+        move |e: DrawingAreaErrorKind<DB::ErrorType>| {
+            anyhow!("drawing the switch-time figure ({what}): {e}")
+        }
+    };
+    root.fill(&WHITE).map_err(err("background"))?;
+    let (left, right) = root.split_horizontally(SIZE_PX.0 / 2 + 40);
+    let lines = switch_lines(rows, cells);
+    let d_max = lines
+        .iter()
+        .flat_map(|l| l.3.iter().map(|p| p.0))
+        .fold(0.0, f64::max)
+        .max(1.0);
+    let x_range = -0.05 * d_max..1.05 * d_max;
+    let top = lines
+        .iter()
+        .flat_map(|l| l.3.iter().map(|p| p.1.max(p.2)))
+        .fold(1.0, f64::max);
+    let y_max = crate::fig5::nice_ceiling(top * 1.45);
+    let mut chart = ChartBuilder::on(&left)
+        .margin(20)
+        .caption("throughput against the switch time", (FONT_FAMILY, 24))
+        .x_label_area_size(60)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x_range.clone(), 0.0..y_max)
+        .map_err(err("throughput axes"))?;
+    chart
+        .configure_mesh()
+        .x_label_formatter(&|v| format!("{v:.1}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .x_desc("the operator's switch time δ (s) the plans are made with")
+        .y_desc("throughput (tasks per hour per operator)")
+        .label_style((FONT_FAMILY, 18))
+        .axis_desc_style((FONT_FAMILY, 20))
+        .light_line_style(WHITE.mix(0.0))
+        .bold_line_style(BLACK.mix(0.12))
+        .draw()
+        .map_err(err("throughput mesh"))?;
+    for (label, colour, continuous, pts) in &lines {
+        let colour = *colour;
+        let measured: Series = pts.iter().map(|p| (p.0, p.1)).collect();
+        let bound: Series = pts.iter().map(|p| (p.0, p.2)).collect();
+        chart
+            .draw_series(LineSeries::new(measured.clone(), colour.stroke_width(3)))
+            .map_err(err("throughput"))?
+            .label(format!("{label} (measured, last 10 %)"))
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
+            });
+        if *continuous {
+            chart
+                .draw_series(
+                    measured
+                        .iter()
+                        .map(|&p| TriangleMarker::new(p, 7, colour.filled())),
+                )
+                .map_err(err("throughput points"))?;
+        } else {
+            chart
+                .draw_series(measured.iter().map(|&p| Circle::new(p, 5, colour.filled())))
+                .map_err(err("throughput points"))?;
+        }
+        chart
+            .draw_series(DashedLineSeries::new(bound, 3, 5, colour.stroke_width(2)))
+            .map_err(err("bound"))?
+            .label(format!("{label}: proven bound"))
+            .legend(dashed_mark!(colour));
+    }
+    draw_legend!(
+        chart,
+        SeriesLabelPosition::UpperRight,
+        15,
+        err("throughput legend")
+    )?;
+
+    let mut chart = ChartBuilder::on(&right)
+        .margin(20)
+        .caption("operator busy", (FONT_FAMILY, 24))
+        .x_label_area_size(60)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x_range, 0.0..140.0)
+        .map_err(err("share axes"))?;
+    chart
+        .configure_mesh()
+        .y_labels(8)
+        .x_label_formatter(&|v| format!("{v:.1}"))
+        .y_label_formatter(&|v| {
+            if *v <= 100.0 {
+                format!("{v:.0}")
+            } else {
+                String::new()
+            }
+        })
+        .x_desc("the operator's switch time δ (s) the plans are made with")
+        .y_desc("operator busy, share of time (%)")
+        .label_style((FONT_FAMILY, 18))
+        .axis_desc_style((FONT_FAMILY, 20))
+        .light_line_style(WHITE.mix(0.0))
+        .bold_line_style(BLACK.mix(0.12))
+        .draw()
+        .map_err(err("share mesh"))?;
+    for (label, colour, continuous, pts) in &lines {
+        let colour = *colour;
+        let busy: Series = pts.iter().map(|p| (p.0, 100.0 * p.3)).collect();
+        if *continuous {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    busy.clone(),
+                    8,
+                    6,
+                    colour.stroke_width(3),
+                ))
+                .map_err(err("busy share"))?
+                .label(label.clone())
+                .legend(dashed_mark!(colour));
+            chart
+                .draw_series(
+                    busy.iter()
+                        .map(|&p| TriangleMarker::new(p, 7, colour.filled())),
+                )
+                .map_err(err("busy share points"))?;
+        } else {
+            chart
+                .draw_series(LineSeries::new(busy.clone(), colour.stroke_width(3)))
+                .map_err(err("busy share"))?
+                .label(label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
+                });
+            chart
+                .draw_series(busy.iter().map(|&p| Circle::new(p, 5, colour.filled())))
+                .map_err(err("busy share points"))?;
+        }
+    }
+    draw_legend!(
+        chart,
+        SeriesLabelPosition::UpperLeft,
+        17,
+        err("share legend")
+    )?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -751,11 +1097,13 @@ mod tests {
     fn r(robots: usize, t: f64, busy: f64, lc: f64) -> CapacityRow {
         CapacityRow {
             robots,
+            switch_s: 0.0,
             executions: 12 / robots * robots,
             rounds: 12 / robots,
             t_total_mean_s: t,
             t_total_std_s: 0.0,
             throughput_per_h: robots as f64 * 3600.0 / t,
+            bound_per_h: robots as f64 * 3600.0 / (t - 10.0),
             steady_throughput_per_h: robots as f64 * 3600.0 / (t + 10.0),
             operator_busy_share: busy,
             robot_wait_share: 0.25,
@@ -769,6 +1117,7 @@ mod tests {
     fn c(robots: usize, lc: f64) -> CellRow {
         CellRow {
             robots,
+            switch_s: 0.0,
             tasks: 240,
             steady_throughput_per_h: 80.0,
             steady_throughput_std_per_h: 1.0,
@@ -885,6 +1234,55 @@ mod tests {
         // The last round of each trial (round 9) took 500 s for three tasks: 21.6 per hour.
         assert!((row.steady_throughput_per_h - 21.6).abs() < 1e-12);
         assert_eq!(row.overlap_ticks, 0);
+    }
+
+    #[test]
+    fn the_switch_sweep_tables_and_draws_each_cell_against_its_bound() {
+        let rows: Vec<CapacityRow> = [0.0, 2.0]
+            .iter()
+            .map(|&d| CapacityRow {
+                switch_s: d,
+                ..r(3, 100.0 + 10.0 * d, 0.9, 30.0)
+            })
+            .collect();
+        let cells: Vec<CellRow> = [0.0, 2.0]
+            .iter()
+            .map(|&d| CellRow {
+                switch_s: d,
+                steady_throughput_per_h: 90.0 - 5.0 * d,
+                bound_per_h: 100.0 - 5.0 * d,
+                ..c(3, 30.0)
+            })
+            .collect();
+        let t = switch_table(&rows, &cells);
+        // Rounds at δ = 2: T_total 120 s, measured 3·3600/130 = 83.1, planned 3·3600/120 =
+        // 90.0, bound 3·3600/110 = 98.2 tasks/h: 84.6 % of it.
+        assert!(
+            t.contains("| rounds | 3 | 2 | 83.1 | 90.0 | 98.2 | 84.6 % | 90 % |"),
+            "{t}"
+        );
+        // Continuous at δ = 2: 80 of 90 tasks/h, 88.9 %.
+        assert!(
+            t.contains("| continuous | 3 | 2 | 80.0 | 85.0 | 90.0 | 88.9 % | 95 % |"),
+            "{t}"
+        );
+        let dir = crate::fig5::tests::scratch_dir("capacity-switch");
+        let (svg, png) = (dir.join("s.svg"), dir.join("s.png"));
+        draw_switch(&rows, &cells, &svg, &png).unwrap();
+        let text = std::fs::read_to_string(&svg).unwrap();
+        for label in [
+            "the operator&apos;s switch time δ (s) the plans are made with",
+            "continuous, N = 3: proven bound",
+            "rounds, N = 3 (measured, last 10 %)",
+            "operator busy, share of time (%)",
+        ] {
+            assert!(
+                text.contains(label) || text.contains(&label.replace("&apos;", "'")),
+                "{label}"
+            );
+        }
+        assert!(draw_switch(&[], &[], &svg, &png).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

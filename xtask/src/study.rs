@@ -59,6 +59,19 @@ pub(crate) struct StudyArgs {
     /// Mean length (s) of an unneeded correction episode; 0 draws every control tick alone.
     #[arg(long)]
     false_correction_s: Option<f64>,
+    /// The switch time δ (s, ≥ 0) the schedules are planned with (`[operator] switch_s`;
+    /// issue 41): at least δ between one robot's low-confidence stretch and another's.
+    #[arg(long, value_name = "S")]
+    switch_s: Option<f64>,
+    /// The operator's load cap u_max in (0, 1] the schedules are planned with (`[operator]
+    /// max_busy_share`).
+    #[arg(long, value_name = "U")]
+    max_busy: Option<f64>,
+    /// The simulated operator's own switch time δ_true (s, ≥ 0; `[operator] switch_true_s`):
+    /// corrections needed in its first δ_true after another robot's stretch ended are missed
+    /// and counted.
+    #[arg(long, value_name = "S")]
+    switch_true_s: Option<f64>,
     /// Decide confidence with the paper's model (Eq. 8–12: zero error rates, nothing
     /// estimated, every control sample one observation) instead of the configured one.
     #[arg(long)]
@@ -401,6 +414,15 @@ fn config(args: &StudyArgs) -> anyhow::Result<StudyConfig> {
     if let Some(v) = args.false_correction_s {
         config.false_correction_s = v;
     }
+    if let Some(v) = args.switch_s {
+        config.operator.switch_s = v;
+    }
+    if let Some(v) = args.max_busy {
+        config.operator.max_busy_share = v;
+    }
+    if let Some(v) = args.switch_true_s {
+        config.operator.switch_true_s = v;
+    }
     if args.no_holds {
         config.planner.holds = Default::default();
     }
@@ -616,6 +638,22 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
         unsupervised,
         unsupervised as f64 / rounds.max(1) as f64
     );
+    if !config.operator.is_default() {
+        let (missed, rounds) = result.switch_missed_total();
+        let op = &config.operator;
+        println!(
+            "operator: planned switch time δ {} s, load cap {}; own switch time δ_true {} s: {} \
+             needed corrections missed while switching ({:.2} per round); realized T_total \
+             {:.2} s per round on average (planned {:.2} s)",
+            op.switch_s,
+            op.max_busy_share,
+            op.switch_true_s,
+            missed,
+            missed as f64 / rounds.max(1) as f64,
+            gap.realized_s / rounds.max(1) as f64,
+            gap.planned_s / rounds.max(1) as f64,
+        );
+    }
     print_ground_truth(&result);
     println!(
         "overlapping low-confidence ticks: {}",

@@ -345,7 +345,14 @@ fn plan_of(
     tasks_recorded: usize,
     tick: u64,
 ) -> Result<(CheckedCyclicPlan, CellIteration)> {
-    let checked = planner.cyclic_plan(&CyclicParams::default(), None)?;
+    // The operator's switch time and load cap of the planner (issue 41; defaults: none).
+    let sampler = &planner.params().sampler;
+    let params = CyclicParams {
+        switch_s: sampler.switch_s,
+        max_busy_share: sampler.max_busy_share,
+        ..CyclicParams::default()
+    };
+    let checked = planner.cyclic_plan(&params, None)?;
     let plan = checked.plan();
     let iteration = CellIteration {
         tasks_recorded,
