@@ -371,7 +371,7 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
         CellChoice::Both => (true, true),
     };
     println!(
-        "capacity ({}): N = 1..={} robots, {} trials × up to {} executions (rounded down to a \
+        "capacity ({}): N = {}..={} robots, {} trials × up to {} executions (rounded down to a \
          multiple of N), {} samples per schedule, seed {seed}; end of learning = the last \
          {:.0} % of rounds or tasks",
         match args.cell {
@@ -379,6 +379,7 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
             CellChoice::Continuous => "continuous cell",
             CellChoice::Both => "rounds and continuous cell",
         },
+        args.min_robots,
         args.max_robots,
         args.trials,
         args.executions,
