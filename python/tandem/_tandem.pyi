@@ -63,6 +63,8 @@ def fit(
     robots: int = 2,
     holds: Optional[Union[Sequence[Union[float, str]], Dict[str, Any]]] = None,
     rate_term: Optional[str] = None,
+    switch_s: Optional[float] = None,
+    max_busy_share: Optional[float] = None,
 ) -> Planner:
     """Learns the task from demonstrations (paths or ``(T_i, C)`` arrays) and makes the first
     schedule (Fig. 2); the same inputs and parameters as ``tandem fit`` give the same state.
@@ -71,7 +73,10 @@ def fit(
     ``dt_s``: the arrays' sample period (s); without it arrays are taken to be 0.01 s apart
     with a ``DataWarning`` (deprecated). ``rate_term``: how the speeds enter ``σ²_D``
     (``"relative"``, ``"absolute"``, ``"relative:opening=13,window=49"``), as
-    ``tandem fit --rate-term``; ``None`` keeps ``params``'."""
+    ``tandem fit --rate-term``; ``None`` keeps ``params``'. ``switch_s``: the operator's
+    switch time δ (s, ≥ 0) between two robots' low-confidence stretches; ``max_busy_share``:
+    its load cap in (0, 1] (``tandem fit --switch-s/--max-busy``); ``None`` keeps
+    ``params["sampler"]``'."""
 
 def read_bag(
     path: Path,
@@ -162,8 +167,11 @@ class Planner:
         samples: Optional[int] = None,
         seed: Optional[int] = None,
         tick_s: Optional[float] = None,
+        switch_s: Optional[float] = None,
+        max_busy_share: Optional[float] = None,
     ) -> Schedule:
-        """Re-runs the sampler warm-started by the current schedule and keeps the result."""
+        """Re-runs the sampler warm-started by the current schedule and keeps the result;
+        ``switch_s``/``max_busy_share`` given become the planner's operator parameters."""
     def plan(self, cell: str = "rounds") -> Union[Schedule, CyclicPlan]:
         """The plan of this planner's ``cell`` (``"rounds"``: the current schedule, checked;
         ``"continuous"``: the cyclic plan), at the current schedule's tick; a snapshot."""

@@ -368,13 +368,22 @@ fn hold_spec(holds: &Bound<'_, PyAny>) -> Result<HoldSpec> {
 ///         ``None`` (default) keeps ``params["holds"]``; ``[]`` declares none (the
 ///         schedule of before hold points, as ``--no-holds``). A hold on a low-confidence
 ///         sample is inactive until the sample is trusted.
+///     switch_s: the operator's switch time ``δ`` (s, finite and ≥ 0; issue 41): at least
+///         this long between the end of one robot's low-confidence stretch and the start of
+///         another robot's, in the worst case (``tandem fit --switch-s``). ``None`` (default)
+///         keeps ``params["sampler"]["switch_s"]`` (0: none). Stored in the state file.
+///     max_busy_share: the operator's load cap ``u_max`` in ``(0, 1]``: its busy share,
+///         supervised time plus ``switch_s`` per change of robot, may not exceed it
+///         (``tandem fit --max-busy``). ``None`` (default) keeps
+///         ``params["sampler"]["max_busy_share"]`` (1: no cap). Stored in the state file.
 ///
 /// Raises:
 ///     InputError: a bad demonstration (with ``file``/``line`` for files).
 ///     ParamError: a bad parameter or robot count, a malformed hold, a hold outside the task
-///         a rule on an unknown channel or one that holds nowhere.
+///         a rule on an unknown channel or one that holds nowhere, a ``switch_s`` or
+///         ``max_busy_share`` out of range (``name`` names it).
 #[pyfunction]
-#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, robots=N_ROBOTS, holds=None, rate_term=None))]
+#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, robots=N_ROBOTS, holds=None, rate_term=None, switch_s=None, max_busy_share=None))]
 #[expect(
     clippy::too_many_arguments,
     reason = "the keyword arguments of the Python function, each documented above"
@@ -388,9 +397,12 @@ pub(crate) fn fit(
     robots: usize,
     holds: Option<&Bound<'_, PyAny>>,
     rate_term: Option<String>,
+    switch_s: Option<f64>,
+    max_busy_share: Option<f64>,
 ) -> PyResult<PyPlanner> {
     let mut params = planner_params(params)?;
     apply_rate_term(&mut params, rate_term.as_deref())?;
+    apply_operator(&mut params, switch_s, max_busy_share)?;
     if let Some(holds) = holds.filter(|h| !h.is_none()) {
         params.holds = hold_spec(holds)?;
         params.validate().map_err(Error::from)?;
@@ -402,6 +414,24 @@ pub(crate) fn fit(
     warn_demonstrations(py, &demos)?;
     let planner = py.detach(|| guard(|| Ok(Planner::with_robots(&demos, params, robots)?)))?;
     Ok(PyPlanner { inner: planner })
+}
+
+/// ``switch_s=`` and ``max_busy_share=`` of :func:`fit`: the operator's switch time and load
+/// cap (`tandem_schedule::SamplerParams::{switch_s, max_busy_share}`, the one source of both),
+/// checked: a `ParamError` naming the one out of range.
+fn apply_operator(
+    params: &mut PlannerParams,
+    switch_s: Option<f64>,
+    max_busy_share: Option<f64>,
+) -> Result<()> {
+    if let Some(d) = switch_s {
+        params.sampler.switch_s = d;
+    }
+    if let Some(u) = max_busy_share {
+        params.sampler.max_busy_share = u;
+    }
+    params.sampler.validate()?;
+    Ok(())
 }
 
 /// ``rate_term=`` of :func:`fit` and :func:`fit_model`: the fit's rate term
@@ -807,7 +837,10 @@ impl PyPlanner {
 
     /// Re-runs the anytime sampler (§II-C) on the current problem, warm-started by the
     /// current schedule, and keeps the result (``T_total`` never increases at the same
-    /// tick). Model, observations, confidence and parameters are unchanged.
+    /// tick). Model, observations, confidence and parameters are unchanged, but for the
+    /// operator's ``switch_s`` and ``max_busy_share`` when given (``tandem schedule
+    /// --switch-s/--max-busy --save``): they become the planner's (``params()["sampler"]``,
+    /// stored by :meth:`save`, honoured by every later schedule).
     ///
     /// Args:
     ///     samples: candidates to sample (default: the parameters').
@@ -816,17 +849,35 @@ impl PyPlanner {
     ///     tick_s: control tick (real s) the margins are checked at and the schedule runs at
     ///         (default: the current schedule's tick). Later :meth:`record_round` calls keep
     ///         the tick chosen here.
+    ///     switch_s: the operator's switch time ``δ`` (s, finite and ≥ 0) from now on
+    ///         (default: the planner's, ``params()["sampler"]["switch_s"]``).
+    ///     max_busy_share: the operator's load cap ``u_max`` in ``(0, 1]`` from now on
+    ///         (default: the planner's).
     ///
     /// Returns:
     ///     Schedule: the new current schedule.
-    #[pyo3(signature = (samples=None, seed=None, tick_s=None))]
+    ///
+    /// Raises:
+    ///     ParamError: a ``switch_s`` or ``max_busy_share`` out of range (``name`` names it;
+    ///         the planner is unchanged).
+    #[pyo3(signature = (samples=None, seed=None, tick_s=None, switch_s=None, max_busy_share=None))]
     fn reschedule(
         &mut self,
         py: Python<'_>,
         samples: Option<usize>,
         seed: Option<u64>,
         tick_s: Option<f64>,
+        switch_s: Option<f64>,
+        max_busy_share: Option<f64>,
     ) -> PyResult<PySchedule> {
+        if switch_s.is_some() || max_busy_share.is_some() {
+            let now = &self.inner.params().sampler;
+            let (d, u) = (
+                switch_s.unwrap_or(now.switch_s),
+                max_busy_share.unwrap_or(now.max_busy_share),
+            );
+            self.inner.set_operator(d, u).map_err(Error::from)?;
+        }
         let mut sp = self.inner.params().sampler.clone();
         sp.seed = match seed {
             Some(s) => s,
