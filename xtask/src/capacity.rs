@@ -860,7 +860,8 @@ const N_COLOURS: [RGBColor; 4] = [MEAN, OPERATOR, GROUND_TRUTH, RGBColor(120, 12
 /// Draws, against the switch time `δ`, the measured throughput (solid, points) and the proven
 /// bound (dashed) of every cell and robot count on the left, and the operator's busy share on
 /// the right, as SVG and PNG (`cargo xtask capacity --switch-s 0,1,2,…`). Rounds are drawn
-/// with circles, the continuous cell with triangles; one colour per robot count.
+/// with circles, the continuous cell with triangles, each cell and robot count in a colour of
+/// its own (cycled).
 ///
 /// # Errors
 /// No rows at all, or a failure to render or write a file.
@@ -906,7 +907,9 @@ fn switch_lines(rows: &[CapacityRow], cells: &[CellRow]) -> Vec<SwitchLine> {
     robots.sort_unstable();
     robots.dedup();
     for (k, &n) in robots.iter().enumerate() {
-        let colour = N_COLOURS[k % N_COLOURS.len()];
+        // Rounds and the continuous cell of one robot count in two colours.
+        let colour = N_COLOURS[(2 * k) % N_COLOURS.len()];
+        let cell_colour = N_COLOURS[(2 * k + 1) % N_COLOURS.len()];
         let mut pts: Vec<(f64, f64, f64, f64)> = rows
             .iter()
             .filter(|r| r.robots == n)
@@ -937,7 +940,7 @@ fn switch_lines(rows: &[CapacityRow], cells: &[CellRow]) -> Vec<SwitchLine> {
             .collect();
         if !pts.is_empty() {
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            lines.push((format!("continuous, N = {n}"), colour, true, pts));
+            lines.push((format!("continuous, N = {n}"), cell_colour, true, pts));
         }
     }
     lines
