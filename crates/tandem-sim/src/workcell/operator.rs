@@ -34,7 +34,8 @@ pub struct OperatorParams {
     pub gain: f64,
     /// The operator's own switch time `δ_true` (real s, finite and ≥ 0; issue 41): a person
     /// needs this long after the end of one robot's supervision before corrections on
-    /// *another* robot are effective ([`Attention`]); a correction needed earlier is missed
+    /// *another* robot are effective (docs/decisions.md, "The simulated operator's switch
+    /// time (issue 41)"); a correction needed earlier is missed
     /// ([`crate::workcell::RobotRun::switch_missed`]). Independent of the switch time the
     /// schedule was planned with (`tandem_schedule::SamplerParams::switch_s`), so a study can
     /// run a plan that ignores it. Default 0: no switch time, the operator of before (the
