@@ -108,6 +108,10 @@ enum Cmd {
         /// apart. 0 (default): the run without it, unchanged.
         #[arg(long, default_value_t = 0.0)]
         switch_s: f64,
+        /// Random problems to draw (default: one per 1000 executions, 1–200): more problems
+        /// with fewer executions each for a reduced batch.
+        #[arg(long)]
+        problems: Option<u64>,
     },
 }
 
@@ -126,14 +130,15 @@ fn main() -> anyhow::Result<()> {
             cell,
             tasks,
             switch_s,
+            problems,
         } => {
             if !(switch_s.is_finite() && switch_s >= 0.0) {
                 anyhow::bail!("--switch-s must be finite and ≥ 0 (seconds), got {switch_s}");
             }
             if cell == "continuous" {
-                stress::run_continuous(executions, seed, robots, tasks, switch_s)
+                stress::run_continuous(executions, seed, robots, tasks, switch_s, problems)
             } else {
-                stress::run(executions, seed, robots, holds, switch_s)
+                stress::run(executions, seed, robots, holds, switch_s, problems)
             }
         }
         Cmd::ReferenceOrder(args) => reference_order::run(&args),

@@ -332,13 +332,14 @@ pub(crate) fn run(
     n_robots: usize,
     holds: bool,
     switch_s: f64,
+    problems: Option<u64>,
 ) -> anyhow::Result<()> {
     if executions == 0 {
         bail!("--executions must be ≥ 1");
     }
     tandem::realtime::RobotCount::new(n_robots).map_err(|e| anyhow::anyhow!("--robots: {e}"))?;
     let start = Instant::now();
-    let n_problems = (executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS);
+    let n_problems = n_problems(executions, problems)?;
     let cases: Vec<Case> = (0..n_problems)
         .into_par_iter()
         .map(|i| {
@@ -442,6 +443,18 @@ fn report_switches(tally: &Tally, switch_s: f64, ks: &[u64]) -> u64 {
         least.map_or("-".to_string(), |m| format!("{m} ticks"))
     );
     short
+}
+
+/// The number of problems of a run: `problems`, or one per [`EXECUTIONS_PER_PROBLEM`]
+/// executions, in `1..=MAX_PROBLEMS` and at most `executions`.
+fn n_problems(executions: u64, problems: Option<u64>) -> anyhow::Result<u64> {
+    match problems {
+        Some(p) if p == 0 || p > MAX_PROBLEMS || p > executions => {
+            bail!("--problems must be in 1..={MAX_PROBLEMS} and at most --executions, got {p}")
+        }
+        Some(p) => Ok(p),
+        None => Ok((executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS)),
+    }
 }
 
 /// What the executions of a stress run add up to, from worker threads.
@@ -663,13 +676,14 @@ pub(crate) fn run_continuous(
     n_robots: usize,
     tasks: u64,
     switch_s: f64,
+    problems: Option<u64>,
 ) -> anyhow::Result<()> {
     if executions == 0 || tasks == 0 {
         bail!("--executions and --tasks must be ≥ 1");
     }
     tandem::realtime::RobotCount::new(n_robots).map_err(|e| anyhow::anyhow!("--robots: {e}"))?;
     let start = Instant::now();
-    let n_problems = (executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS);
+    let n_problems = n_problems(executions, problems)?;
     let cases: Vec<CellCase> = (0..n_problems)
         .into_par_iter()
         .map(|i| {
