@@ -493,6 +493,9 @@ class CellTick:
     def overlap(self) -> bool: ...
     @property
     def fault(self) -> Optional[Dict[str, Any]]: ...
+    @property
+    def next(self) -> Optional[Dict[str, Any]]:
+        """The pre-alert: ``{"robot", "earliest_s", "latest_s"}`` or ``None``."""
 
 class Schedule:
     """Execution warps ``(N, T_ref)``, ``N − 1`` start offsets and the control tick."""
@@ -598,6 +601,9 @@ class Tick:
     def overlap(self) -> bool: ...
     @property
     def fault(self) -> Optional[Dict[str, Any]]: ...
+    @property
+    def next(self) -> Optional[Dict[str, Any]]:
+        """The pre-alert: ``{"robot", "earliest_s", "latest_s"}`` or ``None``."""
 
 class Warp:
     """A time warp from reference samples to query samples."""

@@ -101,6 +101,17 @@ enum Cmd {
         /// With `--cell continuous`: tasks every robot completes per execution.
         #[arg(long, default_value_t = 50)]
         tasks: u64,
+        /// The operator's switch time δ (real s, ≥ 0; issue 41): rounds get tight schedules
+        /// at the edge of `check_margins` at δ, run by coordinators that wait δ at their holds;
+        /// the continuous cell plans δ and its token waits it. Fails on any execution in which
+        /// two robots' low-confidence ticks are fewer than `k = switch_ticks(δ, tick)` ticks
+        /// apart. 0 (default): the run without it, unchanged.
+        #[arg(long, default_value_t = 0.0)]
+        switch_s: f64,
+        /// Random problems to draw (default: one per 1000 executions, 1–200): more problems
+        /// with fewer executions each for a reduced batch.
+        #[arg(long)]
+        problems: Option<u64>,
     },
 }
 
@@ -118,11 +129,16 @@ fn main() -> anyhow::Result<()> {
             holds,
             cell,
             tasks,
+            switch_s,
+            problems,
         } => {
+            if !(switch_s.is_finite() && switch_s >= 0.0) {
+                anyhow::bail!("--switch-s must be finite and ≥ 0 (seconds), got {switch_s}");
+            }
             if cell == "continuous" {
-                stress::run_continuous(executions, seed, robots, tasks)
+                stress::run_continuous(executions, seed, robots, tasks, switch_s, problems)
             } else {
-                stress::run(executions, seed, robots, holds)
+                stress::run(executions, seed, robots, holds, switch_s, problems)
             }
         }
         Cmd::ReferenceOrder(args) => reference_order::run(&args),

@@ -1,4 +1,5 @@
-//! `cargo xtask stress --executions E [--robots N] [--seed S] [--holds]`: the safety invariant
+//! `cargo xtask stress --executions E [--robots N] [--seed S] [--holds] [--switch-s S]`: the
+//! safety invariant
 //! under load.
 //!
 //! Draws random problems and schedules each at a random control tick, then runs `E` executions
@@ -37,6 +38,15 @@
 //! `K` tasks (default 50), so the clocks' drift runs across many cycles. It counts the ticks
 //! with two or more robots low-confidence and the ticks in which a robot moved backwards
 //! (expected 0 of both; `AdversaryRun::backward_steps`) and the tasks per robot.
+//!
+//! `--switch-s S` (issue 41) adds the operator's switch time `δ = S` s: rounds get tight
+//! schedules at an edge of `check_margins` at `δ` (with `--holds`, release rules it accepts),
+//! run by coordinators that wait `δ` at their holds (`Coordinator::with_margins`); the
+//! continuous cell's plan counts `δ` per change of robot (`CyclicParams::switch_s`) and its
+//! token waits it (`ContinuousCoordinator::with_switch_s`). Each execution's shortest switch
+//! is measured on the ticks the robots traversed (`AdversaryRun::min_switch_gap_ticks`; the
+//! beam search measures none), and the run fails if one is shorter than
+//! `k = switch_ticks(δ, tick)`.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -49,7 +59,10 @@ use tandem::realtime::adversary::{Adversary, AdversaryRun, adversary_set, run_ad
 use tandem::realtime::continuous::{ContinuousCoordinator, run_cell};
 use tandem::realtime::holds::{release_rules, usable_holds};
 use tandem::realtime::testkit::{self, Family};
-use tandem::realtime::{Coordinator, Timeline, sufficient_margins, sufficient_margins_with_holds};
+use tandem::realtime::{
+    Coordinator, MarginParams, Timeline, check_margins, sufficient_margins,
+    sufficient_margins_with_holds,
+};
 use tandem::schedule::{
     CyclicParams, Problem, SamplerParams, Source, cyclic_plan, sample_schedule_n,
 };
@@ -66,6 +79,8 @@ const SAMPLES: usize = 500;
 const BATCH: u64 = 50_000;
 /// Executions per parallel batch of the continuous cell (each runs `--tasks` tasks per robot).
 const CELL_BATCH: u64 = BATCH / 50;
+/// Draws of a test kit case per problem with a switch time (`--switch-s`).
+const MAX_DRAWS: u64 = 50;
 /// Reference sample period of this task's random problems (s).
 const DT_S: f64 = 0.01;
 
@@ -85,6 +100,10 @@ struct Case {
     family: &'static str,
     /// How the schedule was made.
     made: Made,
+    /// `k`: the switch time in ticks of this case's tick (0 without `--switch-s`).
+    switch_ticks: u64,
+    /// Draws skipped before this one for want of a schedule at the switch time.
+    skipped: u64,
 }
 
 /// A random problem of 200–400 samples ([`tandem_schedule::testkit::random_problem`], the
@@ -140,7 +159,11 @@ fn scheduled(
 /// Per-robot plans with holds: up to 20 draws of interleaved starts (each robot at a random
 /// point of the span of the robots before it) with release rules on the plans' hold points,
 /// the first that `sufficient_margins_with_holds` accepts; `None` if none is.
-fn held_plans(case: &testkit::Case, rng: &mut ChaCha8Rng) -> anyhow::Result<Option<Coordinator>> {
+fn held_plans(
+    case: &testkit::Case,
+    switch_s: f64,
+    rng: &mut ChaCha8Rng,
+) -> anyhow::Result<Option<Coordinator>> {
     for _ in 0..20 {
         let mut starts = vec![0.0];
         for _ in 1..case.plans.len() {
@@ -153,8 +176,18 @@ fn held_plans(case: &testkit::Case, rng: &mut ChaCha8Rng) -> anyhow::Result<Opti
             .map(|r| usable_holds(r.conf(), &hold_points(r.conf())))
             .collect();
         let holds = release_rules(&robots, &[], &usable);
-        if !holds.is_empty() && sufficient_margins_with_holds(&robots, &holds, case.tick_s)? {
-            return Ok(Some(Coordinator::with_holds(robots, &holds, case.tick_s)?));
+        if holds.is_empty() {
+            continue;
+        }
+        if switch_s == 0.0 {
+            if sufficient_margins_with_holds(&robots, &holds, case.tick_s)? {
+                return Ok(Some(Coordinator::with_holds(robots, &holds, case.tick_s)?));
+            }
+        } else {
+            let params = MarginParams::new(case.tick_s).with_switch_s(switch_s);
+            if check_margins(&robots, &holds, &params)? {
+                return Ok(Some(Coordinator::with_margins(robots, &holds, &params)?));
+            }
         }
     }
     Ok(None)
@@ -164,10 +197,52 @@ fn held_plans(case: &testkit::Case, rng: &mut ChaCha8Rng) -> anyhow::Result<Opti
 /// through the test kit's families (`tandem::realtime::testkit::Family`). Shared-mask problems
 /// are scheduled by the production scheduler; per-robot plans (which no `tandem-schedule`
 /// problem describes) get a tight schedule at an acceptance edge of `sufficient_margins`.
-fn make_case(seed: u64, index: u64, n_robots: usize, holds: bool) -> anyhow::Result<Case> {
+///
+/// With a switch time (`switch_s > 0`) every problem is a test kit family's, with a tight
+/// schedule at an edge of `check_margins`' acceptance at that switch time (with `--holds`
+/// interleaved starts and release rules accepted by it), run by a coordinator that waits the
+/// switch time (`Coordinator::with_margins`): the production scheduler does not plan the
+/// switch time for rounds on this branch, and the edge is where a wrong rule would show.
+fn make_case(
+    seed: u64,
+    index: u64,
+    n_robots: usize,
+    holds: bool,
+    switch_s: f64,
+) -> anyhow::Result<Case> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(index);
-    let (coordinator, overlapping, family, made) = if index % 2 == 0 {
+    let mut skipped = 0;
+    let (coordinator, overlapping, family, made) = if switch_s > 0.0 {
+        // A case whose robots end and start low-confidence may have no schedule the check
+        // accepts at this switch time (not even the serial one): the next draw is taken.
+        let mut found = None;
+        for attempt in 0..MAX_DRAWS {
+            let family = Family::ALL[((index + attempt) % Family::ALL.len() as u64) as usize];
+            let case = testkit::Case::random(family, n_robots, &mut rng);
+            if let Some(c) = holds
+                .then(|| held_plans(&case, switch_s, &mut rng))
+                .transpose()?
+                .flatten()
+            {
+                found = Some((c, true, family.name(), Made::Tight));
+                break;
+            }
+            let check = |r: &[Timeline], h: f64| {
+                check_margins(r, &[], &MarginParams::new(h).with_switch_s(switch_s))
+            };
+            if let Some((starts, o)) = testkit::tight_starts(&case, check, &mut rng) {
+                let params = MarginParams::new(case.tick_s).with_switch_s(switch_s);
+                let c = Coordinator::with_margins(case.robots_at(&starts), &[], &params)?;
+                found = Some((c, o, family.name(), Made::Tight));
+                break;
+            }
+            skipped += 1;
+        }
+        found.with_context(|| {
+            format!("no case of {MAX_DRAWS} draws has a schedule accepted at this switch time")
+        })?
+    } else if index % 2 == 0 {
         let problem = with_holds(random_problem(&mut rng)?, holds)?;
         let tick_s = DT_S * rng.random_range(0.25..=1.0);
         let (c, o) = scheduled(&problem, n_robots, tick_s, &mut rng)?;
@@ -180,7 +255,7 @@ fn make_case(seed: u64, index: u64, n_robots: usize, holds: bool) -> anyhow::Res
             let (c, o) = scheduled(&problem, n_robots, case.tick_s, &mut rng)?;
             (c, o, family.name(), Made::Scheduled)
         } else if let Some(c) = holds
-            .then(|| held_plans(&case, &mut rng))
+            .then(|| held_plans(&case, 0.0, &mut rng))
             .transpose()?
             .flatten()
         {
@@ -210,8 +285,20 @@ fn make_case(seed: u64, index: u64, n_robots: usize, holds: bool) -> anyhow::Res
         .map(|i| coordinator.current_plan(i).end_s() - robots[i].end_s())
         .fold(0.0, f64::max);
     let ticks = ((last_end_s(robots) + dwell_s) / tick_s) as u64;
+    // Each hold with release rules may wait the switch time once more.
+    // Each leg may wait the switch time once at its hold; a robot has at most one leg per
+    // sample.
+    let k = coordinator.switch_ticks();
+    let legs_bound = robots.iter().map(Timeline::n_ref).sum::<usize>() as u64;
+    let switch_waits = if coordinator.has_holds() {
+        k.saturating_mul(legs_bound)
+    } else {
+        0
+    };
     Ok(Case {
-        max_ticks: (2.0 * (slowest_s + dwell_s) / tick_s) as u64 + 100,
+        max_ticks: (2.0 * (slowest_s + dwell_s) / tick_s) as u64 + 100 + switch_waits,
+        switch_ticks: k,
+        skipped,
         adversaries: adversary_set(n_robots, grad_range, ticks, &mut rng),
         coordinator,
         overlapping,
@@ -239,17 +326,25 @@ fn execute(case: &Case, op: Adversary, seed: u64, exec: u64) -> anyhow::Result<A
 
 /// Runs the stress test with `n_robots` robots; fails if any tick had two or more robots
 /// low-confidence.
-pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> anyhow::Result<()> {
+pub(crate) fn run(
+    executions: u64,
+    seed: u64,
+    n_robots: usize,
+    holds: bool,
+    switch_s: f64,
+    problems: Option<u64>,
+) -> anyhow::Result<()> {
     if executions == 0 {
         bail!("--executions must be ≥ 1");
     }
     tandem::realtime::RobotCount::new(n_robots).map_err(|e| anyhow::anyhow!("--robots: {e}"))?;
     let start = Instant::now();
-    let n_problems = (executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS);
+    let n_problems = n_problems(executions, problems)?;
     let cases: Vec<Case> = (0..n_problems)
         .into_par_iter()
         .map(|i| {
-            make_case(seed, i, n_robots, holds).with_context(|| format!("scheduling problem {i}"))
+            make_case(seed, i, n_robots, holds, switch_s)
+                .with_context(|| format!("scheduling problem {i}"))
         })
         .collect::<anyhow::Result<_>>()?;
     let count = |f: &dyn Fn(&Case) -> bool| cases.iter().filter(|c| f(c)).count();
@@ -264,6 +359,13 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> a
         n_problems as usize - n_overlapping,
         start.elapsed().as_secs_f64()
     );
+    if switch_s > 0.0 {
+        println!(
+            "  switch time {switch_s} s: {} test kit draws skipped without a schedule accepted \
+             at it (robots that end and start low-confidence)",
+            cases.iter().map(|c| c.skipped).sum::<u64>()
+        );
+    }
     let mut families: Vec<&str> = cases.iter().map(|c| c.family).collect();
     families.sort_unstable();
     families.dedup();
@@ -290,10 +392,18 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> a
         let r = execute(case, op, seed, e)?;
         tally.add(r.ticks, r.overlap_ticks, r.finished);
         tally.add_backward(r.backward_steps);
+        if switch_s > 0.0 {
+            tally.add_switch(r.min_switch_gap_ticks, case.switch_ticks);
+        }
         Ok(())
     })?;
     let secs = run_start.elapsed().as_secs_f64();
     let backward = tally.backward_steps.load(Ordering::Relaxed);
+    let short = report_switches(
+        &tally,
+        switch_s,
+        &cases.iter().map(|c| c.switch_ticks).collect::<Vec<_>>(),
+    );
     let (ticks, overlap_ticks, overlap_runs, unfinished) = tally.into_counts();
     println!(
         "stress: {executions} executions of {n_robots} robots ({set_size} operator policies, \
@@ -305,17 +415,49 @@ pub(crate) fn run(executions: u64, seed: u64, n_robots: usize, holds: bool) -> a
         ticks as f64 / secs / 1e6,
         threads = rayon::current_num_threads(),
     );
-    if overlap_ticks > 0 || unfinished > 0 || backward > 0 {
+    if overlap_ticks > 0 || unfinished > 0 || backward > 0 || short > 0 {
         bail!(
             "safety invariant broken: {overlap_ticks} overlap ticks, {backward} backward steps, \
-             {unfinished} unfinished executions"
+             {short} executions with a switch shorter than the switch time, {unfinished} \
+             unfinished executions"
         );
     }
     Ok(())
 }
 
+/// Prints the switch-time line of a run with `--switch-s` (`ks`: each case's `k`) and returns
+/// the executions with a switch shorter than `k` (0 without a switch time).
+fn report_switches(tally: &Tally, switch_s: f64, ks: &[u64]) -> u64 {
+    if switch_s == 0.0 {
+        return 0;
+    }
+    let (short, measured, least) = tally.switches();
+    let (k_min, k_max) = (
+        ks.iter().copied().min().unwrap_or(0),
+        ks.iter().copied().max().unwrap_or(0),
+    );
+    println!(
+        "  switch time {switch_s} s (k = {k_min}…{k_max} ticks): {short} executions with two \
+         robots' low-confidence ticks fewer than k ticks apart (expected 0), of {measured} \
+         measured on the ticks traversed (the beam search measures none); least gap − k: {}",
+        least.map_or("-".to_string(), |m| format!("{m} ticks"))
+    );
+    short
+}
+
+/// The number of problems of a run: `problems`, or one per [`EXECUTIONS_PER_PROBLEM`]
+/// executions, in `1..=MAX_PROBLEMS` and at most `executions`.
+fn n_problems(executions: u64, problems: Option<u64>) -> anyhow::Result<u64> {
+    match problems {
+        Some(p) if p == 0 || p > MAX_PROBLEMS || p > executions => {
+            bail!("--problems must be in 1..={MAX_PROBLEMS} and at most --executions, got {p}")
+        }
+        Some(p) => Ok(p),
+        None => Ok((executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS)),
+    }
+}
+
 /// What the executions of a stress run add up to, from worker threads.
-#[derive(Default)]
 struct Tally {
     ticks: AtomicU64,
     overlap_ticks: AtomicU64,
@@ -323,6 +465,32 @@ struct Tally {
     unfinished: AtomicU64,
     /// Ticks in which a robot moved backwards.
     backward_steps: AtomicU64,
+    /// Executions with a switch shorter than the switch time (`AdversaryRun::min_switch_gap_ticks
+    /// < k`, measured on the ticks traversed).
+    short_switches: AtomicU64,
+    /// Executions whose shortest switch was measured (the beam search measures none).
+    switches_measured: AtomicU64,
+    /// The least `gap − k` (ticks) over the measured executions, offset by `2^32` so that it
+    /// is unsigned.
+    least_margin: AtomicU64,
+}
+
+/// Offset of [`Tally::least_margin`].
+const MARGIN_OFFSET: u64 = 1 << 32;
+
+impl Default for Tally {
+    fn default() -> Tally {
+        Tally {
+            ticks: AtomicU64::new(0),
+            overlap_ticks: AtomicU64::new(0),
+            overlap_runs: AtomicU64::new(0),
+            unfinished: AtomicU64::new(0),
+            backward_steps: AtomicU64::new(0),
+            short_switches: AtomicU64::new(0),
+            switches_measured: AtomicU64::new(0),
+            least_margin: AtomicU64::new(u64::MAX),
+        }
+    }
 }
 
 impl Tally {
@@ -343,6 +511,30 @@ impl Tally {
     /// One execution's ticks in which a robot moved backwards.
     fn add_backward(&self, steps: u64) {
         self.backward_steps.fetch_add(steps, Ordering::Relaxed);
+    }
+
+    /// One execution's shortest switch `gap` (ticks, `None` if not measured) against the
+    /// switch time of `k` ticks.
+    fn add_switch(&self, gap: Option<u64>, k: u64) {
+        let Some(g) = gap else { return };
+        self.switches_measured.fetch_add(1, Ordering::Relaxed);
+        if g < k {
+            self.short_switches.fetch_add(1, Ordering::Relaxed);
+        }
+        let m = (MARGIN_OFFSET + g).saturating_sub(k);
+        self.least_margin.fetch_min(m, Ordering::Relaxed);
+    }
+
+    /// The switch report: executions with a short switch, executions measured, and the least
+    /// `gap − k` (ticks; `None` if none measured).
+    fn switches(&self) -> (u64, u64, Option<i64>) {
+        let measured = self.switches_measured.load(Ordering::Relaxed);
+        let least = self.least_margin.load(Ordering::Relaxed);
+        (
+            self.short_switches.load(Ordering::Relaxed),
+            measured,
+            (measured > 0).then(|| least as i64 - MARGIN_OFFSET as i64),
+        )
     }
 
     /// Ticks, overlap ticks, executions with overlaps, unfinished executions.
@@ -402,7 +594,13 @@ struct CellCase {
 /// hold points, 1 without, 2 a test kit family with a shared mask (with hold points; the
 /// per-robot families, which no `Problem` describes, fall back to this task's problem with
 /// hold points). Planned by `cyclic_plan` (runnable orders), run at a random tick.
-fn make_cell_case(seed: u64, index: u64, n_robots: usize, tasks: u64) -> anyhow::Result<CellCase> {
+fn make_cell_case(
+    seed: u64,
+    index: u64,
+    n_robots: usize,
+    tasks: u64,
+    switch_s: f64,
+) -> anyhow::Result<CellCase> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x00c0_ffee);
     rng.set_stream(index);
     let mut family = "stress";
@@ -422,8 +620,14 @@ fn make_cell_case(seed: u64, index: u64, n_robots: usize, tasks: u64) -> anyhow:
     };
     let dt_s = problem.dt_s();
     let tick_s = dt_s * rng.random_range(0.25..=1.0);
-    let plan = cyclic_plan(&problem, n_robots, &CyclicParams::default())?;
-    let cell = plan.coordinator(&problem, tick_s)?;
+    let params = CyclicParams {
+        switch_s,
+        ..CyclicParams::default()
+    };
+    let plan = cyclic_plan(&problem, n_robots, &params)?;
+    let cell = plan
+        .coordinator(&problem, tick_s)?
+        .with_switch_s(switch_s)?;
     let grad_range = [
         problem
             .grad_min()
@@ -444,7 +648,10 @@ fn make_cell_case(seed: u64, index: u64, n_robots: usize, tasks: u64) -> anyhow:
         })
         .sum::<f64>()
         * dt_s;
-    let per_task = slow_s / tick_s + problem.n_ref() as f64;
+    // Each of a task's groups may wait the switch time once for its token.
+    let per_task = slow_s / tick_s
+        + problem.n_ref() as f64
+        + (cell.groups().len() as u64 * cell.switch_ticks()) as f64;
     let max_ticks = ((tasks + 2) as f64 * n_robots as f64 * per_task) as u64 + 1000;
     Ok(CellCase {
         adversaries: adversary_set(
@@ -468,17 +675,19 @@ pub(crate) fn run_continuous(
     seed: u64,
     n_robots: usize,
     tasks: u64,
+    switch_s: f64,
+    problems: Option<u64>,
 ) -> anyhow::Result<()> {
     if executions == 0 || tasks == 0 {
         bail!("--executions and --tasks must be ≥ 1");
     }
     tandem::realtime::RobotCount::new(n_robots).map_err(|e| anyhow::anyhow!("--robots: {e}"))?;
     let start = Instant::now();
-    let n_problems = (executions / EXECUTIONS_PER_PROBLEM).clamp(1, MAX_PROBLEMS);
+    let n_problems = n_problems(executions, problems)?;
     let cases: Vec<CellCase> = (0..n_problems)
         .into_par_iter()
         .map(|i| {
-            make_cell_case(seed, i, n_robots, tasks)
+            make_cell_case(seed, i, n_robots, tasks, switch_s)
                 .with_context(|| format!("planning problem {i}"))
         })
         .collect::<anyhow::Result<_>>()?;
@@ -505,12 +714,17 @@ pub(crate) fn run_continuous(
         let r = run_cell(&mut cell, op, &mut rng, tasks, case.max_ticks)?;
         tally.add(r.ticks, r.overlap_ticks, r.finished);
         tally.add_backward(r.backward_steps);
+        if switch_s > 0.0 {
+            tally.add_switch(r.min_switch_gap_ticks, case.cell.switch_ticks());
+        }
         tasks_done.fetch_add(cell.tasks_completed().iter().sum(), Ordering::Relaxed);
         min_tasks.fetch_min(r.min_tasks, Ordering::Relaxed);
         Ok(())
     })?;
     let secs = run_start.elapsed().as_secs_f64();
     let backward = tally.backward_steps.load(Ordering::Relaxed);
+    let ks: Vec<u64> = cases.iter().map(|c| c.cell.switch_ticks()).collect();
+    let short = report_switches(&tally, switch_s, &ks);
     let (ticks, overlap_ticks, overlap_runs, unfinished) = tally.into_counts();
     let (tasks_done, min_tasks) = (tasks_done.into_inner(), min_tasks.into_inner());
     println!(
@@ -524,10 +738,10 @@ pub(crate) fn run_continuous(
         ticks as f64 / secs / 1e6,
         threads = rayon::current_num_threads(),
     );
-    if overlap_ticks > 0 || unfinished > 0 || backward > 0 {
+    if overlap_ticks > 0 || unfinished > 0 || backward > 0 || short > 0 {
         bail!(
             "safety invariant broken: {overlap_ticks} overlap ticks, {backward} backward steps, \
-             {unfinished} unfinished executions"
+             {unfinished} unfinished executions, {short} with a switch shorter than the switch time"
         );
     }
     Ok(())

@@ -291,13 +291,19 @@ impl Planner {
     }
 
     /// The run-time coordinator of [`Planner::plan`]`(cell)`: every robot at its start, one
-    /// control tick of the schedule's `tick_s` per tick. For rounds it is
-    /// [`Planner::coordinator`].
+    /// control tick of the schedule's `tick_s` per tick, with the operator's switch time of
+    /// the planner's parameters (`params().sampler.switch_s`): rounds wait it at a hold with
+    /// release rules (it is [`Planner::coordinator`]), a continuous cell's token passes to
+    /// another robot no sooner than that after a stretch ended.
     ///
     /// # Errors
     /// As [`Planner::plan`].
     pub fn controller(&self, cell: Cell) -> Result<AnyController> {
-        self.plan(cell)?.controller()
+        let switch_s = self.params().sampler.switch_s;
+        Ok(match self.plan(cell)?.controller()? {
+            AnyController::Rounds(c) => AnyController::Rounds(c.with_switch_s(switch_s)?),
+            AnyController::Continuous(c) => AnyController::Continuous(c.with_switch_s(switch_s)?),
+        })
     }
 
     /// The cyclic plan of a continuous cell of this planner's robots on the current problem

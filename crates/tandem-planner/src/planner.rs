@@ -874,8 +874,16 @@ impl Planner {
     /// The schedule crate's [`tandem_schedule::Error::Invalid`] if the schedule fails the
     /// check (never for a planner made by [`Planner::new`], [`Planner::from_model`] or
     /// [`Planner::load`], which re-schedules a stored schedule that fails it).
+    ///
+    /// It runs with the operator's switch time of the planner's parameters
+    /// (`params().sampler.switch_s`, [`Coordinator::with_switch_s`]): a robot leaves a hold
+    /// with release rules no sooner than that after the robots it waits for left their
+    /// stretches.
     pub fn coordinator(&self) -> Result<Coordinator> {
-        Ok(self.checked_schedule()?.coordinator()?)
+        Ok(self
+            .checked_schedule()?
+            .coordinator()?
+            .with_switch_s(self.params().sampler.switch_s)?)
     }
 
     /// The current schedule checked on the current problem ([`Schedule::check`]): what

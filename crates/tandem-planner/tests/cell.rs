@@ -130,3 +130,43 @@ fn a_bad_tick_names_tick_s_and_a_cell_parses_from_its_name_only() {
         "unknown cell `Continuous`: give `rounds` or `continuous`"
     );
 }
+
+/// Issue 41: both controllers run with the planner's switch time (`sampler.switch_s`, the one
+/// source): 0.5 s at the 10 ms tick is 50 ticks; the continuous cell keeps them between two
+/// robots' stretches.
+#[test]
+fn the_controllers_run_with_the_planners_switch_time() {
+    let mut p = planner(2, None);
+    assert_eq!(p.coordinator().unwrap().switch_ticks(), 0);
+    let mut params = p.params().clone();
+    params.sampler.switch_s = 0.5;
+    p = {
+        let demo = |press: f64| {
+            let force = (0..40)
+                .map(|n| if (10..20).contains(&n) { press } else { 1.0 })
+                .collect();
+            Demonstration::new(vec!["force".into()], force, 0.01).unwrap()
+        };
+        Planner::with_robots(&[demo(2.0), demo(5.0), demo(8.0)], params, 2).unwrap()
+    };
+    assert_eq!(p.coordinator().unwrap().switch_ticks(), 50);
+    let AnyController::Rounds(rounds) = p.controller(Cell::Rounds).unwrap() else {
+        panic!("a rounds controller")
+    };
+    assert_eq!(rounds.switch_ticks(), 50);
+    let AnyController::Continuous(mut cell) = p.controller(Cell::Continuous).unwrap() else {
+        panic!("a continuous controller")
+    };
+    assert_eq!(cell.switch_ticks(), 50);
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(41);
+    let run = tandem_realtime::continuous::run_cell(
+        &mut cell,
+        tandem_realtime::adversary::Adversary::Fastest,
+        &mut rng,
+        5,
+        100_000,
+    )
+    .unwrap();
+    assert_eq!(run.overlap_ticks, 0);
+    assert!(run.min_switch_gap_ticks.is_some_and(|g| g >= 50), "{run:?}");
+}

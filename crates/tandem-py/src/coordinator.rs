@@ -236,6 +236,25 @@ pub(crate) struct PyTick {
 
 #[pymethods]
 impl PyTick {
+    /// The pre-alert (issue 41): ``{"robot": r, "earliest_s": e, "latest_s": l}`` for the
+    /// robot (0-based) whose next low-confidence stretch can start soonest, ``e`` and ``l`` the
+    /// least and most real seconds from the end of this tick until it starts, worst case over
+    /// admissible operators (``l`` is ``inf`` when the start waits on another robot: a hold's
+    /// release, a leg's start, the token); ``None`` when no robot has a stretch ahead.
+    #[getter]
+    fn next<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.inner
+            .next
+            .map(|a| {
+                let d = PyDict::new(py);
+                d.set_item("robot", a.robot)?;
+                d.set_item("earliest_s", a.earliest_s)?;
+                d.set_item("latest_s", a.latest_s)?;
+                Ok(d)
+            })
+            .transpose()
+    }
+
     /// Each robot's fractional reference time at the end of the tick, ``(N,)``, reference
     /// samples in ``[0, T_ref]`` (Eq. 15 at its schedule clock).
     #[getter]

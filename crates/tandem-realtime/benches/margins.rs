@@ -4,9 +4,11 @@
 //! `cargo bench -p tandem-realtime --bench margins -- coordinator_tick`).
 
 use criterion::{BenchmarkId, Criterion, black_box, criterion_main};
+use tandem_realtime::continuous::ContinuousCoordinator;
+use tandem_realtime::holds::{release_rules, usable_holds};
 use tandem_realtime::margins::baseline;
 use tandem_realtime::{
-    Coordinator, MarginParams, Operator, Tick, Timeline, check_margins, margin_slacks,
+    Controller, Coordinator, MarginParams, Operator, Tick, Timeline, check_margins, margin_slacks,
     sufficient_margins, sufficient_margins_per_pair,
 };
 
@@ -75,7 +77,12 @@ fn robots_staggered(n_ref: usize, n_robots: usize) -> Vec<Timeline> {
 /// which allocates nothing), operator inputs cycling through rush, drag, a gradient and no
 /// correction.
 fn bench_tick(c: &mut Criterion, id: &str, robots: Vec<Timeline>, tick_s: f64) {
-    let mut co = Coordinator::new_unchecked(robots, tick_s).expect("valid tick");
+    let co = Coordinator::new_unchecked(robots, tick_s).expect("valid tick");
+    bench_controller(c, id, co);
+}
+
+/// One tick of `co` per iteration (reset when finished), the operators of [`bench_tick`].
+fn bench_controller(c: &mut Criterion, id: &str, mut co: impl Controller) {
     let ops = [
         Operator::Fastest,
         Operator::Fastest,
@@ -197,6 +204,59 @@ fn bench(c: &mut Criterion) {
     for n_robots in [2, 4, 8] {
         let id = format!("coordinator_tick_robots/{n_robots}");
         bench_tick(c, &id, robots_n(6000, n_robots), tick_s);
+    }
+    // The switch time at run time (issue 41): one tick without and with δ = 2 s, same run —
+    // rounds of four robots with holds at every usable sample and their release rules (where
+    // δ delays releases), and a continuous cell of four robots on robot 1's plan with those
+    // holds (where δ delays the token). Both compute the pre-alert in every tick.
+    let r4 = robots_n(6000, 4);
+    let usable: Vec<Vec<usize>> = r4
+        .iter()
+        .map(|tl| usable_holds(tl.conf(), &(1..tl.n_ref()).step_by(50).collect::<Vec<_>>()))
+        .collect();
+    let holds = release_rules(&r4, &[], &usable);
+    let task = r4[0].clone();
+    let groups =
+        tandem_realtime::continuous::groups(task.conf(), &usable[0]).expect("usable holds");
+    let order: Vec<(usize, usize)> = groups
+        .iter()
+        .flat_map(|g| {
+            (0..4).flat_map(move |robot| (g.first_lc..g.end_lc).map(move |lc| (robot, lc)))
+        })
+        .collect();
+    // The pre-alert alone (computed in every tick above): one call on a coordinator in the
+    // middle of its run, so that a tick's cost without it is the difference.
+    for (label, robots) in [("2", r.to_vec()), ("4", r4.clone())] {
+        let mut co = Coordinator::new_unchecked(robots, tick_s).expect("valid tick");
+        for _ in 0..5000 {
+            let t = co.tick(Operator::Scheduled).expect("admissible operator");
+            if t.fault.is_some() {
+                co.clear_fault();
+            }
+        }
+        c.bench_function(&format!("pre_alert/{label}"), |b| {
+            b.iter(|| black_box(black_box(&co).pre_alert()))
+        });
+    }
+    for switch_s in [0.0, 2.0] {
+        let co = Coordinator::with_holds_unchecked(r4.clone(), &holds, tick_s)
+            .expect("valid holds")
+            .with_switch_s(switch_s)
+            .expect("valid switch time");
+        bench_controller(
+            c,
+            &format!("coordinator_tick_switch/holds_4/delta_{switch_s}"),
+            co,
+        );
+        let cell = ContinuousCoordinator::new(task.clone(), &usable[0], &order, 4, tick_s)
+            .expect("a runnable order")
+            .with_switch_s(switch_s)
+            .expect("valid switch time");
+        bench_controller(
+            c,
+            &format!("coordinator_tick_switch/cell_4/delta_{switch_s}"),
+            cell,
+        );
     }
 }
 

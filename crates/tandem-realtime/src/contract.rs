@@ -72,6 +72,13 @@ pub struct Tick {
     /// The latched fault, if any (this tick's or an earlier one's, until
     /// [`Controller::clear_fault`]): see [`Fault`].
     pub fault: Option<Fault>,
+    /// The pre-alert (issue 41): the robot whose next low-confidence stretch (one it has not
+    /// touched yet; for a robot low-confidence now, the one after its current one) can start
+    /// soonest, and bounds on that start in real seconds from the end of this tick, worst case
+    /// over admissible operators ([`PreAlert`](crate::PreAlert), module
+    /// [`prealert`](crate::prealert)). `None` when no robot has a stretch ahead (rounds: every
+    /// remaining stretch touched).
+    pub next: Option<crate::PreAlert>,
 }
 
 impl Tick {

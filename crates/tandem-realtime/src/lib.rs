@@ -74,6 +74,7 @@ mod error;
 pub mod holds;
 pub mod margins;
 mod monitor;
+pub mod prealert;
 mod robots;
 mod rounds;
 pub mod strategy;
@@ -93,6 +94,7 @@ pub use margins::{
     sufficient_margins, sufficient_margins_per_pair, sufficient_margins_with_holds, switch_ticks,
 };
 pub use monitor::Fault;
+pub use prealert::PreAlert;
 pub use robots::{MAX_ROBOTS, PerRobot, RobotCount, RobotFlags};
 pub use rounds::Coordinator;
 pub use strategy::{high_conf_steps, response_step};

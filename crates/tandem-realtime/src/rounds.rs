@@ -11,6 +11,7 @@ use crate::error::{Error, Result};
 use crate::holds::{Hold, Plans};
 use crate::monitor::Fault;
 use crate::monitor::Monitor;
+use crate::prealert::{self, Reach};
 use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
 use crate::strategy::{Member, Mode, advance, first_waiting_start};
 use crate::timeline::Timeline;
@@ -91,6 +92,18 @@ pub struct Coordinator {
     /// The run-time fault monitor (its tick count is the ticks run since the start or the
     /// last reset).
     monitor: Monitor,
+    /// `k`: the operator's switch time in whole ticks ([`crate::switch_ticks`]; 0: none). A
+    /// robot whose current leg has release rules leaves its hold `k` ticks after the tick
+    /// start at which they all first held.
+    switch_ticks: u64,
+    /// Per robot, the ticks its current leg still waits for the switch time after its release
+    /// rules all held (0: not counting).
+    release_wait: [u64; MAX_ROBOTS],
+    /// The pre-alert's tables, per leg ([`crate::prealert`]).
+    reach: Arc<[Reach]>,
+    /// Per leg, the least real time (s) from its end to the tick that reaches the first
+    /// low-confidence run of its robot's later legs (`+∞`: none).
+    after_fast_s: Arc<[f64]>,
 }
 
 impl Coordinator {
@@ -164,6 +177,7 @@ impl Coordinator {
         // Without holds the legs are the robots' timelines: the same tolerance.
         let tol_s = clock_tolerance_s(&plans.legs, tick_s);
         let n = robots.len();
+        let (reach, after_fast_s) = reach_tables(&plans, tick_s, tol_s);
         let mut c = Coordinator {
             robots,
             plans: Arc::new(plans),
@@ -177,9 +191,63 @@ impl Coordinator {
             wait_clock_s: 0.0,
             cursors: [Cursors::default(); MAX_ROBOTS],
             monitor: Monitor::new(n),
+            switch_ticks: 0,
+            release_wait: [0; MAX_ROBOTS],
+            reach: reach.into(),
+            after_fast_s: after_fast_s.into(),
         };
         c.reset();
         Ok(c)
+    }
+
+    /// [`Coordinator::with_holds`] with the margin check and the run time of `params`
+    /// ([`check_margins`](crate::check_margins)): with the operator's switch time
+    /// `params.switch_s`, a robot leaves a hold with release rules no sooner than `k` =
+    /// [`switch_ticks`](crate::switch_ticks) ticks after the tick start at which its rules all
+    /// held, so a released robot's stretch starts at least `k` ticks after the awaited robots
+    /// left theirs ([`Coordinator::with_switch_s`]). `holds` is empty or one list per robot.
+    ///
+    /// # Errors
+    /// As [`Coordinator::with_holds`]; [`Error::BadParam`] for a bad `switch_s`.
+    pub fn with_margins(
+        robots: impl Into<Vec<Timeline>>,
+        holds: &[Vec<Hold>],
+        params: &crate::MarginParams,
+    ) -> Result<Coordinator> {
+        let c = Coordinator::with_holds_unchecked(robots, holds, params.tick_s)?
+            .with_switch_s(params.switch_s)?;
+        if !crate::margins::check_plans_switch(
+            &c.plans,
+            c.robots.len(),
+            params.tick_s,
+            c.switch_ticks,
+        )? {
+            return Err(Error::Unsafe {
+                tick_s: params.tick_s,
+            });
+        }
+        Ok(c)
+    }
+
+    /// The same coordinator with the operator's switch time `switch_s` (real s, finite and
+    /// ≥ 0) at run time, reset to the start: a robot leaves a hold with release rules no
+    /// sooner than `k` = [`switch_ticks`](crate::switch_ticks)`(switch_s, tick_s)` ticks after
+    /// the tick start at which its rules all first held (docs/decisions.md, "The switch time
+    /// at run time (issue 41)"). `switch_s = 0` changes nothing. The margin check that goes
+    /// with it is [`check_margins`](crate::check_margins) at the same `switch_s`.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for a `switch_s` not finite and ≥ 0 or of more than 1e8 ticks.
+    pub fn with_switch_s(mut self, switch_s: f64) -> Result<Coordinator> {
+        self.switch_ticks = crate::switch_ticks(switch_s, self.tick_s)?;
+        self.reset();
+        Ok(self)
+    }
+
+    /// `k`: the switch time in whole ticks this coordinator waits at a hold with release
+    /// rules ([`Coordinator::with_switch_s`]; 0: none).
+    pub fn switch_ticks(&self) -> u64 {
+        self.switch_ticks
     }
 
     /// The latched fault, if two robots have been low-confidence in one tick since the start,
@@ -356,10 +424,31 @@ impl Coordinator {
     /// Latches `released` for every robot whose current leg's release rules hold on the
     /// robots' states now (between ticks: at the next tick start). O(rules of the current
     /// legs).
-    fn update_released(&mut self) {
+    ///
+    /// With a switch time of `k ≥ 1` ticks, a leg with release rules whose rules first all
+    /// hold after a tick (`after_tick`) is released `k` ticks later: it counts down one per
+    /// tick end (the rules are monotone, they keep holding), so it moves from the tick start
+    /// `k` ticks after the one at which they first held. At the start (no tick run, nobody has
+    /// been low-confidence) and for a leg without rules it is released at once.
+    fn update_released(&mut self, after_tick: bool) {
         for i in 0..self.robots.len() {
-            if !self.released[i] && self.rules_met(i) {
-                self.released.set(i, true);
+            if self.released[i] {
+                continue;
+            }
+            if self.release_wait[i] > 0 {
+                self.release_wait[i] -= 1;
+                if self.release_wait[i] == 0 {
+                    self.released.set(i, true);
+                }
+            } else if self.rules_met(i) {
+                if self.switch_ticks == 0
+                    || !after_tick
+                    || self.plans.rules_of(self.leg[i]).is_empty()
+                {
+                    self.released.set(i, true);
+                } else {
+                    self.release_wait[i] = self.switch_ticks;
+                }
             }
         }
     }
@@ -391,7 +480,8 @@ impl Coordinator {
             self.leg[i] = self.plans.first_leg[i];
         }
         self.released = RobotFlags::new(n);
-        self.update_released();
+        self.release_wait = [0; MAX_ROBOTS];
+        self.update_released(false);
         self.cursors = [Cursors::default(); MAX_ROBOTS];
         self.monitor.reset();
     }
@@ -409,6 +499,51 @@ impl Coordinator {
             );
         }
         out
+    }
+
+    /// The pre-alert now ([`Tick::next`], [`crate::prealert`]): per robot not finished, its
+    /// next low-confidence run on its current leg or a later one, the least real time until the
+    /// tick that starts it (the switch wait of a counting release included, holds and starts
+    /// counted as 0) and, when nothing but its own motion stands between (the run on its
+    /// current leg, released or counting down, started, not held by the fault monitor), the
+    /// most. O(N), no allocation.
+    pub fn pre_alert(&self) -> Option<crate::PreAlert> {
+        let h = self.tick_s;
+        let held = self.monitor.held();
+        let cands = (0..self.robots.len()).filter_map(|i| {
+            if self.finished(i) {
+                return None;
+            }
+            let l = self.leg[i];
+            let r = self.cur(i);
+            let c = r.sample_clock_s();
+            let reach = &self.reach[l];
+            // A leg not moved yet (its clock at or below its start) has touched nothing: even
+            // a run at its first sample is ahead.
+            let (s, at, touched_s) = if self.clock_s[i] <= r.start_s() {
+                (r.start_s(), 0, f64::NEG_INFINITY)
+            } else {
+                (self.clock_s[i], self.cursors[i].at, self.clock_s[i])
+            };
+            let wait = self.release_wait[i];
+            if let Some(m) = reach.next_run(c, at, touched_s, self.tol_s) {
+                let (lo, hi) = reach.to_run(c, at, s, m);
+                let earliest = wait + prealert::ticks_before_at_least(lo, h);
+                let moves = (self.released[i] || wait > 0)
+                    && self.clock_s[i] >= r.start_s()
+                    && held != Some(i);
+                let latest = moves
+                    .then(|| prealert::ticks_before_at_most(hi, h).map(|t| t + wait))
+                    .flatten();
+                return Some((i, earliest, latest));
+            }
+            let after = self.after_fast_s[l];
+            after.is_finite().then(|| {
+                let lo = reach.fast_to_end(c, at, s) + after;
+                (i, wait + prealert::ticks_before_at_least(lo, h), None)
+            })
+        });
+        prealert::pick(cands, h)
     }
 
     fn phase(&mut self, i: usize) -> Phase {
@@ -474,6 +609,7 @@ impl Coordinator {
             running: RobotFlags::new(n),
             waiting: RobotFlags::new(n),
             fault: None,
+            next: None,
         };
         let mut first_waiting_start = first_waiting_start(&members[..n], |i| self.cur(i).start_s());
         let has_holds = self.plans.has_holds();
@@ -537,6 +673,7 @@ impl Coordinator {
                 let next = &self.plans.legs[self.leg[i]];
                 next.advance_cursor(&mut self.cursors[i].at, self.wait_clock_s);
                 self.released.set(i, false);
+                self.release_wait[i] = 0;
             }
             self.shown_s[i] = self.clock_s[i].max(self.floor_s[i]);
             out.ref_time.as_mut_slice()[i] = self.ref_time_of(i);
@@ -553,14 +690,47 @@ impl Coordinator {
                 self.shown_s[i]
             );
         }
-        self.update_released();
+        self.update_released(true);
         for i in 0..n {
             out.tasks.as_mut_slice()[i] = u64::from(self.finished(i));
             out.waiting.set(i, self.at_hold(i));
         }
+        out.next = self.pre_alert();
         out.fault = self.monitor.observe(out.low_conf);
         Ok(out)
     }
+}
+
+/// The pre-alert's tables of every leg of `plans` at tick `h` and clock tolerance `tol_s`:
+/// per leg its [`Reach`] (a tick moves a robot between `S_n·h` and `max(1, F_n)·h`, at most
+/// its largest step `M`) and the least real time from its end to its robot's next run on a
+/// later leg (dwells and waits counted as 0).
+fn reach_tables(plans: &Plans, h: f64, tol_s: f64) -> (Vec<Reach>, Vec<f64>) {
+    let reach: Vec<Reach> = plans
+        .legs
+        .iter()
+        .map(|leg| {
+            let m = h * leg.max_rate_fast();
+            Reach::new(
+                leg,
+                |n| leg.rate_slow(n).min(1.0),
+                |n| leg.rate_fast(n).max(1.0),
+                m,
+                tol_s,
+            )
+        })
+        .collect();
+    let mut after = vec![f64::INFINITY; plans.legs.len()];
+    for l in (0..plans.legs.len()).rev() {
+        let robot = plans.robot_of[l];
+        if l + 1 < plans.first_leg[robot + 1] {
+            let next = &reach[l + 1];
+            after[l] = next
+                .fast_to_first_run()
+                .unwrap_or_else(|| next.fast_total() + after[l + 1]);
+        }
+    }
+    (reach, after)
 }
 
 impl Controller for Coordinator {

@@ -641,7 +641,8 @@ const GRID: usize = 24;
 /// Bisection steps towards an acceptance edge per robot.
 const BISECTIONS: usize = 12;
 
-/// A tight schedule of the case's robots accepted by `check`, at an edge of its acceptance:
+/// A tight schedule of the case's robots accepted by `check` (a [`Check`], or any closure, e.g.
+/// one with a switch time), at an edge of its acceptance:
 /// robot 0 at 0; for robot `i`, offsets `0`, `E_i·(k + u_k)/24` (`k = 0..24`, `u_k` uniform) and
 /// `E_i` (the latest end of the robots before it: a serial start) are checked with robots
 /// `0..=i` and the robots after `i` started serially behind them (so every decision is the
@@ -653,7 +654,11 @@ const BISECTIONS: usize = 12;
 ///
 /// # Panics
 /// If `check` returns an error (the case's tick is valid).
-pub fn tight_starts(case: &Case, check: Check, r: &mut ChaCha8Rng) -> Option<(Vec<f64>, bool)> {
+pub fn tight_starts(
+    case: &Case,
+    check: impl Fn(&[Timeline], f64) -> Result<bool>,
+    r: &mut ChaCha8Rng,
+) -> Option<(Vec<f64>, bool)> {
     let n = case.plans.len();
     let mut starts = vec![0.0];
     let mut overlapping = false;

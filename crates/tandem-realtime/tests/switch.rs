@@ -73,7 +73,7 @@ fn ten_ten_forty(tau: f64) -> Vec<Timeline> {
 fn shortest_switch(
     robots: &[Timeline],
     holds: &[Vec<Hold>],
-    tick_s: f64,
+    (tick_s, switch_s): (f64, f64),
     set: &[Adversary],
     r: &mut rand_chacha::ChaCha8Rng,
 ) -> (Option<u64>, bool) {
@@ -82,7 +82,10 @@ fn shortest_switch(
     let budget = ((ends + dwell) / tick_s * 40.0).ceil() as u64 + 100;
     let (mut gap, mut overlap) = (None::<u64>, false);
     for &a in set {
-        let c = Coordinator::with_holds_unchecked(robots.to_vec(), holds, tick_s).unwrap();
+        let c = Coordinator::with_holds_unchecked(robots.to_vec(), holds, tick_s)
+            .unwrap()
+            .with_switch_s(switch_s)
+            .unwrap();
         let run = run_adversary(c, a, r, budget).unwrap();
         assert!(run.finished, "{a:?} did not finish");
         overlap |= run.overlap_ticks > 0;
@@ -121,11 +124,11 @@ fn a_schedule_valid_without_switch_time_is_rejected_with_two_seconds() {
     // enters its own at τ + 1: nominally (τ + 1 − 2)/0.1 ticks apart.
     let mut r = rand_chacha::ChaCha8Rng::seed_from_u64(7);
     let set = adversary_set(2, [0.8, 1.25], 60, &mut r);
-    let (gap0, overlap0) = shortest_switch(&robots, &[], tick_s, &set, &mut r);
+    let (gap0, overlap0) = shortest_switch(&robots, &[], (tick_s, 0.0), &set, &mut r);
     assert!(!overlap0);
     let gap0 = gap0.unwrap();
     assert!(gap0 < 5, "δ = 0 schedule keeps {gap0} ticks");
-    let (gap2, overlap2) = shortest_switch(&ten_ten_forty(tau2), &[], tick_s, &set, &mut r);
+    let (gap2, overlap2) = shortest_switch(&ten_ten_forty(tau2), &[], (tick_s, 2.0), &set, &mut r);
     assert!(!overlap2);
     let gap2 = gap2.unwrap();
     assert!(gap2 >= 20, "δ = 2 s schedule keeps only {gap2} ticks");
@@ -221,7 +224,7 @@ fn accepted_schedules_keep_the_switch_time_under_every_operator() {
             let robots = case.robots_at(&starts);
             let k = switch_ticks(ticks_f * case.tick_s, case.tick_s).unwrap();
             let set = case.adversaries(&robots, &mut r);
-            let (gap, overlap) = shortest_switch(&robots, &[], case.tick_s, &set, &mut r);
+            let (gap, overlap) = shortest_switch(&robots, &[], (case.tick_s, 0.0), &set, &mut r);
             assert!(!overlap, "N = {n}, seed {seed}: overlap");
             if let Some(g) = gap {
                 assert!(
@@ -238,7 +241,8 @@ fn accepted_schedules_keep_the_switch_time_under_every_operator() {
             if let Some((starts0, _)) = tight_starts(&case, zero, &mut r) {
                 let robots0 = case.robots_at(&starts0);
                 let set0 = case.adversaries(&robots0, &mut r);
-                if let (Some(g), _) = shortest_switch(&robots0, &[], case.tick_s, &set0, &mut r)
+                if let (Some(g), _) =
+                    shortest_switch(&robots0, &[], (case.tick_s, 0.0), &set0, &mut r)
                     && g < k
                 {
                     tight_at_zero += 1;
@@ -283,7 +287,8 @@ fn accepted_plans_with_holds_keep_the_switch_time_under_every_operator() {
             accepted += 1;
             let k = switch_ticks(switch_s, case.tick_s).unwrap();
             let set = case.adversaries(&robots, &mut r);
-            let (gap, overlap) = shortest_switch(&robots, &holds, case.tick_s, &set, &mut r);
+            let (gap, overlap) =
+                shortest_switch(&robots, &holds, (case.tick_s, switch_s), &set, &mut r);
             assert!(!overlap, "N = {n}, seed {seed}: overlap with holds");
             assert!(
                 gap.is_none_or(|g| g >= k),
@@ -293,4 +298,82 @@ fn accepted_plans_with_holds_keep_the_switch_time_under_every_operator() {
         eprintln!("N = {n}: {accepted} of {cases} plans with holds accepted at δ = 2.5 ticks");
         assert!(accepted >= 1, "N = {n}: no plan with holds accepted");
     }
+}
+
+/// Robot 1: 10 HC, 10 LC, 40 HC samples of 0.1 s; robot 2 the same, holding at sample 9 (one
+/// HC sample before its stretch) until robot 1 has passed sample 20 (the end of its stretch),
+/// with the planned dwell that makes it due then (1.1 s). Both start at 0, tick 0.1 s.
+fn held_right_before_its_stretch() -> (Vec<Timeline>, Vec<Vec<Hold>>) {
+    let robots = ten_ten_forty(0.0);
+    let hold = Hold {
+        dwell_s: 1.1,
+        after: vec![tandem_realtime::After {
+            robot: 0,
+            ref_idx: 20,
+        }],
+        ..Hold::at(9)
+    };
+    (robots, vec![vec![], vec![hold]])
+}
+
+#[test]
+fn a_held_robot_waits_the_switch_time_after_its_rule_holds() {
+    let (robots, holds) = held_right_before_its_stretch();
+    let tick_s = 0.1;
+    let params = MarginParams::new(tick_s).with_switch_s(2.0);
+    let k = params.switch_ticks().unwrap();
+    assert_eq!(k, 20);
+    // The check accepts it at δ = 2 s: the rule orders the two stretches and the coordinator
+    // waits k ticks after it holds.
+    assert!(check_margins(&robots, &holds, &params).unwrap());
+    let c = Coordinator::with_margins(robots.clone(), &holds, &params).unwrap();
+    assert_eq!(c.switch_ticks(), 20);
+    let mut r = rng(41);
+    let set = adversary_set(2, [0.8, 1.25], 2000, &mut r);
+    let (gap, overlap) = shortest_switch(&robots, &holds, (tick_s, 2.0), &set, &mut r);
+    assert!(!overlap);
+    assert!(gap.is_some_and(|g| g >= k), "switch of {gap:?} ticks");
+    // Regression: without the run-time wait (δ = 0 at run time) robot 2 enters its stretch one
+    // or two ticks after robot 1 left its own.
+    let (gap0, overlap0) = shortest_switch(&robots, &holds, (tick_s, 0.0), &set, &mut r);
+    assert!(!overlap0);
+    assert!(gap0.is_some_and(|g| g < 3), "switch of {gap0:?} ticks");
+}
+
+#[test]
+fn the_token_passes_the_switch_time_after_a_stretch_ended() {
+    use tandem_realtime::continuous::{ContinuousCoordinator, run_cell};
+    // [HC, LC, HC] of 1 s each at ψ̇ = 1, bounds [½, 2]; both gates at the start; tick ¼ s.
+    let task = Timeline::new(
+        &[true, false, true],
+        &[1.0; 3],
+        &[0.5; 3],
+        &[2.0; 3],
+        0.0,
+        1.0,
+    )
+    .unwrap();
+    let gap_of = |switch_s: f64| {
+        let mut r = rng(7);
+        let set = adversary_set(2, [0.5, 2.0], 4000, &mut r);
+        let mut gap = None::<u64>;
+        for a in set {
+            let mut cell =
+                ContinuousCoordinator::new(task.clone(), &[], &[(0, 0), (1, 0)], 2, 0.25)
+                    .unwrap()
+                    .with_switch_s(switch_s)
+                    .unwrap();
+            let run = run_cell(&mut cell, a, &mut r, 20, 40_000).unwrap();
+            assert_eq!(run.overlap_ticks, 0);
+            assert!(cell.tasks_completed().iter().all(|&t| t >= 20), "{a:?}");
+            let g = run.min_switch_gap_ticks.expect("the robots switch");
+            gap = Some(gap.map_or(g, |x| x.min(g)));
+        }
+        gap.unwrap()
+    };
+    // δ = 2 s is k = 8 ticks of ¼ s: no switch is shorter.
+    assert!(gap_of(2.0) >= 8);
+    // Regression: without the wait robot 1 leaves its gate in the tick after robot 0 left its
+    // stretch, and its tolerance-widened interval reaches the stretch within four ticks.
+    assert!(gap_of(0.0) < 8);
 }

@@ -11,6 +11,7 @@ use crate::contract::{Controller, Operator, Tick, check_tick};
 use crate::cursor::{Cursors, operator_step};
 use crate::error::{Error, Result};
 use crate::monitor::{Fault, Monitor};
+use crate::prealert::{self, Reach};
 use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
 use crate::timeline::Timeline;
 use crate::tol::clock_tolerance_s;
@@ -76,6 +77,17 @@ pub struct ContinuousCoordinator {
     /// The run-time fault monitor (its tick count is the ticks run since the start or the
     /// last reset, carried over by a hand-over).
     monitor: Monitor,
+    /// `k`: the operator's switch time in whole ticks ([`crate::switch_ticks`]; 0: none).
+    switch_ticks: u64,
+    /// The robot that last left a group and the index of the first tick after the one in
+    /// which it left (`None`: nobody yet). Another robot's token lets it pass its gate only
+    /// from tick `left + k` on (carried over by a hand-over).
+    last_left: Option<(usize, u64)>,
+    /// The pre-alert's tables of the task ([`crate::prealert`]).
+    reach: Arc<Reach>,
+    /// Per reference sample, the group its low-confidence sample belongs to (unused on
+    /// high-confidence samples).
+    group_of: Arc<[usize]>,
 }
 
 impl ContinuousCoordinator {
@@ -113,6 +125,33 @@ impl ContinuousCoordinator {
             };
         }
         let tol_s = clock_tolerance_s(std::slice::from_ref(&task), tick_s);
+        // A tick moves a robot by `tick_s` of clock on high confidence (capped) and between
+        // `S·h` and `F·h` on low confidence: at most `M = h·max(1, max F)`.
+        let reach = Reach::new(
+            &task,
+            |n| {
+                if task.conf()[n] {
+                    1.0
+                } else {
+                    task.rate_slow(n)
+                }
+            },
+            |n| {
+                if task.conf()[n] {
+                    1.0
+                } else {
+                    task.rate_fast(n)
+                }
+            },
+            tick_s * task.max_rate_fast(),
+            tol_s,
+        );
+        let mut group_of = vec![0; n_ref];
+        for (k, g) in groups.iter().enumerate() {
+            for x in &mut group_of[g.ref_start..g.ref_end] {
+                *x = k;
+            }
+        }
         let mut out = ContinuousCoordinator {
             task: Arc::new(task),
             groups: groups.into(),
@@ -133,9 +172,103 @@ impl ContinuousCoordinator {
             served: [0; MAX_ROBOTS],
             stamp: 0,
             monitor: Monitor::new(n_robots),
+            switch_ticks: 0,
+            last_left: None,
+            reach: Arc::new(reach),
+            group_of: group_of.into(),
         };
         out.reset();
         Ok(out)
+    }
+
+    /// The same cell with the operator's switch time `switch_s` (real s, finite and ≥ 0),
+    /// reset to the start: the token lets a robot pass its gate no sooner than `k` =
+    /// [`switch_ticks`](crate::switch_ticks)`(switch_s, tick_s)` ticks after the tick in which
+    /// *another* robot left its group (the token's move), so between two robots' stretches at
+    /// least `k` ticks pass in which neither is low-confidence (docs/decisions.md, "The switch
+    /// time at run time (issue 41)"). Consecutive groups of one robot wait for nothing.
+    /// `switch_s = 0` changes nothing.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for a `switch_s` not finite and ≥ 0 or of more than 1e8 ticks.
+    pub fn with_switch_s(mut self, switch_s: f64) -> Result<ContinuousCoordinator> {
+        self.switch_ticks = crate::switch_ticks(switch_s, self.tick_s)?;
+        self.reset();
+        Ok(self)
+    }
+
+    /// `k`: the switch time in whole ticks ([`ContinuousCoordinator::with_switch_s`]).
+    pub fn switch_ticks(&self) -> u64 {
+        self.switch_ticks
+    }
+
+    /// Whether robot `i` holds the token for its next group and may pass its gate in tick
+    /// `tick` (the index of a tick: [`Monitor::ticks`] at its start): the token is its, and
+    /// either no other robot left a group fewer than `k` ticks before.
+    fn may_pass(&self, tok: Option<Token>, i: usize, tick: u64) -> bool {
+        tok.is_some_and(|t| t.robot == i && t.group == self.next_group[i])
+            && self.switch_wait(i, tick) == 0
+    }
+
+    /// Ticks robot `i` must still wait at tick index `tick` before the token may let it pass
+    /// (the switch time after another robot left its group; 0 without one).
+    fn switch_wait(&self, i: usize, tick: u64) -> u64 {
+        match self.last_left {
+            Some((r, left)) if self.switch_ticks > 0 && r != i => {
+                (left + self.switch_ticks).saturating_sub(tick)
+            }
+            _ => 0,
+        }
+    }
+
+    /// The pre-alert now ([`Tick::next`], [`crate::prealert`]): per robot its next
+    /// low-confidence run (its current task, else the next one), the least real time until the
+    /// tick that starts it (the switch wait of a token holder included, gates counted as 0)
+    /// and, for a robot holding the token of the group the run is in and not held by the fault
+    /// monitor, the most (else the token's next move, set by the others, bounds it: `+∞`).
+    /// O(N), no allocation.
+    pub fn pre_alert(&self) -> Option<crate::PreAlert> {
+        let h = self.tick_s;
+        let next_tick = self.monitor.ticks();
+        let tok = self.token();
+        let held = self.monitor.held();
+        let c = self.task.sample_clock_s();
+        let reach = &*self.reach;
+        let cands = (0..self.n).filter_map(|i| {
+            let s = self.clock_s[i];
+            let at = self.cursors[i].at;
+            let holder = tok.is_some_and(|t| t.robot == i && t.group == self.next_group[i]);
+            let wait = if holder {
+                self.switch_wait(i, next_tick)
+            } else {
+                0
+            };
+            // At a task's start (clock 0) the robot has touched nothing of it.
+            let touched_s = if s <= 0.0 { f64::NEG_INFINITY } else { s };
+            if let Some(m) = reach.next_run(c, at, touched_s, self.tol_s) {
+                let (lo, hi) = reach.to_run(c, at, s, m);
+                let mut earliest = prealert::ticks_before_at_least(lo, h);
+                let mut slack = 0;
+                if wait > 0 {
+                    // The robot may run up to its gate while it waits for the switch time, and
+                    // passes it `wait` ticks from now at the soonest; the tick that stops it at
+                    // the gate may be short (one tick more at the latest).
+                    let gate = self.groups[self.next_group[i]].gate;
+                    let (lo_gate, _) = reach.to_run_from_sample(gate, m);
+                    earliest = earliest.max(wait + prealert::ticks_before_at_least(lo_gate, h));
+                    slack = wait + 1;
+                }
+                let latest = (holder && held != Some(i) && self.group_of[m] == self.next_group[i])
+                    .then(|| prealert::ticks_before_at_most(hi, h).map(|t| t + slack))
+                    .flatten();
+                return Some((i, earliest, latest));
+            }
+            reach.fast_to_first_run().map(|first| {
+                let lo = reach.fast_to_end(c, at, s) + first;
+                (i, wait + prealert::ticks_before_at_least(lo, h), None)
+            })
+        });
+        prealert::pick(cands, h)
     }
 
     /// Every robot back at sample 0 of its first task, the token at its first entry, the
@@ -165,6 +298,7 @@ impl ContinuousCoordinator {
         }
         self.stamp = rank;
         self.monitor.reset();
+        self.last_left = None;
     }
 
     /// Number of robots `N`.
@@ -238,8 +372,9 @@ impl ContinuousCoordinator {
     pub fn low_conf_now(&self) -> RobotFlags {
         let mut out = RobotFlags::new(self.n);
         let tok = self.token();
+        let tick = self.monitor.ticks();
         for i in 0..self.n {
-            let holder = tok.is_some_and(|t| t.robot == i && t.group == self.next_group[i]);
+            let holder = self.may_pass(tok, i, tick);
             out.set(i, holder && !self.task.conf()[self.cursors[i].at]);
         }
         out
@@ -250,11 +385,12 @@ impl ContinuousCoordinator {
     pub fn at_gate_now(&self) -> RobotFlags {
         let mut out = RobotFlags::new(self.n);
         let tok = self.token();
+        let tick = self.monitor.ticks();
         for i in 0..self.n {
             let g = self.next_group[i];
             let waits = g < self.groups.len()
                 && self.clock_s[i] >= self.gate_s[g]
-                && !tok.is_some_and(|t| t.robot == i && t.group == g);
+                && !self.may_pass(tok, i, tick);
             out.set(i, waits);
         }
         out
@@ -289,6 +425,7 @@ impl ContinuousCoordinator {
         let end_s = task.end_s();
         let tok = self.token();
         let held = self.monitor.held();
+        let this_tick = self.monitor.ticks();
         let mut out = Tick {
             ref_time: PerRobot::new(n),
             tasks: PerRobot::new(n),
@@ -296,6 +433,7 @@ impl ContinuousCoordinator {
             running: RobotFlags::new(n),
             waiting: RobotFlags::new(n),
             fault: None,
+            next: None,
         };
         for i in 0..n {
             if held == Some(i) {
@@ -303,7 +441,7 @@ impl ContinuousCoordinator {
             }
             let s_old = self.clock_s[i];
             let g = self.next_group[i];
-            let holder = tok.is_some_and(|t| t.robot == i && t.group == g);
+            let holder = self.may_pass(tok, i, this_tick);
             let cap = if g >= n_groups {
                 end_s
             } else if holder {
@@ -347,6 +485,7 @@ impl ContinuousCoordinator {
             let (r, g) = (t.robot, t.group);
             let s = self.clock_s[r];
             if self.next_group[r] == g && (s >= end_s || s - self.tol_s >= self.leave_s[g]) {
+                self.last_left = Some((r, this_tick + 1));
                 self.next_group[r] = g + 1;
                 self.served[r] = self.stamp;
                 self.stamp += 1;
@@ -366,9 +505,8 @@ impl ContinuousCoordinator {
             out.ref_time.as_mut_slice()[i] = task.ref_time_in(at, s);
             out.tasks.as_mut_slice()[i] = self.tasks[i];
             let g = self.next_group[i];
-            let waits = g < n_groups
-                && s >= self.gate_s[g]
-                && !tok.is_some_and(|t| t.robot == i && t.group == g);
+            let waits =
+                g < n_groups && s >= self.gate_s[g] && !self.may_pass(tok, i, this_tick + 1);
             out.waiting.set(i, waits);
         }
         #[cfg(debug_assertions)]
@@ -382,6 +520,7 @@ impl ContinuousCoordinator {
             );
         }
         out.fault = self.monitor.observe(out.low_conf);
+        out.next = self.pre_alert();
         Ok(out)
     }
 
@@ -539,6 +678,9 @@ impl ContinuousCoordinator {
         self.served = old.served;
         self.stamp = old.stamp;
         self.monitor = Monitor::resumed_at(self.n, old.monitor.ticks());
+        // The switch time runs on across the hand-over: the robot that last left a group, and
+        // when, are the old cell's.
+        self.last_left = old.last_left;
         Ok(())
     }
 

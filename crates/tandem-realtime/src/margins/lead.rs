@@ -539,6 +539,13 @@ fn pass(
                         - tau_p
                 })
                 .fold(0.0, f64::max);
+            // With a switch time the release comes `k` ticks after the tick start at which the
+            // rules first held (the coordinator's count-down): c moves at most `k·M_c` more
+            // before p can start. Without one nothing is added (the same float operations).
+            let delayed = match switch_extra_s(legs.switch_ticks, max_step_of[c]) {
+                Some(x) if !rules.is_empty() => delayed + x,
+                _ => delayed,
+            };
             max_step_of[c] + behind.max(delayed)
         };
         let thirds: Vec<(f64, f64)> = (0..n)
@@ -577,10 +584,13 @@ fn pass(
             let mut slack_s = match switch_extra_s(legs.switch_ticks, max_step_of[c]) {
                 None if is_enforced || u_max <= lead.start_s() => f64::INFINITY,
                 None => (c_iv.start_s - eps) - (lead.reach_below(u_max) + max_step_of[c]),
+                // A chain of release rules orders the regions, and the coordinator releases a
+                // held robot `k` ticks after the tick start at which its rules held, which is
+                // after the exit tick: `k` ticks pass (docs/decisions.md, "The switch time at
+                // run time (issue 41)").
+                Some(_) if is_enforced => f64::INFINITY,
                 // The switch time (docs/decisions.md, "The operator's switch time in the margin
-                // check"): `c` stays out of `C` for `k` more ticks after `p`'s exit tick. A
-                // release rule orders the regions but gives no switch time under the release at
-                // the exit tick, so it exempts nothing.
+                // check"): `c` stays out of `C` for `k` more ticks after `p`'s exit tick.
                 Some(_) if u_max <= lead.start_s() => super::started_after_exit_slack(
                     super::SwitchRoom {
                         ticks: legs.switch_ticks,

@@ -173,9 +173,13 @@
 //! does, at least `k` = [`switch_ticks`]`(δ, h)` ticks pass. Each test above then keeps `c` a
 //! further `k·M_c` short of its region when `p` has left its own (`c` moves at most `M_c` a
 //! tick), a pair decided before the later robot starts counts the ticks `p` needed to reach that
-//! start, and with holds a release rule no longer exempts a pair (it releases in the exit tick).
-//! With `δ = 0` no term is added: the same float operations (docs/decisions.md, "The operator's
-//! switch time in the margin check (issue 41)").
+//! start. With holds the check is that of a coordinator that waits the switch time at run time
+//! ([`Coordinator::with_switch_s`](crate::Coordinator::with_switch_s)): a held robot leaves its
+//! hold `k` ticks after the tick start at which its release rules first held, so a pair whose
+//! order a chain of rules enforces is still exempt, and a leg delayed by rules starts with `c`
+//! up to `k·M_c` further ahead (test (d)). With `δ = 0` no term is added: the same float
+//! operations (docs/decisions.md, "The operator's switch time in the margin check (issue 41)",
+//! "The switch time at run time (issue 41)").
 //!
 //! # Slacks
 //! [`pair_slacks`] reports, per pair, the room rule 1 (two robots) or the test (d) (three or
@@ -346,7 +350,7 @@ pub(crate) fn check_plans(
 
 /// [`check_plans`] with the operator's switch time, `switch_ticks` whole ticks (0: none, the
 /// same float operations as [`check_plans`]).
-fn check_plans_switch(
+pub(crate) fn check_plans_switch(
     plans: &crate::holds::Plans,
     n_robots: usize,
     tick_s: f64,
@@ -551,9 +555,13 @@ pub fn switch_ticks(switch_s: f64, tick_s: f64) -> Result<u64> {
 /// With `switch_s = 0` it is [`sufficient_margins_with_holds`], bit for bit.
 ///
 /// Two robots without holds: the simulation, `c` a further `k·M_c` short of its region when `p`
-/// has left its own; otherwise the lead bound with the same room. With holds and `k > 0`, a
-/// release rule no longer exempts a pair (a held robot leaves its hold in the tick the other
-/// robot left its stretch, which gives no switch time).
+/// has left its own; otherwise the lead bound with the same room. With holds the guarantee is
+/// that of a coordinator waiting the switch time at its holds ([`Coordinator::with_margins`] or
+/// [`Coordinator::with_switch_s`] at the same `switch_s`): a pair whose order release rules
+/// enforce is exempt, and a leg delayed by rules may start `k` ticks later (module docs).
+///
+/// [`Coordinator::with_margins`]: crate::Coordinator::with_margins
+/// [`Coordinator::with_switch_s`]: crate::Coordinator::with_switch_s
 ///
 /// # Errors
 /// As [`sufficient_margins_with_holds`]; [`Error::BadParam`] for a bad `switch_s`

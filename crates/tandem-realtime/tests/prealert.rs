@@ -1,0 +1,280 @@
+//! The pre-alert of every tick (`Tick::next`, `tandem_realtime::prealert`, issue 41): the
+//! earliest start it announces for a robot's next low-confidence stretch is never later than
+//! the start observed, and the latest, when bounded, never earlier — in rounds (random problems
+//! of the test kit's families, N = 2…4, with and without holds and release rules, switch times
+//! of 0 and 3 ticks) and in continuous cells (random tasks, N = 2…4, random runnable orders),
+//! under every operator policy of the adversary set (the beam search runs as its policy
+//! fallback here: it keeps no ticks to check).
+
+use proptest::prelude::*;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use tandem_realtime::adversary::{adversary_set, run_adversary_on};
+use tandem_realtime::continuous::{ContinuousCoordinator, groups};
+use tandem_realtime::holds::release_rules;
+use tandem_realtime::testkit::{
+    Case, CellHolds, Family, random_cell_task, random_usable, with_random_dwells,
+};
+use tandem_realtime::{
+    Controller, Coordinator, Fault, Operator, PerRobot, RobotFlags, Tick, Timeline,
+};
+
+/// A controller that records every tick it runs.
+struct Watch<C> {
+    inner: C,
+    ticks: Vec<Tick>,
+}
+
+impl<C: Controller> Controller for Watch<C> {
+    fn n_robots(&self) -> usize {
+        self.inner.n_robots()
+    }
+    fn tick_s(&self) -> f64 {
+        self.inner.tick_s()
+    }
+    fn tick(&mut self, operator: Operator) -> tandem_realtime::Result<Tick> {
+        let t = self.inner.tick(operator)?;
+        self.ticks.push(t);
+        Ok(t)
+    }
+    fn reset(&mut self) {
+        self.inner.reset();
+        self.ticks.clear();
+    }
+    fn fault(&self) -> Option<Fault> {
+        self.inner.fault()
+    }
+    fn clear_fault(&mut self) {
+        self.inner.clear_fault();
+    }
+    fn low_conf_now(&self) -> RobotFlags {
+        self.inner.low_conf_now()
+    }
+    fn running_now(&self) -> RobotFlags {
+        self.inner.running_now()
+    }
+    fn waiting_now(&self) -> RobotFlags {
+        self.inner.waiting_now()
+    }
+    fn ref_time_now(&self) -> PerRobot<f64> {
+        self.inner.ref_time_now()
+    }
+    fn tasks_now(&self) -> PerRobot<u64> {
+        self.inner.tasks_now()
+    }
+    fn clock_s(&self) -> &[f64] {
+        self.inner.clock_s()
+    }
+    fn is_finished(&self) -> bool {
+        self.inner.is_finished()
+    }
+    fn ticks(&self) -> u64 {
+        self.inner.ticks()
+    }
+}
+
+/// Checks every announcement of a recorded run at tick `h`: the robot's next stretch starts
+/// in the first tick after the announcement that reports it low-confidence (when it was not
+/// low-confidence in the announcing tick; else in the first such tick after a tick without,
+/// a later stretch, which only the earliest bound must respect). `finished`: the run ended
+/// with every robot done (rounds), so a bounded announced stretch must have been observed.
+/// Returns (announcements checked, of them with a finite latest, the least slack of the
+/// earliest in ticks).
+fn check_run(ticks: &[Tick], h: f64, finished: bool, faults: bool) -> (u64, u64, f64) {
+    let (mut checked, mut bounded, mut least) = (0, 0, f64::INFINITY);
+    for (t0, tick) in ticks.iter().enumerate() {
+        let Some(a) = tick.next else { continue };
+        let r = a.robot;
+        let lc_now = tick.low_conf[r];
+        let mut it = ticks.iter().enumerate().skip(t0 + 1);
+        if lc_now {
+            // Past the current stretch first.
+            if it.by_ref().find(|(_, t)| !t.low_conf[r]).is_none() {
+                continue;
+            }
+        }
+        let Some((t1, _)) = it.find(|(_, t)| t.low_conf[r]) else {
+            // Never observed: the latest must have been unbounded (or the run cut short).
+            assert!(
+                !finished || faults || a.latest_s.is_infinite() || lc_now,
+                "tick {t0}: {a:?} announced, the stretch never started"
+            );
+            continue;
+        };
+        let start_s = (t1 - t0 - 1) as f64 * h;
+        assert!(
+            a.earliest_s <= start_s + 1e-9 * h,
+            "tick {t0}: {a:?} announced, started after {start_s} s (tick {t1}); ref times {:?}",
+            ticks[t0..=t1]
+                .iter()
+                .map(|t| (t.ref_time[r], t.low_conf[r], t.waiting[r]))
+                .collect::<Vec<_>>()
+        );
+        least = least.min((start_s - a.earliest_s) / h);
+        checked += 1;
+        if a.latest_s.is_finite() && !lc_now && !faults {
+            bounded += 1;
+            assert!(
+                start_s <= a.latest_s + 1e-9 * h,
+                "tick {t0}: {a:?} announced, started only after {start_s} s (tick {t1})"
+            );
+        }
+    }
+    (checked, bounded, least)
+}
+
+fn rounds_case(seed: u64, n: usize, holds: bool, switch_ticks: f64) -> (u64, u64) {
+    let mut r = ChaCha8Rng::seed_from_u64(seed);
+    let case = Case::random(Family::of_seed(seed), n, &mut r);
+    let starts = case.interleaved_starts(n, &mut r);
+    let robots: Vec<Timeline> = case.robots_at(&starts);
+    let plan = if holds {
+        let usable = random_usable(&robots, &mut r);
+        let rules = release_rules(&robots, &[], &usable);
+        with_random_dwells(&robots, rules, case.tick_s, &mut r)
+    } else {
+        Vec::new()
+    };
+    let switch_s = switch_ticks * case.tick_s;
+    let c = Coordinator::with_holds_unchecked(robots.clone(), &plan, case.tick_s)
+        .unwrap()
+        .with_switch_s(switch_s)
+        .unwrap();
+    let ends = robots.iter().map(Timeline::end_s).fold(0.0, f64::max);
+    let dwell: f64 = plan.iter().flatten().map(|h| h.dwell_s).sum();
+    let budget = ((ends + dwell) / case.tick_s * 40.0).ceil() as u64 + 100;
+    let set = case.adversaries(&robots, &mut r);
+    let (mut checked, mut bounded) = (0, 0);
+    for a in set {
+        let mut w = Watch {
+            inner: c.clone(),
+            ticks: Vec::new(),
+        };
+        let run = run_adversary_on(&mut w, a, &mut r, 1, budget).unwrap();
+        let faults = run.overlap_ticks > 0;
+        let (k, b, _) = check_run(&w.ticks, case.tick_s, run.finished, faults);
+        checked += k;
+        bounded += b;
+    }
+    (checked, bounded)
+}
+
+fn cell_case(seed: u64, n: usize, switch_ticks: f64) -> (u64, u64) {
+    let mut r = ChaCha8Rng::seed_from_u64(seed);
+    let (task, holds) = random_cell_task(&mut r, 40, CellHolds::Uniform);
+
+    let gs = groups(task.conf(), &holds).unwrap();
+    // A random runnable order: whole groups, each robot's in task order from a random first.
+    let g = gs.len();
+    let first: Vec<usize> = (0..n).map(|_| r.random_range(0..g)).collect();
+    let mut taken = vec![0; n];
+    let mut order = Vec::new();
+    while taken.iter().any(|&k| k < g) {
+        let i = loop {
+            let i = r.random_range(0..n);
+            if taken[i] < g {
+                break i;
+            }
+        };
+        let gr = gs[(first[i] + taken[i]) % g];
+        order.extend((gr.first_lc..gr.end_lc).map(|lc| (i, lc)));
+        taken[i] += 1;
+    }
+    let tick_s = 0.05 * r.random_range(0.2..2.0);
+    let c = ContinuousCoordinator::new(task, &holds, &order, n, tick_s)
+        .unwrap()
+        .with_switch_s(switch_ticks * tick_s)
+        .unwrap();
+    let set = adversary_set(n, [0.3, 3.0], 4000, &mut r);
+    let (mut checked, mut bounded) = (0, 0);
+    for a in set {
+        let mut w = Watch {
+            inner: c.clone(),
+            ticks: Vec::new(),
+        };
+        let run = run_adversary_on(&mut w, a, &mut r, 4, 4000).unwrap();
+        let (k, b, _) = check_run(&w.ticks, tick_s, false, run.overlap_ticks > 0);
+        checked += k;
+        bounded += b;
+    }
+    (checked, bounded)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn rounds_never_start_a_stretch_before_its_announced_earliest(
+        seed in 0u64..1_000_000,
+        n in 2usize..=4,
+        holds in any::<bool>(),
+        switch in prop_oneof![Just(0.0), Just(3.0)],
+    ) {
+        let (checked, _) = rounds_case(seed, n, holds, switch);
+        prop_assert!(checked > 0, "no announcement checked");
+    }
+
+    #[test]
+    fn a_cell_never_starts_a_stretch_before_its_announced_earliest(
+        seed in 0u64..1_000_000,
+        n in 2usize..=4,
+        switch in prop_oneof![Just(0.0), Just(3.0)],
+    ) {
+        let (checked, _) = cell_case(seed, n, switch);
+        prop_assert!(checked > 0, "no announcement checked");
+    }
+}
+
+/// Not vacuous: over fixed seeds the latest is bounded in many announcements, in both cells.
+#[test]
+fn announcements_are_checked_and_latest_is_often_bounded() {
+    let (mut rk, mut rb, mut ck, mut cb) = (0, 0, 0, 0);
+    for seed in 0..8 {
+        let (k, b) = rounds_case(seed, 2 + (seed as usize % 3), seed % 2 == 0, 0.0);
+        rk += k;
+        rb += b;
+        let (k, b) = cell_case(seed, 2 + (seed as usize % 3), 2.0);
+        ck += k;
+        cb += b;
+    }
+    eprintln!("rounds: {rk} announcements checked, {rb} bounded; cell: {ck}, {cb}");
+    assert!(rb * 20 >= rk && rb > 0, "rounds: {rb} of {rk} bounded");
+    assert!(cb * 20 >= ck && cb > 0, "cell: {cb} of {ck} bounded");
+}
+
+/// By hand: [HC, LC, HC] of 1 s, ψ̇ = 1, bounds [½, 2] (F = 2, S = ½), tick ½ s, two robots
+/// of a continuous cell, robot 0's stretch first, a switch time of 1 s. On high confidence a
+/// cell's robot runs on plan (½ s of clock a tick), so robot 0's stretch at 1 s of clock is
+/// reported by its 2nd tick, which starts ½ s from now, whatever the operator does.
+#[test]
+fn the_first_announcement_by_hand() {
+    let task = Timeline::new(
+        &[true, false, true],
+        &[1.0; 3],
+        &[0.5; 3],
+        &[2.0; 3],
+        0.0,
+        1.0,
+    )
+    .unwrap();
+    let mut cell = ContinuousCoordinator::new(task.clone(), &[], &[(0, 0), (1, 0)], 2, 0.5)
+        .unwrap()
+        .with_switch_s(1.0)
+        .unwrap();
+    // Before any tick: robot 0 holds the token at clock 0, its stretch at 1 s of clock (HC
+    // runs on plan: 2 ticks; the 2nd reports it, starting ½ s from now).
+    let a = cell.pre_alert().unwrap();
+    assert_eq!(a.robot, 0);
+    assert_eq!(a.earliest_s, 0.5);
+    assert_eq!(a.latest_s, 0.5);
+    let t = cell.tick(Operator::Scheduled).unwrap();
+    assert!(!t.low_conf[0]);
+    let a = t.next.unwrap();
+    assert_eq!((a.robot, a.earliest_s, a.latest_s), (0, 0.0, 0.0));
+    // Robot 0 in its stretch: the next is robot 1's, waiting for the token: unbounded.
+    let t = cell.tick(Operator::Slowest).unwrap();
+    assert!(t.low_conf[0]);
+    let a = t.next.unwrap();
+    assert_eq!(a.robot, 1);
+    assert!(a.latest_s.is_infinite());
+}
