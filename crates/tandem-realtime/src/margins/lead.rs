@@ -585,7 +585,16 @@ fn pass(
                     super::SwitchRoom {
                         ticks: legs.switch_ticks,
                         step_p: max_step_of[p],
-                        step_c: max_step_of[c],
+                        step_p_after: super::step_within(
+                            &robots[p],
+                            max_step_of[p],
+                            prev.ref_end..robots[p].n_ref(),
+                        ),
+                        step_c_before: super::step_within(
+                            &robots[c],
+                            max_step_of[c],
+                            0..c_iv.ref_start,
+                        ),
                     },
                     u_max,
                     (tau_c, end_p),

@@ -545,7 +545,16 @@ impl<'a> RoleSim<'a> {
                 super::SwitchRoom {
                     ticks: k,
                     step_p,
-                    step_c,
+                    step_p_after: super::step_within(
+                        self.sides[0].tl,
+                        step_p,
+                        pair.prev.ref_end..self.sides[0].tl.n_ref(),
+                    ),
+                    step_c_before: super::step_within(
+                        self.sides[1].tl,
+                        step_c,
+                        0..pair.cur.ref_start,
+                    ),
                 },
                 (pair.t_p_end() + setup.eps).min(end_p),
                 (self.sides[1].tl.start_s(), end_p),
