@@ -360,6 +360,12 @@ fn incumbent(
     if found.as_ref().is_none_or(|inc| serial_t < inc.1) {
         match validate_with_switch(problem, serial, switch_s) {
             Ok(()) => found = Some((serial.clone(), serial_t, Source::Serial)),
+            // With a switch time a task can have schedules but no serial one (a robot that
+            // ends low-confidence leaves the next no time to switch): no incumbent, `T_total`
+            // +∞, and the scheduler reports the serial schedule's violation if nothing passes.
+            Err(_) if found.is_none() && switch_s > 0.0 => {
+                found = Some((serial.clone(), f64::INFINITY, Source::Serial));
+            }
             Err(v) if found.is_none() => return Err(v),
             Err(_) => {}
         }
@@ -684,10 +690,16 @@ fn schedule_n(
     // load cap `u_max` (1: none). `δ = 0` and `u_max = 1` run today's float operations.
     let (sw, u_max) = (params.switch_s, params.max_busy_share);
     let fastest_serial = problem.serial_schedule_n(n_robots, tick_s)?;
-    let serial = if sw > 0.0 {
-        operator::serial_with_switch(problem, n_robots, tick_s, sw)?
+    // With a switch time the serial fallback may fail (why, of its slowed form, kept for the
+    // error if nothing else passes either).
+    let (serial, serial_why) = if sw > 0.0 {
+        match operator::serial_with_switch(problem, n_robots, tick_s, sw) {
+            Ok(s) => (s, None),
+            Err(Error::NoFeasibleSchedule { serial }) => (fastest_serial.clone(), Some(serial)),
+            Err(e) => return Err(e),
+        }
     } else {
-        fastest_serial.clone()
+        (fastest_serial.clone(), None)
     };
     let (incumbent, previous_fate) = match incumbent(problem, &serial, previous, tick_s, sw) {
         Ok(inc) => inc,
@@ -764,7 +776,7 @@ fn schedule_n(
     // so the least `T_total` before it need not be the least after it.
     let capping = u_max < 1.0;
     let mut pool: Vec<Candidate> = Vec::new();
-    if capping {
+    if capping && incumbent.1 < f64::INFINITY {
         pool.push(incumbent.clone());
         if incumbent.2 != Source::Serial
             && let Ok(()) = validate_with_switch(problem, &serial, sw)
@@ -872,6 +884,14 @@ fn schedule_n(
         }
     }
     stats.completion_margin_checks = checks;
+    if best.1 == f64::INFINITY {
+        // No incumbent (the serial schedule fails with the switch time) and nothing passed.
+        let why = serial_why.unwrap_or_else(|| {
+            validate_with_switch(problem, &serial, sw)
+                .expect_err("a valid serial schedule is the incumbent, of finite T_total")
+        });
+        return Err(Error::NoFeasibleSchedule { serial: why });
+    }
     // The load cap: every kept candidate lengthened to its share ([`operator::capped`]), the
     // least `T_total` winning (ties to the earlier kept).
     if capping {
