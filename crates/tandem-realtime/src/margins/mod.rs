@@ -620,6 +620,18 @@ pub(super) fn step_within(tl: &Timeline, max_step: f64, range: std::ops::Range<u
     (max_step * (within / all) * (1.0 + 1e-12)).min(max_step)
 }
 
+/// The switch time's room (schedule-clock s) that `c` may cover in the `k ≥ 1` ticks after
+/// `p`'s exit tick, given that `c` is at most at `y0_s` when the exit tick ends: at most one
+/// tick of its largest step `M_c` (the tick that may start below `y0`), then `k − 1` ticks
+/// that start at or after `y0` and, while `c` is short of its region `C`, traverse only
+/// samples in `[sample_at(y0), C)`: `M_c + (k − 1)·M_c'` with `M_c' = step_of_rest`, `c`'s
+/// largest step over those samples ([`step_within`]), `≤ M_c`. Below `k·M_c`, which charged
+/// every tick the largest step over all samples (docs/decisions.md, "Rounds schedules with the
+/// switch time and the load cap (issue 41)").
+pub(super) fn switch_room_after_s(switch_ticks: u64, max_step_c: f64, step_of_rest: f64) -> f64 {
+    max_step_c + (switch_ticks - 1) as f64 * step_of_rest
+}
+
 /// The room (schedule-clock s, `> 0` when safe) of a pair whose previous robot `p` left its
 /// region before the current robot `c` started, under the switch time: `p`'s exit tick starts
 /// with `p` below `u_max_s`, and `c` starts at `τ_c` (`tau_c_s`) only at a tick start at which
