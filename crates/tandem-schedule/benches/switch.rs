@@ -6,7 +6,10 @@
 //! switch gaps and the margin check with the switch time). It prints the bounds for
 //! `δ ∈ {0, 0.5, 2, 7}` s and `N = 2, 3, 4` (docs/decisions.md, "The switch time in the
 //! scheduler's bounds (issue 41)"), and the continuous cell's plan with the switch time and
-//! the load cap. `cargo bench -p tandem-schedule --bench switch` re-measures.
+//! the load cap; the rounds scheduler's `T_total` with the switch time and the load cap
+//! against its bound, and a re-schedule with against without `δ = 2` s (docs/decisions.md,
+//! "Rounds schedules with the switch time and the load cap (issue 41)").
+//! `cargo bench -p tandem-schedule --bench switch` re-measures.
 #![allow(
     clippy::print_stdout,
     reason = "a bench reports its problem and bounds"
@@ -21,8 +24,8 @@ mod fixture;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use tandem_schedule::{
-    CyclicParams, ExactParams, SamplerParams, cyclic_plan, margin_free_bound, sample_schedule,
-    validate_with_switch,
+    CyclicParams, ExactParams, SamplerParams, busy_share, cyclic_plan, margin_free_bound,
+    sample_schedule, sample_schedule_n, validate_with_switch,
 };
 
 fn bench(c: &mut Criterion) {
@@ -73,6 +76,39 @@ fn bench(c: &mut Criterion) {
             validate_with_switch(&problem, &out.schedule, switch_s).map_err(|v| v.to_string())
         );
     }
+    // The rounds scheduler with the switch time and the load cap (docs/decisions.md, "Rounds
+    // schedules with the switch time and the load cap (issue 41)"): T_total against the
+    // certificate's δ-bound, its source and the operator's busy share.
+    for n in [2usize, 3] {
+        for (switch_s, cap) in [
+            (0.0, 1.0),
+            (0.5, 1.0),
+            (2.0, 1.0),
+            (7.0, 1.0),
+            (0.0, 0.7),
+            (2.0, 0.7),
+        ] {
+            let params = SamplerParams {
+                switch_s,
+                max_busy_share: cap,
+                ..scheduler.clone()
+            };
+            match sample_schedule_n(&problem, n, &params, None) {
+                Ok(o) => println!(
+                    "  rounds N = {n}, δ = {switch_s} s, u_max = {cap}: T_total {:.3} s ({}), \
+                     bound {:.3} s (proven {}), gap {:.2} %, busy share {:.3}, valid with δ: {}",
+                    o.t_total_s,
+                    o.source.name(),
+                    o.lower_bound_s,
+                    o.bound_is_optimum,
+                    100.0 * o.gap,
+                    busy_share(&o.schedule, &problem, switch_s).expect("laid out"),
+                    validate_with_switch(&problem, &o.schedule, switch_s).is_ok()
+                ),
+                Err(e) => println!("  rounds N = {n}, δ = {switch_s} s, u_max = {cap}: {e}"),
+            }
+        }
+    }
     let mut g = c.benchmark_group("switch");
     g.sample_size(20);
     for n in [2usize, 4] {
@@ -83,6 +119,19 @@ fn bench(c: &mut Criterion) {
                 |b, &d| b.iter(|| margin_free_bound(&problem, n, &exact, d)),
             );
         }
+    }
+    // A re-schedule (5000 samples, the exact search and the completion beside them) with
+    // against without δ = 2 s, same run.
+    for switch_s in [0.0, 2.0] {
+        let params = SamplerParams {
+            switch_s,
+            ..scheduler.clone()
+        };
+        g.bench_with_input(
+            BenchmarkId::new("reschedule_2", switch_s),
+            &params,
+            |b, params| b.iter(|| sample_schedule_n(&problem, 2, params, None)),
+        );
     }
     for switch_s in [0.0, 2.0] {
         g.bench_with_input(

@@ -21,7 +21,7 @@
 //!
 //! For `N` robots ([`sample_schedule_n`]) the bound, the completion and the candidates are one
 //! row of `STRATEGIES` per robot count (`N = 1`, `2`, `≥ 3`): for `N ≥ 3` the bound of
-//! `exact::bound_many` and the staggered candidate (`stagger.rs`) in every re-schedule, no
+//! `exact::bound_many_switch` and the staggered candidate (`stagger.rs`) in every re-schedule, no
 //! margin-aware completion.
 //!
 //! Every candidate is checked with [`crate::validate`] at the tick before it can win. The
@@ -32,12 +32,13 @@ use serde::{Deserialize, Serialize};
 use tandem_realtime::{clock_end_s, tol};
 
 use crate::exact;
+use crate::operator;
 use crate::problem::{Problem, check_robot_count};
 use crate::retime::retime;
 use crate::sampler::{self, SamplerBaselines, SamplerParams, SamplerStats};
 use crate::schedule::Schedule;
 use crate::stagger;
-use crate::validate::{Violation, validate};
+use crate::validate::{Violation, validate_with_switch};
 use crate::{Error, Result};
 
 /// Where the returned schedule came from.
@@ -326,6 +327,7 @@ fn incumbent(
     serial: &Schedule,
     previous: Option<&Schedule>,
     tick_s: f64,
+    switch_s: f64,
 ) -> std::result::Result<(Candidate, PreviousFate), Violation> {
     let dt_s = problem.dt_s();
     let mut found: Option<Candidate> = None;
@@ -338,14 +340,14 @@ fn incumbent(
             tick_s,
             ..prev.clone()
         };
-        match validate(problem, &prev) {
+        match validate_with_switch(problem, &prev, switch_s) {
             Ok(()) => {
                 let t = prev.t_total_s(dt_s);
                 fate = PreviousFate::Valid { t_total_s: t };
                 found = Some((prev, t, Source::Previous));
             }
             Err(why) => {
-                let (best, retimed_why) = repaired(problem, &prev, tick_s);
+                let (best, retimed_why) = repaired(problem, &prev, tick_s, switch_s);
                 fate = match &best {
                     Some((_, t)) => PreviousFate::Repaired { why, t_total_s: *t },
                     None => PreviousFate::Invalid { why, retimed_why },
@@ -356,8 +358,14 @@ fn incumbent(
     }
     let serial_t = serial.t_total_s(dt_s);
     if found.as_ref().is_none_or(|inc| serial_t < inc.1) {
-        match validate(problem, serial) {
+        match validate_with_switch(problem, serial, switch_s) {
             Ok(()) => found = Some((serial.clone(), serial_t, Source::Serial)),
+            // With a switch time a task can have schedules but no serial one (a robot that
+            // ends low-confidence leaves the next no time to switch): no incumbent, `T_total`
+            // +∞, and the scheduler reports the serial schedule's violation if nothing passes.
+            Err(_) if found.is_none() && switch_s > 0.0 => {
+                found = Some((serial.clone(), f64::INFINITY, Source::Serial));
+            }
             Err(v) if found.is_none() => return Err(v),
             Err(_) => {}
         }
@@ -378,6 +386,7 @@ fn repaired(
     problem: &Problem,
     prev: &Schedule,
     tick_s: f64,
+    switch_s: f64,
 ) -> (Option<(Schedule, f64)>, Option<Violation>) {
     let dt_s = problem.dt_s();
     let step_s = max_step_s(problem, tick_s);
@@ -427,7 +436,7 @@ fn repaired(
         if best.as_ref().is_some_and(|b| b.1 <= t) {
             continue;
         }
-        match validate(problem, &s) {
+        match validate_with_switch(problem, &s, switch_s) {
             Ok(()) => best = Some((s, t)),
             Err(v) if q == 0 && retimed => first_why = Some(v),
             Err(_) => {}
@@ -455,6 +464,7 @@ fn cleared_optimum(
     held: &Schedule,
     tick_s: f64,
     cap_s: f64,
+    switch_s: f64,
 ) -> (Option<(Schedule, f64)>, usize) {
     let dt_s = problem.dt_s();
     let step_s = max_step_s(problem, tick_s);
@@ -476,7 +486,7 @@ fn cleared_optimum(
                 continue;
             }
             checks += 1;
-            if validate(problem, &s).is_ok() {
+            if validate_with_switch(problem, &s, switch_s).is_ok() {
                 return (Some((s, t)), checks);
             }
         }
@@ -612,9 +622,9 @@ pub(crate) struct Strategies {
 pub(crate) enum BoundBy {
     /// One robot: its fastest execution, the optimum itself ([`exact::operator_bound`]).
     Fastest,
-    /// Two robots: the exact margin-free optimum `T*₀` ([`exact::bound`]).
+    /// Two robots: the exact margin-free optimum `T*₀` ([`exact::bound_switch`], with `δ`).
     Pair,
-    /// `N ≥ 3` robots: the maximum of the `k`-robot bounds ([`exact::bound_many`]).
+    /// `N ≥ 3` robots: the maximum of the `k`-robot bounds ([`exact::bound_many_switch`], with `δ`).
     Many,
 }
 
@@ -676,8 +686,22 @@ fn schedule_n(
         });
     }
     let tick_s = params.tick_s.unwrap_or(problem.dt_s());
-    let serial = problem.serial_schedule_n(n_robots, tick_s)?;
-    let (incumbent, previous_fate) = match incumbent(problem, &serial, previous, tick_s) {
+    // The operator (issue 41): the switch time `δ` every candidate is checked with, and the
+    // load cap `u_max` (1: none). `δ = 0` and `u_max = 1` run today's float operations.
+    let (sw, u_max) = (params.switch_s, params.max_busy_share);
+    let fastest_serial = problem.serial_schedule_n(n_robots, tick_s)?;
+    // With a switch time the serial fallback may fail (why, of its slowed form, kept for the
+    // error if nothing else passes either).
+    let (serial, serial_why) = if sw > 0.0 {
+        match operator::serial_with_switch(problem, n_robots, tick_s, sw) {
+            Ok(s) => (s, None),
+            Err(Error::NoFeasibleSchedule { serial }) => (fastest_serial.clone(), Some(serial)),
+            Err(e) => return Err(e),
+        }
+    } else {
+        (fastest_serial.clone(), None)
+    };
+    let (incumbent, previous_fate) = match incumbent(problem, &serial, previous, tick_s, sw) {
         Ok(inc) => inc,
         Err(serial) => return Err(Error::NoFeasibleSchedule { serial }),
     };
@@ -716,14 +740,23 @@ fn schedule_n(
                 (None, 0),
             ),
             BoundBy::Many => (
-                exact::bound_many(problem, n_robots, &params.exact),
+                exact::bound_many_switch(problem, n_robots, &params.exact, sw),
                 (None, 0),
                 (None, 0),
             ),
             BoundBy::Pair => {
-                let bound = exact::bound(problem, &params.exact);
+                let bound = exact::bound_switch(problem, &params.exact, sw);
                 let done = if pair && bound.lower_bound_s < cap_s {
-                    exact::completion(problem, &params.exact, tick_s, cap_s, budget, true, &warm)
+                    exact::completion(
+                        problem,
+                        &params.exact,
+                        tick_s,
+                        cap_s,
+                        budget,
+                        true,
+                        &warm,
+                        sw,
+                    )
                 } else {
                     (None, 0)
                 };
@@ -731,7 +764,7 @@ fn schedule_n(
                 // the switches into a run with a hold, their waits planned as dwells.
                 let cap = done.0.as_ref().map_or(cap_s, |d| d.t_total_s.min(cap_s));
                 let held = if pair && bound.lower_bound_s < cap {
-                    exact::held_completion(problem, &params.exact, tick_s, cap, budget)
+                    exact::held_completion(problem, &params.exact, tick_s, cap, budget, sw)
                 } else {
                     (None, 0)
                 };
@@ -739,6 +772,22 @@ fn schedule_n(
             }
         },
     );
+    // With a load cap every valid candidate is kept: the cap lengthens each by its own switches,
+    // so the least `T_total` before it need not be the least after it.
+    let capping = u_max < 1.0;
+    let mut pool: Vec<Candidate> = Vec::new();
+    if capping && incumbent.1 < f64::INFINITY {
+        pool.push(incumbent.clone());
+        if incumbent.2 != Source::Serial
+            && let Ok(()) = validate_with_switch(problem, &serial, sw)
+        {
+            pool.push((
+                serial.clone(),
+                serial.t_total_s(problem.dt_s()),
+                Source::Serial,
+            ));
+        }
+    }
     let mut best = incumbent;
     let mut completed = done.map(|d| (d.schedule, d.t_total_s));
     if let Some((s, t, k)) = winner
@@ -755,26 +804,36 @@ fn schedule_n(
                 refine_budget,
                 false,
                 &[&s],
+                sw,
             );
             checks += more;
             if let Some(b) = better {
                 completed = Some((b.schedule, b.t_total_s));
             }
         }
+        if capping {
+            pool.push((s.clone(), t, Source::Sampled { candidate: k }));
+        }
         best = (s, t, Source::Sampled { candidate: k });
     }
     stats.search = bound.stats;
     if let Some((schedule, t)) = completed
         && t < best.1
-        && validate(problem, &schedule).is_ok()
+        && validate_with_switch(problem, &schedule, sw).is_ok()
     {
+        if capping {
+            pool.push((schedule.clone(), t, Source::Completed));
+        }
         best = (schedule, t, Source::Completed);
     }
     checks += held_done.1;
     if let Some(h) = held_done.0
         && h.t_total_s < best.1
-        && validate(problem, &h.schedule).is_ok()
+        && validate_with_switch(problem, &h.schedule, sw).is_ok()
     {
+        if capping {
+            pool.push((h.schedule.clone(), h.t_total_s, Source::Held));
+        }
         best = (h.schedule, h.t_total_s, Source::Held);
     }
     // With hold points, the margin-free optimum itself with release rules (for `N ≥ 3` the
@@ -789,14 +848,20 @@ fn schedule_n(
         if let Ok(held) = problem.with_release_rules(&timed) {
             let t = held.t_total_s(problem.dt_s());
             if t < best.1 {
-                if validate(problem, &held).is_ok() {
+                if validate_with_switch(problem, &held, sw).is_ok() {
+                    if capping {
+                        pool.push((held.clone(), t, Source::Held));
+                    }
                     best = (held, t, Source::Held);
                 } else if plan.bound == BoundBy::Many {
                     // N ≥ 3: the optimum re-timed with growing clearances, its rules
                     // re-derived (docs/decisions.md, "The stuck incumbent").
-                    let (cleared, used) = cleared_optimum(problem, &held, tick_s, best.1);
+                    let (cleared, used) = cleared_optimum(problem, &held, tick_s, best.1, sw);
                     checks += used;
                     if let Some((s, t)) = cleared {
+                        if capping {
+                            pool.push((s.clone(), t, Source::Held));
+                        }
                         best = (s, t, Source::Held);
                     }
                 }
@@ -808,28 +873,65 @@ fn schedule_n(
     // schedule, and a schedule with holds that overlapped the robots hid a shorter staggered
     // one without holds (docs/decisions.md, "An N-robot margin-aware completion").
     if plan.staggered
-        && let Some((schedule, t, used)) = stagger::staggered(problem, &serial)
+        && let Some((schedule, t, used)) = stagger::staggered(problem, &fastest_serial, sw)
     {
         checks += used;
+        if capping {
+            pool.push((schedule.clone(), t, Source::Staggered));
+        }
         if t < best.1 {
             best = (schedule, t, Source::Staggered);
         }
     }
     stats.completion_margin_checks = checks;
+    if best.1 == f64::INFINITY {
+        // No incumbent (the serial schedule fails with the switch time) and nothing passed.
+        let why = serial_why.unwrap_or_else(|| {
+            validate_with_switch(problem, &serial, sw)
+                .expect_err("a valid serial schedule is the incumbent, of finite T_total")
+        });
+        return Err(Error::NoFeasibleSchedule { serial: why });
+    }
+    // The load cap: every kept candidate lengthened to its share ([`operator::capped`]), the
+    // least `T_total` winning (ties to the earlier kept).
+    if capping {
+        best = pool
+            .iter()
+            .filter_map(|(s, _, src)| {
+                operator::capped(problem, s, sw, u_max).map(|(s, t)| (s, t, *src))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .ok_or(Error::BusyShareUnreachable {
+                max_busy_share: u_max,
+                switch_s: sw,
+            })?;
+    }
     let (schedule, t_total_s, source) = best;
     let margin_free_s = bound
         .schedule
         .as_ref()
         .map_or(t_total_s, |s| s.t_total_s(problem.dt_s()).min(t_total_s))
         .max(bound.lower_bound_s.min(t_total_s));
-    let (lower_bound_s, gap) = certificate(bound.lower_bound_s, t_total_s)?;
+    // With a load cap the bound is at least the cap's (`operator::cap_bound_s`); it is then
+    // no longer the margin-free optimum when the cap's is above it.
+    let (bound_s, bound_is_optimum) = if capping {
+        let cap_s = operator::cap_bound_s(problem, n_robots, sw, u_max);
+        if cap_s > bound.lower_bound_s {
+            (cap_s, false)
+        } else {
+            (bound.lower_bound_s, bound.proven_optimal)
+        }
+    } else {
+        (bound.lower_bound_s, bound.proven_optimal)
+    };
+    let (lower_bound_s, gap) = certificate(bound_s, t_total_s)?;
     Ok(Outcome {
         schedule,
         t_total_s,
         source,
         stats,
         lower_bound_s,
-        bound_is_optimum: bound.proven_optimal,
+        bound_is_optimum,
         gap,
         margin_free_s: Some(margin_free_s),
         previous: previous_fate,

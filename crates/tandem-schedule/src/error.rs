@@ -63,6 +63,18 @@ pub enum Error {
         /// Why the serial schedule failed.
         serial: Violation,
     },
+    /// No schedule the scheduler found keeps the operator's load cap
+    /// ([`crate::SamplerParams::max_busy_share`]): none could be made long enough for its busy
+    /// share ([`crate::busy_share`]) by slowing a robot's high-confidence tail.
+    #[error(
+        "no schedule keeps the operator's busy share at or below max_busy_share = {max_busy_share} (switch time {switch_s} s): no robot's high-confidence tail can be slowed enough; raise max_busy_share (to 1 for no cap) or lower switch_s"
+    )]
+    BusyShareUnreachable {
+        /// The cap `u_max`.
+        max_busy_share: f64,
+        /// The switch time `δ` (s).
+        switch_s: f64,
+    },
     /// The schedule does not have `1 ≤ N ≤ MAX_ROBOTS` warps and `N − 1` start offsets
     /// ([`crate::Schedule::check_shape`]).
     #[error("schedule of the wrong shape: {0}")]

@@ -58,6 +58,7 @@ mod choose;
 pub mod cyclic;
 mod error;
 pub mod exact;
+mod operator;
 mod problem;
 mod retime;
 mod sampler;
@@ -82,6 +83,7 @@ pub use exact::{
     ExactParams, MarginFree, SearchStats, earliest_schedule, margin_free_bound, operator_bound_s,
     operator_bound_with_switch_s, solve_exact, solve_exact_with_switch,
 };
+pub use operator::busy_share;
 pub use problem::Problem;
 pub use sampler::{DrawnOffset, SamplerBaselines, SamplerParams, SamplerStats};
 pub use schedule::{GlobalTimeline, LcOverlap, Schedule};

@@ -16,7 +16,7 @@
 //!
 //! (docs/decisions.md, "N robots in the margin-free search".)
 
-use crate::{Problem, Schedule, validate};
+use crate::{Problem, Schedule, validate_with_switch};
 
 /// Full checks (`validate` of the robots placed so far) one staggered schedule may use in all,
 /// the equal spacing first, then the greedy placement's robots in turn; past it a robot starts
@@ -42,8 +42,14 @@ const LADDER_STEPS: usize = 64;
 /// and some robot overlaps the one before it (else it is the serial schedule, which the
 /// scheduler has already), with its `T_total` (s) and the checks used. `None` also for a
 /// problem without low-confidence samples (every robot at 0 is then the optimum, which the
-/// sampler finds).
-pub(crate) fn staggered(problem: &Problem, serial: &Schedule) -> Option<(Schedule, f64, usize)> {
+/// sampler finds). With the operator's switch time `switch_s` (s, ≥ 0; 0: none, the same
+/// float operations) every check is [`validate_with_switch`] and the greedy clearance starts
+/// at `δ` instead of 0 (a robot's run aligned to the end of another's needs at least `δ`).
+pub(crate) fn staggered(
+    problem: &Problem,
+    serial: &Schedule,
+    switch_s: f64,
+) -> Option<(Schedule, f64, usize)> {
     let dt_s = problem.dt_s();
     let (n_robots, tick_s) = (serial.n_robots(), serial.tick_s);
     let warp = serial.grad_exec[0].clone();
@@ -92,7 +98,7 @@ pub(crate) fn staggered(problem: &Problem, serial: &Schedule) -> Option<(Schedul
         }
         checked.offsets_s.clear();
         checked.offsets_s.extend_from_slice(offsets);
-        validate(problem, &checked).is_ok()
+        validate_with_switch(problem, &checked, switch_s).is_ok()
     };
     // Equal spacing `τ_i = i·s`, the least `s` on a grid of `duration/SPACING_STEPS` that
     // passes, bisected down to a tick: a joint placement, for when the greedy one leaves a
@@ -153,7 +159,7 @@ pub(crate) fn staggered(problem: &Problem, serial: &Schedule) -> Option<(Schedul
             }
             // The first clearance that passes: 0, then the ladder from one tick.
             let mut lo: Option<f64> = None;
-            let mut c = 0.0;
+            let mut c = switch_s;
             let mut hi = None;
             for j in 0..=LADDER_STEPS {
                 if best.is_some_and(|b| o + c >= b) || checks >= MAX_STAGGER_CHECKS {
@@ -164,7 +170,11 @@ pub(crate) fn staggered(problem: &Problem, serial: &Schedule) -> Option<(Schedul
                     break;
                 }
                 lo = Some(c);
-                c = tick_s * f64::powf(2.0, j as f64 / 4.0);
+                c = if switch_s > 0.0 {
+                    switch_s + tick_s * f64::powf(2.0, j as f64 / 4.0)
+                } else {
+                    tick_s * f64::powf(2.0, j as f64 / 4.0)
+                };
             }
             let Some(mut hi) = hi else { continue };
             // Bisect between the last failing clearance and the passing one, to a tick or an

@@ -111,15 +111,21 @@ fn validation_with_a_switch_time_by_hand() {
         Err(Violation::SwitchTooShort { robots: [0, 1], .. })
     ));
     // The margin check (M = 0.02 s for both: F = 2 on the LC samples): robot 2 starts at least
-    // e = ⌊(0.3 − 0.2 − ε)/0.02⌋ = 4 ticks after robot 1's exit tick. δ = 0.05 s, k = 5: robot
-    // 2 runs at most 5 + 1 − 4 = 2 ticks of them, 0.3 + 0.04 < 0.4. δ = 0.15 s, k = 15: 12
-    // ticks, 0.3 + 0.24 ≥ 0.4, rejected though the schedule keeps 0.2 s.
+    // e = ⌊(0.3 − 0.2 − ε)/0.02⌋ = 4 ticks after robot 1's exit tick; with the steps of the
+    // samples robot 1 runs after its run (F = 1, 0.01 s), at least 1 + ⌊(0.1 − ε − 0.02)/0.01⌋
+    // = 8 (the exit tick, then 0.01 s per tick); and robot 2 moves 0.01 s per tick before its
+    // run. δ = 0.05 s, k = 5: robot 2 does not run in them. δ = 0.15 s, k = 15: 15 + 1 − 8 = 8
+    // ticks, 0.3 + 0.08 < 0.4. δ = 0.18 s, k = 18: 11 ticks, 0.3 + 0.11 ≥ 0.4, rejected
+    // though the schedule keeps 0.2 s (the exit tick is charged `M`, and its phase is unknown).
+    // (With the largest step over all samples, before the tighter steps, 0.15 s was rejected:
+    // 15 + 1 − 4 = 12 ticks of 0.02 s.)
     assert!(validate_with_switch(&p, &serial, 0.05).is_ok());
+    assert!(validate_with_switch(&p, &serial, 0.15).is_ok());
     assert_eq!(
-        validate_with_switch(&p, &serial, 0.15),
+        validate_with_switch(&p, &serial, 0.18),
         Err(Violation::InsufficientSwitchTime {
             tick_s: 0.01,
-            switch_s: 0.15
+            switch_s: 0.18
         })
     );
     assert!(matches!(

@@ -595,13 +595,35 @@ fn pass(
                     super::SwitchRoom {
                         ticks: legs.switch_ticks,
                         step_p: max_step_of[p],
-                        step_c: max_step_of[c],
+                        step_p_after: super::step_within(
+                            &robots[p],
+                            max_step_of[p],
+                            prev.ref_end..robots[p].n_ref(),
+                        ),
+                        step_c_before: super::step_within(
+                            &robots[c],
+                            max_step_of[c],
+                            0..c_iv.ref_start,
+                        ),
                     },
                     u_max,
                     (tau_c, end_p),
                     c_iv.start_s - eps,
                 ),
-                Some(x) => (c_iv.start_s - eps) - ((lead.reach_below(u_max) + max_step_of[c]) + x),
+                // `c` is at most at `y0 = reach + M_c` when the exit tick ends; the room of the
+                // `k` ticks after it, `M_c + (k − 1)·M_c'` over its samples from `y0` to `C`
+                // (`switch_room_after_s`), at most `x = k·M_c`.
+                Some(x) => {
+                    let y0 = lead.reach_below(u_max) + max_step_of[c];
+                    let rest = super::step_within(
+                        &robots[c],
+                        max_step_of[c],
+                        robots[c].sample_at(y0)..c_iv.ref_start,
+                    );
+                    let room =
+                        super::switch_room_after_s(legs.switch_ticks, max_step_of[c], rest).min(x);
+                    (c_iv.start_s - eps) - (y0 + room)
+                }
             };
             if let Some((_, first)) = prior {
                 // The same pair in the same place of the same order.

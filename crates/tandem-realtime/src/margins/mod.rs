@@ -608,8 +608,36 @@ pub(super) struct SwitchRoom {
     pub(super) ticks: u64,
     /// `M_p`.
     pub(super) step_p: f64,
-    /// `M_c`.
-    pub(super) step_c: f64,
+    /// `p`'s largest step over its samples after its region `P` ([`step_within`]), `≤ M_p`.
+    pub(super) step_p_after: f64,
+    /// `c`'s largest step over its samples before its region `C` ([`step_within`]), `≤ M_c`.
+    pub(super) step_c_before: f64,
+}
+
+/// The largest step (schedule-clock s) of robot `tl` in one tick while it traverses only the
+/// samples `range`: its largest step over all samples, `max_step = h·max(1, max_n F_n)`,
+/// scaled by `max(1, max_{n ∈ range} F_n)/max(1, max_n F_n) ≤ 1` and raised by `1e-12`
+/// relative (so the quotient's rounding can only make it larger than `h·max(1, max_range F)`).
+/// A robot whose clock stays inside the samples `range` during a tick moves at most this.
+pub(super) fn step_within(tl: &Timeline, max_step: f64, range: std::ops::Range<usize>) -> f64 {
+    let all = tl.max_rate_fast();
+    let within = range
+        .filter(|&n| n < tl.n_ref())
+        .map(|n| tl.rate_fast(n))
+        .fold(1.0, f64::max);
+    (max_step * (within / all) * (1.0 + 1e-12)).min(max_step)
+}
+
+/// The switch time's room (schedule-clock s) that `c` may cover in the `k ≥ 1` ticks after
+/// `p`'s exit tick, given that `c` is at most at `y0_s` when the exit tick ends: at most one
+/// tick of its largest step `M_c` (the tick that may start below `y0`), then `k − 1` ticks
+/// that start at or after `y0` and, while `c` is short of its region `C`, traverse only
+/// samples in `[sample_at(y0), C)`: `M_c + (k − 1)·M_c'` with `M_c' = step_of_rest`, `c`'s
+/// largest step over those samples ([`step_within`]), `≤ M_c`. Below `k·M_c`, which charged
+/// every tick the largest step over all samples (docs/decisions.md, "Rounds schedules with the
+/// switch time and the load cap (issue 41)").
+pub(super) fn switch_room_after_s(switch_ticks: u64, max_step_c: f64, step_of_rest: f64) -> f64 {
+    max_step_c + (switch_ticks - 1) as f64 * step_of_rest
 }
 
 /// The room (schedule-clock s, `> 0` when safe) of a pair whose previous robot `p` left its
@@ -621,20 +649,29 @@ pub(super) struct SwitchRoom {
 /// region at `t_c_lim_s = T_c − ε` when `τ_c + (k + 1 − max(e, 1))·M_c < T_c − ε`; `+∞` when it
 /// does not run at all in them. `e` rounds down: a floor of a quotient off by an ulp is still
 /// at most the true count.
+///
+/// Tighter steps (docs/decisions.md, "Rounds schedules with the switch time and the load cap
+/// (issue 41)"): after its exit tick `p` is past `P` (a robot never moves backwards), so every
+/// later tick moves it at most `M_p' = step_p_after`, its largest step over the samples after
+/// `P`; the exit tick ends with `p` at most at `u_max + M_p`; so also `e ≥ 1 + ⌊(min(τ_c, end_p)
+/// − u_max − M_p)/M_p'⌋`, and the larger count holds. And `c`, from `τ_c` until it reaches
+/// `T_c − ε`, traverses only samples before `C`: while `τ_c + j·M_c' < T_c − ε` with `M_c' =
+/// step_c_before` its largest step over them, `c` has not reached `C` after `j` ticks (by
+/// induction: each tick starts and, moving at most `M_c'`, ends before `T_c − ε`).
 pub(super) fn started_after_exit_slack(
     room: SwitchRoom,
     u_max_s: f64,
     (tau_c_s, end_p_s): (f64, f64),
     t_c_lim_s: f64,
 ) -> f64 {
-    let elapsed = ((tau_c_s.min(end_p_s) - u_max_s) / room.step_p)
-        .floor()
-        .max(1.0);
+    let reach_s = tau_c_s.min(end_p_s) - u_max_s;
+    let after_exit = 1.0 + ((reach_s - room.step_p) / room.step_p_after).floor();
+    let elapsed = (reach_s / room.step_p).floor().max(after_exit).max(1.0);
     let k = room.ticks as f64;
     if elapsed > k {
         f64::INFINITY
     } else {
-        t_c_lim_s - (tau_c_s + (k + 1.0 - elapsed) * room.step_c)
+        t_c_lim_s - (tau_c_s + (k + 1.0 - elapsed) * room.step_c_before)
     }
 }
 

@@ -303,6 +303,11 @@ struct RoleSim<'a> {
     switch_extra_s: Option<f64>,
     /// `(k, M_p, M_c)` when `k > 0`: for pairs `p` had left before `c` started.
     switch: Option<(u64, f64, f64)>,
+    /// With a switch time, per sample `n` of `c`: its largest fast rate `max(1, F)` over the
+    /// samples from `n` to the next low-confidence sample (exclusive; `n` itself if it is
+    /// one) and that sample's index (`n_ref` when none): `c`'s step over the samples it
+    /// traverses before its next region, for rule 1's switch room.
+    rest_of_c: Option<(Vec<f64>, Vec<usize>)>,
 }
 
 impl<'a> RoleSim<'a> {
@@ -349,6 +354,23 @@ impl<'a> RoleSim<'a> {
                 setup.max_step_of[c],
             )
         });
+        let rest_of_c = (setup.switch_ticks > 0).then(|| {
+            let tl = &robots[c];
+            let n_ref = tl.n_ref();
+            let (mut rate, mut next) = (vec![1.0; n_ref], vec![n_ref; n_ref]);
+            let (mut run_max, mut next_lc) = (1.0_f64, n_ref);
+            for n in (0..n_ref).rev() {
+                if !tl.conf()[n] {
+                    run_max = 1.0;
+                    next_lc = n;
+                } else {
+                    run_max = run_max.max(tl.rate_fast(n));
+                }
+                rate[n] = run_max;
+                next[n] = next_lc;
+            }
+            (rate, next)
+        });
         let mut sim = RoleSim {
             variant,
             sides,
@@ -359,6 +381,7 @@ impl<'a> RoleSim<'a> {
             step_before,
             switch_extra_s,
             switch,
+            rest_of_c,
         };
         if variant != Variant::Printed && sim.both_started() {
             let (start_p, start_c) = (robots[p].start_s(), robots[c].start_s());
@@ -545,7 +568,16 @@ impl<'a> RoleSim<'a> {
                 super::SwitchRoom {
                     ticks: k,
                     step_p,
-                    step_c,
+                    step_p_after: super::step_within(
+                        self.sides[0].tl,
+                        step_p,
+                        pair.prev.ref_end..self.sides[0].tl.n_ref(),
+                    ),
+                    step_c_before: super::step_within(
+                        self.sides[1].tl,
+                        step_c,
+                        0..pair.cur.ref_start,
+                    ),
                 },
                 (pair.t_p_end() + setup.eps).min(end_p),
                 (self.sides[1].tl.start_s(), end_p),
@@ -586,9 +618,26 @@ impl<'a> RoleSim<'a> {
     /// Rule 1's room left for `c` (conservative check): `(T_c − ε) − (t_c + M)`, schedule-clock
     /// s; `c` is a full step short of its region while this is > 0. With a switch time (`k > 0`)
     /// `(T_c − ε) − ((t_c + M) + k·M_c)`: `c` stays out for `k` more ticks.
+    ///
+    /// The room `k·M_c` is tightened to `M_c + (k − 1)·M_c'` ([`super::switch_room_after_s`])
+    /// when the samples from `t_c + M` up to `C` hold no other low-confidence sample: `M_c'`
+    /// is then `c`'s largest step over them (its largest fast rate there, relative to its
+    /// largest over all samples, times `M_c`, raised by `1e-12` relative), else `M_c`.
     fn slack(&self, pair: Pair, eps: f64) -> f64 {
         let reach = self.clock_s[1] + self.step_pc;
-        let reach = self.switch_extra_s.map_or(reach, |x| reach + x);
+        let reach = match (self.switch, &self.rest_of_c) {
+            (Some((k, _, step_c)), Some((rate, next))) => {
+                let tl = self.sides[1].tl;
+                let a = tl.sample_at(reach);
+                let rest = if next[a] == pair.cur.ref_start && a < pair.cur.ref_start {
+                    (step_c * (rate[a] / tl.max_rate_fast()) * (1.0 + 1e-12)).min(step_c)
+                } else {
+                    step_c
+                };
+                reach + super::switch_room_after_s(k, step_c, rest)
+            }
+            _ => self.switch_extra_s.map_or(reach, |x| reach + x),
+        };
         (pair.t_c_start() - eps) - reach
     }
 

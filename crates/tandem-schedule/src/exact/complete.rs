@@ -5,7 +5,9 @@
 use std::collections::BTreeMap;
 
 use rayon::prelude::*;
-use tandem_realtime::{pair_slacks, pair_slacks_with_holds};
+use tandem_realtime::{
+    MarginParams, PairSlack, margin_slacks, pair_slacks, pair_slacks_with_holds,
+};
 
 use super::chain::Chain;
 use super::search::{self, Clearance, Robot};
@@ -45,6 +47,10 @@ pub(crate) struct Completion<'a> {
     /// The held completion ([`Completion::held`]): `chain` has the usable holds, every switch
     /// into a run whose gap holds one is a release rule, the schedules plan their dwells.
     held: bool,
+    /// The operator's switch time `δ` (s, ≥ 0; [`Completion::with_switch`]).
+    switch_s: f64,
+    /// The least clearance (s) between two robots' runs: `M`, plus `δ` with a switch time.
+    min_clear_s: f64,
 }
 
 /// One pair of LC regions the margin check measured: the previous robot, the runs `(j, k)` of
@@ -108,6 +114,51 @@ impl<'a> Completion<'a> {
             after_start_s: 1e-6 * scale,
             max_pieces,
             held: false,
+            switch_s: 0.0,
+            min_clear_s: tick_s * f_lc,
+        }
+    }
+
+    /// The completion with the operator's switch time `switch_s` (s, ≥ 0; issue 41): every
+    /// clearance between two robots' runs starts at and stays at least `M + δ` (the planned
+    /// switch (3δ) and room for the worst case), a release rule's travel waits `δ` more at its
+    /// hold, robot 2's start gets no exception from the clearance, and the slacks are the
+    /// margin check's with the switch time (`tandem_realtime::margin_slacks`), so what it
+    /// returns passes `check_margins` with `δ`. `switch_s = 0` changes nothing (the same float
+    /// operations).
+    pub(crate) fn with_switch(self, switch_s: f64) -> Self {
+        if switch_s > 0.0 {
+            Completion {
+                switch_s,
+                min_clear_s: self.max_step_s + switch_s,
+                ..self
+            }
+        } else {
+            self
+        }
+    }
+
+    /// `after_start` of the clearances: none with a switch time (robot 2's first run keeps
+    /// `δ` from robot 1's last one even when it starts after it).
+    fn after_start(&self) -> Option<f64> {
+        (self.switch_s == 0.0).then_some(self.after_start_s)
+    }
+
+    /// Every pair's slack of the margin check on the timelines `tl` with the plan's `holds`:
+    /// without a switch time [`pair_slacks`] (no holds) or [`pair_slacks_with_holds`]; with
+    /// one [`margin_slacks`].
+    fn slacks(
+        &self,
+        tl: &[tandem_realtime::Timeline],
+        holds: Option<&[Vec<tandem_realtime::Hold>]>,
+    ) -> Option<Vec<PairSlack>> {
+        if self.switch_s > 0.0 {
+            let params = MarginParams::new(self.tick_s).with_switch_s(self.switch_s);
+            return margin_slacks(tl, holds.unwrap_or(&[]), &params).ok();
+        }
+        match holds {
+            None => pair_slacks(tl, self.tick_s).ok(),
+            Some(h) => pair_slacks_with_holds(tl, h, self.tick_s).ok(),
         }
     }
 
@@ -149,7 +200,12 @@ impl<'a> Completion<'a> {
                     let run = h..self.chain.lc_ref[k].0;
                     let fastest = gmin[run.clone()].iter().sum::<f64>() * dt;
                     let slowest = gmax[run].iter().sum::<f64>() * dt;
-                    Some((fastest + self.tick_s).min(slowest))
+                    let travel = (fastest + self.tick_s).min(slowest);
+                    Some(if self.switch_s > 0.0 {
+                        travel + self.switch_s
+                    } else {
+                        travel
+                    })
                 }
                 None if k == 0 => Some(f64::INFINITY),
                 None => None,
@@ -178,7 +234,7 @@ impl<'a> Completion<'a> {
     fn measure(&self, schedule: &Schedule) -> Option<Vec<Measured>> {
         let tl = schedule.timelines(self.problem).ok()?;
         if !self.held || !schedule.has_holds() {
-            let slacks = pair_slacks(&tl, self.tick_s).ok()?;
+            let slacks = self.slacks(&tl, None)?;
             return Some(
                 slacks
                     .iter()
@@ -195,7 +251,7 @@ impl<'a> Completion<'a> {
                     .collect(),
             );
         }
-        let slacks = pair_slacks_with_holds(&tl, &schedule.holds, self.tick_s).ok()?;
+        let slacks = self.slacks(&tl, Some(&schedule.holds))?;
         // The regions' runs: the check reports them on the robots' legs (a leg's samples
         // count from its hold), found back by robot and schedule-clock start.
         let mut run_of: BTreeMap<(usize, u64), usize> = BTreeMap::new();
@@ -249,7 +305,7 @@ impl<'a> Completion<'a> {
         if cold {
             let all = Clearance {
                 rules: self.rule_clearances(),
-                ..Clearance::uniform(self.max_step_s, Some(self.after_start_s))
+                ..Clearance::uniform(self.min_clear_s, self.after_start())
             };
             trials.extend(FIRST_TILTS.iter().map(|&t| Trial::new(t, all.clone())));
         }
@@ -309,7 +365,7 @@ impl<'a> Completion<'a> {
             }
         }
         regions.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
-        let mut clear = Clearance::uniform(f64::INFINITY, Some(self.after_start_s));
+        let mut clear = Clearance::uniform(f64::INFINITY, self.after_start());
         for w in regions.windows(2) {
             let ((_, end, pr, j), (start, _, r, k)) = (w[0], w[1]);
             if pr != r {
@@ -318,7 +374,7 @@ impl<'a> Completion<'a> {
                     return None;
                 }
                 let entry = clear.pairs.entry((j, k)).or_insert(gap);
-                *entry = entry.max(gap).max(self.max_step_s);
+                *entry = entry.max(gap).max(self.min_clear_s);
             }
         }
         (!clear.pairs.is_empty()).then_some(clear)
@@ -411,7 +467,7 @@ impl<'a> Completion<'a> {
                     target,
                     max_growth,
                 );
-                let next = next.max(self.max_step_s);
+                let next = next.max(self.min_clear_s);
                 if next > delta {
                     raised.push(next);
                 }

@@ -523,13 +523,9 @@ pub fn earliest_schedule(problem: &Problem, order: &[usize]) -> Result<Option<Sc
         .map(|t| build::uniform_schedule(problem, &chain, &t, problem.dt_s())))
 }
 
-/// The margin-free bound of `problem` (see [`solve_exact`]).
-pub(crate) fn bound(problem: &Problem, params: &ExactParams) -> MarginFree {
-    bound_switch(problem, params, 0.0)
-}
-
-/// [`bound`] with the switch time `switch_s` (s, ≥ 0; see [`solve_exact_with_switch`]).
-fn bound_switch(problem: &Problem, params: &ExactParams, switch_s: f64) -> MarginFree {
+/// The margin-free bound of `problem` (see [`solve_exact`]) with the switch time `switch_s`
+/// (s, ≥ 0; 0: none, [`solve_exact`]'s float operations; see [`solve_exact_with_switch`]).
+pub(crate) fn bound_switch(problem: &Problem, params: &ExactParams, switch_s: f64) -> MarginFree {
     margin_free(
         problem,
         &bound_chain(problem, 2),
@@ -591,7 +587,7 @@ fn bound_n_switch(problem: &Problem, n_robots: usize, switch_s: f64) -> MarginFr
 
 /// The certificate's bound for `n_robots ≥ 3` robots, never below the bound of fewer robots:
 /// `B(N) = max(own(N), B(N − 1))` with `own(k)` the `k`-robot search's bound ([`bound_n_switch`]) and
-/// `B(2)` the two-robot margin-free bound ([`bound`]); the schedule, order and counts are
+/// `B(2)` the two-robot margin-free bound ([`bound_switch`]); the schedule, order and counts are
 /// `own(N)`'s, and it is marked optimal only when `own(N)` is proven and not exceeded.
 ///
 /// **Why it is a lower bound.** Take any schedule of `N` robots that satisfies Eq. 20
@@ -607,15 +603,12 @@ fn bound_n_switch(problem: &Problem, n_robots: usize, switch_s: f64) -> MarginFr
 /// `B(N + 1) ≥ B(N)` by construction, where the searches alone are not monotone: the
 /// `N`-robot search may run out of its node budget where the `(N − 1)`-robot one finished,
 /// leaving the operator-limited bound, lower than the proven `(N − 1)`-robot optimum.
-pub(crate) fn bound_many(problem: &Problem, n_robots: usize, params: &ExactParams) -> MarginFree {
-    bound_many_switch(problem, n_robots, params, 0.0)
-}
-
-/// [`bound_many`] with the switch time `switch_s` (s, ≥ 0): the same maximum over `k = 2…N`
+///
+/// With the switch time `switch_s` (s, ≥ 0; 0: none): the same maximum over `k = 2…N`
 /// of the bounds with the switch time (a subset of the robots of a schedule that keeps the
 /// switch time keeps it too: any two LC intervals of different robots are at least `switch_s`
 /// apart, whichever robots are kept).
-fn bound_many_switch(
+pub(crate) fn bound_many_switch(
     problem: &Problem,
     n_robots: usize,
     params: &ExactParams,
@@ -643,30 +636,33 @@ fn bound_many_switch(
 /// The held completion (`complete::Completion::held`) of a problem with usable hold points
 /// at control tick `tick_s` (s): the best schedule with planned dwells and release rules it
 /// finds that passes the margin check and beats `cap_s` (s), with at most `budget` margin
-/// checks; with the number of checks spent. `(None, 0)` without usable holds.
+/// checks; with the number of checks spent. `(None, 0)` without usable holds. With the
+/// switch time `switch_s` (s, ≥ 0; 0: none, the same float operations) see
+/// [`complete::Completion::with_switch`].
 pub(crate) fn held_completion(
     problem: &Problem,
     params: &ExactParams,
     tick_s: f64,
     cap_s: f64,
     budget: usize,
+    switch_s: f64,
 ) -> (Option<complete::Completed>, usize) {
     if problem.usable_holds().is_empty() || budget == 0 {
         return (None, 0);
     }
     let chain = bound_chain(problem, 2);
-    complete::Completion::held(problem, &chain, tick_s, params.max_pieces).run(
-        cap_s,
-        budget,
-        true,
-        &[],
-    )
+    complete::Completion::held(problem, &chain, tick_s, params.max_pieces)
+        .with_switch(switch_s)
+        .run(cap_s, budget, true, &[])
 }
 
 /// The margin-aware completion (see the [module docs](self)) at control tick `tick_s` (s):
 /// the best schedule it finds that passes the margin check and beats `cap_s` (s), with at
 /// most `budget` margin checks, from every clearance at `M` when `cold` and from the
-/// clearances of each schedule of `warm`; with the number of checks spent.
+/// clearances of each schedule of `warm`; with the number of checks spent. With the switch
+/// time `switch_s` (s, ≥ 0; 0: none, the same float operations) every clearance includes it
+/// and the slacks are the margin check's with it ([`complete::Completion::with_switch`]).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn completion(
     problem: &Problem,
     params: &ExactParams,
@@ -675,8 +671,10 @@ pub(crate) fn completion(
     budget: usize,
     cold: bool,
     warm: &[&Schedule],
+    switch_s: f64,
 ) -> (Option<complete::Completed>, usize) {
     let chain = chain::Chain::new(problem);
     complete::Completion::new(problem, &chain, tick_s, params.max_pieces)
+        .with_switch(switch_s)
         .run(cap_s, budget, cold, warm)
 }

@@ -13,7 +13,7 @@ use super::{Sampler, Scratch, WARM_WIDEN, Warm};
 use crate::choose::repair;
 use crate::problem::Problem;
 use crate::schedule::Schedule;
-use crate::validate::validate_full;
+use crate::validate::{validate_full, validate_with_switch};
 
 impl<'a> Sampler<'a> {
     /// The pieces, their suffix sums and, for fitted robot 2 with a previous
@@ -67,6 +67,14 @@ impl<'a> Sampler<'a> {
             tick_s,
             warm,
             has_holds: !problem.usable_holds().is_empty(),
+            switch_room_s: if params.switch_s > 0.0 {
+                [
+                    params.switch_s * crate::choose::max_step_s(problem, 1.0),
+                    params.switch_s,
+                ]
+            } else {
+                [0.0; 2]
+            },
         }
     }
 }
@@ -158,7 +166,8 @@ impl Sampler<'_> {
             scratch.durs_s.push(dur0);
             let mut t_total = dur0;
             for robot in 1..self.n_robots {
-                let (offset_s, dur) = self.fit_next(scratch, robot, t_total, w, bound_s)?;
+                let room_s = self.switch_room_s[(k % 2) as usize];
+                let (offset_s, dur) = self.fit_next(scratch, robot, t_total, w, bound_s, room_s)?;
                 scratch.offsets_s.push(offset_s);
                 scratch.durs_s.push(dur);
                 t_total = t_total.max(offset_s + dur);
@@ -247,10 +256,22 @@ impl Sampler<'_> {
         })
     }
 
+    /// Every constraint of Eq. 20 on `s`, with the operator's switch time when
+    /// [`crate::SamplerParams::switch_s`] is not 0 ([`validate_with_switch`], whose margin
+    /// check has one implementation), else with the baselines' margin check.
+    fn passes(&self, s: &Schedule) -> bool {
+        let switch_s = self.params.switch_s;
+        if switch_s > 0.0 {
+            validate_with_switch(self.problem, s, switch_s).is_ok()
+        } else {
+            validate_full(self.problem, s, self.margin_check).is_ok()
+        }
+    }
+
     /// Full constraints of candidate `k`: the schedule and its `T_total` if feasible.
     pub(super) fn full(&self, k: u64) -> Option<(Schedule, f64)> {
         let mut s = self.materialize(k)?;
-        let mut ok = validate_full(self.problem, &s, self.margin_check).is_ok();
+        let mut ok = self.passes(&s);
         if !ok && self.has_holds {
             // With hold points the order of the stretches can be enforced at run time: the
             // same candidate with release rules. For two robots only when their planned waits
@@ -265,7 +286,7 @@ impl Sampler<'_> {
                     || held.t_total_s(self.problem.dt_s())
                         <= s.t_total_s(self.problem.dt_s()) + 0.5 * self.tick_s)
             {
-                ok = validate_full(self.problem, &held, self.margin_check).is_ok();
+                ok = self.passes(&held);
                 s = held;
             }
         }

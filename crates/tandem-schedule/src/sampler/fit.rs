@@ -7,7 +7,8 @@ use super::{Sampler, Scratch};
 impl Sampler<'_> {
     /// Fitted robot `robot` (≥ 1; robot 2 for two robots): its earliest finish given the
     /// low-confidence intervals of robots `0..robot` in `scratch.lc` (global time; robot 1
-    /// starts at 0), each widened by `δ = w·length + 2·tick_s`, over `τ ∈ [0, latest_end_s]`
+    /// starts at 0), each widened by `δ = w·length + 2·tick_s` (plus the operator's switch
+    /// time's room `switch_room_s`, s, 0 without one), over `τ ∈ [0, latest_end_s]`
     /// (the latest end of the earlier robots, s; `|ψ_E1|` for robot 2) and the robot's
     /// per-piece durations. Writes its factors into `scratch.factors[robot]`; returns
     /// `(τ, |ψ_E|)`, or `None` when it cannot finish before `bound_s` clear of the earlier
@@ -28,15 +29,27 @@ impl Sampler<'_> {
         latest_end_s: f64,
         w: f64,
         bound_s: f64,
+        switch_room_s: f64,
     ) -> Option<(f64, f64)> {
         let dur0 = latest_end_s;
         let margin = 2.0 * self.tick_s;
         let forbidden = &mut scratch.forbidden;
         forbidden.clear();
-        forbidden.extend(scratch.lc[..robot].iter().flatten().map(|iv| {
-            let d = w * (iv.end_s - iv.start_s) + margin;
-            (iv.start_s - d, iv.end_s + d)
-        }));
+        // With the operator's switch time `δ` the fitted robot's runs keep `switch_room_s` (`δ`
+        // or `δ·F`, `Sampler::switch_room_s`) more on both sides of every earlier robot's run:
+        // (3δ) of `validate_with_switch` on schedule, and room for the margin check's `k·M_c`.
+        let switch_s = switch_room_s;
+        if switch_s > 0.0 {
+            forbidden.extend(scratch.lc[..robot].iter().flatten().map(|iv| {
+                let d = w * (iv.end_s - iv.start_s) + margin + switch_s;
+                (iv.start_s - d, iv.end_s + d)
+            }));
+        } else {
+            forbidden.extend(scratch.lc[..robot].iter().flatten().map(|iv| {
+                let d = w * (iv.end_s - iv.start_s) + margin;
+                (iv.start_s - d, iv.end_s + d)
+            }));
+        }
         sort_and_merge(forbidden);
         let forbidden = &scratch.forbidden;
         // Gap g lies between forbidden[g − 1] and forbidden[g] (unbounded at both ends).
@@ -174,7 +187,7 @@ mod tests {
         // [3.2, 8.8]; its last LC must start in [3.2, 3.8] or from 6.2: earliest end 4.2,
         // traced back with the HC piece at its shortest (u = 0) and τ = 1.2.
         let (tau, dur) = sampler
-            .fit_next(&mut s, 1, 6.0, 0.0, f64::INFINITY)
+            .fit_next(&mut s, 1, 6.0, 0.0, f64::INFINITY, 0.0)
             .unwrap();
         assert!(
             (tau - 1.2).abs() < 1e-9 && (dur - 3.0).abs() < 1e-9,
@@ -184,17 +197,20 @@ mod tests {
         // w = 0.1: robot 1's regions grow by 0.1·1 + 0.2 s and robot 2's LC keeps 0.1 s
         // clear: starts [1.4, 3.6] → earliest end 4.4 with τ = 1.4.
         let (tau, dur) = sampler
-            .fit_next(&mut s, 1, 6.0, 0.1, f64::INFINITY)
+            .fit_next(&mut s, 1, 6.0, 0.1, f64::INFINITY, 0.0)
             .unwrap();
         assert!(
             (tau - 1.4).abs() < 1e-9 && (dur - 3.0).abs() < 1e-9,
             "{tau} {dur}"
         );
         // An incumbent of 4 s cuts every start: robot 2 needs 3 s and cannot start before 1.2.
-        assert_eq!(sampler.fit_next(&mut s, 1, 6.0, 0.0, 4.0), None);
+        assert_eq!(sampler.fit_next(&mut s, 1, 6.0, 0.0, 4.0, 0.0), None);
         // Robot 1 at its fastest (LC [0, 1) and [2, 3)): no gap holds a 1 s region before
         // τ's upper end |ψ_E1| = 3 s, so robot 2 cannot be fitted.
         let mut s = scratch(&[(0.0, 1.0), (2.0, 3.0)], &[]);
-        assert_eq!(sampler.fit_next(&mut s, 1, 3.0, 0.0, f64::INFINITY), None);
+        assert_eq!(
+            sampler.fit_next(&mut s, 1, 3.0, 0.0, f64::INFINITY, 0.0),
+            None
+        );
     }
 }

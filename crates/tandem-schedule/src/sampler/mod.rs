@@ -148,6 +148,13 @@ struct Sampler<'a> {
     /// previous schedule, with its low-confidence intervals and duration (s). Candidates
     /// `k ≥ samples` keep it and fit robot 2 with the widening `WARM_WIDEN[k − samples]`.
     warm: Option<Warm>,
+    /// The room (s) a fitted robot keeps from an earlier robot's LC run for the operator's
+    /// switch time `δ`, by candidate parity: even `k` `δ·max(1, max ψ̇̄/ψ̇min of an LC
+    /// sample)` (the margin check charges each of a simulated switch's ticks a step of at
+    /// least that rate), odd `k` `δ` (a robot started after the other left its run, whose
+    /// switch the check counts in the steps of the samples around it); 0 without a switch
+    /// time.
+    switch_room_s: [f64; 2],
 }
 
 /// Robot 1 of the warm start: warp (gradients per reference sample), low-confidence
