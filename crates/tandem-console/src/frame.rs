@@ -499,7 +499,7 @@ impl Geometry {
                     continue;
                 }
                 let (start, end) = if lap == 0 && s <= n && in_lc {
-                    (0.0, g.worst_between(rr.ref_time, e))
+                    (0.0, (g.clock_at(e) - c).max(0.0))
                 } else if lap == 0 && s <= n {
                     // Inside or at the start of a stretch without being supervised (at its
                     // gate, or before its start): not before the current stretch ends.
@@ -525,47 +525,61 @@ impl Geometry {
         }
     }
 
-    /// Every robot's planned low-confidence stretches within the horizon, by start time.
-    #[must_use]
-    pub fn stretches(&self, raw: &RawFrame) -> Vec<Stretch> {
+    /// Every robot's planned low-confidence stretches (at most 8 per robot, any distance),
+    /// in the order the operator takes them: by planned start, each pushed back until the
+    /// one before it has ended (one operator takes one stretch at a time: the robots of a
+    /// continuous cell wait at their gates for the token, which the plan's clocks alone do
+    /// not show), a robot's later stretches pushed back with it. The current stretch (the
+    /// attention robot's) ends at its planned end.
+    fn queue(&self, raw: &RawFrame) -> Vec<Stretch> {
         let mut out = Vec::new();
         for i in 0..raw.n.min(self.robots.len()) {
-            self.stretches_of(raw, i, self.horizon_s, 8, &mut out);
+            self.stretches_of(raw, i, f64::INFINITY, 8, &mut out);
+        }
+        out.sort_by(|a, b| a.start_s.total_cmp(&b.start_s).then(a.robot.cmp(&b.robot)));
+        let mut delay = [0.0f64; MAX_ROBOTS];
+        let mut free_at = 0.0f64;
+        for s in &mut out {
+            let d = &mut delay[s.robot - 1];
+            let start = (s.start_s + *d).max(free_at);
+            *d = start - s.start_s;
+            s.end_s += *d;
+            s.start_s = start;
+            free_at = s.end_s;
         }
         out.sort_by(|a, b| a.start_s.total_cmp(&b.start_s).then(a.robot.cmp(&b.robot)));
         out
     }
+
+    /// The stretches of [`Self::queue`] that start within the horizon.
+    #[must_use]
+    pub fn stretches(&self, raw: &RawFrame) -> Vec<Stretch> {
+        let mut q = self.queue(raw);
+        q.retain(|s| s.start_s <= self.horizon_s);
+        q
+    }
 }
 
-/// The next handover from the plan: the low-confidence stretch that starts soonest after now
-/// (the robot supervised now counts only with its later stretches), with its planned start and
-/// duration at the schedule's speeds; the earliest robot on a tie. Planned times: corrections
-/// and gate waits move it.
+/// The next handover from the plan: the first stretch of the operator's queue after the
+/// current one (the robot supervised now counts only with its later stretches), with its
+/// planned start and duration at the schedule's speeds (the queue: stretches in order of
+/// planned start, each after the one before has ended). Planned times: corrections move them.
 ///
 /// Replaced by `Tick::next` (the coordinator's own pre-alert, `PreAlert { robot, earliest_s,
 /// latest_s }`, issue 41) once that is merged into tandem-realtime: this is the one place the
 /// console computes the countdown.
 #[must_use]
 pub fn next_handover(geometry: &Geometry, raw: &RawFrame) -> Option<NextHandover> {
-    let mut best: Option<NextHandover> = None;
-    let mut buf = Vec::with_capacity(2);
-    for i in 0..raw.n.min(geometry.robots.len()) {
-        buf.clear();
-        geometry.stretches_of(raw, i, f64::INFINITY, 2, &mut buf);
-        let upcoming = buf
-            .iter()
-            .find(|s| !(raw.robots[i].state == RobotState::Lc && s.start_s == 0.0));
-        if let Some(s) = upcoming {
-            if best.as_ref().is_none_or(|b| s.start_s < b.in_s) {
-                best = Some(NextHandover {
-                    robot: i + 1,
-                    in_s: s.start_s,
-                    duration_s: s.end_s - s.start_s,
-                });
-            }
-        }
-    }
-    best
+    let current = geometry.attention(raw).map(|a| a.robot);
+    geometry
+        .queue(raw)
+        .into_iter()
+        .find(|s| !(Some(s.robot) == current && s.start_s == 0.0))
+        .map(|s| NextHandover {
+            robot: s.robot,
+            in_s: s.start_s,
+            duration_s: s.end_s - s.start_s,
+        })
 }
 
 /// The page's frame of `raw` (server side; allocates).
@@ -727,5 +741,46 @@ mod tests {
         assert!(raw.robots[..3].iter().all(|r| r.state == RobotState::Done));
         assert!(next_handover(&g, &raw).is_none());
         assert!(build_frame(&g, &raw).stretches.is_empty());
+    }
+
+    #[test]
+    fn the_queue_takes_one_stretch_at_a_time() {
+        // A continuous cell of three robots on the same task: after one tick robot 1 runs
+        // towards its stretch (planned at 4 s of its task) and robots 2 and 3 wait at their
+        // gates with the same plan. The operator takes them one after the other: robot 1 at
+        // 3.9 s, robot 2 when robot 1's ends (5.9 s), robot 3 at 7.9 s.
+        let conf: Vec<bool> = (0..100).map(|k| !(40..60).contains(&k)).collect();
+        let (g, lo, hi) = (vec![1.0; 100], vec![0.5; 100], vec![2.0; 100]);
+        let task = Timeline::new(&conf, &g, &lo, &hi, 0.0, 0.1).unwrap();
+        let order: Vec<(usize, usize)> = (0..3).map(|i| (i, 0)).collect();
+        let mut ctl = AnyController::Continuous(
+            tandem_realtime::ContinuousCoordinator::new(task, &[], &order, 3, 0.1).unwrap(),
+        );
+        let geometry = Geometry::new(&ctl);
+        let t = ctl.tick(Operator::Scheduled).unwrap();
+        let raw = RawFrame::from_controller(&t, &ctl, false);
+        let states: Vec<_> = raw.robots[..3].iter().map(|r| r.state).collect();
+        assert_eq!(states, [RobotState::Hc, RobotState::Wait, RobotState::Wait]);
+        let q = geometry.stretches(&raw);
+        let got: Vec<(usize, f64, f64)> = q
+            .iter()
+            .take(4)
+            .map(|s| (s.robot, s.start_s, s.end_s))
+            .collect();
+        let want = [(1, 3.9, 5.9), (2, 5.9, 7.9), (3, 7.9, 9.9), (1, 13.9, 15.9)];
+        for (g, w) in got.iter().zip(want) {
+            assert_eq!(g.0, w.0, "{got:?}");
+            assert!(
+                (g.1 - w.1).abs() < 1e-9 && (g.2 - w.2).abs() < 1e-9,
+                "{got:?}"
+            );
+        }
+        // No two stretches of the queue overlap.
+        assert!(
+            q.windows(2).all(|w| w[1].start_s >= w[0].end_s - 1e-9),
+            "{q:?}"
+        );
+        let next = next_handover(&geometry, &raw).unwrap();
+        assert_eq!((next.robot, (next.in_s * 10.0).round()), (1, 39.0));
     }
 }
