@@ -122,8 +122,10 @@ impl RawFrame {
     pub fn from_controller<C: Controller + ?Sized>(tick: &Tick, ctl: &C, rounds: bool) -> Self {
         let n = ctl.n_robots().min(MAX_ROBOTS);
         let low = ctl.low_conf_now();
-        let running = ctl.running_now();
-        let waiting = ctl.waiting_now();
+        // The tick's own flags where they are the controller's now (`Tick::waiting` is
+        // `waiting_now`, the contract's test checks it); only the supervised robot is read
+        // from the controller: one O(N) call instead of three.
+        let (running, waiting) = (tick.running, tick.waiting);
         let held = tick.fault.map(|f| f.stopped);
         let clocks = ctl.clock_s();
         let mut robots = [RawRobot::default(); MAX_ROBOTS];
@@ -134,9 +136,9 @@ impl RawFrame {
                 RobotState::Done
             } else if low[i] {
                 RobotState::Lc
-            } else if rounds && waiting[i] {
+            } else if waiting[i] && rounds {
                 RobotState::Hold
-            } else if !running[i] {
+            } else if waiting[i] || !running[i] {
                 RobotState::Wait
             } else {
                 RobotState::Hc
@@ -170,7 +172,7 @@ impl RawFrame {
         out[5] = self.hold_armed.unwrap_or(0) as u64;
         out[6] = self.published_unix_ms.to_bits();
         out[7] = 0;
-        for (i, r) in self.robots.iter().enumerate() {
+        for (i, r) in self.robots.iter().enumerate().take(self.n) {
             let w = &mut out[8 + 4 * i..12 + 4 * i];
             w[0] = r.state.code();
             w[1] = r.clock_s.to_bits();
@@ -180,8 +182,9 @@ impl RawFrame {
     }
 
     pub(crate) fn decode(w: &[u64; WORDS]) -> RawFrame {
+        let n = (w[0] as usize).min(MAX_ROBOTS);
         let mut robots = [RawRobot::default(); MAX_ROBOTS];
-        for (i, r) in robots.iter_mut().enumerate() {
+        for (i, r) in robots.iter_mut().enumerate().take(n) {
             let w = &w[8 + 4 * i..12 + 4 * i];
             *r = RawRobot {
                 state: RobotState::from_code(w[0]),
@@ -191,7 +194,7 @@ impl RawFrame {
             };
         }
         RawFrame {
-            n: (w[0] as usize).min(MAX_ROBOTS),
+            n,
             tick: w[1],
             tick_s: f64::from_bits(w[2]),
             rounds_done: w[3],
@@ -551,7 +554,9 @@ impl Geometry {
         out
     }
 
-    /// The stretches of [`Self::queue`] that start within the horizon.
+    /// The operator's queue of planned low-confidence stretches that start within the
+    /// horizon: in order of planned start, each pushed back until the one before it has ended
+    /// (one operator, one stretch at a time), a robot's later stretches pushed back with it.
     #[must_use]
     pub fn stretches(&self, raw: &RawFrame) -> Vec<Stretch> {
         let mut q = self.queue(raw);
@@ -563,7 +568,8 @@ impl Geometry {
 /// The next handover from the plan: the first stretch of the operator's queue after the
 /// current one (the robot supervised now counts only with its later stretches), with its
 /// planned start and duration at the schedule's speeds (the queue: stretches in order of
-/// planned start, each after the one before has ended). Planned times: corrections move them.
+/// planned start, each after the one before has ended, as [`Geometry::stretches`] without
+/// the horizon). Planned times: corrections move them.
 ///
 /// Replaced by `Tick::next` (the coordinator's own pre-alert, `PreAlert { robot, earliest_s,
 /// latest_s }`, issue 41) once that is merged into tandem-realtime: this is the one place the

@@ -45,7 +45,8 @@ impl Slot {
         let s = self.seq.load(Ordering::Relaxed);
         self.seq.store(s.wrapping_add(1), Ordering::Relaxed);
         fence(Ordering::Release);
-        for (w, v) in self.words.iter().zip(buf) {
+        // The words of the first `n` robots (a handle's `n` never changes).
+        for (w, v) in self.words.iter().zip(buf).take(8 + 4 * raw.n) {
             w.store(v, Ordering::Relaxed);
         }
         self.seq.store(s.wrapping_add(2), Ordering::Release);
