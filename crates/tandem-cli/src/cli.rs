@@ -235,8 +235,10 @@ pub(crate) struct ConsoleArgs {
     #[arg(long, value_name = "IP", default_value_t = crate::console::localhost())]
     pub(crate) host: std::net::IpAddr,
     /// Lead of the pre-alert (s): the countdown turns amber this long before a handover.
-    #[arg(long, value_name = "S", default_value_t = tandem_console::DEFAULT_LEAD_S)]
-    pub(crate) lead: f64,
+    /// Default: 7 s, or the operator's switch time of the state's parameters
+    /// (`[sampler] switch_s`) where it is longer.
+    #[arg(long, value_name = "S")]
+    pub(crate) lead: Option<f64>,
 }
 
 /// Overrides of the anytime sampler's settings.

@@ -50,10 +50,17 @@ pub(crate) fn console(a: &ConsoleArgs) -> Result<()> {
     let config = ConsoleConfig {
         host: a.host,
         port: a.port,
-        lead_s: a.lead,
+        lead_s: a.lead.unwrap_or_else(|| {
+            tandem_console::DEFAULT_LEAD_S.max(planner.params().sampler.switch_s)
+        }),
         ..ConsoleConfig::default()
     };
-    let (console, handle) = Console::start(&config, Geometry::new(&ctl))?;
+    let (console, handle) = Console::start(&config, Geometry::new(&ctl)).map_err(|e| match e {
+        tandem_console::Error::BadParam { name: "lead_s", .. } => {
+            anyhow::anyhow!("--lead {}: {e}", config.lead_s)
+        }
+        e => e.into(),
+    })?;
     out(console.url());
     note(&format!(
         "console: {} robots, {} cell, speed ×{}; open {} (Ctrl-C stops)",

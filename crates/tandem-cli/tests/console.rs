@@ -102,7 +102,8 @@ fn bad_console_input_exits_2_with_the_reason() {
     let dir = scratch("console-bad");
     let state = small_state(&dir);
     let s = state.to_str().unwrap();
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 5] = [
+        (&["console", s, "--simulate", "--lead=-1"], "--lead -1"),
         (&["console", s], "needs a source: --simulate"),
         (&["console", s, "--simulate", "--speed", "0"], "--speed 0"),
         (&["console", s, "--simulate", "--robots", "9"], "--robots 9"),
