@@ -89,7 +89,7 @@ impl Browser {
                 "--no-first-run",
                 "--no-default-browser-check",
                 "--remote-debugging-port=0",
-                "--window-size=1280,900",
+                "--window-size=1280,760",
                 &format!("--user-data-dir={}", dir.display()),
                 "about:blank",
             ])
@@ -132,7 +132,7 @@ impl Browser {
         b.session = s["sessionId"].as_str().unwrap().to_string();
         b.call(
             "Emulation.setDeviceMetricsOverride",
-            json!({ "width": 1280, "height": 900, "deviceScaleFactor": 1, "mobile": false }),
+            json!({ "width": 1280, "height": 760, "deviceScaleFactor": 1, "mobile": false }),
         );
         b.call("Page.navigate", json!({ "url": url }));
         b
