@@ -183,6 +183,62 @@ pub(crate) enum Command {
     ///   tandem params > params.toml
     #[command(verbatim_doc_comment)]
     Params,
+    /// The operator's console: a local web page showing which robot needs the operator now
+    /// and next, with controls (acknowledge, hold, clear fault, pause).
+    ///
+    /// With --simulate, a simulated cell runs in real time from the state file: the
+    /// planner's plan for --cell (rounds one after the other, or a continuous cell) with
+    /// the study's simulated operator, ticked every control period divided by --speed. The
+    /// page's URL is the first line of standard output; the server listens on 127.0.0.1
+    /// (this machine) unless --host says otherwise; --port 0 picks a free port. Without
+    /// --need, every low-confidence sample needs the operator. Runs until interrupted; the
+    /// state file is not modified. The page's DOM and the frame format: docs/formats.md.
+    ///
+    /// Example:
+    ///
+    ///   tandem console cell.tandem --simulate
+    ///   tandem console cell.tandem --simulate --cell continuous --speed 2 --port 8080
+    ///   tandem console cell.tandem --simulate --robots 3 --need need.csv
+    #[command(verbatim_doc_comment)]
+    Console(ConsoleArgs),
+}
+
+/// `tandem console`.
+#[derive(Debug, Args)]
+pub(crate) struct ConsoleArgs {
+    /// The state file (read only).
+    pub(crate) state: PathBuf,
+    /// Run a simulated cell from the state file (the one source the command line has).
+    #[arg(long)]
+    pub(crate) simulate: bool,
+    /// Robots of the simulated cell. Default: the state's. Another count is planned from the
+    /// state's model, only for a state with no recorded round.
+    #[arg(long, value_name = "N")]
+    pub(crate) robots: Option<usize>,
+    /// How the robots repeat the task.
+    #[arg(long, value_name = "MODE", value_parser = cell_parser(), default_value = "rounds")]
+    pub(crate) cell: Cell,
+    /// Real-time factor of the simulation, in (0, 1000].
+    #[arg(long, value_name = "X", default_value_t = 1.0)]
+    pub(crate) speed: f64,
+    /// Probability of a needed correction per reference sample (CSV, as `tandem simulate`'s),
+    /// drawn once per robot.
+    #[arg(long, value_name = "CSV")]
+    pub(crate) need: Option<PathBuf>,
+    /// Seed of the simulated operator and the need draws.
+    #[arg(long, value_name = "S", default_value_t = 0)]
+    pub(crate) seed: u64,
+    /// Port to listen on (0: any free port).
+    #[arg(long, value_name = "P", default_value_t = 0)]
+    pub(crate) port: u16,
+    /// Address to listen on.
+    #[arg(long, value_name = "IP", default_value_t = crate::console::localhost())]
+    pub(crate) host: std::net::IpAddr,
+    /// Lead of the pre-alert (s): the countdown turns amber this long before a handover.
+    /// Default: 7 s, or the operator's switch time of the state's parameters
+    /// (`[sampler] switch_s`) where it is longer.
+    #[arg(long, value_name = "S")]
+    pub(crate) lead: Option<f64>,
 }
 
 /// Overrides of the anytime sampler's settings.

@@ -36,6 +36,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         Command::Simulate(a) => sim::simulate(&a),
         Command::Need(a) => need::need(&a),
         Command::Params => params(),
+        Command::Console(a) => crate::console::console(&a),
     }
 }
 

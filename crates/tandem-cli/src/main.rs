@@ -13,7 +13,8 @@
 //!   executions in the formats `tandem record` reads;
 //! - `tandem need` writes a need file (the simulated operator's input) from reference-time
 //!   intervals;
-//! - `tandem params` prints the default parameter file.
+//! - `tandem params` prints the default parameter file;
+//! - `tandem console STATE --simulate` serves the operator's console on a simulated cell.
 //!
 //! File formats: `docs/formats.md`. Walk-through: `docs/guide.md`.
 //! Every user error prints `error: …` naming the file and the problem, and exits with code 2;
@@ -22,6 +23,7 @@
 mod bag;
 mod cli;
 mod cmd;
+mod console;
 mod cyclic;
 mod gantt;
 mod input;

@@ -365,7 +365,7 @@ fn text_inspect_explains(text: &str) -> bool {
 #[test]
 fn every_subcommand_has_help_with_an_example() {
     for sub in [
-        "fit", "schedule", "record", "inspect", "plot", "simulate", "params",
+        "fit", "schedule", "record", "inspect", "plot", "simulate", "params", "console",
     ] {
         let stdout = ok(&tandem([sub, "--help"]));
         assert!(stdout.contains("Example"), "{sub} --help:\n{stdout}");

@@ -106,6 +106,13 @@ impl CellSim {
         &self.coord
     }
 
+    /// Releases the robot held by a latched fault now
+    /// ([`ContinuousCoordinator::clear_fault`]); [`tick`](Self::tick) also releases it after
+    /// the first tick in which no robot is low-confidence.
+    pub fn clear_fault(&mut self) {
+        self.coord.clear_fault();
+    }
+
     /// What the cell did so far.
     pub fn stats(&self) -> &CellStats {
         &self.stats

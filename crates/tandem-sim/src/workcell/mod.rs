@@ -71,6 +71,7 @@
 //!    after the first tick in which no robot is low-confidence, so every round finishes.
 
 mod cell;
+mod live;
 mod operator;
 mod record;
 mod run;
@@ -78,6 +79,7 @@ mod run;
 mod tests;
 
 pub use cell::{CellSim, CellStats, FinishedTask};
+pub use live::RoundSim;
 pub use operator::{OperatorParams, correction_input, needs_correction};
 pub use record::{PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
 pub use run::{run_round, run_round_with};

@@ -1016,3 +1016,41 @@ fn an_operator_with_a_switch_time_misses_the_corrections_right_after_another_rob
         })
     ));
 }
+
+/// The console's tick-by-tick round is the workcell's round: same seed, same ticks, same
+/// executions (samples and reference-time logs), and after `restart` the same round again.
+#[test]
+fn a_round_sim_ticks_the_same_round_as_run_round_with() {
+    let planner = planner();
+    let params = OperatorParams::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let want = run_round_with(&planner, painted_needs, &params, &mut rng).unwrap();
+    let coord = planner.coordinator().unwrap();
+    let mut sim = RoundSim::new(planner.model(), planner.problem(), coord, &params).unwrap();
+    for _ in 0..2 {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut ticks = 0;
+        while !tandem_realtime::Controller::is_finished(sim.coordinator()) {
+            let t = sim.tick(planner.model(), painted_needs, &mut rng).unwrap();
+            assert!(!t.overlap());
+            ticks += 1;
+            assert!(
+                ticks <= want.ticks,
+                "the round runs longer than run_round_with's"
+            );
+        }
+        assert_eq!(ticks, want.ticks);
+        sim.restart();
+        assert_eq!(sim.coordinator().ticks(), 0);
+    }
+    // A model of another size is an error, not a panic.
+    let other = Demonstration::new(vec!["force".into()], vec![1.0; 30], 0.01).unwrap();
+    let small = TaskModel::fit(&[other.clone(), other], &FitParams::default());
+    if let Ok(small) = small {
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        assert!(matches!(
+            sim.tick(&small, painted_needs, &mut rng),
+            Err(Error::Mismatch { .. })
+        ));
+    }
+}

@@ -1,0 +1,133 @@
+//! `tandem console STATE --simulate`: the page's URL is the first line of standard output and
+//! serves frames of the state's cell; bad input exits 2 naming the flag and the fix.
+
+mod common;
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::{scratch, small_state, tandem};
+
+/// Kills the console when the test ends, however it ends.
+struct Running(Child);
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn get(host_port: &str, path: &str) -> (u16, String) {
+    let mut s = TcpStream::connect(host_port).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    write!(
+        s,
+        "GET {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    let mut out = String::new();
+    s.read_to_string(&mut out).unwrap();
+    let status = out[9..12].parse().unwrap();
+    (
+        status,
+        out.split_once("\r\n\r\n").map_or("", |x| x.1).to_string(),
+    )
+}
+
+#[test]
+fn the_url_comes_first_and_the_page_shows_the_states_cell() {
+    let dir = scratch("console");
+    let state = small_state(&dir);
+    for (cell, robots) in [("rounds", None), ("continuous", Some("3"))] {
+        let mut args = vec![
+            "console",
+            state.to_str().unwrap(),
+            "--simulate",
+            "--cell",
+            cell,
+        ];
+        if let Some(n) = robots {
+            args.extend(["--robots", n]);
+        }
+        let child = Command::new(env!("CARGO_BIN_EXE_tandem"))
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let mut run = Running(child);
+        let mut first = String::new();
+        BufReader::new(run.0.stdout.take().unwrap())
+            .read_line(&mut first)
+            .unwrap();
+        let url = first.trim();
+        let host_port = url
+            .strip_prefix("http://127.0.0.1:")
+            .map(|p| format!("127.0.0.1:{}", p.trim_end_matches('/')))
+            .unwrap_or_else(|| panic!("the first line is the page's local URL: {url:?}"));
+        assert_eq!(get(&host_port, "/").0, 200);
+        let t0 = Instant::now();
+        let frame: serde_json::Value = loop {
+            let (status, body) = get(&host_port, "/frame");
+            if status == 200 {
+                let f: serde_json::Value = serde_json::from_str(&body).unwrap();
+                if f["tick"].as_u64().unwrap() > 0 {
+                    break f;
+                }
+            }
+            assert!(
+                t0.elapsed() < Duration::from_secs(20),
+                "no frame: {status} {body}"
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        };
+        assert_eq!(frame["cell"], cell);
+        let n = robots.map_or(2, |n| n.parse().unwrap());
+        assert_eq!(frame["robots"].as_array().unwrap().len(), n);
+        let lc = frame["robots"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|r| r["state"] == "lc")
+            .count();
+        assert!(lc <= 1, "{frame}");
+    }
+}
+
+#[test]
+fn bad_console_input_exits_2_with_the_reason() {
+    let dir = scratch("console-bad");
+    let state = small_state(&dir);
+    let s = state.to_str().unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (&["console", s, "--simulate", "--lead=-1"], "--lead -1"),
+        (&["console", s], "needs a source: --simulate"),
+        (&["console", s, "--simulate", "--speed", "0"], "--speed 0"),
+        (&["console", s, "--simulate", "--robots", "9"], "--robots 9"),
+        (
+            &["console", "missing.tandem", "--simulate"],
+            "missing.tandem",
+        ),
+    ];
+    for (args, want) in cases {
+        let out = tandem(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: {err}");
+    }
+    // A state holding recorded rounds keeps its robot count.
+    let golden = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/state/example.tandem"
+    );
+    let out = tandem(["console", golden, "--simulate", "--robots", "3"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("recorded round") && err.contains("tandem fit --robots 3"),
+        "{err}"
+    );
+}

@@ -1,0 +1,336 @@
+//! The control loop's side of the console: [`ConsoleHandle`] publishes each tick's snapshot
+//! into a lock-free slot (a sequence lock over atomic words: the loop never waits, never
+//! allocates; the server reads the newest snapshot and a snapshot it did not read in time is
+//! dropped, never queued), and hands the operator's controls back through a bounded queue the
+//! loop polls at its tick boundary ([`ConsoleHandle::poll_control`]), each confirmed with
+//! [`ConsoleHandle::confirm`] into the frame stream.
+//!
+//! [`Driver`] is the loop-side rule of every control: it applies them at a tick boundary to a
+//! [`ConsoleCell`] (any controller), so a user's loop is `driver.apply(..)`, tick unless
+//! paused, `handle.publish(..)`.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering, fence};
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError};
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use serde::{Deserialize, Serialize};
+use tandem_planner::AnyController;
+use tandem_realtime::{ContinuousCoordinator, Controller, Coordinator, Tick};
+
+use crate::frame::{Ack, RawFrame, WORDS};
+
+/// A single-writer sequence lock over the words of a [`RawFrame`]: the writer bumps the
+/// sequence to odd, stores the words, bumps it to even; a reader retries while the sequence is
+/// odd or changed under it. Safe code only (every word is an atomic).
+#[derive(Debug)]
+pub(crate) struct Slot {
+    seq: AtomicU64,
+    words: [AtomicU64; WORDS],
+}
+
+impl Slot {
+    pub(crate) fn new() -> Slot {
+        Slot {
+            seq: AtomicU64::new(0),
+            words: std::array::from_fn(|_| AtomicU64::new(0)),
+        }
+    }
+
+    /// Writes `raw` (one writer at a time: [`ConsoleHandle`] is the only writer and takes
+    /// `&mut self`). Wait-free.
+    fn write(&self, raw: &RawFrame) {
+        let mut buf = [0u64; WORDS];
+        raw.encode(&mut buf);
+        let s = self.seq.load(Ordering::Relaxed);
+        self.seq.store(s.wrapping_add(1), Ordering::Relaxed);
+        fence(Ordering::Release);
+        // The words of the first `n` robots (a handle's `n` never changes).
+        for (w, v) in self.words.iter().zip(buf).take(8 + 4 * raw.n) {
+            w.store(v, Ordering::Relaxed);
+        }
+        self.seq.store(s.wrapping_add(2), Ordering::Release);
+    }
+
+    /// The newest snapshot and the number of snapshots written so far, or `None` before the
+    /// first. Lock-free: retries only while the writer is inside a write.
+    pub(crate) fn read(&self) -> Option<(u64, RawFrame)> {
+        loop {
+            let s1 = self.seq.load(Ordering::Acquire);
+            if s1 == 0 {
+                return None;
+            }
+            if s1 % 2 == 1 {
+                std::hint::spin_loop();
+                continue;
+            }
+            let mut buf = [0u64; WORDS];
+            for (b, w) in buf.iter_mut().zip(&self.words) {
+                *b = w.load(Ordering::Relaxed);
+            }
+            fence(Ordering::Acquire);
+            if self.seq.load(Ordering::Relaxed) == s1 {
+                return Some((s1 / 2, RawFrame::decode(&buf)));
+            }
+        }
+    }
+}
+
+/// An operation of the operator (the `op` of a control message; docs/formats.md, "Console
+/// controls").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Op {
+    /// Become the controlling client (first to claim; the server answers it).
+    Claim,
+    /// Give control up (the server answers it).
+    Release,
+    /// Acknowledge the next handover (the operator has seen it).
+    Acknowledge,
+    /// Pause the cell when `robot` next waits at a hold point (rounds) or its gate (continuous
+    /// cell): the run-time contract cannot hold one robot alone, so the whole cell pauses there.
+    Hold,
+    /// Clear the latched fault: the held robot moves again.
+    ClearFault,
+    /// Stop ticking at the next tick boundary.
+    Pause,
+    /// Tick again (also disarms a hold).
+    Resume,
+}
+
+impl Op {
+    /// Its text form.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Op::Claim => "claim",
+            Op::Release => "release",
+            Op::Acknowledge => "acknowledge",
+            Op::Hold => "hold",
+            Op::ClearFault => "clear_fault",
+            Op::Pause => "pause",
+            Op::Resume => "resume",
+        }
+    }
+}
+
+/// A control message the server accepted from the controlling client, for the loop.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ControlMsg {
+    /// The client that sent it.
+    pub client: String,
+    /// Its id (increasing per client).
+    pub id: u64,
+    /// What to do.
+    pub op: Op,
+    /// The robot (0-based) of a [`Op::Hold`].
+    pub robot: Option<usize>,
+}
+
+/// What the server and the loop share: the slot and the counters.
+#[derive(Debug)]
+pub(crate) struct Shared {
+    pub(crate) slot: Slot,
+    pub(crate) acks_lost: AtomicU64,
+}
+
+impl Shared {
+    pub(crate) fn new() -> Shared {
+        Shared {
+            slot: Slot::new(),
+            acks_lost: AtomicU64::new(0),
+        }
+    }
+}
+
+/// The control loop's end of a console ([`crate::Console::start`]).
+#[derive(Debug)]
+pub struct ConsoleHandle {
+    shared: Arc<Shared>,
+    controls: Receiver<ControlMsg>,
+    acks: SyncSender<Ack>,
+    rounds: bool,
+    n_robots: usize,
+    can_hold: bool,
+    /// Whether the loop has stopped ticking.
+    paused: bool,
+    /// The robot at whose next wait the cell pauses.
+    hold_armed: Option<usize>,
+    rounds_done: u64,
+}
+
+impl ConsoleHandle {
+    pub(crate) fn new(
+        shared: Arc<Shared>,
+        controls: Receiver<ControlMsg>,
+        acks: SyncSender<Ack>,
+        rounds: bool,
+        n_robots: usize,
+        can_hold: bool,
+    ) -> ConsoleHandle {
+        ConsoleHandle {
+            shared,
+            controls,
+            acks,
+            rounds,
+            n_robots,
+            can_hold,
+            paused: false,
+            hold_armed: None,
+            rounds_done: 0,
+        }
+    }
+
+    /// Publishes the snapshot of `ctl` after `tick` for the page. Lock-free and wait-free,
+    /// never allocates, never blocks: a snapshot the server has not read before the next one
+    /// is dropped. O(N).
+    pub fn publish<C: Controller + ?Sized>(&mut self, tick: &Tick, ctl: &C) {
+        let mut raw = RawFrame::from_controller(tick, ctl, self.rounds);
+        raw.paused = self.paused;
+        raw.hold_armed = self.hold_armed;
+        raw.rounds_done = self.rounds_done;
+        raw.published_unix_ms = SystemTime::now()
+            .duration_since(UNIX_EPOCH)
+            .map_or(0.0, |d| d.as_secs_f64() * 1e3);
+        self.shared.slot.write(&raw);
+    }
+
+    /// The next control message the operator sent, if any (never blocks). Apply it at a tick
+    /// boundary and [`confirm`](Self::confirm) it; [`Driver::apply`] does both.
+    pub fn poll_control(&mut self) -> Option<ControlMsg> {
+        self.controls.try_recv().ok()
+    }
+
+    /// Confirms `msg` into the frame stream: `ok` whether it took effect, `message` what
+    /// happened. Never blocks: a confirmation the server has no room for is counted lost
+    /// ([`crate::Health::acks_lost`]).
+    pub fn confirm(&mut self, msg: &ControlMsg, ok: bool, message: impl Into<String>) {
+        let ack = Ack {
+            client: msg.client.clone(),
+            id: msg.id,
+            op: msg.op.name().to_string(),
+            ok,
+            message: message.into(),
+        };
+        if let Err(TrySendError::Full(_) | TrySendError::Disconnected(_)) = self.acks.try_send(ack)
+        {
+            self.shared.acks_lost.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    /// Counts a finished round (rounds cells run round after round), shown on the page.
+    pub fn round_done(&mut self) {
+        self.rounds_done += 1;
+    }
+
+    /// Whether the loop should not tick now (paused, or a hold took effect).
+    #[must_use]
+    pub fn is_paused(&self) -> bool {
+        self.paused
+    }
+}
+
+/// A cell the console's controls act on: a controller, and how to clear its fault.
+pub trait ConsoleCell {
+    /// The controller (read only).
+    fn controller(&self) -> &dyn Controller;
+    /// Clears the latched fault ([`Controller::clear_fault`]).
+    fn clear_fault(&mut self);
+}
+
+macro_rules! console_cell {
+    ($($t:ty),*) => {$(
+        impl ConsoleCell for $t {
+            fn controller(&self) -> &dyn Controller {
+                self
+            }
+            fn clear_fault(&mut self) {
+                Controller::clear_fault(self);
+            }
+        }
+    )*};
+}
+console_cell!(AnyController, Coordinator, ContinuousCoordinator);
+
+impl ConsoleCell for Box<dyn Controller> {
+    fn controller(&self) -> &dyn Controller {
+        self.as_ref()
+    }
+    fn clear_fault(&mut self) {
+        self.as_mut().clear_fault();
+    }
+}
+
+/// The loop-side rule of the controls, applied at a tick boundary.
+#[derive(Debug, Default)]
+pub struct Driver;
+
+impl Driver {
+    /// Applies every control waiting in `handle`'s queue to `cell` and confirms each, then
+    /// takes an armed hold into effect when its robot waits. Returns whether the loop may tick
+    /// (not paused). Call it before each tick; it allocates only for a control message.
+    pub fn apply(handle: &mut ConsoleHandle, cell: &mut impl ConsoleCell) -> bool {
+        while let Some(msg) = handle.poll_control() {
+            let (ok, text) = Self::one(handle, cell, &msg);
+            handle.confirm(&msg, ok, text);
+        }
+        if let Some(k) = handle.hold_armed {
+            if cell.controller().waiting_now()[k] {
+                handle.hold_armed = None;
+                handle.paused = true;
+            }
+        }
+        !handle.paused
+    }
+
+    fn one(
+        handle: &mut ConsoleHandle,
+        cell: &mut impl ConsoleCell,
+        msg: &ControlMsg,
+    ) -> (bool, String) {
+        match msg.op {
+            Op::Claim | Op::Release => (true, "answered by the server".to_string()),
+            Op::Acknowledge => (true, "handover acknowledged".to_string()),
+            Op::Pause => {
+                handle.paused = true;
+                (true, "paused at a tick boundary".to_string())
+            }
+            Op::Resume => {
+                handle.paused = false;
+                handle.hold_armed = None;
+                (true, "resumed".to_string())
+            }
+            Op::ClearFault => {
+                if cell.controller().fault().is_some() {
+                    cell.clear_fault();
+                    (
+                        true,
+                        "fault cleared: the held robot moves again".to_string(),
+                    )
+                } else {
+                    (false, "no fault is latched".to_string())
+                }
+            }
+            Op::Hold => match msg.robot {
+                Some(k) if k < handle.n_robots && handle.can_hold => {
+                    handle.hold_armed = Some(k);
+                    (
+                        true,
+                        format!(
+                            "hold armed: the cell pauses when robot {} next waits at a hold \
+                             point or gate (the run-time contract holds no single robot)",
+                            k + 1
+                        ),
+                    )
+                }
+                Some(_) if !handle.can_hold => {
+                    (false, "this plan has no hold points: use pause".to_string())
+                }
+                _ => (
+                    false,
+                    format!("hold needs a robot in 1..={}", handle.n_robots),
+                ),
+            },
+        }
+    }
+}

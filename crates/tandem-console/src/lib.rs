@@ -1,0 +1,31 @@
+//! The operator's console (issue 42): a web page that tells one person which robot needs
+//! them now (the red indicator of the paper's Fig. 1), and which will next, fed live by a
+//! control loop.
+//!
+//! - [`Console::start`] serves one static page (no external resource: it works in a cell
+//!   without internet) on 127.0.0.1 by default, the state as server-sent events, the
+//!   operator's controls by POST (docs/formats.md, "The operator's console").
+//! - [`ConsoleHandle`] is the loop's side: [`ConsoleHandle::publish`] after each tick
+//!   (lock-free, allocation-free, never blocking: a slow page drops frames, the robot is never
+//!   delayed) and the controls back through a bounded queue the loop polls
+//!   ([`Driver::apply`] at a tick boundary).
+//! - [`simulate`] runs a simulated cell from a planner in real time through the same handle
+//!   (`tandem console STATE --simulate`).
+//! - [`Frame`] is what the page receives; the page's machine-checkable DOM
+//!   (`data-robot`, `data-state`, `data-attention`, `data-next-robot`, `data-next-s`) is
+//!   documented in docs/formats.md.
+
+mod error;
+mod frame;
+mod handle;
+mod server;
+mod sim;
+
+pub use error::{Error, Result};
+pub use frame::{
+    Ack, Attention, DEFAULT_HORIZON_S, DEFAULT_LEAD_S, Frame, Geometry, Health, NextHandover,
+    RawFrame, RawRobot, RobotFrame, RobotState, Stretch, build_frame, next_handover,
+};
+pub use handle::{ConsoleCell, ConsoleHandle, ControlMsg, Driver, Op};
+pub use server::{Console, ConsoleConfig, PAGE};
+pub use sim::{SimParams, simulate, tick_now};
