@@ -459,7 +459,7 @@ const CLEAR_STEPS: i32 = 8;
 /// high-confidence, the optimum drops below the re-timed incumbent, whose events never move
 /// earlier; if the optimum itself fails the margins, no other `N ≥ 3` candidate is built from
 /// it, and the incumbent stays far above the bound for every later round.
-fn cleared_optimum(
+pub(crate) fn cleared_optimum(
     problem: &Problem,
     held: &Schedule,
     tick_s: f64,
@@ -881,6 +881,31 @@ fn schedule_n(
         }
         if t < best.1 {
             best = (schedule, t, Source::Staggered);
+        }
+    }
+    // N ≥ 3 with hold points: the optimum without release rules (whose planned waits cost the
+    // way from each hold to the next run at every switch), re-timed with clearances only where
+    // the check's pairs lack room, below the best so far (docs/decisions.md, "Per-pair
+    // clearances for N ≥ 3 (issue 38)").
+    if plan.bound == BoundBy::Many
+        && let Some(optimum) = bound.schedule.as_ref()
+        && !problem.usable_holds().is_empty()
+        && optimum.t_total_s(problem.dt_s()) < best.1
+    {
+        let timed = Schedule {
+            tick_s,
+            ..optimum.clone()
+        };
+        let (paired, used) = crate::clearance::pair_cleared(
+            problem,
+            &timed,
+            tick_s,
+            best.1,
+            crate::clearance::MAX_PAIR_CHECKS,
+        );
+        checks += used;
+        if let Some((s, t)) = paired {
+            best = (s, t, Source::Held);
         }
     }
     stats.completion_margin_checks = checks;

@@ -55,6 +55,7 @@
 
 mod checked;
 mod choose;
+mod clearance;
 pub mod cyclic;
 mod error;
 pub mod exact;

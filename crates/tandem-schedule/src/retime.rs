@@ -51,6 +51,44 @@ pub(crate) fn retime(
     tick_s: f64,
     extra_clear_s: f64,
 ) -> Option<Schedule> {
+    retime_with_pairs(problem, previous, tick_s, extra_clear_s, &[], false)
+}
+
+/// A clearance of one pair of low-confidence (LC) runs of different robots for
+/// [`retime_with_pairs`]: robot `cur.0`'s LC run `cur.1` starts at least `extra_s` (s, ≥ 0)
+/// later after the end of robot `prev.0`'s LC run `prev.1` than it did in the previous
+/// schedule (and never before that end). Runs are counted among the problem's LC runs in
+/// reference order, robots from 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PairClearance {
+    /// `(robot, LC run)` of the earlier run.
+    pub(crate) prev: (usize, usize),
+    /// `(robot, LC run)` of the later run.
+    pub(crate) cur: (usize, usize),
+    /// The clearance added (s, ≥ 0).
+    pub(crate) extra_s: f64,
+}
+
+/// [`retime`] with, beside the uniform `extra_clear_s` between consecutive runs, one more
+/// difference constraint per entry of `pairs` ([`PairClearance`]; entries naming a robot or
+/// run the schedule does not have are ignored): the clearances of the margin check's failing
+/// pairs, each only where it fails (docs/decisions.md, "Per-pair clearances for N ≥ 3").
+///
+/// With `dwell_anywhere`, an HC gap in which the robot keeps no hold of `previous` but the
+/// problem has a usable hold point is unbounded too: time beyond its gradients becomes a
+/// planned dwell at the gap's last usable hold, which the result then lists (holds added this
+/// way that get no dwell are left out). Without it only `previous`'s holds may dwell (as
+/// [`retime`]): a schedule that lists only the holds it dwells at (the margin-free optimum's)
+/// would otherwise have every gap without a dwell rigid at its `ψ̇max`, and a clearance that
+/// reaches robot 1 (whose start is the origin) through such gaps has no solution.
+pub(crate) fn retime_with_pairs(
+    problem: &Problem,
+    previous: &Schedule,
+    tick_s: f64,
+    extra_clear_s: f64,
+    pairs: &[PairClearance],
+    dwell_anywhere: bool,
+) -> Option<Schedule> {
     let n_ref = problem.n_ref();
     let n_robots = previous.n_robots();
     if previous.check_shape().is_err()
@@ -103,6 +141,25 @@ pub(crate) fn retime(
                 .collect()
         })
         .collect();
+    // Holds added where the robot keeps none in a gap but the problem has a usable one (the
+    // gap's last), with `dwell_anywhere`.
+    let mut added: Vec<Vec<usize>> = vec![Vec::new(); n_robots];
+    let mut kept = kept;
+    if dwell_anywhere {
+        for (i, hs) in kept.iter_mut().enumerate() {
+            for &(a, b) in &gaps {
+                if hs.iter().any(|h| a < h.ref_idx && h.ref_idx < b) {
+                    continue;
+                }
+                let last = usable.partition_point(|&n| n < b);
+                if last > 0 && usable[last - 1] > a {
+                    added[i].push(usable[last - 1]);
+                    hs.push(Hold::at(usable[last - 1]));
+                }
+            }
+            hs.sort_by_key(|h| h.ref_idx);
+        }
+    }
     let gap_held = |i: usize, g: usize| {
         kept[i]
             .iter()
@@ -166,6 +223,14 @@ pub(crate) fn retime(
             push(lc_var(i, k), lc_var(j, l), lc_s[k] + clear_s);
         }
     }
+    for pc in pairs {
+        let ((i, k), (j, l)) = (pc.prev, pc.cur);
+        if i == j || i >= n_robots || j >= n_robots || k >= m || l >= m {
+            continue;
+        }
+        let clear_s = (old_at[j][lc[l].0] - old_at[i][lc[k].1]).max(0.0) + pc.extra_s.max(0.0);
+        push(lc_var(i, k), lc_var(j, l), lc_s[k] + clear_s);
+    }
     let x = match longest_paths(&edges, n_vars, 0.0) {
         Some(x) => x,
         None => longest_paths(&edges, n_vars, relax_tolerance(&edges, n_vars))?,
@@ -210,6 +275,9 @@ pub(crate) fn retime(
             }
         }
         warps.push(warp);
+    }
+    for (hs, added) in holds_out.iter_mut().zip(&added) {
+        hs.retain(|h| h.dwell_s > 0.0 || added.binary_search(&h.ref_idx).is_err());
     }
     if holds_out.iter().all(Vec::is_empty) {
         holds_out.clear();
