@@ -902,9 +902,13 @@ fn schedule_n(
             tick_s,
             best.1,
             crate::clearance::MAX_PAIR_CHECKS,
+            sw,
         );
         checks += used;
         if let Some((s, t)) = paired {
+            if capping {
+                pool.push((s.clone(), t, Source::Held));
+            }
             best = (s, t, Source::Held);
         }
     }

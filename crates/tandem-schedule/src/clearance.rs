@@ -28,7 +28,7 @@ use crate::choose::max_step_s;
 use crate::problem::Problem;
 use crate::retime::{PairClearance, retime_with_pairs};
 use crate::schedule::Schedule;
-use crate::validate::validate;
+use crate::validate::validate_with_switch;
 
 /// A pair of LC runs the check measured: `(robot, LC run)` before and after, and its slack
 /// (schedule-clock s, `> 0` when the pair has room).
@@ -38,12 +38,15 @@ type Measured = ((usize, usize), (usize, usize), f64);
 type RunPair = ((usize, usize), (usize, usize));
 
 /// Margin checks [`pair_cleared`] may spend on one re-schedule (each iteration costs one
-/// measurement of every pair's slack; the final [`validate`] one more).
+/// measurement of every pair's slack; the final [`validate_with_switch`] one more).
 pub(crate) const MAX_PAIR_CHECKS: usize = 12;
 
 /// `optimum` (the margin-free optimum of `N ≥ 3` robots, its holds without release rules)
 /// re-timed with per-pair clearances (see the module docs): the first re-timing that passes
-/// [`validate`] with `T_total` below `cap_s` (s), and the margin checks used (at most
+/// [`validate_with_switch`] at the operator's switch time `switch_s` (s; the pairs' slacks are
+/// measured without it, so with `switch_s > 0` a re-timing the final check refuses ends the
+/// search, never a schedule that breaks it) with `T_total` below `cap_s` (s), and the margin
+/// checks used (at most
 /// `max_checks + 1`). `None` when a pair cannot be named by its runs, the re-timing has no
 /// solution (the optimum interleaves robots between LC runs whose HC gaps have neither room
 /// nor a usable hold), or no re-timing below `cap_s` passes within the budget.
@@ -53,6 +56,7 @@ pub(crate) fn pair_cleared(
     tick_s: f64,
     cap_s: f64,
     max_checks: usize,
+    switch_s: f64,
 ) -> (Option<(Schedule, f64)>, usize) {
     let dt_s = problem.dt_s();
     let grow_s = max_step_s(problem, tick_s) / 10.0;
@@ -83,7 +87,7 @@ pub(crate) fn pair_cleared(
         let failing: Vec<Measured> = measured.into_iter().filter(|m| m.2 <= 0.0).collect();
         if failing.is_empty() {
             checks += 1;
-            if validate(problem, &s).is_ok() {
+            if validate_with_switch(problem, &s, switch_s).is_ok() {
                 return (Some((s, t)), checks);
             }
             break;
@@ -157,8 +161,9 @@ mod tests {
 
     use super::*;
     use crate::choose::cleared_optimum;
-    use crate::exact::{ExactParams, bound_many};
+    use crate::exact::{ExactParams, bound_many_switch};
     use crate::testkit::{hold_points, random_problem};
+    use crate::validate::validate;
 
     /// Three robots on the test kit's random problem of seed 5 (300–600 samples of 10 ms,
     /// a hold in the middle of every HC run), tick 20 ms. Measured when the per-pair
@@ -172,7 +177,7 @@ mod tests {
         let p = random_problem(&mut rng, 300..=600, 0.01).unwrap();
         let p = p.clone().with_holds(hold_points(p.conf())).unwrap();
         let (n, tick_s) = (3, 0.02);
-        let bound = bound_many(&p, n, &ExactParams::default());
+        let bound = bound_many_switch(&p, n, &ExactParams::default(), 0.0);
         assert!(bound.proven_optimal);
         let optimum = Schedule {
             tick_s,
@@ -182,8 +187,12 @@ mod tests {
         assert!(validate(&p, &held).is_err());
         let serial_s = p.serial_schedule_n(n, tick_s).unwrap().t_total_s(p.dt_s());
         assert!((serial_s - 9.259).abs() < 1e-3, "{serial_s}");
-        assert!(cleared_optimum(&p, &held, tick_s, serial_s).0.is_none());
-        let (found, checks) = pair_cleared(&p, &optimum, tick_s, serial_s, MAX_PAIR_CHECKS);
+        assert!(
+            cleared_optimum(&p, &held, tick_s, serial_s, 0.0)
+                .0
+                .is_none()
+        );
+        let (found, checks) = pair_cleared(&p, &optimum, tick_s, serial_s, MAX_PAIR_CHECKS, 0.0);
         let (s, t) = found.unwrap();
         validate(&p, &s).unwrap();
         assert!(checks <= MAX_PAIR_CHECKS + 1);
