@@ -47,7 +47,7 @@ pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
     };
     if a.json {
         out(&serde_json::to_string_pretty(
-            &crate::json::CyclicPlanOut::from(plan),
+            &tandem::planner::json::CyclicPlanJson::from(plan),
         )?);
     } else {
         out(&plan_text(problem, plan, crate::cmd::verbose())?);
