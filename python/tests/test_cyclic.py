@@ -90,6 +90,14 @@ def test_the_plan_is_read_only_and_prints_its_numbers() -> None:
     text = repr(plan)
     assert text.startswith("CyclicPlan(n_robots=2, period_s=2.000")
     doc = json.loads(plan.to_json())
+    # The documented form (docs/formats.md, "Cyclic plan JSON"), keys in the documented order:
+    # the planner's CyclicPlanJson, the one type the command line prints too.
+    assert list(doc) == [
+        "n_robots", "order", "period_s", "lc_s", "robots", "tasks_per_hour",
+        "operator_share", "lower_bound_s", "gap", "order_exhaustive", "orders_evaluated",
+    ]
+    assert list(doc["robots"][0]) == ["start_s", "lc_start_s", "gaps", "start_wait_s"]
+    assert list(doc["robots"][0]["gaps"][0]) == ["duration_s", "wait_s", "hold"]
     assert doc["period_s"] == plan.period_s
     assert [(s["robot"], s["lc"]) for s in doc["order"]] == plan.order
     assert [r["start_s"] for r in doc["robots"]] == plan.start_s.tolist()

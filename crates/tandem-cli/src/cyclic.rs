@@ -52,7 +52,7 @@ pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
     };
     if a.json {
         out(&serde_json::to_string_pretty(
-            &crate::json::CyclicPlanOut::from(plan),
+            &tandem::planner::json::CyclicPlanJson::from(plan),
         )?);
     } else {
         let sp = &planner.params().sampler;

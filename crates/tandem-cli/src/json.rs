@@ -5,12 +5,13 @@
 //! keys against a committed golden shape.
 //!
 //! `schedule --json` is [`ScheduleDoc`], `inspect --json` [`InspectDoc`], `schedule --cell
-//! continuous --json` [`CyclicPlanOut`] and `inspect BAG --json` [`BagDoc`]. What the state
+//! continuous --json` `tandem::planner::json::CyclicPlanJson` (the planner's, shared with
+//! Python's `CyclicPlan.to_json()`) and `inspect BAG --json` [`BagDoc`]. What the state
 //! documents used to take from a library type's serde form is here too: the schedule
 //! ([`ScheduleOut`]), the declared hold points ([`HoldSpecOut`]), the confidence parameters
 //! ([`ConfidenceParamsOut`]), the operator's error rates ([`ErrorRatesOut`]) and the
 //! low-confidence regions ([`LowRegionOut`]). The cyclic plan is printed directly (keys in
-//! the order declared here, the documented one); the other documents through a
+//! the documented order); the other documents through a
 //! `serde_json::Value` (keys in alphabetical order).
 
 use serde::Serialize;
@@ -19,7 +20,6 @@ use tandem::lfd::HoldSpec;
 use tandem::planner::{ChannelShare, LowCause, LowRegion};
 use tandem::realtime::{After, Hold};
 use tandem::schedule::Schedule;
-use tandem::schedule::cyclic::{CyclicPlan, GapPlan, RobotCycle, Stretch};
 
 /// The document of `tandem schedule --json` and `schedule` of `tandem inspect --json`
 /// (docs/formats.md, "Schedule JSON"): times in seconds of global time, robots 1-based.
@@ -332,110 +332,6 @@ impl From<&LowRegion> for LowRegionOut {
             corrections: *corrections,
             expected_false_corrections: *expected_false_corrections,
             clean_executions_needed: *clean_executions_needed,
-        }
-    }
-}
-
-/// `tandem schedule --cell continuous --json`: the cyclic plan of a continuous cell
-/// (meaning of every field: docs/formats.md, "Cyclic plan JSON").
-#[derive(Serialize)]
-pub(crate) struct CyclicPlanOut {
-    n_robots: usize,
-    order: Vec<StretchOut>,
-    period_s: f64,
-    lc_s: Vec<f64>,
-    robots: Vec<RobotCycleOut>,
-    tasks_per_hour: f64,
-    operator_share: f64,
-    lower_bound_s: f64,
-    gap: f64,
-    order_exhaustive: bool,
-    orders_evaluated: usize,
-}
-
-/// One of [`CyclicPlanOut::order`]: robot and low-confidence stretch, both 0-based.
-#[derive(Serialize)]
-pub(crate) struct StretchOut {
-    robot: usize,
-    lc: usize,
-}
-
-/// One of [`CyclicPlanOut::robots`].
-#[derive(Serialize)]
-pub(crate) struct RobotCycleOut {
-    start_s: f64,
-    lc_start_s: Vec<f64>,
-    gaps: Vec<GapOut>,
-    start_wait_s: f64,
-}
-
-/// One of [`RobotCycleOut::gaps`].
-#[derive(Serialize)]
-pub(crate) struct GapOut {
-    duration_s: f64,
-    wait_s: f64,
-    hold: Option<usize>,
-}
-
-impl From<&CyclicPlan> for CyclicPlanOut {
-    fn from(p: &CyclicPlan) -> Self {
-        let CyclicPlan {
-            n_robots,
-            order,
-            period_s,
-            lc_s,
-            robots,
-            tasks_per_hour,
-            operator_share,
-            lower_bound_s,
-            gap,
-            order_exhaustive,
-            orders_evaluated,
-        } = p;
-        CyclicPlanOut {
-            n_robots: *n_robots,
-            order: order
-                .iter()
-                .map(|&Stretch { robot, lc }| StretchOut { robot, lc })
-                .collect(),
-            period_s: *period_s,
-            lc_s: lc_s.clone(),
-            robots: robots
-                .iter()
-                .map(|r| {
-                    let RobotCycle {
-                        start_s,
-                        lc_start_s,
-                        gaps,
-                        start_wait_s,
-                    } = r;
-                    RobotCycleOut {
-                        start_s: *start_s,
-                        lc_start_s: lc_start_s.clone(),
-                        gaps: gaps
-                            .iter()
-                            .map(
-                                |&GapPlan {
-                                     duration_s,
-                                     wait_s,
-                                     hold,
-                                 }| GapOut {
-                                    duration_s,
-                                    wait_s,
-                                    hold,
-                                },
-                            )
-                            .collect(),
-                        start_wait_s: *start_wait_s,
-                    }
-                })
-                .collect(),
-            tasks_per_hour: *tasks_per_hour,
-            operator_share: *operator_share,
-            lower_bound_s: *lower_bound_s,
-            gap: *gap,
-            order_exhaustive: *order_exhaustive,
-            orders_evaluated: *orders_evaluated,
         }
     }
 }

@@ -59,6 +59,7 @@ mod cell;
 mod error;
 mod explain;
 mod holds;
+pub mod json;
 mod planner;
 pub mod state;
 

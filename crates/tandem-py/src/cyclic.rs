@@ -283,9 +283,10 @@ impl PyCyclicPlan {
     }
 
     /// The plan as JSON, exactly what ``tandem schedule --cell continuous --json`` prints
-    /// (docs/formats.md).
+    /// (docs/formats.md, "Cyclic plan JSON"): the planner's documented form, the one type both
+    /// print (``tandem::planner::json::CyclicPlanJson``), not the library type's serde form.
     fn to_json(&self) -> PyResult<String> {
-        serde_json::to_string_pretty(&self.plan)
+        serde_json::to_string_pretty(&tandem::planner::json::CyclicPlanJson::from(&self.plan))
             .map_err(|e| Error::Panic(format!("cannot write the cyclic plan as JSON: {e}")).into())
     }
 

@@ -29,14 +29,15 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 use tandem_lfd::TaskModel;
-use tandem_planner::Planner;
+use tandem_planner::{ExecutionRecord, Planner};
 use tandem_realtime::Timeline;
 use tandem_schedule::{CheckedCyclicPlan, CyclicParams};
 
 use super::config::StudyConfig;
 use super::inputs::StudyInputs;
 use super::record::mean_std;
-use super::run::{PhaseTimes, Progress, fit_study_model, par_trials, start_trial, truth_operator};
+use super::run::{PhaseTimes, Progress, fit_study_model, par_trials};
+use super::trial::{TrialKind, TrialState, run_trial_loop};
 use crate::task::{self, Label};
 use crate::truth::{SandingTruth, TaskTruth, falsely_trusted_where};
 use crate::workcell::{CellSim, CellStats, FinishedTask, PlanGap, RobotPlan, RobotRun};
@@ -426,121 +427,205 @@ pub fn run_cell_trial_on(
     progress: &(dyn Fn(Progress) + Sync),
     observe: &(dyn Fn(&FinishedTask) + Sync),
 ) -> Result<CellTrialRun> {
-    let can_need = truth.can_need();
-    let mut times = PhaseTimes::default();
-    let t = Instant::now();
-    let (seed, mut planner, mut rng) = start_trial(config, model, truth, trial)?;
-    let n = planner.n_robots();
-    let (plan, first) = plan_of(&planner, can_need, 0, 0)?;
-    // The cell's tick: the plan's, the schedule's (`Δt_s` unless the sampler sets a tick).
-    let dt_s = plan.tick_s();
-    let coord = plan.coordinator();
-    times.scheduling += t.elapsed();
-    let mut sim = CellSim::new(planner.model(), coord, &truth_operator(config, truth))?;
-    let mut needed = (0..n)
-        .map(|_| truth.draw(&mut rng))
-        .collect::<Result<Vec<_>>>()?;
-    let total = config.executions;
-    // A task lasts at most Σ max(ψ̇min, ψ̇max) ticks plus one per sample (tick = Δt_s); even
-    // one robot at a time, the cell does its tasks within twice that each.
-    let slow_ticks: f64 =
-        planner.problem().grad_max().iter().sum::<f64>() + planner.problem().n_ref() as f64;
-    let budget = (total as f64 + 2.0 * n as f64) * (slow_ticks + 10.0) * 2.0 + 10_000.0;
-    let mut iterations = vec![first];
-    let mut completions = Vec::with_capacity(total + n);
-    let mut batch = Vec::with_capacity(n);
-    let mut recorded = 0;
-    // The period of the plan in force (a new plan may wait for its hand-over), each robot's
-    // last completion tick and its gate ticks then (for each task's PlanGap).
-    let mut period_s = iterations[0].period_s;
-    let mut pending_period_s: Option<f64> = None;
-    let mut last_done = vec![0_u64; n];
-    let mut gates_then = vec![0_u64; n];
-    while completions.len() < total {
-        if sim.stats().ticks as f64 >= budget {
-            return Err(Error::DidNotFinish {
-                ticks: budget as usize,
-            });
-        }
-        let t = Instant::now();
-        let finished = sim.tick(planner.model(), |robot, idx| needed[robot][idx], &mut rng)?;
-        times.simulation += t.elapsed();
-        if !sim.has_pending() {
-            if let Some(p) = pending_period_s.take() {
-                period_s = p;
+    run_trial_loop(config, model, truth, trial, progress, |state| {
+        ContinuousTrial::start(state, observe)
+    })
+}
+
+/// The continuous cell in the one trial loop ([`run_trial_loop`]): a batch is the next `N`
+/// tasks completed in a running [`CellSim`], whichever robots did them; the next plan takes
+/// over the running cell at its next hand-over point (module docs).
+struct ContinuousTrial<'a> {
+    /// Where the truth can need the operator (falsely trusted samples are counted on it).
+    can_need: &'a [bool],
+    /// Sees every completed task before it is recorded.
+    observe: &'a (dyn Fn(&FinishedTask) + Sync),
+    /// The running cell.
+    sim: CellSim,
+    /// Each robot's workpiece of its current task: where it needs the operator.
+    needed: Vec<Vec<bool>>,
+    /// Robots `N`.
+    n: usize,
+    /// Tasks per trial (`config.executions`).
+    total: usize,
+    /// Ticks after which the trial is a bug ([`Error::DidNotFinish`]).
+    budget: f64,
+    /// The cell's tick (s): the first plan's, the schedule's.
+    dt_s: f64,
+    /// The plans so far, the first one first.
+    iterations: Vec<CellIteration>,
+    /// Every completed task so far, in completion order.
+    completions: Vec<CellCompletion>,
+    /// Records of the completed tasks not yet recorded into the planner.
+    batch: Vec<ExecutionRecord>,
+    /// Tasks recorded into the planner.
+    recorded: usize,
+    /// The period (s) of the plan in force.
+    period_s: f64,
+    /// The period (s) of a new plan waiting for its hand-over.
+    pending_period_s: Option<f64>,
+    /// Each robot's last completion tick and its gate ticks then (for each task's PlanGap).
+    last_done: Vec<u64>,
+    gates_then: Vec<u64>,
+    /// Tasks completed in the last tick not yet taken (a batch can end inside a tick: the
+    /// rest are taken after the re-plan, under the new model and plan).
+    finished: std::vec::IntoIter<FinishedTask>,
+}
+
+impl<'a> ContinuousTrial<'a> {
+    /// The cell on the trial's first plan, every robot's first workpiece drawn (robot order).
+    fn start(
+        state: &mut TrialState<'a>,
+        observe: &'a (dyn Fn(&FinishedTask) + Sync),
+    ) -> Result<Self> {
+        let can_need = state.truth.can_need();
+        let planner = &state.planner;
+        let n = planner.n_robots();
+        let (plan, first) = plan_of(planner, can_need, 0, 0)?;
+        // The cell's tick: the plan's, the schedule's (`Δt_s` unless the sampler sets a tick).
+        let dt_s = plan.tick_s();
+        let sim = CellSim::new(planner.model(), plan.coordinator(), &state.operator)?;
+        let needed = (0..n)
+            .map(|_| state.truth.draw(&mut state.rng))
+            .collect::<Result<Vec<_>>>()?;
+        let total = state.config.executions;
+        // A task lasts at most Σ max(ψ̇min, ψ̇max) ticks plus one per sample (tick = Δt_s);
+        // even one robot at a time, the cell does its tasks within twice that each.
+        let problem = planner.problem();
+        let slow_ticks: f64 = problem.grad_max().iter().sum::<f64>() + problem.n_ref() as f64;
+        Ok(ContinuousTrial {
+            can_need,
+            observe,
+            sim,
+            needed,
+            n,
+            total,
+            budget: (total as f64 + 2.0 * n as f64) * (slow_ticks + 10.0) * 2.0 + 10_000.0,
+            dt_s,
+            period_s: first.period_s,
+            iterations: vec![first],
+            completions: Vec::with_capacity(total + n),
+            batch: Vec::with_capacity(n),
+            recorded: 0,
+            pending_period_s: None,
+            last_done: vec![0; n],
+            gates_then: vec![0; n],
+            finished: Vec::new().into_iter(),
+        })
+    }
+
+    /// Takes a completed task: its completion (with its [`task_gap`] against the plan in
+    /// force), the observer, the robot's next workpiece, its record into the batch. Returns
+    /// whether the batch is full and recordable (`N` tasks, within the trial's total).
+    fn take(&mut self, state: &mut TrialState<'_>, f: FinishedTask) -> Result<bool> {
+        let stats = self.sim.stats();
+        let i = f.robot;
+        let gates = stats.gate_ticks[i];
+        let plan_gap = task_gap(
+            &f.run,
+            f.tick - self.last_done[i],
+            gates - self.gates_then[i],
+            self.dt_s,
+            self.period_s,
+            self.sim.coordinator().task(),
+        );
+        (self.last_done[i], self.gates_then[i]) = (f.tick, gates);
+        let needed = &self.needed[i];
+        let unsupervised = f
+            .run
+            .ref_time_log
+            .iter()
+            .zip(&f.run.supervised)
+            .filter(|&(&t, &sup)| !sup && needed[t.max(0.0).round() as usize])
+            .count();
+        self.completions.push(CellCompletion {
+            robot: i,
+            tick: f.tick,
+            busy_ticks: stats.busy_ticks,
+            gate_ticks: stats.gate_ticks.iter().sum(),
+            plan_gap,
+            needed_unsupervised: unsupervised,
+        });
+        (self.observe)(&f);
+        self.needed[i] = state.truth.draw(&mut state.rng)?;
+        self.batch.push(f.run.record(state.planner.model())?);
+        Ok(self.batch.len() >= self.n && self.recorded + self.n <= self.total)
+    }
+}
+
+impl TrialKind for ContinuousTrial<'_> {
+    type Run = CellTrialRun;
+
+    fn next_batch(
+        &mut self,
+        state: &mut TrialState<'_>,
+        _round: usize,
+    ) -> Result<Option<Vec<ExecutionRecord>>> {
+        loop {
+            while let Some(f) = self.finished.next() {
+                if self.take(state, f)? {
+                    return Ok(Some(std::mem::take(&mut self.batch)));
+                }
             }
-        }
-        for f in finished {
-            let stats = sim.stats();
-            let i = f.robot;
-            let gates = stats.gate_ticks[i];
-            let plan_gap = task_gap(
-                &f.run,
-                f.tick - last_done[i],
-                gates - gates_then[i],
-                dt_s,
-                period_s,
-                sim.coordinator().task(),
-            );
-            (last_done[i], gates_then[i]) = (f.tick, gates);
-            let unsupervised = f
-                .run
-                .ref_time_log
-                .iter()
-                .zip(&f.run.supervised)
-                .filter(|&(&t, &sup)| !sup && needed[i][t.max(0.0).round() as usize])
-                .count();
-            completions.push(CellCompletion {
-                robot: f.robot,
-                tick: f.tick,
-                busy_ticks: stats.busy_ticks,
-                gate_ticks: stats.gate_ticks.iter().sum(),
-                plan_gap,
-                needed_unsupervised: unsupervised,
-            });
-            observe(&f);
-            needed[f.robot] = truth.draw(&mut rng)?;
-            batch.push(f.run.record(planner.model())?);
-            if batch.len() < n || recorded + n > total {
-                continue;
+            if self.completions.len() >= self.total {
+                return Ok(None);
             }
-            let report = planner.record_round(&batch)?;
-            batch.clear();
-            recorded += n;
-            times.model_update += report.model_update;
-            times.confidence += report.confidence;
-            times.scheduling += report.scheduling;
+            if self.sim.stats().ticks as f64 >= self.budget {
+                return Err(Error::DidNotFinish {
+                    ticks: self.budget as usize,
+                });
+            }
             let t = Instant::now();
-            let (plan, iteration) = plan_of(&planner, can_need, recorded, sim.stats().ticks)?;
-            let next = plan.coordinator();
-            times.scheduling += t.elapsed();
-            if sim.replan(planner.model(), next)? {
-                period_s = iteration.period_s;
-                pending_period_s = None;
-            } else {
-                pending_period_s = Some(iteration.period_s);
+            let needed = &self.needed;
+            let finished = self.sim.tick(
+                state.planner.model(),
+                |robot, idx| needed[robot][idx],
+                &mut state.rng,
+            )?;
+            state.times.simulation += t.elapsed();
+            if !self.sim.has_pending() {
+                if let Some(p) = self.pending_period_s.take() {
+                    self.period_s = p;
+                }
             }
-            iterations.push(iteration);
-            progress(Progress {
-                trial,
-                rounds_done: recorded / n,
-            });
+            self.finished = finished.into_iter();
         }
     }
-    completions.truncate(total);
-    let steady = Steady::of(&completions, n, dt_s).expect("at least one task");
-    Ok(CellTrialRun {
-        result: CellTrialResult {
-            trial,
-            seed,
-            iterations,
-            completions,
-            stats: sim.stats().clone(),
-            steady,
-        },
-        times,
-        planner,
-    })
+
+    fn replan(&mut self, state: &mut TrialState<'_>) -> Result<()> {
+        self.recorded += self.n;
+        let t = Instant::now();
+        let planner = &state.planner;
+        let tick = self.sim.stats().ticks;
+        let (plan, iteration) = plan_of(planner, self.can_need, self.recorded, tick)?;
+        let next = plan.coordinator();
+        state.times.scheduling += t.elapsed();
+        if self.sim.replan(planner.model(), next)? {
+            self.period_s = iteration.period_s;
+            self.pending_period_s = None;
+        } else {
+            self.pending_period_s = Some(iteration.period_s);
+        }
+        self.iterations.push(iteration);
+        Ok(())
+    }
+
+    fn finish(mut self, state: TrialState<'_>) -> Result<CellTrialRun> {
+        self.completions.truncate(self.total);
+        let steady = Steady::of(&self.completions, self.n, self.dt_s).expect("at least one task");
+        Ok(CellTrialRun {
+            result: CellTrialResult {
+                trial: state.trial,
+                seed: state.seed,
+                iterations: self.iterations,
+                completions: self.completions,
+                stats: self.sim.stats().clone(),
+                steady,
+            },
+            times: state.times,
+            planner: state.planner,
+        })
+    }
 }
 
 /// Runs every trial of the continuous study from a fitted model, in parallel (rayon); the

@@ -11,6 +11,7 @@ mod config;
 mod inputs;
 mod record;
 mod run;
+mod trial;
 
 pub use cell::{
     CellCompletion, CellIteration, CellStudyResult, CellSummary, CellTrialResult, CellTrialRun,

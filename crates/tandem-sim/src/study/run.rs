@@ -7,11 +7,12 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use tandem_lfd::TaskModel;
-use tandem_planner::{Planner, derive_seed};
+use tandem_planner::{ExecutionRecord, Planner, derive_seed};
 
 use super::config::StudyConfig;
 use super::inputs::StudyInputs;
 use super::record::{IterationRecord, RoundStats, StudyResult, TrialResult, throughput_per_h};
+use super::trial::{TrialKind, TrialState, run_trial_loop};
 use crate::task::{self, Label};
 use crate::truth::{OperatorTally, SandingTruth, TaskTruth, falsely_trusted_where};
 use crate::workcell::{self, OperatorParams};
@@ -214,83 +215,120 @@ pub fn run_trial_on(
     progress: &(dyn Fn(Progress) + Sync),
     observe: &(dyn Fn(RoundView<'_>) + Sync),
 ) -> Result<TrialRun> {
-    let can_need = truth.can_need();
-    let mut times = PhaseTimes::default();
-    let t = Instant::now();
-    let (seed, mut planner, mut rng) = start_trial(config, model, truth, trial)?;
-    times.scheduling += t.elapsed();
-    let operator = truth_operator(config, truth);
-    let n_rounds = config.n_rounds();
-    let n_robots = planner.n_robots();
-    let mut iterations = Vec::with_capacity(n_rounds + 1);
-    let mut tally = OperatorTally::default();
-    for round in 0..n_rounds {
-        let mut record = iteration_record(&planner, can_need, &tally)?;
-        let needed = (0..n_robots)
-            .map(|_| truth.draw(&mut rng))
+    run_trial_loop(config, model, truth, trial, progress, |state| {
+        let can_need = state.truth.can_need();
+        let tally = OperatorTally::default();
+        let first = iteration_record(&state.planner, can_need, &tally)?;
+        let mut iterations = Vec::with_capacity(config.n_rounds() + 1);
+        iterations.push(first);
+        Ok(Rounds {
+            can_need,
+            observe,
+            n_rounds: config.n_rounds(),
+            tally,
+            iterations,
+        })
+    })
+}
+
+/// Rounds in the one trial loop ([`run_trial_loop`]): a batch is one round of the planner's
+/// schedule, every robot's workpiece drawn from the truth (robot 1 first); the next plan is
+/// the schedule the planner made while recording it.
+struct Rounds<'a> {
+    /// Where the truth can need the operator (falsely trusted samples are counted on it).
+    can_need: &'a [bool],
+    /// Sees every round after it ran, before it is recorded.
+    observe: &'a (dyn Fn(RoundView<'_>) + Sync),
+    /// Rounds per trial.
+    n_rounds: usize,
+    /// What the simulated operator did so far.
+    tally: OperatorTally,
+    /// The records so far; the last one is the current schedule's, its round not run yet.
+    iterations: Vec<IterationRecord>,
+}
+
+impl TrialKind for Rounds<'_> {
+    type Run = TrialRun;
+
+    fn next_batch(
+        &mut self,
+        state: &mut TrialState<'_>,
+        round: usize,
+    ) -> Result<Option<Vec<ExecutionRecord>>> {
+        if round > self.n_rounds {
+            return Ok(None);
+        }
+        let planner = &state.planner;
+        let needed = (0..planner.n_robots())
+            .map(|_| state.truth.draw(&mut state.rng))
             .collect::<Result<Vec<_>>>()?;
         let t = Instant::now();
-        let at = |e: Error| Error::InTrial {
-            trial,
-            round: round + 1,
-            source: Box::new(e),
-        };
         let run = workcell::run_round_with(
-            &planner,
+            planner,
             |robot, ref_idx| needed[robot][ref_idx],
-            &operator,
-            &mut rng,
+            &state.operator,
+            &mut state.rng,
         )
-        .map_err(at)?;
+        .map_err(|e| state.in_round(round, e))?;
         let records = run.records(planner.model())?;
-        times.simulation += t.elapsed();
-        tally.add(&run);
-        let count = |f: fn(&bool) -> bool, pick: fn(&workcell::RobotRun) -> &Vec<bool>| {
-            run.robots
-                .iter()
-                .map(|r| pick(r).iter().filter(|b| f(b)).count())
-                .sum()
-        };
-        observe(RoundView {
-            trial,
-            round: round + 1,
-            planner: &planner,
+        state.times.simulation += t.elapsed();
+        self.tally.add(&run);
+        (self.observe)(RoundView {
+            trial: state.trial,
+            round,
+            planner,
             run: &run,
         });
-        record.round = Some(RoundStats {
-            overlap_ticks: run.overlap_ticks,
-            operator_idle_share: run.operator_idle_share(),
-            duration_s: run.duration_s(),
-            supervised_ticks: count(|b| *b, |r| &r.supervised),
-            corrected_ticks: count(|b| *b, |r| &r.corrected),
-            operator_busy_share: run.operator_busy_share(),
-            faults: run.faults,
-            robot_wait_share: run.robot_wait_share(),
-            hold_ticks: run.robots.iter().map(|r| r.hold_ticks).sum(),
-            plan_gap: run.plan_gap,
-            needed_unsupervised: run.needed_unsupervised(|robot, n| needed[robot][n]),
-            switch_missed: run.robots.iter().map(|r| r.switch_missed).sum(),
-        });
-        iterations.push(record);
-        let report = planner.record_round(&records).map_err(|e| at(e.into()))?;
-        times.model_update += report.model_update;
-        times.confidence += report.confidence;
-        times.scheduling += report.scheduling;
-        progress(Progress {
-            trial,
-            rounds_done: round + 1,
-        });
+        let record = self
+            .iterations
+            .last_mut()
+            .expect("the loop's start pushed the first schedule's record");
+        record.round = Some(round_stats(&run, &needed));
+        Ok(Some(records))
     }
-    iterations.push(iteration_record(&planner, can_need, &tally)?);
-    Ok(TrialRun {
-        result: TrialResult {
-            trial,
-            seed,
-            iterations,
-        },
-        times,
-        planner,
-    })
+
+    fn replan(&mut self, state: &mut TrialState<'_>) -> Result<()> {
+        let record = iteration_record(&state.planner, self.can_need, &self.tally)?;
+        self.iterations.push(record);
+        Ok(())
+    }
+
+    fn finish(self, state: TrialState<'_>) -> Result<TrialRun> {
+        Ok(TrialRun {
+            result: TrialResult {
+                trial: state.trial,
+                seed: state.seed,
+                iterations: self.iterations,
+            },
+            times: state.times,
+            planner: state.planner,
+        })
+    }
+}
+
+/// What a round did ([`RoundStats`]); `needed[robot][n]`: whether robot `robot`'s
+/// workpiece needed the operator at reference sample `n`.
+fn round_stats(run: &workcell::RoundRun, needed: &[Vec<bool>]) -> RoundStats {
+    let count = |pick: fn(&workcell::RobotRun) -> &Vec<bool>| {
+        run.robots
+            .iter()
+            .map(|r| pick(r).iter().filter(|b| **b).count())
+            .sum()
+    };
+    RoundStats {
+        overlap_ticks: run.overlap_ticks,
+        operator_idle_share: run.operator_idle_share(),
+        duration_s: run.duration_s(),
+        supervised_ticks: count(|r| &r.supervised),
+        corrected_ticks: count(|r| &r.corrected),
+        operator_busy_share: run.operator_busy_share(),
+        faults: run.faults,
+        robot_wait_share: run.robot_wait_share(),
+        hold_ticks: run.robots.iter().map(|r| r.hold_ticks).sum(),
+        plan_gap: run.plan_gap,
+        needed_unsupervised: run.needed_unsupervised(|robot, n| needed[robot][n]),
+        switch_missed: run.robots.iter().map(|r| r.switch_missed).sum(),
+    }
 }
 
 /// Runs the study (§III): fits the model once, then runs the trials ([`run_trials`]).
