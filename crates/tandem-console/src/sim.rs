@@ -91,6 +91,7 @@ pub fn tick_now<C: Controller + ?Sized>(ctl: &C) -> Tick {
         running: ctl.running_now(),
         waiting: ctl.waiting_now(),
         fault: ctl.fault(),
+        next: ctl.pre_alert(),
     }
 }
 

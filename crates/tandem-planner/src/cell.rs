@@ -238,6 +238,9 @@ impl Controller for AnyController {
     fn waiting_now(&self) -> RobotFlags {
         each!(self, c => Controller::waiting_now(c))
     }
+    fn pre_alert(&self) -> Option<tandem_realtime::PreAlert> {
+        each!(self, c => Controller::pre_alert(c))
+    }
     fn ref_time_now(&self) -> PerRobot<f64> {
         each!(self, c => Controller::ref_time_now(c))
     }

@@ -142,8 +142,11 @@ fn the_controllers_run_with_the_planners_switch_time() {
     params.sampler.switch_s = 0.5;
     p = {
         let demo = |press: f64| {
-            let force = (0..40)
-                .map(|n| if (10..20).contains(&n) { press } else { 1.0 })
+            // High-confidence head and tail of 0.9 s each, long enough that a serial
+            // schedule keeps 0.5 s between the two robots' stretches even when the worst
+            // case runs them at their fastest.
+            let force = (0..200)
+                .map(|n| if (90..110).contains(&n) { press } else { 1.0 })
                 .collect();
             Demonstration::new(vec!["force".into()], force, 0.01).unwrap()
         };

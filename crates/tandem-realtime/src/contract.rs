@@ -140,6 +140,12 @@ pub trait Controller {
     /// (rounds) or at its next group's gate (the continuous cell).
     fn waiting_now(&self) -> RobotFlags;
 
+    /// The pre-alert now: the value the last [`Tick::next`] reported (the next low-confidence
+    /// stretch of any robot and the bounds on its start, real s from the end of the last tick;
+    /// [`crate::prealert`]), for a caller that reads the controller between ticks. O(N), no
+    /// allocation.
+    fn pre_alert(&self) -> Option<crate::PreAlert>;
+
     /// Each robot's fractional reference time now (reference samples, in its current task):
     /// the value the last [`Tick::ref_time`] reported (0 at the start). Never decreases within
     /// a task.

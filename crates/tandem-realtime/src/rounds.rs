@@ -770,6 +770,10 @@ impl Controller for Coordinator {
         Coordinator::waiting_now(self)
     }
 
+    fn pre_alert(&self) -> Option<crate::PreAlert> {
+        Coordinator::pre_alert(self)
+    }
+
     fn ref_time_now(&self) -> PerRobot<f64> {
         Coordinator::ref_time_now(self)
     }

@@ -56,6 +56,9 @@ impl<C: Controller> Controller for Watch<C> {
     fn waiting_now(&self) -> RobotFlags {
         self.inner.waiting_now()
     }
+    fn pre_alert(&self) -> Option<tandem_realtime::PreAlert> {
+        self.inner.pre_alert()
+    }
     fn ref_time_now(&self) -> PerRobot<f64> {
         self.inner.ref_time_now()
     }

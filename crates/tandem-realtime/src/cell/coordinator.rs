@@ -746,6 +746,10 @@ impl Controller for ContinuousCoordinator {
         self.at_gate_now()
     }
 
+    fn pre_alert(&self) -> Option<crate::PreAlert> {
+        ContinuousCoordinator::pre_alert(self)
+    }
+
     /// O(N log T_ref): each robot's reference time at its clock ([`Self::position_now`]).
     fn ref_time_now(&self) -> PerRobot<f64> {
         let mut out = PerRobot::new(self.n);
