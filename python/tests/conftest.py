@@ -20,7 +20,8 @@ LABELS = SANDING
 
 #: Sampler size of the tests' planners (the paper's 5000 is not needed to test the plumbing).
 SAMPLES = 200
-#: A confidence that latches after a couple of pairs, so that schedules overlap quickly.
+#: A confidence that latches as soon as the votes allow (ten, five pairs), so that schedules
+#: overlap quickly.
 QUICK_CONFIDENCE = {"mu_c": 0.3, "gamma_c": 0.5}
 
 
@@ -57,11 +58,12 @@ def planner() -> tandem.Planner:
 
 @pytest.fixture(scope="session")
 def overlapping_planner() -> tandem.Planner:
-    """A planner whose schedule overlaps the robots (quick confidence, two rounds recorded)."""
+    """A planner whose schedule overlaps the robots (quick confidence, five rounds recorded:
+    ten votes, the fewest on which a supervised sample is trusted, `MIN_VOTES`)."""
     p = tandem.fit(
         DEMOS,
         params={"sampler": {"samples": SAMPLES, "seed": 3}, "confidence": QUICK_CONFIDENCE},
     )
-    record_rounds(p, 2)
+    record_rounds(p, 5)
     assert p.schedule.offsets[0] < p.schedule.durations_s[0] / 2, "the robots overlap"
     return p

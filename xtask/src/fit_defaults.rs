@@ -87,6 +87,9 @@ struct FitView {
     sigma2_mean: f64,
     /// Median of `σ²_D` over the reference samples.
     sigma2_median: f64,
+    /// Percentiles 1–99 of `σ²_D` over the reference samples (reference criteria compared
+    /// offline, `scripts/reference_criteria.py`).
+    sigma2_percentiles: Vec<f64>,
     /// The rate coordinate's range the fit used (demo samples per reference sample).
     rate_range: f64,
     /// The fit's notes.
@@ -215,6 +218,11 @@ fn view(
             let mut v = model.sigma2_d().to_vec();
             v.sort_by(f64::total_cmp);
             v[v.len() / 2]
+        },
+        sigma2_percentiles: {
+            let mut v = model.sigma2_d().to_vec();
+            v.sort_by(f64::total_cmp);
+            (1..100).map(|q| v[(q * (v.len() - 1)) / 100]).collect()
         },
         rate_range,
         notes: Vec::new(),

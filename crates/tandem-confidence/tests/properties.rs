@@ -7,7 +7,8 @@ use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tandem_confidence::{
-    Confidence, ConfidenceParams, Observations, estimate_error_rates, evaluate, posterior,
+    Confidence, ConfidenceParams, MIN_VOTES, Observations, estimate_error_rates, evaluate,
+    posterior,
 };
 
 /// One execution over `n_ref` samples: supervised times (fractional) and corrections.
@@ -125,7 +126,10 @@ proptest! {
             let post = posterior(&sigma2_d, &obs, &params).unwrap();
             let unlatched = evaluate(&sigma2_d, &obs, &params).unwrap();
             for n in 0..n_ref {
-                let fresh = post[n].is_high_confidence(&shifted).unwrap();
+                // Eq. 12 at mu'_c, on MIN_VOTES votes at least once a sample was supervised.
+                let s = obs.supervised()[n];
+                let fresh = post[n].is_high_confidence(&shifted).unwrap()
+                    && (s == 0.0 || s >= MIN_VOTES);
                 prop_assert_eq!(unlatched[n], fresh, "sample {}", n);
                 prop_assert_eq!(conf.conf()[n], before[n] || fresh, "sample {}", n);
             }
@@ -161,6 +165,7 @@ proptest! {
         };
         let mut order: Vec<usize> = (0..n_exec).collect();
         let mut finals = Vec::new();
+        let from_prior = Confidence::from_prior(&sigma2_d, params.clone()).unwrap().conf().to_vec();
         for _ in 0..20 {
             let mut conf = Confidence::from_prior(&sigma2_d, params.clone()).unwrap();
             let mut obs = Observations::new(n_ref).unwrap();
@@ -170,9 +175,14 @@ proptest! {
                 conf.update_round(&sigma2_d, &before, &obs).unwrap();
             }
             // Sums in another order differ in the last bits only: the decision is the
-            // totals' whichever order summed them.
+            // totals' whichever order summed them, except that a sample trusted from its
+            // prior and never corrected keeps the latch although it has fewer than
+            // MIN_VOTES votes (they are asked of samples that earn their trust).
             let totals = evaluate(&sigma2_d, &obs, &params).unwrap();
-            prop_assert_eq!(conf.conf(), totals.as_slice(), "order {:?}", order);
+            let expected: Vec<bool> = (0..n_ref)
+                .map(|n| totals[n] || (from_prior[n] && obs.corrections()[n] == 0.0))
+                .collect();
+            prop_assert_eq!(conf.conf(), expected.as_slice(), "order {:?}", order);
             finals.push(conf.conf().to_vec());
             order.shuffle(&mut rng);
         }

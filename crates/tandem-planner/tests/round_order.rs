@@ -124,10 +124,11 @@ fn totals_decision(p: &Planner) -> Vec<bool> {
     .unwrap()
 }
 
-/// The regression: two clean rounds, then four in which the operator corrects the needed
+/// The regression: clean rounds, then rounds in which the operator corrects the needed
 /// stretch in both executions. Recorded clean rounds first, the old latch trusted the
-/// whole variable stretch after round 1 and kept the needed part trusted through 8
-/// corrections in 8 executions; recorded corrected rounds first, it never was. Now both orders end with the
+/// whole variable stretch after them and kept the needed part trusted through every
+/// correction; recorded corrected rounds first, it never was. (Two clean rounds latched it
+/// before `MIN_VOTES`; five, ten votes, do now.) Now both orders end with the
 /// stretch low-confidence, the totals' decision, and the first order says which samples the
 /// corrections reopened.
 #[test]
@@ -137,21 +138,25 @@ fn corrections_recorded_after_a_lucky_latch_reopen_it() {
         VARIABLE.clone().all(|n| !base.confidence().conf()[n]),
         "the variable stretch starts low"
     );
-    let clean: Vec<[ExecutionRecord; 2]> = (0..2)
+    // Five clean rounds: ten votes per sample, the fewest on which a supervised sample is
+    // trusted (`tandem_confidence::MIN_VOTES`).
+    let n_clean = 5;
+    let clean: Vec<[ExecutionRecord; 2]> = (0..n_clean)
         .map(|k| {
             let e = |i: usize| execution(0.01 * (2 * k + i) as f64, &flags(false, &[]));
             [e(0), e(1)]
         })
         .collect();
-    let corrected: Vec<[ExecutionRecord; 2]> = (0..4)
+    let corrected: Vec<[ExecutionRecord; 2]> = (0..6)
         .map(|k| {
             let e = |i: usize| execution(0.1 + 0.01 * (2 * k + i) as f64, &flags(true, &[]));
             [e(0), e(1)]
         })
         .collect();
     let all: Vec<[ExecutionRecord; 2]> = clean.iter().chain(&corrected).cloned().collect();
+    let clean_order: Vec<usize> = (0..n_clean).collect();
     // Clean rounds first: the whole stretch latches after them...
-    let (after_clean, _) = record(&base, &all, &[0, 1]);
+    let (after_clean, _) = record(&base, &all, &clean_order);
     let latched = |p: &Planner| {
         VARIABLE
             .clone()
@@ -159,15 +164,35 @@ fn corrections_recorded_after_a_lucky_latch_reopen_it() {
             .count()
     };
     assert_eq!(latched(&after_clean), VARIABLE.len());
-    // ...and the corrected rounds reopen the needed samples once their totals fail (two
-    // corrected executions in six still pass at μ_c = 0.3; four in eight do not).
+    // ...and the corrected rounds reopen the needed samples in the round where their totals
+    // first fail (a few corrections in many clean votes still pass at μ_c = 0.3), not before
+    // and not again.
     let mut p = after_clean.clone();
-    let reports: Vec<usize> = (2..6)
-        .map(|k| p.record_round(&all[k]).unwrap().reopened)
-        .collect();
-    assert_eq!(reports, [0, NEEDED.len(), 0, 0]);
-    let (clean_first, _) = record(&base, &all, &[0, 1, 2, 3, 4, 5]);
-    let (corrected_first, reopened) = record(&base, &all, &[2, 3, 4, 5, 0, 1]);
+    let mut reports = Vec::new();
+    let mut first_fail = None;
+    for (k, round) in all[n_clean..].iter().enumerate() {
+        reports.push(p.record_round(round).unwrap().reopened);
+        let totals = totals_decision(&p);
+        if first_fail.is_none() && NEEDED.clone().all(|n| !totals[n]) {
+            first_fail = Some(k);
+        }
+    }
+    let first_fail = first_fail.expect("six corrected rounds make the totals fail");
+    assert!(
+        first_fail > 0,
+        "one corrected round still passes: {reports:?}"
+    );
+    for (k, &r) in reports.iter().enumerate() {
+        assert_eq!(
+            r,
+            if k == first_fail { NEEDED.len() } else { 0 },
+            "{reports:?}"
+        );
+    }
+    let in_order: Vec<usize> = (0..all.len()).collect();
+    let corrected_first_order: Vec<usize> = (n_clean..all.len()).chain(0..n_clean).collect();
+    let (clean_first, _) = record(&base, &all, &in_order);
+    let (corrected_first, reopened) = record(&base, &all, &corrected_first_order);
     assert_eq!(reopened, 0, "nothing latched before its corrections");
     assert_eq!(
         clean_first.confidence().conf(),
