@@ -35,11 +35,13 @@ fn fit(dir: &Path, extra: &[&str]) -> (PathBuf, String) {
 #[test]
 fn fit_stores_the_switch_time_and_load_cap_and_the_summaries_print_them() {
     let dir = scratch("operator-fit");
-    let (state, text) = fit(&dir, &["--switch-s", "2.5", "--max-busy", "0.8"]);
+    // The small task's robots are about 1 s long: a switch time its serial schedule can keep
+    // (0.38 s between the stretches when the worst case runs the rest at its fastest).
+    let (state, text) = fit(&dir, &["--switch-s", "0.25", "--max-busy", "0.8"]);
     let p = Planner::load(&state).expect("the state loads");
-    assert_eq!(p.params().sampler.switch_s, 2.5);
+    assert_eq!(p.params().sampler.switch_s, 0.25);
     assert_eq!(p.params().sampler.max_busy_share, 0.8);
-    let line = "operator: switch time δ 2.5 s (at least δ between one robot's low-confidence \
+    let line = "operator: switch time δ 0.25 s (at least δ between one robot's low-confidence \
                 stretch and another's); load cap u_max 0.8 (busy at most 80 % of the time, \
                 switches included)";
     assert!(text.contains(line), "{text}");
@@ -69,9 +71,9 @@ fn schedule_sets_them_and_saves_them_only_with_save() {
         "--samples",
         "50",
         "--switch-s",
-        "1",
+        "0.2",
     ]));
-    assert!(text.contains("operator: switch time δ 1 s"), "{text}");
+    assert!(text.contains("operator: switch time δ 0.2 s"), "{text}");
     assert!(text.contains("no load cap"), "{text}");
     // Shown, not saved.
     assert_eq!(
@@ -84,7 +86,7 @@ fn schedule_sets_them_and_saves_them_only_with_save() {
         "--samples",
         "50",
         "--switch-s",
-        "1",
+        "0.2",
         "--max-busy",
         "0.9",
         "--save",
@@ -95,7 +97,7 @@ fn schedule_sets_them_and_saves_them_only_with_save() {
             p.params().sampler.switch_s,
             p.params().sampler.max_busy_share
         ),
-        (1.0, 0.9)
+        (0.2, 0.9)
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
