@@ -13,44 +13,76 @@ import tandem
 from conftest import DEMOS, SAMPLES
 
 
+def small_demos(folder: Path) -> list[Path]:
+    """Three demonstrations of a short task (0.55–0.65 s at 10 ms) whose middle third varies
+    in force: low confidence there, high before and after, so a serial schedule of two robots
+    keeps a short switch time (the CLI's small task, crates/tandem-cli/tests/common)."""
+    paths = []
+    for i, (n, bump) in enumerate([(60, 0.0), (66, 6.0), (56, 12.0)]):
+        lines = ["t,x,force"]
+        for k in range(n):
+            u = k / (n - 1)
+            f = 5.0 + bump if 1.0 / 3.0 <= u < 2.0 / 3.0 else 5.0
+            lines.append(f"{k * 0.01:.2f},{u:.6f},{f:.4f}")
+        path = folder / f"demo_{i}.csv"
+        path.write_text("\n".join(lines) + "\n")
+        paths.append(path)
+    return paths
+
+
 def test_fit_sets_them_save_and_load_read_them_back(tmp_path: Path) -> None:
+    demos = small_demos(tmp_path)
     p = tandem.fit(
-        DEMOS,
+        demos,
         params={"sampler": {"samples": SAMPLES, "seed": 5}},
-        switch_s=2.5,
-        max_busy_share=0.7,
+        switch_s=0.2,
+        max_busy_share=0.9,
     )
     sampler = p.params["sampler"]
-    assert (sampler["switch_s"], sampler["max_busy_share"]) == (2.5, 0.7)
+    assert (sampler["switch_s"], sampler["max_busy_share"]) == (0.2, 0.9)
     path = tmp_path / "cell.tandem"
     p.save(path)
     back = tandem.Planner.load(path).params["sampler"]
-    assert (back["switch_s"], back["max_busy_share"]) == (2.5, 0.7)
+    assert (back["switch_s"], back["max_busy_share"]) == (0.2, 0.9)
     # Without the keywords: the parameters' values (none given: no switch time, no cap).
-    plain = tandem.fit(DEMOS, params={"sampler": {"samples": SAMPLES, "seed": 5}})
+    plain = tandem.fit(demos, params={"sampler": {"samples": SAMPLES, "seed": 5}})
     sampler = plain.params["sampler"]
     assert (sampler["switch_s"], sampler["max_busy_share"]) == (0.0, 1.0)
     # The keywords win over the parameters' dict.
     both = tandem.fit(
-        DEMOS,
-        params={"sampler": {"samples": SAMPLES, "seed": 5, "switch_s": 1.0}},
-        switch_s=3.0,
+        demos,
+        params={"sampler": {"samples": SAMPLES, "seed": 5, "switch_s": 0.3}},
+        switch_s=0.1,
     )
-    assert both.params["sampler"]["switch_s"] == 3.0
+    assert both.params["sampler"]["switch_s"] == 0.1
 
 
 def test_reschedule_makes_them_the_planners_and_they_are_saved(tmp_path: Path) -> None:
-    p = tandem.fit(DEMOS, params={"sampler": {"samples": SAMPLES, "seed": 5}})
-    p.reschedule(samples=50, switch_s=1.5)
+    p = tandem.fit(small_demos(tmp_path), params={"sampler": {"samples": SAMPLES, "seed": 5}})
+    p.reschedule(samples=50, switch_s=0.2)
     sampler = p.params["sampler"]
-    assert (sampler["switch_s"], sampler["max_busy_share"]) == (1.5, 1.0)
+    assert (sampler["switch_s"], sampler["max_busy_share"]) == (0.2, 1.0)
     p.reschedule(samples=50, max_busy_share=0.9)
     sampler = p.params["sampler"]
-    assert (sampler["switch_s"], sampler["max_busy_share"]) == (1.5, 0.9)
+    assert (sampler["switch_s"], sampler["max_busy_share"]) == (0.2, 0.9)
     path = tmp_path / "cell.tandem"
     p.save(path)
     back = tandem.Planner.load(path).params["sampler"]
-    assert (back["switch_s"], back["max_busy_share"]) == (1.5, 0.9)
+    assert (back["switch_s"], back["max_busy_share"]) == (0.2, 0.9)
+
+
+def test_a_switch_time_no_schedule_keeps_is_a_clear_error_and_changes_nothing() -> None:
+    # The sanding task just fitted is low-confidence from end to end: the robots' stretches
+    # meet, and no schedule keeps a switch time (Eq. 20 constraint 2 allows no idle time
+    # between robots).
+    with pytest.raises(tandem.ScheduleError) as e:
+        tandem.fit(DEMOS, params={"sampler": {"samples": SAMPLES, "seed": 5}}, switch_s=2.5)
+    assert "switch" in str(e.value)
+    p = tandem.fit(DEMOS, params={"sampler": {"samples": SAMPLES, "seed": 5}})
+    before = p.params
+    with pytest.raises(tandem.ScheduleError):
+        p.reschedule(samples=50, switch_s=1.5)
+    assert p.params == before
 
 
 @pytest.mark.parametrize(

@@ -870,11 +870,12 @@ impl PyPlanner {
         switch_s: Option<f64>,
         max_busy_share: Option<f64>,
     ) -> PyResult<PySchedule> {
+        let now = &self.inner.params().sampler;
+        let before = (now.switch_s, now.max_busy_share);
         if switch_s.is_some() || max_busy_share.is_some() {
-            let now = &self.inner.params().sampler;
             let (d, u) = (
-                switch_s.unwrap_or(now.switch_s),
-                max_busy_share.unwrap_or(now.max_busy_share),
+                switch_s.unwrap_or(before.0),
+                max_busy_share.unwrap_or(before.1),
             );
             self.inner.set_operator(d, u).map_err(Error::from)?;
         }
@@ -890,7 +891,14 @@ impl PyPlanner {
         // `None` keeps the current schedule's tick (the planner's rule).
         sp.tick_s = tick_s;
         let inner = &mut self.inner;
-        py.detach(|| guard(|| Ok(inner.reschedule(&sp).map(|_| ())?)))?;
+        let done = py.detach(|| guard(|| Ok(inner.reschedule(&sp).map(|_| ())?)));
+        if done.is_err() {
+            // A failed re-schedule leaves the planner as it was: its operator parameters too.
+            self.inner
+                .set_operator(before.0, before.1)
+                .map_err(Error::from)?;
+        }
+        done?;
         Ok(self.current_schedule())
     }
 

@@ -161,7 +161,7 @@ proptest! {
             let plain = margin_free_bound(&p, n, &ExactParams::default(), 0.0)
                 .unwrap()
                 .lower_bound_s;
-            prop_assert!(bound >= plain, "{} < {}", bound, plain);
+            prop_assert!(bound >= plain, "N = {}: {} < {}", n, bound, plain);
             let serial = p.serial_schedule_n(n, 0.01).unwrap();
             let mut candidates = vec![serial.clone()];
             for w in fractions.chunks(n - 1) {
