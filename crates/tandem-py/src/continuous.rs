@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::arrays::{out_flags, out_vector, repr_list};
-use crate::coordinator::{fault_dict, operator};
+use crate::coordinator::{fault_dict, operator, pre_alert_dict};
 use crate::errors::{Result, guard};
 use crate::facade::{ContinuousCoordinator, CyclicPlan, Group, Problem, Tick, Token};
 
@@ -270,16 +270,7 @@ impl PyCellTick {
     /// release, a leg's start, the token); ``None`` when no robot has a stretch ahead.
     #[getter]
     fn next<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
-        self.inner
-            .next
-            .map(|a| {
-                let d = PyDict::new(py);
-                d.set_item("robot", a.robot)?;
-                d.set_item("earliest_s", a.earliest_s)?;
-                d.set_item("latest_s", a.latest_s)?;
-                Ok(d)
-            })
-            .transpose()
+        self.inner.next.map(|a| pre_alert_dict(py, &a)).transpose()
     }
 
     /// Each robot's fractional reference time in its current task at the end of the tick,

@@ -219,6 +219,19 @@ impl PyCoordinator {
     }
 }
 
+/// The pre-alert of a tick as Python sees it (``Tick.next``, ``CellTick.next``):
+/// ``{"robot": r, "earliest_s": e, "latest_s": l}``.
+pub(crate) fn pre_alert_dict<'py>(
+    py: Python<'py>,
+    a: &tandem::realtime::PreAlert,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("robot", a.robot)?;
+    d.set_item("earliest_s", a.earliest_s)?;
+    d.set_item("latest_s", a.latest_s)?;
+    Ok(d)
+}
+
 /// A fault as the dict :attr:`Coordinator.fault` returns.
 pub(crate) fn fault_dict<'py>(py: Python<'py>, f: &Fault) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
@@ -243,16 +256,7 @@ impl PyTick {
     /// release, a leg's start, the token); ``None`` when no robot has a stretch ahead.
     #[getter]
     fn next<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
-        self.inner
-            .next
-            .map(|a| {
-                let d = PyDict::new(py);
-                d.set_item("robot", a.robot)?;
-                d.set_item("earliest_s", a.earliest_s)?;
-                d.set_item("latest_s", a.latest_s)?;
-                Ok(d)
-            })
-            .transpose()
+        self.inner.next.map(|a| pre_alert_dict(py, &a)).transpose()
     }
 
     /// Each robot's fractional reference time at the end of the tick, ``(N,)``, reference

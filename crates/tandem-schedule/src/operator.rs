@@ -58,13 +58,7 @@ fn share(busy_s: f64, changes: usize, switch_s: f64, t_total_s: f64) -> f64 {
 /// The scheduled low-confidence time of all robots (s) and the number of changes of robot
 /// between consecutive intervals merged by start.
 fn busy_of(timeline: &GlobalTimeline) -> (f64, usize) {
-    let mut all: Vec<(f64, f64, usize)> = timeline
-        .lc_intervals()
-        .iter()
-        .enumerate()
-        .flat_map(|(r, ivs)| ivs.iter().map(move |iv| (iv.start_s, iv.end_s, r)))
-        .collect();
-    all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+    let all = crate::validate::lc_by_start(timeline);
     let busy_s = all.iter().map(|&(s, e, _)| e - s).sum();
     let changes = all.windows(2).filter(|w| w[0].2 != w[1].2).count();
     (busy_s, changes)

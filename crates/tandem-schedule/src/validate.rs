@@ -252,13 +252,10 @@ pub fn validate_with_switch(
     }
 }
 
-/// The first place (in time) where one robot's scheduled LC interval starts less than
-/// `switch_s` after another robot's ended: the intervals of all robots merged by start
-/// (disjoint, constraint 3), each next to the one before it when their robots differ. Pairs
-/// further apart are implied: between an interval `A` and a later `B` of another robot, the
-/// first interval of a robot other than `A`'s starts at least `switch_s` after the one before
-/// it, which ends no earlier than `A`.
-fn first_short_switch(timeline: &GlobalTimeline, switch_s: f64) -> Option<Violation> {
+/// Every robot's scheduled LC intervals as `(start_s, end_s, robot)` (global s), merged by
+/// start (ties by robot): the one scan of the operator's stretches in time order, for the
+/// switch check and the operator's busy share ([`crate::operator::busy_share`]).
+pub(crate) fn lc_by_start(timeline: &GlobalTimeline) -> Vec<(f64, f64, usize)> {
     let mut all: Vec<(f64, f64, usize)> = timeline
         .lc_intervals()
         .iter()
@@ -266,6 +263,17 @@ fn first_short_switch(timeline: &GlobalTimeline, switch_s: f64) -> Option<Violat
         .flat_map(|(r, ivs)| ivs.iter().map(move |iv| (iv.start_s, iv.end_s, r)))
         .collect();
     all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+    all
+}
+
+/// The first place (in time) where one robot's scheduled LC interval starts less than
+/// `switch_s` after another robot's ended: the intervals of all robots merged by start
+/// (disjoint, constraint 3), each next to the one before it when their robots differ. Pairs
+/// further apart are implied: between an interval `A` and a later `B` of another robot, the
+/// first interval of a robot other than `A`'s starts at least `switch_s` after the one before
+/// it, which ends no earlier than `A`.
+fn first_short_switch(timeline: &GlobalTimeline, switch_s: f64) -> Option<Violation> {
+    let all = lc_by_start(timeline);
     let slack = tol::CLOCK_REL * switch_s + 4.0 * f64::EPSILON * timeline.t_total_s();
     all.windows(2).find_map(|w| {
         let ((_, end_s, a), (start_s, _, b)) = (w[0], w[1]);
