@@ -14,7 +14,7 @@ use tandem_lfd::{Demonstration, Execution, FitParams, HoldSpec, Regridded, TaskM
 use tandem_realtime::Coordinator;
 use tandem_schedule::{
     CheckedSchedule, Outcome, PreviousFate, Problem, SamplerParams, Schedule, Source,
-    sample_schedule_n, validate,
+    sample_schedule_n,
 };
 
 use crate::state::{PlannerState, Stamp, StateLock};
@@ -892,7 +892,10 @@ impl Planner {
     /// # Errors
     /// As [`Planner::coordinator`].
     pub fn checked_schedule(&self) -> Result<CheckedSchedule> {
-        Ok(self.schedule().check(&self.problem)?)
+        let sp = &self.params.sampler;
+        Ok(self
+            .schedule()
+            .check_with_operator(&self.problem, sp.switch_s, sp.max_busy_share)?)
     }
 
     /// Why [`Planner::load`] replaced the stored schedule, if it did: the stored one failed
@@ -1115,12 +1118,17 @@ impl Planner {
     }
 
     /// Re-checks the stored schedule on the stored problem with this build's check
-    /// ([`validate`]); one that fails is never run: it is replaced by a fresh schedule (the
+    /// ([`Planner::checked_schedule`]: [`tandem_schedule::validate`] with constraint 2 relaxed by the stored
+    /// operator parameters); one that fails is never run: it is replaced by a fresh schedule (the
     /// sampler from scratch, at the stored tick when that is a valid tick, with the seed the
     /// next schedule would have had) and [`Planner::load_notice`] says why.
     fn recheck_schedule(&mut self) -> Result<()> {
-        let Err(violation) = validate(&self.problem, self.schedule()) else {
-            return Ok(());
+        // Constraint 2 as the operator's parameters relax it (the idle gaps of a schedule
+        // planned with a switch time or a load cap), everything else as `validate`.
+        let violation = match self.checked_schedule() {
+            Ok(_) => return Ok(()),
+            Err(Error::Schedule(tandem_schedule::Error::Invalid(v))) => v,
+            Err(e) => return Err(e),
         };
         let tick_s = self.schedule().tick_s;
         let sampler = SamplerParams {
@@ -1239,6 +1247,7 @@ impl Planner {
 mod tests {
     use super::*;
     use crate::state::{CrashPoint, write_atomic_with};
+    use tandem_schedule::validate;
 
     /// An empty folder `<temp>/<name>-<pid>` for one test's files.
     fn scratch(name: &str) -> std::path::PathBuf {

@@ -377,3 +377,56 @@ fn the_token_passes_the_switch_time_after_a_stretch_ended() {
     // stretch, and its tolerance-widened interval reaches the stretch within four ticks.
     assert!(gap_of(0.0) < 8);
 }
+
+/// Robots of 10 low-confidence samples of 0.1 s (the whole task), gradients 1, bounds
+/// [0.8, 1.25], started at `starts`: no high-confidence time to switch in, only idle time
+/// between one robot's end and the next one's start (Eq. 20 constraint 2 relaxed by `δ`).
+fn all_low(starts: &[f64]) -> Vec<Timeline> {
+    let conf = [false; 10];
+    let (g, lo, hi) = ([1.0; 10], [0.8; 10], [1.25; 10]);
+    starts
+        .iter()
+        .map(|&tau| Timeline::new(&conf, &g, &lo, &hi, tau, 0.1).unwrap())
+        .collect()
+}
+
+#[test]
+fn an_idle_gap_after_the_earlier_robot_ended_counts_towards_the_switch_time() {
+    let tick_s = 0.1;
+    let at = |switch_s| MarginParams::new(tick_s).with_switch_s(switch_s);
+    // The serial start (robot 2 where robot 1 ends, 1 s) is safe without a switch time and
+    // switches in consecutive ticks: refused at δ = 2 s (k = 20).
+    assert!(sufficient_margins(&all_low(&[0.0, 1.0]), tick_s).unwrap());
+    assert!(!check_margins(&all_low(&[0.0, 1.0]), &[], &at(2.0)).unwrap());
+    // By hand: robot 1's exit tick is its last (e = 1); at its end robot 2's clock is at most
+    // 1 + M = 1.125 s, then runs on schedule (0.1 s a tick, nobody running): it starts, low-
+    // confidence at once, ⌈(τ − 1.125)/0.1⌉ ticks later. 1 + that > 20 needs τ > 3.025 s; on a
+    // 0.05 s grid the earliest accepted start is 3.05 s.
+    let earliest = (0..=120)
+        .map(|i| 0.05 * f64::from(i))
+        .find(|&tau| check_margins(&all_low(&[0.0, tau]), &[], &at(2.0)).unwrap())
+        .unwrap();
+    assert!((earliest - 3.05).abs() < 1e-9, "{earliest}");
+    // Under every adversary the accepted schedule keeps 20 ticks; the one a grid step earlier
+    // (which the check refuses) is where the worst operator comes closest.
+    let mut r = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let set = adversary_set(2, [0.8, 1.25], 60, &mut r);
+    let (gap, overlap) = shortest_switch(&all_low(&[0.0, 3.05]), &[], (tick_s, 2.0), &set, &mut r);
+    assert!(!overlap);
+    let gap = gap.unwrap();
+    assert!((20..=22).contains(&gap), "{gap} ticks");
+    let (early, _) = shortest_switch(&all_low(&[0.0, 2.9]), &[], (tick_s, 0.0), &set, &mut r);
+    assert!(early.unwrap() < 20, "{early:?}");
+    // Three robots, each after the one before ended plus the gap (the lead bound's rule 2 with
+    // the idle ticks): accepted at δ = 2 s, refused with every gap one tick shorter.
+    assert!(check_margins(&all_low(&[0.0, 3.05, 6.1]), &[], &at(2.0)).unwrap());
+    assert!(!check_margins(&all_low(&[0.0, 3.05, 6.0]), &[], &at(2.0)).unwrap());
+    let (gap3, overlap3) = shortest_switch(
+        &all_low(&[0.0, 3.05, 6.1]),
+        &[],
+        (tick_s, 2.0),
+        &adversary_set(3, [0.8, 1.25], 60, &mut r),
+        &mut r,
+    );
+    assert!(!overlap3 && gap3.unwrap() >= 20, "{gap3:?}");
+}

@@ -4,7 +4,7 @@ use tandem_realtime::{Coordinator, Timeline};
 
 use crate::problem::Problem;
 use crate::schedule::Schedule;
-use crate::validate::{MarginCheck, validated_timeline};
+use crate::validate::{MarginCheck, validated_timeline_with};
 use crate::{Error, Result};
 
 /// A [`Schedule`] that passed [`validate`](crate::validate) on one problem — every constraint
@@ -39,10 +39,12 @@ pub struct CheckedSchedule {
 }
 
 impl CheckedSchedule {
-    /// Checks `schedule` on `problem` ([`Schedule::check`]).
-    pub(crate) fn new(problem: &Problem, schedule: Schedule) -> Result<Self> {
-        let timeline = validated_timeline(problem, &schedule, MarginCheck::SinglePass)
-            .map_err(Error::Invalid)?;
+    /// Checks `schedule` on `problem` ([`Schedule::check`]), constraint 2 relaxed by
+    /// `allowance_s` (s; 0: as printed, [`Schedule::check_with_operator`]).
+    pub(crate) fn new(problem: &Problem, schedule: Schedule, allowance_s: f64) -> Result<Self> {
+        let timeline =
+            validated_timeline_with(problem, &schedule, MarginCheck::SinglePass, allowance_s)
+                .map_err(Error::Invalid)?;
         Ok(CheckedSchedule {
             schedule,
             timelines: timeline.into_timelines(),

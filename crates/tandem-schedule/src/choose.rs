@@ -667,6 +667,27 @@ pub(crate) fn strategies(n_robots: usize) -> Strategies {
     STRATEGIES[n_robots.clamp(1, STRATEGIES.len()) - 1]
 }
 
+/// `bound` (the margin-free bound with the switch time `params.switch_s`) raised to the bound
+/// without it when that is larger, as [`exact::margin_free_bound`] does: every schedule that
+/// keeps `δ` keeps 0, so both bound it (the searches with `δ` can end looser; docs/decisions.md,
+/// "A schedule always exists with a switch time: constraint 2 relaxed (issue 41)"). A raised
+/// bound is no proven optimum. Without a switch time `bound` itself (no added operation).
+fn at_least_plain(
+    mut bound: exact::MarginFree,
+    problem: &Problem,
+    n_robots: usize,
+    params: &SamplerParams,
+) -> exact::MarginFree {
+    if params.switch_s > 0.0
+        && let Ok(plain) = exact::margin_free_bound(problem, n_robots, &params.exact, 0.0)
+        && plain.lower_bound_s > bound.lower_bound_s
+    {
+        bound.lower_bound_s = plain.lower_bound_s;
+        bound.proven_optimal = false;
+    }
+    bound
+}
+
 /// [`sample_schedule_n`] with benchmark-only baselines (for two robots only, the default
 /// otherwise): the strategies of [`strategies`]`(n_robots)`, the least `T_total` winning.
 fn schedule_n(
@@ -740,12 +761,22 @@ fn schedule_n(
                 (None, 0),
             ),
             BoundBy::Many => (
-                exact::bound_many_switch(problem, n_robots, &params.exact, sw),
+                at_least_plain(
+                    exact::bound_many_switch(problem, n_robots, &params.exact, sw),
+                    problem,
+                    n_robots,
+                    params,
+                ),
                 (None, 0),
                 (None, 0),
             ),
             BoundBy::Pair => {
-                let bound = exact::bound_switch(problem, &params.exact, sw);
+                let bound = at_least_plain(
+                    exact::bound_switch(problem, &params.exact, sw),
+                    problem,
+                    2,
+                    params,
+                );
                 let done = if pair && bound.lower_bound_s < cap_s {
                     exact::completion(
                         problem,
@@ -924,16 +955,31 @@ fn schedule_n(
     // The load cap: every kept candidate lengthened to its share ([`operator::capped`]), the
     // least `T_total` winning (ties to the earlier kept).
     if capping {
-        best = pool
+        let pooled = pool
             .iter()
             .filter_map(|(s, _, src)| {
                 operator::capped(problem, s, sw, u_max).map(|(s, t)| (s, t, *src))
             })
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .ok_or(Error::BusyShareUnreachable {
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        // The serial schedule with idle gaps for the cap, which always exists (constraint 2
+        // relaxed, `operator::start_allowance_s`): kept when it is shorter or nothing else is.
+        let serial = operator::serial_capped(problem, n_robots, tick_s, sw, u_max).map(|s| {
+            let t = s.t_total_s(problem.dt_s());
+            (s, t, Source::Serial)
+        });
+        best = match (pooled, serial) {
+            (Some(a), Some(b)) => {
+                if b.1 < a.1 {
+                    b
+                } else {
+                    a
+                }
+            }
+            (a, b) => a.or(b).ok_or(Error::BusyShareUnreachable {
                 max_busy_share: u_max,
                 switch_s: sw,
-            })?;
+            })?,
+        };
     }
     let (schedule, t_total_s, source) = best;
     let margin_free_s = bound

@@ -84,10 +84,12 @@ pub use exact::{
     ExactParams, MarginFree, SearchStats, earliest_schedule, margin_free_bound, operator_bound_s,
     operator_bound_with_switch_s, solve_exact, solve_exact_with_switch,
 };
-pub use operator::busy_share;
+pub use operator::{busy_share, start_allowance_s};
 pub use problem::Problem;
 pub use sampler::{DrawnOffset, SamplerBaselines, SamplerParams, SamplerStats};
 pub use schedule::{GlobalTimeline, LcOverlap, Schedule};
 pub use tandem_confidence::Run;
 pub use tandem_realtime::LcInterval;
-pub use validate::{MarginCheck, Violation, validate, validate_with_switch};
+pub use validate::{
+    MarginCheck, Violation, validate, validate_with_operator, validate_with_switch,
+};

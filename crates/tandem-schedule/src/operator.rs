@@ -23,7 +23,7 @@
 
 use crate::problem::Problem;
 use crate::schedule::{GlobalTimeline, Schedule};
-use crate::validate::{Violation, validate_with_switch};
+use crate::validate::{Violation, validate_with_operator, validate_with_switch};
 use crate::{Error, Result};
 
 /// The operator's busy share of one round (dimensionless): `(Σ_i Σ LC interval lengths +
@@ -74,15 +74,65 @@ pub(crate) fn cap_bound_s(
     switch_s: f64,
     max_busy_share: f64,
 ) -> f64 {
-    let dt = problem.dt_s();
-    let lc_s: f64 = (0..problem.n_ref())
-        .filter(|&n| !problem.conf()[n])
-        .map(|n| problem.grad_mean()[n] * dt)
-        .sum();
+    let lc_s = lc_time_s(problem);
     if lc_s <= 0.0 {
         return 0.0;
     }
     (n_robots as f64 * lc_s + (n_robots - 1) as f64 * switch_s) / max_busy_share
+}
+
+/// The operator's allowance on Eq. 20 constraint 2 (s, ≥ 0): how long after every robot before
+/// it has ended a robot may start, `τ_i ≤ max_{j<i}(τ_j + |ψ_Ej|) + A`, for `n_robots` robots at
+/// control tick `tick_s` (real s) with switch time `switch_s` (`δ`, s) and load cap
+/// `max_busy_share` (`u_max`): `A = max(A_δ, A_u)` with
+/// - `A_δ = δ + h + M̂` for `δ > 0` (0 without): the idle gap the margin check needs between a
+///   robot that ends in its stretch and the next one that starts in its own, `k·h + M` with
+///   `k = ⌈δ/h⌉ < δ/h + 1` whole ticks and `M ≤ M̂ = h·max(1, max_n ψ̇max[n]/ψ̇min[n])` the
+///   earlier robot's largest step (its clock may overshoot its end by one step in its last
+///   tick; `tandem_realtime::margins`, rule 2 with the idle ticks);
+/// - `A_u = δ/u_max + N·L·(1/u_max − 1)/(N − 1)` for `u_max < 1` (0 without): the gap the
+///   serial schedule needs to keep the cap, `((N·L + (N − 1)·δ)/u_max − N·D)/(N − 1)` with `D`
+///   its robots' duration, at most this since `D ≥ L` (`L` the LC time of one execution).
+///
+/// So the serial schedule with idle gaps ([`serial_with_switch`], [`serial_capped`]) always
+/// meets the relaxed constraint; a longer gap only lengthens `T_total`. 0 (constraint 2 as
+/// printed) for `δ = 0`, `u_max = 1` or one robot.
+pub fn start_allowance_s(
+    problem: &Problem,
+    n_robots: usize,
+    tick_s: f64,
+    switch_s: f64,
+    max_busy_share: f64,
+) -> f64 {
+    if n_robots < 2 {
+        return 0.0;
+    }
+    let a_switch = if switch_s > 0.0 {
+        let f_max = (0..problem.n_ref())
+            .map(|n| problem.grad_max()[n] / problem.grad_min()[n])
+            .fold(1.0, f64::max);
+        switch_s + tick_s + tick_s * f_max
+    } else {
+        0.0
+    };
+    let a_cap = if max_busy_share < 1.0 {
+        let n = n_robots as f64;
+        switch_s / max_busy_share
+            + n * lc_time_s(problem) * (1.0 / max_busy_share - 1.0) / (n - 1.0)
+    } else {
+        0.0
+    };
+    a_switch.max(a_cap)
+}
+
+/// `L`: the low-confidence time of one execution (s), `Σ ψ̇̄·Δt_s` over the LC samples
+/// (Eq. 20 constraint 4 fixes it).
+fn lc_time_s(problem: &Problem) -> f64 {
+    let dt = problem.dt_s();
+    (0..problem.n_ref())
+        .filter(|&n| !problem.conf()[n])
+        .map(|n| problem.grad_mean()[n] * dt)
+        .sum()
 }
 
 /// `schedule` (valid at its tick with `switch_s`) made to keep the load cap `max_busy_share`
@@ -178,15 +228,19 @@ fn slowed_tail(
 }
 
 /// The serial fallback with the switch time `switch_s` (s, > 0) for `n_robots` robots at
-/// `tick_s`: the fastest serial schedule ([`Problem::serial_schedule_n`]) if it passes
-/// [`validate_with_switch`]; else, when only its planned switches are too short (its
-/// high-confidence tail and head together last less than `δ`), the same with every robot's
-/// tail and head slowed by one common factor `u` towards `ψ̇max` until they last `δ` (the
-/// margin check's worst case runs them at their fastest, so only the plan needs the room).
+/// `tick_s`, which always exists (docs/decisions.md, "A schedule always exists with a switch
+/// time: constraint 2 relaxed (issue 41)"): the fastest serial schedule
+/// ([`Problem::serial_schedule_n`]) if it passes [`validate_with_switch`]; else the faster of
+/// two repairs that pass it — the same with every robot's high-confidence head and tail slowed
+/// by one factor towards `ψ̇max` until they last `δ` on schedule (when only its planned
+/// switches are too short), and the fastest warps with one common idle gap `g` between each
+/// robot's end and the next robot's start, the least that passes found by bisection in
+/// `[0, A_δ]` ([`start_allowance_s`]; at `A_δ` every pair is decided by the margin check's rule
+/// 2 with at least `k` idle ticks, so it passes).
 ///
 /// # Errors
-/// The first violation of the slowed serial schedule (or of the fastest one when slowing
-/// cannot help: no high-confidence tail or head, or the margin check fails).
+/// [`Error::NoFeasibleSchedule`] with the fastest serial schedule's violation only when even
+/// the widest gap fails (a bug: not expected); [`Error::BadParam`] for a bad `tick_s`.
 pub(crate) fn serial_with_switch(
     problem: &Problem,
     n_robots: usize,
@@ -198,9 +252,105 @@ pub(crate) fn serial_with_switch(
         Ok(()) => return Ok(fastest),
         Err(v) => v,
     };
-    if !matches!(why, Violation::SwitchTooShort { .. }) || n_robots < 2 {
+    if n_robots < 2 {
         return Err(Error::NoFeasibleSchedule { serial: why });
     }
+    let dt = problem.dt_s();
+    let slowed = matches!(why, Violation::SwitchTooShort { .. })
+        .then(|| slowed_ends(problem, n_robots, tick_s, switch_s))
+        .flatten()
+        .filter(|s| validate_with_switch(problem, s, switch_s).is_ok());
+    let widest = start_allowance_s(problem, n_robots, tick_s, switch_s, 1.0);
+    let gapped = least_gap(&fastest, widest, |s| {
+        validate_with_switch(problem, s, switch_s).is_ok()
+    });
+    match (slowed, gapped) {
+        (Some(a), Some(b)) => Ok(if b.t_total_s(dt) < a.t_total_s(dt) {
+            b
+        } else {
+            a
+        }),
+        (a, b) => a.or(b).ok_or(Error::NoFeasibleSchedule { serial: why }),
+    }
+}
+
+/// `serial` (robots one after another, each on the same warp) with one common idle gap `g`
+/// (s) added before every robot's start after the first (robot `i` moved `i·g` later).
+fn with_gap(serial: &Schedule, gap_s: f64) -> Schedule {
+    let mut out = serial.clone();
+    for (i, o) in out.offsets_s.iter_mut().enumerate() {
+        *o += (i + 1) as f64 * gap_s;
+    }
+    out
+}
+
+/// The least common idle gap `g ∈ [0, widest_s]` (to `2⁻¹⁶` of `widest_s`, rounded up) with
+/// which `serial` passes `ok` ([`with_gap`]), by bisection (the checks are monotone in `g`:
+/// a longer gap only adds idle ticks and time between the planned stretches); `None` if even
+/// `widest_s` fails.
+fn least_gap(serial: &Schedule, widest_s: f64, ok: impl Fn(&Schedule) -> bool) -> Option<Schedule> {
+    let mut hi = with_gap(serial, widest_s);
+    if !ok(&hi) {
+        return None;
+    }
+    let (mut lo_s, mut hi_s) = (0.0, widest_s);
+    for _ in 0..16 {
+        let mid_s = 0.5 * (lo_s + hi_s);
+        let s = with_gap(serial, mid_s);
+        if ok(&s) {
+            (hi_s, hi) = (mid_s, s);
+        } else {
+            lo_s = mid_s;
+        }
+    }
+    Some(hi)
+}
+
+/// The serial schedule with the switch time and the load cap `max_busy_share` (`u_max < 1`),
+/// which always exists: [`serial_with_switch`] (the fastest serial schedule without a switch
+/// time), and when its busy share exceeds the cap, its idle gaps lengthened by one common
+/// amount so that `T_total` reaches `(busy + (N − 1)·δ)/u_max` (its stretches and switches
+/// stay; `N − 1` gaps; within [`start_allowance_s`] since `D ≥ L`). `None` for one robot above
+/// the cap (no gap to lengthen) or if the result fails [`validate_with_operator`] (a bug).
+pub(crate) fn serial_capped(
+    problem: &Problem,
+    n_robots: usize,
+    tick_s: f64,
+    switch_s: f64,
+    max_busy_share: f64,
+) -> Option<Schedule> {
+    let base = if switch_s > 0.0 {
+        serial_with_switch(problem, n_robots, tick_s, switch_s).ok()?
+    } else {
+        problem.serial_schedule_n(n_robots, tick_s).ok()?
+    };
+    let timeline = GlobalTimeline::of(problem, &base).ok()?;
+    let (busy_s, changes) = busy_of(&timeline);
+    let t_total = timeline.t_total_s();
+    let out = if share(busy_s, changes, switch_s, t_total) <= max_busy_share {
+        base
+    } else {
+        if n_robots < 2 {
+            return None;
+        }
+        let target_s = (busy_s + changes as f64 * switch_s) / max_busy_share;
+        // A hair more than needed, so that the clock's sums reach the target despite rounding.
+        let extra_s = (target_s - t_total) / (n_robots - 1) as f64 * (1.0 + 1e-9);
+        with_gap(&base, extra_s)
+    };
+    let t = out.t_total_s(problem.dt_s());
+    let tl = GlobalTimeline::of(problem, &out).ok()?;
+    let (b, c) = busy_of(&tl);
+    (share(b, c, switch_s, t) <= max_busy_share
+        && validate_with_operator(problem, &out, switch_s, max_busy_share).is_ok())
+    .then_some(out)
+}
+
+/// The serial schedule with every robot's high-confidence head and tail slowed by one common
+/// factor `u` towards `ψ̇max` until together they last `δ` on schedule (the margin check's
+/// worst case runs them at their fastest, so only the plan gets the room); `None` when there
+/// is no such room (no head or tail, or not enough of it).
+fn slowed_ends(problem: &Problem, n_robots: usize, tick_s: f64, switch_s: f64) -> Option<Schedule> {
     let conf = problem.conf();
     let (gmin, gmax) = (problem.grad_min(), problem.grad_max());
     let dt = problem.dt_s();
@@ -211,7 +361,7 @@ pub(crate) fn serial_with_switch(
     let fastest_s: f64 = ends.iter().map(|&n| gmin[n] * dt).sum();
     let span_s: f64 = ends.iter().map(|&n| (gmax[n] - gmin[n]) * dt).sum();
     if span_s <= 0.0 || fastest_s + span_s < switch_s {
-        return Err(Error::NoFeasibleSchedule { serial: why });
+        return None;
     }
     let u = ((switch_s - fastest_s) / span_s * (1.0 + 1e-9)).clamp(0.0, 1.0);
     let mut warp = problem.fastest_warp();
@@ -225,15 +375,12 @@ pub(crate) fn serial_with_switch(
         start_s = tandem_realtime::clock_end_s(&warp, start_s, dt).max(start_s + duration_s);
         offsets_s.push(start_s);
     }
-    let slowed = Schedule {
+    Some(Schedule {
         grad_exec: vec![warp; n_robots],
         offsets_s,
         tick_s,
         holds: Vec::new(),
-    };
-    validate_with_switch(problem, &slowed, switch_s)
-        .map(|()| slowed)
-        .map_err(|serial| Error::NoFeasibleSchedule { serial })
+    })
 }
 
 #[cfg(test)]
@@ -283,29 +430,71 @@ mod tests {
     }
 
     #[test]
-    fn the_serial_fallback_slows_head_and_tail_for_the_switch() {
+    fn the_serial_fallback_keeps_any_switch_time_with_an_idle_gap() {
         let p = hlh();
         // δ = 0.6 s: tail + head at their fastest are 1 s, the serial schedule keeps it.
         let s = serial_with_switch(&p, 2, 0.01, 0.6).unwrap();
         assert_eq!(s, p.serial_schedule_n(2, 0.01).unwrap());
-        // δ = 1.5 s: tail + head (1 s at their fastest, 4 s at their slowest) slowed by
-        // u = 0.5/3 to 1.5 s (gradients 0.5 + 1.5·u = 0.75); every robot the same warp.
-        match serial_with_switch(&p, 3, 0.01, 1.5) {
-            Ok(s) => {
-                assert!((s.grad_exec[0][0] - 0.75).abs() < 1e-6);
-                assert_eq!(validate_with_switch(&p, &s, 1.5), Ok(()));
-            }
-            // The worst case (tail and head run at their fastest) may still refuse it.
-            Err(Error::NoFeasibleSchedule { serial }) => assert!(
-                matches!(serial, Violation::InsufficientSwitchTime { .. }),
-                "{serial}"
-            ),
-            Err(e) => panic!("{e}"),
-        }
-        // δ = 5 s: more than the slowest tail and head (4 s): no serial schedule.
+        // δ = 1.5 s (k = 150 ticks of 0.01 s; M = 0.02 s, the LC samples' F = 2): robot 1 ends
+        // at least 48 ticks after its exit tick starts (1 + ⌊(0.5 − ε − M)/0.01⌋: a last step
+        // of M, then its tail at F = 1), robot 2's head (0.5 s at 0.01 s a tick, less ε) keeps
+        // it out 49 ticks, so robot 2 must start 102 ticks after the exit tick: 54 idle ticks,
+        // ⌈(g − M)/h⌉ ≥ 54, g > 0.55 s. Slowing head and tail to 1.5 s instead would cost
+        // 0.5 s per robot (T_total 7.5 s against 6 + 2·0.55).
+        let s = serial_with_switch(&p, 3, 0.01, 1.5).unwrap();
+        assert_eq!(validate_with_switch(&p, &s, 1.5), Ok(()));
+        let gap = |s: &Schedule| s.offsets_s[0] - s.end_s(0, 0.1);
+        assert!(gap(&s) > 0.55 && gap(&s) < 0.5501, "{}", gap(&s));
+        assert!((s.offsets_s[1] - s.offsets_s[0] - 2.0 - gap(&s)).abs() < 1e-9);
+        assert!((s.t_total_s(0.1) - 7.1).abs() < 1e-3);
+        // A gap one step shorter fails: the bisection found the edge.
+        assert!(
+            validate_with_switch(
+                &p,
+                &with_gap(&p.serial_schedule_n(3, 0.01).unwrap(), 0.549),
+                1.5
+            )
+            .is_err()
+        );
+        // δ = 5 s: more than the slowest tail and head (4 s) could give; the idle gap still
+        // can (k = 500: 404 idle ticks, g > 4.05 s), within the allowance A_δ = 5 + 0.01 +
+        // 0.04 s.
+        let s = serial_with_switch(&p, 2, 0.01, 5.0).unwrap();
+        assert!(gap(&s) > 4.05 && gap(&s) < 4.0501, "{}", gap(&s));
+        assert!((start_allowance_s(&p, 2, 0.01, 5.0, 1.0) - 5.05).abs() < 1e-12);
+        assert_eq!(validate_with_switch(&p, &s, 5.0), Ok(()));
+        // Constraint 2 as printed refuses it; the allowance is what admits it.
         assert!(matches!(
-            serial_with_switch(&p, 2, 0.01, 5.0),
-            Err(Error::NoFeasibleSchedule { .. })
+            crate::validate(&p, &s),
+            Err(Violation::Offset { robot: 1, .. })
         ));
+    }
+
+    #[test]
+    fn the_cap_s_serial_schedule_idles_to_its_share() {
+        let p = hlh();
+        // Serial: 2 s per robot, 1 s LC each; at δ = 0 its share is 2/4. A cap of 0.25 needs
+        // T_total 8 s: the one gap 4 s (beyond any tail), within A_u = 2·1·(4 − 1)/1 = 6 s.
+        let s = serial_capped(&p, 2, 0.01, 0.0, 0.25).unwrap();
+        assert!(
+            (s.t_total_s(0.1) - 8.0).abs() < 1e-6,
+            "{}",
+            s.t_total_s(0.1)
+        );
+        assert!(busy_share(&s, &p, 0.0).unwrap() <= 0.25);
+        assert!((start_allowance_s(&p, 2, 0.01, 0.0, 0.25) - 6.0).abs() < 1e-12);
+        assert_eq!(validate_with_operator(&p, &s, 0.0, 0.25), Ok(()));
+        assert!(validate_with_switch(&p, &s, 0.0).is_err());
+        // With δ = 1.5 s and three robots: (3 + 2·1.5)/0.5 = 12 s at a cap of 0.5.
+        let s = serial_capped(&p, 3, 0.01, 1.5, 0.5).unwrap();
+        assert!(
+            (s.t_total_s(0.1) - 12.0).abs() < 1e-6,
+            "{}",
+            s.t_total_s(0.1)
+        );
+        assert_eq!(validate_with_operator(&p, &s, 1.5, 0.5), Ok(()));
+        // Under the cap already: the switch-time fallback itself.
+        let s = serial_capped(&p, 2, 0.01, 0.0, 0.9).unwrap();
+        assert_eq!(s, p.serial_schedule_n(2, 0.01).unwrap());
     }
 }

@@ -276,7 +276,32 @@ impl Schedule {
     /// # Errors
     /// [`Error::Invalid`] with the first broken constraint.
     pub fn check(&self, problem: &Problem) -> Result<crate::CheckedSchedule> {
-        crate::CheckedSchedule::new(problem, self.clone())
+        crate::CheckedSchedule::new(problem, self.clone(), 0.0)
+    }
+
+    /// [`Schedule::check`] for a schedule planned for an operator with switch time `switch_s`
+    /// (s, ≥ 0) and load cap `max_busy_share` (`SamplerParams::{switch_s, max_busy_share}`):
+    /// Eq. 20 constraint 2 relaxed by [`crate::start_allowance_s`] (a robot may start that long
+    /// after every robot before it has ended: the idle gaps of the serial schedule with a
+    /// switch time or a cap), everything else as [`Schedule::check`]. `switch_s = 0` with
+    /// `max_busy_share = 1` is [`Schedule::check`].
+    ///
+    /// # Errors
+    /// As [`Schedule::check`].
+    pub fn check_with_operator(
+        &self,
+        problem: &Problem,
+        switch_s: f64,
+        max_busy_share: f64,
+    ) -> Result<crate::CheckedSchedule> {
+        let allowance_s = crate::start_allowance_s(
+            problem,
+            self.n_robots(),
+            self.tick_s,
+            switch_s,
+            max_busy_share,
+        );
+        crate::CheckedSchedule::new(problem, self.clone(), allowance_s)
     }
 
     /// Start time of each robot in global time (s): `[0, τ_2, …, τ_N]`.

@@ -226,7 +226,28 @@ pub fn validate_with_switch(
     schedule: &Schedule,
     switch_s: f64,
 ) -> Result<(), Violation> {
-    if switch_s == 0.0 {
+    validate_with_operator(problem, schedule, switch_s, 1.0)
+}
+
+/// [`validate_with_switch`] for an operator with switch time `switch_s` (s, ≥ 0) and load cap
+/// `max_busy_share` (in `(0, 1]`): the same checks, with Eq. 20 constraint 2 relaxed by
+/// [`crate::start_allowance_s`] — `τ_i ≤ max_{j<i}(τ_j + |ψ_Ej|) + A` — so that a robot may
+/// start after every robot before it has ended, by the idle time the operator's switch and
+/// busy share need (docs/decisions.md, "A schedule always exists with a switch time: constraint
+/// 2 relaxed (issue 41)"). The busy share itself is not checked here
+/// ([`crate::busy_share`]). `switch_s = 0` with `max_busy_share = 1` is [`validate`]; with
+/// `max_busy_share < 1` and no switch time, constraint 2 is relaxed and the margin check is
+/// [`validate`]'s.
+///
+/// # Errors
+/// As [`validate_with_switch`] ([`Violation::Offset`] names the relaxed bound).
+pub fn validate_with_operator(
+    problem: &Problem,
+    schedule: &Schedule,
+    switch_s: f64,
+    max_busy_share: f64,
+) -> Result<(), Violation> {
+    if switch_s == 0.0 && max_busy_share >= 1.0 {
         return validate(problem, schedule);
     }
     let tick_s = schedule.tick_s;
@@ -237,17 +258,30 @@ pub fn validate_with_switch(
     params
         .switch_ticks()
         .map_err(|source| Violation::MarginCheck { tick_s, source })?;
-    let timeline = validate_cheap(problem, schedule)?;
+    let allowance_s = crate::operator::start_allowance_s(
+        problem,
+        schedule.n_robots(),
+        tick_s,
+        switch_s,
+        max_busy_share,
+    );
+    if switch_s == 0.0 {
+        return validated_timeline_with(problem, schedule, MarginCheck::SinglePass, allowance_s)
+            .map(drop);
+    }
+    let timeline = validate_cheap_with(problem, schedule, allowance_s)?;
     if let Some(v) = first_short_switch(&timeline, switch_s) {
         return Err(v);
     }
     let robots = timeline.timelines();
     match tandem_realtime::check_margins(robots, &schedule.holds, &params) {
         Ok(true) => Ok(()),
-        Ok(false) => match validate(problem, schedule) {
-            Ok(()) => Err(Violation::InsufficientSwitchTime { tick_s, switch_s }),
-            Err(v) => Err(v),
-        },
+        Ok(false) => {
+            match validated_timeline_with(problem, schedule, MarginCheck::SinglePass, allowance_s) {
+                Ok(_) => Err(Violation::InsufficientSwitchTime { tick_s, switch_s }),
+                Err(v) => Err(v),
+            }
+        }
         Err(source) => Err(Violation::MarginCheck { tick_s, source }),
     }
 }
@@ -302,11 +336,22 @@ pub(crate) fn validated_timeline(
     schedule: &Schedule,
     check: MarginCheck,
 ) -> Result<GlobalTimeline, Violation> {
+    validated_timeline_with(problem, schedule, check, 0.0)
+}
+
+/// [`validated_timeline`] with constraint 2 relaxed by `allowance_s` (s, ≥ 0; 0: as printed,
+/// [`validate_cheap_with`]).
+pub(crate) fn validated_timeline_with(
+    problem: &Problem,
+    schedule: &Schedule,
+    check: MarginCheck,
+    allowance_s: f64,
+) -> Result<GlobalTimeline, Violation> {
     let tick_s = schedule.tick_s;
     if !(tick_s.is_finite() && tick_s > 0.0) {
         return Err(Violation::InvalidTick { tick_s });
     }
-    let timeline = validate_cheap(problem, schedule)?;
+    let timeline = validate_cheap_with(problem, schedule, allowance_s)?;
     let robots = timeline.timelines();
     let decided = if schedule.has_holds() {
         // The lead bound on the robots' legs with their release rules (one implementation).
@@ -340,11 +385,14 @@ pub enum MarginCheck {
     PerPair,
 }
 
-/// Constraints 1–4 (everything but the margins); on success, the schedule's global timeline
-/// (built once, for the margin check to reuse).
-pub(crate) fn validate_cheap(
+/// Constraints 1–4 (everything but the margins), constraint 2 relaxed by `allowance_s` (s,
+/// ≥ 0; 0: as printed): `τ_i ≤ max_{j<i}(τ_j + |ψ_Ej|) + allowance_s`
+/// ([`crate::operator::start_allowance_s`]); on success, the schedule's global timeline (built
+/// once, for the margin check to reuse).
+pub(crate) fn validate_cheap_with(
     problem: &Problem,
     schedule: &Schedule,
+    allowance_s: f64,
 ) -> Result<GlobalTimeline, Violation> {
     schedule.check_shape()?;
     let n_ref = problem.n_ref();
@@ -376,11 +424,17 @@ pub(crate) fn validate_cheap(
     let mut latest_end_s = schedule.end_s(0, dt_s);
     for (i, &offset_s) in schedule.offsets_s.iter().enumerate() {
         let robot = i + 1;
-        if !tol::within_bounds(offset_s, 0.0, latest_end_s) {
+        // Without an allowance the bound is the latest end itself (no added operation).
+        let max_s = if allowance_s > 0.0 {
+            latest_end_s + allowance_s
+        } else {
+            latest_end_s
+        };
+        if !tol::within_bounds(offset_s, 0.0, max_s) {
             return Err(Violation::Offset {
                 robot,
                 offset_s,
-                max_s: latest_end_s,
+                max_s,
             });
         }
         latest_end_s = latest_end_s.max(schedule.end_s(robot, dt_s));
@@ -613,8 +667,8 @@ mod tests {
         let mut s = ok_schedule();
         s.grad_exec[0][0] = 0.5 * (1.0 - 1e-12);
         s.offsets_s[0] *= 1.0 + 1e-12;
-        assert!(validate_cheap(&p, &s).is_ok());
+        assert!(validate_cheap_with(&p, &s, 0.0).is_ok());
         s.grad_exec[0][0] = 0.5 * (1.0 - 1e-6);
-        assert!(validate_cheap(&p, &s).is_err());
+        assert!(validate_cheap_with(&p, &s, 0.0).is_err());
     }
 }

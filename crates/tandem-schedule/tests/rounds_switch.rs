@@ -1,16 +1,17 @@
 //! Rounds schedules with the operator's switch time `δ` and the load cap `u_max` (issue 41;
 //! docs/decisions.md, "Rounds schedules with the switch time and the load cap (issue 41)"):
 //! `δ = 0` and `u_max = 1` reproduce the scheduler before them bit for bit, every schedule the
-//! scheduler returns keeps `δ` (`validate_with_switch`) and the cap (`busy_share`), and its
-//! certificate's bound is the `δ`-bound.
+//! scheduler returns keeps `δ` (`validate_with_operator`) and the cap (`busy_share`), and its
+//! certificate's bound is the `δ`-bound; a schedule always exists (Eq. 20 constraint 2 relaxed
+//! by `start_allowance_s`: the serial schedule with idle gaps).
 
 use proptest::prelude::*;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use tandem_schedule::testkit::random_problem;
 use tandem_schedule::{
-    Error, ExactParams, Outcome, Problem, SamplerParams, Source, Violation, busy_share,
-    margin_free_bound, sample_schedule_n, validate_with_switch,
+    ExactParams, Outcome, Problem, SamplerParams, Source, Violation, busy_share, margin_free_bound,
+    sample_schedule_n, start_allowance_s, validate, validate_with_operator, validate_with_switch,
 };
 
 /// FNV-1a over 64-bit words.
@@ -122,8 +123,12 @@ fn two_robots_one_stretch_each_by_hand() {
         );
     }
     // Heads and tails of 0.5–2 s: the worst case may run robot 1's tail and robot 2's head at
-    // their fastest, 1 s together, so no schedule keeps δ = 2 s (k = 20 ticks of 0.1 s): the
-    // bound (0.5 + 2 + 2 + 0.5 = 5 s) stands, and the scheduler says why it has no schedule.
+    // their fastest, 1 s together, so without idle time no schedule keeps δ = 2 s (k = 20
+    // ticks of 0.1 s). Constraint 2 relaxed by δ (and the tick and one step), the serial
+    // schedule idles: robot 1 ends at least 3 ticks after its exit tick starts (1 + ⌊(0.5 − ε −
+    // M)/0.1⌋ with M = 0.2 s, its LC samples' F = 2), robot 2's head keeps it out 4 more
+    // (0.5 s, less ε, at 0.1 s a tick), so 14 ticks must be idle: ⌈(g − M)/0.1⌉ ≥ 14, g > 1.5
+    // s, T_total 5.5 s against the bound 0.5 + 2 + 2 + 0.5 = 5 s.
     let p = hlh(10);
     let b = margin_free_bound(&p, 2, &ex, 2.0).unwrap();
     assert!((b.lower_bound_s - 5.0).abs() < 1e-9, "{}", b.lower_bound_s);
@@ -132,16 +137,24 @@ fn two_robots_one_stretch_each_by_hand() {
         switch_s: 2.0,
         ..SamplerParams::default()
     };
-    let e = sample_schedule_n(&p, 2, &params, None).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            Error::NoFeasibleSchedule {
-                serial: Violation::InsufficientSwitchTime { .. }
-            }
-        ),
-        "{e}"
-    );
+    let out = sample_schedule_n(&p, 2, &params, None).unwrap();
+    assert_eq!(out.source, Source::Serial);
+    assert_eq!(validate_with_switch(&p, &out.schedule, 2.0), Ok(()));
+    let gap_s = out.schedule.offsets_s[0] - 2.0;
+    assert!(gap_s > 1.5 && gap_s < 1.5001, "{gap_s}");
+    assert!((out.t_total_s - 5.5).abs() < 1e-3, "{}", out.t_total_s);
+    // Constraint 2 as printed refuses it: robot 2 starts after robot 1 has ended.
+    assert!(matches!(
+        validate(&p, &out.schedule),
+        Err(Violation::Offset { robot: 1, .. })
+    ));
+    // The regression: the same schedule without the idle gap (robot 2 where robot 1 ends)
+    // is refused at δ = 2 s, and so is any gap a tick shorter than the one found.
+    for short_s in [0.0, gap_s - 0.1] {
+        let mut s = out.schedule.clone();
+        s.offsets_s[0] = 2.0 + short_s;
+        assert!(validate_with_switch(&p, &s, 2.0).is_err(), "gap {short_s}");
+    }
     // δ = 0.5 s (5 ticks): the serial schedule's 5 + 5 ticks of tail and head keep it.
     let out = sample_schedule_n(
         &p,
@@ -186,8 +199,9 @@ fn the_load_cap_lengthens_the_round_to_its_share() {
     assert!((capped.lower_bound_s - 2.0 / u_max).abs() < 1e-9);
     assert!(!capped.bound_is_optimum);
     assert!(capped.t_total_s >= capped.lower_bound_s - 1e-9);
-    // A cap no tail can reach is an error naming the parameter.
-    let e = sample_schedule_n(
+    // A cap no tail can reach: the serial schedule idles between the robots, T_total 2/0.05 =
+    // 40 s, at the cap's bound (constraint 2 relaxed by the cap's allowance, here 2·1·19 s).
+    let idle = sample_schedule_n(
         &p,
         2,
         &SamplerParams {
@@ -196,9 +210,16 @@ fn the_load_cap_lengthens_the_round_to_its_share() {
         },
         None,
     )
-    .unwrap_err();
-    assert!(matches!(e, Error::BusyShareUnreachable { .. }), "{e}");
-    assert!(e.to_string().contains("max_busy_share"), "{e}");
+    .unwrap();
+    assert_eq!(idle.source, Source::Serial);
+    assert!((idle.t_total_s - 40.0).abs() < 1e-6, "{}", idle.t_total_s);
+    assert!((idle.lower_bound_s - 40.0).abs() < 1e-9);
+    assert!(busy_share(&idle.schedule, &p, 0.0).unwrap() <= 0.05);
+    assert_eq!(
+        validate_with_operator(&p, &idle.schedule, 0.0, 0.05),
+        Ok(())
+    );
+    assert!((start_allowance_s(&p, 2, 0.1, 0.0, 0.05) - 38.0).abs() < 1e-9);
 }
 
 proptest! {
@@ -229,20 +250,71 @@ proptest! {
         prop_assert!(with.lower_bound_s >= zero.lower_bound_s * (1.0 - 1e-12));
         match sample_schedule_n(&p, n, &params, None) {
             Ok(out) => {
-                prop_assert_eq!(validate_with_switch(&p, &out.schedule, switch_s), Ok(()));
+                prop_assert_eq!(
+                    validate_with_operator(&p, &out.schedule, switch_s, params.max_busy_share),
+                    Ok(())
+                );
+                if !capped {
+                    prop_assert_eq!(validate_with_switch(&p, &out.schedule, switch_s), Ok(()));
+                }
                 prop_assert!(out.lower_bound_s >= with.lower_bound_s);
                 prop_assert!(out.t_total_s >= out.lower_bound_s * (1.0 - 1e-9));
                 prop_assert!(out.t_total_s >= zero.lower_bound_s * (1.0 - 1e-9));
                 let share = busy_share(&out.schedule, &p, switch_s).unwrap();
                 prop_assert!(share <= params.max_busy_share, "{}", share);
             }
-            Err(Error::NoFeasibleSchedule { .. }) => {
-                let serial = p.serial_schedule_n(n, 0.1).unwrap();
-                prop_assert!(switch_s > 0.0);
-                prop_assert!(validate_with_switch(&p, &serial, switch_s).is_err());
-            }
-            Err(Error::BusyShareUnreachable { .. }) => prop_assert!(capped),
+            // A schedule always exists: the serial one with idle gaps.
             Err(e) => prop_assert!(false, "{}", e),
         }
     }
+
+    /// The allowance suffices: on random problems, `N = 2..4`, random ticks and switch times,
+    /// the fastest serial schedule with the idle gap `start_allowance_s` between each robot's end
+    /// and the next start keeps the switch time (`validate_with_switch`), and with the cap's
+    /// allowance at a random cap its busy share is at most the cap. Not vacuous: without the gap
+    /// many of these serial schedules fail (counted in `the_allowance_is_needed`).
+    #[test]
+    fn the_serial_schedule_with_its_idle_gaps_is_always_valid(
+        seed in any::<u64>(),
+        n in 2usize..=4,
+        switch_s in 0.01f64..8.0,
+        tick_k in 1usize..=5,
+        u_max in 0.2f64..1.0,
+    ) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let p = random_problem(&mut rng, 60..=300, 0.1).unwrap();
+        let tick_s = 0.02 * tick_k as f64;
+        let serial = p.serial_schedule_n(n, tick_s).unwrap();
+        let gapped = |gap_s: f64| {
+            let mut s = serial.clone();
+            for (i, o) in s.offsets_s.iter_mut().enumerate() {
+                *o += (i + 1) as f64 * gap_s;
+            }
+            s
+        };
+        let a = start_allowance_s(&p, n, tick_s, switch_s, 1.0);
+        prop_assert!(a >= switch_s);
+        prop_assert_eq!(validate_with_switch(&p, &gapped(a), switch_s), Ok(()));
+        // With the cap: the gap the share needs is within the cap's allowance.
+        let params = SamplerParams { samples: 20, seed, switch_s, max_busy_share: u_max, tick_s: Some(tick_s), ..SamplerParams::default() };
+        let out = sample_schedule_n(&p, n, &params, None).unwrap();
+        prop_assert!(busy_share(&out.schedule, &p, switch_s).unwrap() <= u_max);
+        prop_assert_eq!(validate_with_operator(&p, &out.schedule, switch_s, u_max), Ok(()));
+    }
+}
+
+/// Without the idle gap, the fastest serial schedules of the property test above fail at their
+/// switch time on most draws: the allowance is what makes them valid.
+#[test]
+fn the_allowance_is_needed() {
+    let mut failing = 0;
+    for seed in 0..40_u64 {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let p = random_problem(&mut rng, 60..=300, 0.1).unwrap();
+        let serial = p.serial_schedule_n(2, 0.1).unwrap();
+        if validate_with_switch(&p, &serial, 2.0).is_err() {
+            failing += 1;
+        }
+    }
+    assert!(failing >= 10, "{failing} of 40");
 }

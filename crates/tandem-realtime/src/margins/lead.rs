@@ -308,7 +308,8 @@ pub(super) fn integrate(
 /// so that the lead with which `c` can be ahead when a later `p` starts is read from pairs
 /// already done; each pair's regions are tested as soon as its bound is known (and with
 /// `stop_at_first` the check stops at the first slack `≤ 0`). `max_step_of[i]` is `M_i`, `eps`
-/// the comparison tolerance `ε` (schedule-clock s).
+/// the comparison tolerance `ε` (schedule-clock s), `(switch_ticks, tick_s)` the switch time in
+/// whole ticks (0: none) and the control tick (real s).
 ///
 /// For every region `P` of `p` and the first region `C` of `c` starting at or after `P` starts
 /// (later regions of `c` are implied): `slack = (T_c − ε) − (reach + M_c)` with `T_c` where `c`
@@ -323,7 +324,7 @@ pub(super) fn slacks(
     windows: Windows,
     stop_at_first: bool,
     passes: Passes,
-    switch_ticks: u64,
+    (switch_ticks, tick_s): (u64, f64),
 ) -> Vec<PairSlack> {
     let robot_of: Vec<usize> = (0..robots.len()).collect();
     slacks_of_legs(
@@ -332,6 +333,7 @@ pub(super) fn slacks(
             robot_of: &robot_of,
             plans: None,
             switch_ticks,
+            tick_s,
         },
         max_step_of,
         eps,
@@ -364,6 +366,8 @@ pub(super) struct Legs<'a> {
     pub(super) plans: Option<&'a Plans>,
     /// `k`: the operator's switch time in whole ticks (`super::switch_ticks`; 0: none).
     pub(super) switch_ticks: u64,
+    /// The control tick `h` (real s).
+    pub(super) tick_s: f64,
 }
 
 /// [`slacks`] of the legs of plans with holds ([`Legs`]), the pairs' indices being legs. The
@@ -604,6 +608,12 @@ fn pass(
                             &robots[c],
                             max_step_of[c],
                             0..c_iv.ref_start,
+                        ),
+                        idle_ticks: super::idle_ticks_before_start(
+                            robots,
+                            max_step_of,
+                            c,
+                            legs.tick_s,
                         ),
                     },
                     u_max,

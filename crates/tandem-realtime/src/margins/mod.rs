@@ -413,6 +413,7 @@ fn plan_slacks_with(
             robot_of: &plans.robot_of,
             plans: Some(plans),
             switch_ticks,
+            tick_s,
         },
         &max_step_of,
         eps,
@@ -460,7 +461,7 @@ fn lead_slacks(
         windows,
         stop_at_first,
         lead::Passes::Both,
-        switch_ticks,
+        (switch_ticks, tick_s),
     ))
 }
 
@@ -612,6 +613,51 @@ pub(super) struct SwitchRoom {
     pub(super) step_p_after: f64,
     /// `c`'s largest step over its samples before its region `C` ([`step_within`]), `≤ M_c`.
     pub(super) step_c_before: f64,
+    /// Whole ticks in which nobody runs before `c` starts, after `p` has finished
+    /// ([`idle_ticks_before_start`]; 0 when `c` starts before every earlier robot has ended).
+    pub(super) idle_ticks: f64,
+}
+
+/// A lower bound on the whole ticks in which no robot runs before robot `c` of `robots` starts
+/// at `τ_c` (its plan's start, schedule clock), after the last tick in which a robot that
+/// starts before it ran: 0 unless `τ_c` lies beyond `E = max end` of those robots (Eq. 20
+/// constraint 2 relaxed by the operator's switch time, docs/decisions.md, "A schedule always
+/// exists with a switch time: constraint 2 relaxed (issue 41)").
+///
+/// Why (the coordinator's rule 3, `strategy`): until `c` starts its clock is the smallest new
+/// clock of the running robots, capped at `τ_c` and at the starts of the robots still waiting,
+/// and runs on schedule (`+h` a tick) when none runs. Before `c` starts only robots with a start
+/// below `τ_c` run (the others wait, capped at the earliest start waiting, at most `τ_c`), each
+/// below its end and moving at most its largest step `M_r`; so at the end of the last tick in
+/// which one of them runs `c`'s clock is at most `E + M` (`M` their largest step), and it needs
+/// at least `(τ_c − E − M)/h` more ticks, all of them with nobody running, to reach `τ_c`. The
+/// count is a whole number, so its quotient's ceiling, taken after lowering the quotient by
+/// `1e-9` relative, by the clocks' rounding (`8·ε·(|τ_c| + |E|)/h` relative: each tick's sum
+/// rounds by half an ulp) and by `1e-6` absolute, is a lower bound: it errs towards fewer ticks.
+pub(super) fn idle_ticks_before_start(
+    robots: &[Timeline],
+    max_step_of: &[f64],
+    c: usize,
+    tick_s: f64,
+) -> f64 {
+    let tau_c = robots[c].start_s();
+    let (end_s, step_s) = robots
+        .iter()
+        .zip(max_step_of)
+        .enumerate()
+        .filter(|&(r, (tl, _))| r != c && tl.start_s() < tau_c)
+        .fold((f64::NEG_INFINITY, 0.0_f64), |(e, m), (_, (tl, &s))| {
+            (e.max(tl.end_s()), m.max(s))
+        });
+    if end_s == f64::NEG_INFINITY {
+        return 0.0;
+    }
+    let quotient = (tau_c - end_s - step_s) / tick_s;
+    if !(quotient > 0.0 && quotient.is_finite()) {
+        return 0.0;
+    }
+    let rel = 1e-9 + 8.0 * f64::EPSILON * (tau_c.abs() + end_s.abs()) / tick_s;
+    (quotient * (1.0 - rel) - 1e-6).ceil().max(0.0)
 }
 
 /// The largest step (schedule-clock s) of robot `tl` in one tick while it traverses only the
@@ -666,7 +712,9 @@ pub(super) fn started_after_exit_slack(
 ) -> f64 {
     let reach_s = tau_c_s.min(end_p_s) - u_max_s;
     let after_exit = 1.0 + ((reach_s - room.step_p) / room.step_p_after).floor();
-    let elapsed = (reach_s / room.step_p).floor().max(after_exit).max(1.0);
+    // Ticks with nobody running after `p` finished come on top (`idle_ticks`, 0 when `c`
+    // starts before every earlier robot has ended: the same value as without the term).
+    let elapsed = (reach_s / room.step_p).floor().max(after_exit).max(1.0) + room.idle_ticks;
     let k = room.ticks as f64;
     if elapsed > k {
         f64::INFINITY
@@ -701,7 +749,7 @@ pub fn lead_bound_first_pass(
             Windows::Sliding,
             true,
             lead::Passes::First,
-            0,
+            (0, tick_s),
         )
         .iter()
         .all(|s| s.slack_s > 0.0));

@@ -308,6 +308,9 @@ struct RoleSim<'a> {
     /// one) and that sample's index (`n_ref` when none): `c`'s step over the samples it
     /// traverses before its next region, for rule 1's switch room.
     rest_of_c: Option<(Vec<f64>, Vec<usize>)>,
+    /// With a switch time, the whole ticks in which nobody runs before `c` starts
+    /// ([`super::idle_ticks_before_start`]; 0 without a switch time, where it is not read).
+    idle_ticks_c: f64,
 }
 
 impl<'a> RoleSim<'a> {
@@ -371,6 +374,11 @@ impl<'a> RoleSim<'a> {
             }
             (rate, next)
         });
+        let idle_ticks_c = if setup.switch_ticks > 0 {
+            super::idle_ticks_before_start(robots, &setup.max_step_of, c, tick_s)
+        } else {
+            0.0
+        };
         let mut sim = RoleSim {
             variant,
             sides,
@@ -382,6 +390,7 @@ impl<'a> RoleSim<'a> {
             switch_extra_s,
             switch,
             rest_of_c,
+            idle_ticks_c,
         };
         if variant != Variant::Printed && sim.both_started() {
             let (start_p, start_c) = (robots[p].start_s(), robots[c].start_s());
@@ -578,6 +587,7 @@ impl<'a> RoleSim<'a> {
                         step_c,
                         0..pair.cur.ref_start,
                     ),
+                    idle_ticks: self.idle_ticks_c,
                 },
                 (pair.t_p_end() + setup.eps).min(end_p),
                 (self.sides[1].tl.start_s(), end_p),
