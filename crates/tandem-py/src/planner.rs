@@ -1168,7 +1168,9 @@ impl PyStateEdit {
 
 impl PyPlanner {
     fn current_schedule(&self) -> PySchedule {
+        let sp = &self.inner.params().sampler;
         PySchedule::from_outcome(Arc::new(self.inner.problem().clone()), self.inner.outcome())
+            .with_operator(sp.switch_s, sp.max_busy_share)
     }
 }
 

@@ -193,6 +193,10 @@ pub(crate) struct PySchedule {
     /// (valid when made), so that a coordinator checks it itself instead of asking for
     /// `validate()`.
     from_scheduler: bool,
+    /// The operator's `(switch_s, max_busy_share)` the schedule was planned for (a planner's;
+    /// `(0, 1)` otherwise): its check relaxes Eq. 20 constraint 2 by their allowance
+    /// ([`Schedule::check_with_operator`]).
+    operator: (f64, f64),
 }
 
 impl PySchedule {
@@ -216,6 +220,7 @@ impl PySchedule {
             certificate: None,
             checked: OnceLock::new(),
             from_scheduler: false,
+            operator: (0.0, 1.0),
         }
     }
 
@@ -233,7 +238,7 @@ impl PySchedule {
         if !self.from_scheduler {
             return Err(Error::Unchecked);
         }
-        let c = checked_or_violation(&self.problem, &self.schedule)?;
+        let c = checked_or_violation(&self.problem, &self.schedule, self.operator)?;
         Ok(self.checked.get_or_init(|| c))
     }
 
@@ -251,6 +256,15 @@ impl PySchedule {
         }
     }
 
+    /// The same schedule, planned for an operator with `switch_s` and `max_busy_share` (a
+    /// planner's parameters): its check relaxes constraint 2 by their allowance.
+    pub(crate) fn with_operator(self, switch_s: f64, max_busy_share: f64) -> Self {
+        Self {
+            operator: (switch_s, max_busy_share),
+            ..self
+        }
+    }
+
     fn timeline(&self) -> Result<GlobalTimeline> {
         Ok(GlobalTimeline::new(&self.problem, &self.schedule)?)
     }
@@ -258,8 +272,17 @@ impl PySchedule {
 
 /// [`Schedule::check`], a broken constraint as [`Error::Violation`] (``ScheduleError`` with
 /// the rule's name).
-fn checked_or_violation(problem: &Problem, schedule: &Schedule) -> Result<CheckedSchedule> {
-    schedule.check(problem).map_err(|e| match e {
+fn checked_or_violation(
+    problem: &Problem,
+    schedule: &Schedule,
+    (switch_s, max_busy_share): (f64, f64),
+) -> Result<CheckedSchedule> {
+    let checked = if switch_s == 0.0 && max_busy_share >= 1.0 {
+        schedule.check(problem)
+    } else {
+        schedule.check_with_operator(problem, switch_s, max_busy_share)
+    };
+    checked.map_err(|e| match e {
         crate::facade::errors::Schedule::Invalid(v) => Error::Violation(v),
         other => other.into(),
     })
@@ -490,8 +513,8 @@ impl PySchedule {
         if self.checked.get().is_some() {
             return Ok(());
         }
-        let (problem, schedule) = (&*self.problem, &self.schedule);
-        let checked = py.detach(|| guard(|| checked_or_violation(problem, schedule)))?;
+        let (problem, schedule, operator) = (&*self.problem, &self.schedule, self.operator);
+        let checked = py.detach(|| guard(|| checked_or_violation(problem, schedule, operator)))?;
         let _ = self.checked.set(checked);
         Ok(())
     }
