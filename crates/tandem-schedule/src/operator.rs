@@ -94,7 +94,7 @@ pub(crate) fn cap_bound_s(
 ///   serial schedule needs to keep the cap, `((N·L + (N − 1)·δ)/u_max − N·D)/(N − 1)` with `D`
 ///   its robots' duration, at most this since `D ≥ L` (`L` the LC time of one execution).
 ///
-/// So the serial schedule with idle gaps ([`serial_with_switch`], [`serial_capped`]) always
+/// So the serial schedule with idle gaps (`serial_with_switch`, `serial_capped`) always
 /// meets the relaxed constraint; a longer gap only lengthens `T_total`. 0 (constraint 2 as
 /// printed) for `δ = 0`, `u_max = 1` or one robot.
 pub fn start_allowance_s(
