@@ -287,6 +287,7 @@ mod tests {
                     gate_ticks: 0,
                     plan_gap: tandem::sim::workcell::PlanGap::default(),
                     needed_unsupervised: 0,
+                    switch_missed: 0,
                 })
                 .collect(),
             stats: CellStats::default(),
