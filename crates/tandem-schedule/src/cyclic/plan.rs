@@ -37,7 +37,12 @@ pub struct CyclicPlan {
     /// A lower bound (s) on the period of every 1-periodic plan of `N` robots, whatever the
     /// order: [`period_lower_bound_s`]; for a plan searched with the hand-overs counted
     /// ([`crate::CyclicParams::handover_tick_s`]) among runnable orders, the bound of every
-    /// such plan, [`handover_bound_s`] (at least the former).
+    /// such plan, [`handover_bound_s`] (at least the former); with a switch time
+    /// ([`crate::CyclicParams::switch_s`] `> 0`) also at least
+    /// [`period_lower_bound_with_switch_s`] and the chain bound (each interval before a stretch
+    /// a switch or the robot's own gap, whichever is shorter; docs/decisions.md, "The
+    /// continuous cell's chain bound with the switch time (issue 41)"), and with a load cap its
+    /// bound.
     pub lower_bound_s: f64,
     /// `period_s / lower_bound_s − 1` (0 when the plan is at the bound, up to rounding).
     pub gap: f64,
