@@ -640,19 +640,17 @@ fn draw_on<DB: DrawingBackend>(
         .y_label_area_size(80)
         .build_cartesian_2d(x_range.clone(), 0.0..y_max)
         .map_err(err("throughput axes"))?;
-    chart
-        .configure_mesh()
-        .x_labels(n_labels)
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_label_formatter(&|v| format!("{v:.0}"))
-        .x_desc("robots N run by one operator")
-        .y_desc("throughput (tasks per hour per operator)")
-        .label_style((FONT_FAMILY, 18))
-        .axis_desc_style((FONT_FAMILY, 20))
-        .light_line_style(WHITE.mix(0.0))
-        .bold_line_style(BLACK.mix(0.12))
-        .draw()
-        .map_err(err("throughput mesh"))?;
+    mesh_style!(
+        chart
+            .configure_mesh()
+            .x_labels(n_labels)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| format!("{v:.0}"))
+            .x_desc("robots N run by one operator")
+            .y_desc("throughput (tasks per hour per operator)")
+    )
+    .draw()
+    .map_err(err("throughput mesh"))?;
     for (series, colour, label) in [
         (&rounds_tp, MEAN, "rounds (measured, last 10 %)"),
         (
@@ -713,26 +711,18 @@ fn draw_on<DB: DrawingBackend>(
         .y_label_area_size(70)
         .build_cartesian_2d(x_range, 0.0..140.0)
         .map_err(err("share axes"))?;
-    chart
-        .configure_mesh()
-        .x_labels(n_labels)
-        .y_labels(8)
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_label_formatter(&|v| {
-            if *v <= 100.0 {
-                format!("{v:.0}")
-            } else {
-                String::new()
-            }
-        })
-        .x_desc("robots N run by one operator")
-        .y_desc("share of time (%)")
-        .label_style((FONT_FAMILY, 18))
-        .axis_desc_style((FONT_FAMILY, 20))
-        .light_line_style(WHITE.mix(0.0))
-        .bold_line_style(BLACK.mix(0.12))
-        .draw()
-        .map_err(err("share mesh"))?;
+    mesh_style!(
+        chart
+            .configure_mesh()
+            .x_labels(n_labels)
+            .y_labels(8)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&crate::legend::percent_label)
+            .x_desc("robots N run by one operator")
+            .y_desc("share of time (%)")
+    )
+    .draw()
+    .map_err(err("share mesh"))?;
     let shares: [(Series, RGBColor, bool, &str); 4] = [
         (
             rows.iter()
@@ -977,18 +967,16 @@ fn draw_switch_on<DB: DrawingBackend>(
         .y_label_area_size(80)
         .build_cartesian_2d(x_range.clone(), 0.0..y_max)
         .map_err(err("throughput axes"))?;
-    chart
-        .configure_mesh()
-        .x_label_formatter(&|v| format!("{v:.1}"))
-        .y_label_formatter(&|v| format!("{v:.0}"))
-        .x_desc("the operator's switch time δ (s) the plans are made with")
-        .y_desc("throughput (tasks per hour per operator)")
-        .label_style((FONT_FAMILY, 18))
-        .axis_desc_style((FONT_FAMILY, 20))
-        .light_line_style(WHITE.mix(0.0))
-        .bold_line_style(BLACK.mix(0.12))
-        .draw()
-        .map_err(err("throughput mesh"))?;
+    mesh_style!(
+        chart
+            .configure_mesh()
+            .x_label_formatter(&|v| format!("{v:.1}"))
+            .y_label_formatter(&|v| format!("{v:.0}"))
+            .x_desc("the operator's switch time δ (s) the plans are made with")
+            .y_desc("throughput (tasks per hour per operator)")
+    )
+    .draw()
+    .map_err(err("throughput mesh"))?;
     for (label, colour, continuous, pts) in &lines {
         let colour = *colour;
         let measured: Series = pts.iter().map(|p| (p.0, p.1)).collect();
@@ -1033,25 +1021,17 @@ fn draw_switch_on<DB: DrawingBackend>(
         .y_label_area_size(70)
         .build_cartesian_2d(x_range, 0.0..140.0)
         .map_err(err("share axes"))?;
-    chart
-        .configure_mesh()
-        .y_labels(8)
-        .x_label_formatter(&|v| format!("{v:.1}"))
-        .y_label_formatter(&|v| {
-            if *v <= 100.0 {
-                format!("{v:.0}")
-            } else {
-                String::new()
-            }
-        })
-        .x_desc("the operator's switch time δ (s) the plans are made with")
-        .y_desc("operator busy, share of time (%)")
-        .label_style((FONT_FAMILY, 18))
-        .axis_desc_style((FONT_FAMILY, 20))
-        .light_line_style(WHITE.mix(0.0))
-        .bold_line_style(BLACK.mix(0.12))
-        .draw()
-        .map_err(err("share mesh"))?;
+    mesh_style!(
+        chart
+            .configure_mesh()
+            .y_labels(8)
+            .x_label_formatter(&|v| format!("{v:.1}"))
+            .y_label_formatter(&crate::legend::percent_label)
+            .x_desc("the operator's switch time δ (s) the plans are made with")
+            .y_desc("operator busy, share of time (%)")
+    )
+    .draw()
+    .map_err(err("share mesh"))?;
     for (label, colour, continuous, pts) in &lines {
         let colour = *colour;
         let busy: Series = pts.iter().map(|p| (p.0, 100.0 * p.3)).collect();

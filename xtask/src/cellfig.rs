@@ -166,28 +166,20 @@ fn draw_on<DB: DrawingBackend>(
         .build_cartesian_2d(0.0..x_max, 0.0..y_max)
         .map_err(err("axes"))?
         .set_secondary_coord(0.0..x_max, 0.0..140.0);
-    chart
-        .configure_mesh()
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_label_formatter(&|v| format!("{v:.0}"))
-        .x_desc("tasks completed (all robots)")
-        .y_desc("throughput (tasks per hour per operator)")
-        .label_style((FONT_FAMILY, 18))
-        .axis_desc_style((FONT_FAMILY, 20))
-        .light_line_style(WHITE.mix(0.0))
-        .bold_line_style(BLACK.mix(0.12))
-        .draw()
-        .map_err(err("mesh"))?;
+    mesh_style!(
+        chart
+            .configure_mesh()
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| format!("{v:.0}"))
+            .x_desc("tasks completed (all robots)")
+            .y_desc("throughput (tasks per hour per operator)")
+    )
+    .draw()
+    .map_err(err("mesh"))?;
     chart
         .configure_secondary_axes()
         .y_labels(8)
-        .y_label_formatter(&|v| {
-            if *v <= 100.0 {
-                format!("{v:.0}")
-            } else {
-                String::new()
-            }
-        })
+        .y_label_formatter(&crate::legend::percent_label)
         .y_desc("high-confidence samples (%)")
         .label_style((FONT_FAMILY, 18))
         .axis_desc_style((FONT_FAMILY, 20))
@@ -287,6 +279,7 @@ mod tests {
                     gate_ticks: 0,
                     plan_gap: tandem::sim::workcell::PlanGap::default(),
                     needed_unsupervised: 0,
+                    switch_missed: 0,
                 })
                 .collect(),
             stats: CellStats::default(),

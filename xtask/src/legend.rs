@@ -1,5 +1,6 @@
-//! The legend pieces every figure of the xtask shares (capacity, the continuous study, Fig. 5):
-//! macros, since plotters' chart and element types differ per backend and coordinate system.
+//! The legend and mesh pieces every figure of the xtask shares (capacity, the continuous study,
+//! Fig. 5): macros, since plotters' chart and element types differ per backend and coordinate
+//! system.
 
 /// A dashed line's legend mark in `colour` (a closure for `SeriesAnno::legend`).
 macro_rules! dashed_mark {
@@ -28,4 +29,26 @@ macro_rules! draw_legend {
             .draw()
             .map_err($err)
     };
+}
+
+/// The figures' mesh style on a `configure_mesh()` chain: 18 px labels, 20 px axis
+/// descriptions, no light grid lines, faint bold ones.
+macro_rules! mesh_style {
+    ($mesh:expr) => {
+        $mesh
+            .label_style((FONT_FAMILY, 18))
+            .axis_desc_style((FONT_FAMILY, 20))
+            .light_line_style(WHITE.mix(0.0))
+            .bold_line_style(BLACK.mix(0.12))
+    };
+}
+
+/// A share axis's label (percent, 0–100): blank above 100, where the axis leaves room for
+/// the legend.
+pub(crate) fn percent_label(v: &f64) -> String {
+    if *v <= 100.0 {
+        format!("{v:.0}")
+    } else {
+        String::new()
+    }
 }

@@ -279,6 +279,19 @@ fn run_continuous(
         },
         summary.steady_needed_unsupervised_per_task
     );
+    if !config.operator.is_default() {
+        let (missed, tasks) = result.switch_missed_total();
+        let op = &config.operator;
+        println!(
+            "operator: planned switch time δ {} s, load cap {}; own switch time δ_true {} s: {} \
+             needed corrections missed while switching ({:.2} per task)",
+            op.switch_s,
+            op.max_busy_share,
+            op.switch_true_s,
+            missed,
+            missed as f64 / tasks.max(1) as f64,
+        );
+    }
     println!(
         "overlapping low-confidence ticks: {}, faults: {}",
         summary.overlap_ticks, summary.faults

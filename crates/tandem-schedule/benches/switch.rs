@@ -25,8 +25,18 @@ mod fixture;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use tandem_schedule::{
     CyclicParams, ExactParams, SamplerParams, busy_share, cyclic_plan, margin_free_bound,
-    sample_schedule, sample_schedule_n, validate_with_switch,
+    period_lower_bound_with_switch_s, sample_schedule, sample_schedule_n, validate_with_switch,
 };
+
+/// The operator's busy share of a cyclic plan with its switches: the supervised share plus
+/// `δ` per change of robot around the order, over the period.
+fn busy_with_switches(plan: &tandem_schedule::CyclicPlan, switch_s: f64) -> f64 {
+    let len = plan.order.len();
+    let changes = (0..len)
+        .filter(|&q| plan.order[q].robot != plan.order[(q + 1) % len].robot)
+        .count();
+    plan.operator_share + changes as f64 * switch_s / plan.period_s
+}
 
 fn bench(c: &mut Criterion) {
     let (problem, label) = fixture::mid_study_problem();
@@ -60,6 +70,51 @@ fn bench(c: &mut Criterion) {
                 plan.lower_bound_s,
                 100.0 * plan.gap,
                 plan.operator_share
+            );
+        }
+    }
+    // The same with the fixture's transitions as hold points (the study's task: a hold between
+    // every two passes, so every order is runnable), against the chain bound and the bound of
+    // one switch per robot (docs/decisions.md, "The continuous cell's chain bound with the
+    // switch time (issue 41)"), and with the load cap 0.7 against the uncapped plan.
+    let (held, _, _) = fixture::mid_study_problem_with_holds();
+    for n in [2usize, 3] {
+        for switch_s in [0.0, 1.0, 2.0, 5.0, 7.0] {
+            let params = CyclicParams {
+                handover_tick_s: Some(held.dt_s()),
+                switch_s,
+                ..CyclicParams::default()
+            };
+            let plan = cyclic_plan(&held, n, &params).expect("valid");
+            let capped = cyclic_plan(
+                &held,
+                n,
+                &CyclicParams {
+                    max_busy_share: 0.7,
+                    ..params
+                },
+            )
+            .expect("valid");
+            let one_switch = period_lower_bound_with_switch_s(&held, n, switch_s).expect("valid");
+            println!(
+                "  cyclic with holds N = {n}, δ = {switch_s} s: period {:.3} s, {:.2} tasks/h, \
+                 bound {:.3} s (gap {:.2} %, {:.2} % above one switch per robot {:.3} s), \
+                 order {:?}; u_max = 0.7: period {:.3} s, {:.2} tasks/h (gap {:.2} %), \
+                 busy share with the switches {:.3}",
+                plan.period_s,
+                plan.tasks_per_hour,
+                plan.lower_bound_s,
+                100.0 * plan.gap,
+                100.0 * (plan.period_s / one_switch - 1.0),
+                one_switch,
+                plan.order
+                    .iter()
+                    .map(|s| (s.robot, s.lc))
+                    .collect::<Vec<_>>(),
+                capped.period_s,
+                capped.tasks_per_hour,
+                100.0 * capped.gap,
+                busy_with_switches(&capped, switch_s)
             );
         }
     }

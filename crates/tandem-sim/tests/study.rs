@@ -180,3 +180,49 @@ fn an_observed_study_is_the_same_study_and_shows_every_round() {
         assert_eq!(it.t_total_s, t_total_s, "trial {trial} round {round}");
     }
 }
+
+/// The continuous study records, per task, the needed corrections its simulated operator
+/// missed while switching (issue 41): none without a switch time (and the field is left out
+/// of the JSON, so files are as before), some with `δ_true = 2` s on a plan made at `δ = 0`
+/// (the token passes back to back).
+#[test]
+fn a_continuous_study_counts_the_corrections_missed_while_switching() {
+    use tandem_sim::study::{Cell, StudyOperator, run_cell_trials};
+    let (_, model) = common::fixtures();
+    let config = |switch_true_s| StudyConfig {
+        trials: 1,
+        executions: 16,
+        robots: 2,
+        samples: 200,
+        cell: Cell::Continuous,
+        operator: StudyOperator {
+            switch_true_s,
+            ..StudyOperator::default()
+        },
+        ..StudyConfig::default()
+    };
+    let run = |switch_true_s| {
+        run_cell_trials(&config(switch_true_s), model, common::labels(), &|_| {})
+            .expect("the study runs")
+            .0
+    };
+    let (none, two) = (run(0.0), run(2.0));
+    assert_eq!(none.switch_missed_total(), (0, 16));
+    let json = serde_json::to_string(&none).unwrap();
+    assert!(!json.contains("switch_missed"));
+    let (missed, tasks) = two.switch_missed_total();
+    assert_eq!(tasks, 16);
+    assert!(missed > 0, "no correction missed while switching");
+    // Recorded per task, not lumped into one: several tasks missed some.
+    let missing = two.trials[0]
+        .completions
+        .iter()
+        .filter(|c| c.switch_missed > 0)
+        .count();
+    assert!(missing > 1, "{missing} tasks with a miss");
+    assert!(
+        serde_json::to_string(&two)
+            .unwrap()
+            .contains("switch_missed")
+    );
+}

@@ -37,7 +37,12 @@ pub struct CyclicPlan {
     /// A lower bound (s) on the period of every 1-periodic plan of `N` robots, whatever the
     /// order: [`period_lower_bound_s`]; for a plan searched with the hand-overs counted
     /// ([`crate::CyclicParams::handover_tick_s`]) among runnable orders, the bound of every
-    /// such plan, [`handover_bound_s`] (at least the former).
+    /// such plan, [`handover_bound_s`] (at least the former); with a switch time
+    /// ([`crate::CyclicParams::switch_s`] `> 0`) also at least
+    /// [`period_lower_bound_with_switch_s`] and the chain bound (each interval before a stretch
+    /// a switch or the robot's own gap, whichever is shorter; docs/decisions.md, "The
+    /// continuous cell's chain bound with the switch time (issue 41)"), and with a load cap its
+    /// bound.
     pub lower_bound_s: f64,
     /// `period_s / lower_bound_s − 1` (0 when the plan is at the bound, up to rounding).
     pub gap: f64,
@@ -266,6 +271,66 @@ fn handover_switch_bound_of(shape: &TaskShape, n_robots: usize, tick_s: f64, swi
     (n_robots as f64 * (groups_per_task_s(shape) + per_change)).max(old)
 }
 
+/// The chain bound (s) with the operator's switch time `switch_s > 0`: for `N ≥ 2` robots and
+/// `m ≥ 1` stretches, `max(N·(L + Σ_k min(C_k, G_k) + max(0, min_k (C_k − G_k))), D_min)`, where
+/// for the interval before stretch `k` of a robot `G_k` is the robot's own least time from
+/// its previous stretch (gap `k` at its fastest; for `k = 0` the tail and the head of the next
+/// task) and `C_k` the least time after another robot's stretch: the switch time `δ`, or
+/// `max(δ, E_k + tick)` when the hand-overs are counted at `handover_tick_s` and `k` opens a
+/// group ([`crate::CyclicParams::switch_s`]); `∞` where no other robot's stretch can come
+/// before it (a gap without a usable hold too short, even at its slowest, for the shortest
+/// stretch; with `runnable`, any `k` inside a group).
+///
+/// **Why** (docs/decisions.md, "The continuous cell's chain bound with the switch time (issue
+/// 41)"). Around one period the operator supervises the `N·m` stretches once each, in the
+/// cyclic order, with an interval before each: `P = N·L + Σ intervals`. The stretch before
+/// robot `r`'s stretch `k` in the order is either `r`'s own previous stretch (each robot's
+/// stretches come in task order around the cycle), and then the robot's arcs make the
+/// interval at least `G_k`; or another robot's, and then the operator arc makes it at least
+/// `C_k`. So each interval is at least `min(C_k, G_k)`, and with `N ≥ 2` robots each robot's
+/// stretches are entered from another robot at least once per period, which costs
+/// `C_k − G_k` more at one `k` when every `C_k` exceeds its `G_k`. The intervals are
+/// disjoint, one per stretch, so the per-robot sums add. At `δ = 0` without hand-overs it is
+/// `N·(L + I)` ([`period_lower_bound_s`]); it is at least [`period_lower_bound_with_switch_s`]
+/// (every `min(C_k, G_k)` is at least `G_k` on a forced idle gap and at least 0 elsewhere, and
+/// the extra term, with the `min` terms that take `C_k`, gives at least one `δ` per robot) and,
+/// with the hand-overs, than [`handover_bound_s`]'s argument with the switch time
+/// (`G_k ≥ E_k` for a group's first stretch, `G_k = ` the in-group gap otherwise).
+pub(crate) fn chain_switch_bound_of(
+    shape: &TaskShape,
+    n_robots: usize,
+    switch_s: f64,
+    handover_tick_s: Option<f64>,
+    runnable: bool,
+) -> f64 {
+    let m = shape.n_lc();
+    if n_robots < 2 || m == 0 {
+        return bound_of(shape, n_robots);
+    }
+    let shortest = shape.lc_s.iter().copied().fold(f64::INFINITY, f64::min);
+    let (mut sum, mut extra) = (0.0, f64::INFINITY);
+    for k in 0..m {
+        let own = if k == 0 {
+            shape.gaps[m].min_s + shape.gaps[0].min_s
+        } else {
+            shape.gaps[k].min_s
+        };
+        let gap = shape.gaps[k];
+        let closed = k >= 1 && gap.hold.is_none() && (runnable || gap.max_s < shortest);
+        let other = if closed {
+            f64::INFINITY
+        } else {
+            match handover_tick_s {
+                Some(tick_s) if shape.opens_group(k) => switch_s.max(shape.entry_s[k] + tick_s),
+                _ => switch_s,
+            }
+        };
+        sum += own.min(other);
+        extra = extra.min((other - own).max(0.0));
+    }
+    (n_robots as f64 * (shape.lc_total_s() + sum + extra)).max(shape.fastest_s())
+}
+
 /// The cyclic plan of `n_robots` robots on `problem` with the operator's cyclic order `order`
 /// (each robot's stretches in task order around the cycle, starting anywhere): the least
 /// period of its event graph ([`event_graph`], [`max_cycle_ratio`]) and each robot's times.
@@ -327,7 +392,15 @@ pub(crate) fn plan_for_order(
         _ => bound_of(&graph.shape, n_robots),
     };
     let lower_bound_s = if switch_s > 0.0 {
-        lower_bound_s.max(switch_bound_of(&graph.shape, n_robots, switch_s))
+        lower_bound_s
+            .max(switch_bound_of(&graph.shape, n_robots, switch_s))
+            .max(chain_switch_bound_of(
+                &graph.shape,
+                n_robots,
+                switch_s,
+                handover_tick_s,
+                handover_tick_s.is_some() && runnable_only,
+            ))
     } else {
         lower_bound_s
     };

@@ -95,6 +95,20 @@ pub struct CellCompletion {
     /// The task's samples run at high confidence where the truth needed the operator.
     #[serde(default)]
     pub needed_unsupervised: usize,
+    /// Needed corrections of the task the simulated operator missed because it was still
+    /// switching its attention from another robot (its switch time `δ_true`, issue 41;
+    /// [`RobotRun::switch_missed`](crate::workcell::RobotRun::switch_missed)). Left out of the
+    /// JSON when 0, as it always is without a switch time, so files without one are unchanged.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub switch_missed: usize,
+}
+
+#[expect(
+    clippy::trivially_copy_pass_by_ref,
+    reason = "serde passes the field by reference"
+)]
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// Where one task of a continuous cell spent its time against the plan
@@ -287,6 +301,15 @@ pub struct CellSummary {
 }
 
 impl CellStudyResult {
+    /// Needed corrections missed while the simulated operator was switching its attention
+    /// (issue 41), summed over every completed task of every trial
+    /// ([`CellCompletion::switch_missed`]; 0 without a switch time), and the tasks completed.
+    #[must_use]
+    pub fn switch_missed_total(&self) -> (usize, usize) {
+        let tasks = self.trials.iter().flat_map(|t| &t.completions);
+        tasks.fold((0, 0), |(missed, n), c| (missed + c.switch_missed, n + 1))
+    }
+
     /// The summary across trials.
     #[must_use]
     pub fn summary(&self) -> CellSummary {
@@ -545,6 +568,7 @@ impl<'a> ContinuousTrial<'a> {
             gate_ticks: stats.gate_ticks.iter().sum(),
             plan_gap,
             needed_unsupervised: unsupervised,
+            switch_missed: f.run.switch_missed,
         });
         (self.observe)(&f);
         self.needed[i] = state.truth.draw(&mut state.rng)?;
@@ -693,6 +717,7 @@ mod tests {
                     ..PlanGap::default()
                 },
                 needed_unsupervised: i % 2,
+                switch_missed: 0,
             })
             .collect()
     }
