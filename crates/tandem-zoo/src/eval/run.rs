@@ -36,6 +36,12 @@ pub struct RunReport {
     pub bound_s: f64,
     /// Whether that bound is the proven margin-free optimum (rounds only; `false` for a cell).
     pub bound_is_optimum: bool,
+    /// The least `T_total` (s) known of a schedule without margins on the last plan's problem
+    /// (`Outcome::margin_free_s`): the bound and it split the gap into what the margin-free
+    /// search left open and what the margins (or what the scheduler did not find) cost
+    /// (`Outcome::gap_split`). Rounds only; `None` for a cell and in reports saved before it.
+    #[serde(default)]
+    pub margin_free_s: Option<f64>,
     /// The serial schedule's `T_total` on the last plan's problem (`N` fastest executions one
     /// after the other, `Problem::serial_schedule_n`).
     pub serial_s: f64,
@@ -103,6 +109,19 @@ impl RunReport {
     #[must_use]
     pub fn gap_pct(&self) -> f64 {
         100.0 * (self.final_t_s() / self.bound_s - 1.0)
+    }
+
+    /// [`RunReport::gap_pct`] split as `Outcome::gap_split` splits it, percent of the bound:
+    /// `(search, margins)`, the margin-free search's open interval `(margin_free − bound)` and
+    /// the rest `(T_total − margin_free)`; they add up to the gap. `None` without
+    /// [`RunReport::margin_free_s`].
+    #[must_use]
+    pub fn gap_split_pct(&self) -> Option<(f64, f64)> {
+        let free = self.margin_free_s?;
+        Some((
+            100.0 * (free - self.bound_s) / self.bound_s,
+            100.0 * (self.final_t_s() - free) / self.bound_s,
+        ))
     }
 }
 
@@ -251,6 +270,7 @@ pub fn run_rounds(
         high_pct: its.iter().map(|i| i.high_conf_pct).collect(),
         bound_s: last.lower_bound_s,
         bound_is_optimum: last.bound_is_optimum,
+        margin_free_s: run.planner.outcome().margin_free_s,
         serial_s: last_serial,
         truth_high_pct: prep.report.truth_high_pct,
         falsely_trusted,
@@ -319,6 +339,7 @@ pub fn run_continuous(
         high_pct: its.iter().map(|i| i.high_conf_pct).collect(),
         bound_s: last.lower_bound_s,
         bound_is_optimum: false,
+        margin_free_s: None,
         serial_s: serial_s(&run.planner)?,
         truth_high_pct: prep.report.truth_high_pct,
         falsely_trusted,
