@@ -533,6 +533,32 @@ fn markdown(file: &ZooFile) -> String {
             num(r.needed_unsupervised, 1),
         ));
     }
+    if file.family_rows.iter().any(|r| r.gap_split_pct.is_some()) {
+        s.push_str(
+            "\nWhere the gap goes (rounds; percent of the bound, mean over seeds; \
+             `Outcome::gap_split`): `search` is what the margin-free search left open (the best \
+             schedule it found without margins above the bound; 0 when the bound is its proven \
+             optimum), `margins` the rest, what the worst-case margins between the robots' \
+             low-confidence stretches and the waits of release rules cost, plus what the \
+             scheduler did not find. They add up to the gap.\n\n\
+             | family | N | gap % | search | margins | seeds with a proven bound |\n\
+             |---|---|---|---|---|---|\n",
+        );
+        for r in &file.family_rows {
+            if let Some((search, margins)) = r.gap_split_pct {
+                s.push_str(&format!(
+                    "| {} | {} | {} | {} | {} | {} of {} |\n",
+                    r.family,
+                    r.robots,
+                    num(r.gap_pct, 1),
+                    num(search, 1),
+                    num(margins, 1),
+                    r.bound_proven,
+                    r.seeds,
+                ));
+            }
+        }
+    }
     s.push_str(
         "\nThe fit alone (defaults, before any round): high confidence of the prior against the \
          truth on the reference's time axis, low-confidence runs, the reference-choice \

@@ -311,6 +311,40 @@ impl FeatureKind {
             FeatureKind::Spiral { .. } => (0.0, 1.0),
         }
     }
+
+    /// The local phase over which the demonstrations drawn (`draws`, one per demonstration)
+    /// actually differ: for a spike, the union of every demonstration's support (its centre
+    /// ± the half-width; outside every support no demonstration has the spike, so they all
+    /// agree there although the operator can be needed); for a spiral, the whole segment as in
+    /// [`FeatureKind::span_u`]. Sorted, merged.
+    fn varies_u(self, draws: &[FeatureDraw]) -> Vec<(f64, f64)> {
+        match self {
+            FeatureKind::Spike { at, width, .. } => {
+                let mut supports: Vec<(f64, f64)> = draws
+                    .iter()
+                    .map(|&(_, d1)| {
+                        let centre = at.0 + (at.1 - at.0) * d1;
+                        ((centre - width).max(0.0), (centre + width).min(1.0))
+                    })
+                    .collect();
+                supports.sort_by(|a, b| a.0.total_cmp(&b.0));
+                merge_spans(supports)
+            }
+            FeatureKind::Spiral { .. } => vec![self.span_u()],
+        }
+    }
+}
+
+/// Sorted spans `(a, b)` merged where they overlap or touch.
+fn merge_spans(sorted: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    let mut merged: Vec<(f64, f64)> = Vec::new();
+    for (a, b) in sorted {
+        match merged.last_mut() {
+            Some(last) if a <= last.1 => last.1 = last.1.max(b),
+            _ => merged.push((a, b)),
+        }
+    }
+    merged
 }
 
 /// The operator is needed with probability `p` over local phase `from_u..to_u` of segment
@@ -555,8 +589,15 @@ impl Script {
         starts
     }
 
-    /// Need spans (disjoint, sorted, merged) and variable spans (merged).
-    fn truth(&self, p: &[f64]) -> (Vec<NeedSpan>, Vec<(f64, f64)>) {
+    /// Need spans (disjoint, sorted, merged) and variable spans (merged): a feature is needed
+    /// over [`FeatureKind::span_u`] (wherever its event can happen in an execution) and
+    /// variable only where the demonstrations drawn (`feat_draws`, per feature and
+    /// demonstration) differ ([`FeatureKind::varies_u`]).
+    fn truth(
+        &self,
+        p: &[f64],
+        feat_draws: &[Vec<FeatureDraw>],
+    ) -> (Vec<NeedSpan>, Vec<(f64, f64)>) {
         // (from, to, p, learnable) contributions.
         let mut parts: Vec<(f64, f64, f64, bool)> = Vec::new();
         let mut variable: Vec<(f64, f64)> = Vec::new();
@@ -564,12 +605,17 @@ impl Script {
             parts.push((p[v.first], p[v.last + 1], v.need_p, true));
             variable.push((p[v.first], p[v.last + 1]));
         }
-        for f in &self.features {
+        for (f, draws) in self.features.iter().zip(feat_draws) {
             let (u0, u1) = f.kind.span_u();
             let w = p[f.seg + 1] - p[f.seg];
-            let (a, b) = (p[f.seg] + w * u0, p[f.seg] + w * u1);
-            parts.push((a, b, f.need_p, true));
-            variable.push((a, b));
+            let at = |u: f64| p[f.seg] + w * u;
+            parts.push((at(u0), at(u1), f.need_p, true));
+            variable.extend(
+                f.kind
+                    .varies_u(draws)
+                    .into_iter()
+                    .map(|(a, b)| (at(a), at(b))),
+            );
         }
         for a in &self.agreed {
             let w = p[a.seg + 1] - p[a.seg];
@@ -604,14 +650,7 @@ impl Script {
             }
         }
         variable.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut merged: Vec<(f64, f64)> = Vec::new();
-        for (a, b) in variable {
-            match merged.last_mut() {
-                Some(last) if a <= last.1 => last.1 = last.1.max(b),
-                _ => merged.push((a, b)),
-            }
-        }
-        (need, merged)
+        (need, merge_spans(variable))
     }
 }
 
@@ -838,7 +877,7 @@ pub(crate) fn render(script: &Script, rng: &mut ChaCha8Rng) -> Result<ZooTask> {
         progress.push(prog);
     }
 
-    let (need, variable) = script.truth(&p_bounds);
+    let (need, variable) = script.truth(&p_bounds, &feat_draws);
     Ok(ZooTask {
         family: script.family,
         seed: script.seed,
@@ -925,6 +964,38 @@ mod tests {
         for (j, x) in v.iter().enumerate() {
             assert!((j as f64 / 5.0..(j + 1) as f64 / 5.0).contains(x), "{v:?}");
         }
+    }
+
+    #[test]
+    fn a_spike_varies_only_around_the_spikes_drawn() {
+        let spike = FeatureKind::Spike {
+            ch: 0,
+            peak: 1.0,
+            peak_var: 0.0,
+            at: (0.1, 0.9),
+            width: 0.1,
+        };
+        // Its need covers every centre it can have, widened by its half-width.
+        assert_eq!(spike.span_u(), (0.0, 1.0));
+        // Centres 0.1 + 0.8·d1 = 0.2, 0.3 (overlapping supports) and 0.7: two spans, and
+        // 0.4..0.6 (no spike there in any demonstration) is not variable.
+        let v = spike.varies_u(&[(0.0, 0.125), (0.0, 0.75), (0.0, 0.25)]);
+        assert_eq!(v.len(), 2, "{v:?}");
+        for ((a, b), (x, y)) in v.iter().zip([(0.1, 0.4), (0.6, 0.8)]) {
+            assert!((a - x).abs() < 1e-12 && (b - y).abs() < 1e-12, "{v:?}");
+        }
+        // Clipped to the segment.
+        let v = spike.varies_u(&[(0.0, 0.0)]);
+        assert!(v.len() == 1 && v[0].0 == 0.0 && (v[0].1 - 0.2).abs() < 1e-12);
+        // A spiral's direction differs throughout: the whole segment.
+        let spiral = FeatureKind::Spiral {
+            cx: 0,
+            cy: 1,
+            r_max: 0.01,
+            turns: 2.0,
+            friction: None,
+        };
+        assert_eq!(spiral.varies_u(&[(0.3, 0.6)]), [(0.0, 1.0)]);
     }
 
     #[test]

@@ -34,8 +34,11 @@
 //! *variable sections* — per-demonstration offsets or waves in some channels over a span of
 //! progress (a part placed elsewhere, a cable lying differently), and local events that
 //! differ (a torque spike's height and moment, a search spiral's phase and radius). The
-//! operator is needed exactly where (c) happens: [`ZooTask::variable`] lists those spans and
-//! each lies inside a learnable [`NeedSpan`], with `p` graded from 0.2 to 1. Where every
+//! operator is needed exactly where (c) can happen, a learnable [`NeedSpan`] with `p` graded
+//! from 0.2 to 1; [`ZooTask::variable`] lists where the demonstrations drawn actually differ,
+//! each inside such a span (a spike can happen anywhere in its range, but the demonstrations
+//! differ only around their own spikes: the rest of the range is needed although they all
+//! agree there, and is counted with the agreeing samples). Where every
 //! demonstration agrees but the operator is still needed (a fragile feature, a cross-thread
 //! risk), the span is marked `learnable: false`: no fit can see it, only corrections can.
 //! Speed differences, pauses and noise never need the operator: a model that marks them

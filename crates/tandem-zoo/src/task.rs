@@ -57,8 +57,10 @@ pub struct ZooTask {
     /// "valve<0.5"), in the syntax of `tandem_lfd::HoldSpec`/`tandem fit --hold-where`; empty
     /// if none.
     pub holds: Vec<String>,
-    /// Which spans vary between demonstrations (variable sections), for "falsely trusted"
-    /// counts: sorted, disjoint, in progress units. Each lies inside a learnable need span.
+    /// Which spans vary between these demonstrations (variable sections, and the supports of
+    /// the local events they drew), for "falsely trusted" counts: sorted, disjoint, in
+    /// progress units. Each lies inside a learnable need span; a learnable need span may hold
+    /// stretches where no demonstration drew its event, which count as agreeing.
     pub variable: Vec<(f64, f64)>,
 }
 

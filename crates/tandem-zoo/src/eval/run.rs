@@ -36,6 +36,12 @@ pub struct RunReport {
     pub bound_s: f64,
     /// Whether that bound is the proven margin-free optimum (rounds only; `false` for a cell).
     pub bound_is_optimum: bool,
+    /// The least `T_total` (s) known of a schedule without margins on the last plan's problem
+    /// (`Outcome::margin_free_s`): the bound and it split the gap into what the margin-free
+    /// search left open and what the margins (or what the scheduler did not find) cost
+    /// (`Outcome::gap_split`). Rounds only; `None` for a cell and in reports saved before it.
+    #[serde(default)]
+    pub margin_free_s: Option<f64>,
     /// The serial schedule's `T_total` on the last plan's problem (`N` fastest executions one
     /// after the other, `Problem::serial_schedule_n`).
     pub serial_s: f64,
@@ -103,6 +109,19 @@ impl RunReport {
     #[must_use]
     pub fn gap_pct(&self) -> f64 {
         100.0 * (self.final_t_s() / self.bound_s - 1.0)
+    }
+
+    /// [`RunReport::gap_pct`] split as `Outcome::gap_split` splits it, percent of the bound:
+    /// `(search, margins)`, the margin-free search's open interval `(margin_free − bound)` and
+    /// the rest `(T_total − margin_free)`; they add up to the gap. `None` without
+    /// [`RunReport::margin_free_s`].
+    #[must_use]
+    pub fn gap_split_pct(&self) -> Option<(f64, f64)> {
+        let free = self.margin_free_s?;
+        Some((
+            100.0 * (free - self.bound_s) / self.bound_s,
+            100.0 * (self.final_t_s() - free) / self.bound_s,
+        ))
     }
 }
 
@@ -251,6 +270,7 @@ pub fn run_rounds(
         high_pct: its.iter().map(|i| i.high_conf_pct).collect(),
         bound_s: last.lower_bound_s,
         bound_is_optimum: last.bound_is_optimum,
+        margin_free_s: run.planner.outcome().margin_free_s,
         serial_s: last_serial,
         truth_high_pct: prep.report.truth_high_pct,
         falsely_trusted,
@@ -319,6 +339,7 @@ pub fn run_continuous(
         high_pct: its.iter().map(|i| i.high_conf_pct).collect(),
         bound_s: last.lower_bound_s,
         bound_is_optimum: false,
+        margin_free_s: None,
         serial_s: serial_s(&run.planner)?,
         truth_high_pct: prep.report.truth_high_pct,
         falsely_trusted,
@@ -351,6 +372,67 @@ mod tests {
         let b = [0.0, 0.5, 1.0];
         assert_eq!(backward_steps([&a[..], &b[..]]), (2, 1.0));
         assert_eq!(backward_steps([&b[..]]), (0, 0.0));
+    }
+
+    /// A two-robot rounds run ending at `t_total` against `bound`, with `margin_free`.
+    fn run(t_total: f64, bound: f64, margin_free: Option<f64>) -> RunReport {
+        RunReport {
+            family: "f".into(),
+            seed: 0,
+            robots: 2,
+            cell: Cell::Rounds,
+            rounds: 1,
+            t_total_s: vec![2.0 * t_total, t_total],
+            high_pct: vec![50.0, 60.0],
+            bound_s: bound,
+            bound_is_optimum: margin_free.is_some(),
+            margin_free_s: margin_free,
+            serial_s: 2.0 * t_total,
+            truth_high_pct: 60.0,
+            falsely_trusted: 0,
+            falsely_trusted_agreeing: 0,
+            first_overlap_round: Some(0),
+            max_increase_s: 0.0,
+            max_increase_at: None,
+            realized_over_planned: 1.0,
+            realized_over_planned_last: 1.0,
+            planned_per_h: 1.0,
+            realized_per_h: 1.0,
+            plan_gap: PlanGap::default(),
+            needed_unsupervised: 0,
+            backward_steps: 0,
+            max_backward_samples: 0.0,
+            overlap_ticks: 0,
+            faults: 0,
+            tick_s: 0.01,
+        }
+    }
+
+    #[test]
+    fn the_gap_splits_into_search_and_margins_that_add_up() {
+        // Bound 10 s, best margin-free schedule 10.5 s, T_total 12 s: gap 20 % = 5 % the search
+        // left open + 15 % the margins.
+        let r = run(12.0, 10.0, Some(10.5));
+        let (search, margins) = r.gap_split_pct().unwrap();
+        assert!((search - 5.0).abs() < 1e-12 && (margins - 15.0).abs() < 1e-12);
+        assert!((search + margins - r.gap_pct()).abs() < 1e-12);
+        assert_eq!(run(12.0, 10.0, None).gap_split_pct(), None);
+        // Per family: the mean over the seeds that have it; proven bounds counted.
+        let (a, b, c) = (
+            run(12.0, 10.0, Some(10.5)),
+            run(11.0, 10.0, Some(10.0)),
+            run(20.0, 10.0, None),
+        );
+        let report = crate::eval::ZooReport {
+            params: crate::eval::EvalParams::default(),
+            families: vec!["f".into()],
+            fits: Vec::new(),
+            runs: vec![a, b, c],
+        };
+        let rows = crate::eval::family_rows(&report);
+        let (search, margins) = rows[0].gap_split_pct.unwrap();
+        assert!((search - 2.5).abs() < 1e-12 && (margins - 12.5).abs() < 1e-12);
+        assert_eq!(rows[0].bound_proven, 2);
     }
 
     #[test]

@@ -27,6 +27,15 @@ pub struct FamilyRow {
     pub gap_pct: f64,
     /// Largest `T_total / bound − 1` of a seed, percent.
     pub gap_max_pct: f64,
+    /// Where the gap goes (rounds): the mean over seeds of the margin-free search's open
+    /// share and of the margins' share (`RunReport::gap_split_pct`, percent of the bound;
+    /// their sum is [`FamilyRow::gap_pct`]); `None` when no seed measured it (a cell, an old
+    /// report).
+    #[serde(default)]
+    pub gap_split_pct: Option<(f64, f64)>,
+    /// Seeds whose bound is the proven margin-free optimum (rounds).
+    #[serde(default)]
+    pub bound_proven: usize,
     /// Mean of `T_total / serial`.
     pub over_serial: f64,
     /// Final high confidence, percent.
@@ -158,6 +167,16 @@ fn row(family: String, robots: usize, cell: Cell, runs: &[&RunReport]) -> Family
         bound_s: m(&|r| r.bound_s),
         gap_pct: m(&RunReport::gap_pct),
         gap_max_pct: min_max(&runs.iter().map(|r| r.gap_pct()).collect::<Vec<_>>()).1,
+        gap_split_pct: {
+            let split: Vec<(f64, f64)> = runs.iter().filter_map(|r| r.gap_split_pct()).collect();
+            (!split.is_empty()).then(|| {
+                (
+                    mean(split.iter().map(|s| s.0)),
+                    mean(split.iter().map(|s| s.1)),
+                )
+            })
+        },
+        bound_proven: runs.iter().filter(|r| r.bound_is_optimum).count(),
         over_serial: m(&|r| r.final_t_s() / r.serial_s),
         high_pct: m(&RunReport::final_high_pct),
         truth_pct: m(&|r| r.truth_high_pct),
