@@ -1,0 +1,59 @@
+//! A small state file for the tests: the hand-made one-channel task of the simulated cell's
+//! tests (low confidence exactly where the demonstrations differ, reference samples 10..20 of
+//! 60 at 10 ms), planned for `n` robots.
+
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+use tandem_lfd::{Demonstration, FitParams, TaskModel};
+use tandem_planner::{Planner, PlannerParams};
+
+pub(crate) const N_REF: usize = 60;
+
+/// Three demonstrations aligned by known warps: demo 1 presses hard (9 N) over reference
+/// samples 10..20 and takes two samples per reference sample there; the others 1 N.
+pub(crate) fn model() -> TaskModel {
+    let names = vec!["force".to_string()];
+    let light = Demonstration::new(names.clone(), vec![1.0; N_REF], 0.01).unwrap();
+    let mut hard = Vec::new();
+    let mut warp1 = Vec::new();
+    for n in 0..N_REF {
+        warp1.push(hard.len() as f64);
+        let reps = if (10..20).contains(&n) { 2 } else { 1 };
+        for _ in 0..reps {
+            hard.push(if (10..20).contains(&n) { 9.0 } else { 1.0 });
+        }
+    }
+    let hard = Demonstration::new(names, hard, 0.01).unwrap();
+    let identity: Vec<f64> = (0..N_REF).map(|n| n as f64).collect();
+    TaskModel::fit_aligned(
+        &[light.clone(), hard, light],
+        &[identity.clone(), warp1, identity],
+        &FitParams::default(),
+    )
+    .unwrap()
+}
+
+/// A planner of `n` robots on [`model`].
+pub(crate) fn planner(n: usize) -> Planner {
+    let params = PlannerParams {
+        sampler: tandem_schedule::SamplerParams {
+            samples: 50,
+            seed: 3,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    Planner::from_model_with_robots(model(), params, n).unwrap()
+}
+
+/// A fresh folder for test `name` with the state file of [`planner`]`(n)` in it.
+pub(crate) fn state_file(name: &str, n: usize) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tandem-ros2-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("state.tandem");
+    planner(n).save(&path).unwrap();
+    path
+}
