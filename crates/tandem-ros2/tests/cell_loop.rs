@@ -277,3 +277,81 @@ fn an_empty_log_is_an_error_not_a_panic() {
     let err = log.records(p.model()).and_then(|r| Ok(p.record_round(&r)?));
     assert!(err.is_err());
 }
+
+/// Robot speeds in the ticks each robot was supervised, and the round's log, for a round run
+/// with the operator's axis `axis` (button held) on every tick, or no input at all.
+fn supervised_speeds(axis: Option<f64>) -> (Vec<f64>, RoundLog) {
+    let planner = support::planner(2);
+    let mut l = cell_loop(&planner, Cell::Rounds);
+    let tick = Duration::from_secs_f64(l.controller().tick_s());
+    let mut now = Instant::now();
+    ask(&mut l, Request::Start, now);
+    let mut speeds = Vec::new();
+    let mut needs = l.controller().low_conf_now();
+    for _ in 0..10_000 {
+        now += tick;
+        for k in 0..2 {
+            l.handle(
+                Inbound::Progress {
+                    robot: k,
+                    ref_time: 0.0,
+                },
+                now,
+                &mut |_| {},
+            );
+        }
+        if let Some(axis) = axis {
+            l.handle(
+                Inbound::Operator {
+                    axis,
+                    correcting: true,
+                },
+                now,
+                &mut |_| {},
+            );
+        }
+        let s = l.step(now).unwrap();
+        for k in 0..2 {
+            if needs[k] {
+                speeds.push(s.speed[k]);
+            }
+        }
+        needs = s.needs_operator;
+        if s.finished {
+            let Reply::Round { log, .. } = ask(&mut l, Request::TakeRound, now) else {
+                panic!("a finished round is handed over");
+            };
+            return (speeds, log);
+        }
+    }
+    panic!("the round never ended");
+}
+
+#[test]
+fn the_operators_input_sets_the_supervised_robots_speed_and_is_recorded() {
+    // The test task's low-confidence stretch allows 1 to 2 execution samples per reference
+    // sample: speed scale 1 (fastest) to ½ (slowest) at a tick of one sample period.
+    let (scheduled, log) = supervised_speeds(None);
+    assert!(!scheduled.is_empty());
+    assert!(log.robots.iter().all(|r| r.corrected.iter().all(|&c| !c)));
+    // The share of supervised ticks at speed `v` (a tick that leaves the stretch runs part
+    // of it at the scheduled rate).
+    let share = |speeds: &[f64], v: f64| {
+        speeds.iter().filter(|&&x| (x - v).abs() < 1e-9).count() as f64 / speeds.len() as f64
+    };
+    let (slowest, log) = supervised_speeds(Some(-1.0));
+    assert!(share(&slowest, 0.5) >= 0.9, "{slowest:?}");
+    assert!(
+        share(&scheduled, 0.5) < 0.5,
+        "the schedule alone is not already the slowest: {scheduled:?}"
+    );
+    // Corrected exactly where supervised.
+    for r in &log.robots {
+        assert_eq!(r.corrected, r.supervised);
+    }
+    let (fastest, _) = supervised_speeds(Some(1.0));
+    assert!(
+        fastest.iter().all(|&v| (v - 1.0).abs() < 1e-9),
+        "{fastest:?}"
+    );
+}
