@@ -184,6 +184,7 @@ fn a_node_and_a_probe_in_one_process_run_record_and_stall() {
     );
     assert_eq!(rounds_in(&state), 1);
     node.stop().unwrap();
+    support::remove(&state);
 }
 
 /// Starts this test binary again as a node process (the ignored test `node_process`).
@@ -242,6 +243,7 @@ fn two_processes_n_2_and_3() {
         let _ = child.wait();
         assert!(seen.faults.is_empty(), "N = {n}: {:?}", seen.faults);
         assert_eq!(rounds_in(&state), before + 1, "N = {n}");
+        support::remove(&state);
         let p50 = percentile(&mut seen.latencies, 0.5);
         let p99 = percentile(&mut seen.latencies, 0.99);
         eprintln!(
@@ -272,6 +274,7 @@ fn a_probe_on_another_domain_sees_nothing() {
             .is_err()
     );
     node.stop().unwrap();
+    support::remove(&state);
 }
 
 #[test]
@@ -290,6 +293,7 @@ fn a_wrong_robot_count_is_refused_with_the_fix() {
     };
     let err = Node::start(&state, &bad).unwrap_err().to_string();
     assert!(err.contains("`domain`"), "{err}");
+    support::remove(&state);
 }
 
 /// Cyclone DDS's configuration for the interop peer: loopback only, no multicast, the
@@ -348,6 +352,7 @@ fn cyclonedds_reads_the_node_and_drives_the_operator() {
     let seen = round(&probe, 2);
     let out = peer.wait_with_output().unwrap();
     node.stop().unwrap();
+    support::remove(&state);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "cyclonedds peer failed: {text}");
     let v: serde_json::Value = serde_json::from_str(text.trim()).unwrap();

@@ -57,3 +57,10 @@ pub(crate) fn state_file(name: &str, n: usize) -> PathBuf {
     planner(n).save(&path).unwrap();
     path
 }
+
+/// Removes the folder [`state_file`] made for `path`.
+pub(crate) fn remove(path: &std::path::Path) {
+    if let Some(dir) = path.parent() {
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}
