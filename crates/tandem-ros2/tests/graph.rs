@@ -379,3 +379,98 @@ fn cyclonedds_reads_the_node_and_drives_the_operator() {
         "median supervised speed {median}: {v}"
     );
 }
+
+/// A robot process of [`a_killed_robot_process_stalls_the_cell`]: plays robot
+/// `TANDEM_ROS2_ROBOT` (0-based) for 120 s or until killed. Does nothing when not started by it.
+#[test]
+#[ignore = "a robot process of a_killed_robot_process_stalls_the_cell, started by it"]
+fn robot_process() {
+    let Ok(domain) = std::env::var("TANDEM_ROS2_ROBOT_DOMAIN") else {
+        return;
+    };
+    let k: usize = std::env::var("TANDEM_ROS2_ROBOT").unwrap().parse().unwrap();
+    let probe = Probe::new(domain.parse().unwrap(), k + 1).unwrap();
+    let end = Instant::now() + Duration::from_secs(120);
+    while Instant::now() < end {
+        if let Some(c) = probe.commands(k).last() {
+            probe.report(k, c.ref_time).unwrap();
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+}
+
+#[test]
+fn a_killed_robot_process_stalls_the_cell() {
+    let domain = 68;
+    let state = support::state_file("killed", 2);
+    let node = Node::start(
+        &state,
+        &NodeParams {
+            domain,
+            ..NodeParams::default()
+        },
+    )
+    .unwrap();
+    // Robot 2 is a process of its own; the probe here plays robot 1 only.
+    let mut robot2 = Process::new(std::env::current_exe().unwrap())
+        .args(["--exact", "robot_process", "--ignored", "--nocapture"])
+        .env("TANDEM_ROS2_ROBOT_DOMAIN", domain.to_string())
+        .env("TANDEM_ROS2_ROBOT", "1")
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    let probe = Probe::new(domain, 2).unwrap();
+    assert!(
+        discover(&probe, 2, Duration::from_secs(30)),
+        "no discovery on loopback"
+    );
+    let alive = [true, false];
+    let (mut lat, mut last, mut lost) = (Vec::new(), vec![0; 2], 0);
+    // Let the robot process discover the node.
+    let until = Instant::now() + Duration::from_secs(3);
+    while Instant::now() < until {
+        echo(&probe, &alive, &mut lat, &mut last, &mut lost);
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let r = probe
+        .call("start_round", Duration::from_secs(10), || {
+            echo(&probe, &alive, &mut lat, &mut last, &mut lost)
+        })
+        .unwrap();
+    assert!(r.success, "{}", r.message);
+    // Half a second running: robot 2's process keeps it alive.
+    let until = Instant::now() + Duration::from_millis(500);
+    while Instant::now() < until {
+        echo(&probe, &alive, &mut lat, &mut last, &mut lost);
+        let f = probe.fault().unwrap_or_default();
+        assert!(f.is_empty(), "a fault while robot 2's process ran: {f}");
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    robot2.kill().unwrap();
+    let killed = Instant::now();
+    robot2.wait().unwrap();
+    let mut fault = None;
+    while killed.elapsed() < Duration::from_secs(3) {
+        echo(&probe, &alive, &mut lat, &mut last, &mut lost);
+        if let Some(f) = probe.fault().filter(|f| !f.is_empty()) {
+            fault = Some((f, killed.elapsed()));
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let (fault, after) = fault.expect("a killed robot process is a fault");
+    assert!(fault.starts_with("robot 2 stalled"), "{fault}");
+    // Held for 2 s, the tick thread on its period.
+    std::thread::sleep(Duration::from_millis(50));
+    let a = probe.commands(0).last().map(|c| c.ref_time);
+    std::thread::sleep(Duration::from_secs(2));
+    let b = probe.commands(0).last().map(|c| c.ref_time);
+    assert!(a.is_some() && a == b, "{a:?} then {b:?}");
+    let stats = node.stop().unwrap();
+    eprintln!(
+        "killed robot process: `{fault}` {:.0} ms after the kill; node {stats:?}",
+        after.as_secs_f64() * 1e3
+    );
+    assert!(stats.max_period_s < 0.25, "{stats:?}");
+    support::remove(&state);
+}
