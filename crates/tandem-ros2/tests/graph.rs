@@ -474,3 +474,43 @@ fn a_killed_robot_process_stalls_the_cell() {
     assert!(stats.max_period_s < 0.25, "{stats:?}");
     support::remove(&state);
 }
+
+/// The must-show stream: a node process at a 1 ms tick (the test task sampled at 1 kHz),
+/// its two robots' commands over loopback for 10 s with reliable QoS, taken by a probe that
+/// polls every 50 µs: messages lost (tick numbers skipped) and the latency from the node's
+/// tick stamp to the probe's take. A measurement (it prints); run with `--ignored`.
+#[test]
+#[ignore = "a 10 s measurement: cargo test -p tandem-ros2 --test graph stream -- --ignored --nocapture"]
+fn stream_1khz_for_10_s() {
+    let domain = 69;
+    let state =
+        support::state_file_of("stream", support::planner_with(support::model_at(0.001), 2));
+    let mut child = spawn_node(&state, domain, 2);
+    let probe = Probe::new(domain, 2).unwrap();
+    assert!(
+        discover(&probe, 2, Duration::from_secs(30)),
+        "no discovery on loopback"
+    );
+    let (mut lat, mut last, mut lost) = (Vec::new(), vec![0; 2], 0);
+    let end = Instant::now() + Duration::from_secs(10);
+    while Instant::now() < end {
+        echo(&probe, &[true, true], &mut lat, &mut last, &mut lost);
+        std::thread::sleep(Duration::from_micros(50));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    support::remove(&state);
+    let n = lat.len();
+    let (p50, p99, max) = (
+        percentile(&mut lat, 0.5),
+        percentile(&mut lat, 0.99),
+        percentile(&mut lat, 1.0),
+    );
+    eprintln!(
+        "1 kHz for 10 s: {n} commands of 2 robots, {lost} lost, latency p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
+        p50 * 1e3,
+        p99 * 1e3,
+        max * 1e3
+    );
+    assert!(n > 10_000, "{n}");
+}

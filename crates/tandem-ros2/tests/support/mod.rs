@@ -14,8 +14,13 @@ pub(crate) const N_REF: usize = 60;
 /// Three demonstrations aligned by known warps: demo 1 presses hard (9 N) over reference
 /// samples 10..20 and takes two samples per reference sample there; the others 1 N.
 pub(crate) fn model() -> TaskModel {
+    model_at(0.01)
+}
+
+/// [`model`] sampled every `dt_s` (s): its schedule's control tick.
+pub(crate) fn model_at(dt_s: f64) -> TaskModel {
     let names = vec!["force".to_string()];
-    let light = Demonstration::new(names.clone(), vec![1.0; N_REF], 0.01).unwrap();
+    let light = Demonstration::new(names.clone(), vec![1.0; N_REF], dt_s).unwrap();
     let mut hard = Vec::new();
     let mut warp1 = Vec::new();
     for n in 0..N_REF {
@@ -25,7 +30,7 @@ pub(crate) fn model() -> TaskModel {
             hard.push(if (10..20).contains(&n) { 9.0 } else { 1.0 });
         }
     }
-    let hard = Demonstration::new(names, hard, 0.01).unwrap();
+    let hard = Demonstration::new(names, hard, dt_s).unwrap();
     let identity: Vec<f64> = (0..N_REF).map(|n| n as f64).collect();
     TaskModel::fit_aligned(
         &[light.clone(), hard, light],
@@ -37,6 +42,11 @@ pub(crate) fn model() -> TaskModel {
 
 /// A planner of `n` robots on [`model`].
 pub(crate) fn planner(n: usize) -> Planner {
+    planner_with(model(), n)
+}
+
+/// A planner of `n` robots on `model`.
+pub(crate) fn planner_with(model: TaskModel, n: usize) -> Planner {
     let params = PlannerParams {
         sampler: tandem_schedule::SamplerParams {
             samples: 50,
@@ -45,16 +55,21 @@ pub(crate) fn planner(n: usize) -> Planner {
         },
         ..Default::default()
     };
-    Planner::from_model_with_robots(model(), params, n).unwrap()
+    Planner::from_model_with_robots(model, params, n).unwrap()
 }
 
 /// A fresh folder for test `name` with the state file of [`planner`]`(n)` in it.
 pub(crate) fn state_file(name: &str, n: usize) -> PathBuf {
+    state_file_of(name, planner(n))
+}
+
+/// A fresh folder for test `name` with `planner`'s state file in it.
+pub(crate) fn state_file_of(name: &str, planner: Planner) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("tandem-ros2-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("state.tandem");
-    planner(n).save(&path).unwrap();
+    planner.save(&path).unwrap();
     path
 }
 
