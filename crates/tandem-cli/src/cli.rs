@@ -201,6 +201,24 @@ pub(crate) enum Command {
     ///   tandem console cell.tandem --simulate --robots 3 --need need.csv
     #[command(verbatim_doc_comment)]
     Console(ConsoleArgs),
+    /// Run the state file's coordinator live as a ROS 2 node (built with `--features ros2`).
+    ///
+    /// The coordinator ticks on its own thread at the schedule's tick; per robot K it
+    /// publishes /tandem/robotK/command (reference time and speed scale, every tick),
+    /// setpoint and needs_operator, and reads /tandem/robotK/progress; the operator's
+    /// sensor_msgs/Joy on /tandem/operator sets the supervised robot's timing. Services
+    /// (std_srvs/Trigger): /tandem/start_round, stop_round, clear_fault, record_round (into
+    /// the state file, with the checks and lock of `tandem record`). A robot that stops
+    /// reporting for --stall seconds holds the cell until clear_fault. docs/guide.md, "tandem
+    /// in a ROS 2 graph".
+    ///
+    /// Example:
+    ///
+    ///   tandem node cell.tandem --domain 7
+    ///   tandem node cell.tandem --cell continuous --robots 3 --seconds 600
+    #[cfg(feature = "ros2")]
+    #[command(verbatim_doc_comment)]
+    Node(crate::node::NodeArgs),
 }
 
 /// `tandem console`.

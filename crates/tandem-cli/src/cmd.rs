@@ -37,6 +37,8 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         Command::Need(a) => need::need(&a),
         Command::Params => params(),
         Command::Console(a) => crate::console::console(&a),
+        #[cfg(feature = "ros2")]
+        Command::Node(a) => crate::node::node(&a),
     }
 }
 

@@ -29,6 +29,8 @@ mod gantt;
 mod input;
 mod json;
 mod need;
+#[cfg(feature = "ros2")]
+mod node;
 mod plot;
 mod sim;
 mod state_io;

@@ -1,0 +1,97 @@
+//! `tandem node` (feature `ros2`): a state file's coordinator live in a ROS 2 graph
+//! (crate `tandem-ros2`; docs/guide.md, "tandem in a ROS 2 graph").
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use tandem::planner::Cell;
+use tandem_ros2::{Node, NodeParams};
+
+use crate::cli::cell_parser;
+use crate::cmd::out;
+
+/// `tandem node`.
+#[derive(Debug, Args)]
+pub(crate) struct NodeArgs {
+    /// The state file: its schedule runs; `record_round` records into it (under its lock).
+    pub(crate) state: PathBuf,
+    /// Robots the cell has (checked against the state file's). Default: the state's.
+    #[arg(long, value_name = "N")]
+    pub(crate) robots: Option<usize>,
+    /// How the robots repeat the task.
+    #[arg(long, value_name = "MODE", value_parser = cell_parser(), default_value = "rounds")]
+    pub(crate) cell: Cell,
+    /// The DDS domain (ROS_DOMAIN_ID), 0…232.
+    #[arg(long, value_name = "D", default_value_t = 0)]
+    pub(crate) domain: u16,
+    /// A robot silent this long (s) while the cell runs is a fault: the cell holds.
+    #[arg(long, value_name = "S", default_value_t = 0.25)]
+    pub(crate) stall: f64,
+    /// Stop after this long (s). Default: run until interrupted.
+    #[arg(long, value_name = "S")]
+    pub(crate) seconds: Option<f64>,
+}
+
+/// Runs the node until interrupted or `--seconds`, printing its counters every 10 s.
+pub(crate) fn node(a: &NodeArgs) -> Result<()> {
+    let params = NodeParams {
+        domain: a.domain,
+        cell: a.cell,
+        robots: a.robots,
+        loop_params: tandem_ros2::LoopParams {
+            stall_s: a.stall,
+            ..Default::default()
+        },
+        ..NodeParams::default()
+    };
+    if let Some(s) = a.seconds {
+        anyhow::ensure!(
+            s.is_finite() && s > 0.0,
+            "--seconds {s}: give a duration > 0 (s), or leave it out to run until interrupted"
+        );
+    }
+    let node = Node::start(&a.state, &params)
+        .with_context(|| format!("cannot start the node on {}", a.state.display()))?;
+    out(&format!(
+        "tandem node: {} robots, tick {:.4} s, DDS domain {}; topics /tandem/robot1..{}/{{progress,command,setpoint,needs_operator}}, /tandem/{{next_handover,fault,operator}}; services /tandem/{{start_round,stop_round,clear_fault,record_round}}",
+        node.n_robots(),
+        node.tick_s(),
+        a.domain,
+        node.n_robots()
+    ));
+    let start = Instant::now();
+    let mut report = start;
+    while node.is_running() {
+        if a.seconds
+            .is_some_and(|s| start.elapsed().as_secs_f64() >= s)
+        {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+        if report.elapsed() >= Duration::from_secs(10) {
+            report = Instant::now();
+            let s = node.stats();
+            eprintln!(
+                "node: {} ticks, worst period {:.2} ms, {} commands, {} dropped",
+                s.ticks,
+                s.max_period_s * 1e3,
+                s.commands,
+                s.state_dropped + s.inbound_dropped + s.publish_failed
+            );
+        }
+    }
+    let s = node.stop()?;
+    out(&format!(
+        "stopped: {} ticks, worst period {:.2} ms, {} overruns, {} commands, {} snapshots and {} messages dropped, {} publications refused",
+        s.ticks,
+        s.max_period_s * 1e3,
+        s.overruns,
+        s.commands,
+        s.state_dropped,
+        s.inbound_dropped,
+        s.publish_failed
+    ));
+    Ok(())
+}

@@ -1,0 +1,589 @@
+//! The node's control loop without the network: one [`CellLoop`] owned by the tick thread,
+//! fed [`Inbound`] messages and producing a [`Snapshot`] per tick and [`Reply`]s to requests.
+//!
+//! Nothing here waits: the DDS side hands messages over through bounded queues that are
+//! drained with `try_recv` at the start of each tick, and every decision that needs the
+//! network's data (a robot's liveness, the operator's input) is taken on the last value that
+//! arrived, with a timeout for each (docs/decisions.md, "tandem in a live ROS 2 graph").
+
+use std::time::Instant;
+
+use tandem_lfd::{Demonstration, Execution, TaskModel};
+use tandem_planner::{AnyController, Cell, ExecutionRecord};
+use tandem_realtime::{Controller, Fault, MAX_ROBOTS, Operator, PerRobot, PreAlert, RobotFlags};
+
+use crate::error::{Error, Result};
+
+/// The control loop's parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopParams {
+    /// A robot whose progress has not arrived for this long (real s) while a round or the
+    /// cell runs is stalled: the loop latches [`NodeFault::Stalled`] and holds the whole cell
+    /// (no robot's schedule clock moves) until the fault is cleared. Default: 0.25 s.
+    pub stall_s: f64,
+    /// The operator's last input counts for this long (real s); after it the input is
+    /// [`Operator::Scheduled`] (a dead man's switch). Default: 0.25 s.
+    pub operator_timeout_s: f64,
+    /// Axis values with `|a|` below this are no correction of the timing. Default: 0.05.
+    pub deadband: f64,
+}
+
+impl Default for LoopParams {
+    fn default() -> Self {
+        LoopParams {
+            stall_s: 0.25,
+            operator_timeout_s: 0.25,
+            deadband: 0.05,
+        }
+    }
+}
+
+impl LoopParams {
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] naming the field.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name, why: &str| {
+            Err(Error::BadParam {
+                name,
+                why: why.to_owned(),
+            })
+        };
+        if !(self.stall_s.is_finite() && self.stall_s > 0.0) {
+            return bad("stall_s", "must be finite and > 0 (seconds)");
+        }
+        if !(self.operator_timeout_s.is_finite() && self.operator_timeout_s > 0.0) {
+            return bad("operator_timeout_s", "must be finite and > 0 (seconds)");
+        }
+        if !(self.deadband.is_finite() && (0.0..1.0).contains(&self.deadband)) {
+            return bad("deadband", "must be in [0, 1)");
+        }
+        Ok(())
+    }
+}
+
+/// What the DDS side hands the tick thread.
+#[derive(Debug)]
+pub enum Inbound {
+    /// Robot `robot` (0-based) reports the reference time it has reached (reference samples).
+    Progress {
+        /// The robot.
+        robot: usize,
+        /// Its reference time.
+        ref_time: f64,
+    },
+    /// The operator's input device: the timing axis in `[−1, 1]` ([`operator_input`]) and
+    /// whether the operator is correcting (a held button).
+    Operator {
+        /// The axis.
+        axis: f64,
+        /// Whether the operator corrects the supervised robot now.
+        correcting: bool,
+    },
+    /// A service request, answered by a [`Reply`] with the same token.
+    Request {
+        /// The DDS side's key for the answer.
+        token: u64,
+        /// What is asked.
+        what: Request,
+    },
+    /// A round was recorded: the planner's new controller, run from the next started round.
+    Replace(Box<AnyController>),
+    /// Recording the round failed: its log back, to record again after the fix.
+    Restore(RoundLog),
+}
+
+/// The node's services.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Request {
+    /// Start a round (rounds) or run the cell (continuous).
+    Start,
+    /// Abort the round (every robot back to its start) or pause the cell.
+    Stop,
+    /// Clear the latched fault.
+    ClearFault,
+    /// Hand the finished round's log over for recording ([`Reply::Round`]).
+    TakeRound,
+}
+
+/// Why the loop refused a request.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum Refusal {
+    /// Start while running.
+    #[error("a round is running; stop it first (service stop_round)")]
+    Running,
+    /// Stop while not running.
+    #[error("nothing runs; start a round first (service start_round)")]
+    NotRunning,
+    /// Clear without a fault.
+    #[error("no fault is latched")]
+    NoFault,
+    /// Record without a finished round.
+    #[error("no finished round to record: start one and let every robot finish it")]
+    NoFinishedRound,
+    /// Record in a continuous cell.
+    #[error("a continuous cell records no rounds; run the node with --cell rounds to record")]
+    Continuous,
+}
+
+/// The tick thread's answer to a [`Inbound::Request`].
+#[derive(Debug)]
+pub enum Reply {
+    /// Done (`Ok`) or refused.
+    Done {
+        /// The request's token.
+        token: u64,
+        /// The request.
+        what: Request,
+        /// Whether it was done.
+        result: std::result::Result<(), Refusal>,
+    },
+    /// The finished round's log, for [`Request::TakeRound`].
+    Round {
+        /// The request's token.
+        token: u64,
+        /// The log.
+        log: RoundLog,
+    },
+}
+
+/// A fault the loop latched, until [`Request::ClearFault`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NodeFault {
+    /// The coordinator's monitor: two robots were low-confidence in one tick.
+    Overlap(Fault),
+    /// No progress from `robot` for `silent_s` (real s) while the cell ran: the cell holds.
+    Stalled {
+        /// The silent robot (0-based).
+        robot: usize,
+        /// How long it had been silent when the fault latched (s).
+        silent_s: f64,
+    },
+}
+
+impl std::fmt::Display for NodeFault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NodeFault::Overlap(x) => write!(
+                f,
+                "overlap at tick {}: {} robots low-confidence at once; robot {} held \
+                 (clear with service clear_fault)",
+                x.tick,
+                x.low_conf.count(),
+                x.stopped + 1
+            ),
+            NodeFault::Stalled { robot, silent_s } => write!(
+                f,
+                "robot {} stalled: no progress for {silent_s:.3} s; the cell holds (clear with \
+                 service clear_fault once it reports again)",
+                robot + 1
+            ),
+        }
+    }
+}
+
+/// The cell after one tick of the loop: what the node publishes. `Copy`, no heap.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Snapshot {
+    /// The loop's tick count since it started (every tick, running or not).
+    pub tick: u64,
+    /// Whether a round (or the cell) runs.
+    pub active: bool,
+    /// Whether the last round finished and waits to be recorded (rounds).
+    pub finished: bool,
+    /// Each robot's reference time to follow (reference samples, in its current task).
+    pub ref_time: PerRobot<f64>,
+    /// Each robot's speed scale over the last tick: reference samples advanced per
+    /// reference sample period (1 = the reference demonstration's pace; 0 stopped).
+    pub speed: PerRobot<f64>,
+    /// Each robot that the next tick moves at the operator's rate (`needs_operator`).
+    pub needs_operator: RobotFlags,
+    /// Whether two robots traversed a low-confidence sample in this tick.
+    pub overlap: bool,
+    /// The latched fault.
+    pub fault: Option<NodeFault>,
+    /// The next handover ([`PreAlert`], real s from the end of this tick).
+    pub next: Option<PreAlert>,
+}
+
+/// One robot's log of a round: one entry per tick in which it ran.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RobotLog {
+    /// Reference time at the tick's start (reference samples).
+    pub ref_time: Vec<f64>,
+    /// Whether it was supervised (low-confidence) in the tick.
+    pub supervised: Vec<bool>,
+    /// Whether the operator corrected it in the tick.
+    pub corrected: Vec<bool>,
+}
+
+/// A round's log, one [`RobotLog`] per robot, at control tick `tick_s`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RoundLog {
+    /// The control tick (s): the executions' sample period.
+    pub tick_s: f64,
+    /// Robot 1 first.
+    pub robots: Vec<RobotLog>,
+}
+
+impl RoundLog {
+    /// The execution records for
+    /// [`Planner::record_round`](tandem_planner::Planner::record_round): each robot's
+    /// commanded samples (the model's mean command, Eq. 7 with `u = 0`, at each logged
+    /// reference time, one per control tick), the reference-time log, the flags.
+    ///
+    /// # Errors
+    /// The model crate's error for a log it cannot command (a reference time outside the
+    /// task) or samples that do not form a demonstration (an empty log).
+    pub fn records(&self, model: &TaskModel) -> Result<Vec<ExecutionRecord>> {
+        let m = model.channel_names().len();
+        let last = model.n_ref().saturating_sub(1) as f64;
+        let u0 = vec![0.0; model.n_components()];
+        let mut cmd = vec![0.0; m + 1];
+        self.robots
+            .iter()
+            .map(|r| {
+                let mut samples = Vec::with_capacity(r.ref_time.len() * m);
+                for &t in &r.ref_time {
+                    model.command_into(&u0, t.clamp(0.0, last), &mut cmd)?;
+                    samples.extend_from_slice(&cmd[..m]);
+                }
+                let demonstration =
+                    Demonstration::new(model.channel_names().to_vec(), samples, self.tick_s)?;
+                Ok(ExecutionRecord {
+                    execution: Execution {
+                        demonstration,
+                        ref_time_log: r.ref_time.clone(),
+                    },
+                    supervised: r.supervised.clone(),
+                    corrected: r.corrected.clone(),
+                })
+            })
+            .collect()
+    }
+}
+
+/// The operator's timing input from an axis `a ∈ [−1, 1]` (a joystick's, or a Twist's
+/// `linear.x` clamped): `|a| < deadband` no correction ([`Operator::Scheduled`]); `a ≥ 1 −
+/// deadband` [`Operator::Fastest`], `a ≤ −(1 − deadband)` [`Operator::Slowest`]; between, the
+/// execution gradient `2^(−a)` (execution samples per reference sample: forward halves the
+/// time per sample at full throw, back doubles it), which the coordinator clamps to the
+/// demonstrations' `[ψ̇min, ψ̇max]` (§II-B5). A non-finite axis is no correction.
+#[must_use]
+pub fn operator_input(axis: f64, deadband: f64) -> Operator {
+    if !axis.is_finite() || axis.abs() < deadband {
+        Operator::Scheduled
+    } else if axis >= 1.0 - deadband {
+        Operator::Fastest
+    } else if axis <= -(1.0 - deadband) {
+        Operator::Slowest
+    } else {
+        Operator::Gradient((-axis).exp2())
+    }
+}
+
+/// The tick thread's state: the coordinator, the round's log, the last network values.
+#[derive(Debug)]
+pub struct CellLoop {
+    ctl: AnyController,
+    pending: Option<Box<AnyController>>,
+    params: LoopParams,
+    dt_s: f64,
+    last_ref: f64,
+    active: bool,
+    active_since: Instant,
+    finished: bool,
+    last_progress: [Option<Instant>; MAX_ROBOTS],
+    axis: f64,
+    correcting: bool,
+    operator_at: Option<Instant>,
+    stall: Option<NodeFault>,
+    log: RoundLog,
+    capacity: usize,
+    ticks: u64,
+}
+
+impl CellLoop {
+    /// A loop on `ctl` (every robot at its start, not running) of a planner whose model is
+    /// `model` (its sample period and reference length).
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for bad `params`.
+    pub fn new(ctl: AnyController, model: &TaskModel, params: LoopParams) -> Result<CellLoop> {
+        params.validate()?;
+        let dt_s = model.dt_s();
+        if !(dt_s.is_finite() && dt_s > 0.0) {
+            return Err(Error::BadParam {
+                name: "dt_s",
+                why: "must be finite and > 0 (the model's sample period, s)".into(),
+            });
+        }
+        let n = ctl.n_robots();
+        let capacity = round_capacity(&ctl);
+        let log = RoundLog {
+            tick_s: ctl.tick_s(),
+            robots: (0..n)
+                .map(|_| RobotLog {
+                    ref_time: Vec::with_capacity(capacity),
+                    supervised: Vec::with_capacity(capacity),
+                    corrected: Vec::with_capacity(capacity),
+                })
+                .collect(),
+        };
+        Ok(CellLoop {
+            ctl,
+            pending: None,
+            params,
+            dt_s,
+            last_ref: model.n_ref().saturating_sub(1) as f64,
+            active: false,
+            active_since: Instant::now(),
+            finished: false,
+            last_progress: [None; MAX_ROBOTS],
+            axis: 0.0,
+            correcting: false,
+            operator_at: None,
+            stall: None,
+            log,
+            capacity,
+            ticks: 0,
+        })
+    }
+
+    /// The controller it runs.
+    #[must_use]
+    pub fn controller(&self) -> &AnyController {
+        &self.ctl
+    }
+
+    /// Takes one message from the DDS side in at `now`; a request's answer goes to `reply`.
+    pub fn handle(&mut self, msg: Inbound, now: Instant, reply: &mut impl FnMut(Reply)) {
+        match msg {
+            Inbound::Progress { robot, ref_time } => {
+                if robot < self.ctl.n_robots() && ref_time.is_finite() {
+                    self.last_progress[robot] = Some(now);
+                }
+            }
+            Inbound::Operator { axis, correcting } => {
+                self.axis = axis;
+                self.correcting = correcting;
+                self.operator_at = Some(now);
+            }
+            Inbound::Replace(ctl) => self.pending = Some(ctl),
+            Inbound::Restore(log) => {
+                self.log = log;
+                self.finished = true;
+            }
+            Inbound::Request { token, what } => {
+                if what == Request::TakeRound {
+                    match self.take_round() {
+                        Ok(log) => reply(Reply::Round { token, log }),
+                        Err(e) => reply(Reply::Done {
+                            token,
+                            what,
+                            result: Err(e),
+                        }),
+                    }
+                } else {
+                    let result = self.request(what, now);
+                    reply(Reply::Done {
+                        token,
+                        what,
+                        result,
+                    });
+                }
+            }
+        }
+    }
+
+    fn take_round(&mut self) -> std::result::Result<RoundLog, Refusal> {
+        if self.ctl.cell() == Cell::Continuous {
+            return Err(Refusal::Continuous);
+        }
+        if !self.finished {
+            return Err(Refusal::NoFinishedRound);
+        }
+        self.finished = false;
+        let empty = RoundLog {
+            tick_s: self.log.tick_s,
+            robots: vec![RobotLog::default(); self.log.robots.len()],
+        };
+        Ok(std::mem::replace(&mut self.log, empty))
+    }
+
+    fn request(&mut self, what: Request, now: Instant) -> std::result::Result<(), Refusal> {
+        match what {
+            Request::Start => {
+                if self.active {
+                    return Err(Refusal::Running);
+                }
+                if let Some(ctl) = self.pending.take() {
+                    self.capacity = round_capacity(&ctl);
+                    self.log.tick_s = ctl.tick_s();
+                    self.ctl = *ctl;
+                }
+                // Rounds: a new round from the start; the continuous cell resumes.
+                if self.ctl.cell() == Cell::Rounds {
+                    self.ctl.reset();
+                    for r in &mut self.log.robots {
+                        r.ref_time.clear();
+                        r.supervised.clear();
+                        r.corrected.clear();
+                        r.ref_time.reserve(self.capacity);
+                        r.supervised.reserve(self.capacity);
+                        r.corrected.reserve(self.capacity);
+                    }
+                }
+                self.finished = false;
+                self.stall = None;
+                self.last_progress = [None; MAX_ROBOTS];
+                self.active_since = now;
+                self.active = true;
+                Ok(())
+            }
+            Request::Stop => {
+                if !self.active {
+                    return Err(Refusal::NotRunning);
+                }
+                self.active = false;
+                if self.ctl.cell() == Cell::Rounds {
+                    self.ctl.reset();
+                    for r in &mut self.log.robots {
+                        r.ref_time.clear();
+                        r.supervised.clear();
+                        r.corrected.clear();
+                    }
+                }
+                Ok(())
+            }
+            Request::ClearFault => {
+                if self.stall.is_none() && self.ctl.fault().is_none() {
+                    return Err(Refusal::NoFault);
+                }
+                if let Some(NodeFault::Stalled { robot, .. }) = self.stall.take() {
+                    // A fresh grace period: stalled again if it stays silent.
+                    self.last_progress[robot] = Some(now);
+                }
+                self.ctl.clear_fault();
+                Ok(())
+            }
+            Request::TakeRound => Err(Refusal::NoFinishedRound),
+        }
+    }
+
+    /// The latched fault: a stall first, else the coordinator's.
+    #[must_use]
+    pub fn fault(&self) -> Option<NodeFault> {
+        self.stall.or(self.ctl.fault().map(NodeFault::Overlap))
+    }
+
+    /// One control tick at `now`: checks every robot's liveness, then, if running and not
+    /// stalled, logs each moving robot's sample and advances the coordinator with the
+    /// operator's input. No allocation once the round's log has its capacity.
+    ///
+    /// # Errors
+    /// None in practice: the operator's input is always a valid [`Operator`].
+    pub fn step(&mut self, now: Instant) -> Result<Snapshot> {
+        let n = self.ctl.n_robots();
+        self.ticks += 1;
+        if self.active && self.stall.is_none() {
+            for k in 0..n {
+                let last = self.last_progress[k].unwrap_or(self.active_since);
+                let silent_s = now.saturating_duration_since(last).as_secs_f64();
+                if silent_s > self.params.stall_s {
+                    self.stall = Some(NodeFault::Stalled { robot: k, silent_s });
+                    break;
+                }
+            }
+        }
+        let before = self.ctl.ref_time_now();
+        let mut overlap = false;
+        if self.active && self.stall.is_none() {
+            let fresh = self.operator_at.is_some_and(|t| {
+                now.saturating_duration_since(t).as_secs_f64() <= self.params.operator_timeout_s
+            });
+            let (operator, correcting) = if fresh {
+                (
+                    operator_input(self.axis, self.params.deadband),
+                    self.correcting,
+                )
+            } else {
+                (Operator::Scheduled, false)
+            };
+            let corrected = correcting || operator != Operator::Scheduled;
+            let running = self.ctl.running_now();
+            let low = self.ctl.low_conf_now();
+            let logging = self.ctl.cell() == Cell::Rounds;
+            if logging {
+                for (i, r) in self.log.robots.iter_mut().enumerate() {
+                    if running[i] {
+                        // The last reference sample is the task's end (the timeline runs to
+                        // T_ref, one sample period past it), as the simulated cell logs it.
+                        r.ref_time.push(before[i].min(self.last_ref));
+                        r.supervised.push(low[i]);
+                        r.corrected.push(low[i] && corrected);
+                    }
+                }
+            }
+            let tick = self.ctl.tick(operator)?;
+            overlap = tick.overlap();
+            if logging {
+                // A robot that started the tick unsupervised but traversed a low-confidence
+                // sample inside it was watched (the coordinator reports the tick
+                // low-confidence): its sample is supervised, as the simulated cell records it.
+                for (i, r) in self.log.robots.iter_mut().enumerate() {
+                    if running[i] && !low[i] && tick.low_conf[i] {
+                        if let Some(s) = r.supervised.last_mut() {
+                            *s = true;
+                        }
+                        if let Some(c) = r.corrected.last_mut() {
+                            *c = corrected;
+                        }
+                    }
+                }
+            }
+            if self.ctl.is_finished() {
+                self.active = false;
+                self.finished = true;
+            }
+        }
+        let after = self.ctl.ref_time_now();
+        let mut speed = PerRobot::<f64>::new(n);
+        let per_tick = self.ctl.tick_s() / self.dt_s;
+        for (i, s) in speed.as_mut_slice().iter_mut().enumerate() {
+            *s = ((after[i] - before[i]) / per_tick).max(0.0);
+        }
+        Ok(Snapshot {
+            tick: self.ticks,
+            active: self.active,
+            finished: self.finished,
+            ref_time: after,
+            speed,
+            needs_operator: if self.active {
+                self.ctl.low_conf_now()
+            } else {
+                RobotFlags::new(n)
+            },
+            overlap,
+            fault: self.fault(),
+            next: self.ctl.pre_alert(),
+        })
+    }
+}
+
+/// Log entries to reserve per robot: three times the planned round in ticks (rounds; the
+/// operator may drag), at least 64.
+fn round_capacity(ctl: &AnyController) -> usize {
+    let planned = ctl.as_rounds().map_or(0.0, |c| {
+        (0..c.n_robots())
+            .map(|i| c.planned_end_s(i))
+            .fold(0.0, f64::max)
+    });
+    let ticks = planned / ctl.tick_s();
+    if ticks.is_finite() && ticks > 0.0 {
+        (ticks * 3.0) as usize + 64
+    } else {
+        64
+    }
+}

@@ -1,0 +1,23 @@
+//! tandem as a live ROS 2 node (issue 43): a planner's coordinator ticking on its own thread
+//! at the schedule's tick, the ROS 2 graph on another (the pure-Rust `ros2-client` on RustDDS,
+//! pinned and wrapped here: no ROS install), joined by bounded queues that the tick thread
+//! only ever uses without waiting. A robot that stops reporting is a fault the loop holds the
+//! cell on, never a blocked tick.
+//!
+//! - [`core`]: the control loop without the network ([`CellLoop`]), testable alone;
+//! - [`node`]: the threads and the topics and services ([`Node`]; the table is in its docs);
+//! - [`msg`]: the standard message types, as serde structs;
+//! - [`probe`]: a client of the node over DDS (robots, operator, services) for tests.
+
+pub mod core;
+mod error;
+pub mod msg;
+pub mod node;
+pub mod probe;
+
+pub use crate::core::{
+    CellLoop, Inbound, LoopParams, NodeFault, Reply, Request, RoundLog, Snapshot,
+};
+pub use error::{Error, Result};
+pub use node::{Node, NodeParams, NodeStats};
+pub use probe::Probe;

@@ -1,0 +1,740 @@
+//! The live node: a tick thread running a [`CellLoop`] at the schedule's tick and a DDS thread
+//! (ros2-client on RustDDS) publishing and subscribing, joined by bounded queues that are only
+//! ever used with `try_send`/`try_recv` (std's bounded channel: a lock-free array queue).
+//!
+//! The topics and services (`K` = 1…N, robot 1 first):
+//!
+//! | name | type | direction | rate |
+//! |---|---|---|---|
+//! | `/tandem/robotK/progress` | `std_msgs/Float64` | in | the robot's (reference samples reached) |
+//! | `/tandem/robotK/command` | `std_msgs/Float64MultiArray` | out | every tick: `[ref_time, speed_scale, tick, stamp_s]` |
+//! | `/tandem/robotK/setpoint` | `std_msgs/Float64MultiArray` | out | 100 Hz: the model's channels (Eq. 7, `u = 0`) |
+//! | `/tandem/robotK/needs_operator` | `std_msgs/Bool` | out | 100 Hz and on change |
+//! | `/tandem/next_handover` | `std_msgs/Float64MultiArray` | out | 100 Hz: `[robot, earliest_s, latest_s]` or empty |
+//! | `/tandem/fault` | `std_msgs/String` | out | 100 Hz and on change (empty: none) |
+//! | `/tandem/operator` | `sensor_msgs/Joy` | in | axis 0 timing, button 0 correcting |
+//! | `/tandem/{start_round,stop_round,clear_fault,record_round}` | `std_srvs/Trigger` | service | |
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, TrySendError, sync_channel};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use ros2_client::qos::{Durability, History, WhenFull};
+use ros2_client::{
+    Context, ContextOptions, MessageTypeName, Name, Node as RosNode, NodeName, NodeOptions,
+    Publisher, QosProfile, RmwRequestId, Server, ServiceMapping, ServiceTypeName, Subscription,
+};
+use tandem_lfd::TaskModel;
+use tandem_planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
+use tandem_planner::{Cell, Planner};
+use tandem_realtime::Controller;
+
+use crate::core::{CellLoop, Inbound, LoopParams, Reply, Request, RoundLog, Snapshot};
+use crate::error::{Error, Result, dds};
+use crate::msg::{
+    self, BOOL, Bool, FLOAT64, FLOAT64_MULTI_ARRAY, Float64, Float64MultiArray, JOY, Joy, STRING,
+    TRIGGER, Text, TriggerRequest, TriggerResponse, TypeName,
+};
+
+/// The node's parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NodeParams {
+    /// The DDS domain (ROS_DOMAIN_ID), 0…232. Default: 0.
+    pub domain: u16,
+    /// Rounds or a continuous cell. Default: rounds.
+    pub cell: Cell,
+    /// The robot count the caller expects; `None` takes the state file's. Default: `None`.
+    pub robots: Option<usize>,
+    /// The rate of the state topics (Hz; the commands go out every tick). Default: 100.
+    pub state_hz: f64,
+    /// Capacity of each queue between the threads (messages). Default: 4096.
+    pub queue: usize,
+    /// The control loop's timeouts.
+    pub loop_params: LoopParams,
+}
+
+impl Default for NodeParams {
+    fn default() -> Self {
+        NodeParams {
+            domain: 0,
+            cell: Cell::Rounds,
+            robots: None,
+            state_hz: 100.0,
+            queue: 4096,
+            loop_params: LoopParams::default(),
+        }
+    }
+}
+
+impl NodeParams {
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] naming the field.
+    pub fn validate(&self) -> Result<()> {
+        self.loop_params.validate()?;
+        if self.domain > 232 {
+            return Err(Error::BadParam {
+                name: "domain",
+                why: format!("is {}; a DDS domain is 0…232", self.domain),
+            });
+        }
+        if !(self.state_hz.is_finite() && self.state_hz > 0.0) {
+            return Err(Error::BadParam {
+                name: "state_hz",
+                why: "must be finite and > 0 (Hz)".into(),
+            });
+        }
+        if self.queue == 0 {
+            return Err(Error::BadParam {
+                name: "queue",
+                why: "must be ≥ 1 (messages)".into(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Counters of a running node (shared with its threads).
+#[derive(Debug, Default)]
+struct Counters {
+    ticks: AtomicU64,
+    max_period_ns: AtomicU64,
+    overruns: AtomicU64,
+    state_dropped: AtomicU64,
+    inbound_dropped: AtomicU64,
+    commands: AtomicU64,
+    publish_failed: AtomicU64,
+    max_tick_ns: AtomicU64,
+}
+
+/// What a node did so far.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NodeStats {
+    /// Ticks of its loop.
+    pub ticks: u64,
+    /// The longest time between two tick starts (s): the tick thread's worst period.
+    pub max_period_s: f64,
+    /// The longest time one tick's work took (s), the queues' included.
+    pub max_tick_s: f64,
+    /// Ticks that started more than one period late.
+    pub overruns: u64,
+    /// Snapshots the tick thread could not queue (the DDS thread behind).
+    pub state_dropped: u64,
+    /// Messages from the network the DDS thread could not queue (the tick thread behind).
+    pub inbound_dropped: u64,
+    /// Commands published.
+    pub commands: u64,
+    /// Publications DDS refused (a full reliable window: never waited for).
+    pub publish_failed: u64,
+}
+
+/// A running node; [`Node::stop`] ends it.
+#[derive(Debug)]
+pub struct Node {
+    stop: Arc<AtomicBool>,
+    counters: Arc<Counters>,
+    tick: Option<JoinHandle<Result<()>>>,
+    io: Option<JoinHandle<Result<()>>>,
+    n_robots: usize,
+    tick_s: f64,
+}
+
+impl Node {
+    /// Loads the planner in `state`, builds its controller for `params.cell` and starts the
+    /// node's two threads; returns once its DDS entities exist (nothing runs until a
+    /// `start_round` request).
+    ///
+    /// # Errors
+    /// Bad `params`; the planner's errors loading the state or planning the cell;
+    /// [`Error::RobotCount`]; [`Error::Dds`] when an entity cannot be created.
+    pub fn start(state: &Path, params: &NodeParams) -> Result<Node> {
+        params.validate()?;
+        let planner = Planner::load(state)?;
+        let n = planner.n_robots();
+        if let Some(given) = params.robots
+            && given != n
+        {
+            return Err(Error::RobotCount { state: n, given });
+        }
+        let ctl = planner.controller(params.cell)?;
+        let tick_s = ctl.tick_s();
+        let model = planner.model().clone();
+        let cell_loop = CellLoop::new(ctl, &model, params.loop_params.clone())?;
+        let stop = Arc::new(AtomicBool::new(false));
+        let counters = Arc::new(Counters::default());
+        let (in_tx, in_rx) = sync_channel::<Inbound>(params.queue);
+        let (state_tx, state_rx) = sync_channel::<Snapshot>(params.queue);
+        let (reply_tx, reply_rx) = sync_channel::<Reply>(64);
+        let (ready_tx, ready_rx) = sync_channel::<Result<()>>(1);
+        let io = Io {
+            state: state.to_path_buf(),
+            cell: params.cell,
+            domain: params.domain,
+            n,
+            decimate: ((1.0 / params.state_hz) / tick_s).round().max(1.0) as u64,
+            model,
+            in_tx: in_tx.clone(),
+            state_rx,
+            reply_rx,
+            stop: stop.clone(),
+            counters: counters.clone(),
+        };
+        let io = std::thread::Builder::new()
+            .name("tandem-dds".into())
+            .spawn(move || io.run(&ready_tx))
+            .map_err(|e| Error::Thread {
+                name: "tandem-dds",
+                why: e.to_string(),
+            })?;
+        match ready_rx.recv() {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => return Err(e),
+            Err(_) => {
+                return Err(join(io, "tandem-dds").err().unwrap_or(Error::Thread {
+                    name: "tandem-dds",
+                    why: "ended before its entities existed".into(),
+                }));
+            }
+        }
+        let ticker = Ticker {
+            cell_loop,
+            tick_s,
+            in_rx,
+            state_tx,
+            reply_tx,
+            stop: stop.clone(),
+            counters: counters.clone(),
+        };
+        let tick = std::thread::Builder::new()
+            .name("tandem-tick".into())
+            .spawn(move || ticker.run())
+            .map_err(|e| Error::Thread {
+                name: "tandem-tick",
+                why: e.to_string(),
+            })?;
+        Ok(Node {
+            stop,
+            counters,
+            tick: Some(tick),
+            io: Some(io),
+            n_robots: n,
+            tick_s,
+        })
+    }
+
+    /// Robots it runs.
+    #[must_use]
+    pub fn n_robots(&self) -> usize {
+        self.n_robots
+    }
+
+    /// Its control tick (s).
+    #[must_use]
+    pub fn tick_s(&self) -> f64 {
+        self.tick_s
+    }
+
+    /// Its counters now.
+    #[must_use]
+    pub fn stats(&self) -> NodeStats {
+        let c = &self.counters;
+        let get = |a: &AtomicU64| a.load(Ordering::Relaxed);
+        NodeStats {
+            ticks: get(&c.ticks),
+            max_period_s: get(&c.max_period_ns) as f64 * 1e-9,
+            max_tick_s: get(&c.max_tick_ns) as f64 * 1e-9,
+            overruns: get(&c.overruns),
+            state_dropped: get(&c.state_dropped),
+            inbound_dropped: get(&c.inbound_dropped),
+            commands: get(&c.commands),
+            publish_failed: get(&c.publish_failed),
+        }
+    }
+
+    /// Whether both threads still run.
+    #[must_use]
+    pub fn is_running(&self) -> bool {
+        [&self.tick, &self.io]
+            .iter()
+            .all(|h| h.as_ref().is_some_and(|h| !h.is_finished()))
+    }
+
+    /// Stops both threads and returns the counters.
+    ///
+    /// # Errors
+    /// The first error a thread ended with.
+    pub fn stop(mut self) -> Result<NodeStats> {
+        self.stop.store(true, Ordering::Relaxed);
+        let tick = self.tick.take().map(|h| join(h, "tandem-tick"));
+        let io = self.io.take().map(|h| join(h, "tandem-dds"));
+        tick.transpose()?;
+        io.transpose()?;
+        Ok(self.stats())
+    }
+}
+
+impl Drop for Node {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+    }
+}
+
+fn join(h: JoinHandle<Result<()>>, name: &'static str) -> Result<()> {
+    h.join().map_err(|_| Error::Thread {
+        name,
+        why: "panicked".into(),
+    })?
+}
+
+fn max_into(a: &AtomicU64, v: u64) {
+    a.fetch_max(v, Ordering::Relaxed);
+}
+
+/// The tick thread.
+struct Ticker {
+    cell_loop: CellLoop,
+    tick_s: f64,
+    in_rx: Receiver<Inbound>,
+    state_tx: SyncSender<Snapshot>,
+    reply_tx: SyncSender<Reply>,
+    stop: Arc<AtomicBool>,
+    counters: Arc<Counters>,
+}
+
+impl Ticker {
+    fn run(mut self) -> Result<()> {
+        let period = Duration::from_secs_f64(self.tick_s);
+        let mut next = Instant::now();
+        let mut last_start: Option<Instant> = None;
+        let c = self.counters.clone();
+        while !self.stop.load(Ordering::Relaxed) {
+            let now = Instant::now();
+            if let Some(last) = last_start {
+                max_into(&c.max_period_ns, (now - last).as_nanos() as u64);
+            }
+            last_start = Some(now);
+            // At most one queue's worth per tick: a flood cannot lengthen the tick unboundedly.
+            for _ in 0..4096 {
+                match self.in_rx.try_recv() {
+                    Ok(m) => {
+                        let tx = &self.reply_tx;
+                        self.cell_loop.handle(m, now, &mut |r| {
+                            // 64 slots for at most a handful of pending requests.
+                            let _ = tx.try_send(r);
+                        });
+                    }
+                    Err(TryRecvError::Empty | TryRecvError::Disconnected) => break,
+                }
+            }
+            let snap = self.cell_loop.step(now)?;
+            if let Err(TrySendError::Full(_)) = self.state_tx.try_send(snap) {
+                c.state_dropped.fetch_add(1, Ordering::Relaxed);
+            }
+            c.ticks.fetch_add(1, Ordering::Relaxed);
+            max_into(&c.max_tick_ns, now.elapsed().as_nanos() as u64);
+            next += period;
+            let after = Instant::now();
+            if next > after {
+                std::thread::sleep(next - after);
+            } else if after - next > period {
+                // More than a period late: keep the grid from here, count the overrun.
+                c.overruns.fetch_add(1, Ordering::Relaxed);
+                next = after;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The DDS thread's inputs.
+struct Io {
+    state: PathBuf,
+    cell: Cell,
+    domain: u16,
+    n: usize,
+    decimate: u64,
+    model: TaskModel,
+    in_tx: SyncSender<Inbound>,
+    state_rx: Receiver<Snapshot>,
+    reply_rx: Receiver<Reply>,
+    stop: Arc<AtomicBool>,
+    counters: Arc<Counters>,
+}
+
+/// The QoS of every topic: reliable, volatile, keep last 16 — ROS 2's default profile, the one
+/// the client library's interop matrix passes with every RMW; reliable publication never
+/// waits for a full window (`WhenFull::Fail`: the sample is counted as failed).
+pub fn qos() -> QosProfile {
+    QosProfile::publisher_default()
+        .reliability_reliable(WhenFull::Fail)
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 16 })
+}
+
+/// The name of robot `k`'s (0-based) topic `base`: `/tandem/robot{k+1}/{base}`.
+///
+/// # Errors
+/// [`Error::Dds`] (never for these names).
+pub fn robot_topic(k: usize, base: &str) -> Result<Name> {
+    Name::new(&format!("/tandem/robot{}", k + 1), base).map_err(|e| dds(format!("name {base}"), e))
+}
+
+/// The name of the cell's topic or service `base`: `/tandem/{base}`.
+///
+/// # Errors
+/// [`Error::Dds`] (never for these names).
+pub fn cell_topic(base: &str) -> Result<Name> {
+    Name::new("/tandem", base).map_err(|e| dds(format!("name {base}"), e))
+}
+
+/// A ROS 2 context on `domain` and a node named `name` in it.
+///
+/// # Errors
+/// [`Error::Dds`].
+pub fn ros_node(domain: u16, name: &str) -> Result<RosNode> {
+    let ctx = Context::with_options(ContextOptions::new().domain_id(domain))
+        .map_err(|e| dds(format!("join DDS domain {domain}"), e))?;
+    ctx.new_node(
+        NodeName::new("/", name).map_err(|e| dds("name the node", e))?,
+        NodeOptions::new().enable_rosout(false),
+    )
+    .map_err(|e| dds("create the node", e))
+}
+
+/// A publisher of `ty` on `name`.
+///
+/// # Errors
+/// [`Error::Dds`].
+pub fn publisher<M: serde::Serialize>(
+    node: &mut RosNode,
+    name: &Name,
+    ty: TypeName,
+) -> Result<Publisher<M>> {
+    let topic = node
+        .create_topic(name, MessageTypeName::new(ty.0, ty.1), &qos())
+        .map_err(|e| dds(format!("create topic {name:?}"), e))?;
+    node.create_publisher(&topic, None)
+        .map_err(|e| dds(format!("publish on {name:?}"), e))
+}
+
+/// A subscription of `ty` on `name`.
+///
+/// # Errors
+/// [`Error::Dds`].
+pub fn subscription<M: 'static + serde::de::DeserializeOwned>(
+    node: &mut RosNode,
+    name: &Name,
+    ty: TypeName,
+) -> Result<Subscription<M>> {
+    let topic = node
+        .create_topic(name, MessageTypeName::new(ty.0, ty.1), &qos())
+        .map_err(|e| dds(format!("create topic {name:?}"), e))?;
+    node.create_subscription(&topic, None)
+        .map_err(|e| dds(format!("subscribe to {name:?}"), e))
+}
+
+/// The service mapping of every service: ROS 2's "enhanced" request/reply (Fast DDS's).
+pub const SERVICE_MAPPING: ServiceMapping = ServiceMapping::Enhanced;
+
+/// The node's four services, in [`SERVICES`] order.
+pub const SERVICES: [(&str, Request); 4] = [
+    ("start_round", Request::Start),
+    ("stop_round", Request::Stop),
+    ("clear_fault", Request::ClearFault),
+    ("record_round", Request::TakeRound),
+];
+
+/// Per robot: its publishers and subscription.
+struct RobotIo {
+    command: Publisher<Float64MultiArray>,
+    setpoint: Publisher<Float64MultiArray>,
+    needs: Publisher<Bool>,
+    progress: Subscription<Float64>,
+}
+
+/// What a record worker reports.
+struct Recorded {
+    token: u64,
+    result: std::result::Result<(String, Box<TaskModel>), String>,
+}
+
+impl Io {
+    fn run(self, ready: &SyncSender<Result<()>>) -> Result<()> {
+        let entities = self.entities();
+        let (mut node, robots, handover, fault, operator, servers) = match entities {
+            Ok(e) => {
+                let _ = ready.send(Ok(()));
+                e
+            }
+            Err(e) => {
+                let _ = ready.send(Err(e));
+                return Ok(());
+            }
+        };
+        let _ = &mut node;
+        let mut model = self.model.clone();
+        let labels = model.channel_names().join(",");
+        let u0 = vec![0.0; model.n_components()];
+        let mut cmd = vec![0.0; model.channel_names().len() + 1];
+        let mut pending: HashMap<u64, (usize, RmwRequestId)> = HashMap::new();
+        let mut token = 0_u64;
+        let (rec_tx, rec_rx) = sync_channel::<Recorded>(8);
+        let mut last_needs = vec![None; self.n];
+        let mut last_fault: Option<String> = None;
+        let c = &self.counters;
+        let fail = |ok: bool| {
+            if !ok {
+                c.publish_failed.fetch_add(1, Ordering::Relaxed);
+            }
+        };
+        while !self.stop.load(Ordering::Relaxed) {
+            let mut busy = false;
+            // 1. The tick thread's snapshots: commands every tick, state decimated.
+            while let Ok(snap) = self.state_rx.try_recv() {
+                busy = true;
+                let stamp = msg::seconds(msg::now());
+                for (k, r) in robots.iter().enumerate() {
+                    let data = vec![snap.ref_time[k], snap.speed[k], snap.tick as f64, stamp];
+                    let m = Float64MultiArray::labelled("ref_time,speed_scale,tick,stamp_s", data);
+                    fail(r.command.publish(m).is_ok());
+                    c.commands.fetch_add(1, Ordering::Relaxed);
+                }
+                let due = snap.tick % self.decimate == 0;
+                for (k, r) in robots.iter().enumerate() {
+                    let needs = snap.needs_operator[k];
+                    if due || last_needs[k] != Some(needs) {
+                        fail(r.needs.publish(Bool { data: needs }).is_ok());
+                        last_needs[k] = Some(needs);
+                    }
+                    if due {
+                        let t = snap.ref_time[k].clamp(0.0, (model.n_ref() - 1) as f64);
+                        if model.command_into(&u0, t, &mut cmd).is_ok() {
+                            let m = cmd.len() - 1;
+                            let sp = Float64MultiArray::labelled(&labels, cmd[..m].to_vec());
+                            fail(r.setpoint.publish(sp).is_ok());
+                        }
+                    }
+                }
+                let text = snap.fault.map(|f| f.to_string());
+                if due || text != last_fault {
+                    let data = text.clone().unwrap_or_default();
+                    fail(fault.publish(Text { data }).is_ok());
+                    last_fault = text;
+                }
+                if due {
+                    let data = snap.next.map_or_else(Vec::new, |p| {
+                        vec![(p.robot + 1) as f64, p.earliest_s, p.latest_s]
+                    });
+                    let m = Float64MultiArray::labelled("robot,earliest_s,latest_s", data);
+                    fail(handover.publish(m).is_ok());
+                }
+            }
+            // 2. The network's messages to the tick thread.
+            for (k, r) in robots.iter().enumerate() {
+                while let Ok(Some((m, _))) = r.progress.take() {
+                    busy = true;
+                    self.forward(Inbound::Progress {
+                        robot: k,
+                        ref_time: m.data,
+                    });
+                }
+            }
+            while let Ok(Some((joy, _))) = operator.take() {
+                busy = true;
+                let axis = joy.axes.first().map_or(0.0, |&a| f64::from(a));
+                let correcting = joy.buttons.first().is_some_and(|&b| b != 0);
+                self.forward(Inbound::Operator { axis, correcting });
+            }
+            // 3. Service requests.
+            for (i, server) in servers.iter().enumerate() {
+                while let Ok(Some((id, _))) = server.receive_request() {
+                    busy = true;
+                    token += 1;
+                    let what = SERVICES[i].1;
+                    match self.in_tx.try_send(Inbound::Request { token, what }) {
+                        Ok(()) => {
+                            pending.insert(token, (i, id));
+                        }
+                        Err(_) => {
+                            let r = respond(false, "the node is busy; ask again".into());
+                            fail(server.send_response(id, r).is_ok());
+                        }
+                    }
+                }
+            }
+            // 4. The tick thread's replies.
+            while let Ok(reply) = self.reply_rx.try_recv() {
+                busy = true;
+                match reply {
+                    Reply::Done {
+                        token,
+                        what,
+                        result,
+                    } => {
+                        if let Some((i, id)) = pending.remove(&token) {
+                            let r = match result {
+                                Ok(()) => respond(true, done_text(what)),
+                                Err(e) => respond(false, e.to_string()),
+                            };
+                            fail(servers[i].send_response(id, r).is_ok());
+                        }
+                    }
+                    Reply::Round { token, log } => {
+                        self.spawn_record(token, log, rec_tx.clone());
+                    }
+                }
+            }
+            // 5. Finished recordings.
+            while let Ok(done) = rec_rx.try_recv() {
+                busy = true;
+                let r = match done.result {
+                    Ok((text, new_model)) => {
+                        model = *new_model;
+                        respond(true, text)
+                    }
+                    Err(text) => respond(false, text),
+                };
+                if let Some((i, id)) = pending.remove(&done.token) {
+                    fail(servers[i].send_response(id, r).is_ok());
+                }
+            }
+            if !busy {
+                std::thread::sleep(Duration::from_micros(200));
+            }
+        }
+        Ok(())
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn entities(
+        &self,
+    ) -> Result<(
+        RosNode,
+        Vec<RobotIo>,
+        Publisher<Float64MultiArray>,
+        Publisher<Text>,
+        Subscription<Joy>,
+        Vec<Server<TriggerRequest, TriggerResponse>>,
+    )> {
+        let mut node = ros_node(self.domain, "tandem")?;
+        let robots = (0..self.n)
+            .map(|k| {
+                Ok(RobotIo {
+                    command: publisher(
+                        &mut node,
+                        &robot_topic(k, "command")?,
+                        FLOAT64_MULTI_ARRAY,
+                    )?,
+                    setpoint: publisher(
+                        &mut node,
+                        &robot_topic(k, "setpoint")?,
+                        FLOAT64_MULTI_ARRAY,
+                    )?,
+                    needs: publisher(&mut node, &robot_topic(k, "needs_operator")?, BOOL)?,
+                    progress: subscription(&mut node, &robot_topic(k, "progress")?, FLOAT64)?,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let handover = publisher(
+            &mut node,
+            &cell_topic("next_handover")?,
+            FLOAT64_MULTI_ARRAY,
+        )?;
+        let fault = publisher(&mut node, &cell_topic("fault")?, STRING)?;
+        let operator = subscription(&mut node, &cell_topic("operator")?, JOY)?;
+        let servers = SERVICES
+            .iter()
+            .map(|(name, _)| {
+                node.create_server::<TriggerRequest, TriggerResponse>(
+                    SERVICE_MAPPING,
+                    &cell_topic(name)?,
+                    &ServiceTypeName::new(TRIGGER.0, TRIGGER.1),
+                    qos(),
+                    qos(),
+                )
+                .map_err(|e| dds(format!("serve {name}"), e))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok((node, robots, handover, fault, operator, servers))
+    }
+
+    fn forward(&self, m: Inbound) {
+        if self.in_tx.try_send(m).is_err() {
+            self.counters
+                .inbound_dropped
+                .fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    /// Records `log` into the state file on a thread of its own (the lock may be waited for,
+    /// the planner re-schedules): the same lock, load, checks and save as `tandem record`.
+    fn spawn_record(&self, token: u64, log: RoundLog, done: SyncSender<Recorded>) {
+        let state = self.state.clone();
+        let cell = self.cell;
+        let in_tx = self.in_tx.clone();
+        let spawned = std::thread::Builder::new()
+            .name("tandem-record".into())
+            .spawn(move || {
+                let result = match record(&state, cell, &log) {
+                    Ok((text, ctl, model)) => {
+                        // Blocking send is fine here: this thread is not the tick's.
+                        let _ = in_tx.send(Inbound::Replace(ctl));
+                        Ok((text, model))
+                    }
+                    Err(e) => {
+                        let _ = in_tx.send(Inbound::Restore(log));
+                        Err(format!("cannot record the round: {e}"))
+                    }
+                };
+                let _ = done.send(Recorded { token, result });
+            });
+        if spawned.is_err() {
+            self.counters.publish_failed.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+}
+
+/// The record: lock, load, [`Planner::record_round`], save under the lock, the new controller.
+#[allow(clippy::type_complexity)]
+fn record(
+    state: &Path,
+    cell: Cell,
+    log: &RoundLog,
+) -> Result<(String, Box<tandem_planner::AnyController>, Box<TaskModel>)> {
+    let lock = StateLock::acquire(state, DEFAULT_LOCK_TIMEOUT)?;
+    let mut planner = Planner::load(state)?;
+    let records = log.records(planner.model())?;
+    let report = planner.record_round(&records)?;
+    planner.save_locked(&lock)?;
+    drop(lock);
+    let ctl = planner.controller(cell)?;
+    let mut text = format!(
+        "recorded round {} into {}",
+        planner.rounds_recorded(),
+        state.display()
+    );
+    for n in &report.notices {
+        text.push_str("; ");
+        text.push_str(n);
+    }
+    Ok((text, Box::new(ctl), Box::new(planner.model().clone())))
+}
+
+fn respond(success: bool, message: String) -> TriggerResponse {
+    TriggerResponse { success, message }
+}
+
+fn done_text(what: Request) -> String {
+    match what {
+        Request::Start => "started",
+        Request::Stop => "stopped; every robot back at its start",
+        Request::ClearFault => "fault cleared",
+        Request::TakeRound => "recorded",
+    }
+    .into()
+}

@@ -1,0 +1,202 @@
+//! A test client of the node over DDS: it plays the robots (reads each robot's command,
+//! reports progress), the operator's input device, and calls the services. The tests' other
+//! process, and a smoke test for a user's graph.
+
+use std::time::{Duration, Instant};
+
+use ros2_client::{Client, Node as RosNode, Publisher, ServiceTypeName, Subscription};
+
+use crate::error::{Error, Result, dds};
+use crate::msg::{
+    BOOL, Bool, FLOAT64, FLOAT64_MULTI_ARRAY, Float64, Float64MultiArray, Header, JOY, Joy, STRING,
+    TRIGGER, Text, TriggerRequest, TriggerResponse, now,
+};
+use crate::node::{
+    SERVICE_MAPPING, SERVICES, cell_topic, publisher, qos, robot_topic, ros_node, subscription,
+};
+
+/// One command as a robot receives it (`/tandem/robotK/command`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Command {
+    /// Reference time to follow (reference samples).
+    pub ref_time: f64,
+    /// Speed scale over the last tick.
+    pub speed: f64,
+    /// The node's tick count.
+    pub tick: u64,
+    /// The node's wall-clock stamp of the tick (UNIX s).
+    pub stamp_s: f64,
+    /// The probe's wall clock when it took the message (UNIX s).
+    pub received_s: f64,
+}
+
+/// The probe: one ROS 2 node with the counterparts of the node's topics and services.
+pub struct Probe {
+    _node: RosNode,
+    commands: Vec<Subscription<Float64MultiArray>>,
+    needs: Vec<Subscription<Bool>>,
+    progress: Vec<Publisher<Float64>>,
+    fault: Subscription<Text>,
+    operator: Publisher<Joy>,
+    clients: Vec<Client<TriggerRequest, TriggerResponse>>,
+}
+
+impl std::fmt::Debug for Probe {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Probe")
+            .field("robots", &self.commands.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl Probe {
+    /// A probe of `n` robots' topics on DDS domain `domain`.
+    ///
+    /// # Errors
+    /// [`Error::Dds`].
+    pub fn new(domain: u16, n: usize) -> Result<Probe> {
+        let mut node = ros_node(domain, "tandem_probe")?;
+        let mut commands = Vec::new();
+        let mut needs = Vec::new();
+        let mut progress = Vec::new();
+        for k in 0..n {
+            commands.push(subscription(
+                &mut node,
+                &robot_topic(k, "command")?,
+                FLOAT64_MULTI_ARRAY,
+            )?);
+            needs.push(subscription(
+                &mut node,
+                &robot_topic(k, "needs_operator")?,
+                BOOL,
+            )?);
+            progress.push(publisher(&mut node, &robot_topic(k, "progress")?, FLOAT64)?);
+        }
+        let fault = subscription(&mut node, &cell_topic("fault")?, STRING)?;
+        let operator = publisher(&mut node, &cell_topic("operator")?, JOY)?;
+        let clients = SERVICES
+            .iter()
+            .map(|(name, _)| {
+                node.create_client::<TriggerRequest, TriggerResponse>(
+                    SERVICE_MAPPING,
+                    &cell_topic(name)?,
+                    &ServiceTypeName::new(TRIGGER.0, TRIGGER.1),
+                    qos(),
+                    qos(),
+                )
+                .map_err(|e| dds(format!("call {name}"), e))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Probe {
+            _node: node,
+            commands,
+            needs,
+            progress,
+            fault,
+            operator,
+            clients,
+        })
+    }
+
+    /// Every command of robot `k` that arrived since the last call, oldest first.
+    pub fn commands(&self, k: usize) -> Vec<Command> {
+        let mut out = Vec::new();
+        while let Ok(Some((m, _))) = self.commands[k].take() {
+            if let [ref_time, speed, tick, stamp_s, ..] = m.data[..] {
+                out.push(Command {
+                    ref_time,
+                    speed,
+                    tick: tick as u64,
+                    stamp_s,
+                    received_s: crate::msg::seconds(now()),
+                });
+            }
+        }
+        out
+    }
+
+    /// The last `needs_operator` of robot `k` that arrived since the last call.
+    pub fn needs(&self, k: usize) -> Option<bool> {
+        let mut last = None;
+        while let Ok(Some((m, _))) = self.needs[k].take() {
+            last = Some(m.data);
+        }
+        last
+    }
+
+    /// The last fault text that arrived since the last call.
+    pub fn fault(&self) -> Option<String> {
+        let mut last = None;
+        while let Ok(Some((m, _))) = self.fault.take() {
+            last = Some(m.data);
+        }
+        last
+    }
+
+    /// Robot `k` reports reaching `ref_time`.
+    ///
+    /// # Errors
+    /// [`Error::Dds`].
+    pub fn report(&self, k: usize, ref_time: f64) -> Result<()> {
+        self.progress[k]
+            .publish(Float64 { data: ref_time })
+            .map_err(|e| dds("publish progress", e))
+    }
+
+    /// The operator's device: timing axis `axis`, button 0 `correcting`.
+    ///
+    /// # Errors
+    /// [`Error::Dds`].
+    pub fn operate(&self, axis: f32, correcting: bool) -> Result<()> {
+        let joy = Joy {
+            header: Header {
+                stamp: now(),
+                frame_id: String::new(),
+            },
+            axes: vec![axis],
+            buttons: vec![i32::from(correcting)],
+        };
+        self.operator
+            .publish(joy)
+            .map_err(|e| dds("publish the operator's input", e))
+    }
+
+    /// Calls service `name` (one of `start_round`, `stop_round`, `clear_fault`,
+    /// `record_round`) and waits up to `timeout` for the answer, calling `between` while it
+    /// waits (to keep the robots reporting).
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for another name; [`Error::Dds`] when the request cannot be sent
+    /// or no answer came in time.
+    pub fn call(
+        &self,
+        name: &str,
+        timeout: Duration,
+        mut between: impl FnMut(),
+    ) -> Result<TriggerResponse> {
+        let i = SERVICES
+            .iter()
+            .position(|(s, _)| *s == name)
+            .ok_or_else(|| Error::BadParam {
+                name: "service",
+                why: format!(
+                    "`{name}` is none of start_round, stop_round, clear_fault, record_round"
+                ),
+            })?;
+        let client = &self.clients[i];
+        let id = client
+            .send_request(TriggerRequest::default())
+            .map_err(|e| dds(format!("call {name}"), e))?;
+        let end = Instant::now() + timeout;
+        while Instant::now() < end {
+            while let Ok(Some((got, r))) = client.receive_response() {
+                if got == id {
+                    return Ok(r);
+                }
+            }
+            between();
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        Err(dds(format!("call {name}"), "no answer in time"))
+    }
+}
