@@ -1181,6 +1181,7 @@ mod tests {
             lower_bound_s: t_total_s,
             bound_is_optimum: false,
             gap: 0.0,
+            gap_search: None,
             throughput_per_h: 3.0 * 3600.0 / t_total_s,
             offsets_s: vec![1.0, 2.0],
             falsely_trusted_samples: 0,

@@ -92,6 +92,17 @@ proptest! {
                 let out = sample_schedule_n(&p, n, &params, None).unwrap();
                 prop_assert!(out.lower_bound_s >= below, "N = {n}: {} < {below}", out.lower_bound_s);
                 below = out.lower_bound_s;
+                // Where the gap goes: the search's share and the margins' add up to the gap,
+                // neither is negative beyond rounding, and a proven bound leaves the search
+                // nothing open (docs/decisions.md, "A bound that never decreases …").
+                if n >= 3 {
+                    let g = out.gap_split().expect("a fresh outcome knows its margin-free schedule");
+                    prop_assert!((g.search + g.margins - out.gap).abs() < 1e-9, "N = {n}: {g:?} against {}", out.gap);
+                    prop_assert!(g.search >= -1e-9 && g.margins >= -1e-9, "N = {n}: {g:?}");
+                    if out.bound_is_optimum {
+                        prop_assert!(g.search < 1e-6, "N = {n}: proven, yet {g:?}");
+                    }
+                }
             }
         }
     }

@@ -107,6 +107,13 @@ pub struct IterationRecord {
     /// ≥ 0 up to rounding: never below `−realtime::tol::BOUND_REL`, e.g. `−2.4e-16` when the
     /// schedule is the optimum).
     pub gap: f64,
+    /// The search's share of [`IterationRecord::gap`] ([`tandem_schedule::GapSplit::search`]:
+    /// `(margin_free_s − lower_bound_s) / lower_bound_s`, dimensionless, 0 when the bound is
+    /// proven): what the margin-free search left open; the rest of the gap is the margins'
+    /// (and release waits') cost above the best margin-free schedule known. `None` when the
+    /// outcome does not know its margin-free schedule.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gap_search: Option<f64>,
     /// Planned throughput: tasks per hour per operator, `N·3600 / T_total` (`N` robots each
     /// finish one task per `T_total` seconds of the schedule).
     pub throughput_per_h: f64,
@@ -237,6 +244,10 @@ pub struct IterationSummary {
     pub bound_proven_share: f64,
     /// Mean relative gap of `T_total` to the lower bound across trials (dimensionless).
     pub gap_mean: f64,
+    /// Mean across trials of the search's share of the gap ([`IterationRecord::gap_search`];
+    /// `gap_mean` minus it is the margins' share); `None` unless every trial records it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gap_search_mean: Option<f64>,
     /// Mean planned throughput across trials (tasks per hour per operator,
     /// [`IterationRecord::throughput_per_h`]).
     pub throughput_mean_per_h: f64,
@@ -284,6 +295,11 @@ impl StudyResult {
                     bound_proven_share: recs.iter().filter(|r| r.bound_is_optimum).count() as f64
                         / recs.len() as f64,
                     gap_mean: mean_std(recs.iter().map(|r| r.gap)).0,
+                    gap_search_mean: recs
+                        .iter()
+                        .map(|r| r.gap_search)
+                        .collect::<Option<Vec<f64>>>()
+                        .map(|v| mean_std(v.into_iter()).0),
                     throughput_mean_per_h: mean_std(recs.iter().map(|r| r.throughput_per_h)).0,
                     operator_busy_share_mean: {
                         let busy: Vec<f64> = recs
@@ -478,6 +494,7 @@ mod tests {
             lower_bound_s: t_total_s - 1.0,
             bound_is_optimum: iteration == 0,
             gap: 1.0 / (t_total_s - 1.0),
+            gap_search: None,
             throughput_per_h: throughput_per_h(2, t_total_s),
             offsets_s: vec![1.0],
             falsely_trusted_samples: 0,
@@ -500,6 +517,21 @@ mod tests {
             ground_truth_pct: 50.0,
             trials: vec![trial(0, 10.0, 8.0), trial(1, 12.0, 8.0)],
         }
+    }
+
+    /// The summary's search share of the gap is the trials' mean when every trial records
+    /// one, and `None` (left out of the JSON) when one does not.
+    #[test]
+    fn the_gap_search_share_is_averaged_only_when_every_trial_has_it() {
+        let mut r = result();
+        assert_eq!(r.summary()[1].gap_search_mean, None);
+        r.trials[0].iterations[1].gap_search = Some(0.1);
+        assert_eq!(r.summary()[1].gap_search_mean, None);
+        r.trials[1].iterations[1].gap_search = Some(0.3);
+        let mean = r.summary()[1].gap_search_mean.unwrap();
+        assert!((mean - 0.2).abs() < 1e-12, "{mean}");
+        let json = serde_json::to_string(&r.summary()[0]).unwrap();
+        assert!(!json.contains("gap_search"), "{json}");
     }
 
     #[test]

@@ -86,6 +86,7 @@ fn iteration_record(
         lower_bound_s: outcome.lower_bound_s,
         bound_is_optimum: outcome.bound_is_optimum,
         gap: outcome.gap,
+        gap_search: outcome.gap_split().map(|g| g.search),
         throughput_per_h: throughput_per_h(n_robots, outcome.t_total_s),
         offsets_s: schedule.offsets_s.clone(),
         falsely_trusted_samples: falsely_trusted_where(planner.confidence().conf(), can_need),
