@@ -143,6 +143,14 @@ mod tests {
         assert_eq!(hold_points(&[false, false, false]), Vec::<usize>::new());
     }
 
+    /// The problem's runs of one confidence in order: (high confidence, length).
+    fn runs(p: &Problem) -> Vec<(bool, usize)> {
+        p.conf()
+            .chunk_by(|a, b| a == b)
+            .map(|r| (r[0], r.len()))
+            .collect()
+    }
+
     #[test]
     fn random_problems_alternate_runs_within_their_bounds_and_repeat_for_a_seed() {
         for seed in 0..20 {
@@ -150,11 +158,7 @@ mod tests {
             assert!((200..=400).contains(&p.n_ref()), "{}", p.n_ref());
             assert_eq!(p.dt_s(), 0.01);
             // Runs of one kind are 5–80 (HC) or 5–60 (LC) samples, the last one cut.
-            let runs: Vec<(bool, usize)> = p
-                .conf()
-                .chunk_by(|a, b| a == b)
-                .map(|r| (r[0], r.len()))
-                .collect();
+            let runs = runs(&p);
             for (k, &(hc, len)) in runs.iter().enumerate() {
                 let most = if hc { 80 } else { 60 };
                 assert!(len <= most && (len >= 5 || k + 1 == runs.len()), "{runs:?}");
@@ -188,11 +192,7 @@ mod tests {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             let p = random_problem_shaped(&mut rng, 500..=600, 0.02, &shape).unwrap();
             assert!((500..=600).contains(&p.n_ref()) && p.dt_s() == 0.02);
-            let runs: Vec<(bool, usize)> = p
-                .conf()
-                .chunk_by(|a, b| a == b)
-                .map(|r| (r[0], r.len()))
-                .collect();
+            let runs = runs(&p);
             for (k, &(hc, len)) in runs.iter().enumerate() {
                 let range = if hc { 50..=80 } else { 20..=30 };
                 assert!(
