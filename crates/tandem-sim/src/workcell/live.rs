@@ -10,13 +10,13 @@
 
 use rand::Rng;
 use tandem_lfd::TaskModel;
-use tandem_realtime::{Coordinator, Tick, tol};
+use tandem_realtime::{Coordinator, Tick};
 
 use super::record::{RobotRun, TickPhase};
 use tandem_schedule::Problem;
 
 use super::operator::OperatorParams;
-use super::run::{Operate, Robots, step};
+use super::run::{Operate, Robots, check_n_ref, check_tick, step};
 use crate::{Error, Result};
 
 /// A simulated round driven tick by tick: the coordinator of a checked schedule, the
@@ -56,21 +56,8 @@ impl RoundSim {
                 .iter()
                 .map(|t| ("a robot's plan reference samples", t.n_ref())),
         );
-        for (what, found) in sizes {
-            if found != n_ref {
-                return Err(Error::Mismatch {
-                    what,
-                    expected: n_ref,
-                    found,
-                });
-            }
-        }
-        if !tol::same_tick(coord.tick_s(), model.dt_s()) {
-            return Err(Error::TickMismatch {
-                schedule_tick_s: coord.tick_s(),
-                workcell_tick_s: model.dt_s(),
-            });
-        }
+        check_n_ref(n_ref, sizes)?;
+        check_tick(coord.tick_s(), model.dt_s())?;
         let op = Operate::new(model, params, coord.tick_s())?;
         let n = coord.n_robots();
         Ok(RoundSim {

@@ -118,13 +118,34 @@ pub fn run_pair_with(
 /// Checks that the model and every robot's gradients have one entry per reference sample of
 /// `problem`, in that order.
 fn check_sizes(model: &TaskModel, problem: &Problem, schedule: &Schedule) -> Result<()> {
-    let n_ref = problem.n_ref();
     let sizes = std::iter::once(("model reference samples", model.n_ref())).chain(
         schedule
             .grad_exec
             .iter()
             .map(|g| ("a robot's gradients", g.len())),
     );
+    check_n_ref(problem.n_ref(), sizes)
+}
+
+/// Checks that a schedule (or coordinator) made for a control tick of `schedule_tick_s` runs
+/// at the workcell's `workcell_tick_s` (s): [`Error::TickMismatch`] otherwise.
+pub(super) fn check_tick(schedule_tick_s: f64, workcell_tick_s: f64) -> Result<()> {
+    if tol::same_tick(schedule_tick_s, workcell_tick_s) {
+        Ok(())
+    } else {
+        Err(Error::TickMismatch {
+            schedule_tick_s,
+            workcell_tick_s,
+        })
+    }
+}
+
+/// Checks that each `(what, found)` of `sizes` has `n_ref` reference samples, in order:
+/// [`Error::Mismatch`] naming the first that has not.
+pub(super) fn check_n_ref(
+    n_ref: usize,
+    sizes: impl IntoIterator<Item = (&'static str, usize)>,
+) -> Result<()> {
     for (what, found) in sizes {
         if found != n_ref {
             return Err(Error::Mismatch {
@@ -149,13 +170,7 @@ pub(super) fn run_schedule(
 ) -> Result<RoundRun> {
     params.validate()?;
     check_sizes(model, problem, schedule)?;
-    let dt_s = problem.dt_s();
-    if !tol::same_tick(schedule.tick_s, dt_s) {
-        return Err(Error::TickMismatch {
-            schedule_tick_s: schedule.tick_s,
-            workcell_tick_s: dt_s,
-        });
-    }
+    check_tick(schedule.tick_s, problem.dt_s())?;
     // The one place the workcell builds its coordinator (with the margin check).
     let coord = schedule.check(problem)?.coordinator()?;
     run_coordinator(model, problem, coord, needs, params, rng)
