@@ -728,13 +728,7 @@ pub fn find_overlap_with_holds(
     adversaries: &[Adversary],
     rng: &mut ChaCha8Rng,
 ) -> Option<(Adversary, u64)> {
-    let first_start = robots
-        .iter()
-        .map(Timeline::start_s)
-        .fold(f64::INFINITY, f64::min);
-    let dwell: f64 = holds.iter().flatten().map(|h| h.dwell_s).sum();
-    let total = last_end_s(robots) + dwell - first_start;
-    let budget = (total / tick_s * 40.0).ceil() as u64 + 100;
+    let budget = adversary_budget(robots, holds, tick_s);
     for &a in adversaries {
         let c = Coordinator::with_holds_unchecked(robots.to_vec(), holds, tick_s)
             .expect("valid tick and holds");
@@ -745,6 +739,109 @@ pub fn find_overlap_with_holds(
         }
     }
     None
+}
+
+/// The tick budget of a run of an adversary on `robots` with `holds` at `tick_s` (s): 40
+/// times the ticks from the first start to the latest end plus the planned dwells, plus 100
+/// (a generous cap: every admissible operator finishes well within it).
+#[must_use]
+pub fn adversary_budget(robots: &[Timeline], holds: &[Vec<crate::Hold>], tick_s: f64) -> u64 {
+    let first_start = robots
+        .iter()
+        .map(Timeline::start_s)
+        .fold(f64::INFINITY, f64::min);
+    let dwell: f64 = holds.iter().flatten().map(|h| h.dwell_s).sum();
+    let total = last_end_s(robots) + dwell - first_start;
+    (total / tick_s * 40.0).ceil() as u64 + 100
+}
+
+/// A random round with hold points, as the property tests with holds draw it: a [`Case`] of
+/// the given family, its robots at [`Case::interleaved_starts`], and with holds a random
+/// quarter of each robot's usable holds ([`random_usable`]), their release rules
+/// ([`crate::holds::release_rules`]) and random planned dwells ([`with_random_dwells`]).
+#[derive(Clone, Debug)]
+pub struct HeldRound {
+    /// The case the robots' plans come from.
+    pub case: Case,
+    /// Every robot's timeline at its start.
+    pub robots: Vec<Timeline>,
+    /// Each robot's holds with their release rules and dwells (empty without holds).
+    pub holds: Vec<Vec<crate::Hold>>,
+}
+
+impl HeldRound {
+    /// Draws a round of `n` robots of `family` from `r` (see the type docs); with
+    /// `holds = false` no holds are drawn (nor anything after the starts).
+    #[must_use]
+    pub fn random(family: Family, n: usize, holds: bool, r: &mut ChaCha8Rng) -> HeldRound {
+        let case = Case::random(family, n, r);
+        let starts = case.interleaved_starts(n, r);
+        let robots = case.robots_at(&starts);
+        let holds = if holds {
+            let usable = random_usable(&robots, r);
+            let rules = crate::holds::release_rules(&robots, &[], &usable);
+            with_random_dwells(&robots, rules, case.tick_s, r)
+        } else {
+            Vec::new()
+        };
+        HeldRound {
+            case,
+            robots,
+            holds,
+        }
+    }
+
+    /// Whether some robot has a hold with a release rule.
+    #[must_use]
+    pub fn has_holds(&self) -> bool {
+        self.holds.iter().any(|h| !h.is_empty())
+    }
+
+    /// The round's coordinator without the margin check
+    /// ([`Coordinator::with_holds_unchecked`]).
+    ///
+    /// # Panics
+    /// Never for a drawn round (its holds are ones the coordinator accepts).
+    #[must_use]
+    pub fn coordinator(&self) -> Coordinator {
+        Coordinator::with_holds_unchecked(self.robots.clone(), &self.holds, self.case.tick_s)
+            .expect("drawn holds are accepted")
+    }
+
+    /// [`adversary_budget`] of the round.
+    #[must_use]
+    pub fn budget(&self) -> u64 {
+        adversary_budget(&self.robots, &self.holds, self.case.tick_s)
+    }
+}
+
+/// A random runnable order of a continuous cell of `n` robots over the task's `groups`
+/// ([`crate::cell::groups`]): each robot's groups in task order from a random first group,
+/// interleaved at random as whole groups, flattened to `(robot, stretch)` entries.
+///
+/// # Panics
+/// If `groups` is empty while `n > 0` (a task with low confidence has a group).
+pub fn random_order(
+    groups: &[crate::cell::Group],
+    n: usize,
+    rng: &mut ChaCha8Rng,
+) -> Vec<(usize, usize)> {
+    let g = groups.len();
+    let first: Vec<usize> = (0..n).map(|_| rng.random_range(0..g)).collect();
+    let mut taken = vec![0; n];
+    let mut out = Vec::new();
+    while taken.iter().any(|&k| k < g) {
+        let r = loop {
+            let r = rng.random_range(0..n);
+            if taken[r] < g {
+                break r;
+            }
+        };
+        let gr = groups[(first[r] + taken[r]) % g];
+        out.extend((gr.first_lc..gr.end_lc).map(|lc| (r, lc)));
+        taken[r] += 1;
+    }
+    out
 }
 
 /// How [`random_cell_task`] draws its hold points.

@@ -17,7 +17,7 @@ use rand_chacha::ChaCha8Rng;
 use tandem_realtime::adversary::adversary_set;
 use tandem_realtime::continuous::{ContinuousCoordinator, Token, groups, run_cell};
 use tandem_realtime::holds::usable_holds;
-use tandem_realtime::testkit::{CellHolds, random_cell_task};
+use tandem_realtime::testkit::{CellHolds, random_cell_task, random_order};
 use tandem_realtime::{Error, MAX_ROBOTS, Operator, Timeline};
 
 /// A task of confidence `conf` at Δt_s = 1 s, ψ̇ = 1, bounds [½, 2].
@@ -208,31 +208,6 @@ fn a_robot_whose_first_token_is_a_later_group_skips_it_in_the_first_pass() {
 
 // ---------------------------------------------------------------------------------------
 // Property test.
-
-/// A random runnable order: each robot's groups in task order from a random first group,
-/// interleaved at random as whole groups, flattened to stretches.
-fn random_order(
-    groups: &[tandem_realtime::continuous::Group],
-    n: usize,
-    rng: &mut ChaCha8Rng,
-) -> Vec<(usize, usize)> {
-    let g = groups.len();
-    let first: Vec<usize> = (0..n).map(|_| rng.random_range(0..g)).collect();
-    let mut taken = vec![0; n];
-    let mut out = Vec::new();
-    while taken.iter().any(|&k| k < g) {
-        let r = loop {
-            let r = rng.random_range(0..n);
-            if taken[r] < g {
-                break r;
-            }
-        };
-        let gr = groups[(first[r] + taken[r]) % g];
-        out.extend((gr.first_lc..gr.end_lc).map(|lc| (r, lc)));
-        taken[r] += 1;
-    }
-    out
-}
 
 /// The operator policies of the property test, per tick.
 #[derive(Clone, Copy, Debug)]

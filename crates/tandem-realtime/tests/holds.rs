@@ -13,7 +13,7 @@ use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use rand::Rng;
 use tandem_realtime::holds::release_rules;
 use tandem_realtime::testkit::{
-    Case, Family, find_overlap, find_overlap_with_holds, random_usable, rng, with_random_dwells,
+    Case, Family, HeldRound, find_overlap, find_overlap_with_holds, random_usable, rng,
 };
 use tandem_realtime::{
     After, Coordinator, Error, Hold, Operator, Timeline, sufficient_margins,
@@ -330,23 +330,16 @@ fn no_robot_moves_backwards_with_holds_for_any_operator() {
             TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
         let result = runner.run(&any::<u64>(), |seed| {
             let mut r = rng(seed);
-            let case = Case::random(Family::of_seed(seed), n, &mut r);
-            let starts = case.interleaved_starts(n, &mut r);
-            let robots = case.robots_at(&starts);
-            let usable = random_usable(&robots, &mut r);
-            let rules = release_rules(&robots, &[], &usable);
-            if rules.iter().all(Vec::is_empty) {
-                return Ok(());
-            }
             // Planned dwells on some holds, kept when the rules still let the legs start in
             // order (else the plan without them).
-            let holds = with_random_dwells(&robots, rules, case.tick_s, &mut r);
-            let span = robots.iter().map(Timeline::end_s).fold(0.0, f64::max);
-            let coordinator =
-                Coordinator::with_holds_unchecked(robots.clone(), &holds, case.tick_s).unwrap();
-            let dwell: f64 = holds.iter().flatten().map(|h| h.dwell_s).sum();
-            let budget = ((span + dwell) / case.tick_s * 40.0).ceil() as u64 + 100;
-            let mut set = case.adversaries(&robots, &mut r);
+            let round = HeldRound::random(Family::of_seed(seed), n, true, &mut r);
+            if !round.has_holds() {
+                return Ok(());
+            }
+            let (case, robots) = (&round.case, &round.robots);
+            let coordinator = round.coordinator();
+            let budget = round.budget();
+            let mut set = case.adversaries(robots, &mut r);
             if n > 5 {
                 // The beam search is slow for many robots in a debug build; the stress run
                 // (`cargo xtask stress --holds`) runs it for every N.

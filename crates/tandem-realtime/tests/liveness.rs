@@ -13,9 +13,8 @@ use std::cell::Cell;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use tandem_realtime::adversary::{Adversary, run_adversary};
-use tandem_realtime::holds::release_rules;
-use tandem_realtime::testkit::{Case, Family, random_usable, rng, with_random_dwells};
-use tandem_realtime::{Coordinator, Hold, Timeline};
+use tandem_realtime::testkit::{Family, HeldRound, rng};
+use tandem_realtime::{Hold, Timeline};
 
 /// The ticks of the round run serially at the slowest admissible rates: each robot's plan
 /// with every sample at `ψ̇max` (the slowest an operator or the strategy can make it), plus
@@ -53,19 +52,13 @@ fn every_robot_finishes_its_round_with_holds_under_every_adversary() {
             TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
         let result = runner.run(&any::<u64>(), |seed| {
             let mut r = rng(seed);
-            let case = Case::random(Family::of_seed(seed), n, &mut r);
-            let starts = case.interleaved_starts(n, &mut r);
-            let robots = case.robots_at(&starts);
-            let usable = random_usable(&robots, &mut r);
-            let rules = release_rules(&robots, &[], &usable);
-            if rules.iter().all(Vec::is_empty) {
+            let round = HeldRound::random(Family::of_seed(seed), n, true, &mut r);
+            if !round.has_holds() {
                 return Ok(());
             }
-            let holds = with_random_dwells(&robots, rules, case.tick_s, &mut r);
-            let coordinator =
-                Coordinator::with_holds_unchecked(robots.clone(), &holds, case.tick_s).unwrap();
-            let bound = serial_bound(&robots, &holds, case.tick_s);
-            for a in case.adversaries(&robots, &mut r) {
+            let coordinator = round.coordinator();
+            let bound = serial_bound(&round.robots, &round.holds, round.case.tick_s);
+            for a in round.case.adversaries(&round.robots, &mut r) {
                 // The beam search is a search over operators, not one operator's run.
                 if matches!(a, Adversary::Beam { .. }) {
                     continue;

@@ -11,13 +11,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tandem_realtime::adversary::{adversary_set, run_adversary_on};
 use tandem_realtime::continuous::{ContinuousCoordinator, groups};
-use tandem_realtime::holds::release_rules;
-use tandem_realtime::testkit::{
-    Case, CellHolds, Family, random_cell_task, random_usable, with_random_dwells,
-};
-use tandem_realtime::{
-    Controller, Coordinator, Fault, Operator, PerRobot, RobotFlags, Tick, Timeline,
-};
+use tandem_realtime::testkit::{CellHolds, Family, HeldRound, random_cell_task, random_order};
+use tandem_realtime::{Controller, Fault, Operator, PerRobot, RobotFlags, Tick, Timeline};
 
 /// A controller that records every tick it runs.
 struct Watch<C> {
@@ -128,25 +123,14 @@ fn check_run(ticks: &[Tick], h: f64, finished: bool, faults: bool) -> (u64, u64,
 
 fn rounds_case(seed: u64, n: usize, holds: bool, switch_ticks: f64) -> (u64, u64) {
     let mut r = ChaCha8Rng::seed_from_u64(seed);
-    let case = Case::random(Family::of_seed(seed), n, &mut r);
-    let starts = case.interleaved_starts(n, &mut r);
-    let robots: Vec<Timeline> = case.robots_at(&starts);
-    let plan = if holds {
-        let usable = random_usable(&robots, &mut r);
-        let rules = release_rules(&robots, &[], &usable);
-        with_random_dwells(&robots, rules, case.tick_s, &mut r)
-    } else {
-        Vec::new()
-    };
-    let switch_s = switch_ticks * case.tick_s;
-    let c = Coordinator::with_holds_unchecked(robots.clone(), &plan, case.tick_s)
-        .unwrap()
-        .with_switch_s(switch_s)
+    let round = HeldRound::random(Family::of_seed(seed), n, holds, &mut r);
+    let tick_s = round.case.tick_s;
+    let c = round
+        .coordinator()
+        .with_switch_s(switch_ticks * tick_s)
         .unwrap();
-    let ends = robots.iter().map(Timeline::end_s).fold(0.0, f64::max);
-    let dwell: f64 = plan.iter().flatten().map(|h| h.dwell_s).sum();
-    let budget = ((ends + dwell) / case.tick_s * 40.0).ceil() as u64 + 100;
-    let set = case.adversaries(&robots, &mut r);
+    let budget = round.budget();
+    let set = round.case.adversaries(&round.robots, &mut r);
     let (mut checked, mut bounded) = (0, 0);
     for a in set {
         let mut w = Watch {
@@ -155,7 +139,7 @@ fn rounds_case(seed: u64, n: usize, holds: bool, switch_ticks: f64) -> (u64, u64
         };
         let run = run_adversary_on(&mut w, a, &mut r, 1, budget).unwrap();
         let faults = run.overlap_ticks > 0;
-        let (k, b, _) = check_run(&w.ticks, case.tick_s, run.finished, faults);
+        let (k, b, _) = check_run(&w.ticks, tick_s, run.finished, faults);
         checked += k;
         bounded += b;
     }
@@ -166,23 +150,7 @@ fn cell_case(seed: u64, n: usize, switch_ticks: f64) -> (u64, u64) {
     let mut r = ChaCha8Rng::seed_from_u64(seed);
     let (task, holds) = random_cell_task(&mut r, 40, CellHolds::Uniform);
 
-    let gs = groups(task.conf(), &holds).unwrap();
-    // A random runnable order: whole groups, each robot's in task order from a random first.
-    let g = gs.len();
-    let first: Vec<usize> = (0..n).map(|_| r.random_range(0..g)).collect();
-    let mut taken = vec![0; n];
-    let mut order = Vec::new();
-    while taken.iter().any(|&k| k < g) {
-        let i = loop {
-            let i = r.random_range(0..n);
-            if taken[i] < g {
-                break i;
-            }
-        };
-        let gr = gs[(first[i] + taken[i]) % g];
-        order.extend((gr.first_lc..gr.end_lc).map(|lc| (i, lc)));
-        taken[i] += 1;
-    }
+    let order = random_order(&groups(task.conf(), &holds).unwrap(), n, &mut r);
     let tick_s = 0.05 * r.random_range(0.2..2.0);
     let c = ContinuousCoordinator::new(task, &holds, &order, n, tick_s)
         .unwrap()

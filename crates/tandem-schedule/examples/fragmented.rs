@@ -35,6 +35,7 @@ use std::time::Instant;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use tandem_schedule::testkit::{ProblemShape, random_problem_shaped};
 use tandem_schedule::{
     ExactParams, Problem, SamplerBaselines, SamplerParams, Source, sample_schedule,
     sample_schedule_with_baselines, solve_exact,
@@ -59,30 +60,18 @@ const CASES: [(&str, f64, f64, u64); 9] = [
 /// Number of random problems.
 const RANDOM: u64 = 12;
 
-/// Random problem `k` (see the module docs).
+/// Random problem `k` (see the module docs): the test kit's generator in this shape.
 fn random_problem(k: u64) -> Problem {
+    let shape = ProblemShape {
+        hc_run: 50..=800,
+        lc_run: 20..=400,
+        freq: 0.001..0.02,
+        lo: 0.3..0.9,
+        hi: 1.1..2.5,
+    };
     let mut rng = ChaCha8Rng::seed_from_u64(k);
-    let n_ref = rng.random_range(2000..=4000);
-    let (mut conf, mut mean, mut min, mut max) = (vec![], vec![], vec![], vec![]);
-    let mut hc = rng.random_bool(0.5);
-    let (freq, phase) = (rng.random_range(0.001..0.02), rng.random_range(0.0..6.3));
-    while conf.len() < n_ref {
-        let len = if hc {
-            rng.random_range(50..=800)
-        } else {
-            rng.random_range(20..=400)
-        };
-        let (lo, hi) = (rng.random_range(0.3..0.9), rng.random_range(1.1..2.5));
-        for _ in 0..len.min(n_ref - conf.len()) {
-            let m = 1.0 + 0.5 * (freq * conf.len() as f64 + phase).sin();
-            conf.push(hc);
-            mean.push(m);
-            min.push(lo * m);
-            max.push(hi * m);
-        }
-        hc = !hc;
-    }
-    Problem::new(conf, mean, min, max, DT_S).expect("bounds around a positive mean")
+    random_problem_shaped(&mut rng, 2000..=4000, DT_S, &shape)
+        .expect("bounds around a positive mean")
 }
 
 /// One row's numbers: `T*₀`, completion `T_total` and gap and wall time, sampler `T_total` and

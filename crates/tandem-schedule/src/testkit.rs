@@ -6,7 +6,7 @@
 //! that name them by seed, depend on the exact sequence of values drawn from the generator's
 //! random stream, so [`random_problem`] must keep drawing the same values in the same order.
 
-use std::ops::RangeInclusive;
+use std::ops::{Range, RangeInclusive};
 
 use rand::Rng;
 
@@ -31,17 +31,70 @@ pub fn random_problem(
     n_ref: RangeInclusive<usize>,
     dt_s: f64,
 ) -> Result<Problem> {
+    random_problem_shaped(rng, n_ref, dt_s, &ProblemShape::default())
+}
+
+/// The shape of [`random_problem_shaped`]'s problems: the lengths (samples) of the high- and
+/// low-confidence runs, the frequency `f` (per sample) of the mean gradient
+/// `ψ̇mean = 1 + ½·sin(f·n + φ)`, and the per-run bound factors `lo` (`ψ̇min = lo·ψ̇mean`) and
+/// `hi` (`ψ̇max = hi·ψ̇mean`). The default is [`random_problem`]'s.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProblemShape {
+    /// Length of a high-confidence run (samples). Default 5–80.
+    pub hc_run: RangeInclusive<usize>,
+    /// Length of a low-confidence run (samples). Default 5–60.
+    pub lc_run: RangeInclusive<usize>,
+    /// Frequency `f` of the mean gradient (rad per sample). Default `[0.01, 0.2)`.
+    pub freq: Range<f64>,
+    /// Factor `lo` of `ψ̇min` per run. Default `[0.3, 1)`.
+    pub lo: Range<f64>,
+    /// Factor `hi` of `ψ̇max` per run. Default `[1, 2.5)`.
+    pub hi: Range<f64>,
+}
+
+impl Default for ProblemShape {
+    fn default() -> Self {
+        ProblemShape {
+            hc_run: 5..=80,
+            lc_run: 5..=60,
+            freq: 0.01..0.2,
+            lo: 0.3..1.0,
+            hi: 1.0..2.5,
+        }
+    }
+}
+
+/// [`random_problem`] of another `shape`: the same draws in the same order, from the shape's
+/// ranges (`φ` stays in `[0, 6.3)`).
+///
+/// # Errors
+/// As [`random_problem`]; also for bound factors that do not keep `ψ̇min ≤ ψ̇mean ≤ ψ̇max`.
+///
+/// # Panics
+/// On an empty range of `n_ref` or of the shape (the generator draws from each).
+pub fn random_problem_shaped(
+    rng: &mut impl Rng,
+    n_ref: RangeInclusive<usize>,
+    dt_s: f64,
+    shape: &ProblemShape,
+) -> Result<Problem> {
     let n_ref = rng.random_range(n_ref);
     let (mut conf, mut mean, mut min, mut max) = (vec![], vec![], vec![], vec![]);
     let mut hc = rng.random_bool(0.5);
-    let (freq, phase) = (rng.random_range(0.01..0.2), rng.random_range(0.0..6.3));
+    let (freq, phase) = (
+        rng.random_range(shape.freq.clone()),
+        rng.random_range(0.0..6.3),
+    );
     while conf.len() < n_ref {
         let len = if hc {
-            rng.random_range(5..=80)
+            rng.random_range(shape.hc_run.clone())
         } else {
-            rng.random_range(5..=60)
+            rng.random_range(shape.lc_run.clone())
         };
-        let (lo, hi) = (rng.random_range(0.3..1.0), rng.random_range(1.0..2.5));
+        let (lo, hi) = (
+            rng.random_range(shape.lo.clone()),
+            rng.random_range(shape.hi.clone()),
+        );
         for _ in 0..len.min(n_ref - conf.len()) {
             let m = 1.0 + 0.5 * (freq * conf.len() as f64 + phase).sin();
             conf.push(hc);
@@ -90,6 +143,14 @@ mod tests {
         assert_eq!(hold_points(&[false, false, false]), Vec::<usize>::new());
     }
 
+    /// The problem's runs of one confidence in order: (high confidence, length).
+    fn runs(p: &Problem) -> Vec<(bool, usize)> {
+        p.conf()
+            .chunk_by(|a, b| a == b)
+            .map(|r| (r[0], r.len()))
+            .collect()
+    }
+
     #[test]
     fn random_problems_alternate_runs_within_their_bounds_and_repeat_for_a_seed() {
         for seed in 0..20 {
@@ -97,11 +158,7 @@ mod tests {
             assert!((200..=400).contains(&p.n_ref()), "{}", p.n_ref());
             assert_eq!(p.dt_s(), 0.01);
             // Runs of one kind are 5–80 (HC) or 5–60 (LC) samples, the last one cut.
-            let runs: Vec<(bool, usize)> = p
-                .conf()
-                .chunk_by(|a, b| a == b)
-                .map(|r| (r[0], r.len()))
-                .collect();
+            let runs = runs(&p);
             for (k, &(hc, len)) in runs.iter().enumerate() {
                 let most = if hc { 80 } else { 60 };
                 assert!(len <= most && (len >= 5 || k + 1 == runs.len()), "{runs:?}");
@@ -120,5 +177,44 @@ mod tests {
             assert_eq!(again.grad_max(), p.grad_max());
         }
         assert!(random_problem(&mut ChaCha8Rng::seed_from_u64(0), 10..=10, 0.0).is_err());
+    }
+
+    #[test]
+    fn a_shaped_problem_keeps_its_shape_and_the_default_is_random_problem() {
+        let shape = ProblemShape {
+            hc_run: 50..=80,
+            lc_run: 20..=30,
+            freq: 0.001..0.002,
+            lo: 0.3..0.4,
+            hi: 2.0..2.5,
+        };
+        for seed in 0..10 {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let p = random_problem_shaped(&mut rng, 500..=600, 0.02, &shape).unwrap();
+            assert!((500..=600).contains(&p.n_ref()) && p.dt_s() == 0.02);
+            let runs = runs(&p);
+            for (k, &(hc, len)) in runs.iter().enumerate() {
+                let range = if hc { 50..=80 } else { 20..=30 };
+                assert!(
+                    range.contains(&len) || (k + 1 == runs.len() && len <= *range.end()),
+                    "{runs:?}"
+                );
+            }
+            for n in 0..p.n_ref() {
+                let (lo, m, hi) = (p.grad_min()[n], p.grad_mean()[n], p.grad_max()[n]);
+                assert!(0.3 * m <= lo && lo < 0.4 * m, "{lo} {m}");
+                assert!(2.0 * m <= hi && hi < 2.5 * m, "{hi} {m}");
+            }
+            // The default shape draws what `random_problem` draws.
+            let a = random_problem(&mut ChaCha8Rng::seed_from_u64(seed), 200..=400, 0.01);
+            let b = random_problem_shaped(
+                &mut ChaCha8Rng::seed_from_u64(seed),
+                200..=400,
+                0.01,
+                &ProblemShape::default(),
+            );
+            let (a, b) = (a.unwrap(), b.unwrap());
+            assert_eq!((a.conf(), a.grad_min()), (b.conf(), b.grad_min()));
+        }
     }
 }

@@ -20,8 +20,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::adversary::{Adversary, PolicyState, adversary_set};
-use crate::cell::{ContinuousCoordinator, Group, groups};
-use crate::testkit::{CellHolds, random_cell_task};
+use crate::cell::{ContinuousCoordinator, groups};
+use crate::testkit::{CellHolds, random_cell_task, random_order};
 use crate::{MAX_ROBOTS, Operator, Timeline};
 
 /// When the cell is handed over to a new plan (tried each tick until it succeeds: a robot
@@ -244,27 +244,6 @@ fn alternating_orders_that_followed_only_the_old_turn_would_starve_robot_2() {
         assert!(w[0] != w[1] && w[1] != w[2] && w[0] != w[2], "{order:?}");
     }
     assert_eq!(cell.tasks_completed(), [100, 100, 100]);
-}
-
-/// A random runnable order: each robot's groups in task order from a random first group,
-/// interleaved at random as whole groups, flattened to stretches.
-fn random_order(groups: &[Group], n: usize, rng: &mut ChaCha8Rng) -> Vec<(usize, usize)> {
-    let g = groups.len();
-    let first: Vec<usize> = (0..n).map(|_| rng.random_range(0..g)).collect();
-    let mut taken = vec![0; n];
-    let mut out = Vec::new();
-    while taken.iter().any(|&k| k < g) {
-        let r = loop {
-            let r = rng.random_range(0..n);
-            if taken[r] < g {
-                break r;
-            }
-        };
-        let gr = groups[(first[r] + taken[r]) % g];
-        out.extend((gr.first_lc..gr.end_lc).map(|lc| (r, lc)));
-        taken[r] += 1;
-    }
-    out
 }
 
 /// The worst case [`cell_is_fair`] saw: services and tasks of another robot, as fractions

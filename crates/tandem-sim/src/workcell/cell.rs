@@ -14,11 +14,10 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 use tandem_lfd::TaskModel;
 use tandem_realtime::continuous::ContinuousCoordinator;
-use tandem_realtime::tol;
 
 use super::operator::OperatorParams;
 use super::record::RobotRun;
-use super::run::{Operate, Robots, step};
+use super::run::{Operate, Robots, check_n_ref, check_tick, step};
 use crate::{Error, Result};
 
 /// What a continuous cell did so far (control ticks of `tick_s`).
@@ -236,18 +235,9 @@ fn ref_times(coord: &ContinuousCoordinator) -> Vec<f64> {
 }
 
 fn check(model: &TaskModel, coord: &ContinuousCoordinator) -> Result<()> {
-    if coord.task().n_ref() != model.n_ref() {
-        return Err(Error::Mismatch {
-            what: "reference samples of the cell's task",
-            expected: model.n_ref(),
-            found: coord.task().n_ref(),
-        });
-    }
-    if !tol::same_tick(coord.tick_s(), model.dt_s()) {
-        return Err(Error::TickMismatch {
-            schedule_tick_s: coord.tick_s(),
-            workcell_tick_s: model.dt_s(),
-        });
-    }
-    Ok(())
+    check_n_ref(
+        model.n_ref(),
+        [("reference samples of the cell's task", coord.task().n_ref())],
+    )?;
+    check_tick(coord.tick_s(), model.dt_s())
 }

@@ -1,17 +1,22 @@
 //! A round of the simulated workcell one control tick at a time ([`RoundSim`]), for a caller
 //! that drives the cell in real time (the operator's console, issue 42) and may pause it,
 //! clear a fault or start the next round between ticks. The tick is the workcell's one
-//! [`step`] (module docs of [`crate::workcell`]), as in [`run_round_with`](super::run_round_with);
-//! unlike it, a latched fault stays latched until the caller clears it
-//! ([`RoundSim::clear_fault`]): the person at the console releases the held robot.
+//! [`step`] (module docs of [`crate::workcell`]). It is also the one round loop of
+//! [`run_round_with`](super::run_round_with): that is a `RoundSim` ticked to the end, which
+//! additionally records each robot's clock and phase before every tick
+//! (`RoundSim::record_phases`) and releases a held robot itself; here a latched fault stays
+//! latched until the caller clears it ([`RoundSim::clear_fault`]): the person at the console
+//! releases the held robot.
 
 use rand::Rng;
 use tandem_lfd::TaskModel;
-use tandem_realtime::{Coordinator, Tick, tol};
+use tandem_realtime::{Coordinator, Tick};
+
+use super::record::{RobotRun, TickPhase};
 use tandem_schedule::Problem;
 
 use super::operator::OperatorParams;
-use super::run::{Operate, Robots, step};
+use super::run::{Operate, Robots, check_n_ref, check_tick, step};
 use crate::{Error, Result};
 
 /// A simulated round driven tick by tick: the coordinator of a checked schedule, the
@@ -51,21 +56,8 @@ impl RoundSim {
                 .iter()
                 .map(|t| ("a robot's plan reference samples", t.n_ref())),
         );
-        for (what, found) in sizes {
-            if found != n_ref {
-                return Err(Error::Mismatch {
-                    what,
-                    expected: n_ref,
-                    found,
-                });
-            }
-        }
-        if !tol::same_tick(coord.tick_s(), model.dt_s()) {
-            return Err(Error::TickMismatch {
-                schedule_tick_s: coord.tick_s(),
-                workcell_tick_s: model.dt_s(),
-            });
-        }
+        check_n_ref(n_ref, sizes)?;
+        check_tick(coord.tick_s(), model.dt_s())?;
         let op = Operate::new(model, params, coord.tick_s())?;
         let n = coord.n_robots();
         Ok(RoundSim {
@@ -127,8 +119,20 @@ impl RoundSim {
                 found: model.n_ref(),
             });
         }
+        Ok(self.step(model, &mut needs, rng)?.0)
+    }
+
+    /// One control tick on a model of the round's size (checked by the caller): the workcell's
+    /// [`step`] with the round's bounds and confidence. Returns the tick and whether the
+    /// operator's input was a correction.
+    pub(super) fn step(
+        &mut self,
+        model: &TaskModel,
+        needs: &mut impl FnMut(usize, usize) -> bool,
+        rng: &mut impl Rng,
+    ) -> Result<(Tick, bool)> {
         let (grad_min, grad_max) = (&self.grad_min, &self.grad_max);
-        let (tick, _) = step(
+        let out = step(
             &mut self.coord,
             model,
             &mut self.op,
@@ -136,10 +140,40 @@ impl RoundSim {
             Some(&self.conf),
             &mut self.robots,
             self.round_ticks,
-            &mut needs,
+            needs,
             rng,
         )?;
         self.round_ticks += 1;
-        Ok(tick)
+        Ok(out)
+    }
+
+    /// Records, before a tick, each robot's clock (s), whether it is at a hold, and its phase
+    /// ([`TickPhase`]) into its execution in progress: what a recorded round
+    /// ([`run_round_with`](super::run_round_with)) keeps and the console does not need.
+    pub(super) fn record_phases(&mut self) {
+        let held = self.coord.fault().map(|f| f.stopped);
+        let clocks = self.coord.clock_s();
+        let running = self.coord.running_now();
+        for (i, run) in self.robots.runs.iter_mut().enumerate() {
+            run.clock_s.push(clocks[i]);
+            let at_hold = self.coord.at_hold(i);
+            run.hold_ticks += usize::from(at_hold);
+            run.phases.push(if held == Some(i) {
+                TickPhase::Held
+            } else if at_hold {
+                TickPhase::AtHold
+            } else if running[i] {
+                TickPhase::Running
+            } else if self.robots.ref_now[i] >= self.n_ref as f64 {
+                TickPhase::Finished
+            } else {
+                TickPhase::Waiting
+            });
+        }
+    }
+
+    /// The coordinator and each robot's execution (the end of a recorded round).
+    pub(super) fn into_parts(self) -> (Coordinator, Vec<RobotRun>) {
+        (self.coord, self.robots.runs)
     }
 }

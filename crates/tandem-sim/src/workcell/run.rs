@@ -7,10 +7,11 @@ use tandem_planner::Planner;
 use tandem_realtime::{Controller, Coordinator, Operator, Tick, Timeline, tol};
 use tandem_schedule::{Problem, Schedule};
 
+use super::live::RoundSim;
 use super::operator::{
     Attention, Episodes, OperatorParams, local_correction_input, needs_correction,
 };
-use super::record::{PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
+use super::record::{PlanGap, RobotPlan, RobotRun, RoundRun, plan_gap};
 use crate::task::{Label, Workpiece};
 use crate::{Error, Result};
 
@@ -117,13 +118,34 @@ pub fn run_pair_with(
 /// Checks that the model and every robot's gradients have one entry per reference sample of
 /// `problem`, in that order.
 fn check_sizes(model: &TaskModel, problem: &Problem, schedule: &Schedule) -> Result<()> {
-    let n_ref = problem.n_ref();
     let sizes = std::iter::once(("model reference samples", model.n_ref())).chain(
         schedule
             .grad_exec
             .iter()
             .map(|g| ("a robot's gradients", g.len())),
     );
+    check_n_ref(problem.n_ref(), sizes)
+}
+
+/// Checks that a schedule (or coordinator) made for a control tick of `schedule_tick_s` runs
+/// at the workcell's `workcell_tick_s` (s): [`Error::TickMismatch`] otherwise.
+pub(super) fn check_tick(schedule_tick_s: f64, workcell_tick_s: f64) -> Result<()> {
+    if tol::same_tick(schedule_tick_s, workcell_tick_s) {
+        Ok(())
+    } else {
+        Err(Error::TickMismatch {
+            schedule_tick_s,
+            workcell_tick_s,
+        })
+    }
+}
+
+/// Checks that each `(what, found)` of `sizes` has `n_ref` reference samples, in order:
+/// [`Error::Mismatch`] naming the first that has not.
+pub(super) fn check_n_ref(
+    n_ref: usize,
+    sizes: impl IntoIterator<Item = (&'static str, usize)>,
+) -> Result<()> {
     for (what, found) in sizes {
         if found != n_ref {
             return Err(Error::Mismatch {
@@ -148,38 +170,30 @@ pub(super) fn run_schedule(
 ) -> Result<RoundRun> {
     params.validate()?;
     check_sizes(model, problem, schedule)?;
-    let dt_s = problem.dt_s();
-    if !tol::same_tick(schedule.tick_s, dt_s) {
-        return Err(Error::TickMismatch {
-            schedule_tick_s: schedule.tick_s,
-            workcell_tick_s: dt_s,
-        });
-    }
+    check_tick(schedule.tick_s, problem.dt_s())?;
     // The one place the workcell builds its coordinator (with the margin check).
     let coord = schedule.check(problem)?.coordinator()?;
     run_coordinator(model, problem, coord, needs, params, rng)
 }
 
 /// The control loop of the module docs on a coordinator of `problem`'s robots at its own
-/// tick (`Δt_s`; checked by the caller, as are the parameters and sizes). A tick that latches
-/// a fault of the coordinator's run-time monitor (two robots low-confidence at once, which a
-/// checked schedule never has) is counted in [`RoundRun::faults`]; the held robot logs no
-/// samples while held, and the simulated operator releases it
+/// tick (`Δt_s`; checked by the caller, as are the parameters and sizes): a [`RoundSim`]
+/// ticked to the end, recording each robot's clock and phase before every tick. A tick that
+/// latches a fault of the coordinator's run-time monitor (two robots low-confidence at once,
+/// which a checked schedule never has) is counted in [`RoundRun::faults`]; the held robot
+/// logs no samples while held, and the simulated operator releases it
 /// ([`Coordinator::clear_fault`]) after the first tick in which no robot is low-confidence,
 /// so that every round finishes.
 pub(super) fn run_coordinator(
     model: &TaskModel,
     problem: &Problem,
-    mut coord: Coordinator,
+    coord: Coordinator,
     mut needs: impl FnMut(usize, usize) -> bool,
     params: &OperatorParams,
     rng: &mut impl Rng,
 ) -> Result<RoundRun> {
-    let n_ref = problem.n_ref();
     let tick_s = coord.tick_s();
-    let mut op = Operate::new(model, params, tick_s)?;
     let n_robots = coord.n_robots();
-    let runs: Vec<RobotRun> = (0..n_robots).map(|_| op.empty_run(n_ref)).collect();
     let (mut ticks, mut overlap_ticks, mut idle_ticks, mut faults) = (0, 0, 0, 0);
     let max_end_s = coord
         .robots()
@@ -200,47 +214,15 @@ pub(super) fn run_coordinator(
         // which a schedule caps at the serial schedule's length).
         budget *= n_robots + 2;
     }
-    let mut robots = Robots {
-        runs,
-        in_episode: vec![false; n_robots],
-        ref_now: coord.ref_time_now().to_vec(),
-    };
+    let mut sim = RoundSim::new(model, problem, coord, params)?;
     // Whether the operator's input in each tick was a correction (for the round's PlanGap).
     let mut corrected_tick: Vec<bool> = Vec::new();
-    while !coord.is_finished() {
+    while !sim.coordinator().is_finished() {
         if ticks >= budget {
             return Err(Error::DidNotFinish { ticks: budget });
         }
-        let held = coord.fault().map(|f| f.stopped);
-        let clocks = coord.clock_s();
-        let running = coord.running_now();
-        for (i, run) in robots.runs.iter_mut().enumerate() {
-            run.clock_s.push(clocks[i]);
-            let at_hold = coord.at_hold(i);
-            run.hold_ticks += usize::from(at_hold);
-            run.phases.push(if held == Some(i) {
-                TickPhase::Held
-            } else if at_hold {
-                TickPhase::AtHold
-            } else if running[i] {
-                TickPhase::Running
-            } else if robots.ref_now[i] >= n_ref as f64 {
-                TickPhase::Finished
-            } else {
-                TickPhase::Waiting
-            });
-        }
-        let (tick, corrected) = step(
-            &mut coord,
-            model,
-            &mut op,
-            |_, n| (problem.grad_min()[n], problem.grad_max()[n]),
-            Some(problem.conf()),
-            &mut robots,
-            ticks,
-            &mut needs,
-            rng,
-        )?;
+        sim.record_phases();
+        let (tick, corrected) = sim.step(model, &mut needs, rng)?;
         corrected_tick.push(corrected);
         match tick.low_conf.count() {
             0 => idle_ticks += 1,
@@ -250,12 +232,12 @@ pub(super) fn run_coordinator(
         match tick.fault {
             Some(f) if f.tick == ticks as u64 => faults += 1,
             // The operator has dealt with the robot that kept running: release the held one.
-            Some(_) if tick.low_conf.count() == 0 => coord.clear_fault(),
+            Some(_) if tick.low_conf.count() == 0 => sim.clear_fault(),
             _ => {}
         }
         ticks += 1;
     }
-    let mut runs = robots.runs;
+    let (coord, mut runs) = sim.into_parts();
     for run in &mut runs {
         run.start_tick = run.start_tick.min(ticks);
     }

@@ -70,6 +70,15 @@ fn all_painted() -> Workpiece {
     }
 }
 
+/// An operator who never misses a needed correction and never gives an unneeded one.
+fn perfect() -> OperatorParams {
+    OperatorParams {
+        miss_rate: 0.0,
+        false_correction_rate: 0.0,
+        ..OperatorParams::default()
+    }
+}
+
 /// Whether robot `robot` needs the operator at reference sample `ref_idx` on the
 /// painted labels and workpieces ([`run_round`]'s rule).
 fn painted_needs(robot: usize, ref_idx: usize) -> bool {
@@ -145,11 +154,7 @@ fn bad_rates_are_rejected() {
 
 #[test]
 fn a_perfect_operator_corrects_every_needed_sample_and_slows_the_robots() {
-    let perfect = OperatorParams {
-        miss_rate: 0.0,
-        false_correction_rate: 0.0,
-        ..OperatorParams::default()
-    };
+    let perfect = perfect();
     let (run, planned_s) = run(&perfect, 1);
     assert_eq!(run.overlap_ticks, 0);
     let model = model();
@@ -220,11 +225,7 @@ fn a_round_of_three_robots_runs_each_once_and_busies_the_operator_for_each() {
     let model = model();
     let problem = problem(&model);
     let schedule = problem.serial_schedule_n(3, problem.dt_s()).unwrap();
-    let perfect = OperatorParams {
-        miss_rate: 0.0,
-        false_correction_rate: 0.0,
-        ..OperatorParams::default()
-    };
+    let perfect = perfect();
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let run = run_schedule(
         &model,
@@ -395,11 +396,7 @@ fn run_round_with_asks_the_caller_only_about_supervised_samples() {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     // Only robot 1 needs the operator; a perfect operator corrects exactly its
     // supervised samples, and is asked about nothing but low-confidence samples.
-    let perfect = OperatorParams {
-        miss_rate: 0.0,
-        false_correction_rate: 0.0,
-        ..OperatorParams::default()
-    };
+    let perfect = perfect();
     let mut asked = Vec::new();
     let run = run_schedule(
         &model,
@@ -504,11 +501,7 @@ fn an_unsafe_plan_latches_a_fault_that_the_operator_releases_and_the_round_finis
     // ticks, which the margin check rejects.
     let mut schedule = problem.serial_schedule(problem.dt_s()).unwrap();
     schedule.offsets_s = vec![0.0];
-    let perfect = OperatorParams {
-        miss_rate: 0.0,
-        false_correction_rate: 0.0,
-        ..OperatorParams::default()
-    };
+    let perfect = perfect();
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     let refused = run_schedule(
         &model,
@@ -593,11 +586,7 @@ fn a_robot_waits_at_its_hold_while_the_operator_drags_the_other_and_never_overla
     let held = problem.with_release_rules(&plain).unwrap();
     assert_eq!(held.holds_of(1)[0].ref_idx, 5);
     tandem_schedule::validate(&problem, &held).unwrap();
-    let perfect = OperatorParams {
-        miss_rate: 0.0,
-        false_correction_rate: 0.0,
-        ..OperatorParams::default()
-    };
+    let perfect = perfect();
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let run = run_schedule(&model, &problem, &held, painted_needs, &perfect, &mut rng).unwrap();
     assert_eq!(run.overlap_ticks, 0);
@@ -806,11 +795,7 @@ fn a_nominal_round_with_a_hold_ends_on_plan_and_records_where_its_time_went() {
         "{dwell}"
     );
     assert!((held.t_total_s(dt_s) - (plain.t_total_s(dt_s) + dwell)).abs() < 1e-12);
-    let nominal = OperatorParams {
-        miss_rate: 0.0,
-        false_correction_rate: 0.0,
-        ..OperatorParams::default()
-    };
+    let nominal = perfect();
     let never = |_: usize, _: usize| false;
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let run = run_schedule(&model, &problem, &held, never, &nominal, &mut rng).unwrap();
@@ -879,11 +864,7 @@ fn a_fast_robot_crossing_a_one_sample_island_in_one_tick_gets_it_supervised() {
     )
     .unwrap();
     let schedule = problem.serial_schedule(problem.dt_s()).unwrap();
-    let perfect = OperatorParams {
-        miss_rate: 0.0,
-        false_correction_rate: 0.0,
-        ..OperatorParams::default()
-    };
+    let perfect = perfect();
     let mut rng = ChaCha8Rng::seed_from_u64(1);
     let run = run_schedule(
         &model,
@@ -943,11 +924,7 @@ fn supervised_ticks(run: &RobotRun) -> Vec<usize> {
 /// robot's stretch ended; the first robot, and an operator without a switch time, miss none.
 #[test]
 fn an_operator_with_a_switch_time_misses_the_corrections_right_after_another_robots_stretch() {
-    let perfect = OperatorParams {
-        miss_rate: 0.0,
-        false_correction_rate: 0.0,
-        ..OperatorParams::default()
-    };
+    let perfect = perfect();
     let (base, _) = run(&perfect, 11);
     for r in &base.robots {
         assert_eq!((r.missed, r.switch_missed), (0, 0));
