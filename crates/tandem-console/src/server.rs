@@ -48,7 +48,9 @@ pub struct ConsoleConfig {
     pub port: u16,
     /// Frames per second pushed to a page at most. Default: 30.
     pub max_hz: f64,
-    /// The pre-alert's lead (s). Default: [`crate::DEFAULT_LEAD_S`] (7 s).
+    /// The pre-alert's lead (s): the page alerts once the next handover can start within it.
+    /// The console uses the larger of this and the controller's switch time
+    /// ([`Geometry::switch_s`]). Default: [`crate::DEFAULT_LEAD_S`] (7 s).
     pub lead_s: f64,
     /// The timeline's horizon (s). Default: [`crate::DEFAULT_HORIZON_S`] (90 s).
     pub horizon_s: f64,
@@ -111,6 +113,7 @@ struct App {
     controls: SyncSender<ControlMsg>,
     clients: Mutex<Clients>,
     n_robots: usize,
+    shared: Arc<Shared>,
 }
 
 impl App {
@@ -140,7 +143,7 @@ impl Console {
         mut geometry: Geometry,
     ) -> Result<(Console, ConsoleHandle)> {
         config.validate()?;
-        geometry.lead_s = config.lead_s;
+        geometry.lead_s = config.lead_s.max(geometry.switch_s());
         geometry.horizon_s = config.horizon_s;
         let addr = SocketAddr::new(config.host, config.port);
         let listener = TcpListener::bind(addr).map_err(|source| Error::Bind {
@@ -166,6 +169,7 @@ impl Console {
             controls: controls_tx,
             clients: Mutex::new(Clients::default()),
             n_robots: geometry.n_robots(),
+            shared: shared.clone(),
         });
         let rt = tokio::runtime::Builder::new_current_thread()
             .enable_all()
@@ -277,6 +281,14 @@ async fn poller(
     let mut last_push = Instant::now();
     loop {
         interval.tick().await;
+        // Ask the loop for its next snapshot and wait for it (at most one period: a loop that
+        // stopped publishing leaves the newest snapshot, whose age the page shows).
+        let before = shared.slot.written();
+        shared.want.store(true, Ordering::Relaxed);
+        let asked = Instant::now();
+        while shared.slot.written() == before && asked.elapsed() < period {
+            tokio::time::sleep(Duration::from_millis(1)).await;
+        }
         let (acks, version, controller) = {
             let mut c = app.clients();
             while let Ok(ack) = acks_rx.try_recv() {
@@ -311,8 +323,8 @@ async fn poller(
         frame.seq = seq;
         frame.controller = controller;
         frame.acks = acks;
-        frame.health.published = written;
-        frame.health.dropped = written.saturating_sub(sent_new);
+        frame.health.published = raw.published;
+        frame.health.dropped = raw.published.saturating_sub(sent_new);
         frame.health.acks_lost = shared.acks_lost.load(Ordering::Relaxed);
         frame.health.source_age_s = (unix_ms() - raw.published_unix_ms).max(0.0) / 1e3;
         match serde_json::to_string(&frame) {
@@ -538,10 +550,13 @@ async fn control(State(app): State<Arc<App>>, body: Bytes) -> Response {
                 robot,
             };
             match app.controls.try_send(msg) {
-                Ok(()) => reply(
-                    StatusCode::ACCEPTED,
-                    json!({ "ok": true, "id": req.id, "pending": true }),
-                ),
+                Ok(()) => {
+                    app.shared.controls_sent.fetch_add(1, Ordering::Release);
+                    reply(
+                        StatusCode::ACCEPTED,
+                        json!({ "ok": true, "id": req.id, "pending": true }),
+                    )
+                }
                 Err(TrySendError::Full(_)) => reject(
                     StatusCode::SERVICE_UNAVAILABLE,
                     client,

@@ -1,7 +1,7 @@
 //! The console in a real browser: headless Chromium driven through the DevTools protocol (a
 //! small client over a websocket) against the server on an ephemeral port. Checks that the
-//! page shows exactly the coordinator's low-confidence robot at every sampled tick and the
-//! plan's countdown, that a control clicked on the page comes back confirmed and reaches the
+//! page shows exactly the coordinator's low-confidence robot at every sampled tick and its
+//! pre-alert as the countdown, that a control clicked on the page comes back confirmed and reaches the
 //! loop, and that the page reconnects (and takes control again) after the server restarts.
 //!
 //! Skipped, with a message, only when Chromium is absent and `TANDEM_REQUIRE_CHROMIUM` is
@@ -22,9 +22,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use serde_json::{Value, json};
-use tandem_console::{
-    Console, ConsoleConfig, Driver, Geometry, NextHandover, RawFrame, RobotState, next_handover,
-};
+use tandem_console::{Console, ConsoleConfig, Driver, Geometry, RawFrame, RobotState};
 use tandem_planner::AnyController;
 use tandem_realtime::{Controller, Operator};
 use tungstenite::stream::MaybeTlsStream;
@@ -231,9 +229,9 @@ fn base64_decode(s: &str) -> Vec<u8> {
     out
 }
 
-/// What the coordinator said at each tick: its low-confidence robots (1-based) and the plan's
-/// countdown.
-type Truth = Arc<Mutex<HashMap<(u64, u64), (Vec<usize>, Option<NextHandover>)>>>;
+/// What the coordinator said at each tick: its low-confidence robots (1-based) and its
+/// pre-alert (`Tick::next`: the robot, 1-based, and the earliest start, s).
+type Truth = Arc<Mutex<HashMap<(u64, u64), (Vec<usize>, Option<(usize, f64)>)>>>;
 
 /// A user's control loop on `ctl`, one tick every `period`, publishing every tick and
 /// recording the truth; rounds restart when finished. Runs until `stop`.
@@ -265,10 +263,10 @@ fn user_loop(
                 .filter(|&i| raw.robots[i].state == RobotState::Lc)
                 .map(|i| i + 1)
                 .collect();
-            truth
-                .lock()
-                .unwrap()
-                .insert((round, ctl.ticks()), (lc, next_handover(&geometry, &raw)));
+            truth.lock().unwrap().insert(
+                (round, ctl.ticks()),
+                (lc, tick.next.map(|p| (p.robot + 1, p.earliest_s))),
+            );
             handle.publish(&tick, &ctl);
             std::thread::sleep(period);
         }
@@ -372,14 +370,13 @@ fn the_page_shows_the_coordinators_robot_confirms_controls_and_reconnects() {
             None => assert_eq!(v["attention"], "none"),
         }
         match next {
-            Some(n) => {
+            Some((robot, earliest_s)) => {
                 with_next += 1;
-                assert_eq!(v["next_robot"], n.robot.to_string(), "tick {tick}");
+                assert_eq!(v["next_robot"], robot.to_string(), "tick {tick}");
                 let s: f64 = v["next_s"].as_str().unwrap().parse().unwrap();
                 assert!(
-                    (s - n.in_s).abs() <= 0.051,
-                    "tick {tick}: page {s} s, plan {} s",
-                    n.in_s
+                    (s - earliest_s).abs() <= 0.051,
+                    "tick {tick}: page {s} s, the coordinator's pre-alert {earliest_s} s"
                 );
             }
             None => assert_eq!(v["next_robot"], ""),
