@@ -28,6 +28,7 @@ use tokio::sync::{oneshot, watch};
 use crate::error::{Error, Result};
 use crate::frame::{Ack, Geometry, build_frame};
 use crate::handle::{ConsoleHandle, ControlMsg, Op, Shared};
+use crate::strip::Tracker;
 
 /// The page: HTML, CSS and JavaScript in one file, no external resource.
 pub const PAGE: &str = include_str!("page.html");
@@ -111,17 +112,27 @@ struct App {
     controls: SyncSender<ControlMsg>,
     clients: Mutex<Clients>,
     n_robots: usize,
+    /// What the page must be told about the source ([`Console::set_notice`]).
+    notice: Mutex<Option<String>>,
 }
 
 impl App {
     fn clients(&self) -> std::sync::MutexGuard<'_, Clients> {
         self.clients.lock().unwrap_or_else(PoisonError::into_inner)
     }
+
+    fn notice(&self) -> Option<String> {
+        self.notice
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    }
 }
 
 /// A running console: the server thread and its address. Dropping it stops the server.
 #[derive(Debug)]
 pub struct Console {
+    app: Arc<App>,
     url: String,
     addr: SocketAddr,
     stop: Option<oneshot::Sender<()>>,
@@ -166,7 +177,9 @@ impl Console {
             controls: controls_tx,
             clients: Mutex::new(Clients::default()),
             n_robots: geometry.n_robots(),
+            notice: Mutex::new(None),
         });
+        let app_kept = app.clone();
         let rt = tokio::runtime::Builder::new_current_thread()
             .enable_all()
             .build()
@@ -184,6 +197,7 @@ impl Console {
             .map_err(Error::Runtime)?;
         Ok((
             Console {
+                app: app_kept,
                 url: format!("http://{addr}/"),
                 addr,
                 stop: Some(stop_tx),
@@ -197,6 +211,16 @@ impl Console {
     #[must_use]
     pub fn url(&self) -> &str {
         &self.url
+    }
+
+    /// Sets (or clears, `None`) the notice every frame carries to the page from now on (a
+    /// replay's damaged file, its end); it is pushed at the next server period.
+    pub fn set_notice(&self, notice: Option<String>) {
+        *self
+            .app
+            .notice
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = notice;
     }
 
     /// The address the server listens on.
@@ -274,6 +298,8 @@ async fn poller(
     let (mut last_written, mut sent_new, mut seq) = (0u64, 0u64, 0u64);
     let mut last_version = u64::MAX;
     let mut last_controller: Option<String> = None;
+    let mut last_notice: Option<String> = None;
+    let mut tracker = Tracker::new();
     let mut last_push = Instant::now();
     loop {
         interval.tick().await;
@@ -288,6 +314,7 @@ async fn poller(
                 c.controller.clone(),
             )
         };
+        let notice = app.notice();
         let Some((written, raw)) = shared.slot.read() else {
             continue;
         };
@@ -295,6 +322,7 @@ async fn poller(
         if !fresh
             && version == last_version
             && controller == last_controller
+            && notice == last_notice
             && last_push.elapsed() < Duration::from_secs(1)
         {
             continue;
@@ -305,10 +333,17 @@ async fn poller(
         last_written = written;
         last_version = version;
         last_controller.clone_from(&controller);
+        last_notice.clone_from(&notice);
         last_push = Instant::now();
         seq += 1;
         let mut frame = build_frame(&geometry, &raw);
         frame.seq = seq;
+        if fresh {
+            tracker.fill(&geometry, &raw, &mut frame);
+        } else {
+            tracker.fill_again(&mut frame);
+        }
+        frame.notice = notice;
         frame.controller = controller;
         frame.acks = acks;
         frame.health.published = written;
