@@ -56,9 +56,10 @@ pub(crate) fn console(a: &ConsoleArgs) -> Result<()> {
     let ctl = planner
         .controller(a.cell)
         .with_context(|| format!("{}: the {} cell's plan", state.display(), a.cell))?;
+    let schedule = schedule_text(&planner, a.cell)?;
     let mut recorder = match &a.record {
         Some(path) => Some(
-            Recorder::create(path, &Geometry::new(&ctl), ctl.tick_s())
+            Recorder::create(path, &Geometry::new(&ctl), ctl.tick_s(), Some(&schedule))
                 .map_err(|e| anyhow::anyhow!("--record: {e}"))?,
         ),
         None => None,
@@ -85,6 +86,7 @@ pub(crate) fn console(a: &ConsoleArgs) -> Result<()> {
         lead_s: a.lead.unwrap_or_else(|| {
             tandem_console::DEFAULT_LEAD_S.max(planner.params().sampler.switch_s)
         }),
+        schedule: Some(schedule),
         ..ConsoleConfig::default()
     };
     let (console, handle) = Console::start(&config, Geometry::new(&ctl)).map_err(|e| match e {
@@ -113,6 +115,22 @@ pub(crate) fn console(a: &ConsoleArgs) -> Result<()> {
     )?;
     console.stop();
     Ok(())
+}
+
+/// The schedule the cell runs and its certificate in words (the page's health): rounds, the
+/// planner's schedule, its source (certified search or a fallback) and certificate line; the
+/// continuous cell, its cyclic plan.
+fn schedule_text(planner: &Planner, cell: tandem::planner::Cell) -> Result<String> {
+    Ok(match cell {
+        tandem::planner::Cell::Rounds => format!(
+            "{}; {}",
+            crate::gantt::source_name(&planner.outcome().source),
+            crate::gantt::certificate_line(planner.problem(), planner.outcome())?
+        ),
+        tandem::planner::Cell::Continuous => {
+            "the continuous cell's cyclic plan (gate order and token rule)".to_string()
+        }
+    })
 }
 
 /// `--until WHAT:N`.
@@ -164,6 +182,10 @@ fn replay(a: &ConsoleArgs, path: &std::path::Path) -> Result<()> {
         host: a.host,
         port: a.port,
         lead_s,
+        schedule: rec
+            .as_ref()
+            .and_then(|r| r.schedule.as_ref())
+            .map(|s| format!("{s} (recorded)")),
         ..ConsoleConfig::default()
     };
     let (console, handle) = Console::start(&config, geometry)?;
@@ -187,6 +209,7 @@ fn replay(a: &ConsoleArgs, path: &std::path::Path) -> Result<()> {
                 path: path.to_path_buf(),
                 geometry: Geometry::empty(true),
                 tick_s: 0.1,
+                schedule: None,
                 ticks: Vec::new(),
                 problem: Some(failure.unwrap_or_else(|| "no recording".to_string())),
             };

@@ -288,6 +288,11 @@ pub struct Health {
     /// Controls waiting in the loop's queue are not counted; confirmations the loop could not
     /// queue (the server was slower than the loop) are.
     pub acks_lost: u64,
+    /// The schedule the cell runs and its certificate, in words, as the source gave it
+    /// ([`crate::ConsoleConfig::schedule`]), e.g. whether it is the certified plan or a
+    /// fallback.
+    #[serde(default)]
+    pub schedule: Option<String>,
 }
 
 /// One update of the page (server-sent event `frame`; docs/formats.md, "Console frames").

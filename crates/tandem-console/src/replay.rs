@@ -41,6 +41,9 @@ struct Header {
     n_robots: usize,
     tick_s: f64,
     geometry: Geometry,
+    /// The schedule and its certificate, in words (the page's health).
+    #[serde(default)]
+    schedule: Option<String>,
 }
 
 /// One robot of a recorded tick.
@@ -134,11 +137,17 @@ pub struct Recorder {
 
 impl Recorder {
     /// Creates `path` (refusing an existing file) and writes the header of the cell of
-    /// `geometry` ticked every `tick_s` s.
+    /// `geometry` ticked every `tick_s` s, running the schedule described by `schedule` (its
+    /// source and certificate in words, shown in the page's health), if known.
     ///
     /// # Errors
     /// [`Error::Recording`] when the file exists or cannot be written.
-    pub fn create(path: impl AsRef<Path>, geometry: &Geometry, tick_s: f64) -> Result<Recorder> {
+    pub fn create(
+        path: impl AsRef<Path>,
+        geometry: &Geometry,
+        tick_s: f64,
+        schedule: Option<&str>,
+    ) -> Result<Recorder> {
         let path = path.as_ref().to_path_buf();
         let err = |why: String| Error::Recording {
             path: path.display().to_string(),
@@ -167,6 +176,7 @@ impl Recorder {
             n_robots: geometry.n_robots(),
             tick_s,
             geometry: geometry.clone(),
+            schedule: schedule.map(str::to_string),
         };
         let mut rec = Recorder {
             out: BufWriter::new(file),
@@ -270,6 +280,8 @@ pub struct Recording {
     pub geometry: Geometry,
     /// Control period (s).
     pub tick_s: f64,
+    /// The schedule and its certificate, in words, if the recording says.
+    pub schedule: Option<String>,
     /// Every tick read, in order.
     pub ticks: Vec<RecordedTick>,
     /// What stopped the reading before the end of the file (a damaged or truncated line), if
@@ -406,6 +418,7 @@ pub fn read_recording(path: impl AsRef<Path>) -> Result<Recording> {
         path,
         geometry: header.geometry,
         tick_s: header.tick_s,
+        schedule: header.schedule,
         ticks,
         problem,
     })

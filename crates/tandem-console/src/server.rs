@@ -53,6 +53,9 @@ pub struct ConsoleConfig {
     pub lead_s: f64,
     /// The timeline's horizon (s). Default: [`crate::DEFAULT_HORIZON_S`] (90 s).
     pub horizon_s: f64,
+    /// The schedule the cell runs and its certificate, in words (health: certified plan or
+    /// fallback), if the source knows it. Default: `None`.
+    pub schedule: Option<String>,
 }
 
 impl Default for ConsoleConfig {
@@ -63,6 +66,7 @@ impl Default for ConsoleConfig {
             max_hz: 30.0,
             lead_s: crate::DEFAULT_LEAD_S,
             horizon_s: crate::DEFAULT_HORIZON_S,
+            schedule: None,
         }
     }
 }
@@ -186,11 +190,12 @@ impl Console {
             .map_err(Error::Runtime)?;
         let (stop_tx, stop_rx) = oneshot::channel::<()>();
         let period = Duration::from_secs_f64(1.0 / config.max_hz);
+        let schedule = config.schedule.clone();
         let thread = std::thread::Builder::new()
             .name("tandem-console".into())
             .spawn(move || {
                 rt.block_on(serve(
-                    listener, app, shared, geometry, frames_tx, acks_rx, period, stop_rx,
+                    listener, app, shared, geometry, schedule, frames_tx, acks_rx, period, stop_rx,
                 ));
                 rt.shutdown_timeout(Duration::from_millis(200));
             })
@@ -256,6 +261,7 @@ async fn serve(
     app: Arc<App>,
     shared: Arc<Shared>,
     geometry: Geometry,
+    schedule: Option<String>,
     frames_tx: watch::Sender<Arc<str>>,
     acks_rx: Receiver<Ack>,
     period: Duration,
@@ -274,7 +280,7 @@ async fn serve(
         .route("/frame", get(latest))
         .route("/control", post(control))
         .with_state(app.clone());
-    let poll = poller(app, shared, geometry, frames_tx, acks_rx, period);
+    let poll = poller(app, shared, geometry, schedule, frames_tx, acks_rx, period);
     let server = axum::serve(listener, router);
     tokio::select! {
         r = server => if let Err(e) = r { eprintln!("console: server stopped: {e}") },
@@ -289,6 +295,7 @@ async fn poller(
     app: Arc<App>,
     shared: Arc<Shared>,
     geometry: Geometry,
+    schedule: Option<String>,
     frames_tx: watch::Sender<Arc<str>>,
     acks_rx: Receiver<Ack>,
     period: Duration,
@@ -347,6 +354,7 @@ async fn poller(
         frame.controller = controller;
         frame.acks = acks;
         frame.health.published = written;
+        frame.health.schedule.clone_from(&schedule);
         frame.health.dropped = written.saturating_sub(sent_new);
         frame.health.acks_lost = shared.acks_lost.load(Ordering::Relaxed);
         frame.health.source_age_s = (unix_ms() - raw.published_unix_ms).max(0.0) / 1e3;

@@ -287,6 +287,7 @@ struct Cell {
 fn start(ctl: AnyController, port: u16, period: Duration) -> Cell {
     let config = ConsoleConfig {
         port,
+        schedule: Some("hand-made plan: robots 4 s apart (tests/support)".to_string()),
         ..ConsoleConfig::default()
     };
     let (console, handle) = Console::start(&config, Geometry::new(&ctl)).unwrap();
@@ -462,6 +463,12 @@ fn screenshot_of_a_three_robot_cell() {
          window.__lastFrame.next && window.__lastFrame.attention.left_s > 2",
         Duration::from_secs(60),
     );
+    // Tall enough for the controls and the health line under the strips.
+    b.call(
+        "Emulation.setDeviceMetricsOverride",
+        json!({ "width": 1280, "height": 960, "deviceScaleFactor": 1, "mobile": false }),
+    );
+    std::thread::sleep(Duration::from_millis(300));
     b.screenshot(std::path::Path::new(&path));
     cell.stop();
 }

@@ -30,7 +30,8 @@ fn scratch(name: &str) -> PathBuf {
 /// continuous cell runs until its robots completed `tasks` tasks together).
 fn record(ctl: &mut AnyController, path: &std::path::Path, rounds: u64, tasks: u64) -> u64 {
     let is_rounds = matches!(ctl, AnyController::Rounds(_));
-    let mut rec = Recorder::create(path, &Geometry::new(ctl), ctl.tick_s()).unwrap();
+    let mut rec =
+        Recorder::create(path, &Geometry::new(ctl), ctl.tick_s(), Some("hand-made")).unwrap();
     rec.record(&tick_now(ctl), ctl, is_rounds, 0).unwrap();
     let (mut done, mut ticks) = (0u64, 0u64);
     loop {
@@ -123,7 +124,7 @@ fn a_damaged_recording_reads_up_to_its_damage_and_says_where() {
     let text = std::fs::read_to_string(&path).unwrap();
     let lines = text.lines().count();
     // A recording never overwrites a file.
-    let err = Recorder::create(&path, &Geometry::new(&ctl), 0.1)
+    let err = Recorder::create(&path, &Geometry::new(&ctl), 0.1, None)
         .unwrap_err()
         .to_string();
     assert!(err.contains("never overwrites"), "{err}");
