@@ -164,7 +164,7 @@ fn replay(a: &ConsoleArgs, path: &std::path::Path) -> Result<()> {
         let rec = rec.map_err(|e| anyhow::anyhow!("--replay: {e}"))?;
         if let Some(p) = &rec.problem {
             note(&format!(
-                "console: recording {} is damaged: {p}; checked the {} ticks before it",
+                "console: recording {} is damaged: {p}; checked the {} frames before it",
                 rec.path.display(),
                 rec.ticks.len()
             ));
@@ -194,7 +194,7 @@ fn replay(a: &ConsoleArgs, path: &std::path::Path) -> Result<()> {
     match (rec, failure) {
         (Some(rec), _) => {
             note(&format!(
-                "console: replaying {} ({} ticks, {} robots) at ×{}; open {} (Ctrl-C stops)",
+                "console: replaying {} ({} frames, {} robots) at ×{}; open {} (Ctrl-C stops)",
                 rec.path.display(),
                 rec.ticks.len(),
                 rec.geometry.n_robots(),

@@ -457,7 +457,7 @@ pub fn replay(
             format!("cannot replay {}: {p}", rec.path.display())
         } else {
             format!(
-                "recording {} is damaged: {p}; replaying the {} ticks before it",
+                "recording {} is damaged: {p}; replaying the {} frames before it",
                 rec.path.display(),
                 rec.ticks.len()
             )

@@ -308,4 +308,39 @@ mod tests {
         assert_eq!((s.stretches, s.supervised_s, s.rate), (0, 0.0, None));
         assert!(s.confident, "no plan: confident");
     }
+
+    #[test]
+    fn warp_rate_by_hand() {
+        use tandem_planner::AnyController;
+        use tandem_realtime::{Coordinator, Timeline};
+        // One robot, 100 samples of 0.1 s, bounds ψ̇ ∈ [½, 2], confident everywhere.
+        let t = Timeline::new(
+            &[true; 100],
+            &[1.0; 100],
+            &[0.5; 100],
+            &[2.0; 100],
+            0.0,
+            0.1,
+        )
+        .unwrap();
+        let g = Geometry::new(&AnyController::Rounds(
+            Coordinator::new(vec![t], 0.1).unwrap(),
+        ));
+        let mut tr = Tracker::new();
+        let mut at = |tick: u64, r: f64| {
+            tr.update(&g, &raw(tick, &[RobotState::Hc], &[r]))
+                .0
+                .remove(0)
+        };
+        // Half a sample per 0.1 s tick: 1 s of cell time per 5 samples of 0.1 s, ψ̇ = 2.
+        at(0, 0.0);
+        let s = at(10, 5.0);
+        assert!((s.rate.unwrap() - 2.0).abs() < 1e-9, "{s:?}");
+        assert_eq!(s.rate_bounds, Some((0.5, 2.0)));
+        assert!(s.rate_ok && s.confident);
+        // A quarter sample per tick: ψ̇ = 4, out of bounds.
+        let s = at(20, 7.5);
+        assert!((s.rate.unwrap() - 4.0).abs() < 1e-9, "{s:?}");
+        assert!(!s.rate_ok);
+    }
 }
