@@ -246,6 +246,11 @@ pub struct RobotFrame {
     pub progress: f64,
     /// Tasks it completed.
     pub tasks: u64,
+    /// The per-robot strip ([`crate::RobotStrip`]): warp rate within its bounds, confidence
+    /// at the current sample, supervision this execution. Filled by the server from
+    /// successive snapshots; default in [`build_frame`]'s output.
+    #[serde(default)]
+    pub strip: crate::RobotStrip,
 }
 
 /// The robot that may need the operator now (the banner).
@@ -314,6 +319,11 @@ pub struct Health {
     /// Controls waiting in the loop's queue are not counted; confirmations the loop could not
     /// queue (the server was slower than the loop) are.
     pub acks_lost: u64,
+    /// The schedule the cell runs and its certificate, in words, as the source gave it
+    /// ([`crate::ConsoleConfig::schedule`]), e.g. whether it is the certified plan or a
+    /// fallback.
+    #[serde(default)]
+    pub schedule: Option<String>,
 }
 
 /// One update of the page (server-sent event `frame`; docs/formats.md, "Console frames").
@@ -358,10 +368,18 @@ pub struct Frame {
     pub health: Health,
     /// When the loop published the snapshot (ms since the Unix epoch).
     pub published_unix_ms: f64,
+    /// The operator's strip ([`crate::OperatorStrip`]): busy share, switches per hour,
+    /// longest busy stretch, time on shift. Filled by the server.
+    #[serde(default)]
+    pub operator: crate::OperatorStrip,
+    /// A message about the source the page must show (a replay's corrupt or truncated file,
+    /// a replay that ended), if any.
+    #[serde(default)]
+    pub notice: Option<String>,
 }
 
 /// One robot's plan as the page needs it: its low-confidence runs and clock.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 struct RobotGeometry {
     /// `c_n`, `n ∈ 0..=T_ref` (s): the schedule clock at which sample `n` starts.
     clock: Vec<f64>,
@@ -369,6 +387,13 @@ struct RobotGeometry {
     runs: Vec<(usize, usize)>,
     /// `W[n] = Σ_{k<n} ψ̇max[k]·Δt_s`: the slowest time to sample `n` (s).
     worst: Vec<f64>,
+    /// `ψ̇min[n]`, `ψ̇max[n]`: the warp rate's bounds per reference sample (execution
+    /// samples per reference sample). Empty in recordings without them.
+    #[serde(default)]
+    rate_bounds: Vec<(f64, f64)>,
+    /// Reference sample period Δt_s (s); 0 in recordings without it.
+    #[serde(default)]
+    dt_s: f64,
 }
 
 impl RobotGeometry {
@@ -398,6 +423,13 @@ impl RobotGeometry {
             clock: t.sample_clock_s().to_vec(),
             runs,
             worst,
+            rate_bounds: t
+                .grad_min()
+                .iter()
+                .zip(t.grad_max())
+                .map(|(&lo, &hi)| (lo, hi))
+                .collect(),
+            dt_s: t.dt_s(),
         }
     }
 
@@ -420,8 +452,9 @@ impl RobotGeometry {
 
 /// The plan of a cell as the console reads it: every robot's low-confidence runs, schedule
 /// clock and slowest times (built once from the controller, before the loop starts), the
-/// pre-alert's lead and the timeline's horizon.
-#[derive(Clone, Debug)]
+/// pre-alert's lead and the timeline's horizon. Serializable: a replay's recording carries it
+/// (docs/formats.md, "Console recordings").
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Geometry {
     rounds: bool,
     robots: Vec<RobotGeometry>,
@@ -429,6 +462,8 @@ pub struct Geometry {
     task_span_s: (f64, f64),
     can_hold: bool,
     /// The operator's switch time the controller keeps (real s: its whole ticks; 0: none).
+    /// A recording written before it was kept reads as 0.
+    #[serde(default)]
     switch_s: f64,
     /// Pre-alert lead (real s): [`Console::start`](crate::Console::start) sets the larger of
     /// the configured lead and the switch time.
@@ -496,6 +531,46 @@ impl Geometry {
     #[must_use]
     pub fn can_hold(&self) -> bool {
         self.can_hold
+    }
+
+    /// A geometry of no robot: the console of a source that could not be read (a replay
+    /// whose header is corrupt) shows only its notice.
+    #[must_use]
+    pub fn empty(rounds: bool) -> Geometry {
+        Geometry {
+            rounds,
+            robots: Vec::new(),
+            task_span_s: (0.0, 0.0),
+            can_hold: false,
+            switch_s: 0.0,
+            lead_s: DEFAULT_LEAD_S,
+            horizon_s: DEFAULT_HORIZON_S,
+        }
+    }
+
+    /// Whether robot `i` (0-based) is confident (high-confidence) at reference time
+    /// `ref_time` of its task: the sample is outside its low-confidence runs.
+    #[must_use]
+    pub fn confident_at(&self, i: usize, ref_time: f64) -> bool {
+        let n = ref_time.floor().max(0.0) as usize;
+        self.robots
+            .get(i)
+            .is_none_or(|g| !g.runs.iter().any(|&(s, e)| s <= n && n < e))
+    }
+
+    /// Robot `i`'s warp-rate bounds `(ψ̇min, ψ̇max)` at reference time `ref_time` (execution
+    /// samples per reference sample), if the plan carries them.
+    #[must_use]
+    pub fn rate_bounds_at(&self, i: usize, ref_time: f64) -> Option<(f64, f64)> {
+        let g = self.robots.get(i)?;
+        let n = (ref_time.floor().max(0.0) as usize).min(g.rate_bounds.len().checked_sub(1)?);
+        g.rate_bounds.get(n).copied()
+    }
+
+    /// Robot `i`'s reference sample period Δt_s (s), if the plan carries it.
+    #[must_use]
+    pub fn dt_s(&self, i: usize) -> Option<f64> {
+        self.robots.get(i).map(|g| g.dt_s).filter(|d| *d > 0.0)
     }
 
     /// The robot low-confidence now and the worst-case time left in its stretch.
@@ -657,6 +732,7 @@ pub fn build_frame(geometry: &Geometry, raw: &RawFrame) -> Frame {
                     (r.ref_time / n_ref as f64).clamp(0.0, 1.0)
                 },
                 tasks: r.tasks,
+                strip: crate::RobotStrip::default(),
             }
         })
         .collect();
@@ -686,6 +762,8 @@ pub fn build_frame(geometry: &Geometry, raw: &RawFrame) -> Frame {
         acks: Vec::new(),
         health: Health::default(),
         published_unix_ms: raw.published_unix_ms,
+        operator: crate::OperatorStrip::default(),
+        notice: None,
     }
 }
 

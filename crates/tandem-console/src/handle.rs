@@ -229,6 +229,12 @@ impl ConsoleHandle {
         self.published
     }
 
+    /// Publishes a snapshot as it is (a replay's recorded tick): the same slot as
+    /// [`publish`](Self::publish).
+    pub(crate) fn publish_raw(&mut self, raw: &RawFrame) {
+        self.shared.slot.write(raw);
+    }
+
     /// The next control message the operator sent, if any (never blocks). Apply it at a tick
     /// boundary and [`confirm`](Self::confirm) it; [`Driver::apply`] does both. With no message
     /// waiting it costs one atomic load.
