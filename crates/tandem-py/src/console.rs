@@ -130,6 +130,8 @@ impl PyConsole {
             max_hz,
             lead_s: lead_s.unwrap_or(DEFAULT_LEAD_S),
             horizon_s,
+            // A coordinator does not say which schedule it runs: the page's health shows none.
+            schedule: None,
         };
         let geometry = Geometry::new(&ctl);
         let (rounds, n_robots) = (geometry.is_rounds(), geometry.n_robots());
