@@ -20,6 +20,9 @@ NumPy arrays in and out (docs/python.md):
 - :meth:`Planner.plan` / :meth:`Planner.controller` with ``cell="rounds"`` or
   ``"continuous"``: the plan of either kind of cell and its run-time coordinator (a
   :class:`Controller`), both at the schedule's control tick.
+- :class:`Console`: the operator's console (a local web page: which robot needs the operator
+  now, the coordinator's pre-alert of the next) fed by your own loop: :meth:`Console.apply`
+  the operator's controls at each tick boundary, :meth:`Console.publish` each tick.
 - :mod:`tandem.study`: the simulated study of §III; :mod:`tandem.sim`: its workcell.
 - :func:`align`: GDTW time warping (Eq. 2–3).
 - :func:`read_bag`: a ROS 2 bag (rosbag2 MCAP) on one grid; :func:`fit` takes ``.mcap`` paths.
@@ -37,6 +40,7 @@ from ._tandem import (
     N_ROBOTS,
     CellTick,
     Confidence,
+    Console,
     ContinuousCoordinator,
     Coordinator,
     CyclicPlan,
@@ -87,6 +91,7 @@ __all__ = [
     "N_ROBOTS",
     "CellTick",
     "Confidence",
+    "Console",
     "ContinuousCoordinator",
     "Controller",
     "Coordinator",

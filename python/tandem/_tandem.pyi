@@ -497,6 +497,40 @@ class CellTick:
     def next(self) -> Optional[Dict[str, Any]]:
         """The pre-alert: ``{"robot", "earliest_s", "latest_s"}`` or ``None``."""
 
+class Console:
+    """The operator's console of your own control loop: a local web page at ``url``."""
+
+    def __init__(
+        self,
+        controller: Union[Coordinator, ContinuousCoordinator],
+        port: int = 0,
+        host: str = "127.0.0.1",
+        lead_s: Optional[float] = None,
+        max_hz: float = 30.0,
+        horizon_s: float = 90.0,
+    ) -> None:
+        """Starts the server; ``InputError``/``ParamError`` for a bad argument or a taken port."""
+    @property
+    def url(self) -> str: ...
+    @property
+    def port(self) -> int: ...
+    def apply(self, controller: Union[Coordinator, ContinuousCoordinator]) -> bool:
+        """Applies the operator's controls at a tick boundary; ``False`` while paused."""
+    def publish(
+        self, tick: Union[Tick, CellTick], controller: Union[Coordinator, ContinuousCoordinator]
+    ) -> None:
+        """Hands the state after ``tick`` to the page (never blocks)."""
+    def round_done(self) -> None: ...
+    @property
+    def paused(self) -> bool: ...
+    @property
+    def published(self) -> int: ...
+    @property
+    def running(self) -> bool: ...
+    def close(self) -> None: ...
+    def __enter__(self) -> "Console": ...
+    def __exit__(self, *args: Any) -> bool: ...
+
 class Schedule:
     """Execution warps ``(N, T_ref)``, ``N − 1`` start offsets and the control tick."""
 

@@ -194,11 +194,23 @@ pub(crate) enum Command {
     /// --need, every low-confidence sample needs the operator. Runs until interrupted; the
     /// state file is not modified. The page's DOM and the frame format: docs/formats.md.
     ///
+    /// --record FILE writes every tick of the simulated cell into a console recording
+    /// (JSON Lines, docs/formats.md); with --until (`ticks:N`, `rounds:N`, `tasks:N`) the
+    /// cell runs as fast as it can, without a server, until then. --replay FILE|DIR plays a
+    /// recording on the same page at --speed (no state file needed); a damaged or truncated
+    /// recording plays up to its damage and the page and the log say so. --check with
+    /// --replay prints, as JSON, what the page showed on every tick against the coordinator
+    /// (frames with two robots `lc`, frames whose `lc` robot is not the coordinator's, the
+    /// pre-alert's notice before each low-confidence stretch) and exits.
+    ///
     /// Example:
     ///
     ///   tandem console cell.tandem --simulate
     ///   tandem console cell.tandem --simulate --cell continuous --speed 2 --port 8080
     ///   tandem console cell.tandem --simulate --robots 3 --need need.csv
+    ///   tandem console cell.tandem --simulate --record run.jsonl --until rounds:10
+    ///   tandem console --replay run.jsonl --speed 4
+    ///   tandem console --replay run.jsonl --check
     #[command(verbatim_doc_comment)]
     Console(ConsoleArgs),
     /// Run the state file's coordinator live as a ROS 2 node (built with `--features ros2`).
@@ -224,11 +236,24 @@ pub(crate) enum Command {
 /// `tandem console`.
 #[derive(Debug, Args)]
 pub(crate) struct ConsoleArgs {
-    /// The state file (read only).
-    pub(crate) state: PathBuf,
-    /// Run a simulated cell from the state file (the one source the command line has).
+    /// The state file (read only); not with --replay.
+    pub(crate) state: Option<PathBuf>,
+    /// Run a simulated cell from the state file.
     #[arg(long)]
     pub(crate) simulate: bool,
+    /// Replay a console recording (a file, or a directory holding console.jsonl).
+    #[arg(long, value_name = "FILE|DIR", conflicts_with_all = ["simulate", "state"])]
+    pub(crate) replay: Option<PathBuf>,
+    /// With --replay: print what the page showed against the coordinator (JSON) and exit.
+    #[arg(long, requires = "replay")]
+    pub(crate) check: bool,
+    /// With --simulate: write every tick into this new console recording.
+    #[arg(long, value_name = "FILE", requires = "simulate")]
+    pub(crate) record: Option<PathBuf>,
+    /// With --record: run as fast as possible without a server until `ticks:N`,
+    /// `rounds:N` (rounds cells) or `tasks:N` (continuous cells: tasks of all robots).
+    #[arg(long, value_name = "WHAT:N", requires = "record")]
+    pub(crate) until: Option<String>,
     /// Robots of the simulated cell. Default: the state's. Another count is planned from the
     /// state's model, only for a state with no recorded round.
     #[arg(long, value_name = "N")]

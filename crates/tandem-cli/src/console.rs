@@ -10,8 +10,12 @@ use std::sync::atomic::AtomicBool;
 use anyhow::{Context, Result, bail};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use tandem::realtime::Controller;
 use tandem::{Planner, derive_seed};
-use tandem_console::{Console, ConsoleConfig, Geometry, SimParams, simulate};
+use tandem_console::{
+    Console, ConsoleConfig, Geometry, Recorder, SimParams, Until, check_recording, read_recording,
+    record_sim, simulate_recorded,
+};
 
 use crate::cli::ConsoleArgs;
 use crate::cmd::{note, out};
@@ -19,14 +23,19 @@ use crate::{input, state_io};
 
 /// Runs `tandem console`.
 pub(crate) fn console(a: &ConsoleArgs) -> Result<()> {
-    if !a.simulate {
-        bail!(
-            "tandem console needs a source: --simulate (a simulated cell from the state file); \
-             a live control loop feeds a console through tandem_console::ConsoleHandle"
-        );
+    if let Some(path) = &a.replay {
+        return replay(a, path);
     }
-    let planner = state_io::load(&a.state)?;
-    let planner = with_robots(planner, a.robots, &a.state)?;
+    let Some(state) = a.state.as_ref().filter(|_| a.simulate) else {
+        bail!(
+            "tandem console needs a source: STATE --simulate (a simulated cell from the state \
+             file) or --replay FILE|DIR (a console recording); a live control loop feeds a \
+             console through tandem_console::ConsoleHandle"
+        );
+    };
+    let until = a.until.as_deref().map(parse_until).transpose()?;
+    let planner = state_io::load(state)?;
+    let planner = with_robots(planner, a.robots, state)?;
     let params = SimParams {
         cell: a.cell,
         speed: a.speed,
@@ -46,13 +55,38 @@ pub(crate) fn console(a: &ConsoleArgs) -> Result<()> {
     };
     let ctl = planner
         .controller(a.cell)
-        .with_context(|| format!("{}: the {} cell's plan", a.state.display(), a.cell))?;
+        .with_context(|| format!("{}: the {} cell's plan", state.display(), a.cell))?;
+    let schedule = schedule_text(&planner, a.cell)?;
+    let mut recorder = match &a.record {
+        Some(path) => Some(
+            Recorder::create(path, &Geometry::new(&ctl), ctl.tick_s(), Some(&schedule))
+                .map_err(|e| anyhow::anyhow!("--record: {e}"))?,
+        ),
+        None => None,
+    };
+    if let (Some(until), Some(rec)) = (until, recorder.as_mut()) {
+        let ticks =
+            record_sim(&planner, ctl, &params, needed, until, rec).map_err(|e| match e {
+                tandem_console::Error::BadParam { name: "until", why } => {
+                    anyhow::anyhow!("--until {}: {why}", a.until.as_deref().unwrap_or_default())
+                }
+                e => e.into(),
+            })?;
+        note(&format!(
+            "console: recorded {ticks} ticks into {}",
+            a.record
+                .as_ref()
+                .map_or(String::new(), |p| p.display().to_string())
+        ));
+        return Ok(());
+    }
     let config = ConsoleConfig {
         host: a.host,
         port: a.port,
         lead_s: a.lead.unwrap_or_else(|| {
             tandem_console::DEFAULT_LEAD_S.max(planner.params().sampler.switch_s)
         }),
+        schedule: Some(schedule),
         ..ConsoleConfig::default()
     };
     let (console, handle) = Console::start(&config, Geometry::new(&ctl)).map_err(|e| match e {
@@ -70,7 +104,118 @@ pub(crate) fn console(a: &ConsoleArgs) -> Result<()> {
         console.url()
     ));
     let stop = AtomicBool::new(false);
-    simulate(&planner, ctl, &params, needed, handle, &stop)?;
+    simulate_recorded(
+        &planner,
+        ctl,
+        &params,
+        needed,
+        handle,
+        recorder.as_mut(),
+        &stop,
+    )?;
+    console.stop();
+    Ok(())
+}
+
+/// The schedule the cell runs and its certificate in words (the page's health): rounds, the
+/// planner's schedule, its source (certified search or a fallback) and certificate line; the
+/// continuous cell, its cyclic plan.
+fn schedule_text(planner: &Planner, cell: tandem::planner::Cell) -> Result<String> {
+    Ok(match cell {
+        tandem::planner::Cell::Rounds => format!(
+            "{}; {}",
+            crate::gantt::source_name(&planner.outcome().source),
+            crate::gantt::certificate_line(planner.problem(), planner.outcome())?
+        ),
+        tandem::planner::Cell::Continuous => {
+            "the continuous cell's cyclic plan (gate order and token rule)".to_string()
+        }
+    })
+}
+
+/// `--until WHAT:N`.
+fn parse_until(text: &str) -> Result<Until> {
+    let bad = || {
+        anyhow::anyhow!(
+            "--until {text}: expected ticks:N, rounds:N or tasks:N with N a whole number > 0"
+        )
+    };
+    let (what, n) = text.split_once(':').ok_or_else(bad)?;
+    let n: u64 = n.trim().parse().map_err(|_| bad())?;
+    if n == 0 {
+        return Err(bad());
+    }
+    match what.trim() {
+        "ticks" => Ok(Until::Ticks(n)),
+        "rounds" => Ok(Until::Rounds(n)),
+        "tasks" => Ok(Until::Tasks(n)),
+        _ => Err(bad()),
+    }
+}
+
+/// `tandem console --replay FILE|DIR [--check]`.
+fn replay(a: &ConsoleArgs, path: &std::path::Path) -> Result<()> {
+    if !(a.speed > 0.0 && a.speed <= 1000.0) {
+        bail!("--speed {}: must be in (0, 1000]", a.speed);
+    }
+    let rec = read_recording(path);
+    let lead_s = a.lead.unwrap_or(tandem_console::DEFAULT_LEAD_S);
+    if a.check {
+        let rec = rec.map_err(|e| anyhow::anyhow!("--replay: {e}"))?;
+        if let Some(p) = &rec.problem {
+            note(&format!(
+                "console: recording {} is damaged: {p}; checked the {} frames before it",
+                rec.path.display(),
+                rec.ticks.len()
+            ));
+        }
+        let check = check_recording(&rec, lead_s);
+        out(&serde_json::to_string_pretty(&check)?);
+        return Ok(());
+    }
+    // An unreadable recording still serves the page, which says what is wrong.
+    let (geometry, rec, failure) = match rec {
+        Ok(r) => (r.geometry.clone(), Some(r), None),
+        Err(e) => (Geometry::empty(true), None, Some(e.to_string())),
+    };
+    let config = ConsoleConfig {
+        host: a.host,
+        port: a.port,
+        lead_s,
+        schedule: rec
+            .as_ref()
+            .and_then(|r| r.schedule.as_ref())
+            .map(|s| format!("{s} (recorded)")),
+        ..ConsoleConfig::default()
+    };
+    let (console, handle) = Console::start(&config, geometry)?;
+    out(console.url());
+    let stop = AtomicBool::new(false);
+    match (rec, failure) {
+        (Some(rec), _) => {
+            note(&format!(
+                "console: replaying {} ({} frames, {} robots) at ×{}; open {} (Ctrl-C stops)",
+                rec.path.display(),
+                rec.ticks.len(),
+                rec.geometry.n_robots(),
+                a.speed,
+                console.url()
+            ));
+            tandem_console::replay(&rec, a.speed, &console, handle, &stop)?;
+        }
+        (None, failure) => {
+            note(&format!("console: open {} (Ctrl-C stops)", console.url()));
+            let empty = tandem_console::Recording {
+                path: path.to_path_buf(),
+                geometry: Geometry::empty(true),
+                tick_s: 0.1,
+                schedule: None,
+                ticks: Vec::new(),
+                problem: Some(failure.unwrap_or_else(|| "no recording".to_string())),
+            };
+            tandem_console::replay(&empty, 1.0, &console, handle, &stop)?;
+        }
+    }
     console.stop();
     Ok(())
 }

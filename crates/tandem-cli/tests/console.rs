@@ -98,13 +98,88 @@ fn the_url_comes_first_and_the_page_shows_the_states_cell() {
 }
 
 #[test]
+fn a_recorded_run_replays_and_checks() {
+    let dir = scratch("console-record");
+    let state = small_state(&dir);
+    let rec = dir.join("run.jsonl");
+    let out = tandem([
+        "console",
+        state.to_str().unwrap(),
+        "--simulate",
+        "--cell",
+        "continuous",
+        "--robots",
+        "3",
+        "--record",
+        rec.to_str().unwrap(),
+        "--until",
+        "tasks:30",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = tandem(["console", "--replay", rec.to_str().unwrap(), "--check"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let check: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(check["frames"].as_u64().unwrap() > 100, "{check}");
+    assert_eq!(check["two_lc"], 0, "{check}");
+    assert_eq!(check["lc_differs"], 0, "{check}");
+    assert!(check["stretches"].as_u64().unwrap() >= 30, "{check}");
+}
+
+#[test]
 fn bad_console_input_exits_2_with_the_reason() {
     let dir = scratch("console-bad");
     let state = small_state(&dir);
     let s = state.to_str().unwrap();
-    let cases: [(&[&str], &str); 5] = [
+    let rec = dir.join("run.jsonl");
+    let r = rec.to_str().unwrap();
+    let cases: [(&[&str], &str); 11] = [
         (&["console", s, "--simulate", "--lead=-1"], "--lead -1"),
-        (&["console", s], "needs a source: --simulate"),
+        (&["console", s], "needs a source: STATE --simulate"),
+        (
+            &[
+                "console",
+                s,
+                "--simulate",
+                "--record",
+                r,
+                "--until",
+                "laps:3",
+            ],
+            "--until laps:3: expected ticks:N, rounds:N or tasks:N",
+        ),
+        (
+            &[
+                "console",
+                s,
+                "--simulate",
+                "--record",
+                r,
+                "--until",
+                "tasks:3",
+            ],
+            "--until tasks:3: counts tasks, and a rounds cell counts rounds",
+        ),
+        (
+            &["console", "--replay", "missing.jsonl", "--check"],
+            "cannot open the recording",
+        ),
+        (
+            &["console", "--replay", s, "--check"],
+            "not a console recording",
+        ),
+        (
+            &["console", s, "--simulate", "--replay", r],
+            "cannot be used with",
+        ),
+        (&["console", "--replay", r, "--speed", "0"], "--speed 0"),
         (&["console", s, "--simulate", "--speed", "0"], "--speed 0"),
         (&["console", s, "--simulate", "--robots", "9"], "--robots 9"),
         (
@@ -118,6 +193,22 @@ fn bad_console_input_exits_2_with_the_reason() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(want), "{args:?}: {err}");
     }
+    // A recording never overwrites a file.
+    let out = tandem([
+        "console",
+        s,
+        "--simulate",
+        "--record",
+        s,
+        "--until",
+        "ticks:5",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--record") && err.contains("never overwrites"),
+        "{err}"
+    );
     // A state holding recorded rounds keeps its robot count.
     let golden = concat!(
         env!("CARGO_MANIFEST_DIR"),

@@ -25,6 +25,14 @@ pub enum Error {
         /// What it must be.
         why: &'static str,
     },
+    /// A console recording (a replay's file) could not be read or written.
+    #[error("{path}: {why}")]
+    Recording {
+        /// The file, with `:LINE` where one line is at fault.
+        path: String,
+        /// What is wrong and what to do.
+        why: String,
+    },
     /// The planner could not make the cell's plan or controller.
     #[error(transparent)]
     Planner(#[from] tandem_planner::Error),

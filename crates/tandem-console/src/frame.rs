@@ -9,7 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 use tandem_planner::AnyController;
-use tandem_realtime::{Controller, MAX_ROBOTS, Tick, Timeline};
+use tandem_realtime::{Controller, MAX_ROBOTS, PreAlert, Tick, Timeline};
 
 /// A robot's state on the page (`data-state` in the DOM), by precedence: a robot held by the
 /// fault monitor is `fault`; a robot done with its task in a round is `done`; the robot the
@@ -107,14 +107,24 @@ pub struct RawFrame {
     /// Whether a fault is latched.
     pub fault: bool,
     /// When the loop published it: milliseconds since the Unix epoch (for the latency from a
-    /// tick to the page).
+    /// tick to the page). Stamped by [`ConsoleHandle::publish`](crate::ConsoleHandle::publish)
+    /// only for a snapshot the server asked for, never per tick.
     pub published_unix_ms: f64,
+    /// The coordinator's pre-alert after the tick ([`Tick::next`]): the robot whose next
+    /// low-confidence stretch can start soonest and the worst-case bounds on that start (real
+    /// s from the end of the tick). The page's countdown.
+    pub next: Option<PreAlert>,
+    /// Snapshots the loop handed to the handle so far, this one included (the server sends
+    /// at most `max_hz` of them a second: the rest are dropped).
+    pub published: u64,
     /// Each robot, robot `i` at index `i` (the first `n` are meaningful).
     pub robots: [RawRobot; MAX_ROBOTS],
 }
 
-/// Words of a [`RawFrame`] in the slot: 8 of the header, 4 per robot.
-pub(crate) const WORDS: usize = 8 + 4 * MAX_ROBOTS;
+/// Words of a [`RawFrame`]'s header in the slot.
+pub(crate) const HEADER: usize = 11;
+/// Words of a [`RawFrame`] in the slot: [`HEADER`], then 4 per robot.
+pub(crate) const WORDS: usize = HEADER + 4 * MAX_ROBOTS;
 
 impl RawFrame {
     /// The snapshot of `ctl` after `tick` (`rounds`: the cell runs in rounds, where a robot
@@ -155,6 +165,7 @@ impl RawFrame {
             tick: ctl.ticks(),
             tick_s: ctl.tick_s(),
             fault: tick.fault.is_some(),
+            next: tick.next,
             robots,
             ..RawFrame::default()
         }
@@ -163,7 +174,13 @@ impl RawFrame {
     pub(crate) fn encode(&self, out: &mut [u64; WORDS]) {
         let flags = u64::from(self.paused)
             | u64::from(self.fault) << 1
-            | u64::from(self.hold_armed.is_some()) << 2;
+            | u64::from(self.hold_armed.is_some()) << 2
+            | u64::from(self.next.is_some()) << 3;
+        let next = self.next.unwrap_or(PreAlert {
+            robot: 0,
+            earliest_s: 0.0,
+            latest_s: 0.0,
+        });
         out[0] = self.n as u64;
         out[1] = self.tick;
         out[2] = self.tick_s.to_bits();
@@ -171,9 +188,12 @@ impl RawFrame {
         out[4] = flags;
         out[5] = self.hold_armed.unwrap_or(0) as u64;
         out[6] = self.published_unix_ms.to_bits();
-        out[7] = 0;
+        out[7] = next.robot as u64;
+        out[8] = next.earliest_s.to_bits();
+        out[9] = next.latest_s.to_bits();
+        out[10] = self.published;
         for (i, r) in self.robots.iter().enumerate().take(self.n) {
-            let w = &mut out[8 + 4 * i..12 + 4 * i];
+            let w = &mut out[HEADER + 4 * i..HEADER + 4 + 4 * i];
             w[0] = r.state.code();
             w[1] = r.clock_s.to_bits();
             w[2] = r.ref_time.to_bits();
@@ -185,7 +205,7 @@ impl RawFrame {
         let n = (w[0] as usize).min(MAX_ROBOTS);
         let mut robots = [RawRobot::default(); MAX_ROBOTS];
         for (i, r) in robots.iter_mut().enumerate().take(n) {
-            let w = &w[8 + 4 * i..12 + 4 * i];
+            let w = &w[HEADER + 4 * i..HEADER + 4 + 4 * i];
             *r = RawRobot {
                 state: RobotState::from_code(w[0]),
                 clock_s: f64::from_bits(w[1]),
@@ -202,6 +222,12 @@ impl RawFrame {
             fault: w[4] & 2 != 0,
             hold_armed: (w[4] & 4 != 0).then_some(w[5] as usize),
             published_unix_ms: f64::from_bits(w[6]),
+            next: (w[4] & 8 != 0).then(|| PreAlert {
+                robot: w[7] as usize,
+                earliest_s: f64::from_bits(w[8]),
+                latest_s: f64::from_bits(w[9]),
+            }),
+            published: w[10],
             robots,
         }
     }
@@ -220,6 +246,11 @@ pub struct RobotFrame {
     pub progress: f64,
     /// Tasks it completed.
     pub tasks: u64,
+    /// The per-robot strip ([`crate::RobotStrip`]): warp rate within its bounds, confidence
+    /// at the current sample, supervision this execution. Filled by the server from
+    /// successive snapshots; default in [`build_frame`]'s output.
+    #[serde(default)]
+    pub strip: crate::RobotStrip,
 }
 
 /// The robot that may need the operator now (the banner).
@@ -232,13 +263,18 @@ pub struct Attention {
     pub left_s: f64,
 }
 
-/// The next handover: the next low-confidence stretch that starts after now.
+/// The next handover: the coordinator's pre-alert ([`Tick::next`], [`PreAlert`]), the robot
+/// whose next low-confidence stretch can start soonest, with the worst-case bounds on its start.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct NextHandover {
     /// The robot, 1-based.
     pub robot: usize,
-    /// Planned time until it starts (real s, from the frame's tick).
+    /// The countdown: the earliest its stretch can start under every admissible operator
+    /// (`PreAlert::earliest_s`, real s from the frame's tick).
     pub in_s: f64,
+    /// The latest it can start (`PreAlert::latest_s`); `None` when the start waits on another
+    /// robot (a hold's rules, a leg's start, the continuous cell's token) and has no bound.
+    pub latest_s: Option<f64>,
     /// Its planned duration (real s, at the schedule's speeds).
     pub duration_s: f64,
 }
@@ -283,6 +319,11 @@ pub struct Health {
     /// Controls waiting in the loop's queue are not counted; confirmations the loop could not
     /// queue (the server was slower than the loop) are.
     pub acks_lost: u64,
+    /// The schedule the cell runs and its certificate, in words, as the source gave it
+    /// ([`crate::ConsoleConfig::schedule`]), e.g. whether it is the certified plan or a
+    /// fallback.
+    #[serde(default)]
+    pub schedule: Option<String>,
 }
 
 /// One update of the page (server-sent event `frame`; docs/formats.md, "Console frames").
@@ -308,9 +349,10 @@ pub struct Frame {
     pub robots: Vec<RobotFrame>,
     /// The robot that may need the operator now, if any.
     pub attention: Option<Attention>,
-    /// The next handover, if any is planned.
+    /// The next handover, the coordinator's pre-alert ([`next_handover`]), if it announces one.
     pub next: Option<NextHandover>,
-    /// Whether the next handover is at most `lead_s` away (the pre-alert).
+    /// Whether the next handover can start within `lead_s` (`next.in_s ≤ lead_s`: the
+    /// pre-alert).
     pub prealert: bool,
     /// The pre-alert's lead (real s).
     pub lead_s: f64,
@@ -326,10 +368,18 @@ pub struct Frame {
     pub health: Health,
     /// When the loop published the snapshot (ms since the Unix epoch).
     pub published_unix_ms: f64,
+    /// The operator's strip ([`crate::OperatorStrip`]): busy share, switches per hour,
+    /// longest busy stretch, time on shift. Filled by the server.
+    #[serde(default)]
+    pub operator: crate::OperatorStrip,
+    /// A message about the source the page must show (a replay's corrupt or truncated file,
+    /// a replay that ended), if any.
+    #[serde(default)]
+    pub notice: Option<String>,
 }
 
 /// One robot's plan as the page needs it: its low-confidence runs and clock.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 struct RobotGeometry {
     /// `c_n`, `n ∈ 0..=T_ref` (s): the schedule clock at which sample `n` starts.
     clock: Vec<f64>,
@@ -337,6 +387,13 @@ struct RobotGeometry {
     runs: Vec<(usize, usize)>,
     /// `W[n] = Σ_{k<n} ψ̇max[k]·Δt_s`: the slowest time to sample `n` (s).
     worst: Vec<f64>,
+    /// `ψ̇min[n]`, `ψ̇max[n]`: the warp rate's bounds per reference sample (execution
+    /// samples per reference sample). Empty in recordings without them.
+    #[serde(default)]
+    rate_bounds: Vec<(f64, f64)>,
+    /// Reference sample period Δt_s (s); 0 in recordings without it.
+    #[serde(default)]
+    dt_s: f64,
 }
 
 impl RobotGeometry {
@@ -366,6 +423,13 @@ impl RobotGeometry {
             clock: t.sample_clock_s().to_vec(),
             runs,
             worst,
+            rate_bounds: t
+                .grad_min()
+                .iter()
+                .zip(t.grad_max())
+                .map(|(&lo, &hi)| (lo, hi))
+                .collect(),
+            dt_s: t.dt_s(),
         }
     }
 
@@ -388,15 +452,21 @@ impl RobotGeometry {
 
 /// The plan of a cell as the console reads it: every robot's low-confidence runs, schedule
 /// clock and slowest times (built once from the controller, before the loop starts), the
-/// pre-alert's lead and the timeline's horizon.
-#[derive(Clone, Debug)]
+/// pre-alert's lead and the timeline's horizon. Serializable: a replay's recording carries it
+/// (docs/formats.md, "Console recordings").
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Geometry {
     rounds: bool,
     robots: Vec<RobotGeometry>,
     /// Task start and end on its clock (continuous cell: one task plan for every robot).
     task_span_s: (f64, f64),
     can_hold: bool,
-    /// Pre-alert lead (real s).
+    /// The operator's switch time the controller keeps (real s: its whole ticks; 0: none).
+    /// A recording written before it was kept reads as 0.
+    #[serde(default)]
+    switch_s: f64,
+    /// Pre-alert lead (real s): [`Console::start`](crate::Console::start) sets the larger of
+    /// the configured lead and the switch time.
     pub lead_s: f64,
     /// Timeline horizon (real s).
     pub horizon_s: f64,
@@ -408,7 +478,8 @@ pub const DEFAULT_LEAD_S: f64 = 7.0;
 pub const DEFAULT_HORIZON_S: f64 = 90.0;
 
 impl Geometry {
-    /// The geometry of `ctl`'s plan (its timelines), with the default lead and horizon.
+    /// The geometry of `ctl`'s plan (its timelines), with the default horizon and the default
+    /// lead ([`DEFAULT_LEAD_S`], or the controller's switch time where that is larger).
     #[must_use]
     pub fn new(ctl: &AnyController) -> Geometry {
         match ctl {
@@ -417,7 +488,8 @@ impl Geometry {
                 robots: c.robots().iter().map(RobotGeometry::new).collect(),
                 task_span_s: (0.0, 0.0),
                 can_hold: c.has_holds(),
-                lead_s: DEFAULT_LEAD_S,
+                switch_s: c.switch_ticks() as f64 * c.tick_s(),
+                lead_s: DEFAULT_LEAD_S.max(c.switch_ticks() as f64 * c.tick_s()),
                 horizon_s: DEFAULT_HORIZON_S,
             },
             AnyController::Continuous(c) => {
@@ -427,11 +499,19 @@ impl Geometry {
                     robots: vec![RobotGeometry::new(t); c.n_robots()],
                     task_span_s: (t.start_s(), t.end_s()),
                     can_hold: true,
-                    lead_s: DEFAULT_LEAD_S,
+                    switch_s: c.switch_ticks() as f64 * c.tick_s(),
+                    lead_s: DEFAULT_LEAD_S.max(c.switch_ticks() as f64 * c.tick_s()),
                     horizon_s: DEFAULT_HORIZON_S,
                 }
             }
         }
+    }
+
+    /// The operator's switch time the controller keeps (real s, whole ticks; 0: none): the
+    /// least lead a pre-alert can have.
+    #[must_use]
+    pub fn switch_s(&self) -> f64 {
+        self.switch_s
     }
 
     /// Whether the cell runs in rounds.
@@ -451,6 +531,46 @@ impl Geometry {
     #[must_use]
     pub fn can_hold(&self) -> bool {
         self.can_hold
+    }
+
+    /// A geometry of no robot: the console of a source that could not be read (a replay
+    /// whose header is corrupt) shows only its notice.
+    #[must_use]
+    pub fn empty(rounds: bool) -> Geometry {
+        Geometry {
+            rounds,
+            robots: Vec::new(),
+            task_span_s: (0.0, 0.0),
+            can_hold: false,
+            switch_s: 0.0,
+            lead_s: DEFAULT_LEAD_S,
+            horizon_s: DEFAULT_HORIZON_S,
+        }
+    }
+
+    /// Whether robot `i` (0-based) is confident (high-confidence) at reference time
+    /// `ref_time` of its task: the sample is outside its low-confidence runs.
+    #[must_use]
+    pub fn confident_at(&self, i: usize, ref_time: f64) -> bool {
+        let n = ref_time.floor().max(0.0) as usize;
+        self.robots
+            .get(i)
+            .is_none_or(|g| !g.runs.iter().any(|&(s, e)| s <= n && n < e))
+    }
+
+    /// Robot `i`'s warp-rate bounds `(ψ̇min, ψ̇max)` at reference time `ref_time` (execution
+    /// samples per reference sample), if the plan carries them.
+    #[must_use]
+    pub fn rate_bounds_at(&self, i: usize, ref_time: f64) -> Option<(f64, f64)> {
+        let g = self.robots.get(i)?;
+        let n = (ref_time.floor().max(0.0) as usize).min(g.rate_bounds.len().checked_sub(1)?);
+        g.rate_bounds.get(n).copied()
+    }
+
+    /// Robot `i`'s reference sample period Δt_s (s), if the plan carries it.
+    #[must_use]
+    pub fn dt_s(&self, i: usize) -> Option<f64> {
+        self.robots.get(i).map(|g| g.dt_s).filter(|d| *d > 0.0)
     }
 
     /// The robot low-confidence now and the worst-case time left in its stretch.
@@ -565,27 +685,30 @@ impl Geometry {
     }
 }
 
-/// The next handover from the plan: the first stretch of the operator's queue after the
-/// current one (the robot supervised now counts only with its later stretches), with its
-/// planned start and duration at the schedule's speeds (the queue: stretches in order of
-/// planned start, each after the one before has ended, as [`Geometry::stretches`] without
-/// the horizon). Planned times: corrections move them.
-///
-/// Replaced by `Tick::next` (the coordinator's own pre-alert, `PreAlert { robot, earliest_s,
-/// latest_s }`, issue 41) once that is merged into tandem-realtime: this is the one place the
-/// console computes the countdown.
+/// The next handover of `raw`: the coordinator's pre-alert it carries ([`RawFrame::next`]),
+/// 1-based, its countdown the worst-case earliest start and its planned duration that of the
+/// robot's next low-confidence run in the plan (the first that starts after its current
+/// sample; a continuous cell's next task's first when none is left in this one). `None` when
+/// the coordinator announces none.
 #[must_use]
 pub fn next_handover(geometry: &Geometry, raw: &RawFrame) -> Option<NextHandover> {
-    let current = geometry.attention(raw).map(|a| a.robot);
-    geometry
-        .queue(raw)
-        .into_iter()
-        .find(|s| !(Some(s.robot) == current && s.start_s == 0.0))
-        .map(|s| NextHandover {
-            robot: s.robot,
-            in_s: s.start_s,
-            duration_s: s.end_s - s.start_s,
-        })
+    let p = raw.next?;
+    let duration_s = geometry.robots.get(p.robot).map_or(0.0, |g| {
+        let rr = &raw.robots[p.robot.min(MAX_ROBOTS - 1)];
+        let n = rr.ref_time.floor().max(0.0) as usize;
+        g.runs
+            .iter()
+            .find(|&&(s, _)| s > n)
+            .or_else(|| g.runs.iter().find(|&&(_, e)| e > n))
+            .or_else(|| g.runs.first())
+            .map_or(0.0, |&(s, e)| g.clock_at(e) - g.clock_at(s))
+    });
+    Some(NextHandover {
+        robot: p.robot + 1,
+        in_s: p.earliest_s,
+        latest_s: p.latest_s.is_finite().then_some(p.latest_s),
+        duration_s,
+    })
 }
 
 /// The page's frame of `raw` (server side; allocates).
@@ -609,6 +732,7 @@ pub fn build_frame(geometry: &Geometry, raw: &RawFrame) -> Frame {
                     (r.ref_time / n_ref as f64).clamp(0.0, 1.0)
                 },
                 tasks: r.tasks,
+                strip: crate::RobotStrip::default(),
             }
         })
         .collect();
@@ -638,6 +762,8 @@ pub fn build_frame(geometry: &Geometry, raw: &RawFrame) -> Frame {
         acks: Vec::new(),
         health: Health::default(),
         published_unix_ms: raw.published_unix_ms,
+        operator: crate::OperatorStrip::default(),
+        notice: None,
     }
 }
 
@@ -668,6 +794,12 @@ mod tests {
             hold_armed: Some(2),
             fault: true,
             published_unix_ms: 1.5e12,
+            next: Some(PreAlert {
+                robot: 2,
+                earliest_s: 6.4,
+                latest_s: f64::INFINITY,
+            }),
+            published: 123,
             ..RawFrame::default()
         };
         for (i, s) in [RobotState::Lc, RobotState::Fault, RobotState::Done]
@@ -684,6 +816,10 @@ mod tests {
         let mut words = [0; WORDS];
         raw.encode(&mut words);
         assert_eq!(RawFrame::decode(&words), raw);
+        // Without a pre-alert it reads back as none.
+        let none = RawFrame { next: None, ..raw };
+        none.encode(&mut words);
+        assert_eq!(RawFrame::decode(&words).next, None);
         // Every state's code reads back as itself; an unknown code reads as `hc`.
         for s in RobotState::ALL {
             assert_eq!(RobotState::from_code(s.code()), s);
@@ -702,9 +838,18 @@ mod tests {
         let states: Vec<_> = raw.robots[..3].iter().map(|r| r.state).collect();
         assert_eq!(states, [RobotState::Hc, RobotState::Wait, RobotState::Wait]);
         assert!(g.attention(&raw).is_none());
+        // The countdown is the coordinator's pre-alert: robot 1's clock (0.1 s) must reach its
+        // stretch at 4 s; at the fastest rate (2× the schedule's) that takes 1.95 s, so the
+        // 20th tick is the first that can reach it and it starts 19 ticks from now, 1.9 s; at
+        // the slowest (½×) 7.8 s, so it starts at most 78 ticks from now, 7.8 s.
         let next = next_handover(&g, &raw).unwrap();
         assert_eq!(next.robot, 1);
-        assert!((next.in_s - 3.9).abs() < 1e-9, "{next:?}");
+        assert_eq!(raw.next, t.next);
+        assert!((next.in_s - 1.9).abs() < 1e-9, "{next:?}");
+        let latest = next
+            .latest_s
+            .expect("robot 1 runs alone: its start is bounded");
+        assert!((latest - 7.8).abs() <= 0.1 + 1e-9, "{next:?}");
         assert!((next.duration_s - 2.0).abs() < 1e-9);
         // Run to robot 1's sample 45 (clock 4.5 s): it is supervised; the worst case left is
         // 15 samples at ψ̇max = 2, 0.1 s each: 3 s. The next stretch is robot 2's at 8 s.
@@ -718,12 +863,18 @@ mod tests {
         assert_eq!(a.robot, 1);
         let r = raw.robots[0].ref_time;
         assert!((a.left_s - (60.0 - r) * 0.2).abs() < 1e-9, "{a:?} at {r}");
+        // Robot 2's stretch at 8 s: at most twice the schedule's speed, its countdown is the
+        // last whole tick before half the clock time left.
         let next = next_handover(&g, &raw).unwrap();
         assert_eq!(next.robot, 2);
+        let p = ctl.pre_alert().unwrap();
+        assert_eq!((p.robot + 1, p.earliest_s), (next.robot, next.in_s));
+        let fastest = (8.0 - raw.robots[1].clock_s) / 2.0;
         assert!(
-            (next.in_s - (8.0 - raw.robots[1].clock_s)).abs() < 1e-9,
-            "{next:?}"
+            next.in_s <= fastest + 1e-9 && next.in_s > fastest - 0.1 - 1e-9,
+            "{next:?} against {fastest} s at the fastest"
         );
+        assert!((next.in_s * 10.0 - (next.in_s * 10.0).round()).abs() < 1e-6);
         // The frame: one lc robot, the banner's robot, the pre-alert off (3.5 s > 7 s? no: on).
         let f = build_frame(&g, &raw);
         assert_eq!(
@@ -786,7 +937,11 @@ mod tests {
             q.windows(2).all(|w| w[1].start_s >= w[0].end_s - 1e-9),
             "{q:?}"
         );
+        // The countdown is the coordinator's: a continuous cell's high-confidence robot runs
+        // at the plan's pace, so robot 1 (clock 0.1 s) reaches its stretch at 4 s in the 39th
+        // tick from now, which starts 38 ticks (3.8 s) from now.
         let next = next_handover(&geometry, &raw).unwrap();
-        assert_eq!((next.robot, (next.in_s * 10.0).round()), (1, 39.0));
+        assert_eq!((next.robot, (next.in_s * 10.0).round()), (1, 38.0));
+        assert_eq!(t.next.map(|p| p.earliest_s), Some(next.in_s));
     }
 }

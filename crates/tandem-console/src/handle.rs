@@ -10,7 +10,7 @@
 //! paused, `handle.publish(..)`.
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering, fence};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering, fence};
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError};
 use std::time::{SystemTime, UNIX_EPOCH};
 
@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 use tandem_planner::AnyController;
 use tandem_realtime::{ContinuousCoordinator, Controller, Coordinator, Tick};
 
-use crate::frame::{Ack, RawFrame, WORDS};
+use crate::frame::{Ack, HEADER, RawFrame, WORDS};
 
 /// A single-writer sequence lock over the words of a [`RawFrame`]: the writer bumps the
 /// sequence to odd, stores the words, bumps it to even; a reader retries while the sequence is
@@ -46,7 +46,7 @@ impl Slot {
         self.seq.store(s.wrapping_add(1), Ordering::Relaxed);
         fence(Ordering::Release);
         // The words of the first `n` robots (a handle's `n` never changes).
-        for (w, v) in self.words.iter().zip(buf).take(8 + 4 * raw.n) {
+        for (w, v) in self.words.iter().zip(buf).take(HEADER + 4 * raw.n) {
             w.store(v, Ordering::Relaxed);
         }
         self.seq.store(s.wrapping_add(2), Ordering::Release);
@@ -73,6 +73,11 @@ impl Slot {
                 return Some((s1 / 2, RawFrame::decode(&buf)));
             }
         }
+    }
+
+    /// Snapshots written so far (a writer inside a write counts the one it writes).
+    pub(crate) fn written(&self) -> u64 {
+        self.seq.load(Ordering::Acquire).div_ceil(2)
     }
 }
 
@@ -127,10 +132,17 @@ pub struct ControlMsg {
     pub robot: Option<usize>,
 }
 
-/// What the server and the loop share: the slot and the counters.
+/// What the server and the loop share: the slot, the server's request for a snapshot and the
+/// counters.
 #[derive(Debug)]
 pub(crate) struct Shared {
     pub(crate) slot: Slot,
+    /// Set by the server when it wants the next snapshot (at most `max_hz` times a second),
+    /// cleared by the handle when it writes one: the loop's other ticks only count.
+    pub(crate) want: AtomicBool,
+    /// Control messages the server queued for the loop so far (the handle polls its queue only
+    /// when this moved: one load per tick otherwise).
+    pub(crate) controls_sent: AtomicU64,
     pub(crate) acks_lost: AtomicU64,
 }
 
@@ -138,6 +150,8 @@ impl Shared {
     pub(crate) fn new() -> Shared {
         Shared {
             slot: Slot::new(),
+            want: AtomicBool::new(true),
+            controls_sent: AtomicU64::new(0),
             acks_lost: AtomicU64::new(0),
         }
     }
@@ -157,6 +171,10 @@ pub struct ConsoleHandle {
     /// The robot at whose next wait the cell pauses.
     hold_armed: Option<usize>,
     rounds_done: u64,
+    /// Snapshots handed to [`ConsoleHandle::publish`] so far.
+    published: u64,
+    /// Control messages taken from the queue so far.
+    controls_taken: u64,
 }
 
 impl ConsoleHandle {
@@ -178,27 +196,55 @@ impl ConsoleHandle {
             paused: false,
             hold_armed: None,
             rounds_done: 0,
+            published: 0,
+            controls_taken: 0,
         }
     }
 
-    /// Publishes the snapshot of `ctl` after `tick` for the page. Lock-free and wait-free,
-    /// never allocates, never blocks: a snapshot the server has not read before the next one
-    /// is dropped. O(N).
+    /// Hands the snapshot of `ctl` after `tick` to the page. Lock-free and wait-free, never
+    /// allocates, never blocks. Most ticks only count: the snapshot is taken (O(N), with the
+    /// wall-clock stamp of [`RawFrame::published_unix_ms`]) only when the server has asked for
+    /// one since the last (at most `max_hz` times a second); a snapshot the server has not read
+    /// before the next one is dropped.
     pub fn publish<C: Controller + ?Sized>(&mut self, tick: &Tick, ctl: &C) {
+        self.published += 1;
+        if !self.shared.want.load(Ordering::Relaxed) {
+            return;
+        }
+        self.shared.want.store(false, Ordering::Relaxed);
         let mut raw = RawFrame::from_controller(tick, ctl, self.rounds);
         raw.paused = self.paused;
         raw.hold_armed = self.hold_armed;
         raw.rounds_done = self.rounds_done;
+        raw.published = self.published;
         raw.published_unix_ms = SystemTime::now()
             .duration_since(UNIX_EPOCH)
             .map_or(0.0, |d| d.as_secs_f64() * 1e3);
         self.shared.slot.write(&raw);
     }
 
+    /// Snapshots handed to [`publish`](Self::publish) so far.
+    #[must_use]
+    pub fn published(&self) -> u64 {
+        self.published
+    }
+
+    /// Publishes a snapshot as it is (a replay's recorded tick): the same slot as
+    /// [`publish`](Self::publish).
+    pub(crate) fn publish_raw(&mut self, raw: &RawFrame) {
+        self.shared.slot.write(raw);
+    }
+
     /// The next control message the operator sent, if any (never blocks). Apply it at a tick
-    /// boundary and [`confirm`](Self::confirm) it; [`Driver::apply`] does both.
+    /// boundary and [`confirm`](Self::confirm) it; [`Driver::apply`] does both. With no message
+    /// waiting it costs one atomic load.
     pub fn poll_control(&mut self) -> Option<ControlMsg> {
-        self.controls.try_recv().ok()
+        if self.shared.controls_sent.load(Ordering::Acquire) == self.controls_taken {
+            return None;
+        }
+        let msg = self.controls.try_recv().ok()?;
+        self.controls_taken += 1;
+        Some(msg)
     }
 
     /// Confirms `msg` into the frame stream: `ok` whether it took effect, `message` what

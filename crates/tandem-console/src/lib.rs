@@ -11,6 +11,10 @@
 //!   ([`Driver::apply`] at a tick boundary).
 //! - [`simulate`] runs a simulated cell from a planner in real time through the same handle
 //!   (`tandem console STATE --simulate`).
+//! - [`replay`] plays a recorded run ([`Recorder`], [`read_recording`]; `tandem console
+//!   --replay FILE|DIR`) through the same server and page; [`check_recording`] measures what
+//!   the page showed against the coordinator on every tick.
+//! - [`Tracker`] derives the page's per-robot and operator strips from successive snapshots.
 //! - [`Frame`] is what the page receives; the page's machine-checkable DOM
 //!   (`data-robot`, `data-state`, `data-attention`, `data-next-robot`, `data-next-s`) is
 //!   documented in docs/formats.md.
@@ -18,8 +22,10 @@
 mod error;
 mod frame;
 mod handle;
+mod replay;
 mod server;
 mod sim;
+mod strip;
 
 pub use error::{Error, Result};
 pub use frame::{
@@ -27,5 +33,11 @@ pub use frame::{
     RawFrame, RawRobot, RobotFrame, RobotState, Stretch, build_frame, next_handover,
 };
 pub use handle::{ConsoleCell, ConsoleHandle, ControlMsg, Driver, Op};
+pub use replay::{
+    RECORDING_FILE, RECORDING_FORMAT, RECORDING_HZ, RECORDING_VERSION, RecordedPreAlert,
+    RecordedRobot, RecordedTick, Recorder, Recording, ReplayCheck, check_recording, read_recording,
+    replay,
+};
 pub use server::{Console, ConsoleConfig, PAGE};
-pub use sim::{SimParams, simulate, tick_now};
+pub use sim::{SimParams, Until, record_sim, simulate, simulate_recorded, tick_now};
+pub use strip::{OperatorStrip, RobotStrip, Tracker};

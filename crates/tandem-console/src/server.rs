@@ -28,6 +28,7 @@ use tokio::sync::{oneshot, watch};
 use crate::error::{Error, Result};
 use crate::frame::{Ack, Geometry, build_frame};
 use crate::handle::{ConsoleHandle, ControlMsg, Op, Shared};
+use crate::strip::Tracker;
 
 /// The page: HTML, CSS and JavaScript in one file, no external resource.
 pub const PAGE: &str = include_str!("page.html");
@@ -48,10 +49,15 @@ pub struct ConsoleConfig {
     pub port: u16,
     /// Frames per second pushed to a page at most. Default: 30.
     pub max_hz: f64,
-    /// The pre-alert's lead (s). Default: [`crate::DEFAULT_LEAD_S`] (7 s).
+    /// The pre-alert's lead (s): the page alerts once the next handover can start within it.
+    /// The console uses the larger of this and the controller's switch time
+    /// ([`Geometry::switch_s`]). Default: [`crate::DEFAULT_LEAD_S`] (7 s).
     pub lead_s: f64,
     /// The timeline's horizon (s). Default: [`crate::DEFAULT_HORIZON_S`] (90 s).
     pub horizon_s: f64,
+    /// The schedule the cell runs and its certificate, in words (health: certified plan or
+    /// fallback), if the source knows it. Default: `None`.
+    pub schedule: Option<String>,
 }
 
 impl Default for ConsoleConfig {
@@ -62,6 +68,7 @@ impl Default for ConsoleConfig {
             max_hz: 30.0,
             lead_s: crate::DEFAULT_LEAD_S,
             horizon_s: crate::DEFAULT_HORIZON_S,
+            schedule: None,
         }
     }
 }
@@ -111,17 +118,28 @@ struct App {
     controls: SyncSender<ControlMsg>,
     clients: Mutex<Clients>,
     n_robots: usize,
+    shared: Arc<Shared>,
+    /// What the page must be told about the source ([`Console::set_notice`]).
+    notice: Mutex<Option<String>>,
 }
 
 impl App {
     fn clients(&self) -> std::sync::MutexGuard<'_, Clients> {
         self.clients.lock().unwrap_or_else(PoisonError::into_inner)
     }
+
+    fn notice(&self) -> Option<String> {
+        self.notice
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    }
 }
 
 /// A running console: the server thread and its address. Dropping it stops the server.
 #[derive(Debug)]
 pub struct Console {
+    app: Arc<App>,
     url: String,
     addr: SocketAddr,
     stop: Option<oneshot::Sender<()>>,
@@ -140,7 +158,7 @@ impl Console {
         mut geometry: Geometry,
     ) -> Result<(Console, ConsoleHandle)> {
         config.validate()?;
-        geometry.lead_s = config.lead_s;
+        geometry.lead_s = config.lead_s.max(geometry.switch_s());
         geometry.horizon_s = config.horizon_s;
         let addr = SocketAddr::new(config.host, config.port);
         let listener = TcpListener::bind(addr).map_err(|source| Error::Bind {
@@ -166,24 +184,29 @@ impl Console {
             controls: controls_tx,
             clients: Mutex::new(Clients::default()),
             n_robots: geometry.n_robots(),
+            shared: shared.clone(),
+            notice: Mutex::new(None),
         });
+        let app_kept = app.clone();
         let rt = tokio::runtime::Builder::new_current_thread()
             .enable_all()
             .build()
             .map_err(Error::Runtime)?;
         let (stop_tx, stop_rx) = oneshot::channel::<()>();
         let period = Duration::from_secs_f64(1.0 / config.max_hz);
+        let schedule = config.schedule.clone();
         let thread = std::thread::Builder::new()
             .name("tandem-console".into())
             .spawn(move || {
                 rt.block_on(serve(
-                    listener, app, shared, geometry, frames_tx, acks_rx, period, stop_rx,
+                    listener, app, shared, geometry, schedule, frames_tx, acks_rx, period, stop_rx,
                 ));
                 rt.shutdown_timeout(Duration::from_millis(200));
             })
             .map_err(Error::Runtime)?;
         Ok((
             Console {
+                app: app_kept,
                 url: format!("http://{addr}/"),
                 addr,
                 stop: Some(stop_tx),
@@ -197,6 +220,16 @@ impl Console {
     #[must_use]
     pub fn url(&self) -> &str {
         &self.url
+    }
+
+    /// Sets (or clears, `None`) the notice every frame carries to the page from now on (a
+    /// replay's damaged file, its end); it is pushed at the next server period.
+    pub fn set_notice(&self, notice: Option<String>) {
+        *self
+            .app
+            .notice
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = notice;
     }
 
     /// The address the server listens on.
@@ -232,6 +265,7 @@ async fn serve(
     app: Arc<App>,
     shared: Arc<Shared>,
     geometry: Geometry,
+    schedule: Option<String>,
     frames_tx: watch::Sender<Arc<str>>,
     acks_rx: Receiver<Ack>,
     period: Duration,
@@ -250,7 +284,7 @@ async fn serve(
         .route("/frame", get(latest))
         .route("/control", post(control))
         .with_state(app.clone());
-    let poll = poller(app, shared, geometry, frames_tx, acks_rx, period);
+    let poll = poller(app, shared, geometry, schedule, frames_tx, acks_rx, period);
     let server = axum::serve(listener, router);
     tokio::select! {
         r = server => if let Err(e) = r { eprintln!("console: server stopped: {e}") },
@@ -265,6 +299,7 @@ async fn poller(
     app: Arc<App>,
     shared: Arc<Shared>,
     geometry: Geometry,
+    schedule: Option<String>,
     frames_tx: watch::Sender<Arc<str>>,
     acks_rx: Receiver<Ack>,
     period: Duration,
@@ -274,9 +309,19 @@ async fn poller(
     let (mut last_written, mut sent_new, mut seq) = (0u64, 0u64, 0u64);
     let mut last_version = u64::MAX;
     let mut last_controller: Option<String> = None;
+    let mut last_notice: Option<String> = None;
+    let mut tracker = Tracker::new();
     let mut last_push = Instant::now();
     loop {
         interval.tick().await;
+        // Ask the loop for its next snapshot and wait for it (at most one period: a loop that
+        // stopped publishing leaves the newest snapshot, whose age the page shows).
+        let before = shared.slot.written();
+        shared.want.store(true, Ordering::Relaxed);
+        let asked = Instant::now();
+        while shared.slot.written() == before && asked.elapsed() < period {
+            tokio::time::sleep(Duration::from_millis(1)).await;
+        }
         let (acks, version, controller) = {
             let mut c = app.clients();
             while let Ok(ack) = acks_rx.try_recv() {
@@ -288,6 +333,7 @@ async fn poller(
                 c.controller.clone(),
             )
         };
+        let notice = app.notice();
         let Some((written, raw)) = shared.slot.read() else {
             continue;
         };
@@ -295,6 +341,7 @@ async fn poller(
         if !fresh
             && version == last_version
             && controller == last_controller
+            && notice == last_notice
             && last_push.elapsed() < Duration::from_secs(1)
         {
             continue;
@@ -305,14 +352,22 @@ async fn poller(
         last_written = written;
         last_version = version;
         last_controller.clone_from(&controller);
+        last_notice.clone_from(&notice);
         last_push = Instant::now();
         seq += 1;
         let mut frame = build_frame(&geometry, &raw);
         frame.seq = seq;
+        if fresh {
+            tracker.fill(&geometry, &raw, &mut frame);
+        } else {
+            tracker.fill_again(&mut frame);
+        }
+        frame.notice = notice;
         frame.controller = controller;
         frame.acks = acks;
-        frame.health.published = written;
-        frame.health.dropped = written.saturating_sub(sent_new);
+        frame.health.published = raw.published;
+        frame.health.schedule.clone_from(&schedule);
+        frame.health.dropped = raw.published.saturating_sub(sent_new);
         frame.health.acks_lost = shared.acks_lost.load(Ordering::Relaxed);
         frame.health.source_age_s = (unix_ms() - raw.published_unix_ms).max(0.0) / 1e3;
         match serde_json::to_string(&frame) {
@@ -538,10 +593,13 @@ async fn control(State(app): State<Arc<App>>, body: Bytes) -> Response {
                 robot,
             };
             match app.controls.try_send(msg) {
-                Ok(()) => reply(
-                    StatusCode::ACCEPTED,
-                    json!({ "ok": true, "id": req.id, "pending": true }),
-                ),
+                Ok(()) => {
+                    app.shared.controls_sent.fetch_add(1, Ordering::Release);
+                    reply(
+                        StatusCode::ACCEPTED,
+                        json!({ "ok": true, "id": req.id, "pending": true }),
+                    )
+                }
                 Err(TrySendError::Full(_)) => reject(
                     StatusCode::SERVICE_UNAVAILABLE,
                     client,

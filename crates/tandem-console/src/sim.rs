@@ -15,6 +15,7 @@ use tandem_sim::workcell::{CellSim, OperatorParams, RoundSim};
 
 use crate::error::{Error, Result};
 use crate::handle::{ConsoleCell, ConsoleHandle, Driver};
+use crate::replay::Recorder;
 
 /// How the simulated cell runs.
 #[derive(Clone, Debug)]
@@ -95,6 +96,101 @@ pub fn tick_now<C: Controller + ?Sized>(ctl: &C) -> Tick {
     }
 }
 
+/// A simulated cell stepped one tick at a time: what [`simulate`] runs in real time and
+/// [`record_sim`] as fast as it can.
+#[derive(Debug)]
+pub(crate) struct SimRun<'p> {
+    planner: &'p Planner,
+    cell: SimCell,
+    needed: Vec<Vec<bool>>,
+    rng: ChaCha8Rng,
+    rounds_done: u64,
+}
+
+impl<'p> SimRun<'p> {
+    pub(crate) fn new(
+        planner: &'p Planner,
+        ctl: AnyController,
+        params: &SimParams,
+        needed: Option<Vec<Vec<bool>>>,
+    ) -> Result<SimRun<'p>> {
+        params.validate()?;
+        let model = planner.model();
+        let n_ref = model.n_ref();
+        let n = ctl.n_robots();
+        let needed = match needed {
+            Some(t) => {
+                if t.len() != n || t.iter().any(|r| r.len() != n_ref) {
+                    return Err(Error::BadParam {
+                        name: "needed",
+                        why: "must hold one row of T_ref samples per robot",
+                    });
+                }
+                t
+            }
+            None => {
+                let lc: Vec<bool> = planner.problem().conf().iter().map(|c| !c).collect();
+                vec![lc; n]
+            }
+        };
+        let cell = match ctl {
+            AnyController::Rounds(c) => SimCell::Rounds(Box::new(RoundSim::new(
+                model,
+                planner.problem(),
+                c,
+                &params.operator,
+            )?)),
+            AnyController::Continuous(c) => {
+                SimCell::Continuous(Box::new(CellSim::new(model, c, &params.operator)?))
+            }
+        };
+        Ok(SimRun {
+            planner,
+            cell,
+            needed,
+            rng: ChaCha8Rng::seed_from_u64(params.seed),
+            rounds_done: 0,
+        })
+    }
+
+    pub(crate) fn controller(&self) -> &dyn Controller {
+        self.cell.controller()
+    }
+
+    pub(crate) fn is_rounds(&self) -> bool {
+        matches!(self.cell, SimCell::Rounds(_))
+    }
+
+    pub(crate) fn rounds_done(&self) -> u64 {
+        self.rounds_done
+    }
+
+    /// One tick (a finished round restarts first); returns the tick and whether a round
+    /// was completed before it.
+    pub(crate) fn step(&mut self) -> Result<(Tick, bool)> {
+        let model = self.planner.model();
+        let needed = &self.needed;
+        match &mut self.cell {
+            SimCell::Rounds(s) => {
+                let mut new_round = false;
+                if s.coordinator().is_finished() {
+                    s.restart();
+                    self.rounds_done += 1;
+                    new_round = true;
+                }
+                Ok((
+                    s.tick(model, |i, k| needed[i][k], &mut self.rng)?,
+                    new_round,
+                ))
+            }
+            SimCell::Continuous(s) => {
+                s.tick(model, |i, k| needed[i][k], &mut self.rng)?;
+                Ok((tick_now(s.coordinator()), false))
+            }
+        }
+    }
+}
+
 /// Runs the simulated cell of `planner` (its controller `ctl` for `params.cell`, as
 /// [`Planner::controller`] makes it) in real time until `stop` is set, publishing into
 /// `handle`. `needed[i][n]`: robot `i` needs the operator at reference sample `n` (`None`:
@@ -108,44 +204,35 @@ pub fn simulate(
     ctl: AnyController,
     params: &SimParams,
     needed: Option<Vec<Vec<bool>>>,
-    mut handle: ConsoleHandle,
+    handle: ConsoleHandle,
     stop: &AtomicBool,
 ) -> Result<()> {
-    params.validate()?;
-    let model = planner.model();
-    let n_ref = model.n_ref();
-    let n = ctl.n_robots();
-    let needed = match needed {
-        Some(t) => {
-            if t.len() != n || t.iter().any(|r| r.len() != n_ref) {
-                return Err(Error::BadParam {
-                    name: "needed",
-                    why: "must hold one row of T_ref samples per robot",
-                });
-            }
-            t
-        }
-        None => {
-            let lc: Vec<bool> = planner.problem().conf().iter().map(|c| !c).collect();
-            vec![lc; n]
-        }
-    };
-    let mut cell = match ctl {
-        AnyController::Rounds(c) => SimCell::Rounds(Box::new(RoundSim::new(
-            model,
-            planner.problem(),
-            c,
-            &params.operator,
-        )?)),
-        AnyController::Continuous(c) => {
-            SimCell::Continuous(Box::new(CellSim::new(model, c, &params.operator)?))
-        }
-    };
-    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
-    let tick_s = cell.controller().tick_s();
+    simulate_recorded(planner, ctl, params, needed, handle, None, stop)
+}
+
+/// [`simulate`] writing every tick into `recorder` as well (`tandem console --simulate
+/// --record FILE`; a recording [`crate::replay`] plays back).
+///
+/// # Errors
+/// As [`simulate`], and the recorder's write errors.
+pub fn simulate_recorded(
+    planner: &Planner,
+    ctl: AnyController,
+    params: &SimParams,
+    needed: Option<Vec<Vec<bool>>>,
+    mut handle: ConsoleHandle,
+    mut recorder: Option<&mut Recorder>,
+    stop: &AtomicBool,
+) -> Result<()> {
+    let mut run = SimRun::new(planner, ctl, params, needed)?;
+    let rounds = run.is_rounds();
+    let tick_s = run.controller().tick_s();
     let period_s = tick_s / params.speed;
-    let first = tick_now(cell.controller());
-    handle.publish(&first, cell.controller());
+    let first = tick_now(run.controller());
+    handle.publish(&first, run.controller());
+    if let Some(r) = recorder.as_deref_mut() {
+        r.record(&first, run.controller(), rounds, run.rounds_done())?;
+    }
     // Ticks are due at `base + k · period_s`; the base moves on every pause.
     let mut base = Instant::now();
     let mut done_since_base: u64 = 0;
@@ -155,9 +242,9 @@ pub fn simulate(
         // At most half a second of ticks at once: a slow machine lags, it does not race.
         let mut budget = ((0.5 / period_s) as u64).max(1);
         loop {
-            if !Driver::apply(&mut handle, &mut cell) {
-                let t = tick_now(cell.controller());
-                handle.publish(&t, cell.controller());
+            if !Driver::apply(&mut handle, &mut run.cell) {
+                let t = tick_now(run.controller());
+                handle.publish(&t, run.controller());
                 was_paused = true;
                 break;
             }
@@ -170,20 +257,14 @@ pub fn simulate(
             if done_since_base >= due || budget == 0 {
                 break;
             }
-            let tick = match &mut cell {
-                SimCell::Rounds(s) => {
-                    if s.coordinator().is_finished() {
-                        s.restart();
-                        handle.round_done();
-                    }
-                    s.tick(model, |i, k| needed[i][k], &mut rng)?
-                }
-                SimCell::Continuous(s) => {
-                    s.tick(model, |i, k| needed[i][k], &mut rng)?;
-                    tick_now(s.coordinator())
-                }
-            };
-            handle.publish(&tick, cell.controller());
+            let (tick, new_round) = run.step()?;
+            if new_round {
+                handle.round_done();
+            }
+            handle.publish(&tick, run.controller());
+            if let Some(r) = recorder.as_deref_mut() {
+                r.record(&tick, run.controller(), rounds, run.rounds_done())?;
+            }
             done_since_base += 1;
             budget -= 1;
         }
@@ -194,5 +275,85 @@ pub fn simulate(
         }
         std::thread::sleep(Duration::from_secs_f64(period_s.clamp(0.001, 0.02)));
     }
+    if let Some(r) = recorder {
+        r.flush()?;
+    }
     Ok(())
+}
+
+/// When [`record_sim`] stops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Until {
+    /// After this many ticks.
+    Ticks(u64),
+    /// When this many rounds are complete (rounds cells).
+    Rounds(u64),
+    /// When the robots completed this many tasks together (continuous cells).
+    Tasks(u64),
+}
+
+/// Runs the simulated cell as fast as it can (not in real time, no server) until `until`,
+/// writing every tick into `recorder`; returns the ticks run. The recording of a run of
+/// `tandem console --simulate` without waiting for it.
+///
+/// # Errors
+/// As [`simulate`], the recorder's write errors, and [`Error::BadParam`] for an `until` the
+/// cell cannot reach (rounds of a continuous cell, tasks of rounds) or of more than
+/// 10⁸ ticks.
+pub fn record_sim(
+    planner: &Planner,
+    ctl: AnyController,
+    params: &SimParams,
+    needed: Option<Vec<Vec<bool>>>,
+    until: Until,
+    recorder: &mut Recorder,
+) -> Result<u64> {
+    const MAX_TICKS: u64 = 100_000_000;
+    let mut run = SimRun::new(planner, ctl, params, needed)?;
+    let rounds = run.is_rounds();
+    match (until, rounds) {
+        (Until::Rounds(_), false) => {
+            return Err(Error::BadParam {
+                name: "until",
+                why: "counts rounds, and a continuous cell has none: use tasks",
+            });
+        }
+        (Until::Tasks(_), true) => {
+            return Err(Error::BadParam {
+                name: "until",
+                why: "counts tasks, and a rounds cell counts rounds: use rounds",
+            });
+        }
+        _ => {}
+    }
+    recorder.record(&tick_now(run.controller()), run.controller(), rounds, 0)?;
+    let mut ticks = 0u64;
+    loop {
+        let done = match until {
+            Until::Ticks(k) => ticks >= k,
+            Until::Rounds(k) => run.rounds_done() + u64::from(run.controller().is_finished()) >= k,
+            Until::Tasks(k) => {
+                run.controller()
+                    .tasks_now()
+                    .iter()
+                    .take(run.controller().n_robots())
+                    .sum::<u64>()
+                    >= k
+            }
+        };
+        if done {
+            break;
+        }
+        if ticks >= MAX_TICKS {
+            return Err(Error::BadParam {
+                name: "until",
+                why: "not reached within 10^8 ticks",
+            });
+        }
+        let (tick, _) = run.step()?;
+        recorder.record(&tick, run.controller(), rounds, run.rounds_done())?;
+        ticks += 1;
+    }
+    recorder.flush()?;
+    Ok(ticks)
 }

@@ -1,7 +1,7 @@
 //! The console in a real browser: headless Chromium driven through the DevTools protocol (a
 //! small client over a websocket) against the server on an ephemeral port. Checks that the
-//! page shows exactly the coordinator's low-confidence robot at every sampled tick and the
-//! plan's countdown, that a control clicked on the page comes back confirmed and reaches the
+//! page shows exactly the coordinator's low-confidence robot at every sampled tick and its
+//! pre-alert as the countdown, that a control clicked on the page comes back confirmed and reaches the
 //! loop, and that the page reconnects (and takes control again) after the server restarts.
 //!
 //! Skipped, with a message, only when Chromium is absent and `TANDEM_REQUIRE_CHROMIUM` is
@@ -22,9 +22,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use serde_json::{Value, json};
-use tandem_console::{
-    Console, ConsoleConfig, Driver, Geometry, NextHandover, RawFrame, RobotState, next_handover,
-};
+use tandem_console::{Console, ConsoleConfig, Driver, Geometry, RawFrame, RobotState};
 use tandem_planner::AnyController;
 use tandem_realtime::{Controller, Operator};
 use tungstenite::stream::MaybeTlsStream;
@@ -76,8 +74,13 @@ struct Browser {
 
 impl Browser {
     fn launch(bin: &PathBuf, url: &str) -> Browser {
-        let dir =
-            std::env::temp_dir().join(format!("tandem-console-chromium-{}", std::process::id()));
+        // One profile per browser: tests run in parallel and a test may open two pages.
+        static LAUNCHED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let k = LAUNCHED.fetch_add(1, Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!(
+            "tandem-console-chromium-{}-{k}",
+            std::process::id()
+        ));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         let child = Command::new(bin)
@@ -231,9 +234,9 @@ fn base64_decode(s: &str) -> Vec<u8> {
     out
 }
 
-/// What the coordinator said at each tick: its low-confidence robots (1-based) and the plan's
-/// countdown.
-type Truth = Arc<Mutex<HashMap<(u64, u64), (Vec<usize>, Option<NextHandover>)>>>;
+/// What the coordinator said at each tick: its low-confidence robots (1-based) and its
+/// pre-alert (`Tick::next`: the robot, 1-based, and the earliest start, s).
+type Truth = Arc<Mutex<HashMap<(u64, u64), (Vec<usize>, Option<(usize, f64)>)>>>;
 
 /// A user's control loop on `ctl`, one tick every `period`, publishing every tick and
 /// recording the truth; rounds restart when finished. Runs until `stop`.
@@ -265,10 +268,10 @@ fn user_loop(
                 .filter(|&i| raw.robots[i].state == RobotState::Lc)
                 .map(|i| i + 1)
                 .collect();
-            truth
-                .lock()
-                .unwrap()
-                .insert((round, ctl.ticks()), (lc, next_handover(&geometry, &raw)));
+            truth.lock().unwrap().insert(
+                (round, ctl.ticks()),
+                (lc, tick.next.map(|p| (p.robot + 1, p.earliest_s))),
+            );
             handle.publish(&tick, &ctl);
             std::thread::sleep(period);
         }
@@ -287,6 +290,7 @@ struct Cell {
 fn start(ctl: AnyController, port: u16, period: Duration) -> Cell {
     let config = ConsoleConfig {
         port,
+        schedule: Some("hand-made plan: robots 4 s apart (tests/support)".to_string()),
         ..ConsoleConfig::default()
     };
     let (console, handle) = Console::start(&config, Geometry::new(&ctl)).unwrap();
@@ -372,14 +376,13 @@ fn the_page_shows_the_coordinators_robot_confirms_controls_and_reconnects() {
             None => assert_eq!(v["attention"], "none"),
         }
         match next {
-            Some(n) => {
+            Some((robot, earliest_s)) => {
                 with_next += 1;
-                assert_eq!(v["next_robot"], n.robot.to_string(), "tick {tick}");
+                assert_eq!(v["next_robot"], robot.to_string(), "tick {tick}");
                 let s: f64 = v["next_s"].as_str().unwrap().parse().unwrap();
                 assert!(
-                    (s - n.in_s).abs() <= 0.051,
-                    "tick {tick}: page {s} s, plan {} s",
-                    n.in_s
+                    (s - earliest_s).abs() <= 0.051,
+                    "tick {tick}: page {s} s, the coordinator's pre-alert {earliest_s} s"
                 );
             }
             None => assert_eq!(v["next_robot"], ""),
@@ -462,6 +465,12 @@ fn screenshot_of_a_three_robot_cell() {
          window.__lastFrame.next && window.__lastFrame.attention.left_s > 2",
         Duration::from_secs(60),
     );
+    // Tall enough for the controls and the health line under the strips.
+    b.call(
+        "Emulation.setDeviceMetricsOverride",
+        json!({ "width": 1280, "height": 960, "deviceScaleFactor": 1, "mobile": false }),
+    );
+    std::thread::sleep(Duration::from_millis(300));
     b.screenshot(std::path::Path::new(&path));
     cell.stop();
 }
@@ -494,4 +503,78 @@ fn latency_tick_to_dom() {
         s[s.len() - 1]
     );
     assert!(q(0.99) < 1000.0, "p99 {} ms", q(0.99));
+}
+
+#[test]
+fn a_fault_shows_and_clears_through_the_page_and_bad_controls_are_refused_on_it() {
+    let Some(bin) = chromium_or_skip("a_fault_shows_and_clears_through_the_page…") else {
+        return;
+    };
+    // Two robots on the same plan from the same start (the margin check would refuse it):
+    // both reach their low-confidence samples in the same tick, the monitor latches a fault
+    // and holds one of them.
+    let robots = vec![support::task(0.0), support::task(0.0)];
+    let ctl =
+        AnyController::Rounds(tandem_realtime::Coordinator::new_unchecked(robots, 0.1).unwrap());
+    let cell = start(ctl, 0, Duration::from_millis(10));
+    let mut a = Browser::launch(&bin, cell.console.url());
+    a.wait(
+        "the page to control the cell",
+        "window.__lastFrame && window.__lastFrame.controller === window.__client",
+        Duration::from_secs(20),
+    );
+    a.wait(
+        "the fault on the page",
+        "window.__lastFrame.fault && document.querySelector('.robot[data-state=\"fault\"]') \
+         && /FAULT/.test(document.querySelector('.robot[data-state=\"fault\"] .strip').textContent)",
+        Duration::from_secs(20),
+    );
+    // A second page is read-only: its buttons are off, and a control it sends anyway is
+    // refused on it with the reason.
+    let mut b = Browser::launch(&bin, cell.console.url());
+    b.wait(
+        "the second page read-only",
+        "/read-only/.test(document.getElementById('role').textContent) && \
+         document.getElementById('clear').disabled",
+        Duration::from_secs(20),
+    );
+    b.eval("window.__send('clear_fault'); 1");
+    b.wait(
+        "the refusal on the second page",
+        "document.getElementById('status').dataset.ok === 'false' && \
+         /clear_fault refused: read-only: client .* controls the cell/.test(document.getElementById('status').textContent)",
+        Duration::from_secs(10),
+    );
+    // An out-of-order message from the controlling page: refused on it, with both ids.
+    a.eval("nextId = 1; window.__send('pause'); 1");
+    a.wait(
+        "the out-of-order refusal",
+        "/pause refused: out-of-order message: id 1 after id \\d+/.test(document.getElementById('status').textContent)",
+        Duration::from_secs(10),
+    );
+    a.eval("nextId = 1000; 1");
+    // Once no robot is low-confidence, the operator clears the fault with the page's button:
+    // the loop confirms it and the held robot moves again.
+    a.wait(
+        "the running robot past its stretch",
+        "window.__lastFrame.fault && !document.querySelector('.robot[data-state=\"lc\"]')",
+        Duration::from_secs(20),
+    );
+    a.eval("document.getElementById('clear').click(); 1");
+    a.wait(
+        "the clear confirmed",
+        "document.getElementById('status').dataset.ok === 'true' && \
+         /clear_fault confirmed: fault cleared/.test(document.getElementById('status').textContent)",
+        Duration::from_secs(10),
+    );
+    a.wait(
+        "no fault on the page",
+        "!window.__lastFrame.fault && !document.querySelector('.robot[data-state=\"fault\"]')",
+        Duration::from_secs(10),
+    );
+    drop(b);
+    drop(a);
+    // (The next round latches the same fault again: the plan is the same; not checked here.)
+    let ctl = cell.stop();
+    assert!(ctl.ticks() > 0);
 }

@@ -284,3 +284,72 @@ fn a_taken_port_is_a_clear_error_and_bad_settings_are_refused() {
         .to_string();
     assert!(err.contains("max_hz"), "{err}");
 }
+
+/// The page's countdown is the coordinator's pre-alert (`Tick::next`) of the tick the frame
+/// shows, exactly: robot, earliest start (the countdown), latest start; the pre-alert's lead is
+/// the switch time where that exceeds the configured 7 s.
+#[test]
+fn the_countdown_is_the_coordinators_pre_alert() {
+    use std::collections::HashMap;
+    use std::sync::Mutex;
+    use tandem_planner::AnyController;
+
+    let AnyController::Rounds(c) = support::rounds(3) else {
+        unreachable!("support::rounds is a rounds cell")
+    };
+    let ctl = AnyController::Rounds(c.with_switch_s(8.0).unwrap());
+    let geometry = Geometry::new(&ctl);
+    assert_eq!(geometry.switch_s(), 8.0);
+    let (console, mut handle) = Console::start(&ConsoleConfig::default(), geometry).unwrap();
+    let addr = console.addr();
+    type Seen = HashMap<u64, Option<tandem_realtime::PreAlert>>;
+    let truth: Arc<Mutex<Seen>> = Arc::default();
+    let stop = Arc::new(AtomicBool::new(false));
+    let (loop_truth, loop_stop) = (truth.clone(), stop.clone());
+    let worker = std::thread::spawn(move || {
+        let mut ctl = ctl;
+        while !loop_stop.load(Ordering::Relaxed) && !ctl.is_finished() {
+            let t = ctl.tick(Operator::Scheduled).unwrap();
+            loop_truth.lock().unwrap().insert(ctl.ticks(), t.next);
+            handle.publish(&t, &ctl);
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        handle.published()
+    });
+    let (mut looks, mut with_next, mut alerted, mut unbounded) = (0, 0, 0, 0);
+    let t0 = Instant::now();
+    while t0.elapsed() < Duration::from_millis(2500) {
+        let Some(f) = frame(addr) else { continue };
+        looks += 1;
+        assert_eq!(f.lead_s, 8.0, "the switch time exceeds the default 7 s");
+        let want = *truth
+            .lock()
+            .unwrap()
+            .get(&f.tick)
+            .expect("a published tick");
+        match (want, &f.next) {
+            (None, None) => {}
+            (Some(p), Some(n)) => {
+                with_next += 1;
+                assert_eq!(n.robot, p.robot + 1, "tick {}", f.tick);
+                assert_eq!(n.in_s, p.earliest_s, "tick {}", f.tick);
+                assert_eq!(n.latest_s, p.latest_s.is_finite().then_some(p.latest_s));
+                assert_eq!(f.prealert, p.earliest_s <= 8.0);
+                alerted += usize::from(f.prealert);
+                unbounded += usize::from(n.latest_s.is_none());
+                assert!(n.duration_s > 0.0, "{n:?}");
+            }
+            (w, n) => panic!("tick {}: coordinator {w:?}, page {n:?}", f.tick),
+        }
+        assert!(f.health.published >= f.tick, "{:?}", f.health);
+        std::thread::sleep(Duration::from_millis(15));
+    }
+    stop.store(true, Ordering::Relaxed);
+    let published = worker.join().unwrap();
+    console.stop();
+    assert!(
+        looks >= 20 && with_next >= 10 && alerted >= 1,
+        "{looks} looks, {with_next} with a pre-alert, {alerted} alerted, {unbounded} unbounded"
+    );
+    assert!(published > 0);
+}

@@ -70,7 +70,7 @@ fn out_counts<'py>(py: Python<'py>, counts: &[u64]) -> Bound<'py, PyArray1<i64>>
 /// :meth:`CyclicPlan.coordinator` or :meth:`Planner.continuous_coordinator`.
 #[pyclass(module = "tandem", name = "ContinuousCoordinator")]
 pub(crate) struct PyContinuousCoordinator {
-    inner: ContinuousCoordinator,
+    pub(crate) inner: ContinuousCoordinator,
 }
 
 impl PyContinuousCoordinator {
@@ -258,7 +258,7 @@ fn repr_counts(counts: &[u64]) -> String {
 /// What one :meth:`ContinuousCoordinator.tick` did, per robot.
 #[pyclass(module = "tandem", name = "CellTick", frozen)]
 pub(crate) struct PyCellTick {
-    inner: Tick,
+    pub(crate) inner: Tick,
 }
 
 #[pymethods]

@@ -53,7 +53,7 @@ pub(crate) fn operator(x: Option<&Bound<'_, PyAny>>) -> Result<Operator> {
 /// O(1) and allocates nothing on the Rust side.
 #[pyclass(module = "tandem", name = "Coordinator")]
 pub(crate) struct PyCoordinator {
-    inner: Coordinator,
+    pub(crate) inner: Coordinator,
 }
 
 impl PyCoordinator {
@@ -244,7 +244,7 @@ pub(crate) fn fault_dict<'py>(py: Python<'py>, f: &Fault) -> PyResult<Bound<'py,
 /// What one :meth:`Coordinator.tick` did, per robot.
 #[pyclass(module = "tandem", name = "Tick", frozen)]
 pub(crate) struct PyTick {
-    inner: Tick,
+    pub(crate) inner: Tick,
 }
 
 #[pymethods]

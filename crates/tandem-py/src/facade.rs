@@ -14,7 +14,7 @@ pub(crate) use tandem::planner::{
 };
 pub(crate) use tandem::realtime::continuous::{ContinuousCoordinator, Group, Token};
 pub(crate) use tandem::realtime::{
-    Coordinator, Fault, MAX_ROBOTS, Operator, RobotCount, Tick, Timeline,
+    Controller, Coordinator, Fault, MAX_ROBOTS, Operator, RobotCount, Tick, Timeline,
 };
 pub(crate) use tandem::schedule::cyclic::{GapPlan, Stretch};
 pub(crate) use tandem::schedule::{
@@ -33,6 +33,11 @@ pub(crate) use tandem::sim::workcell::{
     OperatorParams, RoundRun, correction_input, needs_correction, run_round_with,
 };
 pub(crate) use tandem::warp::{SignalRef, Warp, WarpParams, align};
+/// The operator's console (not in the facade: a server, as the command line uses it).
+pub(crate) use tandem_console::{
+    Console, ConsoleConfig, ConsoleHandle, DEFAULT_HORIZON_S, DEFAULT_LEAD_S, Driver,
+    Error as ConsoleError, Geometry,
+};
 
 pub(crate) use tandem::bag::{
     BagOptions, Recording, extend_schema as extend_bag_schema, is_bag, read_bag,

@@ -18,6 +18,9 @@
 //! - `continuous`: `tandem.ContinuousCoordinator`, the Rust coordinator of a continuous cell
 //!   (the token rule), from `CyclicPlan.coordinator` or `Planner.continuous_coordinator`,
 //!   one control tick per `tick(operator)`.
+//! - `console`: `tandem.Console`, the operator's console (a local web page, issue 42) fed by
+//!   a user's own control loop: `apply` the operator's controls at each tick boundary,
+//!   `publish` each tick.
 //! - `study` and `sim`: the simulated study of §III and its workcell.
 //! - `warp`: `tandem.align`, GDTW (Eq. 2–3).
 //! - `bag`: `tandem.read_bag`, a ROS 2 bag (rosbag2 MCAP) on one grid; `tandem.fit` takes
@@ -35,6 +38,7 @@
 
 mod arrays;
 mod bag;
+mod console;
 mod continuous;
 mod coordinator;
 mod cyclic;
@@ -55,6 +59,8 @@ use pyo3::prelude::*;
 mod _tandem {
     #[pymodule_export]
     use crate::bag::read_bag;
+    #[pymodule_export]
+    use crate::console::PyConsole;
     #[pymodule_export]
     use crate::continuous::{PyCellTick, PyContinuousCoordinator};
     #[pymodule_export]

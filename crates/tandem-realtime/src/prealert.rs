@@ -211,6 +211,12 @@ impl Reach {
         )
     }
 
+    /// Least real time (s) of motion from clock `s` (sample `at`) to clock `x` (sample
+    /// `x_at`) of plan `c`; 0 when `x ≤ s`.
+    pub(crate) fn fast_between(&self, c: &[f64], at: usize, s: f64, x_at: usize, x: f64) -> f64 {
+        (self.fast_at(c, x_at, x) - self.fast_at(c, at, s)).max(0.0)
+    }
+
     /// Least real time (s) from clock `s` (sample `at`) to the plan's end.
     pub(crate) fn fast_to_end(&self, c: &[f64], at: usize, s: f64) -> f64 {
         (self.fast[self.fast.len() - 1] - self.fast_at(c, at, s)).max(0.0)
@@ -223,25 +229,40 @@ impl Reach {
         (m + 1 < self.run_from.len()).then(|| self.fast_to_run[m].max(0.0))
     }
 
+    /// The plan's first run (the sample it starts at), or `None` without a run.
+    pub(crate) fn first_run(&self) -> Option<usize> {
+        let m = self.run_from[0];
+        (m + 1 < self.run_from.len()).then_some(m)
+    }
+
     /// Least real time (s) through the whole plan.
     pub(crate) fn fast_total(&self) -> f64 {
         self.fast[self.fast.len() - 1]
     }
 }
 
-/// Builds the alert from per-robot candidates `(earliest ticks, latest ticks)` at tick `h`:
-/// the smallest earliest, the lowest index on a tie.
+/// Builds the alert from per-robot candidates `(robot, earliest ticks, latest ticks)` at tick
+/// `h`: the smallest earliest, the lowest index on a tie.
 pub(crate) fn pick(
     candidates: impl Iterator<Item = (usize, u64, Option<u64>)>,
     h: f64,
 ) -> Option<PreAlert> {
-    let mut best: Option<(usize, u64, Option<u64>)> = None;
+    pick_ranked(candidates.map(|(i, e, l)| (i, e, l, i)), h)
+}
+
+/// As [`pick`], with a tie on the earliest broken by the smallest `rank` (then the first
+/// candidate): candidates `(robot, earliest ticks, latest ticks, rank)`.
+pub(crate) fn pick_ranked(
+    candidates: impl Iterator<Item = (usize, u64, Option<u64>, usize)>,
+    h: f64,
+) -> Option<PreAlert> {
+    let mut best: Option<(usize, u64, Option<u64>, usize)> = None;
     for cand in candidates {
-        if best.is_none_or(|b| cand.1 < b.1) {
+        if best.is_none_or(|b| cand.1 < b.1 || (cand.1 == b.1 && cand.3 < b.3)) {
             best = Some(cand);
         }
     }
-    best.map(|(robot, e, l)| PreAlert {
+    best.map(|(robot, e, l, _)| PreAlert {
         robot,
         earliest_s: e as f64 * h,
         latest_s: l.map_or(f64::INFINITY, |l| (l.max(e)) as f64 * h),

@@ -249,3 +249,59 @@ fn the_first_announcement_by_hand() {
     assert_eq!(a.robot, 1);
     assert!(a.latest_s.is_infinite());
 }
+
+/// The continuous cell names the robot the token passes to next, not the lowest-numbered
+/// robot waiting at a gate. By hand: [HC, LC, HC] of 1 s, bounds [½, 2], tick ½ s, three robots
+/// in the serial order 0, 1, 2, no switch time. After robot 0's stretch starts (clock 1 s), the
+/// token moves on no sooner than the end of the next tick (robot 0 through its second of
+/// low confidence at rate 2), so robot 1 passes its gate in the tick after and reports its
+/// stretch (1 s of clock on plan: two ticks) in the tick starting 2 ticks = 1 s from now;
+/// robot 2 waits as long but gets the token after robot 1. Then, whichever robot is in its
+/// stretch, the one named is the next in the order, never a robot waiting behind it (robot 0
+/// back at its gate while robot 1 has the token was named before: it is the lowest index).
+#[test]
+fn a_cell_names_the_robot_the_token_passes_to_next() {
+    let task = Timeline::new(
+        &[true, false, true],
+        &[1.0; 3],
+        &[0.5; 3],
+        &[2.0; 3],
+        0.0,
+        1.0,
+    )
+    .unwrap();
+    let mut cell = ContinuousCoordinator::new(task, &[], &[(0, 0), (1, 0), (2, 0)], 3, 0.5)
+        .unwrap()
+        .with_switch_s(0.0)
+        .unwrap();
+    let t = cell.tick(Operator::Scheduled).unwrap();
+    assert!(!t.low_conf[0]);
+    let t = cell.tick(Operator::Slowest).unwrap();
+    assert!(t.low_conf[0]);
+    let a = t.next.unwrap();
+    assert_eq!((a.robot, a.earliest_s), (1, 1.0));
+    assert!(a.latest_s.is_infinite());
+    let mut named = [0u32; 3];
+    for _ in 0..200 {
+        let t = cell.tick(Operator::Slowest).unwrap();
+        let Some(r) = (0..3).find(|&r| t.low_conf[r]) else {
+            continue;
+        };
+        let a = t.next.unwrap();
+        assert_eq!(
+            a.robot,
+            (r + 1) % 3,
+            "robot {r} in its stretch: {a:?}; {:?} {:?} {:?}",
+            t.ref_time,
+            t.waiting,
+            cell.token()
+        );
+        // The token must move on first: at least one tick.
+        assert!(a.earliest_s >= 0.5, "{a:?}");
+        named[a.robot] += 1;
+    }
+    assert!(
+        named.iter().all(|&k| k > 0),
+        "every robot named in turn: {named:?}"
+    );
+}

@@ -226,7 +226,13 @@ impl ContinuousCoordinator {
     /// tick that starts it (the switch wait of a token holder included, gates counted as 0)
     /// and, for a robot holding the token of the group the run is in and not held by the fault
     /// monitor, the most (else the token's next move, set by the others, bounds it: `+∞`).
-    /// O(N), no allocation.
+    /// A stretch whose token is not the current one (another robot's, or a later group of
+    /// the same robot) cannot start before the token moves on, which is no sooner than the
+    /// tick after the one that takes the token's robot past its group at its fastest, plus
+    /// the run from the stretch's gate: its earliest is at least that. Of the robots with the
+    /// same earliest (several waiting at their gates) the one named is the robot the token
+    /// passes to first.
+    /// O(N) plus a scan of the token sequence up to the last robot's next turn; no allocation.
     pub fn pre_alert(&self) -> Option<crate::PreAlert> {
         let h = self.tick_s;
         let next_tick = self.monitor.ticks();
@@ -234,7 +240,57 @@ impl ContinuousCoordinator {
         let held = self.monitor.held();
         let c = self.task.sample_clock_s();
         let reach = &*self.reach;
+        // Ticks before the token can move on: its robot must first pass the end of its group
+        // (less the clock tolerance, on the safe side) at its fastest.
+        let token_moves = tok.map_or(0, |t| {
+            let s = self.clock_s[t.robot];
+            let x = (self.leave_s[t.group].min(self.task.end_s()) - self.tol_s).max(0.0);
+            let lo = reach.fast_between(c, self.cursors[t.robot].at, s, self.task.sample_at(x), x);
+            prealert::ticks_before_at_least(lo, h)
+        });
+        // Each robot's next turn after the current token's: token positions from the current
+        // one to its first token after it.
+        let mut turn = [usize::MAX; MAX_ROBOTS];
+        let len = self.tokens.len();
+        let (mut k, mut pass, mut found) = (self.pos, self.passes, 0);
+        for step in 0..len {
+            k += 1;
+            if k == len {
+                k = 0;
+                pass += 1;
+            }
+            if pass > 0 || !self.skip_first[k] {
+                let r = self.tokens[k].robot;
+                if turn[r] == usize::MAX {
+                    turn[r] = step;
+                    found += 1;
+                    if found == self.n {
+                        break;
+                    }
+                }
+            }
+        }
         let cands = (0..self.n).filter_map(|i| {
+            // A stretch in group `G` starts only after its robot passes `G`'s gate with the
+            // token `(robot, G)`. Unless that is the current token and the robot's next group,
+            // the token must move on first: the robot passes the gate no sooner than the tick
+            // after, then runs from the gate to the stretch (run `m`; `next_task`: `m` is in the
+            // robot's next task, after this one's end).
+            // The rank on a tie: 0 with the token, else the robot's next turn.
+            let after_token = |e: u64, m: usize, next_task: bool| {
+                let g = self.group_of[m];
+                let next_group = if next_task { 0 } else { self.next_group[i] };
+                let past_groups = !next_task || self.next_group[i] >= self.groups.len();
+                if tok.is_some_and(|t| t.robot == i && t.group == g)
+                    && next_group == g
+                    && past_groups
+                {
+                    return (e, 0);
+                }
+                let (from_gate, _) = reach.to_run_from_sample(self.groups[g].gate, m);
+                let e = e.max(token_moves + 1 + prealert::ticks_before_at_least(from_gate, h));
+                (e, turn[i])
+            };
             let s = self.clock_s[i];
             let at = self.cursors[i].at;
             let holder = tok.is_some_and(|t| t.robot == i && t.group == self.next_group[i]);
@@ -261,14 +317,18 @@ impl ContinuousCoordinator {
                 let latest = (holder && held != Some(i) && self.group_of[m] == self.next_group[i])
                     .then(|| prealert::ticks_before_at_most(hi, h).map(|t| t + slack))
                     .flatten();
-                return Some((i, earliest, latest));
+                let (earliest, rank) = after_token(earliest, m, false);
+                return Some((i, earliest, latest, rank));
             }
             reach.fast_to_first_run().map(|first| {
                 let lo = reach.fast_to_end(c, at, s) + first;
-                (i, wait + prealert::ticks_before_at_least(lo, h), None)
+                let earliest = wait + prealert::ticks_before_at_least(lo, h);
+                let m = reach.first_run().unwrap_or(0);
+                let (earliest, rank) = after_token(earliest, m, true);
+                (i, earliest, None, rank)
             })
         });
-        prealert::pick(cands, h)
+        prealert::pick_ranked(cands, h)
     }
 
     /// Every robot back at sample 0 of its first task, the token at its first entry, the
