@@ -182,10 +182,17 @@ impl Browser {
         let guarded =
             format!("(() => {{ try {{ return !!({expr}); }} catch (e) {{ return false; }} }})()");
         while self.eval(&guarded) != json!(true) {
-            assert!(
-                t0.elapsed() < timeout,
-                "timed out waiting for {what} ({expr})"
-            );
+            if t0.elapsed() >= timeout {
+                // What the page showed, so a failure says why, not only that.
+                let seen = self.eval(
+                    "(() => { const s = document.getElementById('status'); \
+                     return { status: s ? s.textContent : null, ok: s ? s.dataset.ok : null, \
+                     fault: window.__lastFrame ? window.__lastFrame.fault : null, \
+                     controller: window.__lastFrame ? window.__lastFrame.controller : null, \
+                     client: window.__client || null }; })()",
+                );
+                panic!("timed out waiting for {what} ({expr}); the page showed {seen}");
+            }
             std::thread::sleep(Duration::from_millis(30));
         }
     }
