@@ -514,7 +514,10 @@ impl CellLoop {
                 }
             }
         }
-        let before = self.ctl.ref_time_now();
+        // The controller's reference times now: its last tick's (the contract: `Tick::ref_time`
+        // is `ref_time_now()` after the tick; `last` is refreshed whenever a request changes
+        // the controller), read from there instead of the controller, twice a tick.
+        let before = self.last.ref_time;
         let mut overlap = false;
         if self.active && self.stall.is_none() {
             let fresh = self.operator_at.is_some_and(|t| {
@@ -566,7 +569,8 @@ impl CellLoop {
                 self.finished = true;
             }
         }
-        let after = self.ctl.ref_time_now();
+        let after = self.last.ref_time;
+        debug_assert_eq!(after, self.ctl.ref_time_now());
         let mut speed = PerRobot::<f64>::new(n);
         let per_tick = self.ctl.tick_s() / self.dt_s;
         for (i, s) in speed.as_mut_slice().iter_mut().enumerate() {
