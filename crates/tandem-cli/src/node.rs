@@ -29,6 +29,13 @@ pub(crate) struct NodeArgs {
     /// A robot silent this long (s) while the cell runs is a fault: the cell holds.
     #[arg(long, value_name = "S", default_value_t = 0.25)]
     pub(crate) stall: f64,
+    /// Serve the operator console (a local web page) showing the live node; its URL is the
+    /// first line printed.
+    #[arg(long)]
+    pub(crate) console: bool,
+    /// The console's port on 127.0.0.1 (0: a free one). Needs --console.
+    #[arg(long, value_name = "P", requires = "console")]
+    pub(crate) port: Option<u16>,
     /// Stop after this long (s). Default: run until interrupted.
     #[arg(long, value_name = "S")]
     pub(crate) seconds: Option<f64>,
@@ -52,8 +59,23 @@ pub(crate) fn node(a: &NodeArgs) -> Result<()> {
             "--seconds {s}: give a duration > 0 (s), or leave it out to run until interrupted"
         );
     }
-    let node = Node::start(&a.state, &params)
-        .with_context(|| format!("cannot start the node on {}", a.state.display()))?;
+    let node = if a.console {
+        let config = tandem_console::ConsoleConfig {
+            port: a.port.unwrap_or(0),
+            schedule: Some(format!(
+                "the state file's {} cell, run by a ROS 2 node",
+                a.cell
+            )),
+            ..tandem_console::ConsoleConfig::default()
+        };
+        Node::start_with_console(&a.state, &params, &config)
+    } else {
+        Node::start(&a.state, &params)
+    }
+    .with_context(|| format!("cannot start the node on {}", a.state.display()))?;
+    if let Some(url) = node.console_url() {
+        out(url);
+    }
     out(&format!(
         "tandem node: {} robots, tick {:.4} s, DDS domain {}; topics /tandem/robot1..{}/{{progress,command,setpoint,needs_operator}}, /tandem/{{next_handover,fault,operator}}; services /tandem/{{start_round,stop_round,clear_fault,record_round}}",
         node.n_robots(),

@@ -15,9 +15,10 @@ use std::sync::mpsc::sync_channel;
 use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use tandem_console::{Console, ConsoleConfig, Geometry};
 use tandem_planner::Cell;
 use tandem_realtime::{Controller, Operator};
-use tandem_ros2::{CellLoop, Inbound, LoopParams, Request, Snapshot};
+use tandem_ros2::{CellLoop, ConsoleFeed, Inbound, LoopParams, Request, Snapshot};
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -69,7 +70,37 @@ fn bench(c: &mut Criterion) {
             black_box(state_rx.try_recv().ok())
         });
     });
+    // The same with the node's console attached (`tandem node --console`): the feed after each
+    // step, a server running (no page open: the server asks for a snapshot at its rate anyway).
+    let ctl = planner.controller(Cell::Rounds).expect("a plan");
+    let (console, handle) =
+        Console::start(&ConsoleConfig::default(), Geometry::new(&ctl)).expect("a free port");
+    let mut feed = ConsoleFeed::new(handle);
+    let mut l = CellLoop::new(ctl, planner.model(), LoopParams::default()).expect("valid");
+    start(&mut l);
+    group.bench_function("with_queues_and_console", |b| {
+        b.iter(|| {
+            for k in 0..3 {
+                let _ = in_tx.try_send(Inbound::Progress {
+                    robot: k,
+                    ref_time: 0.0,
+                });
+            }
+            let now = Instant::now();
+            while let Ok(m) = in_rx.try_recv() {
+                l.handle(m, now, &mut |_| {});
+            }
+            let s = l.step(now).expect("a valid operator");
+            feed.publish(&l, &s);
+            let _ = state_tx.try_send(s);
+            if s.finished {
+                start(&mut l);
+            }
+            black_box(state_rx.try_recv().ok())
+        });
+    });
     group.finish();
+    console.stop();
 }
 
 criterion_group!(benches, bench);

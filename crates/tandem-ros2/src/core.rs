@@ -8,9 +8,12 @@
 
 use std::time::Instant;
 
+use tandem_console::tick_now;
 use tandem_lfd::{Demonstration, Execution, TaskModel};
 use tandem_planner::{AnyController, Cell, ExecutionRecord};
-use tandem_realtime::{Controller, Fault, MAX_ROBOTS, Operator, PerRobot, PreAlert, RobotFlags};
+use tandem_realtime::{
+    Controller, Fault, MAX_ROBOTS, Operator, PerRobot, PreAlert, RobotFlags, Tick,
+};
 
 use crate::error::{Error, Result};
 
@@ -302,6 +305,9 @@ pub struct CellLoop {
     log: RoundLog,
     capacity: usize,
     ticks: u64,
+    /// The controller's last [`Tick`], or its state as one while it has not ticked since a
+    /// start, stop or fault clearance ([`CellLoop::last_tick`]).
+    last: Tick,
 }
 
 impl CellLoop {
@@ -332,7 +338,6 @@ impl CellLoop {
                 .collect(),
         };
         Ok(CellLoop {
-            ctl,
             pending: None,
             params,
             dt_s,
@@ -348,6 +353,8 @@ impl CellLoop {
             log,
             capacity,
             ticks: 0,
+            last: tick_now(&ctl),
+            ctl,
         })
     }
 
@@ -355,6 +362,15 @@ impl CellLoop {
     #[must_use]
     pub fn controller(&self) -> &AnyController {
         &self.ctl
+    }
+
+    /// The controller's last tick: the one [`step`](Self::step) ran, or, while the controller
+    /// has not ticked since the loop began or a request changed it (start, stop, clear fault),
+    /// its state now as a tick. What a console's [`publish`](tandem_console::ConsoleHandle::publish)
+    /// takes beside [`controller`](Self::controller).
+    #[must_use]
+    pub fn last_tick(&self) -> &Tick {
+        &self.last
     }
 
     /// Takes one message from the DDS side in at `now`; a request's answer goes to `reply`.
@@ -387,6 +403,7 @@ impl CellLoop {
                     }
                 } else {
                     let result = self.request(what, now);
+                    self.last = tick_now(&self.ctl);
                     reply(Reply::Done {
                         token,
                         what,
@@ -497,7 +514,10 @@ impl CellLoop {
                 }
             }
         }
-        let before = self.ctl.ref_time_now();
+        // The controller's reference times now: its last tick's (the contract: `Tick::ref_time`
+        // is `ref_time_now()` after the tick; `last` is refreshed whenever a request changes
+        // the controller), read from there instead of the controller, twice a tick.
+        let before = self.last.ref_time;
         let mut overlap = false;
         if self.active && self.stall.is_none() {
             let fresh = self.operator_at.is_some_and(|t| {
@@ -527,6 +547,7 @@ impl CellLoop {
                 }
             }
             let tick = self.ctl.tick(operator)?;
+            self.last = tick;
             overlap = tick.overlap();
             if logging {
                 // A robot that started the tick unsupervised but traversed a low-confidence
@@ -548,7 +569,8 @@ impl CellLoop {
                 self.finished = true;
             }
         }
-        let after = self.ctl.ref_time_now();
+        let after = self.last.ref_time;
+        debug_assert_eq!(after, self.ctl.ref_time_now());
         let mut speed = PerRobot::<f64>::new(n);
         let per_tick = self.ctl.tick_s() / self.dt_s;
         for (i, s) in speed.as_mut_slice().iter_mut().enumerate() {

@@ -45,6 +45,9 @@ pub enum Error {
     /// The run-time coordinator.
     #[error(transparent)]
     Realtime(#[from] tandem_realtime::Error),
+    /// The operator console (`--console`): its settings or its address.
+    #[error("the console: {0}")]
+    Console(#[from] tandem_console::Error),
     /// The task model.
     #[error(transparent)]
     Lfd(#[from] tandem_lfd::Error),

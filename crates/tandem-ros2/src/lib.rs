@@ -6,9 +6,11 @@
 //!
 //! - [`core`]: the control loop without the network ([`CellLoop`]), testable alone;
 //! - [`node`]: the threads and the topics and services ([`Node`]; the table is in its docs);
+//! - [`console`]: the tick thread's feed of an operator console ([`ConsoleFeed`]);
 //! - [`msg`]: the standard message types, as serde structs;
 //! - [`probe`]: a client of the node over DDS (robots, operator, services) for tests.
 
+pub mod console;
 pub mod core;
 mod error;
 pub mod msg;
@@ -18,6 +20,7 @@ pub mod probe;
 pub use crate::core::{
     CellLoop, Inbound, LoopParams, NodeFault, Reply, Request, RoundLog, Snapshot,
 };
+pub use console::ConsoleFeed;
 pub use error::{Error, Result};
 pub use node::{Node, NodeParams, NodeStats};
 pub use probe::Probe;

@@ -28,11 +28,13 @@ use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, Node as RosNode, NodeName, NodeOptions,
     Publisher, QosProfile, RmwRequestId, Server, ServiceMapping, ServiceTypeName, Subscription,
 };
+use tandem_console::{Console, ConsoleConfig, Geometry};
 use tandem_lfd::TaskModel;
 use tandem_planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 use tandem_planner::{Cell, Planner};
 use tandem_realtime::Controller;
 
+use crate::console::ConsoleFeed;
 use crate::core::{CellLoop, Inbound, LoopParams, Reply, Request, RoundLog, Snapshot};
 use crate::error::{Error, Result, dds};
 use crate::msg::{
@@ -142,6 +144,7 @@ pub struct Node {
     io: Option<JoinHandle<Result<()>>>,
     n_robots: usize,
     tick_s: f64,
+    console: Option<Console>,
 }
 
 impl Node {
@@ -153,6 +156,28 @@ impl Node {
     /// Bad `params`; the planner's errors loading the state or planning the cell;
     /// [`Error::RobotCount`]; [`Error::Dds`] when an entity cannot be created.
     pub fn start(state: &Path, params: &NodeParams) -> Result<Node> {
+        Node::start_inner(state, params, None)
+    }
+
+    /// [`Node::start`] with an operator console on `console`'s address fed by the tick thread
+    /// ([`ConsoleFeed`]): the page at [`Node::console_url`] shows the live node.
+    ///
+    /// # Errors
+    /// Those of [`Node::start`]; [`Error::Console`] for bad `console` settings or an address
+    /// that is taken.
+    pub fn start_with_console(
+        state: &Path,
+        params: &NodeParams,
+        console: &ConsoleConfig,
+    ) -> Result<Node> {
+        Node::start_inner(state, params, Some(console))
+    }
+
+    fn start_inner(
+        state: &Path,
+        params: &NodeParams,
+        console: Option<&ConsoleConfig>,
+    ) -> Result<Node> {
         params.validate()?;
         let planner = Planner::load(state)?;
         let n = planner.n_robots();
@@ -163,6 +188,13 @@ impl Node {
         }
         let ctl = planner.controller(params.cell)?;
         let tick_s = ctl.tick_s();
+        let (console, feed) = match console {
+            Some(config) => {
+                let (console, handle) = Console::start(config, Geometry::new(&ctl))?;
+                (Some(console), Some(ConsoleFeed::new(handle)))
+            }
+            None => (None, None),
+        };
         let model = planner.model().clone();
         let cell_loop = CellLoop::new(ctl, &model, params.loop_params.clone())?;
         let stop = Arc::new(AtomicBool::new(false));
@@ -209,6 +241,7 @@ impl Node {
             reply_tx,
             stop: stop.clone(),
             counters: counters.clone(),
+            console: feed,
         };
         let tick = std::thread::Builder::new()
             .name("tandem-tick".into())
@@ -224,7 +257,14 @@ impl Node {
             io: Some(io),
             n_robots: n,
             tick_s,
+            console,
         })
+    }
+
+    /// The console's page (`http://127.0.0.1:PORT/`) when started with one.
+    #[must_use]
+    pub fn console_url(&self) -> Option<&str> {
+        self.console.as_ref().map(Console::url)
     }
 
     /// Robots it runs.
@@ -272,6 +312,9 @@ impl Node {
         self.stop.store(true, Ordering::Relaxed);
         let tick = self.tick.take().map(|h| join(h, "tandem-tick"));
         let io = self.io.take().map(|h| join(h, "tandem-dds"));
+        if let Some(c) = self.console.take() {
+            c.stop();
+        }
         tick.transpose()?;
         io.transpose()?;
         Ok(self.stats())
@@ -304,6 +347,7 @@ struct Ticker {
     reply_tx: SyncSender<Reply>,
     stop: Arc<AtomicBool>,
     counters: Arc<Counters>,
+    console: Option<ConsoleFeed>,
 }
 
 impl Ticker {
@@ -332,6 +376,9 @@ impl Ticker {
                 }
             }
             let snap = self.cell_loop.step(now)?;
+            if let Some(feed) = &mut self.console {
+                feed.publish(&self.cell_loop, &snap);
+            }
             if let Err(TrySendError::Full(_)) = self.state_tx.try_send(snap) {
                 c.state_dropped.fetch_add(1, Ordering::Relaxed);
             }

@@ -1,0 +1,202 @@
+//! The node feeds the operator console (issue 43, "the console and the node share one
+//! source"): the console's `/frame` shows the loop's own tick, its low-confidence robot is the
+//! node's `needs_operator`, and a node started with a console serves the live round.
+//! Loopback only.
+
+mod support;
+
+use std::io::{Read, Write};
+use std::net::{SocketAddr, TcpStream};
+use std::time::{Duration, Instant};
+
+use tandem_console::{Console, ConsoleConfig, Frame, Geometry, RobotState};
+use tandem_planner::Cell;
+use tandem_realtime::Controller;
+use tandem_ros2::{CellLoop, ConsoleFeed, Inbound, LoopParams, Node, NodeParams, Probe, Request};
+
+/// One HTTP/1.1 request; returns the status and the body.
+fn http(addr: SocketAddr, method: &str, path: &str) -> (u16, String) {
+    let mut s = TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    write!(
+        s,
+        "{method} {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\nContent-Length: 0\r\n\r\n"
+    )
+    .unwrap();
+    let mut out = String::new();
+    s.read_to_string(&mut out).unwrap();
+    let status = out[9..12].parse().unwrap();
+    let body = out.split_once("\r\n\r\n").map_or("", |x| x.1).to_string();
+    (status, body)
+}
+
+/// The newest frame, or `None` before the loop's first (503).
+fn frame(addr: SocketAddr) -> Option<Frame> {
+    let (status, body) = http(addr, "GET", "/frame");
+    if status == 503 {
+        return None;
+    }
+    assert_eq!(status, 200, "{body}");
+    Some(serde_json::from_str(&body).unwrap())
+}
+
+fn lc_robots(f: &Frame) -> Vec<usize> {
+    f.robots
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.state == RobotState::Lc)
+        .map(|(i, _)| i)
+        .collect()
+}
+
+#[test]
+fn the_consoles_lc_robot_is_the_nodes_needs_operator_at_every_change() {
+    let planner = support::planner(2);
+    let ctl = planner.controller(Cell::Rounds).unwrap();
+    let (console, handle) = Console::start(&ConsoleConfig::default(), Geometry::new(&ctl)).unwrap();
+    let addr = console.addr();
+    let mut feed = ConsoleFeed::new(handle);
+    let mut cell = CellLoop::new(ctl, planner.model(), LoopParams::default()).unwrap();
+    let t0 = Instant::now();
+    let tick = Duration::from_secs_f64(cell.controller().tick_s());
+    let mut replies = Vec::new();
+    cell.handle(
+        Inbound::Request {
+            token: 1,
+            what: Request::Start,
+        },
+        t0,
+        &mut |r| replies.push(r),
+    );
+    assert_eq!(replies.len(), 1);
+    let mut before: Option<Vec<usize>> = None;
+    let (mut checked, mut with_lc, mut without_lc) = (0, 0, 0);
+    for i in 1..=10_000_u32 {
+        let now = t0 + tick * i;
+        for robot in 0..2 {
+            let ref_time = cell.last_tick().ref_time[robot];
+            cell.handle(Inbound::Progress { robot, ref_time }, now, &mut |_| {});
+        }
+        let snap = cell.step(now).unwrap();
+        let needs: Vec<usize> = (0..2).filter(|&k| snap.needs_operator[k]).collect();
+        // At every change of the robot that needs the operator (and the round's end): the
+        // loop holds still and publishes until the page's frame is this tick's.
+        if before.as_ref() != Some(&needs) || snap.finished {
+            let want = cell.controller().ticks();
+            let end = Instant::now() + Duration::from_secs(10);
+            let f = loop {
+                feed.publish(&cell, &snap);
+                if let Some(f) = frame(addr).filter(|f| f.tick == want) {
+                    break f;
+                }
+                assert!(Instant::now() < end, "no frame of tick {want}");
+                std::thread::sleep(Duration::from_millis(5));
+            };
+            assert_eq!(lc_robots(&f), needs, "tick {want}: {f:?}");
+            assert!(needs.len() <= 1, "two robots need the operator: {needs:?}");
+            checked += 1;
+            if needs.is_empty() {
+                without_lc += 1;
+            } else {
+                with_lc += 1;
+            }
+            before = Some(needs);
+        } else {
+            feed.publish(&cell, &snap);
+        }
+        if snap.finished {
+            // The round's end is counted on the page.
+            let f = loop {
+                feed.publish(&cell, &snap);
+                if let Some(f) = frame(addr).filter(|f| f.rounds_done == 1) {
+                    break f;
+                }
+                std::thread::sleep(Duration::from_millis(5));
+            };
+            assert_eq!(f.rounds_done, 1);
+            break;
+        }
+    }
+    eprintln!("{checked} changes checked: {with_lc} with a robot lc, {without_lc} without");
+    // Both robots' low-confidence runs (reference samples 10..20) begin and end: at least
+    // two frames with a robot lc and three without.
+    assert!(with_lc >= 2 && without_lc >= 3, "{with_lc} / {without_lc}");
+    assert!(feed.published() > 0);
+    console.stop();
+}
+
+#[test]
+fn a_node_with_a_console_serves_its_live_round() {
+    let state = support::state_file("console", 2);
+    let params = NodeParams {
+        domain: 70,
+        robots: Some(2),
+        ..NodeParams::default()
+    };
+    let node = Node::start_with_console(&state, &params, &ConsoleConfig::default()).unwrap();
+    let url = node.console_url().expect("a console").to_string();
+    assert!(url.starts_with("http://127.0.0.1:"), "{url}");
+    let addr: SocketAddr = url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .parse()
+        .unwrap();
+    // Before a round: the page shows the node's two robots, none low-confidence.
+    let end = Instant::now() + Duration::from_secs(10);
+    let idle = loop {
+        if let Some(f) = frame(addr) {
+            break f;
+        }
+        assert!(Instant::now() < end, "no frame from the node");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(idle.robots.len(), 2);
+    // A round driven over DDS: the page follows the node's controller tick by tick and counts
+    // the round once it ends.
+    let probe = Probe::new(70, 2).unwrap();
+    let echo = || {
+        for k in 0..2 {
+            if let Some(c) = probe.commands(k).last() {
+                probe.report(k, c.ref_time).unwrap();
+            }
+        }
+    };
+    // Discovery on loopback first: both robots' commands reach the probe.
+    let end = Instant::now() + Duration::from_secs(30);
+    let mut seen = [false; 2];
+    while !seen.iter().all(|&s| s) {
+        for (k, s) in seen.iter_mut().enumerate() {
+            *s |= !probe.commands(k).is_empty();
+        }
+        assert!(Instant::now() < end, "no discovery on loopback");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let r = probe
+        .call("start_round", Duration::from_secs(10), echo)
+        .unwrap();
+    assert!(r.success, "{}", r.message);
+    let end = Instant::now() + Duration::from_secs(60);
+    let mut ticks = Vec::new();
+    let mut lc_seen = false;
+    loop {
+        echo();
+        if let Some(f) = frame(addr) {
+            ticks.push(f.tick);
+            lc_seen |= !lc_robots(&f).is_empty();
+            assert!(lc_robots(&f).len() <= 1, "{f:?}");
+            if f.rounds_done == 1 {
+                break;
+            }
+        }
+        assert!(
+            Instant::now() < end,
+            "the page never showed the round's end"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    assert!(ticks.windows(2).all(|w| w[0] <= w[1]), "{ticks:?}");
+    assert!(ticks.last() > ticks.first(), "{ticks:?}");
+    assert!(lc_seen, "no frame showed a robot low-confidence");
+    node.stop().unwrap();
+    support::remove(&state);
+}
