@@ -115,6 +115,8 @@ impl RecordedTick {
                 clock_s: t.clock_s,
                 ref_time: t.ref_time,
                 tasks: t.tasks,
+                // Recordings do not carry the operator's input: the page shows none.
+                corrections: 0,
             };
         }
         raw
