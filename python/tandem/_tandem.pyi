@@ -517,9 +517,13 @@ class Console:
     def apply(self, controller: Union[Coordinator, ContinuousCoordinator]) -> bool:
         """Applies the operator's controls at a tick boundary; ``False`` while paused."""
     def publish(
-        self, tick: Union[Tick, CellTick], controller: Union[Coordinator, ContinuousCoordinator]
+        self,
+        tick: Union[Tick, CellTick],
+        controller: Union[Coordinator, ContinuousCoordinator],
+        corrected: Optional[bool] = None,
     ) -> None:
-        """Hands the state after ``tick`` to the page (never blocks)."""
+        """Hands the state after ``tick`` to the page (never blocks); ``corrected``: whether
+        this tick's input was a correction (the strip counts them; ``None``: not reported)."""
     def round_done(self) -> None: ...
     @property
     def paused(self) -> bool: ...

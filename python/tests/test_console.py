@@ -90,6 +90,17 @@ def test_the_page_shows_the_coordinators_lc_robot_and_pre_alert(overlapping_plan
             assert frame["prealert"] == (pre["earliest_s"] <= frame["lead_s"])
         assert frame["lead_s"] == 7.0
         assert frame["health"]["published"] >= ticks
+        # Not reported yet: no count on the strip.
+        assert all(r["strip"]["corrections"] is None for r in frame["robots"])
+        # Two corrected ticks in a row on the lc robot are one correction; others none.
+        for _ in range(2):
+            assert coord.low_conf_now.any()
+            tick = coord.tick()
+            ticks += 1
+            console.publish(tick, coord, corrected=True)
+        frame = serve_until(console, coord, tick, lambda f: f["tick"] == ticks, f"tick {ticks}")
+        counts = {r["robot"]: r["strip"]["corrections"] for r in frame["robots"]}
+        assert counts == {k: (1 if k == lc else 0) for k in counts}, counts
 
         # The event stream carries the same frames.
         with urllib.request.urlopen(console.url + "events", timeout=5) as stream:

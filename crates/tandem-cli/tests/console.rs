@@ -140,7 +140,7 @@ fn bad_console_input_exits_2_with_the_reason() {
     let s = state.to_str().unwrap();
     let rec = dir.join("run.jsonl");
     let r = rec.to_str().unwrap();
-    let cases: [(&[&str], &str); 11] = [
+    let cases: [(&[&str], &str); 12] = [
         (&["console", s, "--simulate", "--lead=-1"], "--lead -1"),
         (&["console", s], "needs a source: STATE --simulate"),
         (
@@ -174,6 +174,10 @@ fn bad_console_input_exits_2_with_the_reason() {
         (
             &["console", "--replay", s, "--check"],
             "not a console recording",
+        ),
+        (
+            &["console", "--replay", "run.mcap", "--check"],
+            "an MCAP bag is not a console recording",
         ),
         (
             &["console", s, "--simulate", "--replay", r],

@@ -85,6 +85,11 @@ pub struct RawRobot {
     pub ref_time: f64,
     /// Tasks it completed ([`Controller::tasks_now`]).
     pub tasks: u64,
+    /// Corrections the operator gave it in its current execution (task; rounds: this round):
+    /// runs of consecutive ticks whose input was a correction while it was the supervised
+    /// robot. Counted by [`ConsoleHandle::publish_corrected`](crate::ConsoleHandle::publish_corrected);
+    /// meaningful only when [`RawFrame::corrections_known`].
+    pub corrections: u64,
 }
 
 /// The fixed-size snapshot a control loop publishes each tick
@@ -117,14 +122,20 @@ pub struct RawFrame {
     /// Snapshots the loop handed to the handle so far, this one included (the server sends
     /// at most `max_hz` of them a second: the rest are dropped).
     pub published: u64,
+    /// Whether the loop reports its operator's corrections
+    /// ([`ConsoleHandle::publish_corrected`](crate::ConsoleHandle::publish_corrected)): the
+    /// robots' [`RawRobot::corrections`] count; otherwise the page shows none.
+    pub corrections_known: bool,
     /// Each robot, robot `i` at index `i` (the first `n` are meaningful).
     pub robots: [RawRobot; MAX_ROBOTS],
 }
 
 /// Words of a [`RawFrame`]'s header in the slot.
 pub(crate) const HEADER: usize = 11;
-/// Words of a [`RawFrame`] in the slot: [`HEADER`], then 4 per robot.
-pub(crate) const WORDS: usize = HEADER + 4 * MAX_ROBOTS;
+/// Words of one robot of a [`RawFrame`] in the slot.
+pub(crate) const ROBOT_WORDS: usize = 5;
+/// Words of a [`RawFrame`] in the slot: [`HEADER`], then [`ROBOT_WORDS`] per robot.
+pub(crate) const WORDS: usize = HEADER + ROBOT_WORDS * MAX_ROBOTS;
 
 impl RawFrame {
     /// The snapshot of `ctl` after `tick` (`rounds`: the cell runs in rounds, where a robot
@@ -158,6 +169,7 @@ impl RawFrame {
                 clock_s: clocks.get(i).copied().unwrap_or(0.0),
                 ref_time: tick.ref_time[i],
                 tasks: tick.tasks[i],
+                corrections: 0,
             };
         }
         RawFrame {
@@ -175,7 +187,8 @@ impl RawFrame {
         let flags = u64::from(self.paused)
             | u64::from(self.fault) << 1
             | u64::from(self.hold_armed.is_some()) << 2
-            | u64::from(self.next.is_some()) << 3;
+            | u64::from(self.next.is_some()) << 3
+            | u64::from(self.corrections_known) << 4;
         let next = self.next.unwrap_or(PreAlert {
             robot: 0,
             earliest_s: 0.0,
@@ -193,11 +206,12 @@ impl RawFrame {
         out[9] = next.latest_s.to_bits();
         out[10] = self.published;
         for (i, r) in self.robots.iter().enumerate().take(self.n) {
-            let w = &mut out[HEADER + 4 * i..HEADER + 4 + 4 * i];
+            let w = &mut out[HEADER + ROBOT_WORDS * i..HEADER + ROBOT_WORDS * (i + 1)];
             w[0] = r.state.code();
             w[1] = r.clock_s.to_bits();
             w[2] = r.ref_time.to_bits();
             w[3] = r.tasks;
+            w[4] = r.corrections;
         }
     }
 
@@ -205,12 +219,13 @@ impl RawFrame {
         let n = (w[0] as usize).min(MAX_ROBOTS);
         let mut robots = [RawRobot::default(); MAX_ROBOTS];
         for (i, r) in robots.iter_mut().enumerate().take(n) {
-            let w = &w[HEADER + 4 * i..HEADER + 4 + 4 * i];
+            let w = &w[HEADER + ROBOT_WORDS * i..HEADER + ROBOT_WORDS * (i + 1)];
             *r = RawRobot {
                 state: RobotState::from_code(w[0]),
                 clock_s: f64::from_bits(w[1]),
                 ref_time: f64::from_bits(w[2]),
                 tasks: w[3],
+                corrections: w[4],
             };
         }
         RawFrame {
@@ -228,6 +243,7 @@ impl RawFrame {
                 latest_s: f64::from_bits(w[9]),
             }),
             published: w[10],
+            corrections_known: w[4] & 16 != 0,
             robots,
         }
     }
@@ -800,6 +816,7 @@ mod tests {
                 latest_s: f64::INFINITY,
             }),
             published: 123,
+            corrections_known: true,
             ..RawFrame::default()
         };
         for (i, s) in [RobotState::Lc, RobotState::Fault, RobotState::Done]
@@ -811,6 +828,7 @@ mod tests {
                 clock_s: 1.25 * i as f64,
                 ref_time: 3.5 + i as f64,
                 tasks: 10 + i as u64,
+                corrections: 2 * i as u64 + 1,
             };
         }
         let mut words = [0; WORDS];

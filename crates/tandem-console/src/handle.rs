@@ -16,9 +16,9 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use serde::{Deserialize, Serialize};
 use tandem_planner::AnyController;
-use tandem_realtime::{ContinuousCoordinator, Controller, Coordinator, Tick};
+use tandem_realtime::{ContinuousCoordinator, Controller, Coordinator, MAX_ROBOTS, Tick};
 
-use crate::frame::{Ack, HEADER, RawFrame, WORDS};
+use crate::frame::{Ack, HEADER, ROBOT_WORDS, RawFrame, WORDS};
 
 /// A single-writer sequence lock over the words of a [`RawFrame`]: the writer bumps the
 /// sequence to odd, stores the words, bumps it to even; a reader retries while the sequence is
@@ -46,7 +46,12 @@ impl Slot {
         self.seq.store(s.wrapping_add(1), Ordering::Relaxed);
         fence(Ordering::Release);
         // The words of the first `n` robots (a handle's `n` never changes).
-        for (w, v) in self.words.iter().zip(buf).take(HEADER + 4 * raw.n) {
+        for (w, v) in self
+            .words
+            .iter()
+            .zip(buf)
+            .take(HEADER + ROBOT_WORDS * raw.n)
+        {
             w.store(v, Ordering::Relaxed);
         }
         self.seq.store(s.wrapping_add(2), Ordering::Release);
@@ -175,6 +180,14 @@ pub struct ConsoleHandle {
     published: u64,
     /// Control messages taken from the queue so far.
     controls_taken: u64,
+    /// Whether the loop reports corrections ([`ConsoleHandle::publish_corrected`]).
+    corrections_known: bool,
+    /// Per robot, corrections in the execution `count_key` names.
+    corrections: [u64; MAX_ROBOTS],
+    /// Per robot, the execution its count is of: (rounds done, tasks done).
+    count_key: [(u64, u64); MAX_ROBOTS],
+    /// The robot the last tick's correction went to (a correction spans consecutive ticks).
+    last_corrected: Option<usize>,
 }
 
 impl ConsoleHandle {
@@ -198,6 +211,10 @@ impl ConsoleHandle {
             rounds_done: 0,
             published: 0,
             controls_taken: 0,
+            corrections_known: false,
+            corrections: [0; MAX_ROBOTS],
+            count_key: [(0, 0); MAX_ROBOTS],
+            last_corrected: None,
         }
     }
 
@@ -207,6 +224,44 @@ impl ConsoleHandle {
     /// one since the last (at most `max_hz` times a second); a snapshot the server has not read
     /// before the next one is dropped.
     pub fn publish<C: Controller + ?Sized>(&mut self, tick: &Tick, ctl: &C) {
+        self.publish_inner(tick, ctl);
+    }
+
+    /// [`publish`](Self::publish) for a loop that knows its operator's input: `corrected`
+    /// says whether the input of this tick was a correction (anything but
+    /// `Operator::Scheduled`, or the loop's own joystick off its rest). It goes to the robot
+    /// supervised in the tick (the first robot of `tick.low_conf`; none: it changed nothing and
+    /// is not counted), and the page's strip shows each robot's corrections in its current
+    /// execution: runs of consecutive corrected ticks on one robot, so one held correction
+    /// counts once. Same costs as [`publish`](Self::publish): O(1) on an uncorrected tick,
+    /// O(N) on a corrected one; never allocates.
+    pub fn publish_corrected<C: Controller + ?Sized>(
+        &mut self,
+        tick: &Tick,
+        ctl: &C,
+        corrected: bool,
+    ) {
+        self.corrections_known = true;
+        let to = if corrected {
+            tick.low_conf.first().filter(|&i| i < MAX_ROBOTS)
+        } else {
+            None
+        };
+        if let Some(i) = to {
+            let key = (self.rounds_done, tick.tasks[i]);
+            if self.count_key[i] != key {
+                self.count_key[i] = key;
+                self.corrections[i] = 0;
+            }
+            if self.last_corrected != Some(i) {
+                self.corrections[i] += 1;
+            }
+        }
+        self.last_corrected = to;
+        self.publish_inner(tick, ctl);
+    }
+
+    fn publish_inner<C: Controller + ?Sized>(&mut self, tick: &Tick, ctl: &C) {
         self.published += 1;
         if !self.shared.want.load(Ordering::Relaxed) {
             return;
@@ -217,6 +272,15 @@ impl ConsoleHandle {
         raw.hold_armed = self.hold_armed;
         raw.rounds_done = self.rounds_done;
         raw.published = self.published;
+        raw.corrections_known = self.corrections_known;
+        if self.corrections_known {
+            for (i, r) in raw.robots.iter_mut().enumerate().take(raw.n) {
+                // A count of an earlier execution is 0 of this one.
+                if self.count_key[i] == (self.rounds_done, r.tasks) {
+                    r.corrections = self.corrections[i];
+                }
+            }
+        }
         raw.published_unix_ms = SystemTime::now()
             .duration_since(UNIX_EPOCH)
             .map_or(0.0, |d| d.as_secs_f64() * 1e3);

@@ -115,6 +115,8 @@ impl RecordedTick {
                 clock_s: t.clock_s,
                 ref_time: t.ref_time,
                 tasks: t.tasks,
+                // Recordings do not carry the operator's input: the page shows none.
+                corrections: 0,
             };
         }
         raw
@@ -295,7 +297,52 @@ pub struct Recording {
     pub problem: Option<String>,
 }
 
-/// Reads the recording at `path`: a file, or a directory holding [`RECORDING_FILE`]. The ticks
+/// The first bytes of an MCAP file (a ROS 2 bag, tandem-bag's run bags).
+const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
+
+/// Whether `path` is an MCAP bag: its extension, or its first bytes.
+fn is_bag(path: &Path) -> bool {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
+    {
+        return true;
+    }
+    let mut head = [0u8; 8];
+    File::open(path)
+        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
+        .is_ok_and(|()| head == MCAP_MAGIC)
+}
+
+/// Whether directory `dir` holds an MCAP bag (a rosbag2 folder, a run's outputs).
+fn dir_holds_a_bag(dir: &Path) -> bool {
+    std::fs::read_dir(dir).is_ok_and(|entries| {
+        entries.flatten().any(|e| {
+            e.path()
+                .extension()
+                .is_some_and(|x| x.eq_ignore_ascii_case("mcap"))
+        })
+    })
+}
+
+/// The refusal of a bag as a replay (docs/decisions.md, "The console's replay: what a recorded
+/// run is, …"): what it lacks and what to record instead.
+fn not_a_bag(path: &Path) -> Error {
+    Error::Recording {
+        path: path.display().to_string(),
+        why: "an MCAP bag is not a console recording: a run bag holds each round's schedule, \
+              not the speed bounds and the coordinator's pre-alert the page shows, so the \
+              console does not replay bags; record the run for the console instead with \
+              `tandem console STATE --simulate --record FILE [--until …]` (or \
+              `tandem_console::Recorder` in your own loop) and replay that file with \
+              `--replay FILE`"
+            .into(),
+    }
+}
+
+/// Reads the recording at `path`: a file, or a directory holding [`RECORDING_FILE`]. A bag
+/// (an `.mcap` file, a file that starts as one, a directory of one without the recording) is
+/// refused with what to record instead. The ticks
 /// up to the first damaged line are kept and the damage is described in
 /// [`Recording::problem`] (a run cut short, a file truncated in a copy).
 ///
@@ -305,7 +352,14 @@ pub struct Recording {
 pub fn read_recording(path: impl AsRef<Path>) -> Result<Recording> {
     let mut path = path.as_ref().to_path_buf();
     if path.is_dir() {
-        path = path.join(RECORDING_FILE);
+        let inner = path.join(RECORDING_FILE);
+        if !inner.exists() && dir_holds_a_bag(&path) {
+            return Err(not_a_bag(&path));
+        }
+        path = inner;
+    }
+    if is_bag(&path) {
+        return Err(not_a_bag(&path));
     }
     let shown = path.display().to_string();
     let err = |line: usize, why: String| Error::Recording {

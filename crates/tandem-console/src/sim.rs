@@ -165,6 +165,15 @@ impl<'p> SimRun<'p> {
         self.rounds_done
     }
 
+    /// Whether the simulated operator's input in the last [`step`](Self::step) was a
+    /// correction.
+    pub(crate) fn corrected(&self) -> bool {
+        match &self.cell {
+            SimCell::Rounds(s) => s.corrected(),
+            SimCell::Continuous(s) => s.corrected(),
+        }
+    }
+
     /// One tick (a finished round restarts first); returns the tick and whether a round
     /// was completed before it.
     pub(crate) fn step(&mut self) -> Result<(Tick, bool)> {
@@ -229,7 +238,7 @@ pub fn simulate_recorded(
     let tick_s = run.controller().tick_s();
     let period_s = tick_s / params.speed;
     let first = tick_now(run.controller());
-    handle.publish(&first, run.controller());
+    handle.publish_corrected(&first, run.controller(), false);
     if let Some(r) = recorder.as_deref_mut() {
         r.record(&first, run.controller(), rounds, run.rounds_done())?;
     }
@@ -244,7 +253,7 @@ pub fn simulate_recorded(
         loop {
             if !Driver::apply(&mut handle, &mut run.cell) {
                 let t = tick_now(run.controller());
-                handle.publish(&t, run.controller());
+                handle.publish_corrected(&t, run.controller(), false);
                 was_paused = true;
                 break;
             }
@@ -261,7 +270,7 @@ pub fn simulate_recorded(
             if new_round {
                 handle.round_done();
             }
-            handle.publish(&tick, run.controller());
+            handle.publish_corrected(&tick, run.controller(), run.corrected());
             if let Some(r) = recorder.as_deref_mut() {
                 r.record(&tick, run.controller(), rounds, run.rounds_done())?;
             }

@@ -40,6 +40,12 @@ pub struct RobotStrip {
     pub supervised_s: f64,
     /// Low-confidence stretches the operator supervised in its current execution.
     pub stretches: u64,
+    /// Corrections the operator gave it in its current execution (runs of consecutive
+    /// corrected ticks; [`RawRobot::corrections`](crate::RawRobot::corrections)); `None`
+    /// when the source does not report the operator's input (a replay, a loop that calls
+    /// [`ConsoleHandle::publish`](crate::ConsoleHandle::publish)).
+    #[serde(default)]
+    pub corrections: Option<u64>,
     /// Whether the fault monitor holds it.
     pub fault: bool,
 }
@@ -198,6 +204,7 @@ impl Tracker {
                 confident: geometry.confident_at(i, r.ref_time),
                 supervised_s: m.supervised_s,
                 stretches: m.stretches,
+                corrections: raw.corrections_known.then_some(r.corrections),
                 fault: r.state == RobotState::Fault,
             });
         }

@@ -331,6 +331,8 @@ const LOOK: &str = r#"(() => {
   return { tick: f ? f.tick : null, round: f ? f.rounds_done : null, lc,
            attention: b.dataset.attention, banner_robot: b.dataset.robot,
            next_robot: n.dataset.nextRobot, next_s: n.dataset.nextS,
+           queue_next_s: (q => q ? q.dataset.startS : null)(
+             document.querySelector('#queue li[data-from="prealert"]')),
            robots: document.querySelectorAll('.robot[data-robot]').length,
            controller: f ? f.controller : null, client: window.__client,
            connected: document.body.dataset.connected };
@@ -354,7 +356,7 @@ fn the_page_shows_the_coordinators_robot_confirms_controls_and_reconnects() {
     // Sample the page for 8 s (two rounds and more): at every look, the DOM's `lc` robots
     // are exactly the coordinator's at the tick the page shows, the banner names the same
     // robot, and the countdown is the plan's.
-    let (mut looks, mut with_lc, mut with_next) = (0, 0, 0);
+    let (mut looks, mut with_lc, mut with_next, mut with_queue) = (0, 0, 0, 0);
     let t0 = Instant::now();
     while t0.elapsed() < Duration::from_secs(8) {
         let v = b.eval(LOOK);
@@ -391,6 +393,12 @@ fn the_page_shows_the_coordinators_robot_confirms_controls_and_reconnects() {
                     (s - earliest_s).abs() <= 0.051,
                     "tick {tick}: page {s} s, the coordinator's pre-alert {earliest_s} s"
                 );
+                // The queue's entry for that stretch (when it is within the horizon) starts
+                // where the countdown does.
+                if let Some(q) = v["queue_next_s"].as_str() {
+                    assert_eq!(q, v["next_s"].as_str().unwrap(), "tick {tick}: queue {v}");
+                    with_queue += 1;
+                }
             }
             None => assert_eq!(v["next_robot"], ""),
         }
@@ -398,8 +406,9 @@ fn the_page_shows_the_coordinators_robot_confirms_controls_and_reconnects() {
         std::thread::sleep(Duration::from_millis(25));
     }
     assert!(
-        looks >= 50 && with_lc >= 10 && with_next >= 10,
-        "{looks} looks, {with_lc} with an lc robot, {with_next} with a countdown"
+        looks >= 50 && with_lc >= 10 && with_next >= 10 && with_queue >= 10,
+        "{looks} looks, {with_lc} with an lc robot, {with_next} with a countdown, {with_queue} \
+         with the queue's entry from it"
     );
 
     // The page took control when it connected; a click on Pause comes back confirmed with

@@ -1,5 +1,5 @@
 //! The control loop's side of the console never allocates (issue 42): a whole run of
-//! `Driver::apply`, `tick` and `ConsoleHandle::publish` against a running server, which asks for
+//! `Driver::apply`, `tick` and `ConsoleHandle::publish` (and `publish_corrected`) against a running server, which asks for
 //! snapshots at its frame rate meanwhile (so the write path runs), measured with the
 //! `allocation-counter` crate's per-thread counting allocator (the server's own thread, which
 //! does allocate, is not counted).
@@ -33,8 +33,19 @@ fn the_loops_side_allocates_nothing() {
                     if ctl.is_finished() {
                         ctl.reset();
                     }
-                    let t = ctl.tick(Operator::Scheduled).expect("a valid operator");
-                    handle.publish(&t, &ctl);
+                    // Every third tick a correction, counted on the supervised robot.
+                    let corrected = ticks % 3 == 0;
+                    let op = if corrected {
+                        Operator::Slowest
+                    } else {
+                        Operator::Scheduled
+                    };
+                    let t = ctl.tick(op).expect("a valid operator");
+                    if ticks % 2 == 0 {
+                        handle.publish_corrected(&t, &ctl, corrected);
+                    } else {
+                        handle.publish(&t, &ctl);
+                    }
                     ticks += 1;
                 }
                 std::thread::sleep(Duration::from_millis(1));

@@ -184,6 +184,21 @@ fn a_damaged_recording_reads_up_to_its_damage_and_says_where() {
     // A directory holding console.jsonl reads it.
     std::fs::copy(&path, empty_dir.join("console.jsonl")).unwrap();
     assert_eq!(read_recording(&empty_dir).unwrap().ticks.len(), lines - 1);
+    // A bag (MCAP: by extension, by its first bytes, a folder of one) is refused with what
+    // to record instead.
+    let bag_dir = dir.join("bag");
+    std::fs::create_dir_all(&bag_dir).unwrap();
+    std::fs::write(bag_dir.join("run_0.mcap"), b"\x89MCAP0\r\n\0\0").unwrap();
+    let magic = dir.join("run.bin");
+    std::fs::write(&magic, b"\x89MCAP0\r\n\0\0").unwrap();
+    for p in [bag_dir.join("run_0.mcap"), magic, bag_dir.clone()] {
+        let e = read_recording(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("an MCAP bag is not a console recording") && e.contains("--record FILE"),
+            "{}: {e}",
+            p.display()
+        );
+    }
     let v2 = text.replacen("\"version\":1", "\"version\":2", 1);
     std::fs::write(&junk, v2).unwrap();
     let e = read_recording(&junk).unwrap_err().to_string();

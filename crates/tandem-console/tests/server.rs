@@ -353,3 +353,89 @@ fn the_countdown_is_the_coordinators_pre_alert() {
     );
     assert!(published > 0);
 }
+
+/// Publishes the cell as it is (no tick, no correction) until the page's frame is of the
+/// controller's current tick; returns it.
+fn settle<C: Controller>(
+    addr: SocketAddr,
+    handle: &mut tandem_console::ConsoleHandle,
+    ctl: &C,
+) -> Frame {
+    let t0 = Instant::now();
+    loop {
+        handle.publish_corrected(&tandem_console::tick_now(ctl), ctl, false);
+        if let Some(f) = frame(addr).filter(|f| f.tick == ctl.ticks()) {
+            return f;
+        }
+        assert!(
+            t0.elapsed() < Duration::from_secs(10),
+            "no frame of tick {}",
+            ctl.ticks()
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+#[test]
+fn the_strip_counts_the_operators_corrections_in_the_current_execution() {
+    // support::rounds(3): robot i low-confidence from 4 + 4i s for 20 ticks, task 10 s.
+    let mut ctl = support::rounds(3);
+    let (console, mut handle) =
+        Console::start(&ConsoleConfig::default(), Geometry::new(&ctl)).unwrap();
+    let addr = console.addr();
+    let counts =
+        |f: &Frame| -> Vec<Option<u64>> { f.robots.iter().map(|r| r.strip.corrections).collect() };
+    let (mut last_lc, mut k_in) = (None, 0usize);
+    let mut checked = 0;
+    while ctl.ticks() < 110 {
+        let lc = ctl.low_conf_now().first();
+        k_in = if lc == last_lc { k_in + 1 } else { 0 };
+        last_lc = lc;
+        // Before any stretch (no robot supervised): input that moves nobody, not counted.
+        // Robot 1: corrected on its stretch's ticks 0-2 and 6-7 (two corrections); robot 2:
+        // ticks 0-4 (one); robot 3 none.
+        let corrected = match lc {
+            None => ctl.ticks() < 5,
+            Some(0) => [0, 1, 2, 6, 7].contains(&k_in),
+            Some(1) => k_in < 5,
+            Some(_) => false,
+        };
+        let op = if corrected {
+            Operator::Gradient(1.0)
+        } else {
+            Operator::Scheduled
+        };
+        let t = ctl.tick(op).unwrap();
+        handle.publish_corrected(&t, &ctl, corrected);
+        if lc == Some(0) && k_in == 10 {
+            let f = settle(addr, &mut handle, &ctl);
+            assert_eq!(f.robots[0].state.name(), "lc", "{f:?}");
+            assert_eq!(counts(&f), [Some(2), Some(0), Some(0)], "tick {}", f.tick);
+            checked += 1;
+        }
+    }
+    // 11 s: robot 1 finished its task at 10 s (a new execution: none yet), robot 2's stretch
+    // (8-10 s) is behind it with its one correction, robot 3's is ahead.
+    let f = settle(addr, &mut handle, &ctl);
+    assert_eq!(f.robots[0].tasks, 1, "{f:?}");
+    assert_eq!(counts(&f), [Some(0), Some(1), Some(0)], "tick {}", f.tick);
+    assert_eq!(checked, 1);
+    console.stop();
+
+    // A loop that does not report its operator's input: the strip shows no count.
+    let mut ctl = support::rounds(2);
+    let (console, mut handle) =
+        Console::start(&ConsoleConfig::default(), Geometry::new(&ctl)).unwrap();
+    let t0 = Instant::now();
+    let f = loop {
+        let t = ctl.tick(Operator::Scheduled).unwrap();
+        handle.publish(&t, &ctl);
+        if let Some(f) = frame(console.addr()) {
+            break f;
+        }
+        assert!(t0.elapsed() < Duration::from_secs(10), "no frame");
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    assert_eq!(counts(&f), [None, None]);
+    console.stop();
+}

@@ -191,10 +191,20 @@ impl PyConsole {
     /// Args:
     ///     tick: the :class:`Tick` (or :class:`CellTick`) ``controller.tick()`` returned.
     ///     controller: the coordinator that returned it.
+    ///     corrected: whether the operator's input of this tick was a correction (anything
+    ///         but the scheduled pace); once given, the page's per-robot strip counts the
+    ///         corrections of each robot's current execution (consecutive corrected ticks
+    ///         count once). ``None`` (default): not reported, the strip shows no count.
     ///
     /// Raises:
     ///     InputError: a tick or controller of another kind or size than the console's.
-    fn publish(&self, tick: &Bound<'_, PyAny>, controller: &Bound<'_, PyAny>) -> PyResult<()> {
+    #[pyo3(signature = (tick, controller, corrected=None))]
+    fn publish(
+        &self,
+        tick: &Bound<'_, PyAny>,
+        controller: &Bound<'_, PyAny>,
+        corrected: Option<bool>,
+    ) -> PyResult<()> {
         let tick: Tick = if let Ok(t) = tick.cast::<PyTick>() {
             t.get().inner
         } else if let Ok(t) = tick.cast::<PyCellTick>() {
@@ -210,11 +220,17 @@ impl PyConsole {
         if let Ok(c) = controller.cast::<PyCoordinator>() {
             let c = c.borrow();
             self.check_kind(true, c.inner.robots().len())?;
-            handle.publish(&tick, &c.inner);
+            match corrected {
+                Some(k) => handle.publish_corrected(&tick, &c.inner, k),
+                None => handle.publish(&tick, &c.inner),
+            }
         } else if let Ok(c) = controller.cast::<PyContinuousCoordinator>() {
             let c = c.borrow();
             self.check_kind(false, Controller::n_robots(&c.inner))?;
-            handle.publish(&tick, &c.inner);
+            match corrected {
+                Some(k) => handle.publish_corrected(&tick, &c.inner, k),
+                None => handle.publish(&tick, &c.inner),
+            }
         } else {
             return Err(not_a_controller().into());
         }

@@ -61,6 +61,8 @@ pub struct CellSim {
     tasks: Vec<u64>,
     n_ref: usize,
     stats: CellStats,
+    /// Whether the operator's input in the last tick was a correction.
+    corrected: bool,
 }
 
 impl CellSim {
@@ -97,7 +99,15 @@ impl CellSim {
             },
             coord,
             pending: None,
+            corrected: false,
         })
+    }
+
+    /// Whether the operator's input in the last [`tick`](Self::tick) was a correction (the
+    /// console's per-robot count of corrections).
+    #[must_use]
+    pub fn corrected(&self) -> bool {
+        self.corrected
     }
 
     /// The coordinator running the cell.
@@ -181,7 +191,7 @@ impl CellSim {
         }
         // The cell observes no crossings (`None`): its token rule stops a robot at the gate
         // of every low-confidence group it does not hold (docs/decisions.md).
-        let (t, _) = step(
+        let (t, corrected) = step(
             &mut self.coord,
             model,
             &mut self.op,
@@ -193,6 +203,7 @@ impl CellSim {
             rng,
         )?;
         self.stats.ticks += 1;
+        self.corrected = corrected;
         match t.low_conf.count() {
             0 => {}
             1 => self.stats.busy_ticks += 1,

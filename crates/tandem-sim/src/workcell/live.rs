@@ -32,6 +32,8 @@ pub struct RoundSim {
     grad_max: Vec<f64>,
     n_ref: usize,
     round_ticks: usize,
+    /// Whether the operator's input in the last tick was a correction.
+    corrected: bool,
 }
 
 impl RoundSim {
@@ -72,6 +74,7 @@ impl RoundSim {
             grad_max: problem.grad_max().to_vec(),
             n_ref,
             round_ticks: 0,
+            corrected: false,
             coord,
         })
     }
@@ -144,7 +147,15 @@ impl RoundSim {
             rng,
         )?;
         self.round_ticks += 1;
+        self.corrected = out.1;
         Ok(out)
+    }
+
+    /// Whether the operator's input in the last [`tick`](Self::tick) was a correction (the
+    /// console's per-robot count of corrections).
+    #[must_use]
+    pub fn corrected(&self) -> bool {
+        self.corrected
     }
 
     /// Records, before a tick, each robot's clock (s), whether it is at a hold, and its phase
