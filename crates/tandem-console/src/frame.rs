@@ -415,19 +415,12 @@ struct RobotGeometry {
 impl RobotGeometry {
     fn new(t: &Timeline) -> Self {
         let conf = t.conf();
-        let mut runs = Vec::new();
-        let mut n = 0;
-        while n < conf.len() {
-            if conf[n] {
-                n += 1;
-                continue;
-            }
-            let start = n;
-            while n < conf.len() && !conf[n] {
-                n += 1;
-            }
-            runs.push((start, n));
-        }
+        // The timeline's low-confidence runs (Eq. 19), as reference-sample ranges.
+        let runs: Vec<(usize, usize)> = t
+            .lc_intervals()
+            .iter()
+            .map(|i| (i.ref_start, i.ref_end))
+            .collect();
         let mut worst = Vec::with_capacity(conf.len() + 1);
         let mut acc = 0.0;
         worst.push(acc);

@@ -53,19 +53,10 @@ pub fn groups(conf: &[bool], holds: &[usize]) -> Result<Vec<Group>> {
         }
     }
     // The stretches (start, end) in reference order.
-    let mut stretches = Vec::new();
-    let mut n = 0;
-    while n < conf.len() {
-        if conf[n] {
-            n += 1;
-            continue;
-        }
-        let start = n;
-        while n < conf.len() && !conf[n] {
-            n += 1;
-        }
-        stretches.push((start, n));
-    }
+    let stretches: Vec<(usize, usize)> = tandem_confidence::low_regions(conf)
+        .into_iter()
+        .map(|r| (r.start, r.end))
+        .collect();
     let mut out: Vec<Group> = Vec::new();
     for (k, &(start, end)) in stretches.iter().enumerate() {
         let after = if k == 0 { 0 } else { stretches[k - 1].1 };
