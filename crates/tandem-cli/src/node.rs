@@ -36,6 +36,15 @@ pub(crate) struct NodeArgs {
     /// The console's port on 127.0.0.1 (0: a free one). Needs --console.
     #[arg(long, value_name = "P", requires = "console")]
     pub(crate) port: Option<u16>,
+    /// The model's channels that form the setpoint's pose, published as
+    /// `geometry_msgs/PoseStamped` on /tandem/robotK/setpoint_pose: 3 names (x,y,z) or 7
+    /// (x,y,z,qx,qy,qz,qw); `auto` takes the channels named x,y,z (and qx,qy,qz,qw) when the
+    /// model has them; `none` publishes no pose. The other channels stay in `setpoint`.
+    #[arg(long, value_name = "NAMES", default_value = "auto")]
+    pub(crate) pose_channels: String,
+    /// The pose's frame (`header.frame_id`).
+    #[arg(long, value_name = "FRAME", default_value = "world")]
+    pub(crate) frame_id: String,
     /// Stop after this long (s). Default: run until interrupted.
     #[arg(long, value_name = "S")]
     pub(crate) seconds: Option<f64>,
@@ -51,6 +60,14 @@ pub(crate) fn node(a: &NodeArgs) -> Result<()> {
             stall_s: a.stall,
             ..Default::default()
         },
+        pose_channels: match a.pose_channels.as_str() {
+            "auto" => tandem_ros2::PoseChannels::Auto,
+            "none" => tandem_ros2::PoseChannels::Off,
+            names => tandem_ros2::PoseChannels::Named(
+                names.split(',').map(|n| n.trim().to_owned()).collect(),
+            ),
+        },
+        frame_id: a.frame_id.clone(),
         ..NodeParams::default()
     };
     if let Some(s) = a.seconds {
@@ -83,6 +100,17 @@ pub(crate) fn node(a: &NodeArgs) -> Result<()> {
         a.domain,
         node.n_robots()
     ));
+    let pose = node.pose_channels();
+    if pose.is_empty() {
+        out("setpoint: every channel in /tandem/robotK/setpoint (no pose: --pose-channels)");
+    } else {
+        out(&format!(
+            "setpoint_pose: geometry_msgs/PoseStamped in frame `{}` from channels {} (--pose-channels {}); the others in /tandem/robotK/setpoint",
+            a.frame_id,
+            pose.join(","),
+            a.pose_channels
+        ));
+    }
     let start = Instant::now();
     let mut report = start;
     while node.is_running() {

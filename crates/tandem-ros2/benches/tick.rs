@@ -1,27 +1,124 @@
 //! The tick's own cost with the node's queues attached against without, in the same run
 //! (issue 43: at most 1.1×): `bare` ticks a three-robot rounds controller of the test task;
-//! `with_queues` is the node's tick thread on the same controller without the network — the
-//! robots' progress taken from a bounded queue (`try_recv`), `CellLoop::step` (liveness, the
-//! round's log, the tick) and the snapshot handed to the DDS side's queue (`try_send`); the
-//! DDS side's two ends (three progress messages in, the snapshot out) run in the same loop
-//! here and are counted. Run with `cargo bench -p tandem-ros2 --bench tick`.
+//! `with_queues` is the node's tick thread on the same controller without the network
+//! (`Ticker::run` of node.rs, step for step): the clock read, the pending-message counter
+//! (nothing queued), the robots' progress counters (each robot reported since the last tick),
+//! `CellLoop::advance` (liveness, the round's log, the tick), the command pushed into the ring
+//! and the state slot's `want` flag, answered with a snapshot every 10th tick (the 100 Hz state
+//! topics at a 1 kHz tick; `with_queues_state_every_tick`: every tick, the 10 ms tick's case).
+//! The DDS side's ends (three progress reports, the command popped, the snapshot taken) run
+//! in the same loop here and are counted. Run with `cargo bench -p tandem-ros2 --bench tick`.
 #![expect(
     missing_docs,
     reason = "criterion_group! generates an undocumented pub fn"
 )]
 
 use std::hint::black_box;
-use std::sync::mpsc::sync_channel;
 use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use tandem_console::{Console, ConsoleConfig, Geometry};
-use tandem_planner::Cell;
-use tandem_realtime::{Controller, Operator};
-use tandem_ros2::{CellLoop, ConsoleFeed, Inbound, LoopParams, Request, Snapshot};
+use tandem_planner::{Cell, Planner};
+use tandem_realtime::{Controller, MAX_ROBOTS, Operator};
+use tandem_ros2::link::{CommandRing, Heard, Pending, StateSlot};
+use tandem_ros2::{CellLoop, ConsoleFeed, Inbound, LoopParams, Request};
 
 #[path = "../tests/support/mod.rs"]
 mod support;
+
+/// The node's tick thread's side of the links and the DDS side's ends, in one loop.
+struct NodeTick {
+    l: CellLoop,
+    ring: CommandRing,
+    state: StateSlot,
+    heard: Heard,
+    pending: Pending,
+    pending_seen: u64,
+    heard_seen: [u64; MAX_ROBOTS],
+    last_flags: (bool, bool, bool),
+    owed: bool,
+    ask_every: u64,
+    i: u64,
+}
+
+fn start(l: &mut CellLoop) {
+    l.handle(
+        Inbound::Request {
+            token: 0,
+            what: Request::Start,
+        },
+        Instant::now(),
+        &mut |_| {},
+    );
+}
+
+impl NodeTick {
+    fn new(planner: &Planner, ask_every: u64) -> NodeTick {
+        let ctl = planner.controller(Cell::Rounds).expect("a plan");
+        let mut l = CellLoop::new(ctl, planner.model(), LoopParams::default()).expect("valid");
+        start(&mut l);
+        NodeTick {
+            l,
+            ring: CommandRing::new(3, 4096),
+            state: StateSlot::new(),
+            heard: Heard::default(),
+            pending: Pending::default(),
+            pending_seen: 0,
+            heard_seen: [0; MAX_ROBOTS],
+            last_flags: (false, false, false),
+            owed: false,
+            ask_every,
+            i: 0,
+        }
+    }
+
+    /// One tick of the tick thread (`console` after the step when given) and the DDS side's
+    /// work for it.
+    fn tick(&mut self, console: Option<&mut ConsoleFeed>) -> Option<f64> {
+        // The DDS side: three progress reports; the state topics' request at their rate.
+        for k in 0..3 {
+            self.heard.hear(k);
+        }
+        self.i += 1;
+        if self.i.is_multiple_of(self.ask_every) {
+            self.state.ask();
+        }
+        // The tick thread.
+        let now = Instant::now();
+        if self.pending.moved(&mut self.pending_seen) {
+            unreachable!("nothing is queued in this benchmark");
+        }
+        let heard = self.heard.changed(3, &mut self.heard_seen);
+        if heard.count() > 0 {
+            for k in 0..3 {
+                if heard[k] {
+                    self.l.heard(k, now);
+                }
+            }
+        }
+        let cmd = self.l.advance(now).expect("a valid operator");
+        if let Some(feed) = console {
+            feed.publish(&self.l);
+        }
+        self.ring.push(&cmd);
+        let flags = (cmd.fault, cmd.finished, cmd.active);
+        if flags != self.last_flags || self.owed || self.state.wanted() {
+            self.owed = !self.state.put(self.l.snapshot());
+        }
+        self.last_flags = flags;
+        if cmd.finished {
+            start(&mut self.l);
+        }
+        // The DDS side takes the command and the snapshot.
+        let c = self.ring.pop().map(|c| c.ref_time[0]);
+        let s = if self.i.is_multiple_of(self.ask_every) {
+            self.state.take().map(|s| s.ref_time[1])
+        } else {
+            None
+        };
+        c.or(s)
+    }
+}
 
 fn bench(c: &mut Criterion) {
     let planner = support::planner(3);
@@ -35,40 +132,13 @@ fn bench(c: &mut Criterion) {
             black_box(bare.tick(Operator::Scheduled).expect("a valid operator"))
         });
     });
-    let ctl = planner.controller(Cell::Rounds).expect("a plan");
-    let mut l = CellLoop::new(ctl, planner.model(), LoopParams::default()).expect("valid");
-    let (in_tx, in_rx) = sync_channel::<Inbound>(4096);
-    let (state_tx, state_rx) = sync_channel::<Snapshot>(4096);
-    let start = |l: &mut CellLoop| {
-        l.handle(
-            Inbound::Request {
-                token: 0,
-                what: Request::Start,
-            },
-            Instant::now(),
-            &mut |_| {},
-        );
-    };
-    start(&mut l);
+    let mut node = NodeTick::new(&planner, 10);
     group.bench_function("with_queues", |b| {
-        b.iter(|| {
-            for k in 0..3 {
-                let _ = in_tx.try_send(Inbound::Progress {
-                    robot: k,
-                    ref_time: 0.0,
-                });
-            }
-            let now = Instant::now();
-            while let Ok(m) = in_rx.try_recv() {
-                l.handle(m, now, &mut |_| {});
-            }
-            let s = l.step(now).expect("a valid operator");
-            let _ = state_tx.try_send(s);
-            if s.finished {
-                start(&mut l);
-            }
-            black_box(state_rx.try_recv().ok())
-        });
+        b.iter(|| black_box(node.tick(None)));
+    });
+    let mut node = NodeTick::new(&planner, 1);
+    group.bench_function("with_queues_state_every_tick", |b| {
+        b.iter(|| black_box(node.tick(None)));
     });
     // The same with the node's console attached (`tandem node --console`): the feed after each
     // step, a server running (no page open: the server asks for a snapshot at its rate anyway).
@@ -76,28 +146,9 @@ fn bench(c: &mut Criterion) {
     let (console, handle) =
         Console::start(&ConsoleConfig::default(), Geometry::new(&ctl)).expect("a free port");
     let mut feed = ConsoleFeed::new(handle);
-    let mut l = CellLoop::new(ctl, planner.model(), LoopParams::default()).expect("valid");
-    start(&mut l);
+    let mut node = NodeTick::new(&planner, 10);
     group.bench_function("with_queues_and_console", |b| {
-        b.iter(|| {
-            for k in 0..3 {
-                let _ = in_tx.try_send(Inbound::Progress {
-                    robot: k,
-                    ref_time: 0.0,
-                });
-            }
-            let now = Instant::now();
-            while let Ok(m) = in_rx.try_recv() {
-                l.handle(m, now, &mut |_| {});
-            }
-            let s = l.step(now).expect("a valid operator");
-            feed.publish(&l, &s);
-            let _ = state_tx.try_send(s);
-            if s.finished {
-                start(&mut l);
-            }
-            black_box(state_rx.try_recv().ok())
-        });
+        b.iter(|| black_box(node.tick(Some(&mut feed))));
     });
     group.finish();
     console.stop();

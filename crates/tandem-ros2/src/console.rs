@@ -10,7 +10,7 @@
 
 use tandem_console::{ConsoleHandle, ControlMsg, Op};
 
-use crate::core::{CellLoop, Snapshot};
+use crate::core::CellLoop;
 
 /// The tick thread's end of a console.
 #[derive(Debug)]
@@ -30,18 +30,19 @@ impl ConsoleFeed {
         }
     }
 
-    /// After each [`CellLoop::step`] (which returned `snap`): answers the page's controls, counts
-    /// a finished round, and publishes the loop's last tick. Never blocks; allocates only to
-    /// answer a control message.
-    pub fn publish(&mut self, cell_loop: &CellLoop, snap: &Snapshot) {
+    /// After each [`CellLoop::step`] or [`CellLoop::advance`]: answers the page's controls,
+    /// counts a finished round, and publishes the loop's last tick. Never blocks; allocates
+    /// only to answer a control message.
+    pub fn publish(&mut self, cell_loop: &CellLoop) {
+        let finished = cell_loop.is_finished();
         while let Some(msg) = self.handle.poll_control() {
             let (ok, text) = answer(&msg);
             self.handle.confirm(&msg, ok, text);
         }
-        if snap.finished && !self.finished {
+        if finished && !self.finished {
             self.handle.round_done();
         }
-        self.finished = snap.finished;
+        self.finished = finished;
         self.handle
             .publish(cell_loop.last_tick(), cell_loop.controller());
     }

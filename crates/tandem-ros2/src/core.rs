@@ -210,6 +210,66 @@ pub struct Snapshot {
     pub next: Option<PreAlert>,
 }
 
+/// What the node publishes every tick (`/tandem/robotK/command`, and `needs_operator` on
+/// change): the part of a [`Snapshot`] that costs the tick nothing to produce. `Copy`, no heap;
+/// it crosses to the DDS thread as a fixed-size record ([`crate::link::CommandRing`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Command {
+    /// The loop's tick count since it started ([`Snapshot::tick`]).
+    pub tick: u64,
+    /// Whether a round (or the cell) runs.
+    pub active: bool,
+    /// Whether the last round finished and waits to be recorded (rounds).
+    pub finished: bool,
+    /// Whether a fault is latched (its text is the [`Snapshot`]'s).
+    pub fault: bool,
+    /// Each robot's reference time to follow (reference samples).
+    pub ref_time: PerRobot<f64>,
+    /// Each robot's speed scale over the last tick ([`Snapshot::speed`]).
+    pub speed: PerRobot<f64>,
+    /// Each robot that the next tick moves at the operator's rate.
+    pub needs_operator: RobotFlags,
+}
+
+impl Command {
+    /// The flags as one word: bit 0 active, 1 finished, 2 fault, 8 + k robot k needs the
+    /// operator.
+    #[must_use]
+    pub fn flags_word(&self) -> u64 {
+        let mut w =
+            u64::from(self.active) | u64::from(self.finished) << 1 | u64::from(self.fault) << 2;
+        for (k, b) in self.needs_operator.iter().enumerate() {
+            w |= u64::from(b) << (8 + k);
+        }
+        w
+    }
+
+    /// The command of a tick count, a [`flags_word`](Self::flags_word) and the robots' values
+    /// (their count is the robots').
+    #[must_use]
+    pub fn from_words(
+        tick: u64,
+        flags: u64,
+        ref_time: PerRobot<f64>,
+        speed: PerRobot<f64>,
+    ) -> Command {
+        let n = ref_time.len();
+        let mut needs_operator = RobotFlags::new(n);
+        for k in 0..n {
+            needs_operator.set(k, flags >> (8 + k) & 1 == 1);
+        }
+        Command {
+            tick,
+            active: flags & 1 == 1,
+            finished: flags >> 1 & 1 == 1,
+            fault: flags >> 2 & 1 == 1,
+            ref_time,
+            speed,
+            needs_operator,
+        }
+    }
+}
+
 /// One robot's log of a round: one entry per tick in which it ran.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RobotLog {
@@ -308,6 +368,11 @@ pub struct CellLoop {
     /// The controller's last [`Tick`], or its state as one while it has not ticked since a
     /// start, stop or fault clearance ([`CellLoop::last_tick`]).
     last: Tick,
+    /// The controller's `low_conf_now()`, kept from the end of the last tick or request.
+    low_now: RobotFlags,
+    /// The last tick's speed scales and whether two robots were low-confidence in it.
+    speed: PerRobot<f64>,
+    overlap: bool,
 }
 
 impl CellLoop {
@@ -353,6 +418,9 @@ impl CellLoop {
             log,
             capacity,
             ticks: 0,
+            low_now: ctl.low_conf_now(),
+            speed: PerRobot::new(n),
+            overlap: false,
             last: tick_now(&ctl),
             ctl,
         })
@@ -377,8 +445,8 @@ impl CellLoop {
     pub fn handle(&mut self, msg: Inbound, now: Instant, reply: &mut impl FnMut(Reply)) {
         match msg {
             Inbound::Progress { robot, ref_time } => {
-                if robot < self.ctl.n_robots() && ref_time.is_finite() {
-                    self.last_progress[robot] = Some(now);
+                if ref_time.is_finite() {
+                    self.heard(robot, now);
                 }
             }
             Inbound::Operator { axis, correcting } => {
@@ -404,6 +472,7 @@ impl CellLoop {
                 } else {
                     let result = self.request(what, now);
                     self.last = tick_now(&self.ctl);
+                    self.low_now = self.last.low_conf;
                     reply(Reply::Done {
                         token,
                         what,
@@ -412,6 +481,19 @@ impl CellLoop {
                 }
             }
         }
+    }
+
+    /// Robot `robot` (0-based; others ignored) reported progress at `now`: it is alive.
+    pub fn heard(&mut self, robot: usize, now: Instant) {
+        if robot < self.ctl.n_robots() {
+            self.last_progress[robot] = Some(now);
+        }
+    }
+
+    /// Whether the last round finished and waits to be recorded (rounds).
+    #[must_use]
+    pub fn is_finished(&self) -> bool {
+        self.finished
     }
 
     fn take_round(&mut self) -> std::result::Result<RoundLog, Refusal> {
@@ -495,13 +577,51 @@ impl CellLoop {
         self.stall.or(self.ctl.fault().map(NodeFault::Overlap))
     }
 
-    /// One control tick at `now`: checks every robot's liveness, then, if running and not
-    /// stalled, logs each moving robot's sample and advances the coordinator with the
-    /// operator's input. No allocation once the round's log has its capacity.
+    /// One control tick at `now` ([`advance`](Self::advance)) and the cell after it
+    /// ([`snapshot`](Self::snapshot)).
     ///
     /// # Errors
     /// None in practice: the operator's input is always a valid [`Operator`].
     pub fn step(&mut self, now: Instant) -> Result<Snapshot> {
+        self.advance(now)?;
+        Ok(self.snapshot())
+    }
+
+    /// The cell after the last tick: the [`Command`]'s values and the state topics' (the
+    /// fault's text, the next handover). Reads the controller's latched fault; the pre-alert is
+    /// the last tick's ([`Tick::next`]).
+    #[must_use]
+    pub fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            tick: self.ticks,
+            active: self.active,
+            finished: self.finished,
+            ref_time: self.last.ref_time,
+            speed: self.speed,
+            needs_operator: self.needs_operator(),
+            overlap: self.overlap,
+            fault: self.fault(),
+            next: self.last.next,
+        }
+    }
+
+    fn needs_operator(&self) -> RobotFlags {
+        if self.active {
+            self.low_now
+        } else {
+            RobotFlags::new(self.ctl.n_robots())
+        }
+    }
+
+    /// One control tick at `now`: checks every robot's liveness, then, if running and not
+    /// stalled, logs each moving robot's sample and advances the coordinator with the
+    /// operator's input; returns what goes out every tick. No allocation once the round's log
+    /// has its capacity; no reader of the controller but `running_now` and `low_conf_now`
+    /// (the reference times and the pre-alert are the [`Tick`]'s).
+    ///
+    /// # Errors
+    /// None in practice: the operator's input is always a valid [`Operator`].
+    pub fn advance(&mut self, now: Instant) -> Result<Command> {
         let n = self.ctl.n_robots();
         self.ticks += 1;
         if self.active && self.stall.is_none() {
@@ -533,7 +653,8 @@ impl CellLoop {
             };
             let corrected = correcting || operator != Operator::Scheduled;
             let running = self.ctl.running_now();
-            let low = self.ctl.low_conf_now();
+            let low = self.low_now;
+            debug_assert_eq!(low, self.ctl.low_conf_now());
             let logging = self.ctl.cell() == Cell::Rounds;
             if logging {
                 for (i, r) in self.log.robots.iter_mut().enumerate() {
@@ -548,6 +669,7 @@ impl CellLoop {
             }
             let tick = self.ctl.tick(operator)?;
             self.last = tick;
+            self.low_now = self.ctl.low_conf_now();
             overlap = tick.overlap();
             if logging {
                 // A robot that started the tick unsupervised but traversed a low-confidence
@@ -571,25 +693,19 @@ impl CellLoop {
         }
         let after = self.last.ref_time;
         debug_assert_eq!(after, self.ctl.ref_time_now());
-        let mut speed = PerRobot::<f64>::new(n);
         let per_tick = self.ctl.tick_s() / self.dt_s;
-        for (i, s) in speed.as_mut_slice().iter_mut().enumerate() {
+        for (i, s) in self.speed.as_mut_slice().iter_mut().enumerate().take(n) {
             *s = ((after[i] - before[i]) / per_tick).max(0.0);
         }
-        Ok(Snapshot {
+        self.overlap = overlap;
+        Ok(Command {
             tick: self.ticks,
             active: self.active,
             finished: self.finished,
+            fault: self.stall.is_some() || self.last.fault.is_some(),
             ref_time: after,
-            speed,
-            needs_operator: if self.active {
-                self.ctl.low_conf_now()
-            } else {
-                RobotFlags::new(n)
-            },
-            overlap,
-            fault: self.fault(),
-            next: self.ctl.pre_alert(),
+            speed: self.speed,
+            needs_operator: self.needs_operator(),
         })
     }
 }

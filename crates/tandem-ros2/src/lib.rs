@@ -8,19 +8,24 @@
 //! - [`node`]: the threads and the topics and services ([`Node`]; the table is in its docs);
 //! - [`console`]: the tick thread's feed of an operator console ([`ConsoleFeed`]);
 //! - [`msg`]: the standard message types, as serde structs;
+//! - [`pose`]: which of the model's channels form the setpoint's pose;
+//! - [`link`]: the tick thread's wait-free links to the DDS thread (commands, state, progress);
 //! - [`probe`]: a client of the node over DDS (robots, operator, services) for tests.
 
 pub mod console;
 pub mod core;
 mod error;
+pub mod link;
 pub mod msg;
 pub mod node;
+pub mod pose;
 pub mod probe;
 
 pub use crate::core::{
-    CellLoop, Inbound, LoopParams, NodeFault, Reply, Request, RoundLog, Snapshot,
+    CellLoop, Command, Inbound, LoopParams, NodeFault, Reply, Request, RoundLog, Snapshot,
 };
 pub use console::ConsoleFeed;
 pub use error::{Error, Result};
 pub use node::{Node, NodeParams, NodeStats};
+pub use pose::{PoseChannels, PoseMap};
 pub use probe::Probe;

@@ -100,6 +100,61 @@ impl Float64MultiArray {
     }
 }
 
+/// `geometry_msgs/msg/Point`: a position (m, in the header's frame).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Point {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+}
+
+/// `geometry_msgs/msg/Quaternion`: an orientation (`x, y, z, w`, unit norm).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Quaternion {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+    /// w (the scalar part).
+    pub w: f64,
+}
+
+impl Default for Quaternion {
+    /// The identity (ROS's default: `w = 1`).
+    fn default() -> Self {
+        Quaternion {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            w: 1.0,
+        }
+    }
+}
+
+/// `geometry_msgs/msg/Pose`: a position and an orientation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Pose {
+    /// The position.
+    pub position: Point,
+    /// The orientation.
+    pub orientation: Quaternion,
+}
+
+/// `geometry_msgs/msg/PoseStamped`: a pose in a frame at a time. A robot's setpoint when the
+/// model's channels name a pose (`setpoint_pose`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PoseStamped {
+    /// Stamp and frame.
+    pub header: Header,
+    /// The pose.
+    pub pose: Pose,
+}
+
 /// `sensor_msgs/msg/Joy`: the operator's input device.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Joy {
@@ -136,6 +191,7 @@ message!(
     Text,
     Float64MultiArray,
     Joy,
+    PoseStamped,
     TriggerRequest,
     TriggerResponse
 );
@@ -150,6 +206,8 @@ pub const STRING: TypeName = ("std_msgs", "String");
 pub const FLOAT64_MULTI_ARRAY: TypeName = ("std_msgs", "Float64MultiArray");
 /// `sensor_msgs/Joy`.
 pub const JOY: TypeName = ("sensor_msgs", "Joy");
+/// `geometry_msgs/PoseStamped`.
+pub const POSE_STAMPED: TypeName = ("geometry_msgs", "PoseStamped");
 /// `std_srvs/Trigger`.
 pub const TRIGGER: TypeName = ("std_srvs", "Trigger");
 

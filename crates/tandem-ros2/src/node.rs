@@ -8,7 +8,8 @@
 //! |---|---|---|---|
 //! | `/tandem/robotK/progress` | `std_msgs/Float64` | in | the robot's (reference samples reached) |
 //! | `/tandem/robotK/command` | `std_msgs/Float64MultiArray` | out | every tick: `[ref_time, speed_scale, tick, stamp_s]` |
-//! | `/tandem/robotK/setpoint` | `std_msgs/Float64MultiArray` | out | 100 Hz: the model's channels (Eq. 7, `u = 0`) |
+//! | `/tandem/robotK/setpoint` | `std_msgs/Float64MultiArray` | out | 100 Hz: the model's channels (Eq. 7, `u = 0`), those of the pose left out |
+//! | `/tandem/robotK/setpoint_pose` | `geometry_msgs/PoseStamped` | out | 100 Hz, when the model's channels name a pose ([`PoseChannels`]) |
 //! | `/tandem/robotK/needs_operator` | `std_msgs/Bool` | out | 100 Hz and on change |
 //! | `/tandem/next_handover` | `std_msgs/Float64MultiArray` | out | 100 Hz: `[robot, earliest_s, latest_s]` or empty |
 //! | `/tandem/fault` | `std_msgs/String` | out | 100 Hz and on change (empty: none) |
@@ -19,7 +20,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, TrySendError, sync_channel};
+use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -35,12 +36,14 @@ use tandem_planner::{Cell, Planner};
 use tandem_realtime::Controller;
 
 use crate::console::ConsoleFeed;
-use crate::core::{CellLoop, Inbound, LoopParams, Reply, Request, RoundLog, Snapshot};
+use crate::core::{CellLoop, Inbound, LoopParams, Reply, Request, RoundLog};
 use crate::error::{Error, Result, dds};
+use crate::link::{CommandRing, Heard, Pending, StateSlot};
 use crate::msg::{
-    self, BOOL, Bool, FLOAT64, FLOAT64_MULTI_ARRAY, Float64, Float64MultiArray, JOY, Joy, STRING,
-    TRIGGER, Text, TriggerRequest, TriggerResponse, TypeName,
+    self, BOOL, Bool, FLOAT64, FLOAT64_MULTI_ARRAY, Float64, Float64MultiArray, JOY, Joy,
+    POSE_STAMPED, PoseStamped, STRING, TRIGGER, Text, TriggerRequest, TriggerResponse, TypeName,
 };
+use crate::pose::{PoseChannels, PoseMap};
 
 /// The node's parameters.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,6 +60,10 @@ pub struct NodeParams {
     pub queue: usize,
     /// The control loop's timeouts.
     pub loop_params: LoopParams,
+    /// Which channels form the setpoint's pose. Default: [`PoseChannels::Auto`].
+    pub pose_channels: PoseChannels,
+    /// The pose's `header.frame_id`. Default: `world`.
+    pub frame_id: String,
 }
 
 impl Default for NodeParams {
@@ -68,6 +75,8 @@ impl Default for NodeParams {
             state_hz: 100.0,
             queue: 4096,
             loop_params: LoopParams::default(),
+            pose_channels: PoseChannels::Auto,
+            frame_id: "world".into(),
         }
     }
 }
@@ -107,7 +116,6 @@ struct Counters {
     ticks: AtomicU64,
     max_period_ns: AtomicU64,
     overruns: AtomicU64,
-    state_dropped: AtomicU64,
     inbound_dropped: AtomicU64,
     commands: AtomicU64,
     publish_failed: AtomicU64,
@@ -125,7 +133,7 @@ pub struct NodeStats {
     pub max_tick_s: f64,
     /// Ticks that started more than one period late.
     pub overruns: u64,
-    /// Snapshots the tick thread could not queue (the DDS thread behind).
+    /// Commands the tick thread could not hand over (the DDS thread `queue` ticks behind).
     pub state_dropped: u64,
     /// Messages from the network the DDS thread could not queue (the tick thread behind).
     pub inbound_dropped: u64,
@@ -145,6 +153,22 @@ pub struct Node {
     n_robots: usize,
     tick_s: f64,
     console: Option<Console>,
+    links: Option<Arc<Links>>,
+    pose: Option<PoseMap>,
+    channels: Vec<String>,
+}
+
+/// What the tick and DDS threads share besides the queue of rare messages (`crate::link`).
+#[derive(Debug)]
+struct Links {
+    /// Every tick's command, to the DDS thread.
+    commands: CommandRing,
+    /// The state topics' snapshot, when the DDS thread asks.
+    state: StateSlot,
+    /// The robots' progress reports, counted.
+    heard: Heard,
+    /// Messages queued for the tick thread, counted.
+    pending: Pending,
 }
 
 impl Node {
@@ -196,11 +220,17 @@ impl Node {
             None => (None, None),
         };
         let model = planner.model().clone();
+        let pose = params.pose_channels.resolve(model.channel_names())?;
         let cell_loop = CellLoop::new(ctl, &model, params.loop_params.clone())?;
         let stop = Arc::new(AtomicBool::new(false));
         let counters = Arc::new(Counters::default());
         let (in_tx, in_rx) = sync_channel::<Inbound>(params.queue);
-        let (state_tx, state_rx) = sync_channel::<Snapshot>(params.queue);
+        let links = Arc::new(Links {
+            commands: CommandRing::new(n, params.queue),
+            state: StateSlot::new(),
+            heard: Heard::default(),
+            pending: Pending::default(),
+        });
         let (reply_tx, reply_rx) = sync_channel::<Reply>(64);
         let (ready_tx, ready_rx) = sync_channel::<Result<()>>(1);
         let io = Io {
@@ -208,10 +238,12 @@ impl Node {
             cell: params.cell,
             domain: params.domain,
             n,
-            decimate: ((1.0 / params.state_hz) / tick_s).round().max(1.0) as u64,
+            state_period: Duration::from_secs_f64(1.0 / params.state_hz),
+            pose,
+            frame_id: params.frame_id.clone(),
             model,
             in_tx: in_tx.clone(),
-            state_rx,
+            links: links.clone(),
             reply_rx,
             stop: stop.clone(),
             counters: counters.clone(),
@@ -233,11 +265,12 @@ impl Node {
                 }));
             }
         }
+        let links_keep = links.clone();
         let ticker = Ticker {
             cell_loop,
             tick_s,
             in_rx,
-            state_tx,
+            links,
             reply_tx,
             stop: stop.clone(),
             counters: counters.clone(),
@@ -258,6 +291,9 @@ impl Node {
             n_robots: n,
             tick_s,
             console,
+            links: Some(links_keep),
+            pose,
+            channels: planner.model().channel_names().to_vec(),
         })
     }
 
@@ -265,6 +301,20 @@ impl Node {
     #[must_use]
     pub fn console_url(&self) -> Option<&str> {
         self.console.as_ref().map(Console::url)
+    }
+
+    /// The model's channels that form the setpoint's pose (`setpoint_pose`), by name:
+    /// position `x, y, z`, then the orientation's `x, y, z, w` when the pose has one; empty
+    /// when the node publishes no pose.
+    #[must_use]
+    pub fn pose_channels(&self) -> Vec<&str> {
+        self.pose.map_or_else(Vec::new, |m| {
+            m.position
+                .iter()
+                .chain(m.orientation.iter().flatten())
+                .map(|&k| self.channels[k].as_str())
+                .collect()
+        })
     }
 
     /// Robots it runs.
@@ -289,11 +339,15 @@ impl Node {
             max_period_s: get(&c.max_period_ns) as f64 * 1e-9,
             max_tick_s: get(&c.max_tick_ns) as f64 * 1e-9,
             overruns: get(&c.overruns),
-            state_dropped: get(&c.state_dropped),
+            state_dropped: self.links_dropped(),
             inbound_dropped: get(&c.inbound_dropped),
             commands: get(&c.commands),
             publish_failed: get(&c.publish_failed),
         }
+    }
+
+    fn links_dropped(&self) -> u64 {
+        self.links.as_ref().map_or(0, |l| l.commands.dropped())
     }
 
     /// Whether both threads still run.
@@ -343,7 +397,7 @@ struct Ticker {
     cell_loop: CellLoop,
     tick_s: f64,
     in_rx: Receiver<Inbound>,
-    state_tx: SyncSender<Snapshot>,
+    links: Arc<Links>,
     reply_tx: SyncSender<Reply>,
     stop: Arc<AtomicBool>,
     counters: Arc<Counters>,
@@ -356,32 +410,55 @@ impl Ticker {
         let mut next = Instant::now();
         let mut last_start: Option<Instant> = None;
         let c = self.counters.clone();
+        let n = self.cell_loop.controller().n_robots();
+        let mut pending_seen = 0_u64;
+        let mut heard_seen = [0_u64; tandem_realtime::MAX_ROBOTS];
+        let mut last_flags = (false, false, false);
+        let mut owed = false;
         while !self.stop.load(Ordering::Relaxed) {
             let now = Instant::now();
             if let Some(last) = last_start {
                 max_into(&c.max_period_ns, (now - last).as_nanos() as u64);
             }
             last_start = Some(now);
-            // At most one queue's worth per tick: a flood cannot lengthen the tick unboundedly.
-            for _ in 0..4096 {
-                match self.in_rx.try_recv() {
-                    Ok(m) => {
-                        let tx = &self.reply_tx;
-                        self.cell_loop.handle(m, now, &mut |r| {
-                            // 64 slots for at most a handful of pending requests.
-                            let _ = tx.try_send(r);
-                        });
+            let links = &*self.links;
+            // The rare messages (operator, requests, records), only when some were queued; at
+            // most one queue's worth per tick: a flood cannot lengthen the tick unboundedly.
+            if links.pending.moved(&mut pending_seen) {
+                for _ in 0..4096 {
+                    match self.in_rx.try_recv() {
+                        Ok(m) => {
+                            let tx = &self.reply_tx;
+                            self.cell_loop.handle(m, now, &mut |r| {
+                                // 64 slots for at most a handful of pending requests.
+                                let _ = tx.try_send(r);
+                            });
+                        }
+                        Err(TryRecvError::Empty | TryRecvError::Disconnected) => break,
                     }
-                    Err(TryRecvError::Empty | TryRecvError::Disconnected) => break,
                 }
             }
-            let snap = self.cell_loop.step(now)?;
+            let heard = links.heard.changed(n, &mut heard_seen);
+            if heard.count() > 0 {
+                for k in 0..n {
+                    if heard[k] {
+                        self.cell_loop.heard(k, now);
+                    }
+                }
+            }
+            let cmd = self.cell_loop.advance(now)?;
             if let Some(feed) = &mut self.console {
-                feed.publish(&self.cell_loop, &snap);
+                feed.publish(&self.cell_loop);
             }
-            if let Err(TrySendError::Full(_)) = self.state_tx.try_send(snap) {
-                c.state_dropped.fetch_add(1, Ordering::Relaxed);
+            // Every tick's command; the state topics' snapshot when asked, or at once when the
+            // fault or the round's state changed (so their topics follow within the tick).
+            links.commands.push(&cmd);
+            let flags = (cmd.fault, cmd.finished, cmd.active);
+            if flags != last_flags || owed || links.state.wanted() {
+                // A slot the DDS thread holds right now is written at the next tick.
+                owed = !links.state.put(self.cell_loop.snapshot());
             }
+            last_flags = flags;
             c.ticks.fetch_add(1, Ordering::Relaxed);
             max_into(&c.max_tick_ns, now.elapsed().as_nanos() as u64);
             next += period;
@@ -404,10 +481,12 @@ struct Io {
     cell: Cell,
     domain: u16,
     n: usize,
-    decimate: u64,
+    state_period: Duration,
+    pose: Option<PoseMap>,
+    frame_id: String,
     model: TaskModel,
     in_tx: SyncSender<Inbound>,
-    state_rx: Receiver<Snapshot>,
+    links: Arc<Links>,
     reply_rx: Receiver<Reply>,
     stop: Arc<AtomicBool>,
     counters: Arc<Counters>,
@@ -500,6 +579,7 @@ pub const SERVICES: [(&str, Request); 4] = [
 struct RobotIo {
     command: Publisher<Float64MultiArray>,
     setpoint: Publisher<Float64MultiArray>,
+    setpoint_pose: Option<Publisher<PoseStamped>>,
     needs: Publisher<Bool>,
     progress: Subscription<Float64>,
 }
@@ -525,7 +605,15 @@ impl Io {
         };
         let _ = &mut node;
         let mut model = self.model.clone();
-        let labels = model.channel_names().join(",");
+        // The setpoint's array: the channels not in the pose.
+        let others: Vec<usize> = (0..model.channel_names().len())
+            .filter(|&k| !self.pose.is_some_and(|p| p.contains(k)))
+            .collect();
+        let labels = others
+            .iter()
+            .map(|&k| model.channel_names()[k].as_str())
+            .collect::<Vec<_>>()
+            .join(",");
         let u0 = vec![0.0; model.n_components()];
         let mut cmd = vec![0.0; model.channel_names().len() + 1];
         let mut pending: HashMap<u64, (usize, RmwRequestId)> = HashMap::new();
@@ -533,6 +621,7 @@ impl Io {
         let (rec_tx, rec_rx) = sync_channel::<Recorded>(8);
         let mut last_needs = vec![None; self.n];
         let mut last_fault: Option<String> = None;
+        let mut next_state = Instant::now();
         let c = &self.counters;
         let fail = |ok: bool| {
             if !ok {
@@ -541,54 +630,81 @@ impl Io {
         };
         while !self.stop.load(Ordering::Relaxed) {
             let mut busy = false;
-            // 1. The tick thread's snapshots: commands every tick, state decimated.
-            while let Ok(snap) = self.state_rx.try_recv() {
+            // 1. The tick thread's commands, every tick's; `needs_operator` on change.
+            let links = &*self.links;
+            while let Some(command) = links.commands.pop() {
                 busy = true;
                 let stamp = msg::seconds(msg::now());
                 for (k, r) in robots.iter().enumerate() {
-                    let data = vec![snap.ref_time[k], snap.speed[k], snap.tick as f64, stamp];
+                    let data = vec![
+                        command.ref_time[k],
+                        command.speed[k],
+                        command.tick as f64,
+                        stamp,
+                    ];
                     let m = Float64MultiArray::labelled("ref_time,speed_scale,tick,stamp_s", data);
                     fail(r.command.publish(m).is_ok());
                     c.commands.fetch_add(1, Ordering::Relaxed);
                 }
-                let due = snap.tick % self.decimate == 0;
                 for (k, r) in robots.iter().enumerate() {
-                    let needs = snap.needs_operator[k];
-                    if due || last_needs[k] != Some(needs) {
+                    let needs = command.needs_operator[k];
+                    if last_needs[k] != Some(needs) {
                         fail(r.needs.publish(Bool { data: needs }).is_ok());
                         last_needs[k] = Some(needs);
                     }
-                    if due {
-                        let t = snap.ref_time[k].clamp(0.0, (model.n_ref() - 1) as f64);
-                        if model.command_into(&u0, t, &mut cmd).is_ok() {
-                            let m = cmd.len() - 1;
-                            let sp = Float64MultiArray::labelled(&labels, cmd[..m].to_vec());
-                            fail(r.setpoint.publish(sp).is_ok());
+                }
+                if command.fault != last_fault.is_some() {
+                    // The fault's text is the snapshot's: ask for it now.
+                    links.state.ask();
+                }
+            }
+            // 2. The state topics at their rate: ask for a snapshot, publish it when it comes.
+            let now = Instant::now();
+            if now >= next_state {
+                links.state.ask();
+                next_state = (next_state + self.state_period).max(now);
+            }
+            if let Some(snap) = links.state.take() {
+                busy = true;
+                for (k, r) in robots.iter().enumerate() {
+                    let needs = snap.needs_operator[k];
+                    fail(r.needs.publish(Bool { data: needs }).is_ok());
+                    last_needs[k] = Some(needs);
+                    let t = snap.ref_time[k].clamp(0.0, (model.n_ref() - 1) as f64);
+                    if model.command_into(&u0, t, &mut cmd).is_ok() {
+                        let values = others.iter().map(|&k| cmd[k]).collect();
+                        let sp = Float64MultiArray::labelled(&labels, values);
+                        fail(r.setpoint.publish(sp).is_ok());
+                        if let (Some(p), Some(map)) = (&r.setpoint_pose, self.pose) {
+                            fail(
+                                p.publish(map.pose(&cmd, &self.frame_id, msg::now()))
+                                    .is_ok(),
+                            );
                         }
                     }
                 }
                 let text = snap.fault.map(|f| f.to_string());
-                if due || text != last_fault {
-                    let data = text.clone().unwrap_or_default();
-                    fail(fault.publish(Text { data }).is_ok());
-                    last_fault = text;
-                }
-                if due {
-                    let data = snap.next.map_or_else(Vec::new, |p| {
-                        vec![(p.robot + 1) as f64, p.earliest_s, p.latest_s]
-                    });
-                    let m = Float64MultiArray::labelled("robot,earliest_s,latest_s", data);
-                    fail(handover.publish(m).is_ok());
-                }
+                fail(
+                    fault
+                        .publish(Text {
+                            data: text.clone().unwrap_or_default(),
+                        })
+                        .is_ok(),
+                );
+                last_fault = text;
+                let data = snap.next.map_or_else(Vec::new, |p| {
+                    vec![(p.robot + 1) as f64, p.earliest_s, p.latest_s]
+                });
+                let m = Float64MultiArray::labelled("robot,earliest_s,latest_s", data);
+                fail(handover.publish(m).is_ok());
             }
-            // 2. The network's messages to the tick thread.
+            // The network's messages to the tick thread: progress as a count per robot.
             for (k, r) in robots.iter().enumerate() {
                 while let Ok(Some((m, _))) = r.progress.take() {
                     busy = true;
-                    self.forward(Inbound::Progress {
-                        robot: k,
-                        ref_time: m.data,
-                    });
+                    if m.data.is_finite() {
+                        links.heard.hear(k);
+                    }
                 }
             }
             while let Ok(Some((joy, _))) = operator.take() {
@@ -605,6 +721,7 @@ impl Io {
                     let what = SERVICES[i].1;
                     match self.in_tx.try_send(Inbound::Request { token, what }) {
                         Ok(()) => {
+                            self.links.pending.sent();
                             pending.insert(token, (i, id));
                         }
                         Err(_) => {
@@ -682,6 +799,14 @@ impl Io {
                         &robot_topic(k, "setpoint")?,
                         FLOAT64_MULTI_ARRAY,
                     )?,
+                    setpoint_pose: match self.pose {
+                        Some(_) => Some(publisher(
+                            &mut node,
+                            &robot_topic(k, "setpoint_pose")?,
+                            POSE_STAMPED,
+                        )?),
+                        None => None,
+                    },
                     needs: publisher(&mut node, &robot_topic(k, "needs_operator")?, BOOL)?,
                     progress: subscription(&mut node, &robot_topic(k, "progress")?, FLOAT64)?,
                 })
@@ -715,6 +840,8 @@ impl Io {
             self.counters
                 .inbound_dropped
                 .fetch_add(1, Ordering::Relaxed);
+        } else {
+            self.links.pending.sent();
         }
     }
 
@@ -724,17 +851,22 @@ impl Io {
         let state = self.state.clone();
         let cell = self.cell;
         let in_tx = self.in_tx.clone();
+        let links = self.links.clone();
         let spawned = std::thread::Builder::new()
             .name("tandem-record".into())
             .spawn(move || {
                 let result = match record(&state, cell, &log) {
                     Ok((text, ctl, model)) => {
                         // Blocking send is fine here: this thread is not the tick's.
-                        let _ = in_tx.send(Inbound::Replace(ctl));
+                        if in_tx.send(Inbound::Replace(ctl)).is_ok() {
+                            links.pending.sent();
+                        }
                         Ok((text, model))
                     }
                     Err(e) => {
-                        let _ = in_tx.send(Inbound::Restore(log));
+                        if in_tx.send(Inbound::Restore(log)).is_ok() {
+                            links.pending.sent();
+                        }
                         Err(format!("cannot record the round: {e}"))
                     }
                 };

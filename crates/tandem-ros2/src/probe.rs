@@ -8,8 +8,8 @@ use ros2_client::{Client, Node as RosNode, Publisher, ServiceTypeName, Subscript
 
 use crate::error::{Error, Result, dds};
 use crate::msg::{
-    BOOL, Bool, FLOAT64, FLOAT64_MULTI_ARRAY, Float64, Float64MultiArray, Header, JOY, Joy, STRING,
-    TRIGGER, Text, TriggerRequest, TriggerResponse, now,
+    BOOL, Bool, FLOAT64, FLOAT64_MULTI_ARRAY, Float64, Float64MultiArray, Header, JOY, Joy,
+    POSE_STAMPED, PoseStamped, STRING, TRIGGER, Text, TriggerRequest, TriggerResponse, now,
 };
 use crate::node::{
     SERVICE_MAPPING, SERVICES, cell_topic, publisher, qos, robot_topic, ros_node, subscription,
@@ -35,6 +35,8 @@ pub struct Probe {
     _node: RosNode,
     commands: Vec<Subscription<Float64MultiArray>>,
     needs: Vec<Subscription<Bool>>,
+    setpoints: Vec<Subscription<Float64MultiArray>>,
+    poses: Vec<Subscription<PoseStamped>>,
     progress: Vec<Publisher<Float64>>,
     fault: Subscription<Text>,
     operator: Publisher<Joy>,
@@ -58,6 +60,8 @@ impl Probe {
         let mut node = ros_node(domain, "tandem_probe")?;
         let mut commands = Vec::new();
         let mut needs = Vec::new();
+        let mut setpoints = Vec::new();
+        let mut poses = Vec::new();
         let mut progress = Vec::new();
         for k in 0..n {
             commands.push(subscription(
@@ -69,6 +73,16 @@ impl Probe {
                 &mut node,
                 &robot_topic(k, "needs_operator")?,
                 BOOL,
+            )?);
+            setpoints.push(subscription(
+                &mut node,
+                &robot_topic(k, "setpoint")?,
+                FLOAT64_MULTI_ARRAY,
+            )?);
+            poses.push(subscription(
+                &mut node,
+                &robot_topic(k, "setpoint_pose")?,
+                POSE_STAMPED,
             )?);
             progress.push(publisher(&mut node, &robot_topic(k, "progress")?, FLOAT64)?);
         }
@@ -91,6 +105,8 @@ impl Probe {
             _node: node,
             commands,
             needs,
+            setpoints,
+            poses,
             progress,
             fault,
             operator,
@@ -120,6 +136,24 @@ impl Probe {
         let mut last = None;
         while let Ok(Some((m, _))) = self.needs[k].take() {
             last = Some(m.data);
+        }
+        last
+    }
+
+    /// The last setpoint (`Float64MultiArray`) of robot `k` that arrived since the last call.
+    pub fn setpoint(&self, k: usize) -> Option<Float64MultiArray> {
+        let mut last = None;
+        while let Ok(Some((m, _))) = self.setpoints[k].take() {
+            last = Some(m);
+        }
+        last
+    }
+
+    /// The last `setpoint_pose` of robot `k` that arrived since the last call.
+    pub fn setpoint_pose(&self, k: usize) -> Option<PoseStamped> {
+        let mut last = None;
+        while let Ok(Some((m, _))) = self.poses[k].take() {
+            last = Some(m);
         }
         last
     }

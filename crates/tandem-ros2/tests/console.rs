@@ -85,7 +85,7 @@ fn the_consoles_lc_robot_is_the_nodes_needs_operator_at_every_change() {
             let want = cell.controller().ticks();
             let end = Instant::now() + Duration::from_secs(10);
             let f = loop {
-                feed.publish(&cell, &snap);
+                feed.publish(&cell);
                 if let Some(f) = frame(addr).filter(|f| f.tick == want) {
                     break f;
                 }
@@ -102,12 +102,12 @@ fn the_consoles_lc_robot_is_the_nodes_needs_operator_at_every_change() {
             }
             before = Some(needs);
         } else {
-            feed.publish(&cell, &snap);
+            feed.publish(&cell);
         }
         if snap.finished {
             // The round's end is counted on the page.
             let f = loop {
-                feed.publish(&cell, &snap);
+                feed.publish(&cell);
                 if let Some(f) = frame(addr).filter(|f| f.rounds_done == 1) {
                     break f;
                 }

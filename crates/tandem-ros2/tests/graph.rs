@@ -514,3 +514,63 @@ fn stream_1khz_for_10_s() {
     );
     assert!(n > 10_000, "{n}");
 }
+
+/// A model whose channels name a pose (`force`, `x`, `y`, `z`, `qw`, `qx`, `qy`, `qz`:
+/// auto-detected, the quaternion's names out of ROS order), constant over the task: the
+/// setpoint's pose is `(0.5, −0.25, 1.125)` with the orientation `(0, 0, 1.2, 1.6)` normalized
+/// to `(0, 0, 0.6, 0.8)`, and the `Float64MultiArray` keeps `force` alone.
+#[test]
+fn the_setpoint_goes_out_as_a_pose_stamped_and_the_rest_as_an_array() {
+    use tandem_lfd::{Demonstration, FitParams, TaskModel};
+    let names: Vec<String> = "force,x,y,z,qw,qx,qy,qz"
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    let row = [3.0, 0.5, -0.25, 1.125, 1.6, 0.0, 0.0, 1.2];
+    let n_ref = support::N_REF;
+    let demo = Demonstration::new(names, row.repeat(n_ref), 0.01).unwrap();
+    let identity: Vec<f64> = (0..n_ref).map(|n| n as f64).collect();
+    let model = TaskModel::fit_aligned(
+        &[demo.clone(), demo.clone(), demo],
+        &[identity.clone(), identity.clone(), identity],
+        &FitParams::default(),
+    )
+    .unwrap();
+    let state = support::state_file_of("pose", support::planner_with(model, 2));
+    let params = NodeParams {
+        domain: 71,
+        frame_id: "cell".into(),
+        ..NodeParams::default()
+    };
+    let node = Node::start(&state, &params).unwrap();
+    assert_eq!(
+        node.pose_channels(),
+        ["x", "y", "z", "qx", "qy", "qz", "qw"]
+    );
+    let probe = Probe::new(71, 2).unwrap();
+    let end = Instant::now() + Duration::from_secs(30);
+    let (mut pose, mut array) = (None, None);
+    while Instant::now() < end && (pose.is_none() || array.is_none()) {
+        pose = pose.or_else(|| probe.setpoint_pose(1));
+        array = array.or_else(|| probe.setpoint(1));
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let pose = pose.expect("a setpoint_pose within 30 s");
+    assert_eq!(pose.header.frame_id, "cell");
+    let (p, q) = (pose.pose.position, pose.pose.orientation);
+    let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+    assert!(
+        close(p.x, 0.5) && close(p.y, -0.25) && close(p.z, 1.125),
+        "{p:?}"
+    );
+    assert!(
+        close(q.x, 0.0) && close(q.y, 0.0) && close(q.z, 0.6) && close(q.w, 0.8),
+        "{q:?}"
+    );
+    let array = array.expect("a setpoint within 30 s");
+    assert_eq!(array.layout.dim[0].label, "force");
+    assert_eq!(array.data.len(), 1);
+    assert!(close(array.data[0], 3.0), "{:?}", array.data);
+    node.stop().unwrap();
+    support::remove(&state);
+}
