@@ -7,7 +7,8 @@
 //! and the state slot's `want` flag, answered with a snapshot every 10th tick (the 100 Hz state
 //! topics at a 1 kHz tick; `with_queues_state_every_tick`: every tick, the 10 ms tick's case).
 //! The DDS side's ends (three progress reports, the command popped, the snapshot taken) run
-//! in the same loop here and are counted. Run with `cargo bench -p tandem-ros2 --bench tick`.
+//! in the same loop here and are counted. `advance_only` is `CellLoop::advance` alone (a fixed
+//! instant, no links): the loop's own share of the difference. Run with `cargo bench -p tandem-ros2 --bench tick`.
 #![expect(
     missing_docs,
     reason = "criterion_group! generates an undocumented pub fn"
@@ -130,6 +131,22 @@ fn bench(c: &mut Criterion) {
                 bare.reset();
             }
             black_box(bare.tick(Operator::Scheduled).expect("a valid operator"))
+        });
+    });
+    // The loop's own work without the links or the clock (`CellLoop::advance` at a fixed
+    // instant, the robots heard): what the node's tick adds to a bare one before any queue.
+    let mut node = NodeTick::new(&planner, 10);
+    let now = Instant::now();
+    group.bench_function("advance_only", |b| {
+        b.iter(|| {
+            for k in 0..3 {
+                node.l.heard(k, now);
+            }
+            let c = node.l.advance(now).expect("a valid operator");
+            if c.finished {
+                start(&mut node.l);
+            }
+            black_box(c.tick)
         });
     });
     let mut node = NodeTick::new(&planner, 10);
