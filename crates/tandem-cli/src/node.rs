@@ -2,6 +2,8 @@
 //! (crate `tandem-ros2`; docs/guide.md, "tandem in a ROS 2 graph").
 
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
@@ -45,6 +47,11 @@ pub(crate) struct NodeArgs {
     /// The pose's frame (`header.frame_id`).
     #[arg(long, value_name = "FRAME", default_value = "world")]
     pub(crate) frame_id: String,
+    /// Stop cleanly (the threads joined, the counters printed) when standard input closes: a
+    /// supervisor's or a script's way to end the node. Off by default (a node started with
+    /// its input at /dev/null would stop at once).
+    #[arg(long)]
+    pub(crate) stdin_stop: bool,
     /// Stop after this long (s). Default: run until interrupted.
     #[arg(long, value_name = "S")]
     pub(crate) seconds: Option<f64>,
@@ -111,9 +118,18 @@ pub(crate) fn node(a: &NodeArgs) -> Result<()> {
             a.pose_channels
         ));
     }
+    let closed = Arc::new(AtomicBool::new(false));
+    if a.stdin_stop {
+        let closed = closed.clone();
+        // Reads standard input to its end; the thread is left behind when the node stops first.
+        std::thread::spawn(move || {
+            let _ = std::io::copy(&mut std::io::stdin().lock(), &mut std::io::sink());
+            closed.store(true, Ordering::Relaxed);
+        });
+    }
     let start = Instant::now();
     let mut report = start;
-    while node.is_running() {
+    while node.is_running() && !closed.load(Ordering::Relaxed) {
         if a.seconds
             .is_some_and(|s| start.elapsed().as_secs_f64() >= s)
         {

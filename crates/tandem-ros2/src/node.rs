@@ -1,6 +1,8 @@
 //! The live node: a tick thread running a [`CellLoop`] at the schedule's tick and a DDS thread
-//! (ros2-client on RustDDS) publishing and subscribing, joined by bounded queues that are only
-//! ever used with `try_send`/`try_recv` (std's bounded channel: a lock-free array queue).
+//! (ros2-client on RustDDS) publishing and subscribing, joined by the wait-free links of
+//! [`crate::link`] (every tick's command in a ring, the state snapshot when asked, progress as
+//! counters) and a bounded queue of the rare messages, only ever used with
+//! `try_send`/`try_recv` by the tick thread (std's bounded channel: a lock-free array queue).
 //!
 //! The topics and services (`K` = 1…N, robot 1 first):
 //!
