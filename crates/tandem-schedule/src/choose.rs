@@ -114,7 +114,8 @@ pub struct Outcome {
     /// optimum `T*₀` (constraints 1–4, [`crate::solve_exact`]) when
     /// [`Outcome::bound_is_optimum`], else the simple bound of an unfinished search; for
     /// one robot its fastest execution; for `N ≥ 3` the `N`-robot search's optimum when it
-    /// finished, else [`crate::operator_bound_s`]. Reported as computed, never clamped: it is
+    /// finished, else the larger of [`crate::operator_bound_s`] and the least bound of the
+    /// nodes it left open (never below the bound of fewer robots). Reported as computed, never clamped: it is
     /// not above [`Outcome::t_total_s`] except by the rounding a valid schedule is allowed
     /// (at most `tol::BOUND_REL` = `2·tol::GRADIENT_REL` relative: `validate` accepts
     /// gradients that far outside their bounds, and the bound and `T_total` are summed in

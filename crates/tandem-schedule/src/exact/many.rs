@@ -67,6 +67,8 @@ struct Net<'a> {
     gave_up: bool,
     /// Raises of all propagations so far (the search's work).
     raises: usize,
+    /// Propagations stopped at their raise limit so far.
+    gave_ups: usize,
 }
 
 impl<'a> Net<'a> {
@@ -95,6 +97,7 @@ impl<'a> Net<'a> {
             eps: 0.0,
             gave_up: false,
             raises: 0,
+            gave_ups: 0,
         };
         let mut scale = 0.0;
         for r in 0..n {
@@ -146,6 +149,7 @@ impl<'a> Net<'a> {
                     if raises > limit {
                         self.queue.clear();
                         self.gave_up = true;
+                        self.gave_ups += 1;
                         return false;
                     }
                     self.trail.push((z, self.x[z]));
@@ -185,41 +189,86 @@ impl<'a> Net<'a> {
     }
 }
 
+/// What [`search_with_switch`] returns: the best order found, whether it is proven optimal,
+/// the nodes visited and a lower bound on the optimum.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct ManyOutcome {
+    /// The best order found below the cap, if any.
+    pub(crate) found: Option<ManyFound>,
+    /// Whether the search finished: no order is shorter than [`ManyOutcome::found`]'s (or,
+    /// when `None`, below the cap), so its `T_total` is the optimum.
+    pub(crate) proven: bool,
+    /// Nodes visited, the dive's and the exact search's.
+    pub(crate) nodes: usize,
+    /// A lower bound (s) on the `T_total` of every order (every schedule of Eq. 20
+    /// constraints 1–4 on the chain), or on the cap when no order beats it: the least of the
+    /// best `T_total` found (or the cap) and the bounds of the nodes the exact search left open
+    /// (see [`search_with_switch`]); the optimum itself when [`ManyOutcome::proven`] and an
+    /// order was found.
+    pub(crate) lower_bound_s: f64,
+}
+
 /// The best interleaving of `n` robots' LC runs on `chain` (all robots traverse it, each
 /// starting at any time `≥ 0`, no two LC runs overlapping, `T_total` the latest end), by
 /// depth-first branch and bound over machine orders: each node's earliest times (longest
 /// paths, kept incrementally) are lower bounds on every completion's, so a node is cut when
 /// the operator's free time plus the LC time left plus the fastest tail, or a robot's
 /// earliest end, reaches the incumbent `cap_s` (s) or the best found. Robots are
-/// interchangeable, so their first LC runs come in robot order. Children are tried earliest
-/// next start first, so the first leaf is the greedy list schedule. At most `max_nodes`
-/// nodes and about `max_nodes · MAX_RAISES_PER_NODE` raises of the longest paths (a node's
-/// work grows with the number of LC runs); `None` if no order beats `cap_s` (proven only if
-/// the search finished).
+/// interchangeable, so their first LC runs come in robot order. The exact search tries
+/// children earliest next start first (the greedy list order) after a dive (see
+/// [`search_with_switch`]). At most `max_nodes` nodes and about
+/// `max_nodes · MAX_RAISES_PER_NODE` raises of the longest paths (a node's work grows with the
+/// number of LC runs); no order found if none beats `cap_s` (proven only if the search
+/// finished).
 #[cfg(test)]
-pub(crate) fn search(
-    chain: &Chain,
-    n: usize,
-    cap_s: f64,
-    max_nodes: usize,
-) -> (Option<ManyFound>, bool, usize) {
+pub(crate) fn search(chain: &Chain, n: usize, cap_s: f64, max_nodes: usize) -> ManyOutcome {
     search_with_switch(chain, n, cap_s, max_nodes, 0.0)
 }
 
 /// [`search`] with the operator's switch time `switch_s` (s, ≥ 0): an LC run placed right after
 /// *another* robot's run starts at least `switch_s` after that run ends (consecutive runs of
 /// one robot need none), and a node's bound adds `switch_s` for every robot other than the
-/// last placed one that still has runs to place (each needs one switch to it at least). With
-/// `switch_s = 0` it is [`search`], the same float operations.
+/// last placed one that still has runs to place (each needs one switch to it at least).
+///
+/// **The dive.** The greedy list order (earliest next start first) runs into gaps whose
+/// slowest traversal cannot cover the other robots' runs and backtracks deep: on random
+/// problems of 11–21 LC runs it found no order at all within its budget (docs/decisions.md,
+/// "The three-robot search: a dive that reaches a leaf and the open nodes' bound (issue 38)").
+/// So a first depth-first search (at most `max_nodes / DIVE_SHARE` nodes, stopping at its
+/// first leaf) puts *urgent* robots first: robot `r`, in the HC gap before its next LC run
+/// `k`, must start it by its deadline `x(k − 1) + L_{k−1} + b_k` (the gap's slowest
+/// traversal); when the greedy child would end after another robot's deadline, the robots
+/// whose deadlines it passes go first, earliest deadline first. If the dive finds no leaf,
+/// the serial order (each robot's runs after the previous robot's, always feasible: starts
+/// have no upper bound) is the leaf. The leaf is the exact search's incumbent; every node
+/// of the dive and the serial order counts against the budget.
+///
+/// **The open nodes' bound.** A node's bound is a lower bound on the `T_total` of every leaf
+/// below it (its earliest times are the least of every completion's, and placing a run never
+/// lowers `operator free + LC time left`), so when the exact search stops on its budget the
+/// optimum is either the best found or a leaf below a node it left open: the node it stopped
+/// at, the children not yet tried at every node of its path (each bounded by placing it, or by
+/// its parent's bound when the placement stopped on its raise limit), and the children whose
+/// placement stopped on the raise limit. [`ManyOutcome::lower_bound_s`] is the least of these
+/// and of the best found: a valid lower bound on the optimum. Closed nodes (bound at or above
+/// the best found, or an infeasible order proven by a positive cycle) hold no better leaf.
+///
+/// With `switch_s = 0` the same float operations as without a switch time.
 pub(crate) fn search_with_switch(
     chain: &Chain,
     n: usize,
     cap_s: f64,
     max_nodes: usize,
     switch_s: f64,
-) -> (Option<ManyFound>, bool, usize) {
+) -> ManyOutcome {
     let Some(mut net) = Net::new(chain, n, switch_s) else {
-        return (None, true, 0);
+        // The chain alone is infeasible: no order at all.
+        return ManyOutcome {
+            found: None,
+            proven: true,
+            nodes: 0,
+            lower_bound_s: cap_s,
+        };
     };
     let m = chain.n_lc();
     let mut s = Search {
@@ -228,18 +277,47 @@ pub(crate) fn search_with_switch(
         best: None,
         best_t: cap_s,
         nodes: 0,
-        max_nodes,
+        max_nodes: (max_nodes / DIVE_SHARE).max(1),
         out_of_budget: false,
         rem_lc: chain.lc_s.iter().sum::<f64>() * n as f64,
         switch_s,
+        dive: true,
+        open_lb: f64::INFINITY,
     };
     s.dfs(&mut net, None);
-    let proven = !s.out_of_budget && !net.gave_up;
+    if s.best.is_none() {
+        s.serial(&mut net);
+    }
+    // The exact search from the dive's leaf: a fresh node budget (the dive's nodes count),
+    // the raises so far too.
+    s.dive = false;
+    s.out_of_budget = false;
+    s.max_nodes = max_nodes;
+    s.open_lb = f64::INFINITY;
+    net.gave_up = false;
+    if s.nodes < max_nodes {
+        s.dfs(&mut net, None);
+    } else {
+        // No budget left for the exact search: its root stays open.
+        s.out_of_budget = true;
+        s.open_lb = s.bound(&net, None);
+    }
+    let proven = !s.out_of_budget && !net.gave_up && s.open_lb == f64::INFINITY;
     let nodes = s.nodes;
+    let lower_bound_s = if proven {
+        s.best_t
+    } else {
+        s.best_t.min(s.open_lb)
+    };
     let found = s
         .best
         .map(|(order, x)| relabel(&net, &order, &x, proven, nodes));
-    (found, proven, nodes)
+    ManyOutcome {
+        found,
+        proven,
+        nodes,
+        lower_bound_s,
+    }
 }
 
 /// The search's work budget in raises per node of [`search`]'s node budget: 200,000 nodes of
@@ -247,6 +325,10 @@ pub(crate) fn search_with_switch(
 /// 385 LC runs stop after ≈ 0.7 s on 2 cores instead of 205 s (docs/decisions.md, "N robots
 /// in the margin-free search").
 const MAX_RAISES_PER_NODE: usize = 10;
+
+/// The dive's share of the node budget: at most `max_nodes / DIVE_SHARE` nodes before the
+/// serial order is taken as the first leaf.
+const DIVE_SHARE: usize = 4;
 
 struct Search {
     next: Vec<usize>,
@@ -260,15 +342,17 @@ struct Search {
     rem_lc: f64,
     /// The operator's switch time (s, ≥ 0; see [`search_with_switch`]).
     switch_s: f64,
+    /// The dive: urgent robots first, stop at the first leaf, no open nodes kept.
+    dive: bool,
+    /// The least bound (s) of the nodes left open (`+∞`: none).
+    open_lb: f64,
 }
 
 impl Search {
-    fn dfs(&mut self, net: &mut Net, last: Option<(usize, f64)>) {
-        self.nodes += 1;
-        if net.raises > self.max_nodes.saturating_mul(MAX_RAISES_PER_NODE) {
-            self.out_of_budget = true;
-            return;
-        }
+    /// The node's bound (s): the latest earliest end, or the operator's free time plus the LC
+    /// time left (plus a switch to every robot with runs left other than the last one) plus
+    /// the fastest tail.
+    fn bound(&self, net: &Net, last: Option<(usize, f64)>) -> f64 {
         let (n, m) = (net.n, net.m);
         let op_free = last.map_or(0.0, |(v, l)| net.x[v] + l);
         let latest_end = (0..n).map(|r| net.x[net.end(r)]).fold(0.0, f64::max);
@@ -278,28 +362,145 @@ impl Search {
             0.0
         };
         let last_robot = self.order.last().copied();
-        let lb = if self.switch_s > 0.0 {
+        if self.switch_s > 0.0 {
             let switches = (0..n)
                 .filter(|&r| Some(r) != last_robot && self.next[r] < m)
                 .count();
             latest_end.max(op_free + self.rem_lc + self.switch_s * switches as f64 + tail)
         } else {
             latest_end.max(op_free + self.rem_lc + tail)
-        };
+        }
+    }
+
+    /// The operator edge for robot `r`'s next run after the last run: its length, plus δ on
+    /// a switch.
+    fn edge(&self, last: Option<(usize, f64)>, r: usize) -> Option<(usize, f64)> {
+        match last {
+            Some((v, l)) if self.switch_s > 0.0 && Some(r) != self.order.last().copied() => {
+                Some((v, l + self.switch_s))
+            }
+            other => other,
+        }
+    }
+
+    /// Leaves a node open with bound `lb` (s) (nothing during the dive).
+    fn open(&mut self, lb: f64) {
+        if !self.dive {
+            self.open_lb = self.open_lb.min(lb);
+        }
+    }
+
+    /// Leaves robot `r`'s next run open as a child of the node `last` of bound `parent_lb`:
+    /// bounded by placing it, closed if the placement proves it infeasible or its bound
+    /// reaches the best found.
+    fn open_child(&mut self, net: &mut Net, last: Option<(usize, f64)>, r: usize, parent_lb: f64) {
+        if self.dive {
+            return;
+        }
+        let k = self.next[r];
+        let mark = net.trail.len();
+        let edge = self.edge(last, r);
+        let gave_ups = net.gave_ups;
+        if net.place(edge, r, k) {
+            let l = net.chain.lc_s[k];
+            self.next[r] += 1;
+            self.order.push(r);
+            self.rem_lc -= l;
+            let lb = self.bound(net, Some((net.lc(r, k), l)));
+            self.rem_lc += l;
+            self.order.pop();
+            self.next[r] -= 1;
+            if lb < self.best_t * (1.0 - 1e-12) {
+                self.open(lb);
+            }
+        } else if net.gave_ups > gave_ups {
+            self.open(parent_lb);
+        }
+        net.undo(mark, edge);
+    }
+
+    fn dfs(&mut self, net: &mut Net, last: Option<(usize, f64)>) {
+        self.nodes += 1;
+        let (n, m) = (net.n, net.m);
+        let lb = self.bound(net, last);
         let cut = self.best_t * (1.0 - 1e-12);
         if lb >= cut {
             return;
         }
         if self.order.len() == n * m {
-            self.best_t = latest_end;
+            self.best_t = (0..n).map(|r| net.x[net.end(r)]).fold(0.0, f64::max);
             self.best = Some((self.order.clone(), net.x.clone()));
             return;
         }
-        if self.nodes >= self.max_nodes {
+        if self.nodes >= self.max_nodes
+            || net.raises > self.max_nodes.saturating_mul(MAX_RAISES_PER_NODE)
+        {
             self.out_of_budget = true;
+            self.open(lb);
             return;
         }
-        // Robots that may go next, earliest possible start first.
+        let kids = self.children(net, last);
+        // Forward check: a robot whose next run cannot go next cannot go later either (see
+        // [`Search::dead`]), so the node has no feasible completion.
+        if kids.iter().any(|&r| self.dead(net, last, r)) {
+            return;
+        }
+        for (i, &r) in kids.iter().enumerate() {
+            if self.out_of_budget || (self.dive && self.best.is_some()) {
+                for &rest in &kids[i..] {
+                    self.open_child(net, last, rest, lb);
+                }
+                return;
+            }
+            let k = self.next[r];
+            let mark = net.trail.len();
+            let edge = self.edge(last, r);
+            let gave_ups = net.gave_ups;
+            if net.place(edge, r, k) {
+                let l = net.chain.lc_s[k];
+                self.next[r] += 1;
+                self.order.push(r);
+                self.rem_lc -= l;
+                self.dfs(net, Some((net.lc(r, k), l)));
+                self.rem_lc += l;
+                self.order.pop();
+                self.next[r] -= 1;
+            } else if net.gave_ups > gave_ups {
+                // Not proven infeasible: open, bounded by this node.
+                self.open(lb);
+            }
+            net.undo(mark, edge);
+        }
+    }
+
+    /// Whether placing robot `r`'s next run right after the last run is proven infeasible
+    /// (a positive cycle, not the raise limit). Then so is placing it after any further runs:
+    /// the cycle runs through the operator edge from the last run to it, and any further runs
+    /// replace that edge by a path of operator edges at least as long (each run's length is
+    /// ≥ 0, and a path into another robot's run holds a switch as the edge does), while the
+    /// cycle's other edges stay. So no completion of the node exists.
+    fn dead(&self, net: &mut Net, last: Option<(usize, f64)>, r: usize) -> bool {
+        let k = self.next[r];
+        if k == 0 {
+            // A robot's first run: its start has no upper bound, never infeasible.
+            return false;
+        }
+        let mark = net.trail.len();
+        let edge = self.edge(last, r);
+        let gave_ups = net.gave_ups;
+        let ok = net.place(edge, r, k);
+        let dead = !ok && net.gave_ups == gave_ups;
+        net.undo(mark, edge);
+        dead
+    }
+
+    /// The robots that may go next: earliest possible start first (ties by index); in the
+    /// dive, the robots whose deadlines the first one's run would pass go before it, earliest
+    /// deadline first (see [`search_with_switch`]).
+    fn children(&self, net: &Net, last: Option<(usize, f64)>) -> Vec<usize> {
+        let (n, m) = (net.n, net.m);
+        let op_free = last.map_or(0.0, |(v, l)| net.x[v] + l);
+        let last_robot = self.order.last().copied();
         let mut kids: Vec<(f64, usize)> = (0..n)
             .filter(|&r| self.next[r] < m && (r == 0 || self.next[r] > 0 || self.next[r - 1] > 0))
             .map(|r| {
@@ -312,31 +513,93 @@ impl Search {
             })
             .collect();
         kids.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        for (_, r) in kids {
-            if self.out_of_budget {
-                return;
-            }
+        if !self.dive || kids.len() < 2 {
+            return kids.into_iter().map(|(_, r)| r).collect();
+        }
+        // The latest start of robot r's next run k ≥ 1: its gap's slowest traversal after
+        // the end of run k − 1 at its earliest.
+        let deadline = |r: usize| {
             let k = self.next[r];
-            let mark = net.trail.len();
-            // The operator edge from the last run: its length, plus δ on a switch.
-            let edge = match last {
-                Some((v, l)) if self.switch_s > 0.0 && Some(r) != last_robot => {
-                    Some((v, l + self.switch_s))
-                }
-                other => other,
-            };
-            let ok = net.place(edge, r, k);
-            if ok {
-                let l = net.chain.lc_s[k];
-                self.next[r] += 1;
-                self.order.push(r);
-                self.rem_lc -= l;
-                self.dfs(net, Some((net.lc(r, k), l)));
-                self.rem_lc += l;
-                self.order.pop();
-                self.next[r] -= 1;
+            if k == 0 {
+                f64::INFINITY
+            } else {
+                net.x[net.lc(r, k - 1)] + net.chain.lc_s[k - 1] + net.chain.gap_s[k].1
             }
-            net.undo(mark, edge);
+        };
+        let (first_start, first) = kids[0];
+        let mut first_end = first_start + net.chain.lc_s[self.next[first]];
+        if self.switch_s > 0.0 {
+            first_end += self.switch_s;
+        }
+        let mut urgent: Vec<(f64, usize)> = kids
+            .iter()
+            .filter(|&&(_, r)| r != first && deadline(r) < first_end)
+            .map(|&(_, r)| (deadline(r), r))
+            .collect();
+        if urgent.is_empty() {
+            return kids.into_iter().map(|(_, r)| r).collect();
+        }
+        urgent.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let mut out: Vec<usize> = urgent.iter().map(|&(_, r)| r).collect();
+        let rest: Vec<usize> = kids
+            .iter()
+            .map(|&(_, r)| r)
+            .filter(|r| !out.contains(r))
+            .collect();
+        out.extend(rest);
+        out
+    }
+
+    /// The serial order as a leaf: each robot's runs after the previous robot's (one node per
+    /// run). Kept if it beats the best so far.
+    fn serial(&mut self, net: &mut Net) {
+        let (n, m) = (net.n, net.m);
+        let base = net.trail.len();
+        let mut last: Option<(usize, f64)> = None;
+        let mut feasible = true;
+        let mut placed = Vec::with_capacity(n * m);
+        'robots: for r in 0..n {
+            for k in 0..m {
+                self.nodes += 1;
+                let edge = self.edge_serial(last, r, placed.last().copied());
+                if !net.place(edge, r, k) {
+                    feasible = false;
+                    net.undo(net.trail.len(), edge);
+                    break 'robots;
+                }
+                placed.push(r);
+                last = Some((net.lc(r, k), net.chain.lc_s[k]));
+            }
+        }
+        if feasible {
+            let t = (0..n).map(|r| net.x[net.end(r)]).fold(0.0, f64::max);
+            if t < self.best_t {
+                self.best_t = t;
+                self.best = Some((placed.clone(), net.x.clone()));
+            }
+        }
+        // Undo every placement: the trail back to the base and every operator edge.
+        net.undo(base, None);
+        for r in 0..n {
+            for k in 0..m {
+                let v = net.lc(r, k);
+                net.op[v] = None;
+            }
+        }
+    }
+
+    /// [`Search::edge`] for the serial order, whose last placed robot is `last_robot`.
+    fn edge_serial(
+        &self,
+        last: Option<(usize, f64)>,
+        r: usize,
+        last_robot: Option<usize>,
+    ) -> Option<(usize, f64)> {
+        match last {
+            Some((v, l)) if self.switch_s > 0.0 && Some(r) != last_robot => {
+                Some((v, l + self.switch_s))
+            }
+            other => other,
         }
     }
 }
@@ -384,9 +647,9 @@ mod tests {
 
     /// The search's optimum of [`lhl`] for `n` robots: proven, `expected` (s), and feasible.
     fn by_hand(n: usize, expected: f64) {
-        let (found, proven, _) = search(&lhl(), n, f64::INFINITY, 1_000_000);
-        let f = found.unwrap();
-        assert!(proven);
+        let out = search(&lhl(), n, f64::INFINITY, 1_000_000);
+        let f = out.found.unwrap();
+        assert!(out.proven);
         assert!((f.t_total_s - expected).abs() < 1e-12, "{}", f.t_total_s);
         check(&lhl(), &f);
     }
@@ -435,17 +698,30 @@ mod tests {
 
     #[test]
     fn a_cap_below_the_optimum_finds_nothing() {
-        let (found, proven, _) = search(&lhl(), 3, 0.6, 100_000);
-        assert!(found.is_none());
-        assert!(proven);
+        let out = search(&lhl(), 3, 0.6, 100_000);
+        assert!(out.found.is_none());
+        assert!(out.proven);
     }
 
     #[test]
-    fn the_budget_stops_the_search_unproven() {
-        let (found, proven, nodes) = search(&lhl(), 3, f64::INFINITY, 3);
-        assert!(!proven);
-        assert!(nodes <= 3);
-        assert!(found.is_none());
+    fn the_budget_stops_the_search_unproven_with_a_leaf_and_a_bound() {
+        // Budget 3: the dive gets 1 node (no leaf), the serial order is the leaf (6 runs, 6
+        // nodes), and the exact search has no budget left: its root stays open. The root's
+        // bound is the operator's 6 × 0.1 s, here the optimum (three_robots_by_hand).
+        let out = search(&lhl(), 3, f64::INFINITY, 3);
+        assert!(!out.proven);
+        assert_eq!(out.nodes, 1 + 6);
+        let f = out.found.unwrap();
+        check(&lhl(), &f);
+        assert_eq!(f.order, vec![0, 0, 1, 1, 2, 2]);
+        // Serial: each robot 0.1 + 0.05 + 0.1 s, robot r's first run right after robot
+        // r − 1's last ends: robots end at 0.25, 0.5, 0.75 s.
+        assert!((f.t_total_s - 0.75).abs() < 1e-12, "{}", f.t_total_s);
+        assert!(
+            (out.lower_bound_s - 0.6).abs() < 1e-12,
+            "{}",
+            out.lower_bound_s
+        );
     }
 
     /// `T_total` (s) of the earliest solution of one machine order by plain Bellman–Ford over
@@ -586,9 +862,9 @@ mod tests {
         let p = unit_gradients(conf.to_vec(), (1.0, 1.0), 0.01);
         let chain = Chain::new(&p);
         assert_eq!(chain.lc_s.len(), 3);
-        let (found, proven, _) = search(&chain, 2, f64::INFINITY, 1_000_000);
-        let f = found.unwrap();
-        assert!(proven);
+        let out = search(&chain, 2, f64::INFINITY, 1_000_000);
+        let f = out.found.unwrap();
+        assert!(out.proven);
         assert!((f.t_total_s - 0.12).abs() < 1e-9, "{}", f.t_total_s);
         check(&chain, &f);
         assert!(dp_optimum(&chain) >= f.t_total_s - 1e-9);
@@ -607,9 +883,9 @@ mod tests {
                 .iter()
                 .filter_map(|o| order_t_total(&chain, 3, o))
                 .fold(f64::INFINITY, f64::min);
-            let (found, proven, _) = search(&chain, 3, f64::INFINITY, 1_000_000);
-            let f = found.unwrap();
-            prop_assert!(proven);
+            let out = search(&chain, 3, f64::INFINITY, 1_000_000);
+            let f = out.found.unwrap();
+            prop_assert!(out.proven);
             prop_assert!((f.t_total_s - brute).abs() <= 1e-9 * brute, "{} vs {}", f.t_total_s, brute);
             check(&chain, &f);
             // Two robots: the same against all orders, and never above the dynamic program's
@@ -618,9 +894,9 @@ mod tests {
                 .iter()
                 .filter_map(|o| order_t_total(&chain, 2, o))
                 .fold(f64::INFINITY, f64::min);
-            let (two, proven, _) = search(&chain, 2, f64::INFINITY, 1_000_000);
-            prop_assert!(proven);
-            let two = two.unwrap().t_total_s;
+            let two = search(&chain, 2, f64::INFINITY, 1_000_000);
+            prop_assert!(two.proven);
+            let two = two.found.unwrap().t_total_s;
             prop_assert!((two - brute2).abs() <= 1e-9 * brute2, "{} vs {}", two, brute2);
             let dp = dp_optimum(&chain);
             prop_assert!(two <= dp * (1.0 + 1e-9), "{} vs {}", two, dp);
@@ -638,21 +914,20 @@ mod tests {
                     .iter()
                     .filter_map(|o| order_t_total_switch(&chain, n, o, delta))
                     .fold(f64::INFINITY, f64::min);
-                let (found, proven, _) =
-                    search_with_switch(&chain, n, f64::INFINITY, 1_000_000, delta);
-                prop_assert!(proven);
-                match found {
+                let out = search_with_switch(&chain, n, f64::INFINITY, 1_000_000, delta);
+                prop_assert!(out.proven);
+                match out.found {
                     Some(f) => {
                         prop_assert!((f.t_total_s - brute).abs() <= 1e-9 * brute,
                             "n {}: {} vs {}", n, f.t_total_s, brute);
-                        let (free, _, _) = search(&chain, n, f64::INFINITY, 1_000_000);
-                        let free = free.unwrap().t_total_s;
+                        let free = search(&chain, n, f64::INFINITY, 1_000_000);
+                        let free = free.found.unwrap().t_total_s;
                         prop_assert!(f.t_total_s >= free * (1.0 - 1e-9), "{} < {}", f.t_total_s, free);
                     }
                     None => prop_assert!(brute.is_infinite(), "n {}: none found, brute {}", n, brute),
                 }
             }
-            let (two, _, _) = search_with_switch(&chain, 2, f64::INFINITY, 1_000_000, delta);
+            let two = search_with_switch(&chain, 2, f64::INFINITY, 1_000_000, delta).found;
             let clear = super::super::search::Clearance::uniform(delta, None);
             if let (Some(two), (super::super::search::Outcome::Done(Some(dp)), _)) = (
                 two,
@@ -660,6 +935,32 @@ mod tests {
             ) {
                 prop_assert!(two.t_total_s <= dp.t_total_s * (1.0 + 1e-9),
                     "{} vs {}", two.t_total_s, dp.t_total_s);
+            }
+        }
+
+        /// On any budget the search returns an order (the dive's or the serial one) no shorter
+        /// than the optimum over all orders, and a lower bound (the open nodes' and the best
+        /// found) no longer than it; proven, the bound is the optimum.
+        #[test]
+        fn a_small_budget_keeps_a_leaf_and_a_lower_bound(
+            chain in random_chain(),
+            budget in 1usize..60,
+            delta in prop_oneof![Just(0.0), 0.0f64..0.05],
+        ) {
+            let m = chain.n_lc();
+            let brute = all_orders(3, m)
+                .iter()
+                .filter_map(|o| order_t_total_switch(&chain, 3, o, delta))
+                .fold(f64::INFINITY, f64::min);
+            let out = search_with_switch(&chain, 3, f64::INFINITY, budget, delta);
+            let f = out.found.unwrap();
+            check(&chain, &f);
+            prop_assert!(f.t_total_s >= brute * (1.0 - 1e-9), "{} < {}", f.t_total_s, brute);
+            prop_assert!(out.lower_bound_s <= brute * (1.0 + 1e-9),
+                "bound {} above the optimum {}", out.lower_bound_s, brute);
+            prop_assert!(out.lower_bound_s <= f.t_total_s);
+            if out.proven {
+                prop_assert!((out.lower_bound_s - brute).abs() <= 1e-9 * brute);
             }
         }
     }

@@ -62,8 +62,13 @@
 //! are the least in every variable, so `max(latest end, operator free + LC time left + fastest
 //! tail)` bounds every completion and prunes against the best found. Robots are
 //! interchangeable, so their first LC runs come in robot order; children are tried earliest
-//! start first. Finished within [`MAX_SEARCH_NODES`] nodes, its optimum is the certificate's
-//! bound; otherwise the bound is [`operator_bound_s`]. With hold points the chain's gaps that
+//! start first, after a dive that puts robots about to overrun their HC gap first and stops at
+//! its first leaf (the serial order if it finds none), so an order always exists. A node where
+//! some robot's next run cannot go next is dead (it cannot go later either). Finished within
+//! [`MAX_SEARCH_NODES`] nodes, its optimum is the certificate's bound; otherwise the bound is
+//! the least bound of the nodes it left open, or [`operator_bound_s`] if that is higher
+//! (docs/decisions.md, "The three-robot search: a dive that reaches a leaf and the open nodes'
+//! bound (issue 38)"). With hold points the chain's gaps that
 //! contain one are unbounded (capped at `N × fastest`), and the best order, with planned
 //! dwells and release rules, is the scheduler's `Held` candidate for every `N`
 //! (docs/decisions.md, "N robots in the margin-free search").
@@ -556,7 +561,9 @@ pub const MAX_SEARCH_NODES: usize = 200_000;
 /// The margin-free bound of `n_robots ≥ 3` robots (see "N robots" in the [module docs](self)):
 /// the branch and bound over machine orders on the chain with the problem's usable holds; when
 /// it finishes within [`MAX_SEARCH_NODES`] nodes the bound is the optimum `T*₀` (with holds,
-/// if any), else the operator-limited bound ([`operator_bound_s`]), never above it. The
+/// if any), else the larger of the operator-limited bound ([`operator_bound_s`]) and the least
+/// bound of the nodes the search left open (`many::ManyOutcome::lower_bound_s`: every order
+/// better than the best found lies below one of them), both lower bounds on `T*₀`. The
 /// schedule is the best order found (with planned dwells at holds), proven or not; `order` its
 /// robots in time order.
 ///
@@ -569,14 +576,21 @@ fn bound_n_switch(problem: &Problem, n_robots: usize, switch_s: f64) -> MarginFr
     if switch_s > 0.0 {
         plain.lower_bound_s = operator_bound_of(&chain::Chain::new(problem), n_robots, switch_s);
     }
-    let (found, proven, nodes) =
-        many::search_with_switch(&chain, n_robots, f64::INFINITY, MAX_SEARCH_NODES, switch_s);
+    let out = many::search_with_switch(&chain, n_robots, f64::INFINITY, MAX_SEARCH_NODES, switch_s);
+    let (proven, nodes) = (out.proven, out.nodes);
     let stats = SearchStats {
         states: nodes,
         ..plain.stats
     };
-    let Some(f) = found else {
-        return MarginFree { stats, ..plain };
+    // The open nodes' bound of an unfinished search (`many::ManyOutcome::lower_bound_s`), a
+    // lower bound on the optimum like the operator bound: the larger of the two.
+    let kept = plain.lower_bound_s.max(out.lower_bound_s);
+    let Some(f) = out.found else {
+        return MarginFree {
+            lower_bound_s: kept,
+            stats,
+            ..plain
+        };
     };
     let gaps: Vec<Vec<f64>> = (0..n_robots).map(|r| f.times.gaps_s(&chain, r)).collect();
     let schedule = build::gap_schedule(
@@ -590,7 +604,7 @@ fn bound_n_switch(problem: &Problem, n_robots: usize, switch_s: f64) -> MarginFr
         lower_bound_s: if proven {
             f.t_total_s.max(plain.lower_bound_s)
         } else {
-            plain.lower_bound_s
+            kept
         },
         proven_optimal: proven,
         schedule: Some(schedule),
