@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 
 use tandem_confidence::{Confidence, ConfidenceParams, MissEvidence};
 use tandem_lfd::{Demonstration, RateTerm, TaskModel};
-use tandem_planner::state::{self, FORMAT_VERSION, OLDEST_READABLE_VERSION};
+use tandem_planner::state::{
+    self, FORMAT_VERSION, NEWEST_READABLE_VERSION, OLDEST_READABLE_VERSION,
+};
 use tandem_planner::{Error, Planner, PlannerParams};
 use tandem_schedule::validate;
 
@@ -450,7 +452,7 @@ fn older_and_newer_files_say_which_version_they_are() {
     let golden = std::fs::read(golden_path()).unwrap();
     for (found, age) in [
         (OLDEST_READABLE_VERSION - 1, "an older"),
-        (FORMAT_VERSION + 1, "a newer"),
+        (NEWEST_READABLE_VERSION + 1, "a newer"),
     ] {
         let path = dir.join(format!("v{found}.tandem"));
         let mut bytes = golden.clone();
@@ -458,14 +460,14 @@ fn older_and_newer_files_say_which_version_they_are() {
         std::fs::write(&path, &bytes).unwrap();
         let err = Planner::load(&path).unwrap_err();
         assert!(
-            matches!(err, Error::UnsupportedVersion { found: f, expected: FORMAT_VERSION, .. } if f == found),
+            matches!(err, Error::UnsupportedVersion { found: f, expected: NEWEST_READABLE_VERSION, .. } if f == found),
             "{err}"
         );
         let msg = err.to_string();
         for part in [
             path.display().to_string(),
             format!("state format version {found}"),
-            format!("reads versions {OLDEST_READABLE_VERSION} to {FORMAT_VERSION} only"),
+            format!("reads versions {OLDEST_READABLE_VERSION} to {NEWEST_READABLE_VERSION} only"),
             format!("written by {age} build"),
         ] {
             assert!(msg.contains(&part), "`{part}` missing in: {msg}");
