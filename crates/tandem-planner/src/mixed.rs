@@ -685,29 +685,39 @@ pub(crate) fn schedule_mixed(
         candidates.retain(|c| c.is_finite() && *c >= 0.0 && *c < serial);
         candidates.sort_by(f64::total_cmp);
         candidates.dedup();
+        // Ascending: the smallest pending offset first; a rejected one is pushed by its
+        // missing clearance into the pending list, so the first accepted is the smallest
+        // explored.
+        let mut pending: Vec<(f64, usize)> = candidates.into_iter().map(|c| (c, 0)).collect();
+        pending.reverse();
         let mut chosen = None;
         let mut robot_checks = 0;
-        'candidates: for &c0 in &candidates {
-            let mut c = c0;
-            for _ in 0..=PUSHES_PER_CANDIDATE {
-                if robot_checks >= MAX_CHECKS_PER_ROBOT || c >= serial {
-                    break 'candidates;
-                }
-                let mut robots = placed.clone();
-                robots.push(timeline(p, &warps[i], c)?);
-                robot_checks += 1;
-                if check_margins(&robots, &[], &params)? {
-                    chosen = Some((c, robots));
-                    break 'candidates;
-                }
-                // The clearance missing on the pairs with robot i, then that much later.
-                let missing = pair_slacks(&robots, tick_s)?
-                    .iter()
-                    .filter(|s| s.cur_robot == i || s.prev_robot == i)
-                    .map(|s| -s.slack_s)
-                    .filter(|m| m.is_finite() && *m > 0.0)
-                    .fold(0.0, f64::max);
-                c += missing + switch_s + tick_s;
+        while let Some((c, pushes)) = pending.pop() {
+            if robot_checks >= MAX_CHECKS_PER_ROBOT {
+                break;
+            }
+            let mut robots = placed.clone();
+            robots.push(timeline(p, &warps[i], c)?);
+            robot_checks += 1;
+            if check_margins(&robots, &[], &params)? {
+                chosen = Some((c, robots));
+                break;
+            }
+            if pushes >= PUSHES_PER_CANDIDATE {
+                continue;
+            }
+            // The clearance missing on the pairs with robot i, then that much later.
+            let missing = pair_slacks(&robots, tick_s)?
+                .iter()
+                .filter(|s| s.cur_robot == i || s.prev_robot == i)
+                .map(|s| -s.slack_s)
+                .filter(|m| m.is_finite() && *m > 0.0)
+                .fold(0.0, f64::max);
+            let next = c + missing + switch_s + tick_s;
+            if next < serial {
+                // `pending` is sorted descending: insert keeping it so.
+                let at = pending.partition_point(|&(x, _)| x > next);
+                pending.insert(at, (next, pushes + 1));
             }
         }
         let (c, robots) = match chosen {
