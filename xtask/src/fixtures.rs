@@ -16,6 +16,16 @@
 //! `tandem record` write for them. `tandem-planner`'s `golden_state` test loads it; a change
 //! of the format (or of any number in it) shows up here as a diff to review.
 //!
+//! `fixtures/state/mixed.tandem`: the golden file of a cell of two tasks (format
+//! `tandem::planner::state::CELL_FORMAT_VERSION`, issue 45), a pin of that format on the same
+//! tiny inputs: task `example` (the planner of `example.tandem` before its pair, two robots)
+//! and task `example-b` (fitted on `demo_2.csv` and `demo_0.csv` with `params.toml`, so its
+//! reference is demo 2: another model, one robot); no round recorded.
+//!
+//! `fixtures/mixed/deburring/`: the demonstrations of a second task for a cell of different
+//! tasks (issue 45): the task zoo's `deburring` family at seed 0 (a selection seed),
+//! `demo_{i}.csv` exactly as `tandem_zoo` generates them.
+//!
 //! `fixtures/examples/ros2/`: `demo_{0,1,2}.mcap`, the example demonstrations
 //! `fixtures/examples/demo_{0,1,2}.csv` as ROS 2 recordings (rosbag2 MCAP, uncompressed
 //! chunks so the bytes do not depend on a compression library's version): the tool pose on
@@ -35,6 +45,7 @@ use anyhow::{Context, bail};
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 use tandem::lfd::{CsvTable, Demonstration, Execution};
+use tandem::planner::CellPlanner;
 use tandem::sim::task::{
     self, CHANNELS, FIXTURE_SEED, N_FIXTURE_DEMOS, Phase, TaskDemo, TaskParams, Workpiece,
 };
@@ -50,6 +61,10 @@ const STATE_DIR: &str = "fixtures/state";
 const EXAMPLES_DIR: &str = "fixtures/examples";
 /// Directory of the example ROS 2 bags, made from the example demonstrations.
 const BAGS_DIR: &str = "fixtures/examples/ros2";
+/// Directory of the second task of the mixed cell's fixtures (the zoo's deburring).
+const MIXED_DEBURRING_DIR: &str = "fixtures/mixed/deburring";
+/// The zoo seed of `fixtures/mixed/deburring/` (a selection seed).
+const MIXED_DEBURRING_SEED: u64 = 0;
 
 /// Runs the command: regenerate the fixtures, or with `check` compare them.
 pub(crate) fn run(check: bool) -> anyhow::Result<()> {
@@ -58,6 +73,7 @@ pub(crate) fn run(check: bool) -> anyhow::Result<()> {
         (SANDING_DIR, generate()?),
         (STATE_DIR, generate_state(&root.join(EXAMPLES_DIR))?),
         (BAGS_DIR, generate_bags(&root.join(EXAMPLES_DIR))?),
+        (MIXED_DEBURRING_DIR, generate_deburring()?),
     ];
     let n_files: usize = generated.iter().map(|(_, files)| files.len()).sum();
     if check {
@@ -67,7 +83,7 @@ pub(crate) fn run(check: bool) -> anyhow::Result<()> {
         }
         if differing.is_empty() {
             println!(
-                "fixtures: {n_files} files in {SANDING_DIR}, {STATE_DIR} and {BAGS_DIR} are up to date"
+                "fixtures: {n_files} files in {SANDING_DIR}, {STATE_DIR}, {BAGS_DIR} and {MIXED_DEBURRING_DIR} are up to date"
             );
             return Ok(());
         }
@@ -84,7 +100,9 @@ pub(crate) fn run(check: bool) -> anyhow::Result<()> {
             std::fs::write(&path, bytes).with_context(|| format!("writing {}", path.display()))?;
         }
     }
-    println!("fixtures: wrote {n_files} files to {SANDING_DIR}, {STATE_DIR} and {BAGS_DIR}");
+    println!(
+        "fixtures: wrote {n_files} files to {SANDING_DIR}, {STATE_DIR}, {BAGS_DIR} and {MIXED_DEBURRING_DIR}"
+    );
     Ok(())
 }
 
@@ -99,7 +117,19 @@ fn generate_state(examples: &Path) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
     let demos = (0..3)
         .map(|i| Demonstration::from_csv_path(examples.join(format!("demo_{i}.csv")), None))
         .collect::<Result<Vec<_>, _>>()?;
-    let mut planner = Planner::new(&demos, params).context("fitting the example demonstrations")?;
+    let mut planner =
+        Planner::new(&demos, params.clone()).context("fitting the example demonstrations")?;
+    // The cell of two tasks (module docs), made before the pair is recorded.
+    let demos_b = [demos[2].clone(), demos[0].clone()];
+    let planner_b = Planner::with_robots(&demos_b, params, 1).context("fitting example-b")?;
+    let cell = CellPlanner::from_planners(
+        vec![
+            ("example".to_owned(), planner.clone()),
+            ("example-b".to_owned(), planner_b),
+        ],
+        vec![0, 0, 1],
+    )
+    .context("making the mixed cell")?;
     let dt_s = planner.model().dt_s();
     let pair = [
         example_record(examples, 1, dt_s)?,
@@ -114,8 +144,25 @@ fn generate_state(examples: &Path) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
     let path = scratch.join("example.tandem");
     planner.save(&path)?;
     let bytes = std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;
+    let mixed_path = scratch.join("mixed.tandem");
+    cell.save(&mixed_path)?;
+    let mixed =
+        std::fs::read(&mixed_path).with_context(|| format!("reading {}", mixed_path.display()))?;
     std::fs::remove_dir_all(&scratch).with_context(|| format!("removing {}", scratch.display()))?;
-    Ok(vec![("example.tandem".to_owned(), bytes)])
+    Ok(vec![
+        ("example.tandem".to_owned(), bytes),
+        ("mixed.tandem".to_owned(), mixed),
+    ])
+}
+
+/// The files of `fixtures/mixed/deburring/` (module docs).
+fn generate_deburring() -> anyhow::Result<Vec<(String, Vec<u8>)>> {
+    let task = (tandem_zoo::family("deburring")?.generate)(MIXED_DEBURRING_SEED)?;
+    Ok(task
+        .files
+        .into_iter()
+        .map(|(name, text)| (name, text.into_bytes()))
+        .collect())
 }
 
 /// The files of `fixtures/examples/ros2/` (see the module docs), made from the example
@@ -419,12 +466,16 @@ mod tests {
         let examples = workspace_root().join(EXAMPLES_DIR);
         let a = generate_state(&examples).unwrap();
         assert_eq!(a, generate_state(&examples).unwrap());
-        assert_eq!(a.len(), 1);
-        let (name, bytes) = &a[0];
-        assert_eq!(name, "example.tandem");
-        assert_eq!(&bytes[..8], b"TANDEMST");
-        let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
-        assert_eq!(version, tandem::planner::state::FORMAT_VERSION);
+        assert_eq!(a.len(), 2);
+        for ((name, bytes), (want, format)) in a.iter().zip([
+            ("example.tandem", tandem::planner::state::FORMAT_VERSION),
+            ("mixed.tandem", tandem::planner::state::CELL_FORMAT_VERSION),
+        ]) {
+            assert_eq!(name, want);
+            assert_eq!(&bytes[..8], b"TANDEMST");
+            let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
+            assert_eq!(version, format, "{name}");
+        }
     }
 
     #[test]

@@ -315,8 +315,20 @@ pub(crate) struct SamplerArgs {
 #[derive(Debug, Args)]
 pub(crate) struct FitArgs {
     /// Demonstration files (CSV, .json, or ROS 2 bags .mcap). At least two.
-    #[arg(required = true, value_name = "DEMO")]
+    #[arg(required_unless_present = "task", value_name = "DEMO")]
     pub(crate) demos: Vec<PathBuf>,
+    /// A cell of different tasks on different robots (issue 45) instead of DEMO files: one
+    /// task per --task, its name (letters, digits, `_`, `-`) and its demonstration files,
+    /// e.g. `--task sanding=s0.csv,s1.csv --task deburring=d0.csv,d1.csv`; each task's
+    /// robots by --robots NAME=K,… (1 each by default). The parameters (--params and the
+    /// flags) apply to every task; the state holds every task's model, confidence and
+    /// rounds (docs/guide.md, "Different tasks on different robots").
+    #[arg(
+        long,
+        value_name = "NAME=FILE,…",
+        conflicts_with_all = ["demos", "keep_rounds", "force", "ranges"]
+    )]
+    pub(crate) task: Vec<String>,
     /// Which demonstration is the reference, whose samples are the model's time axis:
     /// `medoid` (the one whose model has the least median σ²_D; n alignment passes instead
     /// of one; the model is the same for any order of the files) or `first` (the first
@@ -362,9 +374,10 @@ pub(crate) struct FitArgs {
     pub(crate) topics: Vec<String>,
     /// Robots run by the one operator, 1 to 8 (the paper: 2): every schedule has N warps and
     /// `tandem record` takes N executions per round. Stored in the state file. Default: 2,
-    /// or with --keep-rounds the state's.
-    #[arg(long, value_name = "N")]
-    pub(crate) robots: Option<usize>,
+    /// or with --keep-rounds the state's. With --task: each task's robots, NAME=K,… (robots
+    /// numbered task by task in the order of the --task flags; a task not named has 1).
+    #[arg(long, value_name = "N | NAME=K,…", value_parser = parse_robots)]
+    pub(crate) robots: Option<RobotsArg>,
     /// Hold points at these reference times (s, the reference demonstration's clock), each at
     /// its nearest reference sample: places where a robot may wait as long as needed (the
     /// tool lifted, a part held); a hold on a low-confidence sample is inactive until the
@@ -404,6 +417,39 @@ pub(crate) struct FitArgs {
     /// many).
     #[arg(long)]
     pub(crate) force: bool,
+}
+
+/// `tandem fit --robots`: a robot count, or with `--task` each task's robots.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) enum RobotsArg {
+    /// `N`: the robots of the one task.
+    Count(usize),
+    /// `NAME=K,…`: the robots of each task of a cell.
+    PerTask(Vec<(String, usize)>),
+}
+
+/// Parses `--robots`: `N`, or `NAME=K,…` with each `K` a whole number ≥ 1.
+fn parse_robots(s: &str) -> Result<RobotsArg, String> {
+    if let Ok(n) = s.trim().parse::<usize>() {
+        return Ok(RobotsArg::Count(n));
+    }
+    let mut per = Vec::new();
+    for part in s.split(',') {
+        let Some((name, k)) = part.split_once('=') else {
+            return Err(format!(
+                "`{part}`: give a robot count N, or NAME=K for each task of --task (e.g. \
+                 sanding=2,deburring=1)"
+            ));
+        };
+        let k = k
+            .trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|&k| k >= 1)
+            .ok_or_else(|| format!("`{part}`: K must be a whole number of robots ≥ 1"))?;
+        per.push((name.trim().to_string(), k));
+    }
+    Ok(RobotsArg::PerTask(per))
 }
 
 /// `tandem fit --rate-term`: `tandem::lfd::RateTerm` by its parameter-file spelling; the error

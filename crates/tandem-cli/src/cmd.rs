@@ -9,7 +9,7 @@ use tandem::schedule::SamplerParams;
 use tandem::{ExecutionRecord, Planner, PlannerParams};
 
 use crate::cli::{
-    Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, SamplerArgs, ScheduleArgs,
+    Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, RobotsArg, SamplerArgs, ScheduleArgs,
 };
 use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_doc, source_name};
 use crate::json;
@@ -240,7 +240,8 @@ pub(crate) fn operator_line(p: &SamplerParams) -> Option<String> {
     ))
 }
 
-fn fit(a: &FitArgs) -> Result<()> {
+/// `fit`'s parameters: the parameter file, then the flags over it, checked.
+pub(crate) fn fit_params(a: &FitArgs) -> Result<PlannerParams> {
     let mut params = match &a.params {
         Some(p) => input::read_params(p)?,
         None => PlannerParams::default(),
@@ -274,7 +275,23 @@ fn fit(a: &FitArgs) -> Result<()> {
     {
         bail!("--dt {dt}: the sample period must be finite and > 0 seconds");
     }
-    if let Some(r) = a.robots
+    Ok(params)
+}
+
+fn fit(a: &FitArgs) -> Result<()> {
+    let mut params = fit_params(a)?;
+    if !a.task.is_empty() {
+        return crate::cells::fit_cell(a, params);
+    }
+    let robots_given = match &a.robots {
+        None => None,
+        Some(RobotsArg::Count(r)) => Some(*r),
+        Some(RobotsArg::PerTask(_)) => bail!(
+            "--robots NAME=K: robot counts per task are for a cell of tasks (--task \
+             NAME=FILE,…); with DEMO files give one count N"
+        ),
+    };
+    if let Some(r) = robots_given
         && let Err(e) = tandem::realtime::RobotCount::new(r)
     {
         bail!("--robots {r}: {e}");
@@ -305,7 +322,7 @@ fn fit(a: &FitArgs) -> Result<()> {
     let kept = if a.keep_rounds && a.output.is_file() {
         let lock = state_io::lock(&a.output)?;
         let old = state_io::load(&a.output)?;
-        if let Some(r) = a.robots
+        if let Some(r) = robots_given
             && r != old.n_robots()
         {
             bail!(
@@ -321,7 +338,7 @@ fn fit(a: &FitArgs) -> Result<()> {
     };
     let robots = match &kept {
         Some((_, old)) => old.n_robots(),
-        None => a.robots.unwrap_or(2),
+        None => robots_given.unwrap_or(2),
     };
     let demos: Vec<Demonstration> = bag::read_demos(
         &a.demos,
@@ -815,7 +832,7 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
 /// whole round, [`period_notes`]). With `resample`
 /// (`--resample`) an irregular `t` column is first put on an even grid, the log and flags
 /// with it ([`ExecutionRecord::from_regridded`]).
-fn read_execution(
+pub(crate) fn read_execution(
     planner: &Planner,
     robot: usize,
     exec: &Path,
@@ -875,6 +892,9 @@ fn read_execution(
 }
 
 fn record(a: &RecordArgs) -> Result<()> {
+    if crate::cells::is_cell(&a.state) {
+        return crate::cells::record_cell(a);
+    }
     // A read–modify–write: hold the state file's lock from the load to the save, so that a
     // concurrent `record` waits for this one instead of overwriting its round.
     let lock = state_io::lock(&a.state)?;
@@ -958,6 +978,9 @@ fn inspect(a: &InspectArgs) -> Result<()> {
     // A folder can only be a rosbag2 recording (or is refused as one, with what it holds).
     if tandem::bag::is_bag(&a.state) || a.state.is_dir() {
         return bag::inspect_bag(&a.state, a.json);
+    }
+    if crate::cells::is_cell(&a.state) {
+        return crate::cells::inspect_cell(a);
     }
     let planner = state_io::load(&a.state)?;
     let model = planner.model();

@@ -21,6 +21,7 @@
 //! nothing is written when a command fails.
 
 mod bag;
+mod cells;
 mod cli;
 mod cmd;
 mod console;

@@ -35,7 +35,7 @@ pub enum Error {
         path: PathBuf,
         /// The version in the file.
         found: u32,
-        /// The version this build reads ([`crate::state::FORMAT_VERSION`]).
+        /// The newest version this build reads ([`crate::state::NEWEST_READABLE_VERSION`]).
         expected: u32,
     },
     /// The file is shorter than its header announces.
@@ -177,6 +177,31 @@ pub enum Error {
     UnknownCell {
         /// The name given.
         given: String,
+    },
+    /// A state file of format 12 (a cell of several tasks, [`crate::CellPlanner`]) given
+    /// where one task's planner is expected.
+    #[error(
+        "{}: this state file holds a cell of {} tasks ({}), not one task's planner: load it as a \
+         cell (`CellPlanner::load`; on the command line `tandem inspect` and `tandem record` \
+         read cells), or fit one task into its own state file",
+        path.display(),
+        tasks.len(),
+        tasks.join(", ")
+    )]
+    CellFile {
+        /// The state file.
+        path: PathBuf,
+        /// The cell's task names, in order.
+        tasks: Vec<String>,
+    },
+    /// A cell of task models that cannot be built or used as asked ([`crate::CellPlanner`]):
+    /// a task name, a robot map, a round's size, a parameter mixed cells do not support yet.
+    #[error("cell of tasks: {what}: {why}")]
+    BadCell {
+        /// Which part (a task's name, `robots`, `executions`, a parameter).
+        what: String,
+        /// What is wrong and the fix.
+        why: String,
     },
     /// Demonstrations, executions or the task model (§II-B1/2), alignment included.
     #[error(transparent)]

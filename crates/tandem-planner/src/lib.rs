@@ -60,12 +60,16 @@ mod error;
 mod explain;
 mod holds;
 pub mod json;
+mod mixed;
 mod planner;
 pub mod state;
 
 pub use cell::{AnyController, Cell, Plan};
 pub use error::{Error, Result};
 pub use explain::{ChannelShare, LowCause, LowRegion};
+pub use mixed::{
+    CellPlanner, CellRecordReport, CellSchedule, CellTask, DEFAULT_TASK_NAME, TaskSpec,
+};
 pub use planner::{ExecutionRecord, Planner, PlannerParams, RecordReport, RefitReport};
 
 /// A seed for item `index` of a seeded family (trial `k` of a study, the schedule after

@@ -260,13 +260,13 @@ fn round_fingerprint(records: &[ExecutionRecord]) -> u64 {
 /// Where a planner was loaded from (or last saved to), and that file's content then: a save
 /// into the same file refuses to overwrite content some other process wrote since.
 #[derive(Debug, Default)]
-struct Origin(Mutex<Option<(PathBuf, Stamp)>>);
+pub(crate) struct Origin(Mutex<Option<(PathBuf, Stamp)>>);
 
 impl Origin {
-    fn get(&self) -> Option<(PathBuf, Stamp)> {
+    pub(crate) fn get(&self) -> Option<(PathBuf, Stamp)> {
         self.0.lock().map_or(None, |o| o.clone())
     }
-    fn set(&self, path: PathBuf, stamp: Stamp) {
+    pub(crate) fn set(&self, path: PathBuf, stamp: Stamp) {
         if let Ok(mut o) = self.0.lock() {
             *o = Some((path, stamp));
         }
@@ -1081,14 +1081,24 @@ impl Planner {
         let path = path.as_ref();
         let bytes = state::read(path)?;
         let st = state::decode_state(&bytes, path)?;
+        let planner = Self::from_loaded(st, path)?;
+        if let Some(stamp) = state::stamp_of(&bytes) {
+            planner.origin.set(state::resolved(path), stamp);
+        }
+        Ok(planner)
+    }
+
+    /// The planner of a state read from `path` (for error messages), its schedule re-checked
+    /// ([`Planner::load`] without the file's origin).
+    ///
+    /// # Errors
+    /// As [`Planner::load`].
+    pub(crate) fn from_loaded(st: PlannerState, path: &Path) -> Result<Self> {
         let mut planner = Self::from_state(st).map_err(|e| Error::Corrupt {
             path: path.to_path_buf(),
             why: e.to_string(),
         })?;
         planner.recheck_schedule()?;
-        if let Some(stamp) = state::stamp_of(&bytes) {
-            planner.origin.set(state::resolved(path), stamp);
-        }
         Ok(planner)
     }
 
@@ -1146,7 +1156,7 @@ impl Planner {
         Ok(())
     }
 
-    fn to_state(&self) -> PlannerState {
+    pub(crate) fn to_state(&self) -> PlannerState {
         PlannerState {
             params: self.params.clone(),
             model: self.model.clone(),

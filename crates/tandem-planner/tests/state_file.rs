@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 
 use tandem_confidence::{Confidence, ConfidenceParams, MissEvidence};
 use tandem_lfd::{Demonstration, RateTerm, TaskModel};
-use tandem_planner::state::{self, FORMAT_VERSION, OLDEST_READABLE_VERSION};
+use tandem_planner::state::{
+    self, FORMAT_VERSION, NEWEST_READABLE_VERSION, OLDEST_READABLE_VERSION,
+};
 use tandem_planner::{Error, Planner, PlannerParams};
 use tandem_schedule::validate;
 
@@ -450,7 +452,7 @@ fn older_and_newer_files_say_which_version_they_are() {
     let golden = std::fs::read(golden_path()).unwrap();
     for (found, age) in [
         (OLDEST_READABLE_VERSION - 1, "an older"),
-        (FORMAT_VERSION + 1, "a newer"),
+        (NEWEST_READABLE_VERSION + 1, "a newer"),
     ] {
         let path = dir.join(format!("v{found}.tandem"));
         let mut bytes = golden.clone();
@@ -458,14 +460,14 @@ fn older_and_newer_files_say_which_version_they_are() {
         std::fs::write(&path, &bytes).unwrap();
         let err = Planner::load(&path).unwrap_err();
         assert!(
-            matches!(err, Error::UnsupportedVersion { found: f, expected: FORMAT_VERSION, .. } if f == found),
+            matches!(err, Error::UnsupportedVersion { found: f, expected: NEWEST_READABLE_VERSION, .. } if f == found),
             "{err}"
         );
         let msg = err.to_string();
         for part in [
             path.display().to_string(),
             format!("state format version {found}"),
-            format!("reads versions {OLDEST_READABLE_VERSION} to {FORMAT_VERSION} only"),
+            format!("reads versions {OLDEST_READABLE_VERSION} to {NEWEST_READABLE_VERSION} only"),
             format!("written by {age} build"),
         ] {
             assert!(msg.contains(&part), "`{part}` missing in: {msg}");
@@ -584,4 +586,46 @@ fn old_payloads_convert_into_the_current_wire_types_with_what_they_were_made_wit
     // schedule; `a_version_6_file_loads_with_the_papers_confidence_model` checks that.)
     let (p10, _) = wire(10);
     assert_eq!(p10.params, golden.params);
+}
+
+/// The golden file of a cell of two tasks (format 12, issue 45): the example task on two
+/// robots and another model of it (demos 2 and 0, `params.toml`) on one, no round.
+#[test]
+fn the_golden_cell_file_loads_as_its_two_tasks() {
+    let path = repo().join("fixtures/state/mixed.tandem");
+    let bytes = std::fs::read(&path).unwrap();
+    assert_eq!(
+        u32::from_le_bytes(bytes[8..12].try_into().unwrap()),
+        state::CELL_FORMAT_VERSION,
+        "fixtures/state/mixed.tandem is not of the cell format: run `cargo xtask fixtures`"
+    );
+    let cell = tandem_planner::CellPlanner::load(&path).unwrap();
+    let names: Vec<&str> = cell.tasks().iter().map(|t| t.name()).collect();
+    assert_eq!(names, ["example", "example-b"]);
+    assert_eq!(cell.robot_task(), [0, 0, 1]);
+    assert_eq!(cell.rounds_recorded(), 0);
+    let text = std::fs::read_to_string(examples("params.toml")).unwrap();
+    let params: PlannerParams = toml::from_str(&text).unwrap();
+    let demo = |i: usize| Demonstration::from_csv_path(examples(&format!("demo_{i}.csv")), None);
+    let demos = [demo(0).unwrap(), demo(1).unwrap(), demo(2).unwrap()];
+    let a = Planner::new(&demos, params.clone()).unwrap();
+    let b = Planner::with_robots(&[demos[2].clone(), demos[0].clone()], params, 1).unwrap();
+    for (task, fresh) in cell.tasks().iter().zip([&a, &b]) {
+        assert_eq!(task.planner().params(), fresh.params());
+        assert_eq!(task.planner().confidence(), fresh.confidence());
+        assert_eq!(task.planner().n_robots(), fresh.n_robots());
+    }
+    // Task example-b's reference is demo 2 (36 samples), example's demo 0 (40).
+    assert_eq!(cell.tasks()[0].planner().model().n_ref(), 40);
+    assert_eq!(cell.tasks()[1].planner().model().n_ref(), 36);
+    let s = cell.schedule().unwrap();
+    assert!(s.t_total_s >= s.lower_bound_s);
+    assert!(cell.coordinator().is_ok());
+    // One task's planner refuses it, naming the tasks.
+    let err = Planner::load(&path).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("holds a cell of 2 tasks (example, example-b)"),
+        "{err}"
+    );
 }

@@ -358,7 +358,8 @@ fn classify_facade(e: &Facade) -> Kind {
         | Facade::Locked { path, .. }
         | Facade::WouldOverwrite { path, .. }
         | Facade::Changed { path }
-        | Facade::WouldDiscardRounds { path, .. } => Kind::StateFile { path: path.clone() },
+        | Facade::WouldDiscardRounds { path, .. }
+        | Facade::CellFile { path, .. } => Kind::StateFile { path: path.clone() },
         Facade::Inconsistent { .. } | Facade::Encode { .. } | Facade::CannotReplay { .. } => {
             Kind::StateFile {
                 path: PathBuf::new(),

@@ -11,6 +11,13 @@
 //! | 20..24 | CRC-32 (IEEE) of the payload, `u32` little endian |
 //! | 24.. | payload: the state encoded with `postcard` ([`v11::Payload`]), then, only when a planner uses a parameter added after format 11, the list of such parameters by name ([`Extras`]) |
 //!
+//! A cell of two or more tasks (issue 45, `crate::CellPlanner`) is written as format
+//! [`CELL_FORMAT_VERSION`] (12): the same header, then [`v12::CellPayload`], which nests each
+//! task's complete format 11 payload as bytes. A planner, and a one-task cell, still write
+//! format 11, byte for byte as before; [`crate::Planner::load`] of a format 12 file fails with
+//! [`Error::CellFile`] naming its tasks, and a build older than format 12 with its
+//! [`Error::UnsupportedVersion`] ("written by a newer build").
+//!
 //! Reading checks, in this order: the file can be read, it is at least a header long and
 //! starts with the magic bytes, the version is one this build reads
 //! ([`OLDEST_READABLE_VERSION`]`..=`[`FORMAT_VERSION`]), the payload has
@@ -110,6 +117,7 @@ use crate::{Error, Result};
 pub mod extras;
 mod legacy;
 pub mod v11;
+pub mod v12;
 
 pub use extras::Extras;
 
@@ -181,6 +189,16 @@ pub const MAGIC: [u8; 8] = *b"TANDEMST";
 ///   them: their rounds cannot be replayed.
 pub const FORMAT_VERSION: u32 = 11;
 
+/// The format version of a cell of two or more tasks (issue 45, [`crate::CellPlanner`]): the
+/// header as in every version, then [`v12::CellPayload`] (each task's complete format 11
+/// payload, the robot → task map, the cell's parameters by name). A one-task cell is written
+/// as [`FORMAT_VERSION`], byte for byte its planner's file (docs/decisions.md, "Different
+/// tasks on different robots: the cell of task models (issue 45)").
+pub const CELL_FORMAT_VERSION: u32 = 12;
+
+/// The newest state format version this build reads: [`CELL_FORMAT_VERSION`].
+pub const NEWEST_READABLE_VERSION: u32 = CELL_FORMAT_VERSION;
+
 /// The oldest state format version this build reads (converting it on load).
 pub const OLDEST_READABLE_VERSION: u32 = 4;
 
@@ -195,9 +213,14 @@ pub(crate) fn encode<T: Serialize>(value: &T) -> Result<Vec<u8>> {
 
 /// The state file image of `payload`: the header of the current version, then the payload.
 fn with_header(payload: &[u8]) -> Vec<u8> {
+    with_header_version(payload, FORMAT_VERSION)
+}
+
+/// The state file image of `payload` under a header of `version`.
+pub(crate) fn with_header_version(payload: &[u8], version: u32) -> Vec<u8> {
     let mut bytes = Vec::with_capacity(HEADER_LEN + payload.len());
     bytes.extend_from_slice(&MAGIC);
-    bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    bytes.extend_from_slice(&version.to_le_bytes());
     bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
     bytes.extend_from_slice(&crc32fast::hash(payload).to_le_bytes());
     bytes.extend_from_slice(payload);
@@ -219,13 +242,13 @@ fn unsupported(path: &Path, found: u32) -> Error {
     Error::UnsupportedVersion {
         path: path.to_path_buf(),
         found,
-        expected: FORMAT_VERSION,
+        expected: NEWEST_READABLE_VERSION,
     }
 }
 
 /// The version and the payload of a state file image read from `path`, after every check of
 /// the module docs but the decoding: magic, a readable version
-/// ([`OLDEST_READABLE_VERSION`]`..=`[`FORMAT_VERSION`]), length and checksum.
+/// ([`OLDEST_READABLE_VERSION`]`..=`[`NEWEST_READABLE_VERSION`]), length and checksum.
 pub(crate) fn checked_payload<'a>(bytes: &'a [u8], path: &Path) -> Result<(u32, &'a [u8])> {
     let path_buf = || path.to_path_buf();
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
@@ -240,7 +263,7 @@ pub(crate) fn checked_payload<'a>(bytes: &'a [u8], path: &Path) -> Result<(u32, 
     }
     let word = |range: std::ops::Range<usize>| -> &[u8] { &bytes[range] };
     let version = u32::from_le_bytes(word(8..12).try_into().expect("4-byte slice"));
-    if !(OLDEST_READABLE_VERSION..=FORMAT_VERSION).contains(&version) {
+    if !(OLDEST_READABLE_VERSION..=NEWEST_READABLE_VERSION).contains(&version) {
         return Err(unsupported(path, version));
     }
     let payload_len = u64::from_le_bytes(word(12..20).try_into().expect("8-byte slice"));
@@ -292,7 +315,7 @@ pub(crate) fn decode_payload<T: DeserializeOwned>(payload: &[u8], path: &Path) -
 
 /// The payload bytes of `payload` and the parameters stored by name after it: postcard of
 /// the payload, then, only when there is any, postcard of the [`Extras`] list.
-fn payload_bytes(payload: &v11::Payload, extras: &Extras) -> Result<Vec<u8>> {
+pub(crate) fn payload_bytes(payload: &v11::Payload, extras: &Extras) -> Result<Vec<u8>> {
     let mut bytes = postcard::to_allocvec(payload).map_err(|source| Error::Encode { source })?;
     if !extras.is_empty() {
         bytes.extend(postcard::to_allocvec(extras).map_err(|source| Error::Encode { source })?);
@@ -323,6 +346,22 @@ pub(crate) fn decode_any(bytes: &[u8], path: &Path) -> Result<(v11::Payload, Ext
     if version < FORMAT_VERSION {
         return Ok((legacy::upgrade(version, payload, path)?, Extras::default()));
     }
+    if version == CELL_FORMAT_VERSION {
+        let cell: v12::CellPayload = decode_payload(payload, path)?;
+        return Err(Error::CellFile {
+            path: path.to_path_buf(),
+            tasks: cell.tasks.into_iter().map(|t| t.name).collect(),
+        });
+    }
+    decode_task_payload(payload, path)
+}
+
+/// A format 11 payload (the bytes after the header) read from `path`: [`v11::Payload`] and
+/// the parameters stored by name after it.
+///
+/// # Errors
+/// [`Error::Corrupt`] naming `path` when the bytes do not decode.
+pub(crate) fn decode_task_payload(payload: &[u8], path: &Path) -> Result<(v11::Payload, Extras)> {
     let (value, rest) =
         postcard::take_from_bytes::<v11::Payload>(payload).map_err(|e| Error::Corrupt {
             path: path.to_path_buf(),
@@ -348,6 +387,37 @@ pub(crate) fn decode_state(bytes: &[u8], path: &Path) -> Result<PlannerState> {
         path: path.to_path_buf(),
         why: e.to_string(),
     })
+}
+
+/// What a state file image holds: one task's planner (formats 4 to 11) or a cell of tasks
+/// (format 12).
+pub(crate) enum Stored {
+    /// One task's planner state, an older format converted.
+    Task(Box<PlannerState>),
+    /// A cell of two or more tasks.
+    Cell(v12::CellPayload),
+}
+
+/// The content of a state file image read from `path`, of any readable version.
+///
+/// # Errors
+/// As [`decode_state`] for formats 4 to 11; for format 12 as [`load`].
+pub(crate) fn decode_stored(bytes: &[u8], path: &Path) -> Result<Stored> {
+    let (version, payload) = checked_payload(bytes, path)?;
+    if version == CELL_FORMAT_VERSION {
+        return Ok(Stored::Cell(decode_payload(payload, path)?));
+    }
+    decode_state(bytes, path).map(|s| Stored::Task(Box::new(s)))
+}
+
+/// The complete state file image of a cell of tasks: the header of
+/// [`CELL_FORMAT_VERSION`], then postcard of `cell`.
+///
+/// # Errors
+/// [`Error::Encode`].
+pub(crate) fn encode_cell(cell: &v12::CellPayload) -> Result<Vec<u8>> {
+    let payload = postcard::to_allocvec(cell).map_err(|source| Error::Encode { source })?;
+    Ok(with_header_version(&payload, CELL_FORMAT_VERSION))
 }
 
 /// The payload of the planner's state file at `path` as wire types ([`v11::Payload`], an
@@ -947,18 +1017,18 @@ mod tests {
     #[test]
     fn other_version_is_rejected_with_both_numbers() {
         let mut bytes = encode(&payload(3)).unwrap();
-        bytes[8..12].copy_from_slice(&12u32.to_le_bytes());
+        bytes[8..12].copy_from_slice(&13u32.to_le_bytes());
         let err = decode::<Payload>(&bytes, Path::new("v.tandem")).unwrap_err();
         assert!(matches!(
             err,
             Error::UnsupportedVersion {
-                found: 12,
-                expected: FORMAT_VERSION,
+                found: 13,
+                expected: NEWEST_READABLE_VERSION,
                 ..
             }
         ));
         let msg = err.to_string();
-        assert!(msg.contains("v.tandem") && msg.contains("12") && msg.contains("4 to 11"));
+        assert!(msg.contains("v.tandem") && msg.contains("13") && msg.contains("4 to 12"));
     }
 
     #[test]
