@@ -89,6 +89,7 @@ pub fn tick_now<C: Controller + ?Sized>(ctl: &C) -> Tick {
         ref_time: ctl.ref_time_now(),
         tasks: ctl.tasks_now(),
         low_conf: ctl.low_conf_now(),
+        operator: ctl.operator_now(),
         running: ctl.running_now(),
         waiting: ctl.waiting_now(),
         fault: ctl.fault(),

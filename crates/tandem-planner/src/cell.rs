@@ -164,6 +164,9 @@ impl Plan {
 /// The run-time coordinator of either kind of cell ([`Planner::controller`]), with what both
 /// share forwarded; each tick is its own coordinator's (`tick` of the variant).
 #[derive(Clone, Debug)]
+// Both coordinators are kept inline (the continuous one carries its operators' state, issue
+// 44): boxing one would allocate at every clone, which the cell's no-allocation tests forbid.
+#[allow(clippy::large_enum_variant)]
 pub enum AnyController {
     /// Rounds: the coordinator of §II-B5 (Eq. 17–18, Alg. 1).
     Rounds(Coordinator),
@@ -219,6 +222,15 @@ impl Controller for AnyController {
     }
     fn tick(&mut self, operator: Operator) -> tandem_realtime::Result<Tick> {
         each!(self, c => Controller::tick(c, operator))
+    }
+    fn operators(&self) -> usize {
+        each!(self, c => Controller::operators(c))
+    }
+    fn tick_many(&mut self, inputs: &[Operator]) -> tandem_realtime::Result<Tick> {
+        each!(self, c => Controller::tick_many(c, inputs))
+    }
+    fn operator_now(&self) -> tandem_realtime::PerRobot<Option<u8>> {
+        each!(self, c => Controller::operator_now(c))
     }
     fn reset(&mut self) {
         each!(self, c => Controller::reset(c))

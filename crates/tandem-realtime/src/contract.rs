@@ -2,8 +2,10 @@
 //! [`Coordinator`](crate::Coordinator) and the continuous cell's
 //! [`ContinuousCoordinator`](crate::ContinuousCoordinator) — offers the code that drives it (the
 //! adversary driver [`run_adversary`](crate::adversary::run_adversary), a workcell, a console):
-//! one [`Operator`] input per tick, one [`Tick`] out, one fault monitor ([`Fault`]), and each
-//! robot's position and state ([`Controller`]; docs/decisions.md, "One run-time contract").
+//! one [`Operator`] input per operator per tick ([`Controller::tick_many`]; one operator:
+//! [`Controller::tick`]), one [`Tick`] out, one fault monitor ([`Fault`]), and each robot's
+//! position and state ([`Controller`]; docs/decisions.md, "One run-time contract" and "M
+//! operators: the invariant and the continuous cell (issue 44)").
 
 use crate::adversary::AdversaryRun;
 use crate::error::{Error, Result};
@@ -62,6 +64,13 @@ pub struct Tick {
     /// tolerance, `[s_old − tol, s_new + tol]`: see [`Coordinator`](crate::Coordinator) for
     /// the exact, conservative definition, which both controllers share).
     pub low_conf: RobotFlags,
+    /// The operator (index `0..M`) each robot was assigned to during the tick, for every
+    /// robot flagged in [`low_conf`](Tick::low_conf) (`None` for the others; in a tick with a
+    /// fault an extra robot may have none). One operator (rounds): `Some(0)` for each
+    /// low-confidence robot. The continuous cell assigns a robot to one operator
+    /// from the tick it may pass a group's gate until it leaves the group (never handed over
+    /// mid-way; issue 44).
+    pub operator: PerRobot<Option<u8>>,
     /// Whether each robot ran during the tick: its schedule clock moved (rounds: inside its
     /// plan, `[τ_i, τ_i + |ψ_E|)`).
     pub running: RobotFlags,
@@ -82,20 +91,30 @@ pub struct Tick {
 }
 
 impl Tick {
-    /// Whether two or more robots traversed a low-confidence sample in this tick: the operator
-    /// was needed by two robots at once (a schedule that
+    /// Whether two or more robots traversed a low-confidence sample in this tick: one
+    /// operator was needed by two robots at once (a schedule that
     /// [`sufficient_margins`](crate::sufficient_margins) accepts, and the continuous cell's
-    /// token rule, never have such a tick).
+    /// token rule, never have such a tick). With `M > 1` operators use
+    /// [`over`](Tick::over).
     #[must_use]
     pub fn overlap(&self) -> bool {
         crate::monitor::overlap(&self.low_conf)
     }
+
+    /// Whether more than `operators` robots traversed a low-confidence sample in this tick:
+    /// more robots needed help than there are operators (the fault of a cell of `M`
+    /// operators; `over(1)` is [`overlap`](Tick::overlap)).
+    #[must_use]
+    pub fn over(&self, operators: usize) -> bool {
+        self.low_conf.count() > operators
+    }
 }
 
 /// A cell at run time: `1 ≤ N ≤` [`MAX_ROBOTS`](crate::MAX_ROBOTS) robots advanced one control
-/// period `tick_s` (real seconds) per [`tick`](Controller::tick) under one operator, with the
-/// one fault monitor ([`Fault`]: a tick with two robots low-confidence holds the robot whose
-/// low-confidence run began last until [`clear_fault`](Controller::clear_fault)).
+/// period `tick_s` (real seconds) per [`tick`](Controller::tick) under one operator, or per
+/// [`tick_many`](Controller::tick_many) under `M` ([`operators`](Controller::operators)), with
+/// the one fault monitor ([`Fault`]: a tick with more than `M` robots low-confidence holds the
+/// robot whose low-confidence run began last until [`clear_fault`](Controller::clear_fault)).
 ///
 /// Implemented by the rounds [`Coordinator`](crate::Coordinator) (every robot does its one
 /// task; [`is_finished`](Controller::is_finished) once all have) and the continuous cell's
@@ -108,6 +127,37 @@ pub trait Controller {
 
     /// Control period (real seconds).
     fn tick_s(&self) -> f64;
+
+    /// Number of operators `M` (`1 ≤ M`; [`OperatorCount`](crate::OperatorCount)): at most
+    /// `M` robots are low-confidence in any tick. The default: one.
+    fn operators(&self) -> usize {
+        1
+    }
+
+    /// Advances every robot one control period with one input per operator: `inputs[o]` sets
+    /// the timing of the robot operator `o` supervises ([`Tick::operator`]; ignored when it
+    /// supervises none). `tick_many(&[op])` is [`tick(op)`](Controller::tick). Never
+    /// allocates; O(N). The default (one operator) checks the count and calls `tick`.
+    ///
+    /// # Errors
+    /// [`Error::OperatorInputs`] unless `inputs.len() == M`; [`Error::BadOperator`] for an
+    /// inadmissible gradient; the controller is then unchanged.
+    fn tick_many(&mut self, inputs: &[Operator]) -> Result<Tick> {
+        match inputs {
+            [op] if self.operators() == 1 => self.tick(*op),
+            _ => Err(Error::OperatorInputs {
+                got: inputs.len(),
+                want: self.operators(),
+            }),
+        }
+    }
+
+    /// The operator each robot is assigned to now, for the robots of
+    /// [`low_conf_now`](Controller::low_conf_now) ([`Tick::operator`]). The default (one
+    /// operator): `Some(0)` for each of them.
+    fn operator_now(&self) -> PerRobot<Option<u8>> {
+        one_operator(&self.low_conf_now())
+    }
 
     /// Advances every robot one control period with the operator's input `operator` for the
     /// low-confidence robot (ignored when no robot is low-confidence). Never allocates; O(N).
@@ -180,6 +230,16 @@ pub trait Controller {
         let _ = (width, max_ticks);
         None
     }
+}
+
+/// `Some(0)` for each robot flagged in `low_conf`: the operator of every low-confidence robot
+/// of a one-operator controller ([`Tick::operator`]).
+pub(crate) fn one_operator(low_conf: &RobotFlags) -> PerRobot<Option<u8>> {
+    let mut out = PerRobot::new(low_conf.len());
+    for (i, o) in out.as_mut_slice().iter_mut().enumerate() {
+        *o = low_conf[i].then_some(0);
+    }
+    out
 }
 
 /// Checks a control period: finite and > 0 (the one check of every controller's `tick_s`).

@@ -51,6 +51,26 @@ pub enum Error {
         /// The largest count, [`MAX_ROBOTS`](crate::MAX_ROBOTS).
         max: usize,
     },
+    /// The number of operators is not in `1..=MAX_ROBOTS`
+    /// ([`OperatorCount::new`](crate::OperatorCount::new), issue 44).
+    #[error("{m} operators: a cell has 1 to {max} operators (use 1 for one operator)")]
+    OperatorCount {
+        /// The operator count given.
+        m: usize,
+        /// The largest count, [`MAX_ROBOTS`](crate::MAX_ROBOTS).
+        max: usize,
+    },
+    /// A tick was given another number of operator inputs than the controller has operators
+    /// ([`Controller::tick_many`](crate::Controller::tick_many): one input per operator).
+    #[error(
+        "{got} operator inputs for a cell of {want} operators: pass one `Operator` per operator, in operator order"
+    )]
+    OperatorInputs {
+        /// The number of inputs given.
+        got: usize,
+        /// The controller's operators `M`.
+        want: usize,
+    },
     /// The margin check rejects the robots' plans at this control tick: some admissible operator
     /// could make two robots low-confidence in one tick (build the coordinator from a schedule
     /// that passes the check, or with `Coordinator::new_unchecked` to study what it does).

@@ -95,7 +95,7 @@ pub use margins::{
 };
 pub use monitor::Fault;
 pub use prealert::PreAlert;
-pub use robots::{MAX_ROBOTS, PerRobot, RobotCount, RobotFlags};
+pub use robots::{MAX_ROBOTS, OperatorCount, PerRobot, RobotCount, RobotFlags};
 pub use rounds::Coordinator;
 pub use strategy::{high_conf_steps, response_step};
 pub use timeline::{LcInterval, Rates, Timeline, clock_end_s, clock_s};

@@ -1,6 +1,7 @@
 //! THE run-time fault monitor of every controller (rounds and the continuous cell): after each
 //! tick it keeps when each robot's run of low-confidence ticks began and latches a [`Fault`] in
-//! a tick with two or more robots low-confidence, holding the robot whose run began last.
+//! a tick with more robots low-confidence than the cell has operators (one operator: two or
+//! more), holding the robot whose run began last.
 //!
 //! The fault policy lives here and nowhere else: the rounds [`Coordinator`](crate::Coordinator)
 //! and the [`ContinuousCoordinator`](crate::ContinuousCoordinator) both own a [`Monitor`], feed
@@ -9,7 +10,8 @@
 
 use crate::robots::{MAX_ROBOTS, RobotFlags};
 
-/// A latched fault of the run-time monitor: in tick `tick` two or more robots traversed a
+/// A latched fault of the run-time monitor: in tick `tick` more robots than the cell has
+/// operators (one operator: two or more) traversed a
 /// low-confidence sample (`low_conf`), a state [`sufficient_margins`](crate::sufficient_margins)
 /// (rounds) and the token rule (the continuous cell) exclude. The controller fails safe instead
 /// of carrying on: it holds `stopped`, the robot whose low-confidence stretch began last (the
@@ -41,6 +43,9 @@ pub(crate) fn overlap(low_conf: &RobotFlags) -> bool {
 pub(crate) struct Monitor {
     /// Number of robots.
     n: usize,
+    /// Number of operators `M`: a tick with more than `M` robots low-confidence is the fault
+    /// (`M = 1`: two or more, an overlap).
+    operators: usize,
     /// Ticks observed since the start or the last reset.
     ticks: u64,
     /// Per robot, the tick at which its current run of low-confidence ticks began.
@@ -56,6 +61,7 @@ impl Monitor {
     pub(crate) fn new(n: usize) -> Monitor {
         Monitor {
             n,
+            operators: 1,
             ticks: 0,
             lc_since: [0; MAX_ROBOTS],
             lc_last: RobotFlags::new(n),
@@ -63,17 +69,27 @@ impl Monitor {
         }
     }
 
-    /// Back to [`Monitor::new`]: no tick seen, no fault.
-    pub(crate) fn reset(&mut self) {
-        *self = Monitor::new(self.n);
+    /// The same monitor for `m ≥ 1` operators: a tick with more than `m` robots
+    /// low-confidence is the fault.
+    pub(crate) fn with_operators(self, m: usize) -> Monitor {
+        Monitor {
+            operators: m.max(1),
+            ..self
+        }
     }
 
-    /// A fresh monitor whose tick count goes on from `ticks` (a hand-over to a new plan: the
-    /// runs of low-confidence ticks and the fault start afresh, the tick index does not).
-    pub(crate) fn resumed_at(n: usize, ticks: u64) -> Monitor {
+    /// Back to [`Monitor::new`] (the operators kept): no tick seen, no fault.
+    pub(crate) fn reset(&mut self) {
+        *self = Monitor::new(self.n).with_operators(self.operators);
+    }
+
+    /// A fresh monitor of `m` operators whose tick count goes on from `ticks` (a hand-over to
+    /// a new plan: the runs of low-confidence ticks and the fault start afresh, the tick index
+    /// does not).
+    pub(crate) fn resumed_at(n: usize, m: usize, ticks: u64) -> Monitor {
         Monitor {
             ticks,
-            ..Monitor::new(n)
+            ..Monitor::new(n).with_operators(m)
         }
     }
 
@@ -98,7 +114,8 @@ impl Monitor {
     }
 
     /// After each tick, with the robots low-confidence in it: keeps when each robot's run of
-    /// low-confidence ticks began and, in a tick with two or more, latches a [`Fault`] holding
+    /// low-confidence ticks began and, in a tick with more than `M` (one operator: two or
+    /// more), latches a [`Fault`] holding
     /// the robot whose run began last (the highest index on a tie), unless a fault is already
     /// latched; counts the tick. Returns the latched fault (this tick's or an earlier one's).
     pub(crate) fn observe(&mut self, low_conf: RobotFlags) -> Option<Fault> {
@@ -108,7 +125,7 @@ impl Monitor {
             }
         }
         self.lc_last = low_conf;
-        if self.fault.is_none() && overlap(&low_conf) {
+        if self.fault.is_none() && low_conf.count() > self.operators {
             let stopped = (0..self.n)
                 .filter(|&i| low_conf[i])
                 .max_by_key(|&i| (self.lc_since[i], policy::tie_rank(i, self.n)))
@@ -188,8 +205,19 @@ mod tests {
         );
         m.reset();
         assert_eq!((m.fault(), m.ticks()), (None, 0));
-        let r = Monitor::resumed_at(3, 17);
+        let r = Monitor::resumed_at(3, 1, 17);
         assert_eq!((r.fault(), r.ticks()), (None, 17));
+    }
+
+    #[test]
+    fn with_m_operators_the_fault_is_more_than_m() {
+        let mut m = Monitor::new(4).with_operators(2);
+        assert_eq!(m.observe(flags(&[true, true, false, false])), None);
+        let f = m.observe(flags(&[true, true, true, false])).expect("3 > 2");
+        assert_eq!((f.tick, f.stopped), (1, 2));
+        m.reset();
+        // The operators survive a reset.
+        assert_eq!(m.observe(flags(&[false, true, true, false])), None);
     }
 
     #[test]

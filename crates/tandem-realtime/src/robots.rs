@@ -63,6 +63,57 @@ impl From<RobotCount> for usize {
     }
 }
 
+/// A checked operator count `M`, `1 ≤ M ≤` [`MAX_ROBOTS`] (issue 44): how many operators
+/// share the cell's robots, each correcting one robot at a time. The one check of an operator
+/// count in the workspace ([`Error::OperatorCount`]); `M = 1` is the paper's one operator.
+///
+/// ```
+/// use tandem_realtime::{Error, OperatorCount};
+/// assert_eq!(OperatorCount::new(2)?.get(), 2);
+/// assert_eq!(OperatorCount::ONE.get(), 1);
+/// assert!(matches!(OperatorCount::new(0), Err(Error::OperatorCount { m: 0, .. })));
+/// # Ok::<(), Error>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct OperatorCount(u8);
+
+impl OperatorCount {
+    /// One operator: the paper's cell.
+    pub const ONE: OperatorCount = OperatorCount(1);
+
+    /// The count `m` once checked.
+    ///
+    /// # Errors
+    /// [`Error::OperatorCount`] with `m` unless `1 ≤ m ≤ MAX_ROBOTS`.
+    pub fn new(m: usize) -> Result<Self> {
+        if (1..=MAX_ROBOTS).contains(&m) {
+            Ok(OperatorCount(m as u8))
+        } else {
+            Err(Error::OperatorCount { m, max: MAX_ROBOTS })
+        }
+    }
+
+    /// The number of operators, in `1..=MAX_ROBOTS`.
+    #[must_use]
+    pub const fn get(self) -> usize {
+        self.0 as usize
+    }
+}
+
+impl Default for OperatorCount {
+    fn default() -> Self {
+        OperatorCount::ONE
+    }
+}
+
+impl TryFrom<usize> for OperatorCount {
+    type Error = Error;
+
+    fn try_from(m: usize) -> Result<Self> {
+        OperatorCount::new(m)
+    }
+}
+
 /// Checks a robot count ([`RobotCount::new`], the count dropped).
 ///
 /// # Errors
@@ -293,6 +344,24 @@ mod tests {
         assert_eq!(
             RobotCount::new(0).unwrap_err().to_string(),
             "0 robots: one operator supervises 1 to 8 robots"
+        );
+    }
+
+    #[test]
+    fn an_operator_count_is_checked_once() {
+        for m in 1..=MAX_ROBOTS {
+            assert_eq!(OperatorCount::new(m).map(OperatorCount::get), Ok(m));
+        }
+        for m in [0, MAX_ROBOTS + 1] {
+            assert_eq!(
+                OperatorCount::try_from(m),
+                Err(Error::OperatorCount { m, max: MAX_ROBOTS })
+            );
+        }
+        assert_eq!(OperatorCount::default(), OperatorCount::ONE);
+        assert_eq!(
+            OperatorCount::new(9).unwrap_err().to_string(),
+            "9 operators: a cell has 1 to 8 operators (use 1 for one operator)"
         );
     }
 }

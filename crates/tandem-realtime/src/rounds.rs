@@ -606,6 +606,7 @@ impl Coordinator {
             ref_time: PerRobot::new(n),
             tasks: PerRobot::new(n),
             low_conf: RobotFlags::new(n),
+            operator: PerRobot::new(n),
             running: RobotFlags::new(n),
             waiting: RobotFlags::new(n),
             fault: None,
@@ -696,6 +697,7 @@ impl Coordinator {
             out.waiting.set(i, self.at_hold(i));
         }
         out.next = self.pre_alert();
+        out.operator = crate::contract::one_operator(&out.low_conf);
         out.fault = self.monitor.observe(out.low_conf);
         Ok(out)
     }

@@ -16,6 +16,23 @@ use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
 use crate::timeline::Timeline;
 use crate::tol::clock_tolerance_s;
 
+/// The operators of a cell (issue 44): who holds which entry of the token sequence, and each
+/// operator's and robot's history for the switch time and the preferred operator.
+#[derive(Clone, Debug, Default)]
+struct Staff {
+    /// Per operator, the entry it was granted and has not released (the robot has not left
+    /// the group yet), with the entry's `(pos, passes)`: at most `M` robots inside.
+    slot: [Option<(Token, usize, u64)>; MAX_ROBOTS],
+    /// Per robot, the operator it is assigned to (the inverse of `slot`).
+    assigned: [Option<u8>; MAX_ROBOTS],
+    /// Per robot, the operator it was last assigned to (preferred at its next grant).
+    last_op: [Option<u8>; MAX_ROBOTS],
+    /// Per operator, the robot it last released (that left its group) and the index of the
+    /// first tick after the one in which it left (`None`: nobody yet). The operator is granted
+    /// to another robot only from tick `left + k` on (carried over by a hand-over).
+    last_left: [Option<(usize, u64)>; MAX_ROBOTS],
+}
+
 /// What one [`ContinuousCoordinator::tick`] did: the one [`Tick`] of every controller (its
 /// `at_gate` is [`Tick::waiting`]).
 #[deprecated(
@@ -62,10 +79,14 @@ pub struct ContinuousCoordinator {
     next_group: [usize; MAX_ROBOTS],
     pub(super) tasks: [u64; MAX_ROBOTS],
     cursors: [Cursors; MAX_ROBOTS],
-    /// Index of the current token.
+    /// Index of the next entry of the token sequence to grant an operator (`tokens[pos]`).
     pos: usize,
-    /// Completed passes through the token sequence.
+    /// Completed passes of `pos` through the token sequence.
     passes: u64,
+    /// `M`: the number of operators (tokens), `1..=MAX_ROBOTS`.
+    m: usize,
+    /// The operators' state (inline: a clone of the cell allocates nothing).
+    staff: Staff,
     /// Per robot, the stamp of its last *service* (the token moving on after it left a
     /// group): larger is more recent. Before its first service a robot's stamp is its rank
     /// among the robots' first tokens at the start (`0..N`); services stamp `N, N + 1, …`.
@@ -79,10 +100,6 @@ pub struct ContinuousCoordinator {
     monitor: Monitor,
     /// `k`: the operator's switch time in whole ticks ([`crate::switch_ticks`]; 0: none).
     switch_ticks: u64,
-    /// The robot that last left a group and the index of the first tick after the one in
-    /// which it left (`None`: nobody yet). Another robot's token lets it pass its gate only
-    /// from tick `left + k` on (carried over by a hand-over).
-    last_left: Option<(usize, u64)>,
     /// The pre-alert's tables of the task ([`crate::prealert`]).
     reach: Arc<Reach>,
     /// Per reference sample, the group its low-confidence sample belongs to (unused on
@@ -169,11 +186,12 @@ impl ContinuousCoordinator {
             cursors: [Cursors::default(); MAX_ROBOTS],
             pos: 0,
             passes: 0,
+            m: 1,
+            staff: Staff::default(),
             served: [0; MAX_ROBOTS],
             stamp: 0,
             monitor: Monitor::new(n_robots),
             switch_ticks: 0,
-            last_left: None,
             reach: Arc::new(reach),
             group_of: group_of.into(),
         };
@@ -202,22 +220,72 @@ impl ContinuousCoordinator {
         self.switch_ticks
     }
 
-    /// Whether robot `i` holds the token for its next group and may pass its gate in tick
-    /// `tick` (the index of a tick: [`Monitor::ticks`] at its start): the token is its, and
-    /// either no other robot left a group fewer than `k` ticks before.
-    fn may_pass(&self, tok: Option<Token>, i: usize, tick: u64) -> bool {
-        tok.is_some_and(|t| t.robot == i && t.group == self.next_group[i])
-            && self.switch_wait(i, tick) == 0
+    /// The same cell with `operators` operators (`M` tokens; issue 44), reset to the start:
+    /// at most `M` robots are inside a group at once, each assigned to one operator from the
+    /// tick it may pass its group's gate until it leaves the group, whose input
+    /// ([`tick_many`](Self::tick_many)) sets its rate (module docs, [`crate::cell`]). The
+    /// switch time is per operator. `M = 1` is the one-operator cell, bit for bit.
+    #[must_use]
+    pub fn with_operators(mut self, operators: crate::OperatorCount) -> ContinuousCoordinator {
+        self.m = operators.get();
+        self.monitor = self.monitor.with_operators(self.m);
+        self.reset();
+        self
     }
 
-    /// Ticks robot `i` must still wait at tick index `tick` before the token may let it pass
-    /// (the switch time after another robot left its group; 0 without one).
-    fn switch_wait(&self, i: usize, tick: u64) -> u64 {
-        match self.last_left {
+    /// `M`: the number of operators ([`with_operators`](Self::with_operators)).
+    pub fn operators(&self) -> usize {
+        self.m
+    }
+
+    /// Whether robot `i` may pass its next group's gate: an operator is assigned to it.
+    fn may_pass(&self, i: usize) -> bool {
+        self.staff.assigned[i].is_some()
+    }
+
+    /// Ticks operator `o` must still wait at tick index `tick` before it may be granted to
+    /// robot `i` (the switch time after it released another robot; 0 without one).
+    fn op_wait(&self, o: usize, i: usize, tick: u64) -> u64 {
+        match self.staff.last_left[o] {
             Some((r, left)) if self.switch_ticks > 0 && r != i => {
                 (left + self.switch_ticks).saturating_sub(tick)
             }
             _ => 0,
+        }
+    }
+
+    /// One operator: ticks robot `i` must still wait at tick index `tick` before the token
+    /// may let it pass ([`Self::op_wait`] of operator 0).
+    fn switch_wait(&self, i: usize, tick: u64) -> u64 {
+        self.op_wait(0, i, tick)
+    }
+
+    /// The operator to grant robot `i` at tick index `tick`: a free one whose switch time has
+    /// passed, the robot's last operator first, else the lowest index.
+    fn free_operator(&self, i: usize, tick: u64) -> Option<usize> {
+        let ok = |o: usize| self.staff.slot[o].is_none() && self.op_wait(o, i, tick) == 0;
+        match self.staff.last_op[i] {
+            Some(o) if ok(usize::from(o)) => Some(usize::from(o)),
+            _ => (0..self.m).find(|&o| ok(o)),
+        }
+    }
+
+    /// Grants operators to the token sequence's entries in order, from `pos`, at tick index
+    /// `tick` (the start of that tick): while the next entry's robot has the entry's group
+    /// next, holds no operator, and a free operator may take it. Stops at the first entry that
+    /// cannot be granted (the order is kept). At most `N` grants; no allocation.
+    fn grant(&mut self, tick: u64) {
+        while let Some(&t) = self.tokens.get(self.pos) {
+            if self.staff.assigned[t.robot].is_some() || self.next_group[t.robot] != t.group {
+                return;
+            }
+            let Some(o) = self.free_operator(t.robot, tick) else {
+                return;
+            };
+            self.staff.slot[o] = Some((t, self.pos, self.passes));
+            self.staff.assigned[t.robot] = Some(o as u8);
+            self.staff.last_op[t.robot] = Some(o as u8);
+            self.advance_token();
         }
     }
 
@@ -234,6 +302,9 @@ impl ContinuousCoordinator {
     /// passes to first.
     /// O(N) plus a scan of the token sequence up to the last robot's next turn; no allocation.
     pub fn pre_alert(&self) -> Option<crate::PreAlert> {
+        if self.m > 1 {
+            return None;
+        }
         let h = self.tick_s;
         let next_tick = self.monitor.ticks();
         let tok = self.token();
@@ -252,7 +323,8 @@ impl ContinuousCoordinator {
         // one to its first token after it.
         let mut turn = [usize::MAX; MAX_ROBOTS];
         let len = self.tokens.len();
-        let (mut k, mut pass, mut found) = (self.pos, self.passes, 0);
+        let (tok_pos, tok_passes) = self.token_position();
+        let (mut k, mut pass, mut found) = (tok_pos, tok_passes, 0);
         for step in 0..len {
             k += 1;
             if k == len {
@@ -358,7 +430,8 @@ impl ContinuousCoordinator {
         }
         self.stamp = rank;
         self.monitor.reset();
-        self.last_left = None;
+        self.staff = Staff::default();
+        self.grant(0);
     }
 
     /// Number of robots `N`.
@@ -391,15 +464,37 @@ impl ContinuousCoordinator {
         self.skip_first.get(k).copied().unwrap_or(false)
     }
 
-    /// The current token (`None` for a task without low confidence).
+    /// The current token: the oldest entry of the sequence the operators have not finished —
+    /// the oldest one an operator holds, else the next to grant (`None` for a task without low
+    /// confidence). One operator: the token of the one-operator rule.
     pub fn token(&self) -> Option<Token> {
-        self.tokens.get(self.pos).copied()
+        match self.oldest_held() {
+            Some((t, _, _)) => Some(t),
+            None => self.tokens.get(self.pos).copied(),
+        }
     }
 
-    /// Index of the current token in [`tokens`](Self::tokens) and the number of completed
-    /// passes through the sequence.
+    /// Index of the current [`token`](Self::token) in [`tokens`](Self::tokens) and the number
+    /// of completed passes through the sequence when it was reached.
     pub fn token_position(&self) -> (usize, u64) {
-        (self.pos, self.passes)
+        match self.oldest_held() {
+            Some((_, pos, passes)) => (pos, passes),
+            None => (self.pos, self.passes),
+        }
+    }
+
+    /// The entries the operators hold now, per operator (`None`: operator free).
+    pub fn held_tokens(&self) -> &[Option<(Token, usize, u64)>] {
+        &self.staff.slot[..self.m]
+    }
+
+    /// The operator's entry granted earliest in the sequence.
+    fn oldest_held(&self) -> Option<(Token, usize, u64)> {
+        self.staff.slot[..self.m]
+            .iter()
+            .flatten()
+            .min_by_key(|&&(_, pos, passes)| (passes, pos))
+            .copied()
     }
 
     /// Each robot's number of completed tasks.
@@ -431,11 +526,19 @@ impl ContinuousCoordinator {
     /// the tick start: the robot the next tick moves at the operator's rate. O(N).
     pub fn low_conf_now(&self) -> RobotFlags {
         let mut out = RobotFlags::new(self.n);
-        let tok = self.token();
-        let tick = self.monitor.ticks();
         for i in 0..self.n {
-            let holder = self.may_pass(tok, i, tick);
-            out.set(i, holder && !self.task.conf()[self.cursors[i].at]);
+            out.set(i, self.may_pass(i) && !self.task.conf()[self.cursors[i].at]);
+        }
+        out
+    }
+
+    /// The operator of each robot of [`low_conf_now`](Self::low_conf_now) (`None` for the
+    /// others). O(N).
+    pub fn operator_now(&self) -> PerRobot<Option<u8>> {
+        let lc = self.low_conf_now();
+        let mut out = PerRobot::new(self.n);
+        for (i, o) in out.as_mut_slice().iter_mut().enumerate() {
+            *o = if lc[i] { self.staff.assigned[i] } else { None };
         }
         out
     }
@@ -444,13 +547,10 @@ impl ContinuousCoordinator {
     /// another's): the next tick does not move it. O(N).
     pub fn at_gate_now(&self) -> RobotFlags {
         let mut out = RobotFlags::new(self.n);
-        let tok = self.token();
-        let tick = self.monitor.ticks();
         for i in 0..self.n {
             let g = self.next_group[i];
-            let waits = g < self.groups.len()
-                && self.clock_s[i] >= self.gate_s[g]
-                && !self.may_pass(tok, i, tick);
+            let waits =
+                g < self.groups.len() && self.clock_s[i] >= self.gate_s[g] && !self.may_pass(i);
             out.set(i, waits);
         }
         out
@@ -468,13 +568,35 @@ impl ContinuousCoordinator {
     }
 
     /// Advances every robot one control period with the operator's input `operator` for the
-    /// low-confidence robot. Never allocates; O(N).
+    /// low-confidence robot: [`tick_many`](Self::tick_many) with one input (one operator).
+    /// Never allocates; O(N).
     ///
     /// # Errors
-    /// [`Error::BadOperator`] for an [`Operator::Gradient`] that is NaN, infinite or ≤ 0; the
-    /// coordinator is then unchanged.
+    /// [`Error::OperatorInputs`] for a cell of `M > 1` operators; [`Error::BadOperator`] for
+    /// an [`Operator::Gradient`] that is NaN, infinite or ≤ 0; the coordinator is then
+    /// unchanged.
     pub fn tick(&mut self, operator: Operator) -> Result<Tick> {
-        let op = operator.validate()?;
+        self.tick_many(std::slice::from_ref(&operator))
+    }
+
+    /// Advances every robot one control period with one input per operator: `inputs[o]` sets
+    /// the rate of the robot operator `o` is assigned to ([`Tick::operator`]). Never
+    /// allocates; O(N) (amortized).
+    ///
+    /// # Errors
+    /// [`Error::OperatorInputs`] unless `inputs.len() == M`; [`Error::BadOperator`] for an
+    /// [`Operator::Gradient`] that is NaN, infinite or ≤ 0; the coordinator is then unchanged.
+    pub fn tick_many(&mut self, inputs: &[Operator]) -> Result<Tick> {
+        if inputs.len() != self.m {
+            return Err(Error::OperatorInputs {
+                got: inputs.len(),
+                want: self.m,
+            });
+        }
+        let mut ops = [Operator::Scheduled; MAX_ROBOTS];
+        for (o, op) in ops.iter_mut().zip(inputs) {
+            *o = op.validate()?;
+        }
         let n = self.n;
         // "A robot never moves backwards", checked in debug builds: each robot's (tasks
         // completed, reference time) at the tick end is at least that at its start.
@@ -483,13 +605,13 @@ impl ContinuousCoordinator {
         let n_groups = self.groups.len();
         let task = Arc::clone(&self.task);
         let end_s = task.end_s();
-        let tok = self.token();
         let held = self.monitor.held();
         let this_tick = self.monitor.ticks();
         let mut out = Tick {
             ref_time: PerRobot::new(n),
             tasks: PerRobot::new(n),
             low_conf: RobotFlags::new(n),
+            operator: PerRobot::new(n),
             running: RobotFlags::new(n),
             waiting: RobotFlags::new(n),
             fault: None,
@@ -501,7 +623,7 @@ impl ContinuousCoordinator {
             }
             let s_old = self.clock_s[i];
             let g = self.next_group[i];
-            let holder = self.may_pass(tok, i, this_tick);
+            let holder = self.may_pass(i);
             let cap = if g >= n_groups {
                 end_s
             } else if holder {
@@ -514,7 +636,10 @@ impl ContinuousCoordinator {
             let step = if task.conf()[at] {
                 self.tick_s
             } else {
-                operator_step(&task, at, op, self.tick_s)
+                // The robot's operator's input (a robot on low confidence without one — only
+                // in a state the rule excludes, `place_unchecked` — takes operator 0's).
+                let o = self.staff.assigned[i].map_or(0, usize::from);
+                operator_step(&task, at, ops[o], self.tick_s)
             };
             // On high-confidence ground the robot stops at the next low-confidence sample:
             // the tick after starts on it, at the operator's rate.
@@ -536,23 +661,31 @@ impl ContinuousCoordinator {
                 out.running.set(i, true);
                 let lo = task.advance_cursor(&mut cur.lo, s_old - self.tol_s);
                 let hi = task.advance_cursor(&mut cur.hi, s_new + self.tol_s);
-                out.low_conf.set(i, task.any_low_conf(lo, hi));
+                let lc = task.any_low_conf(lo, hi);
+                out.low_conf.set(i, lc);
+                if lc {
+                    out.operator.as_mut_slice()[i] = self.staff.assigned[i];
+                }
             }
             self.clock_s[i] = s_new;
         }
-        // The token moves once its robot has left its group.
-        if let Some(t) = tok {
+        // An operator is released once its robot has left its group (operators in index
+        // order; one operator: the token moves).
+        for o in 0..self.m {
+            let Some((t, _, _)) = self.staff.slot[o] else {
+                continue;
+            };
             let (r, g) = (t.robot, t.group);
             let s = self.clock_s[r];
             if self.next_group[r] == g && (s >= end_s || s - self.tol_s >= self.leave_s[g]) {
-                self.last_left = Some((r, this_tick + 1));
+                self.staff.last_left[o] = Some((r, this_tick + 1));
                 self.next_group[r] = g + 1;
                 self.served[r] = self.stamp;
                 self.stamp += 1;
-                self.advance_token();
+                self.staff.slot[o] = None;
+                self.staff.assigned[r] = None;
             }
         }
-        let tok = self.token();
         for i in 0..n {
             if self.clock_s[i] >= end_s && self.next_group[i] >= n_groups {
                 self.tasks[i] += 1;
@@ -560,13 +693,16 @@ impl ContinuousCoordinator {
                 self.cursors[i] = Cursors::default();
                 self.next_group[i] = 0;
             }
+        }
+        // The freed operators take the next entries, for the next tick.
+        self.grant(this_tick + 1);
+        for i in 0..n {
             let s = self.clock_s[i];
             let at = task.advance_cursor(&mut self.cursors[i].at, s);
             out.ref_time.as_mut_slice()[i] = task.ref_time_in(at, s);
             out.tasks.as_mut_slice()[i] = self.tasks[i];
             let g = self.next_group[i];
-            let waits =
-                g < n_groups && s >= self.gate_s[g] && !self.may_pass(tok, i, this_tick + 1);
+            let waits = g < n_groups && s >= self.gate_s[g] && !self.may_pass(i);
             out.waiting.set(i, waits);
         }
         #[cfg(debug_assertions)]
@@ -648,6 +784,9 @@ impl ContinuousCoordinator {
         }
         if let Some(f) = old.monitor.fault() {
             return bad(f.stopped, "the old cell has a latched fault");
+        }
+        if old.m != self.m {
+            return bad(0, "the new plan has another number of operators");
         }
         let n_groups = self.groups.len();
         let c = self.task.sample_clock_s();
@@ -737,10 +876,15 @@ impl ContinuousCoordinator {
         self.passes = 0;
         self.served = old.served;
         self.stamp = old.stamp;
-        self.monitor = Monitor::resumed_at(self.n, old.monitor.ticks());
-        // The switch time runs on across the hand-over: the robot that last left a group, and
-        // when, are the old cell's.
-        self.last_left = old.last_left;
+        self.monitor = Monitor::resumed_at(self.n, self.m, old.monitor.ticks());
+        // The switch time runs on across the hand-over: the robot each operator last released,
+        // and when, are the old cell's; so is each robot's preferred operator.
+        self.staff = Staff {
+            last_left: old.staff.last_left,
+            last_op: old.staff.last_op,
+            ..Staff::default()
+        };
+        self.grant(self.monitor.ticks());
         Ok(())
     }
 
@@ -780,6 +924,18 @@ impl Controller for ContinuousCoordinator {
 
     fn tick(&mut self, operator: Operator) -> Result<Tick> {
         ContinuousCoordinator::tick(self, operator)
+    }
+
+    fn operators(&self) -> usize {
+        self.m
+    }
+
+    fn tick_many(&mut self, inputs: &[Operator]) -> Result<Tick> {
+        ContinuousCoordinator::tick_many(self, inputs)
+    }
+
+    fn operator_now(&self) -> PerRobot<Option<u8>> {
+        ContinuousCoordinator::operator_now(self)
     }
 
     fn reset(&mut self) {

@@ -43,6 +43,38 @@
 //! number of tasks, or on where a task ends — the drift of the clocks never matters, because
 //! the robots never rely on a margin: they wait.
 //!
+//! **M operators (issue 44).** With [`ContinuousCoordinator::with_operators`] the cell has `M`
+//! tokens, one per operator. The cyclic sequence is served in order by whichever operators are
+//! free: at the end of every tick (and at the start), while the next entry `(robot, group)` of
+//! the sequence has its robot's next group as its group, the robot holds no operator, and some
+//! operator is free — none holds an entry, and its switch time is over for that robot (below)
+//! — the entry is *granted* that operator (the robot's last operator if it qualifies, else the
+//! lowest index) and the sequence moves on; the first entry that cannot be granted stops the
+//! grants (the order is kept). A robot granted an operator may pass its gate, but not the gate
+//! of its following group; once it has *left* the group (as above) the operator is released,
+//! at the end of that tick. A robot's rate on low confidence is its operator's input
+//! ([`ContinuousCoordinator::tick_many`], one input per operator). With `M = 1` the granted
+//! entry is the token of the one-operator rule, released when the token moved: the same
+//! ticks, bit for bit.
+//!
+//! *Soundness with M operators, for any inputs and any number of tasks.* Call a robot inside
+//! from the tick start at which it holds an operator until the tick end at which it leaves its
+//! group. Each inside robot holds one operator and each operator at most one entry, so at most
+//! `M` robots are inside during any tick; a robot that is not inside traverses high-confidence
+//! samples only (the argument above, word for word). So at most `M` robots are low-confidence
+//! in any tick, and each of them is inside, with the operator it was granted before it passed
+//! its gate and keeps until it has left the group: a stretch is never handed over mid-way
+//! ([`Tick::operator`](crate::Tick::operator) names it). *Switch time, per operator*: when
+//! operator `o`'s robot leaves at the end of tick `a`, `o` may be granted to *another* robot
+//! only from tick `a + 1 + k` on, so between two robots' stretches of one operator at least `k`
+//! ticks pass in which `o` supervises no one. *Liveness*: grants follow the sequence, each
+//! robot's entries come in its task order, and an inside robot leaves its group in finitely
+//! many ticks (rate at least `S`), releasing its operator, whose switch time ends `k` ticks
+//! later; so the next entry is granted in finitely many ticks once its robot has finished its
+//! previous group, which it does for the same reason: no deadlock, every robot keeps completing
+//! tasks (docs/decisions.md, "M operators: the invariant and the continuous cell (issue 44)").
+//! The pre-alert is computed for one operator only (`None` with `M > 1`).
+//!
 //! **Runnable orders.** The rule needs each group to be contiguous in the order: between two
 //! stretches of one robot with no usable hold between them no other robot's stretch may come
 //! (the robot cannot wait there for it). [`is_runnable`] checks it; [`token_sequence`] rejects

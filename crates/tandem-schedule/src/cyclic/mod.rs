@@ -67,6 +67,7 @@
 //! ```
 
 mod checked;
+mod fleet;
 mod graph;
 mod plan;
 mod ratio;
@@ -74,6 +75,7 @@ mod run;
 mod search;
 
 pub use checked::CheckedCyclicPlan;
+pub use fleet::{SectoredPlan, pooled_period_lower_bound_s, sectored_plan};
 pub use graph::{Event, EventGraph, Gap, Stretch, TaskShape, event_graph};
 pub use plan::{
     CyclicPlan, GapPlan, RobotCycle, cyclic_plan_for_order, handover_bound_s, period_lower_bound_s,

@@ -233,7 +233,7 @@ pub(crate) fn handover_bound_of(shape: &TaskShape, n_robots: usize, tick_s: f64)
 }
 
 /// `Σ_g (S_g + E_g)` (s): every stretch, every gap inside a group, every group's entry.
-fn groups_per_task_s(shape: &TaskShape) -> f64 {
+pub(crate) fn groups_per_task_s(shape: &TaskShape) -> f64 {
     (0..shape.n_lc())
         .map(|k| {
             let before = if shape.opens_group(k) {

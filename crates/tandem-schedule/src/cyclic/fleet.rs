@@ -1,0 +1,244 @@
+//! `M` operators over `N` robots (issue 44): the bound on the period of every plan the
+//! continuous cell's `M` tokens run, and the sectored baseline (a fixed partition of the robots
+//! to the operators, each sector a one-operator cell). docs/decisions.md, "M operators: the
+//! invariant and the continuous cell (issue 44)".
+
+use serde::{Deserialize, Serialize};
+
+use super::graph::TaskShape;
+use super::plan::groups_per_task_s;
+use super::search::{CyclicParams, cyclic_plan};
+use crate::problem::check_robot_count;
+use crate::{Problem, Result};
+
+/// A lower bound (s) on the period of every 1-periodic run of `n_robots` robots on `problem`
+/// served by `operators` operators under the `M`-token rule
+/// (`tandem_realtime::cell`, `ContinuousCoordinator::with_operators`):
+/// `max(N·W/M, D_min)` with `W = Σ_g (S_g + E_g)` the operator's hold per task — every group's
+/// span (its stretches at `ψ̇̄` and the gaps inside it at their fastest) and entry (the fastest
+/// travel from its gate to its first stretch) — and `D_min` a robot's fastest task
+/// ([`TaskShape::fastest_s`]). As tasks per hour, `3600·N/P ≤ min(3600·N/D_min, 3600·M/W)`:
+/// the fleet's ceiling, `M` times one operator's.
+///
+/// **Why.** Under the rule an operator is granted to a robot before the robot passes its
+/// group's gate and released only once the robot has left the group: it holds the robot from
+/// the gate to the end of the group's last stretch, at least `E_g + S_g` (the robot travels and
+/// traverses at most at its fastest rates and the plan's `ψ̇̄`), and holds one group at a
+/// time. In one period each robot passes each of its groups once, so the operators hold
+/// groups for at least `N·W` seconds in total, and `M` operators have `M·P` seconds: `P ≥
+/// N·W/M`. Each robot does one task per period: `P ≥ D_min`. With `M = 1` it is at most
+/// [`crate::cyclic::handover_bound_s`] (which adds a tick per hand-over), and `W ≥ L + I`
+/// (item 2 of [`crate::cyclic::period_lower_bound_s`]: the short gaps without a hold are
+/// inside groups).
+///
+/// # Errors
+/// [`crate::Error::Realtime`] (`RobotCount`, `OperatorCount`) for `n_robots` or `operators`
+/// outside `1..=MAX_ROBOTS`.
+pub fn pooled_period_lower_bound_s(
+    problem: &Problem,
+    n_robots: usize,
+    operators: usize,
+) -> Result<f64> {
+    check_robot_count(n_robots)?;
+    let m = tandem_realtime::OperatorCount::new(operators)?.get();
+    Ok(pooled_bound_of(&TaskShape::new(problem), n_robots, m))
+}
+
+pub(crate) fn pooled_bound_of(shape: &TaskShape, n_robots: usize, operators: usize) -> f64 {
+    let per_task = if shape.n_lc() == 0 {
+        0.0
+    } else {
+        groups_per_task_s(shape)
+    };
+    (n_robots as f64 * per_task / operators as f64).max(shape.fastest_s())
+}
+
+/// The best sectored cell of `N` robots and `M` operators: the robots split into at most `M`
+/// sectors, each run by one operator as its own continuous cell (a one-operator
+/// [`cyclic_plan`]); its throughput is the sum of the sectors'. The baseline a pooled cell
+/// (every operator serving every robot) must match or beat.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SectoredPlan {
+    /// Robots per sector (non-increasing, summing to `N`; at most `M` sectors: an operator
+    /// is left without robots when that is best).
+    pub sizes: Vec<usize>,
+    /// Throughput (tasks per hour): the sum of the sectors' plans'.
+    pub tasks_per_hour: f64,
+    /// Each sector size's one-operator plan throughput (tasks per hour), index `k − 1` for
+    /// `k` robots, `k = 1..=N`.
+    pub by_size: Vec<f64>,
+}
+
+/// The best sectored cell ([`SectoredPlan`]) of `n_robots` robots and `operators` operators on
+/// `problem`: the one-operator [`cyclic_plan`] of every sector size `1..=N` with `params`, then
+/// the partition of `N` into at most `M` parts of largest summed throughput (exhaustive, by
+/// dynamic programming over sizes). Ties keep the partition found first (larger parts first).
+///
+/// # Errors
+/// Those of [`cyclic_plan`]; [`crate::Error::Realtime`] (`OperatorCount`) for `operators`
+/// outside `1..=MAX_ROBOTS`.
+pub fn sectored_plan(
+    problem: &Problem,
+    n_robots: usize,
+    operators: usize,
+    params: &CyclicParams,
+) -> Result<SectoredPlan> {
+    check_robot_count(n_robots)?;
+    let m = tandem_realtime::OperatorCount::new(operators)?.get();
+    let by_size = (1..=n_robots)
+        .map(|k| cyclic_plan(problem, k, params).map(|p| p.tasks_per_hour))
+        .collect::<Result<Vec<f64>>>()?;
+    // best[j][r]: the best throughput of r robots in at most j sectors, and its first part.
+    let mut best = vec![vec![(0.0_f64, 0_usize); n_robots + 1]; m + 1];
+    for j in 1..=m {
+        for r in 1..=n_robots {
+            let mut top = best[j - 1][r];
+            for k in (1..=r).rev() {
+                let v = by_size[k - 1] + best[j - 1][r - k].0;
+                if v > top.0 {
+                    top = (v, k);
+                }
+            }
+            best[j][r] = top;
+        }
+    }
+    let mut sizes = Vec::new();
+    let (mut j, mut r) = (m, n_robots);
+    while r > 0 && j > 0 {
+        let k = best[j][r].1;
+        if k == 0 {
+            j -= 1;
+            continue;
+        }
+        sizes.push(k);
+        r -= k;
+        j -= 1;
+    }
+    sizes.sort_unstable_by(|a, b| b.cmp(a));
+    Ok(SectoredPlan {
+        sizes,
+        tasks_per_hour: best[m][n_robots].0,
+        by_size,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 0.5 s of high confidence at the fastest (ψ̇min ½ over 1 s of samples), 1 s of low
+    /// confidence, 0.5 s of high confidence, at 10 ms; no hold but the task start.
+    fn one_stretch() -> Problem {
+        let conf: Vec<bool> = (0..300).map(|n| !(100..200).contains(&n)).collect();
+        Problem::new(conf, vec![1.0; 300], vec![0.5; 300], vec![2.0; 300], 0.01).unwrap()
+    }
+
+    #[test]
+    fn the_pooled_bound_by_hand() {
+        let p = one_stretch();
+        // W = entry 0.5 s + the stretch 1 s = 1.5 s; D_min = 0.5 + 1 + 0.5 = 2 s.
+        let at = |n, m| pooled_period_lower_bound_s(&p, n, m).unwrap();
+        assert!((at(1, 1) - 2.0).abs() < 1e-9);
+        assert!((at(4, 1) - 6.0).abs() < 1e-9);
+        assert!((at(4, 2) - 3.0).abs() < 1e-9);
+        assert!((at(8, 4) - 3.0).abs() < 1e-9);
+        // Enough operators: the robots' own task bounds.
+        assert!((at(4, 4) - 2.0).abs() < 1e-9);
+        assert!(matches!(
+            pooled_period_lower_bound_s(&p, 4, 0),
+            Err(crate::Error::Realtime(
+                tandem_realtime::Error::OperatorCount { m: 0, .. }
+            ))
+        ));
+        // One operator: never above the bound of the plans that count the hand-overs.
+        for n in 1..=8 {
+            let h = crate::cyclic::handover_bound_s(&p, n, 0.01).unwrap();
+            assert!(at(n, 1) <= h + 1e-12, "{n}");
+        }
+    }
+
+    #[test]
+    fn the_best_sectors_by_hand() {
+        let p = one_stretch();
+        let params = CyclicParams {
+            handover_tick_s: Some(0.01),
+            ..CyclicParams::default()
+        };
+        // One operator's plan of k robots: P = max(k·(1.5 + 0.01), 2) (the stretch, its
+        // entry and a tick per hand-over; one robot alone: its task, 2 s).
+        let s = sectored_plan(&p, 4, 2, &params).unwrap();
+        let want = |k: f64| 3600.0 * k / if k < 2.0 { 2.0 } else { k * 1.51 };
+        for (k, got) in s.by_size.iter().enumerate() {
+            let k = (k + 1) as f64;
+            assert!((got - want(k)).abs() < 1e-6, "{k}: {got} vs {}", want(k));
+        }
+        // 4 robots, 2 operators: 2 + 2 (2·2384.1 tasks/h) beats 3 + 1 (2384.1 + 1800) and 4.
+        assert_eq!(s.sizes, [2, 2]);
+        assert!((s.tasks_per_hour - 2.0 * want(2.0)).abs() < 1e-6);
+        // The sectored cell never beats the pooled bound.
+        let pooled = 3600.0 * 4.0 / pooled_period_lower_bound_s(&p, 4, 2).unwrap();
+        assert!(s.tasks_per_hour <= pooled + 1e-9);
+        // More operators than robots: one robot per operator, each at its own task.
+        let s = sectored_plan(&p, 2, 4, &params).unwrap();
+        assert_eq!(s.sizes, [1, 1]);
+        assert!((s.tasks_per_hour - 3600.0).abs() < 1e-6);
+    }
+
+    /// Steady tasks per hour of the pooled cell: the one-operator plan of `n` robots run by
+    /// the `M`-token coordinator under the planned operator at a 10 ms tick, counted over
+    /// ticks 20 000..60 000 (200 s to 600 s).
+    fn pooled_tasks_per_hour(p: &Problem, n: usize, m: usize) -> f64 {
+        let params = CyclicParams {
+            handover_tick_s: Some(0.01),
+            ..CyclicParams::default()
+        };
+        let plan = cyclic_plan(p, n, &params).unwrap();
+        let mut cell = plan
+            .coordinator(p, 0.01)
+            .unwrap()
+            .with_operators(tandem_realtime::OperatorCount::new(m).unwrap());
+        let ops = [tandem_realtime::Operator::Scheduled; 8];
+        let total = |c: &tandem_realtime::ContinuousCoordinator| -> u64 {
+            c.tasks_completed().iter().sum()
+        };
+        let mut at_start = 0;
+        for k in 0..60_000 {
+            if k == 20_000 {
+                at_start = total(&cell);
+            }
+            let t = cell.tick_many(&ops[..m]).unwrap();
+            assert!(!t.over(m) && t.fault.is_none());
+        }
+        (total(&cell) - at_start) as f64 * 3600.0 / 400.0
+    }
+
+    #[test]
+    fn the_pooled_cell_reaches_its_bound_and_beats_the_sectors() {
+        let p = one_stretch();
+        let params = CyclicParams {
+            handover_tick_s: Some(0.01),
+            ..CyclicParams::default()
+        };
+        for (n, m) in [(4, 2), (8, 2), (8, 4), (3, 2)] {
+            let got = pooled_tasks_per_hour(&p, n, m);
+            let ceiling = 3600.0 * n as f64 / pooled_period_lower_bound_s(&p, n, m).unwrap();
+            let sectored = sectored_plan(&p, n, m, &params).unwrap().tasks_per_hour;
+            eprintln!(
+                "({n}, {m}): pooled cell {got:.1} tasks/h, ceiling {ceiling:.1}, best sectors {sectored:.1}"
+            );
+            // ≥ 90 % of the ceiling (the loss: a tick per hand-over and the grant at a tick's
+            // end, 0.01–0.02 s of 1.5 s), never above it; at least the best sectors but for
+            // the same per-hand-over tick (within 2 %).
+            assert!(
+                got >= 0.9 * ceiling && got <= ceiling * 1.001,
+                "({n}, {m}): {got} of {ceiling}"
+            );
+            assert!(got >= 0.98 * sectored, "({n}, {m}): {got} vs {sectored}");
+            // Three robots, two operators: the sectors are 2 + 1 (the lone robot's operator
+            // idles half its time); pooling serves the three from both, 14 % more.
+            if (n, m) == (3, 2) {
+                assert!(got >= 1.1 * sectored, "{got} vs {sectored}");
+            }
+        }
+    }
+}
