@@ -106,6 +106,11 @@ pub(crate) struct StudyArgs {
     /// With --bag: the rounds to write (1-based). Default: the first and the last.
     #[arg(long, value_name = "K,…", value_delimiter = ',', requires = "bag")]
     bag_rounds: Vec<usize>,
+    /// Save each trial's planner after its last round as a state file in this folder
+    /// (created if missing): `trial_<T>.tandem`, for `tandem console`, `tandem simulate`,
+    /// `tandem inspect`. Refuses to start when one of those files exists already.
+    #[arg(long, value_name = "DIR")]
+    save_state: Option<PathBuf>,
 }
 
 /// `--cell`'s parser: the planner's `Cell` by its name (`rounds`, `continuous`), each value
@@ -187,6 +192,102 @@ impl BagSink {
     }
 }
 
+/// Saves each trial's planner after its last round (`--save-state`), from worker threads as
+/// the trials end; remembers the files written and the first error.
+struct StateSink {
+    dir: PathBuf,
+    written: std::sync::Mutex<Vec<PathBuf>>,
+    error: std::sync::Mutex<Option<String>>,
+}
+
+impl StateSink {
+    /// The sink of `--save-state DIR`, or `None` without the flag. Creates `DIR` and refuses,
+    /// before the study runs, a `DIR` that holds one of the files the study would write: the
+    /// study never replaces a state file it did not create.
+    fn new(args: &StudyArgs, config: &StudyConfig) -> anyhow::Result<Option<Self>> {
+        let Some(dir) = &args.save_state else {
+            return Ok(None);
+        };
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        for trial in 0..config.trials {
+            let path = Self::path(dir, trial);
+            if path.exists() {
+                bail!(
+                    "--save-state {}: {} exists already (from an earlier study?); the study \
+                     does not replace state files it did not create: remove it or pass \
+                     another folder",
+                    dir.display(),
+                    path.display()
+                );
+            }
+        }
+        Ok(Some(Self {
+            dir: dir.clone(),
+            written: std::sync::Mutex::new(Vec::new()),
+            error: std::sync::Mutex::new(None),
+        }))
+    }
+
+    /// The state file of trial `trial` (0-based) in `dir`.
+    fn path(dir: &Path, trial: usize) -> PathBuf {
+        dir.join(format!("trial_{trial}.tandem"))
+    }
+
+    /// Saves trial `trial`'s planner through the planner's normal save (atomic, locked, a
+    /// versioned state file); a file that appeared there meanwhile is left alone.
+    fn save(&self, trial: usize, planner: &tandem::planner::Planner) {
+        let path = Self::path(&self.dir, trial);
+        let result = if path.exists() {
+            Err(anyhow::anyhow!(
+                "exists already (created while the study ran); not replaced"
+            ))
+        } else {
+            planner.save(&path).map_err(anyhow::Error::from)
+        };
+        match result {
+            Ok(()) => self.written.lock().expect("no panic holds it").push(path),
+            Err(e) => {
+                let mut first = self.error.lock().expect("no panic holds it");
+                first.get_or_insert(format!("{}: {e:#}", path.display()));
+            }
+        }
+    }
+
+    /// The files written, in trial order, or the first error.
+    fn finish(self) -> anyhow::Result<Vec<PathBuf>> {
+        if let Some(e) = self.error.into_inner().expect("no panic holds it") {
+            bail!("saving a trial's state: {e}");
+        }
+        let mut written = self.written.into_inner().expect("no panic holds it");
+        written.sort_by_key(|p| {
+            p.file_stem()
+                .and_then(|s| s.to_str())
+                .and_then(|s| s.strip_prefix("trial_"))
+                .and_then(|k| k.parse::<usize>().ok())
+        });
+        Ok(written)
+    }
+}
+
+/// Saves a trial's planner into `sink` when there is one (the study's `finished` callback).
+fn save_into(sink: &Option<StateSink>) -> impl Fn(usize, &tandem::planner::Planner) + Sync + '_ {
+    move |trial, planner| {
+        if let Some(s) = sink {
+            s.save(trial, planner);
+        }
+    }
+}
+
+/// Prints the state files `--save-state` wrote (or fails with its first error).
+fn report_saved(sink: Option<StateSink>) -> anyhow::Result<()> {
+    if let Some(s) = sink {
+        for p in s.finish()? {
+            println!("wrote {}", p.display());
+        }
+    }
+    Ok(())
+}
+
 /// What `study.json` holds.
 #[derive(Serialize)]
 struct StudyFile<'a> {
@@ -220,10 +321,17 @@ fn run_continuous(
     out: &Path,
     root: &Path,
     wall: Instant,
+    states: Option<StateSink>,
 ) -> anyhow::Result<()> {
     let bar = TrialBar::new(config, "re-plans (every N tasks)")?;
-    let (result, times) = tandem::sim::study::run_cell_study(config, inputs, &|p| bar.step(p))?;
+    let (result, times) = tandem::sim::study::run_cell_study_finished(
+        config,
+        inputs,
+        &|p| bar.step(p),
+        &save_into(&states),
+    )?;
     bar.finish();
+    report_saved(states)?;
     let summary = result.summary();
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let file = CellStudyFile {
@@ -556,19 +664,27 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
         if args.bag.is_some() {
             bail!("--bag writes rounds; a continuous cell has none (use --cell rounds)");
         }
-        return run_continuous(&config, &inputs, &out, &root, wall);
+        let states = StateSink::new(args, &config)?;
+        return run_continuous(&config, &inputs, &out, &root, wall, states);
     }
 
-    let bar = TrialBar::new(&config, "rounds")?;
     let sink = BagSink::new(args, &config)?;
+    let states = StateSink::new(args, &config)?;
+    let bar = TrialBar::new(&config, "rounds")?;
     let observe = |view: tandem::sim::study::RoundView<'_>| {
         if let Some(s) = &sink {
             s.observe(view);
         }
     };
-    let (result, times) =
-        tandem::sim::study::run_study_observed(&config, &inputs, &|p| bar.step(p), &observe)?;
+    let (result, times) = tandem::sim::study::run_study_finished(
+        &config,
+        &inputs,
+        &|p| bar.step(p),
+        &observe,
+        &save_into(&states),
+    )?;
     bar.finish();
+    report_saved(states)?;
     if let Some(s) = sink {
         if let Some(e) = s.error.into_inner().expect("no panic holds it") {
             bail!("writing a bag: {e}");

@@ -77,7 +77,7 @@ pub use recording::{
     read_bag, read_executions, robot_namespace,
 };
 pub use resample::SNAP_NS;
-pub use run::{RunWriter, SCHEDULE_SCHEMA};
+pub use run::{RunRobotLog, RunRoundLog, RunWriter, SCHEDULE_SCHEMA, read_run};
 pub use write::{BagWriter, Existing, Message, TopicId, TopicSpec, write_demonstration};
 
 /// Largest accepted gap between consecutive messages of a topic, and largest late start or

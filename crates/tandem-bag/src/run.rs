@@ -326,6 +326,172 @@ impl RunWriter {
     }
 }
 
+/// One robot of a round read back from a run ([`read_run`]), tick by tick of the round.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunRobotLog {
+    /// The round's tick (0-based) at which the robot started (its ticks before it waited).
+    pub start_tick: usize,
+    /// Its reference time (reference samples) at each tick it ran, from `start_tick` on.
+    pub ref_time: Vec<f64>,
+    /// Whether the operator supervised it in each tick it ran (`supervised`).
+    pub supervised: Vec<bool>,
+    /// Its schedule clock (s) at every tick of the round.
+    pub clock_s: Vec<f64>,
+}
+
+/// One round of a run read back ([`read_run`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunRoundLog {
+    /// The round (1-based).
+    pub round: usize,
+    /// Control ticks the round took.
+    pub ticks: usize,
+    /// The period between ticks (s): the model's `Δt_s`, the bag's tick spacing.
+    pub dt_s: f64,
+    /// `T_total` (s) of the schedule the round ran (Eq. 13).
+    pub t_total_s: f64,
+    /// Every robot, robot 1 first.
+    pub robots: Vec<RunRobotLog>,
+}
+
+/// Reads back, tick by tick, every round of a run [`RunWriter`] wrote for `n_robots` robots:
+/// each robot's reference-time log, supervised flags and schedule clock, at the ticks the
+/// round's schedule message and the messages' log times give (tick `k` of a round at its
+/// start plus `k·Δt_s`).
+///
+/// # Errors
+/// As [`read_bag`](crate::read_bag) for an unreadable, truncated or damaged file
+/// ([`Error::Truncated`], [`Error::Corrupt`]); [`Error::TopicNotFound`] for a robot the bag
+/// does not hold; [`Error::Layout`] for a bag without schedule messages (not a run tandem
+/// wrote), a round of another robot count than `n_robots`, or logs that do not fill the
+/// round's ticks.
+pub fn read_run(path: impl AsRef<Path>, n_robots: usize) -> Result<Vec<RunRoundLog>> {
+    let path = path.as_ref();
+    let file = path.display().to_string();
+    let layout = |why: String| Error::Layout {
+        file: file.clone(),
+        why,
+    };
+    let names = ["ref_sample", "supervised", "schedule_clock"];
+    let wanted: Vec<String> = (1..=n_robots)
+        .flat_map(|i| names.map(|n| format!("{}/{n}", robot_namespace(i))))
+        .collect();
+    let sel = crate::read::Selection {
+        topics: Some(&wanted),
+        namespace: None,
+        views: true,
+    };
+    let topics = crate::read::read_topics(path, &sel)?;
+    let topic = |name: &str| {
+        topics
+            .iter()
+            .find(|t| t.topic == name)
+            .ok_or_else(|| layout(format!("no topic {name}")))
+    };
+    let schedule = topics
+        .iter()
+        .find(|t| t.topic == SCHEDULE_TOPIC && !t.json.is_empty())
+        .ok_or_else(|| {
+            layout(format!(
+                "no schedule messages on {SCHEDULE_TOPIC}: not a run tandem wrote \
+                 (`tandem simulate --bag`, `cargo xtask study --bag`)"
+            ))
+        })?;
+    let mut rounds = Vec::with_capacity(schedule.json.len());
+    let mut order: Vec<usize> = (0..schedule.json.len()).collect();
+    order.sort_by_key(|&k| schedule.log_ns[k]);
+    for (k, &m) in order.iter().enumerate() {
+        let doc: serde_json::Value = serde_json::from_slice(&schedule.json[m])
+            .map_err(|e| layout(format!("schedule message {}: {e}", k + 1)))?;
+        let field = |name: &str| {
+            doc.get(name).ok_or_else(|| {
+                layout(format!(
+                    "schedule message {} has no `{name}` (see SCHEDULE_SCHEMA)",
+                    k + 1
+                ))
+            })
+        };
+        let ticks = field("ticks")?.as_u64().ok_or_else(|| {
+            layout(format!(
+                "schedule message {}: `ticks` is not a count",
+                k + 1
+            ))
+        })? as usize;
+        let dt_s = field("dt_s")?
+            .as_f64()
+            .filter(|d| *d > 0.0)
+            .ok_or_else(|| {
+                layout(format!(
+                    "schedule message {}: `dt_s` is not a period",
+                    k + 1
+                ))
+            })?;
+        let t_total_s = field("t_total_s")?.as_f64().unwrap_or(f64::NAN);
+        let n = field("n_robots")?.as_u64().unwrap_or(0) as usize;
+        if n != n_robots {
+            return Err(layout(format!(
+                "round {} ran {n} robots, not {n_robots}: pass the state file of the planner \
+                 the run was simulated from",
+                k + 1
+            )));
+        }
+        let start_ns = schedule.log_ns[m];
+        let end_ns = order
+            .get(k + 1)
+            .map_or(i64::MAX, |&next| schedule.log_ns[next]);
+        let dt_ns = dt_s * 1e9;
+        let tick_of = |t_ns: i64| ((t_ns - start_ns) as f64 / dt_ns).round() as usize;
+        let mut robots = Vec::with_capacity(n_robots);
+        for i in 1..=n_robots {
+            let ns = robot_namespace(i);
+            let window = |name: &str| -> Result<Vec<(usize, f64)>> {
+                let t = topic(&format!("{ns}/{name}"))?;
+                Ok(t.log_ns
+                    .iter()
+                    .zip(&t.values)
+                    .filter(|(l, _)| **l >= start_ns && **l < end_ns)
+                    .map(|(l, v)| (tick_of(*l), *v))
+                    .collect())
+            };
+            let refs = window("ref_sample")?;
+            let sup = window("supervised")?;
+            let clock = window("schedule_clock")?;
+            let start_tick = refs.first().map_or(ticks, |r| r.0);
+            let consecutive = |v: &[(usize, f64)], from: usize| {
+                v.iter().enumerate().all(|(j, (tick, _))| *tick == from + j)
+            };
+            if refs.len() != sup.len()
+                || !consecutive(&refs, start_tick)
+                || !consecutive(&sup, start_tick)
+                || clock.len() != ticks
+                || !consecutive(&clock, 0)
+                || start_tick + refs.len() > ticks
+            {
+                return Err(layout(format!(
+                    "round {}: robot {i}'s logs do not fill the round's {ticks} ticks (one \
+                     ref_sample and supervised message per tick it ran, one schedule_clock \
+                     per tick); a bag cut short or edited?",
+                    k + 1
+                )));
+            }
+            robots.push(RunRobotLog {
+                start_tick,
+                ref_time: refs.iter().map(|r| r.1).collect(),
+                supervised: sup.iter().map(|r| r.1 >= 0.5).collect(),
+                clock_s: clock.iter().map(|r| r.1).collect(),
+            });
+        }
+        rounds.push(RunRoundLog {
+            round: k + 1,
+            ticks,
+            dt_s,
+            t_total_s,
+            robots,
+        });
+    }
+    Ok(rounds)
+}
+
 /// The schedule message of round `round` (JSON).
 fn schedule_doc(planner: &Planner, round: usize, start_ns: i64, ticks: usize) -> Result<String> {
     let problem = planner.problem();

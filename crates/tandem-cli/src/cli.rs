@@ -203,6 +203,11 @@ pub(crate) enum Command {
     /// (frames with two robots `lc`, frames whose `lc` robot is not the coordinator's, the
     /// pre-alert's notice before each low-confidence stretch) and exits.
     ///
+    /// STATE --replay RUN.mcap replays a run bag (`tandem simulate --bag`): every tick of its
+    /// rounds rebuilt from the bag's logs (reference times, supervised flags, schedule clocks)
+    /// against the rounds plan of the state file the run was simulated from. A bag records
+    /// no pre-alert: the page shows no countdown, and --check counts none.
+    ///
     /// Example:
     ///
     ///   tandem console cell.tandem --simulate
@@ -211,6 +216,7 @@ pub(crate) enum Command {
     ///   tandem console cell.tandem --simulate --record run.jsonl --until rounds:10
     ///   tandem console --replay run.jsonl --speed 4
     ///   tandem console --replay run.jsonl --check
+    ///   tandem console cell.tandem --replay run.mcap --check
     #[command(verbatim_doc_comment)]
     Console(ConsoleArgs),
     /// Run the state file's coordinator live as a ROS 2 node (built with `--features ros2`).
@@ -236,13 +242,14 @@ pub(crate) enum Command {
 /// `tandem console`.
 #[derive(Debug, Args)]
 pub(crate) struct ConsoleArgs {
-    /// The state file (read only); not with --replay.
+    /// The state file (read only); with --replay only for a run bag (its plan).
     pub(crate) state: Option<PathBuf>,
     /// Run a simulated cell from the state file.
     #[arg(long)]
     pub(crate) simulate: bool,
-    /// Replay a console recording (a file, or a directory holding console.jsonl).
-    #[arg(long, value_name = "FILE|DIR", conflicts_with_all = ["simulate", "state"])]
+    /// Replay a console recording (a file, or a directory holding console.jsonl), or with
+    /// STATE a run bag (RUN.mcap, or a folder holding one).
+    #[arg(long, value_name = "FILE|DIR|RUN.mcap", conflicts_with = "simulate")]
     pub(crate) replay: Option<PathBuf>,
     /// With --replay: print what the page showed against the coordinator (JSON) and exit.
     #[arg(long, requires = "replay")]

@@ -158,7 +158,17 @@ fn replay(a: &ConsoleArgs, path: &std::path::Path) -> Result<()> {
     if !(a.speed > 0.0 && a.speed <= 1000.0) {
         bail!("--speed {}: must be in (0, 1000]", a.speed);
     }
-    let rec = read_recording(path);
+    let bag = tandem_console::looks_like_bag(path);
+    let rec = match (&a.state, bag) {
+        (Some(state), true) => run_bag(state, path)?,
+        (Some(state), false) => bail!(
+            "--replay {}: a console recording carries its own plan; {} is only for a run bag \
+             (RUN.mcap): omit it",
+            path.display(),
+            state.display()
+        ),
+        (None, _) => read_recording(path),
+    };
     let lead_s = a.lead.unwrap_or(tandem_console::DEFAULT_LEAD_S);
     if a.check {
         let rec = rec.map_err(|e| anyhow::anyhow!("--replay: {e}"))?;
@@ -168,6 +178,13 @@ fn replay(a: &ConsoleArgs, path: &std::path::Path) -> Result<()> {
                 rec.path.display(),
                 rec.ticks.len()
             ));
+        }
+        if bag {
+            note(
+                "console: a run bag records no pre-alert: the page showed no countdown, so the \
+                 pre-alert counts are 0; the stretches and the notice the schedule allowed are \
+                 the run's",
+            );
         }
         let check = check_recording(&rec, lead_s);
         out(&serde_json::to_string_pretty(&check)?);
@@ -218,6 +235,42 @@ fn replay(a: &ConsoleArgs, path: &std::path::Path) -> Result<()> {
     }
     console.stop();
     Ok(())
+}
+
+/// The run bag at `path` rebuilt against the rounds plan of the state file `state`
+/// (`tandem console STATE --replay RUN.mcap`); a note when the state's schedule is not the one
+/// the bag's rounds ran (a state recorded into since: the page's plan is the state's).
+fn run_bag(
+    state: &std::path::Path,
+    path: &std::path::Path,
+) -> Result<tandem_console::Result<tandem_console::Recording>> {
+    let planner = state_io::load(state)?;
+    let ctl = planner
+        .controller(tandem::planner::Cell::Rounds)
+        .with_context(|| format!("{}: the rounds plan", state.display()))?;
+    let schedule = schedule_text(&planner, tandem::planner::Cell::Rounds)?;
+    let geometry = Geometry::new(&ctl);
+    let rec = tandem_console::read_run_bag(path, &geometry, Some(&schedule));
+    if let Ok(file) = tandem::bag::bag_file(path)
+        && let Ok(rounds) = tandem::bag::read_run(&file, planner.n_robots())
+    {
+        let planned = planner.outcome().t_total_s;
+        if let Some(r) = rounds
+            .iter()
+            .find(|r| (r.t_total_s - planned).abs() > 1e-6 * planned.max(1.0))
+        {
+            note(&format!(
+                "console: round {} of {} ran a schedule of T_total {:.2} s, {} plans {:.2} s \
+                 (recorded into since?): the page's timeline and time left are the state's plan",
+                r.round,
+                path.display(),
+                r.t_total_s,
+                state.display(),
+                planned
+            ));
+        }
+    }
+    Ok(rec)
 }
 
 /// The planner for `robots` robots: the state's own when it has that many (or `robots` is not

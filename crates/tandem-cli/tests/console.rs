@@ -8,7 +8,7 @@ use std::net::TcpStream;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{scratch, small_state, tandem};
+use common::{SMALL_N_REF, scratch, small_state, tandem, write};
 
 /// Kills the console when the test ends, however it ends.
 struct Running(Child);
@@ -131,6 +131,108 @@ fn a_recorded_run_replays_and_checks() {
     assert_eq!(check["two_lc"], 0, "{check}");
     assert_eq!(check["lc_differs"], 0, "{check}");
     assert!(check["stretches"].as_u64().unwrap() >= 30, "{check}");
+}
+
+/// `tandem console STATE --replay RUN.mcap`: the bag of `tandem simulate --bag` replayed
+/// against its state file's plan, one frame per tick of its rounds; the page's `lc` robot is
+/// the one the run logged as supervised (the frames are rebuilt from the bag's flags, so the
+/// count of stretches is the count of the bag's supervised runs, read here through
+/// `read_executions`, the reader `tandem record` uses). Without the state file, and for a
+/// truncated bag, a clear refusal.
+#[test]
+fn a_run_bag_replays_with_its_state_file() {
+    let dir = scratch("console-bag");
+    let state = small_state(&dir);
+    let s = state.to_str().unwrap();
+    let bag = dir.join("run.mcap");
+    let b = bag.to_str().unwrap();
+    let need = write(
+        &dir,
+        "need.csv",
+        &format!("need\n{}", "1\n".repeat(SMALL_N_REF)),
+    );
+    let n = need.to_str().unwrap();
+    let out = tandem([
+        "simulate", s, "--need", n, "--rounds", "2", "--seed", "3", "--bag", b,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = tandem(["console", s, "--replay", b, "--check"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("records no pre-alert"), "{err}");
+    let check: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // Every tick of both rounds, and the supervised runs of the bag, robot by robot.
+    let rounds = tandem::bag::read_run(&bag, 2).unwrap();
+    let ticks: usize = rounds.iter().map(|r| r.ticks).sum();
+    assert_eq!(check["frames"].as_u64(), Some(ticks as u64), "{check}");
+    assert_eq!(check["two_lc"], 0, "{check}");
+    assert_eq!(check["lc_differs"], 0, "{check}");
+    let mut runs = 0;
+    for round in 1..=2 {
+        let opts = tandem::bag::ExecutionOptions {
+            dt_s: rounds[0].dt_s,
+            robots: vec![1, 2],
+            round: Some(round),
+            topics: None,
+        };
+        for e in tandem::bag::read_executions(&bag, &opts).unwrap() {
+            runs += e
+                .supervised
+                .iter()
+                .enumerate()
+                .filter(|&(k, &on)| on && (k == 0 || !e.supervised[k - 1]))
+                .count();
+        }
+    }
+    assert!(runs > 0);
+    // The check counts the stretches that start during the replay, not one under way at its
+    // first frame.
+    let under_way = rounds[0]
+        .robots
+        .iter()
+        .any(|r| r.start_tick == 0 && r.supervised.first() == Some(&true));
+    assert_eq!(
+        check["stretches"].as_u64(),
+        Some((runs - usize::from(under_way)) as u64),
+        "{check}"
+    );
+    assert_eq!(check["alerted"], 0, "{check}");
+
+    // Without the state file: refused, naming the fix.
+    let out = tandem(["console", "--replay", b, "--check"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("tandem console STATE --replay RUN.mcap"),
+        "{err}"
+    );
+    // A truncated bag: an error naming it.
+    let bytes = std::fs::read(&bag).unwrap();
+    let cut = dir.join("cut.mcap");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let out = tandem(["console", s, "--replay", cut.to_str().unwrap(), "--check"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("cut.mcap") && err.contains("cannot replay this run bag"),
+        "{err}"
+    );
+    // A console recording with a state file: the state is refused as meaningless.
+    let rec = dir.join("run.jsonl");
+    std::fs::write(&rec, "{}\n").unwrap();
+    let out = tandem(["console", s, "--replay", rec.to_str().unwrap(), "--check"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("only for a run bag"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -14,6 +14,8 @@
 //! - [`replay`] plays a recorded run ([`Recorder`], [`read_recording`]; `tandem console
 //!   --replay FILE|DIR`) through the same server and page; [`check_recording`] measures what
 //!   the page showed against the coordinator on every tick.
+//! - [`read_run_bag`] rebuilds a run bag's ticks (`tandem simulate --bag`) against the state
+//!   file's plan as a recording (`tandem console STATE --replay RUN.mcap`).
 //! - [`Tracker`] derives the page's per-robot and operator strips from successive snapshots.
 //! - [`Frame`] is what the page receives; the page's machine-checkable DOM
 //!   (`data-robot`, `data-state`, `data-attention`, `data-next-robot`, `data-next-s`) is
@@ -23,6 +25,7 @@ mod error;
 mod frame;
 mod handle;
 mod replay;
+mod run_bag;
 mod server;
 mod sim;
 mod strip;
@@ -35,9 +38,10 @@ pub use frame::{
 pub use handle::{ConsoleCell, ConsoleHandle, ControlMsg, Driver, Op};
 pub use replay::{
     RECORDING_FILE, RECORDING_FORMAT, RECORDING_HZ, RECORDING_VERSION, RecordedPreAlert,
-    RecordedRobot, RecordedTick, Recorder, Recording, ReplayCheck, check_recording, read_recording,
-    replay,
+    RecordedRobot, RecordedTick, Recorder, Recording, ReplayCheck, check_recording, looks_like_bag,
+    read_recording, replay,
 };
+pub use run_bag::{read_run_bag, recording_from_rounds};
 pub use server::{Console, ConsoleConfig, PAGE};
 pub use sim::{SimParams, Until, record_sim, simulate, simulate_recorded, tick_now};
 pub use strip::{OperatorStrip, RobotStrip, Tracker};

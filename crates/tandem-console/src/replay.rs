@@ -94,7 +94,7 @@ pub struct RecordedPreAlert {
 }
 
 impl RecordedTick {
-    fn raw(&self, tick_s: f64) -> RawFrame {
+    pub(crate) fn raw(&self, tick_s: f64) -> RawFrame {
         let mut raw = RawFrame {
             n: self.robots.len().min(MAX_ROBOTS),
             tick: self.tick,
@@ -300,6 +300,17 @@ pub struct Recording {
 /// The first bytes of an MCAP file (a ROS 2 bag, tandem-bag's run bags).
 const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
 
+/// Whether `path` is an MCAP bag, or a folder holding one and no console recording
+/// (`tandem console STATE --replay RUN.mcap` replays it with the state file).
+#[must_use]
+pub fn looks_like_bag(path: &Path) -> bool {
+    if path.is_dir() {
+        !path.join(RECORDING_FILE).exists() && dir_holds_a_bag(path)
+    } else {
+        is_bag(path)
+    }
+}
+
 /// Whether `path` is an MCAP bag: its extension, or its first bytes.
 fn is_bag(path: &Path) -> bool {
     if path
@@ -330,12 +341,12 @@ fn dir_holds_a_bag(dir: &Path) -> bool {
 fn not_a_bag(path: &Path) -> Error {
     Error::Recording {
         path: path.display().to_string(),
-        why: "an MCAP bag is not a console recording: a run bag holds each round's schedule, \
-              not the speed bounds and the coordinator's pre-alert the page shows, so the \
-              console does not replay bags; record the run for the console instead with \
-              `tandem console STATE --simulate --record FILE [--until …]` (or \
-              `tandem_console::Recorder` in your own loop) and replay that file with \
-              `--replay FILE`"
+        why: "an MCAP bag is not a console recording: a run bag holds each round's logs and \
+              schedule, not the plan's speed bounds the page needs; pass the state file the \
+              run was simulated from before it (`tandem console STATE --replay RUN.mcap`), or \
+              record the run for the console with `tandem console STATE --simulate --record \
+              FILE [--until …]` (or `tandem_console::Recorder` in your own loop) and replay \
+              that file with `--replay FILE`"
             .into(),
     }
 }

@@ -664,8 +664,27 @@ pub fn run_cell_trials(
     labels: &[Label],
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<(CellStudyResult, PhaseTimes)> {
+    run_cell_trials_finished(config, model, labels, progress, &|_, _| {})
+}
+
+/// [`run_cell_trials`] handing every trial's planner after its last recorded batch of `N`
+/// tasks to `finished` (the trial, 0-based, and the planner), from worker threads as the
+/// trials end, in no particular order; the result is the same as without.
+///
+/// # Errors
+/// As [`run_cell_trials`].
+pub fn run_cell_trials_finished(
+    config: &StudyConfig,
+    model: &TaskModel,
+    labels: &[Label],
+    progress: &(dyn Fn(Progress) + Sync),
+    finished: &(dyn Fn(usize, &Planner) + Sync),
+) -> Result<(CellStudyResult, PhaseTimes)> {
+    let truth = SandingTruth::new(labels.to_vec(), config.task.clone());
     let (trials, times) = par_trials(config, model, labels, |k| {
-        run_cell_trial(config, model, labels, k, progress)
+        let run = run_cell_trial_on(config, model, &truth, k, progress, &|_| {})?;
+        finished(k, &run.planner);
+        Ok((run.result, run.times))
     })?;
     Ok((
         CellStudyResult {
@@ -689,9 +708,24 @@ pub fn run_cell_study(
     inputs: &StudyInputs,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<(CellStudyResult, PhaseTimes)> {
+    run_cell_study_finished(config, inputs, progress, &|_, _| {})
+}
+
+/// [`run_cell_study`] handing every trial's planner after its last batch to `finished`
+/// ([`run_cell_trials_finished`]; `cargo xtask study --cell continuous --save-state`).
+///
+/// # Errors
+/// As [`super::run_study`].
+pub fn run_cell_study_finished(
+    config: &StudyConfig,
+    inputs: &StudyInputs,
+    progress: &(dyn Fn(Progress) + Sync),
+    finished: &(dyn Fn(usize, &Planner) + Sync),
+) -> Result<(CellStudyResult, PhaseTimes)> {
     let (model, alignment) = fit_study_model(config, inputs)?;
     let labels = inputs.reference_labels(&model)?;
-    let (result, mut times) = run_cell_trials(config, &model, &labels, progress)?;
+    let (result, mut times) =
+        run_cell_trials_finished(config, &model, &labels, progress, finished)?;
     times.alignment = alignment;
     Ok((result, times))
 }

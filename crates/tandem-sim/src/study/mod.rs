@@ -15,7 +15,8 @@ mod trial;
 
 pub use cell::{
     CellCompletion, CellIteration, CellStudyResult, CellSummary, CellTrialResult, CellTrialRun,
-    Steady, run_cell_study, run_cell_trial, run_cell_trial_on, run_cell_trials, task_gap,
+    Steady, run_cell_study, run_cell_study_finished, run_cell_trial, run_cell_trial_on,
+    run_cell_trials, run_cell_trials_finished, task_gap,
 };
 pub use config::{Cell, StudyConfig, StudyOperator};
 pub use inputs::{StudyInputs, read_labels, reference_labels};
@@ -27,6 +28,7 @@ pub use record::{
 #[expect(deprecated, reason = "re-exported for one release at the public edge")]
 pub use record::PairStats;
 pub use run::{
-    PhaseTimes, Progress, RoundView, TrialRun, run_study, run_study_observed, run_trial,
-    run_trial_observed, run_trial_on, run_trials, run_trials_observed, trial_seed,
+    PhaseTimes, Progress, RoundView, TrialRun, run_study, run_study_finished, run_study_observed,
+    run_trial, run_trial_observed, run_trial_on, run_trials, run_trials_finished,
+    run_trials_observed, trial_seed,
 };

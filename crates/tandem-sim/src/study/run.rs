@@ -358,9 +358,28 @@ pub fn run_study_observed(
     progress: &(dyn Fn(Progress) + Sync),
     observe: &(dyn Fn(RoundView<'_>) + Sync),
 ) -> Result<(StudyResult, PhaseTimes)> {
+    run_study_finished(config, inputs, progress, observe, &|_, _| {})
+}
+
+/// [`run_study_observed`] handing every trial's planner after its last recorded round to
+/// `finished` (the trial, 0-based, and the planner: its model, confidence and the schedule
+/// the next round would run), from worker threads as the trials end, in no particular order
+/// (`cargo xtask study --save-state` saves them, so the study's last round can be replayed).
+/// The result is the same as without.
+///
+/// # Errors
+/// As [`run_study`].
+pub fn run_study_finished(
+    config: &StudyConfig,
+    inputs: &StudyInputs,
+    progress: &(dyn Fn(Progress) + Sync),
+    observe: &(dyn Fn(RoundView<'_>) + Sync),
+    finished: &(dyn Fn(usize, &Planner) + Sync),
+) -> Result<(StudyResult, PhaseTimes)> {
     let (model, alignment) = fit_study_model(config, inputs)?;
     let labels = inputs.reference_labels(&model)?;
-    let (result, mut times) = run_trials_observed(config, &model, &labels, progress, observe)?;
+    let (result, mut times) =
+        run_trials_finished(config, &model, &labels, progress, observe, finished)?;
     times.alignment = alignment;
     Ok((result, times))
 }
@@ -412,8 +431,34 @@ pub fn run_trials_observed(
     progress: &(dyn Fn(Progress) + Sync),
     observe: &(dyn Fn(RoundView<'_>) + Sync),
 ) -> Result<(StudyResult, PhaseTimes)> {
+    run_trials_finished(
+        config,
+        model,
+        reference_labels,
+        progress,
+        observe,
+        &|_, _| {},
+    )
+}
+
+/// [`run_trials_observed`] handing every trial's planner after its last round to `finished`
+/// ([`run_study_finished`]).
+///
+/// # Errors
+/// As [`run_trials`].
+pub fn run_trials_finished(
+    config: &StudyConfig,
+    model: &TaskModel,
+    reference_labels: &[Label],
+    progress: &(dyn Fn(Progress) + Sync),
+    observe: &(dyn Fn(RoundView<'_>) + Sync),
+    finished: &(dyn Fn(usize, &Planner) + Sync),
+) -> Result<(StudyResult, PhaseTimes)> {
+    let truth = SandingTruth::new(reference_labels.to_vec(), config.task.clone());
     let (trials, times) = par_trials(config, model, reference_labels, |k| {
-        run_trial_observed(config, model, reference_labels, k, progress, observe)
+        let run = run_trial_on(config, model, &truth, k, progress, observe)?;
+        finished(k, &run.planner);
+        Ok((run.result, run.times))
     })?;
     Ok((
         StudyResult {
