@@ -540,19 +540,27 @@ fn markdown(file: &ZooFile) -> String {
              schedule it found without margins above the bound; 0 when the bound is its proven \
              optimum), `margins` the rest, what the worst-case margins between the robots' \
              low-confidence stretches and the waits of release rules cost, plus what the \
-             scheduler did not find. They add up to the gap.\n\n\
-             | family | N | gap % | search | margins | seeds with a proven bound |\n\
-             |---|---|---|---|---|---|\n",
+             scheduler did not find. They add up to the gap. `of it unavoidable` is the part \
+             of `margins` that no valid schedule avoids: every switch between the two robots' \
+             low-confidence runs charged the margin check's least step \
+             (`tandem_schedule::switch_charged_bound`; two robots without hold points; the \
+             seeds measured in brackets, — for none).\n\n\
+             | family | N | gap % | search | margins | of it unavoidable | seeds with a proven bound |\n\
+             |---|---|---|---|---|---|---|\n",
         );
         for r in &file.family_rows {
             if let Some((search, margins)) = r.gap_split_pct {
+                let unavoidable = r
+                    .unavoidable_pct
+                    .map_or_else(|| "—".to_string(), |(u, n)| format!("{} ({n})", num(u, 1)));
                 s.push_str(&format!(
-                    "| {} | {} | {} | {} | {} | {} of {} |\n",
+                    "| {} | {} | {} | {} | {} | {} | {} of {} |\n",
                     r.family,
                     r.robots,
                     num(r.gap_pct, 1),
                     num(search, 1),
                     num(margins, 1),
+                    unavoidable,
                     r.bound_proven,
                     r.seeds,
                 ));

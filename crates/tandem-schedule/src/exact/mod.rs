@@ -502,6 +502,93 @@ pub fn margin_free_bound(
     Ok(bound)
 }
 
+/// A two-robot lower bound that charges every switch between the robots' LC runs its least
+/// margin ([`switch_charged_bound`]); all times in seconds of global (schedule-clock) time.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SwitchCharged {
+    /// The bound (s): no schedule of two robots that [`crate::validate`] accepts at the tick
+    /// it was computed for has a smaller `T_total` (up to `tol::BOUND_REL`). Never below
+    /// [`SwitchCharged::margin_free_s`].
+    pub lower_bound_s: f64,
+    /// The margin-free bound of [`solve_exact`] (s): `T*₀` when the search finished.
+    pub margin_free_s: f64,
+    /// The least room (s) every switch was charged: `M = tick · max(1, largest ψ̇̄/ψ̇min of an
+    /// LC sample)`, the least step of the margin check (0 when [`SwitchCharged::charged`] is
+    /// `false`).
+    pub charge_s: f64,
+    /// Whether the switches were charged: `false` for a problem with usable hold points (its
+    /// schedules are checked by the lead bound on legs with release rules, for which the
+    /// argument below is not made), without LC runs, or when a search ran out of its budget;
+    /// the bound is then [`SwitchCharged::margin_free_s`].
+    pub charged: bool,
+}
+
+/// The margin-free bound of two robots ([`solve_exact`]) raised by what the margin check
+/// (Eq. 20 constraint 5, `tandem_realtime::sufficient_margins`) makes every switch cost at
+/// control tick `tick_s` (s): the same dynamic program with a clearance of `M` (schedule-clock
+/// s, `tick_s · max(1, largest ψ̇̄/ψ̇min of an LC sample)`) between an LC run of one robot and
+/// the other robot's LC run right before it, except robot 2's first run after a run of robot 1
+/// that ended by robot 2's start (docs/decisions.md, "A bound that charges every switch its
+/// least margin (issue 38)").
+///
+/// **Why it is a lower bound** on every two-robot schedule without usable holds that the
+/// margin check accepts at `tick_s`. Take two consecutive LC intervals of different robots, `p`
+/// ending at `T_p` and `c` starting at `T_c`. The check either accepts the pair before
+/// simulating it — only when `p` left it by the later robot's start, which makes it robot 1's
+/// run before robot 2's first — or simulates both clocks from their starts and accepts only
+/// after a step with `t_p ≥ T_p + ε` and `t_c + M_pc < T_c − ε` (`ε > 0`, `M_pc` the larger
+/// largest step of the two robots, `≥ M` since an LC sample runs at `ψ̇̄` and `ψ̇min ≤ ψ̇̄`).
+/// The simulated lead `t_c − t_p` starts at 0 (or at a step when `c` is the earlier robot)
+/// and never becomes negative: with rates `S ≤ 1 ≤ F`, `c` rushing leaves `p` at or behind it,
+/// `p` dragging leaves `c` at or ahead of it, and `HIGH-CONF` lands both on one pace no
+/// further than the nearer robot's fastest reach, which the robot behind cannot overshoot. So
+/// `T_c > T_p + M + 2ε`: every switch but the exception keeps a clearance of at least `M`, and
+/// the schedule is a feasible point of the margin-free problem with that clearance, whose
+/// optimum (the search is exact for any clearance table; `τ ≤ |ψ_E1|` is left out, a
+/// relaxation) is at most its `T_total`. The margin-free bound bounds it too, so the maximum
+/// of the two does.
+///
+/// # Errors
+/// [`Error::BadParam`] for invalid parameters or a `tick_s` not finite and > 0.
+pub fn switch_charged_bound(
+    problem: &Problem,
+    params: &ExactParams,
+    tick_s: f64,
+) -> Result<SwitchCharged> {
+    params.validate()?;
+    if !(tick_s.is_finite() && tick_s > 0.0) {
+        return Err(Error::BadParam {
+            name: "tick_s",
+            why: "must be finite and > 0 (the control tick in seconds)",
+        });
+    }
+    let free = bound_switch(problem, params, 0.0).lower_bound_s;
+    let plain = SwitchCharged {
+        lower_bound_s: free,
+        margin_free_s: free,
+        charge_s: 0.0,
+        charged: false,
+    };
+    let chain = chain::Chain::new(problem);
+    if !problem.usable_holds().is_empty() || chain.n_lc() == 0 {
+        return Ok(plain);
+    }
+    // The check's step is `tick · F` with `F` at the schedule's gradient of an LC sample, the
+    // mean up to `tol::GRADIENT_REL`: charge that much less.
+    let charge_s =
+        crate::choose::max_step_s(problem, tick_s) * (1.0 - tandem_realtime::tol::GRADIENT_REL);
+    let clear = search::Clearance::uniform(charge_s, Some(0.0));
+    match search::search(&chain, &clear, f64::INFINITY, params.max_pieces).0 {
+        search::Outcome::Done(Some(found)) => Ok(SwitchCharged {
+            lower_bound_s: found.t_total_s.max(free),
+            margin_free_s: free,
+            charge_s,
+            charged: true,
+        }),
+        _ => Ok(plain),
+    }
+}
+
 /// The certificate of the scheduler for `n_robots ≠ 2` robots: [`operator_bound_s`], marked
 /// as the optimum for one robot (the fastest execution is then both bound and schedule).
 pub(crate) fn operator_bound(problem: &Problem, n_robots: usize) -> MarginFree {

@@ -42,6 +42,14 @@ pub struct RunReport {
     /// (`Outcome::gap_split`). Rounds only; `None` for a cell and in reports saved before it.
     #[serde(default)]
     pub margin_free_s: Option<f64>,
+    /// The last plan's bound that charges every switch between the two robots' low-confidence
+    /// runs its least margin (s, `tandem_schedule::switch_charged_bound` at the plan's tick): no
+    /// schedule the margin check accepts is shorter, so `T_total` above it is what the
+    /// completion did not find, and it above [`RunReport::margin_free_s`] is what the margins
+    /// cost every schedule. Rounds of two robots on a problem without usable hold points only;
+    /// `None` otherwise and in reports saved before it.
+    #[serde(default)]
+    pub switch_charged_s: Option<f64>,
     /// The serial schedule's `T_total` on the last plan's problem (`N` fastest executions one
     /// after the other, `Problem::serial_schedule_n`).
     pub serial_s: f64,
@@ -123,6 +131,28 @@ impl RunReport {
             100.0 * (self.final_t_s() - free) / self.bound_s,
         ))
     }
+
+    /// The part of the margins' share of [`RunReport::gap_split_pct`] that no valid schedule
+    /// avoids, percent of the bound: `(switch_charged − margin_free)/bound`. `None` without
+    /// [`RunReport::switch_charged_s`] or [`RunReport::margin_free_s`].
+    #[must_use]
+    pub fn unavoidable_pct(&self) -> Option<f64> {
+        let free = self.margin_free_s?;
+        let charged = self.switch_charged_s?;
+        Some(100.0 * (charged - free) / self.bound_s)
+    }
+}
+
+/// [`RunReport::switch_charged_s`] of the planner's last problem at control tick `tick_s` (s).
+fn switch_charged_s(planner: &Planner, robots: usize, tick_s: f64) -> Option<f64> {
+    if robots != 2 {
+        return None;
+    }
+    let exact = tandem_schedule::ExactParams::default();
+    tandem_schedule::switch_charged_bound(planner.problem(), &exact, tick_s)
+        .ok()
+        .filter(|b| b.charged)
+        .map(|b| b.lower_bound_s)
 }
 
 /// Backward steps of the reference-time logs: `(count, largest decrease)`.
@@ -271,6 +301,7 @@ pub fn run_rounds(
         bound_s: last.lower_bound_s,
         bound_is_optimum: last.bound_is_optimum,
         margin_free_s: run.planner.outcome().margin_free_s,
+        switch_charged_s: switch_charged_s(&run.planner, robots, tick_s),
         serial_s: last_serial,
         truth_high_pct: prep.report.truth_high_pct,
         falsely_trusted,
@@ -340,6 +371,7 @@ pub fn run_continuous(
         bound_s: last.lower_bound_s,
         bound_is_optimum: false,
         margin_free_s: None,
+        switch_charged_s: None,
         serial_s: serial_s(&run.planner)?,
         truth_high_pct: prep.report.truth_high_pct,
         falsely_trusted,
@@ -387,6 +419,7 @@ mod tests {
             bound_s: bound,
             bound_is_optimum: margin_free.is_some(),
             margin_free_s: margin_free,
+            switch_charged_s: None,
             serial_s: 2.0 * t_total,
             truth_high_pct: 60.0,
             falsely_trusted: 0,
@@ -433,6 +466,30 @@ mod tests {
         let (search, margins) = rows[0].gap_split_pct.unwrap();
         assert!((search - 2.5).abs() < 1e-12 && (margins - 12.5).abs() < 1e-12);
         assert_eq!(rows[0].bound_proven, 2);
+        assert_eq!(rows[0].unavoidable_pct, None);
+    }
+
+    #[test]
+    fn the_unavoidable_part_of_the_margins() {
+        // Bound 10 s, margin-free 10 s, charged switches 10.8 s, T_total 12 s: of the 20 %
+        // margins, 8 % no valid schedule avoids.
+        let mut a = run(12.0, 10.0, Some(10.0));
+        a.switch_charged_s = Some(10.8);
+        assert!((a.unavoidable_pct().unwrap() - 8.0).abs() < 1e-12);
+        let mut b = run(12.0, 10.0, Some(10.0));
+        b.switch_charged_s = Some(10.4);
+        let c = run(12.0, 10.0, Some(10.0));
+        assert_eq!(c.unavoidable_pct(), None);
+        let report = crate::eval::ZooReport {
+            params: crate::eval::EvalParams::default(),
+            families: vec!["f".into()],
+            fits: Vec::new(),
+            runs: vec![a, b, c],
+        };
+        let (u, n) = crate::eval::family_rows(&report)[0]
+            .unavoidable_pct
+            .unwrap();
+        assert!((u - 6.0).abs() < 1e-12 && n == 2);
     }
 
     #[test]

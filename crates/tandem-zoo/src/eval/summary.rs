@@ -33,6 +33,11 @@ pub struct FamilyRow {
     /// report).
     #[serde(default)]
     pub gap_split_pct: Option<(f64, f64)>,
+    /// Of the margins' share, what no valid schedule avoids: the mean over the seeds that
+    /// measured it of `RunReport::unavoidable_pct` (percent of the bound), with their number;
+    /// `None` when none did (holds, a cell, three or more robots, an old report).
+    #[serde(default)]
+    pub unavoidable_pct: Option<(f64, usize)>,
     /// Seeds whose bound is the proven margin-free optimum (rounds).
     #[serde(default)]
     pub bound_proven: usize,
@@ -175,6 +180,10 @@ fn row(family: String, robots: usize, cell: Cell, runs: &[&RunReport]) -> Family
                     mean(split.iter().map(|s| s.1)),
                 )
             })
+        },
+        unavoidable_pct: {
+            let u: Vec<f64> = runs.iter().filter_map(|r| r.unavoidable_pct()).collect();
+            (!u.is_empty()).then(|| (mean(u.iter().copied()), u.len()))
         },
         bound_proven: runs.iter().filter(|r| r.bound_is_optimum).count(),
         over_serial: m(&|r| r.final_t_s() / r.serial_s),
