@@ -6,6 +6,7 @@ use std::sync::Arc;
 use rand::Rng;
 
 use super::groups::{Group, Token, groups, token_sequence};
+use super::pace::Pace;
 use crate::adversary::{Adversary, AdversaryRun};
 use crate::contract::{Controller, Operator, Tick, check_tick};
 use crate::cursor::{Cursors, operator_step};
@@ -83,6 +84,9 @@ pub struct ContinuousCoordinator {
     /// which it left (`None`: nobody yet). Another robot's token lets it pass its gate only
     /// from tick `left + k` on (carried over by a hand-over).
     last_left: Option<(usize, u64)>,
+    /// The operator's load cap at run time, the token's pace (`None`: no cap;
+    /// [`ContinuousCoordinator::with_max_busy_share`]; carried over by a hand-over).
+    pace: Option<Pace>,
     /// The pre-alert's tables of the task ([`crate::prealert`]).
     reach: Arc<Reach>,
     /// Per reference sample, the group its low-confidence sample belongs to (unused on
@@ -174,6 +178,7 @@ impl ContinuousCoordinator {
             monitor: Monitor::new(n_robots),
             switch_ticks: 0,
             last_left: None,
+            pace: None,
             reach: Arc::new(reach),
             group_of: group_of.into(),
         };
@@ -202,6 +207,53 @@ impl ContinuousCoordinator {
         self.switch_ticks
     }
 
+    /// The same cell with the operator's load cap `max_busy_share` (`u_max` in `(0, 1]`,
+    /// `tandem_schedule::SamplerParams::max_busy_share`), reset to the start: the token paces
+    /// the operator so that its busy share — the ticks with a low-confidence robot plus `k`
+    /// ticks per change of robot — is at most `u_max` over every window of whole passes
+    /// through the token sequence (the plan's cycle; and over every prefix of a pass that ends
+    /// where the token's robot may start waiting for its gate), for any operator. After a robot
+    /// leaves its group, the next one passes its gate no sooner than `n` ticks after the pass
+    /// began, `n` the least with `B ≤ u_max·n` for the pass's `B` busy ticks so far (plus the
+    /// switch time if it is another robot): docs/decisions.md, "The load cap at run time: the
+    /// token's pace (issue 41)". `1` changes nothing.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for a `max_busy_share` not in `(0, 1]`.
+    pub fn with_max_busy_share(mut self, max_busy_share: f64) -> Result<ContinuousCoordinator> {
+        if !(max_busy_share > 0.0 && max_busy_share <= 1.0) {
+            return Err(Error::BadParam {
+                name: "max_busy_share",
+                why: "must be in (0, 1]: the operator's busy share cap (1: no cap)",
+            });
+        }
+        self.pace = (max_busy_share < 1.0).then(|| Pace::new(max_busy_share));
+        self.reset();
+        Ok(self)
+    }
+
+    /// The operator's load cap `u_max` ([`ContinuousCoordinator::with_max_busy_share`]; 1: none).
+    pub fn max_busy_share(&self) -> f64 {
+        self.pace.map_or(1.0, |p| p.cap())
+    }
+
+    /// The first tick (index: ticks since the start) of the operator's current episode under
+    /// the load cap ([`ContinuousCoordinator::with_max_busy_share`]): the token's robot waits
+    /// for its gate from there (and the switch time after it, if it is another robot than the
+    /// one that left a group last). May lie ahead of [`ticks`](Self::ticks) (the operator's
+    /// pause). `None` without a cap.
+    pub fn episode_start(&self) -> Option<u64> {
+        self.pace.map(|p| p.start())
+    }
+
+    /// The first tick of the load cap's current accounting window (a pass through the token
+    /// sequence, begun at an episode start): from there to every later
+    /// [`episode_start`](Self::episode_start) the busy share is at most the cap. `None` without
+    /// a cap.
+    pub fn pace_window_start(&self) -> Option<u64> {
+        self.pace.map(|p| p.segment())
+    }
+
     /// Whether robot `i` holds the token for its next group and may pass its gate in tick
     /// `tick` (the index of a tick: [`Monitor::ticks`] at its start): the token is its, and
     /// either no other robot left a group fewer than `k` ticks before.
@@ -213,6 +265,9 @@ impl ContinuousCoordinator {
     /// Ticks robot `i` must still wait at tick index `tick` before the token may let it pass
     /// (the switch time after another robot left its group; 0 without one).
     fn switch_wait(&self, i: usize, tick: u64) -> u64 {
+        if let Some(p) = &self.pace {
+            return p.wait(self.last_left, i, self.switch_ticks, tick);
+        }
         match self.last_left {
             Some((r, left)) if self.switch_ticks > 0 && r != i => {
                 (left + self.switch_ticks).saturating_sub(tick)
@@ -359,6 +414,9 @@ impl ContinuousCoordinator {
         self.stamp = rank;
         self.monitor.reset();
         self.last_left = None;
+        if let Some(p) = &mut self.pace {
+            p.reset();
+        }
     }
 
     /// Number of robots `N`.
@@ -540,16 +598,27 @@ impl ContinuousCoordinator {
             }
             self.clock_s[i] = s_new;
         }
+        if let Some(p) = &mut self.pace {
+            p.observe(out.low_conf.count() > 0);
+        }
         // The token moves once its robot has left its group.
         if let Some(t) = tok {
             let (r, g) = (t.robot, t.group);
             let s = self.clock_s[r];
             if self.next_group[r] == g && (s >= end_s || s - self.tol_s >= self.leave_s[g]) {
+                // The episode's gate waited the switch time iff its robot is not the one that
+                // left a group before (`switch_wait`).
+                let switched = self.last_left.is_some_and(|(q, _)| q != r);
                 self.last_left = Some((r, this_tick + 1));
                 self.next_group[r] = g + 1;
                 self.served[r] = self.stamp;
                 self.stamp += 1;
+                let passes = self.passes;
                 self.advance_token();
+                if let Some(p) = &mut self.pace {
+                    let switch = if switched { self.switch_ticks } else { 0 };
+                    p.end_episode(this_tick + 1, switch, self.passes > passes);
+                }
             }
         }
         let tok = self.token();
@@ -741,6 +810,14 @@ impl ContinuousCoordinator {
         // The switch time runs on across the hand-over: the robot that last left a group, and
         // when, are the old cell's.
         self.last_left = old.last_left;
+        // The load cap's episode runs on too (from the start of the next one when the old cell
+        // had no cap).
+        if let Some(p) = &mut self.pace {
+            match &old.pace {
+                Some(o) => p.carry_over(o),
+                None => p.reset(),
+            }
+        }
         Ok(())
     }
 
