@@ -108,6 +108,11 @@ enum Cmd {
         /// apart. 0 (default): the run without it, unchanged.
         #[arg(long, default_value_t = 0.0)]
         switch_s: f64,
+        /// With `--cell continuous`: the operator's load cap u_max in (0, 1] (issue 41): the
+        /// plans keep it (`CyclicParams::max_busy_share`) and the token paces the operator to it
+        /// (`ContinuousCoordinator::with_max_busy_share`). 1 (default): none.
+        #[arg(long, default_value_t = 1.0)]
+        max_busy: f64,
         /// Random problems to draw (default: one per 1000 executions, 1–200): more problems
         /// with fewer executions each for a reduced batch.
         #[arg(long)]
@@ -130,13 +135,25 @@ fn main() -> anyhow::Result<()> {
             cell,
             tasks,
             switch_s,
+            max_busy,
             problems,
         } => {
             if !(switch_s.is_finite() && switch_s >= 0.0) {
                 anyhow::bail!("--switch-s must be finite and ≥ 0 (seconds), got {switch_s}");
             }
+            if !(max_busy > 0.0 && max_busy <= 1.0) {
+                anyhow::bail!(
+                    "--max-busy must be in (0, 1] (the operator's busy share cap), got {max_busy}"
+                );
+            }
             if cell == "continuous" {
-                stress::run_continuous(executions, seed, robots, tasks, switch_s, problems)
+                stress::run_continuous(
+                    executions, seed, robots, tasks, switch_s, max_busy, problems,
+                )
+            } else if max_busy < 1.0 {
+                anyhow::bail!(
+                    "--max-busy is for --cell continuous (the rounds stress runs tight schedules at the margin check's edge, which has no load cap)"
+                )
             } else {
                 stress::run(executions, seed, robots, holds, switch_s, problems)
             }

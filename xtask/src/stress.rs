@@ -46,7 +46,9 @@
 //! token waits it (`ContinuousCoordinator::with_switch_s`). Each execution's shortest switch
 //! is measured on the ticks the robots traversed (`AdversaryRun::min_switch_gap_ticks`; the
 //! beam search measures none), and the run fails if one is shorter than
-//! `k = switch_ticks(δ, tick)`.
+//! `k = switch_ticks(δ, tick)`. `--max-busy U` (continuous cell) adds the operator's load cap:
+//! the plans keep it and the token paces the operator to it
+//! (`ContinuousCoordinator::with_max_busy_share`), so the same checks run on the paced cell.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -600,6 +602,7 @@ fn make_cell_case(
     n_robots: usize,
     tasks: u64,
     switch_s: f64,
+    max_busy: f64,
 ) -> anyhow::Result<CellCase> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x00c0_ffee);
     rng.set_stream(index);
@@ -622,12 +625,14 @@ fn make_cell_case(
     let tick_s = dt_s * rng.random_range(0.25..=1.0);
     let params = CyclicParams {
         switch_s,
+        max_busy_share: max_busy,
         ..CyclicParams::default()
     };
     let plan = cyclic_plan(&problem, n_robots, &params)?;
     let cell = plan
         .coordinator(&problem, tick_s)?
-        .with_switch_s(switch_s)?;
+        .with_switch_s(switch_s)?
+        .with_max_busy_share(max_busy)?;
     let grad_range = [
         problem
             .grad_min()
@@ -652,7 +657,10 @@ fn make_cell_case(
     let per_task = slow_s / tick_s
         + problem.n_ref() as f64
         + (cell.groups().len() as u64 * cell.switch_ticks()) as f64;
-    let max_ticks = ((tasks + 2) as f64 * n_robots as f64 * per_task) as u64 + 1000;
+    // The load cap's pauses stretch the run by at most 1/u_max: a pass lasts at most the longer
+    // of its run without pauses and n(B) ≤ B/u_max + 1 ticks, its busy ticks B at most the
+    // ticks it ran.
+    let max_ticks = ((tasks + 2) as f64 * n_robots as f64 * per_task / max_busy) as u64 + 1000;
     Ok(CellCase {
         adversaries: adversary_set(
             n_robots,
@@ -676,6 +684,7 @@ pub(crate) fn run_continuous(
     n_robots: usize,
     tasks: u64,
     switch_s: f64,
+    max_busy: f64,
     problems: Option<u64>,
 ) -> anyhow::Result<()> {
     if executions == 0 || tasks == 0 {
@@ -687,7 +696,7 @@ pub(crate) fn run_continuous(
     let cases: Vec<CellCase> = (0..n_problems)
         .into_par_iter()
         .map(|i| {
-            make_cell_case(seed, i, n_robots, tasks, switch_s)
+            make_cell_case(seed, i, n_robots, tasks, switch_s, max_busy)
                 .with_context(|| format!("planning problem {i}"))
         })
         .collect::<anyhow::Result<_>>()?;
@@ -696,9 +705,14 @@ pub(crate) fn run_continuous(
     families.dedup();
     let mean_plan = cases.iter().map(|c| c.plan_per_h).sum::<f64>() / cases.len() as f64;
     println!(
-        "stress --cell continuous: {n_robots} robots, {n_problems} random problems ({}), cyclic plans of {:.1} tasks/h on average; planning took {:.1} s",
+        "stress --cell continuous: {n_robots} robots, {n_problems} random problems ({}), cyclic plans of {:.1} tasks/h on average{}; planning took {:.1} s",
         families.join(", "),
         mean_plan,
+        if max_busy < 1.0 {
+            format!(" (load cap {max_busy}, paced)")
+        } else {
+            String::new()
+        },
         start.elapsed().as_secs_f64()
     );
     let set_size = cases[0].adversaries.len() as u64;

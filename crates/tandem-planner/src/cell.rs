@@ -309,7 +309,8 @@ impl Planner {
     /// control tick of the schedule's `tick_s` per tick, with the operator's switch time of
     /// the planner's parameters (`params().sampler.switch_s`): rounds wait it at a hold with
     /// release rules (it is [`Planner::coordinator`]), a continuous cell's token passes to
-    /// another robot no sooner than that after a stretch ended.
+    /// another robot no sooner than that after a stretch ended, and paces the operator to the
+    /// load cap `params().sampler.max_busy_share` (`ContinuousCoordinator::with_max_busy_share`).
     ///
     /// # Errors
     /// As [`Planner::plan`].
@@ -317,7 +318,10 @@ impl Planner {
         let switch_s = self.params().sampler.switch_s;
         Ok(match self.plan(cell)?.controller()? {
             AnyController::Rounds(c) => AnyController::Rounds(c.with_switch_s(switch_s)?),
-            AnyController::Continuous(c) => AnyController::Continuous(c.with_switch_s(switch_s)?),
+            AnyController::Continuous(c) => AnyController::Continuous(
+                c.with_switch_s(switch_s)?
+                    .with_max_busy_share(self.params().sampler.max_busy_share)?,
+            ),
         })
     }
 

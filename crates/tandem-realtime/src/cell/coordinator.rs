@@ -6,6 +6,7 @@ use std::sync::Arc;
 use rand::Rng;
 
 use super::groups::{Group, Token, groups, token_sequence};
+use super::pace::Pace;
 use crate::adversary::{Adversary, AdversaryRun};
 use crate::contract::{Controller, Operator, Tick, check_tick};
 use crate::cursor::{Cursors, operator_step};
@@ -100,6 +101,9 @@ pub struct ContinuousCoordinator {
     monitor: Monitor,
     /// `k`: the operator's switch time in whole ticks ([`crate::switch_ticks`]; 0: none).
     switch_ticks: u64,
+    /// The operator's load cap at run time, the token's pace (`None`: no cap;
+    /// [`ContinuousCoordinator::with_max_busy_share`]; carried over by a hand-over).
+    pace: Option<Pace>,
     /// The pre-alert's tables of the task ([`crate::prealert`]).
     reach: Arc<Reach>,
     /// Per reference sample, the group its low-confidence sample belongs to (unused on
@@ -192,6 +196,7 @@ impl ContinuousCoordinator {
             stamp: 0,
             monitor: Monitor::new(n_robots),
             switch_ticks: 0,
+            pace: None,
             reach: Arc::new(reach),
             group_of: group_of.into(),
         };
@@ -226,8 +231,15 @@ impl ContinuousCoordinator {
     /// ([`tick_many`](Self::tick_many)) sets its rate (module docs, [`crate::cell`]). The
     /// switch time is per operator. `M = 1` is the one-operator cell, bit for bit.
     #[must_use]
+    ///
+    /// The run-time load cap ([`with_max_busy_share`](Self::with_max_busy_share)) paces one
+    /// operator only: with `M > 1` it is dropped ([`max_busy_share`](Self::max_busy_share)
+    /// reads 1 then) and setting it afterwards is refused.
     pub fn with_operators(mut self, operators: crate::OperatorCount) -> ContinuousCoordinator {
         self.m = operators.get();
+        if self.m > 1 {
+            self.pace = None;
+        }
         self.monitor = self.monitor.with_operators(self.m);
         self.reset();
         self
@@ -243,9 +255,65 @@ impl ContinuousCoordinator {
         self.staff.assigned[i].is_some()
     }
 
+    /// The same cell with the operator's load cap `max_busy_share` (`u_max` in `(0, 1]`,
+    /// `tandem_schedule::SamplerParams::max_busy_share`), reset to the start: the token paces
+    /// the operator so that its busy share — the ticks with a low-confidence robot plus `k`
+    /// ticks per change of robot — is at most `u_max` over every window of whole passes
+    /// through the token sequence (the plan's cycle; and over every prefix of a pass that ends
+    /// where the token's robot may start waiting for its gate), for any operator. After a robot
+    /// leaves its group, the next one passes its gate no sooner than `n` ticks after the pass
+    /// began, `n` the least with `B ≤ u_max·n` for the pass's `B` busy ticks so far (plus the
+    /// switch time if it is another robot): docs/decisions.md, "The load cap at run time: the
+    /// token's pace (issue 41)". `1` changes nothing.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] for a `max_busy_share` not in `(0, 1]`.
+    pub fn with_max_busy_share(mut self, max_busy_share: f64) -> Result<ContinuousCoordinator> {
+        if !(max_busy_share > 0.0 && max_busy_share <= 1.0) {
+            return Err(Error::BadParam {
+                name: "max_busy_share",
+                why: "must be in (0, 1]: the operator's busy share cap (1: no cap)",
+            });
+        }
+        if self.m > 1 && max_busy_share < 1.0 {
+            return Err(Error::BadParam {
+                name: "max_busy_share",
+                why: "the run-time load cap paces one operator; a cell of several operators has none yet (issue 44)",
+            });
+        }
+        self.pace = (max_busy_share < 1.0).then(|| Pace::new(max_busy_share));
+        self.reset();
+        Ok(self)
+    }
+
+    /// The operator's load cap `u_max` ([`ContinuousCoordinator::with_max_busy_share`]; 1: none).
+    pub fn max_busy_share(&self) -> f64 {
+        self.pace.map_or(1.0, |p| p.cap())
+    }
+
+    /// The first tick (index: ticks since the start) of the operator's current episode under
+    /// the load cap ([`ContinuousCoordinator::with_max_busy_share`]): the token's robot waits
+    /// for its gate from there (and the switch time after it, if it is another robot than the
+    /// one that left a group last). May lie ahead of [`ticks`](Self::ticks) (the operator's
+    /// pause). `None` without a cap.
+    pub fn episode_start(&self) -> Option<u64> {
+        self.pace.map(|p| p.start())
+    }
+
+    /// The first tick of the load cap's current accounting window (a pass through the token
+    /// sequence, begun at an episode start): from there to every later
+    /// [`episode_start`](Self::episode_start) the busy share is at most the cap. `None` without
+    /// a cap.
+    pub fn pace_window_start(&self) -> Option<u64> {
+        self.pace.map(|p| p.segment())
+    }
+
     /// Ticks operator `o` must still wait at tick index `tick` before it may be granted to
     /// robot `i` (the switch time after it released another robot; 0 without one).
     fn op_wait(&self, o: usize, i: usize, tick: u64) -> u64 {
+        if let Some(p) = &self.pace {
+            return p.wait(self.staff.last_left[o], i, self.switch_ticks, tick);
+        }
         match self.staff.last_left[o] {
             Some((r, left)) if self.switch_ticks > 0 && r != i => {
                 (left + self.switch_ticks).saturating_sub(tick)
@@ -431,6 +499,9 @@ impl ContinuousCoordinator {
         self.stamp = rank;
         self.monitor.reset();
         self.staff = Staff::default();
+        if let Some(p) = &mut self.pace {
+            p.reset();
+        }
         self.grant(0);
     }
 
@@ -669,21 +740,33 @@ impl ContinuousCoordinator {
             }
             self.clock_s[i] = s_new;
         }
+        if let Some(p) = &mut self.pace {
+            p.observe(out.low_conf.count() > 0);
+        }
         // An operator is released once its robot has left its group (operators in index
         // order; one operator: the token moves).
         for o in 0..self.m {
-            let Some((t, _, _)) = self.staff.slot[o] else {
+            let Some((t, _, entry_passes)) = self.staff.slot[o] else {
                 continue;
             };
             let (r, g) = (t.robot, t.group);
             let s = self.clock_s[r];
             if self.next_group[r] == g && (s >= end_s || s - self.tol_s >= self.leave_s[g]) {
+                // The episode's gate waited the switch time iff its robot is not the one
+                // the operator released before (`op_wait`).
+                let switched = self.staff.last_left[o].is_some_and(|(q, _)| q != r);
                 self.staff.last_left[o] = Some((r, this_tick + 1));
                 self.next_group[r] = g + 1;
                 self.served[r] = self.stamp;
                 self.stamp += 1;
                 self.staff.slot[o] = None;
                 self.staff.assigned[r] = None;
+                // The load cap (one operator): the pass ended iff the grant of this entry
+                // wrapped the token sequence (`advance_token` at the grant).
+                if let Some(p) = &mut self.pace {
+                    let switch = if switched { self.switch_ticks } else { 0 };
+                    p.end_episode(this_tick + 1, switch, self.passes > entry_passes);
+                }
             }
         }
         for i in 0..n {
@@ -885,6 +968,14 @@ impl ContinuousCoordinator {
             ..Staff::default()
         };
         self.grant(self.monitor.ticks());
+        // The load cap's episode runs on too (from the start of the next one when the old cell
+        // had no cap).
+        if let Some(p) = &mut self.pace {
+            match &old.pace {
+                Some(o) => p.carry_over(o),
+                None => p.reset(),
+            }
+        }
         Ok(())
     }
 

@@ -120,6 +120,7 @@ mod coordinator;
 mod groups;
 #[cfg(test)]
 mod liveness;
+mod pace;
 
 #[allow(deprecated)]
 pub use coordinator::{CellRun, CellTick};

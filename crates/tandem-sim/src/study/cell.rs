@@ -31,6 +31,7 @@ use serde::{Deserialize, Serialize};
 use tandem_lfd::TaskModel;
 use tandem_planner::{ExecutionRecord, Planner};
 use tandem_realtime::Timeline;
+use tandem_realtime::cell::ContinuousCoordinator;
 use tandem_schedule::{CheckedCyclicPlan, CyclicParams};
 
 use super::config::StudyConfig;
@@ -360,6 +361,17 @@ impl CellStudyResult {
     }
 }
 
+/// The run-time coordinator of the cell's `plan` with the planner's operator (issue 41): the
+/// token waits the switch time `switch_s` after another robot's group and paces the operator to
+/// the load cap `max_busy_share` (both no-ops at their defaults, 0 and 1).
+fn coordinator_of(planner: &Planner, plan: &CheckedCyclicPlan) -> Result<ContinuousCoordinator> {
+    let sampler = &planner.params().sampler;
+    Ok(plan
+        .coordinator()
+        .with_switch_s(sampler.switch_s)?
+        .with_max_busy_share(sampler.max_busy_share)?)
+}
+
 /// The cell's plan on the planner's problem and its record: the planner's plan of a
 /// continuous cell (`Planner::cyclic_plan`, what `Planner::plan` gives: the token rule's hand-overs counted at the schedule's
 /// tick, the cell's, so its period is what the cell does with the planned operator).
@@ -507,7 +519,11 @@ impl<'a> ContinuousTrial<'a> {
         let (plan, first) = plan_of(planner, can_need, 0, 0)?;
         // The cell's tick: the plan's, the schedule's (`Δt_s` unless the sampler sets a tick).
         let dt_s = plan.tick_s();
-        let sim = CellSim::new(planner.model(), plan.coordinator(), &state.operator)?;
+        let sim = CellSim::new(
+            planner.model(),
+            coordinator_of(planner, &plan)?,
+            &state.operator,
+        )?;
         let needed = (0..n)
             .map(|_| state.truth.draw(&mut state.rng))
             .collect::<Result<Vec<_>>>()?;
@@ -622,7 +638,7 @@ impl TrialKind for ContinuousTrial<'_> {
         let planner = &state.planner;
         let tick = self.sim.stats().ticks;
         let (plan, iteration) = plan_of(planner, self.can_need, self.recorded, tick)?;
-        let next = plan.coordinator();
+        let next = coordinator_of(planner, &plan)?;
         state.times.scheduling += t.elapsed();
         if self.sim.replan(planner.model(), next)? {
             self.period_s = iteration.period_s;

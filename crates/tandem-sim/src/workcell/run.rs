@@ -90,14 +90,16 @@ pub fn run_round_with(
     params: &OperatorParams,
     rng: &mut impl Rng,
 ) -> Result<RoundRun> {
-    run_schedule(
-        planner.model(),
-        planner.problem(),
-        planner.schedule(),
-        needs,
-        params,
-        rng,
-    )
+    params.validate()?;
+    let (model, problem, schedule) = (planner.model(), planner.problem(), planner.schedule());
+    check_sizes(model, problem, schedule)?;
+    check_tick(schedule.tick_s, problem.dt_s())?;
+    // The planner's coordinator (issue 41): the schedule checked with the operator's switch
+    // time and load cap (`Planner::checked_schedule`: the relaxed constraint 2 lets a robot
+    // start after the others ended, which `Schedule::check` refuses), waiting the switch time
+    // at its holds. At switch time 0 and no cap it is `run_schedule`'s coordinator.
+    let coord = planner.coordinator()?;
+    run_coordinator(model, problem, coord, needs, params, rng)
 }
 
 /// Deprecated: [`run_round_with`] under its two-robot name. Kept for one release at the
@@ -158,8 +160,10 @@ pub(super) fn check_n_ref(
     Ok(())
 }
 
-/// [`run_round_with`] on the parts of a planner: `problem` must be the one `schedule` was
-/// made for, from `model`'s gradients (the unit tests build them by hand).
+/// [`run_round_with`] on the parts of a planner without an operator's switch time or load cap
+/// (`Schedule::check`, no hold wait): `problem` must be the one `schedule` was made for, from
+/// `model`'s gradients (the unit tests build them by hand).
+#[cfg(test)]
 pub(super) fn run_schedule(
     model: &TaskModel,
     problem: &Problem,
