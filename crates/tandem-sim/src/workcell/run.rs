@@ -90,14 +90,16 @@ pub fn run_round_with(
     params: &OperatorParams,
     rng: &mut impl Rng,
 ) -> Result<RoundRun> {
-    run_schedule(
-        planner.model(),
-        planner.problem(),
-        planner.schedule(),
-        needs,
-        params,
-        rng,
-    )
+    let (model, problem) = (planner.model(), planner.problem());
+    params.validate()?;
+    check_sizes(model, problem, planner.schedule())?;
+    check_tick(planner.schedule().tick_s, problem.dt_s())?;
+    // The planner's coordinator: checked at the planner's switch time and load cap (the
+    // schedule was planned with them; a check at δ = 0 would refuse the serial schedule's idle
+    // gap and accept switches shorter than δ) and waiting δ at its holds. At δ = 0 and
+    // u_max = 1 it is exactly `schedule.check(problem)?.coordinator()?`.
+    let coord = planner.coordinator()?;
+    run_coordinator(model, problem, coord, needs, params, rng)
 }
 
 /// Deprecated: [`run_round_with`] under its two-robot name. Kept for one release at the
@@ -159,7 +161,10 @@ pub(super) fn check_n_ref(
 }
 
 /// [`run_round_with`] on the parts of a planner: `problem` must be the one `schedule` was
-/// made for, from `model`'s gradients (the unit tests build them by hand).
+/// made for, from `model`'s gradients (the unit tests build them by hand). Checked at `δ = 0`
+/// and without a cap ([`Schedule::check`]): the planner's own rounds run
+/// [`Planner::coordinator`] instead ([`run_round_with`]).
+#[cfg(test)]
 pub(super) fn run_schedule(
     model: &TaskModel,
     problem: &Problem,
