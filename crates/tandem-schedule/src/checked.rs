@@ -4,7 +4,7 @@ use tandem_realtime::{Coordinator, Timeline};
 
 use crate::problem::Problem;
 use crate::schedule::Schedule;
-use crate::validate::{MarginCheck, validated_timeline_with};
+use crate::validate::validated_timeline_with_operator;
 use crate::{Error, Result};
 
 /// A [`Schedule`] that passed [`validate`](crate::validate) on one problem — every constraint
@@ -39,11 +39,18 @@ pub struct CheckedSchedule {
 }
 
 impl CheckedSchedule {
-    /// Checks `schedule` on `problem` ([`Schedule::check`]), constraint 2 relaxed by
-    /// `allowance_s` (s; 0: as printed, [`Schedule::check_with_operator`]).
-    pub(crate) fn new(problem: &Problem, schedule: Schedule, allowance_s: f64) -> Result<Self> {
+    /// Checks `schedule` on `problem` for an operator with switch time `switch_s` (s) and load
+    /// cap `max_busy_share` ([`Schedule::check_with_operator`];
+    /// [`validate_with_operator`](crate::validate_with_operator)); `0` and `1` are
+    /// [`Schedule::check`].
+    pub(crate) fn new(
+        problem: &Problem,
+        schedule: Schedule,
+        switch_s: f64,
+        max_busy_share: f64,
+    ) -> Result<Self> {
         let timeline =
-            validated_timeline_with(problem, &schedule, MarginCheck::SinglePass, allowance_s)
+            validated_timeline_with_operator(problem, &schedule, switch_s, max_busy_share)
                 .map_err(Error::Invalid)?;
         Ok(CheckedSchedule {
             schedule,

@@ -276,32 +276,31 @@ impl Schedule {
     /// # Errors
     /// [`Error::Invalid`] with the first broken constraint.
     pub fn check(&self, problem: &Problem) -> Result<crate::CheckedSchedule> {
-        crate::CheckedSchedule::new(problem, self.clone(), 0.0)
+        crate::CheckedSchedule::new(problem, self.clone(), 0.0, 1.0)
     }
 
     /// [`Schedule::check`] for a schedule planned for an operator with switch time `switch_s`
     /// (s, ≥ 0) and load cap `max_busy_share` (`SamplerParams::{switch_s, max_busy_share}`):
-    /// Eq. 20 constraint 2 relaxed by [`crate::start_allowance_s`] (a robot may start that long
-    /// after every robot before it has ended: the idle gaps of the serial schedule with a
-    /// switch time or a cap), everything else as [`Schedule::check`]. `switch_s = 0` with
-    /// `max_busy_share = 1` is [`Schedule::check`].
+    /// [`validate_with_operator`](crate::validate_with_operator) — Eq. 20 constraint 2 relaxed
+    /// by [`crate::start_allowance_s`] (a robot may start that long after every robot before it
+    /// has ended: the idle gaps of the serial schedule with a switch time or a cap), no planned
+    /// switch shorter than `switch_s` (3δ), and the margin check *with the switch time*
+    /// (`tandem_realtime::check_margins` at `switch_s`, 5δ), so a schedule that keeps the
+    /// operator's switch time only at `δ = 0` is refused. `switch_s = 0` with
+    /// `max_busy_share = 1` is [`Schedule::check`]. Run the coordinator with the same switch
+    /// time (`Coordinator::with_switch_s`): the check with holds assumes its wait.
     ///
     /// # Errors
-    /// As [`Schedule::check`].
+    /// As [`Schedule::check`]; [`Violation::SwitchTooShort`] or
+    /// [`Violation::InsufficientSwitchTime`] inside [`Error::Invalid`] for a schedule that does
+    /// not keep `switch_s`.
     pub fn check_with_operator(
         &self,
         problem: &Problem,
         switch_s: f64,
         max_busy_share: f64,
     ) -> Result<crate::CheckedSchedule> {
-        let allowance_s = crate::start_allowance_s(
-            problem,
-            self.n_robots(),
-            self.tick_s,
-            switch_s,
-            max_busy_share,
-        );
-        crate::CheckedSchedule::new(problem, self.clone(), allowance_s)
+        crate::CheckedSchedule::new(problem, self.clone(), switch_s, max_busy_share)
     }
 
     /// Start time of each robot in global time (s): `[0, τ_2, …, τ_N]`.
@@ -597,6 +596,59 @@ mod tests {
             tick_s: 0.5,
             holds: Vec::new(),
         }
+    }
+
+    /// The check of a schedule planned with a switch time runs the margin check *with* it
+    /// (regression: `check_with_operator` relaxed constraint 2 but checked margins at `δ = 0`,
+    /// and the study's workcell ran its rounds on that check). The fastest serial schedule of
+    /// [HC, LC, LC, HC] at 0.5 s (HC samples at `ψ̇min`, 0.25 s each, LC at 0.5 s; robot 1's
+    /// stretch [0.25, 1.25) s, robot 2 from 1.5 s, its stretch [1.75, 2.75) s: 0.5 s apart on
+    /// schedule) passes the check without a switch time. At `δ = 1` s the planned gap is short
+    /// (3δ). At `δ = 0.5` s (`k = 1` tick) the planned gap is enough but the worst case is not:
+    /// robot 2 starts in the tick robot 1 reaches its end, no tick is idle, and a robot's 0.25 s
+    /// head or tail fits in the tick that leaves or enters its stretch (5δ). Both fail only with
+    /// `δ` in the check. Robot 2 at 2.75 s (after the allowance's idle time: `⌈(2.75 − 1.5 −
+    /// M)/h⌉ = 1` idle tick with `M = h·F = 1` s) keeps `k` and passes at `δ`; constraint 2 as
+    /// printed refuses it.
+    #[test]
+    fn the_check_with_an_operator_keeps_its_switch_time() {
+        let p = problem();
+        let serial = p.serial_schedule(0.5).unwrap();
+        assert_eq!(serial.offsets_s, vec![1.5]);
+        serial.check(&p).unwrap();
+        serial.check_with_operator(&p, 0.0, 1.0).unwrap();
+        let short = serial.check_with_operator(&p, 1.0, 1.0).unwrap_err();
+        assert!(
+            matches!(
+                short,
+                Error::Invalid(Violation::SwitchTooShort { robots: [0, 1], end_s, start_s, .. })
+                    if end_s == 1.25 && start_s == 1.75
+            ),
+            "{short}"
+        );
+        let worst = serial.check_with_operator(&p, 0.5, 1.0).unwrap_err();
+        assert!(
+            matches!(
+                worst,
+                Error::Invalid(Violation::InsufficientSwitchTime { switch_s, .. }) if switch_s == 0.5
+            ),
+            "{worst}"
+        );
+        let idle = Schedule {
+            offsets_s: vec![2.75],
+            ..serial.clone()
+        };
+        let checked = idle.check_with_operator(&p, 0.5, 1.0).unwrap();
+        assert_eq!(checked.schedule(), &idle);
+        let too_soon = Schedule {
+            offsets_s: vec![2.5],
+            ..serial.clone()
+        };
+        assert!(too_soon.check_with_operator(&p, 0.5, 1.0).is_err());
+        assert!(
+            idle.check(&p).is_err(),
+            "constraint 2 as printed refuses the idle gap"
+        );
     }
 
     #[test]

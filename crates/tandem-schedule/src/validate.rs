@@ -247,8 +247,20 @@ pub fn validate_with_operator(
     switch_s: f64,
     max_busy_share: f64,
 ) -> Result<(), Violation> {
+    validated_timeline_with_operator(problem, schedule, switch_s, max_busy_share).map(drop)
+}
+
+/// [`validate_with_operator`]; on success, the schedule's global timeline (what
+/// [`crate::CheckedSchedule`] keeps). `switch_s = 0` with `max_busy_share = 1` is
+/// [`validated_timeline`] with the single-pass check, the same float operations.
+pub(crate) fn validated_timeline_with_operator(
+    problem: &Problem,
+    schedule: &Schedule,
+    switch_s: f64,
+    max_busy_share: f64,
+) -> Result<GlobalTimeline, Violation> {
     if switch_s == 0.0 && max_busy_share >= 1.0 {
-        return validate(problem, schedule);
+        return validated_timeline(problem, schedule, MarginCheck::SinglePass);
     }
     let tick_s = schedule.tick_s;
     if !(tick_s.is_finite() && tick_s > 0.0) {
@@ -266,8 +278,7 @@ pub fn validate_with_operator(
         max_busy_share,
     );
     if switch_s == 0.0 {
-        return validated_timeline_with(problem, schedule, MarginCheck::SinglePass, allowance_s)
-            .map(drop);
+        return validated_timeline_with(problem, schedule, MarginCheck::SinglePass, allowance_s);
     }
     let timeline = validate_cheap_with(problem, schedule, allowance_s)?;
     if let Some(v) = first_short_switch(&timeline, switch_s) {
@@ -275,7 +286,7 @@ pub fn validate_with_operator(
     }
     let robots = timeline.timelines();
     match tandem_realtime::check_margins(robots, &schedule.holds, &params) {
-        Ok(true) => Ok(()),
+        Ok(true) => Ok(timeline),
         Ok(false) => {
             match validated_timeline_with(problem, schedule, MarginCheck::SinglePass, allowance_s) {
                 Ok(_) => Err(Violation::InsufficientSwitchTime { tick_s, switch_s }),

@@ -407,11 +407,17 @@ pub(super) fn slacks_of_legs(
             .then((p, c).cmp(&(q, d)))
     });
     let tables: Vec<RateTable> = robots.iter().map(RateTable::new).collect();
+    let fast: Vec<super::FastRates> = if legs.switch_ticks > 0 {
+        robots.iter().map(super::FastRates::new).collect()
+    } else {
+        Vec::new()
+    };
     let enforced = legs.plans.map(enforced);
     let setup = Setup {
         legs,
         order: &order,
         tables: &tables,
+        fast: &fast,
         enforced: enforced.as_ref(),
         max_step_of,
         eps,
@@ -446,6 +452,9 @@ struct Setup<'a, 'b> {
     /// The ordered pairs, by their later start.
     order: &'a [(usize, usize)],
     tables: &'a [RateTable],
+    /// Per leg, its largest fast rates over prefixes and suffixes ([`super::FastRates`]) when
+    /// there is a switch time (else empty): the restricted steps of every pair read them.
+    fast: &'a [super::FastRates],
     enforced: Option<&'a Enforced>,
     max_step_of: &'a [f64],
     eps: f64,
@@ -470,6 +479,7 @@ fn pass(
         legs,
         order,
         tables,
+        fast,
         enforced,
         max_step_of,
         eps,
@@ -599,12 +609,12 @@ fn pass(
                     super::SwitchRoom {
                         ticks: legs.switch_ticks,
                         step_p: max_step_of[p],
-                        step_p_after: super::step_within(
+                        step_p_after: fast[p].step_within(
                             &robots[p],
                             max_step_of[p],
                             prev.ref_end..robots[p].n_ref(),
                         ),
-                        step_c_before: super::step_within(
+                        step_c_before: fast[c].step_within(
                             &robots[c],
                             max_step_of[c],
                             0..c_iv.ref_start,
@@ -625,7 +635,7 @@ fn pass(
                 // (`switch_room_after_s`), at most `x = k·M_c`.
                 Some(x) => {
                     let y0 = lead.reach_below(u_max) + max_step_of[c];
-                    let rest = super::step_within(
+                    let rest = fast[c].step_within(
                         &robots[c],
                         max_step_of[c],
                         robots[c].sample_at(y0)..c_iv.ref_start,

@@ -609,9 +609,9 @@ pub(super) struct SwitchRoom {
     pub(super) ticks: u64,
     /// `M_p`.
     pub(super) step_p: f64,
-    /// `p`'s largest step over its samples after its region `P` ([`step_within`]), `≤ M_p`.
+    /// `p`'s largest step over its samples after its region `P` ([`FastRates::step_within`]), `≤ M_p`.
     pub(super) step_p_after: f64,
-    /// `c`'s largest step over its samples before its region `C` ([`step_within`]), `≤ M_c`.
+    /// `c`'s largest step over its samples before its region `C` ([`FastRates::step_within`]), `≤ M_c`.
     pub(super) step_c_before: f64,
     /// Whole ticks in which nobody runs before `c` starts, after `p` has finished
     /// ([`idle_ticks_before_start`]; 0 when `c` starts before every earlier robot has ended).
@@ -660,18 +660,80 @@ pub(super) fn idle_ticks_before_start(
     (quotient * (1.0 - rel) - 1e-6).ceil().max(0.0)
 }
 
-/// The largest step (schedule-clock s) of robot `tl` in one tick while it traverses only the
-/// samples `range`: its largest step over all samples, `max_step = h·max(1, max_n F_n)`,
-/// scaled by `max(1, max_{n ∈ range} F_n)/max(1, max_n F_n) ≤ 1` and raised by `1e-12`
-/// relative (so the quotient's rounding can only make it larger than `h·max(1, max_range F)`).
-/// A robot whose clock stays inside the samples `range` during a tick moves at most this.
-pub(super) fn step_within(tl: &Timeline, max_step: f64, range: std::ops::Range<usize>) -> f64 {
-    let all = tl.max_rate_fast();
-    let within = range
-        .filter(|&n| n < tl.n_ref())
-        .map(|n| tl.rate_fast(n))
-        .fold(1.0, f64::max);
+/// `max_step·(within/all)`, raised by `1e-12` relative and capped at `max_step`: the step of
+/// [`FastRates::step_within`] from the largest fast rates over the range (`within`) and over
+/// all samples (`all`).
+pub(super) fn scaled_step(max_step: f64, within: f64, all: f64) -> f64 {
     (max_step * (within / all) * (1.0 + 1e-12)).min(max_step)
+}
+
+/// One robot's largest fast rate `max(1, F_n)` (Eq. 17, `F = ψ̇_E/ψ̇min`) over all its samples,
+/// every prefix `0..i` and every suffix `i..T_ref`, built once per check in O(T_ref), so that
+/// the switch time's restricted steps ([`FastRates::step_within`], one or two per pair of
+/// regions) cost O(1) for a prefix or a suffix instead of O(T_ref) each. The maxima are exact
+/// (a maximum of floats does not round), so every step is the same value, bit for bit, as a
+/// scan of the range would give (docs/decisions.md, "The margin check's cost with a switch time
+/// (issue 41)").
+pub(super) struct FastRates {
+    /// `max(1, max_n F_n)`, exactly `Timeline::max_rate_fast`.
+    all: f64,
+    /// `before[i] = max(1, max_{n < i} F_n)`, `i = 0..=T_ref`.
+    before: Vec<f64>,
+    /// `from[i] = max(1, max_{n ≥ i} F_n)`, `i = 0..=T_ref`.
+    from: Vec<f64>,
+}
+
+impl FastRates {
+    /// The prefix and suffix maxima of `tl`'s fast rates.
+    pub(super) fn new(tl: &Timeline) -> FastRates {
+        let n_ref = tl.n_ref();
+        let mut before = Vec::with_capacity(n_ref + 1);
+        before.push(1.0_f64);
+        for n in 0..n_ref {
+            before.push(before[n].max(tl.rate_fast(n)));
+        }
+        let mut from = vec![1.0_f64; n_ref + 1];
+        for n in (0..n_ref).rev() {
+            from[n] = from[n + 1].max(tl.rate_fast(n));
+        }
+        FastRates {
+            all: before[n_ref],
+            before,
+            from,
+        }
+    }
+
+    /// `max(1, max_n F_n)` over all samples (the rate of the largest step `M`).
+    pub(super) fn all(&self) -> f64 {
+        self.all
+    }
+
+    /// The largest step (schedule-clock s) of robot `tl` (the timeline these rates were built
+    /// from) in one tick while it traverses only the samples `range`: its largest step over all
+    /// samples, `max_step = h·max(1, max_n F_n)`, scaled by
+    /// `max(1, max_{n ∈ range} F_n)/max(1, max_n F_n) ≤ 1` and raised by `1e-12` relative (so
+    /// the quotient's rounding can only make it larger than `h·max(1, max_range F)`). A robot
+    /// whose clock stays inside the samples `range` during a tick moves at most this. A prefix
+    /// or a suffix is read from the tables in O(1), another range scanned.
+    pub(super) fn step_within(
+        &self,
+        tl: &Timeline,
+        max_step: f64,
+        range: std::ops::Range<usize>,
+    ) -> f64 {
+        let n_ref = self.before.len() - 1;
+        let (a, b) = (range.start.min(n_ref), range.end.min(n_ref));
+        let within = if a >= b {
+            1.0
+        } else if a == 0 {
+            self.before[b]
+        } else if b == n_ref {
+            self.from[a]
+        } else {
+            (a..b).map(|n| tl.rate_fast(n)).fold(1.0, f64::max)
+        };
+        scaled_step(max_step, within, self.all)
+    }
 }
 
 /// The switch time's room (schedule-clock s) that `c` may cover in the `k ≥ 1` ticks after
@@ -679,7 +741,7 @@ pub(super) fn step_within(tl: &Timeline, max_step: f64, range: std::ops::Range<u
 /// tick of its largest step `M_c` (the tick that may start below `y0`), then `k − 1` ticks
 /// that start at or after `y0` and, while `c` is short of its region `C`, traverse only
 /// samples in `[sample_at(y0), C)`: `M_c + (k − 1)·M_c'` with `M_c' = step_of_rest`, `c`'s
-/// largest step over those samples ([`step_within`]), `≤ M_c`. Below `k·M_c`, which charged
+/// largest step over those samples ([`FastRates::step_within`]), `≤ M_c`. Below `k·M_c`, which charged
 /// every tick the largest step over all samples (docs/decisions.md, "Rounds schedules with the
 /// switch time and the load cap (issue 41)").
 pub(super) fn switch_room_after_s(switch_ticks: u64, max_step_c: f64, step_of_rest: f64) -> f64 {
@@ -807,5 +869,46 @@ pub mod baseline {
     /// As [`sufficient_margins`](super::sufficient_margins).
     pub fn greedy_pace(robots: &[Timeline], tick_s: f64) -> Result<bool> {
         sim::check_single_pass(robots, tick_s, Variant::Conservative, 0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tables give every range's step exactly as a scan of the range does (the maxima do
+    /// not round), including empty and out-of-range ranges, so the switch time's restricted
+    /// steps are unchanged bit for bit by reading them from the tables.
+    #[test]
+    fn fast_rates_match_a_scan_of_every_range() {
+        let n_ref = 23;
+        let conf: Vec<bool> = (0..n_ref).map(|n| n % 5 != 2).collect();
+        let grad: Vec<f64> = (0..n_ref)
+            .map(|n| 1.0 + 0.37 * ((n * 7 % 11) as f64))
+            .collect();
+        let lo: Vec<f64> = grad
+            .iter()
+            .enumerate()
+            .map(|(n, g)| g * (0.3 + 0.05 * (n % 4) as f64))
+            .collect();
+        let hi: Vec<f64> = grad.iter().map(|g| 2.0 * g).collect();
+        let tl = Timeline::new(&conf, &grad, &lo, &hi, 0.0, 0.1).unwrap();
+        let fast = FastRates::new(&tl);
+        assert_eq!(fast.all().to_bits(), tl.max_rate_fast().to_bits());
+        let max_step = 0.1 * tl.max_rate_fast();
+        for a in 0..=n_ref + 2 {
+            for b in 0..=n_ref + 2 {
+                let scan = (a..b)
+                    .filter(|&n| n < n_ref)
+                    .map(|n| tl.rate_fast(n))
+                    .fold(1.0, f64::max);
+                let want = (max_step * (scan / tl.max_rate_fast()) * (1.0 + 1e-12)).min(max_step);
+                let got = fast.step_within(&tl, max_step, a..b);
+                assert_eq!(got.to_bits(), want.to_bits(), "range {a}..{b}");
+            }
+        }
+        // By hand: the largest fast rate of samples 0..3 is sample 0's, 1/0.3 (bound 0.3·ψ̇_E).
+        let by_hand = max_step * ((1.0 / 0.3) / tl.max_rate_fast()) * (1.0 + 1e-12);
+        assert!((fast.step_within(&tl, max_step, 0..3) - by_hand).abs() < 1e-12);
     }
 }

@@ -308,6 +308,10 @@ struct RoleSim<'a> {
     /// one) and that sample's index (`n_ref` when none): `c`'s step over the samples it
     /// traverses before its next region, for rule 1's switch room.
     rest_of_c: Option<(Vec<f64>, Vec<usize>)>,
+    /// With a switch time, `p`'s and `c`'s largest fast rates over all samples, prefixes and
+    /// suffixes ([`super::FastRates`]), built once for the role: the restricted steps of every
+    /// pair and every simulated tick read them instead of scanning all samples.
+    fast: Option<[super::FastRates; 2]>,
     /// With a switch time, the whole ticks in which nobody runs before `c` starts
     /// ([`super::idle_ticks_before_start`]; 0 without a switch time, where it is not read).
     idle_ticks_c: f64,
@@ -374,6 +378,12 @@ impl<'a> RoleSim<'a> {
             }
             (rate, next)
         });
+        let fast = (setup.switch_ticks > 0).then(|| {
+            [
+                super::FastRates::new(&robots[p]),
+                super::FastRates::new(&robots[c]),
+            ]
+        });
         let idle_ticks_c = if setup.switch_ticks > 0 {
             super::idle_ticks_before_start(robots, &setup.max_step_of, c, tick_s)
         } else {
@@ -390,6 +400,7 @@ impl<'a> RoleSim<'a> {
             switch_extra_s,
             switch,
             rest_of_c,
+            fast,
             idle_ticks_c,
         };
         if variant != Variant::Printed && sim.both_started() {
@@ -572,28 +583,31 @@ impl<'a> RoleSim<'a> {
         let t_p = self.clock_s[0];
         let end_p = self.sides[0].tl.end_s();
         let left = pair.t_p_end() + setup.eps <= t_p || (pair.t_p_end() >= end_p && end_p <= t_p);
-        let switch_slack = self.switch.map(|(k, step_p, step_c)| {
-            super::started_after_exit_slack(
-                super::SwitchRoom {
-                    ticks: k,
-                    step_p,
-                    step_p_after: super::step_within(
-                        self.sides[0].tl,
-                        step_p,
-                        pair.prev.ref_end..self.sides[0].tl.n_ref(),
-                    ),
-                    step_c_before: super::step_within(
-                        self.sides[1].tl,
-                        step_c,
-                        0..pair.cur.ref_start,
-                    ),
-                    idle_ticks: self.idle_ticks_c,
-                },
-                (pair.t_p_end() + setup.eps).min(end_p),
-                (self.sides[1].tl.start_s(), end_p),
-                pair.t_c_start() - setup.eps,
-            )
-        });
+        let switch_slack =
+            self.switch
+                .zip(self.fast.as_ref())
+                .map(|((k, step_p, step_c), fast)| {
+                    super::started_after_exit_slack(
+                        super::SwitchRoom {
+                            ticks: k,
+                            step_p,
+                            step_p_after: fast[0].step_within(
+                                self.sides[0].tl,
+                                step_p,
+                                pair.prev.ref_end..self.sides[0].tl.n_ref(),
+                            ),
+                            step_c_before: fast[1].step_within(
+                                self.sides[1].tl,
+                                step_c,
+                                0..pair.cur.ref_start,
+                            ),
+                            idle_ticks: self.idle_ticks_c,
+                        },
+                        (pair.t_p_end() + setup.eps).min(end_p),
+                        (self.sides[1].tl.start_s(), end_p),
+                        pair.t_c_start() - setup.eps,
+                    )
+                });
         if left && switch_slack.is_none_or(|s| s > 0.0) {
             Admission::Left
         } else if let (true, Some(slack_s)) = (left, switch_slack) {
@@ -635,12 +649,12 @@ impl<'a> RoleSim<'a> {
     /// largest over all samples, times `M_c`, raised by `1e-12` relative), else `M_c`.
     fn slack(&self, pair: Pair, eps: f64) -> f64 {
         let reach = self.clock_s[1] + self.step_pc;
-        let reach = match (self.switch, &self.rest_of_c) {
-            (Some((k, _, step_c)), Some((rate, next))) => {
+        let reach = match (self.switch, &self.rest_of_c, &self.fast) {
+            (Some((k, _, step_c)), Some((rate, next)), Some(fast)) => {
                 let tl = self.sides[1].tl;
                 let a = tl.sample_at(reach);
                 let rest = if next[a] == pair.cur.ref_start && a < pair.cur.ref_start {
-                    (step_c * (rate[a] / tl.max_rate_fast()) * (1.0 + 1e-12)).min(step_c)
+                    super::scaled_step(step_c, rate[a], fast[1].all())
                 } else {
                     step_c
                 };

@@ -90,14 +90,14 @@ pub fn run_round_with(
     params: &OperatorParams,
     rng: &mut impl Rng,
 ) -> Result<RoundRun> {
+    let (model, problem) = (planner.model(), planner.problem());
     params.validate()?;
-    let (model, problem, schedule) = (planner.model(), planner.problem(), planner.schedule());
-    check_sizes(model, problem, schedule)?;
-    check_tick(schedule.tick_s, problem.dt_s())?;
-    // The planner's coordinator (issue 41): the schedule checked with the operator's switch
-    // time and load cap (`Planner::checked_schedule`: the relaxed constraint 2 lets a robot
-    // start after the others ended, which `Schedule::check` refuses), waiting the switch time
-    // at its holds. At switch time 0 and no cap it is `run_schedule`'s coordinator.
+    check_sizes(model, problem, planner.schedule())?;
+    check_tick(planner.schedule().tick_s, problem.dt_s())?;
+    // The planner's coordinator: checked at the planner's switch time and load cap (the
+    // schedule was planned with them; a check at δ = 0 would refuse the serial schedule's idle
+    // gap and accept switches shorter than δ) and waiting δ at its holds. At δ = 0 and
+    // u_max = 1 it is exactly `schedule.check(problem)?.coordinator()?`.
     let coord = planner.coordinator()?;
     run_coordinator(model, problem, coord, needs, params, rng)
 }
@@ -160,9 +160,10 @@ pub(super) fn check_n_ref(
     Ok(())
 }
 
-/// [`run_round_with`] on the parts of a planner without an operator's switch time or load cap
-/// (`Schedule::check`, no hold wait): `problem` must be the one `schedule` was made for, from
-/// `model`'s gradients (the unit tests build them by hand).
+/// [`run_round_with`] on the parts of a planner: `problem` must be the one `schedule` was
+/// made for, from `model`'s gradients (the unit tests build them by hand). Checked at `δ = 0`
+/// and without a cap ([`Schedule::check`]): the planner's own rounds run
+/// [`Planner::coordinator`] instead ([`run_round_with`]).
 #[cfg(test)]
 pub(super) fn run_schedule(
     model: &TaskModel,
