@@ -763,38 +763,13 @@ mod tests {
     use crate::ExecutionRecord;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
-    use tandem_lfd::{Execution, FitParams, TaskModel};
+    use tandem_lfd::Execution;
     use tandem_realtime::adversary::{adversary_set, run_adversary};
-    use tandem_schedule::SamplerParams;
 
-    /// A task of `n` samples of one channel `force`, low-confidence exactly on `lc` (three
-    /// demonstrations that differ there only), every gradient 1 on the model's identity
-    /// warps, for `robots` robots.
+    /// A task of `n` samples of one channel `force`, low-confidence exactly on `lc`, for
+    /// `robots` robots (the planner's unit-test planner, seed 7).
     fn planner(n: usize, lc: std::ops::Range<usize>, robots: usize) -> Planner {
-        let names = vec!["force".to_string()];
-        let demo = |bump: f64| {
-            let x = (0..n)
-                .map(|i| if lc.contains(&i) { bump } else { 1.0 })
-                .collect();
-            Demonstration::new(names.clone(), x, 0.01).unwrap()
-        };
-        let demos = [demo(1.0), demo(5.0), demo(9.0)];
-        let identity: Vec<f64> = (0..n).map(|i| i as f64).collect();
-        let model = TaskModel::fit_aligned(
-            &demos,
-            &[identity.clone(), identity.clone(), identity],
-            &FitParams::default(),
-        )
-        .unwrap();
-        let params = PlannerParams {
-            sampler: SamplerParams {
-                samples: 50,
-                seed: 7,
-                ..SamplerParams::default()
-            },
-            ..PlannerParams::default()
-        };
-        Planner::from_model_with_robots(model, params, robots).unwrap()
+        crate::planner::test_planner(n, lc, robots, 7)
     }
 
     /// Two robots of task `a` (40 samples, low-confidence on 10..20) and one of task `b` (60

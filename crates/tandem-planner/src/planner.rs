@@ -1253,6 +1253,42 @@ impl Planner {
     }
 }
 
+/// The unit tests' planner (this module's and the cell's): `n` samples of one channel
+/// `force`, from three demonstrations aligned by the identity warp that differ only on `lc`
+/// (low confidence exactly there), for `robots` robots, 50 samples per schedule from `seed`.
+#[cfg(test)]
+pub(crate) fn test_planner(
+    n: usize,
+    lc: std::ops::Range<usize>,
+    robots: usize,
+    seed: u64,
+) -> Planner {
+    let names = vec!["force".to_string()];
+    let demo = |bump: f64| {
+        let x = (0..n)
+            .map(|i| if lc.contains(&i) { bump } else { 1.0 })
+            .collect();
+        Demonstration::new(names.clone(), x, 0.01).unwrap()
+    };
+    let demos = [demo(1.0), demo(5.0), demo(9.0)];
+    let identity: Vec<f64> = (0..n).map(|i| i as f64).collect();
+    let model = TaskModel::fit_aligned(
+        &demos,
+        &[identity.clone(), identity.clone(), identity],
+        &FitParams::default(),
+    )
+    .unwrap();
+    let params = PlannerParams {
+        sampler: SamplerParams {
+            samples: 50,
+            seed,
+            ..SamplerParams::default()
+        },
+        ..PlannerParams::default()
+    };
+    Planner::from_model_with_robots(model, params, robots).unwrap()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1268,33 +1304,9 @@ mod tests {
     }
 
     /// A small planner: three 1-channel demonstrations, aligned by the identity warp, whose
-    /// force differs only on reference samples 10..20 (low confidence there).
+    /// force differs only on reference samples 10..20 (low confidence there), two robots.
     fn small_planner(seed: u64) -> Planner {
-        let n = 40;
-        let names = vec!["force".to_string()];
-        let demo = |bump: f64| {
-            let x = (0..n)
-                .map(|i| if (10..20).contains(&i) { bump } else { 1.0 })
-                .collect();
-            Demonstration::new(names.clone(), x, 0.01).unwrap()
-        };
-        let demos = [demo(1.0), demo(5.0), demo(9.0)];
-        let identity: Vec<f64> = (0..n).map(|i| i as f64).collect();
-        let model = TaskModel::fit_aligned(
-            &demos,
-            &[identity.clone(), identity.clone(), identity],
-            &FitParams::default(),
-        )
-        .unwrap();
-        let params = PlannerParams {
-            sampler: SamplerParams {
-                samples: 50,
-                seed,
-                ..SamplerParams::default()
-            },
-            ..PlannerParams::default()
-        };
-        Planner::from_model(model, params).unwrap()
+        test_planner(40, 10..20, 2, seed)
     }
 
     #[test]
