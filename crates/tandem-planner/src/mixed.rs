@@ -496,34 +496,14 @@ impl CellPlanner {
         if !self.is_mixed() {
             return self.tasks[0].planner.save_locked(lock);
         }
-        let path = lock.state_path();
-        state::check_target(path)?;
-        let here = state::resolved(path);
-        let origin = self.origin.get();
-        if let Some((from, stamp)) = &origin
-            && *from == here
-            && let Some(now) = state::stamp_at(path)?
-            && now != *stamp
-        {
-            return Err(Error::Changed {
-                path: path.to_path_buf(),
-            });
-        }
-        if origin.is_none_or(|(from, _)| from != here) {
-            let rounds = Self::rounds_at(path)?;
-            if rounds > 0 {
-                return Err(Error::WouldDiscardRounds {
-                    path: path.to_path_buf(),
-                    rounds,
-                });
-            }
-        }
-        let bytes = state::encode_cell(&self.to_payload()?)?;
-        state::write_atomic(path, &bytes)?;
-        if let Some(stamp) = state::stamp_of(&bytes) {
-            self.origin.set(here, stamp);
-        }
-        Ok(())
+        self.origin
+            .save_guarded(
+                lock,
+                false,
+                |path| Self::rounds_at(path),
+                || state::encode_cell(&self.to_payload()?),
+            )
+            .map(|_| ())
     }
 
     /// The format 12 payload of a cell of two or more tasks.

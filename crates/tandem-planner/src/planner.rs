@@ -271,6 +271,56 @@ impl Origin {
             *o = Some((path, stamp));
         }
     }
+
+    /// The one guarded save of a state file (a planner's or a cell's), under `lock`: refuses a
+    /// target that is not a state file, one another process saved into since it was loaded
+    /// from here ([`Error::Changed`]), and one this state did not come from that holds rounds
+    /// (`rounds_at` counts them; [`Error::WouldDiscardRounds`] unless `discard`); then writes
+    /// `encode()`'s bytes atomically and remembers them as this state's origin. Returns the
+    /// rounds discarded (`None`: an unreadable file replaced with `discard`).
+    pub(crate) fn save_guarded(
+        &self,
+        lock: &StateLock,
+        discard: bool,
+        rounds_at: impl FnOnce(&Path) -> Result<usize>,
+        encode: impl FnOnce() -> Result<Vec<u8>>,
+    ) -> Result<Option<usize>> {
+        let path = lock.state_path();
+        state::check_target(path)?;
+        let here = state::resolved(path);
+        let origin = self.get();
+        if let Some((from, stamp)) = &origin
+            && *from == here
+            && let Some(now) = state::stamp_at(path)?
+            && now != *stamp
+        {
+            return Err(Error::Changed {
+                path: path.to_path_buf(),
+            });
+        }
+        // A file this state did not come from: its rounds would be lost.
+        let mut discarded = Some(0);
+        if origin.is_none_or(|(from, _)| from != here) {
+            match rounds_at(path) {
+                Ok(0) => {}
+                Ok(rounds) if !discard => {
+                    return Err(Error::WouldDiscardRounds {
+                        path: path.to_path_buf(),
+                        rounds,
+                    });
+                }
+                Ok(rounds) => discarded = Some(rounds),
+                Err(_) if discard => discarded = None,
+                Err(e) => return Err(e),
+            }
+        }
+        let bytes = encode()?;
+        state::write_atomic(path, &bytes)?;
+        if let Some(stamp) = state::stamp_of(&bytes) {
+            self.set(here, stamp);
+        }
+        Ok(discarded)
+    }
 }
 
 impl Clone for Origin {
@@ -1026,41 +1076,12 @@ impl Planner {
     /// The save of [`Planner::save_locked`]; `discard`: replace a file holding rounds this
     /// planner does not hold. Returns the rounds discarded.
     fn save_checked(&self, lock: &StateLock, discard: bool) -> Result<Option<usize>> {
-        let path = lock.state_path();
-        state::check_target(path)?;
-        let here = state::resolved(path);
-        let origin = self.origin.get();
-        if let Some((from, stamp)) = &origin
-            && *from == here
-            && let Some(now) = state::stamp_at(path)?
-            && now != *stamp
-        {
-            return Err(Error::Changed {
-                path: path.to_path_buf(),
-            });
-        }
-        // A file this planner did not come from: its rounds would be lost.
-        let mut discarded = Some(0);
-        if origin.is_none_or(|(from, _)| from != here) {
-            match Self::rounds_at(path) {
-                Ok(0) => {}
-                Ok(rounds) if !discard => {
-                    return Err(Error::WouldDiscardRounds {
-                        path: path.to_path_buf(),
-                        rounds,
-                    });
-                }
-                Ok(rounds) => discarded = Some(rounds),
-                Err(_) if discard => discarded = None,
-                Err(e) => return Err(e),
-            }
-        }
-        let bytes = state::encode_state(&self.to_state())?;
-        state::write_atomic(path, &bytes)?;
-        if let Some(stamp) = state::stamp_of(&bytes) {
-            self.origin.set(here, stamp);
-        }
-        Ok(discarded)
+        self.origin.save_guarded(
+            lock,
+            discard,
+            |path| Self::rounds_at(path),
+            || state::encode_state(&self.to_state()),
+        )
     }
 
     /// Loads a planner saved by [`Planner::save`], of the current state format or an older one
