@@ -289,6 +289,10 @@ pub(crate) struct ConsoleArgs {
     /// (`[sampler] switch_s`) where it is longer.
     #[arg(long, value_name = "S")]
     pub(crate) lead: Option<f64>,
+    /// Channel whose increase the simulated operator's corrections aim at. Default: the
+    /// model's process quantity, as `tandem simulate`'s --channel
+    #[arg(long, value_name = "NAME", requires = "simulate")]
+    pub(crate) channel: Option<String>,
 }
 
 /// Overrides of the anytime sampler's settings.
@@ -655,7 +659,9 @@ pub(crate) struct SimulateArgs {
     /// on its own).
     #[arg(long, value_name = "S", default_value_t = OperatorParams::default().false_correction_s)]
     pub(crate) false_episode: f64,
-    /// Channel whose increase a correction aims at.
-    #[arg(long, value_name = "NAME", default_value_t = OperatorParams::default().force_channel)]
-    pub(crate) channel: String,
+    /// Channel whose increase a correction aims at. Default: the model's process quantity
+    /// (the first of force, fz, torque, tz, flow, pressure, depth, width it has, else its
+    /// first scalar channel that is not a position)
+    #[arg(long, value_name = "NAME")]
+    pub(crate) channel: Option<String>,
 }

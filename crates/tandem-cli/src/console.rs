@@ -11,6 +11,7 @@ use anyhow::{Context, Result, bail};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use tandem::realtime::Controller;
+use tandem::sim::workcell::OperatorParams;
 use tandem::{Planner, derive_seed};
 use tandem_console::{
     Console, ConsoleConfig, Geometry, Recorder, SimParams, Until, check_recording, read_recording,
@@ -40,7 +41,10 @@ pub(crate) fn console(a: &ConsoleArgs) -> Result<()> {
         cell: a.cell,
         speed: a.speed,
         seed: a.seed,
-        ..SimParams::default()
+        operator: OperatorParams {
+            force_channel: crate::sim::operator_channel(a.channel.as_deref(), &planner)?,
+            ..OperatorParams::default()
+        },
     };
     params
         .validate()
@@ -64,14 +68,18 @@ pub(crate) fn console(a: &ConsoleArgs) -> Result<()> {
         ),
         None => None,
     };
-    if let (Some(until), Some(rec)) = (until, recorder.as_mut()) {
-        let ticks =
-            record_sim(&planner, ctl, &params, needed, until, rec).map_err(|e| match e {
+    if let (Some(until), Some(rec), Some(path)) = (until, recorder.as_mut(), a.record.as_ref()) {
+        let ticks = record_sim(&planner, ctl, &params, needed, until, rec).map_err(|e| {
+            // A failed batch recording is not a run: remove the file this command created,
+            // so that a retry with the same name works and nothing half-written is replayed.
+            let _ = std::fs::remove_file(path);
+            match e {
                 tandem_console::Error::BadParam { name: "until", why } => {
                     anyhow::anyhow!("--until {}: {why}", a.until.as_deref().unwrap_or_default())
                 }
-                e => e.into(),
-            })?;
+                e => anyhow::Error::from(e),
+            }
+        })?;
         note(&format!(
             "console: recorded {ticks} ticks into {}",
             a.record

@@ -31,11 +31,13 @@ use anyhow::{Context, Result, bail};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tandem::lfd::Execution;
-use tandem::sim::workcell::{OperatorParams, PlanGap, RobotRun, RoundRun, run_round_with};
+use tandem::sim::workcell::{
+    OperatorParams, PlanGap, RobotRun, RoundRun, correction_channel, run_round_with,
+};
 use tandem::{ExecutionRecord, Planner, derive_seed};
 
 use crate::cli::SimulateArgs;
-use crate::cmd::{deprecated, out, verbose};
+use crate::cmd::{deprecated, note, out, verbose};
 use crate::{bag, input, state_io};
 
 /// Runs one round (see the module docs). `needed[i][n]`: robot `i`'s workpiece needs the
@@ -97,6 +99,34 @@ fn execution_files(log: &RobotRun, channels: &[String]) -> [String; 3] {
     [exec, reflog, corr]
 }
 
+/// The channel the simulated operator corrects along: `--channel NAME` checked against the
+/// model, or the model's default ([`correction_channel`]), said in a note when it is not
+/// `force` (the sanding task's, the operator's default before).
+pub(crate) fn operator_channel(channel: Option<&str>, planner: &Planner) -> Result<String> {
+    let model = planner.model();
+    match channel {
+        Some(name) => {
+            if !model.tangent_names().iter().any(|n| n == name) {
+                bail!(
+                    "--channel {name}: the model has no such channel (channels: {})",
+                    model.tangent_names().join(", ")
+                );
+            }
+            Ok(name.to_owned())
+        }
+        None => {
+            let name = correction_channel(model);
+            if name != OperatorParams::default().force_channel {
+                note(&format!(
+                    "the simulated operator's corrections raise channel `{name}` (the model has \
+                     no `force`; --channel NAME chooses another)"
+                ));
+            }
+            Ok(name)
+        }
+    }
+}
+
 /// `tandem simulate`.
 pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
     let rounds = match (a.rounds, a.pairs) {
@@ -115,7 +145,6 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
         miss_rate: a.miss_rate,
         false_correction_rate: a.false_rate,
         false_correction_s: a.false_episode,
-        force_channel: a.channel.clone(),
         ..OperatorParams::default()
     };
     if let Err(e) = op.validate() {
@@ -137,13 +166,10 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
     }
     let mut planner = state_io::load(&a.state)?;
     let need = input::read_need(&a.need, planner.model().n_ref())?;
-    if !planner.model().tangent_names().contains(&a.channel) {
-        bail!(
-            "--channel {}: the model has no such channel (channels: {})",
-            a.channel,
-            planner.model().channel_names().join(", ")
-        );
-    }
+    let op = OperatorParams {
+        force_channel: operator_channel(a.channel.as_deref(), &planner)?,
+        ..op
+    };
     if let Some(dir) = &a.write {
         state_io::prepare_dir(dir)?;
     }

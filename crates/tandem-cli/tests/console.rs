@@ -8,7 +8,7 @@ use std::net::TcpStream;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{SMALL_N_REF, scratch, small_state, tandem, write};
+use common::{SMALL_N_REF, scratch, small_demo, small_state, tandem, write};
 
 /// Kills the console when the test ends, however it ends.
 struct Running(Child);
@@ -131,6 +131,72 @@ fn a_recorded_run_replays_and_checks() {
     assert_eq!(check["two_lc"], 0, "{check}");
     assert_eq!(check["lc_differs"], 0, "{check}");
     assert!(check["stretches"].as_u64().unwrap() >= 30, "{check}");
+}
+
+/// A task without a `force` channel (a welder's `current`): `simulate` and the console's
+/// simulated operator correct along the model's process quantity and say so; a named channel
+/// the model lacks is refused before anything is written (no half-made recording is left).
+#[test]
+fn console_simulates_a_task_without_a_force_channel() {
+    let dir = scratch("console-current");
+    let demos: Vec<_> = (0..3)
+        .map(|i| {
+            let text = small_demo([SMALL_N_REF, 66, 56][i], [0.0, 6.0, 12.0][i]).replacen(
+                "t,x,force",
+                "t,x,current",
+                1,
+            );
+            write(&dir, &format!("weld_{i}.csv"), &text)
+        })
+        .collect();
+    let state = dir.join("weld.tandem");
+    let mut args = vec!["fit".to_string()];
+    args.extend(demos.iter().map(|p| p.to_str().unwrap().to_string()));
+    args.extend(["--samples", "200", "-o", state.to_str().unwrap()].map(String::from));
+    let out = tandem(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rec = dir.join("run.jsonl");
+    let record = |channel: Option<&str>| {
+        let mut args = vec![
+            "console",
+            state.to_str().unwrap(),
+            "--simulate",
+            "--record",
+            rec.to_str().unwrap(),
+            "--until",
+            "rounds:2",
+        ];
+        if let Some(c) = channel {
+            args.extend(["--channel", c]);
+        }
+        tandem(args)
+    };
+    let bad = record(Some("force"));
+    assert_eq!(bad.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("--channel force") && err.contains("current"),
+        "{err}"
+    );
+    assert!(!rec.exists(), "a refused run left {}", rec.display());
+    let out = record(None);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("channel `current`"), "{err}");
+    let out = tandem(["console", "--replay", rec.to_str().unwrap(), "--check"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let check: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(check["frames"].as_u64().unwrap() > 10, "{check}");
+    assert_eq!(check["two_lc"], 0, "{check}");
+    assert_eq!(check["lc_differs"], 0, "{check}");
 }
 
 /// `tandem console STATE --replay RUN.mcap`: the bag of `tandem simulate --bag` replayed

@@ -42,8 +42,17 @@ pub enum Error {
         found: usize,
     },
     /// Workcell: the model has no channel of the name the operator corrects.
-    #[error("the task model has no channel `{0}` for the operator to correct")]
-    NoForceChannel(String),
+    #[error(
+        "the task model has no channel `{name}` for the simulated operator to correct (its \
+         channels: {channels}): name one of them (`--channel NAME` of `tandem simulate` and \
+         `tandem console`, `OperatorParams::force_channel`)"
+    )]
+    NoForceChannel {
+        /// The channel asked for.
+        name: String,
+        /// The model's tangent coordinates, comma-separated.
+        channels: String,
+    },
     /// Workcell: the robots did not finish within the tick budget (a bug or a degenerate
     /// schedule).
     #[error("the round did not finish within {ticks} control ticks")]

@@ -80,7 +80,7 @@ mod tests;
 
 pub use cell::{CellSim, CellStats, FinishedTask};
 pub use live::RoundSim;
-pub use operator::{OperatorParams, correction_input, needs_correction};
+pub use operator::{OperatorParams, correction_channel, correction_input, needs_correction};
 pub use record::{PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
 pub use run::{run_round, run_round_with};
 // The two-robot names of one release ago, deprecated at the crate's public edge only.

@@ -66,7 +66,70 @@ impl Default for OperatorParams {
     }
 }
 
+/// Channels a simulated operator's correction aims at by default, in order of preference: the
+/// task's contact or process quantity when it has one.
+const CORRECTION_CHANNELS: [&str; 8] = [
+    "force", "fz", "torque", "tz", "flow", "pressure", "depth", "width",
+];
+
+/// Position channels, never the default correction channel when another scalar channel exists.
+const POSITION_CHANNELS: [&str; 3] = ["x", "y", "z"];
+
+/// The channel a simulated operator's corrections raise on `model` when the user names none
+/// ([`OperatorParams::force_channel`]): the first of `force`, `fz`, `torque`, `tz`, `flow`,
+/// `pressure`, `depth`, `width` the model has, else its first scalar channel that is not a
+/// position (`x`, `y`, `z`), a quaternion's tangent coordinate or `rate`, else its first
+/// tangent coordinate. On the sanding task: `force` (the default of [`OperatorParams`]).
+///
+/// ```
+/// use tandem_lfd::{Demonstration, FitParams, TaskModel};
+/// use tandem_sim::workcell::correction_channel;
+///
+/// // A welding task: a position, the arc current and the wire feed, two demonstrations.
+/// let names: Vec<String> = ["x", "current", "wire_feed"].map(String::from).into();
+/// let rows = |k: f64| (0..40).flat_map(|n| [n as f64 * 0.01, 150.0 + k, 5.0]).collect();
+/// let demos = [
+///     Demonstration::new(names.clone(), rows(0.0), 0.01)?,
+///     Demonstration::new(names, rows(2.0), 0.01)?,
+/// ];
+/// let model = TaskModel::fit(&demos, &FitParams::default())?;
+/// // No `force` or other known process channel: the first scalar that is not a position.
+/// assert_eq!(correction_channel(&model), "current");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[must_use]
+pub fn correction_channel(model: &TaskModel) -> String {
+    let names = model.tangent_names();
+    CORRECTION_CHANNELS
+        .iter()
+        .find_map(|c| names.iter().find(|n| n.as_str() == *c))
+        .or_else(|| {
+            names.iter().find(|n| {
+                !n.contains('.') && n.as_str() != "rate" && !POSITION_CHANNELS.contains(&n.as_str())
+            })
+        })
+        .or_else(|| names.first())
+        .cloned()
+        .unwrap_or_default()
+}
+
 impl OperatorParams {
+    /// Index of [`OperatorParams::force_channel`] among `model`'s tangent coordinates
+    /// ([`TaskModel::tangent_names`]).
+    ///
+    /// # Errors
+    /// [`Error::NoForceChannel`] naming the channel, the model's channels and the fix.
+    pub fn channel_index(&self, model: &TaskModel) -> Result<usize> {
+        let names = model.tangent_names();
+        names
+            .iter()
+            .position(|n| *n == self.force_channel)
+            .ok_or_else(|| Error::NoForceChannel {
+                name: self.force_channel.clone(),
+                channels: names.join(", "),
+            })
+    }
+
     /// Checks the rates.
     ///
     /// # Errors
@@ -264,6 +327,64 @@ mod tests {
     use rand::SeedableRng;
 
     use super::*;
+
+    /// A model of two demonstrations with these channels: the first a ramp both share, the
+    /// others constant and apart by 0.5.
+    fn model_of(names: &[&str]) -> TaskModel {
+        let names: Vec<String> = names.iter().map(|n| (*n).to_string()).collect();
+        let rows = |k: f64| -> Vec<f64> {
+            (0..30)
+                .flat_map(|n| {
+                    (0..names.len()).map(move |c| {
+                        if c == 0 {
+                            n as f64 * 0.01
+                        } else {
+                            c as f64 + k
+                        }
+                    })
+                })
+                .collect()
+        };
+        let demos = [
+            tandem_lfd::Demonstration::new(names.clone(), rows(0.0), 0.01).unwrap(),
+            tandem_lfd::Demonstration::new(names.clone(), rows(0.5), 0.01).unwrap(),
+        ];
+        TaskModel::fit(&demos, &tandem_lfd::FitParams::default()).unwrap()
+    }
+
+    #[test]
+    fn the_default_correction_channel_prefers_a_process_quantity_then_a_non_position() {
+        // A known process quantity wins wherever it stands.
+        assert_eq!(
+            correction_channel(&model_of(&["x", "valve", "flow"])),
+            "flow"
+        );
+        assert_eq!(correction_channel(&model_of(&["force", "torque"])), "force");
+        // None known: the first scalar that is not a position.
+        assert_eq!(
+            correction_channel(&model_of(&["x", "y", "current", "feed"])),
+            "current"
+        );
+        // Only positions: the first coordinate.
+        assert_eq!(correction_channel(&model_of(&["y", "x"])), "y");
+    }
+
+    #[test]
+    fn a_missing_correction_channel_names_the_models_channels_and_the_fix() {
+        let model = model_of(&["x", "current"]);
+        let e = OperatorParams::default().channel_index(&model).unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("`force`") && text.contains("x, current"),
+            "{text}"
+        );
+        assert!(text.contains("--channel"), "{text}");
+        let ok = OperatorParams {
+            force_channel: "current".into(),
+            ..OperatorParams::default()
+        };
+        assert_eq!(ok.channel_index(&model).unwrap(), 1);
+    }
 
     #[test]
     fn attention_needs_the_switch_time_after_another_robots_stretch() {

@@ -417,11 +417,7 @@ pub(super) struct Operate {
 impl Operate {
     /// The operator `params` on `model` at a control tick of `tick_s` (s).
     pub(super) fn new(model: &TaskModel, params: &OperatorParams, tick_s: f64) -> Result<Self> {
-        let force_idx = model
-            .tangent_names()
-            .iter()
-            .position(|n| *n == params.force_channel)
-            .ok_or_else(|| Error::NoForceChannel(params.force_channel.clone()))?;
+        let force_idx = params.channel_index(model)?;
         let k = model.n_components();
         let switch_ticks = tandem_realtime::switch_ticks(params.switch_true_s, tick_s)? as usize;
         Ok(Operate {

@@ -15,15 +15,6 @@ use tandem_sim::truth::{ProfileTruth, SandingTruth, TaskTruth, needs_help};
 use super::warps::{WarpError, fitted_warps, warp_error};
 use crate::{Error, Family, Result, ZooTask};
 
-/// Channels a simulated operator's correction aims at, in order of preference: the task's
-/// contact or process quantity when it has one (`OperatorParams::force_channel`).
-const CORRECTION_CHANNELS: [&str; 8] = [
-    "force", "fz", "torque", "tz", "flow", "pressure", "depth", "width",
-];
-
-/// Position channels, never the correction channel when another scalar channel exists.
-const POSITION_CHANNELS: [&str; 3] = ["x", "y", "z"];
-
 /// High confidence after the fit for each choice of first file, and with the medoid
 /// (`Reference::Medoid`), percent of reference samples.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -126,23 +117,11 @@ pub struct Prepared {
     pub report: FitReport,
 }
 
-/// The channel the simulated operator's corrections raise on `model`: the first of
-/// `CORRECTION_CHANNELS` the model has, else its first scalar channel that is not a
-/// position, else its first tangent coordinate.
+/// The channel the simulated operator's corrections raise on `model`
+/// ([`tandem_sim::workcell::correction_channel`], what `tandem simulate` uses by default).
 #[must_use]
 pub fn correction_channel(model: &TaskModel) -> String {
-    let names = model.tangent_names();
-    CORRECTION_CHANNELS
-        .iter()
-        .find_map(|c| names.iter().find(|n| n.as_str() == *c))
-        .or_else(|| {
-            names.iter().find(|n| {
-                !n.contains('.') && n.as_str() != "rate" && !POSITION_CHANNELS.contains(&n.as_str())
-            })
-        })
-        .or_else(|| names.first())
-        .cloned()
-        .unwrap_or_default()
+    tandem_sim::workcell::correction_channel(model)
 }
 
 /// High confidence (%) after a fit: the prior alone with the default confidence parameters.
