@@ -42,6 +42,9 @@ def main() -> None:
                          "of the fit needs the operator on a workpiece")
     ap.add_argument("--channel", help="channel the simulated operator's corrections raise "
                                       "(default: force)")
+    ap.add_argument("--resample", action="store_true",
+                    help="put demonstrations whose t column is irregular (a drifting logger) on "
+                         "an even grid first, as tandem fit --resample")
     ap.add_argument("--rounds", type=int, default=40, help="rounds to run (one execution per robot)")
     ap.add_argument("--every", type=int, default=5, help="print every this many rounds")
     ap.add_argument("--samples", type=int, default=1000, help="sampler candidates per schedule")
@@ -50,7 +53,8 @@ def main() -> None:
     args = ap.parse_args()
 
     demos = demonstrations(args.demos_dir)
-    planner = tandem.fit(demos, params={"sampler": {"samples": args.samples}})
+    planner = tandem.fit(demos, params={"sampler": {"samples": args.samples}},
+                         resample=args.resample)
     model = planner.model
     print(f"fitted {len(demos)} demonstrations: T_ref = {model.n_ref} samples × {model.dt_s} s, "
           f"channels {model.channels}")

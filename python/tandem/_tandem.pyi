@@ -65,6 +65,7 @@ def fit(
     rate_term: Optional[str] = None,
     switch_s: Optional[float] = None,
     max_busy_share: Optional[float] = None,
+    resample: bool = False,
 ) -> Planner:
     """Learns the task from demonstrations (paths or ``(T_i, C)`` arrays) and makes the first
     schedule (Fig. 2); the same inputs and parameters as ``tandem fit`` give the same state.
@@ -76,7 +77,8 @@ def fit(
     ``tandem fit --rate-term``; ``None`` keeps ``params``'. ``switch_s``: the operator's
     switch time δ (s, ≥ 0) between two robots' low-confidence stretches; ``max_busy_share``:
     its load cap in (0, 1] (``tandem fit --switch-s/--max-busy``); ``None`` keeps
-    ``params["sampler"]``'."""
+    ``params["sampler"]``'. ``resample``: put CSV files with an irregular ``t`` column on an
+    even grid first, as ``tandem fit --resample`` (a ``DataWarning`` per file)."""
 
 def read_bag(
     path: Path,
@@ -93,6 +95,7 @@ def fit_model(
     params: Params = None,
     dt_s: Optional[float] = None,
     rate_term: Optional[str] = None,
+    resample: bool = False,
 ) -> Model:
     """The task model alone (alignment and statistics, §II-B1/2)."""
 
@@ -125,6 +128,7 @@ class Planner:
         params: Params = None,
         dt_s: Optional[float] = None,
         holds: Optional[Union[Sequence[Union[float, str]], Dict[str, Any]]] = None,
+        resample: bool = False,
     ) -> Planner:
         """Fits the task again from ``demos`` and replays every recorded round onto the new
         fit (the operator's corrections kept); returns the new planner, which saves into the

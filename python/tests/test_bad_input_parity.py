@@ -133,7 +133,6 @@ NO_PYTHON_PATH = {
     "header_only.reflog.csv": "a `--log` file with a header only",
     # fit
     "--ranges": "`--ranges NAME=VALUE` is the command line's syntax for params['fit']['ranges']",
-    "gap.csv --resample": "tandem.fit has no resample=; record_round's resample= is tested",
     "--no-holds --hold-at": "two flags that contradict each other; Python has one `holds=`",
     "--hold-at abc": "a flag value that is not a number; Python's holds=['abc'] is a rule",
     # other commands
@@ -213,6 +212,35 @@ def test_half_a_demonstration_is_refused_the_same_way(folder: Path) -> None:
     )
     assert_worded(cli_msg, py_msg, ["does not reach the end of the task", str(half)])
     assert not (folder / "out.tandem").exists()
+
+
+def test_a_demonstration_off_its_grid_is_resampled_or_refused_the_same_way(folder: Path) -> None:
+    demos = small_demos(folder)
+    params = {"sampler": {"samples": 50}}
+    out = folder / "out.tandem"
+    # A gap of five rows is too long to resample: the same refusal from both front ends.
+    gap = write(folder, "gap.csv", rows_of(small_demo(60, 1.0), lambda k: not 20 <= k < 25))
+    cli_msg = cli_error(["fit", *demos, gap, "--resample", "--samples", 50, "-o", out])
+    py_msg = py_error(lambda: tandem.fit([*demos, gap], params=params, resample=True),
+                      tandem.InputError)
+    assert_same(cli_msg, py_msg)
+    assert "a gap of 0.06 s" in py_msg and not out.exists()
+    # One dropped row: refused without resample=, naming it; put back on the grid with it.
+    dropped = write(folder, "dropped_ok.csv", rows_of(small_demo(60, 1.0), lambda k: k != 30))
+    with pytest.raises(tandem.InputError, match=r"resample=True. of Python's .fit."):
+        tandem.fit([*demos, dropped], params=params)
+    with pytest.warns(tandem.DataWarning) as caught:
+        planner = tandem.fit([*demos, dropped], params=params, resample=True)
+    said = [str(w.message) for w in caught]
+    assert any(m.startswith(f"{dropped}: resampled 59 rows") and "onto 60 samples 0.01 s apart" in m
+               for m in said), said
+    assert planner.model.n_ref > 0
+    model = tandem.fit_model([*demos, dropped], resample=True)
+    assert model.n_ref == planner.model.n_ref
+    # Arrays carry no row times to resample.
+    arrays = [np.array([[k * 0.01, 5.0] for k in range(60)]) for _ in range(2)]
+    with pytest.raises(tandem.InputError, match="resample=True needs the time of every row"):
+        tandem.fit(arrays, channels=["x", "force"], dt_s=0.01, resample=True)
 
 
 def test_a_period_that_contradicts_the_file(folder: Path) -> None:

@@ -972,7 +972,7 @@ fn time_column_period(
                 "this time is {:.3} ms off the even grid of the file's mean period {} s \
                  ({:.1} % of a period; tandem accepts up to {} %: a dropped or repeated \
                  sample, or an irregular log): resample the log onto an even grid (`--resample` \
-                 of `tandem fit` or `tandem record`, `resample=True` in Python's \
+                 of `tandem fit` or `tandem record`, `resample=True` of Python's `fit` or \
                  `record_round`), or remove the `t` column and give the period (`tandem fit \
                  --dt`)",
                 dev * 1e3,

@@ -131,8 +131,8 @@ fn regridded_execution(
     if !is_path {
         return Err(Error::input(
             label,
-            "resample=True needs the time of every row: give the execution as a CSV file \
-             with a `t` column (an array has no times; give it at dt_s instead)",
+            "resample=True needs the time of every row: give a CSV file with a `t` column \
+             (an array has no times; give it at dt_s instead)",
         ));
     }
     let path: PathBuf = x
@@ -196,8 +196,9 @@ fn demonstrations(
     demos: &Bound<'_, PyAny>,
     channels: Option<&[String]>,
     dt_s: Option<f64>,
+    resample: bool,
     params: &mut PlannerParams,
-) -> Result<(Vec<Demonstration>, Vec<String>)> {
+) -> Result<Loaded> {
     let list = items(demos, "demos")?;
     if list.len() < 2 {
         return Err(Error::input(
@@ -210,6 +211,7 @@ fn demonstrations(
     }
     let mut recordings = Vec::new();
     let mut assumed = Vec::new();
+    let mut resampled = Vec::new();
     let out = list
         .iter()
         .enumerate()
@@ -224,7 +226,13 @@ fn demonstrations(
             if dt_s.is_none() && !is_path {
                 assumed.push(label.clone());
             }
-            let demo = demonstration(d, &label, both, dt_s, Some(&mut recordings))?;
+            let demo = if resample {
+                let grid = regridded_execution(d, &label, both)?;
+                resampled.push(grid.note.clone());
+                grid.demonstration
+            } else {
+                demonstration(d, &label, both, dt_s, Some(&mut recordings))?
+            };
             // A file's own time wins over dt_s; a dt_s that contradicts it is refused.
             if let Some(dt) = dt_s
                 && demo.period_source() == PeriodSource::File
@@ -246,7 +254,37 @@ fn demonstrations(
         .collect::<Result<Vec<_>>>()?;
     extend_bag_schema(&mut params.fit.schema, &recordings);
     params.validate()?;
-    Ok((out, assumed))
+    Ok(Loaded {
+        demos: out,
+        assumed,
+        resampled,
+    })
+}
+
+/// Demonstrations as [`demonstrations`] loaded them.
+struct Loaded {
+    /// The demonstrations, in the order given.
+    demos: Vec<Demonstration>,
+    /// Labels of arrays given without `dt_s` (the default period was assumed).
+    assumed: Vec<String>,
+    /// One note per file put on an even grid (`resample=True`), naming the file
+    /// (`Regridded::note`).
+    resampled: Vec<String>,
+}
+
+impl Loaded {
+    /// Raises the loading's `DataWarning`s (assumed periods, resampled files, the
+    /// demonstrations' own) and hands the demonstrations out.
+    fn warned(self, py: Python<'_>) -> PyResult<Vec<Demonstration>> {
+        if !self.assumed.is_empty() {
+            warn(py, &assumed_period_warning(&self.assumed))?;
+        }
+        for note in &self.resampled {
+            warn(py, note)?;
+        }
+        warn_demonstrations(py, &self.demos)?;
+        Ok(self.demos)
+    }
 }
 
 /// The `DataWarning` for arrays given without `dt_s` (`labels`, non-empty): an array carries
@@ -376,6 +414,12 @@ fn hold_spec(holds: &Bound<'_, PyAny>) -> Result<HoldSpec> {
 ///         supervised time plus ``switch_s`` per change of robot, may not exceed it
 ///         (``tandem fit --max-busy``). ``None`` (default) keeps
 ///         ``params["sampler"]["max_busy_share"]`` (1: no cap). Stored in the state file.
+///     resample: put demonstrations given as CSV files with an irregular ``t`` column (a
+///         logger's own jittered clock) on an even grid of their mean period first, as
+///         ``tandem fit --resample`` does (channels interpolated linearly, quaternions by
+///         slerp, 0/1 channels held); a ``DataWarning`` per file says what was done. Arrays,
+///         JSON files and bags are refused with it (they carry no row times or are on a
+///         grid already). Default ``False``: such a file is an ``InputError`` naming the row.
 ///
 /// Raises:
 ///     InputError: a bad demonstration (with ``file``/``line`` for files).
@@ -383,7 +427,7 @@ fn hold_spec(holds: &Bound<'_, PyAny>) -> Result<HoldSpec> {
 ///         a rule on an unknown channel or one that holds nowhere, a ``switch_s`` or
 ///         ``max_busy_share`` out of range (``name`` names it).
 #[pyfunction]
-#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, robots=N_ROBOTS, holds=None, rate_term=None, switch_s=None, max_busy_share=None))]
+#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, robots=N_ROBOTS, holds=None, rate_term=None, switch_s=None, max_busy_share=None, resample=false))]
 #[expect(
     clippy::too_many_arguments,
     reason = "the keyword arguments of the Python function, each documented above"
@@ -399,6 +443,7 @@ pub(crate) fn fit(
     rate_term: Option<String>,
     switch_s: Option<f64>,
     max_busy_share: Option<f64>,
+    resample: bool,
 ) -> PyResult<PyPlanner> {
     let mut params = planner_params(params)?;
     apply_rate_term(&mut params, rate_term.as_deref())?;
@@ -407,11 +452,8 @@ pub(crate) fn fit(
         params.holds = hold_spec(holds)?;
         params.validate().map_err(Error::from)?;
     }
-    let (demos, assumed) = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
-    if !assumed.is_empty() {
-        warn(py, &assumed_period_warning(&assumed))?;
-    }
-    warn_demonstrations(py, &demos)?;
+    let demos =
+        demonstrations(demos, channels.as_deref(), dt_s, resample, &mut params)?.warned(py)?;
     let planner = py.detach(|| guard(|| Ok(Planner::with_robots(&demos, params, robots)?)))?;
     Ok(PyPlanner { inner: planner })
 }
@@ -451,9 +493,10 @@ fn apply_rate_term(params: &mut PlannerParams, rate_term: Option<&str>) -> Resul
 
 /// The task model alone (alignment and statistics, §II-B1/2), without confidence or
 /// schedule: as :func:`fit` but returns a :class:`Model`. ``params`` takes the same form as
-/// :func:`fit`'s; only its ``"fit"`` block is used; ``rate_term`` as :func:`fit`'s.
+/// :func:`fit`'s; only its ``"fit"`` block is used; ``rate_term`` and ``resample`` as
+/// :func:`fit`'s.
 #[pyfunction]
-#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, rate_term=None))]
+#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, rate_term=None, resample=false))]
 pub(crate) fn fit_model(
     py: Python<'_>,
     demos: &Bound<'_, PyAny>,
@@ -461,14 +504,12 @@ pub(crate) fn fit_model(
     params: Option<&Bound<'_, PyAny>>,
     dt_s: Option<f64>,
     rate_term: Option<String>,
+    resample: bool,
 ) -> PyResult<PyModel> {
     let mut params = planner_params(params)?;
     apply_rate_term(&mut params, rate_term.as_deref())?;
-    let (demos, assumed) = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
-    if !assumed.is_empty() {
-        warn(py, &assumed_period_warning(&assumed))?;
-    }
-    warn_demonstrations(py, &demos)?;
+    let demos =
+        demonstrations(demos, channels.as_deref(), dt_s, resample, &mut params)?.warned(py)?;
     let model = py.detach(|| guard(|| Ok(TaskModel::fit(&demos, &params.fit)?)))?;
     Ok(PyModel {
         source: ModelSource::Owned(Arc::new(model)),
@@ -626,7 +667,7 @@ impl PyPlanner {
     /// reference is the same, else through the alignment of the old reference to the new
     /// one), then the rounds are recorded as :meth:`record_round` would. Returns the new
     /// planner; this one is unchanged. The new planner saves into the file this one was
-    /// loaded from (``save(path)``, no ``force`` needed).
+    /// loaded from (``save(path)``, no ``force`` needed). ``resample`` as :func:`fit`'s.
     ///
     /// Raises:
     ///     InputError: a bad demonstration.
@@ -634,7 +675,11 @@ impl PyPlanner {
     ///     StateFileError: the rounds cannot be replayed (recorded by a tandem older than
     ///         state format 11, which did not keep the executions, or refused by the new
     ///         model's checks): keep the old state, or fit and ``save(..., force=True)``.
-    #[pyo3(signature = (demos, channels=None, params=None, dt_s=None, holds=None))]
+    #[pyo3(signature = (demos, channels=None, params=None, dt_s=None, holds=None, resample=false))]
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "the keyword arguments of the Python method, documented above"
+    )]
     fn refit(
         &self,
         py: Python<'_>,
@@ -643,17 +688,15 @@ impl PyPlanner {
         params: Option<&Bound<'_, PyAny>>,
         dt_s: Option<f64>,
         holds: Option<&Bound<'_, PyAny>>,
+        resample: bool,
     ) -> PyResult<PyPlanner> {
         let mut params = planner_params(params)?;
         if let Some(holds) = holds.filter(|h| !h.is_none()) {
             params.holds = hold_spec(holds)?;
             params.validate().map_err(Error::from)?;
         }
-        let (demos, assumed) = demonstrations(demos, channels.as_deref(), dt_s, &mut params)?;
-        if !assumed.is_empty() {
-            warn(py, &assumed_period_warning(&assumed))?;
-        }
-        warn_demonstrations(py, &demos)?;
+        let demos =
+            demonstrations(demos, channels.as_deref(), dt_s, resample, &mut params)?.warned(py)?;
         let old = &self.inner;
         let (planner, _) = py.detach(|| guard(|| Ok(old.refit(&demos, params)?)))?;
         Ok(PyPlanner { inner: planner })
