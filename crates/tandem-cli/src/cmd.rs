@@ -11,7 +11,7 @@ use tandem::{ExecutionRecord, Planner, PlannerParams};
 use crate::cli::{
     Cli, Command, FitArgs, InspectArgs, PlotArgs, RecordArgs, RobotsArg, SamplerArgs, ScheduleArgs,
 };
-use crate::gantt::{certificate_line, gantt_text, offsets_text, schedule_doc, source_name};
+use crate::gantt::{certificate_line, gantt_text, offsets_text, outcome_source_name, schedule_doc};
 use crate::json;
 use crate::{bag, cyclic, input, need, plot, sim, state_io};
 
@@ -766,7 +766,7 @@ fn summary_lines(planner: &Planner) -> Result<()> {
         offsets_text(planner.schedule()).map_or("one robot".into(), |t| format!("τ = {t} s"));
     out(&format!(
         "schedule: {offsets}; {}",
-        source_name(&planner.outcome().source)
+        outcome_source_name(planner.problem(), planner.outcome())
     ));
     Ok(())
 }

@@ -132,7 +132,7 @@ fn schedule_text(planner: &Planner, cell: tandem::planner::Cell) -> Result<Strin
     Ok(match cell {
         tandem::planner::Cell::Rounds => format!(
             "{}; {}",
-            crate::gantt::source_name(&planner.outcome().source),
+            crate::gantt::outcome_source_name(planner.problem(), planner.outcome()),
             crate::gantt::certificate_line(planner.problem(), planner.outcome())?
         ),
         tandem::planner::Cell::Continuous => {

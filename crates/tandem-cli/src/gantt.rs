@@ -6,7 +6,7 @@ use anyhow::Result;
 
 use crate::json::{AfterOut, LcIntervalOut, ScheduleDoc, ScheduleHoldOut, ScheduleOut};
 use tandem::realtime::{After, Timeline, tol};
-use tandem::schedule::{LcInterval, Outcome, Problem, Schedule, Source};
+use tandem::schedule::{LcInterval, Outcome, Problem, Schedule, SerialForm, Source};
 
 /// Columns of the text Gantt's bars.
 const GANTT_COLUMNS: usize = 72;
@@ -21,6 +21,17 @@ pub(crate) fn source_name(source: &Source) -> String {
         Source::Serial => "fastest serial schedule (fallback)".into(),
         Source::Held => "exact optimum with hold points and release rules".into(),
         Source::Staggered => "staggered (fastest warps, least starts the check accepts)".into(),
+    }
+}
+
+/// Human-readable name of where `outcome`'s schedule came from: [`source_name`], except that a
+/// serial fallback is named by its form ([`SerialForm::of`]: the fastest serial schedule, or
+/// one slowed or idling for the operator's switch time or load cap), which the state file's
+/// source alone does not tell.
+pub(crate) fn outcome_source_name(problem: &Problem, outcome: &Outcome) -> String {
+    match outcome.source {
+        Source::Serial => SerialForm::of(&outcome.schedule, problem).label().into(),
+        ref other => source_name(other),
     }
 }
 
@@ -261,7 +272,7 @@ pub(crate) fn schedule_doc(problem: &Problem, outcome: &Outcome) -> Result<Sched
         dt_s: dt,
         tick_s: s.tick_s,
         n_ref: problem.n_ref(),
-        source: source_name(&outcome.source),
+        source: outcome_source_name(problem, outcome),
         lc_intervals,
         schedule: ScheduleOut::from(s),
         holds: with_holds.then(|| holds_out(&layout, dt)),
@@ -326,7 +337,7 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
         out,
         "{starts}{}; schedule: {}",
         runs.join(", "),
-        source_name(&outcome.source)
+        outcome_source_name(problem, outcome)
     )?;
     writeln!(out)?;
     writeln!(
@@ -460,6 +471,19 @@ mod tests {
                 "docs/guide.md's glossary lacks `{entry}`"
             );
         }
+        // A serial fallback is named by its form (`outcome_source_name`).
+        for form in [SerialForm::Fastest, SerialForm::Slowed, SerialForm::Idling] {
+            let entry = format!("**{}** (`serial`)", form.label());
+            assert!(
+                glossary.contains(&entry),
+                "docs/guide.md's glossary lacks `{entry}`"
+            );
+        }
+        assert_eq!(
+            source_name(&Source::Serial),
+            SerialForm::Fastest.label(),
+            "the plain serial source reads as the fastest serial schedule"
+        );
     }
     use super::*;
 

@@ -92,6 +92,67 @@ impl Source {
     }
 }
 
+/// What a serial fallback ([`Source::Serial`]) is, read off its schedule (the state file stores
+/// only the source, so the label of a serial schedule that idles or is slowed for the
+/// operator's switch time or load cap comes from the schedule, not from a source of its own):
+/// see [`SerialForm::of`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SerialForm {
+    /// [`Problem::serial_schedule_n`]: every robot on [`Problem::fastest_warp`], each starting
+    /// when the one before it ends.
+    Fastest,
+    /// Robots one after another with some warp slower than the fastest (heads and tails slowed
+    /// for the switch time, or a tail slowed for the load cap), no idle time between them.
+    Slowed,
+    /// Some robot starts after the robot before it has ended: idle time between them for the
+    /// switch time or the load cap (Eq. 20 constraint 2 relaxed by the start allowance,
+    /// [`crate::start_allowance_s`]); its warps may be slowed too.
+    Idling,
+}
+
+impl SerialForm {
+    /// The form of `schedule` taken as a serial schedule of `problem`: [`SerialForm::Idling`]
+    /// when some robot `i + 1` starts more than `10⁻⁶·h` (`h` = [`Schedule::tick_s`]) after
+    /// robot `i`'s end (the later of its clock end and `τ_i + Σ ψ̇·Δt_s`, as
+    /// [`Problem::serial_schedule_n`] places it; the threshold is above that end's rounding,
+    /// ≈ 10⁻¹¹ s on the study's schedules, and below the least gap the fallback adds, `h/2¹⁵`),
+    /// else [`SerialForm::Slowed`] when some warp differs from [`Problem::fastest_warp`], else
+    /// [`SerialForm::Fastest`].
+    pub fn of(schedule: &Schedule, problem: &Problem) -> SerialForm {
+        let dt_s = problem.dt_s();
+        let mut start_s = 0.0;
+        let mut idles = false;
+        for (warp, next_s) in schedule.grad_exec.iter().zip(&schedule.offsets_s) {
+            let end_s =
+                clock_end_s(warp, start_s, dt_s).max(start_s + warp.iter().sum::<f64>() * dt_s);
+            idles |= *next_s - end_s > 1e-6 * schedule.tick_s;
+            start_s = *next_s;
+        }
+        if idles {
+            return SerialForm::Idling;
+        }
+        let fastest = problem.fastest_warp();
+        if schedule.grad_exec.iter().all(|w| *w == fastest) {
+            SerialForm::Fastest
+        } else {
+            SerialForm::Slowed
+        }
+    }
+
+    /// The form's label for people (what `tandem schedule` prints after `schedule:`).
+    pub fn label(self) -> &'static str {
+        match self {
+            SerialForm::Fastest => "fastest serial schedule (fallback)",
+            SerialForm::Slowed => {
+                "serial schedule slowed for the switch time or load cap (fallback)"
+            }
+            SerialForm::Idling => {
+                "serial schedule idling for the switch time or load cap (fallback)"
+            }
+        }
+    }
+}
+
 /// A re-schedule's result: the schedule and its certificate.
 ///
 /// Two outcomes are equal (`==`) when what the state file stores is: the schedule, `T_total`,

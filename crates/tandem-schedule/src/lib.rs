@@ -71,7 +71,7 @@ mod validate;
 
 pub use checked::CheckedSchedule;
 pub use choose::{
-    GapSplit, Outcome, PreviousFate, Source, sample_schedule, sample_schedule_n,
+    GapSplit, Outcome, PreviousFate, SerialForm, Source, sample_schedule, sample_schedule_n,
     sample_schedule_with_baselines,
 };
 pub use cyclic::{

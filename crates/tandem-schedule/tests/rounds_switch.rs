@@ -10,8 +10,9 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use tandem_schedule::testkit::random_problem;
 use tandem_schedule::{
-    ExactParams, Outcome, Problem, SamplerParams, Source, Violation, busy_share, margin_free_bound,
-    sample_schedule_n, start_allowance_s, validate, validate_with_operator, validate_with_switch,
+    ExactParams, Outcome, Problem, SamplerParams, SerialForm, Source, Violation, busy_share,
+    margin_free_bound, sample_schedule_n, start_allowance_s, validate, validate_with_operator,
+    validate_with_switch,
 };
 
 /// FNV-1a over 64-bit words.
@@ -143,6 +144,21 @@ fn two_robots_one_stretch_each_by_hand() {
     let gap_s = out.schedule.offsets_s[0] - 2.0;
     assert!(gap_s > 1.5 && gap_s < 1.5001, "{gap_s}");
     assert!((out.t_total_s - 5.5).abs() < 1e-3, "{}", out.t_total_s);
+    // Its label says it idles (a serial source, not the fastest serial schedule); without the
+    // gap it is the fastest serial schedule.
+    assert_eq!(SerialForm::of(&out.schedule, &p), SerialForm::Idling);
+    let fastest = p.serial_schedule_n(2, 0.1).unwrap();
+    assert_eq!(SerialForm::of(&fastest, &p), SerialForm::Fastest);
+    assert_eq!(
+        SerialForm::Fastest.label(),
+        "fastest serial schedule (fallback)"
+    );
+    // Robot 1's last sample 1 % slower, robot 2 at its (later) end: slowed, not idling.
+    let mut slowed = fastest.clone();
+    let last = slowed.grad_exec[0].len() - 1;
+    slowed.grad_exec[0][last] *= 1.01;
+    slowed.offsets_s[0] += 0.1 * 0.01 * slowed.grad_exec[0][last] / 1.01;
+    assert_eq!(SerialForm::of(&slowed, &p), SerialForm::Slowed);
     // Constraint 2 as printed refuses it: robot 2 starts after robot 1 has ended.
     assert!(matches!(
         validate(&p, &out.schedule),
@@ -212,6 +228,7 @@ fn the_load_cap_lengthens_the_round_to_its_share() {
     )
     .unwrap();
     assert_eq!(idle.source, Source::Serial);
+    assert_eq!(SerialForm::of(&idle.schedule, &p), SerialForm::Idling);
     assert!((idle.t_total_s - 40.0).abs() < 1e-6, "{}", idle.t_total_s);
     assert!((idle.lower_bound_s - 40.0).abs() < 1e-9);
     assert!(busy_share(&idle.schedule, &p, 0.0).unwrap() <= 0.05);

@@ -49,12 +49,26 @@ fn bounds_with_a_switch_time_by_hand() {
         Err(Violation::SwitchTooShort { robots: [0, 1], .. })
     ));
     // δ = 0.1 s: order 1 2 1 2 needs δ ≤ 0.05; 1 1 2 2 gives 0.5 + δ = 0.6 s only with robot 2
-    // starting after robot 1 ended (0.35 > 0.25 s, Eq. 20 constraint 2, which the dynamic
-    // program leaves out): a bound, not proven, above the operator bound 0.5 s.
-    // (No valid schedule exists: both robots start and end low-confidence.)
+    // starting after robot 1 ended (τ = 0.35 > |ψ_E1| = 0.25 s). Eq. 20 constraint 2 is
+    // relaxed by the start allowance at the schedule's tick 0.01 s, `A = δ + h + h·2/0.5 =
+    // 0.15` s ≥ 0.1 s, so the network finds that schedule and the optimum is proven (before
+    // the allowance: a bound, not proven, no schedule).
     let f = solve_exact_with_switch(&p, &params, 0.1).unwrap();
-    assert!(!f.proven_optimal && f.schedule.is_none());
+    assert!(f.proven_optimal);
+    assert_eq!(f.order, vec![0, 0, 1, 1]);
     assert!((f.lower_bound_s - 0.6).abs() < 1e-9, "{}", f.lower_bound_s);
+    let s = f.schedule.as_ref().unwrap();
+    assert!((s.offsets_s[0] - 0.35).abs() < 1e-9, "{:?}", s.offsets_s);
+    assert!((s.t_total_s(p.dt_s()) - 0.6).abs() < 1e-9);
+    // Valid under the relaxed constraint 2 (only the worst-case margins may refuse it), and
+    // refused by the printed one.
+    match validate_with_switch(&p, s, 0.1) {
+        Ok(())
+        | Err(Violation::InsufficientMargins { .. } | Violation::InsufficientSwitchTime { .. }) => {
+        }
+        Err(v) => panic!("{v}"),
+    }
+    assert!(matches!(validate(&p, s), Err(Violation::Offset { .. })));
     let b = margin_free_bound(&p, 2, &params, 0.1).unwrap();
     assert_eq!(b.lower_bound_s.to_bits(), f.lower_bound_s.to_bits());
     // δ = 0: the search without a switch time, bit for bit.

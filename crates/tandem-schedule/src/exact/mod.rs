@@ -342,12 +342,15 @@ fn margin_free(
         search::Outcome::Done(found) => found,
         search::Outcome::OutOfBudget => None,
     };
-    // With a switch time the program's optimum may start robot 2 after robot 1's end (its
-    // network, which keeps `τ ≤ |ψ_E1|`, is then infeasible): still the optimum of a
+    // With a switch time the program's optimum may start robot 2 after robot 1's end: its
+    // network relaxes constraint 2 by the start allowance at the schedule's tick `Δt_s` (what
+    // `validate_with_operator` accepts; 0 without a switch time). Should the network still be
+    // infeasible (robot 2 beyond the allowance), the search's value is the optimum of a
     // relaxation, so a lower bound, but neither a schedule nor proven.
+    let allowance_s = crate::operator::start_allowance_s(problem, 2, problem.dt_s(), switch_s, 1.0);
     if switch_s > 0.0
         && let Some(f) = &found
-        && stn::earliest(chain, &f.order, &zero).is_none()
+        && stn::earliest_with_allowance(chain, &f.order, &zero, allowance_s).is_none()
     {
         return MarginFree {
             lower_bound_s: f.t_total_s.max(operator_bound_of(chain, 2, switch_s)),
@@ -358,7 +361,7 @@ fn margin_free(
         };
     }
     let exact = found.and_then(|f| {
-        let times = stn::earliest(chain, &f.order, &zero)?;
+        let times = stn::earliest_with_allowance(chain, &f.order, &zero, allowance_s)?;
         Some((f, times))
     });
     match exact {

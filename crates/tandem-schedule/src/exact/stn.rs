@@ -58,22 +58,43 @@ pub(crate) struct Edge {
 /// comparisons is re-checked ignoring gains within rounding (`relax_tolerance`), so a cycle
 /// of weight 0 (a rigid HC run) never reads as positive.
 pub(crate) fn earliest(chain: &Chain, order: &[Robot], clear: &Clearance) -> Option<Times> {
+    earliest_with_allowance(chain, order, clear, 0.0)
+}
+
+/// [`earliest`] with Eq. 20 constraint 2 relaxed by the start allowance `allowance_s` (s,
+/// ≥ 0): `0 ≤ τ ≤ |ψ_E1| + A`, as [`crate::validate_with_operator`] relaxes it
+/// ([`crate::start_allowance_s`]; docs/decisions.md, "A schedule always exists with a switch
+/// time: constraint 2 relaxed (issue 41)"). With a switch time the margin-free optimum may
+/// start robot 2 after robot 1's end (a task that ends and starts low-confidence), which the
+/// printed constraint makes infeasible. `A = 0` is [`earliest`], the same float operations.
+pub(crate) fn earliest_with_allowance(
+    chain: &Chain,
+    order: &[Robot],
+    clear: &Clearance,
+    allowance_s: f64,
+) -> Option<Times> {
     let m = chain.n_lc();
     if order.len() != 2 * m || order.iter().filter(|&&r| r == 0).count() != m {
         return None;
     }
-    let plain = solve(chain, order, clear, false);
+    let plain = solve(chain, order, clear, false, allowance_s);
     if clear.after_start.is_none() {
         return plain;
     }
-    let early = solve(chain, order, clear, true);
+    let early = solve(chain, order, clear, true, allowance_s);
     match (plain, early) {
         (Some(a), Some(b)) => Some(if b.t_total_s() < a.t_total_s() { b } else { a }),
         (a, b) => a.or(b),
     }
 }
 
-fn solve(chain: &Chain, order: &[Robot], clear: &Clearance, after_start: bool) -> Option<Times> {
+fn solve(
+    chain: &Chain,
+    order: &[Robot],
+    clear: &Clearance,
+    after_start: bool,
+    allowance_s: f64,
+) -> Option<Times> {
     let m = chain.n_lc();
     const ORIGIN: usize = 0;
     const TAU: usize = 1;
@@ -105,10 +126,11 @@ fn solve(chain: &Chain, order: &[Robot], clear: &Clearance, after_start: bool) -
         to: TAU,
         w: 0.0,
     });
+    // `τ ≤ |ψ_E1| + A`: `end_1 ≥ τ − A` (`A = 0`: the printed constraint, weight `0.0`).
     edges.push(Edge {
         from: TAU,
         to: end(0),
-        w: 0.0,
+        w: if allowance_s > 0.0 { -allowance_s } else { 0.0 },
     });
     let mut next = [0usize; 2];
     let mut prev: Option<(usize, usize)> = None;
@@ -306,6 +328,36 @@ mod tests {
             longest_paths(&zero, 2, relax_tolerance(&zero, 2)),
             Some(vec![0.0, 1.0])
         );
+    }
+
+    #[test]
+    fn the_start_allowance_relaxes_constraint_2() {
+        // One LC run of 1 s, no head or tail; clearance 2 s (a switch time): robot 2's run
+        // starts at 1 + 2 = 3 s, so τ = 3 s, 2 s after robot 1's end (|ψ_E1| = 1 s).
+        let c = Chain {
+            lc_s: vec![1.0],
+            gap_s: vec![(0.0, 0.0), (0.0, 0.0)],
+            lc_ref: vec![(0, 1)],
+            gap_ref: vec![(0, 0), (1, 1)],
+            gap_hold: vec![None; 2],
+        };
+        let clear = Clearance::uniform(2.0, None);
+        // The printed constraint `τ ≤ |ψ_E1|`: infeasible; so with an allowance below 2 s.
+        assert!(earliest(&c, &[0, 1], &clear).is_none());
+        assert!(earliest_with_allowance(&c, &[0, 1], &clear, 1.9).is_none());
+        // Allowance 2 s or more: τ = 3 s, robot 1 ends at 1 s, T_total 4 s.
+        for a in [2.0, 2.5] {
+            let t = earliest_with_allowance(&c, &[0, 1], &clear, a).unwrap();
+            assert_eq!((t.tau_s, t.end_s, t.t_total_s()), (3.0, [1.0, 4.0], 4.0));
+        }
+        // Allowance 0 is `earliest` (the lhl orders, to the bit).
+        let l = lhl();
+        let z = Clearance::zero();
+        let (a, b) = (
+            earliest(&l, &[0, 0, 1, 1], &z).unwrap(),
+            earliest_with_allowance(&l, &[0, 0, 1, 1], &z, 0.0).unwrap(),
+        );
+        assert_eq!((a.tau_s.to_bits(), a.end_s), (b.tau_s.to_bits(), b.end_s));
     }
 
     #[test]
