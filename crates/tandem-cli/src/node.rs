@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
@@ -52,13 +52,20 @@ pub(crate) struct NodeArgs {
     /// its input at /dev/null would stop at once).
     #[arg(long)]
     pub(crate) stdin_stop: bool,
-    /// Stop after this long (s). Default: run until interrupted.
+    /// Stop after this long (s). Default: run until interrupted (SIGINT or SIGTERM end the
+    /// node cleanly: a running round aborted where it stands, a record in progress finished,
+    /// exit 0; a second signal exits at once with 130).
     #[arg(long, value_name = "S")]
     pub(crate) seconds: Option<f64>,
 }
 
-/// Runs the node until interrupted or `--seconds`, printing its counters every 10 s.
+/// Runs the node until SIGINT/SIGTERM, `--seconds` or (with `--stdin-stop`) the end of standard
+/// input, printing its counters every 10 s; then stops it cleanly ([`Node::stop`]).
 pub(crate) fn node(a: &NodeArgs) -> Result<()> {
+    // Before any thread starts, so that every thread of the node inherits the blocked mask and
+    // the signals reach only the thread that waits for them.
+    let signalled = Arc::new(AtomicU8::new(0));
+    stop_on_signals(&signalled)?;
     let params = NodeParams {
         domain: a.domain,
         cell: a.cell,
@@ -129,7 +136,10 @@ pub(crate) fn node(a: &NodeArgs) -> Result<()> {
     }
     let start = Instant::now();
     let mut report = start;
-    while node.is_running() && !closed.load(Ordering::Relaxed) {
+    while node.is_running()
+        && !closed.load(Ordering::Relaxed)
+        && signalled.load(Ordering::Relaxed) == 0
+    {
         if a.seconds
             .is_some_and(|s| start.elapsed().as_secs_f64() >= s)
         {
@@ -144,20 +154,69 @@ pub(crate) fn node(a: &NodeArgs) -> Result<()> {
                 s.ticks,
                 s.max_period_s * 1e3,
                 s.commands,
-                s.state_dropped + s.inbound_dropped + s.publish_failed
+                s.commands_dropped + s.inbound_dropped + s.publish_failed
             );
         }
     }
+    let why = match signalled.load(Ordering::Relaxed) {
+        0 => "",
+        SIGTERM_CODE => " on SIGTERM",
+        _ => " on SIGINT",
+    };
     let s = node.stop()?;
     out(&format!(
-        "stopped: {} ticks, worst period {:.2} ms, {} overruns, {} commands, {} snapshots and {} messages dropped, {} publications refused",
+        "stopped{why}: {} ticks, worst period {:.2} ms, {} overruns, {} commands, {} commands and {} messages dropped, {} publications refused",
         s.ticks,
         s.max_period_s * 1e3,
         s.overruns,
         s.commands,
-        s.state_dropped,
+        s.commands_dropped,
         s.inbound_dropped,
         s.publish_failed
     ));
+    Ok(())
+}
+
+/// What `signalled` holds after SIGTERM (SIGINT: 2; none: 0).
+const SIGTERM_CODE: u8 = 15;
+
+/// Blocks SIGINT and SIGTERM in this thread (and so in every thread started after it) and
+/// starts a thread that waits for them (`sigwait`, nix's safe `SigSet::wait`: no signal
+/// handler, no unsafe code): the first sets `signalled` (2 or 15), which the main loop polls
+/// every 50 ms to stop the node cleanly; a second one exits at once with 130, for a stop that
+/// hangs.
+#[cfg(unix)]
+fn stop_on_signals(signalled: &Arc<AtomicU8>) -> Result<()> {
+    use nix::sys::signal::{SigSet, Signal};
+    let mut set = SigSet::empty();
+    set.add(Signal::SIGINT);
+    set.add(Signal::SIGTERM);
+    set.thread_block()
+        .context("cannot block SIGINT and SIGTERM for a clean stop")?;
+    let signalled = signalled.clone();
+    std::thread::Builder::new()
+        .name("tandem-signals".into())
+        .spawn(move || {
+            while let Ok(sig) = set.wait() {
+                if signalled.load(Ordering::Relaxed) != 0 {
+                    eprintln!("tandem node: {sig} again: exiting without a clean stop");
+                    std::process::exit(130);
+                }
+                let code = if sig == Signal::SIGTERM {
+                    SIGTERM_CODE
+                } else {
+                    2
+                };
+                eprintln!("tandem node: {sig}: stopping (again to exit at once)");
+                signalled.store(code, Ordering::Relaxed);
+            }
+        })
+        .context("cannot start the thread that waits for SIGINT and SIGTERM")?;
+    Ok(())
+}
+
+/// No signals to wait for on this platform: the node stops on `--seconds` or `--stdin-stop`.
+#[cfg(not(unix))]
+fn stop_on_signals(_signalled: &Arc<AtomicU8>) -> Result<()> {
     Ok(())
 }

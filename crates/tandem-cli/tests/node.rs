@@ -1,7 +1,8 @@
 //! `tandem node` (feature `ros2`) as a process: a probe (`tandem_ros2::Probe`) plays the two
 //! robots over DDS on loopback, drives a round through `start_round` and `record_round`, the
 //! state file holds one more round, and the node stops cleanly when its standard input closes
-//! (`--stdin-stop`). Bad input exits 2 with the problem named. CI runs it inside `unshare --net`
+//! (`--stdin-stop`) or on SIGINT mid-round (the round aborted where it stands, the state file
+//! untouched, exit 0). Bad input exits 2 with the problem named. CI runs it inside `unshare --net`
 //! with the other ROS 2 tests (.ci/run: `cargo test -p tandem-cli --features ros2 --test node`).
 #![cfg(feature = "ros2")]
 
@@ -112,6 +113,121 @@ fn a_node_process_runs_a_round_records_it_and_stops_when_stdin_closes() {
         lines.iter().any(|l| l.starts_with("stopped: ")),
         "{lines:?}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn sigint_mid_round_stops_the_node_cleanly_holding_the_robots() {
+    let dir = scratch("node-sigint");
+    let state = small_state(&dir);
+    let bytes_before = std::fs::read(&state).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_tandem"))
+        .args(["node", state.to_str().unwrap()])
+        .args(["--robots", "2", "--domain", "97"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut node = Running(Some(child));
+    let probe = Probe::new(97, 2).unwrap();
+    // Every command and the last `needs_operator` of each robot (the probe hands each once).
+    let mut hist: [Vec<tandem_ros2::probe::Command>; 2] = [Vec::new(), Vec::new()];
+    let mut needs = [None; 2];
+    let mut pull = |hist: &mut [Vec<tandem_ros2::probe::Command>; 2]| {
+        for k in 0..2 {
+            hist[k].extend(probe.commands(k));
+            if let Some(b) = probe.needs(k) {
+                needs[k] = Some(b);
+            }
+        }
+    };
+    let end = Instant::now() + Duration::from_secs(60);
+    while hist.iter().any(Vec::is_empty) {
+        assert!(Instant::now() < end, "no commands from the node in 60 s");
+        pull(&mut hist);
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let echo_hist = |hist: &[Vec<tandem_ros2::probe::Command>; 2]| {
+        for (k, h) in hist.iter().enumerate() {
+            if let Some(c) = h.last() {
+                probe.report(k, c.ref_time).unwrap();
+            }
+        }
+    };
+    let r = probe
+        .call("start_round", Duration::from_secs(20), || {
+            for k in 0..2 {
+                if let Some(c) = probe.commands(k).last() {
+                    probe.report(k, c.ref_time).unwrap();
+                }
+            }
+        })
+        .unwrap();
+    assert!(r.success, "{}", r.message);
+    // Mid-round: some robot has moved off its start.
+    let end = Instant::now() + Duration::from_secs(30);
+    while !hist
+        .iter()
+        .any(|h| h.last().is_some_and(|c| c.speed > 0.0 && c.ref_time > 0.0))
+    {
+        assert!(
+            Instant::now() < end,
+            "no robot moved in 30 s after start_round"
+        );
+        pull(&mut hist);
+        echo_hist(&hist);
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let pid = node.0.as_ref().unwrap().id().to_string();
+    let kill = Command::new("kill").args(["-INT", &pid]).status().unwrap();
+    assert!(kill.success());
+    let mut child = node.0.take().unwrap();
+    let end = Instant::now() + Duration::from_secs(30);
+    let status = loop {
+        // The robots keep reporting: the node must stop on the signal, not on a stall.
+        pull(&mut hist);
+        echo_hist(&hist);
+        if let Some(st) = child.try_wait().unwrap() {
+            break st;
+        }
+        assert!(
+            Instant::now() < end,
+            "the node did not stop within 30 s of SIGINT"
+        );
+        std::thread::sleep(Duration::from_millis(1));
+    };
+    let lines: Vec<String> = BufReader::new(child.stdout.take().unwrap())
+        .lines()
+        .map(Result::unwrap)
+        .collect();
+    assert!(status.success(), "exit {status:?}; stdout {lines:?}");
+    assert!(
+        lines.iter().any(|l| l.starts_with("stopped on SIGINT: ")),
+        "{lines:?}"
+    );
+    pull(&mut hist);
+    // The last command of each robot holds it where it is: speed scale 0, the reference time
+    // of the command before it (not sent back to its start), the tick after it; nobody needs
+    // the operator.
+    for (k, h) in hist.iter().enumerate() {
+        let (last, before) = (h[h.len() - 1], h[h.len() - 2]);
+        assert_eq!(last.speed, 0.0, "robot {}: {last:?}", k + 1);
+        assert_eq!(last.tick, before.tick + 1, "robot {}: no tick lost", k + 1);
+        assert_eq!(
+            last.ref_time,
+            before.ref_time,
+            "robot {}: held in place",
+            k + 1
+        );
+        assert_eq!(needs[k], Some(false), "robot {}", k + 1);
+    }
+    assert!(
+        hist.iter().any(|h| h[h.len() - 1].ref_time > 0.0),
+        "the round had moved a robot off its start before the signal"
+    );
+    // An unfinished round is never recorded: the state file is byte for byte as it was.
+    assert_eq!(std::fs::read(&state).unwrap(), bytes_before);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

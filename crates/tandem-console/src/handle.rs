@@ -18,7 +18,8 @@ use serde::{Deserialize, Serialize};
 use tandem_planner::AnyController;
 use tandem_realtime::{ContinuousCoordinator, Controller, Coordinator, MAX_ROBOTS, Tick};
 
-use crate::frame::{Ack, HEADER, ROBOT_WORDS, RawFrame, WORDS};
+use crate::frame::{Ack, Geometry, HEADER, ROBOT_WORDS, RawFrame, WORDS};
+use crate::server::Update;
 
 /// A single-writer sequence lock over the words of a [`RawFrame`]: the writer bumps the
 /// sequence to odd, stores the words, bumps it to even; a reader retries while the sequence is
@@ -168,6 +169,8 @@ pub struct ConsoleHandle {
     shared: Arc<Shared>,
     controls: Receiver<ControlMsg>,
     acks: SyncSender<Ack>,
+    /// The plan and notice updates to the server ([`ConsoleHandle::set_plan`]).
+    updates: SyncSender<Update>,
     rounds: bool,
     n_robots: usize,
     can_hold: bool,
@@ -195,6 +198,7 @@ impl ConsoleHandle {
         shared: Arc<Shared>,
         controls: Receiver<ControlMsg>,
         acks: SyncSender<Ack>,
+        updates: SyncSender<Update>,
         rounds: bool,
         n_robots: usize,
         can_hold: bool,
@@ -203,6 +207,7 @@ impl ConsoleHandle {
             shared,
             controls,
             acks,
+            updates,
             rounds,
             n_robots,
             can_hold,
@@ -216,6 +221,27 @@ impl ConsoleHandle {
             count_key: [(0, 0); MAX_ROBOTS],
             last_corrected: None,
         }
+    }
+
+    /// The cell's plan changed (a controller that re-planned: the next round's schedule after a
+    /// recorded one): the server builds the page's frames on `geometry` from its next period
+    /// on (with the console's configured lead and horizon), and its strips start afresh. Give it
+    /// before publishing the first tick of the new controller: snapshots the server reads in
+    /// the same period are read on the new plan. Of the same cell and robots as the console's
+    /// (the handle keeps its cell kind and robot count). Never blocks; `false` when the
+    /// server's queue of updates is full (it is not taken then: give it again).
+    pub fn set_plan(&mut self, geometry: Geometry) -> bool {
+        self.updates
+            .try_send(Update::Plan(Box::new(geometry)))
+            .is_ok()
+    }
+
+    /// Sets (or clears, `None`) the notice every frame carries from the server's next period
+    /// on, from the loop's side ([`Console::set_notice`](crate::Console::set_notice) from the
+    /// console's owner); queued in order with [`set_plan`](Self::set_plan). Never blocks;
+    /// `false` when the server's queue of updates is full (not taken then).
+    pub fn set_notice(&mut self, notice: Option<String>) -> bool {
+        self.updates.try_send(Update::Notice(notice)).is_ok()
     }
 
     /// Hands the snapshot of `ctl` after `tick` to the page. Lock-free and wait-free, never

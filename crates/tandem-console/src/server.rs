@@ -128,6 +128,10 @@ impl App {
         self.clients.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
+    fn set_notice(&self, notice: Option<String>) {
+        *self.notice.lock().unwrap_or_else(PoisonError::into_inner) = notice;
+    }
+
     fn notice(&self) -> Option<String> {
         self.notice
             .lock()
@@ -135,6 +139,26 @@ impl App {
             .clone()
     }
 }
+
+/// The plan the server reads, the configuration's lead and horizon to apply to a new one, and
+/// the loop's updates ([`ConsoleHandle::set_plan`], [`ConsoleHandle::set_notice`]).
+struct Plan {
+    geometry: Geometry,
+    config: (f64, f64),
+    updates: Receiver<Update>,
+}
+
+/// What the control loop's handle sends the server besides snapshots: rare, queued, in order.
+#[derive(Debug)]
+pub(crate) enum Update {
+    /// The cell's plan changed (a controller re-planned after a recorded round).
+    Plan(Box<Geometry>),
+    /// The notice every frame carries from now on ([`Console::set_notice`]).
+    Notice(Option<String>),
+}
+
+/// Queued updates the server has not taken yet (a handful between two server periods).
+const UPDATE_QUEUE: usize = 16;
 
 /// A running console: the server thread and its address. Dropping it stops the server.
 #[derive(Debug)]
@@ -170,10 +194,12 @@ impl Console {
         let shared = Arc::new(Shared::new());
         let (controls_tx, controls_rx) = sync_channel(CONTROL_QUEUE);
         let (acks_tx, acks_rx) = sync_channel(ACK_QUEUE);
+        let (updates_tx, updates_rx) = sync_channel(UPDATE_QUEUE);
         let handle = ConsoleHandle::new(
             shared.clone(),
             controls_rx,
             acks_tx,
+            updates_tx,
             geometry.is_rounds(),
             geometry.n_robots(),
             geometry.can_hold(),
@@ -195,11 +221,24 @@ impl Console {
         let (stop_tx, stop_rx) = oneshot::channel::<()>();
         let period = Duration::from_secs_f64(1.0 / config.max_hz);
         let schedule = config.schedule.clone();
+        let plan_config = (config.lead_s, config.horizon_s);
         let thread = std::thread::Builder::new()
             .name("tandem-console".into())
             .spawn(move || {
                 rt.block_on(serve(
-                    listener, app, shared, geometry, schedule, frames_tx, acks_rx, period, stop_rx,
+                    listener,
+                    app,
+                    shared,
+                    Plan {
+                        geometry,
+                        config: plan_config,
+                        updates: updates_rx,
+                    },
+                    schedule,
+                    frames_tx,
+                    acks_rx,
+                    period,
+                    stop_rx,
                 ));
                 rt.shutdown_timeout(Duration::from_millis(200));
             })
@@ -225,11 +264,7 @@ impl Console {
     /// Sets (or clears, `None`) the notice every frame carries to the page from now on (a
     /// replay's damaged file, its end); it is pushed at the next server period.
     pub fn set_notice(&self, notice: Option<String>) {
-        *self
-            .app
-            .notice
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner) = notice;
+        self.app.set_notice(notice);
     }
 
     /// The address the server listens on.
@@ -264,7 +299,7 @@ async fn serve(
     listener: TcpListener,
     app: Arc<App>,
     shared: Arc<Shared>,
-    geometry: Geometry,
+    plan: Plan,
     schedule: Option<String>,
     frames_tx: watch::Sender<Arc<str>>,
     acks_rx: Receiver<Ack>,
@@ -284,7 +319,7 @@ async fn serve(
         .route("/frame", get(latest))
         .route("/control", post(control))
         .with_state(app.clone());
-    let poll = poller(app, shared, geometry, schedule, frames_tx, acks_rx, period);
+    let poll = poller(app, shared, plan, schedule, frames_tx, acks_rx, period);
     let server = axum::serve(listener, router);
     tokio::select! {
         r = server => if let Err(e) = r { eprintln!("console: server stopped: {e}") },
@@ -298,7 +333,7 @@ async fn serve(
 async fn poller(
     app: Arc<App>,
     shared: Arc<Shared>,
-    geometry: Geometry,
+    plan: Plan,
     schedule: Option<String>,
     frames_tx: watch::Sender<Arc<str>>,
     acks_rx: Receiver<Ack>,
@@ -312,6 +347,11 @@ async fn poller(
     let mut last_notice: Option<String> = None;
     let mut tracker = Tracker::new();
     let mut last_push = Instant::now();
+    let Plan {
+        mut geometry,
+        config: (lead_s, horizon_s),
+        updates,
+    } = plan;
     loop {
         interval.tick().await;
         // Ask the loop for its next snapshot and wait for it (at most one period: a loop that
@@ -321,6 +361,23 @@ async fn poller(
         let asked = Instant::now();
         while shared.slot.written() == before && asked.elapsed() < period {
             tokio::time::sleep(Duration::from_millis(1)).await;
+        }
+        // The loop's updates (`ConsoleHandle::set_plan`, `set_notice`), in their order, after the
+        // snapshot: the loop sends a new plan before the first snapshot on it, so a snapshot of
+        // the new controller is not read on the old plan (unless the loop answered later than
+        // a period, and then for one frame).
+        while let Ok(u) = updates.try_recv() {
+            match u {
+                Update::Plan(g) => {
+                    geometry = *g;
+                    geometry.lead_s = lead_s.max(geometry.switch_s());
+                    geometry.horizon_s = horizon_s;
+                    // The strips follow the new plan's executions from its first snapshot.
+                    tracker = Tracker::new();
+                    last_version = u64::MAX;
+                }
+                Update::Notice(n) => app.set_notice(n),
+            }
         }
         let (acks, version, controller) = {
             let mut c = app.clients();

@@ -133,6 +133,48 @@ fn bench(c: &mut Criterion) {
             black_box(bare.tick(Operator::Scheduled).expect("a valid operator"))
         });
     });
+    // A bare tick paced by a clock, as any live loop is (the node's tick thread reads the clock
+    // once a tick for its period and uses that reading for liveness too): the baseline that
+    // isolates what the node adds.
+    let mut paced = planner.controller(Cell::Rounds).expect("a plan");
+    group.bench_function("bare_clocked", |b| {
+        b.iter(|| {
+            black_box(Instant::now());
+            if paced.is_finished() {
+                paced.reset();
+            }
+            black_box(paced.tick(Operator::Scheduled).expect("a valid operator"))
+        });
+    });
+    // The links alone, both ends, on a fixed command (no tick, no clock): three progress
+    // counters heard and compared, the ring's push and pop, the slot asked every 10th tick,
+    // written and taken.
+    let mut node = NodeTick::new(&planner, 10);
+    let fixed = node.l.advance(Instant::now()).expect("a valid operator");
+    let snap = node.l.snapshot();
+    group.bench_function("links_only", |b| {
+        b.iter(|| {
+            for k in 0..3 {
+                node.heard.hear(k);
+            }
+            node.i += 1;
+            if node.i.is_multiple_of(10) {
+                node.state.ask();
+            }
+            let heard = node.heard.changed(3, &mut node.heard_seen);
+            node.ring.push(black_box(&fixed));
+            if node.state.wanted() {
+                node.state.put(snap);
+            }
+            let c = node.ring.pop().map(|c| c.ref_time[0]);
+            let s = if node.i.is_multiple_of(10) {
+                node.state.take().map(|s| s.ref_time[1])
+            } else {
+                None
+            };
+            black_box((heard, c, s))
+        });
+    });
     // The loop's own work without the links or the clock (`CellLoop::advance` at a fixed
     // instant, the robots heard): what the node's tick adds to a bare one before any queue.
     let mut node = NodeTick::new(&planner, 10);

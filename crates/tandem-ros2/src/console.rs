@@ -17,7 +17,50 @@ use crate::core::CellLoop;
 pub struct ConsoleFeed {
     handle: ConsoleHandle,
     finished: bool,
+    /// The loop's plan generation the page shows ([`CellLoop::plan_generation`]).
+    generation: u64,
+    /// The loop's state the page's notice says (`None` before the first publish).
+    shown: Option<Phase>,
 }
+
+/// What the page's notice says of the node's cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Phase {
+    /// Nothing runs and no round waits to be recorded.
+    Idle,
+    /// A finished round waits to be recorded (or a new one to start).
+    Finished,
+    /// A round (or the cell) runs: no notice.
+    Running,
+}
+
+impl Phase {
+    fn of(cell_loop: &CellLoop) -> Phase {
+        if cell_loop.is_active() {
+            Phase::Running
+        } else if cell_loop.is_finished() {
+            Phase::Finished
+        } else {
+            Phase::Idle
+        }
+    }
+
+    /// The page's notice.
+    fn notice(self) -> Option<String> {
+        match self {
+            Phase::Idle => Some(IDLE_NOTICE.to_owned()),
+            Phase::Finished => Some(FINISHED_NOTICE.to_owned()),
+            Phase::Running => None,
+        }
+    }
+}
+
+/// The page's notice while nothing runs (before the first `start_round`, after `stop_round`,
+/// after a recorded round).
+pub const IDLE_NOTICE: &str = "idle — waiting for start_round (service /tandem/start_round)";
+/// The page's notice while a finished round waits.
+pub const FINISHED_NOTICE: &str = "round finished — record it with /tandem/record_round, or start the \
+                            next with /tandem/start_round";
 
 impl ConsoleFeed {
     /// Feeds `handle` (of a [`tandem_console::Console`] started on the loop's controller's
@@ -27,13 +70,32 @@ impl ConsoleFeed {
         ConsoleFeed {
             handle,
             finished: false,
+            generation: 0,
+            shown: None,
         }
     }
 
     /// After each [`CellLoop::step`] or [`CellLoop::advance`]: answers the page's controls,
-    /// counts a finished round, and publishes the loop's last tick. Never blocks; allocates
-    /// only to answer a control message.
+    /// counts a finished round, hands the page a replaced controller's plan
+    /// ([`CellLoop::plan`]) before its first tick, says on the page whether the cell is idle
+    /// ([`IDLE_NOTICE`]) or a round waits ([`FINISHED_NOTICE`]), and publishes the loop's last tick. Never
+    /// blocks; allocates only to answer a control message, and when the plan or the cell's
+    /// state changed.
     pub fn publish(&mut self, cell_loop: &CellLoop) {
+        let generation = cell_loop.plan_generation();
+        if generation != self.generation {
+            // A full queue of updates: given again at the next tick.
+            if cell_loop
+                .plan()
+                .is_none_or(|g| self.handle.set_plan(g.clone()))
+            {
+                self.generation = generation;
+            }
+        }
+        let phase = Phase::of(cell_loop);
+        if self.shown != Some(phase) && self.handle.set_notice(phase.notice()) {
+            self.shown = Some(phase);
+        }
         let finished = cell_loop.is_finished();
         while let Some(msg) = self.handle.poll_control() {
             let (ok, text) = answer(&msg);

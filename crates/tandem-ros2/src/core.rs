@@ -6,9 +6,9 @@
 //! network's data (a robot's liveness, the operator's input) is taken on the last value that
 //! arrived, with a timeout for each (docs/decisions.md, "tandem in a live ROS 2 graph").
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
-use tandem_console::tick_now;
+use tandem_console::{Geometry, tick_now};
 use tandem_lfd::{Demonstration, Execution, TaskModel};
 use tandem_planner::{AnyController, Cell, ExecutionRecord};
 use tandem_realtime::{
@@ -91,8 +91,9 @@ pub enum Inbound {
         /// What is asked.
         what: Request,
     },
-    /// A round was recorded: the planner's new controller, run from the next started round.
-    Replace(Box<AnyController>),
+    /// A round was recorded: the planner's new controller and its plan as the console draws it
+    /// (built off the tick thread), run from the next started round.
+    Replace(Box<AnyController>, Box<Geometry>),
     /// Recording the round failed: its log back, to record again after the fix.
     Restore(RoundLog),
 }
@@ -350,14 +351,22 @@ pub fn operator_input(axis: f64, deadband: f64) -> Operator {
 #[derive(Debug)]
 pub struct CellLoop {
     ctl: AnyController,
-    pending: Option<Box<AnyController>>,
+    pending: Option<(Box<AnyController>, Box<Geometry>)>,
+    /// Controllers swapped in so far ([`CellLoop::plan_generation`]).
+    generation: u64,
+    /// The plan of the controller swapped in last (`None` while it is the first one).
+    plan: Option<Box<Geometry>>,
     params: LoopParams,
     dt_s: f64,
     last_ref: f64,
     active: bool,
-    active_since: Instant,
+    /// `params.stall_s` as a duration (compared without floating point each tick).
+    stall_after: Duration,
+    /// `params.operator_timeout_s` as a duration.
+    operator_timeout: Duration,
     finished: bool,
-    last_progress: [Option<Instant>; MAX_ROBOTS],
+    /// Each robot's last progress, or the round's start when it has not reported since.
+    last_progress: [Instant; MAX_ROBOTS],
     axis: f64,
     correcting: bool,
     operator_at: Option<Instant>,
@@ -402,15 +411,22 @@ impl CellLoop {
                 })
                 .collect(),
         };
+        // Validated finite and > 0; a duration too long to represent is "never".
+        let stall_after = Duration::try_from_secs_f64(params.stall_s).unwrap_or(Duration::MAX);
+        let operator_timeout =
+            Duration::try_from_secs_f64(params.operator_timeout_s).unwrap_or(Duration::MAX);
         Ok(CellLoop {
             pending: None,
+            generation: 0,
+            plan: None,
             params,
             dt_s,
             last_ref: model.n_ref().saturating_sub(1) as f64,
             active: false,
-            active_since: Instant::now(),
+            stall_after,
+            operator_timeout,
             finished: false,
-            last_progress: [None; MAX_ROBOTS],
+            last_progress: [Instant::now(); MAX_ROBOTS],
             axis: 0.0,
             correcting: false,
             operator_at: None,
@@ -454,7 +470,7 @@ impl CellLoop {
                 self.correcting = correcting;
                 self.operator_at = Some(now);
             }
-            Inbound::Replace(ctl) => self.pending = Some(ctl),
+            Inbound::Replace(ctl, plan) => self.pending = Some((ctl, plan)),
             Inbound::Restore(log) => {
                 self.log = log;
                 self.finished = true;
@@ -486,7 +502,7 @@ impl CellLoop {
     /// Robot `robot` (0-based; others ignored) reported progress at `now`: it is alive.
     pub fn heard(&mut self, robot: usize, now: Instant) {
         if robot < self.ctl.n_robots() {
-            self.last_progress[robot] = Some(now);
+            self.last_progress[robot] = now;
         }
     }
 
@@ -494,6 +510,27 @@ impl CellLoop {
     #[must_use]
     pub fn is_finished(&self) -> bool {
         self.finished
+    }
+
+    /// Whether a round (or the cell) runs: between a `start_round` and the round's end, a
+    /// `stop_round` or the node's stop.
+    #[must_use]
+    pub fn is_active(&self) -> bool {
+        self.active
+    }
+
+    /// How many times the controller was replaced (a recorded round's new schedule, swapped
+    /// in at the next `start_round`); 0 while the loop runs the controller it began with.
+    #[must_use]
+    pub fn plan_generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// The plan of the controller it runs when that replaced the first one
+    /// ([`Inbound::Replace`]); `None` while it runs the controller it began with.
+    #[must_use]
+    pub fn plan(&self) -> Option<&Geometry> {
+        self.plan.as_deref()
     }
 
     fn take_round(&mut self) -> std::result::Result<RoundLog, Refusal> {
@@ -517,10 +554,12 @@ impl CellLoop {
                 if self.active {
                     return Err(Refusal::Running);
                 }
-                if let Some(ctl) = self.pending.take() {
+                if let Some((ctl, plan)) = self.pending.take() {
                     self.capacity = round_capacity(&ctl);
                     self.log.tick_s = ctl.tick_s();
                     self.ctl = *ctl;
+                    self.plan = Some(plan);
+                    self.generation += 1;
                 }
                 // Rounds: a new round from the start; the continuous cell resumes.
                 if self.ctl.cell() == Cell::Rounds {
@@ -536,8 +575,7 @@ impl CellLoop {
                 }
                 self.finished = false;
                 self.stall = None;
-                self.last_progress = [None; MAX_ROBOTS];
-                self.active_since = now;
+                self.last_progress = [now; MAX_ROBOTS];
                 self.active = true;
                 Ok(())
             }
@@ -562,7 +600,7 @@ impl CellLoop {
                 }
                 if let Some(NodeFault::Stalled { robot, .. }) = self.stall.take() {
                     // A fresh grace period: stalled again if it stays silent.
-                    self.last_progress[robot] = Some(now);
+                    self.last_progress[robot] = now;
                 }
                 self.ctl.clear_fault();
                 Ok(())
@@ -626,10 +664,12 @@ impl CellLoop {
         self.ticks += 1;
         if self.active && self.stall.is_none() {
             for k in 0..n {
-                let last = self.last_progress[k].unwrap_or(self.active_since);
-                let silent_s = now.saturating_duration_since(last).as_secs_f64();
-                if silent_s > self.params.stall_s {
-                    self.stall = Some(NodeFault::Stalled { robot: k, silent_s });
+                let silent = now.saturating_duration_since(self.last_progress[k]);
+                if silent > self.stall_after {
+                    self.stall = Some(NodeFault::Stalled {
+                        robot: k,
+                        silent_s: silent.as_secs_f64(),
+                    });
                     break;
                 }
             }
@@ -640,9 +680,9 @@ impl CellLoop {
         let before = self.last.ref_time;
         let mut overlap = false;
         if self.active && self.stall.is_none() {
-            let fresh = self.operator_at.is_some_and(|t| {
-                now.saturating_duration_since(t).as_secs_f64() <= self.params.operator_timeout_s
-            });
+            let fresh = self
+                .operator_at
+                .is_some_and(|t| now.saturating_duration_since(t) <= self.operator_timeout);
             let (operator, correcting) = if fresh {
                 (
                     operator_input(self.axis, self.params.deadband),
@@ -655,34 +695,23 @@ impl CellLoop {
             let running = self.ctl.running_now();
             let low = self.low_now;
             debug_assert_eq!(low, self.ctl.low_conf_now());
-            let logging = self.ctl.cell() == Cell::Rounds;
-            if logging {
-                for (i, r) in self.log.robots.iter_mut().enumerate() {
-                    if running[i] {
-                        // The last reference sample is the task's end (the timeline runs to
-                        // T_ref, one sample period past it), as the simulated cell logs it.
-                        r.ref_time.push(before[i].min(self.last_ref));
-                        r.supervised.push(low[i]);
-                        r.corrected.push(low[i] && corrected);
-                    }
-                }
-            }
             let tick = self.ctl.tick(operator)?;
             self.last = tick;
             self.low_now = self.ctl.low_conf_now();
             overlap = tick.overlap();
-            if logging {
-                // A robot that started the tick unsupervised but traversed a low-confidence
-                // sample inside it was watched (the coordinator reports the tick
-                // low-confidence): its sample is supervised, as the simulated cell records it.
+            if self.ctl.cell() == Cell::Rounds {
+                // One entry per robot that ran: its reference time at the tick's start (the
+                // last reference sample is the task's end: the timeline runs to T_ref, one
+                // sample period past it, as the simulated cell logs it); supervised when it was
+                // low-confidence at the start or traversed a low-confidence sample inside the
+                // tick (the coordinator reports the tick low-confidence), as the simulated cell
+                // records it; corrected when supervised and the operator corrected.
                 for (i, r) in self.log.robots.iter_mut().enumerate() {
-                    if running[i] && !low[i] && tick.low_conf[i] {
-                        if let Some(s) = r.supervised.last_mut() {
-                            *s = true;
-                        }
-                        if let Some(c) = r.corrected.last_mut() {
-                            *c = corrected;
-                        }
+                    if running[i] {
+                        let supervised = low[i] || tick.low_conf[i];
+                        r.ref_time.push(before[i].min(self.last_ref));
+                        r.supervised.push(supervised);
+                        r.corrected.push(supervised && corrected);
                     }
                 }
             }
@@ -707,6 +736,41 @@ impl CellLoop {
             speed: self.speed,
             needs_operator: self.needs_operator(),
         })
+    }
+}
+
+impl CellLoop {
+    /// The node is shutting down (`Node::stop`: a signal, `--stdin-stop`, the end of
+    /// `--seconds`): a running round is aborted where it stands, as a stalled link holds the
+    /// cell — no robot's schedule clock moves again, its log is discarded (an unfinished round is
+    /// never recorded) — and the last command says so: not active, every robot at the
+    /// reference time it reached with speed scale 0, none needing the operator. Unlike
+    /// [`Request::Stop`] the controller is not reset, so a driver that follows the last command
+    /// holds its robot where it is instead of sending it back to its start. A finished round
+    /// that waits to be recorded stays finished (its log is the caller's to record).
+    #[must_use]
+    pub fn halt(&mut self) -> Command {
+        let n = self.ctl.n_robots();
+        self.ticks += 1;
+        if self.active {
+            self.active = false;
+            for r in &mut self.log.robots {
+                r.ref_time.clear();
+                r.supervised.clear();
+                r.corrected.clear();
+            }
+        }
+        self.speed = PerRobot::new(n);
+        self.overlap = false;
+        Command {
+            tick: self.ticks,
+            active: false,
+            finished: self.finished,
+            fault: self.fault().is_some(),
+            ref_time: self.last.ref_time,
+            speed: self.speed,
+            needs_operator: RobotFlags::new(n),
+        }
     }
 }
 

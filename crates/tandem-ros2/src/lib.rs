@@ -24,7 +24,7 @@ pub mod probe;
 pub use crate::core::{
     CellLoop, Command, Inbound, LoopParams, NodeFault, Reply, Request, RoundLog, Snapshot,
 };
-pub use console::ConsoleFeed;
+pub use console::{ConsoleFeed, FINISHED_NOTICE, IDLE_NOTICE};
 pub use error::{Error, Result};
 pub use node::{Node, NodeParams, NodeStats};
 pub use pose::{PoseChannels, PoseMap};

@@ -135,8 +135,11 @@ pub struct NodeStats {
     pub max_tick_s: f64,
     /// Ticks that started more than one period late.
     pub overruns: u64,
-    /// Commands the tick thread could not hand over (the DDS thread `queue` ticks behind).
-    pub state_dropped: u64,
+    /// Ticks whose command the tick thread could not hand over: the command ring was full (the
+    /// DDS thread `queue` ticks behind), so that tick's `command` was never published. (Named
+    /// `state_dropped` before the ring: the state topics' snapshot is never dropped, a request
+    /// the tick thread cannot answer at once is answered at the next tick.)
+    pub commands_dropped: u64,
     /// Messages from the network the DDS thread could not queue (the tick thread behind).
     pub inbound_dropped: u64,
     /// Commands published.
@@ -148,7 +151,10 @@ pub struct NodeStats {
 /// A running node; [`Node::stop`] ends it.
 #[derive(Debug)]
 pub struct Node {
+    /// Ends the tick thread (it then publishes its last command: [`CellLoop::halt`]).
     stop: Arc<AtomicBool>,
+    /// Ends the DDS thread, set once the tick thread has ended (so its last command goes out).
+    io_stop: Arc<AtomicBool>,
     counters: Arc<Counters>,
     tick: Option<JoinHandle<Result<()>>>,
     io: Option<JoinHandle<Result<()>>>,
@@ -225,6 +231,7 @@ impl Node {
         let pose = params.pose_channels.resolve(model.channel_names())?;
         let cell_loop = CellLoop::new(ctl, &model, params.loop_params.clone())?;
         let stop = Arc::new(AtomicBool::new(false));
+        let io_stop = Arc::new(AtomicBool::new(false));
         let counters = Arc::new(Counters::default());
         let (in_tx, in_rx) = sync_channel::<Inbound>(params.queue);
         let links = Arc::new(Links {
@@ -247,7 +254,7 @@ impl Node {
             in_tx: in_tx.clone(),
             links: links.clone(),
             reply_rx,
-            stop: stop.clone(),
+            stop: io_stop.clone(),
             counters: counters.clone(),
         };
         let io = std::thread::Builder::new()
@@ -287,6 +294,7 @@ impl Node {
             })?;
         Ok(Node {
             stop,
+            io_stop,
             counters,
             tick: Some(tick),
             io: Some(io),
@@ -341,7 +349,7 @@ impl Node {
             max_period_s: get(&c.max_period_ns) as f64 * 1e-9,
             max_tick_s: get(&c.max_tick_ns) as f64 * 1e-9,
             overruns: get(&c.overruns),
-            state_dropped: self.links_dropped(),
+            commands_dropped: self.links_dropped(),
             inbound_dropped: get(&c.inbound_dropped),
             commands: get(&c.commands),
             publish_failed: get(&c.publish_failed),
@@ -360,13 +368,18 @@ impl Node {
             .all(|h| h.as_ref().is_some_and(|h| !h.is_finished()))
     }
 
-    /// Stops both threads and returns the counters.
+    /// Stops the node cleanly and returns the counters: the tick thread ends its loop and
+    /// hands over a last command ([`CellLoop::halt`]: a running round aborted where it stands,
+    /// every robot's speed scale 0, nobody needing the operator); then the DDS thread publishes
+    /// what is left in the ring, waits for a `record_round` in progress to finish (its save is
+    /// atomic and under the state file's lock either way) and ends.
     ///
     /// # Errors
     /// The first error a thread ended with.
     pub fn stop(mut self) -> Result<NodeStats> {
         self.stop.store(true, Ordering::Relaxed);
         let tick = self.tick.take().map(|h| join(h, "tandem-tick"));
+        self.io_stop.store(true, Ordering::Relaxed);
         let io = self.io.take().map(|h| join(h, "tandem-dds"));
         if let Some(c) = self.console.take() {
             c.stop();
@@ -380,6 +393,7 @@ impl Node {
 impl Drop for Node {
     fn drop(&mut self) {
         self.stop.store(true, Ordering::Relaxed);
+        self.io_stop.store(true, Ordering::Relaxed);
     }
 }
 
@@ -462,9 +476,10 @@ impl Ticker {
             }
             last_flags = flags;
             c.ticks.fetch_add(1, Ordering::Relaxed);
-            max_into(&c.max_tick_ns, now.elapsed().as_nanos() as u64);
             next += period;
+            // One clock read for both the tick's work and the sleep.
             let after = Instant::now();
+            max_into(&c.max_tick_ns, (after - now).as_nanos() as u64);
             if next > after {
                 std::thread::sleep(next - after);
             } else if after - next > period {
@@ -473,9 +488,20 @@ impl Ticker {
                 next = after;
             }
         }
+        // The last command: the round aborted where it stands (`CellLoop::halt`). A full ring
+        // (the DDS thread `queue` ticks behind) drops it, counted as any other.
+        let last = self.cell_loop.halt();
+        self.links.commands.push(&last);
+        if let Some(feed) = &mut self.console {
+            feed.publish(&self.cell_loop);
+        }
         Ok(())
     }
 }
+
+/// How long the DDS thread keeps its entities after the tick thread's last command, so that
+/// reliable delivery can repair a lost sample (a few heartbeat periods on loopback).
+const LINGER: Duration = Duration::from_millis(300);
 
 /// The DDS thread's inputs.
 struct Io {
@@ -630,7 +656,15 @@ impl Io {
                 c.publish_failed.fetch_add(1, Ordering::Relaxed);
             }
         };
-        while !self.stop.load(Ordering::Relaxed) {
+        // Records running on their threads: the loop ends only when none is left.
+        let mut recording = 0_usize;
+        let mut stopped_at: Option<Instant> = None;
+        loop {
+            // Set once the tick thread has ended: this pass publishes its last commands.
+            let stopping = self.stop.load(Ordering::Relaxed);
+            if stopping && stopped_at.is_none() {
+                stopped_at = Some(Instant::now());
+            }
             let mut busy = false;
             // 1. The tick thread's commands, every tick's; `needs_operator` on change.
             let links = &*self.links;
@@ -751,13 +785,16 @@ impl Io {
                         }
                     }
                     Reply::Round { token, log } => {
-                        self.spawn_record(token, log, rec_tx.clone());
+                        if self.spawn_record(token, log, rec_tx.clone()) {
+                            recording += 1;
+                        }
                     }
                 }
             }
             // 5. Finished recordings.
             while let Ok(done) = rec_rx.try_recv() {
                 busy = true;
+                recording = recording.saturating_sub(1);
                 let r = match done.result {
                     Ok((text, new_model)) => {
                         model = *new_model;
@@ -768,6 +805,12 @@ impl Io {
                 if let Some((i, id)) = pending.remove(&done.token) {
                     fail(servers[i].send_response(id, r).is_ok());
                 }
+            }
+            // The DDS entities live on for `LINGER` after the last publication: the library's
+            // publisher cannot wait for acknowledgments, and a reliable sample lost on the wire
+            // is repaired only while its writer exists.
+            if stopped_at.is_some_and(|t| t.elapsed() >= LINGER) && recording == 0 {
+                break;
             }
             if !busy {
                 std::thread::sleep(Duration::from_micros(200));
@@ -849,7 +892,8 @@ impl Io {
 
     /// Records `log` into the state file on a thread of its own (the lock may be waited for,
     /// the planner re-schedules): the same lock, load, checks and save as `tandem record`.
-    fn spawn_record(&self, token: u64, log: RoundLog, done: SyncSender<Recorded>) {
+    /// `true` when its thread runs (it reports on `done`).
+    fn spawn_record(&self, token: u64, log: RoundLog, done: SyncSender<Recorded>) -> bool {
         let state = self.state.clone();
         let cell = self.cell;
         let in_tx = self.in_tx.clone();
@@ -860,7 +904,8 @@ impl Io {
                 let result = match record(&state, cell, &log) {
                     Ok((text, ctl, model)) => {
                         // Blocking send is fine here: this thread is not the tick's.
-                        if in_tx.send(Inbound::Replace(ctl)).is_ok() {
+                        let plan = Box::new(Geometry::new(&ctl));
+                        if in_tx.send(Inbound::Replace(ctl, plan)).is_ok() {
                             links.pending.sent();
                         }
                         Ok((text, model))
@@ -877,6 +922,7 @@ impl Io {
         if spawned.is_err() {
             self.counters.publish_failed.fetch_add(1, Ordering::Relaxed);
         }
+        spawned.is_ok()
     }
 }
 

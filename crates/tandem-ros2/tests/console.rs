@@ -1,6 +1,8 @@
 //! The node feeds the operator console (issue 43, "the console and the node share one
 //! source"): the console's `/frame` shows the loop's own tick, its low-confidence robot is the
-//! node's `needs_operator`, and a node started with a console serves the live round.
+//! node's `needs_operator`, a controller replaced after a recorded round brings its plan to the
+//! page, the page says when the node is idle, and a node started with a console serves the live
+//! round.
 //! Loopback only.
 
 mod support;
@@ -12,7 +14,10 @@ use std::time::{Duration, Instant};
 use tandem_console::{Console, ConsoleConfig, Frame, Geometry, RobotState};
 use tandem_planner::Cell;
 use tandem_realtime::Controller;
-use tandem_ros2::{CellLoop, ConsoleFeed, Inbound, LoopParams, Node, NodeParams, Probe, Request};
+use tandem_ros2::{
+    CellLoop, ConsoleFeed, FINISHED_NOTICE, IDLE_NOTICE, Inbound, LoopParams, Node, NodeParams,
+    Probe, Request,
+};
 
 /// One HTTP/1.1 request; returns the status and the body.
 fn http(addr: SocketAddr, method: &str, path: &str) -> (u16, String) {
@@ -125,6 +130,107 @@ fn the_consoles_lc_robot_is_the_nodes_needs_operator_at_every_change() {
     console.stop();
 }
 
+/// The frame of `addr` once it shows tick `tick` and satisfies `ok`, publishing meanwhile.
+fn frame_at(
+    addr: SocketAddr,
+    tick: u64,
+    mut publish: impl FnMut(),
+    ok: impl Fn(&Frame) -> bool,
+) -> Frame {
+    let end = Instant::now() + Duration::from_secs(10);
+    loop {
+        publish();
+        if let Some(f) = frame(addr).filter(|f| f.tick == tick && ok(f)) {
+            return f;
+        }
+        assert!(Instant::now() < end, "no frame of tick {tick} as wanted");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+#[test]
+fn a_replaced_controller_brings_its_plan_to_the_page_and_the_page_says_idle() {
+    let planner = support::planner(2);
+    let ctl = planner.controller(Cell::Rounds).unwrap();
+    let geometry_a = Geometry::new(&ctl);
+    let (console, handle) = Console::start(&ConsoleConfig::default(), geometry_a.clone()).unwrap();
+    let addr = console.addr();
+    let mut feed = ConsoleFeed::new(handle);
+    let mut cell = CellLoop::new(ctl, planner.model(), LoopParams::default()).unwrap();
+    // Before any round: the page says the node is idle.
+    let idle = frame_at(addr, 0, || feed.publish(&cell), |f| f.notice.is_some());
+    assert_eq!(idle.notice.as_deref(), Some(IDLE_NOTICE));
+    // The next round's controller, as `record_round` hands it over: here another plan (the
+    // task at a 20 ms tick, so every stretch twice as far), swapped in at the next start.
+    let other = support::planner_with(support::model_at(0.02), 2)
+        .controller(Cell::Rounds)
+        .unwrap();
+    let geometry_b = Geometry::new(&other);
+    let t0 = Instant::now();
+    cell.handle(
+        Inbound::Replace(Box::new(other), Box::new(geometry_b.clone())),
+        t0,
+        &mut |_| {},
+    );
+    assert_eq!(
+        cell.plan_generation(),
+        0,
+        "swapped in at the next start only"
+    );
+    cell.handle(
+        Inbound::Request {
+            token: 1,
+            what: Request::Start,
+        },
+        t0,
+        &mut |_| {},
+    );
+    assert_eq!(cell.plan_generation(), 1);
+    let tick = Duration::from_secs_f64(cell.controller().tick_s());
+    let mut now = t0;
+    let mut step = |cell: &mut CellLoop| {
+        now += tick;
+        for robot in 0..2 {
+            cell.heard(robot, now);
+        }
+        cell.step(now).unwrap()
+    };
+    for _ in 0..5 {
+        step(&mut cell);
+    }
+    let t = cell.controller().ticks();
+    let got = frame_at(addr, t, || feed.publish(&cell), |f| f.notice.is_none());
+    // What a console started on each plan shows for the same tick of the same controller.
+    let shown_on = |g: &Geometry| {
+        let (c, mut h) = Console::start(&ConsoleConfig::default(), g.clone()).unwrap();
+        let f = frame_at(
+            c.addr(),
+            t,
+            || h.publish(cell.last_tick(), cell.controller()),
+            |_| true,
+        );
+        c.stop();
+        f
+    };
+    let (on_a, on_b) = (shown_on(&geometry_a), shown_on(&geometry_b));
+    assert_ne!(
+        on_a.stretches, on_b.stretches,
+        "the two plans must differ for this test"
+    );
+    assert!(!got.stretches.is_empty());
+    assert_eq!(got.stretches, on_b.stretches, "the page kept the old plan");
+    assert_eq!((got.lead_s, got.horizon_s), (on_b.lead_s, on_b.horizon_s));
+    // The round's end: the page says a round waits to be recorded.
+    let end = Instant::now() + Duration::from_secs(30);
+    while !step(&mut cell).finished {
+        assert!(Instant::now() < end, "the round did not finish");
+    }
+    let t = cell.controller().ticks();
+    let done = frame_at(addr, t, || feed.publish(&cell), |f| f.notice.is_some());
+    assert_eq!(done.notice.as_deref(), Some(FINISHED_NOTICE));
+    console.stop();
+}
+
 #[test]
 fn a_node_with_a_console_serves_its_live_round() {
     let state = support::state_file("console", 2);
@@ -151,6 +257,7 @@ fn a_node_with_a_console_serves_its_live_round() {
         std::thread::sleep(Duration::from_millis(20));
     };
     assert_eq!(idle.robots.len(), 2);
+    assert_eq!(idle.notice.as_deref(), Some(IDLE_NOTICE), "{idle:?}");
     // A round driven over DDS: the page follows the node's controller tick by tick and counts
     // the round once it ends.
     let probe = Probe::new(70, 2).unwrap();
@@ -197,6 +304,12 @@ fn a_node_with_a_console_serves_its_live_round() {
     assert!(ticks.windows(2).all(|w| w[0] <= w[1]), "{ticks:?}");
     assert!(ticks.last() > ticks.first(), "{ticks:?}");
     assert!(lc_seen, "no frame showed a robot low-confidence");
+    // The finished round waits: the page says so.
+    let end = Instant::now() + Duration::from_secs(10);
+    while frame(addr).and_then(|f| f.notice).as_deref() != Some(FINISHED_NOTICE) {
+        assert!(Instant::now() < end, "the page never said the round waits");
+        std::thread::sleep(Duration::from_millis(20));
+    }
     node.stop().unwrap();
     support::remove(&state);
 }
