@@ -544,6 +544,62 @@ fn round_starts(topics: &[RawTopic]) -> Vec<i64> {
     v
 }
 
+/// Closes the gaps a run tandem wrote leaves in a robot's per-sample topics where it stood at a
+/// hold point (or was held) in the round starting at bag time `start` (ns, its schedule
+/// message) and ending before `end`: such a run stamps each sample at the tick it ran in
+/// (`"sample_stamps": "tick"` in the schedule message, [`crate::SCHEDULE_SCHEMA`]), and an
+/// execution is its samples one after the other (the time at a hold is not part of it). The
+/// `j`-th sample of a robot whose first ran at tick `s` is moved to tick `s + j`, exactly
+/// where a run without holds stamps it, so the executions read back sample for sample. The
+/// per-tick topics (`schedule_clock`, `waiting`) and bags of other writers are left alone.
+fn close_hold_gaps(topics: &mut [RawTopic], start: i64, end: i64) {
+    let Some(schedule) = topics.iter().find(|t| t.topic == SCHEDULE_TOPIC) else {
+        return;
+    };
+    let Some(doc) = schedule
+        .log_ns
+        .iter()
+        .position(|&t| t == start)
+        .and_then(|m| schedule.json.get(m))
+        .and_then(|j| serde_json::from_slice::<serde_json::Value>(j).ok())
+    else {
+        return;
+    };
+    let by_tick = doc.get("sample_stamps").and_then(|v| v.as_str()) == Some("tick");
+    let Some(dt_ns) = doc
+        .get("dt_s")
+        .and_then(serde_json::Value::as_f64)
+        .filter(|d| by_tick && d.is_finite() && *d > 0.0)
+        .map(|d| d * 1e9)
+    else {
+        return;
+    };
+    let at = |tick: i64| start + (tick as f64 * dt_ns).round() as i64;
+    for t in topics.iter_mut() {
+        if !t.topic.starts_with("/robot_")
+            || t.topic.ends_with("/schedule_clock")
+            || t.topic.ends_with("/waiting")
+        {
+            continue;
+        }
+        let mut mine: Vec<usize> = (0..t.log_ns.len())
+            .filter(|&k| t.log_ns[k] >= start && t.log_ns[k] < end)
+            .collect();
+        mine.sort_by_key(|&k| t.log_ns[k]);
+        let Some(&first) = mine.first() else {
+            continue;
+        };
+        let s = ((t.log_ns[first] - start) as f64 / dt_ns).round() as i64;
+        for (j, &k) in mine.iter().enumerate() {
+            let new = at(s + j as i64);
+            if t.stamp_ns.get(k) == Some(&t.log_ns[k]) {
+                t.stamp_ns[k] = new;
+            }
+            t.log_ns[k] = new;
+        }
+    }
+}
+
 /// Number of rounds of a run tandem wrote (its schedule messages), 0 for any other bag.
 ///
 /// # Errors
@@ -584,7 +640,7 @@ pub fn read_executions(
         namespace: None,
         views: false,
     };
-    let topics = read_topics(path, &sel)?;
+    let mut topics = read_topics(path, &sel)?;
     let layout = |why: String| Error::Layout {
         file: file.clone(),
         why,
@@ -604,6 +660,9 @@ pub fn read_executions(
         }
         (Some(k), _) => Some((starts[k - 1], starts.get(k).copied().unwrap_or(i64::MAX))),
     };
+    if let Some((start, end)) = window.or_else(|| starts.first().map(|&s| (s, i64::MAX))) {
+        close_hold_gaps(&mut topics, start, end);
+    }
     let namespaced = topics.iter().any(|t| t.topic.starts_with("/robot_"));
     options
         .robots

@@ -37,6 +37,7 @@ pub const SCHEDULE_SCHEMA: &str = r#"{
     "tick_s": {"type": "number", "description": "control tick the schedule was checked at (s)"},
     "n_ref": {"type": "integer", "description": "reference samples"},
     "ticks": {"type": "integer", "description": "control ticks the round took"},
+    "sample_stamps": {"type": "string", "description": "\"tick\": each logged sample is stamped at the tick it ran in (a robot at a hold or held logs nothing in those ticks); absent in bags of older builds, which stamped the k-th sample at start_tick + k"},
     "lc_intervals": {"type": "array", "items": {"type": "object", "properties": {
       "robot": {"type": "integer"}, "ref_start": {"type": "integer"}, "ref_end": {"type": "integer"},
       "start_s": {"type": "number"}, "end_s": {"type": "number"}}}},
@@ -106,7 +107,10 @@ fn topic_token(name: &str) -> String {
 /// per control tick the robot ran; `schedule_clock` (`Float64`, s) and `waiting` (`Bool`)
 /// at every tick of the round. `/tandem/schedule` holds one JSON message per round at its
 /// first tick ([`SCHEDULE_SCHEMA`]). Rounds follow each other on one clock; tick `k` of a
-/// round is at bag time `start + k·Δt_s`. Each channel record names its model channels
+/// round is at bag time `start + k·Δt_s`, and each sample is stamped at the tick it ran in
+/// ([`RobotRun::phases`](tandem_sim::workcell::RobotRun::phases)' running ticks: a robot
+/// standing at a hold point or held by the fault monitor logs no sample, so its later
+/// samples are not stamped early). Each channel record names its model channels
 /// ([`crate::FIELDS_KEY`]) and role ([`crate::ROLE_KEY`]), so the executions read back with
 /// the model's names.
 #[derive(Debug)]
@@ -275,8 +279,12 @@ impl RunWriter {
                     ),
                 });
             }
-            for k in 0..n {
-                let t = at(robot.start_tick + k);
+            let stamps = sample_ticks(robot, run.ticks).map_err(|why| Error::Layout {
+                file: file.clone(),
+                why,
+            })?;
+            for (k, &tick) in stamps.iter().enumerate() {
+                let t = at(tick);
                 let row = &robot.samples[k * m..(k + 1) * m];
                 for slot in &topics.slots {
                     match slot {
@@ -326,12 +334,49 @@ impl RunWriter {
     }
 }
 
+/// The round's tick (0-based) of each of `robot`'s logged samples: the ticks its
+/// [`RobotRun::phases`](tandem_sim::workcell::RobotRun::phases) say it ran (one sample per
+/// running tick); without phases (a run built by hand) `start_tick + k`, which is exact only
+/// without hold ticks. An error (the reason) when they do not account for its samples.
+fn sample_ticks(
+    robot: &tandem_sim::workcell::RobotRun,
+    ticks: usize,
+) -> std::result::Result<Vec<usize>, String> {
+    use tandem_sim::workcell::TickPhase;
+    let n = robot.ref_time_log.len();
+    if robot.phases.is_empty() {
+        if robot.hold_ticks > 0 {
+            return Err(format!(
+                "a robot's run has {} ticks at holds but no phases to stamp its samples by",
+                robot.hold_ticks
+            ));
+        }
+        return Ok((robot.start_tick..robot.start_tick + n).collect());
+    }
+    let running: Vec<usize> = (0..robot.phases.len())
+        .filter(|&k| robot.phases[k] == TickPhase::Running)
+        .collect();
+    if robot.phases.len() != ticks || running.len() != n {
+        return Err(format!(
+            "a robot's run has {} phases for {ticks} ticks and {} running ticks for {n} \
+             samples",
+            robot.phases.len(),
+            running.len()
+        ));
+    }
+    Ok(running)
+}
+
 /// One robot of a round read back from a run ([`read_run`]), tick by tick of the round.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunRobotLog {
     /// The round's tick (0-based) at which the robot started (its ticks before it waited).
     pub start_tick: usize,
-    /// Its reference time (reference samples) at each tick it ran, from `start_tick` on.
+    /// The round's tick (0-based) of each logged sample, strictly increasing from
+    /// `start_tick`: consecutive while the robot runs, with a gap for each tick it stood at a
+    /// hold point or was held by the fault monitor.
+    pub sample_ticks: Vec<usize>,
+    /// Its reference time (reference samples) at each tick it ran (`sample_ticks`).
     pub ref_time: Vec<f64>,
     /// Whether the operator supervised it in each tick it ran (`supervised`).
     pub supervised: Vec<bool>,
@@ -357,14 +402,17 @@ pub struct RunRoundLog {
 /// Reads back, tick by tick, every round of a run [`RunWriter`] wrote for `n_robots` robots:
 /// each robot's reference-time log, supervised flags and schedule clock, at the ticks the
 /// round's schedule message and the messages' log times give (tick `k` of a round at its
-/// start plus `k·Δt_s`).
+/// start plus `k·Δt_s`; a robot's samples at the ticks it ran, across the ticks it stood at
+/// a hold). A bag of an older build (no `sample_stamps` in its schedule messages) reads as
+/// before where its schedule has no holds, and is refused where it has: that build stamped
+/// the samples after a hold early.
 ///
 /// # Errors
 /// As [`read_bag`](crate::read_bag) for an unreadable, truncated or damaged file
 /// ([`Error::Truncated`], [`Error::Corrupt`]); [`Error::TopicNotFound`] for a robot the bag
 /// does not hold; [`Error::Layout`] for a bag without schedule messages (not a run tandem
-/// wrote), a round of another robot count than `n_robots`, or logs that do not fill the
-/// round's ticks.
+/// wrote), a round of another robot count than `n_robots`, logs that do not fill the round's
+/// ticks, or a round with holds from an older build (see above).
 pub fn read_run(path: impl AsRef<Path>, n_robots: usize) -> Result<Vec<RunRoundLog>> {
     let path = path.as_ref();
     let file = path.display().to_string();
@@ -435,6 +483,24 @@ pub fn read_run(path: impl AsRef<Path>, n_robots: usize) -> Result<Vec<RunRoundL
                 k + 1
             )));
         }
+        let by_tick = doc.get("sample_stamps").and_then(|v| v.as_str()) == Some("tick");
+        let has_holds = doc
+            .get("schedule")
+            .and_then(|s| s.get("holds"))
+            .and_then(|h| h.as_array())
+            .is_some_and(|h| {
+                h.iter()
+                    .any(|r| r.as_array().is_some_and(|r| !r.is_empty()))
+            });
+        if !by_tick && has_holds {
+            return Err(layout(format!(
+                "round {}: its schedule has hold points and the bag was written by an older \
+                 tandem that stamped each robot's samples after a hold early (at its start \
+                 tick plus their count); write it again with this build (`tandem simulate \
+                 --bag`)",
+                k + 1
+            )));
+        }
         let start_ns = schedule.log_ns[m];
         let end_ns = order
             .get(k + 1)
@@ -460,12 +526,13 @@ pub fn read_run(path: impl AsRef<Path>, n_robots: usize) -> Result<Vec<RunRoundL
             let consecutive = |v: &[(usize, f64)], from: usize| {
                 v.iter().enumerate().all(|(j, (tick, _))| *tick == from + j)
             };
+            let increasing = refs.windows(2).all(|w| w[0].0 < w[1].0);
             if refs.len() != sup.len()
-                || !consecutive(&refs, start_tick)
-                || !consecutive(&sup, start_tick)
+                || !increasing
+                || refs.iter().zip(&sup).any(|(r, s)| r.0 != s.0)
+                || refs.last().is_some_and(|r| r.0 >= ticks)
                 || clock.len() != ticks
                 || !consecutive(&clock, 0)
-                || start_tick + refs.len() > ticks
             {
                 return Err(layout(format!(
                     "round {}: robot {i}'s logs do not fill the round's {ticks} ticks (one \
@@ -476,6 +543,7 @@ pub fn read_run(path: impl AsRef<Path>, n_robots: usize) -> Result<Vec<RunRoundL
             }
             robots.push(RunRobotLog {
                 start_tick,
+                sample_ticks: refs.iter().map(|r| r.0).collect(),
                 ref_time: refs.iter().map(|r| r.1).collect(),
                 supervised: sup.iter().map(|r| r.1 >= 0.5).collect(),
                 clock_s: clock.iter().map(|r| r.1).collect(),
@@ -523,6 +591,7 @@ fn schedule_doc(planner: &Planner, round: usize, start_ns: i64, ticks: usize) ->
         "tick_s": s.tick_s,
         "n_ref": problem.n_ref(),
         "ticks": ticks,
+        "sample_stamps": "tick",
         "lc_intervals": intervals,
         "schedule": serde_json::to_value(s).map_err(|e| Error::Write {
             file: "<run>".into(),

@@ -577,6 +577,9 @@ pub fn replay(
                             .checked_sub(1)
                             .and_then(|k| rec.ticks.get(k))
                             .map_or(0.0, |t| t.t_s);
+                        // The frame shown, no longer paused, now: the next recorded tick may
+                        // be far off, or none be left (a replay resumed after its end).
+                        publish(&mut handle, next.saturating_sub(1), false);
                     }
                     (true, "replay resumed".to_string())
                 }

@@ -79,24 +79,30 @@ pub fn recording_from_rounds(
                 .robots
                 .iter()
                 .map(|r| {
-                    let ran = k.checked_sub(r.start_tick);
-                    let (state, ref_time, tasks) = match ran {
-                        None => (RobotState::Wait, 0.0, 0),
-                        Some(j) if j >= r.ref_time.len() => (
+                    // The first sample logged at or after tick `k` (samples are stamped at
+                    // the ticks they ran in: none while the robot stood at a hold).
+                    let j = r.sample_ticks.partition_point(|&t| t < k);
+                    let (state, ref_time, tasks) = if k < r.start_tick {
+                        (RobotState::Wait, 0.0, 0)
+                    } else if j >= r.ref_time.len() {
+                        (
                             RobotState::Done,
                             r.ref_time.last().copied().unwrap_or(0.0),
                             1,
-                        ),
-                        Some(j) => {
-                            let state = if r.supervised[j] {
-                                RobotState::Lc
-                            } else if r.ref_time.get(j + 1).is_some_and(|&n| n <= r.ref_time[j]) {
-                                RobotState::Hold
-                            } else {
-                                RobotState::Hc
-                            };
-                            (state, r.ref_time[j], 0)
-                        }
+                        )
+                    } else if r.sample_ticks[j] != k {
+                        // Between two samples: it stood (a hold point, or held) where its
+                        // next sample starts.
+                        (RobotState::Hold, r.ref_time[j], 0)
+                    } else {
+                        let state = if r.supervised[j] {
+                            RobotState::Lc
+                        } else if r.ref_time.get(j + 1).is_some_and(|&n| n <= r.ref_time[j]) {
+                            RobotState::Hold
+                        } else {
+                            RobotState::Hc
+                        };
+                        (state, r.ref_time[j], 0)
                     };
                     RecordedRobot {
                         state,
@@ -153,8 +159,9 @@ mod tests {
     }
 
     /// Robot 1 runs ticks 0..6 (supervised in 1..3, held at tick 4: its reference time does
-    /// not advance from tick 4 to 5), robot 2 waits two ticks, then runs 2..7 (supervised in
-    /// 4..6); a round of 8 ticks.
+    /// not advance from tick 4 to 5), robot 2 waits two ticks, runs 2..4, stands at a hold in
+    /// tick 4 (no sample logged: the next is stamped at tick 5) and runs 5..8 (supervised in
+    /// 5..7); a round of 8 ticks.
     #[test]
     fn each_tick_shows_the_logged_states_and_the_logged_supervised_robot() {
         let round = RunRoundLog {
@@ -165,12 +172,14 @@ mod tests {
             robots: vec![
                 RunRobotLog {
                     start_tick: 0,
+                    sample_ticks: (0..6).collect(),
                     ref_time: vec![0.0, 1.0, 2.0, 3.0, 4.0, 4.0],
                     supervised: vec![false, true, true, false, false, false],
                     clock_s: (0..8).map(|k| 0.1 * f64::from(k)).collect(),
                 },
                 RunRobotLog {
                     start_tick: 2,
+                    sample_ticks: vec![2, 3, 5, 6, 7],
                     ref_time: vec![0.0, 1.0, 2.0, 3.0, 4.0],
                     supervised: vec![false, false, true, true, false],
                     clock_s: vec![0.0; 8],
@@ -186,10 +195,10 @@ mod tests {
             (Lc, Wait),
             (Lc, Hc),
             (Hc, Hc),
-            (Hold, Lc),
+            (Hold, Hold),
             (Hc, Lc),
+            (Done, Lc),
             (Done, Hc),
-            (Done, Done),
         ];
         for (k, t) in rec.ticks.iter().enumerate() {
             let (a, b) = want[k % 8];
@@ -214,9 +223,12 @@ mod tests {
         assert!((rec.ticks[3].robots[0].clock_s - 0.3).abs() < 1e-12);
         assert_eq!(rec.ticks[6].robots[0].ref_time, 4.0);
         assert_eq!(rec.ticks[6].robots[0].tasks, 1);
+        // At the hold, robot 2 stands where its next sample starts.
+        assert_eq!(rec.ticks[4].robots[1].ref_time, 2.0);
+        assert_eq!(rec.ticks[7].robots[1].ref_time, 4.0);
         let c = crate::check_recording(&rec, 7.0);
         assert_eq!((c.frames, c.two_lc, c.lc_differs), (16, 0, 0));
-        // Robot 1 at ticks 1 and 9, robot 2 at ticks 4 and 12.
+        // Robot 1 at ticks 1 and 9, robot 2 at ticks 5 and 13.
         assert_eq!(c.stretches, 4);
     }
 

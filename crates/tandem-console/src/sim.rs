@@ -259,9 +259,13 @@ pub fn simulate_recorded(
                 break;
             }
             if was_paused {
+                // Resumed: a frame saying so now, not at the next tick (which may be a long
+                // period away at a low speed).
                 was_paused = false;
                 base = Instant::now();
                 done_since_base = 0;
+                let t = tick_now(run.controller());
+                handle.publish_corrected(&t, run.controller(), false);
                 break;
             }
             if done_since_base >= due || budget == 0 {

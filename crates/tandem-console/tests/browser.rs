@@ -425,17 +425,25 @@ fn the_page_shows_the_coordinators_robot_confirms_controls_and_reconnects() {
          Object.values(window.__acks).some(a => a.op === 'pause' && a.ok)",
         Duration::from_secs(10),
     );
-    let paused_at = b.eval("window.__lastFrame.tick");
+    // Where the cell stopped: the round and the tick in it. A frame's tick counts from the
+    // start of its round, so a pause that lands on a finished round (its last tick) resumes
+    // into the next round at tick 1: "later" is (round, tick) in that order, never the tick
+    // alone (which failed one CI run in three: paused at tick 160, a round's last).
+    const AT: &str = "[window.__lastFrame.rounds_done, window.__lastFrame.tick]";
+    let paused_at = b.eval(AT);
     std::thread::sleep(Duration::from_millis(300));
-    assert_eq!(
-        b.eval("window.__lastFrame.tick"),
-        paused_at,
-        "the cell stopped ticking"
+    assert_eq!(b.eval(AT), paused_at, "the cell stopped ticking");
+    let (round_at, tick_at) = (
+        paused_at[0].as_u64().unwrap(),
+        paused_at[1].as_u64().unwrap(),
     );
     b.eval("document.getElementById('resume').click(); true");
     b.wait(
         "resumed",
-        &format!("!window.__lastFrame.paused && window.__lastFrame.tick > {paused_at}"),
+        &format!(
+            "!window.__lastFrame.paused && (window.__lastFrame.rounds_done > {round_at} || \
+             window.__lastFrame.tick > {tick_at})"
+        ),
         Duration::from_secs(10),
     );
 

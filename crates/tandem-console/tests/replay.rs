@@ -309,6 +309,16 @@ fn a_truncated_replay_plays_to_its_damage_then_says_so_on_the_page() {
     // The operator strip counted the replayed stretches: three robots, one stretch each.
     assert_eq!(f.operator.switches, 2, "{:?}", f.operator);
     assert!(f.operator.busy_share > 0.0 && f.operator.longest_busy_s > 0.0);
+    // Paused and resumed after its end, with no tick left to play: the page is told it
+    // resumed (the frame's flag), not left showing a pause.
+    for (id, op, paused) in [(3, "pause", true), (4, "resume", false)] {
+        let body = format!(r#"{{"client":"a","id":{id},"op":"{op}"}}"#);
+        assert_eq!(http(addr, "POST", "/control", &body).0, 202, "{op}");
+        let f = wait_for(addr, op, |f| {
+            f.paused == paused && f.acks.iter().any(|a| a.id == id && a.ok)
+        });
+        assert_eq!(f.tick, rec.ticks.last().unwrap().tick, "{op}");
+    }
     stop.store(true, Ordering::Relaxed);
     worker.join().unwrap().unwrap();
     std::fs::remove_dir_all(&dir).unwrap();

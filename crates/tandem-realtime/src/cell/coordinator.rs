@@ -468,7 +468,37 @@ impl ContinuousCoordinator {
                 (i, earliest, None, rank)
             })
         });
-        prealert::pick_ranked(cands, h)
+        // The token passes in its fixed order: a robot whose next turn comes later cannot
+        // start its stretch before the robots with earlier turns have started theirs (each
+        // takes the token at its gate and passes it on after its group), so its earliest
+        // start is at least theirs plus a tick. Without this the pre-alert could name a robot
+        // of a later turn whose loose bound was smaller (issue 42: a three-robot cell named
+        // robot 1 while robot 3's turn came first, 100 of 901 stretches pre-alerted late).
+        let mut ranked = [(0usize, 0u64, None, 0usize); MAX_ROBOTS];
+        let mut n = 0;
+        for c in cands {
+            ranked[n] = c;
+            n += 1;
+        }
+        let ranked = &mut ranked[..n];
+        ranked.sort_unstable_by_key(|c| c.3);
+        // The latest earliest start over the ranks below the current one (none yet), and
+        // over the current rank so far.
+        let (mut below, mut rank, mut at_rank) = (None::<u64>, None, 0u64);
+        for c in ranked.iter_mut() {
+            if rank != Some(c.3) {
+                if rank.is_some() {
+                    below = Some(below.map_or(at_rank, |b| b.max(at_rank)));
+                }
+                rank = Some(c.3);
+                at_rank = 0;
+            }
+            if let Some(b) = below {
+                c.1 = c.1.max(b + 1);
+            }
+            at_rank = at_rank.max(c.1);
+        }
+        prealert::pick_ranked(ranked.iter().copied(), h)
     }
 
     /// Every robot back at sample 0 of its first task, the token at its first entry, the
