@@ -1,5 +1,7 @@
-//! The staggered candidate for `N ≥ 3` robots: every robot on its fastest warp, started at
-//! the least offsets that the full check accepts.
+//! The staggered candidate for `N ≥ 2` robots: every robot on its fastest warp, started at
+//! the least offsets that the full check accepts (for two robots beside the margin-aware
+//! completion: docs/decisions.md, "Two robots on their fastest warps at the least offset the
+//! check accepts (issue 38)").
 //!
 //! The sampler widens each earlier robot's low-confidence intervals by `δ = w·length +
 //! 2·tick_s` with `w ≤ 0.1` (docs/decisions.md, "The sampler's distributions"); a task whose

@@ -154,7 +154,8 @@ proptest! {
 
     /// Every schedule the scheduler returns passes `validate` (margins included), lies above
     /// the proven bound, is never worse than the sampler alone with the same seed nor than the
-    /// completion alone, and says where it came from.
+    /// completion alone, and says where it came from (the sampler's, the completion's or the
+    /// staggered candidate's).
     #[test]
     fn scheduled_schedules_pass_validate_and_beat_the_sampler(p in small_problem(), seed in 0u64..4) {
         let params = SamplerParams { samples: 200, seed, ..SamplerParams::default() };
@@ -167,7 +168,11 @@ proptest! {
         }
         prop_assert!(both.t_total_s <= alone.t_total_s);
         prop_assert!(both.t_total_s <= done.t_total_s);
-        prop_assert!(both.source == alone.source || both.source == Source::Completed);
+        prop_assert!(
+            both.source == alone.source
+                || both.source == Source::Completed
+                || both.source == Source::Staggered
+        );
         let free = solve_exact(&p, &ExactParams::default()).unwrap();
         prop_assert!((both.lower_bound_s - free.lower_bound_s).abs() <= 1e-9 * free.lower_bound_s.max(1.0));
     }

@@ -228,8 +228,8 @@ pub struct SamplerStats {
     /// Candidates whose full constraints (incl. margins) were decided in `(T_total, k)` order
     /// (the parallel loop may check up to a few more, whose results are discarded).
     pub margin_checks: usize,
-    /// Margin checks (Alg. 2) the margin-aware completion ran ([`crate::ExactParams`]); for
-    /// `N ≥ 3` the full checks of the staggered candidate ([`crate::Source::Staggered`]).
+    /// Margin checks (Alg. 2) the margin-aware completion ran ([`crate::ExactParams`]), and
+    /// the full checks of the staggered candidate ([`crate::Source::Staggered`], `N ≥ 2`).
     pub completion_margin_checks: usize,
     /// Work counts of the exact search behind the bound.
     pub search: SearchStats,
