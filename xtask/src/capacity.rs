@@ -101,6 +101,21 @@ pub(crate) struct CapacityArgs {
         allow_negative_numbers = true
     )]
     switch_s: Vec<f64>,
+    /// Operators M of a fleet (issue 44), comma-separated (`2,4`): after the one-operator
+    /// continuous rows (which need `--min-robots 1`), a pooled continuous cell of `M` tokens
+    /// for every `N` of `--fleet-robots` above `M`, against the best sectors and the ceiling
+    /// `min(r·N, o·M)` measured in the same run (`fleet.json`, `fleet.svg`, `fleet.png`;
+    /// `crate::fleet`).
+    #[arg(long, value_name = "M,…", value_delimiter = ',')]
+    operators: Vec<usize>,
+    /// With --operators: the robot counts N of the fleet (default: --max-robots).
+    #[arg(
+        long,
+        value_name = "N,…",
+        value_delimiter = ',',
+        requires = "operators"
+    )]
+    fleet_robots: Vec<usize>,
 }
 
 /// One robot count's result in rounds, at the end of learning.
@@ -403,6 +418,21 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
             args.max_robots
         );
     }
+    if !args.operators.is_empty() {
+        if !do_cell || args.min_robots != 1 || deltas.len() > 1 {
+            bail!(
+                "--operators runs the continuous cell after its one-operator rows N = 1, 2, …: \
+                 give --cell continuous or both, --min-robots 1 and at most one --switch-s"
+            );
+        }
+        if let Some(m) = args
+            .operators
+            .iter()
+            .find(|&&m| !(1..=MAX_ROBOTS).contains(&m))
+        {
+            bail!("--operators {m}: a cell has 1 to {MAX_ROBOTS} operators");
+        }
+    }
     let runs = deltas
         .iter()
         .flat_map(|&d| (args.min_robots..=args.max_robots).map(move |n| (d, n)));
@@ -535,6 +565,32 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
             out.display(),
             wall.elapsed().as_secs_f64()
         );
+    }
+    let fleet_over = if args.operators.is_empty() {
+        0
+    } else {
+        let robots = if args.fleet_robots.is_empty() {
+            vec![args.max_robots]
+        } else {
+            args.fleet_robots.clone()
+        };
+        let mut base = base.clone();
+        base.trials = args.trials;
+        base.samples = args.samples;
+        base.seed = seed;
+        base.operator.switch_s = deltas[0];
+        crate::fleet::run(
+            &base,
+            &inputs,
+            &cells,
+            &robots,
+            &args.operators,
+            args.executions,
+            &out,
+        )?
+    };
+    if fleet_over > 0 {
+        bail!("{fleet_over} ticks of the fleet had more than M robots low-confidence, or faults");
     }
     let overlaps = rows.iter().map(|r| r.overlap_ticks as u64).sum::<u64>()
         + cells

@@ -12,6 +12,7 @@ mod cellfig;
 mod fig5;
 mod fit_defaults;
 mod fixtures;
+mod fleet;
 mod reference_order;
 mod stress;
 mod study;

@@ -72,6 +72,11 @@ pub(crate) struct StudyArgs {
     /// and counted.
     #[arg(long, value_name = "S")]
     switch_true_s: Option<f64>,
+    /// The cell's number of operators M (1 to 8; `[operator] operators`; issue 44): M tokens
+    /// and M simulated operators, one per operator index, each with the rates above. Only the
+    /// continuous cell runs M > 1 (`--cell continuous`).
+    #[arg(long, value_name = "M")]
+    operators: Option<usize>,
     /// Decide confidence with the paper's model (Eq. 8–12: zero error rates, nothing
     /// estimated, every control sample one observation) instead of the configured one.
     #[arg(long)]
@@ -391,8 +396,9 @@ fn run_continuous(
         let (missed, tasks) = result.switch_missed_total();
         let op = &config.operator;
         println!(
-            "operator: planned switch time δ {} s, load cap {}; own switch time δ_true {} s: {} \
-             needed corrections missed while switching ({:.2} per task)",
+            "operator: {} operator(s), planned switch time δ {} s, load cap {}; own switch \
+             time δ_true {} s: {} needed corrections missed while switching ({:.2} per task)",
+            op.operators,
             op.switch_s,
             op.max_busy_share,
             op.switch_true_s,
@@ -543,6 +549,9 @@ fn config(args: &StudyArgs) -> anyhow::Result<StudyConfig> {
     }
     if let Some(v) = args.switch_true_s {
         config.operator.switch_true_s = v;
+    }
+    if let Some(m) = args.operators {
+        config.operator.operators = m;
     }
     if args.no_holds {
         config.planner.holds = Default::default();

@@ -212,8 +212,17 @@ pub(crate) fn apply_sampler(mut p: SamplerParams, a: &SamplerArgs) -> Result<Sam
         }
         p.max_busy_share = u;
     }
+    if let Some(m) = a.operators {
+        if !(1..=tandem::realtime::MAX_ROBOTS).contains(&m) {
+            bail!(
+                "--operators {m}: a cell has 1 to {} operators (1: one operator)",
+                tandem::realtime::MAX_ROBOTS
+            );
+        }
+        p.operators = m;
+    }
     p.validate()
-        .context("--samples/--seed/--switch-s/--max-busy")?;
+        .context("--samples/--seed/--switch-s/--max-busy/--operators")?;
     Ok(p)
 }
 
@@ -221,7 +230,7 @@ pub(crate) fn apply_sampler(mut p: SamplerParams, a: &SamplerArgs) -> Result<Sam
 /// time and load cap the schedules honour, when either is not its default (`None` otherwise:
 /// the output of a planner without them is unchanged).
 pub(crate) fn operator_line(p: &SamplerParams) -> Option<String> {
-    if p.switch_s == 0.0 && p.max_busy_share == 1.0 {
+    if p.switch_s == 0.0 && p.max_busy_share == 1.0 && p.operators == 1 {
         return None;
     }
     let cap = if p.max_busy_share == 1.0 {
@@ -233,9 +242,17 @@ pub(crate) fn operator_line(p: &SamplerParams) -> Option<String> {
             secs(100.0 * p.max_busy_share)
         )
     };
+    let fleet = if p.operators == 1 {
+        String::new()
+    } else {
+        format!(
+            "; {} operators (a continuous cell: at most {} robots low-confidence at once)",
+            p.operators, p.operators
+        )
+    };
     Some(format!(
         "operator: switch time δ {} s (at least δ between one robot's low-confidence stretch \
-         and another's); {cap}",
+         and another's); {cap}{fleet}",
         secs(p.switch_s)
     ))
 }
@@ -792,6 +809,7 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
     planner
         .set_operator(sp.switch_s, sp.max_busy_share)
         .context("--switch-s/--max-busy")?;
+    planner.set_operators(sp.operators).context("--operators")?;
     let previous_t_total_s = planner.outcome().t_total_s;
     planner.reschedule(&sp).context("cannot schedule")?;
     if let Some(lock) = &lock {

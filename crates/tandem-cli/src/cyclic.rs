@@ -36,11 +36,13 @@ pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
         );
     }
     let mut planner = crate::state_io::load(&a.state)?;
-    // --switch-s/--max-busy plan this cell with them (shown, not saved: --save is refused).
+    // --switch-s/--max-busy/--operators plan this cell with them (shown, not saved: --save is
+    // refused).
     let sp = crate::cmd::apply_sampler(planner.params().sampler.clone(), &a.sampler)?;
     planner
         .set_operator(sp.switch_s, sp.max_busy_share)
         .context("--switch-s/--max-busy")?;
+    planner.set_operators(sp.operators).context("--operators")?;
     let problem = planner.problem();
     // The planner's plan of the cell, at the schedule's control tick (its hand-overs counted
     // at it, so its period is what the cell does with the planned operator).

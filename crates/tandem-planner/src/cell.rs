@@ -314,15 +314,53 @@ impl Planner {
     ///
     /// # Errors
     /// As [`Planner::plan`].
+    ///
+    /// With `params().sampler.operators = M > 1` (issue 44) a continuous cell runs `M` tokens
+    /// ([`Planner::continuous_coordinator`]); rounds with more than one operator are not built
+    /// yet: [`Error::BadCell`] naming `operators`.
     pub fn controller(&self, cell: Cell) -> Result<AnyController> {
         let switch_s = self.params().sampler.switch_s;
-        Ok(match self.plan(cell)?.controller()? {
-            AnyController::Rounds(c) => AnyController::Rounds(c.with_switch_s(switch_s)?),
-            AnyController::Continuous(c) => AnyController::Continuous(
-                c.with_switch_s(switch_s)?
-                    .with_max_busy_share(self.params().sampler.max_busy_share)?,
-            ),
-        })
+        match self.plan(cell)? {
+            Plan::Rounds(s) => {
+                let m = self.params().sampler.operators;
+                if m > 1 {
+                    return Err(Error::BadCell {
+                        what: "operators".into(),
+                        why: format!(
+                            "rounds with {m} operators are not supported yet (issue 44): run a \
+                             continuous cell (`--cell continuous`) or set operators to 1"
+                        ),
+                    });
+                }
+                Ok(AnyController::Rounds(
+                    s.coordinator()?.with_switch_s(switch_s)?,
+                ))
+            }
+            Plan::Continuous(c) => Ok(AnyController::Continuous(self.continuous_coordinator(&c)?)),
+        }
+    }
+
+    /// The run-time coordinator of a continuous cell's `plan` with this planner's operators:
+    /// the switch time `params().sampler.switch_s` (the token passes to another robot no
+    /// sooner than that after a stretch ended), the load cap `max_busy_share` (one operator
+    /// only) and, for `operators = M > 1`, `M` tokens
+    /// ([`ContinuousCoordinator::with_operators`](tandem_realtime::ContinuousCoordinator::with_operators),
+    /// issue 44). The one place that builds it (the study's cell uses it too). One operator:
+    /// no call of `with_operators`, the coordinator of before bit for bit.
+    ///
+    /// # Errors
+    /// The realtime crate's for a bad switch time or load cap, or a load cap below 1 with
+    /// `M > 1` (the run-time pace serves one operator), or an operator count out of range.
+    pub fn continuous_coordinator(
+        &self,
+        plan: &CheckedCyclicPlan,
+    ) -> Result<tandem_realtime::ContinuousCoordinator> {
+        let sp = &self.params().sampler;
+        let mut c = plan.coordinator().with_switch_s(sp.switch_s)?;
+        if sp.operators > 1 {
+            c = c.with_operators(tandem_realtime::OperatorCount::new(sp.operators)?);
+        }
+        Ok(c.with_max_busy_share(sp.max_busy_share)?)
     }
 
     /// The cyclic plan of a continuous cell of this planner's robots on the current problem

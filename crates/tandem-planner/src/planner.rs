@@ -1020,6 +1020,22 @@ impl Planner {
         Ok(())
     }
 
+    /// Sets the cell's number of operators `M` ([`SamplerParams::operators`], issue 44): a
+    /// continuous cell of this planner runs `M` tokens ([`Planner::controller`]); the
+    /// schedules are unchanged. Stored in the state file. On error the planner is as before.
+    ///
+    /// # Errors
+    /// [`Error::Schedule`] (`BadParam` naming `operators`) unless `1 ≤ M ≤` the robot limit.
+    pub fn set_operators(&mut self, operators: usize) -> Result<()> {
+        let sampler = SamplerParams {
+            operators,
+            ..self.params.sampler.clone()
+        };
+        sampler.validate()?;
+        self.params.sampler = sampler;
+        Ok(())
+    }
+
     /// Rounds recorded so far (a round is one execution of each of the `N` robots).
     pub fn rounds_recorded(&self) -> usize {
         self.pairs_recorded
@@ -1914,5 +1930,40 @@ mod tests {
         let s1 = Planner::sampler_params(&params, 1).seed;
         assert_ne!(s0, s1);
         assert_eq!(s1, Planner::sampler_params(&params, 1).seed);
+    }
+
+    /// The `operators` parameter end to end in the planner (issue 44): a continuous cell gets
+    /// `M` tokens and takes `M` inputs; one operator is the coordinator of before; rounds with
+    /// more than one are refused naming the parameter; an out-of-range count is refused and
+    /// leaves the planner as it was.
+    #[test]
+    fn the_operator_count_makes_the_continuous_cell_and_is_refused_for_rounds() {
+        use tandem_realtime::{Controller, Operator};
+        let mut p = test_planner(40, 10..20, 3, 1);
+        let one = p.controller(crate::Cell::Continuous).unwrap();
+        let crate::AnyController::Continuous(one) = one else {
+            panic!("a continuous cell")
+        };
+        assert_eq!(one.operators(), 1);
+        p.set_operators(2).unwrap();
+        assert_eq!(p.params().sampler.operators, 2);
+        let crate::AnyController::Continuous(mut two) =
+            p.controller(crate::Cell::Continuous).unwrap()
+        else {
+            panic!("a continuous cell")
+        };
+        assert_eq!(Controller::operators(&two), 2);
+        assert!(two.tick(Operator::Scheduled).is_err());
+        two.tick_many(&[Operator::Scheduled; 2]).unwrap();
+        let err = p.controller(crate::Cell::Rounds).unwrap_err().to_string();
+        assert!(
+            err.contains("operators") && err.contains("continuous"),
+            "{err}"
+        );
+        for bad in [0, tandem_realtime::MAX_ROBOTS + 1] {
+            let err = p.set_operators(bad).unwrap_err().to_string();
+            assert!(err.contains("operators"), "{err}");
+            assert_eq!(p.params().sampler.operators, 2);
+        }
     }
 }

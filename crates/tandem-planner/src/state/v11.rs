@@ -84,6 +84,10 @@ pub const SAMPLER_SWITCH_S: &str = "sampler.switch_s";
 /// stored ([`Extras`], an `f64`) when it is not 1 (absent: 1, no cap).
 pub const SAMPLER_MAX_BUSY_SHARE: &str = "sampler.max_busy_share";
 
+/// The name under which [`sched::SamplerParams::operators`] (the cell's number of operators
+/// `M`, issue 44) is stored ([`Extras`], a `u64`) when it is not 1 (absent: 1, one operator).
+pub const SAMPLER_OPERATORS: &str = "sampler.operators";
+
 /// [`lfd::FitParams`] as format 11 writes them.
 #[expect(
     missing_docs,
@@ -617,6 +621,8 @@ impl From<&sched::SamplerParams> for SamplerParams {
             switch_s: _,
             // Added after format 11: stored by name ([`SAMPLER_MAX_BUSY_SHARE`]).
             max_busy_share: _,
+            // Added after format 11: stored by name ([`SAMPLER_OPERATORS`]).
+            operators: _,
         } = p;
         let sched::ExactParams {
             max_pieces,
@@ -1041,6 +1047,7 @@ impl Payload {
         )?;
         extras.put(SAMPLER_SWITCH_S, &params.sampler.switch_s, &0.0)?;
         extras.put(SAMPLER_MAX_BUSY_SHARE, &params.sampler.max_busy_share, &1.0)?;
+        extras.put(SAMPLER_OPERATORS, &(params.sampler.operators as u64), &1)?;
         let payload = Payload {
             params: params.into(),
             model: model.clone(),
@@ -1073,6 +1080,8 @@ impl Payload {
         })?;
         params.sampler.switch_s = extras.take(SAMPLER_SWITCH_S, 0.0)?;
         params.sampler.max_busy_share = extras.take(SAMPLER_MAX_BUSY_SHARE, 1.0)?;
+        let operators: u64 = extras.take(SAMPLER_OPERATORS, 1)?;
+        params.sampler.operators = usize::try_from(operators).unwrap_or(usize::MAX);
         params.sampler.validate()?;
         extras.finish()?;
         Ok(super::PlannerState {
@@ -1224,6 +1233,37 @@ mod tests {
         let (payload, _) = decode_any(&bytes, &path).unwrap();
         let err = payload.into_state(bad).unwrap_err().to_string();
         assert!(err.contains("max_busy_share"), "{err}");
+    }
+
+    #[test]
+    fn the_operator_count_is_stored_by_name_only_off_its_default() {
+        let (path, bytes) = golden();
+        let (payload, extras) = decode_any(&bytes, &path).unwrap();
+        let mut state = payload.into_state(extras).unwrap();
+        // Absent from the file: one operator, and one operator writes nothing.
+        assert_eq!(state.params.sampler.operators, 1);
+        let (_, extras) = Payload::from_state(&state).unwrap();
+        assert_eq!(extras.names().count(), 0);
+        state.params.sampler.operators = 3;
+        let (payload, extras) = Payload::from_state(&state).unwrap();
+        assert_eq!(extras.names().collect::<Vec<_>>(), [SAMPLER_OPERATORS]);
+        let file = encode_payload(&payload, &extras).unwrap();
+        // The payload's bytes are those of the golden file; only the list after it is new.
+        assert_eq!(&file[HEADER_LEN..bytes.len()], &bytes[HEADER_LEN..]);
+        let (payload, extras) = decode_any(&file, &path).unwrap();
+        assert_eq!(
+            payload.into_state(extras).unwrap().params.sampler.operators,
+            3
+        );
+        // A stored count the library refuses (0, or more than the robot limit) is a clear
+        // error naming it.
+        for m in [0_u64, 9, u64::MAX] {
+            let mut bad = Extras::default();
+            bad.put(SAMPLER_OPERATORS, &m, &1).unwrap();
+            let (payload, _) = decode_any(&bytes, &path).unwrap();
+            let err = payload.into_state(bad).unwrap_err().to_string();
+            assert!(err.contains("operators"), "{m}: {err}");
+        }
     }
 
     /// What a build whose warp parameters gained a parameter with a default would write and

@@ -60,6 +60,25 @@ pub struct SamplerParams {
     /// cell's period) must not exceed it ([`crate::CyclicParams::max_busy_share`]). Stored in
     /// the state file by name (only when not 1). Default 1: no cap.
     pub max_busy_share: f64,
+    /// The number of operators `M` of the cell (issue 44), in `1..=tandem_realtime::MAX_ROBOTS`:
+    /// at most `M` robots are low-confidence in any tick. A continuous cell runs its cyclic
+    /// plan's token order with `M` tokens (`tandem_realtime::ContinuousCoordinator::with_operators`);
+    /// the schedules themselves are the one-operator ones (a rounds schedule safe for one
+    /// operator is safe for any `M`; rounds that use `M > 1` are not built yet). One source
+    /// for the planner, the CLI and the study. Stored in the state file by name (only when not
+    /// 1). Default 1: the paper's cell, bit for bit (and not serialized when 1, so every
+    /// JSON and TOML written before the parameter existed is written unchanged).
+    #[serde(skip_serializing_if = "is_one")]
+    pub operators: usize,
+}
+
+/// Whether `m` is 1 (serde's `skip_serializing_if` of [`SamplerParams::operators`]).
+#[expect(
+    clippy::trivially_copy_pass_by_ref,
+    reason = "serde's skip_serializing_if passes a reference"
+)]
+fn is_one(m: &usize) -> bool {
+    *m == 1
 }
 
 impl Default for SamplerParams {
@@ -75,6 +94,7 @@ impl Default for SamplerParams {
             exact: ExactParams::default(),
             switch_s: 0.0,
             max_busy_share: 1.0,
+            operators: 1,
         }
     }
 }
@@ -134,6 +154,12 @@ impl SamplerParams {
             return Err(Error::BadParam {
                 name: "max_busy_share",
                 why: "must be in (0, 1] (1: no cap)",
+            });
+        }
+        if !(1..=tandem_realtime::MAX_ROBOTS).contains(&self.operators) {
+            return Err(Error::BadParam {
+                name: "operators",
+                why: "must be 1 to 8 (tandem_realtime::MAX_ROBOTS): the operators of the cell; 1: one operator",
             });
         }
         Ok(())

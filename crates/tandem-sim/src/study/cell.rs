@@ -361,15 +361,11 @@ impl CellStudyResult {
     }
 }
 
-/// The run-time coordinator of the cell's `plan` with the planner's operator (issue 41): the
-/// token waits the switch time `switch_s` after another robot's group and paces the operator to
-/// the load cap `max_busy_share` (both no-ops at their defaults, 0 and 1).
+/// The run-time coordinator of the cell's `plan` with the planner's operators
+/// (`Planner::continuous_coordinator`: the switch time, the load cap and `M` tokens, issues 41
+/// and 44; no-ops at their defaults).
 fn coordinator_of(planner: &Planner, plan: &CheckedCyclicPlan) -> Result<ContinuousCoordinator> {
-    let sampler = &planner.params().sampler;
-    Ok(plan
-        .coordinator()
-        .with_switch_s(sampler.switch_s)?
-        .with_max_busy_share(sampler.max_busy_share)?)
+    Ok(planner.continuous_coordinator(plan)?)
 }
 
 /// The cell's plan on the planner's problem and its record: the planner's plan of a

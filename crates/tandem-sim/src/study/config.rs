@@ -72,6 +72,23 @@ pub struct StudyOperator {
     /// [`OperatorParams::switch_true_s`]; needed corrections in its first `δ_true` after
     /// another robot's stretch ended are missed and counted. Default: 0 (the operator of §III).
     pub switch_true_s: f64,
+    /// The number of operators `M` of the cell (issue 44), `1 ≤ M ≤`
+    /// [`tandem_realtime::MAX_ROBOTS`]: the planner's
+    /// [`tandem_schedule::SamplerParams::operators`] (set here, not in `[planner.sampler]`),
+    /// and `M` simulated operators, one per operator index of `Tick::operator`, each with the
+    /// error rates and switch time above. Only the continuous cell runs `M > 1` (rounds with
+    /// several operators are not built yet). Default: 1 (not written when so).
+    #[serde(skip_serializing_if = "is_one")]
+    pub operators: usize,
+}
+
+/// Whether `m` is 1 (serde's `skip_serializing_if` of [`StudyOperator::operators`]).
+#[expect(
+    clippy::trivially_copy_pass_by_ref,
+    reason = "serde's skip_serializing_if passes a reference"
+)]
+fn is_one(m: &usize) -> bool {
+    *m == 1
 }
 
 impl Default for StudyOperator {
@@ -80,6 +97,7 @@ impl Default for StudyOperator {
             switch_s: 0.0,
             max_busy_share: 1.0,
             switch_true_s: 0.0,
+            operators: 1,
         }
     }
 }
@@ -183,12 +201,26 @@ impl StudyConfig {
                 "must be finite and ≥ 0 (the simulated operator's switch time in seconds; 0: none)",
             );
         }
+        if !(1..=tandem_realtime::MAX_ROBOTS).contains(&op.operators) {
+            return bad(
+                "operator.operators",
+                "must be between 1 and 8 (tandem_realtime::MAX_ROBOTS): the cell's operators",
+            );
+        }
+        if op.operators > 1 && self.cell == Cell::Rounds {
+            return bad(
+                "operator.operators",
+                "rounds with more than one operator are not supported yet (issue 44): run the \
+                 continuous cell (`cell = \"continuous\"`, `--cell continuous`) or set 1",
+            );
+        }
         let sampler = &self.planner.sampler;
-        if sampler.switch_s != 0.0 || sampler.max_busy_share != 1.0 {
+        if sampler.switch_s != 0.0 || sampler.max_busy_share != 1.0 || sampler.operators != 1 {
             return bad(
                 "planner.sampler",
-                "sets switch_s or max_busy_share: a study sets them in its [operator] table \
-                 (one place for the operator), leave them out of [planner.sampler]",
+                "sets switch_s, max_busy_share or operators: a study sets them in its \
+                 [operator] table (one place for the operator), leave them out of \
+                 [planner.sampler]",
             );
         }
         self.planner.validate()?;
@@ -203,6 +235,7 @@ impl StudyConfig {
         let mut params = self.planner.clone();
         params.sampler.switch_s = self.operator.switch_s;
         params.sampler.max_busy_share = self.operator.max_busy_share;
+        params.sampler.operators = self.operator.operators;
         params
     }
 
@@ -352,6 +385,13 @@ mod tests {
                 .contains("[operator]")
         );
         assert!(toml::from_str::<StudyConfig>("[operator]\nswitch = 1\n").is_err());
+        // M operators (issue 44): the planner's count; written only when not 1.
+        let m: StudyConfig =
+            toml::from_str("cell = \"continuous\"\n[operator]\noperators = 2\n").unwrap();
+        m.validate().unwrap();
+        assert_eq!(m.planner_params().sampler.operators, 2);
+        assert!(toml::to_string(&m).unwrap().contains("operators = 2"));
+        assert!(!text.contains("operators"), "{text}");
         for (text, name) in [
             ("[operator]\nswitch_s = -1.0\n", "operator.switch_s"),
             (
@@ -363,6 +403,14 @@ mod tests {
                 "operator.switch_true_s",
             ),
             ("[planner.sampler]\nswitch_s = 2.0\n", "planner.sampler"),
+            ("[operator]\noperators = 0\n", "operator.operators"),
+            (
+                "cell = \"continuous\"\n[operator]\noperators = 9\n",
+                "operator.operators",
+            ),
+            // Rounds with several operators are not built yet: refused, not run with one.
+            ("[operator]\noperators = 2\n", "operator.operators"),
+            ("[planner.sampler]\noperators = 2\n", "planner.sampler"),
         ] {
             let c: StudyConfig = toml::from_str(text).unwrap();
             let err = c.validate().unwrap_err();

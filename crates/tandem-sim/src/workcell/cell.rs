@@ -25,9 +25,10 @@ use crate::{Error, Result};
 pub struct CellStats {
     /// Control ticks run.
     pub ticks: u64,
-    /// Ticks in which two or more robots traversed a low-confidence sample (must be 0).
+    /// Ticks in which more robots traversed a low-confidence sample than the cell has
+    /// operators (`M`; one operator: two or more robots) (must be 0).
     pub overlap_ticks: u64,
-    /// Ticks in which a robot traversed a low-confidence sample: the operator was busy.
+    /// Ticks in which a robot traversed a low-confidence sample: an operator was busy.
     pub busy_ticks: u64,
     /// Faults latched by the coordinator's monitor (must be 0), each cleared once no robot
     /// was low-confidence.
@@ -204,13 +205,14 @@ impl CellSim {
         )?;
         self.stats.ticks += 1;
         self.corrected = corrected;
-        match t.low_conf.count() {
-            0 => {}
-            1 => self.stats.busy_ticks += 1,
-            _ => {
-                self.stats.busy_ticks += 1;
-                self.stats.overlap_ticks += 1;
-            }
+        // With `M` operators (issue 44) a tick overlaps when more than `M` robots are
+        // low-confidence (`Tick::over`; one operator: two or more, as before).
+        let lc = t.low_conf.count();
+        if lc > 0 {
+            self.stats.busy_ticks += 1;
+        }
+        if t.over(self.coord.operators()) {
+            self.stats.overlap_ticks += 1;
         }
         match t.fault {
             Some(f) if f.tick + 1 == self.coord.ticks() => self.stats.faults += 1,

@@ -330,6 +330,12 @@ pub(super) fn step<C: Controller + ?Sized>(
     let running = coord.running_now();
     let low_conf = coord.low_conf_now();
     let mut operator = Operator::Scheduled;
+    // With `M > 1` operators (issue 44) one simulated operator per operator index: the robot
+    // operator `o` supervises takes `o`'s attention and `o`'s input (`tick_many`); the draws
+    // stay in robot order on the one stream.
+    let m = coord.operators();
+    let assigned = coord.operator_now();
+    let mut inputs = [Operator::Scheduled; tandem_realtime::MAX_ROBOTS];
     // Each robot that logged an unsupervised sample this tick, and that sample's reference
     // time (for the crossings of step 5).
     let mut unsupervised_at = [None; tandem_realtime::MAX_ROBOTS];
@@ -347,7 +353,12 @@ pub(super) fn step<C: Controller + ?Sized>(
         if supervised.is_none() {
             unsupervised_at[i] = Some(ref_now);
         }
-        let switching = low_conf[i] && op.attend(i, ticks);
+        let who = if m > 1 {
+            assigned[i].map_or(0, usize::from)
+        } else {
+            0
+        };
+        let switching = low_conf[i] && op.attend_as(who, i, ticks);
         if let Some(input) = op.robot_tick(
             model,
             run,
@@ -359,10 +370,20 @@ pub(super) fn step<C: Controller + ?Sized>(
             rng,
         )? {
             operator = input;
+            inputs[who] = input;
         }
     }
-    let corrected = !matches!(operator, Operator::Scheduled);
-    let tick = coord.tick(operator)?;
+    let (corrected, tick) = if m > 1 {
+        let corrected = inputs[..m]
+            .iter()
+            .any(|o| !matches!(o, Operator::Scheduled));
+        (corrected, coord.tick_many(&inputs[..m])?)
+    } else {
+        (
+            !matches!(operator, Operator::Scheduled),
+            coord.tick(operator)?,
+        )
+    };
     if let Some(conf) = crossings {
         for (i, t0) in unsupervised_at.iter().enumerate().take(coord.n_robots()) {
             // A robot that started the tick on high-confidence ground may have crossed
@@ -410,8 +431,9 @@ pub(super) struct Operate {
     /// The operator's switch time `δ_true` in whole control ticks
     /// ([`OperatorParams::switch_true_s`], [`tandem_realtime::switch_ticks`]); 0: none.
     switch_ticks: usize,
-    /// Where its attention is (only kept with a switch time).
-    attention: Attention,
+    /// Where each operator's attention is (only kept with a switch time): index `o` for the
+    /// operator `o` of [`Tick::operator`] (one entry per operator; one operator: one entry).
+    attention: [Attention; tandem_realtime::MAX_ROBOTS],
 }
 
 impl Operate {
@@ -431,7 +453,7 @@ impl Operate {
             u_corr: vec![0.0; k],
             cmd: vec![0.0; model.channel_names().len() + 1],
             switch_ticks,
-            attention: Attention::default(),
+            attention: [Attention::default(); tandem_realtime::MAX_ROBOTS],
         })
     }
 
@@ -440,7 +462,14 @@ impl Operate {
     /// corrections this tick are not effective ([`Attention`]). Always `false` without a
     /// switch time (and nothing is kept).
     pub(super) fn attend(&mut self, robot: usize, tick: usize) -> bool {
-        self.switch_ticks > 0 && self.attention.supervise(robot, tick, self.switch_ticks)
+        self.attend_as(0, robot, tick)
+    }
+
+    /// [`attend`](Self::attend) for the operator `operator` of a cell of several (issue 44):
+    /// each operator turns its own attention, with the same switch time. `attend` is
+    /// operator 0's.
+    pub(super) fn attend_as(&mut self, operator: usize, robot: usize, tick: usize) -> bool {
+        self.switch_ticks > 0 && self.attention[operator].supervise(robot, tick, self.switch_ticks)
     }
 
     /// An empty run with room for about two executions of `n_ref` samples.
