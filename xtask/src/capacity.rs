@@ -33,12 +33,13 @@ use std::time::Instant;
 
 use anyhow::{Context, anyhow, bail};
 use plotters::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use tandem::realtime::MAX_ROBOTS;
 use tandem::sim::study::{
-    Cell, CellStudyResult, StudyConfig, StudyInputs, StudyResult, mean_std, run_cell_study,
+    Cell, CellStudyResult, Steady, StudyConfig, StudyInputs, StudyResult, mean_std, run_cell_study,
     run_study, throughput_per_h,
 };
+use tandem::sim::workcell::PlanGap;
 use tandem_plot::{FONT_FAMILY, GROUND_TRUTH, MEAN, OPERATOR};
 
 use crate::study::{TrialBar, read_config};
@@ -116,10 +117,80 @@ pub(crate) struct CapacityArgs {
         requires = "operators"
     )]
     fleet_robots: Vec<usize>,
+    /// Measure the steady state over the last this many tasks of each trial (rounded up to
+    /// whole rounds or periods of `N` tasks) instead of the last 10 %: the tasks before them
+    /// are a warm-up in which the cell learns its task but is not measured (docs/decisions.md,
+    /// "Capacity of a cell that knows its task (issue 41)"). Default: the last 10 %.
+    #[arg(long, value_name = "TASKS")]
+    steady_tasks: Option<usize>,
+    /// Run nothing: read `capacity.json` from each of these output folders of earlier runs
+    /// (comma-separated; e.g. one run per switch time, side by side) and write their rows
+    /// together under `--out`: the tables, `capacity.json` and the figure. The runs must agree
+    /// on trials, samples, seed and measured window.
+    #[arg(long, value_name = "DIR,…", value_delimiter = ',')]
+    merge: Vec<PathBuf>,
+}
+
+/// The run sizes a `capacity.json` records, which merged runs must share.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Sizes {
+    trials: usize,
+    samples: usize,
+    seed: u64,
+    steady_tasks: Option<usize>,
+}
+
+/// `capacity.json` as read back (`--merge`).
+#[derive(Deserialize)]
+struct CapacityFileIn {
+    trials: usize,
+    samples: usize,
+    seed: u64,
+    #[serde(default)]
+    steady_tasks: Option<usize>,
+    rows: Vec<CapacityRow>,
+    continuous: Vec<CellRow>,
+}
+
+/// The rows of the `capacity.json` in each of `dirs` (`--merge`), in order, and their common
+/// sizes.
+fn read_runs(dirs: &[PathBuf]) -> anyhow::Result<(Sizes, Vec<CapacityRow>, Vec<CellRow>)> {
+    let (mut rows, mut cells, mut sizes) = (Vec::new(), Vec::new(), None::<Sizes>);
+    for dir in dirs {
+        let path = dir.join("capacity.json");
+        let text = std::fs::read_to_string(&path).with_context(|| {
+            format!(
+                "--merge: reading {} (a folder `cargo xtask capacity --out` wrote)",
+                path.display()
+            )
+        })?;
+        let file: CapacityFileIn = serde_json::from_str(&text)
+            .with_context(|| format!("--merge: {} is not a capacity.json", path.display()))?;
+        let these = Sizes {
+            trials: file.trials,
+            samples: file.samples,
+            seed: file.seed,
+            steady_tasks: file.steady_tasks,
+        };
+        if let Some(first) = sizes {
+            if first != these {
+                bail!(
+                    "--merge: {} was run with {these:?}, the first folder with {first:?}; \
+                     merge only runs of the same sizes",
+                    path.display()
+                );
+            }
+        }
+        sizes = Some(these);
+        rows.extend(file.rows);
+        cells.extend(file.continuous);
+    }
+    let sizes = sizes.ok_or_else(|| anyhow!("--merge: no folders given"))?;
+    Ok((sizes, rows, cells))
 }
 
 /// One robot count's result in rounds, at the end of learning.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub(crate) struct CapacityRow {
     /// Robots `N`.
     pub robots: usize,
@@ -158,7 +229,7 @@ pub(crate) struct CapacityRow {
 }
 
 /// One robot count's result in a continuous cell, at the end of learning.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub(crate) struct CellRow {
     /// Robots `N`.
     pub robots: usize,
@@ -190,6 +261,13 @@ pub(crate) struct CellRow {
     pub high_conf_pct: f64,
     /// Wall time of this robot count's study (s).
     pub wall_s: f64,
+    /// Tasks per trial in the measured window (whole periods).
+    #[serde(default)]
+    pub steady_tasks: usize,
+    /// The measured window's tasks against the plan in force, per task (s), averaged over
+    /// trials (`CellCompletion::plan_gap`): realized minus planned and its causes.
+    #[serde(default)]
+    pub plan_gap_per_task: PlanGap,
 }
 
 /// What `capacity.json` holds.
@@ -199,6 +277,8 @@ struct CapacityFile<'a> {
     samples: usize,
     seed: u64,
     end_share: f64,
+    /// `--steady-tasks`: the measured window in tasks per trial (`None`: `end_share`).
+    steady_tasks: Option<usize>,
     /// `3600 / E[low-confidence seconds per task]` (tasks per hour per operator).
     operator_limited_per_h: f64,
     /// Rounds, per `N` (empty with `--cell continuous`).
@@ -208,7 +288,11 @@ struct CapacityFile<'a> {
 }
 
 /// The end-of-learning row of one study in rounds.
-pub(crate) fn row(result: &StudyResult, wall_s: f64) -> anyhow::Result<CapacityRow> {
+pub(crate) fn row(
+    result: &StudyResult,
+    wall_s: f64,
+    steady_tasks: Option<usize>,
+) -> anyhow::Result<CapacityRow> {
     let config = &result.config;
     let n = config.robots;
     let finals: Vec<_> = result
@@ -222,7 +306,11 @@ pub(crate) fn row(result: &StudyResult, wall_s: f64) -> anyhow::Result<CapacityR
         .collect::<anyhow::Result<_>>()?;
     let (t_mean, t_std) = mean_std(finals.iter().map(|r| r.t_total_s));
     let rounds = config.n_rounds();
-    let last = ((END_SHARE * rounds as f64).ceil() as usize).clamp(1, rounds);
+    let last = steady_tasks
+        .map_or((END_SHARE * rounds as f64).ceil() as usize, |t| {
+            t.div_ceil(n)
+        })
+        .clamp(1, rounds);
     fn end_rounds(
         t: &tandem::sim::study::TrialResult,
         skip: usize,
@@ -266,9 +354,29 @@ pub(crate) fn row(result: &StudyResult, wall_s: f64) -> anyhow::Result<CapacityR
 }
 
 /// The end-of-learning row of one continuous study.
-pub(crate) fn cell_row(result: &CellStudyResult, wall_s: f64) -> anyhow::Result<CellRow> {
+pub(crate) fn cell_row(
+    result: &CellStudyResult,
+    wall_s: f64,
+    steady_tasks: Option<usize>,
+) -> anyhow::Result<CellRow> {
     let n = result.config.robots;
     let summary = result.summary();
+    // Each trial's measured window: the study's own (the last 10 %) or the last
+    // `steady_tasks` (whole periods).
+    let steady: Vec<Steady> = result
+        .trials
+        .iter()
+        .map(|t| match steady_tasks {
+            None => Some(t.steady),
+            Some(k) => Steady::of_last(&t.completions, n, result.dt_s, k),
+        })
+        .collect::<Option<_>>()
+        .ok_or_else(|| anyhow!("a continuous trial without completed tasks"))?;
+    let (throughput, throughput_std) = mean_std(steady.iter().map(|s| s.throughput_per_h));
+    let per_task: Vec<PlanGap> = steady
+        .iter()
+        .map(|s| s.plan_gap.scaled(1.0 / s.tasks.max(1) as f64))
+        .collect();
     let last: Vec<_> = result
         .trials
         .iter()
@@ -282,15 +390,15 @@ pub(crate) fn cell_row(result: &CellStudyResult, wall_s: f64) -> anyhow::Result<
         robots: n,
         switch_s: result.config.operator.switch_s,
         tasks: result.config.executions,
-        steady_throughput_per_h: summary.steady_throughput_per_h,
-        steady_throughput_std_per_h: summary.steady_throughput_std_per_h,
-        operator_busy_share: summary.steady_operator_busy_share,
-        robot_wait_share: summary.steady_robot_wait_share,
+        steady_throughput_per_h: throughput,
+        steady_throughput_std_per_h: throughput_std,
+        operator_busy_share: mean_std(steady.iter().map(|s| s.operator_busy_share)).0,
+        robot_wait_share: mean_std(steady.iter().map(|s| s.robot_wait_share)).0,
         // Busy seconds of the window over its tasks: each busy tick supervises one robot.
         lc_s_per_task: mean_std(
-            result.trials.iter().map(|t| {
-                t.steady.operator_busy_share * t.steady.duration_s / t.steady.tasks as f64
-            }),
+            steady
+                .iter()
+                .map(|s| s.operator_busy_share * s.duration_s / s.tasks as f64),
         )
         .0,
         plan_per_h: summary.last_plan_tasks_per_hour,
@@ -300,6 +408,8 @@ pub(crate) fn cell_row(result: &CellStudyResult, wall_s: f64) -> anyhow::Result<
         faults: summary.faults,
         high_conf_pct: mean_std(last.iter().map(|i| i.high_conf_pct)).0,
         wall_s,
+        steady_tasks: steady.first().map_or(0, |s| s.tasks),
+        plan_gap_per_task: PlanGap::mean(&per_task).unwrap_or_default(),
     })
 }
 
@@ -380,6 +490,17 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| root.join("results/capacity"));
     let seed = args.seed.unwrap_or(base.seed);
+    if !args.merge.is_empty() {
+        let (sizes, rows, cells) = read_runs(&args.merge)?;
+        let mut deltas: Vec<f64> = rows
+            .iter()
+            .map(|r| r.switch_s)
+            .chain(cells.iter().map(|r| r.switch_s))
+            .collect();
+        deltas.sort_by(f64::total_cmp);
+        deltas.dedup();
+        return report(&sizes, &rows, &cells, &deltas, &out, Instant::now());
+    }
     let (do_rounds, do_cell) = match args.cell {
         CellChoice::Rounds => (true, false),
         CellChoice::Continuous => (false, true),
@@ -387,8 +508,7 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
     };
     println!(
         "capacity ({}): N = {}..={} robots, {} trials × up to {} executions (rounded down to a \
-         multiple of N), {} samples per schedule, seed {seed}; end of learning = the last \
-         {:.0} % of rounds or tasks",
+         multiple of N), {} samples per schedule, seed {seed}; end of learning = the {}",
         match args.cell {
             CellChoice::Rounds => "rounds",
             CellChoice::Continuous => "continuous cell",
@@ -399,7 +519,10 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
         args.trials,
         args.executions,
         args.samples,
-        100.0 * END_SHARE
+        args.steady_tasks.map_or_else(
+            || format!("last {:.0} % of rounds or tasks", 100.0 * END_SHARE),
+            |k| format!("last {k} tasks (whole rounds or periods; the rest a warm-up)")
+        )
     );
     let wall = Instant::now();
     let (mut rows, mut cells) = (Vec::new(), Vec::new());
@@ -464,7 +587,7 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
             let (result, _) = run_study(&config, &inputs, &|p| bar.step(p))
                 .with_context(|| format!("the study with N = {n} robots in rounds"))?;
             bar.clear();
-            let r = row(&result, t.elapsed().as_secs_f64())?;
+            let r = row(&result, t.elapsed().as_secs_f64(), args.steady_tasks)?;
             println!(
                 "N = {n_text}, rounds: T_total {:.1} ± {:.1} s, {:.1} tasks/h planned, {:.1} \
                  measured, operator busy {:.0} %, robots waiting {:.0} %, {} overlapping \
@@ -490,7 +613,7 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
             let (result, _) = run_cell_study(&config, &inputs, &|p| bar.step(p))
                 .with_context(|| format!("the continuous study with N = {n} robots"))?;
             bar.clear();
-            let r = cell_row(&result, t.elapsed().as_secs_f64())?;
+            let r = cell_row(&result, t.elapsed().as_secs_f64(), args.steady_tasks)?;
             println!(
                 "N = {n_text}, continuous: {:.1} ± {:.1} tasks/h measured, last plan {:.1} (bound \
                  {:.1}), operator busy {:.0} %, robots waiting {:.0} %, {} overlapping ticks, \
@@ -505,9 +628,35 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
                 r.faults,
                 r.wall_s
             );
+            println!(
+                "  its {} measured tasks against the plan in force, per task: {}",
+                r.steady_tasks,
+                r.plan_gap_per_task.describe()
+            );
             cells.push(r);
         }
     }
+    let sizes = Sizes {
+        trials: args.trials,
+        samples: args.samples,
+        seed,
+        steady_tasks: args.steady_tasks,
+    };
+    report(&sizes, &rows, &cells, &deltas, &out, wall)
+}
+
+/// Prints the tables of `rows` and `cells` (run with `sizes`, at the switch times `deltas`)
+/// and writes `capacity.json` and the figure under `out` (the switch-time figure for several
+/// `δ`, else the figure against `N`); fails if any run had overlapping low-confidence ticks.
+fn report(
+    sizes: &Sizes,
+    rows: &[CapacityRow],
+    cells: &[CellRow],
+    deltas: &[f64],
+    out: &Path,
+    wall: Instant,
+) -> anyhow::Result<()> {
+    let (rows, cells) = (rows.to_vec(), cells.to_vec());
     let bound = operator_limited_per_h(&rows, &cells);
     if !rows.is_empty() {
         println!("\nrounds:");
@@ -527,12 +676,13 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
         println!("\nthroughput against its proven bound, per switch time δ:");
         print!("{}", switch_table(&rows, &cells));
     }
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let file = CapacityFile {
-        trials: args.trials,
-        samples: args.samples,
-        seed,
+        trials: sizes.trials,
+        samples: sizes.samples,
+        seed: sizes.seed,
         end_share: END_SHARE,
+        steady_tasks: sizes.steady_tasks,
         operator_limited_per_h: bound,
         rows: &rows,
         continuous: &cells,
@@ -541,9 +691,13 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
     std::fs::write(&json_path, serde_json::to_string_pretty(&file)? + "\n")
         .with_context(|| format!("writing {}", json_path.display()))?;
     if deltas.len() > 1 {
+        let window = sizes
+            .steady_tasks
+            .map_or_else(|| "last 10 %".to_string(), |k| format!("last {k} tasks"));
         draw_switch(
             &rows,
             &cells,
+            &window,
             &out.join("capacity_switch.svg"),
             &out.join("capacity_switch.png"),
         )?;
@@ -914,6 +1068,7 @@ const N_COLOURS: [RGBColor; 4] = [MEAN, OPERATOR, GROUND_TRUTH, RGBColor(120, 12
 pub(crate) fn draw_switch(
     rows: &[CapacityRow],
     cells: &[CellRow],
+    window: &str,
     svg: &Path,
     png: &Path,
 ) -> anyhow::Result<()> {
@@ -924,13 +1079,13 @@ pub(crate) fn draw_switch(
     let mut svg_text = String::new();
     {
         let root = SVGBackend::with_string(&mut svg_text, SIZE_PX).into_drawing_area();
-        draw_switch_on(&root, rows, cells)?;
+        draw_switch_on(&root, rows, cells, window)?;
         root.present()
             .map_err(|e| anyhow!("finishing the switch-time SVG: {e}"))?;
     }
     {
         let root = BitMapBackend::new(png, SIZE_PX).into_drawing_area();
-        draw_switch_on(&root, rows, cells)?;
+        draw_switch_on(&root, rows, cells, window)?;
         root.present()
             .map_err(|e| anyhow!("writing {}: {e}", png.display()))?;
     }
@@ -996,6 +1151,7 @@ fn draw_switch_on<DB: DrawingBackend>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     rows: &[CapacityRow],
     cells: &[CellRow],
+    window: &str,
 ) -> anyhow::Result<()> {
     let err = |what: &'static str| {
         move |e: DrawingAreaErrorKind<DB::ErrorType>| {
@@ -1040,7 +1196,7 @@ fn draw_switch_on<DB: DrawingBackend>(
         chart
             .draw_series(LineSeries::new(measured.clone(), colour.stroke_width(3)))
             .map_err(err("throughput"))?
-            .label(format!("{label} (measured, last 10 %)"))
+            .label(format!("{label} (measured, {window})"))
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
             });
@@ -1171,6 +1327,8 @@ mod tests {
             faults: 0,
             high_conf_pct: 60.0,
             wall_s: 1.0,
+            steady_tasks: 24,
+            plan_gap_per_task: PlanGap::default(),
         }
     }
 
@@ -1263,7 +1421,7 @@ mod tests {
             ground_truth_pct: 66.0,
             trials: vec![trial(0, 100.0), trial(1, 200.0)],
         };
-        let row = row(&result, 1.0).unwrap();
+        let row = row(&result, 1.0, None).unwrap();
         assert_eq!((row.robots, row.executions, row.rounds), (3, 30, 10));
         assert_eq!(row.t_total_mean_s, 150.0);
         assert!((row.t_total_std_s - 50.0 * 2f64.sqrt()).abs() < 1e-12);
@@ -1309,7 +1467,7 @@ mod tests {
         );
         let dir = crate::fig5::tests::scratch_dir("capacity-switch");
         let (svg, png) = (dir.join("s.svg"), dir.join("s.png"));
-        draw_switch(&rows, &cells, &svg, &png).unwrap();
+        draw_switch(&rows, &cells, "last 10 %", &svg, &png).unwrap();
         let text = std::fs::read_to_string(&svg).unwrap();
         for label in [
             "the operator&apos;s switch time δ (s) the plans are made with",
@@ -1322,7 +1480,7 @@ mod tests {
                 "{label}"
             );
         }
-        assert!(draw_switch(&[], &[], &svg, &png).is_err());
+        assert!(draw_switch(&[], &[], "last 10 %", &svg, &png).is_err());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -378,6 +378,55 @@ fn the_token_passes_the_switch_time_after_a_stretch_ended() {
     assert!(gap_of(0.0) < 8);
 }
 
+#[test]
+fn the_token_passes_early_by_the_travel_to_the_stretch() {
+    use tandem_realtime::continuous::{ContinuousCoordinator, run_cell};
+    // [HC ×4, LC, HC] of 1 s each at ψ̇ = 1, bounds [½, 2]; both gates at the start, 4 s of
+    // high-confidence travel before the stretch; tick ¼ s, δ = 2 s (k = 8). From its gate a
+    // robot surely needs 15 whole ticks before the tick in which it is first low-confidence
+    // (4 s less the clock tolerance is just under 16 ticks), more than k: the token lets it go
+    // as soon as the other robot left, and it still reaches its stretch more than k ticks
+    // later.
+    let task = Timeline::new(
+        &[true, true, true, true, false, true],
+        &[1.0; 6],
+        &[0.5; 6],
+        &[2.0; 6],
+        0.0,
+        1.0,
+    )
+    .unwrap();
+    let cell_at = |switch_s: f64| {
+        ContinuousCoordinator::new(task.clone(), &[], &[(0, 0), (1, 0)], 2, 0.25)
+            .unwrap()
+            .with_switch_s(switch_s)
+            .unwrap()
+    };
+    let mut r = rng(11);
+    for a in adversary_set(2, [0.5, 2.0], 4000, &mut r) {
+        let mut cell = cell_at(2.0);
+        let run = run_cell(&mut cell, a, &mut r, 10, 40_000).unwrap();
+        assert_eq!(run.overlap_ticks, 0);
+        assert!(cell.tasks_completed().iter().all(|&t| t >= 10), "{a:?}");
+        let g = run.min_switch_gap_ticks.expect("the robots switch");
+        assert!(g >= 8, "{a:?}: a switch of {g} ticks < k = 8");
+    }
+    // The planned operator: the switch costs the travel alone, as without a switch time
+    // (16 ticks from the gate, the last of them touching the stretch within the tolerance),
+    // not the switch time and then the travel (8 + 16 ticks), which the cyclic plan does not
+    // charge (it charges max(δ, travel + tick) per change).
+    let mut gap_nominal = |switch_s: f64| {
+        let mut cell = cell_at(switch_s);
+        let run = run_cell(&mut cell, Adversary::Nominal, &mut r, 10, 40_000).unwrap();
+        (run.min_switch_gap_ticks.unwrap(), cell.ticks())
+    };
+    let (with_delta, ticks_with) = gap_nominal(2.0);
+    let (without, ticks_without) = gap_nominal(0.0);
+    assert!(with_delta >= 8, "{with_delta}");
+    assert_eq!(with_delta, without, "the travel covers the switch time");
+    assert_eq!(ticks_with, ticks_without, "no tick lost to δ = 2 s");
+}
+
 /// Robots of 10 low-confidence samples of 0.1 s (the whole task), gradients 1, bounds
 /// [0.8, 1.25], started at `starts`: no high-confidence time to switch in, only idle time
 /// between one robot's end and the next one's start (Eq. 20 constraint 2 relaxed by `δ`).

@@ -207,7 +207,8 @@ impl ContinuousCoordinator {
     /// The same cell with the operator's switch time `switch_s` (real s, finite and ≥ 0),
     /// reset to the start: the token lets a robot pass its gate no sooner than `k` =
     /// [`switch_ticks`](crate::switch_ticks)`(switch_s, tick_s)` ticks after the tick in which
-    /// *another* robot left its group (the token's move), so between two robots' stretches at
+    /// *another* robot left its group (the token's move), less the whole ticks it surely
+    /// travels from that gate to its stretch (at most `k`), so between two robots' stretches at
     /// least `k` ticks pass in which neither is low-confidence (docs/decisions.md, "The switch
     /// time at run time (issue 41)"). Consecutive groups of one robot wait for nothing.
     /// `switch_s = 0` changes nothing.
@@ -310,16 +311,42 @@ impl ContinuousCoordinator {
 
     /// Ticks operator `o` must still wait at tick index `tick` before it may be granted to
     /// robot `i` (the switch time after it released another robot; 0 without one).
+    ///
+    /// The switch time is counted where it protects the operator, at the robot's stretch,
+    /// not at its gate: the robot is let go [`entry_ticks`](Self::entry_ticks) early (at
+    /// most `k`), the whole ticks it surely needs from its gate to its group's first
+    /// low-confidence tick, so that it travels while the operator switches and still enters
+    /// no sooner than `k` ticks after the other robot left (docs/decisions.md, "The token
+    /// passes early by the travel to the stretch (issue 41)").
     fn op_wait(&self, o: usize, i: usize, tick: u64) -> u64 {
         if let Some(p) = &self.pace {
-            return p.wait(self.staff.last_left[o], i, self.switch_ticks, tick);
+            let early = self.entry_ticks(i);
+            return p.wait(self.staff.last_left[o], i, self.switch_ticks, early, tick);
         }
         match self.staff.last_left[o] {
             Some((r, left)) if self.switch_ticks > 0 && r != i => {
-                (left + self.switch_ticks).saturating_sub(tick)
+                let early = self.entry_ticks(i).min(self.switch_ticks);
+                (left + self.switch_ticks - early).saturating_sub(tick)
             }
             _ => 0,
         }
+    }
+
+    /// Whole ticks that surely pass, from the tick start at which robot `i` may pass the gate
+    /// of its next group, before the tick in which it is first low-confidence in that group:
+    /// the least real time from the gate's sample to the group's first stretch less the clock
+    /// tolerance (`Reach::to_run_from_sample`, every sample between them high-confidence, run
+    /// at its plan), in ticks rounded down (`prealert::ticks_before_at_least`). A robot not
+    /// inside is at or before its next gate, so it needs at least that. 0 without a switch
+    /// time (nothing to shorten) and for a robot with no group left in its task.
+    fn entry_ticks(&self, i: usize) -> u64 {
+        if self.switch_ticks == 0 {
+            return 0;
+        }
+        self.groups.get(self.next_group[i]).map_or(0, |g| {
+            let (fast_s, _) = self.reach.to_run_from_sample(g.gate, g.ref_start);
+            prealert::ticks_before_at_least(fast_s, self.tick_s)
+        })
     }
 
     /// One operator: ticks robot `i` must still wait at tick index `tick` before the token

@@ -66,8 +66,10 @@
 //! its gate and keeps until it has left the group: a stretch is never handed over mid-way
 //! ([`Tick::operator`](crate::Tick::operator) names it). *Switch time, per operator*: when
 //! operator `o`'s robot leaves at the end of tick `a`, `o` may be granted to *another* robot
-//! only from tick `a + 1 + k` on, so between two robots' stretches of one operator at least `k`
-//! ticks pass in which `o` supervises no one. *Liveness*: grants follow the sequence, each
+//! for its group `G` only from tick `a + 1 + k − min(k, e_G)` on, `e_G` the whole ticks a robot
+//! surely travels from `G`'s gate before it is low-confidence in `G` (it travels while the
+//! operator switches), so between two robots' stretches of one operator at least `k` ticks
+//! pass in which `o` supervises no one. *Liveness*: grants follow the sequence, each
 //! robot's entries come in its task order, and an inside robot leaves its group in finitely
 //! many ticks (rate at least `S`), releasing its operator, whose switch time ends `k` ticks
 //! later; so the next entry is granted in finitely many ticks once its robot has finished its

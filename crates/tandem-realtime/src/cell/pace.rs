@@ -106,13 +106,23 @@ impl Pace {
 
     /// Ticks robot `i` must still wait at tick index `tick` before it may pass its gate with
     /// the token: until the episode's start, plus the switch ticks `k` when `last_left` (the
-    /// robot that last left a group, and the tick after) is another robot.
-    pub(super) fn wait(&self, last_left: Option<(usize, u64)>, i: usize, k: u64, tick: u64) -> u64 {
+    /// robot that last left a group, and the tick after) is another robot, less `early` (at
+    /// most the switch ticks: the ticks the robot surely travels from its gate before it is
+    /// low-confidence, so `[A_i, A_i + s_i)` still has no low-confidence tick; never before
+    /// the episode's start).
+    pub(super) fn wait(
+        &self,
+        last_left: Option<(usize, u64)>,
+        i: usize,
+        k: u64,
+        early: u64,
+        tick: u64,
+    ) -> u64 {
         let (from, switch) = match last_left {
             Some((r, left)) => (left.max(self.start), if r == i { 0 } else { k }),
             None => (self.start, 0),
         };
-        (from + switch).saturating_sub(tick)
+        (from + switch - early.min(switch)).saturating_sub(tick)
     }
 }
 
@@ -162,7 +172,7 @@ mod tests {
         for t in 0..10 {
             p.observe((5..9).contains(&t));
         }
-        assert_eq!(p.wait(None, 1, 3, 0), 0);
+        assert_eq!(p.wait(None, 1, 3, 0, 0), 0);
         p.end_episode(10, 0, false);
         assert_eq!(p.start(), 10);
         // Episode 1 of robot 1 (switch 3) busy 6 ticks, left at the end of tick 19: B = 4 +
@@ -172,9 +182,14 @@ mod tests {
         }
         p.end_episode(20, 3, true);
         assert_eq!(p.start(), 26);
-        assert_eq!(p.wait(Some((1, 20)), 2, 3, 20), 9);
-        assert_eq!(p.wait(Some((1, 20)), 1, 3, 20), 6);
-        assert_eq!(p.wait(Some((1, 20)), 1, 3, 26), 0);
+        assert_eq!(p.wait(Some((1, 20)), 2, 3, 0, 20), 9);
+        assert_eq!(p.wait(Some((1, 20)), 1, 3, 0, 20), 6);
+        assert_eq!(p.wait(Some((1, 20)), 1, 3, 0, 26), 0);
+        // A robot 2 ticks of travel from its stretch passes its gate 2 ticks early; the
+        // credit is at most the switch ticks (never before the episode's start, 26).
+        assert_eq!(p.wait(Some((1, 20)), 2, 3, 2, 20), 7);
+        assert_eq!(p.wait(Some((1, 20)), 2, 3, 50, 20), 6);
+        assert_eq!(p.wait(Some((1, 20)), 1, 3, 50, 20), 6);
         // A new segment from 26: an episode already longer than its share goes on at once.
         for t in 20..60 {
             p.observe(t == 50);

@@ -207,12 +207,30 @@ impl Steady {
     /// control tick of `tick_s` (s); `None` without completions.
     #[must_use]
     pub fn of(completions: &[CellCompletion], n_robots: usize, tick_s: f64) -> Option<Steady> {
+        Steady::of_last(
+            completions,
+            n_robots,
+            tick_s,
+            completions.len().div_ceil(10),
+        )
+    }
+
+    /// The steady state over the last `tasks` of `completions` instead of the last 10 %
+    /// (`cargo xtask capacity --steady-tasks`: the tasks before them are a warm-up that
+    /// learns but is not measured), rounded up to a multiple of `N` (whole periods, as
+    /// [`Steady::of`]) and at most all of them; `None` without completions.
+    #[must_use]
+    pub fn of_last(
+        completions: &[CellCompletion],
+        n_robots: usize,
+        tick_s: f64,
+        tasks: usize,
+    ) -> Option<Steady> {
         let total = completions.len();
         if total == 0 {
             return None;
         }
-        let k = total
-            .div_ceil(10)
+        let k = tasks
             .max(1)
             .div_ceil(n_robots.max(1))
             .saturating_mul(n_robots.max(1))
@@ -831,6 +849,15 @@ mod tests {
             assert_eq!(s.tasks % 7, 0, "{total}");
             assert!((s.throughput_per_h - 3600.0).abs() < 1e-9, "{total}: {s:?}");
         }
+        // A longer window (`of_last`): 60 of 238 tasks rounded up to 63 (nine periods).
+        let s = Steady::of_last(&bunched(238), 7, 0.01, 60).unwrap();
+        assert_eq!(s.tasks, 63);
+        assert!((s.duration_s - 63.0).abs() < 1e-9, "{}", s.duration_s);
+        assert!((s.throughput_per_h - 3600.0).abs() < 1e-9);
+        assert_eq!(
+            Steady::of_last(&bunched(20), 7, 0.01, 60).unwrap().tasks,
+            20
+        );
         // Fewer tasks than a period: all of them, from the start.
         let s = Steady::of(&bunched(5), 7, 0.01).unwrap();
         assert_eq!(s.tasks, 5);
