@@ -15,6 +15,7 @@ mod fixtures;
 mod reference_order;
 mod stress;
 mod study;
+mod study_cell;
 mod test;
 mod zoo;
 
