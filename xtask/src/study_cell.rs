@@ -184,6 +184,32 @@ pub(crate) fn run_mixed(
             last.falsely_trusted_mean[t]
         );
     }
+    // The continuous cell's bound for this mix at each trial's last plan: the best task
+    // ratios r ∈ {1..4}^N and what no cyclic plan with them exceeds
+    // (`tandem::schedule::cyclic::best_mix`, docs/decisions.md).
+    for trial in &result.trials {
+        let last = trial.iterations.last().expect("iteration 0 at least");
+        let mix: Vec<tandem::schedule::cyclic::MixTask> = result
+            .robot_task
+            .iter()
+            .map(|&t| tandem::schedule::cyclic::MixTask {
+                fastest_s: last.tasks[t].fastest_s,
+                lc_s: last.tasks[t].lc_s,
+            })
+            .collect();
+        let b = tandem::schedule::cyclic::best_mix(&mix, 4, config.operator.switch_s)?;
+        println!(
+            "  trial {}, last plan, continuous: best ratios {:?} (tasks per robot per period), \
+             at most {:.1} tasks/h (period ≥ {:.2} s); mixed operator-limited bound {:.1} \
+             tasks/h, per-robot bound {:.1} tasks/h",
+            trial.trial,
+            b.ratios,
+            b.tasks_per_hour_bound,
+            b.period_lower_bound_s,
+            b.operator_limited_per_hour,
+            b.robot_limited_per_hour
+        );
+    }
     let (overlaps, faults) = result.overlaps_and_faults();
     println!("overlapping low-confidence ticks: {overlaps}, faults: {faults}");
     println!(

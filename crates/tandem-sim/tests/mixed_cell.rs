@@ -56,6 +56,8 @@ fn mixed_rounds_learn_each_task_without_overlap_and_deterministically() {
                 // Never trusted where a workpiece can need the operator.
                 assert_eq!(t.falsely_trusted_samples, 0);
                 assert!(t.high_conf_pct <= t.truth_never_needed_pct + 1e-9);
+                // The operator-seconds of a task are part of its fastest duration.
+                assert!(t.lc_s > 0.0 && t.lc_s <= t.fastest_s, "{t:?}");
             }
             if let Some(r) = &it.round {
                 // The round ran the whole cell: at least the slower robot's planned time.

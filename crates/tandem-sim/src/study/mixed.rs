@@ -57,6 +57,12 @@ pub struct MixedTaskState {
     pub truth_never_needed_pct: f64,
     /// High-confidence samples where some workpiece can need the operator.
     pub falsely_trusted_samples: usize,
+    /// The task's fastest admissible duration `D` (s) on its current problem
+    /// ([`tandem_schedule::cyclic::MixTask::fastest_s`]).
+    pub fastest_s: f64,
+    /// Its low-confidence time per task at the operator's mean rate `L` (s)
+    /// ([`tandem_schedule::cyclic::MixTask::lc_s`]): the operator-seconds one task needs.
+    pub lc_s: f64,
 }
 
 /// What one round of a mixed cell did.
@@ -193,7 +199,10 @@ fn iteration(cell: &CellPlanner, tasks: &[MixedTask]) -> MixedIteration {
             .zip(tasks)
             .map(|(c, t)| {
                 let conf = c.planner().confidence();
+                let mix = tandem_schedule::cyclic::MixTask::of(c.planner().problem());
                 MixedTaskState {
+                    fastest_s: mix.fastest_s,
+                    lc_s: mix.lc_s,
                     high_conf_pct: 100.0 * conf.high_share(),
                     truth_never_needed_pct: 100.0 * t.truth.never_needed_share(),
                     falsely_trusted_samples: falsely_trusted_where(conf.conf(), t.truth.can_need()),
