@@ -24,7 +24,9 @@
 //!
 //! `fixtures/mixed/deburring/`: the demonstrations of a second task for a cell of different
 //! tasks (issue 45): the task zoo's `deburring` family at seed 0 (a selection seed),
-//! `demo_{i}.csv` exactly as `tandem_zoo` generates them.
+//! `demo_{i}.csv` exactly as `tandem_zoo` generates them, and `need.csv`, the zoo's true need
+//! on the reference of their fit with the default parameters (the simulated operator's truth
+//! in `fixtures/mixed/cell.toml`).
 //!
 //! `fixtures/examples/ros2/`: `demo_{0,1,2}.mcap`, the example demonstrations
 //! `fixtures/examples/demo_{0,1,2}.csv` as ROS 2 recordings (rosbag2 MCAP, uncompressed
@@ -158,11 +160,38 @@ fn generate_state(examples: &Path) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
 /// The files of `fixtures/mixed/deburring/` (module docs).
 fn generate_deburring() -> anyhow::Result<Vec<(String, Vec<u8>)>> {
     let task = (tandem_zoo::family("deburring")?.generate)(MIXED_DEBURRING_SEED)?;
-    Ok(task
+    let need = deburring_need(&task)?;
+    let mut files: Vec<(String, Vec<u8>)> = task
         .files
         .into_iter()
         .map(|(name, text)| (name, text.into_bytes()))
-        .collect())
+        .collect();
+    files.push(("need.csv".to_owned(), need.into_bytes()));
+    Ok(files)
+}
+
+/// `fixtures/mixed/deburring/need.csv`: the zoo's true need on the reference of the fit with
+/// the default parameters (the study's), one row per reference sample: the need level at the
+/// reference demonstration's true progress, as the zoo's evaluation maps it
+/// (`tandem_zoo::eval::prepare`); the simulated operator's truth of the mixed cell's study
+/// (`fixtures/mixed/cell.toml`).
+fn deburring_need(task: &tandem_zoo::ZooTask) -> anyhow::Result<String> {
+    let demos = task.demos()?;
+    let model = tandem::lfd::TaskModel::fit(&demos, &PlannerParams::default().fit)?;
+    let r = model.reference_idx();
+    let progress = task
+        .progress
+        .get(r)
+        .with_context(|| format!("no true progress for the reference, demo {r}"))?;
+    if progress.len() != model.n_ref() {
+        bail!(
+            "the reference (demo {r}) has {} rows of true progress but {} reference samples",
+            progress.len(),
+            model.n_ref()
+        );
+    }
+    let levels: Vec<f64> = progress.iter().map(|&p| task.need_at(p)).collect();
+    Ok(tandem::sim::needs::NeedProfile::from_levels(&levels)?.to_csv())
 }
 
 /// The files of `fixtures/examples/ros2/` (see the module docs), made from the example

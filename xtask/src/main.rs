@@ -16,6 +16,7 @@ mod fleet;
 mod reference_order;
 mod stress;
 mod study;
+mod study_cell;
 mod test;
 mod zoo;
 

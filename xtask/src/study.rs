@@ -116,6 +116,13 @@ pub(crate) struct StudyArgs {
     /// `tandem inspect`. Refuses to start when one of those files exists already.
     #[arg(long, value_name = "DIR")]
     save_state: Option<PathBuf>,
+    /// A cell of different tasks on different robots (issue 45; docs/formats.md, "Cell
+    /// file"): each task's demonstrations, robots, hold rules and ground truth. One task with
+    /// the sanding labels as its truth runs today's study on its demonstrations and robots;
+    /// two or more tasks run the mixed cell in rounds (study.json: `T_total` against the mixed
+    /// bound, each task's confidence against its truth).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["robots", "fixtures", "bag", "save_state"])]
+    cell_file: Option<PathBuf>,
 }
 
 /// `--cell`'s parser: the planner's `Cell` by its name (`rounds`, `continuous`), each value
@@ -652,7 +659,7 @@ fn print_times(times: &PhaseTimes, wall: std::time::Duration) {
 pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
     let wall = Instant::now();
     let root = workspace_root();
-    let config = config(args)?;
+    let mut config = config(args)?;
     if let Some(n) = args.threads {
         if n == 0 {
             bail!("--threads must be at least 1");
@@ -662,10 +669,55 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
             .build_global()
             .context("setting up the worker threads")?;
     }
-    let fixtures = args
+    let mut fixtures = args
         .fixtures
         .clone()
         .unwrap_or_else(|| root.join("fixtures/sanding"));
+    if let Some(path) = &args.cell_file {
+        let (file, dir) = crate::study_cell::read_cell_file(path)?;
+        if !crate::study_cell::is_single_labels(&file) {
+            if config.cell == Cell::Continuous {
+                bail!(
+                    "--cell continuous with a cell of different tasks is not supported yet: \
+                     run it in rounds (--cell rounds)"
+                );
+            }
+            let out = args.out.clone().unwrap_or_else(|| root.join("results"));
+            let mut file = file;
+            if args.no_holds {
+                for t in &mut file.task {
+                    t.holds.clear();
+                }
+            }
+            return crate::study_cell::run_mixed(
+                config,
+                &file,
+                &dir,
+                args.executions.is_some(),
+                &out,
+                &root,
+            );
+        }
+        // One task with the sanding labels: today's study on its demonstrations, robots and
+        // hold rules.
+        let task = &file.task[0];
+        config.robots = task.robots;
+        if args.executions.is_none() && task.robots > 0 {
+            config.executions = config.executions / task.robots * task.robots;
+        }
+        if !args.no_holds {
+            config.planner.holds.rules = task
+                .holds
+                .iter()
+                .map(|r| r.parse())
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("task `{}`: its hold rules", task.name))?;
+        }
+        config
+            .validate()
+            .context("study configuration with the cell file's task")?;
+        fixtures = dir.join(&task.demos);
+    }
     let inputs = StudyInputs::from_dir(&fixtures)
         .with_context(|| format!("reading demonstrations from {}", fixtures.display()))?;
     let out = args.out.clone().unwrap_or_else(|| root.join("results"));

@@ -1009,4 +1009,69 @@ mod tests {
         assert!(err.contains("load cap"), "{err}");
         assert_eq!(cell.tasks()[0].planner().params().sampler.switch_s, 0.05);
     }
+
+    /// Stress with mixed tasks (issue 45): for `N = 2..8` robots, each robot its own random
+    /// task (the test kit's random problems: its own length, confidence runs, gradient bounds
+    /// and sample period of 10, 5 or 4 ms; the cell's tick the shortest), at switch times 0
+    /// and 50 ms, six cells per `N` from fixed seeds: the greedy placement gives a schedule
+    /// no shorter than its lower bound, and every adversary of `adversary_set` but the beam
+    /// search and the two random-gradient ones (the gradient range is per robot) runs it to
+    /// the end with 0 overlapping ticks and no backward step.
+    #[test]
+    fn random_mixed_cells_of_2_to_8_robots_never_run_two_robots_low_confidence() {
+        use rand::Rng;
+        use tandem_realtime::adversary::Adversary;
+        use tandem_schedule::testkit::random_problem;
+        let mut cells = 0;
+        for n in 2..=8 {
+            for case in 0..6u64 {
+                let seed = 45_000 + 100 * n as u64 + case;
+                let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                let problems: Vec<Problem> = (0..n)
+                    .map(|_| {
+                        let dt_s = [0.01, 0.005, 0.004][rng.random_range(0..3)];
+                        random_problem(&mut rng, 40..=160, dt_s).unwrap()
+                    })
+                    .collect();
+                let refs: Vec<&Problem> = problems.iter().collect();
+                let tick_s = problems
+                    .iter()
+                    .map(Problem::dt_s)
+                    .fold(f64::INFINITY, f64::min);
+                let switch_s = if case % 2 == 0 { 0.0 } else { 0.05 };
+                let s = schedule_mixed(&refs, tick_s, switch_s).unwrap();
+                assert!(s.lower_bound_s <= s.t_total_s + 1e-9, "seed {seed}");
+                let timelines: Vec<Timeline> = refs
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| timeline(p, &s.grad_exec[i], s.start_s(i)).unwrap())
+                    .collect();
+                let coordinator = Coordinator::with_margins(
+                    timelines,
+                    &[],
+                    &MarginParams::new(tick_s).with_switch_s(switch_s),
+                )
+                .unwrap();
+                let ticks = (s.t_total_s / tick_s) as u64;
+                for adversary in adversary_set(n, [1.0, 1.0], ticks, &mut rng) {
+                    if matches!(
+                        adversary,
+                        Adversary::Beam { .. }
+                            | Adversary::Random { .. }
+                            | Adversary::RandomHeld { .. }
+                    ) {
+                        continue;
+                    }
+                    let run =
+                        run_adversary(coordinator.clone(), adversary, &mut rng, 8 * ticks + 10_000)
+                            .unwrap();
+                    assert!(run.finished, "seed {seed}, N {n}: {adversary:?}");
+                    assert_eq!(run.overlap_ticks, 0, "seed {seed}, N {n}: {adversary:?}");
+                    assert_eq!(run.backward_steps, 0, "seed {seed}, N {n}: {adversary:?}");
+                }
+                cells += 1;
+            }
+        }
+        assert_eq!(cells, 42);
+    }
 }

@@ -69,6 +69,7 @@
 mod checked;
 mod fleet;
 mod graph;
+mod mix;
 mod plan;
 mod ratio;
 mod run;
@@ -77,6 +78,7 @@ mod search;
 pub use checked::CheckedCyclicPlan;
 pub use fleet::{SectoredPlan, pooled_period_lower_bound_s, sectored_plan};
 pub use graph::{Event, EventGraph, Gap, Stretch, TaskShape, event_graph};
+pub use mix::{MAX_MIX_RATIO, MixBound, MixTask, best_mix, mix_period_lower_bound_s};
 pub use plan::{
     CyclicPlan, GapPlan, RobotCycle, cyclic_plan_for_order, handover_bound_s, period_lower_bound_s,
     period_lower_bound_with_switch_s,

@@ -7,8 +7,10 @@
 //! running the next round under it ([`RoundStats`]; none for the last iteration).
 
 mod cell;
+mod cell_file;
 mod config;
 mod inputs;
+mod mixed;
 mod record;
 mod run;
 mod trial;
@@ -18,8 +20,13 @@ pub use cell::{
     Steady, run_cell_study, run_cell_study_finished, run_cell_trial, run_cell_trial_on,
     run_cell_trials, run_cell_trials_finished, task_gap,
 };
+pub use cell_file::{CellFile, CellFileTask, CellTruth};
 pub use config::{Cell, StudyConfig, StudyOperator};
 pub use inputs::{StudyInputs, read_labels, reference_labels};
+pub use mixed::{
+    MixedIteration, MixedRoundStats, MixedStudyResult, MixedTask, MixedTaskState, MixedTrialResult,
+    run_mixed_study, run_mixed_trial,
+};
 pub use record::{
     IterationRecord, IterationSummary, RoundStats, ScheduleSource, StudyResult, TrialResult,
     mean_std, throughput_per_h,

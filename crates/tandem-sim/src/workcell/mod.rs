@@ -72,6 +72,7 @@
 
 mod cell;
 mod live;
+mod mixed;
 mod operator;
 mod record;
 mod run;
@@ -80,6 +81,7 @@ mod tests;
 
 pub use cell::{CellSim, CellStats, FinishedTask};
 pub use live::RoundSim;
+pub use mixed::run_cell_round;
 pub use operator::{OperatorParams, correction_channel, correction_input, needs_correction};
 pub use record::{PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
 pub use run::{run_round, run_round_with};

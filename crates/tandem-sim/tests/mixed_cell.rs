@@ -1,0 +1,119 @@
+//! A cell of different tasks in the simulated workcell and study (issue 45), on the committed
+//! cell file `fixtures/mixed/cell_1_1.toml` (1 sanding robot + 1 deburring robot): rounds run
+//! and are recorded into each task, never two robots low-confidence in one tick, the learned
+//! confidence never trusts where the truth can need the operator (the latch may give a
+//! sample back after a correction on it, `Confidence::update_round`, so no monotony is asked), deterministic, and a
+//! one-task cell is the single-task round bit for bit.
+
+use std::path::{Path, PathBuf};
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use tandem_planner::CellPlanner;
+use tandem_sim::study::{CellFile, MixedTask, StudyConfig, run_mixed_study, run_mixed_trial};
+use tandem_sim::workcell::{OperatorParams, run_cell_round, run_round_with};
+
+fn mixed_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/mixed")
+}
+
+fn cell_file(name: &str) -> CellFile {
+    let text = std::fs::read_to_string(mixed_dir().join(name)).unwrap();
+    toml::from_str(&text).unwrap()
+}
+
+fn config(executions: usize, robots: usize) -> StudyConfig {
+    StudyConfig {
+        trials: 2,
+        executions,
+        robots,
+        samples: 100,
+        ..StudyConfig::default()
+    }
+}
+
+fn tasks(file: &CellFile, config: &StudyConfig) -> Vec<MixedTask> {
+    file.tasks(&mixed_dir(), config).unwrap()
+}
+
+#[test]
+fn mixed_rounds_learn_each_task_without_overlap_and_deterministically() {
+    let file = cell_file("cell_1_1.toml");
+    assert_eq!(file.n_robots(), 2);
+    let config = config(8, 2);
+    let tasks = tasks(&file, &config);
+    let result = run_mixed_study(&config, &tasks, &|_| {}).unwrap();
+    assert_eq!(result.tasks, ["sanding", "deburring"]);
+    assert_eq!(result.robot_task, [0, 1]);
+    assert_eq!(result.overlaps_and_faults(), (0, 0));
+    for trial in &result.trials {
+        assert_eq!(trial.iterations.len(), 5, "iterations 0..=4");
+        for (k, it) in trial.iterations.iter().enumerate() {
+            assert_eq!(it.iteration, k);
+            assert_eq!(it.round.is_some(), k < 4);
+            assert!(it.lower_bound_s <= it.t_total_s + 1e-9);
+            for t in &it.tasks {
+                // Never trusted where a workpiece can need the operator.
+                assert_eq!(t.falsely_trusted_samples, 0);
+                assert!(t.high_conf_pct <= t.truth_never_needed_pct + 1e-9);
+                // The operator-seconds of a task are part of its fastest duration.
+                assert!(t.lc_s > 0.0 && t.lc_s <= t.fastest_s, "{t:?}");
+            }
+            if let Some(r) = &it.round {
+                // The round ran the whole cell: at least the slower robot's planned time.
+                assert!(r.duration_s >= 0.99 * r.planned_t_total_s, "{r:?}");
+                assert!(r.supervised_ticks > 0);
+            }
+        }
+        // The operator corrected where the sanding and the burr need it.
+        assert!(trial.tally.needed > 0 && trial.tally.missed < trial.tally.needed);
+    }
+    // Deterministic: the same trial again gives the same record.
+    let again = run_mixed_trial(&config, &tasks, 1, &|_| {}).unwrap();
+    assert_eq!(again, result.trials[1]);
+}
+
+#[test]
+fn the_study_refuses_a_robot_count_other_than_the_cells() {
+    let file = cell_file("cell_1_1.toml");
+    let config = config(6, 3);
+    let tasks = tasks(&file, &config);
+    let e = run_mixed_trial(&config, &tasks, 0, &|_| {}).unwrap_err();
+    assert!(e.to_string().contains("robots"), "{e}");
+}
+
+#[test]
+fn a_bad_correction_channel_is_named() {
+    let mut file = cell_file("cell_1_1.toml");
+    if let tandem_sim::study::CellTruth::Need { channel, .. } = &mut file.task[1].truth {
+        *channel = "torque".into();
+    }
+    let e = file.tasks(&mixed_dir(), &config(6, 2)).unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.contains("torque") && msg.contains("deburring"), "{msg}");
+}
+
+#[test]
+fn a_one_task_cell_runs_the_single_task_round() {
+    let file = cell_file("sanding_only.toml");
+    let config = config(2, 2);
+    let mut tasks = tasks(&file, &config);
+    let task = tasks.remove(0);
+    let planner =
+        tandem_planner::Planner::from_model_with_robots(task.model, task.params, 2).unwrap();
+    let cell = CellPlanner::from_planner("sanding", planner.clone()).unwrap();
+    let op = OperatorParams::default();
+    let needs = |robot: usize, k: usize| (k / 500 + robot) % 3 == 0;
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let a = run_cell_round(&cell, needs, std::slice::from_ref(&op), &mut rng).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let b = run_round_with(&planner, needs, &op, &mut rng).unwrap();
+    assert_eq!(a, b);
+    assert_eq!(
+        a.cell_records(&cell).unwrap(),
+        b.records(planner.model()).unwrap()
+    );
+    // One operator per task.
+    let e = run_cell_round(&cell, needs, &[op.clone(), op], &mut rng).unwrap_err();
+    assert!(e.to_string().contains("operators"), "{e}");
+}
