@@ -642,7 +642,35 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
         seed,
         steady_tasks: args.steady_tasks,
     };
-    report(&sizes, &rows, &cells, &deltas, &out, wall)
+    report(&sizes, &rows, &cells, &deltas, &out, wall)?;
+    let fleet_over = if args.operators.is_empty() {
+        0
+    } else {
+        let robots = if args.fleet_robots.is_empty() {
+            vec![args.max_robots]
+        } else {
+            args.fleet_robots.clone()
+        };
+        let mut base = base.clone();
+        base.trials = args.trials;
+        base.samples = args.samples;
+        base.executions = args.executions;
+        base.seed = seed;
+        base.operator.switch_s = deltas[0];
+        crate::fleet::run(
+            &base,
+            &inputs,
+            &cells,
+            &robots,
+            &args.operators,
+            args.steady_tasks,
+            &out,
+        )?
+    };
+    if fleet_over > 0 {
+        bail!("{fleet_over} ticks of the fleet had more than M robots low-confidence, or faults");
+    }
+    Ok(())
 }
 
 /// Prints the tables of `rows` and `cells` (run with `sizes`, at the switch times `deltas`)
@@ -719,32 +747,6 @@ fn report(
             out.display(),
             wall.elapsed().as_secs_f64()
         );
-    }
-    let fleet_over = if args.operators.is_empty() {
-        0
-    } else {
-        let robots = if args.fleet_robots.is_empty() {
-            vec![args.max_robots]
-        } else {
-            args.fleet_robots.clone()
-        };
-        let mut base = base.clone();
-        base.trials = args.trials;
-        base.samples = args.samples;
-        base.seed = seed;
-        base.operator.switch_s = deltas[0];
-        crate::fleet::run(
-            &base,
-            &inputs,
-            &cells,
-            &robots,
-            &args.operators,
-            args.executions,
-            &out,
-        )?
-    };
-    if fleet_over > 0 {
-        bail!("{fleet_over} ticks of the fleet had more than M robots low-confidence, or faults");
     }
     let overlaps = rows.iter().map(|r| r.overlap_ticks as u64).sum::<u64>()
         + cells

@@ -97,7 +97,8 @@ pub(crate) fn best_sectors(one: &[f64], n: usize, m: usize) -> (f64, Vec<usize>)
 }
 
 /// Runs the pooled cells of every `(N, M)` with `N` in `robots`, `M` in `operators`, `M < N`,
-/// after the one-operator rows `one` (continuous, `N = 1..=max`, same configuration), prints
+/// after the one-operator rows `one` (continuous, `N = 1..=max`, same configuration; the
+/// steady state measured as `capacity --steady-tasks` says), prints
 /// the table and writes `fleet.json`, `fleet.svg` and `fleet.png` in `out`. Returns the pooled
 /// cells' ticks with more than `M` robots low-confidence plus their faults (must be 0).
 pub(crate) fn run(
@@ -106,7 +107,7 @@ pub(crate) fn run(
     one: &[CellRow],
     robots: &[usize],
     operators: &[usize],
-    executions: usize,
+    steady_tasks: Option<usize>,
     out: &Path,
 ) -> anyhow::Result<u64> {
     let one_tp: Vec<f64> = one.iter().map(|r| r.steady_throughput_per_h).collect();
@@ -128,7 +129,7 @@ pub(crate) fn run(
         }
         for &m in operators.iter().filter(|&&m| m < n) {
             let mut config = StudyConfig {
-                executions: executions / n * n,
+                executions: base.executions / n * n,
                 robots: n,
                 cell: Cell::Continuous,
                 ..base.clone()
@@ -142,7 +143,7 @@ pub(crate) fn run(
             let (result, _) = run_cell_study(&config, inputs, &|p| bar.step(p))
                 .with_context(|| format!("the pooled cell of N = {n}, M = {m}"))?;
             bar.clear();
-            let pooled = cell_row(&result, t.elapsed().as_secs_f64())?;
+            let pooled = cell_row(&result, t.elapsed().as_secs_f64(), steady_tasks)?;
             let (sectored_per_h, sectors) = best_sectors(&one_tp, n, m);
             let ceiling_per_h = (robot_per_h * n as f64).min(operator_per_h * m as f64);
             let row = FleetRow {
@@ -393,6 +394,8 @@ mod tests {
             faults: 0,
             high_conf_pct: 60.0,
             wall_s: 1.0,
+            steady_tasks: 24,
+            plan_gap_per_task: tandem::sim::workcell::PlanGap::default(),
         };
         let row = FleetRow {
             robots: 4,
