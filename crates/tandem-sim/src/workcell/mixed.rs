@@ -19,8 +19,10 @@ use tandem_planner::{CellPlanner, ExecutionRecord};
 use tandem_realtime::{Operator, Timeline};
 
 use super::operator::OperatorParams;
-use super::record::{PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
-use super::run::{Operate, check_tick, crossed_lc_samples, run_round_with};
+use super::record::{RobotRun, RoundRun, TickPhase};
+use super::run::{
+    Operate, RoundCounts, check_tick, crossed_lc_samples, finished_round, run_round_with,
+};
 use crate::{Error, Result};
 
 /// Runs one round of `cell` (every robot one execution of its own task) with a simulated
@@ -193,38 +195,19 @@ pub fn run_cell_round(
         }
         ticks += 1;
     }
-    for run in &mut runs {
-        run.start_tick = run.start_tick.min(ticks);
-    }
-    let t0 = coord
-        .robots()
-        .iter()
-        .map(Timeline::start_s)
-        .fold(f64::INFINITY, f64::min);
-    let planned_ends_s: Vec<f64> = (0..n).map(|i| coord.planned_end_s(i) - t0).collect();
-    let plans: Vec<RobotPlan> = (0..n)
-        .map(|i| {
-            let tl = &coord.robots()[i];
-            RobotPlan {
-                start_s: tl.start_s(),
-                end_s: coord.planned_end_s(i),
-                sample_clock_s: tl.sample_clock_s().to_vec(),
-            }
-        })
-        .collect();
-    let mut round = RoundRun {
-        robots: runs,
+    let counts = RoundCounts {
         ticks,
-        tick_s,
         overlap_ticks,
         idle_ticks,
         faults,
-        planned_t_total_s: planned_ends_s.iter().copied().fold(0.0, f64::max),
-        planned_ends_s,
-        plan_gap: PlanGap::default(),
     };
-    round.plan_gap = plan_gap(&round, &plans, &corrected_tick);
-    Ok(round)
+    Ok(finished_round(
+        &coord,
+        runs,
+        counts,
+        tick_s,
+        &corrected_tick,
+    ))
 }
 
 impl RoundRun {

@@ -242,9 +242,50 @@ pub(super) fn run_coordinator(
         }
         ticks += 1;
     }
-    let (coord, mut runs) = sim.into_parts();
+    let (coord, runs) = sim.into_parts();
+    let counts = RoundCounts {
+        ticks,
+        overlap_ticks,
+        idle_ticks,
+        faults,
+    };
+    Ok(finished_round(
+        &coord,
+        runs,
+        counts,
+        tick_s,
+        &corrected_tick,
+    ))
+}
+
+/// What a round's loop counted, tick by tick ([`RoundRun`]'s fields of the same names).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct RoundCounts {
+    /// Control ticks run.
+    pub(super) ticks: usize,
+    /// Ticks with two or more robots low-confidence.
+    pub(super) overlap_ticks: usize,
+    /// Ticks with no robot low-confidence.
+    pub(super) idle_ticks: usize,
+    /// Faults the monitor latched.
+    pub(super) faults: usize,
+}
+
+/// The record of a round that ran `counts.ticks` ticks of `coord`'s plan at `tick_s` (s):
+/// the robots' runs (a robot that never started gets the last tick as its start), the
+/// planned ends on the round's clock, and the gap to the plan by cause ([`plan_gap`], from the
+/// ticks in which a correction was given, `corrected_tick`). Shared by the one-task round
+/// ([`run_round_with`]) and the cell of tasks ([`super::run_cell_round`]).
+pub(super) fn finished_round(
+    coord: &Coordinator,
+    mut runs: Vec<RobotRun>,
+    counts: RoundCounts,
+    tick_s: f64,
+    corrected_tick: &[bool],
+) -> RoundRun {
+    let n_robots = runs.len();
     for run in &mut runs {
-        run.start_tick = run.start_tick.min(ticks);
+        run.start_tick = run.start_tick.min(counts.ticks);
     }
     let t0 = coord
         .robots()
@@ -264,17 +305,17 @@ pub(super) fn run_coordinator(
         .collect();
     let mut round = RoundRun {
         robots: runs,
-        ticks,
+        ticks: counts.ticks,
         tick_s,
-        overlap_ticks,
-        idle_ticks,
-        faults,
+        overlap_ticks: counts.overlap_ticks,
+        idle_ticks: counts.idle_ticks,
+        faults: counts.faults,
         planned_t_total_s: planned_ends_s.iter().copied().fold(0.0, f64::max),
         planned_ends_s,
         plan_gap: PlanGap::default(),
     };
-    round.plan_gap = plan_gap(&round, &plans, &corrected_tick);
-    Ok(round)
+    round.plan_gap = plan_gap(&round, &plans, corrected_tick);
+    round
 }
 
 /// The low-confidence reference samples a robot crossed whole inside one tick, from reference
