@@ -41,26 +41,6 @@ pub const MIN_VOTES: f64 = MIN_OBSERVATIONS;
 /// planner uses, keeps that latch against the prior and the error rates but not against
 /// corrections recorded after it, so that the same rounds give the same map in any order.
 ///
-/// **The prior's trust yields to a need on both sides** (with one vote per execution,
-/// [`ConfidenceParams::one_vote_per_execution`]; the paper's counting keeps the paper's
-/// latch): after every update, each maximal run of high-confidence samples that rest on
-/// their prior alone (no correction, fewer than [`MIN_VOTES`] votes) is low-confidence
-/// while the samples on both sides of it are low-confidence and needed by their totals: at
-/// least one correction and `P(π < μ_c | data) < 1 − γ_c`, Eq. 12 mirrored (at `μ'_c` with
-/// non-zero error rates). The run is then supervised and earns its trust on
-/// [`MIN_VOTES`] votes like any other sample; a run that has no vote yet returns to its
-/// prior's decision once a side is no longer needed.
-/// Why: the prior sees only where the demonstrations disagree. Where the operator is
-/// needed although they agree (a search that the alignment pairs turn by turn), the prior
-/// trusts a stretch inside a need that the operator corrects on both sides in every round,
-/// and a trusted sample is never supervised, so nothing else reveals the need: on the task
-/// zoo's peg insertion (selection seeds 4 and 6) 298 and 389 samples of the search spiral,
-/// needed on 100 % and 80 % of the workpieces, were trusted from the prior for 30 rounds
-/// between samples corrected in every round. A stretch with a need on one side only is left
-/// to its prior: the need may end at the border as well as go on, and every such stretch
-/// would cost ten votes (docs/decisions.md, "The prior's trust yields to a need on both
-/// sides").
-///
 /// ```
 /// use tandem_confidence::{Confidence, ConfidenceParams, Observations};
 /// let sigma2_d = [0.0, 10.0, 10.0, 0.0];
@@ -382,74 +362,7 @@ impl Confidence {
         for &ref_idx in &lowered {
             self.high[ref_idx] = false;
         }
-        let (mut n_newly, mut n_lowered) = (newly.len(), lowered.len());
-        if self.params.one_vote_per_execution {
-            let was_high: Vec<bool> = self.high.clone();
-            let yielded = self.prior_trust_yields(sigma2_d, rates, &counts);
-            for ref_idx in yielded {
-                self.high[ref_idx] = false;
-                // A sample latched in this very call is not counted as newly high; one
-                // latched before counts as reopened.
-                if newly.binary_search(&ref_idx).is_ok() {
-                    n_newly -= 1;
-                } else if was_high[ref_idx] {
-                    n_lowered += 1;
-                }
-            }
-        }
-        Ok((n_newly, n_lowered))
-    }
-
-    /// The samples whose trust rests on their prior alone and yields to a need on both
-    /// sides (the type docs): every maximal run of high-confidence samples that have no
-    /// correction and fewer than [`MIN_VOTES`] votes, between two low-confidence samples
-    /// whose totals show the operator needed there (`P(π < μ_c | data) < 1 − γ_c` with at
-    /// least one correction: Eq. 12 mirrored). Sorted.
-    fn prior_trust_yields(
-        &self,
-        sigma2_d: &[f64],
-        rates: &ErrorRates,
-        counts: &impl Fn(usize) -> (f64, f64),
-    ) -> Vec<usize> {
-        let p = &self.params;
-        let mu = if rates.is_zero() {
-            p.mu_c
-        } else {
-            rates.shifted_mu_c(p.mu_c)
-        };
-        let needed = |n: usize| -> bool {
-            if self.high[n] {
-                return false;
-            }
-            let (c, s) = counts(n);
-            if c <= 0.0 {
-                return false;
-            }
-            let (alpha0, beta0) = prior_ab(sigma2_d[n], p);
-            statrs::function::beta::checked_beta_reg(alpha0 + c, beta0 + (s - c), mu)
-                .is_ok_and(|below| below < 1.0 - p.gamma_c)
-        };
-        let on_prior = |n: usize| {
-            let (c, s) = counts(n);
-            self.high[n] && c == 0.0 && s < MIN_VOTES
-        };
-        let n_ref = self.high.len();
-        let mut out = Vec::new();
-        let mut n = 0;
-        while n < n_ref {
-            if !on_prior(n) {
-                n += 1;
-                continue;
-            }
-            let start = n;
-            while n < n_ref && on_prior(n) {
-                n += 1;
-            }
-            if start > 0 && n < n_ref && needed(start - 1) && needed(n) {
-                out.extend(start..n);
-            }
-        }
-        out
+        Ok((newly.len(), lowered.len()))
     }
 
     /// The parameters this state was built with.
@@ -687,69 +600,5 @@ mod tests {
         obs.record(&[0.0, 0.0], &[false, false]).unwrap();
         conf.update(&[s2], &obs).unwrap();
         assert_eq!(conf.conf(), &[true]);
-    }
-
-    #[test]
-    fn the_priors_trust_yields_to_a_need_on_both_sides_and_returns_when_it_ends() {
-        // The demonstrations disagree at samples 1, 4 and 8 only (low-confidence from the
-        // prior); sample 6 earns its trust on twelve clean votes. Fixed rates, so that only
-        // the votes count.
-        let p = ConfidenceParams {
-            estimate_error_rates: false,
-            ..ConfidenceParams::default()
-        };
-        let sigma2_d = [0.0, 10.0, 0.0, 0.0, 10.0, 0.0, 0.0, 0.0, 10.0];
-        let from_prior = [true, false, true, true, false, true, true, true, false];
-        let mut conf = Confidence::from_prior(&sigma2_d, p.clone()).unwrap();
-        assert_eq!(conf.conf(), &from_prior);
-        let mut obs = Observations::new(9).unwrap();
-        for _ in 0..12 {
-            obs.record_votes(&[6.0], &[false]).unwrap();
-        }
-        // No correction yet: the prior's trust stands.
-        let before = obs.clone();
-        conf.update_round(&sigma2_d, &before, &obs).unwrap();
-        assert_eq!(conf.conf(), &from_prior);
-        // Two corrected executions at samples 1, 4 and 8: `Beta(α₀ + 2, β₀)` of a high σ²_D
-        // is far above μ_c = 5 %, so they are needed. Samples 2–3 lie between two needs and
-        // yield; sample 0 has a need on one side only (the task's start on the other),
-        // sample 5 a need and sample 6 (trusted on its votes), sample 7 sample 6 and a need.
-        let before = obs.clone();
-        for _ in 0..2 {
-            obs.record_votes(&[1.0, 4.0, 8.0], &[true; 3]).unwrap();
-        }
-        let round = conf.update_round(&sigma2_d, &before, &obs).unwrap();
-        let yielded = [true, false, false, false, false, true, true, true, false];
-        assert_eq!(conf.conf(), &yielded);
-        assert_eq!(round.reopened, 2);
-        assert_eq!(round.newly_high, 0);
-        // `update` on the same totals decides the same.
-        let mut again = Confidence::from_prior(&sigma2_d, p.clone()).unwrap();
-        again.update(&sigma2_d, &obs).unwrap();
-        assert_eq!(again.conf(), &yielded);
-        // Without the supervision they now get, the need at 4 fading (many clean
-        // executions) returns samples 2–3, which never got a vote, to their prior.
-        let mut faded = again.clone();
-        let mut obs_faded = obs.clone();
-        for _ in 0..200 {
-            obs_faded.record_votes(&[4.0], &[false]).unwrap();
-        }
-        faded.update(&sigma2_d, &obs_faded).unwrap();
-        assert!(faded.conf()[2] && faded.conf()[3]);
-        // Supervised together (they are low-confidence), samples 2–3 earn their trust on
-        // ten clean votes, no earlier, while both sides are still needed.
-        for vote in 1..=10 {
-            let before = obs.clone();
-            obs.record_votes(&[2.0, 3.0], &[false; 2]).unwrap();
-            conf.update_round(&sigma2_d, &before, &obs).unwrap();
-            assert_eq!(&conf.conf()[2..4], &[vote >= 10; 2], "after {vote} votes");
-        }
-        // The paper's counting keeps the paper's latch: nothing yields there.
-        let paper = ConfidenceParams::paper();
-        let mut conf = Confidence::from_prior(&sigma2_d, paper).unwrap();
-        let mut obs = Observations::new(9).unwrap();
-        obs.record(&[1.0, 1.0, 4.0, 4.0], &[true; 4]).unwrap();
-        conf.update(&sigma2_d, &obs).unwrap();
-        assert_eq!(conf.conf(), &from_prior);
     }
 }

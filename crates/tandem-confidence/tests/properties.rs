@@ -8,44 +8,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tandem_confidence::{
     Confidence, ConfidenceParams, MIN_VOTES, Observations, estimate_error_rates, evaluate,
-    posterior, prob_need_below_mu_c,
+    posterior,
 };
-
-/// Rests on its prior alone: no correction and fewer than `MIN_VOTES` votes.
-fn on_prior(obs: &Observations, n: usize) -> bool {
-    obs.corrections()[n] == 0.0 && obs.supervised()[n] < MIN_VOTES
-}
-
-/// The first maximal run of high-confidence samples that rest on their prior alone between
-/// two low-confidence samples their totals show needed (a correction, `P(π < μ_c | data) <
-/// 1 − γ_c`): what the prior's trust yielding to a need on both sides leaves none of
-/// (`Confidence` type docs).
-fn trusted_between_needs(
-    conf: &[bool],
-    sigma2_d: &[f64],
-    obs: &Observations,
-    params: &ConfidenceParams,
-) -> Option<usize> {
-    let below = prob_need_below_mu_c(sigma2_d, obs, params).unwrap();
-    let needed =
-        |m: usize| !conf[m] && obs.corrections()[m] > 0.0 && below[m] < 1.0 - params.gamma_c;
-    let trusted = |n: usize| conf[n] && on_prior(obs, n);
-    let mut n = 0;
-    while n < conf.len() {
-        if !trusted(n) {
-            n += 1;
-            continue;
-        }
-        let start = n;
-        while n < conf.len() && trusted(n) {
-            n += 1;
-        }
-        if start > 0 && n < conf.len() && needed(start - 1) && needed(n) {
-            return Some(start);
-        }
-    }
-    None
-}
 
 /// One execution over `n_ref` samples: supervised times (fractional) and corrections.
 fn execution(rng: &mut ChaCha8Rng, n_ref: usize, p_corr: f64) -> (Vec<f64>, Vec<bool>) {
@@ -167,13 +131,8 @@ proptest! {
                 let fresh = post[n].is_high_confidence(&shifted).unwrap()
                     && (s == 0.0 || s >= MIN_VOTES);
                 prop_assert_eq!(unlatched[n], fresh, "sample {}", n);
-                // The latch, except where a sample resting on its prior yielded to a
-                // need on both sides.
-                if conf.conf()[n] != (before[n] || fresh) {
-                    prop_assert!(!conf.conf()[n] && on_prior(&obs, n), "sample {}", n);
-                }
+                prop_assert_eq!(conf.conf()[n], before[n] || fresh, "sample {}", n);
             }
-            prop_assert_eq!(trusted_between_needs(conf.conf(), &sigma2_d, &obs, &params), None);
         }
     }
 
@@ -181,8 +140,7 @@ proptest! {
     /// error rates the latch that yields to corrections ends at the totals' decision, which
     /// no order changes (Eq. 12 rises with clean mass at fixed corrections, so a sample
     /// latched before its last correction is decided again on the totals, and one latched
-    /// after it passes on the totals too). Samples that rest on their prior alone are the
-    /// exception: their trust yields to a need on both sides, which some orders show earlier.
+    /// after it passes on the totals too).
     #[test]
     fn with_a_fixed_prior_and_rates_any_order_ends_at_the_totals_decision(
         n_ref in 1_usize..8,
@@ -207,7 +165,6 @@ proptest! {
         };
         let mut order: Vec<usize> = (0..n_exec).collect();
         let mut finals = Vec::new();
-        let mut last_obs = Observations::new(n_ref).unwrap();
         let from_prior = Confidence::from_prior(&sigma2_d, params.clone()).unwrap().conf().to_vec();
         for _ in 0..20 {
             let mut conf = Confidence::from_prior(&sigma2_d, params.clone()).unwrap();
@@ -221,29 +178,15 @@ proptest! {
             // totals' whichever order summed them, except that a sample trusted from its
             // prior and never corrected keeps the latch although it has fewer than
             // MIN_VOTES votes (they are asked of samples that earn their trust).
-            // A sample that rests on its prior alone (no correction, fewer than MIN_VOTES
-            // votes) is not trusted between two needed samples, and one that yielded at
-            // some round keeps its low confidence once it has a vote: there the order
-            // matters, and such a sample is trusted only where the latch would trust it.
             let totals = evaluate(&sigma2_d, &obs, &params).unwrap();
             let expected: Vec<bool> = (0..n_ref)
                 .map(|n| totals[n] || (from_prior[n] && obs.corrections()[n] == 0.0))
                 .collect();
-            for (n, &want) in expected.iter().enumerate() {
-                if on_prior(&obs, n) {
-                    prop_assert!(!conf.conf()[n] || want, "sample {} order {:?}", n, order);
-                } else {
-                    prop_assert_eq!(conf.conf()[n], want, "sample {} order {:?}", n, order);
-                }
-            }
-            prop_assert_eq!(trusted_between_needs(conf.conf(), &sigma2_d, &obs, &params), None);
+            prop_assert_eq!(conf.conf(), expected.as_slice(), "order {:?}", order);
             finals.push(conf.conf().to_vec());
-            last_obs = obs.clone();
             order.shuffle(&mut rng);
         }
-        // Every order agrees on every sample that does not rest on its prior alone.
-        let settled: Vec<usize> = (0..n_ref).filter(|&n| !on_prior(&last_obs, n)).collect();
-        prop_assert!(finals.windows(2).all(|w| settled.iter().all(|&n| w[0][n] == w[1][n])));
+        prop_assert!(finals.windows(2).all(|w| w[0] == w[1]));
     }
 
     #[test]
