@@ -105,10 +105,10 @@ pub fn run_cell_round(
         })
         .fold(1.0, f64::max);
     let budget = ((max_end_s / tick_s) * max_ratio * 2.0) as usize + 1000;
-    let (mut ticks, mut overlap_ticks, mut idle_ticks, mut faults) = (0, 0, 0, 0);
+    let mut counts = RoundCounts::default();
     let mut corrected_tick: Vec<bool> = Vec::new();
     while !coord.is_finished() {
-        if ticks >= budget {
+        if counts.ticks >= budget {
             return Err(Error::DidNotFinish { ticks: budget });
         }
         // Step 0 (as `RoundSim::record_phases`): each robot's clock and phase.
@@ -138,7 +138,7 @@ pub fn run_cell_round(
             let t = robot_task[i];
             let run = &mut runs[i];
             if run.start_tick == usize::MAX {
-                run.start_tick = ticks;
+                run.start_tick = counts.ticks;
             }
             let model = models[i];
             let k = (ref_now[i].floor() as usize).min(model.n_ref() - 1);
@@ -147,7 +147,7 @@ pub fn run_cell_round(
             if supervised.is_none() {
                 unsupervised_at[i] = Some(ref_now[i]);
             }
-            let switching = low_conf[i] && ops[0].attend(i, ticks);
+            let switching = low_conf[i] && ops[0].attend(i, counts.ticks);
             if let Some(input) = ops[t].robot_tick(
                 model,
                 run,
@@ -170,7 +170,7 @@ pub fn run_cell_round(
                 let mut crossed = crossed_lc_samples(conf, t0, tick.ref_time[i]);
                 if let Some(first) = crossed.next() {
                     let needed = needs(i, first) | crossed.fold(false, |a, j| a | needs(i, j));
-                    let switching = ops[0].attend(i, ticks);
+                    let switching = ops[0].attend(i, counts.ticks);
                     ops[robot_task[i]].supervise_crossing(
                         &mut runs[i],
                         &mut in_episode[i],
@@ -183,24 +183,11 @@ pub fn run_cell_round(
         }
         ref_now.copy_from_slice(&tick.ref_time);
         corrected_tick.push(corrected);
-        match tick.low_conf.count() {
-            0 => idle_ticks += 1,
-            1 => {}
-            _ => overlap_ticks += 1,
+        if counts.count(&tick) {
+            // The operator has dealt with the robot that kept running: release the held one.
+            coord.clear_fault();
         }
-        match tick.fault {
-            Some(f) if f.tick == ticks as u64 => faults += 1,
-            Some(_) if tick.low_conf.count() == 0 => coord.clear_fault(),
-            _ => {}
-        }
-        ticks += 1;
     }
-    let counts = RoundCounts {
-        ticks,
-        overlap_ticks,
-        idle_ticks,
-        faults,
-    };
     Ok(finished_round(
         &coord,
         runs,

@@ -199,7 +199,7 @@ pub(super) fn run_coordinator(
 ) -> Result<RoundRun> {
     let tick_s = coord.tick_s();
     let n_robots = coord.n_robots();
-    let (mut ticks, mut overlap_ticks, mut idle_ticks, mut faults) = (0, 0, 0, 0);
+    let mut counts = RoundCounts::default();
     let max_end_s = coord
         .robots()
         .iter()
@@ -223,32 +223,18 @@ pub(super) fn run_coordinator(
     // Whether the operator's input in each tick was a correction (for the round's PlanGap).
     let mut corrected_tick: Vec<bool> = Vec::new();
     while !sim.coordinator().is_finished() {
-        if ticks >= budget {
+        if counts.ticks >= budget {
             return Err(Error::DidNotFinish { ticks: budget });
         }
         sim.record_phases();
         let (tick, corrected) = sim.step(model, &mut needs, rng)?;
         corrected_tick.push(corrected);
-        match tick.low_conf.count() {
-            0 => idle_ticks += 1,
-            1 => {}
-            _ => overlap_ticks += 1,
-        }
-        match tick.fault {
-            Some(f) if f.tick == ticks as u64 => faults += 1,
+        if counts.count(&tick) {
             // The operator has dealt with the robot that kept running: release the held one.
-            Some(_) if tick.low_conf.count() == 0 => sim.clear_fault(),
-            _ => {}
+            sim.clear_fault();
         }
-        ticks += 1;
     }
     let (coord, runs) = sim.into_parts();
-    let counts = RoundCounts {
-        ticks,
-        overlap_ticks,
-        idle_ticks,
-        faults,
-    };
     Ok(finished_round(
         &coord,
         runs,
@@ -259,7 +245,7 @@ pub(super) fn run_coordinator(
 }
 
 /// What a round's loop counted, tick by tick ([`RoundRun`]'s fields of the same names).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(super) struct RoundCounts {
     /// Control ticks run.
     pub(super) ticks: usize,
@@ -269,6 +255,30 @@ pub(super) struct RoundCounts {
     pub(super) idle_ticks: usize,
     /// Faults the monitor latched.
     pub(super) faults: usize,
+}
+
+impl RoundCounts {
+    /// Counts one finished tick `tick` (the `counts.ticks`-th): idle (no robot
+    /// low-confidence), overlapping (two or more), a fault the monitor latched in it. Returns
+    /// whether a fault latched earlier may be released: no robot is low-confidence any more.
+    pub(super) fn count(&mut self, tick: &Tick) -> bool {
+        let low_conf = tick.low_conf.count();
+        match low_conf {
+            0 => self.idle_ticks += 1,
+            1 => {}
+            _ => self.overlap_ticks += 1,
+        }
+        let release = match tick.fault {
+            Some(f) if f.tick == self.ticks as u64 => {
+                self.faults += 1;
+                false
+            }
+            Some(_) => low_conf == 0,
+            None => false,
+        };
+        self.ticks += 1;
+        release
+    }
 }
 
 /// The record of a round that ran `counts.ticks` ticks of `coord`'s plan at `tick_s` (s):
