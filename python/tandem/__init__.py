@@ -10,6 +10,8 @@ NumPy arrays in and out (docs/python.md):
   :attr:`Planner.confidence`, :attr:`Planner.schedule`, :meth:`Planner.record_round`,
   :meth:`Planner.reschedule`, :meth:`Planner.save` / :meth:`Planner.load` (the command
   line's state file), :meth:`Planner.command` (Eq. 7).
+- :func:`fit_cell` → :class:`CellPlanner`: different tasks on different robots (one planner
+  per task, one rounds schedule; the command line's ``fit --task … --robots …`` state file).
 - :meth:`Planner.cyclic_plan` / :func:`cyclic_plan` → :class:`CyclicPlan`: the plan of a
   continuous cell (no rounds): its period, throughput, the operator's order and busy share.
 - :class:`Coordinator`: the real-time coordinator of a schedule (§II-B5), one control tick
@@ -38,6 +40,7 @@ import abc
 from ._tandem import (
     MAX_ROBOTS,
     N_ROBOTS,
+    CellPlanner,
     CellTick,
     Confidence,
     Console,
@@ -64,6 +67,7 @@ from ._tandem import (
     cyclic_plan,
     default_params,
     fit,
+    fit_cell,
     fit_model,
     read_bag,
 )

@@ -105,6 +105,58 @@ def default_params() -> Dict[str, Any]:
 def align(reference: ArrayLike, query: ArrayLike, params: Params = None) -> Warp:
     """GDTW (Eq. 2–3): the warp from reference samples to query samples."""
 
+def fit_cell(
+    tasks: Dict[str, Sequence[Demo]],
+    robots: Optional[Dict[str, int]] = None,
+    channels: Optional[Union[Sequence[str], Dict[str, Sequence[str]]]] = None,
+    params: Params = None,
+    dt_s: Optional[Union[float, Dict[str, float]]] = None,
+    resample: bool = False,
+) -> CellPlanner:
+    """A cell of different tasks on different robots (``tandem fit --task … --robots …``)."""
+
+class CellPlanner:
+    """A cell of task models: one planner per task, each robot's task, one rounds schedule."""
+
+    @staticmethod
+    def load(path: Path) -> CellPlanner:
+        """Loads a cell (format 12) or a one-task state file (a cell of task ``"task"``)."""
+    def save(self, path: Path, timeout_s: Optional[float] = None) -> None:
+        """Saves atomically under the file's lock; never discards recorded rounds."""
+    @property
+    def tasks(self) -> List[str]:
+        """The tasks' names, in the cell's order."""
+    @property
+    def robot_tasks(self) -> List[str]:
+        """Each robot's task (robot 1 first)."""
+    @property
+    def n_robots(self) -> int:
+        """The number of robots."""
+    @property
+    def rounds_recorded(self) -> int:
+        """Rounds recorded (one execution of each robot)."""
+    @property
+    def t_total_s(self) -> float:
+        """The current schedule's ``T_total`` (s)."""
+    @property
+    def schedule(self) -> Dict[str, Any]:
+        """``t_total_s``, ``starts_s``, ``ends_s``, ``lc_intervals`` and, for two or more
+        tasks, ``lower_bound_s``, ``gap_s``, ``tick_s``, ``margin_checks`` (global s)."""
+    def planner(self, name: str) -> Planner:
+        """A snapshot of task ``name``'s planner."""
+    def record_round(
+        self,
+        executions: Sequence[Demo],
+        ref_time_logs: Sequence[ArrayLike],
+        supervised: Sequence[ArrayLike],
+        corrected: Sequence[ArrayLike],
+        dt_s: Optional[float] = None,
+        resample: bool = False,
+    ) -> Dict[str, Any]:
+        """Records one execution of each robot into its task, then re-schedules the cell."""
+    def coordinator(self) -> Coordinator:
+        """The run-time coordinator of the cell's rounds schedule (a snapshot)."""
+
 class Planner:
     """The loop of Fig. 2: model, observations, latched confidence and schedule."""
 

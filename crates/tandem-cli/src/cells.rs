@@ -12,7 +12,7 @@ use tandem::planner::state::{CELL_FORMAT_VERSION, MAGIC};
 use tandem::planner::{CellPlanner, TaskSpec};
 use tandem::{ExecutionRecord, PlannerParams};
 
-use crate::cli::{FitArgs, InspectArgs, RecordArgs, RobotsArg};
+use crate::cli::{FitArgs, InspectArgs, RecordArgs, RobotsArg, ScheduleArgs};
 use crate::cmd::{out, period_notes, read_execution, secs};
 use crate::{bag, state_io};
 
@@ -208,16 +208,14 @@ fn summary(cell: &CellPlanner) {
     }
 }
 
-/// `tandem inspect` of a cell of two or more tasks.
+/// `tandem inspect` of a cell of two or more tasks: per task its robots, model, confidence
+/// and rounds, then the cell's schedule; `--json`: [`cell_doc`].
 pub(crate) fn inspect_cell(a: &InspectArgs) -> Result<()> {
-    if a.json {
-        bail!(
-            "{}: --json is not available for a cell of several tasks yet; leave it out for \
-             the text summary per task",
-            a.state.display()
-        );
-    }
     let cell = CellPlanner::load(&a.state).context("cannot load the state")?;
+    if a.json {
+        out(&serde_json::to_string_pretty(&cell_doc(&cell, &a.state)?)?);
+        return Ok(());
+    }
     out(&format!(
         "{}: a cell of {} tasks, {} robots, {} round(s) recorded",
         a.state.display(),
@@ -226,6 +224,168 @@ pub(crate) fn inspect_cell(a: &InspectArgs) -> Result<()> {
         cell.rounds_recorded()
     ));
     summary(&cell);
+    Ok(())
+}
+
+/// Robot `i`'s label in a cell's chart and lists: `robot 1 (sanding)` (1-based, its task).
+fn robot_label(cell: &CellPlanner, i: usize) -> String {
+    format!(
+        "robot {} ({})",
+        i + 1,
+        cell.tasks()[cell.robot_task()[i]].name()
+    )
+}
+
+/// The JSON document of a cell (`tandem inspect --json` and `tandem schedule --json` of a
+/// cell of several tasks; docs/formats.md, "A cell of tasks as JSON"): per task its name,
+/// robots (1-based), reference samples and period (s), channels, high-confidence share and
+/// count, low-confidence regions and rounds; per robot its task; the schedule (global s):
+/// `T_total`, its lower bound and gap, the tick, every robot's start and planned end, and
+/// every low-confidence interval (robot 1-based, its task, reference samples of that task).
+fn cell_doc(cell: &CellPlanner, state: &Path) -> Result<serde_json::Value> {
+    let tasks: Vec<serde_json::Value> = cell
+        .tasks()
+        .iter()
+        .enumerate()
+        .map(|(t, task)| {
+            let p = task.planner();
+            let c = p.confidence();
+            serde_json::json!({
+                "name": task.name(),
+                "robots": cell
+                    .robot_task()
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &x)| x == t)
+                    .map(|(i, _)| i + 1)
+                    .collect::<Vec<_>>(),
+                "n_ref": p.model().n_ref(),
+                "dt_s": p.model().dt_s(),
+                "channels": p.model().channel_names(),
+                "high_share": c.high_share(),
+                "n_high": c.n_high(),
+                "low_regions": c.low_regions().len(),
+                "rounds_recorded": p.rounds_recorded(),
+            })
+        })
+        .collect();
+    let timelines = cell.timelines().context("the cell's schedule")?;
+    let robots: Vec<serde_json::Value> = timelines
+        .iter()
+        .enumerate()
+        .map(|(i, tl)| {
+            serde_json::json!({
+                "robot": i + 1,
+                "task": cell.tasks()[cell.robot_task()[i]].name(),
+                "start_s": tl.start_s(),
+                "end_s": tl.end_s(),
+            })
+        })
+        .collect();
+    let lc: Vec<serde_json::Value> = crate::gantt::cell_intervals(timelines)
+        .into_iter()
+        .map(|(i, iv)| {
+            serde_json::json!({
+                "robot": i + 1,
+                "task": cell.tasks()[cell.robot_task()[i]].name(),
+                "start_s": iv.start_s,
+                "end_s": iv.end_s,
+                "ref_start": iv.ref_start,
+                "ref_end": iv.ref_end,
+            })
+        })
+        .collect();
+    let schedule = match cell.schedule() {
+        Some(s) => serde_json::json!({
+            "t_total_s": s.t_total_s,
+            "lower_bound_s": s.lower_bound_s,
+            "gap_s": s.gap_s(),
+            "tick_s": s.tick_s,
+            "margin_checks": s.margin_checks,
+            "robots": robots,
+            "lc_intervals": lc,
+        }),
+        None => serde_json::json!({
+            "t_total_s": cell.t_total_s(),
+            "robots": robots,
+            "lc_intervals": lc,
+        }),
+    };
+    Ok(serde_json::json!({
+        "state": state.display().to_string(),
+        "n_robots": cell.n_robots(),
+        "rounds_recorded": cell.rounds_recorded(),
+        "tasks": tasks,
+        "robot_tasks": (0..cell.n_robots())
+            .map(|i| cell.tasks()[cell.robot_task()[i]].name())
+            .collect::<Vec<_>>(),
+        "schedule": schedule,
+    }))
+}
+
+/// `tandem schedule` of a cell of two or more tasks: its rounds schedule as a chart naming
+/// each robot's task (or [`cell_doc`] with `--json`). A cell is re-scheduled when a round is
+/// recorded; this shows the schedule it holds, so the sampler's flags and `--save` have
+/// nothing to act on and are refused rather than ignored.
+pub(crate) fn schedule_cell(a: &ScheduleArgs) -> Result<()> {
+    if a.cell == tandem::planner::Cell::Continuous {
+        bail!(
+            "{}: a cell of several tasks has no continuous plan on the command line yet; \
+             `cargo xtask study --cell-file FILE --cell continuous` runs one, or leave out \
+             --cell continuous for its rounds schedule",
+            a.state.display()
+        );
+    }
+    let s = &a.sampler;
+    if a.save
+        || s.samples.is_some()
+        || s.seed.is_some()
+        || s.switch_s.is_some()
+        || s.max_busy.is_some()
+        || s.operators.is_some()
+    {
+        bail!(
+            "{}: a cell of several tasks is re-scheduled when a round is recorded (`tandem \
+             record`), with the parameters each task was fitted with; `tandem schedule` shows \
+             the schedule it holds. Leave out --save, --samples, --seed, --switch-s, \
+             --max-busy and --operators",
+            a.state.display()
+        );
+    }
+    let cell = CellPlanner::load(&a.state).context("cannot load the state")?;
+    if a.json {
+        out(&serde_json::to_string_pretty(&cell_doc(&cell, &a.state)?)?);
+        return Ok(());
+    }
+    let timelines = cell.timelines().context("the cell's schedule")?;
+    match cell.schedule() {
+        Some(s) => out(&format!(
+            "T_total {:.2} s — lower bound {:.2} s (gap {:.2} s): the longest robot's fastest \
+             task, or every robot's low-confidence time in turn; tick {} s",
+            s.t_total_s,
+            s.lower_bound_s,
+            s.gap_s(),
+            secs(s.tick_s)
+        )),
+        None => out(&format!("T_total {:.2} s", cell.t_total_s())),
+    }
+    let runs: Vec<String> = timelines
+        .iter()
+        .enumerate()
+        .map(|(i, tl)| {
+            format!(
+                "{} starts at {:.2} s, runs {:.2} s",
+                robot_label(&cell, i),
+                tl.start_s(),
+                tl.end_s() - tl.start_s()
+            )
+        })
+        .collect();
+    out(&runs.join("; "));
+    let labels: Vec<String> = (0..cell.n_robots())
+        .map(|i| robot_label(&cell, i))
+        .collect();
+    out(crate::gantt::cell_chart(timelines, &labels)?.trim_end());
     Ok(())
 }
 

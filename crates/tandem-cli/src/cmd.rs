@@ -789,6 +789,9 @@ fn summary_lines(planner: &Planner) -> Result<()> {
 }
 
 fn schedule(a: &ScheduleArgs) -> Result<()> {
+    if crate::cells::is_cell(&a.state) {
+        return crate::cells::schedule_cell(a);
+    }
     if a.cell == Cell::Continuous {
         return cyclic::schedule_continuous(a);
     }

@@ -164,6 +164,17 @@ impl Layout {
         })
     }
 
+    /// One leg per robot and no holds: the timelines of a cell of different tasks (each
+    /// robot's own task, global time; `CellPlanner::timelines`).
+    pub(crate) fn of_timelines(timelines: Vec<Timeline>) -> Self {
+        let n = timelines.len();
+        Layout {
+            legs: timelines.into_iter().map(|t| vec![t]).collect(),
+            leg_from: vec![vec![0]; n],
+            dwells: Vec::new(),
+        }
+    }
+
     /// `T_total` (s, global time): the latest end of a leg.
     fn t_total_s(&self) -> f64 {
         self.legs
@@ -282,13 +293,21 @@ pub(crate) fn schedule_doc(problem: &Problem, outcome: &Outcome) -> Result<Sched
     })
 }
 
-/// The text Gantt chart: one bar per robot over `[0, T_total]` (`=` running high-confidence,
-/// `#` running low-confidence, blank not running) and the operator's row (`1`…`8`: which
-/// robot is supervised, `.` idle, `!` two or more), followed by the low-confidence intervals.
-pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String> {
-    let layout = Layout::new(problem, &outcome.schedule)?;
+/// The chart of a [`Layout`]: its time axis, one bar per robot over `[0, T_total]` (`=`
+/// running high-confidence, `#` running low-confidence, `h` waiting at a hold, blank not
+/// running), the operator's row (`1`…`8`: which robot is supervised, `.` idle, `!` two or
+/// more), the legend, and every low-confidence interval in global time. `labels[i]` names
+/// robot `i` (`robot 1`, or `robot 1 (sanding)` in a cell of tasks); the bars start after the
+/// longest label.
+fn write_chart(out: &mut String, layout: &Layout, labels: &[String], holds: bool) -> Result<()> {
     let t_total = layout.t_total_s();
-    let n = outcome.schedule.n_robots();
+    let n = labels.len();
+    let width = labels
+        .iter()
+        .map(|l| l.chars().count())
+        .chain(std::iter::once("operator".len()))
+        .max()
+        .unwrap_or(0);
     let mut rows = vec![String::new(); n + 1];
     for c in 0..GANTT_COLUMNS {
         let t = (c as f64 + 0.5) / GANTT_COLUMNS as f64 * t_total;
@@ -310,6 +329,80 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
             _ => '!',
         });
     }
+    let label_w = labels.iter().map(|l| l.chars().count()).max().unwrap_or(0);
+    let pad = " ".repeat(width + 2);
+    writeln!(out)?;
+    writeln!(
+        out,
+        "{pad}0 s{:>w$}",
+        format!("{t_total:.1} s"),
+        w = GANTT_COLUMNS - 3
+    )?;
+    for (label, row) in labels.iter().zip(&rows[..n]) {
+        writeln!(out, "{label:<w$}|{row}|", w = width + 1)?;
+    }
+    writeln!(out, "{:<w$}|{}|", "operator", rows[n], w = width + 1)?;
+    writeln!(
+        out,
+        "{pad}= high confidence (unsupervised)   # low confidence (operator supervises)"
+    )?;
+    if holds {
+        writeln!(
+            out,
+            "{pad}h waiting at a hold point (planned; at run time until its release rule holds)"
+        )?;
+    }
+    let intervals = sorted_intervals(layout);
+    writeln!(out)?;
+    writeln!(
+        out,
+        "{} low-confidence intervals (global time; reference samples):",
+        intervals.len()
+    )?;
+    for (robot, iv) in intervals.iter().take(SHOWN) {
+        writeln!(
+            out,
+            "  {:<w$}  {:>9.2} – {:>9.2} s   ref {:>6} – {:>6}",
+            labels[*robot],
+            iv.start_s,
+            iv.end_s,
+            iv.ref_start,
+            iv.ref_end,
+            w = label_w
+        )?;
+    }
+    if intervals.len() > SHOWN {
+        writeln!(
+            out,
+            "  … {} more (tandem schedule --json lists all)",
+            intervals.len() - SHOWN
+        )?;
+    }
+    Ok(())
+}
+
+/// The chart ([`write_chart`]) of a cell of different tasks: one timeline per robot (global
+/// time, each on its own task's reference samples) and its label (`robot 1 (sanding)`).
+pub(crate) fn cell_chart(timelines: Vec<Timeline>, labels: &[String]) -> Result<String> {
+    let mut out = String::new();
+    write_chart(&mut out, &Layout::of_timelines(timelines), labels, false)?;
+    Ok(out)
+}
+
+/// Every robot's low-confidence intervals of a cell's timelines, sorted by start (robot
+/// 0-based; reference samples of the robot's own task; global s).
+pub(crate) fn cell_intervals(timelines: Vec<Timeline>) -> Vec<(usize, LcInterval)> {
+    sorted_intervals(&Layout::of_timelines(timelines))
+}
+
+/// Lines of a long list the text output shows (the JSON lists all).
+const SHOWN: usize = 40;
+
+/// The text Gantt chart of a one-task schedule: its certificate, the robots' starts and
+/// durations, and [`write_chart`] (robots named `robot 1`…), followed by its holds.
+pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String> {
+    let layout = Layout::new(problem, &outcome.schedule)?;
+    let n = outcome.schedule.n_robots();
     let mut out = String::new();
     let dt = problem.dt_s();
     let d = outcome.schedule.durations_s(dt);
@@ -339,53 +432,8 @@ pub(crate) fn gantt_text(problem: &Problem, outcome: &Outcome) -> Result<String>
         runs.join(", "),
         outcome_source_name(problem, outcome)
     )?;
-    writeln!(out)?;
-    writeln!(
-        out,
-        "          0 s{:>w$}",
-        format!("{t_total:.1} s"),
-        w = GANTT_COLUMNS - 3
-    )?;
-    for (i, row) in rows[..n].iter().enumerate() {
-        writeln!(out, "robot {}  |{row}|", i + 1)?;
-    }
-    writeln!(out, "operator |{}|", rows[n])?;
-    writeln!(
-        out,
-        "          = high confidence (unsupervised)   # low confidence (operator supervises)"
-    )?;
-    if outcome.schedule.has_holds() {
-        writeln!(
-            out,
-            "          h waiting at a hold point (planned; at run time until its release rule holds)"
-        )?;
-    }
-    let intervals = sorted_intervals(&layout);
-    writeln!(out)?;
-    writeln!(
-        out,
-        "{} low-confidence intervals (global time; reference samples):",
-        intervals.len()
-    )?;
-    const SHOWN: usize = 40;
-    for (robot, iv) in intervals.iter().take(SHOWN) {
-        writeln!(
-            out,
-            "  robot {}  {:>9.2} – {:>9.2} s   ref {:>6} – {:>6}",
-            robot + 1,
-            iv.start_s,
-            iv.end_s,
-            iv.ref_start,
-            iv.ref_end
-        )?;
-    }
-    if intervals.len() > SHOWN {
-        writeln!(
-            out,
-            "  … {} more (tandem schedule --json lists all)",
-            intervals.len() - SHOWN
-        )?;
-    }
+    let labels: Vec<String> = (1..=n).map(|i| format!("robot {i}")).collect();
+    write_chart(&mut out, &layout, &labels, outcome.schedule.has_holds())?;
     if outcome.schedule.has_holds() {
         let dt = problem.dt_s();
         writeln!(out)?;

@@ -120,14 +120,81 @@ fn a_mixed_cell_is_fitted_inspected_and_recorded_per_robot_task() {
             "robot 3 b",
         ],
     );
-    // The single-task commands refuse the cell, naming its tasks and the fix.
+    // `schedule` shows the cell's schedule, each robot named with its task.
+    let out = ok(&tandem(["schedule", &s]));
+    for want in [
+        "robot 1 (a) starts at 0.00 s",
+        "robot 3 (b) starts at",
+        "robot 1 (a) |",
+        "robot 3 (b) |",
+        "operator    |",
+        "low-confidence intervals (global time; reference samples):",
+    ] {
+        assert!(out.contains(want), "`{want}` missing in:\n{out}");
+    }
+    // The margin check accepted the schedule, so no column has two robots supervised.
+    let operator_row = out.lines().find(|l| l.starts_with("operator")).unwrap();
+    assert!(!operator_row.contains('!'), "{out}");
+    // Its JSON, from `schedule` and from `inspect`, is one document.
+    let doc: serde_json::Value =
+        serde_json::from_str(&ok(&tandem(["schedule", &s, "--json"]))).expect("schedule --json");
+    let inspected: serde_json::Value =
+        serde_json::from_str(&ok(&tandem(["inspect", &s, "--json"]))).expect("inspect --json");
+    assert_eq!(doc, inspected);
+    assert_eq!(doc["robot_tasks"], serde_json::json!(["a", "a", "b"]));
+    assert_eq!(doc["tasks"][0]["robots"], serde_json::json!([1, 2]));
+    assert_eq!(doc["tasks"][1]["robots"], serde_json::json!([3]));
+    assert_eq!(doc["rounds_recorded"], 1);
+    let sch = &doc["schedule"];
+    let t_total = sch["t_total_s"].as_f64().unwrap();
+    assert!(
+        sch["lower_bound_s"].as_f64().unwrap() <= t_total + 1e-9,
+        "{sch}"
+    );
+    // T_total is the last robot's planned end; robot 1 starts at 0.
+    let ends: Vec<f64> = sch["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["end_s"].as_f64().unwrap())
+        .collect();
+    assert_eq!(ends.len(), 3);
+    assert!((ends.iter().cloned().fold(f64::MIN, f64::max) - t_total).abs() < 1e-9);
+    assert_eq!(sch["robots"][0]["start_s"], 0.0);
+    // The planned low-confidence intervals of different robots never overlap, and each
+    // names its robot's task.
+    let lc = sch["lc_intervals"].as_array().unwrap();
+    assert!(!lc.is_empty());
+    for (k, a) in lc.iter().enumerate() {
+        let robot = a["robot"].as_u64().unwrap() as usize;
+        assert_eq!(a["task"], doc["robot_tasks"][robot - 1]);
+        for b in &lc[k + 1..] {
+            if a["robot"] != b["robot"] {
+                assert!(
+                    a["end_s"].as_f64().unwrap() <= b["start_s"].as_f64().unwrap() + 1e-9,
+                    "{a} overlaps {b}"
+                );
+            }
+        }
+    }
+    // Nothing to save or re-sample: refused, the file unchanged.
     fails_with(
-        &tandem(["schedule", &s]),
-        &["holds a cell of 2 tasks (a, b)", "load it as a cell"],
+        &tandem(["schedule", &s, "--save"]),
+        &["re-scheduled when a round is recorded", "Leave out --save"],
     );
     fails_with(
-        &tandem(["inspect", &s, "--json"]),
-        &["--json is not available"],
+        &tandem(["schedule", &s, "--samples", "10"]),
+        &["Leave out --save, --samples"],
+    );
+    assert_eq!(std::fs::read(&state).unwrap(), before);
+    // A single-task command refuses the cell, naming its tasks and the fix.
+    fails_with(
+        &tandem(["plot", &s, "-o", &dir.join("p.svg").display().to_string()]),
+        &[
+            "holds a cell of 2 tasks (a, b)",
+            "load it as a cell",
+            "tandem schedule",
+        ],
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }

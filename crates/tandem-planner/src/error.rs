@@ -182,8 +182,8 @@ pub enum Error {
     /// where one task's planner is expected.
     #[error(
         "{}: this state file holds a cell of {} tasks ({}), not one task's planner: load it as a \
-         cell (`CellPlanner::load`; on the command line `tandem inspect` and `tandem record` \
-         read cells), or fit one task into its own state file",
+         cell (`CellPlanner::load`, Python's `tandem.CellPlanner.load`; on the command line \
+         `tandem inspect`, `tandem schedule` and `tandem record` read cells), or fit one task into its own state file",
         path.display(),
         tasks.len(),
         tasks.join(", ")

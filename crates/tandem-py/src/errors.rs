@@ -148,6 +148,20 @@ impl Error {
         }
     }
 
+    /// This error with the task it is about (`task "sanding", demos[2]`) put before the
+    /// argument it names, for the per-task arguments of a cell of tasks; other errors name
+    /// their file or parameter themselves and are returned as they are.
+    pub(crate) fn in_task(self, task: &str) -> Self {
+        match self {
+            Error::Input { what, why, file } => Error::Input {
+                what: format!("task {task:?}, {what}"),
+                why,
+                file,
+            },
+            other => other,
+        }
+    }
+
     /// An [`Error::Param`] about `what`.
     pub(crate) fn param(what: impl Into<String>, why: impl Into<String>) -> Self {
         Error::Param {

@@ -9,8 +9,8 @@ pub(crate) use tandem::lfd::{
 };
 pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{
-    AnyController, Cell, Error as TandemError, ExecutionRecord, Plan, Planner, PlannerParams,
-    RecordReport, reschedule_seed,
+    AnyController, Cell, CellPlanner, CellSchedule, Error as TandemError, ExecutionRecord, Plan,
+    Planner, PlannerParams, RecordReport, TaskSpec, reschedule_seed,
 };
 pub(crate) use tandem::realtime::continuous::{ContinuousCoordinator, Group, Token};
 pub(crate) use tandem::realtime::{

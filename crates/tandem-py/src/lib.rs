@@ -8,6 +8,8 @@
 //!   with the command line's state file, `command` of Eq. 7) and the per-sample arrays of
 //!   the model (`tandem.Model`: `μ̂`, `σ²_D`, `ψ̇min/ψ̇max`) and of the confidence
 //!   (`tandem.Confidence`: latched `conf`, Beta posterior, observations).
+//! - `cell`: `tandem.fit_cell` and `tandem.CellPlanner`, a cell of different tasks on
+//!   different robots (issue 45) with the command line's state file.
 //! - `schedule`: `tandem.Problem` and `tandem.Schedule` (offsets, gradients,
 //!   low-confidence intervals, `T_total`, tick; `validate` against Eq. 20).
 //! - `cyclic`: `tandem.CyclicPlan`, the plan of a continuous cell (no rounds: its period,
@@ -38,6 +40,7 @@
 
 mod arrays;
 mod bag;
+mod cell;
 mod console;
 mod continuous;
 mod coordinator;
@@ -59,6 +62,8 @@ use pyo3::prelude::*;
 mod _tandem {
     #[pymodule_export]
     use crate::bag::read_bag;
+    #[pymodule_export]
+    use crate::cell::{PyCellPlanner, fit_cell};
     #[pymodule_export]
     use crate::console::PyConsole;
     #[pymodule_export]

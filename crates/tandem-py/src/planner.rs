@@ -42,11 +42,11 @@ fn relabel(e: errors::Lfd, label: &str) -> errors::Lfd {
 
 /// The channel names that go with a demonstration argument.
 #[derive(Clone, Copy)]
-struct Channels<'a> {
+pub(crate) struct Channels<'a> {
     /// The names of an array's columns (required for arrays).
-    array: Option<&'a [String]>,
+    pub(crate) array: Option<&'a [String]>,
     /// Names a file's header must have, in order, if any.
-    file: Option<&'a [String]>,
+    pub(crate) file: Option<&'a [String]>,
 }
 
 /// One demonstration or execution from a Python value: a CSV or JSON path (the command
@@ -171,7 +171,7 @@ fn regridded_execution(
 }
 
 /// The items of a Python sequence argument (not a string or a single array).
-fn items<'py>(x: &Bound<'py, PyAny>, what: &str) -> Result<Vec<Bound<'py, PyAny>>> {
+pub(crate) fn items<'py>(x: &Bound<'py, PyAny>, what: &str) -> Result<Vec<Bound<'py, PyAny>>> {
     let single = x.is_instance_of::<PyString>()
         || x.hasattr("__fspath__").unwrap_or(false)
         || x.hasattr("__array_interface__").unwrap_or(false)
@@ -192,7 +192,7 @@ fn items<'py>(x: &Bound<'py, PyAny>, what: &str) -> Result<Vec<Bound<'py, PyAny>
 /// Demonstrations from `demos` (paths or arrays, see [`demonstration`]), with the bags'
 /// orientations added to `params`' channel schema as quaternion blocks, and the labels of
 /// the arrays that took the default period because `dt_s` was not given.
-fn demonstrations(
+pub(crate) fn demonstrations(
     demos: &Bound<'_, PyAny>,
     channels: Option<&[String]>,
     dt_s: Option<f64>,
@@ -262,7 +262,7 @@ fn demonstrations(
 }
 
 /// Demonstrations as [`demonstrations`] loaded them.
-struct Loaded {
+pub(crate) struct Loaded {
     /// The demonstrations, in the order given.
     demos: Vec<Demonstration>,
     /// Labels of arrays given without `dt_s` (the default period was assumed).
@@ -275,7 +275,7 @@ struct Loaded {
 impl Loaded {
     /// Raises the loading's `DataWarning`s (assumed periods, resampled files, the
     /// demonstrations' own) and hands the demonstrations out.
-    fn warned(self, py: Python<'_>) -> PyResult<Vec<Demonstration>> {
+    pub(crate) fn warned(self, py: Python<'_>) -> PyResult<Vec<Demonstration>> {
         if !self.assumed.is_empty() {
             warn(py, &assumed_period_warning(&self.assumed))?;
         }
@@ -322,7 +322,7 @@ fn warn_demonstrations(py: Python<'_>, demos: &[Demonstration]) -> PyResult<()> 
 }
 
 /// The timeout of a lock wait given in seconds from Python (`None`: the default, 60 s).
-fn lock_timeout(timeout_s: Option<f64>) -> Result<Duration> {
+pub(crate) fn lock_timeout(timeout_s: Option<f64>) -> Result<Duration> {
     match timeout_s {
         None => Ok(DEFAULT_LOCK_TIMEOUT),
         Some(t) if t.is_finite() && t >= 0.0 => Ok(Duration::from_secs_f64(t)),
@@ -334,7 +334,7 @@ fn lock_timeout(timeout_s: Option<f64>) -> Result<Duration> {
 }
 
 /// Planner parameters from `params` (None, a dict or a TOML path), checked.
-fn planner_params(params: Option<&Bound<'_, PyAny>>) -> Result<PlannerParams> {
+pub(crate) fn planner_params(params: Option<&Bound<'_, PyAny>>) -> Result<PlannerParams> {
     let p: PlannerParams = from_py(params, "params")?;
     p.validate()?;
     Ok(p)
@@ -534,8 +534,70 @@ pub(crate) struct PyPlanner {
     pub(crate) inner: Planner,
 }
 
+/// Robot `i`'s execution record of a round from its four Python arguments (the execution as
+/// a path or array with `names`, its reference-time log, its `supervised` and `corrected`
+/// flags), at sample period `dt_s` (s) when the execution carries none; with `resample` an
+/// irregular `t` column is put on an even grid first, the log and flags with it (a
+/// `DataWarning` says so). Shared by `Planner.record_round` and `CellPlanner.record_round`.
+pub(crate) fn execution_record(
+    py: Python<'_>,
+    i: usize,
+    [exec, log, sup, cor]: [&Bound<'_, PyAny>; 4],
+    names: Channels<'_>,
+    dt_s: f64,
+    resample: bool,
+) -> PyResult<ExecutionRecord> {
+    if resample {
+        let label = format!("executions[{i}]");
+        let grid = regridded_execution(exec, &label, names)?;
+        warn(
+            py,
+            &format!(
+                "{}; its log and flags put on the same grid (log interpolated, a sample \
+                 supervised where the nearest row was, corrected where any row of its \
+                 period was)",
+                grid.note
+            ),
+        )?;
+        let per_row = "one entry per row of the execution file";
+        let log = vector(log, &format!("ref_time_logs[{i}]"), per_row)?;
+        let sup = flags(sup, &format!("supervised[{i}]"), per_row)?;
+        let cor = flags(cor, &format!("corrected[{i}]"), per_row)?;
+        return Ok(ExecutionRecord::from_regridded(grid, &log, &sup, &cor).map_err(Error::from)?);
+    }
+    let demonstration = demonstration(exec, &format!("executions[{i}]"), names, Some(dt_s), None)?;
+    if let Some(note) = demonstration.period_note() {
+        warn(py, &note)?;
+    }
+    let ref_time_log = vector(
+        log,
+        &format!("ref_time_logs[{i}]"),
+        "one reference time per executed sample",
+    )?;
+    Ok(ExecutionRecord {
+        execution: Execution {
+            demonstration,
+            ref_time_log,
+        },
+        supervised: flags(
+            sup,
+            &format!("supervised[{i}]"),
+            "one flag per executed sample",
+        )?,
+        corrected: flags(
+            cor,
+            &format!("corrected[{i}]"),
+            "one flag per executed sample",
+        )?,
+    })
+}
+
 /// Per-robot arguments of `record_round`, checked to have one entry per robot (`n`).
-fn per_robot<'py>(x: &Bound<'py, PyAny>, what: &str, n: usize) -> Result<Vec<Bound<'py, PyAny>>> {
+pub(crate) fn per_robot<'py>(
+    x: &Bound<'py, PyAny>,
+    what: &str,
+    n: usize,
+) -> Result<Vec<Bound<'py, PyAny>>> {
     let v = items(x, what)?;
     if v.len() != n {
         return Err(Error::input(
@@ -550,7 +612,7 @@ fn per_robot<'py>(x: &Bound<'py, PyAny>, what: &str, n: usize) -> Result<Vec<Bou
 }
 
 /// The report of a recorded round as a dict.
-fn report_dict<'py>(py: Python<'py>, r: &RecordReport) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn report_dict<'py>(py: Python<'py>, r: &RecordReport) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("newly_high", r.newly_high)?;
     d.set_item("reopened", r.reopened)?;
@@ -781,61 +843,18 @@ impl PyPlanner {
             per_robot(supervised, "supervised", n)?,
             per_robot(corrected, "corrected", n)?,
         );
-        let mut records = Vec::with_capacity(n);
-        for i in 0..n {
-            if resample {
-                let label = format!("executions[{i}]");
-                let grid = regridded_execution(&execs[i], &label, names)?;
-                warn(
+        let records = (0..n)
+            .map(|i| {
+                execution_record(
                     py,
-                    &format!(
-                        "{}; its log and flags put on the same grid (log interpolated, a sample \
-                         supervised where the nearest row was, corrected where any row of its \
-                         period was)",
-                        grid.note
-                    ),
-                )?;
-                let per_row = "one entry per row of the execution file";
-                let log = vector(&logs[i], &format!("ref_time_logs[{i}]"), per_row)?;
-                let sup = flags(&sups[i], &format!("supervised[{i}]"), per_row)?;
-                let cor = flags(&cors[i], &format!("corrected[{i}]"), per_row)?;
-                records.push(
-                    ExecutionRecord::from_regridded(grid, &log, &sup, &cor).map_err(Error::from)?,
-                );
-                continue;
-            }
-            let demonstration = demonstration(
-                &execs[i],
-                &format!("executions[{i}]"),
-                names,
-                Some(dt_s),
-                None,
-            )?;
-            if let Some(note) = demonstration.period_note() {
-                warn(py, &note)?;
-            }
-            let ref_time_log = vector(
-                &logs[i],
-                &format!("ref_time_logs[{i}]"),
-                "one reference time per executed sample",
-            )?;
-            records.push(ExecutionRecord {
-                execution: Execution {
-                    demonstration,
-                    ref_time_log,
-                },
-                supervised: flags(
-                    &sups[i],
-                    &format!("supervised[{i}]"),
-                    "one flag per executed sample",
-                )?,
-                corrected: flags(
-                    &cors[i],
-                    &format!("corrected[{i}]"),
-                    "one flag per executed sample",
-                )?,
-            });
-        }
+                    i,
+                    [&execs[i], &logs[i], &sups[i], &cors[i]],
+                    names,
+                    dt_s,
+                    resample,
+                )
+            })
+            .collect::<PyResult<Vec<_>>>()?;
         let inner = &mut self.inner;
         let report = py.detach(|| guard(|| Ok(inner.record_round(&records)?)))?;
         for note in &report.notices {
