@@ -93,6 +93,7 @@ Controller.register(ContinuousCoordinator)
 __all__ = [
     "MAX_ROBOTS",
     "N_ROBOTS",
+    "CellPlanner",
     "CellTick",
     "Confidence",
     "Console",
@@ -120,6 +121,7 @@ __all__ = [
     "cyclic_plan",
     "default_params",
     "fit",
+    "fit_cell",
     "fit_model",
     "read_bag",
     "sim",

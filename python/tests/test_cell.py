@@ -49,6 +49,7 @@ def test_fit_cell_writes_the_clis_cell_bytes(tmp_path: Path) -> None:
     assert cell.robot_tasks == ["a", "a", "b"]
     assert cell.n_robots == 3 and cell.rounds_recorded == 0
     assert "a×2" in repr(cell) and "b×1" in repr(cell)
+    assert "fit_cell" in tandem.__all__ and "CellPlanner" in tandem.__all__
     # The command line reads the file Python wrote: the same schedule.
     doc = json.loads(run_cli("schedule", tmp_path / "py.tandem", "--json"))
     s = cell.schedule
