@@ -967,6 +967,42 @@ fn schedule_n(
             }
         }
     }
+    // N ≥ 3 with a switch time and hold points: the optimum with its waits as dwells at holds
+    // (its approaches at their fastest, `exact::dwelled`) and release rules re-derived, then
+    // re-timed with clearances (docs/decisions.md, "Three robots at δ ≥ 1 s: waits as dwells
+    // (issue 41)"). Not at `δ = 0` (the scheduler of before, bit for bit).
+    if plan.bound == BoundBy::Many
+        && sw > 0.0
+        && let Some(optimum) = bound.schedule.as_ref()
+        && optimum.t_total_s(problem.dt_s()) < best.1
+        && let Some(dwelled) = exact::dwelled(
+            problem,
+            &Schedule {
+                tick_s,
+                ..optimum.clone()
+            },
+            tick_s,
+        )
+        && let Ok(held) = problem.with_release_rules(&dwelled)
+    {
+        let t = held.t_total_s(problem.dt_s());
+        if t < best.1 {
+            checks += 1;
+            let found = if validate_with_switch(problem, &held, sw).is_ok() {
+                Some((held, t))
+            } else {
+                let (cleared, used) = cleared_optimum(problem, &held, tick_s, best.1, sw);
+                checks += used;
+                cleared
+            };
+            if let Some((s, t)) = found {
+                if capping {
+                    pool.push((s.clone(), t, Source::Held));
+                }
+                best = (s, t, Source::Held);
+            }
+        }
+    }
     // The staggered candidate, always (its checks see all robots: at most
     // `MAX_STAGGER_CHECKS` of them). Before, it ran only when nothing beat the serial
     // schedule, and a schedule with holds that overlapped the robots hid a shorter staggered

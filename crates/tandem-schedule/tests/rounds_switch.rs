@@ -338,3 +338,54 @@ fn the_allowance_is_needed() {
     }
     assert!(failing >= 10, "{failing} of 40");
 }
+
+/// Three robots at `δ = 1` s overlap when their waits are dwells at holds, not slowed
+/// approaches (docs/decisions.md, "Three robots at δ ≥ 1 s: waits as dwells (issue 41)").
+///
+/// The task, by hand: `[LC ×10, HC ×40, LC ×10, HC ×40, LC ×10]` at 0.1 s, gradients
+/// `ψ̇̄ = 1` in `[0.5, 2]`, one hold in the middle of each high-confidence run (samples 30
+/// and 80). Fastest execution: 3 × 1 s low-confidence + 2 × 40 × 0.05 s = 7 s, so every
+/// serial schedule of three robots lasts at least 21 s; the `δ`-bound is the operator's
+/// 9 s of stretches plus 8 switches of 1 s, 17 s. The margin-free optimum fills each robot's
+/// wait by slowing its high-confidence samples (up to 2× their mean), which the worst-case
+/// operator may run at `ψ̇min`: with the switch time it failed the margin check and the
+/// scheduler returned the serial schedule with idle gaps (23.2 s). With the approaches at
+/// their fastest and the wait as a dwell at the hold with a release rule it overlaps the
+/// robots and passes.
+#[test]
+fn three_robots_at_one_second_overlap_with_dwells() {
+    let lc = || std::iter::repeat_n(false, 10);
+    let hc = || std::iter::repeat_n(true, 40);
+    let conf: Vec<bool> = lc()
+        .chain(hc())
+        .chain(lc())
+        .chain(hc())
+        .chain(lc())
+        .collect();
+    let n = conf.len();
+    assert_eq!(n, 110);
+    let problem = Problem::new(conf, vec![1.0; n], vec![0.5; n], vec![2.0; n], 0.1)
+        .unwrap()
+        .with_holds(vec![30, 80])
+        .unwrap();
+    let params = SamplerParams {
+        samples: 200,
+        switch_s: 1.0,
+        ..SamplerParams::default()
+    };
+    let out = sample_schedule_n(&problem, 3, &params, None).unwrap();
+    assert_eq!(out.source, Source::Held, "{:?}", out.source);
+    assert!(out.schedule.has_holds());
+    validate_with_switch(&problem, &out.schedule, 1.0).unwrap();
+    assert!(
+        out.t_total_s < 21.0 - 1e-9,
+        "T_total {} s: not below every serial schedule (21 s)",
+        out.t_total_s
+    );
+    assert!(
+        (out.lower_bound_s - 17.0).abs() < 1e-9,
+        "{}",
+        out.lower_bound_s
+    );
+    assert!(out.t_total_s >= out.lower_bound_s);
+}

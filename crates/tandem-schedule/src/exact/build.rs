@@ -83,3 +83,88 @@ pub(crate) fn fill_uniform(problem: &Problem, out: &mut [f64], start: usize, dur
         *g = a + u * (b - a);
     }
 }
+
+/// `schedule` with each robot's waits before its low-confidence runs moved from slowed
+/// high-confidence samples into planned dwells at holds, its low-confidence intervals on the
+/// same schedule clock (up to rounding): every high-confidence run followed by a
+/// low-confidence run and holding a usable hold (`Problem::usable_holds`; the latest, `h`)
+/// runs its samples before `h` at `ψ̇min`, travels from `h` to the run as
+/// `shape::held_schedule` does (its fastest plus one control tick `tick_s`, at most its
+/// slowest; less room when the run is too short), and dwells at `h` for the rest of the run's
+/// planned duration (its samples' clock plus the dwells it had). The dwells carry no release
+/// rules (`Problem::with_release_rules` derives them). `None` when nothing changes.
+///
+/// **Why** (docs/decisions.md, "Three robots at δ ≥ 1 s: waits as dwells (issue 41)"): the
+/// margin check's worst-case operator may run any high-confidence sample at `ψ̇min`, covering
+/// `ψ̇_E/ψ̇min` ticks of schedule clock per tick, so a robot whose approach to its stretch
+/// was planned slowed can arrive that much earlier: with a switch time the room a pair needs
+/// grows with that rate (the lead bound's `M_c + (k − 1)·M_c'`). A dwell's clock passes one
+/// tick per tick whatever the operator, and the hold can wait for the robot before it by a
+/// release rule.
+pub(crate) fn dwelled(problem: &Problem, schedule: &Schedule, tick_s: f64) -> Option<Schedule> {
+    let usable = problem.usable_holds();
+    if usable.is_empty() {
+        return None;
+    }
+    let dt = problem.dt_s();
+    let (gmin, gmax) = (problem.grad_min(), problem.grad_max());
+    let sum = |v: &[f64], a: usize, b: usize| v[a..b].iter().sum::<f64>() * dt;
+    let n_ref = problem.n_ref();
+    let n = schedule.n_robots();
+    let mut out = schedule.clone();
+    if out.holds.is_empty() {
+        out.holds = vec![Vec::new(); n];
+    }
+    let mut changed = false;
+    for r in 0..n {
+        for run in problem.runs() {
+            let (a, b) = (run.start, run.end);
+            if !run.high_conf || b >= n_ref {
+                continue;
+            }
+            let Some(h) = usable.iter().rev().copied().find(|&h| a < h && h < b) else {
+                continue;
+            };
+            let warp = &mut out.grad_exec[r];
+            let holds = &mut out.holds[r];
+            let dwells_s: f64 = holds
+                .iter()
+                .filter(|x| a < x.ref_idx && x.ref_idx < b)
+                .map(|x| x.dwell_s)
+                .sum();
+            let duration_s = tandem_realtime::clock_end_s(&warp[a..b], 0.0, dt) + dwells_s;
+            let pre_min = sum(gmin, a, h);
+            let travel_min = sum(gmin, h, b);
+            let travel_s = (travel_min + tick_s)
+                .min(sum(gmax, h, b))
+                .min(duration_s - pre_min)
+                .max(travel_min);
+            let mut new = warp[a..b].to_vec();
+            new[..h - a].copy_from_slice(&gmin[a..h]);
+            fill_uniform(problem, &mut new[h - a..], h, travel_s);
+            let dwell_s = duration_s - tandem_realtime::clock_end_s(&new, 0.0, dt);
+            // Less than rounding: the run is at its fastest already.
+            if !(dwell_s.is_finite() && dwell_s > 1e-9) {
+                continue;
+            }
+            let same = new == warp[a..b]
+                && holds
+                    .iter()
+                    .filter(|x| a < x.ref_idx && x.ref_idx < b)
+                    .map(|x| (x.ref_idx, x.dwell_s))
+                    .eq([(h, dwell_s)]);
+            if same {
+                continue;
+            }
+            warp[a..b].copy_from_slice(&new);
+            holds.retain(|x| !(a < x.ref_idx && x.ref_idx < b));
+            holds.push(Hold {
+                dwell_s,
+                ..Hold::at(h)
+            });
+            holds.sort_by_key(|x| x.ref_idx);
+            changed = true;
+        }
+    }
+    changed.then_some(out)
+}

@@ -167,6 +167,8 @@ mod search;
 mod shape;
 pub(crate) mod stn;
 
+pub(crate) use build::dwelled;
+
 use serde::{Deserialize, Serialize};
 
 use crate::problem::Problem;
