@@ -1013,6 +1013,37 @@ fn schedule_n(
             best = (s, t, Source::Held);
         }
     }
+    // N = 2 with hold points: the multi-switch candidate, the same per-pair clearances on the
+    // margin-free optimum without release rules, each switch given only the room the check
+    // says it lacks (the staggered candidate is one warp and one offset, the held completion
+    // pays each switch the way from the hold; docs/decisions.md, "Two robots with holds: every
+    // switch at the room the check asks (issue 38)"). Not with the benchmark baselines.
+    if plan.bound == BoundBy::Pair
+        && *baselines == SamplerBaselines::default()
+        && let Some(optimum) = bound.schedule.as_ref()
+        && !problem.usable_holds().is_empty()
+        && optimum.t_total_s(problem.dt_s()) < best.1
+    {
+        let timed = Schedule {
+            tick_s,
+            ..optimum.clone()
+        };
+        let (paired, used) = crate::clearance::pair_cleared(
+            problem,
+            &timed,
+            tick_s,
+            best.1,
+            crate::clearance::MAX_PAIR_CHECKS,
+            sw,
+        );
+        checks += used;
+        if let Some((s, t)) = paired {
+            if capping {
+                pool.push((s.clone(), t, Source::Held));
+            }
+            best = (s, t, Source::Held);
+        }
+    }
     stats.completion_margin_checks = checks;
     if best.1 == f64::INFINITY {
         // No incumbent (the serial schedule fails with the switch time) and nothing passed.
