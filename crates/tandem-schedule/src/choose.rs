@@ -812,7 +812,7 @@ fn schedule_n(
         .then_some(&incumbent.0)
         .into_iter()
         .collect();
-    let ((winner, mut stats), (bound, (done, mut checks), held_done, paired_done)) = rayon::join(
+    let ((winner, mut stats), (bound, (done, mut checks), held_done)) = rayon::join(
         || {
             if baselines.completion_only {
                 (None, SamplerStats::default())
@@ -827,7 +827,6 @@ fn schedule_n(
                 exact::operator_bound(problem, n_robots),
                 (None, 0),
                 (None, 0),
-                (None, 0),
             ),
             BoundBy::Many => (
                 at_least_plain(
@@ -836,7 +835,6 @@ fn schedule_n(
                     n_robots,
                     params,
                 ),
-                (None, 0),
                 (None, 0),
                 (None, 0),
             ),
@@ -869,37 +867,7 @@ fn schedule_n(
                 } else {
                     (None, 0)
                 };
-                // With hold points, the multi-switch candidate: the per-pair clearances of the
-                // optimum without release rules (the staggered candidate is one warp and one
-                // offset, the held completion pays each switch the way from the hold;
-                // docs/decisions.md, "Two robots with holds: every switch at the room the check
-                // asks (issue 38)"). Here, beside the sampler, so that its checks cost no wall
-                // time where a core is free. Its cap is the incumbent's `T_total`, never below
-                // the final best: its re-timings only lengthen as clearances grow, so it returns
-                // what it would with the final best as the cap or one above it, which is dropped
-                // below. Not with the benchmark baselines.
-                let paired = match bound.schedule.as_ref() {
-                    Some(optimum)
-                        if *baselines == SamplerBaselines::default()
-                            && !problem.usable_holds().is_empty()
-                            && optimum.t_total_s(problem.dt_s()) < cap_s =>
-                    {
-                        let timed = Schedule {
-                            tick_s,
-                            ..optimum.clone()
-                        };
-                        crate::clearance::pair_cleared(
-                            problem,
-                            &timed,
-                            tick_s,
-                            cap_s,
-                            crate::clearance::MAX_PAIR_CHECKS,
-                            sw,
-                        )
-                    }
-                    _ => (None, 0),
-                };
-                (bound, done, held, paired)
+                (bound, done, held)
             }
         },
     );
@@ -1044,16 +1012,6 @@ fn schedule_n(
             }
             best = (s, t, Source::Held);
         }
-    }
-    // N = 2 with hold points: the multi-switch candidate (run beside the sampler, above).
-    checks += paired_done.1;
-    if let Some((s, t)) = paired_done.0
-        && t < best.1
-    {
-        if capping {
-            pool.push((s.clone(), t, Source::Held));
-        }
-        best = (s, t, Source::Held);
     }
     stats.completion_margin_checks = checks;
     if best.1 == f64::INFINITY {

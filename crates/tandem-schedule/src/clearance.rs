@@ -19,10 +19,6 @@
 //! every slack is positive, the re-timing is no longer below the cap, it has no solution, or
 //! the budget of checks is spent. The check stays the only oracle: a candidate is returned
 //! only when [`validate`] accepts it.
-//!
-//! Two robots with hold points run the same candidate too, beside the held completion and the
-//! staggered schedule (`choose::schedule_n`; docs/decisions.md, "Two robots with holds: every
-//! switch at the room the check asks (issue 38)").
 
 use std::collections::BTreeMap;
 
@@ -168,48 +164,6 @@ mod tests {
     use crate::exact::{ExactParams, bound_many_switch};
     use crate::testkit::{hold_points, random_problem};
     use crate::validate::validate;
-
-    /// Two robots on the test kit's random problems with a hold in the middle of every HC run
-    /// (seeds 0–23, 300–600 samples of 10 ms, tick 20 ms), the cap the serial schedule: the
-    /// per-pair clearances of the two-robot optimum pass [`validate`] whenever they return, never
-    /// below the bound, and the scheduler's schedule is never longer than what they return (the
-    /// two-robot scheduler runs them as a candidate: docs/decisions.md, "Two robots with holds:
-    /// every switch at the room the check asks (issue 38)").
-    #[test]
-    fn two_robots_per_pair_clearances_scan() {
-        use crate::exact::bound_switch;
-        use crate::{SamplerParams, sample_schedule_n};
-        let (n, tick_s) = (2, 0.02);
-        let mut found = 0;
-        for seed in 0..24u64 {
-            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-            let p = random_problem(&mut rng, 300..=600, 0.01).unwrap();
-            let p = p.clone().with_holds(hold_points(p.conf())).unwrap();
-            let bound = bound_switch(&p, &ExactParams::default(), 0.0);
-            let Some(optimum) = bound.schedule.clone() else {
-                continue;
-            };
-            let optimum = Schedule { tick_s, ..optimum };
-            let serial_s = p.serial_schedule_n(n, tick_s).unwrap().t_total_s(p.dt_s());
-            let (got, checks) = pair_cleared(&p, &optimum, tick_s, serial_s, MAX_PAIR_CHECKS, 0.0);
-            assert!(checks <= MAX_PAIR_CHECKS + 1);
-            let params = SamplerParams {
-                samples: 300,
-                seed,
-                tick_s: Some(tick_s),
-                ..SamplerParams::default()
-            };
-            let out = sample_schedule_n(&p, n, &params, None).unwrap();
-            if let Some((s, t)) = got {
-                validate(&p, &s).unwrap();
-                assert!(t >= bound.lower_bound_s - 1e-9 && t < serial_s);
-                assert!(out.t_total_s <= t + 1e-9, "{} > {t}", out.t_total_s);
-                found += 1;
-            }
-        }
-        // Measured when the candidate was added: 22 of the 24 pass below serial.
-        assert!(found >= 20, "{found}");
-    }
 
     /// Three robots on the test kit's random problem of seed 5 (300–600 samples of 10 ms,
     /// a hold in the middle of every HC run), tick 20 ms. Measured when the per-pair
