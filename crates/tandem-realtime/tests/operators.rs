@@ -251,3 +251,30 @@ fn a_robot_keeps_its_last_operator_when_it_is_free() {
     assert!(c.tasks_completed().iter().all(|&k| k >= 5));
     assert_eq!(ops_of, [vec![0], vec![1]]);
 }
+
+#[test]
+fn a_robot_on_its_way_holds_back_no_operator() {
+    // Two robots, two operators, two groups per task split by a hold at sample 3 (gate of
+    // group 1), the order (0, 0), (0, 1), (1, 0), (1, 1): robot 0's two groups come first.
+    // Robot 0 takes operator 0 for its group 0; the sequence's next entry is robot 0's group
+    // 1, which it reaches only after group 0 and two samples of travel. Robot 1 waits at its
+    // gate (the task start) with its entry next among the waiting robots, so it takes the idle
+    // operator 1 at once: both robots are low-confidence in tick 0. The strict in-order grant
+    // (the one-operator rule run with M tokens) stopped at (0, 1) and left robot 1 waiting
+    // and operator 1 idle until robot 0 had left group 0.
+    let conf = [false, true, true, true, false, true, true];
+    let task = Timeline::new(&conf, &[1.0; 7], &[0.5; 7], &[2.0; 7], 0.0, 1.0).unwrap();
+    let order = [(0, 0), (0, 1), (1, 0), (1, 1)];
+    let mut c = ContinuousCoordinator::new(task.clone(), &[3], &order, 2, 1.0)
+        .unwrap()
+        .with_operators(OperatorCount::new(2).unwrap());
+    let t = c.tick_many(&[Operator::Scheduled; 2]).unwrap();
+    assert_eq!(t.low_conf, [true, true]);
+    assert_eq!(t.operator, [Some(0), Some(1)]);
+    assert!(!t.waiting[1] && !t.over(2));
+    // One operator: the same order serves robot 0's two groups, then robot 1's.
+    let mut one = ContinuousCoordinator::new(task, &[3], &order, 2, 1.0).unwrap();
+    let t = one.tick(Operator::Scheduled).unwrap();
+    assert_eq!(t.low_conf, [true, false]);
+    assert!(t.waiting[1]);
+}

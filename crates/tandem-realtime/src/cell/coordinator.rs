@@ -32,6 +32,10 @@ struct Staff {
     /// first tick after the one in which it left (`None`: nobody yet). The operator is granted
     /// to another robot only from tick `left + k` on (carried over by a hand-over).
     last_left: [Option<(usize, u64)>; MAX_ROBOTS],
+    /// `M > 1` only: per robot, the `(pos, passes)` of its next entry of the token sequence
+    /// not yet granted (`None`: no entry, a task without low confidence). Granted in the
+    /// order of these among the robots waiting at their gates ([`ContinuousCoordinator::grant`]).
+    next_entry: [Option<(usize, u64)>; MAX_ROBOTS],
 }
 
 /// What one [`ContinuousCoordinator::tick`] did: the one [`Tick`] of every controller (its
@@ -369,7 +373,14 @@ impl ContinuousCoordinator {
     /// `tick` (the start of that tick): while the next entry's robot has the entry's group
     /// next, holds no operator, and a free operator may take it. Stops at the first entry that
     /// cannot be granted (the order is kept). At most `N` grants; no allocation.
+    ///
+    /// `M > 1`: [`grant_waiting`](Self::grant_waiting) instead — an entry whose robot has not
+    /// reached its gate holds back neither a free operator nor the robots behind it.
     fn grant(&mut self, tick: u64) {
+        if self.m > 1 {
+            self.grant_waiting(tick);
+            return;
+        }
         while let Some(&t) = self.tokens.get(self.pos) {
             if self.staff.assigned[t.robot].is_some() || self.next_group[t.robot] != t.group {
                 return;
@@ -381,6 +392,97 @@ impl ContinuousCoordinator {
             self.staff.assigned[t.robot] = Some(o as u8);
             self.staff.last_op[t.robot] = Some(o as u8);
             self.advance_token();
+        }
+    }
+
+    /// `M > 1`: grants operators, at tick index `tick`, to the robots that wait at the gate of
+    /// their next group and hold none, in the order of their next entries in the token
+    /// sequence (`Staff::next_entry`), each a free operator whose switch time for it is over
+    /// ([`free_operator`](Self::free_operator)); stops at the first such robot that cannot be
+    /// granted (so a robot is overtaken only by robots whose entries come before its own).
+    /// Unlike the one-operator rule, a robot still on its way to its gate holds neither an
+    /// operator nor the grants behind it: with `M` operators the sequence's next robot is
+    /// often still finishing its previous group or travelling, while other robots wait at
+    /// their gates and operators idle (docs/decisions.md, "The pooled cell grants the robots
+    /// at their gates (issue 44)"). Soundness does not depend on the order (each robot inside
+    /// holds one operator). Liveness: a robot waiting with entry key `K` is overtaken only by
+    /// grants of smaller keys, each entry granted once, so finitely many; operators free
+    /// up as their robots leave, and a switch wait lasts at most `k` ticks. O(N²) comparisons
+    /// for `N ≤ MAX_ROBOTS`, O(len) to advance a granted robot's entry; no allocation.
+    fn grant_waiting(&mut self, tick: u64) {
+        let n_groups = self.groups.len();
+        let mut tried = [false; MAX_ROBOTS];
+        loop {
+            let waiting = (0..self.n).filter(|&i| {
+                let g = self.next_group[i];
+                !tried[i]
+                    && self.staff.assigned[i].is_none()
+                    && g < n_groups
+                    && self.clock_s[i] >= self.gate_s[g]
+                    && self.staff.next_entry[i].is_some()
+            });
+            let Some(i) = waiting.min_by_key(|&i| {
+                let (pos, passes) = self.staff.next_entry[i].expect("filtered");
+                (passes, pos)
+            }) else {
+                return;
+            };
+            tried[i] = true;
+            let (pos, passes) = self.staff.next_entry[i].expect("filtered");
+            let t = self.tokens[pos];
+            debug_assert_eq!(
+                (t.robot, t.group),
+                (i, self.next_group[i]),
+                "robot {i}'s next entry is its next group"
+            );
+            let Some(o) = self.free_operator(i, tick) else {
+                return;
+            };
+            self.staff.slot[o] = Some((t, pos, passes));
+            self.staff.assigned[i] = Some(o as u8);
+            self.staff.last_op[i] = Some(o as u8);
+            self.staff.next_entry[i] = Some(self.entry_after(i, pos, passes));
+            self.sync_oldest_entry();
+        }
+    }
+
+    /// `M > 1`: robot `r`'s entry after `(pos, passes)` in the token sequence (skipping the
+    /// first pass's skipped entries). O(len).
+    fn entry_after(&self, r: usize, mut pos: usize, mut passes: u64) -> (usize, u64) {
+        let len = self.tokens.len();
+        loop {
+            pos += 1;
+            if pos == len {
+                pos = 0;
+                passes += 1;
+            }
+            if self.tokens[pos].robot == r && (passes > 0 || !self.skip_first[pos]) {
+                return (pos, passes);
+            }
+        }
+    }
+
+    /// `M > 1`: each robot's next entry from the start of the sequence (at a reset or a
+    /// hand-over: its first entry not skipped in the first pass, the one of its next group).
+    fn init_next_entries(&mut self) {
+        for r in 0..self.n {
+            self.staff.next_entry[r] = (0..self.tokens.len())
+                .find(|&k| self.tokens[k].robot == r && !self.skip_first[k])
+                .map(|k| (k, 0));
+        }
+        self.sync_oldest_entry();
+    }
+
+    /// `M > 1`: `(pos, passes)` is the oldest entry not granted yet (the least of the robots'
+    /// next entries), so [`token`](Self::token) and [`token_position`](Self::token_position)
+    /// keep their meaning.
+    fn sync_oldest_entry(&mut self) {
+        if let Some((pos, passes)) = self.staff.next_entry[..self.n]
+            .iter()
+            .flatten()
+            .min_by_key(|&&(pos, passes)| (passes, pos))
+        {
+            (self.pos, self.passes) = (*pos, *passes);
         }
     }
 
@@ -558,6 +660,9 @@ impl ContinuousCoordinator {
         self.staff = Staff::default();
         if let Some(p) = &mut self.pace {
             p.reset();
+        }
+        if self.m > 1 {
+            self.init_next_entries();
         }
         self.grant(0);
     }
@@ -1024,6 +1129,9 @@ impl ContinuousCoordinator {
             last_op: old.staff.last_op,
             ..Staff::default()
         };
+        if self.m > 1 {
+            self.init_next_entries();
+        }
         self.grant(self.monitor.ticks());
         // The load cap's episode runs on too (from the start of the next one when the old cell
         // had no cap).

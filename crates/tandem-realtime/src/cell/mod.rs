@@ -44,18 +44,21 @@
 //! the robots never rely on a margin: they wait.
 //!
 //! **M operators (issue 44).** With [`ContinuousCoordinator::with_operators`] the cell has `M`
-//! tokens, one per operator. The cyclic sequence is served in order by whichever operators are
-//! free: at the end of every tick (and at the start), while the next entry `(robot, group)` of
-//! the sequence has its robot's next group as its group, the robot holds no operator, and some
-//! operator is free — none holds an entry, and its switch time is over for that robot (below)
-//! — the entry is *granted* that operator (the robot's last operator if it qualifies, else the
-//! lowest index) and the sequence moves on; the first entry that cannot be granted stops the
-//! grants (the order is kept). A robot granted an operator may pass its gate, but not the gate
+//! tokens, one per operator. The cyclic sequence orders the robots waiting for an operator:
+//! at the end of every tick (and at the start), the robots that wait at the gate of their next
+//! group and hold no operator are taken in the order of their next entries `(robot, group)` in
+//! the sequence, and each is *granted* a free operator — one that holds no entry and whose
+//! switch time is over for that robot (below); the robot's last operator if it qualifies, else
+//! the lowest index — until one cannot be granted (a robot is overtaken only by robots whose
+//! entries come first). A robot still on its way to its gate holds back neither an operator
+//! nor the robots behind it (the one-operator rule run with `M` tokens did: its next entry's
+//! robot, often still inside its previous group, stopped every grant while operators idled).
+//! A robot granted an operator may pass its gate, but not the gate
 //! of its following group; once it has *left* the group (as above) the operator is released,
 //! at the end of that tick. A robot's rate on low confidence is its operator's input
-//! ([`ContinuousCoordinator::tick_many`], one input per operator). With `M = 1` the granted
-//! entry is the token of the one-operator rule, released when the token moved: the same
-//! ticks, bit for bit.
+//! ([`ContinuousCoordinator::tick_many`], one input per operator). With `M = 1` the cell runs
+//! the one-operator token rule above (the token granted when it moves, whether or not its
+//! robot is at the gate yet, released when it moves on): the same ticks, bit for bit.
 //!
 //! *Soundness with M operators, for any inputs and any number of tasks.* Call a robot inside
 //! from the tick start at which it holds an operator until the tick end at which it leaves its
@@ -69,12 +72,15 @@
 //! for its group `G` only from tick `a + 1 + k − min(k, e_G)` on, `e_G` the whole ticks a robot
 //! surely travels from `G`'s gate before it is low-confidence in `G` (it travels while the
 //! operator switches), so between two robots' stretches of one operator at least `k` ticks
-//! pass in which `o` supervises no one. *Liveness*: grants follow the sequence, each
-//! robot's entries come in its task order, and an inside robot leaves its group in finitely
-//! many ticks (rate at least `S`), releasing its operator, whose switch time ends `k` ticks
-//! later; so the next entry is granted in finitely many ticks once its robot has finished its
-//! previous group, which it does for the same reason: no deadlock, every robot keeps completing
-//! tasks (docs/decisions.md, "M operators: the invariant and the continuous cell (issue 44)").
+//! pass in which `o` supervises no one. *Liveness*: a robot that is not inside reaches its
+//! next gate (or its task's end, then the start of the next) in finitely many ticks on
+//! high-confidence samples; an inside robot leaves its group in finitely many ticks (rate at
+//! least `S`), releasing its operator, whose switch time ends `k` ticks later. A robot waiting
+//! at its gate with next entry `K` is overtaken only by grants of entries before `K`, and each
+//! entry is granted once: finitely many. So it is granted in finitely
+//! many ticks: no deadlock, every robot keeps completing tasks (docs/decisions.md, "M
+//! operators: the invariant and the continuous cell (issue 44)" and "The pooled cell grants
+//! the robots at their gates (issue 44)").
 //! The pre-alert is computed for one operator only (`None` with `M > 1`).
 //!
 //! **Runnable orders.** The rule needs each group to be contiguous in the order: between two
