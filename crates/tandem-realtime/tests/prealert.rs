@@ -384,3 +384,41 @@ fn a_cell_names_the_next_turn_not_the_smallest_own_bound() {
     }
     assert!(k >= 24 && checked >= 48, "{k} stretches, {checked} ticks");
 }
+
+/// Regression (issue 42, the three-robot study's rounds: 3 of 8 stretches pre-alerted under
+/// 1 s ahead): a robot waiting for its start (rule 3: it follows the running robot furthest
+/// behind) cannot start before every running robot has reached its start or stopped. Two
+/// robots of 30 samples of 1 s, rates [½, 2]; robot 1 (0-based 0) starts at 0 and is
+/// low-confidence on samples 20–21, robot 2 (0-based 1) starts at 40 and is low-confidence
+/// on its first samples 0–1; tick ½ s. Robot 2 can start only once robot 1 has finished
+/// (30 s of clock, at least 15 s at rate 2), so robot 1's stretch (20 s of clock, at least
+/// 10 s: named at 9.5 s, the tick rounding) is next. The old rule took the wait for a start as 0 and named robot 2 at 0 s.
+#[test]
+fn rounds_do_not_name_a_robot_whose_start_is_far_off() {
+    let conf0: Vec<bool> = (0..30).map(|n| !(20..22).contains(&n)).collect();
+    let conf1: Vec<bool> = (0..30).map(|n| n >= 2).collect();
+    let (g, lo, hi) = (vec![1.0; 30], vec![0.5; 30], vec![2.0; 30]);
+    let robots = vec![
+        Timeline::new(&conf0, &g, &lo, &hi, 0.0, 1.0).unwrap(),
+        Timeline::new(&conf1, &g, &lo, &hi, 40.0, 1.0).unwrap(),
+    ];
+    let mut c = tandem_realtime::Coordinator::new(robots, 0.5).unwrap();
+    let t = c.tick(Operator::Scheduled).unwrap();
+    let a = t.next.unwrap();
+    // 20 s of clock at rate 2 take 10 s: the tick that reaches the stretch is the 20th,
+    // starting 19 ticks = 9.5 s from now.
+    assert_eq!((a.robot, a.earliest_s), (0, 9.5), "{a:?}");
+    let mut first = [None; 2];
+    for k in 1..400u32 {
+        let t = c.tick(Operator::Fastest).unwrap();
+        for (r, f) in first.iter_mut().enumerate() {
+            if t.low_conf[r] && f.is_none() {
+                *f = Some(k);
+            }
+        }
+        if let (Some(a), None) = (t.next, first[0]) {
+            assert_eq!(a.robot, 0, "tick {k}: {a:?}");
+        }
+    }
+    assert!(first[0].unwrap() < first[1].unwrap(), "{first:?}");
+}
