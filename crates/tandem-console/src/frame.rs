@@ -542,6 +542,37 @@ impl Geometry {
         self.can_hold
     }
 
+    /// Rounds: every robot's low-confidence runs `(robot, run)` (0-based) in the plan's order
+    /// of a round, by the schedule clock at which each starts (robot first on a tie); `None`
+    /// for a continuous cell, whose order is its token sequence, kept by its coordinator.
+    /// The operator's queue of one round as the schedule planned it.
+    pub(crate) fn plan_order(&self) -> Option<Vec<(usize, usize)>> {
+        if !self.rounds {
+            return None;
+        }
+        let mut runs: Vec<(f64, usize, usize)> = Vec::new();
+        for (i, r) in self.robots.iter().enumerate() {
+            for (k, &(start, _)) in r.runs.iter().enumerate() {
+                runs.push((r.clock.get(start).copied().unwrap_or(f64::INFINITY), i, k));
+            }
+        }
+        runs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        Some(runs.into_iter().map(|(_, i, k)| (i, k)).collect())
+    }
+
+    /// The low-confidence run (index into robot `i`'s runs, 0-based robot) that a stretch
+    /// reported at reference time `ref_time` (samples) is in: the first run ending after the
+    /// sample holding `ref_time` (a robot reported low-confidence within the clock tolerance
+    /// before its run counts as in it). `None` past the last run.
+    pub(crate) fn run_at(&self, i: usize, ref_time: f64) -> Option<usize> {
+        let n = ref_time.max(0.0).floor() as usize;
+        self.robots
+            .get(i)?
+            .runs
+            .iter()
+            .position(|&(_, end)| end > n)
+    }
+
     /// A geometry of no robot: the console of a source that could not be read (a replay
     /// whose header is corrupt) shows only its notice.
     #[must_use]

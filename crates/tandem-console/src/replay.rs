@@ -638,10 +638,20 @@ pub struct ReplayCheck {
     pub lc_differs: usize,
     /// Low-confidence stretches that started during the recording (a robot became `lc`).
     pub stretches: usize,
-    /// Of them, those the schedule gave at least `lead_s` of notice: from the start of the
-    /// stretch before (any robot's; the page's next handover is the one after the current),
-    /// the round's start or the recording's start, whichever is latest.
+    /// Of them, those the schedule gave at least `lead_s` of notice: the stretch is certain to
+    /// be the next one from the start of the stretch before it (any robot's; until that one
+    /// starts, it is the next), the round's start or the recording's start, whichever is
+    /// latest, and that moment is at least `lead_s` before it. In rounds it must also follow
+    /// the stretch that the plan's order of the round puts before it (`out_of_order`
+    /// otherwise): a stretch that the run's pace moved ahead of another was not fixed by the
+    /// schedule when the stretch before it started, so no worst-case pre-alert could name it
+    /// then. Docs: docs/formats.md, "Console recordings".
     pub allowed: usize,
+    /// Rounds: stretches whose stretch before (or the round's start, for the first) is not
+    /// the one before them in the plan's order of the round (by schedule clock): never
+    /// allowed. 0 for a continuous cell (its coordinator keeps the token order).
+    #[serde(default)]
+    pub out_of_order: usize,
     /// Of the allowed, those the page pre-alerted (the countdown naming the robot with
     /// `prealert` on, without a break until the stretch began) at least `lead_s` ahead.
     pub alerted: usize,
@@ -680,6 +690,9 @@ pub fn check_recording(rec: &Recording, lead_s: f64) -> ReplayCheck {
     let mut alert: Option<(usize, f64)> = None;
     let mut contract: Option<(usize, f64)> = None;
     let mut last_round = 0u64;
+    // Rounds: the plan's order of a round, and the run of the last stretch this round.
+    let plan = g.plan_order();
+    let mut last_run: Option<(usize, usize)> = None;
     for (k, t) in rec.ticks.iter().enumerate() {
         let t_s = t.t_s;
         let raw = t.raw(rec.tick_s);
@@ -702,13 +715,28 @@ pub fn check_recording(rec: &Recording, lead_s: f64) -> ReplayCheck {
             known_from_s = t_s;
             alert = None;
             contract = None;
+            last_run = None;
         }
         let attention = f.attention.as_ref().map(|a| a.robot);
         if let Some(r) = attention {
+            // The stretch's run, and whether the plan puts the last stretch right before it.
+            let i = r.saturating_sub(1);
+            let run = t
+                .robots
+                .get(i)
+                .and_then(|x| g.run_at(i, x.ref_time))
+                .map(|m| (i, m));
+            let in_order = plan.as_ref().is_none_or(|p| {
+                run.and_then(|x| p.iter().position(|&e| e == x))
+                    .is_some_and(|q| q.checked_sub(1).map(|q| p[q]) == last_run)
+            });
             if prev_attention != Some(r) && k > 0 {
                 c.stretches += 1;
+                if !in_order {
+                    c.out_of_order += 1;
+                }
                 let allowed_s = t_s - known_from_s;
-                if allowed_s >= lead_s - eps {
+                if in_order && allowed_s >= lead_s - eps {
                     c.allowed += 1;
                     let notice = alert.filter(|a| a.0 == r).map_or(0.0, |a| t_s - a.1);
                     if notice >= lead_s - eps {
@@ -729,6 +757,9 @@ pub fn check_recording(rec: &Recording, lead_s: f64) -> ReplayCheck {
                         Some(c.contract_min_notice_s.map_or(notice, |m| m.min(notice)));
                 }
                 known_from_s = t_s;
+            }
+            if prev_attention != Some(r) {
+                last_run = run;
             }
         }
         prev_attention = attention;

@@ -323,3 +323,70 @@ fn a_truncated_replay_plays_to_its_damage_then_says_so_on_the_page() {
     worker.join().unwrap().unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The check's "allowed" by hand (issue 42): a stretch is allowed `lead_s` of notice when it
+/// is certain to be next at least `lead_s` before it starts — from the start of the stretch
+/// before it (or the round's start) — and, in rounds, follows the stretch the plan's order
+/// puts before it. Two robots, 30 samples of 1 s, low confidence on samples 10–11, robot 2
+/// starting 10 s after robot 1: the plan's order of a round is robot 1's stretch (schedule
+/// clock 10 s), then robot 2's (20 s). Hand-written frames: round 1 runs robot 2's stretch
+/// at 10 s and robot 1's at 25 s (both out of the plan's order: not allowed, although 10 s
+/// and 15 s followed what came before); round 2 (from 30 s) robot 1's at 40 s (10 s after
+/// the round's start: allowed) and robot 2's at 45 s (5 s after robot 1's start: not).
+/// Without the order rule 3 of the 4 would count as allowed.
+#[test]
+fn allowed_counts_notice_from_when_the_plan_fixes_the_stretch() {
+    let dir = scratch("allowed");
+    let path = dir.join("hand.jsonl");
+    let conf: Vec<bool> = (0..30).map(|n| !(10..12).contains(&n)).collect();
+    let (g, lo, hi) = (vec![1.0; 30], vec![0.5; 30], vec![2.0; 30]);
+    let robots: Vec<_> = (0..2)
+        .map(|i| tandem_realtime::Timeline::new(&conf, &g, &lo, &hi, 10.0 * i as f64, 1.0).unwrap())
+        .collect();
+    let ctl = AnyController::Rounds(tandem_realtime::Coordinator::new(robots, 0.1).unwrap());
+    let rec = Recorder::create(&path, &Geometry::new(&ctl), 0.1, Some("hand-made")).unwrap();
+    drop(rec);
+    let header = std::fs::read_to_string(&path).unwrap();
+    let header = header.lines().next().unwrap();
+    // (cell time, round, robot 1's state and reference time, robot 2's).
+    let frames: [(f64, u64, &str, f64, &str, f64); 12] = [
+        (0.0, 0, "hc", 0.0, "wait", 0.0),
+        (10.0, 0, "hc", 10.0, "lc", 10.0),
+        (12.0, 0, "hc", 12.0, "hc", 12.0),
+        (25.0, 0, "lc", 10.0, "hc", 20.0),
+        (27.0, 0, "hc", 12.0, "hc", 22.0),
+        (29.0, 0, "done", 30.0, "done", 30.0),
+        (30.0, 1, "hc", 0.0, "wait", 0.0),
+        (40.0, 1, "lc", 10.2, "wait", 0.0),
+        (42.0, 1, "hc", 12.0, "hc", 2.0),
+        (45.0, 1, "hc", 15.0, "lc", 10.1),
+        (47.0, 1, "hc", 17.0, "hc", 12.0),
+        (59.0, 1, "done", 30.0, "done", 30.0),
+    ];
+    let mut text = format!("{header}\n");
+    for (k, (t_s, round, s1, r1, s2, r2)) in frames.iter().enumerate() {
+        let lc = match (*s1, *s2) {
+            ("lc", _) => "1",
+            (_, "lc") => "2",
+            _ => "null",
+        };
+        text.push_str(&format!(
+            "{{\"t_s\":{t_s},\"tick\":{k},\"rounds_done\":{round},\"fault\":false,\"robots\":[\
+             {{\"state\":\"{s1}\",\"clock_s\":0.0,\"ref_time\":{r1},\"tasks\":0}},\
+             {{\"state\":\"{s2}\",\"clock_s\":0.0,\"ref_time\":{r2},\"tasks\":0}}],\
+             \"coordinator_lc\":{lc},\"next\":null}}\n"
+        ));
+    }
+    std::fs::write(&path, text).unwrap();
+    let rec = read_recording(&path).unwrap();
+    assert!(rec.problem.is_none(), "{:?}", rec.problem);
+    let c = check_recording(&rec, 7.0);
+    assert_eq!((c.frames, c.two_lc, c.lc_differs), (12, 0, 0), "{c:?}");
+    assert_eq!((c.stretches, c.out_of_order, c.allowed), (4, 2, 1), "{c:?}");
+    // No pre-alert was recorded: the allowed one was not alerted.
+    assert_eq!(
+        (c.alerted, c.contract_alerted, c.min_notice_s),
+        (0, 0, Some(0.0))
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

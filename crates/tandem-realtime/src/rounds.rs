@@ -526,9 +526,15 @@ impl Coordinator {
                 (self.clock_s[i], self.cursors[i].at, self.clock_s[i])
             };
             let wait = self.release_wait[i];
+            // A leg not started waits for the rule clock to reach its start (rule 3).
+            let due = if self.clock_s[i] < r.start_s() {
+                self.ticks_before_leg_start(i, r.start_s())
+            } else {
+                0
+            };
             if let Some(m) = reach.next_run(c, at, touched_s, self.tol_s) {
                 let (lo, hi) = reach.to_run(c, at, s, m);
-                let earliest = wait + prealert::ticks_before_at_least(lo, h);
+                let earliest = wait.max(due) + prealert::ticks_before_at_least(lo, h);
                 let moves = (self.released[i] || wait > 0)
                     && self.clock_s[i] >= r.start_s()
                     && held != Some(i);
@@ -540,10 +546,44 @@ impl Coordinator {
             let after = self.after_fast_s[l];
             after.is_finite().then(|| {
                 let lo = reach.fast_to_end(c, at, s) + after;
-                (i, wait + prealert::ticks_before_at_least(lo, h), None)
+                let mut earliest = wait.max(due) + prealert::ticks_before_at_least(lo, h);
+                // The next leg (its run on it or a later one) waits for the rule clock too.
+                if l + 1 < self.plans.first_leg[i + 1] {
+                    let next = self.plans.legs[l + 1].start_s();
+                    earliest = earliest.max(self.ticks_before_leg_start(i, next));
+                }
+                (i, earliest, None)
             })
         });
         prealert::pick(cands, h)
+    }
+
+    /// Ticks before the tick in which robot `i`'s leg starting at schedule clock `start_s`
+    /// can start at the soonest (a lower bound; issue 42). A leg not started moves with the
+    /// rule clock of rule 3, which follows the running robot furthest behind: it reaches
+    /// `start_s` only once every robot running now (other than `i`, not held by the fault
+    /// monitor) has reached `start_s` or stopped running at its leg's end (its task's end or
+    /// a hold), whichever comes first, each at its fastest. Without this the pre-alert took
+    /// the wait for a start as 0 and named a robot whose start the schedule put far off
+    /// (the three-robot study's rounds: robot 3, starting after two more stretches, named
+    /// for 13 s while robot 1's stretch came next; 2 of 8 stretches pre-alerted < 1 s ahead).
+    /// O(N), no allocation.
+    fn ticks_before_leg_start(&self, i: usize, start_s: f64) -> u64 {
+        let held = self.monitor.held();
+        let mut ticks = 0;
+        for j in 0..self.robots.len() {
+            let r = self.cur(j);
+            let s = self.clock_s[j];
+            if j == i || held == Some(j) || !self.released[j] || s < r.start_s() || s >= r.end_s() {
+                continue;
+            }
+            let x = (start_s.min(r.end_s()) - self.tol_s).max(s);
+            let c = r.sample_clock_s();
+            let lo =
+                self.reach[self.leg[j]].fast_between(c, self.cursors[j].at, s, r.sample_at(x), x);
+            ticks = ticks.max(prealert::ticks_before_at_least(lo, self.tick_s));
+        }
+        ticks
     }
 
     fn phase(&mut self, i: usize) -> Phase {

@@ -305,3 +305,120 @@ fn a_cell_names_the_robot_the_token_passes_to_next() {
         "every robot named in turn: {named:?}"
     );
 }
+
+/// Regression (issue 42, the three-robot cell's 100 late pre-alerts): the robot named is the
+/// next TURN of the token order, not the robot whose own bound is smallest. Task of 8 samples
+/// of 1 s, `[HC, LC, HC, HC, HC, HC, LC, HC]`, bounds [½, 2], a usable hold at sample 5 (the
+/// gate of group 1; group 0's gate is the task start), tick ½ s, no switch time, three
+/// robots (0-based here) in the order `0 1 0 2 1 2`, stretches `(0,0) (1,0) (0,1) (2,0) (1,1)
+/// (2,1)`: each stretch is its own group, so this is the token sequence.
+///
+/// By hand, at the end of the tick in which robot 1 enters its second stretch (tick 21 at the
+/// scheduled pace: robot 1's clock 6.0 s): robot 2, whose turn `(2,1)` is next, is at 3.5 s
+/// on high confidence, where a cell's robot runs on plan (½ s of clock a tick): it reaches
+/// the stretch at 6 s in 5 ticks, the 5th starting 4 ticks = 2.0 s from now. Robot 0 waits at
+/// its next task's start (gate 0): its own bound is the token moving on (robot 1 may leave
+/// sample 6 within this next tick at rate 2: 0 ticks before it), one tick, then 1 s of high
+/// confidence from the gate to the stretch (2 ticks, the second starting 1 tick later):
+/// 2 ticks = 1.0 s. The old rule (the smallest earliest start) named robot 0 at 1.0 s,
+/// although its turn `(0,0)` comes after robot 2's; the rule now raises robot 0 to one tick
+/// past robot 2's earliest and names robot 2 at 2.0 s, and robot 2's stretch does start in
+/// tick 26, exactly 4 ticks after tick 21 ends. Over the whole run, during every robot's
+/// stretch the robot named is the next entry of the order.
+#[test]
+fn a_cell_names_the_next_turn_not_the_smallest_own_bound() {
+    let task = Timeline::new(
+        &[true, false, true, true, true, true, false, true],
+        &[1.0; 8],
+        &[0.5; 8],
+        &[2.0; 8],
+        0.0,
+        1.0,
+    )
+    .unwrap();
+    let order = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (2, 1)];
+    let mut cell = ContinuousCoordinator::new(task, &[5], &order, 3, 0.5)
+        .unwrap()
+        .with_switch_s(0.0)
+        .unwrap();
+    let ticks: Vec<Tick> = (0..400)
+        .map(|_| cell.tick(Operator::Scheduled).unwrap())
+        .collect();
+    let at = ticks
+        .iter()
+        .position(|t| t.low_conf[1] && t.ref_time[1] >= 6.0)
+        .unwrap();
+    assert_eq!(at, 21);
+    let t = &ticks[at];
+    assert_eq!(t.ref_time, [0.0, 6.0, 3.5]);
+    assert!(t.waiting[0]);
+    let a = t.next.unwrap();
+    assert_eq!((a.robot, a.earliest_s), (2, 2.0), "{a:?}");
+    let starts = ticks
+        .iter()
+        .position(|t| t.low_conf[2] && t.ref_time[2] >= 6.0)
+        .unwrap();
+    assert_eq!(starts, 26);
+    // Every stretch in order: during the k-th, the robot named is the (k+1)-th entry's.
+    let mut k = 0usize;
+    let mut inside = None;
+    let mut checked = 0;
+    for t in &ticks {
+        let Some(r) = (0..3).find(|&r| t.low_conf[r]) else {
+            inside = None;
+            continue;
+        };
+        if inside != Some(r) {
+            assert_eq!(r, order[k % order.len()].0, "stretch {k} out of order");
+            inside = Some(r);
+            k += 1;
+        }
+        let want = order[k % order.len()].0;
+        assert_eq!(
+            t.next.map(|a| a.robot),
+            Some(want),
+            "stretch {}: {t:?}",
+            k - 1
+        );
+        checked += 1;
+    }
+    assert!(k >= 24 && checked >= 48, "{k} stretches, {checked} ticks");
+}
+
+/// Regression (issue 42, the three-robot study's rounds: 3 of 8 stretches pre-alerted under
+/// 1 s ahead): a robot waiting for its start (rule 3: it follows the running robot furthest
+/// behind) cannot start before every running robot has reached its start or stopped. Two
+/// robots of 30 samples of 1 s, rates [½, 2]; robot 1 (0-based 0) starts at 0 and is
+/// low-confidence on samples 20–21, robot 2 (0-based 1) starts at 40 and is low-confidence
+/// on its first samples 0–1; tick ½ s. Robot 2 can start only once robot 1 has finished
+/// (30 s of clock, at least 15 s at rate 2), so robot 1's stretch (20 s of clock, at least
+/// 10 s: named at 9.5 s, the tick rounding) is next. The old rule took the wait for a start as 0 and named robot 2 at 0 s.
+#[test]
+fn rounds_do_not_name_a_robot_whose_start_is_far_off() {
+    let conf0: Vec<bool> = (0..30).map(|n| !(20..22).contains(&n)).collect();
+    let conf1: Vec<bool> = (0..30).map(|n| n >= 2).collect();
+    let (g, lo, hi) = (vec![1.0; 30], vec![0.5; 30], vec![2.0; 30]);
+    let robots = vec![
+        Timeline::new(&conf0, &g, &lo, &hi, 0.0, 1.0).unwrap(),
+        Timeline::new(&conf1, &g, &lo, &hi, 40.0, 1.0).unwrap(),
+    ];
+    let mut c = tandem_realtime::Coordinator::new(robots, 0.5).unwrap();
+    let t = c.tick(Operator::Scheduled).unwrap();
+    let a = t.next.unwrap();
+    // 20 s of clock at rate 2 take 10 s: the tick that reaches the stretch is the 20th,
+    // starting 19 ticks = 9.5 s from now.
+    assert_eq!((a.robot, a.earliest_s), (0, 9.5), "{a:?}");
+    let mut first = [None; 2];
+    for k in 1..400u32 {
+        let t = c.tick(Operator::Fastest).unwrap();
+        for (r, f) in first.iter_mut().enumerate() {
+            if t.low_conf[r] && f.is_none() {
+                *f = Some(k);
+            }
+        }
+        if let (Some(a), None) = (t.next, first[0]) {
+            assert_eq!(a.robot, 0, "tick {k}: {a:?}");
+        }
+    }
+    assert!(first[0].unwrap() < first[1].unwrap(), "{first:?}");
+}
