@@ -367,8 +367,9 @@ pub struct Frame {
     pub attention: Option<Attention>,
     /// The next handover, the coordinator's pre-alert ([`next_handover`]), if it announces one.
     pub next: Option<NextHandover>,
-    /// Whether the next handover can start within `lead_s` (`next.in_s ≤ lead_s`: the
-    /// pre-alert).
+    /// Whether the next handover can start within `lead_s` by the page's next frame
+    /// ([`prealert_on`]: `next.in_s ≤ lead_s + tick_s + 1/RECORDING_HZ`, so that the alert,
+    /// raised at a frame, is up at least `lead_s` before a start at the worst-case earliest).
     pub prealert: bool,
     /// The pre-alert's lead (real s).
     pub lead_s: f64,
@@ -751,8 +752,18 @@ pub fn next_handover(geometry: &Geometry, raw: &RawFrame) -> Option<NextHandover
     })
 }
 
-/// The page's frame of `raw` (server side; allocates).
-#[must_use]
+/// Whether a handover that can start in `in_s` real seconds at the earliest is pre-alerted
+/// with lead `lead_s` at a control tick `tick_s` long (all real s): when `in_s ≤ lead_s +
+/// tick_s + 1/RECORDING_HZ`. The alert can only rise at a frame the page (or a recording)
+/// shows, and those come at most one page frame plus one tick apart (a frame per
+/// `1/RECORDING_HZ` s, on the tick grid); raised when the notice left is within that spacing
+/// of the lead, it errs early by at most that spacing, and a stretch that starts at its
+/// earliest has had at least `lead_s` of notice on every frame the page shows (the rounding
+/// the other way would give down to `lead_s − tick_s − 1/RECORDING_HZ`).
+pub(crate) fn prealert_on(in_s: f64, lead_s: f64, tick_s: f64) -> bool {
+    in_s <= lead_s + tick_s.max(0.0) + 1.0 / crate::RECORDING_HZ
+}
+
 pub fn build_frame(geometry: &Geometry, raw: &RawFrame) -> Frame {
     let n_ref = geometry
         .robots
@@ -793,7 +804,9 @@ pub fn build_frame(geometry: &Geometry, raw: &RawFrame) -> Frame {
         fault: raw.fault,
         robots,
         attention: geometry.attention(raw),
-        prealert: next.as_ref().is_some_and(|n| n.in_s <= geometry.lead_s),
+        prealert: next
+            .as_ref()
+            .is_some_and(|n| prealert_on(n.in_s, geometry.lead_s, raw.tick_s)),
         next,
         lead_s: geometry.lead_s,
         stretches: geometry.stretches(raw),
@@ -928,6 +941,13 @@ mod tests {
         );
         assert_eq!(f.attention.as_ref().unwrap().robot, 1);
         assert!(f.prealert, "robot 2 in {} s ≤ 7 s", next.in_s);
+        // Raised one tick early: at the last tick before the notice falls to the lead.
+        // Raised early by one tick and one page frame (1/30 s): the notice on the first frame
+        // that shows it is never below the lead.
+        let early = 0.01 + 1.0 / 30.0;
+        assert!(prealert_on(7.0 + early - 1e-9, 7.0, 0.01));
+        assert!(!prealert_on(7.0 + early + 1e-9, 7.0, 0.01));
+        assert!(prealert_on(6.0, 7.0, 0.01));
         assert_eq!(f.stretches[0].robot, 1);
         assert_eq!(f.stretches[0].start_s, 0.0);
         assert_eq!(f.stretches.len(), 3, "{:?}", f.stretches);

@@ -775,7 +775,7 @@ pub fn check_recording(rec: &Recording, lead_s: f64) -> ReplayCheck {
         );
         contract = on(
             t.next
-                .filter(|p| p.earliest_s <= lead_s + eps)
+                .filter(|p| crate::frame::prealert_on(p.earliest_s, lead_s, rec.tick_s))
                 .map(|p| p.robot),
             contract,
         );
