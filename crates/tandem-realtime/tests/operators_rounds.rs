@@ -327,7 +327,8 @@ fn holds_with_several_operators_are_refused() {
 }
 
 /// The earliest starts a greedy scheduler finds: robot 0 at 0, each later robot at the first
-/// of 49 offsets `E·k/48` (`E` the latest end of the robots before it) that `check` accepts
+/// of the offsets `E·k/48`, `k = 0..=144` (`E` the latest end of the robots before it: up to
+/// three times the serial start) that `check` accepts
 /// with the robots placed so far; `None` if none is. The makespan is the latest end.
 fn greedy_makespan(
     case: &Case,
@@ -345,7 +346,7 @@ fn greedy_makespan(
     let mut starts = vec![0.0];
     for _ in 1..plans.len() {
         let end = at(&starts).iter().map(Timeline::end_s).fold(0.0, f64::max);
-        let tau = (0..=48).map(|k| end * k as f64 / 48.0).find(|&t| {
+        let tau = (0..=144).map(|k| end * k as f64 / 48.0).find(|&t| {
             starts.push(t);
             let ok = check(&at(&starts), case.tick_s);
             starts.pop();
