@@ -9,10 +9,11 @@ use crate::contract::{Operator, Tick};
 use crate::cursor::{Cursors, operator_step};
 use crate::error::{Error, Result};
 use crate::holds::{Hold, Plans};
+use crate::margins::operators::OperatorPlan;
 use crate::monitor::Fault;
 use crate::monitor::Monitor;
 use crate::prealert::{self, Reach};
-use crate::robots::{MAX_ROBOTS, PerRobot, RobotFlags, check_count};
+use crate::robots::{MAX_ROBOTS, OperatorCount, PerRobot, RobotFlags, check_count};
 use crate::strategy::{Member, Mode, advance, first_waiting_start};
 use crate::timeline::Timeline;
 use crate::tol::clock_tolerance_s;
@@ -104,6 +105,9 @@ pub struct Coordinator {
     /// Per leg, the least real time (s) from its end to the tick that reaches the first
     /// low-confidence run of its robot's later legs (`+∞`: none).
     after_fast_s: Arc<[f64]>,
+    /// `M > 1` operators: the operator of every low-confidence run
+    /// ([`crate::margins::operators`]); `None`: one operator, today's coordinator.
+    operators: Option<Arc<OperatorPlan>>,
 }
 
 impl Coordinator {
@@ -195,6 +199,7 @@ impl Coordinator {
             release_wait: [0; MAX_ROBOTS],
             reach: reach.into(),
             after_fast_s: after_fast_s.into(),
+            operators: None,
         };
         c.reset();
         Ok(c)
@@ -240,8 +245,79 @@ impl Coordinator {
     /// [`Error::BadParam`] for a `switch_s` not finite and ≥ 0 or of more than 1e8 ticks.
     pub fn with_switch_s(mut self, switch_s: f64) -> Result<Coordinator> {
         self.switch_ticks = crate::switch_ticks(switch_s, self.tick_s)?;
+        if let Some(p) = &self.operators {
+            let m = OperatorCount::new(p.operators())?;
+            self = self.with_operators(m)?;
+        }
         self.reset();
         Ok(self)
+    }
+
+    /// The same round run by `operators` = `M` operators, reset to the start (issue 44): every
+    /// low-confidence run of every robot is assigned to one operator by
+    /// [`assign_operators`](crate::margins::operators::assign_operators) at this coordinator's
+    /// tick and switch time, which proves that no admissible inputs make more than `M` robots
+    /// low-confidence in one tick, an operator supervise two robots at once, or a stretch
+    /// change operator; [`tick_many`](Coordinator::tick_many) then takes one input per operator
+    /// and [`Tick::operator`] reports the assignment. The fault monitor latches at more than
+    /// `M`. `M = 1` returns the coordinator unchanged (today's check and rules, bit for bit).
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] (`operators`) for plans with holds (the hold rules of `M > 1`
+    /// operators are not built); [`Error::Unsafe`] when the assignment needs more than `M`
+    /// operators; those of [`assign_operators`](crate::margins::operators::assign_operators).
+    pub fn with_operators(mut self, operators: OperatorCount) -> Result<Coordinator> {
+        if operators.get() == 1 {
+            self.operators = None;
+            self.monitor = Monitor::new(self.robots.len());
+            self.reset();
+            return Ok(self);
+        }
+        if self.plans.has_holds() {
+            return Err(Error::BadParam {
+                name: "operators",
+                why: "is more than 1 with hold points: rounds with holds run one operator; drop \
+                      the holds or set operators to 1",
+            });
+        }
+        let plan = crate::margins::operators::assign_operators(
+            &self.robots,
+            self.tick_s,
+            operators,
+            self.switch_ticks,
+        )?
+        .ok_or(Error::Unsafe {
+            tick_s: self.tick_s,
+        })?;
+        self.operators = Some(Arc::new(plan));
+        self.monitor = Monitor::new(self.robots.len()).with_operators(operators.get());
+        self.reset();
+        Ok(self)
+    }
+
+    /// `M`, the number of operators ([`Coordinator::with_operators`]; 1 by default).
+    pub fn operators(&self) -> usize {
+        self.operators.as_ref().map_or(1, |p| p.operators())
+    }
+
+    /// The operators' assignment of `M > 1` operators ([`Coordinator::with_operators`]);
+    /// `None` with one operator.
+    pub fn operator_plan(&self) -> Option<&OperatorPlan> {
+        self.operators.as_deref()
+    }
+
+    /// The operator each robot low-confidence now is assigned to ([`Tick::operator`]): the
+    /// operator of the run its sample belongs to; `Some(0)` for each with one operator. O(N).
+    pub fn operator_now(&self) -> PerRobot<Option<u8>> {
+        let lc = self.low_conf_now();
+        let Some(p) = &self.operators else {
+            return crate::contract::one_operator(&lc);
+        };
+        let mut out = PerRobot::new(self.robots.len());
+        for (i, o) in out.as_mut_slice().iter_mut().enumerate() {
+            *o = lc[i].then(|| p.operator_from(i, self.cursors[i].at));
+        }
+        out
     }
 
     /// `k`: the switch time in whole ticks this coordinator waits at a hold with release
@@ -608,7 +684,45 @@ impl Coordinator {
     /// [`Error::BadOperator`] for an [`Operator::Gradient`] that is NaN, infinite or ≤ 0;
     /// the coordinator is then unchanged.
     pub fn tick(&mut self, operator: Operator) -> Result<Tick> {
+        if self.operators.is_some() {
+            return Err(Error::OperatorInputs {
+                got: 1,
+                want: self.operators(),
+            });
+        }
         let g = operator.validate()?;
+        self.step(&[g])
+    }
+
+    /// Advances one control period with one input per operator: `inputs[o]` sets the timing
+    /// of the low-confidence robot operator `o` is assigned to ([`Tick::operator`]; ignored
+    /// when it has none). With one operator, [`tick`](Coordinator::tick). Never allocates;
+    /// O(N).
+    ///
+    /// # Errors
+    /// [`Error::OperatorInputs`] unless `inputs.len() == M`; [`Error::BadOperator`] for an
+    /// inadmissible gradient; the coordinator is then unchanged.
+    pub fn tick_many(&mut self, inputs: &[Operator]) -> Result<Tick> {
+        if inputs.len() != self.operators() {
+            return Err(Error::OperatorInputs {
+                got: inputs.len(),
+                want: self.operators(),
+            });
+        }
+        if self.operators.is_none() {
+            return self.tick(inputs[0]);
+        }
+        let mut ops = [Operator::Scheduled; MAX_ROBOTS];
+        for (o, op) in ops.iter_mut().zip(inputs) {
+            *o = op.validate()?;
+        }
+        self.step(&ops[..inputs.len()])
+    }
+
+    /// One tick with the validated inputs `ops` (one per operator).
+    fn step(&mut self, ops: &[Operator]) -> Result<Tick> {
+        let g = ops[0];
+        let plan = self.operators.clone();
         let n = self.robots.len();
         // The invariant "a robot never moves backwards", checked in debug builds: every
         // robot's reference time and reported clock at the tick end are at least those at
@@ -630,6 +744,10 @@ impl Coordinator {
                 Phase::Waiting => Member::idle(s, Mode::Waiting),
                 Phase::Finished => Member::idle(s, Mode::Finished),
                 Phase::Active { low_conf: true } => {
+                    let g = match &plan {
+                        None => g,
+                        Some(p) => ops[usize::from(p.operator_from(i, self.cursors[i].at))],
+                    };
                     next_s[i] = s + operator_step(self.cur(i), self.cursors[i].at, g, self.tick_s);
                     pace_robot.get_or_insert(i);
                     Member::idle(s, Mode::Low)
@@ -700,6 +818,13 @@ impl Coordinator {
                 let lo = r.advance_cursor(&mut cur.lo, s_old - self.tol_s);
                 let hi = r.advance_cursor(&mut cur.hi, s_new + self.tol_s);
                 out.low_conf.set(i, r.any_low_conf(lo, hi));
+                if let Some(p) = &plan
+                    && out.low_conf[i]
+                {
+                    // The first run the traversed samples touch: a run touched with the next
+                    // in one tick shares its window, hence its operator.
+                    out.operator.as_mut_slice()[i] = Some(p.operator_from(i, lo));
+                }
             }
             r.advance_cursor(&mut self.cursors[i].at, s_new);
             if has_holds && s_new >= r.end_s() && self.leg[i] + 1 < self.plans.first_leg[i + 1] {
@@ -737,7 +862,9 @@ impl Coordinator {
             out.waiting.set(i, self.at_hold(i));
         }
         out.next = self.pre_alert();
-        out.operator = crate::contract::one_operator(&out.low_conf);
+        if plan.is_none() {
+            out.operator = crate::contract::one_operator(&out.low_conf);
+        }
         out.fault = self.monitor.observe(out.low_conf);
         Ok(out)
     }
@@ -786,6 +913,18 @@ impl Controller for Coordinator {
 
     fn tick(&mut self, operator: Operator) -> Result<Tick> {
         Coordinator::tick(self, operator)
+    }
+
+    fn operators(&self) -> usize {
+        Coordinator::operators(self)
+    }
+
+    fn tick_many(&mut self, inputs: &[Operator]) -> Result<Tick> {
+        Coordinator::tick_many(self, inputs)
+    }
+
+    fn operator_now(&self) -> PerRobot<Option<u8>> {
+        Coordinator::operator_now(self)
     }
 
     fn reset(&mut self) {
@@ -837,6 +976,10 @@ impl Controller for Coordinator {
     }
 
     fn beam_search(&self, width: u32, max_ticks: u64) -> Option<Result<AdversaryRun>> {
+        // The search drives one operator's input; a round of `M > 1` operators has none.
+        if self.operators.is_some() {
+            return None;
+        }
         Some(crate::adversary::search::beam_search(
             self.clone(),
             width as usize,

@@ -188,6 +188,7 @@
 //! check itself as the only owner of the worst case.
 
 mod lead;
+pub mod operators;
 mod sim;
 mod window;
 
