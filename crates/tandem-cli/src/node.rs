@@ -47,6 +47,12 @@ pub(crate) struct NodeArgs {
     /// The pose's frame (`header.frame_id`).
     #[arg(long, value_name = "FRAME", default_value = "world")]
     pub(crate) frame_id: String,
+    /// The nice value (−20…19, lower runs first) the node's tick and DDS threads ask for, so a
+    /// loaded machine runs them first; 0 leaves them at the process's. A process not allowed to
+    /// raise its priority (not root, no CAP_SYS_NICE) runs them at its own: the start says
+    /// which applied.
+    #[arg(long, value_name = "N", default_value_t = -10, allow_negative_numbers = true)]
+    pub(crate) nice: i32,
     /// Stop cleanly (the threads joined, the counters printed) when standard input closes: a
     /// supervisor's or a script's way to end the node. Off by default (a node started with
     /// its input at /dev/null would stop at once).
@@ -82,6 +88,7 @@ pub(crate) fn node(a: &NodeArgs) -> Result<()> {
             ),
         },
         frame_id: a.frame_id.clone(),
+        nice: a.nice,
         ..NodeParams::default()
     };
     if let Some(s) = a.seconds {
@@ -113,6 +120,11 @@ pub(crate) fn node(a: &NodeArgs) -> Result<()> {
         node.tick_s(),
         a.domain,
         node.n_robots()
+    ));
+    let s = node.stats();
+    out(&format!(
+        "priority: tick thread at {}, DDS thread at {}",
+        s.tick_priority, s.dds_priority
     ));
     let pose = node.pose_channels();
     if pose.is_empty() {

@@ -109,6 +109,13 @@ fn a_node_process_runs_a_round_records_it_and_stops_when_stdin_closes() {
         .collect();
     assert!(status.success(), "exit {status:?}; stdout {lines:?}");
     assert!(lines[0].starts_with("tandem node: 2 robots"), "{lines:?}");
+    // The threads' priority, raised or (a process not allowed to) refused, is said at the start.
+    let priority = &lines[1];
+    assert!(
+        priority.starts_with("priority: tick thread at ")
+            && priority.matches("nice -10").count() == 2,
+        "{lines:?}"
+    );
     assert!(
         lines.iter().any(|l| l.starts_with("stopped: ")),
         "{lines:?}"
@@ -274,5 +281,20 @@ fn bad_input_exits_2_naming_the_problem() {
     let err = String::from_utf8_lossy(&out.stderr);
     // The small task's channels are x and force: `y` is the first name it lacks.
     assert!(err.contains("`y`") && err.contains("x,force"), "{err}");
+
+    let out = tandem([
+        "node",
+        state.to_str().unwrap(),
+        "--domain",
+        "97",
+        "--nice",
+        "-25",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("nice") && err.contains("is -25") && err.contains("−20…19"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -8,14 +8,22 @@
 //! topics at a 1 kHz tick; `with_queues_state_every_tick`: every tick, the 10 ms tick's case).
 //! The DDS side's ends (three progress reports, the command popped, the snapshot taken) run
 //! in the same loop here and are counted. `advance_only` is `CellLoop::advance` alone (a fixed
-//! instant, no links): the loop's own share of the difference. Run with `cargo bench -p tandem-ros2 --bench tick`.
+//! instant, no links): the loop's own share of the difference. `tick_thread_only` is
+//! `with_queues` with the DDS side's ends run between timed batches of 64 ticks (in the node they
+//! run on the DDS thread): the tick thread's own share. `node_threads` is the node's pair of
+//! threads: the tick thread's work as in `with_queues` plus the wake of the DDS side
+//! (`Thread::unpark`), which runs on a thread of its own that parks when idle, drains the ring
+//! and hears the three robots after each wake, as the node's DDS thread does; the time is the
+//! tick thread's. Run with `cargo bench -p tandem-ros2 --bench tick`.
 #![expect(
     missing_docs,
     reason = "criterion_group! generates an undocumented pub fn"
 )]
 
 use std::hint::black_box;
-use std::time::Instant;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use tandem_console::{Console, ConsoleConfig, Geometry};
@@ -84,7 +92,20 @@ impl NodeTick {
         if self.i.is_multiple_of(self.ask_every) {
             self.state.ask();
         }
-        // The tick thread.
+        let now = self.tick_thread(console);
+        // The DDS side takes the command and the snapshot.
+        black_box(now);
+        let c = self.ring.pop().map(|(c, at)| (c.ref_time[0], at));
+        let s = if self.i.is_multiple_of(self.ask_every) {
+            self.state.take().map(|s| s.ref_time[1])
+        } else {
+            None
+        };
+        c.map(|(r, _)| r).or(s)
+    }
+
+    /// The tick thread's part of one tick (as `Ticker::run`); returns the tick's instant.
+    fn tick_thread(&mut self, console: Option<&mut ConsoleFeed>) -> Instant {
         let now = Instant::now();
         if self.pending.moved(&mut self.pending_seen) {
             unreachable!("nothing is queued in this benchmark");
@@ -101,7 +122,7 @@ impl NodeTick {
         if let Some(feed) = console {
             feed.publish(&self.l);
         }
-        self.ring.push(&cmd);
+        self.ring.push(&cmd, now);
         let flags = (cmd.fault, cmd.finished, cmd.active);
         if flags != self.last_flags || self.owed || self.state.wanted() {
             self.owed = !self.state.put(self.l.snapshot());
@@ -110,14 +131,114 @@ impl NodeTick {
         if cmd.finished {
             start(&mut self.l);
         }
-        // The DDS side takes the command and the snapshot.
-        let c = self.ring.pop().map(|c| c.ref_time[0]);
-        let s = if self.i.is_multiple_of(self.ask_every) {
-            self.state.take().map(|s| s.ref_time[1])
-        } else {
-            None
+        now
+    }
+}
+
+/// The node's pair of threads: this (the tick thread's side) and a DDS side on its own thread
+/// that parks when idle and, after each wake, drains the ring, takes an asked snapshot and hears
+/// the three robots.
+struct Threads {
+    node: NodeTick,
+    links: Arc<SharedLinks>,
+    writer: std::thread::JoinHandle<u64>,
+    stop: Arc<AtomicBool>,
+}
+
+struct SharedLinks {
+    ring: CommandRing,
+    heard: Heard,
+    state: StateSlot,
+}
+
+impl Threads {
+    fn new(planner: &Planner) -> Threads {
+        let mut node = NodeTick::new(planner, 10);
+        // The DDS side's thread may be starved for longer than the default 0.25 s on a loaded
+        // machine: a latched stall would hold the loop and time a tick that does not tick.
+        let params = LoopParams {
+            stall_s: 3600.0,
+            ..LoopParams::default()
         };
-        c.or(s)
+        let ctl = planner.controller(Cell::Rounds).expect("a plan");
+        node.l = CellLoop::new(ctl, planner.model(), params).expect("valid");
+        start(&mut node.l);
+        let links = Arc::new(SharedLinks {
+            ring: CommandRing::new(3, 4096),
+            heard: Heard::default(),
+            state: StateSlot::new(),
+        });
+        let stop = Arc::new(AtomicBool::new(false));
+        let (l, st) = (links.clone(), stop.clone());
+        let writer = std::thread::spawn(move || {
+            let mut taken = 0_u64;
+            let mut asked = Instant::now();
+            while !st.load(Ordering::Relaxed) {
+                let mut busy = false;
+                while let Some((c, _)) = l.ring.pop() {
+                    black_box(c);
+                    taken += 1;
+                    busy = true;
+                }
+                if asked.elapsed() >= Duration::from_millis(1) {
+                    l.state.ask();
+                    asked = Instant::now();
+                }
+                if l.state.take().is_some() {
+                    busy = true;
+                }
+                if busy {
+                    for k in 0..3 {
+                        l.heard.hear(k);
+                    }
+                } else {
+                    std::thread::park_timeout(Duration::from_micros(200));
+                }
+            }
+            taken
+        });
+        Threads {
+            node,
+            links,
+            writer,
+            stop,
+        }
+    }
+
+    /// One tick of the tick thread against the shared links, and the wake.
+    fn tick(&mut self) -> u64 {
+        let n = &mut self.node;
+        let l = &*self.links;
+        let now = Instant::now();
+        if n.pending.moved(&mut n.pending_seen) {
+            unreachable!("nothing is queued in this benchmark");
+        }
+        let heard = l.heard.changed(3, &mut n.heard_seen);
+        if heard.count() > 0 {
+            for k in 0..3 {
+                if heard[k] {
+                    n.l.heard(k, now);
+                }
+            }
+        }
+        let cmd = n.l.advance(now).expect("a valid operator");
+        l.ring.push(&cmd, now);
+        let flags = (cmd.fault, cmd.finished, cmd.active);
+        if flags != n.last_flags || n.owed || l.state.wanted() {
+            n.owed = !l.state.put(n.l.snapshot());
+        }
+        n.last_flags = flags;
+        if cmd.finished {
+            start(&mut n.l);
+        }
+        self.writer.thread().unpark();
+        cmd.tick
+    }
+
+    fn finish(self) -> u64 {
+        self.stop.store(true, Ordering::Relaxed);
+        self.writer.thread().unpark();
+        self.writer.join().expect("the writer thread")
     }
 }
 
@@ -150,7 +271,8 @@ fn bench(c: &mut Criterion) {
     // counters heard and compared, the ring's push and pop, the slot asked every 10th tick,
     // written and taken.
     let mut node = NodeTick::new(&planner, 10);
-    let fixed = node.l.advance(Instant::now()).expect("a valid operator");
+    let now_fixed = Instant::now();
+    let fixed = node.l.advance(now_fixed).expect("a valid operator");
     let snap = node.l.snapshot();
     group.bench_function("links_only", |b| {
         b.iter(|| {
@@ -162,11 +284,11 @@ fn bench(c: &mut Criterion) {
                 node.state.ask();
             }
             let heard = node.heard.changed(3, &mut node.heard_seen);
-            node.ring.push(black_box(&fixed));
+            node.ring.push(black_box(&fixed), now_fixed);
             if node.state.wanted() {
                 node.state.put(snap);
             }
-            let c = node.ring.pop().map(|c| c.ref_time[0]);
+            let c = node.ring.pop().map(|(c, _)| c.ref_time[0]);
             let s = if node.i.is_multiple_of(10) {
                 node.state.take().map(|s| s.ref_time[1])
             } else {
@@ -195,6 +317,43 @@ fn bench(c: &mut Criterion) {
     group.bench_function("with_queues", |b| {
         b.iter(|| black_box(node.tick(None)));
     });
+    // The tick thread's share alone: the DDS side's ends between timed batches of 64 ticks (the
+    // ring holds 4,096); the robots are heard once a batch (the tick's store of their instants,
+    // three words, runs once a batch instead of every tick).
+    let mut node = NodeTick::new(&planner, 10);
+    group.bench_function("tick_thread_only", |b| {
+        b.iter_custom(|iters| {
+            let mut spent = Duration::ZERO;
+            let mut left = iters;
+            while left > 0 {
+                let batch = left.min(64);
+                for k in 0..3 {
+                    node.heard.hear(k);
+                }
+                let t0 = Instant::now();
+                for _ in 0..batch {
+                    node.i += 1;
+                    if node.i.is_multiple_of(node.ask_every) {
+                        node.state.ask();
+                    }
+                    black_box(node.tick_thread(None));
+                }
+                spent += t0.elapsed();
+                while let Some(c) = node.ring.pop() {
+                    black_box(c);
+                }
+                black_box(node.state.take());
+                left -= batch;
+            }
+            spent
+        });
+    });
+    // The node's two threads, the DDS side woken each tick.
+    let mut threads = Threads::new(&planner);
+    group.bench_function("node_threads", |b| {
+        b.iter(|| black_box(threads.tick()));
+    });
+    black_box(threads.finish());
     let mut node = NodeTick::new(&planner, 1);
     group.bench_function("with_queues_state_every_tick", |b| {
         b.iter(|| black_box(node.tick(None)));

@@ -26,6 +26,6 @@ pub use crate::core::{
 };
 pub use console::{ConsoleFeed, FINISHED_NOTICE, IDLE_NOTICE};
 pub use error::{Error, Result};
-pub use node::{Node, NodeParams, NodeStats};
+pub use node::{Node, NodeParams, NodeStats, Priority, set_thread_nice};
 pub use pose::{PoseChannels, PoseMap};
 pub use probe::Probe;

@@ -6,29 +6,35 @@
 //! Safe code only: every shared word is an atomic. The tick thread never waits on any of them
 //! (a full ring drops the record and counts it; a slot the reader holds is written at the next
 //! tick). Issue 43: "the tick's own cost with the node's queues attached against without"
-//! (docs/decisions.md, "The node's tick at the cost of a bare tick (issue 43)").
+//! (docs/decisions.md, "The node's tick: a command ring, a snapshot when asked, golden bytes and
+//! the pose (issue 43)").
 
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
 use tandem_realtime::{MAX_ROBOTS, PerRobot, RobotFlags};
 
 use crate::core::{Command, Snapshot};
 
-/// Words of one command record for `n` robots: the tick, the flags, then each robot's
-/// reference time and speed scale (`f64` bits).
+/// Words of one command record for `n` robots: the tick, the flags, the tick's start (ns after
+/// the ring's creation), then each robot's reference time and speed scale (`f64` bits).
 const fn record_words(n: usize) -> usize {
-    2 + 2 * n
+    3 + 2 * n
 }
 
 /// A bounded single-producer single-consumer ring of [`Command`]s: the tick thread pushes one
 /// per tick ([`CommandRing::push`], wait-free, no allocation), the DDS thread drains them
 /// ([`CommandRing::pop`]). The producer publishes a record by a release store of its count
 /// after writing its words; the consumer frees a slot by a release store of its own count
-/// after reading them, so neither ever reads a half-written record.
+/// after reading them, so neither ever reads a half-written record. Each record carries the
+/// instant its tick started, so the DDS thread stamps a command with its tick's time, not with
+/// the time it got round to publishing it.
 #[derive(Debug)]
 pub struct CommandRing {
     n: usize,
+    /// The instant the records' times count from.
+    base: Instant,
     capacity: u64,
     words: Box<[AtomicU64]>,
     /// Records pushed so far (written by the producer only).
@@ -47,6 +53,7 @@ impl CommandRing {
         let capacity = capacity.max(1);
         CommandRing {
             n,
+            base: Instant::now(),
             capacity: capacity as u64,
             words: (0..capacity * record_words(n))
                 .map(|_| AtomicU64::new(0))
@@ -63,8 +70,9 @@ impl CommandRing {
         &self.words[at..at + w]
     }
 
-    /// Pushes `cmd` (the producer, one thread); `false` (and counted) when the ring is full.
-    pub fn push(&self, cmd: &Command) -> bool {
+    /// Pushes `cmd` of the tick that started at `at` (the producer, one thread); `false` (and
+    /// counted) when the ring is full.
+    pub fn push(&self, cmd: &Command, at: Instant) -> bool {
         let h = self.head.load(Ordering::Relaxed);
         if h - self.tail.load(Ordering::Acquire) >= self.capacity {
             self.dropped.fetch_add(1, Ordering::Relaxed);
@@ -73,16 +81,20 @@ impl CommandRing {
         let r = self.record(h);
         r[0].store(cmd.tick, Ordering::Relaxed);
         r[1].store(cmd.flags_word(), Ordering::Relaxed);
+        // Nanoseconds fit a u64 for 584 years.
+        let since = at.saturating_duration_since(self.base).as_nanos() as u64;
+        r[2].store(since, Ordering::Relaxed);
         for k in 0..self.n.min(cmd.ref_time.len()) {
-            r[2 + 2 * k].store(cmd.ref_time[k].to_bits(), Ordering::Relaxed);
-            r[3 + 2 * k].store(cmd.speed[k].to_bits(), Ordering::Relaxed);
+            r[3 + 2 * k].store(cmd.ref_time[k].to_bits(), Ordering::Relaxed);
+            r[4 + 2 * k].store(cmd.speed[k].to_bits(), Ordering::Relaxed);
         }
         self.head.store(h + 1, Ordering::Release);
         true
     }
 
-    /// Pops the oldest command (the consumer, one thread), or `None` when the ring is empty.
-    pub fn pop(&self) -> Option<Command> {
+    /// Pops the oldest command and the instant its tick started (the consumer, one thread), or
+    /// `None` when the ring is empty.
+    pub fn pop(&self) -> Option<(Command, Instant)> {
         let t = self.tail.load(Ordering::Relaxed);
         if t == self.head.load(Ordering::Acquire) {
             return None;
@@ -91,9 +103,10 @@ impl CommandRing {
         let mut ref_time = PerRobot::<f64>::new(self.n);
         let mut speed = PerRobot::<f64>::new(self.n);
         for k in 0..self.n {
-            ref_time.as_mut_slice()[k] = f64::from_bits(r[2 + 2 * k].load(Ordering::Relaxed));
-            speed.as_mut_slice()[k] = f64::from_bits(r[3 + 2 * k].load(Ordering::Relaxed));
+            ref_time.as_mut_slice()[k] = f64::from_bits(r[3 + 2 * k].load(Ordering::Relaxed));
+            speed.as_mut_slice()[k] = f64::from_bits(r[4 + 2 * k].load(Ordering::Relaxed));
         }
+        let at = self.base + Duration::from_nanos(r[2].load(Ordering::Relaxed));
         let cmd = Command::from_words(
             r[0].load(Ordering::Relaxed),
             r[1].load(Ordering::Relaxed),
@@ -101,7 +114,7 @@ impl CommandRing {
             speed,
         );
         self.tail.store(t + 1, Ordering::Release);
-        Some(cmd)
+        Some((cmd, at))
     }
 
     /// Records dropped because the ring was full (the DDS thread behind by `capacity` ticks).
@@ -256,30 +269,38 @@ mod tests {
     fn the_ring_round_trips_in_order_and_drops_when_full() {
         let ring = CommandRing::new(3, 4);
         assert!(ring.pop().is_none());
+        // Each tick 1.5 ms after the ring's creation times its number; nanoseconds exact.
+        let at = |t: u64| ring.base + Duration::from_micros(1_500 * t);
         for t in 1..=4 {
-            assert!(ring.push(&cmd(t, 3)));
+            assert!(ring.push(&cmd(t, 3), at(t)));
         }
-        assert!(!ring.push(&cmd(5, 3)), "a full ring refuses");
+        assert!(!ring.push(&cmd(5, 3), at(5)), "a full ring refuses");
         assert_eq!(ring.dropped(), 1);
         for t in 1..=2 {
-            assert_eq!(ring.pop(), Some(cmd(t, 3)));
+            assert_eq!(ring.pop(), Some((cmd(t, 3), at(t))));
         }
         // Wraps around.
         for t in 6..=7 {
-            assert!(ring.push(&cmd(t, 3)));
+            assert!(ring.push(&cmd(t, 3), at(t)));
         }
-        let got: Vec<u64> = std::iter::from_fn(|| ring.pop()).map(|c| c.tick).collect();
-        assert_eq!(got, [3, 4, 6, 7]);
+        let got: Vec<(u64, Instant)> = std::iter::from_fn(|| ring.pop())
+            .map(|(c, i)| (c.tick, i))
+            .collect();
+        assert_eq!(got, [3, 4, 6, 7].map(|t| (t, at(t))));
+        // An instant before the ring existed is its creation.
+        assert!(ring.push(&cmd(8, 3), ring.base - Duration::from_millis(1)));
+        assert_eq!(ring.pop().map(|(_, i)| i), Some(ring.base));
     }
 
     #[test]
     fn the_ring_between_two_threads_keeps_every_record_whole() {
         let ring = std::sync::Arc::new(CommandRing::new(8, 16));
         let r = ring.clone();
+        let base = ring.base;
         let producer = std::thread::spawn(move || {
             let mut t = 1;
             while t <= 3_000 {
-                if r.push(&cmd(t, 8)) {
+                if r.push(&cmd(t, 8), base + Duration::from_nanos(t)) {
                     t += 1;
                 }
             }
@@ -287,7 +308,11 @@ mod tests {
         let mut next = 1;
         while next <= 3_000 {
             if let Some(c) = ring.pop() {
-                assert_eq!(c, cmd(next, 8), "record {next} torn or out of order");
+                assert_eq!(
+                    c,
+                    (cmd(next, 8), base + Duration::from_nanos(next)),
+                    "record {next} torn or out of order"
+                );
                 next += 1;
             }
         }

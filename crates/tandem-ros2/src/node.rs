@@ -20,11 +20,11 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
+use std::sync::{Arc, OnceLock};
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::{Duration, Instant, SystemTime};
 
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{
@@ -66,6 +66,14 @@ pub struct NodeParams {
     pub pose_channels: PoseChannels,
     /// The pose's `header.frame_id`. Default: `world`.
     pub frame_id: String,
+    /// The nice value (−20…19, lower runs first) the tick thread and the DDS thread (and the
+    /// DDS library's threads, which it starts) ask for at their start, so that on a loaded
+    /// machine the OS runs them before ordinary work; 0 leaves them at the process's. Only a
+    /// process allowed to (root, `CAP_SYS_NICE`, or an `RLIMIT_NICE` that admits it) gets a
+    /// negative one; otherwise they run at the process's priority and [`NodeStats`] says so
+    /// ([`Priority::Refused`]). Never required. Default: −10 (docs/decisions.md, "The node's
+    /// tick thread wakes its writer, both at a raised priority (issue 43)").
+    pub nice: i32,
 }
 
 impl Default for NodeParams {
@@ -79,6 +87,7 @@ impl Default for NodeParams {
             loop_params: LoopParams::default(),
             pose_channels: PoseChannels::Auto,
             frame_id: "world".into(),
+            nice: -10,
         }
     }
 }
@@ -108,13 +117,85 @@ impl NodeParams {
                 why: "must be ≥ 1 (messages)".into(),
             });
         }
+        if !(-20..=19).contains(&self.nice) {
+            return Err(Error::BadParam {
+                name: "nice",
+                why: format!(
+                    "is {}; a nice value is −20…19 (lower runs first; 0 leaves the priority)",
+                    self.nice
+                ),
+            });
+        }
         Ok(())
+    }
+}
+
+/// A node thread's scheduling priority: what it asked for ([`NodeParams::nice`]) and what the
+/// OS gave it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Priority {
+    /// Nothing asked (nice 0), or the thread has not started yet: the process's priority.
+    #[default]
+    Unchanged,
+    /// The thread runs at this nice value.
+    Applied(i32),
+    /// The OS refused `nice` (not root, no `CAP_SYS_NICE`, an `RLIMIT_NICE` below it): the
+    /// thread runs at the process's priority. `errno` is the OS's error number.
+    Refused {
+        /// The nice value asked for.
+        nice: i32,
+        /// The OS's error number (`EACCES` or `EPERM`).
+        errno: i32,
+    },
+    /// Not Linux: a thread's own nice value is Linux's (the thread runs at the process's).
+    Unsupported,
+}
+
+impl std::fmt::Display for Priority {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Priority::Unchanged => write!(f, "the process's priority"),
+            Priority::Applied(n) => write!(f, "nice {n}"),
+            Priority::Refused { nice, errno } => write!(
+                f,
+                "the process's priority (nice {nice} refused, errno {errno}: run as root or \
+                 with CAP_SYS_NICE to raise it)"
+            ),
+            Priority::Unsupported => write!(f, "the process's priority (not Linux)"),
+        }
+    }
+}
+
+/// Sets the calling thread's nice value to `nice` (Linux: each thread has its own, and the
+/// threads it starts afterwards inherit it); 0 does nothing. Never fails: what applied is the
+/// answer. The node's tick and DDS threads call it at their start ([`NodeParams::nice`]); a
+/// test's subscriber may call it too.
+#[must_use]
+pub fn set_thread_nice(nice: i32) -> Priority {
+    if nice == 0 {
+        return Priority::Unchanged;
+    }
+    #[cfg(target_os = "linux")]
+    {
+        match rustix::process::setpriority_process(Some(rustix::thread::gettid()), nice) {
+            Ok(()) => Priority::Applied(nice),
+            Err(e) => Priority::Refused {
+                nice,
+                errno: e.raw_os_error(),
+            },
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        Priority::Unsupported
     }
 }
 
 /// Counters of a running node (shared with its threads).
 #[derive(Debug, Default)]
 struct Counters {
+    tick_priority: OnceLock<Priority>,
+    dds_priority: OnceLock<Priority>,
     ticks: AtomicU64,
     max_period_ns: AtomicU64,
     overruns: AtomicU64,
@@ -146,6 +227,10 @@ pub struct NodeStats {
     pub commands: u64,
     /// Publications DDS refused (a full reliable window: never waited for).
     pub publish_failed: u64,
+    /// The tick thread's priority ([`NodeParams::nice`]).
+    pub tick_priority: Priority,
+    /// The DDS thread's priority, which the DDS library's threads inherit.
+    pub dds_priority: Priority,
 }
 
 /// A running node; [`Node::stop`] ends it.
@@ -256,6 +341,7 @@ impl Node {
             reply_rx,
             stop: io_stop.clone(),
             counters: counters.clone(),
+            nice: params.nice,
         };
         let io = std::thread::Builder::new()
             .name("tandem-dds".into())
@@ -275,7 +361,11 @@ impl Node {
             }
         }
         let links_keep = links.clone();
+        let (started_tx, started_rx) = sync_channel::<()>(1);
         let ticker = Ticker {
+            writer: io.thread().clone(),
+            nice: params.nice,
+            started: started_tx,
             cell_loop,
             tick_s,
             in_rx,
@@ -292,6 +382,9 @@ impl Node {
                 name: "tandem-tick",
                 why: e.to_string(),
             })?;
+        // The tick thread has set its priority (so `stats` reports it from here on); an error
+        // is a thread that ended at once, which `stop` reports.
+        let _ = started_rx.recv();
         Ok(Node {
             stop,
             io_stop,
@@ -353,6 +446,8 @@ impl Node {
             inbound_dropped: get(&c.inbound_dropped),
             commands: get(&c.commands),
             publish_failed: get(&c.publish_failed),
+            tick_priority: c.tick_priority.get().copied().unwrap_or_default(),
+            dds_priority: c.dds_priority.get().copied().unwrap_or_default(),
         }
     }
 
@@ -410,6 +505,11 @@ fn max_into(a: &AtomicU64, v: u64) {
 
 /// The tick thread.
 struct Ticker {
+    /// The DDS thread, woken after each command is pushed (it parks when idle).
+    writer: std::thread::Thread,
+    nice: i32,
+    /// Told once the thread's priority is set.
+    started: SyncSender<()>,
     cell_loop: CellLoop,
     tick_s: f64,
     in_rx: Receiver<Inbound>,
@@ -422,6 +522,8 @@ struct Ticker {
 
 impl Ticker {
     fn run(mut self) -> Result<()> {
+        let _ = self.counters.tick_priority.set(set_thread_nice(self.nice));
+        let _ = self.started.try_send(());
         let period = Duration::from_secs_f64(self.tick_s);
         let mut next = Instant::now();
         let mut last_start: Option<Instant> = None;
@@ -468,13 +570,16 @@ impl Ticker {
             }
             // Every tick's command; the state topics' snapshot when asked, or at once when the
             // fault or the round's state changed (so their topics follow within the tick).
-            links.commands.push(&cmd);
+            links.commands.push(&cmd, now);
             let flags = (cmd.fault, cmd.finished, cmd.active);
             if flags != last_flags || owed || links.state.wanted() {
                 // A slot the DDS thread holds right now is written at the next tick.
                 owed = !links.state.put(self.cell_loop.snapshot());
             }
             last_flags = flags;
+            // The DDS thread parks when it has nothing to do: wake it for this command (a swap
+            // when it is awake; a futex wake when parked, measured in the benchmark `wake`).
+            self.writer.unpark();
             c.ticks.fetch_add(1, Ordering::Relaxed);
             next += period;
             // One clock read for both the tick's work and the sleep.
@@ -491,7 +596,8 @@ impl Ticker {
         // The last command: the round aborted where it stands (`CellLoop::halt`). A full ring
         // (the DDS thread `queue` ticks behind) drops it, counted as any other.
         let last = self.cell_loop.halt();
-        self.links.commands.push(&last);
+        self.links.commands.push(&last, Instant::now());
+        self.writer.unpark();
         if let Some(feed) = &mut self.console {
             feed.publish(&self.cell_loop);
         }
@@ -518,6 +624,19 @@ struct Io {
     reply_rx: Receiver<Reply>,
     stop: Arc<AtomicBool>,
     counters: Arc<Counters>,
+    nice: i32,
+}
+
+/// The wall-clock time (s since the Unix epoch) of `at`, by the pair `clock` of one monotonic
+/// instant and the wall-clock time read together: a command's stamp is its tick's start.
+fn wall_s(at: Instant, clock: (Instant, SystemTime)) -> f64 {
+    let (i0, w0) = clock;
+    let wall = match at.checked_duration_since(i0) {
+        Some(d) => w0 + d,
+        None => w0 - i0.duration_since(at),
+    };
+    wall.duration_since(SystemTime::UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64())
 }
 
 /// The QoS of every topic: reliable, volatile, keep last 16 — ROS 2's default profile, the one
@@ -620,6 +739,8 @@ struct Recorded {
 
 impl Io {
     fn run(self, ready: &SyncSender<Result<()>>) -> Result<()> {
+        // Before the DDS library starts its threads, so that they inherit it.
+        let _ = self.counters.dds_priority.set(set_thread_nice(self.nice));
         let entities = self.entities();
         let (mut node, robots, handover, fault, operator, servers) = match entities {
             Ok(e) => {
@@ -650,6 +771,7 @@ impl Io {
         let mut last_needs = vec![None; self.n];
         let mut last_fault: Option<String> = None;
         let mut next_state = Instant::now();
+        let clock = (Instant::now(), SystemTime::now());
         let c = &self.counters;
         let fail = |ok: bool| {
             if !ok {
@@ -668,9 +790,10 @@ impl Io {
             let mut busy = false;
             // 1. The tick thread's commands, every tick's; `needs_operator` on change.
             let links = &*self.links;
-            while let Some(command) = links.commands.pop() {
+            while let Some((command, at)) = links.commands.pop() {
                 busy = true;
-                let stamp = msg::seconds(msg::now());
+                // The tick's start: the latency a subscriber measures is the coordinator's.
+                let stamp = wall_s(at, clock);
                 for (k, r) in robots.iter().enumerate() {
                     let data = vec![
                         command.ref_time[k],
@@ -812,8 +935,11 @@ impl Io {
             if stopped_at.is_some_and(|t| t.elapsed() >= LINGER) && recording == 0 {
                 break;
             }
+            // Idle: park until the tick thread pushes the next command (it unparks this thread
+            // after each; an unpark before the park makes the park return at once), or 200 µs
+            // pass — the network's messages (progress, the operator, services) are polled.
             if !busy {
-                std::thread::sleep(Duration::from_micros(200));
+                std::thread::park_timeout(Duration::from_micros(200));
             }
         }
         Ok(())
@@ -964,4 +1090,57 @@ fn done_text(what: Request) -> String {
         Request::TakeRound => "recorded",
     }
     .into()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_command_is_stamped_with_its_ticks_wall_clock_time() {
+        let i0 = Instant::now();
+        let w0 = SystemTime::UNIX_EPOCH + Duration::from_secs(1_000);
+        let at = i0 + Duration::from_millis(1_500);
+        assert!((wall_s(at, (i0, w0)) - 1_001.5).abs() < 1e-9);
+        // A tick before the pair was read (the ring's first records).
+        let before = i0.checked_sub(Duration::from_millis(250)).unwrap_or(i0);
+        let back = i0.duration_since(before).as_secs_f64();
+        assert!((wall_s(before, (i0, w0)) - (1_000.0 - back)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn nice_is_checked_and_a_thread_gets_the_priority_it_may() {
+        for nice in [-21, 20] {
+            let p = NodeParams {
+                nice,
+                ..NodeParams::default()
+            };
+            let e = p.validate().unwrap_err().to_string();
+            assert!(e.contains("nice") && e.contains("−20…19"), "{e}");
+        }
+        assert_eq!(set_thread_nice(0), Priority::Unchanged);
+        // Lowering a thread's priority is always allowed; only that thread changes.
+        let (got, now) = std::thread::spawn(|| {
+            let got = set_thread_nice(7);
+            #[cfg(target_os = "linux")]
+            let now = rustix::process::getpriority_process(Some(rustix::thread::gettid())).ok();
+            #[cfg(not(target_os = "linux"))]
+            let now = None;
+            (got, now)
+        })
+        .join()
+        .unwrap();
+        if cfg!(target_os = "linux") {
+            assert_eq!(got, Priority::Applied(7));
+            assert_eq!(now, Some(7));
+            #[cfg(target_os = "linux")]
+            assert_ne!(
+                rustix::process::getpriority_process(Some(rustix::thread::gettid())).ok(),
+                Some(7),
+                "this thread keeps its own"
+            );
+        } else {
+            assert_eq!(got, Priority::Unsupported);
+        }
+    }
 }

@@ -219,9 +219,15 @@ fn node_process() {
     let params = NodeParams {
         domain,
         robots: Some(robots),
+        nice: stream_nice().unwrap_or(NodeParams::default().nice),
         ..NodeParams::default()
     };
     let node = Node::start(Path::new(&state), &params).unwrap();
+    let s = node.stats();
+    eprintln!(
+        "node process: tick thread at {}, DDS thread at {}",
+        s.tick_priority, s.dds_priority
+    );
     std::thread::sleep(Duration::from_secs(120));
     node.stop().unwrap();
 }
@@ -475,10 +481,19 @@ fn a_killed_robot_process_stalls_the_cell() {
     support::remove(&state);
 }
 
+/// `TANDEM_ROS2_NICE`: the nice value of the node process's threads and of the stream's
+/// subscriber (a measurement's knob; unset: the node's default, and the subscriber's −10).
+fn stream_nice() -> Option<i32> {
+    std::env::var("TANDEM_ROS2_NICE").ok()?.parse().ok()
+}
+
 /// The must-show stream: a node process at a 1 ms tick (the test task sampled at 1 kHz),
 /// its two robots' commands over loopback for 10 s with reliable QoS, taken by a probe that
-/// polls every 50 µs: messages lost (tick numbers skipped) and the latency from the node's
-/// tick stamp to the probe's take. A measurement (it prints); run with `--ignored`.
+/// polls every 50 µs: messages lost (tick numbers skipped) and the latency from the tick's
+/// start (the command's stamp) to the probe's take. The probe's thread (and the DDS library's
+/// threads it starts) asks for the node's priority, as a robot driver's control thread runs
+/// raised (`TANDEM_ROS2_NICE=0`: neither raised). A measurement (it prints which priorities
+/// applied); run with `--ignored`.
 #[test]
 #[ignore = "a 10 s measurement: cargo test -p tandem-ros2 --test graph stream -- --ignored --nocapture"]
 fn stream_1khz_for_10_s() {
@@ -486,6 +501,9 @@ fn stream_1khz_for_10_s() {
     let state =
         support::state_file_of("stream", support::planner_with(support::model_at(0.001), 2));
     let mut child = spawn_node(&state, domain, 2);
+    let nice = stream_nice().unwrap_or(NodeParams::default().nice);
+    let subscriber = tandem_ros2::set_thread_nice(nice);
+    eprintln!("subscriber at {subscriber}");
     let probe = Probe::new(domain, 2).unwrap();
     assert!(
         discover(&probe, 2, Duration::from_secs(30)),
