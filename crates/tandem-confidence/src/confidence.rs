@@ -41,6 +41,29 @@ pub const MIN_VOTES: f64 = MIN_OBSERVATIONS;
 /// planner uses, keeps that latch against the prior and the error rates but not against
 /// corrections recorded after it, so that the same rounds give the same map in any order.
 ///
+/// **The prior's trust yields to a need on both sides** (with one vote per execution,
+/// [`ConfidenceParams::one_vote_per_execution`]; the paper's counting has no yield):
+/// [`conf`](Self::conf) is the latch ([`latched`](Self::latched)) except that each maximal
+/// run of latched samples that rest on their prior alone (no correction, fewer than
+/// [`MIN_VOTES`] votes) is low-confidence while the samples on both sides of it are not
+/// latched and are needed by their totals: at least one correction and
+/// `P(π < μ_c | data) < 1 − γ_c` (Eq. 12 mirrored, at `μ'_c` with non-zero error rates).
+/// The run is then supervised; it keeps its latch, so it is trusted again once it has
+/// [`MIN_VOTES`] clean votes (it no longer rests on its prior) or once a side is no longer
+/// needed, and a correction decides it on its totals like any latched sample.
+/// The yield is **not stored**: it is evaluated from the latch, `σ²_D`, the totals of the
+/// observations and the error rates estimated from them whenever the confidence is
+/// computed ([`update`](Self::update), [`update_round`](Self::update_round),
+/// [`refresh`](Self::refresh)), so it adds no history: whatever the order of the rounds,
+/// the confidence is the same function of the same latch and the same totals.
+/// Why: the prior sees only where the demonstrations disagree. Where the operator is
+/// needed although they agree (a search that the alignment pairs turn by turn), the prior
+/// trusts a stretch inside a need that the operator corrects on both sides in every round,
+/// and a trusted sample is never supervised, so nothing else reveals the need
+/// (docs/decisions.md, "The prior's trust yields to a need on both sides, from the
+/// totals"). A stretch with a need on one side only is left to its prior: the need may end
+/// at the border as well as go on.
+///
 /// ```
 /// use tandem_confidence::{Confidence, ConfidenceParams, Observations};
 /// let sigma2_d = [0.0, 10.0, 10.0, 0.0];
@@ -61,7 +84,13 @@ pub const MIN_VOTES: f64 = MIN_OBSERVATIONS;
 #[serde(try_from = "ConfidenceData")]
 pub struct Confidence {
     params: ConfidenceParams,
+    /// The latch (what the state file stores).
     high: Vec<bool>,
+    /// `conf`: the latch less the prior's trust that yields to a need on both sides (the
+    /// type docs), evaluated from the totals at every update; equal to the latch until the
+    /// first update or [`refresh`](Confidence::refresh).
+    #[serde(skip)]
+    view: Vec<bool>,
     /// Cache of certified points of the Eq. 12 boundary (speed only; see `boundary.rs`).
     #[serde(skip)]
     boundary: Boundary,
@@ -71,11 +100,11 @@ pub struct Confidence {
     shifted: Option<(f64, Boundary)>,
 }
 
-/// Equality of the model state (parameters and latched `conf`); the evaluation cache is
+/// Equality of the model state (parameters, the latch and `conf`); the evaluation cache is
 /// ignored.
 impl PartialEq for Confidence {
     fn eq(&self, other: &Self) -> bool {
-        self.params == other.params && self.high == other.high
+        self.params == other.params && self.high == other.high && self.view == other.view
     }
 }
 
@@ -97,10 +126,12 @@ impl TryFrom<ConfidenceData> for Confidence {
 /// What [`Confidence::update_round`] changed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RoundUpdate {
-    /// Samples that became high-confidence (latched) in this update.
+    /// Samples that became high-confidence ([`Confidence::conf`]) in this update: newly
+    /// latched, or a latched run whose prior's trust no longer yields.
     pub newly_high: usize,
-    /// Latched samples that the round's corrections turned low-confidence again (their
-    /// totals no longer pass Eq. 12).
+    /// High-confidence samples that turned low-confidence again: latched samples whose
+    /// totals no longer pass Eq. 12 after the round's corrections, and latched samples that
+    /// rest on their prior alone and now yield to a need on both sides.
     pub reopened: usize,
 }
 
@@ -128,7 +159,9 @@ impl Confidence {
         Ok(conf)
     }
 
-    /// Restores a saved state: `high[n]` is the latched `conf` of reference sample `n`.
+    /// Restores a saved state: `high[n]` is the latch of reference sample `n`
+    /// ([`latched`](Self::latched)); `conf` equals it until [`refresh`](Self::refresh) or an
+    /// update evaluates the prior's yield on the totals.
     ///
     /// # Errors
     /// [`Error::BadParam`] for invalid `params`; [`Error::EmptyReference`] if `high` is
@@ -140,6 +173,7 @@ impl Confidence {
         }
         Ok(Self {
             params,
+            view: high.clone(),
             high,
             boundary: Boundary::default(),
             shifted: None,
@@ -149,7 +183,8 @@ impl Confidence {
     /// Re-evaluates Eq. 12 for every sample that is not yet latched, from the current
     /// demonstration variance `sigma2_d` (Eq. 6, dimensionless, one per reference sample)
     /// and all observations so far, and latches the samples that pass.
-    /// Returns how many samples became high-confidence in this call.
+    /// Returns how many samples became high-confidence in this call. The prior's trust then
+    /// yields to a need on both sides on these totals (the type docs).
     ///
     /// With non-zero operator error rates (estimated from `obs` when
     /// [`ConfidenceParams::estimate_error_rates`], [`crate::estimate_error_rates`]) the test
@@ -178,7 +213,44 @@ impl Confidence {
         )?;
         let rates = crate::estimate_error_rates(obs, &self.params)?;
         let (c, s) = (obs.corrections(), obs.supervised());
-        self.latch(sigma2_d, &rates, |n| (c[n], s[n]))
+        Ok(self
+            .latch_reopening(sigma2_d, &rates, |n| (c[n], s[n]), |_| false)?
+            .0)
+    }
+
+    /// Evaluates `conf` again from the latch and the totals `obs` (the prior's trust that
+    /// yields to a need on both sides, the type docs) without changing the latch: what
+    /// [`update`](Self::update) ends with. Call it on a state restored with
+    /// [`from_parts`](Self::from_parts) with the `σ²_D` and the observations it was last
+    /// updated with, so that `conf` is the one it had when it was saved. Returns how many
+    /// latched samples yield.
+    ///
+    /// # Errors
+    /// As [`update`](Self::update); on error nothing changes.
+    pub fn refresh(&mut self, sigma2_d: &[f64], obs: &Observations) -> Result<usize> {
+        check_len(
+            "observations",
+            obs.n_ref(),
+            "the confidence state",
+            self.n_ref(),
+        )?;
+        self.check_sigma2_d(sigma2_d)?;
+        let (c, s) = (obs.corrections(), obs.supervised());
+        // Without a correction nothing is needed, and the rates need no estimate.
+        let view = if self.params.one_vote_per_execution && c.iter().any(|&c| c > 0.0) {
+            let rates = crate::estimate_error_rates(obs, &self.params)?;
+            self.yielded(sigma2_d, &rates, |n| (c[n], s[n]))
+        } else {
+            self.high.clone()
+        };
+        let n_yield = self
+            .high
+            .iter()
+            .zip(&view)
+            .filter(|(h, v)| **h && !**v)
+            .count();
+        self.view = view;
+        Ok(n_yield)
     }
 
     /// [`update`](Self::update) after one round of executions, whose observations took the
@@ -278,7 +350,7 @@ impl Confidence {
         })
     }
 
-    /// Shared body of [`update`](Self::update) and [`from_prior`](Self::from_prior):
+    /// Shared body of [`from_prior`](Self::from_prior) and the updates:
     /// `counts(n)` gives `(corrections[n], supervised[n])`, with `0 ≤ c ≤ s` finite.
     fn latch(
         &mut self,
@@ -289,15 +361,8 @@ impl Confidence {
         Ok(self.latch_reopening(sigma2_d, rates, counts, |_| false)?.0)
     }
 
-    /// [`latch`](Self::latch) where the latched samples with `reopen(n)` are decided again
-    /// too: `(newly high, latched samples that turned low)`.
-    fn latch_reopening(
-        &mut self,
-        sigma2_d: &[f64],
-        rates: &ErrorRates,
-        counts: impl Fn(usize) -> (f64, f64),
-        reopen: impl Fn(usize) -> bool,
-    ) -> Result<(usize, usize)> {
+    /// Checks `sigma2_d` against this state: its length and every value.
+    fn check_sigma2_d(&self, sigma2_d: &[f64]) -> Result<()> {
         self.params.validate()?;
         check_len(
             "sigma2_d",
@@ -308,11 +373,26 @@ impl Confidence {
         for (ref_idx, &v) in sigma2_d.iter().enumerate() {
             check_variance(ref_idx, v)?;
         }
+        Ok(())
+    }
+
+    /// [`latch`](Self::latch) where the latched samples with `reopen(n)` are decided again
+    /// too, then `conf` evaluated on the same totals (the prior's yield):
+    /// `(samples that turned high, samples that turned low)` in `conf`.
+    fn latch_reopening(
+        &mut self,
+        sigma2_d: &[f64],
+        rates: &ErrorRates,
+        counts: impl Fn(usize) -> (f64, f64),
+        reopen: impl Fn(usize) -> bool,
+    ) -> Result<(usize, usize)> {
+        self.check_sigma2_d(sigma2_d)?;
         let Self {
             params: p,
             high: latched,
             boundary,
             shifted,
+            ..
         } = self;
         let mu_shifted = rates.shifted_mu_c(p.mu_c);
         if !rates.is_zero() && shifted.as_ref().is_none_or(|(mu, _)| *mu != mu_shifted) {
@@ -356,13 +436,76 @@ impl Confidence {
                 _ => {}
             }
         }
+        // Every prior was representable: nothing below can fail, so the state changes only
+        // now.
         for &ref_idx in &newly {
             self.high[ref_idx] = true;
         }
         for &ref_idx in &lowered {
             self.high[ref_idx] = false;
         }
-        Ok((newly.len(), lowered.len()))
+        let view = if self.params.one_vote_per_execution {
+            self.yielded(sigma2_d, rates, &counts)
+        } else {
+            self.high.clone()
+        };
+        let turned_high = self.view.iter().zip(&view).filter(|(b, a)| !**b && **a);
+        let turned_low = self.view.iter().zip(&view).filter(|(b, a)| **b && !**a);
+        let counted = (turned_high.count(), turned_low.count());
+        self.view = view;
+        Ok(counted)
+    }
+
+    /// `conf` from the latch and the totals: the latch less every maximal run of latched
+    /// samples that rest on their prior alone (`c = 0`, `s <` [`MIN_VOTES`]) whose
+    /// neighbours on both sides are not latched and are needed by their totals (`c > 0` and
+    /// `P(π < μ_c | data) < 1 − γ_c`, Eq. 12 mirrored at `μ'_c`; the type docs). A pure
+    /// function of `(latch, σ²_D, counts, rates)`: nothing of it is stored.
+    fn yielded(
+        &self,
+        sigma2_d: &[f64],
+        rates: &ErrorRates,
+        counts: impl Fn(usize) -> (f64, f64),
+    ) -> Vec<bool> {
+        let p = &self.params;
+        let needed = |n: usize| -> bool {
+            let (c, s) = counts(n);
+            if self.high[n] || c <= 0.0 {
+                return false;
+            }
+            let (alpha0, beta0) = prior_ab(sigma2_d[n], p);
+            prob_need_below(alpha0 + c, beta0 + (s - c), rates, p.mu_c)
+                .is_some_and(|below| below < 1.0 - p.gamma_c)
+        };
+        let on_prior = |n: usize| {
+            let (c, s) = counts(n);
+            self.high[n] && c == 0.0 && s < MIN_VOTES
+        };
+        let mut view = self.high.clone();
+        let n_ref = view.len();
+        let mut n = 0;
+        while n < n_ref {
+            if !on_prior(n) {
+                n += 1;
+                continue;
+            }
+            let start = n;
+            while n < n_ref && on_prior(n) {
+                n += 1;
+            }
+            if start > 0 && n < n_ref && needed(start - 1) && needed(n) {
+                view[start..n].fill(false);
+            }
+        }
+        view
+    }
+
+    /// The latch per reference sample (what the state file stores): `conf` before the
+    /// prior's trust yields to a need on both sides (the type docs). A sample high in
+    /// [`conf`](Self::conf) is high here.
+    #[must_use]
+    pub fn latched(&self) -> &[bool] {
+        &self.high
     }
 
     /// The parameters this state was built with.
@@ -377,16 +520,18 @@ impl Confidence {
         self.high.len()
     }
 
-    /// `conf` per reference sample: `true` = high confidence (may run unsupervised).
+    /// `conf` per reference sample: `true` = high confidence (may run unsupervised). The
+    /// latch less the prior's trust that yields to a need on both sides, as of the last
+    /// update or [`refresh`](Self::refresh) (the type docs).
     #[must_use]
     pub fn conf(&self) -> &[bool] {
-        &self.high
+        &self.view
     }
 
     /// Number of high-confidence reference samples.
     #[must_use]
     pub fn n_high(&self) -> usize {
-        self.high.iter().filter(|&&h| h).count()
+        self.view.iter().filter(|&&h| h).count()
     }
 
     /// Share of high-confidence reference samples, in `[0, 1]` (Fig. 5, bottom).
@@ -399,7 +544,7 @@ impl Confidence {
     /// Maximal runs of low-confidence reference samples, in increasing order.
     #[must_use]
     pub fn low_regions(&self) -> Vec<Range<usize>> {
-        crate::low_regions(&self.high)
+        crate::low_regions(&self.view)
     }
 }
 
@@ -600,5 +745,108 @@ mod tests {
         obs.record(&[0.0, 0.0], &[false, false]).unwrap();
         conf.update(&[s2], &obs).unwrap();
         assert_eq!(conf.conf(), &[true]);
+    }
+
+    /// Records `votes` clean (or corrected) votes at each of `samples`, `times` times.
+    fn votes(obs: &mut Observations, samples: &[f64], corrected: bool, times: usize) {
+        for _ in 0..times {
+            let flags = vec![corrected; samples.len()];
+            obs.record_votes(samples, &flags).unwrap();
+        }
+    }
+
+    #[test]
+    fn the_priors_trust_yields_to_a_need_on_both_sides_as_a_function_of_the_totals() {
+        // The demonstrations disagree at samples 1, 4 and 8 only (low-confidence from the
+        // prior); sample 6 earns its trust on twelve clean votes. Fixed rates, so that only
+        // the votes count.
+        let p = ConfidenceParams {
+            estimate_error_rates: false,
+            ..ConfidenceParams::default()
+        };
+        let sigma2_d = [0.0, 10.0, 0.0, 0.0, 10.0, 0.0, 0.0, 0.0, 10.0];
+        let from_prior = [true, false, true, true, false, true, true, true, false];
+        let mut conf = Confidence::from_prior(&sigma2_d, p.clone()).unwrap();
+        assert_eq!(conf.conf(), &from_prior);
+        let mut obs = Observations::new(9).unwrap();
+        votes(&mut obs, &[6.0], false, 12);
+        // No correction yet: the prior's trust stands.
+        let before = obs.clone();
+        conf.update_round(&sigma2_d, &before, &obs).unwrap();
+        assert_eq!(conf.conf(), &from_prior);
+        // Two corrected executions at samples 1, 4 and 8. σ²_D = 10 is far above σ²_MAX, so
+        // the prior is Beta(1, 1) (g = 0, Eq. 10–11), and the posterior Beta(3, 1) gives
+        // P(π < 0.05) = 0.05³ = 1.25e-4 < 1 − γ_c = 0.05: needed. Samples 2–3 lie between
+        // two needs and yield; sample 0 has a need on one side only (the task's start on the
+        // other), sample 5 a need and sample 6 (trusted on its votes), sample 7 sample 6 and
+        // a need.
+        let before = obs.clone();
+        votes(&mut obs, &[1.0, 4.0, 8.0], true, 2);
+        let round = conf.update_round(&sigma2_d, &before, &obs).unwrap();
+        let yielded = [true, false, false, false, false, true, true, true, false];
+        assert_eq!(conf.conf(), &yielded);
+        // The latch is not touched: the yield is evaluated, not stored.
+        assert_eq!(conf.latched(), &from_prior);
+        assert_eq!(round.reopened, 2);
+        assert_eq!(round.newly_high, 0);
+        // `update` on the same totals decides the same, and a state restored from its latch
+        // is refreshed to the same `conf`.
+        let mut again = Confidence::from_prior(&sigma2_d, p.clone()).unwrap();
+        again.update(&sigma2_d, &obs).unwrap();
+        assert_eq!(again, conf);
+        let mut restored = Confidence::from_parts(p.clone(), conf.latched().to_vec()).unwrap();
+        assert_eq!(restored.conf(), &from_prior);
+        assert_eq!(restored.refresh(&sigma2_d, &obs).unwrap(), 2);
+        assert_eq!(restored, conf);
+        // Supervised (they are low-confidence), samples 2–3 are trusted again on ten clean
+        // votes, no earlier, while both sides are still needed.
+        let mut supervised = obs.clone();
+        for vote in 1..=10 {
+            let before = supervised.clone();
+            votes(&mut supervised, &[2.0, 3.0], false, 1);
+            conf.update_round(&sigma2_d, &before, &supervised).unwrap();
+            assert_eq!(&conf.conf()[2..4], &[vote >= 10; 2], "after {vote} votes");
+        }
+        // Five votes, then the need at 4 fades (200 clean executions): samples 2–3 return to
+        // their latch although they have votes, and the same rounds in the other order (the
+        // need faded before the corrections) end at the same confidence: nothing of the
+        // yield is history.
+        let rounds: [(&[f64], bool, usize); 4] = [
+            (&[6.0], false, 12),
+            (&[1.0, 4.0, 8.0], true, 2),
+            (&[2.0, 3.0], false, 5),
+            (&[4.0], false, 200),
+        ];
+        let run = |order: &[usize]| {
+            let mut conf = Confidence::from_prior(&sigma2_d, p.clone()).unwrap();
+            let mut obs = Observations::new(9).unwrap();
+            let mut seen = Vec::new();
+            for &k in order {
+                let before = obs.clone();
+                let (samples, corrected, times) = rounds[k];
+                votes(&mut obs, samples, corrected, times);
+                conf.update_round(&sigma2_d, &before, &obs).unwrap();
+                seen.push(conf.conf().to_vec());
+            }
+            (conf, seen)
+        };
+        let (in_order, seen) = run(&[0, 1, 2, 3]);
+        // After the third round the run still yields (5 votes < MIN_VOTES); after the
+        // fourth, sample 4 is latched on its totals (2 corrections in 202 votes) and is no
+        // longer needed.
+        assert_eq!(&seen[2][2..4], &[false, false]);
+        assert_eq!(
+            in_order.conf(),
+            &[true, false, true, true, true, true, true, true, false]
+        );
+        let (reversed, _) = run(&[3, 2, 1, 0]);
+        assert_eq!(reversed, in_order);
+        // The paper's counting keeps the paper's latch: nothing yields there.
+        let paper = ConfidenceParams::paper();
+        let mut conf = Confidence::from_prior(&sigma2_d, paper).unwrap();
+        let mut obs = Observations::new(9).unwrap();
+        obs.record(&[1.0, 1.0, 4.0, 4.0], &[true; 4]).unwrap();
+        conf.update(&sigma2_d, &obs).unwrap();
+        assert_eq!(conf.conf(), &from_prior);
     }
 }

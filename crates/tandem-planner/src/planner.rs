@@ -332,12 +332,14 @@ impl Clone for Origin {
 /// What [`Planner::record_round`] did.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RecordReport {
-    /// Reference samples that became high-confidence (latched) in this update.
+    /// Reference samples that became high-confidence in this update (newly latched, or a
+    /// latched run whose prior's trust no longer yields: [`tandem_confidence::RoundUpdate`]).
     pub newly_high: usize,
-    /// Latched (high-confidence) samples that this round's corrections turned low-confidence
-    /// again ([`Confidence::update_round`]): rounds recorded out of order bring corrections
-    /// of samples latched since they ran; in order, a supervised sample's split and sweep
-    /// reach a latched sample at the edge of a supervised stretch.
+    /// High-confidence samples that turned low-confidence again ([`Confidence::update_round`]):
+    /// latched samples this round's corrections reopened (rounds recorded out of order bring
+    /// corrections of samples latched since they ran; in order, a supervised sample's split
+    /// and sweep reach a latched sample at the edge of a supervised stretch), and latched
+    /// samples resting on their prior whose trust now yields to a need on both sides.
     pub reopened: usize,
     /// Where the new schedule came from (sampled, previous, repaired previous, serial).
     pub source: Source,
@@ -1207,7 +1209,7 @@ impl Planner {
         }
     }
 
-    fn from_state(st: PlannerState) -> Result<Self> {
+    fn from_state(mut st: PlannerState) -> Result<Self> {
         st.params.validate()?;
         let n_ref = st.model.n_ref();
         let schedule = &st.outcome.schedule;
@@ -1272,6 +1274,12 @@ impl Planner {
                 why: format!("{} samples, the model has {n_ref}", r.n_samples()),
             });
         }
+        // The file holds the latch; `conf` is the latch less the prior's trust that yields to
+        // a need on both sides, a function of the model's σ²_D and the observations' totals
+        // (`tandem_confidence::Confidence`), so it is evaluated again here, as `record_round`
+        // left it.
+        st.confidence
+            .refresh(st.model.sigma2_d(), &st.observations)?;
         let problem = problem_for(&st.model, &st.confidence, &st.params.holds)?;
         Ok(Self {
             params: st.params,

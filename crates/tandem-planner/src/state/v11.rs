@@ -752,7 +752,8 @@ impl From<&conf::Confidence> for Confidence {
     fn from(c: &conf::Confidence) -> Self {
         Confidence {
             params: c.params().into(),
-            high: c.conf().to_vec(),
+            // The latch; `conf` is evaluated from it and the totals on load.
+            high: c.latched().to_vec(),
         }
     }
 }
