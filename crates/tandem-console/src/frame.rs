@@ -764,6 +764,8 @@ pub(crate) fn prealert_on(in_s: f64, lead_s: f64, tick_s: f64) -> bool {
     in_s <= lead_s + tick_s.max(0.0) + 1.0 / crate::RECORDING_HZ
 }
 
+/// The page's frame of `raw` (server side; allocates).
+#[must_use]
 pub fn build_frame(geometry: &Geometry, raw: &RawFrame) -> Frame {
     let n_ref = geometry
         .robots
