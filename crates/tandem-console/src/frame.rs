@@ -368,7 +368,7 @@ pub struct Frame {
     /// The next handover, the coordinator's pre-alert ([`next_handover`]), if it announces one.
     pub next: Option<NextHandover>,
     /// Whether the next handover can start within `lead_s` by the page's next frame
-    /// ([`prealert_on`]: `next.in_s ≤ lead_s + tick_s + 1/RECORDING_HZ`, so that the alert,
+    /// (`prealert_on`: `next.in_s ≤ lead_s + tick_s + 1/RECORDING_HZ`, so that the alert,
     /// raised at a frame, is up at least `lead_s` before a start at the worst-case earliest).
     pub prealert: bool,
     /// The pre-alert's lead (real s).
