@@ -58,12 +58,14 @@ def planner() -> tandem.Planner:
 
 @pytest.fixture(scope="session")
 def overlapping_planner() -> tandem.Planner:
-    """A planner whose schedule overlaps the robots (quick confidence, five rounds recorded:
-    ten votes, the fewest on which a supervised sample is trusted, `MIN_VOTES`)."""
+    """A planner whose schedule overlaps the robots (quick confidence, six rounds recorded:
+    twelve votes, past the ten on which a supervised sample is trusted, `MIN_VOTES`; at five
+    rounds the prior-trusted runs between needed samples still yield, so robot 2 starts at
+    71 % of robot 1's execution, at six at 12 %)."""
     p = tandem.fit(
         DEMOS,
         params={"sampler": {"samples": SAMPLES, "seed": 3}, "confidence": QUICK_CONFIDENCE},
     )
-    record_rounds(p, 5)
+    record_rounds(p, 6)
     assert p.schedule.offsets[0] < p.schedule.durations_s[0] / 2, "the robots overlap"
     return p
