@@ -729,6 +729,9 @@ def study_run(
 def study_run_trial(
     task: StudyTask, config: Params, trial: int
 ) -> Tuple[Dict[str, Any], Dict[str, float]]: ...
+def study_run_cell_trial(
+    task: StudyTask, config: Params, trial: int
+) -> Tuple[Dict[str, Any], Dict[str, float]]: ...
 def sim_run_round(
     planner: Planner,
     needs: ArrayLike,

@@ -30,9 +30,24 @@ from typing import Any, Dict, List, Mapping, Optional, Union
 
 import numpy as np
 
-from ._tandem import StudyTask, study_config, study_prepare, study_run, study_run_trial
+from ._tandem import (
+    StudyTask,
+    study_config,
+    study_prepare,
+    study_run,
+    study_run_cell_trial,
+    study_run_trial,
+)
 
-__all__ = ["StudyResult", "TrialResult", "default_config", "run", "run_trial"]
+__all__ = [
+    "CellTrialResult",
+    "StudyResult",
+    "TrialResult",
+    "default_config",
+    "run",
+    "run_cell_trial",
+    "run_trial",
+]
 
 Config = Union[None, Mapping[str, Any], str, PathLike]
 
@@ -253,3 +268,76 @@ def run_trial(
     cfg = _normalized(config)
     data, _times = study_run_trial(_prepared(cfg, demos_dir), cfg, trial)
     return TrialResult(data)
+
+
+class CellTrialResult:
+    """One trial of the continuous study (``config["cell"] = "continuous"``): ``N`` robots and
+    ``M`` operators, each robot starting its next task as soon as the operators' order
+    allows, the plan re-made every ``N`` completed tasks.
+
+    Attributes:
+        data: the trial's record as a dict (``study.json``'s ``result.trials[k]`` of
+            ``cargo xtask study --cell continuous``): ``iterations`` (the plans), ``completions``
+            (every task), ``stats``, ``steady``.
+        trial, seed: the trial's index and seed.
+        steady_tasks_per_h: tasks per hour of the whole cell over the steady window (the last
+            10 % of the tasks, whole periods).
+        steady_busy_share: share of the window's ticks in which a robot was low-confidence.
+        steady_wait_share: share of the robots' time in the window spent waiting at gates.
+        tasks: tasks completed.
+        ticks, overlap_ticks, faults: the cell's control ticks, the ticks with more robots
+            low-confidence than operators (must be 0) and the faults latched (must be 0).
+        plan_tasks_per_h, plan_bound_tasks_per_h: the last plan's throughput and its bound
+            (``3600·N / lower_bound_s``).
+        high_conf_pct: ``(n_plans,)`` array, percent of high-confidence samples of each plan.
+    """
+
+    def __init__(self, data: Mapping[str, Any]) -> None:
+        self.data = dict(data)
+        self.trial: int = data["trial"]
+        self.seed: int = data["seed"]
+        steady = data["steady"]
+        stats = data["stats"]
+        self.steady_tasks_per_h: float = float(steady["throughput_per_h"])
+        self.steady_busy_share: float = float(steady["operator_busy_share"])
+        self.steady_wait_share: float = float(steady["robot_wait_share"])
+        self.tasks: int = len(data["completions"])
+        self.ticks: int = int(stats["ticks"])
+        self.overlap_ticks: int = int(stats["overlap_ticks"])
+        self.faults: int = int(stats["faults"])
+        its = data["iterations"]
+        self.plan_tasks_per_h: float = float(its[-1]["tasks_per_hour"])
+        period, bound = its[-1]["period_s"], its[-1]["lower_bound_s"]
+        self.plan_bound_tasks_per_h: float = (
+            float(its[-1]["tasks_per_hour"]) * period / bound if bound > 0 else float("nan")
+        )
+        self.high_conf_pct = np.array([r["high_conf_pct"] for r in its], dtype=np.float64)
+
+    def to_dict(self) -> dict:
+        """The trial as a dict (JSON-compatible)."""
+        return dict(self.data)
+
+    def __repr__(self) -> str:
+        return (
+            f"CellTrialResult(trial={self.trial}, tasks={self.tasks}, "
+            f"steady {self.steady_tasks_per_h:.1f} tasks/h, overlap_ticks={self.overlap_ticks})"
+        )
+
+
+def run_cell_trial(
+    config: Config,
+    trial: int,
+    demos_dir: Union[None, str, PathLike] = None,
+) -> CellTrialResult:
+    """Runs trial ``trial`` of the continuous study alone (``config["cell"]`` must be
+    ``"continuous"``; seeded by ``(seed, trial)`` only, so it is exactly that trial of
+    ``cargo xtask study --cell continuous``, wherever it runs: a sweep over robots, operators
+    and switch times spreads such trials over a cluster, ``examples/python/sweep_fleet_dask.py``).
+
+    Raises:
+        ParamError: a bad configuration key or value, or a configuration of rounds.
+        InputError: a bad demonstration or labels file in ``demos_dir``.
+    """
+    cfg = _normalized(config)
+    data, _times = study_run_cell_trial(_prepared(cfg, demos_dir), cfg, trial)
+    return CellTrialResult(data)

@@ -172,7 +172,7 @@ fn malformed_demonstrations() {
             vec![
                 "rate.csv:1:1: sample period 0.02 s differs from 0.01 s, the period of 3 of the 4 \
                  demonstrations (",
-                "resample it",
+                "resample every file onto that one grid: `tandem fit --resample --dt 0.01`",
             ],
         ),
         // A row written twice by the logger: named with its twin and the fix.

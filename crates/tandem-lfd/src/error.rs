@@ -265,12 +265,15 @@ pub enum Error {
     /// Sample periods differ by more than 1 %.
     #[error(
         "{}: sample period {} s differs from {} s, the period of {}, by more than 1 % \
-         (resample it to that rate; for a file without a `t` column the period is --dt, \
-         default 0.01 s)",
+         (resample every file onto that one grid: `tandem fit --resample --dt {}`, in Python \
+         `fit(..., resample=True, dt_s={})`; for a file without a `t` column the period is \
+         --dt, default 0.01 s)",
         at(file, *line, *column),
         (found_s * 1e9).round() / 1e9,
         (expected_s * 1e9).round() / 1e9,
-        expected_from
+        expected_from,
+        (expected_s * 1e9).round() / 1e9,
+        (expected_s * 1e9).round() / 1e9
     )]
     SamplePeriodMismatch {
         /// The file or source label.

@@ -24,7 +24,8 @@ pub(crate) use tandem::schedule::{
 };
 pub(crate) use tandem::sim::needs::{NeedProfile, NeedRegion};
 pub(crate) use tandem::sim::study::{
-    PhaseTimes, StudyConfig, StudyInputs, read_labels, reference_labels, run_trial, run_trials,
+    PhaseTimes, StudyConfig, StudyInputs, read_labels, reference_labels, run_cell_trial, run_trial,
+    run_trials,
 };
 pub(crate) use tandem::sim::task::{
     FIXTURE_SEED, Label, N_FIXTURE_DEMOS, TaskDemo, TaskParams, Workpiece, demonstrations,

@@ -87,7 +87,9 @@ mod _tandem {
     #[pymodule_export]
     use crate::sim::{sim_correction_input, sim_needs, sim_run_round, sim_sanding_needs};
     #[pymodule_export]
-    use crate::study::{PyStudyTask, study_config, study_prepare, study_run, study_run_trial};
+    use crate::study::{
+        PyStudyTask, study_config, study_prepare, study_run, study_run_cell_trial, study_run_trial,
+    };
     #[pymodule_export]
     use crate::warp::{PyWarp, align};
 

@@ -18,8 +18,8 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::errors::{Error, Result, guard};
 use crate::facade::{
-    FIXTURE_SEED, Label, N_FIXTURE_DEMOS, PhaseTimes, StudyConfig, StudyInputs, TaskDemo,
-    TaskModel, demonstrations, run_trial, run_trials,
+    Cell, FIXTURE_SEED, Label, N_FIXTURE_DEMOS, PhaseTimes, StudyConfig, StudyInputs, TaskDemo,
+    TaskModel, demonstrations, run_cell_trial, run_trial, run_trials,
 };
 use crate::params::{from_py, serialize_to_py};
 
@@ -143,6 +143,39 @@ pub(crate) fn study_run_trial<'py>(
     let (model, labels) = (task.model.clone(), task.labels.clone());
     let (result, times) =
         py.detach(|| guard(|| Ok(run_trial(&config, &model, &labels, trial, &|_| {})?)))?;
+    Ok((serialize_to_py(py, &result)?, times_dict(py, &times)?))
+}
+
+/// Runs trial `trial` of the continuous study (`config["cell"]` must be `"continuous"`) on
+/// `task`: `N = config["robots"]` robots, `M = config["operator"]["operators"]` operators,
+/// each robot starting its next task as soon as the operators' order allows, re-planned every
+/// `N` tasks, for `config["executions"]` tasks (seeded by `(config.seed, trial)` only, so it
+/// equals that trial of `cargo xtask study --cell continuous`). Returns `(trial_result,
+/// phase_times)`: the trial's record as `study.json`'s `result.trials[trial]` holds it (its
+/// `steady` window: tasks/h, operator busy share; `stats`: ticks, overlap ticks, faults).
+#[pyfunction]
+#[pyo3(signature = (task, config, trial))]
+pub(crate) fn study_run_cell_trial<'py>(
+    py: Python<'py>,
+    task: PyRef<'py, PyStudyTask>,
+    config: Option<&Bound<'py, PyAny>>,
+    trial: usize,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
+    let config = self::config(config)?;
+    if config.cell != Cell::Continuous {
+        return Err(Error::param(
+            "cell",
+            format!(
+                "study_run_cell_trial runs the continuous cell, the configuration says {:?}: \
+                 set config[\"cell\"] = \"continuous\" (or use study_run_trial for rounds)",
+                config.cell.name()
+            ),
+        )
+        .into());
+    }
+    let (model, labels) = (task.model.clone(), task.labels.clone());
+    let (result, times) =
+        py.detach(|| guard(|| Ok(run_cell_trial(&config, &model, &labels, trial, &|_| {})?)))?;
     Ok((serialize_to_py(py, &result)?, times_dict(py, &times)?))
 }
 
