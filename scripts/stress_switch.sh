@@ -12,8 +12,8 @@
 # Environment: DELTAS="0.5 2 7" to choose switch times; MAX_BUSY=0.7 to run the continuous
 # batches with the operator's load cap as well (the paced coordinator; default: none);
 # DRY_RUN=1 prints the commands only.
-# Reduced sizes run on the shared machine: docs/decisions.md, "Issue 41's stress at the reduced
-# sizes, and the continuous cell's load cap under stress (issue 41)".
+# Reduced sizes run on the shared machine: docs/decisions.md, "The switch time at run time
+# (issue 41)", "Issue 41's must-shows run: …" and "Issue 41 line by line (issue 41)".
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-results/stress_switch}"

@@ -103,8 +103,9 @@ enum Cmd {
         /// With `--cell continuous`: tasks every robot completes per execution.
         #[arg(long, default_value_t = 50)]
         tasks: u64,
-        /// The operator's switch time δ (real s, ≥ 0; issue 41): rounds get tight schedules
-        /// at the edge of `check_margins` at δ, run by coordinators that wait δ at their holds;
+        /// The operator's switch time δ (real s, ≥ 0; issue 41): rounds get the production
+        /// scheduler's schedules at δ (half the problems) and tight schedules at the edge of
+        /// `check_margins` at δ (the other half), run by coordinators that wait δ at their holds;
         /// the continuous cell plans δ and its token waits it. Fails on any execution in which
         /// two robots' low-confidence ticks are fewer than `k = switch_ticks(δ, tick)` ticks
         /// apart. 0 (default): the run without it, unchanged.

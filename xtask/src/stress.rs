@@ -39,13 +39,16 @@
 //! with two or more robots low-confidence and the ticks in which a robot moved backwards
 //! (expected 0 of both; `AdversaryRun::backward_steps`) and the tasks per robot.
 //!
-//! `--switch-s S` (issue 41) adds the operator's switch time `δ = S` s: rounds get tight
-//! schedules at an edge of `check_margins` at `δ` (with `--holds`, release rules it accepts),
-//! run by coordinators that wait `δ` at their holds (`Coordinator::with_margins`); the
-//! continuous cell's plan counts `δ` per change of robot (`CyclicParams::switch_s`) and its
-//! token waits it (`ContinuousCoordinator::with_switch_s`). Each execution's shortest switch
-//! is measured on the ticks the robots traversed (`AdversaryRun::min_switch_gap_ticks`; the
-//! beam search measures none), and the run fails if one is shorter than
+//! `--switch-s S` (issue 41) adds the operator's switch time `δ = S` s: in rounds, half the
+//! problems are this task's, scheduled by the production scheduler at `δ`
+//! (`SamplerParams::switch_s`) and run as the planner runs them (`check_with_operator`, the
+//! coordinator `with_switch_s`), the other half the test kit's families with tight schedules at
+//! an edge of `check_margins` at `δ` (with `--holds`, release rules it accepts), run by
+//! coordinators that wait `δ` at their holds (`Coordinator::with_margins`); the continuous
+//! cell's plan counts `δ` per change of robot (`CyclicParams::switch_s`) and its token waits
+//! it (`ContinuousCoordinator::with_switch_s`). Each execution's shortest switch is measured
+//! on the ticks the robots traversed (`AdversaryRun::min_switch_gap_ticks`; the beam search
+//! measures none), and the run fails if one is shorter than
 //! `k = switch_ticks(δ, tick)`. `--max-busy U` (continuous cell) adds the operator's load cap:
 //! the plans keep it and the token paces the operator to it
 //! (`ContinuousCoordinator::with_max_busy_share`), so the same checks run on the paced cell.
@@ -136,18 +139,24 @@ enum Made {
     Tight,
 }
 
-/// Schedules `problem` for `n_robots` with the production scheduler at `tick_s`: its
-/// coordinator and whether the executions overlap (a sampled or completed schedule).
+/// Schedules `problem` for `n_robots` with the production scheduler at `tick_s` and the
+/// operator's switch time `switch_s` (`SamplerParams::switch_s`): its coordinator and whether
+/// the executions overlap (a sampled or completed schedule). At `switch_s = 0` the schedule is
+/// checked by `Schedule::check` as before; with a switch time it is run as the planner runs it
+/// (`Planner::coordinator`: `check_with_operator` at `switch_s`, the coordinator
+/// `with_switch_s`).
 fn scheduled(
     problem: &Problem,
     n_robots: usize,
     tick_s: f64,
+    switch_s: f64,
     rng: &mut ChaCha8Rng,
 ) -> anyhow::Result<(Coordinator, bool)> {
     let params = SamplerParams {
         samples: SAMPLES,
         seed: rng.random(),
         tick_s: Some(tick_s),
+        switch_s,
         ..SamplerParams::default()
     };
     let out = sample_schedule_n(problem, n_robots, &params, None)?;
@@ -155,7 +164,15 @@ fn scheduled(
         out.source,
         Source::Sampled { .. } | Source::Completed | Source::Held | Source::Staggered
     );
-    Ok((out.schedule.check(problem)?.coordinator()?, sampled))
+    let coordinator = if switch_s == 0.0 {
+        out.schedule.check(problem)?.coordinator()?
+    } else {
+        out.schedule
+            .check_with_operator(problem, switch_s, 1.0)?
+            .coordinator()?
+            .with_switch_s(switch_s)?
+    };
+    Ok((coordinator, sampled))
 }
 
 /// Per-robot plans with holds: up to 20 draws of interleaved starts (each robot at a random
@@ -200,11 +217,12 @@ fn held_plans(
 /// are scheduled by the production scheduler; per-robot plans (which no `tandem-schedule`
 /// problem describes) get a tight schedule at an acceptance edge of `sufficient_margins`.
 ///
-/// With a switch time (`switch_s > 0`) every problem is a test kit family's, with a tight
-/// schedule at an edge of `check_margins`' acceptance at that switch time (with `--holds`
-/// interleaved starts and release rules accepted by it), run by a coordinator that waits the
-/// switch time (`Coordinator::with_margins`): the production scheduler does not plan the
-/// switch time for rounds on this branch, and the edge is where a wrong rule would show.
+/// With a switch time (`switch_s > 0`) the even indices are this task's random problems
+/// scheduled by the production scheduler at that switch time and run as the planner runs them
+/// ([`scheduled`]); the odd ones a test kit family's, with a tight schedule at an edge of
+/// `check_margins`' acceptance at that switch time (with `--holds` interleaved starts and
+/// release rules accepted by it), run by a coordinator that waits the switch time
+/// (`Coordinator::with_margins`): the edge is where a wrong rule would show.
 fn make_case(
     seed: u64,
     index: u64,
@@ -215,12 +233,17 @@ fn make_case(
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(index);
     let mut skipped = 0;
-    let (coordinator, overlapping, family, made) = if switch_s > 0.0 {
+    let (coordinator, overlapping, family, made) = if index % 2 == 0 {
+        let problem = with_holds(random_problem(&mut rng)?, holds)?;
+        let tick_s = DT_S * rng.random_range(0.25..=1.0);
+        let (c, o) = scheduled(&problem, n_robots, tick_s, switch_s, &mut rng)?;
+        (c, o, "stress", Made::Scheduled)
+    } else if switch_s > 0.0 {
         // A case whose robots end and start low-confidence may have no schedule the check
         // accepts at this switch time (not even the serial one): the next draw is taken.
         let mut found = None;
         for attempt in 0..MAX_DRAWS {
-            let family = Family::ALL[((index + attempt) % Family::ALL.len() as u64) as usize];
+            let family = Family::ALL[((index / 2 + attempt) % Family::ALL.len() as u64) as usize];
             let case = testkit::Case::random(family, n_robots, &mut rng);
             if let Some(c) = holds
                 .then(|| held_plans(&case, switch_s, &mut rng))
@@ -244,17 +267,12 @@ fn make_case(
         found.with_context(|| {
             format!("no case of {MAX_DRAWS} draws has a schedule accepted at this switch time")
         })?
-    } else if index % 2 == 0 {
-        let problem = with_holds(random_problem(&mut rng)?, holds)?;
-        let tick_s = DT_S * rng.random_range(0.25..=1.0);
-        let (c, o) = scheduled(&problem, n_robots, tick_s, &mut rng)?;
-        (c, o, "stress", Made::Scheduled)
     } else {
         let family = Family::ALL[((index / 2) % Family::ALL.len() as u64) as usize];
         let case = testkit::Case::random(family, n_robots, &mut rng);
         if let Some(m) = case.shared_mask() {
             let problem = with_holds(Problem::new(m.conf, m.mean, m.lo, m.hi, m.dt_s)?, holds)?;
-            let (c, o) = scheduled(&problem, n_robots, case.tick_s, &mut rng)?;
+            let (c, o) = scheduled(&problem, n_robots, case.tick_s, 0.0, &mut rng)?;
             (c, o, family.name(), Made::Scheduled)
         } else if let Some(c) = holds
             .then(|| held_plans(&case, 0.0, &mut rng))
