@@ -1,11 +1,14 @@
 //! The tick's own cost with the node's queues attached against without, in the same run
 //! (issue 43: at most 1.1×): `bare` ticks a three-robot rounds controller of the test task;
+//! `loop_only` is the node's loop without the links, what a user's own live loop on `CellLoop`
+//! runs: the clock read, the three robots heard (`CellLoop::heard`) and `CellLoop::advance`;
 //! `with_queues` is the node's tick thread on the same controller without the network
-//! (`Ticker::run` of node.rs, step for step): the clock read, the pending-message counter
-//! (nothing queued), the robots' progress counters (each robot reported since the last tick),
-//! `CellLoop::advance` (liveness, the round's log, the tick), the command pushed into the ring
-//! and the state slot's `want` flag, answered with a snapshot every 10th tick (the 100 Hz state
-//! topics at a 1 kHz tick; `with_queues_state_every_tick`: every tick, the 10 ms tick's case).
+//! (`link::TickEnd::tick`, which `Ticker::run` of node.rs runs): the clock read, the
+//! pending-message counter (nothing queued), the robots' progress counters (each robot reported
+//! since the last tick), `CellLoop::advance` (liveness, the round's log, the tick), the command
+//! pushed into the ring and the state slot's `want` flag, answered with a snapshot every 10th
+//! tick (the 100 Hz state topics at a 1 kHz tick; `with_queues_state_every_tick`: every tick,
+//! the 10 ms tick's case). The queues' cost is `with_queues` − `loop_only`.
 //! The DDS side's ends (three progress reports, the command popped, the snapshot taken) run
 //! in the same loop here and are counted. `advance_only` is `CellLoop::advance` alone (a fixed
 //! instant, no links): the loop's own share of the difference. `tick_thread_only` is
@@ -28,8 +31,8 @@ use std::time::{Duration, Instant};
 use criterion::{Criterion, criterion_group, criterion_main};
 use tandem_console::{Console, ConsoleConfig, Geometry};
 use tandem_planner::{Cell, Planner};
-use tandem_realtime::{Controller, MAX_ROBOTS, Operator};
-use tandem_ros2::link::{CommandRing, Heard, Pending, StateSlot};
+use tandem_realtime::{Controller, Operator};
+use tandem_ros2::link::{Links, TickEnd};
 use tandem_ros2::{CellLoop, ConsoleFeed, Inbound, LoopParams, Request};
 
 #[path = "../tests/support/mod.rs"]
@@ -38,14 +41,8 @@ mod support;
 /// The node's tick thread's side of the links and the DDS side's ends, in one loop.
 struct NodeTick {
     l: CellLoop,
-    ring: CommandRing,
-    state: StateSlot,
-    heard: Heard,
-    pending: Pending,
-    pending_seen: u64,
-    heard_seen: [u64; MAX_ROBOTS],
-    last_flags: (bool, bool, bool),
-    owed: bool,
+    links: Links,
+    end: TickEnd,
     ask_every: u64,
     i: u64,
 }
@@ -68,14 +65,8 @@ impl NodeTick {
         start(&mut l);
         NodeTick {
             l,
-            ring: CommandRing::new(3, 4096),
-            state: StateSlot::new(),
-            heard: Heard::default(),
-            pending: Pending::default(),
-            pending_seen: 0,
-            heard_seen: [0; MAX_ROBOTS],
-            last_flags: (false, false, false),
-            owed: false,
+            links: Links::new(3, 4096),
+            end: TickEnd::new(3),
             ask_every,
             i: 0,
         }
@@ -86,48 +77,37 @@ impl NodeTick {
     fn tick(&mut self, console: Option<&mut ConsoleFeed>) -> Option<f64> {
         // The DDS side: three progress reports; the state topics' request at their rate.
         for k in 0..3 {
-            self.heard.hear(k);
+            self.links.heard.hear(k);
         }
         self.i += 1;
         if self.i.is_multiple_of(self.ask_every) {
-            self.state.ask();
+            self.links.state.ask();
         }
         let now = self.tick_thread(console);
         // The DDS side takes the command and the snapshot.
         black_box(now);
-        let c = self.ring.pop().map(|(c, at)| (c.ref_time[0], at));
+        let c = self.links.commands.pop().map(|(c, at)| (c.ref_time[0], at));
         let s = if self.i.is_multiple_of(self.ask_every) {
-            self.state.take().map(|s| s.ref_time[1])
+            self.links.state.take().map(|s| s.ref_time[1])
         } else {
             None
         };
         c.map(|(r, _)| r).or(s)
     }
 
-    /// The tick thread's part of one tick (as `Ticker::run`); returns the tick's instant.
+    /// The tick thread's part of one tick (as `Ticker::run`, without the writer's wake and the
+    /// counters); returns the tick's instant.
     fn tick_thread(&mut self, console: Option<&mut ConsoleFeed>) -> Instant {
         let now = Instant::now();
-        if self.pending.moved(&mut self.pending_seen) {
-            unreachable!("nothing is queued in this benchmark");
-        }
-        let heard = self.heard.changed(3, &mut self.heard_seen);
-        if heard.count() > 0 {
-            for k in 0..3 {
-                if heard[k] {
-                    self.l.heard(k, now);
-                }
-            }
-        }
-        let cmd = self.l.advance(now).expect("a valid operator");
+        let cmd = self
+            .end
+            .tick(&mut self.l, &self.links, now, |_| {
+                unreachable!("nothing is queued in this benchmark")
+            })
+            .expect("a valid operator");
         if let Some(feed) = console {
             feed.publish(&self.l);
         }
-        self.ring.push(&cmd, now);
-        let flags = (cmd.fault, cmd.finished, cmd.active);
-        if flags != self.last_flags || self.owed || self.state.wanted() {
-            self.owed = !self.state.put(self.l.snapshot());
-        }
-        self.last_flags = flags;
         if cmd.finished {
             start(&mut self.l);
         }
@@ -140,15 +120,9 @@ impl NodeTick {
 /// the three robots.
 struct Threads {
     node: NodeTick,
-    links: Arc<SharedLinks>,
+    links: Arc<Links>,
     writer: std::thread::JoinHandle<u64>,
     stop: Arc<AtomicBool>,
-}
-
-struct SharedLinks {
-    ring: CommandRing,
-    heard: Heard,
-    state: StateSlot,
 }
 
 impl Threads {
@@ -163,11 +137,7 @@ impl Threads {
         let ctl = planner.controller(Cell::Rounds).expect("a plan");
         node.l = CellLoop::new(ctl, planner.model(), params).expect("valid");
         start(&mut node.l);
-        let links = Arc::new(SharedLinks {
-            ring: CommandRing::new(3, 4096),
-            heard: Heard::default(),
-            state: StateSlot::new(),
-        });
+        let links = Arc::new(Links::new(3, 4096));
         let stop = Arc::new(AtomicBool::new(false));
         let (l, st) = (links.clone(), stop.clone());
         let writer = std::thread::spawn(move || {
@@ -175,7 +145,7 @@ impl Threads {
             let mut asked = Instant::now();
             while !st.load(Ordering::Relaxed) {
                 let mut busy = false;
-                while let Some((c, _)) = l.ring.pop() {
+                while let Some((c, _)) = l.commands.pop() {
                     black_box(c);
                     taken += 1;
                     busy = true;
@@ -210,28 +180,17 @@ impl Threads {
         let n = &mut self.node;
         let l = &*self.links;
         let now = Instant::now();
-        if n.pending.moved(&mut n.pending_seen) {
-            unreachable!("nothing is queued in this benchmark");
-        }
-        let heard = l.heard.changed(3, &mut n.heard_seen);
-        if heard.count() > 0 {
-            for k in 0..3 {
-                if heard[k] {
-                    n.l.heard(k, now);
-                }
-            }
-        }
-        let cmd = n.l.advance(now).expect("a valid operator");
-        l.ring.push(&cmd, now);
-        let flags = (cmd.fault, cmd.finished, cmd.active);
-        if flags != n.last_flags || n.owed || l.state.wanted() {
-            n.owed = !l.state.put(n.l.snapshot());
-        }
-        n.last_flags = flags;
+        let cmd = n
+            .end
+            .tick(&mut n.l, l, now, |_| {
+                unreachable!("nothing is queued in this benchmark")
+            })
+            .expect("a valid operator");
+        self.writer.thread().unpark();
+        n.end.account(l, now, Instant::now());
         if cmd.finished {
             start(&mut n.l);
         }
-        self.writer.thread().unpark();
         cmd.tick
     }
 
@@ -274,23 +233,25 @@ fn bench(c: &mut Criterion) {
     let now_fixed = Instant::now();
     let fixed = node.l.advance(now_fixed).expect("a valid operator");
     let snap = node.l.snapshot();
+    let mut seen = [0; tandem_realtime::MAX_ROBOTS];
     group.bench_function("links_only", |b| {
         b.iter(|| {
+            let links = &node.links;
             for k in 0..3 {
-                node.heard.hear(k);
+                links.heard.hear(k);
             }
             node.i += 1;
             if node.i.is_multiple_of(10) {
-                node.state.ask();
+                links.state.ask();
             }
-            let heard = node.heard.changed(3, &mut node.heard_seen);
-            node.ring.push(black_box(&fixed), now_fixed);
-            if node.state.wanted() {
-                node.state.put(snap);
+            let heard = links.heard.changed(3, &mut seen);
+            links.commands.push(black_box(&fixed), now_fixed);
+            if links.state.wanted() {
+                links.state.put(snap);
             }
-            let c = node.ring.pop().map(|(c, _)| c.ref_time[0]);
+            let c = links.commands.pop().map(|(c, _)| c.ref_time[0]);
             let s = if node.i.is_multiple_of(10) {
-                node.state.take().map(|s| s.ref_time[1])
+                links.state.take().map(|s| s.ref_time[1])
             } else {
                 None
             };
@@ -303,6 +264,22 @@ fn bench(c: &mut Criterion) {
     let now = Instant::now();
     group.bench_function("advance_only", |b| {
         b.iter(|| {
+            for k in 0..3 {
+                node.l.heard(k, now);
+            }
+            let c = node.l.advance(now).expect("a valid operator");
+            if c.finished {
+                start(&mut node.l);
+            }
+            black_box(c.tick)
+        });
+    });
+    // The node's loop without the links, as a user's own live loop runs it: the clock read,
+    // the robots heard, `advance`. `with_queues` − this is what the queues cost.
+    let mut node = NodeTick::new(&planner, 10);
+    group.bench_function("loop_only", |b| {
+        b.iter(|| {
+            let now = Instant::now();
             for k in 0..3 {
                 node.l.heard(k, now);
             }
@@ -328,21 +305,21 @@ fn bench(c: &mut Criterion) {
             while left > 0 {
                 let batch = left.min(64);
                 for k in 0..3 {
-                    node.heard.hear(k);
+                    node.links.heard.hear(k);
                 }
                 let t0 = Instant::now();
                 for _ in 0..batch {
                     node.i += 1;
                     if node.i.is_multiple_of(node.ask_every) {
-                        node.state.ask();
+                        node.links.state.ask();
                     }
                     black_box(node.tick_thread(None));
                 }
                 spent += t0.elapsed();
-                while let Some(c) = node.ring.pop() {
+                while let Some(c) = node.links.commands.pop() {
                     black_box(c);
                 }
-                black_box(node.state.take());
+                black_box(node.links.state.take());
                 left -= batch;
             }
             spent

@@ -367,9 +367,22 @@ pub struct CellLoop {
     finished: bool,
     /// Each robot's last progress, or the round's start when it has not reported since.
     last_progress: [Instant; MAX_ROBOTS],
-    axis: f64,
+    /// No robot can be stalled before this instant: the earliest `last_progress[k] +
+    /// stall_after` when it was last computed, a lower bound of it since (a robot's progress
+    /// only moves later). `None`: compute it at the next tick (after a start, a cleared fault,
+    /// a progress dated earlier than the last, or a bound too far to represent). So the tick's
+    /// liveness check is one comparison, the loop over robots once per `stall_s`.
+    stall_due: Option<Instant>,
+    /// The operator's last input as the coordinator takes it ([`operator_input`] of its axis,
+    /// computed when it arrives) and whether the operator corrects.
+    operator: Operator,
     correcting: bool,
-    operator_at: Option<Instant>,
+    /// Whether an operator input arrived at all, and until when it counts (its arrival plus
+    /// `operator_timeout`; `None`: for ever, a timeout too long to represent).
+    operator_heard: bool,
+    operator_until: Option<Instant>,
+    /// Reference samples per control tick (`tick_s / dt_s`), of the controller it runs.
+    per_tick: f64,
     stall: Option<NodeFault>,
     log: RoundLog,
     capacity: usize,
@@ -427,9 +440,12 @@ impl CellLoop {
             operator_timeout,
             finished: false,
             last_progress: [Instant::now(); MAX_ROBOTS],
-            axis: 0.0,
+            stall_due: None,
+            operator: Operator::Scheduled,
             correcting: false,
-            operator_at: None,
+            operator_heard: false,
+            operator_until: None,
+            per_tick: ctl.tick_s() / dt_s,
             stall: None,
             log,
             capacity,
@@ -466,9 +482,10 @@ impl CellLoop {
                 }
             }
             Inbound::Operator { axis, correcting } => {
-                self.axis = axis;
+                self.operator = operator_input(axis, self.params.deadband);
                 self.correcting = correcting;
-                self.operator_at = Some(now);
+                self.operator_heard = true;
+                self.operator_until = now.checked_add(self.operator_timeout);
             }
             Inbound::Replace(ctl, plan) => self.pending = Some((ctl, plan)),
             Inbound::Restore(log) => {
@@ -502,6 +519,10 @@ impl CellLoop {
     /// Robot `robot` (0-based; others ignored) reported progress at `now`: it is alive.
     pub fn heard(&mut self, robot: usize, now: Instant) {
         if robot < self.ctl.n_robots() {
+            if now < self.last_progress[robot] {
+                // Earlier than before: the stall bound may be earlier too.
+                self.stall_due = None;
+            }
             self.last_progress[robot] = now;
         }
     }
@@ -557,6 +578,7 @@ impl CellLoop {
                 if let Some((ctl, plan)) = self.pending.take() {
                     self.capacity = round_capacity(&ctl);
                     self.log.tick_s = ctl.tick_s();
+                    self.per_tick = ctl.tick_s() / self.dt_s;
                     self.ctl = *ctl;
                     self.plan = Some(plan);
                     self.generation += 1;
@@ -576,6 +598,7 @@ impl CellLoop {
                 self.finished = false;
                 self.stall = None;
                 self.last_progress = [now; MAX_ROBOTS];
+                self.stall_due = None;
                 self.active = true;
                 Ok(())
             }
@@ -601,6 +624,7 @@ impl CellLoop {
                 if let Some(NodeFault::Stalled { robot, .. }) = self.stall.take() {
                     // A fresh grace period: stalled again if it stays silent.
                     self.last_progress[robot] = now;
+                    self.stall_due = None;
                 }
                 self.ctl.clear_fault();
                 Ok(())
@@ -662,17 +686,8 @@ impl CellLoop {
     pub fn advance(&mut self, now: Instant) -> Result<Command> {
         let n = self.ctl.n_robots();
         self.ticks += 1;
-        if self.active && self.stall.is_none() {
-            for k in 0..n {
-                let silent = now.saturating_duration_since(self.last_progress[k]);
-                if silent > self.stall_after {
-                    self.stall = Some(NodeFault::Stalled {
-                        robot: k,
-                        silent_s: silent.as_secs_f64(),
-                    });
-                    break;
-                }
-            }
+        if self.active && self.stall.is_none() && self.stall_due.is_none_or(|d| now > d) {
+            self.check_stall(now);
         }
         // The controller's reference times now: its last tick's (the contract: `Tick::ref_time`
         // is `ref_time_now()` after the tick; `last` is refreshed whenever a request changes
@@ -680,14 +695,11 @@ impl CellLoop {
         let before = self.last.ref_time;
         let mut overlap = false;
         if self.active && self.stall.is_none() {
-            let fresh = self
-                .operator_at
-                .is_some_and(|t| now.saturating_duration_since(t) <= self.operator_timeout);
+            // The input counts while `now ≤ arrival + timeout` (an input stamped after `now`
+            // counts too, as the silence of a negative duration is 0).
+            let fresh = self.operator_heard && self.operator_until.is_none_or(|u| now <= u);
             let (operator, correcting) = if fresh {
-                (
-                    operator_input(self.axis, self.params.deadband),
-                    self.correcting,
-                )
+                (self.operator, self.correcting)
             } else {
                 (Operator::Scheduled, false)
             };
@@ -722,7 +734,7 @@ impl CellLoop {
         }
         let after = self.last.ref_time;
         debug_assert_eq!(after, self.ctl.ref_time_now());
-        let per_tick = self.ctl.tick_s() / self.dt_s;
+        let per_tick = self.per_tick;
         for (i, s) in self.speed.as_mut_slice().iter_mut().enumerate().take(n) {
             *s = ((after[i] - before[i]) / per_tick).max(0.0);
         }
@@ -736,6 +748,33 @@ impl CellLoop {
             speed: self.speed,
             needs_operator: self.needs_operator(),
         })
+    }
+}
+
+impl CellLoop {
+    /// The liveness check of a tick at `now` whose `now` is past the stall bound
+    /// (`stall_due`): latches [`NodeFault::Stalled`] for the first robot silent for more than
+    /// `stall_s` (robot 1 first), else sets the bound to the earliest instant one can be.
+    /// `silent > stall_after` is `now > last_progress + stall_after` in whole nanoseconds, so
+    /// the bound decides exactly as the loop over robots each tick did.
+    #[cold]
+    fn check_stall(&mut self, now: Instant) {
+        let mut due: Option<Instant> = None;
+        for k in 0..self.ctl.n_robots() {
+            let silent = now.saturating_duration_since(self.last_progress[k]);
+            if silent > self.stall_after {
+                self.stall = Some(NodeFault::Stalled {
+                    robot: k,
+                    silent_s: silent.as_secs_f64(),
+                });
+                return;
+            }
+            // A bound too far to represent: this robot never stalls; the others decide.
+            if let Some(d) = self.last_progress[k].checked_add(self.stall_after) {
+                due = Some(due.map_or(d, |e| e.min(d)));
+            }
+        }
+        self.stall_due = due;
     }
 }
 

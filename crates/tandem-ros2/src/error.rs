@@ -51,6 +51,14 @@ pub enum Error {
     /// The task model.
     #[error(transparent)]
     Lfd(#[from] tandem_lfd::Error),
+    /// The stage trace ([`crate::NodeParams::stage_trace`]) could not be written.
+    #[error("cannot write the stage trace {}: {why}; give a path in a writable folder", path.display())]
+    Trace {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The OS's message.
+        why: String,
+    },
 }
 
 /// The crate's result type.

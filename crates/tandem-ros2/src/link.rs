@@ -15,7 +15,8 @@ use std::time::{Duration, Instant};
 
 use tandem_realtime::{MAX_ROBOTS, PerRobot, RobotFlags};
 
-use crate::core::{Command, Snapshot};
+use crate::core::{CellLoop, Command, Snapshot};
+use crate::error::Result;
 
 /// Words of one command record for `n` robots: the tick, the flags, the tick's start (ns after
 /// the ring's creation), then each robot's reference time and speed scale (`f64` bits).
@@ -46,11 +47,13 @@ pub struct CommandRing {
 }
 
 impl CommandRing {
-    /// A ring of `capacity` (≥ 1) records of `n` (1…[`MAX_ROBOTS`]) robots.
+    /// A ring of at least `capacity` records of `n` (1…[`MAX_ROBOTS`]) robots: `capacity`
+    /// rounded up to a power of two (≥ 1), so that a record's slot is its count masked, not a
+    /// division.
     #[must_use]
     pub fn new(n: usize, capacity: usize) -> CommandRing {
         let n = n.clamp(1, MAX_ROBOTS);
-        let capacity = capacity.max(1);
+        let capacity = capacity.max(1).next_power_of_two();
         CommandRing {
             n,
             base: Instant::now(),
@@ -66,7 +69,7 @@ impl CommandRing {
 
     fn record(&self, count: u64) -> &[AtomicU64] {
         let w = record_words(self.n);
-        let at = (count % self.capacity) as usize * w;
+        let at = (count & (self.capacity - 1)) as usize * w;
         &self.words[at..at + w]
     }
 
@@ -121,6 +124,13 @@ impl CommandRing {
     #[must_use]
     pub fn dropped(&self) -> u64 {
         self.dropped.load(Ordering::Relaxed)
+    }
+
+    /// Records the ring holds at most ([`CommandRing::new`]'s `capacity` rounded up to a power
+    /// of two).
+    #[must_use]
+    pub fn capacity(&self) -> usize {
+        self.capacity as usize
     }
 }
 
@@ -205,14 +215,20 @@ impl Heard {
     /// The robots (of the first `n`) heard since `seen` (updated): a flag each.
     pub fn changed(&self, n: usize, seen: &mut [u64; MAX_ROBOTS]) -> RobotFlags {
         let mut out = RobotFlags::new(n);
+        self.each_heard(n, seen, |k| out.set(k, true));
+        out
+    }
+
+    /// Calls `f(k)` for each robot `k` (of the first `n`) heard since `seen` (updated), robot 1
+    /// first: one relaxed load and one comparison per robot.
+    pub fn each_heard(&self, n: usize, seen: &mut [u64; MAX_ROBOTS], mut f: impl FnMut(usize)) {
         for (k, (c, s)) in self.counts.iter().zip(seen.iter_mut()).take(n).enumerate() {
             let v = c.load(Ordering::Relaxed);
             if v != *s {
                 *s = v;
-                out.set(k, true);
+                f(k);
             }
         }
-        out
     }
 }
 
@@ -237,6 +253,133 @@ impl Pending {
         } else {
             *seen = v;
             true
+        }
+    }
+}
+
+/// What the tick thread and the DDS thread share besides the bounded queue of rare messages:
+/// the links above and the tick thread's counters for [`crate::NodeStats`] (each written by
+/// the tick thread only, by a plain store).
+#[derive(Debug)]
+pub struct Links {
+    /// Every tick's command, to the DDS thread.
+    pub commands: CommandRing,
+    /// The state topics' snapshot, when the DDS thread asks.
+    pub state: StateSlot,
+    /// The robots' progress reports, counted.
+    pub heard: Heard,
+    /// Messages queued for the tick thread, counted.
+    pub pending: Pending,
+    /// Ticks run.
+    pub ticks: AtomicU64,
+    /// The longest time between two tick starts (ns).
+    pub max_period_ns: AtomicU64,
+    /// The longest time one tick's work took (ns).
+    pub max_tick_ns: AtomicU64,
+}
+
+impl Links {
+    /// The links of `n` robots with a command ring of at least `capacity` records.
+    #[must_use]
+    pub fn new(n: usize, capacity: usize) -> Links {
+        Links {
+            commands: CommandRing::new(n, capacity),
+            state: StateSlot::new(),
+            heard: Heard::default(),
+            pending: Pending::default(),
+            ticks: AtomicU64::new(0),
+            max_period_ns: AtomicU64::new(0),
+            max_tick_ns: AtomicU64::new(0),
+        }
+    }
+}
+
+/// The tick thread's end of the [`Links`]: what it last saw of each counter and the counters it
+/// keeps, so that one tick ([`TickEnd::tick`]) is a few loads and stores around
+/// [`CellLoop::advance`]. The node's tick thread runs exactly this (and the benchmark and the
+/// instruction-count example run it too).
+#[derive(Debug)]
+pub struct TickEnd {
+    n: usize,
+    pending_seen: u64,
+    heard_seen: [u64; MAX_ROBOTS],
+    /// The last command's fault, finished and active flags (bits 0–2 of
+    /// [`Command::flags_word`]'s order).
+    last_flags: u8,
+    /// A snapshot is owed: the slot was held by the reader when one was due.
+    owed: bool,
+    ticks: u64,
+    last_start: Option<Instant>,
+    max_period_ns: u64,
+    max_tick_ns: u64,
+}
+
+impl TickEnd {
+    /// The tick thread's end for `n` robots, nothing seen yet.
+    #[must_use]
+    pub fn new(n: usize) -> TickEnd {
+        TickEnd {
+            n: n.min(MAX_ROBOTS),
+            pending_seen: 0,
+            heard_seen: [0; MAX_ROBOTS],
+            last_flags: 0,
+            owed: false,
+            ticks: 0,
+            last_start: None,
+            max_period_ns: 0,
+            max_tick_ns: 0,
+        }
+    }
+
+    /// One tick at `now` (the tick's start): `drain` takes the queued rare messages in when
+    /// the pending counter moved, each robot heard since the last tick is alive at `now`,
+    /// [`CellLoop::advance`], the command into the ring (a full ring drops it, counted), and
+    /// the snapshot into the state slot when the DDS thread asked for it or the fault, the
+    /// round's end or the running state changed (or one is owed). Returns the command.
+    ///
+    /// # Errors
+    /// [`CellLoop::advance`]'s.
+    pub fn tick(
+        &mut self,
+        l: &mut CellLoop,
+        links: &Links,
+        now: Instant,
+        drain: impl FnOnce(&mut CellLoop),
+    ) -> Result<Command> {
+        if links.pending.moved(&mut self.pending_seen) {
+            drain(l);
+        }
+        links
+            .heard
+            .each_heard(self.n, &mut self.heard_seen, |k| l.heard(k, now));
+        let cmd = l.advance(now)?;
+        links.commands.push(&cmd, now);
+        let flags = u8::from(cmd.fault) | u8::from(cmd.finished) << 1 | u8::from(cmd.active) << 2;
+        if flags != self.last_flags || self.owed || links.state.wanted() {
+            // A slot the DDS thread holds right now is written at the next tick.
+            self.owed = !links.state.put(l.snapshot());
+        }
+        self.last_flags = flags;
+        Ok(cmd)
+    }
+
+    /// Counts a tick that started at `start` and whose work ended at `end` into `links`'
+    /// counters: one store for the count, one more only when a maximum grew.
+    pub fn account(&mut self, links: &Links, start: Instant, end: Instant) {
+        self.ticks += 1;
+        links.ticks.store(self.ticks, Ordering::Relaxed);
+        if let Some(last) = self.last_start {
+            let period = start.saturating_duration_since(last).as_nanos() as u64;
+            if period > self.max_period_ns {
+                self.max_period_ns = period;
+                links.max_period_ns.store(period, Ordering::Relaxed);
+            }
+        }
+        self.last_start = Some(start);
+        let work = end.saturating_duration_since(start).as_nanos() as u64;
+        if work > self.max_tick_ns {
+            self.max_tick_ns = work;
+            links.max_tick_ns.store(work, Ordering::Relaxed);
         }
     }
 }

@@ -40,7 +40,7 @@ use tandem_realtime::Controller;
 use crate::console::ConsoleFeed;
 use crate::core::{CellLoop, Inbound, LoopParams, Reply, Request, RoundLog};
 use crate::error::{Error, Result, dds};
-use crate::link::{CommandRing, Heard, Pending, StateSlot};
+use crate::link::{Links, TickEnd};
 use crate::msg::{
     self, BOOL, Bool, FLOAT64, FLOAT64_MULTI_ARRAY, Float64, Float64MultiArray, JOY, Joy,
     POSE_STAMPED, PoseStamped, STRING, TRIGGER, Text, TriggerRequest, TriggerResponse, TypeName,
@@ -74,6 +74,14 @@ pub struct NodeParams {
     /// ([`Priority::Refused`]). Never required. Default: −10 (docs/decisions.md, "The node's
     /// tick thread wakes its writer, both at a raised priority (issue 43)").
     pub nice: i32,
+    /// A measurement aid: when set, the DDS thread notes, for every command it publishes, when
+    /// its tick started, when it took it from the ring and when each robot's `publish` returned,
+    /// and writes them to this file when the node stops (one line per tick: `tick start_s
+    /// pop_ns pub1_ns … pubN_ns`, the start as wall-clock s since the Unix epoch, the others ns
+    /// after it), so a subscriber's receive times split the latency into its stages
+    /// (docs/decisions.md, "The node's tick: a few stores, and where the stream's tail is
+    /// (issue 43)"). Costs a branch per command when `None`. Default: `None`.
+    pub stage_trace: Option<PathBuf>,
 }
 
 impl Default for NodeParams {
@@ -88,6 +96,7 @@ impl Default for NodeParams {
             pose_channels: PoseChannels::Auto,
             frame_id: "world".into(),
             nice: -10,
+            stage_trace: None,
         }
     }
 }
@@ -196,13 +205,10 @@ pub fn set_thread_nice(nice: i32) -> Priority {
 struct Counters {
     tick_priority: OnceLock<Priority>,
     dds_priority: OnceLock<Priority>,
-    ticks: AtomicU64,
-    max_period_ns: AtomicU64,
     overruns: AtomicU64,
     inbound_dropped: AtomicU64,
     commands: AtomicU64,
     publish_failed: AtomicU64,
-    max_tick_ns: AtomicU64,
 }
 
 /// What a node did so far.
@@ -246,22 +252,9 @@ pub struct Node {
     n_robots: usize,
     tick_s: f64,
     console: Option<Console>,
-    links: Option<Arc<Links>>,
+    links: Arc<Links>,
     pose: Option<PoseMap>,
     channels: Vec<String>,
-}
-
-/// What the tick and DDS threads share besides the queue of rare messages (`crate::link`).
-#[derive(Debug)]
-struct Links {
-    /// Every tick's command, to the DDS thread.
-    commands: CommandRing,
-    /// The state topics' snapshot, when the DDS thread asks.
-    state: StateSlot,
-    /// The robots' progress reports, counted.
-    heard: Heard,
-    /// Messages queued for the tick thread, counted.
-    pending: Pending,
 }
 
 impl Node {
@@ -319,12 +312,7 @@ impl Node {
         let io_stop = Arc::new(AtomicBool::new(false));
         let counters = Arc::new(Counters::default());
         let (in_tx, in_rx) = sync_channel::<Inbound>(params.queue);
-        let links = Arc::new(Links {
-            commands: CommandRing::new(n, params.queue),
-            state: StateSlot::new(),
-            heard: Heard::default(),
-            pending: Pending::default(),
-        });
+        let links = Arc::new(Links::new(n, params.queue));
         let (reply_tx, reply_rx) = sync_channel::<Reply>(64);
         let (ready_tx, ready_rx) = sync_channel::<Result<()>>(1);
         let io = Io {
@@ -342,6 +330,7 @@ impl Node {
             stop: io_stop.clone(),
             counters: counters.clone(),
             nice: params.nice,
+            stage_trace: params.stage_trace.clone(),
         };
         let io = std::thread::Builder::new()
             .name("tandem-dds".into())
@@ -394,7 +383,7 @@ impl Node {
             n_robots: n,
             tick_s,
             console,
-            links: Some(links_keep),
+            links: links_keep,
             pose,
             channels: planner.model().channel_names().to_vec(),
         })
@@ -436,23 +425,20 @@ impl Node {
     #[must_use]
     pub fn stats(&self) -> NodeStats {
         let c = &self.counters;
+        let l = &self.links;
         let get = |a: &AtomicU64| a.load(Ordering::Relaxed);
         NodeStats {
-            ticks: get(&c.ticks),
-            max_period_s: get(&c.max_period_ns) as f64 * 1e-9,
-            max_tick_s: get(&c.max_tick_ns) as f64 * 1e-9,
+            ticks: get(&l.ticks),
+            max_period_s: get(&l.max_period_ns) as f64 * 1e-9,
+            max_tick_s: get(&l.max_tick_ns) as f64 * 1e-9,
             overruns: get(&c.overruns),
-            commands_dropped: self.links_dropped(),
+            commands_dropped: l.commands.dropped(),
             inbound_dropped: get(&c.inbound_dropped),
             commands: get(&c.commands),
             publish_failed: get(&c.publish_failed),
             tick_priority: c.tick_priority.get().copied().unwrap_or_default(),
             dds_priority: c.dds_priority.get().copied().unwrap_or_default(),
         }
-    }
-
-    fn links_dropped(&self) -> u64 {
-        self.links.as_ref().map_or(0, |l| l.commands.dropped())
     }
 
     /// Whether both threads still run.
@@ -499,10 +485,6 @@ fn join(h: JoinHandle<Result<()>>, name: &'static str) -> Result<()> {
     })?
 }
 
-fn max_into(a: &AtomicU64, v: u64) {
-    a.fetch_max(v, Ordering::Relaxed);
-}
-
 /// The tick thread.
 struct Ticker {
     /// The DDS thread, woken after each command is pushed (it parks when idle).
@@ -526,65 +508,39 @@ impl Ticker {
         let _ = self.started.try_send(());
         let period = Duration::from_secs_f64(self.tick_s);
         let mut next = Instant::now();
-        let mut last_start: Option<Instant> = None;
         let c = self.counters.clone();
-        let n = self.cell_loop.controller().n_robots();
-        let mut pending_seen = 0_u64;
-        let mut heard_seen = [0_u64; tandem_realtime::MAX_ROBOTS];
-        let mut last_flags = (false, false, false);
-        let mut owed = false;
+        let links = self.links.clone();
+        let mut end = TickEnd::new(self.cell_loop.controller().n_robots());
         while !self.stop.load(Ordering::Relaxed) {
             let now = Instant::now();
-            if let Some(last) = last_start {
-                max_into(&c.max_period_ns, (now - last).as_nanos() as u64);
-            }
-            last_start = Some(now);
-            let links = &*self.links;
             // The rare messages (operator, requests, records), only when some were queued; at
             // most one queue's worth per tick: a flood cannot lengthen the tick unboundedly.
-            if links.pending.moved(&mut pending_seen) {
+            let (in_rx, reply_tx) = (&self.in_rx, &self.reply_tx);
+            let drain = |l: &mut CellLoop| {
                 for _ in 0..4096 {
-                    match self.in_rx.try_recv() {
-                        Ok(m) => {
-                            let tx = &self.reply_tx;
-                            self.cell_loop.handle(m, now, &mut |r| {
-                                // 64 slots for at most a handful of pending requests.
-                                let _ = tx.try_send(r);
-                            });
-                        }
+                    match in_rx.try_recv() {
+                        Ok(m) => l.handle(m, now, &mut |r| {
+                            // 64 slots for at most a handful of pending requests.
+                            let _ = reply_tx.try_send(r);
+                        }),
                         Err(TryRecvError::Empty | TryRecvError::Disconnected) => break,
                     }
                 }
-            }
-            let heard = links.heard.changed(n, &mut heard_seen);
-            if heard.count() > 0 {
-                for k in 0..n {
-                    if heard[k] {
-                        self.cell_loop.heard(k, now);
-                    }
-                }
-            }
-            let cmd = self.cell_loop.advance(now)?;
+            };
+            // Every tick's command; the state topics' snapshot when asked, or at once when the
+            // fault or the round's state changed (so their topics follow within the tick).
+            end.tick(&mut self.cell_loop, &links, now, drain)?;
+            // The DDS thread parks when it has nothing to do: wake it for this command (a swap
+            // when it is awake; a futex wake when parked, measured in the benchmark
+            // `node_threads`). Before the console's feed: the command goes out first.
+            self.writer.unpark();
             if let Some(feed) = &mut self.console {
                 feed.publish(&self.cell_loop);
             }
-            // Every tick's command; the state topics' snapshot when asked, or at once when the
-            // fault or the round's state changed (so their topics follow within the tick).
-            links.commands.push(&cmd, now);
-            let flags = (cmd.fault, cmd.finished, cmd.active);
-            if flags != last_flags || owed || links.state.wanted() {
-                // A slot the DDS thread holds right now is written at the next tick.
-                owed = !links.state.put(self.cell_loop.snapshot());
-            }
-            last_flags = flags;
-            // The DDS thread parks when it has nothing to do: wake it for this command (a swap
-            // when it is awake; a futex wake when parked, measured in the benchmark `wake`).
-            self.writer.unpark();
-            c.ticks.fetch_add(1, Ordering::Relaxed);
             next += period;
             // One clock read for both the tick's work and the sleep.
             let after = Instant::now();
-            max_into(&c.max_tick_ns, (after - now).as_nanos() as u64);
+            end.account(&links, now, after);
             if next > after {
                 std::thread::sleep(next - after);
             } else if after - next > period {
@@ -625,6 +581,7 @@ struct Io {
     stop: Arc<AtomicBool>,
     counters: Arc<Counters>,
     nice: i32,
+    stage_trace: Option<PathBuf>,
 }
 
 /// The wall-clock time (s since the Unix epoch) of `at`, by the pair `clock` of one monotonic
@@ -637,6 +594,23 @@ fn wall_s(at: Instant, clock: (Instant, SystemTime)) -> f64 {
     };
     wall.duration_since(SystemTime::UNIX_EPOCH)
         .map_or(0.0, |d| d.as_secs_f64())
+}
+
+/// Writes the DDS thread's stage trace ([`NodeParams::stage_trace`]): one line per command.
+fn write_trace(path: &Path, rows: &[(u64, f64, Vec<u64>)]) -> Result<()> {
+    use std::fmt::Write as _;
+    let mut text = String::with_capacity(rows.len() * 48);
+    for (tick, start, stages) in rows {
+        let _ = write!(text, "{tick} {start:.9}");
+        for s in stages {
+            let _ = write!(text, " {s}");
+        }
+        text.push('\n');
+    }
+    std::fs::write(path, text).map_err(|e| Error::Trace {
+        path: path.to_path_buf(),
+        why: e.to_string(),
+    })
 }
 
 /// The QoS of every topic: reliable, volatile, keep last 16 — ROS 2's default profile, the one
@@ -780,6 +754,12 @@ impl Io {
         };
         // Records running on their threads: the loop ends only when none is left.
         let mut recording = 0_usize;
+        // Per command: the tick, its start (wall s), then the pop and each publish's return
+        // (ns after the start).
+        let mut trace: Option<Vec<(u64, f64, Vec<u64>)>> = self
+            .stage_trace
+            .as_ref()
+            .map(|_| Vec::with_capacity(1 << 16));
         let mut stopped_at: Option<Instant> = None;
         loop {
             // Set once the tick thread has ended: this pass publishes its last commands.
@@ -794,6 +774,8 @@ impl Io {
                 busy = true;
                 // The tick's start: the latency a subscriber measures is the coordinator's.
                 let stamp = wall_s(at, clock);
+                let since = |t: Instant| t.saturating_duration_since(at).as_nanos() as u64;
+                let mut stages = trace.as_ref().map(|_| vec![since(Instant::now())]);
                 for (k, r) in robots.iter().enumerate() {
                     let data = vec![
                         command.ref_time[k],
@@ -803,7 +785,13 @@ impl Io {
                     ];
                     let m = Float64MultiArray::labelled("ref_time,speed_scale,tick,stamp_s", data);
                     fail(r.command.publish(m).is_ok());
+                    if let Some(s) = &mut stages {
+                        s.push(since(Instant::now()));
+                    }
                     c.commands.fetch_add(1, Ordering::Relaxed);
+                }
+                if let (Some(t), Some(s)) = (&mut trace, stages) {
+                    t.push((command.tick, stamp, s));
                 }
                 for (k, r) in robots.iter().enumerate() {
                     let needs = command.needs_operator[k];
@@ -941,6 +929,9 @@ impl Io {
             if !busy {
                 std::thread::park_timeout(Duration::from_micros(200));
             }
+        }
+        if let (Some(path), Some(rows)) = (&self.stage_trace, trace) {
+            write_trace(path, &rows)?;
         }
         Ok(())
     }

@@ -2,8 +2,10 @@
 //! reports progress), the operator's input device, and calls the services. The tests' other
 //! process, and a smoke test for a user's graph.
 
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
+use ros2_client::dds::rustdds::mio1::{Events, Interest, Poll, Token};
 use ros2_client::{Client, Node as RosNode, Publisher, ServiceTypeName, Subscription};
 
 use crate::error::{Error, Result, dds};
@@ -41,6 +43,9 @@ pub struct Probe {
     fault: Subscription<Text>,
     operator: Publisher<Joy>,
     clients: Vec<Client<TriggerRequest, TriggerResponse>>,
+    /// The robots' command readers registered for their data events
+    /// ([`Probe::wait_commands`]).
+    wake: Mutex<(Poll, Events)>,
 }
 
 impl std::fmt::Debug for Probe {
@@ -86,6 +91,12 @@ impl Probe {
             )?);
             progress.push(publisher(&mut node, &robot_topic(k, "progress")?, FLOAT64)?);
         }
+        let poll = Poll::new().map_err(|e| dds("create a poll of the command readers", e))?;
+        for (k, c) in commands.iter_mut().enumerate() {
+            poll.registry()
+                .register(c, Token(k), Interest::READABLE)
+                .map_err(|e| dds(format!("register robot {}'s command reader", k + 1), e))?;
+        }
         let fault = subscription(&mut node, &cell_topic("fault")?, STRING)?;
         let operator = publisher(&mut node, &cell_topic("operator")?, JOY)?;
         let clients = SERVICES
@@ -111,7 +122,26 @@ impl Probe {
             fault,
             operator,
             clients,
+            wake: Mutex::new((poll, Events::with_capacity(16))),
         })
+    }
+
+    /// Waits until a command of any robot has arrived since the last [`Probe::commands`]
+    /// (the reader's data event: RustDDS signals each sample it stores), or `timeout` passes;
+    /// `true` when woken by data (it may be data already taken). What a robot driver's thread
+    /// that follows the commands does instead of polling on a timer: the command is taken as it
+    /// arrives, not up to a poll period later.
+    pub fn wait_commands(&self, timeout: Duration) -> bool {
+        let mut guard = match self.wake.lock() {
+            Ok(g) => g,
+            Err(poisoned) => poisoned.into_inner(),
+        };
+        let (poll, events) = &mut *guard;
+        match poll.poll(events, Some(timeout)) {
+            Ok(()) => !events.is_empty(),
+            // An interrupted wait is a spurious wake-up: the caller takes and waits again.
+            Err(_) => false,
+        }
     }
 
     /// Every command of robot `k` that arrived since the last call, oldest first.

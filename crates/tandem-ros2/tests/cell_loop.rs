@@ -355,3 +355,56 @@ fn the_operators_input_sets_the_supervised_robots_speed_and_is_recorded() {
         "{fastest:?}"
     );
 }
+
+/// The liveness check is one comparison against the earliest instant a robot can be stalled
+/// at; it must decide exactly as a check of every robot each tick: not stalled at a silence of
+/// exactly `stall_s`, stalled one nanosecond later, and a progress dated earlier than the last
+/// one (a caller's clock) brings the bound forward.
+#[test]
+fn the_stall_bound_decides_to_the_nanosecond() {
+    let planner = support::planner(2);
+    let stall = Duration::from_millis(250);
+    let start = |l: &mut CellLoop, t: Instant| {
+        assert_eq!(refused(&ask(l, Request::Start, t)), None);
+    };
+    let t0 = Instant::now();
+    // Robot 1 reports at t0 + 0.1 s, robot 2 not since the start (t0).
+    let mut l = cell_loop(&planner, Cell::Rounds);
+    start(&mut l, t0);
+    l.heard(0, t0 + Duration::from_millis(100));
+    assert!(
+        l.step(t0 + Duration::from_millis(100))
+            .unwrap()
+            .fault
+            .is_none()
+    );
+    assert!(
+        l.step(t0 + stall).unwrap().fault.is_none(),
+        "silent exactly stall_s"
+    );
+    let late = t0 + stall + Duration::from_nanos(1);
+    match l.step(late).unwrap().fault {
+        Some(NodeFault::Stalled { robot, silent_s }) => {
+            assert_eq!(robot, 1);
+            assert_eq!(silent_s, 0.250_000_001);
+        }
+        other => panic!("robot 2 silent for 0.25 s + 1 ns is stalled, got {other:?}"),
+    }
+    // A bound computed at t0 + 0.2 s (both heard then: due at t0 + 0.45 s), then robot 2's
+    // progress dated t0 + 0.1 s: due at t0 + 0.35 s, so stalled at t0 + 0.4 s.
+    let mut l = cell_loop(&planner, Cell::Rounds);
+    start(&mut l, t0);
+    let t2 = t0 + Duration::from_millis(200);
+    l.heard(0, t2);
+    l.heard(1, t2);
+    assert!(l.step(t2).unwrap().fault.is_none());
+    l.heard(1, t0 + Duration::from_millis(100));
+    l.heard(0, t0 + Duration::from_millis(400));
+    match l.step(t0 + Duration::from_millis(400)).unwrap().fault {
+        Some(NodeFault::Stalled { robot, silent_s }) => {
+            assert_eq!(robot, 1);
+            assert!((silent_s - 0.3).abs() < 1e-12, "{silent_s}");
+        }
+        other => panic!("robot 2 silent for 0.3 s is stalled, got {other:?}"),
+    }
+}

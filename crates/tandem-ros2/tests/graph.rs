@@ -216,10 +216,12 @@ fn node_process() {
         .unwrap()
         .parse()
         .unwrap();
+    let trace = std::env::var_os("TANDEM_ROS2_NODE_TRACE").map(std::path::PathBuf::from);
     let params = NodeParams {
         domain,
         robots: Some(robots),
         nice: stream_nice().unwrap_or(NodeParams::default().nice),
+        stage_trace: trace.clone(),
         ..NodeParams::default()
     };
     let node = Node::start(Path::new(&state), &params).unwrap();
@@ -228,7 +230,12 @@ fn node_process() {
         "node process: tick thread at {}, DDS thread at {}",
         s.tick_priority, s.dds_priority
     );
-    std::thread::sleep(Duration::from_secs(120));
+    if trace.is_some() {
+        // Traced: runs until its standard input closes, then stops (writing the trace).
+        let _ = std::io::Read::read_to_end(&mut std::io::stdin(), &mut Vec::new());
+    } else {
+        std::thread::sleep(Duration::from_secs(120));
+    }
     node.stop().unwrap();
 }
 
@@ -489,35 +496,80 @@ fn stream_nice() -> Option<i32> {
 
 /// The must-show stream: a node process at a 1 ms tick (the test task sampled at 1 kHz),
 /// its two robots' commands over loopback for 10 s with reliable QoS, taken by a probe that
-/// polls every 50 µs: messages lost (tick numbers skipped) and the latency from the tick's
-/// start (the command's stamp) to the probe's take. The probe's thread (and the DDS library's
-/// threads it starts) asks for the node's priority, as a robot driver's control thread runs
-/// raised (`TANDEM_ROS2_NICE=0`: neither raised). A measurement (it prints which priorities
-/// applied); run with `--ignored`.
+/// polls every 50 µs (`TANDEM_ROS2_PROBE=events`: waits on its command readers' data events
+/// instead, `Probe::wait_commands`): messages lost (tick numbers skipped) and the latency
+/// from the tick's start (the command's stamp) to the probe's take, split into its stages by the
+/// node's stage trace (`NodeParams::stage_trace`): tick start → the DDS thread's pop (the ring
+/// and the writer's wake), pop → the robot's `publish` returned (serialization, RustDDS's
+/// admission and doorbell), `publish` → the probe's take (RustDDS's event loops, loopback UDP,
+/// the reader's event, the probe's wake). The probe's thread (and the DDS library's threads it
+/// starts) asks for the node's priority, as a robot driver's control thread runs raised
+/// (`TANDEM_ROS2_NICE=0`: neither raised). A measurement (it prints which priorities applied);
+/// run with `--ignored`.
 #[test]
 #[ignore = "a 10 s measurement: cargo test -p tandem-ros2 --test graph stream -- --ignored --nocapture"]
 fn stream_1khz_for_10_s() {
     let domain = 69;
     let state =
         support::state_file_of("stream", support::planner_with(support::model_at(0.001), 2));
-    let mut child = spawn_node(&state, domain, 2);
+    let trace = state.with_file_name("stages.txt");
+    let mut child = Process::new(std::env::current_exe().unwrap())
+        .args(["--exact", "node_process", "--ignored", "--nocapture"])
+        .env("TANDEM_ROS2_NODE_STATE", &state)
+        .env("TANDEM_ROS2_NODE_DOMAIN", domain.to_string())
+        .env("TANDEM_ROS2_NODE_ROBOTS", "2")
+        .env("TANDEM_ROS2_NODE_TRACE", &trace)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .unwrap();
     let nice = stream_nice().unwrap_or(NodeParams::default().nice);
     let subscriber = tandem_ros2::set_thread_nice(nice);
-    eprintln!("subscriber at {subscriber}");
+    let sleep_poll = std::env::var("TANDEM_ROS2_PROBE").as_deref() != Ok("events");
+    eprintln!(
+        "subscriber at {subscriber}, {}",
+        if sleep_poll {
+            "polling every 50 µs"
+        } else {
+            "waiting on the readers' data events"
+        }
+    );
     let probe = Probe::new(domain, 2).unwrap();
     assert!(
         discover(&probe, 2, Duration::from_secs(30)),
         "no discovery on loopback"
     );
+    // (robot, tick) → the probe's take (wall s).
+    let mut taken: Vec<(usize, u64, f64)> = Vec::with_capacity(25_000);
     let (mut lat, mut last, mut lost) = (Vec::new(), vec![0; 2], 0);
     let end = Instant::now() + Duration::from_secs(10);
     while Instant::now() < end {
-        echo(&probe, &[true, true], &mut lat, &mut last, &mut lost);
-        std::thread::sleep(Duration::from_micros(50));
+        for (k, l) in last.iter_mut().enumerate() {
+            let cmds = probe.commands(k);
+            for c in &cmds {
+                lat.push(c.received_s - c.stamp_s);
+                taken.push((k, c.tick, c.received_s));
+                if *l > 0 && c.tick > *l + 1 {
+                    lost += c.tick - *l - 1;
+                }
+                *l = c.tick;
+            }
+            if let Some(c) = cmds.last() {
+                probe.report(k, c.ref_time).unwrap();
+            }
+        }
+        if sleep_poll {
+            std::thread::sleep(Duration::from_micros(50));
+        } else {
+            probe.wait_commands(Duration::from_millis(5));
+        }
     }
-    let _ = child.kill();
-    let _ = child.wait();
+    drop(child.stdin.take());
+    let status = child.wait().unwrap();
+    let stages = std::fs::read_to_string(&trace).unwrap_or_default();
     support::remove(&state);
+    assert!(status.success(), "the node process: {status}");
     let n = lat.len();
     let (p50, p99, max) = (
         percentile(&mut lat, 0.5),
@@ -531,6 +583,72 @@ fn stream_1khz_for_10_s() {
         max * 1e3
     );
     assert!(n > 10_000, "{n}");
+    // The stages of each command taken: ring (start → pop), publish (pop → its robot's
+    // `publish` returned), network (→ the take).
+    let rows: std::collections::HashMap<u64, (f64, Vec<f64>)> = stages
+        .lines()
+        .filter_map(|line| {
+            let mut w = line.split(' ');
+            let tick = w.next()?.parse().ok()?;
+            let start = w.next()?.parse().ok()?;
+            let ns = w
+                .map(|x| x.parse::<f64>().ok().map(|v| v * 1e-9))
+                .collect::<Option<Vec<_>>>()?;
+            Some((tick, (start, ns)))
+        })
+        .collect();
+    let mut split: Vec<[f64; 4]> = taken
+        .iter()
+        .filter_map(|&(k, tick, got)| {
+            let (start, ns) = rows.get(&tick)?;
+            let (pop, publish) = (ns[0], *ns.get(k + 1)?);
+            let total = got - start;
+            Some([pop, publish - pop, total - publish, total])
+        })
+        .collect();
+    assert!(
+        split.len() * 10 > n * 9,
+        "the stage trace covers {} of {n} commands",
+        split.len()
+    );
+    let names = [
+        "ring (start → pop)",
+        "publish (pop → return)",
+        "network (return → take)",
+        "total",
+    ];
+    for (i, name) in names.iter().enumerate() {
+        let mut v: Vec<f64> = split.iter().map(|r| r[i]).collect();
+        eprintln!(
+            "  {name}: p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
+            percentile(&mut v, 0.5) * 1e3,
+            percentile(&mut v, 0.99) * 1e3,
+            percentile(&mut v, 1.0) * 1e3
+        );
+    }
+    // The tail: the commands slower than the total's p99, and which stage held each.
+    split.sort_by(|a, b| a[3].total_cmp(&b[3]));
+    let tail = &split[split.len() * 99 / 100..];
+    let mut held = [0_usize; 3];
+    let mut mean = [0.0; 3];
+    for r in tail {
+        let worst = (0..3).max_by(|&a, &b| r[a].total_cmp(&r[b])).unwrap_or(0);
+        held[worst] += 1;
+        for s in 0..3 {
+            mean[s] += r[s] / tail.len() as f64;
+        }
+    }
+    eprintln!(
+        "  the slowest 1 % ({} commands, total ≥ {:.3} ms): the longest stage ring {} / publish {} / network {}; mean ring {:.3} / publish {:.3} / network {:.3} ms",
+        tail.len(),
+        tail.first().map_or(0.0, |r| r[3]) * 1e3,
+        held[0],
+        held[1],
+        held[2],
+        mean[0] * 1e3,
+        mean[1] * 1e3,
+        mean[2] * 1e3
+    );
 }
 
 /// A model whose channels name a pose (`force`, `x`, `y`, `z`, `qw`, `qx`, `qy`, `qz`:
