@@ -876,7 +876,7 @@ impl Coordinator {
         let mut sector_waiting_start = [f64::INFINITY; MAX_ROBOTS];
         if let Some(sec) = &sectors {
             // Each sector is its own round: the rules of the tick within its robots alone.
-            for o in 0..sec.m {
+            for (o, fws) in sector_waiting_start.iter_mut().enumerate().take(sec.m) {
                 let mut idx = [0_usize; MAX_ROBOTS];
                 let mut sub = [Member::idle(0.0, Mode::Finished); MAX_ROBOTS];
                 let mut sub_next = [0.0_f64; MAX_ROBOTS];
@@ -895,8 +895,7 @@ impl Coordinator {
                 for j in 0..k {
                     next_s[idx[j]] = sub_next[j];
                 }
-                sector_waiting_start[o] =
-                    first_waiting_start(&sub[..k], |j| self.cur(idx[j]).start_s());
+                *fws = first_waiting_start(&sub[..k], |j| self.cur(idx[j]).start_s());
             }
         } else {
             advance(&members[..n], pace_robot, self.tick_s, &mut next_s[..n]);
