@@ -54,6 +54,10 @@ pub(crate) struct Monitor {
     lc_last: RobotFlags,
     /// The latched fault.
     fault: Option<Fault>,
+    /// Sectors (a rounds cell of `M` one-operator sectors, issue 44): each robot's operator;
+    /// a tick with two robots of one sector low-confidence is the fault (which a tick with
+    /// more than `M` always has). `None`: the count rule above.
+    sector_of: Option<[u8; MAX_ROBOTS]>,
 }
 
 impl Monitor {
@@ -66,6 +70,18 @@ impl Monitor {
             lc_since: [0; MAX_ROBOTS],
             lc_last: RobotFlags::new(n),
             fault: None,
+            sector_of: None,
+        }
+    }
+
+    /// The same monitor for `m ≥ 1` operators each serving one fixed sector of robots
+    /// (`sector_of[i] < m` robot `i`'s operator): a tick with two robots of one sector
+    /// low-confidence is the fault — the sector's operator was needed twice at once (with
+    /// more than `m` robots low-confidence some sector has two, so it includes the count rule).
+    pub(crate) fn with_sectors(self, m: usize, sector_of: [u8; MAX_ROBOTS]) -> Monitor {
+        Monitor {
+            sector_of: Some(sector_of),
+            ..self.with_operators(m)
         }
     }
 
@@ -80,7 +96,29 @@ impl Monitor {
 
     /// Back to [`Monitor::new`] (the operators kept): no tick seen, no fault.
     pub(crate) fn reset(&mut self) {
-        *self = Monitor::new(self.n).with_operators(self.operators);
+        *self = Monitor {
+            sector_of: self.sector_of,
+            ..Monitor::new(self.n).with_operators(self.operators)
+        };
+    }
+
+    /// Whether the robots flagged in `low_conf` are more than the cell's operators can
+    /// serve: more than `M`, or with sectors two of one sector.
+    fn too_many(&self, low_conf: &RobotFlags) -> bool {
+        match &self.sector_of {
+            None => low_conf.count() > self.operators,
+            Some(of) => {
+                let mut seen = [false; MAX_ROBOTS];
+                for i in (0..self.n).filter(|&i| low_conf[i]) {
+                    let o = usize::from(of[i]);
+                    if seen[o] {
+                        return true;
+                    }
+                    seen[o] = true;
+                }
+                false
+            }
+        }
     }
 
     /// A fresh monitor of `m` operators whose tick count goes on from `ticks` (a hand-over to
@@ -125,7 +163,7 @@ impl Monitor {
             }
         }
         self.lc_last = low_conf;
-        if self.fault.is_none() && low_conf.count() > self.operators {
+        if self.fault.is_none() && self.too_many(&low_conf) {
             let stopped = (0..self.n)
                 .filter(|&i| low_conf[i])
                 .max_by_key(|&i| (self.lc_since[i], policy::tie_rank(i, self.n)))
@@ -218,6 +256,26 @@ mod tests {
         m.reset();
         // The operators survive a reset.
         assert_eq!(m.observe(flags(&[false, true, true, false])), None);
+    }
+
+    #[test]
+    fn with_sectors_the_fault_is_two_of_one_sector() {
+        // Robots 0, 1 under operator 0; robots 2, 3 under operator 1.
+        let mut of = [0_u8; MAX_ROBOTS];
+        of[2] = 1;
+        of[3] = 1;
+        let mut m = Monitor::new(4).with_sectors(2, of);
+        // One of each sector: two robots, two operators, no fault.
+        assert_eq!(m.observe(flags(&[true, false, true, false])), None);
+        // Two of sector 1 (robots 2 and 3), though only two robots in all: the fault.
+        let f = m
+            .observe(flags(&[false, false, true, true]))
+            .expect("sector 1 twice");
+        assert_eq!((f.tick, f.stopped), (1, 3));
+        m.reset();
+        // The sectors survive a reset.
+        assert_eq!(m.observe(flags(&[false, true, true, false])), None);
+        assert!(m.observe(flags(&[true, true, false, false])).is_some());
     }
 
     #[test]

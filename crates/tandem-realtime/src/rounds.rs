@@ -108,6 +108,18 @@ pub struct Coordinator {
     /// `M > 1` operators: the operator of every low-confidence run
     /// ([`crate::margins::operators`]); `None`: one operator, today's coordinator.
     operators: Option<Arc<OperatorPlan>>,
+    /// `M > 1` operators in fixed sectors ([`Coordinator::sectored`]); `None` otherwise.
+    sectors: Option<Arc<Sectors>>,
+}
+
+/// A rounds cell of `M` operators split into fixed sectors ([`Coordinator::sectored`]): each
+/// robot belongs to one operator's sector, and each sector runs as its own one-operator round.
+#[derive(Clone, Debug)]
+struct Sectors {
+    /// `M`, the operators (some may have an empty sector).
+    m: usize,
+    /// Robot `i`'s operator, `< m`.
+    of: [u8; MAX_ROBOTS],
 }
 
 impl Coordinator {
@@ -200,6 +212,7 @@ impl Coordinator {
             reach: reach.into(),
             after_fast_s: after_fast_s.into(),
             operators: None,
+            sectors: None,
         };
         c.reset();
         Ok(c)
@@ -244,6 +257,22 @@ impl Coordinator {
     /// # Errors
     /// [`Error::BadParam`] for a `switch_s` not finite and ≥ 0 or of more than 1e8 ticks.
     pub fn with_switch_s(mut self, switch_s: f64) -> Result<Coordinator> {
+        if let Some(sec) = &self.sectors {
+            // Sectors are checked at their switch time: check them again at this one.
+            let of: Vec<usize> = (0..self.robots.len())
+                .map(|i| usize::from(sec.of[i]))
+                .collect();
+            let params = crate::MarginParams {
+                tick_s: self.tick_s,
+                switch_s,
+            };
+            return Coordinator::sectored(
+                self.robots.to_vec(),
+                &of,
+                OperatorCount::new(sec.m)?,
+                &params,
+            );
+        }
         self.switch_ticks = crate::switch_ticks(switch_s, self.tick_s)?;
         if let Some(p) = &self.operators {
             let m = OperatorCount::new(p.operators())?;
@@ -267,6 +296,7 @@ impl Coordinator {
     /// operators are not built); [`Error::Unsafe`] when the assignment needs more than `M`
     /// operators; those of [`assign_operators`](crate::margins::operators::assign_operators).
     pub fn with_operators(mut self, operators: OperatorCount) -> Result<Coordinator> {
+        self.sectors = None;
         if operators.get() == 1 {
             self.operators = None;
             self.monitor = Monitor::new(self.robots.len());
@@ -295,8 +325,82 @@ impl Coordinator {
         Ok(self)
     }
 
-    /// `M`, the number of operators ([`Coordinator::with_operators`]; 1 by default).
+    /// A round of `M = operators` operators in fixed sectors (issue 44; docs/decisions.md,
+    /// "M operators in rounds: sectors end to end"): robot `i` (of `robots`, global schedule
+    /// clock) belongs to operator `sector_of[i] < M`'s sector, and the robots of each sector
+    /// are one one-operator round run side by side with the others: every rule of the tick
+    /// (the pace of the sector's low-confidence robot, Eq. 18, Alg. 1, the waits before a
+    /// start) is applied within each sector alone, and the sector's low-confidence robot
+    /// follows its own operator's input ([`tick_many`](Coordinator::tick_many)`(&[op_0, …,
+    /// op_{M−1}])`). Each sector's timelines are checked with
+    /// [`check_margins`](crate::check_margins) at `params` (tick, switch time), so in every
+    /// tick at most one robot of each sector is low-confidence under every admissible input:
+    /// at most `M` in all, each sector's stretches with its one operator (never handed over),
+    /// each operator's switch time kept. [`Tick::operator`] reports the sector; the fault
+    /// monitor latches when two robots of one sector are low-confidence.
+    ///
+    /// # Errors
+    /// [`Error::RobotCount`]; [`Error::LengthMismatch`] unless `sector_of` has one entry per
+    /// robot; [`Error::BadParam`] (`sector_of`) for an entry `≥ M`, or for a bad tick or
+    /// switch time; [`Error::Unsafe`] when a sector's plans fail the margin check.
+    pub fn sectored(
+        robots: impl Into<Vec<Timeline>>,
+        sector_of: &[usize],
+        operators: OperatorCount,
+        params: &crate::MarginParams,
+    ) -> Result<Coordinator> {
+        let robots: Vec<Timeline> = robots.into();
+        check_count(robots.len())?;
+        if sector_of.len() != robots.len() {
+            return Err(Error::LengthMismatch {
+                what: "sector_of (one sector per robot)",
+                expected: robots.len(),
+                found: sector_of.len(),
+            });
+        }
+        let m = operators.get();
+        let mut of = [0_u8; MAX_ROBOTS];
+        for (i, &o) in sector_of.iter().enumerate() {
+            if o >= m {
+                return Err(Error::BadParam {
+                    name: "sector_of",
+                    why: "names an operator not below the operator count M",
+                });
+            }
+            of[i] = o as u8;
+        }
+        for o in 0..m {
+            let sub: Vec<Timeline> = (0..robots.len())
+                .filter(|&i| sector_of[i] == o)
+                .map(|i| robots[i].clone())
+                .collect();
+            if !sub.is_empty() && !crate::check_margins(&sub, &[], params)? {
+                return Err(Error::Unsafe {
+                    tick_s: params.tick_s,
+                });
+            }
+        }
+        let mut c = Coordinator::new_unchecked(robots, params.tick_s)?;
+        c.switch_ticks = params.switch_ticks()?;
+        c.monitor = Monitor::new(c.robots.len()).with_sectors(m, of);
+        c.sectors = Some(Arc::new(Sectors { m, of }));
+        c.reset();
+        Ok(c)
+    }
+
+    /// Robot `robot`'s operator in a sectored round ([`Coordinator::sectored`]); `None`
+    /// otherwise (or for `robot ≥ N`).
+    pub fn sector_of(&self, robot: usize) -> Option<usize> {
+        let s = self.sectors.as_ref()?;
+        (robot < self.robots.len()).then(|| usize::from(s.of[robot]))
+    }
+
+    /// `M`, the number of operators ([`Coordinator::with_operators`],
+    /// [`Coordinator::sectored`]; 1 by default).
     pub fn operators(&self) -> usize {
+        if let Some(s) = &self.sectors {
+            return s.m;
+        }
         self.operators.as_ref().map_or(1, |p| p.operators())
     }
 
@@ -310,6 +414,13 @@ impl Coordinator {
     /// operator of the run its sample belongs to; `Some(0)` for each with one operator. O(N).
     pub fn operator_now(&self) -> PerRobot<Option<u8>> {
         let lc = self.low_conf_now();
+        if let Some(sec) = &self.sectors {
+            let mut out = PerRobot::new(self.robots.len());
+            for (i, o) in out.as_mut_slice().iter_mut().enumerate() {
+                *o = lc[i].then_some(sec.of[i]);
+            }
+            return out;
+        }
         let Some(p) = &self.operators else {
             return crate::contract::one_operator(&lc);
         };
@@ -684,7 +795,7 @@ impl Coordinator {
     /// [`Error::BadOperator`] for an [`Operator::Gradient`] that is NaN, infinite or ≤ 0;
     /// the coordinator is then unchanged.
     pub fn tick(&mut self, operator: Operator) -> Result<Tick> {
-        if self.operators.is_some() {
+        if self.operators.is_some() || self.sectors.is_some() {
             return Err(Error::OperatorInputs {
                 got: 1,
                 want: self.operators(),
@@ -709,7 +820,7 @@ impl Coordinator {
                 want: self.operators(),
             });
         }
-        if self.operators.is_none() {
+        if self.operators.is_none() && self.sectors.is_none() {
             return self.tick(inputs[0]);
         }
         let mut ops = [Operator::Scheduled; MAX_ROBOTS];
@@ -723,6 +834,7 @@ impl Coordinator {
     fn step(&mut self, ops: &[Operator]) -> Result<Tick> {
         let g = ops[0];
         let plan = self.operators.clone();
+        let sectors = self.sectors.clone();
         let n = self.robots.len();
         // The invariant "a robot never moves backwards", checked in debug builds: every
         // robot's reference time and reported clock at the tick end are at least those at
@@ -744,9 +856,10 @@ impl Coordinator {
                 Phase::Waiting => Member::idle(s, Mode::Waiting),
                 Phase::Finished => Member::idle(s, Mode::Finished),
                 Phase::Active { low_conf: true } => {
-                    let g = match &plan {
-                        None => g,
-                        Some(p) => ops[usize::from(p.operator_from(i, self.cursors[i].at))],
+                    let g = match (&plan, &sectors) {
+                        (_, Some(sec)) => ops[usize::from(sec.of[i])],
+                        (None, None) => g,
+                        (Some(p), None) => ops[usize::from(p.operator_from(i, self.cursors[i].at))],
                     };
                     next_s[i] = s + operator_step(self.cur(i), self.cursors[i].at, g, self.tick_s);
                     pace_robot.get_or_insert(i);
@@ -759,7 +872,34 @@ impl Coordinator {
                 },
             };
         }
-        advance(&members[..n], pace_robot, self.tick_s, &mut next_s[..n]);
+        // Per sector, the least start of its robots waiting to start (all robots: one sector).
+        let mut sector_waiting_start = [f64::INFINITY; MAX_ROBOTS];
+        if let Some(sec) = &sectors {
+            // Each sector is its own round: the rules of the tick within its robots alone.
+            for (o, fws) in sector_waiting_start.iter_mut().enumerate().take(sec.m) {
+                let mut idx = [0_usize; MAX_ROBOTS];
+                let mut sub = [Member::idle(0.0, Mode::Finished); MAX_ROBOTS];
+                let mut sub_next = [0.0_f64; MAX_ROBOTS];
+                let mut k = 0;
+                let mut pace = None;
+                for i in (0..n).filter(|&i| usize::from(sec.of[i]) == o) {
+                    idx[k] = i;
+                    sub[k] = members[i];
+                    sub_next[k] = next_s[i];
+                    if members[i].mode == Mode::Low {
+                        pace.get_or_insert(k);
+                    }
+                    k += 1;
+                }
+                advance(&sub[..k], pace, self.tick_s, &mut sub_next[..k]);
+                for j in 0..k {
+                    next_s[idx[j]] = sub_next[j];
+                }
+                *fws = first_waiting_start(&sub[..k], |j| self.cur(idx[j]).start_s());
+            }
+        } else {
+            advance(&members[..n], pace_robot, self.tick_s, &mut next_s[..n]);
+        }
         let mut out = Tick {
             ref_time: PerRobot::new(n),
             tasks: PerRobot::new(n),
@@ -800,7 +940,11 @@ impl Coordinator {
             let s_old = self.clock_s[i];
             let waiting = m.mode == Mode::Waiting;
             let cap = if waiting {
-                r.start_s().min(first_waiting_start)
+                let fws = match &sectors {
+                    Some(sec) => sector_waiting_start[usize::from(sec.of[i])],
+                    None => first_waiting_start,
+                };
+                r.start_s().min(fws)
             } else {
                 r.end_s()
             };
@@ -818,7 +962,11 @@ impl Coordinator {
                 let lo = r.advance_cursor(&mut cur.lo, s_old - self.tol_s);
                 let hi = r.advance_cursor(&mut cur.hi, s_new + self.tol_s);
                 out.low_conf.set(i, r.any_low_conf(lo, hi));
-                if let Some(p) = &plan
+                if let Some(sec) = &sectors
+                    && out.low_conf[i]
+                {
+                    out.operator.as_mut_slice()[i] = Some(sec.of[i]);
+                } else if let Some(p) = &plan
                     && out.low_conf[i]
                 {
                     // The first run the traversed samples touch: a run touched with the next
@@ -862,7 +1010,7 @@ impl Coordinator {
             out.waiting.set(i, self.at_hold(i));
         }
         out.next = self.pre_alert();
-        if plan.is_none() {
+        if plan.is_none() && sectors.is_none() {
             out.operator = crate::contract::one_operator(&out.low_conf);
         }
         out.fault = self.monitor.observe(out.low_conf);
@@ -977,7 +1125,7 @@ impl Controller for Coordinator {
 
     fn beam_search(&self, width: u32, max_ticks: u64) -> Option<Result<AdversaryRun>> {
         // The search drives one operator's input; a round of `M > 1` operators has none.
-        if self.operators.is_some() {
+        if self.operators.is_some() || self.sectors.is_some() {
             return None;
         }
         Some(crate::adversary::search::beam_search(

@@ -64,6 +64,7 @@ mod problem;
 mod retime;
 mod sampler;
 mod schedule;
+mod sectors;
 mod stagger;
 #[cfg(feature = "testkit")]
 pub mod testkit;
@@ -89,6 +90,7 @@ pub use operator::{busy_share, start_allowance_s};
 pub use problem::Problem;
 pub use sampler::{DrawnOffset, SamplerBaselines, SamplerParams, SamplerStats};
 pub use schedule::{GlobalTimeline, LcOverlap, Schedule};
+pub use sectors::{SectoredRounds, even_sector_sizes, fleet_operator_bound_s, sectored_rounds};
 pub use tandem_confidence::Run;
 pub use tandem_realtime::LcInterval;
 pub use validate::{
