@@ -184,30 +184,30 @@ pub(crate) fn run_mixed(
             last.falsely_trusted_mean[t]
         );
     }
-    // The continuous cell's bound for this mix at each trial's last plan: the best task
-    // ratios r ∈ {1..4}^N and what no cyclic plan with them exceeds
-    // (`tandem::schedule::cyclic::best_mix`, docs/decisions.md).
+    // The cell run continuously on each trial's last problems: the mixed cyclic plan
+    // (`tandem::planner::CellPlanner::continuous_plan`) against the bound of its ratios, the
+    // mixed operator-limited bound (3600 over the mean operator-seconds per task of the
+    // mix) and the best any ratios r ∈ {1..4}^N allow (docs/decisions.md).
     for trial in &result.trials {
-        let last = trial.iterations.last().expect("iteration 0 at least");
-        let mix: Vec<tandem::schedule::cyclic::MixTask> = result
-            .robot_task
-            .iter()
-            .map(|&t| tandem::schedule::cyclic::MixTask {
-                fastest_s: last.tasks[t].fastest_s,
-                lc_s: last.tasks[t].lc_s,
-            })
-            .collect();
-        let b = tandem::schedule::cyclic::best_mix(&mix, 4, config.operator.switch_s)?;
+        let c = &trial.continuous_plan;
         println!(
-            "  trial {}, last plan, continuous: best ratios {:?} (tasks per robot per period), \
-             at most {:.1} tasks/h (period ≥ {:.2} s); mixed operator-limited bound {:.1} \
-             tasks/h, per-robot bound {:.1} tasks/h",
+            "  trial {}, last plan, continuous: ratios {:?} (tasks per robot per period), \
+             period {:.2} s (bound {:.2} s, gap {:.1} %), {:.1} tasks/h = {:.1} % of the mixed \
+             operator-limited bound {:.1} tasks/h of these ratios, {:.1} % of the best bound \
+             {:.1} tasks/h (operator busy {:.1} %; {} ratio vectors, {} orders evaluated)",
             trial.trial,
-            b.ratios,
-            b.tasks_per_hour_bound,
-            b.period_lower_bound_s,
-            b.operator_limited_per_hour,
-            b.robot_limited_per_hour
+            c.ratios,
+            c.period_s,
+            c.lower_bound_s,
+            100.0 * c.gap,
+            c.tasks_per_hour,
+            100.0 * c.tasks_per_hour / c.operator_limited_per_hour,
+            c.operator_limited_per_hour,
+            100.0 * c.tasks_per_hour / c.best_bound_per_hour,
+            c.best_bound_per_hour,
+            100.0 * c.operator_share,
+            c.ratios_evaluated,
+            c.orders_evaluated
         );
     }
     let (overlaps, faults) = result.overlaps_and_faults();

@@ -329,6 +329,38 @@ impl CellPlanner {
         self.robot_task.len()
     }
 
+    /// The cyclic plan of this cell run continuously (issue 45): robot `i` repeats its task,
+    /// `r_i` times per period, on its task's current problem
+    /// ([`tandem_schedule::cyclic::mixed_cyclic_plan`]: the best ratios `r ∈ {1..4}^N` and
+    /// operator order found, the period of its event graph and the bound of every plan with
+    /// those ratios), with the token rule's hand-overs counted at the cell's control tick
+    /// (the shortest of the tasks' schedule ticks, real s, as in rounds) and the operator's
+    /// switch time. A one-task cell's continuous plan is its planner's
+    /// ([`Planner::cyclic_plan`]); this one is for comparing a cell of tasks with its bound.
+    ///
+    /// # Errors
+    /// The scheduler's error when no searched order admits a period.
+    pub fn continuous_plan(&self) -> Result<tandem_schedule::cyclic::MixedCyclicPlan> {
+        let problems: Vec<&Problem> = self
+            .robot_task
+            .iter()
+            .map(|&t| self.tasks[t].planner.problem())
+            .collect();
+        let tick_s = self
+            .tasks
+            .iter()
+            .map(|t| t.planner.schedule().tick_s)
+            .fold(f64::INFINITY, f64::min);
+        let params = tandem_schedule::cyclic::MixedParams {
+            handover_tick_s: (tick_s.is_finite() && tick_s > 0.0).then_some(tick_s),
+            switch_s: self.tasks[0].planner.params().sampler.switch_s,
+            ..tandem_schedule::cyclic::MixedParams::default()
+        };
+        Ok(tandem_schedule::cyclic::mixed_cyclic_plan(
+            &problems, &params,
+        )?)
+    }
+
     /// Whether the cell has two or more tasks (scheduled by [`CellSchedule`], saved as
     /// format 12).
     pub fn is_mixed(&self) -> bool {

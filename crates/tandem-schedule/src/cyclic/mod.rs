@@ -70,6 +70,7 @@ mod checked;
 mod fleet;
 mod graph;
 mod mix;
+mod mixed;
 mod plan;
 mod ratio;
 mod run;
@@ -79,6 +80,10 @@ pub use checked::CheckedCyclicPlan;
 pub use fleet::{SectoredPlan, pooled_period_lower_bound_s, sectored_plan};
 pub use graph::{Event, EventGraph, Gap, Stretch, TaskShape, event_graph};
 pub use mix::{MAX_MIX_RATIO, MixBound, MixTask, best_mix, mix_period_lower_bound_s};
+pub use mixed::{
+    MixedCyclicPlan, MixedParams, MixedRobotCycle, mixed_cyclic_plan, mixed_period_lower_bound_s,
+    mixed_plan_for_order, mixed_plan_of_shapes, repeated_shape,
+};
 pub use plan::{
     CyclicPlan, GapPlan, RobotCycle, cyclic_plan_for_order, handover_bound_s, period_lower_bound_s,
     period_lower_bound_with_switch_s,

@@ -113,6 +113,10 @@ pub struct MixedTrialResult {
     pub iterations: Vec<MixedIteration>,
     /// The simulated operator's decisions over the trial.
     pub tally: OperatorTally,
+    /// The cell run continuously on the last iteration's problems: the best task ratios and
+    /// operator order found and their period against the bound
+    /// (`tandem_planner::CellPlanner::continuous_plan`; a plan, not a run).
+    pub continuous_plan: tandem_schedule::cyclic::MixedCyclicPlan,
 }
 
 /// A mixed study: every trial, the task names and the robot → task map.
@@ -288,11 +292,17 @@ pub fn run_mixed_trial(
             rounds_done: round,
         });
     }
+    let continuous_plan = cell.continuous_plan().map_err(|e| Error::InTrial {
+        trial,
+        round: config.n_rounds(),
+        source: Box::new(e.into()),
+    })?;
     Ok(MixedTrialResult {
         trial,
         seed,
         iterations,
         tally,
+        continuous_plan,
     })
 }
 
