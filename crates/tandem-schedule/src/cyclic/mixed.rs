@@ -583,12 +583,20 @@ fn greedy_blocks(
     out
 }
 
+/// One block of the operator's order: `(robot, first group, last group)` of that robot's
+/// repeated shape, the groups `first..=last` served back to back.
+type Block = (usize, usize, usize);
+
+/// The best plan so far over the ratio vectors: `(tasks per hour, tasks per period Σ r_k, the ratios
+/// r_k, the order's blocks, the period P in s)`.
+type BestRatio = (f64, usize, Vec<usize>, Vec<Block>, f64);
+
 /// The best order found for one ratio vector: greedy, then neighbouring swaps of groups of
 /// different robots (cyclically) while the period falls, at most `max_evaluations` periods.
 fn search_order(
     supers: &[TaskShape],
     params: &MixedParams,
-) -> Result<Option<(Vec<(usize, usize, usize)>, f64, usize)>> {
+) -> Result<Option<(Vec<Block>, f64, usize)>> {
     let groups: Vec<Vec<(usize, usize)>> = supers
         .iter()
         .map(|s| groups_of_shape(s, params.runnable_only))
@@ -684,7 +692,7 @@ pub fn mixed_plan_of_shapes(shapes: &[TaskShape], params: &MixedParams) -> Resul
     }
     candidates.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     let best_bound_per_hour = candidates[0].0;
-    let mut best: Option<(f64, usize, Vec<usize>, Vec<(usize, usize, usize)>, f64)> = None;
+    let mut best: Option<BestRatio> = None;
     let (mut ratios_evaluated, mut orders_evaluated) = (0, 0);
     for (bound_rate, _, ratios) in &candidates {
         if ratios_evaluated >= params.max_ratio_candidates {
