@@ -94,6 +94,17 @@ def same_numbers(a: List[dict], b: List[dict]) -> bool:
     )
 
 
+def client_for(scheduler: Optional[str], workers: int):
+    """A dask.distributed client: of the running scheduler at ``scheduler``
+    (``tcp://host:8786``), else of a new ``LocalCluster`` of ``workers`` processes with one
+    thread each."""
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        return Client(scheduler)
+    return Client(LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=None))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scheduler", help="address of a running dask scheduler (default: a LocalCluster)")
@@ -108,8 +119,6 @@ def main() -> None:
     ap.add_argument("--check-serial", action="store_true", help="also run the serial loop and compare")
     args = ap.parse_args()
 
-    from dask.distributed import Client, LocalCluster
-
     base = {
         "executions": args.executions,
         "samples": args.samples,
@@ -117,12 +126,7 @@ def main() -> None:
         "trials": args.replicates,
     }
     points = grid(args.mu_c, args.error_rates, args.replicates)
-    if args.scheduler:
-        client = Client(args.scheduler)
-    else:
-        cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, dashboard_address=None)
-        client = Client(cluster)
-    with client:
+    with client_for(args.scheduler, args.workers) as client:
         print(f"# {len(points)} points on {client}")
         start = time.perf_counter()
         rows = sweep(client, points, base, args.demos_dir)

@@ -22,12 +22,16 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import sys
 import time
+from pathlib import Path
 from typing import Iterable, List, Optional, Sequence
 
-import numpy as np
-
 import tandem
+
+# The μ_c sweep beside this file owns the cluster's client and the exact comparison.
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from sweep_dask import client_for, same_numbers  # noqa: E402
 
 
 def grid(
@@ -92,18 +96,6 @@ def sweep(client, points: Sequence[dict], base: dict, demos_dir: Optional[str] =
     return [row(p, t) for p, t in zip(points, client.gather(futures))]
 
 
-def same_numbers(a: List[dict], b: List[dict]) -> bool:
-    """Whether two sweeps gave identical numbers at every point (exact float equality)."""
-    return len(a) == len(b) and all(
-        x.keys() == y.keys()
-        and all(
-            np.array_equal(x[k], y[k]) if isinstance(x[k], np.ndarray) else x[k] == y[k]
-            for k in x
-        )
-        for x, y in zip(a, b)
-    )
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scheduler", help="address of a running dask scheduler (default: a LocalCluster)")
@@ -119,8 +111,6 @@ def main() -> None:
     ap.add_argument("--check-serial", action="store_true", help="also run the serial loop and compare")
     args = ap.parse_args()
 
-    from dask.distributed import Client, LocalCluster
-
     base = {
         "executions": args.executions,
         "samples": args.samples,
@@ -130,12 +120,7 @@ def main() -> None:
     points = grid(args.robots, args.operators, args.switch_s, args.replicates)
     if not points:
         raise SystemExit("no point has operators ≤ robots: raise --robots or lower --operators")
-    if args.scheduler:
-        client = Client(args.scheduler)
-    else:
-        cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, dashboard_address=None)
-        client = Client(cluster)
-    with client:
+    with client_for(args.scheduler, args.workers) as client:
         print(f"# {len(points)} points on {client}")
         start = time.perf_counter()
         rows = sweep(client, points, base, args.demos_dir)
