@@ -142,8 +142,9 @@ pub struct MixedRobotCycle {
     pub lc_s: Vec<f64>,
 }
 
-/// A repeated plan of a cell of different tasks ([module docs](self)): every `period_s`
-/// robot `k` completes `ratios[k]` tasks and the operator supervises every stretch once, in
+/// A repeated plan of a cell of different tasks (the docs of the module `cyclic::mixed`):
+/// every `period_s` robot `k` completes `ratios[k]` tasks and the operator supervises every
+/// stretch once, in
 /// `order` (a [`Stretch`]'s `lc` counts the robot's stretches over its `r_k` tasks:
 /// `lc = copy·m_k + k`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -179,8 +180,9 @@ pub struct MixedCyclicPlan {
     pub orders_evaluated: usize,
 }
 
-/// Robot `k`'s `r` tasks of one period as one task shape ([module docs](self)): the shape
-/// `r` times, the tail of each copy and the head of the next one merged into one gap (its
+/// Robot `k`'s `r` tasks of one period as one task shape (the docs of the module
+/// `cyclic::mixed`): the shape `r` times, the tail of each copy and the head of the next one
+/// merged into one gap (its
 /// durations their sums) whose hold is the head's hold or else the task start
 /// (reference sample `c·n_ref` of copy `c`); a stretch's entry is its copy's. `r = 1` is the
 /// shape itself.
@@ -251,9 +253,9 @@ pub fn repeated_shape(shape: &TaskShape, r: usize) -> Result<TaskShape> {
 }
 
 /// The lower bound (s) on the period of every plan in which robot `k` (task shape
-/// `shapes[k]`) completes `ratios[k]` tasks per period, whatever the order ([module
-/// docs](self)): [`crate::cyclic::mix_period_lower_bound_s`], and with `handover_tick_s` the
-/// bound of every runnable order with the hand-overs counted.
+/// `shapes[k]`) completes `ratios[k]` tasks per period, whatever the order (the docs of the
+/// module `cyclic::mixed`): [`crate::cyclic::mix_period_lower_bound_s`], and with
+/// `handover_tick_s` the bound of every runnable order with the hand-overs counted.
 ///
 /// # Errors
 /// [`Error::BadParam`] for shapes outside `1..=MAX_ROBOTS`, ratios not one per robot or 0, a
@@ -639,7 +641,8 @@ fn search_order(
 }
 
 /// The cyclic plan of a continuous cell whose robot `k` does the task of `problems[k]`
-/// ([module docs](self)): the best ratios and order found, their least period, and the bound.
+/// (the docs of the module `cyclic::mixed`): the best ratios and order found, their least
+/// period, and the bound.
 ///
 /// # Errors
 /// [`Error::Realtime`] (`RobotCount`) for a robot count outside `1..=MAX_ROBOTS`;
