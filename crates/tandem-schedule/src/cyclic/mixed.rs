@@ -589,8 +589,8 @@ fn greedy_blocks(
 /// repeated shape, the groups `first..=last` served back to back.
 type Block = (usize, usize, usize);
 
-/// The best plan so far over the ratio vectors: `(tasks per hour, tasks per period Σ r_k, the ratios
-/// r_k, the order's blocks, the period P in s)`.
+/// The best plan so far over the ratio vectors: `(tasks per hour, tasks per period Σ r_k,
+/// the ratios r_k, the order's blocks, the period P in s)`.
 type BestRatio = (f64, usize, Vec<usize>, Vec<Block>, f64);
 
 /// The best order found for one ratio vector: greedy, then neighbouring swaps of groups of
