@@ -11,11 +11,12 @@ from conftest import ROOT
 from dask import distributed
 
 
-def load_example():
-    path = ROOT / "examples" / "python" / "sweep_dask.py"
-    spec = importlib.util.spec_from_file_location("sweep_dask", path)
+def load_example(name: str = "sweep_dask"):
+    """examples/python/NAME.py as a module (registered under NAME, as a script's import of it)."""
+    path = ROOT / "examples" / "python" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
-    sys.modules["sweep_dask"] = module
+    sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
 
@@ -38,20 +39,11 @@ def test_sweep_on_a_local_cluster_equals_the_serial_loop() -> None:
     assert all(r["overlap_ticks"] == 0 for r in in_loop)
 
 
-def load_fleet_example():
-    path = ROOT / "examples" / "python" / "sweep_fleet_dask.py"
-    spec = importlib.util.spec_from_file_location("sweep_fleet_dask", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["sweep_fleet_dask"] = module
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_fleet_sweep_on_a_local_cluster_equals_the_serial_loop() -> None:
     """Issue 44: a sweep over (N, M, δ, seeds) of the continuous cell, on a 2-worker cluster,
     gives exactly the serial loop's numbers; no point ever has more robots low-confidence than
     operators."""
-    sweep = load_fleet_example()
+    sweep = load_example("sweep_fleet_dask")
     points = sweep.grid(robots=[2, 3], operators=[1, 2, 3], switch_s=[0.0, 1.0], replicates=1)
     # M ≤ N only: (2,1), (2,2), (3,1), (3,2), (3,3), each at two switch times.
     assert [(p["robots"], p["operators"]) for p in points[::2]] == [
