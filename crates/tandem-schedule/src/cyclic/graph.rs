@@ -302,30 +302,7 @@ pub(crate) fn graph_of_shape(
         for k in 0..m {
             wrapped[r][k] = u8::from(pos[r * m + k] < pos[r * m]);
         }
-        let w = |k: usize| i32::from(wrapped[r][k]);
-        let s = |k: usize| a + 1 + k;
-        // Head: leave the start, reach stretch 0.
-        let head = shape.gaps[0];
-        push(a, s(0), head.min_s, 0);
-        if head.hold.is_none() {
-            push(s(0), a, -head.max_s, 0);
-        }
-        // Stretch k, then gap k + 1, then stretch k + 1.
-        for k in 0..m - 1 {
-            let gap = shape.gaps[k + 1];
-            let h = w(k + 1) - w(k);
-            push(s(k), s(k + 1), shape.lc_s[k] + gap.min_s, h);
-            if gap.hold.is_none() {
-                push(s(k + 1), s(k), -(shape.lc_s[k] + gap.max_s), -h);
-            }
-        }
-        // The last stretch, the tail, the task start (a hold: no maximum) of the next task.
-        push(
-            s(m - 1),
-            a,
-            shape.lc_s[m - 1] + shape.gaps[m].min_s,
-            1 - w(m - 1),
-        );
+        push_robot_chain(&shape, a, &wrapped[r], &mut push);
     }
     // The operator: each stretch after the one before it has ended; the wrap is next period.
     let len = order.len();
@@ -360,4 +337,45 @@ pub(crate) fn graph_of_shape(
         shape,
         wrapped,
     })
+}
+
+/// The arcs of one robot's own chain in the event graph: its task start (event `a`) → its
+/// stretch 0 (event `a + 1`) → … → its last stretch (event `a + m`) → its next task's start,
+/// each after the stretch before it and the gap between (at least the gap's fastest
+/// duration, s), and back from each stretch to the one before it by the gap's slowest
+/// duration where the gap has no hold (a robot cannot wait there). `wrapped[k]` is 1 when
+/// stretch `k` falls in the period after stretch 0's in the operator's order (the arc's
+/// tokens); the arc into the next task's start carries the period's one token. Used by the
+/// one-task graph and the mixed cell's (one repeated shape per robot).
+pub(crate) fn push_robot_chain(
+    shape: &TaskShape,
+    a: usize,
+    wrapped: &[u8],
+    push: &mut impl FnMut(usize, usize, f64, i32),
+) {
+    let m = wrapped.len();
+    let w = |k: usize| i32::from(wrapped[k]);
+    let s = |k: usize| a + 1 + k;
+    // Head: leave the start, reach stretch 0.
+    let head = shape.gaps[0];
+    push(a, s(0), head.min_s, 0);
+    if head.hold.is_none() {
+        push(s(0), a, -head.max_s, 0);
+    }
+    // Stretch k, then gap k + 1, then stretch k + 1.
+    for k in 0..m - 1 {
+        let gap = shape.gaps[k + 1];
+        let h = w(k + 1) - w(k);
+        push(s(k), s(k + 1), shape.lc_s[k] + gap.min_s, h);
+        if gap.hold.is_none() {
+            push(s(k + 1), s(k), -(shape.lc_s[k] + gap.max_s), -h);
+        }
+    }
+    // The last stretch, the tail, the task start (a hold: no maximum) of the next task.
+    push(
+        s(m - 1),
+        a,
+        shape.lc_s[m - 1] + shape.gaps[m].min_s,
+        1 - w(m - 1),
+    );
 }

@@ -39,7 +39,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::graph::{Gap, Stretch, TaskShape};
+use super::graph::{Gap, Stretch, TaskShape, push_robot_chain};
 use super::mix::{MAX_MIX_RATIO, MixTask, mix_period_lower_bound_s};
 use super::plan::groups_per_task_s;
 use super::ratio::{Arc, max_cycle_ratio};
@@ -439,27 +439,7 @@ fn mixed_graph(
         for k in 0..mr {
             wrapped[r][k] = u8::from(pos[r][k] < pos[r][0]);
         }
-        let w = |k: usize| i32::from(wrapped[r][k]);
-        let s = |k: usize| a + 1 + k;
-        let head = shape.gaps[0];
-        push(a, s(0), head.min_s, 0);
-        if head.hold.is_none() {
-            push(s(0), a, -head.max_s, 0);
-        }
-        for k in 0..mr - 1 {
-            let gap = shape.gaps[k + 1];
-            let h = w(k + 1) - w(k);
-            push(s(k), s(k + 1), shape.lc_s[k] + gap.min_s, h);
-            if gap.hold.is_none() {
-                push(s(k + 1), s(k), -(shape.lc_s[k] + gap.max_s), -h);
-            }
-        }
-        push(
-            s(mr - 1),
-            a,
-            shape.lc_s[mr - 1] + shape.gaps[mr].min_s,
-            1 - w(mr - 1),
-        );
+        push_robot_chain(shape, a, &wrapped[r], &mut push);
     }
     let len = order.len();
     for q in 0..len {
