@@ -16,6 +16,12 @@
 //!    tick by factors of `2^(1/4)`, until the robots `0..=i` pass (then it is bisected down);
 //!    alignments in increasing start order, the first start that passes winning.
 //!
+//! The check is not monotone within a tick (robot 2's samples fall on the ticks in another
+//! phase: a start may pass while one a millisecond later fails), so both bisections end by
+//! walking the tick grid down from their start to its first failing point (at most
+//! `GRID_PROBES` checks; docs/decisions.md, "The staggered start walks the tick grid down
+//! (issue 38)").
+//!
 //! (docs/decisions.md, "N robots in the margin-free search".)
 
 use crate::{Problem, Schedule, validate_with_switch};
@@ -129,6 +135,20 @@ pub(crate) fn staggered(
                     lo = mid;
                 }
             }
+            // The check is not monotone within a tick (the robots' samples fall on the ticks
+            // in another phase), so a failing `lo` may lie above a passing point: walk the
+            // tick grid down from `hi` to its first failing point.
+            for _ in 0..GRID_PROBES {
+                let below = grid_below(hi, tick_s);
+                if below <= 0.0 || checks >= MAX_STAGGER_CHECKS {
+                    break;
+                }
+                let offsets: Vec<f64> = (1..n_robots).map(|i| i as f64 * below).collect();
+                if !(spaced_disjoint(&base, &offsets) && passes(&offsets, &mut checks)) {
+                    break;
+                }
+                hi = below;
+            }
             spaced = Some((1..n_robots).map(|i| i as f64 * hi).collect::<Vec<f64>>());
             break;
         }
@@ -191,7 +211,17 @@ pub(crate) fn staggered(
                     }
                 }
             }
-            best = Some(o + hi);
+            // As for the spacing: the tick grid below the bisected start, to its first
+            // failing point.
+            let mut start = o + hi;
+            for _ in 0..GRID_PROBES {
+                let below = grid_below(start, tick_s);
+                if below < o || checks >= MAX_STAGGER_CHECKS || !ok(below, &mut checks) {
+                    break;
+                }
+                start = below;
+            }
+            best = Some(start);
         }
         let start_s = match best {
             Some(o) => {
@@ -229,6 +259,15 @@ pub(crate) fn staggered(
         })
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(s, t)| (s, t, checks))
+}
+
+/// Tick-grid points below a bisected start that are tried, downwards, until one fails.
+const GRID_PROBES: usize = 4;
+
+/// The largest multiple of `tick_s` (s) strictly below `t_s` (by more than a nanosecond).
+fn grid_below(t_s: f64, tick_s: f64) -> f64 {
+    let k = ((t_s - 1e-9) / tick_s).floor();
+    k * tick_s
 }
 
 /// Grid steps of the equal spacing over one execution.

@@ -71,8 +71,12 @@ fn outcomes_digest(params: impl Fn(u64) -> SamplerParams) -> u64 {
 /// the cap entered it (commit 02b5bad, the same test file run there: `0xde94_33d2_94e7_2203`),
 /// re-pinned when the staggered candidate joined the two-robot scheduler (issue 38): of the 24
 /// outcomes only case 21 (`N = 2`) changed, 18.0704 s sampled → 18.0689 s staggered (per-case
-/// digests compared with the strategy row switched back, the same commit).
-const BEFORE_SWITCH: u64 = 0xd2d5_eee3_efdc_acf4;
+/// digests compared with the strategy row switched back, the same commit), and again when the
+/// staggered candidate learned to walk the tick grid down from its bisected starts
+/// (`GRID_PROBES`): only case 23 (`N = 4`) changed, 21.4339 s sampled → 21.4253 s staggered
+/// (equal spacing 3.9 s on the grid, 3.9028 s bisected before; per-case outcomes compared with
+/// `GRID_PROBES = 0`, the same commit).
+const BEFORE_SWITCH: u64 = 0xe895_94f2_2667_4d35;
 
 #[test]
 fn zero_switch_time_and_no_cap_are_the_scheduler_before_bit_for_bit() {
