@@ -125,19 +125,64 @@ pub(crate) struct CapacityArgs {
     steady_tasks: Option<usize>,
     /// Run nothing: read `capacity.json` from each of these output folders of earlier runs
     /// (comma-separated; e.g. one run per switch time, side by side) and write their rows
-    /// together under `--out`: the tables, `capacity.json` and the figure. The runs must agree
-    /// on trials, samples, seed and measured window.
+    /// together under `--out`: the tables, `capacity.json` and the figure. The runs of one
+    /// cell must agree on trials, samples, seed and measured window; the rounds runs and the
+    /// continuous runs may differ from each other (`capacity.json` then records the
+    /// continuous cell's as `continuous_sizes`).
     #[arg(long, value_name = "DIR,…", value_delimiter = ',')]
     merge: Vec<PathBuf>,
 }
 
-/// The run sizes a `capacity.json` records, which merged runs must share.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The run sizes a `capacity.json` records, which merged runs must share cell by cell.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 struct Sizes {
     trials: usize,
     samples: usize,
     seed: u64,
     steady_tasks: Option<usize>,
+}
+
+impl Sizes {
+    /// The fields in which `self` differs from `other`, each as `name value` (the name as its
+    /// command-line flag, e.g. `trials 2`).
+    fn differing(&self, other: &Sizes) -> Vec<String> {
+        let tasks = |t: Option<usize>| t.map_or_else(|| "none".to_string(), |k| k.to_string());
+        [
+            (self.trials != other.trials).then(|| format!("trials {}", self.trials)),
+            (self.samples != other.samples).then(|| format!("samples {}", self.samples)),
+            (self.seed != other.seed).then(|| format!("seed {}", self.seed)),
+            (self.steady_tasks != other.steady_tasks)
+                .then(|| format!("steady-tasks {}", tasks(self.steady_tasks))),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
+    }
+}
+
+/// The sizes of each cell's rows (`None`: no rows of that cell). A run of `cargo xtask
+/// capacity` gives both cells the same sizes; `--merge` may join rounds and continuous runs of
+/// different sizes (e.g. the continuous cell at more trials), never two runs of one cell that
+/// differ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct CellSizes {
+    rounds: Option<Sizes>,
+    continuous: Option<Sizes>,
+}
+
+impl CellSizes {
+    /// The sizes `capacity.json` records at its top level: the rounds rows', else the
+    /// continuous cell's.
+    fn main(&self) -> Option<Sizes> {
+        self.rounds.or(self.continuous)
+    }
+
+    /// The continuous cell's sizes when they differ from [`CellSizes::main`] (recorded as
+    /// `continuous_sizes`).
+    fn continuous_apart(&self) -> Option<Sizes> {
+        self.continuous
+            .filter(|c| self.rounds.is_some_and(|r| r != *c))
+    }
 }
 
 /// `capacity.json` as read back (`--merge`).
@@ -148,14 +193,50 @@ struct CapacityFileIn {
     seed: u64,
     #[serde(default)]
     steady_tasks: Option<usize>,
+    /// The continuous rows' sizes when a merge joined them to rounds of other sizes.
+    #[serde(default)]
+    continuous_sizes: Option<Sizes>,
     rows: Vec<CapacityRow>,
     continuous: Vec<CellRow>,
 }
 
-/// The rows of the `capacity.json` in each of `dirs` (`--merge`), in order, and their common
-/// sizes.
-fn read_runs(dirs: &[PathBuf]) -> anyhow::Result<(Sizes, Vec<CapacityRow>, Vec<CellRow>)> {
-    let (mut rows, mut cells, mut sizes) = (Vec::new(), Vec::new(), None::<Sizes>);
+/// Folds `these`, the sizes of `path`'s rows of `cell`, into `seen`, the sizes of that cell's
+/// rows read so far, or fails when they differ.
+fn same_sizes(
+    seen: &mut Option<(Sizes, PathBuf)>,
+    these: Sizes,
+    cell: &str,
+    path: &Path,
+) -> anyhow::Result<()> {
+    match seen {
+        Some((first, from)) if *first != these => bail!(
+            "--merge: the {cell} rows of {} were run with {}, those of {} with {}; merge only \
+             runs of one cell with the same sizes (re-run one of them with the other's {})",
+            path.display(),
+            these.differing(first).join(", "),
+            from.display(),
+            first.differing(&these).join(", "),
+            these
+                .differing(first)
+                .iter()
+                .map(|d| format!("--{}", d.split(' ').next().unwrap_or_default()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        Some(_) => Ok(()),
+        None => {
+            *seen = Some((these, path.to_path_buf()));
+            Ok(())
+        }
+    }
+}
+
+/// The rows of the `capacity.json` in each of `dirs` (`--merge`), in order, and each cell's
+/// sizes: the rounds rows of every folder must share theirs, and so must the continuous rows,
+/// but the two cells may differ.
+fn read_runs(dirs: &[PathBuf]) -> anyhow::Result<(CellSizes, Vec<CapacityRow>, Vec<CellRow>)> {
+    let (mut rows, mut cells) = (Vec::new(), Vec::new());
+    let (mut rounds, mut continuous) = (None, None);
     for dir in dirs {
         let path = dir.join("capacity.json");
         let text = std::fs::read_to_string(&path).with_context(|| {
@@ -172,20 +253,26 @@ fn read_runs(dirs: &[PathBuf]) -> anyhow::Result<(Sizes, Vec<CapacityRow>, Vec<C
             seed: file.seed,
             steady_tasks: file.steady_tasks,
         };
-        if let Some(first) = sizes {
-            if first != these {
-                bail!(
-                    "--merge: {} was run with {these:?}, the first folder with {first:?}; \
-                     merge only runs of the same sizes",
-                    path.display()
-                );
-            }
+        if !file.rows.is_empty() {
+            same_sizes(&mut rounds, these, "rounds", &path)?;
         }
-        sizes = Some(these);
+        if !file.continuous.is_empty() {
+            let sizes = file.continuous_sizes.unwrap_or(these);
+            same_sizes(&mut continuous, sizes, "continuous", &path)?;
+        }
         rows.extend(file.rows);
         cells.extend(file.continuous);
     }
-    let sizes = sizes.ok_or_else(|| anyhow!("--merge: no folders given"))?;
+    if dirs.is_empty() {
+        bail!("--merge: no folders given");
+    }
+    let sizes = CellSizes {
+        rounds: rounds.map(|(s, _)| s),
+        continuous: continuous.map(|(s, _)| s),
+    };
+    if sizes.main().is_none() {
+        bail!("--merge: the folders hold no rows (give folders of runs that finished)");
+    }
     Ok((sizes, rows, cells))
 }
 
@@ -279,6 +366,10 @@ struct CapacityFile<'a> {
     end_share: f64,
     /// `--steady-tasks`: the measured window in tasks per trial (`None`: `end_share`).
     steady_tasks: Option<usize>,
+    /// The continuous rows' sizes when they differ from the rounds rows' above (`--merge` of
+    /// runs of the two cells at different sizes); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    continuous_sizes: Option<Sizes>,
     /// `3600 / E[low-confidence seconds per task]` (tasks per hour per operator).
     operator_limited_per_h: f64,
     /// Rounds, per `N` (empty with `--cell continuous`).
@@ -642,6 +733,10 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
         seed,
         steady_tasks: args.steady_tasks,
     };
+    let sizes = CellSizes {
+        rounds: do_rounds.then_some(sizes),
+        continuous: do_cell.then_some(sizes),
+    };
     report(&sizes, &rows, &cells, &deltas, &out, wall)?;
     let fleet_over = if args.operators.is_empty() {
         0
@@ -677,7 +772,7 @@ pub(crate) fn run(args: &CapacityArgs) -> anyhow::Result<()> {
 /// and writes `capacity.json` and the figure under `out` (the switch-time figure for several
 /// `δ`, else the figure against `N`); fails if any run had overlapping low-confidence ticks.
 fn report(
-    sizes: &Sizes,
+    sizes: &CellSizes,
     rows: &[CapacityRow],
     cells: &[CellRow],
     deltas: &[f64],
@@ -705,12 +800,16 @@ fn report(
         print!("{}", switch_table(&rows, &cells));
     }
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let main = sizes
+        .main()
+        .ok_or_else(|| anyhow!("no rows to report (neither cell ran)"))?;
     let file = CapacityFile {
-        trials: sizes.trials,
-        samples: sizes.samples,
-        seed: sizes.seed,
+        trials: main.trials,
+        samples: main.samples,
+        seed: main.seed,
         end_share: END_SHARE,
-        steady_tasks: sizes.steady_tasks,
+        steady_tasks: main.steady_tasks,
+        continuous_sizes: sizes.continuous_apart(),
         operator_limited_per_h: bound,
         rows: &rows,
         continuous: &cells,
@@ -719,9 +818,16 @@ fn report(
     std::fs::write(&json_path, serde_json::to_string_pretty(&file)? + "\n")
         .with_context(|| format!("writing {}", json_path.display()))?;
     if deltas.len() > 1 {
-        let window = sizes
-            .steady_tasks
-            .map_or_else(|| "last 10 %".to_string(), |k| format!("last {k} tasks"));
+        let name = |s: Option<Sizes>| {
+            s.and_then(|s| s.steady_tasks)
+                .map_or_else(|| "last 10 %".to_string(), |k| format!("last {k} tasks"))
+        };
+        let window = match (sizes.rounds, sizes.continuous) {
+            (Some(r), Some(c)) if r.steady_tasks != c.steady_tasks => {
+                format!("rounds {}, continuous {}", name(Some(r)), name(Some(c)))
+            }
+            _ => name(sizes.main()),
+        };
         draw_switch(
             &rows,
             &cells,
@@ -1484,6 +1590,143 @@ mod tests {
         }
         assert!(draw_switch(&[], &[], "last 10 %", &svg, &png).is_err());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Writes a `capacity.json` of `rows` and `cells` run with `sizes` (both cells) into a
+    /// new folder `dir/name`, as `report` does.
+    fn run_dir(
+        dir: &Path,
+        name: &str,
+        sizes: Sizes,
+        rows: &[CapacityRow],
+        cells: &[CellRow],
+    ) -> PathBuf {
+        let out = dir.join(name);
+        let sizes = CellSizes {
+            rounds: (!rows.is_empty()).then_some(sizes),
+            continuous: (!cells.is_empty()).then_some(sizes),
+        };
+        report(&sizes, rows, cells, &[0.0], &out, Instant::now()).unwrap();
+        out
+    }
+
+    #[test]
+    fn merge_checks_the_sizes_of_each_cell_apart() {
+        let dir = crate::fig5::tests::scratch_dir("capacity-merge");
+        let rounds = Sizes {
+            trials: 1,
+            samples: 1000,
+            seed: 2023,
+            steady_tasks: None,
+        };
+        let continuous = Sizes {
+            trials: 2,
+            samples: 200,
+            ..rounds
+        };
+        let at = |d: f64| CapacityRow {
+            switch_s: d,
+            ..r(3, 150.0, 0.6, 30.0)
+        };
+        let cell_at = |d: f64| CellRow {
+            switch_s: d,
+            ..c(3, 30.0)
+        };
+        let r0 = run_dir(&dir, "r0", rounds, &[at(0.0)], &[]);
+        let r1 = run_dir(&dir, "r1", rounds, &[at(1.0)], &[]);
+        let c0 = run_dir(&dir, "c0", continuous, &[], &[cell_at(0.0)]);
+        // Rounds and continuous runs of different sizes merge, each cell keeping its own.
+        let (sizes, rows, cells) = read_runs(&[r0.clone(), c0.clone(), r1.clone()]).unwrap();
+        assert_eq!(sizes.rounds, Some(rounds));
+        assert_eq!(sizes.continuous, Some(continuous));
+        assert_eq!((rows.len(), cells.len()), (2, 1));
+        // The merged file records the continuous cell's sizes apart and reads back the same.
+        let merged = dir.join("merged");
+        report(&sizes, &rows, &cells, &[0.0, 1.0], &merged, Instant::now()).unwrap();
+        let text = std::fs::read_to_string(merged.join("capacity.json")).unwrap();
+        assert!(text.contains("\"continuous_sizes\""), "{text}");
+        let (again, rows2, cells2) = read_runs(std::slice::from_ref(&merged)).unwrap();
+        assert_eq!(again, sizes);
+        assert_eq!((rows2, cells2), (rows, cells));
+        // A run with both cells at one size has no separate continuous sizes.
+        let both = run_dir(&dir, "both", rounds, &[at(2.0)], &[cell_at(2.0)]);
+        let text = std::fs::read_to_string(both.join("capacity.json")).unwrap();
+        assert!(!text.contains("continuous_sizes"), "{text}");
+        // Two runs of one cell at different sizes are refused, naming the cell and both folders.
+        let err = read_runs(&[r0.clone(), both.clone(), c0.clone()])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("the continuous rows of"), "{err}");
+        assert!(err.contains("c0") && err.contains("both"), "{err}");
+        // The field that differs, with both values and the flag to re-run with.
+        assert!(
+            err.contains("trials 2") && err.contains("trials 1") && err.contains("--trials"),
+            "{err}"
+        );
+        assert!(
+            err.contains("samples 200") && err.contains("samples 1000"),
+            "{err}"
+        );
+        assert!(!err.contains("seed"), "{err}");
+        let r2 = run_dir(
+            &dir,
+            "r2",
+            Sizes {
+                trials: 2,
+                ..rounds
+            },
+            &[at(2.0)],
+            &[],
+        );
+        let err = read_runs(&[r0, merged, r2]).unwrap_err().to_string();
+        assert!(
+            err.contains("the rounds rows of") && err.contains("r2"),
+            "{err}"
+        );
+        assert!(
+            err.contains("trials 2") && !err.contains("samples"),
+            "{err}"
+        );
+        assert!(read_runs(&[]).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A measurement, not a check (docs/decisions.md, "Three robots at δ ≥ 1 s: per-pair
+    /// clearances on the dwelled schedule (issue 41)"): the state file `TANDEM_STATE` (e.g. a
+    /// `trial_0.tandem` of `cargo xtask study --robots 3 --switch-s 1 --save-state DIR`)
+    /// re-scheduled at each switch time of `TANDEM_SWITCH_S` (comma-separated, s) with 200
+    /// samples, printing `T_total`, the source and the `δ`-bound. Run with
+    /// `TANDEM_STATE=… TANDEM_SWITCH_S=1,2,5 cargo test -p xtask --bin xtask --
+    /// --ignored --nocapture reschedule_a_saved_state`.
+    #[test]
+    #[ignore = "a measurement on a saved state (TANDEM_STATE), minutes"]
+    fn reschedule_a_saved_state() {
+        let path = std::env::var("TANDEM_STATE").expect("TANDEM_STATE: a saved .tandem file");
+        let switches = std::env::var("TANDEM_SWITCH_S").unwrap_or_else(|_| "1".into());
+        for sw in switches.split(',') {
+            let sw: f64 = sw
+                .trim()
+                .parse()
+                .expect("TANDEM_SWITCH_S: numbers, comma-separated");
+            let mut planner = tandem::Planner::load(&path).unwrap();
+            let serial_s = planner.outcome().t_total_s;
+            let sampler = tandem::schedule::SamplerParams {
+                samples: 200,
+                switch_s: sw,
+                ..planner.params().sampler.clone()
+            };
+            let start = Instant::now();
+            let out = planner.reschedule(&sampler).unwrap();
+            eprintln!(
+                "δ = {sw} s: T_total {:.2} s ({}), δ-bound {:.2} s, saved {serial_s:.2} s, \
+                 {} margin checks, {:.0} s",
+                out.t_total_s,
+                out.source.name(),
+                out.lower_bound_s,
+                out.stats.completion_margin_checks,
+                start.elapsed().as_secs_f64()
+            );
+        }
     }
 
     #[test]
