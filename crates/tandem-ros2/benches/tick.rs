@@ -5,8 +5,9 @@
 //! `with_queues` is the node's tick thread on the same controller without the network
 //! (`link::TickEnd::tick`, which `Ticker::run` of node.rs runs): the clock read, the
 //! pending-message counter (nothing queued), the robots' progress counters (each robot reported
-//! since the last tick), `CellLoop::advance` (liveness, the round's log, the tick), the command
-//! pushed into the ring and the state slot's `want` flag, answered with a snapshot every 10th
+//! since the last tick), the loop's tick (`CellLoop::advance`'s: liveness, the round's log, the
+//! controller's tick), the command's words written from the loop into the ring (no `Command`
+//! built) and the state slot's `want` flag, answered with a snapshot every 10th
 //! tick (the 100 Hz state topics at a 1 kHz tick; `with_queues_state_every_tick`: every tick,
 //! the 10 ms tick's case). The queues' cost is `with_queues` − `loop_only`.
 //! The DDS side's ends (three progress reports, the command popped, the snapshot taken) run
@@ -99,8 +100,7 @@ impl NodeTick {
     /// counters); returns the tick's instant.
     fn tick_thread(&mut self, console: Option<&mut ConsoleFeed>) -> Instant {
         let now = Instant::now();
-        let cmd = self
-            .end
+        self.end
             .tick(&mut self.l, &self.links, now, |_| {
                 unreachable!("nothing is queued in this benchmark")
             })
@@ -108,7 +108,7 @@ impl NodeTick {
         if let Some(feed) = console {
             feed.publish(&self.l);
         }
-        if cmd.finished {
+        if self.l.is_finished() {
             start(&mut self.l);
         }
         now
@@ -180,18 +180,18 @@ impl Threads {
         let n = &mut self.node;
         let l = &*self.links;
         let now = Instant::now();
-        let cmd = n
-            .end
+        n.end
             .tick(&mut n.l, l, now, |_| {
                 unreachable!("nothing is queued in this benchmark")
             })
             .expect("a valid operator");
         self.writer.thread().unpark();
-        n.end.account(l, now, Instant::now());
-        if cmd.finished {
+        n.end.account(l, Instant::now());
+        let finished = n.l.is_finished();
+        if finished {
             start(&mut n.l);
         }
-        cmd.tick
+        u64::from(finished)
     }
 
     fn finish(self) -> u64 {

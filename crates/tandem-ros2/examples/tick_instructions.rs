@@ -18,8 +18,9 @@
 //!   (`CellLoop::heard`) and `CellLoop::advance` — what a user's own live loop on `CellLoop`
 //!   runs;
 //! - `run_tick_thread`: the node's tick thread as `Ticker::run` runs it (`link::TickEnd::tick`:
-//!   the pending-message counter, the progress counters, `advance`, the command ring, the state
-//!   slot asked every 10th tick), plus its per-tick bookkeeping and the writer's wake;
+//!   the pending-message counter, the progress counters, the loop's tick (`advance` without
+//!   building its `Command`), the command's words into the ring, the state slot asked every 10th
+//!   tick), plus its per-tick bookkeeping (`TickEnd::account`) and the writer's wake;
 //! - `run_dds_side`: the DDS thread's ends for those ticks (three progress counters, the ring
 //!   drained, the slot asked and taken), for reference: in the node they run on another thread.
 //!
@@ -103,12 +104,11 @@ fn run_tick_thread(
     i: u64,
 ) {
     let now = Instant::now();
-    let c = end
-        .tick(l, links, now, |_| unreachable!("nothing is queued"))
+    end.tick(l, links, now, |_| unreachable!("nothing is queued"))
         .expect("a valid operator");
     writer.unpark();
-    end.account(links, now, Instant::now());
-    if c.finished {
+    end.account(links, Instant::now());
+    if l.is_finished() {
         start(l);
     }
     black_box(i);

@@ -237,12 +237,7 @@ impl Command {
     /// operator.
     #[must_use]
     pub fn flags_word(&self) -> u64 {
-        let mut w =
-            u64::from(self.active) | u64::from(self.finished) << 1 | u64::from(self.fault) << 2;
-        for (k, b) in self.needs_operator.iter().enumerate() {
-            w |= u64::from(b) << (8 + k);
-        }
-        w
+        flags_word(self.active, self.finished, self.fault, &self.needs_operator)
     }
 
     /// The command of a tick count, a [`flags_word`](Self::flags_word) and the robots' values
@@ -269,6 +264,17 @@ impl Command {
             needs_operator,
         }
     }
+}
+
+/// [`Command::flags_word`] of the command's flags: bit 0 `active`, 1 `finished`, 2 `fault`,
+/// 8 + k robot k needs the operator.
+#[inline]
+fn flags_word(active: bool, finished: bool, fault: bool, needs: &RobotFlags) -> u64 {
+    let mut w = u64::from(active) | u64::from(finished) << 1 | u64::from(fault) << 2;
+    for k in 0..needs.len() {
+        w |= u64::from(needs.get(k)) << (8 + k);
+    }
+    w
 }
 
 /// One robot's log of a round: one entry per tick in which it ran.
@@ -684,6 +690,36 @@ impl CellLoop {
     /// # Errors
     /// None in practice: the operator's input is always a valid [`Operator`].
     pub fn advance(&mut self, now: Instant) -> Result<Command> {
+        self.tick_at(now)?;
+        Ok(Command {
+            tick: self.ticks,
+            active: self.active,
+            finished: self.finished,
+            fault: self.stall.is_some() || self.last.fault.is_some(),
+            ref_time: self.last.ref_time,
+            speed: self.speed,
+            needs_operator: self.needs_operator(),
+        })
+    }
+
+    /// The last tick's [`Command`] as the node's ring stores it, read from the loop's state
+    /// without building the command: its tick count, its [`Command::flags_word`], each robot's
+    /// reference time and speed scale. Valid right after [`tick_at`](Self::tick_at) (a request
+    /// handled since changes the reference times to the controller's state).
+    #[inline]
+    pub(crate) fn command_words(&self) -> (u64, u64, &PerRobot<f64>, &PerRobot<f64>) {
+        let fault = self.stall.is_some() || self.last.fault.is_some();
+        let flags = flags_word(self.active, self.finished, fault, &self.needs_operator());
+        (self.ticks, flags, &self.last.ref_time, &self.speed)
+    }
+
+    /// [`advance`](Self::advance) without its [`Command`]: the node's tick thread takes the
+    /// command's words from the loop ([`command_words`](Self::command_words)) straight into the
+    /// ring, so no command is built and copied on the tick thread. Inlined into both callers,
+    /// so that `advance` (a user's own loop, the benchmark's `loop_only`) and the tick thread
+    /// run the same code, neither with a call more.
+    #[inline(always)]
+    pub(crate) fn tick_at(&mut self, now: Instant) -> Result<()> {
         let n = self.ctl.n_robots();
         self.ticks += 1;
         if self.active && self.stall.is_none() && self.stall_due.is_none_or(|d| now > d) {
@@ -739,15 +775,7 @@ impl CellLoop {
             *s = ((after[i] - before[i]) / per_tick).max(0.0);
         }
         self.overlap = overlap;
-        Ok(Command {
-            tick: self.ticks,
-            active: self.active,
-            finished: self.finished,
-            fault: self.stall.is_some() || self.last.fault.is_some(),
-            ref_time: after,
-            speed: self.speed,
-            needs_operator: self.needs_operator(),
-        })
+        Ok(())
     }
 }
 

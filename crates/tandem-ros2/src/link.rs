@@ -67,29 +67,59 @@ impl CommandRing {
         }
     }
 
-    fn record(&self, count: u64) -> &[AtomicU64] {
+    /// The record of the `count`-th push: its tick, flags and start, then each robot's
+    /// reference time and speed scale as a pair.
+    #[inline]
+    fn record(&self, count: u64) -> (&[AtomicU64; 3], &[[AtomicU64; 2]]) {
         let w = record_words(self.n);
         let at = (count & (self.capacity - 1)) as usize * w;
-        &self.words[at..at + w]
+        let r = &self.words[at..at + w];
+        let (head, robots) = r.split_at(3);
+        (
+            head.try_into().expect("a record has three leading words"),
+            robots.as_chunks::<2>().0,
+        )
     }
 
     /// Pushes `cmd` of the tick that started at `at` (the producer, one thread); `false` (and
     /// counted) when the ring is full.
     pub fn push(&self, cmd: &Command, at: Instant) -> bool {
+        let at_ns = self.since(at);
+        self.push_words(cmd.tick, cmd.flags_word(), &cmd.ref_time, &cmd.speed, at_ns)
+    }
+
+    /// `at` in the records' time: ns after the ring's creation (0 before it).
+    #[inline]
+    fn since(&self, at: Instant) -> u64 {
+        // Nanoseconds fit a u64 for 584 years.
+        at.saturating_duration_since(self.base).as_nanos() as u64
+    }
+
+    /// [`push`](Self::push) of a command given as its tick count, its
+    /// [`Command::flags_word`] and its robots' reference times and speed scales (the node's
+    /// tick thread takes them from the loop, [`TickEnd::tick`]: no [`Command`] is built), its
+    /// tick's start as [`since`](Self::since) gives it.
+    #[inline]
+    pub(crate) fn push_words(
+        &self,
+        tick: u64,
+        flags: u64,
+        ref_time: &[f64],
+        speed: &[f64],
+        at_ns: u64,
+    ) -> bool {
         let h = self.head.load(Ordering::Relaxed);
         if h - self.tail.load(Ordering::Acquire) >= self.capacity {
             self.dropped.fetch_add(1, Ordering::Relaxed);
             return false;
         }
-        let r = self.record(h);
-        r[0].store(cmd.tick, Ordering::Relaxed);
-        r[1].store(cmd.flags_word(), Ordering::Relaxed);
-        // Nanoseconds fit a u64 for 584 years.
-        let since = at.saturating_duration_since(self.base).as_nanos() as u64;
-        r[2].store(since, Ordering::Relaxed);
-        for k in 0..self.n.min(cmd.ref_time.len()) {
-            r[3 + 2 * k].store(cmd.ref_time[k].to_bits(), Ordering::Relaxed);
-            r[4 + 2 * k].store(cmd.speed[k].to_bits(), Ordering::Relaxed);
+        let (head, robots) = self.record(h);
+        head[0].store(tick, Ordering::Relaxed);
+        head[1].store(flags, Ordering::Relaxed);
+        head[2].store(at_ns, Ordering::Relaxed);
+        for ((pair, r), s) in robots.iter().zip(ref_time).zip(speed) {
+            pair[0].store(r.to_bits(), Ordering::Relaxed);
+            pair[1].store(s.to_bits(), Ordering::Relaxed);
         }
         self.head.store(h + 1, Ordering::Release);
         true
@@ -102,17 +132,21 @@ impl CommandRing {
         if t == self.head.load(Ordering::Acquire) {
             return None;
         }
-        let r = self.record(t);
+        let (head, robots) = self.record(t);
         let mut ref_time = PerRobot::<f64>::new(self.n);
         let mut speed = PerRobot::<f64>::new(self.n);
-        for k in 0..self.n {
-            ref_time.as_mut_slice()[k] = f64::from_bits(r[3 + 2 * k].load(Ordering::Relaxed));
-            speed.as_mut_slice()[k] = f64::from_bits(r[4 + 2 * k].load(Ordering::Relaxed));
+        for ((pair, r), s) in robots
+            .iter()
+            .zip(ref_time.as_mut_slice())
+            .zip(speed.as_mut_slice())
+        {
+            *r = f64::from_bits(pair[0].load(Ordering::Relaxed));
+            *s = f64::from_bits(pair[1].load(Ordering::Relaxed));
         }
-        let at = self.base + Duration::from_nanos(r[2].load(Ordering::Relaxed));
+        let at = self.base + Duration::from_nanos(head[2].load(Ordering::Relaxed));
         let cmd = Command::from_words(
-            r[0].load(Ordering::Relaxed),
-            r[1].load(Ordering::Relaxed),
+            head[0].load(Ordering::Relaxed),
+            head[1].load(Ordering::Relaxed),
             ref_time,
             speed,
         );
@@ -156,6 +190,7 @@ impl StateSlot {
 
     /// Whether the reader waits for a snapshot (one relaxed load: the tick thread's per-tick
     /// cost when it does not).
+    #[inline]
     #[must_use]
     pub fn wanted(&self) -> bool {
         self.want.load(Ordering::Relaxed)
@@ -206,6 +241,7 @@ impl Default for Heard {
 
 impl Heard {
     /// The DDS thread heard robot `robot` (0-based; others ignored).
+    #[inline]
     pub fn hear(&self, robot: usize) {
         if let Some(c) = self.counts.get(robot) {
             c.fetch_add(1, Ordering::Relaxed);
@@ -221,8 +257,10 @@ impl Heard {
 
     /// Calls `f(k)` for each robot `k` (of the first `n`) heard since `seen` (updated), robot 1
     /// first: one relaxed load and one comparison per robot.
+    #[inline]
     pub fn each_heard(&self, n: usize, seen: &mut [u64; MAX_ROBOTS], mut f: impl FnMut(usize)) {
-        for (k, (c, s)) in self.counts.iter().zip(seen.iter_mut()).take(n).enumerate() {
+        let n = n.min(MAX_ROBOTS);
+        for (k, (c, s)) in self.counts[..n].iter().zip(&mut seen[..n]).enumerate() {
             let v = c.load(Ordering::Relaxed);
             if v != *s {
                 *s = v;
@@ -246,6 +284,7 @@ impl Pending {
     }
 
     /// Whether messages were queued since `seen` (updated).
+    #[inline]
     pub fn moved(&self, seen: &mut u64) -> bool {
         let v = self.sent.load(Ordering::Acquire);
         if v == *seen {
@@ -303,15 +342,19 @@ pub struct TickEnd {
     n: usize,
     pending_seen: u64,
     heard_seen: [u64; MAX_ROBOTS],
-    /// The last command's fault, finished and active flags (bits 0–2 of
-    /// [`Command::flags_word`]'s order).
-    last_flags: u8,
+    /// The last command's active, finished and fault flags (bits 0–2 of
+    /// [`Command::flags_word`]).
+    last_flags: u64,
     /// A snapshot is owed: the slot was held by the reader when one was due.
     owed: bool,
     ticks: u64,
-    last_start: Option<Instant>,
+    /// The last tick's start, and as ns in the ring's time ([`CommandRing::since`]); the one
+    /// before it in the ring's time.
+    start: Option<Instant>,
+    start_ns: u64,
+    last_start_ns: Option<u64>,
     max_period_ns: u64,
-    max_tick_ns: u64,
+    max_tick: Duration,
 }
 
 impl TickEnd {
@@ -325,17 +368,22 @@ impl TickEnd {
             last_flags: 0,
             owed: false,
             ticks: 0,
-            last_start: None,
+            start: None,
+            start_ns: 0,
+            last_start_ns: None,
             max_period_ns: 0,
-            max_tick_ns: 0,
+            max_tick: Duration::ZERO,
         }
     }
 
     /// One tick at `now` (the tick's start): `drain` takes the queued rare messages in when
-    /// the pending counter moved, each robot heard since the last tick is alive at `now`,
-    /// [`CellLoop::advance`], the command into the ring (a full ring drops it, counted), and
-    /// the snapshot into the state slot when the DDS thread asked for it or the fault, the
-    /// round's end or the running state changed (or one is owed). Returns the command.
+    /// the pending counter moved, each robot heard since the last tick is alive at `now`, the
+    /// loop's tick ([`CellLoop::advance`] without building its [`Command`]), the command's
+    /// words from the loop into the ring (a full ring drops it, counted), and the snapshot into
+    /// the state slot when the DDS thread asked for it or the fault, the round's end or the
+    /// running state changed (or one is owed). The ring's record is the command `advance`
+    /// returns (`cargo test -p tandem-ros2 --test cell_loop the_tick_thread`); whether the
+    /// round finished is [`CellLoop::is_finished`].
     ///
     /// # Errors
     /// [`CellLoop::advance`]'s.
@@ -345,41 +393,57 @@ impl TickEnd {
         links: &Links,
         now: Instant,
         drain: impl FnOnce(&mut CellLoop),
-    ) -> Result<Command> {
+    ) -> Result<()> {
         if links.pending.moved(&mut self.pending_seen) {
             drain(l);
         }
         links
             .heard
             .each_heard(self.n, &mut self.heard_seen, |k| l.heard(k, now));
-        let cmd = l.advance(now)?;
-        links.commands.push(&cmd, now);
-        let flags = u8::from(cmd.fault) | u8::from(cmd.finished) << 1 | u8::from(cmd.active) << 2;
+        l.tick_at(now)?;
+        // The tick's start in the ring's time, for its record and the period's count.
+        let start_ns = links.commands.since(now);
+        self.last_start_ns = self.start.map(|_| self.start_ns);
+        self.start = Some(now);
+        self.start_ns = start_ns;
+        let (tick, flags, ref_time, speed) = l.command_words();
+        links
+            .commands
+            .push_words(tick, flags, ref_time, speed, start_ns);
+        // Active, finished, fault.
+        let flags = flags & 0b111;
         if flags != self.last_flags || self.owed || links.state.wanted() {
             // A slot the DDS thread holds right now is written at the next tick.
             self.owed = !links.state.put(l.snapshot());
         }
         self.last_flags = flags;
-        Ok(cmd)
+        Ok(())
     }
 
-    /// Counts a tick that started at `start` and whose work ended at `end` into `links`'
-    /// counters: one store for the count, one more only when a maximum grew.
-    pub fn account(&mut self, links: &Links, start: Instant, end: Instant) {
+    /// Counts the last [`tick`](Self::tick), whose work ended at `end`, into `links`'
+    /// counters: one store for the count, one more only when a maximum grew. The period is
+    /// the difference of the two last ticks' starts in the ring's time (ns, computed by
+    /// [`tick`](Self::tick) for the ring's records), so a tick reads the difference of two
+    /// instants twice, not three times. Nothing is counted before the first tick.
+    pub fn account(&mut self, links: &Links, end: Instant) {
+        let Some(start) = self.start else {
+            return;
+        };
         self.ticks += 1;
         links.ticks.store(self.ticks, Ordering::Relaxed);
-        if let Some(last) = self.last_start {
-            let period = start.saturating_duration_since(last).as_nanos() as u64;
+        if let Some(last) = self.last_start_ns {
+            let period = self.start_ns.saturating_sub(last);
             if period > self.max_period_ns {
                 self.max_period_ns = period;
                 links.max_period_ns.store(period, Ordering::Relaxed);
             }
         }
-        self.last_start = Some(start);
-        let work = end.saturating_duration_since(start).as_nanos() as u64;
-        if work > self.max_tick_ns {
-            self.max_tick_ns = work;
-            links.max_tick_ns.store(work, Ordering::Relaxed);
+        let work = end.saturating_duration_since(start);
+        if work > self.max_tick {
+            self.max_tick = work;
+            links
+                .max_tick_ns
+                .store(work.as_nanos() as u64, Ordering::Relaxed);
         }
     }
 }

@@ -540,7 +540,7 @@ impl Ticker {
             next += period;
             // One clock read for both the tick's work and the sleep.
             let after = Instant::now();
-            end.account(&links, now, after);
+            end.account(&links, after);
             if next > after {
                 std::thread::sleep(next - after);
             } else if after - next > period {

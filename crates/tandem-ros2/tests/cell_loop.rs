@@ -408,3 +408,147 @@ fn the_stall_bound_decides_to_the_nanosecond() {
         other => panic!("robot 2 silent for 0.3 s is stalled, got {other:?}"),
     }
 }
+
+/// The messages of tick `i` of [`the_tick_thread_sends_what_advance_returns`]'s sequence.
+fn scripted(i: u64, finished_at: Option<u64>) -> Vec<Inbound> {
+    let mut m = Vec::new();
+    let request = |what| Inbound::Request { token: 7, what };
+    match i {
+        0 => m.push(request(Request::Start)),
+        // The operator slows the supervised robot, then a gradient, then lets go.
+        20..=30 => m.push(Inbound::Operator {
+            axis: -1.0,
+            correcting: true,
+        }),
+        100 => m.push(Inbound::Operator {
+            axis: 0.5,
+            correcting: false,
+        }),
+        // Robot 2 is silent from tick 40 (below): stalled after 0.25 s; cleared at tick 75.
+        75 => m.push(request(Request::ClearFault)),
+        _ => {}
+    }
+    if let Some(f) = finished_at {
+        if i == f + 5 {
+            m.push(request(Request::TakeRound));
+        } else if i == f + 6 {
+            m.push(request(Request::Start));
+        } else if i == f + 36 {
+            m.push(request(Request::Stop));
+        }
+    }
+    m
+}
+
+/// The node's tick thread (`TickEnd::tick`: the progress counters, the loop's tick, the
+/// command into the ring, the snapshot into the slot) sends exactly the commands that
+/// `CellLoop::advance` returns for the same sequence of ticks and messages — a round with an
+/// operator's corrections, a stall and its clearance, the round's end, its hand-over, a second
+/// round stopped — and a snapshot equal to `CellLoop::snapshot` whenever the fault, the
+/// round's end or the running state changed or the DDS side asked (every 10th tick).
+#[test]
+fn the_tick_thread_sends_what_advance_returns() {
+    use tandem_ros2::link::{Links, TickEnd};
+    let planner = support::planner(3);
+    let mut a = cell_loop(&planner, Cell::Rounds);
+    let mut b = cell_loop(&planner, Cell::Rounds);
+    let tick = Duration::from_secs_f64(a.controller().tick_s());
+    let links = Links::new(3, 64);
+    let mut end = TickEnd::new(3);
+    let t0 = Instant::now();
+    let (mut finished_at, mut last_flags) = (None, None);
+    let (mut faults, mut corrected, mut needs, mut snaps) = (0, 0, 0, 0);
+    let (mut log_a, mut log_b) = (None, None);
+    for i in 0..2_000_u64 {
+        let now = t0 + tick * (i as u32);
+        for k in 0..3 {
+            if !((40..75).contains(&i) && k == 1) {
+                a.heard(k, now);
+                links.heard.hear(k);
+            }
+        }
+        for m in scripted(i, finished_at) {
+            a.handle(m, now, &mut |r| {
+                if let Reply::Round { log, .. } = r {
+                    log_a = Some(log);
+                }
+            });
+        }
+        let msgs = scripted(i, finished_at);
+        if !msgs.is_empty() {
+            links.pending.sent();
+        }
+        if i % 10 == 0 {
+            links.state.ask();
+        }
+        let want = a.advance(now).unwrap();
+        end.tick(&mut b, &links, now, |l| {
+            for m in msgs {
+                l.handle(m, now, &mut |r| {
+                    if let Reply::Round { log, .. } = r {
+                        log_b = Some(log);
+                    }
+                });
+            }
+        })
+        .unwrap();
+        let (got, at) = links.commands.pop().expect("one command per tick");
+        assert_eq!(got, want, "tick {i}");
+        assert_eq!(at, now);
+        assert!(links.commands.pop().is_none());
+        let flags = (want.active, want.finished, want.fault);
+        let snap = links.state.take();
+        if last_flags != Some(flags) || i % 10 == 0 {
+            assert_eq!(snap, Some(a.snapshot()), "tick {i}: a snapshot is due");
+            snaps += 1;
+        } else {
+            assert_eq!(snap, None, "tick {i}: no snapshot is due");
+        }
+        last_flags = Some(flags);
+        faults += u64::from(want.fault);
+        needs += u64::from(want.needs_operator.count() > 0);
+        corrected += u64::from(want.speed.iter().any(|&v| (v - 0.5).abs() < 1e-9));
+        if want.finished && finished_at.is_none() {
+            finished_at = Some(i);
+        }
+        if finished_at.is_some_and(|f| i > f + 40) {
+            break;
+        }
+    }
+    let f = finished_at.expect("the round finished");
+    assert!(
+        faults > 0 && corrected > 0 && needs > 0,
+        "{faults} {corrected} {needs}"
+    );
+    assert!(snaps > f / 10, "{snaps} snapshots in {f} ticks");
+    assert!(
+        log_a.is_some() && log_a == log_b,
+        "the round's log handed over alike"
+    );
+}
+
+/// The tick thread's counters from the instants it is given: ticks counted, the longest time
+/// between two tick starts and the longest tick's work, in ns; nothing before the first tick.
+#[test]
+fn the_tick_threads_counters_take_the_longest_period_and_work() {
+    use std::sync::atomic::Ordering;
+    use tandem_ros2::link::{Links, TickEnd};
+    let planner = support::planner(2);
+    let mut l = cell_loop(&planner, Cell::Rounds);
+    let links = Links::new(2, 16);
+    let mut end = TickEnd::new(2);
+    let t0 = Instant::now();
+    end.account(&links, t0);
+    assert_eq!(links.ticks.load(Ordering::Relaxed), 0);
+    let us = |u: u64| Duration::from_micros(u);
+    // Starts at 0, 1 ms, 4 ms, 5 ms; work 200, 700, 100, 300 µs.
+    for (start, work) in [(0, 200), (1_000, 700), (4_000, 100), (5_000, 300)] {
+        let now = t0 + us(start);
+        end.tick(&mut l, &links, now, |_| {}).unwrap();
+        end.account(&links, now + us(work));
+        while links.commands.pop().is_some() {}
+    }
+    assert_eq!(links.ticks.load(Ordering::Relaxed), 4);
+    assert_eq!(links.max_period_ns.load(Ordering::Relaxed), 3_000_000);
+    assert_eq!(links.max_tick_ns.load(Ordering::Relaxed), 700_000);
+}
