@@ -6,7 +6,9 @@ arguments name the fix."""
 from __future__ import annotations
 
 import json
+import struct
 import subprocess
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -138,3 +140,44 @@ def test_bad_cell_arguments_name_the_fix() -> None:
     # A plain planner's loader refuses a cell, naming the cell's loader.
     with pytest.raises(tandem.StateFileError, match="CellPlanner.load"):
         tandem.Planner.load(ROOT / "fixtures" / "state" / "mixed.tandem")
+
+
+def zero_stored_offset(path: Path, offset: float) -> None:
+    """Sets the stored start offset ``offset`` (its one occurrence in the file) to 0 and
+    rewrites the header's CRC-32 of the payload (bytes 20..24, the payload from byte 24)."""
+    data = bytearray(path.read_bytes())
+    needle = struct.pack("<d", offset)
+    assert data.count(needle) == 1
+    i = data.index(needle)
+    data[i : i + 8] = struct.pack("<d", 0.0)
+    data[20:24] = struct.pack("<I", zlib.crc32(bytes(data[24:])))
+    path.write_bytes(bytes(data))
+
+
+def test_a_stored_schedule_that_fails_the_check_warns_as_planner_load_does(
+    tmp_path: Path,
+) -> None:
+    # Robot 2 moved to start with robot 1: both low-confidence at once (Eq. 20, constraint 3).
+    one = tmp_path / "one.tandem"
+    planner = tandem.fit(A, robots=2, params=PARAMS)
+    planner.save(one)
+    assert planner.schedule.offsets[0] > 0.0
+    zero_stored_offset(one, float(planner.schedule.offsets[0]))
+    with pytest.warns(tandem.DataWarning, match="fails this build's check") as want:
+        tandem.Planner.load(one)
+    with pytest.warns(tandem.DataWarning, match="fails this build's check") as got:
+        cell = tandem.CellPlanner.load(one)
+    assert [str(w.message) for w in got] == [str(w.message) for w in want]
+    assert str(one) in str(got[0].message)
+    assert cell.tasks == ["task"]
+    # A cell of two tasks: the warning names the task whose stored schedule was replaced.
+    two = tmp_path / "two.tandem"
+    ab = fit_ab()
+    ab.save(two)
+    offset = float(ab.planner("a").schedule.offsets[0])
+    assert offset > 0.0
+    zero_stored_offset(two, offset)
+    with pytest.warns(tandem.DataWarning, match="task `a`: the stored schedule fails") as got:
+        loaded = tandem.CellPlanner.load(two)
+    assert len(got) == 1 and str(two) in str(got[0].message)
+    assert loaded.tasks == ["a", "b"]

@@ -120,6 +120,11 @@ enum Cmd {
         /// with fewer executions each for a reduced batch.
         #[arg(long)]
         problems: Option<u64>,
+        /// With `--cell continuous`: a cell of different tasks (issue 45) — each robot its own
+        /// random problem, the mixed cyclic plan (`mixed_cyclic_plan`, task ratios) run by its
+        /// per-robot coordinator (`MixedCyclicPlan::coordinator`); `--problems` counts cells.
+        #[arg(long)]
+        mixed: bool,
     },
 }
 
@@ -140,6 +145,7 @@ fn main() -> anyhow::Result<()> {
             switch_s,
             max_busy,
             problems,
+            mixed,
         } => {
             if !(switch_s.is_finite() && switch_s >= 0.0) {
                 anyhow::bail!("--switch-s must be finite and ≥ 0 (seconds), got {switch_s}");
@@ -149,7 +155,14 @@ fn main() -> anyhow::Result<()> {
                     "--max-busy must be in (0, 1] (the operator's busy share cap), got {max_busy}"
                 );
             }
-            if cell == "continuous" {
+            if mixed {
+                if cell != "continuous" || max_busy < 1.0 {
+                    anyhow::bail!(
+                        "--mixed runs the continuous cell without a load cap: add --cell continuous and leave --max-busy at 1"
+                    );
+                }
+                stress::mixed::run_mixed(executions, seed, robots, tasks, switch_s, problems)
+            } else if cell == "continuous" {
                 stress::run_continuous(
                     executions, seed, robots, tasks, switch_s, max_busy, problems,
                 )

@@ -73,6 +73,8 @@ use tandem::schedule::{
 };
 use tandem_schedule::testkit::hold_points;
 
+pub(crate) mod mixed;
+
 /// Executions per scheduled problem (the number of problems is `N / this`, at least 1 and at
 /// most [`MAX_PROBLEMS`]).
 const EXECUTIONS_PER_PROBLEM: u64 = 1_000;

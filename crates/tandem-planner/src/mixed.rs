@@ -361,6 +361,38 @@ impl CellPlanner {
         )?)
     }
 
+    /// The control tick (real s) of the cell run continuously: the shortest of its tasks'
+    /// schedule ticks (as in rounds), the tick [`CellPlanner::continuous_plan`] counts the
+    /// hand-overs at.
+    pub fn continuous_tick_s(&self) -> f64 {
+        self.tasks
+            .iter()
+            .map(|t| t.planner.schedule().tick_s)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The run-time coordinator of the continuous `plan` of this cell
+    /// ([`CellPlanner::continuous_plan`], made on the tasks' current problems): robot `i` on
+    /// its own task's fastest warp and holds, `r_i` tasks per pass of the plan's operator
+    /// order (`MixedCyclicPlan::coordinator`), at [`CellPlanner::continuous_tick_s`], with the
+    /// operator's switch time of the planner's parameters (the token passes to another
+    /// robot no sooner than that after a stretch ended). Sound for any operator (the token
+    /// rule, per robot's own timeline).
+    ///
+    /// # Errors
+    /// The scheduler's error for a plan made on other problems (plan the cell again), the
+    /// realtime crate's for a bad switch time.
+    pub fn continuous_coordinator(
+        &self,
+        plan: &tandem_schedule::cyclic::MixedCyclicPlan,
+    ) -> Result<tandem_realtime::ContinuousCoordinator> {
+        let problems: Vec<&Problem> = self.tasks.iter().map(|t| t.planner.problem()).collect();
+        let switch_s = self.tasks[0].planner.params().sampler.switch_s;
+        Ok(plan
+            .coordinator(&problems, &self.robot_task, self.continuous_tick_s())?
+            .with_switch_s(switch_s)?)
+    }
+
     /// Whether the cell has two or more tasks (scheduled by [`CellSchedule`], saved as
     /// format 12).
     pub fn is_mixed(&self) -> bool {

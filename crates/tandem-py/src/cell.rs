@@ -193,12 +193,17 @@ impl PyCellPlanner {
     /// Loads a cell from a state file written by :meth:`save` or by the command line (a
     /// state file of one task loads as a cell of that task, named ``"task"``).
     ///
+    /// A task's stored schedule that fails this build's check is never run: it is replaced
+    /// by a fresh schedule, with the ``DataWarning`` :meth:`Planner.load` raises (for a cell
+    /// of two or more tasks it names the task).
+    ///
     /// Raises:
     ///     StateFileError: the file is missing, not a state file, of another format version,
     ///         truncated or corrupt (``path`` names it).
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyCellPlanner> {
         let inner = py.detach(|| guard(|| Ok(CellPlanner::load(&path)?)))?;
+        warn_load_notices(py, &path, &inner)?;
         Ok(PyCellPlanner { inner })
     }
 
@@ -395,4 +400,22 @@ impl PyCellPlanner {
             self.inner.t_total_s()
         )
     }
+}
+
+/// Warns (``DataWarning``) for each task whose stored schedule loading replaced because it
+/// failed this build's check (`Planner::load_notice`): for a one-task cell the very warning
+/// of `Planner.load`, for two or more tasks with the task's name.
+fn warn_load_notices(py: Python<'_>, path: &std::path::Path, cell: &CellPlanner) -> PyResult<()> {
+    let one = cell.tasks().len() == 1;
+    for task in cell.tasks() {
+        if let Some(notice) = task.planner().load_notice() {
+            let text = if one {
+                format!("{}: {notice}", path.display())
+            } else {
+                format!("{}: task `{}`: {notice}", path.display(), task.name())
+            };
+            crate::errors::warn(py, &text)?;
+        }
+    }
+    Ok(())
 }

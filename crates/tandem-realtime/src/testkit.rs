@@ -844,6 +844,44 @@ pub fn random_order(
     out
 }
 
+/// A random runnable order of a continuous cell of different tasks
+/// ([`crate::cell::ContinuousCoordinator::mixed`]): robot `k` has the groups `groups[k]` of
+/// its own task and `ratios[k]` tasks per pass; each robot's `r_k·G_k` groups in task order
+/// from a random first one, interleaved at random as whole groups, flattened to
+/// `(robot, lc)` entries with `lc` counting over the robot's `r_k` tasks. Robots without
+/// groups have no entries.
+#[must_use]
+pub fn random_mixed_order(
+    groups: &[&[crate::cell::Group]],
+    ratios: &[usize],
+    rng: &mut ChaCha8Rng,
+) -> Vec<(usize, usize)> {
+    let n = groups.len();
+    // Per robot its blocks (copy, group) in task order, from a random first one.
+    let blocks: Vec<usize> = (0..n).map(|k| groups[k].len() * ratios[k]).collect();
+    let first: Vec<usize> = blocks
+        .iter()
+        .map(|&b| if b == 0 { 0 } else { rng.random_range(0..b) })
+        .collect();
+    let mut taken = vec![0; n];
+    let mut out = Vec::new();
+    while (0..n).any(|k| taken[k] < blocks[k]) {
+        let r = loop {
+            let r = rng.random_range(0..n);
+            if taken[r] < blocks[r] {
+                break r;
+            }
+        };
+        let b = (first[r] + taken[r]) % blocks[r];
+        let (copy, g) = (b / groups[r].len(), b % groups[r].len());
+        let m = groups[r].last().map_or(0, |g| g.end_lc);
+        let gr = groups[r][g];
+        out.extend((gr.first_lc..gr.end_lc).map(|lc| (r, copy * m + lc)));
+        taken[r] += 1;
+    }
+    out
+}
+
 /// How [`random_cell_task`] draws its hold points.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CellHolds {

@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use rand::Rng;
 
-use super::groups::{Group, Token, groups, token_sequence};
+use super::groups::{Group, Token, groups, mixed_token_sequence, token_sequence};
 use super::pace::Pace;
 use crate::adversary::{Adversary, AdversaryRun};
 use crate::contract::{Controller, Operator, Tick, check_tick};
@@ -63,17 +63,11 @@ pub type CellTick = Tick;
 /// allocates.
 #[derive(Clone, Debug)]
 pub struct ContinuousCoordinator {
-    task: Arc<Timeline>,
-    groups: Arc<[Group]>,
-    /// Schedule clock (s) of each group's gate.
-    gate_s: Arc<[f64]>,
-    /// Schedule clock (s) at which each group is left (start of its `ref_end` sample).
-    leave_s: Arc<[f64]>,
-    /// Per reference sample `k`, the schedule clock (s) of the start of the first
-    /// low-confidence sample after `k` (the task's end if none): a robot on high-confidence
-    /// ground stops there at the end of its tick, so that no low-confidence sample is crossed
-    /// without a tick that starts on it (the operator supervises every one).
-    next_lc_s: Arc<[f64]>,
+    /// The task plans (one per task of the cell; a one-task cell has one), each with its
+    /// groups and tables ([`Plan`]).
+    plans: Arc<[Plan]>,
+    /// Per robot, the index of its task's plan in `plans`.
+    plan_of: [u8; MAX_ROBOTS],
     tokens: Arc<[Token]>,
     skip_first: Arc<[bool]>,
     n: usize,
@@ -108,35 +102,35 @@ pub struct ContinuousCoordinator {
     /// The operator's load cap at run time, the token's pace (`None`: no cap;
     /// [`ContinuousCoordinator::with_max_busy_share`]; carried over by a hand-over).
     pace: Option<Pace>,
-    /// The pre-alert's tables of the task ([`crate::prealert`]).
-    reach: Arc<Reach>,
-    /// Per reference sample, the group its low-confidence sample belongs to (unused on
-    /// high-confidence samples).
-    group_of: Arc<[usize]>,
 }
 
-impl ContinuousCoordinator {
-    /// A continuous cell of `n_robots` robots repeating `task` (its plan; re-based to start at
-    /// schedule clock 0), waiting at the usable holds `holds` ([`groups`]), the operator taking
-    /// the stretches `(robot, lc)` in the cyclic `order` ([`token_sequence`]), at a control
-    /// tick of `tick_s` real seconds. Every robot starts at sample 0 of its first task.
-    ///
-    /// # Errors
-    /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] for a `tick_s`
-    /// not finite and > 0; [`Error::BadGate`] for a bad hold; [`Error::BadOrder`] for an
-    /// order that is malformed or not runnable.
-    pub fn new(
-        task: Timeline,
-        holds: &[usize],
-        order: &[(usize, usize)],
-        n_robots: usize,
-        tick_s: f64,
-    ) -> Result<ContinuousCoordinator> {
-        check_count(n_robots)?;
-        check_tick(tick_s)?;
-        let task = task.sub(0, task.n_ref(), 0.0)?;
-        let groups = groups(task.conf(), holds)?;
-        let (tokens, skip_first) = token_sequence(order, &groups, n_robots)?;
+/// One task's plan in a continuous cell and what the token rule reads of it: its timeline
+/// (schedule clock from 0), groups, the schedule clock of each group's gate and leave point,
+/// the next low-confidence sample's clock per sample, the pre-alert's tables.
+#[derive(Debug)]
+struct Plan {
+    task: Timeline,
+    groups: Vec<Group>,
+    /// Schedule clock (s) of each group's gate.
+    gate_s: Vec<f64>,
+    /// Schedule clock (s) at which each group is left (start of its `ref_end` sample).
+    leave_s: Vec<f64>,
+    /// Per reference sample `k`, the schedule clock (s) of the start of the first
+    /// low-confidence sample after `k` (the task's end if none): a robot on high-confidence
+    /// ground stops there at the end of its tick, so that no low-confidence sample is crossed
+    /// without a tick that starts on it (the operator supervises every one).
+    next_lc_s: Vec<f64>,
+    /// The pre-alert's tables of the task ([`crate::prealert`]).
+    reach: Reach,
+    /// Per reference sample, the group its low-confidence sample belongs to (unused on
+    /// high-confidence samples).
+    group_of: Vec<usize>,
+}
+
+impl Plan {
+    /// The plan of `task` (re-based to clock 0 by the caller) with its `groups`, at a tick of
+    /// `tick_s` and the cell's clock tolerance `tol_s`.
+    fn new(task: Timeline, groups: Vec<Group>, tick_s: f64, tol_s: f64) -> Plan {
         let c = task.sample_clock_s();
         let gate_s: Vec<f64> = groups.iter().map(|g| c[g.gate]).collect();
         let leave_s: Vec<f64> = groups.iter().map(|g| c[g.ref_end]).collect();
@@ -149,7 +143,6 @@ impl ContinuousCoordinator {
                 c[k + 1]
             };
         }
-        let tol_s = clock_tolerance_s(std::slice::from_ref(&task), tick_s);
         // A tick moves a robot by `tick_s` of clock on high confidence (capped) and between
         // `S·h` and `F·h` on low confidence: at most `M = h·max(1, max F)`.
         let reach = Reach::new(
@@ -177,12 +170,130 @@ impl ContinuousCoordinator {
                 *x = k;
             }
         }
+        Plan {
+            task,
+            groups,
+            gate_s,
+            leave_s,
+            next_lc_s,
+            reach,
+            group_of,
+        }
+    }
+}
+
+impl ContinuousCoordinator {
+    /// A continuous cell of `n_robots` robots repeating `task` (its plan; re-based to start at
+    /// schedule clock 0), waiting at the usable holds `holds` ([`groups`]), the operator taking
+    /// the stretches `(robot, lc)` in the cyclic `order` ([`token_sequence`]), at a control
+    /// tick of `tick_s` real seconds. Every robot starts at sample 0 of its first task.
+    ///
+    /// # Errors
+    /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] for a `tick_s`
+    /// not finite and > 0; [`Error::BadGate`] for a bad hold; [`Error::BadOrder`] for an
+    /// order that is malformed or not runnable.
+    pub fn new(
+        task: Timeline,
+        holds: &[usize],
+        order: &[(usize, usize)],
+        n_robots: usize,
+        tick_s: f64,
+    ) -> Result<ContinuousCoordinator> {
+        check_count(n_robots)?;
+        check_tick(tick_s)?;
+        let task = task.sub(0, task.n_ref(), 0.0)?;
+        let groups = groups(task.conf(), holds)?;
+        let (tokens, skip_first) = token_sequence(order, &groups, n_robots)?;
+        let tol_s = clock_tolerance_s(std::slice::from_ref(&task), tick_s);
+        let plan = Plan::new(task, groups, tick_s, tol_s);
+        Ok(Self::assemble(
+            vec![plan],
+            [0; MAX_ROBOTS],
+            tokens,
+            skip_first,
+            n_robots,
+            tick_s,
+            tol_s,
+        ))
+    }
+
+    /// A continuous cell of different tasks (issue 45): robot `i` repeats its own task
+    /// `tasks[robot_task[i]]` (a plan, re-based to schedule clock 0, with its usable holds),
+    /// `ratios[i]` times per pass of the operator's cyclic `order` of stretches `(robot, lc)`,
+    /// `lc` counting robot `i`'s stretches over its `r_i` tasks
+    /// (`tandem_schedule::cyclic::MixedCyclicPlan`'s order; the token sequence is
+    /// [`mixed_token_sequence`](crate::cell::mixed_token_sequence)'s), at a control tick of
+    /// `tick_s` real seconds. Every robot starts at sample 0 of its first task.
+    ///
+    /// Everything the token rule reads of a task (its groups, gates, leave points, the next
+    /// low-confidence sample, the pre-alert's tables) is robot `i`'s own; the clock tolerance
+    /// is the cell's, over every task. The rule's argument ([module docs](crate::cell)) reads
+    /// each robot's own timeline only, so it holds as for one task: at most one robot (with
+    /// `M` operators, `M`) inside a group in any tick, the switch time from the entered
+    /// robot's gate. A cell of one task with ratios 1 is [`new`](Self::new)'s, tick for tick.
+    ///
+    /// # Errors
+    /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS` (`N = robot_task.len()`);
+    /// [`Error::BadParam`] for a `tick_s` not finite and > 0, `ratios` not one per robot
+    /// (each ≥ 1), a `robot_task` entry naming no task, or a task no robot does;
+    /// [`Error::BadGate`] for a bad hold; [`Error::BadOrder`] for an order that is malformed
+    /// or not runnable.
+    pub fn mixed(
+        tasks: &[(Timeline, Vec<usize>)],
+        robot_task: &[usize],
+        ratios: &[usize],
+        order: &[(usize, usize)],
+        tick_s: f64,
+    ) -> Result<ContinuousCoordinator> {
+        let n_robots = robot_task.len();
+        check_count(n_robots)?;
+        check_tick(tick_s)?;
+        if robot_task.iter().any(|&t| t >= tasks.len())
+            || (0..tasks.len()).any(|t| !robot_task.contains(&t))
+        {
+            return Err(Error::BadParam {
+                name: "robot_task",
+                why: "must name one of the tasks for each robot, and every task must have a robot",
+            });
+        }
+        let mut timelines = Vec::with_capacity(tasks.len());
+        let mut task_groups = Vec::with_capacity(tasks.len());
+        for (task, holds) in tasks {
+            let task = task.sub(0, task.n_ref(), 0.0)?;
+            task_groups.push(groups(task.conf(), holds)?);
+            timelines.push(task);
+        }
+        let per_robot: Vec<&[Group]> = robot_task.iter().map(|&t| &task_groups[t][..]).collect();
+        let (tokens, skip_first) = mixed_token_sequence(order, &per_robot, ratios)?;
+        let tol_s = clock_tolerance_s(&timelines, tick_s);
+        let plans: Vec<Plan> = timelines
+            .into_iter()
+            .zip(task_groups)
+            .map(|(task, groups)| Plan::new(task, groups, tick_s, tol_s))
+            .collect();
+        let mut plan_of = [0u8; MAX_ROBOTS];
+        for (p, &t) in plan_of.iter_mut().zip(robot_task) {
+            *p = t as u8;
+        }
+        Ok(Self::assemble(
+            plans, plan_of, tokens, skip_first, n_robots, tick_s, tol_s,
+        ))
+    }
+
+    /// The coordinator of `plans` (robot `i` runs `plans[plan_of[i]]`) with the token
+    /// sequence `tokens` (`skip_first` its first pass's skipped entries), reset to the start.
+    fn assemble(
+        plans: Vec<Plan>,
+        plan_of: [u8; MAX_ROBOTS],
+        tokens: Vec<Token>,
+        skip_first: Vec<bool>,
+        n_robots: usize,
+        tick_s: f64,
+        tol_s: f64,
+    ) -> ContinuousCoordinator {
         let mut out = ContinuousCoordinator {
-            task: Arc::new(task),
-            groups: groups.into(),
-            gate_s: gate_s.into(),
-            leave_s: leave_s.into(),
-            next_lc_s: next_lc_s.into(),
+            plans: plans.into(),
+            plan_of,
             tokens: tokens.into(),
             skip_first: skip_first.into(),
             n: n_robots,
@@ -201,11 +312,9 @@ impl ContinuousCoordinator {
             monitor: Monitor::new(n_robots),
             switch_ticks: 0,
             pace: None,
-            reach: Arc::new(reach),
-            group_of: group_of.into(),
         };
         out.reset();
-        Ok(out)
+        out
     }
 
     /// The same cell with the operator's switch time `switch_s` (real s, finite and ≥ 0),
@@ -258,6 +367,11 @@ impl ContinuousCoordinator {
     /// Whether robot `i` may pass its next group's gate: an operator is assigned to it.
     fn may_pass(&self, i: usize) -> bool {
         self.staff.assigned[i].is_some()
+    }
+
+    /// Robot `i`'s task plan.
+    fn plan(&self, i: usize) -> &Plan {
+        &self.plans[usize::from(self.plan_of[i])]
     }
 
     /// The same cell with the operator's load cap `max_busy_share` (`u_max` in `(0, 1]`,
@@ -347,8 +461,9 @@ impl ContinuousCoordinator {
         if self.switch_ticks == 0 {
             return 0;
         }
-        self.groups.get(self.next_group[i]).map_or(0, |g| {
-            let (fast_s, _) = self.reach.to_run_from_sample(g.gate, g.ref_start);
+        let plan = self.plan(i);
+        plan.groups.get(self.next_group[i]).map_or(0, |g| {
+            let (fast_s, _) = plan.reach.to_run_from_sample(g.gate, g.ref_start);
             prealert::ticks_before_at_least(fast_s, self.tick_s)
         })
     }
@@ -410,15 +525,15 @@ impl ContinuousCoordinator {
     /// up as their robots leave, and a switch wait lasts at most `k` ticks. O(N²) comparisons
     /// for `N ≤ MAX_ROBOTS`, O(len) to advance a granted robot's entry; no allocation.
     fn grant_waiting(&mut self, tick: u64) {
-        let n_groups = self.groups.len();
         let mut tried = [false; MAX_ROBOTS];
         loop {
             let waiting = (0..self.n).filter(|&i| {
                 let g = self.next_group[i];
+                let plan = self.plan(i);
                 !tried[i]
                     && self.staff.assigned[i].is_none()
-                    && g < n_groups
-                    && self.clock_s[i] >= self.gate_s[g]
+                    && g < plan.groups.len()
+                    && self.clock_s[i] >= plan.gate_s[g]
                     && self.staff.next_entry[i].is_some()
             });
             let Some(i) = waiting.min_by_key(|&i| {
@@ -506,14 +621,16 @@ impl ContinuousCoordinator {
         let next_tick = self.monitor.ticks();
         let tok = self.token();
         let held = self.monitor.held();
-        let c = self.task.sample_clock_s();
-        let reach = &*self.reach;
         // Ticks before the token can move on: its robot must first pass the end of its group
         // (less the clock tolerance, on the safe side) at its fastest.
         let token_moves = tok.map_or(0, |t| {
+            let p = self.plan(t.robot);
+            let c = p.task.sample_clock_s();
             let s = self.clock_s[t.robot];
-            let x = (self.leave_s[t.group].min(self.task.end_s()) - self.tol_s).max(0.0);
-            let lo = reach.fast_between(c, self.cursors[t.robot].at, s, self.task.sample_at(x), x);
+            let x = (p.leave_s[t.group].min(p.task.end_s()) - self.tol_s).max(0.0);
+            let lo = p
+                .reach
+                .fast_between(c, self.cursors[t.robot].at, s, p.task.sample_at(x), x);
             prealert::ticks_before_at_least(lo, h)
         });
         // Each robot's next turn after the current token's: token positions from the current
@@ -540,6 +657,8 @@ impl ContinuousCoordinator {
             }
         }
         let cands = (0..self.n).filter_map(|i| {
+            let plan = self.plan(i);
+            let (c, reach) = (plan.task.sample_clock_s(), &plan.reach);
             // A stretch in group `G` starts only after its robot passes `G`'s gate with the
             // token `(robot, G)`. Unless that is the current token and the robot's next group,
             // the token must move on first: the robot passes the gate no sooner than the tick
@@ -547,16 +666,16 @@ impl ContinuousCoordinator {
             // robot's next task, after this one's end).
             // The rank on a tie: 0 with the token, else the robot's next turn.
             let after_token = |e: u64, m: usize, next_task: bool| {
-                let g = self.group_of[m];
+                let g = plan.group_of[m];
                 let next_group = if next_task { 0 } else { self.next_group[i] };
-                let past_groups = !next_task || self.next_group[i] >= self.groups.len();
+                let past_groups = !next_task || self.next_group[i] >= plan.groups.len();
                 if tok.is_some_and(|t| t.robot == i && t.group == g)
                     && next_group == g
                     && past_groups
                 {
                     return (e, 0);
                 }
-                let (from_gate, _) = reach.to_run_from_sample(self.groups[g].gate, m);
+                let (from_gate, _) = reach.to_run_from_sample(plan.groups[g].gate, m);
                 let e = e.max(token_moves + 1 + prealert::ticks_before_at_least(from_gate, h));
                 (e, turn[i])
             };
@@ -578,12 +697,12 @@ impl ContinuousCoordinator {
                     // The robot may run up to its gate while it waits for the switch time, and
                     // passes it `wait` ticks from now at the soonest; the tick that stops it at
                     // the gate may be short (one tick more at the latest).
-                    let gate = self.groups[self.next_group[i]].gate;
+                    let gate = plan.groups[self.next_group[i]].gate;
                     let (lo_gate, _) = reach.to_run_from_sample(gate, m);
                     earliest = earliest.max(wait + prealert::ticks_before_at_least(lo_gate, h));
                     slack = wait + 1;
                 }
-                let latest = (holder && held != Some(i) && self.group_of[m] == self.next_group[i])
+                let latest = (holder && held != Some(i) && plan.group_of[m] == self.next_group[i])
                     .then(|| prealert::ticks_before_at_most(hi, h).map(|t| t + slack))
                     .flatten();
                 let (earliest, rank) = after_token(earliest, m, false);
@@ -677,14 +796,28 @@ impl ContinuousCoordinator {
         self.tick_s
     }
 
-    /// The task plan every robot repeats (schedule clock from 0).
+    /// The task plan every robot repeats (schedule clock from 0); in a cell of different
+    /// tasks ([`ContinuousCoordinator::mixed`]) robot 0's ([`task_of`](Self::task_of)).
     pub fn task(&self) -> &Timeline {
-        &self.task
+        &self.plan(0).task
     }
 
-    /// The task's groups ([`groups`]).
+    /// The task's groups ([`groups`]); in a cell of different tasks robot 0's
+    /// ([`groups_of`](Self::groups_of)).
     pub fn groups(&self) -> &[Group] {
-        &self.groups
+        &self.plan(0).groups
+    }
+
+    /// The task plan robot `robot` repeats (schedule clock from 0; robot 0's for a robot
+    /// index of `N` or more).
+    pub fn task_of(&self, robot: usize) -> &Timeline {
+        &self.plan(if robot < self.n { robot } else { 0 }).task
+    }
+
+    /// The groups of robot `robot`'s task ([`groups`]; robot 0's for a robot index of `N`
+    /// or more).
+    pub fn groups_of(&self, robot: usize) -> &[Group] {
+        &self.plan(if robot < self.n { robot } else { 0 }).groups
     }
 
     /// The cyclic token sequence ([`token_sequence`]).
@@ -760,7 +893,10 @@ impl ContinuousCoordinator {
     pub fn low_conf_now(&self) -> RobotFlags {
         let mut out = RobotFlags::new(self.n);
         for i in 0..self.n {
-            out.set(i, self.may_pass(i) && !self.task.conf()[self.cursors[i].at]);
+            out.set(
+                i,
+                self.may_pass(i) && !self.plan(i).task.conf()[self.cursors[i].at],
+            );
         }
         out
     }
@@ -782,8 +918,9 @@ impl ContinuousCoordinator {
         let mut out = RobotFlags::new(self.n);
         for i in 0..self.n {
             let g = self.next_group[i];
+            let plan = self.plan(i);
             let waits =
-                g < self.groups.len() && self.clock_s[i] >= self.gate_s[g] && !self.may_pass(i);
+                g < plan.groups.len() && self.clock_s[i] >= plan.gate_s[g] && !self.may_pass(i);
             out.set(i, waits);
         }
         out
@@ -835,9 +972,7 @@ impl ContinuousCoordinator {
         // completed, reference time) at the tick end is at least that at its start.
         #[cfg(debug_assertions)]
         let before = self.position_now();
-        let n_groups = self.groups.len();
-        let task = Arc::clone(&self.task);
-        let end_s = task.end_s();
+        let plans = Arc::clone(&self.plans);
         let held = self.monitor.held();
         let this_tick = self.monitor.ticks();
         let mut out = Tick {
@@ -854,15 +989,17 @@ impl ContinuousCoordinator {
             if held == Some(i) {
                 continue;
             }
+            let plan = &plans[usize::from(self.plan_of[i])];
+            let (task, end_s) = (&plan.task, plan.task.end_s());
             let s_old = self.clock_s[i];
             let g = self.next_group[i];
             let holder = self.may_pass(i);
-            let cap = if g >= n_groups {
+            let cap = if g >= plan.groups.len() {
                 end_s
             } else if holder {
-                self.gate_s.get(g + 1).copied().unwrap_or(end_s)
+                plan.gate_s.get(g + 1).copied().unwrap_or(end_s)
             } else {
-                self.gate_s[g]
+                plan.gate_s[g]
             };
             let cur = &mut self.cursors[i];
             let at = task.advance_cursor(&mut cur.at, s_old);
@@ -872,12 +1009,12 @@ impl ContinuousCoordinator {
                 // The robot's operator's input (a robot on low confidence without one — only
                 // in a state the rule excludes, `place_unchecked` — takes operator 0's).
                 let o = self.staff.assigned[i].map_or(0, usize::from);
-                operator_step(&task, at, ops[o], self.tick_s)
+                operator_step(task, at, ops[o], self.tick_s)
             };
             // On high-confidence ground the robot stops at the next low-confidence sample:
             // the tick after starts on it, at the operator's rate.
             let cap = if task.conf()[at] {
-                cap.min(self.next_lc_s[at])
+                cap.min(plan.next_lc_s[at])
             } else {
                 cap
             };
@@ -913,7 +1050,9 @@ impl ContinuousCoordinator {
             };
             let (r, g) = (t.robot, t.group);
             let s = self.clock_s[r];
-            if self.next_group[r] == g && (s >= end_s || s - self.tol_s >= self.leave_s[g]) {
+            let plan = &plans[usize::from(self.plan_of[r])];
+            let end_s = plan.task.end_s();
+            if self.next_group[r] == g && (s >= end_s || s - self.tol_s >= plan.leave_s[g]) {
                 // The episode's gate waited the switch time iff its robot is not the one
                 // the operator released before (`op_wait`).
                 let switched = self.staff.last_left[o].is_some_and(|(q, _)| q != r);
@@ -932,7 +1071,8 @@ impl ContinuousCoordinator {
             }
         }
         for i in 0..n {
-            if self.clock_s[i] >= end_s && self.next_group[i] >= n_groups {
+            let plan = &plans[usize::from(self.plan_of[i])];
+            if self.clock_s[i] >= plan.task.end_s() && self.next_group[i] >= plan.groups.len() {
                 self.tasks[i] += 1;
                 self.clock_s[i] = 0.0;
                 self.cursors[i] = Cursors::default();
@@ -942,12 +1082,14 @@ impl ContinuousCoordinator {
         // The freed operators take the next entries, for the next tick.
         self.grant(this_tick + 1);
         for i in 0..n {
+            let plan = &plans[usize::from(self.plan_of[i])];
+            let task = &plan.task;
             let s = self.clock_s[i];
             let at = task.advance_cursor(&mut self.cursors[i].at, s);
             out.ref_time.as_mut_slice()[i] = task.ref_time_in(at, s);
             out.tasks.as_mut_slice()[i] = self.tasks[i];
             let g = self.next_group[i];
-            let waits = g < n_groups && s >= self.gate_s[g] && !self.may_pass(i);
+            let waits = g < plan.groups.len() && s >= plan.gate_s[g] && !self.may_pass(i);
             out.waiting.set(i, waits);
         }
         #[cfg(debug_assertions)]
@@ -972,7 +1114,10 @@ impl ContinuousCoordinator {
     pub fn position_now(&self) -> PerRobot<(u64, f64)> {
         let mut out = PerRobot::new(self.n);
         for (i, p) in out.as_mut_slice().iter_mut().enumerate() {
-            *p = (self.tasks[i], self.task.ref_time_at(self.clock_s[i]));
+            *p = (
+                self.tasks[i],
+                self.plan(i).task.ref_time_at(self.clock_s[i]),
+            );
         }
         out
     }
@@ -1018,9 +1163,11 @@ impl ContinuousCoordinator {
         if old.n != self.n {
             return bad(0, "the new plan has another number of robots");
         }
-        if old.task.n_ref() != self.task.n_ref() {
+        if let Some(i) =
+            (0..self.n).find(|&i| old.plan(i).task.n_ref() != self.plan(i).task.n_ref())
+        {
             return bad(
-                0,
+                i,
                 "the new plan's task has another number of reference samples",
             );
         }
@@ -1033,37 +1180,37 @@ impl ContinuousCoordinator {
         if old.m != self.m {
             return bad(0, "the new plan has another number of operators");
         }
-        let n_groups = self.groups.len();
-        let c = self.task.sample_clock_s();
         let mut clock = [0.0; MAX_ROBOTS];
         let mut next = [0usize; MAX_ROBOTS];
         for i in 0..self.n {
+            let (plan, old_task) = (self.plan(i), &old.plan(i).task);
+            let (c, n_groups) = (plan.task.sample_clock_s(), plan.groups.len());
             // The robot's reference position in `old`, and the same position's clock here.
             let s_old = old.clock_s[i];
             // `old`'s cursor is at or before the sample of its clock (it only advances to
             // the clock, and both reset together), so this is O(1) amortized, not O(position).
             let mut at = old.cursors[i].at;
-            let n = old.task.advance_cursor(&mut at, s_old);
-            let p = old.task.ref_time_in(n, s_old);
+            let n = old_task.advance_cursor(&mut at, s_old);
+            let p = old_task.ref_time_in(n, s_old);
             let mut s = if p <= 0.0 {
                 0.0
-            } else if p >= self.task.n_ref() as f64 {
-                self.task.end_s()
+            } else if p >= plan.task.n_ref() as f64 {
+                plan.task.end_s()
             } else {
                 let k = p.floor() as usize;
                 c[k] + (p - k as f64) * (c[k + 1] - c[k])
             };
             // The interpolation rounds: never place the robot behind where it is (a robot
             // never moves backwards, not even by a rounding error at a hand-over).
-            while self.task.ref_time_at(s) < p && s < self.task.end_s() {
+            while plan.task.ref_time_at(s) < p && s < plan.task.end_s() {
                 // The next float up (`s ≥ 0`; `f64::next_up` is newer than the MSRV).
                 s = f64::from_bits(s.to_bits() + 1);
             }
             // Its next group here: the first it has not left.
             let g = (0..n_groups)
-                .find(|&g| s - self.tol_s < self.leave_s[g])
+                .find(|&g| s - self.tol_s < plan.leave_s[g])
                 .unwrap_or(n_groups);
-            if g < n_groups && s > self.gate_s[g] {
+            if g < n_groups && s > plan.gate_s[g] {
                 return bad(
                     i,
                     "is inside or past the gate of a low-confidence group of the new plan",
@@ -1074,7 +1221,7 @@ impl ContinuousCoordinator {
         }
         let len = self.tokens.len();
         // The robot's first token: its next group, or group 0 of its next task.
-        let wants = |t: &Token| t.group == next[t.robot] % n_groups.max(1);
+        let wants = |t: &Token| t.group == next[t.robot] % self.plan(t.robot).groups.len().max(1);
         // The token goes to the robot whose turn it was in the old plan (the plan's flow
         // goes on), unless some robot has seen a whole pass's worth of others' services,
         // `(N − 1)·G`, since its own last one: then to the least recently served robot
@@ -1084,8 +1231,10 @@ impl ContinuousCoordinator {
             .min_by_key(|&r| old.served[r])
             .expect("N ≥ 1 robots");
         let waited = old.stamp - 1 - old.served[lru];
+        // The others' services in one pass of the new sequence: `(N − 1)·G` for one task.
+        let others = len - self.tokens.iter().filter(|t| t.robot == lru).count();
         let lru = match old.token() {
-            Some(t) if waited < ((self.n - 1) * n_groups) as u64 => t.robot,
+            Some(t) if waited < others as u64 => t.robot,
             _ => lru,
         };
         let start = (0..len)
@@ -1108,14 +1257,16 @@ impl ContinuousCoordinator {
         self.tasks = old.tasks;
         // Cursors at or before each robot's sample (the tolerance below it), so the next
         // tick advances them by a few samples instead of from the task start.
-        let last = self.task.n_ref() - 1;
         self.cursors = [Cursors::default(); MAX_ROBOTS];
-        for (cur, &s) in self.cursors.iter_mut().zip(&clock).take(self.n) {
+        let plans = Arc::clone(&self.plans);
+        for i in 0..self.n {
+            let task = &plans[usize::from(self.plan_of[i])].task;
+            let (c, s, last) = (task.sample_clock_s(), clock[i], task.n_ref() - 1);
             let k = c
                 .partition_point(|&x| x <= s - self.tol_s)
                 .saturating_sub(1)
                 .min(last);
-            *cur = Cursors::at(k);
+            self.cursors[i] = Cursors::at(k);
         }
         self.pos = 0;
         self.passes = 0;
@@ -1226,7 +1377,7 @@ impl Controller for ContinuousCoordinator {
     fn ref_time_now(&self) -> PerRobot<f64> {
         let mut out = PerRobot::new(self.n);
         for (i, t) in out.as_mut_slice().iter_mut().enumerate() {
-            *t = self.task.ref_time_at(self.clock_s[i]);
+            *t = self.plan(i).task.ref_time_at(self.clock_s[i]);
         }
         out
     }

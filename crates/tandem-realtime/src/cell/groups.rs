@@ -208,6 +208,103 @@ pub fn token_sequence(
     Ok((tokens, skip))
 }
 
+/// The token sequence of a cell of different tasks (issue 45): robot `k` runs its own task,
+/// whose groups are `groups[k]` ([`groups`] of its confidence and holds, `m_k` stretches per
+/// task), `ratios[k]` (`r_k ≥ 1`) times per pass, and the operator's cyclic `order` lists
+/// every `(robot, lc)` with `lc` counting the robot's stretches over its `r_k` tasks
+/// (`lc = copy·m_k + j`, as `tandem_schedule::cyclic::MixedCyclicPlan::order`). Each robot's
+/// stretches must come in task order around the cycle and each group (of each copy) be
+/// contiguous ([`token_sequence`]'s rules per robot). The tokens are `(robot, group)` with
+/// `group` the index in `groups[robot]`, so robot `k`'s tokens are its groups `r_k` times per
+/// pass, each time in task order. In the first pass a robot's entries before its first
+/// group 0 are skipped. With one task for every robot and `r_k = 1` it is
+/// [`token_sequence`]'s sequence.
+///
+/// # Errors
+/// [`Error::BadParam`] when `groups` and `ratios` do not have one entry per robot or a ratio
+/// is 0; [`Error::BadOrder`] as [`token_sequence`].
+pub fn mixed_token_sequence(
+    order: &[(usize, usize)],
+    groups: &[&[Group]],
+    ratios: &[usize],
+) -> Result<(Vec<Token>, Vec<bool>)> {
+    let n = groups.len();
+    if ratios.len() != n || ratios.contains(&0) {
+        return Err(Error::BadParam {
+            name: "ratios",
+            why: "must give each robot its tasks per pass (r_k ≥ 1), one per robot",
+        });
+    }
+    let m: Vec<usize> = groups
+        .iter()
+        .map(|g| g.last().map_or(0, |g| g.end_lc))
+        .collect();
+    let total: Vec<usize> = m.iter().zip(ratios).map(|(&m, &r)| m * r).collect();
+    let len = order.len();
+    let want: usize = total.iter().sum();
+    if len != want {
+        return Err(Error::BadOrder {
+            position: len.min(want),
+            why: "does not list each robot's each stretch of its r_k tasks exactly once",
+        });
+    }
+    let gof: Vec<Vec<usize>> = groups.iter().map(|g| group_of(g)).collect();
+    // Whether robot `r`'s stretch `lc` (over its `r_k` tasks) opens a group of its copy.
+    let opens = |r: usize, lc: usize| {
+        let j = lc % m[r];
+        groups[r][gof[r][j]].first_lc == j
+    };
+    let mut seen: Vec<Vec<bool>> = total.iter().map(|&t| vec![false; t]).collect();
+    let mut last: Vec<Option<usize>> = vec![None; n];
+    for (q, &(r, lc)) in order.iter().enumerate() {
+        let bad = |why| Err(Error::BadOrder { position: q, why });
+        if r >= n || lc >= total[r] {
+            return bad("names a robot or a stretch that does not exist");
+        }
+        if std::mem::replace(&mut seen[r][lc], true) {
+            return bad("repeats a stretch");
+        }
+        if last[r].is_some_and(|l| (l + 1) % total[r] != lc) {
+            return bad("breaks its robot's task order around the cycle");
+        }
+        last[r] = Some(lc);
+        if !opens(r, lc) && order[(q + len - 1) % len] != (r, lc - 1) {
+            return bad(
+                "is not runnable: another robot's stretch comes between it and the stretch \
+                 before it, with no usable hold between them",
+            );
+        }
+    }
+    if len == 0 {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let start = (0..len)
+        .find(|&q| opens(order[q].0, order[q].1))
+        .expect("a robot's stretch 0 opens a group");
+    let tokens: Vec<Token> = (0..len)
+        .map(|k| (start + k) % len)
+        .filter(|&q| opens(order[q].0, order[q].1))
+        .map(|q| Token {
+            robot: order[q].0,
+            group: gof[order[q].0][order[q].1 % m[order[q].0]],
+        })
+        .collect();
+    let first_zero: Vec<usize> = (0..n)
+        .map(|r| {
+            tokens
+                .iter()
+                .position(|t| t.robot == r && t.group == 0)
+                .unwrap_or(usize::MAX)
+        })
+        .collect();
+    let skip = tokens
+        .iter()
+        .enumerate()
+        .map(|(k, t)| k < first_zero[t.robot])
+        .collect();
+    Ok((tokens, skip))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -287,5 +384,67 @@ mod tests {
         for c in cases {
             assert!(!is_runnable(c, &g, 2), "{c:?}");
         }
+    }
+
+    #[test]
+    fn mixed_token_sequences_by_hand() {
+        // Robot 0: groups {0}, {1, 2} (as above); robot 1: one group {0}, twice per pass.
+        let a = [
+            Group {
+                gate: 0,
+                first_lc: 0,
+                end_lc: 1,
+                ref_start: 2,
+                ref_end: 3,
+            },
+            Group {
+                gate: 5,
+                first_lc: 1,
+                end_lc: 3,
+                ref_start: 6,
+                ref_end: 10,
+            },
+        ];
+        let b = [Group {
+            gate: 0,
+            first_lc: 0,
+            end_lc: 1,
+            ref_start: 1,
+            ref_end: 2,
+        }];
+        let t = |robot, group| Token { robot, group };
+        let order = [(0, 0), (1, 0), (0, 1), (0, 2), (1, 1)];
+        let (tokens, skip) = mixed_token_sequence(&order, &[&a, &b], &[1, 2]).unwrap();
+        assert_eq!(tokens, [t(0, 0), t(1, 0), t(0, 1), t(1, 0)]);
+        assert_eq!(skip, [false; 4]);
+        // Robot 1's second task first: its tokens are both group 0, none skipped.
+        let order = [(1, 1), (0, 0), (1, 0), (0, 1), (0, 2)];
+        let (tokens, skip) = mixed_token_sequence(&order, &[&a, &b], &[1, 2]).unwrap();
+        assert_eq!(tokens, [t(1, 0), t(0, 0), t(1, 0), t(0, 1)]);
+        assert_eq!(skip, [false; 4]);
+        // Robot 0 first in its group 1: skipped in the first pass.
+        let order = [(0, 1), (0, 2), (1, 0), (0, 0), (1, 1)];
+        let (_, skip) = mixed_token_sequence(&order, &[&a, &b], &[1, 2]).unwrap();
+        assert_eq!(skip, [true, false, false, false]);
+        // Robot 1 between robot 0's stretches 1 and 2: not runnable, at position 3.
+        let bad = [(0, 0), (1, 0), (0, 1), (1, 1), (0, 2)];
+        assert!(matches!(
+            mixed_token_sequence(&bad, &[&a, &b], &[1, 2]),
+            Err(Error::BadOrder { position: 4, .. })
+        ));
+        // Robot 1's second task missing; out of order; a zero ratio.
+        let short = [(0, 0), (1, 0), (0, 1), (0, 2)];
+        assert!(mixed_token_sequence(&short, &[&a, &b], &[1, 2]).is_err());
+        let swapped = [(0, 0), (1, 1), (0, 1), (0, 2), (1, 0)];
+        assert!(mixed_token_sequence(&swapped, &[&a, &b], &[1, 2]).is_ok());
+        let out_of_order = [(0, 0), (0, 2), (0, 1), (1, 0), (1, 1)];
+        assert!(mixed_token_sequence(&out_of_order, &[&a, &b], &[1, 2]).is_err());
+        assert!(mixed_token_sequence(&order, &[&a, &b], &[1, 0]).is_err());
+        // One task, ratios 1: token_sequence's sequence.
+        let order = [(1, 2), (0, 0), (1, 0), (0, 1), (0, 2), (1, 1)];
+        assert_eq!(
+            mixed_token_sequence(&order, &[&a, &a], &[1, 1]).unwrap(),
+            token_sequence(&order, &a, 2).unwrap()
+        );
     }
 }

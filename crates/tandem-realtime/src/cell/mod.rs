@@ -88,6 +88,16 @@
 //! (the robot cannot wait there for it). [`is_runnable`] checks it; [`token_sequence`] rejects
 //! other orders. Each robot's stretches must also come in task order around the cycle.
 //!
+//! **A cell of different tasks (issue 45).** [`ContinuousCoordinator::mixed`] gives robot `k`
+//! its own task plan (its timeline, holds and so its groups, gates, leave points and
+//! pre-alert tables) and `r_k` tasks per pass: the operator's order lists robot `k`'s
+//! stretches of its `r_k` tasks, and its tokens are its own groups, `r_k` times per pass
+//! ([`mixed_token_sequence`]). Every step of the rule and of its argument above reads one
+//! robot's own timeline only (where it waits, what it traverses, when it has left its
+//! group), so it holds unchanged: at most `M` robots inside, the rest on high-confidence
+//! samples of their own tasks. A one-task cell is [`ContinuousCoordinator::new`]'s, tick for
+//! tick.
+//!
 //! **Liveness.** Each robot's tokens come in its task order (group 0, 1, …, then group 0 of its
 //! next task), which is the order in which it reaches its gates; so the token's robot always
 //! reaches the token's gate (it runs on high-confidence samples at least at `S·tick_s > 0`
@@ -133,4 +143,6 @@ mod pace;
 #[allow(deprecated)]
 pub use coordinator::{CellRun, CellTick};
 pub use coordinator::{ContinuousCoordinator, run_cell};
-pub use groups::{Group, Token, first_split_group, groups, is_runnable, token_sequence};
+pub use groups::{
+    Group, Token, first_split_group, groups, is_runnable, mixed_token_sequence, token_sequence,
+};

@@ -812,6 +812,69 @@ pub fn mixed_plan_for_order(
     })
 }
 
+impl MixedCyclicPlan {
+    /// The continuous coordinator of this plan (issue 45,
+    /// `tandem_realtime::continuous::ContinuousCoordinator::mixed`): robot `k` runs the
+    /// fastest warp of its task `tasks[robot_task[k]]` (the problem the plan was made on:
+    /// `ψ̇min` on high-confidence samples, `ψ̇̄` on low-confidence ones), waits at that task's
+    /// usable holds, and does `ratios[k]` tasks per pass of the plan's operator `order`, at a
+    /// control tick of `tick_s` real seconds. The token rule makes it sound for any operator
+    /// and any number of tasks (the argument of `tandem_realtime::continuous` reads each
+    /// robot's own timeline); under the planned operator its steady period is the plan's
+    /// when the plan counted the hand-overs at this tick ([`MixedParams::handover_tick_s`]).
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] when `robot_task` has not one entry per robot of the plan or names
+    /// no task, or a robot's task has not the plan's number of stretches;
+    /// [`Error::Realtime`] for a bad `tick_s`, a malformed or not runnable order.
+    pub fn coordinator(
+        &self,
+        tasks: &[&Problem],
+        robot_task: &[usize],
+        tick_s: f64,
+    ) -> Result<tandem_realtime::continuous::ContinuousCoordinator> {
+        if robot_task.len() != self.robots.len() || robot_task.iter().any(|&t| t >= tasks.len()) {
+            return Err(Error::BadParam {
+                name: "robot_task",
+                why: "must name one of the tasks for each robot of the plan",
+            });
+        }
+        for (k, &t) in robot_task.iter().enumerate() {
+            if TaskShape::new(tasks[t]).n_lc() != self.robots[k].stretches_per_task {
+                return Err(Error::BadParam {
+                    name: "tasks",
+                    why: "a robot's task has not the plan's number of low-confidence stretches \
+                          (the plan was made on other problems: plan the cell again)",
+                });
+            }
+        }
+        let timelines = tasks
+            .iter()
+            .map(|p| {
+                Ok((
+                    tandem_realtime::Timeline::new(
+                        p.conf(),
+                        &p.fastest_warp(),
+                        p.grad_min(),
+                        p.grad_max(),
+                        0.0,
+                        p.dt_s(),
+                    )?,
+                    p.usable_holds(),
+                ))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let order: Vec<(usize, usize)> = self.order.iter().map(|s| (s.robot, s.lc)).collect();
+        Ok(tandem_realtime::continuous::ContinuousCoordinator::mixed(
+            &timelines,
+            robot_task,
+            &self.ratios,
+            &order,
+            tick_s,
+        )?)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1002,5 +1065,46 @@ mod tests {
             msg(mixed_plan_for_order(&s, &[1], &bad, &MixedParams::default()).unwrap_err())
                 .contains("order")
         );
+    }
+
+    #[test]
+    fn the_plan_runs_at_its_period_under_the_planned_operator() {
+        // A (D = 2 s, L = 1 s) beside B (D = 0.75 s, L = 0.25 s), the plan counting the
+        // token rule's hand-overs at a 10 ms tick: ratios (1, 4) (robot 1's four stretches,
+        // each entered 0.25 s after its gate, cost the hand-overs robot 0's one does not).
+        // Its coordinator at that tick under the planned operator: no overlap, robot 1
+        // completing 4 tasks per task of robot 0, and over tasks 10..40 of robot 0 the
+        // realized period within 1 % of the plan's.
+        let (a, b) = (task(100, 100), task(50, 25));
+        let params = MixedParams {
+            handover_tick_s: Some(0.01),
+            ..MixedParams::default()
+        };
+        let plan = mixed_cyclic_plan(&[&a, &b], &params).unwrap();
+        assert_eq!(plan.ratios, [1, 4]);
+        let mut c = plan.coordinator(&[&a, &b], &[0, 1], 0.01).unwrap();
+        assert!(plan.coordinator(&[&a], &[0, 1], 0.01).is_err());
+        assert!(plan.coordinator(&[&a, &a], &[0, 1], 0.01).is_ok());
+        let mut at_10 = None;
+        for tick in 1..=20_000u64 {
+            let t = c.tick(tandem_realtime::Operator::Scheduled).unwrap();
+            assert!(!t.overlap());
+            if at_10.is_none() && c.tasks_completed()[0] == 10 {
+                at_10 = Some((tick, c.tasks_completed()[1]));
+            }
+            if c.tasks_completed()[0] == 40 {
+                let (t10, b10) = at_10.unwrap();
+                let period = (tick - t10) as f64 * 0.01 / 30.0;
+                assert!(
+                    (period - plan.period_s).abs() <= 0.01 * plan.period_s,
+                    "{period} against {}",
+                    plan.period_s
+                );
+                let b = c.tasks_completed()[1] - b10;
+                assert!((119..=121).contains(&b), "{b}");
+                return;
+            }
+        }
+        panic!("robot 0 did not complete 40 tasks");
     }
 }
