@@ -533,6 +533,43 @@ fn markdown(file: &ZooFile) -> String {
             num(r.needed_unsupervised, 1),
         ));
     }
+    let fated = |r: &&FamilyRow| {
+        let f = r.by_fate;
+        f.valid.count + f.repaired.count + f.invalid.count > 0
+    };
+    if file.family_rows.iter().any(|r| fated(&r)) {
+        s.push_str(
+            "\nRound-to-round changes of `T_total` by what became of the previous schedule in the \
+             re-schedule that made the later plan (`Outcome::previous`; rounds; re-schedules \
+             counted over every seed, the largest increase of one, s, ≤ 0 when none \
+             increased). `valid`: the old schedule still passes every constraint on the updated \
+             model, so the re-schedule is never longer and an increase would be the \
+             scheduler's; `repaired`: the model update broke it (a low-confidence sample's mean \
+             gradient moved, Eq. 20 constraint 4) and its re-timing passes, so the re-schedule \
+             is never longer than the re-timing and an increase is what the update and the \
+             re-timing cost; `invalid`: neither passes, nothing bounds the re-schedule.\n\n\
+             | family | N | re-schedules: valid / repaired / invalid | max increase s: valid | \
+             repaired | invalid |\n|---|---|---|---|---|---|\n",
+        );
+        for r in file.family_rows.iter().filter(fated) {
+            let f = r.by_fate;
+            let inc = |c: tandem_zoo::eval::FateCount| {
+                c.max_increase_s
+                    .map_or_else(|| "—".to_string(), |x| num(x, 3))
+            };
+            s.push_str(&format!(
+                "| {} | {} | {} / {} / {} | {} | {} | {} |\n",
+                r.family,
+                r.robots,
+                f.valid.count,
+                f.repaired.count,
+                f.invalid.count,
+                inc(f.valid),
+                inc(f.repaired),
+                inc(f.invalid),
+            ));
+        }
+    }
     if file.family_rows.iter().any(|r| r.gap_split_pct.is_some()) {
         s.push_str(
             "\nWhere the gap goes (rounds; percent of the bound, mean over seeds; \

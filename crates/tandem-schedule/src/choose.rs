@@ -442,12 +442,41 @@ fn incumbent(
     ))
 }
 
+/// Halvings of the raise [`repaired`] bisects between the ladder's last refused clearance and
+/// its first passing one: at most one re-timing per halving (two with holds: with its release
+/// rules re-derived, and as it is) and so at most `2 · REPAIR_HALVINGS` margin checks. Five
+/// halvings leave the raise within `M/32` of the least passing one in the bracket `[0, M]`
+/// (`3M/32` in `[M, 4M]`; `M` of [`max_step_s`], the room one tick can take), below a tick
+/// of the check's fastest low-confidence step (docs/decisions.md, "A repaired schedule
+/// re-timed at the least raise the check accepts (issue 38)").
+pub(crate) const REPAIR_HALVINGS: usize = 5;
+
+/// The re-timings of `prev` for `problem` with every clearance raised by `extra_s` (s;
+/// [`retime`]): with holds, the one with its release rules re-derived from the re-timed order
+/// ([`Problem::with_release_rules`]; re-timed dwells can reorder the legs a rule relies on, and
+/// a rule that would wait for a leg starting no earlier is refused) after the one as it is;
+/// empty when the re-timing has no solution.
+fn retimings(problem: &Problem, prev: &Schedule, tick_s: f64, extra_s: f64) -> Vec<Schedule> {
+    let Some(re) = retime(problem, prev, tick_s, extra_s) else {
+        return Vec::new();
+    };
+    let rederived = re
+        .has_holds()
+        .then(|| problem.with_release_rules(&without_rules(&re)).ok())
+        .flatten();
+    std::iter::once(re).chain(rederived).collect()
+}
+
 /// The least-`T_total` valid schedule among the re-timings of the previous schedule `prev` for
-/// `problem` ([`retime`], with the old clearances and with them raised by one and by four
-/// maximal steps `M` of the margin check; with holds, each also with its release rules
-/// re-derived from its order, [`Problem::with_release_rules`]) and its plain [`repair`] (with
-/// its holds, and without); with the first violation of the plain re-timing when none
-/// passes.
+/// `problem` ([`retimings`]: with the old clearances and with them raised by one and by four
+/// maximal steps `M` of the margin check) and its plain [`repair`] (with its holds, and
+/// without); with the first violation of the plain re-timing when none passes. When the old
+/// clearances fail but a raised one passes, the raise is bisected between the last refused
+/// rung and the first passing one ([`REPAIR_HALVINGS`] halvings): the ladder alone raised every
+/// clearance by `M` or `4M` where the model update had moved a low-confidence gradient by
+/// 1e-4 relative, and the re-timed schedule cost more than the update
+/// (docs/decisions.md, "A repaired schedule re-timed at the least raise the check accepts
+/// (issue 38)"). Every schedule returned passed [`validate_with_switch`].
 fn repaired(
     problem: &Problem,
     prev: &Schedule,
@@ -456,37 +485,69 @@ fn repaired(
 ) -> (Option<(Schedule, f64)>, Option<Violation>) {
     let dt_s = problem.dt_s();
     let step_s = max_step_s(problem, tick_s);
-    let mut tries: Vec<Schedule> = Vec::new();
-    for extra in [0.0, step_s, 4.0 * step_s] {
-        let Some(re) = retime(problem, prev, tick_s, extra) else {
-            continue;
-        };
-        // Re-timed dwells can reorder the legs a release rule relies on (a rule that would
-        // wait for a leg starting no earlier is refused): the rules re-derived from the
-        // re-timed order are tried too.
-        let rederived = re.has_holds().then(|| {
-            let bare = Schedule {
-                holds: re
-                    .holds
-                    .iter()
-                    .map(|hs| {
-                        hs.iter()
-                            .map(|h| tandem_realtime::Hold {
-                                after: Vec::new(),
-                                ..h.clone()
-                            })
-                            .collect()
-                    })
-                    .collect(),
-                ..re.clone()
-            };
-            problem.with_release_rules(&bare).ok()
-        });
-        tries.push(re);
-        tries.extend(rederived.flatten());
+    let mut best: Option<(Schedule, f64)> = None;
+    let mut first_why = None;
+    // Whether one of `tries` passes (or none was shorter than the best, so none was checked:
+    // `None`), keeping the shortest that passes in `best`.
+    let try_all = |tries: Vec<Schedule>,
+                   best: &mut Option<(Schedule, f64)>,
+                   first_why: &mut Option<Violation>,
+                   plain: bool|
+     -> Option<bool> {
+        let mut verdict = None;
+        for (q, s) in tries.into_iter().enumerate() {
+            let t = s.t_total_s(dt_s);
+            if best.as_ref().is_some_and(|b| b.1 <= t) {
+                continue;
+            }
+            match validate_with_switch(problem, &s, switch_s) {
+                Ok(()) => {
+                    *best = Some((s, t));
+                    verdict = Some(true);
+                }
+                Err(v) => {
+                    if plain && q == 0 && first_why.is_none() {
+                        *first_why = Some(v);
+                    }
+                    verdict = verdict.or(Some(false));
+                }
+            }
+        }
+        verdict
+    };
+    // The ladder: the last raise refused below the first that passes, and that one.
+    let mut refused: Option<f64> = None;
+    let mut passed: Option<f64> = None;
+    let mut retimed = false;
+    for extra_s in [0.0, step_s, 4.0 * step_s] {
+        let tries = retimings(problem, prev, tick_s, extra_s);
+        let first = !retimed;
+        retimed |= !tries.is_empty();
+        let verdict = try_all(tries, &mut best, &mut first_why, first);
+        match verdict {
+            Some(true) if passed.is_none() => passed = Some(extra_s),
+            Some(false) if passed.is_none() => refused = Some(extra_s),
+            _ => {}
+        }
     }
-    let retimed = !tries.is_empty();
+    // The raise bisected between the two (a larger raise never re-times earlier, so one whose
+    // re-timing is no shorter than the best found is not checked and the search goes lower).
+    if let (Some(mut lo), Some(mut hi)) = (refused, passed) {
+        for _ in 0..REPAIR_HALVINGS {
+            let mid = 0.5 * (lo + hi);
+            let tries = retimings(problem, prev, tick_s, mid);
+            if tries.is_empty() {
+                lo = mid;
+                continue;
+            }
+            match try_all(tries, &mut best, &mut first_why, false) {
+                Some(false) => lo = mid,
+                Some(true) | None => hi = mid,
+            }
+        }
+    }
     if let Some(fixed) = repair(problem, prev, tick_s) {
+        let mut tries = Vec::new();
         if prev.has_holds() {
             tries.push(Schedule {
                 holds: prev.holds.clone(),
@@ -494,19 +555,7 @@ fn repaired(
             });
         }
         tries.push(fixed);
-    }
-    let mut best: Option<(Schedule, f64)> = None;
-    let mut first_why = None;
-    for (q, s) in tries.into_iter().enumerate() {
-        let t = s.t_total_s(dt_s);
-        if best.as_ref().is_some_and(|b| b.1 <= t) {
-            continue;
-        }
-        match validate_with_switch(problem, &s, switch_s) {
-            Ok(()) => best = Some((s, t)),
-            Err(v) if q == 0 && retimed => first_why = Some(v),
-            Err(_) => {}
-        }
+        try_all(tries, &mut best, &mut first_why, false);
     }
     (best, first_why)
 }
@@ -1172,6 +1221,88 @@ mod tests {
         }
         assert!(bound_above(1.0 + 3.0 * tol::BOUND_REL, 1.0));
         assert!(!bound_above(1.0 + 0.5 * tol::BOUND_REL, 1.0));
+    }
+
+    // `pegs`: the peg-in-hole problem the integration tests with hold points share.
+    include!("../tests/common/pegs.rs");
+
+    /// `p` after a model update that slowed its low-confidence samples by `factor`.
+    fn slowed(p: &Problem, factor: f64) -> Problem {
+        let mean: Vec<f64> = (0..p.n_ref())
+            .map(|n| p.grad_mean()[n] * if p.conf()[n] { 1.0 } else { factor })
+            .collect();
+        let lo = (0..p.n_ref())
+            .map(|n| p.grad_min()[n].min(mean[n]))
+            .collect();
+        let hi = (0..p.n_ref())
+            .map(|n| p.grad_max()[n].max(mean[n]))
+            .collect();
+        Problem::new(p.conf().to_vec(), mean, lo, hi, p.dt_s())
+            .unwrap()
+            .with_holds(p.holds().to_vec())
+            .unwrap()
+    }
+
+    /// Issue 38's "schedules get worse as the robots learn", by hand: two robots on the
+    /// peg-in-hole problem (20 s at 20 Hz, two low-confidence inserts of 2 s), the sampler's
+    /// schedule with robot 2's offset bisected down to the least the margin check accepts (a
+    /// schedule at its margins, as the completion and the staggered candidate leave them); the
+    /// model update then slows the inserts by 1e-4 relative (0.2 ms each). The old schedule
+    /// breaks Eq. 20 constraint 4, its re-timing with the old clearances the margin check; the
+    /// ladder's next rung (every clearance raised by `M` = 71 ms) passes 0.215 s (4 ticks)
+    /// above the old `T_total`, the bisected raise 7.5 ms above it (measured when the
+    /// bisection was added). The re-schedule must stay within a tick of the old schedule.
+    #[test]
+    fn a_tiny_model_update_costs_a_schedule_at_its_margins_less_than_a_tick() {
+        let p = pegs(false);
+        let tick_s = 0.05;
+        let params = SamplerParams {
+            samples: 400,
+            seed: 0,
+            tick_s: Some(tick_s),
+            ..SamplerParams::default()
+        };
+        let mut prev = sample_schedule_n(&p, 2, &params, None).unwrap().schedule;
+        let (mut lo, mut hi) = (0.0, prev.offsets_s[0]);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            prev.offsets_s = vec![mid];
+            if validate_with_switch(&p, &prev, 0.0).is_ok() {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        prev.offsets_s = vec![hi];
+        validate_with_switch(&p, &prev, 0.0).unwrap();
+        let t_prev = prev.t_total_s(p.dt_s());
+        let q = slowed(&p, 1.0001);
+        assert!(matches!(
+            validate_with_switch(&q, &prev, 0.0),
+            Err(Violation::NotMeanGradient { .. })
+        ));
+        let plain = retime(&q, &prev, tick_s, 0.0).unwrap();
+        assert!(matches!(
+            validate_with_switch(&q, &plain, 0.0),
+            Err(Violation::InsufficientMargins { .. })
+        ));
+        let m = max_step_s(&q, tick_s);
+        let rung = retime(&q, &prev, tick_s, m).unwrap();
+        validate_with_switch(&q, &rung, 0.0).unwrap();
+        assert!(rung.t_total_s(q.dt_s()) > t_prev + tick_s);
+        let out = sample_schedule_n(&q, 2, &params, Some(&prev)).unwrap();
+        let PreviousFate::Repaired { t_total_s, .. } = out.previous else {
+            panic!(
+                "expected a repaired previous schedule, got {:?}",
+                out.previous
+            );
+        };
+        assert!(
+            t_total_s <= t_prev + tick_s && out.t_total_s <= t_total_s,
+            "previous {t_prev}, re-timed {t_total_s}, re-scheduled {}",
+            out.t_total_s
+        );
+        validate_with_switch(&q, &out.schedule, 0.0).unwrap();
     }
 
     #[test]

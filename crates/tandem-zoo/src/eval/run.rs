@@ -6,6 +6,7 @@ use std::sync::{Mutex, PoisonError};
 
 use serde::{Deserialize, Serialize};
 use tandem_planner::{Planner, derive_seed};
+use tandem_schedule::PreviousFate;
 use tandem_sim::study::{Cell, RoundView, StudyConfig, run_cell_trial_on, run_trial_on};
 use tandem_sim::workcell::{FinishedTask, PlanGap};
 
@@ -69,6 +70,12 @@ pub struct RunReport {
     pub max_increase_s: f64,
     /// The plan after which that increase came (rounds recorded; `None` with a single plan).
     pub max_increase_at: Option<usize>,
+    /// The round-to-round changes of `T_total` split by what became of the previous schedule
+    /// in the re-schedule that made the later plan (`Outcome::previous`): still valid, re-timed
+    /// (repaired) or invalid on the updated model. Rounds only; all empty for a cell and in
+    /// reports saved before it.
+    #[serde(default)]
+    pub by_fate: FateIncreases,
     /// Mean over rounds of realized duration over planned `T_total` (continuous: the last
     /// plan's planned throughput over the steady realized one).
     pub realized_over_planned: f64,
@@ -203,10 +210,114 @@ fn config(prep: &Prepared, robots: usize, cell: Cell, rounds: usize) -> StudyCon
     }
 }
 
+/// What became of the previous schedule in one re-schedule ([`PreviousFate`] without its
+/// details), as [`FateIncreases`] counts it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fate {
+    /// Still valid on the updated model ([`PreviousFate::Valid`]): the re-schedule is never
+    /// longer, so an increase here is the scheduler's.
+    Valid,
+    /// Invalid as it was, valid re-timed ([`PreviousFate::Repaired`]): the re-schedule is never
+    /// longer than the re-timing, so an increase is what the model update and the re-timing
+    /// cost.
+    Repaired,
+    /// Invalid, re-timed too ([`PreviousFate::Invalid`]): nothing bounds the re-schedule.
+    Invalid,
+}
+
+impl Fate {
+    /// The fate of `previous`; `None` when no previous schedule was given.
+    #[must_use]
+    pub fn of(previous: &PreviousFate) -> Option<Fate> {
+        match previous {
+            PreviousFate::NotGiven => None,
+            PreviousFate::Valid { .. } => Some(Fate::Valid),
+            PreviousFate::Repaired { .. } => Some(Fate::Repaired),
+            PreviousFate::Invalid { .. } => Some(Fate::Invalid),
+        }
+    }
+}
+
+/// Re-schedules of one [`Fate`] and the largest change of `T_total` over one of them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FateCount {
+    /// Re-schedules with this fate.
+    pub count: usize,
+    /// The largest `T_total` after one minus `T_total` before it (s; ≤ 0 when none increased);
+    /// `None` when [`FateCount::count`] is 0.
+    pub max_increase_s: Option<f64>,
+}
+
+impl FateCount {
+    fn add(&mut self, increase_s: f64) {
+        self.count += 1;
+        self.max_increase_s = Some(
+            self.max_increase_s
+                .map_or(increase_s, |m| m.max(increase_s)),
+        );
+    }
+
+    /// The two counts as one (counts added, the larger increase).
+    #[must_use]
+    pub fn merged(self, other: FateCount) -> FateCount {
+        FateCount {
+            count: self.count + other.count,
+            max_increase_s: match (self.max_increase_s, other.max_increase_s) {
+                (Some(a), Some(b)) => Some(a.max(b)),
+                (a, b) => a.or(b),
+            },
+        }
+    }
+}
+
+/// The round-to-round changes of `T_total` by the previous schedule's [`Fate`] in the
+/// re-schedule that made the later plan, so a reader tells the increases that learning forced
+/// (the model changed where the old schedule relied on it) from the scheduler's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FateIncreases {
+    /// The previous schedule still valid.
+    pub valid: FateCount,
+    /// The previous schedule re-timed.
+    pub repaired: FateCount,
+    /// The previous schedule and its re-timing invalid.
+    pub invalid: FateCount,
+}
+
+impl FateIncreases {
+    /// Plan `k + 1`'s `T_total` minus plan `k`'s, filed by `fates[k + 1]` (the fate in the
+    /// re-schedule that made plan `k + 1`; plans without one are left out).
+    #[must_use]
+    pub fn of(t_total_s: &[f64], fates: &[Option<Fate>]) -> FateIncreases {
+        let mut out = FateIncreases::default();
+        for (k, w) in t_total_s.windows(2).enumerate() {
+            let slot = match fates.get(k + 1).copied().flatten() {
+                Some(Fate::Valid) => &mut out.valid,
+                Some(Fate::Repaired) => &mut out.repaired,
+                Some(Fate::Invalid) => &mut out.invalid,
+                None => continue,
+            };
+            slot.add(w[1] - w[0]);
+        }
+        out
+    }
+
+    /// The two as one, fate by fate ([`FateCount::merged`]).
+    #[must_use]
+    pub fn merged(self, other: FateIncreases) -> FateIncreases {
+        FateIncreases {
+            valid: self.valid.merged(other.valid),
+            repaired: self.repaired.merged(other.repaired),
+            invalid: self.invalid.merged(other.invalid),
+        }
+    }
+}
+
 /// What the observers collect while a run goes.
 #[derive(Default)]
 struct Trace {
     serial_s: Vec<f64>,
+    /// `(round, fate of the re-schedule that made the plan the round ran)`.
+    fates: Vec<(usize, Option<Fate>)>,
     backward: (usize, f64),
     error: Option<crate::Error>,
 }
@@ -247,8 +358,10 @@ pub fn run_rounds(
     let observe = |view: RoundView<'_>| {
         let serial = serial_s(view.planner);
         let backward = backward_steps(view.run.robots.iter().map(|r| &r.ref_time_log[..]));
+        let fate = Fate::of(&view.planner.outcome().previous);
         let mut t = trace.lock().unwrap_or_else(PoisonError::into_inner);
         t.add_backward(backward);
+        t.fates.push((view.round, fate));
         match serial {
             Ok(s) => t.serial_s.push(s),
             Err(e) => {
@@ -278,6 +391,19 @@ pub fn run_rounds(
         .zip(&trace.serial_s)
         .position(|(t, s)| *t < s - 0.5 * tick_s);
     let (max_increase_s, max_increase_at) = max_increase(&t_total_s);
+    // Round `k` (1-based) ran plan `k − 1`; the last plan is the planner's after the trial.
+    trace.fates.sort_by_key(|f| f.0);
+    let fates: Vec<Option<Fate>> = trace
+        .fates
+        .iter()
+        .map(|f| f.1)
+        .chain([Fate::of(&run.planner.outcome().previous)])
+        .collect();
+    let by_fate = if fates.len() == t_total_s.len() {
+        FateIncreases::of(&t_total_s, &fates)
+    } else {
+        FateIncreases::default()
+    };
     let ran: Vec<(f64, f64)> = its
         .iter()
         .filter_map(|i| i.round.as_ref().map(|p| (i.t_total_s, p.duration_s)))
@@ -309,6 +435,7 @@ pub fn run_rounds(
         first_overlap_round,
         max_increase_s,
         max_increase_at,
+        by_fate,
         realized_over_planned,
         realized_over_planned_last: realized_last / planned_last,
         planned_per_h: per_h(planned_last),
@@ -379,6 +506,7 @@ pub fn run_continuous(
         first_overlap_round: None,
         max_increase_s,
         max_increase_at,
+        by_fate: FateIncreases::default(),
         realized_over_planned: ratio,
         realized_over_planned_last: ratio,
         planned_per_h: last.tasks_per_hour,
@@ -427,6 +555,7 @@ mod tests {
             first_overlap_round: Some(0),
             max_increase_s: 0.0,
             max_increase_at: None,
+            by_fate: FateIncreases::default(),
             realized_over_planned: 1.0,
             realized_over_planned_last: 1.0,
             planned_per_h: 1.0,
@@ -490,6 +619,54 @@ mod tests {
             .unavoidable_pct
             .unwrap();
         assert!((u - 6.0).abs() < 1e-12 && n == 2);
+    }
+
+    #[test]
+    fn increases_filed_by_the_previous_schedules_fate() {
+        // Plans 30, 20, 20.5, 25, 24 s; plan 0 had no previous schedule, plan 1 came after a
+        // repaired one (−10), plan 2 a repaired one (+0.5), plan 3 an invalid one (+4.5),
+        // plan 4 a valid one (−1).
+        let t = [30.0, 20.0, 20.5, 25.0, 24.0];
+        let fates = [
+            None,
+            Some(Fate::Repaired),
+            Some(Fate::Repaired),
+            Some(Fate::Invalid),
+            Some(Fate::Valid),
+        ];
+        let f = FateIncreases::of(&t, &fates);
+        assert_eq!(
+            f.repaired,
+            FateCount {
+                count: 2,
+                max_increase_s: Some(0.5)
+            }
+        );
+        assert_eq!(
+            f.invalid,
+            FateCount {
+                count: 1,
+                max_increase_s: Some(4.5)
+            }
+        );
+        assert_eq!(
+            f.valid,
+            FateCount {
+                count: 1,
+                max_increase_s: Some(-1.0)
+            }
+        );
+        // Merged with a run of one valid re-schedule of +0.25 s: 2 valid, the larger +0.25.
+        let g = FateIncreases::of(&[10.0, 10.25], &[None, Some(Fate::Valid)]);
+        let m = f.merged(g);
+        assert_eq!(m.valid.count, 2);
+        assert_eq!(m.valid.max_increase_s, Some(0.25));
+        assert_eq!(m.invalid, f.invalid);
+        // A report saved before the split reads all empty.
+        let mut old = serde_json::to_value(run(12.0, 10.0, None)).unwrap();
+        old.as_object_mut().unwrap().remove("by_fate");
+        let back: RunReport = serde_json::from_value(old).unwrap();
+        assert_eq!(back.by_fate, FateIncreases::default());
     }
 
     #[test]

@@ -6,7 +6,7 @@ use tandem_sim::study::Cell;
 
 use super::ZooReport;
 use super::prepare::min_max;
-use super::run::RunReport;
+use super::run::{FateIncreases, RunReport};
 
 /// One family, robot count and cell, over its seeds (means unless said otherwise).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -63,6 +63,11 @@ pub struct FamilyRow {
     pub max_increase_s: f64,
     /// The same in control ticks.
     pub max_increase_ticks: f64,
+    /// Round-to-round changes of `T_total` by the previous schedule's fate, over every seed
+    /// (`RunReport::by_fate` merged: counts added, the largest increase); all empty for a cell
+    /// and an old report.
+    #[serde(default)]
+    pub by_fate: FateIncreases,
     /// Realized over planned time (mean over rounds and seeds).
     pub realized_over_planned: f64,
     /// Planned throughput of the last round (tasks/h per operator).
@@ -204,6 +209,9 @@ fn row(family: String, robots: usize, cell: Cell, runs: &[&RunReport]) -> Family
         },
         max_increase_s,
         max_increase_ticks,
+        by_fate: runs
+            .iter()
+            .fold(FateIncreases::default(), |a, r| a.merged(r.by_fate)),
         realized_over_planned: m(&|r| r.realized_over_planned),
         planned_per_h: m(&|r| r.planned_per_h),
         realized_per_h: m(&|r| r.realized_per_h),
