@@ -73,8 +73,8 @@ pub(crate) struct StudyArgs {
     #[arg(long, value_name = "S")]
     switch_true_s: Option<f64>,
     /// The cell's number of operators M (1 to 8; `[operator] operators`; issue 44): M tokens
-    /// and M simulated operators, one per operator index, each with the rates above. Only the
-    /// continuous cell runs M > 1 (`--cell continuous`).
+    /// (continuous) or M sectors (rounds) and M simulated operators, one per operator index,
+    /// each with the rates above.
     #[arg(long, value_name = "M")]
     operators: Option<usize>,
     /// Decide confidence with the paper's model (Eq. 8–12: zero error rates, nothing
@@ -822,11 +822,22 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
             .map(|b| (s.iteration, s.throughput_mean_per_h, b))
     });
     if let Some((k, throughput, busy)) = last_round {
-        println!(
-            "round at iteration {k}: {throughput:.1} tasks per hour per operator (planned), \
-             operator busy {:.1} % of the round",
-            100.0 * busy
-        );
+        let m = config.operator.operators;
+        if m > 1 {
+            // The sectored round (issue 44): the cell's tasks per hour, shared by M operators;
+            // the busy share counts the ticks in which any of them is busy.
+            println!(
+                "round at iteration {k}: {throughput:.1} tasks per hour of the cell of {m} \
+                 operators in sectors (planned), some operator busy {:.1} % of the round",
+                100.0 * busy
+            );
+        } else {
+            println!(
+                "round at iteration {k}: {throughput:.1} tasks per hour per operator (planned), \
+                 operator busy {:.1} % of the round",
+                100.0 * busy
+            );
+        }
     }
     let (gap, unsupervised) = result.plan_gap_total(0);
     let rounds = config.trials * config.n_rounds();

@@ -321,9 +321,9 @@ pub(crate) struct SamplerArgs {
     #[arg(long = "max-busy", value_name = "SHARE", allow_negative_numbers = true)]
     pub(crate) max_busy: Option<f64>,
     /// The cell's number of operators M (1 to 8; issue 44): a continuous cell runs M tokens,
-    /// at most M robots low-confidence at once, each with its own operator. Rounds with more
-    /// than one operator are not supported yet. Stored in the state file. Default: from the
-    /// parameters (1).
+    /// rounds run M sectors (the robots split evenly, each sector a one-operator round); at
+    /// most M robots low-confidence at once, each with its own operator. Stored in the state
+    /// file. Default: from the parameters (1).
     #[arg(long, value_name = "M")]
     pub(crate) operators: Option<usize>,
 }

@@ -246,7 +246,8 @@ pub(crate) fn operator_line(p: &SamplerParams) -> Option<String> {
         String::new()
     } else {
         format!(
-            "; {} operators (a continuous cell: at most {} robots low-confidence at once)",
+            "; {} operators (at most {} robots low-confidence at once: a continuous cell's \
+             tokens, or rounds in sectors)",
             p.operators, p.operators
         )
     };
@@ -255,6 +256,27 @@ pub(crate) fn operator_line(p: &SamplerParams) -> Option<String> {
          and another's); {cap}{fleet}",
         secs(p.switch_s)
     ))
+}
+
+/// With `M > 1` operators, the round the robots run (issue 44): the planner's sectored round
+/// (`Planner::sectored_rounds`), its sectors, `T_total` and the bound of every round of `M`
+/// operators; `None` with one operator (the output of before).
+pub(crate) fn sectors_line(planner: &Planner) -> Result<Option<String>> {
+    let m = planner.params().sampler.operators;
+    if m == 1 {
+        return Ok(None);
+    }
+    let (s, _) = planner
+        .sectored_rounds()
+        .context("cannot plan the sectored round")?;
+    let sizes: Vec<String> = s.sizes.iter().map(ToString::to_string).collect();
+    Ok(Some(format!(
+        "rounds with {m} operators: sectors of {} robots (one operator each), T_total {:.2} s \
+         (no round of {m} operators is shorter than {:.2} s)",
+        sizes.join(" + "),
+        s.t_total_s,
+        s.lower_bound_s
+    )))
 }
 
 /// `fit`'s parameters: the parameter file, then the flags over it, checked.
@@ -774,6 +796,9 @@ fn summary_lines(planner: &Planner) -> Result<()> {
     if let Some(line) = operator_line(&planner.params().sampler) {
         out(&line);
     }
+    if let Some(line) = sectors_line(planner)? {
+        out(&line);
+    }
     out(&format!(
         "schedule: {}",
         certificate_line(planner.problem(), planner.outcome())?
@@ -831,6 +856,9 @@ fn schedule(a: &ScheduleArgs) -> Result<()> {
     } else {
         out(&gantt_text(planner.problem(), planner.outcome())?);
         if let Some(line) = operator_line(&planner.params().sampler) {
+            out(&line);
+        }
+        if let Some(line) = sectors_line(&planner)? {
             out(&line);
         }
         out(&format!(

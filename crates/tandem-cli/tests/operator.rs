@@ -202,3 +202,40 @@ fn params_names_them_with_their_units() {
         "{text}"
     );
 }
+
+/// Rounds with two operators (issue 44): `tandem schedule --operators 2` on a rounds state of
+/// four robots prints the sectored round — two sectors of two robots, its `T_total` and the
+/// fleet bound — as the library's `Planner::sectored_rounds` gives them; one operator prints
+/// no such line, and the state is not changed without `--save`.
+#[test]
+fn schedule_with_two_operators_prints_the_sectors_of_the_round() {
+    let dir = scratch("operator-sectors");
+    let (state, text) = fit(&dir, &["--robots", "4"]);
+    assert!(!text.contains("rounds with"), "{text}");
+    let text = ok(&tandem([
+        "schedule",
+        &s(&state),
+        "--samples",
+        "50",
+        "--operators",
+        "2",
+    ]));
+    let mut p = Planner::load(&state).expect("the state loads");
+    assert_eq!(p.params().sampler.operators, 1, "not saved");
+    p.set_operators(2).unwrap();
+    let (sectors, _) = p.sectored_rounds().unwrap();
+    assert_eq!(sectors.sizes, vec![2, 2]);
+    let bound = tandem::schedule::fleet_operator_bound_s(p.problem(), 4, 2).unwrap();
+    assert_eq!(sectors.lower_bound_s, bound);
+    assert!(sectors.t_total_s >= bound);
+    let line = format!(
+        "rounds with 2 operators: sectors of 2 + 2 robots (one operator each), T_total {:.2} s \
+         (no round of 2 operators is shorter than {bound:.2} s)",
+        sectors.t_total_s
+    );
+    assert!(text.contains(&line), "{line}\n{text}");
+    assert!(text.contains("2 operators (at most 2 robots"), "{text}");
+    let plain = ok(&tandem(["schedule", &s(&state), "--samples", "50"]));
+    assert!(!plain.contains("rounds with"), "{plain}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -316,21 +316,14 @@ impl Planner {
     /// As [`Planner::plan`].
     ///
     /// With `params().sampler.operators = M > 1` (issue 44) a continuous cell runs `M` tokens
-    /// ([`Planner::continuous_coordinator`]); rounds with more than one operator are not built
-    /// yet: [`Error::BadCell`] naming `operators`.
+    /// ([`Planner::continuous_coordinator`]); rounds run the sectored round of
+    /// [`Planner::sectored_rounds`] (`M` one-operator rounds side by side).
     pub fn controller(&self, cell: Cell) -> Result<AnyController> {
         let switch_s = self.params().sampler.switch_s;
         match self.plan(cell)? {
             Plan::Rounds(s) => {
-                let m = self.params().sampler.operators;
-                if m > 1 {
-                    return Err(Error::BadCell {
-                        what: "operators".into(),
-                        why: format!(
-                            "rounds with {m} operators are not supported yet (issue 44): run a \
-                             continuous cell (`--cell continuous`) or set operators to 1"
-                        ),
-                    });
+                if self.params().sampler.operators > 1 {
+                    return Ok(AnyController::Rounds(self.sectored_rounds()?.1));
                 }
                 Ok(AnyController::Rounds(
                     s.coordinator()?.with_switch_s(switch_s)?,

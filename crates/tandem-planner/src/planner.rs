@@ -931,11 +931,63 @@ impl Planner {
     /// (`params().sampler.switch_s`, [`Coordinator::with_switch_s`]): a robot leaves a hold
     /// with release rules no sooner than that after the robots it waits for left their
     /// stretches.
+    ///
+    /// With `params().sampler.operators = M > 1` (issue 44) it is the sectored round of
+    /// [`Planner::sectored_rounds`] ([`Coordinator::sectored`]): `M` one-operator rounds side
+    /// by side, one per operator.
     pub fn coordinator(&self) -> Result<Coordinator> {
+        if self.params().sampler.operators > 1 {
+            return Ok(self.sectored_rounds()?.1);
+        }
         Ok(self
             .checked_schedule()?
             .coordinator()?
             .with_switch_s(self.params().sampler.switch_s)?)
+    }
+
+    /// The round of `M = params().sampler.operators` operators (issue 44; docs/decisions.md,
+    /// "M operators in rounds: sectors end to end"), and its coordinator
+    /// ([`Coordinator::sectored`]): of two candidates the one with the least `T_total` —
+    /// the even sectors ([`tandem_schedule::sectored_rounds`], each sector's one-operator
+    /// schedule sampled with this planner's parameters and the seed of the current schedule,
+    /// on the problem without holds), and the current `N`-robot schedule run by operator 0
+    /// alone (when it has no holds; the other operators idle), which wins only where one
+    /// operator's round is no longer than the sectors'. Either keeps at most one robot
+    /// low-confidence per operator in every tick. The returned [`tandem_schedule::SectoredRounds`]
+    /// is the chosen one (one sector of `N` for the second candidate); its `lower_bound_s`
+    /// bounds every round of `M` operators. A snapshot: the planner and its state file keep
+    /// the one-operator schedule.
+    ///
+    /// # Errors
+    /// As [`Planner::checked_schedule`] and [`tandem_schedule::sectored_rounds`]; the realtime
+    /// crate's for the coordinator (never `Unsafe` for the sampler's schedules).
+    pub fn sectored_rounds(&self) -> Result<(tandem_schedule::SectoredRounds, Coordinator)> {
+        let sp = &self.params().sampler;
+        let m = tandem_realtime::OperatorCount::new(sp.operators)?;
+        let tick_s = self.schedule().tick_s;
+        let sampler = SamplerParams {
+            tick_s: Some(tick_s),
+            ..Self::sampler_params(&self.params, self.pairs_recorded)
+        };
+        let margins = tandem_realtime::MarginParams {
+            tick_s,
+            switch_s: sp.switch_s,
+        };
+        let n = self.n_robots();
+        let mut sectors = tandem_schedule::sectored_rounds(self.problem(), n, m.get(), &sampler)?;
+        let mut robots = sectors.timelines(self.problem())?;
+        if !self.schedule().has_holds() && self.outcome.t_total_s < sectors.t_total_s {
+            let one = self.checked_schedule()?;
+            robots = one.timelines().to_vec();
+            sectors = tandem_schedule::SectoredRounds {
+                sizes: vec![n],
+                schedules: vec![one.into_schedule()],
+                t_total_s: self.outcome.t_total_s,
+                lower_bound_s: sectors.lower_bound_s,
+            };
+        }
+        let coord = Coordinator::sectored(robots, &sectors.sector_of(), m, &margins)?;
+        Ok((sectors, coord))
     }
 
     /// The current schedule checked on the current problem ([`Schedule::check`]): what
@@ -1942,10 +1994,10 @@ mod tests {
 
     /// The `operators` parameter end to end in the planner (issue 44): a continuous cell gets
     /// `M` tokens and takes `M` inputs; one operator is the coordinator of before; rounds with
-    /// more than one are refused naming the parameter; an out-of-range count is refused and
-    /// leaves the planner as it was.
+    /// more than one run the sectored round; an out-of-range count is refused and leaves the
+    /// planner as it was.
     #[test]
-    fn the_operator_count_makes_the_continuous_cell_and_is_refused_for_rounds() {
+    fn the_operator_count_makes_the_continuous_cell_and_the_sectored_round() {
         use tandem_realtime::{Controller, Operator};
         let mut p = test_planner(40, 10..20, 3, 1);
         let one = p.controller(crate::Cell::Continuous).unwrap();
@@ -1963,15 +2015,92 @@ mod tests {
         assert_eq!(Controller::operators(&two), 2);
         assert!(two.tick(Operator::Scheduled).is_err());
         two.tick_many(&[Operator::Scheduled; 2]).unwrap();
-        let err = p.controller(crate::Cell::Rounds).unwrap_err().to_string();
-        assert!(
-            err.contains("operators") && err.contains("continuous"),
-            "{err}"
-        );
+        // Rounds with two operators: the sectored round (issue 44), run to its end with two
+        // inputs, never two robots of one sector low-confidence, each under its sector's
+        // operator, no fault.
+        let (sectors, _) = p.sectored_rounds().unwrap();
+        assert!(sectors.t_total_s >= sectors.lower_bound_s * (1.0 - 1e-9));
+        let crate::AnyController::Rounds(mut r) = p.controller(crate::Cell::Rounds).unwrap() else {
+            panic!("rounds")
+        };
+        assert_eq!(Controller::operators(&r), 2);
+        assert!(Controller::tick(&mut r, Operator::Scheduled).is_err());
+        let sector_of = sectors.sector_of();
+        assert_eq!(sector_of.len(), 3);
+        let mut lc_ticks = 0;
+        for _ in 0..100_000 {
+            if Controller::is_finished(&r) {
+                break;
+            }
+            let t = Controller::tick_many(&mut r, &[Operator::Fastest, Operator::Slowest]).unwrap();
+            assert!(t.fault.is_none());
+            for (i, &o) in sector_of.iter().enumerate() {
+                if t.low_conf[i] {
+                    lc_ticks += 1;
+                    assert_eq!(t.operator[i], Some(o as u8));
+                }
+            }
+        }
+        assert!(Controller::is_finished(&r) && lc_ticks > 0);
         for bad in [0, tandem_realtime::MAX_ROBOTS + 1] {
             let err = p.set_operators(bad).unwrap_err().to_string();
             assert!(err.contains("operators"), "{err}");
             assert_eq!(p.params().sampler.operators, 2);
+        }
+    }
+
+    /// The sectored round (issue 44) of (N, M) = (4, 2) and (3, 2) on a small problem: even
+    /// sectors ([2, 2], [2, 1]), each sector's schedule of its own size passes the one-operator
+    /// check (Eq. 20 with Alg. 2's margin check) on the problem without holds, the round's
+    /// `T_total` is the slower sector's own `T_total` (Eq. 13 of its schedule), the sectored
+    /// coordinator's robots are those schedules' (its latest robot ends at `T_total`), and the
+    /// round lies between the fleet bound and one operator's N-robot round.
+    #[test]
+    fn sectored_rounds_take_the_slower_sectors_t_total() {
+        use tandem_realtime::Timeline;
+        for (n, sizes) in [(4, vec![2, 2]), (3, vec![2, 1])] {
+            let mut p = test_planner(60, 20..30, n, 1);
+            p.set_operators(2).unwrap();
+            let (s, coord) = p.sectored_rounds().unwrap();
+            assert_eq!(s.sizes, sizes, "N = {n}");
+            let free = p.problem().clone().with_holds(Vec::new()).unwrap();
+            let own: Vec<f64> = s
+                .schedules
+                .iter()
+                .zip(&sizes)
+                .map(|(sch, &k)| {
+                    assert_eq!(sch.n_robots(), k);
+                    let sp = &p.params().sampler;
+                    sch.check_with_operator(&free, sp.switch_s, sp.max_busy_share)
+                        .unwrap();
+                    sch.t_total_s(free.dt_s())
+                })
+                .collect();
+            let slower = own.iter().copied().fold(0.0, f64::max);
+            assert!(
+                (s.t_total_s - slower).abs() < 1e-9,
+                "{} {own:?}",
+                s.t_total_s
+            );
+            if n == 3 {
+                // The sector of two robots is the slower one: a second robot's stretch waits.
+                assert!(own[0] > own[1], "{own:?}");
+            }
+            assert_eq!(coord.operators(), 2);
+            assert_eq!(coord.n_robots(), n);
+            let end = coord
+                .robots()
+                .iter()
+                .map(Timeline::end_s)
+                .fold(0.0, f64::max);
+            assert!((end - s.t_total_s).abs() < 1e-9, "{end} {}", s.t_total_s);
+            let bound = tandem_schedule::fleet_operator_bound_s(p.problem(), n, 2).unwrap();
+            assert_eq!(s.lower_bound_s, bound);
+            assert!(bound <= s.t_total_s + 1e-9);
+            assert!(
+                s.t_total_s < p.outcome().t_total_s,
+                "sectors beat one operator here"
+            );
         }
     }
 }

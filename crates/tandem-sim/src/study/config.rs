@@ -76,8 +76,9 @@ pub struct StudyOperator {
     /// [`tandem_realtime::MAX_ROBOTS`]: the planner's
     /// [`tandem_schedule::SamplerParams::operators`] (set here, not in `[planner.sampler]`),
     /// and `M` simulated operators, one per operator index of `Tick::operator`, each with the
-    /// error rates and switch time above. Only the continuous cell runs `M > 1` (rounds with
-    /// several operators are not built yet). Default: 1 (not written when so).
+    /// error rates and switch time above. Rounds with `M > 1` run the planner's sectored round
+    /// (`Planner::sectored_rounds`), the continuous cell `M` tokens. Default: 1 (not written
+    /// when so).
     #[serde(skip_serializing_if = "is_one")]
     pub operators: usize,
 }
@@ -205,13 +206,6 @@ impl StudyConfig {
             return bad(
                 "operator.operators",
                 "must be between 1 and 8 (tandem_realtime::MAX_ROBOTS): the cell's operators",
-            );
-        }
-        if op.operators > 1 && self.cell == Cell::Rounds {
-            return bad(
-                "operator.operators",
-                "rounds with more than one operator are not supported yet (issue 44): run the \
-                 continuous cell (`cell = \"continuous\"`, `--cell continuous`) or set 1",
             );
         }
         let sampler = &self.planner.sampler;
@@ -389,6 +383,9 @@ mod tests {
         let m: StudyConfig =
             toml::from_str("cell = \"continuous\"\n[operator]\noperators = 2\n").unwrap();
         m.validate().unwrap();
+        // Rounds with two operators too (issue 44: the sectored round).
+        let r: StudyConfig = toml::from_str("[operator]\noperators = 2\n").unwrap();
+        r.validate().unwrap();
         assert_eq!(m.planner_params().sampler.operators, 2);
         assert!(toml::to_string(&m).unwrap().contains("operators = 2"));
         assert!(!text.contains("operators"), "{text}");
@@ -408,8 +405,6 @@ mod tests {
                 "cell = \"continuous\"\n[operator]\noperators = 9\n",
                 "operator.operators",
             ),
-            // Rounds with several operators are not built yet: refused, not run with one.
-            ("[operator]\noperators = 2\n", "operator.operators"),
             ("[planner.sampler]\noperators = 2\n", "planner.sampler"),
         ] {
             let c: StudyConfig = toml::from_str(text).unwrap();

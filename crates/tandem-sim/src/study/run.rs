@@ -67,28 +67,63 @@ fn iteration_record(
     tally: &OperatorTally,
 ) -> Result<IterationRecord> {
     let schedule = planner.schedule();
-    // As the robots run it: after a hold, a robot's intervals come after its planned dwell.
-    let lc = schedule.lc_intervals(planner.problem())?;
+    let outcome = planner.outcome();
+    let n_robots = planner.n_robots();
+    // M > 1 operators (issue 44): the round runs the planner's sectored round, so the record
+    // is that round's: its `T_total`, bound and gap, and its robots' starts and intervals
+    // (each sector's schedule on the problem without holds, robot `i` at index `i`), not the
+    // stored one-operator schedule's.
+    let sectored = if planner.params().sampler.operators > 1 {
+        Some(planner.sectored_rounds()?.0)
+    } else {
+        None
+    };
+    let (lc, offsets_s, t_total_s, lower_bound_s, gap) = match &sectored {
+        Some(s) => {
+            let free = planner.problem().clone().with_holds(Vec::new())?;
+            let mut lc = Vec::with_capacity(n_robots);
+            // Every robot's start in the round's global time (each sector's robots from 0);
+            // the record keeps robots 2..N's, `τ_2, …, τ_N`.
+            let mut starts_s = Vec::with_capacity(n_robots);
+            for sector in &s.schedules {
+                lc.extend(sector.lc_intervals(&free)?);
+                starts_s.extend(sector.starts_s());
+            }
+            let offsets_s: Vec<f64> = starts_s.into_iter().skip(1).collect();
+            let gap = (s.t_total_s - s.lower_bound_s) / s.lower_bound_s;
+            (lc, offsets_s, s.t_total_s, s.lower_bound_s, gap)
+        }
+        // As the robots run it: after a hold, a robot's intervals come after its planned
+        // dwell.
+        None => (
+            schedule.lc_intervals(planner.problem())?,
+            schedule.offsets_s.clone(),
+            outcome.t_total_s,
+            outcome.lower_bound_s,
+            outcome.gap,
+        ),
+    };
     let lc_intervals_s = lc
         .iter()
         .map(|v| v.iter().map(|i| [i.start_s, i.end_s]).collect())
         .collect();
-    let outcome = planner.outcome();
-    let n_robots = planner.n_robots();
     Ok(IterationRecord {
         iteration: planner.rounds_recorded(),
-        t_total_s: outcome.t_total_s,
-        offset_s: schedule.offsets_s.first().copied().unwrap_or(0.0),
+        t_total_s,
+        offset_s: offsets_s.first().copied().unwrap_or(0.0),
         high_conf_pct: 100.0 * planner.confidence().high_share(),
         source: outcome.source.into(),
         lc_intervals_s,
         round: None,
-        lower_bound_s: outcome.lower_bound_s,
-        bound_is_optimum: outcome.bound_is_optimum,
-        gap: outcome.gap,
-        gap_search: outcome.gap_split().map(|g| g.search),
-        throughput_per_h: throughput_per_h(n_robots, outcome.t_total_s),
-        offsets_s: schedule.offsets_s.clone(),
+        lower_bound_s,
+        bound_is_optimum: outcome.bound_is_optimum && sectored.is_none(),
+        gap,
+        gap_search: outcome
+            .gap_split()
+            .filter(|_| sectored.is_none())
+            .map(|g| g.search),
+        throughput_per_h: throughput_per_h(n_robots, t_total_s),
+        offsets_s,
         falsely_trusted_samples: falsely_trusted_where(planner.confidence().conf(), can_need),
         lc_runs: lc.iter().map(Vec::len).collect(),
         error_rates: planner.error_rates()?,

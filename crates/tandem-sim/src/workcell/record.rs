@@ -131,7 +131,8 @@ pub struct RoundRun {
     pub ticks: usize,
     /// Control period (s).
     pub tick_s: f64,
-    /// Ticks in which two or more robots traversed a low-confidence sample (must be 0).
+    /// Ticks in which more robots traversed a low-confidence sample than the round has
+    /// operators (one operator: two or more; must be 0).
     pub overlap_ticks: usize,
     /// Ticks in which no robot traversed a low-confidence sample.
     pub idle_ticks: usize,

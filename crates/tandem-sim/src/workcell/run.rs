@@ -199,7 +199,10 @@ pub(super) fn run_coordinator(
 ) -> Result<RoundRun> {
     let tick_s = coord.tick_s();
     let n_robots = coord.n_robots();
-    let mut counts = RoundCounts::default();
+    let mut counts = RoundCounts {
+        operators: coord.operators(),
+        ..RoundCounts::default()
+    };
     let max_end_s = coord
         .robots()
         .iter()
@@ -249,12 +252,15 @@ pub(super) fn run_coordinator(
 pub(super) struct RoundCounts {
     /// Control ticks run.
     pub(super) ticks: usize,
-    /// Ticks with two or more robots low-confidence.
+    /// Ticks with more robots low-confidence than operators (one operator: two or more).
     pub(super) overlap_ticks: usize,
     /// Ticks with no robot low-confidence.
     pub(super) idle_ticks: usize,
     /// Faults the monitor latched.
     pub(super) faults: usize,
+    /// The operators `M` of the coordinator (0 is taken as 1): a tick is counted in
+    /// `overlap_ticks` when more than `M` robots are low-confidence.
+    pub(super) operators: usize,
 }
 
 impl RoundCounts {
@@ -263,10 +269,10 @@ impl RoundCounts {
     /// whether a fault latched earlier may be released: no robot is low-confidence any more.
     pub(super) fn count(&mut self, tick: &Tick) -> bool {
         let low_conf = tick.low_conf.count();
-        match low_conf {
-            0 => self.idle_ticks += 1,
-            1 => {}
-            _ => self.overlap_ticks += 1,
+        if low_conf == 0 {
+            self.idle_ticks += 1;
+        } else if low_conf > self.operators.max(1) {
+            self.overlap_ticks += 1;
         }
         let release = match tick.fault {
             Some(f) if f.tick == self.ticks as u64 => {
