@@ -604,9 +604,7 @@ fn run_batches(
 
 /// One planned random problem of the continuous stress run.
 struct CellCase {
-    cell: ContinuousCoordinator,
-    adversaries: Vec<Adversary>,
-    max_ticks: u64,
+    run: PlannedCell,
     family: &'static str,
     /// The plan's throughput (tasks/h), for the report.
     plan_per_h: f64,
@@ -682,14 +680,16 @@ fn make_cell_case(
     // ticks it ran.
     let max_ticks = ((tasks + 2) as f64 * n_robots as f64 * per_task / max_busy) as u64 + 1000;
     Ok(CellCase {
-        adversaries: adversary_set(
-            n_robots,
-            grad_range,
-            (per_task * tasks as f64) as u64,
-            &mut rng,
-        ),
-        cell,
-        max_ticks,
+        run: PlannedCell {
+            adversaries: adversary_set(
+                n_robots,
+                grad_range,
+                (per_task * tasks as f64) as u64,
+                &mut rng,
+            ),
+            cell,
+            max_ticks,
+        },
         family,
         plan_per_h: plan.tasks_per_hour,
     })
@@ -735,13 +735,81 @@ pub(crate) fn run_continuous(
         },
         start.elapsed().as_secs_f64()
     );
+    let runs: Vec<&PlannedCell> = cases.iter().map(|c| &c.run).collect();
+    let counts = run_cell_executions(&runs, executions, seed, tasks, switch_s)?;
+    let CellCounts {
+        ticks,
+        overlap_ticks,
+        overlap_runs,
+        unfinished,
+        backward,
+        tasks_done,
+        min_tasks,
+        secs,
+        ..
+    } = counts;
+    let set_size = runs[0].adversaries.len();
+    println!(
+        "stress --cell continuous: {executions} executions of {n_robots} robots ({set_size} \
+         operator policies, seed {seed}), {ticks} ticks, {threads} threads: {overlap_ticks} \
+         ticks with two or more robots low-confidence (expected 0) in {overlap_runs} \
+         executions; {backward} ticks with a robot moving backwards (expected 0); tasks per robot per execution: at least {min_tasks}, {:.1} on average; \
+         {unfinished} unfinished; {secs:.1} s, {:.0} executions/s, {:.1} M ticks/s",
+        tasks_done as f64 / (executions * n_robots as u64) as f64,
+        executions as f64 / secs,
+        ticks as f64 / secs / 1e6,
+        threads = rayon::current_num_threads(),
+    );
+    counts.check()
+}
+
+/// One planned continuous cell of a stress run: its coordinator (cloned per execution), the
+/// operator policies it runs under and its tick cap per execution.
+pub(crate) struct PlannedCell {
+    pub(crate) cell: ContinuousCoordinator,
+    pub(crate) adversaries: Vec<Adversary>,
+    pub(crate) max_ticks: u64,
+}
+
+/// What the executions of [`run_cell_executions`] add up to.
+#[derive(Clone, Copy)]
+pub(crate) struct CellCounts {
+    pub(crate) ticks: u64,
+    /// Ticks with two or more robots low-confidence, and the executions they fell in.
+    pub(crate) overlap_ticks: u64,
+    pub(crate) overlap_runs: u64,
+    pub(crate) unfinished: u64,
+    /// Ticks in which a robot's reference time decreased.
+    pub(crate) backward: u64,
+    /// Executions with a switch shorter than the switch time (0 when `switch_s` is 0).
+    pub(crate) short: u64,
+    /// Tasks completed over all executions and robots, and the fewest of one robot in one
+    /// execution.
+    pub(crate) tasks_done: u64,
+    pub(crate) min_tasks: u64,
+    /// Wall time of the executions (s).
+    pub(crate) secs: f64,
+}
+
+/// Runs `executions` executions of `tasks` tasks per robot in batches on rayon's threads:
+/// execution `e` runs cell `e mod cells` under policy `(e / cells) mod policies` with the
+/// random stream `e` of `seed`, so the counts do not depend on the thread count. Every cell
+/// has as many policies as the first.
+pub(crate) fn run_cell_executions(
+    cases: &[&PlannedCell],
+    executions: u64,
+    seed: u64,
+    tasks: u64,
+    switch_s: f64,
+) -> anyhow::Result<CellCounts> {
+    let n_cells = cases.len() as u64;
     let set_size = cases[0].adversaries.len() as u64;
     let run_start = Instant::now();
     let (tally, tasks_done) = (Tally::default(), AtomicU64::new(0));
     let min_tasks = AtomicU64::new(u64::MAX);
     run_batches(executions, CELL_BATCH, 10.0, &tally, |e| {
-        let case = &cases[(e % n_problems) as usize];
-        let op = case.adversaries[((e / n_problems) % set_size) as usize];
+        let case = &cases[(e % n_cells) as usize];
+        let op = case.adversaries[((e / n_cells) % set_size) as usize];
         let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
         rng.set_stream(e);
         let mut cell = case.cell.clone();
@@ -760,23 +828,37 @@ pub(crate) fn run_continuous(
     let ks: Vec<u64> = cases.iter().map(|c| c.cell.switch_ticks()).collect();
     let short = report_switches(&tally, switch_s, &ks);
     let (ticks, overlap_ticks, overlap_runs, unfinished) = tally.into_counts();
-    let (tasks_done, min_tasks) = (tasks_done.into_inner(), min_tasks.into_inner());
-    println!(
-        "stress --cell continuous: {executions} executions of {n_robots} robots ({set_size} \
-         operator policies, seed {seed}), {ticks} ticks, {threads} threads: {overlap_ticks} \
-         ticks with two or more robots low-confidence (expected 0) in {overlap_runs} \
-         executions; {backward} ticks with a robot moving backwards (expected 0); tasks per robot per execution: at least {min_tasks}, {:.1} on average; \
-         {unfinished} unfinished; {secs:.1} s, {:.0} executions/s, {:.1} M ticks/s",
-        tasks_done as f64 / (executions * n_robots as u64) as f64,
-        executions as f64 / secs,
-        ticks as f64 / secs / 1e6,
-        threads = rayon::current_num_threads(),
-    );
-    if overlap_ticks > 0 || unfinished > 0 || backward > 0 || short > 0 {
-        bail!(
-            "safety invariant broken: {overlap_ticks} overlap ticks, {backward} backward steps, \
-             {unfinished} unfinished executions, {short} with a switch shorter than the switch time"
-        );
+    Ok(CellCounts {
+        ticks,
+        overlap_ticks,
+        overlap_runs,
+        unfinished,
+        backward,
+        short,
+        tasks_done: tasks_done.into_inner(),
+        min_tasks: min_tasks.into_inner(),
+        secs,
+    })
+}
+
+impl CellCounts {
+    /// An error naming every broken count (overlapping ticks, backward steps, unfinished
+    /// executions, switches shorter than the switch time), or `Ok`.
+    pub(crate) fn check(&self) -> anyhow::Result<()> {
+        let CellCounts {
+            overlap_ticks,
+            backward,
+            unfinished,
+            short,
+            ..
+        } = *self;
+        if overlap_ticks > 0 || unfinished > 0 || backward > 0 || short > 0 {
+            bail!(
+                "safety invariant broken: {overlap_ticks} overlap ticks, {backward} backward \
+                 steps, {unfinished} unfinished executions, {short} with a switch shorter than \
+                 the switch time"
+            );
+        }
+        Ok(())
     }
-    Ok(())
 }

@@ -13,28 +13,24 @@
 //! with two or more robots low-confidence and the ticks in which a robot moved backwards
 //! (both expected 0), and with `--switch-s` the switches shorter than the switch time.
 
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, bail};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use tandem::realtime::adversary::{Adversary, adversary_set};
-use tandem::realtime::continuous::{ContinuousCoordinator, run_cell};
+use tandem::realtime::adversary::adversary_set;
 use tandem::schedule::Problem;
 use tandem::schedule::cyclic::{MixedParams, mixed_cyclic_plan};
 
-use super::{CELL_BATCH, Tally, n_problems, report_switches, run_batches, with_holds};
+use super::{CellCounts, PlannedCell, n_problems, run_cell_executions, with_holds};
 
 /// Reference sample periods (s) a robot's task is drawn at.
 const PERIODS_S: [f64; 3] = [0.010, 0.005, 0.004];
 
 /// One planned random mixed cell.
 struct MixedCase {
-    cell: ContinuousCoordinator,
-    adversaries: Vec<Adversary>,
-    max_ticks: u64,
+    run: PlannedCell,
     /// The plan's throughput and its mixed operator-limited bound (tasks/h).
     plan_per_h: f64,
     operator_limited_per_h: f64,
@@ -111,14 +107,16 @@ fn make_case(
         .sum();
     let max_ticks = ((tasks + 2) as f64 * per_pass) as u64 + 1000;
     Ok(MixedCase {
-        adversaries: adversary_set(
-            n_robots,
-            grad_range,
-            (per_pass * tasks as f64) as u64,
-            &mut rng,
-        ),
-        cell,
-        max_ticks,
+        run: PlannedCell {
+            adversaries: adversary_set(
+                n_robots,
+                grad_range,
+                (per_pass * tasks as f64) as u64,
+                &mut rng,
+            ),
+            cell,
+            max_ticks,
+        },
         plan_per_h: plan.tasks_per_hour,
         operator_limited_per_h: plan.operator_limited_per_hour,
         tasks_per_period: plan.ratios.iter().sum(),
@@ -163,32 +161,20 @@ pub(crate) fn run_mixed(
         100.0 * mean(|c| (c.plan_per_h / c.operator_limited_per_h).min(1.0)),
         start.elapsed().as_secs_f64()
     );
-    let set_size = cases[0].adversaries.len() as u64;
-    let run_start = Instant::now();
-    let (tally, tasks_done) = (Tally::default(), AtomicU64::new(0));
-    let min_tasks = AtomicU64::new(u64::MAX);
-    run_batches(executions, CELL_BATCH, 10.0, &tally, |e| {
-        let case = &cases[(e % n_cells) as usize];
-        let op = case.adversaries[((e / n_cells) % set_size) as usize];
-        let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
-        rng.set_stream(e);
-        let mut cell = case.cell.clone();
-        let r = run_cell(&mut cell, op, &mut rng, tasks, case.max_ticks)?;
-        tally.add(r.ticks, r.overlap_ticks, r.finished);
-        tally.add_backward(r.backward_steps);
-        if switch_s > 0.0 {
-            tally.add_switch(r.min_switch_gap_ticks, case.cell.switch_ticks());
-        }
-        tasks_done.fetch_add(cell.tasks_completed().iter().sum(), Ordering::Relaxed);
-        min_tasks.fetch_min(r.min_tasks, Ordering::Relaxed);
-        Ok(())
-    })?;
-    let secs = run_start.elapsed().as_secs_f64();
-    let backward = tally.backward_steps.load(Ordering::Relaxed);
-    let ks: Vec<u64> = cases.iter().map(|c| c.cell.switch_ticks()).collect();
-    let short = report_switches(&tally, switch_s, &ks);
-    let (ticks, overlap_ticks, overlap_runs, unfinished) = tally.into_counts();
-    let (tasks_done, min_tasks) = (tasks_done.into_inner(), min_tasks.into_inner());
+    let runs: Vec<&PlannedCell> = cases.iter().map(|c| &c.run).collect();
+    let counts = run_cell_executions(&runs, executions, seed, tasks, switch_s)?;
+    let CellCounts {
+        ticks,
+        overlap_ticks,
+        overlap_runs,
+        unfinished,
+        backward,
+        tasks_done,
+        min_tasks,
+        secs,
+        ..
+    } = counts;
+    let set_size = runs[0].adversaries.len();
     println!(
         "stress --cell continuous --mixed: {executions} executions of {n_robots} robots \
          ({set_size} operator policies, seed {seed}), {ticks} ticks: {overlap_ticks} ticks \
@@ -198,11 +184,5 @@ pub(crate) fn run_mixed(
          {secs:.1} s",
         tasks_done as f64 / (executions * n_robots as u64) as f64,
     );
-    if overlap_ticks > 0 || unfinished > 0 || backward > 0 || short > 0 {
-        bail!(
-            "safety invariant broken: {overlap_ticks} overlap ticks, {backward} backward steps, \
-             {unfinished} unfinished executions, {short} with a switch shorter than the switch time"
-        );
-    }
-    Ok(())
+    counts.check()
 }
