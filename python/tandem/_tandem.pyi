@@ -66,6 +66,7 @@ def fit(
     switch_s: Optional[float] = None,
     max_busy_share: Optional[float] = None,
     resample: bool = False,
+    operators: Optional[int] = None,
 ) -> Planner:
     """Learns the task from demonstrations (paths or ``(T_i, C)`` arrays) and makes the first
     schedule (Fig. 2); the same inputs and parameters as ``tandem fit`` give the same state.
@@ -78,7 +79,10 @@ def fit(
     switch time δ (s, ≥ 0) between two robots' low-confidence stretches; ``max_busy_share``:
     its load cap in (0, 1] (``tandem fit --switch-s/--max-busy``); ``None`` keeps
     ``params["sampler"]``'. ``resample``: put CSV files with an irregular ``t`` column on an
-    even grid first, as ``tandem fit --resample`` (a ``DataWarning`` per file)."""
+    even grid first, as ``tandem fit --resample`` (a ``DataWarning`` per file).
+    ``operators``: the cell's operators M, 1 to 8 (``tandem fit --operators``): M tokens in a
+    continuous cell, M sectors in rounds (:meth:`Planner.sectored_rounds`); ``None`` keeps
+    ``params["sampler"]``'."""
 
 def read_bag(
     path: Path,
@@ -225,9 +229,13 @@ class Planner:
         tick_s: Optional[float] = None,
         switch_s: Optional[float] = None,
         max_busy_share: Optional[float] = None,
+        operators: Optional[int] = None,
     ) -> Schedule:
         """Re-runs the sampler warm-started by the current schedule and keeps the result;
-        ``switch_s``/``max_busy_share`` given become the planner's operator parameters."""
+        ``switch_s``/``max_busy_share``/``operators`` given become the planner's."""
+    def sectored_rounds(self) -> Dict[str, Any]:
+        """The round of ``params()["sampler"]["operators"]`` operators in sectors:
+        ``{"sizes", "sector_of", "t_total_s", "lower_bound_s"}`` (issue 44)."""
     def plan(self, cell: str = "rounds") -> Union[Schedule, CyclicPlan]:
         """The plan of this planner's ``cell`` (``"rounds"``: the current schedule, checked;
         ``"continuous"``: the cyclic plan), at the current schedule's tick; a snapshot."""
@@ -492,8 +500,14 @@ class ContinuousCoordinator:
     """The Rust run-time coordinator of a continuous cell (the token rule), one control tick
     per call; from :meth:`CyclicPlan.coordinator` or :meth:`Planner.continuous_coordinator`."""
 
-    def tick(self, operator: Union[None, float, str] = None) -> CellTick:
-        """One tick; ``operator``: None, a gradient, ``"fastest"``, ``"slowest"``."""
+    def tick(
+        self,
+        operator: Union[None, float, str, Sequence[Union[None, float, str]]] = None,
+    ) -> CellTick:
+        """One tick; ``operator``: None, a gradient, ``"fastest"``, ``"slowest"``; with
+        :attr:`operators` M > 1 a list of M of them, one per operator."""
+    @property
+    def operators(self) -> int: ...
     def reset(self) -> None: ...
     @property
     def fault(self) -> Optional[Dict[str, Any]]:
@@ -547,6 +561,9 @@ class CellTick:
     def at_gate(self) -> Bool: ...
     @property
     def overlap(self) -> bool: ...
+    @property
+    def operator(self) -> List[Optional[int]]:
+        """Each robot's operator (0-based) when low-confidence, else ``None``."""
     @property
     def fault(self) -> Optional[Dict[str, Any]]: ...
     @property
@@ -654,8 +671,14 @@ class Coordinator:
 
     def __init__(self, schedule: Schedule) -> None:
         """Raises ``ScheduleError`` for a schedule of your own not yet ``validate()``d."""
-    def tick(self, operator: Union[None, float, str] = None) -> Tick:
-        """One tick; ``operator``: None, a gradient, ``"fastest"``, ``"slowest"``."""
+    def tick(
+        self,
+        operator: Union[None, float, str, Sequence[Union[None, float, str]]] = None,
+    ) -> Tick:
+        """One tick; ``operator``: None, a gradient, ``"fastest"``, ``"slowest"``; with
+        :attr:`operators` M > 1 a list of M of them, one per operator."""
+    @property
+    def operators(self) -> int: ...
     def reset(self) -> None: ...
     @property
     def fault(self) -> Optional[Dict[str, Any]]:
@@ -693,6 +716,9 @@ class Tick:
     def running(self) -> Bool: ...
     @property
     def overlap(self) -> bool: ...
+    @property
+    def operator(self) -> List[Optional[int]]:
+        """Each robot's operator (0-based) when low-confidence, else ``None``."""
     @property
     def fault(self) -> Optional[Dict[str, Any]]: ...
     @property

@@ -253,7 +253,7 @@ def test_sanding_cell_under_a_random_operator(sanding) -> None:
     assert (cell.tasks_completed >= 1).all()
 
 
-@pytest.mark.parametrize("bad", [math.nan, -1.0, 0.0, math.inf, "bogus", [1.0]], ids=repr)
+@pytest.mark.parametrize("bad", [math.nan, -1.0, 0.0, math.inf, "bogus", [1.0, 1.0]], ids=repr)
 def test_a_bad_operator_input_is_an_input_error_and_changes_nothing(planner, bad) -> None:
     cell = planner.continuous_coordinator()
     for _ in range(700):

@@ -105,7 +105,8 @@ def test_a_bad_operator_is_an_error_and_changes_nothing(planner: tandem.Planner)
     for bad in (float("nan"), float("inf"), 0.0, -1.0):
         with pytest.raises(tandem.InputError, match="must be finite and > 0"):
             coord.tick(bad)
-    for bad in ("fast", [1.0], object()):
+    # A list is one input per operator (issue 44): two inputs for one operator are refused.
+    for bad in ("fast", [1.0, 1.0], object()):
         with pytest.raises(tandem.InputError):
             coord.tick(bad)
     np.testing.assert_array_equal(coord.clock_s, before)

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::arrays::{out_flags, out_vector, repr_list};
-use crate::coordinator::{fault_dict, operator, pre_alert_dict};
+use crate::coordinator::{fault_dict, operator_list, pre_alert_dict, tick_with};
 use crate::errors::{Result, guard};
 use crate::facade::{ContinuousCoordinator, CyclicPlan, Group, Problem, Tick, Token};
 
@@ -91,20 +91,28 @@ impl PyContinuousCoordinator {
     ///         ``ψ̇̄``), a gradient ``g > 0`` (execution samples per reference sample, e.g.
     ///         the rate component of :meth:`Planner.command`; clamped to
     ///         ``[ψ̇min, ψ̇max]``), ``"fastest"`` (``ψ̇min``) or ``"slowest"`` (``ψ̇max``).
+    ///         With :attr:`operators` ``M > 1`` (issue 44: ``M`` tokens) a list of ``M`` such
+    ///         inputs, input ``o`` for the robot of operator ``o`` (:attr:`CellTick.operator`).
     ///
     /// Returns:
     ///     CellTick: each robot's reference time and completed tasks at the end of the tick,
-    ///     who was low-confidence, who ran, who waits at a gate.
+    ///     who was low-confidence (and under which operator), who ran, who waits at a gate.
     ///
     /// Raises:
     ///     InputError: a gradient that is NaN, infinite or ≤ 0 (the coordinator is then
-    ///         unchanged), or another kind of input.
+    ///         unchanged), or another kind of input; a single input or a list of a length
+    ///         other than ``M`` to a coordinator of ``M`` operators.
     #[pyo3(signature = (operator=None))]
     fn tick(&mut self, operator: Option<&Bound<'_, PyAny>>) -> PyResult<PyCellTick> {
-        let op = self::operator(operator)?;
-        let inner = &mut self.inner;
-        let tick = guard(|| Ok(inner.tick(op)?))?;
+        let tick = tick_with(&mut self.inner, operator)?;
         Ok(PyCellTick { inner: tick })
+    }
+
+    /// The number of operators ``M`` (tokens) this coordinator takes inputs from
+    /// (``params()["sampler"]["operators"]`` of the planner that made it; issue 44).
+    #[getter]
+    fn operators(&self) -> usize {
+        self.inner.operators()
     }
 
     /// Puts every robot back at sample 0 of its first task, the token at its first entry;
@@ -298,6 +306,13 @@ impl PyCellTick {
     #[getter]
     fn running<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
         out_flags(py, self.inner.running.iter().collect())
+    }
+
+    /// Each robot's operator in this tick (issue 44): ``o`` (0-based) for a low-confidence
+    /// robot, the operator whose token it holds; ``None`` for the others.
+    #[getter]
+    fn operator(&self) -> Vec<Option<u8>> {
+        operator_list(&self.inner)
     }
 
     /// Whether each robot waits at the gate of its next group at the end of the tick (the

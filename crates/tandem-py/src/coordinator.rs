@@ -3,7 +3,7 @@
 
 use numpy::PyArray1;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
 use crate::arrays::{PyBool, out_flags, out_vector, repr_list};
 use crate::errors::{Error, Result, guard};
@@ -41,6 +41,49 @@ pub(crate) fn operator(x: Option<&Bound<'_, PyAny>>) -> Result<Operator> {
             format!("gradient {g} must be finite and > 0 (None means no correction)"),
         )
     })
+}
+
+/// The operators' inputs from Python (issue 44): a list or tuple of `M` inputs, input `o`
+/// for operator `o`'s robot, each as [`operator`] takes it; `None` for anything else (one
+/// operator's single input).
+pub(crate) fn operator_inputs(x: Option<&Bound<'_, PyAny>>) -> Result<Option<Vec<Operator>>> {
+    let Some(x) = x else {
+        return Ok(None);
+    };
+    let items: Vec<Bound<'_, PyAny>> = if let Ok(l) = x.cast::<PyList>() {
+        l.iter().collect()
+    } else if let Ok(t) = x.cast::<PyTuple>() {
+        t.iter().collect()
+    } else {
+        return Ok(None);
+    };
+    items
+        .iter()
+        .map(|i| operator(Some(i)))
+        .collect::<Result<Vec<_>>>()
+        .map(Some)
+}
+
+/// One tick of `c` with the input(s) `x`: a single input ([`operator`]) through
+/// `Controller::tick`, a list of one per operator ([`operator_inputs`]) through
+/// `Controller::tick_many` (a count other than the controller's `M` is refused by the
+/// realtime crate, the controller unchanged).
+pub(crate) fn tick_with(
+    c: &mut impl crate::facade::Controller,
+    x: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Tick> {
+    match operator_inputs(x)? {
+        Some(inputs) => Ok(guard(|| Ok(c.tick_many(&inputs)?))?),
+        None => {
+            let op = operator(x)?;
+            Ok(guard(|| Ok(c.tick(op)?))?)
+        }
+    }
+}
+
+/// Each robot's operator in `tick` (issue 44), `None` for a robot not low-confidence.
+pub(crate) fn operator_list(tick: &Tick) -> Vec<Option<u8>> {
+    tick.operator.to_vec()
 }
 
 /// The runtime coordinator of a schedule (§II-B5): advances every robot's schedule clock by
@@ -100,21 +143,30 @@ impl PyCoordinator {
     ///         robot is low-confidence): ``None`` (no correction: its scheduled gradient),
     ///         a gradient ``g > 0`` (execution samples per reference sample, e.g. the rate
     ///         component of :meth:`Planner.command`; clamped to ``[ψ̇min, ψ̇max]``),
-    ///         ``"fastest"`` (``ψ̇min``) or ``"slowest"`` (``ψ̇max``).
+    ///         ``"fastest"`` (``ψ̇min``) or ``"slowest"`` (``ψ̇max``). With
+    ///         :attr:`operators` ``M > 1`` (issue 44) a list of ``M`` such inputs, input ``o``
+    ///         for the robot of operator ``o`` (:attr:`Tick.operator`).
     ///
     /// Returns:
     ///     Tick: each robot's reference time at the end of the tick, who was
-    ///     low-confidence during it, who was running.
+    ///     low-confidence during it (and under which operator), who was running.
     ///
     /// Raises:
     ///     InputError: a gradient that is NaN, infinite or ≤ 0 (the coordinator is then
-    ///         unchanged), or another kind of input.
+    ///         unchanged), or another kind of input; a single input or a list of a length
+    ///         other than ``M`` to a coordinator of ``M`` operators.
     #[pyo3(signature = (operator=None))]
     fn tick(&mut self, operator: Option<&Bound<'_, PyAny>>) -> PyResult<PyTick> {
-        let op = self::operator(operator)?;
-        let inner = &mut self.inner;
-        let tick = guard(|| Ok(inner.tick(op)?))?;
+        let tick = tick_with(&mut self.inner, operator)?;
         Ok(PyTick { inner: tick })
+    }
+
+    /// The number of operators ``M`` this coordinator takes inputs from (1, or the
+    /// sectors of :meth:`Planner.controller` with ``params()["sampler"]["operators"] > 1``;
+    /// issue 44).
+    #[getter]
+    fn operators(&self) -> usize {
+        self.inner.operators()
     }
 
     /// Puts every clock back at the earliest start (to run the same plan again); clears a
@@ -284,6 +336,14 @@ impl PyTick {
     #[getter]
     fn overlap(&self) -> bool {
         self.inner.overlap()
+    }
+
+    /// Each robot's operator in this tick (issue 44): ``o`` (0-based) for a low-confidence
+    /// robot, the operator whose input moved it; ``None`` for the others. With one operator
+    /// every low-confidence robot's is 0.
+    #[getter]
+    fn operator(&self) -> Vec<Option<u8>> {
+        operator_list(&self.inner)
     }
 
     /// The coordinator's latched fault after this tick (see :attr:`Coordinator.fault`), or

@@ -311,6 +311,8 @@ fn classify_confidence(e: &errors::Confidence) -> Kind {
 fn classify_realtime(e: &errors::Realtime) -> Kind {
     match e {
         errors::Realtime::BadOperator { .. } => input_at(None),
+        // One input per operator (issue 44): the wrong count is the caller's input.
+        errors::Realtime::OperatorInputs { .. } => input_at(None),
         // The planner's and the simulator's robot counts are the argument `robots`.
         errors::Realtime::RobotCount { .. } => param("robots"),
         errors::Realtime::BadParam { name, .. } => param(name),

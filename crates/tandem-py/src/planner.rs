@@ -414,6 +414,11 @@ fn hold_spec(holds: &Bound<'_, PyAny>) -> Result<HoldSpec> {
 ///         supervised time plus ``switch_s`` per change of robot, may not exceed it
 ///         (``tandem fit --max-busy``). ``None`` (default) keeps
 ///         ``params["sampler"]["max_busy_share"]`` (1: no cap). Stored in the state file.
+///     operators: the cell's operators ``M``, 1 to 8 (issue 44; ``tandem fit --operators``):
+///         at most ``M`` robots low-confidence at once, each under its own operator — a
+///         continuous cell runs ``M`` tokens, rounds run ``M`` sectors
+///         (:meth:`Planner.sectored_rounds`). ``None`` (default) keeps
+///         ``params["sampler"]["operators"]`` (1). Stored in the state file.
 ///     resample: put demonstrations given as CSV files with an irregular ``t`` column (a
 ///         logger's own jittered clock) on an even grid of their mean period first, as
 ///         ``tandem fit --resample`` does (channels interpolated linearly, quaternions by
@@ -424,10 +429,10 @@ fn hold_spec(holds: &Bound<'_, PyAny>) -> Result<HoldSpec> {
 /// Raises:
 ///     InputError: a bad demonstration (with ``file``/``line`` for files).
 ///     ParamError: a bad parameter or robot count, a malformed hold, a hold outside the task
-///         a rule on an unknown channel or one that holds nowhere, a ``switch_s`` or
-///         ``max_busy_share`` out of range (``name`` names it).
+///         a rule on an unknown channel or one that holds nowhere, a ``switch_s``,
+///         ``max_busy_share`` or ``operators`` out of range (``name`` names it).
 #[pyfunction]
-#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, robots=N_ROBOTS, holds=None, rate_term=None, switch_s=None, max_busy_share=None, resample=false))]
+#[pyo3(signature = (demos, channels=None, params=None, dt_s=None, robots=N_ROBOTS, holds=None, rate_term=None, switch_s=None, max_busy_share=None, resample=false, operators=None))]
 #[expect(
     clippy::too_many_arguments,
     reason = "the keyword arguments of the Python function, each documented above"
@@ -444,10 +449,11 @@ pub(crate) fn fit(
     switch_s: Option<f64>,
     max_busy_share: Option<f64>,
     resample: bool,
+    operators: Option<usize>,
 ) -> PyResult<PyPlanner> {
     let mut params = planner_params(params)?;
     apply_rate_term(&mut params, rate_term.as_deref())?;
-    apply_operator(&mut params, switch_s, max_busy_share)?;
+    apply_operator(&mut params, switch_s, max_busy_share, operators)?;
     if let Some(holds) = holds.filter(|h| !h.is_none()) {
         params.holds = hold_spec(holds)?;
         params.validate().map_err(Error::from)?;
@@ -458,19 +464,24 @@ pub(crate) fn fit(
     Ok(PyPlanner { inner: planner })
 }
 
-/// ``switch_s=`` and ``max_busy_share=`` of :func:`fit`: the operator's switch time and load
-/// cap (`tandem_schedule::SamplerParams::{switch_s, max_busy_share}`, the one source of both),
-/// checked: a `ParamError` naming the one out of range.
+/// ``switch_s=``, ``max_busy_share=`` and ``operators=`` of :func:`fit`: the operator's switch
+/// time and load cap and the cell's operators `M`
+/// (`tandem_schedule::SamplerParams::{switch_s, max_busy_share, operators}`, the one source of
+/// all three), checked: a `ParamError` naming the one out of range.
 fn apply_operator(
     params: &mut PlannerParams,
     switch_s: Option<f64>,
     max_busy_share: Option<f64>,
+    operators: Option<usize>,
 ) -> Result<()> {
     if let Some(d) = switch_s {
         params.sampler.switch_s = d;
     }
     if let Some(u) = max_busy_share {
         params.sampler.max_busy_share = u;
+    }
+    if let Some(m) = operators {
+        params.sampler.operators = m;
     }
     params.sampler.validate()?;
     Ok(())
@@ -900,9 +911,10 @@ impl PyPlanner {
     /// Re-runs the anytime sampler (§II-C) on the current problem, warm-started by the
     /// current schedule, and keeps the result (``T_total`` never increases at the same
     /// tick). Model, observations, confidence and parameters are unchanged, but for the
-    /// operator's ``switch_s`` and ``max_busy_share`` when given (``tandem schedule
-    /// --switch-s/--max-busy --save``): they become the planner's (``params()["sampler"]``,
-    /// stored by :meth:`save`, honoured by every later schedule).
+    /// operator's ``switch_s`` and ``max_busy_share`` and the cell's ``operators`` when given
+    /// (``tandem schedule --switch-s/--max-busy/--operators --save``): they become the
+    /// planner's (``params()["sampler"]``, stored by :meth:`save`, honoured by every later
+    /// schedule).
     ///
     /// Args:
     ///     samples: candidates to sample (default: the parameters').
@@ -915,14 +927,22 @@ impl PyPlanner {
     ///         (default: the planner's, ``params()["sampler"]["switch_s"]``).
     ///     max_busy_share: the operator's load cap ``u_max`` in ``(0, 1]`` from now on
     ///         (default: the planner's).
+    ///     operators: the cell's operators ``M``, 1 to 8, from now on (issue 44; default: the
+    ///         planner's): rounds then run :meth:`sectored_rounds`, a continuous cell ``M``
+    ///         tokens (:meth:`controller`). The schedule itself is the one-operator schedule of
+    ///         all robots (the state file's).
     ///
     /// Returns:
     ///     Schedule: the new current schedule.
     ///
     /// Raises:
-    ///     ParamError: a ``switch_s`` or ``max_busy_share`` out of range (``name`` names it;
-    ///         the planner is unchanged).
-    #[pyo3(signature = (samples=None, seed=None, tick_s=None, switch_s=None, max_busy_share=None))]
+    ///     ParamError: a ``switch_s``, ``max_busy_share`` or ``operators`` out of range
+    ///         (``name`` names it; the planner is unchanged).
+    #[pyo3(signature = (samples=None, seed=None, tick_s=None, switch_s=None, max_busy_share=None, operators=None))]
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "the keyword arguments of the Python method, each documented above"
+    )]
     fn reschedule(
         &mut self,
         py: Python<'_>,
@@ -931,15 +951,24 @@ impl PyPlanner {
         tick_s: Option<f64>,
         switch_s: Option<f64>,
         max_busy_share: Option<f64>,
+        operators: Option<usize>,
     ) -> PyResult<PySchedule> {
         let now = &self.inner.params().sampler;
-        let before = (now.switch_s, now.max_busy_share);
+        let before = (now.switch_s, now.max_busy_share, now.operators);
         if switch_s.is_some() || max_busy_share.is_some() {
             let (d, u) = (
                 switch_s.unwrap_or(before.0),
                 max_busy_share.unwrap_or(before.1),
             );
             self.inner.set_operator(d, u).map_err(Error::from)?;
+        }
+        if let Some(m) = operators
+            && let Err(e) = self.inner.set_operators(m)
+        {
+            self.inner
+                .set_operator(before.0, before.1)
+                .map_err(Error::from)?;
+            return Err(Error::from(e).into());
         }
         let mut sp = self.inner.params().sampler.clone();
         sp.seed = match seed {
@@ -959,6 +988,7 @@ impl PyPlanner {
             self.inner
                 .set_operator(before.0, before.1)
                 .map_err(Error::from)?;
+            self.inner.set_operators(before.2).map_err(Error::from)?;
         }
         done?;
         Ok(self.current_schedule())
@@ -1013,7 +1043,9 @@ impl PyPlanner {
     /// ``"rounds"`` (default) a :class:`Coordinator` of the current schedule, for
     /// ``"continuous"`` a :class:`ContinuousCoordinator` of the cyclic plan; both at the
     /// current schedule's control tick, every robot at its start. A snapshot: it does not
-    /// follow the planner.
+    /// follow the planner. With ``params()["sampler"]["operators"] = M > 1`` (issue 44) the
+    /// rounds coordinator runs :meth:`sectored_rounds` and the continuous one ``M`` tokens;
+    /// either takes a list of ``M`` inputs per tick.
     ///
     /// Raises:
     ///     ParamError: a ``cell`` other than ``"rounds"`` or ``"continuous"``.
@@ -1076,6 +1108,28 @@ impl PyPlanner {
         ))
     }
 
+    /// The round of ``M = params()["sampler"]["operators"]`` operators (issue 44; Rust
+    /// ``Planner::sectored_rounds``, what :meth:`controller` runs in rounds with ``M > 1``):
+    /// the robots in contiguous sectors, each sector a one-operator round of its own schedule
+    /// run by its own operator. A dict ``{"sizes": [int], "sector_of": [int],
+    /// "t_total_s": float, "lower_bound_s": float}``: robots per sector, each robot's sector
+    /// (its operator), the round's ``T_total`` (s, Eq. 13: the slowest sector's) and the bound
+    /// no round of ``M`` operators beats (s, ``max(a_0 + N·ΣL/M + a_m, D_min)``). A snapshot,
+    /// computed now; the planner keeps its one-operator schedule.
+    ///
+    /// Raises:
+    ///     ScheduleError: a current schedule that fails this build's check.
+    fn sectored_rounds<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let inner = &self.inner;
+        let (s, _) = py.detach(|| guard(|| Ok(inner.sectored_rounds()?)))?;
+        let d = PyDict::new(py);
+        d.set_item("sizes", s.sizes.clone())?;
+        d.set_item("sector_of", s.sector_of())?;
+        d.set_item("t_total_s", s.t_total_s)?;
+        d.set_item("lower_bound_s", s.lower_bound_s)?;
+        Ok(d)
+    }
+
     /// The current schedule (a snapshot: it does not change when the planner does).
     #[getter]
     fn schedule(&self) -> PySchedule {
@@ -1105,7 +1159,14 @@ impl PyPlanner {
     /// The parameters as a nested dict.
     #[getter]
     fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        serialize_to_py(py, self.inner.params())
+        let params = serialize_to_py(py, self.inner.params())?;
+        // `sampler.operators` is left out of the serialized parameters when it is 1 (so that
+        // files and reports of one operator stay as they were); Python always shows it.
+        let sampler = params.get_item("sampler")?;
+        if !sampler.contains("operators")? {
+            sampler.set_item("operators", self.inner.params().sampler.operators)?;
+        }
+        Ok(params)
     }
 
     /// Rounds recorded so far (a round is one execution of each robot).
