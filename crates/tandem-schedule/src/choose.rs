@@ -1226,22 +1226,7 @@ mod tests {
     // `pegs`: the peg-in-hole problem the integration tests with hold points share.
     include!("../tests/common/pegs.rs");
 
-    /// `p` after a model update that slowed its low-confidence samples by `factor`.
-    fn slowed(p: &Problem, factor: f64) -> Problem {
-        let mean: Vec<f64> = (0..p.n_ref())
-            .map(|n| p.grad_mean()[n] * if p.conf()[n] { 1.0 } else { factor })
-            .collect();
-        let lo = (0..p.n_ref())
-            .map(|n| p.grad_min()[n].min(mean[n]))
-            .collect();
-        let hi = (0..p.n_ref())
-            .map(|n| p.grad_max()[n].max(mean[n]))
-            .collect();
-        Problem::new(p.conf().to_vec(), mean, lo, hi, p.dt_s())
-            .unwrap()
-            .with_holds(p.holds().to_vec())
-            .unwrap()
-    }
+    use crate::retime::tests::slowed;
 
     /// Issue 38's "schedules get worse as the robots learn", by hand: two robots on the
     /// peg-in-hole problem (20 s at 20 Hz, two low-confidence inserts of 2 s), the sampler's

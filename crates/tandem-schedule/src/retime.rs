@@ -371,7 +371,7 @@ fn spread_dwell(holds: &mut [Hold], old: &[Hold], (a, b): (usize, usize), dwell_
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::choose::repair;
     use crate::{SamplerParams, sample_schedule_n, validate};
@@ -381,7 +381,7 @@ mod tests {
 
     /// `p` after a model update that slowed its low-confidence samples by `factor` (the mean
     /// gradient times `factor`, the bounds widened to keep it inside), same confidence and holds.
-    fn slowed(p: &Problem, factor: f64) -> Problem {
+    pub(crate) fn slowed(p: &Problem, factor: f64) -> Problem {
         let mean: Vec<f64> = (0..p.n_ref())
             .map(|n| p.grad_mean()[n] * if p.conf()[n] { 1.0 } else { factor })
             .collect();
