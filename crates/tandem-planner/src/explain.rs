@@ -6,8 +6,9 @@
 //! * **the demonstrations' variance**: `σ²_D` (Eq. 6) lies above the level at which the
 //!   prior (Eq. 10–11) turns low-confidence ([`tandem_confidence::prior_low_threshold`]) and
 //!   the supervised executions have not yet shown that corrections are rare there. The
-//!   tangent coordinates whose weighted variance `cov_jj / r_j²` adds most to `σ²_D` over
-//!   the region are named; more clean supervised executions, or a wider range `r_j` for
+//!   tangent coordinates whose part of `σ²_D` (a channel's weighted variance
+//!   `cov_jj / r_j²`, the rate's term as the model computes it) adds most over the region
+//!   are named; more clean supervised executions, or a wider range `r_j` for
 //!   those coordinates (if their variation there does not matter), would change it;
 //! * **the corrections recorded**: the operator corrected more of the region's supervised
 //!   time than their false-correction rate explains. The task needs the operator there;
@@ -24,7 +25,8 @@ pub struct ChannelShare {
     /// Tangent coordinate name (`TaskModel::tangent_names`: a channel, `<block>.rx/ry/rz` of a
     /// quaternion block, or `rate`).
     pub name: String,
-    /// Its mean weighted variance `cov_jj / r_j²` over the region (dimensionless).
+    /// Its mean part of `σ²_D` over the region (dimensionless): `cov_jj / r_j²` for a
+    /// channel, the model's rate term (`TaskModel::sigma2_d_rate`) for `rate`.
     pub sigma2: f64,
     /// Its share of the region's mean `σ²_D`, in `[0, 1]`.
     pub share: f64,
@@ -101,6 +103,17 @@ impl Planner {
         let d = names.len();
         let dt = model.dt_s();
         let mut out = Vec::new();
+        // The rate's part of `σ²_D` is not its covariance over `r²` (the relative term
+        // weighs the local pace and is opened over the alignment's resolution): it is
+        // read from the model, which owns the term.
+        let rate_part = model.sigma2_d_rate();
+        let part_at = |cov: &[f64], n: usize, j: usize| {
+            if j + 1 == d {
+                rate_part[n]
+            } else {
+                cov[j * d + j] / (ranges[j] * ranges[j])
+            }
+        };
         for r in low_regions(self.confidence().conf()) {
             let len = r.len() as f64;
             let mut per = vec![0.0; d];
@@ -109,7 +122,7 @@ impl Planner {
             for n in r.clone() {
                 let cov = model.covariance(n);
                 for (j, p) in per.iter_mut().enumerate() {
-                    *p += cov[j * d + j] / (ranges[j] * ranges[j]) / len;
+                    *p += part_at(&cov, n, j) / len;
                 }
                 if model.sigma2_d()[n] > s2_max {
                     s2_max = model.sigma2_d()[n];
@@ -138,7 +151,7 @@ impl Planner {
                 .map(|&j| {
                     // sigma2_d at the worst sample without coordinate j, and j's variance
                     // there: scaling r_j by k divides j's part by k².
-                    let part = cov_max[j * d + j] / (ranges[j] * ranges[j]);
+                    let part = part_at(&cov_max, s2_max_at, j);
                     let rest = s2_max - part;
                     let range_for_prior = match (cause, threshold) {
                         (LowCause::Variance, Some(t)) if rest < t && part > 0.0 => {
@@ -293,6 +306,57 @@ mod tests {
             conf.low_regions().is_empty()
         };
         assert!(run(need) && !run(need - 1), "{need}");
+    }
+
+    /// The coordinates' parts add up to `σ²_D`: a channel's `cov_jj / r_j²` plus the rate's
+    /// term as the model computes it (relative to the pace, opened over the alignment's
+    /// resolution), not the warp gradients' variance over `r²`, which the model never adds.
+    /// Three demonstrations whose middle dwell lasts 10, 14 and 18 samples with a different
+    /// force there, aligned by the fit itself: the listed parts (every coordinate: `x`,
+    /// `force`, `rate`) sum to the region's mean `σ²_D`, and the rate's part is the model's.
+    #[test]
+    fn the_parts_of_a_region_add_up_to_its_sigma2_d() {
+        let names = vec!["x".to_string(), "force".to_string()];
+        let demo = |dwell: usize, force: f64| {
+            let mut v = Vec::new();
+            for i in 0..20 {
+                v.extend([0.5 * f64::from(i) / 20.0, 1.0]);
+            }
+            for _ in 0..dwell {
+                v.extend([0.5, force]);
+            }
+            for i in 0..20 {
+                v.extend([0.5 + 0.5 * f64::from(i) / 20.0, 1.0]);
+            }
+            Demonstration::new(names.clone(), v, 0.01).unwrap()
+        };
+        let demos = [demo(10, 3.0), demo(14, 6.0), demo(18, 9.0)];
+        let model = TaskModel::fit(&demos, &FitParams::default()).unwrap();
+        let params = PlannerParams {
+            sampler: SamplerParams {
+                samples: 20,
+                ..SamplerParams::default()
+            },
+            ..PlannerParams::default()
+        };
+        let p = Planner::from_model(model, params).unwrap();
+        let regions = p.explain_low_confidence().unwrap();
+        assert!(!regions.is_empty());
+        let sigma2_d = p.model().sigma2_d();
+        let rate = p.model().sigma2_d_rate();
+        for r in &regions {
+            let len = r.ref_end - r.ref_start;
+            let mean = |v: &[f64]| v[r.ref_start..r.ref_end].iter().sum::<f64>() / len as f64;
+            let listed: f64 = r.channels.iter().map(|c| c.sigma2).sum();
+            let want = mean(sigma2_d);
+            assert!(
+                (listed - want).abs() <= 1e-9 * want,
+                "{listed} against {want}: {r:?}"
+            );
+            if let Some(c) = r.channels.iter().find(|c| c.name == "rate") {
+                assert!((c.sigma2 - mean(&rate)).abs() <= 1e-12 * want.max(1e-300));
+            }
+        }
     }
 
     #[test]
