@@ -243,6 +243,39 @@ def test_a_demonstration_off_its_grid_is_resampled_or_refused_the_same_way(folde
         tandem.fit(arrays, channels=["x", "force"], dt_s=0.01, resample=True)
 
 
+def test_drifting_loggers_go_onto_one_grid_and_the_suggested_period_works(folder: Path) -> None:
+    """Loggers at 97 and 103 Hz beside three at 100 Hz: ``resample=True`` puts every file onto
+    the period most of them share, in one note, as ``tandem fit --resample`` does; a file at
+    twice the period is another rate, refused by both front ends with the period to give, and
+    giving it (``resample=True, dt_s=0.01``, the message's own fix) then fits."""
+    demos = small_demos(folder)
+    params = {"sampler": {"samples": 50}}
+    slow = write(folder, "drift_slow.csv", retimed(60, 0.0103))
+    fast = write(folder, "drift_fast.csv", retimed(60, 0.0097))
+    with pytest.warns(tandem.DataWarning) as caught:
+        planner = tandem.fit([*demos, slow, fast], params=params, resample=True)
+    said = [str(w.message) for w in caught]
+    assert any("the 5 files' logger periods differ by up to 6.0 % (0.009708738 – 0.010309278 s"
+               in m and "every file resampled onto 0.01 s, the period of 3 of them" in m
+               for m in said), said
+    assert planner.model.dt_s == pytest.approx(0.01, rel=1e-12)
+    out = folder / "out.tandem"
+    ok = run_cli(["fit", *demos, slow, fast, "--resample", "--samples", 50, "-o", out])
+    assert ok.returncode == 0, ok.stderr
+    assert "every file resampled onto 0.01 s, the period of 3 of them" in ok.stderr
+    double = write(folder, "double.csv", retimed(60, 0.02))
+    cli_msg = cli_error(["fit", *demos, double, "--resample", "--samples", 50, "-o",
+                         folder / "other.tandem"])
+    py_msg = py_error(lambda: tandem.fit([*demos, double], params=params, resample=True),
+                      tandem.InputError)
+    assert_same(cli_msg, py_msg)
+    assert "resample=True, dt_s=0.01" in py_msg
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", tandem.DataWarning)
+        fitted = tandem.fit([*demos, double], params=params, resample=True, dt_s=0.01)
+    assert fitted.model.dt_s == pytest.approx(0.01, rel=1e-12)
+
+
 def test_a_period_that_contradicts_the_file(folder: Path) -> None:
     demos = small_demos(folder)
     cli_msg = cli_error(["fit", *demos, "--dt", 0.02, "-o", folder / "out.tandem"])

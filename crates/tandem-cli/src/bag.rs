@@ -49,6 +49,18 @@ pub(crate) fn read_demos(
     };
     let mut recordings: Vec<Recording> = Vec::new();
     let mut demos = Vec::with_capacity(paths.len());
+    // `--resample` without `--dt`: the CSV logs go onto one grid when their loggers' clocks
+    // merely drift apart (`input::read_demos_resampled`).
+    let logs: Vec<&Path> = paths
+        .iter()
+        .filter(|p| !(is_bag(p) || p.is_dir()))
+        .map(PathBuf::as_path)
+        .collect();
+    let mut resampled = if resample && dt_s.is_none() {
+        input::read_demos_resampled(&logs)?.into_iter()
+    } else {
+        Vec::new().into_iter()
+    };
     for p in paths {
         // A folder is a rosbag2 recording: its one .mcap file is read (or the folder is
         // refused with what it holds and the fix).
@@ -56,6 +68,8 @@ pub(crate) fn read_demos(
             let rec = read_bag(bag_file(p)?, &options)?;
             demos.push(rec.demonstration()?);
             recordings.push(rec);
+        } else if let Some(demo) = resampled.next() {
+            demos.push(demo);
         } else {
             demos.push(if resample {
                 input::read_demo_resampled(p, dt_s)?

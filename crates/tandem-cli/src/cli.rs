@@ -374,7 +374,8 @@ pub(crate) struct FitArgs {
     pub(crate) dt: Option<f64>,
     /// Resample CSV demonstrations with an irregular `t` column (dropped samples, a drifting
     /// logger) onto an even grid: period --dt, or each file's logger period (the span over
-    /// its steps, each counted in median steps); channels are
+    /// its steps, each counted in median steps), every file onto the period most of them
+    /// share when the loggers' periods differ by at most 10 % (drifting clocks); channels are
     /// interpolated linearly, quaternions (`qx, qy, qz, qw`) by slerp, 0/1 channels held (the
     /// one resampling policy, as for executions and bags); a gap over 3 periods is refused.
     /// Without it,

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, anyhow, bail};
 use tandem::PlannerParams;
-use tandem::lfd::{CsvTable, Demonstration};
+use tandem::lfd::{CsvTable, Demonstration, drifting_majority};
 use tandem::sim::needs::NeedProfile;
 
 /// Reads a demonstration or execution: JSON when the extension is `.json`, CSV otherwise.
@@ -31,6 +31,14 @@ pub(crate) fn read_demo(path: &Path, dt_s: Option<f64>) -> Result<Demonstration>
 /// median step), printing what was done as a note. JSON files have no time column to
 /// resample and are refused.
 pub(crate) fn read_demo_resampled(path: &Path, dt_s: Option<f64>) -> Result<Demonstration> {
+    refuse_json(path)?;
+    let (demo, what) = Demonstration::from_csv_path_resampled(path, dt_s)?;
+    crate::cmd::note(&what);
+    Ok(demo)
+}
+
+/// `--resample` of a JSON demonstration, refused: it has no time column to resample.
+fn refuse_json(path: &Path) -> Result<()> {
     if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"))
@@ -41,9 +49,55 @@ pub(crate) fn read_demo_resampled(path: &Path, dt_s: Option<f64>) -> Result<Demo
             path.display()
         );
     }
-    let (demo, what) = Demonstration::from_csv_path_resampled(path, dt_s)?;
-    crate::cmd::note(&what);
-    Ok(demo)
+    Ok(())
+}
+
+/// Reads `--resample`d CSV demonstrations without `--dt` (`tandem fit --resample`): each onto
+/// its logger's period, unless the periods differ only as drifting clocks do
+/// (`tandem_lfd::drifting_majority`), in which case every file goes onto the period most of them share,
+/// said once in a note. Notes as [`read_demo_resampled`].
+pub(crate) fn read_demos_resampled(paths: &[&Path]) -> Result<Vec<Demonstration>> {
+    let mut read = Vec::with_capacity(paths.len());
+    for &path in paths {
+        refuse_json(path)?;
+        read.push(Demonstration::from_csv_path_resampled(path, None)?);
+    }
+    let periods: Vec<f64> = read.iter().map(|(d, _)| d.dt_s()).collect();
+    if let Some((dt, count)) = drifting_majority(&periods) {
+        for (slot, &path) in read.iter_mut().zip(paths) {
+            if !agree_exactly(slot.0.dt_s(), dt) {
+                *slot = Demonstration::from_csv_path_resampled(path, Some(dt))?;
+            }
+        }
+        let nano = |p: f64| (p * 1e9).round() / 1e9;
+        let (lo, hi) = periods
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(lo, hi), &p| {
+                (lo.min(p), hi.max(p))
+            });
+        crate::cmd::note(&format!(
+            "the {} files' logger periods differ by up to {:.1} % ({} – {} s, clocks that \
+             drift): every file resampled onto {} s, the period of {count} of them (`--dt` \
+             for another grid)",
+            paths.len(),
+            100.0 * (hi - lo) / dt,
+            nano(lo),
+            nano(hi),
+            nano(dt),
+        ));
+    }
+    Ok(read
+        .into_iter()
+        .map(|(demo, what)| {
+            crate::cmd::note(&what);
+            demo
+        })
+        .collect())
+}
+
+/// Two periods equal up to float noise.
+fn agree_exactly(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-12 * b
 }
 
 /// Reads an execution CSV with an irregular `t` column onto the even grid of its logger's

@@ -332,6 +332,52 @@ fn malformed_demonstrations() {
         &[&s(&gap), "a gap of 0.06 s", "record the task again"],
         None,
     );
+    // Loggers whose clocks drift (97 and 103 Hz against 100 Hz; the periods snap to whole
+    // rates): --resample puts every
+    // file onto the period most of them share, in one note; a file at twice the period is
+    // another rate, not drift, and stays the fit's error naming it and --dt.
+    let at = |name: &str, period: f64| {
+        let text: String = small_demo(60, 3.0)
+            .lines()
+            .enumerate()
+            .map(|(k, l)| match k {
+                0 => format!("{l}\n"),
+                _ => {
+                    let (_, rest) = l.split_once(',').expect("t,x,force rows");
+                    format!("{:.6},{rest}\n", (k - 1) as f64 * period)
+                }
+            })
+            .collect();
+        write(&dir, name, &text)
+    };
+    let fast = at("drift_fast.csv", 0.0097);
+    let slow = at("drift_slow.csv", 0.0103);
+    let mut args = fit_with(&dir, &fast, false);
+    args.insert(4, s(&slow));
+    args.push("--resample".into());
+    let out = tandem(args.clone());
+    ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(
+            "the 5 files' logger periods differ by up to 6.0 % (0.009708738 – 0.010309278 s"
+        ) && stderr.contains("every file resampled onto 0.01 s, the period of 3 of them")
+            && stderr.contains(&format!("note: {}: resampled 60 rows", s(&fast))),
+        "{stderr}"
+    );
+    std::fs::remove_file(dir.join("out.tandem")).expect("remove output");
+    let double = at("double.csv", 0.02);
+    let mut args = fit_with(&dir, &double, false);
+    args.push("--resample".into());
+    expect_user_error(
+        &args,
+        &[
+            &s(&double),
+            "sample period 0.02 s differs from 0.01 s",
+            "--resample --dt 0.01",
+        ],
+        None,
+    );
     // --dt contradicting a file's `t` column is refused, naming the file and both periods.
     let mut args = fit_with(&dir, &jitter, false);
     args.extend(["--dt".into(), "0.02".into()]);

@@ -902,6 +902,32 @@ fn repeated_row(file: &str, line: usize, previous: usize, column: usize) -> Erro
     }
 }
 
+/// How far (relative) the loggers' periods of resampled files may lie from the period most
+/// of them share for every file to be put onto that one grid without a period given
+/// (`tandem fit --resample` without `--dt`, Python `fit(resample=True)` without `dt_s`):
+/// clocks that drift (a few per cent at most), not files logged at other rates or in other
+/// units, which stay the fit's error naming the odd file and the period to give
+/// (docs/decisions.md, "Resampling puts drifting loggers onto one grid").
+pub const DRIFT_TOLERANCE: f64 = 0.10;
+
+/// The period (s) most of `periods` (s, one per file) share (each within [`DT_TOLERANCE`]
+/// of it; ties: the earlier file) and how many share it, when they do not all share it but every one lies within
+/// [`DRIFT_TOLERANCE`] of it; `None` otherwise (all agree, or one is another rate).
+#[must_use]
+pub fn drifting_majority(periods: &[f64]) -> Option<(f64, usize)> {
+    let agree = |a: f64, b: f64| (a - b).abs() <= DT_TOLERANCE * b;
+    let shared = |p: f64| periods.iter().filter(|&&o| agree(o, p)).count();
+    let (best, count) = periods
+        .iter()
+        .map(|&p| (p, shared(p)))
+        .reduce(|a, b| if b.1 > a.1 { b } else { a })?;
+    let drifting = count < periods.len()
+        && periods
+            .iter()
+            .all(|&p| p.is_finite() && (p - best).abs() <= DRIFT_TOLERANCE * best);
+    drifting.then_some((best, count))
+}
+
 /// The period (s) of a logger whose stamps `times` (s, strictly increasing) may jitter and
 /// miss samples: the span `t_last − t_0` over the number of periods it holds, each step
 /// counted as its whole number of median steps (at least one, so a dropped sample counts
@@ -1198,6 +1224,28 @@ impl ChannelSchema {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn drifting_loggers_share_the_majoritys_period() {
+        // Agreeing within 1 %: nothing to do.
+        assert_eq!(drifting_majority(&[0.01, 0.01005, 0.00996]), None);
+        // 7 loggers around 125 Hz (±2 %): 0.007874 s is within 1 % of itself, 0.00787,
+        // 0.00790 and 0.00785 (4 files); 0.00787 and 0.00785 share as many and come later.
+        let p = [
+            0.00800, 0.007874, 0.00787, 0.00790, 0.00808, 0.00809, 0.00785,
+        ];
+        let (dt, count) = drifting_majority(&p).unwrap();
+        assert_eq!(count, 4);
+        assert_eq!(dt, 0.007874);
+        // One file at another rate (twice the period) or in other units: not drift.
+        assert_eq!(drifting_majority(&[0.01, 0.01, 0.02]), None);
+        assert_eq!(drifting_majority(&[0.01, 0.0101, 10.0]), None);
+        assert_eq!(drifting_majority(&[0.01, 0.0105, f64::NAN]), None);
+        // Within 10 % is drift; beyond it is not.
+        assert_eq!(drifting_majority(&[0.01, 0.01, 0.0109]), Some((0.01, 2)));
+        assert_eq!(drifting_majority(&[0.01, 0.01, 0.0111]), None);
+        assert_eq!(drifting_majority(&[]), None);
+    }
 
     #[test]
     fn csv_with_time_column_sets_dt() {

@@ -90,9 +90,9 @@ pub use checks::{
 };
 pub use csv::{CsvRow, CsvTable};
 pub use demo::{
-    ChannelKind, ChannelSchema, DEFAULT_DT_S, DT_TOLERANCE, Demonstration, JITTER_NOTE,
-    JITTER_TOLERANCE, MAX_ABS_VALUE, MAX_RESAMPLE_GAP, PeriodSource, QuaternionBlock, Regridded,
-    logger_period, period_from_times,
+    ChannelKind, ChannelSchema, DEFAULT_DT_S, DRIFT_TOLERANCE, DT_TOLERANCE, Demonstration,
+    JITTER_NOTE, JITTER_TOLERANCE, MAX_ABS_VALUE, MAX_RESAMPLE_GAP, PeriodSource, QuaternionBlock,
+    Regridded, drifting_majority, logger_period, period_from_times,
 };
 pub use error::{Error, Result};
 pub use model::{

@@ -5,7 +5,7 @@ pub(crate) use tandem::confidence::{
 };
 pub(crate) use tandem::lfd::{
     DEFAULT_DT_S, DT_TOLERANCE, Demonstration, Execution, HoldRule, HoldSpec, PeriodSource,
-    RateTerm, Regridded, TaskModel, length_warnings,
+    RateTerm, Regridded, TaskModel, drifting_majority, length_warnings,
 };
 pub(crate) use tandem::planner::state::{DEFAULT_LOCK_TIMEOUT, StateLock};
 pub(crate) use tandem::planner::{

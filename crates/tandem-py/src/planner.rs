@@ -14,8 +14,9 @@ use crate::errors::{Error, Result, deprecated, guard, warn};
 use crate::facade::{
     AnyController, BetaParams, Cell, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, DT_TOLERANCE,
     Demonstration, Execution, ExecutionRecord, HoldRule, HoldSpec, Observations, PeriodSource,
-    Plan, Planner, PlannerParams, RateTerm, RecordReport, Regridded, StateLock, TaskModel, errors,
-    length_warnings, posterior, prior, prior_low_threshold, prob_need_below_mu_c, reschedule_seed,
+    Plan, Planner, PlannerParams, RateTerm, RecordReport, Regridded, StateLock, TaskModel,
+    drifting_majority, errors, length_warnings, posterior, prior, prior_low_threshold,
+    prob_need_below_mu_c, reschedule_seed,
 };
 use crate::facade::{BagOptions, Recording, extend_bag_schema, is_bag, read_bag};
 use crate::params::{from_py, serialize_to_py};
@@ -118,14 +119,16 @@ fn demonstration(
     Ok(demo.with_source(label))
 }
 
-/// An execution CSV with its own times put on the even grid of its logger's period
-/// (`record_round(resample=True)`, `Demonstration::regrid_csv_str`), keeping how its rows map
-/// onto the grid for the log and flags given beside it. Arrays (no times), JSON and bags
-/// are refused; `channels.file`, when given, must match the header.
+/// A CSV with its own times put on an even grid (`record_round(resample=True)`,
+/// `fit(resample=True)`; `Demonstration::regrid_csv_str`): the period `dt_s`, or its logger's
+/// period, keeping how its rows map onto the grid for the log and flags given beside it.
+/// Arrays (no times), JSON and bags are refused; `channels.file`, when given, must match the
+/// header.
 fn regridded_execution(
     x: &Bound<'_, PyAny>,
     label: &str,
     channels: Channels<'_>,
+    dt_s: Option<f64>,
 ) -> Result<Regridded> {
     let is_path = x.is_instance_of::<PyString>() || x.hasattr("__fspath__").unwrap_or(false);
     if !is_path {
@@ -152,7 +155,7 @@ fn regridded_execution(
             file: Some(path.display().to_string()),
         });
     }
-    let grid = Demonstration::regrid_csv_path(&path, None)?;
+    let grid = Demonstration::regrid_csv_path(&path, dt_s)?;
     if let Some(names) = channels.file
         && names != grid.demonstration.channel_names()
     {
@@ -227,7 +230,7 @@ pub(crate) fn demonstrations(
                 assumed.push(label.clone());
             }
             let demo = if resample {
-                let grid = regridded_execution(d, &label, both)?;
+                let grid = regridded_execution(d, &label, both, dt_s)?;
                 resampled.push(grid.note.clone());
                 grid.demonstration
             } else {
@@ -252,6 +255,44 @@ pub(crate) fn demonstrations(
             Ok(demo)
         })
         .collect::<Result<Vec<_>>>()?;
+    // resample=True without dt_s: loggers whose clocks merely drift apart go onto the period
+    // most of them share, said once (as `tandem fit --resample` without `--dt`).
+    let mut out = out;
+    if resample && dt_s.is_none() {
+        let periods: Vec<f64> = out.iter().map(Demonstration::dt_s).collect();
+        if let Some((dt, count)) = drifting_majority(&periods) {
+            for (k, d) in list.iter().enumerate() {
+                if (out[k].dt_s() - dt).abs() > 1e-12 * dt {
+                    let both = Channels {
+                        array: channels,
+                        file: channels,
+                    };
+                    let grid = regridded_execution(d, &format!("demos[{k}]"), both, Some(dt))?;
+                    resampled[k] = grid.note;
+                    out[k] = grid.demonstration;
+                }
+            }
+            let nano = |p: f64| (p * 1e9).round() / 1e9;
+            let (lo, hi) = periods
+                .iter()
+                .fold((f64::INFINITY, 0.0_f64), |(lo, hi), &p| {
+                    (lo.min(p), hi.max(p))
+                });
+            resampled.insert(
+                0,
+                format!(
+                    "the {} files' logger periods differ by up to {:.1} % ({} – {} s, clocks \
+                     that drift): every file resampled onto {} s, the period of {count} of \
+                     them (dt_s for another grid)",
+                    out.len(),
+                    100.0 * (hi - lo) / dt,
+                    nano(lo),
+                    nano(hi),
+                    nano(dt)
+                ),
+            );
+        }
+    }
     extend_bag_schema(&mut params.fit.schema, &recordings);
     params.validate()?;
     Ok(Loaded {
@@ -560,7 +601,7 @@ pub(crate) fn execution_record(
 ) -> PyResult<ExecutionRecord> {
     if resample {
         let label = format!("executions[{i}]");
-        let grid = regridded_execution(exec, &label, names)?;
+        let grid = regridded_execution(exec, &label, names, None)?;
         warn(
             py,
             &format!(
