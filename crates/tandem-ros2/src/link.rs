@@ -186,7 +186,10 @@ impl CommandRing {
             }
         }
         let (head, robots) = self.record(t);
-        if cmd.ref_time.len() != self.n || cmd.speed.len() != self.n {
+        if cmd.ref_time.len() != self.n
+            || cmd.speed.len() != self.n
+            || cmd.needs_operator.len() != self.n
+        {
             // A command of another robot count: once, on the first pop into it.
             *cmd = Command::idle(self.n);
         }
