@@ -1,24 +1,34 @@
 //! The tick's own cost with the node's queues attached against without, in the same run
-//! (issue 43: at most 1.1×): `bare` ticks a three-robot rounds controller of the test task;
-//! `loop_only` is the node's loop without the links, what a user's own live loop on `CellLoop`
-//! runs: the clock read, the three robots heard (`CellLoop::heard`) and `CellLoop::advance`;
-//! `with_queues` is the node's tick thread on the same controller without the network
-//! (`link::TickEnd::tick`, which `Ticker::run` of node.rs runs): the clock read, the
-//! pending-message counter (nothing queued), the robots' progress counters (each robot reported
-//! since the last tick), the loop's tick (`CellLoop::advance`'s: liveness, the round's log, the
-//! controller's tick), the command's words written from the loop into the ring (no `Command`
-//! built) and the state slot's `want` flag, answered with a snapshot every 10th
-//! tick (the 100 Hz state topics at a 1 kHz tick; `with_queues_state_every_tick`: every tick,
-//! the 10 ms tick's case). The queues' cost is `with_queues` − `loop_only`.
-//! The DDS side's ends (three progress reports, the command popped, the snapshot taken) run
-//! in the same loop here and are counted. `advance_only` is `CellLoop::advance` alone (a fixed
-//! instant, no links): the loop's own share of the difference. `tick_thread_only` is
-//! `with_queues` with the DDS side's ends run between timed batches of 64 ticks (in the node they
-//! run on the DDS thread): the tick thread's own share. `node_threads` is the node's pair of
-//! threads: the tick thread's work as in `with_queues` plus the wake of the DDS side
-//! (`Thread::unpark`), which runs on a thread of its own that parks when idle, drains the ring
-//! and hears the three robots after each wake, as the node's DDS thread does; the time is the
-//! tick thread's. Run with `cargo bench -p tandem-ros2 --bench tick`.
+//! (issue 43: at most 1.1×), on a three-robot rounds controller of the test task:
+//! - `bare`: the controller's tick alone; `bare_clocked`: the same plus one clock read.
+//! - `loop_only`: the node's loop without the links, what a user's own live loop on `CellLoop`
+//!   runs: the clock read, the three robots heard (`CellLoop::heard`) and `CellLoop::advance`.
+//!   `loop_paced`: the same plus the clock read a live loop paces its sleep by.
+//! - `tick_thread_only`: **the issue's "with the queues attached"**, the node's tick thread's
+//!   own work per tick as `Ticker::run` of node.rs does it but the sleep: the clock read,
+//!   `link::TickEnd::tick` (the pending-message counter, the robots' progress counters, the
+//!   loop's tick, the command's words into the ring, the state slot asked every 10th tick), the
+//!   DDS side's wake (an awake thread's `unpark`), the pacing clock read and
+//!   `TickEnd::account`. The DDS side's ends run between timed batches, but for its three
+//!   progress counts a tick (a load and a store each), so the robots are heard every tick as
+//!   in `loop_only`. The issue's pair is `tick_thread_only` against `loop_paced` (both with
+//!   the pacing read), and against `loop_only` (the node's pacing read counted against it).
+//! - `with_queues`: `TickEnd::tick` and the DDS side's ends (three progress reports, the
+//!   command popped, the snapshot taken) in one loop, without the wake, the pacing read and
+//!   the counters: an upper bound of the queues' cost on one core, not the tick thread's
+//!   (the DDS side's ends run on another thread in the node).
+//!   `with_queues_state_every_tick`: the snapshot every tick (the 10 ms tick's case);
+//!   `with_queues_and_console`: plus the console's feed.
+//! - `advance_only`: `CellLoop::advance` alone (a fixed instant, no links); `links_only`: the
+//!   links' both ends on a fixed command.
+//! - `node_threads`: the node's pair of threads: the tick thread's work as in `with_queues`
+//!   plus the wake of the DDS side (`Thread::unpark`), which runs on a thread of its own that
+//!   parks when idle, drains the ring and hears the three robots after each wake, as the
+//!   node's DDS thread does; the time is the tick thread's (a wake of a parked thread is a
+//!   futex system call). `node_threads_spinning`: the same with a DDS side that spins instead
+//!   of parking: the tick thread against a consumer on the other core, no futex wake.
+//!
+//! Run with `cargo bench -p tandem-ros2 --bench tick`.
 #![expect(
     missing_docs,
     reason = "criterion_group! generates an undocumented pub fn"
@@ -34,7 +44,7 @@ use tandem_console::{Console, ConsoleConfig, Geometry};
 use tandem_planner::{Cell, Planner};
 use tandem_realtime::{Controller, Operator};
 use tandem_ros2::link::{Links, TickEnd};
-use tandem_ros2::{CellLoop, ConsoleFeed, Inbound, LoopParams, Request};
+use tandem_ros2::{CellLoop, Command, ConsoleFeed, Inbound, LoopParams, Request};
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -46,6 +56,8 @@ struct NodeTick {
     end: TickEnd,
     ask_every: u64,
     i: u64,
+    /// The DDS side's command buffer (`CommandRing::pop_into`).
+    popped: Command,
 }
 
 fn start(l: &mut CellLoop) {
@@ -70,6 +82,7 @@ impl NodeTick {
             end: TickEnd::new(3),
             ask_every,
             i: 0,
+            popped: Command::idle(3),
         }
     }
 
@@ -87,7 +100,11 @@ impl NodeTick {
         let now = self.tick_thread(console);
         // The DDS side takes the command and the snapshot.
         black_box(now);
-        let c = self.links.commands.pop().map(|(c, at)| (c.ref_time[0], at));
+        let c = self
+            .links
+            .commands
+            .pop_into(&mut self.popped)
+            .map(|at| (self.popped.ref_time[0], at));
         let s = if self.i.is_multiple_of(self.ask_every) {
             self.links.state.take().map(|s| s.ref_time[1])
         } else {
@@ -126,7 +143,10 @@ struct Threads {
 }
 
 impl Threads {
-    fn new(planner: &Planner) -> Threads {
+    /// `spin`: the DDS side never parks (it spins between passes), so the tick thread's wake
+    /// is always of an awake thread and the time counts what the two cores' shared cache lines
+    /// cost the tick thread, without the futex wake of a parked one.
+    fn new(planner: &Planner, spin: bool) -> Threads {
         let mut node = NodeTick::new(planner, 10);
         // The DDS side's thread may be starved for longer than the default 0.25 s on a loaded
         // machine: a latched stall would hold the loop and time a tick that does not tick.
@@ -143,10 +163,11 @@ impl Threads {
         let writer = std::thread::spawn(move || {
             let mut taken = 0_u64;
             let mut asked = Instant::now();
+            let mut popped = Command::idle(3);
             while !st.load(Ordering::Relaxed) {
                 let mut busy = false;
-                while let Some((c, _)) = l.commands.pop() {
-                    black_box(c);
+                while let Some(at) = l.commands.pop_into(&mut popped) {
+                    black_box((at, popped.tick));
                     taken += 1;
                     busy = true;
                 }
@@ -161,6 +182,8 @@ impl Threads {
                     for k in 0..3 {
                         l.heard.hear(k);
                     }
+                } else if spin {
+                    std::hint::spin_loop();
                 } else {
                     std::thread::park_timeout(Duration::from_micros(200));
                 }
@@ -290,44 +313,80 @@ fn bench(c: &mut Criterion) {
             black_box(c.tick)
         });
     });
+    // `loop_only` and the clock read that paces a live loop's sleep (`Ticker::run` reads the
+    // clock after its tick for the sleep and `TickEnd::account`): the baseline of
+    // `tick_thread_only`, which has that read too.
+    let mut node = NodeTick::new(&planner, 10);
+    group.bench_function("loop_paced", |b| {
+        b.iter(|| {
+            let now = Instant::now();
+            for k in 0..3 {
+                node.l.heard(k, now);
+            }
+            let c = node.l.advance(now).expect("a valid operator");
+            if c.finished {
+                start(&mut node.l);
+            }
+            black_box((c.tick, Instant::now()))
+        });
+    });
     let mut node = NodeTick::new(&planner, 10);
     group.bench_function("with_queues", |b| {
         b.iter(|| black_box(node.tick(None)));
     });
-    // The tick thread's share alone: the DDS side's ends between timed batches of 64 ticks (the
-    // ring holds 4,096); the robots are heard once a batch (the tick's store of their instants,
-    // three words, runs once a batch instead of every tick).
+    // The tick thread's own work, as `Ticker::run` does it each tick but the sleep: the clock
+    // read, `TickEnd::tick`, the DDS side's wake (`Thread::unpark` of a thread that is awake,
+    // as the node's DDS thread is while it publishes: one swap; a parked one is
+    // `node_threads`'), the pacing clock read and `TickEnd::account`. The DDS side's ends that
+    // the tick thread never runs (the ring drained, the snapshot taken) run between timed
+    // batches of 64 ticks (the ring holds 4,096); the one DDS-side write left inside the timing
+    // is the three robots' progress counts, one report per robot per tick as `loop_only` hears
+    // them (`Heard::hear`: a load and a store each), so that the tick stores the three robots'
+    // instants every tick as `loop_only` does. Its like-for-like baseline is `loop_paced`.
     let mut node = NodeTick::new(&planner, 10);
+    let writer = std::thread::current();
     group.bench_function("tick_thread_only", |b| {
         b.iter_custom(|iters| {
             let mut spent = Duration::ZERO;
             let mut left = iters;
             while left > 0 {
                 let batch = left.min(64);
-                for k in 0..3 {
-                    node.links.heard.hear(k);
-                }
                 let t0 = Instant::now();
                 for _ in 0..batch {
+                    for k in 0..3 {
+                        node.links.heard.hear(k);
+                    }
                     node.i += 1;
                     if node.i.is_multiple_of(node.ask_every) {
                         node.links.state.ask();
                     }
                     black_box(node.tick_thread(None));
+                    writer.unpark();
+                    node.end.account(&node.links, Instant::now());
                 }
                 spent += t0.elapsed();
-                while let Some(c) = node.links.commands.pop() {
-                    black_box(c);
+                while let Some(c) = node.links.commands.pop_into(&mut node.popped) {
+                    black_box((c, node.popped.tick));
                 }
                 black_box(node.links.state.take());
                 left -= batch;
             }
+            // The thread's unpark token, set by the last batch, is spent here, untimed.
+            std::thread::park_timeout(Duration::ZERO);
             spent
         });
     });
     // The node's two threads, the DDS side woken each tick.
-    let mut threads = Threads::new(&planner);
+    let mut threads = Threads::new(&planner, false);
     group.bench_function("node_threads", |b| {
+        b.iter(|| black_box(threads.tick()));
+    });
+    black_box(threads.finish());
+    // The same with a DDS side that spins instead of parking (it takes a core while it runs):
+    // the tick thread's work against a consumer on another core, the wake always of an awake
+    // thread.
+    let mut threads = Threads::new(&planner, true);
+    group.bench_function("node_threads_spinning", |b| {
         b.iter(|| black_box(threads.tick()));
     });
     black_box(threads.finish());

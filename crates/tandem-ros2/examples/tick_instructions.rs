@@ -17,12 +17,15 @@
 //! - `run_loop`: the node's loop without the links: the clock read, the three robots heard
 //!   (`CellLoop::heard`) and `CellLoop::advance` — what a user's own live loop on `CellLoop`
 //!   runs;
+//! - `run_loop_paced`: the same plus the clock read a live loop paces its sleep by (the
+//!   tick thread's second clock read, below);
 //! - `run_tick_thread`: the node's tick thread as `Ticker::run` runs it (`link::TickEnd::tick`:
 //!   the pending-message counter, the progress counters, the loop's tick (`advance` without
 //!   building its `Command`), the command's words into the ring, the state slot asked every 10th
 //!   tick), plus its per-tick bookkeeping (`TickEnd::account`) and the writer's wake;
 //! - `run_dds_side`: the DDS thread's ends for those ticks (three progress counters, the ring
-//!   drained, the slot asked and taken), for reference: in the node they run on another thread.
+//!   drained into one reused command, the slot asked and taken), for reference: in the node
+//!   they run on another thread.
 //!
 //! Under valgrind the clock read is a system call (no vDSO), whose kernel side is not counted.
 
@@ -32,7 +35,7 @@ use std::time::Instant;
 use tandem_planner::{AnyController, Cell};
 use tandem_realtime::{Controller, Operator};
 use tandem_ros2::link::{Links, TickEnd};
-use tandem_ros2::{CellLoop, Inbound, LoopParams, Request};
+use tandem_ros2::{CellLoop, Command, Inbound, LoopParams, Request};
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -96,6 +99,21 @@ fn run_loop(l: &mut CellLoop, ticks: u64) {
 }
 
 #[inline(never)]
+fn run_loop_paced(l: &mut CellLoop, ticks: u64) {
+    for _ in 0..ticks {
+        let now = Instant::now();
+        for k in 0..3 {
+            l.heard(k, now);
+        }
+        let c = l.advance(now).expect("a valid operator");
+        if c.finished {
+            start(l);
+        }
+        black_box((c.tick, Instant::now()));
+    }
+}
+
+#[inline(never)]
 fn run_tick_thread(
     l: &mut CellLoop,
     end: &mut TickEnd,
@@ -115,15 +133,15 @@ fn run_tick_thread(
 }
 
 #[inline(never)]
-fn run_dds_side(links: &Links, i: u64) {
+fn run_dds_side(links: &Links, popped: &mut Command, i: u64) {
     for k in 0..3 {
         links.heard.hear(k);
     }
     if i.is_multiple_of(10) {
         links.state.ask();
     }
-    while let Some(c) = links.commands.pop() {
-        black_box(c);
+    while let Some(at) = links.commands.pop_into(popped) {
+        black_box((at, popped.tick));
     }
     if i.is_multiple_of(10) {
         black_box(links.state.take());
@@ -143,11 +161,14 @@ fn main() {
     let mut l = cell_loop(ctl(), &planner);
     run_loop(&mut l, ticks);
     let mut l = cell_loop(ctl(), &planner);
+    run_loop_paced(&mut l, ticks);
+    let mut l = cell_loop(ctl(), &planner);
     let links = Links::new(3, 4096);
     let mut end = TickEnd::new(3);
     let writer = std::thread::current();
+    let mut popped = Command::idle(3);
     for i in 1..=ticks {
-        run_dds_side(&links, i);
+        run_dds_side(&links, &mut popped, i);
         run_tick_thread(&mut l, &mut end, &links, &writer, i);
     }
     use std::io::Write as _;

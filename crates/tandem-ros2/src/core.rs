@@ -249,19 +249,43 @@ impl Command {
         ref_time: PerRobot<f64>,
         speed: PerRobot<f64>,
     ) -> Command {
-        let n = ref_time.len();
-        let mut needs_operator = RobotFlags::new(n);
-        for k in 0..n {
-            needs_operator.set(k, flags >> (8 + k) & 1 == 1);
-        }
-        Command {
+        let mut cmd = Command {
             tick,
-            active: flags & 1 == 1,
-            finished: flags >> 1 & 1 == 1,
-            fault: flags >> 2 & 1 == 1,
+            active: false,
+            finished: false,
+            fault: false,
             ref_time,
             speed,
-            needs_operator,
+            needs_operator: RobotFlags::new(ref_time.len()),
+        };
+        cmd.set_flags_word(flags);
+        cmd
+    }
+
+    /// A command of `n` robots (cut to [`MAX_ROBOTS`]) at tick 0: not active, every reference
+    /// time and speed scale 0, no flag set; the buffer that
+    /// [`CommandRing::pop_into`](crate::link::CommandRing::pop_into) overwrites.
+    #[must_use]
+    pub fn idle(n: usize) -> Command {
+        Command {
+            tick: 0,
+            active: false,
+            finished: false,
+            fault: false,
+            ref_time: PerRobot::new(n),
+            speed: PerRobot::new(n),
+            needs_operator: RobotFlags::new(n),
+        }
+    }
+
+    /// Sets the flags from a [`flags_word`](Self::flags_word): `active`, `finished`, `fault`
+    /// and `needs_operator` for the command's robots (its [`RobotFlags`]' length is kept).
+    pub fn set_flags_word(&mut self, flags: u64) {
+        self.active = flags & 1 == 1;
+        self.finished = flags >> 1 & 1 == 1;
+        self.fault = flags >> 2 & 1 == 1;
+        for k in 0..self.needs_operator.len() {
+            self.needs_operator.set(k, flags >> (8 + k) & 1 == 1);
         }
     }
 }
@@ -706,10 +730,25 @@ impl CellLoop {
     /// without building the command: its tick count, its [`Command::flags_word`], each robot's
     /// reference time and speed scale. Valid right after [`tick_at`](Self::tick_at) (a request
     /// handled since changes the reference times to the controller's state).
+    ///
+    /// The flags word is [`flags_word`]'s of [`needs_operator`](Self::needs_operator), built
+    /// from the set flags only (none or one robot low-confidence in most ticks: one test, or
+    /// one bit more, instead of a test per robot).
     #[inline]
     pub(crate) fn command_words(&self) -> (u64, u64, &PerRobot<f64>, &PerRobot<f64>) {
         let fault = self.stall.is_some() || self.last.fault.is_some();
-        let flags = flags_word(self.active, self.finished, fault, &self.needs_operator());
+        let mut flags =
+            u64::from(self.active) | u64::from(self.finished) << 1 | u64::from(fault) << 2;
+        if self.active {
+            let mut low = self.low_now;
+            while let Some(k) = low.first() {
+                if k >= low.len() {
+                    break;
+                }
+                flags |= 1 << (8 + k);
+                low.set(k, false);
+            }
+        }
         (self.ticks, flags, &self.last.ref_time, &self.speed)
     }
 

@@ -38,7 +38,7 @@ use tandem_planner::{Cell, Planner};
 use tandem_realtime::Controller;
 
 use crate::console::ConsoleFeed;
-use crate::core::{CellLoop, Inbound, LoopParams, Reply, Request, RoundLog};
+use crate::core::{CellLoop, Command, Inbound, LoopParams, Reply, Request, RoundLog};
 use crate::error::{Error, Result, dds};
 use crate::link::{Links, TickEnd};
 use crate::msg::{
@@ -744,6 +744,8 @@ impl Io {
         let (rec_tx, rec_rx) = sync_channel::<Recorded>(8);
         let mut last_needs = vec![None; self.n];
         let mut last_fault: Option<String> = None;
+        // The command each pop overwrites (`CommandRing::pop_into`: nothing zeroed per pop).
+        let mut command = Command::idle(self.n);
         let mut next_state = Instant::now();
         let clock = (Instant::now(), SystemTime::now());
         let c = &self.counters;
@@ -770,7 +772,7 @@ impl Io {
             let mut busy = false;
             // 1. The tick thread's commands, every tick's; `needs_operator` on change.
             let links = &*self.links;
-            while let Some((command, at)) = links.commands.pop() {
+            while let Some(at) = links.commands.pop_into(&mut command) {
                 busy = true;
                 // The tick's start: the latency a subscriber measures is the coordinator's.
                 let stamp = wall_s(at, clock);
