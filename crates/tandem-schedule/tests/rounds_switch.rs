@@ -393,3 +393,50 @@ fn three_robots_at_one_second_overlap_with_dwells() {
     );
     assert!(out.t_total_s >= out.lower_bound_s);
 }
+
+/// Issue 41, a last stretch behind a hold-less run (docs/decisions.md, "Three robots at δ ≥ 1 s:
+/// a room-aware order (issue 41)"): `[LC ×10, HC ×40, LC ×10, HC ×80, LC ×10]` at 0.1 s,
+/// gradients 1 in `[0.5, 2]`, one usable hold at sample 30 (the first HC run only), three robots,
+/// `δ = 1` s. One execution lasts at least 3 s of stretches + 2 + 4 s of HC = 9 s; a serial
+/// schedule starts each robot after the previous robot's last stretch and `δ`, so it lasts at
+/// least `3·9 s + 2·1 s = 29 s`. The margin-free optimum's order puts robot 0's last stretch
+/// behind the other robots' stretches inside the hold-less run, which the lead bound's room
+/// rejects and no clearance repairs (a positive cycle): without the room-aware order the
+/// scheduler returns the serial schedule (29.2 s); with it, a held schedule of 26.5 s.
+#[test]
+fn three_robots_with_a_last_stretch_behind_a_hold_less_run() {
+    let lc = || std::iter::repeat_n(false, 10);
+    let conf: Vec<bool> = lc()
+        .chain(std::iter::repeat_n(true, 40))
+        .chain(lc())
+        .chain(std::iter::repeat_n(true, 80))
+        .chain(lc())
+        .collect();
+    let n = conf.len();
+    assert_eq!(n, 150);
+    let problem = Problem::new(conf, vec![1.0; n], vec![0.5; n], vec![2.0; n], 0.1)
+        .unwrap()
+        .with_holds(vec![30])
+        .unwrap();
+    let params = SamplerParams {
+        samples: 200,
+        switch_s: 1.0,
+        ..SamplerParams::default()
+    };
+    let out = sample_schedule_n(&problem, 3, &params, None).unwrap();
+    assert_eq!(out.source, Source::Held, "{:?}", out.source);
+    assert!(out.schedule.has_holds());
+    validate_with_switch(&problem, &out.schedule, 1.0).unwrap();
+    assert!(
+        out.t_total_s < 29.0 - 1e-9,
+        "T_total {} s: not below every serial schedule (29 s)",
+        out.t_total_s
+    );
+    // The δ-bound: 9 s of stretches and 8 switches of 1 s.
+    assert!(
+        (out.lower_bound_s - 17.0).abs() < 1e-9,
+        "{}",
+        out.lower_bound_s
+    );
+    assert!(out.t_total_s >= out.lower_bound_s);
+}

@@ -57,6 +57,8 @@ struct Net<'a> {
     /// The operator edge out of each LC variable, set while its successor in the order is
     /// placed.
     op: Vec<Option<(usize, f64)>>,
+    /// The room arc out of each LC variable ([`search_with_room`]), set with its operator edge.
+    room_op: Vec<Option<(usize, f64)>>,
     x: Vec<f64>,
     /// `(variable, old value)` of every raise, for backtracking.
     trail: Vec<(usize, f64)>,
@@ -91,6 +93,7 @@ impl<'a> Net<'a> {
             m,
             out: vec![Vec::new(); vars],
             op: vec![None; vars],
+            room_op: vec![None; vars],
             x: vec![f64::NEG_INFINITY; vars],
             trail: Vec::new(),
             queue: Vec::new(),
@@ -136,8 +139,8 @@ impl<'a> Net<'a> {
         let mut raises = 0usize;
         while let Some(y) = self.queue.pop() {
             let xy = self.x[y];
-            let op = self.op[y];
-            for &(z, w) in self.out[y].iter().chain(op.iter()) {
+            let (op, room) = (self.op[y], self.room_op[y]);
+            for &(z, w) in self.out[y].iter().chain(op.iter()).chain(room.iter()) {
                 let cand = xy + w;
                 if cand > self.x[z] + self.eps {
                     if z == 0 || Some(z) == closing {
@@ -162,17 +165,42 @@ impl<'a> Net<'a> {
     }
 
     /// Places LC run `k` of robot `r` right after LC variable `prev` (ending `L_prev` after
-    /// its start); `false` if the order becomes infeasible (the caller backtracks either way).
-    fn place(&mut self, prev: Option<(usize, f64)>, r: usize, k: usize) -> bool {
+    /// its start) with the room arc `room` (`(to, w)`: `x[to] ≥ x[prev] + w`, see
+    /// [`search_with_room`]) out of the same LC variable, if any; `false` if the order becomes
+    /// infeasible (the caller backtracks either way).
+    fn place_with(
+        &mut self,
+        prev: Option<(usize, f64)>,
+        r: usize,
+        k: usize,
+        room: Option<(usize, f64)>,
+    ) -> bool {
         let Some((p, l)) = prev else {
             return true;
         };
         let v = self.lc(r, k);
         self.op[p] = Some((v, l));
+        let mut raised = false;
         if self.x[p] + l > self.x[v] + self.eps {
             self.trail.push((v, self.x[v]));
             self.x[v] = self.x[p] + l;
             self.queue.push(v);
+            raised = true;
+        }
+        if let Some((to, w)) = room {
+            self.room_op[p] = Some((to, w));
+            if self.x[p] + w > self.x[to] + self.eps {
+                if to == p {
+                    self.queue.clear();
+                    return false;
+                }
+                self.trail.push((to, self.x[to]));
+                self.x[to] = self.x[p] + w;
+                self.queue.push(to);
+                raised = true;
+            }
+        }
+        if raised {
             return self.propagate(Some(p));
         }
         true
@@ -185,6 +213,7 @@ impl<'a> Net<'a> {
         }
         if let Some((p, _)) = prev {
             self.op[p] = None;
+            self.room_op[p] = None;
         }
     }
 }
@@ -261,6 +290,35 @@ pub(crate) fn search_with_switch(
     max_nodes: usize,
     switch_s: f64,
 ) -> ManyOutcome {
+    search_with_room(chain, n, cap_s, max_nodes, switch_s, &[])
+}
+
+/// [`search_with_switch`] with *room arcs*: when robot `c`'s run `k ≥ 1` is placed right after
+/// another robot's run `j` (a switch) and `guard[k]` is `Some(w_k)`, the network also gets
+/// `x(c, k − 1) ≥ x(j) + L_j + δ + w_k`; with `w_k = e − L_{k−1} − a_k` that is
+/// `x(c, k − 1) + L_{k−1} + a_k ≥ x(j) + L_j + δ + e`: even at its fastest traversal of the HC gap
+/// `k` (`a_k`) from the end of its previous run, `c` could not reach run `k` before `δ + e` after
+/// run `j` ends. `guard` empty (or `switch_s = 0`) is [`search_with_switch`], the same float
+/// operations.
+///
+/// The arcs are a *candidate generator's* constraint, not one of Eq. 20: the orders and times
+/// found satisfy constraints 1–4 with the switch time (every other edge is the plain search's),
+/// but the `T_total` and [`ManyOutcome::lower_bound_s`] bound only the problem with the arcs,
+/// never the margin-free optimum, so the certificate's bound is never taken from it
+/// (docs/decisions.md, "Three robots at δ ≥ 1 s: a room-aware order (issue 41)"). The node
+/// bound is [`search_with_switch`]'s, computed on the raised times (still a lower bound on every
+/// completion's: arcs only raise times). The forward check ([`Search::dead`]) stays valid: a
+/// path of operator edges from the last run to a later predecessor `q` of run `k` weighs at
+/// least `L_last + δ`, so `q`'s room arc into `x(c, k − 1)` is at least as heavy as the last
+/// run's.
+pub(crate) fn search_with_room(
+    chain: &Chain,
+    n: usize,
+    cap_s: f64,
+    max_nodes: usize,
+    switch_s: f64,
+    guard: &[Option<f64>],
+) -> ManyOutcome {
     let Some(mut net) = Net::new(chain, n, switch_s) else {
         // The chain alone is infeasible: no order at all.
         return ManyOutcome {
@@ -281,6 +339,11 @@ pub(crate) fn search_with_switch(
         out_of_budget: false,
         rem_lc: chain.lc_s.iter().sum::<f64>() * n as f64,
         switch_s,
+        guard: if switch_s > 0.0 {
+            guard.to_vec()
+        } else {
+            Vec::new()
+        },
         dive: true,
         open_lb: f64::INFINITY,
     };
@@ -342,6 +405,9 @@ struct Search {
     rem_lc: f64,
     /// The operator's switch time (s, ≥ 0; see [`search_with_switch`]).
     switch_s: f64,
+    /// Per LC run `k`, the room arc's offset `w_k` (s) when a switch into it is guarded (see
+    /// [`search_with_room`]; empty: none).
+    guard: Vec<Option<f64>>,
     /// The dive: urgent robots first, stop at the first leaf, no open nodes kept.
     dive: bool,
     /// The least bound (s) of the nodes left open (`+∞`: none).
@@ -375,12 +441,29 @@ impl Search {
     /// The operator edge for robot `r`'s next run after the last run: its length, plus δ on
     /// a switch.
     fn edge(&self, last: Option<(usize, f64)>, r: usize) -> Option<(usize, f64)> {
-        match last {
-            Some((v, l)) if self.switch_s > 0.0 && Some(r) != self.order.last().copied() => {
-                Some((v, l + self.switch_s))
-            }
-            other => other,
-        }
+        self.edge_serial(last, r, self.order.last().copied())
+    }
+
+    /// The room arc of placing robot `r`'s next run right after the last run (see
+    /// [`search_with_room`]): `None` unless it is a switch into a guarded run `k ≥ 1`.
+    fn room_arc(&self, net: &Net, last: Option<(usize, f64)>, r: usize) -> Option<(usize, f64)> {
+        self.room_arc_serial(net, last, r, self.next[r], self.order.last().copied())
+    }
+
+    /// [`Search::room_arc`] into run `k` of robot `r` when the last placed robot is
+    /// `last_robot` (the serial order's too).
+    fn room_arc_serial(
+        &self,
+        net: &Net,
+        last: Option<(usize, f64)>,
+        r: usize,
+        k: usize,
+        last_robot: Option<usize>,
+    ) -> Option<(usize, f64)> {
+        let (_, l) = last?;
+        let w = (*self.guard.get(k)?)?;
+        (k >= 1 && self.switch_s > 0.0 && Some(r) != last_robot)
+            .then(|| (net.lc(r, k - 1), l + self.switch_s + w))
     }
 
     /// Leaves a node open with bound `lb` (s) (nothing during the dive).
@@ -400,8 +483,9 @@ impl Search {
         let k = self.next[r];
         let mark = net.trail.len();
         let edge = self.edge(last, r);
+        let room = self.room_arc(net, last, r);
         let gave_ups = net.gave_ups;
-        if net.place(edge, r, k) {
+        if net.place_with(edge, r, k, room) {
             let l = net.chain.lc_s[k];
             self.next[r] += 1;
             self.order.push(r);
@@ -455,8 +539,9 @@ impl Search {
             let k = self.next[r];
             let mark = net.trail.len();
             let edge = self.edge(last, r);
+            let room = self.room_arc(net, last, r);
             let gave_ups = net.gave_ups;
-            if net.place(edge, r, k) {
+            if net.place_with(edge, r, k, room) {
                 let l = net.chain.lc_s[k];
                 self.next[r] += 1;
                 self.order.push(r);
@@ -487,8 +572,9 @@ impl Search {
         }
         let mark = net.trail.len();
         let edge = self.edge(last, r);
+        let room = self.room_arc(net, last, r);
         let gave_ups = net.gave_ups;
-        let ok = net.place(edge, r, k);
+        let ok = net.place_with(edge, r, k, room);
         let dead = !ok && net.gave_ups == gave_ups;
         net.undo(mark, edge);
         dead
@@ -562,7 +648,8 @@ impl Search {
             for k in 0..m {
                 self.nodes += 1;
                 let edge = self.edge_serial(last, r, placed.last().copied());
-                if !net.place(edge, r, k) {
+                let room = self.room_arc_serial(net, last, r, k, placed.last().copied());
+                if !net.place_with(edge, r, k, room) {
                     feasible = false;
                     net.undo(net.trail.len(), edge);
                     break 'robots;
@@ -584,6 +671,7 @@ impl Search {
             for k in 0..m {
                 let v = net.lc(r, k);
                 net.op[v] = None;
+                net.room_op[v] = None;
             }
         }
     }
@@ -961,6 +1049,54 @@ mod tests {
             prop_assert!(out.lower_bound_s <= f.t_total_s);
             if out.proven {
                 prop_assert!((out.lower_bound_s - brute).abs() <= 1e-9 * brute);
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Room arcs on every run `k ≥ 1` (issue 41): the order found keeps the chain, the
+        /// switch time and every arc (a switch into run `k` of robot `c` after run `j`:
+        /// `x(c, k − 1) + L_{k−1} + a_k ≥ x(j) + L_j + δ + e`), the serial order being always
+        /// feasible; and, a restriction of the plain problem, it is never shorter than the plain
+        /// optimum with the switch time.
+        #[test]
+        fn search_with_room_keeps_its_arcs(
+            chain in random_chain(),
+            delta in 0.001f64..0.05,
+            extra in 0.0f64..0.05,
+        ) {
+            let m = chain.n_lc();
+            let guard: Vec<Option<f64>> = (0..m)
+                .map(|k| (k >= 1).then(|| extra - chain.lc_s[k - 1] - chain.gap_s[k].0))
+                .collect();
+            for n in [2usize, 3] {
+                let out = search_with_room(&chain, n, f64::INFINITY, 1_000_000, delta, &guard);
+                prop_assert!(out.proven);
+                let f = out.found.expect("the serial order is feasible");
+                check(&chain, &f);
+                let t = &f.times;
+                let mut next = vec![0; n];
+                let mut last: Option<(usize, usize)> = None;
+                for &r in &f.order {
+                    let k = next[r];
+                    next[r] += 1;
+                    if let Some((p, j)) = last.filter(|&(p, _)| p != r) {
+                        let prev_end = t.lc_start_s[p][j] + chain.lc_s[j];
+                        prop_assert!(t.lc_start_s[r][k] >= prev_end + delta - 1e-9);
+                        if k >= 1 {
+                            let arrival = t.lc_start_s[r][k - 1] + chain.lc_s[k - 1] + chain.gap_s[k].0;
+                            prop_assert!(arrival >= prev_end + delta + extra - 1e-9,
+                                "robot {} run {}: arrival {} before {}", r, k, arrival,
+                                prev_end + delta + extra);
+                        }
+                    }
+                    last = Some((r, k));
+                }
+                let plain = search_with_switch(&chain, n, f64::INFINITY, 1_000_000, delta);
+                let plain = plain.found.expect("the serial order is feasible").t_total_s;
+                prop_assert!(f.t_total_s >= plain * (1.0 - 1e-9), "{} < {}", f.t_total_s, plain);
             }
         }
     }

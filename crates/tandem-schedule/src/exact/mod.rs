@@ -705,6 +705,61 @@ fn bound_n_switch(problem: &Problem, n_robots: usize, switch_s: f64) -> MarginFr
     }
 }
 
+/// A room-aware candidate order of `n_robots ≥ 3` robots with the switch time `switch_s`
+/// (s, > 0): [`many::search_with_room`] on the chain with the problem's usable holds, where every
+/// LC run `k ≥ 1` whose HC gap before it has no usable hold (`Chain::gap_hold` is `None`) is
+/// guarded with the extra room `extra_s` (s): a switch into it from run `j` needs the robot's
+/// fastest arrival there (its previous run's end plus the gap's `a_k`) at least `δ + extra_s`
+/// after run `j` ends. Its best order below `cap_s` (s) within `max_nodes` nodes as a schedule
+/// (one speed factor per HC gap, the rest of a gap as a dwell at its hold, as the margin-free
+/// optimum's), with the control tick `tick_s` (s); `None` if it found none. Never a bound.
+///
+/// **Why** (docs/decisions.md, "Three robots at δ ≥ 1 s: a room-aware order (issue 41)"): a
+/// robot whose approach to its stretch has no hold cannot wait there by a dwell and a release
+/// rule; the margin check's lead bound lets a worst-case operator, with a third robot setting the
+/// pace, bring it through that approach as if at its fastest, so the room its switch needs grows
+/// with the wait planned in the approach, and no clearance on the optimum's order provides it
+/// when that approach must also cover other robots' stretches (a positive cycle).
+pub(crate) fn room_aware_many(
+    problem: &Problem,
+    n_robots: usize,
+    switch_s: f64,
+    extra_s: f64,
+    cap_s: f64,
+    max_nodes: usize,
+    tick_s: f64,
+) -> Option<Schedule> {
+    if switch_s <= 0.0 || n_robots < 3 {
+        return None;
+    }
+    let chain = bound_chain(problem, n_robots);
+    let guard: Vec<Option<f64>> = (0..chain.n_lc())
+        .map(|k| {
+            (k >= 1 && chain.gap_hold[k].is_none())
+                .then(|| extra_s - chain.lc_s[k - 1] - chain.gap_s[k].0)
+        })
+        .collect();
+    // Each switch planned one control tick longer than `δ`: a dwell at a hold ends at a tick
+    // start, so a stretch after one may start up to a tick later than the order's times.
+    let out = many::search_with_room(
+        &chain,
+        n_robots,
+        cap_s,
+        max_nodes,
+        switch_s + tick_s,
+        &guard,
+    );
+    let f = out.found?;
+    let gaps: Vec<Vec<f64>> = (0..n_robots).map(|r| f.times.gaps_s(&chain, r)).collect();
+    Some(build::gap_schedule(
+        problem,
+        &chain,
+        &gaps,
+        f.times.start_s[1..].to_vec(),
+        tick_s,
+    ))
+}
+
 /// The certificate's bound for `n_robots ≥ 3` robots, never below the bound of fewer robots:
 /// `B(N) = max(own(N), B(N − 1))` with `own(k)` the `k`-robot search's bound ([`bound_n_switch`]) and
 /// `B(2)` the two-robot margin-free bound ([`bound_switch`]); the schedule, order and counts are
