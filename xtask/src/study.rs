@@ -676,18 +676,15 @@ pub(crate) fn run(args: &StudyArgs) -> anyhow::Result<()> {
     if let Some(path) = &args.cell_file {
         let (file, dir) = crate::study_cell::read_cell_file(path)?;
         if !crate::study_cell::is_single_labels(&file) {
-            if config.cell == Cell::Continuous {
-                bail!(
-                    "--cell continuous with a cell of different tasks is not supported yet: \
-                     run it in rounds (--cell rounds)"
-                );
-            }
             let out = args.out.clone().unwrap_or_else(|| root.join("results"));
             let mut file = file;
             if args.no_holds {
                 for t in &mut file.task {
                     t.holds.clear();
                 }
+            }
+            if config.cell == Cell::Continuous {
+                return crate::study_cell::run_mixed_continuous(config, &file, &dir, &out, &root);
             }
             return crate::study_cell::run_mixed(
                 config,

@@ -5,14 +5,19 @@
 //! (study.json identical); a cell of two or more tasks runs
 //! `tandem::sim::study::run_mixed_study` in rounds and writes `study.json` with, per
 //! iteration, `T_total` against the mixed lower bound and each task's high confidence
-//! against its truth.
+//! against its truth; with `--cell continuous` it runs
+//! `tandem::sim::study::run_mixed_cell_study` (the mixed cyclic plan run and re-planned as
+//! the tasks learn) and writes each trial's plans, completions and steady throughput
+//! against the plan and the mixed operator-limited bound.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, bail};
 use serde::Serialize;
-use tandem::sim::study::{CellFile, CellTruth, MixedStudyResult, StudyConfig, mean_std};
+use tandem::sim::study::{
+    CellFile, CellTruth, MixedCellStudyResult, MixedStudyResult, StudyConfig, mean_std,
+};
 
 use crate::study::{TrialBar, git_revision};
 
@@ -209,6 +214,132 @@ pub(crate) fn run_mixed(
             c.ratios_evaluated,
             c.orders_evaluated
         );
+    }
+    let (overlaps, faults) = result.overlaps_and_faults();
+    println!("overlapping low-confidence ticks: {overlaps}, faults: {faults}");
+    println!(
+        "wrote {} (fit {:.1} s, wall {:.1} s)",
+        path.display(),
+        fit_s,
+        wall.elapsed().as_secs_f64()
+    );
+    if overlaps > 0 || faults > 0 {
+        bail!("two robots were low-confidence in the same tick: the cell is unsafe");
+    }
+    Ok(())
+}
+
+/// What `study.json` holds for a continuous mixed cell.
+#[derive(Serialize)]
+struct MixedCellStudyFile<'a> {
+    git_revision: String,
+    /// "continuous, mixed tasks".
+    cell: &'static str,
+    /// Per task (the cell's order): the share of its reference where its truth never needs
+    /// the operator (%).
+    truth_never_needed_pct: Vec<f64>,
+    config: &'a StudyConfig,
+    result: &'a MixedCellStudyResult,
+}
+
+/// Runs the continuous study of a cell of two or more tasks (or one task with a need file):
+/// `config.executions` tasks per trial (the cell's, every robot's together); writes
+/// `study.json` into `out` and prints, per trial, the steady throughput against the last
+/// plan and the mixed operator-limited bound, and each task's learnt confidence against its
+/// truth.
+pub(crate) fn run_mixed_continuous(
+    mut config: StudyConfig,
+    file: &CellFile,
+    dir: &Path,
+    out: &Path,
+    root: &Path,
+) -> anyhow::Result<()> {
+    let wall = Instant::now();
+    config.robots = file.n_robots();
+    config
+        .validate()
+        .context("study configuration with the cell file's robots")?;
+    let t = Instant::now();
+    let tasks = file
+        .tasks(dir, &config)
+        .context("fitting the cell's tasks")?;
+    let fit_s = t.elapsed().as_secs_f64();
+    let bar = TrialBar::new(&config, "rounds")?;
+    let result = tandem::sim::study::run_mixed_cell_study(&config, &tasks, &|p| bar.step(p))?;
+    bar.finish();
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let study = MixedCellStudyFile {
+        git_revision: git_revision(root),
+        cell: "continuous, mixed tasks",
+        truth_never_needed_pct: tasks
+            .iter()
+            .map(|t| 100.0 * t.truth.never_needed_share())
+            .collect(),
+        config: &config,
+        result: &result,
+    };
+    let path = out.join("study.json");
+    std::fs::write(&path, serde_json::to_string(&study)? + "\n")
+        .with_context(|| format!("writing {}", path.display()))?;
+    let names: Vec<String> = file
+        .task
+        .iter()
+        .map(|t| format!("{} {}", t.robots, t.name))
+        .collect();
+    println!(
+        "mixed continuous cell {}: {} trials × {} tasks, seed {}",
+        names.join(" + "),
+        config.trials,
+        config.executions,
+        config.seed
+    );
+    for trial in &result.trials {
+        let (first, last) = (
+            &trial.iterations[0],
+            &trial.iterations[trial.iterations.len() - 1],
+        );
+        let s = &trial.steady;
+        println!(
+            "  trial {}: {} plans ({} hand-overs), last ratios {:?}, period {:.2} s (bound \
+             {:.2} s), groups per task {:?}; plan {:.1} tasks/h, mixed operator-limited bound \
+             {:.1} tasks/h (plan {:.1} % of it); steady (last {} tasks, {:.0} s, per robot \
+             {:?}): {:.1} tasks/h = {:.1} % of the plan, {:.1} % of the bound, operator busy \
+             {:.1} %; unrecorded at the end {:?}",
+            trial.trial,
+            trial.iterations.len(),
+            trial.stats.hand_overs,
+            last.ratios,
+            last.period_s,
+            last.lower_bound_s,
+            last.groups,
+            last.tasks_per_hour,
+            last.operator_limited_per_hour,
+            100.0 * last.tasks_per_hour / last.operator_limited_per_hour,
+            s.tasks,
+            s.duration_s,
+            s.tasks_per_robot,
+            s.throughput_per_h,
+            100.0 * s.throughput_per_h / last.tasks_per_hour,
+            100.0 * s.throughput_per_h / last.operator_limited_per_hour,
+            100.0 * s.operator_busy_share,
+            trial.unrecorded
+        );
+        println!(
+            "    first plan: ratios {:?}, {:.1} tasks/h against the bound {:.1} tasks/h",
+            first.ratios, first.tasks_per_hour, first.operator_limited_per_hour
+        );
+        for (k, task) in file.task.iter().enumerate() {
+            println!(
+                "    task {}: high confidence {:.1} % → {:.1} % (truth never needs the \
+                 operator on {:.1} %), falsely trusted {} samples at the end, {} rounds recorded",
+                task.name,
+                first.tasks[k].high_conf_pct,
+                last.tasks[k].high_conf_pct,
+                study.truth_never_needed_pct[k],
+                last.tasks[k].falsely_trusted_samples,
+                last.records
+            );
+        }
     }
     let (overlaps, faults) = result.overlaps_and_faults();
     println!("overlapping low-confidence ticks: {overlaps}, faults: {faults}");

@@ -192,8 +192,9 @@ impl CellPlanner {
     /// [`Error::BadCell`] for no task, a bad or repeated name, a robot mapped to no task, a
     /// task without robots or with another robot count than its planner's, more than
     /// `MAX_ROBOTS` robots, and, for two or more tasks, tasks whose operators differ
-    /// (`switch_s`), a load cap below 1 or declared hold points (not supported in mixed
-    /// cells yet); the realtime crate's error when no placement passes the margin check.
+    /// (`switch_s`) or a load cap below 1; the realtime crate's error when no placement
+    /// passes the margin check. Declared hold points are kept per task (used by the
+    /// continuous cell; the rounds placement runs without waiting at them).
     pub fn from_planners(tasks: Vec<(String, Planner)>, robot_task: Vec<usize>) -> Result<Self> {
         if tasks.is_empty() {
             return Err(Error::BadCell {
@@ -249,8 +250,10 @@ impl CellPlanner {
         Ok(cell)
     }
 
-    /// For two or more tasks: one operator (the same `switch_s` in every task), no load cap
-    /// and no hold points (not supported in mixed cells yet).
+    /// For two or more tasks: one operator (the same `switch_s` in every task) and no load
+    /// cap. Each task keeps its declared hold points: the continuous cell waits at its
+    /// usable ones ([`CellPlanner::continuous_plan`]); the rounds placement does not
+    /// ([`CellSchedule`]).
     fn check_mixed(&self) -> Result<()> {
         if self.tasks.len() < 2 {
             return Ok(());
@@ -272,12 +275,6 @@ impl CellPlanner {
                 return Err(bad(
                     "max_busy_share",
                     "a load cap is not supported in a cell of several tasks yet: leave it at 1",
-                ));
-            }
-            if !p.holds.is_empty() {
-                return Err(bad(
-                    "holds",
-                    "hold points are not supported in a cell of several tasks yet: remove them",
                 ));
             }
         }
@@ -1423,5 +1420,104 @@ mod tests {
             }
         }
         assert_eq!(cells, 42);
+    }
+
+    /// A task of `n` samples of one channel `force`, low-confidence on each range of `lc`
+    /// (the demonstrations differ there only), for `robots` robots (as the planner's
+    /// unit-test planner).
+    fn planner_runs(n: usize, lc: &[std::ops::Range<usize>], robots: usize) -> Planner {
+        use tandem_lfd::{FitParams, TaskModel};
+        let names = vec!["force".to_string()];
+        let demo = |bump: f64| {
+            let x = (0..n)
+                .map(|i| {
+                    if lc.iter().any(|r| r.contains(&i)) {
+                        bump
+                    } else {
+                        1.0
+                    }
+                })
+                .collect();
+            Demonstration::new(names.clone(), x, 0.01).unwrap()
+        };
+        let demos = [demo(1.0), demo(5.0), demo(9.0)];
+        let identity: Vec<f64> = (0..n).map(|i| i as f64).collect();
+        let model = TaskModel::fit_aligned(
+            &demos,
+            &[identity.clone(), identity.clone(), identity],
+            &FitParams::default(),
+        )
+        .unwrap();
+        let mut params = PlannerParams::default();
+        params.sampler.samples = 50;
+        params.sampler.seed = 7;
+        Planner::from_model_with_robots(model, params, robots).unwrap()
+    }
+
+    /// Holds in a cell of different tasks (issue 45): each task keeps its own declared hold
+    /// points, they round-trip through the format 12 file (a one-task cell with holds stays
+    /// format 11), the continuous cell cuts each task's low-confidence groups at its usable
+    /// holds (task `a`: two runs 10..20 and 40..50 split by its hold at sample 30, so two
+    /// groups; task `b` without holds, one group), and the rounds placement still passes
+    /// the margin check.
+    #[test]
+    fn each_task_keeps_its_holds_in_a_mixed_cell_and_its_file() {
+        let mut a = planner_runs(60, &[10..20, 40..50], 1);
+        a.set_holds(tandem_lfd::HoldSpec {
+            at_s: vec![0.30],
+            rules: Vec::new(),
+        })
+        .unwrap();
+        assert_eq!(a.problem().usable_holds(), [30]);
+        let b = planner(50, 20..30, 1);
+        let cell =
+            CellPlanner::from_planners(vec![("a".into(), a.clone()), ("b".into(), b)], vec![0, 1])
+                .unwrap();
+        let coordinator = cell.coordinator().unwrap();
+        assert_eq!(coordinator.n_robots(), 2);
+        let plan = cell.continuous_plan().unwrap();
+        let c = cell.continuous_coordinator(&plan).unwrap();
+        assert_eq!(c.groups_of(0).len(), 2, "task a split at its hold");
+        assert_eq!(c.groups_of(1).len(), 1, "task b: one group");
+        // Format 12 keeps each task's declared holds.
+        let dir = scratch("holds");
+        let path = dir.join("cell.tandem");
+        cell.save(&path).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 12);
+        let back = CellPlanner::load(&path).unwrap();
+        assert_eq!(back.tasks()[0].planner().params().holds.at_s, [0.30]);
+        assert!(back.tasks()[1].planner().params().holds.at_s.is_empty());
+        assert_eq!(back.tasks()[0].planner().problem().usable_holds(), [30]);
+        assert_eq!(back.schedule(), cell.schedule());
+        // A one-task cell with holds is its planner's format 11 file, byte for byte.
+        let one = CellPlanner::from_planner("a", a.clone()).unwrap();
+        one.save(dir.join("one.tandem")).unwrap();
+        a.save(dir.join("planner.tandem")).unwrap();
+        let one_bytes = std::fs::read(dir.join("one.tandem")).unwrap();
+        assert_eq!(
+            one_bytes,
+            std::fs::read(dir.join("planner.tandem")).unwrap()
+        );
+        assert_eq!(u32::from_le_bytes(one_bytes[8..12].try_into().unwrap()), 11);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// What a mixed cell still refuses, by name and fix: a load cap, and operators of
+    /// different switch times.
+    #[test]
+    fn a_mixed_cell_refuses_a_load_cap_naming_the_task_and_the_fix() {
+        let mut b = planner(60, 30..45, 1);
+        b.set_operator(0.0, 0.8).unwrap();
+        let err = CellPlanner::from_planners(
+            vec![("a".into(), planner(40, 10..20, 1)), ("b".into(), b)],
+            vec![0, 1],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("max_busy_share of task `b`") && err.contains("leave it at 1"),
+            "{err}"
+        );
     }
 }

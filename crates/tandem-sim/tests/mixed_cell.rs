@@ -10,7 +10,10 @@ use std::path::{Path, PathBuf};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use tandem_planner::CellPlanner;
-use tandem_sim::study::{CellFile, MixedTask, StudyConfig, run_mixed_study, run_mixed_trial};
+use tandem_sim::study::{
+    Cell, CellFile, MixedTask, StudyConfig, StudyOperator, run_mixed_cell_study,
+    run_mixed_cell_trial, run_mixed_study, run_mixed_trial,
+};
 use tandem_sim::workcell::{OperatorParams, run_cell_round, run_round_with};
 
 fn mixed_dir() -> PathBuf {
@@ -116,4 +119,68 @@ fn a_one_task_cell_runs_the_single_task_round() {
     // One operator per task.
     let e = run_cell_round(&cell, needs, &[op.clone(), op], &mut rng).unwrap_err();
     assert!(e.to_string().contains("operators"), "{e}");
+}
+
+/// The continuous cell of different tasks (`cargo xtask study --cell continuous
+/// --cell-file`): 1 sanding + 1 deburring robot, each task with the cell file's holds, until
+/// the cell has completed 10 tasks. Never two robots low-confidence in one tick; a plan per
+/// record, each at least its bound and at most the mixed operator-limited bound; every
+/// completed task is either recorded (one per robot per record, the oldest first) or still
+/// queued; never trusted where the truth can need the operator; deterministic.
+#[test]
+fn the_continuous_mixed_study_learns_each_task_and_never_overlaps() {
+    let file = cell_file("cell_1_1.toml");
+    let config = StudyConfig {
+        cell: Cell::Continuous,
+        trials: 1,
+        ..config(10, 2)
+    };
+    let tasks = tasks(&file, &config);
+    let result = run_mixed_cell_study(&config, &tasks, &|_| {}).unwrap();
+    assert_eq!(result.tasks, ["sanding", "deburring"]);
+    assert_eq!(result.overlaps_and_faults(), (0, 0));
+    let trial = &result.trials[0];
+    assert_eq!(trial.completions.len(), 10);
+    let records = trial.iterations.last().unwrap().records;
+    assert!(records >= 1, "no record in 10 tasks");
+    assert_eq!(trial.iterations.len(), records + 1);
+    assert!(trial.stats.hand_overs <= records as u64);
+    for (k, it) in trial.iterations.iter().enumerate() {
+        assert_eq!(it.records, k);
+        assert!(it.period_s >= it.lower_bound_s - 1e-9, "{it:?}");
+        assert!(
+            it.tasks_per_hour <= it.operator_limited_per_hour + 1e-6,
+            "{it:?}"
+        );
+        assert!(it.tasks_per_hour <= it.best_bound_per_hour + 1e-6, "{it:?}");
+        for t in &it.tasks {
+            assert_eq!(t.falsely_trusted_samples, 0);
+            assert!(t.high_conf_pct <= t.truth_never_needed_pct + 1e-9);
+        }
+    }
+    for robot in 0..2 {
+        let done = trial
+            .completions
+            .iter()
+            .filter(|c| c.robot == robot)
+            .count();
+        assert_eq!(done, records + trial.unrecorded[robot], "robot {robot}");
+    }
+    assert!(trial.completions.windows(2).all(|w| w[0].tick <= w[1].tick));
+    assert_eq!(
+        trial.steady.tasks_per_robot.iter().sum::<usize>(),
+        trial.steady.tasks
+    );
+    let again = run_mixed_cell_trial(&config, &tasks, 0, &|_| {}).unwrap();
+    assert_eq!(&again, trial);
+    // More than one operator is refused by name.
+    let two = StudyConfig {
+        operator: StudyOperator {
+            operators: 2,
+            ..config.operator.clone()
+        },
+        ..config.clone()
+    };
+    let e = run_mixed_cell_trial(&two, &tasks, 0, &|_| {}).unwrap_err();
+    assert!(e.to_string().contains("operator.operators"), "{e}");
 }

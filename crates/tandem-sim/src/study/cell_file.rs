@@ -35,8 +35,9 @@ pub struct CellFileTask {
     pub demos: PathBuf,
     /// How many robots do it (≥ 1).
     pub robots: usize,
-    /// Its hold rules (`CHANNEL<VALUE`, as `[planner.holds] rules`); a cell of two or more
-    /// tasks refuses them (not supported in mixed cells yet). Default: none.
+    /// Its hold rules (`CHANNEL<VALUE`, as `[planner.holds] rules`). In a cell of two or
+    /// more tasks the continuous cell waits at their usable holds; the rounds placement does
+    /// not wait at them. Default: none.
     #[serde(default)]
     pub holds: Vec<String>,
     /// Where its workpieces need the simulated operator.

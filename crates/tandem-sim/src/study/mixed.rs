@@ -144,7 +144,7 @@ impl MixedStudyResult {
 
 /// The simulated operator on each task: the study's rates, corrections that raise the task
 /// truth's [`TaskTruth::correction_channel`].
-fn operators(config: &StudyConfig, tasks: &[MixedTask]) -> Vec<OperatorParams> {
+pub(super) fn operators(config: &StudyConfig, tasks: &[MixedTask]) -> Vec<OperatorParams> {
     tasks
         .iter()
         .map(|t| OperatorParams {
@@ -156,7 +156,11 @@ fn operators(config: &StudyConfig, tasks: &[MixedTask]) -> Vec<OperatorParams> {
 
 /// The cell of a trial: each task's planner on its model (its parameters with the study's
 /// operator, the sampler seeded with `seed`), the robots numbered task by task.
-fn trial_cell(config: &StudyConfig, tasks: &[MixedTask], seed: u64) -> Result<CellPlanner> {
+pub(super) fn trial_cell(
+    config: &StudyConfig,
+    tasks: &[MixedTask],
+    seed: u64,
+) -> Result<CellPlanner> {
     let mut planners = Vec::with_capacity(tasks.len());
     let mut robot_task = Vec::new();
     for (t, task) in tasks.iter().enumerate() {
@@ -197,24 +201,28 @@ fn iteration(cell: &CellPlanner, tasks: &[MixedTask]) -> MixedIteration {
         t_total_s,
         lower_bound_s,
         offsets_s,
-        tasks: cell
-            .tasks()
-            .iter()
-            .zip(tasks)
-            .map(|(c, t)| {
-                let conf = c.planner().confidence();
-                let mix = tandem_schedule::cyclic::MixTask::of(c.planner().problem());
-                MixedTaskState {
-                    fastest_s: mix.fastest_s,
-                    lc_s: mix.lc_s,
-                    high_conf_pct: 100.0 * conf.high_share(),
-                    truth_never_needed_pct: 100.0 * t.truth.never_needed_share(),
-                    falsely_trusted_samples: falsely_trusted_where(conf.conf(), t.truth.can_need()),
-                }
-            })
-            .collect(),
+        tasks: task_states(cell, tasks),
         round: None,
     }
+}
+
+/// Each task's learning in `cell` against its truth (the cell's task order).
+pub(super) fn task_states(cell: &CellPlanner, tasks: &[MixedTask]) -> Vec<MixedTaskState> {
+    cell.tasks()
+        .iter()
+        .zip(tasks)
+        .map(|(c, t)| {
+            let conf = c.planner().confidence();
+            let mix = tandem_schedule::cyclic::MixTask::of(c.planner().problem());
+            MixedTaskState {
+                fastest_s: mix.fastest_s,
+                lc_s: mix.lc_s,
+                high_conf_pct: 100.0 * conf.high_share(),
+                truth_never_needed_pct: 100.0 * t.truth.never_needed_share(),
+                falsely_trusted_samples: falsely_trusted_where(conf.conf(), t.truth.can_need()),
+            }
+        })
+        .collect()
 }
 
 fn round_stats(run: &RoundRun) -> MixedRoundStats {

@@ -11,6 +11,7 @@ mod cell_file;
 mod config;
 mod inputs;
 mod mixed;
+mod mixed_cell;
 mod record;
 mod run;
 mod trial;
@@ -26,6 +27,10 @@ pub use inputs::{StudyInputs, read_labels, reference_labels};
 pub use mixed::{
     MixedIteration, MixedRoundStats, MixedStudyResult, MixedTask, MixedTaskState, MixedTrialResult,
     run_mixed_study, run_mixed_trial,
+};
+pub use mixed_cell::{
+    MixedCellCompletion, MixedCellIteration, MixedCellStudyResult, MixedCellTrialResult,
+    MixedSteady, run_mixed_cell_study, run_mixed_cell_trial,
 };
 pub use record::{
     IterationRecord, IterationSummary, RoundStats, ScheduleSource, StudyResult, TrialResult,

@@ -73,6 +73,7 @@
 mod cell;
 mod live;
 mod mixed;
+mod mixed_cell;
 mod operator;
 mod record;
 mod run;
@@ -82,6 +83,7 @@ mod tests;
 pub use cell::{CellSim, CellStats, FinishedTask};
 pub use live::RoundSim;
 pub use mixed::run_cell_round;
+pub use mixed_cell::{MixedCellSim, mixed_record};
 pub use operator::{OperatorParams, correction_channel, correction_input, needs_correction};
 pub use record::{PlanGap, RobotPlan, RobotRun, RoundRun, TickPhase, plan_gap};
 pub use run::{run_round, run_round_with};
