@@ -950,9 +950,10 @@ impl Planner {
     /// ([`Coordinator::sectored`]): of two candidates the one with the least `T_total` —
     /// the even sectors ([`tandem_schedule::sectored_rounds`], each sector's one-operator
     /// schedule sampled with this planner's parameters and the seed of the current schedule,
-    /// on the problem without holds), and the current `N`-robot schedule run by operator 0
-    /// alone (when it has no holds; the other operators idle), which wins only where one
-    /// operator's round is no longer than the sectors'. Either keeps at most one robot
+    /// on the problem with its hold points, each sector waiting at its holds by its own
+    /// release rules), and the current `N`-robot schedule run by operator 0 alone (with its
+    /// holds; the other operators idle), which wins only where one operator's round is
+    /// shorter than the sectors'. Either keeps at most one robot
     /// low-confidence per operator in every tick. The returned [`tandem_schedule::SectoredRounds`]
     /// is the chosen one (one sector of `N` for the second candidate); its `lower_bound_s`
     /// bounds every round of `M` operators. A snapshot: the planner and its state file keep
@@ -976,7 +977,7 @@ impl Planner {
         let n = self.n_robots();
         let mut sectors = tandem_schedule::sectored_rounds(self.problem(), n, m.get(), &sampler)?;
         let mut robots = sectors.timelines(self.problem())?;
-        if !self.schedule().has_holds() && self.outcome.t_total_s < sectors.t_total_s {
+        if self.outcome.t_total_s < sectors.t_total_s {
             let one = self.checked_schedule()?;
             robots = one.timelines().to_vec();
             sectors = tandem_schedule::SectoredRounds {
@@ -986,7 +987,8 @@ impl Planner {
                 lower_bound_s: sectors.lower_bound_s,
             };
         }
-        let coord = Coordinator::sectored(robots, &sectors.sector_of(), m, &margins)?;
+        let holds = sectors.holds();
+        let coord = Coordinator::sectored(robots, &holds, &sectors.sector_of(), m, &margins)?;
         Ok((sectors, coord))
     }
 
@@ -2051,7 +2053,7 @@ mod tests {
 
     /// The sectored round (issue 44) of (N, M) = (4, 2) and (3, 2) on a small problem: even
     /// sectors ([2, 2], [2, 1]), each sector's schedule of its own size passes the one-operator
-    /// check (Eq. 20 with Alg. 2's margin check) on the problem without holds, the round's
+    /// check (Eq. 20 with Alg. 2's margin check) on the planner's problem, the round's
     /// `T_total` is the slower sector's own `T_total` (Eq. 13 of its schedule), the sectored
     /// coordinator's robots are those schedules' (its latest robot ends at `T_total`), and the
     /// round lies between the fleet bound and one operator's N-robot round.
@@ -2063,7 +2065,7 @@ mod tests {
             p.set_operators(2).unwrap();
             let (s, coord) = p.sectored_rounds().unwrap();
             assert_eq!(s.sizes, sizes, "N = {n}");
-            let free = p.problem().clone().with_holds(Vec::new()).unwrap();
+            let free = p.problem();
             let own: Vec<f64> = s
                 .schedules
                 .iter()
@@ -2071,7 +2073,7 @@ mod tests {
                 .map(|(sch, &k)| {
                     assert_eq!(sch.n_robots(), k);
                     let sp = &p.params().sampler;
-                    sch.check_with_operator(&free, sp.switch_s, sp.max_busy_share)
+                    sch.check_with_operator(free, sp.switch_s, sp.max_busy_share)
                         .unwrap();
                     sch.t_total_s(free.dt_s())
                 })

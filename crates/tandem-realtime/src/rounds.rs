@@ -110,6 +110,9 @@ pub struct Coordinator {
     operators: Option<Arc<OperatorPlan>>,
     /// `M > 1` operators in fixed sectors ([`Coordinator::sectored`]); `None` otherwise.
     sectors: Option<Arc<Sectors>>,
+    /// Per sector (operator index), the clock of its legs not yet started: each sector's own
+    /// `wait_clock_s`, moved by its robots alone. Unused without sectors.
+    sector_wait_s: [f64; MAX_ROBOTS],
 }
 
 /// A rounds cell of `M` operators split into fixed sectors ([`Coordinator::sectored`]): each
@@ -120,6 +123,9 @@ struct Sectors {
     m: usize,
     /// Robot `i`'s operator, `< m`.
     of: [u8; MAX_ROBOTS],
+    /// The hold points as given to [`Coordinator::sectored`] (global robot indices; empty:
+    /// none), kept to check the sectors again at another switch time.
+    holds: Vec<Vec<Hold>>,
 }
 
 impl Coordinator {
@@ -213,6 +219,7 @@ impl Coordinator {
             after_fast_s: after_fast_s.into(),
             operators: None,
             sectors: None,
+            sector_wait_s: [0.0; MAX_ROBOTS],
         };
         c.reset();
         Ok(c)
@@ -268,6 +275,7 @@ impl Coordinator {
             };
             return Coordinator::sectored(
                 self.robots.to_vec(),
+                &sec.holds,
                 &of,
                 OperatorCount::new(sec.m)?,
                 &params,
@@ -326,25 +334,35 @@ impl Coordinator {
     }
 
     /// A round of `M = operators` operators in fixed sectors (issue 44; docs/decisions.md,
-    /// "M operators in rounds: sectors end to end"): robot `i` (of `robots`, global schedule
-    /// clock) belongs to operator `sector_of[i] < M`'s sector, and the robots of each sector
-    /// are one one-operator round run side by side with the others: every rule of the tick
-    /// (the pace of the sector's low-confidence robot, Eq. 18, Alg. 1, the waits before a
-    /// start) is applied within each sector alone, and the sector's low-confidence robot
-    /// follows its own operator's input ([`tick_many`](Coordinator::tick_many)`(&[op_0, …,
-    /// op_{M−1}])`). Each sector's timelines are checked with
-    /// [`check_margins`](crate::check_margins) at `params` (tick, switch time), so in every
-    /// tick at most one robot of each sector is low-confidence under every admissible input:
-    /// at most `M` in all, each sector's stretches with its one operator (never handed over),
-    /// each operator's switch time kept. [`Tick::operator`] reports the sector; the fault
-    /// monitor latches when two robots of one sector are low-confidence.
+    /// "M operators in rounds: sectors end to end" and "M operators in rounds: sectors with
+    /// hold points"): robot `i` (of `robots`, global schedule clock) belongs to operator
+    /// `sector_of[i] < M`'s sector, and the robots of each sector are one one-operator round
+    /// run side by side with the others: every rule of the tick (the pace of the sector's
+    /// low-confidence robot, Eq. 18, Alg. 1, the waits before a start, and with hold points
+    /// the clock of the legs not started, rule 3, and the release rules with their switch-time
+    /// count-down) is applied within each sector alone — one wait clock per sector — and the
+    /// sector's low-confidence robot follows its own operator's input
+    /// ([`tick_many`](Coordinator::tick_many)`(&[op_0, …, op_{M−1}])`). `holds` is empty (no
+    /// holds) or one list per robot (global robot indices, as [`Coordinator::with_holds`]);
+    /// a release rule names a robot of the same sector. Each sector's timelines and holds
+    /// (renumbered within the sector) are checked with [`check_margins`](crate::check_margins)
+    /// at `params` (tick, switch time), so in every tick at most one robot of each sector is
+    /// low-confidence under every admissible input: at most `M` in all, each sector's
+    /// stretches with its one operator (never handed over), each operator's switch time
+    /// kept. [`Tick::operator`] reports the sector; the fault monitor latches when two robots
+    /// of one sector are low-confidence. Each sector ticks exactly as its own
+    /// [`Coordinator::with_margins`] would when it has a robot starting at the round's
+    /// earliest start (as the planner's sectors: each from 0); otherwise it idles until then.
     ///
     /// # Errors
     /// [`Error::RobotCount`]; [`Error::LengthMismatch`] unless `sector_of` has one entry per
-    /// robot; [`Error::BadParam`] (`sector_of`) for an entry `≥ M`, or for a bad tick or
-    /// switch time; [`Error::Unsafe`] when a sector's plans fail the margin check.
+    /// robot and `holds` none or one list per robot; [`Error::BadParam`] (`sector_of`) for an
+    /// entry `≥ M`, or for a bad tick or switch time; [`Error::BadHold`] for a hold that
+    /// [`crate::holds::check_holds`] rejects or a release rule naming a robot of another
+    /// sector; [`Error::Unsafe`] when a sector's plans fail the margin check.
     pub fn sectored(
         robots: impl Into<Vec<Timeline>>,
+        holds: &[Vec<Hold>],
         sector_of: &[usize],
         operators: OperatorCount,
         params: &crate::MarginParams,
@@ -358,6 +376,13 @@ impl Coordinator {
                 found: sector_of.len(),
             });
         }
+        if !holds.is_empty() && holds.len() != robots.len() {
+            return Err(Error::LengthMismatch {
+                what: "holds",
+                expected: robots.len(),
+                found: holds.len(),
+            });
+        }
         let m = operators.get();
         let mut of = [0_u8; MAX_ROBOTS];
         for (i, &o) in sector_of.iter().enumerate() {
@@ -369,21 +394,59 @@ impl Coordinator {
             }
             of[i] = o as u8;
         }
+        // The global plans first: they check every hold (robot indices, samples, dwells).
+        let mut c = Coordinator::with_holds_unchecked(robots, holds, params.tick_s)?;
+        for (i, list) in holds.iter().enumerate() {
+            for h in list {
+                if h.after.iter().any(|a| sector_of[a.robot] != sector_of[i]) {
+                    return Err(Error::BadHold {
+                        robot: i,
+                        ref_idx: h.ref_idx,
+                        why: "waits for a robot of another sector (a sector runs as its own \
+                              round: its release rules name robots of the same sector)",
+                    });
+                }
+            }
+        }
         for o in 0..m {
-            let sub: Vec<Timeline> = (0..robots.len())
-                .filter(|&i| sector_of[i] == o)
-                .map(|i| robots[i].clone())
-                .collect();
-            if !sub.is_empty() && !crate::check_margins(&sub, &[], params)? {
+            let members: Vec<usize> = (0..c.robots.len()).filter(|&i| sector_of[i] == o).collect();
+            if members.is_empty() {
+                continue;
+            }
+            let sub: Vec<Timeline> = members.iter().map(|&i| c.robots[i].clone()).collect();
+            // The sector's holds, its robots renumbered `0..` as its own coordinator has them.
+            let sub_holds: Vec<Vec<Hold>> = if holds.is_empty() {
+                Vec::new()
+            } else {
+                members
+                    .iter()
+                    .map(|&i| {
+                        let mut list = holds[i].clone();
+                        for h in &mut list {
+                            for a in &mut h.after {
+                                a.robot = members
+                                    .iter()
+                                    .position(|&j| j == a.robot)
+                                    .expect("checked above: the same sector");
+                            }
+                        }
+                        list
+                    })
+                    .collect()
+            };
+            if !crate::check_margins(&sub, &sub_holds, params)? {
                 return Err(Error::Unsafe {
                     tick_s: params.tick_s,
                 });
             }
         }
-        let mut c = Coordinator::new_unchecked(robots, params.tick_s)?;
         c.switch_ticks = params.switch_ticks()?;
         c.monitor = Monitor::new(c.robots.len()).with_sectors(m, of);
-        c.sectors = Some(Arc::new(Sectors { m, of }));
+        c.sectors = Some(Arc::new(Sectors {
+            m,
+            of,
+            holds: holds.to_vec(),
+        }));
         c.reset();
         Ok(c)
     }
@@ -662,6 +725,7 @@ impl Coordinator {
         self.shown_s = [t0; MAX_ROBOTS];
         self.floor_s = [f64::NEG_INFINITY; MAX_ROBOTS];
         self.wait_clock_s = t0;
+        self.sector_wait_s = [t0; MAX_ROBOTS];
         let n = self.robots.len();
         for i in 0..n {
             self.leg[i] = self.plans.first_leg[i];
@@ -762,6 +826,12 @@ impl Coordinator {
             let r = self.cur(j);
             let s = self.clock_s[j];
             if j == i || held == Some(j) || !self.released[j] || s < r.start_s() || s >= r.end_s() {
+                continue;
+            }
+            // In sectors a leg follows the running robots of its own sector alone.
+            if let Some(sec) = &self.sectors
+                && sec.of[j] != sec.of[i]
+            {
                 continue;
             }
             let x = (start_s.min(r.end_s()) - self.tol_s).max(s);
@@ -896,6 +966,27 @@ impl Coordinator {
                     next_s[idx[j]] = sub_next[j];
                 }
                 *fws = first_waiting_start(&sub[..k], |j| self.cur(idx[j]).start_s());
+                if self.plans.has_holds() {
+                    // The sector's legs not started: due at their starts, and its own wait
+                    // clock (rule 3 among its robots), as below for one round.
+                    let mut follow = f64::INFINITY;
+                    for &i in &idx[..k] {
+                        let next = self.leg[i] + 1;
+                        if members[i].mode != Mode::Waiting && next < self.plans.first_leg[i + 1] {
+                            *fws = fws.min(self.plans.legs[next].start_s());
+                        }
+                        if matches!(members[i].mode, Mode::High | Mode::Low) {
+                            follow = follow.min(next_s[i]);
+                        }
+                    }
+                    let w = self.sector_wait_s[o];
+                    let follow = if follow.is_finite() {
+                        follow
+                    } else {
+                        w + self.tick_s
+                    };
+                    self.sector_wait_s[o] = follow.min(*fws).max(w);
+                }
             }
         } else {
             advance(&members[..n], pace_robot, self.tick_s, &mut next_s[..n]);
@@ -912,7 +1003,7 @@ impl Coordinator {
         };
         let mut first_waiting_start = first_waiting_start(&members[..n], |i| self.cur(i).start_s());
         let has_holds = self.plans.has_holds();
-        if has_holds {
+        if has_holds && sectors.is_none() {
             // Legs not started yet wait too (rule 3 for every leg): a robot's next leg is due
             // at its start.
             for (i, m) in members[..n].iter().enumerate() {
@@ -980,12 +1071,16 @@ impl Coordinator {
                 // one every leg not yet started has (rule 3: it follows the running robot
                 // furthest behind, so it may be below `s_new`). The robot stands at the hold's
                 // sample; its reported clock stays at `s_new` until the rule clock passes it.
+                let wait_clock_s = match &sectors {
+                    Some(sec) => self.sector_wait_s[usize::from(sec.of[i])],
+                    None => self.wait_clock_s,
+                };
                 self.floor_s[i] = s_new;
                 self.leg[i] += 1;
-                self.clock_s[i] = self.wait_clock_s;
+                self.clock_s[i] = wait_clock_s;
                 self.cursors[i] = Cursors::default();
                 let next = &self.plans.legs[self.leg[i]];
-                next.advance_cursor(&mut self.cursors[i].at, self.wait_clock_s);
+                next.advance_cursor(&mut self.cursors[i].at, wait_clock_s);
                 self.released.set(i, false);
                 self.release_wait[i] = 0;
             }

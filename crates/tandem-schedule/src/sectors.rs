@@ -83,8 +83,9 @@ pub fn even_sector_sizes(n_robots: usize, operators: usize) -> Vec<usize> {
 pub struct SectoredRounds {
     /// Robots per sector (sector `o` is robots `Σ_{p<o} sizes[p] .. + sizes[o]`).
     pub sizes: Vec<usize>,
-    /// Each sector's one-operator schedule (its robot `j` is the sector's `j`-th robot),
-    /// planned on the problem without hold points.
+    /// Each sector's one-operator schedule (its robot `j` is the sector's `j`-th robot; its
+    /// holds' release rules name robots of the sector by that index), planned on the problem
+    /// with its hold points.
     pub schedules: Vec<Schedule>,
     /// The round's `T_total` (s): the latest sector's.
     pub t_total_s: f64,
@@ -105,24 +106,51 @@ impl SectoredRounds {
     }
 
     /// Every robot's plan (robot `i` at index `i`; global schedule clock from 0, each
-    /// sector's own), as the sectors' schedules give them on `problem` without its holds.
+    /// sector's own), as the sectors' schedules give them on `problem` (the plans without
+    /// their dwells: [`SectoredRounds::holds`] splits them at run time).
     ///
     /// # Errors
     /// As [`Schedule::timelines`].
     pub fn timelines(&self, problem: &Problem) -> Result<Vec<tandem_realtime::Timeline>> {
-        let free = problem.clone().with_holds(Vec::new())?;
         let mut out = Vec::new();
         for s in &self.schedules {
-            out.extend(s.timelines(&free)?);
+            out.extend(s.timelines(problem)?);
         }
         Ok(out)
+    }
+
+    /// Every robot's hold points with their planned dwells and release rules (robot `i` at
+    /// index `i`, the rules naming robots of the round: a sector's robot `j` is robot
+    /// `Σ_{p<o} sizes[p] + j`); empty when no sector's schedule has a hold, as
+    /// `tandem_realtime::Coordinator::sectored` takes them.
+    #[must_use]
+    pub fn holds(&self) -> Vec<Vec<tandem_realtime::Hold>> {
+        if !self.schedules.iter().any(Schedule::has_holds) {
+            return Vec::new();
+        }
+        let mut out = Vec::new();
+        let mut first = 0;
+        for (s, &k) in self.schedules.iter().zip(&self.sizes) {
+            for robot in 0..k {
+                let mut list = s.holds_of(robot).to_vec();
+                for h in &mut list {
+                    for a in &mut h.after {
+                        a.robot += first;
+                    }
+                }
+                out.push(list);
+            }
+            first += k;
+        }
+        out
     }
 }
 
 /// The sectored round of `n_robots` robots and `operators` = `M` operators on `problem`: the
 /// [`even_sector_sizes`], each size's one-operator schedule by [`sample_schedule_n`] with
-/// `params` (one run per distinct size: the robots are alike), on the problem without hold
-/// points (the sectors' coordinator runs no holds). Each schedule is valid for one operator at
+/// `params` (one run per distinct size: the robots are alike), on `problem` with its hold
+/// points (each sector waits at its holds by its own release rules, with its own wait clock:
+/// `tandem_realtime::Coordinator::sectored`). Each schedule is valid for one operator at
 /// `params`' tick and switch time, so each sector has at most one robot low-confidence in any
 /// tick: at most `M` in all.
 ///
@@ -135,12 +163,11 @@ pub fn sectored_rounds(
     params: &SamplerParams,
 ) -> Result<SectoredRounds> {
     let lower_bound_s = fleet_operator_bound_s(problem, n_robots, operators)?;
-    let free = problem.clone().with_holds(Vec::new())?;
     let sizes = even_sector_sizes(n_robots, operators);
     let mut by_size: Vec<(usize, Outcome)> = Vec::new();
     for &k in &sizes {
         if !by_size.iter().any(|(j, _)| *j == k) {
-            by_size.push((k, sample_schedule_n(&free, k, params, None)?));
+            by_size.push((k, sample_schedule_n(problem, k, params, None)?));
         }
     }
     let schedules: Vec<Schedule> = sizes
@@ -224,5 +251,75 @@ mod tests {
         assert!(s.t_total_s >= s.lower_bound_s - 1e-9, "{s:?}");
         assert!((s.lower_bound_s - 3.0).abs() < 1e-9);
         assert_eq!(s.timelines(&p).unwrap().len(), 4);
+        assert!(s.holds().is_empty());
+    }
+
+    /// [HC ×4, LC ×4, HC ×2], gradients 1 in [0.25, 2], `Δt = 0.1` s, with a hold point at
+    /// sample 3 or none (`tests/holds.rs`: two robots' best round waits at the hold, 1.025 s).
+    fn short_stretch(hold: bool) -> Problem {
+        let conf: Vec<bool> = (0..10).map(|n| !(4..8).contains(&n)).collect();
+        let p = Problem::new(conf, vec![1.0; 10], vec![0.25; 10], vec![2.0; 10], 0.1).unwrap();
+        if hold {
+            p.with_holds(vec![3]).unwrap()
+        } else {
+            p
+        }
+    }
+
+    /// With hold points each sector is the one-operator scheduler's schedule on the problem
+    /// with its holds, and the round's holds are the sectors' renumbered: sector 1's rules
+    /// name robots 2 and 3.
+    #[test]
+    fn sectors_are_planned_with_the_hold_points() {
+        let p = short_stretch(true);
+        let params = SamplerParams {
+            samples: 200,
+            seed: 3,
+            tick_s: Some(0.05),
+            ..SamplerParams::default()
+        };
+        let s = sectored_rounds(&p, 4, 2, &params).unwrap();
+        let two = sample_schedule_n(&p, 2, &params, None).unwrap();
+        assert!(two.schedule.has_holds(), "{:?}", two.schedule);
+        assert_eq!(
+            s.schedules,
+            vec![two.schedule.clone(), two.schedule.clone()]
+        );
+        assert_eq!(s.t_total_s, two.t_total_s);
+        assert!((s.t_total_s - 1.025).abs() < 1e-9, "{}", s.t_total_s);
+        let holds = s.holds();
+        assert_eq!(holds.len(), 4);
+        for j in 0..2 {
+            assert_eq!(holds[j], two.schedule.holds_of(j));
+            let shifted: Vec<Vec<usize>> = holds[2 + j]
+                .iter()
+                .map(|h| h.after.iter().map(|a| a.robot).collect())
+                .collect();
+            let own: Vec<Vec<usize>> = two
+                .schedule
+                .holds_of(j)
+                .iter()
+                .map(|h| h.after.iter().map(|a| a.robot + 2).collect())
+                .collect();
+            assert_eq!(shifted, own);
+        }
+        // The round's plans run in sectors with these holds.
+        let c = tandem_realtime::Coordinator::sectored(
+            s.timelines(&p).unwrap(),
+            &holds,
+            &s.sector_of(),
+            tandem_realtime::OperatorCount::new(2).unwrap(),
+            &tandem_realtime::MarginParams::new(0.05),
+        )
+        .unwrap();
+        assert!(c.has_holds());
+        // Without the holds the pair's round is longer: the holds are what the sectors gain.
+        let free = sectored_rounds(&short_stretch(false), 4, 2, &params).unwrap();
+        assert!(
+            free.t_total_s > s.t_total_s,
+            "{} {}",
+            free.t_total_s,
+            s.t_total_s
+        );
     }
 }

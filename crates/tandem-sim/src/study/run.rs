@@ -71,8 +71,8 @@ fn iteration_record(
     let n_robots = planner.n_robots();
     // M > 1 operators (issue 44): the round runs the planner's sectored round, so the record
     // is that round's: its `T_total`, bound and gap, and its robots' starts and intervals
-    // (each sector's schedule on the problem without holds, robot `i` at index `i`), not the
-    // stored one-operator schedule's.
+    // (each sector's schedule as its robots run it, after the planned dwells at its holds,
+    // robot `i` at index `i`), not the stored one-operator schedule's.
     let sectored = if planner.params().sampler.operators > 1 {
         Some(planner.sectored_rounds()?.0)
     } else {
@@ -80,13 +80,12 @@ fn iteration_record(
     };
     let (lc, offsets_s, t_total_s, lower_bound_s, gap) = match &sectored {
         Some(s) => {
-            let free = planner.problem().clone().with_holds(Vec::new())?;
             let mut lc = Vec::with_capacity(n_robots);
             // Every robot's start in the round's global time (each sector's robots from 0);
             // the record keeps robots 2..N's, `τ_2, …, τ_N`.
             let mut starts_s = Vec::with_capacity(n_robots);
             for sector in &s.schedules {
-                lc.extend(sector.lc_intervals(&free)?);
+                lc.extend(sector.lc_intervals(planner.problem())?);
                 starts_s.extend(sector.starts_s());
             }
             let offsets_s: Vec<f64> = starts_s.into_iter().skip(1).collect();
