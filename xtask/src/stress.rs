@@ -48,7 +48,7 @@
 //! cell's plan counts `δ` per change of robot (`CyclicParams::switch_s`) and its token waits
 //! it (`ContinuousCoordinator::with_switch_s`). Each execution's shortest switch is measured
 //! on the ticks the robots traversed (`AdversaryRun::min_switch_gap_ticks`; the beam search
-//! measures none), and the run fails if one is shorter than
+//! of rounds over every sequence it expanded), and the run fails if one is shorter than
 //! `k = switch_ticks(δ, tick)`. `--max-busy U` (continuous cell) adds the operator's load cap:
 //! the plans keep it and the token paces the operator to it
 //! (`ContinuousCoordinator::with_max_busy_share`), so the same checks run on the paced cell.
@@ -416,6 +416,11 @@ pub(crate) fn run(
         tally.add_backward(r.backward_steps);
         if switch_s > 0.0 {
             tally.add_switch(r.min_switch_gap_ticks, case.switch_ticks);
+            if matches!(op, Adversary::Beam { .. }) {
+                tally.beam[0].fetch_add(1, Ordering::Relaxed);
+                let measured = u64::from(r.min_switch_gap_ticks.is_some());
+                tally.beam[1].fetch_add(measured, Ordering::Relaxed);
+            }
         }
         Ok(())
     })?;
@@ -461,9 +466,17 @@ fn report_switches(tally: &Tally, switch_s: f64, ks: &[u64]) -> u64 {
     println!(
         "  switch time {switch_s} s (k = {k_min}…{k_max} ticks): {short} executions with two \
          robots' low-confidence ticks fewer than k ticks apart (expected 0), of {measured} \
-         measured on the ticks traversed (the beam search measures none); least gap − k: {}",
+         measured on the ticks traversed (the beam search of rounds: over every sequence it \
+         expanded); least gap − k: {}",
         least.map_or("-".to_string(), |m| format!("{m} ticks"))
     );
+    let beam = tally.beam.each_ref().map(|a| a.load(Ordering::Relaxed));
+    if beam[0] > 0 {
+        println!(
+            "  the beam search: {} of its {} executions measured a switch",
+            beam[1], beam[0]
+        );
+    }
     short
 }
 
@@ -490,11 +503,15 @@ struct Tally {
     /// Executions with a switch shorter than the switch time (`AdversaryRun::min_switch_gap_ticks
     /// < k`, measured on the ticks traversed).
     short_switches: AtomicU64,
-    /// Executions whose shortest switch was measured (the beam search measures none).
+    /// Executions whose shortest switch was measured (one with fewer than two robots
+    /// low-confidence measures none).
     switches_measured: AtomicU64,
     /// The least `gap − k` (ticks) over the measured executions, offset by `2^32` so that it
     /// is unsigned.
     least_margin: AtomicU64,
+    /// Executions of the beam search (rounds) and those of them whose shortest switch was
+    /// measured.
+    beam: [AtomicU64; 2],
 }
 
 /// Offset of [`Tally::least_margin`].
@@ -511,6 +528,7 @@ impl Default for Tally {
             short_switches: AtomicU64::new(0),
             switches_measured: AtomicU64::new(0),
             least_margin: AtomicU64::new(u64::MAX),
+            beam: [AtomicU64::new(0), AtomicU64::new(0)],
         }
     }
 }

@@ -7,12 +7,13 @@
 //! with and without holds.
 
 use rand::SeedableRng;
-use tandem_realtime::adversary::{Adversary, adversary_set, run_adversary};
+use tandem_realtime::adversary::{Adversary, SwitchGaps, adversary_set, run_adversary};
 use tandem_realtime::holds::{release_rules, usable_holds};
 use tandem_realtime::testkit::{Case, Check, Family, rng, tight_starts};
 use tandem_realtime::{
-    Coordinator, Error, Hold, MarginParams, Timeline, check_margins, margin_slacks, pair_slacks,
-    pair_slacks_with_holds, sufficient_margins, sufficient_margins_with_holds, switch_ticks,
+    Coordinator, Error, Hold, MarginParams, RobotFlags, Timeline, check_margins, margin_slacks,
+    pair_slacks, pair_slacks_with_holds, sufficient_margins, sufficient_margins_with_holds,
+    switch_ticks,
 };
 
 #[test]
@@ -141,6 +142,67 @@ fn a_schedule_valid_without_switch_time_is_rejected_with_two_seconds() {
     // The serial schedule (robot 2 at robot 1's end, 6 s): robot 1 left its region 4 s of clock
     // (≥ 32 ticks at F = 1.25) before robot 2 starts, so it is accepted at δ = 2 s.
     assert!(check_margins(&ten_ten_forty(6.0), &[], &at(2.0)).unwrap());
+}
+
+/// The switch count of every stress run (`SwitchGaps`, the ticks the robots traversed), on a
+/// hand-built trace of two robots.
+#[test]
+fn switch_gaps_on_a_hand_built_trace() {
+    let flags = |a, b| RobotFlags::from_slice(&[a, b]);
+    let mut g = SwitchGaps::default();
+    // Robot 0 low-confidence in ticks 0 and 1: one robot, no switch yet.
+    g.record(0, &flags(true, false));
+    g.record(1, &flags(true, false));
+    g.record(2, &flags(false, false));
+    assert_eq!(g.min_gap_ticks(), None);
+    // Robot 1 in tick 4: ticks 2 and 3 had neither, a switch of 2 ticks.
+    g.record(4, &flags(false, true));
+    assert_eq!(g.min_gap_ticks(), Some(2));
+    // Robot 1 again in tick 5: 3 ticks after robot 0's last, the least stays 2.
+    g.record(5, &flags(false, true));
+    assert_eq!(g.min_gap_ticks(), Some(2));
+    // Robot 0 in tick 9 (3 ticks after robot 1's last), robot 1 right after in tick 10.
+    g.record(9, &flags(true, false));
+    assert_eq!(g.min_gap_ticks(), Some(2));
+    g.record(10, &flags(false, true));
+    assert_eq!(g.min_gap_ticks(), Some(0));
+}
+
+/// The beam search measures the switches of the sequences it expands (issue 41: the stress
+/// counts it): on the earliest start of robot 2 that the check accepts at `δ = 0` (the schedule
+/// of `a_schedule_valid_without_switch_time_is_rejected_with_two_seconds`) it finds a switch
+/// shorter than `k = 20` ticks, and on the earliest accepted at `δ = 2` s none.
+#[test]
+fn the_beam_search_measures_the_switch_time() {
+    let tick_s = 0.1;
+    let at = |switch_s| MarginParams::new(tick_s).with_switch_s(switch_s);
+    let earliest = |switch_s: f64| {
+        (0..=120)
+            .map(|i| 0.05 * f64::from(i))
+            .find(|&tau| check_margins(&ten_ten_forty(tau), &[], &at(switch_s)).unwrap())
+            .unwrap()
+    };
+    let beam = |tau: f64, switch_s: f64| {
+        let c = Coordinator::with_margins(ten_ten_forty(tau), &[], &at(switch_s)).unwrap();
+        run_adversary(c, Adversary::Beam { width: 4 }, &mut rng(1), 2_000).unwrap()
+    };
+    let tau0 = earliest(0.0);
+    assert!(!check_margins(&ten_ten_forty(tau0), &[], &at(2.0)).unwrap());
+    let short = beam(tau0, 0.0);
+    assert_eq!(short.overlap_ticks, 0);
+    let gap = short
+        .min_switch_gap_ticks
+        .expect("the beam measures its switches");
+    // On schedule robot 1 leaves its region at 2 s and robot 2 enters its own at τ + 1: fewer
+    // than 20 ticks of 0.1 s apart while τ < 3 s.
+    assert!(tau0 < 3.0, "{tau0}");
+    assert!(gap < 20, "{gap}");
+    let kept = beam(earliest(2.0), 2.0);
+    assert_eq!(kept.overlap_ticks, 0);
+    let gap = kept
+        .min_switch_gap_ticks
+        .expect("the beam measures its switches");
+    assert!(gap >= switch_ticks(2.0, tick_s).unwrap(), "{gap}");
 }
 
 #[test]

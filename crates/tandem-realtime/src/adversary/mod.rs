@@ -204,8 +204,8 @@ pub struct AdversaryRun {
     pub min_tasks: u64,
     /// The shortest switch seen ([`SwitchGaps`]): the fewest ticks between a tick in which one
     /// robot traversed a low-confidence sample and a later tick in which another robot did, in
-    /// which neither did (`None`: no such pair of ticks, or [`Adversary::Beam`], which does not
-    /// keep its sequence's ticks). A schedule that
+    /// which neither did (`None`: no such pair of ticks; [`Adversary::Beam`]: the shortest over
+    /// every sequence the search expanded, [`search::beam_search`]). A schedule that
     /// [`check_margins`](crate::check_margins) accepts with switch time `δ` keeps it
     /// `≥ switch_ticks(δ, tick_s)`.
     pub min_switch_gap_ticks: Option<u64>,

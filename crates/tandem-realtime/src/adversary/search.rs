@@ -9,10 +9,15 @@
 //! progress (the sum of all robots' schedule clocks, in cells of one nominal tick of every robot), the cells are
 //! expanded in order of progress, and each cell keeps the `width` states with the smallest
 //! clearance now (then the smallest along the way, then the fewest ticks).
+//!
+//! Every sequence the search runs is an admissible operator's execution (a prefix of one), so
+//! the switches it traverses are measured as in a policy's run ([`SwitchGaps`], issue 41): the
+//! search reports the shortest switch over *all* the sequences it expanded, pruned ones
+//! included, not only over the one it returns.
 
 use std::collections::BTreeMap;
 
-use super::{AdversaryRun, Backward};
+use super::{AdversaryRun, Backward, SwitchGaps};
 use crate::{Coordinator, Operator, Result, Timeline};
 
 /// The operator inputs the search tries at every tick.
@@ -66,16 +71,24 @@ struct Candidate {
     worst_s: f64,
     /// Ticks of the sequence in which a robot moved backwards ([`super::Backward`]).
     backward_steps: u64,
+    /// The switches of the sequence so far, on the ticks it traversed.
+    gaps: SwitchGaps,
+}
+
+/// The lesser of two shortest switches (`None`: none measured).
+fn min_gap(a: Option<u64>, b: Option<u64>) -> Option<u64> {
+    a.into_iter().chain(b).min()
 }
 
 /// The run of a sequence that overlapped at tick `first`: continued without corrections to the
-/// end (or to `max_ticks`), counting every overlapping tick.
+/// end (or to `max_ticks`), counting every overlapping tick; `gaps` the sequence's switches so
+/// far, `least_gap` the shortest switch of the other sequences expanded.
 fn finish(
     mut coordinator: Coordinator,
-    mut ticks: u64,
-    first: u64,
-    max_ticks: u64,
+    (mut ticks, first, max_ticks): (u64, u64, u64),
     mut backward_steps: u64,
+    mut gaps: SwitchGaps,
+    least_gap: Option<u64>,
 ) -> Result<AdversaryRun> {
     let mut overlap_ticks = 1;
     let mut backward = Backward::new(&coordinator);
@@ -84,6 +97,7 @@ fn finish(
         let tick = coordinator.tick(Operator::Scheduled)?;
         overlap_ticks += u64::from(tick.overlap());
         backward_steps += u64::from(backward.step(&coordinator, &tick));
+        gaps.record(ticks, &tick.low_conf);
         ticks += 1;
     }
     Ok(AdversaryRun {
@@ -93,7 +107,7 @@ fn finish(
         finished: coordinator.is_finished(),
         backward_steps,
         min_tasks: u64::from(coordinator.is_finished()),
-        min_switch_gap_ticks: None,
+        min_switch_gap_ticks: min_gap(gaps.min_gap_ticks(), least_gap),
     })
 }
 
@@ -101,7 +115,8 @@ fn finish(
 /// the coordinator's current state, for at most `max_ticks` ticks along any sequence. Returns
 /// the first sequence that makes two robots low-confidence in one tick (`overlap_ticks = 1`,
 /// `first_overlap` its tick), or else the run of the sequence with the smallest clearance that
-/// finished.
+/// finished. Its `min_switch_gap_ticks` is the shortest switch over every sequence expanded
+/// (each an admissible operator's execution), measured on the ticks it traversed.
 ///
 /// # Errors
 /// None in practice (the choices are always admissible); a coordinator error is passed on.
@@ -118,7 +133,10 @@ pub fn beam_search(coordinator: Coordinator, width: usize, max_ticks: u64) -> Re
         coordinator,
         ticks: 0,
         backward_steps: 0,
+        gaps: SwitchGaps::default(),
     };
+    // The shortest switch over every sequence expanded so far.
+    let mut least_gap: Option<u64> = None;
     cells
         .entry(progress(&start.coordinator))
         .or_default()
@@ -147,15 +165,17 @@ pub fn beam_search(coordinator: Coordinator, width: usize, max_ticks: u64) -> Re
                 let tick = next.coordinator.tick(op)?;
                 next.ticks += 1;
                 next.backward_steps += u64::from(backward.step(&next.coordinator, &tick));
+                next.gaps.record(cand.ticks, &tick.low_conf);
                 if tick.overlap() {
                     return finish(
                         next.coordinator,
-                        next.ticks,
-                        cand.ticks,
-                        max_ticks,
+                        (next.ticks, cand.ticks, max_ticks),
                         next.backward_steps,
+                        next.gaps,
+                        least_gap,
                     );
                 }
+                least_gap = min_gap(least_gap, next.gaps.min_gap_ticks());
                 next.now_s = min_clearance_s(&next.coordinator);
                 next.worst_s = next.worst_s.min(next.now_s);
                 cells
@@ -173,7 +193,7 @@ pub fn beam_search(coordinator: Coordinator, width: usize, max_ticks: u64) -> Re
             finished: b.coordinator.is_finished(),
             backward_steps: b.backward_steps,
             min_tasks: u64::from(b.coordinator.is_finished()),
-            min_switch_gap_ticks: None,
+            min_switch_gap_ticks: least_gap,
         }),
     )
 }

@@ -1,0 +1,200 @@
+//! The operator's load cap at run time in rounds (issue 41; docs/decisions.md, "The load cap in
+//! rounds at run time: the plan alone does not keep it (issue 41)"): the busy share of a round
+//! planned with `max_busy_share`, measured on the ticks the robots traversed under the adversary
+//! policies.
+#![allow(
+    clippy::print_stdout,
+    reason = "the test reports the shares it measured"
+)]
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use tandem_realtime::adversary::{Adversary, run_adversary_on};
+use tandem_realtime::{Controller, Coordinator, Fault, Operator, PerRobot, RobotFlags, Tick};
+use tandem_schedule::{SamplerParams, busy_share, sample_schedule_n, testkit};
+
+/// The control tick and the problems' sample period (s).
+const DT_S: f64 = 0.02;
+
+/// A round that records, per tick, the robot that was low-confidence (if any).
+struct Watch {
+    inner: Coordinator,
+    lc: Vec<Option<usize>>,
+}
+
+impl Controller for Watch {
+    fn n_robots(&self) -> usize {
+        self.inner.n_robots()
+    }
+    fn tick_s(&self) -> f64 {
+        self.inner.tick_s()
+    }
+    fn tick(&mut self, operator: Operator) -> tandem_realtime::Result<Tick> {
+        let t = self.inner.tick(operator)?;
+        self.lc.push(t.low_conf.first());
+        Ok(t)
+    }
+    fn reset(&mut self) {
+        self.inner.reset();
+        self.lc.clear();
+    }
+    fn fault(&self) -> Option<Fault> {
+        self.inner.fault()
+    }
+    fn clear_fault(&mut self) {
+        self.inner.clear_fault();
+    }
+    fn low_conf_now(&self) -> RobotFlags {
+        self.inner.low_conf_now()
+    }
+    fn running_now(&self) -> RobotFlags {
+        self.inner.running_now()
+    }
+    fn waiting_now(&self) -> RobotFlags {
+        self.inner.waiting_now()
+    }
+    fn pre_alert(&self) -> Option<tandem_realtime::PreAlert> {
+        self.inner.pre_alert()
+    }
+    fn ref_time_now(&self) -> PerRobot<f64> {
+        self.inner.ref_time_now()
+    }
+    fn tasks_now(&self) -> PerRobot<u64> {
+        self.inner.tasks_now()
+    }
+    fn clock_s(&self) -> &[f64] {
+        self.inner.clock_s()
+    }
+    fn is_finished(&self) -> bool {
+        self.inner.is_finished()
+    }
+    fn ticks(&self) -> u64 {
+        self.inner.ticks()
+    }
+}
+
+/// The operator's busy ticks of a recorded round: every tick with a low-confidence robot, plus
+/// `k` for every change of robot (a low-confidence tick of a robot other than the one of the
+/// low-confidence tick before it).
+fn busy(lc: &[Option<usize>], k: u64) -> u64 {
+    let mut last = None;
+    let mut busy = 0;
+    for r in lc.iter().flatten() {
+        busy += 1;
+        if last.is_some_and(|q| q != r) {
+            busy += k;
+        }
+        last = Some(r);
+    }
+    busy
+}
+
+/// The rest (ticks) after a round of `ticks` ticks with `busy` busy ticks that brings the
+/// round's share to at most `cap`: the least `n` with `busy ≤ cap·n` as computed in floating
+/// point, less the round's ticks (0 when the round alone keeps the cap).
+fn rest(busy: u64, ticks: u64, cap: f64) -> u64 {
+    let mut n = (busy as f64 / cap).ceil() as u64;
+    while (n as f64) * cap < busy as f64 {
+        n += 1;
+    }
+    n.saturating_sub(ticks)
+}
+
+/// Rounds planned with a cap of 0.7 (`SamplerParams::max_busy_share`, the share per round on
+/// schedule), run under the adversary policies: the plan alone does not keep the cap at run
+/// time (rounds above it, the nominal operator's among them); a rest after each round that
+/// brings the round's share to the cap costs the reported share of the round's ticks.
+#[test]
+fn the_rounds_share_under_the_adversary_set() {
+    let cap = 0.7;
+    let mut rng = ChaCha8Rng::seed_from_u64(4142);
+    let (mut rounds, mut above, mut most) = (0, 0, 0.0_f64);
+    let (mut rest_nominal, mut rest_worst) = (Vec::new(), 0.0_f64);
+    for case in 0..16u64 {
+        let p =
+            testkit::random_problem(&mut ChaCha8Rng::seed_from_u64(2000 + case), 150..=400, DT_S)
+                .unwrap();
+        let n = rng.random_range(2..=4usize);
+        let switch_s = [0.0, 0.1, 0.3][rng.random_range(0..3)];
+        let params = SamplerParams {
+            samples: 60,
+            seed: case,
+            tick_s: Some(DT_S),
+            switch_s,
+            max_busy_share: cap,
+            ..SamplerParams::default()
+        };
+        let Ok(out) = sample_schedule_n(&p, n, &params, None) else {
+            println!("case {case}: N = {n}, δ = {switch_s}: no schedule");
+            continue;
+        };
+        let planned = busy_share(&out.schedule, &p, switch_s).unwrap();
+        let base = out
+            .schedule
+            .check_with_operator(&p, switch_s, cap)
+            .unwrap()
+            .coordinator()
+            .unwrap()
+            .with_switch_s(switch_s)
+            .unwrap();
+        let k = base.switch_ticks();
+        let (lo, hi) = (
+            p.grad_min().iter().copied().fold(f64::INFINITY, f64::min),
+            p.grad_max().iter().copied().fold(0.0, f64::max),
+        );
+        let policies = [
+            Adversary::Nominal,
+            Adversary::Fastest,
+            Adversary::Slowest,
+            Adversary::RushRobot { rush: 0 },
+            Adversary::SwitchFavourite { max_hold: 50 },
+            Adversary::RandomSwitching { max_hold: 50 },
+            Adversary::RandomExtreme,
+            Adversary::Random { lo, hi },
+        ];
+        let mut line = Vec::new();
+        for (j, &adv) in policies.iter().enumerate() {
+            let mut w = Watch {
+                inner: base.clone(),
+                lc: Vec::new(),
+            };
+            let mut r = ChaCha8Rng::seed_from_u64(case * 16 + j as u64);
+            let run = run_adversary_on(&mut w, adv, &mut r, 1, 20_000_000).unwrap();
+            assert_eq!(run.overlap_ticks, 0);
+            assert!(run.finished);
+            let (b, t) = (busy(&w.lc, k), w.lc.len() as u64);
+            let share = b as f64 / t as f64;
+            let r = rest(b, t, cap);
+            assert!(b as f64 <= cap * (t + r) as f64 && (r == 0 || share > cap));
+            let cost = r as f64 / t as f64;
+            rest_worst = rest_worst.max(cost);
+            if adv == Adversary::Nominal {
+                rest_nominal.push(cost);
+            }
+            most = most.max(share);
+            above += usize::from(share > cap);
+            rounds += 1;
+            line.push(format!("{share:.3}"));
+        }
+        println!(
+            "case {case}: N = {n}, δ = {switch_s}, planned share {planned:.3} ({:?}): run {}",
+            out.source,
+            line.join(" ")
+        );
+    }
+    rest_nominal.sort_by(f64::total_cmp);
+    println!(
+        "{rounds} rounds: {above} above the cap {cap}, largest share {most:.4}; a rest after \
+         the round to the cap: nominal operator median {:.2} %, largest {:.2} % of the round's \
+         ticks, any policy largest {:.2} %",
+        100.0 * rest_nominal[rest_nominal.len() / 2],
+        100.0 * rest_nominal[rest_nominal.len() - 1],
+        100.0 * rest_worst
+    );
+    assert!(rounds >= 64, "{rounds} rounds");
+    // The plan's share is on schedule: at run time it is exceeded (measured 38 of 128).
+    assert!(
+        above > 0,
+        "no round above the cap: the measurement is vacuous"
+    );
+}
