@@ -224,6 +224,48 @@ mod tests {
         assert!(changed > 0);
     }
 
+    /// A round of 16 robots and 4 operators (`MAX_ROBOTS`): four waves of four robots of
+    /// [HC, HC, LC, LC, HC × 6], gradient 1 in [0.5, 2], the waves 30 s apart, ticked at
+    /// 0.25 s. `Coordinator::with_operators(4)` accepts it
+    /// (`margins::operators::tests::four_waves_of_four_robots_need_four_operators`: it was
+    /// refused before the lower envelope left out finished robots), and under every policy
+    /// per operator no tick has more than 4 robots low-confidence, no stretch is handed over,
+    /// no operator is on two robots, no fault; some tick has all 4 operators busy.
+    #[test]
+    fn sixteen_robots_in_four_waves_run_with_four_operators() {
+        let conf: Vec<bool> = (0..10).map(|k| !(2..4).contains(&k)).collect();
+        let robots: Vec<Timeline> = (0..16)
+            .map(|i| {
+                let start = 30.0 * (i / 4) as f64;
+                Timeline::new(&conf, &[1.0; 10], &[0.5; 10], &[2.0; 10], start, 1.0).unwrap()
+            })
+            .collect();
+        let c = crate::Coordinator::new_unchecked(robots, 0.25)
+            .unwrap()
+            .with_operators(OperatorCount::new(4).unwrap())
+            .unwrap();
+        assert_eq!(c.operators(), 4);
+        for (k, adversary) in [
+            Adversary::Nominal,
+            Adversary::RandomExtreme,
+            Adversary::RushRobot { rush: 1 },
+            Adversary::SwitchFavourite { max_hold: 5 },
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let mut c = c.clone();
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(k as u64);
+            let r = run_operators_on(&mut c, adversary, &mut rng, 1, 100_000).unwrap();
+            assert!(r.finished && r.most_low_conf == 4, "{adversary:?}: {r:?}");
+            assert_eq!(
+                (r.over_ticks, r.handed_over, r.misassigned, r.faults),
+                (0, 0, 0, 0),
+                "{adversary:?}: {r:?}"
+            );
+        }
+    }
+
     #[test]
     fn one_operator_on_coinciding_stretches_counts_the_ticks_over() {
         // Unchecked, one operator: the three stretches coincide; the monitor latches a fault
