@@ -49,7 +49,7 @@ enum Cmd {
     /// Measure ROS 2 bag support: the sanding fixtures as bags fitted against the CSV fit, and
     /// the time to read and fit bags against the same data as CSV (docs/decisions.md).
     Bags(bags::BagsArgs),
-    /// Run the study for N = 1..8 robots with reduced sizes and draw throughput and operator
+    /// Run the study for N = 1..--max-robots (default 8) robots with reduced sizes and draw throughput and operator
     /// busy share against N (results/capacity/capacity.svg and .png; docs/study.md).
     Capacity(capacity::CapacityArgs),
     /// Regenerate the generated fixtures: the sanding demonstrations in fixtures/sanding/
@@ -120,9 +120,9 @@ enum Cmd {
         /// operators, each with its own copy of the execution's policy on the robot it
         /// supervises, and fails on a tick with more than M robots low-confidence, a stretch
         /// handed over mid-way, an operator on two robots, a fault or a backward step. Rounds:
-        /// test kit cases tight at the edge of the operators' check
-        /// (`margins::operators::assign_operators`), no holds; `--cell continuous`: the cyclic
-        /// plans run with M tokens (no load cap).
+        /// the sectored round (`Coordinator::sectored`, M even sectors, each a test kit case
+        /// tight at the edge of the one-operator check, the beam search per sector), no holds;
+        /// `--cell continuous`: the cyclic plans run with M tokens (no load cap).
         #[arg(long, default_value_t = 1)]
         operators: usize,
         /// Random problems to draw (default: one per 1000 executions, 1–200): more problems

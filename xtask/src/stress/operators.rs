@@ -13,10 +13,17 @@
 //! with `--switch-s`, each operator's switches shorter than `k` ticks. Every one of them must
 //! be 0; every number depends only on the flags and the seed.
 //!
-//! - *Rounds*: test kit cases of every family (`testkit::Case::random`), made tight at an edge
-//!   of the operators' check (`margins::operators::assign_operators` at the case's tick, `M`
-//!   and `k`; `testkit::tight_starts`), run by `Coordinator::with_operators(M)` (which runs the
-//!   check again and refuses what it does not accept). Holds are refused with `M > 1`.
+//! - *Rounds*: the sectored round the planner runs with `M > 1` (`Coordinator::sectored`;
+//!   docs/decisions.md, "M operators in rounds: sectors end to end"): the `N` robots split
+//!   evenly into `M` sectors of consecutive robots (the first `N mod M` one robot larger, as
+//!   `tandem_schedule::sectors`), one test kit case of every family per problem
+//!   (`testkit::Case::random`), each sector's robots made tight at an edge of the one-operator
+//!   check at the case's tick and switch time (`check_margins`; `testkit::tight_starts`, robot
+//!   0 of every sector at 0, so the sectors' stretches meet), run by `Coordinator::sectored`
+//!   (which checks every sector again). [`Adversary::Beam`] runs as the beam search of every
+//!   sector's own one-operator round (`Coordinator::with_margins` of the sector's robots, which
+//!   the sectored coordinator ticks exactly, `tests/sectors.rs`) and, on the sectored round,
+//!   as the switching favourite per operator. Holds are refused with `M > 1`.
 //! - *Continuous*: the problems of the one-operator continuous stress ([`super::make_cell_case`]:
 //!   this task's random problems with and without hold points, the test kit's shared-mask
 //!   families), each planned by `cyclic_plan` and run with `M` tokens
@@ -31,12 +38,14 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use tandem::realtime::adversary::Adversary;
 use tandem::realtime::adversary::operators::{OperatorsRun, run_operators_on};
-use tandem::realtime::margins::operators::assign_operators;
+use tandem::realtime::adversary::run_adversary;
 use tandem::realtime::testkit::{self, Family};
-use tandem::realtime::{Controller, Coordinator, OperatorCount, Timeline, switch_ticks};
+use tandem::realtime::{
+    Controller, Coordinator, MarginParams, OperatorCount, Timeline, check_margins,
+};
 
-/// Draws of a test kit case per problem before giving up (a case whose robots' stretches
-/// cannot be coloured with `M` operators even serially is skipped).
+/// Draws of a test kit case per problem before giving up (a case some sector of which has no
+/// accepted start, not even the serial one, is drawn again).
 const MAX_DRAWS: u64 = 50;
 
 /// One case of the run: a controller (cloned per execution), its policies and budget.
@@ -45,14 +54,23 @@ struct OpCase<C> {
     adversaries: Vec<Adversary>,
     max_ticks: u64,
     family: &'static str,
-    /// Whether some robot starts before the robots placed before it have ended (rounds).
+    /// Whether some robot starts before the robots placed before it have ended (rounds: in
+    /// some sector).
     overlapping: bool,
     /// `k`, the switch time in ticks.
     switch_ticks: u64,
+    /// Rounds: every sector's own one-operator round, for the beam search per sector.
+    sectors: Vec<Coordinator>,
 }
 
-/// A rounds case of `n` robots and `m` operators at switch time `switch_s`: the first of up to
-/// [`MAX_DRAWS`] test kit draws whose starts `tight_starts` finds.
+/// The sizes of `m` sectors of `n` robots: as even as possible, the larger first.
+fn sector_sizes(n: usize, m: usize) -> Vec<usize> {
+    (0..m).map(|o| n / m + usize::from(o < n % m)).collect()
+}
+
+/// A sectored rounds case of `n` robots and `m` operators at switch time `switch_s`: the first
+/// of up to [`MAX_DRAWS`] test kit draws whose every sector has starts `tight_starts` finds at
+/// the one-operator check.
 fn rounds_case(
     seed: u64,
     index: u64,
@@ -62,21 +80,32 @@ fn rounds_case(
 ) -> anyhow::Result<OpCase<Coordinator>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x0044_0044);
     rng.set_stream(index);
-    for attempt in 0..MAX_DRAWS {
+    let sizes = sector_sizes(n, m.get());
+    'draw: for attempt in 0..MAX_DRAWS {
         let family = Family::ALL[((index + attempt) % Family::ALL.len() as u64) as usize];
-        let case = testkit::Case::random(family, n, &mut rng);
-        let k = switch_ticks(switch_s, case.tick_s)?;
-        let check = |robots: &[Timeline], tick_s: f64| {
-            assign_operators(robots, tick_s, m, k).map(|p| p.is_some())
+        let case = testkit::Case::random(family, sizes[0], &mut rng);
+        let params = MarginParams {
+            tick_s: case.tick_s,
+            switch_s,
         };
-        let Some((starts, overlapping)) = testkit::tight_starts(&case, check, &mut rng) else {
-            continue;
-        };
-        let robots = case.robots_at(&starts);
+        let k = params.switch_ticks()?;
+        let check = |robots: &[Timeline], _: f64| check_margins(robots, &[], &params);
+        let (mut robots, mut sector_of, mut sectors) = (Vec::new(), Vec::new(), Vec::new());
+        let mut overlapping = false;
+        for (o, &g) in sizes.iter().enumerate() {
+            let mut sub = case.clone();
+            sub.plans.truncate(g);
+            let Some((starts, over)) = testkit::tight_starts(&sub, check, &mut rng) else {
+                continue 'draw;
+            };
+            overlapping |= over;
+            let own = sub.robots_at(&starts);
+            sectors.push(Coordinator::with_margins(own.clone(), &[], &params)?);
+            robots.extend(own);
+            sector_of.extend(std::iter::repeat_n(o, g));
+        }
         let budget = testkit::adversary_budget(&robots, &[], case.tick_s);
-        let controller = Coordinator::new_unchecked(robots.clone(), case.tick_s)?
-            .with_switch_s(switch_s)?
-            .with_operators(m)?;
+        let controller = Coordinator::sectored(robots.clone(), &sector_of, m, &params)?;
         return Ok(OpCase {
             adversaries: case.adversaries(&robots, &mut rng),
             controller,
@@ -84,9 +113,12 @@ fn rounds_case(
             family: family.name(),
             overlapping,
             switch_ticks: k,
+            sectors,
         });
     }
-    bail!("no test kit case of {MAX_DRAWS} draws has starts the operators' check accepts")
+    bail!(
+        "no test kit case of {MAX_DRAWS} draws has starts the one-operator check accepts in every sector"
+    )
 }
 
 /// A continuous case: [`super::make_cell_case`]'s cell with `m` tokens.
@@ -99,14 +131,15 @@ fn cell_case(
     switch_s: f64,
 ) -> anyhow::Result<OpCase<tandem::realtime::continuous::ContinuousCoordinator>> {
     let c = super::make_cell_case(seed, index, n, tasks, switch_s, 1.0)?;
-    let k = c.cell.switch_ticks();
+    let k = c.run.cell.switch_ticks();
     Ok(OpCase {
-        controller: c.cell.with_operators(m),
-        adversaries: c.adversaries,
-        max_ticks: c.max_ticks,
+        controller: c.run.cell.with_operators(m),
+        adversaries: c.run.adversaries,
+        max_ticks: c.run.max_ticks,
         family: c.family,
         overlapping: true,
         switch_ticks: k,
+        sectors: Vec::new(),
     })
 }
 
@@ -129,6 +162,10 @@ struct OpTally {
     /// Executions in which some operator changed robot (its switch measured).
     switches_measured: AtomicU64,
     tasks: AtomicU64,
+    /// Beam searches run on a sector's own round, and the ticks with two robots of one sector
+    /// low-confidence they found (expected 0).
+    beam_searches: AtomicU64,
+    beam_overlaps: AtomicU64,
 }
 
 impl OpTally {
@@ -251,6 +288,15 @@ fn report<C: Controller + Clone + Sync>(
             let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
             rng.set_stream(e);
             let mut c = case.controller.clone();
+            if let Adversary::Beam { .. } = op {
+                for sector in &case.sectors {
+                    let b = run_adversary(sector.clone(), op, &mut rng, case.max_ticks)?;
+                    tally.beam_searches.fetch_add(1, Ordering::Relaxed);
+                    tally
+                        .beam_overlaps
+                        .fetch_add(b.overlap_ticks, Ordering::Relaxed);
+                }
+            }
             let r = run_operators_on(&mut c, op, &mut rng, tasks, case.max_ticks)?;
             let done_tasks: u64 = c.tasks_now().iter().sum();
             tally.add(&r, m, case.switch_ticks, done_tasks);
@@ -266,6 +312,7 @@ fn report<C: Controller + Clone + Sync>(
     }
     let secs = run_start.elapsed().as_secs_f64();
     let get = |a: &AtomicU64| a.load(Ordering::Relaxed);
+    let beam_overlaps = get(&tally.beam_overlaps);
     let (over, handed, mis, faults, back, unfinished, short) = (
         get(&tally.over_ticks),
         get(&tally.handed_over),
@@ -288,6 +335,13 @@ fn report<C: Controller + Clone + Sync>(
         get(&tally.changed_at_task_end),
         get(&tally.tasks) as f64 / (executions * n as u64) as f64,
     );
+    if cases.iter().any(|c| !c.sectors.is_empty()) {
+        println!(
+            "  beam search per sector: {} searches of a sector's own round, {beam_overlaps} ticks \
+             with two robots of one sector low-confidence (expected 0)",
+            get(&tally.beam_searches)
+        );
+    }
     if switch_s > 0.0 {
         let ks: Vec<u64> = cases.iter().map(|c| c.switch_ticks).collect();
         println!(
@@ -305,11 +359,11 @@ fn report<C: Controller + Clone + Sync>(
             e % n_problems
         );
     }
-    if over + handed + mis + faults + back + unfinished + short > 0 {
+    if over + handed + mis + faults + back + unfinished + short + beam_overlaps > 0 {
         bail!(
             "the {m}-operator invariant is broken: {over} ticks over {m}, {handed} handed over, \
              {mis} misassigned, {faults} faults, {back} backward steps, {unfinished} unfinished, \
-             {short} short switches"
+             {short} short switches, {beam_overlaps} beam overlaps in a sector"
         );
     }
     Ok(())
