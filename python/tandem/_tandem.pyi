@@ -2,7 +2,7 @@
 
 Shapes: ``T_ref`` reference samples, ``C`` channels, ``d`` tangent coordinates (``C`` with
 quaternion blocks as rotation vectors, plus the rate), ``K`` correction components, ``N``
-robots (1 to ``MAX_ROBOTS`` = 8; ``fit(robots=...)``, default ``N_ROBOTS`` = 2). Times in seconds unless named in samples.
+robots (1 to ``MAX_ROBOTS`` = 16; ``fit(robots=...)``, default ``N_ROBOTS`` = 2). Times in seconds unless named in samples.
 """
 
 from os import PathLike
@@ -80,7 +80,7 @@ def fit(
     its load cap in (0, 1] (``tandem fit --switch-s/--max-busy``); ``None`` keeps
     ``params["sampler"]``'. ``resample``: put CSV files with an irregular ``t`` column on an
     even grid first, as ``tandem fit --resample`` (a ``DataWarning`` per file).
-    ``operators``: the cell's operators M, 1 to 8 (``tandem fit --operators``): M tokens in a
+    ``operators``: the cell's operators M, 1 to 16 (``tandem fit --operators``): M tokens in a
     continuous cell, M sectors in rounds (:meth:`Planner.sectored_rounds`); ``None`` keeps
     ``params["sampler"]``'."""
 

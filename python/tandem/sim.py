@@ -181,7 +181,7 @@ def sanding_needs(
             demonstration's own labels file. A folder or a list needs ``planner``.
         seed: seed of the workpieces' draw.
         task: task parameters (dict; only ``n_sections`` matters).
-        robots: ``N``, one workpiece per robot (1 to 8; default: the planner's, else 2).
+        robots: ``N``, one workpiece per robot (1 to 16; default: the planner's, else 2).
         planner: the planner whose model the needs are for; picks its reference's labels and
             checks that they are one per reference sample.
 

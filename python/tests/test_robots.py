@@ -103,5 +103,5 @@ def test_rounds_take_one_execution_per_robot(three: tandem.Planner) -> None:
     with pytest.raises(tandem.InputError):
         tandem.sim.run_round(three, tandem.sim.sanding_needs(LABELS, seed=9, planner=three, robots=2), seed=9)
     with pytest.raises(tandem.ParamError):
-        tandem.fit(DEMOS[:2], robots=9)
+        tandem.fit(DEMOS[:2], robots=tandem.MAX_ROBOTS + 1)
     assert np.array_equal(needs.shape, (3, three.model.n_ref))

@@ -35,6 +35,10 @@ use anyhow::{Context, anyhow, bail};
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 use tandem::realtime::MAX_ROBOTS;
+
+/// The default `--max-robots`: 8, the figure of docs/study.md (it was `MAX_ROBOTS` until that
+/// became 16 in issue 44; the default run is unchanged).
+const DEFAULT_MAX_ROBOTS: usize = 8;
 use tandem::sim::study::{
     Cell, CellStudyResult, Steady, StudyConfig, StudyInputs, StudyResult, mean_std, run_cell_study,
     run_study, throughput_per_h,
@@ -64,8 +68,9 @@ pub(crate) enum CellChoice {
 /// Flags of `cargo xtask capacity`.
 #[derive(clap::Args, Debug)]
 pub(crate) struct CapacityArgs {
-    /// Largest robot count (runs N = 1..=this).
-    #[arg(long, default_value_t = MAX_ROBOTS)]
+    /// Largest robot count (runs N = 1..=this; at most `MAX_ROBOTS` = 16). Default 8: the
+    /// figure of docs/study.md (one operator saturates at about three robots).
+    #[arg(long, default_value_t = DEFAULT_MAX_ROBOTS)]
     max_robots: usize,
     /// Trials per robot count.
     #[arg(long, default_value_t = 3)]

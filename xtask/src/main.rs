@@ -49,7 +49,7 @@ enum Cmd {
     /// Measure ROS 2 bag support: the sanding fixtures as bags fitted against the CSV fit, and
     /// the time to read and fit bags against the same data as CSV (docs/decisions.md).
     Bags(bags::BagsArgs),
-    /// Run the study for N = 1..8 robots with reduced sizes and draw throughput and operator
+    /// Run the study for N = 1..--max-robots (default 8) robots with reduced sizes and draw throughput and operator
     /// busy share against N (results/capacity/capacity.svg and .png; docs/study.md).
     Capacity(capacity::CapacityArgs),
     /// Regenerate the generated fixtures: the sanding demonstrations in fixtures/sanding/
@@ -81,7 +81,7 @@ enum Cmd {
         /// Total number of executions.
         #[arg(long, default_value_t = 1_000_000)]
         executions: u64,
-        /// Number of robots N (1 to 8): half the problems from the test kit's families, every
+        /// Number of robots N (1 to 16): half the problems from the test kit's families, every
         /// shared-mask problem scheduled by the production scheduler (`sample_schedule_n`), the
         /// rest tight at an acceptance edge of the margin check.
         #[arg(long, default_value_t = 2)]
@@ -116,6 +116,15 @@ enum Cmd {
         /// (`ContinuousCoordinator::with_max_busy_share`). 1 (default): none.
         #[arg(long, default_value_t = 1.0)]
         max_busy: f64,
+        /// Operators M (issue 44; default 1: the runs above). With M > 1 each execution runs M
+        /// operators, each with its own copy of the execution's policy on the robot it
+        /// supervises, and fails on a tick with more than M robots low-confidence, a stretch
+        /// handed over mid-way, an operator on two robots, a fault or a backward step. Rounds:
+        /// the sectored round (`Coordinator::sectored`, M even sectors, each a test kit case
+        /// tight at the edge of the one-operator check, the beam search per sector), no holds;
+        /// `--cell continuous`: the cyclic plans run with M tokens (no load cap).
+        #[arg(long, default_value_t = 1)]
+        operators: usize,
         /// Random problems to draw (default: one per 1000 executions, 1–200): more problems
         /// with fewer executions each for a reduced batch.
         #[arg(long)]
@@ -144,6 +153,7 @@ fn main() -> anyhow::Result<()> {
             tasks,
             switch_s,
             max_busy,
+            operators,
             problems,
             mixed,
         } => {
@@ -162,6 +172,23 @@ fn main() -> anyhow::Result<()> {
                     );
                 }
                 stress::mixed::run_mixed(executions, seed, robots, tasks, switch_s, problems)
+            } else if operators != 1 {
+                if max_busy < 1.0 {
+                    anyhow::bail!(
+                        "--max-busy with --operators {operators}: the load cap paces one operator"
+                    );
+                }
+                stress::operators::run(
+                    cell == "continuous",
+                    executions,
+                    seed,
+                    robots,
+                    operators,
+                    holds,
+                    tasks,
+                    switch_s,
+                    problems,
+                )
             } else if cell == "continuous" {
                 stress::run_continuous(
                     executions, seed, robots, tasks, switch_s, max_busy, problems,

@@ -52,6 +52,10 @@
 //! `k = switch_ticks(δ, tick)`. `--max-busy U` (continuous cell) adds the operator's load cap:
 //! the plans keep it and the token paces the operator to it
 //! (`ContinuousCoordinator::with_max_busy_share`), so the same checks run on the paced cell.
+//!
+//! `--operators M` (issue 44) runs `M` operators in either cell instead: [`operators`].
+
+pub(crate) mod operators;
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;

@@ -39,7 +39,7 @@ pub(crate) struct StudyArgs {
     /// execution per robot).
     #[arg(long)]
     executions: Option<usize>,
-    /// Robots N run by the one operator (1 to 8; default: the configuration's, 2). The
+    /// Robots N run by the one operator (1 to 16; default: the configuration's, 2). The
     /// configured executions are rounded down to a multiple of N unless --executions is given.
     #[arg(long)]
     robots: Option<usize>,
@@ -72,7 +72,7 @@ pub(crate) struct StudyArgs {
     /// and counted.
     #[arg(long, value_name = "S")]
     switch_true_s: Option<f64>,
-    /// The cell's number of operators M (1 to 8; `[operator] operators`; issue 44): M tokens
+    /// The cell's number of operators M (1 to 16; `[operator] operators`; issue 44): M tokens
     /// (continuous) or M sectors (rounds) and M simulated operators, one per operator index,
     /// each with the rates above.
     #[arg(long, value_name = "M")]

@@ -8,7 +8,7 @@ use tandem::lfd::{HoldRule, RateTerm, Reference};
 use tandem::planner::Cell;
 use tandem::sim::workcell::OperatorParams;
 
-/// Coordinated multi-robot shared autonomy from your own demonstrations: one operator, 1 to 8
+/// Coordinated multi-robot shared autonomy from your own demonstrations: one operator, 1 to 16
 /// robots (2 by default, --robots N at fit) (Hagenow et al., RA-L 2023).
 ///
 /// Typical session:
@@ -320,7 +320,7 @@ pub(crate) struct SamplerArgs {
     /// Stored in the state file. Default: from the parameters (1: no cap).
     #[arg(long = "max-busy", value_name = "SHARE", allow_negative_numbers = true)]
     pub(crate) max_busy: Option<f64>,
-    /// The cell's number of operators M (1 to 8; issue 44): a continuous cell runs M tokens,
+    /// The cell's number of operators M (1 to 16; issue 44): a continuous cell runs M tokens,
     /// rounds run M sectors (the robots split evenly, each sector a one-operator round); at
     /// most M robots low-confidence at once, each with its own operator. Stored in the state
     /// file. Default: from the parameters (1).
@@ -390,7 +390,7 @@ pub(crate) struct FitArgs {
     /// (PoseStamped, WrenchStamped, TwistStamped, JointState, Float64, Bool).
     #[arg(long, value_name = "/A,/B", value_delimiter = ',')]
     pub(crate) topics: Vec<String>,
-    /// Robots run by the one operator, 1 to 8 (the paper: 2): every schedule has N warps and
+    /// Robots run by the one operator, 1 to 16 (the paper: 2): every schedule has N warps and
     /// `tandem record` takes N executions per round. Stored in the state file. Default: 2,
     /// or with --keep-rounds the state's. With --task: each task's robots, NAME=K,… (robots
     /// numbered task by task in the order of the --task flags; a task not named has 1).

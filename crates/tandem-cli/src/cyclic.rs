@@ -420,8 +420,8 @@ fn activity_at(segs: &[(f64, f64, Activity)], start_s: f64, period_s: f64, t: f6
 
 /// The text Gantt of two periods `[0, 2P)`: one row per robot (`=` running high-confidence,
 /// `#` low-confidence, `h` waiting at a hold, the task start included) and the operator's
-/// row (`1`…`8`: whose stretch it supervises, `.` idle, `!` two at once: never in a valid
-/// plan), [`COLUMNS_PER_PERIOD`] columns per period, each showing its middle instant.
+/// row (`1`…`9`, then `a`…`g` for robots 10–16: whose stretch it supervises, `.` idle, `!`
+/// two at once: never in a valid plan), [`COLUMNS_PER_PERIOD`] columns per period, each showing its middle instant.
 pub(crate) fn gantt(problem: &Problem, plan: &CyclicPlan) -> String {
     let shape = TaskShape::new(problem);
     let n = plan.n_robots;
@@ -448,7 +448,7 @@ pub(crate) fn gantt(problem: &Problem, plan: &CyclicPlan) -> String {
         }
         rows[n].push(match supervised.as_slice() {
             [] => '.',
-            [r] => char::from_digit(*r as u32 + 1, 10).unwrap_or('?'),
+            [r] => char::from_digit(*r as u32 + 1, 36).unwrap_or('?'),
             _ => '!',
         });
     }

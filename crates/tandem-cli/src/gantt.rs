@@ -295,8 +295,8 @@ pub(crate) fn schedule_doc(problem: &Problem, outcome: &Outcome) -> Result<Sched
 
 /// The chart of a [`Layout`]: its time axis, one bar per robot over `[0, T_total]` (`=`
 /// running high-confidence, `#` running low-confidence, `h` waiting at a hold, blank not
-/// running), the operator's row (`1`…`8`: which robot is supervised, `.` idle, `!` two or
-/// more), the legend, and every low-confidence interval in global time. `labels[i]` names
+/// running), the operator's row (`1`…`9`, then `a`…`g` for robots 10–16: which robot is
+/// supervised, `.` idle, `!` two or more), the legend, and every low-confidence interval in global time. `labels[i]` names
 /// robot `i` (`robot 1`, or `robot 1 (sanding)` in a cell of tasks); the bars start after the
 /// longest label.
 fn write_chart(out: &mut String, layout: &Layout, labels: &[String], holds: bool) -> Result<()> {
@@ -325,7 +325,7 @@ fn write_chart(out: &mut String, layout: &Layout, labels: &[String], holds: bool
         }
         rows[n].push(match supervised.as_slice() {
             [] => '.',
-            [i] => char::from_digit(*i as u32 + 1, 10).unwrap_or('?'),
+            [i] => char::from_digit(*i as u32 + 1, 36).unwrap_or('?'),
             _ => '!',
         });
     }

@@ -424,7 +424,7 @@ impl Figure for ConfidenceFigure<'_> {
 }
 
 /// Every robot in global time: gray running high-confidence, each robot's colour
-/// (`ROBOT_LC_N`: robot 1 blue, robot 2 red, …) low-confidence.
+/// (`ROBOT_LC_N`: robot 1 blue, robot 2 red, …, repeated from robot 9 on) low-confidence.
 struct ScheduleFigure {
     t_total_s: f64,
     spans: Vec<(f64, f64)>,
@@ -553,7 +553,7 @@ impl Figure for ScheduleFigure {
                 BLACK.stroke_width(1),
             )))
             .map_err(de)?;
-        for (i, colour) in ROBOT_LC_N.iter().take(n).enumerate() {
+        for (i, colour) in ROBOT_LC_N.iter().cycle().take(n).enumerate() {
             chart
                 .draw_series(self.lc[i].iter().map(|&iv| {
                     let (s, e) = widened(iv);
@@ -561,7 +561,7 @@ impl Figure for ScheduleFigure {
                 }))
                 .map_err(de)?;
         }
-        for (i, colour) in ROBOT_LC_N.iter().take(n).enumerate() {
+        for (i, colour) in ROBOT_LC_N.iter().cycle().take(n).enumerate() {
             let y = (n + 1 - i) as f64 - 0.5;
             let (a, b) = self.spans[i];
             chart

@@ -353,7 +353,10 @@ fn bad_console_input_exits_2_with_the_reason() {
         ),
         (&["console", "--replay", r, "--speed", "0"], "--speed 0"),
         (&["console", s, "--simulate", "--speed", "0"], "--speed 0"),
-        (&["console", s, "--simulate", "--robots", "9"], "--robots 9"),
+        (
+            &["console", s, "--simulate", "--robots", "17"],
+            "--robots 17",
+        ),
         (
             &["console", "missing.tandem", "--simulate"],
             "missing.tandem",

@@ -490,7 +490,7 @@ fn medoid_reference_does_not_depend_on_the_order_of_the_files() {
 /// Three robots through the binary: `fit --robots 3` on the documented example, the schedule
 /// JSON of docs/formats.md (three warps, two offsets, no two robots low-confidence at once),
 /// `simulate --write` writes three executions per round, `record` takes exactly three and
-/// refuses two, and `--robots 9` is a user error.
+/// refuses two, and `--robots 17` is a user error.
 #[test]
 fn three_robots_fit_schedule_simulate_record() {
     let dir = scratch("three");
@@ -587,9 +587,13 @@ fn three_robots_fit_schedule_simulate_record() {
 
     let mut bad = fit.clone();
     let k = bad.iter().position(|a| a == "3").unwrap();
-    bad[k] = "9".into();
+    bad[k] = "17".into();
     let out = tandem(&bad);
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--robots 9"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--robots 17") && err.contains("1 to 16 robots"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

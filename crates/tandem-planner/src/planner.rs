@@ -1281,6 +1281,14 @@ impl Planner {
             "schedule robot 6",
             "schedule robot 7",
             "schedule robot 8",
+            "schedule robot 9",
+            "schedule robot 10",
+            "schedule robot 11",
+            "schedule robot 12",
+            "schedule robot 13",
+            "schedule robot 14",
+            "schedule robot 15",
+            "schedule robot 16",
         ];
         let warps = WARPS
             .iter()
@@ -1426,13 +1434,28 @@ mod tests {
             assert!(
                 matches!(
                     err,
-                    Error::Realtime(tandem_realtime::Error::RobotCount { n: count, max: 8 })
+                    Error::Realtime(tandem_realtime::Error::RobotCount { n: count, max: 16 })
                         if count == n
                 ),
                 "{err}"
             );
-            assert!(err.to_string().contains("1 to 8 robots"), "{err}");
+            assert!(err.to_string().contains("1 to 16 robots"), "{err}");
         }
+        // The largest count is accepted: 16 robots, 16 warps, and the planner's round
+        // checks take 16 executions.
+        let big = Planner::from_model_with_robots(
+            p.model().clone(),
+            p.params().clone(),
+            tandem_realtime::MAX_ROBOTS,
+        )
+        .unwrap();
+        assert_eq!(big.n_robots(), 16);
+        let dir = scratch("tandem-planner-sixteen");
+        let path = dir.join("cell.tandem");
+        big.save(&path).unwrap();
+        let loaded = Planner::load(&path).unwrap();
+        assert_eq!((loaded.n_robots(), loaded.schedule()), (16, big.schedule()));
+        std::fs::remove_dir_all(&dir).unwrap();
         let mut q = p.clone();
         let err = q.record_round(&[]).unwrap_err();
         assert!(

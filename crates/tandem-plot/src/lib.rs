@@ -42,9 +42,10 @@ pub const MEAN: RGBColor = RGBColor(16, 42, 120);
 /// schedules (Fig. 5); index by robot (0 or 1). The first two of [`ROBOT_LC_N`].
 pub const ROBOT_LC: [RGBColor; 2] = [ROBOT_LC_N[0], ROBOT_LC_N[1]];
 
-/// Low-confidence stretches of robots 1 to 8 (the most `tandem_realtime` runs): robot 1 blue
-/// and robot 2 red as in [`ROBOT_LC`], then orange, brown, pink, olive, cyan and gold; index
-/// by robot (0-based).
+/// Low-confidence stretches of robots 1 to 8 (then again from robot 9): robot 1 blue and robot 2 red as in
+/// [`ROBOT_LC`], then orange, brown, pink, olive, cyan and gold; index by robot (0-based),
+/// modulo 8 for robots 9 to 16 (`tandem_realtime` runs up to 16: the figures repeat the
+/// colours and name the robots in their labels).
 pub const ROBOT_LC_N: [RGBColor; 8] = [
     RGBColor(66, 133, 244),
     RGBColor(214, 39, 40),

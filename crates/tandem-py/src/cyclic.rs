@@ -322,7 +322,7 @@ fn order_of(order: &Bound<'_, PyAny>) -> Result<Vec<Stretch>> {
         .collect())
 }
 
-/// The cyclic plan of a continuous cell of ``robots`` robots (1 to 8, default 2) on
+/// The cyclic plan of a continuous cell of ``robots`` robots (1 to 16, default 2) on
 /// ``problem``: the operator order with the least period, every order searched while there
 /// are at most ``max_enumerated`` (default 100 000), a local search beyond (see
 /// :attr:`CyclicPlan.order_exhaustive`).
@@ -338,7 +338,7 @@ fn order_of(order: &Bound<'_, PyAny>) -> Result<Vec<Stretch>> {
 /// (:meth:`Planner.cyclic_plan` gives the planner's tick). Default: not counted.
 ///
 /// Raises:
-///     ParamError: ``robots`` outside 1…8, ``max_enumerated`` 0 or ``tick_s`` not finite and > 0.
+///     ParamError: ``robots`` outside 1…16, ``max_enumerated`` 0 or ``tick_s`` not finite and > 0.
 ///     InputError: an ``order`` that is not a sequence of pairs of non-negative ints.
 ///     ScheduleError: an ``order`` that does not list each robot's each stretch once in task
 ///         order, or that no period admits.

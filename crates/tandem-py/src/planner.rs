@@ -437,7 +437,7 @@ fn hold_spec(holds: &Bound<'_, PyAny>) -> Result<HoldSpec> {
 ///     dt_s: sample period (s) of arrays and of files without a ``t`` column. Give it for
 ///         arrays: without it they are taken to be 0.01 s apart with a ``DataWarning`` naming
 ///         them (deprecated: a later release refuses arrays without ``dt_s``).
-///     robots: robots ``N`` run by the one operator, 1 to 8 (default 2, the paper's): every
+///     robots: robots ``N`` run by the one operator, 1 to 16 (default 2, the paper's): every
 ///         schedule has ``N`` warps and :meth:`Planner.record_round` takes ``N`` executions.
 ///     holds: hold points, places where a robot may wait as long as needed (``tandem fit
 ///         --hold-at``/``--hold-where``): a list of reference times (numbers, s, each at its
@@ -455,7 +455,7 @@ fn hold_spec(holds: &Bound<'_, PyAny>) -> Result<HoldSpec> {
 ///         supervised time plus ``switch_s`` per change of robot, may not exceed it
 ///         (``tandem fit --max-busy``). ``None`` (default) keeps
 ///         ``params["sampler"]["max_busy_share"]`` (1: no cap). Stored in the state file.
-///     operators: the cell's operators ``M``, 1 to 8 (issue 44; ``tandem fit --operators``):
+///     operators: the cell's operators ``M``, 1 to 16 (issue 44; ``tandem fit --operators``):
 ///         at most ``M`` robots low-confidence at once, each under its own operator — a
 ///         continuous cell runs ``M`` tokens, rounds run ``M`` sectors
 ///         (:meth:`Planner.sectored_rounds`). ``None`` (default) keeps
@@ -968,7 +968,7 @@ impl PyPlanner {
     ///         (default: the planner's, ``params()["sampler"]["switch_s"]``).
     ///     max_busy_share: the operator's load cap ``u_max`` in ``(0, 1]`` from now on
     ///         (default: the planner's).
-    ///     operators: the cell's operators ``M``, 1 to 8, from now on (issue 44; default: the
+    ///     operators: the cell's operators ``M``, 1 to 16, from now on (issue 44; default: the
     ///         planner's): rounds then run :meth:`sectored_rounds`, a continuous cell ``M``
     ///         tokens (:meth:`controller`). The schedule itself is the one-operator schedule of
     ///         all robots (the state file's).

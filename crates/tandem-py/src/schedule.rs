@@ -111,7 +111,7 @@ impl PyProblem {
 
     /// The fastest serial schedule (§II-C fallback): every robot as fast as allowed, each
     /// starting when the one before it ends; valid at any tick. ``tick_s`` (real s) defaults
-    /// to ``dt_s``; ``robots`` is ``N`` (1 to 8, default 2).
+    /// to ``dt_s``; ``robots`` is ``N`` (1 to 16, default 2).
     #[pyo3(signature = (tick_s=None, robots=N_ROBOTS))]
     fn serial_schedule(&self, tick_s: Option<f64>, robots: usize) -> PyResult<PySchedule> {
         let tick_s = tick_s.unwrap_or(self.inner.dt_s());
@@ -125,7 +125,7 @@ impl PyProblem {
         })
     }
 
-    /// The scheduler (§II-C) on this problem for ``robots`` robots (1 to 8, default 2):
+    /// The scheduler (§II-C) on this problem for ``robots`` robots (1 to 16, default 2):
     /// ``samples`` candidates from ``seed`` (deterministic for a seed whatever the thread
     /// count), margins checked at control tick ``tick_s`` (real s, default ``dt_s``),
     /// warm-started by ``previous``.

@@ -44,7 +44,7 @@ pub enum Error {
     },
     /// The number of robots is not in `1..=MAX_ROBOTS` ([`RobotCount::new`](crate::RobotCount::new),
     /// the one check of a robot count in the workspace).
-    #[error("{n} robots: one operator supervises 1 to {max} robots")]
+    #[error("{n} robots: a cell has 1 to {max} robots")]
     RobotCount {
         /// The robot count given.
         n: usize,

@@ -9,11 +9,12 @@ use crate::error::{Error, Result};
 
 /// Largest number of robots one [`Coordinator`](crate::Coordinator) or one
 /// [`sufficient_margins`](crate::sufficient_margins) call takes (the per-tick state lives in
-/// arrays of this size).
-pub const MAX_ROBOTS: usize = 8;
+/// arrays of this size; [`RobotFlags`] is a 16-bit set). 16 since issue 44 (8 before): what
+/// limits it is docs/decisions.md, "Up to 16 robots: what limits N (issue 44)".
+pub const MAX_ROBOTS: usize = 16;
 
 /// A checked robot count `N`, `1 ≤ N ≤` [`MAX_ROBOTS`]: the one place the workspace checks
-/// how many robots one operator may supervise, and the one error it gives
+/// how many robots one cell (its `M ≥ 1` operators) may have, and the one error it gives
 /// ([`Error::RobotCount`]). The schedule, the cyclic plan, the planner and the front ends
 /// convert a count they are given into it where it enters (their own errors wrap this one),
 /// so the rule and its message live here only.
@@ -23,7 +24,7 @@ pub const MAX_ROBOTS: usize = 8;
 /// assert_eq!(RobotCount::new(3)?.get(), 3);
 /// assert!(matches!(RobotCount::new(0), Err(Error::RobotCount { n: 0, .. })));
 /// let err = RobotCount::new(MAX_ROBOTS + 1).unwrap_err();
-/// assert_eq!(err.to_string(), "9 robots: one operator supervises 1 to 8 robots");
+/// assert_eq!(err.to_string(), "17 robots: a cell has 1 to 16 robots");
 /// # Ok::<(), Error>(())
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -191,7 +192,7 @@ impl<T: fmt::Debug> fmt::Debug for PerRobot<T> {
 }
 
 /// One flag per robot (robot `i` at index `i`) for the `n ≤ MAX_ROBOTS` robots of one
-/// coordinator, as a bit set: two bytes, copied for free with every
+/// coordinator, as a bit set: four bytes, copied for free with every
 /// [`Tick`](crate::Tick). Reads like a `[bool]` of length `n`: `flags[i]`, `iter`, comparison
 /// with a `[bool; n]`.
 ///
@@ -206,7 +207,7 @@ impl<T: fmt::Debug> fmt::Debug for PerRobot<T> {
 #[derive(Clone, Copy, Default, PartialEq, Eq)]
 pub struct RobotFlags {
     len: u8,
-    bits: u8,
+    bits: u16,
 }
 
 impl RobotFlags {
@@ -313,7 +314,7 @@ mod tests {
         assert_eq!(format!("{v:?}"), "[0.0, 0.0, 1.5]");
         assert_ne!(v, PerRobot::from_slice(&[0.0, 0.0]));
         assert_eq!(PerRobot::<bool>::new(20).len(), MAX_ROBOTS);
-        assert!(check_count(0).is_err() && check_count(9).is_err());
+        assert!(check_count(0).is_err() && check_count(MAX_ROBOTS + 1).is_err());
         let mut f = RobotFlags::new(3);
         f.set(2, true);
         f.set(5, true);
@@ -343,7 +344,7 @@ mod tests {
         }
         assert_eq!(
             RobotCount::new(0).unwrap_err().to_string(),
-            "0 robots: one operator supervises 1 to 8 robots"
+            "0 robots: a cell has 1 to 16 robots"
         );
     }
 
@@ -360,8 +361,8 @@ mod tests {
         }
         assert_eq!(OperatorCount::default(), OperatorCount::ONE);
         assert_eq!(
-            OperatorCount::new(9).unwrap_err().to_string(),
-            "9 operators: a cell has 1 to 8 operators (use 1 for one operator)"
+            OperatorCount::new(17).unwrap_err().to_string(),
+            "17 operators: a cell has 1 to 16 operators (use 1 for one operator)"
         );
     }
 }

@@ -1608,7 +1608,7 @@ mod tests {
         ));
         assert!(matches!(
             Coordinator::new(vec![r[0].clone(); MAX_ROBOTS + 1], 1.0),
-            Err(Error::RobotCount { n: 9, max: 8 })
+            Err(Error::RobotCount { n: 17, max: 16 })
         ));
     }
 }

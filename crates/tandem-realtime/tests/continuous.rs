@@ -150,7 +150,7 @@ fn bad_input_is_an_error() {
     ));
     assert!(matches!(
         new(&[], &order, MAX_ROBOTS + 1, 0.5),
-        Err(Error::RobotCount { n: 9, .. })
+        Err(Error::RobotCount { n: 17, .. })
     ));
     for tick in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         assert!(matches!(

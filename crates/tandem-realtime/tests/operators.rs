@@ -152,7 +152,13 @@ proptest! {
     #[test]
     fn at_most_m_robots_low_confidence_each_with_one_operator(
         seed in any::<u64>(),
-        (n, m) in prop_oneof![Just((4_usize, 2_usize)), Just((8, 2)), Just((8, 4)), Just((3, 1))],
+        (n, m) in prop_oneof![
+            Just((4_usize, 2_usize)),
+            Just((8, 2)),
+            Just((8, 4)),
+            Just((3, 1)),
+            Just((16, 4)),
+        ],
         policy in prop_oneof![
             Just(Policy::Rush),
             Just(Policy::Drag),

@@ -1,4 +1,4 @@
-//! The safety invariant for N ∈ {2, …, 6} robots: for every schedule `sufficient_margins`
+//! The safety invariant for N ∈ {2, …, 6, 16} robots: for every schedule `sufficient_margins`
 //! accepts and every operator of `tandem_realtime::adversary` (Alg. 2's worst case with each
 //! robot as the current one, the favoured robot switching at random times, extremes, random and
 //! switching sequences, and the beam search over per-tick choices), the coordinator never has
@@ -39,7 +39,12 @@ fn accepted_schedules_of_n_robots_never_overlap_under_any_operator() {
         };
         TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha))
     };
-    for n in 2..=6usize {
+    // N = 16 (MAX_ROBOTS): a few cases, a fortieth of the others' (each has 15 robots to
+    // place at an edge, every adversary of 30).
+    for (n, cases) in (2..=6usize)
+        .map(|n| (n, cases))
+        .chain([(16, (cases / 40).max(4))])
+    {
         let (overlapping, edge) = (Cell::new(0u32), Cell::new(0u32));
         let result = runner(cases).run(&any::<u64>(), |seed| {
             let mut r = rng(seed);

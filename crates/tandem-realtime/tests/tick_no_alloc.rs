@@ -55,7 +55,7 @@ fn a_whole_run_of_ticks_allocates_nothing() {
         whole_run_allocates_nothing(n_robots, false);
     }
     // With hold points: every robot's plan split into legs at holds in its HC runs (one with a
-    // planned dwell), release rules from the order of the stretches; N = 1…8.
+    // planned dwell), release rules from the order of the stretches; N = 1…MAX_ROBOTS.
     for n_robots in 1..=MAX_ROBOTS {
         whole_run_allocates_nothing(n_robots, true);
     }

@@ -630,12 +630,12 @@ mod tests {
             }))
         ));
         let mut bad = s.clone();
-        bad.grad_exec = vec![bad.grad_exec[0].clone(); 9];
-        bad.offsets_s = vec![0.0; 8];
+        bad.grad_exec = vec![bad.grad_exec[0].clone(); 17];
+        bad.offsets_s = vec![0.0; 16];
         assert!(matches!(
             validate(&p, &bad),
             Err(Violation::RobotCount(tandem_realtime::Error::RobotCount {
-                n: 9,
+                n: 17,
                 ..
             }))
         ));

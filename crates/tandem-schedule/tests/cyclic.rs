@@ -330,7 +330,7 @@ fn check_plan(p: &Problem, plan: &CyclicPlan) {
 fn a_task_without_low_confidence_runs_at_its_fastest() {
     // 10 samples at 0.1 s, ψ̇min 0.5: 0.5 s.
     let p = problem(&[(10, true)], 0.5, 2.0, 0.1, vec![]);
-    for n in 1..=8 {
+    for n in 1..=tandem_realtime::MAX_ROBOTS {
         let plan = cyclic_plan(&p, n, &CyclicParams::default()).unwrap();
         assert!((plan.period_s - 0.5).abs() < 1e-12);
         assert!(plan.order.is_empty() && plan.operator_share == 0.0);
@@ -342,14 +342,14 @@ fn a_task_without_low_confidence_runs_at_its_fastest() {
         cyclic_plan(&p, 0, &CyclicParams::default()),
         Err(Error::Realtime(tandem_realtime::Error::RobotCount {
             n: 0,
-            max: 8
+            max: 16
         }))
     ));
     assert!(matches!(
-        cyclic_plan(&p, 9, &CyclicParams::default()),
+        cyclic_plan(&p, 17, &CyclicParams::default()),
         Err(Error::Realtime(tandem_realtime::Error::RobotCount {
-            n: 9,
-            max: 8
+            n: 17,
+            max: 16
         }))
     ));
 }
@@ -435,9 +435,9 @@ fn a_gap_without_hold_forbids_interleaving_and_a_hold_allows_it() {
         ));
     }
     assert!(matches!(
-        period_lower_bound_s(&held, 9),
+        period_lower_bound_s(&held, 17),
         Err(Error::Realtime(tandem_realtime::Error::RobotCount {
-            n: 9,
+            n: 17,
             ..
         }))
     ));

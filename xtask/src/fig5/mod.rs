@@ -66,7 +66,7 @@ pub(crate) struct ExampleSchedule {
     pub iteration: usize,
     /// The schedule's task length `T_total` (Eq. 13), in seconds of global time.
     pub t_total_s: f64,
-    /// Per robot (robot 1 first; 1 to 8 robots), the global-time intervals
+    /// Per robot (robot 1 first; 1 to 16 robots), the global-time intervals
     /// `(start_s, end_s)` in which it is low-confidence; each within `[0, t_total_s]`.
     pub lc: Vec<Vec<(f64, f64)>>,
 }

@@ -16,7 +16,8 @@
 //! [`adversary_set`] returns the full set for one case of `N` robots, [`run_adversary`] runs one
 //! execution under one adversary and counts the ticks with two or more robots low-confidence.
 //! The driver is the one for every controller ([`Controller`]: rounds and the continuous cell,
-//! [`run_adversary_on`] for a number of tasks).
+//! [`run_adversary_on`] for a number of tasks); [`operators::run_operators_on`] drives `M ≥ 1`
+//! operators, each with its own copy of a policy, and checks the `M`-operator invariant.
 //!
 //! ```
 //! use rand::SeedableRng;
@@ -38,6 +39,7 @@
 //! # Ok::<(), tandem_realtime::Error>(())
 //! ```
 
+pub mod operators;
 pub mod search;
 
 use rand::Rng;

@@ -35,8 +35,15 @@
 //! from the start for the first robots): a waiting robot is at least at the least clock of the
 //! robots started before it (by induction over the ticks: while one runs it follows the least
 //! of them; when all have finished, at their ends, it moves on by `h`), and a started one is
-//! at or past `τ_i`. When every such `k` has surely finished (`L_k(n) ≥ e_k`) none runs in tick
-//! `n`, so also `L_i(n+1) ≥ min(τ_i, L_i(n) + h)`.
+//! at or past `τ_i`. Also `L_i(n+1) ≥ min(τ_i, L_i(n) + h, min_k L_k(n+1))` over only the
+//! robots `k` with `τ_k < τ_i` not surely finished (`L_k(n) < e_k`; `+∞` when there are none):
+//! the robots running in tick `n` are among them, so the least new clock `x` they set is at
+//! least that minimum; with none running the robot moves on by `h`; and the cap is `τ_i` or the
+//! start `τ_j < τ_i` of a waiting robot `j`, which is among them with `L_j(n+1) ≤ τ_j`. Without
+//! this second bound a robot that finished long ago (its clock stays at `e_k`) held the lower
+//! envelope of every later robot back: a third wave of robots had windows from its upper
+//! envelope's start to far past its real end, and a round of four waves of four robots was
+//! refused with four operators (`four_waves_of_four_robots_need_four_operators`).
 //!
 //! # Windows, and why they are conservative
 //! Robot `i` reports low confidence in tick `n` only if a low-confidence sample of one of its
@@ -58,8 +65,22 @@
 //! `w` and those windows form a clique): the check accepts exactly when at most `M` robots'
 //! windows ever share a tick. With `k > 0` a successful assignment is still a proof.
 //!
+//! **Ordered robots.** The envelopes bound each robot alone and forget that in a round robot
+//! `b` with `e_a ≤ τ_b` starts only after robot `a` has finished: while `a` runs, the least new
+//! clock `x` of the running robots is at most `e_a ≤ τ_b`, and while `a` waits the cap is at
+//! most `τ_a < τ_b`, so `b` reaches `τ_b` at the earliest in the tick in which `a` finishes and
+//! runs (and reports low confidence) only from the next one. Their stretches never share a
+//! tick, however wide their windows (waves of robots, each after the last: the uncertainty of
+//! the clocks grows from wave to wave and the windows of consecutive waves overlap). With
+//! `k = 0` an operator is therefore also free for a window of `b` while it holds windows of
+//! such robots `a` (before or after it); with `k > 0` the windows must be `k` ticks apart as
+//! above. The greedy colouring checks every window an operator holds; with ordered robots it
+//! may need more operators than the most robots that can be low-confidence at once, but every
+//! assignment it returns is a proof.
+//!
 //! **The guarantee.** Two robots low-confidence in one tick lie in two windows containing that
-//! tick, which have different operators; an operator's windows are disjoint. So in every tick
+//! tick, of robots not ordered, which have different operators; an operator's windows are
+//! disjoint or of ordered robots. So in every tick
 //! each operator has at most one low-confidence robot, at most `M` robots are low-confidence,
 //! no stretch changes operator (its window has one), and an operator's stretches of two robots
 //! have at least `k` ticks between them. The coordinator finds a robot's operator from the run
@@ -235,13 +256,13 @@ pub fn operator_windows(robots: &[Timeline], tick_s: f64) -> Result<Vec<Operator
                 .fold(f64::INFINITY, f64::min);
             // Every robot that can run while `i` waits starts before it, so `least` is finite.
             new_lo[i] = lo[i].max(least.min(start[i]));
-            // Every robot before it surely finished: none runs, `i` moves on by `h`.
-            if (0..n)
-                .filter(|&k| start[k] < start[i])
-                .all(|k| lo[k] >= end[k])
-            {
-                new_lo[i] = new_lo[i].max((lo[i] + h).min(start[i]));
-            }
+            // The same over the robots before it not surely finished (a finished robot does
+            // not run; none running, `i` moves on by `h`): `+∞` when all surely finished.
+            let unfinished = (0..n)
+                .filter(|&k| start[k] < start[i] && lo[k] < end[k])
+                .map(|k| new_lo[k])
+                .fold(f64::INFINITY, f64::min);
+            new_lo[i] = new_lo[i].max(unfinished.min(lo[i] + h).min(start[i]));
         }
         // Windows: tick `tick` is in run `[a, b)`'s window iff U(tick+1) + pad ≥ a and
         // L(tick) − pad < b.
@@ -311,14 +332,27 @@ pub fn assign_operators(
 ) -> Result<Option<OperatorPlan>> {
     let mut windows = operator_windows(robots, tick_s)?;
     let m = operators.get();
-    // Per operator: the last tick and robot of its last window.
-    let mut busy: Vec<Option<(u64, usize)>> = vec![None; m];
+    // Robot `b` starts only after robot `a` has finished when `e_a ≤ τ_b` (module docs,
+    // "Ordered robots"): their stretches never share a tick.
+    let ordered = |a: usize, b: usize| {
+        let (ra, rb) = (&robots[a], &robots[b]);
+        ra.end_s() <= rb.start_s() || rb.end_s() <= ra.start_s()
+    };
+    // Per operator: the windows (indices) assigned to it so far.
+    let mut held: Vec<Vec<usize>> = vec![Vec::new(); m];
     let mut last_op: Vec<Option<usize>> = vec![None; robots.len()];
-    for w in &mut windows {
-        let free = |o: usize| match busy[o] {
-            None => true,
-            Some((end, robot)) if robot == w.robot => end < w.first,
-            Some((end, _)) => end.saturating_add(switch_ticks) < w.first,
+    for wi in 0..windows.len() {
+        let w = windows[wi];
+        let free = |o: usize| {
+            held[o].iter().all(|&vi| {
+                let v: &OperatorWindow = &windows[vi];
+                if v.robot == w.robot {
+                    v.last < w.first
+                } else {
+                    v.last.saturating_add(switch_ticks) < w.first
+                        || (switch_ticks == 0 && ordered(v.robot, w.robot))
+                }
+            })
         };
         let pick = last_op[w.robot]
             .filter(|&o| free(o))
@@ -326,8 +360,8 @@ pub fn assign_operators(
         let Some(o) = pick else {
             return Ok(None);
         };
-        w.operator = o as u8;
-        busy[o] = Some((w.last, w.robot));
+        windows[wi].operator = o as u8;
+        held[o].push(wi);
         last_op[w.robot] = Some(o);
     }
     let mut op_of_run: Vec<Vec<u8>> = robots
@@ -410,6 +444,70 @@ mod tests {
         assert!(assign_operators(&st, 1.0, m(2), 2).unwrap().is_none());
         assert_eq!(p.operator_from(2, 0), 0);
         assert_eq!(p.operator_from(1, 3), 1);
+    }
+
+    /// Four waves of four robots of [HC, HC, LC, LC, HC × 6] (one sample a second, started
+    /// together within a wave, the waves 30 s apart), ticked at 1 s. Rigid (bounds [1, 1]): the
+    /// clock is the tick count, so wave `w`'s windows are `[30w + 1, 30w + 4]` as for one robot
+    /// (`one_robot_on_schedule_has_its_window_by_hand`), four robots share each: four operators
+    /// suffice, three do not. Before the lower envelope left out the robots surely finished,
+    /// wave 2's envelope stayed at the first wave's end (10 s) while wave 1 ran, its windows
+    /// ran into wave 3's and the round was refused with four operators. With bounds [0.5, 2]
+    /// the windows of consecutive waves overlap, but the waves are ordered (module docs,
+    /// "Ordered robots"): four operators again, without a switch time.
+    #[test]
+    fn four_waves_of_four_robots_need_four_operators() {
+        let m = |k| OperatorCount::new(k).unwrap();
+        let waves = |lo: f64, hi: f64| -> Vec<Timeline> {
+            (0..16)
+                .map(|i| task(2, 2, 6, 30.0 * (i / 4) as f64, lo, hi))
+                .collect()
+        };
+        let rigid = waves(1.0, 1.0);
+        let w = operator_windows(&rigid, 1.0).unwrap();
+        assert_eq!(w.len(), 16);
+        for x in &w {
+            let wave = (x.robot / 4) as u64;
+            assert_eq!((x.first, x.last), (30 * wave + 1, 30 * wave + 4), "{x:?}");
+        }
+        assert!(assign_operators(&rigid, 1.0, m(3), 0).unwrap().is_none());
+        let p = assign_operators(&rigid, 1.0, m(4), 0).unwrap().unwrap();
+        assert_eq!(p.max_concurrent(), 4);
+        // [0.5, 2]: wave `w` may end 5 to 20 ticks after its start, so the clocks' uncertainty
+        // grows by 15 ticks a wave and the windows of consecutive waves overlap from wave 2 on
+        // (8 windows share a tick); the waves are ordered (each ends 20 s of clock before the
+        // next starts), so each operator holds one robot of every wave.
+        let wide = waves(0.5, 2.0);
+        let w = operator_windows(&wide, 1.0).unwrap();
+        let of = |r: usize| w.iter().find(|x| x.robot == r).map(|x| (x.first, x.last));
+        assert!(of(8).unwrap().1 >= of(12).unwrap().0, "{w:?}");
+        let p = assign_operators(&wide, 1.0, m(4), 0).unwrap().unwrap();
+        assert_eq!(p.max_concurrent(), 8);
+        for wave in 0..4 {
+            let mut ops: Vec<u8> = (0..4).map(|j| p.operator_from(4 * wave + j, 0)).collect();
+            ops.sort_unstable();
+            assert_eq!(ops, [0, 1, 2, 3]);
+        }
+        assert!(assign_operators(&wide, 1.0, m(3), 0).unwrap().is_none());
+        // With a switch time the order gives no gap of `k` ticks: the windows must be apart,
+        // and these are not (the limit: such a round is refused, `Error::Unsafe`).
+        assert!(assign_operators(&wide, 1.0, m(4), 1).unwrap().is_none());
+        assert!(assign_operators(&rigid, 1.0, m(4), 1).unwrap().is_some());
+        let err = crate::Coordinator::new_unchecked(wide, 1.0)
+            .unwrap()
+            .with_switch_s(1.0)
+            .unwrap()
+            .with_operators(m(4))
+            .unwrap_err();
+        assert!(
+            matches!(err, Error::Unsafe { tick_s } if tick_s == 1.0),
+            "{err}"
+        );
+        assert!(
+            err.to_string()
+                .contains("the margin check rejects these plans"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -159,7 +159,7 @@ impl SamplerParams {
         if !(1..=tandem_realtime::MAX_ROBOTS).contains(&self.operators) {
             return Err(Error::BadParam {
                 name: "operators",
-                why: "must be 1 to 8 (tandem_realtime::MAX_ROBOTS): the operators of the cell; 1: one operator",
+                why: "must be 1 to 16 (tandem_realtime::MAX_ROBOTS): the operators of the cell; 1: one operator",
             });
         }
         Ok(())

@@ -152,7 +152,7 @@ impl StudyConfig {
         if !(1..=tandem_realtime::MAX_ROBOTS).contains(&self.robots) {
             return bad(
                 "robots",
-                "must be between 1 and 8 (tandem_realtime::MAX_ROBOTS)",
+                "must be between 1 and 16 (tandem_realtime::MAX_ROBOTS)",
             );
         }
         if self.executions == 0 || self.executions % self.robots != 0 {
@@ -205,7 +205,7 @@ impl StudyConfig {
         if !(1..=tandem_realtime::MAX_ROBOTS).contains(&op.operators) {
             return bad(
                 "operator.operators",
-                "must be between 1 and 8 (tandem_realtime::MAX_ROBOTS): the cell's operators",
+                "must be between 1 and 16 (tandem_realtime::MAX_ROBOTS): the cell's operators",
             );
         }
         let sampler = &self.planner.sampler;
@@ -270,7 +270,7 @@ mod tests {
             ),
             (
                 StudyConfig {
-                    robots: 9,
+                    robots: 17,
                     ..Default::default()
                 },
                 "robots",
