@@ -105,7 +105,7 @@ fn rounds_case(
             sector_of.extend(std::iter::repeat_n(o, g));
         }
         let budget = testkit::adversary_budget(&robots, &[], case.tick_s);
-        let controller = Coordinator::sectored(robots.clone(), &sector_of, m, &params)?;
+        let controller = Coordinator::sectored(robots.clone(), &[], &sector_of, m, &params)?;
         return Ok(OpCase {
             adversaries: case.adversaries(&robots, &mut rng),
             controller,
