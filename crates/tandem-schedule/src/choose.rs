@@ -601,6 +601,14 @@ fn settle_room_aware(
     cleared
 }
 
+/// The relative gap `T_total / T*₀ − 1` above which two robots try the margin-free optimum
+/// with clearances traded between switches (`clearance::pair_traded`) after every other
+/// candidate; below it its up to `MAX_TRADE_CHECKS + 1` margin checks are not spent. Not tuned
+/// on the zoo: the default study ends its `--trials 1 --executions 40` run 2.2 % above `T*₀`
+/// (and its full run 0.1 %), below it (docs/decisions.md, "Two robots with holds: clearances
+/// traded between switches (issue 38)").
+pub(crate) const TRADE_GAP_TRIGGER: f64 = 0.03;
+
 /// Clearance steps of [`cleared_optimum`]: `M·2^k` for `k = 0..CLEAR_STEPS`.
 const CLEAR_STEPS: i32 = 8;
 
@@ -1131,6 +1139,38 @@ fn schedule_n(
         }
         if t < best.1 {
             best = (schedule, t, Source::Staggered);
+        }
+    }
+    // N = 2 with at least two LC runs, when the best so far is more than `TRADE_GAP_TRIGGER`
+    // above the bound: the margin-free optimum without release rules re-timed with every
+    // switch at the room the check asks, room traded between switches (`clearance::
+    // pair_traded`; docs/decisions.md, "Two robots with holds: clearances traded between
+    // switches (issue 38)"). Not with the benchmark baselines.
+    if plan.bound == BoundBy::Pair
+        && *baselines == SamplerBaselines::default()
+        && best.1 > (1.0 + TRADE_GAP_TRIGGER) * bound.lower_bound_s
+        && problem.runs().iter().filter(|r| !r.high_conf).count() >= 2
+        && let Some(optimum) = bound.schedule.as_ref()
+        && optimum.t_total_s(problem.dt_s()) < best.1
+    {
+        let timed = Schedule {
+            tick_s,
+            ..optimum.clone()
+        };
+        let (traded, used) = crate::clearance::pair_traded(
+            problem,
+            &timed,
+            tick_s,
+            best.1,
+            crate::clearance::MAX_TRADE_CHECKS,
+            sw,
+        );
+        checks += used;
+        if let Some((s, t)) = traded {
+            if capping {
+                pool.push((s.clone(), t, Source::Held));
+            }
+            best = (s, t, Source::Held);
         }
     }
     // N ≥ 3 with hold points: the optimum without release rules (whose planned waits cost the

@@ -26,13 +26,14 @@ use tandem_realtime::{Timeline, pair_slacks, pair_slacks_with_holds};
 
 use crate::choose::max_step_s;
 use crate::problem::Problem;
-use crate::retime::{PairClearance, retime_with_pairs};
+use crate::retime::{PairClearance, retime_with_pairs, retime_with_set_pairs};
 use crate::schedule::Schedule;
 use crate::validate::validate_with_switch;
 
-/// A pair of LC runs the check measured: `(robot, LC run)` before and after, and its slack
-/// (schedule-clock s, `> 0` when the pair has room).
-type Measured = ((usize, usize), (usize, usize), f64);
+/// A pair of LC runs the check measured: `(robot, LC run)` before and after, its slack
+/// (schedule-clock s, `> 0` when the pair has room) and its room on schedule (s: the later
+/// run's start less the earlier run's end).
+type Measured = ((usize, usize), (usize, usize), f64, f64);
 
 /// A pair of LC runs of different robots: `(robot, LC run)` before and after.
 type RunPair = ((usize, usize), (usize, usize));
@@ -95,8 +96,90 @@ pub(crate) fn pair_cleared(
         if failing.iter().any(|m| !m.2.is_finite()) {
             break;
         }
-        for (prev, cur, slack_s) in failing {
+        for (prev, cur, slack_s, _) in failing {
             *extra.entry((prev, cur)).or_insert(0.0) += -slack_s + grow_s;
+        }
+    }
+    (None, checks)
+}
+
+/// Margin checks [`pair_traded`] may spend on one re-schedule (as [`MAX_PAIR_CHECKS`]).
+pub(crate) const MAX_TRADE_CHECKS: usize = 12;
+
+/// `optimum` (the margin-free optimum of two robots, its holds without release rules)
+/// re-timed with every switch at the room the check asks, room traded between switches: each
+/// iteration measures every pair's slack ([`measure`]) and sets the pair's clearance (the
+/// later run's start less the earlier run's end, [`retime_with_set_pairs`]) to its room on
+/// schedule less its slack plus a tenth of the check's maximal step `M` where the pair fails,
+/// and to its room less half of its slack beyond `M/10` where it has more to spare, until
+/// every slack is positive and [`validate_with_switch`] accepts the re-timing at the switch
+/// time `switch_s` (s), the re-timing is no longer below `cap_s` (s) or has no solution, or
+/// `max_checks` measurements are spent. Returns the re-timing with its `T_total` (s) and the
+/// margin checks used (at most `max_checks + 1`).
+///
+/// Why beside [`pair_cleared`]: its clearances only grow from the optimum's, and the optimum
+/// can keep more room at one switch than the check needs while a robot's HC gap without a
+/// usable hold cannot absorb the room another switch lacks (two robots alternating two runs
+/// each: `c₁ + c₂` must fit in one HC gap's slowing range, and the optimum gives `c₁` all of
+/// it), so growing the failing switch's clearance has no solution; here the first switch gives
+/// back what it does not need (docs/decisions.md, "Two robots with holds: clearances traded
+/// between switches (issue 38)").
+pub(crate) fn pair_traded(
+    problem: &Problem,
+    optimum: &Schedule,
+    tick_s: f64,
+    cap_s: f64,
+    max_checks: usize,
+    switch_s: f64,
+) -> (Option<(Schedule, f64)>, usize) {
+    let dt_s = problem.dt_s();
+    let grow_s = max_step_s(problem, tick_s) / 10.0;
+    let lc_starts: Vec<usize> = problem
+        .runs()
+        .iter()
+        .filter(|r| !r.high_conf)
+        .map(|r| r.start)
+        .collect();
+    let mut clear: BTreeMap<RunPair, f64> = BTreeMap::new();
+    let mut checks = 0;
+    while checks < max_checks {
+        let pairs: Vec<PairClearance> = clear
+            .iter()
+            .map(|(&(prev, cur), &extra_s)| PairClearance { prev, cur, extra_s })
+            .collect();
+        let Some(s) = retime_with_set_pairs(problem, optimum, tick_s, &pairs, true) else {
+            break;
+        };
+        let t = s.t_total_s(dt_s);
+        if t >= cap_s {
+            break;
+        }
+        checks += 1;
+        let Some(measured) = measure(problem, &s, tick_s, &lc_starts) else {
+            break;
+        };
+        if measured.iter().all(|m| m.2 > 0.0) {
+            checks += 1;
+            if validate_with_switch(problem, &s, switch_s).is_ok() {
+                return (Some((s, t)), checks);
+            }
+            break;
+        }
+        if measured
+            .iter()
+            .any(|m| !m.2.is_finite() || !m.3.is_finite())
+        {
+            break;
+        }
+        for (prev, cur, slack_s, room_s) in measured {
+            let set_s = if slack_s <= 0.0 {
+                room_s - slack_s + grow_s
+            } else if slack_s > grow_s {
+                room_s - 0.5 * (slack_s - grow_s)
+            } else {
+                room_s
+            };
+            clear.insert((prev, cur), set_s.max(0.0));
         }
     }
     (None, checks)
@@ -137,7 +220,12 @@ fn measure(
         .map(|s| {
             let prev = *run_of.get(&(s.prev_robot, s.prev.start_s.to_bits()))?;
             let cur = *run_of.get(&(s.cur_robot, s.cur.start_s.to_bits()))?;
-            Some(((s.prev_robot, prev), (s.cur_robot, cur), s.slack_s))
+            Some((
+                (s.prev_robot, prev),
+                (s.cur_robot, cur),
+                s.slack_s,
+                s.cur.start_s - s.prev.end_s,
+            ))
         })
         .collect()
 }

@@ -89,6 +89,43 @@ pub(crate) fn retime_with_pairs(
     pairs: &[PairClearance],
     dwell_anywhere: bool,
 ) -> Option<Schedule> {
+    retime_pairs(
+        problem,
+        previous,
+        tick_s,
+        extra_clear_s,
+        pairs,
+        dwell_anywhere,
+        false,
+    )
+}
+
+/// [`retime_with_pairs`] with every pair of `pairs` at the clearance `extra_s` itself (s, ≥ 0:
+/// the later run starts at least that long after the earlier ends) instead of its old
+/// clearance plus `extra_s`; a pair of consecutive runs that `pairs` names no longer keeps its
+/// old clearance, so room one switch of `previous` had to spare can go to another that lacks
+/// it (docs/decisions.md, "Two robots with holds: clearances traded between switches (issue
+/// 38)"). Pairs not named keep their old clearances, events no earlier than in `previous`.
+pub(crate) fn retime_with_set_pairs(
+    problem: &Problem,
+    previous: &Schedule,
+    tick_s: f64,
+    pairs: &[PairClearance],
+    dwell_anywhere: bool,
+) -> Option<Schedule> {
+    retime_pairs(problem, previous, tick_s, 0.0, pairs, dwell_anywhere, true)
+}
+
+/// [`retime_with_pairs`] (`set` false) and [`retime_with_set_pairs`] (`set` true).
+fn retime_pairs(
+    problem: &Problem,
+    previous: &Schedule,
+    tick_s: f64,
+    extra_clear_s: f64,
+    pairs: &[PairClearance],
+    dwell_anywhere: bool,
+    set: bool,
+) -> Option<Schedule> {
     let n_ref = problem.n_ref();
     let n_robots = previous.n_robots();
     if previous.check_shape().is_err()
@@ -216,10 +253,18 @@ pub(crate) fn retime_with_pairs(
         .map(|(i, k)| (old_at[i][lc[k].0], i, k))
         .collect();
     order.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+    let named = |i: usize, k: usize, j: usize, l: usize| {
+        pairs.iter().any(|pc| pc.prev == (i, k) && pc.cur == (j, l))
+    };
     for w in order.windows(2) {
         let ((_, i, k), (start_s, j, l)) = (w[0], w[1]);
         if i != j {
-            let clear_s = (start_s - old_at[i][lc[k].1]).max(0.0) + extra_clear_s;
+            // A named pair's clearance is its own (below); the order stays.
+            let clear_s = if set && named(i, k, j, l) {
+                0.0
+            } else {
+                (start_s - old_at[i][lc[k].1]).max(0.0) + extra_clear_s
+            };
             push(lc_var(i, k), lc_var(j, l), lc_s[k] + clear_s);
         }
     }
@@ -228,7 +273,11 @@ pub(crate) fn retime_with_pairs(
         if i == j || i >= n_robots || j >= n_robots || k >= m || l >= m {
             continue;
         }
-        let clear_s = (old_at[j][lc[l].0] - old_at[i][lc[k].1]).max(0.0) + pc.extra_s.max(0.0);
+        let clear_s = if set {
+            pc.extra_s.max(0.0)
+        } else {
+            (old_at[j][lc[l].0] - old_at[i][lc[k].1]).max(0.0) + pc.extra_s.max(0.0)
+        };
         push(lc_var(i, k), lc_var(j, l), lc_s[k] + clear_s);
     }
     let x = match longest_paths(&edges, n_vars, 0.0) {

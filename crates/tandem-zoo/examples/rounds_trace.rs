@@ -3,8 +3,11 @@
 //! would give without the previous schedule (`--fresh`).
 //!
 //! `cargo run --release -p tandem-zoo --example rounds_trace -- FAMILY SEED ROBOTS ROUNDS
-//! [--fresh]` (the run of `cargo xtask zoo --seeds SEED --families FAMILY --robots ROBOTS
-//! --cell rounds --rounds ROUNDS --no-spread`, the same study seed).
+//! [--fresh] [--dump ROUND PATH]` (the run of `cargo xtask zoo --seeds SEED --families FAMILY
+//! --robots ROBOTS --cell rounds --rounds ROUNDS --no-spread`, the same study seed). `--dump`
+//! writes the problem of round `ROUND` as JSON to `PATH` (fields `problem`, `schedule`,
+//! `t_total_s`, `tick_s`, `seed`: the seed of the round's re-schedule, and `previous`: the round before's
+//! schedule), the input of a scheduler test.
 
 #![allow(clippy::print_stdout, reason = "an example reports to the terminal")]
 
@@ -18,9 +21,19 @@ use tandem_zoo::eval::prepare;
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [family, seed, robots, rounds, rest @ ..] = &args[..] else {
-        return Err("usage: rounds_trace FAMILY SEED ROBOTS ROUNDS [--fresh]".into());
+        return Err(
+            "usage: rounds_trace FAMILY SEED ROBOTS ROUNDS [--fresh] [--dump ROUND PATH]".into(),
+        );
     };
     let fresh = rest.iter().any(|a| a == "--fresh");
+    let dump: Option<(usize, String)> = match rest.iter().position(|a| a == "--dump") {
+        Some(i) => match (rest.get(i + 1), rest.get(i + 2)) {
+            (Some(r), Some(path)) => Some((r.parse()?, path.clone())),
+            _ => return Err("--dump needs ROUND and PATH".into()),
+        },
+        None => None,
+    };
+    let previous = Mutex::new(None::<tandem_schedule::Schedule>);
     let (seed, robots, rounds): (u64, usize, usize) =
         (seed.parse()?, robots.parse()?, rounds.parse()?);
     let fam = tandem_zoo::family(family)?;
@@ -59,6 +72,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             o.previous.describe().unwrap_or_default(),
         );
         line += &format!("\n          offsets {:?}", o.schedule.offsets_s);
+        let mut prev = previous
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some((round, path)) = &dump
+            && *round == view.round
+        {
+            let v = serde_json::json!({
+                "problem": p.problem(),
+                "schedule": o.schedule,
+                "t_total_s": o.t_total_s,
+                "tick_s": o.schedule.tick_s,
+                "seed": derive_seed(p.params().sampler.seed, p.rounds_recorded() as u64),
+                "previous": *prev,
+            });
+            match serde_json::to_string(&v).map(|t| std::fs::write(path, t)) {
+                Ok(Ok(())) => line += &format!("\n          dumped to {path}"),
+                Ok(Err(e)) => line += &format!("\n          dump: {e}"),
+                Err(e) => line += &format!("\n          dump: {e}"),
+            }
+        }
+        *prev = Some(o.schedule.clone());
+        drop(prev);
         if fresh {
             let params = tandem_schedule::SamplerParams {
                 tick_s: Some(o.schedule.tick_s),
