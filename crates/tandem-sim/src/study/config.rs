@@ -402,7 +402,7 @@ mod tests {
             ("[planner.sampler]\nswitch_s = 2.0\n", "planner.sampler"),
             ("[operator]\noperators = 0\n", "operator.operators"),
             (
-                "cell = \"continuous\"\n[operator]\noperators = 9\n",
+                "cell = \"continuous\"\n[operator]\noperators = 17\n",
                 "operator.operators",
             ),
             ("[planner.sampler]\noperators = 2\n", "planner.sampler"),
