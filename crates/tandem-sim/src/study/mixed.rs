@@ -324,9 +324,28 @@ pub fn run_mixed_study(
     tasks: &[MixedTask],
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<MixedStudyResult> {
+    let (tasks_named, robot_task, trials) = run_trials(config, tasks, |k| {
+        run_mixed_trial(config, tasks, k, progress)
+    })?;
+    Ok(MixedStudyResult {
+        tasks: tasks_named,
+        robot_task,
+        trials,
+    })
+}
+
+/// The trials `0..config.trials` of a mixed study run in parallel by `trial` (the result in
+/// trial order, so it does not depend on the thread count; the first failing trial's error),
+/// with the tasks' names and each robot's task index (robots of task 0 first) beside them:
+/// what the rounds and the continuous mixed studies both report.
+pub(super) fn run_trials<T: Send>(
+    config: &StudyConfig,
+    tasks: &[MixedTask],
+    trial: impl Fn(usize) -> Result<T> + Sync + Send,
+) -> Result<(Vec<String>, Vec<usize>, Vec<T>)> {
     let trials = (0..config.trials)
         .into_par_iter()
-        .map(|k| run_mixed_trial(config, tasks, k, progress))
+        .map(&trial)
         .collect::<Vec<_>>()
         .into_iter()
         .collect::<Result<Vec<_>>>()?;
@@ -334,9 +353,9 @@ pub fn run_mixed_study(
     for (t, task) in tasks.iter().enumerate() {
         robot_task.extend(std::iter::repeat_n(t, task.robots));
     }
-    Ok(MixedStudyResult {
-        tasks: tasks.iter().map(|t| t.name.clone()).collect(),
+    Ok((
+        tasks.iter().map(|t| t.name.clone()).collect(),
         robot_task,
         trials,
-    })
+    ))
 }

@@ -34,14 +34,13 @@ use std::collections::VecDeque;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
 use serde::Serialize;
 use tandem_lfd::TaskModel;
 use tandem_planner::{CellPlanner, ExecutionRecord};
 use tandem_schedule::cyclic::MixedCyclicPlan;
 
 use super::config::StudyConfig;
-use super::mixed::{MixedTask, MixedTaskState, operators, task_states, trial_cell};
+use super::mixed::{MixedTask, MixedTaskState, operators, run_trials, task_states, trial_cell};
 use super::run::{Progress, trial_seed};
 use crate::workcell::{CellStats, MixedCellSim, mixed_record};
 use crate::{Error, Result};
@@ -353,18 +352,11 @@ pub fn run_mixed_cell_study(
     tasks: &[MixedTask],
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<MixedCellStudyResult> {
-    let trials = (0..config.trials)
-        .into_par_iter()
-        .map(|k| run_mixed_cell_trial(config, tasks, k, progress))
-        .collect::<Vec<_>>()
-        .into_iter()
-        .collect::<Result<Vec<_>>>()?;
-    let mut robot_task = Vec::new();
-    for (t, task) in tasks.iter().enumerate() {
-        robot_task.extend(std::iter::repeat_n(t, task.robots));
-    }
+    let (tasks_named, robot_task, trials) = run_trials(config, tasks, |k| {
+        run_mixed_cell_trial(config, tasks, k, progress)
+    })?;
     Ok(MixedCellStudyResult {
-        tasks: tasks.iter().map(|t| t.name.clone()).collect(),
+        tasks: tasks_named,
         robot_task,
         trials,
     })
