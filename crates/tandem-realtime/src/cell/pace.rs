@@ -129,7 +129,7 @@ impl Pace {
 /// `n(β)`: the least whole number of ticks `n` with `β ≤ u·n` as computed in floating point
 /// (`u = cap` in `(0, 1]`), so that `β` busy ticks in `n` are a share of at most `u` as a run
 /// measures it. 0 for `β = 0`.
-pub(super) fn ticks_for_share(busy: u64, cap: f64) -> u64 {
+pub(crate) fn ticks_for_share(busy: u64, cap: f64) -> u64 {
     let b = busy as f64;
     // The quotient rounded up, then corrected by whole ticks either way if the product says so
     // (the division may round across an integer).
