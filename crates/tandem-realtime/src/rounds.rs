@@ -588,12 +588,7 @@ impl Coordinator {
     /// # Errors
     /// [`Error::BadParam`] naming `max_busy_share` for a value not in `(0, 1]`.
     pub fn with_max_busy_share(mut self, max_busy_share: f64) -> Result<Coordinator> {
-        if !(max_busy_share > 0.0 && max_busy_share <= 1.0) {
-            return Err(Error::BadParam {
-                name: "max_busy_share",
-                why: "must be in (0, 1]: the operator's busy share cap (1: no cap)",
-            });
-        }
+        crate::cell::pace::check_max_busy_share(max_busy_share)?;
         self.pace = (max_busy_share < 1.0).then(|| RoundPace::new(max_busy_share));
         self.reset();
         Ok(self)

@@ -27,6 +27,8 @@
 //! arbitrary ticks exceeds `u·W` by at most `(1 − u)` times the busy ticks of the two segments
 //! it cuts.
 
+use crate::error::{Error, Result};
+
 /// The token's pace of a cell with a load cap `u < 1`: the current segment's start and busy
 /// count, and the current episode's start (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -123,6 +125,22 @@ impl Pace {
             None => (self.start, 0),
         };
         (from + switch - early.min(switch)).saturating_sub(tick)
+    }
+}
+
+/// Checks the operator's load cap `u_max` (`max_busy_share`, a share of ticks): it must lie in
+/// `(0, 1]` (1: no cap). The one check of both coordinators' `with_max_busy_share`.
+///
+/// # Errors
+/// [`Error::BadParam`] naming `max_busy_share` otherwise.
+pub(crate) fn check_max_busy_share(max_busy_share: f64) -> Result<()> {
+    if max_busy_share > 0.0 && max_busy_share <= 1.0 {
+        Ok(())
+    } else {
+        Err(Error::BadParam {
+            name: "max_busy_share",
+            why: "must be in (0, 1]: the operator's busy share cap (1: no cap)",
+        })
     }
 }
 
