@@ -8,8 +8,10 @@
 //!   own work per tick as `Ticker::run` of node.rs does it but the sleep: the clock read,
 //!   `link::TickEnd::tick` (the pending-message counter, the robots' progress counters, the
 //!   loop's tick, the command's words into the ring with the next tick's deadline, the state
-//!   slot asked every 10th tick), the pacing clock read and `TickEnd::account` (no wake of the
-//!   DDS side: the node's tick thread wakes it only when `TickEnd::tick` asks, never here). The DDS side's ends run between timed batches, but for its three
+//!   slot asked every 10th tick), the pacing clock read, `TickEnd::account` and the sleep's
+//!   length (`TickGrid::pace`, not slept; no wake of the DDS side: the node's tick thread wakes
+//!   it only when `TickEnd::tick` asks, never here). The DDS side's ends run between timed
+//!   batches, but for its three
 //!   progress counts a tick (a load and a store each), so the robots are heard every tick as
 //!   in `loop_only`. The issue's pair is `tick_thread_only` against `loop_paced` (both with
 //!   the pacing read), and against `loop_only` (the node's pacing read counted against it).
@@ -34,7 +36,10 @@
 //!   `node_threads_spinning`: the same with a DDS side that spins instead of parking: the tick
 //!   thread against a consumer on the other core at every tick's lines, no futex wake.
 //!
-//! Run with `cargo bench -p tandem-ros2 --bench tick`.
+//! Run with `cargo bench -p tandem-ros2 --bench tick`. The issue's pair, settled on a loaded
+//! machine: `cargo bench -p tandem-ros2 --bench tick -- --pairs 1000 [--block 2000] [--out CSV]`
+//! times `loop_paced`, `tick_thread_only` and `node_threads` in alternating blocks instead of
+//! running criterion (`pairs` below).
 #![expect(
     missing_docs,
     reason = "criterion_group! generates an undocumented pub fn"
@@ -45,11 +50,11 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{Criterion, criterion_group};
 use tandem_console::{Console, ConsoleConfig, Geometry};
 use tandem_planner::{Cell, Planner};
 use tandem_realtime::{Controller, Operator};
-use tandem_ros2::link::{Links, TickEnd, WriterSchedule};
+use tandem_ros2::link::{Links, TickEnd, TickGrid, WriterSchedule};
 use tandem_ros2::{CellLoop, Command, ConsoleFeed, Inbound, LoopParams, Request};
 
 #[path = "../tests/support/mod.rs"]
@@ -64,8 +69,8 @@ struct NodeTick {
     i: u64,
     /// The DDS side's command buffer (`CommandRing::pop_into`).
     popped: Command,
-    /// The next tick's deadline, kept as `Ticker::run` keeps it (`next += period`).
-    next: Instant,
+    /// The next tick's deadline, kept as `Ticker::run` keeps it (`TickGrid::advance`).
+    grid: TickGrid,
 }
 
 /// The tick period the benches' ticks announce (their ticks run back to back).
@@ -87,14 +92,16 @@ impl NodeTick {
         let ctl = planner.controller(Cell::Rounds).expect("a plan");
         let mut l = CellLoop::new(ctl, planner.model(), LoopParams::default()).expect("valid");
         start(&mut l);
+        let links = Links::new(3, 4096);
+        let grid = TickGrid::new(&links.commands, Instant::now(), PERIOD);
         NodeTick {
             l,
-            links: Links::new(3, 4096),
+            links,
             end: TickEnd::new(3),
             ask_every,
             i: 0,
             popped: Command::idle(3),
-            next: Instant::now(),
+            grid,
         }
     }
 
@@ -130,10 +137,10 @@ impl NodeTick {
     /// instant.
     fn tick_thread(&mut self, console: Option<&mut ConsoleFeed>) -> Instant {
         let now = Instant::now();
-        self.next += PERIOD;
+        self.grid.advance();
         let wake = self
             .end
-            .tick(&mut self.l, &self.links, now, self.next, |_| {
+            .tick(&mut self.l, &self.links, now, &self.grid, |_| {
                 unreachable!("nothing is queued in this benchmark")
             })
             .expect("a valid operator");
@@ -187,6 +194,7 @@ impl Threads {
         node.l = CellLoop::new(ctl, planner.model(), params).expect("valid");
         start(&mut node.l);
         let links = Arc::new(Links::new(3, 4096));
+        node.grid = TickGrid::new(&links.commands, Instant::now(), PERIOD);
         let stop = Arc::new(AtomicBool::new(false));
         let (l, st) = (links.clone(), stop.clone());
         let writer = std::thread::spawn(move || {
@@ -248,10 +256,10 @@ impl Threads {
         let n = &mut self.node;
         let l = &*self.links;
         let now = Instant::now();
-        n.next += PERIOD;
+        n.grid.advance();
         let behind = n
             .end
-            .tick(&mut n.l, l, now, n.next, |_| {
+            .tick(&mut n.l, l, now, &n.grid, |_| {
                 unreachable!("nothing is queued in this benchmark")
             })
             .expect("a valid operator");
@@ -260,12 +268,22 @@ impl Threads {
             self.wakes += 1;
         }
         self.ticks += 1;
-        n.end.account(l, Instant::now());
+        let end = n.end.account(l, Instant::now());
+        black_box(n.grid.pace(end));
         let finished = n.l.is_finished();
         if finished {
             start(&mut n.l);
         }
         u64::from(finished)
+    }
+
+    /// `iters` ticks back to back, timed by `clock` (the tick thread's time).
+    fn run(&mut self, iters: u64, clock: Clock) -> Duration {
+        let t0 = clock.read();
+        for _ in 0..iters {
+            black_box(self.tick());
+        }
+        clock.since(t0)
     }
 
     /// Ends the DDS side; prints the ticks, the wakes the tick thread made and the records the
@@ -376,17 +394,7 @@ fn bench(c: &mut Criterion) {
     // `tick_thread_only`, which has that read too.
     let mut node = NodeTick::new(&planner, 10);
     group.bench_function("loop_paced", |b| {
-        b.iter(|| {
-            let now = Instant::now();
-            for k in 0..3 {
-                node.l.heard(k, now);
-            }
-            let c = node.l.advance(now).expect("a valid operator");
-            if c.finished {
-                start(&mut node.l);
-            }
-            black_box((c.tick, Instant::now()))
-        });
+        b.iter_custom(|iters| loop_paced(&mut node, iters, Clock::Wall));
     });
     let mut node = NodeTick::new(&planner, 10);
     group.bench_function("with_queues", |b| {
@@ -402,37 +410,12 @@ fn bench(c: &mut Criterion) {
     // instants every tick as `loop_only` does. Its like-for-like baseline is `loop_paced`.
     let mut node = NodeTick::new(&planner, 10);
     group.bench_function("tick_thread_only", |b| {
-        b.iter_custom(|iters| {
-            let mut spent = Duration::ZERO;
-            let mut left = iters;
-            while left > 0 {
-                let batch = left.min(64);
-                let t0 = Instant::now();
-                for _ in 0..batch {
-                    for k in 0..3 {
-                        node.links.heard.hear(k);
-                    }
-                    node.i += 1;
-                    if node.i.is_multiple_of(node.ask_every) {
-                        node.links.state.ask();
-                    }
-                    black_box(node.tick_thread(None));
-                    node.end.account(&node.links, Instant::now());
-                }
-                spent += t0.elapsed();
-                while let Some(c) = node.links.commands.pop_into(&mut node.popped) {
-                    black_box((c, node.popped.tick));
-                }
-                black_box(node.links.state.take());
-                left -= batch;
-            }
-            spent
-        });
+        b.iter_custom(|iters| tick_thread_only(&mut node, iters, 64, Clock::Wall));
     });
     // The node's two threads, the DDS side sleeping by the announced deadlines.
     let mut threads = Threads::new(&planner, Side::Scheduled);
     group.bench_function("node_threads", |b| {
-        b.iter(|| black_box(threads.tick()));
+        b.iter_custom(|iters| threads.run(iters, Clock::Wall));
     });
     black_box(threads.finish("node_threads"));
     // The node before: the DDS side woken after every tick, parking when idle.
@@ -468,4 +451,221 @@ fn bench(c: &mut Criterion) {
 }
 
 criterion_group!(benches, bench);
-criterion_main!(benches);
+
+/// `iters` ticks of `loop_only` and the clock read that paces a live loop's sleep (`Ticker::run`
+/// reads the clock after its tick for the sleep and `TickEnd::account`), timed: the baseline of
+/// `tick_thread_only` and `node_threads`, which have that read too.
+fn loop_paced(node: &mut NodeTick, iters: u64, clock: Clock) -> Duration {
+    let t0 = clock.read();
+    for _ in 0..iters {
+        let now = Instant::now();
+        for k in 0..3 {
+            node.l.heard(k, now);
+        }
+        let c = node.l.advance(now).expect("a valid operator");
+        if c.finished {
+            start(&mut node.l);
+        }
+        black_box((c.tick, Instant::now()));
+    }
+    clock.since(t0)
+}
+
+/// `iters` ticks of the tick thread's own work, as `Ticker::run` does it each tick but the
+/// sleep: the clock read, `TickEnd::tick` (the ring drained often enough that it never asks
+/// for the DDS side's wake), the pacing clock read, `TickEnd::account` and `TickGrid::pace`.
+/// The DDS side's ends that the tick thread never runs (the ring drained, the snapshot taken)
+/// run between timed batches of `batch` ticks (≤ 2,048, half the ring's 4,096 records, so the
+/// tick never asks for the DDS side's wake; criterion's batches are 64); the one DDS-side write left
+/// inside the timing is the three robots' progress counts, one report per robot per tick as
+/// `loop_only` hears them (`Heard::hear`: a load and a store each), so that the tick stores the
+/// three robots' instants every tick as `loop_only` does. Its like-for-like baseline is
+/// `loop_paced`.
+fn tick_thread_only(node: &mut NodeTick, iters: u64, batch: u64, clock: Clock) -> Duration {
+    let mut spent = Duration::ZERO;
+    let mut left = iters;
+    while left > 0 {
+        let batch = left.min(batch.clamp(1, 2_048));
+        let t0 = clock.read();
+        for _ in 0..batch {
+            for k in 0..3 {
+                node.links.heard.hear(k);
+            }
+            node.i += 1;
+            if node.i.is_multiple_of(node.ask_every) {
+                node.links.state.ask();
+            }
+            black_box(node.tick_thread(None));
+            let end = node.end.account(&node.links, Instant::now());
+            black_box(node.grid.pace(end));
+        }
+        spent += clock.since(t0);
+        while let Some(c) = node.links.commands.pop_into(&mut node.popped) {
+            black_box((c, node.popped.tick));
+        }
+        black_box(node.links.state.take());
+        left -= batch;
+    }
+    spent
+}
+
+/// What a timed block is timed by.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Clock {
+    /// The monotonic clock (`Instant`): criterion's, and what the node's pacing reads.
+    Wall,
+    /// The calling thread's CPU time (`CLOCK_THREAD_CPUTIME_ID`, Linux): a block's time without
+    /// the time the thread was preempted (on a loaded machine most of a block's wall time), but
+    /// with what the other threads' use of the caches costs it.
+    #[cfg(target_os = "linux")]
+    ThreadCpu,
+}
+
+impl Clock {
+    /// The clock's reading (ns from an origin of its own).
+    fn read(self) -> u64 {
+        match self {
+            Clock::Wall => {
+                static ORIGIN: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+                ORIGIN.get_or_init(Instant::now).elapsed().as_nanos() as u64
+            }
+            #[cfg(target_os = "linux")]
+            Clock::ThreadCpu => {
+                let t = rustix::time::clock_gettime(rustix::time::ClockId::ThreadCPUTime);
+                t.tv_sec as u64 * 1_000_000_000 + t.tv_nsec as u64
+            }
+        }
+    }
+
+    /// The time since the reading `t0`.
+    fn since(self, t0: u64) -> Duration {
+        Duration::from_nanos(self.read().saturating_sub(t0))
+    }
+}
+
+/// The issue's pair in alternating blocks, `--pairs ROUNDS [--block TICKS] [--clock cpu|wall]
+/// [--out CSV]` (defaults 1,000 rounds, 1,000 ticks, `cpu` on Linux): each round times a block
+/// of `TICKS` ticks of `loop_paced`, `tick_thread_only` and `node_threads` (the DDS side on its
+/// own thread, sleeping by the deadlines), one after the other on this thread in an order
+/// rotated by one each round, so each variant comes first, second and last equally often. A
+/// round's ratios are its blocks' times against its `loop_paced` block, taken within a
+/// millisecond or two of each other, so a drift of the machine's speed (other processes, the
+/// clock's frequency) hits both sides of a ratio alike, and the median over the rounds drops
+/// the rounds in which one block was preempted. `cpu` times each block by the thread's CPU
+/// clock, so the time other processes held the core is not counted at all (criterion's wall
+/// clock counts it). `tick_thread_only`'s DDS-side ends run after its block, untimed (its
+/// batch is the block, at most 2,048). Prints each variant's median ns per tick and each
+/// ratio's median, quartiles and 10th/90th percentiles over the rounds; `--out` writes each
+/// round's ns per tick (docs/decisions.md, "The node's tick: a nanosecond grid and a pair
+/// measured in alternating blocks (issue 43)").
+fn pairs(args: &[String]) {
+    let value = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1))
+    };
+    let arg = |name: &str, default: u64| -> u64 {
+        value(name).map_or(default, |v| {
+            v.parse().unwrap_or_else(|_| {
+                eprintln!("{name} takes a whole number, not {v:?}");
+                std::process::exit(2)
+            })
+        })
+    };
+    let rounds = arg("--pairs", 1_000).max(1);
+    let block = arg("--block", 1_000).clamp(1, 2_048);
+    let clock = match value("--clock").map(String::as_str) {
+        Some("wall") => Clock::Wall,
+        #[cfg(target_os = "linux")]
+        None | Some("cpu") => Clock::ThreadCpu,
+        #[cfg(not(target_os = "linux"))]
+        None => Clock::Wall,
+        Some(other) => {
+            eprintln!("--clock is cpu (Linux) or wall, not {other:?}");
+            std::process::exit(2)
+        }
+    };
+    let out = value("--out");
+    let planner = support::planner(3);
+    let mut paced = NodeTick::new(&planner, 10);
+    let mut own = NodeTick::new(&planner, 10);
+    let mut threads = Threads::new(&planner, Side::Scheduled);
+    const NAMES: [&str; 3] = ["loop_paced", "tick_thread_only", "node_threads"];
+    let mut run = |v: usize, ticks: u64| match v {
+        0 => loop_paced(&mut paced, ticks, clock),
+        1 => tick_thread_only(&mut own, ticks, block, clock),
+        _ => threads.run(ticks, clock),
+    };
+    // Warm-up: caches, the clock's frequency, the DDS side's thread started.
+    for _ in 0..50 {
+        for v in 0..3 {
+            black_box(run(v, block));
+        }
+    }
+    let mut ns = vec![[0.0_f64; 3]; rounds as usize];
+    for (r, row) in ns.iter_mut().enumerate() {
+        for j in 0..3 {
+            let v = (j + r) % 3;
+            row[v] = run(v, block).as_nanos() as f64 / block as f64;
+        }
+    }
+    let (wakes, ticks) = (threads.wakes, threads.ticks);
+    black_box(threads.finish("node_threads"));
+    if let Some(path) = out {
+        let mut csv = String::from("round,loop_paced_ns,tick_thread_only_ns,node_threads_ns\n");
+        for (r, row) in ns.iter().enumerate() {
+            csv.push_str(&format!("{r},{:.2},{:.2},{:.2}\n", row[0], row[1], row[2]));
+        }
+        if let Err(e) = std::fs::write(path, csv) {
+            eprintln!("--out {path}: {e}");
+            std::process::exit(1);
+        }
+    }
+    let quantiles = |mut x: Vec<f64>| -> [f64; 5] {
+        x.sort_by(f64::total_cmp);
+        // Linear interpolation between the closest ranks.
+        [0.1, 0.25, 0.5, 0.75, 0.9].map(|q| {
+            let at = q * (x.len() - 1) as f64;
+            let (lo, hi) = (at.floor() as usize, at.ceil() as usize);
+            x[lo] + (x[hi] - x[lo]) * (at - lo as f64)
+        })
+    };
+    use std::io::Write as _;
+    let mut stdout = std::io::stdout().lock();
+    let _ = writeln!(
+        stdout,
+        "{rounds} rounds of {block} ticks per variant, order rotated each round, clock {clock:?}; \
+         node_threads: {wakes} wakes of the DDS side in {ticks} ticks"
+    );
+    for (v, name) in NAMES.iter().enumerate() {
+        let q = quantiles(ns.iter().map(|row| row[v]).collect());
+        let _ = writeln!(
+            stdout,
+            "{name:<16} ns/tick  median {:8.1}  quartiles {:8.1} {:8.1}",
+            q[2], q[1], q[3]
+        );
+    }
+    for (v, name) in NAMES.iter().enumerate().skip(1) {
+        let q = quantiles(ns.iter().map(|row| row[v] / row[0]).collect());
+        let _ = writeln!(
+            stdout,
+            "{name:<16} / loop_paced  median {:.3}x  IQR {:.3}-{:.3}x ({:.3})  p10-p90 {:.3}-{:.3}x",
+            q[2],
+            q[1],
+            q[3],
+            q[3] - q[1],
+            q[0],
+            q[4]
+        );
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.iter().any(|a| a == "--pairs") {
+        pairs(&args);
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -22,7 +22,8 @@
 //! - `run_tick_thread`: the node's tick thread as `Ticker::run` runs it (`link::TickEnd::tick`:
 //!   the pending-message counter, the progress counters, the loop's tick (`advance` without
 //!   building its `Command`), the command's words into the ring, the state slot asked every 10th
-//!   tick, with the next tick's deadline), plus its per-tick bookkeeping (`TickEnd::account`);
+//!   tick, with the next tick's deadline from its `TickGrid`), plus its per-tick bookkeeping
+//!   (`TickEnd::account`) and the sleep's length (`TickGrid::pace`, not slept);
 //!   the writer is woken only when `TickEnd::tick` asks (never here: the DDS side drains each
 //!   tick);
 //! - `run_dds_side`: the DDS thread's ends for those ticks (three progress counters, the ring
@@ -36,7 +37,7 @@ use std::time::Instant;
 
 use tandem_planner::{AnyController, Cell};
 use tandem_realtime::{Controller, Operator};
-use tandem_ros2::link::{Links, TickEnd};
+use tandem_ros2::link::{Links, TickEnd, TickGrid};
 use tandem_ros2::{CellLoop, Command, Inbound, LoopParams, Request};
 
 /// The tick period `run_tick_thread` announces (its ticks run back to back).
@@ -124,18 +125,19 @@ fn run_tick_thread(
     end: &mut TickEnd,
     links: &Links,
     writer: &std::thread::Thread,
-    next: &mut Instant,
+    grid: &mut TickGrid,
     i: u64,
 ) {
     let now = Instant::now();
-    *next += PERIOD;
+    grid.advance();
     let wake = end
-        .tick(l, links, now, *next, |_| unreachable!("nothing is queued"))
+        .tick(l, links, now, grid, |_| unreachable!("nothing is queued"))
         .expect("a valid operator");
     if wake {
         writer.unpark();
     }
-    end.account(links, Instant::now());
+    let end_ns = end.account(links, Instant::now());
+    black_box(grid.pace(end_ns));
     if l.is_finished() {
         start(l);
     }
@@ -177,10 +179,10 @@ fn main() {
     let mut end = TickEnd::new(3);
     let writer = std::thread::current();
     let mut popped = Command::idle(3);
-    let mut next = Instant::now();
+    let mut grid = TickGrid::new(&links.commands, Instant::now(), PERIOD);
     for i in 1..=ticks {
         run_dds_side(&links, &mut popped, i);
-        run_tick_thread(&mut l, &mut end, &links, &writer, &mut next, i);
+        run_tick_thread(&mut l, &mut end, &links, &writer, &mut grid, i);
     }
     use std::io::Write as _;
     let _ = writeln!(std::io::stdout(), "{ticks} ticks of each variant");

@@ -353,6 +353,83 @@ impl WriterSchedule {
     }
 }
 
+/// The tick thread's deadlines: tick `k`'s (`k` = 0 the first, at the grid's start `t_0`) is
+/// `t_0 + k·h` (`h` the schedule's tick, [`Controller::tick_s`](tandem_realtime::Controller::tick_s),
+/// as whole ns), kept as ns after the [`CommandRing`]'s creation (the records' time) so that
+/// announcing the next tick's deadline with each record ([`TickEnd::tick`]) and pacing the sleep
+/// to it ([`TickGrid::pace`]) are integer adds and differences: no `Instant` arithmetic and no
+/// conversion per tick (docs/decisions.md, "The node's tick: a nanosecond grid and a pair
+/// measured in alternating blocks (issue 43)"). Exact: the deadline after `k` advances is
+/// `t_0 + k·h` to the ns (no float accumulates), the same grid as `Instant + Duration` steps,
+/// until a tick more than a period late restarts it ([`Pace::Overrun`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TickGrid {
+    /// The next tick's deadline (ns in the ring's time).
+    next_ns: u64,
+    /// `h` (ns, ≥ 1).
+    period_ns: u64,
+}
+
+/// What the tick thread does after a tick's work: [`TickGrid::pace`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pace {
+    /// Sleep this long: the next deadline is ahead.
+    Sleep(Duration),
+    /// The deadline has passed by at most a period: tick again at once (the grid kept).
+    Late,
+    /// The deadline has passed by more than a period: tick at once, the grid restarted at the
+    /// work's end (counted as an overrun by the node).
+    Overrun,
+}
+
+impl TickGrid {
+    /// The grid of `period` (rounded to ≥ 1 ns) whose first deadline is `start`, in `ring`'s
+    /// time (an instant before the ring's creation is its creation).
+    #[must_use]
+    pub fn new(ring: &CommandRing, start: Instant, period: Duration) -> TickGrid {
+        TickGrid {
+            next_ns: ring.since(start),
+            // A period of 584 years or more saturates: no tick would come anyway.
+            period_ns: u64::try_from(period.as_nanos()).unwrap_or(u64::MAX).max(1),
+        }
+    }
+
+    /// Moves to the next deadline (`+ h`: one add, saturating at 584 years).
+    #[inline]
+    pub fn advance(&mut self) {
+        self.next_ns = self.next_ns.saturating_add(self.period_ns);
+    }
+
+    /// The next deadline in `ring`'s time (ns): what [`TickEnd::tick`] announces.
+    #[inline]
+    #[must_use]
+    pub fn next_ns(&self) -> u64 {
+        self.next_ns
+    }
+
+    /// The next deadline as an instant of `ring` (the ring the grid was made for).
+    #[must_use]
+    pub fn deadline(&self, ring: &CommandRing) -> Instant {
+        ring.base + Duration::from_nanos(self.next_ns)
+    }
+
+    /// After a tick whose work ended at `end_ns` (ns in the ring's time, [`TickEnd::account`]):
+    /// sleep to the next deadline, tick again at once when it has passed by at most a period,
+    /// or restart the grid at `end_ns` when it has passed by more (the ticks missed are not
+    /// made up in a burst).
+    #[inline]
+    pub fn pace(&mut self, end_ns: u64) -> Pace {
+        if self.next_ns > end_ns {
+            Pace::Sleep(Duration::from_nanos(self.next_ns - end_ns))
+        } else if end_ns - self.next_ns > self.period_ns {
+            self.next_ns = end_ns;
+            Pace::Overrun
+        } else {
+            Pace::Late
+        }
+    }
+}
+
 /// The state topics' [`Snapshot`], written by the tick thread only when the DDS thread has asked
 /// ([`StateSlot::ask`], at the state topics' rate) or the cell's fault or round state changed.
 /// The tick thread's write is a `try_lock` (never waits: a slot the reader holds is written at a
@@ -545,13 +622,14 @@ pub struct TickEnd {
     /// A snapshot is owed: the slot was held by the reader when one was due.
     owed: bool,
     ticks: u64,
-    /// The last tick's start, and as ns in the ring's time ([`CommandRing::since`]); the one
-    /// before it in the ring's time.
-    start: Option<Instant>,
+    /// A tick has run.
+    started: bool,
+    /// The last tick's start as ns in the ring's time ([`CommandRing::since`]); the one before
+    /// it.
     start_ns: u64,
     last_start_ns: Option<u64>,
     max_period_ns: u64,
-    max_tick: Duration,
+    max_tick_ns: u64,
 }
 
 impl TickEnd {
@@ -565,15 +643,16 @@ impl TickEnd {
             last_flags: 0,
             owed: false,
             ticks: 0,
-            start: None,
+            started: false,
             start_ns: 0,
             last_start_ns: None,
             max_period_ns: 0,
-            max_tick: Duration::ZERO,
+            max_tick_ns: 0,
         }
     }
 
-    /// One tick at `now` (the tick's start), the next to start at `next`: `drain` takes the
+    /// One tick at `now` (the tick's start), the next to start at `next`'s deadline (already
+    /// advanced past this tick: [`TickGrid::advance`]): `drain` takes the
     /// queued rare messages in when the pending counter moved, each robot heard since the last
     /// tick is alive at `now`, the loop's tick ([`CellLoop::advance`] without building its
     /// [`Command`]), the command's words from the loop into the ring with `next` as the DDS
@@ -592,7 +671,7 @@ impl TickEnd {
         l: &mut CellLoop,
         links: &Links,
         now: Instant,
-        next: Instant,
+        next: &TickGrid,
         drain: impl FnOnce(&mut CellLoop),
     ) -> Result<bool> {
         if links.pending.moved(&mut self.pending_seen) {
@@ -604,14 +683,14 @@ impl TickEnd {
         l.tick_at(now)?;
         // The tick's start in the ring's time, for its record and the period's count.
         let start_ns = links.commands.since(now);
-        self.last_start_ns = self.start.map(|_| self.start_ns);
-        self.start = Some(now);
+        self.last_start_ns = self.started.then_some(self.start_ns);
+        self.started = true;
         self.start_ns = start_ns;
         let (tick, flags, ref_time, speed) = l.command_words();
-        let next_ns = links.commands.since(next);
-        let pushed = links
-            .commands
-            .push_words((tick, flags, start_ns, next_ns), ref_time, speed);
+        let pushed =
+            links
+                .commands
+                .push_words((tick, flags, start_ns, next.next_ns()), ref_time, speed);
         // Active, finished, fault.
         let flags = flags & 0b111;
         if flags != self.last_flags || self.owed || links.state.wanted() {
@@ -623,14 +702,17 @@ impl TickEnd {
     }
 
     /// Counts the last [`tick`](Self::tick), whose work ended at `end`, into `links`'
-    /// counters: one store for the count, one more only when a maximum grew. The period is
-    /// the difference of the two last ticks' starts in the ring's time (ns, computed by
-    /// [`tick`](Self::tick) for the ring's records), so a tick reads the difference of two
-    /// instants twice, not three times. Nothing is counted before the first tick.
-    pub fn account(&mut self, links: &Links, end: Instant) {
-        let Some(start) = self.start else {
-            return;
-        };
+    /// counters: one store for the count, one more only when a maximum grew; returns `end` in
+    /// the ring's time (ns), which the tick thread paces its sleep by ([`TickGrid::pace`]).
+    /// The period is the difference of the two last ticks' starts and the work `end` less the
+    /// last start, all in the ring's time (the start computed by [`tick`](Self::tick) for the
+    /// ring's record), so a tick converts two instants, its start and its end, and the rest is
+    /// integer arithmetic. Nothing is counted before the first tick.
+    pub fn account(&mut self, links: &Links, end: Instant) -> u64 {
+        let end_ns = links.commands.since(end);
+        if !self.started {
+            return end_ns;
+        }
         self.ticks += 1;
         links.ticks.store(self.ticks, Ordering::Relaxed);
         if let Some(last) = self.last_start_ns {
@@ -640,13 +722,12 @@ impl TickEnd {
                 links.max_period_ns.store(period, Ordering::Relaxed);
             }
         }
-        let work = end.saturating_duration_since(start);
-        if work > self.max_tick {
-            self.max_tick = work;
-            links
-                .max_tick_ns
-                .store(work.as_nanos() as u64, Ordering::Relaxed);
+        let work = end_ns.saturating_sub(self.start_ns);
+        if work > self.max_tick_ns {
+            self.max_tick_ns = work;
+            links.max_tick_ns.store(work, Ordering::Relaxed);
         }
+        end_ns
     }
 }
 
@@ -817,6 +898,64 @@ mod tests {
         assert_eq!(s.sleep(t0 + us(1_030), d, u32::MAX), us(1_000));
         // A tick shorter than the lead: straight to past the deadline.
         assert_eq!(s.sleep(t0, Some(t0 + us(100)), 0), us(120));
+    }
+
+    /// The grid's deadline after `k` advances is `t_0 + k·h` to the ns for 10⁶ ticks, the
+    /// same as stepping an `Instant` by `h` (the grid before the ns one), for a period of whole
+    /// µs, one of 333,333 ns (`1/3000` s rounded by `Duration::from_secs_f64`) and one of 1 ns;
+    /// by arithmetic only (no clock is read after the ring's creation).
+    #[test]
+    fn the_grid_keeps_its_deadlines_exact_over_a_million_ticks() {
+        let ring = CommandRing::new(1, 1);
+        let t0 = ring.base + Duration::from_nanos(123_456_789);
+        for (period, h) in [
+            (Duration::from_millis(1), 1_000_000_u64),
+            (Duration::from_secs_f64(1.0 / 3000.0), 333_333),
+            (Duration::from_nanos(1), 1),
+        ] {
+            let mut grid = TickGrid::new(&ring, t0, period);
+            let mut stepped = t0;
+            for k in 1..=1_000_000_u64 {
+                grid.advance();
+                stepped += period;
+                assert_eq!(grid.next_ns(), 123_456_789 + k * h, "tick {k} of {h} ns");
+                if k.is_multiple_of(997) || k == 1_000_000 {
+                    assert_eq!(grid.deadline(&ring), stepped, "tick {k} of {h} ns");
+                    assert_eq!(grid.deadline(&ring), t0 + period * k as u32);
+                }
+            }
+            // No drift: 10⁶ periods of whole ns.
+            assert_eq!(
+                grid.deadline(&ring) - t0,
+                Duration::from_nanos(h * 1_000_000)
+            );
+        }
+        // A start before the ring's creation is its creation.
+        let early = TickGrid::new(&ring, ring.base - Duration::from_secs(1), Duration::ZERO);
+        assert_eq!((early.next_ns(), early.period_ns), (0, 1));
+    }
+
+    /// The pace after a tick's work: the sleep to the deadline, at once within a period past
+    /// it, and past a period the grid restarted at the work's end (the overrun).
+    #[test]
+    fn the_grid_paces_the_sleep_and_restarts_after_an_overrun() {
+        let ring = CommandRing::new(1, 1);
+        let us = |u: u64| u * 1_000;
+        let mut grid = TickGrid::new(&ring, ring.base, Duration::from_micros(1_000));
+        grid.advance();
+        // Deadline 1 ms: work ending at 0.3 ms sleeps 0.7 ms; at 1 ms and 2 ms goes on.
+        assert_eq!(grid.pace(us(300)), Pace::Sleep(Duration::from_micros(700)));
+        assert_eq!(grid.pace(us(1_000)), Pace::Late);
+        assert_eq!(grid.pace(us(2_000)), Pace::Late);
+        assert_eq!(grid.next_ns(), us(1_000), "kept");
+        // 1 ms + 1 ns past it: the grid restarts there, the next tick a period later.
+        assert_eq!(grid.pace(us(2_000) + 1), Pace::Overrun);
+        assert_eq!(grid.next_ns(), us(2_000) + 1);
+        grid.advance();
+        assert_eq!(
+            grid.pace(us(2_500)),
+            Pace::Sleep(Duration::from_nanos(us(500) + 1))
+        );
     }
 
     #[test]

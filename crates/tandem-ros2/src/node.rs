@@ -42,7 +42,7 @@ use tandem_realtime::Controller;
 use crate::console::ConsoleFeed;
 use crate::core::{CellLoop, Command, Inbound, LoopParams, Reply, Request, RoundLog};
 use crate::error::{Error, Result, dds};
-use crate::link::{Links, TickEnd, WriterSchedule};
+use crate::link::{Links, Pace, TickEnd, TickGrid, WriterSchedule};
 use crate::msg::{
     self, BOOL, Bool, FLOAT64, FLOAT64_MULTI_ARRAY, Float64, Float64MultiArray, JOY, Joy,
     POSE_STAMPED, PoseStamped, STRING, TRIGGER, Text, TriggerRequest, TriggerResponse, TypeName,
@@ -522,9 +522,11 @@ impl Ticker {
         let _ = self.counters.tick_priority.set(set_thread_nice(self.nice));
         let _ = self.started.try_send(());
         let period = Duration::from_secs_f64(self.tick_s);
-        let mut next = Instant::now();
         let c = self.counters.clone();
         let links = self.links.clone();
+        // The deadlines in the ring's time: the next one announced and the sleep paced by
+        // integer arithmetic (`TickGrid`).
+        let mut grid = TickGrid::new(&links.commands, Instant::now(), period);
         let mut end = TickEnd::new(self.cell_loop.controller().n_robots());
         while !self.stop.load(Ordering::Relaxed) {
             let now = Instant::now();
@@ -547,8 +549,8 @@ impl Ticker {
             // Every tick's command, announcing the next tick's deadline, by which the DDS
             // thread sleeps; the state topics' snapshot when asked, or at once when the fault
             // or the round's state changed (so their topics follow within the tick).
-            next += period;
-            let behind = end.tick(&mut self.cell_loop, &links, now, next, drain)?;
+            grid.advance();
+            let behind = end.tick(&mut self.cell_loop, &links, now, &grid, drain)?;
             // No wake per tick (a futex wake when the DDS thread sleeps, ≈ 0.5 µs: the
             // benchmark `node_threads` before "The node's DDS thread sleeps by the tick's
             // announced deadline, no wake per tick (issue 43)"): only a reply, which a
@@ -562,14 +564,14 @@ impl Ticker {
                 feed.publish(&self.cell_loop);
             }
             // One clock read for both the tick's work and the sleep.
-            let after = Instant::now();
-            end.account(&links, after);
-            if next > after {
-                std::thread::sleep(next - after);
-            } else if after - next > period {
-                // More than a period late: keep the grid from here, count the overrun.
-                c.overruns.fetch_add(1, Ordering::Relaxed);
-                next = after;
+            let after = end.account(&links, Instant::now());
+            match grid.pace(after) {
+                Pace::Sleep(d) => std::thread::sleep(d),
+                Pace::Late => {}
+                // More than a period late: the grid restarted from here, the overrun counted.
+                Pace::Overrun => {
+                    c.overruns.fetch_add(1, Ordering::Relaxed);
+                }
             }
         }
         // The last command: the round aborted where it stands (`CellLoop::halt`). A full ring

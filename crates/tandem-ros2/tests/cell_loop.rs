@@ -448,7 +448,7 @@ fn scripted(i: u64, finished_at: Option<u64>) -> Vec<Inbound> {
 /// round's end or the running state changed or the DDS side asked (every 10th tick).
 #[test]
 fn the_tick_thread_sends_what_advance_returns() {
-    use tandem_ros2::link::{Links, TickEnd};
+    use tandem_ros2::link::{Links, TickEnd, TickGrid};
     let planner = support::planner(3);
     let mut a = cell_loop(&planner, Cell::Rounds);
     let mut b = cell_loop(&planner, Cell::Rounds);
@@ -456,6 +456,8 @@ fn the_tick_thread_sends_what_advance_returns() {
     let links = Links::new(3, 64);
     let mut end = TickEnd::new(3);
     let t0 = Instant::now();
+    // The node's grid from `t0`: tick `i` at `t0 + i·h`, each announcing the next one.
+    let mut grid = TickGrid::new(&links.commands, t0, tick);
     let (mut finished_at, mut last_flags) = (None, None);
     let (mut faults, mut corrected, mut needs, mut snaps) = (0, 0, 0, 0);
     let (mut log_a, mut log_b) = (None, None);
@@ -482,8 +484,9 @@ fn the_tick_thread_sends_what_advance_returns() {
             links.state.ask();
         }
         let want = a.advance(now).unwrap();
+        grid.advance();
         let wake = end
-            .tick(&mut b, &links, now, now + tick, |l| {
+            .tick(&mut b, &links, now, &grid, |l| {
                 for m in msgs {
                     l.handle(m, now, &mut |r| {
                         if let Reply::Round { log, .. } = r {
@@ -535,21 +538,24 @@ fn the_tick_thread_sends_what_advance_returns() {
 #[test]
 fn the_tick_threads_counters_take_the_longest_period_and_work() {
     use std::sync::atomic::Ordering;
-    use tandem_ros2::link::{Links, TickEnd};
+    use tandem_ros2::link::{Links, TickEnd, TickGrid};
     let planner = support::planner(2);
     let mut l = cell_loop(&planner, Cell::Rounds);
     let links = Links::new(2, 16);
     let mut end = TickEnd::new(2);
     let t0 = Instant::now();
-    end.account(&links, t0);
+    let mut grid = TickGrid::new(&links.commands, t0, Duration::from_millis(1));
+    // Nothing counted; `t0` in the ring's time returned.
+    let t0_ns = end.account(&links, t0);
     assert_eq!(links.ticks.load(Ordering::Relaxed), 0);
     let us = |u: u64| Duration::from_micros(u);
     // Starts at 0, 1 ms, 4 ms, 5 ms; work 200, 700, 100, 300 µs.
     for (start, work) in [(0, 200), (1_000, 700), (4_000, 100), (5_000, 300)] {
         let now = t0 + us(start);
-        end.tick(&mut l, &links, now, now + us(1_000), |_| {})
-            .unwrap();
-        end.account(&links, now + us(work));
+        grid.advance();
+        end.tick(&mut l, &links, now, &grid, |_| {}).unwrap();
+        let end_ns = end.account(&links, now + us(work));
+        assert_eq!(end_ns - t0_ns, (start + work) * 1_000, "the work's end");
         while links.commands.pop().is_some() {}
     }
     assert_eq!(links.ticks.load(Ordering::Relaxed), 4);
