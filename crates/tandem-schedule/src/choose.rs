@@ -1119,6 +1119,20 @@ fn schedule_n(
         }
         best = (s, t, Source::Held);
     }
+    // Beside it, the order whose switches into a held stretch charge the travel from the hold
+    // (docs/decisions.md, "Three robots at δ ≥ 2 s: a switch into a held stretch costs the
+    // travel from its hold (issue 41)"). Not at `δ = 0`.
+    if plan.bound == BoundBy::Many
+        && sw > 0.0
+        && !problem.usable_holds().is_empty()
+        && let Some((s, t)) =
+            room::room_with_travel(problem, n_robots, tick_s, best.1, sw, &mut checks)
+    {
+        if capping {
+            pool.push((s.clone(), t, Source::Held));
+        }
+        best = (s, t, Source::Held);
+    }
     // The staggered candidate, always (its checks see all robots: at most
     // `MAX_STAGGER_CHECKS` of them). Before, it ran only when nothing beat the serial
     // schedule, and a schedule with holds that overlapped the robots hid a shorter staggered

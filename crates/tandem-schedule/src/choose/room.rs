@@ -99,6 +99,27 @@ pub(super) fn room_from_slacks(
     best
 }
 
+/// The room-aware order whose switches into a held stretch charge the travel from the hold
+/// ([`exact::room_aware_many_travel`], room `e = 0`), settled as [`room_from_slacks`]'s orders
+/// ([`settle_room_aware`]: dwelled, release rules, checked with
+/// [`crate::validate_with_switch`] at `switch_s` (s), re-timed with clearances if it fails,
+/// below `cap_s`, s), with its `T_total`; `None` if nothing passes below `cap_s`. Counts the
+/// margin checks in `checks`. Run beside [`room_from_slacks`], never instead of it: neither
+/// order is shorter on every problem (docs/decisions.md, "Three robots at δ ≥ 2 s: a switch
+/// into a held stretch costs the travel from its hold (issue 41)").
+pub(super) fn room_with_travel(
+    problem: &Problem,
+    n_robots: usize,
+    tick_s: f64,
+    cap_s: f64,
+    switch_s: f64,
+    checks: &mut usize,
+) -> Option<(Schedule, f64)> {
+    let order =
+        exact::room_aware_many_travel(problem, n_robots, switch_s, 0.0, cap_s, ROOM_NODES, tick_s)?;
+    settle_room_aware(problem, order, tick_s, cap_s, switch_s, checks)
+}
+
 /// The room (schedule-clock s, > 0) each failing stretch of `schedule` misses under the margin
 /// check with the switch time `switch_s` (s): per pair `(p, c)` with a negative finite slack,
 /// `(k, −slack)` with `k` the index of `c`'s stretch among its low-confidence runs (the chain's
@@ -199,5 +220,47 @@ mod tests {
         let missing = missing_room(&p, &held, sw).unwrap();
         let m = missing.iter().map(|x| x.1).fold(0.0, f64::max);
         assert!(m > 2.0 * sw, "{missing:?}");
+    }
+
+    /// Three robots on `[LC ×10, HC ×60, LC ×3, HC ×40, LC ×3, HC ×5]` at 0.1 s, gradients 1
+    /// in `[0.5, 2]`, one usable hold at sample 20, 50 samples (2.5 s at the fastest) before
+    /// the second stretch; the last high-confidence run before the last stretch has none.
+    /// At `δ = 0.5` s a robot released from the hold by its rule reaches its stretch `δ` plus
+    /// 2.5 s after the stretch before it ended, not `δ`: no room of the ladder and no rooms
+    /// from the check give an order below serial, the order that charges the travel does.
+    #[test]
+    fn a_switch_into_a_held_stretch_charges_the_travel_from_its_hold() {
+        let conf: Vec<bool> = [(false, 10), (true, 60), (false, 3), (true, 40), (false, 3)]
+            .into_iter()
+            .chain([(true, 5)])
+            .flat_map(|(c, n)| std::iter::repeat_n(c, n))
+            .collect();
+        let n = conf.len();
+        let p = Problem::new(conf, vec![1.0; n], vec![0.5; n], vec![2.0; n], 0.1)
+            .unwrap()
+            .with_holds(vec![20])
+            .unwrap();
+        let (tick, sw) = (p.dt_s(), 0.5);
+        let serial = crate::operator::serial_with_switch(&p, 3, tick, sw).unwrap();
+        let cap = serial.t_total_s(p.dt_s());
+        // Three fastest executions of 6.85 s (1.6 s of stretches, 5.25 s of HC at ψ̇ = 0.5)
+        // and two switches of `δ` plus a tick.
+        assert!((cap - 21.75).abs() < 1e-3, "{cap}");
+        let mut checks = 0;
+        assert!(room_from_slacks(&p, 3, tick, cap, sw, &mut checks).is_none());
+        let mut checks = 0;
+        let (s, t) = room_with_travel(&p, 3, tick, cap, sw, &mut checks).expect("a schedule");
+        validate_with_switch(&p, &s, sw).unwrap();
+        assert!(t < cap - 0.4, "T_total {t} s against serial {cap} s");
+        assert!((t - s.t_total_s(p.dt_s())).abs() < 1e-12);
+        // The scheduler takes it.
+        let params = crate::SamplerParams {
+            samples: 50,
+            switch_s: sw,
+            ..Default::default()
+        };
+        let out = crate::sample_schedule_n(&p, 3, &params, None).unwrap();
+        validate_with_switch(&p, &out.schedule, sw).unwrap();
+        assert!(out.t_total_s <= t + 1e-9, "{} against {t}", out.t_total_s);
     }
 }

@@ -319,6 +319,34 @@ pub(crate) fn search_with_room(
     switch_s: f64,
     guard: &[Option<f64>],
 ) -> ManyOutcome {
+    search_with_room_travel(chain, n, cap_s, max_nodes, switch_s, guard, &[])
+}
+
+/// [`search_with_room`] where a switch into run `k` also charges `travel_s[k]` (s, ≥ 0): the
+/// operator edge from another robot's run `j` is `x(c, k) ≥ x(j) + L_j + δ + travel_s[k]`.
+/// `travel_s` empty (or `switch_s = 0`) is [`search_with_room`], the same float operations.
+///
+/// **Why** (docs/decisions.md, "Three robots at δ ≥ 2 s: a switch into a held stretch costs
+/// the travel from its hold (issue 41)"): a robot that waits at a hold for the run before it
+/// leaves by a release rule `δ` after that run's robot has *left* its stretch, and only then
+/// travels from the hold to its own stretch (at best its fastest), so such a switch lasts
+/// `δ` plus that travel, not `δ`. An order planned with `δ` alone has the later robots of a
+/// chain of such releases later than planned, and a robot released earlier, on a hold-less
+/// approach, further ahead of them than the margin check allows.
+///
+/// Like the room arcs, the travel is the candidate generator's, never the certificate's: the
+/// node bound stays [`search_with_switch`]'s (extra weight only raises times), and the forward
+/// check ([`Search::dead`]) stays valid (a path of operator edges into run `k` of robot `c`
+/// from another robot's run ends with a switch into `k`, which carries the same travel).
+pub(crate) fn search_with_room_travel(
+    chain: &Chain,
+    n: usize,
+    cap_s: f64,
+    max_nodes: usize,
+    switch_s: f64,
+    guard: &[Option<f64>],
+    travel_s: &[f64],
+) -> ManyOutcome {
     let Some(mut net) = Net::new(chain, n, switch_s) else {
         // The chain alone is infeasible: no order at all.
         return ManyOutcome {
@@ -341,6 +369,11 @@ pub(crate) fn search_with_room(
         switch_s,
         guard: if switch_s > 0.0 {
             guard.to_vec()
+        } else {
+            Vec::new()
+        },
+        travel: if switch_s > 0.0 {
+            travel_s.to_vec()
         } else {
             Vec::new()
         },
@@ -408,6 +441,9 @@ struct Search {
     /// Per LC run `k`, the room arc's offset `w_k` (s) when a switch into it is guarded (see
     /// [`search_with_room`]; empty: none).
     guard: Vec<Option<f64>>,
+    /// Per LC run `k`, the travel (s) a switch into it charges on top of `δ` (see
+    /// [`search_with_room_travel`]; empty: none).
+    travel: Vec<f64>,
     /// The dive: urgent robots first, stop at the first leaf, no open nodes kept.
     dive: bool,
     /// The least bound (s) of the nodes left open (`+∞`: none).
@@ -441,7 +477,25 @@ impl Search {
     /// The operator edge for robot `r`'s next run after the last run: its length, plus δ on
     /// a switch.
     fn edge(&self, last: Option<(usize, f64)>, r: usize) -> Option<(usize, f64)> {
-        self.edge_serial(last, r, self.order.last().copied())
+        self.edge_into(last, r, self.next[r], self.order.last().copied())
+    }
+
+    /// [`Search::edge_serial`] into run `k` of robot `r`, with the travel of a switch into it
+    /// ([`search_with_room_travel`]) when there is one.
+    fn edge_into(
+        &self,
+        last: Option<(usize, f64)>,
+        r: usize,
+        k: usize,
+        last_robot: Option<usize>,
+    ) -> Option<(usize, f64)> {
+        let edge = self.edge_serial(last, r, last_robot);
+        match (edge, self.travel.get(k)) {
+            (Some((v, w)), Some(&t)) if last.is_some() && Some(r) != last_robot && t > 0.0 => {
+                Some((v, w + t))
+            }
+            _ => edge,
+        }
     }
 
     /// The room arc of placing robot `r`'s next run right after the last run (see
@@ -647,7 +701,7 @@ impl Search {
         'robots: for r in 0..n {
             for k in 0..m {
                 self.nodes += 1;
-                let edge = self.edge_serial(last, r, placed.last().copied());
+                let edge = self.edge_into(last, r, k, placed.last().copied());
                 let room = self.room_arc_serial(net, last, r, k, placed.last().copied());
                 if !net.place_with(edge, r, k, room) {
                     feasible = false;
@@ -1097,6 +1151,47 @@ mod tests {
                 let plain = search_with_switch(&chain, n, f64::INFINITY, 1_000_000, delta);
                 let plain = plain.found.expect("the serial order is feasible").t_total_s;
                 prop_assert!(f.t_total_s >= plain * (1.0 - 1e-9), "{} < {}", f.t_total_s, plain);
+            }
+        }
+
+        /// [`search_with_room_travel`]: every switch into run `k` lasts at least `δ` plus its
+        /// travel; empty travel is [`search_with_room`] to the bit; never shorter than
+        /// without the travel.
+        #[test]
+        fn search_with_room_travel_keeps_its_travel(
+            chain in random_chain(),
+            delta in 0.001f64..0.05,
+            travel in proptest::collection::vec(0.0f64..0.05, 8),
+        ) {
+            let m = chain.n_lc();
+            let travel: Vec<f64> = (0..m).map(|k| travel[k % travel.len()]).collect();
+            for n in [2usize, 3] {
+                let out =
+                    search_with_room_travel(&chain, n, f64::INFINITY, 1_000_000, delta, &[], &travel);
+                prop_assert!(out.proven);
+                let f = out.found.expect("the serial order is feasible");
+                check(&chain, &f);
+                let t = &f.times;
+                let mut next = vec![0; n];
+                let mut last: Option<(usize, usize)> = None;
+                for &r in &f.order {
+                    let k = next[r];
+                    next[r] += 1;
+                    if let Some((p, j)) = last.filter(|&(p, _)| p != r) {
+                        let prev_end = t.lc_start_s[p][j] + chain.lc_s[j];
+                        prop_assert!(t.lc_start_s[r][k] >= prev_end + delta + travel[k] - 1e-9,
+                            "robot {} run {}: {} before {}", r, k, t.lc_start_s[r][k],
+                            prev_end + delta + travel[k]);
+                    }
+                    last = Some((r, k));
+                }
+                let none = search_with_room_travel(&chain, n, f64::INFINITY, 1_000_000, delta, &[], &[]);
+                prop_assert_eq!(
+                    &none,
+                    &search_with_room(&chain, n, f64::INFINITY, 1_000_000, delta, &[])
+                );
+                let none = none.found.expect("the serial order is feasible").t_total_s;
+                prop_assert!(f.t_total_s >= none * (1.0 - 1e-9), "{} < {}", f.t_total_s, none);
             }
         }
     }

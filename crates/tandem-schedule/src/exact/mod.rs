@@ -839,6 +839,47 @@ pub(crate) fn room_aware_many(
     max_nodes: usize,
     tick_s: f64,
 ) -> Option<Schedule> {
+    room_aware_order(
+        problem, n_robots, switch_s, extra_s, cap_s, max_nodes, tick_s, false,
+    )
+}
+
+/// [`room_aware_many`] where a switch into a run whose HC gap holds a usable hold also
+/// charges the travel from that hold (`Chain::gap_hold`, the latest) to the run at its fastest
+/// (`Σ ψ̇min·Δt_s`, s): [`many::search_with_room_travel`]. Never a bound.
+///
+/// **Why** (docs/decisions.md, "Three robots at δ ≥ 2 s: a switch into a held stretch costs
+/// the travel from its hold (issue 41)"): with release rules (`Problem::with_release_rules`)
+/// the robot leaves its hold `δ` after the robot before it has left its stretch, then travels
+/// to its own (`exact::dwelled` plans that travel at its fastest plus a tick), so the switch
+/// lasts `δ` plus the travel; planned with `δ` alone, the stretch and every later one of a
+/// chain of such releases run later than the order says.
+pub(crate) fn room_aware_many_travel(
+    problem: &Problem,
+    n_robots: usize,
+    switch_s: f64,
+    extra_s: f64,
+    cap_s: f64,
+    max_nodes: usize,
+    tick_s: f64,
+) -> Option<Schedule> {
+    room_aware_order(
+        problem, n_robots, switch_s, extra_s, cap_s, max_nodes, tick_s, true,
+    )
+}
+
+/// [`room_aware_many`] (`travel = false`) or [`room_aware_many_travel`] (`true`).
+#[allow(clippy::too_many_arguments)]
+fn room_aware_order(
+    problem: &Problem,
+    n_robots: usize,
+    switch_s: f64,
+    extra_s: f64,
+    cap_s: f64,
+    max_nodes: usize,
+    tick_s: f64,
+    travel: bool,
+) -> Option<Schedule> {
     if switch_s <= 0.0 || n_robots < 3 {
         return None;
     }
@@ -849,15 +890,34 @@ pub(crate) fn room_aware_many(
                 .then(|| extra_s - chain.lc_s[k - 1] - chain.gap_s[k].0)
         })
         .collect();
+    // With `travel`, a switch into a run whose gap holds a usable hold also lasts the travel
+    // from that hold to the run at its fastest (see `room_aware_many_travel`).
+    let dt = problem.dt_s();
+    let travel: Vec<f64> = if travel {
+        (0..chain.n_lc())
+            .map(|k| match chain.gap_hold[k] {
+                Some(h) => {
+                    problem.grad_min()[h..chain.gap_ref[k].1]
+                        .iter()
+                        .sum::<f64>()
+                        * dt
+                }
+                None => 0.0,
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
     // Each switch planned one control tick longer than `δ`: a dwell at a hold ends at a tick
     // start, so a stretch after one may start up to a tick later than the order's times.
-    let out = many::search_with_room(
+    let out = many::search_with_room_travel(
         &chain,
         n_robots,
         cap_s,
         max_nodes,
         switch_s + tick_s,
         &guard,
+        &travel,
     );
     let f = out.found?;
     let gaps: Vec<Vec<f64>> = (0..n_robots).map(|r| f.times.gaps_s(&chain, r)).collect();
