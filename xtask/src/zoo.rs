@@ -580,8 +580,9 @@ fn markdown(file: &ZooFile) -> String {
              scheduler did not find. They add up to the gap. `of it unavoidable` is the part \
              of `margins` that no valid schedule avoids: every switch between the two robots' \
              low-confidence runs charged the margin check's least step and the drag lead \
-             it must see there (`tandem_schedule::drag_charged_bound`; two robots without \
-             hold points; the \
+             it must see there, or with hold points the least of that and what a wait at \
+             the follower's last hold before its run leaves (`tandem_schedule::held_charged_bound`; \
+             two robots; the \
              seeds measured in brackets, — for none).\n\n\
              | family | N | gap % | search | margins | of it unavoidable | seeds with a proven bound |\n\
              |---|---|---|---|---|---|---|\n",

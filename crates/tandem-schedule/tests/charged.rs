@@ -11,8 +11,8 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use tandem_schedule::testkit;
 use tandem_schedule::{
-    ExactParams, Problem, SamplerParams, Schedule, drag_charged_bound, sample_schedule,
-    switch_charged_bound, validate,
+    ExactParams, Problem, SamplerParams, Schedule, drag_charged_bound, held_charged_bound,
+    sample_schedule, switch_charged_bound, validate,
 };
 
 /// `tol::BOUND_REL`: how far a correct bound may lie above a valid schedule's `T_total`.
@@ -231,4 +231,113 @@ fn zoo_painting_drag_bound() {
     eprintln!("step {step:?}\ndrag {d:?}");
     assert!(d.lower_bound_s >= step.lower_bound_s);
     assert!(d.lower_bound_s <= 35.258);
+}
+
+/// `held_charged_bound` is at most the `T_total` of the valid schedule `s` at `tick_s` (the
+/// scheduler's and the serial ones plan the waits of their release rules), and never below the
+/// step-only bound nor the margin-free one.
+fn held_bound_holds_for(p: &Problem, s: &Schedule, tick_s: f64) -> Result<(), TestCaseError> {
+    prop_assert_eq!(validate(p, s), Ok(()));
+    let step = switch_charged_bound(p, &ExactParams::default(), tick_s).unwrap();
+    let h = held_charged_bound(p, &ExactParams::default(), tick_s).unwrap();
+    let t = s.t_total_s(p.dt_s());
+    prop_assert!(
+        h.lower_bound_s <= t * (1.0 + BOUND_REL),
+        "held bound {} above a valid schedule's T_total {t} ({h:?}, holds {:?})",
+        h.lower_bound_s,
+        s.holds
+    );
+    prop_assert!(
+        h.lower_bound_s >= step.lower_bound_s,
+        "{h:?} below {step:?}"
+    );
+    prop_assert!(h.lower_bound_s >= h.margin_free_s);
+    Ok(())
+}
+
+/// Two LC runs of 10 samples (`ψ̇min, ψ̇̄, ψ̇max = 0.5, 1, 4`: slow time 0.4 s, planned 0.1 s)
+/// around a gap of 40 HC samples (`0.9, 0.95, 1.0`: at least 0.36 s planned, 0.4 s of slow
+/// time) with a hold at sample 30, and a tail like it; 10 ms samples and tick. `T*₀ = 1.02 s`
+/// (robot 1's runs at 0 and 0.46 s, robot 2's at 0.1 and 0.56 s). A switch into run 1 (the
+/// other robot's run 0 or 1 before it): the follower's leg started before its run 0 (robot 1,
+/// or robot 2 from its start) crosses the whole gap, `0.36 − 0.1 = 0.26 s`; waiting at the hold
+/// (the travel from it `20·0.009 = 0.18 s`) until the other robot is between entry points 55
+/// and 56 of its run (0.05 s from its exit), `0.18 − 0.05 = 0.13 s` (released later:
+/// 0.18 − 0.04 with the drag from 56, `c` crossing 0.16 s of slow time, 0.144 s of planned
+/// gap, plus `M` = 0.02 s, only 0.124 s; 0.14 s at 54 and 57); released before, the drag from
+/// the hold reaches run 1 (no valid schedule). So room 0.13 s; into run 0 nothing (robot 2's
+/// start may wait for a rule whose wait is not planned). Bound: robot 1's runs at 0 and 0.46
+/// s, robot 2's at 0.1 and `0.56 + 0.13 = 0.69` s (its gap may dwell at the hold), end
+/// `0.79 + 0.36 = 1.15 s`; robot 2's run 1 first costs 1.25 s, robot 1 both runs first 1.48
+/// s. The scheduler's schedule and the serial one are valid and not below it.
+#[test]
+fn two_runs_with_a_hold_by_hand() {
+    let n = 100;
+    let lc = |i: usize| i < 10 || (50..60).contains(&i);
+    let conf: Vec<bool> = (0..n).map(|i| !lc(i)).collect();
+    let pick = |i: usize, h: f64, l: f64| if lc(i) { l } else { h };
+    let plain = Problem::new(
+        conf,
+        (0..n).map(|i| pick(i, 0.95, 1.0)).collect(),
+        (0..n).map(|i| pick(i, 0.9, 0.5)).collect(),
+        (0..n).map(|i| pick(i, 1.0, 4.0)).collect(),
+        0.01,
+    )
+    .unwrap();
+    let p = plain.clone().with_holds(vec![30]).unwrap();
+    let h = held_charged_bound(&p, &ExactParams::default(), 0.01).unwrap();
+    assert!(h.charged);
+    assert!((h.margin_free_s - 1.02).abs() < 1e-6, "{h:?}");
+    assert!((h.max_charge_s - 0.13).abs() < 1e-6, "{h:?}");
+    assert!((h.lower_bound_s - 1.15).abs() < 1e-6, "{h:?}");
+    let out = sample_schedule(&p, &SamplerParams::default(), None).unwrap();
+    held_bound_holds_for(&p, &out.schedule, 0.01).unwrap();
+    held_bound_holds_for(&p, &p.serial_schedule(0.01).unwrap(), 0.01).unwrap();
+    for bad in [0.0, f64::NAN] {
+        assert!(held_charged_bound(&p, &ExactParams::default(), bad).is_err());
+    }
+    // Without the hold it is the drag bound.
+    assert_eq!(
+        held_charged_bound(&plain, &ExactParams::default(), 0.01).unwrap(),
+        drag_charged_bound(&plain, &ExactParams::default(), 0.01).unwrap()
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// Small random problems with a hold in the middle of every HC run of three samples or
+    /// more (`testkit::hold_points`): the scheduler's schedule (with the release rules and
+    /// planned waits it makes) and the serial one are never below the bound with holds, and
+    /// it is never below the step-only bound.
+    #[test]
+    fn the_held_bound_is_below_every_checked_schedule_small(
+        p in small_problem(),
+        seed in any::<u64>(),
+    ) {
+        let holds = testkit::hold_points(p.conf());
+        let p = p.with_holds(holds).unwrap();
+        let params = SamplerParams { samples: 2000, seed, ..SamplerParams::default() };
+        let out = sample_schedule(&p, &params, None).unwrap();
+        held_bound_holds_for(&p, &out.schedule, p.dt_s())?;
+        held_bound_holds_for(&p, &p.serial_schedule(p.dt_s()).unwrap(), p.dt_s())?;
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(40))]
+
+    /// Larger random problems with holds (`testkit::random_problem`, 200–1200 samples,
+    /// `testkit::hold_points`), at the problem's sample time and at a tick twice as long.
+    #[test]
+    fn the_held_bound_is_below_every_checked_schedule(seed in any::<u64>(), long in any::<bool>()) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let p = testkit::random_problem(&mut rng, 200..=1200, 0.01).unwrap();
+        let holds = testkit::hold_points(p.conf());
+        let p = p.with_holds(holds).unwrap();
+        let tick_s = if long { 0.02 } else { 0.01 };
+        let params = SamplerParams { samples: 500, seed, tick_s: Some(tick_s), ..SamplerParams::default() };
+        let out = sample_schedule(&p, &params, None).unwrap();
+        held_bound_holds_for(&p, &out.schedule, tick_s)?;
+    }
 }

@@ -77,6 +77,7 @@ impl Cum {
 }
 
 /// What the room of one switch is computed from (all s, schedule clock unless said).
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct DragParams {
     /// `M_lo`: the least the check's maximal step can be (the LC samples' `ψ̇̄/ψ̇min` alone,
     /// less the gradient tolerance).
@@ -147,9 +148,21 @@ fn least_before(cum: &Cum, gap: (usize, usize), r_s: f64, dp: &DragParams) -> f6
 /// `p` crosses `n`, and `p` spends at least `ψ̇_E[n]·Δt/S̃(n)` real seconds there, `S̃(n)` the
 /// least `ψ̇̄/ψ̇max` of those samples (`n` itself among them: at least its slow time).
 fn drag_time(problem: &Problem, cum: &Cum, run: (usize, usize), dp: &DragParams) -> Vec<f64> {
+    let reach = (dp.step_lo_s - dp.tick_s * (1.0 + dp.rel)).max(0.0) / (1.0 + dp.rel);
+    drag_time_within(problem, cum, run, (reach, true), dp.rel)
+}
+
+/// [`drag_time`] with the window reaching `reach` (s of `Σψ̇̄Δt` from the far end of sample `n`)
+/// before every sample and, when `forward`, after it too.
+fn drag_time_within(
+    problem: &Problem,
+    cum: &Cum,
+    run: (usize, usize),
+    (reach, forward): (f64, bool),
+    rel: f64,
+) -> Vec<f64> {
     let (s, e) = run;
     let (gmean, gmax) = (problem.grad_mean(), problem.grad_max());
-    let reach = (dp.step_lo_s - dp.tick_s * (1.0 + dp.rel)).max(0.0) / (1.0 + dp.rel);
     let rate = |n: usize| gmean[n] / gmax[n];
     let mut out = Vec::with_capacity(e - s + 1);
     out.push(0.0);
@@ -157,7 +170,7 @@ fn drag_time(problem: &Problem, cum: &Cum, run: (usize, usize), dp: &DragParams)
     for n in s..e {
         let mut least = rate(n);
         let mut b = n + 1;
-        while b < e && cum.mean[b] - cum.mean[n] <= reach {
+        while forward && b < e && cum.mean[b] - cum.mean[n] <= reach {
             least = least.min(rate(b));
             b += 1;
         }
@@ -166,7 +179,7 @@ fn drag_time(problem: &Problem, cum: &Cum, run: (usize, usize), dp: &DragParams)
             least = least.min(rate(a - 1));
             a -= 1;
         }
-        sum += (1.0 - 3.0 * dp.rel) * (cum.mean[n + 1] - cum.mean[n]) / least;
+        sum += (1.0 - 3.0 * rel) * (cum.mean[n + 1] - cum.mean[n]) / least;
         out.push(sum);
     }
     out
@@ -258,6 +271,107 @@ pub(crate) fn drag_room(
                 general
             };
             out.insert((j, k), room.max(0.0));
+        }
+    }
+    out
+}
+
+/// `M_lo` of one LC run `[s, e)` alone: `tick · max(1, largest ψ̇̄/ψ̇min of its samples)`, less
+/// the gradient tolerance. The lead bound's step `M_i` of a leg (`tick ·` its largest fast rate)
+/// is at least this on every leg that holds the run.
+fn run_step_lo(problem: &Problem, run: (usize, usize), dp: &DragParams) -> f64 {
+    let (gmean, gmin) = (problem.grad_mean(), problem.grad_min());
+    let rate = (run.0..run.1)
+        .map(|n| gmean[n] / gmin[n])
+        .fold(1.0, f64::max);
+    dp.tick_s * rate * (1.0 - dp.rel)
+}
+
+/// Per pair `(j, k)` of LC runs (as [`drag_room`]), the least room `T_c − T_p` (s) that every
+/// two-robot schedule *with holds* (split into legs, `tandem_realtime::holds`) keeps when the
+/// margin check (the lead bound on the legs with their release rules) accepts it at tick
+/// `dp.tick_s` and its planned dwells cover its release rules (every held leg starts no earlier
+/// than the planned clock at which the samples it awaits are passed, as
+/// `tandem_realtime::holds::release_rules` plans them; robot 2's start is not planned to wait:
+/// nothing is charged from it). Lowered by `slack_s` (the clocks'
+/// rounding); not below 0. The proof is in [`super::held_charged_bound`].
+pub(crate) fn held_room(
+    problem: &Problem,
+    chain: &Chain,
+    dp: &DragParams,
+    slack_s: f64,
+) -> BTreeMap<(usize, usize), f64> {
+    let cum = Cum::new(problem);
+    let m = chain.n_lc();
+    let usable = problem.usable_holds();
+    let k_mean = 1.0 + dp.rel;
+    let k_fast = 1.0 - dp.rel;
+    let fast = |u: usize| k_fast * cum.fast[u];
+    let steps: Vec<f64> = chain
+        .lc_ref
+        .iter()
+        .map(|&r| run_step_lo(problem, r, dp))
+        .collect();
+    let mut out = BTreeMap::new();
+    for j in 0..m {
+        let (s_j, e_j) = chain.lc_ref[j];
+        let stride = (e_j - s_j).div_ceil(MAX_ENTRY_POINTS).max(1);
+        let mut entries: Vec<usize> = (s_j..e_j).step_by(stride).collect();
+        entries.push(e_j);
+        // `p`'s window is `[u − M_p, u]` (behind its clock only), `M_p ≥ M_lo(j)`; a sample
+        // whose far end is within `M_lo(j)/(1 + rel)` of mean time is inside it.
+        let reach = steps[j] / k_mean;
+        let p_real = drag_time_within(problem, &cum, (s_j, e_j), (reach, false), dp.rel);
+        let slow_left = |q: usize| p_real[e_j - s_j] - p_real[q - s_j];
+        let mean_left = |q: usize| k_mean * (cum.mean[e_j] - cum.mean[q]);
+        for (k, &step_k) in steps.iter().enumerate() {
+            let dpk = DragParams {
+                step_lo_s: step_k,
+                ..*dp
+            };
+            let (g0, g1) = chain.gap_ref[k];
+            let fast_gap = fast(g1) - fast(g0);
+            // (a) `c`'s leg holds its run `k − 1` too (or is robot 1's first): tested by the
+            // lead bound; its frontier is in gap `k` (then `Φ_k`) or behind it (then the whole
+            // gap is still to go), and `c` keeps at least its step.
+            let general = entries
+                .iter()
+                .map(|&q| {
+                    least_before(&cum, (g0, g1), slow_left(q), &dpk).min(fast_gap) - mean_left(q)
+                })
+                .fold(f64::NEG_INFINITY, f64::max)
+                .max(step_k);
+            // (b) `c`'s leg starts at a hold of gap `k` (robot 2's start for `k = 0`).
+            let holds: Vec<usize> = usable
+                .iter()
+                .copied()
+                .filter(|&h| h > g0 && h < g1)
+                .chain((k == 0).then_some(0))
+                .collect();
+            let held = match (holds.iter().min(), holds.iter().max()) {
+                (Some(&h_min), Some(&h_max)) => {
+                    // Robot 2's start may wait for a rule without a planned wait (its offset is
+                    // the start's dwell): from the start, no travel is charged.
+                    let travel = if k == 0 { 0.0 } else { fast(g1) - fast(h_max) };
+                    let before = |q: usize| least_before(&cum, (h_min, g1), slow_left(q), &dpk);
+                    // Released before `p` enters run `j`: every entry point counts.
+                    let early = entries
+                        .iter()
+                        .map(|&q| before(q) - mean_left(q))
+                        .fold(f64::NEG_INFINITY, f64::max)
+                        .max(step_k);
+                    // Released inside run `j`, between two entry points.
+                    let inside = entries
+                        .windows(2)
+                        .map(|w| before(w[1]).max(travel) - mean_left(w[0]))
+                        .fold(f64::INFINITY, f64::min);
+                    // Released once `p` has left (the rule's planned wait, or a leg that starts
+                    // after the pair: the check does not test it).
+                    early.min(inside).min(travel)
+                }
+                _ => f64::INFINITY,
+            };
+            out.insert((j, k), (general.min(held) - slack_s).max(0.0));
         }
     }
     out

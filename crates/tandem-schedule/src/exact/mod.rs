@@ -665,26 +665,7 @@ pub fn drag_charged_bound(
         return Ok(step);
     }
     let chain = chain::Chain::new(problem);
-    let rel = tandem_realtime::tol::GRADIENT_REL;
-    let (gmean, gmin, gmax) = (problem.grad_mean(), problem.grad_min(), problem.grad_max());
-    let fastest_rate = (0..problem.n_ref())
-        .map(|n| {
-            if problem.conf()[n] {
-                gmax[n] / gmin[n]
-            } else {
-                gmean[n] / gmin[n]
-            }
-        })
-        .fold(1.0, f64::max);
-    // The check's `ε` (`4·CLOCK_REL·scale`), for schedules within ten times the slowest
-    // serial execution (a longer one is above the bound anyway).
-    let eps_s = 4.0 * tandem_realtime::tol::CLOCK_REL * (20.0 * chain.slowest_s() + tick_s + 1.0);
-    let dp = drag::DragParams {
-        step_lo_s: step.charge_s,
-        step_hi_s: tick_s * fastest_rate * (1.0 + rel) + eps_s,
-        tick_s,
-        rel,
-    };
+    let (dp, _) = drag_params(problem, &chain, step.charge_s, tick_s);
     let room = drag::drag_room(problem, &chain, &dp);
     let max_charge_s = room.values().fold(step.charge_s, |a, &b| a.max(b));
     let clear = search::Clearance {
@@ -699,6 +680,146 @@ pub fn drag_charged_bound(
             lower_bound_s: found.t_total_s.max(step.lower_bound_s),
             max_charge_s,
             ..step
+        }),
+        _ => Ok(step),
+    }
+}
+
+/// What [`drag::drag_room`] and [`drag::held_room`] compute the room from, with the step `M`
+/// `charge_s` (s), and the check's `ε` (s, `4·CLOCK_REL·scale`, for schedules within ten
+/// times the slowest serial execution: a longer one is above the bound anyway).
+fn drag_params(
+    problem: &Problem,
+    chain: &chain::Chain,
+    charge_s: f64,
+    tick_s: f64,
+) -> (drag::DragParams, f64) {
+    let rel = tandem_realtime::tol::GRADIENT_REL;
+    let (gmean, gmin, gmax) = (problem.grad_mean(), problem.grad_min(), problem.grad_max());
+    let fastest_rate = (0..problem.n_ref())
+        .map(|n| {
+            if problem.conf()[n] {
+                gmax[n] / gmin[n]
+            } else {
+                gmean[n] / gmin[n]
+            }
+        })
+        .fold(1.0, f64::max);
+    let eps_s = 4.0 * tandem_realtime::tol::CLOCK_REL * (20.0 * chain.slowest_s() + tick_s + 1.0);
+    let dp = drag::DragParams {
+        step_lo_s: charge_s,
+        step_hi_s: tick_s * fastest_rate * (1.0 + rel) + eps_s,
+        tick_s,
+        rel,
+    };
+    (dp, eps_s)
+}
+
+/// [`drag_charged_bound`] extended to problems with usable hold points: every switch is
+/// charged the least room of a schedule without holds (the drag lead under the two-robot
+/// simulation, [`drag_charged_bound`]) or with holds (the drag lead the lead bound builds on
+/// the follower's *leg*, or the follower's travel from its last hold), whichever is less
+/// (docs/decisions.md, "Two robots with holds: the drag lead charged from the last hold
+/// (issue 38)"). Without usable holds it is [`drag_charged_bound`].
+///
+/// **Which schedules it bounds.** Every two-robot schedule that [`crate::validate`] accepts at
+/// `tick_s` (`h`, `δ = 0`) and whose planned dwells cover its release rules: each hold with a
+/// rule "robot `a` has passed sample `s`" ends (the held leg starts) no earlier than the
+/// planned clock at which `a` reaches `s`, up to `10⁻¹²` relative — what
+/// `tandem_realtime::holds::release_rules` makes of every schedule the scheduler returns
+/// ("A plan is what the cell does"). [`crate::validate`] does not ask this of a schedule given
+/// to it, so a hand-made plan whose dwells are shorter than its rules make them (its `T_total`
+/// then understates what the cell does) can lie below: this is why the bound is not the
+/// certificate's.
+///
+/// **Why.** A schedule without holds (none, or only start holds without rules) is checked by
+/// the simulation: its switches keep [`drag_charged_bound`]'s table and the step `M`. One with
+/// holds is checked by the lead bound on its legs (`tandem_realtime::margins`, "Three or more
+/// robots: the lead bound", with holds: each leg starts as a robot starts). Take a pair `(p,
+/// c)`: `p` leaves LC run `j` at `T_p`, `c` enters run `k` next at `T_c`, `c`'s leg holding run
+/// `k` starts at clock `H_c` at reference position `h`; `M_k`, `M_j` the steps of runs `k`,
+/// `j` alone (each leg's step is at least its runs').
+/// 1. *Untested pairs.* The check skips a pair whose order a chain of release rules enforces or
+///    whose later leg starts after `p` has left (`u_max` at or before the analysis's start).
+///    With covered dwells an enforcing rule gates `C` at a hold of `c` whose planned leg start
+///    is at least `T_p`, and that hold lies after `c`'s run `k − 1` (else run `k − 1` would
+///    start after `T_p`, after run `j` starts, and not be before it in the merged order): a
+///    hold `h` of gap `k`, or robot 2's start for `k = 0`. So `T_c ≥ T_p + fast(h, g₁)`
+///    (planned at least the fastest, Eq. 20 constraint 1; `g₁` run `k`'s start), at least the
+///    travel from the latest usable hold of the gap.
+/// 2. *Tested pairs.* The check accepts only if `T_c − ε > reach + M_c ≥ X(T_p) + M_c`, with
+///    `X(u) = u + Λ(u)` the frontier from `u₀ = max(H_p, H_c)` (the legs' later start),
+///    `Λ ≥ 0` (floored; its start lead is ≥ 0). On every cell (one sample of `p`) in which
+///    `p`'s window `[u − M_p, u]` holds an LC sample and the frontier crosses only HC samples
+///    of `c`, `Λ' ≥ S_c^w/S_p^w − 1` (the drag case is among those maximised), with `S_p^w`
+///    the least `S` of `p`'s window and `S_c^w` the largest over every HC sample the frontier
+///    crosses; so the frontier crosses at least as much *slow time* of `c` as `p` spends in
+///    the cell (`ψ̇_E[n]·Δt/S_p^w`, at least the run's `ψ̇̄/ψ̇max` within `M_lo(j)` behind it,
+///    `drag::drag_time_within`). From an entry point `a ≥ u₀` at position `q` of run `j`,
+///    `X(a) ≥ a` at `c`'s position `y`, and either `y` is behind gap `k` (then
+///    `T_c − a ≥ fast(gap k)`) or `y ≤ Y_R(x)` at the frontier's exit position `x`, so
+///    `T_c − a ≥ Φ_k(R(q))` (`drag::least_before` with `M_k`, `y` at or after `h` when `c`'s
+///    leg starts at a hold of gap `k`); `T_p − a ≤ (1 + rel)·mean(q, e_j)`. `c`'s leg starting
+///    before run `k − 1`: every `a` counts and the room is at least `M_k`. Starting at a hold
+///    of gap `k` (or robot 2's start): before run `j`, every `a` counts; inside run `j`
+///    between entry points `q_i < q_{i+1}`, the entries from `q_{i+1}` and the travel
+///    `T_c ≥ H_c + fast(h, g₁)` with `H_c > a(q_i)`; after it, case 1.
+///
+/// Every rounding errs low: planned durations are taken `(1 − rel)·fast` below and
+/// `(1 + rel)·mean` above, `p`'s drag time `(1 − 3·rel)` below, the entry points are a subset
+/// (the largest over fewer is less), the hold positions widened to the gap's first (for
+/// `Φ`) and latest (for the travel), and every room lowered by the check's `ε`. The search
+/// runs on the chain with holds (a gap with a usable hold may last any time up to twice the
+/// fastest execution, as for `T*₀`; the serial schedule is feasible, so a schedule with a
+/// longer gap is above the result), and its optimum (a relaxation, `τ ≤ |ψ_E1|` left out) is
+/// at most the `T_total` of every schedule of either kind.
+///
+/// # Errors
+/// [`Error::BadParam`] for invalid parameters or a `tick_s` not finite and > 0.
+pub fn held_charged_bound(
+    problem: &Problem,
+    params: &ExactParams,
+    tick_s: f64,
+) -> Result<SwitchCharged> {
+    if problem.usable_holds().is_empty() {
+        return drag_charged_bound(problem, params, tick_s);
+    }
+    let step = switch_charged_bound(problem, params, tick_s)?;
+    let chain = chain::Chain::new(problem);
+    if chain.n_lc() == 0 {
+        return Ok(step);
+    }
+    let charge_s =
+        crate::choose::max_step_s(problem, tick_s) * (1.0 - tandem_realtime::tol::GRADIENT_REL);
+    let (dp, eps_s) = drag_params(problem, &chain, charge_s, tick_s);
+    let free_room = drag::drag_room(problem, &chain, &dp);
+    let held = drag::held_room(problem, &chain, &dp, eps_s);
+    let pairs: std::collections::BTreeMap<(usize, usize), f64> = held
+        .into_iter()
+        .map(|(pair, r)| {
+            let plain = free_room.get(&pair).copied().unwrap_or(0.0).max(charge_s);
+            (pair, r.min(plain))
+        })
+        .collect();
+    let max_charge_s = pairs.values().fold(0.0, |a: f64, &b| a.max(b));
+    let clear = search::Clearance {
+        pairs,
+        ..search::Clearance::uniform(0.0, Some(0.0))
+    };
+    match search::search(
+        &bound_chain(problem, 2),
+        &clear,
+        f64::INFINITY,
+        params.max_pieces,
+    )
+    .0
+    {
+        search::Outcome::Done(Some(found)) => Ok(SwitchCharged {
+            lower_bound_s: found.t_total_s.max(step.lower_bound_s),
+            margin_free_s: step.margin_free_s,
+            charge_s,
+            max_charge_s,
+            charged: true,
         }),
         _ => Ok(step),
     }

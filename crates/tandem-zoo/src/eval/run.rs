@@ -45,12 +45,13 @@ pub struct RunReport {
     pub margin_free_s: Option<f64>,
     /// The last plan's bound that charges every switch between the two robots' low-confidence
     /// runs its least margin and the drag lead the check must see there (s,
-    /// `tandem_schedule::drag_charged_bound` at the plan's tick; reports saved before it hold
-    /// `switch_charged_bound`, the step alone): no
-    /// schedule the margin check accepts is shorter, so `T_total` above it is what the
-    /// completion did not find, and it above [`RunReport::margin_free_s`] is what the margins
-    /// cost every schedule. Rounds of two robots on a problem without usable hold points only;
-    /// `None` otherwise and in reports saved before it.
+    /// `tandem_schedule::held_charged_bound` at the plan's tick, with usable hold points the
+    /// least of the drag lead and what a wait at the follower's last hold saves; reports saved
+    /// before it hold `drag_charged_bound` or `switch_charged_bound`): no schedule the margin
+    /// check accepts (with holds: whose planned dwells cover its release rules, as the
+    /// scheduler's do) is shorter, so `T_total` above it is what the completion did not find,
+    /// and it above [`RunReport::margin_free_s`] is what the margins cost every schedule.
+    /// Rounds of two robots only; `None` otherwise and in reports saved before it.
     #[serde(default)]
     pub switch_charged_s: Option<f64>,
     /// The serial schedule's `T_total` on the last plan's problem (`N` fastest executions one
@@ -158,7 +159,7 @@ fn switch_charged_s(planner: &Planner, robots: usize, tick_s: f64) -> Option<f64
         return None;
     }
     let exact = tandem_schedule::ExactParams::default();
-    tandem_schedule::drag_charged_bound(planner.problem(), &exact, tick_s)
+    tandem_schedule::held_charged_bound(planner.problem(), &exact, tick_s)
         .ok()
         .filter(|b| b.charged)
         .map(|b| b.lower_bound_s)

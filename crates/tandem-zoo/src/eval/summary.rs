@@ -35,7 +35,7 @@ pub struct FamilyRow {
     pub gap_split_pct: Option<(f64, f64)>,
     /// Of the margins' share, what no valid schedule avoids: the mean over the seeds that
     /// measured it of `RunReport::unavoidable_pct` (percent of the bound), with their number;
-    /// `None` when none did (holds, a cell, three or more robots, an old report).
+    /// `None` when none did (a cell, three or more robots, an old report).
     #[serde(default)]
     pub unavoidable_pct: Option<(f64, usize)>,
     /// Seeds whose bound is the proven margin-free optimum (rounds).
