@@ -30,6 +30,14 @@ enum Phase {
     Idle,
     /// A finished round waits to be recorded (or a new one to start).
     Finished,
+    /// The operator's rest after a round (the load cap, [`CellLoop::rest_left_ticks`]): whole
+    /// seconds left, rounded up; whether the round waits to be recorded.
+    Resting {
+        /// The rest left (s, rounded up).
+        left_s: u64,
+        /// Whether a finished round waits to be recorded.
+        finished: bool,
+    },
     /// A round (or the cell) runs: no notice.
     Running,
 }
@@ -38,6 +46,11 @@ impl Phase {
     fn of(cell_loop: &CellLoop) -> Phase {
         if cell_loop.is_active() {
             Phase::Running
+        } else if cell_loop.rest_left_ticks() > 0 {
+            Phase::Resting {
+                left_s: cell_loop.rest_left_s().ceil() as u64,
+                finished: cell_loop.is_finished(),
+            }
         } else if cell_loop.is_finished() {
             Phase::Finished
         } else {
@@ -50,8 +63,28 @@ impl Phase {
         match self {
             Phase::Idle => Some(IDLE_NOTICE.to_owned()),
             Phase::Finished => Some(FINISHED_NOTICE.to_owned()),
+            Phase::Resting { left_s, finished } => Some(rest_notice(left_s, finished)),
             Phase::Running => None,
         }
+    }
+}
+
+/// The page's notice during the operator's rest after a round (issue 41: the load cap
+/// `max_busy_share` of the state file): `rest: N s` (whole seconds, rounded up, so the page
+/// never shows less than is left), then what may be done meanwhile. It changes once a second
+/// (a new notice, so one allocation a second on the tick thread while the rest lasts).
+#[must_use]
+pub fn rest_notice(left_s: u64, finished: bool) -> String {
+    if finished {
+        format!(
+            "rest: {left_s} s before the next round (the operator's load cap) — record the \
+             round with /tandem/record_round; /tandem/start_round is refused until then"
+        )
+    } else {
+        format!(
+            "rest: {left_s} s before the next round (the operator's load cap) — \
+             /tandem/start_round is refused until then"
+        )
     }
 }
 
@@ -78,7 +111,8 @@ impl ConsoleFeed {
     /// After each [`CellLoop::step`] or [`CellLoop::advance`]: answers the page's controls,
     /// counts a finished round, hands the page a replaced controller's plan
     /// ([`CellLoop::plan`]) before its first tick, says on the page whether the cell is idle
-    /// ([`IDLE_NOTICE`]) or a round waits ([`FINISHED_NOTICE`]), and publishes the loop's last tick. Never
+    /// ([`IDLE_NOTICE`]), a round waits ([`FINISHED_NOTICE`]) or the operator rests
+    /// ([`rest_notice`]), and publishes the loop's last tick. Never
     /// blocks; allocates only to answer a control message, and when the plan or the cell's
     /// state changed.
     pub fn publish(&mut self, cell_loop: &CellLoop) {

@@ -129,6 +129,24 @@ pub enum Refusal {
     /// Record in a continuous cell.
     #[error("a continuous cell records no rounds; run the node with --cell rounds to record")]
     Continuous,
+    /// Start before the operator's rest after the last round has passed (the load cap
+    /// `max_busy_share` < 1 of the state file; [`CellLoop::rest_left_ticks`]).
+    #[error(
+        "the operator rests after the last round (load cap max_busy_share): {} s left \
+         ({left_ticks} ticks); call start_round again then",
+        fmt_ms(*left_ms)
+    )]
+    Resting {
+        /// The rest left (ms, rounded up).
+        left_ms: u64,
+        /// The rest left (control ticks).
+        left_ticks: u64,
+    },
+}
+
+/// `ms` milliseconds as seconds with three decimals.
+fn fmt_ms(ms: u64) -> String {
+    format!("{}.{:03}", ms / 1000, ms % 1000)
 }
 
 /// The tick thread's answer to a [`Inbound::Request`].
@@ -209,6 +227,10 @@ pub struct Snapshot {
     pub fault: Option<NodeFault>,
     /// The next handover ([`PreAlert`], real s from the end of this tick).
     pub next: Option<PreAlert>,
+    /// The operator's rest left before the next round may start (s, whole ticks: the load
+    /// cap's rest after a round, [`CellLoop::rest_left_ticks`]); 0 when none (always in a
+    /// continuous cell and without a cap).
+    pub rest_s: f64,
 }
 
 /// What the node publishes every tick (`/tandem/robotK/command`, and `needs_operator` on
@@ -425,6 +447,10 @@ pub struct CellLoop {
     /// The last tick's speed scales and whether two robots were low-confidence in it.
     speed: PerRobot<f64>,
     overlap: bool,
+    /// The loop's tick count from which a round may start again: the tick that ended (or
+    /// stopped) the last round plus the rest the load cap asks after it
+    /// ([`tandem_realtime::Coordinator::rest_ticks`]); 0 before any round.
+    rest_until: u64,
 }
 
 impl CellLoop {
@@ -483,6 +509,7 @@ impl CellLoop {
             low_now: ctl.low_conf_now(),
             speed: PerRobot::new(n),
             overlap: false,
+            rest_until: 0,
             last: tick_now(&ctl),
             ctl,
         })
@@ -584,6 +611,34 @@ impl CellLoop {
         self.plan.as_deref()
     }
 
+    /// The operator's rest left, in control ticks of the loop, before a round may start
+    /// (issue 41; docs/decisions.md, "The operator's rest in the node, Python and the console
+    /// (issue 41)"): when a round ends (or is stopped) the loop takes the rounds coordinator's
+    /// [`rest_ticks`](tandem_realtime::Coordinator::rest_ticks) — the least rest that keeps
+    /// the operator's busy share of the round and its rest at most the state file's
+    /// `max_busy_share` — and a `start_round` before that many ticks have passed since the
+    /// round's last tick is refused ([`Refusal::Resting`]). So at least `rest` ticks without a
+    /// round lie between the round's last tick and the next round's first. 0 without a cap, in
+    /// a continuous cell, and once the rest has passed.
+    #[must_use]
+    pub fn rest_left_ticks(&self) -> u64 {
+        self.rest_until.saturating_sub(self.ticks)
+    }
+
+    /// [`rest_left_ticks`](Self::rest_left_ticks) in seconds (ticks times the control tick).
+    #[must_use]
+    pub fn rest_left_s(&self) -> f64 {
+        self.rest_left_ticks() as f64 * self.ctl.tick_s()
+    }
+
+    /// The round ended or was stopped at the loop's tick `self.ticks`: the rest its operators
+    /// get before the next round (read before the controller is reset).
+    #[cold]
+    fn rest_after_round(&mut self) {
+        let rest = self.ctl.as_rounds().map_or(0, |c| c.rest_ticks());
+        self.rest_until = self.ticks.saturating_add(rest);
+    }
+
     fn take_round(&mut self) -> std::result::Result<RoundLog, Refusal> {
         if self.ctl.cell() == Cell::Continuous {
             return Err(Refusal::Continuous);
@@ -604,6 +659,14 @@ impl CellLoop {
             Request::Start => {
                 if self.active {
                     return Err(Refusal::Running);
+                }
+                let left_ticks = self.rest_left_ticks();
+                if left_ticks > 0 {
+                    let left_s = left_ticks as f64 * self.ctl.tick_s();
+                    return Err(Refusal::Resting {
+                        left_ms: (left_s * 1000.0).ceil() as u64,
+                        left_ticks,
+                    });
                 }
                 if let Some((ctl, plan)) = self.pending.take() {
                     self.capacity = round_capacity(&ctl);
@@ -638,6 +701,8 @@ impl CellLoop {
                 }
                 self.active = false;
                 if self.ctl.cell() == Cell::Rounds {
+                    // The operator worked the stopped round's part: its rest too.
+                    self.rest_after_round();
                     self.ctl.reset();
                     for r in &mut self.log.robots {
                         r.ref_time.clear();
@@ -694,6 +759,7 @@ impl CellLoop {
             overlap: self.overlap,
             fault: self.fault(),
             next: self.last.next,
+            rest_s: self.rest_left_s(),
         }
     }
 
@@ -805,6 +871,7 @@ impl CellLoop {
             if self.ctl.is_finished() {
                 self.active = false;
                 self.finished = true;
+                self.rest_after_round();
             }
         }
         let after = self.last.ref_time;

@@ -24,7 +24,7 @@ pub mod probe;
 pub use crate::core::{
     CellLoop, Command, Inbound, LoopParams, NodeFault, Reply, Request, RoundLog, Snapshot,
 };
-pub use console::{ConsoleFeed, FINISHED_NOTICE, IDLE_NOTICE};
+pub use console::{ConsoleFeed, FINISHED_NOTICE, IDLE_NOTICE, rest_notice};
 pub use error::{Error, Result};
 pub use node::{Node, NodeParams, NodeStats, Priority, set_thread_nice};
 pub use pose::{PoseChannels, PoseMap};

@@ -17,6 +17,7 @@
 //! | `/tandem/robotK/needs_operator` | `std_msgs/Bool` | out | 100 Hz and on change |
 //! | `/tandem/next_handover` | `std_msgs/Float64MultiArray` | out | 100 Hz: `[robot, earliest_s, latest_s]` or empty |
 //! | `/tandem/fault` | `std_msgs/String` | out | 100 Hz and on change (empty: none) |
+//! | `/tandem/rest` | `std_msgs/Float64` | out | 100 Hz: the operator's rest left before `start_round` is accepted (s; 0: none; [`CellLoop::rest_left_ticks`](crate::core::CellLoop::rest_left_ticks)) |
 //! | `/tandem/operator` | `sensor_msgs/Joy` | in | axis 0 timing, button 0 correcting |
 //! | `/tandem/{start_round,stop_round,clear_fault,record_round}` | `std_srvs/Trigger` | service | |
 
@@ -742,7 +743,7 @@ impl Io {
         // Before the DDS library starts its threads, so that they inherit it.
         let _ = self.counters.dds_priority.set(set_thread_nice(self.nice));
         let entities = self.entities();
-        let (mut node, robots, handover, fault, operator, servers) = match entities {
+        let (mut node, robots, handover, fault, rest, operator, servers) = match entities {
             Ok(e) => {
                 let _ = ready.send(Ok(()));
                 e
@@ -876,6 +877,7 @@ impl Io {
                 });
                 let m = Float64MultiArray::labelled("robot,earliest_s,latest_s", data);
                 fail(handover.publish(m).is_ok());
+                fail(rest.publish(Float64 { data: snap.rest_s }).is_ok());
             }
             // The network's messages to the tick thread: progress as a count per robot.
             for (k, r) in robots.iter().enumerate() {
@@ -985,6 +987,7 @@ impl Io {
         Vec<RobotIo>,
         Publisher<Float64MultiArray>,
         Publisher<Text>,
+        Publisher<Float64>,
         Subscription<Joy>,
         Vec<Server<TriggerRequest, TriggerResponse>>,
     )> {
@@ -1021,6 +1024,7 @@ impl Io {
             FLOAT64_MULTI_ARRAY,
         )?;
         let fault = publisher(&mut node, &cell_topic("fault")?, STRING)?;
+        let rest = publisher(&mut node, &cell_topic("rest")?, FLOAT64)?;
         let operator = subscription(&mut node, &cell_topic("operator")?, JOY)?;
         let servers = SERVICES
             .iter()
@@ -1035,7 +1039,7 @@ impl Io {
                 .map_err(|e| dds(format!("serve {name}"), e))
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok((node, robots, handover, fault, operator, servers))
+        Ok((node, robots, handover, fault, rest, operator, servers))
     }
 
     fn forward(&self, m: Inbound) {

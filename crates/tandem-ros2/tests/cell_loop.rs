@@ -562,3 +562,119 @@ fn the_tick_threads_counters_take_the_longest_period_and_work() {
     assert_eq!(links.max_period_ns.load(Ordering::Relaxed), 3_000_000);
     assert_eq!(links.max_tick_ns.load(Ordering::Relaxed), 700_000);
 }
+
+/// Steps a started round to its end with every robot reporting every tick and the operator's
+/// `axis` held (virtual time from `*now`): the round's ticks and its busy ticks (ticks in which
+/// a robot was low-confidence), the test's own count.
+fn run_counting(l: &mut CellLoop, now: &mut Instant, tick: Duration, axis: f64) -> (u64, u64) {
+    let n = l.controller().n_robots();
+    let (mut ticks, mut busy) = (0, 0);
+    loop {
+        *now += tick;
+        for k in 0..n {
+            l.heard(k, *now);
+        }
+        l.handle(
+            Inbound::Operator {
+                axis,
+                correcting: false,
+            },
+            *now,
+            &mut |_| {},
+        );
+        let s = l.step(*now).unwrap();
+        ticks += 1;
+        busy += u64::from(l.last_tick().low_conf.count() > 0);
+        assert!(s.fault.is_none() && !s.overlap);
+        if s.finished {
+            return (ticks, busy);
+        }
+        assert!(ticks < 100_000, "the round never ended");
+    }
+}
+
+/// The least `n ≥ 0` with `busy ≤ u·(ticks + n)`, searched from below.
+fn rest_by_hand(busy: u64, ticks: u64, u: f64) -> u64 {
+    let mut n = 0;
+    while busy as f64 > u * (ticks + n) as f64 {
+        n += 1;
+    }
+    n
+}
+
+#[test]
+fn a_start_is_refused_until_the_operators_rest_has_passed() {
+    let u = 0.1;
+    let mut planner = support::planner(2);
+    planner.set_operator(0.0, u).unwrap();
+    for axis in [0.0, -1.0] {
+        let mut l = cell_loop(&planner, Cell::Rounds);
+        let tick = Duration::from_secs_f64(l.controller().tick_s());
+        let tick_s = l.controller().tick_s();
+        let mut now = Instant::now();
+        assert_eq!(l.rest_left_ticks(), 0, "no rest before the first round");
+        assert_eq!(refused(&ask(&mut l, Request::Start, now)), None);
+        let (ticks, busy) = run_counting(&mut l, &mut now, tick, axis);
+        // No switch time: the busy count is the low-confidence ticks (one operator, k = 0).
+        let rounds = l.controller().as_rounds().unwrap();
+        assert_eq!(rounds.busy_ticks(0), Some(busy));
+        let rest = rest_by_hand(busy, ticks, u);
+        assert!(rest > 0, "the cap binds: {busy} busy ticks of {ticks}");
+        assert_eq!((rounds.rest_ticks(), l.rest_left_ticks()), (rest, rest));
+        assert_eq!(l.snapshot().rest_s, rest as f64 * tick_s);
+        // Every tick of the rest refuses a start, saying how long is left; the idle ticks
+        // count it down; the round waits to be recorded meanwhile.
+        for left in (1..=rest).rev() {
+            let r = ask(&mut l, Request::Start, now);
+            let want_ms = (left as f64 * tick_s * 1000.0).ceil() as u64;
+            assert_eq!(
+                refused(&r),
+                Some(Refusal::Resting {
+                    left_ms: want_ms,
+                    left_ticks: left
+                })
+            );
+            let text = refused(&r).unwrap().to_string();
+            assert!(
+                text.contains(&format!("{}.{:03} s left", want_ms / 1000, want_ms % 1000))
+                    && text.contains("start_round"),
+                "{text}"
+            );
+            now += tick;
+            let s = l.step(now).unwrap();
+            assert!(!s.active && s.finished);
+            assert_eq!(s.rest_s, (left - 1) as f64 * tick_s);
+        }
+        // The rest has passed: `rest` ticks without a round since its last tick, so the round
+        // and its rest keep the cap, and one tick less would not have.
+        assert_eq!(l.rest_left_ticks(), 0);
+        assert!(busy as f64 <= u * (ticks + rest) as f64);
+        assert!(busy as f64 > u * (ticks + rest - 1) as f64);
+        assert_eq!(refused(&ask(&mut l, Request::Start, now)), None);
+        assert!(l.is_active());
+        // A stopped round's part is rested too: stop once the operator has been busy.
+        let mut part = (0, 0);
+        while part.1 < 3 {
+            now += tick;
+            for k in 0..2 {
+                l.heard(k, now);
+            }
+            l.step(now).unwrap();
+            part.0 += 1;
+            part.1 += u64::from(l.last_tick().low_conf.count() > 0);
+        }
+        let want = rest_by_hand(part.1, part.0, u);
+        assert_eq!(refused(&ask(&mut l, Request::Stop, now)), None);
+        assert_eq!(l.rest_left_ticks(), want);
+        assert!(want > 0);
+    }
+    // Without a cap: the next round may start at once.
+    let free = support::planner(2);
+    let mut l = cell_loop(&free, Cell::Rounds);
+    let tick = Duration::from_secs_f64(l.controller().tick_s());
+    let mut now = Instant::now();
+    ask(&mut l, Request::Start, now);
+    run_counting(&mut l, &mut now, tick, -1.0);
+    assert_eq!((l.rest_left_ticks(), l.snapshot().rest_s), (0, 0.0));
+    assert_eq!(refused(&ask(&mut l, Request::Start, now)), None);
+}

@@ -1,8 +1,8 @@
 //! The node feeds the operator console (issue 43, "the console and the node share one
 //! source"): the console's `/frame` shows the loop's own tick, its low-confidence robot is the
 //! node's `needs_operator`, a controller replaced after a recorded round brings its plan to the
-//! page, the page says when the node is idle, and a node started with a console serves the live
-//! round.
+//! page, the page says when the node is idle and how long the operator rests after a round
+//! (the load cap), and a node started with a console serves the live round.
 //! Loopback only.
 
 mod support;
@@ -16,7 +16,7 @@ use tandem_planner::Cell;
 use tandem_realtime::Controller;
 use tandem_ros2::{
     CellLoop, ConsoleFeed, FINISHED_NOTICE, IDLE_NOTICE, Inbound, LoopParams, Node, NodeParams,
-    Probe, Request,
+    Probe, Request, rest_notice,
 };
 
 /// One HTTP/1.1 request; returns the status and the body.
@@ -227,6 +227,58 @@ fn a_replaced_controller_brings_its_plan_to_the_page_and_the_page_says_idle() {
     }
     let t = cell.controller().ticks();
     let done = frame_at(addr, t, || feed.publish(&cell), |f| f.notice.is_some());
+    assert_eq!(done.notice.as_deref(), Some(FINISHED_NOTICE));
+    console.stop();
+}
+
+#[test]
+fn the_page_says_how_long_the_operator_rests_after_a_round() {
+    let mut planner = support::planner(2);
+    planner.set_operator(0.0, 0.1).unwrap();
+    let ctl = planner.controller(Cell::Rounds).unwrap();
+    let (console, handle) = Console::start(&ConsoleConfig::default(), Geometry::new(&ctl)).unwrap();
+    let addr = console.addr();
+    let mut feed = ConsoleFeed::new(handle);
+    let mut cell = CellLoop::new(ctl, planner.model(), LoopParams::default()).unwrap();
+    let tick = Duration::from_secs_f64(cell.controller().tick_s());
+    let mut now = Instant::now();
+    let start = Inbound::Request {
+        token: 1,
+        what: Request::Start,
+    };
+    cell.handle(start, now, &mut |_| {});
+    let mut step = |cell: &mut CellLoop| {
+        now += tick;
+        for robot in 0..2 {
+            cell.heard(robot, now);
+        }
+        cell.step(now).unwrap()
+    };
+    while !step(&mut cell).finished {}
+    let t = cell.controller().ticks();
+    let rest = cell.rest_left_ticks();
+    assert!(rest > 0, "the cap of 0.1 binds on this round");
+    // Whole seconds, rounded up: never less than is left.
+    let left_s = (cell.rest_left_s()).ceil() as u64;
+    assert!(left_s >= 1);
+    let resting = frame_at(addr, t, || feed.publish(&cell), |f| f.notice.is_some());
+    assert_eq!(
+        resting.notice.as_deref(),
+        Some(rest_notice(left_s, true).as_str())
+    );
+    assert!(rest_notice(left_s, true).starts_with(&format!("rest: {left_s} s")));
+    // The rest passes in idle ticks (the controller does not tick: the frame's tick stays);
+    // then the page says the round waits, as without a cap.
+    for _ in 0..rest {
+        step(&mut cell);
+    }
+    assert_eq!(cell.rest_left_ticks(), 0);
+    let done = frame_at(
+        addr,
+        t,
+        || feed.publish(&cell),
+        |f| f.notice.as_deref() == Some(FINISHED_NOTICE),
+    );
     assert_eq!(done.notice.as_deref(), Some(FINISHED_NOTICE));
     console.stop();
 }
