@@ -303,8 +303,10 @@ pub(crate) fn run_mixed_continuous(
             "  trial {}: {} plans ({} hand-overs), last ratios {:?}, period {:.2} s (bound \
              {:.2} s), groups per task {:?}; plan {:.1} tasks/h, mixed operator-limited bound \
              {:.1} tasks/h (plan {:.1} % of it); steady (last {} tasks, {:.0} s, per robot \
-             {:?}): {:.1} tasks/h = {:.1} % of the plan, {:.1} % of the bound, operator busy \
-             {:.1} %; unrecorded at the end {:?}",
+             {:?}): {:.1} tasks/h = {:.1} % of the plan, {:.1} % of the operator-limited \
+             bound, {:.1} % of the best bound {:.1} tasks/h of any plan the token rule can run \
+             (ratios ≤ {}; robot- and operator-limited; no such plan exceeds {:.1} % of its \
+             operator-limited bound), operator busy {:.1} %; unrecorded at the end {:?}",
             trial.trial,
             trial.iterations.len(),
             trial.stats.hand_overs,
@@ -321,6 +323,10 @@ pub(crate) fn run_mixed_continuous(
             s.throughput_per_h,
             100.0 * s.throughput_per_h / last.tasks_per_hour,
             100.0 * s.throughput_per_h / last.operator_limited_per_hour,
+            100.0 * s.throughput_per_h / last.best_bound_per_hour,
+            last.best_bound_per_hour,
+            last.max_ratio,
+            100.0 * last.best_operator_limited_share,
             100.0 * s.operator_busy_share,
             trial.unrecorded
         );
@@ -331,12 +337,14 @@ pub(crate) fn run_mixed_continuous(
         for (k, task) in file.task.iter().enumerate() {
             println!(
                 "    task {}: high confidence {:.1} % → {:.1} % (truth never needs the \
-                 operator on {:.1} %), falsely trusted {} samples at the end, {} rounds recorded",
+                 operator on {:.1} %), falsely trusted {} samples at the end, {} rounds recorded \
+                 in {} record steps",
                 task.name,
                 first.tasks[k].high_conf_pct,
                 last.tasks[k].high_conf_pct,
                 study.truth_never_needed_pct[k],
                 last.tasks[k].falsely_trusted_samples,
+                last.task_rounds[k],
                 last.records
             );
         }

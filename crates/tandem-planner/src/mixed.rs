@@ -410,9 +410,15 @@ impl CellPlanner {
         }
     }
 
-    /// Rounds recorded (the same in every task: a round is one execution of every robot).
+    /// Rounds recorded: the fewest any task holds (the same in every task when every round
+    /// was one execution of every robot, [`CellPlanner::record_round`]; per task:
+    /// [`CellPlanner::task_rounds`]).
     pub fn rounds_recorded(&self) -> usize {
-        self.tasks[0].planner.rounds_recorded()
+        self.tasks
+            .iter()
+            .map(|t| t.planner.rounds_recorded())
+            .min()
+            .unwrap_or(0)
     }
 
     /// Robot `i`'s timeline on the cell's schedule (its task's confidence and gradient
@@ -523,6 +529,65 @@ impl CellPlanner {
         })
     }
 
+    /// Records rounds of single tasks (the continuous cell, where robots of different tasks
+    /// finish at different rates): `rounds[t]` are rounds of task `t` in the order they were
+    /// run, each as many executions of task `t` as it has robots ([`Planner::record_round`] of
+    /// that task; the planner learns from every execution alike, so they may come from any of
+    /// the task's robots, e.g. two of a robot that runs more tasks per period); a task with no
+    /// round is left as it is. Each task's rounds go into its planner one by one (model, observations,
+    /// confidence, its own schedule), then a cell of two or more tasks is re-scheduled once.
+    /// Afterwards the tasks may hold different numbers of rounds
+    /// ([`CellPlanner::task_rounds`]). A failure in any task leaves the whole cell as it was.
+    ///
+    /// # Errors
+    /// [`Error::BadCell`] for a list of other than one entry per task; each round's
+    /// [`Planner::record_round`] error, named by task and round.
+    pub fn record_task_rounds(
+        &mut self,
+        rounds: &[Vec<Vec<crate::ExecutionRecord>>],
+    ) -> Result<Vec<Vec<RecordReport>>> {
+        if rounds.len() != self.tasks.len() {
+            return Err(Error::BadCell {
+                what: "task rounds".into(),
+                why: format!(
+                    "rounds for {} tasks in a cell of {} tasks: give one list per task (empty \
+                     for none)",
+                    rounds.len(),
+                    self.tasks.len()
+                ),
+            });
+        }
+        let mut next = self.clone();
+        let mut reports = Vec::with_capacity(self.tasks.len());
+        for (task, mine) in next.tasks.iter_mut().zip(rounds) {
+            let mut done = Vec::with_capacity(mine.len());
+            for (k, round) in mine.iter().enumerate() {
+                let report = task
+                    .planner
+                    .record_round(round)
+                    .map_err(|e| Error::BadCell {
+                        what: format!("round {} of task `{}`", k + 1, task.name),
+                        why: format!("{e}; nothing was recorded"),
+                    })?;
+                done.push(report);
+            }
+            reports.push(done);
+        }
+        next.reschedule()?;
+        *self = next;
+        Ok(reports)
+    }
+
+    /// Rounds recorded per task, in the cell's order: all equal when every round was recorded
+    /// by [`CellPlanner::record_round`], the tasks' own counts after
+    /// [`CellPlanner::record_task_rounds`].
+    pub fn task_rounds(&self) -> Vec<usize> {
+        self.tasks
+            .iter()
+            .map(|t| t.planner.rounds_recorded())
+            .collect()
+    }
+
     /// Sets the operator's switch time and load cap of every task ([`Planner::set_operator`])
     /// and, for two or more tasks, re-schedules the cell with them. On error the cell is as
     /// before.
@@ -624,14 +689,6 @@ impl CellPlanner {
             })?;
             tasks.push((name, planner));
         }
-        let rounds = tasks[0].1.rounds_recorded();
-        if let Some((name, p)) = tasks.iter().find(|(_, p)| p.rounds_recorded() != rounds) {
-            return Err(corrupt(format!(
-                "task `{name}` holds {} rounds, task `{}` {rounds}: every task records every round",
-                p.rounds_recorded(),
-                tasks[0].0
-            )));
-        }
         let robot_task = cell.robot_task.iter().map(|&t| t as usize).collect();
         let out = Self::from_planners(tasks, robot_task).map_err(|e| corrupt(e.to_string()))?;
         if let Some(stamp) = state::stamp_of(&bytes) {
@@ -640,8 +697,8 @@ impl CellPlanner {
         Ok(out)
     }
 
-    /// The rounds recorded in the state file at `path`, a task's or a cell's; 0 when there is
-    /// no file or an empty one.
+    /// The rounds recorded in the state file at `path`, a task's or a cell's (the most any of
+    /// its tasks holds); 0 when there is no file or an empty one.
     ///
     /// # Errors
     /// As [`CellPlanner::load`] for a file that is there but cannot be read.
@@ -655,12 +712,11 @@ impl CellPlanner {
         let bytes = state::read(path)?;
         match state::decode_stored(&bytes, path)? {
             Stored::Task(st) => Ok(st.rounds_recorded),
-            Stored::Cell(cell) => {
-                let Some(first) = cell.tasks.into_iter().next() else {
-                    return Ok(0);
-                };
-                Ok(first.payload(path)?.0.rounds_recorded)
-            }
+            // Tasks may hold different counts ([`CellPlanner::record_task_rounds`]): the
+            // file holds rounds when any task does.
+            Stored::Cell(cell) => cell.tasks.into_iter().try_fold(0, |most, task| {
+                Ok(most.max(task.payload(path)?.0.rounds_recorded))
+            }),
         }
     }
 }
@@ -1279,6 +1335,54 @@ mod tests {
             msg.contains("cell of 2 tasks (a, b)") && msg.contains("load it as a cell"),
             "{msg}"
         );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn task_rounds_record_each_task_alone_and_save_with_different_counts() {
+        let mut cell = mixed();
+        // Task a (two robots): one round of two executions; task b (one robot): three.
+        let rounds = vec![
+            vec![vec![record(40, 10..20, 0.1), record(40, 10..20, 0.2)]],
+            vec![
+                vec![record(60, 30..45, 0.3)],
+                vec![record(60, 30..45, 0.4)],
+                vec![record(60, 30..45, 0.5)],
+            ],
+        ];
+        let reports = cell.record_task_rounds(&rounds).unwrap();
+        assert_eq!(reports.iter().map(Vec::len).collect::<Vec<_>>(), [1, 3]);
+        assert_eq!(cell.task_rounds(), [1, 3]);
+        assert_eq!(cell.rounds_recorded(), 1);
+        // Task b's planner is the one that recorded the same three rounds on its own.
+        let mut b = planner(60, 30..45, 1);
+        for r in &rounds[1] {
+            b.record_round(r).unwrap();
+        }
+        assert_eq!(cell.tasks()[1].planner().confidence(), b.confidence());
+        // A task with no round is left as it is; one list per task is required.
+        let before = cell.tasks()[0].planner().confidence().clone();
+        cell.record_task_rounds(&[vec![], vec![vec![record(60, 30..45, 0.6)]]])
+            .unwrap();
+        assert_eq!(cell.task_rounds(), [1, 4]);
+        assert_eq!(cell.tasks()[0].planner().confidence(), &before);
+        let err = cell.record_task_rounds(&[vec![]]).unwrap_err();
+        assert!(err.to_string().contains("one list per task"), "{err}");
+        // A round of the wrong size fails and records nothing, in any task.
+        let bad = vec![
+            vec![],
+            vec![vec![record(60, 30..45, 0.7), record(60, 30..45, 0.8)]],
+        ];
+        let err = cell.record_task_rounds(&bad).unwrap_err();
+        assert!(err.to_string().contains("round 1 of task `b`"), "{err}");
+        assert_eq!(cell.task_rounds(), [1, 4]);
+        // Different counts save and load back; the file holds the most any task has.
+        let dir = scratch("task-rounds");
+        let path = dir.join("cell.tandem");
+        cell.save(&path).unwrap();
+        let back = CellPlanner::load(&path).unwrap();
+        assert_eq!(back.task_rounds(), [1, 4]);
+        assert_eq!(CellPlanner::rounds_at(&path).unwrap(), 4);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -158,14 +158,39 @@ fn the_continuous_mixed_study_learns_each_task_and_never_overlaps() {
             assert!(t.high_conf_pct <= t.truth_never_needed_pct + 1e-9);
         }
     }
+    // Every execution a robot finished is recorded as a round of its task (one robot per
+    // task here) except those still queued, whatever the ratios: the number of recorded
+    // rounds per task equals its executions less its queue.
+    let last = trial.iterations.last().unwrap();
     for robot in 0..2 {
         let done = trial
             .completions
             .iter()
             .filter(|c| c.robot == robot)
             .count();
-        assert_eq!(done, records + trial.unrecorded[robot], "robot {robot}");
+        assert_eq!(
+            done,
+            last.task_rounds[robot] + trial.unrecorded[robot],
+            "robot {robot}"
+        );
     }
+    // A record step records at least one round of every task, so the slower task (sanding,
+    // one per period) has one per step; the faster one at least as many.
+    for it in &trial.iterations {
+        assert_eq!(it.task_rounds[0], it.records, "{it:?}");
+        assert!(it.task_rounds[1] >= it.task_rounds[0], "{it:?}");
+        assert!(it.best_operator_limited_share <= 1.0 + 1e-12, "{it:?}");
+        assert!(
+            it.operator_share <= it.best_operator_limited_share + 1e-9,
+            "{it:?}"
+        );
+    }
+    // The plans ran at ratios above 1 for deburring, so it recorded more rounds than sanding.
+    assert!(
+        last.task_rounds[1] > last.task_rounds[0],
+        "{:?}",
+        last.task_rounds
+    );
     assert!(trial.completions.windows(2).all(|w| w[0].tick <= w[1].tick));
     assert_eq!(
         trial.steady.tasks_per_robot.iter().sum::<usize>(),

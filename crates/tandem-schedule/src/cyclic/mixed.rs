@@ -176,6 +176,13 @@ pub struct MixedCyclicPlan {
     /// The most tasks per hour any plan with ratios in `{1..R}^N` can complete (the best
     /// `3600·Σ r_k / bound` over them): the plan's throughput is at most this.
     pub best_bound_per_hour: f64,
+    /// The largest share of its own ratios' operator-limited bound that any plan with ratios
+    /// in `{1..R}^N` can reach: `max_r Σ_k r_k·L_k / P_min(r)`, `P_min(r)` the bound of
+    /// [`mixed_period_lower_bound_s`] (the hand-overs counted when the plan's are). Equal
+    /// to the best operator busy share of any such plan; below 0.95 it proves that no plan
+    /// of these ratios reaches 95 % of its operator-limited bound (`NaN` without low
+    /// confidence, and for a plan of one given order, [`mixed_plan_for_order`]).
+    pub best_operator_limited_share: f64,
     /// `R` as searched (after lowering so that `R^N ≤ 65 536`).
     pub max_ratio: usize,
     /// Ratio vectors whose order was searched.
@@ -746,6 +753,7 @@ pub fn mixed_plan_of_shapes(shapes: &[TaskShape], params: &MixedParams) -> Resul
     }
     // Every ratio vector with its bound's throughput.
     let mut candidates: Vec<(f64, usize, Vec<usize>)> = Vec::new();
+    let mut best_share = f64::NAN;
     let mut r = vec![1usize; n];
     loop {
         let supers = r
@@ -761,6 +769,10 @@ pub fn mixed_plan_of_shapes(shapes: &[TaskShape], params: &MixedParams) -> Resul
             params.switch_s,
         )?;
         let total: usize = r.iter().sum();
+        let lc: f64 = supers.iter().map(TaskShape::lc_total_s).sum();
+        if lc > 0.0 {
+            best_share = best_share.max(lc / p);
+        }
         candidates.push((3600.0 * total as f64 / p, total, r.clone()));
         let Some(k) = (0..n).rev().find(|&k| r[k] < max_ratio) else {
             break;
@@ -810,6 +822,7 @@ pub fn mixed_plan_of_shapes(shapes: &[TaskShape], params: &MixedParams) -> Resul
     };
     let mut plan = mixed_plan_for_order(shapes, &ratios, &expand(&blocks), params)?;
     plan.best_bound_per_hour = best_bound_per_hour;
+    plan.best_operator_limited_share = best_share;
     plan.max_ratio = max_ratio;
     plan.ratios_evaluated = ratios_evaluated;
     plan.orders_evaluated = orders_evaluated;
@@ -901,6 +914,7 @@ pub fn mixed_plan_for_order(
             f64::INFINITY
         },
         best_bound_per_hour: f64::NAN,
+        best_operator_limited_share: f64::NAN,
         max_ratio: params.max_ratio,
         ratios_evaluated: 0,
         orders_evaluated: 1,

@@ -4,22 +4,29 @@
 //! [`crate::workcell::MixedCellSim`]), robot `k` doing `r_k` tasks per period, and every
 //! task learns from its own robots' executions.
 //!
-//! **The learning rule.** The planner's unit of learning is a round: one execution per robot
-//! ([`CellPlanner::record_round`], each task's planner takes its robots' executions). In a
-//! mixed cell the robots complete tasks in the ratios `r_k`, so each robot's finished
-//! executions wait in its own queue, in completion order; once every robot has at least one,
-//! the oldest of each is taken, recorded as one round, the cell is re-planned on the new
-//! problems and the new plan takes over the running cell at its next hand-over point
-//! ([`ContinuousCoordinator::take_over`](tandem_realtime::continuous::ContinuousCoordinator::take_over)).
-//! *Why it is unbiased:* which execution of a robot is recorded next is fixed by the count of
-//! records alone (its `j`-th record is its `j`-th execution), never by what the execution
-//! held; so each robot's recorded executions are a prefix of its executions in time order,
+//! **The learning rule.** A task's unit of learning is a round of that task: as many
+//! executions as it has robots ([`CellPlanner::record_task_rounds`]; its planner updates its
+//! model and confidence from each execution alike, whichever of its robots ran it). In a
+//! mixed cell the robots complete tasks in the ratios `r_k`, so each task's finished
+//! executions wait in the task's queue, in completion order. Once every task has a round
+//! complete, *every* complete round of every task is recorded — for each task, oldest first,
+//! as many rounds as its queue holds executions of its robot count —, the cell is
+//! re-planned on the new problems and the new plan takes over the running cell at its next
+//! hand-over point ([`ContinuousCoordinator::take_over`](tandem_realtime::continuous::ContinuousCoordinator::take_over)).
+//! So a robot of ratio `r_k` gives its task about `r_k` executions per period, and a higher
+//! ratio never slows its task's learning per execution: at every re-plan each task has
+//! recorded every execution its robots finished but fewer than its robot count. The plans
+//! are made as often as before (once per completion of the slowest task): a plan searches
+//! the ratio vectors and orders, so one per execution of the fast robot would multiply the
+//! cost of a trial by its ratio. docs/decisions.md, "Mixed cells: every execution recorded,
+//! and the two bounds (issue 45)".
+//! *Why it is unbiased:* which executions of a robot are recorded is fixed by the counts
+//! alone (the task's `j`-th recorded execution is the `j`-th its robots finished), never by
+//! what an execution held; so each task's recorded executions are a prefix of its executions
+//! in completion order,
 //! each drawn from its task's truth like any other. Taking the newest instead, or the one in
 //! progress when the slowest robot finishes, would favour the executions that ran long
-//! (length-biased: the ones with more corrections). The price is lag: a robot of ratio
-//! `r_k > 1` is recorded once per record of the slowest robot, so its queue grows by about
-//! `r_k / r_min − 1` executions per record and its task learns from executions made under
-//! older plans (the same model reference, so every record stays valid).
+//! (length-biased: the ones with more corrections).
 //!
 //! Workpieces are drawn from each robot's task truth ([`crate::truth::TaskTruth`]) on the
 //! trial's one random stream (ChaCha8 of [`trial_seed`], stream 1): every robot's first in
@@ -48,8 +55,12 @@ use crate::{Error, Result};
 /// The cell's continuous plan after some records: one per re-plan of a trial.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct MixedCellIteration {
-    /// Rounds recorded into the cell when the plan was made (0: demonstrations only).
+    /// Record steps before the plan was made (0: demonstrations only); each records every
+    /// complete round of every task (module docs).
     pub records: usize,
+    /// Per task (the cell's order), the rounds it had recorded when the plan was made: each
+    /// as many executions as it has robots ([`CellPlanner::task_rounds`]).
+    pub task_rounds: Vec<usize>,
     /// The cell's tick (control ticks from the trial start) at which it was made.
     pub tick: u64,
     /// `r_k` per robot: tasks per period.
@@ -65,8 +76,17 @@ pub struct MixedCellIteration {
     /// The mixed operator-limited bound of these ratios (tasks/h):
     /// `3600 / (Σ r_k L_k / Σ r_k)`, 3600 over the mean operator-seconds per task of the mix.
     pub operator_limited_per_hour: f64,
-    /// The best bound over every ratio vector searched (tasks/h).
+    /// The best bound over every ratio vector searched (tasks/h): the most tasks per hour
+    /// any plan the token rule can run (ratios `≤ R`, the hand-overs counted) can complete,
+    /// `max_r 3600·Σ r_k / P_min(r)` with `P_min(r) ≥ max(operator time, max_k r_k·D_k)`:
+    /// the robot-limited and operator-limited bounds together.
     pub best_bound_per_hour: f64,
+    /// The largest share of its ratios' operator-limited bound any such plan can reach
+    /// (`MixedCyclicPlan::best_operator_limited_share`): below 0.95 no plan of ratios `≤ R`
+    /// reaches 95 % of it.
+    pub best_operator_limited_share: f64,
+    /// `R`, the largest ratio searched.
+    pub max_ratio: usize,
     /// Per task, the low-confidence groups the token rule hands the operator per task
     /// (split by the task's usable holds).
     pub groups: Vec<usize>,
@@ -111,8 +131,10 @@ pub struct MixedCellTrialResult {
     pub iterations: Vec<MixedCellIteration>,
     /// Every completed task, in completion order.
     pub completions: Vec<MixedCellCompletion>,
-    /// Executions finished but not recorded at the end, per robot (the queues' lengths):
-    /// robot `i`'s completions are its recorded executions (one per record) plus these.
+    /// Executions finished but not recorded at the end, per robot: the completions of task
+    /// `t`'s robots are its recorded rounds (the last plan's `task_rounds[t]`) times its robot
+    /// count plus these, fewer than its robot count, unless the trial ended between a
+    /// completion and the next record.
     pub unrecorded: Vec<usize>,
     /// What the cell did (ticks, overlaps, faults, hand-overs, waiting per robot).
     pub stats: CellStats,
@@ -150,10 +172,12 @@ fn plan_record(
     cell: &CellPlanner,
     tasks: &[MixedTask],
     plan: &MixedCyclicPlan,
+    records: usize,
     tick: u64,
 ) -> MixedCellIteration {
     MixedCellIteration {
-        records: cell.rounds_recorded(),
+        records,
+        task_rounds: cell.task_rounds(),
         tick,
         ratios: plan.ratios.clone(),
         period_s: plan.period_s,
@@ -162,6 +186,8 @@ fn plan_record(
         lower_bound_s: plan.lower_bound_s,
         operator_limited_per_hour: plan.operator_limited_per_hour,
         best_bound_per_hour: plan.best_bound_per_hour,
+        best_operator_limited_share: plan.best_operator_limited_share,
+        max_ratio: plan.max_ratio,
         groups: cell
             .tasks()
             .iter()
@@ -280,9 +306,11 @@ pub fn run_mixed_cell_trial(
         })
         .fold(0.0, f64::max);
     let budget = (total as f64 + 2.0 * n as f64) * (slow_ticks + 10.0) * 2.0 + 10_000.0;
-    let mut queues: Vec<VecDeque<ExecutionRecord>> = vec![VecDeque::new(); n];
+    // Per task, its robots' finished executions not yet recorded, in completion order.
+    let mut queues: Vec<VecDeque<(usize, ExecutionRecord)>> = vec![VecDeque::new(); tasks.len()];
+    let robots_of: Vec<usize> = tasks.iter().map(|t| t.robots).collect();
     let mut completions: Vec<MixedCellCompletion> = Vec::with_capacity(total + n);
-    let mut iterations = vec![plan_record(&cell, tasks, &plan, 0)];
+    let mut iterations = vec![plan_record(&cell, tasks, &plan, 0, 0)];
     let mut last_ratios = plan.ratios.clone();
     while completions.len() < total {
         if sim.stats().ticks as f64 >= budget {
@@ -305,28 +333,41 @@ pub fn run_mixed_cell_trial(
             });
             needed[f.robot] = tasks[t].truth.draw(&mut rng)?;
             let model = cell.tasks()[t].planner().model();
-            queues[f.robot].push_back(mixed_record(&f.run, model, tick_s)?);
+            queues[t].push_back((f.robot, mixed_record(&f.run, model, tick_s)?));
         }
-        if completions.len() < total && queues.iter().all(|q| !q.is_empty()) {
-            let round = cell.rounds_recorded() + 1;
-            let batch: Vec<ExecutionRecord> = queues
-                .iter_mut()
-                .map(|q| q.pop_front().expect("every queue is non-empty"))
+        // Per task, its complete rounds: as many as its queue holds executions of its robot
+        // count.
+        let complete: Vec<usize> = queues
+            .iter()
+            .zip(&robots_of)
+            .map(|(q, &k)| q.len() / k)
+            .collect();
+        if completions.len() < total && complete.iter().all(|&k| k > 0) {
+            let record = iterations.len();
+            let rounds: Vec<Vec<Vec<ExecutionRecord>>> = complete
+                .iter()
+                .enumerate()
+                .map(|(t, &k)| {
+                    (0..k)
+                        .map(|_| queues[t].drain(..robots_of[t]).map(|(_, e)| e).collect())
+                        .collect()
+                })
                 .collect();
-            cell.record_round(&batch)
-                .map_err(|e| in_record(round)(e.into()))?;
+            cell.record_task_rounds(&rounds)
+                .map_err(|e| in_record(record)(e.into()))?;
             let plan = cell
                 .continuous_plan()
-                .map_err(|e| in_record(round)(e.into()))?;
+                .map_err(|e| in_record(record)(e.into()))?;
             let next = cell
                 .continuous_coordinator(&plan)
-                .map_err(|e| in_record(round)(e.into()))?;
-            sim.replan(&models(&cell), next).map_err(in_record(round))?;
+                .map_err(|e| in_record(record)(e.into()))?;
+            sim.replan(&models(&cell), next)
+                .map_err(in_record(record))?;
             last_ratios = plan.ratios.clone();
-            iterations.push(plan_record(&cell, tasks, &plan, sim.stats().ticks));
+            iterations.push(plan_record(&cell, tasks, &plan, record, sim.stats().ticks));
             progress(Progress {
                 trial,
-                rounds_done: round.min(config.n_rounds()),
+                rounds_done: record.min(config.n_rounds()),
             });
         }
     }
@@ -336,7 +377,14 @@ pub fn run_mixed_cell_trial(
         seed,
         iterations,
         completions,
-        unrecorded: queues.iter().map(VecDeque::len).collect(),
+        unrecorded: (0..n)
+            .map(|i| {
+                queues[robot_task[i]]
+                    .iter()
+                    .filter(|(r, _)| *r == i)
+                    .count()
+            })
+            .collect(),
         stats: sim.stats().clone(),
         steady,
     })

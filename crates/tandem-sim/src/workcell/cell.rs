@@ -13,11 +13,12 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 use tandem_lfd::TaskModel;
+use tandem_realtime::Tick;
 use tandem_realtime::continuous::ContinuousCoordinator;
 
 use super::operator::OperatorParams;
 use super::record::RobotRun;
-use super::run::{Operate, Robots, check_n_ref, check_tick, step};
+use super::run::{Operate, Robots, Tasks, check_n_ref, check_tick, step};
 use crate::{Error, Result};
 
 /// What a continuous cell did so far (control ticks of `tick_s`).
@@ -155,15 +156,7 @@ impl CellSim {
     }
 
     fn try_hand_over(&mut self) -> bool {
-        let Some(next) = self.pending.as_mut() else {
-            return false;
-        };
-        if next.take_over(&self.coord).is_err() {
-            return false;
-        }
-        self.coord = self.pending.take().expect("checked above");
-        self.stats.hand_overs += 1;
-        true
+        hand_over(&mut self.coord, &mut self.pending, &mut self.stats)
     }
 
     /// One control tick (module docs): `needs(robot, ref_idx)` says whether robot `robot`
@@ -186,55 +179,106 @@ impl CellSim {
                 found: model.n_ref(),
             });
         }
-        let at_gate = self.coord.at_gate_now();
-        for (i, k) in self.stats.gate_ticks.iter_mut().enumerate() {
-            *k += u64::from(at_gate[i]);
-        }
+        count_gates(&mut self.stats, &self.coord);
         // The cell observes no crossings (`None`): its token rule stops a robot at the gate
         // of every low-confidence group it does not hold (docs/decisions.md).
         let (t, corrected) = step(
             &mut self.coord,
-            model,
-            &mut self.op,
-            |c, n| (c.task().grad_min()[n], c.task().grad_max()[n]),
+            Tasks {
+                models: &[model],
+                ops: std::slice::from_mut(&mut self.op),
+                robot_task: &[],
+            },
+            |c, _, n| (c.task().grad_min()[n], c.task().grad_max()[n]),
             None,
             &mut self.robots,
             self.stats.ticks as usize,
             &mut needs,
             rng,
         )?;
-        self.stats.ticks += 1;
         self.corrected = corrected;
-        // With `M` operators (issue 44) a tick overlaps when more than `M` robots are
-        // low-confidence (`Tick::over`; one operator: two or more, as before).
-        let lc = t.low_conf.count();
-        if lc > 0 {
-            self.stats.busy_ticks += 1;
-        }
-        if t.over(self.coord.operators()) {
-            self.stats.overlap_ticks += 1;
-        }
-        match t.fault {
-            Some(f) if f.tick + 1 == self.coord.ticks() => self.stats.faults += 1,
-            Some(_) if t.low_conf.count() == 0 => self.coord.clear_fault(),
-            _ => {}
-        }
-        let mut done = Vec::new();
-        for (i, k) in self.tasks.iter_mut().enumerate() {
-            if t.tasks[i] > *k {
-                *k = t.tasks[i];
-                let run =
-                    std::mem::replace(&mut self.robots.runs[i], self.op.empty_run(self.n_ref));
-                done.push(FinishedTask {
-                    robot: i,
-                    tick: self.stats.ticks,
-                    run,
-                });
-            }
-        }
+        count_tick(&mut self.stats, &mut self.coord, &t);
+        let (op, n_ref) = (&self.op, self.n_ref);
+        let done = completed(
+            &mut self.tasks,
+            &t,
+            self.stats.ticks,
+            &mut self.robots.runs,
+            |_| op.empty_run(n_ref),
+        );
         self.try_hand_over();
         Ok(done)
     }
+}
+
+/// Counts the robots waiting at their gate before a tick of a continuous cell into `stats`
+/// (the one-task [`CellSim`] and [`MixedCellSim`](super::MixedCellSim)).
+pub(super) fn count_gates(stats: &mut CellStats, coord: &ContinuousCoordinator) {
+    let at_gate = coord.at_gate_now();
+    for (i, k) in stats.gate_ticks.iter_mut().enumerate() {
+        *k += u64::from(at_gate[i]);
+    }
+}
+
+/// Counts the coordinator's tick `t` of a continuous cell into `stats`: one tick, busy when a
+/// robot was low-confidence, overlapping when more were than the cell has operators
+/// ([`Tick::over`]; one operator: two or more, issue 44), a fault latched in it; a fault
+/// latched before is released once no robot is low-confidence.
+pub(super) fn count_tick(stats: &mut CellStats, coord: &mut ContinuousCoordinator, t: &Tick) {
+    stats.ticks += 1;
+    if t.low_conf.count() > 0 {
+        stats.busy_ticks += 1;
+    }
+    if t.over(coord.operators()) {
+        stats.overlap_ticks += 1;
+    }
+    match t.fault {
+        Some(f) if f.tick + 1 == coord.ticks() => stats.faults += 1,
+        Some(_) if t.low_conf.count() == 0 => coord.clear_fault(),
+        _ => {}
+    }
+}
+
+/// The tasks completed in tick `t` (the `tick`-th): each robot whose count in `t.tasks` rose
+/// above `counts` hands back its run, replaced by `fresh(robot)`.
+pub(super) fn completed(
+    counts: &mut [u64],
+    t: &Tick,
+    tick: u64,
+    runs: &mut [RobotRun],
+    fresh: impl Fn(usize) -> RobotRun,
+) -> Vec<FinishedTask> {
+    let mut done = Vec::new();
+    for (i, k) in counts.iter_mut().enumerate() {
+        if t.tasks[i] > *k {
+            *k = t.tasks[i];
+            let run = std::mem::replace(&mut runs[i], fresh(i));
+            done.push(FinishedTask {
+                robot: i,
+                tick,
+                run,
+            });
+        }
+    }
+    done
+}
+
+/// The plan `pending` takes over the running `coord` if the robots are at a hand-over point
+/// of it ([`ContinuousCoordinator::take_over`]), counted in `stats`; returns whether it did.
+pub(super) fn hand_over(
+    coord: &mut ContinuousCoordinator,
+    pending: &mut Option<ContinuousCoordinator>,
+    stats: &mut CellStats,
+) -> bool {
+    let Some(next) = pending.as_mut() else {
+        return false;
+    };
+    if next.take_over(coord).is_err() {
+        return false;
+    }
+    *coord = pending.take().expect("checked above");
+    stats.hand_overs += 1;
+    true
 }
 
 /// Each robot's reference time at its clock.

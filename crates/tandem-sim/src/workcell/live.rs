@@ -16,7 +16,7 @@ use super::record::{RobotRun, TickPhase};
 use tandem_schedule::Problem;
 
 use super::operator::OperatorParams;
-use super::run::{Operate, Robots, check_n_ref, check_tick, step};
+use super::run::{Operate, Robots, Tasks, check_n_ref, check_tick, step};
 use crate::{Error, Result};
 
 /// A simulated round driven tick by tick: the coordinator of a checked schedule, the
@@ -137,9 +137,12 @@ impl RoundSim {
         let (grad_min, grad_max) = (&self.grad_min, &self.grad_max);
         let out = step(
             &mut self.coord,
-            model,
-            &mut self.op,
-            |_, n| (grad_min[n], grad_max[n]),
+            Tasks {
+                models: &[model],
+                ops: std::slice::from_mut(&mut self.op),
+                robot_task: &[],
+            },
+            |_, _, n| (grad_min[n], grad_max[n]),
             Some(&self.conf),
             &mut self.robots,
             self.round_ticks,

@@ -17,13 +17,12 @@
 use rand::Rng;
 use tandem_lfd::{Demonstration, Execution, TaskModel};
 use tandem_planner::ExecutionRecord;
-use tandem_realtime::Operator;
 use tandem_realtime::continuous::ContinuousCoordinator;
 
-use super::cell::{CellStats, FinishedTask};
+use super::cell::{CellStats, FinishedTask, completed, count_gates, count_tick, hand_over};
 use super::operator::OperatorParams;
 use super::record::RobotRun;
-use super::run::{Operate, check_tick};
+use super::run::{Operate, Robots, Tasks, check_tick, step};
 use crate::{Error, Result};
 
 /// A simulated continuous cell of different tasks (module docs).
@@ -34,10 +33,9 @@ pub struct MixedCellSim {
     /// The operator on each task.
     ops: Vec<Operate>,
     robot_task: Vec<usize>,
-    runs: Vec<RobotRun>,
-    in_episode: Vec<bool>,
-    /// Each robot's fractional reference time (its own task's samples) at the tick start.
-    ref_now: Vec<f64>,
+    /// Each robot's execution in progress, episode, and fractional reference time (its own
+    /// task's samples) at the tick start.
+    robots: Robots,
     /// Each robot's completed tasks at the end of the last tick.
     tasks: Vec<u64>,
     /// Each task's reference samples.
@@ -111,9 +109,11 @@ impl MixedCellSim {
             .collect::<Result<Vec<_>>>()?;
         let n_ref: Vec<usize> = models.iter().map(|m| m.n_ref()).collect();
         let mut sim = MixedCellSim {
-            runs: Vec::new(),
-            in_episode: vec![false; robot_task.len()],
-            ref_now: Vec::new(),
+            robots: Robots {
+                runs: Vec::new(),
+                in_episode: vec![false; robot_task.len()],
+                ref_now: Vec::new(),
+            },
             tasks: coord.tasks_completed().to_vec(),
             stats: CellStats {
                 gate_ticks: vec![0; robot_task.len()],
@@ -125,17 +125,11 @@ impl MixedCellSim {
             coord,
             pending: None,
         };
-        sim.runs = (0..robot_task.len()).map(|i| sim.empty_run(i)).collect();
-        sim.ref_now = sim.ref_times();
+        sim.robots.runs = (0..robot_task.len())
+            .map(|i| empty_run(&sim.ops, &sim.robot_task, &sim.n_ref, &sim.coord, i))
+            .collect();
+        sim.robots.ref_now = sim.ref_times();
         Ok(sim)
-    }
-
-    fn empty_run(&self, robot: usize) -> RobotRun {
-        let t = self.robot_task[robot];
-        let per_ref = (self.coord.task_of(robot).dt_s() / self.coord.tick_s())
-            .ceil()
-            .max(1.0) as usize;
-        self.ops[t].empty_run(self.n_ref[t] * per_ref)
     }
 
     /// Each robot's reference time at its clock, on its own task.
@@ -180,15 +174,7 @@ impl MixedCellSim {
     }
 
     fn try_hand_over(&mut self) -> bool {
-        let Some(next) = self.pending.as_mut() else {
-            return false;
-        };
-        if next.take_over(&self.coord).is_err() {
-            return false;
-        }
-        self.coord = self.pending.take().expect("checked above");
-        self.stats.hand_overs += 1;
-        true
+        hand_over(&mut self.coord, &mut self.pending, &mut self.stats)
     }
 
     /// One control tick (module docs): `needs(robot, ref_idx)` says whether robot `robot`
@@ -221,71 +207,51 @@ impl MixedCellSim {
                 });
             }
         }
-        let at_gate = self.coord.at_gate_now();
-        for (i, k) in self.stats.gate_ticks.iter_mut().enumerate() {
-            *k += u64::from(at_gate[i]);
-        }
-        let ticks = self.stats.ticks as usize;
-        let running = self.coord.running_now();
-        let low_conf = self.coord.low_conf_now();
-        let mut operator = Operator::Scheduled;
-        for i in 0..self.robot_task.len() {
-            if !running[i] {
-                continue;
-            }
-            let t = self.robot_task[i];
-            let run = &mut self.runs[i];
-            if run.start_tick == usize::MAX {
-                run.start_tick = ticks;
-            }
-            let ref_now = self.ref_now[i];
-            let task = self.coord.task_of(i);
-            let k = (ref_now.floor() as usize).min(self.n_ref[t] - 1);
-            let supervised = low_conf[i].then(|| (task.grad_min()[k], task.grad_max()[k]));
-            let switching = low_conf[i] && self.ops[0].attend(i, ticks);
-            if let Some(input) = self.ops[t].robot_tick(
-                models[t],
-                run,
-                &mut self.in_episode[i],
-                ref_now,
-                supervised,
-                switching,
-                |idx| needs(i, idx),
-                rng,
-            )? {
-                operator = input;
-            }
-        }
-        let t = self.coord.tick(operator)?;
-        self.ref_now.copy_from_slice(&t.ref_time);
-        self.stats.ticks += 1;
-        if t.low_conf.count() > 0 {
-            self.stats.busy_ticks += 1;
-        }
-        if t.over(self.coord.operators()) {
-            self.stats.overlap_ticks += 1;
-        }
-        match t.fault {
-            Some(f) if f.tick + 1 == self.coord.ticks() => self.stats.faults += 1,
-            Some(_) if t.low_conf.count() == 0 => self.coord.clear_fault(),
-            _ => {}
-        }
-        let mut done = Vec::new();
-        for i in 0..self.tasks.len() {
-            if t.tasks[i] > self.tasks[i] {
-                self.tasks[i] = t.tasks[i];
-                let fresh = self.empty_run(i);
-                let run = std::mem::replace(&mut self.runs[i], fresh);
-                done.push(FinishedTask {
-                    robot: i,
-                    tick: self.stats.ticks,
-                    run,
-                });
-            }
-        }
+        count_gates(&mut self.stats, &self.coord);
+        // No crossings (`None`), as in the one-task cell (module docs).
+        let (t, _) = step(
+            &mut self.coord,
+            Tasks {
+                models,
+                ops: &mut self.ops,
+                robot_task: &self.robot_task,
+            },
+            |c, i, n| (c.task_of(i).grad_min()[n], c.task_of(i).grad_max()[n]),
+            None,
+            &mut self.robots,
+            self.stats.ticks as usize,
+            &mut needs,
+            rng,
+        )?;
+        count_tick(&mut self.stats, &mut self.coord, &t);
+        let (ops, robot_task, n_ref, coord) =
+            (&self.ops, &self.robot_task, &self.n_ref, &self.coord);
+        let done = completed(
+            &mut self.tasks,
+            &t,
+            self.stats.ticks,
+            &mut self.robots.runs,
+            |i| empty_run(ops, robot_task, n_ref, coord, i),
+        );
         self.try_hand_over();
         Ok(done)
     }
+}
+
+/// An empty run for robot `robot`: room for its task's samples at the cell's control tick
+/// (a task of a longer period logs several samples per reference sample).
+fn empty_run(
+    ops: &[Operate],
+    robot_task: &[usize],
+    n_ref: &[usize],
+    coord: &ContinuousCoordinator,
+    robot: usize,
+) -> RobotRun {
+    let t = robot_task[robot];
+    let per_ref = (coord.task_of(robot).dt_s() / coord.tick_s())
+        .ceil()
+        .max(1.0) as usize;
+    ops[t].empty_run(n_ref[t] * per_ref)
 }
 
 /// The planner's record of `run`, an execution of `model`'s task logged at the control tick

@@ -362,29 +362,45 @@ pub(super) struct Robots {
     pub(super) ref_now: Vec<f64>,
 }
 
+/// The tasks a control tick runs ([`step`]): task `t` is commanded by `models[t]` and its
+/// operator is `ops[t]` (its correction channel and inputs), robot `i` does task
+/// `robot_task[i]` (every robot task 0 when `robot_task` is empty: the one-task cell and
+/// rounds); the operator's attention (its switch time) is `ops[0]`'s for every robot.
+pub(super) struct Tasks<'a> {
+    pub(super) models: &'a [&'a TaskModel],
+    pub(super) ops: &'a mut [Operate],
+    pub(super) robot_task: &'a [usize],
+}
+
 /// One control tick of the simulated workcell on any controller (steps 1–5 of the module
-/// docs of [`crate::workcell`]), the one loop body of rounds ([`run_coordinator`]) and of the
-/// continuous cell ([`CellSim::tick`](super::CellSim::tick)): every robot the controller will
-/// move ([`Controller::running_now`]) logs one execution sample at its reference time; the
-/// robot the controller reports low-confidence ([`Controller::low_conf_now`]) is supervised,
-/// with `bounds(coord, n)` the `(ψ̇min, ψ̇max)` of reference sample `n`, and the operator's
-/// input drives it. With `crossings = Some(conf)` (rounds), a robot that started the tick
+/// docs of [`crate::workcell`]), the one loop body of rounds ([`run_coordinator`]), of the
+/// continuous cell ([`CellSim::tick`](super::CellSim::tick)) and of the continuous cell of
+/// different tasks ([`MixedCellSim::tick`](super::MixedCellSim::tick)): every robot the
+/// controller will move ([`Controller::running_now`]) logs one execution sample of its task
+/// ([`Tasks`]) at its reference time; the robot the controller reports low-confidence
+/// ([`Controller::low_conf_now`]) is supervised, with `bounds(coord, i, n)` the
+/// `(ψ̇min, ψ̇max)` of reference sample `n` of robot `i`'s task, and the operator's input
+/// drives it. With `crossings = Some(conf)` (rounds), a robot that started the tick
 /// unsupervised but traversed low-confidence samples of `conf` inside it is supervised after
 /// the fact (step 5). `ticks` is the tick's index (a run's `start_tick`). Returns the tick
 /// and whether the operator's input was a correction; `robots.ref_now` is updated.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn step<C: Controller + ?Sized>(
     coord: &mut C,
-    model: &TaskModel,
-    op: &mut Operate,
-    bounds: impl Fn(&C, usize) -> (f64, f64),
+    tasks: Tasks<'_>,
+    bounds: impl Fn(&C, usize, usize) -> (f64, f64),
     crossings: Option<&[bool]>,
     robots: &mut Robots,
     ticks: usize,
     needs: &mut impl FnMut(usize, usize) -> bool,
     rng: &mut impl Rng,
 ) -> Result<(Tick, bool)> {
-    let n_ref = model.n_ref();
+    let Tasks {
+        models,
+        ops,
+        robot_task,
+    } = tasks;
+    let task_of = |i: usize| robot_task.get(i).copied().unwrap_or(0);
     let running = coord.running_now();
     let low_conf = coord.low_conf_now();
     let mut operator = Operator::Scheduled;
@@ -406,8 +422,9 @@ pub(super) fn step<C: Controller + ?Sized>(
             run.start_tick = ticks;
         }
         let ref_now = robots.ref_now[i];
-        let n = (ref_now.floor() as usize).min(n_ref - 1);
-        let supervised = low_conf[i].then(|| bounds(coord, n));
+        let t = task_of(i);
+        let n = (ref_now.floor() as usize).min(models[t].n_ref() - 1);
+        let supervised = low_conf[i].then(|| bounds(coord, i, n));
         if supervised.is_none() {
             unsupervised_at[i] = Some(ref_now);
         }
@@ -416,9 +433,9 @@ pub(super) fn step<C: Controller + ?Sized>(
         } else {
             0
         };
-        let switching = low_conf[i] && op.attend_as(who, i, ticks);
-        if let Some(input) = op.robot_tick(
-            model,
+        let switching = low_conf[i] && ops[0].attend_as(who, i, ticks);
+        if let Some(input) = ops[t].robot_tick(
+            models[t],
             run,
             &mut robots.in_episode[i],
             ref_now,
@@ -456,8 +473,8 @@ pub(super) fn step<C: Controller + ?Sized>(
                 if let Some(first) = crossed.next() {
                     // Asked once per crossed sample (any that needs one is a need).
                     let needed = needs(i, first) | crossed.fold(false, |a, j| a | needs(i, j));
-                    let switching = op.attend(i, ticks);
-                    op.supervise_crossing(
+                    let switching = ops[0].attend(i, ticks);
+                    ops[task_of(i)].supervise_crossing(
                         &mut robots.runs[i],
                         &mut robots.in_episode[i],
                         needed,
