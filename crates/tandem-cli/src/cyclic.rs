@@ -64,6 +64,29 @@ pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
             (sp.switch_s, sp.max_busy_share),
             crate::cmd::verbose(),
         )?);
+        if sp.operators > 1 {
+            // Which cell the M operators run (issue 44): the even sectors, each a one-operator
+            // cell, when their ceiling is the pooled cell's; else the pooled cell.
+            let c = planner.fleet_cell().context("--operators")?;
+            let sizes: Vec<String> = c.sectors.iter().map(usize::to_string).collect();
+            out(&if sizes.is_empty() {
+                format!(
+                    "{} operators run the pooled cell (this plan's order, {} tokens): ceiling {:.1} tasks/h, the even sectors' {:.1}",
+                    sp.operators,
+                    sp.operators,
+                    c.pooled_bound_tasks_per_hour,
+                    c.sectored_bound_tasks_per_hour
+                )
+            } else {
+                format!(
+                    "{} operators run sectors of {} robots, each its own one-operator plan: ceiling {:.1} tasks/h, the pooled cell's {:.1}",
+                    sp.operators,
+                    sizes.join(" + "),
+                    c.sectored_bound_tasks_per_hour,
+                    c.pooled_bound_tasks_per_hour
+                )
+            });
+        }
     }
     Ok(())
 }

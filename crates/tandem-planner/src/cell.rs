@@ -344,16 +344,67 @@ impl Planner {
     /// # Errors
     /// The realtime crate's for a bad switch time or load cap, or a load cap below 1 with
     /// `M > 1` (the run-time pace serves one operator), or an operator count out of range.
+    ///
+    /// With `M > 1` the cell is the pooled one (`plan`'s order served by `M` tokens) or the
+    /// even sectors, as [`Planner::fleet_cell`] chooses: then each sector runs the
+    /// one-operator plan of its size (the planner's cyclic parameters at `plan`'s tick,
+    /// searched here) under its own operator
+    /// ([`tandem_schedule::sectored_coordinator`]), and `plan` is not run.
     pub fn continuous_coordinator(
         &self,
         plan: &CheckedCyclicPlan,
     ) -> Result<tandem_realtime::ContinuousCoordinator> {
         let sp = &self.params().sampler;
-        let mut c = plan.coordinator().with_switch_s(sp.switch_s)?;
-        if sp.operators > 1 {
-            c = c.with_operators(tandem_realtime::OperatorCount::new(sp.operators)?);
-        }
+        let c = if sp.operators > 1 {
+            let m = tandem_realtime::OperatorCount::new(sp.operators)?;
+            let choice = self.fleet_cell()?;
+            let c = if choice.sectors.is_empty() {
+                plan.coordinator()
+            } else {
+                let params = CyclicParams {
+                    switch_s: sp.switch_s,
+                    max_busy_share: sp.max_busy_share,
+                    ..CyclicParams::default()
+                };
+                let mut plans: Vec<CheckedCyclicPlan> = Vec::new();
+                for &k in &choice.sectors {
+                    if !plans.iter().any(|p| p.n_robots() == k) {
+                        plans.push(CheckedCyclicPlan::search(
+                            self.problem(),
+                            k,
+                            &params,
+                            plan.tick_s(),
+                        )?);
+                    }
+                }
+                tandem_schedule::sectored_coordinator(
+                    self.problem(),
+                    &choice.sectors,
+                    &plans,
+                    plan.tick_s(),
+                )?
+                .0
+            };
+            c.with_switch_s(sp.switch_s)?.with_operators(m)
+        } else {
+            plan.coordinator().with_switch_s(sp.switch_s)?
+        };
         Ok(c.with_max_busy_share(sp.max_busy_share)?)
+    }
+
+    /// Which continuous cell this planner's `M = params().sampler.operators` operators run on
+    /// the current problem ([`tandem_schedule::fleet_cell_choice`]): the even sectors, each a
+    /// one-operator cell, when their ceiling is the pooled cell's; else the pooled cell (and
+    /// always for `M = 1`). The choice and both ceilings (tasks per hour).
+    ///
+    /// # Errors
+    /// The schedule crate's for a robot or operator count out of range.
+    pub fn fleet_cell(&self) -> Result<tandem_schedule::FleetCellChoice> {
+        Ok(tandem_schedule::fleet_cell_choice(
+            self.problem(),
+            self.n_robots(),
+            self.params().sampler.operators,
+        )?)
     }
 
     /// The cyclic plan of a continuous cell of this planner's robots on the current problem

@@ -2074,6 +2074,57 @@ mod tests {
         }
     }
 
+    /// The continuous cell of `M > 1` operators is the one `Planner::fleet_cell` names (issue
+    /// 44): for the even sectors a sectored coordinator whose robots run under their sector's
+    /// operator only, else the pooled `M`-token cell; the sectors' ceiling never exceeds the
+    /// pooled one's.
+    #[test]
+    fn the_continuous_cell_of_m_operators_is_the_fleet_cells_choice() {
+        use tandem_realtime::{Controller, Operator};
+        for (n, m) in [(4, 2), (3, 2), (4, 4)] {
+            let mut p = test_planner(40, 10..20, n, 1);
+            p.set_operators(m).unwrap();
+            let choice = p.fleet_cell().unwrap();
+            assert!(
+                choice.sectored_bound_tasks_per_hour
+                    <= choice.pooled_bound_tasks_per_hour * (1.0 + 1e-9)
+            );
+            let crate::AnyController::Continuous(mut c) =
+                p.controller(crate::Cell::Continuous).unwrap()
+            else {
+                panic!("a continuous cell")
+            };
+            assert_eq!(Controller::operators(&c), m);
+            let Some(sector_of) = c.sector_of() else {
+                assert!(choice.sectors.is_empty(), "({n}, {m}): {choice:?}");
+                continue;
+            };
+            // Contiguous even sectors.
+            let want: Vec<u8> = choice
+                .sectors
+                .iter()
+                .enumerate()
+                .flat_map(|(o, &k)| std::iter::repeat_n(o as u8, k))
+                .collect();
+            assert_eq!(&sector_of[..], &want[..], "({n}, {m})");
+            let inputs: Vec<Operator> = (0..m)
+                .map(|o| [Operator::Fastest, Operator::Slowest][o % 2])
+                .collect();
+            let mut lc_ticks = 0;
+            for _ in 0..20_000 {
+                let t = c.tick_many(&inputs).unwrap();
+                assert!(t.fault.is_none() && !t.over(m));
+                for (i, &o) in sector_of.iter().enumerate() {
+                    if t.low_conf[i] {
+                        lc_ticks += 1;
+                        assert_eq!(t.operator[i], Some(o));
+                    }
+                }
+            }
+            assert!(lc_ticks > 0 && c.tasks_completed().iter().all(|&k| k > 0));
+        }
+    }
+
     /// The sectored round (issue 44) of (N, M) = (4, 2) and (3, 2) on a small problem: even
     /// sectors ([2, 2], [2, 1]), each sector's schedule of its own size passes the one-operator
     /// check (Eq. 20 with Alg. 2's margin check) on the planner's problem, the round's
