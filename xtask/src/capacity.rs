@@ -1504,6 +1504,7 @@ mod tests {
                 plan_gap: tandem::sim::workcell::PlanGap::default(),
                 needed_unsupervised: 0,
                 switch_missed: 0,
+                rest_s: 0.0,
             }),
             lower_bound_s: t_total_s,
             bound_is_optimum: false,

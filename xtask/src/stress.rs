@@ -296,11 +296,6 @@ fn make_case(
     };
     let robots = coordinator.robots();
     let tick_s = coordinator.tick_s();
-    // Every robot at its slowest, one after the other, plus slack.
-    let slowest_s: f64 = robots
-        .iter()
-        .map(|r| r.grad_max().iter().sum::<f64>() * r.dt_s())
-        .sum();
     let all = |f: fn(&Timeline) -> &[f64]| robots.iter().flat_map(move |r| f(r).iter().copied());
     let grad_range = [
         all(Timeline::grad_min).fold(f64::INFINITY, f64::min),
@@ -311,18 +306,9 @@ fn make_case(
         .map(|i| coordinator.current_plan(i).end_s() - robots[i].end_s())
         .fold(0.0, f64::max);
     let ticks = ((last_end_s(robots) + dwell_s) / tick_s) as u64;
-    // Each hold with release rules may wait the switch time once more.
-    // Each leg may wait the switch time once at its hold; a robot has at most one leg per
-    // sample.
     let k = coordinator.switch_ticks();
-    let legs_bound = robots.iter().map(Timeline::n_ref).sum::<usize>() as u64;
-    let switch_waits = if coordinator.has_holds() {
-        k.saturating_mul(legs_bound)
-    } else {
-        0
-    };
     Ok(Case {
-        max_ticks: (2.0 * (slowest_s + dwell_s) / tick_s) as u64 + 100 + switch_waits,
+        max_ticks: tick_budget(&coordinator),
         switch_ticks: k,
         skipped,
         adversaries: adversary_set(n_robots, grad_range, ticks, &mut rng),
@@ -331,6 +317,45 @@ fn make_case(
         family,
         made,
     })
+}
+
+/// The tick budget of one execution of `coordinator`'s round: an execution that has not ended
+/// within it is counted "unfinished". In a tick in which some robot runs, that robot moves on
+/// by at least its slowest step, so such ticks number at most `Σ_i` (robot `i` at its slowest,
+/// `Σ_n ψ̇max[n]·Δt_s`) over the tick; in a tick in which no robot runs (all waiting to start,
+/// at a hold or finished), the clocks of the robots waiting to start move on by the tick
+/// (rule 3), so before the last start there are at most `(max_i τ_i − min_i τ_i)` over the tick
+/// of them (the start offsets: at a switch time `δ` the scheduler may leave about `δ` between
+/// one robot's end and the next one's start, "A schedule always exists with a switch time:
+/// constraint 2 relaxed (issue 41)"); at holds, the planned dwells (the latest leg end of any
+/// robot past its plan's end) and each leg's switch wait `k` (a robot has at most one leg per
+/// sample). Twice the serial time and offsets plus dwells, plus 100 ticks for the tick grid
+/// (every partial step of a sample), plus the switch waits: `2·(Σ slowest + offsets + dwells)/h
+/// + 100 + k·legs` (legs only with holds), in whole ticks.
+fn tick_budget(coordinator: &Coordinator) -> u64 {
+    let robots = coordinator.robots();
+    let slowest_s: f64 = robots
+        .iter()
+        .map(|r| r.grad_max().iter().sum::<f64>() * r.dt_s())
+        .sum();
+    let first_start = robots
+        .iter()
+        .map(Timeline::start_s)
+        .fold(f64::INFINITY, f64::min);
+    let offsets_s = robots
+        .iter()
+        .map(|r| r.start_s() - first_start)
+        .fold(0.0, f64::max);
+    let dwell_s: f64 = (0..coordinator.n_robots())
+        .map(|i| coordinator.current_plan(i).end_s() - robots[i].end_s())
+        .fold(0.0, f64::max);
+    let switch_waits = if coordinator.has_holds() {
+        let legs = robots.iter().map(Timeline::n_ref).sum::<usize>() as u64;
+        coordinator.switch_ticks().saturating_mul(legs)
+    } else {
+        0
+    };
+    (2.0 * (slowest_s + offsets_s + dwell_s) / coordinator.tick_s()) as u64 + 100 + switch_waits
 }
 
 /// Latest end (s) of `robots`.
@@ -882,5 +907,36 @@ impl CellCounts {
             );
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A robot of ten samples at `Δt_s` = 0.25 s (`ψ̇` in [0.5, 2], samples 3–5
+    /// low-confidence) starting at `start_s`.
+    fn robot(start_s: f64) -> Timeline {
+        let conf: Vec<bool> = (0..10).map(|n| !(3..6).contains(&n)).collect();
+        Timeline::new(&conf, &[1.0; 10], &[0.5; 10], &[2.0; 10], start_s, 0.25).unwrap()
+    }
+
+    /// The budget by hand: two robots of 10 samples at most 2 s per sample's 0.25 s (5 s
+    /// each at their slowest, 10 s serial), the second starting 60 s after the first, at a
+    /// tick of 0.25 s: `2·(10 + 60)/0.25 + 100 = 660` ticks. Without the start offset it was
+    /// `2·10/0.25 + 100 = 180`, while the second robot waits at least `(60 − 2.5)/0.25 = 230`
+    /// ticks after the first one's end (2.5 s on schedule) before it starts: every execution
+    /// of such a round was "unfinished". Each policy ends within the new budget, after more
+    /// ticks than the old one.
+    #[test]
+    fn the_tick_budget_counts_the_start_offsets() {
+        let c = Coordinator::new(vec![robot(0.0), robot(60.0)], 0.25).unwrap();
+        assert_eq!(tick_budget(&c), 660);
+        for op in [Adversary::Nominal, Adversary::Fastest, Adversary::Slowest] {
+            let mut rng = ChaCha8Rng::seed_from_u64(1);
+            let run = run_adversary(c.clone(), op, &mut rng, tick_budget(&c)).unwrap();
+            assert!(run.finished, "{op:?}");
+            assert!(run.ticks > 230 && run.ticks <= 660, "{op:?}: {}", run.ticks);
+        }
     }
 }

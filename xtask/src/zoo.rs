@@ -579,8 +579,9 @@ fn markdown(file: &ZooFile) -> String {
              low-confidence stretches and the waits of release rules cost, plus what the \
              scheduler did not find. They add up to the gap. `of it unavoidable` is the part \
              of `margins` that no valid schedule avoids: every switch between the two robots' \
-             low-confidence runs charged the margin check's least step \
-             (`tandem_schedule::switch_charged_bound`; two robots without hold points; the \
+             low-confidence runs charged the margin check's least step and the drag lead \
+             it must see there (`tandem_schedule::drag_charged_bound`; two robots without \
+             hold points; the \
              seeds measured in brackets, — for none).\n\n\
              | family | N | gap % | search | margins | of it unavoidable | seeds with a proven bound |\n\
              |---|---|---|---|---|---|---|\n",

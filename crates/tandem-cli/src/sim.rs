@@ -238,6 +238,14 @@ pub(crate) fn simulate(a: &SimulateArgs) -> Result<()> {
         if verbose() {
             out(&format!("       gap: {}", describe_gap(&round.plan_gap)));
         }
+        if round.rest_ticks > 0 {
+            // The load cap at run time (issue 41): the next round starts after the rest.
+            out(&format!(
+                "       rest {:.2} s before the next round (load cap {})",
+                round.rest_ticks as f64 * round.tick_s,
+                planner.params().sampler.max_busy_share
+            ));
+        }
     }
     for line in realization_summary(&gaps, planner.n_robots(), unsupervised_needed) {
         out(&line);

@@ -308,7 +308,8 @@ impl Planner {
     /// The run-time coordinator of [`Planner::plan`]`(cell)`: every robot at its start, one
     /// control tick of the schedule's `tick_s` per tick, with the operator's switch time of
     /// the planner's parameters (`params().sampler.switch_s`): rounds wait it at a hold with
-    /// release rules (it is [`Planner::coordinator`]), a continuous cell's token passes to
+    /// release rules and ask a rest after the round under the load cap (it is
+    /// [`Planner::coordinator`]), a continuous cell's token passes to
     /// another robot no sooner than that after a stretch ended, and paces the operator to the
     /// load cap `params().sampler.max_busy_share` (`ContinuousCoordinator::with_max_busy_share`).
     ///
@@ -319,14 +320,16 @@ impl Planner {
     /// ([`Planner::continuous_coordinator`]); rounds run the sectored round of
     /// [`Planner::sectored_rounds`] (`M` one-operator rounds side by side).
     pub fn controller(&self, cell: Cell) -> Result<AnyController> {
-        let switch_s = self.params().sampler.switch_s;
+        let sp = &self.params().sampler;
         match self.plan(cell)? {
             Plan::Rounds(s) => {
-                if self.params().sampler.operators > 1 {
-                    return Ok(AnyController::Rounds(self.sectored_rounds()?.1));
-                }
+                let c = if sp.operators > 1 {
+                    self.sectored_rounds()?.1
+                } else {
+                    s.coordinator()?.with_switch_s(sp.switch_s)?
+                };
                 Ok(AnyController::Rounds(
-                    s.coordinator()?.with_switch_s(switch_s)?,
+                    c.with_max_busy_share(sp.max_busy_share)?,
                 ))
             }
             Plan::Continuous(c) => Ok(AnyController::Continuous(self.continuous_coordinator(&c)?)),

@@ -328,7 +328,7 @@ impl CellPlanner {
 
     /// The cyclic plan of this cell run continuously (issue 45): robot `i` repeats its task,
     /// `r_i` times per period, on its task's current problem
-    /// ([`tandem_schedule::cyclic::mixed_cyclic_plan`]: the best ratios `r ∈ {1..4}^N` and
+    /// ([`tandem_schedule::cyclic::mixed_cyclic_plan`]: the best ratios `r ∈ {1..6}^N` and
     /// operator order found, the period of its event graph and the bound of every plan with
     /// those ratios), with the token rule's hand-overs counted at the cell's control tick
     /// (the shortest of the tasks' schedule ticks, real s, as in rounds) and the operator's

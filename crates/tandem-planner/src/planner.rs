@@ -935,14 +935,22 @@ impl Planner {
     /// With `params().sampler.operators = M > 1` (issue 44) it is the sectored round of
     /// [`Planner::sectored_rounds`] ([`Coordinator::sectored`]): `M` one-operator rounds side
     /// by side, one per operator.
+    ///
+    /// With a load cap `params().sampler.max_busy_share = u < 1` (issue 41) it counts each
+    /// operator's busy ticks ([`Coordinator::with_max_busy_share`]) and, once the round has
+    /// ended, [`Coordinator::rest_ticks`] is the rest before the next round that keeps every
+    /// operator's share of the round and its rest at most `u`: whoever starts the next round
+    /// (the simulated workcell, `tandem simulate`, a user's loop) waits it.
     pub fn coordinator(&self) -> Result<Coordinator> {
-        if self.params().sampler.operators > 1 {
-            return Ok(self.sectored_rounds()?.1);
-        }
-        Ok(self
-            .checked_schedule()?
-            .coordinator()?
-            .with_switch_s(self.params().sampler.switch_s)?)
+        let sp = &self.params().sampler;
+        let c = if sp.operators > 1 {
+            self.sectored_rounds()?.1
+        } else {
+            self.checked_schedule()?
+                .coordinator()?
+                .with_switch_s(sp.switch_s)?
+        };
+        Ok(c.with_max_busy_share(sp.max_busy_share)?)
     }
 
     /// The round of `M = params().sampler.operators` operators (issue 44; docs/decisions.md,

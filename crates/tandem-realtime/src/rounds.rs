@@ -113,6 +113,76 @@ pub struct Coordinator {
     /// Per sector (operator index), the clock of its legs not yet started: each sector's own
     /// `wait_clock_s`, moved by its robots alone. Unused without sectors.
     sector_wait_s: [f64; MAX_ROBOTS],
+    /// The operator's load cap at run time ([`Coordinator::with_max_busy_share`]): the busy
+    /// count of the round so far; `None` without a cap (`u = 1`), when nothing is counted.
+    pace: Option<RoundPace>,
+}
+
+/// The load cap's count of a round (issue 41; docs/decisions.md, "The load cap in rounds at
+/// run time: the rest after a round (issue 41)"): per operator, its busy ticks (ticks in which
+/// a robot it supervises is low-confidence) and its changes of robot (a low-confidence tick of
+/// another robot than its last one; each costs the switch time `k` ticks). The round's first
+/// stretch is no change (its robot's previous stretch was in another round, which the rest
+/// after that round paid for).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct RoundPace {
+    /// `u`: the load cap, in `(0, 1)`.
+    cap: f64,
+    /// Per operator, the ticks with one of its robots low-confidence.
+    busy: [u64; MAX_ROBOTS],
+    /// Per operator, its changes of low-confidence robot.
+    changes: [u64; MAX_ROBOTS],
+    /// Per operator, the robot of its last low-confidence tick.
+    last: [Option<u8>; MAX_ROBOTS],
+}
+
+impl RoundPace {
+    fn new(cap: f64) -> RoundPace {
+        RoundPace {
+            cap,
+            busy: [0; MAX_ROBOTS],
+            changes: [0; MAX_ROBOTS],
+            last: [None; MAX_ROBOTS],
+        }
+    }
+
+    /// Counts a tick: each operator with a low-confidence robot in it is busy once (its first
+    /// such robot; a second is a fault the monitor latches).
+    fn observe(&mut self, tick: &Tick) {
+        let mut seen = 0_u32;
+        for i in 0..tick.low_conf.len() {
+            if !tick.low_conf[i] {
+                continue;
+            }
+            let o = usize::from(tick.operator[i].unwrap_or(0));
+            if seen & (1 << o) != 0 {
+                continue;
+            }
+            seen |= 1 << o;
+            self.busy[o] += 1;
+            // Robot indices are below MAX_ROBOTS = 16.
+            let r = i as u8;
+            if self.last[o].is_some_and(|q| q != r) {
+                self.changes[o] += 1;
+            }
+            self.last[o] = Some(r);
+        }
+    }
+
+    /// `B_o = busy_o + k·changes_o`: operator `o`'s busy ticks with `k` switch ticks per
+    /// change.
+    fn busy_ticks(&self, o: usize, k: u64) -> u64 {
+        self.busy[o].saturating_add(k.saturating_mul(self.changes[o]))
+    }
+
+    /// The rest after `ticks` ticks of the round: `max_o n(B_o) − ticks`, 0 when negative.
+    fn rest_ticks(&self, ticks: u64, k: u64) -> u64 {
+        (0..MAX_ROBOTS)
+            .map(|o| crate::cell::pace::ticks_for_share(self.busy_ticks(o, k), self.cap))
+            .max()
+            .unwrap_or(0)
+            .saturating_sub(ticks)
+    }
 }
 
 /// A rounds cell of `M` operators split into fixed sectors ([`Coordinator::sectored`]): each
@@ -220,6 +290,7 @@ impl Coordinator {
             operators: None,
             sectors: None,
             sector_wait_s: [0.0; MAX_ROBOTS],
+            pace: None,
         };
         c.reset();
         Ok(c)
@@ -273,13 +344,15 @@ impl Coordinator {
                 tick_s: self.tick_s,
                 switch_s,
             };
-            return Coordinator::sectored(
+            let mut c = Coordinator::sectored(
                 self.robots.to_vec(),
                 &sec.holds,
                 &of,
                 OperatorCount::new(sec.m)?,
                 &params,
-            );
+            )?;
+            c.pace = self.pace.map(|p| RoundPace::new(p.cap));
+            return Ok(c);
         }
         self.switch_ticks = crate::switch_ticks(switch_s, self.tick_s)?;
         if let Some(p) = &self.operators {
@@ -498,6 +571,58 @@ impl Coordinator {
     /// rules ([`Coordinator::with_switch_s`]; 0: none).
     pub fn switch_ticks(&self) -> u64 {
         self.switch_ticks
+    }
+
+    /// The same round with the operator's load cap `u = max_busy_share` (in `(0, 1]`) kept at
+    /// run time, reset to the start (issue 41; docs/decisions.md, "The load cap in rounds at
+    /// run time: the rest after a round (issue 41)"): the coordinator counts, per operator, the
+    /// round's busy ticks `B` — ticks in which a robot it supervises is low-confidence, plus
+    /// the switch time `k` ([`Coordinator::switch_ticks`]) per change of robot — and
+    /// [`Coordinator::rest_ticks`] is the rest after the round that brings `B` to at most `u`
+    /// times the round's ticks and the rest. Nothing inside the round changes (the margin
+    /// check, the switch time and the pre-alert are untouched); whoever starts the next round
+    /// starts it after the rest. `u = 1` counts nothing and never asks a rest (the coordinator
+    /// of before, bit for bit). Keeps the cap across [`Coordinator::with_switch_s`]; set it
+    /// after [`Coordinator::with_operators`] and [`Coordinator::sectored`], which build anew.
+    ///
+    /// # Errors
+    /// [`Error::BadParam`] naming `max_busy_share` for a value not in `(0, 1]`.
+    pub fn with_max_busy_share(mut self, max_busy_share: f64) -> Result<Coordinator> {
+        crate::cell::pace::check_max_busy_share(max_busy_share)?;
+        self.pace = (max_busy_share < 1.0).then(|| RoundPace::new(max_busy_share));
+        self.reset();
+        Ok(self)
+    }
+
+    /// The operator's load cap `u` kept at run time ([`Coordinator::with_max_busy_share`];
+    /// 1: none).
+    pub fn max_busy_share(&self) -> f64 {
+        self.pace.map_or(1.0, |p| p.cap)
+    }
+
+    /// `B`: the busy ticks of operator `operator` (`< M`) in the round so far — its ticks with
+    /// a low-confidence robot plus `k` per change of robot — as the load cap counts them
+    /// ([`Coordinator::with_max_busy_share`]); `None` without a cap or for an operator `≥ M`.
+    pub fn busy_ticks(&self, operator: usize) -> Option<u64> {
+        let p = self.pace.as_ref()?;
+        (operator < self.operators()).then(|| p.busy_ticks(operator, self.switch_ticks))
+    }
+
+    /// The rest (ticks) the operators must get after the round so far before the next round
+    /// starts, under the load cap `u` ([`Coordinator::with_max_busy_share`]): the least whole
+    /// `n` with `B_o ≤ u·n` for every operator `o` (as computed in floating point), less the
+    /// round's ticks ([`Coordinator::ticks`]), 0 when the round alone keeps the cap; 0 without
+    /// a cap. Read once the round [`is_finished`](Coordinator::is_finished): the share of the
+    /// round and its rest, `B_o / (ticks + rest)`, is then at most `u` for every operator
+    /// whatever the operator did, hence over every run of whole rounds with their rests.
+    pub fn rest_ticks(&self) -> u64 {
+        self.pace
+            .map_or(0, |p| p.rest_ticks(self.monitor.ticks(), self.switch_ticks))
+    }
+
+    /// [`Coordinator::rest_ticks`] in seconds (ticks times the tick).
+    pub fn rest_s(&self) -> f64 {
+        self.rest_ticks() as f64 * self.tick_s
     }
 
     /// The latched fault, if two robots have been low-confidence in one tick since the start,
@@ -735,6 +860,9 @@ impl Coordinator {
         self.update_released(false);
         self.cursors = [Cursors::default(); MAX_ROBOTS];
         self.monitor.reset();
+        if let Some(p) = &mut self.pace {
+            *p = RoundPace::new(p.cap);
+        }
     }
 
     /// Whether each robot is running and low-confidence at its current schedule clock (Eq. 16
@@ -1109,6 +1237,9 @@ impl Coordinator {
             out.operator = crate::contract::one_operator(&out.low_conf);
         }
         out.fault = self.monitor.observe(out.low_conf);
+        if let Some(p) = &mut self.pace {
+            p.observe(&out);
+        }
         Ok(out)
     }
 }
@@ -1404,6 +1535,58 @@ mod tests {
         assert_eq!(first_running_tick(Operator::Slowest), Some(6));
         // Rushed (step F·tick = 1): one tick on the LC sample, robot 1 starts ½ s earlier.
         assert_eq!(first_running_tick(Operator::Fastest), Some(3));
+    }
+
+    /// The load cap's rest by hand: two rigid robots ([HC, LC, HC], gradients 1 with bounds
+    /// [1, 1], Δt_s = 1 s, at a tick of 1 s), robot 1 starting where robot 0 ends (3 s). Each
+    /// robot is low-confidence in all three of its ticks (its LC sample and the tick either side
+    /// that touches it within the clock tolerance), so the round is 6 ticks, all busy, and one
+    /// change of robot. At `u = ½` and no switch time `B = 6`, `n(B) = 12`: a rest of 6 ticks;
+    /// with `δ = 2` s (`k = 2`) `B = 8`, `n = 16`, a rest of 10. Without a cap: no rest.
+    #[test]
+    fn the_rest_after_a_round_by_hand() {
+        let conf = [true, false, true];
+        let robot = |tau| Timeline::new(&conf, &[1.0; 3], &[1.0; 3], &[1.0; 3], tau, 1.0);
+        let base =
+            Coordinator::new_unchecked([robot(0.0).unwrap(), robot(3.0).unwrap()], 1.0).unwrap();
+        for (switch_s, k, busy, rest) in [(0.0, 0, 6, 6), (2.0, 2, 8, 10)] {
+            let mut c = base
+                .clone()
+                .with_switch_s(switch_s)
+                .unwrap()
+                .with_max_busy_share(0.5)
+                .unwrap();
+            assert_eq!(c.switch_ticks(), k);
+            let mut lc = Vec::new();
+            while !c.is_finished() {
+                lc.push(c.tick(Operator::Scheduled).unwrap().low_conf.first());
+            }
+            assert_eq!(lc, [Some(0), Some(0), Some(0), Some(1), Some(1), Some(1)]);
+            assert_eq!((c.busy_ticks(0), c.busy_ticks(1)), (Some(busy), None));
+            assert_eq!(c.rest_ticks(), rest);
+            assert_eq!(c.rest_s(), rest as f64);
+            // The round and its rest keep the cap, and one tick less would not.
+            assert!(busy as f64 <= 0.5 * (6 + rest) as f64);
+            assert!(busy as f64 > 0.5 * (6 + rest - 1) as f64);
+            // A reset starts a new round's count.
+            c.reset();
+            assert_eq!((c.busy_ticks(0), c.rest_ticks()), (Some(0), 0));
+        }
+        let mut free = base.clone().with_max_busy_share(1.0).unwrap();
+        while !free.is_finished() {
+            free.tick(Operator::Scheduled).unwrap();
+        }
+        assert_eq!((free.busy_ticks(0), free.rest_ticks()), (None, 0));
+        assert_eq!(free.max_busy_share(), 1.0);
+        for bad in [0.0, -0.5, 1.5, f64::NAN] {
+            assert!(matches!(
+                base.clone().with_max_busy_share(bad),
+                Err(Error::BadParam {
+                    name: "max_busy_share",
+                    ..
+                })
+            ));
+        }
     }
 
     #[test]

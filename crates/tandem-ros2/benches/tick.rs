@@ -7,9 +7,9 @@
 //! - `tick_thread_only`: **the "with the queues attached"**, the node's tick thread's
 //!   own work per tick as `Ticker::run` of node.rs does it but the sleep: the clock read,
 //!   `link::TickEnd::tick` (the pending-message counter, the robots' progress counters, the
-//!   loop's tick, the command's words into the ring, the state slot asked every 10th tick), the
-//!   DDS side's wake (an awake thread's `unpark`), the pacing clock read and
-//!   `TickEnd::account`. The DDS side's ends run between timed batches, but for its three
+//!   loop's tick, the command's words into the ring with the next tick's deadline, the state
+//!   slot asked every 10th tick), the pacing clock read and `TickEnd::account` (no wake of the
+//!   DDS side: the node's tick thread wakes it only when `TickEnd::tick` asks, never here). The DDS side's ends run between timed batches, but for its three
 //!   progress counts a tick (a load and a store each), so the robots are heard every tick as
 //!   in `loop_only`. The pair is `tick_thread_only` against `loop_paced` (both with
 //!   the pacing read), and against `loop_only` (the node's pacing read counted against it).
@@ -21,12 +21,18 @@
 //!   `with_queues_and_console`: plus the console's feed.
 //! - `advance_only`: `CellLoop::advance` alone (a fixed instant, no links); `links_only`: the
 //!   links' both ends on a fixed command.
-//! - `node_threads`: the node's pair of threads: the tick thread's work as in `with_queues`
-//!   plus the wake of the DDS side (`Thread::unpark`), which runs on a thread of its own that
-//!   parks when idle, drains the ring and hears the three robots after each wake, as the
-//!   node's DDS thread does; the time is the tick thread's (a wake of a parked thread is a
-//!   futex system call). `node_threads_spinning`: the same with a DDS side that spins instead
-//!   of parking: the tick thread against a consumer on the other core, no futex wake.
+//! - `node_threads`: the node's pair of threads: the tick thread's work as `Ticker::run` does
+//!   it (`tick_thread_only`'s, each tick announcing a deadline 0.5 ms after its start, the DDS
+//!   side woken only when `TickEnd::tick` asks), against a DDS side on a thread of its own
+//!   that sleeps by `WriterSchedule::NODE` on the announced deadlines and, at each wake, drains
+//!   the ring, takes an asked snapshot and hears the three robots, as the node's DDS thread
+//!   does. The ticks run back to back, so each wake drains a few hundred ticks' records (the
+//!   node's, at its tick, one); the time is the tick thread's; the wakes it made are printed
+//!   (0 expected). `node_threads_woken_each_tick`: the node before it, for the comparison in
+//!   one run: the tick thread wakes the DDS side (`Thread::unpark`) after every tick, which
+//!   parks 200 µs when idle (a wake of a parked thread is a futex system call).
+//!   `node_threads_spinning`: the same with a DDS side that spins instead of parking: the tick
+//!   thread against a consumer on the other core at every tick's lines, no futex wake.
 //!
 //! Run with `cargo bench -p tandem-ros2 --bench tick`.
 #![expect(
@@ -43,7 +49,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use tandem_console::{Console, ConsoleConfig, Geometry};
 use tandem_planner::{Cell, Planner};
 use tandem_realtime::{Controller, Operator};
-use tandem_ros2::link::{Links, TickEnd};
+use tandem_ros2::link::{Links, TickEnd, WriterSchedule};
 use tandem_ros2::{CellLoop, Command, ConsoleFeed, Inbound, LoopParams, Request};
 
 #[path = "../tests/support/mod.rs"]
@@ -58,7 +64,12 @@ struct NodeTick {
     i: u64,
     /// The DDS side's command buffer (`CommandRing::pop_into`).
     popped: Command,
+    /// The next tick's deadline, kept as `Ticker::run` keeps it (`next += period`).
+    next: Instant,
 }
+
+/// The tick period the benches' ticks announce (their ticks run back to back).
+const PERIOD: Duration = Duration::from_micros(500);
 
 fn start(l: &mut CellLoop) {
     l.handle(
@@ -83,6 +94,7 @@ impl NodeTick {
             ask_every,
             i: 0,
             popped: Command::idle(3),
+            next: Instant::now(),
         }
     }
 
@@ -113,15 +125,19 @@ impl NodeTick {
         c.map(|(r, _)| r).or(s)
     }
 
-    /// The tick thread's part of one tick (as `Ticker::run`, without the writer's wake and the
-    /// counters); returns the tick's instant.
+    /// The tick thread's part of one tick (as `Ticker::run`, without the counters; the ring
+    /// drained often enough that it never asks for the writer's wake); returns the tick's
+    /// instant.
     fn tick_thread(&mut self, console: Option<&mut ConsoleFeed>) -> Instant {
         let now = Instant::now();
-        self.end
-            .tick(&mut self.l, &self.links, now, |_| {
+        self.next += PERIOD;
+        let wake = self
+            .end
+            .tick(&mut self.l, &self.links, now, self.next, |_| {
                 unreachable!("nothing is queued in this benchmark")
             })
             .expect("a valid operator");
+        assert!(!wake, "a drained ring asks for no wake");
         if let Some(feed) = console {
             feed.publish(&self.l);
         }
@@ -132,21 +148,34 @@ impl NodeTick {
     }
 }
 
+/// How the benches' DDS side waits between its passes.
+#[derive(Clone, Copy, PartialEq)]
+enum Side {
+    /// As the node's DDS thread: sleeps by `WriterSchedule::NODE` on the announced deadlines;
+    /// the tick thread wakes it only when `TickEnd::tick` asks.
+    Scheduled,
+    /// As the node's before: parks 200 µs when idle, woken by the tick thread after each tick.
+    WokenEachTick,
+    /// Never parks (spins between passes), woken after each tick as `WokenEachTick`: the wake
+    /// is always of an awake thread.
+    Spinning,
+}
+
 /// The node's pair of threads: this (the tick thread's side) and a DDS side on its own thread
-/// that parks when idle and, after each wake, drains the ring, takes an asked snapshot and hears
-/// the three robots.
+/// that, at each pass, drains the ring, takes an asked snapshot and hears the three robots.
 struct Threads {
     node: NodeTick,
     links: Arc<Links>,
     writer: std::thread::JoinHandle<u64>,
     stop: Arc<AtomicBool>,
+    side: Side,
+    /// Wakes of the DDS side by the tick thread.
+    wakes: u64,
+    ticks: u64,
 }
 
 impl Threads {
-    /// `spin`: the DDS side never parks (it spins between passes), so the tick thread's wake
-    /// is always of an awake thread and the time counts what the two cores' shared cache lines
-    /// cost the tick thread, without the futex wake of a parked one.
-    fn new(planner: &Planner, spin: bool) -> Threads {
+    fn new(planner: &Planner, side: Side) -> Threads {
         let mut node = NodeTick::new(planner, 10);
         // The DDS side's thread may be starved for longer than the default 0.25 s on a loaded
         // machine: a latched stall would hold the loop and time a tick that does not tick.
@@ -164,12 +193,14 @@ impl Threads {
             let mut taken = 0_u64;
             let mut asked = Instant::now();
             let mut popped = Command::idle(3);
+            let (schedule, mut late) = (WriterSchedule::NODE, 0);
             while !st.load(Ordering::Relaxed) {
                 let mut busy = false;
                 while let Some(at) = l.commands.pop_into(&mut popped) {
                     black_box((at, popped.tick));
                     taken += 1;
                     busy = true;
+                    late = 0;
                 }
                 if asked.elapsed() >= Duration::from_millis(1) {
                     l.state.ask();
@@ -182,10 +213,21 @@ impl Threads {
                     for k in 0..3 {
                         l.heard.hear(k);
                     }
-                } else if spin {
-                    std::hint::spin_loop();
-                } else {
-                    std::thread::park_timeout(Duration::from_micros(200));
+                    continue;
+                }
+                match side {
+                    Side::Scheduled => {
+                        // As `Io::run` of node.rs.
+                        let now = Instant::now();
+                        let next = l.commands.next_deadline();
+                        let sleep = schedule.sleep(now, next, late);
+                        if schedule.is_late(now, next) {
+                            late += 1;
+                        }
+                        std::thread::park_timeout(sleep);
+                    }
+                    Side::WokenEachTick => std::thread::park_timeout(Duration::from_micros(200)),
+                    Side::Spinning => std::hint::spin_loop(),
                 }
             }
             taken
@@ -195,20 +237,29 @@ impl Threads {
             links,
             writer,
             stop,
+            side,
+            wakes: 0,
+            ticks: 0,
         }
     }
 
-    /// One tick of the tick thread against the shared links, and the wake.
+    /// One tick of the tick thread against the shared links, and the wake when one is due.
     fn tick(&mut self) -> u64 {
         let n = &mut self.node;
         let l = &*self.links;
         let now = Instant::now();
-        n.end
-            .tick(&mut n.l, l, now, |_| {
+        n.next += PERIOD;
+        let behind = n
+            .end
+            .tick(&mut n.l, l, now, n.next, |_| {
                 unreachable!("nothing is queued in this benchmark")
             })
             .expect("a valid operator");
-        self.writer.thread().unpark();
+        if behind || self.side != Side::Scheduled {
+            self.writer.thread().unpark();
+            self.wakes += 1;
+        }
+        self.ticks += 1;
         n.end.account(l, Instant::now());
         let finished = n.l.is_finished();
         if finished {
@@ -217,10 +268,17 @@ impl Threads {
         u64::from(finished)
     }
 
-    fn finish(self) -> u64 {
+    /// Ends the DDS side; prints the ticks, the wakes the tick thread made and the records the
+    /// DDS side took.
+    fn finish(self, name: &str) -> u64 {
         self.stop.store(true, Ordering::Relaxed);
         self.writer.thread().unpark();
-        self.writer.join().expect("the writer thread")
+        let taken = self.writer.join().expect("the writer thread");
+        eprintln!(
+            "{name}: {} ticks, {} wakes of the DDS side by the tick thread, {taken} records taken",
+            self.ticks, self.wakes
+        );
+        taken
     }
 }
 
@@ -335,16 +393,14 @@ fn bench(c: &mut Criterion) {
         b.iter(|| black_box(node.tick(None)));
     });
     // The tick thread's own work, as `Ticker::run` does it each tick but the sleep: the clock
-    // read, `TickEnd::tick`, the DDS side's wake (`Thread::unpark` of a thread that is awake,
-    // as the node's DDS thread is while it publishes: one swap; a parked one is
-    // `node_threads`'), the pacing clock read and `TickEnd::account`. The DDS side's ends that
+    // read, `TickEnd::tick` (the ring drained often enough that it never asks for the DDS
+    // side's wake), the pacing clock read and `TickEnd::account`. The DDS side's ends that
     // the tick thread never runs (the ring drained, the snapshot taken) run between timed
     // batches of 64 ticks (the ring holds 4,096); the one DDS-side write left inside the timing
     // is the three robots' progress counts, one report per robot per tick as `loop_only` hears
     // them (`Heard::hear`: a load and a store each), so that the tick stores the three robots'
     // instants every tick as `loop_only` does. Its like-for-like baseline is `loop_paced`.
     let mut node = NodeTick::new(&planner, 10);
-    let writer = std::thread::current();
     group.bench_function("tick_thread_only", |b| {
         b.iter_custom(|iters| {
             let mut spent = Duration::ZERO;
@@ -361,7 +417,6 @@ fn bench(c: &mut Criterion) {
                         node.links.state.ask();
                     }
                     black_box(node.tick_thread(None));
-                    writer.unpark();
                     node.end.account(&node.links, Instant::now());
                 }
                 spent += t0.elapsed();
@@ -371,25 +426,29 @@ fn bench(c: &mut Criterion) {
                 black_box(node.links.state.take());
                 left -= batch;
             }
-            // The thread's unpark token, set by the last batch, is spent here, untimed.
-            std::thread::park_timeout(Duration::ZERO);
             spent
         });
     });
-    // The node's two threads, the DDS side woken each tick.
-    let mut threads = Threads::new(&planner, false);
+    // The node's two threads, the DDS side sleeping by the announced deadlines.
+    let mut threads = Threads::new(&planner, Side::Scheduled);
     group.bench_function("node_threads", |b| {
         b.iter(|| black_box(threads.tick()));
     });
-    black_box(threads.finish());
+    black_box(threads.finish("node_threads"));
+    // The node before: the DDS side woken after every tick, parking when idle.
+    let mut threads = Threads::new(&planner, Side::WokenEachTick);
+    group.bench_function("node_threads_woken_each_tick", |b| {
+        b.iter(|| black_box(threads.tick()));
+    });
+    black_box(threads.finish("node_threads_woken_each_tick"));
     // The same with a DDS side that spins instead of parking (it takes a core while it runs):
     // the tick thread's work against a consumer on another core, the wake always of an awake
     // thread.
-    let mut threads = Threads::new(&planner, true);
+    let mut threads = Threads::new(&planner, Side::Spinning);
     group.bench_function("node_threads_spinning", |b| {
         b.iter(|| black_box(threads.tick()));
     });
-    black_box(threads.finish());
+    black_box(threads.finish("node_threads_spinning"));
     let mut node = NodeTick::new(&planner, 1);
     group.bench_function("with_queues_state_every_tick", |b| {
         b.iter(|| black_box(node.tick(None)));

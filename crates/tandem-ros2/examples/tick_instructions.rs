@@ -22,7 +22,9 @@
 //! - `run_tick_thread`: the node's tick thread as `Ticker::run` runs it (`link::TickEnd::tick`:
 //!   the pending-message counter, the progress counters, the loop's tick (`advance` without
 //!   building its `Command`), the command's words into the ring, the state slot asked every 10th
-//!   tick), plus its per-tick bookkeeping (`TickEnd::account`) and the writer's wake;
+//!   tick, with the next tick's deadline), plus its per-tick bookkeeping (`TickEnd::account`);
+//!   the writer is woken only when `TickEnd::tick` asks (never here: the DDS side drains each
+//!   tick);
 //! - `run_dds_side`: the DDS thread's ends for those ticks (three progress counters, the ring
 //!   drained into one reused command, the slot asked and taken), for reference: in the node
 //!   they run on another thread.
@@ -36,6 +38,9 @@ use tandem_planner::{AnyController, Cell};
 use tandem_realtime::{Controller, Operator};
 use tandem_ros2::link::{Links, TickEnd};
 use tandem_ros2::{CellLoop, Command, Inbound, LoopParams, Request};
+
+/// The tick period `run_tick_thread` announces (its ticks run back to back).
+const PERIOD: std::time::Duration = std::time::Duration::from_micros(500);
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -119,12 +124,17 @@ fn run_tick_thread(
     end: &mut TickEnd,
     links: &Links,
     writer: &std::thread::Thread,
+    next: &mut Instant,
     i: u64,
 ) {
     let now = Instant::now();
-    end.tick(l, links, now, |_| unreachable!("nothing is queued"))
+    *next += PERIOD;
+    let wake = end
+        .tick(l, links, now, *next, |_| unreachable!("nothing is queued"))
         .expect("a valid operator");
-    writer.unpark();
+    if wake {
+        writer.unpark();
+    }
     end.account(links, Instant::now());
     if l.is_finished() {
         start(l);
@@ -167,9 +177,10 @@ fn main() {
     let mut end = TickEnd::new(3);
     let writer = std::thread::current();
     let mut popped = Command::idle(3);
+    let mut next = Instant::now();
     for i in 1..=ticks {
         run_dds_side(&links, &mut popped, i);
-        run_tick_thread(&mut l, &mut end, &links, &writer, i);
+        run_tick_thread(&mut l, &mut end, &links, &writer, &mut next, i);
     }
     use std::io::Write as _;
     let _ = writeln!(std::io::stdout(), "{ticks} ticks of each variant");

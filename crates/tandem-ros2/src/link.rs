@@ -5,7 +5,10 @@
 //!
 //! Safe code only: every shared word is an atomic. The tick thread never waits on any of them
 //! (a full ring drops the record and counts it; a slot the reader holds is written at the next
-//! tick). Issue 43: "the tick's own cost with the node's queues attached against without"
+//! tick), and it does not wake the DDS thread each tick: each record announces the next tick's
+//! deadline, by which the DDS thread sleeps ([`WriterSchedule`]); the tick thread wakes it only
+//! when the ring is half full or a reply waits (docs/decisions.md, "The node's DDS thread sleeps
+//! by the tick's announced deadline, no wake per tick (issue 43)"). Issue 43: "the tick's own cost with the node's queues attached against without"
 //! (docs/decisions.md, "The node's tick: a command ring, a snapshot when asked, golden bytes and
 //! the pose (issue 43)").
 
@@ -18,10 +21,29 @@ use tandem_realtime::{MAX_ROBOTS, RobotFlags};
 use crate::core::{CellLoop, Command, Snapshot};
 use crate::error::Result;
 
-/// Words of one command record for `n` robots: the tick, the flags, the tick's start (ns after
-/// the ring's creation), then each robot's reference time and speed scale (`f64` bits).
+/// Words of one command record for `n` robots: the tick, the flags, the tick's start and the
+/// next tick's deadline (ns after the ring's creation; [`NO_DEADLINE`]: none announced), then
+/// each robot's reference time and speed scale (`f64` bits).
 const fn record_words(n: usize) -> usize {
-    3 + 2 * n
+    HEAD_WORDS + 2 * n
+}
+
+/// The leading words of a record: tick, flags, start, next deadline.
+const HEAD_WORDS: usize = 4;
+
+/// A record's next-deadline word when its tick announced none ([`CommandRing::push`], the
+/// tick thread's last command).
+const NO_DEADLINE: u64 = u64::MAX;
+
+/// What a push did, for the tick thread's decision to wake the DDS thread.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Push {
+    /// Stored; the ring held fewer than half its capacity.
+    Stored,
+    /// Stored into a ring at least half full: the DDS thread is behind, wake it.
+    Wake,
+    /// The ring was full: dropped and counted (wake the DDS thread too).
+    Dropped,
 }
 
 /// A value alone on its cache lines: 128 bytes, two 64-byte lines, as x86's adjacent-line
@@ -50,6 +72,9 @@ struct ConsumerEnd {
     tail: AtomicU64,
     /// The producer's count as the consumer last read it: every record below it is written.
     head_seen: AtomicU64,
+    /// The next tick's deadline the last popped record announced (ns in the ring's time,
+    /// [`NO_DEADLINE`] before the first pop).
+    next_ns: AtomicU64,
 }
 
 /// A bounded single-producer single-consumer ring of [`Command`]s: the tick thread pushes one
@@ -61,13 +86,17 @@ struct ConsumerEnd {
 /// (producer) or empty (consumer), and each end's words are on cache lines of their own: a push
 /// into a ring with room reads no line the consumer writes. Each record carries the instant its
 /// tick started, so the DDS thread stamps a command with its tick's time, not with the time it
-/// got round to publishing it.
+/// got round to publishing it, and the deadline of the tick after it
+/// ([`CommandRing::next_deadline`]), by which the DDS thread sleeps: the tick thread does not
+/// wake it per record, only when a push finds the ring half full (the DDS thread behind).
 #[derive(Debug)]
 pub struct CommandRing {
     n: usize,
     /// The instant the records' times count from.
     base: Instant,
     capacity: u64,
+    /// Unread records at which a push asks for the DDS thread's wake: half the capacity (≥ 1).
+    wake_fill: u64,
     words: Box<[AtomicU64]>,
     /// Written by the producer only.
     producer: OwnLine<ProducerEnd>,
@@ -87,33 +116,46 @@ impl CommandRing {
             n,
             base: Instant::now(),
             capacity: capacity as u64,
+            wake_fill: (capacity as u64 / 2).max(1),
             words: (0..capacity * record_words(n))
                 .map(|_| AtomicU64::new(0))
                 .collect(),
             producer: OwnLine::default(),
-            consumer: OwnLine::default(),
+            consumer: OwnLine(ConsumerEnd {
+                next_ns: AtomicU64::new(NO_DEADLINE),
+                ..ConsumerEnd::default()
+            }),
         }
     }
 
-    /// The record of the `count`-th push: its tick, flags and start, then each robot's
-    /// reference time and speed scale as a pair.
+    /// The record of the `count`-th push: its tick, flags, start and next deadline, then each
+    /// robot's reference time and speed scale as a pair.
     #[inline]
-    fn record(&self, count: u64) -> (&[AtomicU64; 3], &[[AtomicU64; 2]]) {
+    fn record(&self, count: u64) -> (&[AtomicU64; HEAD_WORDS], &[[AtomicU64; 2]]) {
         let w = record_words(self.n);
         let at = (count & (self.capacity - 1)) as usize * w;
         let r = &self.words[at..at + w];
-        let (head, robots) = r.split_at(3);
+        let (head, robots) = r.split_at(HEAD_WORDS);
         (
-            head.try_into().expect("a record has three leading words"),
+            head.try_into().expect("a record has four leading words"),
             robots.as_chunks::<2>().0,
         )
     }
 
-    /// Pushes `cmd` of the tick that started at `at` (the producer, one thread); `false` (and
-    /// counted) when the ring is full.
+    /// Pushes `cmd` of the tick that started at `at` (the producer, one thread), announcing no
+    /// next deadline (the tick thread's last command); `false` (and counted) when the ring is
+    /// full.
     pub fn push(&self, cmd: &Command, at: Instant) -> bool {
         let at_ns = self.since(at);
-        self.push_words(cmd.tick, cmd.flags_word(), &cmd.ref_time, &cmd.speed, at_ns)
+        let words = (cmd.tick, cmd.flags_word(), at_ns, NO_DEADLINE);
+        self.push_words(words, &cmd.ref_time, &cmd.speed) != Push::Dropped
+    }
+
+    /// [`push`](Self::push) announcing `next`, the deadline of the tick after this one: the
+    /// DDS thread sleeps until just past it ([`WriterSchedule`]) instead of being woken.
+    pub fn push_until(&self, cmd: &Command, at: Instant, next: Instant) -> bool {
+        let words = (cmd.tick, cmd.flags_word(), self.since(at), self.since(next));
+        self.push_words(words, &cmd.ref_time, &cmd.speed) != Push::Dropped
     }
 
     /// `at` in the records' time: ns after the ring's creation (0 before it).
@@ -123,42 +165,48 @@ impl CommandRing {
         at.saturating_duration_since(self.base).as_nanos() as u64
     }
 
-    /// [`push`](Self::push) of a command given as its tick count, its
-    /// [`Command::flags_word`] and its robots' reference times and speed scales (the node's
-    /// tick thread takes them from the loop, [`TickEnd::tick`]: no [`Command`] is built), its
-    /// tick's start as [`since`](Self::since) gives it.
+    /// [`push`](Self::push) of a command given as its head words (its tick count, its
+    /// [`Command::flags_word`], its tick's start and the next tick's deadline, both as
+    /// [`since`](Self::since) gives them) and its robots' reference times and speed scales (the
+    /// node's tick thread takes them from the loop, [`TickEnd::tick`]: no [`Command`] is
+    /// built). [`Push::Wake`] when the ring held half its capacity or more: the consumer's
+    /// count is read only when the count last seen says so, so a ring the DDS thread keeps
+    /// drained costs one read of its line per half ring of pushes.
     #[inline]
     pub(crate) fn push_words(
         &self,
-        tick: u64,
-        flags: u64,
+        (tick, flags, at_ns, next_ns): (u64, u64, u64, u64),
         ref_time: &[f64],
         speed: &[f64],
-        at_ns: u64,
-    ) -> bool {
+    ) -> Push {
         let p = &self.producer.0;
         let h = p.head.load(Ordering::Relaxed);
-        if h - p.tail_seen.load(Ordering::Relaxed) >= self.capacity {
-            // Full as last seen: read the consumer's count (every slot below it was read
+        let mut pushed = Push::Stored;
+        if h - p.tail_seen.load(Ordering::Relaxed) >= self.wake_fill {
+            // Half full as last seen: read the consumer's count (every slot below it was read
             // before its release store, which this acquire load orders before our writes).
             let t = self.consumer.0.tail.load(Ordering::Acquire);
             p.tail_seen.store(t, Ordering::Relaxed);
             if h - t >= self.capacity {
                 p.dropped
                     .store(p.dropped.load(Ordering::Relaxed) + 1, Ordering::Relaxed);
-                return false;
+                return Push::Dropped;
+            }
+            if h - t >= self.wake_fill {
+                pushed = Push::Wake;
             }
         }
         let (head, robots) = self.record(h);
         head[0].store(tick, Ordering::Relaxed);
         head[1].store(flags, Ordering::Relaxed);
         head[2].store(at_ns, Ordering::Relaxed);
+        head[3].store(next_ns, Ordering::Relaxed);
         for ((pair, r), s) in robots.iter().zip(ref_time).zip(speed) {
             pair[0].store(r.to_bits(), Ordering::Relaxed);
             pair[1].store(s.to_bits(), Ordering::Relaxed);
         }
         p.head.store(h + 1, Ordering::Release);
-        true
+        pushed
     }
 
     /// Pops the oldest command and the instant its tick started (the consumer, one thread), or
@@ -204,8 +252,21 @@ impl CommandRing {
         let at = self.base + Duration::from_nanos(head[2].load(Ordering::Relaxed));
         cmd.tick = head[0].load(Ordering::Relaxed);
         cmd.set_flags_word(head[1].load(Ordering::Relaxed));
+        c.next_ns
+            .store(head[3].load(Ordering::Relaxed), Ordering::Relaxed);
         c.tail.store(t + 1, Ordering::Release);
         Some(at)
+    }
+
+    /// The deadline of the tick after the last popped one, as that tick announced it (the
+    /// consumer's; `None` before the first pop and after a record that announced none): the
+    /// next record is due when that tick has run, so the DDS thread sleeps until just past it.
+    #[must_use]
+    pub fn next_deadline(&self) -> Option<Instant> {
+        match self.consumer.0.next_ns.load(Ordering::Relaxed) {
+            NO_DEADLINE => None,
+            ns => Some(self.base + Duration::from_nanos(ns)),
+        }
     }
 
     /// Records dropped because the ring was full (the DDS thread behind by `capacity` ticks).
@@ -219,6 +280,76 @@ impl CommandRing {
     #[must_use]
     pub fn capacity(&self) -> usize {
         self.capacity as usize
+    }
+}
+
+/// When the node's DDS thread wakes, from the deadline the tick thread announced with its last
+/// command ([`CommandRing::next_deadline`], `D`): `lead` before `D` to take the network's
+/// messages in (progress, the operator, requests), so the tick at `D` reads them; `after` past
+/// `D` to publish that tick's command; at least every `poll` (the network's messages, the
+/// record thread's results, a tick thread that announced nothing). When it wakes past
+/// `D + after` and the command is not in the ring yet (the tick thread late), it sleeps again
+/// `retry`, doubled at each such wake in a row up to `poll`: never a spin.
+///
+/// The wait of a command in the ring (its push → the DDS thread's pop), both threads sleeping
+/// with the kernel's timer slack `s` (50 µs for a thread that is not real-time): the tick
+/// starts in `[D, D + s]` and pushes within its work; the DDS thread wakes in
+/// `[D + after, D + after + s]`. Woken after the push, the command waited < `after + s`; woken
+/// before it, the DDS thread sleeps `retry` and wakes < `retry + s` after the push when the
+/// push came within `retry` of that wake: ≤ 70 µs either way with [`WriterSchedule::NODE`]. A
+/// tick that starts `L` late (its thread not run) finds the retries doubled to < `2L + retry`
+/// (at most `poll`), plus `s`. Add the scheduler's delay of a runnable thread, as for a woken
+/// one (docs/decisions.md, "The node's DDS thread sleeps by the tick's announced deadline, no
+/// wake per tick (issue 43)").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WriterSchedule {
+    /// How long before a tick's deadline the DDS thread takes the network's messages in.
+    pub lead: Duration,
+    /// How long after a tick's deadline it wakes for that tick's command.
+    pub after: Duration,
+    /// Its first sleep when it woke for a command not pushed yet (doubled each time).
+    pub retry: Duration,
+    /// Its longest sleep.
+    pub poll: Duration,
+}
+
+impl WriterSchedule {
+    /// The node's: `lead` 200 µs (the polling period of the DDS thread before, so a message is
+    /// read by the next tick when it arrives ≥ 200 µs before it, as then), `after` 20 µs,
+    /// `retry` 20 µs, `poll` 1 ms.
+    pub const NODE: WriterSchedule = WriterSchedule {
+        lead: Duration::from_micros(200),
+        after: Duration::from_micros(20),
+        retry: Duration::from_micros(20),
+        poll: Duration::from_millis(1),
+    };
+
+    /// The sleep from `now` after a pass that found nothing to do, when the tick announced
+    /// `next` ([`CommandRing::next_deadline`]) and `late` passes in a row have found that
+    /// tick's command missing past `next + after` ([`is_late`](Self::is_late)).
+    #[must_use]
+    pub fn sleep(&self, now: Instant, next: Option<Instant>, late: u32) -> Duration {
+        let Some(next) = next else {
+            return self.poll;
+        };
+        let until = |t: Instant| t.saturating_duration_since(now).min(self.poll);
+        if let Some(before) = next.checked_sub(self.lead)
+            && now < before
+        {
+            return until(before);
+        }
+        let publish = next + self.after;
+        if now < publish {
+            return until(publish);
+        }
+        self.retry.saturating_mul(1 << late.min(16)).min(self.poll)
+    }
+
+    /// Whether a pass at `now` that found no command came past `next + after`: the tick that
+    /// announced `next` has not pushed its command yet.
+    #[must_use]
+    pub fn is_late(&self, now: Instant, next: Option<Instant>) -> bool {
+        next.is_some_and(|d| now >= d + self.after)
     }
 }
 
@@ -442,14 +573,17 @@ impl TickEnd {
         }
     }
 
-    /// One tick at `now` (the tick's start): `drain` takes the queued rare messages in when
-    /// the pending counter moved, each robot heard since the last tick is alive at `now`, the
-    /// loop's tick ([`CellLoop::advance`] without building its [`Command`]), the command's
-    /// words from the loop into the ring (a full ring drops it, counted), and the snapshot into
+    /// One tick at `now` (the tick's start), the next to start at `next`: `drain` takes the
+    /// queued rare messages in when the pending counter moved, each robot heard since the last
+    /// tick is alive at `now`, the loop's tick ([`CellLoop::advance`] without building its
+    /// [`Command`]), the command's words from the loop into the ring with `next` as the DDS
+    /// thread's next deadline (a full ring drops it, counted), and the snapshot into
     /// the state slot when the DDS thread asked for it or the fault, the round's end or the
     /// running state changed (or one is owed). The ring's record is the command `advance`
     /// returns (`cargo test -p tandem-ros2 --test cell_loop the_tick_thread`); whether the
-    /// round finished is [`CellLoop::is_finished`].
+    /// round finished is [`CellLoop::is_finished`]. `true` when the DDS thread should be woken
+    /// now: the ring was half full or full (it is behind its deadlines); otherwise it wakes by
+    /// `next` ([`WriterSchedule`]).
     ///
     /// # Errors
     /// [`CellLoop::advance`]'s.
@@ -458,8 +592,9 @@ impl TickEnd {
         l: &mut CellLoop,
         links: &Links,
         now: Instant,
+        next: Instant,
         drain: impl FnOnce(&mut CellLoop),
-    ) -> Result<()> {
+    ) -> Result<bool> {
         if links.pending.moved(&mut self.pending_seen) {
             drain(l);
         }
@@ -473,9 +608,10 @@ impl TickEnd {
         self.start = Some(now);
         self.start_ns = start_ns;
         let (tick, flags, ref_time, speed) = l.command_words();
-        links
+        let next_ns = links.commands.since(next);
+        let pushed = links
             .commands
-            .push_words(tick, flags, ref_time, speed, start_ns);
+            .push_words((tick, flags, start_ns, next_ns), ref_time, speed);
         // Active, finished, fault.
         let flags = flags & 0b111;
         if flags != self.last_flags || self.owed || links.state.wanted() {
@@ -483,7 +619,7 @@ impl TickEnd {
             self.owed = !links.state.put(l.snapshot());
         }
         self.last_flags = flags;
-        Ok(())
+        Ok(pushed != Push::Stored)
     }
 
     /// Counts the last [`tick`](Self::tick), whose work ended at `end`, into `links`'
@@ -620,6 +756,67 @@ mod tests {
             }
         }
         producer.join().unwrap();
+    }
+
+    #[test]
+    fn each_record_announces_the_next_deadline_and_a_half_full_ring_asks_for_a_wake() {
+        let ring = CommandRing::new(2, 4);
+        let ms = |t: u64| ring.base + Duration::from_millis(t);
+        let push = |t: u64| {
+            let c = cmd(t, 2);
+            let words = (t, c.flags_word(), ring.since(ms(t)), ring.since(ms(t + 1)));
+            ring.push_words(words, &c.ref_time, &c.speed)
+        };
+        assert_eq!(ring.next_deadline(), None);
+        // 0 and 1 unread before the push: stored; 2 and 3 (half of 4 and more): a wake; full.
+        let got: Vec<Push> = (1..=5).map(push).collect();
+        use Push::{Dropped, Stored, Wake};
+        assert_eq!(got, [Stored, Stored, Wake, Wake, Dropped]);
+        assert_eq!(ring.dropped(), 1);
+        assert_eq!(ring.pop().map(|(c, at)| (c.tick, at)), Some((1, ms(1))));
+        assert_eq!(ring.next_deadline(), Some(ms(2)));
+        for t in [2, 3] {
+            assert_eq!(ring.pop().map(|(c, _)| c.tick), Some(t));
+        }
+        assert_eq!(ring.next_deadline(), Some(ms(4)));
+        // One unread (4): stored; then two unread: a wake, with no deadline announced.
+        assert_eq!(push(6), Stored);
+        assert!(ring.push(&cmd(7, 2), ms(7)));
+        assert_eq!(ring.dropped(), 1);
+        let popped: Vec<(u64, Option<Instant>)> =
+            std::iter::from_fn(|| ring.pop().map(|(c, _)| (c.tick, ring.next_deadline())))
+                .collect();
+        assert_eq!(popped, [(4, Some(ms(5))), (6, Some(ms(7))), (7, None)]);
+        // `push_until` announces its deadline.
+        assert!(ring.push_until(&cmd(8, 2), ms(8), ms(9)));
+        assert_eq!(ring.pop().map(|(c, _)| c), Some(cmd(8, 2)));
+        assert_eq!(ring.next_deadline(), Some(ms(9)));
+    }
+
+    #[test]
+    fn the_writer_sleeps_to_the_lead_then_past_the_deadline_then_backs_off() {
+        let s = WriterSchedule::NODE;
+        let t0 = Instant::now();
+        let us = Duration::from_micros;
+        let d = Some(t0 + us(1_000));
+        // Nothing announced: the poll; 1 ms ahead: to 200 µs before it; 3 ms: the poll.
+        assert_eq!(s.sleep(t0, None, 0), us(1_000));
+        assert_eq!(s.sleep(t0, d, 0), us(800));
+        assert_eq!(s.sleep(t0, Some(t0 + us(3_000)), 0), us(1_000));
+        // Within the lead: to 20 µs past the deadline.
+        assert_eq!(s.sleep(t0 + us(800), d, 0), us(220));
+        assert_eq!(s.sleep(t0 + us(1_010), d, 0), us(10));
+        // Late from 20 µs past it on: 20 µs, doubled at each late pass, at most the poll.
+        assert!(!s.is_late(t0 + us(1_019), d));
+        assert!(s.is_late(t0 + us(1_020), d));
+        assert!(!s.is_late(t0 + us(9_000), None));
+        let backoff: Vec<u128> = (0..8)
+            .map(|k| s.sleep(t0 + us(1_030), d, k).as_micros())
+            .collect();
+        assert_eq!(backoff, [20, 40, 80, 160, 320, 640, 1_000, 1_000]);
+        assert_eq!(s.sleep(t0 + us(1_030), d, u32::MAX), us(1_000));
+        // A tick shorter than the lead: straight to past the deadline.
+        assert_eq!(s.sleep(t0, Some(t0 + us(100)), 0), us(120));
     }
 
     #[test]

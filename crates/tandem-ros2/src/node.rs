@@ -3,6 +3,8 @@
 //! [`crate::link`] (every tick's command in a ring, the state snapshot when asked, progress as
 //! counters) and a bounded queue of the rare messages, only ever used with
 //! `try_send`/`try_recv` by the tick thread (std's bounded channel: a lock-free array queue).
+//! The DDS thread sleeps by the deadline each tick announces with its command
+//! ([`WriterSchedule`]); the tick thread wakes it only for a reply or a half-full ring.
 //!
 //! The topics and services (`K` = 1…N, robot 1 first):
 //!
@@ -40,7 +42,7 @@ use tandem_realtime::Controller;
 use crate::console::ConsoleFeed;
 use crate::core::{CellLoop, Command, Inbound, LoopParams, Reply, Request, RoundLog};
 use crate::error::{Error, Result, dds};
-use crate::link::{Links, TickEnd};
+use crate::link::{Links, TickEnd, WriterSchedule};
 use crate::msg::{
     self, BOOL, Bool, FLOAT64, FLOAT64_MULTI_ARRAY, Float64, Float64MultiArray, JOY, Joy,
     POSE_STAMPED, PoseStamped, STRING, TRIGGER, Text, TriggerRequest, TriggerResponse, TypeName,
@@ -209,6 +211,8 @@ struct Counters {
     inbound_dropped: AtomicU64,
     commands: AtomicU64,
     publish_failed: AtomicU64,
+    wakes: AtomicU64,
+    late_wakes: AtomicU64,
 }
 
 /// What a node did so far.
@@ -237,6 +241,14 @@ pub struct NodeStats {
     pub tick_priority: Priority,
     /// The DDS thread's priority, which the DDS library's threads inherit.
     pub dds_priority: Priority,
+    /// Times the tick thread woke the DDS thread (a reply to a request or a round to record,
+    /// a ring half full, the stop): none for the ticks themselves, by whose announced
+    /// deadlines the DDS thread sleeps ([`WriterSchedule`]).
+    pub wakes: u64,
+    /// Times the DDS thread woke for a tick's command ([`WriterSchedule::is_late`]) before the
+    /// tick thread had pushed it, and slept again for [`WriterSchedule`]'s `retry` (doubled
+    /// when again too early): each adds at most that sleep to a command's latency.
+    pub late_wakes: u64,
 }
 
 /// A running node; [`Node::stop`] ends it.
@@ -438,6 +450,8 @@ impl Node {
             publish_failed: get(&c.publish_failed),
             tick_priority: c.tick_priority.get().copied().unwrap_or_default(),
             dds_priority: c.dds_priority.get().copied().unwrap_or_default(),
+            wakes: get(&c.wakes),
+            late_wakes: get(&c.late_wakes),
         }
     }
 
@@ -487,7 +501,8 @@ fn join(h: JoinHandle<Result<()>>, name: &'static str) -> Result<()> {
 
 /// The tick thread.
 struct Ticker {
-    /// The DDS thread, woken after each command is pushed (it parks when idle).
+    /// The DDS thread, woken only for a reply, a half-full ring and the stop: it sleeps by the
+    /// deadline each command announces ([`WriterSchedule`]).
     writer: std::thread::Thread,
     nice: i32,
     /// Told once the thread's priority is set.
@@ -516,28 +531,36 @@ impl Ticker {
             // The rare messages (operator, requests, records), only when some were queued; at
             // most one queue's worth per tick: a flood cannot lengthen the tick unboundedly.
             let (in_rx, reply_tx) = (&self.in_rx, &self.reply_tx);
+            let mut replied = false;
             let drain = |l: &mut CellLoop| {
                 for _ in 0..4096 {
                     match in_rx.try_recv() {
                         Ok(m) => l.handle(m, now, &mut |r| {
                             // 64 slots for at most a handful of pending requests.
                             let _ = reply_tx.try_send(r);
+                            replied = true;
                         }),
                         Err(TryRecvError::Empty | TryRecvError::Disconnected) => break,
                     }
                 }
             };
-            // Every tick's command; the state topics' snapshot when asked, or at once when the
-            // fault or the round's state changed (so their topics follow within the tick).
-            end.tick(&mut self.cell_loop, &links, now, drain)?;
-            // The DDS thread parks when it has nothing to do: wake it for this command (a swap
-            // when it is awake; a futex wake when parked, measured in the benchmark
-            // `node_threads`). Before the console's feed: the command goes out first.
-            self.writer.unpark();
+            // Every tick's command, announcing the next tick's deadline, by which the DDS
+            // thread sleeps; the state topics' snapshot when asked, or at once when the fault
+            // or the round's state changed (so their topics follow within the tick).
+            next += period;
+            let behind = end.tick(&mut self.cell_loop, &links, now, next, drain)?;
+            // No wake per tick (a futex wake when the DDS thread sleeps, ≈ 0.5 µs: the
+            // benchmark `node_threads` before "The node's DDS thread sleeps by the tick's
+            // announced deadline, no wake per tick (issue 43)"): only a reply, which a
+            // service caller waits for, and a ring half full wake it. Before the console's
+            // feed: the command goes out first.
+            if behind || replied {
+                self.writer.unpark();
+                c.wakes.fetch_add(1, Ordering::Relaxed);
+            }
             if let Some(feed) = &mut self.console {
                 feed.publish(&self.cell_loop);
             }
-            next += period;
             // One clock read for both the tick's work and the sleep.
             let after = Instant::now();
             end.account(&links, after);
@@ -554,6 +577,7 @@ impl Ticker {
         let last = self.cell_loop.halt();
         self.links.commands.push(&last, Instant::now());
         self.writer.unpark();
+        c.wakes.fetch_add(1, Ordering::Relaxed);
         if let Some(feed) = &mut self.console {
             feed.publish(&self.cell_loop);
         }
@@ -763,6 +787,9 @@ impl Io {
             .as_ref()
             .map(|_| Vec::with_capacity(1 << 16));
         let mut stopped_at: Option<Instant> = None;
+        // Passes in a row that woke for a command not pushed yet.
+        let mut late = 0_u32;
+        let schedule = WriterSchedule::NODE;
         loop {
             // Set once the tick thread has ended: this pass publishes its last commands.
             let stopping = self.stop.load(Ordering::Relaxed);
@@ -774,6 +801,7 @@ impl Io {
             let links = &*self.links;
             while let Some(at) = links.commands.pop_into(&mut command) {
                 busy = true;
+                late = 0;
                 // The tick's start: the latency a subscriber measures is the coordinator's.
                 let stamp = wall_s(at, clock);
                 let since = |t: Instant| t.saturating_duration_since(at).as_nanos() as u64;
@@ -925,11 +953,20 @@ impl Io {
             if stopped_at.is_some_and(|t| t.elapsed() >= LINGER) && recording == 0 {
                 break;
             }
-            // Idle: park until the tick thread pushes the next command (it unparks this thread
-            // after each; an unpark before the park makes the park return at once), or 200 µs
-            // pass — the network's messages (progress, the operator, services) are polled.
+            // Idle: sleep by the deadline the last command announced (`WriterSchedule`):
+            // before it for the network's messages, just past it for its tick's command, at
+            // least every millisecond; a wake from the tick thread (a reply, a half-full ring,
+            // the stop) or a record's thread ends the sleep early (an unpark before the park
+            // makes the park return at once).
             if !busy {
-                std::thread::park_timeout(Duration::from_micros(200));
+                let now = Instant::now();
+                let next = links.commands.next_deadline();
+                let sleep = schedule.sleep(now, next, late);
+                if schedule.is_late(now, next) {
+                    late = late.saturating_add(1);
+                    c.late_wakes.fetch_add(1, Ordering::Relaxed);
+                }
+                std::thread::park_timeout(sleep);
             }
         }
         if let (Some(path), Some(rows)) = (&self.stage_trace, trace) {
@@ -1017,6 +1054,8 @@ impl Io {
         let cell = self.cell;
         let in_tx = self.in_tx.clone();
         let links = self.links.clone();
+        // This (the DDS) thread, woken when the record is done: it sleeps by the ticks.
+        let dds = std::thread::current();
         let spawned = std::thread::Builder::new()
             .name("tandem-record".into())
             .spawn(move || {
@@ -1037,6 +1076,7 @@ impl Io {
                     }
                 };
                 let _ = done.send(Recorded { token, result });
+                dds.unpark();
             });
         if spawned.is_err() {
             self.counters.publish_failed.fetch_add(1, Ordering::Relaxed);

@@ -482,19 +482,22 @@ fn the_tick_thread_sends_what_advance_returns() {
             links.state.ask();
         }
         let want = a.advance(now).unwrap();
-        end.tick(&mut b, &links, now, |l| {
-            for m in msgs {
-                l.handle(m, now, &mut |r| {
-                    if let Reply::Round { log, .. } = r {
-                        log_b = Some(log);
-                    }
-                });
-            }
-        })
-        .unwrap();
+        let wake = end
+            .tick(&mut b, &links, now, now + tick, |l| {
+                for m in msgs {
+                    l.handle(m, now, &mut |r| {
+                        if let Reply::Round { log, .. } = r {
+                            log_b = Some(log);
+                        }
+                    });
+                }
+            })
+            .unwrap();
+        assert!(!wake, "tick {i}: a drained ring asks for no wake");
         let (got, at) = links.commands.pop().expect("one command per tick");
         assert_eq!(got, want, "tick {i}");
         assert_eq!(at, now);
+        assert_eq!(links.commands.next_deadline(), Some(now + tick));
         assert!(links.commands.pop().is_none());
         let flags = (want.active, want.finished, want.fault);
         let snap = links.state.take();
@@ -544,7 +547,8 @@ fn the_tick_threads_counters_take_the_longest_period_and_work() {
     // Starts at 0, 1 ms, 4 ms, 5 ms; work 200, 700, 100, 300 µs.
     for (start, work) in [(0, 200), (1_000, 700), (4_000, 100), (5_000, 300)] {
         let now = t0 + us(start);
-        end.tick(&mut l, &links, now, |_| {}).unwrap();
+        end.tick(&mut l, &links, now, now + us(1_000), |_| {})
+            .unwrap();
         end.account(&links, now + us(work));
         while links.commands.pop().is_some() {}
     }

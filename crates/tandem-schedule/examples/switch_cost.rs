@@ -17,8 +17,8 @@ use std::process::ExitCode;
 
 use serde::Deserialize;
 use tandem_schedule::{
-    ExactParams, Outcome, Problem, SamplerParams, Schedule, sample_schedule, switch_charged_bound,
-    validate,
+    ExactParams, Outcome, Problem, SamplerParams, Schedule, drag_charged_bound, sample_schedule,
+    switch_charged_bound, validate,
 };
 
 /// The fields read from a plan file.
@@ -64,6 +64,7 @@ fn one(path: &str) -> Result<serde_json::Value, String> {
     let tick_s = s.tick_s;
     let exact = ExactParams::default();
     let bound = switch_charged_bound(p, &exact, tick_s).map_err(|e| format!("{path}: {e}"))?;
+    let drag = drag_charged_bound(p, &exact, tick_s).map_err(|e| format!("{path}: {e}"))?;
     let plan_rooms = switches(p, s);
     let run = |params: SamplerParams| {
         sample_schedule(p, &params, None).map_err(|e| format!("{path}: {e}"))
@@ -98,6 +99,8 @@ fn one(path: &str) -> Result<serde_json::Value, String> {
         "switch_charged_s": bound.lower_bound_s,
         "charged": bound.charged,
         "charge_s": bound.charge_s,
+        "drag_charged_s": drag.lower_bound_s,
+        "drag_max_charge_s": drag.max_charge_s,
         "scratch": summary(p, &default),
         "checks_x8": summary(p, &more_checks),
         "samples_50000": summary(p, &sampled),

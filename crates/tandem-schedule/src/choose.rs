@@ -44,6 +44,8 @@ use crate::stagger;
 use crate::validate::{Violation, validate_with_switch};
 use crate::{Error, Result};
 
+mod room;
+
 /// Where the returned schedule came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Source {
@@ -560,11 +562,11 @@ fn repaired(
     (best, first_why)
 }
 
-/// The room-aware candidates' extra rooms, in units of the switch time `δ`: a switch into a
-/// stretch behind a high-confidence run with no usable hold needs the robot's fastest arrival
-/// `δ + c·δ` after the previous stretch ends, `c` tried in this order
-/// ([`exact::room_aware_many`]; docs/decisions.md, "Three robots at δ ≥ 1 s: a room-aware order
-/// (issue 41)").
+/// The room-aware candidates' extra rooms in units of the switch time `δ`, beside the rooms
+/// the check asks (`room::room_from_slacks`): a switch into a stretch behind a high-confidence
+/// run with no usable hold needs the robot's fastest arrival `δ + c·δ` after the previous
+/// stretch ends ([`exact::room_aware_many`]; docs/decisions.md, "Three robots at δ ≥ 1 s: a
+/// room-aware order (issue 41)", "Three robots at δ ≥ 1 s: the room the check asks (issue 41)").
 const ROOM_STEPS: [f64; 4] = [0.0, 0.5, 1.0, 2.0];
 
 /// Node budget of each room-aware search (a quarter of the bound's own, [`exact::MAX_SEARCH_NODES`]).
@@ -1102,27 +1104,20 @@ fn schedule_n(
         }
     }
     // N ≥ 3 with a switch time: room-aware orders, where a switch into a stretch behind a
-    // high-confidence run with no usable hold costs `c·δ` beyond `δ` (`c` of `ROOM_STEPS`,
-    // the first whose schedule passes wins), each dwelled with release rules as the optimum
+    // high-confidence run with no usable hold needs the robot's fastest arrival `δ + e` after
+    // the previous stretch ends, `e` from 0 up over the rooms the check asks and `ROOM_STEPS`
+    // (the first that passes, then bisected), each dwelled with release rules as the optimum
     // above, then re-timed with clearances; judged by the unchanged check (docs/decisions.md,
-    // "Three robots at δ ≥ 1 s: a room-aware order (issue 41)"). Not at `δ = 0`.
-    if plan.bound == BoundBy::Many && sw > 0.0 {
-        for c in ROOM_STEPS {
-            let Some(order) =
-                exact::room_aware_many(problem, n_robots, sw, c * sw, best.1, ROOM_NODES, tick_s)
-            else {
-                continue;
-            };
-            let Some((s, t)) = settle_room_aware(problem, order, tick_s, best.1, sw, &mut checks)
-            else {
-                continue;
-            };
-            if capping {
-                pool.push((s.clone(), t, Source::Held));
-            }
-            best = (s, t, Source::Held);
-            break;
+    // "Three robots at δ ≥ 1 s: the room the check asks (issue 41)"). Not at `δ = 0`.
+    if plan.bound == BoundBy::Many
+        && sw > 0.0
+        && let Some((s, t)) =
+            room::room_from_slacks(problem, n_robots, tick_s, best.1, sw, &mut checks)
+    {
+        if capping {
+            pool.push((s.clone(), t, Source::Held));
         }
+        best = (s, t, Source::Held);
     }
     // The staggered candidate, always (its checks see all robots: at most
     // `MAX_STAGGER_CHECKS` of them). Before, it ran only when nothing beat the serial

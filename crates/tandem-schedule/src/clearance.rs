@@ -59,48 +59,30 @@ pub(crate) fn pair_cleared(
     max_checks: usize,
     switch_s: f64,
 ) -> (Option<(Schedule, f64)>, usize) {
-    let dt_s = problem.dt_s();
     let grow_s = max_step_s(problem, tick_s) / 10.0;
-    let lc_starts: Vec<usize> = problem
-        .runs()
-        .iter()
-        .filter(|r| !r.high_conf)
-        .map(|r| r.start)
-        .collect();
-    let mut extra: BTreeMap<RunPair, f64> = BTreeMap::new();
-    let mut checks = 0;
-    while checks < max_checks {
-        let pairs: Vec<PairClearance> = extra
-            .iter()
-            .map(|(&(prev, cur), &extra_s)| PairClearance { prev, cur, extra_s })
-            .collect();
-        let Some(s) = retime_with_pairs(problem, optimum, tick_s, 0.0, &pairs, true) else {
-            break;
-        };
-        let t = s.t_total_s(dt_s);
-        if t >= cap_s {
-            break;
-        }
-        checks += 1;
-        let Some(measured) = measure(problem, &s, tick_s, &lc_starts) else {
-            break;
-        };
-        let failing: Vec<Measured> = measured.into_iter().filter(|m| m.2 <= 0.0).collect();
-        if failing.is_empty() {
-            checks += 1;
-            if validate_with_switch(problem, &s, switch_s).is_ok() {
-                return (Some((s, t)), checks);
+    let retime =
+        |pairs: &[PairClearance]| retime_with_pairs(problem, optimum, tick_s, 0.0, pairs, true);
+    retime_until_clear(
+        problem,
+        tick_s,
+        cap_s,
+        max_checks,
+        switch_s,
+        retime,
+        |extra, measured| {
+            let failing: Vec<&Measured> = measured.iter().filter(|m| m.2 <= 0.0).collect();
+            if failing.is_empty() {
+                return Next::Check;
             }
-            break;
-        }
-        if failing.iter().any(|m| !m.2.is_finite()) {
-            break;
-        }
-        for (prev, cur, slack_s, _) in failing {
-            *extra.entry((prev, cur)).or_insert(0.0) += -slack_s + grow_s;
-        }
-    }
-    (None, checks)
+            if failing.iter().any(|m| !m.2.is_finite()) {
+                return Next::Stop;
+            }
+            for &&(prev, cur, slack_s, _) in &failing {
+                *extra.entry((prev, cur)).or_insert(0.0) += -slack_s + grow_s;
+            }
+            Next::Retime
+        },
+    )
 }
 
 /// Margin checks [`pair_traded`] may spend on one re-schedule (as [`MAX_PAIR_CHECKS`]).
@@ -132,8 +114,68 @@ pub(crate) fn pair_traded(
     max_checks: usize,
     switch_s: f64,
 ) -> (Option<(Schedule, f64)>, usize) {
-    let dt_s = problem.dt_s();
     let grow_s = max_step_s(problem, tick_s) / 10.0;
+    let retime =
+        |pairs: &[PairClearance]| retime_with_set_pairs(problem, optimum, tick_s, pairs, true);
+    retime_until_clear(
+        problem,
+        tick_s,
+        cap_s,
+        max_checks,
+        switch_s,
+        retime,
+        |clear, measured| {
+            if measured.iter().all(|m| m.2 > 0.0) {
+                return Next::Check;
+            }
+            if measured
+                .iter()
+                .any(|m| !m.2.is_finite() || !m.3.is_finite())
+            {
+                return Next::Stop;
+            }
+            for &(prev, cur, slack_s, room_s) in measured {
+                let set_s = if slack_s <= 0.0 {
+                    room_s - slack_s + grow_s
+                } else if slack_s > grow_s {
+                    room_s - 0.5 * (slack_s - grow_s)
+                } else {
+                    room_s
+                };
+                clear.insert((prev, cur), set_s.max(0.0));
+            }
+            Next::Retime
+        },
+    )
+}
+
+/// What [`retime_until_clear`] does after a measurement.
+enum Next {
+    /// Every measured pair has room: the final check decides.
+    Check,
+    /// Give up (a slack or room that is not finite).
+    Stop,
+    /// Re-time with the clearances as updated.
+    Retime,
+}
+
+/// The loop [`pair_cleared`] and [`pair_traded`] share: re-time `optimum` with the per-pair
+/// clearances of the map (`retime`: empty map first), stop when the re-timing has no solution
+/// or is not below `cap_s` (s), measure every pair's slack ([`measure`]) and let `update`
+/// decide: [`Next::Check`] runs [`validate_with_switch`] at `switch_s` (s) and returns the
+/// re-timing with its `T_total` (s) if it passes (else nothing), [`Next::Retime`] goes round
+/// again with the map `update` changed, [`Next::Stop`] gives up; at most `max_checks`
+/// measurements. Returns the result and the margin checks used (at most `max_checks + 1`).
+fn retime_until_clear(
+    problem: &Problem,
+    tick_s: f64,
+    cap_s: f64,
+    max_checks: usize,
+    switch_s: f64,
+    retime: impl Fn(&[PairClearance]) -> Option<Schedule>,
+    mut update: impl FnMut(&mut BTreeMap<RunPair, f64>, &[Measured]) -> Next,
+) -> (Option<(Schedule, f64)>, usize) {
+    let dt_s = problem.dt_s();
     let lc_starts: Vec<usize> = problem
         .runs()
         .iter()
@@ -147,7 +189,7 @@ pub(crate) fn pair_traded(
             .iter()
             .map(|(&(prev, cur), &extra_s)| PairClearance { prev, cur, extra_s })
             .collect();
-        let Some(s) = retime_with_set_pairs(problem, optimum, tick_s, &pairs, true) else {
+        let Some(s) = retime(&pairs) else {
             break;
         };
         let t = s.t_total_s(dt_s);
@@ -158,28 +200,16 @@ pub(crate) fn pair_traded(
         let Some(measured) = measure(problem, &s, tick_s, &lc_starts) else {
             break;
         };
-        if measured.iter().all(|m| m.2 > 0.0) {
-            checks += 1;
-            if validate_with_switch(problem, &s, switch_s).is_ok() {
-                return (Some((s, t)), checks);
+        match update(&mut clear, &measured) {
+            Next::Check => {
+                checks += 1;
+                if validate_with_switch(problem, &s, switch_s).is_ok() {
+                    return (Some((s, t)), checks);
+                }
+                break;
             }
-            break;
-        }
-        if measured
-            .iter()
-            .any(|m| !m.2.is_finite() || !m.3.is_finite())
-        {
-            break;
-        }
-        for (prev, cur, slack_s, room_s) in measured {
-            let set_s = if slack_s <= 0.0 {
-                room_s - slack_s + grow_s
-            } else if slack_s > grow_s {
-                room_s - 0.5 * (slack_s - grow_s)
-            } else {
-                room_s
-            };
-            clear.insert((prev, cur), set_s.max(0.0));
+            Next::Stop => break,
+            Next::Retime => {}
         }
     }
     (None, checks)

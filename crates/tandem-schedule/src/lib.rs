@@ -83,9 +83,9 @@ pub use cyclic::{
 };
 pub use error::{Error, Result};
 pub use exact::{
-    ExactParams, MarginFree, SearchStats, SwitchCharged, earliest_schedule, margin_free_bound,
-    operator_bound_s, operator_bound_with_switch_s, solve_exact, solve_exact_with_switch,
-    switch_charged_bound,
+    ExactParams, MarginFree, SearchStats, SwitchCharged, drag_charged_bound, earliest_schedule,
+    margin_free_bound, operator_bound_s, operator_bound_with_switch_s, solve_exact,
+    solve_exact_with_switch, switch_charged_bound,
 };
 pub use operator::{busy_share, start_allowance_s};
 pub use problem::Problem;

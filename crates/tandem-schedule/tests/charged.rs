@@ -11,7 +11,8 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use tandem_schedule::testkit;
 use tandem_schedule::{
-    ExactParams, Problem, SamplerParams, Schedule, sample_schedule, switch_charged_bound, validate,
+    ExactParams, Problem, SamplerParams, Schedule, drag_charged_bound, sample_schedule,
+    switch_charged_bound, validate,
 };
 
 /// `tol::BOUND_REL`: how far a correct bound may lie above a valid schedule's `T_total`.
@@ -52,6 +53,15 @@ fn holds_for(p: &Problem, s: &Schedule, tick_s: f64) -> Result<(), TestCaseError
         b.lower_bound_s
     );
     prop_assert!(b.lower_bound_s >= b.margin_free_s);
+    // The drag-lead bound: below the valid schedule too, never below the step-only bound.
+    let d = drag_charged_bound(p, &ExactParams::default(), tick_s).unwrap();
+    prop_assert!(
+        d.lower_bound_s <= t * (1.0 + BOUND_REL),
+        "drag bound {} above a valid schedule's T_total {t} ({d:?})",
+        d.lower_bound_s
+    );
+    prop_assert!(d.lower_bound_s >= b.lower_bound_s, "{d:?} below {b:?}");
+    prop_assert!(d.max_charge_s >= d.charge_s && d.charged == b.charged);
     if b.charged
         && let Some(least) = least_charged_switch(p, s)
     {
@@ -92,6 +102,50 @@ fn three_runs_by_hand() {
     }
 }
 
+/// One LC run between a long head and tail: the drag lead by hand. Head and tail 40 HC
+/// samples with `ψ̇min, ψ̇̄, ψ̇max = 0.9, 0.95, 1.0` (a robot there can hardly slow down), the
+/// run 10 LC samples with `0.5, 1, 4` (its slow rate `S = 1/4`: the operator may drag it to a
+/// quarter of its pace), 10 ms samples and tick. Margin-free: head 0.36 s, run 0.1 s, robot
+/// 2's run right after robot 1's, `T*₀ = 0.46 + 0.1 + 0.36 = 0.92 s`; the step `M = 0.02 s`
+/// gives 0.94 s. Drag: while `p` drags its whole run (slow time `10·0.04 = 0.4 s`) `c` crosses
+/// at least 0.4 s of slow time, i.e. its whole head, planned at least `0.36 s`, plus `M`
+/// before its run: room `0.36 + 0.02 − 0.1 − h = 0.27 s` (entry at the run's start, the
+/// largest). Robot 2 starting inside the run: its head's 0.36 s less what is left of the run
+/// when it starts, least on the first cell, `0.36 − 0.1 − h = 0.25 s`. The pair's room is
+/// 0.25 s: robot 2's run starts at `0.46 + 0.25`, `T = 0.71 + 0.1 + 0.36 = 1.17 s` (waiting
+/// for the exception instead costs `0.46 + 0.82 = 1.28 s`). The check agrees that it is
+/// below every valid schedule: robot 2 starting `δ` before robot 1's exit crosses `4δ` of slow
+/// time, `3.6δ` of planned head, and needs `3.6δ + M < 0.36`, so its room `0.36 − δ` is at
+/// least 0.266 s; the scheduler's schedule is not below the bound.
+#[test]
+fn one_run_drag_by_hand() {
+    let n = 90;
+    let lc = |i: usize| (40..50).contains(&i);
+    let conf: Vec<bool> = (0..n).map(|i| !lc(i)).collect();
+    let pick = |i: usize, h: f64, l: f64| if lc(i) { l } else { h };
+    let p = Problem::new(
+        conf,
+        (0..n).map(|i| pick(i, 0.95, 1.0)).collect(),
+        (0..n).map(|i| pick(i, 0.9, 0.5)).collect(),
+        (0..n).map(|i| pick(i, 1.0, 4.0)).collect(),
+        0.01,
+    )
+    .unwrap();
+    let step = switch_charged_bound(&p, &ExactParams::default(), 0.01).unwrap();
+    assert!((step.margin_free_s - 0.92).abs() < 1e-6, "{step:?}");
+    assert!((step.lower_bound_s - 0.94).abs() < 1e-6, "{step:?}");
+    let d = drag_charged_bound(&p, &ExactParams::default(), 0.01).unwrap();
+    assert!(d.charged);
+    assert!((d.max_charge_s - 0.25).abs() < 1e-6, "{d:?}");
+    assert!((d.lower_bound_s - 1.17).abs() < 1e-6, "{d:?}");
+    let out = sample_schedule(&p, &SamplerParams::default(), None).unwrap();
+    holds_for(&p, &out.schedule, 0.01).unwrap();
+    assert!(out.schedule.t_total_s(p.dt_s()) >= 1.186 - 1e-6);
+    for bad in [0.0, f64::NAN] {
+        assert!(drag_charged_bound(&p, &ExactParams::default(), bad).is_err());
+    }
+}
+
 /// With usable hold points the switches are not charged (the lead bound on legs checks those
 /// schedules): the bound is the margin-free one.
 #[test]
@@ -103,6 +157,8 @@ fn holds_are_not_charged() {
         .unwrap();
     let b = switch_charged_bound(&p, &ExactParams::default(), 0.01).unwrap();
     assert!(!b.charged && b.charge_s == 0.0 && b.lower_bound_s == b.margin_free_s);
+    let d = drag_charged_bound(&p, &ExactParams::default(), 0.01).unwrap();
+    assert_eq!(d, b);
 }
 
 /// Random small problems: 1–6 runs of 1–9 samples, high confidence with probability 0.65.
@@ -151,4 +207,28 @@ proptest! {
         let out = sample_schedule(&p, &params, None).unwrap();
         holds_for(&p, &out.schedule, tick_s)?;
     }
+}
+
+/// The zoo's painting task (selection seed 3 after 30 rounds, one LC run of 7.78 s): the
+/// drag-lead bound lies between the step-only bound and the best valid schedule known
+/// (35.258 s, the fastest warps at the least offset the check accepts,
+/// `tests/single_switch.rs`).
+#[test]
+fn zoo_painting_drag_bound() {
+    #[derive(serde::Deserialize)]
+    struct Data {
+        problem: Problem,
+        tick_s: f64,
+    }
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/zoo_painting_select3_round30.json"
+    ))
+    .unwrap();
+    let Data { problem: p, tick_s } = serde_json::from_str(&text).unwrap();
+    let step = switch_charged_bound(&p, &ExactParams::default(), tick_s).unwrap();
+    let d = drag_charged_bound(&p, &ExactParams::default(), tick_s).unwrap();
+    eprintln!("step {step:?}\ndrag {d:?}");
+    assert!(d.lower_bound_s >= step.lower_bound_s);
+    assert!(d.lower_bound_s <= 35.258);
 }

@@ -524,12 +524,7 @@ impl ContinuousCoordinator {
     /// # Errors
     /// [`Error::BadParam`] for a `max_busy_share` not in `(0, 1]`.
     pub fn with_max_busy_share(mut self, max_busy_share: f64) -> Result<ContinuousCoordinator> {
-        if !(max_busy_share > 0.0 && max_busy_share <= 1.0) {
-            return Err(Error::BadParam {
-                name: "max_busy_share",
-                why: "must be in (0, 1]: the operator's busy share cap (1: no cap)",
-            });
-        }
+        super::pace::check_max_busy_share(max_busy_share)?;
         if (self.m > 1 || self.sectors.is_some()) && max_busy_share < 1.0 {
             return Err(Error::BadParam {
                 name: "max_busy_share",

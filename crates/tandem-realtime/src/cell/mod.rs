@@ -138,7 +138,7 @@ mod coordinator;
 mod groups;
 #[cfg(test)]
 mod liveness;
-mod pace;
+pub(crate) mod pace;
 
 #[allow(deprecated)]
 pub use coordinator::{CellRun, CellTick};

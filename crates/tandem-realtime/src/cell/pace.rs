@@ -27,6 +27,8 @@
 //! arbitrary ticks exceeds `u·W` by at most `(1 − u)` times the busy ticks of the two segments
 //! it cuts.
 
+use crate::error::{Error, Result};
+
 /// The token's pace of a cell with a load cap `u < 1`: the current segment's start and busy
 /// count, and the current episode's start (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -126,10 +128,26 @@ impl Pace {
     }
 }
 
+/// Checks the operator's load cap `u_max` (`max_busy_share`, a share of ticks): it must lie in
+/// `(0, 1]` (1: no cap). The one check of both coordinators' `with_max_busy_share`.
+///
+/// # Errors
+/// [`Error::BadParam`] naming `max_busy_share` otherwise.
+pub(crate) fn check_max_busy_share(max_busy_share: f64) -> Result<()> {
+    if max_busy_share > 0.0 && max_busy_share <= 1.0 {
+        Ok(())
+    } else {
+        Err(Error::BadParam {
+            name: "max_busy_share",
+            why: "must be in (0, 1]: the operator's busy share cap (1: no cap)",
+        })
+    }
+}
+
 /// `n(β)`: the least whole number of ticks `n` with `β ≤ u·n` as computed in floating point
 /// (`u = cap` in `(0, 1]`), so that `β` busy ticks in `n` are a share of at most `u` as a run
 /// measures it. 0 for `β = 0`.
-pub(super) fn ticks_for_share(busy: u64, cap: f64) -> u64 {
+pub(crate) fn ticks_for_share(busy: u64, cap: f64) -> u64 {
     let b = busy as f64;
     // The quotient rounded up, then corrected by whole ticks either way if the product says so
     // (the division may round across an integer).

@@ -20,9 +20,11 @@
 //! **The search** ([`mixed_cyclic_plan`]). Ratios `r ∈ {1..R}^N` are taken in decreasing
 //! order of the throughput their bound allows ([`mixed_period_lower_bound_s`]); for each, an
 //! order of whole groups (runnable: a robot never waits for the operator between two
-//! stretches without a usable hold between them) is built greedily (the group whose start
-//! could come first next) and improved by swapping neighbouring groups of different robots
-//! while the period falls. The search stops when the best plan found completes at least as
+//! stretches without a usable hold between them) is built twice — greedily (the group whose
+//! start could come first next) and spread (each robot's groups at the fraction of its task
+//! where they start, so a short robot's groups fall between a long robot's) — and each is
+//! improved by an insertion search (every group moved to the position of the least period
+//! its robot's order allows, passes repeated while the period falls). The search stops when the best plan found completes at least as
 //! many tasks per hour as the next ratios' bound allows (no plan with them does better), or
 //! after [`MixedParams::max_ratio_candidates`] ratios.
 //!
@@ -54,12 +56,14 @@ const MAX_RATIO_VECTORS: usize = 65_536;
 #[derive(Clone, Debug, PartialEq)]
 pub struct MixedParams {
     /// `R`: the most tasks of one robot per period (`1..=MAX_MIX_RATIO`; lowered so that
-    /// `R^N ≤ 65 536`). Default 4.
+    /// `R^N ≤ 65 536`). Default 6 (docs/decisions.md, "The mixed cyclic plan near its best
+    /// bound: the insertion search and ratios up to 6 (issue 45)").
     pub max_ratio: usize,
     /// The most ratio vectors whose order is searched (the ones whose bound allows the most
     /// tasks per hour first). Must be ≥ 1. Default 12.
     pub max_ratio_candidates: usize,
-    /// The most periods computed per ratio vector by the swap search. Default 600.
+    /// The most periods computed per ratio vector by the order search (the insertion search
+    /// from two starting orders, [`mixed_cyclic_plan`]). Default 600.
     pub max_evaluations: usize,
     /// The control tick (real s) of the cell that runs the plan: counts the token rule's
     /// hand-overs as [`crate::CyclicParams::handover_tick_s`] does. `None`: the operator's
@@ -78,7 +82,7 @@ pub struct MixedParams {
 impl Default for MixedParams {
     fn default() -> Self {
         MixedParams {
-            max_ratio: 4,
+            max_ratio: 6,
             max_ratio_candidates: 12,
             max_evaluations: 600,
             handover_tick_s: None,
@@ -573,8 +577,108 @@ type Block = (usize, usize, usize);
 /// the ratios r_k, the order's blocks, the period P in s)`.
 type BestRatio = (f64, usize, Vec<usize>, Vec<Block>, f64);
 
-/// The best order found for one ratio vector: greedy, then neighbouring swaps of groups of
-/// different robots (cyclically) while the period falls, at most `max_evaluations` periods.
+/// The spread order of groups: every robot's groups placed by the fraction of its repeated
+/// task at which each starts (its own chain at the fastest: the start of the group's first
+/// stretch over the repeated task's fastest duration), merged in that order (ties: the lower
+/// robot first). A short robot's groups then fall between the long robot's evenly over the
+/// period, where the greedy order puts them all at the head while the short robot is ready.
+fn spread_blocks(supers: &[TaskShape], groups: &[Vec<(usize, usize)>]) -> Vec<Block> {
+    let mut keyed: Vec<(f64, usize, Block)> = Vec::new();
+    for (r, (shape, gs)) in supers.iter().zip(groups).enumerate() {
+        let total = shape.fastest_s();
+        // The start of stretch k on the robot's own chain at the fastest.
+        let mut t = shape.gaps[0].min_s;
+        let mut starts = Vec::with_capacity(shape.n_lc());
+        for k in 0..shape.n_lc() {
+            if k > 0 {
+                t += shape.lc_s[k - 1] + shape.gaps[k].min_s;
+            }
+            starts.push(t);
+        }
+        for &(first, last) in gs {
+            let key = if total > 0.0 {
+                starts[first] / total
+            } else {
+                0.0
+            };
+            keyed.push((key, r, (r, first, last)));
+        }
+    }
+    keyed.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    keyed.into_iter().map(|(_, _, b)| b).collect()
+}
+
+/// `a` strictly shorter than `b` (`None`: no period admits the order).
+fn shorter(a: Option<f64>, b: Option<f64>) -> bool {
+    match (a, b) {
+        (Some(a), Some(b)) => a < b * (1.0 - 1e-12),
+        (Some(_), None) => true,
+        _ => false,
+    }
+}
+
+/// Local search on an order of groups by *insertion*: each block in turn is moved to every
+/// position its robot's order allows (past the neighbouring blocks of other robots, up to the
+/// robot's previous and next block, cyclically; one step is the neighbouring swap), and kept
+/// at the position of the least period; passes repeat while the period falls, at most
+/// `budget` periods computed. Returns the period and the periods computed.
+fn insertion_search(
+    supers: &[TaskShape],
+    blocks: &mut [Block],
+    mut best: Option<f64>,
+    params: &MixedParams,
+    budget: usize,
+) -> Result<(Option<f64>, usize)> {
+    let len = blocks.len();
+    let mut evals = 0;
+    if len < 2 {
+        return Ok((best, evals));
+    }
+    let mut improved = true;
+    while improved && evals < budget {
+        improved = false;
+        for q0 in 0..len {
+            // Moves of the block at q0 forward (dir 1) and backward (dir len − 1), one step
+            // at a time; the block's best position is kept.
+            for dir in [1, len - 1] {
+                let mut q = q0;
+                let mut at_best = q0;
+                let mut moved = 0;
+                while moved + 1 < len && evals < budget {
+                    let q2 = (q + dir) % len;
+                    if blocks[q2].0 == blocks[q].0 {
+                        break;
+                    }
+                    blocks.swap(q, q2);
+                    q = q2;
+                    moved += 1;
+                    evals += 1;
+                    let p = period_of_blocks(supers, blocks, params)?;
+                    if shorter(p, best) {
+                        best = p;
+                        at_best = q;
+                        improved = true;
+                    }
+                }
+                // Back from q to at_best (the swaps undone in reverse).
+                let back = (dir * (len - 1)) % len;
+                while q != at_best {
+                    let q2 = (q + back) % len;
+                    blocks.swap(q, q2);
+                    q = q2;
+                }
+                if at_best != q0 {
+                    break;
+                }
+            }
+        }
+    }
+    Ok((best, evals))
+}
+
+/// The best order found for one ratio vector: from the greedy order and from the spread
+/// order ([`spread_blocks`]), each improved by the insertion search
+/// ([`insertion_search`]), at most `max_evaluations` periods computed in all (half each).
 fn search_order(
     supers: &[TaskShape],
     params: &MixedParams,
@@ -583,41 +687,32 @@ fn search_order(
         .iter()
         .map(|s| groups_of_shape(s, params.runnable_only))
         .collect();
-    let mut blocks = greedy_blocks(supers, &groups, params);
-    let mut evals = 1;
-    let mut best = period_of_blocks(supers, &blocks, params)?;
-    let len = blocks.len();
-    if len < 2 {
-        return Ok(best.map(|p| (blocks, p, evals)));
-    }
-    let mut improved = true;
-    while improved && evals < params.max_evaluations {
-        improved = false;
-        for q in 0..len {
-            if evals >= params.max_evaluations {
-                break;
-            }
-            let q2 = (q + 1) % len;
-            if blocks[q].0 == blocks[q2].0 {
-                continue;
-            }
-            blocks.swap(q, q2);
-            evals += 1;
-            let p = period_of_blocks(supers, &blocks, params)?;
-            let better = match (p, best) {
-                (Some(p), Some(b)) => p < b * (1.0 - 1e-12),
-                (Some(_), None) => true,
-                _ => false,
-            };
-            if better {
-                best = p;
-                improved = true;
-            } else {
-                blocks.swap(q, q2);
-            }
+    let starts = [
+        greedy_blocks(supers, &groups, params),
+        spread_blocks(supers, &groups),
+    ];
+    let mut evals = 0;
+    let mut out: Option<(Vec<Block>, f64)> = None;
+    for (i, mut blocks) in starts.into_iter().enumerate() {
+        if i > 0 && evals >= params.max_evaluations {
+            break;
+        }
+        let p0 = period_of_blocks(supers, &blocks, params)?;
+        evals += 1;
+        let budget = if i == 0 {
+            params.max_evaluations / 2
+        } else {
+            params.max_evaluations.saturating_sub(evals)
+        };
+        let (p, e) = insertion_search(supers, &mut blocks, p0, params, budget)?;
+        evals += e;
+        if let Some(p) = p
+            && out.as_ref().is_none_or(|o| shorter(Some(p), Some(o.1)))
+        {
+            out = Some((blocks, p));
         }
     }
-    Ok(best.map(|p| (blocks, p, evals)))
+    Ok(out.map(|(b, p)| (b, p, evals)))
 }
 
 /// The cyclic plan of a continuous cell whose robot `k` does the task of `problems[k]`
@@ -932,7 +1027,11 @@ mod tests {
         // 6400/h (2.25 s), (1, 4) 6000/h, (1, 2) and (2, 4) 5400/h: after (1, 2) reaches
         // 5400/h no other can beat it.
         let (a, b) = (task(100, 100), task(50, 25));
-        let plan = mixed_cyclic_plan(&[&a, &b], &MixedParams::default()).unwrap();
+        let r4 = MixedParams {
+            max_ratio: 4,
+            ..MixedParams::default()
+        };
+        let plan = mixed_cyclic_plan(&[&a, &b], &r4).unwrap();
         assert_eq!(plan.ratios, [1, 2]);
         assert!((plan.period_s - 2.0).abs() < 1e-9, "{}", plan.period_s);
         assert!((plan.tasks_per_hour - 5400.0).abs() < 1e-6);
@@ -1078,6 +1177,7 @@ mod tests {
         let (a, b) = (task(100, 100), task(50, 25));
         let params = MixedParams {
             handover_tick_s: Some(0.01),
+            max_ratio: 4,
             ..MixedParams::default()
         };
         let plan = mixed_cyclic_plan(&[&a, &b], &params).unwrap();
@@ -1106,5 +1206,67 @@ mod tests {
             }
         }
         panic!("robot 0 did not complete 40 tasks");
+    }
+
+    /// A long task of five low-confidence runs with a hold in every gap between them, at
+    /// 10 ms, `ψ̇̄ = 1`, `ψ̇min = 0.5`: head 0.5 s, runs of 1 s, gaps of 1 s, tail 0.5 s
+    /// (`D = 10` s, `L = 5` s); beside it a short task 0.25 + 0.5 + 0.25 s (`D = 1` s,
+    /// `L = 0.5` s) without holds.
+    fn long_and_short() -> (Problem, Problem) {
+        let (mut conf, mut holds) = (vec![true; 100], Vec::new());
+        for j in 0..5 {
+            conf.extend([false; 100]);
+            if j < 4 {
+                holds.push(conf.len() + 100);
+                conf.extend([true; 200]);
+            }
+        }
+        conf.extend([true; 100]);
+        let n = conf.len();
+        let a = Problem::new(conf, vec![1.0; n], vec![0.5; n], vec![2.0; n], 0.01)
+            .unwrap()
+            .with_holds(holds)
+            .unwrap();
+        (a, task(50, 50))
+    }
+
+    #[test]
+    fn the_short_robots_groups_go_into_the_long_robots_gaps() {
+        // Ratios ≤ 4: every r = (1, q) has the bound max(5 + 0.5·q, 10, q) = 10 s, so (1, 4)
+        // allows the most, 5 tasks per 10 s = 1800/h. It is reached: the long robot runs at
+        // its fastest, runs at [0.5, 1.5], [2.5, 3.5], … [8.5, 9.5] s, and the short robot's
+        // four stretches fill its four gaps, [1.5, 2], [3.5, 4], [5.5, 6], [7.5, 8] s (2 s
+        // apart ≥ its 1 s chain; it waits at its task start, a hold). So the plan is
+        // optimal. The greedy order with neighbouring swaps stopped at 10.5 s (1714/h): the
+        // greedy order starts the short robot first and the swaps could not move its
+        // stretches by more than one group.
+        let (a, b) = long_and_short();
+        let params = MixedParams {
+            max_ratio: 4,
+            ..MixedParams::default()
+        };
+        let plan = mixed_cyclic_plan(&[&a, &b], &params).unwrap();
+        assert_eq!(plan.ratios, [1, 4]);
+        assert!(
+            (plan.lower_bound_s - 10.0).abs() < 1e-9,
+            "{}",
+            plan.lower_bound_s
+        );
+        assert!((plan.period_s - 10.0).abs() < 1e-9, "{}", plan.period_s);
+        assert!((plan.tasks_per_hour - 1800.0).abs() < 1e-6);
+        assert_sound(&plan, &[TaskShape::new(&a), TaskShape::new(&b)]);
+        // The operator alternates: one short stretch between two long ones, four times.
+        let robots: Vec<usize> = plan.order.iter().map(|s| s.robot).collect();
+        let switches = (0..robots.len())
+            .filter(|&q| robots[q] != robots[(q + 1) % robots.len()])
+            .count();
+        assert_eq!(switches, 8, "{robots:?}");
+        // Ratios up to 6: the short robot fits one stretch into each gap and one into the
+        // long robot's tail and head (1 s): (1, 5) at 10 s, 2160/h, on its bound; (1, 6)
+        // has the bound 10 s too (2520/h) but no sixth slot: the plan is at least (1, 5)'s.
+        let plan = mixed_cyclic_plan(&[&a, &b], &MixedParams::default()).unwrap();
+        assert!(plan.tasks_per_hour >= 2160.0 - 1e-6, "{plan:?}");
+        assert!(plan.ratios[1] >= 5);
+        assert_sound(&plan, &[TaskShape::new(&a), TaskShape::new(&b)]);
     }
 }

@@ -161,6 +161,7 @@
 mod build;
 mod chain;
 mod complete;
+mod drag;
 mod many;
 mod pl;
 mod search;
@@ -521,6 +522,11 @@ pub struct SwitchCharged {
     /// LC sample)`, the least step of the margin check (0 when [`SwitchCharged::charged`] is
     /// `false`).
     pub charge_s: f64,
+    /// The largest room (s) one switch was charged: [`SwitchCharged::charge_s`] for
+    /// [`switch_charged_bound`], the largest entry of the drag-lead table for
+    /// [`drag_charged_bound`] (0 when not charged).
+    #[serde(default)]
+    pub max_charge_s: f64,
     /// Whether the switches were charged: `false` for a problem with usable hold points (its
     /// schedules are checked by the lead bound on legs with release rules, for which the
     /// argument below is not made), without LC runs, or when a search ran out of its budget;
@@ -572,6 +578,7 @@ pub fn switch_charged_bound(
         lower_bound_s: free,
         margin_free_s: free,
         charge_s: 0.0,
+        max_charge_s: 0.0,
         charged: false,
     };
     let chain = chain::Chain::new(problem);
@@ -588,9 +595,112 @@ pub fn switch_charged_bound(
             lower_bound_s: found.t_total_s.max(free),
             margin_free_s: free,
             charge_s,
+            max_charge_s: charge_s,
             charged: true,
         }),
         _ => Ok(plain),
+    }
+}
+
+/// The two-robot bound of [`switch_charged_bound`] with every switch charged the *drag lead*
+/// on top of the check's step: per pair `(j, k)` of LC runs (robot `p` leaves run `j`, the
+/// other robot `c` enters run `k` next on the operator) the least room `T_c − T_p` (s,
+/// schedule clock) that any placement of the two robots the check accepts keeps, as a
+/// clearance table of the same exact search (docs/decisions.md, "Two robots: a bound that
+/// charges the drag lead (issue 38)"). [`SwitchCharged::charge_s`] is the step `M` as there;
+/// [`SwitchCharged::max_charge_s`] the largest entry of the table.
+///
+/// **Why it is a lower bound** on every two-robot schedule without usable holds that
+/// [`crate::validate`] accepts at `tick_s` (`h`). Notation: sample `n` is planned at
+/// `d_n = ψ̇_E[n]·Δt` (s) with `ψ̇min ≤ ψ̇_E ≤ ψ̇max` on HC samples (Eq. 20 constraint 1) and
+/// `ψ̇_E = ψ̇̄` on LC samples (constraint 4); `fast(u, v)`, `slow(u, v)`, `mean(u, v)` sum
+/// `ψ̇min·Δt`, `ψ̇max·Δt`, `ψ̇̄·Δt` over the reference between positions `u` and `v`. The slow
+/// rate of Eq. 17 is `S = ψ̇_E/ψ̇max`, so a clock moving at `S·h` per tick through sample `n`
+/// spends `ψ̇max[n]·Δt` real seconds per sample: its *slow time*, fixed by the problem.
+/// Take a pair `(p, c)` the check accepts by simulation (not the exception) and an entry point
+/// `a`, the clock of `p` at position `q` of run `j` (ending at `e_j`, `T_p`).
+/// 1. While `p`'s window holds its LC samples and `c`'s holds none, the two-robot simulation
+///    (`tandem_realtime::margins`, fixes 1–4) has one branch, `p` dragging: `p` moves
+///    `S_p^w·h` with `S_p^w` the least `S` of its window, `c` responds (Eq. 18) by at least
+///    `S_c^w·h`, the largest `S` of its window. Both steps are at most `M` (`M` ≥ every step)
+///    and the windows reach `M + ε` around the clocks, so every sample a step touches has
+///    `S_p ≥ S_p^w` (p) and `S_c ≤ S_c^w` (c): `p` spends at least, `c` at most, the slow
+///    time of what it crosses. Over the ticks from the last one with `p`'s clock at or before
+///    `a` (at most one step, `≤ h`, before `a`) to the exit (`p`'s clock past `T_p`), `p`
+///    crosses `[q, e_j]`, slow time `R = slow(q, e_j)`, so `c` crosses at least `R` of slow
+///    time: from `y` to its exit position `x` with `y ≤ Y_R(x)` (`slow(Y_R(x), x) = R`).
+/// 2. The lead `t_c − t_p` is never negative (the argument of [`switch_charged_bound`]), so
+///    `c`'s clock at the first of those ticks is at least `a − h`, and at acceptance
+///    `t_c + M < T_c − ε` with `M ≥ M_lo`. Hence `T_c ≥ a − h + planned(y, g₁)` with
+///    `planned(y, g₁) ≥ fast(Y_R(x), x) + max(M_lo, fast(x, g₁))` (`g₁` run `k`'s start), and
+///    `T_c − T_p ≥ Φ_k(R) − (1 + rel)·mean(q, e_j) − h`, `Φ_k` the least of that over `x` in
+///    gap `k` (`drag::least_before`).
+/// 3. If `c`'s window still held its previous run `k − 1` at the first tick, the one branch
+///    begins later, when `c` is at most `2M + ε` past that run's end:
+///    `T_c − T_p ≥ fast(gap k) − 2M − ε − (1 + rel)·mean(q, e_j) − h` (`M ≤ M_hi`, every
+///    sample at its largest fast rate). The lesser of 2 and 3 holds for every `a`: the room is
+///    at least the largest over `a`.
+/// 4. `k = 0` with robot 2 as `c`: if robot 2 starts at `τ` inside run `j` (before `τ` the
+///    rule does not apply, after `T_p` it is the exception), the simulation begins at `τ`
+///    with both clocks there, so 1–2 hold from `a = τ` only, and robot 2's head takes at
+///    least `fast(head)`: `T_c − T_p ≥ max(Φ₀(R(τ)), fast(head)) − (1 + rel)·mean(τ, e_j) − h`,
+///    bounded on each cell of entry points by its least value there; the pair's room is the
+///    lesser of that over every cell and the bound of 1–3 (robot 2 started before run `j`, or
+///    robot 1 as `c`).
+///
+/// So every accepted schedule is a feasible point of the margin-free problem with this table
+/// (and the step `M` at least, [`switch_charged_bound`]), and the exact search's optimum (a
+/// relaxation, `τ ≤ |ψ_E1|` left out) is at most its `T_total`. Not claimed with usable holds
+/// (then `charged = false` and the bound is the margin-free one).
+///
+/// # Errors
+/// [`Error::BadParam`] for invalid parameters or a `tick_s` not finite and > 0.
+pub fn drag_charged_bound(
+    problem: &Problem,
+    params: &ExactParams,
+    tick_s: f64,
+) -> Result<SwitchCharged> {
+    let step = switch_charged_bound(problem, params, tick_s)?;
+    if !step.charged {
+        return Ok(step);
+    }
+    let chain = chain::Chain::new(problem);
+    let rel = tandem_realtime::tol::GRADIENT_REL;
+    let (gmean, gmin, gmax) = (problem.grad_mean(), problem.grad_min(), problem.grad_max());
+    let fastest_rate = (0..problem.n_ref())
+        .map(|n| {
+            if problem.conf()[n] {
+                gmax[n] / gmin[n]
+            } else {
+                gmean[n] / gmin[n]
+            }
+        })
+        .fold(1.0, f64::max);
+    // The check's `ε` (`4·CLOCK_REL·scale`), for schedules within ten times the slowest
+    // serial execution (a longer one is above the bound anyway).
+    let eps_s = 4.0 * tandem_realtime::tol::CLOCK_REL * (20.0 * chain.slowest_s() + tick_s + 1.0);
+    let dp = drag::DragParams {
+        step_lo_s: step.charge_s,
+        step_hi_s: tick_s * fastest_rate * (1.0 + rel) + eps_s,
+        tick_s,
+        rel,
+    };
+    let room = drag::drag_room(problem, &chain, &dp);
+    let max_charge_s = room.values().fold(step.charge_s, |a, &b| a.max(b));
+    let clear = search::Clearance {
+        pairs: room
+            .into_iter()
+            .map(|(pair, r)| (pair, r.max(step.charge_s)))
+            .collect(),
+        ..search::Clearance::uniform(step.charge_s, Some(0.0))
+    };
+    match search::search(&chain, &clear, f64::INFINITY, params.max_pieces).0 {
+        search::Outcome::Done(Some(found)) => Ok(SwitchCharged {
+            lower_bound_s: found.t_total_s.max(step.lower_bound_s),
+            max_charge_s,
+            ..step
+        }),
+        _ => Ok(step),
     }
 }
 

@@ -60,6 +60,13 @@ pub struct RoundStats {
     /// Left out of the JSON when 0, as it always is without a switch time.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub switch_missed: usize,
+    /// The operator's rest after the round (s) under the load cap `u_max < 1` (issue 41;
+    /// [`RoundRun::rest_ticks`](crate::workcell::RoundRun::rest_ticks) times the tick): the
+    /// next round starts that long after this one ended. The operator's busy share over the
+    /// round and its rest is at most `u_max`. Left out of the JSON when 0, as it always is
+    /// without a cap.
+    #[serde(default, skip_serializing_if = "is_zero_s")]
+    pub rest_s: f64,
 }
 
 /// Deprecated: [`RoundStats`] under its two-robot name. Kept for one release at the crate's
@@ -74,6 +81,15 @@ pub type PairStats = RoundStats;
 )]
 fn is_zero(n: &usize) -> bool {
     *n == 0
+}
+
+/// Whether a time is 0 (for `skip_serializing_if`).
+#[expect(
+    clippy::trivially_copy_pass_by_ref,
+    reason = "serde passes the field by reference"
+)]
+fn is_zero_s(s: &f64) -> bool {
+    *s == 0.0
 }
 
 /// One iteration of a trial: a schedule and what running it gave.
@@ -490,6 +506,7 @@ mod tests {
                 },
                 needed_unsupervised: iteration + 3,
                 switch_missed: 0,
+                rest_s: 0.0,
             }),
             lower_bound_s: t_total_s - 1.0,
             bound_is_optimum: iteration == 0,

@@ -363,6 +363,7 @@ fn round_stats(run: &workcell::RoundRun, needed: &[Vec<bool>]) -> RoundStats {
         plan_gap: run.plan_gap,
         needed_unsupervised: run.needed_unsupervised(|robot, n| needed[robot][n]),
         switch_missed: run.robots.iter().map(|r| r.switch_missed).sum(),
+        rest_s: run.rest_ticks as f64 * run.tick_s,
     }
 }
 

@@ -156,6 +156,13 @@ pub struct RoundRun {
     /// All zero in older records.
     #[serde(default)]
     pub plan_gap: PlanGap,
+    /// The operator's rest after the round (control ticks) under the load cap `u_max < 1`
+    /// (issue 41, [`tandem_realtime::Coordinator::rest_ticks`]): the next round starts that
+    /// many ticks after this one ended, so that the operator's busy ticks (low-confidence
+    /// ticks and the switch time per change of robot) are at most `u_max` of the round and
+    /// its rest. 0 without a cap, and then left out of the JSON.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub rest_ticks: usize,
 }
 
 /// Deprecated: [`RoundRun`] under its two-robot name (a round is one execution of each

@@ -329,6 +329,7 @@ pub(super) fn finished_round(
         planned_t_total_s: planned_ends_s.iter().copied().fold(0.0, f64::max),
         planned_ends_s,
         plan_gap: PlanGap::default(),
+        rest_ticks: usize::try_from(coord.rest_ticks()).unwrap_or(usize::MAX),
     };
     round.plan_gap = plan_gap(&round, &plans, corrected_tick);
     round

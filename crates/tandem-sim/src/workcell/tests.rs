@@ -723,6 +723,7 @@ fn a_round_gap_splits_realized_minus_planned_into_its_causes_exactly() {
         planned_t_total_s: 7.0,
         planned_ends_s: vec![4.0, 7.0],
         plan_gap: PlanGap::default(),
+        rest_ticks: 0,
     };
     let plan = |start_s: f64, end_s: f64| RobotPlan {
         start_s,
@@ -1029,5 +1030,52 @@ fn a_round_sim_ticks_the_same_round_as_run_round_with() {
             sim.tick(&small, painted_needs, &mut rng),
             Err(Error::Mismatch { .. })
         ));
+    }
+}
+
+/// The load cap at run time (issue 41; docs/decisions.md, "The load cap in rounds at run time:
+/// the rest after a round (issue 41)"): a planner with `max_busy_share = u` runs its round by
+/// [`run_round_with`] with the coordinator's rest; with no switch time the busy ticks are the
+/// ticks with a low-confidence robot (`ticks − idle_ticks`), and over the round and its rest
+/// they are at most `u`, with the least such rest. Without a cap: no rest, none in the JSON.
+#[test]
+fn a_round_under_the_load_cap_reports_the_rest_that_keeps_it() {
+    for u in [0.3, 1.0] {
+        let params = tandem_planner::PlannerParams {
+            sampler: tandem_schedule::SamplerParams {
+                samples: 50,
+                seed: 3,
+                max_busy_share: u,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let planner = Planner::from_model(model(), params).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let round = run_round_with(
+            &planner,
+            painted_needs,
+            &OperatorParams::default(),
+            &mut rng,
+        )
+        .unwrap();
+        let (busy, ticks, rest) = (
+            (round.ticks - round.idle_ticks) as f64,
+            round.ticks,
+            round.rest_ticks,
+        );
+        let json = serde_json::to_string(&round).unwrap();
+        if u < 1.0 {
+            assert!(busy > 0.0);
+            assert!(
+                busy <= u * (ticks + rest) as f64,
+                "{busy} in {ticks} + {rest}"
+            );
+            assert!(rest == 0 || busy > u * (ticks + rest - 1) as f64);
+            assert_eq!(json.contains("rest_ticks"), rest > 0);
+        } else {
+            assert_eq!(rest, 0);
+            assert!(!json.contains("rest_ticks"));
+        }
     }
 }

@@ -44,7 +44,9 @@ pub struct RunReport {
     #[serde(default)]
     pub margin_free_s: Option<f64>,
     /// The last plan's bound that charges every switch between the two robots' low-confidence
-    /// runs its least margin (s, `tandem_schedule::switch_charged_bound` at the plan's tick): no
+    /// runs its least margin and the drag lead the check must see there (s,
+    /// `tandem_schedule::drag_charged_bound` at the plan's tick; reports saved before it hold
+    /// `switch_charged_bound`, the step alone): no
     /// schedule the margin check accepts is shorter, so `T_total` above it is what the
     /// completion did not find, and it above [`RunReport::margin_free_s`] is what the margins
     /// cost every schedule. Rounds of two robots on a problem without usable hold points only;
@@ -156,7 +158,7 @@ fn switch_charged_s(planner: &Planner, robots: usize, tick_s: f64) -> Option<f64
         return None;
     }
     let exact = tandem_schedule::ExactParams::default();
-    tandem_schedule::switch_charged_bound(planner.problem(), &exact, tick_s)
+    tandem_schedule::drag_charged_bound(planner.problem(), &exact, tick_s)
         .ok()
         .filter(|b| b.charged)
         .map(|b| b.lower_bound_s)
