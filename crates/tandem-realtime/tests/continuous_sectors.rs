@@ -1,6 +1,6 @@
-//! The sectored continuous cell (issue 44; docs/decisions.md, "The continuous cell runs
-//! sectors when their bound is the pooled one's (issue 44)"): operator `o` serves only sector
-//! `o`'s robots by the one-operator rule, so each sector ticks exactly as its own one-operator
+//! The sectored continuous cell (issue 44; docs/decisions.md, "The continuous cell of M
+//! operators: one hand-over per sector, pooled or sectored by measurement (issue 44)"):
+//! operator `o` serves only sector `o`'s robots by the one-operator rule, so each sector ticks exactly as its own one-operator
 //! cell — checked here tick for tick, bit for bit, from the start and across a hand-over — and
 //! at most `M` robots are low-confidence in any tick, each under its sector's operator, under
 //! every operator policy.
@@ -207,6 +207,102 @@ fn a_sectored_hand_over_is_each_sectors_own_hand_over() {
     assert!(handed >= 4, "handed over in {handed} of 8 cases");
 }
 
+/// One hand-over per sector (`take_over_sector`): each sector takes the new plan when its own
+/// robots are at a hand-over point, while the others run on — also while a robot of another
+/// sector is in the middle of a stretch — and takes it exactly as its own one-operator cell's
+/// `take_over` does (the same ticks succeed, and the cells stay equal tick for tick, bit for
+/// bit, across every sector's hand-over and for 1500 ticks after the last).
+#[test]
+fn each_sector_hands_over_on_its_own() {
+    let (mut all, mut mid_stretch) = (0, 0);
+    for seed in 0..8_u64 {
+        let (n, m) = [(4, 2), (8, 4)][seed as usize % 2];
+        let mut c = case(seed, n, m, seed % 2 == 0);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed + 300);
+        tick_alike(&mut c, Policy::RandomExtreme, 300, &mut rng);
+        let gs = groups(c.task.conf(), &c.holds).unwrap();
+        let orders: Vec<Vec<(usize, usize)>> = c
+            .members
+            .iter()
+            .map(|r| random_order(&gs, r.len(), &mut rng))
+            .collect();
+        let sectors: Vec<SectorOrder> = c.members.iter().cloned().zip(orders.clone()).collect();
+        let fresh =
+            ContinuousCoordinator::sectored(c.task.clone(), &c.holds, &sectors, n, c.tick_s)
+                .unwrap()
+                .with_switch_s(c.switch_s)
+                .unwrap();
+        let own_fresh: Vec<ContinuousCoordinator> = (0..m)
+            .map(|o| {
+                ContinuousCoordinator::new(
+                    c.task.clone(),
+                    &c.holds,
+                    &orders[o],
+                    c.members[o].len(),
+                    c.tick_s,
+                )
+                .unwrap()
+                .with_switch_s(c.switch_s)
+                .unwrap()
+            })
+            .collect();
+        let mut taken = vec![false; m];
+        for _ in 0..20_000 {
+            for o in 0..m {
+                if taken[o] {
+                    continue;
+                }
+                let others_lc = c.cell.low_conf_now();
+                let busy_elsewhere =
+                    (0..m).any(|q| q != o && c.members[q].iter().any(|&r| others_lc[r]));
+                let ok = c.cell.take_over_sector(&fresh, o).is_ok();
+                let mut own = own_fresh[o].clone();
+                assert_eq!(
+                    own.take_over(&c.own[o]).is_ok(),
+                    ok,
+                    "seed {seed}: sector {o} hands over where its own cell does"
+                );
+                if ok {
+                    c.own[o] = own;
+                    taken[o] = true;
+                    mid_stretch += usize::from(busy_elsewhere);
+                }
+            }
+            if taken.iter().all(|&t| t) {
+                all += 1;
+                break;
+            }
+            tick_alike(&mut c, Policy::RandomExtreme, 1, &mut rng);
+        }
+        tick_alike(&mut c, Policy::Mixed, 1500, &mut rng);
+    }
+    eprintln!("every sector handed over in {all} of 8 cases, {mid_stretch} hand-overs mid-stretch");
+    assert_eq!(all, 8, "every sector handed over in {all} of 8 cases");
+    // Not vacuous: sectors took their plans while another sector's robot was low-confidence.
+    assert!(
+        mid_stretch >= 4,
+        "{mid_stretch} hand-overs mid-stretch elsewhere"
+    );
+    // Refused by name: a pooled cell, other sectors, a sector without robots.
+    let c = case(1, 4, 2, false);
+    let pooled = ContinuousCoordinator::new(c.task.clone(), &c.holds, &[], 4, c.tick_s);
+    if let Ok(p) = pooled {
+        assert!(matches!(
+            c.cell.clone().take_over_sector(&p, 0),
+            Err(Error::HandOver { .. })
+        ));
+    }
+    let other = case(1, 4, 4, false).cell;
+    assert!(matches!(
+        c.cell.clone().take_over_sector(&other, 0),
+        Err(Error::HandOver { .. })
+    ));
+    assert!(matches!(
+        c.cell.clone().take_over_sector(&c.cell, 2),
+        Err(Error::HandOver { .. })
+    ));
+}
+
 /// Runs a random sectored cell until every robot has done 20 tasks under `policy`, checking
 /// the invariant at every tick: at most `M` robots low-confidence, at most one per sector and
 /// under its sector's operator, no fault, each operator's stretches of different robots more
@@ -217,6 +313,7 @@ fn sectors_sound(
     m: usize,
     policy: Policy,
     switch: bool,
+    replan: bool,
 ) -> Result<(), TestCaseError> {
     let mut c = case(seed, n, m, switch);
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5ec7);
@@ -242,8 +339,37 @@ fn sectors_sound(
     let bound = (25.0 * n as f64 * per_task) as u64 + 1000;
     let mut last_lc: Vec<Option<(usize, u64)>> = vec![None; m];
     let mut ticks = 0_u64;
+    // With `replan`, a new plan (new random orders) every 150 ticks, taken sector by sector
+    // (`take_over_sector`), each sector when its own robots are at a hand-over point.
+    let gs = groups(c.task.conf(), &c.holds).unwrap();
+    let mut pending: Option<(ContinuousCoordinator, Vec<bool>)> = None;
+    let mut sector_hand_overs = 0_u64;
     while c.cell.tasks_completed().iter().any(|&t| t < 20) {
         prop_assert!(ticks < bound, "deadlock? {:?}", c.cell.tasks_completed());
+        if replan && ticks % 150 == 50 {
+            let sectors: Vec<SectorOrder> = c
+                .members
+                .iter()
+                .map(|r| (r.clone(), random_order(&gs, r.len(), &mut rng)))
+                .collect();
+            let next =
+                ContinuousCoordinator::sectored(c.task.clone(), &c.holds, &sectors, n, c.tick_s)
+                    .unwrap()
+                    .with_switch_s(c.switch_s)
+                    .unwrap();
+            pending = Some((next, vec![false; m]));
+        }
+        if let Some((next, taken)) = &mut pending {
+            for (o, t) in taken.iter_mut().enumerate() {
+                if !*t && c.cell.take_over_sector(next, o).is_ok() {
+                    *t = true;
+                    sector_hand_overs += 1;
+                }
+            }
+            if taken.iter().all(|&t| t) {
+                pending = None;
+            }
+        }
         let inputs: Vec<Operator> = (0..m).map(|o| input(policy, o, ticks, &mut rng)).collect();
         let t = c.cell.tick_many(&inputs).unwrap();
         prop_assert!(!t.over(m) && t.fault.is_none(), "tick {ticks}: {t:?}");
@@ -269,6 +395,11 @@ fn sectors_sound(
         }
         ticks += 1;
     }
+    prop_assert!(
+        !replan || ticks < 1000 || sector_hand_overs > 0,
+        "no sector took a new plan in {} ticks",
+        ticks
+    );
     Ok(())
 }
 
@@ -296,8 +427,9 @@ proptest! {
             Just(Policy::Mixed),
         ],
         switch in any::<bool>(),
+        replan in any::<bool>(),
     ) {
-        sectors_sound(seed, n, m, policy, switch)?;
+        sectors_sound(seed, n, m, policy, switch, replan)?;
     }
 }
 

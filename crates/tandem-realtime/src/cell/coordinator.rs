@@ -135,7 +135,7 @@ pub struct ContinuousCoordinator {
 /// One task's plan in a continuous cell and what the token rule reads of it: its timeline
 /// (schedule clock from 0), groups, the schedule clock of each group's gate and leave point,
 /// the next low-confidence sample's clock per sample, the pre-alert's tables.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 struct Plan {
     task: Timeline,
     groups: Vec<Group>,
@@ -706,27 +706,33 @@ impl ContinuousCoordinator {
     /// `N` grants; no allocation.
     fn grant_sectors(&mut self, tick: u64, sec: &Sectors) {
         for o in 0..self.m {
-            let (start, end) = sec.range[o];
-            if start == end {
-                continue;
-            }
-            loop {
-                let (pos, passes) = self.staff.cursor[o];
-                let t = self.tokens[pos];
-                if self.staff.assigned[t.robot].is_some()
-                    || self.next_group[t.robot] != t.group
-                    || self.staff.slot[o].is_some()
-                    || self.op_wait(o, t.robot, tick) > 0
-                {
-                    break;
-                }
-                self.staff.slot[o] = Some((t, pos, passes));
-                self.staff.assigned[t.robot] = Some(o as u8);
-                self.staff.last_op[t.robot] = Some(o as u8);
-                self.staff.cursor[o] = self.sector_after(sec, o, pos, passes);
-            }
+            self.grant_sector(tick, sec, o);
         }
         self.sync_sector_cursors(sec);
+    }
+
+    /// A sectored cell: operator `o`'s grants of [`grant_sectors`](Self::grant_sectors), on
+    /// its range only (touches only operator `o`'s slot and cursor and its sector's robots).
+    fn grant_sector(&mut self, tick: u64, sec: &Sectors, o: usize) {
+        let (start, end) = sec.range[o];
+        if start == end {
+            return;
+        }
+        loop {
+            let (pos, passes) = self.staff.cursor[o];
+            let t = self.tokens[pos];
+            if self.staff.assigned[t.robot].is_some()
+                || self.next_group[t.robot] != t.group
+                || self.staff.slot[o].is_some()
+                || self.op_wait(o, t.robot, tick) > 0
+            {
+                break;
+            }
+            self.staff.slot[o] = Some((t, pos, passes));
+            self.staff.assigned[t.robot] = Some(o as u8);
+            self.staff.last_op[t.robot] = Some(o as u8);
+            self.staff.cursor[o] = self.sector_after(sec, o, pos, passes);
+        }
     }
 
     /// A sectored cell: operator `o`'s entry after `(pos, passes)` in its range (skipping the
@@ -1035,7 +1041,9 @@ impl ContinuousCoordinator {
     }
 
     /// The task plan every robot repeats (schedule clock from 0); in a cell of different
-    /// tasks ([`ContinuousCoordinator::mixed`]) robot 0's ([`task_of`](Self::task_of)).
+    /// tasks ([`ContinuousCoordinator::mixed`]), or a sectored cell whose sectors took their
+    /// new plans one at a time ([`take_over_sector`](Self::take_over_sector)), robot 0's
+    /// ([`task_of`](Self::task_of)).
     pub fn task(&self) -> &Timeline {
         &self.plan(0).task
     }
@@ -1423,41 +1431,7 @@ impl ContinuousCoordinator {
         let mut clock = [0.0; MAX_ROBOTS];
         let mut next = [0usize; MAX_ROBOTS];
         for i in 0..self.n {
-            let (plan, old_task) = (self.plan(i), &old.plan(i).task);
-            let (c, n_groups) = (plan.task.sample_clock_s(), plan.groups.len());
-            // The robot's reference position in `old`, and the same position's clock here.
-            let s_old = old.clock_s[i];
-            // `old`'s cursor is at or before the sample of its clock (it only advances to
-            // the clock, and both reset together), so this is O(1) amortized, not O(position).
-            let mut at = old.cursors[i].at;
-            let n = old_task.advance_cursor(&mut at, s_old);
-            let p = old_task.ref_time_in(n, s_old);
-            let mut s = if p <= 0.0 {
-                0.0
-            } else if p >= plan.task.n_ref() as f64 {
-                plan.task.end_s()
-            } else {
-                let k = p.floor() as usize;
-                c[k] + (p - k as f64) * (c[k + 1] - c[k])
-            };
-            // The interpolation rounds: never place the robot behind where it is (a robot
-            // never moves backwards, not even by a rounding error at a hand-over).
-            while plan.task.ref_time_at(s) < p && s < plan.task.end_s() {
-                // The next float up (`s ≥ 0`; `f64::next_up` is newer than the MSRV).
-                s = f64::from_bits(s.to_bits() + 1);
-            }
-            // Its next group here: the first it has not left.
-            let g = (0..n_groups)
-                .find(|&g| s - self.tol_s < plan.leave_s[g])
-                .unwrap_or(n_groups);
-            if g < n_groups && s > plan.gate_s[g] {
-                return bad(
-                    i,
-                    "is inside or past the gate of a low-confidence group of the new plan",
-                );
-            }
-            clock[i] = s;
-            next[i] = g;
+            (clock[i], next[i]) = self.placement(old, i)?;
         }
         if let Some(sec) = self.sectors {
             self.take_over_sectors(old, &sec, &clock, &next);
@@ -1510,6 +1484,50 @@ impl ContinuousCoordinator {
             }
         }
         Ok(())
+    }
+
+    /// Robot `i` of the running cell `old` placed on this coordinator's plan of it: its
+    /// schedule clock here at its reference position in `old` (never behind it) and its next
+    /// group here (the first it has not left).
+    ///
+    /// # Errors
+    /// [`Error::HandOver`] when the robot is inside or past the gate of a group of this plan
+    /// (not at a hand-over point).
+    fn placement(&self, old: &ContinuousCoordinator, i: usize) -> Result<(f64, usize)> {
+        let (plan, old_task) = (self.plan(i), &old.plan(i).task);
+        let (c, n_groups) = (plan.task.sample_clock_s(), plan.groups.len());
+        // The robot's reference position in `old`, and the same position's clock here.
+        let s_old = old.clock_s[i];
+        // `old`'s cursor is at or before the sample of its clock (it only advances to
+        // the clock, and both reset together), so this is O(1) amortized, not O(position).
+        let mut at = old.cursors[i].at;
+        let n = old_task.advance_cursor(&mut at, s_old);
+        let p = old_task.ref_time_in(n, s_old);
+        let mut s = if p <= 0.0 {
+            0.0
+        } else if p >= plan.task.n_ref() as f64 {
+            plan.task.end_s()
+        } else {
+            let k = p.floor() as usize;
+            c[k] + (p - k as f64) * (c[k + 1] - c[k])
+        };
+        // The interpolation rounds: never place the robot behind where it is (a robot
+        // never moves backwards, not even by a rounding error at a hand-over).
+        while plan.task.ref_time_at(s) < p && s < plan.task.end_s() {
+            // The next float up (`s ≥ 0`; `f64::next_up` is newer than the MSRV).
+            s = f64::from_bits(s.to_bits() + 1);
+        }
+        // Its next group here: the first it has not left.
+        let g = (0..n_groups)
+            .find(|&g| s - self.tol_s < plan.leave_s[g])
+            .unwrap_or(n_groups);
+        if g < n_groups && s > plan.gate_s[g] {
+            return Err(Error::HandOver {
+                robot: i,
+                why: "is inside or past the gate of a low-confidence group of the new plan",
+            });
+        }
+        Ok((s, g))
     }
 
     /// [`take_over`](Self::take_over) of a sectored cell, the robots at `clock` with `next`
@@ -1597,6 +1615,179 @@ impl ContinuousCoordinator {
         self.monitor = self.monitor.with_sectors(self.m, sec.of);
         self.init_sector_cursors(sec);
         self.grant(self.monitor.ticks());
+    }
+
+    /// Hands sector `o` of this running sectored cell over to `new`'s plan of sector `o`
+    /// (issue 44), the other sectors running on untouched: one hand-over per sector, each
+    /// taken when *its own* robots are at a hand-over point, never waiting for the others'
+    /// (a re-plan of `M` sectors calls it once per sector, each when it succeeds;
+    /// [`take_over`](Self::take_over) needs every sector at a point at once, which sectors
+    /// whose operators are busy almost all the time reach rarely). `new` is a sectored cell
+    /// with the same sectors (a fresh [`sectored`](Self::sectored) of the new plan); sector
+    /// `o`'s robots continue from where they are, in reference time, on `new`'s task plan,
+    /// groups and sector-`o` token order, exactly as sector `o`'s own one-operator cell's
+    /// [`take_over`](Self::take_over) places them and rotates its sequence (the token to the
+    /// robot whose turn it was in the sector, unless a robot of the sector has seen a pass of
+    /// the sector's services since its own last one, then to the sector's least recently
+    /// served robot: the sector's own stamps, so its hand-over liveness is the one-operator
+    /// cell's). Operator `o` keeps its switch state (the robot it last released and when);
+    /// an entry it was granted whose robot has not reached its gate is dropped, as
+    /// `take_over` drops it, and granted anew by the new order.
+    ///
+    /// **Why the guarantee holds.** Each sector keeps ticking exactly as its own one-operator
+    /// cell (a robot's step reads only its own state, plan and its sector's operator), and a
+    /// sector's hand-over is its own cell's `take_over`, at its own hand-over point: sector
+    /// `o`'s robots are then all outside the new plan's groups, operator `o` holds nothing,
+    /// so the one-operator argument starts afresh in sector `o` (at most one of its robots
+    /// low-confidence in any tick, its stretches `k` ticks apart) while every other sector's
+    /// state, including a robot in the middle of a stretch and its operator's slot, is not
+    /// touched. The sectors' operators are disjoint and fixed, so at most one robot per
+    /// sector, at most `M` in all, is low-confidence in any tick, and a robot's stretch is
+    /// only ever under its sector's operator: no stretch is handed over, whatever the order in
+    /// which the sectors take their plans. After the call the cell runs sector `o` on `new`'s
+    /// plan and the others on theirs (per sector a plan; allocates the plans and the spliced
+    /// token sequence, O(M·T_ref + len)).
+    ///
+    /// # Errors
+    /// [`Error::HandOver`] when either cell is not sectored, the sectors differ, `o` is not a
+    /// sector with robots, `new` has another robot count, task length or control tick, this
+    /// cell has a latched fault, or a robot of sector `o` is not at a hand-over point of
+    /// `new`; `self` is then unchanged.
+    pub fn take_over_sector(&mut self, new: &ContinuousCoordinator, o: usize) -> Result<()> {
+        let bad = |robot, why| Err(Error::HandOver { robot, why });
+        let (Some(sec), Some(nsec)) = (self.sectors, new.sectors) else {
+            return bad(0, "a sector's hand-over needs two sectored cells");
+        };
+        if new.n != self.n || new.m != self.m || nsec.of[..self.n] != sec.of[..self.n] {
+            return bad(0, "the new plan has other sectors");
+        }
+        let members = (0..self.n).filter(|&r| usize::from(sec.of[r]) == o);
+        let Some(first_robot) = members.clone().next() else {
+            return bad(0, "names no sector with robots");
+        };
+        if let Some(i) = members
+            .clone()
+            .find(|&i| new.plan(i).task.n_ref() != self.plan(i).task.n_ref())
+        {
+            return bad(
+                i,
+                "the new plan's task has another number of reference samples",
+            );
+        }
+        if (new.tick_s - self.tick_s).abs() > 1e-12 * self.tick_s.max(new.tick_s) {
+            return bad(0, "the new plan runs at another control tick");
+        }
+        if let Some(f) = self.monitor.fault() {
+            return bad(f.stopped, "the old cell has a latched fault");
+        }
+        let mut clock = [0.0; MAX_ROBOTS];
+        let mut next = [0usize; MAX_ROBOTS];
+        for i in members.clone() {
+            (clock[i], next[i]) = new.placement(self, i)?;
+        }
+        // Sector o's new sequence, rotated as its own cell's take_over rotates it.
+        let (nstart, nend) = nsec.range[o];
+        let nlen = nend - nstart;
+        let n_groups = new.plan(first_robot).groups.len().max(1);
+        let wants = |t: &Token| t.group == next[t.robot] % n_groups;
+        let lru = members
+            .clone()
+            .min_by_key(|&r| self.sector_served[r])
+            .expect("a sector with robots");
+        let waited = self.sector_stamp[o] - 1 - self.sector_served[lru];
+        let others = nlen
+            - (nstart..nend)
+                .filter(|&k| new.tokens[k].robot == lru)
+                .count();
+        let old_token = self.staff.slot[o]
+            .map(|(t, _, _)| t)
+            .or_else(|| self.tokens.get(self.staff.cursor[o].0).copied());
+        let chosen = match old_token {
+            Some(t) if waited < others as u64 => t.robot,
+            _ => lru,
+        };
+        let first = (0..nlen)
+            .find(|&q| {
+                let t = &new.tokens[nstart + q];
+                t.robot == chosen && wants(t)
+            })
+            .unwrap_or(0);
+        // Splice it in place of the sector's old range; the later ranges shift.
+        let (start, end) = sec.range[o];
+        let mut tokens = Vec::with_capacity(self.tokens.len() - (end - start) + nlen);
+        let mut skip = Vec::with_capacity(tokens.capacity());
+        tokens.extend_from_slice(&self.tokens[..start]);
+        skip.extend_from_slice(&self.skip_first[..start]);
+        let mut found = [false; MAX_ROBOTS];
+        for k in 0..nlen {
+            let t = new.tokens[nstart + (first + k) % nlen];
+            found[t.robot] |= wants(&t);
+            tokens.push(t);
+            skip.push(!found[t.robot]);
+        }
+        tokens.extend_from_slice(&self.tokens[end..]);
+        skip.extend_from_slice(&self.skip_first[end..]);
+        let shift = |p: usize| {
+            if p >= end {
+                p + nlen - (end - start)
+            } else {
+                p
+            }
+        };
+        let mut sec2 = sec;
+        for q in 0..self.m {
+            let (a, b) = sec.range[q];
+            if q == o || a == b {
+                continue;
+            }
+            sec2.range[q] = (shift(a), shift(b));
+            self.staff.cursor[q].0 = shift(self.staff.cursor[q].0);
+            if let Some((_, pos, _)) = &mut self.staff.slot[q] {
+                *pos = shift(*pos);
+            }
+        }
+        sec2.range[o] = (start, start + nlen);
+        // One plan per sector: sector o's is new's, the others keep theirs.
+        let plans: Vec<Plan> = (0..self.m)
+            .map(|q| {
+                let r = (0..self.n).find(|&r| usize::from(sec.of[r]) == q);
+                match r {
+                    Some(r) if q != o => self.plan(r).clone(),
+                    _ => new.plan(first_robot).clone(),
+                }
+            })
+            .collect();
+        self.plans = plans.into();
+        for r in 0..self.n {
+            self.plan_of[r] = sec.of[r];
+        }
+        self.tokens = tokens.into();
+        self.skip_first = skip.into();
+        self.sectors = Some(sec2);
+        // One clock tolerance for all the plans (the larger errs on the safe side: module
+        // docs of `tol`); the same task's plans have the same, bit for bit.
+        self.tol_s = self.tol_s.max(new.tol_s);
+        // Sector o's robots where they are on the new plan, none granted; the rest is kept.
+        for i in members {
+            self.clock_s[i] = clock[i];
+            self.next_group[i] = next[i];
+            let task = &self.plans[o].task;
+            let (c, last) = (task.sample_clock_s(), task.n_ref() - 1);
+            let k = c
+                .partition_point(|&x| x <= clock[i] - self.tol_s)
+                .saturating_sub(1)
+                .min(last);
+            self.cursors[i] = Cursors::at(k);
+            self.staff.assigned[i] = None;
+        }
+        self.staff.slot[o] = None;
+        let f = (start..start + nlen)
+            .find(|&k| !self.skip_first[k])
+            .unwrap_or(start);
+        self.staff.cursor[o] = (f, 0);
+        self.grant_sector(self.monitor.ticks(), &sec2, o);
+        self.sync_sector_cursors(&sec2);
+        Ok(())
     }
 
     /// The common part of a hand-over: every robot at `clock` with `next` its next group, the

@@ -139,7 +139,7 @@ impl RoundSim {
             &mut self.coord,
             model,
             &mut self.op,
-            |_, n| (grad_min[n], grad_max[n]),
+            |_, _, n| (grad_min[n], grad_max[n]),
             Some(&self.conf),
             &mut self.robots,
             self.round_ticks,

@@ -367,7 +367,7 @@ pub(super) struct Robots {
 /// continuous cell ([`CellSim::tick`](super::CellSim::tick)): every robot the controller will
 /// move ([`Controller::running_now`]) logs one execution sample at its reference time; the
 /// robot the controller reports low-confidence ([`Controller::low_conf_now`]) is supervised,
-/// with `bounds(coord, n)` the `(ψ̇min, ψ̇max)` of reference sample `n`, and the operator's
+/// with `bounds(coord, i, n)` the `(ψ̇min, ψ̇max)` of robot `i`'s reference sample `n`, and the operator's
 /// input drives it. With `crossings = Some(conf)` (rounds), a robot that started the tick
 /// unsupervised but traversed low-confidence samples of `conf` inside it is supervised after
 /// the fact (step 5). `ticks` is the tick's index (a run's `start_tick`). Returns the tick
@@ -377,7 +377,7 @@ pub(super) fn step<C: Controller + ?Sized>(
     coord: &mut C,
     model: &TaskModel,
     op: &mut Operate,
-    bounds: impl Fn(&C, usize) -> (f64, f64),
+    bounds: impl Fn(&C, usize, usize) -> (f64, f64),
     crossings: Option<&[bool]>,
     robots: &mut Robots,
     ticks: usize,
@@ -407,7 +407,7 @@ pub(super) fn step<C: Controller + ?Sized>(
         }
         let ref_now = robots.ref_now[i];
         let n = (ref_now.floor() as usize).min(n_ref - 1);
-        let supervised = low_conf[i].then(|| bounds(coord, n));
+        let supervised = low_conf[i].then(|| bounds(coord, i, n));
         if supervised.is_none() {
             unsupervised_at[i] = Some(ref_now);
         }
