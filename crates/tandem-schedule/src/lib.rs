@@ -78,8 +78,9 @@ pub use choose::{
 pub use cyclic::{
     CheckedCyclicPlan, CycleRatio, CyclicParams, CyclicPlan, FleetCellChoice, SectoredPlan,
     Stretch, cyclic_plan, cyclic_plan_for_order, fleet_cell_choice, handover_bound_s,
-    max_cycle_ratio, period_lower_bound_s, period_lower_bound_with_switch_s,
-    pooled_period_lower_bound_s, sectored_coordinator, sectored_plan,
+    max_cycle_ratio, nominal_tasks_per_hour, period_lower_bound_s,
+    period_lower_bound_with_switch_s, pooled_period_lower_bound_s, sectored_coordinator,
+    sectored_plan,
 };
 pub use error::{Error, Result};
 pub use exact::{

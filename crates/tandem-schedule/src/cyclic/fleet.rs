@@ -140,10 +140,12 @@ pub struct FleetCellChoice {
     pub sectored_bound_tasks_per_hour: f64,
 }
 
-/// Which continuous cell `M > 1` operators run on `problem` with `N` robots: the even sectors
-/// when their ceiling equals the pooled cell's (within 1e-9, relative), else the pooled cell
-/// (docs/decisions.md, "The continuous cell runs sectors when their bound is the pooled
-/// one's (issue 44)"). `M = 1` and `N ≤ 1` are the pooled cell (one cell of all robots).
+/// The ceilings of the two continuous cells `M > 1` operators may run on `problem` with `N`
+/// robots, and the even sectors when their ceiling equals the pooled cell's (within 1e-9,
+/// relative), else none. Which cell runs is measured, not read from this
+/// (`Planner::fleet_coordinator`; docs/decisions.md, "The continuous cell of M operators: one
+/// hand-over per sector, pooled or sectored by measurement (issue 44)"). `M = 1` and `N ≤ 1`:
+/// no sectors.
 ///
 /// **Why.** `Σ_o min(3600·k_o/D_min, 3600/W) ≤ min(3600·N/D_min, 3600·M/W)` always (a sum of
 /// minima is at most the minimum of the sums), so pooling can gain only where the sectors'
@@ -220,6 +222,47 @@ pub fn sectored_coordinator(
     let cell =
         ContinuousCoordinator::sectored(task, &problem.usable_holds(), &sectors, first, tick_s)?;
     Ok((cell, planned))
+}
+
+/// The throughput (tasks per hour) a continuous `cell` (a copy of it, from where it is)
+/// measures with every operator at the plan's rate (`Operator::Scheduled`): `warm` periods of
+/// `period_s` to settle, then the tasks completed in the next `window` periods, per hour of
+/// that window (the tick's real seconds). Deterministic (no random input); O(ticks·N).
+/// What the planner compares the pooled and the sectored cell by (issue 44): each cell's
+/// own run-time rule with the planned operator, hand-overs and queueing at the tokens
+/// included, which neither cell's ceiling counts.
+///
+/// # Errors
+/// [`Error::BadParam`] (`period_s`) unless finite and > 0, `window` ≥ 1 and the run is at
+/// most 10⁷ ticks; the realtime crate's for a tick that fails.
+pub fn nominal_tasks_per_hour(
+    cell: &ContinuousCoordinator,
+    period_s: f64,
+    warm: u32,
+    window: u32,
+) -> Result<f64> {
+    let h = cell.tick_s();
+    let per = (period_s / h).ceil();
+    let total = per * f64::from(warm + window);
+    if !(period_s.is_finite() && period_s > 0.0) || window == 0 || total > 1e7 {
+        return Err(Error::BadParam {
+            name: "period_s",
+            why: "must be finite and > 0, with a window of ≥ 1 period and at most 1e7 ticks in all",
+        });
+    }
+    let mut c = cell.clone();
+    let ops = [tandem_realtime::Operator::Scheduled; tandem_realtime::MAX_ROBOTS];
+    let m = c.operators();
+    let done = |c: &ContinuousCoordinator| c.tasks_completed().iter().sum::<u64>();
+    for _ in 0..(per as u64) * u64::from(warm) {
+        c.tick_many(&ops[..m])?;
+    }
+    let at_start = done(&c);
+    let ticks = (per as u64) * u64::from(window);
+    for _ in 0..ticks {
+        c.tick_many(&ops[..m])?;
+    }
+    Ok((done(&c) - at_start) as f64 * 3600.0 / (ticks as f64 * h))
 }
 
 #[cfg(test)]
