@@ -266,6 +266,7 @@ mod tests {
             lc_ref: Vec::new(),
             holds: Vec::new(),
             falsely_trusted_samples: 0,
+            fleet: None,
         };
         let trial = |k: usize| CellTrialResult {
             trial: k,

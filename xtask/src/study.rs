@@ -77,6 +77,11 @@ pub(crate) struct StudyArgs {
     /// each with the rates above.
     #[arg(long, value_name = "M")]
     operators: Option<usize>,
+    /// Which continuous cell M > 1 operators run (`[operator] fleet_cell`; issue 44): `auto`
+    /// (the pooled cell unless the even sectors measure strictly faster with the planned
+    /// operator), `pooled` or `sectored` (forced: the two cells on the same run).
+    #[arg(long, value_name = "CELL", value_parser = clap::builder::PossibleValuesParser::new(["auto", "pooled", "sectored"]))]
+    fleet_cell: Option<String>,
     /// Decide confidence with the paper's model (Eq. 8–12: zero error rates, nothing
     /// estimated, every control sample one observation) instead of the configured one.
     #[arg(long)]
@@ -362,6 +367,35 @@ fn run_continuous(
     );
     for t in &result.trials {
         let last = t.iterations.last().expect("the first plan at least");
+        let picks: Vec<_> = t
+            .iterations
+            .iter()
+            .filter_map(|i| i.fleet.as_ref())
+            .collect();
+        if let Some(p) = picks.last() {
+            // M > 1 (issue 44): which cell ran, and the measured rates it was picked by.
+            let sectored = picks
+                .iter()
+                .filter(|p| p.cell == tandem::planner::FleetCell::Sectored)
+                .count();
+            let rate = |r: Option<f64>| r.map_or("-".to_string(), |r| format!("{r:.1}"));
+            println!(
+                "  trial {}: {} of {} plans ran sectored ({}), {} pooled; last plan measured \
+                 with the planned operator: pooled {} tasks/h, sectored {} (planned {})",
+                t.trial,
+                sectored,
+                picks.len(),
+                p.sectors
+                    .iter()
+                    .map(usize::to_string)
+                    .collect::<Vec<_>>()
+                    .join(" + "),
+                picks.len() - sectored,
+                rate(p.pooled_tasks_per_hour),
+                rate(p.sectored_tasks_per_hour),
+                rate(p.sectored_planned_tasks_per_hour),
+            );
+        }
         println!(
             "  trial {}: steady {:.1} tasks/h, operator busy {:.1} %, robots waiting {:.1} %; \
              last plan {:.1} tasks/h (bound {:.1}, {} stretches), {} hand-overs",
@@ -559,6 +593,9 @@ fn config(args: &StudyArgs) -> anyhow::Result<StudyConfig> {
     }
     if let Some(m) = args.operators {
         config.operator.operators = m;
+    }
+    if let Some(f) = &args.fleet_cell {
+        config.operator.fleet_cell = f.parse()?;
     }
     if args.no_holds {
         config.planner.holds = Default::default();

@@ -64,6 +64,31 @@ pub(crate) fn schedule_continuous(a: &ScheduleArgs) -> Result<()> {
             (sp.switch_s, sp.max_busy_share),
             crate::cmd::verbose(),
         )?);
+        if sp.operators > 1 {
+            // Which cell the M operators run (issue 44): the pooled cell unless the even
+            // sectors measure strictly faster with the planned operator.
+            let c = planner.fleet_cell().context("--operators")?;
+            let cyclic = checked.as_continuous().expect("checked above");
+            let (_, pick) = planner
+                .fleet_coordinator(cyclic, tandem::planner::FleetCell::Auto)
+                .context("--operators")?;
+            if let Some(p) = pick {
+                let sizes: Vec<String> = p.sectors.iter().map(usize::to_string).collect();
+                let rate = |r: Option<f64>| r.map_or("-".to_string(), |r| format!("{r:.1}"));
+                out(&format!(
+                    "{} operators run the {} cell: measured with the planned operator, pooled ({} tokens) {} tasks/h, sectors of {} robots {} (planned {}); ceilings {:.1} and {:.1}",
+                    sp.operators,
+                    p.cell,
+                    sp.operators,
+                    rate(p.pooled_tasks_per_hour),
+                    sizes.join(" + "),
+                    rate(p.sectored_tasks_per_hour),
+                    rate(p.sectored_planned_tasks_per_hour),
+                    c.pooled_bound_tasks_per_hour,
+                    c.sectored_bound_tasks_per_hour
+                ));
+            }
+        }
     }
     Ok(())
 }

@@ -91,6 +91,80 @@ impl FromStr for Cell {
     }
 }
 
+/// Which continuous cell `M > 1` operators run (issue 44): its text form (serde, the study's
+/// `[operator] fleet_cell`, xtask's `--fleet-cell`) is the lowercase name.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FleetCell {
+    /// The cell of the larger measured throughput ([`Planner::fleet_coordinator`]): the
+    /// sectors only when they are strictly better, else the pooled cell.
+    #[default]
+    Auto,
+    /// The pooled cell: every operator serves every robot (the plan's order, `M` tokens).
+    Pooled,
+    /// The even sectors, each a one-operator cell of its own plan.
+    Sectored,
+}
+
+impl FleetCell {
+    /// Every choice, `auto` first.
+    pub const ALL: [FleetCell; 3] = [FleetCell::Auto, FleetCell::Pooled, FleetCell::Sectored];
+
+    /// Its text form: `auto`, `pooled` or `sectored`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            FleetCell::Auto => "auto",
+            FleetCell::Pooled => "pooled",
+            FleetCell::Sectored => "sectored",
+        }
+    }
+
+    /// Whether it is [`FleetCell::Auto`] (serde's `skip_serializing_if`).
+    #[must_use]
+    pub fn is_auto(&self) -> bool {
+        *self == FleetCell::Auto
+    }
+}
+
+impl fmt::Display for FleetCell {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for FleetCell {
+    type Err = Error;
+
+    /// `auto`, `pooled` or `sectored` (exactly; [`Error::UnknownFleetCell`] otherwise).
+    fn from_str(s: &str) -> Result<FleetCell> {
+        FleetCell::ALL
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| Error::UnknownFleetCell {
+                given: s.to_string(),
+            })
+    }
+}
+
+/// What [`Planner::fleet_coordinator`] ran for `M > 1` operators and why: the cell, the
+/// sectors' sizes, and the throughputs (tasks per hour) measured with the planned operator
+/// ([`tandem_schedule::nominal_tasks_per_hour`]; `None` where a forced choice measured
+/// nothing).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FleetPick {
+    /// [`FleetCell::Pooled`] or [`FleetCell::Sectored`]: the cell that runs.
+    pub cell: FleetCell,
+    /// The even sectors' sizes (the sectored candidate; robots `0..k₀`, then the next `k₁`, …).
+    pub sectors: Vec<usize>,
+    /// The pooled cell's measured throughput.
+    pub pooled_tasks_per_hour: Option<f64>,
+    /// The sectored cell's measured throughput.
+    pub sectored_tasks_per_hour: Option<f64>,
+    /// The sectors' planned throughput, the sum of their one-operator plans'.
+    pub sectored_planned_tasks_per_hour: Option<f64>,
+}
+
 /// The plan of a cell on the planner's current problem ([`Planner::plan`]), checked on it at
 /// the tick it runs at.
 #[derive(Clone, Debug)]
@@ -347,16 +421,129 @@ impl Planner {
     /// # Errors
     /// The realtime crate's for a bad switch time or load cap, or a load cap below 1 with
     /// `M > 1` (the run-time pace serves one operator), or an operator count out of range.
+    ///
+    /// With `M > 1` the cell is the pooled one (`plan`'s order served by `M` tokens) or the
+    /// even sectors, whichever measures faster with the planned operator
+    /// ([`Planner::fleet_coordinator`] with [`FleetCell::Auto`]): then each sector runs the
+    /// one-operator plan of its size under its own operator
+    /// ([`tandem_schedule::sectored_coordinator`]), and `plan` is not run.
     pub fn continuous_coordinator(
         &self,
         plan: &CheckedCyclicPlan,
     ) -> Result<tandem_realtime::ContinuousCoordinator> {
+        Ok(self.fleet_coordinator(plan, FleetCell::Auto)?.0)
+    }
+
+    /// [`Planner::continuous_coordinator`] with the cell of `M > 1` operators chosen by
+    /// `fleet`, and what was chosen (`None` for one operator). [`FleetCell::Auto`] builds both
+    /// cells — the pooled one (`plan`'s order, `M` tokens) and the even sectors
+    /// (`even_sector_sizes`, contiguous robots, each the one-operator plan of its size,
+    /// searched here with the planner's cyclic parameters at `plan`'s tick) — and measures
+    /// each from its start with the planned operator over 30 periods of the pooled bound after
+    /// 5 to settle ([`tandem_schedule::nominal_tasks_per_hour`]): the sectors run only when
+    /// strictly faster. The pooled plan is searched in any case (it is `plan`, the one the
+    /// study records), so nothing is searched for the comparison but the sectors' plans.
+    /// [`FleetCell::Pooled`] and [`FleetCell::Sectored`] force the cell, measuring nothing.
+    ///
+    /// # Errors
+    /// As [`Planner::continuous_coordinator`]; the schedule crate's for a sector's plan.
+    pub fn fleet_coordinator(
+        &self,
+        plan: &CheckedCyclicPlan,
+        fleet: FleetCell,
+    ) -> Result<(tandem_realtime::ContinuousCoordinator, Option<FleetPick>)> {
         let sp = &self.params().sampler;
-        let mut c = plan.coordinator().with_switch_s(sp.switch_s)?;
-        if sp.operators > 1 {
-            c = c.with_operators(tandem_realtime::OperatorCount::new(sp.operators)?);
+        if sp.operators <= 1 {
+            let c = plan.coordinator().with_switch_s(sp.switch_s)?;
+            return Ok((c.with_max_busy_share(sp.max_busy_share)?, None));
         }
-        Ok(c.with_max_busy_share(sp.max_busy_share)?)
+        let m = tandem_realtime::OperatorCount::new(sp.operators)?;
+        let n = self.n_robots();
+        let pooled = || -> Result<tandem_realtime::ContinuousCoordinator> {
+            Ok(plan
+                .coordinator()
+                .with_switch_s(sp.switch_s)?
+                .with_operators(m))
+        };
+        let sizes = tandem_schedule::even_sector_sizes(n, m.get());
+        let sectored = || -> Result<(tandem_realtime::ContinuousCoordinator, f64)> {
+            let params = CyclicParams {
+                switch_s: sp.switch_s,
+                max_busy_share: sp.max_busy_share,
+                ..CyclicParams::default()
+            };
+            let mut plans: Vec<CheckedCyclicPlan> = Vec::new();
+            for &k in &sizes {
+                if !plans.iter().any(|p| p.n_robots() == k) {
+                    plans.push(CheckedCyclicPlan::search(
+                        self.problem(),
+                        k,
+                        &params,
+                        plan.tick_s(),
+                    )?);
+                }
+            }
+            let (c, planned) = tandem_schedule::sectored_coordinator(
+                self.problem(),
+                &sizes,
+                &plans,
+                plan.tick_s(),
+            )?;
+            Ok((c.with_switch_s(sp.switch_s)?.with_operators(m), planned))
+        };
+        let mut pick = FleetPick {
+            cell: FleetCell::Pooled,
+            sectors: sizes.clone(),
+            pooled_tasks_per_hour: None,
+            sectored_tasks_per_hour: None,
+            sectored_planned_tasks_per_hour: None,
+        };
+        let c = match fleet {
+            FleetCell::Pooled => pooled()?,
+            FleetCell::Sectored => {
+                let (c, planned) = sectored()?;
+                pick.cell = FleetCell::Sectored;
+                pick.sectored_planned_tasks_per_hour = Some(planned);
+                c
+            }
+            FleetCell::Auto => {
+                let period_s =
+                    tandem_schedule::pooled_period_lower_bound_s(self.problem(), n, m.get())?;
+                let p = pooled()?;
+                let p_rate = tandem_schedule::nominal_tasks_per_hour(&p, period_s, 5, 30)?;
+                pick.pooled_tasks_per_hour = Some(p_rate);
+                if n > 1 {
+                    let (s, planned) = sectored()?;
+                    let s_rate = tandem_schedule::nominal_tasks_per_hour(&s, period_s, 5, 30)?;
+                    pick.sectored_tasks_per_hour = Some(s_rate);
+                    pick.sectored_planned_tasks_per_hour = Some(planned);
+                    if s_rate > p_rate {
+                        pick.cell = FleetCell::Sectored;
+                        s
+                    } else {
+                        p
+                    }
+                } else {
+                    p
+                }
+            }
+        };
+        Ok((c.with_max_busy_share(sp.max_busy_share)?, Some(pick)))
+    }
+
+    /// The ceilings (tasks per hour) of the pooled cell and the even sectors of this planner's
+    /// `M = params().sampler.operators` operators on the current problem
+    /// ([`tandem_schedule::fleet_cell_choice`]). Which cell runs is measured, not read from
+    /// these: [`Planner::fleet_coordinator`].
+    ///
+    /// # Errors
+    /// The schedule crate's for a robot or operator count out of range.
+    pub fn fleet_cell(&self) -> Result<tandem_schedule::FleetCellChoice> {
+        Ok(tandem_schedule::fleet_cell_choice(
+            self.problem(),
+            self.n_robots(),
+            self.params().sampler.operators,
+        )?)
     }
 
     /// The cyclic plan of a continuous cell of this planner's robots on the current problem

@@ -178,6 +178,12 @@ pub enum Error {
         /// The name given.
         given: String,
     },
+    /// A fleet cell that is none of `auto`, `pooled`, `sectored` ([`crate::FleetCell`]).
+    #[error("unknown fleet cell `{given}`: give `auto`, `pooled` or `sectored`")]
+    UnknownFleetCell {
+        /// The name given.
+        given: String,
+    },
     /// A state file of format 12 (a cell of several tasks, [`crate::CellPlanner`]) given
     /// where one task's planner is expected.
     #[error(

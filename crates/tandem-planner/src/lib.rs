@@ -64,7 +64,7 @@ mod mixed;
 mod planner;
 pub mod state;
 
-pub use cell::{AnyController, Cell, Plan};
+pub use cell::{AnyController, Cell, FleetCell, FleetPick, Plan};
 pub use error::{Error, Result};
 pub use explain::{ChannelShare, LowCause, LowRegion};
 pub use mixed::{

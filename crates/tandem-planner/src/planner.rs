@@ -2092,6 +2092,90 @@ mod tests {
         }
     }
 
+    /// The continuous cell of `M > 1` operators is picked by measurement (issue 44):
+    /// `FleetCell::Auto` runs the even sectors exactly when they measure strictly faster than
+    /// the pooled cell with the planned operator (both rates reported), `Pooled` and
+    /// `Sectored` force the cell; a sectored coordinator's robots run under their contiguous
+    /// sector's operator only; one operator has no pick; the sectors' ceiling never exceeds
+    /// the pooled one's.
+    #[test]
+    fn the_continuous_cell_of_m_operators_is_picked_by_measurement() {
+        use crate::FleetCell;
+        use tandem_realtime::{Controller, Operator};
+        let p1 = test_planner(40, 10..20, 4, 1);
+        let crate::Plan::Continuous(plan) = p1.plan(crate::Cell::Continuous).unwrap() else {
+            panic!("a continuous plan")
+        };
+        assert!(
+            p1.fleet_coordinator(&plan, FleetCell::Auto)
+                .unwrap()
+                .1
+                .is_none()
+        );
+        for (n, m) in [(4, 2), (3, 2), (4, 4)] {
+            let mut p = test_planner(40, 10..20, n, 1);
+            p.set_operators(m).unwrap();
+            let choice = p.fleet_cell().unwrap();
+            assert!(
+                choice.sectored_bound_tasks_per_hour
+                    <= choice.pooled_bound_tasks_per_hour * (1.0 + 1e-9)
+            );
+            let crate::Plan::Continuous(plan) = p.plan(crate::Cell::Continuous).unwrap() else {
+                panic!("a continuous plan")
+            };
+            let (pooled, pick) = p.fleet_coordinator(&plan, FleetCell::Pooled).unwrap();
+            let pick = pick.unwrap();
+            assert!(pooled.sector_of().is_none() && pick.cell == FleetCell::Pooled);
+            assert_eq!(pick.pooled_tasks_per_hour, None);
+            let want: Vec<u8> = pick
+                .sectors
+                .iter()
+                .enumerate()
+                .flat_map(|(o, &k)| std::iter::repeat_n(o as u8, k))
+                .collect();
+            let (forced, _) = p.fleet_coordinator(&plan, FleetCell::Sectored).unwrap();
+            assert_eq!(&forced.sector_of().unwrap()[..], &want[..], "({n}, {m})");
+            let (mut c, pick) = p.fleet_coordinator(&plan, FleetCell::Auto).unwrap();
+            let pick = pick.unwrap();
+            let (pr, sr) = (
+                pick.pooled_tasks_per_hour.unwrap(),
+                pick.sectored_tasks_per_hour.unwrap(),
+            );
+            assert!(pr > 0.0 && sr > 0.0, "({n}, {m}): {pick:?}");
+            assert_eq!(
+                pick.cell == FleetCell::Sectored,
+                sr > pr,
+                "({n}, {m}): {pick:?}"
+            );
+            assert_eq!(c.sector_of().is_some(), sr > pr, "({n}, {m})");
+            // The controller runs the same pick.
+            let crate::AnyController::Continuous(k) =
+                p.controller(crate::Cell::Continuous).unwrap()
+            else {
+                panic!("a continuous cell")
+            };
+            assert_eq!(k.sector_of(), c.sector_of());
+            assert_eq!(Controller::operators(&c), m);
+            let sector_of = forced.sector_of().unwrap();
+            c = forced;
+            let inputs: Vec<Operator> = (0..m)
+                .map(|o| [Operator::Fastest, Operator::Slowest][o % 2])
+                .collect();
+            let mut lc_ticks = 0;
+            for _ in 0..20_000 {
+                let t = c.tick_many(&inputs).unwrap();
+                assert!(t.fault.is_none() && !t.over(m));
+                for (i, &o) in sector_of.iter().enumerate() {
+                    if t.low_conf[i] {
+                        lc_ticks += 1;
+                        assert_eq!(t.operator[i], Some(o));
+                    }
+                }
+            }
+            assert!(lc_ticks > 0 && c.tasks_completed().iter().all(|&k| k > 0));
+        }
+    }
+
     /// The sectored round (issue 44) of (N, M) = (4, 2) and (3, 2) on a small problem: even
     /// sectors ([2, 2], [2, 1]), each sector's schedule of its own size passes the one-operator
     /// check (Eq. 20 with Alg. 2's margin check) on the planner's problem, the round's

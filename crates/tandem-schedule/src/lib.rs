@@ -76,9 +76,11 @@ pub use choose::{
     sample_schedule_with_baselines,
 };
 pub use cyclic::{
-    CheckedCyclicPlan, CycleRatio, CyclicParams, CyclicPlan, SectoredPlan, Stretch, cyclic_plan,
-    cyclic_plan_for_order, handover_bound_s, max_cycle_ratio, period_lower_bound_s,
-    period_lower_bound_with_switch_s, pooled_period_lower_bound_s, sectored_plan,
+    CheckedCyclicPlan, CycleRatio, CyclicParams, CyclicPlan, FleetCellChoice, SectoredPlan,
+    Stretch, cyclic_plan, cyclic_plan_for_order, fleet_cell_choice, handover_bound_s,
+    max_cycle_ratio, nominal_tasks_per_hour, period_lower_bound_s,
+    period_lower_bound_with_switch_s, pooled_period_lower_bound_s, sectored_coordinator,
+    sectored_plan,
 };
 pub use error::{Error, Result};
 pub use exact::{

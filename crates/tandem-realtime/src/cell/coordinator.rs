@@ -36,7 +36,27 @@ struct Staff {
     /// not yet granted (`None`: no entry, a task without low confidence). Granted in the
     /// order of these among the robots waiting at their gates ([`ContinuousCoordinator::grant`]).
     next_entry: [Option<(usize, u64)>; MAX_ROBOTS],
+    /// A sectored cell only: per operator, the `(pos, passes)` of its sector's next entry to
+    /// grant (`pos` in the operator's range of the token sequence, `passes` the completed
+    /// passes through that range): each sector's one-operator token.
+    cursor: [(usize, u64); MAX_ROBOTS],
 }
+
+/// The sectors of a sectored cell (issue 44, [`ContinuousCoordinator::sectored`]): a fixed
+/// partition of the robots to the operators, operator `o` serving only sector `o`'s robots in
+/// its own one-operator token sequence.
+#[derive(Clone, Copy, Debug)]
+struct Sectors {
+    /// Per robot, its sector (its operator).
+    of: [u8; MAX_ROBOTS],
+    /// Per operator, its sector's token sequence: `tokens[start..end]` (empty: no robots).
+    range: [(usize, usize); MAX_ROBOTS],
+}
+
+/// One sector of a sectored continuous cell ([`ContinuousCoordinator::sectored`]): its robots
+/// (ascending cell indices) and its one-operator cyclic order of stretches `(j, lc)`, `j`
+/// indexing the sector's robots.
+pub type SectorOrder = (Vec<usize>, Vec<(usize, usize)>);
 
 /// What one [`ContinuousCoordinator::tick`] did: the one [`Tick`] of every controller (its
 /// `at_gate` is [`Tick::waiting`]).
@@ -102,12 +122,20 @@ pub struct ContinuousCoordinator {
     /// The operator's load cap at run time, the token's pace (`None`: no cap;
     /// [`ContinuousCoordinator::with_max_busy_share`]; carried over by a hand-over).
     pace: Option<Pace>,
+    /// `None`: a pooled cell (every operator serves every robot). `Some`: a sectored cell
+    /// ([`ContinuousCoordinator::sectored`]).
+    sectors: Option<Sectors>,
+    /// A sectored cell only: per robot, the stamp of its last service counted within its
+    /// sector (`served` of the sector's own one-operator cell).
+    sector_served: [u64; MAX_ROBOTS],
+    /// A sectored cell only: per operator, its sector's next service stamp.
+    sector_stamp: [u64; MAX_ROBOTS],
 }
 
 /// One task's plan in a continuous cell and what the token rule reads of it: its timeline
 /// (schedule clock from 0), groups, the schedule clock of each group's gate and leave point,
 /// the next low-confidence sample's clock per sample, the pre-alert's tables.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 struct Plan {
     task: Timeline,
     groups: Vec<Group>,
@@ -312,9 +340,108 @@ impl ContinuousCoordinator {
             monitor: Monitor::new(n_robots),
             switch_ticks: 0,
             pace: None,
+            sectors: None,
+            sector_served: [0; MAX_ROBOTS],
+            sector_stamp: [0; MAX_ROBOTS],
         };
         out.reset();
         out
+    }
+
+    /// A *sectored* continuous cell (issue 44): the robots `0..N` of `task` (re-based to
+    /// schedule clock 0, waiting at the usable `holds`) split into sectors, `sectors[o] =
+    /// (robots, order)` served by operator `o` alone: `robots` (ascending) are the sector's,
+    /// and `order` is the sector's own one-operator cyclic order of stretches `(j, lc)`, `j`
+    /// indexing `robots` (the order of `tandem_schedule::cyclic_plan` for `robots.len()`
+    /// robots). Operator `o` grants only its sector's robots, in its sector's token sequence,
+    /// by the one-operator rule: each sector ticks exactly as its own one-operator cell
+    /// ([`new`](Self::new) of its robots and order), so each keeps that cell's guarantee — at
+    /// most one of its robots low-confidence in a tick, under operator `o`, never handed to
+    /// another operator (a robot's operator is its sector's), operator `o`'s stretches of
+    /// different robots `k` ticks apart ([`with_switch_s`](Self::with_switch_s)) — and at
+    /// most `M` robots are low-confidence in all. The fault monitor latches when two robots of
+    /// one sector are low-confidence. [`with_operators`](Self::with_operators) may add
+    /// operators without robots (never below the sectors' number); the pre-alert
+    /// ([`Tick::next`]) and the load cap are not built for sectors (`None`, refused).
+    ///
+    /// # Errors
+    /// [`Error::RobotCount`] unless `1 ≤ N ≤ MAX_ROBOTS`; [`Error::BadParam`] (`sectors`)
+    /// unless the sectors' robots, each ascending and non-empty, are `0..N` once each and
+    /// there are at most `MAX_ROBOTS` sectors; otherwise as [`new`](Self::new) for the tick,
+    /// the holds and each sector's order.
+    pub fn sectored(
+        task: Timeline,
+        holds: &[usize],
+        sectors: &[SectorOrder],
+        n_robots: usize,
+        tick_s: f64,
+    ) -> Result<ContinuousCoordinator> {
+        check_count(n_robots)?;
+        check_tick(tick_s)?;
+        let bad = |why| Error::BadParam {
+            name: "sectors",
+            why,
+        };
+        if sectors.is_empty() || sectors.len() > MAX_ROBOTS {
+            return Err(bad("must be 1 to MAX_ROBOTS sectors, one per operator"));
+        }
+        let mut of = [0u8; MAX_ROBOTS];
+        let mut seen = [false; MAX_ROBOTS];
+        for (o, (robots, _)) in sectors.iter().enumerate() {
+            if robots.is_empty() || robots.windows(2).any(|w| w[0] >= w[1]) {
+                return Err(bad("each sector's robots must be non-empty and ascending"));
+            }
+            for &r in robots {
+                if r >= n_robots || std::mem::replace(&mut seen[r], true) {
+                    return Err(bad("must name each robot 0..N exactly once"));
+                }
+                of[r] = o as u8;
+            }
+        }
+        if seen[..n_robots].iter().any(|s| !s) {
+            return Err(bad("must name each robot 0..N exactly once"));
+        }
+        let task = task.sub(0, task.n_ref(), 0.0)?;
+        let groups = groups(task.conf(), holds)?;
+        let mut tokens = Vec::new();
+        let mut skip_first = Vec::new();
+        let mut range = [(0usize, 0usize); MAX_ROBOTS];
+        for (o, (robots, order)) in sectors.iter().enumerate() {
+            let (t, skip) = token_sequence(order, &groups, robots.len())?;
+            let start = tokens.len();
+            tokens.extend(t.into_iter().map(|t| Token {
+                robot: robots[t.robot],
+                ..t
+            }));
+            skip_first.extend(skip);
+            range[o] = (start, tokens.len());
+        }
+        let tol_s = clock_tolerance_s(std::slice::from_ref(&task), tick_s);
+        let plan = Plan::new(task, groups, tick_s, tol_s);
+        let mut out = Self::assemble(
+            vec![plan],
+            [0; MAX_ROBOTS],
+            tokens,
+            skip_first,
+            n_robots,
+            tick_s,
+            tol_s,
+        );
+        out.m = sectors.len();
+        out.sectors = Some(Sectors { of, range });
+        out.monitor = Monitor::new(n_robots).with_sectors(out.m, of);
+        out.reset();
+        Ok(out)
+    }
+
+    /// The sectors of a sectored cell ([`sectored`](Self::sectored)): per robot its sector
+    /// (its operator); `None` for a pooled cell.
+    pub fn sector_of(&self) -> Option<PerRobot<u8>> {
+        self.sectors.map(|s| {
+            let mut out = PerRobot::new(self.n);
+            out.as_mut_slice().copy_from_slice(&s.of[..self.n]);
+            out
+        })
     }
 
     /// The same cell with the operator's switch time `switch_s` (real s, finite and ≥ 0),
@@ -351,6 +478,15 @@ impl ContinuousCoordinator {
     /// reads 1 then) and setting it afterwards is refused.
     pub fn with_operators(mut self, operators: crate::OperatorCount) -> ContinuousCoordinator {
         self.m = operators.get();
+        if let Some(sec) = self.sectors {
+            // Operators beyond the sectors have empty ranges (no robots); never fewer.
+            let sectors = 1
+                + (0..self.n)
+                    .map(|r| usize::from(sec.of[r]))
+                    .max()
+                    .unwrap_or(0);
+            self.m = self.m.max(sectors);
+        }
         if self.m > 1 {
             self.pace = None;
         }
@@ -389,7 +525,7 @@ impl ContinuousCoordinator {
     /// [`Error::BadParam`] for a `max_busy_share` not in `(0, 1]`.
     pub fn with_max_busy_share(mut self, max_busy_share: f64) -> Result<ContinuousCoordinator> {
         super::pace::check_max_busy_share(max_busy_share)?;
-        if self.m > 1 && max_busy_share < 1.0 {
+        if (self.m > 1 || self.sectors.is_some()) && max_busy_share < 1.0 {
             return Err(Error::BadParam {
                 name: "max_busy_share",
                 why: "the run-time load cap paces one operator; a cell of several operators has none yet (issue 44)",
@@ -487,6 +623,10 @@ impl ContinuousCoordinator {
     /// `M > 1`: [`grant_waiting`](Self::grant_waiting) instead — an entry whose robot has not
     /// reached its gate holds back neither a free operator nor the robots behind it.
     fn grant(&mut self, tick: u64) {
+        if let Some(sec) = self.sectors {
+            self.grant_sectors(tick, &sec);
+            return;
+        }
         if self.m > 1 {
             self.grant_waiting(tick);
             return;
@@ -556,6 +696,113 @@ impl ContinuousCoordinator {
         }
     }
 
+    /// A sectored cell: each operator `o` grants its sector's token sequence by the
+    /// one-operator rule ([`grant`](Self::grant) with `M = 1`, word for word, on the range
+    /// `sec.range[o]`): while its next entry's robot has that group next, holds no operator,
+    /// `o` is free and its switch time for the robot is over, `o` takes the entry and its
+    /// cursor moves on; the first entry that cannot be granted stops the sector's grants.
+    /// Operator `o` grants no robot of another sector, and a robot's state is touched only by
+    /// its own sector's operator, so each sector runs as its own one-operator cell. At most
+    /// `N` grants; no allocation.
+    fn grant_sectors(&mut self, tick: u64, sec: &Sectors) {
+        for o in 0..self.m {
+            self.grant_sector(tick, sec, o);
+        }
+        self.sync_sector_cursors(sec);
+    }
+
+    /// A sectored cell: operator `o`'s grants of [`grant_sectors`](Self::grant_sectors), on
+    /// its range only (touches only operator `o`'s slot and cursor and its sector's robots).
+    fn grant_sector(&mut self, tick: u64, sec: &Sectors, o: usize) {
+        let (start, end) = sec.range[o];
+        if start == end {
+            return;
+        }
+        loop {
+            let (pos, passes) = self.staff.cursor[o];
+            let t = self.tokens[pos];
+            if self.staff.assigned[t.robot].is_some()
+                || self.next_group[t.robot] != t.group
+                || self.staff.slot[o].is_some()
+                || self.op_wait(o, t.robot, tick) > 0
+            {
+                break;
+            }
+            self.staff.slot[o] = Some((t, pos, passes));
+            self.staff.assigned[t.robot] = Some(o as u8);
+            self.staff.last_op[t.robot] = Some(o as u8);
+            self.staff.cursor[o] = self.sector_after(sec, o, pos, passes);
+        }
+    }
+
+    /// A sectored cell: operator `o`'s entry after `(pos, passes)` in its range (skipping the
+    /// first pass's skipped entries). O(range).
+    fn sector_after(
+        &self,
+        sec: &Sectors,
+        o: usize,
+        mut pos: usize,
+        mut passes: u64,
+    ) -> (usize, u64) {
+        let (start, end) = sec.range[o];
+        loop {
+            pos += 1;
+            if pos == end {
+                pos = start;
+                passes += 1;
+            }
+            if passes > 0 || !self.skip_first[pos] {
+                return (pos, passes);
+            }
+        }
+    }
+
+    /// A sectored cell: `(pos, passes)` is the least of the sectors' cursors, so
+    /// [`token`](Self::token) names an entry not granted yet when no operator holds one.
+    fn sync_sector_cursors(&mut self, sec: &Sectors) {
+        if let Some(&(pos, passes)) = (0..self.m)
+            .filter(|&o| sec.range[o].0 < sec.range[o].1)
+            .map(|o| &self.staff.cursor[o])
+            .min_by_key(|&&(pos, passes)| (passes, pos))
+        {
+            (self.pos, self.passes) = (pos, passes);
+        }
+    }
+
+    /// A sectored cell: each sector's cursor at its first entry not skipped in the first pass,
+    /// and its service stamps ranked as its own one-operator cell ranks them at a reset (by
+    /// the sector's first entries, then its robots in order).
+    fn init_sectors(&mut self, sec: &Sectors) {
+        for o in 0..self.m {
+            let (start, end) = sec.range[o];
+            let mut rank = 0;
+            let mut ranked = [false; MAX_ROBOTS];
+            let firsts = (start..end)
+                .filter(|&k| !self.skip_first[k])
+                .map(|k| self.tokens[k].robot);
+            let members = (0..self.n).filter(|&r| usize::from(sec.of[r]) == o);
+            for r in firsts.chain(members) {
+                if !std::mem::replace(&mut ranked[r], true) {
+                    self.sector_served[r] = rank;
+                    rank += 1;
+                }
+            }
+            self.sector_stamp[o] = rank;
+        }
+        self.init_sector_cursors(sec);
+    }
+
+    /// A sectored cell: each sector's cursor at its first entry not skipped in the first pass
+    /// (at a reset or a hand-over).
+    fn init_sector_cursors(&mut self, sec: &Sectors) {
+        for o in 0..self.m {
+            let (start, end) = sec.range[o];
+            let first = (start..end).find(|&k| !self.skip_first[k]).unwrap_or(start);
+            self.staff.cursor[o] = (first, 0);
+        }
+        self.sync_sector_cursors(sec);
+    }
+
     /// `M > 1`: robot `r`'s entry after `(pos, passes)` in the token sequence (skipping the
     /// first pass's skipped entries). O(len).
     fn entry_after(&self, r: usize, mut pos: usize, mut passes: u64) -> (usize, u64) {
@@ -609,7 +856,7 @@ impl ContinuousCoordinator {
     /// passes to first.
     /// O(N) plus a scan of the token sequence up to the last robot's next turn; no allocation.
     pub fn pre_alert(&self) -> Option<crate::PreAlert> {
-        if self.m > 1 {
+        if self.m > 1 || self.sectors.is_some() {
             return None;
         }
         let h = self.tick_s;
@@ -775,7 +1022,9 @@ impl ContinuousCoordinator {
         if let Some(p) = &mut self.pace {
             p.reset();
         }
-        if self.m > 1 {
+        if let Some(sec) = self.sectors {
+            self.init_sectors(&sec);
+        } else if self.m > 1 {
             self.init_next_entries();
         }
         self.grant(0);
@@ -792,7 +1041,9 @@ impl ContinuousCoordinator {
     }
 
     /// The task plan every robot repeats (schedule clock from 0); in a cell of different
-    /// tasks ([`ContinuousCoordinator::mixed`]) robot 0's ([`task_of`](Self::task_of)).
+    /// tasks ([`ContinuousCoordinator::mixed`]), or a sectored cell whose sectors took their
+    /// new plans one at a time ([`take_over_sector`](Self::take_over_sector)), robot 0's
+    /// ([`task_of`](Self::task_of)).
     pub fn task(&self) -> &Timeline {
         &self.plan(0).task
     }
@@ -1055,6 +1306,8 @@ impl ContinuousCoordinator {
                 self.next_group[r] = g + 1;
                 self.served[r] = self.stamp;
                 self.stamp += 1;
+                self.sector_served[r] = self.sector_stamp[o];
+                self.sector_stamp[o] += 1;
                 self.staff.slot[o] = None;
                 self.staff.assigned[r] = None;
                 // The load cap (one operator): the pass ended iff the grant of this entry
@@ -1178,41 +1431,11 @@ impl ContinuousCoordinator {
         let mut clock = [0.0; MAX_ROBOTS];
         let mut next = [0usize; MAX_ROBOTS];
         for i in 0..self.n {
-            let (plan, old_task) = (self.plan(i), &old.plan(i).task);
-            let (c, n_groups) = (plan.task.sample_clock_s(), plan.groups.len());
-            // The robot's reference position in `old`, and the same position's clock here.
-            let s_old = old.clock_s[i];
-            // `old`'s cursor is at or before the sample of its clock (it only advances to
-            // the clock, and both reset together), so this is O(1) amortized, not O(position).
-            let mut at = old.cursors[i].at;
-            let n = old_task.advance_cursor(&mut at, s_old);
-            let p = old_task.ref_time_in(n, s_old);
-            let mut s = if p <= 0.0 {
-                0.0
-            } else if p >= plan.task.n_ref() as f64 {
-                plan.task.end_s()
-            } else {
-                let k = p.floor() as usize;
-                c[k] + (p - k as f64) * (c[k + 1] - c[k])
-            };
-            // The interpolation rounds: never place the robot behind where it is (a robot
-            // never moves backwards, not even by a rounding error at a hand-over).
-            while plan.task.ref_time_at(s) < p && s < plan.task.end_s() {
-                // The next float up (`s ≥ 0`; `f64::next_up` is newer than the MSRV).
-                s = f64::from_bits(s.to_bits() + 1);
-            }
-            // Its next group here: the first it has not left.
-            let g = (0..n_groups)
-                .find(|&g| s - self.tol_s < plan.leave_s[g])
-                .unwrap_or(n_groups);
-            if g < n_groups && s > plan.gate_s[g] {
-                return bad(
-                    i,
-                    "is inside or past the gate of a low-confidence group of the new plan",
-                );
-            }
-            clock[i] = s;
-            next[i] = g;
+            (clock[i], next[i]) = self.placement(old, i)?;
+        }
+        if let Some(sec) = self.sectors {
+            self.take_over_sectors(old, &sec, &clock, &next);
+            return Ok(());
         }
         let len = self.tokens.len();
         // The robot's first token: its next group, or group 0 of its next task.
@@ -1247,8 +1470,337 @@ impl ContinuousCoordinator {
         let tokens: Vec<Token> = (0..len).map(|k| self.tokens[(start + k) % len]).collect();
         self.tokens = tokens.into();
         self.skip_first = skip.into();
-        self.clock_s = clock;
-        self.next_group = next;
+        self.place_after_hand_over(old, &clock, &next);
+        if self.m > 1 {
+            self.init_next_entries();
+        }
+        self.grant(self.monitor.ticks());
+        // The load cap's episode runs on too (from the start of the next one when the old cell
+        // had no cap).
+        if let Some(p) = &mut self.pace {
+            match &old.pace {
+                Some(o) => p.carry_over(o),
+                None => p.reset(),
+            }
+        }
+        Ok(())
+    }
+
+    /// Robot `i` of the running cell `old` placed on this coordinator's plan of it: its
+    /// schedule clock here at its reference position in `old` (never behind it) and its next
+    /// group here (the first it has not left).
+    ///
+    /// # Errors
+    /// [`Error::HandOver`] when the robot is inside or past the gate of a group of this plan
+    /// (not at a hand-over point).
+    fn placement(&self, old: &ContinuousCoordinator, i: usize) -> Result<(f64, usize)> {
+        let (plan, old_task) = (self.plan(i), &old.plan(i).task);
+        let (c, n_groups) = (plan.task.sample_clock_s(), plan.groups.len());
+        // The robot's reference position in `old`, and the same position's clock here.
+        let s_old = old.clock_s[i];
+        // `old`'s cursor is at or before the sample of its clock (it only advances to
+        // the clock, and both reset together), so this is O(1) amortized, not O(position).
+        let mut at = old.cursors[i].at;
+        let n = old_task.advance_cursor(&mut at, s_old);
+        let p = old_task.ref_time_in(n, s_old);
+        let mut s = if p <= 0.0 {
+            0.0
+        } else if p >= plan.task.n_ref() as f64 {
+            plan.task.end_s()
+        } else {
+            let k = p.floor() as usize;
+            c[k] + (p - k as f64) * (c[k + 1] - c[k])
+        };
+        // The interpolation rounds: never place the robot behind where it is (a robot
+        // never moves backwards, not even by a rounding error at a hand-over).
+        while plan.task.ref_time_at(s) < p && s < plan.task.end_s() {
+            // The next float up (`s ≥ 0`; `f64::next_up` is newer than the MSRV).
+            s = f64::from_bits(s.to_bits() + 1);
+        }
+        // Its next group here: the first it has not left.
+        let g = (0..n_groups)
+            .find(|&g| s - self.tol_s < plan.leave_s[g])
+            .unwrap_or(n_groups);
+        if g < n_groups && s > plan.gate_s[g] {
+            return Err(Error::HandOver {
+                robot: i,
+                why: "is inside or past the gate of a low-confidence group of the new plan",
+            });
+        }
+        Ok((s, g))
+    }
+
+    /// [`take_over`](Self::take_over) of a sectored cell, the robots at `clock` with `next`
+    /// their next groups (checked to be a hand-over point): each sector's token sequence is
+    /// rotated as its own one-operator cell's `take_over` rotates it. When `old` has the same
+    /// sectors, each sector's token goes to the robot whose turn it was in `old`'s sector,
+    /// unless a robot of the sector has seen a pass's worth of its sector's services since its
+    /// own last one, then to the sector's least recently served robot — the one-operator rule
+    /// with the sector's own stamps, so each sector hands over exactly as its own cell. From
+    /// a pooled cell or other sectors, each sector starts at its least recently served robot
+    /// (`served`, one clock for every robot). Allocates the rotated sequence.
+    fn take_over_sectors(
+        &mut self,
+        old: &ContinuousCoordinator,
+        sec: &Sectors,
+        clock: &[f64; MAX_ROBOTS],
+        next: &[usize; MAX_ROBOTS],
+    ) {
+        let same = old
+            .sectors
+            .is_some_and(|o| o.of[..self.n] == sec.of[..self.n] && old.m == self.m);
+        let wants = |t: &Token| t.group == next[t.robot] % self.plan(t.robot).groups.len().max(1);
+        let mut tokens = Vec::with_capacity(self.tokens.len());
+        let mut skip = Vec::with_capacity(self.tokens.len());
+        let mut found = [false; MAX_ROBOTS];
+        let mut sector_served = [0u64; MAX_ROBOTS];
+        let mut sector_stamp = [0u64; MAX_ROBOTS];
+        for o in 0..self.m {
+            let (start, end) = sec.range[o];
+            let members = || (0..self.n).filter(move |&r| usize::from(sec.of[r]) == o);
+            let chosen = if same {
+                sector_served = old.sector_served;
+                sector_stamp = old.sector_stamp;
+                let lru = members().min_by_key(|&r| old.sector_served[r]);
+                lru.map(|lru| {
+                    let waited = old.sector_stamp[o] - 1 - old.sector_served[lru];
+                    let others = (end - start)
+                        - (start..end)
+                            .filter(|&k| self.tokens[k].robot == lru)
+                            .count();
+                    let old_token = old.staff.slot[o]
+                        .map(|(t, _, _)| t)
+                        .or_else(|| old.tokens.get(old.staff.cursor[o].0).copied());
+                    match old_token {
+                        Some(t) if waited < others as u64 => t.robot,
+                        _ => lru,
+                    }
+                })
+            } else {
+                // The sector's robots ranked by their last service (one clock for all).
+                let mut ranked = [0usize; MAX_ROBOTS];
+                let mut k = 0;
+                for r in members() {
+                    ranked[k] = r;
+                    k += 1;
+                }
+                ranked[..k].sort_by_key(|&r| old.served[r]);
+                for (rank, &r) in ranked[..k].iter().enumerate() {
+                    sector_served[r] = rank as u64;
+                }
+                sector_stamp[o] = k as u64;
+                ranked[..k].first().copied()
+            };
+            let len = end - start;
+            let first = chosen
+                .and_then(|c| {
+                    (0..len).find(|&q| {
+                        let t = &self.tokens[start + q];
+                        t.robot == c && wants(t)
+                    })
+                })
+                .unwrap_or(0);
+            for k in 0..len {
+                let t = self.tokens[start + (first + k) % len];
+                found[t.robot] |= wants(&t);
+                tokens.push(t);
+                skip.push(!found[t.robot]);
+            }
+        }
+        self.tokens = tokens.into();
+        self.skip_first = skip.into();
+        self.place_after_hand_over(old, clock, next);
+        self.sector_served = sector_served;
+        self.sector_stamp = sector_stamp;
+        self.monitor = self.monitor.with_sectors(self.m, sec.of);
+        self.init_sector_cursors(sec);
+        self.grant(self.monitor.ticks());
+    }
+
+    /// Hands sector `o` of this running sectored cell over to `new`'s plan of sector `o`
+    /// (issue 44), the other sectors running on untouched: one hand-over per sector, each
+    /// taken when *its own* robots are at a hand-over point, never waiting for the others'
+    /// (a re-plan of `M` sectors calls it once per sector, each when it succeeds;
+    /// [`take_over`](Self::take_over) needs every sector at a point at once, which sectors
+    /// whose operators are busy almost all the time reach rarely). `new` is a sectored cell
+    /// with the same sectors (a fresh [`sectored`](Self::sectored) of the new plan); sector
+    /// `o`'s robots continue from where they are, in reference time, on `new`'s task plan,
+    /// groups and sector-`o` token order, exactly as sector `o`'s own one-operator cell's
+    /// [`take_over`](Self::take_over) places them and rotates its sequence (the token to the
+    /// robot whose turn it was in the sector, unless a robot of the sector has seen a pass of
+    /// the sector's services since its own last one, then to the sector's least recently
+    /// served robot: the sector's own stamps, so its hand-over liveness is the one-operator
+    /// cell's). Operator `o` keeps its switch state (the robot it last released and when);
+    /// an entry it was granted whose robot has not reached its gate is dropped, as
+    /// `take_over` drops it, and granted anew by the new order.
+    ///
+    /// **Why the guarantee holds.** Each sector keeps ticking exactly as its own one-operator
+    /// cell (a robot's step reads only its own state, plan and its sector's operator), and a
+    /// sector's hand-over is its own cell's `take_over`, at its own hand-over point: sector
+    /// `o`'s robots are then all outside the new plan's groups, operator `o` holds nothing,
+    /// so the one-operator argument starts afresh in sector `o` (at most one of its robots
+    /// low-confidence in any tick, its stretches `k` ticks apart) while every other sector's
+    /// state, including a robot in the middle of a stretch and its operator's slot, is not
+    /// touched. The sectors' operators are disjoint and fixed, so at most one robot per
+    /// sector, at most `M` in all, is low-confidence in any tick, and a robot's stretch is
+    /// only ever under its sector's operator: no stretch is handed over, whatever the order in
+    /// which the sectors take their plans. After the call the cell runs sector `o` on `new`'s
+    /// plan and the others on theirs (per sector a plan; allocates the plans and the spliced
+    /// token sequence, O(M·T_ref + len)).
+    ///
+    /// # Errors
+    /// [`Error::HandOver`] when either cell is not sectored, the sectors differ, `o` is not a
+    /// sector with robots, `new` has another robot count, task length or control tick, this
+    /// cell has a latched fault, or a robot of sector `o` is not at a hand-over point of
+    /// `new`; `self` is then unchanged.
+    pub fn take_over_sector(&mut self, new: &ContinuousCoordinator, o: usize) -> Result<()> {
+        let bad = |robot, why| Err(Error::HandOver { robot, why });
+        let (Some(sec), Some(nsec)) = (self.sectors, new.sectors) else {
+            return bad(0, "a sector's hand-over needs two sectored cells");
+        };
+        if new.n != self.n || new.m != self.m || nsec.of[..self.n] != sec.of[..self.n] {
+            return bad(0, "the new plan has other sectors");
+        }
+        let members = (0..self.n).filter(|&r| usize::from(sec.of[r]) == o);
+        let Some(first_robot) = members.clone().next() else {
+            return bad(0, "names no sector with robots");
+        };
+        if let Some(i) = members
+            .clone()
+            .find(|&i| new.plan(i).task.n_ref() != self.plan(i).task.n_ref())
+        {
+            return bad(
+                i,
+                "the new plan's task has another number of reference samples",
+            );
+        }
+        if (new.tick_s - self.tick_s).abs() > 1e-12 * self.tick_s.max(new.tick_s) {
+            return bad(0, "the new plan runs at another control tick");
+        }
+        if let Some(f) = self.monitor.fault() {
+            return bad(f.stopped, "the old cell has a latched fault");
+        }
+        let mut clock = [0.0; MAX_ROBOTS];
+        let mut next = [0usize; MAX_ROBOTS];
+        for i in members.clone() {
+            (clock[i], next[i]) = new.placement(self, i)?;
+        }
+        // Sector o's new sequence, rotated as its own cell's take_over rotates it.
+        let (nstart, nend) = nsec.range[o];
+        let nlen = nend - nstart;
+        let n_groups = new.plan(first_robot).groups.len().max(1);
+        let wants = |t: &Token| t.group == next[t.robot] % n_groups;
+        let lru = members
+            .clone()
+            .min_by_key(|&r| self.sector_served[r])
+            .expect("a sector with robots");
+        let waited = self.sector_stamp[o] - 1 - self.sector_served[lru];
+        let others = nlen
+            - (nstart..nend)
+                .filter(|&k| new.tokens[k].robot == lru)
+                .count();
+        let old_token = self.staff.slot[o]
+            .map(|(t, _, _)| t)
+            .or_else(|| self.tokens.get(self.staff.cursor[o].0).copied());
+        let chosen = match old_token {
+            Some(t) if waited < others as u64 => t.robot,
+            _ => lru,
+        };
+        let first = (0..nlen)
+            .find(|&q| {
+                let t = &new.tokens[nstart + q];
+                t.robot == chosen && wants(t)
+            })
+            .unwrap_or(0);
+        // Splice it in place of the sector's old range; the later ranges shift.
+        let (start, end) = sec.range[o];
+        let mut tokens = Vec::with_capacity(self.tokens.len() - (end - start) + nlen);
+        let mut skip = Vec::with_capacity(tokens.capacity());
+        tokens.extend_from_slice(&self.tokens[..start]);
+        skip.extend_from_slice(&self.skip_first[..start]);
+        let mut found = [false; MAX_ROBOTS];
+        for k in 0..nlen {
+            let t = new.tokens[nstart + (first + k) % nlen];
+            found[t.robot] |= wants(&t);
+            tokens.push(t);
+            skip.push(!found[t.robot]);
+        }
+        tokens.extend_from_slice(&self.tokens[end..]);
+        skip.extend_from_slice(&self.skip_first[end..]);
+        let shift = |p: usize| {
+            if p >= end {
+                p + nlen - (end - start)
+            } else {
+                p
+            }
+        };
+        let mut sec2 = sec;
+        for q in 0..self.m {
+            let (a, b) = sec.range[q];
+            if q == o || a == b {
+                continue;
+            }
+            sec2.range[q] = (shift(a), shift(b));
+            self.staff.cursor[q].0 = shift(self.staff.cursor[q].0);
+            if let Some((_, pos, _)) = &mut self.staff.slot[q] {
+                *pos = shift(*pos);
+            }
+        }
+        sec2.range[o] = (start, start + nlen);
+        // One plan per sector: sector o's is new's, the others keep theirs.
+        let plans: Vec<Plan> = (0..self.m)
+            .map(|q| {
+                let r = (0..self.n).find(|&r| usize::from(sec.of[r]) == q);
+                match r {
+                    Some(r) if q != o => self.plan(r).clone(),
+                    _ => new.plan(first_robot).clone(),
+                }
+            })
+            .collect();
+        self.plans = plans.into();
+        for r in 0..self.n {
+            self.plan_of[r] = sec.of[r];
+        }
+        self.tokens = tokens.into();
+        self.skip_first = skip.into();
+        self.sectors = Some(sec2);
+        // One clock tolerance for all the plans (the larger errs on the safe side: module
+        // docs of `tol`); the same task's plans have the same, bit for bit.
+        self.tol_s = self.tol_s.max(new.tol_s);
+        // Sector o's robots where they are on the new plan, none granted; the rest is kept.
+        for i in members {
+            self.clock_s[i] = clock[i];
+            self.next_group[i] = next[i];
+            let task = &self.plans[o].task;
+            let (c, last) = (task.sample_clock_s(), task.n_ref() - 1);
+            let k = c
+                .partition_point(|&x| x <= clock[i] - self.tol_s)
+                .saturating_sub(1)
+                .min(last);
+            self.cursors[i] = Cursors::at(k);
+            self.staff.assigned[i] = None;
+        }
+        self.staff.slot[o] = None;
+        let f = (start..start + nlen)
+            .find(|&k| !self.skip_first[k])
+            .unwrap_or(start);
+        self.staff.cursor[o] = (f, 0);
+        self.grant_sector(self.monitor.ticks(), &sec2, o);
+        self.sync_sector_cursors(&sec2);
+        Ok(())
+    }
+
+    /// The common part of a hand-over: every robot at `clock` with `next` its next group, the
+    /// tasks, service stamps, fault monitor's tick count and the operators' switch state and
+    /// preferred operators carried over from `old`, no operator holding an entry.
+    fn place_after_hand_over(
+        &mut self,
+        old: &ContinuousCoordinator,
+        clock: &[f64; MAX_ROBOTS],
+        next: &[usize; MAX_ROBOTS],
+    ) {
+        self.clock_s = *clock;
+        self.next_group = *next;
         self.tasks = old.tasks;
         // Cursors at or before each robot's sample (the tolerance below it), so the next
         // tick advances them by a few samples instead of from the task start.
@@ -1275,19 +1827,6 @@ impl ContinuousCoordinator {
             last_op: old.staff.last_op,
             ..Staff::default()
         };
-        if self.m > 1 {
-            self.init_next_entries();
-        }
-        self.grant(self.monitor.ticks());
-        // The load cap's episode runs on too (from the start of the next one when the old cell
-        // had no cap).
-        if let Some(p) = &mut self.pace {
-            match &old.pace {
-                Some(o) => p.carry_over(o),
-                None => p.reset(),
-            }
-        }
-        Ok(())
     }
 
     /// Test only: puts robot `robot` at schedule clock `clock_s` of its current task with

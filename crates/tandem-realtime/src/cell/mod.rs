@@ -142,7 +142,7 @@ pub(crate) mod pace;
 
 #[allow(deprecated)]
 pub use coordinator::{CellRun, CellTick};
-pub use coordinator::{ContinuousCoordinator, run_cell};
+pub use coordinator::{ContinuousCoordinator, SectorOrder, run_cell};
 pub use groups::{
     Group, Token, first_split_group, groups, is_runnable, mixed_token_sequence, token_sequence,
 };

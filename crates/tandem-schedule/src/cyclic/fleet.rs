@@ -4,12 +4,15 @@
 //! invariant and the continuous cell (issue 44)".
 
 use serde::{Deserialize, Serialize};
+use tandem_realtime::ContinuousCoordinator;
 
+use super::checked::CheckedCyclicPlan;
 use super::graph::TaskShape;
 use super::plan::groups_per_task_s;
 use super::search::{CyclicParams, cyclic_plan};
 use crate::problem::check_robot_count;
-use crate::{Problem, Result};
+use crate::sectors::even_sector_sizes;
+use crate::{Error, Problem, Result};
 
 /// A lower bound (s) on the period of every 1-periodic run of `n_robots` robots on `problem`
 /// served by `operators` operators under the `M`-token rule
@@ -120,6 +123,146 @@ pub fn sectored_plan(
         tasks_per_hour: best[m][n_robots].0,
         by_size,
     })
+}
+
+/// The ceilings (tasks per hour) of the two continuous cells of `N` robots and `M` operators
+/// ([`fleet_cell_choice`]): the pooled cell's `3600·N/max(N·W/M, D_min)`
+/// ([`pooled_period_lower_bound_s`]) and the even sectors' (`even_sector_sizes`: `N mod M`
+/// sectors of `⌈N/M⌉` robots, the rest `⌊N/M⌋`) `Σ_o 3600·k_o/max(k_o·W, D_min)`, each sector a
+/// one-operator cell bounded by the same argument with `M = 1`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FleetCellChoice {
+    /// The even sectors' sizes when they are run, empty for the pooled cell.
+    pub sectors: Vec<usize>,
+    /// The pooled cell's ceiling (tasks per hour).
+    pub pooled_bound_tasks_per_hour: f64,
+    /// The even sectors' ceiling (tasks per hour), at most the pooled one's.
+    pub sectored_bound_tasks_per_hour: f64,
+}
+
+/// The ceilings of the two continuous cells `M > 1` operators may run on `problem` with `N`
+/// robots, and the even sectors when their ceiling equals the pooled cell's (within 1e-9,
+/// relative), else none. Which cell runs is measured, not read from this
+/// (`Planner::fleet_coordinator`; docs/decisions.md, "The continuous cell of M operators: one
+/// hand-over per sector, pooled or sectored by measurement (issue 44)"). `M = 1` and `N ≤ 1`:
+/// no sectors.
+///
+/// **Why.** `Σ_o min(3600·k_o/D_min, 3600/W) ≤ min(3600·N/D_min, 3600·M/W)` always (a sum of
+/// minima is at most the minimum of the sums), so pooling can gain only where the sectors'
+/// ceiling is below the pooled one's — robots that do not divide evenly among the operators
+/// (some sectors robot-bound while others are operator-bound, `(3, 2)` of the unit tests).
+/// Where they are equal, each sector runs a one-operator plan that reaches its own ceiling
+/// (the plans count the hand-overs), while the pooled cell runs one operator's order of all
+/// `N` robots with `M` tokens and loses to queueing (measured 84 % of the ceiling at `(8, 4)`).
+///
+/// # Errors
+/// [`crate::Error::Realtime`] (`RobotCount`, `OperatorCount`) for `N` or `M` outside
+/// `1..=MAX_ROBOTS`.
+pub fn fleet_cell_choice(
+    problem: &Problem,
+    n_robots: usize,
+    operators: usize,
+) -> Result<FleetCellChoice> {
+    check_robot_count(n_robots)?;
+    let m = tandem_realtime::OperatorCount::new(operators)?.get();
+    let shape = TaskShape::new(problem);
+    let rate = |k: usize, m: usize| 3600.0 * k as f64 / pooled_bound_of(&shape, k, m);
+    let pooled = rate(n_robots, m);
+    let sizes = even_sector_sizes(n_robots, m);
+    let sectored: f64 = sizes.iter().map(|&k| rate(k, 1)).sum();
+    let run_sectors = m > 1 && n_robots > 1 && sectored >= pooled * (1.0 - 1e-9);
+    Ok(FleetCellChoice {
+        sectors: if run_sectors { sizes } else { Vec::new() },
+        pooled_bound_tasks_per_hour: pooled,
+        sectored_bound_tasks_per_hour: sectored,
+    })
+}
+
+/// The sectored continuous cell of `sizes` (robots per sector, sector `o` the contiguous robots
+/// `Σ_{p<o} sizes[p] ..`) on `problem` at the control tick `tick_s`: each sector runs `plans`'
+/// one-operator plan of its size (the first of `plans` with that many robots) under operator
+/// `o` alone ([`ContinuousCoordinator::sectored`]). Returns the coordinator and the planned
+/// throughput, the sum of the sectors' plans' `tasks_per_hour`.
+///
+/// # Errors
+/// [`Error::BadParam`] (`plans`) when no plan has a sector's size, or one was checked at
+/// another tick; the realtime crate's for bad sectors.
+pub fn sectored_coordinator(
+    problem: &Problem,
+    sizes: &[usize],
+    plans: &[CheckedCyclicPlan],
+    tick_s: f64,
+) -> Result<(ContinuousCoordinator, f64)> {
+    let mut sectors = Vec::with_capacity(sizes.len());
+    let mut first = 0;
+    let mut planned = 0.0;
+    let mut task = None;
+    for &k in sizes {
+        let Some(p) = plans
+            .iter()
+            .find(|p| p.n_robots() == k && p.tick_s().to_bits() == tick_s.to_bits())
+        else {
+            return Err(Error::BadParam {
+                name: "plans",
+                why: "must hold a plan checked at the cell's tick for every sector size",
+            });
+        };
+        let order = p.plan().order.iter().map(|s| (s.robot, s.lc)).collect();
+        sectors.push(((first..first + k).collect(), order));
+        planned += p.plan().tasks_per_hour;
+        first += k;
+        task.get_or_insert_with(|| p.coordinator().task().clone());
+    }
+    let Some(task) = task else {
+        return Err(Error::BadParam {
+            name: "sizes",
+            why: "must name at least one sector",
+        });
+    };
+    let cell =
+        ContinuousCoordinator::sectored(task, &problem.usable_holds(), &sectors, first, tick_s)?;
+    Ok((cell, planned))
+}
+
+/// The throughput (tasks per hour) a continuous `cell` (a copy of it, from where it is)
+/// measures with every operator at the plan's rate (`Operator::Scheduled`): `warm` periods of
+/// `period_s` to settle, then the tasks completed in the next `window` periods, per hour of
+/// that window (the tick's real seconds). Deterministic (no random input); O(ticks·N).
+/// What the planner compares the pooled and the sectored cell by (issue 44): each cell's
+/// own run-time rule with the planned operator, hand-overs and queueing at the tokens
+/// included, which neither cell's ceiling counts.
+///
+/// # Errors
+/// [`Error::BadParam`] (`period_s`) unless finite and > 0, `window` ≥ 1 and the run is at
+/// most 10⁷ ticks; the realtime crate's for a tick that fails.
+pub fn nominal_tasks_per_hour(
+    cell: &ContinuousCoordinator,
+    period_s: f64,
+    warm: u32,
+    window: u32,
+) -> Result<f64> {
+    let h = cell.tick_s();
+    let per = (period_s / h).ceil();
+    let total = per * f64::from(warm + window);
+    if !(period_s.is_finite() && period_s > 0.0) || window == 0 || total > 1e7 {
+        return Err(Error::BadParam {
+            name: "period_s",
+            why: "must be finite and > 0, with a window of ≥ 1 period and at most 1e7 ticks in all",
+        });
+    }
+    let mut c = cell.clone();
+    let ops = [tandem_realtime::Operator::Scheduled; tandem_realtime::MAX_ROBOTS];
+    let m = c.operators();
+    let done = |c: &ContinuousCoordinator| c.tasks_completed().iter().sum::<u64>();
+    for _ in 0..(per as u64) * u64::from(warm) {
+        c.tick_many(&ops[..m])?;
+    }
+    let at_start = done(&c);
+    let ticks = (per as u64) * u64::from(window);
+    for _ in 0..ticks {
+        c.tick_many(&ops[..m])?;
+    }
+    Ok((done(&c) - at_start) as f64 * 3600.0 / (ticks as f64 * h))
 }
 
 #[cfg(test)]
@@ -240,5 +383,62 @@ mod tests {
                 assert!(got >= 1.1 * sectored, "{got} vs {sectored}");
             }
         }
+    }
+
+    #[test]
+    fn the_cell_choice_by_hand() {
+        let p = one_stretch();
+        // W = 1.5 s, D_min = 2 s. (4, 2): pooled 3600·4/max(3, 2) = 4800; sectors 2 + 2, each
+        // 3600·2/max(3, 2) = 2400: equal, the sectors run.
+        let c = fleet_cell_choice(&p, 4, 2).unwrap();
+        assert_eq!(c.sectors, [2, 2]);
+        assert!((c.pooled_bound_tasks_per_hour - 4800.0).abs() < 1e-9);
+        assert!((c.sectored_bound_tasks_per_hour - 4800.0).abs() < 1e-9);
+        // (3, 2): pooled 3600·3/max(2.25, 2) = 4800; sectors 2 + 1: 2400 + 3600/2 = 4200 <
+        // 4800, the pooled cell runs.
+        let c = fleet_cell_choice(&p, 3, 2).unwrap();
+        assert!(c.sectors.is_empty());
+        assert!((c.sectored_bound_tasks_per_hour - 4200.0).abs() < 1e-9);
+        // (8, 4): 9600 both, four sectors of 2; one operator: the pooled (one) cell.
+        assert_eq!(fleet_cell_choice(&p, 8, 4).unwrap().sectors, [2, 2, 2, 2]);
+        assert!(fleet_cell_choice(&p, 8, 1).unwrap().sectors.is_empty());
+    }
+
+    #[test]
+    fn the_sectored_cell_reaches_its_planned_throughput() {
+        let p = one_stretch();
+        for (n, m) in [(4, 2), (8, 4)] {
+            let sizes = fleet_cell_choice(&p, n, m).unwrap().sectors;
+            let plans = [CheckedCyclicPlan::search(&p, 2, &CyclicParams::default(), 0.01).unwrap()];
+            let (mut cell, planned) = sectored_coordinator(&p, &sizes, &plans, 0.01).unwrap();
+            assert_eq!(cell.operators(), m);
+            let ops = [tandem_realtime::Operator::Scheduled; 4];
+            let mut at_start = 0;
+            for k in 0..60_000 {
+                if k == 20_000 {
+                    at_start = cell.tasks_completed().iter().sum::<u64>();
+                }
+                let t = cell.tick_many(&ops[..m]).unwrap();
+                assert!(!t.over(m) && t.fault.is_none());
+            }
+            let got =
+                (cell.tasks_completed().iter().sum::<u64>() - at_start) as f64 * 3600.0 / 400.0;
+            let ceiling = 3600.0 * n as f64 / pooled_period_lower_bound_s(&p, n, m).unwrap();
+            eprintln!(
+                "({n}, {m}): sectored cell {got:.1} tasks/h, planned {planned:.1}, ceiling {ceiling:.1}"
+            );
+            // The planned 2 sectors of 2 robots: 3600·2/3.02 each (a tick per hand-over).
+            assert!(
+                (planned - m as f64 * 7200.0 / 3.02).abs() < 1e-6,
+                "{planned}"
+            );
+            assert!(got >= 0.98 * planned && got <= ceiling * 1.001, "{got}");
+        }
+        // A size without its plan is refused by name.
+        let plans = [CheckedCyclicPlan::search(&p, 2, &CyclicParams::default(), 0.01).unwrap()];
+        assert!(matches!(
+            sectored_coordinator(&p, &[3], &plans, 0.01),
+            Err(crate::Error::BadParam { name: "plans", .. })
+        ));
     }
 }

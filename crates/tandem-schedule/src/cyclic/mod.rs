@@ -77,7 +77,10 @@ mod run;
 mod search;
 
 pub use checked::CheckedCyclicPlan;
-pub use fleet::{SectoredPlan, pooled_period_lower_bound_s, sectored_plan};
+pub use fleet::{
+    FleetCellChoice, SectoredPlan, fleet_cell_choice, nominal_tasks_per_hour,
+    pooled_period_lower_bound_s, sectored_coordinator, sectored_plan,
+};
 pub use graph::{Event, EventGraph, Gap, Stretch, TaskShape, event_graph};
 pub use mix::{MAX_MIX_RATIO, MixBound, MixTask, best_mix, mix_period_lower_bound_s};
 pub use mixed::{

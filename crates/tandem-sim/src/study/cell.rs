@@ -29,7 +29,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 use tandem_lfd::TaskModel;
-use tandem_planner::{ExecutionRecord, Planner};
+use tandem_planner::{ExecutionRecord, FleetPick, Planner};
 use tandem_realtime::Timeline;
 use tandem_realtime::cell::ContinuousCoordinator;
 use tandem_schedule::{CheckedCyclicPlan, CyclicParams};
@@ -74,6 +74,11 @@ pub struct CellIteration {
     pub holds: Vec<usize>,
     /// Reference samples that truly need help but are high-confidence ([`crate::truth::falsely_trusted`]).
     pub falsely_trusted_samples: usize,
+    /// `M > 1` operators (issue 44): which cell ran this plan, pooled or sectored, and the
+    /// throughputs it was picked by (`Planner::fleet_coordinator`). `None` (not written) for
+    /// one operator.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fleet: Option<FleetPick>,
 }
 
 /// A completed task of a trial.
@@ -380,10 +385,15 @@ impl CellStudyResult {
 }
 
 /// The run-time coordinator of the cell's `plan` with the planner's operators
-/// (`Planner::continuous_coordinator`: the switch time, the load cap and `M` tokens, issues 41
-/// and 44; no-ops at their defaults).
-fn coordinator_of(planner: &Planner, plan: &CheckedCyclicPlan) -> Result<ContinuousCoordinator> {
-    Ok(planner.continuous_coordinator(plan)?)
+/// (`Planner::fleet_coordinator`: the switch time, the load cap and `M` tokens, issues 41
+/// and 44; no-ops at their defaults), the cell of `M > 1` operators chosen as the study's
+/// `[operator] fleet_cell` says, and what ran.
+fn coordinator_of(
+    planner: &Planner,
+    plan: &CheckedCyclicPlan,
+    config: &StudyConfig,
+) -> Result<(ContinuousCoordinator, Option<FleetPick>)> {
+    Ok(planner.fleet_coordinator(plan, config.operator.fleet_cell)?)
 }
 
 /// The cell's plan on the planner's problem and its record: the planner's plan of a
@@ -422,6 +432,7 @@ fn plan_of(
             .collect(),
         holds: planner.problem().usable_holds(),
         falsely_trusted_samples: falsely_trusted_where(planner.confidence().conf(), can_need),
+        fleet: None,
     };
     Ok((checked, iteration))
 }
@@ -530,14 +541,12 @@ impl<'a> ContinuousTrial<'a> {
         let can_need = state.truth.can_need();
         let planner = &state.planner;
         let n = planner.n_robots();
-        let (plan, first) = plan_of(planner, can_need, 0, 0)?;
+        let (plan, mut first) = plan_of(planner, can_need, 0, 0)?;
         // The cell's tick: the plan's, the schedule's (`Δt_s` unless the sampler sets a tick).
         let dt_s = plan.tick_s();
-        let sim = CellSim::new(
-            planner.model(),
-            coordinator_of(planner, &plan)?,
-            &state.operator,
-        )?;
+        let (coord, fleet) = coordinator_of(planner, &plan, state.config)?;
+        first.fleet = fleet;
+        let sim = CellSim::new(planner.model(), coord, &state.operator)?;
         let needed = (0..n)
             .map(|_| state.truth.draw(&mut state.rng))
             .collect::<Result<Vec<_>>>()?;
@@ -580,7 +589,7 @@ impl<'a> ContinuousTrial<'a> {
             gates - self.gates_then[i],
             self.dt_s,
             self.period_s,
-            self.sim.coordinator().task(),
+            self.sim.coordinator().task_of(i),
         );
         (self.last_done[i], self.gates_then[i]) = (f.tick, gates);
         let needed = &self.needed[i];
@@ -651,8 +660,9 @@ impl TrialKind for ContinuousTrial<'_> {
         let t = Instant::now();
         let planner = &state.planner;
         let tick = self.sim.stats().ticks;
-        let (plan, iteration) = plan_of(planner, self.can_need, self.recorded, tick)?;
-        let next = coordinator_of(planner, &plan)?;
+        let (plan, mut iteration) = plan_of(planner, self.can_need, self.recorded, tick)?;
+        let (next, fleet) = coordinator_of(planner, &plan, state.config)?;
+        iteration.fleet = fleet;
         state.times.scheduling += t.elapsed();
         if self.sim.replan(planner.model(), next)? {
             self.period_s = iteration.period_s;

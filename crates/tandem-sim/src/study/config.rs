@@ -1,7 +1,7 @@
 //! The study's configuration (`fixtures/study.toml`).
 
 use serde::{Deserialize, Serialize};
-use tandem_planner::PlannerParams;
+use tandem_planner::{FleetCell, PlannerParams};
 
 use crate::task::TaskParams;
 use crate::workcell::OperatorParams;
@@ -81,6 +81,12 @@ pub struct StudyOperator {
     /// when so).
     #[serde(skip_serializing_if = "is_one")]
     pub operators: usize,
+    /// Which continuous cell `M > 1` operators run (issue 44): `auto` (the default, not
+    /// written: the pooled cell unless the even sectors measure strictly faster,
+    /// `Planner::fleet_coordinator`), `pooled` or `sectored` (forced, to compare the two in
+    /// one study). Rounds and one operator ignore it.
+    #[serde(skip_serializing_if = "FleetCell::is_auto")]
+    pub fleet_cell: FleetCell,
 }
 
 /// Whether `m` is 1 (serde's `skip_serializing_if` of [`StudyOperator::operators`]).
@@ -99,6 +105,7 @@ impl Default for StudyOperator {
             max_busy_share: 1.0,
             switch_true_s: 0.0,
             operators: 1,
+            fleet_cell: FleetCell::Auto,
         }
     }
 }

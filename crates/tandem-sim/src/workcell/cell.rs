@@ -57,6 +57,10 @@ pub struct FinishedTask {
 pub struct CellSim {
     coord: ContinuousCoordinator,
     pending: Option<ContinuousCoordinator>,
+    /// A sectored cell taking a sectored `pending` of the same sectors: per sector, whether
+    /// it has taken that plan already (one hand-over per sector,
+    /// [`ContinuousCoordinator::take_over_sector`]).
+    taken: Vec<bool>,
     op: Operate,
     robots: Robots,
     /// Each robot's completed tasks at the end of the last tick.
@@ -101,6 +105,7 @@ impl CellSim {
             },
             coord,
             pending: None,
+            taken: Vec::new(),
             corrected: false,
         })
     }
@@ -152,10 +157,46 @@ impl CellSim {
             });
         }
         self.pending = Some(next);
+        self.taken.clear();
         Ok(self.try_hand_over())
     }
 
+    /// Hands the cell over to the pending plan where the robots allow: a sectored cell to a
+    /// plan of the same sectors sector by sector, each sector when its own robots are at a
+    /// hand-over point ([`ContinuousCoordinator::take_over_sector`]; the plan counts as taken
+    /// over, [`CellStats::hand_overs`], once every sector has it); any other cell all robots
+    /// at once ([`ContinuousCoordinator::take_over`]).
     fn try_hand_over(&mut self) -> bool {
+        let Some(next) = self.pending.as_mut() else {
+            return false;
+        };
+        let same_sectors = self.coord.operators() == next.operators()
+            && self
+                .coord
+                .sector_of()
+                .is_some_and(|s| next.sector_of().is_some_and(|t| s == t));
+        if same_sectors {
+            let of = self.coord.sector_of().expect("checked above");
+            let m = self.coord.operators();
+            if self.taken.len() != m {
+                // Operators without robots have nothing to take over.
+                self.taken = (0..m)
+                    .map(|o| !of.iter().any(|&s| usize::from(s) == o))
+                    .collect();
+            }
+            for o in 0..m {
+                if !self.taken[o] {
+                    self.taken[o] = self.coord.take_over_sector(next, o).is_ok();
+                }
+            }
+            if self.taken.iter().any(|t| !t) {
+                return false;
+            }
+            self.pending = None;
+            self.taken.clear();
+            self.stats.hand_overs += 1;
+            return true;
+        }
         hand_over(&mut self.coord, &mut self.pending, &mut self.stats)
     }
 
@@ -189,7 +230,10 @@ impl CellSim {
                 ops: std::slice::from_mut(&mut self.op),
                 robot_task: &[],
             },
-            |c, _, n| (c.task().grad_min()[n], c.task().grad_max()[n]),
+            |c, i, n| {
+                let task = c.task_of(i);
+                (task.grad_min()[n], task.grad_max()[n])
+            },
             None,
             &mut self.robots,
             self.stats.ticks as usize,
@@ -283,11 +327,14 @@ pub(super) fn hand_over(
 
 /// Each robot's reference time at its clock.
 fn ref_times(coord: &ContinuousCoordinator) -> Vec<f64> {
-    let task = coord.task();
     coord
         .clock_s()
         .iter()
-        .map(|&c| task.ref_time_at(c).min(task.n_ref() as f64))
+        .enumerate()
+        .map(|(i, &c)| {
+            let task = coord.task_of(i);
+            task.ref_time_at(c).min(task.n_ref() as f64)
+        })
         .collect()
 }
 
