@@ -669,8 +669,22 @@ class Schedule:
 class Coordinator:
     """The Rust real-time coordinator of a schedule (§II-B5), one control tick per call."""
 
-    def __init__(self, schedule: Schedule) -> None:
-        """Raises ``ScheduleError`` for a schedule of your own not yet ``validate()``d."""
+    def __init__(self, schedule: Schedule, max_busy_share: float = 1.0) -> None:
+        """Raises ``ScheduleError`` for a schedule of your own not yet ``validate()``d,
+        ``ParamError`` for ``max_busy_share`` not in (0, 1]."""
+    @property
+    def max_busy_share(self) -> float:
+        """The operator's load cap ``u`` kept at run time (1: none)."""
+    @property
+    def switch_ticks(self) -> int: ...
+    def busy_ticks(self, operator: int = 0) -> Optional[int]:
+        """The round's busy ticks ``B`` of ``operator`` (``None`` without a cap)."""
+    @property
+    def rest_ticks(self) -> int:
+        """The rest (ticks) after the round that keeps ``B ≤ u·(ticks + rest)``."""
+    @property
+    def rest_s(self) -> float:
+        """``rest_ticks`` in seconds: sleep it before the next round."""
     def tick(
         self,
         operator: Union[None, float, str, Sequence[Union[None, float, str]]] = None,

@@ -127,13 +127,71 @@ impl PyCoordinator {
     /// one of your own that passed :meth:`Schedule.validate` (the margin check of Alg. 2 at
     /// its tick is what makes a run safe).
     ///
+    /// Args:
+    ///     schedule: the schedule to run.
+    ///     max_busy_share: the operator's load cap ``u`` in ``(0, 1]`` kept at run time
+    ///         (issue 41; default 1: no cap). The coordinator counts the round's busy ticks
+    ///         ``B`` (ticks with a low-confidence robot, plus the switch time's ticks per change
+    ///         of robot) and, once the round has ended, :attr:`rest_ticks` / :attr:`rest_s` is
+    ///         the rest before the next round that keeps ``B ≤ u·(ticks + rest)``
+    ///         (``tandem_realtime::Coordinator::with_max_busy_share``). Nothing inside the
+    ///         round changes. :meth:`Planner.controller` sets the planner's
+    ///         ``params["sampler"]["max_busy_share"]`` (stored in the state file).
+    ///
     /// Raises:
     ///     ScheduleError: a schedule of your own not yet validated (``violation`` is
     ///         ``"Unchecked"``), or one that fails the check (``violation`` names the rule).
+    ///     ParamError: ``max_busy_share`` not in ``(0, 1]`` (``name`` is
+    ///         ``"max_busy_share"``; the text is the Rust error's).
     #[new]
-    fn py_new(schedule: PyRef<'_, PySchedule>) -> PyResult<Self> {
-        let inner = guard(|| schedule.checked()?.coordinator().map_err(Error::from))?;
+    #[pyo3(signature = (schedule, max_busy_share=1.0))]
+    fn py_new(schedule: PyRef<'_, PySchedule>, max_busy_share: f64) -> PyResult<Self> {
+        let inner = guard(|| {
+            let c = schedule.checked()?.coordinator()?;
+            Ok(c.with_max_busy_share(max_busy_share)?)
+        })?;
         Ok(Self { inner })
+    }
+
+    /// The operator's load cap ``u`` this coordinator keeps at run time (``max_busy_share=``
+    /// of the constructor, or the planner's for :meth:`Planner.controller`; 1: none).
+    #[getter]
+    fn max_busy_share(&self) -> f64 {
+        self.inner.max_busy_share()
+    }
+
+    /// ``k``: the operator's switch time in whole ticks (0 for ``Coordinator(schedule)``; the
+    /// planner's ``switch_s`` for :meth:`Planner.controller`), counted once per change of
+    /// robot in :meth:`busy_ticks`.
+    #[getter]
+    fn switch_ticks(&self) -> u64 {
+        self.inner.switch_ticks()
+    }
+
+    /// ``B``: the busy ticks of ``operator`` (0-based, ``< M``) in the round so far — its
+    /// ticks with a low-confidence robot plus :attr:`switch_ticks` per change of robot (the
+    /// round's first stretch is no change) — or ``None`` without a load cap or for an
+    /// operator ``≥ M``.
+    #[pyo3(signature = (operator=0))]
+    fn busy_ticks(&self, operator: usize) -> Option<u64> {
+        self.inner.busy_ticks(operator)
+    }
+
+    /// The rest (ticks) before the next round, under the load cap ``u``: the least whole
+    /// ``n`` with ``B ≤ u·n`` for every operator, less the round's ticks, 0 when the round
+    /// alone keeps the cap (always 0 at ``u = 1``). Read it once :attr:`is_finished`, before
+    /// :meth:`reset` (which starts a new count): the share of the round and its rest is then
+    /// at most ``u`` whatever the operator did.
+    #[getter]
+    fn rest_ticks(&self) -> u64 {
+        self.inner.rest_ticks()
+    }
+
+    /// :attr:`rest_ticks` in seconds (ticks × :attr:`tick_s`): how long the operator rests
+    /// before the next round starts.
+    #[getter]
+    fn rest_s(&self) -> f64 {
+        self.inner.rest_s()
     }
 
     /// Advances one control tick.
