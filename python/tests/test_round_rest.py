@@ -128,3 +128,25 @@ def test_the_docs_example_runs() -> None:
     blocks = re.findall(r"```python\n(.*?)```", text[start:end], flags=re.S)
     assert len(blocks) == 1
     exec(compile(blocks[0], "docs/python.md", "exec"), {})
+
+
+def test_a_planned_schedules_coordinator_keeps_the_planned_switch_time(tmp_path: Path) -> None:
+    # A planner's schedule carries its switch time: ``Coordinator(p.schedule)`` runs exactly as
+    # ``p.controller("rounds")`` (robots leave their holds δ after the robots they wait for left
+    # their stretches), tick for tick under every operator.
+    p = tandem.fit(
+        small_demos(tmp_path),
+        params={"sampler": {"samples": SAMPLES, "seed": 5}},
+        switch_s=0.2,
+    )
+    for operator in [None, "slowest", "fastest"]:
+        mine = tandem.Coordinator(p.schedule)
+        planners = p.controller("rounds")
+        k = 0  # the least k with k·h ≥ δ, as the coordinator counts the switch time
+        while k * mine.tick_s < 0.2:
+            k += 1
+        assert mine.switch_ticks == planners.switch_ticks == k > 0
+        a, b = run_round(mine, operator), run_round(planners, operator)
+        assert len(a) == len(b) and all((x == y).all() for x, y in zip(a, b))
+    # A schedule of its own carries none.
+    assert tandem.Coordinator(tiny_schedule(0.1)).switch_ticks == 0

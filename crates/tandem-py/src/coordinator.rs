@@ -120,7 +120,10 @@ impl PyCoordinator {
 #[pymethods]
 impl PyCoordinator {
     /// The coordinator of ``schedule`` on its problem, at its tick, both clocks at the
-    /// earliest start.
+    /// earliest start, with the operator's switch time the schedule was planned for (a
+    /// planner's ``schedule`` carries its ``switch_s``: a robot leaves a hold with release
+    /// rules no sooner than that after the robots it waits for left their stretches, as in
+    /// :meth:`Planner.controller`; 0 for a schedule of your own).
     ///
     /// Raises:
     /// ``schedule`` must be checked by this build: one the scheduler or a planner made, or
@@ -147,7 +150,10 @@ impl PyCoordinator {
     #[pyo3(signature = (schedule, max_busy_share=1.0))]
     fn py_new(schedule: PyRef<'_, PySchedule>, max_busy_share: f64) -> PyResult<Self> {
         let inner = guard(|| {
-            let c = schedule.checked()?.coordinator()?;
+            let c = schedule
+                .checked()?
+                .coordinator()?
+                .with_switch_s(schedule.planned_switch_s())?;
             Ok(c.with_max_busy_share(max_busy_share)?)
         })?;
         Ok(Self { inner })

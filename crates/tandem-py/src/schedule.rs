@@ -256,6 +256,12 @@ impl PySchedule {
         }
     }
 
+    /// The operator's switch time `δ` (s) the schedule was planned for (0 unless a planner
+    /// made it with `switch_s > 0`), which its coordinator keeps at the holds' release rules.
+    pub(crate) fn planned_switch_s(&self) -> f64 {
+        self.operator.0
+    }
+
     /// The same schedule, planned for an operator with `switch_s` and `max_busy_share` (a
     /// planner's parameters): its check relaxes constraint 2 by their allowance.
     pub(crate) fn with_operator(self, switch_s: f64, max_busy_share: f64) -> Self {
