@@ -1411,20 +1411,7 @@ impl ContinuousCoordinator {
         if old.n != self.n {
             return bad(0, "the new plan has another number of robots");
         }
-        if let Some(i) =
-            (0..self.n).find(|&i| old.plan(i).task.n_ref() != self.plan(i).task.n_ref())
-        {
-            return bad(
-                i,
-                "the new plan's task has another number of reference samples",
-            );
-        }
-        if (old.tick_s - self.tick_s).abs() > 1e-12 * self.tick_s.max(old.tick_s) {
-            return bad(0, "the new plan runs at another control tick");
-        }
-        if let Some(f) = old.monitor.fault() {
-            return bad(f.stopped, "the old cell has a latched fault");
-        }
+        check_hand_over(old, self, 0..self.n)?;
         if old.m != self.m {
             return bad(0, "the new plan has another number of operators");
         }
@@ -1665,21 +1652,7 @@ impl ContinuousCoordinator {
         let Some(first_robot) = members.clone().next() else {
             return bad(0, "names no sector with robots");
         };
-        if let Some(i) = members
-            .clone()
-            .find(|&i| new.plan(i).task.n_ref() != self.plan(i).task.n_ref())
-        {
-            return bad(
-                i,
-                "the new plan's task has another number of reference samples",
-            );
-        }
-        if (new.tick_s - self.tick_s).abs() > 1e-12 * self.tick_s.max(new.tick_s) {
-            return bad(0, "the new plan runs at another control tick");
-        }
-        if let Some(f) = self.monitor.fault() {
-            return bad(f.stopped, "the old cell has a latched fault");
-        }
+        check_hand_over(self, new, members.clone())?;
         let mut clock = [0.0; MAX_ROBOTS];
         let mut next = [0usize; MAX_ROBOTS];
         for i in members.clone() {
@@ -1957,4 +1930,29 @@ pub fn run_cell(
     max_ticks: u64,
 ) -> Result<AdversaryRun> {
     crate::adversary::run_adversary_on(cell, adversary, rng, min_tasks, max_ticks)
+}
+
+/// The hand-over preconditions that [`ContinuousCoordinator::take_over`] (every robot) and
+/// [`ContinuousCoordinator::take_over_sector`] (a sector's robots) share: each robot of
+/// `robots` has a task of the same length (reference samples) in `old` and `new`, both run at
+/// the same control tick (s, to 1e-12 relative), and `old` has no latched fault.
+fn check_hand_over(
+    old: &ContinuousCoordinator,
+    new: &ContinuousCoordinator,
+    mut robots: impl Iterator<Item = usize>,
+) -> Result<()> {
+    let bad = |robot, why| Err(Error::HandOver { robot, why });
+    if let Some(i) = robots.find(|&i| old.plan(i).task.n_ref() != new.plan(i).task.n_ref()) {
+        return bad(
+            i,
+            "the new plan's task has another number of reference samples",
+        );
+    }
+    if (old.tick_s - new.tick_s).abs() > 1e-12 * new.tick_s.max(old.tick_s) {
+        return bad(0, "the new plan runs at another control tick");
+    }
+    if let Some(f) = old.monitor.fault() {
+        return bad(f.stopped, "the old cell has a latched fault");
+    }
+    Ok(())
 }
