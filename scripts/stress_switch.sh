@@ -14,6 +14,10 @@
 # DRY_RUN=1 prints the commands only.
 # Reduced sizes run on the shared machine: docs/decisions.md, "The switch time at run time
 # (issue 41)", "Issue 41's must-shows run: …" and "Issue 41 line by line (issue 41)".
+# Size reading: "10⁶ executions at N = 2" is read per row (each δ, with and without holds), the
+# stricter of the readings; every other row 10⁵. A deterministic policy's run on a problem is
+# run once and replayed for its other executions (the counts identical, `digest` line of each
+# log); the batches run here and their sums: "Issue 41's stress at the issue's sizes (issue 41)".
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-results/stress_switch}"
@@ -30,7 +34,7 @@ run() { # name, command…
   if [[ -n "${DRY_RUN:-}" ]]; then return; fi
   /usr/bin/time -f "%e s wall" "$@" >"$out/$name.log" 2>&1 || {
     echo "FAILED: $name (see $out/$name.log)"; tail -20 "$out/$name.log"; exit 1; }
-  grep -E "switch time|overlap|backward|unfinished|s wall" "$out/$name.log" | sed 's/^/    /'
+  grep -E "switch time|overlap|backward|unfinished|digest|s wall" "$out/$name.log" | sed 's/^/    /'
 }
 
 for d in $deltas; do

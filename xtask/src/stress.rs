@@ -54,6 +54,13 @@
 //! (`ContinuousCoordinator::with_max_busy_share`), so the same checks run on the paced cell.
 //!
 //! `--operators M` (issue 44) runs `M` operators in either cell instead: [`operators`].
+//!
+//! A policy that draws nothing from its random stream (no correction, the extremes, rush,
+//! periodic, one switch, and in rounds the beam search: [`is_deterministic`]) gives the same
+//! execution every time it runs on one case, so it runs once per case and its run is counted
+//! again for the case's other executions under it ([`Replays`]; every count as before, bit
+//! for bit). Each run prints a digest of the per-execution counts ([`execution_digest`]), the
+//! executions run and replayed, and the time per policy kind.
 
 pub(crate) mod operators;
 
@@ -437,10 +444,15 @@ pub(crate) fn run(
     let set_size = cases[0].adversaries.len() as u64;
     let run_start = Instant::now();
     let tally = Tally::default();
+    let replays = Replays::new(n_problems, set_size, true);
     run_batches(executions, BATCH, 5.0, &tally, |e| {
-        let case = &cases[(e % n_problems) as usize];
-        let op = case.adversaries[((e / n_problems) % set_size) as usize];
-        let r = execute(case, op, seed, e)?;
+        let (c, p) = (e % n_problems, (e / n_problems) % set_size);
+        let case = &cases[c as usize];
+        let op = case.adversaries[p as usize];
+        let t0 = Instant::now();
+        let ((r, _), replayed) =
+            replays.get_or_run(c, p, op, || Ok((execute(case, op, seed, e)?, 0)))?;
+        tally.add_run(e, op, &r, 0, t0.elapsed().as_nanos() as u64, replayed);
         tally.add(r.ticks, r.overlap_ticks, r.finished);
         tally.add_backward(r.backward_steps);
         if switch_s > 0.0 {
@@ -454,6 +466,7 @@ pub(crate) fn run(
         Ok(())
     })?;
     let secs = run_start.elapsed().as_secs_f64();
+    report_time_split(&tally);
     let backward = tally.backward_steps.load(Ordering::Relaxed);
     let short = report_switches(
         &tally,
@@ -541,10 +554,168 @@ struct Tally {
     /// Executions of the beam search (rounds) and those of them whose shortest switch was
     /// measured.
     beam: [AtomicU64; 2],
+    /// The digest of every execution's counts ([`execution_digest`]), added up (wrapping): the
+    /// same executions give the same digest in any order.
+    digest: AtomicU64,
+    /// Per policy kind ([`policy_kind`]): executions, ticks and the wall time of their runs
+    /// on the worker threads (ns), for the time split of [`report_time_split`], and the
+    /// executions and ticks replayed ([`Replays`]).
+    per_policy: [[AtomicU64; 5]; POLICY_KINDS.len()],
 }
 
 /// Offset of [`Tally::least_margin`].
 const MARGIN_OFFSET: u64 = 1 << 32;
+
+/// The policy kinds of the time split ([`policy_kind`]).
+const POLICY_KINDS: [&str; 6] = [
+    "beam search",
+    "fixed (no correction, extremes, rush, periodic, one switch)",
+    "switching favourite",
+    "random extremes",
+    "random gradients",
+    "random per robot",
+];
+
+/// The kind of `op` in [`POLICY_KINDS`].
+fn policy_kind(op: Adversary) -> usize {
+    match op {
+        Adversary::Beam { .. } => 0,
+        Adversary::Nominal
+        | Adversary::Fastest
+        | Adversary::Slowest
+        | Adversary::RushRobot { .. }
+        | Adversary::Periodic { .. }
+        | Adversary::SwitchOnce { .. } => 1,
+        Adversary::SwitchFavourite { .. } => 2,
+        Adversary::RandomSwitching { .. } | Adversary::RandomExtreme => 3,
+        Adversary::Random { .. } | Adversary::RandomHeld { .. } => 4,
+        Adversary::RandomPerRobot => 5,
+    }
+}
+
+/// Whether an execution under `op` draws nothing from its random stream, so that it is the
+/// same for every execution of one case (`in_rounds`: the beam search is the rounds
+/// coordinator's deterministic search; in the continuous cell it runs as a switching
+/// favourite, which draws).
+fn is_deterministic(op: Adversary, in_rounds: bool) -> bool {
+    policy_kind(op) == 1 || (in_rounds && policy_kind(op) == 0)
+}
+
+/// The runs of the deterministic (case, policy) pairs of a stress run, each run once and
+/// replayed for its other executions: `slots[case · policies + policy]`, with the cell's
+/// tasks completed (0 in rounds).
+struct Replays {
+    slots: Vec<std::sync::OnceLock<(AdversaryRun, u64)>>,
+    policies: u64,
+    in_rounds: bool,
+}
+
+impl Replays {
+    fn new(cases: u64, policies: u64, in_rounds: bool) -> Replays {
+        Replays {
+            slots: (0..cases * policies)
+                .map(|_| std::sync::OnceLock::new())
+                .collect(),
+            policies,
+            in_rounds,
+        }
+    }
+
+    /// The run of policy `p` (`op`) on case `c`: its first run's, if `op` is deterministic and
+    /// ran before (`true`), else `run()`'s (stored when deterministic; `false`).
+    fn get_or_run(
+        &self,
+        c: u64,
+        p: u64,
+        op: Adversary,
+        run: impl FnOnce() -> anyhow::Result<(AdversaryRun, u64)>,
+    ) -> anyhow::Result<((AdversaryRun, u64), bool)> {
+        if !is_deterministic(op, self.in_rounds) {
+            return Ok((run()?, false));
+        }
+        let slot = &self.slots[(c * self.policies + p) as usize];
+        if let Some(&r) = slot.get() {
+            return Ok((r, true));
+        }
+        let r = run()?;
+        // Two threads may run the same pair at once: both runs are the same.
+        let _ = slot.set(r);
+        Ok((r, false))
+    }
+}
+
+/// SplitMix64's finaliser: a well-mixed 64-bit hash of `x`.
+fn mix(mut x: u64) -> u64 {
+    x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    x ^ (x >> 31)
+}
+
+/// The digest of execution `e`'s counts: its ticks, overlap ticks, first overlap, whether it
+/// finished, backward steps, fewest tasks, shortest switch and `extra` (the cell's tasks
+/// completed), chained through [`mix`]. Summed over the executions it is the run's digest,
+/// which a change of the harness must leave as it is for every seed.
+fn execution_digest(e: u64, r: &AdversaryRun, extra: u64) -> u64 {
+    let opt = |v: Option<u64>| v.map_or(u64::MAX, |x| x);
+    [
+        r.ticks,
+        r.overlap_ticks,
+        opt(r.first_overlap),
+        u64::from(r.finished),
+        r.backward_steps,
+        r.min_tasks,
+        opt(r.min_switch_gap_ticks),
+        extra,
+    ]
+    .into_iter()
+    .fold(mix(e), |h, v| mix(h ^ v))
+}
+
+/// Prints the run's digest ([`execution_digest`], summed) and where the executions' time went
+/// per policy kind: executions run, ticks, the share of the worker threads' time and ticks
+/// per second of one thread, and the executions replayed ([`Replays`]).
+fn report_time_split(tally: &Tally) {
+    let get = |a: &AtomicU64| a.load(Ordering::Relaxed);
+    let total_ns = tally
+        .per_policy
+        .iter()
+        .map(|[_, _, w, _, _]| get(w))
+        .sum::<u64>()
+        .max(1);
+    let parts: Vec<String> = POLICY_KINDS
+        .iter()
+        .zip(&tally.per_policy)
+        .filter(|(_, [n, _, _, rn, _])| get(n) + get(rn) > 0)
+        .map(|(name, [n, t, w, rn, rt])| {
+            let secs = get(w) as f64 / 1e9;
+            format!(
+                "{name}: {} executions run, {} ticks, {:.1} % of the time, {:.2} M ticks/s per \
+                 thread; {} replayed ({} ticks)",
+                get(n),
+                get(t),
+                100.0 * get(w) as f64 / total_ns as f64,
+                get(t) as f64 / secs.max(1e-9) / 1e6,
+                get(rn),
+                get(rt)
+            )
+        })
+        .collect();
+    let replayed: u64 = tally
+        .per_policy
+        .iter()
+        .map(|[_, _, _, rn, _]| get(rn))
+        .sum();
+    let run: u64 = tally.per_policy.iter().map(|[n, _, _, _, _]| get(n)).sum();
+    println!(
+        "  digest of the per-execution counts: {:016x}; {run} executions run, {replayed} replayed \
+         (a deterministic policy's run on a case, counted again without running it); time per \
+         policy kind (thread time {:.1} s): {}",
+        get(&tally.digest),
+        total_ns as f64 / 1e9,
+        parts.join("; ")
+    );
+}
 
 impl Default for Tally {
     fn default() -> Tally {
@@ -558,6 +729,8 @@ impl Default for Tally {
             switches_measured: AtomicU64::new(0),
             least_margin: AtomicU64::new(u64::MAX),
             beam: [AtomicU64::new(0), AtomicU64::new(0)],
+            digest: AtomicU64::new(0),
+            per_policy: std::array::from_fn(|_| std::array::from_fn(|_| AtomicU64::new(0))),
         }
     }
 }
@@ -574,6 +747,32 @@ impl Tally {
         }
         if !finished {
             self.unfinished.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    /// Execution `e`'s run `r` (and `extra`: the cell's tasks completed, 0 in rounds) into the
+    /// digest, and its policy's ticks and run time `ns` into the time split.
+    /// `replayed`: the run is a replay of the case's first run under the same deterministic
+    /// policy ([`Replays`]).
+    fn add_run(
+        &self,
+        e: u64,
+        op: Adversary,
+        r: &AdversaryRun,
+        extra: u64,
+        ns: u64,
+        replayed: bool,
+    ) {
+        self.digest
+            .fetch_add(execution_digest(e, r, extra), Ordering::Relaxed);
+        let [n, t, w, rn, rt] = &self.per_policy[policy_kind(op)];
+        if replayed {
+            rn.fetch_add(1, Ordering::Relaxed);
+            rt.fetch_add(r.ticks, Ordering::Relaxed);
+        } else {
+            n.fetch_add(1, Ordering::Relaxed);
+            t.fetch_add(r.ticks, Ordering::Relaxed);
+            w.fetch_add(ns, Ordering::Relaxed);
         }
     }
 
@@ -854,23 +1053,31 @@ pub(crate) fn run_cell_executions(
     let run_start = Instant::now();
     let (tally, tasks_done) = (Tally::default(), AtomicU64::new(0));
     let min_tasks = AtomicU64::new(u64::MAX);
+    let replays = Replays::new(n_cells, set_size, false);
     run_batches(executions, CELL_BATCH, 10.0, &tally, |e| {
-        let case = &cases[(e % n_cells) as usize];
-        let op = case.adversaries[((e / n_cells) % set_size) as usize];
-        let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
-        rng.set_stream(e);
-        let mut cell = case.cell.clone();
-        let r = run_cell(&mut cell, op, &mut rng, tasks, case.max_ticks)?;
+        let (c, p) = (e % n_cells, (e / n_cells) % set_size);
+        let case = &cases[c as usize];
+        let op = case.adversaries[p as usize];
+        let t0 = Instant::now();
+        let ((r, done), replayed) = replays.get_or_run(c, p, op, || {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
+            rng.set_stream(e);
+            let mut cell = case.cell.clone();
+            let r = run_cell(&mut cell, op, &mut rng, tasks, case.max_ticks)?;
+            Ok((r, cell.tasks_completed().iter().sum()))
+        })?;
+        tally.add_run(e, op, &r, done, t0.elapsed().as_nanos() as u64, replayed);
         tally.add(r.ticks, r.overlap_ticks, r.finished);
         tally.add_backward(r.backward_steps);
         if switch_s > 0.0 {
             tally.add_switch(r.min_switch_gap_ticks, case.cell.switch_ticks());
         }
-        tasks_done.fetch_add(cell.tasks_completed().iter().sum(), Ordering::Relaxed);
+        tasks_done.fetch_add(done, Ordering::Relaxed);
         min_tasks.fetch_min(r.min_tasks, Ordering::Relaxed);
         Ok(())
     })?;
     let secs = run_start.elapsed().as_secs_f64();
+    report_time_split(&tally);
     let backward = tally.backward_steps.load(Ordering::Relaxed);
     let ks: Vec<u64> = cases.iter().map(|c| c.cell.switch_ticks()).collect();
     let short = report_switches(&tally, switch_s, &ks);
@@ -928,6 +1135,59 @@ mod tests {
     /// ticks after the first one's end (2.5 s on schedule) before it starts: every execution
     /// of such a round was "unfinished". Each policy ends within the new budget, after more
     /// ticks than the old one.
+    /// The replays are sound: every policy [`is_deterministic`] names gives the same run (and
+    /// the cell the same tasks) from two random streams, in rounds (the beam search included)
+    /// and in the continuous cell. By hand, of the 16 policies of two robots: no correction,
+    /// fastest, slowest, rush robot 0 and 1, the two periodic and one switch are fixed (8),
+    /// and the beam search in rounds (9); [`Replays`] runs each once and the random ones every
+    /// time.
+    #[test]
+    fn deterministic_policies_run_the_same_from_any_stream() {
+        let c = Coordinator::new(vec![robot(0.0), robot(3.0)], 0.25).unwrap();
+        let (g, lo, hi) = ([1.0; 3], [0.5; 3], [2.0; 3]);
+        let task = Timeline::new(&[true, false, true], &g, &lo, &hi, 0.0, 1.0).unwrap();
+        let cell = ContinuousCoordinator::new(task, &[], &[(0, 0), (1, 0)], 2, 1.0).unwrap();
+        let set = adversary_set(2, [0.5, 2.0], 40, &mut ChaCha8Rng::seed_from_u64(3));
+        assert_eq!(set.len(), 16);
+        let (mut fixed_rounds, mut fixed_cell) = (0, 0);
+        let replays = Replays::new(1, set.len() as u64, true);
+        for (p, &op) in set.iter().enumerate() {
+            let rounds: Vec<AdversaryRun> = (0..2)
+                .map(|s| run_adversary(c.clone(), op, &mut ChaCha8Rng::seed_from_u64(s), 1000))
+                .collect::<Result<_, _>>()
+                .unwrap();
+            let cells: Vec<(AdversaryRun, u64)> = (0..2)
+                .map(|s| {
+                    let mut cell = cell.clone();
+                    let rng = &mut ChaCha8Rng::seed_from_u64(s);
+                    let r = run_cell(&mut cell, op, rng, 3, 1000).unwrap();
+                    (r, cell.tasks_completed().iter().sum())
+                })
+                .collect();
+            assert!(rounds[0].finished && cells[0].0.finished, "{op:?}");
+            if is_deterministic(op, true) {
+                assert_eq!(rounds[0], rounds[1], "{op:?}");
+                fixed_rounds += 1;
+            }
+            if is_deterministic(op, false) {
+                assert_eq!(cells[0], cells[1], "{op:?}");
+                fixed_cell += 1;
+            }
+            // The first call runs, the second replays a fixed policy and runs a random one.
+            for (call, rng_seed) in [(0, 0), (1, 1)] {
+                let (r, replayed) = replays
+                    .get_or_run(0, p as u64, op, || {
+                        let rng = &mut ChaCha8Rng::seed_from_u64(rng_seed);
+                        Ok((run_adversary(c.clone(), op, rng, 1000)?, 0))
+                    })
+                    .unwrap();
+                assert_eq!(replayed, call == 1 && is_deterministic(op, true), "{op:?}");
+                assert_eq!(r.0, rounds[call], "{op:?}");
+            }
+        }
+        assert_eq!((fixed_rounds, fixed_cell), (9, 8));
+    }
+
     #[test]
     fn the_tick_budget_counts_the_start_offsets() {
         let c = Coordinator::new(vec![robot(0.0), robot(60.0)], 0.25).unwrap();
