@@ -106,6 +106,11 @@ pub(crate) struct StudyArgs {
     /// points existed.
     #[arg(long)]
     no_holds: bool,
+    /// A continuous cell of different tasks (`--cell-file` of two or more tasks) runs the
+    /// token rule alone, without nested groups (`[operator] nested_groups = false`): the
+    /// comparison for issue 45.
+    #[arg(long)]
+    no_nested_groups: bool,
     /// Write chosen rounds as ROS 2 bags (MCAP, for Foxglove) into this folder, one file per
     /// round: `trial_<T>_round_<K>.mcap` (replaced if present).
     #[arg(long, value_name = "DIR")]
@@ -599,6 +604,9 @@ fn config(args: &StudyArgs) -> anyhow::Result<StudyConfig> {
     }
     if args.no_holds {
         config.planner.holds = Default::default();
+    }
+    if args.no_nested_groups {
+        config.operator.nested_groups = false;
     }
     if let Some(c) = args.cell {
         config.cell = c;

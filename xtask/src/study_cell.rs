@@ -306,7 +306,8 @@ pub(crate) fn run_mixed_continuous(
              {:?}): {:.1} tasks/h = {:.1} % of the plan, {:.1} % of the operator-limited \
              bound, {:.1} % of the best bound {:.1} tasks/h of any plan the token rule can run \
              (ratios ≤ {}; robot- and operator-limited; no such plan exceeds {:.1} % of its \
-             operator-limited bound), operator busy {:.1} %; unrecorded at the end {:?}",
+             operator-limited bound), operator busy {:.1} %; unrecorded at the end {:?}; \
+             groups nested {}",
             trial.trial,
             trial.iterations.len(),
             trial.stats.hand_overs,
@@ -328,7 +329,8 @@ pub(crate) fn run_mixed_continuous(
             last.max_ratio,
             100.0 * last.best_operator_limited_share,
             100.0 * s.operator_busy_share,
-            trial.unrecorded
+            trial.unrecorded,
+            trial.nested_groups
         );
         println!(
             "    first plan: ratios {:?}, {:.1} tasks/h against the bound {:.1} tasks/h",

@@ -6,6 +6,7 @@ use std::sync::Arc;
 use rand::Rng;
 
 use super::groups::{Group, Token, groups, mixed_token_sequence, token_sequence};
+use super::nest;
 use super::pace::Pace;
 use crate::adversary::{Adversary, AdversaryRun};
 use crate::contract::{Controller, Operator, Tick, check_tick};
@@ -130,6 +131,15 @@ pub struct ContinuousCoordinator {
     sector_served: [u64; MAX_ROBOTS],
     /// A sectored cell only: per operator, its sector's next service stamp.
     sector_stamp: [u64; MAX_ROBOTS],
+    /// Whether the next entry may be granted *nested* inside the token's group
+    /// ([`ContinuousCoordinator::with_nesting`]).
+    nest: bool,
+    /// The entry granted nested and not yet left, with its `(pos, passes)`.
+    nested: Option<(Token, usize, u64)>,
+    /// Nested grants since the start or the last reset.
+    nested_grants: u64,
+    /// Per robot, one past the index of its last low-confidence tick (0: none yet).
+    last_lc: [u64; MAX_ROBOTS],
 }
 
 /// One task's plan in a continuous cell and what the token rule reads of it: its timeline
@@ -153,6 +163,11 @@ struct Plan {
     /// Per reference sample, the group its low-confidence sample belongs to (unused on
     /// high-confidence samples).
     group_of: Vec<usize>,
+    /// Per group, `W` of [`nest::span_ticks`]: the most ticks from its gate until it is left.
+    span_ticks: Vec<u64>,
+    /// Per group, the whole ticks a robot surely travels from its gate before it is first
+    /// low-confidence in it (`Reach::to_run_from_sample` at the fastest, rounded down).
+    entry_ticks: Vec<u64>,
 }
 
 impl Plan {
@@ -198,6 +213,17 @@ impl Plan {
                 *x = k;
             }
         }
+        let span_ticks = groups
+            .iter()
+            .map(|g| nest::span_ticks(&task, g, tick_s, tol_s))
+            .collect();
+        let entry_ticks = groups
+            .iter()
+            .map(|g| {
+                let (fast_s, _) = reach.to_run_from_sample(g.gate, g.ref_start);
+                prealert::ticks_before_at_least(fast_s, tick_s)
+            })
+            .collect();
         Plan {
             task,
             groups,
@@ -206,6 +232,8 @@ impl Plan {
             next_lc_s,
             reach,
             group_of,
+            span_ticks,
+            entry_ticks,
         }
     }
 }
@@ -343,6 +371,10 @@ impl ContinuousCoordinator {
             sectors: None,
             sector_served: [0; MAX_ROBOTS],
             sector_stamp: [0; MAX_ROBOTS],
+            nest: false,
+            nested: None,
+            nested_grants: 0,
+            last_lc: [0; MAX_ROBOTS],
         };
         out.reset();
         out
@@ -498,6 +530,113 @@ impl ContinuousCoordinator {
     /// `M`: the number of operators ([`with_operators`](Self::with_operators)).
     pub fn operators(&self) -> usize {
         self.m
+    }
+
+    /// The same cell with *nested groups* (issue 45), reset to the start: while the token's
+    /// robot `i` is on high-confidence ground inside its group, the next entry's robot `j`,
+    /// waiting at its gate, may go through its whole group then — when the least time before
+    /// `i` can be low-confidence again covers the most ticks `j` needs to leave its group, at
+    /// the slowest input, plus the switch time back, and the switch time since the last
+    /// low-confidence tick of every other robot has passed by `j`'s first possible
+    /// low-confidence tick (the rule and its proof: `cell/nest.rs`). The operator so fills the
+    /// high-confidence gaps of a group that no hold splits with another robot's whole group;
+    /// the entries keep their order, and a check that fails leaves the entry to the token rule.
+    /// For any operator, at most one robot is low-confidence in a tick and the switch time is
+    /// kept. One operator only: in a cell of `M > 1` operators, a sectored cell or one with a
+    /// load cap nothing is nested. The pre-alert ([`Tick::next`]) is not computed for a cell
+    /// with nesting (`None`). Without this call nothing changes.
+    #[must_use]
+    pub fn with_nesting(mut self) -> ContinuousCoordinator {
+        self.nest = true;
+        self.reset();
+        self
+    }
+
+    /// Whether groups may be nested ([`with_nesting`](Self::with_nesting)).
+    pub fn nesting(&self) -> bool {
+        self.nest
+    }
+
+    /// The groups granted nested since the start or the last reset (or hand-over)
+    /// ([`with_nesting`](Self::with_nesting)).
+    pub fn nested_grants(&self) -> u64 {
+        self.nested_grants
+    }
+
+    /// With nesting ([`with_nesting`](Self::with_nesting)), at tick index `tick` (the start of
+    /// the next tick): grants the next entry nested inside the token's group when the rule of
+    /// `cell/nest.rs` allows it. At most one nested entry at a time; O(N).
+    fn grant_nested(&mut self, tick: u64) {
+        if !self.nest
+            || self.m > 1
+            || self.sectors.is_some()
+            || self.pace.is_some()
+            || self.nested.is_some()
+        {
+            return;
+        }
+        let Some((t, _, _)) = self.staff.slot[0] else {
+            return;
+        };
+        let (i, g) = (t.robot, t.group);
+        let Some(&next) = self.tokens.get(self.pos) else {
+            return;
+        };
+        let (j, gj) = (next.robot, next.group);
+        let held = self.monitor.held();
+        if j == i || self.next_group[i] != g || held.is_some() {
+            return;
+        }
+        let (pi, pj) = (self.plan(i), self.plan(j));
+        // `j` waits at its next group's gate, the entry's.
+        if self.staff.assigned[j].is_some()
+            || self.next_group[j] != gj
+            || gj >= pj.groups.len()
+            || self.clock_s[j] < pj.gate_s[gj]
+        {
+            return;
+        }
+        // `i` is inside `G` on high-confidence ground: every sample from its clock less the
+        // tolerance to its clock, and its next low-confidence sample lies in `G`.
+        let (task, c) = (&pi.task, pi.task.sample_clock_s());
+        let s = self.clock_s[i];
+        if s >= task.end_s() || s - self.tol_s >= pi.leave_s[g] {
+            return;
+        }
+        let lo = c
+            .partition_point(|&x| x <= s - self.tol_s)
+            .saturating_sub(1);
+        let at = c.partition_point(|&x| x <= s).saturating_sub(1);
+        let at = at.min(task.n_ref() - 1);
+        if !task.conf()[lo.min(at)..=at].iter().all(|&h| h) {
+            return;
+        }
+        let a = pi.next_lc_s[at];
+        if a >= pi.leave_s[g] {
+            return;
+        }
+        let k = self.switch_ticks;
+        // 1. Back in time: `j` has left before `i` can be low-confidence, `k` ticks to spare.
+        let n_i = nest::ticks_before_lc(s, a, self.tick_s, self.tol_s);
+        let w_j = pj.span_ticks[gj];
+        if n_i < w_j.saturating_add(k).saturating_add(1) {
+            return;
+        }
+        // 2. The switch to `j`: `k` ticks after every other robot's last low-confidence tick.
+        let e_j = pj.entry_ticks[gj];
+        let last = (0..self.n)
+            .filter(|&r| r != j)
+            .map(|r| self.last_lc[r])
+            .max()
+            .unwrap_or(0);
+        if tick.saturating_add(e_j) < last.saturating_add(k) {
+            return;
+        }
+        self.nested = Some((next, self.pos, self.passes));
+        self.staff.assigned[j] = Some(0);
+        self.staff.last_op[j] = Some(0);
+        self.nested_grants += 1;
+        self.advance_token();
     }
 
     /// Whether robot `i` may pass its next group's gate: an operator is assigned to it.
@@ -856,7 +995,7 @@ impl ContinuousCoordinator {
     /// passes to first.
     /// O(N) plus a scan of the token sequence up to the last robot's next turn; no allocation.
     pub fn pre_alert(&self) -> Option<crate::PreAlert> {
-        if self.m > 1 || self.sectors.is_some() {
+        if self.m > 1 || self.sectors.is_some() || self.nest {
             return None;
         }
         let h = self.tick_s;
@@ -1019,6 +1158,9 @@ impl ContinuousCoordinator {
         self.stamp = rank;
         self.monitor.reset();
         self.staff = Staff::default();
+        self.nested = None;
+        self.nested_grants = 0;
+        self.last_lc = [0; MAX_ROBOTS];
         if let Some(p) = &mut self.pace {
             p.reset();
         }
@@ -1281,12 +1423,30 @@ impl ContinuousCoordinator {
                 out.low_conf.set(i, lc);
                 if lc {
                     out.operator.as_mut_slice()[i] = self.staff.assigned[i];
+                    self.last_lc[i] = this_tick + 1;
                 }
             }
             self.clock_s[i] = s_new;
         }
         if let Some(p) = &mut self.pace {
             p.observe(out.low_conf.count() > 0);
+        }
+        // A nested entry is released once its robot has left its group (before the token's
+        // robot can: `cell/nest.rs`); the operator's last robot is then the nested one.
+        if let Some((t, _, _)) = self.nested {
+            let (r, g) = (t.robot, t.group);
+            let plan = &plans[usize::from(self.plan_of[r])];
+            let s = self.clock_s[r];
+            if self.next_group[r] == g
+                && (s >= plan.task.end_s() || s - self.tol_s >= plan.leave_s[g])
+            {
+                self.staff.last_left[0] = Some((r, this_tick + 1));
+                self.next_group[r] = g + 1;
+                self.served[r] = self.stamp;
+                self.stamp += 1;
+                self.staff.assigned[r] = None;
+                self.nested = None;
+            }
         }
         // An operator is released once its robot has left its group (operators in index
         // order; one operator: the token moves).
@@ -1329,6 +1489,7 @@ impl ContinuousCoordinator {
         }
         // The freed operators take the next entries, for the next tick.
         self.grant(this_tick + 1);
+        self.grant_nested(this_tick + 1);
         for i in 0..n {
             let plan = &plans[usize::from(self.plan_of[i])];
             let task = &plan.task;
@@ -1800,6 +1961,8 @@ impl ContinuousCoordinator {
             last_op: old.staff.last_op,
             ..Staff::default()
         };
+        self.nested = None;
+        self.last_lc = old.last_lc;
     }
 
     /// Test only: puts robot `robot` at schedule clock `clock_s` of its current task with

@@ -138,6 +138,7 @@ mod coordinator;
 mod groups;
 #[cfg(test)]
 mod liveness;
+mod nest;
 pub(crate) mod pace;
 
 #[allow(deprecated)]

@@ -87,6 +87,22 @@ pub struct StudyOperator {
     /// one study). Rounds and one operator ignore it.
     #[serde(skip_serializing_if = "FleetCell::is_auto")]
     pub fleet_cell: FleetCell,
+    /// Whether the continuous cell of different tasks (issue 45) nests groups: the next
+    /// robot's whole group run inside a high-confidence gap of the token robot's group when
+    /// the gap's least duration covers the group's largest span and the switch time
+    /// (`ContinuousCoordinator::with_nesting`). `false`: the token rule alone. Single-task
+    /// cells ignore it. Default: `true` (not written when so).
+    #[serde(skip_serializing_if = "is_true")]
+    pub nested_groups: bool,
+}
+
+/// Whether `b` is true (serde's `skip_serializing_if` of [`StudyOperator::nested_groups`]).
+#[expect(
+    clippy::trivially_copy_pass_by_ref,
+    reason = "serde's skip_serializing_if passes a reference"
+)]
+fn is_true(b: &bool) -> bool {
+    *b
 }
 
 /// Whether `m` is 1 (serde's `skip_serializing_if` of [`StudyOperator::operators`]).
@@ -106,6 +122,7 @@ impl Default for StudyOperator {
             switch_true_s: 0.0,
             operators: 1,
             fleet_cell: FleetCell::Auto,
+            nested_groups: true,
         }
     }
 }

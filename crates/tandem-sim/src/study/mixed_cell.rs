@@ -44,6 +44,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 use tandem_lfd::TaskModel;
 use tandem_planner::{CellPlanner, ExecutionRecord};
+use tandem_realtime::continuous::ContinuousCoordinator;
 use tandem_schedule::cyclic::MixedCyclicPlan;
 
 use super::config::StudyConfig;
@@ -138,6 +139,10 @@ pub struct MixedCellTrialResult {
     pub unrecorded: Vec<usize>,
     /// What the cell did (ticks, overlaps, faults, hand-overs, waiting per robot).
     pub stats: CellStats,
+    /// Groups run nested inside another robot's group over the trial, every plan's
+    /// coordinator together (`ContinuousCoordinator::nested_grants`; 0 without
+    /// [`crate::study::StudyOperator::nested_groups`]).
+    pub nested_groups: u64,
     /// The last tasks' throughput.
     pub steady: MixedSteady,
 }
@@ -239,6 +244,16 @@ fn steady(
     }
 }
 
+/// The plan's coordinator with nested groups when the study's `[operator]` asks for them
+/// ([`crate::study::StudyOperator::nested_groups`], `ContinuousCoordinator::with_nesting`).
+fn nesting(config: &StudyConfig, coord: ContinuousCoordinator) -> ContinuousCoordinator {
+    if config.operator.nested_groups {
+        coord.with_nesting()
+    } else {
+        coord
+    }
+}
+
 /// Runs trial `trial` of the mixed continuous study (module docs) until the cell has
 /// completed `config.executions` tasks; `config.robots` must be the cell's robot count.
 /// Reports `progress` after every record (`rounds_done`: records so far).
@@ -282,9 +297,11 @@ pub fn run_mixed_cell_trial(
         }
     };
     let plan = cell.continuous_plan().map_err(|e| in_record(0)(e.into()))?;
-    let coord = cell
-        .continuous_coordinator(&plan)
-        .map_err(|e| in_record(0)(e.into()))?;
+    let coord = nesting(
+        config,
+        cell.continuous_coordinator(&plan)
+            .map_err(|e| in_record(0)(e.into()))?,
+    );
     let tick_s = coord.tick_s();
     let ops = operators(config, tasks);
     let mut sim = MixedCellSim::new(&models(&cell), &robot_task, coord, &ops)?;
@@ -312,6 +329,7 @@ pub fn run_mixed_cell_trial(
     let mut completions: Vec<MixedCellCompletion> = Vec::with_capacity(total + n);
     let mut iterations = vec![plan_record(&cell, tasks, &plan, 0, 0)];
     let mut last_ratios = plan.ratios.clone();
+    let (mut nested_groups, mut seen) = (0u64, (0u64, sim.stats().hand_overs));
     while completions.len() < total {
         if sim.stats().ticks as f64 >= budget {
             return Err(Error::DidNotFinish {
@@ -322,6 +340,16 @@ pub fn run_mixed_cell_trial(
             let needed = &needed;
             sim.tick(&models(&cell), |robot, idx| needed[robot][idx], &mut rng)?
         };
+        // A hand-over puts a coordinator whose count starts from 0 in place (grants of the
+        // old one in the tick of the hand-over are not counted: a lower bound).
+        let grants = sim.coordinator().nested_grants();
+        let hand_overs = sim.stats().hand_overs;
+        nested_groups += if hand_overs == seen.1 {
+            grants - seen.0
+        } else {
+            grants
+        };
+        seen = (grants, hand_overs);
         // Tasks past the trial's total (several robots can finish in its last tick) are
         // neither counted nor queued.
         for f in finished.into_iter().take(total - completions.len()) {
@@ -358,9 +386,11 @@ pub fn run_mixed_cell_trial(
             let plan = cell
                 .continuous_plan()
                 .map_err(|e| in_record(record)(e.into()))?;
-            let next = cell
-                .continuous_coordinator(&plan)
-                .map_err(|e| in_record(record)(e.into()))?;
+            let next = nesting(
+                config,
+                cell.continuous_coordinator(&plan)
+                    .map_err(|e| in_record(record)(e.into()))?,
+            );
             sim.replan(&models(&cell), next)
                 .map_err(in_record(record))?;
             last_ratios = plan.ratios.clone();
@@ -386,6 +416,7 @@ pub fn run_mixed_cell_trial(
             })
             .collect(),
         stats: sim.stats().clone(),
+        nested_groups,
         steady,
     })
 }
