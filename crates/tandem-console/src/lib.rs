@@ -43,5 +43,5 @@ pub use replay::{
 };
 pub use run_bag::{read_run_bag, recording_from_rounds};
 pub use server::{Console, ConsoleConfig, PAGE};
-pub use sim::{SimParams, Until, record_sim, simulate, simulate_recorded, tick_now};
+pub use sim::{SimParams, Until, record_sim, rest_notice, simulate, simulate_recorded, tick_now};
 pub use strip::{OperatorStrip, RobotStrip, Tracker};

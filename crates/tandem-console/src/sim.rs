@@ -2,7 +2,11 @@
 //! for the chosen kind of cell with tandem-sim's simulated operator
 //! ([`RoundSim`] / [`CellSim`]), ticked every `tick_s / speed` real seconds, publishing every
 //! tick through the same [`ConsoleHandle`] a user's loop uses and taking the operator's
-//! controls at tick boundaries ([`Driver`]). Rounds run one after the other.
+//! controls at tick boundaries ([`Driver`]). Rounds run one after the other; under the
+//! operator's load cap (`max_busy_share` of the state file, issue 41) the next round starts
+//! only after the rest the finished round asks (`Coordinator::rest_ticks`): that many idle
+//! ticks between the round's last tick and the next round's first, as the ROS 2 node keeps
+//! it, the page's notice saying `rest: N s before the next round` meanwhile ([`rest_notice`]).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -106,6 +110,11 @@ pub(crate) struct SimRun<'p> {
     needed: Vec<Vec<bool>>,
     rng: ChaCha8Rng,
     rounds_done: u64,
+    /// Idle ticks of the operator's rest still to run before the next round's first tick
+    /// (rounds under a load cap; set when a round finishes).
+    rest_left: u64,
+    /// Whether the last [`step`](Self::step) was a tick of the rest.
+    resting: bool,
 }
 
 impl<'p> SimRun<'p> {
@@ -151,6 +160,8 @@ impl<'p> SimRun<'p> {
             needed,
             rng: ChaCha8Rng::seed_from_u64(params.seed),
             rounds_done: 0,
+            rest_left: 0,
+            resting: false,
         })
     }
 
@@ -166,32 +177,51 @@ impl<'p> SimRun<'p> {
         self.rounds_done
     }
 
+    /// Ticks of the operator's rest still to run before the next round's first tick (0 while
+    /// a round runs, without a load cap, and in a continuous cell).
+    pub(crate) fn rest_left_ticks(&self) -> u64 {
+        self.rest_left
+    }
+
     /// Whether the simulated operator's input in the last [`step`](Self::step) was a
     /// correction.
     pub(crate) fn corrected(&self) -> bool {
+        if self.resting {
+            return false;
+        }
         match &self.cell {
             SimCell::Rounds(s) => s.corrected(),
             SimCell::Continuous(s) => s.corrected(),
         }
     }
 
-    /// One tick (a finished round restarts first); returns the tick and whether a round
-    /// was completed before it.
+    /// One tick; returns the tick and whether a round was completed before it. After a
+    /// finished round, first the rest it asks
+    /// ([`Coordinator::rest_ticks`](tandem_realtime::Coordinator::rest_ticks), read at its
+    /// last tick): that many idle ticks, in which nothing moves (the tick describes the
+    /// finished round, no correction); then the round restarts.
     pub(crate) fn step(&mut self) -> Result<(Tick, bool)> {
         let model = self.planner.model();
         let needed = &self.needed;
+        self.resting = false;
         match &mut self.cell {
             SimCell::Rounds(s) => {
                 let mut new_round = false;
                 if s.coordinator().is_finished() {
+                    if self.rest_left > 0 {
+                        self.rest_left -= 1;
+                        self.resting = true;
+                        return Ok((tick_now(s.coordinator()), false));
+                    }
                     s.restart();
                     self.rounds_done += 1;
                     new_round = true;
                 }
-                Ok((
-                    s.tick(model, |i, k| needed[i][k], &mut self.rng)?,
-                    new_round,
-                ))
+                let tick = s.tick(model, |i, k| needed[i][k], &mut self.rng)?;
+                if s.coordinator().is_finished() {
+                    self.rest_left = s.coordinator().rest_ticks();
+                }
+                Ok((tick, new_round))
             }
             SimCell::Continuous(s) => {
                 s.tick(model, |i, k| needed[i][k], &mut self.rng)?;
@@ -243,6 +273,8 @@ pub fn simulate_recorded(
     if let Some(r) = recorder.as_deref_mut() {
         r.record(&first, run.controller(), rounds, run.rounds_done())?;
     }
+    // The rest's notice shown (whole seconds left; `None`: no notice of ours).
+    let mut shown_rest: Option<u64> = None;
     // Ticks are due at `base + k · period_s`; the base moves on every pause.
     let mut base = Instant::now();
     let mut done_since_base: u64 = 0;
@@ -275,6 +307,11 @@ pub fn simulate_recorded(
             if new_round {
                 handle.round_done();
             }
+            let rest = rest_left_s(run.rest_left_ticks(), tick_s);
+            // A full queue of updates: given again at the next tick.
+            if rest != shown_rest && handle.set_notice(rest.map(rest_notice)) {
+                shown_rest = rest;
+            }
             handle.publish_corrected(&tick, run.controller(), run.corrected());
             if let Some(r) = recorder.as_deref_mut() {
                 r.record(&tick, run.controller(), rounds, run.rounds_done())?;
@@ -293,6 +330,24 @@ pub fn simulate_recorded(
         r.flush()?;
     }
     Ok(())
+}
+
+/// The rest left in whole seconds, rounded up (never less than is left), of `ticks` ticks of
+/// `tick_s`; `None` without a rest.
+fn rest_left_s(ticks: u64, tick_s: f64) -> Option<u64> {
+    (ticks > 0).then(|| (ticks as f64 * tick_s).ceil() as u64)
+}
+
+/// The page's notice while the simulated operator rests after a round under the load cap
+/// (issue 41): `rest: N s before the next round (the operator's load cap)`, `N` whole seconds
+/// rounded up, as the ROS 2 node's notice (`tandem_ros2::rest_notice`) begins; the simulated
+/// cell then starts the next round by itself.
+#[must_use]
+pub fn rest_notice(left_s: u64) -> String {
+    format!(
+        "rest: {left_s} s before the next round (the operator's load cap) — the simulated cell \
+         starts it when the rest has passed"
+    )
 }
 
 /// When [`record_sim`] stops.
@@ -370,4 +425,142 @@ pub fn record_sim(
     }
     recorder.flush()?;
     Ok(ticks)
+}
+
+#[cfg(test)]
+mod tests {
+    use tandem_lfd::{Demonstration, FitParams, TaskModel};
+    use tandem_planner::PlannerParams;
+
+    use super::*;
+
+    /// The hand-made one-channel task of the node's tests (low confidence where the
+    /// demonstrations differ, reference samples 10..20 of 60 at 10 ms), planned for two robots,
+    /// with the operator's load cap `u`.
+    fn planner(u: f64) -> Planner {
+        let names = vec!["force".to_string()];
+        let light = Demonstration::new(names.clone(), vec![1.0; 60], 0.01).unwrap();
+        let (mut hard, mut warp) = (Vec::new(), Vec::new());
+        for n in 0..60 {
+            warp.push(hard.len() as f64);
+            let reps = if (10..20).contains(&n) { 2 } else { 1 };
+            for _ in 0..reps {
+                hard.push(if (10..20).contains(&n) { 9.0 } else { 1.0 });
+            }
+        }
+        let hard = Demonstration::new(names, hard, 0.01).unwrap();
+        let identity: Vec<f64> = (0..60).map(f64::from).collect();
+        let model = TaskModel::fit_aligned(
+            &[light.clone(), hard, light],
+            &[identity.clone(), warp, identity],
+            &FitParams::default(),
+        )
+        .unwrap();
+        let mut params = PlannerParams::default();
+        params.sampler.samples = 50;
+        params.sampler.seed = 3;
+        let mut planner = Planner::from_model_with_robots(model, params, 2).unwrap();
+        planner.set_operator(0.0, u).unwrap();
+        planner
+    }
+
+    /// The rest by hand: the least whole `n` with `busy ≤ u·n` (floating point, from below
+    /// the quotient), less the round's ticks.
+    fn rest_by_hand(busy: u64, ticks: u64, u: f64) -> u64 {
+        let mut n = ((busy as f64 / u).floor() as u64).saturating_sub(2);
+        while (n as f64) * u < busy as f64 {
+            n += 1;
+        }
+        n.saturating_sub(ticks)
+    }
+
+    /// Runs the current round of `run` to its end; returns (its ticks, its busy ticks: with a
+    /// robot low-confidence, one operator, no switch time) and whether its first step started
+    /// a new round.
+    fn run_round(run: &mut SimRun<'_>) -> (u64, u64, bool) {
+        let (mut ticks, mut busy, mut started) = (0, 0, false);
+        loop {
+            let (tick, new_round) = run.step().unwrap();
+            assert!(!run.resting);
+            assert!(!new_round || ticks == 0, "a round starts at its first tick");
+            started |= new_round;
+            ticks += 1;
+            busy += u64::from(tick.low_conf.first().is_some());
+            if run.controller().is_finished() {
+                return (ticks, busy, started);
+            }
+        }
+    }
+
+    /// Under a load cap of 0.1 the simulated cell starts the next round exactly the round's
+    /// rest after its last tick (this test's own count of the busy ticks and its own least
+    /// `n`): that many idle ticks in which nothing moves, no correction is counted and the
+    /// rest left counts down; the next step restarts. Three rounds in a row, each with its own
+    /// rest. Without a cap the next step restarts at once.
+    #[test]
+    fn a_simulated_round_after_a_capped_round_starts_exactly_its_rest_later() {
+        let u = 0.1;
+        let planner = planner(u);
+        let ctl = planner.controller(Cell::Rounds).unwrap();
+        let tick_s = ctl.tick_s();
+        let mut run = SimRun::new(&planner, ctl, &SimParams::default(), None).unwrap();
+        for round in 0..3 {
+            let (ticks, busy, started) = run_round(&mut run);
+            assert_eq!(started, round > 0);
+            assert_eq!(run.rounds_done(), round);
+            let rest = rest_by_hand(busy, ticks, u);
+            assert!(rest > 0, "the cap binds: {busy} busy ticks of {ticks}");
+            let SimCell::Rounds(s) = &run.cell else {
+                panic!("a rounds cell")
+            };
+            assert_eq!(s.coordinator().rest_ticks(), rest);
+            assert_eq!(run.rest_left_ticks(), rest);
+            assert!(busy as f64 <= u * (ticks + rest) as f64);
+            assert!(
+                busy as f64 > u * (ticks + rest - 1) as f64,
+                "the least rest"
+            );
+            let at_end = (run.controller().ticks(), run.controller().ref_time_now());
+            for left in (0..rest).rev() {
+                let (tick, new_round) = run.step().unwrap();
+                assert!(!new_round && run.resting && !run.corrected());
+                assert_eq!(run.rest_left_ticks(), left);
+                assert_eq!((run.controller().ticks(), tick.ref_time), at_end);
+                assert!(run.controller().is_finished());
+            }
+            assert_eq!(
+                rest_left_s(rest, tick_s),
+                Some((rest as f64 * tick_s).ceil() as u64)
+            );
+        }
+        assert_eq!(rest_left_s(0, tick_s), None);
+        // The next round's first tick: one step after the rest.
+        let (_, new_round) = run.step().unwrap();
+        assert!(new_round && !run.resting && run.rest_left_ticks() == 0);
+        assert_eq!(run.rounds_done(), 3);
+
+        let planner = planner_uncapped();
+        let ctl = planner.controller(Cell::Rounds).unwrap();
+        let mut run = SimRun::new(&planner, ctl, &SimParams::default(), None).unwrap();
+        run_round(&mut run);
+        assert_eq!(run.rest_left_ticks(), 0);
+        let (_, new_round) = run.step().unwrap();
+        assert!(new_round);
+    }
+
+    fn planner_uncapped() -> Planner {
+        planner(1.0)
+    }
+
+    /// The notice begins as the node's does (`tandem_ros2::rest_notice`).
+    #[test]
+    fn the_rest_notice_says_the_seconds_left_as_the_node_does() {
+        assert!(
+            rest_notice(3)
+                .starts_with("rest: 3 s before the next round (the operator's load cap) — ")
+        );
+        assert_eq!(rest_left_s(1, 0.01), Some(1));
+        assert_eq!(rest_left_s(100, 0.01), Some(1));
+        assert_eq!(rest_left_s(101, 0.01), Some(2));
+    }
 }

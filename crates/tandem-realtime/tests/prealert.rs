@@ -3,13 +3,15 @@
 //! the start observed, and the latest, when bounded, never earlier — in rounds (random problems
 //! of the test kit's families, N = 2…4, with and without holds and release rules, switch times
 //! of 0 and 3 ticks) and in continuous cells (random tasks, N = 2…4, random runnable orders),
-//! under every operator policy of the adversary set (the beam search runs as its policy
-//! fallback here: it keeps no ticks to check).
+//! under every operator policy of the adversary set and, in rounds, the beam search (its
+//! sequence, `adversary::search::beam_search_run`, replayed tick by tick; a continuous cell has
+//! no beam search: it runs as its policy fallback there).
 
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tandem_realtime::adversary::{adversary_set, run_adversary_on};
+use tandem_realtime::adversary::search::beam_search_run;
+use tandem_realtime::adversary::{Adversary, AdversaryRun, adversary_set, run_adversary_on};
 use tandem_realtime::continuous::{ContinuousCoordinator, groups};
 use tandem_realtime::testkit::{CellHolds, Family, HeldRound, random_cell_task, random_order};
 use tandem_realtime::{Controller, Fault, Operator, PerRobot, RobotFlags, Tick, Timeline};
@@ -121,7 +123,34 @@ fn check_run(ticks: &[Tick], h: f64, finished: bool, faults: bool) -> (u64, u64,
     (checked, bounded, least)
 }
 
-fn rounds_case(seed: u64, n: usize, holds: bool, switch_ticks: f64) -> (u64, u64) {
+/// Runs the beam search from `w`'s coordinator and gives its sequence's inputs to `w` tick by
+/// tick (after an overlap the fault cleared before each tick, as the search runs it); the
+/// replay ends where the search's sequence ended. Returns the search's run.
+fn replay_beam(
+    w: &mut Watch<tandem_realtime::Coordinator>,
+    width: u32,
+    budget: u64,
+) -> AdversaryRun {
+    let end = beam_search_run(w.inner.clone(), width as usize, budget).unwrap();
+    for (i, &op) in end.operators.iter().enumerate() {
+        if end.run.first_overlap.is_some_and(|f| i as u64 > f) {
+            w.clear_fault();
+        }
+        w.tick(op).unwrap();
+    }
+    assert_eq!(
+        (w.inner.ticks(), w.inner.clock_s(), w.inner.is_finished()),
+        (
+            end.coordinator.ticks(),
+            end.coordinator.clock_s(),
+            end.coordinator.is_finished()
+        )
+    );
+    end.run
+}
+
+/// Announcements checked, of them bounded, of them in the beam search's sequence.
+fn rounds_case(seed: u64, n: usize, holds: bool, switch_ticks: f64) -> (u64, u64, u64) {
     let mut r = ChaCha8Rng::seed_from_u64(seed);
     let round = HeldRound::random(Family::of_seed(seed), n, holds, &mut r);
     let tick_s = round.case.tick_s;
@@ -131,19 +160,26 @@ fn rounds_case(seed: u64, n: usize, holds: bool, switch_ticks: f64) -> (u64, u64
         .unwrap();
     let budget = round.budget();
     let set = round.case.adversaries(&round.robots, &mut r);
-    let (mut checked, mut bounded) = (0, 0);
+    let (mut checked, mut bounded, mut beam) = (0, 0, 0);
     for a in set {
         let mut w = Watch {
             inner: c.clone(),
             ticks: Vec::new(),
         };
-        let run = run_adversary_on(&mut w, a, &mut r, 1, budget).unwrap();
+        let run = match a {
+            // The search's sequence, replayed tick by tick from the same start.
+            Adversary::Beam { width } => replay_beam(&mut w, width, budget),
+            _ => run_adversary_on(&mut w, a, &mut r, 1, budget).unwrap(),
+        };
         let faults = run.overlap_ticks > 0;
         let (k, b, _) = check_run(&w.ticks, tick_s, run.finished, faults);
         checked += k;
         bounded += b;
+        if matches!(a, Adversary::Beam { .. }) {
+            beam += k;
+        }
     }
-    (checked, bounded)
+    (checked, bounded, beam)
 }
 
 fn cell_case(seed: u64, n: usize, switch_ticks: f64) -> (u64, u64) {
@@ -181,7 +217,7 @@ proptest! {
         holds in any::<bool>(),
         switch in prop_oneof![Just(0.0), Just(3.0)],
     ) {
-        let (checked, _) = rounds_case(seed, n, holds, switch);
+        let (checked, _, _) = rounds_case(seed, n, holds, switch);
         prop_assert!(checked > 0, "no announcement checked");
     }
 
@@ -199,16 +235,21 @@ proptest! {
 /// Not vacuous: over fixed seeds the latest is bounded in many announcements, in both cells.
 #[test]
 fn announcements_are_checked_and_latest_is_often_bounded() {
-    let (mut rk, mut rb, mut ck, mut cb) = (0, 0, 0, 0);
+    let (mut rk, mut rb, mut ck, mut cb, mut beam) = (0, 0, 0, 0, 0);
     for seed in 0..8 {
-        let (k, b) = rounds_case(seed, 2 + (seed as usize % 3), seed % 2 == 0, 0.0);
+        let (k, b, kb) = rounds_case(seed, 2 + (seed as usize % 3), seed % 2 == 0, 0.0);
         rk += k;
         rb += b;
+        beam += kb;
         let (k, b) = cell_case(seed, 2 + (seed as usize % 3), 2.0);
         ck += k;
         cb += b;
     }
-    eprintln!("rounds: {rk} announcements checked, {rb} bounded; cell: {ck}, {cb}");
+    eprintln!(
+        "rounds: {rk} announcements checked ({beam} in the beam search's sequences), {rb} \
+         bounded; cell: {ck}, {cb}"
+    );
+    assert!(beam > 0, "the beam search's sequences announce nothing");
     assert!(rb * 20 >= rk && rb > 0, "rounds: {rb} of {rk} bounded");
     assert!(cb * 20 >= ck && cb > 0, "cell: {cb} of {ck} bounded");
 }

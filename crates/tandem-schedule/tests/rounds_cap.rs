@@ -2,7 +2,10 @@
 //! rounds at run time: the plan alone does not keep it (issue 41)" and "The load cap in rounds
 //! at run time: the rest after a round (issue 41)"): the busy share of a round planned with
 //! `max_busy_share`, measured on the ticks the robots traversed under the adversary policies,
-//! without and with the coordinator's rest after the round (`Coordinator::rest_ticks`).
+//! without and with the coordinator's rest after the round (`Coordinator::rest_ticks`), and
+//! under the beam search (`adversary::search::beam_search_run`: its sequence replayed tick by
+//! tick, docs/decisions.md "The beam search in the load cap's test and the console's simulated
+//! rest (issue 41)").
 #![allow(
     clippy::print_stdout,
     reason = "the test reports the shares it measured"
@@ -10,7 +13,8 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tandem_realtime::adversary::{Adversary, run_adversary_on};
+use tandem_realtime::adversary::search::beam_search_run;
+use tandem_realtime::adversary::{Adversary, BEAM_WIDTH, run_adversary_on};
 use tandem_realtime::{Controller, Coordinator, Fault, Operator, PerRobot, RobotFlags, Tick};
 use tandem_schedule::{SamplerParams, busy_share, sample_schedule_n, testkit};
 
@@ -102,6 +106,54 @@ fn rest(busy: u64, ticks: u64, cap: f64) -> u64 {
     n.saturating_sub(ticks)
 }
 
+/// What one round measured: its busy share without the rest, its rest (ticks), the share of
+/// the round and its rest, and the rest's share of the round and its rest (the throughput
+/// lost against starting the next round at once).
+struct Measured {
+    share: f64,
+    rest: u64,
+    rested_share: f64,
+    cost: f64,
+}
+
+/// Checks the round `w` ran to its end: the coordinator's busy ticks equal this test's count
+/// from the recorded low-confidence ticks (`k` per change of robot), its rest is the least that
+/// keeps `cap` (this test's own `n`), the round and its rest keep the cap, and a rest is taken
+/// only by a round above the cap.
+fn measure(w: &Watch, k: u64, cap: f64, what: &str) -> Measured {
+    let (b, t) = (busy(&w.lc, k), w.lc.len() as u64);
+    assert_eq!(
+        (w.inner.ticks(), w.inner.busy_ticks(0)),
+        (t, Some(b)),
+        "{what}"
+    );
+    let share = b as f64 / t as f64;
+    let r = w.inner.rest_ticks();
+    assert_eq!(r, rest(b, t, cap), "{what}");
+    assert!(
+        b as f64 <= cap * (t + r) as f64,
+        "{what}: {b} busy ticks in {t} + {r}"
+    );
+    assert!(r == 0 || share > cap, "{what}");
+    Measured {
+        share,
+        rest: r,
+        rested_share: b as f64 / (t + r) as f64,
+        cost: r as f64 / (t + r) as f64,
+    }
+}
+
+/// The beam search's rounds: counts and shares as for the policies.
+#[derive(Default)]
+struct Beam {
+    rounds: usize,
+    above: usize,
+    rested: usize,
+    most: f64,
+    worst_rested: f64,
+    costs: Vec<f64>,
+}
+
 /// Rounds planned with a cap of 0.7 (`SamplerParams::max_busy_share`, the share per round on
 /// schedule), run under the adversary policies by the coordinator with the cap
 /// (`Coordinator::with_max_busy_share`): the plan alone does not keep the cap at run time
@@ -117,6 +169,7 @@ fn the_rounds_share_under_the_adversary_set() {
     let (mut rounds, mut above, mut most) = (0, 0, 0.0_f64);
     let (mut rest_nominal, mut rest_worst) = (Vec::new(), 0.0_f64);
     let (mut rested, mut worst_rested) = (0, 0.0_f64);
+    let mut beam = Beam::default();
     for case in 0..16u64 {
         let p =
             testkit::random_problem(&mut ChaCha8Rng::seed_from_u64(2000 + case), 150..=400, DT_S)
@@ -171,30 +224,45 @@ fn the_rounds_share_under_the_adversary_set() {
             let run = run_adversary_on(&mut w, adv, &mut r, 1, 20_000_000).unwrap();
             assert_eq!(run.overlap_ticks, 0);
             assert!(run.finished);
-            let (b, t) = (busy(&w.lc, k), w.lc.len() as u64);
-            assert_eq!((w.inner.ticks(), w.inner.busy_ticks(0)), (t, Some(b)));
-            let share = b as f64 / t as f64;
-            // The coordinator's rest: the round and its rest keep the cap, and it is the least
-            // rest that does.
-            let r = w.inner.rest_ticks();
-            assert_eq!(r, rest(b, t, cap), "case {case}, {adv:?}");
-            assert!(
-                b as f64 <= cap * (t + r) as f64,
-                "case {case}, {adv:?}: {b} busy ticks in {t} + {r}"
-            );
-            assert!(r == 0 || share > cap);
-            worst_rested = worst_rested.max(b as f64 / (t + r) as f64);
-            rested += usize::from(r > 0);
-            let cost = r as f64 / (t + r) as f64;
-            rest_worst = rest_worst.max(cost);
+            let m = measure(&w, k, cap, &format!("case {case}, {adv:?}"));
+            worst_rested = worst_rested.max(m.rested_share);
+            rested += usize::from(m.rest > 0);
+            rest_worst = rest_worst.max(m.cost);
             if adv == Adversary::Nominal {
-                rest_nominal.push(cost);
+                rest_nominal.push(m.cost);
             }
-            most = most.max(share);
-            above += usize::from(share > cap);
+            most = most.max(m.share);
+            above += usize::from(m.share > cap);
             rounds += 1;
+            let share = m.share;
             line.push(format!("{share:.3}"));
         }
+        // The beam search: the sequence it keeps (the smallest clearance between regions),
+        // replayed tick by tick from the same start, ends in the search's own coordinator.
+        let end = beam_search_run(base.clone(), BEAM_WIDTH as usize, 20_000_000).unwrap();
+        assert_eq!(end.run.overlap_ticks, 0);
+        assert!(end.run.finished);
+        let mut w = Watch {
+            inner: base.clone(),
+            lc: Vec::new(),
+        };
+        for &op in &end.operators {
+            w.tick(op).unwrap();
+        }
+        let c = &end.coordinator;
+        assert!(w.inner.is_finished());
+        assert_eq!(
+            (w.inner.ticks(), w.inner.busy_ticks(0), w.inner.rest_ticks()),
+            (c.ticks(), c.busy_ticks(0), c.rest_ticks())
+        );
+        let m = measure(&w, k, cap, &format!("case {case}, beam"));
+        beam.rounds += 1;
+        beam.above += usize::from(m.share > cap);
+        beam.rested += usize::from(m.rest > 0);
+        beam.most = beam.most.max(m.share);
+        beam.worst_rested = beam.worst_rested.max(m.rested_share);
+        beam.costs.push(m.cost);
+        line.push(format!("beam {:.3}", m.share));
         println!(
             "case {case}: N = {n}, δ = {switch_s}, planned share {planned:.3} ({:?}): run {}",
             out.source,
@@ -212,8 +280,23 @@ fn the_rounds_share_under_the_adversary_set() {
         100.0 * rest_nominal[rest_nominal.len() - 1],
         100.0 * rest_worst
     );
+    beam.costs.sort_by(f64::total_cmp);
+    println!(
+        "beam search ({} rounds): {} above the cap {cap} without the rest, largest share \
+         {:.4}; {} rested, largest share of a round and its rest {:.4}; the rest's share of the \
+         round and its rest median {:.2} %, largest {:.2} %",
+        beam.rounds,
+        beam.above,
+        beam.most,
+        beam.rested,
+        beam.worst_rested,
+        100.0 * beam.costs[beam.costs.len() / 2],
+        100.0 * beam.costs[beam.costs.len() - 1],
+    );
     assert!(worst_rested <= cap);
+    assert!(beam.worst_rested <= cap);
     assert!(rounds >= 64, "{rounds} rounds");
+    assert_eq!(beam.rounds * 8, rounds);
     // The plan's share is on schedule: at run time it is exceeded (measured 38 of 128).
     assert!(
         above > 0,
