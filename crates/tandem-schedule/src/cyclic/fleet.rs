@@ -132,7 +132,8 @@ pub fn sectored_plan(
 /// one-operator cell bounded by the same argument with `M = 1`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FleetCellChoice {
-    /// The even sectors' sizes when they are run, empty for the pooled cell.
+    /// The even sectors' sizes when their ceiling equals the pooled cell's (the ceilings leave
+    /// the choice to measurement), empty when the pooled cell's ceiling is higher.
     pub sectors: Vec<usize>,
     /// The pooled cell's ceiling (tasks per hour).
     pub pooled_bound_tasks_per_hour: f64,
@@ -147,13 +148,20 @@ pub struct FleetCellChoice {
 /// hand-over per sector, pooled or sectored by measurement (issue 44)"). `M = 1` and `N ≤ 1`:
 /// no sectors.
 ///
-/// **Why.** `Σ_o min(3600·k_o/D_min, 3600/W) ≤ min(3600·N/D_min, 3600·M/W)` always (a sum of
-/// minima is at most the minimum of the sums), so pooling can gain only where the sectors'
-/// ceiling is below the pooled one's — robots that do not divide evenly among the operators
-/// (some sectors robot-bound while others are operator-bound, `(3, 2)` of the unit tests).
-/// Where they are equal, each sector runs a one-operator plan that reaches its own ceiling
-/// (the plans count the hand-overs), while the pooled cell runs one operator's order of all
-/// `N` robots with `M` tokens and loses to queueing (measured 84 % of the ceiling at `(8, 4)`).
+/// **Why the ceilings do not pick the cell.** `Σ_o min(3600·k_o/D_min, 3600/W) ≤
+/// min(3600·N/D_min, 3600·M/W)` always (a sum of minima is at most the minimum of the sums),
+/// so the sectors' ceiling is below the pooled one's only where the robots do not divide
+/// evenly among the operators (some sectors robot-bound while others are operator-bound,
+/// `(3, 2)` of the unit tests), and equal elsewhere. Neither ceiling counts what decides
+/// between the two cells when they are equal: the hand-overs and the queueing at the `M`
+/// tokens of the pooled cell (it serves one operator's order of all `N` robots) against the
+/// one-operator hand-overs of each sector. Measured in the study on sanding (docs/decisions.md,
+/// "The continuous cell of M operators: one hand-over per sector, pooled or sectored by
+/// measurement (issue 44)"), the pooled cell was ahead at `(4, 2)` (180.4 against 179.4
+/// tasks/h) with equal ceilings, so the earlier rule (sectors whenever the ceilings are equal)
+/// was dropped: `Planner::fleet_coordinator` runs both cells with the planned operator
+/// ([`nominal_tasks_per_hour`]) and keeps the faster. `sectors` here only says where the
+/// ceilings leave the choice open.
 ///
 /// # Errors
 /// [`crate::Error::Realtime`] (`RobotCount`, `OperatorCount`) for `N` or `M` outside

@@ -46,11 +46,13 @@ pub struct CyclicPlan {
     pub lower_bound_s: f64,
     /// `period_s / lower_bound_s − 1` (0 when the plan is at the bound, up to rounding).
     pub gap: f64,
-    /// Whether `order` is the best of all orders (the search enumerated every order), so
+    /// Whether `order` is the best of all orders (the search enumerated every order, or every
+    /// order up to the first whose period meets `lower_bound_s`, which no order beats), so
     /// `period_s` is the least period of every 1-periodic plan; `false` for a given order or
     /// a heuristic search.
     pub order_exhaustive: bool,
-    /// Orders whose period was computed to choose this one (1 for a given order).
+    /// Orders whose period was computed to choose this one (1 for a given order; the search
+    /// stops at an order whose period meets `lower_bound_s`).
     pub orders_evaluated: usize,
 }
 
@@ -384,36 +386,14 @@ pub(crate) fn plan_for_order(
             ratio.period_s = capped;
         }
     }
-    let lower_bound_s = match handover_tick_s {
-        Some(tick_s) if runnable_only && switch_s > 0.0 => {
-            handover_switch_bound_of(&graph.shape, n_robots, tick_s, switch_s)
-        }
-        Some(tick_s) if runnable_only => handover_bound_of(&graph.shape, n_robots, tick_s),
-        _ => bound_of(&graph.shape, n_robots),
-    };
-    let lower_bound_s = if switch_s > 0.0 {
-        lower_bound_s
-            .max(switch_bound_of(&graph.shape, n_robots, switch_s))
-            .max(chain_switch_bound_of(
-                &graph.shape,
-                n_robots,
-                switch_s,
-                handover_tick_s,
-                handover_tick_s.is_some() && runnable_only,
-            ))
-    } else {
-        lower_bound_s
-    };
-    let lower_bound_s = if max_busy_share < 1.0 {
-        lower_bound_s.max(cap_bound_of(
-            &graph.shape,
-            n_robots,
-            switch_s,
-            max_busy_share,
-        ))
-    } else {
-        lower_bound_s
-    };
+    let lower_bound_s = plan_bound_of(
+        &graph.shape,
+        n_robots,
+        handover_tick_s,
+        runnable_only,
+        switch_s,
+        max_busy_share,
+    );
     Ok(layout(
         &graph,
         n_robots,
@@ -422,6 +402,45 @@ pub(crate) fn plan_for_order(
         &ratio.times_s,
         lower_bound_s,
     ))
+}
+
+/// The lower bound (s) on the period of every order of a plan searched with these parameters
+/// ([`plan_for_order`]'s `lower_bound_s`): [`handover_bound_s`] for runnable orders with the
+/// hand-overs counted, else [`period_lower_bound_s`]; raised by the switch time's bounds and
+/// the load cap's when they are set.
+pub(crate) fn plan_bound_of(
+    shape: &TaskShape,
+    n_robots: usize,
+    handover_tick_s: Option<f64>,
+    runnable_only: bool,
+    switch_s: f64,
+    max_busy_share: f64,
+) -> f64 {
+    let lower_bound_s = match handover_tick_s {
+        Some(tick_s) if runnable_only && switch_s > 0.0 => {
+            handover_switch_bound_of(shape, n_robots, tick_s, switch_s)
+        }
+        Some(tick_s) if runnable_only => handover_bound_of(shape, n_robots, tick_s),
+        _ => bound_of(shape, n_robots),
+    };
+    let lower_bound_s = if switch_s > 0.0 {
+        lower_bound_s
+            .max(switch_bound_of(shape, n_robots, switch_s))
+            .max(chain_switch_bound_of(
+                shape,
+                n_robots,
+                switch_s,
+                handover_tick_s,
+                handover_tick_s.is_some() && runnable_only,
+            ))
+    } else {
+        lower_bound_s
+    };
+    if max_busy_share < 1.0 {
+        lower_bound_s.max(cap_bound_of(shape, n_robots, switch_s, max_busy_share))
+    } else {
+        lower_bound_s
+    }
 }
 
 /// The period of one order, or `None` if no period admits it (for the search).

@@ -3,7 +3,7 @@
 use tandem_realtime::continuous::{Group, first_split_group};
 
 use super::graph::{Stretch, TaskShape};
-use super::plan::{CyclicPlan, period_of, plan_for_order};
+use super::plan::{CyclicPlan, period_of, plan_bound_of, plan_for_order};
 use super::run::groups_of;
 use crate::problem::check_robot_count;
 use crate::{Error, Problem, Result};
@@ -161,6 +161,11 @@ pub fn order_count(n_robots: usize, m: usize) -> u64 {
 ///   seeds and swaps are the same on groups, so every order visited is runnable (with a hold
 ///   in every gap, groups are stretches and nothing changes).
 ///
+/// Both stop as soon as the best order's period meets the plan's lower bound
+/// ([`CyclicPlan::lower_bound_s`]): no order can then be better by the search's rule, so
+/// the plan is the one the whole search returns, bit for bit, with fewer orders evaluated
+/// (docs/decisions.md, "Issue 44's fleet at steady confidence …").
+///
 /// A task without low-confidence stretches has the empty order and the period `D_min`; one
 /// robot has its own task's order and period `D_min`.
 ///
@@ -171,6 +176,17 @@ pub fn cyclic_plan(
     problem: &Problem,
     n_robots: usize,
     params: &CyclicParams,
+) -> Result<CyclicPlan> {
+    search(problem, n_robots, params, true)
+}
+
+/// [`cyclic_plan`], stopping at the bound or not (`stop_at_bound = false`: the whole search,
+/// for the test that both give the same plan).
+fn search(
+    problem: &Problem,
+    n_robots: usize,
+    params: &CyclicParams,
+    stop_at_bound: bool,
 ) -> Result<CyclicPlan> {
     params.validate()?;
     check_robot_count(n_robots)?;
@@ -185,11 +201,18 @@ pub fn cyclic_plan(
         None
     };
     let count = order_count(n_robots, m);
+    let bound_s = if stop_at_bound {
+        search_bound(&shape, n_robots, params)
+    } else {
+        f64::NEG_INFINITY
+    };
     let (order, evaluated, exhaustive) = if count <= params.max_enumerated {
-        let (order, evaluated) = enumerate(&shape, n_robots, m, groups.as_deref(), params)?;
+        let (order, evaluated) =
+            enumerate(&shape, n_robots, m, groups.as_deref(), params, bound_s)?;
         (order, evaluated, true)
     } else {
-        let (order, evaluated) = local_search(&shape, n_robots, params, groups.as_deref())?;
+        let (order, evaluated) =
+            local_search(&shape, n_robots, params, groups.as_deref(), bound_s)?;
         (order, evaluated, false)
     };
     let mut plan = plan_for_order(
@@ -221,6 +244,29 @@ fn better(p: Option<f64>, best: Option<f64>) -> bool {
     }
 }
 
+/// Whether a period `p` of the search is at the plan's lower bound `bound_s` (the
+/// `lower_bound_s` its plan gets, [`plan_bound_of`]; `−∞`: never), so that no order can be
+/// [`better`]:
+/// that would take a period below `p·(1 − 10⁻¹²)` ≤ `bound_s·(1 − 4.9·10⁻¹³)`, a cycle ratio
+/// more than `4.9·10⁻¹³` (relative) below a proven bound on every order's period, far beyond
+/// the rounding of the ratio's sums (≈ 10⁻¹⁵). So the search stops there with the order it
+/// would have returned anyway: the same plan, bit for bit, sooner.
+fn at_bound(p: Option<f64>, bound_s: f64) -> bool {
+    p.is_some_and(|p| p <= bound_s * (1.0 + 5e-13))
+}
+
+/// The lower bound the plan of `params` gets ([`plan_bound_of`]), for [`at_bound`].
+fn search_bound(shape: &TaskShape, n_robots: usize, params: &CyclicParams) -> f64 {
+    plan_bound_of(
+        shape,
+        n_robots,
+        params.handover_tick_s,
+        params.runnable_only,
+        params.switch_s,
+        params.max_busy_share,
+    )
+}
+
 /// Every order up to rotation ([`cyclic_plan`]); with `groups` (runnable orders only) those
 /// that keep every group contiguous (`continuous::first_split_group`, the coordinator's rule).
 fn enumerate(
@@ -229,6 +275,7 @@ fn enumerate(
     m: usize,
     groups: Option<&[Group]>,
     params: &CyclicParams,
+    bound_s: f64,
 ) -> Result<(Vec<Stretch>, usize)> {
     if m == 0 {
         return Ok((Vec::new(), 1));
@@ -242,12 +289,13 @@ fn enumerate(
     let mut evaluated = 0;
     let mut order = Vec::with_capacity(len);
     // Depth-first over the labels of positions 1..len, then over the rotations.
+    // `visit` returns whether to go on (false once the best order is at the bound).
     fn labels_at(
         q: usize,
         labels: &mut [usize],
         left: &mut [usize],
-        visit: &mut dyn FnMut(&[usize]) -> Result<()>,
-    ) -> Result<()> {
+        visit: &mut dyn FnMut(&[usize]) -> Result<bool>,
+    ) -> Result<bool> {
         if q == labels.len() {
             return visit(labels);
         }
@@ -255,13 +303,16 @@ fn enumerate(
             if left[r] > 0 {
                 left[r] -= 1;
                 labels[q] = r;
-                labels_at(q + 1, labels, left, visit)?;
+                let go_on = labels_at(q + 1, labels, left, visit)?;
                 left[r] += 1;
+                if !go_on {
+                    return Ok(false);
+                }
             }
         }
-        Ok(())
+        Ok(true)
     }
-    let mut visit = |labels: &[usize]| -> Result<()> {
+    let mut visit = |labels: &[usize]| -> Result<bool> {
         // Every rotation of robots 1..N (robot 0 starts at its stretch 0).
         rot.fill(0);
         loop {
@@ -286,6 +337,9 @@ fn enumerate(
                 )?;
                 if better(p, best.0) {
                     best = (p, order.clone());
+                    if at_bound(p, bound_s) {
+                        return Ok(false);
+                    }
                 }
             }
             // Next rotation (odometer over robots 1..N).
@@ -299,7 +353,7 @@ fn enumerate(
                 r += 1;
             }
             if r == n_robots {
-                return Ok(());
+                return Ok(true);
             }
         }
     };
@@ -323,6 +377,7 @@ fn local_search(
     n_robots: usize,
     params: &CyclicParams,
     groups: Option<&[Group]>,
+    bound_s: f64,
 ) -> Result<(Vec<Stretch>, usize)> {
     let units = units(shape.n_lc(), groups);
     let u = units.len();
@@ -357,6 +412,9 @@ fn local_search(
         evaluated += 1;
         let len = cur.len();
         for _ in 0..params.max_swap_passes {
+            if at_bound(p, bound_s) {
+                break;
+            }
             let mut step: Option<(usize, Option<f64>)> = None;
             for q in 0..len {
                 let q2 = (q + 1) % len;
@@ -389,6 +447,78 @@ fn local_search(
         if better(p, best.0) {
             best = (p, flat(&cur));
         }
+        if at_bound(best.0, bound_s) {
+            break;
+        }
     }
     Ok((best.1, evaluated))
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+    use rand::rngs::StdRng;
+
+    use super::*;
+    use crate::testkit::{hold_points, random_problem};
+
+    /// Stopping at the bound returns the whole search's plan bit for bit (order, period,
+    /// bound), with at most as many orders evaluated; over random problems with and without
+    /// holds, 2 to 8 robots (enumerated and local search), with and without the hand-overs,
+    /// the switch time and the load cap; and it does stop on some (a saturated operator).
+    #[test]
+    fn stopping_at_the_bound_gives_the_whole_searchs_plan() {
+        let mut rng = StdRng::seed_from_u64(44);
+        let (mut cases, mut stopped) = (0, 0);
+        for case in 0..48 {
+            let p = random_problem(&mut rng, 60..=240, 0.1).unwrap();
+            let p = if case % 2 == 0 {
+                let holds = hold_points(p.conf());
+                p.with_holds(holds).unwrap()
+            } else {
+                p
+            };
+            let n = 2 + case % 7;
+            let params = CyclicParams {
+                handover_tick_s: (case % 3 != 0).then_some(0.1),
+                switch_s: if case % 4 == 1 { 0.7 } else { 0.0 },
+                max_busy_share: if case % 5 == 2 { 0.8 } else { 1.0 },
+                max_swap_passes: 20,
+                ..CyclicParams::default()
+            };
+            let (Ok(fast), Ok(whole)) =
+                (search(&p, n, &params, true), search(&p, n, &params, false))
+            else {
+                // An order the cap admits for no period: both must fail alike.
+                assert_eq!(
+                    search(&p, n, &params, true).is_ok(),
+                    search(&p, n, &params, false).is_ok()
+                );
+                continue;
+            };
+            cases += 1;
+            assert_eq!(fast.order, whole.order, "case {case}");
+            assert_eq!(
+                fast.period_s.to_bits(),
+                whole.period_s.to_bits(),
+                "case {case}"
+            );
+            assert_eq!(fast.lower_bound_s.to_bits(), whole.lower_bound_s.to_bits());
+            assert_eq!(fast.order_exhaustive, whole.order_exhaustive);
+            assert!(fast.orders_evaluated <= whole.orders_evaluated);
+            // The plan's bound is the one the search stops at.
+            let bound = search_bound(&TaskShape::new(&p), n, &params);
+            assert_eq!(
+                bound.to_bits(),
+                whole.lower_bound_s.to_bits(),
+                "case {case}"
+            );
+            stopped += usize::from(fast.orders_evaluated < whole.orders_evaluated);
+        }
+        assert!(cases >= 40, "{cases} cases planned");
+        assert!(
+            stopped >= 5,
+            "the search stopped early in {stopped} of {cases} cases"
+        );
+    }
 }
