@@ -94,7 +94,10 @@ mod rates;
 mod runs;
 
 pub use beta::{BetaParams, posterior, prior};
-pub use confidence::{Confidence, MIN_VOTES, RoundUpdate, evaluate, prob_need_below_mu_c};
+pub use confidence::{
+    Confidence, MIN_VOTES, RoundUpdate, YIELD_REACH, evaluate, one_sided_yield,
+    prob_need_below_mu_c,
+};
 pub use error::{Error, Result};
 pub use observations::{MissEvidence, Observations};
 pub use params::ConfidenceParams;

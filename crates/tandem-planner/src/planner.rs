@@ -1014,7 +1014,9 @@ impl Planner {
 
     /// Why [`Planner::load`] replaced the stored schedule, if it did: the stored one failed
     /// this build's check on the stored problem (e.g. a file written by a build whose margin
-    /// check accepted more, or edited by hand), and a fresh one was made. The replacement is
+    /// check accepted more, or whose confidence trusted more samples than this build derives
+    /// from the stored latch and totals, or edited by hand), and a fresh one was made; the
+    /// recorded rounds, observations and latch are kept as stored. The replacement is
     /// in memory until the planner is saved.
     pub fn load_notice(&self) -> Option<&str> {
         self.load_notice.as_deref()
@@ -1345,7 +1347,8 @@ impl Planner {
             });
         }
         // The file holds the latch; `conf` is the latch less the prior's trust that yields to
-        // a need on both sides, a function of the model's σ²_D and the observations' totals
+        // a need on both sides or, on one side, on the half of its run nearer the need (at
+        // most `YIELD_REACH`), a function of the model's σ²_D and the observations' totals
         // (`tandem_confidence::Confidence`), so it is evaluated again here, as `record_round`
         // left it.
         st.confidence
@@ -1683,7 +1686,14 @@ mod tests {
         );
         assert_eq!(p.outcome(), &before);
         assert_eq!(p.params().holds, spec(0.15));
-        // Outside the stretch, high-confidence: accepted and active.
+        // Beside the needed stretch the prior's trust yields on the half of each run nearer
+        // it (`tandem_confidence::one_sided_yield`: 5 of 0..10, 10 of 20..40): low-confidence
+        // now, refused.
+        let conf = p.confidence().conf();
+        assert!(conf[5..10].iter().chain(&conf[20..30]).all(|c| !*c));
+        assert!(conf[..5].iter().chain(&conf[30..]).all(|c| *c));
+        assert!(p.set_holds(spec(0.25)).is_err());
+        // Beyond it, high-confidence: accepted and active.
         p.set_holds(spec(0.3)).unwrap();
         assert_eq!(p.problem().holds(), &[30]);
         assert_eq!(p.problem().active_holds().collect::<Vec<_>>(), vec![30]);
