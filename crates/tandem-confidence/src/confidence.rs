@@ -186,6 +186,11 @@ pub struct RoundUpdate {
     /// rest on their prior alone and now yield to a need on both sides, or on one side
     /// ([`one_sided_yield`]).
     pub reopened: usize,
+    /// Of [`RoundUpdate::reopened`], the samples still latched: trusted from the prior alone,
+    /// whose trust yields to a need the corrections confirmed beside them (the rest had their
+    /// latch reopened by the round's corrections; [`trust_change`](crate::trust_change)
+    /// tells the two apart between any two states).
+    pub yielded: usize,
 }
 
 impl Confidence {
@@ -342,7 +347,8 @@ impl Confidence {
     /// assert_eq!(a.update_round(&sigma2_d, &before, &obs)?.newly_high, 1);
     /// let before = obs.clone();
     /// obs.record(&[0.0; 10], &[true; 10])?;
-    /// assert_eq!(a.update_round(&sigma2_d, &before, &obs)?.reopened, 1);
+    /// let round = a.update_round(&sigma2_d, &before, &obs)?;
+    /// assert_eq!((round.reopened, round.yielded), (1, 0)); // its latch, not the prior's trust
     /// assert!(!a.conf()[0]);
     /// // The other order ends the same: the corrections first, then the clean rounds.
     /// let (mut b, mut obs) = (Confidence::from_prior(&sigma2_d, p)?, Observations::new(1)?);
@@ -395,11 +401,12 @@ impl Confidence {
             }
         }
         let rates = crate::estimate_error_rates(after, &self.params)?;
-        let (newly_high, reopened) =
+        let (newly_high, reopened, yielded) =
             self.latch_reopening(sigma2_d, &rates, |n| (c[n], s[n]), |n| c[n] > c0[n])?;
         Ok(RoundUpdate {
             newly_high,
             reopened,
+            yielded,
         })
     }
 
@@ -431,14 +438,15 @@ impl Confidence {
 
     /// [`latch`](Self::latch) where the latched samples with `reopen(n)` are decided again
     /// too, then `conf` evaluated on the same totals (the prior's yield):
-    /// `(samples that turned high, samples that turned low)` in `conf`.
+    /// `(samples that turned high, samples that turned low, of those the ones still latched)`
+    /// in `conf`.
     fn latch_reopening(
         &mut self,
         sigma2_d: &[f64],
         rates: &ErrorRates,
         counts: impl Fn(usize) -> (f64, f64),
         reopen: impl Fn(usize) -> bool,
-    ) -> Result<(usize, usize)> {
+    ) -> Result<(usize, usize, usize)> {
         self.check_sigma2_d(sigma2_d)?;
         let Self {
             params: p,
@@ -503,8 +511,14 @@ impl Confidence {
             self.high.clone()
         };
         let turned_high = self.view.iter().zip(&view).filter(|(b, a)| !**b && **a);
-        let turned_low = self.view.iter().zip(&view).filter(|(b, a)| **b && !**a);
-        let counted = (turned_high.count(), turned_low.count());
+        let turned_low = || self.view.iter().zip(&view).zip(&self.high);
+        let counted = (
+            turned_high.count(),
+            turned_low().filter(|((b, a), _)| **b && !**a).count(),
+            turned_low()
+                .filter(|((b, a), latched)| **b && !**a && **latched)
+                .count(),
+        );
         self.view = view;
         Ok(counted)
     }
@@ -1028,6 +1042,11 @@ mod tests {
         let expected: Vec<bool> = (0..n_ref).map(|n| !(10..42).contains(&n)).collect();
         assert_eq!(conf.conf(), expected.as_slice());
         assert_eq!(round.reopened, 10 + 19);
+        assert_eq!(
+            round.yielded,
+            10 + 19,
+            "all of the prior's trust, still latched"
+        );
         assert_eq!(conf.n_high(), 28);
         // Supervised, the yielded halves are trusted again on ten clean votes and nothing
         // creeps on: the far halves now border samples trusted on their votes.

@@ -86,6 +86,7 @@
 
 mod beta;
 mod boundary;
+mod change;
 mod confidence;
 mod error;
 mod observations;
@@ -94,6 +95,7 @@ mod rates;
 mod runs;
 
 pub use beta::{BetaParams, posterior, prior};
+pub use change::{TrustChange, trust_change};
 pub use confidence::{
     Confidence, MIN_VOTES, RoundUpdate, YIELD_REACH, evaluate, one_sided_yield,
     prob_need_below_mu_c,

@@ -1,5 +1,6 @@
 //! Property tests: observation mass is conserved by the fractional split, the latch only
-//! ever adds high-confidence samples, every latched decision equals a direct statrs
+//! ever adds high-confidence samples (`update`), `conf` falls only where the prior's trust
+//! yields or a correction reopens a latch (`trust_change`), every latched decision equals a direct statrs
 //! evaluation of Eq. 12, `conf` is the latch less the prior's trust that yields to a need on
 //! both sides evaluated on the totals, and every order of the same rounds gives the same
 //! confidence on every sample.
@@ -10,7 +11,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tandem_confidence::{
     Confidence, ConfidenceParams, MIN_VOTES, Observations, YIELD_REACH, estimate_error_rates,
-    evaluate, posterior, prob_need_below_mu_c,
+    evaluate, posterior, prob_need_below_mu_c, trust_change,
 };
 
 /// Rests on its prior alone: no correction and fewer than `MIN_VOTES` votes.
@@ -273,8 +274,15 @@ proptest! {
             let mut obs = Observations::new(n_ref).unwrap();
             for &k in &order {
                 let before = obs.clone();
+                let prev = conf.clone();
                 record(&mut obs, &executions[k]).unwrap();
                 conf.update_round(&sigma2_d, &before, &obs).unwrap();
+                // Trust falls only where the prior's trust yields or a correction reopens a
+                // latch, and the count of high samples moves by exactly those causes.
+                let t = trust_change(&prev, &before, &conf, &obs).unwrap();
+                prop_assert_eq!(t.other, 0, "{:?}", t);
+                prop_assert!(t.voted_fell <= t.reopened);
+                prop_assert_eq!(conf.n_high() + t.fell(), prev.n_high() + t.rose);
             }
             // Sums in another order differ in the last bits only: the decision is the
             // totals' whichever order summed them, except that a sample trusted from its
@@ -338,8 +346,12 @@ proptest! {
             let mut obs = Observations::new(n_ref).unwrap();
             for &k in &order {
                 let before = obs.clone();
+                let prev = conf.clone();
                 obs.record_votes(&rounds[k].0, &rounds[k].1).unwrap();
                 conf.update_round(&sigma2_d, &before, &obs).unwrap();
+                let t = trust_change(&prev, &before, &conf, &obs).unwrap();
+                prop_assert_eq!(t.other, 0, "{:?}", t);
+                prop_assert_eq!(conf.n_high() + t.fell(), prev.n_high() + t.rose);
                 prop_assert!(!trusted_beside_a_need(&conf, &sigma2_d, &obs, &params));
             }
             if let Some(first) = finals.first() {
@@ -390,8 +402,12 @@ proptest! {
             let mut obs = Observations::new(n_ref).unwrap();
             for &k in &order {
                 let before = obs.clone();
+                let prev = conf.clone();
                 obs.record_votes(&rounds[k].0, &rounds[k].1).unwrap();
                 conf.update_round(&sigma2_d, &before, &obs).unwrap();
+                let t = trust_change(&prev, &before, &conf, &obs).unwrap();
+                prop_assert_eq!(t.other, 0, "{:?}", t);
+                prop_assert_eq!(conf.n_high() + t.fell(), prev.n_high() + t.rose);
                 prop_assert!(!trusted_beside_a_need(&conf, &sigma2_d, &obs, &params));
                 let view = latch_less_yield(conf.latched(), &sigma2_d, &obs, &params);
                 prop_assert_eq!(conf.conf(), view.as_slice());

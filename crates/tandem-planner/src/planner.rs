@@ -339,8 +339,13 @@ pub struct RecordReport {
     /// latched samples this round's corrections reopened (rounds recorded out of order bring
     /// corrections of samples latched since they ran; in order, a supervised sample's split
     /// and sweep reach a latched sample at the edge of a supervised stretch), and latched
-    /// samples resting on their prior whose trust now yields to a need on both sides.
+    /// samples resting on their prior whose trust now yields to a need on both sides, or on
+    /// one side ([`tandem_confidence::one_sided_yield`]).
     pub reopened: usize,
+    /// Of [`RecordReport::reopened`], the samples trusted from the prior alone (still latched)
+    /// whose trust yields to a need this round's corrections confirmed beside them; the rest
+    /// were latched on the operator's votes or the prior and reached by the corrections.
+    pub yielded: usize,
     /// Where the new schedule came from (sampled, previous, repaired previous, serial).
     pub source: Source,
     /// The new schedule's `T_total` (Eq. 13), s.
@@ -720,6 +725,7 @@ impl Planner {
         let report = RecordReport {
             newly_high: latching.newly_high,
             reopened: latching.reopened,
+            yielded: latching.yielded,
             source: outcome.source,
             t_total_s: outcome.t_total_s,
             previous_t_total_s: self.outcome.t_total_s,
