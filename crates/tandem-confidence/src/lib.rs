@@ -86,6 +86,7 @@
 
 mod beta;
 mod boundary;
+mod change;
 mod confidence;
 mod error;
 mod observations;
@@ -94,7 +95,11 @@ mod rates;
 mod runs;
 
 pub use beta::{BetaParams, posterior, prior};
-pub use confidence::{Confidence, MIN_VOTES, RoundUpdate, evaluate, prob_need_below_mu_c};
+pub use change::{TrustChange, trust_change};
+pub use confidence::{
+    Confidence, MIN_VOTES, RoundUpdate, YIELD_REACH, evaluate, one_sided_yield,
+    prob_need_below_mu_c,
+};
 pub use error::{Error, Result};
 pub use observations::{MissEvidence, Observations};
 pub use params::ConfidenceParams;
