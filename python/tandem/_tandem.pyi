@@ -209,13 +209,8 @@ class Planner:
         tick); a finer log is resampled to the model's period. ``resample``: CSV executions
         with an irregular ``t`` column are put on an even grid first, their logs and flags
         (one entry per row) with them. A sample ``corrected`` but not ``supervised`` is an
-        ``InputError``. The dict's ``reopened`` counts samples that turned low-confidence
-        again (latched samples the round's corrections reached, e.g. rounds recorded out of
-        order, and ``yielded`` of them, trusted from the demonstrations alone beside a need
-        the corrections confirmed); ``previous`` (``"valid"``, ``"repaired"``, ``"invalid"``)
-        says what became of the round's schedule on the updated model, ``previous_note``
-        why: only after ``"repaired"`` or ``"invalid"`` can ``t_total_s`` exceed
-        ``previous_t_total_s`` by more than a tick."""
+        ``InputError``. The dict's ``reopened`` counts latched samples the round's
+        corrections turned low-confidence again (e.g. rounds recorded out of order)."""
     def record_pair(
         self,
         executions: Sequence[Demo],

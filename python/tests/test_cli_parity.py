@@ -79,24 +79,16 @@ def test_record_round_equals_tandem_record(tmp_path: Path) -> None:
     py = tandem.fit(DEMOS, params=PARAMS)
     run = tandem.sim.run_round(py, tandem.sim.sanding_needs(LABELS, seed=1, planner=py), seed=1)
     files = [write_execution(tmp_path, i, run, py.model.channels) for i in range(2)]
-    out = run_cli(
+    run_cli(
         "record", tmp_path / "cli.state",
         "--execution", files[0][0], "--execution", files[1][0],
         "--log", files[0][1], "--log", files[1][1],
         "--corrections", files[0][2], "--corrections", files[1][2],
     )
-    before, tick_s = py.schedule.t_total_s, py.schedule.tick_s
     report = py.record_round(**run.record_args())
     py.save(tmp_path / "py.state")
     assert (tmp_path / "py.state").read_bytes() == (tmp_path / "cli.state").read_bytes()
     assert report["t_total_s"] == py.schedule.t_total_s
-    # What became of the round's schedule, in the words `tandem record` prints: the plan grows
-    # by more than a tick only when that schedule no longer fits the updated model.
-    assert report["previous_t_total_s"] == before
-    assert report["previous"] in ("valid", "repaired", "invalid")
-    assert f"previous schedule: {report['previous_note']}" in out
-    assert report["previous"] != "valid" or report["t_total_s"] <= before + tick_s
-    assert 0 <= report["yielded"] <= report["reopened"]
     assert py.rounds_recorded == 1 and py.model.count == 8
 
 

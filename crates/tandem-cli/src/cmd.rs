@@ -1005,18 +1005,11 @@ fn record(a: &RecordArgs) -> Result<()> {
         100.0 * before_high,
         100.0 * planner.confidence().high_share()
     ));
-    if report.reopened > report.yielded {
+    if report.reopened > 0 {
         out(&format!(
             "reopened: {} latched reference samples are low-confidence again (this round's \
              corrections reached them)",
-            report.reopened - report.yielded
-        ));
-    }
-    if report.yielded > 0 {
-        out(&format!(
-            "yielded: {} reference samples trusted from the demonstrations alone are \
-             supervised again (beside a need this round's corrections confirmed)",
-            report.yielded
+            report.reopened
         ));
     }
     out(&format!(

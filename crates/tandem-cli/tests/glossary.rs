@@ -65,7 +65,6 @@ const TERMS: &[(&str, &str)] = &[
     ("over plan", "over / under plan"),
     ("needed but unsupervised", "needed but unsupervised"),
     ("reopened:", "reopened"),
-    ("yielded:", "yielded"),
     ("previous schedule: ", "previous schedule: …"),
     ("high-conf %", "high / low confidence"),
     ("grid of", "grid (of a bag)"),

@@ -28,45 +28,6 @@ use crate::{ConfidenceParams, Error, ErrorRates, MIN_OBSERVATIONS, Observations,
 /// per control sample, [`ConfidenceParams::paper`]) is left as the paper has it.
 pub const MIN_VOTES: f64 = MIN_OBSERVATIONS;
 
-/// How far, in reference samples, the prior's trust yields beside a need on **one** side at
-/// most ([`Confidence`]'s type docs, [`one_sided_yield`]): the alignment's resolution.
-///
-/// Why 48: the prior sees a need only through `σ²_D`, and the fit's duration term measures
-/// a stretch whose duration varies over a window of 97 reference samples centred on each
-/// sample (`tandem_lfd::RateTerm::DEFAULT_WINDOW`, 24 node spacings of the alignment's grid
-/// and one), so where a variable stretch begins or ends is resolved to its half-width,
-/// 48 samples: a need that the corrections confirm may go on that far into samples the
-/// demonstrations show as agreeing. On the task zoo's selection seeds the samples falsely
-/// trusted beside a need on one side lay within 24–37 samples of it (docs/decisions.md,
-/// "A need on one side: the prior's trust yields within the alignment's resolution").
-pub const YIELD_REACH: usize = 48;
-
-/// How many samples of a run of `run_len` samples resting on their prior yield beside a
-/// need on **one** side (the [`Confidence`] type docs): the half of the run nearer the need,
-/// `⌈run_len / 2⌉`, at most [`YIELD_REACH`] (reference samples).
-///
-/// Why half: where the need ends is unknown to the prior within the run; it may end at the
-/// border or go on to the run's other border. Yielding `y` of `L` samples leaves at worst
-/// `L − y` samples falsely trusted (the need goes on) or `y` supervised in vain (it ends at
-/// the border): the half is the least worst case of the two, and a sample yields exactly
-/// when it lies no farther from the need than from the run's other end. Beyond the
-/// alignment's resolution ([`YIELD_REACH`]) the demonstrations' agreement is evidence the
-/// prior resolves, so a long run yields that many. A fixed reach alone would turn a task
-/// shorter than `2 · YIELD_REACH` samples low-confidence whole after one need
-/// (docs/decisions.md, "A need on one side: the prior's trust yields within the
-/// alignment's resolution").
-///
-/// ```
-/// use tandem_confidence::{YIELD_REACH, one_sided_yield};
-/// assert_eq!(one_sided_yield(1), 1);
-/// assert_eq!(one_sided_yield(37), 19);
-/// assert_eq!(one_sided_yield(400), YIELD_REACH);
-/// ```
-#[must_use]
-pub fn one_sided_yield(run_len: usize) -> usize {
-    run_len.div_ceil(2).min(YIELD_REACH)
-}
-
 /// `conf(t)` per reference sample, latched: once a sample is high-confidence it stays so.
 ///
 /// [`update`](Confidence::update) recomputes Eq. 12 from the current demonstration
@@ -86,22 +47,10 @@ pub fn one_sided_yield(run_len: usize) -> usize {
 /// run of latched samples that rest on their prior alone (no correction, fewer than
 /// [`MIN_VOTES`] votes) is low-confidence while the samples on both sides of it are not
 /// latched and are needed by their totals: at least one correction and
-/// `P(π < μ_c | data) < 1 − γ_c` (Eq. 12 mirrored, at `μ'_c` with non-zero error rates);
-/// a side counts as needed also when its border is low-confidence but not needed and a
-/// needed sample follows within the first [`YIELD_REACH`] low-confidence samples outwards
-/// (the edge of a supervised stretch gets a vote or two: the split of Eq. 9's times).
+/// `P(π < μ_c | data) < 1 − γ_c` (Eq. 12 mirrored, at `μ'_c` with non-zero error rates).
 /// The run is then supervised; it keeps its latch, so it is trusted again once it has
 /// [`MIN_VOTES`] clean votes (it no longer rests on its prior) or once a side is no longer
 /// needed, and a correction decides it on its totals like any latched sample.
-/// **Beside a need on one side only** (the other side trusted, low but not needed, or the
-/// task's end) the run yields its [`one_sided_yield`] samples next to the needed
-/// neighbour (the half of the run nearer the need, at most [`YIELD_REACH`]), the rest of it
-/// keeps the prior's trust: where a need ends is known to the prior only as well as the
-/// alignment resolves where the demonstrations start to differ, and not at all within a run
-/// shorter than that. Once those samples have [`MIN_VOTES`] clean votes they are trusted on
-/// their votes and the rest of the run, now beside them, keeps its trust; if they are
-/// corrected until they are needed, the rest of the run yields in turn: the supervision
-/// follows a need as far as it goes.
 /// The yield is **not stored**: it is evaluated from the latch, `σ²_D`, the totals of the
 /// observations and the error rates estimated from them whenever the confidence is
 /// computed ([`update`](Self::update), [`update_round`](Self::update_round),
@@ -112,9 +61,8 @@ pub fn one_sided_yield(run_len: usize) -> usize {
 /// trusts a stretch inside a need that the operator corrects on both sides in every round,
 /// and a trusted sample is never supervised, so nothing else reveals the need
 /// (docs/decisions.md, "The prior's trust yields to a need on both sides, from the
-/// totals"). A stretch with a need on one side only yields near the need alone: the need
-/// may end at the border as well as go on (docs/decisions.md, "A need on one side: the
-/// prior's trust yields within the alignment's resolution").
+/// totals"). A stretch with a need on one side only is left to its prior: the need may end
+/// at the border as well as go on.
 ///
 /// ```
 /// use tandem_confidence::{Confidence, ConfidenceParams, Observations};
@@ -183,14 +131,8 @@ pub struct RoundUpdate {
     pub newly_high: usize,
     /// High-confidence samples that turned low-confidence again: latched samples whose
     /// totals no longer pass Eq. 12 after the round's corrections, and latched samples that
-    /// rest on their prior alone and now yield to a need on both sides, or on one side
-    /// ([`one_sided_yield`]).
+    /// rest on their prior alone and now yield to a need on both sides.
     pub reopened: usize,
-    /// Of [`RoundUpdate::reopened`], the samples still latched: trusted from the prior alone,
-    /// whose trust yields to a need the corrections confirmed beside them (the rest had their
-    /// latch reopened by the round's corrections; [`trust_change`](crate::trust_change)
-    /// tells the two apart between any two states).
-    pub yielded: usize,
 }
 
 impl Confidence {
@@ -347,8 +289,7 @@ impl Confidence {
     /// assert_eq!(a.update_round(&sigma2_d, &before, &obs)?.newly_high, 1);
     /// let before = obs.clone();
     /// obs.record(&[0.0; 10], &[true; 10])?;
-    /// let round = a.update_round(&sigma2_d, &before, &obs)?;
-    /// assert_eq!((round.reopened, round.yielded), (1, 0)); // its latch, not the prior's trust
+    /// assert_eq!(a.update_round(&sigma2_d, &before, &obs)?.reopened, 1);
     /// assert!(!a.conf()[0]);
     /// // The other order ends the same: the corrections first, then the clean rounds.
     /// let (mut b, mut obs) = (Confidence::from_prior(&sigma2_d, p)?, Observations::new(1)?);
@@ -401,12 +342,11 @@ impl Confidence {
             }
         }
         let rates = crate::estimate_error_rates(after, &self.params)?;
-        let (newly_high, reopened, yielded) =
+        let (newly_high, reopened) =
             self.latch_reopening(sigma2_d, &rates, |n| (c[n], s[n]), |n| c[n] > c0[n])?;
         Ok(RoundUpdate {
             newly_high,
             reopened,
-            yielded,
         })
     }
 
@@ -438,15 +378,14 @@ impl Confidence {
 
     /// [`latch`](Self::latch) where the latched samples with `reopen(n)` are decided again
     /// too, then `conf` evaluated on the same totals (the prior's yield):
-    /// `(samples that turned high, samples that turned low, of those the ones still latched)`
-    /// in `conf`.
+    /// `(samples that turned high, samples that turned low)` in `conf`.
     fn latch_reopening(
         &mut self,
         sigma2_d: &[f64],
         rates: &ErrorRates,
         counts: impl Fn(usize) -> (f64, f64),
         reopen: impl Fn(usize) -> bool,
-    ) -> Result<(usize, usize, usize)> {
+    ) -> Result<(usize, usize)> {
         self.check_sigma2_d(sigma2_d)?;
         let Self {
             params: p,
@@ -511,14 +450,8 @@ impl Confidence {
             self.high.clone()
         };
         let turned_high = self.view.iter().zip(&view).filter(|(b, a)| !**b && **a);
-        let turned_low = || self.view.iter().zip(&view).zip(&self.high);
-        let counted = (
-            turned_high.count(),
-            turned_low().filter(|((b, a), _)| **b && !**a).count(),
-            turned_low()
-                .filter(|((b, a), latched)| **b && !**a && **latched)
-                .count(),
-        );
+        let turned_low = self.view.iter().zip(&view).filter(|(b, a)| **b && !**a);
+        let counted = (turned_high.count(), turned_low.count());
         self.view = view;
         Ok(counted)
     }
@@ -526,11 +459,8 @@ impl Confidence {
     /// `conf` from the latch and the totals: the latch less every maximal run of latched
     /// samples that rest on their prior alone (`c = 0`, `s <` [`MIN_VOTES`]) whose
     /// neighbours on both sides are not latched and are needed by their totals (`c > 0` and
-    /// `P(π < μ_c | data) < 1 − γ_c`, Eq. 12 mirrored at `μ'_c`; the type docs), and less
-    /// the [`one_sided_yield`] samples of such a run next to its one needed side. A side is
-    /// needed when one of the first [`YIELD_REACH`] samples from the border outwards that
-    /// are not latched is needed. A pure function of `(latch, σ²_D, counts, rates)`:
-    /// nothing of it is stored.
+    /// `P(π < μ_c | data) < 1 − γ_c`, Eq. 12 mirrored at `μ'_c`; the type docs). A pure
+    /// function of `(latch, σ²_D, counts, rates)`: nothing of it is stored.
     fn yielded(
         &self,
         sigma2_d: &[f64],
@@ -551,23 +481,8 @@ impl Confidence {
             let (c, s) = counts(n);
             self.high[n] && c == 0.0 && s < MIN_VOTES
         };
-        let n_ref = self.high.len();
-        // A side of a run is needed when a needed sample lies among the first YIELD_REACH
-        // low-confidence samples from its border outwards (`forward`: towards the task's
-        // end): the border itself, or further in where the border is the edge of a
-        // supervised stretch with a vote or two (the split of Eq. 9's times).
-        let side_needed = |border: usize, forward: bool| -> bool {
-            let outwards: Box<dyn Iterator<Item = usize>> = if forward {
-                Box::new(border..n_ref)
-            } else {
-                Box::new((0..=border).rev())
-            };
-            outwards
-                .take(YIELD_REACH)
-                .take_while(|&k| !self.high[k])
-                .any(&needed)
-        };
         let mut view = self.high.clone();
+        let n_ref = view.len();
         let mut n = 0;
         while n < n_ref {
             if !on_prior(n) {
@@ -578,15 +493,8 @@ impl Confidence {
             while n < n_ref && on_prior(n) {
                 n += 1;
             }
-            let left = start > 0 && side_needed(start - 1, false);
-            let right = n < n_ref && side_needed(n, true);
-            let reach = one_sided_yield(n - start);
-            if left && right {
+            if start > 0 && n < n_ref && needed(start - 1) && needed(n) {
                 view[start..n].fill(false);
-            } else if left {
-                view[start..start + reach].fill(false);
-            } else if right {
-                view[n - reach..n].fill(false);
             }
         }
         view
@@ -785,12 +693,7 @@ mod tests {
         obs.record(&[1.0, 1.5], &[false, true]).unwrap();
         conf.update(&[0.0, 1.0, 0.001], &obs).unwrap();
         let json = serde_json::to_string(&conf).unwrap();
-        let mut back: Confidence = serde_json::from_str(&json).unwrap();
-        // The latch is what is stored; `conf` is evaluated again from the totals (sample 0
-        // rests on its prior beside sample 1, needed by one correction in half a vote).
-        assert_eq!(back.latched(), conf.latched());
-        assert_eq!(conf.conf(), &[false, false, true]);
-        back.refresh(&[0.0, 1.0, 0.001], &obs).unwrap();
+        let back: Confidence = serde_json::from_str(&json).unwrap();
         assert_eq!(back, conf);
         let bad = r#"{"params":{"mu_c":2.0},"high":[true]}"#;
         let err = serde_json::from_str::<Confidence>(bad).unwrap_err();
@@ -874,19 +777,17 @@ mod tests {
         // Two corrected executions at samples 1, 4 and 8. σ²_D = 10 is far above σ²_MAX, so
         // the prior is Beta(1, 1) (g = 0, Eq. 10–11), and the posterior Beta(3, 1) gives
         // P(π < 0.05) = 0.05³ = 1.25e-4 < 1 − γ_c = 0.05: needed. Samples 2–3 lie between
-        // two needs and yield; sample 0 (the task's start on the other side), sample 5
-        // (sample 6, trusted on its votes, on the other side) and sample 7 (sample 6 and a
-        // need) have a need on one side only, and as runs of one sample they yield whole
-        // (`one_sided_yield(1) = 1`).
-        // Sample 6 rests on its votes and keeps its trust.
+        // two needs and yield; sample 0 has a need on one side only (the task's start on the
+        // other), sample 5 a need and sample 6 (trusted on its votes), sample 7 sample 6 and
+        // a need.
         let before = obs.clone();
         votes(&mut obs, &[1.0, 4.0, 8.0], true, 2);
         let round = conf.update_round(&sigma2_d, &before, &obs).unwrap();
-        let yielded = [false, false, false, false, false, false, true, false, false];
+        let yielded = [true, false, false, false, false, true, true, true, false];
         assert_eq!(conf.conf(), &yielded);
         // The latch is not touched: the yield is evaluated, not stored.
         assert_eq!(conf.latched(), &from_prior);
-        assert_eq!(round.reopened, 5);
+        assert_eq!(round.reopened, 2);
         assert_eq!(round.newly_high, 0);
         // `update` on the same totals decides the same, and a state restored from its latch
         // is refreshed to the same `conf`.
@@ -895,7 +796,7 @@ mod tests {
         assert_eq!(again, conf);
         let mut restored = Confidence::from_parts(p.clone(), conf.latched().to_vec()).unwrap();
         assert_eq!(restored.conf(), &from_prior);
-        assert_eq!(restored.refresh(&sigma2_d, &obs).unwrap(), 5);
+        assert_eq!(restored.refresh(&sigma2_d, &obs).unwrap(), 2);
         assert_eq!(restored, conf);
         // Supervised (they are low-confidence), samples 2–3 are trusted again on ten clean
         // votes, no earlier, while both sides are still needed.
@@ -906,10 +807,10 @@ mod tests {
             conf.update_round(&sigma2_d, &before, &supervised).unwrap();
             assert_eq!(&conf.conf()[2..4], &[vote >= 10; 2], "after {vote} votes");
         }
-        // Five votes, then the need at 4 fades (200 clean executions): the run 2–3 is beside
-        // one need (sample 1) and its half nearer it, sample 2, still yields, sample 5 is
-        // beside none and returns to its latch, and the same rounds in the other order (the need faded before the
-        // corrections) end at the same confidence: nothing of the yield is history.
+        // Five votes, then the need at 4 fades (200 clean executions): samples 2–3 return to
+        // their latch although they have votes, and the same rounds in the other order (the
+        // need faded before the corrections) end at the same confidence: nothing of the
+        // yield is history.
         let rounds: [(&[f64], bool, usize); 4] = [
             (&[6.0], false, 12),
             (&[1.0, 4.0, 8.0], true, 2),
@@ -936,7 +837,7 @@ mod tests {
         assert_eq!(&seen[2][2..4], &[false, false]);
         assert_eq!(
             in_order.conf(),
-            &[false, false, false, true, true, true, true, false, false]
+            &[true, false, true, true, true, true, true, true, false]
         );
         let (reversed, _) = run(&[3, 2, 1, 0]);
         assert_eq!(reversed, in_order);
@@ -947,115 +848,5 @@ mod tests {
         obs.record(&[1.0, 1.0, 4.0, 4.0], &[true; 4]).unwrap();
         conf.update(&sigma2_d, &obs).unwrap();
         assert_eq!(conf.conf(), &from_prior);
-    }
-
-    #[test]
-    fn beside_a_need_on_one_side_the_priors_trust_yields_within_the_reach() {
-        // Sample 0 varies (a need once corrected), samples 1..=len agree (trusted from the
-        // prior), the last varies and is never corrected (low, not needed). Fixed rates.
-        let p = ConfidenceParams {
-            estimate_error_rates: false,
-            ..ConfidenceParams::default()
-        };
-        // A run longer than twice the reach: the reach, not its half, bounds the yield.
-        let len = 2 * YIELD_REACH + 5;
-        let n_ref = len + 2;
-        let mut sigma2_d = vec![0.0; n_ref];
-        sigma2_d[0] = 10.0;
-        sigma2_d[n_ref - 1] = 10.0;
-        let mut conf = Confidence::from_prior(&sigma2_d, p.clone()).unwrap();
-        let from_prior: Vec<bool> = (0..n_ref).map(|n| n > 0 && n <= len).collect();
-        assert_eq!(conf.conf(), from_prior.as_slice());
-        // Two corrections at sample 0: Beta(3, 1), P(π < 0.05) = 1.25e-4 < 0.05, needed. The
-        // YIELD_REACH samples next to it yield, the 53 beyond keep the prior's trust.
-        let mut obs = Observations::new(n_ref).unwrap();
-        let before = obs.clone();
-        votes(&mut obs, &[0.0], true, 2);
-        let round = conf.update_round(&sigma2_d, &before, &obs).unwrap();
-        let one_sided: Vec<bool> = (0..n_ref).map(|n| n > YIELD_REACH && n <= len).collect();
-        assert_eq!(conf.conf(), one_sided.as_slice());
-        assert_eq!(round.reopened, YIELD_REACH);
-        assert_eq!(conf.latched(), from_prior.as_slice());
-        // Supervised, the yielded samples are trusted again on ten clean votes, no fewer;
-        // then the rest of the run is beside samples trusted on their votes and keeps its
-        // trust: nothing creeps on.
-        let near: Vec<f64> = (1..=YIELD_REACH).map(|n| n as f64).collect();
-        let mut supervised = obs.clone();
-        for vote in 1..=10 {
-            let before = supervised.clone();
-            votes(&mut supervised, &near, false, 1);
-            conf.update_round(&sigma2_d, &before, &supervised).unwrap();
-            let expected = if vote >= 10 { &from_prior } else { &one_sided };
-            assert_eq!(conf.conf(), expected.as_slice(), "after {vote} votes");
-        }
-        // A need on the other side too: the whole run yields, whatever its length.
-        let mut both = obs.clone();
-        votes(&mut both, &[(n_ref - 1) as f64], true, 2);
-        conf = Confidence::from_prior(&sigma2_d, p).unwrap();
-        conf.update(&sigma2_d, &both).unwrap();
-        assert_eq!(conf.n_high(), 0);
-        // The same totals from a restored latch give the same `conf`.
-        let mut restored =
-            Confidence::from_parts(conf.params().clone(), conf.latched().to_vec()).unwrap();
-        assert_eq!(restored.refresh(&sigma2_d, &both).unwrap(), len);
-        assert_eq!(restored, conf);
-        // The border the edge of a supervised stretch: sample 1 varies and has two clean
-        // votes (Beta(1, 3): low, and not needed without a correction), the need is sample 0
-        // beyond it. The side is needed: the YIELD_REACH samples beside sample 1 yield.
-        let mut sigma2_d = vec![0.0; n_ref + 1];
-        sigma2_d[..2].fill(10.0);
-        sigma2_d[n_ref] = 10.0;
-        let mut obs = Observations::new(n_ref + 1).unwrap();
-        votes(&mut obs, &[0.0], true, 2);
-        votes(&mut obs, &[1.0], false, 2);
-        let mut conf = Confidence::from_prior(&sigma2_d, conf.params().clone()).unwrap();
-        conf.update(&sigma2_d, &obs).unwrap();
-        let edge: Vec<bool> = (0..=n_ref)
-            .map(|n| n > YIELD_REACH + 1 && n < n_ref)
-            .collect();
-        assert_eq!(conf.conf(), edge.as_slice());
-    }
-
-    #[test]
-    fn on_a_short_task_one_need_leaves_the_far_half_of_each_run_trusted() {
-        // 60 samples; the demonstrations differ at samples 20..23 only (`σ²_D = 10`, Beta(1,
-        // 1) from the prior), two corrected executions there: Beta(3, 1), P(π < 0.05) =
-        // 1.25e-4 < 0.05, needed. The runs beside it, 0..20 (the task's start on the other
-        // side) and 23..60, rest on their prior: the half of each nearer the need yields,
-        // ⌈20/2⌉ = 10 (samples 10..20) and ⌈37/2⌉ = 19 (samples 23..42); 0..10 and 42..60
-        // keep the prior's trust (a reach of 48 alone turned all 60 low).
-        let p = ConfidenceParams {
-            estimate_error_rates: false,
-            ..ConfidenceParams::default()
-        };
-        let n_ref = 60;
-        let need = 20..23;
-        let sigma2_d: Vec<f64> = (0..n_ref)
-            .map(|n| if need.contains(&n) { 10.0 } else { 0.0 })
-            .collect();
-        let mut conf = Confidence::from_prior(&sigma2_d, p).unwrap();
-        assert_eq!(conf.n_high(), n_ref - need.len());
-        let mut obs = Observations::new(n_ref).unwrap();
-        let before = obs.clone();
-        votes(&mut obs, &[20.0, 21.0, 22.0], true, 2);
-        let round = conf.update_round(&sigma2_d, &before, &obs).unwrap();
-        let expected: Vec<bool> = (0..n_ref).map(|n| !(10..42).contains(&n)).collect();
-        assert_eq!(conf.conf(), expected.as_slice());
-        assert_eq!(round.reopened, 10 + 19);
-        assert_eq!(
-            round.yielded,
-            10 + 19,
-            "all of the prior's trust, still latched"
-        );
-        assert_eq!(conf.n_high(), 28);
-        // Supervised, the yielded halves are trusted again on ten clean votes and nothing
-        // creeps on: the far halves now border samples trusted on their votes.
-        let near: Vec<f64> = (10..20).chain(23..42).map(|n| n as f64).collect();
-        for _ in 0..10 {
-            let before = obs.clone();
-            votes(&mut obs, &near, false, 1);
-            conf.update_round(&sigma2_d, &before, &obs).unwrap();
-        }
-        assert_eq!(conf.n_high(), n_ref - need.len());
     }
 }

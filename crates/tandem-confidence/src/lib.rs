@@ -86,7 +86,6 @@
 
 mod beta;
 mod boundary;
-mod change;
 mod confidence;
 mod error;
 mod observations;
@@ -95,11 +94,7 @@ mod rates;
 mod runs;
 
 pub use beta::{BetaParams, posterior, prior};
-pub use change::{TrustChange, trust_change};
-pub use confidence::{
-    Confidence, MIN_VOTES, RoundUpdate, YIELD_REACH, evaluate, one_sided_yield,
-    prob_need_below_mu_c,
-};
+pub use confidence::{Confidence, MIN_VOTES, RoundUpdate, evaluate, prob_need_below_mu_c};
 pub use error::{Error, Result};
 pub use observations::{MissEvidence, Observations};
 pub use params::ConfidenceParams;

@@ -339,13 +339,8 @@ pub struct RecordReport {
     /// latched samples this round's corrections reopened (rounds recorded out of order bring
     /// corrections of samples latched since they ran; in order, a supervised sample's split
     /// and sweep reach a latched sample at the edge of a supervised stretch), and latched
-    /// samples resting on their prior whose trust now yields to a need on both sides, or on
-    /// one side ([`tandem_confidence::one_sided_yield`]).
+    /// samples resting on their prior whose trust now yields to a need on both sides.
     pub reopened: usize,
-    /// Of [`RecordReport::reopened`], the samples trusted from the prior alone (still latched)
-    /// whose trust yields to a need this round's corrections confirmed beside them; the rest
-    /// were latched on the operator's votes or the prior and reached by the corrections.
-    pub yielded: usize,
     /// Where the new schedule came from (sampled, previous, repaired previous, serial).
     pub source: Source,
     /// The new schedule's `T_total` (Eq. 13), s.
@@ -725,7 +720,6 @@ impl Planner {
         let report = RecordReport {
             newly_high: latching.newly_high,
             reopened: latching.reopened,
-            yielded: latching.yielded,
             source: outcome.source,
             t_total_s: outcome.t_total_s,
             previous_t_total_s: self.outcome.t_total_s,
@@ -1020,9 +1014,7 @@ impl Planner {
 
     /// Why [`Planner::load`] replaced the stored schedule, if it did: the stored one failed
     /// this build's check on the stored problem (e.g. a file written by a build whose margin
-    /// check accepted more, or whose confidence trusted more samples than this build derives
-    /// from the stored latch and totals, or edited by hand), and a fresh one was made; the
-    /// recorded rounds, observations and latch are kept as stored. The replacement is
+    /// check accepted more, or edited by hand), and a fresh one was made. The replacement is
     /// in memory until the planner is saved.
     pub fn load_notice(&self) -> Option<&str> {
         self.load_notice.as_deref()
@@ -1353,8 +1345,7 @@ impl Planner {
             });
         }
         // The file holds the latch; `conf` is the latch less the prior's trust that yields to
-        // a need on both sides or, on one side, on the half of its run nearer the need (at
-        // most `YIELD_REACH`), a function of the model's σ²_D and the observations' totals
+        // a need on both sides, a function of the model's σ²_D and the observations' totals
         // (`tandem_confidence::Confidence`), so it is evaluated again here, as `record_round`
         // left it.
         st.confidence
@@ -1692,14 +1683,7 @@ mod tests {
         );
         assert_eq!(p.outcome(), &before);
         assert_eq!(p.params().holds, spec(0.15));
-        // Beside the needed stretch the prior's trust yields on the half of each run nearer
-        // it (`tandem_confidence::one_sided_yield`: 5 of 0..10, 10 of 20..40): low-confidence
-        // now, refused.
-        let conf = p.confidence().conf();
-        assert!(conf[5..10].iter().chain(&conf[20..30]).all(|c| !*c));
-        assert!(conf[..5].iter().chain(&conf[30..]).all(|c| *c));
-        assert!(p.set_holds(spec(0.25)).is_err());
-        // Beyond it, high-confidence: accepted and active.
+        // Outside the stretch, high-confidence: accepted and active.
         p.set_holds(spec(0.3)).unwrap();
         assert_eq!(p.problem().holds(), &[30]);
         assert_eq!(p.problem().active_holds().collect::<Vec<_>>(), vec![30]);

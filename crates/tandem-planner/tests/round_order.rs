@@ -9,9 +9,7 @@ use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use tandem_confidence::{
-    ConfidenceParams, MIN_VOTES, YIELD_REACH, evaluate, one_sided_yield, prob_need_below_mu_c,
-};
+use tandem_confidence::{ConfidenceParams, evaluate};
 use tandem_lfd::{Demonstration, Execution, FitParams, TaskModel};
 use tandem_planner::{ExecutionRecord, Planner, PlannerParams};
 use tandem_schedule::SamplerParams;
@@ -116,58 +114,14 @@ fn record(base: &Planner, rounds: &[[ExecutionRecord; 2]], order: &[usize]) -> (
     (p, reopened)
 }
 
-/// The decision of Eq. 9–12 on the planner's totals alone (no latch, no history), less the
-/// prior's yield (`tandem_confidence::Confidence`'s type docs) written out again here from
-/// the same totals: a sample trusted by the totals that rests on its prior alone (no
-/// correction, fewer than `MIN_VOTES` votes) is low-confidence when, within its maximal run
-/// of such samples, a needed sample (not trusted, a correction, `P(π < μ_c | data) < 1 − γ_c`)
-/// lies on both sides, or on one side with the sample among the run's `one_sided_yield`
-/// samples next to it (the half of the run nearer it, at most `YIELD_REACH`). A side has a need when one is among the first `YIELD_REACH` untrusted samples from
-/// the run's border outwards.
+/// The decision of Eq. 9–12 on the planner's totals alone (no latch, no history).
 fn totals_decision(p: &Planner) -> Vec<bool> {
-    let params = &p.params().confidence;
-    let obs = p.observations();
-    let trusted = evaluate(p.model().sigma2_d(), obs, params).unwrap();
-    let below = prob_need_below_mu_c(p.model().sigma2_d(), obs, params).unwrap();
-    let (c, s) = (obs.corrections(), obs.supervised());
-    let n_ref = trusted.len();
-    let on_prior = |n: usize| trusted[n] && c[n] == 0.0 && s[n] < MIN_VOTES;
-    let needed = |m: usize| !trusted[m] && c[m] > 0.0 && below[m] < 1.0 - params.gamma_c;
-    // Whether a need lies among the first YIELD_REACH untrusted samples of `outwards`.
-    if !params.one_vote_per_execution {
-        // The paper's counting has no yield.
-        return trusted;
-    }
-    let need_within = |outwards: &mut dyn Iterator<Item = usize>| {
-        outwards
-            .take(YIELD_REACH)
-            .take_while(|&m| !trusted[m])
-            .any(needed)
-    };
-    (0..n_ref)
-        .map(|n| {
-            if !on_prior(n) {
-                return trusted[n];
-            }
-            // The run of samples resting on their prior that holds `n`: [first, last].
-            let first = (0..n)
-                .rev()
-                .take_while(|&m| on_prior(m))
-                .last()
-                .unwrap_or(n);
-            let last = (n + 1..n_ref)
-                .take_while(|&m| on_prior(m))
-                .last()
-                .unwrap_or(n);
-            let before = need_within(&mut (0..first).rev());
-            let after = need_within(&mut (last + 1..n_ref));
-            // Both sides: the whole run; one side: the `one_sided_yield` samples next to it.
-            let reach = one_sided_yield(last - first + 1);
-            let from_before = before && (after || n - first < reach);
-            let from_after = after && last - n < reach;
-            !(from_before || from_after)
-        })
-        .collect()
+    evaluate(
+        p.model().sigma2_d(),
+        p.observations(),
+        &p.params().confidence,
+    )
+    .unwrap()
 }
 
 /// The regression: clean rounds, then rounds in which the operator corrects the needed
@@ -228,22 +182,10 @@ fn corrections_recorded_after_a_lucky_latch_reopen_it() {
         first_fail > 0,
         "one corrected round still passes: {reports:?}"
     );
-    // In that round the prior's trust yields too: samples 0..10 are never supervised (no
-    // correction, no vote: they rest on their prior) and their run borders sample 10, needed
-    // from that round on, on one side (the task's start on the other), so the half of the
-    // run nearer sample 10 yields (`one_sided_yield(10)` = 5: samples 5..10). Samples 20..40
-    // rest on their prior too, but their border, sample 19, is latched on its clean votes: no
-    // need on either side, they keep their trust. 4 + 5 = 9 reopened.
-    let one_sided = one_sided_yield(VARIABLE.start);
-    assert_eq!(one_sided, 5);
     for (k, &r) in reports.iter().enumerate() {
         assert_eq!(
             r,
-            if k == first_fail {
-                NEEDED.len() + one_sided
-            } else {
-                0
-            },
+            if k == first_fail { NEEDED.len() } else { 0 },
             "{reports:?}"
         );
     }
@@ -251,19 +193,7 @@ fn corrections_recorded_after_a_lucky_latch_reopen_it() {
     let corrected_first_order: Vec<usize> = (n_clean..all.len()).chain(0..n_clean).collect();
     let (clean_first, _) = record(&base, &all, &in_order);
     let (corrected_first, reopened) = record(&base, &all, &corrected_first_order);
-    // Corrected rounds first, no latch of the variable stretch forms before its corrections,
-    // so what turns low is the prior's trust alone, once each: samples 5..10 beside the need
-    // at 10 (as above), and samples 20..30, the half nearer the need of the run 20..40 (the
-    // task's end on its other side), whose border 19 is low (samples 14..20 have fewer than
-    // MIN_VOTES votes while the need is first confirmed) with the need at 13 among the first
-    // YIELD_REACH low samples outwards; they yield until 14..20 latch on their clean votes.
-    // 5 + 10 = 15.
-    let prior_runs = one_sided_yield(VARIABLE.start) + one_sided_yield(N_REF - VARIABLE.end);
-    assert_eq!(prior_runs, 15);
-    assert_eq!(
-        reopened, prior_runs,
-        "nothing latched before its corrections"
-    );
+    assert_eq!(reopened, 0, "nothing latched before its corrections");
     assert_eq!(
         clean_first.confidence().conf(),
         corrected_first.confidence().conf()

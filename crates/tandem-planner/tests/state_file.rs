@@ -389,61 +389,14 @@ fn old_golden_loads_and_saves_as_the_golden_file(version: u32, added: usize) -> 
 #[test]
 fn a_version_10_file_loads_without_stored_rounds_and_saves_as_its_payload_extended() {
     // Format 11 appends the reference demonstration and the recorded executions: the version
-    // 10 payload written again is that payload followed by `None` and an empty list. (Its
-    // payload no longer leads the golden file's: the golden model's ranges carry the relative
-    // rate term's marker and its rate range, `tandem_lfd`'s `RateTerm`.)
+    // 10 file saved again is its payload followed by `None` and an empty list. (Its payload no
+    // longer leads the golden file's: the golden model's ranges carry the relative rate
+    // term's marker and its rate range, `tandem_lfd`'s `RateTerm`.)
     let v10 = std::fs::read(old_golden_path(10)).unwrap();
     const HEADER: usize = tandem_planner::state::HEADER_LEN;
-    let dir = tmp_dir("v10-payload");
-    let (stored, extras) = state::load_payload(&old_golden_path(10)).unwrap();
-    let written = |name: &str, payload: &state::v11::Payload| {
-        let path = dir.join(name);
-        state::save_payload(&path, payload, &extras).unwrap();
-        std::fs::read(&path).unwrap()
-    };
-    let as_is = written("as_is.tandem", &stored);
-    assert_eq!(&as_is[HEADER..as_is.len() - 2], &v10[HEADER..]);
-    assert_eq!(&as_is[as_is.len() - 2..], &[0, 0]);
-    // The planner rechecks the stored schedule against the confidence this build derives
-    // from the stored latch and totals: the prior's trust now yields beside the need the
-    // stored round confirmed (`tandem_confidence::one_sided_yield`), so the stored schedule
-    // runs two robots low-confidence at once (constraint 3). It is never run: it is replaced
-    // by a valid one and the load says so (docs/decisions.md, "A need on one side: the
-    // prior's trust yields within the alignment's resolution").
-    let old = Planner::load(old_golden_path(10)).unwrap();
-    let notice = old.load_notice().expect("the stored schedule is replaced");
-    assert!(
-        notice.contains("fails this build's check") && notice.contains("low-confidence"),
-        "{notice}"
-    );
-    let stored_schedule: tandem_schedule::Schedule = stored.outcome.schedule.clone().into();
-    assert!(validate(old.problem(), &stored_schedule).is_err());
-    assert!(validate(old.problem(), old.schedule()).is_ok());
-    assert!(old.checked_schedule().is_ok());
-    assert_eq!(old.schedule().tick_s, stored_schedule.tick_s);
-    // Saved, it is the stored payload with the new outcome: the model, the recorded round's
-    // totals, the latch, the round count and fingerprints are the version 10 file's bytes.
     let again = v10_saved_again("v10");
-    let replaced = state::v11::Payload {
-        outcome: old.outcome().into(),
-        ..stored.clone()
-    };
-    assert_ne!(replaced.outcome, stored.outcome);
-    assert_eq!(written("replaced.tandem", &replaced), again);
-    let (saved, _) = state::load_payload(&{
-        let path = dir.join("again.tandem");
-        std::fs::write(&path, &again).unwrap();
-        path
-    })
-    .unwrap();
-    assert_eq!((saved.rounds_recorded, &saved.rounds), (1, &stored.rounds));
-    assert_eq!(saved.observations, stored.observations);
-    assert_eq!(saved.confidence, stored.confidence);
-    // Loaded again, the replacement passes: no notice, the same schedule.
-    let reloaded = Planner::load(dir.join("again.tandem")).unwrap();
-    assert_eq!(reloaded.load_notice(), None);
-    assert_eq!(reloaded.schedule(), old.schedule());
-    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(&again[HEADER..again.len() - 2], &v10[HEADER..]);
+    assert_eq!(&again[again.len() - 2..], &[0, 0]);
     // Its round cannot be replayed (its executions were not kept); the golden file's can.
     let old = Planner::load(old_golden_path(10)).unwrap();
     assert_eq!(old.rounds_recorded(), 1);

@@ -19,7 +19,7 @@ pub(crate) use tandem::realtime::{
 pub(crate) use tandem::schedule::cyclic::{GapPlan, Stretch};
 pub(crate) use tandem::schedule::{
     CheckedCyclicPlan, CheckedSchedule, CyclicParams, CyclicPlan, GlobalTimeline, LcInterval,
-    Outcome, PreviousFate, Problem, SamplerParams, Schedule, Source, Violation, cyclic_plan,
+    Outcome, Problem, SamplerParams, Schedule, Source, Violation, cyclic_plan,
     cyclic_plan_for_order, sample_schedule_n,
 };
 pub(crate) use tandem::sim::needs::{NeedProfile, NeedRegion};

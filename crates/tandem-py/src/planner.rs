@@ -14,8 +14,8 @@ use crate::errors::{Error, Result, deprecated, guard, warn};
 use crate::facade::{
     AnyController, BetaParams, Cell, DEFAULT_DT_S, DEFAULT_LOCK_TIMEOUT, DT_TOLERANCE,
     Demonstration, Execution, ExecutionRecord, HoldRule, HoldSpec, Observations, PeriodSource,
-    Plan, Planner, PlannerParams, PreviousFate, RateTerm, RecordReport, Regridded, StateLock,
-    TaskModel, drifting_majority, errors, length_warnings, posterior, prior, prior_low_threshold,
+    Plan, Planner, PlannerParams, RateTerm, RecordReport, Regridded, StateLock, TaskModel,
+    drifting_majority, errors, length_warnings, posterior, prior, prior_low_threshold,
     prob_need_below_mu_c, reschedule_seed,
 };
 use crate::facade::{BagOptions, Recording, extend_bag_schema, is_bag, read_bag};
@@ -668,24 +668,12 @@ pub(crate) fn report_dict<'py>(py: Python<'py>, r: &RecordReport) -> PyResult<Bo
     let d = PyDict::new(py);
     d.set_item("newly_high", r.newly_high)?;
     d.set_item("reopened", r.reopened)?;
-    d.set_item("yielded", r.yielded)?;
     d.set_item("source", crate::schedule::source_name(r.source))?;
     d.set_item("t_total_s", r.t_total_s)?;
     d.set_item("model_update_s", r.model_update.as_secs_f64())?;
     d.set_item("confidence_s", r.confidence.as_secs_f64())?;
     d.set_item("scheduling_s", r.scheduling.as_secs_f64())?;
     d.set_item("notices", r.notices.clone())?;
-    d.set_item("previous_t_total_s", r.previous_t_total_s)?;
-    d.set_item(
-        "previous",
-        match r.previous {
-            PreviousFate::NotGiven => None,
-            PreviousFate::Valid { .. } => Some("valid"),
-            PreviousFate::Repaired { .. } => Some("repaired"),
-            PreviousFate::Invalid { .. } => Some("invalid"),
-        },
-    )?;
-    d.set_item("previous_note", r.previous.describe())?;
     Ok(d)
 }
 
@@ -866,17 +854,11 @@ impl PyPlanner {
     /// supervise), as ``tandem record`` checks: otherwise ``InputError``.
     ///
     /// Returns:
-    ///     dict: ``newly_high`` (samples latched high-confidence), ``reopened`` (samples
-    ///     that turned low-confidence again: latched samples this round's corrections
-    ///     reached, e.g. rounds recorded out of order, and ``yielded`` of them, trusted from
-    ///     the demonstrations alone beside a need the corrections confirmed), ``source`` of
-    ///     the new schedule, its ``t_total_s`` (Eq. 13, s), the round's schedule's
-    ///     ``previous_t_total_s``, ``previous`` (``"valid"``, ``"repaired"`` or
-    ///     ``"invalid"``: what became of that schedule on the updated model; only after
-    ///     ``"repaired"`` or ``"invalid"`` can ``t_total_s`` exceed ``previous_t_total_s``
-    ///     by more than a tick) and ``previous_note`` (why, one sentence), wall times
-    ///     ``model_update_s``, ``confidence_s``, ``scheduling_s``, and ``notices`` (what was
-    ///     resampled).
+    ///     dict: ``newly_high`` (samples latched high-confidence), ``reopened`` (latched
+    ///     samples this round's corrections turned low-confidence again, e.g. rounds recorded
+    ///     out of order), ``source`` of the new
+    ///     schedule, its ``t_total_s`` (Eq. 13, s), wall times ``model_update_s``,
+    ///     ``confidence_s``, ``scheduling_s``, and ``notices`` (what was resampled).
     #[pyo3(signature = (executions, ref_time_logs, supervised, corrected, channels=None, dt_s=None, resample=false))]
     #[expect(
         clippy::too_many_arguments,

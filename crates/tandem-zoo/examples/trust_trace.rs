@@ -6,12 +6,7 @@
 //! rates and `σ²_D` of then, and its neighbours. The last line sorts the samples where the
 //! demonstrations vary: trusted from the prior, latched after fewer than 10 votes, latched
 //! while `f̂` was above 3 %, other (docs/decisions.md, "Graded needs: the error rate's
-//! estimate and the latch's evidence"). The `CLASS` lines sort every falsely trusted sample
-//! by the run resting on its prior that holds it and by that run's two borders in the terms
-//! of `Confidence`'s yield (`N` needed by its totals, `c` corrected but not needed, `l` low
-//! and never corrected, `t` trusted on its votes, `e` the task's end; `voted`: not resting
-//! on its prior), with the runs' lengths (docs/decisions.md, "A need on one side: the
-//! prior's trust yields within the alignment's resolution").
+//! estimate and the latch's evidence").
 //!
 //! `cargo run --release -p tandem-zoo --example trust_trace -- FAMILY SEED [ROUNDS]`
 
@@ -189,62 +184,6 @@ fn main() {
         .filter(|&n| conf[n] && prep.need_kind[n] == Some(false))
         .count();
     println!("falsely trusted vary {vary} agree {agree}");
-    // Every falsely trusted sample where the demonstrations vary, sorted by the maximal run
-    // of samples resting on their prior (latched, `c = 0`, `s <` MIN_VOTES) that holds it
-    // and by that run's borders, in the totals' terms of `Confidence`'s yield rule: `N` a
-    // border needed by its totals (not latched, `c > 0`, `P(π < μ_c | data) < 1 − γ_c`),
-    // `c` corrected but not needed, `l` low and never corrected, `t` trusted on its votes,
-    // `e` the task's end. `voted`: the sample does not rest on its prior.
-    let p_below =
-        tandem_confidence::prob_need_below_mu_c(pl.model().sigma2_d(), obs, &params.confidence)
-            .unwrap();
-    let latched = pl.confidence().latched();
-    let (c, s) = (obs.corrections(), obs.supervised());
-    let on_prior = |n: usize| latched[n] && c[n] == 0.0 && s[n] < tandem_confidence::MIN_VOTES;
-    let border = |n: Option<usize>| match n {
-        None => 'e',
-        Some(n) if latched[n] => 't',
-        Some(n) if c[n] > 0.0 && p_below[n] < 1.0 - params.confidence.gamma_c => 'N',
-        Some(n) if c[n] > 0.0 => 'c',
-        Some(_) => 'l',
-    };
-    let mut classes: std::collections::BTreeMap<String, (usize, usize, Vec<usize>)> =
-        std::collections::BTreeMap::new();
-    let mut n = 0;
-    while n < n_ref {
-        if !on_prior(n) {
-            if conf[n] && prep.need_kind[n] == Some(true) {
-                classes.entry("voted".into()).or_default().0 += 1;
-            }
-            n += 1;
-            continue;
-        }
-        let a = n;
-        while n < n_ref && on_prior(n) {
-            n += 1;
-        }
-        let vary = (a..n)
-            .filter(|&k| conf[k] && prep.need_kind[k] == Some(true))
-            .count();
-        let agree = (a..n)
-            .filter(|&k| conf[k] && prep.need_kind[k] == Some(false))
-            .count();
-        if vary + agree == 0 {
-            continue;
-        }
-        let key = format!(
-            "{}{}",
-            border(a.checked_sub(1)),
-            border((n < n_ref).then_some(n))
-        );
-        let e = classes.entry(key).or_default();
-        e.0 += vary;
-        e.1 += agree;
-        e.2.push(n - a);
-    }
-    for (k, (vary, agree, lens)) in &classes {
-        println!("CLASS {k}: vary {vary} agree {agree} run lengths {lens:?}");
-    }
     let (mut prior, mut few, mut inflated, mut other) = (0, 0, 0, 0);
     for n in 0..n_ref {
         if !(conf[n] && prep.need_kind[n] == Some(true)) {

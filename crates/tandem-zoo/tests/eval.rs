@@ -70,37 +70,8 @@ fn a_short_loop_reports_consistent_numbers_on_any_number_of_threads() {
         );
         assert!(r.serial_s > 0.0 && r.planned_per_h > 0.0 && r.realized_per_h > 0.0);
         assert_eq!(r.truth_high_pct, fit.truth_high_pct);
-        if r.cell == Cell::Rounds {
-            // Learning takes back trust in two ways only: trust resting on the prior yields to
-            // a need the corrections confirmed beside it, or a round's corrections reach a
-            // latched sample; trust earned on votes falls only with a correction of it. The
-            // high share moves by exactly what the causes count.
-            assert_eq!(r.trust.len(), r.rounds);
-            let n_high: Vec<usize> = r
-                .high_pct
-                .iter()
-                .map(|p| (p * fit.n_ref as f64 / 100.0).round() as usize)
-                .collect();
-            for (k, t) in r.trust.iter().enumerate() {
-                assert_eq!(t.other, 0, "round {}: {t:?}", k + 1);
-                assert!(t.voted_fell <= t.reopened, "round {}: {t:?}", k + 1);
-                assert_eq!(
-                    n_high[k + 1] + t.fell(),
-                    n_high[k] + t.rose,
-                    "round {}: {t:?}",
-                    k + 1
-                );
-            }
-            // The plan grows by more than a tick only where the old schedule became invalid.
-            assert!(
-                r.increases.iter().all(|i| !i.unexplained()),
-                "{:?}",
-                r.increases
-            );
-            assert!(r.increases.iter().all(|i| i.increase_s > r.tick_s));
-        } else {
-            assert!(r.trust.is_empty() && r.increases.is_empty());
-        }
+        // Learning only ever adds high confidence (the latch).
+        assert!(r.high_pct.windows(2).all(|w| w[1] >= w[0]));
         assert_eq!(r.overlap_ticks + r.faults, 0);
     }
     let rows = family_rows(&report);
@@ -115,9 +86,7 @@ fn a_short_loop_reports_consistent_numbers_on_any_number_of_threads() {
         },
     );
     assert!(
-        breaches.iter().all(|b| !b.what.contains("overlapping")
-            && !b.what.contains("still valid")
-            && !b.what.contains("neither by")),
+        breaches.iter().all(|b| !b.what.contains("overlapping")),
         "{breaches:?}"
     );
 }

@@ -41,7 +41,7 @@ pub use prepare::{
     FitReport, Prepared, ReferenceSpread, SANDING, correction_channel, falsely_trusted_split,
     prepare, prepare_sanding,
 };
-pub use run::{Fate, FateCount, FateIncreases, Increase, RunReport, run_continuous, run_rounds};
+pub use run::{Fate, FateCount, FateIncreases, RunReport, run_continuous, run_rounds};
 pub use summary::{Breach, FamilyRow, FitRow, Thresholds, check, family_rows, fit_rows};
 pub use warps::{ExportMeta, WarpError, export_alignment, fitted_warps, warp_error, warp_errors};
 

@@ -5,7 +5,6 @@
 use std::sync::{Mutex, PoisonError};
 
 use serde::{Deserialize, Serialize};
-use tandem_confidence::{Confidence, Observations, TrustChange, trust_change};
 use tandem_planner::{Planner, derive_seed};
 use tandem_schedule::PreviousFate;
 use tandem_sim::study::{Cell, RoundView, StudyConfig, run_cell_trial_on, run_trial_on};
@@ -80,21 +79,6 @@ pub struct RunReport {
     /// reports saved before it.
     #[serde(default)]
     pub by_fate: FateIncreases,
-    /// Every plan-to-plan increase of `T_total` above one control tick, with the previous
-    /// schedule's fate in the re-schedule that made the later plan: learning may lengthen the
-    /// plan by more than a tick only where the new confidence invalidated the schedule the
-    /// round ran ([`Fate::Repaired`], [`Fate::Invalid`]; [`check`](super::check) names any
-    /// other). Rounds only; empty for a cell and in reports saved before it.
-    #[serde(default)]
-    pub increases: Vec<Increase>,
-    /// How the confidence changed in every recorded round, by cause
-    /// (`tandem_confidence::trust_change`, one entry per round, the first round's first): the
-    /// high-confidence share falls only where the prior's trust yields to a need the
-    /// corrections confirmed (`yielded`) or where a round's corrections reached a latched
-    /// sample (`reopened`); `other` is 0 ([`check`](super::check) names any other). Rounds
-    /// only; empty for a cell and in reports saved before it.
-    #[serde(default)]
-    pub trust: Vec<TrustChange>,
     /// Mean over rounds of realized duration over planned `T_total` (continuous: the last
     /// plan's planned throughput over the steady realized one).
     pub realized_over_planned: f64,
@@ -231,7 +215,7 @@ fn config(prep: &Prepared, robots: usize, cell: Cell, rounds: usize) -> StudyCon
 
 /// What became of the previous schedule in one re-schedule ([`PreviousFate`] without its
 /// details), as [`FateIncreases`] counts it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Fate {
     /// Still valid on the updated model ([`PreviousFate::Valid`]): the re-schedule is never
     /// longer, so an increase here is the scheduler's.
@@ -254,45 +238,6 @@ impl Fate {
             PreviousFate::Repaired { .. } => Some(Fate::Repaired),
             PreviousFate::Invalid { .. } => Some(Fate::Invalid),
         }
-    }
-}
-
-/// One plan-to-plan increase of `T_total` above one control tick ([`RunReport::increases`]).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Increase {
-    /// Plans before the later one (rounds recorded when it was made: plan `after + 1` came
-    /// after plan `after`).
-    pub after: usize,
-    /// `T_total` of plan `after + 1` minus plan `after`'s (s).
-    pub increase_s: f64,
-    /// The previous schedule's fate in the re-schedule that made plan `after + 1` (`None`:
-    /// no previous schedule was given).
-    pub fate: Option<Fate>,
-}
-
-impl Increase {
-    /// Every increase of `t_total_s` (one per plan) above `tick_s`, with `fates` (one per
-    /// plan, as [`FateIncreases::of`] takes them).
-    #[must_use]
-    pub fn of(t_total_s: &[f64], fates: &[Option<Fate>], tick_s: f64) -> Vec<Increase> {
-        t_total_s
-            .windows(2)
-            .enumerate()
-            .filter(|(_, w)| w[1] - w[0] > tick_s)
-            .map(|(k, w)| Increase {
-                after: k,
-                increase_s: w[1] - w[0],
-                fate: fates.get(k + 1).copied().flatten(),
-            })
-            .collect()
-    }
-
-    /// Whether the previous schedule still bounded the later plan ([`Fate::Valid`]), so that
-    /// this increase breaks the rule "never more than a tick longer unless the new confidence
-    /// invalidated the old schedule".
-    #[must_use]
-    pub fn unexplained(&self) -> bool {
-        matches!(self.fate, Some(Fate::Valid))
     }
 }
 
@@ -376,8 +321,6 @@ struct Trace {
     serial_s: Vec<f64>,
     /// `(round, fate of the re-schedule that made the plan the round ran)`.
     fates: Vec<(usize, Option<Fate>)>,
-    /// `(round, the confidence and the observations of the plan the round ran)`.
-    states: Vec<(usize, Confidence, Observations)>,
     backward: (usize, f64),
     error: Option<crate::Error>,
 }
@@ -419,15 +362,9 @@ pub fn run_rounds(
         let serial = serial_s(view.planner);
         let backward = backward_steps(view.run.robots.iter().map(|r| &r.ref_time_log[..]));
         let fate = Fate::of(&view.planner.outcome().previous);
-        let state = (
-            view.round,
-            view.planner.confidence().clone(),
-            view.planner.observations().clone(),
-        );
         let mut t = trace.lock().unwrap_or_else(PoisonError::into_inner);
         t.add_backward(backward);
         t.fates.push((view.round, fate));
-        t.states.push(state);
         match serial {
             Ok(s) => t.serial_s.push(s),
             Err(e) => {
@@ -465,24 +402,11 @@ pub fn run_rounds(
         .map(|f| f.1)
         .chain([Fate::of(&run.planner.outcome().previous)])
         .collect();
-    let (by_fate, increases) = if fates.len() == t_total_s.len() {
-        (
-            FateIncreases::of(&t_total_s, &fates),
-            Increase::of(&t_total_s, &fates, tick_s),
-        )
+    let by_fate = if fates.len() == t_total_s.len() {
+        FateIncreases::of(&t_total_s, &fates)
     } else {
-        (FateIncreases::default(), Vec::new())
+        FateIncreases::default()
     };
-    // Round `k` ran the state of plan `k − 1`; the last state is the planner's after the trial.
-    trace.states.sort_by_key(|s| s.0);
-    let mut states: Vec<(&Confidence, &Observations)> =
-        trace.states.iter().map(|s| (&s.1, &s.2)).collect();
-    states.push((run.planner.confidence(), run.planner.observations()));
-    let trust = states
-        .windows(2)
-        .map(|w| trust_change(w[0].0, w[0].1, w[1].0, w[1].1))
-        .collect::<std::result::Result<Vec<_>, _>>()
-        .map_err(tandem_planner::Error::from)?;
     let ran: Vec<(f64, f64)> = its
         .iter()
         .filter_map(|i| i.round.as_ref().map(|p| (i.t_total_s, p.duration_s)))
@@ -515,8 +439,6 @@ pub fn run_rounds(
         max_increase_s,
         max_increase_at,
         by_fate,
-        increases,
-        trust,
         realized_over_planned,
         realized_over_planned_last: realized_last / planned_last,
         planned_per_h: per_h(planned_last),
@@ -588,8 +510,6 @@ pub fn run_continuous(
         max_increase_s,
         max_increase_at,
         by_fate: FateIncreases::default(),
-        increases: Vec::new(),
-        trust: Vec::new(),
         realized_over_planned: ratio,
         realized_over_planned_last: ratio,
         planned_per_h: last.tasks_per_hour,
@@ -639,8 +559,6 @@ mod tests {
             max_increase_s: 0.0,
             max_increase_at: None,
             by_fate: FateIncreases::default(),
-            increases: Vec::new(),
-            trust: Vec::new(),
             realized_over_planned: 1.0,
             realized_over_planned_last: 1.0,
             planned_per_h: 1.0,
@@ -752,58 +670,6 @@ mod tests {
         old.as_object_mut().unwrap().remove("by_fate");
         let back: RunReport = serde_json::from_value(old).unwrap();
         assert_eq!(back.by_fate, FateIncreases::default());
-    }
-
-    #[test]
-    fn increases_above_a_tick_with_their_fate_and_the_rule() {
-        // The plans of `increases_filed_by_the_previous_schedules_fate`: +0.5 s after plan 1
-        // (repaired) and +4.5 s after plan 2 (invalid) are above a 10 ms tick, only +4.5 s
-        // above a 1 s tick; neither breaks the rule (the old schedule became invalid).
-        let t = [30.0, 20.0, 20.5, 25.0, 24.0];
-        let fates = [
-            None,
-            Some(Fate::Repaired),
-            Some(Fate::Repaired),
-            Some(Fate::Invalid),
-            Some(Fate::Valid),
-        ];
-        let inc = Increase::of(&t, &fates, 0.01);
-        assert_eq!(
-            inc.iter()
-                .map(|i| (i.after, i.increase_s, i.fate))
-                .collect::<Vec<_>>(),
-            vec![
-                (1, 0.5, Some(Fate::Repaired)),
-                (2, 4.5, Some(Fate::Invalid))
-            ]
-        );
-        assert!(inc.iter().all(|i| !i.unexplained()));
-        assert_eq!(Increase::of(&t, &fates, 1.0).len(), 1);
-        // +0.25 s with the previous schedule still valid breaks it, and `check` names it;
-        // +0.005 s (half a tick) is within the rule.
-        let valid = Increase::of(&[10.0, 10.25], &[None, Some(Fate::Valid)], 0.01);
-        assert!(valid.len() == 1 && valid[0].unexplained());
-        assert!(Increase::of(&[10.0, 10.005], &[None, Some(Fate::Valid)], 0.01).is_empty());
-        let mut r = run(12.0, 10.0, None);
-        r.increases = valid;
-        r.trust = vec![TrustChange {
-            other: 2,
-            ..TrustChange::default()
-        }];
-        let report = crate::eval::ZooReport {
-            params: crate::eval::EvalParams::default(),
-            families: vec!["f".into()],
-            fits: Vec::new(),
-            runs: vec![r],
-        };
-        let breaches = crate::eval::check(&report, &crate::eval::Thresholds::CI);
-        assert_eq!(breaches.len(), 2, "{breaches:?}");
-        assert!(breaches[0].what.contains("still valid"));
-        assert!(
-            breaches[1]
-                .what
-                .contains("round 1: 2 high-confidence samples")
-        );
     }
 
     #[test]

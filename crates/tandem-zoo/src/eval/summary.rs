@@ -348,11 +348,7 @@ pub struct Breach {
 }
 
 /// Every limit of `limits` that `report` breaks: backward steps and overlaps per run (any
-/// cell), the gap and the high confidence per family row of the rounds cell; and, with no
-/// limit to set, the two rules of learning per run of rounds: an increase of `T_total` above
-/// one tick while the previous schedule was still valid ([`Increase::unexplained`](super::Increase::unexplained)), and a
-/// fall of high confidence that neither the prior's trust yielding nor a correction explains
-/// (`TrustChange::other`).
+/// cell), the gap and the high confidence per family row of the rounds cell.
 #[must_use]
 pub fn check(report: &ZooReport, limits: &Thresholds) -> Vec<Breach> {
     let mut out = Vec::new();
@@ -364,27 +360,6 @@ pub fn check(report: &ZooReport, limits: &Thresholds) -> Vec<Breach> {
                 what: format!(
                     "{} backward steps of reference time (largest {:.3} samples; limit {})",
                     r.backward_steps, r.max_backward_samples, limits.max_backward_steps
-                ),
-            });
-        }
-        for inc in r.increases.iter().filter(|i| i.unexplained()) {
-            out.push(Breach {
-                at: at.clone(),
-                what: format!(
-                    "T_total rose {:.3} s after plan {} although the previous schedule was \
-                     still valid (the rule: never more than a tick unless it became invalid)",
-                    inc.increase_s, inc.after
-                ),
-            });
-        }
-        for (k, t) in r.trust.iter().enumerate().filter(|(_, t)| t.other > 0) {
-            out.push(Breach {
-                at: at.clone(),
-                what: format!(
-                    "round {}: {} high-confidence samples turned low neither by the prior's \
-                     trust yielding nor by corrections reaching them",
-                    k + 1,
-                    t.other
                 ),
             });
         }
