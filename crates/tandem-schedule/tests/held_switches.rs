@@ -4,6 +4,30 @@
 
 use tandem_schedule::{Problem, SamplerParams, Schedule, Source, sample_schedule_n, validate};
 
+/// A problem dumped by the zoo's `rounds_trace --dump` (`tests/data/NAME`: the fields
+/// `problem`, `tick_s` (s), `seed`), with the sampler parameters of the re-schedule that met it.
+fn dumped(name: &str) -> (Problem, SamplerParams) {
+    #[derive(serde::Deserialize)]
+    struct Data {
+        problem: Problem,
+        tick_s: f64,
+        seed: u64,
+    }
+    let path = format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap();
+    let Data {
+        problem,
+        tick_s,
+        seed,
+    } = serde_json::from_str(&text).unwrap();
+    let params = SamplerParams {
+        seed,
+        tick_s: Some(tick_s),
+        ..SamplerParams::default()
+    };
+    (problem, params)
+}
+
 /// The problem of a zoo deburring task (selection seed 6, two robots, after 30 rounds: three
 /// low-confidence runs of 5.43, 0.02 and 0.15 s, holds `spindle<0.5`; written by `cargo run
 /// --release -p tandem-zoo --example rounds_trace -- deburring 6 2 30 --dump 30 PATH`, the
@@ -13,27 +37,7 @@ use tandem_schedule::{Problem, SamplerParams, Schedule, Source, sample_schedule_
 /// clearances set from the check's slacks passes at 26.659 s.
 #[test]
 fn a_zoo_deburring_task_gets_each_switch_the_room_the_check_asks() {
-    #[derive(serde::Deserialize)]
-    struct Data {
-        problem: Problem,
-        tick_s: f64,
-        seed: u64,
-    }
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/zoo_deburring_select6_round30.json"
-    ))
-    .unwrap();
-    let Data {
-        problem: p,
-        tick_s,
-        seed,
-    } = serde_json::from_str(&text).unwrap();
-    let params = SamplerParams {
-        seed,
-        tick_s: Some(tick_s),
-        ..SamplerParams::default()
-    };
+    let (p, params) = dumped("zoo_deburring_select6_round30.json");
     let out = sample_schedule_n(&p, 2, &params, None).unwrap();
     assert_eq!(validate(&p, &out.schedule), Ok(()));
     assert!(out.bound_is_optimum);
@@ -65,27 +69,8 @@ fn a_zoo_deburring_task_gets_each_switch_the_room_the_check_asks() {
 /// scheduler's: a candidate that builds it then wins.
 #[test]
 fn the_alternating_order_of_a_zoo_dispensing_task_fails_the_check_at_every_tried_timing() {
-    #[derive(serde::Deserialize)]
-    struct Data {
-        problem: Problem,
-        tick_s: f64,
-        seed: u64,
-    }
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/zoo_dispensing_select5_round30.json"
-    ))
-    .unwrap();
-    let Data {
-        problem: p,
-        tick_s,
-        seed,
-    } = serde_json::from_str(&text).unwrap();
-    let params = SamplerParams {
-        seed,
-        tick_s: Some(tick_s),
-        ..SamplerParams::default()
-    };
+    let (p, params) = dumped("zoo_dispensing_select5_round30.json");
+    let tick_s = params.tick_s.expect("the dump names its tick");
     let out = sample_schedule_n(&p, 2, &params, None).unwrap();
     assert_eq!(validate(&p, &out.schedule), Ok(()));
     assert!(out.bound_is_optimum);
